@@ -1,0 +1,228 @@
+/*
+ * polarlux — exact night lighting of 2.5D cities on small machines.
+ *
+ * This header is the whole public API. Conventions:
+ *  - Every call takes the engine first; there is no global state.
+ *  - The caller gives the engine one block of memory at creation. Nothing is
+ *    allocated after that: running out of the block returns PLX_E_NOMEM and
+ *    names the part that asked; the engine stays usable.
+ *  - Functions returning plx_status return PLX_OK (0) on success. On failure
+ *    plx_last_error() holds one line saying what failed, where and why.
+ *  - Out parameters are marked OUT. Pointers returned by the engine stay
+ *    valid until the next call that loads a scene or destroys the engine.
+ */
+#ifndef POLARLUX_H
+#define POLARLUX_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+#define PLX_VERSION_MAJOR 0
+#define PLX_VERSION_MINOR 1
+#define PLX_VERSION_PATCH 0
+#define PLX_VERSION_STRING "0.1.0"
+
+/* One error enum for the whole library. */
+typedef enum plx_status {
+    PLX_OK = 0,
+    PLX_E_INVALID,   /* bad argument or misuse of the API */
+    PLX_E_NOMEM,     /* the engine's memory block (or a part's budget) is exhausted */
+    PLX_E_IO,        /* a file could not be read or written */
+    PLX_E_PARSE,     /* malformed JSON (message gives byte offset, line, column) */
+    PLX_E_SCENE,     /* the scene is not a valid polarlux GeoJSON profile */
+    PLX_E_NOSCENE,   /* the call needs a loaded scene */
+    PLX_E_RANGE,     /* a query point is outside Bounds, inside a building, ... */
+    PLX_E_UNSUPPORTED, /* the port or build lacks the service asked for */
+    PLX_STATUS_COUNT
+} plx_status;
+
+/* A short fixed description of a status code ("out of memory", ...). */
+const char *plx_strerror(plx_status s);
+
+/* Parts of the engine's memory, for budgets and reports. */
+typedef enum plx_part {
+    PLX_PART_ENGINE = 0, /* the engine object itself */
+    PLX_PART_SCENE,      /* buildings, rings, lamps, blocks */
+    PLX_PART_POLAR,      /* polar diagrams */
+    PLX_PART_LIT,        /* lamp lit regions */
+    PLX_PART_PHOTON,     /* photon buffers */
+    PLX_PART_FRAME,      /* frame buffers and render scratch */
+    PLX_PART_SCRATCH,    /* temporary memory during a call (JSON parse tree, ...) */
+    PLX_PART_COUNT
+} plx_part;
+
+const char *plx_part_name(plx_part p);
+
+/* Log levels passed to plx_port.log. */
+typedef enum plx_log_level { PLX_LOG_ERROR = 0, PLX_LOG_WARN, PLX_LOG_INFO } plx_log_level;
+
+/*
+ * The platform services the core may ask for. Every member may be NULL:
+ * the engine then has no clock (times read 0), is silent, or cannot read
+ * files (plx_load_file returns PLX_E_UNSUPPORTED). plx_port_posix() gives
+ * the POSIX implementation.
+ */
+typedef struct plx_port {
+    void *ctx;
+    /* Monotonic time in nanoseconds. */
+    uint64_t (*clock_ns)(void *ctx);
+    /* One message line, without a trailing newline. */
+    void (*log)(void *ctx, plx_log_level level, const char *msg);
+    /* Size of a file in bytes; 0 on success, else -1 with a reason in err. */
+    int (*file_size)(void *ctx, const char *path, size_t *size, char *err, size_t errlen);
+    /* Read exactly 'size' bytes of the file into buf; 0 on success. */
+    int (*file_read)(void *ctx, const char *path, void *buf, size_t size, char *err, size_t errlen);
+    /* A process-wide lock held around JSON parsing (cJSON's allocation hooks
+     * are process-wide). Needed only when engines load in several threads. */
+    void (*lock)(void *ctx);
+    void (*unlock)(void *ctx);
+} plx_port;
+
+typedef struct plx_config {
+    const plx_port *port;             /* NULL: no platform services */
+    int strict;                       /* 1: the first bad feature fails the load */
+    size_t part_budget[PLX_PART_COUNT]; /* per-part byte limits, 0 = only the block limits */
+} plx_config;
+
+/* Fills cfg with the defaults: no port, lenient loading, no part limits. */
+void plx_config_default(plx_config *cfg);
+
+typedef struct plx_engine plx_engine;
+
+/* Minimum size of the block given to plx_engine_create. */
+#define PLX_ENGINE_MIN_BYTES 4096
+/* The block is used from its first 16-byte aligned address. */
+#define PLX_ENGINE_ALIGN 16
+
+/*
+ * Creates an engine inside the caller's block 'mem' of 'size' bytes. The
+ * engine object itself lives in the block; the caller keeps ownership and
+ * frees it after plx_engine_destroy. Fails with PLX_E_INVALID when mem is
+ * NULL or size < PLX_ENGINE_MIN_BYTES.
+ */
+plx_status plx_engine_create(void *mem, size_t size, const plx_config *cfg,
+                             plx_engine **engine /* OUT */);
+/* Ends the engine; the block may then be reused or freed by the caller. */
+void plx_engine_destroy(plx_engine *e);
+/* The block the engine was created in (the 'mem' given to plx_engine_create). */
+void *plx_engine_block(const plx_engine *e);
+
+/* The last error message of this engine ("" after a success). Never NULL. */
+const char *plx_last_error(const plx_engine *e);
+
+/* Number of warnings (skipped features, ignored properties) of the last load. */
+uint32_t plx_warning_count(const plx_engine *e);
+
+/*
+ * Loads a scene from GeoJSON text (not necessarily NUL-terminated). 'name'
+ * (may be NULL) prefixes messages. The previous scene and everything derived
+ * from it are dropped first. On failure no scene is loaded and all memory the
+ * load took is given back.
+ */
+plx_status plx_load_geojson(plx_engine *e, const char *text, size_t len, const char *name);
+/* The same from a file, read through the engine's port. */
+plx_status plx_load_file(plx_engine *e, const char *path);
+
+typedef struct plx_scene_info {
+    uint32_t buildings;       /* loaded buildings (raised ones included) */
+    uint32_t raised;          /* buildings with min_height > 0 */
+    uint32_t blocks;          /* connected groups of touching buildings */
+    uint32_t courtyards;      /* courtyard rings of all blocks */
+    uint32_t holes;           /* inner rings of the buildings themselves */
+    uint32_t lamps;           /* loaded lamps */
+    uint32_t vertices;        /* footprint vertices after cleaning */
+    uint32_t skipped_features;/* bad features left out */
+    uint32_t skipped_lamps;   /* lamps left out (inside a building, ...) */
+    uint32_t overlapping_pairs; /* pairs of footprints whose interiors overlap */
+    int lonlat;               /* 1 when coordinates were WGS84 and projected */
+    double lon0, lat0;        /* projection centre when lonlat */
+    double bounds[4];         /* minx, miny, maxx, maxy (building box + 50 m) */
+    double height_min, height_median, height_max;
+    double ground_albedo;
+    uint64_t load_ns;         /* time the load took, by the port's clock */
+} plx_scene_info;
+
+plx_status plx_scene_info_get(plx_engine *e, plx_scene_info *out /* OUT */);
+
+typedef struct plx_building {
+    uint32_t nrings;           /* 1 outer ring + holes; see plx_building_ring */
+    double height, min_height, albedo;
+    double box[4];             /* minx, miny, maxx, maxy of the footprint */
+    uint32_t feature;          /* index of the feature in the collection */
+    uint32_t block;            /* index of its block */
+    const char *id;            /* properties.id / @id / osm_id / feature id, or NULL */
+} plx_building;
+
+typedef struct plx_lamp {
+    double x, y, z, intensity, radius;
+    float color[3];
+    uint32_t feature;
+    const char *id;
+} plx_lamp;
+
+typedef struct plx_block {
+    uint32_t nbuildings;
+    const uint32_t *buildings; /* building indices */
+    uint32_t nrings;           /* outer boundary + courtyards; see plx_block_ring */
+    double box[4];
+} plx_block;
+
+plx_status plx_building_get(plx_engine *e, uint32_t i, plx_building *out /* OUT */);
+plx_status plx_lamp_get(plx_engine *e, uint32_t i, plx_lamp *out /* OUT */);
+plx_status plx_block_get(plx_engine *e, uint32_t i, plx_block *out /* OUT */);
+/* Ring r of building i: n vertices as x,y pairs in local metres, no closing
+ * vertex; ring 0 is the outer ring (counter-clockwise), the rest holes
+ * (clockwise). */
+plx_status plx_building_ring(plx_engine *e, uint32_t i, uint32_t r,
+                             const double **xy /* OUT */, uint32_t *n /* OUT */);
+/* Ring r of block i: ring 0 the outer boundary of the union of its
+ * footprints (counter-clockwise), the rest its courtyards (clockwise). */
+plx_status plx_block_ring(plx_engine *e, uint32_t i, uint32_t r,
+                          const double **xy /* OUT */, uint32_t *n /* OUT */);
+
+typedef struct plx_memory_report {
+    size_t capacity;                 /* usable bytes of the block */
+    size_t used[PLX_PART_COUNT];     /* bytes held now, by part */
+    size_t peak[PLX_PART_COUNT];     /* high-water mark, by part */
+    size_t used_total, peak_total;   /* all parts together */
+} plx_memory_report;
+
+void plx_memory_get(const plx_engine *e, plx_memory_report *out /* OUT */);
+
+/*
+ * Fault injection for tests: the k-th memory request from now on (k >= 1)
+ * fails as if the block were exhausted; k = 0 switches it off. Returns the
+ * number of memory requests served since the last call.
+ */
+uint64_t plx_debug_fail_alloc(plx_engine *e, uint64_t k);
+
+/* ---- Procedural cities (plx gen) ------------------------------------- */
+
+/* Receives generated text; returns 0 to go on, non-zero to stop. */
+typedef int (*plx_write_fn)(void *ctx, const char *data, size_t len);
+
+/*
+ * Writes a procedural city as a GeoJSON FeatureCollection in metres.
+ * style: "grid", "eixample" or "oldtown"; nx, ny: blocks along x and y.
+ * Deterministic for a seed. Needs no engine and allocates nothing.
+ */
+plx_status plx_gen_city(const char *style, int nx, int ny, uint64_t seed,
+                        plx_write_fn write, void *ctx);
+
+/* ---- POSIX port (port/posix) ----------------------------------------- */
+
+/* The POSIX services: clock_gettime, stderr logging, stdio files. */
+const plx_port *plx_port_posix(void);
+/* Creates an engine in a block of 'budget' bytes taken from the C heap. */
+plx_status plx_engine_new(size_t budget, const plx_config *cfg, plx_engine **engine /* OUT */);
+/* Destroys an engine made by plx_engine_new and frees its block. */
+void plx_engine_free(plx_engine *e);
+
+#ifdef __cplusplus
+}
+#endif
+#endif

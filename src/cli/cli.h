@@ -1,0 +1,42 @@
+/* The polarlux command: shared helpers of the subcommands. */
+#ifndef PLX_CLI_H
+#define PLX_CLI_H
+
+#include <stdio.h>
+#include "polarlux.h"
+
+/* Exit codes (README, "Exit codes"). */
+enum {
+    EXIT_OK = 0,
+    EXIT_FAIL = 1,   /* the work failed: bad scene, I/O, query out of range */
+    EXIT_USAGE = 2,  /* unknown option, missing or malformed argument */
+    EXIT_NOMEM = 3   /* the memory budget (--mem) is too small */
+};
+
+typedef struct cli_common {
+    size_t mem;      /* engine budget in bytes (--mem) */
+    int strict;      /* --strict */
+    int quiet;       /* --quiet: no warnings on stderr */
+} cli_common;
+
+#define CLI_DEFAULT_MEM ((size_t)1 << 30)
+
+/* Prints "polarlux CMD: msg" on stderr and returns EXIT_USAGE. */
+int cli_usage_error(const char *cmd, const char *fmt, ...);
+/* Parses sizes like 512M, 2G, 65536; 0 on failure. */
+size_t cli_parse_size(const char *s);
+/* Parses a decimal number / integer strictly; 0 on success. */
+int cli_parse_double(const char *s, double *out);
+int cli_parse_int(const char *s, long lo, long hi, long *out);
+/* Handles --mem, --strict, --quiet at argv[*i]; 1 if consumed, -1 on error. */
+int cli_common_option(const char *cmd, int argc, char **argv, int *i, cli_common *c);
+/* Creates an engine and loads the scene; prints the error and returns an
+ * exit code on failure (engine freed), EXIT_OK on success. */
+int cli_open_scene(const char *cmd, const char *path, const cli_common *c, plx_engine **e);
+/* Maps a status to an exit code. */
+int cli_exit_code(plx_status s);
+
+int cmd_info(int argc, char **argv);
+int cmd_gen(int argc, char **argv);
+
+#endif

@@ -1,0 +1,79 @@
+/* polarlux info SCENE: counts, bounds, heights, skipped features, load time
+ * and memory per part. */
+#include <string.h>
+#include "cli.h"
+
+static const char help[] =
+    "usage: polarlux info SCENE [--mem SIZE] [--strict] [--quiet]\n"
+    "\n"
+    "Loads SCENE (GeoJSON, see README 'Scene format') and prints counts of\n"
+    "buildings, blocks, courtyards, lamps and vertices, the bounds, building\n"
+    "heights (min/median/max), skipped features, the load time and the memory\n"
+    "used per part with the high-water mark.\n"
+    "\n"
+    "  --mem SIZE   memory budget of the engine (default 1G; e.g. 256M)\n"
+    "  --strict     the first bad feature is an error (default: skip and report)\n"
+    "  --quiet      do not print warnings about skipped features\n";
+
+static void print_memory(const plx_engine *e)
+{
+    plx_memory_report m;
+    int p;
+    plx_memory_get(e, &m);
+    printf("memory: %zu bytes in use, peak %zu, of a %zu-byte block\n", m.used_total,
+           m.peak_total, m.capacity);
+    for (p = 0; p < PLX_PART_COUNT; p++)
+        printf("  %-8s %12zu bytes  (peak %zu)\n", plx_part_name((plx_part)p), m.used[p], m.peak[p]);
+}
+
+int cmd_info(int argc, char **argv)
+{
+    cli_common c;
+    const char *path = NULL;
+    plx_engine *e;
+    plx_scene_info si;
+    int i, rc;
+    memset(&c, 0, sizeof c);
+    for (i = 1; i < argc; i++) {
+        int r = cli_common_option("info", argc, argv, &i, &c);
+        if (r < 0)
+            return EXIT_USAGE;
+        if (r)
+            continue;
+        if (strcmp(argv[i], "--help") == 0 || strcmp(argv[i], "-h") == 0) {
+            fputs(help, stdout);
+            return EXIT_OK;
+        }
+        if (argv[i][0] == '-' && argv[i][1] != '\0')
+            return cli_usage_error("info", "unknown option '%s'", argv[i]);
+        if (path)
+            return cli_usage_error("info", "one scene at a time ('%s' and '%s')", path, argv[i]);
+        path = argv[i];
+    }
+    if (!path)
+        return cli_usage_error("info", "missing SCENE");
+    rc = cli_open_scene("info", path, &c, &e);
+    if (rc != EXIT_OK)
+        return rc;
+    plx_scene_info_get(e, &si);
+    printf("scene: %s\n", path);
+    printf("buildings: %u (%u raised above the ground, %u with inner rings)\n", si.buildings,
+           si.raised, si.holes);
+    printf("blocks: %u with %u courtyards\n", si.blocks, si.courtyards);
+    printf("lamps: %u\n", si.lamps);
+    printf("vertices: %u\n", si.vertices);
+    printf("skipped: %u features, %u lamps inside buildings\n", si.skipped_features, si.skipped_lamps);
+    printf("overlapping pairs: %u\n", si.overlapping_pairs);
+    if (si.lonlat)
+        printf("coordinates: WGS84 lon/lat, projected about lon0 %.7f lat0 %.7f\n", si.lon0, si.lat0);
+    else
+        printf("coordinates: local metres\n");
+    printf("bounds: %.3f %.3f %.3f %.3f (%.1f x %.1f m)\n", si.bounds[0], si.bounds[1],
+           si.bounds[2], si.bounds[3], si.bounds[2] - si.bounds[0], si.bounds[3] - si.bounds[1]);
+    printf("heights: min %.2f median %.2f max %.2f m\n", si.height_min, si.height_median, si.height_max);
+    printf("ground albedo: %.3f\n", si.ground_albedo);
+    printf("load time: %.2f ms\n", si.load_ns / 1e6);
+    print_memory(e);
+    plx_engine_free(e);
+    return EXIT_OK;
+}

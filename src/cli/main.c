@@ -1,0 +1,49 @@
+/* polarlux: the command-line program. */
+#include <string.h>
+#include "cli.h"
+
+typedef struct command {
+    const char *name;
+    int (*run)(int argc, char **argv);
+    const char *summary;
+} command;
+
+static const command commands[] = {
+    { "info", cmd_info, "load a scene and print what it holds, its timing and memory" },
+    { "gen", cmd_gen, "write a procedural city (grid, eixample, oldtown) as GeoJSON" },
+};
+
+static void usage(FILE *f)
+{
+    size_t i;
+    fprintf(f, "usage: polarlux COMMAND [options]\n\n"
+               "Exact night lighting of 2.5D cities (version " PLX_VERSION_STRING ").\n\n"
+               "commands:\n");
+    for (i = 0; i < sizeof commands / sizeof commands[0]; i++)
+        fprintf(f, "  %-10s %s\n", commands[i].name, commands[i].summary);
+    fprintf(f, "\n'polarlux COMMAND --help' describes a command.\n"
+               "exit codes: 0 success, 1 the work failed (bad scene, I/O, query out of range),\n"
+               "            2 usage error, 3 memory budget too small (--mem)\n");
+}
+
+int main(int argc, char **argv)
+{
+    size_t i;
+    if (argc < 2) {
+        usage(stderr);
+        return EXIT_USAGE;
+    }
+    if (strcmp(argv[1], "--help") == 0 || strcmp(argv[1], "-h") == 0 || strcmp(argv[1], "help") == 0) {
+        usage(stdout);
+        return EXIT_OK;
+    }
+    if (strcmp(argv[1], "--version") == 0) {
+        printf("polarlux %s\n", PLX_VERSION_STRING);
+        return EXIT_OK;
+    }
+    for (i = 0; i < sizeof commands / sizeof commands[0]; i++)
+        if (strcmp(argv[1], commands[i].name) == 0)
+            return commands[i].run(argc - 1, argv + 1);
+    fprintf(stderr, "polarlux: unknown command '%s' (see 'polarlux --help')\n", argv[1]);
+    return EXIT_USAGE;
+}

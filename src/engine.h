@@ -1,0 +1,36 @@
+/* engine: the object every public call hangs off. Internal layout. */
+#ifndef PLX_ENGINE_H
+#define PLX_ENGINE_H
+
+#include "polarlux.h"
+#include "arena.h"
+#include "scene.h"
+#include "strbuf.h"
+
+#define ENGINE_ERR_BYTES 512
+
+struct plx_engine {
+    uint32_t magic;
+    void *block;            /* the caller's block, as given */
+    arena mem;
+    plx_config cfg;
+    plx_port port;          /* copy of the caller's port, or all NULL */
+    arena_mark base;        /* the arena just after the engine object */
+    char err[ENGINE_ERR_BYTES];
+    uint32_t warnings;
+    scene *sc;              /* NULL until a scene is loaded */
+};
+
+#define ENGINE_MAGIC 0x504c5831u /* "PLX1" */
+
+/* Sets the last error to 'msg' (the text of 'b' when b is given) and returns s. */
+plx_status eng_fail(plx_engine *e, plx_status s, const char *msg);
+/* The standard out-of-memory error, naming the part that asked. */
+plx_status eng_nomem(plx_engine *e, const char *during);
+void eng_clear_error(plx_engine *e);
+void eng_log(plx_engine *e, plx_log_level level, const char *msg);
+uint64_t eng_clock(plx_engine *e);
+/* Checks the engine handle for API misuse. */
+int eng_ok(const plx_engine *e);
+
+#endif
