@@ -1,0 +1,402 @@
+/* image_write: PNG and PFM files through a temporary file and rename.
+ * See image_write.h for the contracts. */
+#include <errno.h>
+#include <fcntl.h>
+#include <limits.h>
+#include <stdarg.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+#include <png.h>
+
+#include "image_write.h"
+
+/* Largest width or height accepted (libpng's default user limit). */
+#define IMAGE_MAX_DIM 1000000
+
+static void set_err(char *err, size_t errlen, const char *fmt, ...)
+{
+    va_list ap;
+    if (err == NULL || errlen == 0)
+        return;
+    va_start(ap, fmt);
+    vsnprintf(err, errlen, fmt, ap);
+    va_end(ap);
+}
+
+/* ---- temporary file, then rename ---------------------------------------- */
+
+/* Creates "<path>.tmp.<pid>.<n>" exclusively; returns it open for writing
+ * with its malloc'd name in *tmp, or NULL with a message. */
+static FILE *temp_open(const char *op, const char *path, char **tmp, char *err, size_t errlen)
+{
+    size_t n = strlen(path) + 48;
+    char *t = malloc(n);
+    int fd = -1, k, e;
+    FILE *f;
+
+    *tmp = NULL;
+    if (t == NULL) {
+        set_err(err, errlen, "%s: '%s': out of memory for the temporary file name", op, path);
+        return NULL;
+    }
+    for (k = 0; k < 100; k++) {
+        snprintf(t, n, "%s.tmp.%ld.%d", path, (long)getpid(), k);
+        fd = open(t, O_WRONLY | O_CREAT | O_EXCL, 0666);
+        if (fd >= 0 || errno != EEXIST)
+            break;
+    }
+    if (fd < 0) {
+        set_err(err, errlen, "%s: cannot create a temporary file for '%s' ('%s'): %s",
+                op, path, t, strerror(errno));
+        free(t);
+        return NULL;
+    }
+    f = fdopen(fd, "wb");
+    if (f == NULL) {
+        e = errno;
+        close(fd);
+        unlink(t);
+        set_err(err, errlen, "%s: cannot open '%s' as a stream: %s", op, t, strerror(e));
+        free(t);
+        return NULL;
+    }
+    *tmp = t;
+    return f;
+}
+
+/* Gives up: closes and removes the temporary file. */
+static void temp_abort(FILE *f, char *tmp)
+{
+    fclose(f);
+    unlink(tmp);
+    free(tmp);
+}
+
+/* Flushes, syncs and closes f, then renames tmp to path. Always releases
+ * f and tmp; on failure removes tmp and returns -1 with a message. */
+static int temp_commit(const char *op, FILE *f, char *tmp, const char *path,
+                       char *err, size_t errlen)
+{
+    int e;
+
+    errno = 0;
+    if (fflush(f) != 0) {
+        e = errno;
+        temp_abort(f, tmp);
+        set_err(err, errlen, "%s: cannot write '%s': %s", op, path, strerror(e));
+        return -1;
+    }
+    /* EINVAL: this kind of file cannot be synced; nothing more to do. */
+    if (fsync(fileno(f)) != 0 && errno != EINVAL) {
+        e = errno;
+        temp_abort(f, tmp);
+        set_err(err, errlen, "%s: cannot write '%s' to disk: %s", op, path, strerror(e));
+        return -1;
+    }
+    if (fclose(f) != 0) {
+        e = errno;
+        unlink(tmp);
+        free(tmp);
+        set_err(err, errlen, "%s: cannot close '%s': %s", op, path, strerror(e));
+        return -1;
+    }
+    if (rename(tmp, path) != 0) {
+        e = errno;
+        unlink(tmp);
+        set_err(err, errlen, "%s: cannot rename '%s' to '%s': %s", op, tmp, path, strerror(e));
+        free(tmp);
+        return -1;
+    }
+    free(tmp);
+    return 0;
+}
+
+static int check_size(const char *op, const char *path, int width, int height,
+                      const void *pixels, char *err, size_t errlen)
+{
+    if (path == NULL || pixels == NULL) {
+        set_err(err, errlen, "%s: %s is NULL", op, path == NULL ? "path" : "pixel buffer");
+        return -1;
+    }
+    if (width < 1 || width > IMAGE_MAX_DIM || height < 1 || height > IMAGE_MAX_DIM) {
+        set_err(err, errlen, "%s: '%s': size %dx%d outside 1..%d", op, path, width, height,
+                IMAGE_MAX_DIM);
+        return -1;
+    }
+    return 0;
+}
+
+/* ---- libpng glue ---------------------------------------------------------- */
+
+/* What went wrong inside libpng: the system error of our own I/O callbacks
+ * if there was one, else libpng's message. */
+typedef struct png_io {
+    FILE *f;
+    int sys_errno;
+    char msg[160];
+} png_io;
+
+static void png_io_error(png_structp png, png_const_charp msg)
+{
+    png_io *io = png_get_error_ptr(png);
+    snprintf(io->msg, sizeof io->msg, "%s", msg);
+    png_longjmp(png, 1);
+}
+
+static void png_io_warning(png_structp png, png_const_charp msg)
+{
+    (void)png;
+    (void)msg;      /* warnings are not errors; the library stays silent */
+}
+
+static void png_io_write(png_structp png, png_bytep data, size_t len)
+{
+    png_io *io = png_get_io_ptr(png);
+    errno = 0;
+    if (fwrite(data, 1, len, io->f) != len) {
+        io->sys_errno = errno != 0 ? errno : EIO;
+        png_error(png, "write failed");
+    }
+}
+
+static void png_io_flush(png_structp png)
+{
+    png_io *io = png_get_io_ptr(png);
+    errno = 0;
+    if (fflush(io->f) != 0) {
+        io->sys_errno = errno != 0 ? errno : EIO;
+        png_error(png, "flush failed");
+    }
+}
+
+static const char *png_io_reason(const png_io *io)
+{
+    return io->sys_errno != 0 ? strerror(io->sys_errno) : io->msg;
+}
+
+/* ---- PNG writer ----------------------------------------------------------- */
+
+/* Encodes the image into io->f. Returns 0, or -1 with the reason in io. */
+static int png_encode(png_io *io, int width, int height, const uint8_t *rgb, size_t step)
+{
+    png_structp png;
+    png_infop info;
+    int y;
+
+    png = png_create_write_struct(PNG_LIBPNG_VER_STRING, io, png_io_error, png_io_warning);
+    info = png != NULL ? png_create_info_struct(png) : NULL;
+    if (info == NULL) {
+        png_destroy_write_struct(&png, NULL);
+        snprintf(io->msg, sizeof io->msg, "libpng could not set up (out of memory)");
+        return -1;
+    }
+    if (setjmp(png_jmpbuf(png))) {
+        png_destroy_write_struct(&png, &info);
+        return -1;
+    }
+    png_set_write_fn(png, io, png_io_write, png_io_flush);
+    png_set_IHDR(png, info, (png_uint_32)width, (png_uint_32)height, 8, PNG_COLOR_TYPE_RGB,
+                 PNG_INTERLACE_NONE, PNG_COMPRESSION_TYPE_DEFAULT, PNG_FILTER_TYPE_DEFAULT);
+    png_set_sRGB(png, info, PNG_sRGB_INTENT_PERCEPTUAL);
+    png_write_info(png, info);
+    for (y = 0; y < height; y++)
+        png_write_row(png, (png_const_bytep)(rgb + (size_t)y * step));
+    png_write_end(png, info);
+    png_destroy_write_struct(&png, &info);
+    return 0;
+}
+
+int image_write_png_rgb8(const char *path, int width, int height, const uint8_t *rgb,
+                         int stride, char *err, size_t errlen)
+{
+    const char *op = "write_png";
+    png_io io;
+    char *tmp;
+    FILE *f;
+
+    if (check_size(op, path, width, height, rgb, err, errlen) != 0)
+        return -1;
+    if (stride == 0)
+        stride = width * 3;     /* width <= 1e6: no overflow */
+    if (stride < width * 3) {
+        set_err(err, errlen, "%s: '%s': stride %d is shorter than a row of %d bytes",
+                op, path, stride, width * 3);
+        return -1;
+    }
+    f = temp_open(op, path, &tmp, err, errlen);
+    if (f == NULL)
+        return -1;
+    memset(&io, 0, sizeof io);
+    io.f = f;
+    if (png_encode(&io, width, height, rgb, (size_t)stride) != 0) {
+        temp_abort(f, tmp);
+        set_err(err, errlen, "%s: cannot write '%s': %s", op, path, png_io_reason(&io));
+        return -1;
+    }
+    return temp_commit(op, f, tmp, path, err, errlen);
+}
+
+/* ---- PFM writer ------------------------------------------------------------ */
+
+int image_write_pfm(const char *path, int width, int height, const float *rgb,
+                    char *err, size_t errlen)
+{
+    const char *op = "write_pfm";
+    size_t row_floats, i;
+    unsigned char *row;
+    char *tmp;
+    FILE *f;
+    int y, e;
+
+    if (check_size(op, path, width, height, rgb, err, errlen) != 0)
+        return -1;
+    row_floats = (size_t)width * 3;
+    row = malloc(row_floats * 4);
+    if (row == NULL) {
+        set_err(err, errlen, "%s: '%s': out of memory for a row of %zu bytes", op, path,
+                row_floats * 4);
+        return -1;
+    }
+    f = temp_open(op, path, &tmp, err, errlen);
+    if (f == NULL) {
+        free(row);
+        return -1;
+    }
+    errno = 0;
+    if (fprintf(f, "PF\n%d %d\n-1.0\n", width, height) < 0)
+        goto write_error;
+    /* PFM stores the bottom row first. */
+    for (y = height - 1; y >= 0; y--) {
+        const float *src = rgb + (size_t)y * row_floats;
+        for (i = 0; i < row_floats; i++) {
+            uint32_t u;
+            memcpy(&u, &src[i], 4);
+            row[4 * i + 0] = (unsigned char)(u & 0xFFu);
+            row[4 * i + 1] = (unsigned char)((u >> 8) & 0xFFu);
+            row[4 * i + 2] = (unsigned char)((u >> 16) & 0xFFu);
+            row[4 * i + 3] = (unsigned char)((u >> 24) & 0xFFu);
+        }
+        errno = 0;
+        if (fwrite(row, 4, row_floats, f) != row_floats)
+            goto write_error;
+    }
+    free(row);
+    return temp_commit(op, f, tmp, path, err, errlen);
+
+write_error:
+    e = errno != 0 ? errno : EIO;
+    free(row);
+    temp_abort(f, tmp);
+    set_err(err, errlen, "%s: cannot write '%s': %s", op, path, strerror(e));
+    return -1;
+}
+
+/* ---- PNG reader ------------------------------------------------------------ */
+
+int image_read_png_rgb8(const char *path, uint8_t *buf, size_t cap, uint8_t **out,
+                        int *width, int *height, char *err, size_t errlen)
+{
+    const char *op = "read_png";
+    png_structp png;
+    png_infop info;
+    png_io io;
+    unsigned char sig[8];
+    uint8_t *volatile pixels = NULL;
+    volatile int owned = 0;
+    png_uint_32 w, h, y;
+    int bit_depth, color_type, passes, pass;
+    size_t row_bytes, need;
+    FILE *f;
+
+    if (out != NULL)
+        *out = NULL;
+    if (path == NULL || out == NULL) {
+        set_err(err, errlen, "%s: %s is NULL", op, path == NULL ? "path" : "out");
+        return -1;
+    }
+    f = fopen(path, "rb");
+    if (f == NULL) {
+        set_err(err, errlen, "%s: cannot open '%s': %s", op, path, strerror(errno));
+        return -1;
+    }
+    if (fread(sig, 1, sizeof sig, f) != sizeof sig || png_sig_cmp(sig, 0, sizeof sig) != 0) {
+        fclose(f);
+        set_err(err, errlen, "%s: '%s' is not a PNG file (bad signature)", op, path);
+        return -1;
+    }
+
+    memset(&io, 0, sizeof io);
+    io.f = f;
+    png = png_create_read_struct(PNG_LIBPNG_VER_STRING, &io, png_io_error, png_io_warning);
+    info = png != NULL ? png_create_info_struct(png) : NULL;
+    if (info == NULL) {
+        png_destroy_read_struct(&png, NULL, NULL);
+        fclose(f);
+        set_err(err, errlen, "%s: '%s': libpng could not set up (out of memory)", op, path);
+        return -1;
+    }
+    if (setjmp(png_jmpbuf(png))) {
+        png_destroy_read_struct(&png, &info, NULL);
+        fclose(f);
+        if (owned)
+            free(pixels);
+        set_err(err, errlen, "%s: cannot decode '%s': %s", op, path, png_io_reason(&io));
+        return -1;
+    }
+    png_init_io(png, f);
+    png_set_sig_bytes(png, (int)sizeof sig);
+    png_read_info(png, info);
+    png_get_IHDR(png, info, &w, &h, &bit_depth, &color_type, NULL, NULL, NULL);
+    if (width != NULL) *width = (int)w;
+    if (height != NULL) *height = (int)h;
+
+    /* Everything to 8-bit RGB. */
+    if (color_type == PNG_COLOR_TYPE_PALETTE)
+        png_set_palette_to_rgb(png);
+    if (color_type == PNG_COLOR_TYPE_GRAY && bit_depth < 8)
+        png_set_expand_gray_1_2_4_to_8(png);
+    if (bit_depth == 16)
+        png_set_scale_16(png);
+    if (color_type == PNG_COLOR_TYPE_GRAY || color_type == PNG_COLOR_TYPE_GRAY_ALPHA)
+        png_set_gray_to_rgb(png);
+    png_set_strip_alpha(png);
+    passes = png_set_interlace_handling(png);
+    png_read_update_info(png, info);
+
+    row_bytes = png_get_rowbytes(png, info);
+    if (png_get_channels(png, info) != 3 || png_get_bit_depth(png, info) != 8 ||
+        row_bytes != (size_t)w * 3) {
+        png_error(png, "could not convert to 8-bit RGB");
+    }
+    if (w > IMAGE_MAX_DIM || h > IMAGE_MAX_DIM)
+        png_error(png, "image too large");
+    need = row_bytes * (size_t)h;           /* <= 3e12: fits a 64-bit size_t */
+    if (need / row_bytes != (size_t)h)
+        png_error(png, "image too large for memory");
+    if (buf != NULL) {
+        if (cap < need) {
+            png_destroy_read_struct(&png, &info, NULL);
+            fclose(f);
+            set_err(err, errlen, "%s: '%s': buffer of %zu bytes given, the %lux%lu image needs %zu",
+                    op, path, cap, (unsigned long)w, (unsigned long)h, need);
+            return -1;
+        }
+        pixels = buf;
+    } else {
+        pixels = malloc(need);
+        if (pixels == NULL)
+            png_error(png, "out of memory for the pixels");
+        owned = 1;
+    }
+    for (pass = 0; pass < passes; pass++)
+        for (y = 0; y < h; y++)
+            png_read_row(png, (png_bytep)(pixels + (size_t)y * row_bytes), NULL);
+    png_read_end(png, NULL);
+    png_destroy_read_struct(&png, &info, NULL);
+    fclose(f);
+    *out = pixels;
+    return 0;
+}

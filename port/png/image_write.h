@@ -1,0 +1,67 @@
+/* image_write: PNG (libpng) and PFM files, written safely.
+ *
+ * Port code: uses stdio, POSIX and libpng. Images are rows of pixels, row 0
+ * at the top (SPEC.md §5), 3 channels R G B.
+ *
+ * Every writer writes a temporary file beside the output
+ * ("<path>.tmp.<pid>.<n>", created exclusively with mode 0666 & ~umask),
+ * flushes it to disk (fsync), closes it, and only then renames it over
+ * <path>. A crash, a full disk or any error therefore never leaves a partial
+ * output: <path> is either the complete new image or whatever was there
+ * before. On failure the temporary file is removed.
+ *
+ * All functions return 0 on success, -1 on failure. On failure, when err is
+ * not NULL and errlen > 0, err receives one line (NUL-terminated, truncated
+ * to errlen) naming the operation, the file and the reason, e.g.
+ *   "write_png: cannot create a temporary file for '/no/dir/a.png'
+ *    ('/no/dir/a.png.tmp.42.0'): No such file or directory"
+ * They never print and keep no state between calls.
+ */
+#ifndef PLX_IMAGE_WRITE_H
+#define PLX_IMAGE_WRITE_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+/*
+ * Writes an 8-bit RGB PNG (no interlace, tagged sRGB: the bytes are taken
+ * to be sRGB-encoded). rgb holds height rows of width*3 bytes, each row
+ * starting stride bytes after the previous one (stride 0 means width*3;
+ * otherwise it must be >= width*3). width and height must be 1..1000000.
+ */
+int image_write_png_rgb8(const char *path, int width, int height, const uint8_t *rgb,
+                         int stride, char *err, size_t errlen);
+
+/*
+ * Writes a colour PFM: header "PF\n<width> <height>\n-1.0\n" (negative
+ * scale = little-endian), then width*height*3 IEEE floats in little-endian
+ * byte order on every host, rows from the bottom of the image to the top as
+ * PFM requires. rgb holds height packed rows of width*3 floats, top row
+ * first; values are written unchanged (linear radiance). width and height
+ * must be 1..1000000.
+ */
+int image_write_pfm(const char *path, int width, int height, const float *rgb,
+                    char *err, size_t errlen);
+
+/*
+ * Reads any PNG libpng can decode (grey, grey+alpha, palette, RGB, RGBA;
+ * 1 to 16 bits; interlaced or not) as packed 8-bit RGB, top row first:
+ * palettes are expanded, grey is replicated to R G B, 16-bit samples are
+ * scaled to 8 bits, alpha is dropped (not composited), no gamma correction
+ * is applied.
+ *
+ * Buffer ownership:
+ *  - buf != NULL: the caller's buffer of cap bytes receives the pixels if
+ *    cap >= width*height*3; then *out = buf. If it is too small the call
+ *    fails, but *width and *height are still set, so the caller can size a
+ *    buffer and call again.
+ *  - buf == NULL: the pixels go to a new buffer from malloc(), returned in
+ *    *out; the caller releases it with free().
+ * On failure *out is NULL, nothing stays allocated, and the contents of a
+ * caller's buf are unspecified. width and height (OUT, may be NULL) are set
+ * as soon as the header has been read.
+ */
+int image_read_png_rgb8(const char *path, uint8_t *buf, size_t cap, uint8_t **out,
+                        int *width, int *height, char *err, size_t errlen);
+
+#endif
