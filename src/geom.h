@@ -24,10 +24,10 @@ int geom_orient(vec2 a, vec2 b, vec2 c);
  * Needs finite coordinates. */
 int geom_orient_ref(vec2 a, vec2 b, vec2 c);
 
-/* Twice the signed area of a ring of n vertices (no closing vertex).
- * Positive for counter-clockwise rings; 0 when n < 3. Plain double
- * arithmetic (shoelace about the first vertex), not exact. */
+/* Twice the signed area of a ring of n vertices (no closing vertex). */
 double geom_ring_area2(const vec2 *p, uint32_t n);
+/* Details: positive for counter-clockwise rings, 0 when n < 3. Plain double
+ * arithmetic (shoelace about the first vertex), not exact. */
 
 /* How two closed segments ab and cd meet, decided exactly. */
 enum {
@@ -68,9 +68,10 @@ int geom_ring_is_simple(arena *a, const vec2 *p, uint32_t n, uint32_t *ei, uint3
  *   two vertices at one point      -> 0, the edges starting at them.
  * A triangle with three distinct, non-collinear vertices is simple. */
 
-/* Squared distance between closed segments ab and cd: exactly 0 when
- * geom_seg_meet says they meet, otherwise the smallest endpoint-to-segment
- * distance in plain double arithmetic. */
+/* Squared distance between closed segments ab and cd. */
 double geom_seg_dist2(vec2 a, vec2 b, vec2 c, vec2 d);
+/* Details: exactly 0 when geom_seg_meet says they meet; otherwise the
+ * smallest endpoint-to-segment distance in plain double arithmetic (it may
+ * underflow to 0 for segments closer than about 1e-154). */
 
 #endif
