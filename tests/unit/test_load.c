@@ -499,7 +499,12 @@ static void test_helsinki(void **state)
     assert_true(si.buildings >= 440);
     assert_int_equal(si.skipped_lamps, 2);
     assert_int_equal(si.lamps, 584);
-    assert_true(si.overlapping_pairs >= 11);
+    /* The data README counts 11 pairs overlapping by more than a few cm; 4 of
+     * them involve the skipped church towers. An independent check (sampling
+     * every pair's box intersection on a 10 cm grid, outside this suite)
+     * found 7 pairs overlapping by 2.2 m^2 or more among the loaded
+     * buildings, and the next largest only 0.43 m^2 (a sliver of a few cm). */
+    assert_int_equal(si.overlapping_pairs, 7);
     assert_non_null(strstr(f->book.all, "(way/234871779, line "));
     assert_non_null(strstr(f->book.all, "min_height 18 m is not below height 12 m (the default)"));
     close_engine(f);
