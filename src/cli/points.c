@@ -1,0 +1,156 @@
+#include <errno.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "points.h"
+#include "port.h"
+
+static int sep(char c)
+{
+    return c == ' ' || c == '\t' || c == ',' || c == '\r';
+}
+
+static int grow(points *p, size_t *cap)
+{
+    size_t ncap = *cap ? *cap * 2 : 256;
+    double *v = realloc(p->v, ncap * (size_t)p->cols * sizeof *v);
+    size_t *l;
+    if (!v)
+        return -1;
+    p->v = v;
+    l = realloc(p->line, ncap * sizeof *l);
+    if (!l)
+        return -1;
+    p->line = l;
+    *cap = ncap;
+    return 0;
+}
+
+/* Parses one line [s, end) into row; returns the count of numbers or -1. */
+static int parse_row(const char *s, const char *end, double *row, int cols, const char **bad)
+{
+    int k = 0;
+    while (s < end) {
+        char *stop;
+        double v;
+        while (s < end && sep(*s))
+            s++;
+        if (s >= end)
+            break;
+        errno = 0;
+        v = strtod(s, &stop);
+        if (stop == s || stop > end || (stop < end && !sep(*stop)) || !isfinite(v)) {
+            *bad = s;
+            return -1;
+        }
+        if (k < cols)
+            row[k] = v;
+        k++;
+        s = stop;
+    }
+    return k;
+}
+
+int points_parse(const char *name, const char *text, int need, int cols, const double *fill,
+                 points *out, char *err, size_t errlen)
+{
+    size_t cap = 0, lineno = 0;
+    const char *s = text;
+    memset(out, 0, sizeof *out);
+    out->cols = cols;
+    while (*s) {
+        const char *end = strchr(s, '\n'), *t, *bad = NULL;
+        double *row;
+        int k, j;
+        if (!end)
+            end = s + strlen(s);
+        lineno++;
+        for (t = s; t < end && sep(*t); t++)
+            ;
+        if (t == end || *t == '#') {
+            s = *end ? end + 1 : end;
+            continue;
+        }
+        if (out->n == cap && grow(out, &cap) != 0) {
+            snprintf(err, errlen, "%s: out of memory", name);
+            points_free(out);
+            return -1;
+        }
+        row = out->v + out->n * (size_t)cols;
+        k = parse_row(t, end, row, cols, &bad);
+        if (k < 0 || k < need || (k < cols && !fill)) {
+            int len = 0;
+            if (bad)
+                while (bad + len < end && !sep(bad[len]) && len < 30)
+                    len++;
+            if (k < 0)
+                snprintf(err, errlen, "%s:%zu: '%.*s' is not a finite number", name, lineno, len, bad);
+            else
+                snprintf(err, errlen, "%s:%zu: expected %d numbers, found %d", name, lineno,
+                         fill ? need : cols, k);
+            points_free(out);
+            return -1;
+        }
+        for (j = k; j < cols; j++)
+            row[j] = fill[j];
+        out->line[out->n++] = lineno;
+        s = *end ? end + 1 : end;
+    }
+    return 0;
+}
+
+static char *read_stdin(char *err, size_t errlen)
+{
+    size_t len = 0, cap = 1 << 16, got;
+    char *buf = malloc(cap);
+    while (buf && (got = fread(buf + len, 1, cap - len - 1, stdin)) > 0) {
+        len += got;
+        if (len + 1 == cap) {
+            char *nb = realloc(buf, cap * 2);
+            if (!nb) {
+                free(buf);
+                buf = NULL;
+                break;
+            }
+            buf = nb;
+            cap *= 2;
+        }
+    }
+    if (!buf) {
+        snprintf(err, errlen, "standard input: out of memory");
+        return NULL;
+    }
+    buf[len] = '\0';
+    return buf;
+}
+
+int points_read(const char *path, int need, int cols, const double *fill, points *out,
+                char *err, size_t errlen)
+{
+    char *text;
+    int rc;
+    char why[256];
+    if (strcmp(path, "-") == 0) {
+        text = read_stdin(err, errlen);
+    } else {
+        text = port_read_text(path, NULL, why, sizeof why);
+        if (!text)
+            snprintf(err, errlen, "%s: %s", path, why);
+    }
+    if (!text)
+        return -1;
+    rc = points_parse(strcmp(path, "-") == 0 ? "<stdin>" : path, text, need, cols, fill, out, err, errlen);
+    free(text);
+    return rc;
+}
+
+void points_free(points *p)
+{
+    free(p->v);
+    free(p->line);
+    p->v = NULL;
+    p->line = NULL;
+    p->n = 0;
+}

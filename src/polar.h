@@ -1,0 +1,148 @@
+/* polar: the four quadrant polar diagrams of the occluding footprints.
+ *
+ * Objects are the footprints of the buildings with min_height <= 0 (a raised
+ * building is no occluder). Solid = the union of the closed footprints minus
+ * the open courtyards; free space = the rest of the Bounds box s->bounds.
+ *
+ * Quadrant q scans directions in [q pi/2, (q+1) pi/2] counter-clockwise. The
+ * diagram of quadrant q labels every free point p with the object met first
+ * by that scan (ties: the nearest along the ray). Its polar axes are the
+ * segments drawn from every footprint vertex parallel to the start direction
+ * of the scan (backwards and forwards) until they meet a wall; where the ray
+ * of direction q pi/2 leaves p and meets a wall, the owner is that wall's
+ * building and is constant between two axes. The axes and the walls cut the
+ * Bounds box into trapezoids ("regions"), each with at most two neighbours
+ * across each of its two axis sides; a region whose start ray reaches the
+ * Bounds box without meeting a wall has no fixed owner (owner -1), the
+ * object met first there is found by vis_first() (visibility.h).
+ *
+ * Quadrants 0 and 2 (scan starting east and west) share one set of
+ * horizontal axes, quadrants 1 and 3 one set of vertical axes: two planar
+ * subdivisions, four labellings. Each subdivision is built by randomized
+ * incremental construction with a fixed seed (O(n log n) expected for n
+ * footprint edges, deterministic for a scene) and keeps its search DAG, so
+ * locating a point costs O(log n) expected. A ray walks from region to region
+ * through the stored adjacency until it leaves through a wall.
+ *
+ * Degenerate input: footprints that share walls exactly, touch at T-junctions
+ * or overlap are first cut into pieces at every contact (exact predicates;
+ * crossing points of overlapping walls are rounded to doubles, the only
+ * inexact step). Pieces lying on top of each other are merged and keep up to
+ * two owners. Every combinatorial decision afterwards uses geom_orient.
+ *
+ * Memory: everything lives in the arena, part PLX_PART_POLAR; construction
+ * temporaries come from arena_scratch and are released before return.
+ */
+#ifndef PLX_POLAR_H
+#define PLX_POLAR_H
+
+#include <stddef.h>
+#include <stdint.h>
+#include "polarlux.h"
+#include "scene.h"
+#include "arena.h"
+
+#define POLAR_NONE 0xffffffffu
+
+/* One footprint wall piece (or a side of the Bounds box, bld[0] == -2). */
+typedef struct polar_seg {
+    uint32_t a, b;       /* point indices; the building lies on the left of a->b */
+    int32_t bld[2];      /* owning buildings (bld[1] = -1 unless two coincide) */
+    int32_t cover;       /* footprints entered when crossing from right to left */
+} polar_seg;
+
+/* One of the two subdivisions. Trapezoids in its frame: frame 0 maps world
+ * (x, y) to (y, -x) (axes horizontal in the world), frame 1 is the identity
+ * (axes vertical). Within a frame points are ordered by (u, v) lexicographic
+ * order, so equal u needs no special case. Stored as parallel arrays so that
+ * memory can be reported by part. */
+typedef struct polar_map {
+    int frame;
+    uint32_t ntrap;
+    /* regions */
+    uint32_t *top, *bot;     /* bounding wall pieces (frame above / below) */
+    uint8_t *solid;          /* 1 inside a footprint, 0 free */
+    /* polar axes: the two sides of a region and the regions across them */
+    uint32_t *lp, *rp;       /* points whose axes bound the region (frame left/right) */
+    uint32_t (*nb)[4];       /* neighbours: upper-left, lower-left, upper-right, lower-right */
+    /* search structure */
+    uint32_t (*node)[3];     /* kind<<30 | index, child below/left, child above/right */
+    uint32_t nnode;
+    uint32_t root;
+    uint32_t box_top, box_bot; /* segment indices of the Bounds sides on top/bottom */
+    uint32_t box_lo, box_hi;   /* point indices of the extreme Bounds corners */
+} polar_map;
+
+typedef struct polar {
+    const scene *s;
+    vec2 *pts;               /* footprint vertices, crossing points, 4 box corners */
+    uint32_t npts;
+    polar_seg *seg;          /* wall pieces, then the 4 Bounds sides */
+    uint32_t nseg;
+    uint32_t nwall;          /* wall pieces come first: seg[0 .. nwall-1] */
+    uint32_t nbld;           /* s->nbld */
+    double box[4];           /* s->bounds */
+    polar_map map[2];        /* [0]: quadrants 0, 2   [1]: quadrants 1, 3 */
+    size_t bytes[4];         /* axes, regions, polygons, rest */
+} polar;
+
+/* Builds the four diagrams of scene s. On success *out points into arena
+ * memory (PLX_PART_POLAR) valid until that memory is released; the scene must
+ * stay unchanged meanwhile. Fails with PLX_E_NOMEM (nothing kept, scratch
+ * released) or PLX_E_INVALID (NULL argument, empty or non-finite bounds).
+ * A scene with no occluder gives diagrams of one free region each. */
+plx_status polar_build(arena *a, const scene *s, polar **out /* OUT */);
+
+/* Where p lies in the diagram of quadrant q (0..3).
+ * Returns the region index (>= 0) and stores the owner (the building met
+ * first by the scan at the start direction q pi/2, or -1 when that ray
+ * reaches Bounds) in *owner (may be NULL). Returns -1 when p is outside the
+ * open Bounds box, -2 when p is on a wall, -3 when p is inside a footprint
+ * (then *owner is that footprint's building, or -1 if unknown). */
+int32_t polar_locate(const polar *pd, int q, vec2 p, int32_t *owner /* OUT */);
+
+typedef struct polar_hit {
+    int32_t bld;         /* building hit, -1 when the ray reaches the Bounds box */
+    int32_t bld2;        /* second owner of a wall shared exactly, else -1 */
+    uint32_t seg;        /* wall piece (index into pd->seg) */
+    int32_t ring_edge;   /* unused (-1): pieces are cut from footprint edges */
+    vec2 pt;             /* first point hit (rounded) */
+    double t;            /* ray parameter of pt: pt = p + t * (q - p) */
+    uint32_t steps;      /* regions walked */
+} polar_hit;
+
+/* First wall met by the ray from the free point p through q (q != p).
+ * side = +1 / -1: the ray turned by an infinitesimal angle counter-clockwise
+ * / clockwise (the one-sided limits, used to look past a vertex on the ray);
+ * side = 0: the exact ray, blocked where it first enters the interior of the
+ * solid (grazing a corner does not block; sliding along a wall shared by two
+ * footprints does, the shared wall being interior to their union).
+ * Returns PLX_OK, PLX_E_RANGE when p is not free (outside the open Bounds
+ * box, on a wall or inside a footprint), PLX_E_INVALID when q == p. */
+plx_status polar_shoot_to(const polar *pd, vec2 p, vec2 q, int side, polar_hit *out /* OUT */);
+
+/* The same for a direction (dx, dy) != (0, 0); the ray goes through the
+ * rounded point p + L (dx, dy) for a length L beyond the Bounds box. */
+plx_status polar_shoot(const polar *pd, vec2 p, double dx, double dy, polar_hit *out /* OUT */);
+
+/* Bytes of arena memory held, like robles2014 Table 3:
+ * [0] polar axes, [1] polar regions, [2] polygons (wall pieces and points),
+ * [3] the rest (search structures, headers). Both subdivisions together. */
+void polar_memory(const polar *pd, size_t bytes[4] /* OUT */);
+
+/* For drawing. Number of regions of the diagram of quadrant q, and region i
+ * as a polygon of 3 or 4 corners (world coordinates, counter-clockwise; a
+ * degenerate region may repeat a corner): returns the number of corners
+ * written to c[0..3] and stores the owner (as polar_locate) and whether the
+ * region is solid. Returns 0 for an index out of range. */
+uint32_t polar_region_count(const polar *pd, int q);
+int polar_region(const polar *pd, int q, uint32_t i, vec2 c[4] /* OUT */,
+                 int32_t *owner /* OUT */, int *solid /* OUT */);
+
+/* Internal helpers shared with visibility.c. */
+vec2 polar_fpt(const polar *pd, int frame, uint32_t i);      /* point in a frame */
+vec2 polar_to_frame(int frame, vec2 w);
+vec2 polar_from_frame(int frame, vec2 f);
+int32_t polar_locate_frame(const polar *pd, const polar_map *m, vec2 f);
+
+#endif

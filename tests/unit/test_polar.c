@@ -1,0 +1,708 @@
+/* test_polar: polar diagrams and the fan of tangent rays against brute force.
+ *
+ * Visibility is compared with tests/ref/ref_vis (an angular sweep over every
+ * edge): areas to 1e-9 relative, visible sets identical. Point location and
+ * ray shooting are compared with plain scans over every footprint and edge.
+ */
+#include <stdarg.h>
+#include <stddef.h>
+#include <setjmp.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <math.h>
+#include <cmocka.h>
+
+#include "scene.h"
+#include "arena.h"
+#include "polar.h"
+#include "visibility.h"
+#include "ref_scene.h"
+#include "ref_vis.h"
+
+#define PI 3.14159265358979323846
+#define ARENA_BYTES ((size_t)32 << 20)
+#define POLY_CAP 20000
+#define VIS_CAP 4000
+
+/* ---------------------------------------------------------------- helpers */
+
+typedef struct fixture {
+    scene s;
+    void *mem;
+    arena a;
+    polar *pd;
+    vec2 *poly;
+    uint32_t *vis;
+} fixture;
+
+static uint32_t rnd_state;
+
+static double urand(void)
+{
+    rnd_state = rnd_state * 1103515245u + 12345u;
+    return ((rnd_state >> 8) & 0xffffff) / 16777216.0;
+}
+
+static fixture *fixture_new(void)
+{
+    fixture *f = calloc(1, sizeof *f);
+    assert_non_null(f);
+    ref_scene_init(&f->s);
+    f->mem = malloc(ARENA_BYTES);
+    f->poly = malloc(POLY_CAP * sizeof(vec2));
+    f->vis = malloc(VIS_CAP * sizeof(uint32_t));
+    assert_non_null(f->mem);
+    assert_non_null(f->poly);
+    assert_non_null(f->vis);
+    arena_init(&f->a, f->mem, ARENA_BYTES);
+    return f;
+}
+
+static void fixture_build(fixture *f)
+{
+    ref_scene_finish(&f->s);
+    assert_int_equal(polar_build(&f->a, &f->s, &f->pd), PLX_OK);
+    assert_non_null(f->pd);
+}
+
+static void fixture_free(fixture *f)
+{
+    ref_scene_free(&f->s);
+    free(f->mem);
+    free(f->poly);
+    free(f->vis);
+    free(f);
+}
+
+static int add_poly(fixture *f, const double *xy, uint32_t n)
+{
+    return ref_scene_add_building(&f->s, xy, &n, 1, 10.0, 0.0);
+}
+
+static void add_rotated_box(fixture *f, double x, double y, double w, double h, double ang)
+{
+    double c = cos(ang), s = sin(ang), xy[8];
+    double ox[4] = { 0, w, w, 0 }, oy[4] = { 0, 0, h, h };
+    int k;
+    for (k = 0; k < 4; k++) {
+        xy[2 * k] = x + c * ox[k] - s * oy[k];
+        xy[2 * k + 1] = y + s * ox[k] + c * oy[k];
+    }
+    assert_true(add_poly(f, xy, 4) >= 0);
+}
+
+static void add_l_shape(fixture *f, double x, double y, double w, double h)
+{
+    double xy[12] = { x, y, x + w, y, x + w, y + h / 2, x + w / 2, y + h / 2,
+                      x + w / 2, y + h, x, y + h };
+    assert_true(add_poly(f, xy, 6) >= 0);
+}
+
+static void add_courtyard(fixture *f, double x, double y, double w, double h, double t)
+{
+    double xy[16] = { x, y, x + w, y, x + w, y + h, x, y + h,
+                      x + t, y + t, x + t, y + h - t, x + w - t, y + h - t, x + w - t, y + t };
+    uint32_t n[2] = { 4, 4 };
+    assert_true(ref_scene_add_building(&f->s, xy, n, 2, 20.0, 0.0) >= 0);
+}
+
+/* Is p strictly inside or on some occluder footprint? 0 free, 1 in, 2 on. */
+static int where(const scene *s, vec2 p)
+{
+    uint32_t b;
+    int on = 0;
+    for (b = 0; b < s->nbld; b++) {
+        int w;
+        if (s->bld[b].min_height > 0)
+            continue;
+        w = ref_footprint_where(s, b, p.x, p.y);
+        if (w == REF_IN)
+            return 1;
+        if (w == REF_ON)
+            on = 1;
+    }
+    return on ? 2 : 0;
+}
+
+/* Compares vis_query with ref_vis at p; returns 1 when they agree. */
+static int vis_agrees(fixture *f, vec2 p, int full, double a0, double a1, int verbose)
+{
+    ref_vis_result rr;
+    vis_result vr;
+    int rc, ok;
+    uint32_t k;
+    plx_status st;
+    arena_mark before = arena_get_mark(&f->a);
+    rc = full ? ref_vis(&f->s, p.x, p.y, &rr) : ref_vis_range(&f->s, p.x, p.y, a0, a1, &rr);
+    memset(&vr, 0, sizeof vr);
+    vr.poly = f->poly;
+    vr.poly_cap = POLY_CAP;
+    vr.vis = f->vis;
+    vr.vis_cap = VIS_CAP;
+    st = vis_query(f->pd, p, a0, a1, full, &f->a, &vr);
+    /* scratch is given back */
+    ok = f->a.hi == before.hi && f->a.lo == before.lo;
+    if (rc == -3)
+        return 1;
+    if (rc != 0)
+        return ok && st == PLX_E_RANGE;
+    /* 1e-9 relative; slivers of a few 1e-7 m^2 (viewer 1e-9 m from a wall,
+     * narrow range) are held to 1e-9 m^2 absolute: there both sides are only
+     * as exact as doubles of coordinates ~10^2 m allow (test_viewer_near_wall
+     * checks one such sliver by hand) */
+    ok = ok && st == PLX_OK && fabs(vr.area - rr.area) <= 1e-9 * fmax(rr.area, 1.0) &&
+         vr.nvis == rr.nvisible;
+    for (k = 0; ok && k < vr.nvis; k++)
+        ok = vr.vis[k] == rr.visible[k];
+    if (!ok && verbose) {
+        print_message("p = (%.17g, %.17g) full %d [%g, %g]: st %d area %.15g ref %.15g, "
+                      "nvis %u ref %u\n", p.x, p.y, full, a0, a1, st, vr.area, rr.area,
+                      vr.nvis, rr.nvisible);
+    }
+    ref_vis_free(&rr);
+    return ok;
+}
+
+/* Random free points of the scene, full turn and random ranges. */
+static void random_vis(fixture *f, int npts)
+{
+    int i, n = 0, bad = 0, tries = 0;
+    const double *bx = f->s.bounds;
+    while (n < npts && tries < 50 * npts) {
+        vec2 p;
+        double a0 = urand() * 4 * PI - 2 * PI, a1 = a0 + urand() * 2.2 * PI;
+        tries++;
+        p.x = bx[0] + urand() * (bx[2] - bx[0]);
+        p.y = bx[1] + urand() * (bx[3] - bx[1]);
+        if (where(&f->s, p) != 0)
+            continue;
+        n++;
+        for (i = 0; i < 2; i++)
+            if (!vis_agrees(f, p, i == 0, a0, a1, bad < 5))
+                bad++;
+    }
+    assert_int_equal(n, npts);
+    assert_int_equal(bad, 0);
+}
+
+/* ---------------------------------------------------- brute-force helpers */
+
+/* First crossing of the ray p->q (parameter > 0) with any occluder edge,
+ * in plain doubles; *bld gets the building or -1 (none). */
+static double brute_first(const scene *s, vec2 p, vec2 q, int *bld)
+{
+    double best = 1e300;
+    uint32_t i, r, k;
+    *bld = -1;
+    for (i = 0; i < s->nbld; i++) {
+        if (s->bld[i].min_height > 0)
+            continue;
+        for (r = 0; r < s->bld[i].ring_count; r++) {
+            const scene_ring *g = &s->rings[s->bld[i].ring_first + r];
+            for (k = 0; k < g->count; k++) {
+                vec2 a = s->pts[g->first + k], b = s->pts[g->first + (k + 1) % g->count];
+                double rx = q.x - p.x, ry = q.y - p.y, sx = b.x - a.x, sy = b.y - a.y;
+                double den = rx * sy - ry * sx, t, u;
+                if (den == 0.0)
+                    continue;
+                t = ((a.x - p.x) * sy - (a.y - p.y) * sx) / den;
+                u = ((a.x - p.x) * ry - (a.y - p.y) * rx) / den;
+                if (t > 0 && u >= 0 && u <= 1 && t < best) {
+                    best = t;
+                    *bld = (int)i;
+                }
+            }
+        }
+    }
+    return best;
+}
+
+/* Checks locate and shoot at random points (random directions avoid
+ * degenerate grazing, which the hand-made tests cover). */
+static void random_locate_shoot(fixture *f, int npts)
+{
+    int n, bad = 0;
+    const double *bx = f->s.bounds;
+    static const double dirs[4][2] = { { 1, 0 }, { 0, 1 }, { -1, 0 }, { 0, -1 } };
+    for (n = 0; n < npts; n++) {
+        vec2 p, q;
+        int w, q4, bb;
+        double ang, bt;
+        polar_hit h;
+        p.x = bx[0] + urand() * (bx[2] - bx[0]);
+        p.y = bx[1] + urand() * (bx[3] - bx[1]);
+        w = where(&f->s, p);
+        for (q4 = 0; q4 < 4; q4++) {
+            int32_t own, r = polar_locate(f->pd, q4, p, &own);
+            if (w == 1 && r != -3)
+                bad++;
+            if (w == 2 && r != -2)
+                bad++;
+            if (w == 0) {
+                /* owner = first building met by the start ray of the quadrant */
+                vec2 e;
+                e.x = p.x + dirs[q4][0] * 1e4;
+                e.y = p.y + dirs[q4][1] * 1e4;
+                brute_first(&f->s, p, e, &bb);
+                if (r < 0 || own != bb)
+                    bad++;
+            }
+        }
+        if (w != 0) {
+            if (polar_shoot(f->pd, p, 1.0, 0.5, &h) != PLX_E_RANGE)
+                bad++;
+            continue;
+        }
+        ang = urand() * 2 * PI;
+        q.x = p.x + cos(ang) * 1e4;
+        q.y = p.y + sin(ang) * 1e4;
+        bt = brute_first(&f->s, p, q, &bb);
+        if (polar_shoot_to(f->pd, p, q, 0, &h) != PLX_OK) {
+            bad++;
+            continue;
+        }
+        if (bb < 0) {
+            if (h.bld != -1)
+                bad++;
+        } else if (fabs(h.t - bt) > 1e-9 * (1 + bt) || (h.bld != bb && h.bld2 != bb)) {
+            bad++;
+        }
+    }
+    assert_int_equal(bad, 0);
+}
+
+/* ------------------------------------------------------- random scenes */
+
+static void scene_boxes(fixture *f, int n, int rotated)
+{
+    int i;
+    for (i = 0; i < n; i++) {
+        double x = urand() * 150, y = urand() * 150, w = 2 + urand() * 14, h = 2 + urand() * 14;
+        if (rotated && urand() < 0.6)
+            add_rotated_box(f, x, y, w, h, urand() * PI);
+        else
+            assert_true(ref_scene_add_box(&f->s, x, y, x + w, y + h, 10, 0) >= 0);
+    }
+}
+
+static void test_random_boxes(void **state)
+{
+    int k;
+    (void)state;
+    for (k = 0; k < 4; k++) {
+        fixture *f = fixture_new();
+        rnd_state = 1000u + (uint32_t)k;
+        scene_boxes(f, 25 + 10 * k, 0);
+        fixture_build(f);
+        random_vis(f, 150);
+        random_locate_shoot(f, 400);
+        fixture_free(f);
+    }
+}
+
+static void test_random_rotated(void **state)
+{
+    int k;
+    (void)state;
+    for (k = 0; k < 4; k++) {
+        fixture *f = fixture_new();
+        rnd_state = 2000u + (uint32_t)k;
+        scene_boxes(f, 25 + 10 * k, 1);
+        fixture_build(f);
+        random_vis(f, 150);
+        random_locate_shoot(f, 400);
+        fixture_free(f);
+    }
+}
+
+/* Terraces of boxes sharing walls exactly, L-shapes, a courtyard with a
+ * kiosk inside, a raised bridge. */
+static void test_random_mixed_city(void **state)
+{
+    int k, i, j;
+    (void)state;
+    for (k = 0; k < 3; k++) {
+        fixture *f = fixture_new();
+        rnd_state = 3000u + (uint32_t)k;
+        for (i = 0; i < 3; i++) {
+            double y0 = 10 + 40 * i, x = 5 + urand() * 5;
+            for (j = 0; j < 5; j++) {
+                double w = 4 + floor(urand() * 6), h = 8 + floor(urand() * 8);
+                assert_true(ref_scene_add_box(&f->s, x, y0, x + w, y0 + h, 10, 0) >= 0);
+                x += w;                         /* next one shares the wall */
+            }
+            add_l_shape(f, 70 + urand() * 10, y0, 12, 14);
+        }
+        add_courtyard(f, 100, 20, 40, 40, 8);
+        assert_true(ref_scene_add_box(&f->s, 115, 35, 120, 40, 5, 0) >= 0);  /* kiosk */
+        assert_true(ref_scene_add_box(&f->s, 20, 25, 60, 30, 12, 6) >= 0);   /* raised */
+        fixture_build(f);
+        random_vis(f, 250);
+        random_locate_shoot(f, 400);
+        fixture_free(f);
+    }
+}
+
+/* Buildings overlapping by centimetres, as in real map data. */
+static void test_random_overlaps(void **state)
+{
+    fixture *f = fixture_new();
+    int i;
+    (void)state;
+    rnd_state = 4000u;
+    for (i = 0; i < 12; i++) {
+        double x = 10 + 9.97 * i, y = 10 + urand() * 0.2;
+        assert_true(ref_scene_add_box(&f->s, x, y, x + 10, y + 12, 10, 0) >= 0);
+        add_rotated_box(f, x + 2, 40 + urand() * 0.1, 10.05, 8, 0.01 * (i - 6));
+    }
+    fixture_build(f);
+    random_vis(f, 200);
+    random_locate_shoot(f, 400);
+    fixture_free(f);
+}
+
+/* ------------------------------------------------------ degenerate cases */
+
+static void expect_all(fixture *f, const vec2 *pts, int n)
+{
+    int i, k, bad = 0;
+    for (i = 0; i < n; i++) {
+        if (!vis_agrees(f, pts[i], 1, 0, 0, 1))
+            bad++;
+        for (k = 0; k < 8; k++)
+            if (!vis_agrees(f, pts[i], 0, k * PI / 4, k * PI / 4 + PI / 3, 1))
+                bad++;
+    }
+    assert_int_equal(bad, 0);
+}
+
+static void test_viewer_on_edge_extension(void **state)
+{
+    fixture *f = fixture_new();
+    vec2 p[4] = { { 20, 0 }, { -5, 10 }, { 0, -7 }, { 10, 33 } };
+    (void)state;
+    assert_true(ref_scene_add_box(&f->s, 0, 0, 10, 10, 10, 0) >= 0);
+    assert_true(ref_scene_add_box(&f->s, 30, -20, 40, 0, 10, 0) >= 0);  /* same line y=0 */
+    fixture_build(f);
+    expect_all(f, p, 4);
+    fixture_free(f);
+}
+
+static void test_viewer_aligned_with_two_vertices(void **state)
+{
+    fixture *f = fixture_new();
+    vec2 p[3] = { { 0, 0 }, { 45, 45 }, { 25, 25 } };
+    (void)state;
+    assert_true(ref_scene_add_box(&f->s, 10, 10, 20, 20, 10, 0) >= 0);
+    assert_true(ref_scene_add_box(&f->s, 30, 30, 40, 40, 10, 0) >= 0);
+    assert_true(ref_scene_add_box(&f->s, 50, 20, 60, 30, 10, 0) >= 0);
+    fixture_build(f);
+    expect_all(f, p, 3);
+    fixture_free(f);
+}
+
+static void test_viewer_near_wall(void **state)
+{
+    fixture *f = fixture_new();
+    vec2 p[4] = { { 10 + 1e-9, 5 }, { 5, -1e-9 }, { 10 + 1e-9, 10 + 1e-9 }, { 12, 5 } };
+    (void)state;
+    assert_true(ref_scene_add_box(&f->s, 0, 0, 10, 10, 10, 0) >= 0);
+    assert_true(ref_scene_add_box(&f->s, 20, 0, 30, 10, 10, 0) >= 0);
+    fixture_build(f);
+    expect_all(f, p, 4);
+    /* sector [90, 150] degrees from (10 + d, 5): a strip of width d along the
+     * wall up to the corner (10, 10) (area 5 d), then the wedge between the
+     * vertical x = 10 + d and the ray through the corner up to y = 60, widths
+     * d and 11 d (area 300 d); terms in d^2 are below 1e-18 */
+    {
+        double d = p[0].x - 10.0;
+        vis_result r;
+        memset(&r, 0, sizeof r);
+        assert_int_equal(vis_query(f->pd, p[0], PI / 2, PI / 2 + PI / 3, 0, &f->a, &r), PLX_OK);
+        assert_true(fabs(r.area - 305.0 * d) <= 1e-8 * 305.0 * d);
+        assert_int_equal(r.nvis, 1);
+    }
+    fixture_free(f);
+}
+
+static void test_ray_grazing_vertex(void **state)
+{
+    fixture *f = fixture_new();
+    vec2 p[2] = { { -10, -10 }, { -20, -30 } };
+    polar_hit h;
+    vec2 q = { 0, 10 };
+    (void)state;
+    assert_true(ref_scene_add_box(&f->s, 0, 0, 10, 10, 10, 0) >= 0);   /* corner (0,10) */
+    assert_true(ref_scene_add_box(&f->s, 5, 25, 15, 35, 10, 0) >= 0);  /* behind it */
+    fixture_build(f);
+    expect_all(f, p, 2);
+    /* the exact ray through the corner passes and meets the second box */
+    assert_int_equal(polar_shoot_to(f->pd, p[0], q, 0, &h), PLX_OK);
+    assert_int_equal(h.bld, 1);
+    assert_true(fabs(h.pt.x - 7.5) < 1e-9 && fabs(h.pt.y - 25) < 1e-9);
+    /* turned clockwise it enters the first box at the corner */
+    assert_int_equal(polar_shoot_to(f->pd, p[0], q, -1, &h), PLX_OK);
+    assert_int_equal(h.bld, 0);
+    assert_true(fabs(h.pt.x) < 1e-9 && fabs(h.pt.y - 10) < 1e-9);
+    assert_int_equal(polar_shoot_to(f->pd, p[0], q, 1, &h), PLX_OK);
+    assert_int_equal(h.bld, 1);
+    fixture_free(f);
+}
+
+static void test_shared_walls(void **state)
+{
+    fixture *f = fixture_new();
+    vec2 p[5] = { { 10, -5 }, { 10, 20 }, { 25, 5 }, { -3, 10 }, { 5, 12 } };
+    polar_hit h;
+    vec2 q = { 10, 50 };
+    (void)state;
+    assert_true(ref_scene_add_box(&f->s, 0, 0, 10, 10, 10, 0) >= 0);
+    assert_true(ref_scene_add_box(&f->s, 10, 0, 20, 10, 10, 0) >= 0);
+    assert_true(ref_scene_add_box(&f->s, 20, 2, 24, 8, 10, 0) >= 0);   /* T-junction */
+    fixture_build(f);
+    expect_all(f, p, 5);
+    /* a ray along the shared wall is blocked where the wall starts */
+    assert_int_equal(polar_shoot_to(f->pd, p[0], q, 0, &h), PLX_OK);
+    assert_true(h.bld == 0 || h.bld == 1);
+    assert_true(fabs(h.pt.y) < 1e-9);
+    fixture_free(f);
+}
+
+static void test_collinear_neighbour_edges(void **state)
+{
+    fixture *f = fixture_new();
+    vec2 p[4] = { { -5, 0 }, { 30, 0 }, { 12.5, -3 }, { 12.5, 4 } };
+    (void)state;
+    assert_true(ref_scene_add_box(&f->s, 0, 0, 10, 10, 10, 0) >= 0);
+    assert_true(ref_scene_add_box(&f->s, 15, 0, 25, 10, 10, 0) >= 0);
+    assert_true(ref_scene_add_box(&f->s, 0, -10, 25, -6, 10, 0) >= 0);
+    fixture_build(f);
+    expect_all(f, p, 4);
+    fixture_free(f);
+}
+
+static void test_courtyard_and_kiosk(void **state)
+{
+    fixture *f = fixture_new();
+    vec2 p[3] = { { 110, 50 }, { 125, 30 }, { 90, 10 } };
+    vis_result r;
+    (void)state;
+    add_courtyard(f, 100, 20, 40, 40, 8);
+    assert_true(ref_scene_add_box(&f->s, 115, 35, 120, 40, 5, 0) >= 0);
+    fixture_build(f);
+    expect_all(f, p, 3);
+    /* inside the courtyard only the courtyard is seen: area 24^2 - 5^2
+     * seen from beside the kiosk is less than that, but the total never more */
+    memset(&r, 0, sizeof r);
+    assert_int_equal(vis_query(f->pd, p[0], 0, 0, 1, &f->a, &r), PLX_OK);
+    assert_true(r.area <= 24.0 * 24.0 - 25.0 + 1e-9);
+    assert_true(r.nvis == 2);
+    fixture_free(f);
+}
+
+static void test_errors(void **state)
+{
+    fixture *f = fixture_new();
+    vis_result r;
+    polar_hit h;
+    vec2 in = { 5, 5 }, out = { -1000, 0 }, on = { 10, 5 }, yard = { 120, 40 };
+    vec2 corner = { 10, 10 };
+    (void)state;
+    assert_true(ref_scene_add_box(&f->s, 0, 0, 10, 10, 10, 0) >= 0);
+    add_courtyard(f, 100, 20, 40, 40, 8);
+    fixture_build(f);
+    memset(&r, 0, sizeof r);
+    assert_int_equal(vis_query(f->pd, in, 0, 0, 1, &f->a, &r), PLX_E_RANGE);
+    assert_int_equal(vis_query(f->pd, out, 0, 0, 1, &f->a, &r), PLX_E_RANGE);
+    assert_int_equal(vis_query(f->pd, on, 0, 0, 1, &f->a, &r), PLX_E_RANGE);
+    assert_int_equal(vis_query(f->pd, corner, 0, 0, 1, &f->a, &r), PLX_E_RANGE);
+    assert_int_equal(vis_query(f->pd, yard, 0, 0, 1, &f->a, &r), PLX_OK);
+    assert_true(fabs(r.area - 24.0 * 24.0) < 1e-9);
+    assert_int_equal(r.nvis, 1);
+    assert_int_equal(polar_shoot(f->pd, in, 1, 0, &h), PLX_E_RANGE);
+    assert_int_equal(polar_shoot(f->pd, out, 1, 0, &h), PLX_E_RANGE);
+    assert_int_equal(polar_shoot(f->pd, yard, 0, 0, &h), PLX_E_INVALID);
+    assert_int_equal(polar_locate(f->pd, 0, in, NULL), -3);
+    assert_int_equal(polar_locate(f->pd, 0, out, NULL), -1);
+    assert_int_equal(polar_locate(f->pd, 0, on, NULL), -2);
+    assert_true(polar_locate(f->pd, 0, yard, NULL) >= 0);
+    /* too small a caller buffer: counted, NOMEM, area still right */
+    {
+        vec2 small[3];
+        memset(&r, 0, sizeof r);
+        r.poly = small;
+        r.poly_cap = 3;
+        assert_int_equal(vis_query(f->pd, yard, 0, 0, 1, &f->a, &r), PLX_E_NOMEM);
+        assert_true(r.npoly >= 4);
+        assert_true(fabs(r.area - 24.0 * 24.0) < 1e-9);
+    }
+    fixture_free(f);
+}
+
+/* A hand-checkable view: one 10 x 10 box, viewer due west at distance 10.
+ * Bounds [-50, 60]^2; hidden: the trapezoid between the rays through (0,0)
+ * and (0,10) from x = 0 to x = 60. */
+static void test_hand_area(void **state)
+{
+    fixture *f = fixture_new();
+    vec2 p = { -10, 5 };
+    vis_result r;
+    double box = 110.0 * 110.0, shadow;
+    (void)state;
+    assert_true(ref_scene_add_box(&f->s, 0, 0, 10, 10, 10, 0) >= 0);
+    fixture_build(f);
+    /* the rays through (0,0) and (0,10) open by 0.5 m per metre: everything
+     * between them beyond x = 0 is hidden (the box included), a trapezoid of
+     * widths 10 (x = 0) and 70 (x = 60) */
+    shadow = 0.5 * (10.0 + 70.0) * 60.0;
+    memset(&r, 0, sizeof r);
+    assert_int_equal(vis_query(f->pd, p, 0, 0, 1, &f->a, &r), PLX_OK);
+    assert_true(fabs(r.area - (box - shadow)) < 1e-9 * box);
+    assert_int_equal(r.nvis, 1);
+    fixture_free(f);
+}
+
+/* -------------------------------------------------------- the structure */
+
+/* The free regions of every quadrant tile the free space: their areas add
+ * up to the box minus the footprints (no overlap in this scene). */
+static void test_regions_tile_free_space(void **state)
+{
+    fixture *f = fixture_new();
+    int q;
+    double want, fp = 0;
+    uint32_t i;
+    (void)state;
+    rnd_state = 77u;
+    add_courtyard(f, 0, 0, 30, 30, 6);
+    add_l_shape(f, 40, 0, 10, 12);
+    add_rotated_box(f, 60, 5, 8, 4, 0.7);
+    fixture_build(f);
+    for (i = 0; i < f->s.nbld; i++) {
+        uint32_t r;
+        for (r = 0; r < f->s.bld[i].ring_count; r++) {
+            const scene_ring *g = &f->s.rings[f->s.bld[i].ring_first + r];
+            double a = 0;
+            uint32_t k;
+            for (k = 0; k < g->count; k++) {
+                vec2 u = f->s.pts[g->first + k], v = f->s.pts[g->first + (k + 1) % g->count];
+                a += u.x * v.y - v.x * u.y;
+            }
+            fp += 0.5 * a;      /* holes are clockwise: they subtract */
+        }
+    }
+    want = (f->s.bounds[2] - f->s.bounds[0]) * (f->s.bounds[3] - f->s.bounds[1]) - fp;
+    for (q = 0; q < 4; q++) {
+        double got = 0;
+        uint32_t n = polar_region_count(f->pd, q);
+        assert_true(n > 10);
+        for (i = 0; i < n; i++) {
+            vec2 c[4];
+            int32_t own;
+            int solid, k;
+            double a = 0;
+            assert_int_equal(polar_region(f->pd, q, i, c, &own, &solid), 4);
+            for (k = 0; k < 4; k++)
+                a += c[k].x * c[(k + 1) % 4].y - c[(k + 1) % 4].x * c[k].y;
+            assert_true(a >= -1e-6);
+            if (!solid)
+                got += 0.5 * a;
+        }
+        assert_true(fabs(got - want) < 1e-9 * want);
+    }
+    fixture_free(f);
+}
+
+static void test_memory_accounting(void **state)
+{
+    fixture *f = fixture_new();
+    size_t by[4], used0, scratch0;
+    (void)state;
+    rnd_state = 5u;
+    scene_boxes(f, 40, 1);
+    ref_scene_finish(&f->s);
+    used0 = f->a.used[PLX_PART_POLAR];
+    scratch0 = f->a.used[PLX_PART_SCRATCH];
+    assert_int_equal(polar_build(&f->a, &f->s, &f->pd), PLX_OK);
+    polar_memory(f->pd, by);
+    assert_true(by[0] > 0 && by[1] > 0 && by[2] > 0 && by[3] > 0);
+    assert_true(by[0] + by[1] + by[2] + by[3] <= f->a.used[PLX_PART_POLAR] - used0);
+    assert_true(by[0] + by[1] + by[2] + by[3] + 64 * 16 >= f->a.used[PLX_PART_POLAR] - used0);
+    assert_int_equal(f->a.used[PLX_PART_SCRATCH], scratch0);
+    assert_int_equal(f->a.hi, 0);
+    fixture_free(f);
+}
+
+/* Every memory request failing in turn: NOMEM and nothing kept, until the
+ * build succeeds. */
+static void test_fault_injection(void **state)
+{
+    fixture *f = fixture_new();
+    uint64_t k;
+    int done = 0;
+    (void)state;
+    rnd_state = 9u;
+    scene_boxes(f, 8, 1);
+    ref_scene_finish(&f->s);
+    for (k = 1; k < 200 && !done; k++) {
+        arena_mark m = arena_get_mark(&f->a);
+        plx_status st;
+        f->a.requests = 0;
+        f->a.fail_at = k;
+        st = polar_build(&f->a, &f->s, &f->pd);
+        f->a.fail_at = 0;
+        if (st == PLX_OK) {
+            done = 1;
+            break;
+        }
+        assert_int_equal(st, PLX_E_NOMEM);
+        assert_null(f->pd);
+        assert_int_equal(f->a.lo, m.lo);
+        assert_int_equal(f->a.hi, m.hi);
+    }
+    assert_true(done);
+    assert_true(k > 5);
+    fixture_free(f);
+}
+
+static void test_first_object(void **state)
+{
+    fixture *f = fixture_new();
+    vec2 p = { 0, 0 };
+    (void)state;
+    assert_true(ref_scene_add_box(&f->s, 10, 20, 12, 22, 10, 0) >= 0);  /* 0: NE, steep */
+    assert_true(ref_scene_add_box(&f->s, 30, 5, 32, 40, 10, 0) >= 0);   /* 1: NE, shallow */
+    assert_true(ref_scene_add_box(&f->s, -20, -5, -18, 5, 10, 0) >= 0); /* 2: due west */
+    fixture_build(f);
+    assert_int_equal(vis_first(f->pd, 0, p, &f->a), 1);   /* smallest angle from east */
+    assert_int_equal(vis_first(f->pd, 1, p, &f->a), 2);   /* from north: reaches west */
+    assert_int_equal(vis_first(f->pd, 2, p, &f->a), 2);
+    assert_int_equal(vis_first(f->pd, 3, p, &f->a), -1);
+    fixture_free(f);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_hand_area),
+        cmocka_unit_test(test_errors),
+        cmocka_unit_test(test_viewer_on_edge_extension),
+        cmocka_unit_test(test_viewer_aligned_with_two_vertices),
+        cmocka_unit_test(test_viewer_near_wall),
+        cmocka_unit_test(test_ray_grazing_vertex),
+        cmocka_unit_test(test_shared_walls),
+        cmocka_unit_test(test_collinear_neighbour_edges),
+        cmocka_unit_test(test_courtyard_and_kiosk),
+        cmocka_unit_test(test_first_object),
+        cmocka_unit_test(test_regions_tile_free_space),
+        cmocka_unit_test(test_memory_accounting),
+        cmocka_unit_test(test_fault_injection),
+        cmocka_unit_test(test_random_boxes),
+        cmocka_unit_test(test_random_rotated),
+        cmocka_unit_test(test_random_mixed_city),
+        cmocka_unit_test(test_random_overlaps),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
