@@ -50,7 +50,7 @@ typedef enum plx_part {
     PLX_PART_POLAR,      /* polar diagrams */
     PLX_PART_LIT,        /* lamp lit regions */
     PLX_PART_PHOTON,     /* photon buffers */
-    PLX_PART_FRAME,      /* frame buffers and render scratch */
+    PLX_PART_FRAME,      /* frame buffers, query results */
     PLX_PART_SCRATCH,    /* temporary memory during a call (JSON parse tree, ...) */
     PLX_PART_COUNT
 } plx_part;
@@ -167,7 +167,7 @@ typedef struct plx_lamp {
 typedef struct plx_block {
     uint32_t nbuildings;
     const uint32_t *buildings; /* building indices */
-    uint32_t nrings;           /* outer boundary + courtyards; see plx_block_ring */
+    uint32_t nrings;           /* outer boundary, courtyards, extra parts; see plx_block_ring */
     double box[4];
 } plx_block;
 
@@ -180,7 +180,9 @@ plx_status plx_block_get(plx_engine *e, uint32_t i, plx_block *out /* OUT */);
 plx_status plx_building_ring(plx_engine *e, uint32_t i, uint32_t r,
                              const double **xy /* OUT */, uint32_t *n /* OUT */);
 /* Ring r of block i: ring 0 the outer boundary of the union of its
- * footprints (counter-clockwise), the rest its courtyards (clockwise). */
+ * footprints (counter-clockwise, the largest), then its courtyards
+ * (clockwise), then any further counter-clockwise rings (parts of the union
+ * joined to the rest only at a point). See src/blocks.h for the rules. */
 plx_status plx_block_ring(plx_engine *e, uint32_t i, uint32_t r,
                           const double **xy /* OUT */, uint32_t *n /* OUT */);
 
@@ -199,6 +201,58 @@ void plx_memory_get(const plx_engine *e, plx_memory_report *out /* OUT */);
  * number of memory requests served since the last call.
  */
 uint64_t plx_debug_fail_alloc(plx_engine *e, uint64_t k);
+
+/* ---- Polar diagrams and planar visibility (SPEC §3) -------------------- */
+
+/*
+ * Builds the four quadrant polar diagrams of the loaded scene (part
+ * PLX_PART_POLAR) and the query result buffers (PLX_PART_FRAME). Queries
+ * build them on first need; calling this first puts the cost up front.
+ * Errors: PLX_E_NOSCENE, PLX_E_NOMEM (nothing kept).
+ */
+plx_status plx_polar_build(plx_engine *e);
+
+typedef struct plx_polar_info {
+    uint64_t build_ns;        /* construction time by the port's clock */
+    size_t axes, regions, polygons, rest; /* bytes by part (robles2014 Table 3) */
+    size_t total;
+    uint32_t nregions[4];     /* regions of quadrant diagrams 0..3 */
+    uint32_t vertices;        /* footprint vertices of the occluders */
+} plx_polar_info;
+
+/* Builds the diagrams if needed, then describes them. */
+plx_status plx_polar_info_get(plx_engine *e, plx_polar_info *out /* OUT */);
+
+/*
+ * Region i of quadrant diagram q (0: scan from east, 1: north, 2: west,
+ * 3: south): up to 4 corners (x,y pairs, counter-clockwise) in xy, their count
+ * in *n, the owner building in *owner (the object first met by the scan from
+ * the region's points; -1 where the start ray leaves the Bounds box) and
+ * whether the region is inside a footprint in *solid.
+ */
+plx_status plx_polar_region_count(plx_engine *e, int q, uint32_t *count /* OUT */);
+plx_status plx_polar_region(plx_engine *e, int q, uint32_t i, double xy[8] /* OUT */,
+                            uint32_t *n /* OUT */, int32_t *owner /* OUT */, int *solid /* OUT */);
+
+typedef struct plx_visibility {
+    double area;              /* m^2, within Bounds (SPEC §3) */
+    uint32_t nverts;          /* vertices of the visibility polygon */
+    const double *xy;         /* its vertices, x,y pairs, counter-clockwise */
+    uint32_t nvisible;        /* visible buildings */
+    const uint32_t *visible;  /* their indices, ascending */
+} plx_visibility;
+
+/*
+ * The exact visibility polygon and visible set of the free point (x, y),
+ * buildings infinitely tall, over the directions dir_deg ± fov_deg/2
+ * (degrees counter-clockwise from +x, east); fov_deg >= 360 is the full turn.
+ * The arrays in out stay valid until the next visibility query or load.
+ * Errors: PLX_E_RANGE when the point is outside Bounds, on a wall or inside a
+ * footprint (the message says which building); PLX_E_INVALID for non-finite
+ * input or fov_deg <= 0; PLX_E_NOSCENE; PLX_E_NOMEM.
+ */
+plx_status plx_visibility_get(plx_engine *e, double x, double y, double dir_deg, double fov_deg,
+                              plx_visibility *out /* OUT */);
 
 /* ---- Procedural cities (plx gen) ------------------------------------- */
 

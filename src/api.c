@@ -30,6 +30,17 @@ static plx_status bad_index(plx_engine *e, const char *fn, uint32_t i, uint32_t 
     return eng_fail(e, PLX_E_RANGE, msg);
 }
 
+static double ring_area2(const vec2 *p, uint32_t n)
+{
+    double a = 0.0;
+    uint32_t i;
+    for (i = 0; i < n; i++) {
+        vec2 u = p[i], v = p[(i + 1) % n];
+        a += u.x * v.y - v.x * u.y;
+    }
+    return a;
+}
+
 plx_status plx_scene_info_get(plx_engine *e, plx_scene_info *out)
 {
     const scene *s;
@@ -45,8 +56,13 @@ plx_status plx_scene_info_get(plx_engine *e, plx_scene_info *out)
         out->holes += s->bld[i].ring_count - 1;
     }
     out->blocks = s->nblocks;
-    for (i = 0; i < s->nblocks; i++)
-        out->courtyards += s->blocks[i].ring_count > 1 ? s->blocks[i].ring_count - 1 : 0;
+    for (i = 0; i < s->nblocks; i++) {
+        uint32_t r;
+        for (r = 1; r < s->blocks[i].ring_count; r++) {
+            const scene_ring *g = &s->block_rings[s->blocks[i].ring_first + r];
+            out->courtyards += ring_area2(s->block_pts + g->first, g->count) < 0.0;
+        }
+    }
     out->lamps = s->nlamps;
     out->vertices = s->npts;
     out->skipped_features = s->skipped_features;

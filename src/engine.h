@@ -19,6 +19,12 @@ struct plx_engine {
     char err[ENGINE_ERR_BYTES];
     uint32_t warnings;
     scene *sc;              /* NULL until a scene is loaded */
+    struct polar *pd;       /* polar diagrams, built on first need */
+    uint64_t polar_ns;
+    vec2 *vis_poly;         /* visibility query results (PLX_PART_FRAME) */
+    uint32_t vis_poly_cap;
+    uint32_t *vis_ids;
+    uint32_t vis_ids_cap;
 };
 
 #define ENGINE_MAGIC 0x504c5831u /* "PLX1" */

@@ -402,6 +402,9 @@ static plx_status load(plx_engine *e, loader *ld)
 static void drop_scene(plx_engine *e)
 {
     e->sc = NULL;
+    e->pd = NULL;
+    e->vis_poly = NULL;
+    e->vis_ids = NULL;
     e->warnings = 0;
     eng_clear_error(e);
     e->mem.lo = e->base.lo;

@@ -38,5 +38,7 @@ int cli_exit_code(plx_status s);
 
 int cmd_info(int argc, char **argv);
 int cmd_gen(int argc, char **argv);
+int cmd_vis(int argc, char **argv);
+int cmd_draw(int argc, char **argv);
 
 #endif

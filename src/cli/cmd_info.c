@@ -8,8 +8,9 @@ static const char help[] =
     "\n"
     "Loads SCENE (GeoJSON, see README 'Scene format') and prints counts of\n"
     "buildings, blocks, courtyards, lamps and vertices, the bounds, building\n"
-    "heights (min/median/max), skipped features, the load time and the memory\n"
-    "used per part with the high-water mark.\n"
+    "heights (min/median/max), skipped features, the load time, the polar\n"
+    "diagrams (build time, memory by part) and the memory used per part with\n"
+    "the high-water mark.\n"
     "\n"
     "  --mem SIZE   memory budget of the engine (default 1G; e.g. 256M)\n"
     "  --strict     the first bad feature is an error (default: skip and report)\n"
@@ -32,6 +33,7 @@ int cmd_info(int argc, char **argv)
     const char *path = NULL;
     plx_engine *e;
     plx_scene_info si;
+    plx_polar_info pi;
     int i, rc;
     memset(&c, 0, sizeof c);
     for (i = 1; i < argc; i++) {
@@ -73,7 +75,17 @@ int cmd_info(int argc, char **argv)
     printf("heights: min %.2f median %.2f max %.2f m\n", si.height_min, si.height_median, si.height_max);
     printf("ground albedo: %.3f\n", si.ground_albedo);
     printf("load time: %.2f ms\n", si.load_ns / 1e6);
+    if (plx_polar_info_get(e, &pi) == PLX_OK) {
+        printf("polar diagrams: built in %.2f ms; %zu bytes = axes %zu + regions %zu + polygons %zu + rest %zu"
+               " (%.1f bytes per footprint vertex); regions per quadrant %u %u %u %u\n",
+               pi.build_ns / 1e6, pi.total, pi.axes, pi.regions, pi.polygons, pi.rest,
+               pi.vertices ? (double)pi.total / pi.vertices : 0.0, pi.nregions[0], pi.nregions[1],
+               pi.nregions[2], pi.nregions[3]);
+    } else {
+        printf("polar diagrams: not built: %s\n", plx_last_error(e));
+        rc = plx_last_error(e)[0] && strstr(plx_last_error(e), "out of memory") ? EXIT_NOMEM : EXIT_FAIL;
+    }
     print_memory(e);
     plx_engine_free(e);
-    return EXIT_OK;
+    return rc;
 }

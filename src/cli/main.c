@@ -11,6 +11,8 @@ typedef struct command {
 static const command commands[] = {
     { "info", cmd_info, "load a scene and print what it holds, its timing and memory" },
     { "gen", cmd_gen, "write a procedural city (grid, eixample, oldtown) as GeoJSON" },
+    { "vis", cmd_vis, "exact visibility (area, polygon, visible buildings) from points" },
+    { "draw", cmd_draw, "draw a quadrant polar diagram as a PNG" },
 };
 
 static void usage(FILE *f)

@@ -24,7 +24,7 @@ expect help 0 "^usage: polarlux COMMAND" -- "$bin" --help
 expect no-args 2 "^usage: polarlux COMMAND" -- "$bin"
 expect version 0 "^polarlux [0-9]+\.[0-9]+\.[0-9]+$" -- "$bin" --version
 expect unknown-command 2 "unknown command 'frobnicate'" -- "$bin" frobnicate
-for c in info gen; do
+for c in info gen vis draw; do
     expect "$c-help" 0 "^usage: polarlux $c" -- "$bin" $c --help
     expect "$c-unknown-option" 2 "polarlux $c: unknown option '--bogus'" -- "$bin" $c --bogus x
 done
@@ -51,6 +51,25 @@ expect gen-grid-info 0 "^buildings: 6 " -- "$bin" info "$tmp/g.geojson"
 "$bin" gen oldtown 5 5 --seed 7 >"$tmp/a.json"; "$bin" gen oldtown 5 5 --seed 7 >"$tmp/b.json"
 if cmp -s "$tmp/a.json" "$tmp/b.json"; then echo "ok   gen-deterministic"; pass=$((pass + 1)); else echo "FAIL gen-deterministic"; fail=$((fail + 1)); fi
 expect gen-eixample-info 0 "^blocks: 4 with 4 courtyards" -- sh -c "'$bin' gen eixample 2 2 > '$tmp/e.json' && '$bin' info '$tmp/e.json'"
+printf '50 10\n# a comment\n\n50 12.5\n' >"$tmp/p.txt"
+expect vis-courtyard 0 "^50 10 100 4$" -- "$bin" vis -q fixtures/tiny.geojson --points "$tmp/p.txt"
+printf '50 10\n5 5\n' >"$tmp/p2.txt"
+expect vis-inside 1 "p2.txt:2: point \(5, 5\) is inside building 0 \(A\): not a free viewpoint" -- "$bin" vis -q fixtures/tiny.geojson --points "$tmp/p2.txt"
+expect vis-inside-row 1 "^5 5 nan 0$" -- "$bin" vis -q fixtures/tiny.geojson --points "$tmp/p2.txt"
+printf '50 ten\n' >"$tmp/p3.txt"
+expect vis-bad-points 1 "p3.txt:1: 'ten' is not a finite number" -- "$bin" vis -q fixtures/tiny.geojson --points "$tmp/p3.txt"
+expect vis-both 2 "give exactly one of --points FILE and --at X,Y" -- "$bin" vis fixtures/tiny.geojson
+expect vis-at 0 "^# visible: 3 of 3 buildings" -- "$bin" vis -q fixtures/tiny.geojson --at 30,30
+expect vis-at-fov 0 "^2 C$" -- "$bin" vis -q fixtures/tiny.geojson --at 50,10 --dir 90 --fov 60
+expect vis-geojson 0 "" -- "$bin" vis -q fixtures/tiny.geojson --points "$tmp/p.txt" --geojson "$tmp/v.geojson"
+expect vis-geojson-loads 0 "^buildings: 2 " -- "$bin" info -q "$tmp/v.geojson"
+expect vis-helsinki-lonlat 0 "" -- "$bin" vis -q fixtures/helsinki-centre.geojson --at 0,0 --geojson "$tmp/h.geojson"
+expect vis-helsinki-geojson-lonlat 0 "^coordinates: WGS84 lon/lat" -- "$bin" info -q "$tmp/h.geojson"
+expect draw-missing-q 2 "missing --polar Q" -- "$bin" draw fixtures/tiny.geojson -o "$tmp/d.png"
+expect draw-bad-q 2 "--polar '7' is not a quadrant 0..3" -- "$bin" draw fixtures/tiny.geojson --polar 7 -o "$tmp/d.png"
+expect draw-ok 0 "^polar diagram 1: [0-9]+ regions" -- "$bin" draw -q fixtures/tiny.geojson --polar 1 -o "$tmp/d.png" --size 200
+if [ "$(head -c 4 "$tmp/d.png" | od -An -c | tr -d ' ')" = "211PNG" ]; then echo "ok   draw-png"; pass=$((pass + 1)); else echo "FAIL draw-png: not a PNG"; fail=$((fail + 1)); fi
+expect draw-unwritable 1 "" -- "$bin" draw -q fixtures/tiny.geojson --polar 0 -o "$tmp/no/such/dir/d.png"
 ls "$tmp"/*.tmp* >/dev/null 2>&1 && { echo "FAIL temporary files left"; fail=$((fail + 1)); }
 echo "cli: $pass passed, $fail failed"
 [ "$fail" -eq 0 ]

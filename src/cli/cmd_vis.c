@@ -1,0 +1,217 @@
+/* polarlux vis: exact planar visibility (SPEC §3) from points. */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "cli.h"
+#include "geo_out.h"
+#include "points.h"
+
+static const char help[] =
+    "usage: polarlux vis SCENE --points FILE [--geojson OUT] [options]\n"
+    "       polarlux vis SCENE --at X,Y [--dir DEG --fov DEG] [--geojson OUT] [options]\n"
+    "\n"
+    "Exact visibility from free points, buildings treated as infinitely tall\n"
+    "(SPEC §3), through the polar diagrams.\n"
+    "\n"
+    "  --points FILE  lines 'x y [...]' (local metres; '-' reads standard input);\n"
+    "                 prints one line 'x y area nverts' per point: the area (m^2)\n"
+    "                 of the visibility polygon within Bounds and its vertex count.\n"
+    "                 A point that is not free (inside a building, on a wall,\n"
+    "                 outside Bounds) prints 'x y nan 0' and a message on stderr,\n"
+    "                 and the exit code is 1.\n"
+    "  --at X,Y       one viewer: prints the visible buildings (index and id), the\n"
+    "                 area, and the fraction of the scene's buildings and vertices\n"
+    "                 they hold\n"
+    "  --dir DEG      view direction, degrees counter-clockwise from east (default 0)\n"
+    "  --fov DEG      horizontal field of view (default 360: the full turn)\n"
+    "  --geojson OUT  also write the visibility polygons (lon/lat when the scene\n"
+    "                 was lon/lat), with area and the visible building count\n"
+    "  --mem SIZE, --strict, --quiet   as for 'polarlux info'\n";
+
+typedef struct vis_opts {
+    const char *scene, *points, *geojson;
+    int have_at;
+    double at[2], dir, fov;
+    cli_common c;
+} vis_opts;
+
+static int parse_pair(const char *s, double v[2])
+{
+    char buf[128];
+    char *comma;
+    if (strlen(s) >= sizeof buf)
+        return -1;
+    strcpy(buf, s);
+    comma = strchr(buf, ',');
+    if (!comma)
+        return -1;
+    *comma = '\0';
+    return cli_parse_double(buf, &v[0]) || cli_parse_double(comma + 1, &v[1]) ? -1 : 0;
+}
+
+static int parse_args(int argc, char **argv, vis_opts *o)
+{
+    int i;
+    memset(o, 0, sizeof *o);
+    o->fov = 360.0;
+    for (i = 1; i < argc; i++) {
+        const char *a = argv[i];
+        int r = cli_common_option("vis", argc, argv, &i, &o->c);
+        if (r < 0)
+            return EXIT_USAGE;
+        if (r)
+            continue;
+        if (strcmp(a, "--help") == 0 || strcmp(a, "-h") == 0) {
+            fputs(help, stdout);
+            return -1;
+        }
+        if ((strcmp(a, "--points") == 0 || strcmp(a, "--geojson") == 0 || strcmp(a, "--at") == 0 ||
+             strcmp(a, "--dir") == 0 || strcmp(a, "--fov") == 0) && i + 1 >= argc)
+            return cli_usage_error("vis", "%s needs a value", a);
+        if (strcmp(a, "--points") == 0) {
+            o->points = argv[++i];
+        } else if (strcmp(a, "--geojson") == 0) {
+            o->geojson = argv[++i];
+        } else if (strcmp(a, "--at") == 0) {
+            if (parse_pair(argv[++i], o->at) != 0)
+                return cli_usage_error("vis", "--at '%s' is not X,Y", argv[i]);
+            o->have_at = 1;
+        } else if (strcmp(a, "--dir") == 0) {
+            if (cli_parse_double(argv[++i], &o->dir) != 0 || !isfinite(o->dir))
+                return cli_usage_error("vis", "--dir '%s' is not a number of degrees", argv[i]);
+        } else if (strcmp(a, "--fov") == 0) {
+            if (cli_parse_double(argv[++i], &o->fov) != 0 || !(o->fov > 0))
+                return cli_usage_error("vis", "--fov '%s' is not a positive number of degrees", argv[i]);
+        } else if (a[0] == '-' && a[1] != '\0') {
+            return cli_usage_error("vis", "unknown option '%s'", a);
+        } else if (!o->scene) {
+            o->scene = a;
+        } else {
+            return cli_usage_error("vis", "unexpected argument '%s'", a);
+        }
+    }
+    if (!o->scene)
+        return cli_usage_error("vis", "missing SCENE");
+    if (!o->points == !o->have_at)
+        return cli_usage_error("vis", "give exactly one of --points FILE and --at X,Y");
+    return EXIT_OK;
+}
+
+static void add_polygon(geo_out *g, const plx_visibility *v, double x, double y)
+{
+    cJSON *props = cJSON_CreateObject(), *rings = cJSON_CreateArray();
+    cJSON_AddNumberToObject(props, "x", x);
+    cJSON_AddNumberToObject(props, "y", y);
+    cJSON_AddNumberToObject(props, "area", v->area);
+    cJSON_AddNumberToObject(props, "nverts", v->nverts);
+    cJSON_AddNumberToObject(props, "visible_buildings", v->nvisible);
+    if (v->nverts >= 3)
+        cJSON_AddItemToArray(rings, geo_ring(g, v->xy, v->nverts, NULL));
+    geo_add(g, geo_geometry("Polygon", rings), props);
+}
+
+static int run_points(plx_engine *e, const vis_opts *o, geo_out *g)
+{
+    points pts;
+    char err[512];
+    size_t k;
+    int failed = 0;
+    if (points_read(o->points, 2, 2, NULL, &pts, err, sizeof err) != 0) {
+        fprintf(stderr, "polarlux vis: %s\n", err);
+        return EXIT_FAIL;
+    }
+    for (k = 0; k < pts.n; k++) {
+        double x = pts.v[2 * k], y = pts.v[2 * k + 1];
+        plx_visibility v;
+        plx_status st = plx_visibility_get(e, x, y, o->dir, o->fov, &v);
+        if (st != PLX_OK) {
+            fprintf(stderr, "polarlux vis: %s:%zu: %s\n", o->points, pts.line[k], plx_last_error(e));
+            if (st != PLX_E_RANGE) {
+                points_free(&pts);
+                return cli_exit_code(st);
+            }
+            printf("%.17g %.17g nan 0\n", x, y);
+            failed = 1;
+            continue;
+        }
+        printf("%.17g %.17g %.17g %u\n", x, y, v.area, v.nverts);
+        if (g->root)
+            add_polygon(g, &v, x, y);
+    }
+    points_free(&pts);
+    return failed ? EXIT_FAIL : EXIT_OK;
+}
+
+static int run_at(plx_engine *e, const vis_opts *o, geo_out *g)
+{
+    plx_visibility v;
+    plx_scene_info si;
+    uint32_t i, vis_verts = 0, all_verts = 0, occluders = 0;
+    plx_status st = plx_visibility_get(e, o->at[0], o->at[1], o->dir, o->fov, &v);
+    if (st != PLX_OK) {
+        fprintf(stderr, "polarlux vis: %s\n", plx_last_error(e));
+        return cli_exit_code(st);
+    }
+    plx_scene_info_get(e, &si);
+    for (i = 0; i < si.buildings; i++) {
+        plx_building b;
+        uint32_t r, n = 0;
+        plx_building_get(e, i, &b);
+        if (b.min_height > 0)
+            continue;
+        for (r = 0; r < b.nrings; r++) {
+            const double *xy;
+            uint32_t m;
+            plx_building_ring(e, i, r, &xy, &m);
+            n += m;
+        }
+        all_verts += n;
+        occluders++;
+    }
+    printf("# visible buildings from (%.6f, %.6f), dir %.3f, fov %.3f\n", o->at[0], o->at[1], o->dir, o->fov);
+    for (i = 0; i < v.nvisible; i++) {
+        plx_building b;
+        uint32_t r;
+        plx_building_get(e, v.visible[i], &b);
+        printf("%u %s\n", v.visible[i], b.id ? b.id : "-");
+        for (r = 0; r < b.nrings; r++) {
+            const double *xy;
+            uint32_t m;
+            plx_building_ring(e, v.visible[i], r, &xy, &m);
+            vis_verts += m;
+        }
+    }
+    printf("# area %.6f m^2, %u polygon vertices\n", v.area, v.nverts);
+    printf("# visible: %u of %u buildings (%.3f%%), %u of %u vertices (%.3f%% of the geometry)\n",
+           v.nvisible, occluders, occluders ? 100.0 * v.nvisible / occluders : 0.0, vis_verts, all_verts,
+           all_verts ? 100.0 * vis_verts / all_verts : 0.0);
+    if (g->root)
+        add_polygon(g, &v, o->at[0], o->at[1]);
+    return EXIT_OK;
+}
+
+int cmd_vis(int argc, char **argv)
+{
+    vis_opts o;
+    plx_engine *e;
+    geo_out g;
+    int rc = parse_args(argc, argv, &o);
+    if (rc != EXIT_OK)
+        return rc < 0 ? EXIT_OK : rc;
+    rc = cli_open_scene("vis", o.scene, &o.c, &e);
+    if (rc != EXIT_OK)
+        return rc;
+    memset(&g, 0, sizeof g);
+    if (o.geojson && geo_begin(&g, e) != 0) {
+        fprintf(stderr, "polarlux vis: out of memory\n");
+        plx_engine_free(e);
+        return EXIT_FAIL;
+    }
+    rc = o.points ? run_points(e, &o, &g) : run_at(e, &o, &g);
+    if (o.geojson && rc != EXIT_USAGE && rc != EXIT_NOMEM && geo_write(&g, "vis", o.geojson) != 0)
+        rc = EXIT_FAIL;
+    geo_free(&g);
+    plx_engine_free(e);
+    return rc;
+}

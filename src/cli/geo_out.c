@@ -1,0 +1,91 @@
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "geo_out.h"
+#include "port.h"
+
+int geo_begin(geo_out *g, plx_engine *e)
+{
+    plx_scene_info si;
+    memset(g, 0, sizeof *g);
+    if (plx_scene_info_get(e, &si) != PLX_OK)
+        return -1;
+    g->lonlat = si.lonlat;
+    g->lon0 = si.lon0;
+    g->lat0 = si.lat0;
+    g->coslat = cos(si.lat0 * 3.14159265358979323846 / 180.0);
+    g->root = cJSON_CreateObject();
+    cJSON_AddStringToObject(g->root, "type", "FeatureCollection");
+    if (!g->lonlat) {
+        cJSON *p = cJSON_AddObjectToObject(g->root, "properties");
+        cJSON_AddStringToObject(p, "units", "m");
+    }
+    g->features = cJSON_AddArrayToObject(g->root, "features");
+    return g->root && g->features ? 0 : -1;
+}
+
+cJSON *geo_position(const geo_out *g, double x, double y, const double *z)
+{
+    cJSON *a = cJSON_CreateArray();
+    if (g->lonlat) {
+        x = g->lon0 + x / (111320.0 * g->coslat);
+        y = g->lat0 + y / 110540.0;
+    }
+    cJSON_AddItemToArray(a, cJSON_CreateNumber(x));
+    cJSON_AddItemToArray(a, cJSON_CreateNumber(y));
+    if (z)
+        cJSON_AddItemToArray(a, cJSON_CreateNumber(*z));
+    return a;
+}
+
+cJSON *geo_ring(const geo_out *g, const double *xy, uint32_t n, const double *z)
+{
+    cJSON *ring = cJSON_CreateArray();
+    uint32_t i;
+    for (i = 0; i <= n; i++) {
+        uint32_t k = i % n;
+        cJSON_AddItemToArray(ring, geo_position(g, xy[2 * k], xy[2 * k + 1], z ? &z[k] : NULL));
+    }
+    return ring;
+}
+
+cJSON *geo_geometry(const char *type, cJSON *coordinates)
+{
+    cJSON *geom = cJSON_CreateObject();
+    cJSON_AddStringToObject(geom, "type", type);
+    cJSON_AddItemToObject(geom, "coordinates", coordinates);
+    return geom;
+}
+
+void geo_add(geo_out *g, cJSON *geometry, cJSON *props)
+{
+    cJSON *f = cJSON_CreateObject();
+    cJSON_AddStringToObject(f, "type", "Feature");
+    cJSON_AddItemToObject(f, "properties", props ? props : cJSON_CreateObject());
+    cJSON_AddItemToObject(f, "geometry", geometry ? geometry : cJSON_CreateNull());
+    cJSON_AddItemToArray(g->features, f);
+}
+
+int geo_write(geo_out *g, const char *cmd, const char *path)
+{
+    char err[512];
+    char *text = cJSON_PrintUnformatted(g->root);
+    int rc;
+    if (!text) {
+        fprintf(stderr, "polarlux %s: %s: out of memory formatting GeoJSON\n", cmd, path);
+        return -1;
+    }
+    rc = port_write_atomic(path, text, strlen(text), err, sizeof err);
+    if (rc != 0)
+        fprintf(stderr, "polarlux %s: %s\n", cmd, err);
+    free(text);
+    return rc;
+}
+
+void geo_free(geo_out *g)
+{
+    cJSON_Delete(g->root);
+    g->root = NULL;
+}
