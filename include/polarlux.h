@@ -86,6 +86,7 @@ typedef struct plx_config {
     const plx_port *port;             /* NULL: no platform services */
     int strict;                       /* 1: the first bad feature fails the load */
     size_t part_budget[PLX_PART_COUNT]; /* per-part byte limits, 0 = only the block limits */
+    size_t lit_cache_bytes;           /* pool for lamp lit regions (0: 16 MiB) */
 } plx_config;
 
 /* Fills cfg with the defaults: no port, lenient loading, no part limits. */
@@ -253,6 +254,75 @@ typedef struct plx_visibility {
  */
 plx_status plx_visibility_get(plx_engine *e, double x, double y, double dir_deg, double fov_deg,
                               plx_visibility *out /* OUT */);
+
+/* ---- Lamp light (SPEC §2) -------------------------------------------------- */
+
+/*
+ * Direct illuminance E (lux) at n surface points P[3k..3k+2] with unit
+ * normals N[3k..3k+2] (SPEC §2, exact 2.5D visibility). E_indirect gets the
+ * photon-buffer estimate (0 until indirect light is computed; may be NULL).
+ * rgb (may be NULL) gets 3 values per point: each lamp's term weighted by its
+ * colour. A point that is not on a surface (inside a building's solid, in
+ * the air) or whose normal points into the solid gets NaN, and the call
+ * returns PLX_E_RANGE naming the first such point; the others are filled.
+ * Lamp lit regions are computed on first need and cached (part
+ * PLX_PART_LIT, pool size from plx_config.lit_cache_bytes).
+ */
+plx_status plx_illuminance(plx_engine *e, size_t n, const double *P, const double *N,
+                           double *E_direct /* OUT */, double *E_indirect /* OUT */,
+                           double *rgb /* OUT */);
+
+/* Is P (normal n) lit, and by which lamps: up to cap lamp indices and their
+ * terms in lux, in lamp order; *count gets the number of lamps lighting P
+ * (which may exceed cap). Same checks as plx_illuminance. */
+plx_status plx_lamps_at(plx_engine *e, const double P[3], const double n[3], uint32_t *ids /* OUT */,
+                        double *lux /* OUT */, uint32_t cap, uint32_t *count /* OUT */);
+
+typedef struct plx_lit_region {
+    uint32_t lamp;
+    uint32_t nground;             /* lit ground polygons (z = 0) */
+    uint32_t nfacade;             /* lit facade polygons (on wall planes) */
+} plx_lit_region;
+
+/*
+ * The lit region of a lamp within its reach. The polygons are read with
+ * plx_lit_ground / plx_lit_facade and stay valid until the next call that
+ * computes light (illuminance, another lamp's region) or a load.
+ */
+plx_status plx_lit_region_get(plx_engine *e, uint32_t lamp, plx_lit_region *out /* OUT */);
+/* Ground polygon k: n vertices, x,y pairs. */
+plx_status plx_lit_ground(plx_engine *e, uint32_t k, const double **xy /* OUT */, uint32_t *n /* OUT */);
+/* Facade polygon k: n vertices, x,y,z triples, on the wall of building *bld. */
+plx_status plx_lit_facade(plx_engine *e, uint32_t k, const double **xyz /* OUT */, uint32_t *n /* OUT */,
+                          uint32_t *bld /* OUT */);
+
+/* ---- How well lit is a route? ------------------------------------------- */
+
+typedef struct plx_route_stats {
+    double length;          /* m of path scored (on the ground outside buildings) */
+    double mean, min, max;  /* horizontal illuminance in lux (direct + indirect) */
+    double uniformity;      /* min / mean (0 when mean is 0) */
+    double dark_share;      /* share of the scored length with E below dark_lux */
+    int p_class;            /* EN 13201 P-class met: 1..6 for P1..P6, 0 for none */
+    uint32_t samples;       /* points computed */
+    double blocked_length;  /* m of path inside building footprints, not scored */
+} plx_route_stats;
+
+/*
+ * Scores the polyline of n vertices xy (local metres) sampled every 'step'
+ * metres (each segment into ceil(length/step) equal parts, both ends
+ * included) on the ground facing up. Means are length-weighted (trapezoid
+ * rule); min and max are over the samples. total (may be NULL) gets the
+ * whole line, segments (may be NULL) n-1 entries, one per segment. The
+ * P-class is the best class whose mean and minimum the line meets (P1 15/3,
+ * P2 10/2, P3 7.5/1.5, P4 5/1, P5 3/0.6, P6 2/0.4 lx).
+ * Errors: PLX_E_INVALID (n < 2, step <= 0, non-finite input), PLX_E_NOMEM.
+ */
+plx_status plx_route_score(plx_engine *e, const double *xy, uint32_t n, double step, double dark_lux,
+                           plx_route_stats *total /* OUT */, plx_route_stats *segments /* OUT */);
+
+/* The EN 13201 P-class (1..6, 0 for none) met by mean and minimum lux. */
+int plx_p_class(double mean, double min);
 
 /* ---- Procedural cities (plx gen) ------------------------------------- */
 

@@ -42,6 +42,15 @@ int eng_ok(const plx_engine *e)
     return e != NULL && e->magic == ENGINE_MAGIC;
 }
 
+/* Messages are one line: control characters that came in with the input
+ * (a raw newline inside an id, say) are shown as '?'. */
+static void one_line(char *s)
+{
+    for (; *s; s++)
+        if ((unsigned char)*s < 0x20 || *s == 0x7f)
+            *s = '?';
+}
+
 plx_status eng_fail(plx_engine *e, plx_status s, const char *msg)
 {
     strbuf b;
@@ -49,6 +58,7 @@ plx_status eng_fail(plx_engine *e, plx_status s, const char *msg)
         sb_init(&b, e->err, sizeof e->err);
         sb_str(&b, msg);
     }
+    one_line(e->err);
     return s;
 }
 
@@ -86,8 +96,14 @@ plx_status eng_nomem(plx_engine *e, const char *during)
 
 void eng_log(plx_engine *e, plx_log_level level, const char *msg)
 {
-    if (e->port.log)
-        e->port.log(e->port.ctx, level, msg);
+    char line[ENGINE_ERR_BYTES];
+    strbuf b;
+    if (!e->port.log)
+        return;
+    sb_init(&b, line, sizeof line);
+    sb_str(&b, msg);
+    one_line(line);
+    e->port.log(e->port.ctx, level, line);
 }
 
 uint64_t eng_clock(plx_engine *e)

@@ -25,6 +25,8 @@ struct plx_engine {
     uint32_t vis_poly_cap;
     uint32_t *vis_ids;
     uint32_t vis_ids_cap;
+    struct light *lt;       /* lamp light, created on first need */
+    const struct lit_region *lit_last; /* region of the last plx_lit_region_get */
 };
 
 #define ENGINE_MAGIC 0x504c5831u /* "PLX1" */

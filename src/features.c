@@ -262,7 +262,7 @@ static plx_status read_ring(loader *ld, const cJSON *jr, uint32_t ring, scene_ri
     return PLX_OK;
 }
 
-/* Holes must lie inside the outer ring and not cross it or each other. */
+/* No edge of a crosses or overlaps an edge of b (touching at points is fine). */
 static int rings_disjoint(const scene *s, const scene_ring *a, const scene_ring *b)
 {
     uint32_t i, j;
@@ -280,26 +280,78 @@ static int rings_disjoint(const scene *s, const scene_ring *a, const scene_ring 
     return 1;
 }
 
+/* Where the points of ring a lie relative to ring b, given that no edges of
+ * the two cross or overlap (rings_disjoint): bit SIDE_IN when some point of a
+ * is strictly inside b, SIDE_OUT when some is strictly outside. Each edge of a
+ * is tested at its start vertex and at the midpoint of every piece between
+ * the vertices of b lying on it: with no crossings, a piece's interior does
+ * not meet b, so its midpoint tells on which side the whole piece is. */
+#define SIDE_IN 1
+#define SIDE_OUT 2
+
+static int side_bit(int where)
+{
+    return where == GEOM_INSIDE ? SIDE_IN : where == GEOM_OUTSIDE ? SIDE_OUT : 0;
+}
+
+static int ring_sides(const scene *s, const scene_ring *a, const scene_ring *b)
+{
+    const vec2 *q = s->pts + b->first;
+    uint32_t i, j;
+    int sides = 0;
+    if ((double)a->count * b->count > HOLE_PAIR_CHECK_LIMIT) {
+        for (i = 0; i < a->count && !sides; i++) /* too large: the first vertex off b */
+            sides = side_bit(geom_point_in_ring(s->pts[a->first + i], q, b->count));
+        return sides;
+    }
+    for (i = 0; i < a->count; i++) {
+        vec2 p0 = s->pts[a->first + i], p1 = s->pts[a->first + (i + 1) % a->count], cur = p0;
+        int along_x = fabs(p1.x - p0.x) >= fabs(p1.y - p0.y);
+        double end = along_x ? p1.x : p1.y;
+        double dir = end > (along_x ? p0.x : p0.y) ? 1.0 : -1.0;
+        sides |= side_bit(geom_point_in_ring(p0, q, b->count));
+        for (;;) {
+            /* the next vertex of b on the edge after cur, else the edge's end */
+            vec2 next = p1, mid;
+            double c = along_x ? cur.x : cur.y, best = end;
+            for (j = 0; j < b->count; j++) {
+                double t = along_x ? q[j].x : q[j].y;
+                if ((t - c) * dir > 0.0 && (best - t) * dir > 0.0 && geom_orient(p0, p1, q[j]) == 0) {
+                    best = t;
+                    next = q[j];
+                }
+            }
+            mid.x = 0.5 * cur.x + 0.5 * next.x;
+            mid.y = 0.5 * cur.y + 0.5 * next.y;
+            sides |= side_bit(geom_point_in_ring(mid, q, b->count));
+            if (next.x == p1.x && next.y == p1.y)
+                break;
+            cur = next;
+        }
+        if (sides == (SIDE_IN | SIDE_OUT))
+            break;
+    }
+    return sides;
+}
+
+/* Holes must lie inside the outer ring (touching it at points at most) and
+ * must not cross, overlap or contain each other. */
 static int check_holes(const scene *s, uint32_t first, uint32_t count, strbuf *why)
 {
     const scene_ring *outer = &s->rings[first];
     uint32_t h, g;
     for (h = 1; h < count; h++) {
         const scene_ring *r = &s->rings[first + h];
-        vec2 v = s->pts[r->first];
-        uint32_t k;
-        int where = geom_point_in_ring(v, s->pts + outer->first, outer->count);
-        for (k = 1; where == GEOM_ON_BOUNDARY && k < r->count; k++)
-            where = geom_point_in_ring(s->pts[r->first + k], s->pts + outer->first, outer->count);
-        if (where != GEOM_INSIDE || !rings_disjoint(s, outer, r)) {
+        if (!rings_disjoint(s, outer, r) || ring_sides(s, r, outer) != SIDE_IN) {
             sb_str(why, "inner ring ");
             sb_uint(why, h);
             sb_str(why, " is not inside the outer ring");
             return 0;
         }
         for (g = 1; g < h; g++) {
-            if (!rings_disjoint(s, &s->rings[first + g], r) ||
-                geom_point_in_ring(v, s->pts + s->rings[first + g].first, s->rings[first + g].count) == GEOM_INSIDE) {
+            const scene_ring *o = &s->rings[first + g];
+            if (!rings_disjoint(s, o, r) || (ring_sides(s, r, o) & SIDE_IN) ||
+                (ring_sides(s, o, r) & SIDE_IN)) {
                 sb_str(why, "inner rings ");
                 sb_uint(why, g);
                 sb_str(why, " and ");
@@ -573,8 +625,14 @@ static plx_status read_feature(loader *ld, const cJSON *f, uint32_t fi)
         return read_building(ld, f, props, 0, fi, id);
     if (strcmp(t, "MultiPolygon") == 0)
         return read_building(ld, f, props, 1, fi, id);
-    if (strcmp(t, "Point") == 0)
-        return is_lamp(props) ? read_lamp(ld, f, props, fi, id) : PLX_OK;
+    if (strcmp(t, "Point") == 0) {
+        const cJSON *lamp = cJSON_GetObjectItemCaseSensitive(props, "lamp");
+        if (is_lamp(props))
+            return read_lamp(ld, f, props, fi, id);
+        if (lamp && !cJSON_IsBool(lamp) && !cJSON_IsNull(lamp))
+            ld_warn(ld, fi, id, "property \"lamp\" is not true or false; ignored, the point is not a lamp");
+        return PLX_OK;
+    }
     sb_init(&b, why, sizeof why);
     sb_str(&b, "geometry type \"");
     sb_strn(&b, t, 40);

@@ -118,21 +118,70 @@ static plx_status fail_scene(loader *ld, const char *why)
 
 /* ---- parsing ------------------------------------------------------------ */
 
+static int is_space(char c);
+
+/* 1 when the text from off to the end holds only white space. */
+static int only_space(const loader *ld, size_t off)
+{
+    for (; off < ld->len; off++)
+        if (!is_space(ld->text[off]))
+            return 0;
+    return 1;
+}
+
+/* Arrays and objects open before byte off (outside strings). */
+static long depth_at(const loader *ld, size_t off)
+{
+    size_t i;
+    long depth = 0;
+    int in_string = 0;
+    for (i = 0; i < off && i < ld->len; i++) {
+        char c = ld->text[i];
+        if (in_string) {
+            if (c == '\\')
+                i++;
+            else if (c == '"')
+                in_string = 0;
+        } else if (c == '"') {
+            in_string = 1;
+        } else if (c == '[' || c == '{') {
+            depth++;
+        } else if (c == ']' || c == '}') {
+            depth--;
+        }
+    }
+    return depth;
+}
+
 static plx_status parse_error(loader *ld, const char *at)
 {
     char msg[ENGINE_ERR_BYTES];
     strbuf b;
     size_t off = at && at >= ld->text ? (size_t)(at - ld->text) : 0;
     uint32_t line, col;
-    int truncated = jsonscan_truncated(ld->text, ld->len);
+    int truncated = jsonscan_truncated(ld->text, ld->len), empty = only_space(ld, 0);
     /* cJSON reports the last byte when it runs off the end */
-    if (off > ld->len || (truncated && off + 1 >= ld->len))
+    if (off > ld->len || (truncated && off + 1 >= ld->len) || empty)
         off = ld->len;
     jsonscan_line_col(ld->text, ld->len, off, &line, &col);
     sb_init(&b, msg, sizeof msg);
     if (ld->name) {
         sb_str(&b, ld->name);
         sb_str(&b, ": ");
+    }
+    if (off < ld->len && (ld->text[off] == '[' || ld->text[off] == '{') &&
+        depth_at(ld, off) >= CJSON_NESTING_LIMIT) {
+        /* well-formed maybe, but deeper than cJSON parses */
+        sb_str(&b, "JSON nested deeper than ");
+        sb_uint(&b, CJSON_NESTING_LIMIT);
+        sb_str(&b, " levels at byte ");
+        sb_uint(&b, off);
+        sb_str(&b, " (line ");
+        sb_uint(&b, line);
+        sb_str(&b, ", column ");
+        sb_uint(&b, col);
+        sb_str(&b, ")");
+        return eng_fail(ld->e, PLX_E_PARSE, msg);
     }
     sb_str(&b, "malformed JSON at byte ");
     sb_uint(&b, off);
@@ -142,7 +191,7 @@ static plx_status parse_error(loader *ld, const char *at)
     sb_uint(&b, col);
     sb_str(&b, ")");
     if (off >= ld->len)
-        sb_str(&b, truncated || ld->len == 0 ? ": the text ends early" : ": unexpected end");
+        sb_str(&b, truncated || empty ? ": the text ends early" : ": unexpected end");
     return eng_fail(ld->e, PLX_E_PARSE, msg);
 }
 
@@ -228,11 +277,21 @@ static int parse_number_text(const char *s, double *out)
         s++;
     if (*s == '+' || *s == '-')
         neg = (*s++ == '-');
-    for (; *s >= '0' && *s <= '9'; s++, digits++)
-        mant = mant * 10.0 + (*s - '0');
-    if (*s == '.') {
-        for (s++; *s >= '0' && *s <= '9'; s++, digits++, exp10--)
+    /* digits past the 18th only scale the value (they are below its
+     * precision), so a long mantissa cannot overflow to inf */
+    for (; *s >= '0' && *s <= '9'; s++, digits = 1) {
+        if (mant < 1e18)
             mant = mant * 10.0 + (*s - '0');
+        else if (exp10 < 10000)
+            exp10++;
+    }
+    if (*s == '.') {
+        for (s++; *s >= '0' && *s <= '9'; s++, digits = 1) {
+            if (mant < 1e18 && exp10 > -10000) {
+                mant = mant * 10.0 + (*s - '0');
+                exp10--;
+            }
+        }
     }
     if (digits == 0)
         return 0;
@@ -240,7 +299,7 @@ static int parse_number_text(const char *s, double *out)
         s++;
         if (*s == '+' || *s == '-')
             eneg = (*s++ == '-');
-        for (; *s >= '0' && *s <= '9'; s++, edigits++)
+        for (; *s >= '0' && *s <= '9'; s++, edigits = 1)
             if (e < 10000)
                 e = e * 10 + (*s - '0');
         if (edigits == 0)
@@ -256,6 +315,8 @@ static int parse_number_text(const char *s, double *out)
     }
     if (*s != '\0')
         return 0;
+    if (mant == 0.0)
+        exp10 = 0; /* "0e99999" is 0, not 0 * inf */
     if (exp10 < 0)
         mant /= pow(10.0, -exp10);
     else if (exp10 > 0)
@@ -405,6 +466,8 @@ static void drop_scene(plx_engine *e)
     e->pd = NULL;
     e->vis_poly = NULL;
     e->vis_ids = NULL;
+    e->lt = NULL;
+    e->lit_last = NULL;
     e->warnings = 0;
     eng_clear_error(e);
     e->mem.lo = e->base.lo;

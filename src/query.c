@@ -5,6 +5,7 @@
 #include "engine.h"
 #include "polar.h"
 #include "visibility.h"
+#include "geom.h"
 
 #define DEG 0.017453292519943295
 
@@ -120,6 +121,27 @@ plx_status plx_polar_region(plx_engine *e, int q, uint32_t i, double xy[8], uint
     return PLX_OK;
 }
 
+/* The building whose footprint holds p strictly inside, or -1. */
+static int32_t host_building(const scene *s, vec2 p)
+{
+    uint32_t i, r;
+    for (i = 0; i < s->nbld; i++) {
+        const scene_building *b = &s->bld[i];
+        int in;
+        if (b->min_height > 0.0 || p.x < b->box[0] || p.x > b->box[2] || p.y < b->box[1] || p.y > b->box[3])
+            continue;
+        in = geom_point_in_ring(p, s->pts + s->rings[b->ring_first].first, s->rings[b->ring_first].count) ==
+             GEOM_INSIDE;
+        for (r = 1; in && r < b->ring_count; r++) {
+            const scene_ring *h = &s->rings[b->ring_first + r];
+            in = geom_point_in_ring(p, s->pts + h->first, h->count) == GEOM_OUTSIDE;
+        }
+        if (in)
+            return (int32_t)i;
+    }
+    return -1;
+}
+
 /* Says why p cannot be a viewer. */
 static plx_status not_free(plx_engine *e, vec2 p)
 {
@@ -127,6 +149,8 @@ static plx_status not_free(plx_engine *e, vec2 p)
     strbuf b;
     int32_t owner = -1;
     int32_t r = polar_locate(e->pd, 0, p, &owner);
+    if (r == -3)
+        owner = host_building(e->sc, p); /* the error path only: a scan is fine */
     const double *bx = e->sc->bounds;
     sb_init(&b, msg, sizeof msg);
     sb_str(&b, "point (");
@@ -143,7 +167,7 @@ static plx_status not_free(plx_engine *e, vec2 p)
             sb_char(&b, ')');
         }
     } else if (r == -3) {
-        sb_str(&b, "is inside a building");
+        sb_str(&b, "lies on a wall shared by two buildings");
     } else if (r == -2) {
         sb_str(&b, "lies on a wall");
     } else {

@@ -132,7 +132,10 @@ static void test_courtyard_and_errors(void **state)
     assert_int_equal(plx_visibility_get(e, 5, 5, 0, 360, &v), PLX_E_RANGE);
     assert_string_equal(plx_last_error(e), "point (5, 5) is inside building 0 (A): not a free viewpoint");
     assert_int_equal(plx_visibility_get(e, 10, 5, 0, 360, &v), PLX_E_RANGE);
-    assert_string_equal(plx_last_error(e), "point (10, 5) lies on a wall: not a free viewpoint");
+    /* the wall shared by A and B is inside their union */
+    assert_string_equal(plx_last_error(e), "point (10, 5) lies on a wall shared by two buildings: not a free viewpoint");
+    assert_int_equal(plx_visibility_get(e, 0, 5, 0, 360, &v), PLX_E_RANGE);
+    assert_string_equal(plx_last_error(e), "point (0, 5) lies on a wall: not a free viewpoint");
     assert_int_equal(plx_visibility_get(e, 500, 5, 0, 360, &v), PLX_E_RANGE);
     assert_string_equal(plx_last_error(e), "point (500, 5) is outside Bounds [-50, -50] - [110, 70]: not a free viewpoint");
     assert_int_equal(plx_visibility_get(e, NAN, 5, 0, 360, &v), PLX_E_INVALID);
