@@ -87,6 +87,48 @@ void canvas_line(canvas *c, double ax, double ay, double bx, double by, const ui
     }
 }
 
+/* 5x7 glyphs: 7 rows of 5 bits, the high bit on the left. */
+typedef struct glyph {
+    char c;
+    uint8_t rows[7];
+} glyph;
+
+static const glyph font[] = {
+    { '0', { 14, 17, 19, 21, 25, 17, 14 } }, { '1', { 4, 12, 4, 4, 4, 4, 14 } },
+    { '2', { 14, 17, 1, 2, 4, 8, 31 } },     { '3', { 31, 2, 4, 2, 1, 17, 14 } },
+    { '4', { 2, 6, 10, 18, 31, 2, 2 } },     { '5', { 31, 16, 30, 1, 1, 17, 14 } },
+    { '6', { 6, 8, 16, 30, 17, 17, 14 } },   { '7', { 31, 1, 2, 4, 8, 8, 8 } },
+    { '8', { 14, 17, 17, 14, 17, 17, 14 } }, { '9', { 14, 17, 17, 15, 1, 2, 12 } },
+    { '.', { 0, 0, 0, 0, 0, 12, 12 } },      { '-', { 0, 0, 0, 31, 0, 0, 0 } },
+    { '+', { 0, 4, 4, 31, 4, 4, 0 } },       { 'e', { 0, 0, 14, 17, 31, 16, 14 } },
+    { 'l', { 12, 4, 4, 4, 4, 4, 14 } },      { 'u', { 0, 0, 17, 17, 17, 19, 13 } },
+    { 'x', { 0, 0, 17, 10, 4, 10, 17 } },
+};
+
+void canvas_rect(canvas *c, int x0, int y0, int x1, int y1, const uint8_t rgb[3])
+{
+    int x, y;
+    for (y = y0; y < y1; y++)
+        for (x = x0; x < x1; x++)
+            put(c, x, y, rgb);
+}
+
+void canvas_text(canvas *c, int x, int y, int scale, const char *text, const uint8_t rgb[3])
+{
+    for (; *text; text++, x += 6 * scale) {
+        size_t g;
+        int r, b;
+        for (g = 0; g < sizeof font / sizeof font[0] && font[g].c != *text; g++)
+            ;
+        if (g == sizeof font / sizeof font[0])
+            continue;
+        for (r = 0; r < 7; r++)
+            for (b = 0; b < 5; b++)
+                if (font[g].rows[r] & (16 >> b))
+                    canvas_rect(c, x + b * scale, y + r * scale, x + (b + 1) * scale, y + (r + 1) * scale, rgb);
+    }
+}
+
 int canvas_write(const canvas *c, const char *path, char *err, size_t errlen)
 {
     return image_write_png_rgb8(path, c->w, c->h, c->rgb, 0, err, errlen);

@@ -40,5 +40,10 @@ int cmd_info(int argc, char **argv);
 int cmd_gen(int argc, char **argv);
 int cmd_vis(int argc, char **argv);
 int cmd_draw(int argc, char **argv);
+int cmd_illum(int argc, char **argv);
+int cmd_lit(int argc, char **argv);
+int cmd_heatmap(int argc, char **argv);
+int cmd_route(int argc, char **argv);
+int cmd_dark_spots(int argc, char **argv);
 
 #endif

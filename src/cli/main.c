@@ -13,6 +13,11 @@ static const command commands[] = {
     { "gen", cmd_gen, "write a procedural city (grid, eixample, oldtown) as GeoJSON" },
     { "vis", cmd_vis, "exact visibility (area, polygon, visible buildings) from points" },
     { "draw", cmd_draw, "draw a quadrant polar diagram as a PNG" },
+    { "illum", cmd_illum, "illuminance in lux at surface points" },
+    { "lit", cmd_lit, "a lamp's lit ground and facade polygons as GeoJSON" },
+    { "heatmap", cmd_heatmap, "a top-down ground illuminance map with a lux legend (PNG)" },
+    { "route", cmd_route, "how well lit is a route: lux statistics and EN 13201 P-class" },
+    { "dark-spots", cmd_dark_spots, "the darkest points of the street area as GeoJSON" },
 };
 
 static void usage(FILE *f)

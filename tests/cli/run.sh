@@ -24,7 +24,7 @@ expect help 0 "^usage: polarlux COMMAND" -- "$bin" --help
 expect no-args 2 "^usage: polarlux COMMAND" -- "$bin"
 expect version 0 "^polarlux [0-9]+\.[0-9]+\.[0-9]+$" -- "$bin" --version
 expect unknown-command 2 "unknown command 'frobnicate'" -- "$bin" frobnicate
-for c in info gen vis draw; do
+for c in info gen vis draw illum lit heatmap route dark-spots; do
     expect "$c-help" 0 "^usage: polarlux $c" -- "$bin" $c --help
     expect "$c-unknown-option" 2 "polarlux $c: unknown option '--bogus'" -- "$bin" $c --bogus x
 done
@@ -70,6 +70,23 @@ expect draw-bad-q 2 "--polar '7' is not a quadrant 0..3" -- "$bin" draw fixtures
 expect draw-ok 0 "^polar diagram 1: [0-9]+ regions" -- "$bin" draw -q fixtures/tiny.geojson --polar 1 -o "$tmp/d.png" --size 200
 if [ "$(head -c 4 "$tmp/d.png" | od -An -c | tr -d ' ')" = "211PNG" ]; then echo "ok   draw-png"; pass=$((pass + 1)); else echo "FAIL draw-png: not a PNG"; fail=$((fail + 1)); fi
 expect draw-unwritable 1 "" -- "$bin" draw -q fixtures/tiny.geojson --polar 0 -o "$tmp/no/such/dir/d.png"
+# illum: directly under lamp L2 (50, 10, z 8) in the courtyard:
+# E = I / z^2 * W(z/R) = 1000 / 64 * (1 - (8/30)^4)^2 = 15.4673748...
+printf '50 10\n50 10 0 0 0 1\n5 5 3 0 0 1\n' >"$tmp/i.txt"
+expect illum-under-lamp 1 "^50 10 0 15\.46737485749[0-9]* 0$" -- "$bin" illum -q fixtures/tiny.geojson --points "$tmp/i.txt"
+expect illum-inside 1 "i.txt:3: point \(5, 5, 3\) is inside a building's solid" -- "$bin" illum -q fixtures/tiny.geojson --points "$tmp/i.txt"
+expect illum-missing 2 "missing --points FILE" -- "$bin" illum fixtures/tiny.geojson
+expect lit-L1 0 "^lamp 0 \(L1\): [0-9]+ lit ground polygons, [0-9]+ lit facade polygons" -- "$bin" lit -q fixtures/tiny.geojson --lamp L1 -o "$tmp/lit.geojson"
+expect lit-index 0 "^lamp 1 \(L2\)" -- "$bin" lit -q fixtures/tiny.geojson --lamp 1 -o "$tmp/lit2.geojson"
+expect lit-no-lamp 1 "no lamp with id or index 'L9'" -- "$bin" lit -q fixtures/tiny.geojson --lamp L9 -o "$tmp/lit3.geojson"
+expect heatmap-ok 0 "^heatmap: [0-9]+x[0-9]+ pixels at 1 m" -- "$bin" heatmap -q fixtures/tiny.geojson --res 1 -o "$tmp/hm.png"
+expect heatmap-bad-box 2 "--box '1,2,3' is not X0,Y0,X1,Y1" -- "$bin" heatmap -q fixtures/tiny.geojson --box 1,2,3 -o "$tmp/hm.png"
+expect route-table 0 "^park-walk +all +[0-9.]+ " -- "$bin" route -q fixtures/helsinki-centre.geojson --path fixtures/helsinki-route.geojson --step 2 --geojson "$tmp/r.geojson"
+expect route-geojson 0 "" -- sh -c "grep -q '\"p_class\"' '$tmp/r.geojson'"
+printf '{"type":"FeatureCollection","features":[{"type":"Feature","properties":{},"geometry":{"type":"Point","coordinates":[1000,0]}}]}' >"$tmp/bad-route.json"
+expect route-not-lines 1 "feature 0: geometry is not a LineString or MultiLineString" -- "$bin" route -q fixtures/tiny.geojson --path "$tmp/bad-route.json"
+expect route-lonlat-vs-metres 1 "the path is in lon/lat but the scene is in local metres" -- "$bin" route -q fixtures/tiny.geojson --path fixtures/helsinki-route.geojson
+expect dark-spots 0 "\"rank\":1" -- "$bin" dark-spots -q fixtures/tiny.geojson --res 2 --count 5
 ls "$tmp"/*.tmp* >/dev/null 2>&1 && { echo "FAIL temporary files left"; fail=$((fail + 1)); }
 echo "cli: $pass passed, $fail failed"
 [ "$fail" -eq 0 ]

@@ -1,0 +1,212 @@
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <cjson/cJSON.h>
+
+#include "port.h"
+#include "route_io.h"
+
+typedef struct frame {
+    int lonlat;           /* the path file is in lon/lat */
+    double lon0, lat0, coslat;
+} frame;
+
+static int add_line(route_set *rs, size_t *cap, const char *name, const cJSON *coords, const frame *f,
+                    char *why, size_t whylen)
+{
+    route_line *l;
+    const cJSON *pos;
+    uint32_t k = 0;
+    int n = cJSON_GetArraySize(coords);
+    if (!cJSON_IsArray(coords) || n < 2) {
+        snprintf(why, whylen, "a line needs at least 2 positions");
+        return -1;
+    }
+    if (rs->n == *cap) {
+        size_t nc = *cap ? *cap * 2 : 16;
+        route_line *nl = realloc(rs->lines, nc * sizeof *nl);
+        if (!nl) {
+            snprintf(why, whylen, "out of memory");
+            return -1;
+        }
+        rs->lines = nl;
+        *cap = nc;
+    }
+    l = &rs->lines[rs->n];
+    memset(l, 0, sizeof *l);
+    snprintf(l->name, sizeof l->name, "%s", name);
+    l->xy = malloc(sizeof *l->xy * 2 * (size_t)n);
+    if (!l->xy) {
+        snprintf(why, whylen, "out of memory");
+        return -1;
+    }
+    cJSON_ArrayForEach(pos, coords) {
+        const cJSON *x = cJSON_GetArrayItem(pos, 0), *y = cJSON_GetArrayItem(pos, 1);
+        double vx, vy;
+        if (!cJSON_IsNumber(x) || !cJSON_IsNumber(y) || !isfinite(x->valuedouble) || !isfinite(y->valuedouble)) {
+            snprintf(why, whylen, "position %u is not [x, y] of finite numbers", k);
+            free(l->xy);
+            return -1;
+        }
+        vx = x->valuedouble;
+        vy = y->valuedouble;
+        if (f->lonlat) {
+            vx = (vx - f->lon0) * 111320.0 * f->coslat;
+            vy = (vy - f->lat0) * 110540.0;
+        }
+        l->xy[2 * k] = vx;
+        l->xy[2 * k + 1] = vy;
+        k++;
+    }
+    l->n = k;
+    rs->n++;
+    return 0;
+}
+
+/* Checks every coordinate lies in lon/lat range. */
+static int all_lonlat(const cJSON *c)
+{
+    const cJSON *it;
+    if (cJSON_IsNumber(c))
+        return 1;
+    if (cJSON_IsArray(c) && cJSON_IsNumber(cJSON_GetArrayItem(c, 0))) {
+        double x = cJSON_GetArrayItem(c, 0)->valuedouble, y = cJSON_IsNumber(cJSON_GetArrayItem(c, 1))
+                                                                   ? cJSON_GetArrayItem(c, 1)->valuedouble
+                                                                   : 0;
+        return x >= -180 && x <= 180 && y >= -90 && y <= 90;
+    }
+    cJSON_ArrayForEach(it, c) if (!all_lonlat(it)) return 0;
+    return 1;
+}
+
+static int set_frame(const cJSON *root, const cJSON *features, plx_engine *e, frame *f, char *why, size_t whylen)
+{
+    const cJSON *props = cJSON_GetObjectItemCaseSensitive(root, "properties");
+    const cJSON *units = cJSON_GetObjectItemCaseSensitive(props, "units"), *ft;
+    plx_scene_info si;
+    int ll = 1;
+    memset(f, 0, sizeof f[0]);
+    plx_scene_info_get(e, &si);
+    if (cJSON_IsString(units) && strcmp(units->valuestring, "m") == 0)
+        return 0;
+    if (units) {
+        snprintf(why, whylen, "properties.units must be \"m\" when given");
+        return -1;
+    }
+    cJSON_ArrayForEach(ft, features) {
+        const cJSON *g = cJSON_GetObjectItemCaseSensitive(ft, "geometry");
+        if (!all_lonlat(cJSON_GetObjectItemCaseSensitive(g, "coordinates")))
+            ll = 0;
+    }
+    if (!ll)
+        return 0; /* metres, as for scenes (with no warning: the path file follows the scene) */
+    if (!si.lonlat) {
+        snprintf(why, whylen, "the path is in lon/lat but the scene is in local metres");
+        return -1;
+    }
+    f->lonlat = 1;
+    f->lon0 = si.lon0;
+    f->lat0 = si.lat0;
+    f->coslat = cos(si.lat0 * 3.14159265358979323846 / 180.0);
+    return 0;
+}
+
+static void line_name(const cJSON *ft, size_t k, char *out, size_t len)
+{
+    const cJSON *props = cJSON_GetObjectItemCaseSensitive(ft, "properties");
+    const cJSON *nm = cJSON_GetObjectItemCaseSensitive(props, "name");
+    const cJSON *id = cJSON_GetObjectItemCaseSensitive(props, "id");
+    if (cJSON_IsString(nm))
+        snprintf(out, len, "%s", nm->valuestring);
+    else if (cJSON_IsString(id))
+        snprintf(out, len, "%s", id->valuestring);
+    else if (cJSON_IsNumber(id))
+        snprintf(out, len, "%.0f", id->valuedouble);
+    else
+        snprintf(out, len, "#%zu", k);
+}
+
+int route_parse(const char *name, const char *text, size_t len, plx_engine *e, route_set *out,
+                char *err, size_t errlen)
+{
+    cJSON *root = cJSON_ParseWithLength(text, len);
+    const cJSON *features, *ft, *type;
+    frame f;
+    size_t cap = 0, k = 0;
+    char why[256];
+    memset(out, 0, sizeof *out);
+    if (!root) {
+        const char *at = cJSON_GetErrorPtr();
+        long off = at && at >= text && at <= text + len ? (long)(at - text) : -1;
+        snprintf(err, errlen, "%s: malformed JSON near byte %ld", name, off);
+        return -1;
+    }
+    type = cJSON_GetObjectItemCaseSensitive(root, "type");
+    features = cJSON_GetObjectItemCaseSensitive(root, "features");
+    if (!cJSON_IsString(type) || strcmp(type->valuestring, "FeatureCollection") != 0 || !cJSON_IsArray(features)) {
+        snprintf(err, errlen, "%s: not a GeoJSON FeatureCollection with a features array", name);
+        cJSON_Delete(root);
+        return -1;
+    }
+    if (set_frame(root, features, e, &f, why, sizeof why) != 0) {
+        snprintf(err, errlen, "%s: %s", name, why);
+        cJSON_Delete(root);
+        return -1;
+    }
+    cJSON_ArrayForEach(ft, features) {
+        const cJSON *g = cJSON_GetObjectItemCaseSensitive(ft, "geometry");
+        const cJSON *gt = cJSON_GetObjectItemCaseSensitive(g, "type");
+        const cJSON *co = cJSON_GetObjectItemCaseSensitive(g, "coordinates"), *part;
+        char nm[32];
+        int bad = 0;
+        line_name(ft, k, nm, sizeof nm);
+        if (cJSON_IsString(gt) && strcmp(gt->valuestring, "LineString") == 0) {
+            bad = add_line(out, &cap, nm, co, &f, why, sizeof why);
+        } else if (cJSON_IsString(gt) && strcmp(gt->valuestring, "MultiLineString") == 0 && cJSON_IsArray(co)) {
+            cJSON_ArrayForEach(part, co) if (!bad) bad = add_line(out, &cap, nm, part, &f, why, sizeof why);
+        } else {
+            snprintf(why, sizeof why, "geometry is not a LineString or MultiLineString");
+            bad = 1;
+        }
+        if (bad) {
+            snprintf(err, errlen, "%s: feature %zu: %s", name, k, why);
+            cJSON_Delete(root);
+            route_free(out);
+            return -1;
+        }
+        k++;
+    }
+    cJSON_Delete(root);
+    if (out->n == 0) {
+        snprintf(err, errlen, "%s: no LineString features", name);
+        return -1;
+    }
+    return 0;
+}
+
+int route_read(const char *path, plx_engine *e, route_set *out, char *err, size_t errlen)
+{
+    char why[256];
+    size_t len;
+    char *text = port_read_text(path, &len, why, sizeof why);
+    int rc;
+    memset(out, 0, sizeof *out);
+    if (!text) {
+        snprintf(err, errlen, "%s: %s", path, why);
+        return -1;
+    }
+    rc = route_parse(path, text, len, e, out, err, errlen);
+    free(text);
+    return rc;
+}
+
+void route_free(route_set *rs)
+{
+    size_t i;
+    for (i = 0; i < rs->n; i++)
+        free(rs->lines[i].xy);
+    free(rs->lines);
+    rs->lines = NULL;
+    rs->n = 0;
+}

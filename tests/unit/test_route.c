@@ -1,0 +1,221 @@
+/* Route scoring: hand-computed values (one lamp over a straight street; a
+ * building's shadow across it), consistency with plx_illuminance at the same
+ * points, and the EN 13201 P-class boundaries. */
+#include <stdarg.h>
+#include <stddef.h>
+#include <setjmp.h>
+#include <stdint.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <cmocka.h>
+
+#include "polarlux.h"
+
+#define MEM (64u << 20)
+
+static plx_engine *load(const char *json, void **mem)
+{
+    plx_engine *e;
+    plx_config cfg;
+    plx_config_default(&cfg);
+    *mem = malloc(MEM);
+    assert_int_equal(plx_engine_create(*mem, MEM, &cfg, &e), PLX_OK);
+    assert_int_equal(plx_load_geojson(e, json, strlen(json), "t"), PLX_OK);
+    return e;
+}
+
+static double window(double x)
+{
+    double t = 1.0 - x * x * x * x;
+    t = t < 0 ? 0 : t > 1 ? 1 : t;
+    return t * t;
+}
+
+/* E at ground point (x, y) from a lamp at (lx, ly, lz), I cd, reach R, unblocked. */
+static double lamp_E(double x, double y, double lx, double ly, double lz, double I, double R)
+{
+    double dx = lx - x, dy = ly - y, d = sqrt(dx * dx + dy * dy + lz * lz);
+    return I * lz / (d * d * d) * window(d / R);
+}
+
+static void test_one_lamp_straight_street(void **state)
+{
+    void *mem;
+    plx_engine *e = load("{\"type\":\"FeatureCollection\",\"properties\":{\"units\":\"m\"},\"features\":["
+                         "{\"type\":\"Feature\",\"properties\":{\"lamp\":true,\"z\":6,\"intensity\":1000,\"radius\":30},"
+                         "\"geometry\":{\"type\":\"Point\",\"coordinates\":[0,0]}}]}", &mem);
+    double xy[4] = { -10, 0, 10, 0 }, sum = 0, mn = 1e9, mx = 0, dark = 0;
+    plx_route_stats tot, seg[1];
+    int i;
+    (void)state;
+    for (i = 0; i <= 20; i++) {
+        double E = lamp_E(-10 + i, 0, 0, 0, 6, 1000, 30), w = (i == 0 || i == 20) ? 0.5 : 1.0;
+        sum += w * E;
+        mn = fmin(mn, E);
+        mx = fmax(mx, E);
+        if (E < 5.0)
+            dark += w;
+    }
+    assert_int_equal(plx_route_score(e, xy, 2, 1.0, 5.0, &tot, seg), PLX_OK);
+    assert_true(fabs(tot.length - 20.0) < 1e-12);
+    assert_int_equal(tot.samples, 21);
+    assert_true(fabs(tot.mean - sum / 20.0) < 1e-9 * tot.mean);
+    assert_true(fabs(tot.min - mn) < 1e-9 * mn && fabs(tot.max - mx) < 1e-9 * mx);
+    /* directly below: I z / z^3 W(z/R) = 1000/36 (1 - 0.2^4)^2 */
+    assert_true(fabs(tot.max - 1000.0 / 36.0 * pow(1 - pow(0.2, 4), 2)) < 1e-9);
+    assert_true(fabs(tot.uniformity - mn / (sum / 20.0)) < 1e-9);
+    assert_true(fabs(tot.dark_share - dark / 20.0) < 1e-12);
+    assert_true(fabs(seg[0].mean - tot.mean) < 1e-12);
+    assert_int_equal(tot.p_class, plx_p_class(sum / 20.0, mn));
+    plx_engine_destroy(e);
+    free(mem);
+}
+
+static void test_shadow_across_street(void **state)
+{
+    /* lamp at (0, 5, 6); a 20 m tall box x in [-2, 2], y in [2, 3]; the street
+     * y = 0 from x = -10 to 10. The segment from the lamp to (x, 0) meets the
+     * box's top side y = 3 at x' = 0.4 x, so |x| < 5 is in the shadow and
+     * |x| = 5 grazes the corner (lit). */
+    void *mem;
+    plx_engine *e = load("{\"type\":\"FeatureCollection\",\"properties\":{\"units\":\"m\"},\"features\":["
+                         "{\"type\":\"Feature\",\"properties\":{\"height\":20},\"geometry\":{\"type\":\"Polygon\","
+                         "\"coordinates\":[[[-2,2],[2,2],[2,3],[-2,3],[-2,2]]]}},"
+                         "{\"type\":\"Feature\",\"properties\":{\"lamp\":true,\"z\":6,\"intensity\":1000,\"radius\":30},"
+                         "\"geometry\":{\"type\":\"Point\",\"coordinates\":[0,5]}}]}", &mem);
+    double xy[4] = { -10, 0, 10, 0 }, sum = 0, dark = 0;
+    plx_route_stats tot;
+    int i;
+    (void)state;
+    for (i = 0; i <= 20; i++) {
+        double x = -10 + i, w = (i == 0 || i == 20) ? 0.5 : 1.0;
+        double E = fabs(x) < 5 ? 0.0 : lamp_E(x, 0, 0, 5, 6, 1000, 30);
+        sum += w * E;
+        if (E < 1.0)
+            dark += w;
+    }
+    assert_int_equal(plx_route_score(e, xy, 2, 1.0, 1.0, &tot, NULL), PLX_OK);
+    assert_true(tot.min == 0.0);
+    assert_true(fabs(tot.mean - sum / 20.0) < 1e-9 * tot.mean);
+    assert_true(fabs(tot.dark_share - dark / 20.0) < 1e-12);
+    assert_true(fabs(dark - 9.0) < 1e-12); /* x = -4 .. 4 */
+    assert_int_equal(tot.p_class, 0);
+    assert_true(tot.uniformity == 0.0);
+    plx_engine_destroy(e);
+    free(mem);
+}
+
+static void test_route_through_building(void **state)
+{
+    void *mem;
+    plx_engine *e = load("{\"type\":\"FeatureCollection\",\"properties\":{\"units\":\"m\"},\"features\":["
+                         "{\"type\":\"Feature\",\"properties\":{\"height\":10},\"geometry\":{\"type\":\"Polygon\","
+                         "\"coordinates\":[[[-2.5,-5],[2.5,-5],[2.5,5],[-2.5,5],[-2.5,-5]]]}},"
+                         "{\"type\":\"Feature\",\"properties\":{\"lamp\":true},"
+                         "\"geometry\":{\"type\":\"Point\",\"coordinates\":[0,10]}}]}", &mem);
+    double xy[4] = { -10, 0, 10, 0 };
+    plx_route_stats tot;
+    (void)state;
+    assert_int_equal(plx_route_score(e, xy, 2, 1.0, 1.0, &tot, NULL), PLX_OK);
+    /* samples x = -2 .. 2 are inside the footprint: 5 m not scored */
+    assert_true(fabs(tot.blocked_length - 5.0) < 1e-12);
+    assert_true(fabs(tot.length - 15.0) < 1e-12);
+    assert_int_equal(tot.samples, 16);
+    plx_engine_destroy(e);
+    free(mem);
+}
+
+static void test_consistent_with_illuminance(void **state)
+{
+    void *mem = malloc(MEM);
+    plx_engine *e;
+    plx_config cfg;
+    double xy[6] = { -200, -300, 100, -250, 150, 100 }, P[3 * 400], N[3 * 400], E[400], Ei[400];
+    plx_route_stats tot, seg[2];
+    int s;
+    (void)state;
+    plx_config_default(&cfg);
+    assert_int_equal(plx_engine_create(mem, MEM, &cfg, &e), PLX_OK);
+    {
+        FILE *f = fopen("fixtures/helsinki-centre.geojson", "rb");
+        static char text[400000];
+        size_t len = fread(text, 1, sizeof text, f);
+        fclose(f);
+        assert_int_equal(plx_load_geojson(e, text, len, "h"), PLX_OK);
+    }
+    assert_int_equal(plx_route_score(e, xy, 3, 2.0, 1.0, &tot, seg), PLX_OK);
+    for (s = 0; s < 2; s++) {
+        const double *a = xy + 2 * s, *b = a + 2;
+        double len = hypot(b[0] - a[0], b[1] - a[1]), w, sum = 0, L = 0, mn = INFINITY;
+        int k = (int)ceil(len / 2.0), i;
+        assert_true(k + 1 <= 400);
+        for (i = 0; i <= k; i++) {
+            P[3 * i] = a[0] + (b[0] - a[0]) * i / k;
+            P[3 * i + 1] = a[1] + (b[1] - a[1]) * i / k;
+            P[3 * i + 2] = 0;
+            N[3 * i] = N[3 * i + 1] = 0;
+            N[3 * i + 2] = 1;
+        }
+        plx_illuminance(e, (size_t)k + 1, P, N, E, Ei, NULL);
+        w = len / k;
+        for (i = 0; i <= k; i++) {
+            double wi = (i == 0 || i == k) ? w / 2 : w;
+            if (E[i] != E[i])
+                continue;
+            sum += wi * (E[i] + Ei[i]);
+            L += wi;
+            mn = fmin(mn, E[i] + Ei[i]);
+        }
+        assert_true(fabs(seg[s].length - L) < 1e-9);
+        assert_true(fabs(seg[s].mean - sum / L) <= 1e-12 * fmax(1.0, sum / L));
+        assert_true(seg[s].min == mn);
+    }
+    plx_engine_destroy(e);
+    free(mem);
+}
+
+static void test_p_class_boundaries(void **state)
+{
+    (void)state;
+    assert_int_equal(plx_p_class(15.0, 3.0), 1);
+    assert_int_equal(plx_p_class(14.99, 3.0), 2);
+    assert_int_equal(plx_p_class(15.0, 2.99), 2);
+    assert_int_equal(plx_p_class(10.0, 2.0), 2);
+    assert_int_equal(plx_p_class(7.5, 1.5), 3);
+    assert_int_equal(plx_p_class(7.49, 1.5), 4);
+    assert_int_equal(plx_p_class(5.0, 1.0), 4);
+    assert_int_equal(plx_p_class(3.0, 0.6), 5);
+    assert_int_equal(plx_p_class(2.0, 0.4), 6);
+    assert_int_equal(plx_p_class(100.0, 0.39), 0);
+    assert_int_equal(plx_p_class(1.99, 1.0), 0);
+}
+
+static void test_errors(void **state)
+{
+    void *mem;
+    plx_engine *e = load("{\"type\":\"FeatureCollection\",\"features\":[]}", &mem);
+    double xy[4] = { 0, 0, 1, 0 };
+    plx_route_stats t;
+    (void)state;
+    assert_int_equal(plx_route_score(e, xy, 1, 1.0, 1.0, &t, NULL), PLX_E_INVALID);
+    assert_int_equal(plx_route_score(e, xy, 2, 0.0, 1.0, &t, NULL), PLX_E_INVALID);
+    xy[2] = NAN;
+    assert_int_equal(plx_route_score(e, xy, 2, 1.0, 1.0, &t, NULL), PLX_E_INVALID);
+    plx_engine_destroy(e);
+    free(mem);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_one_lamp_straight_street),
+        cmocka_unit_test(test_shadow_across_street),
+        cmocka_unit_test(test_route_through_building),
+        cmocka_unit_test(test_consistent_with_illuminance),
+        cmocka_unit_test(test_p_class_boundaries),
+        cmocka_unit_test(test_errors),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
