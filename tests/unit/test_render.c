@@ -1,0 +1,1129 @@
+/* test_render: the renderer (src/render.h, src/mesh.h) against an
+ * independent per-pixel reference written here.
+ *
+ * The reference follows SPEC §5 from scratch: one primary ray per pixel
+ * through the pixel centre, the first hit found by brute force against
+ * every wall, roof and underside of every prism and the ground plane,
+ * shaded with tests/ref/ref_light (colour-weighted SPEC §2 illuminance),
+ * radiance albedo / pi * E, exposure, the sRGB curve computed with pow and
+ * rounded. The renderer is given the same brute-force shader, so the test
+ * checks the camera, visibility, hit points, normals and tone mapping.
+ *
+ * Agreement rule: at least 99.5 % of pixels within 2/255 on every channel,
+ * and every pixel beyond that has a neighbour (8-neighbourhood) whose
+ * reference hit is another surface (a geometric edge).
+ *
+ * Golden images: fixtures/golden/NAME.png (glows on). On a mismatch the test
+ * writes <name>.actual.png and <name>.diff.png into build/golden-out/ and
+ * prints how to update: PLX_UPDATE_GOLDEN=1 build/tests/test_render.
+ *
+ * PLX_RENDER_OUT=dir writes every rendered image there, for looking at.
+ */
+#include <stdarg.h>
+#include <stddef.h>
+#include <setjmp.h>
+#include <stdint.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <cmocka.h>
+
+#include "polarlux.h"
+#include "engine.h"
+#include "render.h"
+#include "mesh.h"
+#include "light.h"
+#include "geom.h"
+#include "ref_light.h"
+#include "png/image_write.h"
+
+#define MEM (512u << 20)
+#define PI 3.14159265358979323846
+#define TWO_PI_T (2.0 * PI)
+
+static int quick(void)
+{
+    return getenv("PLX_TEST_QUICK") != NULL;
+}
+
+static plx_engine *open_scene(const char *path, void **mem)
+{
+    plx_engine *e;
+    plx_config cfg;
+    static plx_port port;
+    port = *plx_port_posix();
+    port.log = NULL;
+    plx_config_default(&cfg);
+    cfg.port = &port;
+    *mem = malloc(MEM);
+    assert_non_null(*mem);
+    assert_int_equal(plx_engine_create(*mem, MEM, &cfg, &e), PLX_OK);
+    assert_int_equal(plx_load_file(e, path), PLX_OK);
+    return e;
+}
+
+/* The brute-force shader, fed per lamp only the buildings that can block
+ * it: a blocking building meets the segment L->P, which lies within R of L
+ * whenever the lamp contributes (d < R), so its box comes within R of L.
+ * Each lamp gets a shallow copy of the scene holding that lamp alone and
+ * those buildings (rings and points shared); the sum over lamps of
+ * ref_illuminance_rgb on them is exactly ref_illuminance_rgb on the scene. */
+typedef struct ref_sh {
+    const scene *s;
+    scene *sub;           /* one per lamp */
+} ref_sh;
+
+static ref_sh *ref_sh_new(const scene *s)
+{
+    ref_sh *r = calloc(1, sizeof *r);
+    uint32_t l, b;
+    r->s = s;
+    r->sub = calloc(s->nlamps + 1, sizeof *r->sub);
+    for (l = 0; l < s->nlamps; l++) {
+        const scene_lamp *lp = &s->lamps[l];
+        scene *q = &r->sub[l];
+        *q = *s;
+        q->lamps = (scene_lamp *)lp;
+        q->nlamps = 1;
+        q->bld = malloc((s->nbld + 1) * sizeof *q->bld);
+        q->nbld = 0;
+        for (b = 0; b < s->nbld; b++) {
+            const double *bx = s->bld[b].box;
+            double dx = fmax(0.0, fmax(bx[0] - lp->x, lp->x - bx[2]));
+            double dy = fmax(0.0, fmax(bx[1] - lp->y, lp->y - bx[3]));
+            if (dx * dx + dy * dy <= lp->radius * lp->radius * 1.0001 + 1e-6)
+                q->bld[q->nbld++] = s->bld[b];
+        }
+    }
+    return r;
+}
+
+static void ref_sh_free(ref_sh *r)
+{
+    uint32_t l;
+    for (l = 0; l < r->s->nlamps; l++)
+        free(r->sub[l].bld);
+    free(r->sub);
+    free(r);
+}
+
+static void ref_shade(void *user, const double P[3], const double n[3], double rgb[3])
+{
+    const ref_sh *r = user;
+    uint32_t l;
+    rgb[0] = rgb[1] = rgb[2] = 0;
+    for (l = 0; l < r->s->nlamps; l++) {
+        const scene_lamp *lp = &r->s->lamps[l];
+        double dx = lp->x - P[0], dy = lp->y - P[1], dz = lp->z - P[2], e[3];
+        if (dx * dx + dy * dy + dz * dz >= lp->radius * lp->radius)
+            continue;
+        ref_illuminance_rgb(&r->sub[l], P, n, e);
+        rgb[0] += e[0];
+        rgb[1] += e[1];
+        rgb[2] += e[2];
+    }
+}
+
+static void save_png(const char *name, const uint8_t *img, int w, int h)
+{
+    const char *dir = getenv("PLX_RENDER_OUT");
+    char path[512], err[256];
+    if (!dir)
+        return;
+    snprintf(path, sizeof path, "%s/%s.png", dir, name);
+    if (image_write_png_rgb8(path, w, h, img, 0, err, sizeof err) != 0)
+        print_message("%s\n", err);
+}
+
+/* ---- the independent reference ------------------------------------------ */
+
+/* Crossing-number point in polygon (plain doubles; boundary either way). */
+static int in_ring(const vec2 *p, uint32_t n, double x, double y)
+{
+    uint32_t i, j;
+    int c = 0;
+    for (i = 0, j = n - 1; i < n; j = i++) {
+        if ((p[i].y > y) != (p[j].y > y)) {
+            double xc = p[j].x + (y - p[j].y) * (p[i].x - p[j].x) / (p[i].y - p[j].y);
+            if (x < xc)
+                c = !c;
+        }
+    }
+    return c;
+}
+
+static int in_footprint(const scene *s, const scene_building *b, double x, double y)
+{
+    uint32_t r;
+    const scene_ring *o = &s->rings[b->ring_first];
+    if (!in_ring(s->pts + o->first, o->count, x, y))
+        return 0;
+    for (r = 1; r < b->ring_count; r++) {
+        const scene_ring *h = &s->rings[b->ring_first + r];
+        if (in_ring(s->pts + h->first, h->count, x, y))
+            return 0;
+    }
+    return 1;
+}
+
+typedef struct ref_hit {
+    uint32_t surf;     /* the mesh.h id convention */
+    double t;
+    double n[3];
+    double albedo;
+} ref_hit;
+
+static ref_hit ref_first_hit(const scene *s, const double e[3], const double d[3])
+{
+    ref_hit h;
+    uint32_t b, r, i;
+    h.surf = 0;
+    h.t = HUGE_VAL;
+    h.albedo = 0;
+    h.n[0] = h.n[1] = 0;
+    h.n[2] = 1;
+    for (b = 0; b < s->nbld; b++) {
+        const scene_building *bd = &s->bld[b];
+        double zs[2];
+        int k;
+        /* walls */
+        for (r = 0; r < bd->ring_count; r++) {
+            const scene_ring *rg = &s->rings[bd->ring_first + r];
+            for (i = 0; i < rg->count; i++) {
+                vec2 a = s->pts[rg->first + i], c = s->pts[rg->first + (i + 1) % rg->count];
+                double ex = c.x - a.x, ey = c.y - a.y;
+                /* solve e + t d = a + u (c - a) in xy */
+                double den = d[0] * ey - d[1] * ex, t, u, z;
+                if (den == 0.0)
+                    continue;
+                t = ((a.x - e[0]) * ey - (a.y - e[1]) * ex) / den;
+                u = ((a.x - e[0]) * d[1] - (a.y - e[1]) * d[0]) / den;
+                if (!(t > 0.0) || u < 0.0 || u > 1.0 || !(t < h.t))
+                    continue;
+                z = e[2] + t * d[2];
+                if (z < bd->min_height || z > bd->height)
+                    continue;
+                h.t = t;
+                h.surf = 2 + rg->first + i;
+                {
+                    double len = sqrt(ex * ex + ey * ey);
+                    h.n[0] = ey / len;
+                    h.n[1] = -ex / len;
+                    h.n[2] = 0;
+                }
+                h.albedo = bd->albedo;
+            }
+        }
+        /* roof and underside */
+        zs[0] = bd->height;
+        zs[1] = bd->min_height;
+        for (k = 0; k < 2; k++) {
+            double t, x, y;
+            if (k == 1 && !(bd->min_height > 0))
+                continue;
+            if (d[2] == 0.0)
+                continue;
+            t = (zs[k] - e[2]) / d[2];
+            if (!(t > 0.0) || !(t < h.t))
+                continue;
+            x = e[0] + t * d[0];
+            y = e[1] + t * d[1];
+            if (x < bd->box[0] || x > bd->box[2] || y < bd->box[1] || y > bd->box[3])
+                continue;
+            if (!in_footprint(s, bd, x, y))
+                continue;
+            h.t = t;
+            h.surf = k == 0 ? 2 + s->npts + b : 2 + s->npts + s->nbld + b;
+            h.n[0] = h.n[1] = 0;
+            h.n[2] = k == 0 ? 1 : -1;
+            h.albedo = bd->albedo;
+        }
+    }
+    if (h.surf == 0 && d[2] < 0) {
+        h.surf = 1;
+        h.t = -e[2] / d[2];
+        h.n[0] = h.n[1] = 0;
+        h.n[2] = 1;
+        h.albedo = s->ground_albedo;
+    }
+    return h;
+}
+
+static uint8_t ref_srgb8(double v)
+{
+    double e;
+    if (!(v > 0))
+        return 0;
+    if (v >= 1)
+        return 255;
+    e = v <= 0.0031308 ? 12.92 * v : 1.055 * pow(v, 1.0 / 2.4) - 0.055;
+    return (uint8_t)floor(e * 255.0 + 0.5);
+}
+
+typedef struct ref_cam {
+    double eye[3], target[3], fov;
+    int w, h;
+} ref_cam;
+
+/* The reference image (and the surface of each pixel). */
+static void ref_render(const scene *s, const ref_sh *sh, const ref_cam *c, double exposure, uint8_t *img,
+                       uint32_t *surf)
+{
+    double f[3], rt[3], up[3], l, th = tan(c->fov * PI / 360.0), asp = (double)c->w / c->h;
+    int i, j, k;
+    for (k = 0; k < 3; k++)
+        f[k] = c->target[k] - c->eye[k];
+    l = sqrt(f[0] * f[0] + f[1] * f[1] + f[2] * f[2]);
+    for (k = 0; k < 3; k++)
+        f[k] /= l;
+    /* right = f x (0, 0, 1) normalised; up = right x f */
+    rt[0] = f[1];
+    rt[1] = -f[0];
+    rt[2] = 0;
+    l = sqrt(rt[0] * rt[0] + rt[1] * rt[1]);
+    rt[0] /= l;
+    rt[1] /= l;
+    up[0] = rt[1] * f[2] - rt[2] * f[1];
+    up[1] = rt[2] * f[0] - rt[0] * f[2];
+    up[2] = rt[0] * f[1] - rt[1] * f[0];
+    for (j = 0; j < c->h; j++)
+        for (i = 0; i < c->w; i++) {
+            double x = (2.0 * (i + 0.5) / c->w - 1.0) * th * asp, y = (1.0 - 2.0 * (j + 0.5) / c->h) * th;
+            double d[3], P[3], n[3], E[3] = { 0, 0, 0 };
+            ref_hit h;
+            uint8_t *px = &img[3 * ((size_t)j * c->w + i)];
+            for (k = 0; k < 3; k++)
+                d[k] = f[k] + x * rt[k] + y * up[k];
+            h = ref_first_hit(s, c->eye, d);
+            surf[(size_t)j * c->w + i] = h.surf;
+            if (h.surf == 0) {
+                px[0] = px[1] = px[2] = 0;
+                continue;
+            }
+            for (k = 0; k < 3; k++)
+                P[k] = c->eye[k] + h.t * d[k];
+            if (h.surf == 1)
+                P[2] = 0;
+            /* the normal facing the eye */
+            if (h.n[0] * d[0] + h.n[1] * d[1] + h.n[2] * d[2] > 0)
+                for (k = 0; k < 3; k++)
+                    h.n[k] = -h.n[k];
+            for (k = 0; k < 3; k++)
+                n[k] = h.n[k];
+            ref_shade((void *)sh, P, n, E);
+            for (k = 0; k < 3; k++)
+                px[k] = ref_srgb8(h.albedo / PI * E[k] * exposure);
+        }
+}
+
+/* ---- helpers ---------------------------------------------------------------- */
+
+static render_camera to_cam(const ref_cam *c)
+{
+    render_camera k;
+    memcpy(k.eye, c->eye, sizeof k.eye);
+    memcpy(k.target, c->target, sizeof k.target);
+    k.fov_deg = c->fov;
+    k.width = c->w;
+    k.height = c->h;
+    return k;
+}
+
+typedef struct agree { size_t n, close, edge_only, bad; int maxdiff; } agree;
+
+/* Compares img with the reference ref (surfaces rs). */
+static agree compare(const uint8_t *img, const uint8_t *ref, const uint32_t *rs, int w, int h)
+{
+    agree a;
+    int i, j, k;
+    memset(&a, 0, sizeof a);
+    a.n = (size_t)w * h;
+    for (j = 0; j < h; j++)
+        for (i = 0; i < w; i++) {
+            size_t p = (size_t)j * w + i;
+            int dmax = 0, di, dj, edge = 0;
+            for (k = 0; k < 3; k++) {
+                int d = abs((int)img[3 * p + k] - (int)ref[3 * p + k]);
+                if (d > dmax)
+                    dmax = d;
+            }
+            if (dmax > a.maxdiff)
+                a.maxdiff = dmax;
+            if (dmax <= 2) {
+                a.close++;
+                continue;
+            }
+            for (dj = -1; dj <= 1; dj++)
+                for (di = -1; di <= 1; di++) {
+                    int x = i + di, y = j + dj;
+                    if (x < 0 || y < 0 || x >= w || y >= h)
+                        continue;
+                    if (rs[(size_t)y * w + x] != rs[p])
+                        edge = 1;
+                }
+            if (edge)
+                a.edge_only++;
+            else {
+                if (a.bad < 5)
+                    print_message("  non-edge mismatch at (%d, %d): %d %d %d vs %d %d %d, surface %u\n", i, j,
+                                  img[3 * p], img[3 * p + 1], img[3 * p + 2], ref[3 * p], ref[3 * p + 1],
+                                  ref[3 * p + 2], rs[p]);
+                a.bad++;
+            }
+        }
+    return a;
+}
+
+typedef struct fixture {
+    void *mem;
+    plx_engine *e;
+    render *r;
+    ref_sh *sh;
+} fixture;
+
+static void fx_open(fixture *f, const char *path, int w, int h)
+{
+    f->e = open_scene(path, &f->mem);
+    f->sh = ref_sh_new(f->e->sc);
+    assert_int_equal(render_create(&f->e->mem, f->e->sc, w, h, ref_shade, f->sh, &f->r), PLX_OK);
+}
+
+static void fx_close(fixture *f)
+{
+    ref_sh_free(f->sh);
+    plx_engine_destroy(f->e);
+    free(f->mem);
+}
+
+/* Renders c and the reference; checks the agreement rule. */
+static void check_against_ref(fixture *f, const ref_cam *c, const char *name)
+{
+    render_camera cam = to_cam(c);
+    render_opts o;
+    render_stats st;
+    size_t px = (size_t)c->w * c->h;
+    uint8_t *img = malloc(3 * px), *ref = malloc(3 * px);
+    uint32_t *rs = malloc(px * sizeof *rs);
+    agree a;
+    char nm[128];
+    render_opts_default(&o);
+    o.no_glow = 1;
+    assert_int_equal(render_frame(f->r, &cam, &o, img, NULL, &st), PLX_OK);
+    ref_render(f->e->sc, f->sh, c, 1.0, ref, rs);
+    a = compare(img, ref, rs, c->w, c->h);
+    print_message("%s: %zu px, %.3f %% within 2/255, %zu edge mismatches, %zu others, max diff %d; "
+                  "%u/%u buildings drawn, %.1f %% of triangles\n", name, a.n, 100.0 * a.close / a.n,
+                  a.edge_only, a.bad, a.maxdiff, st.drawn, st.buildings, 100.0 * st.drawn_fraction);
+    snprintf(nm, sizeof nm, "%s", name);
+    save_png(nm, img, c->w, c->h);
+    snprintf(nm, sizeof nm, "%s.ref", name);
+    save_png(nm, ref, c->w, c->h);
+    assert_true(a.close >= (size_t)ceil(0.995 * a.n));
+    assert_int_equal(a.bad, 0);
+    /* something is lit: not a black image */
+    {
+        size_t p, lit = 0;
+        for (p = 0; p < 3 * px; p++)
+            lit += img[p] > 8;
+        assert_true(lit > px / 50);
+    }
+    free(img);
+    free(ref);
+    free(rs);
+}
+
+static int W(void) { return quick() ? 96 : 160; }
+static int H(void) { return quick() ? 72 : 120; }
+
+/* ---- cameras ---------------------------------------------------------------- */
+
+static ref_cam cam_tiny(void)
+{
+    ref_cam c = { { -18, -22, 9 }, { 32, 10, 2 }, 60, 0, 0 };
+    c.w = W();
+    c.h = H();
+    return c;
+}
+
+static ref_cam cam_eixample(void)
+{
+    /* street level in the street x = 133, looking north, a little to the east */
+    ref_cam c = { { 131, 40, 1.7 }, { 160, 300, 8 }, 60, 0, 0 };
+    c.w = W();
+    c.h = H();
+    return c;
+}
+
+static ref_cam cam_helsinki(const scene *s)
+{
+    /* from above a lamp, at 25 m, looking at another lamp 150 m away */
+    ref_cam c = { { 0, 0, 25 }, { 0, 0, 0 }, 55, 0, 0 };
+    const scene_lamp *a = &s->lamps[0];
+    uint32_t i;
+    c.eye[0] = a->x;
+    c.eye[1] = a->y;
+    for (i = 1; i < s->nlamps; i++) {
+        double dx = s->lamps[i].x - a->x, dy = s->lamps[i].y - a->y;
+        if (dx * dx + dy * dy > 150.0 * 150.0) {
+            c.target[0] = a->x + 0.4 * dx;
+            c.target[1] = a->y + 0.4 * dy;
+            break;
+        }
+    }
+    c.w = W();
+    c.h = H();
+    return c;
+}
+
+/* ---- tests: images against the reference ----------------------------------- */
+
+static void test_tiny_vs_ref(void **state)
+{
+    fixture f;
+    ref_cam c = cam_tiny();
+    (void)state;
+    fx_open(&f, "fixtures/tiny.geojson", 320, 240);
+    check_against_ref(&f, &c, "tiny");
+    /* under the canopy D, looking at it from the side, low */
+    {
+        ref_cam c2 = { { 22, -6, 1.5 }, { 28, 3, 3.5 }, 70, 0, 0 };
+        c2.w = W();
+        c2.h = H();
+        check_against_ref(&f, &c2, "tiny-canopy");
+    }
+    /* from high above the courtyard of C, nearly straight down */
+    {
+        ref_cam c3 = { { 50, 9, 60 }, { 50, 10, 0 }, 50, 0, 0 };
+        c3.w = W();
+        c3.h = H();
+        check_against_ref(&f, &c3, "tiny-above");
+    }
+    fx_close(&f);
+}
+
+static void test_eixample_vs_ref(void **state)
+{
+    fixture f;
+    ref_cam c = cam_eixample();
+    (void)state;
+    fx_open(&f, "fixtures/eixample-4x4.geojson", 320, 240);
+    check_against_ref(&f, &c, "eixample");
+    fx_close(&f);
+}
+
+static void test_helsinki_vs_ref(void **state)
+{
+    fixture f;
+    ref_cam c;
+    (void)state;
+    fx_open(&f, "fixtures/helsinki-centre.geojson", 320, 240);
+    c = cam_helsinki(f.e->sc);
+    check_against_ref(&f, &c, "helsinki");
+    fx_close(&f);
+}
+
+/* ---- culling: the culled image is the unculled image ---------------------- */
+
+/* A cheap shader that gives every surface point its own colour. */
+static void pos_shade(void *user, const double P[3], const double n[3], double rgb[3])
+{
+    (void)user;
+    rgb[0] = 20.0 * (1.5 + sin(0.7 * P[0] + 0.3 * n[0]));
+    rgb[1] = 20.0 * (1.5 + sin(0.9 * P[1] + 0.5 * n[1]));
+    rgb[2] = 20.0 * (1.5 + sin(1.3 * P[2] + 0.7 * n[2]));
+}
+
+static uint64_t rng_next(uint64_t *s)
+{
+    uint64_t z = (*s += 0x9e3779b97f4a7c15ull);
+    z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ull;
+    z = (z ^ (z >> 27)) * 0x94d049bb133111ebull;
+    return z ^ (z >> 31);
+}
+
+static double rng_unit(uint64_t *s)
+{
+    return (rng_next(s) >> 11) * (1.0 / 9007199254740992.0);
+}
+
+/* Renders ncam cameras culled and unculled; returns buildings culled by
+ * occlusion in all. Eyes: near lamps (streets), at height z (z < 0: the
+ * eye height drawn from 1.5 .. -z). */
+static uint64_t cull_equal(const char *path, int ncam, double zmax, uint64_t seed)
+{
+    void *mem;
+    plx_engine *e = open_scene(path, &mem);
+    const scene *s = e->sc;
+    render *r;
+    int w = quick() ? 80 : 160, h = quick() ? 60 : 120, c;
+    size_t px = (size_t)w * h;
+    uint8_t *a = malloc(3 * px), *b = malloc(3 * px);
+    float *fa = malloc(3 * px * sizeof(float)), *fb = malloc(3 * px * sizeof(float));
+    uint32_t *ids = malloc(px * sizeof *ids);
+    uint64_t culled = 0, drawn = 0, total = 0;
+    assert_int_equal(render_create(&e->mem, s, w, h, pos_shade, NULL, &r), PLX_OK);
+    for (c = 0; c < ncam; c++) {
+        const scene_lamp *l = &s->lamps[rng_next(&seed) % s->nlamps];
+        double ang = TWO_PI_T * rng_unit(&seed);
+        render_camera cam;
+        render_opts o;
+        render_stats sa, sb;
+        cam.eye[0] = l->x + 1.3 * cos(ang);
+        cam.eye[1] = l->y + 1.3 * sin(ang);
+        cam.eye[2] = 1.5 + (zmax - 1.5) * rng_unit(&seed);
+        ang = TWO_PI_T * rng_unit(&seed);
+        cam.target[0] = cam.eye[0] + 100 * cos(ang);
+        cam.target[1] = cam.eye[1] + 100 * sin(ang);
+        cam.target[2] = cam.eye[2] + 30 * (rng_unit(&seed) - 0.6);
+        cam.fov_deg = 30 + 60 * rng_unit(&seed);
+        cam.width = w;
+        cam.height = h;
+        render_opts_default(&o);
+        o.cull = RENDER_CULL_NONE;
+        assert_int_equal(render_frame(r, &cam, &o, a, fa, &sa), PLX_OK);
+        memcpy(ids, render_ids(r), px * sizeof *ids);
+        o.cull = RENDER_CULL_ALL;
+        assert_int_equal(render_frame(r, &cam, &o, b, fb, &sb), PLX_OK);
+        if (memcmp(ids, render_ids(r), px * sizeof *ids) != 0 || memcmp(a, b, 3 * px) != 0 ||
+            memcmp(fa, fb, 3 * px * sizeof(float)) != 0) {
+            size_t p, nd = 0;
+            for (p = 0; p < px; p++)
+                nd += ids[p] != render_ids(r)[p];
+            save_png("cull-unculled", a, w, h);
+            save_png("cull-culled", b, w, h);
+            fail_msg("%s camera %d: eye (%.3f, %.3f, %.3f) target (%.3f, %.3f, %.3f) fov %.2f: culled image "
+                     "differs (%zu pixels of other surfaces)", path, c, cam.eye[0], cam.eye[1], cam.eye[2],
+                     cam.target[0], cam.target[1], cam.target[2], cam.fov_deg, nd);
+        }
+        assert_int_equal(sa.occlusion_culled, 0);
+        culled += sb.occlusion_culled;
+        drawn += sb.triangles_drawn;
+        total += sb.triangles;
+    }
+    print_message("%s: %d cameras, eye z 1.5 .. %.0f m: %.1f %% of triangles drawn, %llu buildings culled by "
+                  "occlusion\n", path, ncam, zmax, 100.0 * drawn / total, (unsigned long long)culled);
+    free(a);
+    free(b);
+    free(fa);
+    free(fb);
+    free(ids);
+    plx_engine_destroy(e);
+    free(mem);
+    return culled;
+}
+
+static void test_cull_equal_street(void **state)
+{
+    (void)state;
+    assert_true(cull_equal("fixtures/eixample-4x4.geojson", quick() ? 6 : 24, 1.8, 11) > 0);
+    assert_true(cull_equal("fixtures/helsinki-centre.geojson", quick() ? 6 : 24, 1.8, 12) > 0);
+    cull_equal("fixtures/tiny.geojson", 10, 1.8, 13);
+}
+
+static void test_cull_equal_above_roofs(void **state)
+{
+    (void)state;
+    /* eyes up to 35 m: above many roofs (eixample 15-28 m, Helsinki median 12 m) */
+    assert_true(cull_equal("fixtures/eixample-4x4.geojson", quick() ? 6 : 24, 35, 21) > 0);
+    assert_true(cull_equal("fixtures/helsinki-centre.geojson", quick() ? 6 : 24, 35, 22) > 0);
+    cull_equal("fixtures/tiny.geojson", 10, 14, 23);
+    cull_equal("fixtures/oldtown-8x8.geojson", quick() ? 6 : 16, 25, 24);
+}
+
+/* An eye just above a low roof, looking over it at taller buildings behind:
+ * the low building must not hide them. */
+static void test_cull_over_low_roof(void **state)
+{
+    static const char *text =
+        "{\"type\":\"FeatureCollection\",\"properties\":{\"units\":\"m\"},\"features\":["
+        "{\"type\":\"Feature\",\"properties\":{\"height\":6},\"geometry\":{\"type\":\"Polygon\","
+        "\"coordinates\":[[[-20,10],[20,10],[20,20],[-20,20],[-20,10]]]}},"
+        "{\"type\":\"Feature\",\"properties\":{\"height\":30},\"geometry\":{\"type\":\"Polygon\","
+        "\"coordinates\":[[[-10,40],[10,40],[10,50],[-10,50],[-10,40]]]}},"
+        "{\"type\":\"Feature\",\"properties\":{\"height\":5},\"geometry\":{\"type\":\"Polygon\","
+        "\"coordinates\":[[[-5,60],[5,60],[5,70],[-5,70],[-5,60]]]}},"
+        "{\"type\":\"Feature\",\"properties\":{\"lamp\":true,\"z\":8,\"radius\":60},"
+        "\"geometry\":{\"type\":\"Point\",\"coordinates\":[0,30]}},"
+        "{\"type\":\"Feature\",\"properties\":{\"lamp\":true,\"z\":8,\"radius\":60},"
+        "\"geometry\":{\"type\":\"Point\",\"coordinates\":[0,0]}}]}";
+    void *mem = malloc(MEM);
+    plx_engine *e;
+    plx_config cfg;
+    render *r;
+    render_camera cam = { { 0, 0, 7 }, { 0, 45, 8 }, 60, 96, 72 };
+    render_opts o;
+    render_stats st;
+    uint32_t *ids = malloc(96 * 72 * sizeof *ids);
+    size_t p, tall = 0;
+    double z;
+    (void)state;
+    plx_config_default(&cfg);
+    assert_int_equal(plx_engine_create(mem, MEM, &cfg, &e), PLX_OK);
+    assert_int_equal(plx_load_geojson(e, text, strlen(text), "low"), PLX_OK);
+    assert_int_equal(render_create(&e->mem, e->sc, 96, 72, pos_shade, NULL, &r), PLX_OK);
+    render_opts_default(&o);
+    for (z = 1.5; z < 40; z += 2.5) {
+        cam.eye[2] = z;
+        cam.target[2] = z;
+        o.cull = RENDER_CULL_NONE;
+        assert_int_equal(render_frame(r, &cam, &o, NULL, NULL, &st), PLX_OK);
+        memcpy(ids, render_ids(r), 96 * 72 * sizeof *ids);
+        o.cull = RENDER_CULL_ALL;
+        assert_int_equal(render_frame(r, &cam, &o, NULL, NULL, &st), PLX_OK);
+        assert_memory_equal(ids, render_ids(r), 96 * 72 * sizeof *ids);
+        for (p = 0, tall = 0; p < 96 * 72; p++)
+            tall += ids[p] == mesh_roof_id(e->sc, 1) || (ids[p] >= 2 + 4 && ids[p] < 2 + 8);
+        /* below 6 m the low building hides the tall one's lower part only;
+         * the tall one always shows (it rises above) */
+        assert_true(tall > 0);
+        /* the 5 m building right behind the tower is in its shadow from
+         * every height here (from above, rays reaching it are too steep) */
+        assert_true(st.occlusion_culled >= 1);
+    }
+    free(ids);
+    plx_engine_destroy(e);
+    free(mem);
+}
+
+/* ---- the mesh ---------------------------------------------------------------- */
+
+typedef struct dedge { double a[3], b[3]; } dedge;
+
+static int cmp_dedge(const void *pa, const void *pb)
+{
+    const double *a = pa, *b = pb;
+    int k;
+    for (k = 0; k < 6; k++)
+        if (a[k] != b[k])
+            return a[k] < b[k] ? -1 : 1;
+    return 0;
+}
+
+static void check_mesh_of(plx_engine *e, const char *path)
+{
+    const scene *s = e->sc;
+    mesh *m;
+    uint32_t b, k, open_edges = 0;
+    dedge *ed;
+    assert_int_equal(mesh_build(&e->mem, s, &m), PLX_OK);
+    assert_int_equal(m->bad_holes, 0);
+    ed = malloc((3 * (size_t)m->ntri + 1) * sizeof *ed);
+    for (b = 0; b < s->nbld; b++) {
+        const scene_building *bd = &s->bld[b];
+        const mesh_bld *mb = &m->bld[b];
+        double want = 0, got = 0;
+        uint32_t r, ne = 0, i;
+        for (r = 0; r < bd->ring_count; r++) {
+            const scene_ring *rg = &s->rings[bd->ring_first + r];
+            want += geom_ring_area2(s->pts + rg->first, rg->count) * 0.5;
+        }
+        for (k = 0; k < mb->t_count; k++) {
+            const mesh_tri *t = &m->tri[mb->t_first + k];
+            const double *p0 = &m->xyz[3 * t->v[0]], *p1 = &m->xyz[3 * t->v[1]], *p2 = &m->xyz[3 * t->v[2]];
+            double nx = (p1[1] - p0[1]) * (p2[2] - p0[2]) - (p1[2] - p0[2]) * (p2[1] - p0[1]);
+            double ny = (p1[2] - p0[2]) * (p2[0] - p0[0]) - (p1[0] - p0[0]) * (p2[2] - p0[2]);
+            double nz = (p1[0] - p0[0]) * (p2[1] - p0[1]) - (p1[1] - p0[1]) * (p2[0] - p0[0]);
+            const mesh_surf *sf = &m->surf[t->surf];
+            int j;
+            assert_true(t->v[0] >= mb->v_first && t->v[0] < mb->v_first + mb->v_count);
+            /* every triangle faces out of the solid */
+            assert_true(nx * sf->n[0] + ny * sf->n[1] + nz * sf->n[2] > 0);
+            assert_int_equal(sf->bld, b);
+            if (t->surf == mesh_roof_id(s, b))
+                got += 0.5 * nz;
+            for (j = 0; j < 3; j++) {
+                memcpy(ed[ne].a, &m->xyz[3 * t->v[j]], 3 * sizeof(double));
+                memcpy(ed[ne].b, &m->xyz[3 * t->v[(j + 1) % 3]], 3 * sizeof(double));
+                ne++;
+            }
+        }
+        if (fabs(got - want) > 1e-9 * fabs(want) + 1e-9)
+            fail_msg("%s building %u: roof area %.17g, footprint area %.17g", path, b, got, want);
+        /* watertight: every directed edge has its reverse (the bottom of a
+         * building on the ground aside) */
+        qsort(ed, ne, sizeof *ed, cmp_dedge);
+        for (i = 0; i < ne; i++) {
+            dedge rev;
+            memcpy(rev.a, ed[i].b, sizeof rev.a);
+            memcpy(rev.b, ed[i].a, sizeof rev.b);
+            if (!bsearch(&rev, ed, ne, sizeof *ed, cmp_dedge)) {
+                if (bd->min_height == 0 && ed[i].a[2] == 0 && ed[i].b[2] == 0)
+                    continue;
+                open_edges++;
+            }
+        }
+    }
+    print_message("%s: %u vertices, %u triangles, %u column split vertices, %u ear fallbacks, %zu bytes\n",
+                  path, m->nv, m->ntri, m->split_verts, m->fallbacks, m->bytes);
+    assert_int_equal(open_edges, 0);
+    free(ed);
+}
+
+static void check_mesh(const char *path)
+{
+    void *mem;
+    plx_engine *e = open_scene(path, &mem);
+    check_mesh_of(e, path);
+    plx_engine_destroy(e);
+    free(mem);
+}
+
+static void test_mesh_fixtures(void **state)
+{
+    (void)state;
+    check_mesh("fixtures/tiny.geojson");
+    check_mesh("fixtures/eixample-4x4.geojson");
+    check_mesh("fixtures/oldtown-8x8.geojson");
+    check_mesh("fixtures/helsinki-centre.geojson");
+}
+
+/* Awkward footprints: collinear vertices, a comb, holes near each other and
+ * near the outer ring, a hole touching the outer ring's vertex line. */
+static void test_mesh_awkward(void **state)
+{
+    static const char *text =
+        "{\"type\":\"FeatureCollection\",\"properties\":{\"units\":\"m\"},\"features\":["
+        /* square with collinear vertices on every side and two holes */
+        "{\"type\":\"Feature\",\"properties\":{\"height\":10},\"geometry\":{\"type\":\"Polygon\",\"coordinates\":["
+        "[[0,0],[5,0],[10,0],[10,5],[10,10],[5,10],[0,10],[0,5],[0,0]],"
+        "[[2,2],[2,4],[4,4],[4,2],[2,2]],[[6,6],[6,8],[8,8],[8,6],[6,6]]]}},"
+        /* a comb */
+        "{\"type\":\"Feature\",\"properties\":{\"height\":7},\"geometry\":{\"type\":\"Polygon\",\"coordinates\":["
+        "[[20,0],[30,0],[30,10],[29,10],[29,2],[28,2],[28,10],[27,10],[27,2],[26,2],[26,10],[25,10],"
+        "[25,2],[24,2],[24,10],[23,10],[23,2],[22,2],[22,10],[20,10],[20,0]]]}},"
+        /* holes side by side with aligned vertices (bridges must not cross) */
+        "{\"type\":\"Feature\",\"properties\":{\"height\":9,\"min_height\":3},\"geometry\":{\"type\":\"Polygon\",\"coordinates\":["
+        "[[40,0],[60,0],[60,10],[40,10],[40,0]],"
+        "[[42,4],[42,6],[44,6],[44,4],[42,4]],[[46,4],[46,6],[48,6],[48,4],[46,4]],"
+        "[[50,4],[50,6],[52,6],[52,4],[50,4]],[[54,4],[54,6],[56,6],[56,4],[54,4]]]}},"
+        /* a spiral-ish concave polygon */
+        "{\"type\":\"Feature\",\"properties\":{\"height\":12},\"geometry\":{\"type\":\"Polygon\",\"coordinates\":["
+        "[[0,20],[12,20],[12,32],[2,32],[2,24],[8,24],[8,28],[6,28],[6,26],[4,26],[4,30],[10,30],[10,22],"
+        "[0,22],[0,20]]]}}]}";
+    void *mem = malloc(MEM);
+    plx_engine *e;
+    plx_config cfg;
+    (void)state;
+    plx_config_default(&cfg);
+    assert_int_equal(plx_engine_create(mem, MEM, &cfg, &e), PLX_OK);
+    assert_int_equal(plx_load_geojson(e, text, strlen(text), "awkward"), PLX_OK);
+    assert_int_equal(e->sc->nbld, 4);
+    check_mesh_of(e, "awkward");
+    plx_engine_destroy(e);
+    free(mem);
+}
+
+/* ---- golden images ------------------------------------------------------------ */
+
+/* Compares img with fixtures/golden/<name>.png: every channel within 3/255
+ * on 99.8 % of pixels (and the image size equal). On failure writes
+ * build/golden-out/<name>.actual.png and <name>.diff.png (|difference| x 16)
+ * and says how to update. PLX_UPDATE_GOLDEN=1 writes the golden instead. */
+static void golden(const char *name, const uint8_t *img, int w, int h)
+{
+    char path[256], err[256], out[256];
+    uint8_t *g = NULL;
+    int gw = 0, gh = 0;
+    size_t p, bad = 0, px = (size_t)w * h;
+    snprintf(path, sizeof path, "fixtures/golden/%s.png", name);
+    if (getenv("PLX_UPDATE_GOLDEN")) {
+        mkdir("fixtures/golden", 0777);
+        assert_int_equal(image_write_png_rgb8(path, w, h, img, 0, err, sizeof err), 0);
+        print_message("golden: wrote %s\n", path);
+        return;
+    }
+    if (image_read_png_rgb8(path, NULL, 0, &g, &gw, &gh, err, sizeof err) == 0 && gw == w && gh == h) {
+        for (p = 0; p < 3 * px; p += 3) {
+            int k, d = 0;
+            for (k = 0; k < 3; k++)
+                d = abs((int)img[p + k] - (int)g[p + k]) > d ? abs((int)img[p + k] - (int)g[p + k]) : d;
+            bad += d > 3;
+        }
+        if (bad * 1000 <= px * 2) {
+            free(g);
+            return;
+        }
+    }
+    mkdir("build", 0777);
+    mkdir("build/golden-out", 0777);
+    snprintf(out, sizeof out, "build/golden-out/%s.actual.png", name);
+    image_write_png_rgb8(out, w, h, img, 0, err, sizeof err);
+    if (g && gw == w && gh == h) {
+        uint8_t *d = malloc(3 * px);
+        for (p = 0; p < 3 * px; p++) {
+            int v = abs((int)img[p] - (int)g[p]) * 16;
+            d[p] = (uint8_t)(v > 255 ? 255 : v);
+        }
+        snprintf(out, sizeof out, "build/golden-out/%s.diff.png", name);
+        image_write_png_rgb8(out, w, h, d, 0, err, sizeof err);
+        free(d);
+    }
+    free(g);
+    fail_msg("golden image %s: %s (%zu pixels beyond 3/255); actual and diff images are in build/golden-out/; "
+             "if the change is intended, update with: PLX_UPDATE_GOLDEN=1 build/tests/test_render (from the "
+             "repository root), then look at fixtures/golden/%s.png", path,
+             gw ? "differs" : "missing or unreadable", bad, name);
+}
+
+static void test_golden(void **state)
+{
+    fixture f;
+    render_opts o;
+    render_camera cam;
+    uint8_t *img = malloc(160 * 120 * 3);
+    ref_cam c;
+    (void)state;
+    render_opts_default(&o);
+    /* tiny: glows on */
+    fx_open(&f, "fixtures/tiny.geojson", 160, 120);
+    c = cam_tiny();
+    c.w = 160;
+    c.h = 120;
+    cam = to_cam(&c);
+    assert_int_equal(render_frame(f.r, &cam, &o, img, NULL, NULL), PLX_OK);
+    save_png("golden-tiny", img, 160, 120);
+    golden("tiny-street", img, 160, 120);
+    fx_close(&f);
+    /* eixample street, exposure 0.25 */
+    fx_open(&f, "fixtures/eixample-4x4.geojson", 160, 120);
+    c = cam_eixample();
+    c.w = 160;
+    c.h = 120;
+    cam = to_cam(&c);
+    o.exposure = 0.25;
+    assert_int_equal(render_frame(f.r, &cam, &o, img, NULL, NULL), PLX_OK);
+    save_png("golden-eixample", img, 160, 120);
+    golden("eixample-street", img, 160, 120);
+    /* eixample aerial with the light map */
+    assert_int_equal(render_lightmap_build(f.r, 2.0, 64u << 20), PLX_OK);
+    {
+        render_camera air = { { 266, -150, 320 }, { 266, 300, 0 }, 55, 160, 120 };
+        o.exposure = 0.5;
+        o.lightmap = 1;
+        assert_int_equal(render_frame(f.r, &air, &o, img, NULL, NULL), PLX_OK);
+        save_png("golden-eixample-aerial", img, 160, 120);
+        golden("eixample-aerial", img, 160, 120);
+    }
+    fx_close(&f);
+    free(img);
+}
+
+/* ---- aerial view: the light map ------------------------------------------------ */
+
+static void test_aerial_lightmap(void **state)
+{
+    fixture f;
+    render_opts o;
+    render_stats st;
+    render_lightmap_info li;
+    render_camera air = { { 200, -120, 260 }, { 260, 260, 0 }, 50, 0, 0 };
+    int w = quick() ? 96 : 160, h = quick() ? 72 : 120;
+    size_t px = (size_t)w * h, p, ground = 0, close = 0, same = 0, bld = 0;
+    float *exact = malloc(3 * px * sizeof(float)), *map = malloc(3 * px * sizeof(float));
+    uint8_t *a8 = malloc(3 * px), *b8 = malloc(3 * px);
+    uint32_t *ids = malloc(px * sizeof *ids);
+    uint64_t seed = 5;
+    int i;
+    double sum = 0;
+    (void)state;
+    air.width = w;
+    air.height = h;
+    fx_open(&f, "fixtures/eixample-4x4.geojson", w, h);
+    render_lightmap_get(f.r, &li);
+    assert_int_equal(li.built, 0);
+    /* a budget too small for 1 m texels: the pitch grows to fit */
+    assert_int_equal(render_lightmap_build(f.r, 1.0, (size_t)12 * 200 * 200), PLX_OK);
+    render_lightmap_get(f.r, &li);
+    assert_true(li.built && li.cell > 1.0 && li.bytes <= (size_t)12 * 200 * 200);
+    assert_int_equal(render_lightmap_build(f.r, 0.0, 1000), PLX_E_INVALID);
+    /* texels hold the exact illuminance at their centres */
+    render_lightmap_get(f.r, &li);
+    for (i = 0; i < 300; i++) {
+        uint32_t x = (uint32_t)(rng_next(&seed) % li.nx), y = (uint32_t)(rng_next(&seed) % li.ny);
+        double P[3], n[3] = { 0, 0, 1 }, E[3];
+        const float *t = &li.rgb[3 * ((size_t)y * li.nx + x)];
+        int k;
+        P[0] = li.x0 + (x + 0.5) * li.cell;
+        P[1] = li.y0 + (y + 0.5) * li.cell;
+        P[2] = 0;
+        ref_illuminance_rgb(f.e->sc, P, n, E);
+        for (k = 0; k < 3; k++)
+            assert_true(fabs(t[k] - E[k]) <= 1e-6 * fabs(E[k]) + 1e-9);
+    }
+    render_opts_default(&o);
+    o.no_glow = 1;
+    o.exposure = 0.5;
+    assert_int_equal(render_frame(f.r, &air, &o, a8, exact, &st), PLX_OK);
+    memcpy(ids, render_ids(f.r), px * sizeof *ids);
+    o.lightmap = 1;
+    assert_int_equal(render_frame(f.r, &air, &o, b8, map, &st), PLX_OK);
+    save_png("aerial-exact", a8, w, h);
+    save_png("aerial-map", b8, w, h);
+    assert_memory_equal(ids, render_ids(f.r), px * sizeof *ids);
+    for (p = 0; p < px; p++) {
+        int k, d = 0;
+        for (k = 0; k < 3; k++)
+            d = abs((int)a8[3 * p + k] - (int)b8[3 * p + k]) > d ? abs((int)a8[3 * p + k] - (int)b8[3 * p + k]) : d;
+        if (ids[p] == MESH_SURF_GROUND) {
+            ground++;
+            close += d <= 6;
+            sum += d;
+        } else {
+            /* facades and roofs are shaded exactly either way */
+            bld++;
+            same += memcmp(&exact[3 * p], &map[3 * p], 3 * sizeof(float)) == 0;
+        }
+    }
+    print_message("aerial: light map %u x %u at %.2f m; %zu ground px, %.2f %% within 6/255, mean diff %.2f/255; "
+                  "%zu building px identical of %zu\n", li.nx, li.ny, li.cell, ground, 100.0 * close / ground,
+                  sum / ground, same, bld);
+    assert_true(ground > px / 4);
+    assert_int_equal(same, bld);
+    assert_true(close >= (size_t)(0.9 * ground));
+    assert_true(sum / ground < 2.0);
+    fx_close(&f);
+    free(exact);
+    free(map);
+    free(a8);
+    free(b8);
+    free(ids);
+}
+
+/* ---- errors, glows, memory --------------------------------------------------- */
+
+static void test_errors_and_glow(void **state)
+{
+    fixture f;
+    render_camera c = { { -18, -22, 9 }, { 32, 10, 2 }, 60, 64, 48 };
+    render_camera bad;
+    render_opts o;
+    render_stats st;
+    uint8_t a[64 * 48 * 3], b[64 * 48 * 3];
+    float fa[64 * 48 * 3];
+    size_t p, diff = 0;
+    (void)state;
+    fx_open(&f, "fixtures/tiny.geojson", 64, 48);
+    render_opts_default(&o);
+    bad = c;
+    bad.eye[2] = 0;
+    assert_int_equal(render_frame(f.r, &bad, &o, a, NULL, NULL), PLX_E_INVALID);
+    assert_string_equal(render_error(f.r), "render_frame: the eye must be above the ground (z > 0)");
+    bad = c;
+    memcpy(bad.target, bad.eye, sizeof bad.eye);
+    assert_int_equal(render_frame(f.r, &bad, &o, a, NULL, NULL), PLX_E_INVALID);
+    assert_string_equal(render_error(f.r), "render_frame: eye and target are the same point");
+    bad = c;
+    bad.fov_deg = 180;
+    assert_int_equal(render_frame(f.r, &bad, &o, a, NULL, NULL), PLX_E_INVALID);
+    bad = c;
+    bad.width = 65;
+    assert_int_equal(render_frame(f.r, &bad, &o, a, NULL, NULL), PLX_E_INVALID);
+    bad = c;
+    bad.eye[0] = NAN;
+    assert_int_equal(render_frame(f.r, &bad, &o, a, NULL, NULL), PLX_E_INVALID);
+    assert_int_equal(render_frame(f.r, NULL, &o, a, NULL, NULL), PLX_E_INVALID);
+    /* straight down works (right = +x) */
+    bad = c;
+    bad.eye[0] = bad.target[0] = 30;
+    bad.eye[1] = bad.target[1] = 10;
+    bad.eye[2] = 80;
+    bad.target[2] = 0;
+    assert_int_equal(render_frame(f.r, &bad, &o, a, NULL, &st), PLX_OK);
+    assert_string_equal(render_error(f.r), "");
+    assert_true(st.building_pixels > 0 && st.ground_pixels > 0);
+    /* glows: only near lamps, only adding light; none with no_glow */
+    assert_int_equal(render_frame(f.r, &c, &o, a, fa, &st), PLX_OK);
+    assert_true(st.glows >= 1);
+    o.no_glow = 1;
+    assert_int_equal(render_frame(f.r, &c, &o, b, NULL, &st), PLX_OK);
+    assert_int_equal(st.glows, 0);
+    for (p = 0; p < sizeof a; p++) {
+        assert_true(a[p] >= b[p]);
+        diff += a[p] != b[p];
+    }
+    assert_true(diff > 0 && diff < sizeof a / 10);
+    /* the float output is the radiance before tone mapping */
+    for (p = 0; p < sizeof a; p++)
+        assert_int_equal(a[p], render_srgb8(f.r, fa[p]));
+    /* sRGB table: exact at the ends and monotonic */
+    assert_int_equal(render_srgb8(f.r, 0.0), 0);
+    assert_int_equal(render_srgb8(f.r, -1.0), 0);
+    assert_int_equal(render_srgb8(f.r, NAN), 0);
+    assert_int_equal(render_srgb8(f.r, 1.0), 255);
+    assert_int_equal(render_srgb8(f.r, 0.5), ref_srgb8(0.5));
+    assert_int_equal(render_srgb8(f.r, 0.001), ref_srgb8(0.001));
+    fx_close(&f);
+}
+
+static void test_eye_inside_solid(void **state)
+{
+    fixture f;
+    render_camera c = { { 5, 5, 5 }, { 15, 6, 5 }, 70, 64, 48 };
+    render_stats st;
+    uint8_t a[64 * 48 * 3];
+    (void)state;
+    fx_open(&f, "fixtures/tiny.geojson", 64, 48);
+    assert_int_equal(render_frame(f.r, &c, NULL, a, NULL, &st), PLX_OK);
+    assert_int_equal(st.eye_inside, 1);
+    assert_int_equal(st.occlusion_culled, 0);
+    assert_int_equal(st.sky_pixels + st.ground_pixels, 0); /* walls all round */
+    fx_close(&f);
+}
+
+static void test_fault_injection(void **state)
+{
+    void *mem;
+    plx_engine *e = open_scene("fixtures/eixample-4x4.geojson", &mem);
+    plx_memory_report before, after;
+    render *r = NULL;
+    plx_status st = PLX_E_NOMEM;
+    uint64_t k;
+    (void)state;
+    plx_memory_get(e, &before);
+    for (k = 1; st == PLX_E_NOMEM; k++) {
+        plx_debug_fail_alloc(e, k);
+        st = render_create(&e->mem, e->sc, 64, 48, pos_shade, NULL, &r);
+        if (st == PLX_E_NOMEM) {
+            plx_memory_get(e, &after);
+            assert_int_equal(after.used_total, before.used_total);
+            assert_null(r);
+        }
+    }
+    plx_debug_fail_alloc(e, 0);
+    assert_int_equal(st, PLX_OK);
+    assert_true(k > 10);
+    plx_memory_get(e, &after);
+    print_message("render_create on eixample-4x4, 64x48: %zu bytes in part frame, %llu requests tried\n",
+                  after.used[PLX_PART_FRAME] - before.used[PLX_PART_FRAME], (unsigned long long)k - 1);
+    /* the frame itself allocates nothing */
+    {
+        render_camera c = { { 131, 40, 1.7 }, { 160, 300, 8 }, 60, 64, 48 };
+        plx_debug_fail_alloc(e, 1);
+        assert_int_equal(render_frame(r, &c, NULL, NULL, NULL, NULL), PLX_OK);
+        assert_int_equal(plx_debug_fail_alloc(e, 0), 0);
+    }
+    plx_engine_destroy(e);
+    free(mem);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_tiny_vs_ref),
+        cmocka_unit_test(test_eixample_vs_ref),
+        cmocka_unit_test(test_helsinki_vs_ref),
+        cmocka_unit_test(test_cull_equal_street),
+        cmocka_unit_test(test_cull_equal_above_roofs),
+        cmocka_unit_test(test_cull_over_low_roof),
+        cmocka_unit_test(test_mesh_fixtures),
+        cmocka_unit_test(test_mesh_awkward),
+        cmocka_unit_test(test_golden),
+        cmocka_unit_test(test_aerial_lightmap),
+        cmocka_unit_test(test_errors_and_glow),
+        cmocka_unit_test(test_eye_inside_solid),
+        cmocka_unit_test(test_fault_injection),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
