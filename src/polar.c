@@ -16,7 +16,9 @@
 #include "geom.h"
 
 enum { UL = 0, LL = 1, UR = 2, LR = 3 };
-enum { N_LEAF = 0, N_X = 1, N_Y = 2 };
+/* search nodes: a leaf, a point (x) test, a segment (y) test whose frame-left
+ * end is seg.a (N_Y) or seg.b (N_YB) */
+enum { N_LEAF = 0, N_X = 1, N_Y = 2, N_YB = 3 };
 #define KIND(w) ((w) >> 30)
 #define IDX(w) ((w) & 0x3fffffffu)
 #define PACK(k, i) (((uint32_t)(k) << 30) | (uint32_t)(i))
@@ -364,12 +366,19 @@ static void emit_piece(piece *out, uint32_t *n, const vec2 *P, uint32_t a, uint3
 
 /* ---- trapezoidal map construction ------------------------------------- */
 
+/* A trapezoid during construction (one cache line holds most of it). */
+typedef struct btrap {
+    uint32_t lp, rp, top, bot;
+    uint32_t nb[4];
+    uint32_t leaf;           /* its leaf node */
+    uint32_t dead;
+} btrap;
+
 typedef struct tbuild {
     const polar *pd;
     int frame;
     uint32_t cap;            /* trapezoid slots */
-    uint32_t *top, *bot, *lp, *rp, (*nb)[4], *leaf;
-    uint8_t *dead;
+    btrap *T;
     uint32_t ntrap;
     uint32_t *freel;
     uint32_t nfree;
@@ -377,7 +386,7 @@ typedef struct tbuild {
     uint32_t nnode, cap_node;
     uint32_t *list;          /* trapezoids crossed by the new segment */
     uint32_t *up, *lo;       /* per crossed trapezoid: new upper / lower part */
-    uint32_t otop[2], obot[2];
+    uint32_t (*lr)[2];       /* per segment: frame-left and frame-right end */
     int fail;
 } tbuild;
 
@@ -393,9 +402,9 @@ static uint32_t new_trap(tbuild *b)
         }
         t = b->ntrap++;
     }
-    b->dead[t] = 0;
-    b->nb[t][0] = b->nb[t][1] = b->nb[t][2] = b->nb[t][3] = POLAR_NONE;
-    b->leaf[t] = POLAR_NONE;
+    b->T[t].dead = 0;
+    b->T[t].nb[0] = b->T[t].nb[1] = b->T[t].nb[2] = b->T[t].nb[3] = POLAR_NONE;
+    b->T[t].leaf = POLAR_NONE;
     return t;
 }
 
@@ -429,30 +438,34 @@ static uint32_t find_first(const tbuild *b, vec2 P, vec2 Q)
         if (KIND(w) == N_X) {
             n = lex_cmp(P, bpt(b, IDX(w))) < 0 ? b->node[n][1] : b->node[n][2];
         } else {
-            uint32_t l, r;
-            int o;
-            seg_ends(b->pd, b->frame, IDX(w), &l, &r);
-            o = geom_orient(bpt(b, l), bpt(b, r), P);
+            const uint32_t *e = b->lr[IDX(w)];
+            vec2 L = bpt(b, e[0]), R = bpt(b, e[1]);
+            int o = geom_orient(L, R, P);
             if (o == 0)
-                o = geom_orient(bpt(b, l), bpt(b, r), Q);
+                o = geom_orient(L, R, Q);
             n = o > 0 ? b->node[n][2] : b->node[n][1];
         }
     }
 }
 
+static uint32_t ykind(const tbuild *b, uint32_t s)
+{
+    return b->lr[s][0] == b->pd->seg[s].a ? N_Y : N_YB;
+}
+
 /* Replaces the neighbour link 'old' of trapezoid x on side (f0, f1). */
 static void relink(tbuild *b, uint32_t x, int f, uint32_t old, uint32_t nw)
 {
-    if (x != POLAR_NONE && b->nb[x][f] == old)
-        b->nb[x][f] = nw;
+    if (x != POLAR_NONE && b->T[x].nb[f] == old)
+        b->T[x].nb[f] = nw;
 }
 
 static void set_trap(tbuild *b, uint32_t t, uint32_t lp, uint32_t rp, uint32_t top, uint32_t bot)
 {
-    b->lp[t] = lp;
-    b->rp[t] = rp;
-    b->top[t] = top;
-    b->bot[t] = bot;
+    b->T[t].lp = lp;
+    b->T[t].rp = rp;
+    b->T[t].top = top;
+    b->T[t].bot = bot;
 }
 
 /* Follows the new segment s (ends l < r) through the map; returns k. */
@@ -462,10 +475,10 @@ static uint32_t follow(tbuild *b, uint32_t s, uint32_t l, uint32_t r)
     uint32_t k = 0;
     (void)s;
     b->list[0] = find_first(b, P, Q);
-    while (lex_cmp(Q, bpt(b, b->rp[b->list[k]])) > 0) {
+    while (lex_cmp(Q, bpt(b, b->T[b->list[k]].rp)) > 0) {
         uint32_t t = b->list[k], nx;
-        int o = geom_orient(P, Q, bpt(b, b->rp[t]));
-        nx = o > 0 ? b->nb[t][LR] : b->nb[t][UR];
+        int o = geom_orient(P, Q, bpt(b, b->T[t].rp));
+        nx = o > 0 ? b->T[t].nb[LR] : b->T[t].nb[UR];
         if (nx == POLAR_NONE || k + 1 >= b->cap) {
             b->fail = 2;
             return k;
@@ -485,30 +498,30 @@ static void make_chain(tbuild *b, uint32_t s, uint32_t l, uint32_t r, uint32_t k
     int fi_l = up ? LL : UL, fi_r = up ? LR : UR;  /* links along s */
     (void)fi_l;
     if (up)
-        set_trap(b, cur, l, r, b->top[b->list[0]], s);
+        set_trap(b, cur, l, r, b->T[b->list[0]].top, s);
     else
-        set_trap(b, cur, l, r, s, b->bot[b->list[0]]);
+        set_trap(b, cur, l, r, s, b->T[b->list[0]].bot);
     part[0] = cur;
     for (j = 0; j < k; j++) {
-        uint32_t t = b->list[j], t1 = b->list[j + 1], R = b->rp[t], nx, x;
+        uint32_t t = b->list[j], t1 = b->list[j + 1], R = b->T[t].rp, nx, x;
         int o = geom_orient(P, Q, bpt(b, R));
         if ((o > 0) != (up != 0)) {
             part[j + 1] = cur;        /* the axis at R is cut away: merge */
             continue;
         }
-        b->rp[cur] = R;
+        b->T[cur].rp = R;
         nx = new_trap(b);
         if (up)
-            set_trap(b, nx, R, r, b->top[t1], s);
+            set_trap(b, nx, R, r, b->T[t1].top, s);
         else
-            set_trap(b, nx, R, r, s, b->bot[t1]);
-        x = b->nb[t][fc];
-        b->nb[cur][fc] = x;
+            set_trap(b, nx, R, r, s, b->T[t1].bot);
+        x = b->T[t].nb[fc];
+        b->T[cur].nb[fc] = x;
         relink(b, x, fo, t, cur);
-        b->nb[cur][fi_r] = nx;
-        b->nb[nx][up ? LL : UL] = cur;
-        x = b->nb[t1][fo];
-        b->nb[nx][fo] = x;
+        b->T[cur].nb[fi_r] = nx;
+        b->T[nx].nb[up ? LL : UL] = cur;
+        x = b->T[t1].nb[fo];
+        b->T[nx].nb[fo] = x;
         relink(b, x, fc, t1, nx);
         cur = nx;
         part[j + 1] = cur;
@@ -520,25 +533,26 @@ static void insert_seg(tbuild *b, uint32_t s)
 {
     uint32_t l, r, k, j, first, last, A = POLAR_NONE, B = POLAR_NONE;
     uint32_t U0, L0, Uk, Lk, fnb[4], lnb[4], flp, lrp;
-    seg_ends(b->pd, b->frame, s, &l, &r);
+    l = b->lr[s][0];
+    r = b->lr[s][1];
     k = follow(b, s, l, r);
     if (b->fail)
         return;
     first = b->list[0];
     last = b->list[k];
     for (j = 0; j < 4; j++) {
-        fnb[j] = b->nb[first][j];
-        lnb[j] = b->nb[last][j];
+        fnb[j] = b->T[first].nb[j];
+        lnb[j] = b->T[last].nb[j];
     }
-    flp = b->lp[first];
-    lrp = b->rp[last];
+    flp = b->T[first].lp;
+    lrp = b->T[last].rp;
     if (lex_cmp(bpt(b, l), bpt(b, flp)) > 0) {
         A = new_trap(b);
-        set_trap(b, A, flp, l, b->top[first], b->bot[first]);
+        set_trap(b, A, flp, l, b->T[first].top, b->T[first].bot);
     }
     if (lex_cmp(bpt(b, r), bpt(b, lrp)) < 0) {
         B = new_trap(b);
-        set_trap(b, B, r, lrp, b->top[last], b->bot[last]);
+        set_trap(b, B, r, lrp, b->T[last].top, b->T[last].bot);
     }
     make_chain(b, s, l, r, k, 1);
     make_chain(b, s, l, r, k, 0);
@@ -550,19 +564,19 @@ static void insert_seg(tbuild *b, uint32_t s)
     Lk = b->lo[k];
     /* left end */
     if (A != POLAR_NONE) {
-        b->nb[A][UL] = fnb[UL];
-        b->nb[A][LL] = fnb[LL];
+        b->T[A].nb[UL] = fnb[UL];
+        b->T[A].nb[LL] = fnb[LL];
         relink(b, fnb[UL], UR, first, A);
         relink(b, fnb[UL], LR, first, A);
         relink(b, fnb[LL], UR, first, A);
         relink(b, fnb[LL], LR, first, A);
-        b->nb[A][UR] = U0;
-        b->nb[A][LR] = L0;
-        b->nb[U0][UL] = A;
-        b->nb[L0][LL] = A;
+        b->T[A].nb[UR] = U0;
+        b->T[A].nb[LR] = L0;
+        b->T[U0].nb[UL] = A;
+        b->T[L0].nb[LL] = A;
     } else {
-        b->nb[U0][UL] = fnb[UL];
-        b->nb[L0][LL] = fnb[LL];
+        b->T[U0].nb[UL] = fnb[UL];
+        b->T[L0].nb[LL] = fnb[LL];
         relink(b, fnb[UL], UR, first, U0);
         relink(b, fnb[UL], LR, first, L0);
         relink(b, fnb[LL], UR, first, U0);
@@ -570,19 +584,19 @@ static void insert_seg(tbuild *b, uint32_t s)
     }
     /* right end */
     if (B != POLAR_NONE) {
-        b->nb[B][UR] = lnb[UR];
-        b->nb[B][LR] = lnb[LR];
+        b->T[B].nb[UR] = lnb[UR];
+        b->T[B].nb[LR] = lnb[LR];
         relink(b, lnb[UR], UL, last, B);
         relink(b, lnb[UR], LL, last, B);
         relink(b, lnb[LR], UL, last, B);
         relink(b, lnb[LR], LL, last, B);
-        b->nb[B][UL] = Uk;
-        b->nb[B][LL] = Lk;
-        b->nb[Uk][UR] = B;
-        b->nb[Lk][LR] = B;
+        b->T[B].nb[UL] = Uk;
+        b->T[B].nb[LL] = Lk;
+        b->T[Uk].nb[UR] = B;
+        b->T[Lk].nb[LR] = B;
     } else {
-        b->nb[Uk][UR] = lnb[UR];
-        b->nb[Lk][LR] = lnb[LR];
+        b->T[Uk].nb[UR] = lnb[UR];
+        b->T[Lk].nb[LR] = lnb[LR];
         relink(b, lnb[UR], UL, last, Uk);
         relink(b, lnb[UR], LL, last, Lk);
         relink(b, lnb[LR], UL, last, Uk);
@@ -590,47 +604,47 @@ static void insert_seg(tbuild *b, uint32_t s)
     }
     /* leaves for the new trapezoids */
     if (A != POLAR_NONE)
-        b->leaf[A] = new_node(b, N_LEAF, A, 0, 0);
+        b->T[A].leaf = new_node(b, N_LEAF, A, 0, 0);
     if (B != POLAR_NONE)
-        b->leaf[B] = new_node(b, N_LEAF, B, 0, 0);
+        b->T[B].leaf = new_node(b, N_LEAF, B, 0, 0);
     for (j = 0; j <= k; j++) {
-        if (b->leaf[b->up[j]] == POLAR_NONE)
-            b->leaf[b->up[j]] = new_node(b, N_LEAF, b->up[j], 0, 0);
-        if (b->leaf[b->lo[j]] == POLAR_NONE)
-            b->leaf[b->lo[j]] = new_node(b, N_LEAF, b->lo[j], 0, 0);
+        if (b->T[b->up[j]].leaf == POLAR_NONE)
+            b->T[b->up[j]].leaf = new_node(b, N_LEAF, b->up[j], 0, 0);
+        if (b->T[b->lo[j]].leaf == POLAR_NONE)
+            b->T[b->lo[j]].leaf = new_node(b, N_LEAF, b->lo[j], 0, 0);
     }
     if (b->fail)
         return;
     /* the old leaves become search nodes */
     for (j = 0; j <= k; j++) {
-        uint32_t t = b->list[j], n = b->leaf[t];
-        uint32_t y0 = b->leaf[b->lo[j]], y1 = b->leaf[b->up[j]];
+        uint32_t t = b->list[j], n = b->T[t].leaf;
+        uint32_t y0 = b->T[b->lo[j]].leaf, y1 = b->T[b->up[j]].leaf;
         uint32_t inner;
         int xa = (j == 0 && A != POLAR_NONE), xb = (j == k && B != POLAR_NONE);
         if (!xa && !xb) {
-            b->node[n][0] = PACK(N_Y, s);
+            b->node[n][0] = PACK(ykind(b, s), s);
             b->node[n][1] = y0;
             b->node[n][2] = y1;
         } else {
-            inner = new_node(b, N_Y, s, y0, y1);
+            inner = new_node(b, ykind(b, s), s, y0, y1);
             if (xb) {
-                uint32_t xq = xa ? new_node(b, N_X, r, inner, b->leaf[B]) : POLAR_NONE;
+                uint32_t xq = xa ? new_node(b, N_X, r, inner, b->T[B].leaf) : POLAR_NONE;
                 if (xa) {
                     b->node[n][0] = PACK(N_X, l);
-                    b->node[n][1] = b->leaf[A];
+                    b->node[n][1] = b->T[A].leaf;
                     b->node[n][2] = xq;
                 } else {
                     b->node[n][0] = PACK(N_X, r);
                     b->node[n][1] = inner;
-                    b->node[n][2] = b->leaf[B];
+                    b->node[n][2] = b->T[B].leaf;
                 }
             } else {
                 b->node[n][0] = PACK(N_X, l);
-                b->node[n][1] = b->leaf[A];
+                b->node[n][1] = b->T[A].leaf;
                 b->node[n][2] = inner;
             }
         }
-        b->dead[t] = 1;
+        b->T[t].dead = 1;
         b->freel[b->nfree++] = t;
     }
 }
@@ -651,8 +665,8 @@ static int compute_cover(tbuild *b, int32_t *cov, uint32_t *below,
     for (s = pd->nwall; s < nseg; s++)
         cov[s] = 0;
     for (t = 0; t < b->ntrap; t++)
-        if (!b->dead[t] && below[b->top[t]] == POLAR_NONE)
-            below[b->top[t]] = b->bot[t];
+        if (!b->T[t].dead && below[b->T[t].top] == POLAR_NONE)
+            below[b->T[t].top] = b->T[t].bot;
     for (s = 0; s < nseg; s++) {
         uint32_t n = 0, x = s;
         while (cov[x] == UNSET) {
@@ -748,12 +762,27 @@ static void *keep_n(arena *a, size_t n, size_t size, size_t *acc)
     return p;
 }
 
+/* The child word (polar.h) for build node c. */
+static uint32_t child_word(const tbuild *b, uint32_t c, const uint32_t *renum,
+                           const uint32_t *nrenum, const int32_t *cov)
+{
+    uint32_t w = b->node[c][0], t;
+    if (KIND(w) != N_LEAF)
+        return PACK(POLAR_CHILD_NODE, nrenum[c]);
+    t = IDX(w);
+    if (cov[b->T[t].bot] == 0)
+        return PACK(POLAR_CHILD_FREE, renum[t]);
+    /* solid: the wall with the footprint on the trapezoid's side */
+    return PACK(POLAR_CHILD_SOLID, seg_delta(b->pd, b->frame, b->T[t].bot) > 0 ? b->T[t].bot
+                                                                             : b->T[t].top);
+}
+
 /* Builds the trapezoidal map of one frame into scratch, then copies it. */
 static plx_status build_map(arena *a, polar *pd, polar_map *m, uint32_t *order)
 {
     tbuild b;
     uint32_t nw = pd->nwall, i, t, n;
-    uint32_t *renum;
+    uint32_t *renum, *nrenum, *queue, nq;
     int32_t *cov;
     uint32_t *below, *stack;
     memset(&b, 0, sizeof b);
@@ -761,25 +790,24 @@ static plx_status build_map(arena *a, polar *pd, polar_map *m, uint32_t *order)
     b.frame = m->frame;
     b.cap = 4 * nw + 64;
     b.cap_node = 16 * nw + 64;
-    b.top = scratch_n(a, b.cap, 4);
-    b.bot = scratch_n(a, b.cap, 4);
-    b.lp = scratch_n(a, b.cap, 4);
-    b.rp = scratch_n(a, b.cap, 4);
-    b.nb = scratch_n(a, b.cap, 16);
-    b.leaf = scratch_n(a, b.cap, 4);
-    b.dead = scratch_n(a, b.cap, 1);
+    b.T = scratch_n(a, b.cap, sizeof(btrap));
     b.freel = scratch_n(a, b.cap, 4);
     b.list = scratch_n(a, b.cap, 4);
     b.up = scratch_n(a, b.cap, 4);
     b.lo = scratch_n(a, b.cap, 4);
     b.node = scratch_n(a, b.cap_node, 12);
-    if (!b.top || !b.bot || !b.lp || !b.rp || !b.nb || !b.leaf || !b.dead || !b.freel ||
+    b.lr = scratch_n(a, pd->nseg, 8);
+    if (!b.lr)
+        return PLX_E_NOMEM;
+    for (i = 0; i < pd->nseg; i++)
+        seg_ends(pd, m->frame, i, &b.lr[i][0], &b.lr[i][1]);
+    if (!b.T || !b.freel ||
         !b.list || !b.up || !b.lo || !b.node)
         return PLX_E_NOMEM;
     frame_box(pd, m);
     t = new_trap(&b);
     set_trap(&b, t, m->box_lo, m->box_hi, m->box_top, m->box_bot);
-    b.leaf[t] = new_node(&b, N_LEAF, t, 0, 0);
+    b.T[t].leaf = new_node(&b, N_LEAF, t, 0, 0);
     for (i = 0; i < nw && !b.fail; i++)
         insert_seg(&b, order[i]);
     if (b.fail)
@@ -793,39 +821,65 @@ static plx_status build_map(arena *a, polar *pd, polar_map *m, uint32_t *order)
         return PLX_E_NOMEM;
     if (compute_cover(&b, cov, below, stack) != 0)
         return PLX_E_SCENE;
+    /* keep the free trapezoids only; inner search nodes in breadth-first
+     * order from the root (the top levels, visited by every search, share
+     * cache lines); leaves folded into child words */
     n = 0;
     for (t = 0; t < b.ntrap; t++)
-        renum[t] = b.dead[t] ? POLAR_NONE : n++;
-    m->ntrap = n;
-    m->nnode = b.nnode;
-    m->root = 0;
-    m->top = keep_n(a, n, 4, &pd->bytes[1]);
-    m->bot = keep_n(a, n, 4, &pd->bytes[1]);
-    m->solid = keep_n(a, n, 1, &pd->bytes[1]);
-    m->lp = keep_n(a, n, 4, &pd->bytes[0]);
-    m->rp = keep_n(a, n, 4, &pd->bytes[0]);
-    m->nb = keep_n(a, n, 16, &pd->bytes[0]);
-    m->node = keep_n(a, b.nnode, 12, &pd->bytes[3]);
-    if (!m->top || !m->bot || !m->solid || !m->lp || !m->rp || !m->nb || !m->node)
+        renum[t] = (b.T[t].dead || cov[b.T[t].bot] != 0) ? POLAR_NONE : n++;
+    nrenum = scratch_n(a, b.nnode, 4);
+    queue = scratch_n(a, b.nnode, 4);
+    if (!nrenum || !queue)
         return PLX_E_NOMEM;
+    for (i = 0; i < b.nnode; i++)
+        nrenum[i] = POLAR_NONE;
+    nq = 0;
+    if (KIND(b.node[0][0]) != N_LEAF) {
+        nrenum[0] = 0;
+        queue[nq++] = 0;
+    }
+    for (i = 0; i < nq; i++) {
+        uint32_t j;
+        for (j = 1; j < 3; j++) {
+            uint32_t c = b.node[queue[i]][j];
+            if (KIND(b.node[c][0]) != N_LEAF && nrenum[c] == POLAR_NONE) {
+                nrenum[c] = nq;
+                queue[nq++] = c;
+            }
+        }
+    }
+    m->ntrap = n;
+    m->nnode = nq;
+    m->trap = keep_n(a, n, sizeof(polar_trap), &pd->bytes[0]);
+    m->node = keep_n(a, nq, 12, &pd->bytes[3]);
+    if (!m->trap || !m->node)
+        return PLX_E_NOMEM;
+    /* polar_memory: the axes (lp, rp, nb) and the regions (top, bot) */
+    pd->bytes[0] -= (size_t)n * 8;
+    pd->bytes[1] += (size_t)n * 8;
     for (t = 0; t < b.ntrap; t++) {
         uint32_t u = renum[t], j;
+        polar_trap *q;
         if (u == POLAR_NONE)
             continue;
-        m->top[u] = b.top[t];
-        m->bot[u] = b.bot[t];
-        m->lp[u] = b.lp[t];
-        m->rp[u] = b.rp[t];
-        m->solid[u] = cov[b.bot[t]] != 0;
-        for (j = 0; j < 4; j++)
-            m->nb[u][j] = b.nb[t][j] == POLAR_NONE ? POLAR_NONE : renum[b.nb[t][j]];
+        q = &m->trap[u];
+        q->top = b.T[t].top;
+        q->bot = b.T[t].bot;
+        q->lp = b.T[t].lp;
+        q->rp = b.T[t].rp;
+        for (j = 0; j < 4; j++) {
+            uint32_t x = b.T[t].nb[j];
+            if (x != POLAR_NONE && renum[x] == POLAR_NONE)
+                return PLX_E_SCENE;    /* a solid neighbour: cannot happen */
+            q->nb[j] = x == POLAR_NONE ? POLAR_NONE : renum[x];
+        }
     }
-    for (i = 0; i < b.nnode; i++) {
-        m->node[i][0] = b.node[i][0];
-        m->node[i][1] = b.node[i][1];
-        m->node[i][2] = b.node[i][2];
-        if (KIND(b.node[i][0]) == N_LEAF)
-            m->node[i][0] = PACK(N_LEAF, renum[IDX(b.node[i][0])]);
+    m->root = child_word(&b, 0, renum, nrenum, cov);
+    for (i = 0; i < nq; i++) {
+        uint32_t o = queue[i];
+        m->node[i][0] = b.node[o][0];
+        m->node[i][1] = child_word(&b, b.node[o][1], renum, nrenum, cov);
+        m->node[i][2] = child_word(&b, b.node[o][2], renum, nrenum, cov);
     }
     return PLX_OK;
 }
@@ -915,12 +969,62 @@ static plx_status make_walls(arena *a, polar *pd)
         pd->seg[nm].cover = 1;
         nm++;
     }
-    /* pieces cancelling out (cover 0) separate solid from solid: keep them,
-     * they are still walls of the diagram */
+    /* pieces cancelling out (cover 0: a party wall, two footprints on
+     * either side) separate solid from solid: no ray of a free point meets
+     * them first, and they change no count of footprints, so they are left
+     * out of the diagrams (fewer axes, regions and search nodes) */
+    for (i = 0, j = 0; i < nm; i++)
+        if (pd->seg[i].cover != 0)
+            pd->seg[j++] = pd->seg[i];
+    nm = j;
     pd->nwall = nm;
     pd->nseg = nm;
     add_box(pd, s->npts + nextra);
     return PLX_OK;
+}
+
+/* Biased randomized insertion order (Amenta, Choi, Rote 2003): every wall
+ * piece draws a round at random (the last round holds about half of them,
+ * the one before a quarter, ...); rounds go in order and, within a round,
+ * pieces follow a Z-order curve of their midpoints. The randomness of the
+ * rounds keeps the expected O(n log n) of randomized incremental
+ * construction; the spatial order within a round makes consecutive searches
+ * in the DAG run through the same nodes (cache hits). Deterministic. */
+static uint32_t spread16(uint32_t x)
+{
+    x &= 0xffffu;
+    x = (x | (x << 8)) & 0x00ff00ffu;
+    x = (x | (x << 4)) & 0x0f0f0f0fu;
+    x = (x | (x << 2)) & 0x33333333u;
+    x = (x | (x << 1)) & 0x55555555u;
+    return x;
+}
+
+static int insertion_order(arena *a, const polar *pd, uint32_t *order, uint64_t *seed)
+{
+    uint32_t i, n = pd->nwall;
+    keyed *k = scratch_n(a, n, sizeof(keyed));
+    double sx = 65535.0 / (pd->box[2] - pd->box[0]), sy = 65535.0 / (pd->box[3] - pd->box[1]);
+    if (!k)
+        return -1;
+    for (i = 0; i < n; i++) {
+        const polar_seg *g = &pd->seg[i];
+        vec2 pa = pd->pts[g->a], pb = pd->pts[g->b];
+        uint32_t r = rng_next(seed), round = 0, ux, uy;
+        double mx = 0.5 * (pa.x + pb.x) - pd->box[0], my = 0.5 * (pa.y + pb.y) - pd->box[1];
+        while (round < 24 && (r & 1u)) {   /* round 24 - t with probability 2^-(t+1) */
+            round++;
+            r >>= 1;
+        }
+        ux = (uint32_t)fmin(fmax(mx * sx, 0.0), 65535.0);
+        uy = (uint32_t)fmin(fmax(my * sy, 0.0), 65535.0);
+        k[i].key = (double)(24 - round) * 4294967296.0 + (double)(spread16(ux) | (spread16(uy) << 1));
+        k[i].idx = i;
+    }
+    qsort(k, n, sizeof(keyed), cmp_keyed);
+    for (i = 0; i < n; i++)
+        order[i] = k[i].idx;
+    return 0;
 }
 
 plx_status polar_build(arena *a, const scene *s, polar **out)
@@ -946,15 +1050,8 @@ plx_status polar_build(arena *a, const scene *s, polar **out)
     st = make_walls(a, pd);
     if (st == PLX_OK) {
         order = scratch_n(a, pd->nwall, 4);
-        if (!order)
+        if (!order || insertion_order(a, pd, order, &seed) != 0)
             st = PLX_E_NOMEM;
-        for (i = 0; st == PLX_OK && i < pd->nwall; i++)
-            order[i] = i;
-        for (i = pd->nwall; st == PLX_OK && i > 1; i--) {
-            uint32_t j = rng_next(&seed) % i, t = order[i - 1];
-            order[i - 1] = order[j];
-            order[j] = t;
-        }
         for (i = 0; st == PLX_OK && i < 2; i++) {
             pd->map[i].frame = i;
             st = build_map(a, pd, &pd->map[i], order);
@@ -975,29 +1072,37 @@ plx_status polar_build(arena *a, const scene *s, polar **out)
 
 /* ---- queries ----------------------------------------------------------- */
 
-/* Region of frame point f: index, or -2 when f is on a wall or a vertex. */
-int32_t polar_locate_frame(const polar *pd, const polar_map *m, vec2 f)
+/* The child word of the leaf holding frame point f, or POLAR_NONE when f
+ * is on a wall or has the abscissa and ordinate of a vertex. */
+static uint32_t locate_word(const polar *pd, const polar_map *m, vec2 f)
 {
-    uint32_t n = m->root;
-    for (;;) {
-        uint32_t w = m->node[n][0];
-        if (KIND(w) == N_LEAF)
-            return (int32_t)IDX(w);
+    uint32_t c = m->root;
+    while (POLAR_TAG(c) == POLAR_CHILD_NODE) {
+        const uint32_t *nd = m->node[c];
+        uint32_t w = nd[0];
         if (KIND(w) == N_X) {
-            int c = lex_cmp(f, polar_fpt(pd, m->frame, IDX(w)));
-            if (c == 0)
-                return -2;
-            n = c < 0 ? m->node[n][1] : m->node[n][2];
+            int k = lex_cmp(f, polar_fpt(pd, m->frame, IDX(w)));
+            if (k == 0)
+                return POLAR_NONE;
+            c = k < 0 ? nd[1] : nd[2];
         } else {
-            uint32_t l, r;
-            int o;
-            seg_ends(pd, m->frame, IDX(w), &l, &r);
-            o = geom_orient(polar_fpt(pd, m->frame, l), polar_fpt(pd, m->frame, r), f);
+            const polar_seg *g = &pd->seg[IDX(w)];
+            uint32_t l = KIND(w) == N_Y ? g->a : g->b, r = KIND(w) == N_Y ? g->b : g->a;
+            int o = geom_orient(polar_fpt(pd, m->frame, l), polar_fpt(pd, m->frame, r), f);
             if (o == 0)
-                return -2;
-            n = o > 0 ? m->node[n][2] : m->node[n][1];
+                return POLAR_NONE;
+            c = o > 0 ? nd[2] : nd[1];
         }
     }
+    return c;
+}
+
+int32_t polar_locate_frame(const polar *pd, const polar_map *m, vec2 f)
+{
+    uint32_t c = locate_word(pd, m, f);
+    if (c == POLAR_NONE)
+        return -2;
+    return POLAR_TAG(c) == POLAR_CHILD_FREE ? (int32_t)POLAR_IDX(c) : -3;
 }
 
 static int inside_box(const polar *pd, vec2 p)
@@ -1022,24 +1127,24 @@ int32_t polar_locate(const polar *pd, int q, vec2 p, int32_t *owner)
     int mi, top;
     const polar_map *m;
     int32_t t;
+    uint32_t c;
     if (owner)
         *owner = -1;
     if (!pd || q < 0 || q > 3 || !inside_box(pd, p))
         return -1;
     quadrant_side(q, &mi, &top);
     m = &pd->map[mi];
-    t = polar_locate_frame(pd, m, polar_to_frame(m->frame, p));
-    if (t < 0)
+    c = locate_word(pd, m, polar_to_frame(m->frame, p));
+    if (c == POLAR_NONE)
         return -2;
-    if (m->solid[t]) {
-        if (owner) {
-            uint32_t s = seg_delta(pd, m->frame, m->bot[t]) > 0 ? m->bot[t] : m->top[t];
-            *owner = seg_owner(pd, s);
-        }
+    if (POLAR_TAG(c) == POLAR_CHILD_SOLID) {
+        if (owner)
+            *owner = seg_owner(pd, POLAR_IDX(c));
         return -3;
     }
+    t = (int32_t)POLAR_IDX(c);
     if (owner)
-        *owner = seg_owner(pd, top ? m->top[t] : m->bot[t]);
+        *owner = seg_owner(pd, top ? m->trap[t].top : m->trap[t].bot);
     return t;
 }
 
@@ -1077,7 +1182,7 @@ static void walk(const polar *pd, const polar_map *m, uint32_t t, vec2 p, vec2 q
     uint32_t hit = POLAR_NONE, steps = 0;
     int box = 0;
     for (;;) {
-        uint32_t r = right ? m->rp[t] : m->lp[t], nx;
+        uint32_t r = right ? m->trap[t].rp : m->trap[t].lp, nx;
         int o;
         steps++;
         if (r == (right ? m->box_hi : m->box_lo)) {
@@ -1091,15 +1196,15 @@ static void walk(const polar *pd, const polar_map *m, uint32_t t, vec2 p, vec2 q
             o = -o;
         /* o > 0: the ray passes below r (in the frame) */
         if (o > 0) {
-            nx = m->nb[t][right ? LR : LL];
+            nx = m->trap[t].nb[right ? LR : LL];
             if (nx == POLAR_NONE) {
-                hit = m->bot[t];
+                hit = m->trap[t].bot;
                 break;
             }
         } else {
-            nx = m->nb[t][right ? UR : UL];
+            nx = m->trap[t].nb[right ? UR : UL];
             if (nx == POLAR_NONE) {
-                hit = m->top[t];
+                hit = m->trap[t].top;
                 break;
             }
         }
@@ -1143,7 +1248,7 @@ plx_status polar_shoot_to(const polar *pd, vec2 p, vec2 q, int side, polar_hit *
     Q = polar_to_frame(m->frame, q);
     (void)Q;
     t = polar_locate_frame(pd, m, P);
-    if (t < 0 || m->solid[t])
+    if (t < 0)
         return PLX_E_RANGE;
     if (side != 0) {
         walk(pd, m, (uint32_t)t, p, q, side, out);
@@ -1213,15 +1318,15 @@ int polar_region(const polar *pd, int q, uint32_t i, vec2 c[4], int32_t *owner, 
         return 0;
     quadrant_side(q, &mi, &top);
     m = &pd->map[mi];
-    ul = polar_fpt(pd, m->frame, m->lp[i]).x;
-    ur = polar_fpt(pd, m->frame, m->rp[i]).x;
-    c[0] = polar_from_frame(m->frame, seg_at(pd, m->frame, m->bot[i], ul));
-    c[1] = polar_from_frame(m->frame, seg_at(pd, m->frame, m->bot[i], ur));
-    c[2] = polar_from_frame(m->frame, seg_at(pd, m->frame, m->top[i], ur));
-    c[3] = polar_from_frame(m->frame, seg_at(pd, m->frame, m->top[i], ul));
+    ul = polar_fpt(pd, m->frame, m->trap[i].lp).x;
+    ur = polar_fpt(pd, m->frame, m->trap[i].rp).x;
+    c[0] = polar_from_frame(m->frame, seg_at(pd, m->frame, m->trap[i].bot, ul));
+    c[1] = polar_from_frame(m->frame, seg_at(pd, m->frame, m->trap[i].bot, ur));
+    c[2] = polar_from_frame(m->frame, seg_at(pd, m->frame, m->trap[i].top, ur));
+    c[3] = polar_from_frame(m->frame, seg_at(pd, m->frame, m->trap[i].top, ul));
     if (owner)
-        *owner = m->solid[i] ? -1 : seg_owner(pd, top ? m->top[i] : m->bot[i]);
+        *owner = seg_owner(pd, top ? m->trap[i].top : m->trap[i].bot);
     if (solid)
-        *solid = m->solid[i];
+        *solid = 0;
     return 4;
 }

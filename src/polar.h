@@ -15,6 +15,11 @@
  * across each of its two axis sides; a region whose start ray reaches the
  * Bounds box without meeting a wall has no fixed owner (owner -1), the
  * object met first there is found by vis_first() (visibility.h).
+ * Known gap against a full polar diagram (Grima, Marquez, Ortega 2006):
+ * in such an escape region the first object of the scan is not constant —
+ * it changes across the lines through pairs of vertices (where one object
+ * starts to hide another) — and these lines are not part of the stored
+ * subdivision, so those regions carry no label.
  *
  * Quadrants 0 and 2 (scan starting east and west) share one set of
  * horizontal axes, quadrants 1 and 3 one set of vertical axes: two planar
@@ -28,7 +33,15 @@
  * or overlap are first cut into pieces at every contact (exact predicates;
  * crossing points of overlapping walls are rounded to doubles, the only
  * inexact step). Pieces lying on top of each other are merged and keep up to
- * two owners. Every combinatorial decision afterwards uses geom_orient.
+ * two owners; pieces of two footprints lying on top of each other in
+ * opposite directions (a party wall: solid on both sides) are left out, as
+ * no ray from free space meets them first. Every combinatorial decision
+ * afterwards uses geom_orient.
+ *
+ * Construction order: a biased randomized insertion order (random rounds,
+ * a Z-order curve within each round), which keeps the expected bounds of
+ * randomized incremental construction and makes consecutive searches share
+ * cached DAG nodes.
  *
  * Memory: everything lives in the arena, part PLX_PART_POLAR; construction
  * temporaries come from arena_scratch and are released before return.
@@ -51,24 +64,41 @@ typedef struct polar_seg {
     int32_t cover;       /* footprints entered when crossing from right to left */
 } polar_seg;
 
+/* A free region of a subdivision: a trapezoid in the frame of its map,
+ * bounded by two walls (or Bounds sides) and by the polar axes of two
+ * points. 32 bytes. */
+typedef struct polar_trap {
+    uint32_t lp, rp;         /* points whose axes bound it (frame left / right) */
+    uint32_t top, bot;       /* wall pieces bounding it (frame above / below) */
+    uint32_t nb[4];          /* regions across its axis sides: upper-left,
+                              * lower-left, upper-right, lower-right (or
+                              * POLAR_NONE: the side ends on that wall) */
+} polar_trap;
+
 /* One of the two subdivisions. Trapezoids in its frame: frame 0 maps world
  * (x, y) to (y, -x) (axes horizontal in the world), frame 1 is the identity
  * (axes vertical). Within a frame points are ordered by (u, v) lexicographic
- * order, so equal u needs no special case. Stored as parallel arrays so that
- * memory can be reported by part. */
+ * order, so equal u needs no special case.
+ *
+ * Only the free trapezoids are kept as regions: a region next to a free one
+ * across an axis side is free too (solid and free are only ever separated
+ * by walls), so walks never need the solid ones. The search DAG (trapezoidal
+ * map search structure) keeps its inner nodes; its leaves are folded into
+ * the child words of their parents: a child word is an inner node (tag 0),
+ * a free region (tag 1) or a solid trapezoid (tag 2, whose index is the wall
+ * piece bounding it on the side of its footprint). */
+#define POLAR_TAG(w) ((w) >> 30)
+#define POLAR_IDX(w) ((w) & 0x3fffffffu)
+enum { POLAR_CHILD_NODE = 0, POLAR_CHILD_FREE = 1, POLAR_CHILD_SOLID = 2 };
+
 typedef struct polar_map {
     int frame;
-    uint32_t ntrap;
-    /* regions */
-    uint32_t *top, *bot;     /* bounding wall pieces (frame above / below) */
-    uint8_t *solid;          /* 1 inside a footprint, 0 free */
-    /* polar axes: the two sides of a region and the regions across them */
-    uint32_t *lp, *rp;       /* points whose axes bound the region (frame left/right) */
-    uint32_t (*nb)[4];       /* neighbours: upper-left, lower-left, upper-right, lower-right */
+    uint32_t ntrap;          /* free regions */
+    polar_trap *trap;
     /* search structure */
     uint32_t (*node)[3];     /* kind<<30 | index, child below/left, child above/right */
     uint32_t nnode;
-    uint32_t root;
+    uint32_t root;           /* child word of the root */
     uint32_t box_top, box_bot; /* segment indices of the Bounds sides on top/bottom */
     uint32_t box_lo, box_hi;   /* point indices of the extreme Bounds corners */
 } polar_map;
@@ -130,16 +160,19 @@ plx_status polar_shoot(const polar *pd, vec2 p, double dx, double dy, polar_hit 
  * [3] the rest (search structures, headers). Both subdivisions together. */
 void polar_memory(const polar *pd, size_t bytes[4] /* OUT */);
 
-/* For drawing. Number of regions of the diagram of quadrant q, and region i
- * as a polygon of 3 or 4 corners (world coordinates, counter-clockwise; a
- * degenerate region may repeat a corner): returns the number of corners
- * written to c[0..3] and stores the owner (as polar_locate) and whether the
- * region is solid. Returns 0 for an index out of range. */
+/* For drawing. Number of (free) regions of the diagram of quadrant q, and
+ * region i as a polygon of 3 or 4 corners (world coordinates,
+ * counter-clockwise; a degenerate region may repeat a corner): returns the
+ * number of corners written to c[0..3] and stores the owner (as
+ * polar_locate) and whether the region is solid (always 0: solid trapezoids
+ * are not kept). Returns 0 for an index out of range. */
 uint32_t polar_region_count(const polar *pd, int q);
 int polar_region(const polar *pd, int q, uint32_t i, vec2 c[4] /* OUT */,
                  int32_t *owner /* OUT */, int *solid /* OUT */);
 
-/* Internal helpers shared with visibility.c. */
+/* Internal helpers shared with visibility.c. polar_locate_frame: the free
+ * region holding frame point f (>= 0), -2 when f is on a wall or a vertex
+ * (or has the frame abscissa and ordinate of one), -3 inside a footprint. */
 vec2 polar_fpt(const polar *pd, int frame, uint32_t i);      /* point in a frame */
 vec2 polar_to_frame(int frame, vec2 w);
 vec2 polar_from_frame(int frame, vec2 f);

@@ -1,6 +1,7 @@
 /* visibility: fan of tangent rays by cone walking (see visibility.h). */
 #include <float.h>
 #include <math.h>
+#include <stdlib.h>
 #include <string.h>
 #include "visibility.h"
 #include "geom.h"
@@ -28,6 +29,15 @@ typedef struct chunk {
     cone c[CHUNK];
 } chunk;
 
+/* Buildings met by closed cones, in the order met (repeats kept but for
+ * immediate ones); sorted and made unique at the end. */
+#define HCHUNK 1024
+typedef struct hchunk {
+    struct hchunk *prev;
+    uint32_t n;
+    uint32_t v[HCHUNK];
+} hchunk;
+
 typedef struct walker {
     const polar *pd;
     const polar_map *m;
@@ -38,7 +48,10 @@ typedef struct walker {
     int nomem;
     /* output */
     vis_result *out;
-    uint8_t *seen;       /* per building */
+    int want_vis;        /* collect the visible buildings */
+    hchunk *hits;
+    uint32_t nhits;
+    int32_t last_hit;
     double area2;        /* twice the area */
     vec2 last;           /* last polygon point */
     uint32_t last_seg;
@@ -63,6 +76,32 @@ static int push(walker *w, const cone *c)
     }
     k->c[k->n++] = *c;
     return 1;
+}
+
+static void add_hit(walker *w, int32_t b)
+{
+    hchunk *k = w->hits;
+    if (b == w->last_hit)
+        return;
+    if (!k || k->n == HCHUNK) {
+        hchunk *nk = arena_scratch(w->a, sizeof(hchunk), 16);
+        if (!nk) {
+            w->nomem = 1;
+            return;
+        }
+        nk->prev = k;
+        nk->n = 0;
+        w->hits = k = nk;
+    }
+    k->v[k->n++] = (uint32_t)b;
+    w->nhits++;
+    w->last_hit = b;
+}
+
+static int cmp_u32(const void *x, const void *y)
+{
+    uint32_t a = *(const uint32_t *)x, b = *(const uint32_t *)y;
+    return (a > b) - (a < b);
 }
 
 static int pop(walker *w, cone *c)
@@ -204,11 +243,11 @@ static void close_cone(walker *w, uint32_t s, vec2 A, vec2 B)
     }
     add_piece(w, ray_line(w->p, wa, pd->pts[g->a], pd->pts[g->b]),
               ray_line(w->p, wb, pd->pts[g->a], pd->pts[g->b]), s);
-    if (!w->seen || cone_width(w->P, A, B) < VIS_MIN_WIDTH)
+    if (!w->want_vis || cone_width(w->P, A, B) < VIS_MIN_WIDTH)
         return;
     for (k = 0; k < 2; k++)
         if (g->bld[k] >= 0)
-            w->seen[g->bld[k]] = 1;
+            add_hit(w, g->bld[k]);
 }
 
 /* Has every ray of cone c already crossed the floor (below = 1) or ceiling
@@ -218,7 +257,7 @@ static void close_cone(walker *w, uint32_t s, vec2 A, vec2 B)
 static int past_wall(const walker *w, const cone *c, vec2 R, int below)
 {
     const polar_map *m = w->m;
-    const polar_seg *g = &w->pd->seg[below ? m->bot[c->t] : m->top[c->t]];
+    const polar_seg *g = &w->pd->seg[below ? m->trap[c->t].bot : m->trap[c->t].top];
     vec2 a = polar_fpt(w->pd, m->frame, g->a), b = polar_fpt(w->pd, m->frame, g->b), X;
     double cy, cr, xx, xy, cx2, cy2;
     int sgn;
@@ -245,16 +284,17 @@ static void step(walker *w, cone c)
         int oA, oB, below_only, above_only;
         cone hi;
         w->out->nsteps++;
-        r = c.right ? m->rp[c.t] : m->lp[c.t];
+        r = c.right ? m->trap[c.t].rp : m->trap[c.t].lp;
         if (r == (c.right ? m->box_hi : m->box_lo)) {
             w->out->ncones++;
             close_box(w, polar_from_frame(m->frame, c.A), polar_from_frame(m->frame, c.B));
             return;
         }
         R = polar_fpt(w->pd, m->frame, r);
-        oA = geom_orient(w->P, c.A, R);
+        /* "below" = the part passing below R in the frame; the limit ray A
+         * is only looked at when B does not decide */
         oB = geom_orient(w->P, c.B, R);
-        /* "below" = the part passing below R in the frame */
+        oA = oB >= 0 ? 1 : geom_orient(w->P, c.A, R);
         if (c.right) {
             below_only = oB >= 0;
             above_only = !below_only && oA <= 0;
@@ -274,15 +314,15 @@ static void step(walker *w, cone c)
             above_only = !c.right;
         }
         if (below_only) {
-            nx = m->nb[c.t][c.right ? LR : LL];
+            nx = m->trap[c.t].nb[c.right ? LR : LL];
             if (nx == POLAR_NONE || past_wall(w, &c, R, 1)) {
-                close_cone(w, m->bot[c.t], c.A, c.B);
+                close_cone(w, m->trap[c.t].bot, c.A, c.B);
                 return;
             }
         } else {
-            nx = m->nb[c.t][c.right ? UR : UL];
+            nx = m->trap[c.t].nb[c.right ? UR : UL];
             if (nx == POLAR_NONE || past_wall(w, &c, R, 0)) {
-                close_cone(w, m->top[c.t], c.A, c.B);
+                close_cone(w, m->trap[c.t].top, c.A, c.B);
                 return;
             }
         }
@@ -326,21 +366,46 @@ static vec2 dir_point(const polar *pd, vec2 p, double ang, int q, int exact_axis
     return r;
 }
 
-/* Walks the cone of world directions [A, B] lying in quadrant q. */
-static void quadrant_cone(walker *w, int q, vec2 A, vec2 B, const uint32_t t0[2])
+/* Walks the cone of world directions [A, B] (inside quadrant q) in the
+ * diagram mi: there the rays all move towards increasing frame order
+ * (right) when their frame abscissa grows, else towards decreasing. */
+static void walk_cone(walker *w, int mi, int q, vec2 A, vec2 B, const uint32_t t0[2])
 {
-    int mi = q & 1;
-    int fq = mi == 0 ? (q + 3) % 4 : q;
     cone c;
     w->m = &w->pd->map[mi];
     w->P = polar_to_frame(w->m->frame, w->p);
     c.A = polar_to_frame(w->m->frame, A);
     c.B = polar_to_frame(w->m->frame, B);
     c.t = t0[mi];
-    c.right = (fq == 0 || fq == 3);
+    c.right = mi == 0 ? (q == 0 || q == 1) : (q == 0 || q == 3);
+    run(w, c);
+}
+
+/* Walks the cone of world directions [A, B] lying in quadrant q. Its rays
+ * near the quadrant's start axis go through the diagram whose axes are
+ * parallel to that axis (diagram q & 1), those past the diagonal through
+ * the other one: a ray crosses the axes of a diagram the faster the more it
+ * turns away from them, so each half crosses fewer regions this way. The
+ * split ray is one exact ray shared by both halves. */
+static void quadrant_cone(walker *w, int q, vec2 A, vec2 B, const uint32_t t0[2])
+{
+    static const int sg[4][2] = { { 1, 1 }, { -1, 1 }, { -1, -1 }, { 1, -1 } };
+    double L = 2.0 * ((w->pd->box[2] - w->pd->box[0]) + (w->pd->box[3] - w->pd->box[1]));
+    int m0 = q & 1, m1 = 1 - m0;
+    vec2 D;
     if (geom_orient(w->p, A, B) <= 0)
         return;                 /* empty */
-    run(w, c);
+    D.x = w->p.x + sg[q][0] * L;
+    D.y = w->p.y + sg[q][1] * L;
+    if (geom_orient(w->p, A, D) <= 0) {
+        walk_cone(w, m1, q, A, B, t0);
+    } else if (geom_orient(w->p, D, B) <= 0) {
+        walk_cone(w, m0, q, A, B, t0);
+    } else {
+        walk_cone(w, m0, q, A, D, t0);
+        if (!w->nomem && !w->stopped)
+            walk_cone(w, m1, q, D, B, t0);
+    }
 }
 
 static int locate_free(const polar *pd, vec2 p, uint32_t t0[2])
@@ -351,7 +416,7 @@ static int locate_free(const polar *pd, vec2 p, uint32_t t0[2])
     for (i = 0; i < 2; i++) {
         const polar_map *m = &pd->map[i];
         int32_t t = polar_locate_frame(pd, m, polar_to_frame(m->frame, p));
-        if (t < 0 || m->solid[t])
+        if (t < 0)
             return -1;
         t0[i] = (uint32_t)t;
     }
@@ -432,30 +497,38 @@ plx_status vis_query(const polar *pd, vec2 p, double a0, double a1, int full_cir
     w.p = p;
     w.out = out;
     w.last_seg = POLAR_NONE;
-    w.seen = pd->nbld ? arena_scratch(a, pd->nbld, 1) : NULL;
-    if (pd->nbld && !w.seen) {
-        arena_release(a, &mk);
-        return PLX_E_NOMEM;
-    }
-    if (w.seen)
-        memset(w.seen, 0, pd->nbld);
+    w.want_vis = 1;
+    w.last_hit = -1;
     if (!full_circle)
         add_point(&w, p);
     range_cones(&w, a0, wd, full_circle, t0);
-    if (w.nomem)
-        st = PLX_E_NOMEM;
     /* close the ring: drop a last point equal to the first */
     if (out->npoly > 1 && out->poly && out->npoly <= out->poly_cap &&
         out->poly[0].x == w.last.x && out->poly[0].y == w.last.y)
         out->npoly--;
     out->area = 0.5 * w.area2;
-    for (i = 0; i < pd->nbld; i++) {
-        if (!w.seen[i])
-            continue;
-        if (out->vis && out->nvis < out->vis_cap)
-            out->vis[out->nvis] = i;
-        out->nvis++;
+    if (!w.nomem && w.nhits > 0) {
+        uint32_t *all = arena_scratch(a, (size_t)w.nhits * 4, 16), n = 0;
+        hchunk *k;
+        if (!all) {
+            w.nomem = 1;
+        } else {
+            for (k = w.hits; k; k = k->prev) {
+                memcpy(all + n, k->v, k->n * 4);
+                n += k->n;
+            }
+            qsort(all, n, 4, cmp_u32);
+            for (i = 0; i < n; i++) {
+                if (i > 0 && all[i] == all[i - 1])
+                    continue;
+                if (out->vis && out->nvis < out->vis_cap)
+                    out->vis[out->nvis] = all[i];
+                out->nvis++;
+            }
+        }
     }
+    if (w.nomem)
+        st = PLX_E_NOMEM;
     if ((out->poly && out->npoly > out->poly_cap) || (out->vis && out->nvis > out->vis_cap))
         st = PLX_E_NOMEM;
     arena_release(a, &mk);

@@ -9,6 +9,7 @@
 #include <setjmp.h>
 #include <stdint.h>
 #include <stdio.h>
+#include <pthread.h>
 #include <stdlib.h>
 #include <string.h>
 #include <math.h>
@@ -16,6 +17,7 @@
 
 #include "scene.h"
 #include "arena.h"
+#include "engine.h"
 #include "polar.h"
 #include "visibility.h"
 #include "ref_scene.h"
@@ -683,6 +685,167 @@ static void test_first_object(void **state)
     fixture_free(f);
 }
 
+/* ------------------------------------------------------- the fixtures */
+
+/* Random free points over the bundled fixtures, full-turn visibility (and a
+ * range for one point in eight) compared with ref_vis: areas to 1e-9
+ * relative, identical visible sets. ref_vis costs O(E^2) per query, from
+ * 0.3 ms (grid-4x4) to 1.7 s (helsinki-centre), so the points are spread by
+ * cost; the default run holds 10,004 points. PLX_TEST_POINTS=N asks
+ * for about N points in all (same proportions), PLX_TEST_QUICK for 1/20. The
+ * reference runs in two threads (the diagrams are read only; each thread has
+ * its own scratch arena). */
+
+#define FIX_THREADS 2
+#define FIX_SCRATCH ((size_t)4 << 20)
+
+typedef struct fix_job {
+    const scene *s;
+    const polar *pd;
+    const vec2 *pts;
+    int n, tid;
+    int bad, checked;
+    char msg[512];
+} fix_job;
+
+static int fix_check(fix_job *j, arena *a, vec2 p, int full, double a0, double a1)
+{
+    ref_vis_result rr;
+    vis_result vr;
+    uint32_t k, vis[4096];
+    plx_status st;
+    int rc, ok;
+    rc = full ? ref_vis(j->s, p.x, p.y, &rr) : ref_vis_range(j->s, p.x, p.y, a0, a1, &rr);
+    memset(&vr, 0, sizeof vr);
+    vr.vis = vis;
+    vr.vis_cap = 4096;
+    st = vis_query(j->pd, p, a0, a1, full, a, &vr);
+    ok = rc == 0 && st == PLX_OK && fabs(vr.area - rr.area) <= 1e-9 * fmax(rr.area, 1.0) &&
+         vr.nvis == rr.nvisible && a->hi == 0;
+    for (k = 0; ok && k < vr.nvis; k++)
+        ok = vr.vis[k] == rr.visible[k];
+    if (!ok && j->msg[0] == '\0')
+        snprintf(j->msg, sizeof j->msg, "p = (%.17g, %.17g) full %d [%.17g, %.17g]: rc %d st %d "
+                 "area %.15g ref %.15g, nvis %u ref %u", p.x, p.y, full, a0, a1, rc, st,
+                 vr.area, rr.area, vr.nvis, rr.nvisible);
+    ref_vis_free(&rr);
+    return ok;
+}
+
+static void *fix_worker(void *arg)
+{
+    fix_job *j = arg;
+    void *mem = malloc(FIX_SCRATCH);
+    arena a;
+    int i;
+    if (!mem) {
+        j->bad = -1;
+        return NULL;
+    }
+    arena_init(&a, mem, FIX_SCRATCH);
+    for (i = j->tid; i < j->n; i += FIX_THREADS) {
+        double a0 = (i % 13) * 0.5 - 3.0, a1 = a0 + 0.3 + (i % 7) * 0.9;
+        j->checked++;
+        if (!fix_check(j, &a, j->pts[i], 1, 0, 0))
+            j->bad++;
+        if (i % 8 == 3 && !fix_check(j, &a, j->pts[i], 0, a0, a1))
+            j->bad++;
+    }
+    free(mem);
+    return NULL;
+}
+
+/* Points wanted for a fixture whose default share is n. */
+static int fix_points(int n)
+{
+    const char *e = getenv("PLX_TEST_POINTS");
+    if (e && atoi(e) > 0)
+        n = (int)((double)n * atoi(e) / 10004.0 + 0.5);
+    else if (getenv("PLX_TEST_QUICK"))
+        n /= 20;
+    return n < 1 ? 1 : n;
+}
+
+static void fixture_points(const char *path, int npts)
+{
+    plx_engine *e;
+    plx_config cfg;
+    plx_port quiet = *plx_port_posix();
+    const scene *s;
+    polar *pd;
+    vec2 *pts;
+    fix_job job[FIX_THREADS];
+    pthread_t th[FIX_THREADS];
+    int i, n = 0, tries = 0, bad = 0, checked = 0;
+    quiet.log = NULL;
+    plx_config_default(&cfg);
+    cfg.port = &quiet;
+    assert_int_equal(plx_engine_new((size_t)256 << 20, &cfg, &e), PLX_OK);
+    assert_int_equal(plx_load_file(e, path), PLX_OK);
+    s = e->sc;
+    assert_int_equal(polar_build(&e->mem, s, &pd), PLX_OK);
+    pts = malloc((size_t)npts * sizeof *pts);
+    assert_non_null(pts);
+    while (n < npts && tries < 100 * npts) {
+        vec2 p;
+        tries++;
+        p.x = s->bounds[0] + urand() * (s->bounds[2] - s->bounds[0]);
+        p.y = s->bounds[1] + urand() * (s->bounds[3] - s->bounds[1]);
+        if (where(s, p) == 0)
+            pts[n++] = p;
+    }
+    assert_int_equal(n, npts);
+    for (i = 0; i < FIX_THREADS; i++) {
+        memset(&job[i], 0, sizeof job[i]);
+        job[i].s = s;
+        job[i].pd = pd;
+        job[i].pts = pts;
+        job[i].n = n;
+        job[i].tid = i;
+        assert_int_equal(pthread_create(&th[i], NULL, fix_worker, &job[i]), 0);
+    }
+    for (i = 0; i < FIX_THREADS; i++) {
+        pthread_join(th[i], NULL);
+        if (job[i].msg[0])
+            print_message("%s: %s\n", path, job[i].msg);
+        bad += job[i].bad;
+        checked += job[i].checked;
+    }
+    print_message("%s: %d free points, %d mismatches\n", path, checked, bad);
+    assert_int_equal(checked, n);
+    assert_int_equal(bad, 0);
+    free(pts);
+    plx_engine_free(e);
+}
+
+static void test_fixture_grid(void **state)
+{
+    (void)state;
+    rnd_state = 6001u;
+    fixture_points("fixtures/grid-4x4.geojson", fix_points(8700));
+}
+
+static void test_fixture_oldtown(void **state)
+{
+    (void)state;
+    rnd_state = 6002u;
+    fixture_points("fixtures/oldtown-8x8.geojson", fix_points(1100));
+}
+
+static void test_fixture_eixample(void **state)
+{
+    (void)state;
+    rnd_state = 6003u;
+    fixture_points("fixtures/eixample-4x4.geojson", fix_points(200));
+}
+
+static void test_fixture_helsinki(void **state)
+{
+    (void)state;
+    rnd_state = 6004u;
+    fixture_points("fixtures/helsinki-centre.geojson", fix_points(4));
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -703,6 +866,10 @@ int main(void)
         cmocka_unit_test(test_random_rotated),
         cmocka_unit_test(test_random_mixed_city),
         cmocka_unit_test(test_random_overlaps),
+        cmocka_unit_test(test_fixture_grid),
+        cmocka_unit_test(test_fixture_oldtown),
+        cmocka_unit_test(test_fixture_eixample),
+        cmocka_unit_test(test_fixture_helsinki),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
