@@ -87,6 +87,8 @@ typedef struct plx_config {
     int strict;                       /* 1: the first bad feature fails the load */
     size_t part_budget[PLX_PART_COUNT]; /* per-part byte limits, 0 = only the block limits */
     size_t lit_cache_bytes;           /* pool for lamp lit regions (0: 16 MiB) */
+    int32_t render_max_width;         /* largest frame plx_render draws (0: 1920) */
+    int32_t render_max_height;        /* (0: 1080) */
 } plx_config;
 
 /* Fills cfg with the defaults: no port, lenient loading, no part limits. */
@@ -295,6 +297,41 @@ plx_status plx_lit_ground(plx_engine *e, uint32_t k, const double **xy /* OUT */
 /* Facade polygon k: n vertices, x,y,z triples, on the wall of building *bld. */
 plx_status plx_lit_facade(plx_engine *e, uint32_t k, const double **xyz /* OUT */, uint32_t *n /* OUT */,
                           uint32_t *bld /* OUT */);
+
+/* ---- Night images (SPEC §5) ----------------------------------------------- */
+
+typedef struct plx_camera {
+    double eye[3], target[3];   /* up is +z */
+    double fov_deg;             /* vertical field of view, 0 < fov < 180 */
+    int32_t width, height;      /* pixels, at most the config's render maximum */
+} plx_camera;
+
+typedef struct plx_render_opts {
+    double exposure;            /* radiance multiplier before sRGB (SPEC default 1) */
+    int no_glow;                /* 1: no lamp glows: every pixel is SPEC §5's radiance */
+    int aerial;                 /* 1: ground from the aerial light map (built once) */
+    double aerial_m_per_texel;  /* light map resolution (0: 1 m, coarser if the budget needs) */
+    int no_cull;                /* 1: draw every building (the culled image is identical) */
+} plx_render_opts;
+
+void plx_render_opts_default(plx_render_opts *o /* OUT */);
+
+typedef struct plx_render_info {
+    uint32_t buildings, drawn;  /* buildings in the scene, drawn after culling */
+    double drawn_fraction;      /* triangles drawn / triangles of the scene */
+    uint64_t shaded_pixels;
+} plx_render_info;
+
+/*
+ * Renders one frame into caller-owned buffers: rgb8 (width*height*3 bytes,
+ * sRGB after exposure, row 0 at the top) and/or rgbf (width*height*3 floats,
+ * linear radiance); either may be NULL. Direct light only for now. The
+ * renderer's own buffers come from the engine (PLX_PART_FRAME) on first use.
+ * Errors: PLX_E_INVALID (bad camera: eye below the ground, eye == target,
+ * size above the maximum), PLX_E_NOSCENE, PLX_E_NOMEM.
+ */
+plx_status plx_render(plx_engine *e, const plx_camera *cam, const plx_render_opts *o, uint8_t *rgb8 /* OUT */,
+                      float *rgbf /* OUT */, plx_render_info *info /* OUT */);
 
 /* ---- How well lit is a route? ------------------------------------------- */
 

@@ -27,6 +27,8 @@ struct plx_engine {
     uint32_t vis_ids_cap;
     struct light *lt;       /* lamp light, created on first need */
     const struct lit_region *lit_last; /* region of the last plx_lit_region_get */
+    struct render *rd;      /* renderer, created on first need */
+    double lightmap_cell;   /* light map texel size when built, else 0 */
 };
 
 #define ENGINE_MAGIC 0x504c5831u /* "PLX1" */
@@ -38,6 +40,8 @@ plx_status eng_nomem(plx_engine *e, const char *during);
 void eng_clear_error(plx_engine *e);
 void eng_log(plx_engine *e, plx_log_level level, const char *msg);
 uint64_t eng_clock(plx_engine *e);
+/* Creates the lamp light object on first need (lightapi.c). */
+plx_status eng_need_light(plx_engine *e, const char *fn);
 /* Checks the engine handle for API misuse. */
 int eng_ok(const plx_engine *e);
 

@@ -468,6 +468,8 @@ static void drop_scene(plx_engine *e)
     e->vis_ids = NULL;
     e->lt = NULL;
     e->lit_last = NULL;
+    e->rd = NULL;
+    e->lightmap_cell = 0.0;
     e->warnings = 0;
     eng_clear_error(e);
     e->mem.lo = e->base.lo;

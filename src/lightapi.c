@@ -8,7 +8,7 @@
 
 #define DEFAULT_LIT_CACHE ((size_t)16 << 20)
 
-static plx_status need_light(plx_engine *e, const char *fn)
+plx_status eng_need_light(plx_engine *e, const char *fn)
 {
     char msg[128];
     strbuf b;
@@ -99,7 +99,7 @@ plx_status plx_illuminance(plx_engine *e, size_t n, const double *P, const doubl
     size_t k;
     int bad = 0;
     char first[ENGINE_ERR_BYTES];
-    plx_status st = need_light(e, "plx_illuminance");
+    plx_status st = eng_need_light(e, "plx_illuminance");
     if (st != PLX_OK)
         return st;
     if (n && (!P || !N || !E_direct))
@@ -134,7 +134,7 @@ plx_status plx_lamps_at(plx_engine *e, const double P[3], const double n[3], uin
                         double *lux, uint32_t cap, uint32_t *count)
 {
     int got;
-    plx_status st = need_light(e, "plx_lamps_at");
+    plx_status st = eng_need_light(e, "plx_lamps_at");
     if (st != PLX_OK)
         return st;
     if (!P || !n || !count || (cap && (!ids || !lux)))
@@ -149,7 +149,7 @@ plx_status plx_lamps_at(plx_engine *e, const double P[3], const double n[3], uin
 plx_status plx_lit_region_get(plx_engine *e, uint32_t lamp, plx_lit_region *out)
 {
     const lit_region *r;
-    plx_status st = need_light(e, "plx_lit_region_get");
+    plx_status st = eng_need_light(e, "plx_lit_region_get");
     if (st != PLX_OK)
         return st;
     if (!out)

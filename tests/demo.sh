@@ -1,12 +1,25 @@
 #!/bin/sh
 # The README's first command (make demo): runs the main job on the bundled
-# fixtures and says where the results are.
+# real district and says where the results are.
 bin=$1
+out=build/demo
 set -e
-mkdir -p build/demo
-echo "== polarlux info fixtures/helsinki-centre.geojson (real OpenStreetMap district)"
-"$bin" info fixtures/helsinki-centre.geojson
+mkdir -p "$out"
+scene=fixtures/helsinki-centre.geojson
+echo "== $scene: central Helsinki, OpenStreetMap (c) OpenStreetMap contributors, ODbL"
+"$bin" info --quiet "$scene"
 echo
-echo "== polarlux gen eixample 30 30 -o build/demo/eixample-30x30.geojson"
-"$bin" gen eixample 30 30 -o build/demo/eixample-30x30.geojson
-"$bin" info build/demo/eixample-30x30.geojson
+echo "== night images"
+"$bin" render --quiet "$scene" --eye -45,-434,1.7 --target 120,-426,5 --exposure 0.4 \
+    -o "$out/helsinki-street.png" --pfm "$out/helsinki-street.pfm"
+"$bin" render --quiet "$scene" --view aerial --size 720x1080 --texel 2 --exposure 0.4 -o "$out/helsinki-aerial.png"
+"$bin" heatmap --quiet "$scene" -o "$out/helsinki-heatmap.png"
+echo
+echo "== how well lit are two walks (EN 13201 P-classes)"
+"$bin" route --quiet "$scene" --path fixtures/helsinki-route.geojson --geojson "$out/helsinki-route.geojson"
+echo
+echo "== visibility from a pedestrian at (0, -431.5) looking east"
+"$bin" vis --quiet "$scene" --at 0,-431.5 --dir 0 --fov 90 | tail -2
+echo
+echo "results in $out/:"
+ls -1 "$out" | sed 's/^/  /'

@@ -17,6 +17,7 @@ typedef struct cli_common {
     size_t mem;      /* engine budget in bytes (--mem) */
     int strict;      /* --strict */
     int quiet;       /* --quiet: no warnings on stderr */
+    int render_w, render_h; /* largest frame the engine will render (0: default) */
 } cli_common;
 
 #define CLI_DEFAULT_MEM ((size_t)1 << 30)
@@ -43,6 +44,7 @@ int cmd_draw(int argc, char **argv);
 int cmd_illum(int argc, char **argv);
 int cmd_lit(int argc, char **argv);
 int cmd_heatmap(int argc, char **argv);
+int cmd_render(int argc, char **argv);
 int cmd_route(int argc, char **argv);
 int cmd_dark_spots(int argc, char **argv);
 

@@ -111,6 +111,8 @@ int cli_open_scene(const char *cmd, const char *path, const cli_common *c, plx_e
         cfg.port = &quiet_port;
     }
     cfg.strict = c->strict;
+    cfg.render_max_width = c->render_w;
+    cfg.render_max_height = c->render_h;
     st = plx_engine_new(c->mem ? c->mem : CLI_DEFAULT_MEM, &cfg, e);
     if (st != PLX_OK) {
         fprintf(stderr, "polarlux %s: cannot create an engine of %zu bytes: %s\n", cmd,
