@@ -1,0 +1,279 @@
+/* Polar diagram benchmark: construction time and memory of the four quadrant
+ * diagrams (src/polar.h), and full-turn visibility queries (src/visibility.h)
+ * at random free pedestrian points, against the brute-force reference
+ * tests/ref/ref_vis run in the same process on the first of those points.
+ *
+ * Cities: the real district fixtures/helsinki-centre.geojson, then
+ * `gen eixample 30 30` (14,400 buildings), `gen oldtown 110 110` (~12,100)
+ * and `gen oldtown 317 317` (~100,000), generated in memory.
+ *
+ * The reference is O(E^2) per query for E footprint edges (it tests every
+ * pair of edges for a crossing), so it runs on few points: on a city as many
+ * as fit in a few seconds (at most 20), and not at all when one query would
+ * take minutes (the estimate from the previous city is printed instead).
+ * Its answers are checked against the engine's (area 1e-9 relative, same
+ * visible set) and any mismatch is reported and fails the benchmark.
+ *
+ * Usage: bench_polar [QUERIES]   (default 2000 query points per city)
+ */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "polarlux.h"
+#include "port.h"
+#include "engine.h"
+#include "polar.h"
+#include "visibility.h"
+#include "ref_vis.h"
+
+#define BUDGET ((size_t)6 << 30)
+#define REF_MAX 20
+#define REF_SECONDS 6.0
+
+typedef struct text {
+    char *buf;
+    size_t len, cap;
+} text;
+
+static int append(void *ctx, const char *data, size_t len)
+{
+    text *t = ctx;
+    if (t->len + len + 1 > t->cap) {
+        char *nb;
+        t->cap = (t->len + len + 1) * 2;
+        nb = realloc(t->buf, t->cap);
+        if (!nb)
+            return -1;
+        t->buf = nb;
+    }
+    memcpy(t->buf + t->len, data, len);
+    t->len += len;
+    t->buf[t->len] = '\0';
+    return 0;
+}
+
+static int cmp_double(const void *a, const void *b)
+{
+    double x = *(const double *)a, y = *(const double *)b;
+    return (x > y) - (x < y);
+}
+
+/* Quantile q of v[0..n-1] (sorts v). */
+static double quantile(double *v, int n, double q)
+{
+    int i;
+    if (n <= 0)
+        return 0;
+    qsort(v, (size_t)n, sizeof *v, cmp_double);
+    i = (int)(q * (n - 1) + 0.5);
+    return v[i];
+}
+
+static uint64_t rng = 0x2545f4914f6cdd1dull;
+
+static double urand(void)
+{
+    rng ^= rng << 13;
+    rng ^= rng >> 7;
+    rng ^= rng << 17;
+    return (double)(rng >> 11) / 9007199254740992.0;
+}
+
+/* Seconds per reference query on the previous city, and its edge count. */
+static double ref_prev_s = 0, ref_prev_e = 0;
+
+static void bench(const char *name, const char *buf, size_t len, int nq)
+{
+    plx_config cfg;
+    plx_port quiet = *plx_port_posix();
+    plx_engine *e;
+    scene *s;
+    polar *pd = NULL;
+    arena_mark m0;
+    size_t by[4], tot, kept;
+    uint32_t i, nocc = 0, nv = 0;
+    double tb = 1e300, *tq, *tr, vis_frac = 0, steps = 0, est;
+    vec2 *pts;
+    uint32_t *visbuf;
+    int reps, r, n = 0, tries = 0, nref = 0, bad = 0;
+    unsigned long long t0;
+
+    quiet.log = NULL;
+    plx_config_default(&cfg);
+    cfg.port = &quiet;
+    if (plx_engine_new(BUDGET, &cfg, &e) != PLX_OK) {
+        fprintf(stderr, "bench_polar: cannot create an engine of %zu bytes\n", (size_t)BUDGET);
+        exit(1);
+    }
+    if (plx_load_geojson(e, buf, len, name) != PLX_OK) {
+        fprintf(stderr, "bench_polar: %s: %s\n", name, plx_last_error(e));
+        exit(1);
+    }
+    s = e->sc;
+    for (i = 0; i < s->nbld; i++) {
+        uint32_t k;
+        if (s->bld[i].min_height > 0)
+            continue;
+        nocc++;
+        for (k = 0; k < s->bld[i].ring_count; k++)
+            nv += s->rings[s->bld[i].ring_first + k].count;
+    }
+    /* construction: best of a few */
+    reps = nv > 200000 ? 2 : 4;
+    m0 = arena_get_mark(&e->mem);
+    for (r = 0; r < reps; r++) {
+        plx_status st;
+        double t;
+        if (r > 0)
+            arena_release(&e->mem, &m0);
+        t0 = port_now_ns();
+        st = polar_build(&e->mem, s, &pd);
+        t = (port_now_ns() - t0) / 1e6;
+        if (st != PLX_OK) {
+            fprintf(stderr, "bench_polar: %s: polar_build: %s\n", name, plx_strerror(st));
+            exit(1);
+        }
+        if (t < tb)
+            tb = t;
+    }
+    polar_memory(pd, by);
+    tot = by[0] + by[1] + by[2] + by[3];
+    kept = e->mem.used[PLX_PART_POLAR] - m0.used[PLX_PART_POLAR];
+
+    printf("%-20s %6u buildings (%u occluders), %7u footprint vertices, %u wall pieces\n",
+           name, s->nbld, nocc, nv, pd->nwall);
+    printf("  construction %8.1f ms  (%.2f us per vertex; best of %d)\n", tb, 1e3 * tb / nv, reps);
+    printf("  memory       %8.2f MB = %5.1f bytes/vertex (arena part polar %.2f MB)\n",
+           tot / 1048576.0, (double)tot / nv, kept / 1048576.0);
+    printf("    axes %5.1f  regions %5.1f  polygons %5.1f  rest %5.1f  bytes/vertex"
+           "  (regions %u + %u)\n", (double)by[0] / nv, (double)by[1] / nv,
+           (double)by[2] / nv, (double)by[3] / nv, pd->map[0].ntrap, pd->map[1].ntrap);
+
+    /* queries at random free points of the building box (Bounds less 50 m) */
+    tq = malloc((size_t)nq * sizeof *tq);
+    tr = malloc(REF_MAX * sizeof *tr);
+    pts = malloc((size_t)nq * sizeof *pts);
+    visbuf = malloc((s->nbld + 1) * sizeof *visbuf);
+    if (!tq || !tr || !pts || !visbuf) {
+        fprintf(stderr, "bench_polar: out of memory\n");
+        exit(1);
+    }
+    while (n < nq && tries < 100 * nq) {
+        vis_result vr;
+        vec2 p;
+        double t;
+        plx_status st;
+        tries++;
+        p.x = s->bounds[0] + 50 + urand() * (s->bounds[2] - s->bounds[0] - 100);
+        p.y = s->bounds[1] + 50 + urand() * (s->bounds[3] - s->bounds[1] - 100);
+        memset(&vr, 0, sizeof vr);
+        t0 = port_now_ns();
+        st = vis_query(pd, p, 0, 0, 1, &e->mem, &vr);
+        t = (port_now_ns() - t0) / 1e3;
+        if (st == PLX_E_RANGE)
+            continue;
+        if (st != PLX_OK) {
+            fprintf(stderr, "bench_polar: %s: vis_query: %s\n", name, plx_strerror(st));
+            exit(1);
+        }
+        pts[n] = p;
+        tq[n++] = t;
+        vis_frac += (double)vr.nvis / (nocc ? nocc : 1);
+        steps += vr.nsteps;
+    }
+
+    /* the reference on the first points, within a time budget */
+    est = ref_prev_e > 0 ? ref_prev_s * ((double)nv / ref_prev_e) * ((double)nv / ref_prev_e) : 0;
+    if (est < 60.0) {
+        double spent = 0;
+        while (nref < REF_MAX && nref < n && (nref == 0 || spent + spent / nref < REF_SECONDS)) {
+            ref_vis_result rr;
+            vis_result vr;
+            int rc;
+            uint32_t k;
+            double t;
+            t0 = port_now_ns();
+            rc = ref_vis(s, pts[nref].x, pts[nref].y, &rr);
+            t = (port_now_ns() - t0) / 1e3;
+            memset(&vr, 0, sizeof vr);
+            vr.vis = visbuf;
+            vr.vis_cap = s->nbld + 1;
+            vis_query(pd, pts[nref], 0, 0, 1, &e->mem, &vr);
+            if (rc != 0 || fabs(vr.area - rr.area) > 1e-9 * fmax(rr.area, 1.0) ||
+                vr.nvis != rr.nvisible) {
+                bad++;
+            } else {
+                for (k = 0; k < vr.nvis; k++)
+                    if (vr.vis[k] != rr.visible[k]) {
+                        bad++;
+                        break;
+                    }
+            }
+            ref_vis_free(&rr);
+            tr[nref++] = t;
+            spent += t / 1e6;
+        }
+        ref_prev_s = spent / (nref ? nref : 1);
+        ref_prev_e = nv;
+    }
+    {
+        double med = quantile(tq, n, 0.5), p95 = quantile(tq, n, 0.95);
+        printf("  360 query    median %8.1f us  p95 %8.1f us  (%d free points, %.0f regions "
+               "crossed, %.2f%% of buildings visible on average)\n",
+               med, p95, n, steps / (n ? n : 1), 100.0 * vis_frac / (n ? n : 1));
+        if (nref > 0) {
+            double rmed = quantile(tr, nref, 0.5), rp95 = quantile(tr, nref, 0.95);
+            printf("  ref_vis      median %8.0f us  p95 %8.0f us  (brute force, O(E^2): %d points "
+                   "only) ratio %.0fx; %s\n", rmed, rp95, nref, rmed / med,
+                   bad ? "MISMATCH" : "same areas and visible sets");
+        } else {
+            printf("  ref_vis      not run: about %.0f s per query (O(E^2), from the previous "
+                   "city)\n", est);
+        }
+    }
+    free(tq);
+    free(tr);
+    free(pts);
+    free(visbuf);
+    plx_engine_free(e);
+    if (bad) {
+        fprintf(stderr, "bench_polar: %s: %d reference mismatches\n", name, bad);
+        exit(1);
+    }
+}
+
+static void bench_gen(const char *style, int nx, int ny, int nq)
+{
+    text t = { NULL, 0, 0 };
+    char name[64];
+    if (plx_gen_city(style, nx, ny, 1, append, &t) != PLX_OK) {
+        fprintf(stderr, "bench_polar: gen %s failed\n", style);
+        exit(1);
+    }
+    snprintf(name, sizeof name, "gen %s %d %d", style, nx, ny);
+    bench(name, t.buf, t.len, nq);
+    free(t.buf);
+}
+
+int main(int argc, char **argv)
+{
+    char err[256];
+    size_t len;
+    int nq = argc > 1 ? atoi(argv[1]) : 2000;
+    char *h = port_read_text("fixtures/helsinki-centre.geojson", &len, err, sizeof err);
+    if (!h) {
+        fprintf(stderr, "%s\n", err);
+        return 1;
+    }
+    if (nq < 1)
+        nq = 1;
+    printf("polar diagrams: one thread; times by the port clock\n");
+    bench("helsinki-centre", h, len, nq);
+    free(h);
+    bench_gen("eixample", 30, 30, nq);
+    bench_gen("oldtown", 110, 110, nq);
+    bench_gen("oldtown", 317, 317, nq);
+    return 0;
+}
