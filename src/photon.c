@@ -1,0 +1,1201 @@
+/* photon: photon buffers, progressive pass, lookup, levels (see photon.h). */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "photon.h"
+
+#define PI 3.14159265358979323846
+#define HEIGHT_TOL 1e-3   /* m: a splat's texels are at the photon's height */
+#define BOUNCE_OFFSET 1e-5 /* m: bounce origins are moved off the surface */
+#define PROBE 0.01        /* m: exposure probes in front of a wall */
+
+void photon_config_default(photon_config *c)
+{
+    memset(c, 0, sizeof *c);
+    c->chart_w = 256;
+    c->chart_h = 32;
+    c->level_blocks[0] = 10;
+    c->level_blocks[1] = 40;
+    c->level_blocks[2] = 160;
+    c->level_blocks[3] = 640;
+    c->aerial_res = 512;
+    c->coverage_probes = 3;
+    c->kernel_max = 4.0;
+    c->kernel_min = 2.0;
+    c->kernel_frames = 8.0;
+    c->max_bounces = 16;
+    c->lamp_res = 64;
+    c->lamp_photons = 32768;
+    c->lamp_kernel = 1.5;
+    c->lamp_slots = 0;
+    c->lamp_cache_bytes = (size_t)4 << 20;
+    c->near_radius = 60.0;
+    c->cell_size = 0.0;
+}
+
+static int config_ok(const photon_config *c)
+{
+    int L;
+    if (c->chart_w < 8 || c->chart_h < 8 || c->aerial_res < 2 || c->coverage_probes < 1 ||
+        c->coverage_probes > 16 || c->lamp_res < 2 || c->chart_w > 65536 || c->chart_h > 65536 ||
+        c->aerial_res > 65536 || c->lamp_res > 4096)
+        return 0;
+    if (!(c->kernel_max > 0.0 && c->kernel_max <= PHOTON_KERNEL_MAX) ||
+        !(c->kernel_min > 0.0 && c->kernel_min <= c->kernel_max) ||
+        !(c->kernel_frames >= 0.0) ||
+        !(c->lamp_kernel > 0.0 && c->lamp_kernel <= PHOTON_KERNEL_MAX) ||
+        !(c->near_radius >= 0.0))
+        return 0;
+    for (L = 0; L < PHOTON_LEVELS; L++)
+        if ((c->chart_w >> L) < 1 || (c->chart_h >> L) < 1)
+            return 0;
+    return 1;
+}
+
+/* ---- small helpers ------------------------------------------------------ */
+
+double photon_window(double x)
+{
+    double x2, v;
+    if (!(x < 1.0))
+        return 0.0;
+    if (x < 0.0)
+        x = 0.0;
+    x2 = x * x;
+    v = 1.0 - x2 * x2;
+    return v * v;
+}
+
+uint64_t photon_rand(uint64_t *st)
+{
+    uint64_t z = (*st += 0x9e3779b97f4a7c15ull);
+    z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ull;
+    z = (z ^ (z >> 27)) * 0x94d049bb133111ebull;
+    return z ^ (z >> 31);
+}
+
+double photon_rand01(uint64_t *st)
+{
+    return (double)(photon_rand(st) >> 11) * (1.0 / 9007199254740992.0);
+}
+
+void photon_cosine_dir(uint64_t *st, const double n[3], double d[3])
+{
+    double u1 = photon_rand01(st), u2 = photon_rand01(st);
+    double r = sqrt(u1), phi = 2.0 * PI * u2;
+    double a = r * cos(phi), b = r * sin(phi), c = sqrt(1.0 - u1);
+    double t[3], bt[3], l;
+    if (fabs(n[2]) < 0.9) {
+        t[0] = -n[1];
+        t[1] = n[0];
+        t[2] = 0.0;
+    } else {
+        t[0] = 0.0;
+        t[1] = -n[2];
+        t[2] = n[1];
+    }
+    l = sqrt(t[0] * t[0] + t[1] * t[1] + t[2] * t[2]);
+    t[0] /= l;
+    t[1] /= l;
+    t[2] /= l;
+    bt[0] = n[1] * t[2] - n[2] * t[1];
+    bt[1] = n[2] * t[0] - n[0] * t[2];
+    bt[2] = n[0] * t[1] - n[1] * t[0];
+    d[0] = a * t[0] + b * bt[0] + c * n[0];
+    d[1] = a * t[1] + b * bt[1] + c * n[1];
+    d[2] = a * t[2] + b * bt[2] + c * n[2];
+    l = sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+    d[0] /= l;
+    d[1] /= l;
+    d[2] /= l;
+}
+
+static int texel_ok(const float *area, const float *height, double z, size_t i)
+{
+    if (!(area[i] > 0.0f))
+        return 0;
+    if (height && fabs((double)height[i] - z) > HEIGHT_TOL)
+        return 0;
+    return 1;
+}
+
+/* Wraps or rejects column i; returns -1 when outside. */
+static int column(int i, uint32_t w, int wrap)
+{
+    if (i >= 0 && i < (int)w)
+        return i;
+    if (!wrap)
+        return -1;
+    return ((i % (int)w) + (int)w) % (int)w;
+}
+
+/* Deposit index of grid texel (i, j) in the output window, or -1. */
+static long win_index(int i, int j, uint32_t ow, uint32_t oh, int32_t ox, int32_t oy)
+{
+    int a = i - ox, b = j - oy;
+    if (a < 0 || b < 0 || a >= (int)ow || b >= (int)oh)
+        return -1;
+    return (long)b * (long)ow + a;
+}
+
+static int splat_any(float *out, uint32_t ow, uint32_t oh, int32_t ox, int32_t oy,
+                     const float *area, const float *height, double z, uint32_t w, uint32_t h,
+                     int wrap, double fx, double fy, double r, double phi)
+{
+    enum { MAXK = 2 * PHOTON_KERNEL_MAXI + 3 };
+    int ti[MAXK * MAXK], tj[MAXK * MAXK];
+    double wt[MAXK * MAXK], sum = 0.0;
+    int n = 0, i, j, i0, i1, j0, j1;
+    if (r > PHOTON_KERNEL_MAX)
+        r = PHOTON_KERNEL_MAX;
+    if (!(fx > -r - 2.0 && fy > -r - 2.0 && fx < (double)w + r + 2.0 &&
+          fy < (double)h + r + 2.0))
+        return 0;
+    i0 = (int)floor(fx - r);
+    i1 = (int)floor(fx + r);
+    j0 = (int)floor(fy - r);
+    j1 = (int)floor(fy + r);
+    for (j = j0; j <= j1; j++) {
+        double dy = (j + 0.5) - fy;
+        if (j < 0 || j >= (int)h)
+            continue;
+        for (i = i0; i <= i1; i++) {
+            double dx = (i + 0.5) - fx, dist = sqrt(dx * dx + dy * dy), wgt;
+            int ii = column(i, w, wrap);
+            if (dist >= r || ii < 0)
+                continue;
+            if (!texel_ok(area, height, z, (size_t)j * w + (size_t)ii))
+                continue;
+            wgt = 1.0 - dist / r;
+            ti[n] = ii;
+            tj[n] = j;
+            wt[n] = wgt;
+            sum += wgt;
+            n++;
+        }
+    }
+    if (n == 0 || !(sum > 0.0)) {
+        /* nearest valid texel of the 3 x 3 around the photon */
+        double bd = INFINITY;
+        int bi = 0, bj = 0, ci = (int)floor(fx), cj = (int)floor(fy);
+        long o;
+        for (j = cj - 1; j <= cj + 1; j++) {
+            if (j < 0 || j >= (int)h)
+                continue;
+            for (i = ci - 1; i <= ci + 1; i++) {
+                int ii = column(i, w, wrap);
+                double dx = (i + 0.5) - fx, dy = (j + 0.5) - fy, d2 = dx * dx + dy * dy;
+                if (ii < 0)
+                    continue;
+                if (texel_ok(area, height, z, (size_t)j * w + (size_t)ii) && d2 < bd) {
+                    bd = d2;
+                    bi = ii;
+                    bj = j;
+                }
+            }
+        }
+        if (bd == INFINITY)
+            return 0;
+        o = win_index(bi, bj, ow, oh, ox, oy);
+        if (o >= 0)
+            out[o] += (float)phi;
+        return 1;
+    }
+    for (i = 0; i < n; i++) {
+        long o = win_index(ti[i], tj[i], ow, oh, ox, oy);
+        if (o >= 0)
+            out[o] += (float)(phi * (wt[i] / sum));
+    }
+    return 1;
+}
+
+int photon_splat(float *flux, const float *area, const float *height, double z, uint32_t w,
+                 uint32_t h, int wrap, double fx, double fy, double r, double phi)
+{
+    return splat_any(flux, w, h, 0, 0, area, height, z, w, h, wrap, fx, fy, r, phi);
+}
+
+int photon_splat_win(float *out, uint32_t ow, uint32_t oh, int32_t ox, int32_t oy,
+                     const float *area, const float *height, double z, uint32_t w, uint32_t h,
+                     double fx, double fy, double r, double phi)
+{
+    return splat_any(out, ow, oh, ox, oy, area, height, z, w, h, 0, fx, fy, r, phi);
+}
+
+static double gather_any(const float *out, uint32_t ow, uint32_t oh, int32_t ox, int32_t oy,
+                         const float *area, const float *height, double z, uint32_t w,
+                         uint32_t h, int wrap, double fx, double fy)
+{
+    double gx = fx - 0.5, gy = fy - 0.5, sf = 0.0, sa = 0.0;
+    int i0, j0, a, b;
+    double tx, ty;
+    if (!(fx > -2.0 && fy > -2.0 && fx < (double)w + 2.0 && fy < (double)h + 2.0))
+        return 0.0;
+    i0 = (int)floor(gx);
+    j0 = (int)floor(gy);
+    tx = gx - i0;
+    ty = gy - j0;
+    for (b = 0; b < 2; b++)
+        for (a = 0; a < 2; a++) {
+            int j = j0 + b, i = column(i0 + a, w, wrap);
+            double wgt = (a ? tx : 1.0 - tx) * (b ? ty : 1.0 - ty);
+            size_t k;
+            long o;
+            if (j < 0 || j >= (int)h || i < 0 || wgt <= 0.0)
+                continue;
+            k = (size_t)j * w + (size_t)i;
+            if (!texel_ok(area, height, z, k))
+                continue;
+            o = win_index(i, j, ow, oh, ox, oy);
+            if (o >= 0)
+                sf += wgt * out[o];
+            sa += wgt * area[k];
+        }
+    if (sa > 0.0)
+        return sf / sa;
+    /* no valid texel among the four: the nearest valid one of the 3 x 3 */
+    {
+        int ci = (int)floor(fx), cj = (int)floor(fy), i, j;
+        double bd = INFINITY, best = 0.0;
+        for (j = cj - 1; j <= cj + 1; j++) {
+            if (j < 0 || j >= (int)h)
+                continue;
+            for (i = ci - 1; i <= ci + 1; i++) {
+                int ii = column(i, w, wrap);
+                double dx = (i + 0.5) - fx, dy = (j + 0.5) - fy;
+                size_t k;
+                if (ii < 0)
+                    continue;
+                k = (size_t)j * w + (size_t)ii;
+                if (texel_ok(area, height, z, k) && dx * dx + dy * dy < bd) {
+                    long o = win_index(ii, j, ow, oh, ox, oy);
+                    bd = dx * dx + dy * dy;
+                    best = o >= 0 ? (double)out[o] / (double)area[k] : 0.0;
+                }
+            }
+        }
+        return best;
+    }
+}
+
+double photon_gather(const float *flux, const float *area, const float *height, double z,
+                     uint32_t w, uint32_t h, int wrap, double fx, double fy)
+{
+    return gather_any(flux, w, h, 0, 0, area, height, z, w, h, wrap, fx, fy);
+}
+
+double photon_gather_win(const float *out, uint32_t ow, uint32_t oh, int32_t ox, int32_t oy,
+                         const float *area, const float *height, double z, uint32_t w,
+                         uint32_t h, double fx, double fy)
+{
+    return gather_any(out, ow, oh, ox, oy, area, height, z, w, h, 0, fx, fy);
+}
+
+void photon_aerial_xy(const photon_sys *ps, double x, double y, double *fx, double *fy)
+{
+    *fx = (x - ps->gx0) / ps->gtex;
+    *fy = (y - ps->gy0) / ps->gtex;
+}
+
+static double kernel_radius(const photon_config *c, uint32_t frames)
+{
+    double m = frames > 0 ? (double)(frames - 1) : 0.0;
+    if (c->kernel_frames <= 0.0)
+        return c->kernel_min;
+    return c->kernel_min + (c->kernel_max - c->kernel_min) * c->kernel_frames /
+                               (c->kernel_frames + m);
+}
+
+/* ---- sizes -------------------------------------------------------------- */
+
+/* Allocation or counting: with a == NULL only bytes are summed. */
+typedef struct taker {
+    arena *a;
+    size_t bytes;
+    int failed;
+} taker;
+
+static void *take(taker *t, size_t n, size_t size)
+{
+    size_t b = arena_mul(n ? n : 1, size);
+    void *p;
+    if (b == SIZE_MAX) {
+        t->failed = 1;
+        t->bytes = SIZE_MAX;
+        return NULL;
+    }
+    if (t->bytes != SIZE_MAX)
+        t->bytes = (t->bytes + b + 63 > t->bytes) ? t->bytes + b + 63 : SIZE_MAX;
+    if (!t->a)
+        return NULL;
+    p = arena_calloc(t->a, PLX_PART_PHOTON, n ? n : 1, size, 16);
+    if (!p)
+        t->failed = 1;
+    return p;
+}
+
+static uint32_t level_slots(const scene *s, const photon_config *c, int L)
+{
+    return c->level_blocks[L] < s->nblocks ? c->level_blocks[L] : s->nblocks;
+}
+
+static void aerial_dims(const scene *s, const photon_config *c, uint32_t *gw, uint32_t *gh,
+                        double *tex)
+{
+    double w = s->bounds[2] - s->bounds[0], h = s->bounds[3] - s->bounds[1];
+    double m = w > h ? w : h, t;
+    if (!(m > 0.0))
+        m = 1.0;
+    t = m / c->aerial_res;
+    *tex = t;
+    *gw = (uint32_t)ceil(w / t - 1e-9);
+    *gh = (uint32_t)ceil(h / t - 1e-9);
+    if (*gw < 1)
+        *gw = 1;
+    if (*gh < 1)
+        *gh = 1;
+}
+
+static double max_lamp_radius(const scene *s)
+{
+    double r = 0.0;
+    uint32_t i;
+    for (i = 0; i < s->nlamps; i++)
+        if (s->lamps[i].radius > r)
+            r = s->lamps[i].radius;
+    return r;
+}
+
+static uint32_t dwin_side(const scene *s, const photon_config *c, double gtex)
+{
+    double side = 2.0 * max_lamp_radius(s) / gtex;
+    return (uint32_t)ceil(side) + 2u * ((uint32_t)ceil(c->kernel_min) + 2u);
+}
+
+size_t photon_lamp_slot_bytes(const scene *s, const photon_config *cfg)
+{
+    photon_config c;
+    uint32_t gw, gh, dn;
+    double tex;
+    size_t f;
+    if (!s)
+        return 0;
+    if (!cfg)
+        photon_config_default(&c);
+    else
+        c = *cfg;
+    aerial_dims(s, &c, &gw, &gh, &tex);
+    dn = dwin_side(s, &c, tex);
+    f = (size_t)c.lamp_res * c.lamp_res;
+    return sizeof(photon_lamp_slot) + 3 * (f * sizeof(float) + 63) +
+           (size_t)dn * dn * sizeof(float) + 63;
+}
+
+static uint32_t cache_slots(const scene *s, const photon_config *c)
+{
+    size_t n;
+    if (s->nlamps == 0)
+        return 0;
+    if (c->lamp_slots)
+        n = c->lamp_slots;
+    else
+        n = c->lamp_cache_bytes / photon_lamp_slot_bytes(s, c);
+    if (n > s->nlamps)
+        n = s->nlamps;
+    return (uint32_t)n;
+}
+
+/* Takes (or counts) every buffer of the system. */
+static void layout(photon_sys *ps, taker *t, const scene *s, const photon_config *c)
+{
+    photon_sys dummy;
+    int L;
+    uint32_t i;
+    size_t g;
+    if (!ps) {
+        memset(&dummy, 0, sizeof dummy);
+        ps = &dummy;
+    }
+    ps->eclass = take(t, s->npts, 1);
+    ps->ez0 = take(t, s->npts, sizeof(float));
+    ps->ez1 = take(t, s->npts, sizeof(float));
+    ps->blevel = take(t, s->nblocks, 1);
+    ps->bslot = take(t, s->nblocks, sizeof(uint32_t));
+    ps->bcx = take(t, s->nblocks, sizeof(double));
+    ps->bcy = take(t, s->nblocks, sizeof(double));
+    ps->bhmax = take(t, s->nblocks, sizeof(double));
+    ps->bfacade = take(t, s->nblocks, sizeof(double));
+    ps->bamb = take(t, s->nblocks, sizeof(double));
+    for (L = 0; L < PHOTON_LEVELS; L++) {
+        photon_level *lv = &ps->lev[L];
+        size_t tex;
+        lv->w = c->chart_w >> L;
+        lv->h = c->chart_h >> L;
+        lv->nslots = level_slots(s, c, L);
+        tex = arena_mul(arena_mul((size_t)lv->nslots * 2, lv->w), lv->h);
+        lv->flux = take(t, tex, sizeof(float));
+        lv->area = take(t, tex, sizeof(float));
+        lv->slot_block = take(t, lv->nslots, sizeof(uint32_t));
+        lv->slot_frames = take(t, lv->nslots, sizeof(uint32_t));
+        lv->free_slots = take(t, lv->nslots, sizeof(uint32_t));
+    }
+    aerial_dims(s, c, &ps->gw, &ps->gh, &ps->gtex);
+    g = (size_t)ps->gw * ps->gh;
+    ps->gheight = take(t, g, sizeof(float));
+    ps->garea = take(t, g, sizeof(float));
+    ps->gflux = take(t, g, sizeof(float));
+    ps->gimp = take(t, g, sizeof(float));
+    ps->lamp_cdf = take(t, s->nlamps, sizeof(double));
+    ps->refined = take(t, s->nlamps, 1);
+    ps->lamp_slot = take(t, s->nlamps, sizeof(uint32_t));
+    ps->nslots = cache_slots(s, c);
+    ps->dwin_n = dwin_side(s, c, ps->gtex);
+    ps->slots = take(t, ps->nslots, sizeof(photon_lamp_slot));
+    for (i = 0; i < ps->nslots; i++) {
+        size_t f = (size_t)c->lamp_res * c->lamp_res;
+        float *fl = take(t, f, sizeof(float));
+        float *ar = take(t, f, sizeof(float));
+        float *hg = take(t, f, sizeof(float));
+        float *dw = take(t, (size_t)ps->dwin_n * ps->dwin_n, sizeof(float));
+        if (ps != &dummy && ps->slots) {
+            ps->slots[i].flux = fl;
+            ps->slots[i].area = ar;
+            ps->slots[i].height = hg;
+            ps->slots[i].dwin = dw;
+        }
+    }
+}
+
+size_t photon_bytes(const scene *s, const photon_config *cfg)
+{
+    photon_config c;
+    taker t;
+    if (!s)
+        return 0;
+    if (!cfg)
+        photon_config_default(&c);
+    else
+        c = *cfg;
+    t.a = NULL;
+    t.bytes = sizeof(photon_sys) + 63;
+    t.failed = 0;
+    layout(NULL, &t, s, &c);
+    if (t.bytes == SIZE_MAX)
+        return SIZE_MAX;
+    {
+        size_t tb = trace_bytes(s, c.cell_size);
+        return t.bytes + tb < t.bytes ? SIZE_MAX : t.bytes + tb;
+    }
+}
+
+/* ---- walls and blocks ----------------------------------------------------- */
+
+static double ring_area(const vec2 *p, uint32_t n)
+{
+    double a = 0.0;
+    uint32_t i;
+    for (i = 0; i < n; i++) {
+        const vec2 *u = &p[i], *v = &p[i + 1 == n ? 0 : i + 1];
+        a += u->x * v->y - v->x * u->y;
+    }
+    return 0.5 * a;
+}
+
+static int in_ring(const vec2 *p, uint32_t n, double x, double y)
+{
+    uint32_t k, in = 0;
+    const vec2 *a = &p[n - 1];
+    for (k = 0; k < n; k++) {
+        const vec2 *b = &p[k];
+        if ((a->y > y) != (b->y > y)) {
+            double xc = a->x + (y - a->y) * (b->x - a->x) / (b->y - a->y);
+            if (x < xc)
+                in ^= 1u;
+        }
+        a = b;
+    }
+    return (int)in;
+}
+
+/* Exposure and chart class of every wall. */
+static void walls_classify(photon_sys *ps)
+{
+    const scene *s = ps->s;
+    const tracer *T = ps->T;
+    uint32_t b;
+    for (b = 0; b < s->nbld; b++) {
+        const scene_building *B = &s->bld[b];
+        uint32_t r;
+        for (r = 0; r < B->ring_count; r++) {
+            const scene_ring *R = &s->rings[B->ring_first + r];
+            uint32_t k;
+            for (k = 0; k < R->count; k++) {
+                uint32_t e = R->first + k;
+                const vec2 *p = &s->pts[e], *q = &s->pts[T->enext[e]];
+                double ex = q->x - p->x, ey = q->y - p->y, l = sqrt(ex * ex + ey * ey);
+                double qx, qy, z0 = B->min_height, z1 = B->height, fx, fy;
+                int cls = PHOTON_EDGE_OUTER;
+                if (!(l > 0.0)) {
+                    ps->eclass[e] = PHOTON_EDGE_INTERNAL;
+                    continue;
+                }
+                qx = 0.5 * (p->x + q->x) + PROBE * ey / l;
+                qy = 0.5 * (p->y + q->y) - PROBE * ex / l;
+                fx = floor((qx - T->x0) * T->inv);
+                fy = floor((qy - T->y0) * T->inv);
+                if (fx >= 0.0 && fy >= 0.0 && fx < (double)T->nx && fy < (double)T->ny) {
+                    uint32_t c = (uint32_t)fy * T->nx + (uint32_t)fx, j;
+                    for (j = T->start[c]; j < T->start[c + 1]; j++) {
+                        uint32_t o = T->ids[j];
+                        const scene_building *O = &s->bld[o];
+                        if (o == b || qx < O->box[0] || qx > O->box[2] || qy < O->box[1] ||
+                            qy > O->box[3] || !trace_inside(T, o, qx, qy))
+                            continue;
+                        /* the covered range [O->min_height, O->height] */
+                        if (O->min_height <= z0 && O->height > z0)
+                            z0 = O->height;
+                        else if (O->height >= z1 && O->min_height < z1)
+                            z1 = O->min_height;
+                        else if (O->min_height > z0 && O->height < z1) {
+                            if (O->min_height - z0 >= z1 - O->height)
+                                z1 = O->min_height;
+                            else
+                                z0 = O->height;
+                        }
+                    }
+                }
+                if (!(z1 > z0)) {
+                    cls = PHOTON_EDGE_INTERNAL;
+                    z0 = z1 = 0.0;
+                } else if (r > 0) {
+                    cls = PHOTON_EDGE_INNER; /* a hole of the building: a courtyard */
+                } else if (B->block < s->nblocks) {
+                    const scene_block *K = &s->blocks[B->block];
+                    uint32_t rr;
+                    for (rr = 1; rr < K->ring_count; rr++) {
+                        const scene_ring *CR = &s->block_rings[K->ring_first + rr];
+                        const vec2 *cp = &s->block_pts[CR->first];
+                        if (ring_area(cp, CR->count) < 0.0 && in_ring(cp, CR->count, qx, qy)) {
+                            cls = PHOTON_EDGE_INNER;
+                            break;
+                        }
+                    }
+                }
+                ps->eclass[e] = (uint8_t)cls;
+                ps->ez0[e] = (float)z0;
+                ps->ez1[e] = (float)z1;
+            }
+        }
+    }
+}
+
+static void blocks_setup(photon_sys *ps)
+{
+    const scene *s = ps->s;
+    uint32_t k, j;
+    double dsum = 0.0;
+    for (k = 0; k < s->nblocks; k++) {
+        const scene_block *K = &s->blocks[k];
+        double hm = 0.0, area = 0.0;
+        ps->bcx[k] = 0.5 * (K->box[0] + K->box[2]);
+        ps->bcy[k] = 0.5 * (K->box[1] + K->box[3]);
+        for (j = 0; j < K->bld_count; j++) {
+            uint32_t b = s->block_bld[K->bld_first + j], r;
+            const scene_building *B = &s->bld[b];
+            if (B->height > hm)
+                hm = B->height;
+            for (r = 0; r < B->ring_count; r++) {
+                const scene_ring *R = &s->rings[B->ring_first + r];
+                uint32_t i;
+                for (i = 0; i < R->count; i++) {
+                    uint32_t e = R->first + i;
+                    const vec2 *p = &s->pts[e], *q = &s->pts[ps->T->enext[e]];
+                    if (ps->eclass[e] == PHOTON_EDGE_INTERNAL)
+                        continue;
+                    area += hypot(q->x - p->x, q->y - p->y) * (double)(ps->ez1[e] - ps->ez0[e]);
+                }
+            }
+        }
+        ps->bhmax[k] = hm > 0.0 ? hm : 1.0;
+        ps->bfacade[k] = area;
+        ps->blevel[k] = PHOTON_LEVELS;
+        ps->bslot[k] = PHOTON_NONE;
+        dsum += hypot(K->box[2] - K->box[0], K->box[3] - K->box[1]);
+    }
+    ps->mean_diam = s->nblocks ? dsum / s->nblocks : 1.0;
+    if (!(ps->mean_diam > 0.0))
+        ps->mean_diam = 1.0;
+}
+
+/* Facade chart coordinates of (x, y, z) for block k at level L. */
+static void chart_xy(const photon_sys *ps, uint32_t k, const photon_level *lv, double x, double y,
+                     double z, double *fx, double *fy)
+{
+    double u = (atan2(y - ps->bcy[k], x - ps->bcx[k]) + PI) / (2.0 * PI);
+    if (u >= 1.0)
+        u -= 1.0;
+    *fx = u * lv->w;
+    *fy = z / ps->bhmax[k] * lv->h;
+}
+
+static int cmp_double(const void *a, const void *b)
+{
+    double x = *(const double *)a, y = *(const double *)b;
+    return (x > y) - (x < y);
+}
+
+/* Texel areas of the two charts of block k in slot 'slot' of level L; tb
+ * is scratch for chart_w + 2 doubles. The area of a texel is exact: each
+ * wall is cut where the rays from the centre at the column boundaries
+ * cross it. */
+static void chart_build(photon_sys *ps, uint32_t k, int L, uint32_t slot, double *tb)
+{
+    const scene *s = ps->s;
+    photon_level *lv = &ps->lev[L];
+    const scene_block *K = &s->blocks[k];
+    size_t csize = (size_t)lv->w * lv->h, base = (size_t)slot * 2 * csize;
+    double H = ps->bhmax[k];
+    uint32_t j;
+    memset(lv->flux + base, 0, 2 * csize * sizeof(float));
+    memset(lv->area + base, 0, 2 * csize * sizeof(float));
+    lv->slot_frames[slot] = 0;
+    for (j = 0; j < K->bld_count; j++) {
+        uint32_t b = s->block_bld[K->bld_first + j], r;
+        const scene_building *B = &s->bld[b];
+        for (r = 0; r < B->ring_count; r++) {
+            const scene_ring *R = &s->rings[B->ring_first + r];
+            uint32_t i;
+            for (i = 0; i < R->count; i++) {
+                uint32_t e = R->first + i, np, pc;
+                const vec2 *p = &s->pts[e], *q = &s->pts[ps->T->enext[e]];
+                double len, z0, z1;
+                float *area;
+                if (ps->eclass[e] == PHOTON_EDGE_INTERNAL)
+                    continue;
+                area = lv->area + base + (ps->eclass[e] == PHOTON_EDGE_INNER ? csize : 0);
+                z0 = ps->ez0[e];
+                z1 = ps->ez1[e];
+                /* exact pieces: the edge cut by the rays from the centre at
+                 * every column boundary */
+                np = 0;
+                tb[np++] = 0.0;
+                tb[np++] = 1.0;
+                {
+                    double ex = q->x - p->x, ey = q->y - p->y;
+                    double cpx = ps->bcx[k] - p->x, cpy = ps->bcy[k] - p->y;
+                    uint32_t cb;
+                    for (cb = 0; cb < lv->w; cb++) {
+                        double th = -PI + 2.0 * PI * cb / lv->w, ux = cos(th), uy = sin(th);
+                        double den = ux * ey - uy * ex, t, sr;
+                        if (den == 0.0)
+                            continue;
+                        t = (ux * cpy - uy * cpx) / den;
+                        sr = (ex * (-cpy) - ey * (-cpx)) / (ex * uy - ey * ux);
+                        if (t > 0.0 && t < 1.0 && sr > 0.0)
+                            tb[np++] = t;
+                    }
+                }
+                qsort(tb, np, sizeof *tb, cmp_double);
+                len = hypot(q->x - p->x, q->y - p->y);
+                for (pc = 0; pc + 1 < np; pc++) {
+                    double t = 0.5 * (tb[pc] + tb[pc + 1]), fx, fy, x, y, plen;
+                    int row, r0, r1;
+                    plen = (tb[pc + 1] - tb[pc]) * len;
+                    if (!(plen > 0.0))
+                        continue;
+                    x = p->x + t * (q->x - p->x);
+                    y = p->y + t * (q->y - p->y);
+                    chart_xy(ps, k, lv, x, y, 0.0, &fx, &fy);
+                    {
+                        int col = (int)floor(fx);
+                        if (col < 0)
+                            col = 0;
+                        if (col >= (int)lv->w)
+                            col = (int)lv->w - 1;
+                        r0 = (int)floor(z0 / H * lv->h);
+                        r1 = (int)ceil(z1 / H * lv->h);
+                        if (r0 < 0)
+                            r0 = 0;
+                        if (r1 > (int)lv->h)
+                            r1 = (int)lv->h;
+                        for (row = r0; row < r1; row++) {
+                            double lo = H * row / lv->h, hi = H * (row + 1) / lv->h;
+                            double ov = (z1 < hi ? z1 : hi) - (z0 > lo ? z0 : lo);
+                            if (ov > 0.0)
+                                area[(size_t)row * lv->w + (size_t)col] += (float)(plen * ov);
+                        }
+                    }
+                }
+            }
+        }
+    }
+}
+
+/* ---- aerial chart ---------------------------------------------------------- */
+
+static void aerial_build(photon_sys *ps)
+{
+    uint32_t i, j, a, b, k = ps->cfg.coverage_probes;
+    double t = ps->gtex;
+    for (j = 0; j < ps->gh; j++)
+        for (i = 0; i < ps->gw; i++) {
+            double cx = ps->gx0 + (i + 0.5) * t, cy = ps->gy0 + (j + 0.5) * t;
+            double hc = trace_top(ps->T, cx, cy, NULL);
+            uint32_t match = 0;
+            for (b = 0; b < k; b++)
+                for (a = 0; a < k; a++) {
+                    double x = ps->gx0 + (i + (a + 0.5) / k) * t;
+                    double y = ps->gy0 + (j + (b + 0.5) / k) * t;
+                    if (fabs(trace_top(ps->T, x, y, NULL) - hc) <= HEIGHT_TOL)
+                        match++;
+                }
+            if (match == 0)
+                match = 1; /* an even k misses the centre */
+            ps->gheight[(size_t)j * ps->gw + i] = (float)hc;
+            ps->garea[(size_t)j * ps->gw + i] = (float)(t * t * match / (double)(k * k));
+        }
+}
+
+/* ---- creation ---------------------------------------------------------------- */
+
+plx_status photon_create(arena *a, const scene *s, const photon_config *cfg, photon_sys **out)
+{
+    arena_mark m;
+    photon_sys *ps;
+    taker t;
+    plx_status st;
+    photon_config c;
+    uint32_t i;
+    int L;
+    double eye[3];
+    if (!a || !s || !out)
+        return PLX_E_INVALID;
+    *out = NULL;
+    if (!cfg)
+        photon_config_default(&c);
+    else
+        c = *cfg;
+    if (!config_ok(&c) || (s->nbld > 0 && s->nblocks == 0))
+        return PLX_E_INVALID;
+    m = arena_get_mark(a);
+    ps = arena_calloc(a, PLX_PART_PHOTON, 1, sizeof *ps, 16);
+    if (!ps)
+        return PLX_E_NOMEM;
+    ps->a = a;
+    ps->s = s;
+    ps->cfg = c;
+    st = trace_create(a, PLX_PART_PHOTON, s, c.cell_size, &ps->T);
+    if (st != PLX_OK) {
+        arena_release(a, &m);
+        return st;
+    }
+    t.a = a;
+    t.bytes = 0;
+    t.failed = 0;
+    layout(ps, &t, s, &c);
+    if (t.failed) {
+        arena_release(a, &m);
+        return PLX_E_NOMEM;
+    }
+    ps->gx0 = s->bounds[0];
+    ps->gy0 = s->bounds[1];
+    walls_classify(ps);
+    blocks_setup(ps);
+    for (L = 0; L < PHOTON_LEVELS; L++) {
+        photon_level *lv = &ps->lev[L];
+        for (i = 0; i < lv->nslots; i++) {
+            lv->slot_block[i] = PHOTON_NONE;
+            lv->free_slots[i] = lv->nslots - 1 - i;
+        }
+        lv->nfree = lv->nslots;
+    }
+    aerial_build(ps);
+    ps->flux_total = 0.0;
+    for (i = 0; i < s->nlamps; i++) {
+        double f = s->lamps[i].intensity > 0.0 && s->lamps[i].radius > 0.0
+                       ? 4.0 * PI * s->lamps[i].intensity
+                       : 0.0;
+        ps->flux_total += f;
+        ps->lamp_cdf[i] = ps->flux_total;
+        ps->lamp_slot[i] = PHOTON_NONE;
+    }
+    for (i = 0; i < ps->nslots; i++) {
+        ps->slots[i].lamp = PHOTON_NONE;
+        ps->slots[i].prev = i == 0 ? PHOTON_NONE : i - 1;
+        ps->slots[i].next = i + 1 == ps->nslots ? PHOTON_NONE : i + 1;
+    }
+    ps->lru_head = ps->nslots ? 0 : PHOTON_NONE;
+    ps->lru_tail = ps->nslots ? ps->nslots - 1 : PHOTON_NONE;
+    eye[0] = 0.5 * (s->bounds[0] + s->bounds[2]);
+    eye[1] = 0.5 * (s->bounds[1] + s->bounds[3]);
+    eye[2] = 1.7;
+    st = photon_set_viewer(ps, eye, NULL, 0.0);
+    if (st != PLX_OK) {
+        arena_release(a, &m);
+        return st;
+    }
+    *out = ps;
+    return PLX_OK;
+}
+
+void photon_reset(photon_sys *ps)
+{
+    int L;
+    uint32_t i;
+    size_t g = (size_t)ps->gw * ps->gh;
+    for (L = 0; L < PHOTON_LEVELS; L++) {
+        photon_level *lv = &ps->lev[L];
+        size_t cs = (size_t)lv->w * lv->h * 2;
+        for (i = 0; i < lv->nslots; i++) {
+            memset(lv->flux + (size_t)i * cs, 0, cs * sizeof(float));
+            lv->slot_frames[i] = 0;
+        }
+    }
+    for (i = 0; i < ps->s->nblocks; i++)
+        ps->bamb[i] = 0.0;
+    ps->amb_frames = 0;
+    memset(ps->gflux, 0, g * sizeof(float));
+    memset(ps->gimp, 0, g * sizeof(float));
+    ps->gframes = 0;
+    for (i = 0; i < ps->s->nlamps; i++) {
+        ps->refined[i] = 0;
+        ps->lamp_slot[i] = PHOTON_NONE;
+    }
+    for (i = 0; i < ps->nslots; i++)
+        ps->slots[i].lamp = PHOTON_NONE;
+    memset(&ps->st, 0, sizeof ps->st);
+}
+
+/* ---- levels ------------------------------------------------------------------- */
+
+typedef struct keyed {
+    double key;
+    uint32_t id;
+} keyed;
+
+static int cmp_keyed(const void *a, const void *b)
+{
+    const keyed *x = a, *y = b;
+    if (x->key != y->key)
+        return x->key < y->key ? -1 : 1;
+    return (x->id > y->id) - (x->id < y->id);
+}
+
+int photon_block_level(const photon_sys *ps, uint32_t b)
+{
+    if (!ps || b >= ps->s->nblocks)
+        return PHOTON_LEVELS;
+    return ps->blevel[b];
+}
+
+plx_status photon_set_viewer(photon_sys *ps, const double eye[3], const double dir[3],
+                             double fov_deg)
+{
+    const scene *s = ps->s;
+    arena_mark m = arena_get_mark(ps->a);
+    keyed *order;
+    uint8_t *want;
+    double *tb;
+    uint32_t k, cnt[PHOTON_LEVELS];
+    double bsz = ps->mean_diam, half = 0.5 * fov_deg * PI / 180.0;
+    int L;
+    ps->eye[0] = eye[0];
+    ps->eye[1] = eye[1];
+    ps->eye[2] = eye[2];
+    if (s->nblocks == 0)
+        return PLX_OK;
+    order = arena_scratch(ps->a, (size_t)s->nblocks * sizeof *order, 16);
+    want = arena_scratch(ps->a, s->nblocks, 16);
+    tb = arena_scratch(ps->a, ((size_t)ps->cfg.chart_w + 2) * sizeof *tb, 16);
+    if (!order || !want || !tb) {
+        arena_release(ps->a, &m);
+        return PLX_E_NOMEM;
+    }
+    for (k = 0; k < s->nblocks; k++) {
+        const double *bx = s->blocks[k].box;
+        double dx = eye[0] < bx[0] ? bx[0] - eye[0] : (eye[0] > bx[2] ? eye[0] - bx[2] : 0.0);
+        double dy = eye[1] < bx[1] ? bx[1] - eye[1] : (eye[1] > bx[3] ? eye[1] - bx[3] : 0.0);
+        double dz = eye[2] < 0.0 ? -eye[2] : (eye[2] > ps->bhmax[k] ? eye[2] - ps->bhmax[k] : 0.0);
+        double d = sqrt(dx * dx + dy * dy + dz * dz);
+        int lvl = d < 3 * bsz ? 0 : d < 6 * bsz ? 1 : d < 12 * bsz ? 2 : d < 24 * bsz ? 3 : 4;
+        if (dir && fov_deg > 0.0 && fov_deg < 360.0) {
+            double cx = ps->bcx[k] - eye[0], cy = ps->bcy[k] - eye[1];
+            double cz = 0.5 * ps->bhmax[k] - eye[2];
+            double cl = sqrt(cx * cx + cy * cy + cz * cz);
+            double rad = 0.5 * sqrt((bx[2] - bx[0]) * (bx[2] - bx[0]) +
+                                    (bx[3] - bx[1]) * (bx[3] - bx[1]) +
+                                    ps->bhmax[k] * ps->bhmax[k]);
+            if (cl > rad) {
+                double cosang = (cx * dir[0] + cy * dir[1] + cz * dir[2]) / cl;
+                double ang = acos(cosang > 1.0 ? 1.0 : cosang < -1.0 ? -1.0 : cosang);
+                double angr = asin(rad / cl);
+                if (ang - angr > half)
+                    lvl = d < 3 * bsz ? 2 : 4;
+            }
+        }
+        want[k] = (uint8_t)lvl;
+        order[k].key = d;
+        order[k].id = k;
+    }
+    qsort(order, s->nblocks, sizeof *order, cmp_keyed);
+    for (L = 0; L < PHOTON_LEVELS; L++)
+        cnt[L] = 0;
+    for (k = 0; k < s->nblocks; k++) {
+        uint32_t b = order[k].id;
+        int lvl = want[b];
+        while (lvl < PHOTON_LEVELS && cnt[lvl] >= ps->lev[lvl].nslots)
+            lvl++;
+        if (lvl < PHOTON_LEVELS)
+            cnt[lvl]++;
+        want[b] = (uint8_t)lvl;
+    }
+    /* free the slots of blocks that move, then give them new ones */
+    for (k = 0; k < s->nblocks; k++)
+        if (want[k] != ps->blevel[k] && ps->bslot[k] != PHOTON_NONE) {
+            photon_level *lv = &ps->lev[ps->blevel[k]];
+            lv->slot_block[ps->bslot[k]] = PHOTON_NONE;
+            lv->free_slots[lv->nfree++] = ps->bslot[k];
+            ps->bslot[k] = PHOTON_NONE;
+        }
+    for (k = 0; k < s->nblocks; k++)
+        if (want[k] != ps->blevel[k]) {
+            ps->blevel[k] = want[k];
+            if (want[k] < PHOTON_LEVELS) {
+                photon_level *lv = &ps->lev[want[k]];
+                uint32_t slot = lv->free_slots[--lv->nfree];
+                lv->slot_block[slot] = k;
+                ps->bslot[k] = slot;
+                chart_build(ps, k, want[k], slot, tb);
+            }
+        }
+    for (L = 0; L <= PHOTON_LEVELS; L++)
+        ps->level_count[L] = 0;
+    for (k = 0; k < s->nblocks; k++)
+        ps->level_count[ps->blevel[k]]++;
+    arena_release(ps->a, &m);
+    return PLX_OK;
+}
+
+/* ---- tracing ---------------------------------------------------------------------- */
+
+/* Where the progressive pass puts a photon arriving at h with flux f. */
+static void store_progressive(photon_sys *ps, uint32_t lamp, const trace_hit *h, double f)
+{
+    const scene *s = ps->s;
+    photon_stats *st = &ps->st;
+    if (h->kind == TRACE_WALL) {
+        uint32_t k = s->bld[h->bld].block;
+        int L;
+        photon_level *lv;
+        size_t cs, base;
+        double fx, fy;
+        if (k >= s->nblocks || ps->eclass[h->edge] == PHOTON_EDGE_INTERNAL) {
+            st->lost += f;
+            return;
+        }
+        ps->bamb[k] += f;
+        L = ps->blevel[k];
+        if (L >= PHOTON_LEVELS) {
+            st->stored_ambient += f;
+            return;
+        }
+        lv = &ps->lev[L];
+        cs = (size_t)lv->w * lv->h;
+        base = (size_t)ps->bslot[k] * 2 * cs + (ps->eclass[h->edge] == PHOTON_EDGE_INNER ? cs : 0);
+        chart_xy(ps, k, lv, h->p[0], h->p[1], h->p[2], &fx, &fy);
+        if (photon_splat(lv->flux + base, lv->area + base, NULL, 0.0, lv->w, lv->h, 1, fx, fy,
+                         kernel_radius(&ps->cfg, lv->slot_frames[ps->bslot[k]]), f))
+            st->stored_chart += f;
+        else
+            st->lost += f;
+        return;
+    }
+    if (h->kind == TRACE_GROUND || h->kind == TRACE_ROOF) {
+        double fx, fy;
+        if (ps->refined[lamp]) {
+            st->skipped_refined += f;
+            return;
+        }
+        photon_aerial_xy(ps, h->p[0], h->p[1], &fx, &fy);
+        if (photon_splat(ps->gflux, ps->garea, ps->gheight, h->p[2], ps->gw, ps->gh, 0, fx, fy,
+                         kernel_radius(&ps->cfg, ps->gframes), f))
+            st->stored_aerial += f;
+        else
+            st->lost += f;
+        return;
+    }
+    st->lost += f;
+}
+
+void photon_trace_lamp(photon_sys *ps, uint32_t lamp, double phi, uint64_t *rng,
+                       photon_stats *st, photon_store_fn store, void *ctx)
+{
+    const scene_lamp *Lp = &ps->s->lamps[lamp];
+    double o[3], d[3], z, r, ph, f;
+    trace_hit h;
+    uint32_t b;
+    o[0] = Lp->x;
+    o[1] = Lp->y;
+    o[2] = Lp->z;
+    z = 1.0 - 2.0 * photon_rand01(rng);
+    r = sqrt(1.0 - z * z > 0.0 ? 1.0 - z * z : 0.0);
+    ph = 2.0 * PI * photon_rand01(rng);
+    d[0] = r * cos(ph);
+    d[1] = r * sin(ph);
+    d[2] = z;
+    st->photons++;
+    st->emitted += phi;
+    st->traced++;
+    if (trace_ray(ps->T, o, d, Lp->radius, &h) == TRACE_SKY)
+        return;
+    f = phi * photon_window(h.t / Lp->radius);
+    if (!(f > 0.0))
+        return;
+    st->first += f;
+    for (b = 0; b < ps->cfg.max_bounces; b++) {
+        double alb = h.kind == TRACE_GROUND ? ps->s->ground_albedo : ps->s->bld[h.bld].albedo;
+        if (photon_rand01(rng) >= alb) {
+            st->absorbed += f;
+            return;
+        }
+        photon_cosine_dir(rng, h.n, d);
+        o[0] = h.p[0] + BOUNCE_OFFSET * h.n[0];
+        o[1] = h.p[1] + BOUNCE_OFFSET * h.n[1];
+        o[2] = h.p[2] + BOUNCE_OFFSET * h.n[2];
+        st->traced++;
+        if (trace_ray(ps->T, o, d, INFINITY, &h) == TRACE_SKY) {
+            st->escaped += f;
+            return;
+        }
+        st->arrived += f;
+        store(ps, ctx, lamp, &h, f);
+    }
+    st->cut += f;
+}
+
+static void store_step(photon_sys *ps, void *ctx, uint32_t lamp, const trace_hit *h, double f)
+{
+    (void)ctx;
+    store_progressive(ps, lamp, h, f);
+}
+
+void photon_step(photon_sys *ps, uint32_t n, uint64_t seed)
+{
+    const scene *s = ps->s;
+    /* the state is the seed hashed: frames with neighbouring seeds must
+     * not share stream positions (stratified photons of one lamp take the
+     * same indices every frame, and correlated streams froze their noise) */
+    uint64_t rng = seed ^ 0x5bd1e9955bd1e995ull;
+    rng = photon_rand(&rng);
+    rng = photon_rand(&rng);
+    uint32_t k, lamp = 0;
+    int L;
+    double phi;
+    if (!ps || n == 0 || s->nlamps == 0 || !(ps->flux_total > 0.0))
+        return;
+    for (L = 0; L < PHOTON_LEVELS; L++) {
+        photon_level *lv = &ps->lev[L];
+        uint32_t i;
+        for (i = 0; i < lv->nslots; i++)
+            if (lv->slot_block[i] != PHOTON_NONE)
+                lv->slot_frames[i]++;
+    }
+    ps->amb_frames++;
+    ps->gframes++;
+    ps->st.frames++;
+    phi = ps->flux_total / n;
+    for (k = 0; k < n; k++) {
+        /* stratified choice of the lamp: the k-th of n equal flux shares */
+        double u = (k + photon_rand01(&rng)) / n * ps->flux_total;
+        while (lamp + 1 < s->nlamps && ps->lamp_cdf[lamp] <= u)
+            lamp++;
+        if (ps->lamp_cdf[lamp] <= u || (lamp > 0 && ps->lamp_cdf[lamp - 1] > u)) {
+            /* rounding at the end of the cdf: search */
+            uint32_t lo = 0, hi = s->nlamps - 1;
+            while (lo < hi) {
+                uint32_t mid = lo + (hi - lo) / 2;
+                if (ps->lamp_cdf[mid] > u)
+                    hi = mid;
+                else
+                    lo = mid + 1;
+            }
+            lamp = lo;
+        }
+        photon_trace_lamp(ps, lamp, phi, &rng, &ps->st, store_step, NULL);
+    }
+}
+
+/* ---- lookup ------------------------------------------------------------------------ */
+
+static double facade_lookup(const photon_sys *ps, const trace_hit *h)
+{
+    const scene *s = ps->s;
+    uint32_t k = s->bld[h->bld].block;
+    int L;
+    const photon_level *lv;
+    size_t cs, base;
+    uint32_t slot, fr;
+    double fx, fy;
+    if (k >= s->nblocks)
+        return 0.0;
+    L = ps->blevel[k];
+    if (L >= PHOTON_LEVELS) {
+        if (ps->amb_frames == 0 || !(ps->bfacade[k] > 0.0))
+            return 0.0;
+        return ps->bamb[k] / (ps->bfacade[k] * ps->amb_frames);
+    }
+    lv = &ps->lev[L];
+    slot = ps->bslot[k];
+    fr = lv->slot_frames[slot];
+    if (fr == 0)
+        return 0.0;
+    cs = (size_t)lv->w * lv->h;
+    base = (size_t)slot * 2 * cs + (ps->eclass[h->edge] == PHOTON_EDGE_INNER ? cs : 0);
+    chart_xy(ps, k, lv, h->p[0], h->p[1], h->p[2], &fx, &fy);
+    return photon_gather(lv->flux + base, lv->area + base, NULL, 0.0, lv->w, lv->h, 1, fx, fy) /
+           fr;
+}
+
+double photon_indirect(photon_sys *ps, const double P[3], const double n[3])
+{
+    trace_hit h;
+    double o[3], d[3];
+    if (!ps || !P || !n)
+        return 0.0;
+    if (n[2] > 0.5) {
+        double fx, fy, e = 0.0;
+        photon_aerial_xy(ps, P[0], P[1], &fx, &fy);
+        if (ps->gframes > 0)
+            e = photon_gather(ps->gflux, ps->garea, ps->gheight, P[2], ps->gw, ps->gh, 0, fx,
+                              fy) /
+                ps->gframes;
+        return e + photon_night_horizontal(ps, P[0], P[1], P[2]);
+    }
+    /* a wall or an underside: find it with a short probe ray */
+    o[0] = P[0] + 0.005 * n[0];
+    o[1] = P[1] + 0.005 * n[1];
+    o[2] = P[2] + 0.005 * n[2];
+    if (o[2] < 0.0)
+        o[2] = 0.0;
+    d[0] = -n[0];
+    d[1] = -n[1];
+    d[2] = -n[2];
+    {
+        double l = sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+        if (!(l > 0.0))
+            return 0.0;
+        d[0] /= l;
+        d[1] /= l;
+        d[2] /= l;
+    }
+    trace_ray(ps->T, o, d, 0.02, &h);
+    if (h.kind == TRACE_WALL)
+        return facade_lookup(ps, &h);
+    if (h.kind == TRACE_UNDER) {
+        uint32_t k = ps->s->bld[h.bld].block;
+        if (k < ps->s->nblocks && ps->amb_frames > 0 && ps->bfacade[k] > 0.0)
+            return ps->bamb[k] / (ps->bfacade[k] * ps->amb_frames);
+    }
+    return 0.0;
+}

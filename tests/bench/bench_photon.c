@@ -1,0 +1,335 @@
+/* Photon benchmark (src/photon.h, src/trace.h), single thread:
+ *  - the photon pass: ms per photon_step of 64K photons on
+ *    `gen eixample 30 30` (generated in memory), target <= 10 ms;
+ *  - rays per second of the grid caster against the brute-force caster
+ *    (every building) on the same rays, run in the same process;
+ *  - memory of the photon buffers by kind;
+ *  - lookup time of photon_indirect (ground and facade points);
+ *  - error against photon count on fixtures/eixample-4x4.geojson, measured
+ *    against a long run of the same estimator (convergence, not accuracy:
+ *    tests/unit/test_photon.c checks accuracy against path tracing).
+ *
+ * Usage: bench_photon [FRAMES]   (default 20 timed passes)
+ */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "polarlux.h"
+#include "engine.h"
+#include "trace.h"
+#include "photon.h"
+
+#define BUDGET ((size_t)3 << 30)
+
+typedef struct text {
+    char *buf;
+    size_t len, cap;
+} text;
+
+static int append(void *ctx, const char *data, size_t len)
+{
+    text *t = ctx;
+    if (t->len + len + 1 > t->cap) {
+        char *nb;
+        t->cap = (t->len + len + 1) * 2;
+        nb = realloc(t->buf, t->cap);
+        if (!nb)
+            return -1;
+        t->buf = nb;
+    }
+    memcpy(t->buf + t->len, data, len);
+    t->len += len;
+    t->buf[t->len] = '\0';
+    return 0;
+}
+
+static uint64_t now_ns(void)
+{
+    return plx_port_posix()->clock_ns(NULL);
+}
+
+static int cmp_double(const void *a, const void *b)
+{
+    double x = *(const double *)a, y = *(const double *)b;
+    return (x > y) - (x < y);
+}
+
+static plx_engine *engine_with(const char *text_or_path, size_t len, int is_file)
+{
+    plx_engine *e;
+    plx_config cfg;
+    plx_port port = *plx_port_posix();
+    static plx_port keep;
+    port.log = NULL;
+    keep = port;
+    plx_config_default(&cfg);
+    cfg.port = &keep;
+    if (plx_engine_new(BUDGET, &cfg, &e) != PLX_OK) {
+        fprintf(stderr, "bench_photon: no memory for the engine\n");
+        exit(1);
+    }
+    if ((is_file ? plx_load_file(e, text_or_path)
+                 : plx_load_geojson(e, text_or_path, len, "eixample")) != PLX_OK) {
+        fprintf(stderr, "bench_photon: load failed: %s\n", plx_last_error(e));
+        exit(1);
+    }
+    return e;
+}
+
+static int free_point(tracer *T, const scene *s, uint64_t *rs, double o[3])
+{
+    int tries;
+    for (tries = 0; tries < 1000; tries++) {
+        o[0] = s->bounds[0] + (s->bounds[2] - s->bounds[0]) * photon_rand01(rs);
+        o[1] = s->bounds[1] + (s->bounds[3] - s->bounds[1]) * photon_rand01(rs);
+        o[2] = 0.5 + 10.0 * photon_rand01(rs);
+        if (trace_top(T, o[0], o[1], NULL) == 0.0)
+            return 1;
+    }
+    return 0;
+}
+
+static void sphere(uint64_t *rs, double d[3])
+{
+    double z = 1.0 - 2.0 * photon_rand01(rs), r = sqrt(1.0 - z * z);
+    double p = 2.0 * 3.14159265358979323846 * photon_rand01(rs);
+    d[0] = r * cos(p);
+    d[1] = r * sin(p);
+    d[2] = z;
+}
+
+int main(int argc, char **argv)
+{
+    int frames = argc > 1 ? atoi(argv[1]) : 20;
+    text t = {NULL, 0, 0};
+    plx_engine *e;
+    const scene *s;
+    photon_sys *ps;
+    plx_memory_report mr;
+    uint64_t t0, rs = 12345;
+    double *ms;
+    int i;
+    if (frames < 1)
+        frames = 1;
+    if (plx_gen_city("eixample", 30, 30, 1, append, &t) != PLX_OK) {
+        fprintf(stderr, "bench_photon: gen failed\n");
+        return 1;
+    }
+    e = engine_with(t.buf, t.len, 0);
+    s = e->sc;
+    printf("city: gen eixample 30 30: %u buildings, %u blocks, %u lamps, %u vertices\n", s->nbld,
+           s->nblocks, s->nlamps, s->npts);
+    t0 = now_ns();
+    if (photon_create(&e->mem, s, NULL, &ps) != PLX_OK) {
+        fprintf(stderr, "bench_photon: photon_create: out of memory\n");
+        return 1;
+    }
+    printf("photon_create: %.1f ms (tracer grid %ux%u cells of %.1f m, aerial %ux%u texels of "
+           "%.2f m)\n",
+           (now_ns() - t0) / 1e6, ps->T->nx, ps->T->ny, ps->T->cell, ps->gw, ps->gh, ps->gtex);
+
+    /* ---- memory ---- */
+    plx_memory_get(e, &mr);
+    {
+        size_t lv = 0, g = (size_t)ps->gw * ps->gh * 4 * sizeof(float);
+        size_t cache = ps->nslots * photon_lamp_slot_bytes(s, &ps->cfg);
+        int L;
+        for (L = 0; L < PHOTON_LEVELS; L++)
+            lv += (size_t)ps->lev[L].nslots * 2 * ps->lev[L].w * ps->lev[L].h * 2 * sizeof(float);
+        printf("memory (part photon): %.1f MiB total; facade atlases %.1f MiB (4 levels), "
+               "aerial charts %.1f MiB, lamp cache %.1f MiB (%u slots), tracer and tables "
+               "%.1f MiB; scene itself %.1f MiB\n",
+               mr.used[PLX_PART_PHOTON] / 1048576.0, lv / 1048576.0, g / 1048576.0,
+               cache / 1048576.0, ps->nslots,
+               (mr.used[PLX_PART_PHOTON] - lv - g - cache) / 1048576.0,
+               mr.used[PLX_PART_SCENE] / 1048576.0);
+    }
+
+    /* ---- the photon pass ---- */
+    {
+        double eye[3];
+        eye[0] = 0.5 * (s->bounds[0] + s->bounds[2]);
+        eye[1] = 0.5 * (s->bounds[1] + s->bounds[3]);
+        eye[2] = 1.7;
+        photon_set_viewer(ps, eye, NULL, 0.0);
+    }
+    ms = malloc(sizeof *ms * (size_t)frames);
+    photon_step(ps, 65536, 1); /* warm-up */
+    {
+        uint64_t traced0 = ps->st.traced;
+        for (i = 0; i < frames; i++) {
+            t0 = now_ns();
+            photon_step(ps, 65536, 2 + (uint64_t)i);
+            ms[i] = (now_ns() - t0) / 1e6;
+        }
+        qsort(ms, (size_t)frames, sizeof *ms, cmp_double);
+        printf("photon pass: 65536 photons in %.2f ms median (min %.2f, max %.2f) over %d "
+               "passes; %.2f rays per photon; target 10 ms: %s\n",
+               ms[frames / 2], ms[0], ms[frames - 1], frames,
+               (double)(ps->st.traced - traced0) / (65536.0 * frames),
+               ms[frames / 2] <= 10.0 ? "met" : "NOT met");
+        printf("  per photon %.0f ns; stored %.0f%% of the flux reaching later hits "
+               "(chart %.0f%%, aerial %.0f%%, ambient %.0f%%, lost %.1f%%)\n",
+               ms[frames / 2] * 1e6 / 65536.0,
+               100.0 * (ps->st.stored_chart + ps->st.stored_aerial + ps->st.stored_ambient) /
+                   ps->st.arrived,
+               100.0 * ps->st.stored_chart / ps->st.arrived,
+               100.0 * ps->st.stored_aerial / ps->st.arrived,
+               100.0 * ps->st.stored_ambient / ps->st.arrived,
+               100.0 * ps->st.lost / ps->st.arrived);
+    }
+
+    /* ---- the caster ---- */
+    {
+        enum { NR = 200000, NB = 300 };
+        static double o[NR][3], d[NR][3];
+        trace_hit h, hb;
+        double fast, brute;
+        int mism = 0;
+        uint64_t tests0;
+        for (i = 0; i < NR; i++) {
+            free_point(ps->T, s, &rs, o[i]);
+            sphere(&rs, d[i]);
+        }
+        tests0 = ps->T->tests;
+        t0 = now_ns();
+        for (i = 0; i < NR; i++)
+            trace_ray(ps->T, o[i], d[i], INFINITY, &h);
+        fast = NR / ((now_ns() - t0) / 1e9);
+        printf("caster: %.2f M rays/s (random rays from street points, any direction; %.1f "
+               "prism tests per ray)\n",
+               fast / 1e6, (double)(ps->T->tests - tests0) / NR);
+        t0 = now_ns();
+        for (i = 0; i < NB; i++)
+            trace_ray_brute(ps->T, o[i], d[i], INFINITY, &hb);
+        brute = NB / ((now_ns() - t0) / 1e9);
+        for (i = 0; i < NB; i++) {
+            trace_ray(ps->T, o[i], d[i], INFINITY, &h);
+            trace_ray_brute(ps->T, o[i], d[i], INFINITY, &hb);
+            if (h.kind != hb.kind || (h.kind != TRACE_SKY && fabs(h.t - hb.t) > 1e-9 * (1 + h.t)))
+                mism++;
+        }
+        printf("brute-force caster (every building): %.0f rays/s on %d of the rays; grid is "
+               "%.0fx faster; %d mismatches\n",
+               brute, NB, fast / brute, mism);
+        if (mism)
+            return 1;
+    }
+
+    /* ---- lookups ---- */
+    {
+        enum { NQ = 100000 };
+        static double P[NQ][3], N[NQ][3];
+        int nq = 0, nf = 0;
+        double sum = 0.0, tg, tf;
+        while (nq < NQ) {
+            double o[3], dd[3];
+            trace_hit h;
+            free_point(ps->T, s, &rs, o);
+            if (nq % 2 == 0) {
+                P[nq][0] = o[0];
+                P[nq][1] = o[1];
+                P[nq][2] = 0.0;
+                N[nq][0] = N[nq][1] = 0.0;
+                N[nq][2] = 1.0;
+                nq++;
+                continue;
+            }
+            sphere(&rs, dd);
+            dd[2] = 0.0;
+            {
+                double l = hypot(dd[0], dd[1]);
+                dd[0] /= l;
+                dd[1] /= l;
+            }
+            if (trace_ray(ps->T, o, dd, 50.0, &h) != TRACE_WALL)
+                continue;
+            memcpy(P[nq], h.p, sizeof P[nq]);
+            memcpy(N[nq], h.n, sizeof N[nq]);
+            nq++;
+            nf++;
+        }
+        t0 = now_ns();
+        for (i = 0; i < NQ; i += 2)
+            sum += photon_indirect(ps, P[i], N[i]);
+        tg = (now_ns() - t0) / (NQ / 2.0);
+        t0 = now_ns();
+        for (i = 1; i < NQ; i += 2)
+            sum += photon_indirect(ps, P[i], N[i]);
+        tf = (now_ns() - t0) / (NQ / 2.0);
+        printf("lookup: ground %.0f ns, facade %.0f ns (probe ray + chart) per point; %d "
+               "points, mean E %.3f lx\n",
+               tg, tf, NQ, sum / NQ);
+    }
+    plx_engine_free(e);
+    free(t.buf);
+    free(ms);
+
+    /* ---- error vs photons on eixample-4x4 (convergence) ---- */
+    {
+        enum { NP = 64 };
+        static double P[NP][3], N[NP][3], ref[NP];
+        int np = 0, k, marks[6] = {1, 4, 16, 64, 0, 0}, m;
+        photon_sys *p2;
+        photon_config c;
+        double eye[3];
+        e = engine_with("fixtures/eixample-4x4.geojson", 0, 1);
+        s = e->sc;
+        photon_config_default(&c);
+        eye[0] = 0.5 * (s->bounds[0] + s->bounds[2]);
+        eye[1] = 0.5 * (s->bounds[1] + s->bounds[3]);
+        eye[2] = 1.7;
+        if (photon_create(&e->mem, s, &c, &p2) != PLX_OK)
+            return 1;
+        photon_set_viewer(p2, eye, NULL, 0.0);
+        while (np < NP) {
+            const scene_lamp *L = &s->lamps[photon_rand(&rs) % s->nlamps];
+            double a = 6.283185307179586 * photon_rand01(&rs), dd[3] = {cos(a), sin(a), 0};
+            double o[3] = {L->x, L->y, 2.0};
+            trace_hit h;
+            if (np % 2 == 0) {
+                double x = L->x + 4 * cos(a), y = L->y + 4 * sin(a);
+                if (trace_top(p2->T, x, y, NULL) != 0.0)
+                    continue;
+                P[np][0] = x;
+                P[np][1] = y;
+                P[np][2] = 0;
+                N[np][0] = N[np][1] = 0;
+                N[np][2] = 1;
+            } else {
+                if (trace_ray(p2->T, o, dd, 12.0, &h) != TRACE_WALL)
+                    continue;
+                memcpy(P[np], h.p, sizeof P[np]);
+                memcpy(N[np], h.n, sizeof N[np]);
+            }
+            np++;
+        }
+        /* baseline: 512 passes (33.5 M photons) */
+        for (k = 0; k < 512; k++)
+            photon_step(p2, 65536, 100000 + (uint64_t)k);
+        for (i = 0; i < NP; i++)
+            ref[i] = photon_indirect(p2, P[i], N[i]);
+        photon_reset(p2);
+        printf("error vs photons (eixample-4x4, %d ground+facade points near lamps, against "
+               "512 passes = 33.5 M photons):\n  photons     mean rel diff\n",
+               NP);
+        for (m = 0, k = 0; marks[m]; k++) {
+            photon_step(p2, 65536, 7 + (uint64_t)k);
+            if (k + 1 == marks[m]) {
+                double err = 0.0;
+                int used = 0;
+                for (i = 0; i < NP; i++)
+                    if (ref[i] > 0.0) {
+                        err += fabs(photon_indirect(p2, P[i], N[i]) - ref[i]) / ref[i];
+                        used++;
+                    }
+                printf("  %9d   %.4f\n", marks[m] * 65536, used ? err / used : 0.0);
+                m++;
+            }
+        }
+        plx_engine_free(e);
+    }
+    return 0;
+}

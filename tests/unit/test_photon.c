@@ -1,0 +1,956 @@
+/* photon: the 2.5D ray caster against brute force, energy balance in a
+ * closed box, flux conservation through splatting, a one-bounce case with
+ * an analytic (numerically integrated) answer, accuracy on the eixample
+ * fixture against an independent path-traced estimate, the lamp cache
+ * (LRU) and its exchange with the aerial chart, levels for a moving
+ * viewer, histogram matching, and out-of-memory at creation.
+ *
+ * PLX_PHOTON_FULL=1 runs the accuracy tables with more photons and more
+ * reference paths (slower). PLX_TEST_QUICK=1 (valgrind) runs them with far
+ * fewer photons and checks only looser bounds (printed). */
+#include <stdarg.h>
+#include <stddef.h>
+#include <setjmp.h>
+#include <stdint.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <cmocka.h>
+
+#include "polarlux.h"
+#include "engine.h"
+#include "arena.h"
+#include "blocks.h"
+#include "trace.h"
+#include "photon.h"
+#include "ref_scene.h"
+
+#define PI 3.14159265358979323846
+
+static int full_mode(void)
+{
+    const char *v = getenv("PLX_PHOTON_FULL");
+    return v && v[0] && v[0] != '0';
+}
+
+static int quick_mode(void)
+{
+    const char *v = getenv("PLX_TEST_QUICK");
+    return v && v[0] && v[0] != '0';
+}
+
+static uint64_t rng_next(uint64_t *s)
+{
+    uint64_t z = (*s += 0x9e3779b97f4a7c15ull);
+    z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ull;
+    z = (z ^ (z >> 27)) * 0x94d049bb133111ebull;
+    return z ^ (z >> 31);
+}
+
+static double urand(uint64_t *s)
+{
+    return (rng_next(s) >> 11) * (1.0 / 9007199254740992.0);
+}
+
+static void sphere_dir(uint64_t *s, double d[3])
+{
+    double z = 1.0 - 2.0 * urand(s), r = sqrt(1.0 - z * z), p = 2.0 * PI * urand(s);
+    d[0] = r * cos(p);
+    d[1] = r * sin(p);
+    d[2] = z;
+}
+
+/* ---- a scene from arrays with its blocks, in an arena on the heap ------- */
+
+typedef struct fixture {
+    scene s;
+    void *mem;
+    arena a;
+} fixture;
+
+static void fx_open(fixture *f, size_t bytes)
+{
+    ref_scene_init(&f->s);
+    f->mem = malloc(bytes);
+    assert_non_null(f->mem);
+    arena_init(&f->a, f->mem, bytes);
+}
+
+static void fx_finish(fixture *f)
+{
+    ref_scene_finish(&f->s);
+    assert_int_equal(blocks_build(&f->a, &f->s, 0.05), PLX_OK);
+}
+
+static void fx_close(fixture *f)
+{
+    ref_scene_free(&f->s);
+    free(f->mem);
+}
+
+/* ---- brute-force ray casting, written independently of src/trace.c ------ */
+
+/* First hit by plane tests against every face of every building. */
+static int brute_cast(const scene *s, const double o[3], const double d[3], double *tout)
+{
+    double best = INFINITY;
+    int kind = TRACE_SKY;
+    uint32_t b;
+    if (d[2] < 0.0 && o[2] > 0.0) {
+        best = -o[2] / d[2];
+        kind = TRACE_GROUND;
+    }
+    for (b = 0; b < s->nbld; b++) {
+        const scene_building *B = &s->bld[b];
+        uint32_t r;
+        for (r = 0; r < B->ring_count; r++) {
+            const scene_ring *R = &s->rings[B->ring_first + r];
+            uint32_t k;
+            for (k = 0; k < R->count; k++) {
+                const vec2 *p = &s->pts[R->first + k];
+                const vec2 *q = &s->pts[R->first + (k + 1) % R->count];
+                /* o + t d = p + u (q - p) in the plane */
+                double ex = q->x - p->x, ey = q->y - p->y;
+                double den = d[0] * ey - d[1] * ex, t, u, z;
+                if (den == 0.0)
+                    continue;
+                t = ((p->x - o[0]) * ey - (p->y - o[1]) * ex) / den;
+                u = ((p->x - o[0]) * d[1] - (p->y - o[1]) * d[0]) / den;
+                z = o[2] + t * d[2];
+                if (t > 1e-12 && u >= 0.0 && u <= 1.0 && z >= B->min_height && z <= B->height &&
+                    t < best) {
+                    best = t;
+                    kind = TRACE_WALL;
+                }
+            }
+        }
+        if (d[2] != 0.0) {
+            double zs[2];
+            int i;
+            zs[0] = B->height;
+            zs[1] = B->min_height;
+            for (i = 0; i < 2; i++) {
+                double t = (zs[i] - o[2]) / d[2];
+                if (i == 1 && B->min_height <= 0.0)
+                    continue;
+                if (t > 1e-12 && t < best &&
+                    ref_footprint_where(s, b, o[0] + t * d[0], o[1] + t * d[1]) == REF_IN) {
+                    best = t;
+                    kind = i == 0 ? TRACE_ROOF : TRACE_UNDER;
+                }
+            }
+        }
+    }
+    *tout = best;
+    return kind;
+}
+
+static int in_solid(const scene *s, const double p[3])
+{
+    uint32_t b;
+    for (b = 0; b < s->nbld; b++)
+        if (p[2] >= s->bld[b].min_height - 1e-9 && p[2] <= s->bld[b].height + 1e-9 &&
+            ref_footprint_where(s, b, p[0], p[1]) != REF_OUT)
+            return 1;
+    return 0;
+}
+
+/* Random city: boxes on a jittered grid (some touching, some raised, some
+ * with a courtyard), an L-shape and a hexagon. */
+static void random_city(fixture *f, uint64_t seed)
+{
+    uint64_t rs = seed;
+    int i, j;
+    for (j = 0; j < 6; j++)
+        for (i = 0; i < 6; i++) {
+            double x0 = i * 30.0 + 4.0 * urand(&rs), y0 = j * 30.0 + 4.0 * urand(&rs);
+            double w = 10.0 + 16.0 * urand(&rs), h = 10.0 + 16.0 * urand(&rs);
+            double ht = 5.0 + 30.0 * urand(&rs), mh = urand(&rs) < 0.2 ? 3.0 + 2.0 * urand(&rs) : 0.0;
+            if ((i + j) % 7 == 3) {
+                double xy[16] = {x0, y0, x0 + w, y0, x0 + w, y0 + h, x0, y0 + h,
+                                 x0 + 3, y0 + 3, x0 + 3, y0 + h - 3, x0 + w - 3, y0 + h - 3,
+                                 x0 + w - 3, y0 + 3};
+                uint32_t rn[2] = {4, 4};
+                assert_true(ref_scene_add_building(&f->s, xy, rn, 2, ht, 0.0) >= 0);
+            } else {
+                assert_true(ref_scene_add_box(&f->s, x0, y0, x0 + w, y0 + h, ht, mh) >= 0);
+            }
+        }
+    {
+        double xy[12] = {200, 0, 230, 0, 230, 10, 210, 10, 210, 40, 200, 40};
+        uint32_t rn[1] = {6};
+        assert_true(ref_scene_add_building(&f->s, xy, rn, 1, 22.0, 0.0) >= 0);
+    }
+    {
+        double xy[12];
+        uint32_t rn[1] = {6};
+        int k;
+        for (k = 0; k < 6; k++) {
+            xy[2 * k] = 215.0 + 9.0 * cos(k * PI / 3.0 + 0.2);
+            xy[2 * k + 1] = 100.0 + 9.0 * sin(k * PI / 3.0 + 0.2);
+        }
+        assert_true(ref_scene_add_building(&f->s, xy, rn, 1, 14.0, 0.0) >= 0);
+    }
+    /* two boxes sharing a wall, different heights */
+    assert_true(ref_scene_add_box(&f->s, 200, 150, 215, 170, 12.0, 0.0) >= 0);
+    assert_true(ref_scene_add_box(&f->s, 215, 150, 230, 170, 20.0, 0.0) >= 0);
+}
+
+static void test_trace_vs_brute(void **state)
+{
+    fixture f;
+    tracer *T;
+    uint64_t rs = 77;
+    int n = full_mode() ? 50000 : quick_mode() ? 500 : 5000, done = 0, mism = 0, kinds[5] = {0, 0, 0, 0, 0};
+    (void)state;
+    fx_open(&f, 8u << 20);
+    random_city(&f, 5);
+    fx_finish(&f);
+    assert_int_equal(trace_create(&f.a, PLX_PART_PHOTON, &f.s, 0.0, &T), PLX_OK);
+    while (done < n) {
+        double o[3], d[3], tb, dz;
+        trace_hit h, h2;
+        int kb, kt;
+        o[0] = f.s.bounds[0] + (f.s.bounds[2] - f.s.bounds[0]) * urand(&rs);
+        o[1] = f.s.bounds[1] + (f.s.bounds[3] - f.s.bounds[1]) * urand(&rs);
+        o[2] = 45.0 * urand(&rs);
+        if (in_solid(&f.s, o))
+            continue;
+        sphere_dir(&rs, d);
+        if (done % 10 == 0) { /* some horizontal and vertical rays */
+            dz = d[2];
+            d[2] = 0.0;
+            if (done % 20 == 0) {
+                d[0] = d[1] = 0.0;
+                d[2] = dz < 0 ? -1.0 : 1.0;
+            } else {
+                double l = hypot(d[0], d[1]);
+                d[0] /= l;
+                d[1] /= l;
+            }
+        }
+        kb = brute_cast(&f.s, o, d, &tb);
+        kt = trace_ray(T, o, d, INFINITY, &h);
+        trace_ray_brute(T, o, d, INFINITY, &h2);
+        done++;
+        kinds[kt]++;
+        if (kb != kt || (kb != TRACE_SKY && fabs(tb - h.t) > 1e-7 * (1.0 + tb)) ||
+            h2.kind != kt || (kt != TRACE_SKY && fabs(h2.t - h.t) > 1e-9 * (1.0 + h.t))) {
+            if (mism < 5)
+                printf("mismatch: o %.6f %.6f %.6f d %.6f %.6f %.6f: brute %d t=%.9f, "
+                       "trace %d t=%.9f\n",
+                       o[0], o[1], o[2], d[0], d[1], d[2], kb, tb, kt, h.t);
+            mism++;
+        }
+    }
+    printf("trace vs brute force: %d rays, %d mismatches (sky %d ground %d wall %d roof %d "
+           "under %d)\n",
+           done, mism, kinds[0], kinds[1], kinds[2], kinds[3], kinds[4]);
+    assert_int_equal(mism, 0);
+    assert_true(kinds[TRACE_WALL] > n / 10 && kinds[TRACE_ROOF] > n / 50 &&
+                (quick_mode() || kinds[TRACE_UNDER] > 0) && kinds[TRACE_GROUND] > n / 10);
+    /* trace_top: roofs and ground */
+    {
+        int k;
+        for (k = 0; k < 2000; k++) {
+            double x = f.s.bounds[0] + (f.s.bounds[2] - f.s.bounds[0]) * urand(&rs);
+            double y = f.s.bounds[1] + (f.s.bounds[3] - f.s.bounds[1]) * urand(&rs);
+            double top = 0.0, o[3], d[3] = {0, 0, -1}, tb;
+            uint32_t b;
+            o[0] = x;
+            o[1] = y;
+            o[2] = 100.0;
+            if (brute_cast(&f.s, o, d, &tb) == TRACE_ROOF)
+                top = 100.0 - tb;
+            for (b = 0; b < f.s.nbld; b++)
+                if (ref_footprint_where(&f.s, b, x, y) == REF_ON)
+                    break;
+            if (b < f.s.nbld)
+                continue; /* on an edge: either way */
+            assert_true(fabs(trace_top(T, x, y, NULL) - top) < 1e-9);
+        }
+    }
+    fx_close(&f);
+}
+
+/* ---- energy in a closed box --------------------------------------------- */
+
+/* A courtyard closed by a canopy: donut [0,20]^2 minus [5,15]^2, height 10,
+ * and a raised slab over [4,16]^2 from z = 10 to 11. Uniform albedo a. */
+static void closed_box(fixture *f, double a)
+{
+    double xy[16] = {0, 0, 20, 0, 20, 20, 0, 20, 5, 5, 5, 15, 15, 15, 15, 5};
+    uint32_t rn[2] = {4, 4};
+    uint32_t i;
+    fx_open(f, 64u << 20);
+    assert_true(ref_scene_add_building(&f->s, xy, rn, 2, 10.0, 0.0) >= 0);
+    assert_true(ref_scene_add_box(&f->s, 4, 4, 16, 16, 11.0, 10.0) >= 0);
+    assert_true(ref_scene_add_lamp(&f->s, 10, 9, 5, 1000, 1e6) >= 0);
+    f->s.ground_albedo = a;
+    for (i = 0; i < f->s.nbld; i++)
+        f->s.bld[i].albedo = a;
+    fx_finish(f);
+}
+
+static double sum_floats(const float *v, size_t n)
+{
+    double s = 0.0;
+    size_t i;
+    for (i = 0; i < n; i++)
+        s += v[i];
+    return s;
+}
+
+static double chart_total(const photon_sys *ps)
+{
+    double t = 0.0;
+    int L;
+    for (L = 0; L < PHOTON_LEVELS; L++) {
+        const photon_level *lv = &ps->lev[L];
+        t += sum_floats(lv->flux, (size_t)lv->nslots * 2 * lv->w * lv->h);
+    }
+    return t;
+}
+
+static void test_energy_closed_box(void **state)
+{
+    fixture f;
+    photon_sys *ps;
+    photon_config c;
+    const photon_stats *st;
+    double a = 0.5, ratio, ends, stored, tex;
+    int k;
+    (void)state;
+    closed_box(&f, a);
+    photon_config_default(&c);
+    c.aerial_res = 128;
+    c.max_bounces = 200;
+    assert_int_equal(photon_create(&f.a, &f.s, &c, &ps), PLX_OK);
+    for (k = 0; k < (quick_mode() ? 1 : 4); k++)
+        photon_step(ps, 50000, 100 + k);
+    st = &ps->st;
+    /* closed: nothing escapes, and every lumen that reached a first surface
+     * ends absorbed (or cut) */
+    assert_true(st->escaped == 0.0);
+    assert_true(st->first > 0.99 * st->emitted); /* R is huge: W ~ 1 */
+    ends = st->absorbed + st->cut;
+    assert_true(fabs(ends - st->first) <= 1e-9 * st->first);
+    /* later hits carry a + a^2 + ... = a / (1 - a) of the first */
+    ratio = st->arrived / st->first;
+    printf("closed box, albedo %.2f: arrived / first = %.4f (expected %.4f), escaped %g\n", a,
+           ratio, a / (1 - a), st->escaped);
+    assert_true(fabs(ratio - a / (1 - a)) < (quick_mode() ? 0.06 : 0.03) * a / (1 - a));
+    /* bookkeeping of the later hits: stored somewhere or counted lost */
+    stored = st->stored_chart + st->stored_aerial + st->stored_ambient + st->lost;
+    assert_true(fabs(stored - st->arrived) <= 1e-9 * st->arrived);
+    /* flux conservation through splatting, to float precision */
+    tex = chart_total(ps);
+    assert_true(fabs(tex - st->stored_chart) <= 1e-5 * st->stored_chart);
+    tex = sum_floats(ps->gflux, (size_t)ps->gw * ps->gh);
+    assert_true(fabs(tex - st->stored_aerial) <= 1e-5 * st->stored_aerial);
+    /* the floor (under the canopy: not the topmost surface) and the
+     * ceiling (an underside) have no chart; the walls do */
+    printf("closed box: stored chart %.4g aerial %.4g lost (floor, ceiling) %.4g of %.4g\n",
+           st->stored_chart, st->stored_aerial, st->lost, st->arrived);
+    assert_true(st->stored_aerial == 0.0);
+    assert_true(st->stored_chart > 0.4 * st->arrived && st->lost > 0.2 * st->arrived);
+    /* mean indirect irradiance on the courtyard walls against the room's
+     * mean: the flux arriving at later hits over floor 100 + walls 400 +
+     * ceiling 100 m^2 */
+    {
+        double sum = 0.0, expect = st->arrived / st->frames / 600.0;
+        int n = 0, i, j, w;
+        for (w = 0; w < 4; w++)
+            for (j = 0; j < 10; j++)
+                for (i = 0; i < 10; i++) {
+                    double u = 5.5 + i, z = 0.5 + j, P[3], nn[3] = {0, 0, 0};
+                    if (w == 0) { P[0] = 5; P[1] = u; nn[0] = 1; }
+                    else if (w == 1) { P[0] = 15; P[1] = u; nn[0] = -1; }
+                    else if (w == 2) { P[0] = u; P[1] = 5; nn[1] = 1; }
+                    else { P[0] = u; P[1] = 15; nn[1] = -1; }
+                    P[2] = z;
+                    sum += photon_indirect(ps, P, nn);
+                    n++;
+                }
+        printf("closed box walls: mean E_ind %.2f lx, room mean %.2f lx\n", sum / n, expect);
+        assert_true(sum / n > 0.7 * expect && sum / n < 1.3 * expect);
+    }
+    fx_close(&f);
+}
+
+/* ---- one bounce from the ground onto one wall: numeric integration -------- */
+
+static double one_bounce_wall(double xl, double zl, double I, double R, double ag, double yp,
+                              double zp)
+{
+    double h = 0.04, sum = 0.0, x, y, rg = sqrt(R * R - zl * zl);
+    for (x = 0.5 * h; x < xl + rg; x += h)
+        for (y = -rg + 0.5 * h; y < rg; y += h) {
+            double dx = x - xl, d2 = dx * dx + y * y + zl * zl, d = sqrt(d2);
+            double xr, e, r2;
+            if (d >= R)
+                continue;
+            xr = d / R;
+            e = I * zl / (d2 * d) * (1 - xr * xr * xr * xr) * (1 - xr * xr * xr * xr);
+            r2 = x * x + (y - yp) * (y - yp) + zp * zp;
+            sum += ag / PI * e * (zp / sqrt(r2)) * (x / sqrt(r2)) / r2;
+        }
+    return sum * h * h;
+}
+
+static void test_one_bounce_wall(void **state)
+{
+    fixture f;
+    photon_sys *ps;
+    photon_config c;
+    double xl = 4.0, zl = 5.0, I = 1000.0, R = 30.0, ag = 0.5;
+    double pts[6][2] = {{0, 1}, {-3, 2}, {4, 1.5}, {0, 4}, {6, 3}, {-8, 2}};
+    double err_first = 0.0, err_last = 0.0;
+    int frames = full_mode() ? 64 : quick_mode() ? 8 : 24, k, i, round;
+    double bound = quick_mode() ? 0.15 : 0.10;
+    double eye[3] = {3, 0, 1.7};
+    (void)state;
+    fx_open(&f, 256u << 20);
+    assert_true(ref_scene_add_box(&f.s, -100, -100, 0, 100, 40.0, 0.0) >= 0);
+    assert_true(ref_scene_add_lamp(&f.s, xl, 0, zl, I, R) >= 0);
+    f.s.bld[0].albedo = 0.0;
+    f.s.ground_albedo = ag;
+    fx_finish(&f);
+    photon_config_default(&c);
+    c.chart_w = 1024;
+    c.chart_h = 64;
+    c.aerial_res = 256;
+    c.kernel_min = 1.5;
+    assert_int_equal(photon_create(&f.a, &f.s, &c, &ps), PLX_OK);
+    assert_int_equal(photon_set_viewer(ps, eye, NULL, 0.0), PLX_OK);
+    assert_int_equal(photon_block_level(ps, 0), 0);
+    printf("one bounce ground -> wall (lamp at x=%.0f z=%.0f):\n  photons   mean rel err\n", xl,
+           zl);
+    for (round = 0, k = 0; k < frames; k++) {
+        photon_step(ps, 65536, 1000 + k);
+        if (k + 1 == 2 || k + 1 == 8 || k + 1 == frames) {
+            double err = 0.0;
+            for (i = 0; i < 6; i++) {
+                double P[3] = {0.0, pts[i][0], pts[i][1]}, n[3] = {1, 0, 0};
+                double ref = one_bounce_wall(xl, zl, I, R, ag, pts[i][0], pts[i][1]);
+                double est = photon_indirect(ps, P, n);
+                if (k + 1 == frames)
+                    printf("    y=%5.1f z=%4.1f: photons %8.3f lx, integral %8.3f lx\n", P[1],
+                           P[2], est, ref);
+                err += fabs(est - ref) / ref;
+            }
+            err /= 6;
+            printf("  %8d   %.4f\n", (k + 1) * 65536, err);
+            if (round++ == 0)
+                err_first = err;
+            err_last = err;
+        }
+    }
+    /* the ground keeps nothing: wall-first photons die (albedo 0), and the
+     * ground is never a later hit */
+    assert_true(ps->st.stored_aerial == 0.0);
+    assert_true(err_last < bound);
+    assert_true(err_last < err_first);
+    fx_close(&f);
+}
+
+/* ---- accuracy on the eixample fixture ------------------------------------- */
+
+static plx_engine *open_fixture(const char *path, void **mem, size_t bytes)
+{
+    plx_engine *e;
+    plx_config cfg;
+    plx_port port = *plx_port_posix();
+    port.log = NULL;
+    plx_config_default(&cfg);
+    cfg.port = &port;
+    *mem = malloc(bytes);
+    assert_non_null(*mem);
+    assert_int_equal(plx_engine_create(*mem, bytes, &cfg, &e), PLX_OK);
+    assert_int_equal(plx_load_file(e, path), PLX_OK);
+    e->cfg.port = NULL; /* the local port goes out of scope */
+    e->port.log = NULL;
+    return e;
+}
+
+/* Direct light at Q (SPEC §2), lamps within reach, visibility by shadow rays. */
+static double direct_at(tracer *T, const scene *s, const double Q[3], const double n[3])
+{
+    double e = 0.0;
+    uint32_t i;
+    for (i = 0; i < s->nlamps; i++) {
+        const scene_lamp *L = &s->lamps[i];
+        double w[3] = {L->x - Q[0], L->y - Q[1], L->z - Q[2]}, d, c, o[3], x;
+        trace_hit h;
+        if (fabs(w[0]) >= L->radius || fabs(w[1]) >= L->radius)
+            continue;
+        d = sqrt(w[0] * w[0] + w[1] * w[1] + w[2] * w[2]);
+        if (d >= L->radius || d == 0.0)
+            continue;
+        w[0] /= d;
+        w[1] /= d;
+        w[2] /= d;
+        c = w[0] * n[0] + w[1] * n[1] + w[2] * n[2];
+        if (c <= 0.0)
+            continue;
+        o[0] = Q[0] + 1e-6 * n[0];
+        o[1] = Q[1] + 1e-6 * n[1];
+        o[2] = Q[2] + 1e-6 * n[2];
+        if (trace_ray(T, o, w, d - 1e-6, &h) != TRACE_SKY)
+            continue;
+        x = d / L->radius;
+        e += L->intensity * c / (d * d) * (1 - x * x * x * x) * (1 - x * x * x * x);
+    }
+    return e;
+}
+
+/* Path-traced E_indirect at P: X = a(Q1) E_d(Q1) + [prob a(Q1)] X(Q1),
+ * Q1 found by a cosine-weighted ray from P. */
+static double reference_indirect(tracer *T, const scene *s, const double P[3],
+                                 const double n[3], int paths, uint64_t seed)
+{
+    double sum = 0.0;
+    int k;
+    uint64_t rs = seed * 0x2545f4914f6cdd1dull;
+    rs = rng_next(&rs);
+    for (k = 0; k < paths; k++) {
+        double p[3] = {P[0], P[1], P[2]}, nn[3] = {n[0], n[1], n[2]};
+        int depth;
+        for (depth = 0; depth < 30; depth++) {
+            double d[3], o[3], a;
+            trace_hit h;
+            photon_cosine_dir(&rs, nn, d);
+            o[0] = p[0] + 1e-6 * nn[0];
+            o[1] = p[1] + 1e-6 * nn[1];
+            o[2] = p[2] + 1e-6 * nn[2];
+            if (trace_ray(T, o, d, INFINITY, &h) == TRACE_SKY)
+                break;
+            a = h.kind == TRACE_GROUND ? s->ground_albedo : s->bld[h.bld].albedo;
+            sum += a * direct_at(T, s, h.p, h.n);
+            if (urand(&rs) >= a)
+                break;
+            memcpy(p, h.p, sizeof p);
+            memcpy(nn, h.n, sizeof nn);
+        }
+    }
+    return sum / paths;
+}
+
+static void test_accuracy_eixample(void **state)
+{
+    void *mem;
+    plx_engine *e = open_fixture("fixtures/eixample-4x4.geojson", &mem, 512u << 20);
+    const scene *s = e->sc;
+    photon_sys *ps;
+    double P[16][3], N[16][3], ref[16];
+    int npts = 0, paths = full_mode() ? 40000 : quick_mode() ? 500 : 5000, k, i;
+    int frames = full_mode() ? 256 : quick_mode() ? 16 : 128;
+    double bound = quick_mode() ? 0.40 : 0.10;
+    double first_err = -1.0, last_err = 0.0, eye[3];
+    uint64_t rs = 4242;
+    (void)state;
+    assert_int_equal(photon_create(&e->mem, s, NULL, &ps), PLX_OK);
+    /* 8 ground points and 8 facade points near lamps */
+    while (npts < 16) {
+        const scene_lamp *L = &s->lamps[rng_next(&rs) % s->nlamps];
+        if (npts < 8) {
+            double a = 2 * PI * urand(&rs), r = 2.0 + 6.0 * urand(&rs);
+            double x = L->x + r * cos(a), y = L->y + r * sin(a);
+            if (x < s->bounds[0] + 60 || x > s->bounds[2] - 60 || y < s->bounds[1] + 60 ||
+                y > s->bounds[3] - 60 || trace_top(ps->T, x, y, NULL) != 0.0)
+                continue;
+            P[npts][0] = x;
+            P[npts][1] = y;
+            P[npts][2] = 0.0;
+            N[npts][0] = N[npts][1] = 0.0;
+            N[npts][2] = 1.0;
+        } else {
+            double a = 2 * PI * urand(&rs), o[3] = {L->x, L->y, 1.0 + (L->z - 1.5) * urand(&rs)};
+            double d[3] = {cos(a), sin(a), 0.0};
+            trace_hit h;
+            if (trace_ray(ps->T, o, d, 12.0, &h) != TRACE_WALL)
+                continue;
+            if (ps->eclass[h.edge] == PHOTON_EDGE_INTERNAL)
+                continue;
+            memcpy(P[npts], h.p, sizeof P[npts]);
+            memcpy(N[npts], h.n, sizeof N[npts]);
+        }
+        npts++;
+    }
+    for (i = 0; i < npts; i++)
+        ref[i] = reference_indirect(ps->T, s, P[i], N[i], paths, 9000 + i);
+    eye[0] = 0.5 * (s->bounds[0] + s->bounds[2]);
+    eye[1] = 0.5 * (s->bounds[1] + s->bounds[3]);
+    eye[2] = 1.7;
+    assert_int_equal(photon_set_viewer(ps, eye, NULL, 0.0), PLX_OK);
+    printf("eixample-4x4, %u lamps, %d reference paths per point\n"
+           "  photons    mean rel err (ground, facade, all)\n",
+           s->nlamps, paths);
+    for (k = 0; k < frames; k++) {
+        photon_step(ps, 65536, 77 + k);
+        if (((k + 1) & k) == 0 || k + 1 == frames) {
+            double eg = 0.0, ef = 0.0;
+            for (i = 0; i < npts; i++) {
+                double est = photon_indirect(ps, P[i], N[i]);
+                double err = fabs(est - ref[i]) / ref[i];
+                if (k + 1 == frames)
+                    printf("    %s (%.1f %.1f %.1f): photons %7.3f lx, paths %7.3f lx\n",
+                           i < 8 ? "ground" : "facade", P[i][0], P[i][1], P[i][2], est, ref[i]);
+                if (i < 8)
+                    eg += err;
+                else
+                    ef += err;
+            }
+            printf("  %9d  %.4f %.4f %.4f\n", (k + 1) * 65536, eg / 8, ef / 8,
+                   (eg + ef) / npts);
+            if (first_err < 0.0)
+                first_err = (eg + ef) / npts;
+            last_err = (eg + ef) / npts;
+        }
+    }
+    printf("  bound on the last row: %.2f%s\n", bound, quick_mode() ? " (quick mode)" : "");
+    assert_true(last_err <= bound);
+    assert_true(last_err < first_err);
+    plx_engine_destroy(e);
+    free(mem);
+}
+
+/* ---- lamp cache ---------------------------------------------------------------- */
+
+static void lamp_row(fixture *f, int nl)
+{
+    int i;
+    fx_open(f, 64u << 20);
+    assert_true(ref_scene_add_box(&f->s, 0, 10, 200, 30, 15.0, 0.0) >= 0);
+    for (i = 0; i < nl; i++)
+        assert_true(ref_scene_add_lamp(&f->s, 10.0 + 20.0 * i, 5.0, 6.0, 1000, 20.0) >= 0);
+    f->s.ground_albedo = 0.3;
+    fx_finish(f);
+}
+
+static void test_lamp_lru(void **state)
+{
+    fixture f;
+    photon_sys *ps;
+    photon_config c;
+    uint32_t order[8], n;
+    (void)state;
+    lamp_row(&f, 6);
+    photon_config_default(&c);
+    c.aerial_res = 128;
+    c.lamp_slots = 3;
+    c.lamp_res = 16;
+    c.lamp_photons = 500;
+    assert_int_equal(photon_create(&f.a, &f.s, &c, &ps), PLX_OK);
+    assert_int_equal(ps->nslots, 3);
+    assert_int_equal(photon_lamp_request(ps, 0), 0);
+    assert_int_equal(photon_lamp_request(ps, 1), 0);
+    assert_int_equal(photon_lamp_request(ps, 2), 0);
+    assert_int_equal(photon_lamp_request(ps, 0), 1);
+    n = photon_lamp_lru(ps, order, 8);
+    assert_int_equal(n, 3);
+    assert_int_equal(order[0], 0);
+    assert_int_equal(order[1], 2);
+    assert_int_equal(order[2], 1);
+    /* a miss evicts the least recently used: lamp 1 */
+    assert_int_equal(photon_lamp_request(ps, 3), 0);
+    assert_false(photon_lamp_cached(ps, 1));
+    assert_true(photon_lamp_cached(ps, 0) && photon_lamp_cached(ps, 2) &&
+                photon_lamp_cached(ps, 3));
+    n = photon_lamp_lru(ps, order, 8);
+    assert_int_equal(order[0], 3);
+    assert_int_equal(order[1], 0);
+    assert_int_equal(order[2], 2);
+    assert_int_equal(photon_lamp_request(ps, 2), 1);
+    assert_int_equal(photon_lamp_request(ps, 1), 0); /* evicts 0 */
+    assert_false(photon_lamp_cached(ps, 0));
+    assert_int_equal(ps->st.lamp_hits, 2);
+    assert_int_equal(ps->st.lamp_misses, 5);
+    assert_int_equal(ps->st.lamp_evictions, 2);
+    assert_int_equal(ps->st.lamp_refined, 4); /* 0, 1, 2, 3; 1 again is not new */
+    assert_int_equal(photon_lamp_request(ps, 99), -1);
+    /* near the viewer: lamps within 25 m of x = 50 are 2 (x=50), 1 and 3 */
+    {
+        double eye[3] = {50.0, 5.0, 1.7};
+        ps->cfg.near_radius = 25.0;
+        photon_lamps_update(ps, eye);
+        n = photon_lamp_lru(ps, order, 8);
+        assert_int_equal(n, 3);
+        assert_int_equal(order[0], 2);
+        assert_true((order[1] == 1 && order[2] == 3) || (order[1] == 3 && order[2] == 1));
+    }
+    fx_close(&f);
+    /* capacity from the budget */
+    lamp_row(&f, 6);
+    c.lamp_slots = 0;
+    c.lamp_cache_bytes = (size_t)(2.5 * (double)photon_lamp_slot_bytes(&f.s, &c));
+    assert_int_equal(photon_create(&f.a, &f.s, &c, &ps), PLX_OK);
+    assert_int_equal(ps->nslots, 2);
+    fx_close(&f);
+}
+
+/* Push-pull: a lamp's ground indirect is the same whether it comes from the
+ * progressive aerial chart (never refined), from its cached floor map, or
+ * from the improved map after eviction; eviction and recomputation leave
+ * the answer unchanged. */
+static void test_lamp_push_pull(void **state)
+{
+    fixture f;
+    photon_sys *ps;
+    photon_config c;
+    double P[4][3] = {{30, 6, 0}, {24, 4, 0}, {36, 8, 0}, {30, 2, 0}}, n[3] = {0, 0, 1};
+    double prog[4], cached[4], pushed[4], again[4];
+    int i, k;
+    (void)state;
+    fx_open(&f, 64u << 20);
+    assert_true(ref_scene_add_box(&f.s, 0, 10, 60, 30, 15.0, 0.0) >= 0);
+    assert_true(ref_scene_add_lamp(&f.s, 30.0, 5.0, 6.0, 1000, 20.0) >= 0);
+    assert_true(ref_scene_add_lamp(&f.s, 150.0, 5.0, 6.0, 1000, 20.0) >= 0);
+    f.s.ground_albedo = 0.3;
+    fx_finish(&f);
+    photon_config_default(&c);
+    c.aerial_res = 128;
+    c.lamp_slots = 1;
+    c.lamp_res = 32;
+    c.lamp_photons = quick_mode() ? 100000 : 400000;
+    c.kernel_min = 1.5;
+    assert_int_equal(photon_create(&f.a, &f.s, &c, &ps), PLX_OK);
+    for (k = 0; k < (quick_mode() ? 10 : 40); k++)
+        photon_step(ps, 20000, 5 + k);
+    for (i = 0; i < 4; i++)
+        prog[i] = photon_indirect(ps, P[i], n);
+    assert_int_equal(photon_lamp_request(ps, 0), 0);
+    assert_int_equal(ps->gframes, 0); /* A restarted */
+    for (i = 0; i < 4; i++)
+        cached[i] = photon_indirect(ps, P[i], n);
+    assert_int_equal(photon_lamp_request(ps, 1), 0); /* evicts lamp 0: I keeps it */
+    for (i = 0; i < 4; i++)
+        pushed[i] = photon_indirect(ps, P[i], n);
+    assert_int_equal(photon_lamp_request(ps, 0), 0); /* recomputed, same photons */
+    for (i = 0; i < 4; i++)
+        again[i] = photon_indirect(ps, P[i], n);
+    printf("push-pull (ground near a refined lamp): progressive / cached / pushed / again\n");
+    for (i = 0; i < 4; i++) {
+        printf("  (%.0f,%.0f): %.4f %.4f %.4f %.4f\n", P[i][0], P[i][1], prog[i], cached[i],
+               pushed[i], again[i]);
+        assert_true(prog[i] > 0.0);
+        assert_true(fabs(cached[i] - prog[i]) < (quick_mode() ? 0.3 : 0.15) * prog[i]);
+        assert_true(fabs(pushed[i] - prog[i]) < (quick_mode() ? 0.3 : 0.15) * prog[i]);
+        assert_true(fabs(again[i] - cached[i]) <= 1e-4 * cached[i]);
+    }
+    /* the progressive pass no longer splats lamp 0 into A */
+    photon_step(ps, 20000, 999);
+    assert_true(ps->st.skipped_refined > 0.0);
+    fx_close(&f);
+}
+
+/* ---- levels --------------------------------------------------------------------- */
+
+static void test_levels_moving_viewer(void **state)
+{
+    void *mem;
+    plx_engine *e = open_fixture("fixtures/eixample-4x4.geojson", &mem, 256u << 20);
+    const scene *s = e->sc;
+    photon_sys *ps;
+    photon_config c;
+    double eye[3];
+    int step;
+    uint32_t k;
+    (void)state;
+    assert_int_equal(s->nblocks, 16);
+    photon_config_default(&c);
+    c.level_blocks[0] = 2;
+    c.level_blocks[1] = 3;
+    c.level_blocks[2] = 4;
+    c.level_blocks[3] = 3;
+    c.aerial_res = 64;
+    assert_int_equal(photon_create(&e->mem, s, &c, &ps), PLX_OK);
+    for (step = 0; step < 12; step++) {
+        uint32_t cnt[5] = {0, 0, 0, 0, 0}, a, b;
+        eye[0] = s->bounds[0] + (s->bounds[2] - s->bounds[0]) * step / 11.0;
+        eye[1] = s->bounds[1] + 0.3 * (s->bounds[3] - s->bounds[1]);
+        eye[2] = 1.7;
+        assert_int_equal(photon_set_viewer(ps, eye, NULL, 0.0), PLX_OK);
+        for (k = 0; k < s->nblocks; k++)
+            cnt[photon_block_level(ps, k)]++;
+        for (k = 0; k < 4; k++)
+            assert_true(cnt[k] <= c.level_blocks[k]);
+        /* 16 blocks, 12 slots: 4 at level 4, and the levels fill in order */
+        assert_int_equal(cnt[4], 4);
+        /* nearer blocks never get a coarser level */
+        for (a = 0; a < s->nblocks; a++)
+            for (b = 0; b < s->nblocks; b++) {
+                const double *ba = s->blocks[a].box, *bb = s->blocks[b].box;
+                double da = hypot(fmax(0, fmax(ba[0] - eye[0], eye[0] - ba[2])),
+                                  fmax(0, fmax(ba[1] - eye[1], eye[1] - ba[3])));
+                double db = hypot(fmax(0, fmax(bb[0] - eye[0], eye[0] - bb[2])),
+                                  fmax(0, fmax(bb[1] - eye[1], eye[1] - bb[3])));
+                if (da < db - 1e-9)
+                    assert_true(photon_block_level(ps, a) <= photon_block_level(ps, b));
+            }
+        /* slots are distinct per level */
+        for (a = 0; a < s->nblocks; a++)
+            for (b = a + 1; b < s->nblocks; b++)
+                if (ps->blevel[a] == ps->blevel[b] && ps->blevel[a] < PHOTON_LEVELS)
+                    assert_true(ps->bslot[a] != ps->bslot[b]);
+    }
+    /* buffers are kept while the level does not change */
+    {
+        uint32_t b0 = PHOTON_NONE, fr;
+        photon_step(ps, 4096, 1);
+        for (k = 0; k < s->nblocks; k++)
+            if (ps->blevel[k] == 0)
+                b0 = k;
+        assert_true(b0 != PHOTON_NONE);
+        fr = ps->lev[0].slot_frames[ps->bslot[b0]];
+        assert_int_equal(fr, 1);
+        eye[0] += 0.5; /* a small move: same levels */
+        assert_int_equal(photon_set_viewer(ps, eye, NULL, 0.0), PLX_OK);
+        assert_int_equal(ps->blevel[b0], 0);
+        assert_int_equal(ps->lev[0].slot_frames[ps->bslot[b0]], 1);
+        /* far away: it leaves level 0 and its new chart starts empty */
+        eye[0] = s->bounds[0];
+        eye[1] = s->bounds[1];
+        assert_int_equal(photon_set_viewer(ps, eye, NULL, 0.0), PLX_OK);
+        if (ps->blevel[b0] < PHOTON_LEVELS && ps->blevel[b0] != 0)
+            assert_int_equal(ps->lev[ps->blevel[b0]].slot_frames[ps->bslot[b0]], 0);
+        assert_true(ps->blevel[b0] != 0);
+    }
+    /* a view cone: blocks behind the viewer are not at level 0 or 1 */
+    {
+        double dir[3] = {1, 0, 0};
+        eye[0] = 0.5 * (s->bounds[0] + s->bounds[2]);
+        eye[1] = 0.5 * (s->bounds[1] + s->bounds[3]);
+        assert_int_equal(photon_set_viewer(ps, eye, dir, 60.0), PLX_OK);
+        for (k = 0; k < s->nblocks; k++)
+            if (s->blocks[k].box[2] < eye[0] - 1.0)
+                assert_true(photon_block_level(ps, k) >= 2);
+    }
+    plx_engine_destroy(e);
+    free(mem);
+}
+
+/* ---- histogram matching ----------------------------------------------------------- */
+
+static void test_hist_match(void **state)
+{
+    enum { N = 1000 };
+    static uint8_t src[N * 3], ref[N * 3], out[N * 3];
+    uint64_t rs = 3;
+    int i, c;
+    (void)state;
+    for (i = 0; i < N; i++)
+        for (c = 0; c < 3; c++) {
+            src[3 * i + c] = (uint8_t)(rng_next(&rs) % 256);
+            ref[3 * i + c] = (uint8_t)(rng_next(&rs) % 256);
+        }
+    /* to itself: identity */
+    assert_int_equal(photon_hist_match(src, N, src, N, 0.0, out), 0);
+    assert_memory_equal(src, out, sizeof src);
+    /* a uniform source onto a reference with values only 100 and 200 in
+     * equal parts: the lower half of each channel goes to 100, the rest to
+     * 200; the mapping is monotone */
+    for (i = 0; i < N; i++)
+        for (c = 0; c < 3; c++) {
+            src[3 * i + c] = (uint8_t)(i * 256 / N);
+            ref[3 * i + c] = (uint8_t)(i % 2 ? 200 : 100);
+        }
+    assert_int_equal(photon_hist_match(src, N, ref, N, 0.0, out), 0);
+    for (i = 0; i < N; i++)
+        for (c = 0; c < 3; c++) {
+            assert_true(out[3 * i + c] == 100 || out[3 * i + c] == 200);
+            assert_int_equal(out[3 * i + c], i < N / 2 ? 100 : 200);
+        }
+    /* a dark reference: pixels below the threshold are left out */
+    for (i = 0; i < N; i++) {
+        int dark = i % 4 != 0;
+        ref[3 * i] = dark ? 2 : 250;
+        ref[3 * i + 1] = dark ? 1 : 150;
+        ref[3 * i + 2] = dark ? 0 : 60;
+    }
+    assert_int_equal(photon_hist_match(src, N, ref, N, 0.0, out), 0);
+    assert_int_equal(out[0], 2); /* dark pixels count: the darkest go dark */
+    assert_int_equal(photon_hist_match(src, N, ref, N, 20.0, out), 0);
+    for (i = 0; i < N; i++) {
+        assert_int_equal(out[3 * i], 250);
+        assert_int_equal(out[3 * i + 1], 150);
+        assert_int_equal(out[3 * i + 2], 60);
+    }
+    /* all dark and a threshold above them: all are used */
+    assert_int_equal(photon_hist_match(src, N, ref + 3, 1, 200.0, out), 0);
+    assert_int_equal(out[0], 2);
+    /* in place */
+    memcpy(out, src, sizeof src);
+    assert_int_equal(photon_hist_match(out, N, ref, N, 20.0, out), 0);
+    assert_int_equal(out[5], 60);
+    assert_int_equal(photon_hist_match(NULL, N, ref, N, 0.0, out), -1);
+    assert_int_equal(photon_hist_match(src, 0, ref, N, 0.0, out), -1);
+}
+
+/* ---- memory ----------------------------------------------------------------------- */
+
+static void test_create_nomem(void **state)
+{
+    fixture f;
+    photon_sys *ps = NULL;
+    photon_config c;
+    uint64_t k;
+    arena_mark m;
+    plx_status st = PLX_E_NOMEM;
+    (void)state;
+    lamp_row(&f, 4);
+    photon_config_default(&c);
+    c.aerial_res = 64;
+    c.lamp_slots = 2;
+    c.lamp_res = 8;
+    m = arena_get_mark(&f.a);
+    for (k = 1; k < 1000 && st != PLX_OK; k++) {
+        f.a.requests = 0;
+        f.a.fail_at = k;
+        st = photon_create(&f.a, &f.s, &c, &ps);
+        if (st != PLX_OK) {
+            assert_int_equal(st, PLX_E_NOMEM);
+            assert_int_equal(f.a.lo, m.lo);
+            assert_int_equal(f.a.hi, m.hi);
+            assert_int_equal(f.a.used[PLX_PART_PHOTON], m.used[PLX_PART_PHOTON]);
+        }
+    }
+    f.a.fail_at = 0;
+    assert_int_equal(st, PLX_OK);
+    printf("photon_create: succeeded at request %llu; %zu bytes (photon_bytes %zu)\n",
+           (unsigned long long)(k - 1), f.a.used[PLX_PART_PHOTON] - m.used[PLX_PART_PHOTON],
+           photon_bytes(&f.s, &c));
+    assert_true(f.a.used[PLX_PART_PHOTON] - m.used[PLX_PART_PHOTON] <= photon_bytes(&f.s, &c));
+    /* a budget too small for the part */
+    {
+        photon_sys *p2;
+        f.a.budget[PLX_PART_PHOTON] = f.a.used[PLX_PART_PHOTON] + 1000;
+        assert_int_equal(photon_create(&f.a, &f.s, &c, &p2), PLX_E_NOMEM);
+        f.a.budget[PLX_PART_PHOTON] = 0;
+    }
+    /* bad configurations */
+    c.kernel_min = 3.0;
+    c.kernel_max = 2.0;
+    assert_int_equal(photon_create(&f.a, &f.s, &c, &ps), PLX_E_INVALID);
+    photon_config_default(&c);
+    c.chart_h = 4;
+    assert_int_equal(photon_create(&f.a, &f.s, &c, &ps), PLX_E_INVALID);
+    fx_close(&f);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_trace_vs_brute),
+        cmocka_unit_test(test_energy_closed_box),
+        cmocka_unit_test(test_one_bounce_wall),
+        cmocka_unit_test(test_accuracy_eixample),
+        cmocka_unit_test(test_lamp_lru),
+        cmocka_unit_test(test_lamp_push_pull),
+        cmocka_unit_test(test_levels_moving_viewer),
+        cmocka_unit_test(test_hist_match),
+        cmocka_unit_test(test_create_nomem),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
