@@ -298,6 +298,35 @@ plx_status plx_lit_ground(plx_engine *e, uint32_t k, const double **xy /* OUT */
 plx_status plx_lit_facade(plx_engine *e, uint32_t k, const double **xyz /* OUT */, uint32_t *n /* OUT */,
                           uint32_t *bld /* OUT */);
 
+/* ---- Indirect light (SPEC §4, photon buffers) ------------------------------ */
+
+/*
+ * One progressive frame of the photon pass: 'photons' photons shared among
+ * the lamps by flux, traced with diffuse bounces and splatted into the
+ * photon buffers (part PLX_PART_PHOTON, created on first need). After one or
+ * more frames plx_illuminance fills E_indirect and plx_render adds indirect
+ * light. Deterministic for (frames so far, photons, seed).
+ * Errors: PLX_E_NOSCENE, PLX_E_INVALID (photons == 0), PLX_E_NOMEM.
+ */
+plx_status plx_indirect_step(plx_engine *e, uint32_t photons, uint64_t seed);
+/* Frames accumulated so far (0 before the first step or after a reset). */
+uint64_t plx_indirect_frames(const plx_engine *e);
+/* Chart resolution levels for a viewer at eye looking along dir (unit, or
+ * NULL for all around) with a full cone of fov_deg (argudo2012 §3.6); blocks
+ * whose level changes start again. */
+plx_status plx_indirect_set_viewer(plx_engine *e, const double eye[3], const double dir[3], double fov_deg);
+/* Drops every accumulated photon. */
+plx_status plx_indirect_reset(plx_engine *e);
+
+/*
+ * Histogram matching of a day orthophoto to a night palette (munoz2013
+ * §3.1): each channel of day (npx RGB8 pixels) is mapped so its histogram
+ * follows night's (nnight pixels), leaving out night pixels darker than
+ * dark_threshold (luminance 0..255). out may be day. Needs no engine.
+ */
+plx_status plx_nightify(const uint8_t *day, size_t npx, const uint8_t *night, size_t nnight,
+                        double dark_threshold, uint8_t *out /* OUT */);
+
 /* ---- Night images (SPEC §5) ----------------------------------------------- */
 
 typedef struct plx_camera {
@@ -312,6 +341,7 @@ typedef struct plx_render_opts {
     int aerial;                 /* 1: ground from the aerial light map (built once) */
     double aerial_m_per_texel;  /* light map resolution (0: 1 m, coarser if the budget needs) */
     int no_cull;                /* 1: draw every building (the culled image is identical) */
+    int no_indirect;            /* 1: direct light only even when photons were traced */
 } plx_render_opts;
 
 void plx_render_opts_default(plx_render_opts *o /* OUT */);
@@ -325,7 +355,8 @@ typedef struct plx_render_info {
 /*
  * Renders one frame into caller-owned buffers: rgb8 (width*height*3 bytes,
  * sRGB after exposure, row 0 at the top) and/or rgbf (width*height*3 floats,
- * linear radiance); either may be NULL. Direct light only for now. The
+ * linear radiance); either may be NULL. Indirect light is added when photon
+ * frames were traced (plx_indirect_step) unless o->no_indirect. The
  * renderer's own buffers come from the engine (PLX_PART_FRAME) on first use.
  * Errors: PLX_E_INVALID (bad camera: eye below the ground, eye == target,
  * size above the maximum), PLX_E_NOSCENE, PLX_E_NOMEM.

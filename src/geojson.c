@@ -469,6 +469,7 @@ static void drop_scene(plx_engine *e)
     e->lt = NULL;
     e->lit_last = NULL;
     e->rd = NULL;
+    e->ph = NULL;
     e->lightmap_cell = 0.0;
     e->warnings = 0;
     eng_clear_error(e);

@@ -121,6 +121,8 @@ plx_status plx_illuminance(plx_engine *e, size_t n, const double *P, const doubl
             continue;
         }
         light_illuminance(e->lt, p, nn, &E_direct[k], c);
+        if (E_indirect)
+            E_indirect[k] = eng_indirect(e, p, nn);
     }
     if (bad) {
         memcpy(e->err, first, sizeof first);

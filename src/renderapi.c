@@ -17,6 +17,17 @@ void plx_render_opts_default(plx_render_opts *o)
     o->exposure = 1.0;
 }
 
+/* The photon hook of the renderer: scalar E_indirect tinted with the mean
+ * lamp colour. */
+static void shade_indirect(void *user, const double P[3], const double n[3], double rgb[3])
+{
+    plx_engine *e = user;
+    double E = eng_indirect(e, P, n);
+    rgb[0] = E * e->tint[0];
+    rgb[1] = E * e->tint[1];
+    rgb[2] = E * e->tint[2];
+}
+
 static plx_status need_render(plx_engine *e)
 {
     int32_t w = e->cfg.render_max_width ? e->cfg.render_max_width : DEFAULT_MAX_W;
@@ -75,6 +86,10 @@ plx_status plx_render(plx_engine *e, const plx_camera *cam, const plx_render_opt
     ro.no_glow = o->no_glow;
     ro.lightmap = o->aerial;
     ro.cull = o->no_cull ? RENDER_CULL_NONE : RENDER_CULL_ALL;
+    if (!o->no_indirect && e->ph && plx_indirect_frames(e) > 0) {
+        ro.indirect = shade_indirect;
+        ro.indirect_user = e;
+    }
     st = render_frame(e->rd, &rc, &ro, rgb8, rgbf, &rs);
     if (st == PLX_E_NOMEM)
         return eng_nomem(e, "rendering a frame");

@@ -34,6 +34,19 @@ int cli_common_option(const char *cmd, int argc, char **argv, int *i, cli_common
 /* Creates an engine and loads the scene; prints the error and returns an
  * exit code on failure (engine freed), EXIT_OK on success. */
 int cli_open_scene(const char *cmd, const char *path, const cli_common *c, plx_engine **e);
+/* Photon frames for indirect light (--photons, --frames, --no-indirect). */
+typedef struct cli_indirect {
+    long photons;    /* per frame (default 65536) */
+    long frames;     /* progressive frames (default 16) */
+    int off;         /* --no-indirect */
+} cli_indirect;
+void cli_indirect_default(cli_indirect *ind);
+/* Handles --photons N, --frames K, --no-indirect at argv[*i]; 1 if consumed, -1 on error. */
+int cli_indirect_option(const char *cmd, int argc, char **argv, int *i, cli_indirect *ind);
+/* Traces the frames (progress on a terminal), viewer at eye looking along
+ * dir (either may be NULL). Returns an exit code. */
+int cli_indirect_run(const char *cmd, plx_engine *e, const cli_indirect *ind, const double *eye,
+                     const double *dir, double fov_deg);
 /* Maps a status to an exit code. */
 int cli_exit_code(plx_status s);
 
@@ -46,6 +59,7 @@ int cmd_lit(int argc, char **argv);
 int cmd_heatmap(int argc, char **argv);
 int cmd_render(int argc, char **argv);
 int cmd_route(int argc, char **argv);
+int cmd_nightify(int argc, char **argv);
 int cmd_dark_spots(int argc, char **argv);
 
 #endif

@@ -13,18 +13,24 @@ static const char help[] =
     "metres and a unit normal; 'x y' alone means a ground point facing up,\n"
     "'x y z' a point facing up; '-' reads standard input). Prints one line\n"
     "'x y z E_direct E_indirect' per point, in lux. E_direct is exact (2.5D\n"
-    "shadows, SPEC §2); E_indirect is 0 until the photon buffers are computed.\n"
+    "shadows, SPEC §2); E_indirect comes from the photon buffers (SPEC §4),\n"
+    "traced first (--frames progressive frames of --photons photons; progress\n"
+    "on a terminal), 0 with --no-indirect.\n"
     "A point on no surface (inside a building, in the air) or with a normal\n"
     "into a building prints 'x y z nan nan', is reported on stderr with its\n"
     "line, and makes the exit code 1.\n"
     "\n"
     "  --points FILE  the points (required)\n"
+    "  --photons N    photons per frame (default 65536)\n"
+    "  --frames K     progressive photon frames (default 16)\n"
+    "  --no-indirect  direct light only (E_indirect 0)\n"
     "  --mem SIZE, --strict, --quiet   as for 'polarlux info'\n";
 
 int cmd_illum(int argc, char **argv)
 {
     static const double fill[6] = { 0, 0, 0, 0, 0, 1 };
     cli_common c;
+    cli_indirect ind;
     const char *scene = NULL, *file = NULL;
     plx_engine *e;
     points pts;
@@ -33,8 +39,11 @@ int cmd_illum(int argc, char **argv)
     size_t k;
     int i, rc, failed = 0;
     memset(&c, 0, sizeof c);
+    cli_indirect_default(&ind);
     for (i = 1; i < argc; i++) {
         int r = cli_common_option("illum", argc, argv, &i, &c);
+        if (r == 0)
+            r = cli_indirect_option("illum", argc, argv, &i, &ind);
         if (r < 0)
             return EXIT_USAGE;
         if (r)
@@ -67,6 +76,19 @@ int cmd_illum(int argc, char **argv)
     if (rc != EXIT_OK) {
         points_free(&pts);
         return rc;
+    }
+    if (!ind.off && pts.n > 0) {
+        double eye[3] = { 0, 0, 1.7 };
+        for (k = 0; k < pts.n; k++) {
+            eye[0] += pts.v[6 * k] / pts.n;
+            eye[1] += pts.v[6 * k + 1] / pts.n;
+        }
+        rc = cli_indirect_run("illum", e, &ind, eye, NULL, 360.0);
+        if (rc != EXIT_OK) {
+            points_free(&pts);
+            plx_engine_free(e);
+            return rc;
+        }
     }
     ed = malloc(sizeof *ed * (pts.n + 1));
     ei = malloc(sizeof *ei * (pts.n + 1));

@@ -30,7 +30,10 @@ static const char help[] =
     "  --texel M        aerial light map resolution (default 1 m)\n"
     "  --exposure E     radiance multiplier before sRGB (default 1.0, SPEC §5)\n"
     "  --no-glow        no lamp glows: every pixel is exactly SPEC §5's radiance\n"
-    "  --no-indirect    accepted; indirect light is not part of images yet\n"
+    "  --no-indirect    direct light only (default: indirect light from the photon\n"
+    "                   buffers, traced first; progress on a terminal)\n"
+    "  --photons N      photons per frame (default 65536)\n"
+    "  --frames K       progressive photon frames for the still image (default 16)\n"
     "  --backend B      soft (default, built in); osmesa is not built yet\n"
     "  -o FILE          output PNG (required)\n"
     "  --pfm FILE       also write the linear radiance as PFM\n"
@@ -42,6 +45,7 @@ typedef struct render_args {
     plx_camera cam;
     plx_render_opts opts;
     cli_common c;
+    cli_indirect ind;
 } render_args;
 
 static int parse_vec3(const char *s, double v[3])
@@ -110,12 +114,15 @@ static int parse_args(int argc, char **argv, render_args *a)
     size_t k;
     memset(a, 0, sizeof *a);
     plx_render_opts_default(&a->opts);
+    cli_indirect_default(&a->ind);
     a->cam.fov_deg = 60.0;
     a->cam.width = 640;
     a->cam.height = 480;
     for (i = 1; i < argc; i++) {
         const char *s = argv[i];
         int r = cli_common_option("render", argc, argv, &i, &a->c);
+        if (r == 0)
+            r = cli_indirect_option("render", argc, argv, &i, &a->ind);
         if (r < 0)
             return EXIT_USAGE;
         if (r)
@@ -128,8 +135,6 @@ static int parse_args(int argc, char **argv, render_args *a)
             a->opts.no_glow = 1;
             continue;
         }
-        if (strcmp(s, "--no-indirect") == 0)
-            continue;
         for (k = 0; k < sizeof valued / sizeof valued[0]; k++)
             if (strcmp(s, valued[k]) == 0)
                 break;
@@ -154,6 +159,7 @@ static int parse_args(int argc, char **argv, render_args *a)
     if (a->have_eye != a->have_target)
         return cli_usage_error("render", "give both --eye and --target, or neither");
     a->opts.aerial = a->aerial;
+    a->opts.no_indirect = a->ind.off;
     return EXIT_OK;
 }
 
@@ -279,6 +285,21 @@ int cmd_render(int argc, char **argv)
             fprintf(stderr, "polarlux render: found no free street spot beside a lamp; give --eye and --target\n");
             plx_engine_free(e);
             return EXIT_FAIL;
+        }
+    }
+    {
+        double dir[3], len;
+        int k;
+        for (k = 0; k < 3; k++)
+            dir[k] = a.cam.target[k] - a.cam.eye[k];
+        len = sqrt(dir[0] * dir[0] + dir[1] * dir[1] + dir[2] * dir[2]);
+        for (k = 0; k < 3 && len > 0; k++)
+            dir[k] /= len;
+        rc = cli_indirect_run("render", e, &a.ind, a.cam.eye, a.aerial || !(len > 0) ? NULL : dir,
+                              a.cam.fov_deg * a.cam.width / a.cam.height);
+        if (rc != EXIT_OK) {
+            plx_engine_free(e);
+            return rc;
         }
     }
     rgb8 = malloc((size_t)a.cam.width * a.cam.height * 3);

@@ -4,6 +4,8 @@
 #include <string.h>
 
 #include "cli.h"
+#include "port.h"
+#include <unistd.h>
 
 int cli_usage_error(const char *cmd, const char *fmt, ...)
 {
@@ -129,5 +131,63 @@ int cli_open_scene(const char *cmd, const char *path, const cli_common *c, plx_e
         *e = NULL;
         return st == PLX_E_INVALID ? EXIT_FAIL : cli_exit_code(st);
     }
+    return EXIT_OK;
+}
+
+void cli_indirect_default(cli_indirect *ind)
+{
+    ind->photons = 65536;
+    ind->frames = 16;
+    ind->off = 0;
+}
+
+int cli_indirect_option(const char *cmd, int argc, char **argv, int *i, cli_indirect *ind)
+{
+    const char *a = argv[*i];
+    if (strcmp(a, "--no-indirect") == 0) {
+        ind->off = 1;
+        return 1;
+    }
+    if (strcmp(a, "--photons") != 0 && strcmp(a, "--frames") != 0)
+        return 0;
+    if (*i + 1 >= argc) {
+        cli_usage_error(cmd, "%s needs a number", a);
+        return -1;
+    }
+    if (strcmp(a, "--photons") == 0 ? cli_parse_int(argv[++*i], 1, 100000000, &ind->photons)
+                                    : cli_parse_int(argv[++*i], 0, 100000, &ind->frames)) {
+        cli_usage_error(cmd, "%s '%s' is not a whole number in range", a, argv[*i]);
+        return -1;
+    }
+    return 1;
+}
+
+int cli_indirect_run(const char *cmd, plx_engine *e, const cli_indirect *ind, const double *eye,
+                     const double *dir, double fov_deg)
+{
+    long k;
+    int tty = isatty(2);
+    unsigned long long t0 = port_now_ns();
+    if (ind->off || ind->frames == 0)
+        return EXIT_OK;
+    if (eye) {
+        plx_status st = plx_indirect_set_viewer(e, eye, dir, fov_deg);
+        if (st != PLX_OK) {
+            fprintf(stderr, "polarlux %s: %s\n", cmd, plx_last_error(e));
+            return cli_exit_code(st);
+        }
+    }
+    for (k = 0; k < ind->frames; k++) {
+        plx_status st = plx_indirect_step(e, (uint32_t)ind->photons, (uint64_t)k + 1);
+        if (st != PLX_OK) {
+            fprintf(stderr, "%spolarlux %s: %s\n", tty ? "\n" : "", cmd, plx_last_error(e));
+            return cli_exit_code(st);
+        }
+        if (tty)
+            fprintf(stderr, "\rindirect light: frame %ld/%ld (%ld photons each), %.1f s", k + 1, ind->frames,
+                    ind->photons, (port_now_ns() - t0) / 1e9);
+    }
+    if (tty)
+        fprintf(stderr, "\n");
     return EXIT_OK;
 }

@@ -17,6 +17,7 @@ static const command commands[] = {
     { "lit", cmd_lit, "a lamp's lit ground and facade polygons as GeoJSON" },
     { "heatmap", cmd_heatmap, "a top-down ground illuminance map with a lux legend (PNG)" },
     { "render", cmd_render, "a night image (street or aerial view) as PNG, and PFM" },
+    { "nightify", cmd_nightify, "turn a day orthophoto into night colours (histogram matching)" },
     { "route", cmd_route, "how well lit is a route: lux statistics and EN 13201 P-class" },
     { "dark-spots", cmd_dark_spots, "the darkest points of the street area as GeoJSON" },
 };

@@ -24,7 +24,7 @@ expect help 0 "^usage: polarlux COMMAND" -- "$bin" --help
 expect no-args 2 "^usage: polarlux COMMAND" -- "$bin"
 expect version 0 "^polarlux [0-9]+\.[0-9]+\.[0-9]+$" -- "$bin" --version
 expect unknown-command 2 "unknown command 'frobnicate'" -- "$bin" frobnicate
-for c in info gen vis draw illum lit heatmap render route dark-spots; do
+for c in info gen vis draw illum lit heatmap render nightify route dark-spots; do
     expect "$c-help" 0 "^usage: polarlux $c" -- "$bin" $c --help
     expect "$c-unknown-option" 2 "polarlux $c: unknown option '--bogus'" -- "$bin" $c --bogus x
 done
@@ -73,7 +73,10 @@ expect draw-unwritable 1 "" -- "$bin" draw -q fixtures/tiny.geojson --polar 0 -o
 # illum: directly under lamp L2 (50, 10, z 8) in the courtyard:
 # E = I / z^2 * W(z/R) = 1000 / 64 * (1 - (8/30)^4)^2 = 15.4673748...
 printf '50 10\n50 10 0 0 0 1\n5 5 3 0 0 1\n' >"$tmp/i.txt"
-expect illum-under-lamp 1 "^50 10 0 15\.46737485749[0-9]* 0$" -- "$bin" illum -q fixtures/tiny.geojson --points "$tmp/i.txt"
+expect illum-under-lamp 1 "^50 10 0 15\.46737485749[0-9]* 0$" -- "$bin" illum -q --no-indirect fixtures/tiny.geojson --points "$tmp/i.txt"
+expect illum-indirect 1 "^50 10 0 15\.46737485749[0-9]* [0-9.]+(e-?[0-9]+)?$" -- "$bin" illum -q --frames 4 --photons 20000 fixtures/tiny.geojson --points "$tmp/i.txt"
+if grep -q "^50 10 0 15.46737485749[0-9]* 0$" "$tmp/out"; then echo "FAIL illum-indirect: E_indirect is 0 in a lit courtyard"; fail=$((fail + 1)); else echo "ok   illum-indirect-nonzero"; pass=$((pass + 1)); fi
+expect illum-bad-frames 2 "--frames 'x' is not a whole number" -- "$bin" illum -q fixtures/tiny.geojson --points "$tmp/i.txt" --frames x
 expect illum-inside 1 "i.txt:3: point \(5, 5, 3\) is inside a building's solid" -- "$bin" illum -q fixtures/tiny.geojson --points "$tmp/i.txt"
 expect illum-missing 2 "missing --points FILE" -- "$bin" illum fixtures/tiny.geojson
 expect lit-L1 0 "^lamp 0 \(L1\): [0-9]+ lit ground polygons, [0-9]+ lit facade polygons" -- "$bin" lit -q fixtures/tiny.geojson --lamp L1 -o "$tmp/lit.geojson"
@@ -96,6 +99,8 @@ expect render-eye-underground 2 "the eye must be above the ground" -- "$bin" ren
 expect render-eye-only 2 "give both --eye and --target" -- "$bin" render -q fixtures/tiny.geojson --eye 30,30,2 -o "$tmp/u.png"
 expect render-osmesa 1 "the osmesa backend is not built" -- "$bin" render -q fixtures/tiny.geojson --backend osmesa -o "$tmp/u.png"
 expect render-bad-size 2 "--size '12' is not WxH" -- "$bin" render -q fixtures/tiny.geojson --size 12 -o "$tmp/u.png"
+expect nightify-ok 0 "^nightify: 160x120 day image matched to 120x80 night reference" -- "$bin" nightify "$tmp/s.png" "$tmp/a.png" -o "$tmp/n.png"
+expect nightify-missing 1 "nope.png" -- "$bin" nightify "$tmp/nope.png" "$tmp/a.png" -o "$tmp/n2.png"
 ls "$tmp"/*.tmp* >/dev/null 2>&1 && { echo "FAIL temporary files left"; fail=$((fail + 1)); }
 echo "cli: $pass passed, $fail failed"
 [ "$fail" -eq 0 ]

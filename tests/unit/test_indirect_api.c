@@ -1,0 +1,142 @@
+/* The public indirect-light API: nothing before the first frame, a positive
+ * and deterministic E_indirect after, reset, the render hook, nightify, and
+ * memory exhaustion while creating the photon buffers. */
+#include <stdarg.h>
+#include <stddef.h>
+#include <setjmp.h>
+#include <stdint.h>
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+#include <cmocka.h>
+
+#include "polarlux.h"
+
+#define MEM (128u << 20)
+
+static plx_engine *open_tiny(void **mem)
+{
+    plx_engine *e;
+    plx_config cfg;
+    plx_port quiet = *plx_port_posix();
+    static plx_port port;
+    quiet.log = NULL;
+    port = quiet;
+    plx_config_default(&cfg);
+    cfg.port = &port;
+    *mem = malloc(MEM);
+    assert_int_equal(plx_engine_create(*mem, MEM, &cfg, &e), PLX_OK);
+    assert_int_equal(plx_load_file(e, "fixtures/tiny.geojson"), PLX_OK);
+    return e;
+}
+
+static void test_frames_and_values(void **state)
+{
+    void *m1, *m2;
+    plx_engine *a = open_tiny(&m1), *b = open_tiny(&m2);
+    /* a courtyard ground point under lamp L2 and a courtyard wall facing in */
+    double P[6] = { 50, 10, 0, 45, 10, 3 }, N[6] = { 0, 0, 1, 1, 0, 0 }, Ed[2], Ei[2], Eb[2], Ebi[2];
+    int k;
+    (void)state;
+    assert_int_equal(plx_illuminance(a, 2, P, N, Ed, Ei, NULL), PLX_OK);
+    assert_true(Ei[0] == 0.0 && Ei[1] == 0.0);
+    assert_int_equal(plx_indirect_frames(a), 0);
+    for (k = 0; k < 4; k++) {
+        assert_int_equal(plx_indirect_step(a, 20000, (uint64_t)k + 1), PLX_OK);
+        assert_int_equal(plx_indirect_step(b, 20000, (uint64_t)k + 1), PLX_OK);
+    }
+    assert_int_equal(plx_indirect_frames(a), 4);
+    assert_int_equal(plx_illuminance(a, 2, P, N, Ed, Ei, NULL), PLX_OK);
+    assert_int_equal(plx_illuminance(b, 2, P, N, Eb, Ebi, NULL), PLX_OK);
+    /* light bounces off the courtyard's walls and ground: both get some */
+    assert_true(Ei[0] > 0.0 && Ei[1] > 0.0);
+    /* the 10 x 10 m courtyard with 12 m walls of albedo 0.5 is nearly a
+     * closed box, whose indirect/direct ratio is at most rho / (1 - rho) = 1 */
+    assert_true(Ei[0] < Ed[0]);
+    /* deterministic */
+    assert_true(Ei[0] == Ebi[0] && Ei[1] == Ebi[1]);
+    assert_int_equal(plx_indirect_reset(a), PLX_OK);
+    assert_int_equal(plx_indirect_frames(a), 0);
+    assert_int_equal(plx_illuminance(a, 2, P, N, Ed, Ei, NULL), PLX_OK);
+    assert_true(Ei[0] == 0.0);
+    assert_int_equal(plx_indirect_step(a, 0, 1), PLX_E_INVALID);
+    plx_engine_destroy(a);
+    plx_engine_destroy(b);
+    free(m1);
+    free(m2);
+}
+
+static void test_render_hook(void **state)
+{
+    void *mem;
+    plx_engine *e = open_tiny(&mem);
+    plx_camera cam = { { 30, 30, 1.7 }, { 50, 10, 2 }, 60, 64, 48 };
+    plx_render_opts o;
+    float with[64 * 48 * 3], without[64 * 48 * 3];
+    double sum_with = 0, sum_without = 0;
+    int i;
+    (void)state;
+    plx_render_opts_default(&o);
+    o.no_glow = 1;
+    assert_int_equal(plx_indirect_step(e, 20000, 1), PLX_OK);
+    assert_int_equal(plx_render(e, &cam, &o, NULL, with, NULL), PLX_OK);
+    o.no_indirect = 1;
+    assert_int_equal(plx_render(e, &cam, &o, NULL, without, NULL), PLX_OK);
+    for (i = 0; i < 64 * 48 * 3; i++) {
+        assert_true(with[i] >= without[i]);
+        sum_with += with[i];
+        sum_without += without[i];
+    }
+    assert_true(sum_with > sum_without);
+    plx_engine_destroy(e);
+    free(mem);
+}
+
+static void test_nightify(void **state)
+{
+    uint8_t day[4 * 3] = { 10, 10, 10, 20, 20, 20, 30, 30, 30, 40, 40, 40 };
+    uint8_t night[4 * 3] = { 0, 0, 0, 100, 50, 20, 200, 100, 40, 250, 125, 50 };
+    uint8_t out[12];
+    (void)state;
+    /* with the black pixel left out, the three brightest night colours remain */
+    assert_int_equal(plx_nightify(day, 4, night, 4, 10.0, out), PLX_OK);
+    assert_true(out[0] == 100 && out[1] == 50 && out[2] == 20);
+    assert_true(out[9] == 250 && out[10] == 125 && out[11] == 50);
+    assert_int_equal(plx_nightify(day, 0, night, 4, 10.0, out), PLX_E_INVALID);
+}
+
+static void test_nomem(void **state)
+{
+    void *mem;
+    plx_engine *e = open_tiny(&mem);
+    plx_memory_report before, after;
+    plx_status st = PLX_E_NOMEM;
+    uint64_t k;
+    (void)state;
+    plx_memory_get(e, &before);
+    for (k = 1; st == PLX_E_NOMEM; k++) {
+        plx_debug_fail_alloc(e, k);
+        st = plx_indirect_step(e, 1000, 1);
+        if (st == PLX_E_NOMEM) {
+            plx_memory_get(e, &after);
+            assert_int_equal(after.used_total, before.used_total);
+            assert_non_null(strstr(plx_last_error(e), "creating the photon buffers"));
+        }
+    }
+    assert_int_equal(st, PLX_OK);
+    assert_true(k > 3);
+    plx_debug_fail_alloc(e, 0);
+    plx_engine_destroy(e);
+    free(mem);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_frames_and_values),
+        cmocka_unit_test(test_render_hook),
+        cmocka_unit_test(test_nightify),
+        cmocka_unit_test(test_nomem),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
