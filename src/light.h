@@ -52,7 +52,9 @@
  *
  *    Lit polygons (the output of a region):
  *    - ground: "angular trapezoids" (3 or 4 corners, counter-clockwise, two
- *      sides on rays from O) covering the lit ground within the ground reach
+ *      sides on rays from O; a run of unshadowed 1-degree pieces is one fan
+ *      ring O, chord points..., of up to 64 points) covering the lit ground
+ *      within the ground reach
  *      Rg = sqrt(R^2 - zL^2). Sectors are further cut at the rays every 1
  *      degree and at the directions where two boundary lines (scaled edges,
  *      the reach chord) cross, so that inside each piece the order of the
@@ -78,7 +80,10 @@
  * Memory: everything comes from the arena. light_create takes the object,
  * the two grids, per-lamp cache entries and a pool of cache_bytes, all in
  * part PLX_PART_LIT. Regions live in the pool, least recently used evicted
- * first (then the pool is compacted). Computing a region uses scratch
+ * first (then the pool is compacted). Queries cache index-only regions
+ * (sectors, bands, lines: ~2 KiB a lamp); light_region replaces one by the
+ * full region with polygons (~15-20 KiB). A lamp no query reaches is never
+ * computed. Computing a region uses scratch
  * memory (arena_scratch, released before return): the working arrays, and
  * an output buffer of at most the pool's size. Queries allocate nothing
  * except when a region has to be computed. No global state; one light
@@ -128,7 +133,7 @@ typedef struct lit_region {
     const uint32_t *sec_first; /* nsec + 1 offsets into band */
     const lit_band *band;      uint32_t nband;
     const lit_line *line;      uint32_t nline;
-    /* output polygons */
+    /* output polygons (polygons == 1; an array is NULL when its count is 0) */
     const lit_ring *ground;    uint32_t nground;
     const vec2 *gpts;          uint32_t ngpts;
     const lit_ring *facade;    uint32_t nfacade;

@@ -484,7 +484,8 @@ static plx_status index_emit(lr_work *w, uint32_t lamp)
 
 /* A boundary line of the ground pieces: the points O + t u of the line have
  * t = c / cross(u, e) (a scaled edge line, or the reach chord). */
-typedef struct gline { double ex, ey, c; } gline;
+typedef struct gline { double ex, ey, c; int near; } gline;
+/* near: the line comes within the reach circle (else it cannot meet a chord) */
 
 /* Bounds of one shadow interval along a ray: indices into the lines; -1 is
  * O for lo and infinity for hi. */
@@ -498,6 +499,11 @@ typedef struct gpiece {
     int nline;
     gspan span[G_MAXB];
     int nspan;
+    vec2 scut[LR_MAXCUT];    /* where two band lines cross (t > 0), per sector, */
+    double sang[LR_MAXCUT];  /* by pseudo-angle (unwrapped from the sector start) */
+    int nscut, next_cut;
+    double p0, p1;           /* pseudo-angles of the piece's rays (unwrapped) */
+    double rg;               /* the ground reach */
     int fan;                 /* 1 while a fan ring of unshadowed pieces is open */
     lit_ring *fan_ring;
 } gpiece;
@@ -522,14 +528,18 @@ static int add_gline(gpiece *g, const lit_line *l, double scale)
     d->ex = l->ex;
     d->ey = l->ey;
     d->c = l->c * scale;
+    d->near = fabs(d->c) < g->rg * sqrt(d->ex * d->ex + d->ey * d->ey);
     return g->nline++;
 }
 
-/* The shadow intervals of sector i's bands on the ground within piece g. */
-static void piece_spans(const lr_work *w, uint32_t i, gpiece *g)
+/* The shadow intervals of sector i's bands on the ground (lines from 1 on;
+ * line 0 is the reach chord, set per piece). A band whose scaled near line
+ * stays outside the reach circle shadows nothing within reach. */
+static void sector_spans(const lr_work *w, uint32_t i, gpiece *g)
 {
     uint32_t k;
     g->nspan = 0;
+    g->nline = 1;
     for (k = w->sec_first[i]; k < w->sec_first[i + 1] && g->nspan < G_MAXB; k++) {
         const lit_band *b = &w->band[k];
         const scene_building *bd = &w->s->bld[b->bld];
@@ -538,15 +548,11 @@ static void piece_spans(const lr_work *w, uint32_t i, gpiece *g)
             continue;                       /* no ground shadow */
         sp->lo = -1;
         if (b->lo != LIT_NONE) {
+            const lit_line *l = &w->line[b->lo];
             double cm = w->zl / (w->zl - bd->min_height);
-            gline tmp;
-            tmp.ex = w->line[b->lo].ex;
-            tmp.ey = w->line[b->lo].ey;
-            tmp.c = w->line[b->lo].c * cm;
-            if (gl_t(&tmp, g->d0) >= gl_t(&g->line[0], g->d0) &&
-                gl_t(&tmp, g->d1) >= gl_t(&g->line[0], g->d1))
+            if (fabs(l->c * cm) >= w->Rg * sqrt(l->ex * l->ex + l->ey * l->ey))
                 continue;                   /* beyond the reach */
-            sp->lo = add_gline(g, &w->line[b->lo], cm);
+            sp->lo = add_gline(g, l, cm);
         }
         sp->hi = -1;
         if (b->hi != LIT_NONE && bd->height < w->zl)
@@ -555,40 +561,80 @@ static void piece_spans(const lr_work *w, uint32_t i, gpiece *g)
     }
 }
 
-/* Directions strictly inside the piece where two of its lines cross, sorted. */
-static int piece_cuts(const gpiece *g, vec2 *cut)
+/* Direction (t > 0 side) where lines a and b cross; 0 if parallel. */
+static int line_cross_dir(const gline *a, const gline *b, vec2 *v)
 {
-    int p, q, n = 0, i, j;
-    double key[LR_MAXCUT];
-    for (p = 0; p < g->nline; p++)
-        for (q = p + 1; q < g->nline && n < LR_MAXCUT; q++) {
-            const gline *a = &g->line[p], *b = &g->line[q];
-            vec2 v;
-            double t, k;
-            v.x = a->c * b->ex - b->c * a->ex;
-            v.y = a->c * b->ey - b->c * a->ey;
-            if (v.x == 0.0 && v.y == 0.0)
+    double den;
+    v->x = a->c * b->ex - b->c * a->ex;
+    v->y = a->c * b->ey - b->c * a->ey;
+    den = cross2(v->x, v->y, a->ex, a->ey);
+    if (den == 0.0 || a->c == 0.0)
+        return 0;
+    if ((a->c > 0.0) != (den > 0.0)) {       /* t = c / den < 0 */
+        v->x = -v->x;
+        v->y = -v->y;
+    }
+    return 1;
+}
+
+/* The crossings of the band lines (line 1 on), once per sector, sorted by
+ * pseudo-angle counted from the sector's start a0. */
+static void sector_cuts(gpiece *g, double a0)
+{
+    int p, q, i;
+    vec2 v;
+    g->nscut = g->next_cut = 0;
+    for (p = 1; p < g->nline; p++)
+        for (q = p + 1; q < g->nline && g->nscut < LR_MAXCUT; q++) {
+            double a;
+            if (!line_cross_dir(&g->line[p], &g->line[q], &v))
                 continue;
-            t = gl_t(a, v);
-            if (!isfinite(t) || t == 0.0)
-                continue;
-            if (t < 0.0) {
-                v.x = -v.x;
-                v.y = -v.y;
+            a = light_pseudo_angle(v.x, v.y);
+            if (a < a0)
+                a += 4.0;
+            for (i = g->nscut; i > 0 && g->sang[i - 1] > a; i--) {
+                g->sang[i] = g->sang[i - 1];
+                g->scut[i] = g->scut[i - 1];
             }
-            if (!(cross2(g->d0.x, g->d0.y, v.x, v.y) > 0.0 &&
-                  cross2(v.x, v.y, g->d1.x, g->d1.y) > 0.0))
-                continue;
-            k = cross2(g->d0.x, g->d0.y, v.x, v.y) / (g->d0.x * v.x + g->d0.y * v.y);
-            for (i = n; i > 0 && key[i - 1] > k; i--) {
-                key[i] = key[i - 1];
-                cut[i] = cut[i - 1];
-            }
-            key[i] = k;
-            cut[i] = v;
-            n++;
+            g->sang[i] = a;
+            g->scut[i] = v;
+            g->nscut++;
         }
-    for (i = 1, j = 0; i < n; i++)          /* drop repeats */
+}
+
+/* Keeps v when strictly inside the piece, in order of angle. */
+static int insert_cut(const gpiece *g, vec2 v, vec2 *cut, double *key, int n)
+{
+    double k;
+    int i;
+    if (n >= LR_MAXCUT || !(cross2(g->d0.x, g->d0.y, v.x, v.y) > 0.0 &&
+                            cross2(v.x, v.y, g->d1.x, g->d1.y) > 0.0))
+        return n;
+    k = cross2(g->d0.x, g->d0.y, v.x, v.y) / (g->d0.x * v.x + g->d0.y * v.y);
+    for (i = n; i > 0 && key[i - 1] > k; i--) {
+        key[i] = key[i - 1];
+        cut[i] = cut[i - 1];
+    }
+    key[i] = k;
+    cut[i] = v;
+    return n + 1;
+}
+
+/* Directions strictly inside the piece where two of its lines cross, sorted
+ * and without repeats. */
+static int piece_cuts(gpiece *g, vec2 *cut)
+{
+    int p, n = 0, i, j;
+    double key[LR_MAXCUT];
+    vec2 v;
+    while (g->next_cut < g->nscut && g->sang[g->next_cut] < g->p0)
+        g->next_cut++;
+    for (p = g->next_cut; p < g->nscut && g->sang[p] <= g->p1; p++)
+        n = insert_cut(g, g->scut[p], cut, key, n);
+    for (p = 1; p < g->nline; p++)
+        if (g->line[p].near && line_cross_dir(&g->line[0], &g->line[p], &v))
+            n = insert_cut(g, v, cut, key, n);
+    for (i = 1, j = 0; i < n; i++)
         if (key[i] != key[j])
             cut[++j] = cut[i], key[j] = key[i];
     return n ? j + 1 : 0;
@@ -723,8 +769,7 @@ static plx_status ground_piece(lr_work *w, uint32_t i, gpiece *g, int cell)
     g->line[0].ex = w->Rg * (r1[0] - r0[0]);
     g->line[0].ey = w->Rg * (r1[1] - r0[1]);
     g->line[0].c = cross2(w->Rg * r0[0], w->Rg * r0[1], g->line[0].ex, g->line[0].ey);
-    g->nline = 1;
-    piece_spans(w, i, g);
+    (void)i;
     if (g->nspan == 0)
         return ground_fan(w, g);
     g->fan = 0;
@@ -763,20 +808,27 @@ static plx_status ground_emit(lr_work *w, gpiece *g)
         double a1 = i + 1 < w->nsec ? w->bang[i + 1] : w->bang[0] + 4.0;
         int kk = ray_after(L, w->bang[i]);
         int cell = (kk + 359) % 360;
+        g->rg = w->Rg;
+        sector_spans(w, i, g);
+        sector_cuts(g, w->bang[i]);
         g->d0 = w->bdir[i];
+        g->p0 = w->bang[i];
         for (;; kk++) {
             double ra = kk < 360 ? L->ray_ang[kk] : L->ray_ang[kk - 360] + 4.0;
             if (kk >= 720 || !(ra < a1))
                 break;
             g->d1.x = L->ray_dir[kk % 360][0];
             g->d1.y = L->ray_dir[kk % 360][1];
+            g->p1 = ra;
             st = ground_piece(w, i, g, cell);
             if (st != PLX_OK)
                 return st;
             g->d0 = g->d1;
+            g->p0 = ra;
             cell = kk % 360;
         }
         g->d1 = w->bdir[i + 1 < w->nsec ? i + 1 : 0];
+        g->p1 = a1;
         st = ground_piece(w, i, g, cell);
     }
     return st;
@@ -1223,8 +1275,10 @@ static void evict(light *L, uint32_t i)
     L->st.evictions++;
 }
 
-/* Fixes the pointers of a region copied from 'from' to 'to'. */
-#define REBASE(p, T) ((p) = (T)(void *)(to + ((const unsigned char *)(const void *)(p) - from)))
+/* Fixes the pointers of a region copied from 'from' to 'to' (arrays an
+ * index-only region lacks stay NULL). */
+#define REBASE(p, T) \
+    ((p) = (p) ? (T)(void *)(to + ((const unsigned char *)(const void *)(p) - from)) : NULL)
 static void rebase(lit_region *r, const unsigned char *from, unsigned char *to)
 {
     REBASE(r->sec_ang, const double *);

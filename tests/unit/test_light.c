@@ -1006,9 +1006,9 @@ static int same_region(const lit_region *a, const lit_region *b)
 {
     return a->nsec == b->nsec && a->nband == b->nband && a->nground == b->nground &&
            a->nfacade == b->nfacade && a->bytes == b->bytes &&
-           memcmp(a->band, b->band, a->nband * sizeof *a->band) == 0 &&
-           memcmp(a->gpts, b->gpts, a->ngpts * sizeof *a->gpts) == 0 &&
-           memcmp(a->fpts, b->fpts, a->nfpts * sizeof *a->fpts) == 0;
+           (!a->nband || memcmp(a->band, b->band, a->nband * sizeof *a->band) == 0) &&
+           (!a->ngpts || memcmp(a->gpts, b->gpts, a->ngpts * sizeof *a->gpts) == 0) &&
+           (!a->nfpts || memcmp(a->fpts, b->fpts, a->nfpts * sizeof *a->fpts) == 0);
 }
 
 static void test_cache_lru(void **state)
