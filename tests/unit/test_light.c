@@ -4,7 +4,7 @@
  * region cache, point classification.
  *
  * PLX_LIGHT_POINTS=N sets the number of random points per generated scene
- * (default 1500 over 14 scenes, plus the fixtures); PLX_TEST_QUICK=1 makes
+ * (default 5500 over 14 scenes, plus 10000, 10000 and 6000 on the eixample, oldtown and Helsinki fixtures: over 100,000 points); PLX_TEST_QUICK=1 makes
  * it smaller. */
 #include <stdarg.h>
 #include <stddef.h>
@@ -399,7 +399,7 @@ static void compare_scene(const scene *s, long npts, uint64_t seed, size_t cache
 
 static void test_random_scenes(void **state)
 {
-    long per = env_long("PLX_LIGHT_POINTS", quick() ? 300 : 1500);
+    long per = env_long("PLX_LIGHT_POINTS", quick() ? 300 : 5500);
     tally sum;
     int kind, seed;
     (void)state;
@@ -511,19 +511,19 @@ static void compare_fixture(const char *path, long npts)
 static void test_fixture_eixample(void **state)
 {
     (void)state;
-    compare_fixture("fixtures/eixample-4x4.geojson", env_long("PLX_LIGHT_POINTS", quick() ? 400 : 4000));
+    compare_fixture("fixtures/eixample-4x4.geojson", env_long("PLX_LIGHT_POINTS", quick() ? 400 : 10000));
 }
 
 static void test_fixture_oldtown(void **state)
 {
     (void)state;
-    compare_fixture("fixtures/oldtown-8x8.geojson", env_long("PLX_LIGHT_POINTS", quick() ? 400 : 4000));
+    compare_fixture("fixtures/oldtown-8x8.geojson", env_long("PLX_LIGHT_POINTS", quick() ? 400 : 10000));
 }
 
 static void test_fixture_helsinki(void **state)
 {
     (void)state;
-    compare_fixture("fixtures/helsinki-centre.geojson", env_long("PLX_LIGHT_POINTS", quick() ? 200 : 1200));
+    compare_fixture("fixtures/helsinki-centre.geojson", env_long("PLX_LIGHT_POINTS", quick() ? 200 : 6000));
 }
 
 /* ---- hand-checked cases ---------------------------------------------------------------- */
