@@ -99,7 +99,7 @@ $(BUILD)/bench/bench_%: $(BUILD)/tests/bench/bench_%.o $(REF_OBJ) $(LIB_A)
 	@mkdir -p $(@D)
 	$(CC) $(CFLAGS_ALL) -o $@ $< $(REF_OBJ) $(LIB_A) $(LIBS)
 
-include port/osmesa/osmesa.mk
+-include port/osmesa/osmesa.mk
 -include $(shell find $(BUILD) -name '*.d' 2>/dev/null)
 
 # ---- the main job -------------------------------------------------------------
