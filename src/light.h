@@ -51,17 +51,24 @@
  *    raised ones).
  *
  *    Lit polygons (the output of a region):
- *    - ground: "angular trapezoids" (3 or 4 corners, counter-clockwise, two
- *      sides on rays from O; a run of unshadowed 1-degree pieces is one fan
- *      ring O, chord points..., of up to 64 points) covering the lit ground
- *      within the ground reach
- *      Rg = sqrt(R^2 - zL^2). Sectors are further cut at the rays every 1
- *      degree and at the directions where two boundary lines (scaled edges,
- *      the reach chord) cross, so that inside each piece the order of the
- *      lines along a ray is fixed. The reach circle is replaced by the chord
- *      between consecutive 1-degree rays: the ground between chord and arc
- *      (at most R (1 - cos 0.5 deg) ~ 3.8e-5 R deep) is left out, where
- *      W(d/R) <= 3e-8 (W(1) = 0), so the light missed there is nil.
+ *    - ground: rings, counter-clockwise, covering the lit ground
+ *      within the reach polygon: the 360-gon inscribed in the circle of the
+ *      ground reach Rg = sqrt(R^2 - zL^2), its vertices on the rays every
+ *      1 degree. Inside a sector the bounds along a ray (scaled edge lines,
+ *      the reach polygon) keep their order except where two lines cross or
+ *      a line crosses the reach polygon (found from the side each line is
+ *      on at the rays: within one chord's span it crosses that chord
+ *      exactly when its side changes); those directions cut the sector into
+ *      sub-sectors, and each lit interval of a sub-sector is one ring: a
+ *      quad (a triangle from O) between two lines, or a ring from a line
+ *      (or O) out to the reach polygon through the vertices of the rays in
+ *      between. Rings following the reach polygon have at most 64 points
+ *      (longer runs are split at a ray); runs of unshadowed sectors are
+ *      one fan ring O, reach points... Crossings of two lines beyond the
+ *      reach circle are not cuts (nothing there is kept). The ground
+ *      between chord and arc (at most R (1 - cos 0.5 deg) ~ 3.8e-5 R deep)
+ *      is left out, where W(d/R) <= 3e-8 (W(1) = 0), so the light missed
+ *      there is nil; the visibility queries are not cut off.
  *    - facades: on every wall facing the lamp (O strictly on its outer
  *      side) that comes within R horizontally, quads in the wall's vertical
  *      plane (3D corners, counter-clockwise seen from outside) covering its
@@ -82,7 +89,7 @@
  * part PLX_PART_LIT. Regions live in the pool, least recently used evicted
  * first (then the pool is compacted). Queries cache index-only regions
  * (sectors, bands, lines: ~2 KiB a lamp); light_region replaces one by the
- * full region with polygons (~15-20 KiB). A lamp no query reaches is never
+ * full region with polygons (~5-10 KiB). A lamp no query reaches is never
  * computed. Computing a region uses scratch
  * memory (arena_scratch, released before return): the working arrays, and
  * an output buffer of at most the pool's size. Queries allocate nothing

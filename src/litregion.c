@@ -8,7 +8,6 @@
 #include <string.h>
 
 #define LR_ALIGN 16
-#define LR_MAXCUT 64         /* crossing directions kept per piece */
 
 /* ---- output buffer: arrays growing up, rings growing down ------------------ */
 
@@ -41,6 +40,7 @@ typedef struct lr_edge {
     uint32_t va, vb;         /* scene point indices of the edge a -> b */
     int o;                   /* orient(O, a, b): > 0 exit (O on the interior side) */
     double a0, a1;           /* pseudo-angles of its span, counter-clockwise */
+    uint32_t s0, s1;         /* its sectors [s0, s1) with wrap (set by incidences) */
 } lr_edge;
 
 typedef struct lr_key { uint32_t cand, edge; double t; } lr_key;
@@ -290,7 +290,7 @@ static plx_status edges(lr_work *w, uint32_t nv)
     return PLX_OK;
 }
 
-/* Calls the sector range of edge e: sectors [i0, i1) with wrap. */
+/* The sector range of edge e: sectors [i0, i1) with wrap. */
 static void edge_range(const lr_work *w, const lr_edge *e, uint32_t *i0, uint32_t *i1)
 {
     *i0 = find_sector(w->bang, w->nsec, e->a0);
@@ -300,14 +300,15 @@ static void edge_range(const lr_work *w, const lr_edge *e, uint32_t *i0, uint32_
 /* Lists the active edges of every sector (CSR). */
 static plx_status incidences(lr_work *w)
 {
-    uint32_t k, i, i0, i1, total = 0;
+    uint32_t k, i, total = 0;
     w->inc_first = arena_scratch(w->L->a, arena_mul(w->nsec + 2, sizeof(uint32_t)), LR_ALIGN);
     if (!w->inc_first)
         return PLX_E_NOMEM;
     memset(w->inc_first, 0, (w->nsec + 2) * sizeof(uint32_t));
     for (k = 0; k < w->nedge; k++) {
-        edge_range(w, &w->edge[k], &i0, &i1);
-        for (i = i0; i != i1; i = (i + 1 == w->nsec ? 0 : i + 1)) {
+        lr_edge *e = &w->edge[k];
+        edge_range(w, e, &e->s0, &e->s1);
+        for (i = e->s0; i != e->s1; i = (i + 1 == w->nsec ? 0 : i + 1)) {
             w->inc_first[i + 1]++;
             total++;
         }
@@ -319,11 +320,9 @@ static plx_status incidences(lr_work *w)
     w->key = arena_scratch(w->L->a, arena_mul(total + 1, sizeof(lr_key)), LR_ALIGN);
     if (!w->inc || !w->key)
         return PLX_E_NOMEM;
-    for (k = 0; k < w->nedge; k++) {
-        edge_range(w, &w->edge[k], &i0, &i1);
-        for (i = i0; i != i1; i = (i + 1 == w->nsec ? 0 : i + 1))
+    for (k = 0; k < w->nedge; k++)
+        for (i = w->edge[k].s0; i != w->edge[k].s1; i = (i + 1 == w->nsec ? 0 : i + 1))
             w->inc[w->inc_first[i]++] = k;
-    }
     for (i = w->nsec; i > 0; i--)
         w->inc_first[i] = w->inc_first[i - 1];
     w->inc_first[0] = 0;
@@ -482,31 +481,57 @@ static plx_status index_emit(lr_work *w, uint32_t lamp)
 
 /* ---- lit ground polygons ---------------------------------------------------------- */
 
-/* A boundary line of the ground pieces: the points O + t u of the line have
- * t = c / cross(u, e) (a scaled edge line, or the reach chord). */
-typedef struct gline { double ex, ey, c; int near; } gline;
-/* near: the line comes within the reach circle (else it cannot meet a chord) */
+/* The ground is built sector by sector. Within a sector the lines bounding
+ * the shadows (scaled edge lines) are straight, and the outer bound is the
+ * reach polygon (the 360-gon inscribed in the circle of radius Rg, vertices
+ * on the 1-degree rays). The order of all bounds along a ray changes only
+ * where two lines cross or where a line crosses the reach polygon; those
+ * directions cut the sector into sub-sectors, and each lit interval of a
+ * sub-sector becomes one polygon: a quad (a triangle from O) between two
+ * lines, or a ring whose outer side follows the reach polygon through the
+ * vertices of the rays inside the sub-sector. */
 
-/* Bounds of one shadow interval along a ray: indices into the lines; -1 is
+/* A boundary line: the points O + t u of the line have t = c / cross(u, e)
+ * (a scaled edge line, or a chord of the reach polygon). */
+typedef struct gline { double ex, ey, c; int near; } gline;
+/* near: the line comes within the reach circle (else it cannot meet the
+ * reach polygon) */
+
+/* Bounds of one shadow interval along a ray: indices into the lines; G_O is
  * O for lo and infinity for hi. */
 typedef struct gspan { int lo, hi; double tlo, thi; } gspan;
 
-#define G_MAXB 64            /* shadow intervals kept per piece */
+/* A cut direction of a sector and its pseudo-angle (unwrapped from the
+ * sector's start). */
+typedef struct gcut { vec2 v; double a; } gcut;
+
+#define G_MAXB 64            /* shadow intervals kept per sector */
+#define G_O (-1)             /* O (lower bound), infinity (upper bound) */
+#define G_RING_MAX 64        /* points of a ring following the reach polygon */
 
 typedef struct gpiece {
-    vec2 d0, d1;             /* the piece's rays, counter-clockwise */
-    gline line[2 * G_MAXB + 1];  /* [0] the chord */
+    gline line[2 * G_MAXB];
     int nline;
     gspan span[G_MAXB];
     int nspan;
-    vec2 scut[LR_MAXCUT];    /* where two band lines cross (t > 0), per sector, */
-    double sang[LR_MAXCUT];  /* by pseudo-angle (unwrapped from the sector start) */
-    int nscut, next_cut;
-    double p0, p1;           /* pseudo-angles of the piece's rays (unwrapped) */
+    gcut *cut;               /* scratch, cutcap entries */
+    uint32_t ncut, cutcap;
+    unsigned char before[2 * G_MAXB]; /* per line: inside the reach polygon */
     double rg;               /* the ground reach */
-    int fan;                 /* 1 while a fan ring of unshadowed pieces is open */
-    lit_ring *fan_ring;
+    lit_ring *fan;           /* the last ring, when it is a fan O, reach... */
+    double fan_a;            /* pseudo-angle where the open fan ends */
 } gpiece;
+
+/* Cut directions a sector may need, for a sector of at most 'edges' active
+ * edges (each ground line is one of them, scaled): crossings of its lines
+ * in pairs and of each line with the reach polygon (at most twice, as it is
+ * convex; ground_add_cut drops any beyond the room, which only rounding at
+ * a grazing line could ask for). */
+static uint32_t ground_cut_cap(uint32_t edges)
+{
+    uint32_t nl = edges < 2 * G_MAXB ? edges : 2 * G_MAXB;
+    return nl * (nl > 0 ? nl - 1 : 0) / 2 + 2 * nl + 4;
+}
 
 static double gl_t(const gline *l, vec2 u)
 {
@@ -532,21 +557,21 @@ static int add_gline(gpiece *g, const lit_line *l, double scale)
     return g->nline++;
 }
 
-/* The shadow intervals of sector i's bands on the ground (lines from 1 on;
- * line 0 is the reach chord, set per piece). A band whose scaled near line
- * stays outside the reach circle shadows nothing within reach. */
+/* The shadow intervals of sector i's bands on the ground. A band whose
+ * scaled near line stays outside the reach circle shadows nothing within
+ * reach. */
 static void sector_spans(const lr_work *w, uint32_t i, gpiece *g)
 {
     uint32_t k;
     g->nspan = 0;
-    g->nline = 1;
+    g->nline = 0;
     for (k = w->sec_first[i]; k < w->sec_first[i + 1] && g->nspan < G_MAXB; k++) {
         const lit_band *b = &w->band[k];
         const scene_building *bd = &w->s->bld[b->bld];
         gspan *sp = &g->span[g->nspan];
         if (!(bd->min_height < w->zl))
             continue;                       /* no ground shadow */
-        sp->lo = -1;
+        sp->lo = G_O;
         if (b->lo != LIT_NONE) {
             const lit_line *l = &w->line[b->lo];
             double cm = w->zl / (w->zl - bd->min_height);
@@ -554,7 +579,7 @@ static void sector_spans(const lr_work *w, uint32_t i, gpiece *g)
                 continue;                   /* beyond the reach */
             sp->lo = add_gline(g, l, cm);
         }
-        sp->hi = -1;
+        sp->hi = G_O;
         if (b->hi != LIT_NONE && bd->height < w->zl)
             sp->hi = add_gline(g, &w->line[b->hi], w->zl / (w->zl - bd->height));
         g->nspan++;
@@ -577,77 +602,171 @@ static int line_cross_dir(const gline *a, const gline *b, vec2 *v)
     return 1;
 }
 
-/* The crossings of the band lines (line 1 on), once per sector, sorted by
- * pseudo-angle counted from the sector's start a0. */
-static void sector_cuts(gpiece *g, double a0)
+/* ---- the 1-degree rays and the reach polygon ---- */
+
+/* Ray kk in [0, 720): direction and pseudo-angle (unwrapped: + 4 from 360). */
+static double ray_ang_at(const light *L, int kk)
 {
-    int p, q, i;
-    vec2 v;
-    g->nscut = g->next_cut = 0;
-    for (p = 1; p < g->nline; p++)
-        for (q = p + 1; q < g->nline && g->nscut < LR_MAXCUT; q++) {
-            double a;
-            if (!line_cross_dir(&g->line[p], &g->line[q], &v))
-                continue;
-            a = light_pseudo_angle(v.x, v.y);
-            if (a < a0)
-                a += 4.0;
-            for (i = g->nscut; i > 0 && g->sang[i - 1] > a; i--) {
-                g->sang[i] = g->sang[i - 1];
-                g->scut[i] = g->scut[i - 1];
-            }
-            g->sang[i] = a;
-            g->scut[i] = v;
-            g->nscut++;
-        }
+    return kk < 360 ? L->ray_ang[kk] : L->ray_ang[kk - 360] + 4.0;
 }
 
-/* Keeps v when strictly inside the piece, in order of angle. */
-static int insert_cut(const gpiece *g, vec2 v, vec2 *cut, double *key, int n)
+/* First ray whose pseudo-angle is above a (strict) or at least a, for a in
+ * [0, 8). */
+static int ray_search(const light *L, double a, int strict)
 {
-    double k;
-    int i;
-    if (n >= LR_MAXCUT || !(cross2(g->d0.x, g->d0.y, v.x, v.y) > 0.0 &&
-                            cross2(v.x, v.y, g->d1.x, g->d1.y) > 0.0))
-        return n;
-    k = cross2(g->d0.x, g->d0.y, v.x, v.y) / (g->d0.x * v.x + g->d0.y * v.y);
-    for (i = n; i > 0 && key[i - 1] > k; i--) {
-        key[i] = key[i - 1];
-        cut[i] = cut[i - 1];
+    int lo = 0, hi = 360, off = 0;
+    if (a >= 4.0) {
+        a -= 4.0;
+        off = 360;
     }
-    key[i] = k;
-    cut[i] = v;
-    return n + 1;
+    while (lo < hi) {
+        int mid = (lo + hi) / 2;
+        if (strict ? L->ray_ang[mid] > a : L->ray_ang[mid] >= a)
+            hi = mid;
+        else
+            lo = mid + 1;
+    }
+    return lo + off;
 }
 
-/* Directions strictly inside the piece where two of its lines cross, sorted
- * and without repeats. */
-static int piece_cuts(gpiece *g, vec2 *cut)
+/* The chord of the reach polygon from ray kk to ray kk + 1. */
+static void reach_chord(const lr_work *w, int kk, gline *c)
 {
-    int p, n = 0, i, j;
-    double key[LR_MAXCUT];
+    const double *r0 = w->L->ray_dir[kk % 360], *r1 = w->L->ray_dir[(kk + 1) % 360];
+    c->ex = w->Rg * (r1[0] - r0[0]);
+    c->ey = w->Rg * (r1[1] - r0[1]);
+    c->c = cross2(w->Rg * r0[0], w->Rg * r0[1], c->ex, c->ey);
+    c->near = 1;
+}
+
+static vec2 ray_vertex(const lr_work *w, int kk)
+{
+    vec2 p;
+    p.x = w->o.x + w->Rg * w->L->ray_dir[kk % 360][0];
+    p.y = w->o.y + w->Rg * w->L->ray_dir[kk % 360][1];
+    return p;
+}
+
+/* Where the ray of direction u (pseudo-angle a) meets the reach polygon. */
+static vec2 reach_point(const lr_work *w, vec2 u, double a)
+{
+    int kk = ray_search(w->L, a, 1) - 1;
+    gline c;
+    if (ray_ang_at(w->L, kk) == a)
+        return ray_vertex(w, kk);
+    reach_chord(w, kk, &c);
+    return gl_point(w, &c, u);
+}
+
+/* ---- cuts ---- */
+
+static void ground_add_cut(gpiece *g, vec2 v, double a0, double a1)
+{
+    double a = light_pseudo_angle(v.x, v.y);
+    if (a < a0)
+        a += 4.0;
+    if (!(a > a0 && a < a1) || g->ncut >= g->cutcap)
+        return;
+    g->cut[g->ncut].v = v;
+    g->cut[g->ncut++].a = a;
+}
+
+/* Crossings of two lines within the reach circle, inside (a0, a1). */
+static void line_cuts(gpiece *g, double a0, double a1)
+{
+    int p, q;
+    double r2 = g->rg * g->rg;
     vec2 v;
-    while (g->next_cut < g->nscut && g->sang[g->next_cut] < g->p0)
-        g->next_cut++;
-    for (p = g->next_cut; p < g->nscut && g->sang[p] <= g->p1; p++)
-        n = insert_cut(g, g->scut[p], cut, key, n);
-    for (p = 1; p < g->nline; p++)
-        if (g->line[p].near && line_cross_dir(&g->line[0], &g->line[p], &v))
-            n = insert_cut(g, v, cut, key, n);
-    for (i = 1, j = 0; i < n; i++)
-        if (key[i] != key[j])
-            cut[++j] = cut[i], key[j] = key[i];
-    return n ? j + 1 : 0;
+    for (p = 0; p < g->nline; p++) {
+        const gline *lp = &g->line[p];
+        if (!lp->near)
+            continue;                        /* meets every other line beyond reach */
+        for (q = p + 1; q < g->nline; q++) {
+            double t;
+            if (!g->line[q].near || !line_cross_dir(lp, &g->line[q], &v))
+                continue;
+            t = gl_t(lp, v);
+            if (t * t * (v.x * v.x + v.y * v.y) >= r2)
+                continue;                    /* beyond the reach polygon: no matter */
+            ground_add_cut(g, v, a0, a1);
+        }
+    }
 }
 
-static vec2 unit_sum(vec2 a, vec2 b)
+/* 1 when line l is met by the ray u at 0 < t < tb. */
+static unsigned char gl_before(const gline *l, vec2 u, double tb)
 {
-    double la = sqrt(a.x * a.x + a.y * a.y), lb = sqrt(b.x * b.x + b.y * b.y);
-    vec2 m;
-    m.x = a.x / la + b.x / lb;
-    m.y = a.y / la + b.y / lb;
-    return m;
+    double t = gl_t(l, u);
+    return t > 0.0 && t < tb;
 }
+
+/* Crossings of the near lines with the reach polygon inside (a0, a1): the
+ * side a line is on (inside the reach polygon or not) is taken at the
+ * sector's ends and at every ray between; inside one chord's span a line
+ * crosses the chord at most once, and exactly when its side changes. */
+static void reach_cuts(const lr_work *w, gpiece *g, vec2 d0, double a0, vec2 d1, double a1)
+{
+    const light *L = w->L;
+    int idx[2 * G_MAXB], nn = 0, j, kk;
+    gline c;
+    vec2 u;
+    double tb;
+    for (j = 0; j < g->nline; j++)
+        if (g->line[j].near)
+            idx[nn++] = j;
+    if (nn == 0)
+        return;
+    kk = ray_search(L, a0, 1);
+    reach_chord(w, kk - 1, &c);
+    tb = gl_t(&c, d0);
+    for (j = 0; j < nn; j++)
+        g->before[idx[j]] = gl_before(&g->line[idx[j]], d0, tb);
+    for (;; kk++) {
+        int end = kk >= 720 || !(ray_ang_at(L, kk) < a1);
+        if (end) {
+            u = d1;
+            tb = gl_t(&c, d1);
+        } else {
+            u.x = L->ray_dir[kk % 360][0];
+            u.y = L->ray_dir[kk % 360][1];
+            tb = w->Rg;
+        }
+        for (j = 0; j < nn; j++) {
+            gline *l = &g->line[idx[j]];
+            unsigned char b = gl_before(l, u, tb);
+            vec2 v;
+            if (b != g->before[idx[j]] && line_cross_dir(&c, l, &v))
+                ground_add_cut(g, v, a0, a1);
+            g->before[idx[j]] = b;
+        }
+        if (end)
+            break;
+        reach_chord(w, kk, &c);
+    }
+}
+
+static int cmp_cut(const void *p, const void *q)
+{
+    const gcut *a = p, *b = q;
+    return (a->a > b->a) - (a->a < b->a);
+}
+
+static void sort_cuts(gcut *c, uint32_t n)
+{
+    uint32_t i, j;
+    if (n > 24) {
+        qsort(c, n, sizeof *c, cmp_cut);
+        return;
+    }
+    for (i = 1; i < n; i++) {
+        gcut x = c[i];
+        for (j = i; j > 0 && c[j - 1].a > x.a; j--)
+            c[j] = c[j - 1];
+        c[j] = x;
+    }
+}
+
+/* ---- emitting ---- */
 
 /* Appends one ring of n points; returns its first point slot or NULL. */
 static vec2 *ground_ring(lr_work *w, uint32_t n)
@@ -667,10 +786,11 @@ static vec2 *ground_ring(lr_work *w, uint32_t n)
     return p;
 }
 
-/* Emits the lit piece between line x (-1: O) and line y along [u0, u1]. */
-static plx_status ground_quad(lr_work *w, const gpiece *g, int x, int y, vec2 u0, vec2 u1)
+/* The lit piece between line x (G_O: O) and line y along [u0, u1]. */
+static plx_status ground_quad(lr_work *w, gpiece *g, int x, int y, vec2 u0, vec2 u1)
 {
     vec2 *p = ground_ring(w, x < 0 ? 3 : 4);
+    g->fan = NULL;
     if (!p)
         return PLX_E_NOMEM;
     if (x < 0) {
@@ -684,6 +804,79 @@ static plx_status ground_quad(lr_work *w, const gpiece *g, int x, int y, vec2 u0
         p[3] = gl_point(w, &g->line[x], u1);
     }
     return PLX_OK;
+}
+
+/* Extends the open fan (ending at pseudo-angle pa) by the rays [kb, ke)
+ * and the reach point of ub; 0 when it has no room. */
+static int fan_extend(lr_work *w, gpiece *g, double pa, int kb, int ke, vec2 ub, double pb,
+                      plx_status *st)
+{
+    int at_ray = ray_ang_at(w->L, kb > 0 ? kb - 1 : 0) == pa;
+    uint32_t add = (uint32_t)(ke - kb) + (at_ray ? 1u : 0u);
+    vec2 *p;
+    int kk;
+    if (g->fan->count + add > G_RING_MAX)
+        return 0;
+    *st = PLX_OK;
+    if (add > 0 && !(p = ob_up(&w->out, add * sizeof *p))) {
+        *st = PLX_E_NOMEM;
+        return 1;
+    }
+    /* the fan's last point lies on the chord the next points start on,
+     * unless it is a vertex: then it stays */
+    p = (vec2 *)(void *)(w->out.base + w->out.lo) - ((ke - kb) + 1);
+    for (kk = kb; kk < ke; kk++)
+        *p++ = ray_vertex(w, kk);
+    *p = reach_point(w, ub, pb);
+    g->fan->count += add;
+    w->reg->ngpts += add;
+    g->fan_a = pb;
+    return 1;
+}
+
+/* The lit piece between line x (G_O: O) and the reach polygon along
+ * [ua, ub] (pseudo-angles pa < pb), rings of at most G_RING_MAX points
+ * through the reach vertices in between. */
+static plx_status ground_reach(lr_work *w, gpiece *g, int x, vec2 ua, double pa, vec2 ub,
+                               double pb)
+{
+    int kb = ray_search(w->L, pa, 1), ke = ray_search(w->L, pb, 0);
+    int room = G_RING_MAX - 2 - (x < 0 ? 1 : 2);
+    plx_status st = PLX_OK;
+    if (x < 0 && g->fan && g->fan_a == pa && fan_extend(w, g, pa, kb, ke, ub, pb, &st))
+        return st;
+    for (;;) {
+        int last = ke - kb <= room, kend = last ? ke : kb + room, n, kk, j = 0;
+        vec2 ue = ub, *p;
+        double pe = pb;
+        if (!last) {
+            ue.x = w->L->ray_dir[kend % 360][0];
+            ue.y = w->L->ray_dir[kend % 360][1];
+            pe = ray_ang_at(w->L, kend);
+        }
+        n = (kend - kb) + 2 + (x < 0 ? 1 : 2);
+        p = ground_ring(w, (uint32_t)n);
+        if (!p)
+            return PLX_E_NOMEM;
+        p[j++] = x < 0 ? w->o : gl_point(w, &g->line[x], ua);
+        p[j++] = reach_point(w, ua, pa);
+        for (kk = kb; kk < kend; kk++)
+            p[j++] = ray_vertex(w, kk);
+        p[j++] = reach_point(w, ue, pe);
+        if (x >= 0)
+            p[j++] = gl_point(w, &g->line[x], ue);
+        if (x < 0) {
+            g->fan = (lit_ring *)(void *)(w->out.base + w->out.cap - w->out.hi);
+            g->fan_a = pe;
+        } else {
+            g->fan = NULL;
+        }
+        if (last)
+            return st;
+        ua = ue;
+        pa = pe;
+        kb = kend + 1;
+    }
 }
 
 static void sort_spans(gspan *s, int n)
@@ -702,13 +895,17 @@ static int lit_width(double x, double y)
     return y - x > 1e-12 * (y > 0.0 ? y : -y) + 1e-300;
 }
 
-/* Lit pieces along the rays between u0 and u1 (line order fixed there). */
-static plx_status ground_sub(lr_work *w, gpiece *g, vec2 u0, vec2 u1)
+/* Lit pieces along the rays between u0 and u1 (pseudo-angles p0 < p1; the
+ * order of the bounds is fixed there). */
+static plx_status ground_sub(lr_work *w, gpiece *g, vec2 u0, double p0, vec2 u1, double p1)
 {
-    vec2 m = unit_sum(u0, u1);
-    double tr = gl_t(&g->line[0], m), cur = 0.0;
-    int k, cur_id = -1;
+    double pm = 0.5 * (p0 + p1), tr, cur = 0.0;
+    vec2 m = pseudo_dir(pm);
+    gline c;
+    int k, cur_id = G_O;
     plx_status st = PLX_OK;
+    reach_chord(w, ray_search(w->L, pm, 1) - 1, &c);
+    tr = gl_t(&c, m);
     for (k = 0; k < g->nspan; k++) {
         gspan *sp = &g->span[k];
         sp->tlo = sp->lo < 0 ? 0.0 : gl_t(&g->line[sp->lo], m);
@@ -718,10 +915,10 @@ static plx_status ground_sub(lr_work *w, gpiece *g, vec2 u0, vec2 u1)
     for (k = 0; k < g->nspan && cur < tr && st == PLX_OK; k++) {
         const gspan *sp = &g->span[k];
         if (sp->tlo > cur) {
-            int yid = sp->tlo < tr ? sp->lo : 0;
             double y = sp->tlo < tr ? sp->tlo : tr;
             if (lit_width(cur, y))
-                st = ground_quad(w, g, cur_id, yid, u0, u1);
+                st = sp->tlo < tr ? ground_quad(w, g, cur_id, sp->lo, u0, u1)
+                                  : ground_reach(w, g, cur_id, u0, p0, u1, p1);
         }
         if (sp->thi > cur) {
             cur = sp->thi;
@@ -729,108 +926,45 @@ static plx_status ground_sub(lr_work *w, gpiece *g, vec2 u0, vec2 u1)
         }
     }
     if (st == PLX_OK && cur < tr && lit_width(cur, tr))
-        st = ground_quad(w, g, cur_id, 0, u0, u1);
+        st = ground_reach(w, g, cur_id, u0, p0, u1, p1);
     return st;
 }
 
-/* An unshadowed piece: extends the open fan ring or starts one. */
-static plx_status ground_fan(lr_work *w, gpiece *g)
+/* The lit ground of sector i. */
+static plx_status ground_sector(lr_work *w, gpiece *g, uint32_t i)
 {
-    vec2 *p;
-    if (g->fan && g->fan_ring->count < 64) {
-        p = ob_up(&w->out, sizeof *p);
-        if (!p)
-            return PLX_E_NOMEM;
-        *p = gl_point(w, &g->line[0], g->d1);
-        g->fan_ring->count++;
-        w->reg->ngpts++;
-        return PLX_OK;
-    }
-    p = ground_ring(w, 3);
-    if (!p)
-        return PLX_E_NOMEM;
-    p[0] = w->o;
-    p[1] = gl_point(w, &g->line[0], g->d0);
-    p[2] = gl_point(w, &g->line[0], g->d1);
-    g->fan = 1;
-    g->fan_ring = (lit_ring *)(void *)(w->out.base + w->out.cap - w->out.hi);
-    return PLX_OK;
-}
-
-/* One piece of sector i between rays d0 and d1 within reach cell k. */
-static plx_status ground_piece(lr_work *w, uint32_t i, gpiece *g, int cell)
-{
-    const double *r0 = w->L->ray_dir[cell], *r1 = w->L->ray_dir[(cell + 1) % 360];
-    vec2 cut[LR_MAXCUT + 1], u0;
-    int n, k;
+    uint32_t nx = i + 1 < w->nsec ? i + 1 : 0, k;
+    double a0 = w->bang[i], a1 = nx ? w->bang[nx] : w->bang[0] + 4.0, p0 = a0;
+    vec2 d0 = w->bdir[i], d1 = w->bdir[nx], u0 = d0;
     plx_status st = PLX_OK;
-    if (!(cross2(g->d0.x, g->d0.y, g->d1.x, g->d1.y) > 0.0))
-        return PLX_OK;                       /* no width */
-    g->line[0].ex = w->Rg * (r1[0] - r0[0]);
-    g->line[0].ey = w->Rg * (r1[1] - r0[1]);
-    g->line[0].c = cross2(w->Rg * r0[0], w->Rg * r0[1], g->line[0].ex, g->line[0].ey);
-    (void)i;
+    sector_spans(w, i, g);
     if (g->nspan == 0)
-        return ground_fan(w, g);
-    g->fan = 0;
-    n = piece_cuts(g, cut);
-    u0 = g->d0;
-    for (k = 0; k <= n && st == PLX_OK; k++) {
-        vec2 u1 = k < n ? cut[k] : g->d1;
-        st = ground_sub(w, g, u0, u1);
+        return a1 - a0 >= 1.0 || cross2(d0.x, d0.y, d1.x, d1.y) > 0.0
+               ? ground_reach(w, g, G_O, d0, a0, d1, a1) : PLX_OK;
+    g->ncut = 0;
+    line_cuts(g, a0, a1);
+    reach_cuts(w, g, d0, a0, d1, a1);
+    sort_cuts(g->cut, g->ncut);
+    for (k = 0; k <= g->ncut && st == PLX_OK; k++) {
+        vec2 u1 = k < g->ncut ? g->cut[k].v : d1;
+        double p1 = k < g->ncut ? g->cut[k].a : a1;
+        if (p1 > p0 && (p1 - p0 >= 1.0 || cross2(u0.x, u0.y, u1.x, u1.y) > 0.0))
+            st = ground_sub(w, g, u0, p0, u1, p1);
         u0 = u1;
+        p0 = p1;
     }
     return st;
-}
-
-/* First reach ray with a pseudo-angle above a (index may be 360 = wrap). */
-static int ray_after(const light *L, double a)
-{
-    int lo = 0, hi = 360;
-    while (lo < hi) {
-        int mid = (lo + hi) / 2;
-        if (L->ray_ang[mid] > a)
-            hi = mid;
-        else
-            lo = mid + 1;
-    }
-    return lo;
 }
 
 static plx_status ground_emit(lr_work *w, gpiece *g)
 {
-    const light *L = w->L;
     uint32_t i;
     plx_status st = PLX_OK;
     w->reg->gpts = (const vec2 *)(const void *)(w->out.base + ((w->out.lo + 7) & ~(size_t)7));
-    g->fan = 0;
-    for (i = 0; i < w->nsec && st == PLX_OK; i++) {
-        double a1 = i + 1 < w->nsec ? w->bang[i + 1] : w->bang[0] + 4.0;
-        int kk = ray_after(L, w->bang[i]);
-        int cell = (kk + 359) % 360;
-        g->rg = w->Rg;
-        sector_spans(w, i, g);
-        sector_cuts(g, w->bang[i]);
-        g->d0 = w->bdir[i];
-        g->p0 = w->bang[i];
-        for (;; kk++) {
-            double ra = kk < 360 ? L->ray_ang[kk] : L->ray_ang[kk - 360] + 4.0;
-            if (kk >= 720 || !(ra < a1))
-                break;
-            g->d1.x = L->ray_dir[kk % 360][0];
-            g->d1.y = L->ray_dir[kk % 360][1];
-            g->p1 = ra;
-            st = ground_piece(w, i, g, cell);
-            if (st != PLX_OK)
-                return st;
-            g->d0 = g->d1;
-            g->p0 = ra;
-            cell = kk % 360;
-        }
-        g->d1 = w->bdir[i + 1 < w->nsec ? i + 1 : 0];
-        g->p1 = a1;
-        st = ground_piece(w, i, g, cell);
-    }
+    g->fan = NULL;
+    g->rg = w->Rg;
+    for (i = 0; i < w->nsec && st == PLX_OK; i++)
+        st = ground_sector(w, g, i);
     return st;
 }
 
@@ -1138,7 +1272,8 @@ static plx_status facade_wall(lr_work *w, uint32_t e, fwall *f)
     if (uhi > 1.0) uhi = 1.0;
     if (!(ulo < uhi))
         return PLX_OK;
-    edge_range(w, ed, &i0, &i1);
+    i0 = ed->s0;
+    i1 = ed->s1;
     for (i = i0; i != i1 && st == PLX_OK; i = (i + 1 == w->nsec ? 0 : i + 1)) {
         uint32_t nx = i + 1 == w->nsec ? 0 : i + 1;
         double us = i == i0 ? 1.0 : wall_u(f, w->bdir[i]);
@@ -1200,10 +1335,21 @@ static plx_status region_output(lr_work *w, uint32_t lamp, int polygons)
 {
     gpiece *g = arena_scratch(w->L->a, sizeof *g, LR_ALIGN);
     fwall *f = arena_scratch(w->L->a, sizeof *f, LR_ALIGN);
+    uint32_t i, maxinc = 0;
     size_t room;
     plx_status st;
     if (!g || !f)
         return PLX_E_NOMEM;
+    if (polygons && w->Rg > 0.0) {
+        /* a sector's ground lines are some of its active edges, scaled */
+        for (i = 0; i < w->nsec; i++)
+            if (w->inc_first[i + 1] - w->inc_first[i] > maxinc)
+                maxinc = w->inc_first[i + 1] - w->inc_first[i];
+        g->cutcap = ground_cut_cap(maxinc);
+        g->cut = arena_scratch(w->L->a, arena_mul(g->cutcap, sizeof *g->cut), LR_ALIGN);
+        if (!g->cut)
+            return PLX_E_NOMEM;
+    }
     room = arena_free_bytes(w->L->a);
     room = room > 256 ? room - 256 : 0;
     if (room > w->L->pool_cap)

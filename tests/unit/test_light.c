@@ -1000,6 +1000,128 @@ static void test_region_vs_points(void **state)
     assert_true(ng > 1000 && nf > 1000);
 }
 
+/* The reach chord cut-off: the ground polygons stop at the 360-gon
+ * inscribed in the ground reach circle (vertices on the 1-degree rays); the
+ * ground between a chord and the arc, at most Rg (1 - cos 0.5 deg) deep, is
+ * left out, and there W(d / R) <= 3e-8. Checked on an empty plane and with
+ * two boxes: a shadow running out through the arc, and one whose far side
+ * crosses the reach polygon inside chords' spans. Queries are not cut off:
+ * the sector index still sees the lamp in the sliver. */
+static long check_chord_sliver(light *L, const scene *s, uint32_t lamp, rng *g, long *bad,
+                               double *wmax)
+{
+    const lit_region *reg;
+    const scene_lamp *lp = &s->lamps[lamp];
+    const double deg = 3.14159265358979323846 / 180.0;
+    double Lp[3] = { lp->x, lp->y, lp->z }, Rg;
+    long done = 0;
+    uint32_t k, q;
+    int c, j;
+    assert_int_equal(light_region(L, lamp, &reg), PLX_OK);
+    Rg = reg->ground_reach;
+    for (k = 0; k < reg->nground; k++) {        /* no vertex beyond the arc */
+        assert_true(reg->ground[k].count <= 64);
+        for (q = 0; q < reg->ground[k].count; q++) {
+            const vec2 *p = &reg->gpts[reg->ground[k].first + q];
+            assert_true(hypot(p->x - lp->x, p->y - lp->y) <= Rg * (1.0 + 1e-12));
+        }
+    }
+    for (c = 0; c < 360; c++)
+        for (j = 0; j < 8; j++) {
+            /* a direction in cell c (the middle, then random), where the chord
+             * is at Rg cos(0.5 deg) / cos(a - mid); a point between chord and
+             * arc, and one inside (just inside, then in the outer tenth) */
+            double a = (c + (j == 0 ? 0.5 : runi(g, 0.01, 0.99))) * deg;
+            double chord = Rg * cos(0.5 * deg) / cos(a - (c + 0.5) * deg);
+            double out = chord + (Rg - chord) * (j == 0 ? 0.5 : runi(g, 0.05, 0.95));
+            double in = chord - (j < 3 ? 1e-5 : runi(g, 0.0, 0.1 * Rg)), P[3], Q[3], d, x, wv, E, dmin = INFINITY, dd, contrib[4];
+            uint32_t ids[4];
+            int in_out = 0, in_in = 0, vis, n;
+            P[0] = lp->x + out * cos(a); P[1] = lp->y + out * sin(a); P[2] = 0.0;
+            Q[0] = lp->x + in * cos(a);  Q[1] = lp->y + in * sin(a);  Q[2] = 0.0;
+            for (k = 0; k < reg->nground; k++) {
+                const vec2 *p = reg->gpts + reg->ground[k].first;
+                in_out |= in_ring(p, reg->ground[k].count, P[0], P[1], &dd);
+                if (in_ring(p, reg->ground[k].count, Q[0], Q[1], &dd))
+                    in_in = 1;
+                if (dd < dmin) dmin = dd;
+            }
+            /* the sliver point: in no ring, and its light is negligible */
+            d = sqrt(out * out + lp->z * lp->z);
+            x = d / lp->radius;
+            wv = (1.0 - x * x * x * x) * (1.0 - x * x * x * x);
+            n = light_lamps_at(L, P, UP, ids, contrib, 4);    /* this lamp's term */
+            for (E = 0.0, q = 0; q < (uint32_t)n && q < 4; q++)
+                if (ids[q] == lamp)
+                    E = contrib[q];
+            assert_int_equal(light_region(L, lamp, &reg), PLX_OK);  /* may have moved */
+            if (wv > *wmax) *wmax = wv;
+            vis = !ref_segment_blocked(s, Lp, P);
+            if (in_out || wv > 3e-8 || E > 3e-8 * lp->intensity * lp->z / (d * d * d) ||
+                light_region_visible(L, reg, P) != vis) {
+                if (*bad < 5)
+                    printf("  sliver point lamp %u cell %d: in a ring %d, W %.3g, E %.3g\n",
+                           lamp, c, in_out, wv, E);
+                (*bad)++;
+            }
+            /* inside the chord: lit polygons as the reference says */
+            if (dmin > 1e-7 && in_in != !ref_segment_blocked(s, Lp, Q)) {
+                if (*bad < 5)
+                    printf("  inside the chord lamp %u cell %d: in a ring %d\n", lamp, c,
+                           in_in);
+                (*bad)++;
+            }
+            done++;
+        }
+    return done;
+}
+
+static void test_reach_chord(void **state)
+{
+    scene s;
+    lab b;
+    rng g;
+    const lit_region *r;
+    long bad = 0, done = 0;
+    double wmax = 0.0, Rg, got;
+    int neg;
+    (void)state;
+    g.s = 29;
+    ref_scene_init(&s);
+    ref_scene_add_lamp(&s, 3.0, 4.0, 6.0, 1000.0, 30.0);    /* empty plane */
+    ref_scene_finish(&s);
+    lab_open(&b, &s, 1u << 20);
+    assert_int_equal(light_region(b.L, 0, &r), PLX_OK);
+    Rg = sqrt(900.0 - 36.0);
+    got = ground_area(r, &neg);
+    /* exactly the reach polygon: the arc segments are left out */
+    assert_false(neg);
+    assert_true(fabs(got - reach_polygon_area(Rg)) <= 1e-12 * got);
+    /* what is left out: Rg^2 (pi - 180 sin 1 deg) ~ 1.6e-4 Rg^2 */
+    assert_true(3.14159265358979323846 * Rg * Rg - got > 1.5e-4 * Rg * Rg);
+    assert_true(3.14159265358979323846 * Rg * Rg - got < 1.7e-4 * Rg * Rg);
+    done += check_chord_sliver(b.L, &s, 0, &g, &bad, &wmax);
+    lab_close(&b);
+    ref_scene_free(&s);
+
+    ref_scene_init(&s);
+    ref_scene_add_box(&s, 5, -1, 7, 1, 9, 0);    /* shadow x 10: out through the arc */
+    /* shadow x 10/6 from O: its far side (x = -36.67) crosses the arc */
+    ref_scene_add_box(&s, -22, -12, -20, 12, 4, 0);
+    ref_scene_add_lamp(&s, 0, 0, 10, 1000, 40);
+    ref_scene_add_lamp(&s, 0.5, 30, 10, 1000, 40);  /* the box near its reach */
+    ref_scene_finish(&s);
+    lab_open(&b, &s, 1u << 20);
+    done += check_chord_sliver(b.L, &s, 0, &g, &bad, &wmax);
+    done += check_chord_sliver(b.L, &s, 1, &g, &bad, &wmax);
+    lab_close(&b);
+    ref_scene_free(&s);
+    printf("  reach chords: %ld points between chord and arc, max W there %.3g, %ld wrong\n",
+           done, wmax, bad);
+    assert_int_equal(bad, 0);
+    assert_true(wmax <= 3e-8 && wmax > 1e-9);
+}
+
 /* ---- the cache ------------------------------------------------------------------------------ */
 
 static int same_region(const lit_region *a, const lit_region *b)
@@ -1223,6 +1345,7 @@ int main(void)
         cmocka_unit_test(test_courtyard_lamp),
         cmocka_unit_test(test_region_areas),
         cmocka_unit_test(test_region_vs_points),
+        cmocka_unit_test(test_reach_chord),
         cmocka_unit_test(test_cache_lru),
         cmocka_unit_test(test_cache_nomem),
         cmocka_unit_test(test_fault_injection),
