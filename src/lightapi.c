@@ -170,6 +170,9 @@ plx_status plx_lit_region_get(plx_engine *e, uint32_t lamp, plx_lit_region *out)
     st = light_region(e->lt, lamp, &r);
     if (st == PLX_E_NOMEM)
         return eng_nomem(e, "computing a lit region (raise plx_config.lit_cache_bytes)");
+    if (st == PLX_E_UNSUPPORTED)
+        return eng_fail(e, st, "plx_lit_region_get: along some direction this lamp's reach crosses more than 64 "
+                               "building intervals; its lit polygons are not built (illuminance is unaffected)");
     if (st != PLX_OK)
         return eng_fail(e, st, "plx_lit_region_get failed");
     e->lit_last = r;

@@ -937,6 +937,8 @@ static plx_status ground_sector(lr_work *w, gpiece *g, uint32_t i)
     double a0 = w->bang[i], a1 = nx ? w->bang[nx] : w->bang[0] + 4.0, p0 = a0;
     vec2 d0 = w->bdir[i], d1 = w->bdir[nx], u0 = d0;
     plx_status st = PLX_OK;
+    if (w->sec_first[i + 1] - w->sec_first[i] > G_MAXB)
+        return PLX_E_UNSUPPORTED; /* more bands than the polygon builder keeps: never drop one */
     sector_spans(w, i, g);
     if (g->nspan == 0)
         return a1 - a0 >= 1.0 || cross2(d0.x, d0.y, d1.x, d1.y) > 0.0
@@ -1227,6 +1229,8 @@ static plx_status facade_piece(lr_work *w, fwall *f, uint32_t e, uint32_t i, dou
     double cut[F_MAXCUT], u0 = p0;
     int n, k;
     plx_status st = PLX_OK;
+    if (w->sec_first[i + 1] - w->sec_first[i] > G_MAXB)
+        return PLX_E_UNSUPPORTED; /* more bands than the polygon builder keeps: never drop one */
     facade_bands(w, f, e, i, p0, p1);
     n = f->nfb ? facade_cuts(w, f, p0, p1, cut) : 0;
     for (k = 0; k <= n && st == PLX_OK; k++) {
