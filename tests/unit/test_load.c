@@ -393,6 +393,10 @@ static void test_fault_injection_tiny(void **state)
 static void test_fault_injection_eixample(void **state)
 {
     (void)state;
+    /* thousands of loads: skipped in the quick mode used under valgrind,
+     * where the tiny fixture and tests/unit/test_corpus.c cover every path */
+    if (getenv("PLX_TEST_QUICK"))
+        skip();
     fault_inject_file("fixtures/eixample-4x4.geojson");
 }
 
