@@ -1,12 +1,12 @@
 /* polar: quadrant polar diagrams as trapezoidal subdivisions (see polar.h).
  *
- * Construction, per subdivision: wall pieces are inserted in a random order
- * (fixed seed) into a trapezoidal map with a search DAG (randomized
- * incremental construction in the manner of Seidel 1991 / Mulmuley, as
- * taught in de Berg et al., "Computational Geometry", ch. 6), in a frame
- * where the axes are "vertical" and points are ordered lexicographically by
- * (u, v). Then every trapezoid learns whether it is solid by counting the
- * footprints above its floor wall.
+ * Construction, per subdivision: a plane sweep over the wall ends in a
+ * frame where the axes are "vertical" and points are ordered
+ * lexicographically by (u, v) (the trapezoidal map of de Berg et al.,
+ * "Computational Geometry", ch. 6, built by a sweep rather than by
+ * randomized insertion); whether a gap is solid is known when its floor
+ * wall enters the sweep, so only free trapezoids are made. Points are
+ * located through a grid of the wall pieces (see locate()).
  */
 #include <float.h>
 #include <math.h>
@@ -25,7 +25,7 @@ enum { N_LEAF = 0, N_X = 1, N_Y = 2, N_YB = 3 };
 
 /* ---- frames and small helpers ----------------------------------------- */
 
-vec2 polar_to_frame(int frame, vec2 w)
+static vec2 to_frame(int frame, vec2 w)
 {
     vec2 f;
     if (frame == 0) {
@@ -35,6 +35,11 @@ vec2 polar_to_frame(int frame, vec2 w)
         f = w;
     }
     return f;
+}
+
+vec2 polar_to_frame(int frame, vec2 w)
+{
+    return to_frame(frame, w);
 }
 
 vec2 polar_from_frame(int frame, vec2 f)
@@ -49,9 +54,22 @@ vec2 polar_from_frame(int frame, vec2 f)
     return w;
 }
 
+/* Point i in a frame (the inline twin of polar_fpt, for the hot loops). */
+static vec2 fpt(const polar *pd, int frame, uint32_t i)
+{
+    vec2 w = pd->pts[i], f;
+    if (frame == 0) {
+        f.x = w.y;
+        f.y = -w.x;
+    } else {
+        f = w;
+    }
+    return f;
+}
+
 vec2 polar_fpt(const polar *pd, int frame, uint32_t i)
 {
-    return polar_to_frame(frame, pd->pts[i]);
+    return fpt(pd, frame, i);
 }
 
 static int lex_cmp(vec2 a, vec2 b)
@@ -71,7 +89,7 @@ static int lex_cmp(vec2 a, vec2 b)
 static void seg_ends(const polar *pd, int frame, uint32_t s, uint32_t *l, uint32_t *r)
 {
     const polar_seg *g = &pd->seg[s];
-    if (lex_cmp(polar_fpt(pd, frame, g->a), polar_fpt(pd, frame, g->b)) < 0) {
+    if (lex_cmp(fpt(pd, frame, g->a), fpt(pd, frame, g->b)) < 0) {
         *l = g->a;
         *r = g->b;
     } else {
@@ -84,18 +102,8 @@ static void seg_ends(const polar *pd, int frame, uint32_t s, uint32_t *l, uint32
 static int32_t seg_delta(const polar *pd, int frame, uint32_t s)
 {
     const polar_seg *g = &pd->seg[s];
-    int fwd = lex_cmp(polar_fpt(pd, frame, g->a), polar_fpt(pd, frame, g->b)) < 0;
+    int fwd = lex_cmp(fpt(pd, frame, g->a), fpt(pd, frame, g->b)) < 0;
     return fwd ? g->cover : -g->cover;
-}
-
-static uint32_t rng_next(uint64_t *st)
-{
-    uint64_t x = *st;
-    x ^= x << 13;
-    x ^= x >> 7;
-    x ^= x << 17;
-    *st = x;
-    return (uint32_t)(x >> 32);
 }
 
 /* ---- wall pieces ------------------------------------------------------- */
@@ -160,30 +168,72 @@ static int strictly_between(vec2 a, vec2 b, vec2 c)
     return ca != 0 && cb != 0 && ca != cb;
 }
 
+/* Cuts and crossing points are recorded in one pass over the contacts,
+ * in chunks of scratch memory (their number is not known beforehand). */
+#define SPLIT_CHUNK 1024
+typedef struct split_chunk {
+    struct split_chunk *next;
+    uint32_t n;
+    split v[SPLIT_CHUNK];
+} split_chunk;
+
+typedef struct point_chunk {
+    struct point_chunk *next;
+    uint32_t n;
+    vec2 v[SPLIT_CHUNK];
+} point_chunk;
+
 typedef struct split_ctx {
     polar *pd;
     const edges *e;
-    split *sp;        /* NULL: count only */
+    arena *a;
+    split_chunk *sp0, *sp;    /* first and last chunk of cuts */
+    point_chunk *pt0, *pt;    /* first and last chunk of crossing points */
     uint32_t nsp;
-    uint32_t npts;    /* next free point index */
-    uint32_t cap_pts;
+    uint32_t npts;            /* next free point index */
+    int nomem;
 } split_ctx;
 
 static void add_split(split_ctx *c, uint32_t seg, uint32_t pt)
 {
-    if (c->sp) {
-        c->sp[c->nsp].seg = seg;
-        c->sp[c->nsp].pt = pt;
+    if (!c->sp || c->sp->n == SPLIT_CHUNK) {
+        split_chunk *k = arena_scratch(c->a, sizeof(split_chunk), 16);
+        if (!k) {
+            c->nomem = 1;
+            return;
+        }
+        k->next = NULL;
+        k->n = 0;
+        if (c->sp)
+            c->sp->next = k;
+        else
+            c->sp0 = k;
+        c->sp = k;
     }
+    c->sp->v[c->sp->n].seg = seg;
+    c->sp->v[c->sp->n].pt = pt;
+    c->sp->n++;
     c->nsp++;
 }
 
 static uint32_t add_point(split_ctx *c, vec2 p)
 {
-    uint32_t i = c->npts++;
-    if (c->sp && i < c->cap_pts)
-        c->pd->pts[i] = p;
-    return i;
+    if (!c->pt || c->pt->n == SPLIT_CHUNK) {
+        point_chunk *k = arena_scratch(c->a, sizeof(point_chunk), 16);
+        if (!k) {
+            c->nomem = 1;
+            return 0;
+        }
+        k->next = NULL;
+        k->n = 0;
+        if (c->pt)
+            c->pt->next = k;
+        else
+            c->pt0 = k;
+        c->pt = k;
+    }
+    c->pt->v[c->pt->n++] = p;
+    return c->npts++;
 }
 
 static vec2 cross_point(vec2 a, vec2 b, vec2 c, vec2 d)
@@ -207,34 +257,72 @@ static void meet_edges(split_ctx *c, uint32_t i, uint32_t j)
     const vec2 *P = c->pd->pts;
     uint32_t ia = c->e->a[i], ib = c->e->b[i], ja = c->e->a[j], jb = c->e->b[j];
     vec2 a = P[ia], b = P[ib], d0 = P[ja], d1 = P[jb];
-    int m;
+    int o1, o2, o3, o4;
     if (fmax(a.x, b.x) < fmin(d0.x, d1.x) || fmax(d0.x, d1.x) < fmin(a.x, b.x) ||
         fmax(a.y, b.y) < fmin(d0.y, d1.y) || fmax(d0.y, d1.y) < fmin(a.y, b.y))
         return;
-    m = geom_seg_meet(a, b, d0, d1);
-    if (m == GEOM_SEG_DISJOINT)
+    /* the four signs once (geom_seg_meet would take them again below) */
+    o1 = geom_orient(a, b, d0);
+    o2 = geom_orient(a, b, d1);
+    if ((o1 > 0 && o2 > 0) || (o1 < 0 && o2 < 0))
         return;
-    if (m == GEOM_SEG_CROSS) {
+    o3 = geom_orient(d0, d1, a);
+    o4 = geom_orient(d0, d1, b);
+    if ((o3 > 0 && o4 > 0) || (o3 < 0 && o4 < 0))
+        return;
+    if (o1 != 0 && o2 != 0 && o3 != 0 && o4 != 0) {
         uint32_t x = add_point(c, cross_point(a, b, d0, d1));
         add_split(c, i, x);
         add_split(c, j, x);
         return;
     }
     /* touch or overlap: cut each at the other's ends lying inside it */
-    if (geom_orient(a, b, d0) == 0 && strictly_between(a, b, d0))
+    if (o1 == 0 && strictly_between(a, b, d0))
         add_split(c, i, ja);
-    if (geom_orient(a, b, d1) == 0 && strictly_between(a, b, d1))
+    if (o2 == 0 && strictly_between(a, b, d1))
         add_split(c, i, jb);
-    if (geom_orient(d0, d1, a) == 0 && strictly_between(d0, d1, a))
+    if (o3 == 0 && strictly_between(d0, d1, a))
         add_split(c, j, ia);
-    if (geom_orient(d0, d1, b) == 0 && strictly_between(d0, d1, b))
+    if (o4 == 0 && strictly_between(d0, d1, b))
         add_split(c, j, ib);
 }
 
-static void meet_buildings(split_ctx *c, uint32_t p, uint32_t q)
+/* The edges of building p whose bounding boxes meet the closed box bx,
+ * into out[0..cap-1]; returns their count, or cap + 1 when they do not fit. */
+static uint32_t edges_near(const split_ctx *c, uint32_t p, const double *bx, uint32_t *out,
+                           uint32_t cap)
 {
     const edges *e = c->e;
-    uint32_t i, j;
+    const vec2 *P = c->pd->pts;
+    uint32_t i, n = 0;
+    for (i = e->first[p]; i < e->first[p] + e->count[p]; i++) {
+        vec2 a = P[e->a[i]], b = P[e->b[i]];
+        if (fmax(a.x, b.x) < bx[0] || fmin(a.x, b.x) > bx[2] || fmax(a.y, b.y) < bx[1] ||
+            fmin(a.y, b.y) > bx[3])
+            continue;
+        if (n == cap)
+            return cap + 1;
+        out[n++] = i;
+    }
+    return n;
+}
+
+/* Every edge of p against every edge of q, those far from the other
+ * building's box left out first. */
+static void meet_buildings(split_ctx *c, uint32_t p, uint32_t q)
+{
+    enum { CAP = 48 };
+    const edges *e = c->e;
+    const scene *s = c->pd->s;
+    uint32_t ep[CAP], eq[CAP], np, nq, i, j;
+    np = edges_near(c, p, s->bld[q].box, ep, CAP);
+    nq = edges_near(c, q, s->bld[p].box, eq, CAP);
+    if (np <= CAP && nq <= CAP) {
+        for (i = 0; i < np; i++)
+            for (j = 0; j < nq; j++)
+                meet_edges(c, ep[i], eq[j]);
+        return;
+    }
     for (i = e->first[p]; i < e->first[p] + e->count[p]; i++)
         for (j = e->first[q]; j < e->first[q] + e->count[q]; j++)
             meet_edges(c, i, j);
@@ -276,12 +364,6 @@ static void find_contacts(split_ctx *c, const scene *s, keyed *order, uint32_t n
     }
 }
 
-static int cmp_split(const void *x, const void *y)
-{
-    const split *a = x, *b = y;
-    return (a->seg > b->seg) - (a->seg < b->seg);
-}
-
 typedef struct piece {
     uint32_t a, b;   /* point indices, oriented as the original edge */
     int32_t bld;
@@ -296,38 +378,56 @@ static int cmp_piece_pts(const piece *a, const piece *b, const vec2 *P)
     return lex_cmp(P[a->hi], P[b->hi]);
 }
 
-/* Heap sort of pieces by their ends (qsort cannot see the points). */
-static void sift(piece *v, uint32_t i, uint32_t n, const vec2 *P)
+/* Pieces sorted by their ends: keys with the coordinates inline, bottom-up
+ * merge sort (stable: equal pieces keep the order of their edges). */
+typedef struct pkey {
+    vec2 lo, hi;
+    uint32_t k;
+} pkey;
+
+static int pkey_before(const pkey *a, const pkey *b)
 {
-    for (;;) {
-        uint32_t c = 2 * i + 1, m = i;
-        piece t;
-        if (c < n && cmp_piece_pts(&v[c], &v[m], P) > 0)
-            m = c;
-        if (c + 1 < n && cmp_piece_pts(&v[c + 1], &v[m], P) > 0)
-            m = c + 1;
-        if (m == i)
-            return;
-        t = v[i];
-        v[i] = v[m];
-        v[m] = t;
-        i = m;
-    }
+    int c = lex_cmp(a->lo, b->lo);
+    if (c == 0)
+        c = lex_cmp(a->hi, b->hi);
+    return c < 0 || (c == 0 && a->k < b->k);
 }
 
-static void sort_pieces(piece *v, uint32_t n, const vec2 *P)
+static void sort_pkeys(pkey *v, pkey *tmp, uint32_t n)
 {
-    uint32_t i;
-    if (n < 2)
-        return;
-    for (i = n / 2; i-- > 0;)
-        sift(v, i, n, P);
-    for (i = n - 1; i > 0; i--) {
-        piece t = v[0];
-        v[0] = v[i];
-        v[i] = t;
-        sift(v, 0, i, P);
+    uint32_t w, i, j;
+    pkey *src = v, *dst = tmp;
+    for (i = 0; i < n; i += 16) {
+        uint32_t e = i + 16 < n ? i + 16 : n;
+        for (j = i + 1; j < e; j++) {
+            pkey t = v[j];
+            uint32_t k = j;
+            while (k > i && pkey_before(&t, &v[k - 1])) {
+                v[k] = v[k - 1];
+                k--;
+            }
+            v[k] = t;
+        }
     }
+    for (w = 16; w < n; w *= 2) {
+        for (i = 0; i < n; i += 2 * w) {
+            uint32_t a = i, am = i + w < n ? i + w : n, b = am, bm = i + 2 * w < n ? i + 2 * w : n;
+            uint32_t o = i;
+            while (a < am && b < bm)
+                dst[o++] = pkey_before(&src[b], &src[a]) ? src[b++] : src[a++];
+            while (a < am)
+                dst[o++] = src[a++];
+            while (b < bm)
+                dst[o++] = src[b++];
+        }
+        {
+            pkey *t = src;
+            src = dst;
+            dst = t;
+        }
+    }
+    if (src != v)
+        memcpy(v, src, (size_t)n * sizeof *v);
 }
 
 /* Sorts the cut points of one edge along it (insertion sort: few cuts). */
@@ -362,325 +462,6 @@ static void emit_piece(piece *out, uint32_t *n, const vec2 *P, uint32_t a, uint3
         q->lo = b;
         q->hi = a;
     }
-}
-
-/* ---- trapezoidal map construction ------------------------------------- */
-
-/* A trapezoid during construction (one cache line holds most of it). */
-typedef struct btrap {
-    uint32_t lp, rp, top, bot;
-    uint32_t nb[4];
-    uint32_t leaf;           /* its leaf node */
-    uint32_t dead;
-} btrap;
-
-typedef struct tbuild {
-    const polar *pd;
-    int frame;
-    uint32_t cap;            /* trapezoid slots */
-    btrap *T;
-    uint32_t ntrap;
-    uint32_t *freel;
-    uint32_t nfree;
-    uint32_t (*node)[3];
-    uint32_t nnode, cap_node;
-    uint32_t *list;          /* trapezoids crossed by the new segment */
-    uint32_t *up, *lo;       /* per crossed trapezoid: new upper / lower part */
-    uint32_t (*lr)[2];       /* per segment: frame-left and frame-right end */
-    int fail;
-} tbuild;
-
-static uint32_t new_trap(tbuild *b)
-{
-    uint32_t t;
-    if (b->nfree > 0) {
-        t = b->freel[--b->nfree];
-    } else {
-        if (b->ntrap >= b->cap) {
-            b->fail = 1;
-            return 0;
-        }
-        t = b->ntrap++;
-    }
-    b->T[t].dead = 0;
-    b->T[t].nb[0] = b->T[t].nb[1] = b->T[t].nb[2] = b->T[t].nb[3] = POLAR_NONE;
-    b->T[t].leaf = POLAR_NONE;
-    return t;
-}
-
-static uint32_t new_node(tbuild *b, uint32_t kind, uint32_t idx, uint32_t c0, uint32_t c1)
-{
-    uint32_t n;
-    if (b->nnode >= b->cap_node) {
-        b->fail = 1;
-        return 0;
-    }
-    n = b->nnode++;
-    b->node[n][0] = PACK(kind, idx);
-    b->node[n][1] = c0;
-    b->node[n][2] = c1;
-    return n;
-}
-
-static vec2 bpt(const tbuild *b, uint32_t i)
-{
-    return polar_fpt(b->pd, b->frame, i);
-}
-
-/* Descends the DAG with the left end P of a new segment PQ. */
-static uint32_t find_first(const tbuild *b, vec2 P, vec2 Q)
-{
-    uint32_t n = 0;
-    for (;;) {
-        uint32_t w = b->node[n][0];
-        if (KIND(w) == N_LEAF)
-            return IDX(w);
-        if (KIND(w) == N_X) {
-            n = lex_cmp(P, bpt(b, IDX(w))) < 0 ? b->node[n][1] : b->node[n][2];
-        } else {
-            const uint32_t *e = b->lr[IDX(w)];
-            vec2 L = bpt(b, e[0]), R = bpt(b, e[1]);
-            int o = geom_orient(L, R, P);
-            if (o == 0)
-                o = geom_orient(L, R, Q);
-            n = o > 0 ? b->node[n][2] : b->node[n][1];
-        }
-    }
-}
-
-static uint32_t ykind(const tbuild *b, uint32_t s)
-{
-    return b->lr[s][0] == b->pd->seg[s].a ? N_Y : N_YB;
-}
-
-/* Replaces the neighbour link 'old' of trapezoid x on side (f0, f1). */
-static void relink(tbuild *b, uint32_t x, int f, uint32_t old, uint32_t nw)
-{
-    if (x != POLAR_NONE && b->T[x].nb[f] == old)
-        b->T[x].nb[f] = nw;
-}
-
-static void set_trap(tbuild *b, uint32_t t, uint32_t lp, uint32_t rp, uint32_t top, uint32_t bot)
-{
-    b->T[t].lp = lp;
-    b->T[t].rp = rp;
-    b->T[t].top = top;
-    b->T[t].bot = bot;
-}
-
-/* Follows the new segment s (ends l < r) through the map; returns k. */
-static uint32_t follow(tbuild *b, uint32_t s, uint32_t l, uint32_t r)
-{
-    vec2 P = bpt(b, l), Q = bpt(b, r);
-    uint32_t k = 0;
-    (void)s;
-    b->list[0] = find_first(b, P, Q);
-    while (lex_cmp(Q, bpt(b, b->T[b->list[k]].rp)) > 0) {
-        uint32_t t = b->list[k], nx;
-        int o = geom_orient(P, Q, bpt(b, b->T[t].rp));
-        nx = o > 0 ? b->T[t].nb[LR] : b->T[t].nb[UR];
-        if (nx == POLAR_NONE || k + 1 >= b->cap) {
-            b->fail = 2;
-            return k;
-        }
-        b->list[++k] = nx;
-    }
-    return k;
-}
-
-/* Builds the chain of new trapezoids above (up = 1) or below the segment. */
-static void make_chain(tbuild *b, uint32_t s, uint32_t l, uint32_t r, uint32_t k, int up)
-{
-    vec2 P = bpt(b, l), Q = bpt(b, r);
-    uint32_t *part = up ? b->up : b->lo;
-    uint32_t j, cur = new_trap(b);
-    int fo = up ? UL : LL, fc = up ? UR : LR;     /* outer-side links */
-    int fi_l = up ? LL : UL, fi_r = up ? LR : UR;  /* links along s */
-    (void)fi_l;
-    if (up)
-        set_trap(b, cur, l, r, b->T[b->list[0]].top, s);
-    else
-        set_trap(b, cur, l, r, s, b->T[b->list[0]].bot);
-    part[0] = cur;
-    for (j = 0; j < k; j++) {
-        uint32_t t = b->list[j], t1 = b->list[j + 1], R = b->T[t].rp, nx, x;
-        int o = geom_orient(P, Q, bpt(b, R));
-        if ((o > 0) != (up != 0)) {
-            part[j + 1] = cur;        /* the axis at R is cut away: merge */
-            continue;
-        }
-        b->T[cur].rp = R;
-        nx = new_trap(b);
-        if (up)
-            set_trap(b, nx, R, r, b->T[t1].top, s);
-        else
-            set_trap(b, nx, R, r, s, b->T[t1].bot);
-        x = b->T[t].nb[fc];
-        b->T[cur].nb[fc] = x;
-        relink(b, x, fo, t, cur);
-        b->T[cur].nb[fi_r] = nx;
-        b->T[nx].nb[up ? LL : UL] = cur;
-        x = b->T[t1].nb[fo];
-        b->T[nx].nb[fo] = x;
-        relink(b, x, fc, t1, nx);
-        cur = nx;
-        part[j + 1] = cur;
-    }
-}
-
-/* Inserts wall piece s into the map. */
-static void insert_seg(tbuild *b, uint32_t s)
-{
-    uint32_t l, r, k, j, first, last, A = POLAR_NONE, B = POLAR_NONE;
-    uint32_t U0, L0, Uk, Lk, fnb[4], lnb[4], flp, lrp;
-    l = b->lr[s][0];
-    r = b->lr[s][1];
-    k = follow(b, s, l, r);
-    if (b->fail)
-        return;
-    first = b->list[0];
-    last = b->list[k];
-    for (j = 0; j < 4; j++) {
-        fnb[j] = b->T[first].nb[j];
-        lnb[j] = b->T[last].nb[j];
-    }
-    flp = b->T[first].lp;
-    lrp = b->T[last].rp;
-    if (lex_cmp(bpt(b, l), bpt(b, flp)) > 0) {
-        A = new_trap(b);
-        set_trap(b, A, flp, l, b->T[first].top, b->T[first].bot);
-    }
-    if (lex_cmp(bpt(b, r), bpt(b, lrp)) < 0) {
-        B = new_trap(b);
-        set_trap(b, B, r, lrp, b->T[last].top, b->T[last].bot);
-    }
-    make_chain(b, s, l, r, k, 1);
-    make_chain(b, s, l, r, k, 0);
-    if (b->fail)
-        return;
-    U0 = b->up[0];
-    L0 = b->lo[0];
-    Uk = b->up[k];
-    Lk = b->lo[k];
-    /* left end */
-    if (A != POLAR_NONE) {
-        b->T[A].nb[UL] = fnb[UL];
-        b->T[A].nb[LL] = fnb[LL];
-        relink(b, fnb[UL], UR, first, A);
-        relink(b, fnb[UL], LR, first, A);
-        relink(b, fnb[LL], UR, first, A);
-        relink(b, fnb[LL], LR, first, A);
-        b->T[A].nb[UR] = U0;
-        b->T[A].nb[LR] = L0;
-        b->T[U0].nb[UL] = A;
-        b->T[L0].nb[LL] = A;
-    } else {
-        b->T[U0].nb[UL] = fnb[UL];
-        b->T[L0].nb[LL] = fnb[LL];
-        relink(b, fnb[UL], UR, first, U0);
-        relink(b, fnb[UL], LR, first, L0);
-        relink(b, fnb[LL], UR, first, U0);
-        relink(b, fnb[LL], LR, first, L0);
-    }
-    /* right end */
-    if (B != POLAR_NONE) {
-        b->T[B].nb[UR] = lnb[UR];
-        b->T[B].nb[LR] = lnb[LR];
-        relink(b, lnb[UR], UL, last, B);
-        relink(b, lnb[UR], LL, last, B);
-        relink(b, lnb[LR], UL, last, B);
-        relink(b, lnb[LR], LL, last, B);
-        b->T[B].nb[UL] = Uk;
-        b->T[B].nb[LL] = Lk;
-        b->T[Uk].nb[UR] = B;
-        b->T[Lk].nb[LR] = B;
-    } else {
-        b->T[Uk].nb[UR] = lnb[UR];
-        b->T[Lk].nb[LR] = lnb[LR];
-        relink(b, lnb[UR], UL, last, Uk);
-        relink(b, lnb[UR], LL, last, Lk);
-        relink(b, lnb[LR], UL, last, Uk);
-        relink(b, lnb[LR], LL, last, Lk);
-    }
-    /* leaves for the new trapezoids */
-    if (A != POLAR_NONE)
-        b->T[A].leaf = new_node(b, N_LEAF, A, 0, 0);
-    if (B != POLAR_NONE)
-        b->T[B].leaf = new_node(b, N_LEAF, B, 0, 0);
-    for (j = 0; j <= k; j++) {
-        if (b->T[b->up[j]].leaf == POLAR_NONE)
-            b->T[b->up[j]].leaf = new_node(b, N_LEAF, b->up[j], 0, 0);
-        if (b->T[b->lo[j]].leaf == POLAR_NONE)
-            b->T[b->lo[j]].leaf = new_node(b, N_LEAF, b->lo[j], 0, 0);
-    }
-    if (b->fail)
-        return;
-    /* the old leaves become search nodes */
-    for (j = 0; j <= k; j++) {
-        uint32_t t = b->list[j], n = b->T[t].leaf;
-        uint32_t y0 = b->T[b->lo[j]].leaf, y1 = b->T[b->up[j]].leaf;
-        uint32_t inner;
-        int xa = (j == 0 && A != POLAR_NONE), xb = (j == k && B != POLAR_NONE);
-        if (!xa && !xb) {
-            b->node[n][0] = PACK(ykind(b, s), s);
-            b->node[n][1] = y0;
-            b->node[n][2] = y1;
-        } else {
-            inner = new_node(b, ykind(b, s), s, y0, y1);
-            if (xb) {
-                uint32_t xq = xa ? new_node(b, N_X, r, inner, b->T[B].leaf) : POLAR_NONE;
-                if (xa) {
-                    b->node[n][0] = PACK(N_X, l);
-                    b->node[n][1] = b->T[A].leaf;
-                    b->node[n][2] = xq;
-                } else {
-                    b->node[n][0] = PACK(N_X, r);
-                    b->node[n][1] = inner;
-                    b->node[n][2] = b->T[B].leaf;
-                }
-            } else {
-                b->node[n][0] = PACK(N_X, l);
-                b->node[n][1] = b->T[A].leaf;
-                b->node[n][2] = inner;
-            }
-        }
-        b->T[t].dead = 1;
-        b->freel[b->nfree++] = t;
-    }
-}
-
-/* ---- coverage ---------------------------------------------------------- */
-
-/* Footprints covering the space just above each segment (frame). */
-static int compute_cover(tbuild *b, int32_t *cov, uint32_t *below,
-                         uint32_t *stack)
-{
-    const polar *pd = b->pd;
-    uint32_t t, s, nseg = pd->nseg;
-    const int32_t UNSET = INT32_MIN;
-    for (s = 0; s < nseg; s++) {
-        cov[s] = UNSET;
-        below[s] = POLAR_NONE;
-    }
-    for (s = pd->nwall; s < nseg; s++)
-        cov[s] = 0;
-    for (t = 0; t < b->ntrap; t++)
-        if (!b->T[t].dead && below[b->T[t].top] == POLAR_NONE)
-            below[b->T[t].top] = b->T[t].bot;
-    for (s = 0; s < nseg; s++) {
-        uint32_t n = 0, x = s;
-        while (cov[x] == UNSET) {
-            if (below[x] == POLAR_NONE || n >= nseg)
-                return -1;
-            stack[n++] = x;
-            x = below[x];
-        }
-        while (n > 0) {
-            uint32_t y = stack[--n];
-            cov[y] = cov[below[y]] + seg_delta(pd, b->frame, y);
-        }
-    }
-    return 0;
 }
 
 /* ---- build ------------------------------------------------------------- */
@@ -722,7 +503,7 @@ static void frame_box(const polar *pd, polar_map *m)
     double vmax = -DBL_MAX, vmin = DBL_MAX;
     for (i = 0; i < 4; i++) {
         const polar_seg *g = &pd->seg[s0 + i];
-        vec2 a = polar_fpt(pd, m->frame, g->a), b = polar_fpt(pd, m->frame, g->b);
+        vec2 a = fpt(pd, m->frame, g->a), b = fpt(pd, m->frame, g->b);
         if (a.y == b.y && a.y > vmax) {
             vmax = a.y;
             m->box_top = s0 + i;
@@ -734,10 +515,10 @@ static void frame_box(const polar *pd, polar_map *m)
     }
     m->box_lo = m->box_hi = p0;
     for (i = 1; i < 4; i++) {
-        vec2 f = polar_fpt(pd, m->frame, p0 + i);
-        if (lex_cmp(f, polar_fpt(pd, m->frame, m->box_lo)) < 0)
+        vec2 f = fpt(pd, m->frame, p0 + i);
+        if (lex_cmp(f, fpt(pd, m->frame, m->box_lo)) < 0)
             m->box_lo = p0 + i;
-        if (lex_cmp(f, polar_fpt(pd, m->frame, m->box_hi)) > 0)
+        if (lex_cmp(f, fpt(pd, m->frame, m->box_hi)) > 0)
             m->box_hi = p0 + i;
     }
 }
@@ -763,124 +544,488 @@ static void *keep_n(arena *a, size_t n, size_t size, size_t *acc)
 }
 
 /* The child word (polar.h) for build node c. */
-static uint32_t child_word(const tbuild *b, uint32_t c, const uint32_t *renum,
-                           const uint32_t *nrenum, const int32_t *cov)
+/* ---- the grid of wall pieces ------------------------------------------ */
+
+static uint32_t grid_cell(double v, double v0, double scale, uint32_t n)
 {
-    uint32_t w = b->node[c][0], t;
-    if (KIND(w) != N_LEAF)
-        return PACK(POLAR_CHILD_NODE, nrenum[c]);
-    t = IDX(w);
-    if (cov[b->T[t].bot] == 0)
-        return PACK(POLAR_CHILD_FREE, renum[t]);
-    /* solid: the wall with the footprint on the trapezoid's side */
-    return PACK(POLAR_CHILD_SOLID, seg_delta(b->pd, b->frame, b->T[t].bot) > 0 ? b->T[t].bot
-                                                                             : b->T[t].top);
+    double c = floor((v - v0) * scale);
+    if (!(c >= 0.0))
+        return 0;
+    if (c >= (double)n)
+        return n - 1;
+    return (uint32_t)c;
 }
 
-/* Builds the trapezoidal map of one frame into scratch, then copies it. */
-static plx_status build_map(arena *a, polar *pd, polar_map *m, uint32_t *order)
+static uint32_t grid_x(const polar *pd, double x)
 {
-    tbuild b;
-    uint32_t nw = pd->nwall, i, t, n;
-    uint32_t *renum, *nrenum, *queue, nq;
-    int32_t *cov;
-    uint32_t *below, *stack;
-    memset(&b, 0, sizeof b);
-    b.pd = pd;
-    b.frame = m->frame;
-    b.cap = 4 * nw + 64;
-    b.cap_node = 16 * nw + 64;
-    b.T = scratch_n(a, b.cap, sizeof(btrap));
-    b.freel = scratch_n(a, b.cap, 4);
-    b.list = scratch_n(a, b.cap, 4);
-    b.up = scratch_n(a, b.cap, 4);
-    b.lo = scratch_n(a, b.cap, 4);
-    b.node = scratch_n(a, b.cap_node, 12);
-    b.lr = scratch_n(a, pd->nseg, 8);
-    if (!b.lr)
+    return grid_cell(x, pd->box[0], pd->gsx, pd->gnx);
+}
+
+static uint32_t grid_y(const polar *pd, double y)
+{
+    return grid_cell(y, pd->box[1], pd->gsy, pd->gny);
+}
+
+/* Every wall piece listed in the cells its bounding box meets (about two
+ * pieces per cell). Cell functions are monotone, which is all polar_locate
+ * needs to stop its scan exactly. */
+static plx_status build_grid(arena *a, polar *pd)
+{
+    double W = pd->box[2] - pd->box[0], H = pd->box[3] - pd->box[1];
+    double side = sqrt(W * H / ((double)pd->nwall / 2.0 + 1.0));
+    uint32_t nx = (uint32_t)fmin(fmax(ceil(W / side), 1.0), 2048.0);
+    uint32_t ny = (uint32_t)fmin(fmax(ceil(H / side), 1.0), 2048.0);
+    uint32_t ncell = nx * ny, s, i, x, y;
+    uint32_t *cell;
+    size_t total = 0;
+    pd->gnx = nx;
+    pd->gny = ny;
+    pd->gsx = (double)nx / W;
+    pd->gsy = (double)ny / H;
+    cell = keep_n(a, (size_t)ncell + 1, 4, &pd->bytes[3]);
+    if (!cell)
         return PLX_E_NOMEM;
-    for (i = 0; i < pd->nseg; i++)
-        seg_ends(pd, m->frame, i, &b.lr[i][0], &b.lr[i][1]);
-    if (!b.T || !b.freel ||
-        !b.list || !b.up || !b.lo || !b.node)
-        return PLX_E_NOMEM;
-    frame_box(pd, m);
-    t = new_trap(&b);
-    set_trap(&b, t, m->box_lo, m->box_hi, m->box_top, m->box_bot);
-    b.T[t].leaf = new_node(&b, N_LEAF, t, 0, 0);
-    for (i = 0; i < nw && !b.fail; i++)
-        insert_seg(&b, order[i]);
-    if (b.fail)
-        return b.fail == 1 ? PLX_E_NOMEM : PLX_E_SCENE;
-    /* solid or free */
-    cov = scratch_n(a, pd->nseg, 4);
-    below = scratch_n(a, pd->nseg, 4);
-    stack = scratch_n(a, pd->nseg, 4);
-    renum = scratch_n(a, b.ntrap, 4);
-    if (!cov || !below || !stack || !renum)
-        return PLX_E_NOMEM;
-    if (compute_cover(&b, cov, below, stack) != 0)
-        return PLX_E_SCENE;
-    /* keep the free trapezoids only; inner search nodes in breadth-first
-     * order from the root (the top levels, visited by every search, share
-     * cache lines); leaves folded into child words */
-    n = 0;
-    for (t = 0; t < b.ntrap; t++)
-        renum[t] = (b.T[t].dead || cov[b.T[t].bot] != 0) ? POLAR_NONE : n++;
-    nrenum = scratch_n(a, b.nnode, 4);
-    queue = scratch_n(a, b.nnode, 4);
-    if (!nrenum || !queue)
-        return PLX_E_NOMEM;
-    for (i = 0; i < b.nnode; i++)
-        nrenum[i] = POLAR_NONE;
-    nq = 0;
-    if (KIND(b.node[0][0]) != N_LEAF) {
-        nrenum[0] = 0;
-        queue[nq++] = 0;
+    memset(cell, 0, ((size_t)ncell + 1) * 4);
+    for (s = 0; s < pd->nwall; s++) {
+        vec2 p = pd->pts[pd->seg[s].a], q = pd->pts[pd->seg[s].b];
+        uint32_t x0 = grid_x(pd, fmin(p.x, q.x)), x1 = grid_x(pd, fmax(p.x, q.x));
+        uint32_t y0 = grid_y(pd, fmin(p.y, q.y)), y1 = grid_y(pd, fmax(p.y, q.y));
+        for (y = y0; y <= y1; y++)
+            for (x = x0; x <= x1; x++)
+                cell[y * nx + x + 1]++;
+        total += (size_t)(x1 - x0 + 1) * (y1 - y0 + 1);
     }
-    for (i = 0; i < nq; i++) {
-        uint32_t j;
-        for (j = 1; j < 3; j++) {
-            uint32_t c = b.node[queue[i]][j];
-            if (KIND(b.node[c][0]) != N_LEAF && nrenum[c] == POLAR_NONE) {
-                nrenum[c] = nq;
-                queue[nq++] = c;
+    if (total >= 0xffffffffu)
+        return PLX_E_NOMEM;
+    for (i = 0; i < ncell; i++)
+        cell[i + 1] += cell[i];
+    pd->gwall = keep_n(a, total, 4, &pd->bytes[3]);
+    if (!pd->gwall)
+        return PLX_E_NOMEM;
+    for (s = 0; s < pd->nwall; s++) {
+        vec2 p = pd->pts[pd->seg[s].a], q = pd->pts[pd->seg[s].b];
+        uint32_t x0 = grid_x(pd, fmin(p.x, q.x)), x1 = grid_x(pd, fmax(p.x, q.x));
+        uint32_t y0 = grid_y(pd, fmin(p.y, q.y)), y1 = grid_y(pd, fmax(p.y, q.y));
+        for (y = y0; y <= y1; y++)
+            for (x = x0; x <= x1; x++)
+                pd->gwall[cell[y * nx + x]++] = s;
+    }
+    for (i = ncell; i > 0; i--)
+        cell[i] = cell[i - 1];
+    cell[0] = 0;
+    pd->gcell = cell;
+    return PLX_OK;
+}
+
+/* Is wall LR above wall BL-BR where both span a common frame abscissa
+ * (lexicographically) and do not cross? */
+static int seg_over(vec2 L, vec2 R, vec2 BL, vec2 BR)
+{
+    int c = lex_cmp(L, BL), o;
+    if (c > 0) {
+        o = geom_orient(BL, BR, L);
+        return (o ? o : geom_orient(BL, BR, R)) > 0;
+    }
+    if (c < 0) {
+        o = geom_orient(L, R, BL);
+        return (o ? o : geom_orient(L, R, BR)) < 0;
+    }
+    return geom_orient(BL, BR, R) > 0;
+}
+
+/* The nearest wall piece below frame point f (frame "below": smaller v)
+ * among those whose span holds f strictly (lexicographically), found by
+ * scanning the grid column of f downwards and stopping as soon as no unseen
+ * piece can be higher; POLAR_NONE when there is none (the Bounds side).
+ * Sets *on and returns POLAR_NONE when f is on a piece, or is the end of
+ * one unless ends_ok (then pieces ending at f are passed over). */
+static uint32_t wall_below(const polar *pd, int frame, vec2 f, int ends_ok, int *on)
+{
+    vec2 wp = polar_from_frame(frame, f), BL = f, BR = f;
+    uint32_t best = POLAR_NONE, fixed, nx = pd->gnx;
+    int32_t k, end, step;
+    *on = 0;
+    if (frame) {
+        fixed = grid_x(pd, wp.x);
+        k = (int32_t)grid_y(pd, wp.y);
+        step = -1;
+        end = -1;
+    } else {
+        fixed = grid_y(pd, wp.y);
+        k = (int32_t)grid_x(pd, wp.x);
+        step = 1;
+        end = (int32_t)nx;
+    }
+    for (; k != end; k += step) {
+        uint32_t cell = frame ? (uint32_t)k * nx + fixed : fixed * nx + (uint32_t)k, e;
+        for (e = pd->gcell[cell]; e < pd->gcell[cell + 1]; e++) {
+            uint32_t s = pd->gwall[e];
+            vec2 L, R, wa = pd->pts[pd->seg[s].a], wb = pd->pts[pd->seg[s].b];
+            int cl, cr, o;
+            if (frame ? (wa.x < wp.x && wb.x < wp.x) || (wa.x > wp.x && wb.x > wp.x)
+                      : (wa.y < wp.y && wb.y < wp.y) || (wa.y > wp.y && wb.y > wp.y))
+                continue;      /* its frame abscissae miss f's */
+            L = to_frame(frame, wa);
+            R = to_frame(frame, wb);
+            if (lex_cmp(L, R) > 0) {
+                vec2 x = L;
+                L = R;
+                R = x;
+            }
+            cl = lex_cmp(f, L);
+            cr = lex_cmp(f, R);
+            if (cl == 0 || cr == 0) {
+                if (ends_ok)
+                    continue;
+                *on = 1;
+                return POLAR_NONE;
+            }
+            if (cl < 0 || cr > 0 || s == best)
+                continue;
+            o = geom_orient(L, R, f);
+            if (o == 0) {
+                *on = 1;
+                return POLAR_NONE;
+            }
+            if (o > 0 && (best == POLAR_NONE || seg_over(L, R, BL, BR))) {
+                best = s;
+                BL = L;
+                BR = R;
+            }
+        }
+        if (best != POLAR_NONE) {
+            double low = fmin(BL.y, BR.y);
+            int32_t lim = frame ? (int32_t)grid_y(pd, low) : (int32_t)grid_x(pd, -low);
+            if (frame ? k <= lim : k >= lim)
+                break;
+        }
+    }
+    return best;
+}
+
+/* ---- trapezoidal map construction: a plane sweep ---------------------- */
+
+/* The sweep runs over the wall ends in frame order (lexicographic (u, v),
+ * i.e. a sweep line turned by an infinitesimal angle, so equal u needs no
+ * special case). The status is the list of wall pieces crossing the sweep
+ * line, bottom to top, headed by the Bounds side at the bottom; between two
+ * consecutive pieces lies one open trapezoid, which the next event between
+ * them closes with the axis of that event's point. An event where pieces
+ * end finds its place in the list through them; an event where pieces only
+ * start finds the piece below it through the grid of walls (wall_below: the
+ * nearest piece below whose span holds the point is exactly the status
+ * piece below it). Only free trapezoids are made: whether the gap above a
+ * piece is solid is known when the piece enters the status (footprints
+ * counted from the bottom, as the piece below plus the piece's own change).
+ * Every decision is a geom_orient sign or a lexicographic comparison. */
+
+typedef struct snode {
+    vec2 l, r;          /* frame ends, l before r */
+    int32_t cov;        /* footprints covering the gap above it */
+    uint32_t open;      /* the free region open above it, or POLAR_NONE */
+    uint32_t prev, next; /* status list; prev == POLAR_NONE: not in it */
+} snode;
+
+typedef struct fpoint {
+    vec2 f;             /* frame coordinates */
+    uint32_t i;         /* point index */
+} fpoint;
+
+typedef struct sweep {
+    const polar *pd;
+    polar_map *m;
+    snode *N;           /* per segment (walls and Bounds sides) */
+    polar_trap *T;
+    uint32_t ntrap, cap;
+    uint32_t *above;    /* per wall: the first free region above it */
+    const uint32_t *inc_first, *inc; /* walls incident to each point */
+    uint32_t *start;    /* scratch: pieces starting at the event */
+} sweep;
+
+static int fp_before(const fpoint *a, const fpoint *b)
+{
+    int c = lex_cmp(a->f, b->f);
+    return c < 0 || (c == 0 && a->i < b->i);
+}
+
+/* Bottom-up merge sort (runs of 16 by insertion first); result in v. */
+static void sort_fpoints(fpoint *v, fpoint *tmp, uint32_t n)
+{
+    uint32_t w, i, j;
+    fpoint *src = v, *dst = tmp;
+    for (i = 0; i < n; i += 16) {
+        uint32_t e = i + 16 < n ? i + 16 : n;
+        for (j = i + 1; j < e; j++) {
+            fpoint t = v[j];
+            uint32_t k = j;
+            while (k > i && fp_before(&t, &v[k - 1])) {
+                v[k] = v[k - 1];
+                k--;
+            }
+            v[k] = t;
+        }
+    }
+    for (w = 16; w < n; w *= 2) {
+        for (i = 0; i < n; i += 2 * w) {
+            uint32_t a = i, am = i + w < n ? i + w : n, b = am, bm = i + 2 * w < n ? i + 2 * w : n;
+            uint32_t o = i;
+            while (a < am && b < bm)
+                dst[o++] = fp_before(&src[b], &src[a]) ? src[b++] : src[a++];
+            while (a < am)
+                dst[o++] = src[a++];
+            while (b < bm)
+                dst[o++] = src[b++];
+        }
+        {
+            fpoint *t = src;
+            src = dst;
+            dst = t;
+        }
+    }
+    if (src != v)
+        memcpy(v, src, (size_t)n * sizeof *v);
+}
+
+static uint32_t new_region(sweep *w, uint32_t lp, uint32_t top, uint32_t bot)
+{
+    polar_trap *t;
+    if (w->ntrap >= w->cap)
+        return POLAR_NONE;
+    t = &w->T[w->ntrap];
+    t->lp = lp;
+    t->rp = POLAR_NONE;
+    t->top = top;
+    t->bot = bot;
+    t->nb[0] = t->nb[1] = t->nb[2] = t->nb[3] = POLAR_NONE;
+    return w->ntrap++;
+}
+
+/* One event: the walls ending and starting at frame point P (point index
+ * pi, the points pts[0..npts-1] all at P). Returns 0, or -1 when the walls
+ * are not a planar subdivision (pieces crossing after rounding). */
+static int sweep_event(sweep *w, vec2 P, uint32_t pi, const fpoint *pts, uint32_t npts)
+{
+    snode *N = w->N;
+    const polar_map *m = w->m;
+    uint32_t x, y, B, A, last = POLAR_NONE, some_end = POLAR_NONE, k = 0, nend = 0, ns = 0;
+    uint32_t G0, Gk, H0 = POLAR_NONE, Hm = POLAR_NONE, i, j;
+    /* the walls starting here, bottom to top; those ending here counted */
+    for (i = 0; i < npts; i++) {
+        uint32_t p = pts[i].i;
+        for (j = w->inc_first[p]; j < w->inc_first[p + 1]; j++) {
+            uint32_t s = w->inc[j];
+            if (lex_cmp(N[s].l, P) == 0) {
+                /* x above y: orient(y.l, y.r, x.r) > 0 */
+                uint32_t q = ns++;
+                while (q > 0) {
+                    int o = geom_orient(N[w->start[q - 1]].l, N[w->start[q - 1]].r, N[s].r);
+                    if (o == 0)
+                        return -1;
+                    if (o > 0)
+                        break;
+                    w->start[q] = w->start[q - 1];
+                    q--;
+                }
+                w->start[q] = s;
+            } else {
+                nend++;
+                some_end = s;
             }
         }
     }
-    m->ntrap = n;
-    m->nnode = nq;
-    m->trap = keep_n(a, n, sizeof(polar_trap), &pd->bytes[0]);
-    m->node = keep_n(a, nq, 12, &pd->bytes[3]);
-    if (!m->trap || !m->node)
-        return PLX_E_NOMEM;
-    /* polar_memory: the axes (lp, rp, nb) and the regions (top, bot) */
-    pd->bytes[0] -= (size_t)n * 8;
-    pd->bytes[1] += (size_t)n * 8;
-    for (t = 0; t < b.ntrap; t++) {
-        uint32_t u = renum[t], j;
-        polar_trap *q;
-        if (u == POLAR_NONE)
-            continue;
-        q = &m->trap[u];
-        q->top = b.T[t].top;
-        q->bot = b.T[t].bot;
-        q->lp = b.T[t].lp;
-        q->rp = b.T[t].rp;
-        for (j = 0; j < 4; j++) {
-            uint32_t x = b.T[t].nb[j];
-            if (x != POLAR_NONE && renum[x] == POLAR_NONE)
-                return PLX_E_SCENE;    /* a solid neighbour: cannot happen */
-            q->nb[j] = x == POLAR_NONE ? POLAR_NONE : renum[x];
+    /* B: the status piece below P */
+    if (nend > 0) {
+        x = some_end;
+        if (N[x].prev == POLAR_NONE)
+            return -1;
+        while ((y = N[x].prev) != m->box_bot && lex_cmp(N[y].r, P) == 0)
+            x = y;
+        B = N[x].prev;
+    } else {
+        int on;
+        B = wall_below(w->pd, m->frame, P, 1, &on);
+        if (on)
+            return -1;
+        if (B == POLAR_NONE)
+            B = m->box_bot;
+        else if (N[B].prev == POLAR_NONE)
+            return -1;
+    }
+    /* the pieces ending at P follow B */
+    for (y = N[B].next; y != POLAR_NONE && lex_cmp(N[y].r, P) == 0; y = N[y].next) {
+        last = y;
+        k++;
+    }
+    if (k != nend)
+        return -1;
+    A = y;
+    if (A != POLAR_NONE && geom_orient(N[A].l, N[A].r, P) >= 0)
+        return -1;
+    /* close the gaps B..e1, e1..e2, ..., ek..A */
+    G0 = N[B].open;
+    Gk = k ? N[last].open : G0;
+    if (G0 != POLAR_NONE)
+        w->T[G0].rp = pi;
+    for (y = N[B].next, i = 0; i < k; i++) {
+        x = N[y].next;
+        if (N[y].open != POLAR_NONE)
+            w->T[N[y].open].rp = pi;
+        N[y].prev = N[y].next = POLAR_NONE;
+        y = x;
+    }
+    /* open the gaps B..s1, s1..s2, ..., sm..A and link s1..sm in */
+    for (j = 0; j <= ns; j++) {
+        uint32_t bot = j ? w->start[j - 1] : B;
+        uint32_t top = j < ns ? w->start[j] : (A == POLAR_NONE ? m->box_top : A);
+        uint32_t h = POLAR_NONE;
+        if (j > 0) {
+            const polar_seg *g = &w->pd->seg[bot];
+            int32_t d = lex_cmp(fpt(w->pd, m->frame, g->a), P) == 0 ? g->cover : -g->cover;
+            uint32_t below = j > 1 ? w->start[j - 2] : B;
+            N[bot].cov = N[below].cov + d;
+            N[bot].prev = below;
+            N[below].next = bot;
+        }
+        if (N[bot].cov == 0) {
+            h = new_region(w, pi, top, bot);
+            if (h == POLAR_NONE)
+                return -1;
+        }
+        N[bot].open = h;
+        if (j > 0)
+            w->above[bot] = h;
+        if (j == 0)
+            H0 = h;
+        if (j == ns) {
+            Hm = h;
+            N[bot].next = A;
+            if (A != POLAR_NONE)
+                N[A].prev = bot;
         }
     }
-    m->root = child_word(&b, 0, renum, nrenum, cov);
-    for (i = 0; i < nq; i++) {
-        uint32_t o = queue[i];
-        m->node[i][0] = b.node[o][0];
-        m->node[i][1] = child_word(&b, b.node[o][1], renum, nrenum, cov);
-        m->node[i][2] = child_word(&b, b.node[o][2], renum, nrenum, cov);
+    if (G0 != POLAR_NONE)
+        w->T[G0].nb[LR] = H0;
+    if (Gk != POLAR_NONE)
+        w->T[Gk].nb[UR] = Hm;
+    if (H0 != POLAR_NONE)
+        w->T[H0].nb[LL] = G0;
+    if (Hm != POLAR_NONE)
+        w->T[Hm].nb[UL] = Gk;
+    return 0;
+}
+
+/* Walls incident to each point (both frames), and the points that are
+ * wall ends: the events of the sweeps. */
+static plx_status build_incidence(arena *a, const polar *pd, uint32_t **inc_first,
+                                  uint32_t **inc, uint32_t **evp, uint32_t *nev)
+{
+    uint32_t i, s, n = 0, *f, *v, *e;
+    f = scratch_n(a, (size_t)pd->npts + 1, 4);
+    v = scratch_n(a, (size_t)pd->nwall * 2, 4);
+    e = scratch_n(a, pd->npts, 4);
+    if (!f || !v || !e)
+        return PLX_E_NOMEM;
+    memset(f, 0, ((size_t)pd->npts + 1) * 4);
+    for (s = 0; s < pd->nwall; s++) {
+        f[pd->seg[s].a + 1]++;
+        f[pd->seg[s].b + 1]++;
     }
+    for (i = 0; i < pd->npts; i++) {
+        if (f[i + 1] > 0)
+            e[n++] = i;
+        f[i + 1] += f[i];
+    }
+    for (s = 0; s < pd->nwall; s++) {
+        v[f[pd->seg[s].a]++] = s;
+        v[f[pd->seg[s].b]++] = s;
+    }
+    for (i = pd->npts; i > 0; i--)
+        f[i] = f[i - 1];
+    f[0] = 0;
+    *inc_first = f;
+    *inc = v;
+    *evp = e;
+    *nev = n;
+    return PLX_OK;
+}
+
+/* Builds the trapezoidal map of one frame: the sweep, then the regions and
+ * the first region above each wall piece are kept, with the regions above
+ * the Bounds side at the bottom indexed by grid column (polar_locate). */
+static plx_status build_map(arena *a, polar *pd, polar_map *m, const uint32_t *inc_first,
+                            const uint32_t *inc, const uint32_t *evp, uint32_t nev)
+{
+    sweep w;
+    fpoint *ev, *tmp;
+    uint32_t i, j, s, t, c, ncol;
+    memset(&w, 0, sizeof w);
+    w.pd = pd;
+    w.m = m;
+    w.inc_first = inc_first;
+    w.inc = inc;
+    w.cap = 3 * pd->nwall + 8;
+    w.N = scratch_n(a, pd->nseg, sizeof(snode));
+    w.T = scratch_n(a, w.cap, sizeof(polar_trap));
+    w.start = scratch_n(a, pd->nwall + 1, 4);
+    ev = scratch_n(a, nev, sizeof(fpoint));
+    tmp = scratch_n(a, nev, sizeof(fpoint));
+    ncol = m->frame ? pd->gnx : pd->gny;
+    m->above = keep_n(a, pd->nwall, 4, &pd->bytes[3]);
+    m->col_start = keep_n(a, ncol, 4, &pd->bytes[3]);
+    if (!w.N || !w.T || !w.start || !ev || !tmp || !m->above || !m->col_start)
+        return PLX_E_NOMEM;
+    m->ncol = ncol;
+    w.above = m->above;
+    frame_box(pd, m);
+    for (s = 0; s < pd->nseg; s++) {
+        uint32_t l, r;
+        seg_ends(pd, m->frame, s, &l, &r);
+        w.N[s].l = fpt(pd, m->frame, l);
+        w.N[s].r = fpt(pd, m->frame, r);
+        w.N[s].cov = 0;
+        w.N[s].open = POLAR_NONE;
+        w.N[s].prev = w.N[s].next = POLAR_NONE;
+    }
+    for (s = 0; s < pd->nwall; s++)
+        m->above[s] = POLAR_NONE;
+    w.N[m->box_bot].open = new_region(&w, m->box_lo, m->box_top, m->box_bot);
+    for (i = 0; i < nev; i++) {
+        ev[i].f = fpt(pd, m->frame, evp[i]);
+        ev[i].i = evp[i];
+    }
+    sort_fpoints(ev, tmp, nev);
+    for (i = 0; i < nev; i = j) {
+        for (j = i + 1; j < nev && lex_cmp(ev[j].f, ev[i].f) == 0; j++)
+            ;
+        if (sweep_event(&w, ev[i].f, ev[i].i, ev + i, j - i) != 0)
+            return PLX_E_SCENE;
+    }
+    if (w.N[m->box_bot].next != POLAR_NONE || w.N[m->box_bot].open == POLAR_NONE)
+        return PLX_E_SCENE;
+    w.T[w.N[m->box_bot].open].rp = m->box_hi;
+    for (t = 0; t < w.ntrap; t++)
+        if (w.T[t].rp == POLAR_NONE)
+            return PLX_E_SCENE;
+    m->ntrap = w.ntrap;
+    m->trap = keep_n(a, w.ntrap, sizeof(polar_trap), &pd->bytes[0]);
+    if (!m->trap)
+        return PLX_E_NOMEM;
+    memcpy(m->trap, w.T, (size_t)w.ntrap * sizeof(polar_trap));
+    /* polar_memory: the axes (lp, rp, nb) and the regions (top, bot) */
+    pd->bytes[0] -= (size_t)w.ntrap * 8;
+    pd->bytes[1] += (size_t)w.ntrap * 8;
+    /* the regions above the bottom side, left to right: per column the
+     * first one reaching into it */
+    for (t = 0, c = 0; t != POLAR_NONE && c < ncol; t = m->trap[t].nb[LR]) {
+        double u = fpt(pd, m->frame, m->trap[t].rp).x;
+        uint32_t last = m->frame ? grid_x(pd, u) : grid_y(pd, u);
+        if (m->trap[t].rp == m->box_hi)
+            last = ncol - 1;
+        while (c <= last && c < ncol)
+            m->col_start[c++] = t;
+    }
+    if (c < ncol)
+        return PLX_E_SCENE;
     return PLX_OK;
 }
 
@@ -891,7 +1036,7 @@ static plx_status make_walls(arena *a, polar *pd)
     edges e;
     split_ctx c;
     keyed *order;
-    uint32_t *active, i, j, nocc = 0, nextra, np = 0, nm = 0;
+    uint32_t *active, *cut_first, i, j, nocc = 0, nextra, np = 0, nm = 0;
     split *sp;
     piece *pc;
     e.n = count_edges(s);
@@ -913,28 +1058,44 @@ static plx_status make_walls(arena *a, polar *pd)
         nocc++;
     }
     qsort(order, nocc, sizeof(keyed), cmp_keyed);
-    /* pass 1: count cuts and new points, with the scene's points */
+    /* the contacts, with the scene's points (edges end at scene points) */
     memset(&c, 0, sizeof c);
     c.pd = pd;
     c.e = &e;
-    pd->pts = (vec2 *)s->pts;   /* read only during the count */
+    c.a = a;
+    pd->pts = (vec2 *)s->pts;   /* read only meanwhile */
     c.npts = s->npts;
     find_contacts(&c, s, order, nocc, active);
+    if (c.nomem)
+        return PLX_E_NOMEM;
     nextra = c.npts - s->npts;
-    /* pass 2: for real */
     pd->npts = s->npts + nextra + 4;
     pd->pts = keep_n(a, pd->npts, sizeof(vec2), &pd->bytes[2]);
     sp = scratch_n(a, c.nsp, sizeof(split));
-    if (!pd->pts || !sp)
+    cut_first = scratch_n(a, (size_t)e.n + 1, 4);
+    if (!pd->pts || !sp || !cut_first)
         return PLX_E_NOMEM;
     if (s->npts)
         memcpy(pd->pts, s->pts, s->npts * sizeof(vec2));
-    c.sp = sp;
-    c.nsp = 0;
-    c.npts = s->npts;
-    c.cap_pts = s->npts + nextra;
-    find_contacts(&c, s, order, nocc, active);
-    qsort(sp, c.nsp, sizeof(split), cmp_split); /* stable enough: grouped by edge */
+    {
+        uint32_t n = s->npts;
+        point_chunk *k;
+        split_chunk *q;
+        for (k = c.pt0; k; k = k->next) {
+            memcpy(pd->pts + n, k->v, k->n * sizeof(vec2));
+            n += k->n;
+        }
+        /* the cuts grouped by edge (counting sort) */
+        memset(cut_first, 0, ((size_t)e.n + 1) * 4);
+        for (q = c.sp0; q; q = q->next)
+            for (i = 0; i < q->n; i++)
+                cut_first[q->v[i].seg + 1]++;
+        for (i = 0; i < e.n; i++)
+            cut_first[i + 1] += cut_first[i];
+        for (q = c.sp0; q; q = q->next)
+            for (i = 0; i < q->n; i++)
+                sp[cut_first[q->v[i].seg]++] = q->v[i];
+    }
     pc = scratch_n(a, e.n + c.nsp, sizeof(piece));
     if (!pc)
         return PLX_E_NOMEM;
@@ -949,7 +1110,21 @@ static plx_status make_walls(arena *a, polar *pd)
         }
         emit_piece(pc, &np, pd->pts, prev, e.b[i], e.bld[i]);
     }
-    sort_pieces(pc, np, pd->pts);
+    {
+        pkey *ky = scratch_n(a, np, sizeof(pkey)), *tmp = scratch_n(a, np, sizeof(pkey));
+        piece *pc2 = scratch_n(a, np, sizeof(piece));
+        if (!ky || !tmp || !pc2)
+            return PLX_E_NOMEM;
+        for (i = 0; i < np; i++) {
+            ky[i].lo = pd->pts[pc[i].lo];
+            ky[i].hi = pd->pts[pc[i].hi];
+            ky[i].k = i;
+        }
+        sort_pkeys(ky, tmp, np);
+        for (i = 0; i < np; i++)
+            pc2[i] = pc[ky[i].k];
+        pc = pc2;
+    }
     pd->seg = keep_n(a, np + 4, sizeof(polar_seg), &pd->bytes[2]);
     if (!pd->seg)
         return PLX_E_NOMEM;
@@ -983,57 +1158,12 @@ static plx_status make_walls(arena *a, polar *pd)
     return PLX_OK;
 }
 
-/* Biased randomized insertion order (Amenta, Choi, Rote 2003): every wall
- * piece draws a round at random (the last round holds about half of them,
- * the one before a quarter, ...); rounds go in order and, within a round,
- * pieces follow a Z-order curve of their midpoints. The randomness of the
- * rounds keeps the expected O(n log n) of randomized incremental
- * construction; the spatial order within a round makes consecutive searches
- * in the DAG run through the same nodes (cache hits). Deterministic. */
-static uint32_t spread16(uint32_t x)
-{
-    x &= 0xffffu;
-    x = (x | (x << 8)) & 0x00ff00ffu;
-    x = (x | (x << 4)) & 0x0f0f0f0fu;
-    x = (x | (x << 2)) & 0x33333333u;
-    x = (x | (x << 1)) & 0x55555555u;
-    return x;
-}
-
-static int insertion_order(arena *a, const polar *pd, uint32_t *order, uint64_t *seed)
-{
-    uint32_t i, n = pd->nwall;
-    keyed *k = scratch_n(a, n, sizeof(keyed));
-    double sx = 65535.0 / (pd->box[2] - pd->box[0]), sy = 65535.0 / (pd->box[3] - pd->box[1]);
-    if (!k)
-        return -1;
-    for (i = 0; i < n; i++) {
-        const polar_seg *g = &pd->seg[i];
-        vec2 pa = pd->pts[g->a], pb = pd->pts[g->b];
-        uint32_t r = rng_next(seed), round = 0, ux, uy;
-        double mx = 0.5 * (pa.x + pb.x) - pd->box[0], my = 0.5 * (pa.y + pb.y) - pd->box[1];
-        while (round < 24 && (r & 1u)) {   /* round 24 - t with probability 2^-(t+1) */
-            round++;
-            r >>= 1;
-        }
-        ux = (uint32_t)fmin(fmax(mx * sx, 0.0), 65535.0);
-        uy = (uint32_t)fmin(fmax(my * sy, 0.0), 65535.0);
-        k[i].key = (double)(24 - round) * 4294967296.0 + (double)(spread16(ux) | (spread16(uy) << 1));
-        k[i].idx = i;
-    }
-    qsort(k, n, sizeof(keyed), cmp_keyed);
-    for (i = 0; i < n; i++)
-        order[i] = k[i].idx;
-    return 0;
-}
-
 plx_status polar_build(arena *a, const scene *s, polar **out)
 {
     arena_mark m0, m1;
     polar *pd;
     plx_status st;
-    uint32_t *order, i;
-    uint64_t seed = 0x9e3779b97f4a7c15ull;
+    uint32_t *inc_first = NULL, *inc = NULL, *evp = NULL, nev = 0, i;
     if (!a || !s || !out)
         return PLX_E_INVALID;
     *out = NULL;
@@ -1048,14 +1178,13 @@ plx_status polar_build(arena *a, const scene *s, polar **out)
     memcpy(pd->box, s->bounds, sizeof pd->box);
     pd->bytes[3] = sizeof(polar);
     st = make_walls(a, pd);
-    if (st == PLX_OK) {
-        order = scratch_n(a, pd->nwall, 4);
-        if (!order || insertion_order(a, pd, order, &seed) != 0)
-            st = PLX_E_NOMEM;
-        for (i = 0; st == PLX_OK && i < 2; i++) {
-            pd->map[i].frame = i;
-            st = build_map(a, pd, &pd->map[i], order);
-        }
+    if (st == PLX_OK)
+        st = build_grid(a, pd);
+    if (st == PLX_OK)
+        st = build_incidence(a, pd, &inc_first, &inc, &evp, &nev);
+    for (i = 0; st == PLX_OK && i < 2; i++) {
+        pd->map[i].frame = (int)i;
+        st = build_map(a, pd, &pd->map[i], inc_first, inc, evp, nev);
     }
     if (st != PLX_OK) {
         arena_release(a, &m0);
@@ -1072,37 +1201,49 @@ plx_status polar_build(arena *a, const scene *s, polar **out)
 
 /* ---- queries ----------------------------------------------------------- */
 
-/* The child word of the leaf holding frame point f, or POLAR_NONE when f
- * is on a wall or has the abscissa and ordinate of a vertex. */
-static uint32_t locate_word(const polar *pd, const polar_map *m, vec2 f)
+static int32_t seg_owner(const polar *pd, uint32_t s)
 {
-    uint32_t c = m->root;
-    while (POLAR_TAG(c) == POLAR_CHILD_NODE) {
-        const uint32_t *nd = m->node[c];
-        uint32_t w = nd[0];
-        if (KIND(w) == N_X) {
-            int k = lex_cmp(f, polar_fpt(pd, m->frame, IDX(w)));
-            if (k == 0)
-                return POLAR_NONE;
-            c = k < 0 ? nd[1] : nd[2];
-        } else {
-            const polar_seg *g = &pd->seg[IDX(w)];
-            uint32_t l = KIND(w) == N_Y ? g->a : g->b, r = KIND(w) == N_Y ? g->b : g->a;
-            int o = geom_orient(polar_fpt(pd, m->frame, l), polar_fpt(pd, m->frame, r), f);
-            if (o == 0)
-                return POLAR_NONE;
-            c = o > 0 ? nd[2] : nd[1];
+    return pd->seg[s].bld[0] < 0 ? -1 : pd->seg[s].bld[0];
+}
+
+/* The free region holding frame point f, -2 when f is on a wall or a wall
+ * end, -3 inside a footprint (*owner: the footprint above the wall found
+ * below f, -1 when that wall is not its boundary). The nearest wall below f
+ * (frame) is found by scanning the grid column of f downwards, stopping as
+ * soon as no unseen wall can be higher; then the regions above that wall
+ * are walked to f's abscissa. */
+static int32_t locate(const polar *pd, const polar_map *m, vec2 f, int32_t *owner)
+{
+    int on;
+    uint32_t t, best = wall_below(pd, m->frame, f, 0, &on);
+    if (on)
+        return -2;
+    if (best == POLAR_NONE) {
+        vec2 wp = polar_from_frame(m->frame, f);
+        t = m->col_start[m->frame ? grid_x(pd, wp.x) : grid_y(pd, wp.y)];
+    } else {
+        t = m->above[best];
+        if (t == POLAR_NONE) {
+            if (owner)
+                *owner = seg_delta(pd, m->frame, best) > 0 ? seg_owner(pd, best) : -1;
+            return -3;
         }
     }
-    return c;
+    for (;;) {
+        int c = lex_cmp(f, fpt(pd, m->frame, m->trap[t].rp));
+        if (c < 0)
+            return (int32_t)t;
+        if (c == 0)
+            return -2;
+        t = m->trap[t].nb[LR];
+        if (t == POLAR_NONE)
+            return -2;
+    }
 }
 
 int32_t polar_locate_frame(const polar *pd, const polar_map *m, vec2 f)
 {
-    uint32_t c = locate_word(pd, m, f);
-    if (c == POLAR_NONE)
-        return -2;
-    return POLAR_TAG(c) == POLAR_CHILD_FREE ? (int32_t)POLAR_IDX(c) : -3;
+    return locate(pd, m, f, NULL);
 }
 
 static int inside_box(const polar *pd, vec2 p)
@@ -1117,36 +1258,23 @@ static void quadrant_side(int q, int *map, int *top)
     *top = (q == 1 || q == 2);
 }
 
-static int32_t seg_owner(const polar *pd, uint32_t s)
-{
-    return pd->seg[s].bld[0] < 0 ? -1 : pd->seg[s].bld[0];
-}
-
 int32_t polar_locate(const polar *pd, int q, vec2 p, int32_t *owner)
 {
     int mi, top;
     const polar_map *m;
     int32_t t;
-    uint32_t c;
     if (owner)
         *owner = -1;
     if (!pd || q < 0 || q > 3 || !inside_box(pd, p))
         return -1;
     quadrant_side(q, &mi, &top);
     m = &pd->map[mi];
-    c = locate_word(pd, m, polar_to_frame(m->frame, p));
-    if (c == POLAR_NONE)
-        return -2;
-    if (POLAR_TAG(c) == POLAR_CHILD_SOLID) {
-        if (owner)
-            *owner = seg_owner(pd, POLAR_IDX(c));
-        return -3;
-    }
-    t = (int32_t)POLAR_IDX(c);
-    if (owner)
+    t = locate(pd, m, to_frame(m->frame, p), owner);
+    if (t >= 0 && owner)
         *owner = seg_owner(pd, top ? m->trap[t].top : m->trap[t].bot);
     return t;
 }
+
 
 /* Intersection parameter of line p->q with the line of segment s. */
 static double line_param(vec2 p, vec2 q, vec2 a, vec2 b)
@@ -1177,7 +1305,7 @@ static double box_exit(const polar *pd, vec2 p, vec2 q)
 static void walk(const polar *pd, const polar_map *m, uint32_t t, vec2 p, vec2 q, int side,
                  polar_hit *h)
 {
-    vec2 P = polar_to_frame(m->frame, p), Q = polar_to_frame(m->frame, q);
+    vec2 P = to_frame(m->frame, p), Q = to_frame(m->frame, q);
     int right = lex_cmp(Q, P) > 0;
     uint32_t hit = POLAR_NONE, steps = 0;
     int box = 0;
@@ -1189,7 +1317,7 @@ static void walk(const polar *pd, const polar_map *m, uint32_t t, vec2 p, vec2 q
             box = 1;
             break;
         }
-        o = geom_orient(P, Q, polar_fpt(pd, m->frame, r));
+        o = geom_orient(P, Q, fpt(pd, m->frame, r));
         if (o == 0)
             o = side > 0 ? -1 : 1;
         if (!right)
@@ -1244,8 +1372,8 @@ plx_status polar_shoot_to(const polar *pd, vec2 p, vec2 q, int side, polar_hit *
         int qd = (dx > 0 && dy >= 0) ? 0 : (dx <= 0 && dy > 0) ? 1 : (dx < 0) ? 2 : 3;
         m = &pd->map[qd & 1];
     }
-    P = polar_to_frame(m->frame, p);
-    Q = polar_to_frame(m->frame, q);
+    P = to_frame(m->frame, p);
+    Q = to_frame(m->frame, q);
     (void)Q;
     t = polar_locate_frame(pd, m, P);
     if (t < 0)
@@ -1299,8 +1427,8 @@ static vec2 seg_at(const polar *pd, int frame, uint32_t s, double u)
     uint32_t l, r;
     vec2 A, B, c;
     seg_ends(pd, frame, s, &l, &r);
-    A = polar_fpt(pd, frame, l);
-    B = polar_fpt(pd, frame, r);
+    A = fpt(pd, frame, l);
+    B = fpt(pd, frame, r);
     c.x = u;
     if (B.x == A.x)
         c.y = A.y;
@@ -1318,8 +1446,8 @@ int polar_region(const polar *pd, int q, uint32_t i, vec2 c[4], int32_t *owner, 
         return 0;
     quadrant_side(q, &mi, &top);
     m = &pd->map[mi];
-    ul = polar_fpt(pd, m->frame, m->trap[i].lp).x;
-    ur = polar_fpt(pd, m->frame, m->trap[i].rp).x;
+    ul = fpt(pd, m->frame, m->trap[i].lp).x;
+    ur = fpt(pd, m->frame, m->trap[i].rp).x;
     c[0] = polar_from_frame(m->frame, seg_at(pd, m->frame, m->trap[i].bot, ul));
     c[1] = polar_from_frame(m->frame, seg_at(pd, m->frame, m->trap[i].bot, ur));
     c[2] = polar_from_frame(m->frame, seg_at(pd, m->frame, m->trap[i].top, ur));

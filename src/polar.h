@@ -23,11 +23,14 @@
  *
  * Quadrants 0 and 2 (scan starting east and west) share one set of
  * horizontal axes, quadrants 1 and 3 one set of vertical axes: two planar
- * subdivisions, four labellings. Each subdivision is built by randomized
- * incremental construction with a fixed seed (O(n log n) expected for n
- * footprint edges, deterministic for a scene) and keeps its search DAG, so
- * locating a point costs O(log n) expected. A ray walks from region to region
- * through the stored adjacency until it leaves through a wall.
+ * subdivisions, four labellings. Each subdivision is built by a plane sweep
+ * over the wall ends (deterministic; O(n log n) for n footprint edges to
+ * sort the ends, then O(1) per event for evenly spread walls: the sweep
+ * status is a linked list, and an event where walls only start finds the
+ * wall below it in a grid of the wall pieces, scanning that grid's column
+ * downwards). Points are located the same way (the nearest wall below in
+ * the frame, then the regions above that wall). A ray walks from region to
+ * region through the stored adjacency until it leaves through a wall.
  *
  * Degenerate input: footprints that share walls exactly, touch at T-junctions
  * or overlap are first cut into pieces at every contact (exact predicates;
@@ -37,11 +40,6 @@
  * opposite directions (a party wall: solid on both sides) are left out, as
  * no ray from free space meets them first. Every combinatorial decision
  * afterwards uses geom_orient.
- *
- * Construction order: a biased randomized insertion order (random rounds,
- * a Z-order curve within each round), which keeps the expected bounds of
- * randomized incremental construction and makes consecutive searches share
- * cached DAG nodes.
  *
  * Memory: everything lives in the arena, part PLX_PART_POLAR; construction
  * temporaries come from arena_scratch and are released before return.
@@ -82,23 +80,21 @@ typedef struct polar_trap {
  *
  * Only the free trapezoids are kept as regions: a region next to a free one
  * across an axis side is free too (solid and free are only ever separated
- * by walls), so walks never need the solid ones. The search DAG (trapezoidal
- * map search structure) keeps its inner nodes; its leaves are folded into
- * the child words of their parents: a child word is an inner node (tag 0),
- * a free region (tag 1) or a solid trapezoid (tag 2, whose index is the wall
- * piece bounding it on the side of its footprint). */
-#define POLAR_TAG(w) ((w) >> 30)
-#define POLAR_IDX(w) ((w) & 0x3fffffffu)
-enum { POLAR_CHILD_NODE = 0, POLAR_CHILD_FREE = 1, POLAR_CHILD_SOLID = 2 };
-
+ * by walls), so walks never need the solid ones. Point location needs no
+ * search structure of its own: the wall below a point is found in the grid
+ * of wall pieces shared by both maps (polar.grid*), then the regions above
+ * that wall are walked to the point (above[], col_start[]). */
 typedef struct polar_map {
     int frame;
     uint32_t ntrap;          /* free regions */
     polar_trap *trap;
-    /* search structure */
-    uint32_t (*node)[3];     /* kind<<30 | index, child below/left, child above/right */
-    uint32_t nnode;
-    uint32_t root;           /* child word of the root */
+    uint32_t *above;         /* per wall piece: the first (frame-leftmost)
+                              * region above it, POLAR_NONE when the side above
+                              * it is solid */
+    uint32_t *col_start;     /* per grid column of frame abscissae: the first
+                              * region above the Bounds side at the bottom
+                              * reaching that column */
+    uint32_t ncol;
     uint32_t box_top, box_bot; /* segment indices of the Bounds sides on top/bottom */
     uint32_t box_lo, box_hi;   /* point indices of the extreme Bounds corners */
 } polar_map;
@@ -113,13 +109,20 @@ typedef struct polar {
     uint32_t nbld;           /* s->nbld */
     double box[4];           /* s->bounds */
     polar_map map[2];        /* [0]: quadrants 0, 2   [1]: quadrants 1, 3 */
+    /* grid of wall pieces over the Bounds box: cell (x, y) lists the pieces
+     * whose bounding boxes meet it, gwall[gcell[y gnx + x] .. gcell[.. + 1]) */
+    uint32_t gnx, gny;
+    double gsx, gsy;         /* cells per metre */
+    uint32_t *gcell, *gwall;
     size_t bytes[4];         /* axes, regions, polygons, rest */
 } polar;
 
 /* Builds the four diagrams of scene s. On success *out points into arena
  * memory (PLX_PART_POLAR) valid until that memory is released; the scene must
  * stay unchanged meanwhile. Fails with PLX_E_NOMEM (nothing kept, scratch
- * released) or PLX_E_INVALID (NULL argument, empty or non-finite bounds).
+ * released), PLX_E_INVALID (NULL argument, empty or non-finite bounds) or
+ * PLX_E_SCENE (the wall pieces, once cut at every contact, still cross: only
+ * possible through the rounding of crossing points; nothing kept).
  * A scene with no occluder gives diagrams of one free region each. */
 plx_status polar_build(arena *a, const scene *s, polar **out /* OUT */);
 
@@ -157,7 +160,8 @@ plx_status polar_shoot(const polar *pd, vec2 p, double dx, double dy, polar_hit 
 
 /* Bytes of arena memory held, like robles2014 Table 3:
  * [0] polar axes, [1] polar regions, [2] polygons (wall pieces and points),
- * [3] the rest (search structures, headers). Both subdivisions together. */
+ * [3] the rest (grid of walls, per-wall region indices, headers). Both
+ * subdivisions together. */
 void polar_memory(const polar *pd, size_t bytes[4] /* OUT */);
 
 /* For drawing. Number of (free) regions of the diagram of quadrant q, and

@@ -61,6 +61,19 @@ typedef struct walker {
     int stopped;
 } walker;
 
+/* Point i in the frame (polar_fpt, inlined: it is read on every step). */
+static vec2 fpt(const polar *pd, int frame, uint32_t i)
+{
+    vec2 w = pd->pts[i], f;
+    if (frame == 0) {
+        f.x = w.y;
+        f.y = -w.x;
+    } else {
+        f = w;
+    }
+    return f;
+}
+
 static int push(walker *w, const cone *c)
 {
     chunk *k = w->top;
@@ -258,7 +271,7 @@ static int past_wall(const walker *w, const cone *c, vec2 R, int below)
 {
     const polar_map *m = w->m;
     const polar_seg *g = &w->pd->seg[below ? m->trap[c->t].bot : m->trap[c->t].top];
-    vec2 a = polar_fpt(w->pd, m->frame, g->a), b = polar_fpt(w->pd, m->frame, g->b), X;
+    vec2 a = fpt(w->pd, m->frame, g->a), b = fpt(w->pd, m->frame, g->b), X;
     double cy, cr, xx, xy, cx2, cy2;
     int sgn;
     if (a.x == b.x)
@@ -290,7 +303,7 @@ static void step(walker *w, cone c)
             close_box(w, polar_from_frame(m->frame, c.A), polar_from_frame(m->frame, c.B));
             return;
         }
-        R = polar_fpt(w->pd, m->frame, r);
+        R = fpt(w->pd, m->frame, r);
         /* "below" = the part passing below R in the frame; the limit ray A
          * is only looked at when B does not decide */
         oB = geom_orient(w->P, c.B, R);

@@ -16,7 +16,8 @@
  * the polygon (per cone: where its two limit rays meet the wall's line, or
  * the Bounds box with its corners) and the visible set. Every split and every
  * closing decision is a geom_orient sign; only the output points are rounded.
- * Cost: O(log n) to locate p, then O(1) per region a cone crosses.
+ * Cost: locating p (polar.h: a grid scan, O(1) expected for evenly spread
+ * walls), then O(1) per region a cone crosses.
  *
  * Visible set: building i is visible iff a closed cone of positive angular
  * width (at least 1e-12 rad, so that a rounded range limit passing a hair

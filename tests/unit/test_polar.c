@@ -1,8 +1,12 @@
 /* test_polar: polar diagrams and the fan of tangent rays against brute force.
  *
  * Visibility is compared with tests/ref/ref_vis (an angular sweep over every
- * edge): areas to 1e-9 relative, visible sets identical. Point location and
- * ray shooting are compared with plain scans over every footprint and edge.
+ * edge): areas to 1e-9 relative, visible sets identical. On the small scenes
+ * every reference answer is also asked of tests/ref/ref_vis_fast (the same
+ * sweep with grid searches), which must give the same answer; the fixtures,
+ * the real district among them, are then checked against ref_vis_fast at
+ * thousands of points. Point location and ray shooting are compared with
+ * plain scans over every footprint and edge.
  */
 #include <stdarg.h>
 #include <stddef.h>
@@ -22,6 +26,7 @@
 #include "visibility.h"
 #include "ref_scene.h"
 #include "ref_vis.h"
+#include "ref_vis_fast.h"
 
 #define PI 3.14159265358979323846
 #define ARENA_BYTES ((size_t)32 << 20)
@@ -128,6 +133,26 @@ static int where(const scene *s, vec2 p)
     return on ? 2 : 0;
 }
 
+/* Does ref_vis_fast give ref_vis's answer (return code rc, result *rr)?
+ * Same intervals, same nearest edges: areas equal to rounding. */
+static int fast_agrees(const scene *s, vec2 p, int full, double a0, double a1, int rc,
+                       const ref_vis_result *rr)
+{
+    ref_vis_result ff;
+    int rf, ok;
+    uint32_t k;
+    rf = full ? ref_vis_fast(s, p.x, p.y, &ff) : ref_vis_fast_range(s, p.x, p.y, a0, a1, &ff);
+    ok = rf == rc;
+    if (ok && rc == 0) {
+        ok = fabs(ff.area - rr->area) <= 1e-12 * fmax(rr->area, 1.0) &&
+             ff.nverts == rr->nverts && ff.nvisible == rr->nvisible;
+        for (k = 0; ok && k < ff.nvisible; k++)
+            ok = ff.visible[k] == rr->visible[k];
+    }
+    ref_vis_free(&ff);
+    return ok;
+}
+
 /* Compares vis_query with ref_vis at p; returns 1 when they agree. */
 static int vis_agrees(fixture *f, vec2 p, int full, double a0, double a1, int verbose)
 {
@@ -138,6 +163,13 @@ static int vis_agrees(fixture *f, vec2 p, int full, double a0, double a1, int ve
     plx_status st;
     arena_mark before = arena_get_mark(&f->a);
     rc = full ? ref_vis(&f->s, p.x, p.y, &rr) : ref_vis_range(&f->s, p.x, p.y, a0, a1, &rr);
+    if (!fast_agrees(&f->s, p, full, a0, a1, rc, &rr)) {
+        if (verbose)
+            print_message("p = (%.17g, %.17g) full %d [%g, %g]: ref_vis_fast differs from "
+                          "ref_vis\n", p.x, p.y, full, a0, a1);
+        ref_vis_free(&rr);
+        return 0;
+    }
     memset(&vr, 0, sizeof vr);
     vr.poly = f->poly;
     vr.poly_cap = POLY_CAP;
@@ -363,6 +395,25 @@ static void test_random_overlaps(void **state)
     random_vis(f, 200);
     random_locate_shoot(f, 400);
     fixture_free(f);
+}
+
+/* Dense heaps of rotated boxes crossing each other everywhere: many
+ * rounded crossing points, which the sweep must still accept. */
+static void test_random_dense_overlaps(void **state)
+{
+    int k, i;
+    (void)state;
+    for (k = 0; k < 2; k++) {
+        fixture *f = fixture_new();
+        rnd_state = 4100u + (uint32_t)k;
+        for (i = 0; i < 50; i++)
+            add_rotated_box(f, urand() * 40, urand() * 40, 3 + urand() * 10, 3 + urand() * 10,
+                            urand() * PI);
+        fixture_build(f);
+        random_vis(f, 40);
+        random_locate_shoot(f, 300);
+        fixture_free(f);
+    }
 }
 
 /* ------------------------------------------------------ degenerate cases */
@@ -688,19 +739,22 @@ static void test_first_object(void **state)
 /* ------------------------------------------------------- the fixtures */
 
 /* Random free points over the bundled fixtures, full-turn visibility (and a
- * range for one point in eight) compared with ref_vis: areas to 1e-9
- * relative, identical visible sets. ref_vis costs O(E^2) per query, from
- * 0.3 ms (grid-4x4) to 1.7 s (helsinki-centre), so the points are spread by
- * cost; the default run holds 10,004 points. PLX_TEST_POINTS=N asks
- * for about N points in all (same proportions), PLX_TEST_QUICK for 1/20. The
- * reference runs in two threads (the diagrams are read only; each thread has
- * its own scratch arena). */
+ * range for one point in eight) compared with ref_vis_fast (checked against
+ * ref_vis on every small scene above, and on the real district by
+ * test_fixture_helsinki_slow_ref): areas to 1e-9 relative, identical visible
+ * sets. ref_vis_fast costs from 0.1 ms (grid-4x4) to about 7 ms
+ * (helsinki-centre) per query; the default run holds 12,000 points, 2,000
+ * of them on the real district. PLX_TEST_POINTS=N asks for about N points in
+ * all (same proportions), PLX_TEST_QUICK for 1/20. The reference runs in two
+ * threads (the diagrams and the prepared reference are read only; each
+ * thread has its own scratch arena). */
 
 #define FIX_THREADS 2
 #define FIX_SCRATCH ((size_t)4 << 20)
 
 typedef struct fix_job {
     const scene *s;
+    const ref_fast *rf;
     const polar *pd;
     const vec2 *pts;
     int n, tid;
@@ -715,7 +769,8 @@ static int fix_check(fix_job *j, arena *a, vec2 p, int full, double a0, double a
     uint32_t k, vis[4096];
     plx_status st;
     int rc, ok;
-    rc = full ? ref_vis(j->s, p.x, p.y, &rr) : ref_vis_range(j->s, p.x, p.y, a0, a1, &rr);
+    rc = full ? ref_fast_vis(j->rf, p.x, p.y, &rr)
+              : ref_fast_vis_range(j->rf, p.x, p.y, a0, a1, &rr);
     memset(&vr, 0, sizeof vr);
     vr.vis = vis;
     vr.vis_cap = 4096;
@@ -760,7 +815,7 @@ static int fix_points(int n)
 {
     const char *e = getenv("PLX_TEST_POINTS");
     if (e && atoi(e) > 0)
-        n = (int)((double)n * atoi(e) / 10004.0 + 0.5);
+        n = (int)((double)n * atoi(e) / 12000.0 + 0.5);
     else if (getenv("PLX_TEST_QUICK"))
         n /= 20;
     return n < 1 ? 1 : n;
@@ -773,6 +828,7 @@ static void fixture_points(const char *path, int npts)
     plx_port quiet = *plx_port_posix();
     const scene *s;
     polar *pd;
+    ref_fast *rf;
     vec2 *pts;
     fix_job job[FIX_THREADS];
     pthread_t th[FIX_THREADS];
@@ -784,6 +840,8 @@ static void fixture_points(const char *path, int npts)
     assert_int_equal(plx_load_file(e, path), PLX_OK);
     s = e->sc;
     assert_int_equal(polar_build(&e->mem, s, &pd), PLX_OK);
+    rf = ref_fast_new(s);
+    assert_non_null(rf);
     pts = malloc((size_t)npts * sizeof *pts);
     assert_non_null(pts);
     while (n < npts && tries < 100 * npts) {
@@ -798,6 +856,7 @@ static void fixture_points(const char *path, int npts)
     for (i = 0; i < FIX_THREADS; i++) {
         memset(&job[i], 0, sizeof job[i]);
         job[i].s = s;
+        job[i].rf = rf;
         job[i].pd = pd;
         job[i].pts = pts;
         job[i].n = n;
@@ -815,6 +874,7 @@ static void fixture_points(const char *path, int npts)
     assert_int_equal(checked, n);
     assert_int_equal(bad, 0);
     free(pts);
+    ref_fast_free(rf);
     plx_engine_free(e);
 }
 
@@ -843,7 +903,53 @@ static void test_fixture_helsinki(void **state)
 {
     (void)state;
     rnd_state = 6004u;
-    fixture_points("fixtures/helsinki-centre.geojson", fix_points(4));
+    fixture_points("fixtures/helsinki-centre.geojson", fix_points(2000));
+}
+
+/* The fast reference against the O(E^2) one on the real district (about
+ * 2 s per point): the same answer, and the engine's. */
+static void test_fixture_helsinki_slow_ref(void **state)
+{
+    plx_engine *e;
+    plx_config cfg;
+    plx_port quiet = *plx_port_posix();
+    const scene *s;
+    polar *pd;
+    int n = 0, tries = 0;
+    (void)state;
+    quiet.log = NULL;
+    plx_config_default(&cfg);
+    cfg.port = &quiet;
+    assert_int_equal(plx_engine_new((size_t)256 << 20, &cfg, &e), PLX_OK);
+    assert_int_equal(plx_load_file(e, "fixtures/helsinki-centre.geojson"), PLX_OK);
+    s = e->sc;
+    assert_int_equal(polar_build(&e->mem, s, &pd), PLX_OK);
+    rnd_state = 6005u;
+    while (n < 1 && tries < 100) {
+        ref_vis_result rr;
+        vis_result vr;
+        uint32_t k, vis[4096];
+        vec2 p;
+        tries++;
+        p.x = s->bounds[0] + urand() * (s->bounds[2] - s->bounds[0]);
+        p.y = s->bounds[1] + urand() * (s->bounds[3] - s->bounds[1]);
+        if (where(s, p) != 0)
+            continue;
+        n++;
+        assert_int_equal(ref_vis(s, p.x, p.y, &rr), 0);
+        assert_true(fast_agrees(s, p, 1, 0, 0, 0, &rr));
+        memset(&vr, 0, sizeof vr);
+        vr.vis = vis;
+        vr.vis_cap = 4096;
+        assert_int_equal(vis_query(pd, p, 0, 0, 1, &e->mem, &vr), PLX_OK);
+        assert_true(fabs(vr.area - rr.area) <= 1e-9 * rr.area);
+        assert_int_equal(vr.nvis, rr.nvisible);
+        for (k = 0; k < vr.nvis; k++)
+            assert_int_equal(vr.vis[k], rr.visible[k]);
+        ref_vis_free(&rr);
+    }
+    assert_int_equal(n, 1);
+    plx_engine_free(e);
 }
 
 int main(void)
@@ -866,10 +972,12 @@ int main(void)
         cmocka_unit_test(test_random_rotated),
         cmocka_unit_test(test_random_mixed_city),
         cmocka_unit_test(test_random_overlaps),
+        cmocka_unit_test(test_random_dense_overlaps),
         cmocka_unit_test(test_fixture_grid),
         cmocka_unit_test(test_fixture_oldtown),
         cmocka_unit_test(test_fixture_eixample),
         cmocka_unit_test(test_fixture_helsinki),
+        cmocka_unit_test(test_fixture_helsinki_slow_ref),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
