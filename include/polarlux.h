@@ -335,6 +335,10 @@ typedef struct plx_camera {
     int32_t width, height;      /* pixels, at most the config's render maximum */
 } plx_camera;
 
+/* A raster backend for the visibility pass (depth and surface id per
+ * pixel); opaque here, made by a port (see plx_render_opts.backend). */
+typedef struct plx_backend plx_backend;
+
 typedef struct plx_render_opts {
     double exposure;            /* radiance multiplier before sRGB (SPEC default 1) */
     int no_glow;                /* 1: no lamp glows: every pixel is SPEC §5's radiance */
@@ -342,6 +346,8 @@ typedef struct plx_render_opts {
     double aerial_m_per_texel;  /* light map resolution (0: 1 m, coarser if the budget needs) */
     int no_cull;                /* 1: draw every building (the culled image is identical) */
     int no_indirect;            /* 1: direct light only even when photons were traced */
+    const plx_backend *backend; /* visibility pass: NULL = the built-in software rasteriser;
+                                   or a port's, e.g. port/osmesa/plx_osmesa.h */
 } plx_render_opts;
 
 void plx_render_opts_default(plx_render_opts *o /* OUT */);
@@ -359,7 +365,8 @@ typedef struct plx_render_info {
  * frames were traced (plx_indirect_step) unless o->no_indirect. The
  * renderer's own buffers come from the engine (PLX_PART_FRAME) on first use.
  * Errors: PLX_E_INVALID (bad camera: eye below the ground, eye == target,
- * size above the maximum), PLX_E_NOSCENE, PLX_E_NOMEM.
+ * size above the maximum), PLX_E_NOSCENE, PLX_E_NOMEM, PLX_E_UNSUPPORTED
+ * (o->backend could not draw the frame).
  */
 plx_status plx_render(plx_engine *e, const plx_camera *cam, const plx_render_opts *o, uint8_t *rgb8 /* OUT */,
                       float *rgbf /* OUT */, plx_render_info *info /* OUT */);

@@ -14,6 +14,9 @@
 
 typedef struct cull_item { double key; uint32_t b; } cull_item;
 
+#define RENDER_TILE 8           /* shading tiles, pixels a side */
+#define RENDER_TILE_LAMPS 64    /* longest lamp list of a tile */
+
 struct render {
     arena *a;
     const scene *s;
@@ -25,6 +28,9 @@ struct render {
     uint32_t *id;
     float *lin;
     raster_vertex *vbuf;
+    float *clip;                /* 4 per vertex of one building */
+    render_backend soft;        /* the built-in backend (user = this) */
+    raster_ctx rc;              /* its rasteriser state during a frame */
     /* culling */
     cull_item *order;           /* nbld */
     cull_item *heap;            /* nbld, min-heap by w_max */
@@ -37,6 +43,14 @@ struct render {
     uint32_t cur_id;
     double eye[3], f[3], rt[3], up[3];
     double sx, sy, za, zb, tanh_, aspect, near_, far_;
+    /* shading by tiles */
+    light *lt;                  /* the light module when shade is render_shade_light */
+    uint32_t *lamp_stamp;       /* nlamps (lt only) */
+    uint32_t stamp_now;
+    uint32_t tl[RENDER_TILE_LAMPS];
+    double tP[RENDER_TILE * RENDER_TILE][3], tN[RENDER_TILE * RENDER_TILE][3];
+    double tE[RENDER_TILE * RENDER_TILE][3];
+    uint8_t tcall[RENDER_TILE * RENDER_TILE];  /* 0 sky, 1 no shader, 2 shader */
     /* light map */
     float *lm;
     size_t lm_cap;              /* floats */
@@ -77,7 +91,7 @@ size_t render_bytes(const scene *s, int32_t max_w, int32_t max_h)
 {
     size_t px = (size_t)max_w * (size_t)max_h;
     return px * 20 + (size_t)s->nbld * (2 * sizeof(cull_item) + 17) + RENDER_BINS * 8 + 65536 +
-           sizeof(render) + 4096;
+           (size_t)s->nlamps * 4 + sizeof(render) + 4096;
 }
 
 const mesh *render_mesh(const render *r)
@@ -107,6 +121,63 @@ uint8_t render_srgb8(const render *r, double v)
             hi = mid;
     }
     return (uint8_t)lo;
+}
+
+/* ---- the software backend (raster.h) ------------------------------------------ */
+
+static int frag_id(void *user, int32_t x, int32_t y, float depth, const float *attr, float rgba[4])
+{
+    render *r = user;
+    (void)depth;
+    (void)attr;
+    (void)rgba;
+    r->id[(size_t)y * (size_t)r->w + (size_t)x] = r->cur_id;
+    return 1;
+}
+
+static int soft_begin(void *user, int32_t w, int32_t h, int cull_back)
+{
+    render *r = user;
+    raster_target tg;
+    memset(&tg, 0, sizeof tg);
+    tg.format = RASTER_RGBA8;
+    tg.width = w;
+    tg.height = h;
+    tg.color = NULL;
+    tg.depth = r->depth;
+    if (raster_init(&r->rc, &tg, NULL) != PLX_OK)
+        return -1;
+    memset(r->id, 0, (size_t)w * (size_t)h * sizeof *r->id);
+    raster_clear_depth(&r->rc, 1.0f);
+    raster_set_fragment(&r->rc, frag_id, r, 0);
+    raster_set_cull(&r->rc, cull_back ? RASTER_CULL_BACK : RASTER_CULL_NONE);
+    return 0;
+}
+
+static void soft_draw(void *user, const float *clip, uint32_t nv, const mesh_tri *tri, uint32_t ntri,
+                      uint32_t v_base)
+{
+    render *r = user;
+    uint32_t k;
+    for (k = 0; k < nv; k++)
+        memcpy(r->vbuf[k].pos, clip + 4 * (size_t)k, 4 * sizeof(float));
+    for (k = 0; k < ntri; k++) {
+        const mesh_tri *t = &tri[k];
+        r->cur_id = t->surf;
+        raster_triangle(&r->rc, &r->vbuf[t->v[0] - v_base], &r->vbuf[t->v[1] - v_base],
+                        &r->vbuf[t->v[2] - v_base]);
+    }
+}
+
+static int soft_finish(void *user, uint32_t *id, float *depth)
+{
+    render *r = user;
+    size_t px = (size_t)r->w * (size_t)r->h;
+    if (id != r->id)
+        memcpy(id, r->id, px * sizeof *id);
+    if (depth != r->depth)
+        memcpy(depth, r->depth, px * sizeof *depth);
+    return 0;
 }
 
 plx_status render_create(arena *a, const scene *s, int32_t max_w, int32_t max_h,
@@ -142,19 +213,24 @@ plx_status render_create(arena *a, const scene *s, int32_t max_w, int32_t max_h,
     r->id = arena_alloc(a, PLX_PART_FRAME, arena_mul(px, sizeof(uint32_t)), 64);
     r->lin = arena_alloc(a, PLX_PART_FRAME, arena_mul(px, 3 * sizeof(float)), 64);
     r->vbuf = arena_alloc(a, PLX_PART_FRAME, arena_mul(r->m->max_bld_verts + 1, sizeof(raster_vertex)), 64);
+    r->clip = arena_alloc(a, PLX_PART_FRAME, arena_mul(r->m->max_bld_verts + 1, 4 * sizeof(float)), 64);
     r->order = arena_alloc(a, PLX_PART_FRAME, arena_mul(s->nbld + 1, sizeof(cull_item)), R_ALIGN);
     r->heap = arena_alloc(a, PLX_PART_FRAME, arena_mul(s->nbld + 1, sizeof(cull_item)), R_ALIGN);
     r->wmin = arena_alloc(a, PLX_PART_FRAME, arena_mul(s->nbld + 1, sizeof(double)), R_ALIGN);
     r->wmax = arena_alloc(a, PLX_PART_FRAME, arena_mul(s->nbld + 1, sizeof(double)), R_ALIGN);
     r->draw = arena_alloc(a, PLX_PART_FRAME, s->nbld + 1, R_ALIGN);
     r->bins = arena_alloc(a, PLX_PART_FRAME, RENDER_BINS * sizeof(double), R_ALIGN);
-    if (!r->depth || !r->id || !r->lin || !r->vbuf || !r->order || !r->heap || !r->wmin ||
+    if (!r->depth || !r->id || !r->lin || !r->vbuf || !r->clip || !r->order || !r->heap || !r->wmin ||
         !r->wmax || !r->draw || !r->bins) {
         arena_release(a, &m0);
         return PLX_E_NOMEM;
     }
     r->lut = arena_alloc(a, PLX_PART_FRAME, 65536, R_ALIGN);
-    if (!r->lut) {
+    if (shade == render_shade_light && user) {
+        r->lt = user;
+        r->lamp_stamp = arena_calloc(a, PLX_PART_FRAME, (size_t)s->nlamps + 1, sizeof(uint32_t), R_ALIGN);
+    }
+    if (!r->lut || (r->lt && !r->lamp_stamp)) {
         arena_release(a, &m0);
         return PLX_E_NOMEM;
     }
@@ -165,6 +241,11 @@ plx_status render_create(arena *a, const scene *s, int32_t max_w, int32_t max_h,
         cv.u = (uint32_t)k << 16;
         r->lut[k] = render_srgb8(r, (double)cv.f);
     }
+    r->soft.name = "soft";
+    r->soft.user = r;
+    r->soft.begin = soft_begin;
+    r->soft.draw = soft_draw;
+    r->soft.finish = soft_finish;
     r->err = "";
     *out = r;
     return PLX_OK;
@@ -514,17 +595,7 @@ static void cull(render *r, int mode, int inside, render_stats *st)
 
 /* ---- drawing ------------------------------------------------------------------ */
 
-static int frag_id(void *user, int32_t x, int32_t y, float depth, const float *attr, float rgba[4])
-{
-    render *r = user;
-    (void)depth;
-    (void)attr;
-    (void)rgba;
-    r->id[(size_t)y * (size_t)r->w + (size_t)x] = r->cur_id;
-    return 1;
-}
-
-static void draw_buildings(render *r, raster_ctx *rc, render_stats *st)
+static void draw_buildings(render *r, const render_backend *be, render_stats *st)
 {
     const mesh *m = r->m;
     uint32_t b, k;
@@ -536,19 +607,14 @@ static void draw_buildings(render *r, raster_ctx *rc, render_stats *st)
         st->triangles_drawn += mb->t_count;
         for (k = 0; k < mb->v_count; k++) {
             double c[4];
-            raster_vertex *v = &r->vbuf[k];
+            float *v = &r->clip[4 * (size_t)k];
             to_clip(r, &m->xyz[3 * (size_t)(mb->v_first + k)], c);
-            v->pos[0] = (float)c[0];
-            v->pos[1] = (float)c[1];
-            v->pos[2] = (float)c[2];
-            v->pos[3] = (float)c[3];
+            v[0] = (float)c[0];
+            v[1] = (float)c[1];
+            v[2] = (float)c[2];
+            v[3] = (float)c[3];
         }
-        for (k = 0; k < mb->t_count; k++) {
-            const mesh_tri *t = &m->tri[mb->t_first + k];
-            r->cur_id = t->surf;
-            raster_triangle(rc, &r->vbuf[t->v[0] - mb->v_first], &r->vbuf[t->v[1] - mb->v_first],
-                            &r->vbuf[t->v[2] - mb->v_first]);
-        }
+        be->draw(be->user, r->clip, mb->v_count, &m->tri[mb->t_first], mb->t_count, mb->v_first);
     }
 }
 
@@ -583,71 +649,369 @@ static void lightmap_sample(const render *r, const double P[3], double rgb[3])
     }
 }
 
+/* Lamps whose reach sphere meets box bx (minx, miny, minz, maxx, maxy,
+ * maxz), in lamp index order, into r->tl (at most RENDER_TILE_LAMPS);
+ * returns their number, or -1 when there are more (the caller then takes
+ * the light module's own lamp walk). */
+static int tile_lamps(render *r, const double bx[6])
+{
+    const light_grid *g = &r->lt->lgrid;
+    const scene *s = r->s;
+    uint32_t c0, c1, cx0, cx1, cy0, cy1, cx, cy, k;
+    int n = 0, i, j;
+    if (s->nlamps == 0 || g->nx == 0)
+        return 0;
+    c0 = light_grid_cell(g, bx[0], bx[1]);
+    c1 = light_grid_cell(g, bx[3], bx[4]);
+    cx0 = c0 % g->nx;
+    cy0 = c0 / g->nx;
+    cx1 = c1 % g->nx;
+    cy1 = c1 / g->nx;
+    if ((uint64_t)(cx1 - cx0 + 1) * (cy1 - cy0 + 1) > 16)
+        return -1;
+    if (++r->stamp_now == 0) {
+        memset(r->lamp_stamp, 0, s->nlamps * sizeof *r->lamp_stamp);
+        r->stamp_now = 1;
+    }
+    for (cy = cy0; cy <= cy1; cy++)
+        for (cx = cx0; cx <= cx1; cx++) {
+            uint32_t cell = cy * g->nx + cx;
+            for (k = g->start[cell]; k < g->start[cell + 1]; k++) {
+                uint32_t l = g->ids[k];
+                const scene_lamp *lp = &s->lamps[l];
+                double dx, dy, dz;
+                if (r->lamp_stamp[l] == r->stamp_now)
+                    continue;
+                r->lamp_stamp[l] = r->stamp_now;
+                if (!(lp->radius > 0.0) || !(lp->intensity > 0.0))
+                    continue;
+                dx = fmax(0.0, fmax(bx[0] - lp->x, lp->x - bx[3]));
+                dy = fmax(0.0, fmax(bx[1] - lp->y, lp->y - bx[4]));
+                dz = fmax(0.0, fmax(bx[2] - lp->z, lp->z - bx[5]));
+                /* the term is 0 from d >= R on (light.h, SPEC §2): a margin keeps rounding out */
+                if (!(dx * dx + dy * dy + dz * dz < lp->radius * lp->radius * (1.0 + 1e-9)))
+                    continue;
+                if (n == RENDER_TILE_LAMPS)
+                    return -1;
+                r->tl[n++] = l;
+            }
+        }
+    /* lamp index order (the order of the light module's walk) */
+    for (i = 1; i < n; i++) {
+        uint32_t v = r->tl[i];
+        for (j = i - 1; j >= 0 && r->tl[j] > v; j--)
+            r->tl[j + 1] = r->tl[j];
+        r->tl[j + 1] = v;
+    }
+    return n;
+}
+
+/* The sector of pseudo-angle a (light.h: sector i starts at sec_ang[i];
+ * angles before sec_ang[0] belong to the last, wrapping sector). */
+static uint32_t tile_find_sector(const double *ang, uint32_t nsec, double a)
+{
+    uint32_t lo = 0, hi = nsec;
+    if (a < ang[0])
+        return nsec - 1;
+    while (hi - lo > 1) {
+        uint32_t mid = (lo + hi) / 2;
+        if (ang[mid] <= a)
+            lo = mid;
+        else
+            hi = mid;
+    }
+    return lo;
+}
+
+/* SPEC §2's term of lamp lp at P facing n, without visibility: the light
+ * module's formula (light.c), operation for operation. */
+static double lamp_term(const scene_lamp *lp, const double P[3], const double n[3])
+{
+    double v[3], d2, d, x, x2, c, w, cw;
+    v[0] = lp->x - P[0];
+    v[1] = lp->y - P[1];
+    v[2] = lp->z - P[2];
+    d2 = v[0] * v[0] + v[1] * v[1] + v[2] * v[2];
+    if (d2 == 0.0 || !(lp->radius > 0.0) || !(d2 < lp->radius * lp->radius))
+        return 0.0;
+    d = sqrt(d2);
+    x = d / lp->radius;
+    x2 = x * x;
+    c = 1.0 - x2 * x2;
+    if (c <= 0.0)
+        return 0.0;
+    w = c * c;
+    cw = (n[0] * v[0] + n[1] * v[1] + n[2] * v[2]) / d;
+    if (!(cw > 0.0))
+        return 0.0;
+    return lp->intensity * cw / d2 * w;
+}
+
+/* Is every point whose ground projection lies in the convex hull of the nc
+ * points c (2 or 4: a segment or a box, none of them at the lamp's ground
+ * point O) visible from lamp l for sure? Through the lamp's sector index
+ * (light.h, litregion.c's light_region_visible): along w = P' - O a band
+ * covers t from t_lo = c / cross(w, e) (its lo line) on, and stops the
+ * segment O->P only if (min(t_hi, t2) - max(t_lo, t1)) |P - L| > 1e-9 with
+ * t2 <= 1; the term of lamp l is 0 unless |P - L| < R. So a band with
+ * t_lo >= 1 - eta/2, eta = 1e-9 / R, stops nothing at P -- neither a
+ * building beyond P nor the wall P lies on (t_lo = 1 there). With
+ * q(w) = cross(w, e) / c = 1 / t_lo, linear in w: if 0 < q <= 1 + eta/4 at
+ * every corner of the hull, the same holds over the hull, so t_lo >=
+ * 1 - eta/4 at every point of it (rounding of t_lo, ~1e-15 relative, is
+ * far inside the remaining eta/4). The bands looked at are those of every
+ * sector meeting the pseudo-angle range of the corners (the hull subtends
+ * less than 180 degrees from O: checked). Returns 0 when unsure: no
+ * region, a hull around O, a band from O itself (no lo line). */
+static int hull_visible(render *r, uint32_t l, const double (*c)[2], int nc)
+{
+    light *L = r->lt;
+    const lit_region *rg;
+    double wx[4], wy[4], base = 0.0, lo = 0.0, hi = 0.0, qmax;
+    uint32_t i0, i1, i, k;
+    int j;
+    if (L->pool_cap == 0 || !(r->s->lamps[l].radius > 0.0) ||
+        light_region_index(L, l, &rg) != PLX_OK || rg->nsec == 0)
+        return 0;
+    qmax = 1.0 + 0.25e-9 / r->s->lamps[l].radius;
+    for (j = 0; j < nc; j++) {
+        double d;
+        wx[j] = c[j][0] - rg->o[0];
+        wy[j] = c[j][1] - rg->o[1];
+        if (wx[j] == 0.0 && wy[j] == 0.0)
+            return 0;
+        if (j == 0) {
+            base = light_pseudo_angle(wx[0], wy[0]);
+            continue;
+        }
+        d = light_pseudo_angle(wx[j], wy[j]) - base;
+        if (d > 2.0) d -= 4.0;
+        if (d <= -2.0) d += 4.0;
+        lo = d < lo ? d : lo;
+        hi = d > hi ? d : hi;
+    }
+    /* O outside the hull: for a box, not inside it; for a segment, not on
+     * its line (checked by the spans below: a hull around O spans 2 or more) */
+    if (nc == 4 && rg->o[0] >= c[0][0] && rg->o[0] <= c[3][0] && rg->o[1] >= c[0][1] && rg->o[1] <= c[3][1])
+        return 0;
+    if (nc == 2 && !(wx[0] * wy[1] - wy[0] * wx[1] != 0.0))
+        return 0;
+    if (!(hi - lo < 1.999))
+        return 0;
+    lo += base - 1e-9;
+    hi += base + 1e-9;
+    lo = lo < 0.0 ? lo + 4.0 : lo >= 4.0 ? lo - 4.0 : lo;
+    hi = hi < 0.0 ? hi + 4.0 : hi >= 4.0 ? hi - 4.0 : hi;
+    i0 = tile_find_sector(rg->sec_ang, rg->nsec, lo);
+    i1 = tile_find_sector(rg->sec_ang, rg->nsec, hi);
+    for (i = i0;; i = (i + 1) % rg->nsec) {
+        for (k = rg->sec_first[i]; k < rg->sec_first[i + 1]; k++) {
+            const lit_band *b = &rg->band[k];
+            const lit_line *ln;
+            if (b->lo == LIT_NONE)
+                return 0;
+            ln = &rg->line[b->lo];
+            if (!(ln->c != 0.0) || !isfinite(ln->c))
+                return 0;
+            for (j = 0; j < nc; j++) {
+                double q = (wx[j] * ln->ey - wy[j] * ln->ex) / ln->c;
+                if (!(q > 0.0 && q <= qmax))
+                    return 0;
+            }
+        }
+        if (i == i1)
+            break;
+    }
+    return 1;
+}
+
+/* E_rgb at P from the tile's lamp list (the light shader's value); lamps
+ * whose bit is set in sure are visible without asking. */
+static void shade_tile_lamps(render *r, int nl, uint64_t sure, const double P[3], const double n[3],
+                             double rgb[3], render_stats *st)
+{
+    const scene *s = r->s;
+    int k;
+    rgb[0] = rgb[1] = rgb[2] = 0.0;
+    for (k = 0; k < nl; k++) {
+        uint32_t l = r->tl[k];
+        const scene_lamp *lp = &s->lamps[l];
+        double term = lamp_term(lp, P, n);
+        if (term == 0.0)
+            continue;
+        if ((sure >> k) & 1u)
+            st->visibility_skipped++;
+        else if (!light_visible(r->lt, l, P))
+            continue;
+        rgb[0] += term * lp->color[0];
+        rgb[1] += term * lp->color[1];
+        rgb[2] += term * lp->color[2];
+    }
+}
+
+/* The shading pass, by tiles of RENDER_TILE x RENDER_TILE pixels: first
+ * every pixel's hit point, then (light shader) the lamps whose reach meets
+ * the box of the tile's hit points, then the illuminance from that list. */
 static void shade_pass(render *r, const render_opts *o, render_stats *st)
 {
     const mesh *m = r->m;
-    int32_t i, j;
+    int32_t i, j, ti, tj;
     double ta = r->tanh_ * r->aspect, tb = r->tanh_;
     int use_lm = o->lightmap && r->lm_built;
-    for (j = 0; j < r->h; j++) {
-        double bj = (1.0 - 2.0 * (j + 0.5) / r->h) * tb;
-        for (i = 0; i < r->w; i++) {
-            size_t p = (size_t)j * (size_t)r->w + (size_t)i;
-            double ai = (2.0 * (i + 0.5) / r->w - 1.0) * ta;
-            double d[3], P[3], n[3], E[3] = { 0, 0, 0 }, t, nd, albedo;
-            uint32_t sid = r->id[p];
-            const mesh_surf *sf;
-            float *out = &r->lin[3 * p];
-            int k, call;
-            d[0] = r->f[0] + ai * r->rt[0] + bj * r->up[0];
-            d[1] = r->f[1] + ai * r->rt[1] + bj * r->up[1];
-            d[2] = r->f[2] + ai * r->rt[2] + bj * r->up[2];
-            if (sid == MESH_SURF_NONE) {
-                if (!(d[2] < 0.0)) {
-                    st->sky_pixels++;
-                    out[0] = out[1] = out[2] = 0.0f;
-                    continue;
+    double (*TP)[3] = r->tP, (*TN)[3] = r->tN;
+    for (tj = 0; tj < r->h; tj += RENDER_TILE)
+        for (ti = 0; ti < r->w; ti += RENDER_TILE) {
+            int32_t j1 = tj + RENDER_TILE < r->h ? tj + RENDER_TILE : r->h;
+            int32_t i1 = ti + RENDER_TILE < r->w ? ti + RENDER_TILE : r->w;
+            double bx[6] = { HUGE_VAL, HUGE_VAL, HUGE_VAL, -HUGE_VAL, -HUGE_VAL, -HUGE_VAL };
+            double gb[4] = { HUGE_VAL, HUGE_VAL, -HUGE_VAL, -HUGE_VAL };
+            double wmin = HUGE_VAL, wmax = -HUGE_VAL, wa[2] = { 0, 0 }, wb[2] = { 0, 0 };
+            int ncall = 0, nground = 0, nl = -1, q = 0;
+            uint32_t wall = MESH_SURF_NONE;   /* the one wall of the tile's wall pixels, if one */
+            uint64_t sure_g = 0, sure_w = 0;
+            /* 1: hit points; E = 0 (or the light map) in out for now */
+            for (j = tj; j < j1; j++) {
+                double bj = (1.0 - 2.0 * (j + 0.5) / r->h) * tb;
+                for (i = ti; i < i1; i++, q++) {
+                    size_t p = (size_t)j * (size_t)r->w + (size_t)i;
+                    double ai = (2.0 * (i + 0.5) / r->w - 1.0) * ta;
+                    double d[3], t, nd, E[3] = { 0, 0, 0 };
+                    double *P = TP[q], *n = TN[q];
+                    uint32_t sid = r->id[p];
+                    const mesh_surf *sf;
+                    float *out = &r->lin[3 * p];
+                    int k;
+                    r->tcall[q] = 0;
+                    d[0] = r->f[0] + ai * r->rt[0] + bj * r->up[0];
+                    d[1] = r->f[1] + ai * r->rt[1] + bj * r->up[1];
+                    d[2] = r->f[2] + ai * r->rt[2] + bj * r->up[2];
+                    if (sid == MESH_SURF_NONE) {
+                        if (!(d[2] < 0.0)) {
+                            st->sky_pixels++;
+                            out[0] = out[1] = out[2] = 0.0f;
+                            continue;
+                        }
+                        sid = MESH_SURF_GROUND;
+                        r->id[p] = sid;
+                    }
+                    sf = &m->surf[sid];
+                    nd = sf->n[0] * d[0] + sf->n[1] * d[1] + sf->n[2] * d[2];
+                    if (sid == MESH_SURF_GROUND) {
+                        t = -r->eye[2] / d[2];
+                        st->ground_pixels++;
+                    } else {
+                        t = (sf->d - (sf->n[0] * r->eye[0] + sf->n[1] * r->eye[1] + sf->n[2] * r->eye[2])) / nd;
+                        st->building_pixels++;
+                    }
+                    if (!isfinite(t) || t < 0.0)
+                        t = 0.0;
+                    for (k = 0; k < 3; k++) {
+                        P[k] = r->eye[k] + t * d[k];
+                        n[k] = nd > 0.0 ? -sf->n[k] : sf->n[k];
+                    }
+                    if (sid == MESH_SURF_GROUND)
+                        P[2] = 0.0;
+                    r->tcall[q] = 1;
+                    if (sf->lit && sid == MESH_SURF_GROUND && use_lm)
+                        lightmap_sample(r, P, E);
+                    else if (sf->lit) {
+                        r->tcall[q] = 2;
+                        ncall++;
+                        if (r->lt) {
+                            /* hit points are finite: plain comparisons */
+                            for (k = 0; k < 3; k++) {
+                                bx[k] = P[k] < bx[k] ? P[k] : bx[k];
+                                bx[3 + k] = P[k] > bx[3 + k] ? P[k] : bx[3 + k];
+                            }
+                            if (sid == MESH_SURF_GROUND) {
+                                nground++;
+                                gb[0] = P[0] < gb[0] ? P[0] : gb[0];
+                                gb[1] = P[1] < gb[1] ? P[1] : gb[1];
+                                gb[2] = P[0] > gb[2] ? P[0] : gb[2];
+                                gb[3] = P[1] > gb[3] ? P[1] : gb[3];
+                            } else if (sf->kind == MESH_KIND_WALL && wall != UINT32_MAX) {
+                                /* the ends of the wall pixels along the wall */
+                                double u = P[0] * -sf->n[1] + P[1] * sf->n[0];
+                                if (wall != MESH_SURF_NONE && wall != sid)
+                                    wall = UINT32_MAX;
+                                else {
+                                    wall = sid;
+                                    if (u < wmin) {
+                                        wmin = u;
+                                        wa[0] = P[0];
+                                        wa[1] = P[1];
+                                    }
+                                    if (u > wmax) {
+                                        wmax = u;
+                                        wb[0] = P[0];
+                                        wb[1] = P[1];
+                                    }
+                                }
+                            }
+                        }
+                    }
+                    for (k = 0; k < 3; k++)
+                        r->tE[q][k] = E[k];
                 }
-                sid = MESH_SURF_GROUND;
-                r->id[p] = sid;
             }
-            sf = &m->surf[sid];
-            nd = sf->n[0] * d[0] + sf->n[1] * d[1] + sf->n[2] * d[2];
-            if (sid == MESH_SURF_GROUND) {
-                t = -r->eye[2] / d[2];
-                st->ground_pixels++;
-            } else {
-                t = (sf->d - (sf->n[0] * r->eye[0] + sf->n[1] * r->eye[1] + sf->n[2] * r->eye[2])) / nd;
-                st->building_pixels++;
+            /* 2: the tile's lamps */
+            if (ncall > 0 && r->lt)
+                nl = tile_lamps(r, bx);
+            if (nl > 0 && nground > 0) {
+                double hb[4][2];
+                int k;
+                hb[0][0] = hb[2][0] = gb[0];
+                hb[1][0] = hb[3][0] = gb[2];
+                hb[0][1] = hb[1][1] = gb[1];
+                hb[2][1] = hb[3][1] = gb[3];
+                for (k = 0; k < nl; k++)
+                    if (hull_visible(r, r->tl[k], (const double (*)[2])hb, 4))
+                        sure_g |= (uint64_t)1 << k;
             }
-            if (!isfinite(t) || t < 0.0)
-                t = 0.0;
-            for (k = 0; k < 3; k++) {
-                P[k] = r->eye[k] + t * d[k];
-                n[k] = nd > 0.0 ? -sf->n[k] : sf->n[k];
+            if (nl > 0 && wall != MESH_SURF_NONE && wall != UINT32_MAX) {
+                double hs[2][2];
+                int k;
+                hs[0][0] = wa[0];
+                hs[0][1] = wa[1];
+                hs[1][0] = wb[0];
+                hs[1][1] = wb[1];
+                /* a single pixel: a point is a segment of length 0 (O not on it) */
+                for (k = 0; k < nl; k++)
+                    if (hull_visible(r, r->tl[k], (const double (*)[2])hs, 2))
+                        sure_w |= (uint64_t)1 << k;
             }
-            if (sid == MESH_SURF_GROUND)
-                P[2] = 0.0;
-            albedo = sf->albedo;
-            call = sf->lit;
-            if (call && sid == MESH_SURF_GROUND && use_lm) {
-                lightmap_sample(r, P, E);
-                call = 0;
-            }
-            if (call) {
-                r->shade(r->user, P, n, E);
-                st->shader_calls++;
-            }
-            if (o->indirect) {
-                double Ei[3] = { 0, 0, 0 };
-                o->indirect(o->indirect_user, P, n, Ei);
-                for (k = 0; k < 3; k++)
-                    E[k] += Ei[k];
-            }
-            for (k = 0; k < 3; k++)
-                out[k] = (float)(albedo / PI * E[k]);
+            /* 3: shade */
+            for (q = 0, j = tj; j < j1; j++)
+                for (i = ti; i < i1; i++, q++) {
+                    size_t p = (size_t)j * (size_t)r->w + (size_t)i;
+                    const mesh_surf *sf = &m->surf[r->id[p]];
+                    double *E = r->tE[q];
+                    float *out = &r->lin[3 * p];
+                    int k;
+                    if (!r->tcall[q])
+                        continue;
+                    if (r->tcall[q] == 2) {
+                        if (nl >= 0) {
+                            shade_tile_lamps(r, nl,
+                                             r->id[p] == MESH_SURF_GROUND ? sure_g
+                                             : r->id[p] == wall           ? sure_w
+                                                                          : 0,
+                                             TP[q], TN[q], E, st);
+                            st->shader_tiled++;
+                        } else
+                            r->shade(r->user, TP[q], TN[q], E);
+                        st->shader_calls++;
+                    }
+                    if (o->indirect) {
+                        double Ei[3] = { 0, 0, 0 };
+                        o->indirect(o->indirect_user, TP[q], TN[q], Ei);
+                        for (k = 0; k < 3; k++)
+                            E[k] += Ei[k];
+                    }
+                    for (k = 0; k < 3; k++)
+                        out[k] = (float)(sf->albedo / PI * E[k]);
+                }
         }
-    }
 }
 
 static void glows(render *r, render_stats *st)
@@ -708,8 +1072,7 @@ plx_status render_frame(render *r, const render_camera *cam, const render_opts *
 {
     render_stats st;
     render_opts def;
-    raster_target tg;
-    raster_ctx rc;
+    const render_backend *be;
     size_t px, p;
     int inside;
     if (!r)
@@ -728,26 +1091,23 @@ plx_status render_frame(render *r, const render_camera *cam, const render_opts *
     st.buildings = r->s->nbld;
     st.triangles = r->m->ntri;
     px = (size_t)r->w * (size_t)r->h;
-    memset(r->id, 0, px * sizeof *r->id);
-
-    memset(&tg, 0, sizeof tg);
-    tg.format = RASTER_RGBA8;
-    tg.width = r->w;
-    tg.height = r->h;
-    tg.color = NULL;
-    tg.depth = r->depth;
-    if (raster_init(&rc, &tg, NULL) != PLX_OK) {
-        r->err = "render_frame: the rasteriser refused the target";
+    be = o->backend ? o->backend : &r->soft;
+    if (!be->begin || !be->draw || !be->finish) {
+        r->err = "render_frame: the backend lacks a function";
         return PLX_E_INVALID;
     }
-    raster_clear_depth(&rc, 1.0f);
-    raster_set_fragment(&rc, frag_id, r, 0);
     inside = eye_inside_solid(r);
     st.eye_inside = inside;
-    raster_set_cull(&rc, inside ? RASTER_CULL_NONE : RASTER_CULL_BACK);
-
+    if (be->begin(be->user, r->w, r->h, !inside) != 0) {
+        r->err = "render_frame: the backend could not start the frame";
+        return PLX_E_UNSUPPORTED;
+    }
     cull(r, o->cull, inside, &st);
-    draw_buildings(r, &rc, &st);
+    draw_buildings(r, be, &st);
+    if (be->finish(be->user, r->id, r->depth) != 0) {
+        r->err = "render_frame: the backend could not read the frame back";
+        return PLX_E_UNSUPPORTED;
+    }
     st.drawn_fraction = st.triangles ? (double)st.triangles_drawn / (double)st.triangles : 1.0;
     shade_pass(r, o, &st);
     if (!o->no_glow)

@@ -42,6 +42,28 @@
  * surface (so P does not suffer from float interpolation), and the shader
  * is called there -- except on surfaces that no lamp can light (mesh.h
  * 'lit' flag: the direct term is exactly 0) when there is no indirect hook.
+ * The shading pass runs by tiles of 8 x 8 pixels. With the light module's
+ * shader (render_shade_light) the renderer does the lamp walk itself: the
+ * lamps whose reach sphere meets the box of the tile's hit points are
+ * gathered once per tile from the light module's lamp grid (in lamp index
+ * order, the order of light_illuminance's walk; at most 64 lamps and 16
+ * grid cells, else the tile takes light_illuminance per pixel), and every
+ * pixel sums SPEC §2's term over that list with light_visible for the
+ * visibility -- the same operations as light_illuminance, so the same
+ * values (test_render checks them bit for bit); a lamp left out reaches no
+ * hit point of the tile (its term is exactly 0 there). The visibility
+ * query is skipped where its answer is known for the whole tile: for the
+ * tile's ground pixels (hull: the box of their ground points) and for its
+ * wall pixels when they all lie on one wall (hull: the segment between
+ * the two extreme ones), a lamp whose sector index (light.h) has, in every
+ * sector the hull's directions meet, only bands that start at or beyond
+ * every point of the hull (t_lo >= 1 - 1e-9 / (4 R), checked at the hull's
+ * corners since 1 / t_lo is linear in the point) lights all of them: such
+ * a band cannot stop the segment by more than light.h's 1e-9 m rule. The
+ * wall a pixel lies on starts exactly at it, so walls in the open take the
+ * shortcut too; any band nearer than the hull (a shadow caster) or one
+ * without a lo line (the lamp over a footprint) sends every pixel of the
+ * group to light_visible. Other shaders are called per pixel.
  * Depth range: near plane render_opts.near (default 0.05 m), far plane
  * beyond the farthest corner of the scene (buildings and lamps' reach). Back
  * faces are dropped unless the eye is inside a solid.
@@ -127,10 +149,22 @@
  * and undersides are still shaded exactly per pixel. The map's pitch is the
  * one asked for, enlarged when needed to stay within the byte budget.
  *
+ * Backends (render_backend below). Only pass (1) is pluggable: a backend
+ * takes the visible buildings' triangles, already in clip space (the core
+ * computes them in double precision and rounds them to float, identically
+ * for every backend), and returns per pixel the surface id of the nearest
+ * triangle covering the pixel centre and its window depth. Culling, the
+ * shading pass, glows and tone mapping stay in the core, so two backends
+ * can differ only in which triangle owns a pixel on an edge (fill rule,
+ * sub-pixel precision) and in depth quantisation. The built-in software
+ * rasteriser (raster.h) is the default; port/osmesa/ draws through OpenGL.
+ * Both cull back faces as raster.h's RASTER_CULL_BACK does unless the eye
+ * is inside a solid.
+ *
  * Memory: render_create takes the mesh, the frame buffers for the largest
- * image (depth, ids, linear colour: 20 bytes per pixel) and the culling
- * arrays from the arena (part PLX_PART_FRAME); the light map is taken there
- * when built. render_frame allocates nothing. No global state; one render
+ * image (depth, ids, linear colour: 20 bytes per pixel), the culling
+ * arrays and (light shader) 4 bytes per lamp from the arena (part
+ * PLX_PART_FRAME); the light map is taken there when built. render_frame allocates nothing. No global state; one render
  * object must not be used by two threads at once.
  */
 #ifndef PLX_RENDER_H
@@ -163,6 +197,34 @@ typedef struct render_camera {
 enum { RENDER_CULL_NONE = 0, RENDER_CULL_FRUSTUM = 1, RENDER_CULL_OCCLUSION = 2,
        RENDER_CULL_ALL = 3 };
 
+/* A raster backend (pass 1 above). Public as the opaque plx_backend of
+ * polarlux.h; a port fills the functions and its own state in user. Per
+ * frame the core calls begin once, draw once per visible building (in
+ * building index order), then finish once. A backend must draw each
+ * call's triangles in order with the depth test "less" (a later triangle
+ * at equal depth does not replace an earlier one), so ties resolve as in
+ * the software rasteriser. */
+typedef struct plx_backend render_backend;
+struct plx_backend {
+    const char *name;          /* "soft", "osmesa", ... for messages */
+    void *user;                /* the backend's state */
+    /* Starts a frame of w x h pixels: depth cleared to the far plane, ids
+     * to MESH_SURF_NONE. cull_back: drop triangles clockwise in normalised
+     * device coordinates (x right, y up). Returns 0, or -1 when the backend
+     * cannot draw this frame (e.g. larger than its buffers). */
+    int (*begin)(void *user, int32_t w, int32_t h, int cull_back);
+    /* Draws ntri triangles over nv vertices: triangle k has the clip-space
+     * vertices clip[4 (tri[k].v[i] - v_base) ..] (x, y, z, w floats, OpenGL
+     * clip space as in raster.h; tri[k].v[i] - v_base < nv) and the surface
+     * id tri[k].surf. */
+    void (*draw)(void *user, const float *clip, uint32_t nv, const mesh_tri *tri, uint32_t ntri,
+                 uint32_t v_base);
+    /* Ends the frame: writes the id of every pixel to id[w*h] and its window
+     * depth in [0, 1] (1 where nothing was drawn) to depth[w*h], row 0 at
+     * the top. Returns 0, or -1 on failure. */
+    int (*finish)(void *user, uint32_t *id /* OUT */, float *depth /* OUT */);
+};
+
 typedef struct render_opts {
     double exposure;           /* radiance multiplier before sRGB, default 1 */
     int no_glow;               /* 1: no lamp discs (exact SPEC §5 pixels) */
@@ -171,6 +233,7 @@ typedef struct render_opts {
     double near;               /* near plane distance, default 0.05 m */
     render_shade_fn indirect;  /* added to E_rgb when not NULL (photon hook) */
     void *indirect_user;
+    const render_backend *backend;  /* pass 1; NULL: the built-in software rasteriser */
 } render_opts;
 
 void render_opts_default(render_opts *o /* OUT */);
@@ -181,6 +244,8 @@ typedef struct render_stats {
     uint64_t triangles, triangles_drawn;
     double drawn_fraction;     /* triangles drawn / triangles of the scene */
     uint64_t shader_calls;     /* calls of the shade function */
+    uint64_t shader_tiled;     /* of which answered from a tile's lamp list */
+    uint64_t visibility_skipped; /* lamp visibility known from the tile (no query) */
     uint64_t ground_pixels, building_pixels, sky_pixels;
     uint32_t glows;            /* lamp discs drawn */
     int eye_inside;            /* the eye is inside a solid */
@@ -207,7 +272,8 @@ const mesh *render_mesh(const render *r);
  * (width*height*3 floats, linear) are caller-owned and either may be NULL;
  * stats may be NULL. Returns PLX_OK or PLX_E_INVALID (bad camera: non-finite,
  * eye == target, fov outside (0, 180), size outside 1..max, eye.z <= 0;
- * render_error says which). */
+ * render_error says which) or PLX_E_UNSUPPORTED (the backend could not
+ * draw the frame). */
 plx_status render_frame(render *r, const render_camera *cam, const render_opts *o,
                         uint8_t *rgb8 /* OUT */, float *rgbf /* OUT */,
                         render_stats *stats /* OUT */);

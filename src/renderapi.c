@@ -86,6 +86,7 @@ plx_status plx_render(plx_engine *e, const plx_camera *cam, const plx_render_opt
     ro.no_glow = o->no_glow;
     ro.lightmap = o->aerial;
     ro.cull = o->no_cull ? RENDER_CULL_NONE : RENDER_CULL_ALL;
+    ro.backend = o->backend;
     if (!o->no_indirect && e->ph && plx_indirect_frames(e) > 0) {
         ro.indirect = shade_indirect;
         ro.indirect_user = e;

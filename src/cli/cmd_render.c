@@ -6,6 +6,15 @@
 #include "cli.h"
 #include "port.h"
 #include "png/image_write.h"
+#ifdef PLX_HAVE_OSMESA
+#include "plx_osmesa.h"
+#endif
+
+#ifdef PLX_HAVE_OSMESA
+#define OSMESA_STATE "built in"
+#else
+#define OSMESA_STATE "not built into this polarlux"
+#endif
 
 static const char help[] =
     "usage: polarlux render SCENE [--eye X,Y,Z --target X,Y,Z] [--fov DEG] [--size WxH]\n"
@@ -34,14 +43,15 @@ static const char help[] =
     "                   buffers, traced first; progress on a terminal)\n"
     "  --photons N      photons per frame (default 65536)\n"
     "  --frames K       progressive photon frames for the still image (default 16)\n"
-    "  --backend B      soft (default, built in); osmesa is not built yet\n"
+    "  --backend B      raster pass: soft (default, built in) or osmesa (OpenGL into\n"
+    "                   an OSMesa buffer; " OSMESA_STATE "); the same image\n"
     "  -o FILE          output PNG (required)\n"
     "  --pfm FILE       also write the linear radiance as PFM\n"
     "  --mem SIZE, --strict, --quiet   as for 'polarlux info'\n";
 
 typedef struct render_args {
     const char *scene, *out, *pfm;
-    int have_eye, have_target, aerial;
+    int have_eye, have_target, aerial, osmesa;
     plx_camera cam;
     plx_render_opts opts;
     cli_common c;
@@ -82,12 +92,9 @@ static int parse_value(render_args *a, const char *opt, const char *val)
             return cli_usage_error("render", "--view '%s' is not street or aerial", val);
         a->aerial = strcmp(val, "aerial") == 0;
     } else if (strcmp(opt, "--backend") == 0) {
-        if (strcmp(val, "soft") == 0)
+        if (strcmp(val, "soft") == 0 || strcmp(val, "osmesa") == 0) {
+            a->osmesa = strcmp(val, "osmesa") == 0;
             return EXIT_OK;
-        if (strcmp(val, "osmesa") == 0) {
-            fprintf(stderr, "polarlux render: the osmesa backend is not built into this polarlux yet; "
-                            "use --backend soft\n");
-            return EXIT_FAIL;
         }
         return cli_usage_error("render", "--backend '%s' is not soft or osmesa", val);
     } else if (strcmp(opt, "--exposure") == 0) {
@@ -270,11 +277,21 @@ int cmd_render(int argc, char **argv)
     float *rgbf = NULL;
     unsigned long long t0;
     plx_status st;
+#ifdef PLX_HAVE_OSMESA
+    plx_osmesa *om = NULL;
+#endif
     int rc = parse_args(argc, argv, &a);
     if (rc != EXIT_OK)
         return rc < 0 ? EXIT_OK : rc;
     a.c.render_w = a.cam.width;
     a.c.render_h = a.cam.height;
+#ifndef PLX_HAVE_OSMESA
+    if (a.osmesa) {
+        fprintf(stderr, "polarlux render: this polarlux was built without OSMesa (libosmesa6-dev); "
+                        "use --backend soft\n");
+        return EXIT_FAIL;
+    }
+#endif
     rc = cli_open_scene("render", a.scene, &a.c, &e);
     if (rc != EXIT_OK)
         return rc;
@@ -309,10 +326,26 @@ int cmd_render(int argc, char **argv)
         rc = EXIT_FAIL;
         goto done;
     }
+#ifdef PLX_HAVE_OSMESA
+    if (a.osmesa) {
+        char err[256];
+        om = plx_osmesa_open(a.cam.width, a.cam.height, err, sizeof err);
+        if (!om) {
+            fprintf(stderr, "polarlux render: %s\n", err);
+            rc = EXIT_FAIL;
+            goto done;
+        }
+        a.opts.backend = plx_osmesa_backend(om);
+    }
+#endif
     t0 = port_now_ns();
     st = plx_render(e, &a.cam, &a.opts, rgb8, rgbf, &info);
     if (st != PLX_OK) {
         fprintf(stderr, "polarlux render: %s\n", plx_last_error(e));
+#ifdef PLX_HAVE_OSMESA
+        if (om && *plx_osmesa_error(om))
+            fprintf(stderr, "polarlux render: osmesa: %s\n", plx_osmesa_error(om));
+#endif
         rc = cli_exit_code(st);
         goto done;
     }
@@ -324,6 +357,9 @@ int cmd_render(int argc, char **argv)
                a.cam.target[0], a.cam.target[1], a.cam.target[2], info.drawn, info.buildings,
                100.0 * info.drawn_fraction, (port_now_ns() - t0) / 1e6, a.out);
 done:
+#ifdef PLX_HAVE_OSMESA
+    plx_osmesa_close(om);
+#endif
     free(rgb8);
     free(rgbf);
     plx_engine_free(e);

@@ -8,6 +8,10 @@
  * per pixel instead of from the light map. Median of several frames each;
  * the first frame (which fills the light module's cache) is reported apart.
  *
+ * With OSMesa built (PLX_HAVE_OSMESA): the street frame through the osmesa
+ * backend (port/osmesa) against the soft one, with the real and the zero
+ * shader (the latter isolates the raster pass).
+ *
  * Usage: bench_render [FRAMES]   (default 7)
  */
 #include <math.h>
@@ -21,6 +25,9 @@
 #include "light.h"
 #include "render.h"
 #include "png/image_write.h"
+#ifdef PLX_HAVE_OSMESA
+#include "plx_osmesa.h"
+#endif
 
 #define BUDGET ((size_t)3 << 30)
 
@@ -140,6 +147,8 @@ int main(int argc, char **argv)
            "(%.2f %% of triangles; %u frustum-culled, %u occlusion-culled), %llu shader calls\n",
            culled, first, st.drawn, st.buildings, 100.0 * st.drawn_fraction, st.frustum_culled,
            st.occlusion_culled, (unsigned long long)st.shader_calls);
+    printf("  of which %llu from tile lamp lists, %llu lamp visibilities known from the tile\n",
+           (unsigned long long)st.shader_tiled, (unsigned long long)st.visibility_skipped);
     if (out) {
         char p[512], err[256];
         snprintf(p, sizeof p, "%s/bench-street.png", out);
@@ -167,6 +176,27 @@ int main(int argc, char **argv)
         o.cull = RENDER_CULL_ALL;
         printf("street 640x480 with a zero shader (culling, raster, shading pass, tone map): culled %.2f ms, "
                "unculled %.2f ms, ratio %.3f\n", g, gu, g / gu);
+#ifdef PLX_HAVE_OSMESA
+        {
+            char err[256];
+            plx_osmesa *om = plx_osmesa_open(640, 480, err, sizeof err);
+            if (!om) {
+                printf("osmesa: no context (%s)\n", err);
+            } else {
+                double go, so, ss;
+                o.backend = plx_osmesa_backend(om);
+                go = time_frames(r0, &street, &o, nf, img, &st, &first);
+                so = time_frames(r, &street, &o, nf, img, &st, &first);
+                o.backend = NULL;
+                ss = time_frames(r, &street, &o, nf, img, &st, &first);
+                printf("street 640x480 culled, soft vs osmesa: zero shader %.2f vs %.2f ms, light shader "
+                       "%.2f vs %.2f ms, ratio osmesa/soft %.3f\n", g, go, ss, so, so / ss);
+                plx_osmesa_close(om);
+            }
+        }
+#else
+        printf("osmesa: not built (no OSMesa at build time)\n");
+#endif
     }
 
     t0 = port_now_ns();

@@ -1,0 +1,47 @@
+# The OSMesa port of the renderer's raster pass (port/osmesa/plx_osmesa.h),
+# included by the Makefile. Built only when pkg-config knows osmesa AND the
+# compiler in use can link it (so cross builds and builds without
+# libosmesa6-dev go on without it); `make OSMESA=0` leaves it out by hand.
+# When built:
+#  - build/libpolarlux_osmesa.a holds glraster.o (GL calls, no context) and
+#    plx_osmesa.o (the OSMesa context); libpolarlux itself never needs GL;
+#  - the CLI's render command and the render test and bench are compiled with
+#    -DPLX_HAVE_OSMESA and linked with that archive and -lOSMesa.
+OSMESA ?= auto
+ifeq ($(OSMESA),auto)
+OSMESA := $(shell pkg-config --exists osmesa 2>/dev/null && \
+  printf 'int main(void){return 0;}\n' | $(CC) -x c - -o /dev/null $$(pkg-config --libs osmesa) \
+  >/dev/null 2>&1 && echo 1 || echo 0)
+endif
+
+# Objects that change with the setting are rebuilt when it changes.
+OSMESA_CLIENTS = $(BUILD)/src/cli/cmd_render.o $(BUILD)/tests/unit/test_render.o \
+                 $(BUILD)/tests/bench/bench_render.o
+OSMESA_STAMP   = $(BUILD)/.osmesa-$(OSMESA)
+$(OSMESA_CLIENTS): $(OSMESA_STAMP)
+$(OSMESA_STAMP):
+	@mkdir -p $(@D); rm -f $(BUILD)/.osmesa-*; touch $@
+
+ifeq ($(OSMESA),1)
+OSMESA_CFLAGS := $(shell pkg-config --cflags osmesa)
+OSMESA_LIBS   := $(shell pkg-config --libs osmesa)
+OSMESA_SRC     = $(wildcard port/osmesa/*.c)
+OSMESA_OBJ     = $(OSMESA_SRC:%.c=$(BUILD)/%.o)
+OSMESA_A       = $(BUILD)/libpolarlux_osmesa.a
+# the programs that may use it
+OSMESA_USERS   = $(BIN) $(BUILD)/tests/test_render $(BUILD)/bench/bench_render
+
+$(OSMESA_OBJ): CPPFLAGS += -Iport/osmesa $(OSMESA_CFLAGS)
+$(OSMESA_CLIENTS): CPPFLAGS += -DPLX_HAVE_OSMESA -Iport/osmesa
+
+$(OSMESA_A): $(OSMESA_OBJ)
+	@rm -f $@
+	ar rcs $@ $^
+
+# Mesa keeps a few blocks for the process's life: not ours to report
+# (LeakSanitizer is told in plx_osmesa.c, valgrind here).
+export VALGRIND_OPTS := $(VALGRIND_OPTS) --suppressions=$(CURDIR)/port/osmesa/valgrind.supp
+
+$(OSMESA_USERS): $(OSMESA_A)
+$(OSMESA_USERS): LIBS := $(OSMESA_A) $(OSMESA_LIBS) $(LIBS)
+endif
