@@ -5,8 +5,9 @@
 #                             FUZZ_SECONDS each (default 60), clang + ASan + UBSan
 #   make fuzz-replay          the same targets built with $(CC) + ASan/UBSan and
 #                             run once over their seeds (no clang needed)
-#   make check-determinism    `polarlux gen` bytes and `polarlux info` output
-#                             (minus the timing line) equal across runs
+#   make check-determinism    `polarlux gen` bytes, `polarlux info` output
+#                             (minus the timing line) and render/heatmap
+#                             PNG/PFM bytes equal across runs
 #   make check-arm64          cross-compiles for aarch64 and runs the whole test
 #                             suite under qemu-user, then compares gen/info output
 #                             with the host's
@@ -85,7 +86,20 @@ check-determinism: all
 	  MALLOC_PERTURB_=170 $(BIN) info "$$f" 2>&1 | $(UNTIMED) >$$t/i2; \
 	  cmp $$t/i1 $$t/i2 || { echo "determinism: info $$f differs"; diff $$t/i1 $$t/i2 | head; exit 1; }; \
 	  n=$$((n + 1)); \
-	done; echo "determinism: $$n passed, 0 failed"
+	done; \
+	for view in street aerial; do \
+	  $(BIN) render -q fixtures/eixample-4x4.geojson --view $$view --size 160x120 --frames 4 --photons 8000 \
+	    -o $$t/r1.png --pfm $$t/r1.pfm >/dev/null; \
+	  MALLOC_PERTURB_=85 $(BIN) render -q fixtures/eixample-4x4.geojson --view $$view --size 160x120 --frames 4 \
+	    --photons 8000 -o $$t/r2.png --pfm $$t/r2.pfm >/dev/null; \
+	  cmp $$t/r1.png $$t/r2.png && cmp $$t/r1.pfm $$t/r2.pfm || { echo "determinism: render $$view differs"; exit 1; }; \
+	  n=$$((n + 2)); \
+	done; \
+	$(BIN) heatmap -q fixtures/tiny.geojson --res 1 -o $$t/h1.png >/dev/null; \
+	MALLOC_PERTURB_=85 $(BIN) heatmap -q fixtures/tiny.geojson --res 1 -o $$t/h2.png >/dev/null; \
+	cmp $$t/h1.png $$t/h2.png || { echo "determinism: heatmap differs"; exit 1; }; \
+	n=$$((n + 1)); \
+	echo "determinism: $$n passed, 0 failed"
 
 # ---- arm64 under qemu-user ---------------------------------------------------------
 ARM64_CC    ?= aarch64-linux-gnu-gcc
