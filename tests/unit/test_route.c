@@ -207,6 +207,48 @@ static void test_errors(void **state)
     free(mem);
 }
 
+/* Every memory request of a first route score (lamp light set-up, lit
+ * regions, sample scratch) and of a first illuminance call fails in turn:
+ * PLX_E_NOMEM, the arena back where it was, the engine still usable. */
+static void test_fault_injection(void **state)
+{
+    static const char scene[] = "{\"type\":\"FeatureCollection\",\"properties\":{\"units\":\"m\"},\"features\":["
+                                "{\"type\":\"Feature\",\"properties\":{\"height\":20},\"geometry\":{\"type\":\"Polygon\","
+                                "\"coordinates\":[[[-2,2],[2,2],[2,3],[-2,3],[-2,2]]]}},"
+                                "{\"type\":\"Feature\",\"properties\":{\"lamp\":true},"
+                                "\"geometry\":{\"type\":\"Point\",\"coordinates\":[0,5]}}]}";
+    double xy[4] = { -10, 0, 10, 0 }, P[3] = { 0, 8, 0 }, N[3] = { 0, 0, 1 }, E, Ei, want;
+    int which;
+    (void)state;
+    for (which = 0; which < 2; which++) {
+        void *mem;
+        plx_engine *e = load(scene, &mem);
+        plx_memory_report before, after;
+        plx_route_stats t;
+        plx_status st = PLX_E_NOMEM;
+        uint64_t k;
+        plx_memory_get(e, &before);
+        for (k = 1; st == PLX_E_NOMEM; k++) {
+            plx_debug_fail_alloc(e, k);
+            st = which == 0 ? plx_route_score(e, xy, 2, 1.0, 1.0, &t, NULL)
+                            : plx_illuminance(e, 1, P, N, &E, &Ei, NULL);
+            plx_memory_get(e, &after);
+            if (st == PLX_E_NOMEM)
+                assert_int_equal(after.used_total, before.used_total);
+            assert_true(k < 100000);
+        }
+        plx_debug_fail_alloc(e, 0);
+        assert_int_equal(st, PLX_OK);
+        assert_true(k > 2);
+        if (which == 1) {
+            want = lamp_E(0, 8, 0, 5, 6, 1000, 30);
+            assert_true(fabs(E - want) < 1e-9 * want);
+        }
+        plx_engine_destroy(e);
+        free(mem);
+    }
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -216,6 +258,7 @@ int main(void)
         cmocka_unit_test(test_consistent_with_illuminance),
         cmocka_unit_test(test_p_class_boundaries),
         cmocka_unit_test(test_errors),
+        cmocka_unit_test(test_fault_injection),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
