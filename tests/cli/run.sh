@@ -90,11 +90,11 @@ printf '{"type":"FeatureCollection","features":[{"type":"Feature","properties":{
 expect route-not-lines 1 "feature 0: geometry is not a LineString or MultiLineString" -- "$bin" route -q fixtures/tiny.geojson --path "$tmp/bad-route.json"
 expect route-lonlat-vs-metres 1 "the path is in lon/lat but the scene is in local metres" -- "$bin" route -q fixtures/tiny.geojson --path fixtures/helsinki-route.geojson
 expect dark-spots 0 "\"rank\":1" -- "$bin" dark-spots -q fixtures/tiny.geojson --res 2 --count 5
-expect render-street 0 "^street view 160x120 from \(30\.0, 30\.0, 1\.7\) to \(50\.0, 10\.0, 2\.0\): drew [0-9]+ of 4 buildings" -- "$bin" render -q fixtures/tiny.geojson --eye 30,30,1.7 --target 50,10,2 --size 160x120 -o "$tmp/s.png" --pfm "$tmp/s.pfm"
+expect render-street 0 "^street view 160x120 from \(30\.0, 30\.0, 1\.7\) to \(50\.0, 10\.0, 2\.0\): drew [0-9]+ of 4 buildings" -- "$bin" render -q --frames 4 fixtures/tiny.geojson --eye 30,30,1.7 --target 50,10,2 --size 160x120 -o "$tmp/s.png" --pfm "$tmp/s.pfm"
 if [ "$(head -c 12 "$tmp/s.pfm" | tr '\n' ' ')" = "PF 160 120 -" ]; then echo "ok   render-pfm-header"; pass=$((pass + 1)); else echo "FAIL render-pfm-header"; fail=$((fail + 1)); fi
 if [ "$(wc -c < "$tmp/s.pfm")" -gt $((160 * 120 * 12)) ]; then echo "ok   render-pfm-size"; pass=$((pass + 1)); else echo "FAIL render-pfm-size"; fail=$((fail + 1)); fi
-expect render-aerial 0 "^aerial view 120x80 " -- "$bin" render -q fixtures/tiny.geojson --view aerial --size 120x80 -o "$tmp/a.png"
-expect render-default-street 0 "^street view 64x48 " -- "$bin" render -q fixtures/eixample-4x4.geojson --size 64x48 -o "$tmp/d.png"
+expect render-aerial 0 "^aerial view 120x80 " -- "$bin" render -q --frames 4 fixtures/tiny.geojson --view aerial --size 120x80 -o "$tmp/a.png"
+expect render-default-street 0 "^street view 64x48 " -- "$bin" render -q --frames 4 fixtures/eixample-4x4.geojson --size 64x48 -o "$tmp/d.png"
 expect render-eye-underground 2 "the eye must be above the ground" -- "$bin" render -q fixtures/tiny.geojson --eye 30,30,-1 --target 50,10,2 --size 16x16 -o "$tmp/u.png"
 expect render-eye-only 2 "give both --eye and --target" -- "$bin" render -q fixtures/tiny.geojson --eye 30,30,2 -o "$tmp/u.png"
 if "$bin" render --help | grep -q "not built into this polarlux"; then
