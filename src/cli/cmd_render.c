@@ -165,6 +165,11 @@ static int parse_args(int argc, char **argv, render_args *a)
         return cli_usage_error("render", "missing -o OUT.png");
     if (a->have_eye != a->have_target)
         return cli_usage_error("render", "give both --eye and --target, or neither");
+    if (a->have_eye && !(a->cam.eye[2] > 0.0))
+        return cli_usage_error("render", "the eye must be above the ground (z > 0), not %g", a->cam.eye[2]);
+    if (a->have_eye && a->cam.eye[0] == a->cam.target[0] && a->cam.eye[1] == a->cam.target[1] &&
+        a->cam.eye[2] == a->cam.target[2])
+        return cli_usage_error("render", "--eye and --target are the same point");
     a->opts.aerial = a->aerial;
     a->opts.no_indirect = a->ind.off;
     return EXIT_OK;

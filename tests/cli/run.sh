@@ -77,7 +77,7 @@ expect illum-under-lamp 1 "^50 10 0 15\.46737485749[0-9]* 0$" -- "$bin" illum -q
 expect illum-indirect 1 "^50 10 0 15\.46737485749[0-9]* [0-9.]+(e-?[0-9]+)?$" -- "$bin" illum -q --frames 4 --photons 20000 fixtures/tiny.geojson --points "$tmp/i.txt"
 if grep -q "^50 10 0 15.46737485749[0-9]* 0$" "$tmp/out"; then echo "FAIL illum-indirect: E_indirect is 0 in a lit courtyard"; fail=$((fail + 1)); else echo "ok   illum-indirect-nonzero"; pass=$((pass + 1)); fi
 expect illum-bad-frames 2 "--frames 'x' is not a whole number" -- "$bin" illum -q fixtures/tiny.geojson --points "$tmp/i.txt" --frames x
-expect illum-inside 1 "i.txt:3: point \(5, 5, 3\) is inside a building's solid" -- "$bin" illum -q fixtures/tiny.geojson --points "$tmp/i.txt"
+expect illum-inside 1 "i.txt:3: point \(5, 5, 3\) is inside a building's solid" -- "$bin" illum -q --frames 2 fixtures/tiny.geojson --points "$tmp/i.txt"
 expect illum-missing 2 "missing --points FILE" -- "$bin" illum fixtures/tiny.geojson
 expect lit-L1 0 "^lamp 0 \(L1\): [0-9]+ lit ground polygons, [0-9]+ lit facade polygons" -- "$bin" lit -q fixtures/tiny.geojson --lamp L1 -o "$tmp/lit.geojson"
 expect lit-index 0 "^lamp 1 \(L2\)" -- "$bin" lit -q fixtures/tiny.geojson --lamp 1 -o "$tmp/lit2.geojson"
@@ -98,9 +98,9 @@ expect render-default-street 0 "^street view 64x48 " -- "$bin" render -q --frame
 expect render-eye-underground 2 "the eye must be above the ground" -- "$bin" render -q fixtures/tiny.geojson --eye 30,30,-1 --target 50,10,2 --size 16x16 -o "$tmp/u.png"
 expect render-eye-only 2 "give both --eye and --target" -- "$bin" render -q fixtures/tiny.geojson --eye 30,30,2 -o "$tmp/u.png"
 if "$bin" render --help | grep -q "not built into this polarlux"; then
-expect render-osmesa 1 "built without OSMesa" -- "$bin" render -q fixtures/tiny.geojson --backend osmesa -o "$tmp/u.png"
+expect render-osmesa 1 "built without OSMesa" -- "$bin" render -q --frames 2 fixtures/tiny.geojson --backend osmesa -o "$tmp/u.png"
 else
-expect render-osmesa 0 "^street view 64x48 " -- "$bin" render -q fixtures/tiny.geojson --backend osmesa --size 64x48 -o "$tmp/u.png"
+expect render-osmesa 0 "^street view 64x48 " -- "$bin" render -q --frames 2 fixtures/tiny.geojson --backend osmesa --size 64x48 -o "$tmp/u.png"
 fi
 expect render-bad-size 2 "--size '12' is not WxH" -- "$bin" render -q fixtures/tiny.geojson --size 12 -o "$tmp/u.png"
 expect nightify-ok 0 "^nightify: 160x120 day image matched to 120x80 night reference" -- "$bin" nightify "$tmp/s.png" "$tmp/a.png" -o "$tmp/n.png"
