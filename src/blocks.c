@@ -5,8 +5,12 @@
  * tested for touch and overlap; union-find makes the blocks. Each block is
  * then outlined on its own, in scratch memory given back after the block:
  * gather vertices, cluster them (grid), bend edges through nearby clusters
- * (grid), split at crossings (grid over pieces), merge equal sub-edges
- * (sort), classify them by a ray count (strips), link and split loops. The
+ * (hashed grid), split at crossings (hashed grid over pieces), merge equal
+ * sub-edges (sort), classify them by a ray count (sweep with a Fenwick tree
+ * plus a hashed grid), link and split loops. The hashed grids have cells
+ * about the size of the items, so a thin ring around an empty middle or a
+ * long band of teeth stays near linear; their finds are put in the order
+ * the plain grid would give, so the results do not depend on them. The
  * outlines go to a scratch cache first; if it is too small they are
  * counted, and computed again straight into persistent arrays. */
 #include <string.h>
@@ -348,13 +352,11 @@ static void item_box(const double *box, const vec2 *pts, uint32_t i, double b[4]
 /* Builds a grid over n items given as boxes (4 doubles each) or as points.
  * Cells are at least min_cs wide; there are about n of them and the items
  * cover at most about 8n cells (the size grows until they do). */
-static plx_status grid_build(arena *a, grid *g, const double *box, const vec2 *pts, uint32_t n,
-                             double min_cs)
+static void grid_size(grid *g, const double *box, const vec2 *pts, uint32_t n, double min_cs)
 {
     double bx0 = DBL_MAX, by0 = DBL_MAX, bx1 = -DBL_MAX, by1 = -DBL_MAX, w, h, cs, b[4];
     double cap_cells = 2.0 * n + 64.0, cap_items = 8.0 * n + 64.0;
-    size_t ncell, nitem;
-    uint32_t i, c, r[4], x, y, iter;
+    uint32_t i, r[4], iter;
     for (i = 0; i < n; i++) {
         item_box(box, pts, i, b);
         if (b[0] < bx0) bx0 = b[0];
@@ -399,6 +401,15 @@ static plx_status grid_build(arena *a, grid *g, const double *box, const vec2 *p
             break;
         cs *= 1.5;
     }
+}
+
+static plx_status grid_build(arena *a, grid *g, const double *box, const vec2 *pts, uint32_t n,
+                             double min_cs)
+{
+    double b[4];
+    size_t ncell, nitem;
+    uint32_t i, c, r[4], x, y;
+    grid_size(g, box, pts, n, min_cs);
     ncell = (size_t)g->nx * g->ny;
     g->start = arena_scratch(a, arena_mul(ncell + 1, sizeof(uint32_t)), BLK_ALIGN);
     if (!g->start)
@@ -443,6 +454,162 @@ static int grid_owns_pair(const grid *g, uint32_t c, const double *b1, const dou
 static int boxes_meet(const double *b1, const double *b2)
 {
     return !(b1[0] > b2[2] || b2[0] > b1[2] || b1[1] > b2[3] || b2[1] > b1[3]);
+}
+
+/* ---- hashed grid over boxes, sized by the boxes themselves -------------- */
+
+/* A uniform grid of square cells whose size follows the typical box (not the
+ * area they spread over, so a thin ring of small edges around an empty
+ * middle still gets small cells); only the cells boxes meet are stored, in
+ * a hash table. A bucket may hold the boxes of several cells: users check
+ * that a box covers the cell they look at. Each box is listed at most once
+ * per bucket. */
+typedef struct hgrid {
+    double x0, y0, inv;
+    uint32_t mask;    /* buckets - 1 (buckets: a power of two) */
+    int shift;        /* 64 - log2(buckets) */
+    uint32_t *start;  /* mask + 2 offsets into item */
+    uint32_t *item;
+} hgrid;
+
+static uint32_t hgrid_cell(double v, double v0, double inv)
+{
+    double f = (v - v0) * inv;
+    if (!(f >= 0.0))
+        return 0;
+    if (f >= 2147483647.0)
+        return 2147483647u;
+    return (uint32_t)f;
+}
+
+static uint32_t hgrid_bucket(const hgrid *h, uint32_t cx, uint32_t cy)
+{
+    /* mixed, then the top bits: regular cell numbers (all even, say)
+     * still spread over all buckets */
+    uint64_t v = (uint64_t)cx * 0x9E3779B97F4A7C15ull + (uint64_t)cy * 0xC2B2AE3D27D4EB4Full;
+    v ^= v >> 29;
+    v *= 0xBF58476D1CE4E5B9ull;
+    return (uint32_t)(v >> h->shift);
+}
+
+/* Cell range r = {x0, y0, x1, y1} of a box. */
+static void hgrid_range(const hgrid *h, const double *b, uint32_t r[4])
+{
+    r[0] = hgrid_cell(b[0], h->x0, h->inv);
+    r[1] = hgrid_cell(b[1], h->y0, h->inv);
+    r[2] = hgrid_cell(b[2], h->x0, h->inv);
+    r[3] = hgrid_cell(b[3], h->y0, h->inv);
+}
+
+/* Counts (fill == 0) or stores the bucket entries of the n boxes (or
+ * points); last[] keeps each box out of a bucket it is already in. */
+static void hgrid_pass(hgrid *h, const double *box, const vec2 *pts, uint32_t n, uint32_t *last,
+                       int fill)
+{
+    uint32_t i, x, y, b, r[4];
+    double bb[4];
+    for (b = 0; b <= h->mask; b++)
+        last[b] = BLK_NONE;
+    for (i = 0; i < n; i++) {
+        item_box(box, pts, i, bb);
+        hgrid_range(h, bb, r);
+        for (y = r[1]; y <= r[3]; y++)
+            for (x = r[0]; x <= r[2]; x++) {
+                b = hgrid_bucket(h, x, y);
+                if (last[b] == i)
+                    continue;
+                last[b] = i;
+                if (fill)
+                    h->item[h->start[b]++] = i;
+                else
+                    h->start[b + 1]++;
+            }
+    }
+}
+
+/* Histogram of sizes by power of two, for a median within a factor 2. */
+static void hist_add(uint32_t hist[64], double e)
+{
+    int ex = -32;
+    if (e > 0.0 && e <= DBL_MAX)
+        (void)frexp(e, &ex);
+    ex += 32;
+    hist[ex < 0 ? 0 : ex > 63 ? 63 : ex]++;
+}
+
+/* A power of two at least the median of the n sizes counted. */
+static double hist_median(const uint32_t hist[64], uint32_t n)
+{
+    uint32_t t = 0, i;
+    for (i = 0; i < 63; i++) {
+        t += hist[i];
+        if (2 * (uint64_t)t >= n)
+            break;
+    }
+    return ldexp(1.0, (int)i - 32);
+}
+
+/* Builds the grid over n boxes (or points) with cells at least min_cs and
+ * about the median box size; a box meets at most about 8n cells. */
+static plx_status hgrid_build(arena *a, hgrid *h, const double *box, const vec2 *pts, uint32_t n,
+                              double min_cs)
+{
+    double bx0 = DBL_MAX, by0 = DBL_MAX, bx1 = -DBL_MAX, by1 = -DBL_MAX, cs, e, cells, b[4];
+    double cap = 8.0 * n + 64.0;
+    uint32_t hist[64], i, nb, *last;
+    memset(hist, 0, sizeof(hist));
+    for (i = 0; i < n; i++) {
+        item_box(box, pts, i, b);
+        if (b[0] < bx0) bx0 = b[0];
+        if (b[1] < by0) by0 = b[1];
+        if (b[2] > bx1) bx1 = b[2];
+        if (b[3] > by1) by1 = b[3];
+        hist_add(hist, b[2] - b[0] > b[3] - b[1] ? b[2] - b[0] : b[3] - b[1]);
+    }
+    if (n == 0)
+        bx0 = by0 = bx1 = by1 = 0.0;
+    cs = hist_median(hist, n);
+    if (cs < min_cs)
+        cs = min_cs;
+    e = (bx1 - bx0 > by1 - by0 ? bx1 - bx0 : by1 - by0) / 1073741824.0;
+    if (cs < e)
+        cs = e;
+    if (!(cs > 0.0))
+        cs = 1.0;
+    h->x0 = bx0;
+    h->y0 = by0;
+    for (;;) {
+        h->inv = 1.0 / cs;
+        cells = 0.0;
+        for (i = 0; i < n && cells <= cap; i++) {
+            uint32_t r[4];
+            item_box(box, pts, i, b);
+            hgrid_range(h, b, r);
+            cells += (double)(r[2] - r[0] + 1) * (double)(r[3] - r[1] + 1);
+        }
+        if (cells <= cap)
+            break;
+        cs *= 2.0;
+    }
+    for (nb = 64, h->shift = 58; nb < 2 * (uint64_t)n && nb < 0x40000000u; nb *= 2)
+        h->shift--;
+    h->mask = nb - 1;
+    h->start = arena_scratch(a, arena_mul((size_t)nb + 1, sizeof(uint32_t)), BLK_ALIGN);
+    last = arena_scratch(a, arena_mul(nb, sizeof(uint32_t)), BLK_ALIGN);
+    if (!h->start || !last)
+        return PLX_E_NOMEM;
+    memset(h->start, 0, ((size_t)nb + 1) * sizeof(uint32_t));
+    hgrid_pass(h, box, pts, n, last, 0);
+    for (i = 0; i < nb; i++)
+        h->start[i + 1] += h->start[i];
+    h->item = arena_scratch(a, arena_mul(h->start[nb], sizeof(uint32_t)), BLK_ALIGN);
+    if (!h->item)
+        return PLX_E_NOMEM;
+    hgrid_pass(h, box, pts, n, last, 1);
+    for (i = nb; i > 0; i--)
+        h->start[i] = h->start[i - 1];
+    h->start[0] = 0;
+    return PLX_OK;
 }
 
 /* ---- strips along one axis, for axis-parallel rays ---------------------- */
@@ -616,6 +783,8 @@ typedef struct blk {
     uint32_t nk;           /* kept sub-edges, union on the left */
     uint32_t *kf, *kt;
     double mina;           /* loops of smaller area are dropped */
+    int fast;              /* cluster coordinates finite and <= 1e150: hashed grids */
+    double cmax;           /* largest |coordinate| of a cluster */
     int broken;            /* some kept edges could not be linked */
 } blk;
 
@@ -660,13 +829,27 @@ static plx_status blk_gather(blk *k, const uint32_t *bl, uint32_t nb)
  * cluster and takes every free vertex within tol of it (not transitively,
  * so a finely drawn curve keeps its shape: cluster centres end up more
  * than tol apart and each vertex moves by at most tol). */
+static int pts_fast(const vec2 *p, uint32_t n, double *mx);
+
 static plx_status blk_cluster(blk *k, uint32_t *cid)
 {
     grid g;
-    uint32_t i, x, y, c, e, j, r[4];
-    plx_status st = grid_build(k->a, &g, NULL, k->vp, k->nv0, k->tol);
+    hgrid h;
+    uint32_t i, x, y, c, e, j, r[4], ro[4];
+    double mx, widen, q[4];
+    int fast = pts_fast(k->vp, k->nv0, &mx);
+    plx_status st;
+    if (fast) {
+        /* a hashed grid finds the same candidates as the plain one: those
+         * in the plain cells of the query (any order will do) */
+        grid_size(&g, NULL, k->vp, k->nv0, k->tol);
+        st = hgrid_build(k->a, &h, NULL, k->vp, k->nv0, 4.0 * k->tol);
+    } else {
+        st = grid_build(k->a, &g, NULL, k->vp, k->nv0, k->tol);
+    }
     if (st != PLX_OK)
         return st;
+    widen = k->tol + 1e-6 * k->tol + 64.0 * DBL_EPSILON * mx + DBL_MIN;
     for (i = 0; i < k->nv0; i++)
         cid[i] = BLK_NONE;
     SCRATCH(k->cp, k->nv0, vec2);
@@ -677,13 +860,42 @@ static plx_status blk_cluster(blk *k, uint32_t *cid)
             continue;
         cid[i] = k->nc;
         k->cp[k->nc] = p;
-        grid_range(&g, p.x - k->tol, p.y - k->tol, p.x + k->tol, p.y + k->tol, r);
+        grid_range(&g, p.x - k->tol, p.y - k->tol, p.x + k->tol, p.y + k->tol, ro);
+        if (!fast) {
+            for (y = ro[1]; y <= ro[3]; y++)
+                for (x = ro[0]; x <= ro[2]; x++) {
+                    c = y * g.nx + x;
+                    for (e = g.start[c]; e < g.start[c + 1]; e++) {
+                        j = g.item[e];
+                        if (cid[j] == BLK_NONE && dist2(p, k->vp[j]) <= k->tol2)
+                            cid[j] = k->nc;
+                    }
+                }
+            k->nc++;
+            continue;
+        }
+        q[0] = p.x - widen;
+        q[1] = p.y - widen;
+        q[2] = p.x + widen;
+        q[3] = p.y + widen;
+        hgrid_range(&h, q, r);
         for (y = r[1]; y <= r[3]; y++)
             for (x = r[0]; x <= r[2]; x++) {
-                c = y * g.nx + x;
-                for (e = g.start[c]; e < g.start[c + 1]; e++) {
-                    j = g.item[e];
-                    if (cid[j] == BLK_NONE && dist2(p, k->vp[j]) <= k->tol2)
+                uint32_t bk = hgrid_bucket(&h, x, y);
+                for (e = h.start[bk]; e < h.start[bk + 1]; e++) {
+                    vec2 v;
+                    uint32_t ox, oy;
+                    j = h.item[e];
+                    if (cid[j] != BLK_NONE)
+                        continue;
+                    v = k->vp[j];
+                    if (hgrid_cell(v.x, h.x0, h.inv) != x || hgrid_cell(v.y, h.y0, h.inv) != y)
+                        continue;
+                    ox = grid_cell1(v.x, g.x0, g.inv, g.nx);
+                    oy = grid_cell1(v.y, g.y0, g.inv, g.ny);
+                    if (ox < ro[0] || ox > ro[2] || oy < ro[1] || oy > ro[3])
+                        continue; /* the plain grid would not look at it */
+                    if (dist2(p, v) <= k->tol2)
                         cid[j] = k->nc;
                 }
             }
@@ -726,13 +938,146 @@ static uint32_t edge_hits(const blk *k, const grid *g, uint32_t u, uint32_t v, u
     return n;
 }
 
+/* The cells of h, across the axis 'mn', that segment a + t*d (0 <= t <= 1)
+ * widened by m can reach within the slab of cells number c along the axis
+ * 'ax' (m also covers rounding: give it a cell more); r clips the range. */
+static void hgrid_span(const hgrid *h, int ax, const double A[2], const double D[2], double m,
+                       uint32_t c, const uint32_t r[4], uint32_t *lo, uint32_t *hi)
+{
+    int mn = 1 - ax;
+    double o0 = ax ? h->y0 : h->x0, o1 = ax ? h->x0 : h->y0, t0, t1, v0, v1, sw;
+    t0 = (o0 + c / h->inv - m - A[ax]) / D[ax];
+    t1 = (o0 + (c + 1.0) / h->inv + m - A[ax]) / D[ax];
+    if (t0 > t1) {
+        sw = t0;
+        t0 = t1;
+        t1 = sw;
+    }
+    t0 = t0 < 0.0 ? 0.0 : t0 > 1.0 ? 1.0 : t0;
+    t1 = t1 < 0.0 ? 0.0 : t1 > 1.0 ? 1.0 : t1;
+    v0 = A[mn] + t0 * D[mn];
+    v1 = A[mn] + t1 * D[mn];
+    if (v0 > v1) {
+        sw = v0;
+        v0 = v1;
+        v1 = sw;
+    }
+    *lo = hgrid_cell(v0 - m, o1, h->inv);
+    *hi = hgrid_cell(v1 + m, o1, h->inv);
+    if (*lo < r[mn])
+        *lo = r[mn];
+    if (*hi > r[mn + 2])
+        *hi = r[mn + 2];
+}
+
+/* The same hits as edge_hits() over a plain grid with the geometry of og,
+ * in the same order (by plain cell, then cluster), found through the hashed
+ * grid h within 'widen' of the edge (> tol plus rounding: every hit lies
+ * there). Only the cells along the edge are looked at, so a long slanted
+ * edge costs about its length in cells, not its box. */
+static uint32_t edge_hits_h(const blk *k, const hgrid *h, const grid *og, double widen,
+                            uint32_t u, uint32_t v, uint32_t *hw, double *ht)
+{
+    vec2 a = k->cp[u], b = k->cp[v];
+    double dx = b.x - a.x, dy = b.y - a.y, l2 = dx * dx + dy * dy, t, q[4], A[2], D[2], m;
+    uint32_t ro[4], r[4], cc[2], c, lo, hi, e, w, n = 0, i, j;
+    int ax = fabs(dx) >= fabs(dy) ? 0 : 1;
+    if (!(l2 > 0.0))
+        return 0;
+    grid_range(og, (a.x < b.x ? a.x : b.x) - k->tol, (a.y < b.y ? a.y : b.y) - k->tol,
+               (a.x < b.x ? b.x : a.x) + k->tol, (a.y < b.y ? b.y : a.y) + k->tol, ro);
+    q[0] = (a.x < b.x ? a.x : b.x) - widen;
+    q[1] = (a.y < b.y ? a.y : b.y) - widen;
+    q[2] = (a.x < b.x ? b.x : a.x) + widen;
+    q[3] = (a.y < b.y ? b.y : a.y) + widen;
+    hgrid_range(h, q, r);
+    A[0] = a.x;
+    A[1] = a.y;
+    D[0] = dx;
+    D[1] = dy;
+    m = widen + 1.0 / h->inv + 64.0 * DBL_EPSILON * k->cmax;
+    for (c = r[ax]; c <= r[ax + 2]; c++) {
+        hgrid_span(h, ax, A, D, m, c, r, &lo, &hi);
+        cc[ax] = c;
+        for (cc[1 - ax] = lo; cc[1 - ax] <= hi; cc[1 - ax]++) {
+            uint32_t bk = hgrid_bucket(h, cc[0], cc[1]);
+            for (e = h->start[bk]; e < h->start[bk + 1]; e++) {
+                vec2 p;
+                uint32_t ox, oy;
+                w = h->item[e];
+                p = k->cp[w];
+                if (w == u || w == v || hgrid_cell(p.x, h->x0, h->inv) != cc[0] ||
+                    hgrid_cell(p.y, h->y0, h->inv) != cc[1])
+                    continue;
+                ox = grid_cell1(p.x, og->x0, og->inv, og->nx);
+                oy = grid_cell1(p.y, og->y0, og->inv, og->ny);
+                if (ox < ro[0] || ox > ro[2] || oy < ro[1] || oy > ro[3])
+                    continue; /* the plain grid would not look at it */
+                t = ((p.x - a.x) * dx + (p.y - a.y) * dy) / l2;
+                if (!(t > 0.0 && t < 1.0) || dist2(p, lerp(a, b, t)) > k->tol2)
+                    continue;
+                if (hw) {
+                    hw[n] = w;
+                    ht[n] = t;
+                }
+                n++;
+            }
+        }
+    }
+    /* the plain grid's order: by cell (rows of x), then cluster */
+    for (i = 1; hw && i < n; i++) {
+        uint32_t ti = hw[i];
+        double tt = ht[i];
+        uint64_t ki;
+        vec2 p = k->cp[ti];
+        ki = ((uint64_t)grid_cell1(p.y, og->y0, og->inv, og->ny) * og->nx +
+              grid_cell1(p.x, og->x0, og->inv, og->nx)) << 32 | ti;
+        for (j = i; j > 0; j--) {
+            vec2 o = k->cp[hw[j - 1]];
+            uint64_t kj = ((uint64_t)grid_cell1(o.y, og->y0, og->inv, og->ny) * og->nx +
+                           grid_cell1(o.x, og->x0, og->inv, og->nx)) << 32 | hw[j - 1];
+            if (kj <= ki)
+                break;
+            hw[j] = hw[j - 1];
+            ht[j] = ht[j - 1];
+        }
+        hw[j] = ti;
+        ht[j] = tt;
+    }
+    return n;
+}
+
+/* Are the n coordinates all finite and at most 1e150 (the rounding bounds
+ * of the hashed-grid searches hold)? *mx: the largest |coordinate|. */
+static int pts_fast(const vec2 *p, uint32_t n, double *mx)
+{
+    uint32_t i;
+    double v;
+    *mx = 0.0;
+    for (i = 0; i < n; i++) {
+        v = fabs(p[i].x) > fabs(p[i].y) ? fabs(p[i].x) : fabs(p[i].y);
+        if (!(v <= 1e150) || p[i].x != p[i].x || p[i].y != p[i].y)
+            return 0;
+        if (v > *mx)
+            *mx = v;
+    }
+    return 1;
+}
+
+/* Sets k->fast and k->cmax for the clusters. */
+static void blk_check_fast(blk *k)
+{
+    k->fast = pts_fast(k->cp, k->nc, &k->cmax);
+}
+
 /* Step 1b: footprint edges between clusters, bent through the clusters near
  * their interior (T-junctions), give the pieces. */
 static plx_status blk_pieces(blk *k, const uint32_t *cid)
 {
     grid g;
+    hgrid hg;
     uint32_t *ea, *eb, *hs, *hw, ne = 0, i, h, u, prev;
-    double *ht;
+    double *ht, widen = 0.0;
     plx_status st;
     SCRATCH(ea, k->nv0, uint32_t);
     SCRATCH(eb, k->nv0, uint32_t);
@@ -744,13 +1089,30 @@ static plx_status blk_pieces(blk *k, const uint32_t *cid)
             ne++;
         }
     }
-    st = grid_build(k->a, &g, NULL, k->cp, k->nc, k->tol);
+    blk_check_fast(k);
+    if (k->fast) {
+        /* cells about the length of an edge (plus tol), so an edge looks
+         * at a few cells; their order is that of the plain grid */
+        uint32_t hist[64];
+        memset(hist, 0, sizeof(hist));
+        for (i = 0; i < ne; i++) {
+            vec2 a = k->cp[ea[i]], b = k->cp[eb[i]];
+            double ex = fabs(b.x - a.x), ey = fabs(b.y - a.y);
+            hist_add(hist, (ex > ey ? ex : ey) + 2.0 * k->tol);
+        }
+        grid_size(&g, NULL, k->cp, k->nc, k->tol);
+        st = hgrid_build(k->a, &hg, NULL, k->cp, k->nc, hist_median(hist, ne));
+        widen = k->tol + 1e-6 * k->tol + 64.0 * DBL_EPSILON * k->cmax + DBL_MIN;
+    } else {
+        st = grid_build(k->a, &g, NULL, k->cp, k->nc, k->tol);
+    }
     if (st != PLX_OK)
         return st;
     SCRATCH(hs, (size_t)ne + 1, uint32_t);
     hs[0] = 0;
     for (i = 0; i < ne; i++) {
-        h = edge_hits(k, &g, ea[i], eb[i], NULL, NULL);
+        h = k->fast ? edge_hits_h(k, &hg, &g, widen, ea[i], eb[i], NULL, NULL)
+                    : edge_hits(k, &g, ea[i], eb[i], NULL, NULL);
         if (h > BLK_MAX_VERTS - hs[i])
             return PLX_E_NOMEM;
         hs[i + 1] = hs[i] + h;
@@ -760,7 +1122,10 @@ static plx_status blk_pieces(blk *k, const uint32_t *cid)
     SCRATCH(hw, hs[ne], uint32_t);
     SCRATCH(ht, hs[ne], double);
     for (i = 0; i < ne; i++) {
-        edge_hits(k, &g, ea[i], eb[i], hw + hs[i], ht + hs[i]);
+        if (k->fast)
+            edge_hits_h(k, &hg, &g, widen, ea[i], eb[i], hw + hs[i], ht + hs[i]);
+        else
+            edge_hits(k, &g, ea[i], eb[i], hw + hs[i], ht + hs[i]);
         sort_by_key(hw + hs[i], ht + hs[i], hs[i + 1] - hs[i]);
     }
     k->np = ne + hs[ne];
@@ -823,6 +1188,90 @@ static uint32_t cross_pass(const blk *k, const grid *g, const double *pbox, cros
     return n;
 }
 
+/* cross_pass() over the hashed grid: the same crossings, in another order. */
+static uint32_t cross_pass_h(const blk *k, const hgrid *h, const double *pbox, crossing *out)
+{
+    uint32_t bk, e, f, i, j, n = 0;
+    double t;
+    for (bk = 0; bk <= h->mask; bk++)
+        for (e = h->start[bk]; e < h->start[bk + 1]; e++) {
+            i = h->item[e];
+            for (f = e + 1; f < h->start[bk + 1]; f++) {
+                const double *b1 = pbox + 4 * (size_t)i, *b2;
+                vec2 a, b, p, q;
+                j = h->item[f];
+                b2 = pbox + 4 * (size_t)j;
+                if (k->pa[i] == k->pa[j] || k->pa[i] == k->pb[j] || k->pb[i] == k->pa[j] ||
+                    k->pb[i] == k->pb[j])
+                    continue;
+                if (!boxes_meet(b1, b2) ||
+                    hgrid_bucket(h, hgrid_cell(b1[0] > b2[0] ? b1[0] : b2[0], h->x0, h->inv),
+                                 hgrid_cell(b1[1] > b2[1] ? b1[1] : b2[1], h->y0, h->inv)) != bk)
+                    continue;
+                a = k->cp[k->pa[i]];
+                b = k->cp[k->pb[i]];
+                p = k->cp[k->pa[j]];
+                q = k->cp[k->pb[j]];
+                if (!seg_cross(a, b, p, q, &t))
+                    continue;
+                if (out) {
+                    double tj;
+                    out[n].i = i;
+                    out[n].j = j;
+                    out[n].ti = t;
+                    out[n].p = lerp(a, b, t);
+                    if (!seg_cross(p, q, a, b, &tj))
+                        tj = 0.5; /* cannot happen: the test is symmetric in sign */
+                    out[n].tj = tj;
+                }
+                n++;
+            }
+        }
+    return n;
+}
+
+/* The cell of og where cross_pass() meets crossing x. */
+static size_t cross_cell(const grid *og, const double *pbox, const crossing *x)
+{
+    const double *b1 = pbox + 4 * (size_t)x->i, *b2 = pbox + 4 * (size_t)x->j;
+    uint32_t cx = grid_cell1(b1[0] > b2[0] ? b1[0] : b2[0], og->x0, og->inv, og->nx);
+    uint32_t cy = grid_cell1(b1[1] > b2[1] ? b1[1] : b2[1], og->y0, og->inv, og->ny);
+    return (size_t)cy * og->nx + cx;
+}
+
+/* Sorts the crossings into the order cross_pass() over a plain grid with
+ * the geometry of og finds them: by cell, then by pieces (merge sort). */
+static void cross_sort(const grid *og, const double *pbox, crossing *xr, crossing *tmp,
+                       uint32_t n)
+{
+    crossing *src = xr, *dst = tmp, *t;
+    size_t w, i, m, r, p, q, o;
+    for (w = 1; w < n; w *= 2) {
+        for (i = 0; i < n; i += 2 * w) {
+            m = i + w < n ? i + w : n;
+            r = i + 2 * w < n ? i + 2 * w : n;
+            p = i;
+            q = m;
+            o = i;
+            while (p < m && q < r) {
+                size_t cp = cross_cell(og, pbox, &src[p]), cq = cross_cell(og, pbox, &src[q]);
+                int qfirst = cq < cp || (cq == cp && (src[q].i < src[p].i ||
+                                                      (src[q].i == src[p].i && src[q].j < src[p].j)));
+                dst[o++] = qfirst ? src[q++] : src[p++];
+            }
+            while (p < m)
+                dst[o++] = src[p++];
+            while (q < r)
+                dst[o++] = src[q++];
+        }
+        t = src;
+        src = dst;
+        dst = t;
+    }
+    if (src != xr)
+        memcpy(xr, src, (size_t)n * sizeof(crossing));
+}
+
 static void seg_push(seg *sg, uint32_t *n, uint32_t u, uint32_t v)
 {
     if (u == v)
@@ -843,6 +1292,7 @@ static void seg_push(seg *sg, uint32_t *n, uint32_t u, uint32_t v)
 static plx_status blk_segments(blk *k)
 {
     grid g;
+    hgrid hg;
     double *pbox, *ct, best, d;
     crossing *xr;
     uint32_t *xmap, *xuf, *cs, *cx, nx, i, j, c, prev, id, n, e;
@@ -857,14 +1307,28 @@ static plx_status blk_segments(blk *k)
         bx[2] = a.x < b.x ? b.x : a.x;
         bx[3] = a.y < b.y ? b.y : a.y;
     }
-    st = grid_build(k->a, &g, pbox, NULL, k->np, k->tol);
+    if (k->fast) {
+        /* hashed cells about the size of a piece; the crossings are then
+         * put in the order of the plain grid */
+        grid_size(&g, pbox, NULL, k->np, k->tol);
+        st = hgrid_build(k->a, &hg, pbox, NULL, k->np, 0.0);
+    } else {
+        st = grid_build(k->a, &g, pbox, NULL, k->np, k->tol);
+    }
     if (st != PLX_OK)
         return st;
-    nx = cross_pass(k, &g, pbox, NULL);
+    nx = k->fast ? cross_pass_h(k, &hg, pbox, NULL) : cross_pass(k, &g, pbox, NULL);
     if (nx > (BLK_MAX_VERTS - k->np) / 2)
         return PLX_E_NOMEM;
     SCRATCH(xr, nx, crossing);
-    cross_pass(k, &g, pbox, xr);
+    if (k->fast) {
+        crossing *xt;
+        cross_pass_h(k, &hg, pbox, xr);
+        SCRATCH(xt, nx, crossing);
+        cross_sort(&g, pbox, xr, xt, nx);
+    } else {
+        cross_pass(k, &g, pbox, xr);
+    }
 
     /* A crossing within BLK_EPS of an end of its two pieces becomes that
      * end (only rounding; moving crossings further could make new ones). */
@@ -953,45 +1417,342 @@ static plx_status blk_segments(blk *k)
     return PLX_OK;
 }
 
-/* Step 2: keep the sub-edges with the union on exactly one side. */
-static plx_status blk_classify(blk *k)
+/* Step 2: keep the sub-edges with the union on exactly one side.
+ *
+ * The ray of sub-edge i goes towards +x from its midpoint m when the
+ * sub-edge is steep (|dy| >= |dx|), else towards +y. ray_hit() is the one
+ * test of a sub-edge j against such a ray; the count of a side is the sum of
+ * ray_hit() over all j != i. Summing it edge by edge within a strip is
+ * quadratic when many edges share one band (a comb), so the sum is split:
+ *  - D: the sub-edges active on the ray's line (half-open, exactly as in
+ *    ray_hit) that start beyond m by more than 'delta', a bound on the
+ *    rounding of the crossing coordinate: ray_hit() counts each of them for
+ *    sure. Their sum comes from a sweep along the line coordinate with a
+ *    Fenwick tree over the sub-edges' low ends.
+ *  - the rest whose range along the ray comes within delta of its start:
+ *    ray_hit() itself, on the candidates a hashed grid over the sub-edge
+ *    boxes gives.
+ * Every other sub-edge is missed by ray_hit() for sure, so the sum is the
+ * same integer as the plain one, in O(n log n) for a comb or a circle.
+ * (Coordinates not finite or beyond 1e150: the plain count in strips.) */
+
+/* Contribution of sub-edge j to the count along the ray from m: towards +x
+ * (dir 0) or +y (dir 1). */
+static int32_t ray_hit(const blk *k, uint32_t j, vec2 m, int dir)
+{
+    vec2 a = k->pos[k->sg[j].u], b = k->pos[k->sg[j].v];
+    if (dir == 0) {
+        if ((a.y > m.y) != (b.y > m.y)) {
+            double xc = a.x + (m.y - a.y) * (b.x - a.x) / (b.y - a.y);
+            if (xc > m.x)
+                return b.y > a.y ? k->sg[j].w : -k->sg[j].w;
+        }
+    } else if ((a.x > m.x) != (b.x > m.x)) {
+        double yc = a.y + (m.x - a.x) * (b.y - a.y) / (b.x - a.x);
+        if (yc > m.y)
+            return b.x < a.x ? k->sg[j].w : -k->sg[j].w;
+    }
+    return 0;
+}
+
+/* Direction of the ray of sub-edge i (-1: zero length, no ray) and its
+ * start, the midpoint. */
+static int ray_of(const blk *k, uint32_t i, vec2 *m)
+{
+    vec2 p = k->pos[k->sg[i].u], q = k->pos[k->sg[i].v];
+    double dx = q.x - p.x, dy = q.y - p.y;
+    if (dx == 0.0 && dy == 0.0)
+        return -1;
+    *m = lerp(p, q, 0.5);
+    return fabs(dy) >= fabs(dx) ? 0 : 1;
+}
+
+/* The plain count within strips: used when the coordinates are not finite
+ * or too large for the rounding bound of the sweep. */
+static plx_status ray_counts_strips(blk *k, int64_t *wsum)
 {
     strips rows, cols;
-    uint32_t i, e, j, row;
+    uint32_t i, e, row;
+    vec2 m;
+    int dir;
     plx_status st = strips_build(k->a, &rows, k->pos, k->sg, k->ns, 1);
     if (st != PLX_OK)
         return st;
     st = strips_build(k->a, &cols, k->pos, k->sg, k->ns, 0);
     if (st != PLX_OK)
         return st;
-    SCRATCH(k->kf, k->ns, uint32_t);
-    SCRATCH(k->kt, k->ns, uint32_t);
-    k->nk = 0;
     for (i = 0; i < k->ns; i++) {
-        vec2 p = k->pos[k->sg[i].u], q = k->pos[k->sg[i].v], m;
-        double dx = q.x - p.x, dy = q.y - p.y;
-        long wl, wr, w = 0;
-        if (dx == 0.0 && dy == 0.0)
+        const strips *sp;
+        int64_t w = 0;
+        dir = ray_of(k, i, &m);
+        wsum[i] = 0;
+        if (dir < 0)
             continue;
-        m = lerp(p, q, 0.5);
-        if (fabs(dy) >= fabs(dx)) {
-            /* ray towards +x: the side it starts on is the right one when
-             * the sub-edge goes up */
-            row = grid_cell1(m.y, rows.v0, rows.inv, rows.n);
-            for (e = rows.start[row]; e < rows.start[row + 1]; e++) {
-                vec2 a, b;
-                j = rows.item[e];
+        sp = dir == 0 ? &rows : &cols;
+        row = grid_cell1(dir == 0 ? m.y : m.x, sp->v0, sp->inv, sp->n);
+        for (e = sp->start[row]; e < sp->start[row + 1]; e++)
+            if (sp->item[e] != i)
+                w += ray_hit(k, sp->item[e], m, dir);
+        wsum[i] = w;
+    }
+    return PLX_OK;
+}
+
+/* A key with the id it belongs to, for sorting. */
+typedef struct keyid {
+    double key;
+    uint32_t id;
+} keyid;
+
+/* Stable bottom-up merge sort of n keys (no NaN); tmp holds n. */
+static void keyid_sort(keyid *a, keyid *tmp, uint32_t n)
+{
+    keyid *src = a, *dst = tmp, *t;
+    size_t w, i, m, r, p, q, o;
+    for (w = 1; w < n; w *= 2) {
+        for (i = 0; i < n; i += 2 * w) {
+            m = i + w < n ? i + w : n;
+            r = i + 2 * w < n ? i + 2 * w : n;
+            p = i;
+            q = m;
+            o = i;
+            while (p < m && q < r)
+                dst[o++] = src[q].key < src[p].key ? src[q++] : src[p++];
+            while (p < m)
+                dst[o++] = src[p++];
+            while (q < r)
+                dst[o++] = src[q++];
+        }
+        t = src;
+        src = dst;
+        dst = t;
+    }
+    if (src != a)
+        memcpy(a, src, (size_t)n * sizeof(keyid));
+}
+
+/* What the sweep of one direction shares. box[4j..4j+3] is the box of
+ * sub-edge j (minx, miny, maxx, maxy). */
+typedef struct sweep {
+    blk *k;
+    const double *box;
+    const hgrid *g;
+    double delta;
+    int64_t *wsum;
+} sweep;
+
+/* Adds the counts along the rays of direction 'dir' (0: +x, the sweep runs
+ * along y; 1: +y, along x) to wsum. Scratch is given back on success. */
+static plx_status ray_counts_dir(const sweep *sw, int dir)
+{
+    blk *k = sw->k;
+    arena_mark mk = arena_get_mark(k->a);
+    const double *box = sw->box;
+    const hgrid *g = sw->g;
+    /* in box: the line coordinate is s, the ray coordinate r */
+    int s0 = dir == 0 ? 1 : 0, r0 = dir == 0 ? 0 : 1;
+    keyid *qs, *ins, *del, *rl, *tmp;
+    uint32_t *rank, nq = 0, ne = 0, i, j, qi, pi = 0, pd = 0, c, lo, hi, mid, x, e;
+    int32_t *cj;
+    int64_t *fen, tot = 0, sum;
+    vec2 m;
+    SCRATCH(qs, k->ns, keyid);
+    SCRATCH(ins, k->ns, keyid);
+    SCRATCH(del, k->ns, keyid);
+    SCRATCH(rl, k->ns, keyid);
+    SCRATCH(tmp, k->ns, keyid);
+    SCRATCH(rank, k->ns, uint32_t);
+    SCRATCH(cj, k->ns, int32_t);
+    for (i = 0; i < k->ns; i++) {
+        const double *b = box + 4 * (size_t)i;
+        vec2 p = k->pos[k->sg[i].u], q = k->pos[k->sg[i].v];
+        if (ray_of(k, i, &m) == dir) {
+            qs[nq].key = dir == 0 ? m.y : m.x;
+            qs[nq].id = i;
+            nq++;
+        }
+        if (dir == 0)
+            cj[i] = q.y > p.y ? k->sg[i].w : -k->sg[i].w;
+        else
+            cj[i] = q.x < p.x ? k->sg[i].w : -k->sg[i].w;
+        if (b[s0] < b[s0 + 2]) { /* never on a line otherwise */
+            ins[ne].key = b[s0];
+            ins[ne].id = i;
+            del[ne].key = b[s0 + 2];
+            del[ne].id = i;
+            rl[ne].key = b[r0];
+            rl[ne].id = i;
+            ne++;
+        }
+    }
+    if (nq == 0) {
+        arena_release(k->a, &mk);
+        return PLX_OK;
+    }
+    keyid_sort(qs, tmp, nq);
+    keyid_sort(ins, tmp, ne);
+    keyid_sort(del, tmp, ne);
+    keyid_sort(rl, tmp, ne);
+    for (j = 0; j < ne; j++)
+        rank[rl[j].id] = j;
+    SCRATCH(fen, (size_t)ne + 1, int64_t);
+    memset(fen, 0, ((size_t)ne + 1) * sizeof(int64_t));
+    for (qi = 0; qi < nq; qi++) {
+        double Y, X, thi, tlo;
+        const double *bi;
+        uint32_t r[4], a0, a1, fix;
+        i = qs[qi].id;
+        Y = qs[qi].key;
+        ray_of(k, i, &m);
+        X = dir == 0 ? m.x : m.y;
+        /* the sub-edges active on the line: low end <= Y < high end */
+        for (; pi < ne && ins[pi].key <= Y; pi++) {
+            j = ins[pi].id;
+            tot += cj[j];
+            for (x = rank[j] + 1; x <= ne; x += x & (0u - x))
+                fen[x] += cj[j];
+        }
+        for (; pd < ne && del[pd].key <= Y; pd++) {
+            j = del[pd].id;
+            tot -= cj[j];
+            for (x = rank[j] + 1; x <= ne; x += x & (0u - x))
+                fen[x] -= cj[j];
+        }
+        /* D: active ones whose low ray coordinate is > thi */
+        thi = X + sw->delta;
+        tlo = X - sw->delta;
+        lo = 0;
+        hi = ne;
+        while (lo < hi) {
+            mid = lo + (hi - lo) / 2;
+            if (rl[mid].key > thi)
+                hi = mid;
+            else
+                lo = mid + 1;
+        }
+        sum = 0;
+        for (x = lo; x > 0; x -= x & (0u - x))
+            sum += fen[x];
+        sum = tot - sum;
+        bi = box + 4 * (size_t)i;
+        if (bi[s0] <= Y && Y < bi[s0 + 2] && bi[r0] > thi)
+            sum -= cj[i];
+        /* the others near the ray's start, from the grid */
+        if (dir == 0) {
+            a0 = hgrid_cell(tlo, g->x0, g->inv);
+            a1 = hgrid_cell(thi, g->x0, g->inv);
+            fix = hgrid_cell(Y, g->y0, g->inv);
+        } else {
+            a0 = hgrid_cell(tlo, g->y0, g->inv);
+            a1 = hgrid_cell(thi, g->y0, g->inv);
+            fix = hgrid_cell(Y, g->x0, g->inv);
+        }
+        for (c = a0; c <= a1; c++) {
+            uint32_t bk = dir == 0 ? hgrid_bucket(g, c, fix) : hgrid_bucket(g, fix, c);
+            for (e = g->start[bk]; e < g->start[bk + 1]; e++) {
+                const double *bj;
+                j = g->item[e];
                 if (j == i)
                     continue;
-                a = k->pos[k->sg[j].u];
-                b = k->pos[k->sg[j].v];
-                if ((a.y > m.y) != (b.y > m.y)) {
-                    double xc = a.x + (m.y - a.y) * (b.x - a.x) / (b.y - a.y);
-                    if (xc > m.x)
-                        w += b.y > a.y ? k->sg[j].w : -k->sg[j].w;
-                }
+                bj = box + 4 * (size_t)j;
+                hgrid_range(g, bj, r);
+                /* on cell c of the line, and met there first */
+                if (fix < r[s0] || fix > r[s0 + 2] || c < r[r0] || c > r[r0 + 2] ||
+                    (r[r0] > a0 ? r[r0] : a0) != c)
+                    continue;
+                if (bj[s0] <= Y && Y < bj[s0 + 2] && bj[r0] > thi)
+                    continue; /* in D */
+                sum += ray_hit(k, j, m, dir);
             }
-            if (dy > 0.0) {
+        }
+        sw->wsum[i] += sum;
+    }
+    arena_release(k->a, &mk);
+    return PLX_OK;
+}
+
+/* wsum[i]: the sum of ray_hit() over all sub-edges j != i along the ray of
+ * sub-edge i (0 for a sub-edge of zero length). */
+static plx_status ray_counts(blk *k, int64_t *wsum)
+{
+    double *box, mx = 0.0, dmin = DBL_MAX, v;
+    uint32_t i, t;
+    hgrid g;
+    sweep sw;
+    plx_status st;
+    for (i = 0; i < k->ns; i++) {
+        vec2 p = k->pos[k->sg[i].u], q = k->pos[k->sg[i].v];
+        double c[4];
+        c[0] = p.x;
+        c[1] = p.y;
+        c[2] = q.x;
+        c[3] = q.y;
+        for (t = 0; t < 4; t++) {
+            v = fabs(c[t]);
+            if (!(v <= 1e150)) /* not finite, or products could overflow */
+                return ray_counts_strips(k, wsum);
+            if (v > mx)
+                mx = v;
+        }
+        for (t = 0; t < 2; t++) {
+            v = fabs(c[t + 2] - c[t]);
+            if (v > 0.0 && v < dmin)
+                dmin = v;
+        }
+    }
+    /* The crossing coordinate ray_hit() computes lies within about
+     * 5*DBL_EPSILON*mx of the sub-edge's range, plus what underflow in the
+     * product and quotient can lose (divided by the smallest difference). */
+    sw.delta = 64.0 * DBL_EPSILON * mx + DBL_MIN / dmin + DBL_MIN;
+    SCRATCH(box, 4 * (size_t)k->ns, double);
+    for (i = 0; i < k->ns; i++) {
+        vec2 p = k->pos[k->sg[i].u], q = k->pos[k->sg[i].v];
+        double *b = box + 4 * (size_t)i;
+        b[0] = p.x < q.x ? p.x : q.x;
+        b[1] = p.y < q.y ? p.y : q.y;
+        b[2] = p.x < q.x ? q.x : p.x;
+        b[3] = p.y < q.y ? q.y : p.y;
+        wsum[i] = 0;
+    }
+    st = hgrid_build(k->a, &g, box, NULL, k->ns, 0.0);
+    if (st != PLX_OK)
+        return st;
+    sw.k = k;
+    sw.box = box;
+    sw.g = &g;
+    sw.wsum = wsum;
+    st = ray_counts_dir(&sw, 0);
+    if (st == PLX_OK)
+        st = ray_counts_dir(&sw, 1);
+    return st;
+}
+
+static plx_status blk_classify(blk *k)
+{
+    arena_mark mk;
+    int64_t *wsum, w, wl, wr;
+    uint32_t i;
+    vec2 m;
+    int dir;
+    plx_status st;
+    SCRATCH(k->kf, k->ns, uint32_t);
+    SCRATCH(k->kt, k->ns, uint32_t);
+    mk = arena_get_mark(k->a);
+    SCRATCH(wsum, k->ns, int64_t);
+    st = ray_counts(k, wsum);
+    if (st != PLX_OK)
+        return st;
+    k->nk = 0;
+    for (i = 0; i < k->ns; i++) {
+        vec2 p = k->pos[k->sg[i].u], q = k->pos[k->sg[i].v];
+        dir = ray_of(k, i, &m);
+        if (dir < 0)
+            continue;
+        w = wsum[i];
+        if (dir == 0) {
+            /* ray towards +x: the side it starts on is the right one when
+             * the sub-edge goes up */
+            if (q.y - p.y > 0.0) {
                 wr = w;
                 wl = w + k->sg[i].w;
             } else {
@@ -1001,21 +1762,7 @@ static plx_status blk_classify(blk *k)
         } else {
             /* ray towards +y: it starts on the left when the sub-edge goes
              * towards +x */
-            row = grid_cell1(m.x, cols.v0, cols.inv, cols.n);
-            for (e = cols.start[row]; e < cols.start[row + 1]; e++) {
-                vec2 a, b;
-                j = cols.item[e];
-                if (j == i)
-                    continue;
-                a = k->pos[k->sg[j].u];
-                b = k->pos[k->sg[j].v];
-                if ((a.x > m.x) != (b.x > m.x)) {
-                    double yc = a.y + (m.x - a.x) * (b.y - a.y) / (b.x - a.x);
-                    if (yc > m.y)
-                        w += b.x < a.x ? k->sg[j].w : -k->sg[j].w;
-                }
-            }
-            if (dx > 0.0) {
+            if (q.x - p.x > 0.0) {
                 wl = w;
                 wr = w - k->sg[i].w;
             } else {
@@ -1029,6 +1776,7 @@ static plx_status blk_classify(blk *k)
             k->nk++;
         }
     }
+    arena_release(k->a, &mk);
     return PLX_OK;
 }
 
@@ -1241,6 +1989,27 @@ static plx_status blk_loops(blk *k, outbuf *o)
     return PLX_OK;
 }
 
+/* Gives back the scratch of steps 1 to 1c (taken since m), keeping only the
+ * vertices and sub-edges, which are moved up to the freed end: the
+ * classification then needs no more memory than the steps before it. The
+ * moves cannot clobber what is still to be moved (pos lies above sg and
+ * both only move up). */
+static plx_status blk_compact(blk *k, const arena_mark *m)
+{
+    vec2 *pos;
+    seg *sg;
+    arena_release(k->a, m);
+    k->vp = k->cp = NULL;
+    k->vnext = k->pa = k->pb = NULL;
+    SCRATCH(pos, k->nv, vec2);
+    memmove(pos, k->pos, (size_t)k->nv * sizeof(vec2));
+    k->pos = pos;
+    SCRATCH(sg, k->ns, seg);
+    memmove(sg, k->sg, (size_t)k->ns * sizeof(seg));
+    k->sg = sg;
+    return PLX_OK;
+}
+
 /* One outline pass with snapping distance 'snap'; sets *broken when some
  * kept edges could not be linked into loops. Scratch is given back. */
 static plx_status outline_pass(arena *a, const scene *s, double snap, double tol,
@@ -1267,6 +2036,8 @@ static plx_status outline_pass(arena *a, const scene *s, double snap, double tol
     }
     if (st == PLX_OK)
         st = blk_segments(k);
+    if (st == PLX_OK)
+        st = blk_compact(k, &m);
     if (st == PLX_OK)
         st = blk_classify(k);
     if (st == PLX_OK)

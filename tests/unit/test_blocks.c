@@ -831,6 +831,108 @@ static void test_long_row(void **state)
     fx_free(&f);
 }
 
+/* A comb: the bottom edge (0,0)-(W,0), then back along a zigzag top at
+ * y = 10 or 15, so every edge shares one horizontal band. The outline used
+ * to take time quadratic in the vertices here (a ray across all teeth). */
+static void test_comb_one_band_fast(void **state)
+{
+    fixture f;
+    uint32_t n = getenv("PLX_TEST_QUICK") ? 10000 : 100000, w = n - 3, x, k = 0;
+    double *xy = malloc(2 * (size_t)n * sizeof(double));
+    clock_t c0;
+    double secs;
+    (void)state;
+    assert_non_null(xy);
+    fx_init(&f, 64u << 20, n, 1, 1);
+    xy[k++] = 0;
+    xy[k++] = 0;
+    xy[k++] = w;
+    xy[k++] = 0;
+    for (x = w + 1; x-- > 0;) {
+        xy[k++] = x;
+        xy[k++] = x % 2 ? 15 : 10;
+    }
+    fx_poly(&f, xy, n);
+    free(xy);
+    c0 = clock();
+    fx_run(&f);
+    secs = (double)(clock() - c0) / CLOCKS_PER_SEC;
+    printf("blocks_build: a comb of %u vertices in one band in %.3f s, scratch peak %zu bytes\n",
+           n, secs, f.a.peak[PLX_PART_SCRATCH]);
+    assert_int_equal(f.s.nblocks, 1);
+    assert_int_equal(f.s.blocks[0].ring_count, 1);
+    assert_int_equal(ring_len(&f.s, 0, 0), n);
+    assert_true(ring_area(&f.s, 0, 0) == 12.5 * w);
+    assert_true(secs < 2.0);
+    fx_free(&f);
+}
+
+/* The same comb turned by 0.3 rad: its long bottom edge is slanted, so its
+ * box covers the whole comb. */
+static void test_slanted_comb_fast(void **state)
+{
+    fixture f;
+    uint32_t n = getenv("PLX_TEST_QUICK") ? 10000 : 100000, w = n - 3, x, k;
+    double *xy = malloc(2 * (size_t)n * sizeof(double)), ca = cos(0.3), sa = sin(0.3), want;
+    clock_t c0;
+    double secs;
+    (void)state;
+    assert_non_null(xy);
+    fx_init(&f, 64u << 20, n, 1, 1);
+    xy[0] = 0;
+    xy[1] = 0;
+    xy[2] = w;
+    xy[3] = 0;
+    for (k = 4, x = w + 1; x-- > 0;) {
+        xy[k++] = x;
+        xy[k++] = x % 2 ? 15 : 10;
+    }
+    for (k = 0; k < n; k++) {
+        double px = xy[2 * k], py = xy[2 * k + 1];
+        xy[2 * k] = ca * px - sa * py;
+        xy[2 * k + 1] = sa * px + ca * py;
+    }
+    fx_poly(&f, xy, n);
+    free(xy);
+    want = area_of(f.s.pts, n);
+    c0 = clock();
+    fx_run(&f);
+    secs = (double)(clock() - c0) / CLOCKS_PER_SEC;
+    printf("blocks_build: a slanted comb of %u vertices in %.3f s\n", n, secs);
+    assert_int_equal(f.s.nblocks, 1);
+    assert_int_equal(f.s.blocks[0].ring_count, 1);
+    assert_int_equal(ring_len(&f.s, 0, 0), n);
+    assert_true(fabs(ring_area(&f.s, 0, 0) - want) <= 1e-9 * want);
+    assert_true(fabs(want - 12.5 * w) <= 1e-6 * want);
+    assert_true(secs < 2.0);
+    fx_free(&f);
+}
+
+/* A fine circle of 50000 vertices 250 m across an empty middle: the same
+ * ring back, nothing dropped or added. */
+static void test_fine_circle(void **state)
+{
+    fixture f;
+    uint32_t n = getenv("PLX_TEST_QUICK") ? 5000 : 50000, i;
+    double *xy = malloc(2 * (size_t)n * sizeof(double)), want;
+    (void)state;
+    assert_non_null(xy);
+    fx_init(&f, 64u << 20, n, 1, 1);
+    for (i = 0; i < n; i++) {
+        double a = 2.0 * 3.14159265358979323846 * i / n;
+        xy[2 * i] = floor(2e5 * cos(a) + 0.5);
+        xy[2 * i + 1] = floor(2e5 * sin(a) + 0.5);
+    }
+    fx_poly(&f, xy, n);
+    free(xy);
+    want = area_of(f.s.pts, n);
+    fx_run(&f);
+    assert_int_equal(f.s.nblocks, 1);
+    assert_int_equal(f.s.blocks[0].ring_count, 1);
+    assert_true(fabs(ring_area(&f.s, 0, 0) - want) <= 1e-9 * want);
+    fx_free(&f);
+}
+
 static void test_empty_and_invalid(void **state)
 {
     fixture f;
@@ -940,6 +1042,9 @@ int main(void)
         cmocka_unit_test(test_random_rects),
         cmocka_unit_test(test_grid_100x100_fast),
         cmocka_unit_test(test_long_row),
+        cmocka_unit_test(test_comb_one_band_fast),
+        cmocka_unit_test(test_slanted_comb_fast),
+        cmocka_unit_test(test_fine_circle),
         cmocka_unit_test(test_empty_and_invalid),
         cmocka_unit_test(test_fault_injection),
         cmocka_unit_test(test_small_block_nomem),
