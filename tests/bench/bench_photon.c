@@ -23,27 +23,7 @@
 
 #define BUDGET ((size_t)3 << 30)
 
-typedef struct text {
-    char *buf;
-    size_t len, cap;
-} text;
-
-static int append(void *ctx, const char *data, size_t len)
-{
-    text *t = ctx;
-    if (t->len + len + 1 > t->cap) {
-        char *nb;
-        t->cap = (t->len + len + 1) * 2;
-        nb = realloc(t->buf, t->cap);
-        if (!nb)
-            return -1;
-        t->buf = nb;
-    }
-    memcpy(t->buf + t->len, data, len);
-    t->len += len;
-    t->buf[t->len] = '\0';
-    return 0;
-}
+#include "gen_text.h"
 
 static uint64_t now_ns(void)
 {

@@ -12,24 +12,7 @@
 #include "engine.h"
 #include "ref_light.h"
 
-typedef struct text {
-    char *buf;
-    size_t len, cap;
-} text;
-
-static int append(void *ctx, const char *data, size_t len)
-{
-    text *t = ctx;
-    if (t->len + len + 1 > t->cap) {
-        t->cap = (t->len + len + 1) * 2;
-        t->buf = realloc(t->buf, t->cap);
-        if (!t->buf)
-            return -1;
-    }
-    memcpy(t->buf + t->len, data, len);
-    t->len += len;
-    return 0;
-}
+#include "gen_text.h"
 
 int main(void)
 {
