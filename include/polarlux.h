@@ -229,8 +229,9 @@ plx_status plx_polar_info_get(plx_engine *e, plx_polar_info *out /* OUT */);
 /*
  * Region i of quadrant diagram q (0: scan from east, 1: north, 2: west,
  * 3: south): up to 4 corners (x,y pairs, counter-clockwise) in xy, their count
- * in *n, the owner building in *owner (the object first met by the scan from
- * the region's points; -1 where the start ray leaves the Bounds box) and
+ * in *n, the region's label in *owner (the object angularly first from the
+ * region's points: a building, or -1 for the Bounds frame, which encloses
+ * the scene and is met first where the start ray reaches the box) and
  * whether the region is inside a footprint in *solid.
  */
 plx_status plx_polar_region_count(plx_engine *e, int q, uint32_t *count /* OUT */);

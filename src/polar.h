@@ -12,14 +12,22 @@
  * of direction q pi/2 leaves p and meets a wall, the owner is that wall's
  * building and is constant between two axes. The axes and the walls cut the
  * Bounds box into trapezoids ("regions"), each with at most two neighbours
- * across each of its two axis sides; a region whose start ray reaches the
- * Bounds box without meeting a wall has no fixed owner (owner -1), the
- * object met first there is found by vis_first() (visibility.h).
- * Known gap against a full polar diagram (Grima, Marquez, Ortega 2006):
- * in such an escape region the first object of the scan is not constant —
- * it changes across the lines through pairs of vertices (where one object
- * starts to hide another) — and these lines are not part of the stored
- * subdivision, so those regions carry no label.
+ * across each of its two axis sides.
+ *
+ * Labels. The objects of the diagrams are the occluding footprints and the
+ * Bounds frame: SPEC §3 closes every visibility polygon on the Bounds box, so
+ * the scene is a world enclosed by that box, and the box's sides are walls
+ * like any other (they are wall pieces here, bld[0] == -2). In an enclosed
+ * world the start ray q pi/2 from any free point meets a wall, at angle 0 of
+ * the scan, so the object angularly first from p is the owner of that wall
+ * (ties at angle 0: the nearest along the ray). The owner is therefore
+ * constant on every region, and every region is labelled: a building index,
+ * or -1 for the Bounds frame. The diagrams are those of Grima, Marquez,
+ * Ortega (2006) for the footprints plus the enclosing frame.
+ * The first BUILDING of the scan (the frame left out) is not constant on
+ * frame-labelled regions - it changes across the lines through pairs of
+ * vertices - and is answered by vis_first() (visibility.h), which walks the
+ * regions of the quadrant's cone.
  *
  * Quadrants 0 and 2 (scan starting east and west) share one set of
  * horizontal axes, quadrants 1 and 3 one set of vertical axes: two planar
@@ -127,9 +135,9 @@ typedef struct polar {
 plx_status polar_build(arena *a, const scene *s, polar **out /* OUT */);
 
 /* Where p lies in the diagram of quadrant q (0..3).
- * Returns the region index (>= 0) and stores the owner (the building met
- * first by the scan at the start direction q pi/2, or -1 when that ray
- * reaches Bounds) in *owner (may be NULL). Returns -1 when p is outside the
+ * Returns the region index (>= 0) and stores the region's label (the
+ * building met first by the scan at the start direction q pi/2, or -1 for
+ * the Bounds frame when that ray reaches the box) in *owner (may be NULL). Returns -1 when p is outside the
  * open Bounds box, -2 when p is on a wall, -3 when p is inside a footprint
  * (then *owner is that footprint's building, or -1 if unknown). */
 int32_t polar_locate(const polar *pd, int q, vec2 p, int32_t *owner /* OUT */);
