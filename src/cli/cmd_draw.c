@@ -11,7 +11,7 @@ static const char help[] =
     "3: south) over the Bounds box: each region filled with a colour of its owner\n"
     "(the object met first by the counter-clockwise scan from its points: a\n"
     "building, or in grey the Bounds frame enclosing the scene), footprints in\n"
-    "white, region boundaries (polar axes and walls) in dark lines.\n"
+    "black, region boundaries (polar axes and walls) in dark lines.\n"
     "\n"
     "  --polar Q     quadrant 0..3 (required)\n"
     "  -o OUT.png    output image (required)\n"
