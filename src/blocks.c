@@ -1147,42 +1147,48 @@ static plx_status blk_pieces(blk *k, const uint32_t *cid)
     return PLX_OK;
 }
 
+/* Whether pieces i and j share an end (then they do not cross properly). */
+static int share_end(const blk *k, uint32_t i, uint32_t j)
+{
+    return k->pa[i] == k->pa[j] || k->pa[i] == k->pb[j] || k->pb[i] == k->pa[j] ||
+           k->pb[i] == k->pb[j];
+}
+
+/* Tests pieces i and j for a proper crossing; counts it in *n and, when out
+ * is not NULL, stores it at out[*n]. */
+static void pair_cross(const blk *k, uint32_t i, uint32_t j, crossing *out, uint32_t *n)
+{
+    vec2 a = k->cp[k->pa[i]], b = k->cp[k->pb[i]], p = k->cp[k->pa[j]], q = k->cp[k->pb[j]];
+    double t, tj;
+    if (!seg_cross(a, b, p, q, &t))
+        return;
+    if (out) {
+        out[*n].i = i;
+        out[*n].j = j;
+        out[*n].ti = t;
+        out[*n].p = lerp(a, b, t);
+        if (!seg_cross(p, q, a, b, &tj))
+            tj = 0.5; /* cannot happen: the test is symmetric in sign */
+        out[*n].tj = tj;
+    }
+    (*n)++;
+}
+
 /* Proper crossings between pieces, each pair once; counts them, and stores
  * them when out is not NULL. */
 static uint32_t cross_pass(const blk *k, const grid *g, const double *pbox, crossing *out)
 {
     uint32_t c, e, f, i, j, n = 0;
     size_t ncell = (size_t)g->nx * g->ny;
-    double t;
     for (c = 0; c < ncell; c++)
         for (e = g->start[c]; e < g->start[c + 1]; e++) {
             i = g->item[e];
             for (f = e + 1; f < g->start[c + 1]; f++) {
-                vec2 a, b, p, q;
                 j = g->item[f];
-                if (k->pa[i] == k->pa[j] || k->pa[i] == k->pb[j] || k->pb[i] == k->pa[j] ||
-                    k->pb[i] == k->pb[j])
-                    continue;
-                if (!boxes_meet(pbox + 4 * (size_t)i, pbox + 4 * (size_t)j) ||
+                if (share_end(k, i, j) || !boxes_meet(pbox + 4 * (size_t)i, pbox + 4 * (size_t)j) ||
                     !grid_owns_pair(g, c, pbox + 4 * (size_t)i, pbox + 4 * (size_t)j))
                     continue;
-                a = k->cp[k->pa[i]];
-                b = k->cp[k->pb[i]];
-                p = k->cp[k->pa[j]];
-                q = k->cp[k->pb[j]];
-                if (!seg_cross(a, b, p, q, &t))
-                    continue;
-                if (out) {
-                    double tj;
-                    out[n].i = i;
-                    out[n].j = j;
-                    out[n].ti = t;
-                    out[n].p = lerp(a, b, t);
-                    if (!seg_cross(p, q, a, b, &tj))
-                        tj = 0.5; /* cannot happen: the test is symmetric in sign */
-                    out[n].tj = tj;
-                }
-                n++;
+                pair_cross(k, i, j, out, &n);
             }
         }
     return n;
@@ -1192,39 +1198,18 @@ static uint32_t cross_pass(const blk *k, const grid *g, const double *pbox, cros
 static uint32_t cross_pass_h(const blk *k, const hgrid *h, const double *pbox, crossing *out)
 {
     uint32_t bk, e, f, i, j, n = 0;
-    double t;
     for (bk = 0; bk <= h->mask; bk++)
         for (e = h->start[bk]; e < h->start[bk + 1]; e++) {
             i = h->item[e];
             for (f = e + 1; f < h->start[bk + 1]; f++) {
                 const double *b1 = pbox + 4 * (size_t)i, *b2;
-                vec2 a, b, p, q;
                 j = h->item[f];
                 b2 = pbox + 4 * (size_t)j;
-                if (k->pa[i] == k->pa[j] || k->pa[i] == k->pb[j] || k->pb[i] == k->pa[j] ||
-                    k->pb[i] == k->pb[j])
-                    continue;
-                if (!boxes_meet(b1, b2) ||
+                if (share_end(k, i, j) || !boxes_meet(b1, b2) ||
                     hgrid_bucket(h, hgrid_cell(b1[0] > b2[0] ? b1[0] : b2[0], h->x0, h->inv),
                                  hgrid_cell(b1[1] > b2[1] ? b1[1] : b2[1], h->y0, h->inv)) != bk)
                     continue;
-                a = k->cp[k->pa[i]];
-                b = k->cp[k->pb[i]];
-                p = k->cp[k->pa[j]];
-                q = k->cp[k->pb[j]];
-                if (!seg_cross(a, b, p, q, &t))
-                    continue;
-                if (out) {
-                    double tj;
-                    out[n].i = i;
-                    out[n].j = j;
-                    out[n].ti = t;
-                    out[n].p = lerp(a, b, t);
-                    if (!seg_cross(p, q, a, b, &tj))
-                        tj = 0.5; /* cannot happen: the test is symmetric in sign */
-                    out[n].tj = tj;
-                }
-                n++;
+                pair_cross(k, i, j, out, &n);
             }
         }
     return n;
