@@ -22,6 +22,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include <cmocka.h>
+#include <unistd.h>
 
 #include "polarlux.h"
 #include "engine.h"
@@ -823,6 +824,32 @@ static void test_photon_uniform(void **state)
     slab_close(&f);
 }
 
+/* The port's reader refuses an image above the cap before taking pixel
+ * memory, and reads one at the cap. */
+static void test_png_cap(void **state)
+{
+    char path[64], err[300];
+    uint8_t *row = calloc(16385 * 3, 1), *out = NULL;
+    int w = 0, h = 0;
+    (void)state;
+    row[0] = 255;
+    snprintf(path, sizeof path, "/tmp/plx_ground_cap_%ld.png", (long)getpid());
+    assert_int_equal(image_write_png_rgb8(path, 16385, 1, row, 0, err, sizeof err), 0);
+    assert_int_equal(image_read_png_max(path, 16384, &out, &w, &h, err, sizeof err), -1);
+    assert_null(out);
+    assert_true(w == 16385 && h == 1);
+    {
+        char want[300];
+        snprintf(want, sizeof want, "read_png: '%s' is 16385x1 pixels, larger than the 16384x16384 allowed", path);
+        assert_string_equal(err, want);
+    }
+    assert_int_equal(image_read_png_max(path, 16385, &out, &w, &h, err, sizeof err), 0);
+    assert_true(out[0] == 255 && out[3] == 0);
+    free(out);
+    remove(path);
+    free(row);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -837,6 +864,7 @@ int main(void)
         cmocka_unit_test(test_render_fixture),
         cmocka_unit_test(test_photon_two_colours),
         cmocka_unit_test(test_photon_uniform),
+        cmocka_unit_test(test_png_cap),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
