@@ -6,6 +6,13 @@
  * fills the scene arrays. All scratch memory is given back before return;
  * on failure the scene part is given back too.
  *
+ * Top-level properties: units, ground_albedo (fatal when wrong), and
+ * ground_image / ground_image_bounds (README "Scene format"): the path is
+ * kept as written (the core reads no files; the caller gives the pixels to
+ * plx_set_ground_image, src/ground.c) and the bounds are projected like the
+ * features once the frame is known; a bad value is fatal when strict and
+ * ignored with a warning otherwise.
+ *
  * cJSON's hooks are process-wide, so the hook functions must find the arena
  * through one static pointer: the single piece of mutable static state in
  * the core, forced by cJSON's API. The port's lock (when given) serialises
