@@ -151,6 +151,50 @@ typedef struct plx_scene_info {
 
 plx_status plx_scene_info_get(plx_engine *e, plx_scene_info *out /* OUT */);
 
+/* ---- Ground albedo from a day image (README "Scene format") ------------- */
+
+/*
+ * The scene may name a day orthophoto (properties.ground_image, a PNG path
+ * relative to the scene file) and where it lies (properties.ground_image_bounds
+ * [x0, y0, x1, y1] in the scene's coordinates, else the Bounds box; top row
+ * north). The core reads no files: the caller decodes the image and gives
+ * its pixels here (the polarlux command does this for every scene it loads).
+ *
+ * Per pixel, each channel is decoded from sRGB to linear and scaled so the
+ * image's mean linear luminance (0.2126 R + 0.7152 G + 0.0722 B) equals the
+ * scene's ground albedo, then clamped to [0, 0.95]. The ground takes the
+ * albedo of the nearest pixel inside the image's box and the constant
+ * ground albedo outside it; images and photon bounces use it.
+ *
+ * rgb8: width*height pixels of 3 bytes (sRGB), top row first; copied into
+ * the engine (part PLX_PART_SCENE, w*h*3 bytes + about 2.2 KB). bounds: the
+ * box in local metres, or NULL for the scene's (see plx_ground_image_get).
+ * Calling it again replaces the image (in the same memory when the new one
+ * is not larger; otherwise the old memory stays held until the next load).
+ * (0, 0, NULL, NULL) removes the image. Photons already traced used the old
+ * ground: they are dropped (as plx_indirect_reset); renders need nothing
+ * rebuilt. Loading a scene drops the image.
+ * Errors: PLX_E_NOSCENE; PLX_E_INVALID (sizes outside 1..16384, rgb8 NULL,
+ * bounds not finite and increasing, a black image); PLX_E_NOMEM (the old
+ * image stays).
+ */
+plx_status plx_set_ground_image(plx_engine *e, uint32_t width, uint32_t height, const uint8_t *rgb8,
+                                const double bounds[4]);
+
+typedef struct plx_ground_image_info {
+    const char *path;         /* properties.ground_image as written, or NULL */
+    int bounds_given;         /* properties.ground_image_bounds was given */
+    double bounds[4];         /* x0, y0, x1, y1, local metres: the image's, else where the scene puts it */
+    uint32_t width, height;   /* 0 until plx_set_ground_image */
+    double mean_albedo[3];    /* mean albedo over the pixels (the constant without image) */
+    double mean_luminance;    /* its luminance (the ground albedo unless pixels were clamped) */
+} plx_ground_image_info;
+
+plx_status plx_ground_image_get(plx_engine *e, plx_ground_image_info *out /* OUT */);
+
+/* The ground's albedo per channel at (x, y) (local metres). */
+plx_status plx_ground_albedo_at(plx_engine *e, double x, double y, double rgb[3] /* OUT */);
+
 typedef struct plx_building {
     uint32_t nrings;           /* 1 outer ring + holes; see plx_building_ring */
     double height, min_height, albedo;

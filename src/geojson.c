@@ -6,6 +6,13 @@
  * fills the scene arrays. All scratch memory is given back before return;
  * on failure the scene part is given back too.
  *
+ * Top-level properties: units, ground_albedo (fatal when wrong), and
+ * ground_image / ground_image_bounds (README "Scene format"): the path is
+ * kept as written (the core reads no files; the caller gives the pixels to
+ * plx_set_ground_image, src/ground.c) and the bounds are projected like the
+ * features once the frame is known; a bad value is fatal when strict and
+ * ignored with a warning otherwise.
+ *
  * cJSON's hooks are process-wide, so the hook functions must find the arena
  * through one static pointer: the single piece of mutable static state in
  * the core, forced by cJSON's API. The port's lock (when given) serialises
@@ -30,6 +37,7 @@
 #define DEFAULT_ALBEDO 0.35
 #define DEFAULT_GROUND_ALBEDO 0.15
 #define BLOCK_TOLERANCE 0.05
+#define MAX_IMAGE_PATH 4096
 
 static arena *json_arena; /* see the header comment */
 static int json_oom;
@@ -114,6 +122,27 @@ static plx_status fail_scene(loader *ld, const char *why)
     }
     sb_str(&b, why);
     return eng_fail(ld->e, PLX_E_SCENE, msg);
+}
+
+/* A top-level property with a bad value that the scene can do without
+ * (properties.ground_image*): fatal when strict, else ignored with a
+ * warning. Returns PLX_OK to go on. */
+static plx_status bad_top_property(loader *ld, const char *why)
+{
+    char msg[ENGINE_ERR_BYTES];
+    strbuf b;
+    if (ld->e->cfg.strict)
+        return fail_scene(ld, why);
+    sb_init(&b, msg, sizeof msg);
+    if (ld->name) {
+        sb_str(&b, ld->name);
+        sb_str(&b, ": ");
+    }
+    sb_str(&b, why);
+    sb_str(&b, "; ignored");
+    ld->e->warnings++;
+    eng_log(ld->e, PLX_LOG_WARN, msg);
+    return PLX_OK;
 }
 
 /* ---- parsing ------------------------------------------------------------ */
@@ -232,6 +261,75 @@ static plx_status parse_json(loader *ld, cJSON **root)
 
 /* ---- top level ------------------------------------------------------------ */
 
+/* properties.ground_image (a path, kept as written: the core reads no
+ * files) and properties.ground_image_bounds (kept in scene coordinates
+ * until the frame is known; place_ground_image). */
+static plx_status read_ground_image(loader *ld, const cJSON *props)
+{
+    const cJSON *gi = cJSON_GetObjectItemCaseSensitive(props, "ground_image");
+    const cJSON *gb = cJSON_GetObjectItemCaseSensitive(props, "ground_image_bounds");
+    if (gi && !cJSON_IsNull(gi)) {
+        size_t n = cJSON_IsString(gi) ? strlen(gi->valuestring) : 0;
+        if (n == 0 || n > MAX_IMAGE_PATH) {
+            plx_status st = bad_top_property(ld, "properties.ground_image must be the path of a PNG file "
+                                                 "(a non-empty string of at most 4096 bytes)");
+            if (st != PLX_OK)
+                return st;
+        } else {
+            char *path = arena_alloc(&ld->e->mem, PLX_PART_SCENE, n + 1, 1);
+            if (!path)
+                return eng_nomem(ld->e, "loading the scene");
+            memcpy(path, gi->valuestring, n + 1);
+            ld->s->ground_image = path;
+        }
+    }
+    if (gb && !cJSON_IsNull(gb)) {
+        double v[4];
+        int i, ok = cJSON_IsArray(gb) && cJSON_GetArraySize(gb) == 4;
+        for (i = 0; ok && i < 4; i++) {
+            const cJSON *it = cJSON_GetArrayItem(gb, i);
+            ok = cJSON_IsNumber(it) && isfinite(it->valuedouble);
+            v[i] = ok ? it->valuedouble : 0.0;
+        }
+        if (!ok || !(v[0] < v[2] && v[1] < v[3]))
+            return bad_top_property(ld, "properties.ground_image_bounds must be [x0, y0, x1, y1]: "
+                                        "4 finite numbers with x0 < x1 and y0 < y1");
+        ld->gi_bounds_given = 1;
+        memcpy(ld->gi_bounds, v, sizeof v);
+    }
+    return PLX_OK;
+}
+
+/* The ground image's box in local metres: the given bounds projected like
+ * every coordinate of the scene (SPEC §1), else the Bounds box. */
+static plx_status place_ground_image(loader *ld)
+{
+    scene *s = ld->s;
+    double b[4];
+    int i;
+    memcpy(s->ground_image_bounds, s->bounds, sizeof s->bounds);
+    if (!ld->gi_bounds_given)
+        return PLX_OK;
+    memcpy(b, ld->gi_bounds, sizeof b);
+    if (s->lonlat) {
+        if (!(b[0] >= -180.0 && b[2] <= 180.0 && b[1] >= -90.0 && b[3] <= 90.0))
+            return bad_top_property(ld, "properties.ground_image_bounds must be lon/lat degrees like the "
+                                        "scene's coordinates (lon -180..180, lat -90..90)");
+        for (i = 0; i < 4; i += 2) {
+            b[i] = (b[i] - ld->lon0) * 111320.0 * ld->coslat;
+            b[i + 1] = (b[i + 1] - ld->lat0) * 110540.0;
+        }
+    }
+    for (i = 0; i < 4; i++)
+        if (!(fabs(b[i]) <= MAX_COORD))
+            return bad_top_property(ld, "properties.ground_image_bounds is out of range (|coordinate| > 1e7 m)");
+    if (!(b[0] < b[2] && b[1] < b[3]))
+        return bad_top_property(ld, "properties.ground_image_bounds is empty once projected to metres");
+    memcpy(s->ground_image_bounds, b, sizeof b);
+    s->ground_image_bounds_given = 1;
+    return PLX_OK;
+}
+
 static plx_status read_collection(loader *ld, cJSON *root, cJSON **features)
 {
     cJSON *type, *props;
@@ -261,6 +359,7 @@ static plx_status read_collection(loader *ld, cJSON *root, cJSON **features)
                 return fail_scene(ld, "properties.ground_albedo must be a number from 0 to 1");
             ld->s->ground_albedo = v;
         }
+        return read_ground_image(ld, props);
     }
     return PLX_OK;
 }
@@ -445,6 +544,9 @@ static plx_status load(plx_engine *e, loader *ld)
     if (st != PLX_OK)
         return st;
     finish_info(s);
+    st = place_ground_image(ld);
+    if (st != PLX_OK)
+        return st;
     st = height_stats(e, s);
     if (st != PLX_OK)
         return st;

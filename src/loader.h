@@ -16,6 +16,8 @@ typedef struct loader {
     uint32_t nfeat;
     int metres;            /* properties.units == "m" */
     double lon0, lat0, coslat;
+    int gi_bounds_given;   /* properties.ground_image_bounds read (scene coordinates) */
+    double gi_bounds[4];
 } loader;
 
 /* 1: a number (JSON number or numeric string with optional unit m),

@@ -570,6 +570,7 @@ plx_status mesh_build(arena *a, const scene *s, mesh **out)
         goto nomem;
 
     m->surf[MESH_SURF_GROUND].n[2] = 1.0;
+    /* the constant; render.c shades ground pixels with scene_ground_albedo */
     m->surf[MESH_SURF_GROUND].albedo = s->ground_albedo;
     m->surf[MESH_SURF_GROUND].bld = UINT32_MAX;
     m->surf[MESH_SURF_GROUND].kind = MESH_KIND_GROUND;

@@ -1054,7 +1054,8 @@ void photon_trace_lamp(photon_sys *ps, uint32_t lamp, double phi, uint64_t *rng,
         return;
     st->first += f;
     for (b = 0; b < ps->cfg.max_bounces; b++) {
-        double alb = h.kind == TRACE_GROUND ? ps->s->ground_albedo : ps->s->bld[h.bld].albedo;
+        double alb = h.kind == TRACE_GROUND ? scene_ground_albedo_y(ps->s, h.p[0], h.p[1])
+                                             : ps->s->bld[h.bld].albedo;
         if (photon_rand01(rng) >= alb) {
             st->absorbed += f;
             return;

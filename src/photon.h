@@ -19,7 +19,9 @@
  *
  * BOUNCES. Lambertian: cosine-weighted directions about the normal, Russian
  * roulette with survival probability = albedo (building albedo on walls,
- * roofs and undersides, scene ground_albedo on the ground), so a surviving
+ * roofs and undersides; on the ground the luminance of the ground's albedo
+ * at the hit, scene_ground_albedo_y: a ground image's pixel or the scene's
+ * ground_albedo, src/ground.c), so a surviving
  * photon keeps its flux and every stored photon carries its emission flux
  * times W. At most cfg.max_bounces surfaces after the first.
  *

@@ -1008,8 +1008,15 @@ static void shade_pass(render *r, const render_opts *o, render_stats *st)
                         for (k = 0; k < 3; k++)
                             E[k] += Ei[k];
                     }
-                    for (k = 0; k < 3; k++)
-                        out[k] = (float)(sf->albedo / PI * E[k]);
+                    if (r->id[p] == MESH_SURF_GROUND) {
+                        double alb[3]; /* per channel: the ground image (ground.c) */
+                        scene_ground_albedo(r->s, TP[q][0], TP[q][1], alb);
+                        for (k = 0; k < 3; k++)
+                            out[k] = (float)(alb[k] / PI * E[k]);
+                    } else {
+                        for (k = 0; k < 3; k++)
+                            out[k] = (float)(sf->albedo / PI * E[k]);
+                    }
                 }
         }
 }

@@ -17,7 +17,9 @@
  *     d = f + ((2 (i + 0.5) / W - 1) tan(fov/2) W/H) r + ((1 - 2 (j + 0.5) / H) tan(fov/2)) u
  * where f = (target - eye)/|target - eye|, r = f x z / |f x z| (for a camera
  * looking straight up or down r = +x), u = r x f. The pixel's linear value
- * is the radiance of the first surface hit, L = albedo / pi * E_rgb, with
+ * is the radiance of the first surface hit, L = albedo / pi * E_rgb (on the
+ * ground the albedo per channel of scene_ground_albedo: a day image's pixel
+ * or the constant, src/ground.c), with
  * E_rgb the colour-weighted direct illuminance of SPEC §2 at the hit point
  * (from the shade function; each lamp's term times its color) plus the
  * optional indirect term (render_opts.indirect, the hook for the photon

@@ -8,6 +8,7 @@
 #ifndef PLX_SCENE_H
 #define PLX_SCENE_H
 
+#include <stddef.h>
 #include <stdint.h>
 
 typedef struct vec2 { double x, y; } vec2;
@@ -38,6 +39,22 @@ typedef struct scene_lamp {
     const char *id;
 } scene_lamp;
 
+/* The ground's albedo from a day image (src/ground.c; README "Scene
+ * format"). The pixels are the caller's 8-bit sRGB, kept as bytes: the
+ * albedo of channel value v is lut[v] (sRGB decoded to linear, times
+ * ground_albedo / mean_y so that the image's mean linear luminance is the
+ * scene's ground albedo, clamped to [0, 0.95]). */
+typedef struct scene_ground_image {
+    uint32_t w, h;
+    uint8_t *rgb;         /* w*h*3, top row (y = box[3]) first */
+    size_t cap;           /* bytes available at rgb (a smaller image reuses them) */
+    double box[4];        /* x0, y0, x1, y1 in local metres */
+    double fx, fy;        /* pixels per metre along x and y */
+    double mean_y;        /* mean linear luminance of the pixels (> 0) */
+    double mean_albedo[3]; /* mean albedo per channel over the pixels */
+    double lut[256];
+} scene_ground_image;
+
 /* A block: a connected group of buildings that touch or overlap. */
 typedef struct scene_block {
     uint32_t bld_first;   /* index into scene.block_bld */
@@ -59,12 +76,24 @@ typedef struct scene {
     scene_ring *block_rings; uint32_t nblock_rings; /* rings into block_pts */
 
     double bounds[4];     /* building box grown by 50 m */
-    double ground_albedo;
+    double ground_albedo;   /* the constant ground albedo (outside a ground image) */
+    const char *ground_image;   /* properties.ground_image as written, or NULL */
+    int ground_image_bounds_given;
+    double ground_image_bounds[4]; /* x0, y0, x1, y1, local metres (the Bounds box when not given) */
+    scene_ground_image *gimg;   /* pixels given by plx_set_ground_image, or NULL */
     int lonlat;
     double lon0, lat0;
     double height_min, height_median, height_max;
     uint32_t skipped_features, skipped_lamps, overlapping_pairs;
     uint64_t load_ns;
 } scene;
+
+/* The ground's albedo per channel at (x, y) (src/ground.c): the ground
+ * image's nearest pixel inside its box, else the constant ground_albedo.
+ * Every read of the ground's albedo goes through here. O(1). */
+void scene_ground_albedo(const scene *s, double x, double y, double rgb[3] /* OUT */);
+/* Its luminance 0.2126 R + 0.7152 G + 0.0722 B (the ground_albedo itself
+ * where there is no image): the photon tracer's survival probability. */
+double scene_ground_albedo_y(const scene *s, double x, double y);
 
 #endif

@@ -296,8 +296,8 @@ write_error:
 
 /* ---- PNG reader ------------------------------------------------------------ */
 
-int image_read_png_rgb8(const char *path, uint8_t *buf, size_t cap, uint8_t **out,
-                        int *width, int *height, char *err, size_t errlen)
+static int read_png(const char *path, uint8_t *buf, size_t cap, uint8_t **out, int *width,
+                    int *height, png_uint_32 max_dim, char *err, size_t errlen)
 {
     const char *op = "read_png";
     png_structp png;
@@ -371,8 +371,13 @@ int image_read_png_rgb8(const char *path, uint8_t *buf, size_t cap, uint8_t **ou
         row_bytes != (size_t)w * 3) {
         png_error(png, "could not convert to 8-bit RGB");
     }
-    if (w > IMAGE_MAX_DIM || h > IMAGE_MAX_DIM)
-        png_error(png, "image too large");
+    if (w > max_dim || h > max_dim) {
+        png_destroy_read_struct(&png, &info, NULL);
+        fclose(f);
+        set_err(err, errlen, "%s: '%s' is %lux%lu pixels, larger than the %lux%lu allowed", op, path,
+                (unsigned long)w, (unsigned long)h, (unsigned long)max_dim, (unsigned long)max_dim);
+        return -1;
+    }
     need = row_bytes * (size_t)h;           /* <= 3e12: fits a 64-bit size_t */
     if (need / row_bytes != (size_t)h)
         png_error(png, "image too large for memory");
@@ -399,4 +404,22 @@ int image_read_png_rgb8(const char *path, uint8_t *buf, size_t cap, uint8_t **ou
     fclose(f);
     *out = pixels;
     return 0;
+}
+
+int image_read_png_rgb8(const char *path, uint8_t *buf, size_t cap, uint8_t **out,
+                        int *width, int *height, char *err, size_t errlen)
+{
+    return read_png(path, buf, cap, out, width, height, IMAGE_MAX_DIM, err, errlen);
+}
+
+int image_read_png_max(const char *path, int max_dim, uint8_t **out, int *width, int *height,
+                       char *err, size_t errlen)
+{
+    if (max_dim < 1 || max_dim > IMAGE_MAX_DIM) {
+        if (out != NULL)
+            *out = NULL;
+        set_err(err, errlen, "read_png: max_dim %d is not 1..%d", max_dim, IMAGE_MAX_DIM);
+        return -1;
+    }
+    return read_png(path, NULL, 0, out, width, height, (png_uint_32)max_dim, err, errlen);
 }

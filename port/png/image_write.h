@@ -64,4 +64,15 @@ int image_write_pfm(const char *path, int width, int height, const float *rgb,
 int image_read_png_rgb8(const char *path, uint8_t *buf, size_t cap, uint8_t **out,
                         int *width, int *height, char *err, size_t errlen);
 
+/*
+ * The same into a new malloc() buffer (*out, freed by the caller), refusing
+ * an image wider or taller than max_dim (1..1000000) before any pixel
+ * memory is taken: "read_png: 'big.png' is 20000x300 pixels, larger than
+ * the 16384x16384 allowed". Other messages as above: "read_png: cannot
+ * open 'x.png': No such file or directory", "read_png: 'x.png' is not a
+ * PNG file (bad signature)", "read_png: cannot decode 'x.png': ...".
+ */
+int image_read_png_max(const char *path, int max_dim, uint8_t **out, int *width, int *height,
+                       char *err, size_t errlen);
+
 #endif

@@ -8,7 +8,8 @@ static const char help[] =
     "\n"
     "Loads SCENE (GeoJSON, see README 'Scene format') and prints counts of\n"
     "buildings, blocks, courtyards, lamps and vertices, the bounds, building\n"
-    "heights (min/median/max), skipped features, the load time, the polar\n"
+    "heights (min/median/max), the ground albedo and ground image (path,\n"
+    "size, bounds, mean albedo), skipped features, the load time, the polar\n"
     "diagrams (build time, memory by part) and the memory used per part with\n"
     "the high-water mark.\n"
     "\n"
@@ -34,6 +35,7 @@ int cmd_info(int argc, char **argv)
     plx_engine *e;
     plx_scene_info si;
     plx_polar_info pi;
+    plx_ground_image_info gi;
     int i, rc;
     memset(&c, 0, sizeof c);
     for (i = 1; i < argc; i++) {
@@ -74,6 +76,12 @@ int cmd_info(int argc, char **argv)
            si.bounds[2], si.bounds[3], si.bounds[2] - si.bounds[0], si.bounds[3] - si.bounds[1]);
     printf("heights: min %.2f median %.2f max %.2f m\n", si.height_min, si.height_median, si.height_max);
     printf("ground albedo: %.3f\n", si.ground_albedo);
+    if (plx_ground_image_get(e, &gi) == PLX_OK && gi.width > 0)
+        printf("ground image: %s (%ux%u pixels) over %.3f %.3f %.3f %.3f%s; mean albedo %.4f %.4f %.4f"
+               " (luminance %.4f)\n", gi.path ? gi.path : "(set by the caller)", gi.width, gi.height,
+               gi.bounds[0], gi.bounds[1], gi.bounds[2], gi.bounds[3],
+               gi.bounds_given ? "" : " (the bounds)", gi.mean_albedo[0], gi.mean_albedo[1],
+               gi.mean_albedo[2], gi.mean_luminance);
     printf("load time: %.2f ms\n", si.load_ns / 1e6);
     if (plx_polar_info_get(e, &pi) == PLX_OK) {
         printf("polar diagrams: built in %.2f ms; %zu bytes = axes %zu + regions %zu + polygons %zu + rest %zu"

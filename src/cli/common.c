@@ -5,6 +5,7 @@
 
 #include "cli.h"
 #include "port.h"
+#include "png/image_write.h"
 #include <unistd.h>
 
 int cli_usage_error(const char *cmd, const char *fmt, ...)
@@ -100,8 +101,52 @@ static void quiet_log(void *ctx, plx_log_level level, const char *msg)
         fprintf(stderr, "polarlux: error: %s\n", msg);
 }
 
+/* The scene's ground image (properties.ground_image, a path relative to the
+ * scene file's folder unless absolute) read and given to the engine.
+ * Prints the error and returns an exit code on failure. */
+static int load_ground_image(const char *cmd, const char *scene_path, plx_engine *e, size_t mem)
+{
+    plx_ground_image_info gi;
+    const char *slash;
+    char *full;
+    size_t dir;
+    uint8_t *px = NULL;
+    int w = 0, h = 0;
+    char err[600];
+    plx_status st;
+    if (plx_ground_image_get(e, &gi) != PLX_OK || !gi.path)
+        return EXIT_OK;
+    slash = strrchr(scene_path, '/');
+    dir = gi.path[0] == '/' || !slash ? 0 : (size_t)(slash - scene_path) + 1;
+    full = malloc(dir + strlen(gi.path) + 1);
+    if (!full) {
+        fprintf(stderr, "polarlux %s: %s: out of memory for the ground image path\n", cmd, scene_path);
+        return EXIT_FAIL;
+    }
+    memcpy(full, scene_path, dir);
+    strcpy(full + dir, gi.path);
+    if (image_read_png_max(full, 16384, &px, &w, &h, err, sizeof err) != 0) {
+        fprintf(stderr, "polarlux %s: %s: ground image '%s': %s\n", cmd, scene_path, gi.path, err);
+        free(full);
+        return EXIT_FAIL;
+    }
+    st = plx_set_ground_image(e, (uint32_t)w, (uint32_t)h, px, NULL);
+    free(px);
+    if (st != PLX_OK) {
+        fprintf(stderr, "polarlux %s: %s: ground image '%s' (%s): %s\n", cmd, scene_path, gi.path, full,
+                plx_last_error(e));
+        if (st == PLX_E_NOMEM)
+            fprintf(stderr, "polarlux %s: give the engine more memory with --mem (now %zu bytes)\n", cmd, mem);
+        free(full);
+        return st == PLX_E_NOMEM ? EXIT_NOMEM : EXIT_FAIL;
+    }
+    free(full);
+    return EXIT_OK;
+}
+
 int cli_open_scene(const char *cmd, const char *path, const cli_common *c, plx_engine **e)
 {
+    int rc;
     static plx_port quiet_port;
     plx_config cfg;
     plx_status st;
@@ -131,7 +176,12 @@ int cli_open_scene(const char *cmd, const char *path, const cli_common *c, plx_e
         *e = NULL;
         return st == PLX_E_INVALID ? EXIT_FAIL : cli_exit_code(st);
     }
-    return EXIT_OK;
+    rc = load_ground_image(cmd, path, *e, c->mem ? c->mem : CLI_DEFAULT_MEM);
+    if (rc != EXIT_OK) {
+        plx_engine_free(*e);
+        *e = NULL;
+    }
+    return rc;
 }
 
 void cli_indirect_default(cli_indirect *ind)

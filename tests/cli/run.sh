@@ -105,6 +105,22 @@ fi
 expect render-bad-size 2 "--size '12' is not WxH" -- "$bin" render -q fixtures/tiny.geojson --size 12 -o "$tmp/u.png"
 expect nightify-ok 0 "^nightify: 160x120 day image matched to 120x80 night reference" -- "$bin" nightify "$tmp/s.png" "$tmp/a.png" -o "$tmp/n.png"
 expect nightify-missing 1 "nope.png" -- "$bin" nightify "$tmp/nope.png" "$tmp/a.png" -o "$tmp/n2.png"
+# ground image (properties.ground_image): read relative to the scene's folder
+expect info-ground-image 0 "^ground image: ground-day\.png \(64x64 pixels\) over -32\.000 -32\.000 32\.000 32\.000; mean albedo 0\.[0-9]+ 0\.[0-9]+ 0\.[0-9]+ \(luminance 0\.2000\)$" -- "$bin" info fixtures/ground-image.geojson
+expect render-ground-image 0 "^aerial view 120x80 " -- "$bin" render -q --no-indirect fixtures/ground-image.geojson --view aerial --size 120x80 -o "$tmp/gi.png"
+expect illum-ground-image 0 "^0 0 0 [0-9.]+ [0-9.]+" -- sh -c "echo '0 0' | '$bin' illum -q --frames 2 --photons 5000 fixtures/ground-image.geojson --points -"
+mkdir -p "$tmp/gi"
+cp fixtures/ground-image.geojson "$tmp/gi/s.geojson"
+expect ground-image-missing 1 "^polarlux info: $tmp/gi/s\.geojson: ground image 'ground-day\.png': read_png: cannot open '$tmp/gi/ground-day\.png': No such file or directory$" -- "$bin" info "$tmp/gi/s.geojson"
+expect ground-image-missing-heatmap 1 "polarlux heatmap: $tmp/gi/s\.geojson: ground image 'ground-day\.png'" -- "$bin" heatmap "$tmp/gi/s.geojson" -o "$tmp/gi/h.png"
+echo "not a png" >"$tmp/gi/ground-day.png"
+expect ground-image-not-png 1 "ground image 'ground-day\.png': read_png: '$tmp/gi/ground-day\.png' is not a PNG file \(bad signature\)$" -- "$bin" render -q "$tmp/gi/s.geojson" -o "$tmp/gi/r.png"
+sed "s|\"ground-day.png\"|\"$(pwd)/fixtures/ground-day.png\"|" fixtures/ground-image.geojson >"$tmp/gi/abs.geojson"
+expect ground-image-absolute 0 "^ground image: /.*fixtures/ground-day\.png \(64x64 pixels\)" -- "$bin" info "$tmp/gi/abs.geojson"
+printf '{"type": "FeatureCollection", "properties": {"units": "m", "ground_image": 5}, "features": []}' >"$tmp/gi/bad.geojson"
+expect ground-image-bad-strict 1 "polarlux info: $tmp/gi/bad\.geojson: properties\.ground_image must be the path of a PNG file" -- "$bin" info --strict "$tmp/gi/bad.geojson"
+expect ground-image-bad-lenient 0 "warning: $tmp/gi/bad\.geojson: properties\.ground_image must be the path of a PNG file \(a non-empty string of at most 4096 bytes\); ignored" -- "$bin" info "$tmp/gi/bad.geojson"
+expect ground-image-nomem 3 "out of memory while storing the ground image" -- "$bin" info --mem 15K fixtures/ground-image.geojson
 ls "$tmp"/*.tmp* >/dev/null 2>&1 && { echo "FAIL temporary files left"; fail=$((fail + 1)); }
 echo "cli: $pass passed, $fail failed"
 [ "$fail" -eq 0 ]

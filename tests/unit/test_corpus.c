@@ -327,6 +327,13 @@ static const corpus_case corpus[] = {
       "",
       0, 0, 0, 0,
       NULL },
+    { "wrong-type-ground-image.geojson", PLX_OK,
+      NULL,
+      "properties.ground_image must be the path of a PNG file (a non-empty string of at most 4096 bytes)",
+      "properties.ground_image must be the path of a PNG file (a non-empty string of at most 4096 bytes); ignored\n"
+      "properties.ground_image_bounds must be [x0, y0, x1, y1]: 4 finite numbers with x0 < x1 and y0 < y1; ignored\n",
+      0, 1, 0, 0,
+      "|L" },
     { "wrong-type-top-level.geojson", PLX_E_SCENE,
       "the top-level value is not a JSON object (expected a GeoJSON FeatureCollection)",
       "the top-level value is not a JSON object (expected a GeoJSON FeatureCollection)",
