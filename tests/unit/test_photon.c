@@ -293,24 +293,44 @@ static void closed_box(fixture *f, double a)
     fx_finish(f);
 }
 
-static double sum_floats(const float *v, size_t n)
+/* Channel c of n texels of PHOTON_CH floats. */
+static double sum_channel(const float *v, size_t n, int c)
 {
     double s = 0.0;
     size_t i;
     for (i = 0; i < n; i++)
-        s += v[i];
+        s += v[i * PHOTON_CH + (size_t)c];
     return s;
 }
 
-static double chart_total(const photon_sys *ps)
+static double chart_total(const photon_sys *ps, int c)
 {
     double t = 0.0;
     int L;
     for (L = 0; L < PHOTON_LEVELS; L++) {
         const photon_level *lv = &ps->lev[L];
-        t += sum_floats(lv->flux, (size_t)lv->nslots * 2 * lv->w * lv->h);
+        t += sum_channel(lv->flux, (size_t)lv->nslots * 2 * lv->w * lv->h, c);
     }
     return t;
+}
+
+/* Flux of channel c in the level-4 ambient terms. */
+static double ambient_total(const photon_sys *ps, int c)
+{
+    double t = 0.0;
+    uint32_t k;
+    for (k = 0; k < ps->s->nblocks; k++)
+        if (ps->blevel[k] >= PHOTON_LEVELS)
+            t += ps->bamb[(size_t)k * PHOTON_CH + (size_t)c];
+    return t;
+}
+
+/* Every buffer of the progressive pass, channel c. */
+static double buffers_total(const photon_sys *ps, int c)
+{
+    return chart_total(ps, c) + ambient_total(ps, c) +
+           sum_channel(ps->gflux, (size_t)ps->gw * ps->gh, c) +
+           sum_channel(ps->cov_flux, ps->ncov, c);
 }
 
 static void test_energy_closed_box(void **state)
@@ -342,19 +362,44 @@ static void test_energy_closed_box(void **state)
            ratio, a / (1 - a), st->escaped);
     assert_true(fabs(ratio - a / (1 - a)) < (quick_mode() ? 0.06 : 0.03) * a / (1 - a));
     /* bookkeeping of the later hits: stored somewhere or counted lost */
-    stored = st->stored_chart + st->stored_aerial + st->stored_ambient + st->lost;
+    stored = st->stored_chart + st->stored_aerial + st->stored_ambient + st->stored_covered +
+             st->lost;
     assert_true(fabs(stored - st->arrived) <= 1e-9 * st->arrived);
     /* flux conservation through splatting, to float precision */
-    tex = chart_total(ps);
+    tex = chart_total(ps, 0);
     assert_true(fabs(tex - st->stored_chart) <= 1e-5 * st->stored_chart);
-    tex = sum_floats(ps->gflux, (size_t)ps->gw * ps->gh);
+    tex = sum_channel(ps->gflux, (size_t)ps->gw * ps->gh, 0);
     assert_true(fabs(tex - st->stored_aerial) <= 1e-5 * st->stored_aerial);
-    /* the floor (under the canopy: not the topmost surface) and the
-     * ceiling (an underside) have no chart; the walls do */
-    printf("closed box: stored chart %.4g aerial %.4g lost (floor, ceiling) %.4g of %.4g\n",
-           st->stored_chart, st->stored_aerial, st->lost, st->arrived);
+    tex = sum_channel(ps->cov_flux, ps->ncov, 0);
+    assert_true(fabs(tex - st->stored_covered) <= 1e-5 * st->stored_covered);
+    /* per channel (lamp colour 1, 0.62, 0.28; grey albedos): what arrives
+     * and what is stored is the scalar times the colour, and the buffers
+     * hold exactly what was stored */
+    {
+        const float *col = f.s.lamps[0].color;
+        double sc = st->stored_chart + st->stored_aerial + st->stored_ambient +
+                    st->stored_covered;
+        int ch;
+        for (ch = 0; ch < 3; ch++) {
+            double buf = buffers_total(ps, 1 + ch);
+            printf("closed box channel %d: arrived %.6g (scalar x colour %.6g), stored %.6g, "
+                   "in buffers %.6g\n",
+                   ch, st->arrived_rgb[ch], st->arrived * col[ch], st->stored_rgb[ch], buf);
+            assert_true(fabs(st->arrived_rgb[ch] - st->arrived * col[ch]) <=
+                        1e-9 * st->arrived);
+            assert_true(fabs(st->stored_rgb[ch] - sc * col[ch]) <= 1e-9 * sc);
+            assert_true(fabs(buf - st->stored_rgb[ch]) <= 1e-5 * st->stored_rgb[ch]);
+        }
+    }
+    /* the floor (under the canopy) has its covered-ground chart; the
+     * ceiling (an underside) has none; the walls have theirs */
+    printf("closed box: stored chart %.4g aerial %.4g covered floor %.4g lost (ceiling) %.4g "
+           "of %.4g; %u covered slots\n",
+           st->stored_chart, st->stored_aerial, st->stored_covered, st->lost, st->arrived,
+           ps->ncov);
     assert_true(st->stored_aerial == 0.0);
-    assert_true(st->stored_chart > 0.4 * st->arrived && st->lost > 0.2 * st->arrived);
+    assert_true(st->stored_chart > 0.4 * st->arrived && st->stored_covered > 0.1 * st->arrived &&
+                st->lost > 0.1 * st->arrived);
     /* mean indirect irradiance on the courtyard walls against the room's
      * mean: the flux arriving at later hits over floor 100 + walls 400 +
      * ceiling 100 m^2 */
@@ -374,6 +419,18 @@ static void test_energy_closed_box(void **state)
                     n++;
                 }
         printf("closed box walls: mean E_ind %.2f lx, room mean %.2f lx\n", sum / n, expect);
+        assert_true(sum / n > 0.7 * expect && sum / n < 1.3 * expect);
+        /* the floor under the canopy: read from the covered-ground layer */
+        sum = 0.0;
+        n = 0;
+        for (j = 0; j < 10; j++)
+            for (i = 0; i < 10; i++) {
+                double P[3] = {5.5 + i, 5.5 + j, 0.0}, up[3] = {0, 0, 1};
+                assert_true(photon_covered_at(ps, P[0], P[1]));
+                sum += photon_indirect(ps, P, up);
+                n++;
+            }
+        printf("closed box floor: mean E_ind %.2f lx, room mean %.2f lx\n", sum / n, expect);
         assert_true(sum / n > 0.7 * expect && sum / n < 1.3 * expect);
     }
     fx_close(&f);
