@@ -891,7 +891,7 @@ static void test_covered_canopy(void **state)
     double pts[6][2] = {{5, 3}, {10, 5}, {15, 7}, {10, 2}, {3, 8}, {17, 4}}, up[3] = {0, 0, 1};
     int paths = full_mode() ? 40000 : quick_mode() ? 500 : 8000;
     int frames = full_mode() ? 64 : quick_mode() ? 4 : 24, k, i;
-    double err = 0.0, bound = quick_mode() ? 0.4 : 0.12;
+    double err = 0.0, bound = quick_mode() ? 0.4 : 0.12, prog[6], night_err = 0.0;
     (void)state;
     fx_open(&f, 256u << 20);
     assert_true(ref_scene_add_box(&f.s, 0, 0, 20, 10, 5.0, 4.0) >= 0);   /* canopy */
@@ -903,6 +903,8 @@ static void test_covered_canopy(void **state)
     fx_finish(&f);
     photon_config_default(&c);
     c.aerial_res = 128;
+    c.lamp_photons = quick_mode() ? 1u << 17 : 1u << 20;
+    c.kernel_min = 2.5; /* I_cov uses kernel_min; A is at r(24) = 2.5 */
     assert_int_equal(photon_create(&f.a, &f.s, &c, &ps), PLX_OK);
     assert_true(ps->ncov > 0 && ps->ncov <= ps->cov_cap);
     for (k = 0; k < frames; k++)
@@ -912,7 +914,7 @@ static void test_covered_canopy(void **state)
     for (i = 0; i < 6; i++) {
         double P[3] = {pts[i][0], pts[i][1], 0.0}, sd, ref, est;
         assert_true(photon_covered_at(ps, P[0], P[1]));
-        est = photon_indirect(ps, P, up);
+        est = prog[i] = photon_indirect(ps, P, up);
         ref = reference_indirect_rgb(ps->T, &f.s, P, up, paths, 900 + i, NULL, &sd);
         printf("  (%4.1f %4.1f): %7.3f lx, %7.3f +- %.3f lx\n", P[0], P[1], est, ref, sd);
         assert_true(ref > 0.0 && est > 0.5 * ref);
@@ -928,6 +930,17 @@ static void test_covered_canopy(void **state)
     assert_true(fabs(ps->st.stored_chart + ps->st.stored_aerial + ps->st.stored_ambient +
                      ps->st.stored_covered + ps->st.lost - ps->st.arrived) <=
                 1e-9 * ps->st.arrived);
+    /* the lamp refined (floor map, push into I and I_cov; A and A_cov
+     * restart): covered ground now reads I_cov, with the same answer */
+    assert_int_equal(photon_lamp_request(ps, 0), 0);
+    assert_int_equal(ps->gframes, 0);
+    for (i = 0; i < 6; i++) {
+        double P[3] = {pts[i][0], pts[i][1], 0.0}, est = photon_indirect(ps, P, up);
+        night_err += fabs(est - prog[i]) / prog[i] / 6;
+    }
+    printf("  after refining the lamp: mean rel diff to the progressive answer %.4f\n",
+           night_err);
+    assert_true(night_err <= (quick_mode() ? 0.4 : 0.1));
     fx_close(&f);
 }
 
@@ -1213,8 +1226,15 @@ static void test_create_nomem(void **state)
     uint64_t k;
     arena_mark m;
     plx_status st = PLX_E_NOMEM;
+    int i;
     (void)state;
-    lamp_row(&f, 4);
+    /* a row of lamps by a block, and a canopy (covered ground) */
+    fx_open(&f, 64u << 20);
+    assert_true(ref_scene_add_box(&f.s, 0, 10, 200, 30, 15.0, 0.0) >= 0);
+    assert_true(ref_scene_add_box(&f.s, 50, 0, 60, 8, 5.0, 3.0) >= 0);
+    for (i = 0; i < 4; i++)
+        assert_true(ref_scene_add_lamp(&f.s, 10.0 + 20.0 * i, 5.0, 6.0, 1000, 20.0) >= 0);
+    fx_finish(&f);
     photon_config_default(&c);
     c.aerial_res = 64;
     c.lamp_slots = 2;
@@ -1233,6 +1253,7 @@ static void test_create_nomem(void **state)
     }
     f.a.fail_at = 0;
     assert_int_equal(st, PLX_OK);
+    assert_true(ps->ncov > 0 && ps->gcov != NULL);
     printf("photon_create: succeeded at request %llu; %zu bytes (photon_bytes %zu)\n",
            (unsigned long long)(k - 1), f.a.used[PLX_PART_PHOTON] - m.used[PLX_PART_PHOTON],
            photon_bytes(&f.s, &c));
