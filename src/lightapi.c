@@ -1,5 +1,6 @@
-/* lightapi: the public face of lamp light (SPEC §2): illuminance at points,
- * which lamps light a point, and lamp lit regions. */
+/* lightapi: the public face of lamp light (SPEC §2): illuminance at points
+ * (with the photon buffers' indirect term, scalar or RGB), which lamps light
+ * a point, and lamp lit regions. */
 #include <math.h>
 #include <string.h>
 

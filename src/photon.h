@@ -122,7 +122,10 @@
  *
  * MEMORY. photon_create takes every buffer from the arena (part
  * PLX_PART_PHOTON): the tracer, per-edge and per-block tables, the four
- * level atlases, the aerial charts, the lamp cache. photon_set_viewer and
+ * level atlases, the aerial charts, the covered-ground layer, the lamp
+ * cache. A texel keeps its flux as PHOTON_CH floats (16 bytes: scalar and
+ * RGB) beside its area (and height) floats; cfg.lamp_cache_bytes is a byte
+ * budget, so colour halves the slots it holds. photon_set_viewer and
  * photon_lamps_update use scratch memory (released before return); steps and
  * lookups allocate nothing. One photon_sys must not be used from two threads
  * at once. No global state: randomness comes from the seeds given.
