@@ -319,6 +319,18 @@ plx_status plx_illuminance(plx_engine *e, size_t n, const double *P, const doubl
                            double *E_direct /* OUT */, double *E_indirect /* OUT */,
                            double *rgb /* OUT */);
 
+/*
+ * Indirect light at n surface points, as images use it (SPEC §4, §5): rgb
+ * gets 3 values per point, the photon-buffer E_indirect with each lamp's
+ * light weighted by its colour (equal to E_indirect for white lamps); the
+ * colour-blind E_indirect (lux, as plx_illuminance reports it) goes to
+ * E_indirect (may be NULL). 0 until indirect light is computed. Same
+ * checks as plx_illuminance (NaN and PLX_E_RANGE for points not on a
+ * surface); PLX_E_INVALID when P, N or rgb is NULL with n > 0.
+ */
+plx_status plx_indirect_rgb(plx_engine *e, size_t n, const double *P, const double *N,
+                            double *E_indirect /* OUT */, double *rgb /* OUT */);
+
 /* Is P (normal n) lit, and by which lamps: up to cap lamp indices and their
  * terms in lux, in lamp order; *count gets the number of lamps lighting P
  * (which may exceed cap). Same checks as plx_illuminance. */

@@ -29,7 +29,6 @@ struct plx_engine {
     const struct lit_region *lit_last; /* region of the last plx_lit_region_get */
     struct render *rd;      /* renderer, created on first need */
     struct photon_sys *ph;  /* photon buffers, created on first need */
-    double tint[3];         /* mean lamp colour, for the scalar indirect light */
     double lightmap_cell;   /* light map texel size when built, else 0 */
 };
 
@@ -46,6 +45,8 @@ uint64_t eng_clock(plx_engine *e);
 plx_status eng_need_light(plx_engine *e, const char *fn);
 /* E_indirect at a checked surface point, 0 without photon frames (indirectapi.c). */
 double eng_indirect(plx_engine *e, const double P[3], const double n[3]);
+/* The same, also writing its RGB version to rgb (may be NULL); returns the scalar. */
+double eng_indirect_rgb(plx_engine *e, const double P[3], const double n[3], double rgb[3] /* OUT */);
 /* Checks the engine handle for API misuse. */
 int eng_ok(const plx_engine *e);
 

@@ -4,23 +4,6 @@
 #include "engine.h"
 #include "photon.h"
 
-/* The intensity-weighted mean lamp colour: the photon buffers carry scalar
- * flux, so indirect light is tinted with it in images. */
-static void mean_tint(const scene *s, double tint[3])
-{
-    double w = 0.0;
-    uint32_t i;
-    int k;
-    tint[0] = tint[1] = tint[2] = 0.0;
-    for (i = 0; i < s->nlamps; i++) {
-        for (k = 0; k < 3; k++)
-            tint[k] += s->lamps[i].intensity * s->lamps[i].color[k];
-        w += s->lamps[i].intensity;
-    }
-    for (k = 0; k < 3; k++)
-        tint[k] = w > 0.0 ? tint[k] / w : 1.0;
-}
-
 static plx_status need_photons(plx_engine *e, const char *fn)
 {
     photon_config cfg;
@@ -43,7 +26,6 @@ static plx_status need_photons(plx_engine *e, const char *fn)
         return eng_nomem(e, "creating the photon buffers");
     if (st != PLX_OK)
         return eng_fail(e, st, "creating the photon buffers failed");
-    mean_tint(e->sc, e->tint);
     return PLX_OK;
 }
 
@@ -90,9 +72,19 @@ plx_status plx_indirect_reset(plx_engine *e)
 /* E_indirect at a checked surface point (0 without frames). */
 double eng_indirect(plx_engine *e, const double P[3], const double n[3])
 {
-    if (!e->ph || plx_indirect_frames(e) == 0)
+    return eng_indirect_rgb(e, P, n, NULL);
+}
+
+/* The same with its RGB version (each lamp's light weighted by its colour:
+ * the photons carry both). */
+double eng_indirect_rgb(plx_engine *e, const double P[3], const double n[3], double rgb[3])
+{
+    if (!e->ph || plx_indirect_frames(e) == 0) {
+        if (rgb)
+            rgb[0] = rgb[1] = rgb[2] = 0.0;
         return 0.0;
-    return photon_indirect(e->ph, P, n);
+    }
+    return photon_indirect_rgb(e->ph, P, n, rgb);
 }
 
 plx_status plx_nightify(const uint8_t *day, size_t npx, const uint8_t *night, size_t nnight,

@@ -1,5 +1,6 @@
-/* lightapi: the public face of lamp light (SPEC §2): illuminance at points,
- * which lamps light a point, and lamp lit regions. */
+/* lightapi: the public face of lamp light (SPEC §2): illuminance at points
+ * (with the photon buffers' indirect term, scalar or RGB), which lamps light
+ * a point, and lamp lit regions. */
 #include <math.h>
 #include <string.h>
 
@@ -93,36 +94,50 @@ static int check_point(plx_engine *e, size_t k, const double P[3], const double 
     return -1;
 }
 
-plx_status plx_illuminance(plx_engine *e, size_t n, const double *P, const double *N,
-                           double *E_direct, double *E_indirect, double *rgb)
+/* Where a point loop writes: direct (E_direct, rgb) or indirect only
+ * (E_indirect, rgb_ind); NULL pointers are skipped. */
+typedef struct point_out {
+    double *E_direct, *rgb, *E_indirect, *rgb_ind;
+} point_out;
+
+static void point_nan(const point_out *o, size_t k)
+{
+    int c;
+    if (o->E_direct)
+        o->E_direct[k] = NAN;
+    if (o->E_indirect)
+        o->E_indirect[k] = NAN;
+    for (c = 0; c < 3; c++) {
+        if (o->rgb)
+            o->rgb[3 * k + (size_t)c] = NAN;
+        if (o->rgb_ind)
+            o->rgb_ind[3 * k + (size_t)c] = NAN;
+    }
+}
+
+/* Checks and fills every point; PLX_E_RANGE names the first bad one. */
+static plx_status point_loop(plx_engine *e, size_t n, const double *P, const double *N,
+                             const point_out *o)
 {
     size_t k;
     int bad = 0;
     char first[ENGINE_ERR_BYTES];
-    plx_status st = eng_need_light(e, "plx_illuminance");
-    if (st != PLX_OK)
-        return st;
-    if (n && (!P || !N || !E_direct))
-        return eng_fail(e, PLX_E_INVALID, "plx_illuminance: P, N and E_direct must not be NULL");
     first[0] = '\0';
     for (k = 0; k < n; k++) {
         const double *p = P + 3 * k, *nn = N + 3 * k;
-        double *c = rgb ? rgb + 3 * k : NULL;
-        if (E_indirect)
-            E_indirect[k] = 0.0;
         if (check_point(e, k, p, nn) != 0) {
-            E_direct[k] = NAN;
-            if (c)
-                c[0] = c[1] = c[2] = NAN;
-            if (E_indirect)
-                E_indirect[k] = NAN;
+            point_nan(o, k);
             if (!bad++)
                 memcpy(first, e->err, sizeof first);
             continue;
         }
-        light_illuminance(e->lt, p, nn, &E_direct[k], c);
-        if (E_indirect)
-            E_indirect[k] = eng_indirect(e, p, nn);
+        if (o->E_direct)
+            light_illuminance(e->lt, p, nn, &o->E_direct[k], o->rgb ? o->rgb + 3 * k : NULL);
+        if (o->E_indirect || o->rgb_ind) {
+            double Ei = eng_indirect_rgb(e, p, nn, o->rgb_ind ? o->rgb_ind + 3 * k : NULL);
+            if (o->E_indirect)
+                o->E_indirect[k] = Ei;
+        }
     }
     if (bad) {
         memcpy(e->err, first, sizeof first);
@@ -130,6 +145,43 @@ plx_status plx_illuminance(plx_engine *e, size_t n, const double *P, const doubl
     }
     eng_clear_error(e);
     return PLX_OK;
+}
+
+plx_status plx_illuminance(plx_engine *e, size_t n, const double *P, const double *N,
+                           double *E_direct, double *E_indirect, double *rgb)
+{
+    point_out o;
+    plx_status st = eng_need_light(e, "plx_illuminance");
+    if (st != PLX_OK)
+        return st;
+    if (n && (!P || !N || !E_direct))
+        return eng_fail(e, PLX_E_INVALID, "plx_illuminance: P, N and E_direct must not be NULL");
+    o.E_direct = E_direct;
+    o.rgb = rgb;
+    o.E_indirect = E_indirect;
+    o.rgb_ind = NULL;
+    if (E_indirect) {
+        size_t k;
+        for (k = 0; k < n; k++)
+            E_indirect[k] = 0.0;
+    }
+    return point_loop(e, n, P, N, &o);
+}
+
+plx_status plx_indirect_rgb(plx_engine *e, size_t n, const double *P, const double *N,
+                            double *E_indirect, double *rgb)
+{
+    point_out o;
+    plx_status st = eng_need_light(e, "plx_indirect_rgb");
+    if (st != PLX_OK)
+        return st;
+    if (n && (!P || !N || !rgb))
+        return eng_fail(e, PLX_E_INVALID, "plx_indirect_rgb: P, N and rgb must not be NULL");
+    o.E_direct = NULL;
+    o.rgb = NULL;
+    o.E_indirect = E_indirect;
+    o.rgb_ind = rgb;
+    return point_loop(e, n, P, N, &o);
 }
 
 plx_status plx_lamps_at(plx_engine *e, const double P[3], const double n[3], uint32_t *ids,

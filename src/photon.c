@@ -111,11 +111,22 @@ void photon_cosine_dir(uint64_t *st, const double n[3], double d[3])
     d[2] /= l;
 }
 
-static int texel_ok(const float *area, const float *height, double z, size_t i)
+/* Storage slot of grid texel k: k itself, or idx[k] on a sparse grid
+ * (-1 when not charted). */
+static long slot_of(const uint32_t *idx, size_t k)
 {
-    if (!(area[i] > 0.0f))
+    if (!idx)
+        return (long)k;
+    return idx[k] == PHOTON_NONE ? -1 : (long)idx[k];
+}
+
+static int texel_ok(const float *area, const float *height, const uint32_t *idx, double z,
+                    size_t k)
+{
+    long s = slot_of(idx, k);
+    if (s < 0 || !(area[s] > 0.0f))
         return 0;
-    if (height && fabs((double)height[i] - z) > HEIGHT_TOL)
+    if (height && fabs((double)height[k] - z) > HEIGHT_TOL)
         return 0;
     return 1;
 }
@@ -130,18 +141,77 @@ static int column(int i, uint32_t w, int wrap)
     return ((i % (int)w) + (int)w) % (int)w;
 }
 
-/* Deposit index of grid texel (i, j) in the output window, or -1. */
-static long win_index(int i, int j, uint32_t ow, uint32_t oh, int32_t ox, int32_t oy)
+/* A grid being splatted into or read: flux of the output (the whole grid,
+ * a window of it, or the slots of a sparse grid), validity from area,
+ * height and idx of the whole grid. */
+typedef struct grid {
+    const float *area, *height;
+    const uint32_t *idx;
+    double z;
+    uint32_t w, h;
+    int wrap;
+    int win;                  /* output is the window (ow, oh, ox, oy) */
+    uint32_t ow, oh;
+    int32_t ox, oy;
+} grid;
+
+/* Output index (in texels) of grid texel (i, j), or -1. */
+static long out_index(const grid *g, int i, int j)
 {
-    int a = i - ox, b = j - oy;
-    if (a < 0 || b < 0 || a >= (int)ow || b >= (int)oh)
-        return -1;
-    return (long)b * (long)ow + a;
+    if (g->win) {
+        int a = i - g->ox, b = j - g->oy;
+        if (a < 0 || b < 0 || a >= (int)g->ow || b >= (int)g->oh)
+            return -1;
+        return (long)b * (long)g->ow + a;
+    }
+    return slot_of(g->idx, (size_t)j * g->w + (size_t)i);
 }
 
-static int splat_any(float *out, uint32_t ow, uint32_t oh, int32_t ox, int32_t oy,
-                     const float *area, const float *height, double z, uint32_t w, uint32_t h,
-                     int wrap, double fx, double fy, double r, double phi)
+/* Area of grid texel k (valid texels only). */
+static double texel_area(const grid *g, size_t k)
+{
+    return (double)g->area[slot_of(g->idx, k)];
+}
+
+static int gvalid(const grid *g, int i, int j)
+{
+    return texel_ok(g->area, g->height, g->idx, g->z, (size_t)j * g->w + (size_t)i);
+}
+
+static void deposit(float *out, long o, const double phi[PHOTON_CH], double share)
+{
+    int c;
+    if (o < 0)
+        return;
+    for (c = 0; c < PHOTON_CH; c++)
+        out[(size_t)o * PHOTON_CH + (size_t)c] += (float)(phi[c] * share);
+}
+
+/* Nearest valid texel of the 3 x 3 around (fx, fy); returns 0 when none. */
+static int nearest3(const grid *g, double fx, double fy, int *bi, int *bj)
+{
+    double bd = INFINITY;
+    int ci = (int)floor(fx), cj = (int)floor(fy), i, j;
+    for (j = cj - 1; j <= cj + 1; j++) {
+        if (j < 0 || j >= (int)g->h)
+            continue;
+        for (i = ci - 1; i <= ci + 1; i++) {
+            int ii = column(i, g->w, g->wrap);
+            double dx = (i + 0.5) - fx, dy = (j + 0.5) - fy, d2 = dx * dx + dy * dy;
+            if (ii < 0)
+                continue;
+            if (gvalid(g, ii, j) && d2 < bd) {
+                bd = d2;
+                *bi = ii;
+                *bj = j;
+            }
+        }
+    }
+    return bd < INFINITY;
+}
+
+static int splat_any(float *out, const grid *g, double fx, double fy, double r,
+                     const double phi[PHOTON_CH])
 {
     enum { MAXK = 2 * PHOTON_KERNEL_MAXI + 3 };
     int ti[MAXK * MAXK], tj[MAXK * MAXK];
@@ -149,8 +219,8 @@ static int splat_any(float *out, uint32_t ow, uint32_t oh, int32_t ox, int32_t o
     int n = 0, i, j, i0, i1, j0, j1;
     if (r > PHOTON_KERNEL_MAX)
         r = PHOTON_KERNEL_MAX;
-    if (!(fx > -r - 2.0 && fy > -r - 2.0 && fx < (double)w + r + 2.0 &&
-          fy < (double)h + r + 2.0))
+    if (!(fx > -r - 2.0 && fy > -r - 2.0 && fx < (double)g->w + r + 2.0 &&
+          fy < (double)g->h + r + 2.0))
         return 0;
     i0 = (int)floor(fx - r);
     i1 = (int)floor(fx + r);
@@ -158,14 +228,14 @@ static int splat_any(float *out, uint32_t ow, uint32_t oh, int32_t ox, int32_t o
     j1 = (int)floor(fy + r);
     for (j = j0; j <= j1; j++) {
         double dy = (j + 0.5) - fy;
-        if (j < 0 || j >= (int)h)
+        if (j < 0 || j >= (int)g->h)
             continue;
         for (i = i0; i <= i1; i++) {
             double dx = (i + 0.5) - fx, dist = sqrt(dx * dx + dy * dy), wgt;
-            int ii = column(i, w, wrap);
+            int ii = column(i, g->w, g->wrap);
             if (dist >= r || ii < 0)
                 continue;
-            if (!texel_ok(area, height, z, (size_t)j * w + (size_t)ii))
+            if (!gvalid(g, ii, j))
                 continue;
             wgt = 1.0 - dist / r;
             ti[n] = ii;
@@ -176,61 +246,76 @@ static int splat_any(float *out, uint32_t ow, uint32_t oh, int32_t ox, int32_t o
         }
     }
     if (n == 0 || !(sum > 0.0)) {
-        /* nearest valid texel of the 3 x 3 around the photon */
-        double bd = INFINITY;
-        int bi = 0, bj = 0, ci = (int)floor(fx), cj = (int)floor(fy);
-        long o;
-        for (j = cj - 1; j <= cj + 1; j++) {
-            if (j < 0 || j >= (int)h)
-                continue;
-            for (i = ci - 1; i <= ci + 1; i++) {
-                int ii = column(i, w, wrap);
-                double dx = (i + 0.5) - fx, dy = (j + 0.5) - fy, d2 = dx * dx + dy * dy;
-                if (ii < 0)
-                    continue;
-                if (texel_ok(area, height, z, (size_t)j * w + (size_t)ii) && d2 < bd) {
-                    bd = d2;
-                    bi = ii;
-                    bj = j;
-                }
-            }
-        }
-        if (bd == INFINITY)
+        int bi = 0, bj = 0;
+        if (!nearest3(g, fx, fy, &bi, &bj))
             return 0;
-        o = win_index(bi, bj, ow, oh, ox, oy);
-        if (o >= 0)
-            out[o] += (float)phi;
+        deposit(out, out_index(g, bi, bj), phi, 1.0);
         return 1;
     }
-    for (i = 0; i < n; i++) {
-        long o = win_index(ti[i], tj[i], ow, oh, ox, oy);
-        if (o >= 0)
-            out[o] += (float)(phi * (wt[i] / sum));
-    }
+    for (i = 0; i < n; i++)
+        deposit(out, out_index(g, ti[i], tj[i]), phi, wt[i] / sum);
     return 1;
 }
 
-int photon_splat(float *flux, const float *area, const float *height, double z, uint32_t w,
-                 uint32_t h, int wrap, double fx, double fy, double r, double phi)
+static grid grid_full(const float *area, const float *height, const uint32_t *idx, double z,
+                      uint32_t w, uint32_t h, int wrap)
 {
-    return splat_any(flux, w, h, 0, 0, area, height, z, w, h, wrap, fx, fy, r, phi);
+    grid g;
+    memset(&g, 0, sizeof g);
+    g.area = area;
+    g.height = height;
+    g.idx = idx;
+    g.z = z;
+    g.w = w;
+    g.h = h;
+    g.wrap = wrap;
+    return g;
+}
+
+static grid grid_win(uint32_t ow, uint32_t oh, int32_t ox, int32_t oy, const float *area,
+                     const float *height, double z, uint32_t w, uint32_t h)
+{
+    grid g = grid_full(area, height, NULL, z, w, h, 0);
+    g.win = 1;
+    g.ow = ow;
+    g.oh = oh;
+    g.ox = ox;
+    g.oy = oy;
+    return g;
+}
+
+int photon_splat(float *flux, const float *area, const float *height, double z, uint32_t w,
+                 uint32_t h, int wrap, double fx, double fy, double r,
+                 const double phi[PHOTON_CH])
+{
+    grid g = grid_full(area, height, NULL, z, w, h, wrap);
+    return splat_any(flux, &g, fx, fy, r, phi);
+}
+
+int photon_splat_sparse(float *flux, const float *area, const uint32_t *idx, uint32_t w,
+                        uint32_t h, double fx, double fy, double r, const double phi[PHOTON_CH])
+{
+    grid g = grid_full(area, NULL, idx, 0.0, w, h, 0);
+    return splat_any(flux, &g, fx, fy, r, phi);
 }
 
 int photon_splat_win(float *out, uint32_t ow, uint32_t oh, int32_t ox, int32_t oy,
                      const float *area, const float *height, double z, uint32_t w, uint32_t h,
-                     double fx, double fy, double r, double phi)
+                     double fx, double fy, double r, const double phi[PHOTON_CH])
 {
-    return splat_any(out, ow, oh, ox, oy, area, height, z, w, h, 0, fx, fy, r, phi);
+    grid g = grid_win(ow, oh, ox, oy, area, height, z, w, h);
+    return splat_any(out, &g, fx, fy, r, phi);
 }
 
-static double gather_any(const float *out, uint32_t ow, uint32_t oh, int32_t ox, int32_t oy,
-                         const float *area, const float *height, double z, uint32_t w,
-                         uint32_t h, int wrap, double fx, double fy)
+static double gather_any(const float *out, const grid *g, double fx, double fy,
+                         double e[PHOTON_CH])
 {
-    double gx = fx - 0.5, gy = fy - 0.5, sf = 0.0, sa = 0.0;
-    int i0, j0, a, b;
+    double gx = fx - 0.5, gy = fy - 0.5, sf[PHOTON_CH] = {0.0, 0.0, 0.0, 0.0}, sa = 0.0;
+    int i0, j0, a, b, c, bi = 0, bj = 0;
     double tx, ty;
-    if (!(fx > -2.0 && fy > -2.0 && fx < (double)w + 2.0 && fy < (double)h + 2.0))
+    for (c = 0; c < PHOTON_CH; c++)
+        e[c] = 0.0;
+    if (!(fx > -2.0 && fy > -2.0 && fx < (double)g->w + 2.0 && fy < (double)g->h + 2.0))
         return 0.0;
     i0 = (int)floor(gx);
     j0 = (int)floor(gy);
@@ -238,58 +323,56 @@ static double gather_any(const float *out, uint32_t ow, uint32_t oh, int32_t ox,
     ty = gy - j0;
     for (b = 0; b < 2; b++)
         for (a = 0; a < 2; a++) {
-            int j = j0 + b, i = column(i0 + a, w, wrap);
+            int j = j0 + b, i = column(i0 + a, g->w, g->wrap);
             double wgt = (a ? tx : 1.0 - tx) * (b ? ty : 1.0 - ty);
-            size_t k;
             long o;
-            if (j < 0 || j >= (int)h || i < 0 || wgt <= 0.0)
+            if (j < 0 || j >= (int)g->h || i < 0 || wgt <= 0.0)
                 continue;
-            k = (size_t)j * w + (size_t)i;
-            if (!texel_ok(area, height, z, k))
+            if (!gvalid(g, i, j))
                 continue;
-            o = win_index(i, j, ow, oh, ox, oy);
+            o = out_index(g, i, j);
             if (o >= 0)
-                sf += wgt * out[o];
-            sa += wgt * area[k];
+                for (c = 0; c < PHOTON_CH; c++)
+                    sf[c] += wgt * out[(size_t)o * PHOTON_CH + (size_t)c];
+            sa += wgt * texel_area(g, (size_t)j * g->w + (size_t)i);
         }
-    if (sa > 0.0)
-        return sf / sa;
-    /* no valid texel among the four: the nearest valid one of the 3 x 3 */
-    {
-        int ci = (int)floor(fx), cj = (int)floor(fy), i, j;
-        double bd = INFINITY, best = 0.0;
-        for (j = cj - 1; j <= cj + 1; j++) {
-            if (j < 0 || j >= (int)h)
-                continue;
-            for (i = ci - 1; i <= ci + 1; i++) {
-                int ii = column(i, w, wrap);
-                double dx = (i + 0.5) - fx, dy = (j + 0.5) - fy;
-                size_t k;
-                if (ii < 0)
-                    continue;
-                k = (size_t)j * w + (size_t)ii;
-                if (texel_ok(area, height, z, k) && dx * dx + dy * dy < bd) {
-                    long o = win_index(ii, j, ow, oh, ox, oy);
-                    bd = dx * dx + dy * dy;
-                    best = o >= 0 ? (double)out[o] / (double)area[k] : 0.0;
-                }
-            }
-        }
-        return best;
+    if (sa > 0.0) {
+        for (c = 0; c < PHOTON_CH; c++)
+            e[c] = sf[c] / sa;
+        return e[0];
     }
+    /* no valid texel among the four: the nearest valid one of the 3 x 3 */
+    if (nearest3(g, fx, fy, &bi, &bj)) {
+        long o = out_index(g, bi, bj);
+        double ar = texel_area(g, (size_t)bj * g->w + (size_t)bi);
+        if (o >= 0)
+            for (c = 0; c < PHOTON_CH; c++)
+                e[c] = (double)out[(size_t)o * PHOTON_CH + (size_t)c] / ar;
+    }
+    return e[0];
 }
 
 double photon_gather(const float *flux, const float *area, const float *height, double z,
-                     uint32_t w, uint32_t h, int wrap, double fx, double fy)
+                     uint32_t w, uint32_t h, int wrap, double fx, double fy,
+                     double e[PHOTON_CH])
 {
-    return gather_any(flux, w, h, 0, 0, area, height, z, w, h, wrap, fx, fy);
+    grid g = grid_full(area, height, NULL, z, w, h, wrap);
+    return gather_any(flux, &g, fx, fy, e);
+}
+
+double photon_gather_sparse(const float *flux, const float *area, const uint32_t *idx,
+                            uint32_t w, uint32_t h, double fx, double fy, double e[PHOTON_CH])
+{
+    grid g = grid_full(area, NULL, idx, 0.0, w, h, 0);
+    return gather_any(flux, &g, fx, fy, e);
 }
 
 double photon_gather_win(const float *out, uint32_t ow, uint32_t oh, int32_t ox, int32_t oy,
                          const float *area, const float *height, double z, uint32_t w,
-                         uint32_t h, double fx, double fy)
+                         uint32_t h, double fx, double fy, double e[PHOTON_CH])
 {
-    return gather_any(out, ow, oh, ox, oy, area, height, z, w, h, 0, fx, fy);
+    grid g = grid_win(ow, oh, ox, oy, area, height, z, w, h);
+    return gather_any(out, &g, fx, fy, e);
 }
 
 void photon_aerial_xy(const photon_sys *ps, double x, double y, double *fx, double *fy)
@@ -388,8 +471,9 @@ size_t photon_lamp_slot_bytes(const scene *s, const photon_config *cfg)
     aerial_dims(s, &c, &gw, &gh, &tex);
     dn = dwin_side(s, &c, tex);
     f = (size_t)c.lamp_res * c.lamp_res;
-    return sizeof(photon_lamp_slot) + 3 * (f * sizeof(float) + 63) +
-           (size_t)dn * dn * sizeof(float) + 63;
+    return sizeof(photon_lamp_slot) + 2 * (f * sizeof(float) + 63) +
+           (f * PHOTON_CH * sizeof(float) + 63) + (size_t)dn * dn * PHOTON_CH * sizeof(float) +
+           63;
 }
 
 static uint32_t cache_slots(const scene *s, const photon_config *c)
@@ -404,6 +488,35 @@ static uint32_t cache_slots(const scene *s, const photon_config *c)
     if (n > s->nlamps)
         n = s->nlamps;
     return (uint32_t)n;
+}
+
+/* Upper bound on the covered-ground slots, from the scene alone: the aerial
+ * texels meeting the boxes of raised buildings (min_height > 0), at most
+ * the whole grid. A texel with covered ground has a probe inside a raised
+ * footprint, hence inside its box. */
+static uint32_t covered_capacity(const scene *s, uint32_t gw, uint32_t gh, double tex)
+{
+    uint64_t n = 0, g = (uint64_t)gw * gh;
+    uint32_t b;
+    for (b = 0; b < s->nbld && n < g; b++) {
+        const scene_building *B = &s->bld[b];
+        double i0, i1, j0, j1;
+        if (!(B->min_height > 0.0))
+            continue;
+        i0 = floor((B->box[0] - s->bounds[0]) / tex);
+        i1 = floor((B->box[2] - s->bounds[0]) / tex);
+        j0 = floor((B->box[1] - s->bounds[1]) / tex);
+        j1 = floor((B->box[3] - s->bounds[1]) / tex);
+        i0 = i0 < 0.0 ? 0.0 : i0;
+        j0 = j0 < 0.0 ? 0.0 : j0;
+        i1 = i1 > gw - 1.0 ? gw - 1.0 : i1;
+        j1 = j1 > gh - 1.0 ? gh - 1.0 : j1;
+        if (i1 >= i0 && j1 >= j0)
+            n += (uint64_t)(i1 - i0 + 1.0) * (uint64_t)(j1 - j0 + 1.0);
+    }
+    if (n > g)
+        n = g;
+    return n < UINT32_MAX ? (uint32_t)n : UINT32_MAX - 1u;
 }
 
 /* Takes (or counts) every buffer of the system. */
@@ -426,7 +539,7 @@ static void layout(photon_sys *ps, taker *t, const scene *s, const photon_config
     ps->bcy = take(t, s->nblocks, sizeof(double));
     ps->bhmax = take(t, s->nblocks, sizeof(double));
     ps->bfacade = take(t, s->nblocks, sizeof(double));
-    ps->bamb = take(t, s->nblocks, sizeof(double));
+    ps->bamb = take(t, arena_mul(s->nblocks, PHOTON_CH), sizeof(double));
     for (L = 0; L < PHOTON_LEVELS; L++) {
         photon_level *lv = &ps->lev[L];
         size_t tex;
@@ -434,7 +547,7 @@ static void layout(photon_sys *ps, taker *t, const scene *s, const photon_config
         lv->h = c->chart_h >> L;
         lv->nslots = level_slots(s, c, L);
         tex = arena_mul(arena_mul((size_t)lv->nslots * 2, lv->w), lv->h);
-        lv->flux = take(t, tex, sizeof(float));
+        lv->flux = take(t, arena_mul(tex, PHOTON_CH), sizeof(float));
         lv->area = take(t, tex, sizeof(float));
         lv->slot_block = take(t, lv->nslots, sizeof(uint32_t));
         lv->slot_frames = take(t, lv->nslots, sizeof(uint32_t));
@@ -444,8 +557,15 @@ static void layout(photon_sys *ps, taker *t, const scene *s, const photon_config
     g = (size_t)ps->gw * ps->gh;
     ps->gheight = take(t, g, sizeof(float));
     ps->garea = take(t, g, sizeof(float));
-    ps->gflux = take(t, g, sizeof(float));
-    ps->gimp = take(t, g, sizeof(float));
+    ps->gflux = take(t, arena_mul(g, PHOTON_CH), sizeof(float));
+    ps->gimp = take(t, arena_mul(g, PHOTON_CH), sizeof(float));
+    ps->cov_cap = covered_capacity(s, ps->gw, ps->gh, ps->gtex);
+    if (ps->cov_cap > 0) {
+        ps->gcov = take(t, g, sizeof(uint32_t));
+        ps->cov_area = take(t, ps->cov_cap, sizeof(float));
+        ps->cov_flux = take(t, (size_t)ps->cov_cap * PHOTON_CH, sizeof(float));
+        ps->cov_imp = take(t, (size_t)ps->cov_cap * PHOTON_CH, sizeof(float));
+    }
     ps->lamp_cdf = take(t, s->nlamps, sizeof(double));
     ps->refined = take(t, s->nlamps, 1);
     ps->lamp_slot = take(t, s->nlamps, sizeof(uint32_t));
@@ -454,10 +574,10 @@ static void layout(photon_sys *ps, taker *t, const scene *s, const photon_config
     ps->slots = take(t, ps->nslots, sizeof(photon_lamp_slot));
     for (i = 0; i < ps->nslots; i++) {
         size_t f = (size_t)c->lamp_res * c->lamp_res;
-        float *fl = take(t, f, sizeof(float));
+        float *fl = take(t, f * PHOTON_CH, sizeof(float));
         float *ar = take(t, f, sizeof(float));
         float *hg = take(t, f, sizeof(float));
-        float *dw = take(t, (size_t)ps->dwin_n * ps->dwin_n, sizeof(float));
+        float *dw = take(t, (size_t)ps->dwin_n * ps->dwin_n * PHOTON_CH, sizeof(float));
         if (ps != &dummy && ps->slots) {
             ps->slots[i].flux = fl;
             ps->slots[i].area = ar;
@@ -657,7 +777,7 @@ static void chart_build(photon_sys *ps, uint32_t k, int L, uint32_t slot, double
     size_t csize = (size_t)lv->w * lv->h, base = (size_t)slot * 2 * csize;
     double H = ps->bhmax[k];
     uint32_t j;
-    memset(lv->flux + base, 0, 2 * csize * sizeof(float));
+    memset(lv->flux + base * PHOTON_CH, 0, 2 * csize * PHOTON_CH * sizeof(float));
     memset(lv->area + base, 0, 2 * csize * sizeof(float));
     lv->slot_frames[slot] = 0;
     for (j = 0; j < K->bld_count; j++) {
@@ -734,6 +854,88 @@ static void chart_build(photon_sys *ps, uint32_t k, int L, uint32_t slot, double
 
 /* ---- aerial chart ---------------------------------------------------------- */
 
+/* Whether the ground at (x, y) is open (no building standing on the ground
+ * contains it) and under a raised building. */
+static int ground_covered(const photon_sys *ps, double x, double y)
+{
+    const tracer *T = ps->T;
+    const scene *s = ps->s;
+    double fx = floor((x - T->x0) * T->inv), fy = floor((y - T->y0) * T->inv);
+    uint32_t c, j;
+    int raised = 0;
+    if (!(fx >= 0.0 && fy >= 0.0 && fx < (double)T->nx && fy < (double)T->ny))
+        return 0;
+    c = (uint32_t)fy * T->nx + (uint32_t)fx;
+    for (j = T->start[c]; j < T->start[c + 1]; j++) {
+        const scene_building *B = &s->bld[T->ids[j]];
+        if (x < B->box[0] || x > B->box[2] || y < B->box[1] || y > B->box[3] ||
+            !trace_inside(T, T->ids[j], x, y))
+            continue;
+        if (!(B->min_height > 0.0))
+            return 0;
+        raised = 1;
+    }
+    return raised;
+}
+
+/* Slots of the covered-ground layer: every aerial texel under the box of a
+ * raised building with covered probes gets one, its area the covered
+ * fraction of the texel. */
+static void covered_build(photon_sys *ps)
+{
+    const scene *s = ps->s;
+    uint32_t b, k = ps->cfg.coverage_probes;
+    size_t g = (size_t)ps->gw * ps->gh, q;
+    double t = ps->gtex;
+    ps->ncov = 0;
+    if (!ps->gcov)
+        return;
+    for (q = 0; q < g; q++)
+        ps->gcov[q] = PHOTON_NONE;
+    for (b = 0; b < s->nbld; b++) {
+        const scene_building *B = &s->bld[b];
+        double fx0, fy0, fx1, fy1;
+        int i, j, i0, i1, j0, j1;
+        if (!(B->min_height > 0.0))
+            continue;
+        photon_aerial_xy(ps, B->box[0], B->box[1], &fx0, &fy0);
+        photon_aerial_xy(ps, B->box[2], B->box[3], &fx1, &fy1);
+        i0 = fx0 < 0.0 ? 0 : (int)floor(fx0);
+        j0 = fy0 < 0.0 ? 0 : (int)floor(fy0);
+        i1 = fx1 >= ps->gw - 1.0 ? (int)ps->gw - 1 : (int)floor(fx1);
+        j1 = fy1 >= ps->gh - 1.0 ? (int)ps->gh - 1 : (int)floor(fy1);
+        for (j = j0; j <= j1; j++)
+            for (i = i0; i <= i1; i++) {
+                size_t at = (size_t)j * ps->gw + (size_t)i;
+                uint32_t a, c, m = 0;
+                if (ps->gcov[at] != PHOTON_NONE || ps->ncov >= ps->cov_cap)
+                    continue;
+                for (c = 0; c < k; c++)
+                    for (a = 0; a < k; a++)
+                        m += (uint32_t)ground_covered(ps, ps->gx0 + (i + (a + 0.5) / k) * t,
+                                                      ps->gy0 + (j + (c + 0.5) / k) * t);
+                if (m == 0)
+                    continue;
+                ps->gcov[at] = ps->ncov;
+                ps->cov_area[ps->ncov] = (float)(t * t * m / (double)(k * k));
+                ps->ncov++;
+            }
+    }
+}
+
+int photon_covered_at(const photon_sys *ps, double x, double y)
+{
+    double fx, fy;
+    if (!ps->gcov)
+        return 0;
+    photon_aerial_xy(ps, x, y, &fx, &fy);
+    if (!(fx >= 0.0 && fy >= 0.0 && fx < (double)ps->gw && fy < (double)ps->gh))
+        return 0;
+    if (ps->gcov[(size_t)floor(fy) * ps->gw + (size_t)floor(fx)] == PHOTON_NONE)
+        return 0;
+    return trace_top(ps->T, x, y, NULL) > HEIGHT_TOL;
+}
+
 static void aerial_build(photon_sys *ps)
 {
     uint32_t i, j, a, b, k = ps->cfg.coverage_probes;
@@ -755,6 +957,7 @@ static void aerial_build(photon_sys *ps)
             ps->gheight[(size_t)j * ps->gw + i] = (float)hc;
             ps->garea[(size_t)j * ps->gw + i] = (float)(t * t * match / (double)(k * k));
         }
+    covered_build(ps);
 }
 
 /* ---- creation ---------------------------------------------------------------- */
@@ -848,15 +1051,19 @@ void photon_reset(photon_sys *ps)
         photon_level *lv = &ps->lev[L];
         size_t cs = (size_t)lv->w * lv->h * 2;
         for (i = 0; i < lv->nslots; i++) {
-            memset(lv->flux + (size_t)i * cs, 0, cs * sizeof(float));
+            memset(lv->flux + (size_t)i * cs * PHOTON_CH, 0, cs * PHOTON_CH * sizeof(float));
             lv->slot_frames[i] = 0;
         }
     }
-    for (i = 0; i < ps->s->nblocks; i++)
+    for (i = 0; i < ps->s->nblocks * PHOTON_CH; i++)
         ps->bamb[i] = 0.0;
     ps->amb_frames = 0;
-    memset(ps->gflux, 0, g * sizeof(float));
-    memset(ps->gimp, 0, g * sizeof(float));
+    memset(ps->gflux, 0, g * PHOTON_CH * sizeof(float));
+    memset(ps->gimp, 0, g * PHOTON_CH * sizeof(float));
+    if (ps->cov_cap > 0) {
+        memset(ps->cov_flux, 0, (size_t)ps->cov_cap * PHOTON_CH * sizeof(float));
+        memset(ps->cov_imp, 0, (size_t)ps->cov_cap * PHOTON_CH * sizeof(float));
+    }
     ps->gframes = 0;
     for (i = 0; i < ps->s->nlamps; i++) {
         ps->refined[i] = 0;
@@ -979,62 +1186,128 @@ plx_status photon_set_viewer(photon_sys *ps, const double eye[3], const double d
 
 /* ---- tracing ---------------------------------------------------------------------- */
 
-/* Where the progressive pass puts a photon arriving at h with flux f. */
-static void store_progressive(photon_sys *ps, uint32_t lamp, const trace_hit *h, double f)
+/* The ground's RGB albedo at (x, y): every ground albedo read of the
+ * photon pass goes through here (a ground image's pixel or the scene's
+ * ground_albedo, src/ground.c). */
+static void ground_albedo_rgb(const scene *s, double x, double y, double rgb[3])
+{
+    scene_ground_albedo(s, x, y, rgb);
+}
+
+/* RGB albedo of the surface at hit h: the ground's, or the building's
+ * scalar albedo (grey) on walls, roofs and undersides. */
+static void hit_albedo_rgb(const scene *s, const trace_hit *h, double rgb[3])
+{
+    if (h->kind == TRACE_GROUND)
+        ground_albedo_rgb(s, h->p[0], h->p[1], rgb);
+    else
+        rgb[0] = rgb[1] = rgb[2] = s->bld[h->bld].albedo;
+}
+
+double photon_albedo_scalar(const double rgb[3])
+{
+    if (rgb[0] == rgb[1] && rgb[1] == rgb[2])
+        return rgb[0];
+    return 0.2126 * rgb[0] + 0.7152 * rgb[1] + 0.0722 * rgb[2];
+}
+
+int photon_bounce(double f[PHOTON_CH], const double alb[3], double u)
+{
+    double p = photon_albedo_scalar(alb);
+    int c;
+    if (!(u < p))
+        return 0;
+    /* f[0] *= a_Y / p = 1; x / x is exactly 1, so grey albedos change nothing */
+    for (c = 0; c < 3; c++)
+        f[1 + c] *= alb[c] / p;
+    return 1;
+}
+
+static void add_rgb(double acc[3], const double f[PHOTON_CH])
+{
+    acc[0] += f[1];
+    acc[1] += f[2];
+    acc[2] += f[3];
+}
+
+/* A photon on a wall: its block's facade chart or ambient term. */
+static void store_wall(photon_sys *ps, const trace_hit *h, const double f[PHOTON_CH])
 {
     const scene *s = ps->s;
     photon_stats *st = &ps->st;
+    uint32_t k = s->bld[h->bld].block;
+    int L, c;
+    photon_level *lv;
+    size_t cs, base;
+    double fx, fy;
+    if (k >= s->nblocks || ps->eclass[h->edge] == PHOTON_EDGE_INTERNAL) {
+        st->lost += f[0];
+        return;
+    }
+    for (c = 0; c < PHOTON_CH; c++)
+        ps->bamb[(size_t)k * PHOTON_CH + (size_t)c] += f[c];
+    L = ps->blevel[k];
+    if (L >= PHOTON_LEVELS) {
+        st->stored_ambient += f[0];
+        add_rgb(st->stored_rgb, f);
+        return;
+    }
+    lv = &ps->lev[L];
+    cs = (size_t)lv->w * lv->h;
+    base = (size_t)ps->bslot[k] * 2 * cs + (ps->eclass[h->edge] == PHOTON_EDGE_INNER ? cs : 0);
+    chart_xy(ps, k, lv, h->p[0], h->p[1], h->p[2], &fx, &fy);
+    if (photon_splat(lv->flux + base * PHOTON_CH, lv->area + base, NULL, 0.0, lv->w, lv->h, 1,
+                     fx, fy, kernel_radius(&ps->cfg, lv->slot_frames[ps->bslot[k]]), f)) {
+        st->stored_chart += f[0];
+        add_rgb(st->stored_rgb, f);
+    } else
+        st->lost += f[0];
+}
+
+/* Where the progressive pass puts a photon arriving at h with weights f. */
+static void store_progressive(photon_sys *ps, uint32_t lamp, const trace_hit *h,
+                              const double f[PHOTON_CH])
+{
+    photon_stats *st = &ps->st;
+    double fx, fy, r = kernel_radius(&ps->cfg, ps->gframes);
     if (h->kind == TRACE_WALL) {
-        uint32_t k = s->bld[h->bld].block;
-        int L;
-        photon_level *lv;
-        size_t cs, base;
-        double fx, fy;
-        if (k >= s->nblocks || ps->eclass[h->edge] == PHOTON_EDGE_INTERNAL) {
-            st->lost += f;
-            return;
-        }
-        ps->bamb[k] += f;
-        L = ps->blevel[k];
-        if (L >= PHOTON_LEVELS) {
-            st->stored_ambient += f;
-            return;
-        }
-        lv = &ps->lev[L];
-        cs = (size_t)lv->w * lv->h;
-        base = (size_t)ps->bslot[k] * 2 * cs + (ps->eclass[h->edge] == PHOTON_EDGE_INNER ? cs : 0);
-        chart_xy(ps, k, lv, h->p[0], h->p[1], h->p[2], &fx, &fy);
-        if (photon_splat(lv->flux + base, lv->area + base, NULL, 0.0, lv->w, lv->h, 1, fx, fy,
-                         kernel_radius(&ps->cfg, lv->slot_frames[ps->bslot[k]]), f))
-            st->stored_chart += f;
-        else
-            st->lost += f;
+        store_wall(ps, h, f);
         return;
     }
-    if (h->kind == TRACE_GROUND || h->kind == TRACE_ROOF) {
-        double fx, fy;
-        if (ps->refined[lamp]) {
-            st->skipped_refined += f;
-            return;
-        }
-        photon_aerial_xy(ps, h->p[0], h->p[1], &fx, &fy);
-        if (photon_splat(ps->gflux, ps->garea, ps->gheight, h->p[2], ps->gw, ps->gh, 0, fx, fy,
-                         kernel_radius(&ps->cfg, ps->gframes), f))
-            st->stored_aerial += f;
-        else
-            st->lost += f;
+    if (h->kind != TRACE_GROUND && h->kind != TRACE_ROOF) {
+        st->lost += f[0];
         return;
     }
-    st->lost += f;
+    if (ps->refined[lamp]) {
+        st->skipped_refined += f[0];
+        return;
+    }
+    photon_aerial_xy(ps, h->p[0], h->p[1], &fx, &fy);
+    if (h->kind == TRACE_GROUND && photon_covered_at(ps, h->p[0], h->p[1])) {
+        if (photon_splat_sparse(ps->cov_flux, ps->cov_area, ps->gcov, ps->gw, ps->gh, fx, fy, r,
+                                f)) {
+            st->stored_covered += f[0];
+            add_rgb(st->stored_rgb, f);
+        } else
+            st->lost += f[0];
+        return;
+    }
+    if (photon_splat(ps->gflux, ps->garea, ps->gheight, h->p[2], ps->gw, ps->gh, 0, fx, fy, r,
+                     f)) {
+        st->stored_aerial += f[0];
+        add_rgb(st->stored_rgb, f);
+    } else
+        st->lost += f[0];
 }
 
 void photon_trace_lamp(photon_sys *ps, uint32_t lamp, double phi, uint64_t *rng,
                        photon_stats *st, photon_store_fn store, void *ctx)
 {
     const scene_lamp *Lp = &ps->s->lamps[lamp];
-    double o[3], d[3], z, r, ph, f;
+    double o[3], d[3], z, r, ph, f[PHOTON_CH], alb[3];
     trace_hit h;
     uint32_t b;
+    int c;
     o[0] = Lp->x;
     o[1] = Lp->y;
     o[2] = Lp->z;
@@ -1049,15 +1322,16 @@ void photon_trace_lamp(photon_sys *ps, uint32_t lamp, double phi, uint64_t *rng,
     st->traced++;
     if (trace_ray(ps->T, o, d, Lp->radius, &h) == TRACE_SKY)
         return;
-    f = phi * photon_window(h.t / Lp->radius);
-    if (!(f > 0.0))
+    f[0] = phi * photon_window(h.t / Lp->radius);
+    if (!(f[0] > 0.0))
         return;
-    st->first += f;
+    for (c = 0; c < 3; c++)
+        f[1 + c] = f[0] * (double)Lp->color[c];
+    st->first += f[0];
     for (b = 0; b < ps->cfg.max_bounces; b++) {
-        double alb = h.kind == TRACE_GROUND ? scene_ground_albedo_y(ps->s, h.p[0], h.p[1])
-                                             : ps->s->bld[h.bld].albedo;
-        if (photon_rand01(rng) >= alb) {
-            st->absorbed += f;
+        hit_albedo_rgb(ps->s, &h, alb);
+        if (!photon_bounce(f, alb, photon_rand01(rng))) {
+            st->absorbed += f[0];
             return;
         }
         photon_cosine_dir(rng, h.n, d);
@@ -1066,16 +1340,18 @@ void photon_trace_lamp(photon_sys *ps, uint32_t lamp, double phi, uint64_t *rng,
         o[2] = h.p[2] + BOUNCE_OFFSET * h.n[2];
         st->traced++;
         if (trace_ray(ps->T, o, d, INFINITY, &h) == TRACE_SKY) {
-            st->escaped += f;
+            st->escaped += f[0];
             return;
         }
-        st->arrived += f;
+        st->arrived += f[0];
+        add_rgb(st->arrived_rgb, f);
         store(ps, ctx, lamp, &h, f);
     }
-    st->cut += f;
+    st->cut += f[0];
 }
 
-static void store_step(photon_sys *ps, void *ctx, uint32_t lamp, const trace_hit *h, double f)
+static void store_step(photon_sys *ps, void *ctx, uint32_t lamp, const trace_hit *h,
+                       const double f[PHOTON_CH])
 {
     (void)ctx;
     store_progressive(ps, lamp, h, f);
@@ -1129,51 +1405,81 @@ void photon_step(photon_sys *ps, uint32_t n, uint64_t seed)
 
 /* ---- lookup ------------------------------------------------------------------------ */
 
-static double facade_lookup(const photon_sys *ps, const trace_hit *h)
+/* A block's ambient term (level 4, undersides): mean facade irradiance. */
+static void ambient(const photon_sys *ps, uint32_t k, double e[PHOTON_CH])
+{
+    int c;
+    for (c = 0; c < PHOTON_CH; c++)
+        e[c] = 0.0;
+    if (ps->amb_frames == 0 || !(ps->bfacade[k] > 0.0))
+        return;
+    for (c = 0; c < PHOTON_CH; c++)
+        e[c] = ps->bamb[(size_t)k * PHOTON_CH + (size_t)c] / (ps->bfacade[k] * ps->amb_frames);
+}
+
+static void facade_lookup(const photon_sys *ps, const trace_hit *h, double e[PHOTON_CH])
 {
     const scene *s = ps->s;
     uint32_t k = s->bld[h->bld].block;
-    int L;
+    int L, c;
     const photon_level *lv;
     size_t cs, base;
     uint32_t slot, fr;
     double fx, fy;
+    for (c = 0; c < PHOTON_CH; c++)
+        e[c] = 0.0;
     if (k >= s->nblocks)
-        return 0.0;
+        return;
     L = ps->blevel[k];
     if (L >= PHOTON_LEVELS) {
-        if (ps->amb_frames == 0 || !(ps->bfacade[k] > 0.0))
-            return 0.0;
-        return ps->bamb[k] / (ps->bfacade[k] * ps->amb_frames);
+        ambient(ps, k, e);
+        return;
     }
     lv = &ps->lev[L];
     slot = ps->bslot[k];
     fr = lv->slot_frames[slot];
     if (fr == 0)
-        return 0.0;
+        return;
     cs = (size_t)lv->w * lv->h;
     base = (size_t)slot * 2 * cs + (ps->eclass[h->edge] == PHOTON_EDGE_INNER ? cs : 0);
     chart_xy(ps, k, lv, h->p[0], h->p[1], h->p[2], &fx, &fy);
-    return photon_gather(lv->flux + base, lv->area + base, NULL, 0.0, lv->w, lv->h, 1, fx, fy) /
-           fr;
+    photon_gather(lv->flux + base * PHOTON_CH, lv->area + base, NULL, 0.0, lv->w, lv->h, 1, fx,
+                  fy, e);
+    for (c = 0; c < PHOTON_CH; c++)
+        e[c] /= fr;
 }
 
-double photon_indirect(photon_sys *ps, const double P[3], const double n[3])
+/* The ground or a roof: A / M + the floor-map share; covered ground reads
+ * A_cov / M + I_cov. */
+static void horizontal_lookup(const photon_sys *ps, const double P[3], double e[PHOTON_CH])
+{
+    double fx, fy, night[PHOTON_CH];
+    int c, covered = P[2] <= HEIGHT_TOL && photon_covered_at(ps, P[0], P[1]);
+    for (c = 0; c < PHOTON_CH; c++)
+        e[c] = 0.0;
+    photon_aerial_xy(ps, P[0], P[1], &fx, &fy);
+    if (ps->gframes > 0) {
+        if (covered)
+            photon_gather_sparse(ps->cov_flux, ps->cov_area, ps->gcov, ps->gw, ps->gh, fx, fy, e);
+        else
+            photon_gather(ps->gflux, ps->garea, ps->gheight, P[2], ps->gw, ps->gh, 0, fx, fy, e);
+        for (c = 0; c < PHOTON_CH; c++)
+            e[c] /= ps->gframes;
+    }
+    photon_night_horizontal(ps, P[0], P[1], P[2], covered, night);
+    for (c = 0; c < PHOTON_CH; c++)
+        e[c] += night[c];
+}
+
+/* A wall or an underside, found with a short probe ray. */
+static void vertical_lookup(const photon_sys *ps, const double P[3], const double n[3],
+                            double e[PHOTON_CH])
 {
     trace_hit h;
-    double o[3], d[3];
-    if (!ps || !P || !n)
-        return 0.0;
-    if (n[2] > 0.5) {
-        double fx, fy, e = 0.0;
-        photon_aerial_xy(ps, P[0], P[1], &fx, &fy);
-        if (ps->gframes > 0)
-            e = photon_gather(ps->gflux, ps->garea, ps->gheight, P[2], ps->gw, ps->gh, 0, fx,
-                              fy) /
-                ps->gframes;
-        return e + photon_night_horizontal(ps, P[0], P[1], P[2]);
-    }
-    /* a wall or an underside: find it with a short probe ray */
+    double o[3], d[3], l;
+    int c;
+    for (c = 0; c < PHOTON_CH; c++)
+        e[c] = 0.0;
     o[0] = P[0] + 0.005 * n[0];
     o[1] = P[1] + 0.005 * n[1];
     o[2] = P[2] + 0.005 * n[2];
@@ -1182,21 +1488,37 @@ double photon_indirect(photon_sys *ps, const double P[3], const double n[3])
     d[0] = -n[0];
     d[1] = -n[1];
     d[2] = -n[2];
-    {
-        double l = sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
-        if (!(l > 0.0))
-            return 0.0;
-        d[0] /= l;
-        d[1] /= l;
-        d[2] /= l;
-    }
+    l = sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+    if (!(l > 0.0))
+        return;
+    d[0] /= l;
+    d[1] /= l;
+    d[2] /= l;
     trace_ray(ps->T, o, d, 0.02, &h);
     if (h.kind == TRACE_WALL)
-        return facade_lookup(ps, &h);
-    if (h.kind == TRACE_UNDER) {
-        uint32_t k = ps->s->bld[h.bld].block;
-        if (k < ps->s->nblocks && ps->amb_frames > 0 && ps->bfacade[k] > 0.0)
-            return ps->bamb[k] / (ps->bfacade[k] * ps->amb_frames);
+        facade_lookup(ps, &h, e);
+    else if (h.kind == TRACE_UNDER && ps->s->bld[h.bld].block < ps->s->nblocks)
+        ambient(ps, ps->s->bld[h.bld].block, e);
+}
+
+double photon_indirect_rgb(photon_sys *ps, const double P[3], const double n[3], double rgb[3])
+{
+    double e[PHOTON_CH] = {0.0, 0.0, 0.0, 0.0};
+    if (ps && P && n) {
+        if (n[2] > 0.5)
+            horizontal_lookup(ps, P, e);
+        else
+            vertical_lookup(ps, P, n, e);
     }
-    return 0.0;
+    if (rgb) {
+        rgb[0] = e[1];
+        rgb[1] = e[2];
+        rgb[2] = e[3];
+    }
+    return e[0];
+}
+
+double photon_indirect(photon_sys *ps, const double P[3], const double n[3])
+{
+    return photon_indirect_rgb(ps, P, n, NULL);
 }

@@ -17,13 +17,22 @@
  * first hit is at d1 >= R carry nothing and are not traced further (the
  * first-hit ray is cast only to R).
  *
+ * COLOUR. A photon carries PHOTON_CH = 4 weights: a colour-blind scalar
+ * flux (channel 0; what illuminance in lux reports, SPEC §2: colour is
+ * ignored) and an RGB flux (channels 1-3; what images use, each lamp's
+ * light weighted by its colour). A photon of lamp i starts with
+ * phi W (1, c_i). Charts, floor maps and ambient terms store all four, so
+ * a lookup gives E_indirect and its RGB version in one pass.
+ *
  * BOUNCES. Lambertian: cosine-weighted directions about the normal, Russian
- * roulette with survival probability = albedo (building albedo on walls,
- * roofs and undersides; on the ground the luminance of the ground's albedo
- * at the hit, scene_ground_albedo_y: a ground image's pixel or the scene's
- * ground_albedo, src/ground.c), so a surviving
- * photon keeps its flux and every stored photon carries its emission flux
- * times W. At most cfg.max_bounces surfaces after the first.
+ * roulette with one scalar survival probability p = the albedo's luminance
+ * (building albedo on walls, roofs and undersides, grey; on the ground the
+ * albedo at the hit, scene_ground_albedo: a ground image's pixel or the
+ * scene's ground_albedo, src/ground.c), and the survivor's weights become
+ * f_0 a_Y / p = f_0 and f_c a_c / p (photon_bounce): unbiased per channel,
+ * and for grey albedos every weight is unchanged, so a stored photon
+ * carries its emission flux times W. At most cfg.max_bounces surfaces
+ * after the first.
  *
  * CHARTS (where photons are stored; argudo2012 §3.2).
  *  - Facades. Per block two cylindrical charts, outer walls and courtyard
@@ -45,10 +54,23 @@
  *    the texel centre: a roof height or 0) and each texel's area = texel
  *    area times the fraction of k x k probes whose top surface is that same
  *    surface. Splats only reach texels of the photon's height (within 1 mm),
- *    so roof and floor photons do not mix. Horizontal surfaces that are not
- *    topmost (ground under raised buildings, undersides) have no chart:
- *    photons there are counted as lost and the lookup answers with the
- *    block's ambient term (undersides) or 0 (covered ground).
+ *    so roof and floor photons do not mix.
+ *  - Covered ground (ground under raised buildings: canopies, bridges,
+ *    min_height > 0). A second, sparse aerial layer on the same texel grid:
+ *    gcov maps an aerial texel to its slot in compact arrays (cov_*), and
+ *    only texels with covered ground get one; a slot's area is the texel
+ *    area times the fraction of k x k probes that are open ground under a
+ *    raised building (disjoint from the aerial chart's area there). Ground
+ *    photons in such a texel whose point is covered (trace_top > 0) are
+ *    splatted into this layer (same kernel, validity = a slot with area),
+ *    and a lookup at z = 0 under a canopy reads it. Capacity is bounded
+ *    from the scene alone (the aerial texels under the boxes of raised
+ *    buildings), so photon_bytes needs no tracer; scenes without raised
+ *    buildings allocate nothing for it.
+ *    Other horizontal surfaces that are not topmost (roofs under a raised
+ *    building, undersides) have no chart: photons there are counted as
+ *    lost and the lookup answers with the block's ambient term (undersides)
+ *    or the nearest texel of the right height (roofs).
  *
  * LEVELS (argudo2012 §3.6). Blocks get levels 0-4 from their distance d to
  * the viewer (nearest point of the block's box, 0..tallest height) and the
@@ -95,10 +117,16 @@
  *    Evicting a lamp needs no update (I already holds it); recomputing it
  *    gives the same photons, so D_i cancels its share of I again.
  *  Facade charts always take every lamp's photons from the progressive pass.
+ *  Covered ground has no floor maps: A_cov (progressive) holds the unrefined
+ *  lamps and I_cov every refined lamp's covered-ground photons, pushed with
+ *  I; E = A_cov / M + I_cov (C_i and D_i leave covered photons out).
  *
  * MEMORY. photon_create takes every buffer from the arena (part
  * PLX_PART_PHOTON): the tracer, per-edge and per-block tables, the four
- * level atlases, the aerial charts, the lamp cache. photon_set_viewer and
+ * level atlases, the aerial charts, the covered-ground layer, the lamp
+ * cache. A texel keeps its flux as PHOTON_CH floats (16 bytes: scalar and
+ * RGB) beside its area (and height) floats; cfg.lamp_cache_bytes is a byte
+ * budget, so colour halves the slots it holds. photon_set_viewer and
  * photon_lamps_update use scratch memory (released before return); steps and
  * lookups allocate nothing. One photon_sys must not be used from two threads
  * at once. No global state: randomness comes from the seeds given.
@@ -117,6 +145,7 @@
 #define PHOTON_NONE 0xffffffffu
 #define PHOTON_KERNEL_MAXI 6   /* largest splat radius, texels */
 #define PHOTON_KERNEL_MAX ((double)PHOTON_KERNEL_MAXI)
+#define PHOTON_CH 4            /* flux channels per texel: scalar, R, G, B */
 
 typedef struct photon_config {
     uint32_t chart_w, chart_h;      /* level 0 facade chart, texels (u around, v up); 256 x 32 */
@@ -148,11 +177,15 @@ typedef struct photon_stats {
     double stored_chart;            /* lm splatted into facade charts (levels 0-3) */
     double stored_ambient;          /* lm counted in level-4 blocks' ambient terms */
     double stored_aerial;           /* lm splatted into the aerial chart A */
+    double stored_covered;          /* lm splatted into the covered-ground layer A_cov */
     double skipped_refined;         /* lm of refined lamps' horizontal photons (kept in I) */
     double lost;                    /* lm arriving where there is no chart */
     double escaped;                 /* lm leaving to the sky after a bounce */
     double absorbed;                /* lm ended by Russian roulette */
     double cut;                     /* lm ended by max_bounces */
+    double arrived_rgb[3];          /* RGB flux arriving at 2nd and later hits */
+    double stored_rgb[3];           /* RGB flux stored by the progressive pass: facade
+                                       charts, ambient terms, A and A_cov */
     uint64_t lamp_hits, lamp_misses, lamp_evictions, lamp_refined;
     uint64_t aerial_restarts;
 } photon_stats;
@@ -160,8 +193,8 @@ typedef struct photon_stats {
 typedef struct photon_level {
     uint32_t w, h;                  /* chart texels */
     uint32_t nslots;
-    float *flux;                    /* nslots * 2 charts * w * h: accumulated lm */
-    float *area;                    /* same layout: world area of each texel, m^2 */
+    float *flux;                    /* nslots * 2 charts * w * h * PHOTON_CH: accumulated lm */
+    float *area;                    /* nslots * 2 charts * w * h: world area of each texel, m^2 */
     uint32_t *slot_block;           /* block in each slot or PHOTON_NONE */
     uint32_t *slot_frames;          /* frames the slot has received */
     uint32_t *free_slots;           /* stack of free slot indices */
@@ -173,8 +206,9 @@ typedef struct photon_lamp_slot {
     uint32_t prev, next;            /* LRU list, most recent first */
     double x0, y0, texel;           /* floor map origin (min corner) and texel size */
     int32_t dx0, dy0;               /* D window origin in aerial texels */
-    float *flux, *area, *height;    /* lamp_res^2 each */
-    float *dwin;                    /* D_i: dwin_n^2 aerial texels */
+    float *flux;                    /* lamp_res^2 * PHOTON_CH */
+    float *area, *height;           /* lamp_res^2 each */
+    float *dwin;                    /* D_i: dwin_n^2 aerial texels * PHOTON_CH */
 } photon_lamp_slot;
 
 typedef struct photon_sys {
@@ -190,7 +224,8 @@ typedef struct photon_sys {
     uint32_t *bslot;                /* slot in its level or PHOTON_NONE */
     double *bcx, *bcy, *bhmax;      /* chart centre and height */
     double *bfacade;                /* exposed facade area, m^2 */
-    double *bamb;                   /* facade flux accumulated, lm (ambient term) */
+    double *bamb;                   /* facade flux accumulated, lm, PHOTON_CH per block
+                                       (ambient term) */
     double mean_diam;               /* b */
     uint32_t amb_frames;
     photon_level lev[PHOTON_LEVELS];
@@ -199,9 +234,16 @@ typedef struct photon_sys {
     uint32_t gw, gh;
     double gx0, gy0, gtex;
     float *gheight, *garea;
-    float *gflux;                   /* A: progressive, unrefined lamps */
-    float *gimp;                    /* I: refined lamps, one computation each */
+    float *gflux;                   /* A: progressive, unrefined lamps; PHOTON_CH per texel */
+    float *gimp;                    /* I: refined lamps, one computation each; same */
     uint32_t gframes;
+    /* covered ground (under raised buildings): sparse layer on the aerial grid */
+    uint32_t *gcov;                 /* per aerial texel: slot or PHOTON_NONE; NULL when
+                                       the scene has no raised building */
+    uint32_t ncov, cov_cap;         /* slots used, slots allocated */
+    float *cov_area;                /* per slot: covered ground area, m^2 */
+    float *cov_flux;                /* A_cov: PHOTON_CH per slot */
+    float *cov_imp;                 /* I_cov: PHOTON_CH per slot */
     /* lamps */
     double *lamp_cdf;               /* cumulative flux, nlamps */
     double flux_total;
@@ -251,6 +293,12 @@ void photon_step(photon_sys *ps, uint32_t n, uint64_t seed);
  */
 double photon_indirect(photon_sys *ps, const double P[3], const double n[3]);
 
+/* The same, also writing the RGB version of E_indirect to rgb (may be NULL):
+ * each lamp's light weighted by its colour (equals the scalar for white
+ * lamps and grey albedos). Returns the scalar. */
+double photon_indirect_rgb(photon_sys *ps, const double P[3], const double n[3],
+                           double rgb[3] /* OUT */);
+
 /*
  * Levels for a viewer at eye looking along dir (unit; NULL = all around)
  * with a full cone angle fov_deg. Blocks whose level changes get a new
@@ -290,9 +338,11 @@ int photon_lamp_cached(const photon_sys *ps, uint32_t lamp);
  * lamp indices, returns how many are cached. */
 uint32_t photon_lamp_lru(const photon_sys *ps, uint32_t *lamps /* OUT */, uint32_t cap);
 
-/* The floor-map share of E_indirect at (x, y, z) on the ground or a roof:
- * I - sum D_i + sum C_i (lux), 0 when nothing is refined. */
-double photon_night_horizontal(const photon_sys *ps, double x, double y, double z);
+/* The floor-map share of E_indirect at (x, y, z) on the ground or a roof,
+ * PHOTON_CH channels: I - sum D_i + sum C_i (lux), 0 when nothing is
+ * refined. On covered ground (covered != 0) it is I_cov. */
+void photon_night_horizontal(const photon_sys *ps, double x, double y, double z, int covered,
+                             double e[PHOTON_CH] /* OUT */);
 
 /* ---- histogram matching (photon_hist.c; munoz2013 §3.1) --------------- */
 
@@ -314,35 +364,55 @@ int photon_hist_match(const uint8_t *src, size_t npx, const uint8_t *ref, size_t
 
 /* The reach window W(x) = (clamp(1 - x^4, 0, 1))^2. */
 double photon_window(double x);
-/* Splats flux at continuous texel coordinates (fx, fy) of a w x h grid:
- * cone of radius r (texels), texels valid when area > 0 and, with height
- * given, |height - z| <= 1 mm; wrap: u periodic. Returns 1 when deposited,
- * 0 when no valid texel was near (nothing deposited). */
+/* Splats the PHOTON_CH weights phi at continuous texel coordinates
+ * (fx, fy) of a w x h grid: cone of radius r (texels), texels valid when
+ * area > 0 and, with height given, |height - z| <= 1 mm; wrap: u periodic.
+ * flux holds PHOTON_CH floats per texel. Returns 1 when deposited, 0 when
+ * no valid texel was near (nothing deposited). */
 int photon_splat(float *flux, const float *area, const float *height, double z,
                  uint32_t w, uint32_t h, int wrap, double fx, double fy, double r,
-                 double phi);
-/* Ratio lookup over the 2 x 2 texels around (fx, fy): sum w F / sum w A
- * (0 when no valid texel). */
+                 const double phi[PHOTON_CH]);
+/* Ratio lookup over the 2 x 2 texels around (fx, fy): e = sum w F / sum w A
+ * per channel (0 when no valid texel). Returns e[0]. */
 double photon_gather(const float *flux, const float *area, const float *height, double z,
-                     uint32_t w, uint32_t h, int wrap, double fx, double fy);
+                     uint32_t w, uint32_t h, int wrap, double fx, double fy,
+                     double e[PHOTON_CH] /* OUT */);
+/* The same on a sparse grid: grid texel k is stored in slot idx[k]
+ * (PHOTON_NONE: not charted); flux and area are per slot; no height, no
+ * wrap. */
+int photon_splat_sparse(float *flux, const float *area, const uint32_t *idx, uint32_t w,
+                        uint32_t h, double fx, double fy, double r, const double phi[PHOTON_CH]);
+double photon_gather_sparse(const float *flux, const float *area, const uint32_t *idx,
+                            uint32_t w, uint32_t h, double fx, double fy,
+                            double e[PHOTON_CH] /* OUT */);
 /* The same into a window of the grid: out holds ow x oh texels whose first
  * is texel (ox, oy) of the w x h grid (no wrap); validity comes from the
  * full grid's area and height. Parts falling outside the window are
  * dropped. */
 int photon_splat_win(float *out, uint32_t ow, uint32_t oh, int32_t ox, int32_t oy,
                      const float *area, const float *height, double z, uint32_t w, uint32_t h,
-                     double fx, double fy, double r, double phi);
+                     double fx, double fy, double r, const double phi[PHOTON_CH]);
 /* photon_gather with the flux taken from such a window (0 outside it). */
 double photon_gather_win(const float *out, uint32_t ow, uint32_t oh, int32_t ox, int32_t oy,
                          const float *area, const float *height, double z, uint32_t w,
-                         uint32_t h, double fx, double fy);
-/* Receives a photon arriving at h (second or later hit) with flux f. */
+                         uint32_t h, double fx, double fy, double e[PHOTON_CH] /* OUT */);
+/* Receives a photon arriving at h (second or later hit) with weights f. */
 typedef void (*photon_store_fn)(photon_sys *ps, void *ctx, uint32_t lamp, const trace_hit *h,
-                                double f);
+                                const double f[PHOTON_CH]);
 /* Traces one photon of flux phi (before W) from lamp: first hit, W, then
  * bounces, calling store at every later hit; counts into st. */
 void photon_trace_lamp(photon_sys *ps, uint32_t lamp, double phi, uint64_t *rng,
                        photon_stats *st, photon_store_fn store, void *ctx);
+/* The colour-blind albedo of an RGB albedo: its luminance (Rec. 709
+ * weights), exactly the common value when the three are equal. */
+double photon_albedo_scalar(const double rgb[3]);
+/* One diffuse bounce's Russian roulette with uniform u in [0, 1): returns 0
+ * (absorbed) when u >= p = photon_albedo_scalar(alb), else scales the RGB
+ * weights f[1..3] by alb_c / p (f[0] is kept) and returns 1. */
+int photon_bounce(double f[PHOTON_CH], const double alb[3], double u);
+/* Whether (x, y) is ground under a raised building that the covered-ground
+ * layer charts (its aerial texel has a slot and the point is covered). */
+int photon_covered_at(const photon_sys *ps, double x, double y);
 /* Random numbers (splitmix64 state). */
 uint64_t photon_rand(uint64_t *st);
 double photon_rand01(uint64_t *st);

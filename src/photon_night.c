@@ -15,7 +15,8 @@ typedef struct lamp_ctx {
     photon_stats st;
 } lamp_ctx;
 
-static void store_lamp(photon_sys *ps, void *vctx, uint32_t lamp, const trace_hit *h, double f)
+static void store_lamp(photon_sys *ps, void *vctx, uint32_t lamp, const trace_hit *h,
+                       const double f[PHOTON_CH])
 {
     lamp_ctx *c = vctx;
     photon_lamp_slot *sl = c->sl;
@@ -25,6 +26,13 @@ static void store_lamp(photon_sys *ps, void *vctx, uint32_t lamp, const trace_hi
     if (h->kind != TRACE_GROUND && h->kind != TRACE_ROOF)
         return;
     photon_aerial_xy(ps, h->p[0], h->p[1], &gx, &gy);
+    if (h->kind == TRACE_GROUND && photon_covered_at(ps, h->p[0], h->p[1])) {
+        /* covered ground: only I_cov (no floor map, so neither C nor D) */
+        if (c->push)
+            photon_splat_sparse(ps->cov_imp, ps->cov_area, ps->gcov, ps->gw, ps->gh, gx, gy,
+                                ps->cfg.kernel_min, f);
+        return;
+    }
     fx = (h->p[0] - sl->x0) / sl->texel;
     fy = (h->p[1] - sl->y0) / sl->texel;
     if (fx >= 0.0 && fy >= 0.0 && fx < (double)F && fy < (double)F &&
@@ -55,8 +63,8 @@ static void lamp_compute(photon_sys *ps, uint32_t i, photon_lamp_slot *sl)
     sl->y0 = L->y - R;
     sl->dx0 = (int32_t)floor((sl->x0 - ps->gx0) / ps->gtex) - (int32_t)margin;
     sl->dy0 = (int32_t)floor((sl->y0 - ps->gy0) / ps->gtex) - (int32_t)margin;
-    memset(sl->flux, 0, f2 * sizeof(float));
-    memset(sl->dwin, 0, (size_t)ps->dwin_n * ps->dwin_n * sizeof(float));
+    memset(sl->flux, 0, f2 * PHOTON_CH * sizeof(float));
+    memset(sl->dwin, 0, (size_t)ps->dwin_n * ps->dwin_n * PHOTON_CH * sizeof(float));
     for (y = 0; y < F; y++)
         for (x = 0; x < F; x++) {
             double cx = sl->x0 + (x + 0.5) * t, cy = sl->y0 + (y + 0.5) * t;
@@ -91,7 +99,9 @@ static void lamp_compute(photon_sys *ps, uint32_t i, photon_lamp_slot *sl)
         ps->refined[i] = 1;
         ps->st.lamp_refined++;
         /* A restarts without lamp i (its older photons leave A) */
-        memset(ps->gflux, 0, (size_t)ps->gw * ps->gh * sizeof(float));
+        memset(ps->gflux, 0, (size_t)ps->gw * ps->gh * PHOTON_CH * sizeof(float));
+        if (ps->cov_cap > 0)
+            memset(ps->cov_flux, 0, (size_t)ps->cov_cap * PHOTON_CH * sizeof(float));
         ps->gframes = 0;
         ps->st.aerial_restarts++;
     }
@@ -223,14 +233,22 @@ int photon_lamps_update(photon_sys *ps, const double eye[3])
     return misses;
 }
 
-double photon_night_horizontal(const photon_sys *ps, double x, double y, double z)
+void photon_night_horizontal(const photon_sys *ps, double x, double y, double z, int covered,
+                             double e[PHOTON_CH])
 {
-    double gx, gy, e;
+    double gx, gy, t[PHOTON_CH];
     uint32_t s, F;
+    int c;
+    for (c = 0; c < PHOTON_CH; c++)
+        e[c] = 0.0;
     if (!ps || ps->st.lamp_refined == 0)
-        return 0.0;
+        return;
     photon_aerial_xy(ps, x, y, &gx, &gy);
-    e = photon_gather(ps->gimp, ps->garea, ps->gheight, z, ps->gw, ps->gh, 0, gx, gy);
+    if (covered) {
+        photon_gather_sparse(ps->cov_imp, ps->cov_area, ps->gcov, ps->gw, ps->gh, gx, gy, e);
+        return;
+    }
+    photon_gather(ps->gimp, ps->garea, ps->gheight, z, ps->gw, ps->gh, 0, gx, gy, e);
     F = ps->cfg.lamp_res;
     for (s = ps->lru_head; s != PHOTON_NONE; s = ps->slots[s].next) {
         const photon_lamp_slot *sl = &ps->slots[s];
@@ -241,9 +259,12 @@ double photon_night_horizontal(const photon_sys *ps, double x, double y, double 
         fy = (y - sl->y0) / sl->texel;
         if (!(fx >= 0.0 && fy >= 0.0 && fx < (double)F && fy < (double)F))
             continue;
-        e += photon_gather(sl->flux, sl->area, sl->height, z, F, F, 0, fx, fy);
-        e -= photon_gather_win(sl->dwin, ps->dwin_n, ps->dwin_n, sl->dx0, sl->dy0, ps->garea,
-                               ps->gheight, z, ps->gw, ps->gh, gx, gy);
+        photon_gather(sl->flux, sl->area, sl->height, z, F, F, 0, fx, fy, t);
+        for (c = 0; c < PHOTON_CH; c++)
+            e[c] += t[c];
+        photon_gather_win(sl->dwin, ps->dwin_n, ps->dwin_n, sl->dx0, sl->dy0, ps->garea,
+                          ps->gheight, z, ps->gw, ps->gh, gx, gy, t);
+        for (c = 0; c < PHOTON_CH; c++)
+            e[c] -= t[c];
     }
-    return e;
 }

@@ -17,15 +17,11 @@ void plx_render_opts_default(plx_render_opts *o)
     o->exposure = 1.0;
 }
 
-/* The photon hook of the renderer: scalar E_indirect tinted with the mean
- * lamp colour. */
+/* The photon hook of the renderer: the RGB indirect term (each lamp's light
+ * weighted by its colour, carried by the photons; SPEC §5). */
 static void shade_indirect(void *user, const double P[3], const double n[3], double rgb[3])
 {
-    plx_engine *e = user;
-    double E = eng_indirect(e, P, n);
-    rgb[0] = E * e->tint[0];
-    rgb[1] = E * e->tint[1];
-    rgb[2] = E * e->tint[2];
+    eng_indirect_rgb(user, P, n, rgb);
 }
 
 static plx_status need_render(plx_engine *e)

@@ -113,17 +113,23 @@ int main(int argc, char **argv)
     /* ---- memory ---- */
     plx_memory_get(e, &mr);
     {
-        size_t lv = 0, g = (size_t)ps->gw * ps->gh * 4 * sizeof(float);
+        /* aerial: height, area, A and I (PHOTON_CH each); covered ground:
+         * its texel index and its slots (area, A_cov, I_cov) */
+        size_t g = (size_t)ps->gw * ps->gh * (2 + 2 * PHOTON_CH) * sizeof(float), lv = 0;
+        size_t cov = ps->gcov ? (size_t)ps->gw * ps->gh * sizeof(uint32_t) +
+                                    (size_t)ps->cov_cap * (1 + 2 * PHOTON_CH) * sizeof(float)
+                              : 0;
         size_t cache = ps->nslots * photon_lamp_slot_bytes(s, &ps->cfg);
         int L;
         for (L = 0; L < PHOTON_LEVELS; L++)
-            lv += (size_t)ps->lev[L].nslots * 2 * ps->lev[L].w * ps->lev[L].h * 2 * sizeof(float);
+            lv += (size_t)ps->lev[L].nslots * 2 * ps->lev[L].w * ps->lev[L].h *
+                  (1 + PHOTON_CH) * sizeof(float);
         printf("memory (part photon): %.1f MiB total; facade atlases %.1f MiB (4 levels), "
-               "aerial charts %.1f MiB, lamp cache %.1f MiB (%u slots), tracer and tables "
-               "%.1f MiB; scene itself %.1f MiB\n",
+               "aerial charts %.1f MiB, covered ground %.2f MiB (%u of %u slots), lamp cache "
+               "%.1f MiB (%u slots), tracer and tables %.1f MiB; scene itself %.1f MiB\n",
                mr.used[PLX_PART_PHOTON] / 1048576.0, lv / 1048576.0, g / 1048576.0,
-               cache / 1048576.0, ps->nslots,
-               (mr.used[PLX_PART_PHOTON] - lv - g - cache) / 1048576.0,
+               cov / 1048576.0, ps->ncov, ps->cov_cap, cache / 1048576.0, ps->nslots,
+               (mr.used[PLX_PART_PHOTON] - lv - g - cov - cache) / 1048576.0,
                mr.used[PLX_PART_SCENE] / 1048576.0);
     }
 
@@ -151,13 +157,16 @@ int main(int argc, char **argv)
                (double)(ps->st.traced - traced0) / (65536.0 * frames),
                ms[frames / 2] <= 10.0 ? "met" : "NOT met");
         printf("  per photon %.0f ns; stored %.0f%% of the flux reaching later hits "
-               "(chart %.0f%%, aerial %.0f%%, ambient %.0f%%, lost %.1f%%)\n",
+               "(chart %.0f%%, aerial %.0f%%, ambient %.0f%%, covered ground %.1f%%, "
+               "lost %.1f%%)\n",
                ms[frames / 2] * 1e6 / 65536.0,
-               100.0 * (ps->st.stored_chart + ps->st.stored_aerial + ps->st.stored_ambient) /
+               100.0 * (ps->st.stored_chart + ps->st.stored_aerial + ps->st.stored_ambient +
+                        ps->st.stored_covered) /
                    ps->st.arrived,
                100.0 * ps->st.stored_chart / ps->st.arrived,
                100.0 * ps->st.stored_aerial / ps->st.arrived,
                100.0 * ps->st.stored_ambient / ps->st.arrived,
+               100.0 * ps->st.stored_covered / ps->st.arrived,
                100.0 * ps->st.lost / ps->st.arrived);
     }
 

@@ -697,13 +697,14 @@ typedef struct tally {
     uint64_t n;
 } tally;
 
-static void count_store(photon_sys *ps, void *ctx, uint32_t lamp, const trace_hit *h, double fl)
+static void count_store(photon_sys *ps, void *ctx, uint32_t lamp, const trace_hit *h,
+                        const double f[PHOTON_CH])
 {
     tally *t = ctx;
     (void)ps;
     (void)lamp;
     (void)h;
-    t->stored += fl;
+    t->stored += f[0]; /* the colour-blind channel */
     t->n++;
 }
 

@@ -1,5 +1,6 @@
 /* The public indirect-light API: nothing before the first frame, a positive
- * and deterministic E_indirect after, reset, the render hook, nightify, and
+ * and deterministic E_indirect after, reset, its RGB version, the render
+ * hook, nightify, and
  * memory exhaustion while creating the photon buffers. */
 #include <stdarg.h>
 #include <stddef.h>
@@ -64,6 +65,41 @@ static void test_frames_and_values(void **state)
     plx_engine_destroy(b);
     free(m1);
     free(m2);
+}
+
+/* plx_indirect_rgb: the same scalar as plx_illuminance, and colour per
+ * channel: tiny's lamps are white (L2) or (1, 0.62, 0.28), so red equals
+ * the scalar bit for bit and green and blue lie between the two colours. */
+static void test_indirect_rgb(void **state)
+{
+    void *mem;
+    plx_engine *e = open_tiny(&mem);
+    double P[9] = { 50, 10, 0, 45, 10, 3, 50, 10, -5 }, N[9] = { 0, 0, 1, 1, 0, 0, 0, 0, 1 };
+    double Ed[2], Ei[2], Ej[3], rgb[9];
+    int k;
+    (void)state;
+    assert_int_equal(plx_indirect_rgb(e, 2, P, N, Ej, rgb), PLX_OK);
+    for (k = 0; k < 6; k++)
+        assert_true(rgb[k] == 0.0);
+    assert_int_equal(plx_indirect_step(e, 20000, 1), PLX_OK);
+    assert_int_equal(plx_indirect_step(e, 20000, 2), PLX_OK);
+    assert_int_equal(plx_illuminance(e, 2, P, N, Ed, Ei, NULL), PLX_OK);
+    assert_int_equal(plx_indirect_rgb(e, 2, P, N, Ej, rgb), PLX_OK);
+    for (k = 0; k < 2; k++) {
+        double *c = rgb + 3 * k;
+        assert_true(Ej[k] == Ei[k] && Ei[k] > 0.0);
+        assert_true(c[0] == Ei[k]);
+        assert_true(c[1] >= 0.62 * Ei[k] * (1 - 1e-6) && c[1] <= Ei[k] * (1 + 1e-6));
+        assert_true(c[2] >= 0.28 * Ei[k] * (1 - 1e-6) && c[2] <= c[1]);
+    }
+    /* E_indirect may be NULL; rgb may not */
+    assert_int_equal(plx_indirect_rgb(e, 1, P, N, NULL, rgb), PLX_OK);
+    assert_int_equal(plx_indirect_rgb(e, 1, P, N, Ej, NULL), PLX_E_INVALID);
+    /* a point under the ground: NaN and PLX_E_RANGE, the others filled */
+    assert_int_equal(plx_indirect_rgb(e, 3, P, N, Ej, rgb), PLX_E_RANGE);
+    assert_true(isnan(Ej[2]) && isnan(rgb[6]) && isnan(rgb[8]) && rgb[0] == Ei[0]);
+    plx_engine_destroy(e);
+    free(mem);
 }
 
 static void test_render_hook(void **state)
@@ -134,6 +170,7 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_frames_and_values),
+        cmocka_unit_test(test_indirect_rgb),
         cmocka_unit_test(test_render_hook),
         cmocka_unit_test(test_nightify),
         cmocka_unit_test(test_nomem),

@@ -293,24 +293,44 @@ static void closed_box(fixture *f, double a)
     fx_finish(f);
 }
 
-static double sum_floats(const float *v, size_t n)
+/* Channel c of n texels of PHOTON_CH floats. */
+static double sum_channel(const float *v, size_t n, int c)
 {
     double s = 0.0;
     size_t i;
     for (i = 0; i < n; i++)
-        s += v[i];
+        s += v[i * PHOTON_CH + (size_t)c];
     return s;
 }
 
-static double chart_total(const photon_sys *ps)
+static double chart_total(const photon_sys *ps, int c)
 {
     double t = 0.0;
     int L;
     for (L = 0; L < PHOTON_LEVELS; L++) {
         const photon_level *lv = &ps->lev[L];
-        t += sum_floats(lv->flux, (size_t)lv->nslots * 2 * lv->w * lv->h);
+        t += sum_channel(lv->flux, (size_t)lv->nslots * 2 * lv->w * lv->h, c);
     }
     return t;
+}
+
+/* Flux of channel c in the level-4 ambient terms. */
+static double ambient_total(const photon_sys *ps, int c)
+{
+    double t = 0.0;
+    uint32_t k;
+    for (k = 0; k < ps->s->nblocks; k++)
+        if (ps->blevel[k] >= PHOTON_LEVELS)
+            t += ps->bamb[(size_t)k * PHOTON_CH + (size_t)c];
+    return t;
+}
+
+/* Every buffer of the progressive pass, channel c. */
+static double buffers_total(const photon_sys *ps, int c)
+{
+    return chart_total(ps, c) + ambient_total(ps, c) +
+           sum_channel(ps->gflux, (size_t)ps->gw * ps->gh, c) +
+           sum_channel(ps->cov_flux, ps->ncov, c);
 }
 
 static void test_energy_closed_box(void **state)
@@ -342,19 +362,44 @@ static void test_energy_closed_box(void **state)
            ratio, a / (1 - a), st->escaped);
     assert_true(fabs(ratio - a / (1 - a)) < (quick_mode() ? 0.06 : 0.03) * a / (1 - a));
     /* bookkeeping of the later hits: stored somewhere or counted lost */
-    stored = st->stored_chart + st->stored_aerial + st->stored_ambient + st->lost;
+    stored = st->stored_chart + st->stored_aerial + st->stored_ambient + st->stored_covered +
+             st->lost;
     assert_true(fabs(stored - st->arrived) <= 1e-9 * st->arrived);
     /* flux conservation through splatting, to float precision */
-    tex = chart_total(ps);
+    tex = chart_total(ps, 0);
     assert_true(fabs(tex - st->stored_chart) <= 1e-5 * st->stored_chart);
-    tex = sum_floats(ps->gflux, (size_t)ps->gw * ps->gh);
+    tex = sum_channel(ps->gflux, (size_t)ps->gw * ps->gh, 0);
     assert_true(fabs(tex - st->stored_aerial) <= 1e-5 * st->stored_aerial);
-    /* the floor (under the canopy: not the topmost surface) and the
-     * ceiling (an underside) have no chart; the walls do */
-    printf("closed box: stored chart %.4g aerial %.4g lost (floor, ceiling) %.4g of %.4g\n",
-           st->stored_chart, st->stored_aerial, st->lost, st->arrived);
+    tex = sum_channel(ps->cov_flux, ps->ncov, 0);
+    assert_true(fabs(tex - st->stored_covered) <= 1e-5 * st->stored_covered);
+    /* per channel (lamp colour 1, 0.62, 0.28; grey albedos): what arrives
+     * and what is stored is the scalar times the colour, and the buffers
+     * hold exactly what was stored */
+    {
+        const float *col = f.s.lamps[0].color;
+        double sc = st->stored_chart + st->stored_aerial + st->stored_ambient +
+                    st->stored_covered;
+        int ch;
+        for (ch = 0; ch < 3; ch++) {
+            double buf = buffers_total(ps, 1 + ch);
+            printf("closed box channel %d: arrived %.6g (scalar x colour %.6g), stored %.6g, "
+                   "in buffers %.6g\n",
+                   ch, st->arrived_rgb[ch], st->arrived * col[ch], st->stored_rgb[ch], buf);
+            assert_true(fabs(st->arrived_rgb[ch] - st->arrived * col[ch]) <=
+                        1e-9 * st->arrived);
+            assert_true(fabs(st->stored_rgb[ch] - sc * col[ch]) <= 1e-9 * sc);
+            assert_true(fabs(buf - st->stored_rgb[ch]) <= 1e-5 * st->stored_rgb[ch]);
+        }
+    }
+    /* the floor (under the canopy) has its covered-ground chart; the
+     * ceiling (an underside) has none; the walls have theirs */
+    printf("closed box: stored chart %.4g aerial %.4g covered floor %.4g lost (ceiling) %.4g "
+           "of %.4g; %u covered slots\n",
+           st->stored_chart, st->stored_aerial, st->stored_covered, st->lost, st->arrived,
+           ps->ncov);
     assert_true(st->stored_aerial == 0.0);
-    assert_true(st->stored_chart > 0.4 * st->arrived && st->lost > 0.2 * st->arrived);
+    assert_true(st->stored_chart > 0.4 * st->arrived && st->stored_covered > 0.1 * st->arrived &&
+                st->lost > 0.1 * st->arrived);
     /* mean indirect irradiance on the courtyard walls against the room's
      * mean: the flux arriving at later hits over floor 100 + walls 400 +
      * ceiling 100 m^2 */
@@ -374,6 +419,18 @@ static void test_energy_closed_box(void **state)
                     n++;
                 }
         printf("closed box walls: mean E_ind %.2f lx, room mean %.2f lx\n", sum / n, expect);
+        assert_true(sum / n > 0.7 * expect && sum / n < 1.3 * expect);
+        /* the floor under the canopy: read from the covered-ground layer */
+        sum = 0.0;
+        n = 0;
+        for (j = 0; j < 10; j++)
+            for (i = 0; i < 10; i++) {
+                double P[3] = {5.5 + i, 5.5 + j, 0.0}, up[3] = {0, 0, 1};
+                assert_true(photon_covered_at(ps, P[0], P[1]));
+                sum += photon_indirect(ps, P, up);
+                n++;
+            }
+        printf("closed box floor: mean E_ind %.2f lx, room mean %.2f lx\n", sum / n, expect);
         assert_true(sum / n > 0.7 * expect && sum / n < 1.3 * expect);
     }
     fx_close(&f);
@@ -474,11 +531,15 @@ static plx_engine *open_fixture(const char *path, void **mem, size_t bytes)
     return e;
 }
 
-/* Direct light at Q (SPEC §2), lamps within reach, visibility by shadow rays. */
-static double direct_at(tracer *T, const scene *s, const double Q[3], const double n[3])
+/* Direct light at Q (SPEC §2), lamps within reach, visibility by shadow
+ * rays; rgb (may be NULL) gets each lamp's term weighted by its colour. */
+static double direct_at(tracer *T, const scene *s, const double Q[3], const double n[3],
+                        double rgb[3])
 {
     double e = 0.0;
     uint32_t i;
+    if (rgb)
+        rgb[0] = rgb[1] = rgb[2] = 0.0;
     for (i = 0; i < s->nlamps; i++) {
         const scene_lamp *L = &s->lamps[i];
         double w[3] = {L->x - Q[0], L->y - Q[1], L->z - Q[2]}, d, c, o[3], x;
@@ -500,25 +561,34 @@ static double direct_at(tracer *T, const scene *s, const double Q[3], const doub
         if (trace_ray(T, o, w, d - 1e-6, &h) != TRACE_SKY)
             continue;
         x = d / L->radius;
-        e += L->intensity * c / (d * d) * (1 - x * x * x * x) * (1 - x * x * x * x);
+        c = L->intensity * c / (d * d) * (1 - x * x * x * x) * (1 - x * x * x * x);
+        e += c;
+        if (rgb) {
+            int k;
+            for (k = 0; k < 3; k++)
+                rgb[k] += c * L->color[k];
+        }
     }
     return e;
 }
 
 /* Path-traced E_indirect at P: X = a(Q1) E_d(Q1) + [prob a(Q1)] X(Q1),
- * Q1 found by a cosine-weighted ray from P. */
-static double reference_indirect(tracer *T, const scene *s, const double P[3],
-                                 const double n[3], int paths, uint64_t seed)
+ * Q1 found by a cosine-weighted ray from P (albedos are grey). With rgb,
+ * also its colour-weighted version and with sd the standard error of the
+ * scalar. */
+static double reference_indirect_rgb(tracer *T, const scene *s, const double P[3],
+                                     const double n[3], int paths, uint64_t seed, double rgb[3],
+                                     double *sd)
 {
-    double sum = 0.0;
-    int k;
+    double sum = 0.0, sum2 = 0.0, srgb[3] = {0, 0, 0};
+    int k, c;
     uint64_t rs = seed * 0x2545f4914f6cdd1dull;
     rs = rng_next(&rs);
     for (k = 0; k < paths; k++) {
-        double p[3] = {P[0], P[1], P[2]}, nn[3] = {n[0], n[1], n[2]};
+        double p[3] = {P[0], P[1], P[2]}, nn[3] = {n[0], n[1], n[2]}, x = 0.0;
         int depth;
         for (depth = 0; depth < 30; depth++) {
-            double d[3], o[3], a;
+            double d[3], o[3], a, drgb[3];
             trace_hit h;
             photon_cosine_dir(&rs, nn, d);
             o[0] = p[0] + 1e-6 * nn[0];
@@ -527,14 +597,31 @@ static double reference_indirect(tracer *T, const scene *s, const double P[3],
             if (trace_ray(T, o, d, INFINITY, &h) == TRACE_SKY)
                 break;
             a = h.kind == TRACE_GROUND ? s->ground_albedo : s->bld[h.bld].albedo;
-            sum += a * direct_at(T, s, h.p, h.n);
+            x += a * direct_at(T, s, h.p, h.n, drgb);
+            for (c = 0; c < 3; c++)
+                srgb[c] += a * drgb[c];
             if (urand(&rs) >= a)
                 break;
             memcpy(p, h.p, sizeof p);
             memcpy(nn, h.n, sizeof nn);
         }
+        sum += x;
+        sum2 += x * x;
+    }
+    if (rgb)
+        for (c = 0; c < 3; c++)
+            rgb[c] = srgb[c] / paths;
+    if (sd) {
+        double m = sum / paths, var = sum2 / paths - m * m;
+        *sd = sqrt((var > 0.0 ? var : 0.0) / paths);
     }
     return sum / paths;
+}
+
+static double reference_indirect(tracer *T, const scene *s, const double P[3],
+                                 const double n[3], int paths, uint64_t seed)
+{
+    return reference_indirect_rgb(T, s, P, n, paths, seed, NULL, NULL);
 }
 
 static void test_accuracy_eixample(void **state)
@@ -614,6 +701,247 @@ static void test_accuracy_eixample(void **state)
     assert_true(last_err < first_err);
     plx_engine_destroy(e);
     free(mem);
+}
+
+/* ---- colour ---------------------------------------------------------------------- */
+
+/* Russian roulette with one scalar survival probability keeps every channel
+ * unbiased: with stratified u the survivors' mean weights are f_c alb_c per
+ * RGB channel and f_0 p for the scalar; grey albedos leave weights alone. */
+static void test_bounce_weights(void **state)
+{
+    double alb[3] = {0.8, 0.4, 0.1}, grey[3] = {0.3, 0.3, 0.3};
+    double f0[PHOTON_CH] = {2.0, 1.0, 0.5, 0.25}, mean[PHOTON_CH] = {0, 0, 0, 0};
+    double p = photon_albedo_scalar(alb);
+    int N = 100000, k, c;
+    (void)state;
+    assert_true(fabs(p - (0.2126 * 0.8 + 0.7152 * 0.4 + 0.0722 * 0.1)) < 1e-15);
+    assert_true(photon_albedo_scalar(grey) == 0.3);
+    for (k = 0; k < N; k++) {
+        double f[PHOTON_CH];
+        memcpy(f, f0, sizeof f);
+        if (photon_bounce(f, alb, (k + 0.5) / N))
+            for (c = 0; c < PHOTON_CH; c++)
+                mean[c] += f[c] / N;
+    }
+    printf("bounce, albedo (0.8 0.4 0.1), p %.4f: mean weights %.5f %.5f %.5f %.5f, "
+           "expected %.5f %.5f %.5f %.5f\n",
+           p, mean[0], mean[1], mean[2], mean[3], f0[0] * p, f0[1] * alb[0], f0[2] * alb[1],
+           f0[3] * alb[2]);
+    assert_true(fabs(mean[0] - f0[0] * p) <= 2.0 * f0[0] / N);
+    for (c = 0; c < 3; c++)
+        assert_true(fabs(mean[1 + c] - f0[1 + c] * alb[c]) <= 2.0 * f0[1 + c] / (p * N));
+    for (k = 0; k < 1000; k++) {
+        double f[PHOTON_CH];
+        memcpy(f, f0, sizeof f);
+        if (photon_bounce(f, grey, k / 1000.0))
+            assert_memory_equal(f, f0, sizeof f);
+        else
+            assert_true(k / 1000.0 >= 0.3);
+    }
+}
+
+/* White lamps: the RGB channels are the scalar, bit for bit, through the
+ * charts, the ambient terms, A, I and the floor maps. */
+static void test_white_lamps_equal(void **state)
+{
+    void *mem;
+    plx_engine *e = open_fixture("fixtures/eixample-4x4.geojson", &mem, 256u << 20);
+    scene *s = e->sc;
+    photon_sys *ps;
+    photon_config c;
+    double eye[3];
+    uint64_t rs = 99;
+    uint32_t i;
+    int k, n = 0, nonzero = 0;
+    (void)state;
+    for (i = 0; i < s->nlamps; i++)
+        s->lamps[i].color[0] = s->lamps[i].color[1] = s->lamps[i].color[2] = 1.0f;
+    photon_config_default(&c);
+    c.aerial_res = 128;
+    c.lamp_photons = 4096;
+    c.lamp_slots = 4;
+    c.level_blocks[0] = 2;
+    c.level_blocks[1] = 2;
+    c.level_blocks[2] = 2;
+    c.level_blocks[3] = 2; /* some blocks at level 4: ambient terms */
+    assert_int_equal(photon_create(&e->mem, s, &c, &ps), PLX_OK);
+    eye[0] = 0.5 * (s->bounds[0] + s->bounds[2]);
+    eye[1] = 0.5 * (s->bounds[1] + s->bounds[3]);
+    eye[2] = 1.7;
+    for (k = 0; k < 3; k++)
+        photon_step(ps, 20000, 300 + k);
+    assert_true(photon_lamps_update(ps, eye) > 0);
+    photon_step(ps, 20000, 400);
+    while (n < 400) {
+        double P[3], N[3] = {0, 0, 1}, rgb[3], E;
+        const scene_lamp *L = &s->lamps[rng_next(&rs) % s->nlamps];
+        if (n % 2 == 0) {
+            double a = 2 * PI * urand(&rs), r = 1.0 + 10.0 * urand(&rs);
+            P[0] = L->x + r * cos(a);
+            P[1] = L->y + r * sin(a);
+            P[2] = trace_top(ps->T, P[0], P[1], NULL);
+        } else {
+            double a = 2 * PI * urand(&rs), o[3] = {L->x, L->y, 1.0 + 8.0 * urand(&rs)};
+            double d[3] = {cos(a), sin(a), 0.0};
+            trace_hit h;
+            if (trace_ray(ps->T, o, d, 30.0, &h) != TRACE_WALL)
+                continue;
+            memcpy(P, h.p, sizeof P);
+            memcpy(N, h.n, sizeof N);
+        }
+        E = photon_indirect_rgb(ps, P, N, rgb);
+        assert_true(rgb[0] == E && rgb[1] == E && rgb[2] == E);
+        nonzero += E > 0.0;
+        n++;
+    }
+    printf("white lamps: %d points (ground, roofs, facades), %d lit, RGB == scalar at all; "
+           "%u lamps refined, level-4 blocks %u\n",
+           n, nonzero, (unsigned)ps->st.lamp_refined, ps->level_count[PHOTON_LEVELS]);
+    assert_true(nonzero > n / 2 && ps->level_count[PHOTON_LEVELS] > 0);
+    plx_engine_destroy(e);
+    free(mem);
+}
+
+/* Two lamps of different colours light the two sides of a street (red on
+ * the south side at x = -20, blue on the north side at x = +20): the
+ * indirect colour on each side follows its lamp, as the path tracer says.
+ * The old mean-lamp-colour tint gave both sides the same colour. */
+static void test_two_colour_street(void **state)
+{
+    fixture f;
+    photon_sys *ps;
+    photon_config c;
+    double red[3] = {1.0, 0.25, 0.1}, blue[3] = {0.1, 0.35, 1.0};
+    double eye[3] = {0, 0, 1.7};
+    int paths = full_mode() ? 20000 : quick_mode() ? 300 : 3000;
+    int frames = full_mode() ? 64 : quick_mode() ? 4 : 24, side, k, i;
+    double bound = quick_mode() ? 0.5 : 0.05; /* relative, plus 0.01 */
+    (void)state;
+    fx_open(&f, 256u << 20);
+    assert_true(ref_scene_add_box(&f.s, -60, -25, 60, -6, 15.0, 0.0) >= 0);
+    assert_true(ref_scene_add_box(&f.s, -60, 6, 60, 25, 15.0, 0.0) >= 0);
+    assert_true(ref_scene_add_lamp_rgb(&f.s, -20, -4.5, 5, 1000, 20, red[0], red[1], red[2]) >= 0);
+    assert_true(ref_scene_add_lamp_rgb(&f.s, 20, 4.5, 5, 1000, 20, blue[0], blue[1], blue[2]) >=
+                0);
+    f.s.ground_albedo = 0.3;
+    f.s.bld[0].albedo = f.s.bld[1].albedo = 0.4;
+    fx_finish(&f);
+    photon_config_default(&c);
+    c.aerial_res = 128;
+    assert_int_equal(photon_create(&f.a, &f.s, &c, &ps), PLX_OK);
+    assert_int_equal(photon_set_viewer(ps, eye, NULL, 0.0), PLX_OK);
+    for (k = 0; k < frames; k++)
+        photon_step(ps, 65536, 500 + k);
+    printf("two-colour street: chromaticity rgb / E (photons | paths)\n");
+    for (side = 0; side < 2; side++) {
+        double sgn = side ? 1.0 : -1.0, ph[4] = {0, 0, 0, 0}, rf[4] = {0, 0, 0, 0};
+        /* facade points facing the street near the side's lamp, and ground
+         * points between the lamp and the facade */
+        for (i = 0; i < 8; i++) {
+            double P[3], N[3], rgb[3], E;
+            if (i < 6) {
+                P[0] = sgn * (16.0 + 4.0 * (i % 3));
+                P[1] = sgn * 6.0;
+                P[2] = 2.0 + 2.0 * (i / 3);
+                N[0] = 0.0;
+                N[1] = -sgn;
+                N[2] = 0.0;
+            } else {
+                P[0] = sgn * (18.0 + 4.0 * (i - 6));
+                P[1] = sgn * 3.0;
+                P[2] = 0.0;
+                N[0] = N[1] = 0.0;
+                N[2] = 1.0;
+            }
+            E = photon_indirect_rgb(ps, P, N, rgb);
+            ph[0] += E;
+            for (k = 0; k < 3; k++)
+                ph[1 + k] += rgb[k];
+            E = reference_indirect_rgb(ps->T, &f.s, P, N, paths, 700 + 10 * side + i, rgb, NULL);
+            rf[0] += E;
+            for (k = 0; k < 3; k++)
+                rf[1 + k] += rgb[k];
+        }
+        printf("  %s side: E %.3f | %.3f lx; r %.3f g %.3f b %.3f | r %.3f g %.3f b %.3f\n",
+               side ? "north (blue lamp)" : "south (red lamp)", ph[0] / 8, rf[0] / 8,
+               ph[1] / ph[0], ph[2] / ph[0], ph[3] / ph[0], rf[1] / rf[0], rf[2] / rf[0],
+               rf[3] / rf[0]);
+        assert_true(ph[0] > 0.0 && rf[0] > 0.0);
+        /* each side is the colour of its lamp */
+        if (side == 0)
+            assert_true(ph[1] > 3.0 * ph[3] && rf[1] > 3.0 * rf[3]);
+        else
+            assert_true(ph[3] > 3.0 * ph[1] && rf[3] > 3.0 * rf[1]);
+        /* and its chromaticity matches the reference's */
+        for (k = 1; k < 4; k++)
+            assert_true(fabs(ph[k] / ph[0] - rf[k] / rf[0]) <= bound * rf[k] / rf[0] + 0.01);
+    }
+    fx_close(&f);
+}
+
+/* Ground under a canopy (a raised building) gets indirect light from the
+ * covered-ground layer; it matches the path tracer within its error (it was
+ * 0 without a chart there). */
+static void test_covered_canopy(void **state)
+{
+    fixture f;
+    photon_sys *ps;
+    photon_config c;
+    double pts[6][2] = {{5, 3}, {10, 5}, {15, 7}, {10, 2}, {3, 8}, {17, 4}}, up[3] = {0, 0, 1};
+    int paths = full_mode() ? 40000 : quick_mode() ? 500 : 8000;
+    int frames = full_mode() ? 64 : quick_mode() ? 4 : 24, k, i;
+    double err = 0.0, bound = quick_mode() ? 0.4 : 0.12, prog[6], night_err = 0.0;
+    (void)state;
+    fx_open(&f, 256u << 20);
+    assert_true(ref_scene_add_box(&f.s, 0, 0, 20, 10, 5.0, 4.0) >= 0);   /* canopy */
+    assert_true(ref_scene_add_box(&f.s, -5, 14, 25, 20, 10.0, 0.0) >= 0); /* a wall behind */
+    assert_true(ref_scene_add_lamp(&f.s, 10, 12, 3, 1000, 25) >= 0);
+    f.s.ground_albedo = 0.3;
+    f.s.bld[0].albedo = 0.5;
+    f.s.bld[1].albedo = 0.4;
+    fx_finish(&f);
+    photon_config_default(&c);
+    c.aerial_res = 128;
+    c.lamp_photons = quick_mode() ? 1u << 17 : 1u << 20;
+    c.kernel_min = 2.5; /* I_cov uses kernel_min; A is at r(24) = 2.5 */
+    assert_int_equal(photon_create(&f.a, &f.s, &c, &ps), PLX_OK);
+    assert_true(ps->ncov > 0 && ps->ncov <= ps->cov_cap);
+    for (k = 0; k < frames; k++)
+        photon_step(ps, 65536, 800 + k);
+    printf("covered ground under a canopy (%u slots of %u): photons vs paths (+- 1 sd)\n",
+           ps->ncov, ps->cov_cap);
+    for (i = 0; i < 6; i++) {
+        double P[3] = {pts[i][0], pts[i][1], 0.0}, sd, ref, est;
+        assert_true(photon_covered_at(ps, P[0], P[1]));
+        est = prog[i] = photon_indirect(ps, P, up);
+        ref = reference_indirect_rgb(ps->T, &f.s, P, up, paths, 900 + i, NULL, &sd);
+        printf("  (%4.1f %4.1f): %7.3f lx, %7.3f +- %.3f lx\n", P[0], P[1], est, ref, sd);
+        assert_true(ref > 0.0 && est > 0.5 * ref);
+        err += fabs(est - ref) / ref;
+    }
+    err /= 6;
+    printf("  mean rel err %.4f (bound %.2f); stored covered %.1f%% of the later-hit flux, "
+           "lost %.2f%%\n",
+           err, bound, 100.0 * ps->st.stored_covered / ps->st.arrived,
+           100.0 * ps->st.lost / ps->st.arrived);
+    assert_true(err <= bound);
+    assert_true(ps->st.stored_covered > 0.0);
+    assert_true(fabs(ps->st.stored_chart + ps->st.stored_aerial + ps->st.stored_ambient +
+                     ps->st.stored_covered + ps->st.lost - ps->st.arrived) <=
+                1e-9 * ps->st.arrived);
+    /* the lamp refined (floor map, push into I and I_cov; A and A_cov
+     * restart): covered ground now reads I_cov, with the same answer */
+    assert_int_equal(photon_lamp_request(ps, 0), 0);
+    assert_int_equal(ps->gframes, 0);
+    for (i = 0; i < 6; i++) {
+        double P[3] = {pts[i][0], pts[i][1], 0.0}, est = photon_indirect(ps, P, up);
+        night_err += fabs(est - prog[i]) / prog[i] / 6;
+    }
+    printf("  after refining the lamp: mean rel diff to the progressive answer %.4f\n",
+           night_err);
+    assert_true(night_err <= (quick_mode() ? 0.4 : 0.1));
+    fx_close(&f);
 }
 
 /* ---- lamp cache ---------------------------------------------------------------- */
@@ -898,8 +1226,15 @@ static void test_create_nomem(void **state)
     uint64_t k;
     arena_mark m;
     plx_status st = PLX_E_NOMEM;
+    int i;
     (void)state;
-    lamp_row(&f, 4);
+    /* a row of lamps by a block, and a canopy (covered ground) */
+    fx_open(&f, 64u << 20);
+    assert_true(ref_scene_add_box(&f.s, 0, 10, 200, 30, 15.0, 0.0) >= 0);
+    assert_true(ref_scene_add_box(&f.s, 50, 0, 60, 8, 5.0, 3.0) >= 0);
+    for (i = 0; i < 4; i++)
+        assert_true(ref_scene_add_lamp(&f.s, 10.0 + 20.0 * i, 5.0, 6.0, 1000, 20.0) >= 0);
+    fx_finish(&f);
     photon_config_default(&c);
     c.aerial_res = 64;
     c.lamp_slots = 2;
@@ -918,6 +1253,7 @@ static void test_create_nomem(void **state)
     }
     f.a.fail_at = 0;
     assert_int_equal(st, PLX_OK);
+    assert_true(ps->ncov > 0 && ps->gcov != NULL);
     printf("photon_create: succeeded at request %llu; %zu bytes (photon_bytes %zu)\n",
            (unsigned long long)(k - 1), f.a.used[PLX_PART_PHOTON] - m.used[PLX_PART_PHOTON],
            photon_bytes(&f.s, &c));
@@ -946,6 +1282,10 @@ int main(void)
         cmocka_unit_test(test_energy_closed_box),
         cmocka_unit_test(test_one_bounce_wall),
         cmocka_unit_test(test_accuracy_eixample),
+        cmocka_unit_test(test_bounce_weights),
+        cmocka_unit_test(test_white_lamps_equal),
+        cmocka_unit_test(test_two_colour_street),
+        cmocka_unit_test(test_covered_canopy),
         cmocka_unit_test(test_lamp_lru),
         cmocka_unit_test(test_lamp_push_pull),
         cmocka_unit_test(test_levels_moving_viewer),
