@@ -138,10 +138,10 @@ typedef struct polar_hit {
     int32_t bld;         /* building hit, -1 when the ray reaches the Bounds box */
     int32_t bld2;        /* second owner of a wall shared exactly, else -1 */
     uint32_t seg;        /* wall piece (index into pd->seg) */
-    int32_t ring_edge;   /* unused (-1): pieces are cut from footprint edges */
     vec2 pt;             /* first point hit (rounded) */
     double t;            /* ray parameter of pt: pt = p + t * (q - p) */
-    uint32_t steps;      /* regions walked */
+    uint32_t steps;      /* regions walked (both one-sided rays past a
+                          * corner on the exact ray, side 0) */
 } polar_hit;
 
 /* First wall met by the ray from the free point p through q (q != p).
