@@ -300,10 +300,12 @@ static int clearly_wide(vec2 P, vec2 A, vec2 B)
     return ax * by - ay * bx > 1e-6 * (fabs(ax) + fabs(ay)) * (fabs(bx) + fabs(by));
 }
 
-/* A closed cone (frame rays A, B) meeting wall piece s. */
-static void close_cone(walker *w, uint32_t s, vec2 A, vec2 B)
+/* A closed cone c meeting wall piece s. (By pointer: its points passed as
+ * values were packed through the stack on every call.) */
+static void close_cone(walker *w, uint32_t s, const cone *c)
 {
     const polar *pd = w->pd;
+    const vec2 A = c->A, B = c->B;
     const polar_seg *g = &pd->seg[s];
     int frame = w->m->frame;
     vec2 wa = from_frame(frame, A), wb = from_frame(frame, B);
@@ -436,7 +438,7 @@ static void step(walker *w, cone c)
         }
         nx = advance(w, &c, R, low, &wall);
         if (nx == POLAR_NONE) {
-            close_cone(w, wall, c.A, c.B);
+            close_cone(w, wall, &c);
             break;
         }
         c.t = nx;
@@ -449,7 +451,7 @@ static void run(walker *w, cone c)
     step(w, c);
     while (!w->nomem && !w->stopped && pop(w, &c)) {
         if (c.shut != POLAR_NONE)
-            close_cone(w, c.shut, c.A, c.B);
+            close_cone(w, c.shut, &c);
         else
             step(w, c);
     }
