@@ -234,7 +234,7 @@ int geom_orient_ref(vec2 a, vec2 b, vec2 c)
  * - No overflow: S finite implies every intermediate is finite (an inf in a
  *   difference makes a product inf or NaN, so S is inf or NaN and the test
  *   fails). If dl - dr overflows, det is an infinity of the right sign. */
-static const double orient_bound_a = (3.0 + 64.0 * 0x1p-53) * 0x1p-53;
+/* (The test itself is geom_orient_filter in geom.h, inline for hot loops.) */
 
 /* Stages B and C are exact when every coordinate is 0 or has magnitude in
  * [2^-480, 2^480]: then every nonzero coordinate has quantum >= 2^-532, so do
@@ -285,18 +285,8 @@ static int orient_exact(vec2 a, vec2 b, vec2 c)
 
 int geom_orient(vec2 a, vec2 b, vec2 c)
 {
-    double dl = (a.x - c.x) * (b.y - c.y);
-    double dr = (a.y - c.y) * (b.x - c.x);
-    double det = dl - dr;
-    double s = fabs(dl) + fabs(dr);
-    if (s >= 0x1p-900 && s <= DBL_MAX) {
-        double bound = orient_bound_a * s;
-        if (det > bound)
-            return 1;
-        if (-det > bound)
-            return -1;
-    }
-    return orient_exact(a, b, c);
+    int o = geom_orient_filter((a.x - c.x) * (b.y - c.y), (a.y - c.y) * (b.x - c.x));
+    return o ? o : orient_exact(a, b, c);
 }
 
 /* ------------------------------------------------------------------------ */

@@ -9,6 +9,8 @@
 #ifndef PLX_GEOM_H
 #define PLX_GEOM_H
 
+#include <float.h>
+#include <math.h>
 #include <stddef.h>
 #include <stdint.h>
 #include "scene.h"
@@ -17,6 +19,26 @@
 /* Sign of the area of triangle a,b,c: +1 counter-clockwise (c left of a->b),
  * -1 clockwise, 0 exactly collinear. Exact for all finite doubles. */
 int geom_orient(vec2 a, vec2 b, vec2 c);
+
+/* The first stage of geom_orient, for hot loops that compute the two
+ * products themselves: dl = fl(fl(ax - cx) fl(by - cy)) and
+ * dr = fl(fl(ay - cy) fl(bx - cx)), each difference and product rounded once
+ * (the differences may be computed once and reused). Returns the sign of the
+ * exact determinant when the filter proves it, else 0: then ask geom_orient.
+ * geom_orient itself runs this very test (the bound is derived in geom.c). */
+static inline int geom_orient_filter(double dl, double dr)
+{
+    const double bound_a = (3.0 + 64.0 * 0x1p-53) * 0x1p-53;
+    double det = dl - dr, s = fabs(dl) + fabs(dr);
+    if (s >= 0x1p-900 && s <= DBL_MAX) {
+        double bound = bound_a * s;
+        if (det > bound)
+            return 1;
+        if (-det > bound)
+            return -1;
+    }
+    return 0;
+}
 
 /* The same sign, computed only by the slow exact path (a fixed-point big
  * integer holding the determinant for any finite doubles, about 600 bytes of

@@ -1301,48 +1301,66 @@ static double box_exit(const polar *pd, vec2 p, vec2 q)
     return t;
 }
 
-/* Walks one-sided ray (side +1 / -1) from region t0 of map m. */
-static void walk(const polar *pd, const polar_map *m, uint32_t t, vec2 p, vec2 q, int side,
-                 polar_hit *h)
+/* Walks the ray from frame point P through Q from region *t of map m, until
+ * it leaves through a wall (*hit) or reaches the Bounds box (*hit =
+ * POLAR_NONE); returns 1. side = +1 / -1: the one-sided ray, a corner on the
+ * ray counted as passed on the other side. side = 0: the exact ray, which
+ * stops at the first corner lying exactly on it and returns 0 with *t the
+ * region whose corner that is (the two one-sided rays part there, and walk
+ * on from *t). *steps counts the regions left behind. */
+static int walk(const polar *pd, const polar_map *m, uint32_t *t, vec2 P, vec2 Q, int side,
+                uint32_t *hit, uint32_t *steps)
 {
-    vec2 P = to_frame(m->frame, p), Q = to_frame(m->frame, q);
+    const polar_trap *trap = m->trap;
     int right = lex_cmp(Q, P) > 0;
-    uint32_t hit = POLAR_NONE, steps = 0;
-    int box = 0;
+    uint32_t end = right ? m->box_hi : m->box_lo, k = *t, n = 0;
+    double qx = Q.x - P.x, qy = Q.y - P.y;
     for (;;) {
-        uint32_t r = right ? m->trap[t].rp : m->trap[t].lp, nx;
+        uint32_t r = right ? trap[k].rp : trap[k].lp, nx;
+        vec2 R;
         int o;
-        steps++;
-        if (r == (right ? m->box_hi : m->box_lo)) {
-            box = 1;
+        n++;
+        if (r == end) {
+            *hit = POLAR_NONE;
             break;
         }
-        o = geom_orient(P, Q, fpt(pd, m->frame, r));
+        R = fpt(pd, m->frame, r);
+        /* geom_orient(P, Q, R), filtered on the differences from P */
+        o = geom_orient_filter(qx * (R.y - P.y), qy * (R.x - P.x));
         if (o == 0)
+            o = geom_orient(P, Q, R);
+        if (o == 0) {
+            if (side == 0) {
+                *t = k;
+                *steps += n - 1;
+                return 0;
+            }
             o = side > 0 ? -1 : 1;
+        }
         if (!right)
             o = -o;
         /* o > 0: the ray passes below r (in the frame) */
-        if (o > 0) {
-            nx = m->trap[t].nb[right ? LR : LL];
-            if (nx == POLAR_NONE) {
-                hit = m->trap[t].bot;
-                break;
-            }
-        } else {
-            nx = m->trap[t].nb[right ? UR : UL];
-            if (nx == POLAR_NONE) {
-                hit = m->trap[t].top;
-                break;
-            }
+        nx = trap[k].nb[o > 0 ? (right ? LR : LL) : (right ? UR : UL)];
+        if (nx == POLAR_NONE) {
+            *hit = o > 0 ? trap[k].bot : trap[k].top;
+            break;
         }
-        t = nx;
+        k = nx;
     }
+    *t = k;
+    *steps += n;
+    return 1;
+}
+
+/* Fills the hit record of the ray p->q that left through wall piece hit
+ * (POLAR_NONE: through the Bounds box). */
+static void hit_record(const polar *pd, vec2 p, vec2 q, uint32_t hit, uint32_t steps,
+                       polar_hit *h)
+{
     h->steps = steps;
-    h->ring_edge = -1;
-    if (box || pd->seg[hit].bld[0] == -2) {
+    if (hit == POLAR_NONE || pd->seg[hit].bld[0] == -2) {
         h->bld = h->bld2 = -1;
-        h->seg = box ? POLAR_NONE : hit;
+        h->seg = hit;
         h->t = box_exit(pd, p, q);
     } else {
         const polar_seg *g = &pd->seg[hit];
@@ -1355,10 +1373,15 @@ static void walk(const polar *pd, const polar_map *m, uint32_t t, vec2 p, vec2 q
     h->pt.y = p.y + h->t * (q.y - p.y);
 }
 
+/* The exact ray (side 0) is walked once; only where it passes exactly
+ * through a corner does it part into the two one-sided rays, each walked on
+ * from there, and the one blocked farther wins (the exact ray enters the
+ * solid only where both sides of it are solid). */
 plx_status polar_shoot_to(const polar *pd, vec2 p, vec2 q, int side, polar_hit *out)
 {
     const polar_map *m;
     int32_t t;
+    uint32_t k, hit, steps = 0;
     vec2 P, Q;
     if (!pd || !out)
         return PLX_E_INVALID;
@@ -1374,22 +1397,21 @@ plx_status polar_shoot_to(const polar *pd, vec2 p, vec2 q, int side, polar_hit *
     }
     P = to_frame(m->frame, p);
     Q = to_frame(m->frame, q);
-    (void)Q;
     t = polar_locate_frame(pd, m, P);
     if (t < 0)
         return PLX_E_RANGE;
-    if (side != 0) {
-        walk(pd, m, (uint32_t)t, p, q, side, out);
+    k = (uint32_t)t;
+    if (walk(pd, m, &k, P, Q, side, &hit, &steps)) {
+        hit_record(pd, p, q, hit, steps, out);
     } else {
         polar_hit h2;
-        walk(pd, m, (uint32_t)t, p, q, 1, out);
-        walk(pd, m, (uint32_t)t, p, q, -1, &h2);
-        if (h2.t > out->t) {
-            h2.steps += out->steps;
+        uint32_t k2 = k, hit2, steps2 = 0;
+        walk(pd, m, &k, P, Q, 1, &hit, &steps);
+        walk(pd, m, &k2, P, Q, -1, &hit2, &steps2);
+        hit_record(pd, p, q, hit, steps + steps2, out);
+        hit_record(pd, p, q, hit2, steps + steps2, &h2);
+        if (h2.t > out->t)
             *out = h2;
-        } else {
-            out->steps += h2.steps;
-        }
     }
     return PLX_OK;
 }

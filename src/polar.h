@@ -146,10 +146,10 @@ typedef struct polar_hit {
     int32_t bld;         /* building hit, -1 when the ray reaches the Bounds box */
     int32_t bld2;        /* second owner of a wall shared exactly, else -1 */
     uint32_t seg;        /* wall piece (index into pd->seg) */
-    int32_t ring_edge;   /* unused (-1): pieces are cut from footprint edges */
     vec2 pt;             /* first point hit (rounded) */
     double t;            /* ray parameter of pt: pt = p + t * (q - p) */
-    uint32_t steps;      /* regions walked */
+    uint32_t steps;      /* regions walked (both one-sided rays past a
+                          * corner on the exact ray, side 0) */
 } polar_hit;
 
 /* First wall met by the ray from the free point p through q (q != p).
@@ -157,7 +157,10 @@ typedef struct polar_hit {
  * / clockwise (the one-sided limits, used to look past a vertex on the ray);
  * side = 0: the exact ray, blocked where it first enters the interior of the
  * solid (grazing a corner does not block; sliding along a wall shared by two
- * footprints does, the shared wall being interior to their union).
+ * footprints does, the shared wall being interior to their union). The
+ * exact ray is walked once; where it passes exactly through a corner it
+ * parts into the two one-sided rays, walked on from there, and is blocked
+ * where the farther of them is (the counter-clockwise one on a tie).
  * Returns PLX_OK, PLX_E_RANGE when p is not free (outside the open Bounds
  * box, on a wall or inside a footprint), PLX_E_INVALID when q == p. */
 plx_status polar_shoot_to(const polar *pd, vec2 p, vec2 q, int side, polar_hit *out /* OUT */);

@@ -1,7 +1,6 @@
 /* visibility: fan of tangent rays by cone walking (see visibility.h). */
 #include <float.h>
 #include <math.h>
-#include <stdlib.h>
 #include <string.h>
 #include "visibility.h"
 #include "geom.h"
@@ -14,13 +13,23 @@ enum { UL = 0, LL = 1, UR = 2, LR = 3 };
  * are one). Areas are not affected. */
 #define VIS_MIN_WIDTH 1e-12
 
+/* A hint to fetch memory soon to be read (no effect on results). */
+#if defined(__GNUC__)
+#define PREFETCH(p) __builtin_prefetch(p)
+#else
+#define PREFETCH(p) ((void)(p))
+#endif
+
 /* A pending cone: rays from p through A (clockwise limit) and B, in the
  * frame of its map, in region t, moving towards increasing (right) or
- * decreasing frame order. */
+ * decreasing frame order. A cone pushed at a split has already been moved
+ * past the splitting corner: shut is then the wall it closes on (else
+ * POLAR_NONE). */
 typedef struct cone {
     vec2 A, B;
     uint32_t t;
     uint32_t right;
+    uint32_t shut;
 } cone;
 
 typedef struct chunk {
@@ -74,6 +83,29 @@ static vec2 fpt(const polar *pd, int frame, uint32_t i)
     return f;
 }
 
+/* polar_from_frame, inlined. */
+static vec2 from_frame(int frame, vec2 f)
+{
+    vec2 r;
+    if (frame == 0) {
+        r.x = -f.y;
+        r.y = f.x;
+    } else {
+        r = f;
+    }
+    return r;
+}
+
+/* Sign of geom_orient(P, X, R) given x = X - P and r = R - P (differences
+ * rounded once, computed by the caller and reused across tests). These are
+ * the products geom_orient(X, R, P) filters, the same sign (a cyclic turn of
+ * the arguments); geom_orient decides when the filter cannot. */
+static int orient_rel(double xx, double xy, double rx, double ry, vec2 P, vec2 X, vec2 R)
+{
+    int o = geom_orient_filter(xx * ry, xy * rx);
+    return o ? o : geom_orient(P, X, R);
+}
+
 static int push(walker *w, const cone *c)
 {
     chunk *k = w->top;
@@ -111,10 +143,32 @@ static void add_hit(walker *w, int32_t b)
     w->last_hit = b;
 }
 
-static int cmp_u32(const void *x, const void *y)
+/* Sorts v[0..n-1] ascending; tmp holds n more. Radix sort by bytes, only
+ * as many passes as the largest value needs (two below 65536 buildings):
+ * a few hundred hits per query, where qsort's calls cost more. Returns the
+ * array holding the result (v or tmp). */
+static uint32_t *sort_u32(uint32_t *v, uint32_t *tmp, uint32_t n)
 {
-    uint32_t a = *(const uint32_t *)x, b = *(const uint32_t *)y;
-    return (a > b) - (a < b);
+    uint32_t all = 0, i, sh;
+    for (i = 0; i < n; i++)
+        all |= v[i];
+    for (sh = 0; sh < 32 && (all >> sh) != 0; sh += 8) {
+        uint32_t cnt[256], sum = 0, *t;
+        memset(cnt, 0, sizeof cnt);
+        for (i = 0; i < n; i++)
+            cnt[(v[i] >> sh) & 255]++;
+        for (i = 0; i < 256; i++) {
+            uint32_t c = cnt[i];
+            cnt[i] = sum;
+            sum += c;
+        }
+        for (i = 0; i < n; i++)
+            tmp[cnt[(v[i] >> sh) & 255]++] = v[i];
+        t = v;
+        v = tmp;
+        tmp = t;
+    }
+    return v;
 }
 
 static int pop(walker *w, cone *c)
@@ -236,13 +290,25 @@ static double cone_width(vec2 P, vec2 A, vec2 B)
     return atan2(ax * by - ay * bx, ax * bx + ay * by);
 }
 
-/* A closed cone (frame rays A, B) meeting wall piece s. */
-static void close_cone(walker *w, uint32_t s, vec2 A, vec2 B)
+/* Is the angle from ray PA to ray PB surely above 1e-6 rad, so that
+ * cone_width need not be asked? cr is the rounded cross product (error below
+ * 3 ulp of |a|_1 |b|_1), and |a| |b| <= |a|_1 |b|_1 bounds the sine from
+ * below. When no, cone_width decides, as before. */
+static int clearly_wide(vec2 P, vec2 A, vec2 B)
+{
+    double ax = A.x - P.x, ay = A.y - P.y, bx = B.x - P.x, by = B.y - P.y;
+    return ax * by - ay * bx > 1e-6 * (fabs(ax) + fabs(ay)) * (fabs(bx) + fabs(by));
+}
+
+/* A closed cone c meeting wall piece s. (By pointer: its points passed as
+ * values were packed through the stack on every call.) */
+static void close_cone(walker *w, uint32_t s, const cone *c)
 {
     const polar *pd = w->pd;
+    const vec2 A = c->A, B = c->B;
     const polar_seg *g = &pd->seg[s];
     int frame = w->m->frame;
-    vec2 wa = polar_from_frame(frame, A), wb = polar_from_frame(frame, B);
+    vec2 wa = from_frame(frame, A), wb = from_frame(frame, B);
     int k;
     w->out->ncones++;
     if (g->bld[0] == -2) {
@@ -256,7 +322,7 @@ static void close_cone(walker *w, uint32_t s, vec2 A, vec2 B)
     }
     add_piece(w, ray_line(w->p, wa, pd->pts[g->a], pd->pts[g->b]),
               ray_line(w->p, wb, pd->pts[g->a], pd->pts[g->b]), s);
-    if (!w->want_vis || cone_width(w->P, A, B) < VIS_MIN_WIDTH)
+    if (!w->want_vis || (!clearly_wide(w->P, A, B) && cone_width(w->P, A, B) < VIS_MIN_WIDTH))
         return;
     for (k = 0; k < 2; k++)
         if (g->bld[k] >= 0)
@@ -287,67 +353,108 @@ static int past_wall(const walker *w, const cone *c, vec2 R, int below)
     return sgn * cr > 1e-9 * (fabs(xx) + fabs(xy)) * (fabs(cx2) + fabs(cy2));
 }
 
-/* Walks one cone until it is closed or split; pushes the later half. */
+/* The region after region c->t past its corner R, below R in the frame
+ * (low = 1) or above it; POLAR_NONE when the cone closes there, on *wall. */
+static uint32_t advance(const walker *w, const cone *c, vec2 R, int low, uint32_t *wall)
+{
+    const polar_trap *tr = &w->m->trap[c->t];
+    uint32_t nx = tr->nb[low ? (c->right ? LR : LL) : (c->right ? UR : UL)];
+    if (nx == POLAR_NONE || past_wall(w, c, R, low)) {
+        *wall = low ? tr->bot : tr->top;
+        return POLAR_NONE;
+    }
+    return nx;
+}
+
+/* Walks one cone until it is closed; pushes the later half at a split.
+ * The limit rays are kept as differences from P (a, b), and the corner of
+ * each region as r = R - P, so that each orientation test costs two
+ * products and the filter. */
 static void step(walker *w, cone c)
 {
     const polar_map *m = w->m;
+    const polar_trap *trap = m->trap;
+    const vec2 *pts = w->pd->pts;
+    const vec2 P = w->P;
+    const int frame = m->frame;
+    const uint32_t end = c.right ? m->box_hi : m->box_lo;
+    double ax = c.A.x - P.x, ay = c.A.y - P.y, bx = c.B.x - P.x, by = c.B.y - P.y;
+    uint32_t steps = 0;
     for (;;) {
-        uint32_t r, nx;
+        uint32_t r = c.right ? trap[c.t].rp : trap[c.t].lp, nx, wall;
         vec2 R;
-        int oA, oB, below_only, above_only;
-        cone hi;
-        w->out->nsteps++;
-        r = c.right ? m->trap[c.t].rp : m->trap[c.t].lp;
-        if (r == (c.right ? m->box_hi : m->box_lo)) {
+        double rx, ry;
+        int low;
+        steps++;
+        /* the next region is one of these two: fetch both while the
+         * orientation tests run (large cities do not fit in the cache) */
+        {
+            const uint32_t *nb = trap[c.t].nb + (c.right ? UR : UL);
+            if (nb[0] != POLAR_NONE)
+                PREFETCH(&trap[nb[0]]);
+            if (nb[1] != POLAR_NONE)
+                PREFETCH(&trap[nb[1]]);
+            PREFETCH(&w->pd->seg[trap[c.t].top]);
+            PREFETCH(&w->pd->seg[trap[c.t].bot]);
+        }
+        if (r == end) {
             w->out->ncones++;
-            close_box(w, polar_from_frame(m->frame, c.A), polar_from_frame(m->frame, c.B));
-            return;
+            close_box(w, from_frame(frame, c.A), from_frame(frame, c.B));
+            break;
         }
-        R = fpt(w->pd, m->frame, r);
-        /* "below" = the part passing below R in the frame; the limit ray A
-         * is only looked at when B does not decide */
-        oB = geom_orient(w->P, c.B, R);
-        oA = oB >= 0 ? 1 : geom_orient(w->P, c.A, R);
-        if (c.right) {
-            below_only = oB >= 0;
-            above_only = !below_only && oA <= 0;
+        if (frame == 0) {
+            R.x = pts[r].y;
+            R.y = -pts[r].x;
         } else {
-            above_only = oB >= 0;
-            below_only = !above_only && oA <= 0;
+            R = pts[r];
         }
-        if (!below_only && !above_only) {
-            /* R splits the cone: clockwise half first */
-            hi = c;
+        rx = R.x - P.x;
+        ry = R.y - P.y;
+        /* "low" = the cone passes below R in the frame; the limit ray A is
+         * only looked at when B does not decide */
+        if (orient_rel(bx, by, rx, ry, P, c.B, R) >= 0) {
+            low = (int)c.right;
+        } else if (orient_rel(ax, ay, rx, ry, P, c.A, R) <= 0) {
+            low = !c.right;
+        } else {
+            /* R splits the cone: clockwise half first. The later half is
+             * moved past R now (its next step would test R against its own
+             * limit ray, an exact zero) and walked when popped. */
+            cone hi = c;
             hi.A = R;
             c.B = R;
+            bx = rx;
+            by = ry;
+            steps++;
+            nx = advance(w, &hi, R, !c.right, &wall);
+            if (nx == POLAR_NONE)
+                hi.shut = wall;
+            else
+                hi.t = nx;
             if (!push(w, &hi))
-                return;
+                break;
             /* the clockwise half is below R when moving right */
-            below_only = c.right;
-            above_only = !c.right;
+            low = (int)c.right;
         }
-        if (below_only) {
-            nx = m->trap[c.t].nb[c.right ? LR : LL];
-            if (nx == POLAR_NONE || past_wall(w, &c, R, 1)) {
-                close_cone(w, m->trap[c.t].bot, c.A, c.B);
-                return;
-            }
-        } else {
-            nx = m->trap[c.t].nb[c.right ? UR : UL];
-            if (nx == POLAR_NONE || past_wall(w, &c, R, 0)) {
-                close_cone(w, m->trap[c.t].top, c.A, c.B);
-                return;
-            }
+        nx = advance(w, &c, R, low, &wall);
+        if (nx == POLAR_NONE) {
+            close_cone(w, wall, &c);
+            break;
         }
         c.t = nx;
     }
+    w->out->nsteps += steps;
 }
 
 static void run(walker *w, cone c)
 {
     step(w, c);
-    while (!w->nomem && !w->stopped && pop(w, &c))
-        step(w, c);
+    while (!w->nomem && !w->stopped && pop(w, &c)) {
+        if (c.shut != POLAR_NONE)
+            close_cone(w, c.shut, &c);
+        else
+            step(w, c);
+    }
 }
 
 /* A ray point for world direction angle ang within quadrant q. */
@@ -390,6 +497,7 @@ static void walk_cone(walker *w, int mi, int q, vec2 A, vec2 B, const uint32_t t
     c.A = polar_to_frame(w->m->frame, A);
     c.B = polar_to_frame(w->m->frame, B);
     c.t = t0[mi];
+    c.shut = POLAR_NONE;
     c.right = mi == 0 ? (q == 0 || q == 1) : (q == 0 || q == 3);
     run(w, c);
 }
@@ -521,7 +629,7 @@ plx_status vis_query(const polar *pd, vec2 p, double a0, double a1, int full_cir
         out->npoly--;
     out->area = 0.5 * w.area2;
     if (!w.nomem && w.nhits > 0) {
-        uint32_t *all = arena_scratch(a, (size_t)w.nhits * 4, 16), n = 0;
+        uint32_t *all = arena_scratch(a, (size_t)w.nhits * 8, 16), n = 0;
         hchunk *k;
         if (!all) {
             w.nomem = 1;
@@ -530,7 +638,7 @@ plx_status vis_query(const polar *pd, vec2 p, double a0, double a1, int full_cir
                 memcpy(all + n, k->v, k->n * 4);
                 n += k->n;
             }
-            qsort(all, n, 4, cmp_u32);
+            all = sort_u32(all, all + n, n);
             for (i = 0; i < n; i++) {
                 if (i > 0 && all[i] == all[i - 1])
                     continue;

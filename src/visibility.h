@@ -17,7 +17,12 @@
  * the Bounds box with its corners) and the visible set. Every split and every
  * closing decision is a geom_orient sign; only the output points are rounded.
  * Cost: locating p (polar.h: a grid scan, O(1) expected for evenly spread
- * walls), then O(1) per region a cone crosses.
+ * walls), then O(1) per region a cone crosses: one or two orientation tests
+ * of the region's corner against the cone's limit rays, on differences from
+ * p computed once per cone and per corner, decided by geom_orient's filter
+ * inline (the exact fallback only near collinearity). The later half of a
+ * split is moved past the splitting corner at once rather than testing that
+ * corner against its own limit ray (an exact zero) when it is popped.
  *
  * Visible set: building i is visible iff a closed cone of positive angular
  * width (at least 1e-12 rad, so that a rounded range limit passing a hair

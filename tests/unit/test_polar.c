@@ -555,6 +555,129 @@ static void test_courtyard_and_kiosk(void **state)
     fixture_free(f);
 }
 
+/* A lattice of boxes with aligned corners, some sharing walls, some touching
+ * at one corner only, and an octagon with chamfered corners: viewers on the
+ * lines through two vertices, on the extensions of walls, on the axes of
+ * vertices, and exactly diagonal to corners. Many cones get split by a
+ * corner whose later half closes at once on that corner's wall, or walks
+ * along a row of corners lying exactly on one of its limit rays. */
+static vec2 lattice_scene(fixture *f)
+{
+    static const double oct[16] = { 62, 40, 66, 40, 68, 42, 68, 46, 66, 48, 62, 48, 60, 46,
+                                    60, 42 };
+    vec2 lo = { 0, 0 };
+    int i, j;
+    for (i = 0; i < 4; i++)
+        for (j = 0; j < 4; j++) {
+            double x = 10.0 * i, y = 10.0 * j, w = (i == 1 ? 10.0 : 6.0);
+            assert_true(ref_scene_add_box(&f->s, x, y, x + w, y + 6, 10, 0) >= 0);
+        }
+    /* touching the lattice at the corner (46, 36) only */
+    assert_true(ref_scene_add_box(&f->s, 36, 36, 46, 46, 10, 0) >= 0);
+    assert_true(ref_scene_add_box(&f->s, 46, 30, 52, 36, 10, 0) >= 0);
+    assert_true(add_poly(f, oct, 8) >= 0);
+    return lo;
+}
+
+static void test_lattice_alignments(void **state)
+{
+    fixture *f = fixture_new();
+    vec2 p[] = {
+        { -4, -4 }, { 8, 8 }, { 8, -2 }, { -2, 8 }, { 28, 28 }, { 48, 8 },  /* diagonals */
+        { 8, 40 }, { -5, 6 }, { 48, 0 }, { 3, 48 },      /* wall extensions, vertex axes */
+        { 58, 48 }, { 70, 40 }, { 56, 24 }, { 46, 50 },  /* chamfers, touching corner */
+        { 52, 40 }, { 41, 29 }, { 9, 3 }, { 58.5, 29 },
+    };
+    (void)state;
+    lattice_scene(f);
+    fixture_build(f);
+    expect_all(f, p, (int)(sizeof p / sizeof p[0]));
+    fixture_free(f);
+}
+
+/* Exact rays (side 0) against the two one-sided rays, each walked alone:
+ * the exact ray is blocked where the farther of them is (the one turned
+ * counter-clockwise on a tie), to the bit. Rays at random, through
+ * vertices, along walls, along the axes of vertices. */
+static int shoot_same(fixture *f, vec2 p, vec2 q, int *parted)
+{
+    polar_hit h, hp, hm;
+    const polar_hit *w;
+    plx_status st = polar_shoot_to(f->pd, p, q, 0, &h);
+    if (polar_shoot_to(f->pd, p, q, 1, &hp) != st || polar_shoot_to(f->pd, p, q, -1, &hm) != st)
+        return 0;
+    if (st != PLX_OK)
+        return 1;
+    w = hm.t > hp.t ? &hm : &hp;
+    if (hp.seg != hm.seg)
+        (*parted)++;
+    return h.bld == w->bld && h.bld2 == w->bld2 && h.seg == w->seg && h.t == w->t &&
+           h.pt.x == w->pt.x && h.pt.y == w->pt.y && h.steps <= hp.steps + hm.steps;
+}
+
+static void test_shoot_exact_once(void **state)
+{
+    fixture *f = fixture_new();
+    int n, bad = 0, parted = 0, rays = 0;
+    (void)state;
+    rnd_state = 6000u;
+    lattice_scene(f);
+    add_rotated_box(f, 75, 5, 8, 5, 0.6);
+    fixture_build(f);
+    for (n = 0; n < 3000; n++) {
+        const vec2 *v = f->pd->pts;
+        uint32_t nv = f->pd->npts, a = (uint32_t)(urand() * nv), b = (uint32_t)(urand() * nv);
+        vec2 p, q;
+        double t = urand();
+        switch (n % 5) {
+        case 0:                         /* random */
+            p.x = -8 + urand() * 96;
+            p.y = -8 + urand() * 66;
+            q.x = p.x + urand() * 20 - 10;
+            q.y = p.y + urand() * 20 - 10;
+            break;
+        case 1:                         /* towards a vertex */
+            p.x = -8 + urand() * 96;
+            p.y = -8 + urand() * 66;
+            q = v[a];
+            break;
+        case 2:                         /* on the line through two vertices */
+            p.x = v[a].x + (t * 3 - 1) * (v[b].x - v[a].x);
+            p.y = v[a].y + (t * 3 - 1) * (v[b].y - v[a].y);
+            q = urand() < 0.5 ? v[a] : v[b];
+            break;
+        case 3:                         /* on a vertex's axis, along the axis */
+            p = v[a];
+            if (urand() < 0.5)
+                p.x += urand() * 20 - 10;
+            else
+                p.y += urand() * 20 - 10;
+            q = v[a];
+            break;
+        default:                        /* exactly diagonal from a vertex */
+            t = floor(urand() * 12) - 6;
+            p.x = v[a].x + t;
+            p.y = v[a].y + (urand() < 0.5 ? t : -t);
+            q = v[a];
+            break;
+        }
+        if (p.x == q.x && p.y == q.y)
+            continue;
+        rays++;
+        if (!shoot_same(f, p, q, &parted)) {
+            if (bad < 5)
+                print_message("ray (%.17g, %.17g) -> (%.17g, %.17g) differs\n", p.x, p.y, q.x,
+                              q.y);
+            bad++;
+        }
+    }
+    assert_int_equal(bad, 0);
+    /* the one-sided rays parted at a vertex on hundreds of the rays */
+    assert_true(parted > 300);
+    assert_true(rays > 2900);
+    fixture_free(f);
+}
+
 static void test_errors(void **state)
 {
     fixture *f = fixture_new();
@@ -964,6 +1087,8 @@ int main(void)
         cmocka_unit_test(test_shared_walls),
         cmocka_unit_test(test_collinear_neighbour_edges),
         cmocka_unit_test(test_courtyard_and_kiosk),
+        cmocka_unit_test(test_lattice_alignments),
+        cmocka_unit_test(test_shoot_exact_once),
         cmocka_unit_test(test_first_object),
         cmocka_unit_test(test_regions_tile_free_space),
         cmocka_unit_test(test_memory_accounting),
