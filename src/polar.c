@@ -744,6 +744,7 @@ typedef struct snode {
     int32_t cov;        /* footprints covering the gap above it */
     uint32_t open;      /* the free region open above it, or POLAR_NONE */
     uint32_t prev, next; /* status list; prev == POLAR_NONE: not in it */
+    uint32_t li, ri;    /* point indices of l and r */
 } snode;
 
 typedef struct fpoint {
@@ -1007,6 +1008,8 @@ typedef struct dbuild {
     uint32_t nchunk, maxchunk, nnode;
     uint32_t *list, *up, *lo; /* per crossed trapezoid: it, its new upper / lower part */
     const uint32_t *canon;   /* per point: the first point at its position */
+    const snode *N;          /* per piece: frame ends, left first (the sweep's) */
+    uint32_t *hint;          /* per canonical point: its x node, POLAR_NONE */
     int fail;                /* 1: out of memory, 2: pieces not planar */
 } dbuild;
 
@@ -1059,14 +1062,14 @@ static uint32_t new_node(dbuild *b, uint32_t kind, uint32_t idx, uint32_t c0, ui
 /* The y test of piece s: its kind by which end is frame-left. */
 static uint32_t ykind(const dbuild *b, uint32_t s)
 {
-    const polar_seg *g = &b->pd->seg[s];
-    return lex_cmp(bpt(b, g->a), bpt(b, g->b)) < 0 ? N_Y : N_YB;
+    return b->pd->seg[s].a == b->N[s].li ? N_Y : N_YB;
 }
 
-/* Descends the DAG with the left end P of a new piece PQ. */
-static uint32_t find_first(dbuild *b, vec2 P, vec2 Q)
+/* Descends the DAG with the left end P of a new piece PQ, from node n:
+ * the root, or the x node of P if P is already in the map (its cell, the
+ * trapezoid that held P when it came in, holds everything just right of P). */
+static uint32_t find_first(dbuild *b, uint32_t n, vec2 P, vec2 Q)
 {
-    uint32_t n = 0;
     for (;;) {
         const uint32_t *nd = dnode(b, n);
         uint32_t w = nd[0];
@@ -1075,11 +1078,10 @@ static uint32_t find_first(dbuild *b, vec2 P, vec2 Q)
         if (KIND(w) == N_X) {
             n = lex_cmp(P, bpt(b, IDX(w))) < 0 ? nd[1] : nd[2];
         } else {
-            const polar_seg *g = &b->pd->seg[IDX(w)];
-            vec2 L = bpt(b, KIND(w) == N_Y ? g->a : g->b), R = bpt(b, KIND(w) == N_Y ? g->b : g->a);
-            int o = geom_orient(L, R, P);
+            const snode *g = &b->N[IDX(w)];
+            int o = geom_orient(g->l, g->r, P);
             if (o == 0)
-                o = geom_orient(L, R, Q);   /* a shared left end: the slopes */
+                o = geom_orient(g->l, g->r, Q);   /* a shared left end: the slopes */
             if (o == 0) {
                 b->fail = 2;
                 return POLAR_NONE;
@@ -1110,7 +1112,7 @@ static uint32_t follow(dbuild *b, uint32_t l, uint32_t r)
 {
     vec2 P = bpt(b, l), Q = bpt(b, r);
     uint32_t k = 0;
-    b->list[0] = find_first(b, P, Q);
+    b->list[0] = find_first(b, b->hint[l] != POLAR_NONE ? b->hint[l] : 0, P, Q);
     if (b->fail)
         return 0;
     while (lex_cmp(Q, bpt(b, b->T[b->list[k]].rp)) > 0) {
@@ -1227,11 +1229,15 @@ static void replace_leaf(dbuild *b, uint32_t s, uint32_t l, uint32_t r, uint32_t
         nd[0] = PACK(N_X, l);
         nd[1] = b->T[A].leaf;
         nd[2] = xq;
+        b->hint[l] = n;
+        if (B != POLAR_NONE)
+            b->hint[r] = xq;
     } else if (!b->fail) {
         nd = dnode(b, n);
         nd[0] = PACK(N_X, r);
         nd[1] = inner;
         nd[2] = b->T[B].leaf;
+        b->hint[r] = n;
     }
 }
 
@@ -1323,20 +1329,19 @@ static uint32_t leaf_word(const dbuild *b, const sweep *w, const uint32_t *hash,
     return POLAR_NONE;
 }
 
-/* Leaves to child words, the inner nodes numbered breadth-first from the
- * root and kept (polar_memory: rest). */
+/* Leaves to child words, the inner nodes kept in the order they were made
+ * (the top levels first; with the insertion order, nodes made together lie
+ * together) and counted in polar_memory (rest). */
 static plx_status dag_keep(arena *a, polar *pd, polar_map *m, dbuild *b, const sweep *w)
 {
-    uint32_t mask = 1, i, j, t, nq = 0, *hash, *word, *nrenum, *queue;
+    uint32_t mask = 1, i, j, nq = 0, *hash, *fw;
     uint8_t *hit;
     while (mask < 2 * w->ntrap + 2)
         mask *= 2;
     hash = scratch_n(a, mask, 4);
     hit = scratch_n(a, w->ntrap, 1);
-    word = scratch_n(a, b->ntrap, 4);
-    nrenum = scratch_n(a, b->nnode, 4);
-    queue = scratch_n(a, b->nnode, 4);
-    if (!hash || !hit || !word || !nrenum || !queue)
+    fw = scratch_n(a, b->nnode, 4);
+    if (!hash || !hit || !fw)
         return PLX_E_NOMEM;
     mask--;
     memset(hash, 0xff, ((size_t)mask + 1) * 4);
@@ -1348,57 +1353,89 @@ static plx_status dag_keep(arena *a, polar *pd, polar_map *m, dbuild *b, const s
             h = (h + 1) & mask;
         hash[h] = i;
     }
-    for (t = 0; t < b->ntrap; t++)
-        if (b->T[t].leaf != POLAR_NONE &&
-            (word[t] = leaf_word(b, w, hash, mask, hit, t)) == POLAR_NONE)
+    /* fw: per build node its child word */
+    for (i = 0; i < b->nnode; i++) {
+        uint32_t w0 = dnode(b, i)[0];
+        if (KIND(w0) != N_LEAF)
+            fw[i] = PACK(POLAR_CHILD_NODE, nq++);
+        else if ((fw[i] = leaf_word(b, w, hash, mask, hit, IDX(w0))) == POLAR_NONE)
             return PLX_E_SCENE;
+    }
     for (i = 0; i < w->ntrap; i++)    /* every region of positive width is a leaf */
         if (!hit[i] && lex_cmp(bpt(b, w->T[i].lp), bpt(b, w->T[i].rp)) < 0)
             return PLX_E_SCENE;
-    for (i = 0; i < b->nnode; i++)
-        nrenum[i] = POLAR_NONE;
-    if (KIND(dnode(b, 0)[0]) != N_LEAF) {
-        nrenum[0] = 0;
-        queue[nq++] = 0;
-    }
-    for (i = 0; i < nq; i++) {
-        for (j = 1; j < 3; j++) {
-            uint32_t c = dnode(b, queue[i])[j];
-            if (KIND(dnode(b, c)[0]) != N_LEAF && nrenum[c] == POLAR_NONE) {
-                nrenum[c] = nq;
-                queue[nq++] = c;
-            }
-        }
-    }
     m->nnode = nq;
     m->node = keep_n(a, nq, 12, &pd->bytes[3]);
     if (!m->node)
         return PLX_E_NOMEM;
-    for (i = 0; i <= nq; i++) {
-        uint32_t o = i < nq ? queue[i] : 0, w3[3];
-        const uint32_t *nd = dnode(b, o);
-        for (j = 0; j < 3; j++) {
-            uint32_t c = j == 0 ? o : nd[j], kc = KIND(dnode(b, c)[0]);
-            w3[j] = kc == N_LEAF ? word[IDX(dnode(b, c)[0])] : PACK(POLAR_CHILD_NODE, nrenum[c]);
-        }
-        if (i == nq) {
-            m->root = w3[0];    /* the root: node 0 */
-        } else {
-            m->node[i][0] = nd[0];
-            m->node[i][1] = w3[1];
-            m->node[i][2] = w3[2];
-        }
+    for (i = 0, j = 0; i < b->nnode; i++) {
+        const uint32_t *nd = dnode(b, i);
+        if (KIND(nd[0]) == N_LEAF)
+            continue;
+        m->node[j][0] = nd[0];
+        m->node[j][1] = fw[nd[1]];
+        m->node[j][2] = fw[nd[2]];
+        j++;
     }
+    m->root = fw[0];
+    return PLX_OK;
+}
+
+static uint32_t spread16(uint32_t x)
+{
+    x &= 0xffffu;
+    x = (x | (x << 8)) & 0x00ff00ffu;
+    x = (x | (x << 4)) & 0x0f0f0f0fu;
+    x = (x | (x << 2)) & 0x33333333u;
+    x = (x | (x << 1)) & 0x55555555u;
+    return x;
+}
+
+/* The insertion order of the wall pieces, shared by both maps: a biased
+ * randomized insertion order (Amenta, Choi, Rote 2003). Every piece draws
+ * a round from a seeded generator (the last round holds about half of
+ * them, the one before a quarter, ...); rounds go in order and, within a
+ * round, pieces follow a Z-order curve of their midpoints. The rounds are
+ * random samples, which keeps the expected bounds of randomized
+ * incremental construction (size, search path length); the spatial order
+ * within a round makes consecutive insertions walk the same nodes (cache
+ * hits). Deterministic: no global state. */
+static plx_status insertion_order(arena *a, const polar *pd, uint32_t **out)
+{
+    uint32_t i, n = pd->nwall, *order = scratch_n(a, n, 4);
+    keyed *k = scratch_n(a, n, sizeof(keyed));
+    uint64_t seed = 0x9e3779b97f4a7c15ull;
+    double sx = 65535.0 / (pd->box[2] - pd->box[0]), sy = 65535.0 / (pd->box[3] - pd->box[1]);
+    if (!order || !k)
+        return PLX_E_NOMEM;
+    for (i = 0; i < n; i++) {
+        const polar_seg *g = &pd->seg[i];
+        vec2 pa = pd->pts[g->a], pb = pd->pts[g->b];
+        uint64_t r = rng_step(&seed) >> 20;
+        uint32_t round = 0, ux, uy;
+        double mx = 0.5 * (pa.x + pb.x) - pd->box[0], my = 0.5 * (pa.y + pb.y) - pd->box[1];
+        while (round < 40 && (r & 1u)) {   /* round 40 - t with probability 2^-(t+1) */
+            round++;
+            r >>= 1;
+        }
+        ux = (uint32_t)fmin(fmax(mx * sx, 0.0), 65535.0);
+        uy = (uint32_t)fmin(fmax(my * sy, 0.0), 65535.0);
+        k[i].key = (double)(40 - round) * 4294967296.0 + (double)(spread16(ux) | (spread16(uy) << 1));
+        k[i].idx = i;
+    }
+    qsort(k, n, sizeof(keyed), cmp_keyed);
+    for (i = 0; i < n; i++)
+        order[i] = k[i].idx;
+    *out = order;
     return PLX_OK;
 }
 
 /* Builds the search DAG of map m (after its sweep w). */
 static plx_status build_dag(arena *a, polar *pd, polar_map *m, const sweep *w,
-                            const uint32_t *canon)
+                            const uint32_t *canon, const uint32_t *order)
 {
     dbuild b;
-    uint32_t nw = pd->nwall, i, *order, t;
-    uint64_t seed = 0x9e3779b97f4a7c15ull + (uint64_t)m->frame * 0x632be59bd9b4e019ull;
+    uint32_t nw = pd->nwall, i, t;
     if (nw >= (1u << 28) || pd->npts >= (1u << 30))
         return PLX_E_NOMEM;   /* indices must fit in 30 bits */
     memset(&b, 0, sizeof b);
@@ -1406,6 +1443,7 @@ static plx_status build_dag(arena *a, polar *pd, polar_map *m, const sweep *w,
     b.a = a;
     b.frame = m->frame;
     b.canon = canon;
+    b.N = w->N;
     b.cap = 5 * nw + 64;
     /* expected about 8 nodes per piece; beyond 64 the shuffle has failed
      * beyond any reasonable chance (reported as out of memory) */
@@ -1418,24 +1456,15 @@ static plx_status build_dag(arena *a, polar *pd, polar_map *m, const sweep *w,
     b.up = scratch_n(a, b.cap, 4);
     b.lo = scratch_n(a, b.cap, 4);
     b.chunk = scratch_n(a, b.maxchunk, sizeof *b.chunk);
-    order = scratch_n(a, nw, 4);
-    if (!b.T || !b.freel || !b.list || !b.up || !b.lo || !b.chunk || !order)
+    b.hint = scratch_n(a, pd->npts, 4);
+    if (!b.T || !b.freel || !b.list || !b.up || !b.lo || !b.chunk || !b.hint)
         return PLX_E_NOMEM;
-    for (i = 0; i < nw; i++)
-        order[i] = i;
-    for (i = nw; i > 1; i--) {
-        uint32_t j = (uint32_t)(rng_step(&seed) % i), x = order[i - 1];
-        order[i - 1] = order[j];
-        order[j] = x;
-    }
+    memset(b.hint, 0xff, (size_t)pd->npts * 4);
     t = new_trap(&b);
     set_trap(&b, t, m->box_lo, m->box_hi, m->box_top, m->box_bot);
     b.T[t].leaf = new_node(&b, N_LEAF, t, 0, 0);
-    for (i = 0; i < nw && !b.fail; i++) {
-        uint32_t l, r;
-        seg_ends(pd, m->frame, order[i], &l, &r);
-        insert_seg(&b, order[i], l, r);
-    }
+    for (i = 0; i < nw && !b.fail; i++)
+        insert_seg(&b, order[i], w->N[order[i]].li, w->N[order[i]].ri);
     if (b.fail)
         return b.fail == 1 ? PLX_E_NOMEM : PLX_E_SCENE;
     return dag_keep(a, pd, m, &b, w);
@@ -1445,7 +1474,7 @@ static plx_status build_dag(arena *a, polar *pd, polar_map *m, const sweep *w,
  * are kept, then (unless flags say otherwise) the search DAG. */
 static plx_status build_map(arena *a, polar *pd, polar_map *m, const wgrid *g,
                             const uint32_t *inc_first, const uint32_t *inc, const uint32_t *evp,
-                            uint32_t nev, int flags)
+                            uint32_t nev, const uint32_t *order)
 {
     sweep w;
     fpoint *ev, *tmp;
@@ -1471,6 +1500,8 @@ static plx_status build_map(arena *a, polar *pd, polar_map *m, const wgrid *g,
         seg_ends(pd, m->frame, s, &l, &r);
         w.N[s].l = fpt(pd, m->frame, l);
         w.N[s].r = fpt(pd, m->frame, r);
+        w.N[s].li = l;
+        w.N[s].ri = r;
         w.N[s].cov = 0;
         w.N[s].open = POLAR_NONE;
         w.N[s].prev = w.N[s].next = POLAR_NONE;
@@ -1503,9 +1534,9 @@ static plx_status build_map(arena *a, polar *pd, polar_map *m, const wgrid *g,
     /* polar_memory: the axes (lp, rp, nb) and the regions (top, bot) */
     pd->bytes[0] -= (size_t)w.ntrap * 8;
     pd->bytes[1] += (size_t)w.ntrap * 8;
-    if (flags & POLAR_BUILD_NO_DAG)
+    if (!order)
         return PLX_OK;
-    return build_dag(a, pd, m, &w, canon);
+    return build_dag(a, pd, m, &w, canon, order);
 }
 
 /* Cuts the occluders' edges into wall pieces (pd->pts, pd->seg filled). */
@@ -1648,7 +1679,7 @@ plx_status polar_build_flags(arena *a, const scene *s, int flags, polar **out)
     polar *pd;
     plx_status st;
     wgrid g;
-    uint32_t *inc_first = NULL, *inc = NULL, *evp = NULL, nev = 0, i;
+    uint32_t *inc_first = NULL, *inc = NULL, *evp = NULL, *order = NULL, nev = 0, i;
     if (!a || !s || !out)
         return PLX_E_INVALID;
     *out = NULL;
@@ -1667,10 +1698,12 @@ plx_status polar_build_flags(arena *a, const scene *s, int flags, polar **out)
         st = build_grid(a, pd, &g, 0);
     if (st == PLX_OK)
         st = build_incidence(a, pd, &inc_first, &inc, &evp, &nev);
+    if (st == PLX_OK && !(flags & POLAR_BUILD_NO_DAG))
+        st = insertion_order(a, pd, &order);
     for (i = 0; st == PLX_OK && i < 2; i++) {
         arena_mark mm = arena_get_mark(a);
         pd->map[i].frame = (int)i;
-        st = build_map(a, pd, &pd->map[i], &g, inc_first, inc, evp, nev, flags);
+        st = build_map(a, pd, &pd->map[i], &g, inc_first, inc, evp, nev, order);
         /* give back this map's scratch (kept memory grows from the other end) */
         mm.lo = a->lo;
         mm.used[PLX_PART_POLAR] = a->used[PLX_PART_POLAR];
