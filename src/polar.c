@@ -745,6 +745,8 @@ typedef struct snode {
     uint32_t open;      /* the free region open above it, or POLAR_NONE */
     uint32_t prev, next; /* status list; prev == POLAR_NONE: not in it */
     uint32_t li, ri;    /* point indices of l and r */
+    uint32_t solid;     /* child word of a solid trapezoid on it (search DAG) */
+    uint32_t yk;        /* its search node kind: N_Y (l is seg.a) or N_YB */
 } snode;
 
 typedef struct fpoint {
@@ -1062,7 +1064,7 @@ static uint32_t new_node(dbuild *b, uint32_t kind, uint32_t idx, uint32_t c0, ui
 /* The y test of piece s: its kind by which end is frame-left. */
 static uint32_t ykind(const dbuild *b, uint32_t s)
 {
-    return b->pd->seg[s].a == b->N[s].li ? N_Y : N_YB;
+    return b->N[s].yk;
 }
 
 /* Descends the DAG with the left end P of a new piece PQ, from node n:
@@ -1091,6 +1093,31 @@ static uint32_t find_first(dbuild *b, uint32_t n, vec2 P, vec2 Q)
     }
 }
 
+/* The same from the right end Q of the new piece, known to the map: from
+ * its x node, with Q pushed towards P (ties at Q go left). */
+static uint32_t find_last(dbuild *b, uint32_t n, vec2 Q, vec2 P)
+{
+    for (;;) {
+        const uint32_t *nd = dnode(b, n);
+        uint32_t w = nd[0];
+        if (KIND(w) == N_LEAF)
+            return IDX(w);
+        if (KIND(w) == N_X) {
+            n = lex_cmp(Q, bpt(b, IDX(w))) <= 0 ? nd[1] : nd[2];
+        } else {
+            const snode *g = &b->N[IDX(w)];
+            int o = geom_orient(g->l, g->r, Q);
+            if (o == 0)
+                o = geom_orient(g->l, g->r, P);
+            if (o == 0) {
+                b->fail = 2;
+                return POLAR_NONE;
+            }
+            n = o > 0 ? nd[2] : nd[1];
+        }
+    }
+}
+
 /* Replaces the neighbour link 'old' of trapezoid x on side f. */
 static void relink(dbuild *b, uint32_t x, int f, uint32_t old, uint32_t nw)
 {
@@ -1106,12 +1133,41 @@ static void set_trap(dbuild *b, uint32_t t, uint32_t lp, uint32_t rp, uint32_t t
     b->T[t].bot = bot;
 }
 
+/* Follows the new piece leftwards from the trapezoid t holding its right
+ * end r; returns k, the trapezoids crossed being list[0..k], left first. */
+static uint32_t follow_back(dbuild *b, uint32_t t, vec2 P, vec2 Q)
+{
+    uint32_t k = 0, i;
+    b->list[0] = t;
+    while (lex_cmp(P, bpt(b, b->T[t].lp)) < 0) {
+        int o = geom_orient(P, Q, bpt(b, b->T[t].lp));
+        uint32_t nx = o > 0 ? b->T[t].nb[LL] : b->T[t].nb[UL];
+        if (o == 0 || nx == POLAR_NONE || k + 1 >= b->cap) {
+            b->fail = 2;
+            return k;
+        }
+        b->list[++k] = t = nx;
+    }
+    for (i = 0; i < k - i; i++) {
+        uint32_t x = b->list[i];
+        b->list[i] = b->list[k - i];
+        b->list[k - i] = x;
+    }
+    return k;
+}
+
 /* Follows the new piece (ends l < r) through the map; returns k, the
- * trapezoids crossed being list[0..k]. */
+ * trapezoids crossed being list[0..k]. The search starts at the x node of
+ * l, or of r when only r is in the map (then the piece is followed
+ * leftwards), or at the root. */
 static uint32_t follow(dbuild *b, uint32_t l, uint32_t r)
 {
     vec2 P = bpt(b, l), Q = bpt(b, r);
     uint32_t k = 0;
+    if (b->hint[l] == POLAR_NONE && b->hint[r] != POLAR_NONE) {
+        uint32_t t = find_last(b, b->hint[r], Q, P);
+        return b->fail ? 0 : follow_back(b, t, P, Q);
+    }
     b->list[0] = find_first(b, b->hint[l] != POLAR_NONE ? b->hint[l] : 0, P, Q);
     if (b->fail)
         return 0;
@@ -1314,11 +1370,8 @@ static uint32_t leaf_word(const dbuild *b, const sweep *w, const uint32_t *hash,
 {
     const btrap *x = &b->T[t];
     uint32_t h;
-    if (w->N[x->bot].cov != 0) {
-        int32_t own = seg_delta(b->pd, b->frame, x->bot) > 0 && b->pd->seg[x->bot].bld[0] >= 0
-                          ? b->pd->seg[x->bot].bld[0] : -1;
-        return PACK(POLAR_CHILD_SOLID, (uint32_t)(own + 1));
-    }
+    if (w->N[x->bot].cov != 0)
+        return w->N[x->bot].solid;
     for (h = trap_hash(x->top, x->bot, x->lp, mask); hash[h] != POLAR_NONE; h = (h + 1) & mask) {
         const polar_trap *r = &w->T[hash[h]];
         if (r->top == x->top && r->bot == x->bot && r->lp == x->lp) {
@@ -1502,6 +1555,15 @@ static plx_status build_map(arena *a, polar *pd, polar_map *m, const wgrid *g,
         w.N[s].r = fpt(pd, m->frame, r);
         w.N[s].li = l;
         w.N[s].ri = r;
+        {
+            /* polar_locate's owner inside the solid above s: the footprint
+             * entered across s, if any (see locate in polar_scan) */
+            const polar_seg *gs = &pd->seg[s];
+            int32_t own = (l == gs->a ? gs->cover : -gs->cover) > 0 && gs->bld[0] >= 0 ? gs->bld[0]
+                                                                                     : -1;
+            w.N[s].solid = PACK(POLAR_CHILD_SOLID, (uint32_t)(own + 1));
+            w.N[s].yk = l == gs->a ? N_Y : N_YB;
+        }
         w.N[s].cov = 0;
         w.N[s].open = POLAR_NONE;
         w.N[s].prev = w.N[s].next = POLAR_NONE;
