@@ -8,7 +8,12 @@
  * wall enters the sweep, so only free trapezoids are made. Points are
  * located by a search DAG: the same trapezoidal map built a second time by
  * randomized incremental insertion (see "the search DAG" below), its leaves
- * mapped to the sweep's free regions.
+ * mapped to the sweep's free regions or marked solid. The sweep stays: it
+ * checks that the pieces form a planar subdivision, gives the regions in a
+ * deterministic order with their adjacency, and costs about a third of the
+ * DAG's insertions. The grid of wall pieces the sweep uses (wall_below) is
+ * scratch; polar_scan keeps one, with the former grid-scan point location,
+ * as a reference for tests and benchmarks.
  */
 #include <float.h>
 #include <math.h>
@@ -586,7 +591,7 @@ static uint32_t grid_y(const polar *pd, const wgrid *g, double y)
 }
 
 /* Every wall piece listed in the cells its bounding box meets (about two
- * pieces per cell). Cell functions are monotone, which is all polar_locate
+ * pieces per cell). Cell functions are monotone, which is all wall_below
  * needs to stop its scan exactly. */
 static plx_status build_grid(arena *a, const polar *pd, wgrid *g, int keep)
 {
@@ -980,11 +985,16 @@ static plx_status build_incidence(arena *a, const polar *pd, uint32_t **inc_firs
  * through the trapezoids it crosses, and those are replaced by the pieces
  * left, right, above and below it (runs of pieces above or below whose
  * separating axis the new piece cuts away are merged, so one leaf may have
- * several parents). The order is a shuffle with a fixed seed, so the build
- * is deterministic while the expected bounds hold: O(n) nodes, O(log n)
- * nodes on a search path, O(n log n) time. The sweep (run first) has
- * already checked that the pieces do not cross; a failure here is reported
- * as PLX_E_SCENE all the same. In the end every leaf becomes a child word:
+ * several parents). The order is random from a fixed seed (see
+ * insertion_order), so the build is deterministic while the expected bounds
+ * hold: O(n) nodes, O(log n) nodes on a search path, O(n log n) time. A
+ * piece with an end already in the map is searched from that end's x node
+ * (most are: polygon edges share their ends), the others from the root.
+ * Measured (bench_polar): about 4.8 inner nodes per piece (12 bytes each)
+ * on a dense old town, search paths of about 2 log2 n nodes on average;
+ * the build costs about 3 times the rest of polar_build. The sweep (run
+ * first) has already checked that the pieces do not cross; a failure here
+ * is reported as PLX_E_SCENE all the same. In the end every leaf becomes a child word:
  * a free trapezoid is the sweep's region with the same floor, ceiling and
  * left axis (found through a hash; point indices are made canonical, the
  * first of the points sharing a position, as the sweep's events are), a
@@ -1473,7 +1483,8 @@ static plx_status insertion_order(arena *a, const polar *pd, uint32_t **out)
         }
         ux = (uint32_t)fmin(fmax(mx * sx, 0.0), 65535.0);
         uy = (uint32_t)fmin(fmax(my * sy, 0.0), 65535.0);
-        k[i].key = (double)(40 - round) * 4294967296.0 + (double)(spread16(ux) | (spread16(uy) << 1));
+        k[i].key = (double)(40 - round) * 4294967296.0 +
+                   (double)(spread16(ux) | (spread16(uy) << 1));
         k[i].idx = i;
     }
     qsort(k, n, sizeof(keyed), cmp_keyed);

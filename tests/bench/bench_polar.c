@@ -122,8 +122,8 @@ static int bench_locate(const polar *pd, arena *a, int nl, uint32_t nv)
         dsum += dep;
         dmax = dep > dmax ? dep : dmax;
     }
-    printf("  locate       DAG %6.0f ns/query  grid scan %6.0f ns/query  ratio %.2fx  (%d points x 2 "
-           "maps, best of 3; %s)\n", tdag, tscan, tscan / tdag, nl,
+    printf("  locate       DAG %6.0f ns/query  grid scan %6.0f ns/query  ratio %.2fx  "
+           "(%d points x 2 maps, best of 3; %s)\n", tdag, tscan, tscan / tdag, nl,
            bad ? "MISMATCH" : "same answers");
     printf("  search DAG   %u + %u nodes = %.1f bytes/vertex; depth mean %.1f max %u "
            "(log2 of wall pieces %.1f)\n", pd->map[0].nnode, pd->map[1].nnode,
@@ -212,7 +212,7 @@ static void bench(const char *name, const char *buf, size_t len, int nq)
            "%.1f ms: DAGs %.0f%%\n", tb, 1e3 * tb / nv, reps, tb0, 100.0 * (tb - tb0) / tb);
     printf("  memory       %8.2f MB = %5.1f bytes/vertex (arena part polar %.2f MB)\n",
            tot / 1048576.0, (double)tot / nv, kept / 1048576.0);
-    printf("    axes %5.1f  regions %5.1f  polygons %5.1f  rest %5.1f  bytes/vertex"
+    printf("    axes %5.1f  regions %5.1f  polygons %5.1f  rest (search DAGs) %5.1f  bytes/vertex"
            "  (regions %u + %u)\n", (double)by[0] / nv, (double)by[1] / nv,
            (double)by[2] / nv, (double)by[3] / nv, pd->map[0].ntrap, pd->map[1].ntrap);
 

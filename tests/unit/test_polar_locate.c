@@ -200,7 +200,8 @@ static int side_of(const polar *pd, int frame, uint32_t k, vec2 f)
 static int region_holds(const polar *pd, const polar_map *m, uint32_t t, vec2 f)
 {
     const polar_trap *r = &m->trap[t];
-    return lex(polar_fpt(pd, m->frame, r->lp), f) < 0 && lex(f, polar_fpt(pd, m->frame, r->rp)) < 0 &&
+    return lex(polar_fpt(pd, m->frame, r->lp), f) < 0 &&
+           lex(f, polar_fpt(pd, m->frame, r->rp)) < 0 &&
            side_of(pd, m->frame, r->top, f) < 0 && side_of(pd, m->frame, r->bot, f) > 0;
 }
 
@@ -210,6 +211,25 @@ typedef struct stats {
     double depth_sum;
     uint32_t depth_max;
 } stats;
+
+/* Prints a disagreement with the brute force and the footprints holding p. */
+static void report_bad(const polar *pd, int mi, vec2 p, int32_t r, int32_t od, int on, int in)
+{
+    uint32_t b, q;
+    print_message("map %d p = (%.17g, %.17g): answer %d owner %d (brute %d), on a wall %d, "
+                  "in a footprint %d\n", mi, p.x, p.y, r, od,
+                  brute_owner(pd, pd->map[mi].frame, polar_to_frame(pd->map[mi].frame, p)), on, in);
+    for (b = 0; b < pd->s->nbld; b++) {
+        const scene_ring *rg = &pd->s->rings[pd->s->bld[b].ring_first];
+        if (pd->s->bld[b].min_height > 0 || fp_where(pd->s, b, p) == GEOM_OUTSIDE)
+            continue;
+        print_message("  building %u (%d), outer ring:", b, fp_where(pd->s, b, p));
+        for (q = 0; q < rg->count; q++)
+            print_message(" (%.17g, %.17g)", pd->s->pts[rg->first + q].x,
+                          pd->s->pts[rg->first + q].y);
+        print_message("\n");
+    }
+}
 
 /* Checks world point p (inside the open Bounds box) in both maps. */
 static void check_point(const polar *pd, const polar_scan *g, vec2 p, stats *st)
@@ -255,20 +275,8 @@ static void check_point(const polar *pd, const polar_scan *g, vec2 p, stats *st)
             if ((r >= 0) == in)
                 st->ring_diff++;
         }
-        if (!ok && st->brute_bad++ < 5) {
-            uint32_t b;
-            print_message("map %d p = (%.17g, %.17g): answer %d owner %d (brute %d), on a wall %d, in a "
-                          "footprint %d\n", mi, p.x, p.y, r, od, brute_owner(pd, m->frame, f), on, in);
-            for (b = 0; b < pd->s->nbld; b++)
-                if (pd->s->bld[b].min_height <= 0 && fp_where(pd->s, b, p) != GEOM_OUTSIDE) {
-                    const scene_ring *rg = &pd->s->rings[pd->s->bld[b].ring_first];
-                    uint32_t q;
-                    print_message("  building %u where %d rings %u:", b, fp_where(pd->s, b, p), pd->s->bld[b].ring_count);
-                    for (q = 0; q < rg->count; q++)
-                        print_message(" (%.17g, %.17g)", pd->s->pts[rg->first + q].x, pd->s->pts[rg->first + q].y);
-                    print_message("\n");
-                }
-        }
+        if (!ok && st->brute_bad++ < 5)
+            report_bad(pd, mi, p, r, od, on, in);
     }
     st->points++;
 }
