@@ -1392,10 +1392,33 @@ static uint32_t leaf_word(const dbuild *b, const sweep *w, const uint32_t *hash,
     return POLAR_NONE;
 }
 
+/* Child word c (tag << 30 | index) in the narrow form, tag << 19 | index. */
+static uint64_t narrow_child(uint32_t c)
+{
+    return (uint64_t)(POLAR_TAG(c) << 19 | POLAR_IDX(c));
+}
+
+/* Stores inner node j of m: test t, children c0, c1 (32-bit forms). */
+static void put_node(polar_map *m, uint32_t j, uint32_t t, uint32_t c0, uint32_t c1)
+{
+    if (m->narrow) {
+        uint64_t x = (uint64_t)(KIND(t) << 20 | IDX(t)) | narrow_child(c0) << 22 |
+                     narrow_child(c1) << 43;
+        m->node[2 * (size_t)j] = (uint32_t)x;
+        m->node[2 * (size_t)j + 1] = (uint32_t)(x >> 32);
+    } else {
+        m->node[3 * (size_t)j] = t;
+        m->node[3 * (size_t)j + 1] = c0;
+        m->node[3 * (size_t)j + 2] = c1;
+    }
+}
+
 /* Leaves to child words, the inner nodes kept in the order they were made
  * (the top levels first; with the insertion order, nodes made together lie
- * together) and counted in polar_memory (rest). */
-static plx_status dag_keep(arena *a, polar *pd, polar_map *m, dbuild *b, const sweep *w)
+ * together), narrow when every index fits, and counted in polar_memory
+ * (rest). */
+static plx_status dag_keep(arena *a, polar *pd, polar_map *m, dbuild *b, const sweep *w,
+                           int flags)
 {
     uint32_t mask = 1, i, j, nq = 0, *hash, *fw;
     uint8_t *hit;
@@ -1428,17 +1451,16 @@ static plx_status dag_keep(arena *a, polar *pd, polar_map *m, dbuild *b, const s
         if (!hit[i] && lex_cmp(bpt(b, w->T[i].lp), bpt(b, w->T[i].rp)) < 0)
             return PLX_E_SCENE;
     m->nnode = nq;
-    m->node = keep_n(a, nq, 12, &pd->bytes[3]);
+    m->narrow = !(flags & POLAR_BUILD_WIDE_DAG) && nq < (1u << 19) && w->ntrap < (1u << 19) &&
+                pd->nbld < (1u << 19) - 1 && pd->npts < (1u << 20) && pd->nseg < (1u << 20);
+    m->node = keep_n(a, nq, m->narrow ? 8 : 12, &pd->bytes[3]);
     if (!m->node)
         return PLX_E_NOMEM;
     for (i = 0, j = 0; i < b->nnode; i++) {
         const uint32_t *nd = dnode(b, i);
         if (KIND(nd[0]) == N_LEAF)
             continue;
-        m->node[j][0] = nd[0];
-        m->node[j][1] = fw[nd[1]];
-        m->node[j][2] = fw[nd[2]];
-        j++;
+        put_node(m, j++, nd[0], fw[nd[1]], fw[nd[2]]);
     }
     m->root = fw[0];
     return PLX_OK;
@@ -1496,7 +1518,7 @@ static plx_status insertion_order(arena *a, const polar *pd, uint32_t **out)
 
 /* Builds the search DAG of map m (after its sweep w). */
 static plx_status build_dag(arena *a, polar *pd, polar_map *m, const sweep *w,
-                            const uint32_t *canon, const uint32_t *order)
+                            const uint32_t *canon, const uint32_t *order, int flags)
 {
     dbuild b;
     uint32_t nw = pd->nwall, i, t;
@@ -1531,14 +1553,14 @@ static plx_status build_dag(arena *a, polar *pd, polar_map *m, const sweep *w,
         insert_seg(&b, order[i], w->N[order[i]].li, w->N[order[i]].ri);
     if (b.fail)
         return b.fail == 1 ? PLX_E_NOMEM : PLX_E_SCENE;
-    return dag_keep(a, pd, m, &b, w);
+    return dag_keep(a, pd, m, &b, w, flags);
 }
 
 /* Builds the trapezoidal map of one frame: the sweep, whose free regions
  * are kept, then (unless flags say otherwise) the search DAG. */
 static plx_status build_map(arena *a, polar *pd, polar_map *m, const wgrid *g,
                             const uint32_t *inc_first, const uint32_t *inc, const uint32_t *evp,
-                            uint32_t nev, const uint32_t *order)
+                            uint32_t nev, const uint32_t *order, int flags)
 {
     sweep w;
     fpoint *ev, *tmp;
@@ -1609,7 +1631,7 @@ static plx_status build_map(arena *a, polar *pd, polar_map *m, const wgrid *g,
     pd->bytes[1] += (size_t)w.ntrap * 8;
     if (!order)
         return PLX_OK;
-    return build_dag(a, pd, m, &w, canon, order);
+    return build_dag(a, pd, m, &w, canon, order, flags);
 }
 
 /* Cuts the occluders' edges into wall pieces (pd->pts, pd->seg filled). */
@@ -1776,7 +1798,7 @@ plx_status polar_build_flags(arena *a, const scene *s, int flags, polar **out)
     for (i = 0; st == PLX_OK && i < 2; i++) {
         arena_mark mm = arena_get_mark(a);
         pd->map[i].frame = (int)i;
-        st = build_map(a, pd, &pd->map[i], &g, inc_first, inc, evp, nev, order);
+        st = build_map(a, pd, &pd->map[i], &g, inc_first, inc, evp, nev, order, flags);
         /* give back this map's scratch (kept memory grows from the other end) */
         mm.lo = a->lo;
         mm.used[PLX_PART_POLAR] = a->used[PLX_PART_POLAR];
@@ -1803,6 +1825,28 @@ static int32_t seg_owner(const polar *pd, uint32_t s)
     return pd->seg[s].bld[0] < 0 ? -1 : pd->seg[s].bld[0];
 }
 
+/* Node n of m unpacked (see polar_map). */
+static void node_get(const polar_map *m, uint32_t n, uint32_t w[3])
+{
+    if (m->narrow) {
+        uint64_t x = (uint64_t)m->node[2 * (size_t)n] | (uint64_t)m->node[2 * (size_t)n + 1] << 32;
+        uint32_t t = (uint32_t)(x & 0x3fffffu), c0 = (uint32_t)(x >> 22) & 0x1fffffu,
+                 c1 = (uint32_t)(x >> 43) & 0x1fffffu;
+        w[0] = PACK(t >> 20, t & 0xfffffu);
+        w[1] = PACK(c0 >> 19, c0 & 0x7ffffu);
+        w[2] = PACK(c1 >> 19, c1 & 0x7ffffu);
+    } else {
+        w[0] = m->node[3 * (size_t)n];
+        w[1] = m->node[3 * (size_t)n + 1];
+        w[2] = m->node[3 * (size_t)n + 2];
+    }
+}
+
+void polar_node(const polar_map *m, uint32_t n, uint32_t w[3])
+{
+    node_get(m, n, w);
+}
+
 /* The free region holding frame point f: the search DAG descended from
  * its root. -2 as soon as a test is a tie: f at a vertex (x test) or on a
  * wall piece (y test: the nodes met are those whose regions hold f, so f
@@ -1814,9 +1858,10 @@ static int32_t dag_locate(const polar *pd, const polar_map *m, vec2 f, int32_t *
     uint32_t c = m->root, d = 0;
     int32_t r;
     while (POLAR_TAG(c) == POLAR_CHILD_NODE) {
-        const uint32_t *nd = m->node[c];
-        uint32_t w = nd[0];
+        uint32_t nd[3], w;
         int k;
+        node_get(m, c, nd);
+        w = nd[0];
         d++;
         if (KIND(w) == N_X) {
             k = lex_cmp(f, fpt(pd, m->frame, IDX(w)));

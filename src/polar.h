@@ -87,15 +87,19 @@ typedef struct polar_trap {
  * by walls), so walks never need the solid ones.
  *
  * Point location: node[] holds the inner nodes of the search DAG of the
- * trapezoidal map (12 bytes each, breadth-first from the root so the top
- * levels share cache lines): word 0 is the test, kind << 30 | index (kind
- * POLAR_NODE_X: is the point before point 'index' in the frame's
- * lexicographic order; POLAR_NODE_Y / POLAR_NODE_YB: is it below wall piece
- * 'index', whose frame-left end is seg.a / seg.b), words 1 and 2 the child
- * words for "before / below" and "after / above". A child word is an inner
- * node (tag POLAR_CHILD_NODE), a free region (POLAR_CHILD_FREE, its index)
- * or a solid trapezoid (POLAR_CHILD_SOLID, the owner reported by
- * polar_locate plus one). */
+ * trapezoidal map, in the order they were made (the top levels first). A
+ * node is a test, kind << 30 | index (kind POLAR_NODE_X: is the point
+ * before point 'index' in the frame's lexicographic order; POLAR_NODE_Y /
+ * POLAR_NODE_YB: is it below wall piece 'index', whose frame-left end is
+ * seg.a / seg.b), and the child words for "before / below" and "after /
+ * above". A child word is an inner node (tag POLAR_CHILD_NODE), a free
+ * region (POLAR_CHILD_FREE, its index) or a solid trapezoid
+ * (POLAR_CHILD_SOLID, the owner reported by polar_locate plus one).
+ * Stored in 8 bytes a node ("narrow") when all indices fit: the 64 bits
+ * w0 | w1 << 32 hold the test as kind << 20 | index in bits 0-21 and the
+ * children as tag << 19 | index in bits 22-42 and 43-63 (up to 2^19 nodes,
+ * regions and buildings, 2^20 points and pieces); otherwise in 12 bytes,
+ * the three words. polar_node() unpacks either. */
 #define POLAR_TAG(w) ((w) >> 30)
 #define POLAR_IDX(w) ((w) & 0x3fffffffu)
 enum { POLAR_CHILD_NODE = 0, POLAR_CHILD_FREE = 1, POLAR_CHILD_SOLID = 2 };
@@ -105,9 +109,11 @@ typedef struct polar_map {
     int frame;
     uint32_t ntrap;          /* free regions */
     polar_trap *trap;
-    uint32_t (*node)[3];     /* inner search nodes (see above) */
+    uint32_t *node;          /* inner search nodes (see above): 2 words each
+                              * when narrow, else 3 */
     uint32_t nnode;
     uint32_t root;           /* child word of the root */
+    int narrow;
     uint32_t box_top, box_bot; /* segment indices of the Bounds sides on top/bottom */
     uint32_t box_lo, box_hi;   /* point indices of the extreme Bounds corners */
 } polar_map;
@@ -198,10 +204,15 @@ int32_t polar_locate_frame(const polar *pd, const polar_map *m, vec2 f);
 int32_t polar_locate_frame_ex(const polar *pd, const polar_map *m, vec2 f, int32_t *owner,
                               uint32_t *depth);
 
+/* Inner node n (< m->nnode) of map m's search DAG: w[0] the test, w[1],
+ * w[2] the child words, in the 32-bit forms above. */
+void polar_node(const polar_map *m, uint32_t n, uint32_t w[3] /* OUT */);
+
 /* polar_build with flags: POLAR_BUILD_NO_DAG skips the search DAGs (to time
  * the rest of the construction; point location and everything using it are
- * then unusable). */
-enum { POLAR_BUILD_NO_DAG = 1 };
+ * then unusable); POLAR_BUILD_WIDE_DAG stores every node in 12 bytes (to
+ * test that layout on small scenes). */
+enum { POLAR_BUILD_NO_DAG = 1, POLAR_BUILD_WIDE_DAG = 2 };
 plx_status polar_build_flags(arena *a, const scene *s, int flags, polar **out /* OUT */);
 
 /* The former point location, kept as a reference: the nearest wall below

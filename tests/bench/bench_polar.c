@@ -125,10 +125,12 @@ static int bench_locate(const polar *pd, arena *a, int nl, uint32_t nv)
     printf("  locate       DAG %6.0f ns/query  grid scan %6.0f ns/query  ratio %.2fx  "
            "(%d points x 2 maps, best of 3; %s)\n", tdag, tscan, tscan / tdag, nl,
            bad ? "MISMATCH" : "same answers");
-    printf("  search DAG   %u + %u nodes = %.1f bytes/vertex; depth mean %.1f max %u "
-           "(log2 of wall pieces %.1f)\n", pd->map[0].nnode, pd->map[1].nnode,
-           12.0 * (pd->map[0].nnode + pd->map[1].nnode) / (nv ? nv : 1), dsum / (2.0 * nl), dmax,
-           log2((double)pd->nwall + 1));
+    printf("  search DAG   %u + %u nodes of %d + %d bytes = %.1f bytes/vertex; depth mean %.1f "
+           "max %u (log2 of wall pieces %.1f)\n", pd->map[0].nnode, pd->map[1].nnode,
+           pd->map[0].narrow ? 8 : 12, pd->map[1].narrow ? 8 : 12,
+           ((pd->map[0].narrow ? 8.0 : 12.0) * pd->map[0].nnode +
+            (pd->map[1].narrow ? 8.0 : 12.0) * pd->map[1].nnode) / (nv ? nv : 1),
+           dsum / (2.0 * nl), dmax, log2((double)pd->nwall + 1));
     free(fp);
     free(ans);
     arena_release(a, &m0);

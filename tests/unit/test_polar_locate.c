@@ -498,19 +498,20 @@ static void test_random_degenerate(void **state)
 
 /* Points on a fine lattice over a lattice scene: they fall on walls, at
  * vertices and on the axes of vertices in both frames far more often than
- * random points do. */
-static void test_lattice_points(void **state)
+ * random points do. Once with nodes of 8 bytes, once of 12. */
+static void lattice_points(int flags)
 {
     fix *f = fix_new();
     polar_scan *g;
     stats st;
     int i, j, step = getenv("PLX_TEST_QUICK") ? 4 : 1;
-    (void)state;
     memset(&st, 0, sizeof st);
     rnd_state = 99u;
     lattice_scene(f, 60, 1.0);
     ref_scene_finish(&f->s);
-    assert_int_equal(polar_build(&f->a, &f->s, &f->pd), PLX_OK);
+    assert_int_equal(polar_build_flags(&f->a, &f->s, flags, &f->pd), PLX_OK);
+    assert_int_equal(f->pd->map[0].narrow, !(flags & POLAR_BUILD_WIDE_DAG));
+    assert_int_equal(f->pd->map[1].narrow, !(flags & POLAR_BUILD_WIDE_DAG));
     assert_int_equal(polar_scan_new(&f->a, f->pd, &g), PLX_OK);
     for (i = -8; i <= 4 * 44; i += step) {
         for (j = -8; j <= 4 * 30; j += step) {
@@ -520,11 +521,19 @@ static void test_lattice_points(void **state)
             check_point(f->pd, g, p, &st);
         }
     }
-    report("lattice points", &st);
+    report(flags & POLAR_BUILD_WIDE_DAG ? "lattice points, 12-byte nodes"
+                                        : "lattice points, 8-byte nodes", &st);
     assert_int_equal(st.dag_scan_diff, 0);
     assert_int_equal(st.brute_bad, 0);
     assert_true(st.n_on > 100 && st.n_in > 100 && st.n_region > 100);
     fix_free(f);
+}
+
+static void test_lattice_points(void **state)
+{
+    (void)state;
+    lattice_points(0);
+    lattice_points(POLAR_BUILD_WIDE_DAG);
 }
 
 /* --------------------------------------------------------- the comb */
