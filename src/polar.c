@@ -1518,11 +1518,12 @@ static plx_status insertion_order(arena *a, const polar *pd, uint32_t **out)
 
 /* Builds the search DAG of map m (after its sweep w). */
 static plx_status build_dag(arena *a, polar *pd, polar_map *m, const sweep *w,
-                            const uint32_t *canon, const uint32_t *order, int flags)
+                            const uint32_t *canon, const uint32_t *order, uint32_t nends,
+                            int flags)
 {
     dbuild b;
     uint32_t nw = pd->nwall, i, t;
-    if (nw >= (1u << 28) || pd->npts >= (1u << 30))
+    if (nw >= (1u << 26) || pd->npts >= (1u << 26))
         return PLX_E_NOMEM;   /* indices must fit in 30 bits */
     memset(&b, 0, sizeof b);
     b.pd = pd;
@@ -1530,7 +1531,10 @@ static plx_status build_dag(arena *a, polar *pd, polar_map *m, const sweep *w,
     b.frame = m->frame;
     b.canon = canon;
     b.N = w->N;
-    b.cap = 5 * nw + 64;
+    /* trapezoid slots: at most 3 i + 1 live after i pieces; a new piece
+     * crosses one trapezoid more than the axes it cuts, at most one per
+     * wall end, and makes two per crossed one plus two: 3 n + 2 ends + 64 */
+    b.cap = 3 * nw + 2 * nends + 64;
     /* expected about 8 nodes per piece; beyond 64 the shuffle has failed
      * beyond any reasonable chance (reported as out of memory) */
     b.maxchunk = (uint32_t)(((uint64_t)64 * nw + 1024) >> NODE_BITS) + 1;
@@ -1631,7 +1635,7 @@ static plx_status build_map(arena *a, polar *pd, polar_map *m, const wgrid *g,
     pd->bytes[1] += (size_t)w.ntrap * 8;
     if (!order)
         return PLX_OK;
-    return build_dag(a, pd, m, &w, canon, order, flags);
+    return build_dag(a, pd, m, &w, canon, order, nev, flags);
 }
 
 /* Cuts the occluders' edges into wall pieces (pd->pts, pd->seg filled). */
