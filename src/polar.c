@@ -990,15 +990,16 @@ static plx_status build_incidence(arena *a, const polar *pd, uint32_t **inc_firs
  * hold: O(n) nodes, O(log n) nodes on a search path, O(n log n) time. A
  * piece with an end already in the map is searched from that end's x node
  * (most are: polygon edges share their ends), the others from the root.
- * Measured (bench_polar): about 4.8 inner nodes per piece (12 bytes each)
- * on a dense old town, search paths of about 2 log2 n nodes on average;
- * the build costs about 3 times the rest of polar_build. The sweep (run
- * first) has already checked that the pieces do not cross; a failure here
- * is reported as PLX_E_SCENE all the same. In the end every leaf becomes a child word:
- * a free trapezoid is the sweep's region with the same floor, ceiling and
- * left axis (found through a hash; point indices are made canonical, the
- * first of the points sharing a position, as the sweep's events are), a
- * solid one carries the owner that polar_locate reports. */
+ * Measured (bench_polar): 4.4 to 4.9 inner nodes per piece (8 or 12
+ * bytes each, see polar_map), search paths of about 2 log2 n nodes on
+ * average; the build costs 1.5 to 3 times the rest of polar_build. The
+ * sweep (run first) has already checked that the pieces do not cross; a
+ * failure here is reported as PLX_E_SCENE all the same. In the end every
+ * leaf becomes a child word: a free trapezoid is the sweep's region with
+ * the same floor, ceiling and left axis (found through a hash; point
+ * indices are made canonical, the first of the points sharing a position,
+ * as the sweep's events are), a solid one carries the owner that
+ * polar_locate reports. */
 
 typedef struct btrap {
     uint32_t lp, rp, top, bot;
