@@ -31,9 +31,10 @@
  * Points are located in O(log n) expected time by a search DAG per
  * subdivision: the trapezoidal map of the same walls built again by
  * randomized incremental insertion (de Berg et al., "Computational
- * Geometry", ch. 6; Seidel 1991) in a deterministic shuffled order, its
- * leaves mapped to the sweep's free regions or marked solid (expected O(n)
- * nodes, expected O(n log n) to build). A ray walks from region to region
+ * Geometry", ch. 6; Seidel 1991) in a seeded random order (random rounds,
+ * spatial order within a round: deterministic), its leaves mapped to the
+ * sweep's free regions or marked solid (expected O(n) nodes, expected
+ * O(n log n) to build). A ray walks from region to region
  * through the stored adjacency until it leaves through a wall.
  *
  * Degenerate input: footprints that share walls exactly, touch at T-junctions
