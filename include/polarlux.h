@@ -261,7 +261,8 @@ plx_status plx_polar_build(plx_engine *e);
 
 typedef struct plx_polar_info {
     uint64_t build_ns;        /* construction time by the port's clock */
-    size_t axes, regions, polygons, rest; /* bytes by part (robles2014 Table 3) */
+    size_t axes, regions, polygons, rest; /* bytes by part (robles2014 Table 3); rest:
+                               * the point-location search DAGs, headers */
     size_t total;
     uint32_t nregions[4];     /* regions of quadrant diagrams 0..3 */
     uint32_t vertices;        /* footprint vertices of the occluders */

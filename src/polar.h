@@ -35,10 +35,15 @@
  * over the wall ends (deterministic; O(n log n) for n footprint edges to
  * sort the ends, then O(1) per event for evenly spread walls: the sweep
  * status is a linked list, and an event where walls only start finds the
- * wall below it in a grid of the wall pieces, scanning that grid's column
- * downwards). Points are located the same way (the nearest wall below in
- * the frame, then the regions above that wall). A ray walks from region to
- * region through the stored adjacency until it leaves through a wall.
+ * wall below it in a grid of the wall pieces, a construction temporary).
+ * Points are located in O(log n) expected time by a search DAG per
+ * subdivision: the trapezoidal map of the same walls built again by
+ * randomized incremental insertion (de Berg et al., "Computational
+ * Geometry", ch. 6; Seidel 1991) in a seeded random order (random rounds,
+ * spatial order within a round: deterministic), its leaves mapped to the
+ * sweep's free regions or marked solid (expected O(n) nodes, expected
+ * O(n log n) to build). A ray walks from region to region
+ * through the stored adjacency until it leaves through a wall.
  *
  * Degenerate input: footprints that share walls exactly, touch at T-junctions
  * or overlap are first cut into pieces at every contact (exact predicates;
@@ -88,21 +93,36 @@ typedef struct polar_trap {
  *
  * Only the free trapezoids are kept as regions: a region next to a free one
  * across an axis side is free too (solid and free are only ever separated
- * by walls), so walks never need the solid ones. Point location needs no
- * search structure of its own: the wall below a point is found in the grid
- * of wall pieces shared by both maps (polar.grid*), then the regions above
- * that wall are walked to the point (above[], col_start[]). */
+ * by walls), so walks never need the solid ones.
+ *
+ * Point location: node[] holds the inner nodes of the search DAG of the
+ * trapezoidal map, in the order they were made (the top levels first). A
+ * node is a test, kind << 30 | index (kind POLAR_NODE_X: is the point
+ * before point 'index' in the frame's lexicographic order; POLAR_NODE_Y /
+ * POLAR_NODE_YB: is it below wall piece 'index', whose frame-left end is
+ * seg.a / seg.b), and the child words for "before / below" and "after /
+ * above". A child word is an inner node (tag POLAR_CHILD_NODE), a free
+ * region (POLAR_CHILD_FREE, its index) or a solid trapezoid
+ * (POLAR_CHILD_SOLID, the owner reported by polar_locate plus one).
+ * Stored in 8 bytes a node ("narrow") when all indices fit: the 64 bits
+ * w0 | w1 << 32 hold the test as kind << 20 | index in bits 0-21 and the
+ * children as tag << 19 | index in bits 22-42 and 43-63 (up to 2^19 nodes,
+ * regions and buildings, 2^20 points and pieces); otherwise in 12 bytes,
+ * the three words. polar_node() unpacks either. */
+#define POLAR_TAG(w) ((w) >> 30)
+#define POLAR_IDX(w) ((w) & 0x3fffffffu)
+enum { POLAR_CHILD_NODE = 0, POLAR_CHILD_FREE = 1, POLAR_CHILD_SOLID = 2 };
+enum { POLAR_NODE_X = 1, POLAR_NODE_Y = 2, POLAR_NODE_YB = 3 };
+
 typedef struct polar_map {
     int frame;
     uint32_t ntrap;          /* free regions */
     polar_trap *trap;
-    uint32_t *above;         /* per wall piece: the first (frame-leftmost)
-                              * region above it, POLAR_NONE when the side above
-                              * it is solid */
-    uint32_t *col_start;     /* per grid column of frame abscissae: the first
-                              * region above the Bounds side at the bottom
-                              * reaching that column */
-    uint32_t ncol;
+    uint32_t *node;          /* inner search nodes (see above): 2 words each
+                              * when narrow, else 3 */
+    uint32_t nnode;
+    uint32_t root;           /* child word of the root */
+    int narrow;
     uint32_t box_top, box_bot; /* segment indices of the Bounds sides on top/bottom */
     uint32_t box_lo, box_hi;   /* point indices of the extreme Bounds corners */
 } polar_map;
@@ -117,12 +137,7 @@ typedef struct polar {
     uint32_t nbld;           /* s->nbld */
     double box[4];           /* s->bounds */
     polar_map map[2];        /* [0]: quadrants 0, 2   [1]: quadrants 1, 3 */
-    /* grid of wall pieces over the Bounds box: cell (x, y) lists the pieces
-     * whose bounding boxes meet it, gwall[gcell[y gnx + x] .. gcell[.. + 1]) */
-    uint32_t gnx, gny;
-    double gsx, gsy;         /* cells per metre */
-    uint32_t *gcell, *gwall;
-    size_t bytes[4];         /* axes, regions, polygons, rest */
+    size_t bytes[4];         /* axes, regions, polygons, rest (search DAGs, header) */
 } polar;
 
 /* Builds the four diagrams of scene s. On success *out points into arena
@@ -171,7 +186,7 @@ plx_status polar_shoot(const polar *pd, vec2 p, double dx, double dy, polar_hit 
 
 /* Bytes of arena memory held, like robles2014 Table 3:
  * [0] polar axes, [1] polar regions, [2] polygons (wall pieces and points),
- * [3] the rest (grid of walls, per-wall region indices, headers). Both
+ * [3] the rest (the search DAGs of point location, headers). Both
  * subdivisions together. */
 void polar_memory(const polar *pd, size_t bytes[4] /* OUT */);
 
@@ -192,5 +207,35 @@ vec2 polar_fpt(const polar *pd, int frame, uint32_t i);      /* point in a frame
 vec2 polar_to_frame(int frame, vec2 w);
 vec2 polar_from_frame(int frame, vec2 f);
 int32_t polar_locate_frame(const polar *pd, const polar_map *m, vec2 f);
+
+/* ---- for tests and benchmarks only ---- */
+
+/* polar_locate_frame, also giving the owner of a footprint for -3 (as
+ * polar_locate; -1 otherwise) and the number of DAG nodes visited (both may
+ * be NULL). */
+int32_t polar_locate_frame_ex(const polar *pd, const polar_map *m, vec2 f, int32_t *owner,
+                              uint32_t *depth);
+
+/* Inner node n (< m->nnode) of map m's search DAG: w[0] the test, w[1],
+ * w[2] the child words, in the 32-bit forms above. */
+void polar_node(const polar_map *m, uint32_t n, uint32_t w[3] /* OUT */);
+
+/* polar_build with flags: POLAR_BUILD_NO_DAG skips the search DAGs (to time
+ * the rest of the construction; point location and everything using it are
+ * then unusable); POLAR_BUILD_WIDE_DAG stores every node in 12 bytes (to
+ * test that layout on small scenes). */
+enum { POLAR_BUILD_NO_DAG = 1, POLAR_BUILD_WIDE_DAG = 2 };
+plx_status polar_build_flags(arena *a, const scene *s, int flags, polar **out /* OUT */);
+
+/* The former point location, kept as a reference: the nearest wall below
+ * the point found by scanning a column of a grid of the wall pieces, then
+ * the regions above that wall walked to the point (O(1) expected for evenly
+ * spread walls, O(n) worst case). polar_scan_new keeps its grid and tables
+ * in arena memory (part PLX_PART_POLAR, not counted in polar_memory);
+ * polar_scan_locate_frame answers as polar_locate_frame_ex (owner may be
+ * NULL), for map mi (0 or 1). */
+typedef struct polar_scan polar_scan;
+plx_status polar_scan_new(arena *a, const polar *pd, polar_scan **out /* OUT */);
+int32_t polar_scan_locate_frame(const polar_scan *g, int mi, vec2 f, int32_t *owner);
 
 #endif

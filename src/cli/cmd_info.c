@@ -84,7 +84,7 @@ int cmd_info(int argc, char **argv)
                gi.mean_albedo[2], gi.mean_luminance);
     printf("load time: %.2f ms\n", si.load_ns / 1e6);
     if (plx_polar_info_get(e, &pi) == PLX_OK) {
-        printf("polar diagrams: built in %.2f ms; %zu bytes = axes %zu + regions %zu + polygons %zu + rest %zu"
+        printf("polar diagrams: built in %.2f ms; %zu bytes = axes %zu + regions %zu + polygons %zu + rest (search DAGs) %zu"
                " (%.1f bytes per footprint vertex); regions per quadrant %u %u %u %u\n",
                pi.build_ns / 1e6, pi.total, pi.axes, pi.regions, pi.polygons, pi.rest,
                pi.vertices ? (double)pi.total / pi.vertices : 0.0, pi.nregions[0], pi.nregions[1],

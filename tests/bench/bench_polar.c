@@ -15,7 +15,17 @@
  * are checked against the engine's (area 1e-9 relative, same visible set)
  * and any mismatch is reported and fails the benchmark.
  *
- * Usage: bench_polar [QUERIES]   (default 2000 query points per city)
+ * Point location: the search DAG (polar_locate_frame_ex) against the
+ * former grid scan (polar_scan_locate_frame, built in the same process) at
+ * the same random points of the Bounds box (free, in footprints, both
+ * maps), ns per query side by side; every answer is compared (a mismatch
+ * fails the benchmark). Construction is also timed without the DAGs
+ * (POLAR_BUILD_NO_DAG) to give their share. A hostile scene for the grid
+ * scan comes last: a comb (one long thin footprint and thousands of short
+ * teeth above it, so thousands of regions sit on one wall).
+ *
+ * Usage: bench_polar [QUERIES [quick]]   (default 2000 query points per
+ * city; "quick" leaves out the 100,000-building city)
  */
 #include <math.h>
 #include <stdio.h>
@@ -63,6 +73,70 @@ static double urand(void)
     return (double)(rng >> 11) / 9007199254740992.0;
 }
 
+/* Point location at nl random points of the Bounds box, both maps: DAG
+ * against the grid scan, answers compared. Returns the mismatches. */
+static int bench_locate(const polar *pd, arena *a, int nl, uint32_t nv)
+{
+    polar_scan *g;
+    vec2 *fp;
+    int32_t *ans;
+    double tdag = 1e300, tscan = 1e300, dsum = 0;
+    uint32_t dmax = 0, dep;
+    int i, r, bad = 0;
+    unsigned long long t0;
+    arena_mark m0 = arena_get_mark(a);
+    if (polar_scan_new(a, pd, &g) != PLX_OK) {
+        fprintf(stderr, "bench_polar: polar_scan_new failed\n");
+        exit(1);
+    }
+    fp = malloc((size_t)nl * 2 * sizeof *fp);
+    ans = malloc((size_t)nl * 2 * sizeof *ans);
+    if (!fp || !ans) {
+        fprintf(stderr, "bench_polar: out of memory\n");
+        exit(1);
+    }
+    for (i = 0; i < nl; i++) {
+        vec2 p;
+        p.x = pd->box[0] + urand() * (pd->box[2] - pd->box[0]);
+        p.y = pd->box[1] + urand() * (pd->box[3] - pd->box[1]);
+        fp[2 * i] = polar_to_frame(pd->map[0].frame, p);
+        fp[2 * i + 1] = polar_to_frame(pd->map[1].frame, p);
+    }
+    for (r = 0; r < 3; r++) {
+        double t;
+        t0 = port_now_ns();
+        for (i = 0; i < 2 * nl; i++)
+            ans[i] = polar_locate_frame(pd, &pd->map[i & 1], fp[i]);
+        t = (double)(port_now_ns() - t0) / (2.0 * nl);
+        tdag = t < tdag ? t : tdag;
+        t0 = port_now_ns();
+        for (i = 0; i < 2 * nl; i++)
+            ans[i] ^= polar_scan_locate_frame(g, i & 1, fp[i], NULL);
+        t = (double)(port_now_ns() - t0) / (2.0 * nl);
+        tscan = t < tscan ? t : tscan;
+        for (i = 0; i < 2 * nl; i++)
+            bad += ans[i] != 0;
+    }
+    for (i = 0; i < 2 * nl; i++) {
+        polar_locate_frame_ex(pd, &pd->map[i & 1], fp[i], NULL, &dep);
+        dsum += dep;
+        dmax = dep > dmax ? dep : dmax;
+    }
+    printf("  locate       DAG %6.0f ns/query  grid scan %6.0f ns/query  ratio %.2fx  "
+           "(%d points x 2 maps, best of 3; %s)\n", tdag, tscan, tscan / tdag, nl,
+           bad ? "MISMATCH" : "same answers");
+    printf("  search DAG   %u + %u nodes of %d + %d bytes = %.1f bytes/vertex; depth mean %.1f "
+           "max %u (log2 of wall pieces %.1f)\n", pd->map[0].nnode, pd->map[1].nnode,
+           pd->map[0].narrow ? 8 : 12, pd->map[1].narrow ? 8 : 12,
+           ((pd->map[0].narrow ? 8.0 : 12.0) * pd->map[0].nnode +
+            (pd->map[1].narrow ? 8.0 : 12.0) * pd->map[1].nnode) / (nv ? nv : 1),
+           dsum / (2.0 * nl), dmax, log2((double)pd->nwall + 1));
+    free(fp);
+    free(ans);
+    arena_release(a, &m0);
+    return bad;
+}
+
 static void bench(const char *name, const char *buf, size_t len, int nq)
 {
     plx_config cfg;
@@ -73,7 +147,7 @@ static void bench(const char *name, const char *buf, size_t len, int nq)
     arena_mark m0;
     size_t by[4], tot, kept;
     uint32_t i, nocc = 0, nv = 0;
-    double tb = 1e300, *tq, *tr, vis_frac = 0, steps = 0, ref_prep = 0;
+    double tb = 1e300, tb0 = 1e300, *tq, *tr, vis_frac = 0, steps = 0, ref_prep = 0;
     vec2 *pts;
     uint32_t *visbuf;
     int reps, r, n = 0, tries = 0, nref = 0, bad = 0;
@@ -116,19 +190,42 @@ static void bench(const char *name, const char *buf, size_t len, int nq)
         }
         if (t < tb)
             tb = t;
+        arena_release(&e->mem, &m0);
+        t0 = port_now_ns();
+        st = polar_build_flags(&e->mem, s, POLAR_BUILD_NO_DAG, &pd);
+        t = (port_now_ns() - t0) / 1e6;
+        if (st != PLX_OK) {
+            fprintf(stderr, "bench_polar: %s: polar_build_flags: %s\n", name, plx_strerror(st));
+            exit(1);
+        }
+        if (t < tb0)
+            tb0 = t;
     }
+    arena_release(&e->mem, &m0);
+    if (polar_build(&e->mem, s, &pd) != PLX_OK)
+        exit(1);
     polar_memory(pd, by);
     tot = by[0] + by[1] + by[2] + by[3];
     kept = e->mem.used[PLX_PART_POLAR] - m0.used[PLX_PART_POLAR];
 
     printf("%-20s %6u buildings (%u occluders), %7u footprint vertices, %u wall pieces\n",
            name, s->nbld, nocc, nv, pd->nwall);
-    printf("  construction %8.1f ms  (%.2f us per vertex; best of %d)\n", tb, 1e3 * tb / nv, reps);
+    printf("  construction %8.1f ms  (%.2f us per vertex; best of %d); without the search DAGs "
+           "%.1f ms: DAGs %.0f%%\n", tb, 1e3 * tb / nv, reps, tb0, 100.0 * (tb - tb0) / tb);
     printf("  memory       %8.2f MB = %5.1f bytes/vertex (arena part polar %.2f MB)\n",
            tot / 1048576.0, (double)tot / nv, kept / 1048576.0);
-    printf("    axes %5.1f  regions %5.1f  polygons %5.1f  rest %5.1f  bytes/vertex"
+    printf("    axes %5.1f  regions %5.1f  polygons %5.1f  rest (search DAGs) %5.1f  bytes/vertex"
            "  (regions %u + %u)\n", (double)by[0] / nv, (double)by[1] / nv,
            (double)by[2] / nv, (double)by[3] / nv, pd->map[0].ntrap, pd->map[1].ntrap);
+
+    if (bench_locate(pd, &e->mem, nv > 200000 ? 100000 : 200000, nv) != 0) {
+        fprintf(stderr, "bench_polar: %s: DAG and grid scan disagree\n", name);
+        exit(1);
+    }
+    if (nq <= 0) {
+        plx_engine_free(e);
+        return;
+    }
 
     /* queries at random free points of the building box (Bounds less 50 m) */
     tq = malloc((size_t)nq * sizeof *tq);
@@ -239,6 +336,39 @@ static void bench_gen(const char *style, int nx, int ny, int nq)
     free(t.buf);
 }
 
+/* The comb: one footprint 2000 m x 1 m, n teeth 1 m x (2000 / n / 2) m
+ * above it (1 m gap), and a few boxes elsewhere. Visibility queries are
+ * left out (nq = 0). */
+static void bench_comb(int n)
+{
+    text t = { NULL, 0, 0 };
+    char line[512], name[64];
+    int i;
+    double w = 2000.0 / n;
+    snprintf(line, sizeof line, "{\"type\": \"FeatureCollection\", \"properties\": "
+             "{\"units\": \"m\"}, \"features\": [\n");
+    append(&t, line, strlen(line));
+    snprintf(line, sizeof line, "{\"type\": \"Feature\", \"properties\": {\"height\": 10}, "
+             "\"geometry\": {\"type\": \"Polygon\", \"coordinates\": "
+             "[[[0,0],[2000,0],[2000,1],[0,1],[0,0]]]}}");
+    append(&t, line, strlen(line));
+    for (i = 0; i < n; i++) {
+        double x0 = i * w, x1 = x0 + w / 2;
+        snprintf(line, sizeof line, ",\n{\"type\": \"Feature\", \"properties\": {\"height\": "
+                 "10}, \"geometry\": {\"type\": \"Polygon\", \"coordinates\": "
+                 "[[[%.6f,2],[%.6f,2],[%.6f,3],[%.6f,3],[%.6f,2]]]}}", x0, x1, x1, x0, x0);
+        append(&t, line, strlen(line));
+    }
+    append(&t, "]}\n", 3);
+    if (!t.buf) {
+        fprintf(stderr, "bench_polar: out of memory\n");
+        exit(1);
+    }
+    snprintf(name, sizeof name, "comb %d teeth", n);
+    bench(name, t.buf, t.len, 0);
+    free(t.buf);
+}
+
 int main(int argc, char **argv)
 {
     char err[256];
@@ -256,6 +386,9 @@ int main(int argc, char **argv)
     free(h);
     bench_gen("eixample", 30, 30, nq);
     bench_gen("oldtown", 110, 110, nq);
-    bench_gen("oldtown", 317, 317, nq);
+    if (argc < 3)
+        bench_gen("oldtown", 317, 317, nq);
+    bench_comb(2000);
+    bench_comb(16000);
     return 0;
 }
