@@ -152,9 +152,13 @@ plx_status polar_build(arena *a, const scene *s, polar **out /* OUT */);
 /* Where p lies in the diagram of quadrant q (0..3).
  * Returns the region index (>= 0) and stores the region's label (the
  * building met first by the scan at the start direction q pi/2, or -1 for
- * the Bounds frame when that ray reaches the box) in *owner (may be NULL). Returns -1 when p is outside the
- * open Bounds box, -2 when p is on a wall, -3 when p is inside a footprint
- * (then *owner is that footprint's building, or -1 if unknown). */
+ * the Bounds frame when that ray reaches the box) in *owner (may be NULL).
+ * Returns -1 when p is outside the open Bounds box, -2 when p is on a wall,
+ * -3 when p is inside a footprint (then *owner is a building whose footprint
+ * the solid trapezoid holding p belongs to: the one entered across the wall
+ * below p, which, where a party wall was left out, may be the neighbour of
+ * the footprint holding p; -1 if unknown; callers that must name the
+ * footprint look it up in the scene, as query.c does). */
 int32_t polar_locate(const polar *pd, int q, vec2 p, int32_t *owner /* OUT */);
 
 typedef struct polar_hit {
