@@ -17,29 +17,41 @@
  *                the ground under one means passing a wall first), normal +z.
  *   TRACE_SKY    nothing before tmax.
  *
- * Method. Per building, the exact ray/prism entry: the slab of t where
- * min_height <= z(t) <= height is cut to the search range; whether the
- * entry point of that range lies inside the footprint is the parity of the
- * crossings of the ray's 2D line with the ring edges before it (a vertex on
- * the line counts as lying on its left, so a line through a vertex crosses
- * the two edges there once in all); inside means a roof/underside hit at
- * the slab entry, else the first crossing inside the range is the wall hit.
- * A ray that starts strictly inside a solid does not hit that building (the
- * caller offsets bounce origins along the normal, so this happens only by
- * rounding at corners; the photon then leaves through the solid).
- * Candidates come from a uniform grid over the Bounds box, each cell listing
- * the buildings whose box overlaps it and the tallest top among them; the
- * ray walks the cells in order (2D DDA, Amanatides-Woo) and stops as soon
- * as the best hit lies before the current cell's exit. Cells the ray passes
- * above their tallest top are skipped, and the walk ends once the ray rises
- * above the tallest building. Each building is tested at most once per ray
- * (per-building stamps), so a tracer must not be used by two threads at
- * once (make one per thread: they share nothing but the scene).
+ * Method. A uniform grid over the Bounds box; each cell lists
+ *   - its walls: compact records (first vertex, edge vector, the building's
+ *     [min_height, height], edge and building) of every footprint edge that
+ *     comes within a hair of the cell (segment clipped to the cell box,
+ *     Liang-Barsky), and
+ *   - its buildings (box overlap) and the tallest top among them.
+ * The ray walks the cells in order (2D DDA, Amanatides-Woo) and stops as
+ * soon as the best hit lies before the current cell's exit. In a cell it
+ * first compares the range of its heights there with the cell's top (the
+ * whole cell is skipped when the ray passes above it), then tests the walls
+ * whose height range meets the ray's, and the roofs (going down) or
+ * undersides (going up) whose height the ray crosses in the cell. A wall is
+ * hit when the ray enters the solid through it (walls are one-sided: a ray
+ * leaving a solid through a wall does not hit it), 0 < t, the crossing is
+ * on the closed edge and its height in the closed [min_height, height]: a
+ * few multiplications and sign tests, one division for a crossing. A roof
+ * or underside is hit when the point where the ray meets its plane is
+ * inside the footprint (even-odd over the building's rings, in its box).
+ * The walk ends where the ray rises above the tallest building, leaves the
+ * grid, or reaches tmax (the ground or the first hit). Nothing is written
+ * but the counters, so a tracer must still not be shared by two threads
+ * that trace at once (make one per thread: they share nothing but the
+ * scene) only because of them.
  *
  * Degenerate cases: faces are closed (a ray touching an edge of a roof or a
- * wall exactly hits it), ties between coincident faces of two buildings
- * (shared walls) go to either; a ray running inside a wall's plane does not
- * cross that edge. Hits are correct to rounding (about 1e-12 relative).
+ * wall exactly hits it; on the boundary of a footprint the roof test goes
+ * either way, but the wall there is hit at the same t when the ray comes
+ * from outside), ties between coincident faces of two buildings (shared
+ * walls) go to either; a ray running inside a wall's plane does not cross
+ * that edge (it meets the neighbouring edges at their ends). A ray that
+ * starts inside a solid (the caller offsets bounce origins along the
+ * normal, so this happens only by rounding at corners) leaves it without a
+ * hit and may hit it again further on. Hits are correct to rounding (about
+ * 1e-12 relative): tests/unit/test_photon.c compares them with an
+ * independent brute force (tolerance 1e-9 (1 + t) on t).
  *
  * Memory: trace_create takes everything from the arena (part given by the
  * caller, PLX_PART_PHOTON for the photon system); construction scratch is
@@ -67,19 +79,49 @@ typedef struct trace_hit {
     int kind;          /* TRACE_SKY, TRACE_GROUND, ... */
 } trace_hit;
 
+/* Cell size (m) per sqrt(area per building) when trace_create chooses it:
+ * small cells keep few walls per cell (measured on gen eixample, see
+ * bench_photon). */
+#define TRACE_CELL_FACTOR 0.5
+
+/* A wall as listed in a cell: everything the ray test reads, in one cache
+ * line. */
+typedef struct trace_wall {
+    double px, py;     /* first vertex */
+    double ex, ey;     /* edge vector (next vertex - first) */
+    double zlo, zhi;   /* the building's min_height and height */
+    uint32_t edge;     /* index in scene.pts of the first vertex */
+    uint32_t bld;
+    uint64_t pad;
+} trace_wall;
+
+/* A building as listed in a cell, for its roof and underside. */
+typedef struct trace_cap {
+    double zlo, zhi;   /* min_height, height */
+    uint32_t bld;
+    uint32_t pad;
+} trace_cap;
+
+/* A cell: its walls are walls[w0 .. next cell's w0), its buildings
+ * caps[r0 .. next cell's r0); top bounds every height in it from above. */
+typedef struct trace_cell {
+    uint32_t w0, r0;
+    double top;
+} trace_cell;
+
 typedef struct tracer {
     const scene *s;
     double x0, y0;         /* grid origin (Bounds min corner) */
     double cell, inv;      /* cell size (m) and its inverse */
     uint32_t nx, ny;
+    trace_cell *cells;     /* nx*ny + 1 (the last one ends the lists) */
+    trace_wall *walls;
+    trace_cap *caps;
     uint32_t *start;       /* nx*ny + 1 offsets into ids */
-    uint32_t *ids;         /* building indices per cell */
-    float *top;            /* tallest height per cell (0 for empty cells) */
+    uint32_t *ids;         /* building indices per cell (the caps' buildings) */
     uint32_t *enext;       /* per scene point: the next vertex of its ring */
-    uint32_t *stamp;       /* per building: last ray that tested it */
-    uint32_t now;
     double zmax;           /* tallest building */
-    uint64_t rays, tests;  /* counters: rays cast, prism tests */
+    uint64_t rays, tests;  /* counters: rays cast, wall records examined */
 } tracer;
 
 /*
@@ -103,8 +145,8 @@ size_t trace_bytes(const scene *s, double cell_size);
 int trace_ray(tracer *T, const double o[3], const double d[3], double tmax,
               trace_hit *h /* OUT */);
 
-/* The same answer by testing every building (no grid): the baseline for
- * benchmarks. */
+/* The same answer by the same wall and roof tests over every building (no
+ * grid): checks the walk. */
 int trace_ray_brute(tracer *T, const double o[3], const double d[3], double tmax,
                     trace_hit *h /* OUT */);
 

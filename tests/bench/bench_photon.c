@@ -20,6 +20,7 @@
 #include "engine.h"
 #include "trace.h"
 #include "photon.h"
+#include "ref_trace_old.h"
 
 #define BUDGET ((size_t)3 << 30)
 
@@ -78,6 +79,86 @@ static void sphere(uint64_t *rs, double d[3])
     d[0] = r * cos(p);
     d[1] = r * sin(p);
     d[2] = z;
+}
+
+
+/* Rays like those of a photon pass (photon_trace_lamp): from a random lamp
+ * in a uniform direction up to its radius, then diffuse bounces from each
+ * hit (albedo survival, 1e-5 m off the surface like photon.c's
+ * BOUNCE_OFFSET). Stored as o, d, tmax for replays. */
+static int pass_rays(tracer *T, const scene *s, uint64_t *rs, int n, double (*o)[3],
+                     double (*d)[3], double *tmax)
+{
+    int k = 0;
+    while (k < n) {
+        const scene_lamp *L = &s->lamps[photon_rand(rs) % s->nlamps];
+        trace_hit h;
+        int b;
+        o[k][0] = L->x;
+        o[k][1] = L->y;
+        o[k][2] = L->z;
+        sphere(rs, d[k]);
+        tmax[k] = L->radius;
+        if (trace_ray(T, o[k], d[k], tmax[k], &h) == TRACE_SKY) {
+            k++;
+            continue;
+        }
+        k++;
+        for (b = 0; b < 16 && k < n; b++) {
+            double alb = h.kind == TRACE_GROUND ? s->ground_albedo : s->bld[h.bld].albedo;
+            if (photon_rand01(rs) >= alb)
+                break;
+            photon_cosine_dir(rs, h.n, d[k]);
+            o[k][0] = h.p[0] + 1e-5 * h.n[0];
+            o[k][1] = h.p[1] + 1e-5 * h.n[1];
+            o[k][2] = h.p[2] + 1e-5 * h.n[2];
+            tmax[k] = INFINITY;
+            if (trace_ray(T, o[k], d[k], tmax[k], &h) == TRACE_SKY) {
+                k++;
+                break;
+            }
+            k++;
+        }
+    }
+    return k;
+}
+
+/* Rays per second of the new and the old caster on the same rays, runs
+ * alternated (the machine is shared); mismatches of kind or t. */
+static void new_vs_old(const char *what, tracer *T, old_tracer *O, int n, double (*o)[3],
+                       double (*d)[3], const double *tmax)
+{
+    double best_new = 0.0, best_old = 0.0;
+    uint64_t t0, tests0 = T->tests, otests0 = O->tests;
+    int i, r, mism = 0;
+    trace_hit h, ho;
+    for (r = 0; r < 5; r++) {
+        double v;
+        t0 = now_ns();
+        for (i = 0; i < n; i++)
+            trace_ray(T, o[i], d[i], tmax[i], &h);
+        v = n / ((now_ns() - t0) / 1e9);
+        if (v > best_new)
+            best_new = v;
+        t0 = now_ns();
+        for (i = 0; i < n; i++)
+            old_trace_ray(O, o[i], d[i], tmax[i], &ho);
+        v = n / ((now_ns() - t0) / 1e9);
+        if (v > best_old)
+            best_old = v;
+    }
+    for (i = 0; i < n; i++) {
+        trace_ray(T, o[i], d[i], tmax[i], &h);
+        old_trace_ray(O, o[i], d[i], tmax[i], &ho);
+        if (h.kind != ho.kind || (h.kind != TRACE_SKY && fabs(h.t - ho.t) > 1e-9 * (1 + h.t)))
+            mism++;
+    }
+    printf("caster new vs old (%s, %d rays, best of 5 alternated runs): new %.2f M rays/s "
+           "(%.0f ns/ray, %.1f walls examined per ray), old %.2f M rays/s (%.0f ns/ray, %.1f "
+           "prism tests per ray): %.2fx; %d mismatches\n",
+           what, n, best_new / 1e6, 1e9 / best_new, (double)(T->tests - tests0) / (6.0 * n),
+           best_old / 1e6, 1e9 / best_old, (double)(O->tests - otests0) / (6.0 * n),
+           best_new / best_old, mism);
 }
 
 int main(int argc, char **argv)
@@ -196,6 +277,47 @@ int main(int argc, char **argv)
                brute, NB, fast / brute, mism);
         if (mism)
             return 1;
+        {
+            enum { NP = 200000 };
+            static double po[NP][3], pd[NP][3], pt[NP], tm[NR];
+            old_tracer *O;
+            static const double sizes[] = {0.3, 0.4, 0.5, 0.6, 0.75, 1.0};
+            double per = (s->bounds[2] - s->bounds[0]) * (s->bounds[3] - s->bounds[1]) / s->nbld;
+            unsigned z;
+            if (old_trace_create(&e->mem, PLX_PART_PHOTON, s, 0.0, &O) != PLX_OK) {
+                fprintf(stderr, "bench_photon: old caster: out of memory\n");
+                return 1;
+            }
+            for (i = 0; i < NR; i++)
+                tm[i] = INFINITY;
+            new_vs_old("street rays", ps->T, O, NR, o, d, tm);
+            pass_rays(ps->T, s, &rs, NP, po, pd, pt);
+            new_vs_old("photon-pass rays", ps->T, O, NP, po, pd, pt);
+            printf("cell size sweep on the photon-pass rays (cell = factor x sqrt(area per "
+                   "building); default factor %.2f):\n",
+                   TRACE_CELL_FACTOR);
+            for (z = 0; z < sizeof sizes / sizeof sizes[0]; z++) {
+                arena_mark m = arena_get_mark(&e->mem);
+                tracer *T2;
+                double best = 0.0;
+                int r;
+                if (trace_create(&e->mem, PLX_PART_PHOTON, s, sizes[z] * sqrt(per), &T2) !=
+                    PLX_OK)
+                    return 1;
+                for (r = 0; r < 3; r++) {
+                    double v;
+                    t0 = now_ns();
+                    for (i = 0; i < NP; i++)
+                        trace_ray(T2, po[i], pd[i], pt[i], &h);
+                    v = NP / ((now_ns() - t0) / 1e9);
+                    if (v > best)
+                        best = v;
+                }
+                printf("  factor %.2f (%.1f m cells): %.2f M rays/s, %.1f MiB\n", sizes[z],
+                       T2->cell, best / 1e6, trace_bytes(s, T2->cell) / 1048576.0);
+                arena_release(&e->mem, &m);
+            }
+        }
     }
 
     /* ---- lookups ---- */
