@@ -113,7 +113,7 @@ static int seg_meets_cell(const gridspec *g, const vec2 *p, const vec2 *q, uint3
  * cnt[c] / cells[c].w0.
  */
 static size_t grid_lists(const scene *s, const gridspec *g, int pass, uint32_t *cnt,
-                         trace_cell *cells, uint32_t *ids, trace_wall *walls, size_t *nwalls)
+                         trace_cell *cells, uint32_t *ids, uint32_t *wids, size_t *nwalls)
 {
     size_t refs = 0, nw = 0;
     uint32_t b;
@@ -145,7 +145,6 @@ static size_t grid_lists(const scene *s, const gridspec *g, int pass, uint32_t *
                 for (cj = j0; cj <= j1; cj++)
                     for (ci = i0; ci <= i1; ci++) {
                         size_t c = (size_t)cj * g->nx + ci;
-                        trace_wall *w;
                         if (!seg_meets_cell(g, p, q, ci, cj))
                             continue;
                         nw++;
@@ -155,16 +154,7 @@ static size_t grid_lists(const scene *s, const gridspec *g, int pass, uint32_t *
                             cells[c + 1].w0++;
                             continue;
                         }
-                        w = &walls[cells[c].w0++];
-                        w->px = p->x;
-                        w->py = p->y;
-                        w->ex = q->x - p->x;
-                        w->ey = q->y - p->y;
-                        w->zlo = B->min_height;
-                        w->zhi = B->height;
-                        w->edge = e;
-                        w->bld = b;
-                        w->pad = 0;
+                        wids[cells[c].w0++] = e;
                     }
             }
         }
@@ -183,9 +173,10 @@ size_t trace_bytes(const scene *s, double cell_size)
     cells = (size_t)g.nx * g.ny;
     refs = grid_lists(s, &g, 0, NULL, NULL, NULL, NULL, &nw);
     return sizeof(tracer) + 64 + (cells + 1) * sizeof(trace_cell) + 64 +
-           (nw ? nw : 1) * sizeof(trace_wall) + 64 + (refs ? refs : 1) * sizeof(trace_cap) + 64 +
-           (cells + 1) * sizeof(uint32_t) + 64 + (refs ? refs : 1) * sizeof(uint32_t) + 64 +
-           (size_t)(s->npts ? s->npts : 1) * sizeof(uint32_t) + 64;
+           (nw ? nw : 1) * sizeof(uint32_t) + 64 +
+           (size_t)(s->npts ? s->npts : 1) * (sizeof(trace_wall) + 2 * sizeof(uint32_t)) + 3 * 64 +
+           (size_t)(s->nbld ? s->nbld : 1) * 2 * sizeof(double) + 64 +
+           (cells + 1) * sizeof(uint32_t) + 64 + (refs ? refs : 1) * sizeof(uint32_t) + 64;
 }
 
 /* Turns counts in cnt[1..cells] into starts in cnt[0..cells]; with
@@ -235,40 +226,65 @@ plx_status trace_create(arena *a, plx_part part, const scene *s, double cell_siz
     T->nx = g.nx;
     T->ny = g.ny;
     T->cells = arena_calloc(a, part, cells + 1, sizeof(trace_cell), 64);
-    T->walls = arena_alloc(a, part, (nw ? nw : 1) * sizeof(trace_wall), 64);
-    T->caps = arena_alloc(a, part, (refs ? refs : 1) * sizeof(trace_cap), 64);
-    T->start = arena_calloc(a, part, cells + 1, sizeof(uint32_t), 16);
-    T->ids = arena_alloc(a, part, (refs ? refs : 1) * sizeof(uint32_t), 16);
-    T->enext = arena_alloc(a, part, (s->npts ? s->npts : 1) * sizeof(uint32_t), 16);
-    if (!T->cells || !T->walls || !T->caps || !T->start || !T->ids || !T->enext)
+    T->wids = arena_alloc(a, part, (nw ? nw : 1) * sizeof(uint32_t), 64);
+    T->walls = arena_alloc(a, part, (s->npts ? s->npts : 1) * sizeof(trace_wall), 64);
+    T->ebld = arena_alloc(a, part, (s->npts ? s->npts : 1) * sizeof(uint32_t), 64);
+    T->enext = arena_alloc(a, part, (s->npts ? s->npts : 1) * sizeof(uint32_t), 64);
+    T->hz = arena_alloc(a, part, (s->nbld ? s->nbld : 1) * 2 * sizeof(double), 64);
+    T->start = arena_calloc(a, part, cells + 1, sizeof(uint32_t), 64);
+    T->ids = arena_alloc(a, part, (refs ? refs : 1) * sizeof(uint32_t), 64);
+    if (!T->cells || !T->wids || !T->walls || !T->ebld || !T->enext || !T->hz || !T->start ||
+        !T->ids)
         goto nomem;
     /* counting sort of the (cell, building) and (cell, wall) references */
     grid_lists(s, &g, 0, T->start, T->cells, NULL, NULL, &nw);
     prefix(T->start, T->cells, cells, 0);
-    grid_lists(s, &g, 1, T->start, T->cells, T->ids, T->walls, &nw);
+    grid_lists(s, &g, 1, T->start, T->cells, T->ids, T->wids, &nw);
     prefix(T->start, T->cells, cells, 1);
+    for (b = 0; b < s->nbld; b++) {
+        const scene_building *B = &s->bld[b];
+        uint32_t r;
+        T->hz[2 * b] = B->min_height;
+        T->hz[2 * b + 1] = B->height;
+        if (B->height > T->zmax)
+            T->zmax = B->height;
+        for (r = 0; r < B->ring_count; r++) {
+            const scene_ring *R = &s->rings[B->ring_first + r];
+            uint32_t k;
+            for (k = 0; k < R->count; k++) {
+                uint32_t e = R->first + k, f = R->first + (k + 1 == R->count ? 0 : k + 1);
+                trace_wall *w = &T->walls[e];
+                T->enext[e] = f;
+                T->ebld[e] = b;
+                w->px = s->pts[e].x;
+                w->py = s->pts[e].y;
+                w->ex = s->pts[f].x - s->pts[e].x;
+                w->ey = s->pts[f].y - s->pts[e].y;
+                w->zlo = B->min_height;
+                w->zhi = B->height;
+                {
+                    double l = sqrt(w->ex * w->ex + w->ey * w->ey);
+                    w->nx = l > 0.0 ? w->ey / l : 0.0;
+                    w->ny = l > 0.0 ? -w->ex / l : 0.0;
+                }
+            }
+        }
+    }
     for (i = 0; i <= cells; i++)
         T->cells[i].r0 = T->start[i];
-    for (i = 0; i < refs; i++) {
-        const scene_building *B = &s->bld[T->ids[i]];
-        T->caps[i].zlo = B->min_height;
-        T->caps[i].zhi = B->height;
-        T->caps[i].bld = T->ids[i];
-        T->caps[i].pad = 0;
-    }
     for (i = 0; i < cells; i++) {
+        trace_cell *C = &T->cells[i];
         uint32_t k;
-        for (k = T->start[i]; k < T->start[i + 1]; k++)
-            if (T->caps[k].zhi > T->cells[i].top)
-                T->cells[i].top = T->caps[k].zhi;
-    }
-    for (b = 0; b < s->nbld; b++)
-        if (s->bld[b].height > T->zmax)
-            T->zmax = s->bld[b].height;
-    for (i = 0; i < s->nrings; i++) {
-        uint32_t f = s->rings[i].first, n = s->rings[i].count, k;
-        for (k = 0; k < n; k++)
-            T->enext[f + k] = f + (k + 1 == n ? 0 : k + 1);
+        C->roof_lo = INFINITY;
+        for (k = T->start[i]; k < T->start[i + 1]; k++) {
+            const double *hz = &T->hz[2 * T->ids[k]];
+            if (hz[1] > C->top)
+                C->top = hz[1];
+            if (hz[1] < C->roof_lo)
+                C->roof_lo = hz[1];
+            if (hz[0] > C->under_hi)
+                C->under_hi = hz[0];
+        }
     }
     *out = T;
     return PLX_OK;
@@ -280,7 +296,7 @@ nomem:
 /* The best hit so far, with what finish needs (no scene lookups). */
 typedef struct best {
     double t;
-    double ex, ey;     /* wall: edge vector */
+    double nx, ny;     /* wall: its normal */
     double zc;         /* roof or underside: its height */
     uint32_t bld, edge;
     int kind;
@@ -290,34 +306,27 @@ typedef struct best {
  * Wall w against o + t d: a hit when the ray enters the solid through the
  * face (walls are one-sided: the solid lies to the left of the edge, so
  * den = d x e < 0), 0 < t < best, the crossing lies on the closed edge
- * (0 <= u <= 1, compared without dividing) and its height on the closed
- * [zlo, zhi]. The formulas are those of the plane/segment intersection
- * t = ((p - o) x e) / (d x e), u = ((p - o) x d) / (d x e).
+ * (0 <= u <= 1) and its height on the closed [zlo, zhi]. The formulas are
+ * those of the plane/segment intersection t = ((p - o) x e) / (d x e),
+ * u = ((p - o) x d) / (d x e); the signs are compared without dividing and
+ * combined without branching (they are unpredictable; a crossing is rare).
  */
-static void wall_test(const trace_wall *w, const double o[3], const double d[3], best *bs)
+static void wall_test(const trace_wall *w, uint32_t e, const double o[3], const double d[3],
+                      best *bs)
 {
-    double den = d[0] * w->ey - d[1] * w->ex, wx, wy, tn, un, t, z;
-    if (!(den < 0.0))
-        return;
-    wx = w->px - o[0];
-    wy = w->py - o[1];
-    tn = wx * w->ey - wy * w->ex;
-    if (!(tn < 0.0))
-        return;
-    un = wx * d[1] - wy * d[0];
-    if (un > 0.0 || un < den)
+    double den = d[0] * w->ey - d[1] * w->ex;
+    double wx = w->px - o[0], wy = w->py - o[1];
+    double tn = wx * w->ey - wy * w->ex, un = wx * d[1] - wy * d[0], t, z;
+    if (!((den < 0.0) & (tn < 0.0) & (un <= 0.0) & (un >= den)))
         return;
     t = tn / den;
-    if (!(t < bs->t))
-        return;
     z = o[2] + t * d[2];
-    if (z < w->zlo || z > w->zhi)
+    if (!((t < bs->t) & (z >= w->zlo) & (z <= w->zhi)))
         return;
     bs->t = t;
-    bs->ex = w->ex;
-    bs->ey = w->ey;
-    bs->bld = w->bld;
-    bs->edge = w->edge;
+    bs->nx = w->nx;
+    bs->ny = w->ny;
+    bs->edge = e;
     bs->kind = TRACE_WALL;
 }
 
@@ -344,22 +353,22 @@ static int inside_footprint(const scene *s, uint32_t b, double x, double y)
 }
 
 /*
- * The horizontal faces of building c->bld whose height lies in [zlo, zhi]
- * (the ray's heights over the part of its path being searched): the roof
- * going down, the underside (min_height > 0) going up. A hit when the ray
- * meets the plane at 0 < t < best inside the footprint.
+ * The horizontal faces of building b whose height lies in [zlo, zhi] (the
+ * ray's heights over the part of its path being searched): the roof going
+ * down, the underside (min_height > 0) going up. A hit when the ray meets
+ * the plane at 0 < t < best inside the footprint.
  */
-static void cap_test(const tracer *T, const trace_cap *c, double zlo, double zhi,
-                     const double o[3], const double d[3], best *bs)
+static void cap_test(const tracer *T, uint32_t b, double zlo, double zhi, const double o[3],
+                     const double d[3], best *bs)
 {
     const scene_building *B;
     double zc, t, x, y;
     int kind;
     if (d[2] < 0.0) {
-        zc = c->zhi;
+        zc = T->hz[2 * b + 1];
         kind = TRACE_ROOF;
     } else {
-        zc = c->zlo;
+        zc = T->hz[2 * b];
         kind = TRACE_UNDER;
         if (!(zc > 0.0))
             return;
@@ -371,13 +380,13 @@ static void cap_test(const tracer *T, const trace_cap *c, double zlo, double zhi
         return;
     x = o[0] + t * d[0];
     y = o[1] + t * d[1];
-    B = &T->s->bld[c->bld];
+    B = &T->s->bld[b];
     if (x < B->box[0] || x > B->box[2] || y < B->box[1] || y > B->box[3] ||
-        !inside_footprint(T->s, c->bld, x, y))
+        !inside_footprint(T->s, b, x, y))
         return;
     bs->t = t;
     bs->zc = zc;
-    bs->bld = c->bld;
+    bs->bld = b;
     bs->edge = TRACE_NONE;
     bs->kind = kind;
 }
@@ -388,26 +397,29 @@ static void cell_test(tracer *T, size_t c, double za, double zb, const double o[
 {
     const trace_cell *C = &T->cells[c];
     double zlo = (za < zb ? za : zb) - TRACE_ZSLACK, zhi = (za < zb ? zb : za) + TRACE_ZSLACK;
-    const trace_wall *w, *w1;
-    const trace_cap *r, *r1;
+    uint32_t k, k1;
     if (zlo > C->top)
         return; /* above every roof in the cell */
-    w1 = T->walls + C[1].w0;
-    T->tests += C[1].w0 - C->w0;
-    for (w = T->walls + C->w0; w < w1; w++)
+    k1 = C[1].w0;
+    T->tests += k1 - C->w0;
+    for (k = C->w0; k < k1; k++) {
+        uint32_t e = T->wids[k];
+        const trace_wall *w = &T->walls[e];
         if (w->zhi >= zlo && w->zlo <= zhi)
-            wall_test(w, o, d, bs);
-    if (d[2] == 0.0)
-        return;
-    r1 = T->caps + C[1].r0;
-    for (r = T->caps + C->r0; r < r1; r++)
-        cap_test(T, r, zlo, zhi, o, d, bs);
+            wall_test(w, e, o, d, bs);
+    }
+    if (d[2] < 0.0 ? zhi < C->roof_lo : !(d[2] > 0.0 && zlo <= C->under_hi))
+        return; /* no roof (going down) or underside (up) at the ray's heights */
+    k1 = C[1].r0;
+    for (k = C->r0; k < k1; k++)
+        cap_test(T, T->ids[k], zlo, zhi, o, d, bs);
 }
 
-static int finish(const double o[3], const double d[3], const best *bs, trace_hit *h)
+static int finish(const tracer *T, const double o[3], const double d[3], const best *bs,
+                  trace_hit *h)
 {
     h->t = bs->t;
-    h->bld = bs->bld;
+    h->bld = bs->kind == TRACE_WALL ? T->ebld[bs->edge] : bs->bld;
     h->edge = bs->edge;
     h->kind = bs->kind;
     h->p[0] = o[0] + bs->t * d[0];
@@ -427,12 +439,10 @@ static int finish(const double o[3], const double d[3], const best *bs, trace_hi
         h->p[2] = bs->zc;
         h->n[2] = -1.0;
         break;
-    case TRACE_WALL: {
-        double l = sqrt(bs->ex * bs->ex + bs->ey * bs->ey);
-        h->n[0] = bs->ey / l;
-        h->n[1] = -bs->ex / l;
+    case TRACE_WALL:
+        h->n[0] = bs->nx;
+        h->n[1] = bs->ny;
         break;
-    }
     default:
         break;
     }
@@ -443,7 +453,7 @@ static int finish(const double o[3], const double d[3], const best *bs, trace_hi
 static void ray_begin(tracer *T, const double o[3], const double d[3], double tmax, best *bs)
 {
     bs->t = tmax;
-    bs->ex = bs->ey = bs->zc = 0.0;
+    bs->nx = bs->ny = bs->zc = 0.0;
     bs->bld = TRACE_NONE;
     bs->edge = TRACE_NONE;
     bs->kind = TRACE_SKY;
@@ -539,7 +549,7 @@ static void walk(tracer *T, const double o[3], const double d[3], const double i
         if (te > t1)
             te = t1;
         else if (inside)
-            TRACE_PREFETCH(T->walls + T->cells[(size_t)jy * T->nx + (uint32_t)jx].w0);
+            TRACE_PREFETCH(T->wids + T->cells[(size_t)jy * T->nx + (uint32_t)jx].w0);
         zb = o[2] + te * d[2];
         cell_test(T, c, za, zb, o, d, bs);
         if (bs->t <= te || te >= t1 || !inside)
@@ -563,7 +573,7 @@ int trace_ray(tracer *T, const double o[3], const double d[3], double tmax, trac
     t1 = bs.t;
     /* above the tallest building and not going down: nothing to hit */
     if (d[2] >= 0.0 && o[2] > T->zmax)
-        return finish(o, d, &bs, h);
+        return finish(T, o, d, &bs, h);
     if (d[2] > 0.0) {
         double tt = (T->zmax - o[2]) / d[2];
         if (tt < t1)
@@ -580,10 +590,10 @@ int trace_ray(tracer *T, const double o[3], const double d[3], double tmax, trac
     if (!(t0 == 0.0 && o[0] >= T->x0 && o[0] <= gx1 && o[1] >= T->y0 && o[1] <= gy1) &&
         !(clip_axis(o[0], d[0], inv[0], T->x0, gx1, &t0, &t1) &&
           clip_axis(o[1], d[1], inv[1], T->y0, gy1, &t0, &t1)))
-        return finish(o, d, &bs, h);
+        return finish(T, o, d, &bs, h);
     if (t0 <= t1)
         walk(T, o, d, inv, t0, t1, &bs);
-    return finish(o, d, &bs, h);
+    return finish(T, o, d, &bs, h);
 }
 
 int trace_ray_brute(tracer *T, const double o[3], const double d[3], double tmax, trace_hit *h)
@@ -594,33 +604,19 @@ int trace_ray_brute(tracer *T, const double o[3], const double d[3], double tmax
     ray_begin(T, o, d, tmax, &bs);
     for (b = 0; b < s->nbld; b++) {
         const scene_building *B = &s->bld[b];
-        trace_cap c;
         uint32_t r;
         for (r = 0; r < B->ring_count; r++) {
             const scene_ring *R = &s->rings[B->ring_first + r];
             uint32_t k;
             for (k = 0; k < R->count; k++) {
-                const vec2 *p = &s->pts[R->first + k], *q = &s->pts[T->enext[R->first + k]];
-                trace_wall w;
-                w.px = p->x;
-                w.py = p->y;
-                w.ex = q->x - p->x;
-                w.ey = q->y - p->y;
-                w.zlo = B->min_height;
-                w.zhi = B->height;
-                w.edge = R->first + k;
-                w.bld = b;
                 T->tests++;
-                wall_test(&w, o, d, &bs);
+                wall_test(&T->walls[R->first + k], R->first + k, o, d, &bs);
             }
         }
-        c.zlo = B->min_height;
-        c.zhi = B->height;
-        c.bld = b;
         if (d[2] != 0.0)
-            cap_test(T, &c, -INFINITY, INFINITY, o, d, &bs);
+            cap_test(T, b, -INFINITY, INFINITY, o, d, &bs);
     }
-    return finish(o, d, &bs, h);
+    return finish(T, o, d, &bs, h);
 }
 
 double trace_top(tracer *T, double x, double y, uint32_t *bld)

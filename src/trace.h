@@ -84,29 +84,24 @@ typedef struct trace_hit {
  * bench_photon). */
 #define TRACE_CELL_FACTOR 0.5
 
-/* A wall as listed in a cell: everything the ray test reads, in one cache
- * line. */
+/* A wall (footprint edge), as the ray test reads it: one record per edge,
+ * indexed like scene.pts (by the edge's first vertex), so the records of a
+ * building's walls lie together. */
 typedef struct trace_wall {
     double px, py;     /* first vertex */
     double ex, ey;     /* edge vector (next vertex - first) */
     double zlo, zhi;   /* the building's min_height and height */
-    uint32_t edge;     /* index in scene.pts of the first vertex */
-    uint32_t bld;
-    uint64_t pad;
+    double nx, ny;     /* unit normal out of the solid, (ey, -ex) / |e| */
 } trace_wall;
 
-/* A building as listed in a cell, for its roof and underside. */
-typedef struct trace_cap {
-    double zlo, zhi;   /* min_height, height */
-    uint32_t bld;
-    uint32_t pad;
-} trace_cap;
-
-/* A cell: its walls are walls[w0 .. next cell's w0), its buildings
- * caps[r0 .. next cell's r0); top bounds every height in it from above. */
+/* A cell: its walls are wids[w0 .. next cell's w0), its buildings
+ * ids[r0 .. next cell's r0) (r0 = start[c]); the tallest top, the lowest
+ * roof and the highest underside among them (0 if none) decide whether
+ * a ray needs to look at the cell, and at its roofs. */
 typedef struct trace_cell {
     uint32_t w0, r0;
-    double top;
+    double top, roof_lo, under_hi;
+    double pad;
 } trace_cell;
 
 typedef struct tracer {
@@ -115,10 +110,12 @@ typedef struct tracer {
     double cell, inv;      /* cell size (m) and its inverse */
     uint32_t nx, ny;
     trace_cell *cells;     /* nx*ny + 1 (the last one ends the lists) */
-    trace_wall *walls;
-    trace_cap *caps;
+    uint32_t *wids;        /* wall (edge) indices per cell */
+    trace_wall *walls;     /* per scene point: its edge's wall */
+    uint32_t *ebld;        /* per scene point: the building of its edge */
+    double *hz;            /* per building: min_height, height */
     uint32_t *start;       /* nx*ny + 1 offsets into ids */
-    uint32_t *ids;         /* building indices per cell (the caps' buildings) */
+    uint32_t *ids;         /* building indices per cell (box overlap) */
     uint32_t *enext;       /* per scene point: the next vertex of its ring */
     double zmax;           /* tallest building */
     uint64_t rays, tests;  /* counters: rays cast, wall records examined */
