@@ -352,11 +352,35 @@ static int inside_footprint(const scene *s, uint32_t b, double x, double y)
     return (int)in;
 }
 
+/* Whether (x, y) lies on an edge of building b's rings (to rounding: the
+ * cross product of the edge and the point vanishes, within the edge's box).
+ * Makes roofs closed like walls: a ray grazing a roof along its outline
+ * hits it. */
+static int on_outline(const scene *s, uint32_t b, double x, double y)
+{
+    const scene_building *B = &s->bld[b];
+    uint32_t r;
+    for (r = 0; r < B->ring_count; r++) {
+        const scene_ring *R = &s->rings[B->ring_first + r];
+        uint32_t k;
+        const vec2 *p = &s->pts[R->first + R->count - 1];
+        for (k = 0; k < R->count; k++) {
+            const vec2 *q = &s->pts[R->first + k];
+            if (x >= (p->x < q->x ? p->x : q->x) && x <= (p->x < q->x ? q->x : p->x) &&
+                y >= (p->y < q->y ? p->y : q->y) && y <= (p->y < q->y ? q->y : p->y) &&
+                (q->x - p->x) * (y - p->y) - (q->y - p->y) * (x - p->x) == 0.0)
+                return 1;
+            p = q;
+        }
+    }
+    return 0;
+}
+
 /*
  * The horizontal faces of building b whose height lies in [zlo, zhi] (the
  * ray's heights over the part of its path being searched): the roof going
  * down, the underside (min_height > 0) going up. A hit when the ray meets
- * the plane at 0 < t < best inside the footprint.
+ * the plane at 0 < t < best inside the footprint or on its outline.
  */
 static void cap_test(const tracer *T, uint32_t b, double zlo, double zhi, const double o[3],
                      const double d[3], best *bs)
@@ -382,7 +406,7 @@ static void cap_test(const tracer *T, uint32_t b, double zlo, double zhi, const 
     y = o[1] + t * d[1];
     B = &T->s->bld[b];
     if (x < B->box[0] || x > B->box[2] || y < B->box[1] || y > B->box[3] ||
-        !inside_footprint(T->s, b, x, y))
+        !(inside_footprint(T->s, b, x, y) || on_outline(T->s, b, x, y)))
         return;
     bs->t = t;
     bs->zc = zc;
