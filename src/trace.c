@@ -163,6 +163,170 @@ static size_t grid_lists(const scene *s, const gridspec *g, int pass, uint32_t *
     return refs;
 }
 
+/* Bytes of the lamp tables for nl lamps and nref references. */
+static size_t lamp_bytes(uint32_t nl, size_t nref)
+{
+    return ((size_t)nl * (TRACE_SECTORS + 2) + 1) * sizeof(uint32_t) + 64 +
+           (nref ? nref : 1) * sizeof(uint32_t) + 64 + (nl ? nl : 1) + 64;
+}
+
+/* Sector of direction (x, y) (not both 0): TRACE_SECTORS equal steps of the
+ * pseudo-angle in [0, 4) that grows counter-clockwise from +x (a quarter
+ * turn per unit), so the sectors of a direction span are consecutive. */
+static uint32_t sector_of(double x, double y)
+{
+    double ax = fabs(x), ay = fabs(y), a;
+    uint32_t k;
+    if (y >= 0.0)
+        a = x >= 0.0 ? ay / (ax + ay) : 1.0 + ax / (ax + ay);
+    else
+        a = x < 0.0 ? 2.0 + ay / (ax + ay) : 3.0 + ax / (ax + ay);
+    k = (uint32_t)(a * (TRACE_SECTORS / 4.0));
+    return k >= TRACE_SECTORS ? k - TRACE_SECTORS : k;
+}
+
+/* Distance from (x, y) to segment p + u e, 0 <= u <= 1. */
+static double seg_dist(double x, double y, const trace_wall *w)
+{
+    double l2 = w->ex * w->ex + w->ey * w->ey, u = 0.0, px, py;
+    if (l2 > 0.0) {
+        u = ((x - w->px) * w->ex + (y - w->py) * w->ey) / l2;
+        u = u < 0.0 ? 0.0 : u > 1.0 ? 1.0 : u;
+    }
+    px = w->px + u * w->ex - x;
+    py = w->py + u * w->ey - y;
+    return sqrt(px * px + py * py);
+}
+
+/*
+ * The references of lamp l's table: (sector, wall) pairs and (TRACE_SECTORS,
+ * building) for caps. Mode 0 counts them (returns the count), mode 1 counts
+ * per slot into cnt[k + 1], mode 2 places them at the cursors cnt[k].
+ * Buildings come from the grid cells around the lamp, each once (in the
+ * first cell of the range that lists it).
+ */
+static uint32_t lamp_refs(const tracer *T, const gridspec *g, uint32_t l, int mode,
+                          uint32_t *cnt, uint32_t *ref)
+{
+    const scene *s = T->s;
+    const scene_lamp *L = &s->lamps[l];
+    double R = L->radius * (1.0 + 1e-9) + g->pad, o[3];
+    uint32_t li0, li1, lj0, lj1, ci, cj, n = 0;
+    o[0] = L->x;
+    o[1] = L->y;
+    o[2] = L->z;
+    cell_range(g, o[0] - R, o[0] + R, g->x0, g->nx, &li0, &li1);
+    cell_range(g, o[1] - R, o[1] + R, g->y0, g->ny, &lj0, &lj1);
+    for (cj = lj0; cj <= lj1; cj++)
+        for (ci = li0; ci <= li1; ci++) {
+            size_t c = (size_t)cj * g->nx + ci;
+            uint32_t k;
+            for (k = T->start[c]; k < T->start[c + 1]; k++) {
+                uint32_t b = T->ids[k], bi0, bi1, bj0, bj1, r;
+                const scene_building *B = &s->bld[b];
+                double bx = B->box[0] - o[0] > o[0] - B->box[2] ? B->box[0] - o[0]
+                                                                : o[0] - B->box[2];
+                double by = B->box[1] - o[1] > o[1] - B->box[3] ? B->box[1] - o[1]
+                                                                : o[1] - B->box[3];
+                cell_range(g, B->box[0], B->box[2], g->x0, g->nx, &bi0, &bi1);
+                cell_range(g, B->box[1], B->box[3], g->y0, g->ny, &bj0, &bj1);
+                if ((bi0 > li0 ? bi0 : li0) != ci || (bj0 > lj0 ? bj0 : lj0) != cj)
+                    continue; /* listed in an earlier cell of the range */
+                if ((bx > 0.0 ? bx * bx : 0.0) + (by > 0.0 ? by * by : 0.0) > R * R)
+                    continue;
+                if (B->height < o[2] || (B->min_height > 0.0 && B->min_height > o[2])) {
+                    n++;
+                    if (mode == 1)
+                        cnt[TRACE_SECTORS + 1]++;
+                    else if (mode == 2)
+                        ref[cnt[TRACE_SECTORS]++] = b;
+                }
+                for (r = 0; r < B->ring_count; r++) {
+                    const scene_ring *Rg = &s->rings[B->ring_first + r];
+                    uint32_t e;
+                    for (e = Rg->first; e < Rg->first + Rg->count; e++) {
+                        const trace_wall *w = &T->walls[e];
+                        double tn = (w->px - o[0]) * w->ey - (w->py - o[1]) * w->ex;
+                        uint32_t s0, s1, span, j;
+                        /* rays from o meet it only from its outer side
+                         * (tn < 0, as in wall_test) and within R */
+                        if (!(tn < 0.0) || seg_dist(o[0], o[1], w) > R)
+                            continue;
+                        s0 = sector_of(w->px + w->ex - o[0], w->py + w->ey - o[1]);
+                        s1 = sector_of(w->px - o[0], w->py - o[1]);
+                        span = (s1 + TRACE_SECTORS - s0) % TRACE_SECTORS + 3;
+                        if (span > TRACE_SECTORS)
+                            span = TRACE_SECTORS;
+                        s0 = (s0 + TRACE_SECTORS - 1) % TRACE_SECTORS;
+                        for (j = 0; j < span; j++) {
+                            uint32_t sk = (s0 + j) % TRACE_SECTORS;
+                            n++;
+                            if (mode == 1)
+                                cnt[sk + 1]++;
+                            else if (mode == 2)
+                                ref[cnt[sk]++] = e;
+                        }
+                    }
+                }
+            }
+        }
+    return n;
+}
+
+/* Whether lamp l gets a table: a finite positive radius, a small range of
+ * cells around it, at most TRACE_LAMP_REFS references. */
+static int lamp_fits(const tracer *T, const gridspec *g, uint32_t l)
+{
+    const scene_lamp *L = &T->s->lamps[l];
+    double cells = 2.0 * L->radius * g->inv + 2.0;
+    return L->radius > 0.0 && cells * cells <= 256.0 &&
+           lamp_refs(T, g, l, 0, NULL, NULL) <= TRACE_LAMP_REFS;
+}
+
+/* Builds the lamp tables (the grid is built): counts, allocates, places. */
+static int lamp_tables(tracer *T, arena *a, plx_part part, const gridspec *g)
+{
+    const scene *s = T->s;
+    const uint32_t W = TRACE_SECTORS + 2;
+    size_t total = 0;
+    uint32_t l, k;
+    T->lsec = arena_calloc(a, part, (size_t)s->nlamps * W + 1, sizeof(uint32_t), 64);
+    T->lfast = arena_calloc(a, part, s->nlamps ? s->nlamps : 1, 1, 64);
+    if (!T->lsec || !T->lfast)
+        return 0;
+    for (l = 0; l < s->nlamps; l++) {
+        T->lfast[l] = (uint8_t)lamp_fits(T, g, l);
+        if (T->lfast[l])
+            total += lamp_refs(T, g, l, 0, NULL, NULL);
+    }
+    T->lref = arena_alloc(a, part, (total ? total : 1) * sizeof(uint32_t), 64);
+    if (!T->lref)
+        return 0;
+    total = 0;
+    for (l = 0; l < s->nlamps; l++) {
+        /* the lamp's W offsets: counts per slot, starts, cursors moved to
+         * the ends by placing, then shifted back to starts */
+        uint32_t *cnt = &T->lsec[(size_t)l * W], first = (uint32_t)total;
+        memset(cnt, 0, W * sizeof(uint32_t));
+        cnt[0] = first;
+        if (T->lfast[l]) {
+            lamp_refs(T, g, l, 1, cnt, NULL);
+            for (k = 1; k < W; k++)
+                cnt[k] += cnt[k - 1];
+            total = cnt[W - 1];
+            lamp_refs(T, g, l, 2, cnt, T->lref);
+            for (k = W - 1; k > 0; k--)
+                cnt[k] = cnt[k - 1];
+            cnt[0] = first;
+        } else {
+            for (k = 1; k < W; k++)
+                cnt[k] = first;
+        }
+    }
+    T->lsec[(size_t)s->nlamps * W] = (uint32_t)total;
+    return 1;
+}
+
 size_t trace_bytes(const scene *s, double cell_size)
 {
     gridspec g;
@@ -176,7 +340,8 @@ size_t trace_bytes(const scene *s, double cell_size)
            (nw ? nw : 1) * sizeof(uint32_t) + 64 +
            (size_t)(s->npts ? s->npts : 1) * (sizeof(trace_wall) + 2 * sizeof(uint32_t)) + 3 * 64 +
            (size_t)(s->nbld ? s->nbld : 1) * 2 * sizeof(double) + 64 +
-           (cells + 1) * sizeof(uint32_t) + 64 + (refs ? refs : 1) * sizeof(uint32_t) + 64;
+           (cells + 1) * sizeof(uint32_t) + 64 + (refs ? refs : 1) * sizeof(uint32_t) + 64 +
+           lamp_bytes(s->nlamps, (size_t)s->nlamps * TRACE_LAMP_REFS);
 }
 
 /* Turns counts in cnt[1..cells] into starts in cnt[0..cells]; with
@@ -272,6 +437,8 @@ plx_status trace_create(arena *a, plx_part part, const scene *s, double cell_siz
     }
     for (i = 0; i <= cells; i++)
         T->cells[i].r0 = T->start[i];
+    if (!lamp_tables(T, a, part, &g))
+        goto nomem;
     for (i = 0; i < cells; i++) {
         trace_cell *C = &T->cells[i];
         uint32_t k;
@@ -617,6 +784,34 @@ int trace_ray(tracer *T, const double o[3], const double d[3], double tmax, trac
         return finish(T, o, d, &bs, h);
     if (t0 <= t1)
         walk(T, o, d, inv, t0, t1, &bs);
+    return finish(T, o, d, &bs, h);
+}
+
+int trace_lamp_ray(tracer *T, uint32_t lamp, const double d[3], trace_hit *h)
+{
+    const scene_lamp *L = &T->s->lamps[lamp];
+    const uint32_t *sec = &T->lsec[(size_t)lamp * (TRACE_SECTORS + 2)];
+    double o[3];
+    best bs;
+    uint32_t k, k1;
+    o[0] = L->x;
+    o[1] = L->y;
+    o[2] = L->z;
+    if (!T->lfast[lamp])
+        return trace_ray(T, o, d, L->radius, h);
+    ray_begin(T, o, d, L->radius, &bs);
+    if (d[0] != 0.0 || d[1] != 0.0) {
+        uint32_t sk = sector_of(d[0], d[1]);
+        k1 = sec[sk + 1];
+        T->tests += k1 - sec[sk];
+        for (k = sec[sk]; k < k1; k++)
+            wall_test(&T->walls[T->lref[k]], T->lref[k], o, d, &bs);
+    }
+    if (d[2] != 0.0) {
+        k1 = sec[TRACE_SECTORS + 1];
+        for (k = sec[TRACE_SECTORS]; k < k1; k++)
+            cap_test(T, T->lref[k], -INFINITY, INFINITY, o, d, &bs);
+    }
     return finish(T, o, d, &bs, h);
 }
 

@@ -84,6 +84,12 @@ typedef struct trace_hit {
  * bench_photon). */
 #define TRACE_CELL_FACTOR 0.5
 
+/* Lamp tables: sectors of directions (equal steps of a pseudo-angle) and
+ * the most wall references a lamp's table may hold (beyond, its rays walk
+ * the grid). */
+#define TRACE_SECTORS 32
+#define TRACE_LAMP_REFS 128
+
 /* A wall (footprint edge), as the ray test reads it: one record per edge,
  * indexed like scene.pts (by the edge's first vertex), so the records of a
  * building's walls lie together. */
@@ -117,6 +123,12 @@ typedef struct tracer {
     uint32_t *start;       /* nx*ny + 1 offsets into ids */
     uint32_t *ids;         /* building indices per cell (box overlap) */
     uint32_t *enext;       /* per scene point: the next vertex of its ring */
+    /* lamp tables (trace_lamp_ray): per lamp TRACE_SECTORS + 2 offsets into
+     * lref, the walls it can hit per sector of directions, then the
+     * buildings whose roof or underside it can hit */
+    uint32_t *lsec;
+    uint32_t *lref;
+    uint8_t *lfast;        /* per lamp: 1 if it has a table */
     double zmax;           /* tallest building */
     uint64_t rays, tests;  /* counters: rays cast, wall records examined */
 } tracer;
@@ -141,6 +153,17 @@ size_t trace_bytes(const scene *s, double cell_size);
  */
 int trace_ray(tracer *T, const double o[3], const double d[3], double tmax,
               trace_hit *h /* OUT */);
+
+/*
+ * trace_ray from lamp 'lamp' of the scene (o = its position, tmax = its
+ * radius R), the same answer (ties aside) by its table: the walls that can
+ * be hit from it (facing it, within R) listed per sector of directions
+ * (each wall in the sectors its angular span meets, one more each side for
+ * rounding), and the roofs below it and undersides above it within R. A
+ * lamp without a table (radius not finite and positive, too many walls)
+ * walks the grid.
+ */
+int trace_lamp_ray(tracer *T, uint32_t lamp, const double d[3], trace_hit *h /* OUT */);
 
 /* The same answer by the same wall and roof tests over every building (no
  * grid): checks the walk. */

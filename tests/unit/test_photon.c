@@ -175,15 +175,17 @@ static int brute_cast(const scene *s, const double o[3], const double d[3], doub
 /* Hit tolerance: |t - t_brute| <= TRACE_TOL (1 + t_brute). */
 #define TRACE_TOL 1e-9
 
-/* Whether the caster's answer h agrees with the brute force on o + t d
- * (tmax INFINITY): no hit for no hit, else a kind among those tied first
- * and the same t within TRACE_TOL. Prints the first few disagreements. */
-static int trace_agrees(const scene *s, const double o[3], const double d[3],
-                        const trace_hit *h, int *shown)
+/* Whether the caster's answer h agrees with the brute force on o + t d,
+ * t < tmax: no hit for no hit, else a kind among those tied first and the
+ * same t within TRACE_TOL. Prints the first few disagreements. */
+static int trace_agrees_tmax(const scene *s, const double o[3], const double d[3], double tmax,
+                             const trace_hit *h, int *shown)
 {
     double tb;
     unsigned tie;
     int kb = brute_cast_tie(s, o, d, TRACE_TOL, &tb, &tie);
+    if (!(tb < tmax))
+        kb = TRACE_SKY;
     if (kb == TRACE_SKY ? h->kind == TRACE_SKY
                         : ((tie >> h->kind) & 1u) && fabs(h->t - tb) <= TRACE_TOL * (1.0 + tb))
         return 1;
@@ -243,6 +245,12 @@ static void random_city(fixture *f, uint64_t seed)
     /* two boxes sharing a wall, different heights */
     assert_true(ref_scene_add_box(&f->s, 200, 150, 215, 170, 12.0, 0.0) >= 0);
     assert_true(ref_scene_add_box(&f->s, 215, 150, 230, 170, 20.0, 0.0) >= 0);
+}
+
+static int trace_agrees(const scene *s, const double o[3], const double d[3],
+                        const trace_hit *h, int *shown)
+{
+    return trace_agrees_tmax(s, o, d, INFINITY, h, shown);
 }
 
 static void test_trace_vs_brute(void **state)
@@ -324,13 +332,14 @@ static void test_trace_vs_brute(void **state)
  * L-shape (E), an octagon with 45-degree faces (F), a box as tall as A (G).
  * Integer coordinates: rays along walls, through corners and at roof
  * heights are computed exactly. */
-static void exact_city(fixture *f)
+static void exact_city(fixture *f, const double (*lamps)[4], int nl)
 {
     double dxy[16] = {0, 20, 30, 20, 30, 50, 0, 50, 10, 30, 10, 40, 20, 40, 20, 30};
     double exy[12] = {50, 0, 70, 0, 70, 10, 60, 10, 60, 30, 50, 30};
     double fxy[16] = {82, 0, 88, 0, 90, 2, 90, 8, 88, 10, 82, 10, 80, 8, 80, 2};
     uint32_t dn[2] = {4, 4}, en[1] = {6}, fn[1] = {8};
-    fx_open(f, 8u << 20);
+    int i;
+    fx_open(f, 16u << 20);
     assert_true(ref_scene_add_box(&f->s, 0, 0, 10, 10, 10.0, 0.0) >= 0);
     assert_true(ref_scene_add_box(&f->s, 10, 0, 20, 10, 15.0, 0.0) >= 0);
     assert_true(ref_scene_add_box(&f->s, 30, 0, 40, 10, 12.0, 4.0) >= 0);
@@ -338,6 +347,9 @@ static void exact_city(fixture *f)
     assert_true(ref_scene_add_building(&f->s, exy, en, 1, 20.0, 0.0) >= 0);
     assert_true(ref_scene_add_building(&f->s, fxy, fn, 1, 9.0, 0.0) >= 0);
     assert_true(ref_scene_add_box(&f->s, 50, 40, 60, 50, 10.0, 0.0) >= 0);
+    for (i = 0; i < nl; i++)
+        assert_true(ref_scene_add_lamp(&f->s, lamps[i][0], lamps[i][1], lamps[i][2], 1000,
+                                       lamps[i][3]) >= 0);
     fx_finish(f);
 }
 
@@ -519,7 +531,7 @@ static void test_trace_degenerate(void **state)
     int i, nr = quick_mode() ? 20 : 120;
     unsigned z;
     (void)state;
-    exact_city(&f);
+    exact_city(&f, NULL, 0);
     memset(&c, 0, sizeof c);
     c.s = &f.s;
     c.nt = 3;
@@ -570,6 +582,114 @@ static void test_trace_degenerate(void **state)
         }
     }
     fx_close(&f);
+}
+
+/* ---- rays from lamps (trace_lamp_ray) ---------------------------------- */
+
+/* trace_lamp_ray against the brute force (tmax = the lamp's radius) and
+ * against trace_ray from the same point, on lamps of both test cities:
+ * random ones at random heights and at roof heights, and exact ones at
+ * the degenerate spots; directions random, level, vertical, axis and
+ * exactly at building corners. */
+static int lamp_rays(fixture *f, uint64_t *rs, int nrand, int *kinds, int *shown)
+{
+    tracer *T;
+    uint32_t l, v, fast = 0;
+    int mism = 0, k;
+    assert_int_equal(trace_create(&f->a, PLX_PART_PHOTON, &f->s, 0.0, &T), PLX_OK);
+    for (l = 0; l < f->s.nlamps; l++)
+        fast += T->lfast[l];
+    printf("  %u of %u lamps with a table\n", fast, f->s.nlamps);
+    assert_true(fast * 4 >= f->s.nlamps * 3);
+    for (l = 0; l < f->s.nlamps; l++) {
+        const scene_lamp *L = &f->s.lamps[l];
+        double o[3] = {L->x, L->y, L->z}, d[3];
+        for (k = 0; k < nrand + 10 + (int)f->s.npts; k++) {
+            trace_hit h, h2;
+            if (k < nrand) {
+                sphere_dir(rs, d);
+                if (k % 4 == 0) {
+                    double m = hypot(d[0], d[1]);
+                    d[0] /= m;
+                    d[1] /= m;
+                    d[2] = 0.0;
+                }
+            } else if (k < nrand + 8) {
+                static const double ax[8][2] = {{1, 0}, {1, 1}, {0, 1}, {-1, 1},
+                                                {-1, 0}, {-1, -1}, {0, -1}, {1, -1}};
+                d[0] = ax[k - nrand][0] * ((k - nrand) % 2 ? sqrt(0.5) : 1.0);
+                d[1] = ax[k - nrand][1] * ((k - nrand) % 2 ? sqrt(0.5) : 1.0);
+                d[2] = 0.0;
+            } else if (k < nrand + 10) {
+                d[0] = d[1] = 0.0;
+                d[2] = k == nrand + 8 ? 1.0 : -1.0;
+            } else {
+                /* at a vertex, level or tilted */
+                double m;
+                v = (uint32_t)(k - nrand - 10);
+                d[0] = f->s.pts[v].x - o[0];
+                d[1] = f->s.pts[v].y - o[1];
+                d[2] = v % 2 ? 0.0 : -0.3 * hypot(d[0], d[1]);
+                m = sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+                if (!(m > 0.0))
+                    continue;
+                d[0] /= m;
+                d[1] /= m;
+                d[2] /= m;
+            }
+            trace_lamp_ray(T, l, d, &h);
+            trace_ray(T, o, d, L->radius, &h2);
+            kinds[h.kind]++;
+            if (!trace_agrees_tmax(&f->s, o, d, L->radius, &h, shown) ||
+                (h.kind == TRACE_SKY) != (h2.kind == TRACE_SKY) ||
+                (h.kind != TRACE_SKY && fabs(h.t - h2.t) > 1e-12 * (1.0 + h.t)))
+                mism++;
+        }
+    }
+    return mism;
+}
+
+static void test_trace_lamp_rays(void **state)
+{
+    fixture f;
+    uint64_t rs = 99;
+    int kinds[5] = {0, 0, 0, 0, 0}, mism, shown = 0, nl = 0, nrand = quick_mode() ? 40 : 400;
+    (void)state;
+    /* random city: lamps at random points outside the solids, some at the
+     * height of a roof, radii 5 to 80 m */
+    fx_open(&f, 16u << 20);
+    random_city(&f, 5);
+    while (nl < 40) {
+        double o[3];
+        o[0] = f.s.bounds[0] + 50.0 + (f.s.bounds[2] - f.s.bounds[0] - 100.0) * urand(&rs);
+        o[1] = f.s.bounds[1] + 50.0 + (f.s.bounds[3] - f.s.bounds[1] - 100.0) * urand(&rs);
+        o[2] = nl % 3 == 0 ? f.s.bld[nl % f.s.nbld].height : 40.0 * urand(&rs);
+        if (in_solid(&f.s, o))
+            continue;
+        assert_true(ref_scene_add_lamp(&f.s, o[0], o[1], o[2], 1000, 5.0 + 75.0 * urand(&rs)) >= 0);
+        nl++;
+    }
+    fx_finish(&f);
+    mism = lamp_rays(&f, &rs, nrand, kinds, &shown);
+    fx_close(&f);
+    /* exact city: lamps at the degenerate spots (roof heights, on the line
+     * of walls, under the raised box, in the courtyard) */
+    {
+        static const double L[][4] = {{5, -5, 10, 30},  {-5, 0, 3, 30},   {25, 5, 2, 40},
+                                      {25, 5, 4, 40},   {35, 5, 1, 20},   {15, 35, 6, 25},
+                                      {15, 35, 12, 25}, {55, 35, 10, 35}, {90, 12, 9, 15},
+                                      {10, -3, 15, 40}, {45, 5, 12, 50},  {75, 20, 20, 60}};
+        exact_city(&f, L, (int)(sizeof L / sizeof L[0]));
+        mism += lamp_rays(&f, &rs, nrand, kinds, &shown);
+        fx_close(&f);
+    }
+    printf("trace_lamp_ray vs brute force and trace_ray: %d rays, %d mismatches (sky %d ground "
+           "%d wall %d roof %d under %d)\n",
+           kinds[0] + kinds[1] + kinds[2] + kinds[3] + kinds[4], mism, kinds[0], kinds[1],
+           kinds[2], kinds[3], kinds[4]);
+    assert_int_equal(mism, 0);
+    assert_true(kinds[TRACE_WALL] > 0 && kinds[TRACE_ROOF] > 0 && kinds[TRACE_UNDER] > 0 &&
+                kinds[TRACE_GROUND] > 0 && kinds[TRACE_SKY] > 0);
 }
 
 /* ---- energy in a closed box --------------------------------------------- */
@@ -1242,6 +1362,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_trace_vs_brute),
         cmocka_unit_test(test_trace_degenerate),
+        cmocka_unit_test(test_trace_lamp_rays),
         cmocka_unit_test(test_energy_closed_box),
         cmocka_unit_test(test_one_bounce_wall),
         cmocka_unit_test(test_accuracy_eixample),
