@@ -3,6 +3,11 @@
  *    `gen eixample 30 30` (generated in memory), target <= 10 ms;
  *  - rays per second of the grid caster against the brute-force caster
  *    (every building) on the same rays, run in the same process;
+ *  - caster new vs old: ns per ray of the lamp tables (trace_lamp_ray),
+ *    the grid walk (trace_ray) and the caster before them
+ *    (tests/ref/ref_trace_old.c) on the same rays (street rays, and rays
+ *    like a photon pass's: from lamps and bounces), thread CPU time, best
+ *    of 5 alternated runs; a sweep of the grid's cell size;
  *  - memory of the photon buffers by kind;
  *  - lookup time of photon_indirect (ground and facade points);
  *  - error against photon count on fixtures/eixample-4x4.geojson, measured
