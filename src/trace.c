@@ -200,8 +200,8 @@ static double seg_dist(double x, double y, const trace_wall *w)
 
 /*
  * The references of lamp l's table: (sector, wall) pairs and (TRACE_SECTORS,
- * building) for caps. Mode 0 counts them (returns the count), mode 1 counts
- * per slot into cnt[k + 1], mode 2 places them at the cursors cnt[k].
+ * building) for caps; returns their number. Mode 1 also counts them per
+ * slot into cnt[k + 1], mode 2 places them at the cursors cnt[k].
  * Buildings come from the grid cells around the lamp, each once (in the
  * first cell of the range that lists it).
  */
@@ -273,17 +273,20 @@ static uint32_t lamp_refs(const tracer *T, const gridspec *g, uint32_t l, int mo
     return n;
 }
 
-/* Whether lamp l gets a table: a finite positive radius, a small range of
- * cells around it, at most TRACE_LAMP_REFS references. */
-static int lamp_fits(const tracer *T, const gridspec *g, uint32_t l)
+/* Whether lamp l may get a table: a finite positive radius and a small
+ * range of cells around it (then at most TRACE_LAMP_REFS references). */
+static int lamp_small(const gridspec *g, const scene_lamp *L)
 {
-    const scene_lamp *L = &T->s->lamps[l];
     double cells = 2.0 * L->radius * g->inv + 2.0;
-    return L->radius > 0.0 && cells * cells <= 256.0 &&
-           lamp_refs(T, g, l, 0, NULL, NULL) <= TRACE_LAMP_REFS;
+    return L->radius > 0.0 && cells * cells <= 256.0;
 }
 
-/* Builds the lamp tables (the grid is built): counts, allocates, places. */
+/*
+ * Builds the lamp tables (the grid is built). Per lamp its W offsets hold
+ * first the counts per slot (cnt[k + 1]), then, once the references are
+ * allocated, the starts, the cursors moved to the ends by placing, and the
+ * starts again.
+ */
 static int lamp_tables(tracer *T, arena *a, plx_part part, const gridspec *g)
 {
     const scene *s = T->s;
@@ -295,32 +298,32 @@ static int lamp_tables(tracer *T, arena *a, plx_part part, const gridspec *g)
     if (!T->lsec || !T->lfast)
         return 0;
     for (l = 0; l < s->nlamps; l++) {
-        T->lfast[l] = (uint8_t)lamp_fits(T, g, l);
-        if (T->lfast[l])
-            total += lamp_refs(T, g, l, 0, NULL, NULL);
+        uint32_t *cnt = &T->lsec[(size_t)l * W], n;
+        if (!lamp_small(g, &s->lamps[l]))
+            continue;
+        n = lamp_refs(T, g, l, 1, cnt, NULL);
+        if (n > TRACE_LAMP_REFS) {
+            memset(cnt, 0, W * sizeof(uint32_t));
+            continue;
+        }
+        T->lfast[l] = 1;
+        total += n;
     }
     T->lref = arena_alloc(a, part, (total ? total : 1) * sizeof(uint32_t), 64);
     if (!T->lref)
         return 0;
     total = 0;
     for (l = 0; l < s->nlamps; l++) {
-        /* the lamp's W offsets: counts per slot, starts, cursors moved to
-         * the ends by placing, then shifted back to starts */
         uint32_t *cnt = &T->lsec[(size_t)l * W], first = (uint32_t)total;
-        memset(cnt, 0, W * sizeof(uint32_t));
         cnt[0] = first;
+        for (k = 1; k < W; k++)
+            cnt[k] += cnt[k - 1];
+        total = cnt[W - 1];
         if (T->lfast[l]) {
-            lamp_refs(T, g, l, 1, cnt, NULL);
-            for (k = 1; k < W; k++)
-                cnt[k] += cnt[k - 1];
-            total = cnt[W - 1];
             lamp_refs(T, g, l, 2, cnt, T->lref);
             for (k = W - 1; k > 0; k--)
                 cnt[k] = cnt[k - 1];
             cnt[0] = first;
-        } else {
-            for (k = 1; k < W; k++)
-                cnt[k] = first;
         }
     }
     T->lsec[(size_t)s->nlamps * W] = (uint32_t)total;

@@ -678,7 +678,8 @@ static void test_trace_lamp_rays(void **state)
         static const double L[][4] = {{5, -5, 10, 30},  {-5, 0, 3, 30},   {25, 5, 2, 40},
                                       {25, 5, 4, 40},   {35, 5, 1, 20},   {15, 35, 6, 25},
                                       {15, 35, 12, 25}, {55, 35, 10, 35}, {90, 12, 9, 15},
-                                      {10, -3, 15, 40}, {45, 5, 12, 50},  {75, 20, 20, 60}};
+                                      {10, -3, 15, 40}, {45, 5, 12, 50},  {75, 20, 20, 60},
+                                      {45, 25, 8, 900}}; /* the last one walks the grid */
         exact_city(&f, L, (int)(sizeof L / sizeof L[0]));
         mism += lamp_rays(&f, &rs, nrand, kinds, &shown);
         fx_close(&f);
