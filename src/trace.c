@@ -5,6 +5,15 @@
 #include "trace.h"
 
 #define TRACE_MAX_CELLS (1u << 22)
+
+/* A hint to fetch the cache line at p (the walk knows the next cell before
+ * it tests the current one; a hit's building is read next by callers); nothing on other compilers. */
+#if defined(__GNUC__)
+#define TRACE_PREFETCH(p) __builtin_prefetch(p)
+#else
+#define TRACE_PREFETCH(p) ((void)(p))
+#endif
+
 /* Slack of the per-cell height filters (m): they only skip work, so they
  * err on the side of testing (rounding of z at the cell's ends is far
  * smaller). */
@@ -341,7 +350,7 @@ size_t trace_bytes(const scene *s, double cell_size)
     refs = grid_lists(s, &g, 0, NULL, NULL, NULL, NULL, &nw);
     return sizeof(tracer) + 64 + (cells + 1) * sizeof(trace_cell) + 64 +
            (nw ? nw : 1) * sizeof(uint32_t) + 64 +
-           (size_t)(s->npts ? s->npts : 1) * (sizeof(trace_wall) + 2 * sizeof(uint32_t)) + 3 * 64 +
+           (size_t)(s->npts ? s->npts : 1) * (sizeof(trace_wall) + sizeof(uint32_t)) + 2 * 64 +
            (size_t)(s->nbld ? s->nbld : 1) * 2 * sizeof(double) + 64 +
            (cells + 1) * sizeof(uint32_t) + 64 + (refs ? refs : 1) * sizeof(uint32_t) + 64 +
            lamp_bytes(s->nlamps, (size_t)s->nlamps * TRACE_LAMP_REFS);
@@ -396,12 +405,11 @@ plx_status trace_create(arena *a, plx_part part, const scene *s, double cell_siz
     T->cells = arena_calloc(a, part, cells + 1, sizeof(trace_cell), 64);
     T->wids = arena_alloc(a, part, (nw ? nw : 1) * sizeof(uint32_t), 64);
     T->walls = arena_alloc(a, part, (s->npts ? s->npts : 1) * sizeof(trace_wall), 64);
-    T->ebld = arena_alloc(a, part, (s->npts ? s->npts : 1) * sizeof(uint32_t), 64);
     T->enext = arena_alloc(a, part, (s->npts ? s->npts : 1) * sizeof(uint32_t), 64);
     T->hz = arena_alloc(a, part, (s->nbld ? s->nbld : 1) * 2 * sizeof(double), 64);
     T->start = arena_calloc(a, part, cells + 1, sizeof(uint32_t), 64);
     T->ids = arena_alloc(a, part, (refs ? refs : 1) * sizeof(uint32_t), 64);
-    if (!T->cells || !T->wids || !T->walls || !T->ebld || !T->enext || !T->hz || !T->start ||
+    if (!T->cells || !T->wids || !T->walls || !T->enext || !T->hz || !T->start ||
         !T->ids)
         goto nomem;
     /* counting sort of the (cell, building) and (cell, wall) references */
@@ -423,18 +431,14 @@ plx_status trace_create(arena *a, plx_part part, const scene *s, double cell_siz
                 uint32_t e = R->first + k, f = R->first + (k + 1 == R->count ? 0 : k + 1);
                 trace_wall *w = &T->walls[e];
                 T->enext[e] = f;
-                T->ebld[e] = b;
                 w->px = s->pts[e].x;
                 w->py = s->pts[e].y;
                 w->ex = s->pts[f].x - s->pts[e].x;
                 w->ey = s->pts[f].y - s->pts[e].y;
                 w->zlo = B->min_height;
                 w->zhi = B->height;
-                {
-                    double l = sqrt(w->ex * w->ex + w->ey * w->ey);
-                    w->nx = l > 0.0 ? w->ey / l : 0.0;
-                    w->ny = l > 0.0 ? -w->ex / l : 0.0;
-                }
+                w->bld = b;
+                w->pad[0] = w->pad[1] = w->pad[2] = 0;
             }
         }
     }
@@ -466,7 +470,8 @@ nomem:
 /* The best hit so far, with what finish needs (no scene lookups). */
 typedef struct best {
     double t;
-    double nx, ny;     /* wall: its normal */
+    double ex, ey;     /* wall: its edge vector */
+    const scene_building *bldv; /* the scene's buildings (prefetched at a hit) */
     double zc;         /* roof or underside: its height */
     uint32_t bld, edge;
     int kind;
@@ -494,9 +499,11 @@ static void wall_test(const trace_wall *w, uint32_t e, const double o[3], const 
     if (!((t < bs->t) & (z >= w->zlo) & (z <= w->zhi)))
         return;
     bs->t = t;
-    bs->nx = w->nx;
-    bs->ny = w->ny;
+    bs->ex = w->ex;
+    bs->ey = w->ey;
+    bs->bld = w->bld;
     bs->edge = e;
+    TRACE_PREFETCH(bs->bldv + w->bld);
     bs->kind = TRACE_WALL;
 }
 
@@ -609,11 +616,10 @@ static void cell_test(tracer *T, size_t c, double za, double zb, const double o[
         cap_test(T, T->ids[k], zlo, zhi, o, d, bs);
 }
 
-static int finish(const tracer *T, const double o[3], const double d[3], const best *bs,
-                  trace_hit *h)
+static int finish(const double o[3], const double d[3], const best *bs, trace_hit *h)
 {
     h->t = bs->t;
-    h->bld = bs->kind == TRACE_WALL ? T->ebld[bs->edge] : bs->bld;
+    h->bld = bs->bld;
     h->edge = bs->edge;
     h->kind = bs->kind;
     h->p[0] = o[0] + bs->t * d[0];
@@ -633,10 +639,12 @@ static int finish(const tracer *T, const double o[3], const double d[3], const b
         h->p[2] = bs->zc;
         h->n[2] = -1.0;
         break;
-    case TRACE_WALL:
-        h->n[0] = bs->nx;
-        h->n[1] = bs->ny;
+    case TRACE_WALL: {
+        double l = sqrt(bs->ex * bs->ex + bs->ey * bs->ey);
+        h->n[0] = bs->ey / l;
+        h->n[1] = -bs->ex / l;
         break;
+    }
     default:
         break;
     }
@@ -647,7 +655,8 @@ static int finish(const tracer *T, const double o[3], const double d[3], const b
 static void ray_begin(tracer *T, const double o[3], const double d[3], double tmax, best *bs)
 {
     bs->t = tmax;
-    bs->nx = bs->ny = bs->zc = 0.0;
+    bs->ex = bs->ey = bs->zc = 0.0;
+    bs->bldv = T->s->bld;
     bs->bld = TRACE_NONE;
     bs->edge = TRACE_NONE;
     bs->kind = TRACE_SKY;
@@ -660,14 +669,6 @@ static void ray_begin(tracer *T, const double o[3], const double d[3], double tm
     }
     T->rays++;
 }
-
-/* A hint to fetch the cache line at p (the walk knows the next cell before
- * it tests the current one); nothing on other compilers. */
-#if defined(__GNUC__)
-#define TRACE_PREFETCH(p) __builtin_prefetch(p)
-#else
-#define TRACE_PREFETCH(p) ((void)(p))
-#endif
 
 /* Cuts [*t0, *t1] to the slab lo <= o + t d <= hi of one axis (inv = 1 / d);
  * 0 when the ray misses it. */
@@ -767,7 +768,7 @@ int trace_ray(tracer *T, const double o[3], const double d[3], double tmax, trac
     t1 = bs.t;
     /* above the tallest building and not going down: nothing to hit */
     if (d[2] >= 0.0 && o[2] > T->zmax)
-        return finish(T, o, d, &bs, h);
+        return finish(o, d, &bs, h);
     if (d[2] > 0.0) {
         double tt = (T->zmax - o[2]) / d[2];
         if (tt < t1)
@@ -784,10 +785,10 @@ int trace_ray(tracer *T, const double o[3], const double d[3], double tmax, trac
     if (!(t0 == 0.0 && o[0] >= T->x0 && o[0] <= gx1 && o[1] >= T->y0 && o[1] <= gy1) &&
         !(clip_axis(o[0], d[0], inv[0], T->x0, gx1, &t0, &t1) &&
           clip_axis(o[1], d[1], inv[1], T->y0, gy1, &t0, &t1)))
-        return finish(T, o, d, &bs, h);
+        return finish(o, d, &bs, h);
     if (t0 <= t1)
         walk(T, o, d, inv, t0, t1, &bs);
-    return finish(T, o, d, &bs, h);
+    return finish(o, d, &bs, h);
 }
 
 int trace_lamp_ray(tracer *T, uint32_t lamp, const double d[3], trace_hit *h)
@@ -815,7 +816,7 @@ int trace_lamp_ray(tracer *T, uint32_t lamp, const double d[3], trace_hit *h)
         for (k = sec[TRACE_SECTORS]; k < k1; k++)
             cap_test(T, T->lref[k], -INFINITY, INFINITY, o, d, &bs);
     }
-    return finish(T, o, d, &bs, h);
+    return finish(o, d, &bs, h);
 }
 
 int trace_ray_brute(tracer *T, const double o[3], const double d[3], double tmax, trace_hit *h)
@@ -838,7 +839,7 @@ int trace_ray_brute(tracer *T, const double o[3], const double d[3], double tmax
         if (d[2] != 0.0)
             cap_test(T, b, -INFINITY, INFINITY, o, d, &bs);
     }
-    return finish(T, o, d, &bs, h);
+    return finish(o, d, &bs, h);
 }
 
 double trace_top(tracer *T, double x, double y, uint32_t *bld)

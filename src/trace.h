@@ -18,7 +18,7 @@
  *   TRACE_SKY    nothing before tmax.
  *
  * Method. One record per wall (footprint edge: first vertex, edge vector,
- * the building's [min_height, height], unit normal; 64 bytes) and a
+ * the building's [min_height, height] and index; 64 bytes) and a
  * uniform grid over the Bounds box; each cell lists
  *   - its walls (indices of every edge that comes within a hair of the
  *     cell: segment clipped to the padded cell box, Liang-Barsky), and
@@ -71,8 +71,9 @@
  *
  * Memory: trace_create takes everything from the arena (part given by the
  * caller, PLX_PART_PHOTON for the photon system) and no scratch: lists are
- * counted, then placed. On gen eixample 30 30 the grid takes 8 MiB and
- * the lamp tables 7 MiB. Tracing allocates nothing.
+ * counted, then placed. On gen eixample 30 30 the grid takes 6 MiB (4 of
+ * them the wall records) and the lamp tables 7 MiB. Tracing allocates
+ * nothing.
  */
 #ifndef PLX_TRACE_H
 #define PLX_TRACE_H
@@ -96,10 +97,13 @@ typedef struct trace_hit {
     int kind;          /* TRACE_SKY, TRACE_GROUND, ... */
 } trace_hit;
 
-/* Cell size (m) per sqrt(area per building) when trace_create chooses it:
- * small cells keep few walls per cell (measured on gen eixample, see
- * bench_photon). */
-#define TRACE_CELL_FACTOR 0.5
+/* Cell size (m) per sqrt(area per building) when trace_create chooses it.
+ * On gen eixample 30 30 (bench_photon) the walk alone is fastest at 0.5
+ * (17 m cells, 135 ns per photon-pass ray against 148 at 0.75), but the
+ * photon pass (whose first rays use the lamp tables) and random probe rays
+ * (photon_indirect) are faster at 0.75: the grid is half the size (cells,
+ * lists), so it competes less for the cache. */
+#define TRACE_CELL_FACTOR 0.75
 
 /* Lamp tables: sectors of directions (equal steps of a pseudo-angle) and
  * the most wall references a lamp's table may hold (beyond, its rays walk
@@ -114,7 +118,8 @@ typedef struct trace_wall {
     double px, py;     /* first vertex */
     double ex, ey;     /* edge vector (next vertex - first) */
     double zlo, zhi;   /* the building's min_height and height */
-    double nx, ny;     /* unit normal out of the solid, (ey, -ex) / |e| */
+    uint32_t bld;      /* the building */
+    uint32_t pad[3];   /* to 64 bytes: one cache line */
 } trace_wall;
 
 /* A cell: its walls are wids[w0 .. next cell's w0), its buildings
@@ -135,7 +140,6 @@ typedef struct tracer {
     trace_cell *cells;     /* nx*ny + 1 (the last one ends the lists) */
     uint32_t *wids;        /* wall (edge) indices per cell */
     trace_wall *walls;     /* per scene point: its edge's wall */
-    uint32_t *ebld;        /* per scene point: the building of its edge */
     double *hz;            /* per building: min_height, height */
     uint32_t *start;       /* nx*ny + 1 offsets into ids */
     uint32_t *ids;         /* building indices per cell (box overlap) */

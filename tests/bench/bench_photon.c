@@ -201,6 +201,83 @@ static void new_vs_old(const char *what, tracer *T, old_tracer *O, int n, double
                best[2] / best[0], mism);
 }
 
+/* ---- caster new vs old ---- */
+
+enum { NR = 200000 };
+static double o_st[NR][3], d_st[NR][3]; /* the street rays of the caster section */
+
+/* The new casters against the old one (tests/ref/ref_trace_old.c) on the
+ * street rays and on photon-pass rays, and a sweep of the cell size. Run
+ * after the lookups: it takes memory (the old caster, sweep grids). */
+static int compare_casters(plx_engine *e, photon_sys *ps, const scene *s, uint64_t *prs)
+{
+    double (*o)[3] = o_st, (*d)[3] = d_st;
+    uint64_t rs = *prs, t0;
+    trace_hit h;
+    int i;
+    {
+        enum { NP = 200000 };
+        static double po[NP][3], pd[NP][3], pt[NP], tm[NR];
+        static int32_t pl[NP], nol[NR];
+        old_tracer *O;
+        static const double sizes[] = {0.3, 0.4, 0.5, 0.6, 0.75, 1.0};
+        double per = (s->bounds[2] - s->bounds[0]) * (s->bounds[3] - s->bounds[1]) / s->nbld;
+        uint32_t l, nfast = 0;
+        unsigned z;
+        if (old_trace_create(&e->mem, PLX_PART_PHOTON, s, 0.0, &O) != PLX_OK) {
+            fprintf(stderr, "bench_photon: old caster: out of memory\n");
+            return 1;
+        }
+        for (l = 0; l < s->nlamps; l++)
+            nfast += ps->T->lfast[l];
+        printf("lamp tables: %u of %u lamps, %u wall references (%.1f per lamp, %d sectors), "
+               "%.1f MiB; grid %.1f MiB (walls, cells, lists)\n",
+               nfast, s->nlamps, ps->T->lsec[(size_t)s->nlamps * (TRACE_SECTORS + 2)],
+               ps->T->lsec[(size_t)s->nlamps * (TRACE_SECTORS + 2)] / (double)nfast,
+               TRACE_SECTORS,
+               (ps->T->lsec[(size_t)s->nlamps * (TRACE_SECTORS + 2)] * 4.0 +
+                s->nlamps * ((TRACE_SECTORS + 2) * 4.0 + 1)) / 1048576.0,
+               (ps->T->cells[(size_t)ps->T->nx * ps->T->ny].w0 * 4.0 +
+                ((size_t)ps->T->nx * ps->T->ny + 1) * (sizeof(trace_cell) + 4.0) +
+                s->npts * (sizeof(trace_wall) + 4.0) + s->nbld * 16.0 +
+                ps->T->start[(size_t)ps->T->nx * ps->T->ny] * 4.0) / 1048576.0);
+        for (i = 0; i < NR; i++) {
+            tm[i] = INFINITY;
+            nol[i] = -1;
+        }
+        new_vs_old("street rays", ps->T, O, NR, o, d, tm, nol, 1);
+        pass_rays(ps->T, s, &rs, NP, po, pd, pt, pl);
+        new_vs_old("photon-pass rays, all", ps->T, O, NP, po, pd, pt, pl, -1);
+        new_vs_old("photon-pass rays, from lamps", ps->T, O, NP, po, pd, pt, pl, 0);
+        new_vs_old("photon-pass rays, bounces", ps->T, O, NP, po, pd, pt, pl, 1);
+        printf("cell size sweep, grid walk on the photon-pass rays (cell = factor x "
+               "sqrt(area per building); default factor %.2f):\n",
+               TRACE_CELL_FACTOR);
+        for (z = 0; z < sizeof sizes / sizeof sizes[0]; z++) {
+            arena_mark m = arena_get_mark(&e->mem);
+            tracer *T2;
+            double best = 1e30;
+            int r;
+            if (trace_create(&e->mem, PLX_PART_PHOTON, s, sizes[z] * sqrt(per), &T2) !=
+                PLX_OK)
+                return 1;
+            for (r = 0; r < 3; r++) {
+                double v;
+                t0 = cpu_ns();
+                for (i = 0; i < NP; i++)
+                    trace_ray(T2, po[i], pd[i], pt[i], &h);
+                v = (double)(cpu_ns() - t0) / NP;
+                if (v < best)
+                    best = v;
+            }
+            printf("  factor %.2f (%.1f m cells): %.0f ns/ray\n", sizes[z], T2->cell, best);
+            arena_release(&e->mem, &m);
+        }
+    }
+    *prs = rs;
+    return 0;
+}
+
 int main(int argc, char **argv)
 {
     int frames = argc > 1 ? atoi(argv[1]) : 20;
@@ -289,8 +366,8 @@ int main(int argc, char **argv)
 
     /* ---- the caster ---- */
     {
-        enum { NR = 200000, NB = 300 };
-        static double o[NR][3], d[NR][3];
+        enum { NB = 300 };
+        double (*o)[3] = o_st, (*d)[3] = d_st;
         trace_hit h, hb;
         double fast, brute;
         int mism = 0;
@@ -322,65 +399,6 @@ int main(int argc, char **argv)
                brute, NB, fast / brute, mism);
         if (mism)
             return 1;
-        {
-            enum { NP = 200000 };
-            static double po[NP][3], pd[NP][3], pt[NP], tm[NR];
-            static int32_t pl[NP], nol[NR];
-            old_tracer *O;
-            static const double sizes[] = {0.3, 0.4, 0.5, 0.6, 0.75, 1.0};
-            double per = (s->bounds[2] - s->bounds[0]) * (s->bounds[3] - s->bounds[1]) / s->nbld;
-            uint32_t l, nfast = 0;
-            unsigned z;
-            if (old_trace_create(&e->mem, PLX_PART_PHOTON, s, 0.0, &O) != PLX_OK) {
-                fprintf(stderr, "bench_photon: old caster: out of memory\n");
-                return 1;
-            }
-            for (l = 0; l < s->nlamps; l++)
-                nfast += ps->T->lfast[l];
-            printf("lamp tables: %u of %u lamps, %u wall references (%.1f per lamp, %d sectors), "
-                   "%.1f MiB; grid %.1f MiB (walls, cells, lists)\n",
-                   nfast, s->nlamps, ps->T->lsec[(size_t)s->nlamps * (TRACE_SECTORS + 2)],
-                   ps->T->lsec[(size_t)s->nlamps * (TRACE_SECTORS + 2)] / (double)nfast,
-                   TRACE_SECTORS,
-                   (ps->T->lsec[(size_t)s->nlamps * (TRACE_SECTORS + 2)] * 4.0 +
-                    s->nlamps * ((TRACE_SECTORS + 2) * 4.0 + 1)) / 1048576.0,
-                   (ps->T->cells[(size_t)ps->T->nx * ps->T->ny].w0 * 4.0 +
-                    ((size_t)ps->T->nx * ps->T->ny + 1) * (sizeof(trace_cell) + 4.0) +
-                    s->npts * (sizeof(trace_wall) + 8.0) + s->nbld * 16.0 +
-                    ps->T->start[(size_t)ps->T->nx * ps->T->ny] * 4.0) / 1048576.0);
-            for (i = 0; i < NR; i++) {
-                tm[i] = INFINITY;
-                nol[i] = -1;
-            }
-            new_vs_old("street rays", ps->T, O, NR, o, d, tm, nol, 1);
-            pass_rays(ps->T, s, &rs, NP, po, pd, pt, pl);
-            new_vs_old("photon-pass rays, all", ps->T, O, NP, po, pd, pt, pl, -1);
-            new_vs_old("photon-pass rays, from lamps", ps->T, O, NP, po, pd, pt, pl, 0);
-            new_vs_old("photon-pass rays, bounces", ps->T, O, NP, po, pd, pt, pl, 1);
-            printf("cell size sweep, grid walk on the photon-pass rays (cell = factor x "
-                   "sqrt(area per building); default factor %.2f):\n",
-                   TRACE_CELL_FACTOR);
-            for (z = 0; z < sizeof sizes / sizeof sizes[0]; z++) {
-                arena_mark m = arena_get_mark(&e->mem);
-                tracer *T2;
-                double best = 1e30;
-                int r;
-                if (trace_create(&e->mem, PLX_PART_PHOTON, s, sizes[z] * sqrt(per), &T2) !=
-                    PLX_OK)
-                    return 1;
-                for (r = 0; r < 3; r++) {
-                    double v;
-                    t0 = cpu_ns();
-                    for (i = 0; i < NP; i++)
-                        trace_ray(T2, po[i], pd[i], pt[i], &h);
-                    v = (double)(cpu_ns() - t0) / NP;
-                    if (v < best)
-                        best = v;
-                }
-                printf("  factor %.2f (%.1f m cells): %.0f ns/ray\n", sizes[z], T2->cell, best);
-                arena_release(&e->mem, &m);
-            }
-        }
     }
 
     /* ---- lookups ---- */
@@ -428,6 +446,8 @@ int main(int argc, char **argv)
                "points, mean E %.3f lx\n",
                tg, tf, NQ, sum / NQ);
     }
+    if (compare_casters(e, ps, s, &rs))
+        return 1;
     plx_engine_free(e);
     free(t.buf);
     free(ms);
