@@ -6,8 +6,9 @@
 
 #define TRACE_MAX_CELLS (1u << 22)
 
-/* A hint to fetch the cache line at p (the walk knows the next cell before
- * it tests the current one; a hit's building is read next by callers); nothing on other compilers. */
+/* A hint to fetch the cache line at p: the walk knows the next cell before
+ * it tests the current one, and callers read a hit's building next.
+ * Nothing on other compilers. */
 #if defined(__GNUC__)
 #define TRACE_PREFETCH(p) __builtin_prefetch(p)
 #else

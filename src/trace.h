@@ -61,8 +61,9 @@
  * Degenerate cases: faces are closed (a ray touching an edge of a roof or a
  * wall exactly hits it; "on the outline" is to rounding, exact for
  * coordinates that are exact in binary), ties between coincident faces
- * (shared walls, a wall's top edge and its roof) go to either; a ray running inside a wall's plane does not cross
- * that edge (it meets the neighbouring edges at their ends). A ray that
+ * (shared walls, a wall's top edge and its roof) go to either; a ray
+ * running inside a wall's plane does not cross that edge (it meets the
+ * neighbouring edges at their ends). A ray that
  * starts inside a solid (the caller offsets bounce origins along the
  * normal, so this happens only by rounding at corners) leaves it without a
  * hit and may hit it again further on. Hits are correct to rounding (about
