@@ -1320,7 +1320,7 @@ void photon_trace_lamp(photon_sys *ps, uint32_t lamp, double phi, uint64_t *rng,
     st->photons++;
     st->emitted += phi;
     st->traced++;
-    if (trace_ray(ps->T, o, d, Lp->radius, &h) == TRACE_SKY)
+    if (trace_lamp_ray(ps->T, lamp, d, &h) == TRACE_SKY)
         return;
     f[0] = phi * photon_window(h.t / Lp->radius);
     if (!(f[0] > 0.0))

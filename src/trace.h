@@ -17,33 +17,64 @@
  *                the ground under one means passing a wall first), normal +z.
  *   TRACE_SKY    nothing before tmax.
  *
- * Method. Per building, the exact ray/prism entry: the slab of t where
- * min_height <= z(t) <= height is cut to the search range; whether the
- * entry point of that range lies inside the footprint is the parity of the
- * crossings of the ray's 2D line with the ring edges before it (a vertex on
- * the line counts as lying on its left, so a line through a vertex crosses
- * the two edges there once in all); inside means a roof/underside hit at
- * the slab entry, else the first crossing inside the range is the wall hit.
- * A ray that starts strictly inside a solid does not hit that building (the
- * caller offsets bounce origins along the normal, so this happens only by
- * rounding at corners; the photon then leaves through the solid).
- * Candidates come from a uniform grid over the Bounds box, each cell listing
- * the buildings whose box overlaps it and the tallest top among them; the
- * ray walks the cells in order (2D DDA, Amanatides-Woo) and stops as soon
- * as the best hit lies before the current cell's exit. Cells the ray passes
- * above their tallest top are skipped, and the walk ends once the ray rises
- * above the tallest building. Each building is tested at most once per ray
- * (per-building stamps), so a tracer must not be used by two threads at
- * once (make one per thread: they share nothing but the scene).
+ * Method. One record per wall (footprint edge: first vertex, edge vector,
+ * the building's [min_height, height] and index; 64 bytes) and a
+ * uniform grid over the Bounds box; each cell lists
+ *   - its walls (indices of every edge that comes within a hair of the
+ *     cell: segment clipped to the padded cell box, Liang-Barsky), and
+ *   - its buildings (box overlap), with in its header the tallest top, the
+ *     lowest roof and the highest underside among them.
+ * The ray walks the cells in order (2D DDA, Amanatides-Woo, inverse
+ * direction computed once, the next cell's list prefetched) and stops as
+ * soon as the best hit lies before the current cell's exit. In a cell it
+ * first compares the range of its heights there with the cell's top (the
+ * whole cell is skipped when the ray passes above it), then tests the walls
+ * whose height range meets the ray's, and, only if the ray crosses a roof
+ * height (going down) or an underside height (going up) of the cell, its
+ * buildings' roofs or undersides. A wall is hit when the ray enters the
+ * solid through it (walls are one-sided: a ray leaving a solid through a
+ * wall does not hit it), 0 < t, the crossing is on the closed edge and its
+ * height in the closed [min_height, height]: a few multiplications and
+ * sign tests, one division for a crossing. A roof or underside is hit when
+ * the point where the ray meets its plane is inside the footprint (even-odd
+ * over the building's rings, in its box) or on its outline.
+ * The walk ends where the ray rises above the tallest building, leaves the
+ * grid, or reaches tmax (the ground or the first hit).
+ *
+ * Lamp tables (trace_lamp_ray, the first ray of a photon). Per scene lamp
+ * the walls that a ray from it can hit (facing it, tn < 0 as in the wall
+ * test, and within its radius R, which bounds the ray) are listed per
+ * sector of directions: 32 equal steps of a pseudo-angle that grows with
+ * the azimuth (one division), each wall in the sectors between its two
+ * ends plus one each side (so rounding at a sector border cannot lose
+ * it), and the buildings whose roof is below the lamp or underside above
+ * it within R. A ray from the lamp tests its sector's walls (two on
+ * average on gen eixample) and those caps: no walk, no per-ray setup but
+ * the ground. The same wall and cap tests as the walk, on a superset of
+ * the faces it could hit, so the same answer (a tie may go the other
+ * way).
+ *
+ * Tracing writes only the counters (rays, tests): a tracer must not be
+ * used by two threads at once (make one per thread: they share nothing
+ * but the scene).
  *
  * Degenerate cases: faces are closed (a ray touching an edge of a roof or a
- * wall exactly hits it), ties between coincident faces of two buildings
- * (shared walls) go to either; a ray running inside a wall's plane does not
- * cross that edge. Hits are correct to rounding (about 1e-12 relative).
+ * wall exactly hits it; "on the outline" is to rounding, exact for
+ * coordinates that are exact in binary), ties between coincident faces
+ * (shared walls, a wall's top edge and its roof) go to either; a ray
+ * running inside a wall's plane does not cross that edge (it meets the
+ * neighbouring edges at their ends). A ray that
+ * starts inside a solid (the caller offsets bounce origins along the
+ * normal, so this happens only by rounding at corners) leaves it without a
+ * hit and may hit it again further on. Hits are correct to rounding (about
+ * 1e-12 relative): tests/unit/test_photon.c compares them with an
+ * independent brute force (tolerance 1e-9 (1 + t) on t).
  *
  * Memory: trace_create takes everything from the arena (part given by the
- * caller, PLX_PART_PHOTON for the photon system); construction scratch is
- * released before return. Tracing allocates nothing.
+ * caller, PLX_PART_PHOTON for the photon system) and no scratch: lists are
+ * counted, then placed. On gen eixample 30 30 the grid takes 6 MiB (4 of
+ * them the wall records) and the lamp tables 7 MiB. Tracing allocates
+ * nothing.
  */
 #ifndef PLX_TRACE_H
 #define PLX_TRACE_H
@@ -67,19 +98,61 @@ typedef struct trace_hit {
     int kind;          /* TRACE_SKY, TRACE_GROUND, ... */
 } trace_hit;
 
+/* Cell size (m) per sqrt(area per building) when trace_create chooses it.
+ * On gen eixample 30 30 (bench_photon) the walk alone is fastest at 0.5
+ * (17 m cells, 135 ns per photon-pass ray against 148 at 0.75), but the
+ * photon pass (whose first rays use the lamp tables) and random probe rays
+ * (photon_indirect) are faster at 0.75: the grid is half the size (cells,
+ * lists), so it competes less for the cache. */
+#define TRACE_CELL_FACTOR 0.75
+
+/* Lamp tables: sectors of directions (equal steps of a pseudo-angle) and
+ * the most wall references a lamp's table may hold (beyond, its rays walk
+ * the grid). */
+#define TRACE_SECTORS 32
+#define TRACE_LAMP_REFS 128
+
+/* A wall (footprint edge), as the ray test reads it: one record per edge,
+ * indexed like scene.pts (by the edge's first vertex), so the records of a
+ * building's walls lie together. */
+typedef struct trace_wall {
+    double px, py;     /* first vertex */
+    double ex, ey;     /* edge vector (next vertex - first) */
+    double zlo, zhi;   /* the building's min_height and height */
+    uint32_t bld;      /* the building */
+    uint32_t pad[3];   /* to 64 bytes: one cache line */
+} trace_wall;
+
+/* A cell: its walls are wids[w0 .. next cell's w0), its buildings
+ * ids[r0 .. next cell's r0) (r0 = start[c]); the tallest top, the lowest
+ * roof and the highest underside among them (0 if none) decide whether
+ * a ray needs to look at the cell, and at its roofs. */
+typedef struct trace_cell {
+    uint32_t w0, r0;
+    double top, roof_lo, under_hi;
+    double pad;
+} trace_cell;
+
 typedef struct tracer {
     const scene *s;
     double x0, y0;         /* grid origin (Bounds min corner) */
     double cell, inv;      /* cell size (m) and its inverse */
     uint32_t nx, ny;
+    trace_cell *cells;     /* nx*ny + 1 (the last one ends the lists) */
+    uint32_t *wids;        /* wall (edge) indices per cell */
+    trace_wall *walls;     /* per scene point: its edge's wall */
+    double *hz;            /* per building: min_height, height */
     uint32_t *start;       /* nx*ny + 1 offsets into ids */
-    uint32_t *ids;         /* building indices per cell */
-    float *top;            /* tallest height per cell (0 for empty cells) */
+    uint32_t *ids;         /* building indices per cell (box overlap) */
     uint32_t *enext;       /* per scene point: the next vertex of its ring */
-    uint32_t *stamp;       /* per building: last ray that tested it */
-    uint32_t now;
+    /* lamp tables (trace_lamp_ray): per lamp TRACE_SECTORS + 2 offsets into
+     * lref, the walls it can hit per sector of directions, then the
+     * buildings whose roof or underside it can hit */
+    uint32_t *lsec;
+    uint32_t *lref;
+    uint8_t *lfast;        /* per lamp: 1 if it has a table */
     double zmax;           /* tallest building */
-    uint64_t rays, tests;  /* counters: rays cast, prism tests */
+    uint64_t rays, tests;  /* counters: rays cast, wall records examined */
 } tracer;
 
 /*
@@ -91,7 +164,9 @@ typedef struct tracer {
 plx_status trace_create(arena *a, plx_part part, const scene *s, double cell_size,
                         tracer **out /* OUT */);
 
-/* Bytes trace_create takes for scene s and the given cell size (same rule). */
+/* Bytes trace_create takes at most for scene s and the given cell size
+ * (same rule; the lamp tables are counted at TRACE_LAMP_REFS references
+ * per lamp, a lamp needing more gets none). */
 size_t trace_bytes(const scene *s, double cell_size);
 
 /*
@@ -103,8 +178,19 @@ size_t trace_bytes(const scene *s, double cell_size);
 int trace_ray(tracer *T, const double o[3], const double d[3], double tmax,
               trace_hit *h /* OUT */);
 
-/* The same answer by testing every building (no grid): the baseline for
- * benchmarks. */
+/*
+ * trace_ray from lamp 'lamp' of the scene (o = its position, tmax = its
+ * radius R), the same answer (ties aside) by its table: the walls that can
+ * be hit from it (facing it, within R) listed per sector of directions
+ * (each wall in the sectors its angular span meets, one more each side for
+ * rounding), and the roofs below it and undersides above it within R. A
+ * lamp without a table (radius not finite and positive, too many walls)
+ * walks the grid.
+ */
+int trace_lamp_ray(tracer *T, uint32_t lamp, const double d[3], trace_hit *h /* OUT */);
+
+/* The same answer by the same wall and roof tests over every building (no
+ * grid): checks the walk. */
 int trace_ray_brute(tracer *T, const double o[3], const double d[3], double tmax,
                     trace_hit *h /* OUT */);
 

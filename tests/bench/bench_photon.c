@@ -3,6 +3,11 @@
  *    `gen eixample 30 30` (generated in memory), target <= 10 ms;
  *  - rays per second of the grid caster against the brute-force caster
  *    (every building) on the same rays, run in the same process;
+ *  - caster new vs old: ns per ray of the lamp tables (trace_lamp_ray),
+ *    the grid walk (trace_ray) and the caster before them
+ *    (tests/ref/ref_trace_old.c) on the same rays (street rays, and rays
+ *    like a photon pass's: from lamps and bounces), thread CPU time, best
+ *    of 5 alternated runs; a sweep of the grid's cell size;
  *  - memory of the photon buffers by kind;
  *  - lookup time of photon_indirect (ground and facade points);
  *  - error against photon count on fixtures/eixample-4x4.geojson, measured
@@ -15,11 +20,13 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <time.h>
 
 #include "polarlux.h"
 #include "engine.h"
 #include "trace.h"
 #include "photon.h"
+#include "ref_trace_old.h"
 
 #define BUDGET ((size_t)3 << 30)
 
@@ -78,6 +85,197 @@ static void sphere(uint64_t *rs, double d[3])
     d[0] = r * cos(p);
     d[1] = r * sin(p);
     d[2] = z;
+}
+
+
+/* Rays like those of a photon pass (photon_trace_lamp): lamps taken in
+ * order like photon_step's stratified choice (NPH photons spread over the
+ * lamps), from the lamp in a uniform direction up to its radius, then
+ * diffuse bounces from each hit (albedo survival, 1e-5 m off the surface
+ * like photon.c's BOUNCE_OFFSET). Stored as o, d, tmax and the lamp (or
+ * -1 for a bounce) for replays. */
+static int pass_rays(tracer *T, const scene *s, uint64_t *rs, int n, double (*o)[3],
+                     double (*d)[3], double *tmax, int32_t *lamp)
+{
+    int k = 0, ph = 0;
+    const int NPH = 65536;
+    while (k < n) {
+        uint32_t l = (uint32_t)((ph++ % NPH + photon_rand01(rs)) / NPH * s->nlamps);
+        const scene_lamp *L = &s->lamps[l < s->nlamps ? l : s->nlamps - 1];
+        trace_hit h;
+        int b;
+        o[k][0] = L->x;
+        o[k][1] = L->y;
+        o[k][2] = L->z;
+        sphere(rs, d[k]);
+        tmax[k] = L->radius;
+        lamp[k] = (int32_t)(L - s->lamps);
+        if (trace_ray(T, o[k], d[k], tmax[k], &h) == TRACE_SKY) {
+            k++;
+            continue;
+        }
+        k++;
+        for (b = 0; b < 16 && k < n; b++) {
+            double alb = h.kind == TRACE_GROUND ? s->ground_albedo : s->bld[h.bld].albedo;
+            if (photon_rand01(rs) >= alb)
+                break;
+            photon_cosine_dir(rs, h.n, d[k]);
+            o[k][0] = h.p[0] + 1e-5 * h.n[0];
+            o[k][1] = h.p[1] + 1e-5 * h.n[1];
+            o[k][2] = h.p[2] + 1e-5 * h.n[2];
+            tmax[k] = INFINITY;
+            lamp[k] = -1;
+            if (trace_ray(T, o[k], d[k], tmax[k], &h) == TRACE_SKY) {
+                k++;
+                break;
+            }
+            k++;
+        }
+    }
+    return k;
+}
+
+/* Thread CPU time: the machine is shared, so a run is timed by the time it
+ * got, and the best of several runs is kept. */
+static uint64_t cpu_ns(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+    return (uint64_t)ts.tv_sec * 1000000000u + (uint64_t)ts.tv_nsec;
+}
+
+/* Which caster new_vs_old times: 0 trace_ray, 1 trace_lamp_ray where the
+ * ray comes from a lamp (trace_ray for bounces), 2 the old caster. */
+static void cast(int which, tracer *T, old_tracer *O, const double *o, const double *d,
+                 double tmax, int32_t lamp, trace_hit *h)
+{
+    if (which == 2)
+        old_trace_ray(O, o, d, tmax, h);
+    else if (which == 1 && lamp >= 0)
+        trace_lamp_ray(T, (uint32_t)lamp, d, h);
+    else
+        trace_ray(T, o, d, tmax, h);
+}
+
+/* ns per ray of the casters on the same rays (sel: -1 all, 0 lamp rays,
+ * 1 bounces), best of 5 alternated runs; mismatches of kind or t (1e-9
+ * relative) against the old caster. */
+static void new_vs_old(const char *what, tracer *T, old_tracer *O, int n, double (*o)[3],
+                       double (*d)[3], const double *tmax, const int32_t *lamp, int sel)
+{
+    double best[3] = {1e30, 1e30, 1e30};
+    uint64_t t0, tests0 = T->tests;
+    int i, r, w, mism = 0, used = 0;
+    trace_hit h, ho;
+    for (r = 0; r < 5; r++)
+        for (w = 0; w < 3; w++) {
+            double v;
+            if (w == 1 && sel == 1)
+                continue;
+            t0 = cpu_ns();
+            for (i = 0; i < n; i++)
+                if (sel < 0 || (lamp[i] >= 0) == (sel == 0))
+                    cast(w, T, O, o[i], d[i], tmax[i], lamp[i], &h);
+            v = (double)(cpu_ns() - t0);
+            if (v < best[w])
+                best[w] = v;
+        }
+    for (i = 0; i < n; i++) {
+        if (!(sel < 0 || (lamp[i] >= 0) == (sel == 0)))
+            continue;
+        used++;
+        cast(1, T, O, o[i], d[i], tmax[i], lamp[i], &h);
+        old_trace_ray(O, o[i], d[i], tmax[i], &ho);
+        if (h.kind != ho.kind || (h.kind != TRACE_SKY && fabs(h.t - ho.t) > 1e-9 * (1 + h.t)))
+            mism++;
+    }
+    (void)tests0;
+    if (sel == 1)
+        printf("caster new vs old (%s, %d rays): grid walk %.0f ns/ray, old %.0f ns/ray: %.2fx; "
+               "%d mismatches\n",
+               what, used, best[0] / used, best[2] / used, best[2] / best[0], mism);
+    else
+        printf("caster new vs old (%s, %d rays): lamp tables %.0f ns/ray, grid walk %.0f "
+               "ns/ray, old %.0f ns/ray: %.2fx (walk %.2fx); %d mismatches\n",
+               what, used, best[1] / used, best[0] / used, best[2] / used, best[2] / best[1],
+               best[2] / best[0], mism);
+}
+
+/* ---- caster new vs old ---- */
+
+enum { NR = 200000 };
+static double o_st[NR][3], d_st[NR][3]; /* the street rays of the caster section */
+
+/* The new casters against the old one (tests/ref/ref_trace_old.c) on the
+ * street rays and on photon-pass rays, and a sweep of the cell size. Run
+ * after the lookups: it takes memory (the old caster, sweep grids). */
+static int compare_casters(plx_engine *e, photon_sys *ps, const scene *s, uint64_t *prs)
+{
+    double (*o)[3] = o_st, (*d)[3] = d_st;
+    uint64_t rs = *prs, t0;
+    trace_hit h;
+    int i;
+    {
+        enum { NP = 200000 };
+        static double po[NP][3], pd[NP][3], pt[NP], tm[NR];
+        static int32_t pl[NP], nol[NR];
+        old_tracer *O;
+        static const double sizes[] = {0.3, 0.4, 0.5, 0.6, 0.75, 1.0};
+        double per = (s->bounds[2] - s->bounds[0]) * (s->bounds[3] - s->bounds[1]) / s->nbld;
+        uint32_t l, nfast = 0;
+        unsigned z;
+        if (old_trace_create(&e->mem, PLX_PART_PHOTON, s, 0.0, &O) != PLX_OK) {
+            fprintf(stderr, "bench_photon: old caster: out of memory\n");
+            return 1;
+        }
+        for (l = 0; l < s->nlamps; l++)
+            nfast += ps->T->lfast[l];
+        printf("lamp tables: %u of %u lamps, %u wall references (%.1f per lamp, %d sectors), "
+               "%.1f MiB; grid %.1f MiB (walls, cells, lists)\n",
+               nfast, s->nlamps, ps->T->lsec[(size_t)s->nlamps * (TRACE_SECTORS + 2)],
+               ps->T->lsec[(size_t)s->nlamps * (TRACE_SECTORS + 2)] / (double)nfast,
+               TRACE_SECTORS,
+               (ps->T->lsec[(size_t)s->nlamps * (TRACE_SECTORS + 2)] * 4.0 +
+                s->nlamps * ((TRACE_SECTORS + 2) * 4.0 + 1)) / 1048576.0,
+               (ps->T->cells[(size_t)ps->T->nx * ps->T->ny].w0 * 4.0 +
+                ((size_t)ps->T->nx * ps->T->ny + 1) * (sizeof(trace_cell) + 4.0) +
+                s->npts * (sizeof(trace_wall) + 4.0) + s->nbld * 16.0 +
+                ps->T->start[(size_t)ps->T->nx * ps->T->ny] * 4.0) / 1048576.0);
+        for (i = 0; i < NR; i++) {
+            tm[i] = INFINITY;
+            nol[i] = -1;
+        }
+        new_vs_old("street rays", ps->T, O, NR, o, d, tm, nol, 1);
+        pass_rays(ps->T, s, &rs, NP, po, pd, pt, pl);
+        new_vs_old("photon-pass rays, all", ps->T, O, NP, po, pd, pt, pl, -1);
+        new_vs_old("photon-pass rays, from lamps", ps->T, O, NP, po, pd, pt, pl, 0);
+        new_vs_old("photon-pass rays, bounces", ps->T, O, NP, po, pd, pt, pl, 1);
+        printf("cell size sweep, grid walk on the photon-pass rays (cell = factor x "
+               "sqrt(area per building); default factor %.2f):\n",
+               TRACE_CELL_FACTOR);
+        for (z = 0; z < sizeof sizes / sizeof sizes[0]; z++) {
+            arena_mark m = arena_get_mark(&e->mem);
+            tracer *T2;
+            double best = 1e30;
+            int r;
+            if (trace_create(&e->mem, PLX_PART_PHOTON, s, sizes[z] * sqrt(per), &T2) !=
+                PLX_OK)
+                return 1;
+            for (r = 0; r < 3; r++) {
+                double v;
+                t0 = cpu_ns();
+                for (i = 0; i < NP; i++)
+                    trace_ray(T2, po[i], pd[i], pt[i], &h);
+                v = (double)(cpu_ns() - t0) / NP;
+                if (v < best)
+                    best = v;
+            }
+            printf("  factor %.2f (%.1f m cells): %.0f ns/ray\n", sizes[z], T2->cell, best);
+            arena_release(&e->mem, &m);
+        }
+    }
+    *prs = rs;
+    return 0;
 }
 
 int main(int argc, char **argv)
@@ -145,11 +343,16 @@ int main(int argc, char **argv)
     photon_step(ps, 65536, 1); /* warm-up */
     {
         uint64_t traced0 = ps->st.traced;
+        double cpu_min = 1e30;
         for (i = 0; i < frames; i++) {
+            uint64_t c0 = cpu_ns();
             t0 = now_ns();
             photon_step(ps, 65536, 2 + (uint64_t)i);
             ms[i] = (now_ns() - t0) / 1e6;
+            if ((cpu_ns() - c0) / 1e6 < cpu_min)
+                cpu_min = (cpu_ns() - c0) / 1e6;
         }
+        printf("photon pass, thread CPU time: %.2f ms min over %d passes\n", cpu_min, frames);
         qsort(ms, (size_t)frames, sizeof *ms, cmp_double);
         printf("photon pass: 65536 photons in %.2f ms median (min %.2f, max %.2f) over %d "
                "passes; %.2f rays per photon; target 10 ms: %s\n",
@@ -172,8 +375,8 @@ int main(int argc, char **argv)
 
     /* ---- the caster ---- */
     {
-        enum { NR = 200000, NB = 300 };
-        static double o[NR][3], d[NR][3];
+        enum { NB = 300 };
+        double (*o)[3] = o_st, (*d)[3] = d_st;
         trace_hit h, hb;
         double fast, brute;
         int mism = 0;
@@ -188,7 +391,7 @@ int main(int argc, char **argv)
             trace_ray(ps->T, o[i], d[i], INFINITY, &h);
         fast = NR / ((now_ns() - t0) / 1e9);
         printf("caster: %.2f M rays/s (random rays from street points, any direction; %.1f "
-               "prism tests per ray)\n",
+               "wall records examined per ray)\n",
                fast / 1e6, (double)(ps->T->tests - tests0) / NR);
         t0 = now_ns();
         for (i = 0; i < NB; i++)
@@ -252,6 +455,8 @@ int main(int argc, char **argv)
                "points, mean E %.3f lx\n",
                tg, tf, NQ, sum / NQ);
     }
+    if (compare_casters(e, ps, s, &rs))
+        return 1;
     plx_engine_free(e);
     free(t.buf);
     free(ms);

@@ -91,15 +91,25 @@ static void fx_close(fixture *f)
 
 /* ---- brute-force ray casting, written independently of src/trace.c ------ */
 
-/* First hit by plane tests against every face of every building. */
-static int brute_cast(const scene *s, const double o[3], const double d[3], double *tout)
+/*
+ * First hit by plane tests against every face of every building, with the
+ * caster's contract: walls are one-sided (met from outside the solid, the
+ * solid lying left of every ring edge: d x e < 0), faces closed (a roof is
+ * hit on its outline too), 1e-12 < t. Returns the kind of the nearest hit
+ * (TRACE_SKY if none) and in *tie the set (bit mask over kinds) of kinds
+ * met within 'tol' of it: at a tie (a ray through the top edge of a wall
+ * meets the wall and the roof at once) either is right.
+ */
+static int brute_cast_tie(const scene *s, const double o[3], const double d[3], double tol,
+                          double *tout, unsigned *tie)
 {
+    double ts[64];
+    int ks[64], n = 0, i, kind = TRACE_SKY;
     double best = INFINITY;
-    int kind = TRACE_SKY;
     uint32_t b;
     if (d[2] < 0.0 && o[2] > 0.0) {
-        best = -o[2] / d[2];
-        kind = TRACE_GROUND;
+        ts[n] = -o[2] / d[2];
+        ks[n++] = TRACE_GROUND;
     }
     for (b = 0; b < s->nbld; b++) {
         const scene_building *B = &s->bld[b];
@@ -113,37 +123,77 @@ static int brute_cast(const scene *s, const double o[3], const double d[3], doub
                 /* o + t d = p + u (q - p) in the plane */
                 double ex = q->x - p->x, ey = q->y - p->y;
                 double den = d[0] * ey - d[1] * ex, t, u, z;
-                if (den == 0.0)
+                if (!(den < 0.0))
                     continue;
                 t = ((p->x - o[0]) * ey - (p->y - o[1]) * ex) / den;
                 u = ((p->x - o[0]) * d[1] - (p->y - o[1]) * d[0]) / den;
                 z = o[2] + t * d[2];
                 if (t > 1e-12 && u >= 0.0 && u <= 1.0 && z >= B->min_height && z <= B->height &&
-                    t < best) {
-                    best = t;
-                    kind = TRACE_WALL;
+                    n < 64) {
+                    ts[n] = t;
+                    ks[n++] = TRACE_WALL;
                 }
             }
         }
         if (d[2] != 0.0) {
             double zs[2];
-            int i;
             zs[0] = B->height;
             zs[1] = B->min_height;
             for (i = 0; i < 2; i++) {
                 double t = (zs[i] - o[2]) / d[2];
                 if (i == 1 && B->min_height <= 0.0)
                     continue;
-                if (t > 1e-12 && t < best &&
-                    ref_footprint_where(s, b, o[0] + t * d[0], o[1] + t * d[1]) == REF_IN) {
-                    best = t;
-                    kind = i == 0 ? TRACE_ROOF : TRACE_UNDER;
+                if ((i == 0) != (d[2] < 0.0))
+                    continue; /* roofs are met going down, undersides going up */
+                if (t > 1e-12 && n < 64 &&
+                    ref_footprint_where(s, b, o[0] + t * d[0], o[1] + t * d[1]) != REF_OUT) {
+                    ts[n] = t;
+                    ks[n++] = i == 0 ? TRACE_ROOF : TRACE_UNDER;
                 }
             }
         }
     }
+    for (i = 0; i < n; i++)
+        if (ts[i] < best) {
+            best = ts[i];
+            kind = ks[i];
+        }
+    *tie = 0;
+    for (i = 0; i < n; i++)
+        if (ts[i] <= best + tol * (1.0 + best))
+            *tie |= 1u << ks[i];
     *tout = best;
     return kind;
+}
+
+static int brute_cast(const scene *s, const double o[3], const double d[3], double *tout)
+{
+    unsigned tie;
+    return brute_cast_tie(s, o, d, 1e-9, tout, &tie);
+}
+
+/* Hit tolerance: |t - t_brute| <= TRACE_TOL (1 + t_brute). */
+#define TRACE_TOL 1e-9
+
+/* Whether the caster's answer h agrees with the brute force on o + t d,
+ * t < tmax: no hit for no hit, else a kind among those tied first and the
+ * same t within TRACE_TOL. Prints the first few disagreements. */
+static int trace_agrees_tmax(const scene *s, const double o[3], const double d[3], double tmax,
+                             const trace_hit *h, int *shown)
+{
+    double tb;
+    unsigned tie;
+    int kb = brute_cast_tie(s, o, d, TRACE_TOL, &tb, &tie);
+    if (!(tb < tmax))
+        kb = TRACE_SKY;
+    if (kb == TRACE_SKY ? h->kind == TRACE_SKY
+                        : ((tie >> h->kind) & 1u) && fabs(h->t - tb) <= TRACE_TOL * (1.0 + tb))
+        return 1;
+    if ((*shown)++ < 8)
+        printf("mismatch: o %.17g %.17g %.17g d %.17g %.17g %.17g: brute %d t=%.12f (ties %x), "
+               "trace %d t=%.12f\n",
+               o[0], o[1], o[2], d[0], d[1], d[2], kb, tb, tie, h->kind, h->t);
+    return 0;
 }
 
 static int in_solid(const scene *s, const double p[3])
@@ -197,21 +247,28 @@ static void random_city(fixture *f, uint64_t seed)
     assert_true(ref_scene_add_box(&f->s, 215, 150, 230, 170, 20.0, 0.0) >= 0);
 }
 
+static int trace_agrees(const scene *s, const double o[3], const double d[3],
+                        const trace_hit *h, int *shown)
+{
+    return trace_agrees_tmax(s, o, d, INFINITY, h, shown);
+}
+
 static void test_trace_vs_brute(void **state)
 {
     fixture f;
     tracer *T;
     uint64_t rs = 77;
-    int n = full_mode() ? 50000 : quick_mode() ? 500 : 5000, done = 0, mism = 0, kinds[5] = {0, 0, 0, 0, 0};
+    int n = full_mode() ? 100000 : quick_mode() ? 1000 : 20000, done = 0, mism = 0, shown = 0;
+    int kinds[5] = {0, 0, 0, 0, 0};
     (void)state;
     fx_open(&f, 8u << 20);
     random_city(&f, 5);
     fx_finish(&f);
     assert_int_equal(trace_create(&f.a, PLX_PART_PHOTON, &f.s, 0.0, &T), PLX_OK);
     while (done < n) {
-        double o[3], d[3], tb, dz;
+        double o[3], d[3], dz;
         trace_hit h, h2;
-        int kb, kt;
+        int kt;
         o[0] = f.s.bounds[0] + (f.s.bounds[2] - f.s.bounds[0]) * urand(&rs);
         o[1] = f.s.bounds[1] + (f.s.bounds[3] - f.s.bounds[1]) * urand(&rs);
         o[2] = 45.0 * urand(&rs);
@@ -230,26 +287,21 @@ static void test_trace_vs_brute(void **state)
                 d[1] /= l;
             }
         }
-        kb = brute_cast(&f.s, o, d, &tb);
         kt = trace_ray(T, o, d, INFINITY, &h);
         trace_ray_brute(T, o, d, INFINITY, &h2);
         done++;
         kinds[kt]++;
-        if (kb != kt || (kb != TRACE_SKY && fabs(tb - h.t) > 1e-7 * (1.0 + tb)) ||
-            h2.kind != kt || (kt != TRACE_SKY && fabs(h2.t - h.t) > 1e-9 * (1.0 + h.t))) {
-            if (mism < 5)
-                printf("mismatch: o %.6f %.6f %.6f d %.6f %.6f %.6f: brute %d t=%.9f, "
-                       "trace %d t=%.9f\n",
-                       o[0], o[1], o[2], d[0], d[1], d[2], kb, tb, kt, h.t);
+        /* the walk finds what testing every building finds */
+        if (!trace_agrees(&f.s, o, d, &h, &shown) || h2.kind != kt ||
+            (kt != TRACE_SKY && fabs(h2.t - h.t) > 1e-12 * (1.0 + h.t)))
             mism++;
-        }
     }
     printf("trace vs brute force: %d rays, %d mismatches (sky %d ground %d wall %d roof %d "
            "under %d)\n",
            done, mism, kinds[0], kinds[1], kinds[2], kinds[3], kinds[4]);
     assert_int_equal(mism, 0);
     assert_true(kinds[TRACE_WALL] > n / 10 && kinds[TRACE_ROOF] > n / 50 &&
-                (quick_mode() || kinds[TRACE_UNDER] > 0) && kinds[TRACE_GROUND] > n / 10);
+                kinds[TRACE_UNDER] > 0 && kinds[TRACE_GROUND] > n / 10);
     /* trace_top: roofs and ground */
     {
         int k;
@@ -272,6 +324,373 @@ static void test_trace_vs_brute(void **state)
         }
     }
     fx_close(&f);
+}
+
+/* ---- degenerate rays on a city with exact coordinates -------------------- */
+
+/* Boxes sharing a wall (A, B), a raised box (C), a courtyard (D), an
+ * L-shape (E), an octagon with 45-degree faces (F), a box as tall as A (G).
+ * Integer coordinates: rays along walls, through corners and at roof
+ * heights are computed exactly. */
+static void exact_city(fixture *f, const double (*lamps)[4], int nl)
+{
+    double dxy[16] = {0, 20, 30, 20, 30, 50, 0, 50, 10, 30, 10, 40, 20, 40, 20, 30};
+    double exy[12] = {50, 0, 70, 0, 70, 10, 60, 10, 60, 30, 50, 30};
+    double fxy[16] = {82, 0, 88, 0, 90, 2, 90, 8, 88, 10, 82, 10, 80, 8, 80, 2};
+    uint32_t dn[2] = {4, 4}, en[1] = {6}, fn[1] = {8};
+    int i;
+    fx_open(f, 16u << 20);
+    assert_true(ref_scene_add_box(&f->s, 0, 0, 10, 10, 10.0, 0.0) >= 0);
+    assert_true(ref_scene_add_box(&f->s, 10, 0, 20, 10, 15.0, 0.0) >= 0);
+    assert_true(ref_scene_add_box(&f->s, 30, 0, 40, 10, 12.0, 4.0) >= 0);
+    assert_true(ref_scene_add_building(&f->s, dxy, dn, 2, 12.0, 0.0) >= 0);
+    assert_true(ref_scene_add_building(&f->s, exy, en, 1, 20.0, 0.0) >= 0);
+    assert_true(ref_scene_add_building(&f->s, fxy, fn, 1, 9.0, 0.0) >= 0);
+    assert_true(ref_scene_add_box(&f->s, 50, 40, 60, 50, 10.0, 0.0) >= 0);
+    for (i = 0; i < nl; i++)
+        assert_true(ref_scene_add_lamp(&f->s, lamps[i][0], lamps[i][1], lamps[i][2], 1000,
+                                       lamps[i][3]) >= 0);
+    fx_finish(f);
+}
+
+typedef struct ray_check {
+    const scene *s;
+    tracer *T[3];
+    int nt, rays, mism, shown, kinds[5];
+} ray_check;
+
+/* One ray through every tracer (different cell sizes), each against the
+ * brute force. */
+static void check_ray(ray_check *c, const double o[3], const double d[3])
+{
+    int i;
+    for (i = 0; i < c->nt; i++) {
+        trace_hit h;
+        trace_ray(c->T[i], o, d, INFINITY, &h);
+        c->kinds[h.kind]++;
+        if (!trace_agrees(c->s, o, d, &h, &c->shown))
+            c->mism++;
+    }
+    c->rays++;
+}
+
+static const double exact_z[] = {0.0, 2.0, 4.0, 6.0, 9.0, 10.0, 12.0, 15.0, 20.0, 25.0};
+#define NEXACT_Z (sizeof exact_z / sizeof exact_z[0])
+
+/* Rays along the line of every edge (from outside its ends, both ways),
+ * level and tilted, at the listed heights; and the same lines shifted to
+ * pass exactly through the edge's ends diagonally. */
+static void rays_along_edges(ray_check *c, uint64_t *rs)
+{
+    const scene *s = c->s;
+    uint32_t e;
+    for (e = 0; e < s->npts; e++) {
+        uint32_t r, nxt = e + 1;
+        const vec2 *p, *q;
+        double ex, ey, l, o[3], d[3];
+        unsigned z;
+        int side, tilt;
+        for (r = 0; r < s->nrings; r++)
+            if (e + 1 == s->rings[r].first + s->rings[r].count)
+                nxt = s->rings[r].first;
+        p = &s->pts[e];
+        q = &s->pts[nxt];
+        ex = q->x - p->x;
+        ey = q->y - p->y;
+        l = sqrt(ex * ex + ey * ey);
+        for (z = 0; z < NEXACT_Z; z++)
+            for (side = 0; side < 2; side++)
+                for (tilt = -1; tilt <= 1; tilt++) {
+                    double sg = side ? -1.0 : 1.0, k = 3.0 + (double)(photon_rand(rs) % 4);
+                    const vec2 *a = side ? q : p;
+                    o[0] = a->x - sg * k * ex / l;
+                    o[1] = a->y - sg * k * ey / l;
+                    o[2] = exact_z[z];
+                    d[0] = sg * ex / l;
+                    d[1] = sg * ey / l;
+                    d[2] = 0.25 * tilt;
+                    if (tilt) {
+                        double m = sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+                        d[0] /= m;
+                        d[1] /= m;
+                        d[2] /= m;
+                    }
+                    if (!in_solid(s, o))
+                        check_ray(c, o, d);
+                    /* diagonally through the end a (axis-aligned edges) */
+                    if (ex == 0.0 || ey == 0.0) {
+                        int qx, qy;
+                        for (qx = -1; qx <= 1; qx += 2)
+                            for (qy = -1; qy <= 1; qy += 2) {
+                                o[0] = a->x + qx * k;
+                                o[1] = a->y + qy * k;
+                                o[2] = exact_z[z];
+                                d[0] = -qx * sqrt(0.5);
+                                d[1] = -qy * sqrt(0.5);
+                                d[2] = 0.0;
+                                if (!in_solid(s, o))
+                                    check_ray(c, o, d);
+                            }
+                    }
+                }
+    }
+}
+
+/* Rays that start on a wall (edge midpoints, exact) and leave it: random
+ * directions in the outer half space, and along the wall both ways. */
+static void rays_from_walls(ray_check *c, uint64_t *rs)
+{
+    const scene *s = c->s;
+    uint32_t e;
+    for (e = 0; e < s->npts; e++) {
+        uint32_t r, nxt = e + 1, b;
+        const vec2 *p, *q;
+        double ex, ey, l, n[2], o[3], d[3];
+        int k;
+        for (r = 0; r < s->nrings; r++)
+            if (e + 1 == s->rings[r].first + s->rings[r].count)
+                nxt = s->rings[r].first;
+        for (b = 0; b < s->nbld; b++)
+            if (e >= s->rings[s->bld[b].ring_first].first)
+                r = b; /* the building of edge e (rings in building order) */
+        b = r;
+        p = &s->pts[e];
+        q = &s->pts[nxt];
+        ex = q->x - p->x;
+        ey = q->y - p->y;
+        l = sqrt(ex * ex + ey * ey);
+        n[0] = ey / l;
+        n[1] = -ex / l;
+        for (k = 0; k < 24; k++) {
+            o[0] = 0.5 * (p->x + q->x);
+            o[1] = 0.5 * (p->y + q->y);
+            o[2] = k < 4 ? exact_z[k + 2] : s->bld[b].min_height +
+                                                 (s->bld[b].height - s->bld[b].min_height) *
+                                                     urand(rs);
+            if (k < 2) {
+                d[0] = (k ? -1.0 : 1.0) * ex / l;
+                d[1] = (k ? -1.0 : 1.0) * ey / l;
+                d[2] = 0.0;
+            } else {
+                sphere_dir(rs, d);
+                if (d[0] * n[0] + d[1] * n[1] < 0.0) {
+                    double dn = d[0] * n[0] + d[1] * n[1];
+                    d[0] -= 2.0 * dn * n[0];
+                    d[1] -= 2.0 * dn * n[1];
+                }
+            }
+            check_ray(c, o, d);
+        }
+    }
+}
+
+/* Rays from given points in random, level, vertical and axis directions. */
+static void rays_from(ray_check *c, uint64_t *rs, double x, double y, double z, int nrand)
+{
+    static const double axis[8][2] = {{1, 0}, {0, 1}, {-1, 0}, {0, -1},
+                                      {1, 1}, {-1, 1}, {-1, -1}, {1, -1}};
+    double o[3], d[3];
+    int k;
+    o[0] = x;
+    o[1] = y;
+    o[2] = z;
+    if (in_solid(c->s, o))
+        return;
+    for (k = 0; k < 8; k++) {
+        double m = sqrt(axis[k][0] * axis[k][0] + axis[k][1] * axis[k][1]);
+        d[0] = axis[k][0] / m;
+        d[1] = axis[k][1] / m;
+        d[2] = 0.0;
+        check_ray(c, o, d);
+    }
+    d[0] = d[1] = 0.0;
+    d[2] = 1.0;
+    check_ray(c, o, d);
+    d[2] = -1.0;
+    check_ray(c, o, d);
+    for (k = 0; k < nrand; k++) {
+        sphere_dir(rs, d);
+        if (k % 3 == 0) {
+            double m = hypot(d[0], d[1]);
+            d[0] /= m;
+            d[1] /= m;
+            d[2] = 0.0;
+        }
+        check_ray(c, o, d);
+    }
+}
+
+static void test_trace_degenerate(void **state)
+{
+    fixture f;
+    ray_check c;
+    uint64_t rs = 4242;
+    static const double cells[3] = {0.0, 10.0, 5.0};
+    static const double lamps[][2] = {{5, -5}, {25, 5}, {45, 5}, {55, 35}, {75, 20},
+                                      {85, -3}, {-3, 15}, {35, 25}};
+    int i, nr = quick_mode() ? 20 : 120;
+    unsigned z;
+    (void)state;
+    exact_city(&f, NULL, 0);
+    memset(&c, 0, sizeof c);
+    c.s = &f.s;
+    c.nt = 3;
+    /* cells of 10 and 5 m put cell borders on the walls (bounds start at -50) */
+    for (i = 0; i < c.nt; i++)
+        assert_int_equal(trace_create(&f.a, PLX_PART_PHOTON, &f.s, cells[i], &c.T[i]), PLX_OK);
+    rays_along_edges(&c, &rs);
+    printf("  along edges and through corners: %d rays\n", c.rays);
+    rays_from_walls(&c, &rs);
+    printf("  + from walls outwards: %d rays\n", c.rays);
+    /* lamps at roof height (A and G: 10 m) and at other exact heights */
+    for (i = 0; i < (int)(sizeof lamps / sizeof lamps[0]); i++)
+        for (z = 0; z < NEXACT_Z; z++)
+            rays_from(&c, &rs, lamps[i][0], lamps[i][1], exact_z[z], nr / 4);
+    printf("  + from street points at exact heights (roof heights too): %d rays\n", c.rays);
+    /* under the raised box C (min_height 4), into the courtyard of D, above roofs */
+    for (z = 0; z < 4; z++) {
+        static const double under[4] = {0.5, 2.0, 3.5, 3.999};
+        rays_from(&c, &rs, 35, 5, under[z], nr);
+        rays_from(&c, &rs, 25, 5, under[z], nr / 4);
+    }
+    for (z = 0; z < NEXACT_Z; z++) {
+        rays_from(&c, &rs, 15, 35, exact_z[z], nr / 2);
+        rays_from(&c, &rs, 12, 38, exact_z[z], nr / 4);
+    }
+    rays_from(&c, &rs, 5, 5, 30, nr);
+    rays_from(&c, &rs, 35, 5, 30, nr);
+    rays_from(&c, &rs, 85, 5, 9.5, nr);
+    printf("trace on degenerate rays (x3 cell sizes): %d rays, %d mismatches (sky %d ground %d "
+           "wall %d roof %d under %d)\n",
+           c.rays, c.mism, c.kinds[0], c.kinds[1], c.kinds[2], c.kinds[3], c.kinds[4]);
+    assert_int_equal(c.mism, 0);
+    assert_true(c.kinds[TRACE_WALL] > 0 && c.kinds[TRACE_ROOF] > 0 && c.kinds[TRACE_UNDER] > 0 &&
+                c.kinds[TRACE_GROUND] > 0 && c.kinds[TRACE_SKY] > 0);
+    /* a few answers fixed by hand: along A's bottom wall into A's corner,
+     * level at A's roof height into its wall's top edge, under C at 2 m
+     * (passes) and at 4 m (its wall's bottom edge), up into C's underside */
+    {
+        static const double cases[][7] = {{-5, 0, 3, 1, 0, 0, 5},   {5, -5, 10, 0, 1, 0, 5},
+                                          {25, 5, 2, 1, 0, 0, 25},  {25, 5, 4, 1, 0, 0, 5},
+                                          {35, 5, 1, 0, 0, 1, 3},   {15, 35, 6, 1, 0, 0, 5}};
+        static const int kinds[] = {TRACE_WALL, TRACE_WALL, TRACE_WALL,
+                                    TRACE_WALL, TRACE_UNDER, TRACE_WALL};
+        for (i = 0; i < 6; i++) {
+            trace_hit h;
+            assert_int_equal(trace_ray(c.T[1], cases[i], cases[i] + 3, INFINITY, &h), kinds[i]);
+            assert_true(fabs(h.t - cases[i][6]) < 1e-12);
+        }
+    }
+    fx_close(&f);
+}
+
+/* ---- rays from lamps (trace_lamp_ray) ---------------------------------- */
+
+/* trace_lamp_ray against the brute force (tmax = the lamp's radius) and
+ * against trace_ray from the same point, on lamps of both test cities:
+ * random ones at random heights and at roof heights, and exact ones at
+ * the degenerate spots; directions random, level, vertical, axis and
+ * exactly at building corners. */
+static int lamp_rays(fixture *f, uint64_t *rs, int nrand, int *kinds, int *shown)
+{
+    tracer *T;
+    uint32_t l, v, fast = 0;
+    int mism = 0, k;
+    assert_int_equal(trace_create(&f->a, PLX_PART_PHOTON, &f->s, 0.0, &T), PLX_OK);
+    for (l = 0; l < f->s.nlamps; l++)
+        fast += T->lfast[l];
+    printf("  %u of %u lamps with a table\n", fast, f->s.nlamps);
+    assert_true(fast * 4 >= f->s.nlamps * 3);
+    for (l = 0; l < f->s.nlamps; l++) {
+        const scene_lamp *L = &f->s.lamps[l];
+        double o[3] = {L->x, L->y, L->z}, d[3];
+        for (k = 0; k < nrand + 10 + (int)f->s.npts; k++) {
+            trace_hit h, h2;
+            if (k < nrand) {
+                sphere_dir(rs, d);
+                if (k % 4 == 0) {
+                    double m = hypot(d[0], d[1]);
+                    d[0] /= m;
+                    d[1] /= m;
+                    d[2] = 0.0;
+                }
+            } else if (k < nrand + 8) {
+                static const double ax[8][2] = {{1, 0}, {1, 1}, {0, 1}, {-1, 1},
+                                                {-1, 0}, {-1, -1}, {0, -1}, {1, -1}};
+                d[0] = ax[k - nrand][0] * ((k - nrand) % 2 ? sqrt(0.5) : 1.0);
+                d[1] = ax[k - nrand][1] * ((k - nrand) % 2 ? sqrt(0.5) : 1.0);
+                d[2] = 0.0;
+            } else if (k < nrand + 10) {
+                d[0] = d[1] = 0.0;
+                d[2] = k == nrand + 8 ? 1.0 : -1.0;
+            } else {
+                /* at a vertex, level or tilted */
+                double m;
+                v = (uint32_t)(k - nrand - 10);
+                d[0] = f->s.pts[v].x - o[0];
+                d[1] = f->s.pts[v].y - o[1];
+                d[2] = v % 2 ? 0.0 : -0.3 * hypot(d[0], d[1]);
+                m = sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+                if (!(m > 0.0))
+                    continue;
+                d[0] /= m;
+                d[1] /= m;
+                d[2] /= m;
+            }
+            trace_lamp_ray(T, l, d, &h);
+            trace_ray(T, o, d, L->radius, &h2);
+            kinds[h.kind]++;
+            if (!trace_agrees_tmax(&f->s, o, d, L->radius, &h, shown) ||
+                (h.kind == TRACE_SKY) != (h2.kind == TRACE_SKY) ||
+                (h.kind != TRACE_SKY && fabs(h.t - h2.t) > 1e-12 * (1.0 + h.t)))
+                mism++;
+        }
+    }
+    return mism;
+}
+
+static void test_trace_lamp_rays(void **state)
+{
+    fixture f;
+    uint64_t rs = 99;
+    int kinds[5] = {0, 0, 0, 0, 0}, mism, shown = 0, nl = 0, nrand = quick_mode() ? 40 : 400;
+    (void)state;
+    /* random city: lamps at random points outside the solids, some at the
+     * height of a roof, radii 5 to 80 m */
+    fx_open(&f, 16u << 20);
+    random_city(&f, 5);
+    while (nl < 40) {
+        double o[3];
+        o[0] = f.s.bounds[0] + 50.0 + (f.s.bounds[2] - f.s.bounds[0] - 100.0) * urand(&rs);
+        o[1] = f.s.bounds[1] + 50.0 + (f.s.bounds[3] - f.s.bounds[1] - 100.0) * urand(&rs);
+        o[2] = nl % 3 == 0 ? f.s.bld[nl % f.s.nbld].height : 40.0 * urand(&rs);
+        if (in_solid(&f.s, o))
+            continue;
+        assert_true(ref_scene_add_lamp(&f.s, o[0], o[1], o[2], 1000, 5.0 + 75.0 * urand(&rs)) >= 0);
+        nl++;
+    }
+    fx_finish(&f);
+    mism = lamp_rays(&f, &rs, nrand, kinds, &shown);
+    fx_close(&f);
+    /* exact city: lamps at the degenerate spots (roof heights, on the line
+     * of walls, under the raised box, in the courtyard) */
+    {
+        static const double L[][4] = {{5, -5, 10, 30},  {-5, 0, 3, 30},   {25, 5, 2, 40},
+                                      {25, 5, 4, 40},   {35, 5, 1, 20},   {15, 35, 6, 25},
+                                      {15, 35, 12, 25}, {55, 35, 10, 35}, {90, 12, 9, 15},
+                                      {10, -3, 15, 40}, {45, 5, 12, 50},  {75, 20, 20, 60},
+                                      {45, 25, 8, 900}}; /* the last one walks the grid */
+        exact_city(&f, L, (int)(sizeof L / sizeof L[0]));
+        mism += lamp_rays(&f, &rs, nrand, kinds, &shown);
+        fx_close(&f);
+    }
+    printf("trace_lamp_ray vs brute force and trace_ray: %d rays, %d mismatches (sky %d ground "
+           "%d wall %d roof %d under %d)\n",
+           kinds[0] + kinds[1] + kinds[2] + kinds[3] + kinds[4], mism, kinds[0], kinds[1],
+           kinds[2], kinds[3], kinds[4]);
+    assert_int_equal(mism, 0);
+    assert_true(kinds[TRACE_WALL] > 0 && kinds[TRACE_ROOF] > 0 && kinds[TRACE_UNDER] > 0 &&
+                kinds[TRACE_GROUND] > 0 && kinds[TRACE_SKY] > 0);
 }
 
 /* ---- energy in a closed box --------------------------------------------- */
@@ -1279,6 +1698,8 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_trace_vs_brute),
+        cmocka_unit_test(test_trace_degenerate),
+        cmocka_unit_test(test_trace_lamp_rays),
         cmocka_unit_test(test_energy_closed_box),
         cmocka_unit_test(test_one_bounce_wall),
         cmocka_unit_test(test_accuracy_eixample),
