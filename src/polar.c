@@ -169,6 +169,17 @@ static void fill_edges(const scene *s, edges *e)
     e->n = n;
 }
 
+/* fmin and fmax are library calls (NaN rules); coordinates are finite */
+static double dmin(double a, double b)
+{
+    return a < b ? a : b;
+}
+
+static double dmax(double a, double b)
+{
+    return a > b ? a : b;
+}
+
 /* Is c strictly inside segment ab, knowing the three are collinear? */
 static int strictly_between(vec2 a, vec2 b, vec2 c)
 {
@@ -293,9 +304,24 @@ static void meet_segs(split_ctx *c, uint32_t i, uint32_t ia, uint32_t ib, uint32
     const vec2 *P = c->pd->pts;
     vec2 a = P[ia], b = P[ib], d0 = P[ja], d1 = P[jb];
     int o1, o2, o3, o4;
-    if (fmax(a.x, b.x) < fmin(d0.x, d1.x) || fmax(d0.x, d1.x) < fmin(a.x, b.x) ||
-        fmax(a.y, b.y) < fmin(d0.y, d1.y) || fmax(d0.y, d1.y) < fmin(a.y, b.y))
+    if (dmax(a.x, b.x) < dmin(d0.x, d1.x) || dmax(d0.x, d1.x) < dmin(a.x, b.x) ||
+        dmax(a.y, b.y) < dmin(d0.y, d1.y) || dmax(d0.y, d1.y) < dmin(a.y, b.y))
         return;
+    /* a common end (pieces of one edge, corners shared by neighbours): they
+     * meet elsewhere only when collinear, then where one's other end lies
+     * inside the other (the cuts the four signs below would give) */
+    if (lex_cmp(a, d0) == 0 || lex_cmp(a, d1) == 0 || lex_cmp(b, d0) == 0 ||
+        lex_cmp(b, d1) == 0) {
+        uint32_t u = lex_cmp(a, d0) == 0 || lex_cmp(a, d1) == 0 ? ib : ia;
+        uint32_t v = lex_cmp(d0, a) == 0 || lex_cmp(d0, b) == 0 ? jb : ja;
+        if (geom_orient(a, b, P[v]) != 0)
+            return;
+        if (strictly_between(a, b, P[v]))
+            add_split(c, i, v, 0);
+        if (strictly_between(d0, d1, P[u]))
+            add_split(c, j, u, 0);
+        return;
+    }
     /* the four signs once (geom_seg_meet would take them again below) */
     o1 = geom_orient(a, b, d0);
     o2 = geom_orient(a, b, d1);
@@ -337,8 +363,8 @@ static uint32_t edges_near(const split_ctx *c, uint32_t p, const double *bx, uin
     uint32_t i, n = 0;
     for (i = e->first[p]; i < e->first[p] + e->count[p]; i++) {
         vec2 a = P[e->a[i]], b = P[e->b[i]];
-        if (fmax(a.x, b.x) < bx[0] || fmin(a.x, b.x) > bx[2] || fmax(a.y, b.y) < bx[1] ||
-            fmin(a.y, b.y) > bx[3])
+        if (dmax(a.x, b.x) < bx[0] || dmin(a.x, b.x) > bx[2] || dmax(a.y, b.y) < bx[1] ||
+            dmin(a.y, b.y) > bx[3])
             continue;
         if (n == cap)
             return cap + 1;
@@ -523,20 +549,27 @@ static void emit_piece(piece *out, uint32_t *n, const vec2 *P, uint32_t a, uint3
 static void *scratch_n(arena *a, size_t n, size_t size);
 
 /* Uniform grid over the dirty pieces: cell c lists item[cell[c] ..
- * cell[c + 1]), the dirty pieces whose bounding boxes meet it. */
+ * cell[c + 1]), the dirty pieces whose bounding boxes meet it, with their
+ * boxes (read in the cell's order, not from the points). */
+typedef struct ditem {
+    double bx[4];
+    uint32_t d;
+} ditem;
+
 typedef struct dgrid {
     double x0, y0, x1, y1, sx, sy;
     uint32_t nx, ny;
-    uint32_t *cell, *item;
+    uint32_t *cell;
+    ditem *item;
 } dgrid;
 
 static void piece_box(const vec2 *P, const piece *q, double *bx)
 {
     vec2 a = P[q->a], b = P[q->b];
-    bx[0] = fmin(a.x, b.x);
-    bx[1] = fmin(a.y, b.y);
-    bx[2] = fmax(a.x, b.x);
-    bx[3] = fmax(a.y, b.y);
+    bx[0] = dmin(a.x, b.x);
+    bx[1] = dmin(a.y, b.y);
+    bx[2] = dmax(a.x, b.x);
+    bx[3] = dmax(a.y, b.y);
 }
 
 /* Monotone in v, so a point of two boxes falls in a cell of both ranges. */
@@ -603,15 +636,18 @@ static plx_status dgrid_build(arena *a, dgrid *g, const vec2 *P, const piece *pc
     }
     for (i = 0; i < nc; i++)
         g->cell[i + 1] += g->cell[i];
-    g->item = scratch_n(a, g->cell[nc], 4);
+    g->item = scratch_n(a, g->cell[nc], sizeof(ditem));
     if (!g->item)
         return PLX_E_NOMEM;
     for (i = 0; i < nd; i++) {
         piece_box(P, &pc[dl[i]], bx);
         dgrid_range(g, bx, r);
         for (y = r[1]; y <= r[3]; y++)
-            for (x = r[0]; x <= r[2]; x++)
-                g->item[g->cell[y * g->nx + x]++] = dl[i];
+            for (x = r[0]; x <= r[2]; x++) {
+                ditem *t = &g->item[g->cell[y * g->nx + x]++];
+                memcpy(t->bx, bx, sizeof bx);
+                t->d = dl[i];
+            }
     }
     for (i = nc; i > 0; i--)
         g->cell[i] = g->cell[i - 1];
@@ -624,16 +660,16 @@ static plx_status dgrid_build(arena *a, dgrid *g, const vec2 *P, const piece *pc
 static void meet_in_cell(split_ctx *c, const piece *pc, const uint8_t *dirty, const dgrid *g,
                          uint32_t s, const double *bs, uint32_t x, uint32_t y)
 {
-    const vec2 *P = c->pd->pts;
     uint32_t k, cl = y * g->nx + x;
     for (k = g->cell[cl]; k < g->cell[cl + 1]; k++) {
-        uint32_t d = g->item[k];
-        double bd[4];
+        uint32_t d = g->item[k].d;
+        const double *bd = g->item[k].bx;
         if (d == s || (dirty[s] && s > d))
             continue;
-        piece_box(P, &pc[d], bd);
-        if (dcell(fmax(bs[0], bd[0]), g->x0, g->sx, g->nx) != x ||
-            dcell(fmax(bs[1], bd[1]), g->y0, g->sy, g->ny) != y)
+        if (bd[2] < bs[0] || bd[0] > bs[2] || bd[3] < bs[1] || bd[1] > bs[3])
+            continue;
+        if (dcell(dmax(bs[0], bd[0]), g->x0, g->sx, g->nx) != x ||
+            dcell(dmax(bs[1], bd[1]), g->y0, g->sy, g->ny) != y)
             continue;
         meet_segs(c, s, pc[s].a, pc[s].b, d, pc[d].a, pc[d].b);
     }
