@@ -6,7 +6,8 @@
  * hundreds of random scenes made to be hard for that (rotated boxes
  * crossing lattice boxes and their collinear walls, near-collinear
  * crossings, three walls through nearly one point, overlaps of 1e-9 to
- * 1e-3 m, dense heaps of rotated boxes):
+ * 1e-3 m, dense heaps of rotated boxes, a city grid of boxes and
+ * courtyards turned and grown by tiny amounts over their neighbours):
  *   - polar_build returns PLX_OK, every time;
  *   - the pieces it keeps form a planar subdivision, checked pair by pair
  *     with geom_orient_ref (the stack-expansion orientation, independent of
@@ -184,9 +185,48 @@ static void scene_heap(fix *f, int n)
                     urand() * PI);
 }
 
+/* A courtyard building (outer ring, one hole t inside it), rotated. */
+static void add_rotated_courtyard(fix *f, double x, double y, double w, double h, double t,
+                                  double ang)
+{
+    double c = cos(ang), sn = sin(ang), xy[16];
+    double ox[8] = { 0, w, w, 0, t, t, w - t, w - t }, oy[8] = { 0, 0, h, h, t, h - t, h - t, t };
+    uint32_t n[2] = { 4, 4 };
+    int k;
+    for (k = 0; k < 8; k++) {
+        xy[2 * k] = x + c * ox[k] - sn * oy[k];
+        xy[2 * k + 1] = y + sn * ox[k] + c * oy[k];
+    }
+    assert_true(ref_scene_add_building(&f->s, xy, n, 2, 20, 0) >= 0);
+}
+
+/* A city block grid of 10 m cells: exact boxes sharing walls, boxes and
+ * courtyards turned by 1e-9..1e-3 rad and grown by 1e-9..1e-2 m over
+ * their neighbours (real data), a few turned at random. */
+static void scene_tilted_city(fix *f, int n)
+{
+    int i, j, side = 3 + n / 12;
+    for (i = 0; i < side; i++)
+        for (j = 0; j < side; j++) {
+            double x = i * 10.0, y = j * 10.0, r = urand(), o = tiny() * (urand() < 0.5 ? 1 : 10);
+            double ang = (urand() - 0.5) * tiny();
+            if (r < 0.3)
+                add_box(f, x, y, x + 10, y + 10);
+            else if (r < 0.7)
+                add_rotated(f, x - o, y - o, 10 + 2 * o, 10 + 2 * o, ang);
+            else if (r < 0.9)
+                add_rotated_courtyard(f, x - o, y - o, 10 + 2 * o, 10 + 2 * o, 3, ang);
+            else
+                add_rotated(f, x + 2, y + 1, 6, 4, urand() * PI);
+        }
+}
+
 static void make_scene(fix *f, int kind, int n)
 {
     switch (kind) {
+    case 4:
+        scene_tilted_city(f, n);
+        break;
     case 0:
         scene_lattice_rotated(f, n);
         break;
@@ -439,10 +479,10 @@ static void test_crossing_scenes(void **state)
 {
     counts c;
     int k, kind, nsc = quick(100);
-    static const char *name[4] = { "lattice + rotated", "near one point", "tiny overlaps",
-                                   "dense heaps" };
+    static const char *name[5] = { "lattice + rotated", "near one point", "tiny overlaps",
+                                   "dense heaps", "tilted city" };
     (void)state;
-    for (kind = 0; kind < 4; kind++) {
+    for (kind = 0; kind < 5; kind++) {
         memset(&c, 0, sizeof c);
         for (k = 0; k < nsc; k++) {
             fix *f = fix_new();
