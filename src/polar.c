@@ -257,9 +257,9 @@ static uint32_t add_point(split_ctx *c, vec2 p)
 }
 
 /* The crossing point of segments ab and cd (crossing properly), rounded,
- * then clamped into the intersection of their bounding boxes: it holds the
- * exact crossing, so the rounded point stays within both spans (a cut never
- * lands beyond a piece's end, which would fold the piece back on itself). */
+ * then clamped into the intersection of their bounding boxes (which holds
+ * the exact crossing): a cut there stays within both pieces' boxes, so a
+ * piece cut near its end folds back, if at all, by no more than rounding. */
 static vec2 cross_point(vec2 a, vec2 b, vec2 c, vec2 d)
 {
     double rx = b.x - a.x, ry = b.y - a.y, sx = d.x - c.x, sy = d.y - c.y;
@@ -337,6 +337,7 @@ static void meet_segs(split_ctx *c, uint32_t i, uint32_t ia, uint32_t ib, uint32
         add_split(c, j, x, 1);
         return;
     }
+    /* touch or overlap: cut each at the other's ends lying inside it */
     if (o1 == 0 && strictly_between(a, b, d0))
         add_split(c, i, ja, 0);
     if (o2 == 0 && strictly_between(a, b, d1))
