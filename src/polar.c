@@ -116,8 +116,9 @@ static int32_t seg_delta(const polar *pd, int frame, uint32_t s)
 /* ---- wall pieces ------------------------------------------------------- */
 
 typedef struct split {
-    uint32_t seg;   /* original edge index */
-    uint32_t pt;    /* point index */
+    uint32_t seg;     /* edge (first pass) or piece index */
+    uint32_t pt;      /* point index */
+    uint32_t rounded; /* a crossing: pt is off the line, the pieces bend */
 } split;
 
 typedef struct edges {
@@ -168,6 +169,17 @@ static void fill_edges(const scene *s, edges *e)
     e->n = n;
 }
 
+/* fmin and fmax are library calls (NaN rules); coordinates are finite */
+static double dmin(double a, double b)
+{
+    return a < b ? a : b;
+}
+
+static double dmax(double a, double b)
+{
+    return a > b ? a : b;
+}
+
 /* Is c strictly inside segment ab, knowing the three are collinear? */
 static int strictly_between(vec2 a, vec2 b, vec2 c)
 {
@@ -201,7 +213,7 @@ typedef struct split_ctx {
     int nomem;
 } split_ctx;
 
-static void add_split(split_ctx *c, uint32_t seg, uint32_t pt)
+static void add_split(split_ctx *c, uint32_t seg, uint32_t pt, uint32_t rounded)
 {
     if (!c->sp || c->sp->n == SPLIT_CHUNK) {
         split_chunk *k = arena_scratch(c->a, sizeof(split_chunk), 16);
@@ -219,6 +231,7 @@ static void add_split(split_ctx *c, uint32_t seg, uint32_t pt)
     }
     c->sp->v[c->sp->n].seg = seg;
     c->sp->v[c->sp->n].pt = pt;
+    c->sp->v[c->sp->n].rounded = rounded;
     c->sp->n++;
     c->nsp++;
 }
@@ -243,31 +256,72 @@ static uint32_t add_point(split_ctx *c, vec2 p)
     return c->npts++;
 }
 
+/* The crossing point of segments ab and cd (crossing properly), rounded,
+ * then clamped into the intersection of their bounding boxes (which holds
+ * the exact crossing): a cut there stays within both pieces' boxes, so a
+ * piece cut near its end folds back, if at all, by no more than rounding. */
 static vec2 cross_point(vec2 a, vec2 b, vec2 c, vec2 d)
 {
     double rx = b.x - a.x, ry = b.y - a.y, sx = d.x - c.x, sy = d.y - c.y;
     double den = rx * sy - ry * sx;
     double t = ((c.x - a.x) * sy - (c.y - a.y) * sx) / den;
+    double x0 = fmax(fmin(a.x, b.x), fmin(c.x, d.x)), x1 = fmin(fmax(a.x, b.x), fmax(c.x, d.x));
+    double y0 = fmax(fmin(a.y, b.y), fmin(c.y, d.y)), y1 = fmin(fmax(a.y, b.y), fmax(c.y, d.y));
     vec2 p;
     if (t < 0.0)
         t = 0.0;
     if (t > 1.0)
         t = 1.0;
-    p.x = a.x + t * rx;
-    p.y = a.y + t * ry;
+    p.x = fmin(fmax(a.x + t * rx, x0), x1);
+    p.y = fmin(fmax(a.y + t * ry, y0), y1);
     return p;
 }
 
-/* Records where edges i and j (of different buildings) must be cut. */
-static void meet_edges(split_ctx *c, uint32_t i, uint32_t j)
+/* The point where pieces (ia, ib) and (ja, jb) cross: one of the four ends
+ * when the rounded crossing falls on it, else a new point. */
+static uint32_t crossing(split_ctx *c, uint32_t ia, uint32_t ib, uint32_t ja, uint32_t jb)
 {
     const vec2 *P = c->pd->pts;
-    uint32_t ia = c->e->a[i], ib = c->e->b[i], ja = c->e->a[j], jb = c->e->b[j];
+    vec2 x = cross_point(P[ia], P[ib], P[ja], P[jb]);
+    if (lex_cmp(x, P[ia]) == 0)
+        return ia;
+    if (lex_cmp(x, P[ib]) == 0)
+        return ib;
+    if (lex_cmp(x, P[ja]) == 0)
+        return ja;
+    if (lex_cmp(x, P[jb]) == 0)
+        return jb;
+    return add_point(c, x);
+}
+
+/* Records the cuts that contact between segments i (ia, ib) and j (ja, jb)
+ * asks for: both at their crossing point when they cross properly (the only
+ * rounded step), else each at the other's ends lying strictly inside it
+ * (touching, overlapping collinear). */
+static void meet_segs(split_ctx *c, uint32_t i, uint32_t ia, uint32_t ib, uint32_t j,
+                      uint32_t ja, uint32_t jb)
+{
+    const vec2 *P = c->pd->pts;
     vec2 a = P[ia], b = P[ib], d0 = P[ja], d1 = P[jb];
     int o1, o2, o3, o4;
-    if (fmax(a.x, b.x) < fmin(d0.x, d1.x) || fmax(d0.x, d1.x) < fmin(a.x, b.x) ||
-        fmax(a.y, b.y) < fmin(d0.y, d1.y) || fmax(d0.y, d1.y) < fmin(a.y, b.y))
+    if (dmax(a.x, b.x) < dmin(d0.x, d1.x) || dmax(d0.x, d1.x) < dmin(a.x, b.x) ||
+        dmax(a.y, b.y) < dmin(d0.y, d1.y) || dmax(d0.y, d1.y) < dmin(a.y, b.y))
         return;
+    /* a common end (pieces of one edge, corners shared by neighbours): they
+     * meet elsewhere only when collinear, then where one's other end lies
+     * inside the other (the cuts the four signs below would give) */
+    if (lex_cmp(a, d0) == 0 || lex_cmp(a, d1) == 0 || lex_cmp(b, d0) == 0 ||
+        lex_cmp(b, d1) == 0) {
+        uint32_t u = lex_cmp(a, d0) == 0 || lex_cmp(a, d1) == 0 ? ib : ia;
+        uint32_t v = lex_cmp(d0, a) == 0 || lex_cmp(d0, b) == 0 ? jb : ja;
+        if (geom_orient(a, b, P[v]) != 0)
+            return;
+        if (strictly_between(a, b, P[v]))
+            add_split(c, i, v, 0);
+        if (strictly_between(d0, d1, P[u]))
+            add_split(c, j, u, 0);
+        return;
+    }
     /* the four signs once (geom_seg_meet would take them again below) */
     o1 = geom_orient(a, b, d0);
     o2 = geom_orient(a, b, d1);
@@ -278,20 +332,26 @@ static void meet_edges(split_ctx *c, uint32_t i, uint32_t j)
     if ((o3 > 0 && o4 > 0) || (o3 < 0 && o4 < 0))
         return;
     if (o1 != 0 && o2 != 0 && o3 != 0 && o4 != 0) {
-        uint32_t x = add_point(c, cross_point(a, b, d0, d1));
-        add_split(c, i, x);
-        add_split(c, j, x);
+        uint32_t x = crossing(c, ia, ib, ja, jb);
+        add_split(c, i, x, 1);
+        add_split(c, j, x, 1);
         return;
     }
     /* touch or overlap: cut each at the other's ends lying inside it */
     if (o1 == 0 && strictly_between(a, b, d0))
-        add_split(c, i, ja);
+        add_split(c, i, ja, 0);
     if (o2 == 0 && strictly_between(a, b, d1))
-        add_split(c, i, jb);
+        add_split(c, i, jb, 0);
     if (o3 == 0 && strictly_between(d0, d1, a))
-        add_split(c, j, ia);
+        add_split(c, j, ia, 0);
     if (o4 == 0 && strictly_between(d0, d1, b))
-        add_split(c, j, ib);
+        add_split(c, j, ib, 0);
+}
+
+/* Records where edges i and j (of different buildings) must be cut. */
+static void meet_edges(split_ctx *c, uint32_t i, uint32_t j)
+{
+    meet_segs(c, i, c->e->a[i], c->e->b[i], j, c->e->a[j], c->e->b[j]);
 }
 
 /* The edges of building p whose bounding boxes meet the closed box bx,
@@ -304,8 +364,8 @@ static uint32_t edges_near(const split_ctx *c, uint32_t p, const double *bx, uin
     uint32_t i, n = 0;
     for (i = e->first[p]; i < e->first[p] + e->count[p]; i++) {
         vec2 a = P[e->a[i]], b = P[e->b[i]];
-        if (fmax(a.x, b.x) < bx[0] || fmin(a.x, b.x) > bx[2] || fmax(a.y, b.y) < bx[1] ||
-            fmin(a.y, b.y) > bx[3])
+        if (dmax(a.x, b.x) < bx[0] || dmin(a.x, b.x) > bx[2] || dmax(a.y, b.y) < bx[1] ||
+            dmin(a.y, b.y) > bx[3])
             continue;
         if (n == cap)
             return cap + 1;
@@ -469,6 +529,280 @@ static void emit_piece(piece *out, uint32_t *n, const vec2 *P, uint32_t a, uint3
         q->lo = b;
         q->hi = a;
     }
+}
+
+/* ---- pieces made consistent after rounding ---------------------------- */
+
+/* A rounded crossing point lies off its edges' lines by up to an ulp: the
+ * pieces of such an edge bend there, and a bent piece can cross, touch or
+ * overlap another piece again (three walls through nearly one point, a
+ * crossing rounded onto a collinear wall's line, a crossing an ulp from a
+ * vertex). So contacts are looked for again among the pieces and cut as in
+ * the first pass, in rounds, until none is left. A round compares the
+ * pieces cut in the round before ("dirty") with all pieces: two pieces
+ * neither of which was cut had no contact a round before (or it would have
+ * cut one of them), so they have none now. For the first round the dirty
+ * pieces are those of edges with a rounded cut: edges cut at scene points
+ * only are cut exactly (on their lines) at every end lying inside them, and
+ * their pieces touch nothing but at shared ends, as without crossings. */
+#define WALL_ROUNDS 64
+
+static void *scratch_n(arena *a, size_t n, size_t size);
+
+/* Uniform grid over the dirty pieces: cell c lists item[cell[c] ..
+ * cell[c + 1]), the dirty pieces whose bounding boxes meet it, with their
+ * boxes (read in the cell's order, not from the points). */
+typedef struct ditem {
+    double bx[4];
+    uint32_t d;
+} ditem;
+
+typedef struct dgrid {
+    double x0, y0, x1, y1, sx, sy;
+    uint32_t nx, ny;
+    uint32_t *cell;
+    ditem *item;
+} dgrid;
+
+static void piece_box(const vec2 *P, const piece *q, double *bx)
+{
+    vec2 a = P[q->a], b = P[q->b];
+    bx[0] = dmin(a.x, b.x);
+    bx[1] = dmin(a.y, b.y);
+    bx[2] = dmax(a.x, b.x);
+    bx[3] = dmax(a.y, b.y);
+}
+
+/* Monotone in v, so a point of two boxes falls in a cell of both ranges. */
+static uint32_t dcell(double v, double v0, double scale, uint32_t n)
+{
+    double c = floor((v - v0) * scale);
+    if (!(c > 0.0))
+        return 0;
+    if (c >= (double)n)
+        return n - 1;
+    return (uint32_t)c;
+}
+
+static void dgrid_range(const dgrid *g, const double *bx, uint32_t *r)
+{
+    r[0] = dcell(bx[0], g->x0, g->sx, g->nx);
+    r[1] = dcell(bx[1], g->y0, g->sy, g->ny);
+    r[2] = dcell(bx[2], g->x0, g->sx, g->nx);
+    r[3] = dcell(bx[3], g->y0, g->sy, g->ny);
+}
+
+/* Cells of about the area per dirty piece, at most 5 nd + 1 of them. */
+static void dgrid_size(dgrid *g, const vec2 *P, const piece *pc, const uint32_t *dl, uint32_t nd)
+{
+    double bx[4], w, h, cs;
+    uint32_t i;
+    g->x0 = g->y0 = DBL_MAX;
+    g->x1 = g->y1 = -DBL_MAX;
+    for (i = 0; i < nd; i++) {
+        piece_box(P, &pc[dl[i]], bx);
+        g->x0 = fmin(g->x0, bx[0]);
+        g->y0 = fmin(g->y0, bx[1]);
+        g->x1 = fmax(g->x1, bx[2]);
+        g->y1 = fmax(g->y1, bx[3]);
+    }
+    w = g->x1 - g->x0;
+    h = g->y1 - g->y0;
+    cs = sqrt(w * h / nd);
+    if (!(cs > 0.0))
+        cs = fmax(w, h) / nd;
+    g->nx = cs > 0.0 ? (uint32_t)fmin(w / cs, 2.0 * nd) + 1 : 1;
+    g->ny = cs > 0.0 ? (uint32_t)fmin(h / cs, 2.0 * nd) + 1 : 1;
+    g->sx = w > 0.0 ? g->nx / w : 0.0;
+    g->sy = h > 0.0 ? g->ny / h : 0.0;
+}
+
+static plx_status dgrid_build(arena *a, dgrid *g, const vec2 *P, const piece *pc,
+                              const uint32_t *dl, uint32_t nd)
+{
+    uint32_t i, x, y, r[4], nc;
+    double bx[4];
+    dgrid_size(g, P, pc, dl, nd);
+    nc = g->nx * g->ny;
+    g->cell = scratch_n(a, (size_t)nc + 1, 4);
+    if (!g->cell)
+        return PLX_E_NOMEM;
+    memset(g->cell, 0, ((size_t)nc + 1) * 4);
+    for (i = 0; i < nd; i++) {
+        piece_box(P, &pc[dl[i]], bx);
+        dgrid_range(g, bx, r);
+        for (y = r[1]; y <= r[3]; y++)
+            for (x = r[0]; x <= r[2]; x++)
+                g->cell[y * g->nx + x + 1]++;
+    }
+    for (i = 0; i < nc; i++)
+        g->cell[i + 1] += g->cell[i];
+    g->item = scratch_n(a, g->cell[nc], sizeof(ditem));
+    if (!g->item)
+        return PLX_E_NOMEM;
+    for (i = 0; i < nd; i++) {
+        piece_box(P, &pc[dl[i]], bx);
+        dgrid_range(g, bx, r);
+        for (y = r[1]; y <= r[3]; y++)
+            for (x = r[0]; x <= r[2]; x++) {
+                ditem *t = &g->item[g->cell[y * g->nx + x]++];
+                memcpy(t->bx, bx, sizeof bx);
+                t->d = dl[i];
+            }
+    }
+    for (i = nc; i > 0; i--)
+        g->cell[i] = g->cell[i - 1];
+    g->cell[0] = 0;
+    return PLX_OK;
+}
+
+/* Piece s against the dirty pieces of one cell: each pair once, in the
+ * cell holding the low corner of the two boxes' intersection. */
+static void meet_in_cell(split_ctx *c, const piece *pc, const uint8_t *dirty, const dgrid *g,
+                         uint32_t s, const double *bs, uint32_t x, uint32_t y)
+{
+    uint32_t k, cl = y * g->nx + x;
+    for (k = g->cell[cl]; k < g->cell[cl + 1]; k++) {
+        uint32_t d = g->item[k].d;
+        const double *bd = g->item[k].bx;
+        if (d == s || (dirty[s] && s > d))
+            continue;
+        if (bd[2] < bs[0] || bd[0] > bs[2] || bd[3] < bs[1] || bd[1] > bs[3])
+            continue;
+        if (dcell(dmax(bs[0], bd[0]), g->x0, g->sx, g->nx) != x ||
+            dcell(dmax(bs[1], bd[1]), g->y0, g->sy, g->ny) != y)
+            continue;
+        meet_segs(c, s, pc[s].a, pc[s].b, d, pc[d].a, pc[d].b);
+    }
+}
+
+/* Every piece against the dirty pieces near it. */
+static void meet_pieces(split_ctx *c, const piece *pc, uint32_t np, const uint8_t *dirty,
+                        const dgrid *g)
+{
+    const vec2 *P = c->pd->pts;
+    uint32_t s, x, y, r[4];
+    double bs[4];
+    for (s = 0; s < np && !c->nomem; s++) {
+        piece_box(P, &pc[s], bs);
+        if (bs[2] < g->x0 || bs[0] > g->x1 || bs[3] < g->y0 || bs[1] > g->y1)
+            continue;
+        dgrid_range(g, bs, r);
+        for (y = r[1]; y <= r[3]; y++)
+            for (x = r[0]; x <= r[2]; x++)
+                meet_in_cell(c, pc, dirty, g, s, bs, x, y);
+    }
+}
+
+/* The points gathered in c's chunks appended to the nold points of
+ * c->pd->pts, in a new scratch array that c->pd->pts then points to. */
+static plx_status flat_points(arena *a, split_ctx *c, uint32_t nold)
+{
+    vec2 *P = scratch_n(a, c->npts, sizeof(vec2));
+    point_chunk *k;
+    uint32_t n = nold;
+    if (!P)
+        return PLX_E_NOMEM;
+    if (nold)
+        memcpy(P, c->pd->pts, (size_t)nold * sizeof(vec2));
+    for (k = c->pt0; k; k = k->next) {
+        memcpy(P + n, k->v, k->n * sizeof(vec2));
+        n += k->n;
+    }
+    c->pd->pts = P;
+    return PLX_OK;
+}
+
+/* Cuts in[0..n-1] at the cuts recorded in c into *out (*nout pieces, in
+ * the order of in, each one's along it). (*dirty)[k]: piece k comes from a
+ * piece with a rounded cut, or with any cut when all_cuts. */
+static plx_status cut_pieces(arena *a, split_ctx *c, const piece *in, uint32_t n, int all_cuts,
+                             piece **out, uint32_t *nout, uint8_t **dirty)
+{
+    const vec2 *P = c->pd->pts;
+    split *sp = scratch_n(a, c->nsp, sizeof(split));
+    uint32_t *first = scratch_n(a, (size_t)n + 1, 4), i, j, k, m = 0;
+    piece *pc = scratch_n(a, (size_t)n + c->nsp, sizeof(piece));
+    uint8_t *dy = scratch_n(a, (size_t)n + c->nsp, 1);
+    split_chunk *q;
+    if (!sp || !first || !pc || !dy)
+        return PLX_E_NOMEM;
+    /* the cuts grouped by piece (counting sort) */
+    memset(first, 0, ((size_t)n + 1) * 4);
+    for (q = c->sp0; q; q = q->next)
+        for (i = 0; i < q->n; i++)
+            first[q->v[i].seg + 1]++;
+    for (i = 0; i < n; i++)
+        first[i + 1] += first[i];
+    for (q = c->sp0; q; q = q->next)
+        for (i = 0; i < q->n; i++)
+            sp[first[q->v[i].seg]++] = q->v[i];
+    for (i = 0, j = 0; i < n; i++) {
+        uint32_t j0 = j, prev = in[i].a, m0 = m;
+        uint8_t bent = 0;
+        for (; j < c->nsp && sp[j].seg == i; j++)
+            bent |= (uint8_t)(all_cuts || sp[j].rounded);
+        sort_cuts(sp + j0, j - j0, P, lex_cmp(P[in[i].a], P[in[i].b]) < 0);
+        for (k = j0; k < j; k++) {
+            emit_piece(pc, &m, P, prev, sp[k].pt, in[i].bld);
+            prev = sp[k].pt;
+        }
+        emit_piece(pc, &m, P, prev, in[i].b, in[i].bld);
+        for (k = m0; k < m; k++)
+            dy[k] = bent;
+    }
+    *out = pc;
+    *nout = m;
+    *dirty = dy;
+    return PLX_OK;
+}
+
+static void reset_cuts(split_ctx *c)
+{
+    c->sp0 = c->sp = NULL;
+    c->pt0 = c->pt = NULL;
+    c->nsp = 0;
+}
+
+/* Rounds of cuts at the contacts left among the pieces, until none is left.
+ * A round's new crossings lie within a few ulps of the points rounded the
+ * round before and only pieces near them are cut; a crossing rounded onto
+ * a piece's end joins the pieces there, and a contact of two pieces always
+ * really cuts one of them, so the bends die out within a few rounds (at
+ * most 3 in the tests, see test_polar_robust). PLX_E_SCENE after
+ * WALL_ROUNDS rounds is a safety net that no scene is known to reach. */
+static plx_status settle_pieces(arena *a, split_ctx *c, piece **pc, uint32_t *np,
+                                uint8_t **dirty, uint32_t *rounds)
+{
+    uint32_t r, i, nd;
+    for (r = 0; r < WALL_ROUNDS; r++) {
+        uint32_t *dl = scratch_n(a, *np, 4), nold = c->npts;
+        dgrid g;
+        plx_status st;
+        if (!dl)
+            return PLX_E_NOMEM;
+        for (i = 0, nd = 0; i < *np; i++)
+            if ((*dirty)[i])
+                dl[nd++] = i;
+        if (nd == 0)
+            return PLX_OK;
+        *rounds = r + 1;
+        reset_cuts(c);
+        st = dgrid_build(a, &g, c->pd->pts, *pc, dl, nd);
+        if (st != PLX_OK)
+            return st;
+        meet_pieces(c, *pc, *np, *dirty, &g);
+        if (c->nomem)
+            return PLX_E_NOMEM;
+        if (c->nsp == 0)
+            return PLX_OK;
+        st = flat_points(a, c, nold);
+        if (st == PLX_OK)
+            st = cut_pieces(a, c, *pc, *np, 1, pc, np, dirty);
+        if (st != PLX_OK)
+            return st;
+    }
+    return PLX_E_SCENE;
 }
 
 /* ---- build ------------------------------------------------------------- */
@@ -1639,16 +1973,34 @@ static plx_status build_map(arena *a, polar *pd, polar_map *m, const wgrid *g,
     return build_dag(a, pd, m, &w, canon, order, nev, flags);
 }
 
-/* Cuts the occluders' edges into wall pieces (pd->pts, pd->seg filled). */
-static plx_status make_walls(arena *a, polar *pd)
+/* The occluders' edges as pieces, uncut. */
+static piece *edge_pieces(arena *a, const edges *e)
+{
+    piece *pc = scratch_n(a, e->n, sizeof(piece));
+    uint32_t i;
+    if (!pc)
+        return NULL;
+    for (i = 0; i < e->n; i++) {
+        pc[i].a = pc[i].lo = e->a[i];
+        pc[i].b = pc[i].hi = e->b[i];
+        pc[i].bld = e->bld[i];
+    }
+    return pc;
+}
+
+/* Cuts the occluders' edges into wall pieces that meet only at their ends:
+ * first at every contact of two buildings' edges, then at the contacts the
+ * rounded crossing points make among the pieces (settle_pieces). */
+static plx_status cut_edges(arena *a, polar *pd, piece **pc, uint32_t *np)
 {
     const scene *s = pd->s;
     edges e;
     split_ctx c;
     keyed *order;
-    uint32_t *active, *cut_first, i, j, nocc = 0, nextra, np = 0, nm = 0;
-    split *sp;
-    piece *pc;
+    uint32_t *active, i, nocc = 0;
+    uint8_t *dirty;
+    piece *ep;
+    plx_status st;
     e.n = count_edges(s);
     e.a = scratch_n(a, e.n, 4);
     e.b = scratch_n(a, e.n, 4);
@@ -1678,48 +2030,33 @@ static plx_status make_walls(arena *a, polar *pd)
     find_contacts(&c, s, order, nocc, active);
     if (c.nomem)
         return PLX_E_NOMEM;
-    nextra = c.npts - s->npts;
-    pd->npts = s->npts + nextra + 4;
-    pd->pts = keep_n(a, pd->npts, sizeof(vec2), &pd->bytes[2]);
-    sp = scratch_n(a, c.nsp, sizeof(split));
-    cut_first = scratch_n(a, (size_t)e.n + 1, 4);
-    if (!pd->pts || !sp || !cut_first)
+    st = flat_points(a, &c, s->npts);
+    ep = st == PLX_OK ? edge_pieces(a, &e) : NULL;
+    if (!ep)
         return PLX_E_NOMEM;
-    if (s->npts)
-        memcpy(pd->pts, s->pts, s->npts * sizeof(vec2));
-    {
-        uint32_t n = s->npts;
-        point_chunk *k;
-        split_chunk *q;
-        for (k = c.pt0; k; k = k->next) {
-            memcpy(pd->pts + n, k->v, k->n * sizeof(vec2));
-            n += k->n;
-        }
-        /* the cuts grouped by edge (counting sort) */
-        memset(cut_first, 0, ((size_t)e.n + 1) * 4);
-        for (q = c.sp0; q; q = q->next)
-            for (i = 0; i < q->n; i++)
-                cut_first[q->v[i].seg + 1]++;
-        for (i = 0; i < e.n; i++)
-            cut_first[i + 1] += cut_first[i];
-        for (q = c.sp0; q; q = q->next)
-            for (i = 0; i < q->n; i++)
-                sp[cut_first[q->v[i].seg]++] = q->v[i];
-    }
-    pc = scratch_n(a, e.n + c.nsp, sizeof(piece));
-    if (!pc)
+    /* piece i is edge i (cut_pieces leaves zero-length pieces out) */
+    st = cut_pieces(a, &c, ep, e.n, 0, pc, np, &dirty);
+    if (st == PLX_OK && c.npts > s->npts)
+        st = settle_pieces(a, &c, pc, np, &dirty, &pd->wall_rounds);
+    pd->npts = c.npts;
+    return st;
+}
+
+/* Cuts the occluders' edges into wall pieces (pd->pts, pd->seg filled). */
+static plx_status make_walls(arena *a, polar *pd)
+{
+    uint32_t i, j, np = 0, nm = 0;
+    piece *pc;
+    vec2 *P;
+    plx_status st = cut_edges(a, pd, &pc, &np);
+    if (st != PLX_OK)
+        return st;
+    P = pd->pts;
+    pd->pts = keep_n(a, (size_t)pd->npts + 4, sizeof(vec2), &pd->bytes[2]);
+    if (!pd->pts)
         return PLX_E_NOMEM;
-    for (i = 0, j = 0; i < e.n; i++) {
-        uint32_t j0 = j, prev = e.a[i], q;
-        while (j < c.nsp && sp[j].seg == i)
-            j++;
-        sort_cuts(sp + j0, j - j0, pd->pts, lex_cmp(pd->pts[e.a[i]], pd->pts[e.b[i]]) < 0);
-        for (q = j0; q < j; q++) {
-            emit_piece(pc, &np, pd->pts, prev, sp[q].pt, e.bld[i]);
-            prev = sp[q].pt;
-        }
-        emit_piece(pc, &np, pd->pts, prev, e.b[i], e.bld[i]);
-    }
+    if (pd->npts)
+        memcpy(pd->pts, P, (size_t)pd->npts * sizeof(vec2));
     {
         pkey *ky = scratch_n(a, np, sizeof(pkey)), *tmp = scratch_n(a, np, sizeof(pkey));
         piece *pc2 = scratch_n(a, np, sizeof(piece));
@@ -1764,7 +2101,7 @@ static plx_status make_walls(arena *a, polar *pd)
     nm = j;
     pd->nwall = nm;
     pd->nseg = nm;
-    add_box(pd, s->npts + nextra);
+    add_box(pd, pd->npts);
     return PLX_OK;
 }
 

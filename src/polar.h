@@ -135,6 +135,8 @@ typedef struct polar {
     uint32_t nseg;
     uint32_t nwall;          /* wall pieces come first: seg[0 .. nwall-1] */
     uint32_t nbld;           /* s->nbld */
+    uint32_t wall_rounds;    /* contact searches after the first cut, the last finding
+                              * none (0: no crossing point was rounded) */
     double box[4];           /* s->bounds */
     polar_map map[2];        /* [0]: quadrants 0, 2   [1]: quadrants 1, 3 */
     size_t bytes[4];         /* axes, regions, polygons, rest (search DAGs, header) */
@@ -144,8 +146,10 @@ typedef struct polar {
  * memory (PLX_PART_POLAR) valid until that memory is released; the scene must
  * stay unchanged meanwhile. Fails with PLX_E_NOMEM (nothing kept, scratch
  * released), PLX_E_INVALID (NULL argument, empty or non-finite bounds) or
- * PLX_E_SCENE (the wall pieces, once cut at every contact, still cross: only
- * possible through the rounding of crossing points; nothing kept).
+ * PLX_E_SCENE (wall pieces that still touch elsewhere than at their ends:
+ * after many rounds of cuts at the contacts rounded crossing points make,
+ * which no scene is known to need, or where edges of one building touch,
+ * which the loader rejects as a self-intersecting ring; nothing kept).
  * A scene with no occluder gives diagrams of one free region each. */
 plx_status polar_build(arena *a, const scene *s, polar **out /* OUT */);
 
