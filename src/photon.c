@@ -10,6 +10,16 @@
 #define BOUNCE_OFFSET 1e-5 /* m: bounce origins are moved off the surface */
 #define PROBE 0.01        /* m: exposure probes in front of a wall */
 
+/* A hint to fetch the cache line at p (a splat's rows are fetched before
+ * its weights are computed; nothing on other compilers). */
+#if defined(__GNUC__)
+#define PHOTON_PREFETCH(p) __builtin_prefetch(p)
+#define PHOTON_PREFETCH_W(p) __builtin_prefetch(p, 1)
+#else
+#define PHOTON_PREFETCH(p) ((void)(p))
+#define PHOTON_PREFETCH_W(p) ((void)(p))
+#endif
+
 void photon_config_default(photon_config *c)
 {
     memset(c, 0, sizeof *c);
@@ -80,12 +90,67 @@ double photon_rand01(uint64_t *st)
     return (double)(photon_rand(st) >> 11) * (1.0 / 9007199254740992.0);
 }
 
+/* cos and sin of 2 pi u for u in [0, 1), without a libm call (sincos was
+ * a tenth of the photon pass): u is split into quarter turns q and a
+ * remainder f in [-1/2, 1/2] (both exact), t = f pi / 2 lies in
+ * [-pi/4, pi/4] where the Taylor series of sin to t^15 and of cos to t^16
+ * are within half an ulp; evaluated by Estrin's scheme (short dependency
+ * chains), then rotated by q quarter turns. Within 2 ulps of libm's, so
+ * the photon pass samples the same directions from the same random
+ * numbers as it did with libm (tests/unit/test_photon.c compares). */
+void photon_sincos_turn(double u, double *c, double *s)
+{
+    double x = 4.0 * u, qf = floor(x + 0.5), t = (x - qf) * (PI / 2.0);
+    double t2 = t * t, t4 = t2 * t2, t8 = t4 * t4, sn, cs;
+    int q = (int)qf & 3;
+    sn = ((1.0 + (-1.0 / 6.0) * t2) + ((1.0 / 120.0) + (-1.0 / 5040.0) * t2) * t4) +
+         (((1.0 / 362880.0) + (-1.0 / 39916800.0) * t2) +
+          ((1.0 / 6227020800.0) + (-1.0 / 1307674368000.0) * t2) * t4) *
+             t8;
+    sn *= t;
+    cs = ((1.0 + (-1.0 / 2.0) * t2) + ((1.0 / 24.0) + (-1.0 / 720.0) * t2) * t4) +
+         (((1.0 / 40320.0) + (-1.0 / 3628800.0) * t2) +
+          ((1.0 / 479001600.0) + (-1.0 / 87178291200.0) * t2) * t4) *
+             t8 +
+         (1.0 / 20922789888000.0) * (t8 * t8);
+    switch (q) {
+    case 0:
+        *c = cs;
+        *s = sn;
+        break;
+    case 1:
+        *c = -sn;
+        *s = cs;
+        break;
+    case 2:
+        *c = -cs;
+        *s = -sn;
+        break;
+    default:
+        *c = sn;
+        *s = -cs;
+        break;
+    }
+}
+
+void photon_sphere_dir(uint64_t *st, double d[3])
+{
+    double z = 1.0 - 2.0 * photon_rand01(st), r = sqrt(1.0 - z * z > 0.0 ? 1.0 - z * z : 0.0);
+    double c, s;
+    photon_sincos_turn(photon_rand01(st), &c, &s);
+    d[0] = r * c;
+    d[1] = r * s;
+    d[2] = z;
+}
+
 void photon_cosine_dir(uint64_t *st, const double n[3], double d[3])
 {
     double u1 = photon_rand01(st), u2 = photon_rand01(st);
-    double r = sqrt(u1), phi = 2.0 * PI * u2;
-    double a = r * cos(phi), b = r * sin(phi), c = sqrt(1.0 - u1);
+    double r = sqrt(u1), cp, sp, a, b, c = sqrt(1.0 - u1);
     double t[3], bt[3], l;
+    photon_sincos_turn(u2, &cp, &sp);
+    a = r * cp;
+    b = r * sp;
     if (fabs(n[2]) < 0.9) {
         t[0] = -n[1];
         t[1] = n[0];
@@ -210,13 +275,78 @@ static int nearest3(const grid *g, double fx, double fy, int *bi, int *bj)
     return bd < INFINITY;
 }
 
+/* Output slot of valid grid texel (i, j) (k = j w + i): the texel itself,
+ * its sparse slot or its window index; -1 when the texel is not valid
+ * (TEXEL_INVALID) or valid but outside the window (TEXEL_OUTSIDE: it still
+ * takes its share of the weights). Inlined in the splat's loop: it is the
+ * pass's innermost test. */
+#define TEXEL_INVALID (-2L)
+#define TEXEL_OUTSIDE (-1L)
+static long valid_slot(const grid *g, int i, int j, size_t k)
+{
+    long s = (long)k;
+    if (g->idx) {
+        if (g->idx[k] == PHOTON_NONE)
+            return TEXEL_INVALID;
+        s = (long)g->idx[k];
+    }
+    if (!(g->area[s] > 0.0f))
+        return TEXEL_INVALID;
+    if (g->height && fabs((double)g->height[k] - g->z) > HEIGHT_TOL)
+        return TEXEL_INVALID;
+    if (g->win) {
+        int a = i - g->ox, b = j - g->oy;
+        if (a < 0 || b < 0 || a >= (int)g->ow || b >= (int)g->oh)
+            return TEXEL_OUTSIDE;
+        return (long)b * (long)g->ow + a;
+    }
+    return s;
+}
+
+/* Asks for the cache lines of rows j0..j1, columns i0..i1 (clamped, not
+ * wrapped) of the grid's area, height and (whole-grid output) flux: a
+ * splat's texels are scattered over a few rows of big arrays and missed
+ * the cache one after the other; fetched together they arrive together. */
+static void prefetch_rows(const float *out, const grid *g, int i0, int i1, int j0, int j1)
+{
+    int j;
+    if (g->idx)
+        return;
+    i0 = i0 < 0 ? 0 : i0;
+    i1 = i1 >= (int)g->w ? (int)g->w - 1 : i1;
+    j0 = j0 < 0 ? 0 : j0;
+    j1 = j1 >= (int)g->h ? (int)g->h - 1 : j1;
+    if (i1 < i0)
+        return;
+    for (j = j0; j <= j1; j++) {
+        size_t a = (size_t)j * g->w + (size_t)i0, b = (size_t)j * g->w + (size_t)i1;
+        PHOTON_PREFETCH(g->area + a);
+        PHOTON_PREFETCH(g->area + b);
+        if (g->height) {
+            PHOTON_PREFETCH(g->height + a);
+            PHOTON_PREFETCH(g->height + b);
+        }
+        if (!g->win) {
+            size_t k;
+            for (k = a; k <= b + 3; k += 4) /* 4 texels of 16 bytes a line */
+                PHOTON_PREFETCH_W(out + (k < b ? k : b) * PHOTON_CH);
+        }
+    }
+}
+
+/* The cone kernel over the texels within r of (fx, fy), weights normalised
+ * over the valid ones. The square's columns (wrapped) and their dx^2 are
+ * found once; a texel is looked at only when d^2 says it may be inside
+ * (the exact test on the distance, as the weight uses it, follows), so
+ * the corners of the square cost neither a read nor a square root. */
 static int splat_any(float *out, const grid *g, double fx, double fy, double r,
                      const double phi[PHOTON_CH])
 {
     enum { MAXK = 2 * PHOTON_KERNEL_MAXI + 3 };
-    int ti[MAXK * MAXK], tj[MAXK * MAXK];
-    double wt[MAXK * MAXK], sum = 0.0;
-    int n = 0, i, j, i0, i1, j0, j1;
+    long to[MAXK * MAXK];
+    int col[MAXK];
+    double wt[MAXK * MAXK], dx2[MAXK], sum = 0.0, r2;
+    int n = 0, i, j, i0, i1, j0, j1, c;
     if (r > PHOTON_KERNEL_MAX)
         r = PHOTON_KERNEL_MAX;
     if (!(fx > -r - 2.0 && fy > -r - 2.0 && fx < (double)g->w + r + 2.0 &&
@@ -226,20 +356,32 @@ static int splat_any(float *out, const grid *g, double fx, double fy, double r,
     i1 = (int)floor(fx + r);
     j0 = (int)floor(fy - r);
     j1 = (int)floor(fy + r);
+    r2 = r * r * (1.0 + 1e-9); /* a little wide: the exact test is on sqrt */
+    prefetch_rows(out, g, i0, i1, j0, j1);
+    for (i = i0; i <= i1; i++) {
+        double dx = (i + 0.5) - fx;
+        col[i - i0] = column(i, g->w, g->wrap);
+        dx2[i - i0] = dx * dx;
+    }
     for (j = j0; j <= j1; j++) {
-        double dy = (j + 0.5) - fy;
-        if (j < 0 || j >= (int)g->h)
+        double dy = (j + 0.5) - fy, dy2 = dy * dy;
+        size_t row;
+        if (j < 0 || j >= (int)g->h || !(dy2 < r2))
             continue;
-        for (i = i0; i <= i1; i++) {
-            double dx = (i + 0.5) - fx, dist = sqrt(dx * dx + dy * dy), wgt;
-            int ii = column(i, g->w, g->wrap);
-            if (dist >= r || ii < 0)
+        row = (size_t)j * g->w;
+        for (c = 0; c <= i1 - i0; c++) {
+            double d2 = dx2[c] + dy2, dist, wgt;
+            long o;
+            if (!(d2 < r2) || col[c] < 0)
                 continue;
-            if (!gvalid(g, ii, j))
+            dist = sqrt(d2);
+            if (dist >= r)
+                continue;
+            o = valid_slot(g, col[c], j, row + (size_t)col[c]);
+            if (o == TEXEL_INVALID)
                 continue;
             wgt = 1.0 - dist / r;
-            ti[n] = ii;
-            tj[n] = j;
+            to[n] = o;
             wt[n] = wgt;
             sum += wgt;
             n++;
@@ -253,7 +395,12 @@ static int splat_any(float *out, const grid *g, double fx, double fy, double r,
         return 1;
     }
     for (i = 0; i < n; i++)
-        deposit(out, out_index(g, ti[i], tj[i]), phi, wt[i] / sum);
+        if (to[i] >= 0) {
+            float *q = out + (size_t)to[i] * PHOTON_CH;
+            double share = wt[i] / sum;
+            for (c = 0; c < PHOTON_CH; c++)
+                q[c] += (float)(phi[c] * share);
+        }
     return 1;
 }
 
@@ -530,6 +677,7 @@ static void layout(photon_sys *ps, taker *t, const scene *s, const photon_config
         memset(&dummy, 0, sizeof dummy);
         ps = &dummy;
     }
+    ps->balb = take(t, s->nbld, sizeof(double));
     ps->eclass = take(t, s->npts, 1);
     ps->ez0 = take(t, s->npts, sizeof(float));
     ps->ez1 = take(t, s->npts, sizeof(float));
@@ -1003,6 +1151,8 @@ plx_status photon_create(arena *a, const scene *s, const photon_config *cfg, pho
     }
     ps->gx0 = s->bounds[0];
     ps->gy0 = s->bounds[1];
+    for (i = 0; i < s->nbld; i++)
+        ps->balb[i] = s->bld[i].albedo;
     walls_classify(ps);
     blocks_setup(ps);
     for (L = 0; L < PHOTON_LEVELS; L++) {
@@ -1196,12 +1346,12 @@ static void ground_albedo_rgb(const scene *s, double x, double y, double rgb[3])
 
 /* RGB albedo of the surface at hit h: the ground's, or the building's
  * scalar albedo (grey) on walls, roofs and undersides. */
-static void hit_albedo_rgb(const scene *s, const trace_hit *h, double rgb[3])
+static void hit_albedo_rgb(const photon_sys *ps, const trace_hit *h, double rgb[3])
 {
     if (h->kind == TRACE_GROUND)
-        ground_albedo_rgb(s, h->p[0], h->p[1], rgb);
+        ground_albedo_rgb(ps->s, h->p[0], h->p[1], rgb);
     else
-        rgb[0] = rgb[1] = rgb[2] = s->bld[h->bld].albedo;
+        rgb[0] = rgb[1] = rgb[2] = ps->balb[h->bld];
 }
 
 double photon_albedo_scalar(const double rgb[3])
@@ -1304,19 +1454,14 @@ void photon_trace_lamp(photon_sys *ps, uint32_t lamp, double phi, uint64_t *rng,
                        photon_stats *st, photon_store_fn store, void *ctx)
 {
     const scene_lamp *Lp = &ps->s->lamps[lamp];
-    double o[3], d[3], z, r, ph, f[PHOTON_CH], alb[3];
+    double o[3], d[3], f[PHOTON_CH], alb[3];
     trace_hit h;
     uint32_t b;
     int c;
     o[0] = Lp->x;
     o[1] = Lp->y;
     o[2] = Lp->z;
-    z = 1.0 - 2.0 * photon_rand01(rng);
-    r = sqrt(1.0 - z * z > 0.0 ? 1.0 - z * z : 0.0);
-    ph = 2.0 * PI * photon_rand01(rng);
-    d[0] = r * cos(ph);
-    d[1] = r * sin(ph);
-    d[2] = z;
+    photon_sphere_dir(rng, d);
     st->photons++;
     st->emitted += phi;
     st->traced++;
@@ -1329,7 +1474,7 @@ void photon_trace_lamp(photon_sys *ps, uint32_t lamp, double phi, uint64_t *rng,
         f[1 + c] = f[0] * (double)Lp->color[c];
     st->first += f[0];
     for (b = 0; b < ps->cfg.max_bounces; b++) {
-        hit_albedo_rgb(ps->s, &h, alb);
+        hit_albedo_rgb(ps, &h, alb);
         if (!photon_bounce(f, alb, photon_rand01(rng))) {
             st->absorbed += f[0];
             return;

@@ -216,6 +216,8 @@ typedef struct photon_sys {
     const scene *s;
     photon_config cfg;
     tracer *T;
+    double *balb;                   /* per building: its albedo (s->bld[].albedo, read
+                                       at every hit: a compact copy stays in cache) */
     /* walls (per scene point = edge start) */
     uint8_t *eclass;                /* PHOTON_EDGE_* */
     float *ez0, *ez1;               /* exposed height range */
@@ -416,7 +418,13 @@ int photon_covered_at(const photon_sys *ps, double x, double y);
 /* Random numbers (splitmix64 state). */
 uint64_t photon_rand(uint64_t *st);
 double photon_rand01(uint64_t *st);
-/* Cosine-weighted direction about unit n. */
+/* cos and sin of 2 pi u, u in [0, 1), by a polynomial (no libm call;
+ * within 2 ulps of libm). */
+void photon_sincos_turn(double u, double *c /* OUT */, double *s /* OUT */);
+/* Uniform direction on the unit sphere from two random numbers
+ * (z = 1 - 2 u1, azimuth 2 pi u2). */
+void photon_sphere_dir(uint64_t *st, double d[3] /* OUT */);
+/* Cosine-weighted direction about unit n (radius sqrt u1, azimuth 2 pi u2). */
 void photon_cosine_dir(uint64_t *st, const double n[3], double d[3] /* OUT */);
 /* Aerial texel coordinates of (x, y). */
 void photon_aerial_xy(const photon_sys *ps, double x, double y, double *fx, double *fy);

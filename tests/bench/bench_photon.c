@@ -14,7 +14,8 @@
  *    against a long run of the same estimator (convergence, not accuracy:
  *    tests/unit/test_photon.c checks accuracy against path tracing).
  *
- * Usage: bench_photon [FRAMES]   (default 20 timed passes)
+ * Usage: bench_photon [FRAMES [pass]]   (default 20 timed passes; "pass":
+ * stop after the photon pass, for profiling it)
  */
 #include <math.h>
 #include <stdio.h>
@@ -372,6 +373,8 @@ int main(int argc, char **argv)
                100.0 * ps->st.stored_covered / ps->st.arrived,
                100.0 * ps->st.lost / ps->st.arrived);
     }
+    if (argc > 2 && strcmp(argv[2], "pass") == 0)
+        return 0;
 
     /* ---- the caster ---- */
     {
