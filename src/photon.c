@@ -1380,74 +1380,156 @@ static void add_rgb(double acc[3], const double f[PHOTON_CH])
     acc[2] += f[3];
 }
 
+/* A stored photon, decided but not yet splatted: the progressive pass
+ * works out where a photon goes (chart, coordinates, radius) when it
+ * arrives and asks for the texel rows then, and splats it a few photons
+ * later (store_queue), when the rows have arrived; the splats and every
+ * sum they touch still happen in arrival order, so the results are the
+ * same bytes as splatting at once. */
+enum { OP_LOST, OP_SKIPPED, OP_AMBIENT, OP_SPLAT };
+typedef struct store_op {
+    int what;                 /* OP_* */
+    uint32_t block;           /* wall photons: the block (PHOTON_NONE otherwise) */
+    double *stored;           /* OP_SPLAT: the stats sum of its chart kind */
+    float *out;               /* OP_SPLAT: flux of the grid */
+    grid g;
+    double fx, fy, r;
+    double f[PHOTON_CH];
+} store_op;
+
+static void prepare_splat(store_op *op, double *stored, float *out, grid g, double fx,
+                          double fy, double r)
+{
+    double rr = r > PHOTON_KERNEL_MAX ? PHOTON_KERNEL_MAX : r;
+    op->what = OP_SPLAT;
+    op->stored = stored;
+    op->out = out;
+    op->g = g;
+    op->fx = fx;
+    op->fy = fy;
+    op->r = r;
+    if (fx > -rr - 2.0 && fy > -rr - 2.0 && fx < (double)g.w + rr + 2.0 &&
+        fy < (double)g.h + rr + 2.0)
+        prefetch_rows(out, &op->g, (int)floor(fx - rr), (int)floor(fx + rr),
+                      (int)floor(fy - rr), (int)floor(fy + rr));
+}
+
 /* A photon on a wall: its block's facade chart or ambient term. */
-static void store_wall(photon_sys *ps, const trace_hit *h, const double f[PHOTON_CH])
+static void prepare_wall(photon_sys *ps, const trace_hit *h, store_op *op)
 {
     const scene *s = ps->s;
-    photon_stats *st = &ps->st;
     uint32_t k = s->bld[h->bld].block;
-    int L, c;
     photon_level *lv;
     size_t cs, base;
     double fx, fy;
+    int L;
     if (k >= s->nblocks || ps->eclass[h->edge] == PHOTON_EDGE_INTERNAL) {
-        st->lost += f[0];
+        op->what = OP_LOST;
         return;
     }
-    for (c = 0; c < PHOTON_CH; c++)
-        ps->bamb[(size_t)k * PHOTON_CH + (size_t)c] += f[c];
+    op->block = k;
     L = ps->blevel[k];
     if (L >= PHOTON_LEVELS) {
-        st->stored_ambient += f[0];
-        add_rgb(st->stored_rgb, f);
+        op->what = OP_AMBIENT;
         return;
     }
     lv = &ps->lev[L];
     cs = (size_t)lv->w * lv->h;
     base = (size_t)ps->bslot[k] * 2 * cs + (ps->eclass[h->edge] == PHOTON_EDGE_INNER ? cs : 0);
     chart_xy(ps, k, lv, h->p[0], h->p[1], h->p[2], &fx, &fy);
-    if (photon_splat(lv->flux + base * PHOTON_CH, lv->area + base, NULL, 0.0, lv->w, lv->h, 1,
-                     fx, fy, kernel_radius(&ps->cfg, lv->slot_frames[ps->bslot[k]]), f)) {
-        st->stored_chart += f[0];
-        add_rgb(st->stored_rgb, f);
-    } else
-        st->lost += f[0];
+    prepare_splat(op, &ps->st.stored_chart, lv->flux + base * PHOTON_CH,
+                  grid_full(lv->area + base, NULL, NULL, 0.0, lv->w, lv->h, 1), fx, fy,
+                  kernel_radius(&ps->cfg, lv->slot_frames[ps->bslot[k]]));
 }
 
 /* Where the progressive pass puts a photon arriving at h with weights f. */
-static void store_progressive(photon_sys *ps, uint32_t lamp, const trace_hit *h,
-                              const double f[PHOTON_CH])
+static void prepare_progressive(photon_sys *ps, uint32_t lamp, const trace_hit *h,
+                                const double f[PHOTON_CH], store_op *op)
 {
-    photon_stats *st = &ps->st;
     double fx, fy, r = kernel_radius(&ps->cfg, ps->gframes);
+    int c;
+    for (c = 0; c < PHOTON_CH; c++)
+        op->f[c] = f[c];
+    op->block = PHOTON_NONE;
     if (h->kind == TRACE_WALL) {
-        store_wall(ps, h, f);
+        prepare_wall(ps, h, op);
         return;
     }
     if (h->kind != TRACE_GROUND && h->kind != TRACE_ROOF) {
-        st->lost += f[0];
+        op->what = OP_LOST;
         return;
     }
     if (ps->refined[lamp]) {
-        st->skipped_refined += f[0];
+        op->what = OP_SKIPPED;
         return;
     }
     photon_aerial_xy(ps, h->p[0], h->p[1], &fx, &fy);
-    if (h->kind == TRACE_GROUND && photon_covered_at(ps, h->p[0], h->p[1])) {
-        if (photon_splat_sparse(ps->cov_flux, ps->cov_area, ps->gcov, ps->gw, ps->gh, fx, fy, r,
-                                f)) {
-            st->stored_covered += f[0];
+    if (h->kind == TRACE_GROUND && photon_covered_at(ps, h->p[0], h->p[1]))
+        prepare_splat(op, &ps->st.stored_covered, ps->cov_flux,
+                      grid_full(ps->cov_area, NULL, ps->gcov, 0.0, ps->gw, ps->gh, 0), fx, fy, r);
+    else
+        prepare_splat(op, &ps->st.stored_aerial, ps->gflux,
+                      grid_full(ps->garea, ps->gheight, NULL, h->p[2], ps->gw, ps->gh, 0), fx,
+                      fy, r);
+}
+
+/* Splats a prepared photon and counts it. */
+static void commit_store(photon_sys *ps, const store_op *op)
+{
+    photon_stats *st = &ps->st;
+    const double *f = op->f;
+    int c;
+    if (op->block != PHOTON_NONE)
+        for (c = 0; c < PHOTON_CH; c++)
+            ps->bamb[(size_t)op->block * PHOTON_CH + (size_t)c] += f[c];
+    switch (op->what) {
+    case OP_LOST:
+        st->lost += f[0];
+        break;
+    case OP_SKIPPED:
+        st->skipped_refined += f[0];
+        break;
+    case OP_AMBIENT:
+        st->stored_ambient += f[0];
+        add_rgb(st->stored_rgb, f);
+        break;
+    default:
+        if (splat_any(op->out, &op->g, op->fx, op->fy, op->r, f)) {
+            *op->stored += f[0];
             add_rgb(st->stored_rgb, f);
         } else
             st->lost += f[0];
-        return;
+        break;
     }
-    if (photon_splat(ps->gflux, ps->garea, ps->gheight, h->p[2], ps->gw, ps->gh, 0, fx, fy, r,
-                     f)) {
-        st->stored_aerial += f[0];
-        add_rgb(st->stored_rgb, f);
-    } else
-        st->lost += f[0];
+}
+
+/* The photons prepared and not yet splatted (oldest at head). */
+#define STORE_QUEUE 4
+typedef struct store_queue {
+    store_op op[STORE_QUEUE];
+    unsigned head, n;
+} store_queue;
+
+static void store_step(photon_sys *ps, void *ctx, uint32_t lamp, const trace_hit *h,
+                       const double f[PHOTON_CH])
+{
+    store_queue *q = ctx;
+    if (q->n == STORE_QUEUE) {
+        commit_store(ps, &q->op[q->head]);
+        q->head = (q->head + 1) % STORE_QUEUE;
+        q->n--;
+    }
+    prepare_progressive(ps, lamp, h, f, &q->op[(q->head + q->n) % STORE_QUEUE]);
+    q->n++;
+}
+
+static void store_flush(photon_sys *ps, store_queue *q)
+{
+    while (q->n > 0) {
+        commit_store(ps, &q->op[q->head]);
+        q->head = (q->head + 1) % STORE_QUEUE;
+        q->n--;
+    }
 }
 
 void photon_trace_lamp(photon_sys *ps, uint32_t lamp, double phi, uint64_t *rng,
@@ -1495,13 +1577,6 @@ void photon_trace_lamp(photon_sys *ps, uint32_t lamp, double phi, uint64_t *rng,
     st->cut += f[0];
 }
 
-static void store_step(photon_sys *ps, void *ctx, uint32_t lamp, const trace_hit *h,
-                       const double f[PHOTON_CH])
-{
-    (void)ctx;
-    store_progressive(ps, lamp, h, f);
-}
-
 void photon_step(photon_sys *ps, uint32_t n, uint64_t seed)
 {
     const scene *s = ps->s;
@@ -1511,11 +1586,16 @@ void photon_step(photon_sys *ps, uint32_t n, uint64_t seed)
     uint64_t rng = seed ^ 0x5bd1e9955bd1e995ull;
     rng = photon_rand(&rng);
     rng = photon_rand(&rng);
-    uint32_t k, lamp = 0;
+    uint32_t k, lamp = 0, prev = PHOTON_NONE;
     int L;
     double phi;
+    store_queue q;
+    q.head = q.n = 0;
     if (!ps || n == 0 || s->nlamps == 0 || !(ps->flux_total > 0.0))
         return;
+    trace_lamp_prefetch(ps->T, 0, 0);
+    trace_lamp_prefetch(ps->T, 1, 0);
+    trace_lamp_prefetch(ps->T, 2, 0);
     for (L = 0; L < PHOTON_LEVELS; L++) {
         photon_level *lv = &ps->lev[L];
         uint32_t i;
@@ -1544,8 +1624,16 @@ void photon_step(photon_sys *ps, uint32_t n, uint64_t seed)
             }
             lamp = lo;
         }
-        photon_trace_lamp(ps, lamp, phi, &rng, &ps->st, store_step, NULL);
+        if (lamp != prev) {
+            /* lamps come in order: fetch the next ones' tables early */
+            trace_lamp_prefetch(ps->T, lamp + 1, 2);
+            trace_lamp_prefetch(ps->T, lamp + 2, 1);
+            trace_lamp_prefetch(ps->T, lamp + 3, 0);
+            prev = lamp;
+        }
+        photon_trace_lamp(ps, lamp, phi, &rng, &ps->st, store_step, &q);
     }
+    store_flush(ps, &q);
 }
 
 /* ---- lookup ------------------------------------------------------------------------ */

@@ -820,6 +820,33 @@ int trace_lamp_ray(tracer *T, uint32_t lamp, const double d[3], trace_hit *h)
     return finish(o, d, &bs, h);
 }
 
+void trace_lamp_prefetch(const tracer *T, uint32_t lamp, int stage)
+{
+    const uint32_t *sec;
+    uint32_t k, k1;
+    if (lamp >= T->s->nlamps)
+        return;
+    sec = &T->lsec[(size_t)lamp * (TRACE_SECTORS + 2)];
+    if (stage == 0) {
+        TRACE_PREFETCH(sec);
+        TRACE_PREFETCH(sec + TRACE_SECTORS + 1);
+        TRACE_PREFETCH(T->lfast + lamp);
+        return;
+    }
+    if (!T->lfast[lamp])
+        return;
+    k1 = sec[TRACE_SECTORS + 1];
+    if (stage == 1) {
+        for (k = sec[0]; k < k1; k += 16)
+            TRACE_PREFETCH(T->lref + k);
+        TRACE_PREFETCH(T->lref + k1 - 1);
+        return;
+    }
+    k1 = sec[TRACE_SECTORS];
+    for (k = sec[0]; k < k1; k++)
+        TRACE_PREFETCH(T->walls + T->lref[k]);
+}
+
 int trace_ray_brute(tracer *T, const double o[3], const double d[3], double tmax, trace_hit *h)
 {
     const scene *s = T->s;

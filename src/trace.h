@@ -189,6 +189,14 @@ int trace_ray(tracer *T, const double o[3], const double d[3], double tmax,
  */
 int trace_lamp_ray(tracer *T, uint32_t lamp, const double d[3], trace_hit *h /* OUT */);
 
+/* Asks for the cache lines trace_lamp_ray will read for lamp (an index
+ * past the last lamp is ignored): stage 0 its table's offsets, stage 1
+ * (after stage 0 had time to arrive: it reads them) its wall and cap
+ * references. A caller that takes lamps in order (the photon pass) calls
+ * stage 1 for the next lamp and stage 0 for the one after. No effect on
+ * results. */
+void trace_lamp_prefetch(const tracer *T, uint32_t lamp, int stage);
+
 /* The same answer by the same wall and roof tests over every building (no
  * grid): checks the walk. */
 int trace_ray_brute(tracer *T, const double o[3], const double d[3], double tmax,
