@@ -65,7 +65,7 @@ static int config_ok(const photon_config *c)
 
 /* ---- small helpers ------------------------------------------------------ */
 
-double photon_window(double x)
+static double reach_window(double x)
 {
     double x2, v;
     if (!(x < 1.0))
@@ -77,7 +77,12 @@ double photon_window(double x)
     return v * v;
 }
 
-uint64_t photon_rand(uint64_t *st)
+double photon_window(double x)
+{
+    return reach_window(x);
+}
+
+static uint64_t rng_next(uint64_t *st)
 {
     uint64_t z = (*st += 0x9e3779b97f4a7c15ull);
     z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ull;
@@ -85,9 +90,19 @@ uint64_t photon_rand(uint64_t *st)
     return z ^ (z >> 31);
 }
 
+uint64_t photon_rand(uint64_t *st)
+{
+    return rng_next(st);
+}
+
+static double rng01(uint64_t *st)
+{
+    return (double)(rng_next(st) >> 11) * (1.0 / 9007199254740992.0);
+}
+
 double photon_rand01(uint64_t *st)
 {
-    return (double)(photon_rand(st) >> 11) * (1.0 / 9007199254740992.0);
+    return rng01(st);
 }
 
 /* cos and sin of 2 pi u for u in [0, 1), without a libm call (sincos was
@@ -98,7 +113,7 @@ double photon_rand01(uint64_t *st)
  * chains), then rotated by q quarter turns. Within 2 ulps of libm's, so
  * the photon pass samples the same directions from the same random
  * numbers as it did with libm (tests/unit/test_photon.c compares). */
-void photon_sincos_turn(double u, double *c, double *s)
+static void sincos_turn(double u, double *c, double *s)
 {
     double x = 4.0 * u, qf = floor(x + 0.5), t = (x - qf) * (PI / 2.0);
     double t2 = t * t, t4 = t2 * t2, t8 = t4 * t4, sn, cs;
@@ -133,22 +148,32 @@ void photon_sincos_turn(double u, double *c, double *s)
     }
 }
 
-void photon_sphere_dir(uint64_t *st, double d[3])
+void photon_sincos_turn(double u, double *c, double *s)
 {
-    double z = 1.0 - 2.0 * photon_rand01(st), r = sqrt(1.0 - z * z > 0.0 ? 1.0 - z * z : 0.0);
+    sincos_turn(u, c, s);
+}
+
+static void sphere_dir(uint64_t *st, double d[3])
+{
+    double z = 1.0 - 2.0 * rng01(st), r = sqrt(1.0 - z * z > 0.0 ? 1.0 - z * z : 0.0);
     double c, s;
-    photon_sincos_turn(photon_rand01(st), &c, &s);
+    sincos_turn(rng01(st), &c, &s);
     d[0] = r * c;
     d[1] = r * s;
     d[2] = z;
 }
 
-void photon_cosine_dir(uint64_t *st, const double n[3], double d[3])
+void photon_sphere_dir(uint64_t *st, double d[3])
 {
-    double u1 = photon_rand01(st), u2 = photon_rand01(st);
+    sphere_dir(st, d);
+}
+
+static void cosine_dir(uint64_t *st, const double n[3], double d[3])
+{
+    double u1 = rng01(st), u2 = rng01(st);
     double r = sqrt(u1), cp, sp, a, b, c = sqrt(1.0 - u1);
     double t[3], bt[3], l;
-    photon_sincos_turn(u2, &cp, &sp);
+    sincos_turn(u2, &cp, &sp);
     a = r * cp;
     b = r * sp;
     if (fabs(n[2]) < 0.9) {
@@ -174,6 +199,11 @@ void photon_cosine_dir(uint64_t *st, const double n[3], double d[3])
     d[0] /= l;
     d[1] /= l;
     d[2] /= l;
+}
+
+void photon_cosine_dir(uint64_t *st, const double n[3], double d[3])
+{
+    cosine_dir(st, n, d);
 }
 
 /* Storage slot of grid texel k: k itself, or idx[k] on a sparse grid
@@ -522,10 +552,15 @@ double photon_gather_win(const float *out, uint32_t ow, uint32_t oh, int32_t ox,
     return gather_any(out, &g, fx, fy, e);
 }
 
-void photon_aerial_xy(const photon_sys *ps, double x, double y, double *fx, double *fy)
+static void aerial_xy(const photon_sys *ps, double x, double y, double *fx, double *fy)
 {
     *fx = (x - ps->gx0) / ps->gtex;
     *fy = (y - ps->gy0) / ps->gtex;
+}
+
+void photon_aerial_xy(const photon_sys *ps, double x, double y, double *fx, double *fy)
+{
+    aerial_xy(ps, x, y, fx, fy);
 }
 
 static double kernel_radius(const photon_config *c, uint32_t frames)
@@ -1046,8 +1081,8 @@ static void covered_build(photon_sys *ps)
         int i, j, i0, i1, j0, j1;
         if (!(B->min_height > 0.0))
             continue;
-        photon_aerial_xy(ps, B->box[0], B->box[1], &fx0, &fy0);
-        photon_aerial_xy(ps, B->box[2], B->box[3], &fx1, &fy1);
+        aerial_xy(ps, B->box[0], B->box[1], &fx0, &fy0);
+        aerial_xy(ps, B->box[2], B->box[3], &fx1, &fy1);
         i0 = fx0 < 0.0 ? 0 : (int)floor(fx0);
         j0 = fy0 < 0.0 ? 0 : (int)floor(fy0);
         i1 = fx1 >= ps->gw - 1.0 ? (int)ps->gw - 1 : (int)floor(fx1);
@@ -1071,17 +1106,22 @@ static void covered_build(photon_sys *ps)
     }
 }
 
-int photon_covered_at(const photon_sys *ps, double x, double y)
+static int covered_at(const photon_sys *ps, double x, double y)
 {
     double fx, fy;
     if (!ps->gcov)
         return 0;
-    photon_aerial_xy(ps, x, y, &fx, &fy);
+    aerial_xy(ps, x, y, &fx, &fy);
     if (!(fx >= 0.0 && fy >= 0.0 && fx < (double)ps->gw && fy < (double)ps->gh))
         return 0;
     if (ps->gcov[(size_t)floor(fy) * ps->gw + (size_t)floor(fx)] == PHOTON_NONE)
         return 0;
     return trace_top(ps->T, x, y, NULL) > HEIGHT_TOL;
+}
+
+int photon_covered_at(const photon_sys *ps, double x, double y)
+{
+    return covered_at(ps, x, y);
 }
 
 static void aerial_build(photon_sys *ps)
@@ -1354,16 +1394,21 @@ static void hit_albedo_rgb(const photon_sys *ps, const trace_hit *h, double rgb[
         rgb[0] = rgb[1] = rgb[2] = ps->balb[h->bld];
 }
 
-double photon_albedo_scalar(const double rgb[3])
+static double albedo_scalar(const double rgb[3])
 {
     if (rgb[0] == rgb[1] && rgb[1] == rgb[2])
         return rgb[0];
     return 0.2126 * rgb[0] + 0.7152 * rgb[1] + 0.0722 * rgb[2];
 }
 
-int photon_bounce(double f[PHOTON_CH], const double alb[3], double u)
+double photon_albedo_scalar(const double rgb[3])
 {
-    double p = photon_albedo_scalar(alb);
+    return albedo_scalar(rgb);
+}
+
+static int bounce(double f[PHOTON_CH], const double alb[3], double u)
+{
+    double p = albedo_scalar(alb);
     int c;
     if (!(u < p))
         return 0;
@@ -1371,6 +1416,11 @@ int photon_bounce(double f[PHOTON_CH], const double alb[3], double u)
     for (c = 0; c < 3; c++)
         f[1 + c] *= alb[c] / p;
     return 1;
+}
+
+int photon_bounce(double f[PHOTON_CH], const double alb[3], double u)
+{
+    return bounce(f, alb, u);
 }
 
 static void add_rgb(double acc[3], const double f[PHOTON_CH])
@@ -1463,8 +1513,8 @@ static void prepare_progressive(photon_sys *ps, uint32_t lamp, const trace_hit *
         op->what = OP_SKIPPED;
         return;
     }
-    photon_aerial_xy(ps, h->p[0], h->p[1], &fx, &fy);
-    if (h->kind == TRACE_GROUND && photon_covered_at(ps, h->p[0], h->p[1]))
+    aerial_xy(ps, h->p[0], h->p[1], &fx, &fy);
+    if (h->kind == TRACE_GROUND && covered_at(ps, h->p[0], h->p[1]))
         prepare_splat(op, &ps->st.stored_covered, ps->cov_flux,
                       grid_full(ps->cov_area, NULL, ps->gcov, 0.0, ps->gw, ps->gh, 0), fx, fy, r);
     else
@@ -1532,7 +1582,7 @@ static void store_flush(photon_sys *ps, store_queue *q)
     }
 }
 
-void photon_trace_lamp(photon_sys *ps, uint32_t lamp, double phi, uint64_t *rng,
+static void trace_lamp(photon_sys *ps, uint32_t lamp, double phi, uint64_t *rng,
                        photon_stats *st, photon_store_fn store, void *ctx)
 {
     const scene_lamp *Lp = &ps->s->lamps[lamp];
@@ -1543,13 +1593,13 @@ void photon_trace_lamp(photon_sys *ps, uint32_t lamp, double phi, uint64_t *rng,
     o[0] = Lp->x;
     o[1] = Lp->y;
     o[2] = Lp->z;
-    photon_sphere_dir(rng, d);
+    sphere_dir(rng, d);
     st->photons++;
     st->emitted += phi;
     st->traced++;
     if (trace_lamp_ray(ps->T, lamp, d, &h) == TRACE_SKY)
         return;
-    f[0] = phi * photon_window(h.t / Lp->radius);
+    f[0] = phi * reach_window(h.t / Lp->radius);
     if (!(f[0] > 0.0))
         return;
     for (c = 0; c < 3; c++)
@@ -1557,11 +1607,11 @@ void photon_trace_lamp(photon_sys *ps, uint32_t lamp, double phi, uint64_t *rng,
     st->first += f[0];
     for (b = 0; b < ps->cfg.max_bounces; b++) {
         hit_albedo_rgb(ps, &h, alb);
-        if (!photon_bounce(f, alb, photon_rand01(rng))) {
+        if (!bounce(f, alb, rng01(rng))) {
             st->absorbed += f[0];
             return;
         }
-        photon_cosine_dir(rng, h.n, d);
+        cosine_dir(rng, h.n, d);
         o[0] = h.p[0] + BOUNCE_OFFSET * h.n[0];
         o[1] = h.p[1] + BOUNCE_OFFSET * h.n[1];
         o[2] = h.p[2] + BOUNCE_OFFSET * h.n[2];
@@ -1577,6 +1627,12 @@ void photon_trace_lamp(photon_sys *ps, uint32_t lamp, double phi, uint64_t *rng,
     st->cut += f[0];
 }
 
+void photon_trace_lamp(photon_sys *ps, uint32_t lamp, double phi, uint64_t *rng,
+                       photon_stats *st, photon_store_fn store, void *ctx)
+{
+    trace_lamp(ps, lamp, phi, rng, st, store, ctx);
+}
+
 void photon_step(photon_sys *ps, uint32_t n, uint64_t seed)
 {
     const scene *s = ps->s;
@@ -1584,8 +1640,8 @@ void photon_step(photon_sys *ps, uint32_t n, uint64_t seed)
      * not share stream positions (stratified photons of one lamp take the
      * same indices every frame, and correlated streams froze their noise) */
     uint64_t rng = seed ^ 0x5bd1e9955bd1e995ull;
-    rng = photon_rand(&rng);
-    rng = photon_rand(&rng);
+    rng = rng_next(&rng);
+    rng = rng_next(&rng);
     uint32_t k, lamp = 0, prev = PHOTON_NONE;
     int L;
     double phi;
@@ -1609,7 +1665,7 @@ void photon_step(photon_sys *ps, uint32_t n, uint64_t seed)
     phi = ps->flux_total / n;
     for (k = 0; k < n; k++) {
         /* stratified choice of the lamp: the k-th of n equal flux shares */
-        double u = (k + photon_rand01(&rng)) / n * ps->flux_total;
+        double u = (k + rng01(&rng)) / n * ps->flux_total;
         while (lamp + 1 < s->nlamps && ps->lamp_cdf[lamp] <= u)
             lamp++;
         if (ps->lamp_cdf[lamp] <= u || (lamp > 0 && ps->lamp_cdf[lamp - 1] > u)) {
@@ -1631,7 +1687,7 @@ void photon_step(photon_sys *ps, uint32_t n, uint64_t seed)
             trace_lamp_prefetch(ps->T, lamp + 3, 0);
             prev = lamp;
         }
-        photon_trace_lamp(ps, lamp, phi, &rng, &ps->st, store_step, &q);
+        trace_lamp(ps, lamp, phi, &rng, &ps->st, store_step, &q);
     }
     store_flush(ps, &q);
 }
@@ -1687,10 +1743,10 @@ static void facade_lookup(const photon_sys *ps, const trace_hit *h, double e[PHO
 static void horizontal_lookup(const photon_sys *ps, const double P[3], double e[PHOTON_CH])
 {
     double fx, fy, night[PHOTON_CH];
-    int c, covered = P[2] <= HEIGHT_TOL && photon_covered_at(ps, P[0], P[1]);
+    int c, covered = P[2] <= HEIGHT_TOL && covered_at(ps, P[0], P[1]);
     for (c = 0; c < PHOTON_CH; c++)
         e[c] = 0.0;
-    photon_aerial_xy(ps, P[0], P[1], &fx, &fy);
+    aerial_xy(ps, P[0], P[1], &fx, &fy);
     if (ps->gframes > 0) {
         if (covered)
             photon_gather_sparse(ps->cov_flux, ps->cov_area, ps->gcov, ps->gw, ps->gh, fx, fy, e);
