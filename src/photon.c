@@ -82,7 +82,7 @@ double photon_window(double x)
     return reach_window(x);
 }
 
-static uint64_t rng_next(uint64_t *st)
+static inline uint64_t rng_next(uint64_t *st)
 {
     uint64_t z = (*st += 0x9e3779b97f4a7c15ull);
     z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ull;
@@ -95,7 +95,7 @@ uint64_t photon_rand(uint64_t *st)
     return rng_next(st);
 }
 
-static double rng01(uint64_t *st)
+static inline double rng01(uint64_t *st)
 {
     return (double)(rng_next(st) >> 11) * (1.0 / 9007199254740992.0);
 }
@@ -113,7 +113,7 @@ double photon_rand01(uint64_t *st)
  * chains), then rotated by q quarter turns. Within 2 ulps of libm's, so
  * the photon pass samples the same directions from the same random
  * numbers as it did with libm (tests/unit/test_photon.c compares). */
-static void sincos_turn(double u, double *c, double *s)
+static inline void sincos_turn(double u, double *c, double *s)
 {
     double x = 4.0 * u, qf = floor(x + 0.5), t = (x - qf) * (PI / 2.0);
     double t2 = t * t, t4 = t2 * t2, t8 = t4 * t4, sn, cs;
@@ -153,7 +153,7 @@ void photon_sincos_turn(double u, double *c, double *s)
     sincos_turn(u, c, s);
 }
 
-static void sphere_dir(uint64_t *st, double d[3])
+static inline void sphere_dir(uint64_t *st, double d[3])
 {
     double z = 1.0 - 2.0 * rng01(st), r = sqrt(1.0 - z * z > 0.0 ? 1.0 - z * z : 0.0);
     double c, s;
