@@ -712,7 +712,6 @@ static void layout(photon_sys *ps, taker *t, const scene *s, const photon_config
         memset(&dummy, 0, sizeof dummy);
         ps = &dummy;
     }
-    ps->balb = take(t, s->nbld, sizeof(double));
     ps->eclass = take(t, s->npts, 1);
     ps->ez0 = take(t, s->npts, sizeof(float));
     ps->ez1 = take(t, s->npts, sizeof(float));
@@ -1191,8 +1190,6 @@ plx_status photon_create(arena *a, const scene *s, const photon_config *cfg, pho
     }
     ps->gx0 = s->bounds[0];
     ps->gy0 = s->bounds[1];
-    for (i = 0; i < s->nbld; i++)
-        ps->balb[i] = s->bld[i].albedo;
     walls_classify(ps);
     blocks_setup(ps);
     for (L = 0; L < PHOTON_LEVELS; L++) {
@@ -1385,13 +1382,15 @@ static void ground_albedo_rgb(const scene *s, double x, double y, double rgb[3])
 }
 
 /* RGB albedo of the surface at hit h: the ground's, or the building's
- * scalar albedo (grey) on walls, roofs and undersides. */
+ * scalar albedo (grey) on walls, roofs and undersides (the caster hands it
+ * over with the hit: reading the scene's building record missed the
+ * cache at most bounces). */
 static void hit_albedo_rgb(const photon_sys *ps, const trace_hit *h, double rgb[3])
 {
     if (h->kind == TRACE_GROUND)
         ground_albedo_rgb(ps->s, h->p[0], h->p[1], rgb);
     else
-        rgb[0] = rgb[1] = rgb[2] = ps->balb[h->bld];
+        rgb[0] = rgb[1] = rgb[2] = h->albedo;
 }
 
 static double albedo_scalar(const double rgb[3])

@@ -216,8 +216,6 @@ typedef struct photon_sys {
     const scene *s;
     photon_config cfg;
     tracer *T;
-    double *balb;                   /* per building: its albedo (s->bld[].albedo, read
-                                       at every hit: a compact copy stays in cache) */
     /* walls (per scene point = edge start) */
     uint8_t *eclass;                /* PHOTON_EDGE_* */
     float *ez0, *ez1;               /* exposed height range */

@@ -94,6 +94,9 @@ typedef struct trace_hit {
     double p[3];       /* hit point o + t d */
     double n[3];       /* unit normal out of the solid (+z for the ground) */
     uint32_t bld;      /* building, TRACE_NONE for ground and sky */
+    double albedo;     /* the building's albedo (scene_building.albedo; 0 for ground
+                          and sky): photons bounce on it, and it comes in the wall
+                          record or the building the test read anyway */
     uint32_t edge;     /* wall: index in scene.pts of the edge's first vertex */
     int kind;          /* TRACE_SKY, TRACE_GROUND, ... */
 } trace_hit;
@@ -120,8 +123,9 @@ typedef struct trace_wall {
     double ex, ey;     /* edge vector (next vertex - first) */
     double zlo, zhi;   /* the building's min_height and height */
     uint32_t bld;      /* the building */
-    uint32_t pad[3];   /* to 64 bytes: one cache line */
-} trace_wall;
+    uint32_t pad;
+    double albedo;     /* the building's (a hit's albedo comes with its wall) */
+} trace_wall;          /* 64 bytes: one cache line */
 
 /* A cell: its walls are wids[w0 .. next cell's w0), its buildings
  * ids[r0 .. next cell's r0) (r0 = start[c]); the tallest top, the lowest
