@@ -845,7 +845,8 @@ void trace_lamp_prefetch(const tracer *T, uint32_t lamp, int stage)
     if (stage == 1) {
         for (k = sec[0]; k < k1; k += 16)
             TRACE_PREFETCH(T->lref + k);
-        TRACE_PREFETCH(T->lref + k1 - 1);
+        if (k1 > sec[0])
+            TRACE_PREFETCH(T->lref + k1 - 1);
         return;
     }
     k1 = sec[TRACE_SECTORS];
