@@ -387,7 +387,6 @@ static int splat_any(float *out, const grid *g, double fx, double fy, double r,
     j0 = (int)floor(fy - r);
     j1 = (int)floor(fy + r);
     r2 = r * r * (1.0 + 1e-9); /* a little wide: the exact test is on sqrt */
-    prefetch_rows(out, g, i0, i1, j0, j1);
     for (i = i0; i <= i1; i++) {
         double dx = (i + 0.5) - fx;
         col[i - i0] = column(i, g->w, g->wrap);
