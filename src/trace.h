@@ -18,7 +18,7 @@
  *   TRACE_SKY    nothing before tmax.
  *
  * Method. One record per wall (footprint edge: first vertex, edge vector,
- * the building's [min_height, height] and index; 64 bytes) and a
+ * the building's [min_height, height], index and albedo; 64 bytes) and a
  * uniform grid over the Bounds box; each cell lists
  *   - its walls (indices of every edge that comes within a hair of the
  *     cell: segment clipped to the padded cell box, Liang-Barsky), and
