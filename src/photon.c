@@ -375,7 +375,7 @@ static int splat_any(float *out, const grid *g, double fx, double fy, double r,
     enum { MAXK = 2 * PHOTON_KERNEL_MAXI + 3 };
     long to[MAXK * MAXK];
     int col[MAXK];
-    double wt[MAXK * MAXK], dx2[MAXK], sum = 0.0, r2;
+    double wt[MAXK * MAXK], dx2[MAXK], sum = 0.0, r2, rinv, sinv;
     int n = 0, i, j, i0, i1, j0, j1, c;
     if (r > PHOTON_KERNEL_MAX)
         r = PHOTON_KERNEL_MAX;
@@ -387,6 +387,7 @@ static int splat_any(float *out, const grid *g, double fx, double fy, double r,
     j0 = (int)floor(fy - r);
     j1 = (int)floor(fy + r);
     r2 = r * r * (1.0 + 1e-9); /* a little wide: the exact test is on sqrt */
+    rinv = 1.0 / r; /* two divisions per texel were a fifth of the splat */
     for (i = i0; i <= i1; i++) {
         double dx = (i + 0.5) - fx;
         col[i - i0] = column(i, g->w, g->wrap);
@@ -409,7 +410,7 @@ static int splat_any(float *out, const grid *g, double fx, double fy, double r,
             o = valid_slot(g, col[c], j, row + (size_t)col[c]);
             if (o == TEXEL_INVALID)
                 continue;
-            wgt = 1.0 - dist / r;
+            wgt = 1.0 - dist * rinv;
             to[n] = o;
             wt[n] = wgt;
             sum += wgt;
@@ -423,10 +424,11 @@ static int splat_any(float *out, const grid *g, double fx, double fy, double r,
         deposit(out, out_index(g, bi, bj), phi, 1.0);
         return 1;
     }
+    sinv = 1.0 / sum;
     for (i = 0; i < n; i++)
         if (to[i] >= 0) {
             float *q = out + (size_t)to[i] * PHOTON_CH;
-            double share = wt[i] / sum;
+            double share = wt[i] * sinv;
             for (c = 0; c < PHOTON_CH; c++)
                 q[c] += (float)(phi[c] * share);
         }

@@ -1157,11 +1157,13 @@ static void test_accuracy_eixample(void **state)
 /* ---- splat kernel and direction samplers ---------------------------------------- */
 
 /* The splat by its definition, texel by texel over the whole square: cone
- * weights 1 - dist / r of the valid texels (sparse slot with area, area > 0,
- * height within 1 mm), normalised; else the nearest valid texel of the
- * 3 x 3; window texels outside the window take their share and drop it.
- * Points more than r + 2 texels outside the grid deposit nothing (even
- * with wrap). Returns 1 when deposited. */
+ * weights 1 - dist / r of the valid texels (sparse slot with area,
+ * area > 0, height within 1 mm), normalised (with photon.c's arithmetic:
+ * times 1 / r, shares times 1 / sum, so the floats compare exactly);
+ * else the nearest valid texel of the 3 x 3; window texels outside the
+ * window take their share and drop it. Points more than r + 2 texels
+ * outside the grid deposit nothing (even with wrap). Returns 1 when
+ * deposited. */
 static int ref_splat(float *out, const float *area, const float *height, const uint32_t *idx,
                      double z, int w, int h, int wrap, int win, int ow, int oh, int ox, int oy,
                      double fx, double fy, double r, const double phi[PHOTON_CH])
@@ -1196,7 +1198,7 @@ static int ref_splat(float *out, const float *area, const float *height, const u
                 j > (int)floor(fy + r) || dist >= r)
                 continue;
             slot[n] = o;
-            wt[n] = 1.0 - dist / r;
+            wt[n] = 1.0 - dist * (1.0 / r);
             sum += wt[n];
             n++;
         }
@@ -1211,7 +1213,7 @@ static int ref_splat(float *out, const float *area, const float *height, const u
     for (i = 0; i < n; i++)
         if (slot[i] >= 0)
             for (c = 0; c < PHOTON_CH; c++)
-                out[(size_t)slot[i] * PHOTON_CH + c] += (float)(phi[c] * (wt[i] / sum));
+                out[(size_t)slot[i] * PHOTON_CH + c] += (float)(phi[c] * (wt[i] * (1.0 / sum)));
     return 1;
 }
 
