@@ -10,6 +10,16 @@
 #define BOUNCE_OFFSET 1e-5 /* m: bounce origins are moved off the surface */
 #define PROBE 0.01        /* m: exposure probes in front of a wall */
 
+/* A hint to fetch the cache line at p (a splat's rows are fetched before
+ * its weights are computed; nothing on other compilers). */
+#if defined(__GNUC__)
+#define PHOTON_PREFETCH(p) __builtin_prefetch(p)
+#define PHOTON_PREFETCH_W(p) __builtin_prefetch(p, 1)
+#else
+#define PHOTON_PREFETCH(p) ((void)(p))
+#define PHOTON_PREFETCH_W(p) ((void)(p))
+#endif
+
 void photon_config_default(photon_config *c)
 {
     memset(c, 0, sizeof *c);
@@ -55,7 +65,7 @@ static int config_ok(const photon_config *c)
 
 /* ---- small helpers ------------------------------------------------------ */
 
-double photon_window(double x)
+static double reach_window(double x)
 {
     double x2, v;
     if (!(x < 1.0))
@@ -67,7 +77,12 @@ double photon_window(double x)
     return v * v;
 }
 
-uint64_t photon_rand(uint64_t *st)
+double photon_window(double x)
+{
+    return reach_window(x);
+}
+
+static inline uint64_t rng_next(uint64_t *st)
 {
     uint64_t z = (*st += 0x9e3779b97f4a7c15ull);
     z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ull;
@@ -75,17 +90,92 @@ uint64_t photon_rand(uint64_t *st)
     return z ^ (z >> 31);
 }
 
-double photon_rand01(uint64_t *st)
+uint64_t photon_rand(uint64_t *st)
 {
-    return (double)(photon_rand(st) >> 11) * (1.0 / 9007199254740992.0);
+    return rng_next(st);
 }
 
-void photon_cosine_dir(uint64_t *st, const double n[3], double d[3])
+static inline double rng01(uint64_t *st)
 {
-    double u1 = photon_rand01(st), u2 = photon_rand01(st);
-    double r = sqrt(u1), phi = 2.0 * PI * u2;
-    double a = r * cos(phi), b = r * sin(phi), c = sqrt(1.0 - u1);
+    return (double)(rng_next(st) >> 11) * (1.0 / 9007199254740992.0);
+}
+
+double photon_rand01(uint64_t *st)
+{
+    return rng01(st);
+}
+
+/* cos and sin of 2 pi u for u in [0, 1), without a libm call (sincos was
+ * a tenth of the photon pass): u is split into quarter turns q and a
+ * remainder f in [-1/2, 1/2] (both exact), t = f pi / 2 lies in
+ * [-pi/4, pi/4] where the Taylor series of sin to t^15 and of cos to t^16
+ * are within half an ulp; evaluated by Estrin's scheme (short dependency
+ * chains), then rotated by q quarter turns. Within 2 ulps of libm's, so
+ * the photon pass samples the same directions from the same random
+ * numbers as it did with libm (tests/unit/test_photon.c compares). */
+static inline void sincos_turn(double u, double *c, double *s)
+{
+    double x = 4.0 * u, qf = floor(x + 0.5), t = (x - qf) * (PI / 2.0);
+    double t2 = t * t, t4 = t2 * t2, t8 = t4 * t4, sn, cs;
+    int q = (int)qf & 3;
+    sn = ((1.0 + (-1.0 / 6.0) * t2) + ((1.0 / 120.0) + (-1.0 / 5040.0) * t2) * t4) +
+         (((1.0 / 362880.0) + (-1.0 / 39916800.0) * t2) +
+          ((1.0 / 6227020800.0) + (-1.0 / 1307674368000.0) * t2) * t4) *
+             t8;
+    sn *= t;
+    cs = ((1.0 + (-1.0 / 2.0) * t2) + ((1.0 / 24.0) + (-1.0 / 720.0) * t2) * t4) +
+         (((1.0 / 40320.0) + (-1.0 / 3628800.0) * t2) +
+          ((1.0 / 479001600.0) + (-1.0 / 87178291200.0) * t2) * t4) *
+             t8 +
+         (1.0 / 20922789888000.0) * (t8 * t8);
+    switch (q) {
+    case 0:
+        *c = cs;
+        *s = sn;
+        break;
+    case 1:
+        *c = -sn;
+        *s = cs;
+        break;
+    case 2:
+        *c = -cs;
+        *s = -sn;
+        break;
+    default:
+        *c = sn;
+        *s = -cs;
+        break;
+    }
+}
+
+void photon_sincos_turn(double u, double *c, double *s)
+{
+    sincos_turn(u, c, s);
+}
+
+static inline void sphere_dir(uint64_t *st, double d[3])
+{
+    double z = 1.0 - 2.0 * rng01(st), r = sqrt(1.0 - z * z > 0.0 ? 1.0 - z * z : 0.0);
+    double c, s;
+    sincos_turn(rng01(st), &c, &s);
+    d[0] = r * c;
+    d[1] = r * s;
+    d[2] = z;
+}
+
+void photon_sphere_dir(uint64_t *st, double d[3])
+{
+    sphere_dir(st, d);
+}
+
+static void cosine_dir(uint64_t *st, const double n[3], double d[3])
+{
+    double u1 = rng01(st), u2 = rng01(st);
+    double r = sqrt(u1), cp, sp, a, b, c = sqrt(1.0 - u1);
     double t[3], bt[3], l;
+    sincos_turn(u2, &cp, &sp);
+    a = r * cp;
+    b = r * sp;
     if (fabs(n[2]) < 0.9) {
         t[0] = -n[1];
         t[1] = n[0];
@@ -109,6 +199,11 @@ void photon_cosine_dir(uint64_t *st, const double n[3], double d[3])
     d[0] /= l;
     d[1] /= l;
     d[2] /= l;
+}
+
+void photon_cosine_dir(uint64_t *st, const double n[3], double d[3])
+{
+    cosine_dir(st, n, d);
 }
 
 /* Storage slot of grid texel k: k itself, or idx[k] on a sparse grid
@@ -210,13 +305,78 @@ static int nearest3(const grid *g, double fx, double fy, int *bi, int *bj)
     return bd < INFINITY;
 }
 
+/* Output slot of valid grid texel (i, j) (k = j w + i): the texel itself,
+ * its sparse slot or its window index; -1 when the texel is not valid
+ * (TEXEL_INVALID) or valid but outside the window (TEXEL_OUTSIDE: it still
+ * takes its share of the weights). Inlined in the splat's loop: it is the
+ * pass's innermost test. */
+#define TEXEL_INVALID (-2L)
+#define TEXEL_OUTSIDE (-1L)
+static long valid_slot(const grid *g, int i, int j, size_t k)
+{
+    long s = (long)k;
+    if (g->idx) {
+        if (g->idx[k] == PHOTON_NONE)
+            return TEXEL_INVALID;
+        s = (long)g->idx[k];
+    }
+    if (!(g->area[s] > 0.0f))
+        return TEXEL_INVALID;
+    if (g->height && fabs((double)g->height[k] - g->z) > HEIGHT_TOL)
+        return TEXEL_INVALID;
+    if (g->win) {
+        int a = i - g->ox, b = j - g->oy;
+        if (a < 0 || b < 0 || a >= (int)g->ow || b >= (int)g->oh)
+            return TEXEL_OUTSIDE;
+        return (long)b * (long)g->ow + a;
+    }
+    return s;
+}
+
+/* Asks for the cache lines of rows j0..j1, columns i0..i1 (clamped, not
+ * wrapped) of the grid's area, height and (whole-grid output) flux: a
+ * splat's texels are scattered over a few rows of big arrays and missed
+ * the cache one after the other; fetched together they arrive together. */
+static void prefetch_rows(const float *out, const grid *g, int i0, int i1, int j0, int j1)
+{
+    int j;
+    if (g->idx)
+        return;
+    i0 = i0 < 0 ? 0 : i0;
+    i1 = i1 >= (int)g->w ? (int)g->w - 1 : i1;
+    j0 = j0 < 0 ? 0 : j0;
+    j1 = j1 >= (int)g->h ? (int)g->h - 1 : j1;
+    if (i1 < i0)
+        return;
+    for (j = j0; j <= j1; j++) {
+        size_t a = (size_t)j * g->w + (size_t)i0, b = (size_t)j * g->w + (size_t)i1;
+        PHOTON_PREFETCH(g->area + a);
+        PHOTON_PREFETCH(g->area + b);
+        if (g->height) {
+            PHOTON_PREFETCH(g->height + a);
+            PHOTON_PREFETCH(g->height + b);
+        }
+        if (!g->win) {
+            size_t k;
+            for (k = a; k <= b + 3; k += 4) /* 4 texels of 16 bytes a line */
+                PHOTON_PREFETCH_W(out + (k < b ? k : b) * PHOTON_CH);
+        }
+    }
+}
+
+/* The cone kernel over the texels within r of (fx, fy), weights normalised
+ * over the valid ones. The square's columns (wrapped) and their dx^2 are
+ * found once; a texel is looked at only when d^2 says it may be inside
+ * (the exact test on the distance, as the weight uses it, follows), so
+ * the corners of the square cost neither a read nor a square root. */
 static int splat_any(float *out, const grid *g, double fx, double fy, double r,
                      const double phi[PHOTON_CH])
 {
     enum { MAXK = 2 * PHOTON_KERNEL_MAXI + 3 };
-    int ti[MAXK * MAXK], tj[MAXK * MAXK];
-    double wt[MAXK * MAXK], sum = 0.0;
-    int n = 0, i, j, i0, i1, j0, j1;
+    long to[MAXK * MAXK];
+    int col[MAXK];
+    double wt[MAXK * MAXK], dx2[MAXK], sum = 0.0, r2, rinv, sinv;
+    int n = 0, i, j, i0, i1, j0, j1, c;
     if (r > PHOTON_KERNEL_MAX)
         r = PHOTON_KERNEL_MAX;
     if (!(fx > -r - 2.0 && fy > -r - 2.0 && fx < (double)g->w + r + 2.0 &&
@@ -226,20 +386,32 @@ static int splat_any(float *out, const grid *g, double fx, double fy, double r,
     i1 = (int)floor(fx + r);
     j0 = (int)floor(fy - r);
     j1 = (int)floor(fy + r);
+    r2 = r * r * (1.0 + 1e-9); /* a little wide: the exact test is on sqrt */
+    rinv = 1.0 / r; /* two divisions per texel were a fifth of the splat */
+    for (i = i0; i <= i1; i++) {
+        double dx = (i + 0.5) - fx;
+        col[i - i0] = column(i, g->w, g->wrap);
+        dx2[i - i0] = dx * dx;
+    }
     for (j = j0; j <= j1; j++) {
-        double dy = (j + 0.5) - fy;
-        if (j < 0 || j >= (int)g->h)
+        double dy = (j + 0.5) - fy, dy2 = dy * dy;
+        size_t row;
+        if (j < 0 || j >= (int)g->h || !(dy2 < r2))
             continue;
-        for (i = i0; i <= i1; i++) {
-            double dx = (i + 0.5) - fx, dist = sqrt(dx * dx + dy * dy), wgt;
-            int ii = column(i, g->w, g->wrap);
-            if (dist >= r || ii < 0)
+        row = (size_t)j * g->w;
+        for (c = 0; c <= i1 - i0; c++) {
+            double d2 = dx2[c] + dy2, dist, wgt;
+            long o;
+            if (!(d2 < r2) || col[c] < 0)
                 continue;
-            if (!gvalid(g, ii, j))
+            dist = sqrt(d2);
+            if (dist >= r)
                 continue;
-            wgt = 1.0 - dist / r;
-            ti[n] = ii;
-            tj[n] = j;
+            o = valid_slot(g, col[c], j, row + (size_t)col[c]);
+            if (o == TEXEL_INVALID)
+                continue;
+            wgt = 1.0 - dist * rinv;
+            to[n] = o;
             wt[n] = wgt;
             sum += wgt;
             n++;
@@ -252,8 +424,14 @@ static int splat_any(float *out, const grid *g, double fx, double fy, double r,
         deposit(out, out_index(g, bi, bj), phi, 1.0);
         return 1;
     }
+    sinv = 1.0 / sum;
     for (i = 0; i < n; i++)
-        deposit(out, out_index(g, ti[i], tj[i]), phi, wt[i] / sum);
+        if (to[i] >= 0) {
+            float *q = out + (size_t)to[i] * PHOTON_CH;
+            double share = wt[i] * sinv;
+            for (c = 0; c < PHOTON_CH; c++)
+                q[c] += (float)(phi[c] * share);
+        }
     return 1;
 }
 
@@ -375,10 +553,15 @@ double photon_gather_win(const float *out, uint32_t ow, uint32_t oh, int32_t ox,
     return gather_any(out, &g, fx, fy, e);
 }
 
-void photon_aerial_xy(const photon_sys *ps, double x, double y, double *fx, double *fy)
+static void aerial_xy(const photon_sys *ps, double x, double y, double *fx, double *fy)
 {
     *fx = (x - ps->gx0) / ps->gtex;
     *fy = (y - ps->gy0) / ps->gtex;
+}
+
+void photon_aerial_xy(const photon_sys *ps, double x, double y, double *fx, double *fy)
+{
+    aerial_xy(ps, x, y, fx, fy);
 }
 
 static double kernel_radius(const photon_config *c, uint32_t frames)
@@ -898,8 +1081,8 @@ static void covered_build(photon_sys *ps)
         int i, j, i0, i1, j0, j1;
         if (!(B->min_height > 0.0))
             continue;
-        photon_aerial_xy(ps, B->box[0], B->box[1], &fx0, &fy0);
-        photon_aerial_xy(ps, B->box[2], B->box[3], &fx1, &fy1);
+        aerial_xy(ps, B->box[0], B->box[1], &fx0, &fy0);
+        aerial_xy(ps, B->box[2], B->box[3], &fx1, &fy1);
         i0 = fx0 < 0.0 ? 0 : (int)floor(fx0);
         j0 = fy0 < 0.0 ? 0 : (int)floor(fy0);
         i1 = fx1 >= ps->gw - 1.0 ? (int)ps->gw - 1 : (int)floor(fx1);
@@ -923,17 +1106,22 @@ static void covered_build(photon_sys *ps)
     }
 }
 
-int photon_covered_at(const photon_sys *ps, double x, double y)
+static int covered_at(const photon_sys *ps, double x, double y)
 {
     double fx, fy;
     if (!ps->gcov)
         return 0;
-    photon_aerial_xy(ps, x, y, &fx, &fy);
+    aerial_xy(ps, x, y, &fx, &fy);
     if (!(fx >= 0.0 && fy >= 0.0 && fx < (double)ps->gw && fy < (double)ps->gh))
         return 0;
     if (ps->gcov[(size_t)floor(fy) * ps->gw + (size_t)floor(fx)] == PHOTON_NONE)
         return 0;
     return trace_top(ps->T, x, y, NULL) > HEIGHT_TOL;
+}
+
+int photon_covered_at(const photon_sys *ps, double x, double y)
+{
+    return covered_at(ps, x, y);
 }
 
 static void aerial_build(photon_sys *ps)
@@ -1195,25 +1383,32 @@ static void ground_albedo_rgb(const scene *s, double x, double y, double rgb[3])
 }
 
 /* RGB albedo of the surface at hit h: the ground's, or the building's
- * scalar albedo (grey) on walls, roofs and undersides. */
-static void hit_albedo_rgb(const scene *s, const trace_hit *h, double rgb[3])
+ * scalar albedo (grey) on walls, roofs and undersides (the caster hands it
+ * over with the hit: reading the scene's building record missed the
+ * cache at most bounces). */
+static void hit_albedo_rgb(const photon_sys *ps, const trace_hit *h, double rgb[3])
 {
     if (h->kind == TRACE_GROUND)
-        ground_albedo_rgb(s, h->p[0], h->p[1], rgb);
+        ground_albedo_rgb(ps->s, h->p[0], h->p[1], rgb);
     else
-        rgb[0] = rgb[1] = rgb[2] = s->bld[h->bld].albedo;
+        rgb[0] = rgb[1] = rgb[2] = h->albedo;
 }
 
-double photon_albedo_scalar(const double rgb[3])
+static double albedo_scalar(const double rgb[3])
 {
     if (rgb[0] == rgb[1] && rgb[1] == rgb[2])
         return rgb[0];
     return 0.2126 * rgb[0] + 0.7152 * rgb[1] + 0.0722 * rgb[2];
 }
 
-int photon_bounce(double f[PHOTON_CH], const double alb[3], double u)
+double photon_albedo_scalar(const double rgb[3])
 {
-    double p = photon_albedo_scalar(alb);
+    return albedo_scalar(rgb);
+}
+
+static int bounce(double f[PHOTON_CH], const double alb[3], double u)
+{
+    double p = albedo_scalar(alb);
     int c;
     if (!(u < p))
         return 0;
@@ -1223,6 +1418,11 @@ int photon_bounce(double f[PHOTON_CH], const double alb[3], double u)
     return 1;
 }
 
+int photon_bounce(double f[PHOTON_CH], const double alb[3], double u)
+{
+    return bounce(f, alb, u);
+}
+
 static void add_rgb(double acc[3], const double f[PHOTON_CH])
 {
     acc[0] += f[1];
@@ -1230,111 +1430,188 @@ static void add_rgb(double acc[3], const double f[PHOTON_CH])
     acc[2] += f[3];
 }
 
+/* A stored photon, decided but not yet splatted: the progressive pass
+ * works out where a photon goes (chart, coordinates, radius) when it
+ * arrives and asks for the texel rows then, and splats it a few photons
+ * later (store_queue), when the rows have arrived; the splats and every
+ * sum they touch still happen in arrival order, so the results are the
+ * same bytes as splatting at once. */
+enum { OP_LOST, OP_SKIPPED, OP_AMBIENT, OP_SPLAT };
+typedef struct store_op {
+    int what;                 /* OP_* */
+    uint32_t block;           /* wall photons: the block (PHOTON_NONE otherwise) */
+    double *stored;           /* OP_SPLAT: the stats sum of its chart kind */
+    float *out;               /* OP_SPLAT: flux of the grid */
+    grid g;
+    double fx, fy, r;
+    double f[PHOTON_CH];
+} store_op;
+
+static void prepare_splat(store_op *op, double *stored, float *out, grid g, double fx,
+                          double fy, double r)
+{
+    double rr = r > PHOTON_KERNEL_MAX ? PHOTON_KERNEL_MAX : r;
+    op->what = OP_SPLAT;
+    op->stored = stored;
+    op->out = out;
+    op->g = g;
+    op->fx = fx;
+    op->fy = fy;
+    op->r = r;
+    if (fx > -rr - 2.0 && fy > -rr - 2.0 && fx < (double)g.w + rr + 2.0 &&
+        fy < (double)g.h + rr + 2.0)
+        prefetch_rows(out, &op->g, (int)floor(fx - rr), (int)floor(fx + rr),
+                      (int)floor(fy - rr), (int)floor(fy + rr));
+}
+
 /* A photon on a wall: its block's facade chart or ambient term. */
-static void store_wall(photon_sys *ps, const trace_hit *h, const double f[PHOTON_CH])
+static void prepare_wall(photon_sys *ps, const trace_hit *h, store_op *op)
 {
     const scene *s = ps->s;
-    photon_stats *st = &ps->st;
     uint32_t k = s->bld[h->bld].block;
-    int L, c;
     photon_level *lv;
     size_t cs, base;
     double fx, fy;
+    int L;
     if (k >= s->nblocks || ps->eclass[h->edge] == PHOTON_EDGE_INTERNAL) {
-        st->lost += f[0];
+        op->what = OP_LOST;
         return;
     }
-    for (c = 0; c < PHOTON_CH; c++)
-        ps->bamb[(size_t)k * PHOTON_CH + (size_t)c] += f[c];
+    op->block = k;
     L = ps->blevel[k];
     if (L >= PHOTON_LEVELS) {
-        st->stored_ambient += f[0];
-        add_rgb(st->stored_rgb, f);
+        op->what = OP_AMBIENT;
         return;
     }
     lv = &ps->lev[L];
     cs = (size_t)lv->w * lv->h;
     base = (size_t)ps->bslot[k] * 2 * cs + (ps->eclass[h->edge] == PHOTON_EDGE_INNER ? cs : 0);
     chart_xy(ps, k, lv, h->p[0], h->p[1], h->p[2], &fx, &fy);
-    if (photon_splat(lv->flux + base * PHOTON_CH, lv->area + base, NULL, 0.0, lv->w, lv->h, 1,
-                     fx, fy, kernel_radius(&ps->cfg, lv->slot_frames[ps->bslot[k]]), f)) {
-        st->stored_chart += f[0];
-        add_rgb(st->stored_rgb, f);
-    } else
-        st->lost += f[0];
+    prepare_splat(op, &ps->st.stored_chart, lv->flux + base * PHOTON_CH,
+                  grid_full(lv->area + base, NULL, NULL, 0.0, lv->w, lv->h, 1), fx, fy,
+                  kernel_radius(&ps->cfg, lv->slot_frames[ps->bslot[k]]));
 }
 
 /* Where the progressive pass puts a photon arriving at h with weights f. */
-static void store_progressive(photon_sys *ps, uint32_t lamp, const trace_hit *h,
-                              const double f[PHOTON_CH])
+static void prepare_progressive(photon_sys *ps, uint32_t lamp, const trace_hit *h,
+                                const double f[PHOTON_CH], store_op *op)
 {
-    photon_stats *st = &ps->st;
     double fx, fy, r = kernel_radius(&ps->cfg, ps->gframes);
+    int c;
+    for (c = 0; c < PHOTON_CH; c++)
+        op->f[c] = f[c];
+    op->block = PHOTON_NONE;
     if (h->kind == TRACE_WALL) {
-        store_wall(ps, h, f);
+        prepare_wall(ps, h, op);
         return;
     }
     if (h->kind != TRACE_GROUND && h->kind != TRACE_ROOF) {
-        st->lost += f[0];
+        op->what = OP_LOST;
         return;
     }
     if (ps->refined[lamp]) {
-        st->skipped_refined += f[0];
+        op->what = OP_SKIPPED;
         return;
     }
-    photon_aerial_xy(ps, h->p[0], h->p[1], &fx, &fy);
-    if (h->kind == TRACE_GROUND && photon_covered_at(ps, h->p[0], h->p[1])) {
-        if (photon_splat_sparse(ps->cov_flux, ps->cov_area, ps->gcov, ps->gw, ps->gh, fx, fy, r,
-                                f)) {
-            st->stored_covered += f[0];
+    aerial_xy(ps, h->p[0], h->p[1], &fx, &fy);
+    if (h->kind == TRACE_GROUND && covered_at(ps, h->p[0], h->p[1]))
+        prepare_splat(op, &ps->st.stored_covered, ps->cov_flux,
+                      grid_full(ps->cov_area, NULL, ps->gcov, 0.0, ps->gw, ps->gh, 0), fx, fy, r);
+    else
+        prepare_splat(op, &ps->st.stored_aerial, ps->gflux,
+                      grid_full(ps->garea, ps->gheight, NULL, h->p[2], ps->gw, ps->gh, 0), fx,
+                      fy, r);
+}
+
+/* Splats a prepared photon and counts it. */
+static void commit_store(photon_sys *ps, const store_op *op)
+{
+    photon_stats *st = &ps->st;
+    const double *f = op->f;
+    int c;
+    if (op->block != PHOTON_NONE)
+        for (c = 0; c < PHOTON_CH; c++)
+            ps->bamb[(size_t)op->block * PHOTON_CH + (size_t)c] += f[c];
+    switch (op->what) {
+    case OP_LOST:
+        st->lost += f[0];
+        break;
+    case OP_SKIPPED:
+        st->skipped_refined += f[0];
+        break;
+    case OP_AMBIENT:
+        st->stored_ambient += f[0];
+        add_rgb(st->stored_rgb, f);
+        break;
+    default:
+        if (splat_any(op->out, &op->g, op->fx, op->fy, op->r, f)) {
+            *op->stored += f[0];
             add_rgb(st->stored_rgb, f);
         } else
             st->lost += f[0];
-        return;
+        break;
     }
-    if (photon_splat(ps->gflux, ps->garea, ps->gheight, h->p[2], ps->gw, ps->gh, 0, fx, fy, r,
-                     f)) {
-        st->stored_aerial += f[0];
-        add_rgb(st->stored_rgb, f);
-    } else
-        st->lost += f[0];
 }
 
-void photon_trace_lamp(photon_sys *ps, uint32_t lamp, double phi, uint64_t *rng,
+/* The photons prepared and not yet splatted (oldest at head). */
+#define STORE_QUEUE 4
+typedef struct store_queue {
+    store_op op[STORE_QUEUE];
+    unsigned head, n;
+} store_queue;
+
+static void store_step(photon_sys *ps, void *ctx, uint32_t lamp, const trace_hit *h,
+                       const double f[PHOTON_CH])
+{
+    store_queue *q = ctx;
+    if (q->n == STORE_QUEUE) {
+        commit_store(ps, &q->op[q->head]);
+        q->head = (q->head + 1) % STORE_QUEUE;
+        q->n--;
+    }
+    prepare_progressive(ps, lamp, h, f, &q->op[(q->head + q->n) % STORE_QUEUE]);
+    q->n++;
+}
+
+static void store_flush(photon_sys *ps, store_queue *q)
+{
+    while (q->n > 0) {
+        commit_store(ps, &q->op[q->head]);
+        q->head = (q->head + 1) % STORE_QUEUE;
+        q->n--;
+    }
+}
+
+static void trace_lamp(photon_sys *ps, uint32_t lamp, double phi, uint64_t *rng,
                        photon_stats *st, photon_store_fn store, void *ctx)
 {
     const scene_lamp *Lp = &ps->s->lamps[lamp];
-    double o[3], d[3], z, r, ph, f[PHOTON_CH], alb[3];
+    double o[3], d[3], f[PHOTON_CH], alb[3];
     trace_hit h;
     uint32_t b;
     int c;
     o[0] = Lp->x;
     o[1] = Lp->y;
     o[2] = Lp->z;
-    z = 1.0 - 2.0 * photon_rand01(rng);
-    r = sqrt(1.0 - z * z > 0.0 ? 1.0 - z * z : 0.0);
-    ph = 2.0 * PI * photon_rand01(rng);
-    d[0] = r * cos(ph);
-    d[1] = r * sin(ph);
-    d[2] = z;
+    sphere_dir(rng, d);
     st->photons++;
     st->emitted += phi;
     st->traced++;
     if (trace_lamp_ray(ps->T, lamp, d, &h) == TRACE_SKY)
         return;
-    f[0] = phi * photon_window(h.t / Lp->radius);
+    f[0] = phi * reach_window(h.t / Lp->radius);
     if (!(f[0] > 0.0))
         return;
     for (c = 0; c < 3; c++)
         f[1 + c] = f[0] * (double)Lp->color[c];
     st->first += f[0];
     for (b = 0; b < ps->cfg.max_bounces; b++) {
-        hit_albedo_rgb(ps->s, &h, alb);
-        if (!photon_bounce(f, alb, photon_rand01(rng))) {
+        hit_albedo_rgb(ps, &h, alb);
+        if (!bounce(f, alb, rng01(rng))) {
             st->absorbed += f[0];
             return;
         }
-        photon_cosine_dir(rng, h.n, d);
+        cosine_dir(rng, h.n, d);
         o[0] = h.p[0] + BOUNCE_OFFSET * h.n[0];
         o[1] = h.p[1] + BOUNCE_OFFSET * h.n[1];
         o[2] = h.p[2] + BOUNCE_OFFSET * h.n[2];
@@ -1350,11 +1627,10 @@ void photon_trace_lamp(photon_sys *ps, uint32_t lamp, double phi, uint64_t *rng,
     st->cut += f[0];
 }
 
-static void store_step(photon_sys *ps, void *ctx, uint32_t lamp, const trace_hit *h,
-                       const double f[PHOTON_CH])
+void photon_trace_lamp(photon_sys *ps, uint32_t lamp, double phi, uint64_t *rng,
+                       photon_stats *st, photon_store_fn store, void *ctx)
 {
-    (void)ctx;
-    store_progressive(ps, lamp, h, f);
+    trace_lamp(ps, lamp, phi, rng, st, store, ctx);
 }
 
 void photon_step(photon_sys *ps, uint32_t n, uint64_t seed)
@@ -1364,13 +1640,18 @@ void photon_step(photon_sys *ps, uint32_t n, uint64_t seed)
      * not share stream positions (stratified photons of one lamp take the
      * same indices every frame, and correlated streams froze their noise) */
     uint64_t rng = seed ^ 0x5bd1e9955bd1e995ull;
-    rng = photon_rand(&rng);
-    rng = photon_rand(&rng);
-    uint32_t k, lamp = 0;
+    rng = rng_next(&rng);
+    rng = rng_next(&rng);
+    uint32_t k, lamp = 0, prev = PHOTON_NONE;
     int L;
     double phi;
+    store_queue q;
+    q.head = q.n = 0;
     if (!ps || n == 0 || s->nlamps == 0 || !(ps->flux_total > 0.0))
         return;
+    trace_lamp_prefetch(ps->T, 0, 0);
+    trace_lamp_prefetch(ps->T, 1, 0);
+    trace_lamp_prefetch(ps->T, 2, 0);
     for (L = 0; L < PHOTON_LEVELS; L++) {
         photon_level *lv = &ps->lev[L];
         uint32_t i;
@@ -1384,7 +1665,7 @@ void photon_step(photon_sys *ps, uint32_t n, uint64_t seed)
     phi = ps->flux_total / n;
     for (k = 0; k < n; k++) {
         /* stratified choice of the lamp: the k-th of n equal flux shares */
-        double u = (k + photon_rand01(&rng)) / n * ps->flux_total;
+        double u = (k + rng01(&rng)) / n * ps->flux_total;
         while (lamp + 1 < s->nlamps && ps->lamp_cdf[lamp] <= u)
             lamp++;
         if (ps->lamp_cdf[lamp] <= u || (lamp > 0 && ps->lamp_cdf[lamp - 1] > u)) {
@@ -1399,8 +1680,16 @@ void photon_step(photon_sys *ps, uint32_t n, uint64_t seed)
             }
             lamp = lo;
         }
-        photon_trace_lamp(ps, lamp, phi, &rng, &ps->st, store_step, NULL);
+        if (lamp != prev) {
+            /* lamps come in order: fetch the next ones' tables early */
+            trace_lamp_prefetch(ps->T, lamp + 1, 2);
+            trace_lamp_prefetch(ps->T, lamp + 2, 1);
+            trace_lamp_prefetch(ps->T, lamp + 3, 0);
+            prev = lamp;
+        }
+        trace_lamp(ps, lamp, phi, &rng, &ps->st, store_step, &q);
     }
+    store_flush(ps, &q);
 }
 
 /* ---- lookup ------------------------------------------------------------------------ */
@@ -1454,10 +1743,10 @@ static void facade_lookup(const photon_sys *ps, const trace_hit *h, double e[PHO
 static void horizontal_lookup(const photon_sys *ps, const double P[3], double e[PHOTON_CH])
 {
     double fx, fy, night[PHOTON_CH];
-    int c, covered = P[2] <= HEIGHT_TOL && photon_covered_at(ps, P[0], P[1]);
+    int c, covered = P[2] <= HEIGHT_TOL && covered_at(ps, P[0], P[1]);
     for (c = 0; c < PHOTON_CH; c++)
         e[c] = 0.0;
-    photon_aerial_xy(ps, P[0], P[1], &fx, &fy);
+    aerial_xy(ps, P[0], P[1], &fx, &fy);
     if (ps->gframes > 0) {
         if (covered)
             photon_gather_sparse(ps->cov_flux, ps->cov_area, ps->gcov, ps->gw, ps->gh, fx, fy, e);

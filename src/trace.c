@@ -439,7 +439,8 @@ plx_status trace_create(arena *a, plx_part part, const scene *s, double cell_siz
                 w->zlo = B->min_height;
                 w->zhi = B->height;
                 w->bld = b;
-                w->pad[0] = w->pad[1] = w->pad[2] = 0;
+                w->pad = 0;
+                w->albedo = s->bld[b].albedo;
             }
         }
     }
@@ -474,6 +475,7 @@ typedef struct best {
     double ex, ey;     /* wall: its edge vector */
     const scene_building *bldv; /* the scene's buildings (prefetched at a hit) */
     double zc;         /* roof or underside: its height */
+    double albedo;     /* the building's */
     uint32_t bld, edge;
     int kind;
 } best;
@@ -503,6 +505,7 @@ static void wall_test(const trace_wall *w, uint32_t e, const double o[3], const 
     bs->ex = w->ex;
     bs->ey = w->ey;
     bs->bld = w->bld;
+    bs->albedo = w->albedo;
     bs->edge = e;
     TRACE_PREFETCH(bs->bldv + w->bld);
     bs->kind = TRACE_WALL;
@@ -589,6 +592,7 @@ static void cap_test(const tracer *T, uint32_t b, double zlo, double zhi, const 
     bs->t = t;
     bs->zc = zc;
     bs->bld = b;
+    bs->albedo = B->albedo;
     bs->edge = TRACE_NONE;
     bs->kind = kind;
 }
@@ -621,6 +625,7 @@ static int finish(const double o[3], const double d[3], const best *bs, trace_hi
 {
     h->t = bs->t;
     h->bld = bs->bld;
+    h->albedo = bs->albedo;
     h->edge = bs->edge;
     h->kind = bs->kind;
     h->p[0] = o[0] + bs->t * d[0];
@@ -659,6 +664,7 @@ static void ray_begin(tracer *T, const double o[3], const double d[3], double tm
     bs->ex = bs->ey = bs->zc = 0.0;
     bs->bldv = T->s->bld;
     bs->bld = TRACE_NONE;
+    bs->albedo = 0.0;
     bs->edge = TRACE_NONE;
     bs->kind = TRACE_SKY;
     if (d[2] < 0.0) {
@@ -818,6 +824,34 @@ int trace_lamp_ray(tracer *T, uint32_t lamp, const double d[3], trace_hit *h)
             cap_test(T, T->lref[k], -INFINITY, INFINITY, o, d, &bs);
     }
     return finish(o, d, &bs, h);
+}
+
+void trace_lamp_prefetch(const tracer *T, uint32_t lamp, int stage)
+{
+    const uint32_t *sec;
+    uint32_t k, k1;
+    if (lamp >= T->s->nlamps)
+        return;
+    sec = &T->lsec[(size_t)lamp * (TRACE_SECTORS + 2)];
+    if (stage == 0) {
+        TRACE_PREFETCH(sec);
+        TRACE_PREFETCH(sec + TRACE_SECTORS + 1);
+        TRACE_PREFETCH(T->lfast + lamp);
+        return;
+    }
+    if (!T->lfast[lamp])
+        return;
+    k1 = sec[TRACE_SECTORS + 1];
+    if (stage == 1) {
+        for (k = sec[0]; k < k1; k += 16)
+            TRACE_PREFETCH(T->lref + k);
+        if (k1 > sec[0])
+            TRACE_PREFETCH(T->lref + k1 - 1);
+        return;
+    }
+    k1 = sec[TRACE_SECTORS];
+    for (k = sec[0]; k < k1; k++)
+        TRACE_PREFETCH(T->walls + T->lref[k]);
 }
 
 int trace_ray_brute(tracer *T, const double o[3], const double d[3], double tmax, trace_hit *h)

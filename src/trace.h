@@ -18,7 +18,7 @@
  *   TRACE_SKY    nothing before tmax.
  *
  * Method. One record per wall (footprint edge: first vertex, edge vector,
- * the building's [min_height, height] and index; 64 bytes) and a
+ * the building's [min_height, height], index and albedo; 64 bytes) and a
  * uniform grid over the Bounds box; each cell lists
  *   - its walls (indices of every edge that comes within a hair of the
  *     cell: segment clipped to the padded cell box, Liang-Barsky), and
@@ -94,6 +94,9 @@ typedef struct trace_hit {
     double p[3];       /* hit point o + t d */
     double n[3];       /* unit normal out of the solid (+z for the ground) */
     uint32_t bld;      /* building, TRACE_NONE for ground and sky */
+    double albedo;     /* the building's albedo (scene_building.albedo; 0 for ground
+                          and sky): photons bounce on it, and it comes in the wall
+                          record or the building the test read anyway */
     uint32_t edge;     /* wall: index in scene.pts of the edge's first vertex */
     int kind;          /* TRACE_SKY, TRACE_GROUND, ... */
 } trace_hit;
@@ -120,8 +123,9 @@ typedef struct trace_wall {
     double ex, ey;     /* edge vector (next vertex - first) */
     double zlo, zhi;   /* the building's min_height and height */
     uint32_t bld;      /* the building */
-    uint32_t pad[3];   /* to 64 bytes: one cache line */
-} trace_wall;
+    uint32_t pad;
+    double albedo;     /* the building's (a hit's albedo comes with its wall) */
+} trace_wall;          /* 64 bytes: one cache line */
 
 /* A cell: its walls are wids[w0 .. next cell's w0), its buildings
  * ids[r0 .. next cell's r0) (r0 = start[c]); the tallest top, the lowest
@@ -188,6 +192,14 @@ int trace_ray(tracer *T, const double o[3], const double d[3], double tmax,
  * walks the grid.
  */
 int trace_lamp_ray(tracer *T, uint32_t lamp, const double d[3], trace_hit *h /* OUT */);
+
+/* Asks for the cache lines trace_lamp_ray will read for lamp (an index
+ * past the last lamp is ignored): stage 0 its table's offsets, stage 1
+ * (after stage 0 had time to arrive: it reads them) its wall and cap
+ * references. A caller that takes lamps in order (the photon pass) calls
+ * stage 1 for the next lamp and stage 0 for the one after. No effect on
+ * results. */
+void trace_lamp_prefetch(const tracer *T, uint32_t lamp, int stage);
 
 /* The same answer by the same wall and roof tests over every building (no
  * grid): checks the walk. */

@@ -14,7 +14,8 @@
  *    against a long run of the same estimator (convergence, not accuracy:
  *    tests/unit/test_photon.c checks accuracy against path tracing).
  *
- * Usage: bench_photon [FRAMES]   (default 20 timed passes)
+ * Usage: bench_photon [FRAMES [pass]]   (default 20 timed passes; "pass":
+ * stop after the photon pass, for profiling it)
  */
 #include <math.h>
 #include <stdio.h>
@@ -142,6 +143,37 @@ static uint64_t cpu_ns(void)
     struct timespec ts;
     clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
     return (uint64_t)ts.tv_sec * 1000000000u + (uint64_t)ts.tv_nsec;
+}
+
+/* The pass without its stores: photons like photon_step's (lamps taken
+ * in order by equal flux shares, the same tracing and roulette through
+ * photon_trace_lamp; not the lamp-table prefetch of photon_step) with a
+ * store that only counts: what the pass costs apart from storing. Returns
+ * thread CPU ms. */
+static void count_store(photon_sys *ps, void *ctx, uint32_t lamp, const trace_hit *h,
+                        const double f[PHOTON_CH])
+{
+    (void)ps;
+    (void)lamp;
+    (void)h;
+    (void)f;
+    ++*(uint64_t *)ctx;
+}
+
+static double pass_without_stores(photon_sys *ps, uint32_t n, uint64_t seed, uint64_t *stores)
+{
+    const scene *s = ps->s;
+    uint64_t rng = seed ^ 0x5bd1e9955bd1e995ull, c0 = cpu_ns();
+    photon_stats st;
+    uint32_t k, lamp = 0;
+    memset(&st, 0, sizeof st);
+    for (k = 0; k < n; k++) {
+        double u = (k + photon_rand01(&rng)) / n * ps->flux_total;
+        while (lamp + 1 < s->nlamps && ps->lamp_cdf[lamp] <= u)
+            lamp++;
+        photon_trace_lamp(ps, lamp, ps->flux_total / n, &rng, &st, count_store, stores);
+    }
+    return (cpu_ns() - c0) / 1e6;
 }
 
 /* Which caster new_vs_old times: 0 trace_ray, 1 trace_lamp_ray where the
@@ -372,6 +404,20 @@ int main(int argc, char **argv)
                100.0 * ps->st.stored_covered / ps->st.arrived,
                100.0 * ps->st.lost / ps->st.arrived);
     }
+    {
+        double best = 1e30;
+        uint64_t stores = 0;
+        for (i = 0; i < frames; i++) {
+            double c = pass_without_stores(ps, 65536, 2 + (uint64_t)i, &stores);
+            if (c < best)
+                best = c;
+        }
+        printf("  photons without storing (photon_trace_lamp, a store that only counts): "
+               "%.2f ms thread CPU min; %.0f stores per pass\n",
+               best, (double)stores / frames);
+    }
+    if (argc > 2 && strcmp(argv[2], "pass") == 0)
+        return 0;
 
     /* ---- the caster ---- */
     {
