@@ -22,7 +22,7 @@ static const char help[] =
     "\n"
     "  --points FILE  the points (required)\n"
     "  --photons N    photons per frame (default 65536)\n"
-    "  --frames K     progressive photon frames (default 128: 8.4M photons)\n"
+    "  --frames K     progressive photon frames (default 256: 16.8M photons)\n"
     "  --no-indirect  direct light only (E_indirect 0)\n"
     "  --mem SIZE, --strict, --quiet   as for 'polarlux info'\n";
 

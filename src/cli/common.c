@@ -187,7 +187,7 @@ int cli_open_scene(const char *cmd, const char *path, const cli_common *c, plx_e
 void cli_indirect_default(cli_indirect *ind)
 {
     ind->photons = 65536;
-    ind->frames = 128; /* 8.4M photons: the count whose error tests/unit/test_photon.c bounds by 10% */
+    ind->frames = 256; /* 16.8M photons: the count whose error tests/unit/test_photon.c bounds by 10% */
     ind->off = 0;
 }
 

@@ -1082,8 +1082,8 @@ static void test_accuracy_eixample(void **state)
     const scene *s = e->sc;
     photon_sys *ps;
     double P[16][3], N[16][3], ref[16];
-    int npts = 0, paths = full_mode() ? 40000 : quick_mode() ? 500 : 5000, k, i;
-    int frames = full_mode() ? 256 : quick_mode() ? 16 : 128;
+    int npts = 0, paths = full_mode() ? 160000 : quick_mode() ? 500 : 40000, k, i;
+    int frames = full_mode() ? 512 : quick_mode() ? 16 : 256;
     double bound = quick_mode() ? 0.40 : 0.10;
     double first_err = -1.0, last_err = 0.0, eye[3];
     uint64_t rs = 4242;
