@@ -744,6 +744,13 @@ static uint32_t wall_below(const polar *pd, const wgrid *g, int frame, vec2 f, i
  * counted from the bottom, as the piece below plus the piece's own change).
  * Every decision is a geom_orient sign or a lexicographic comparison. */
 
+/* A trapezoid of the search DAG's map (see "the search DAG" below). */
+typedef struct btrap {
+    uint32_t lp, rp, top, bot;
+    uint32_t nb[4];
+    uint32_t leaf;           /* its leaf node; POLAR_NONE: slot free */
+} btrap;
+
 typedef struct snode {
     vec2 l, r;          /* frame ends, l before r */
     int32_t cov;        /* footprints covering the gap above it */
@@ -765,9 +772,17 @@ typedef struct sweep {
     snode *N;           /* per segment (walls and Bounds sides) */
     polar_trap *T;
     uint32_t ntrap, cap;
-    const wgrid *g;     /* the grid of wall pieces */
     const uint32_t *inc_first, *inc; /* walls incident to each point */
-    uint32_t *start;    /* scratch: pieces starting at the event */
+    uint32_t *start, *tmp; /* scratch: pieces starting at the event */
+    /* the final map of the search DAG: per piece the trapezoid below /
+     * above it at its left end, per point one trapezoid with that left
+     * axis; each gap the sweep opens is one of them, whose child word it
+     * sets in word[], and regd[] keeps it per region */
+    const btrap *DT;
+    const uint32_t *below_l, *above_l, *right_of;
+    uint32_t *word, *regd;
+    uint32_t ngap;      /* gaps opened, free or solid */
+    uint64_t steps;     /* status pieces walked and start pieces sorted */
 } sweep;
 
 static int fp_before(const fpoint *a, const fpoint *b)
@@ -828,6 +843,77 @@ static uint32_t new_region(sweep *w, uint32_t lp, uint32_t top, uint32_t bot)
     return w->ntrap++;
 }
 
+/* The gap above bot opened at point pi (below top) is trapezoid d of the
+ * DAG's map: checked, and its child word set (region h, or solid).
+ * Returns 0, or -1 when the two maps differ. */
+static int open_gap(sweep *w, uint32_t d, uint32_t pi, uint32_t top, uint32_t bot, uint32_t h)
+{
+    const btrap *t;
+    if (d == POLAR_NONE)
+        return -1;
+    t = &w->DT[d];
+    if (t->lp != pi || t->top != top || t->bot != bot || w->word[d] != POLAR_NONE)
+        return -1;
+    w->word[d] = h != POLAR_NONE ? PACK(POLAR_CHILD_FREE, h) : w->N[bot].solid;
+    if (h != POLAR_NONE)
+        w->regd[h] = d;
+    w->ngap++;
+    return 0;
+}
+
+/* Does piece y start below piece x (both starting at the same point)?
+ * Sets *flat when they are collinear. */
+static int start_below(const snode *N, uint32_t y, uint32_t x, int *flat)
+{
+    int o = geom_orient(N[y].l, N[y].r, N[x].r);
+    if (o == 0)
+        *flat = 1;
+    return o > 0;
+}
+
+/* Sorts the n pieces w->start[] starting at one point bottom to top
+ * (insertion sort for a few, else bottom-up merge sort: O(n log n) at a
+ * point of any degree). Returns 0, or -1 when two are collinear (two
+ * neighbours in the order are always compared, so it is seen). */
+static int sort_starts(sweep *w, uint32_t n)
+{
+    const snode *N = w->N;
+    uint32_t *src = w->start, *dst = w->tmp, i, j, wd;
+    int flat = 0;
+    for (i = 0; i < n; i += 8) {
+        uint32_t e = i + 8 < n ? i + 8 : n;
+        for (j = i + 1; j < e; j++) {
+            uint32_t t = src[j], k = j;
+            while (k > i && start_below(N, t, src[k - 1], &flat)) {
+                src[k] = src[k - 1];
+                k--;
+            }
+            src[k] = t;
+        }
+    }
+    for (wd = 8; wd < n; wd *= 2) {
+        for (i = 0; i < n; i += 2 * wd) {
+            uint32_t a = i, am = i + wd < n ? i + wd : n, b = am, bm = i + 2 * wd < n ? i + 2 * wd : n;
+            uint32_t o = i;
+            while (a < am && b < bm)
+                dst[o++] = start_below(N, src[b], src[a], &flat) ? src[b++] : src[a++];
+            while (a < am)
+                dst[o++] = src[a++];
+            while (b < bm)
+                dst[o++] = src[b++];
+        }
+        {
+            uint32_t *t = src;
+            src = dst;
+            dst = t;
+        }
+    }
+    if (src != w->start)
+        memcpy(w->start, src, (size_t)n * 4);
+    w->steps += n;
+    return flat ? -1 : 0;
+}
+
 /* One event: the walls ending and starting at frame point P (point index
  * pi, the points pts[0..npts-1] all at P). Returns 0, or -1 when the walls
  * are not a planar subdivision (pieces crossing after rounding). */
@@ -843,24 +929,15 @@ static int sweep_event(sweep *w, vec2 P, uint32_t pi, const fpoint *pts, uint32_
         for (j = w->inc_first[p]; j < w->inc_first[p + 1]; j++) {
             uint32_t s = w->inc[j];
             if (lex_cmp(N[s].l, P) == 0) {
-                /* x above y: orient(y.l, y.r, x.r) > 0 */
-                uint32_t q = ns++;
-                while (q > 0) {
-                    int o = geom_orient(N[w->start[q - 1]].l, N[w->start[q - 1]].r, N[s].r);
-                    if (o == 0)
-                        return -1;
-                    if (o > 0)
-                        break;
-                    w->start[q] = w->start[q - 1];
-                    q--;
-                }
-                w->start[q] = s;
+                w->start[ns++] = s;
             } else {
                 nend++;
                 some_end = s;
             }
         }
     }
+    if (ns > 1 && sort_starts(w, ns) != 0)
+        return -1;
     /* B: the status piece below P */
     if (nend > 0) {
         x = some_end;
@@ -870,13 +947,17 @@ static int sweep_event(sweep *w, vec2 P, uint32_t pi, const fpoint *pts, uint32_
             x = y;
         B = N[x].prev;
     } else {
-        int on;
-        B = wall_below(w->pd, w->g, m->frame, P, 1, &on);
-        if (on)
+        /* only starts: the floor of the trapezoid below the lowest piece
+         * starting here, at its left end, in the DAG's map (the map has
+         * every piece: that floor is the piece below P just right of P,
+         * and no piece ends at P, so it is the status piece below P);
+         * checked to be in the status and strictly below P */
+        uint32_t d = ns ? w->below_l[w->start[0]] : POLAR_NONE;
+        if (d == POLAR_NONE)
             return -1;
-        if (B == POLAR_NONE)
-            B = m->box_bot;
-        else if (N[B].prev == POLAR_NONE)
+        B = w->DT[d].bot;
+        if (B != m->box_bot &&
+            (B >= w->pd->nseg || N[B].prev == POLAR_NONE || geom_orient(N[B].l, N[B].r, P) <= 0))
             return -1;
     }
     /* the pieces ending at P follow B */
@@ -884,6 +965,7 @@ static int sweep_event(sweep *w, vec2 P, uint32_t pi, const fpoint *pts, uint32_
         last = y;
         k++;
     }
+    w->steps += k + ns;
     if (k != nend)
         return -1;
     A = y;
@@ -919,6 +1001,9 @@ static int sweep_event(sweep *w, vec2 P, uint32_t pi, const fpoint *pts, uint32_
             if (h == POLAR_NONE)
                 return -1;
         }
+        if (open_gap(w, j ? w->above_l[bot] : ns ? w->below_l[w->start[0]] : w->right_of[pi],
+                     pi, top, bot, h) != 0)
+            return -1;
         N[bot].open = h;
         if (j == 0)
             H0 = h;
@@ -1001,12 +1086,6 @@ static plx_status build_incidence(arena *a, const polar *pd, uint32_t **inc_firs
  * as the sweep's events are), a solid one carries the owner that
  * polar_locate reports. */
 
-typedef struct btrap {
-    uint32_t lp, rp, top, bot;
-    uint32_t nb[4];
-    uint32_t leaf;           /* its leaf node; POLAR_NONE: slot free */
-} btrap;
-
 #define NODE_BITS 14
 #define NODE_CHUNK (1u << NODE_BITS)
 
@@ -1024,6 +1103,7 @@ typedef struct dbuild {
     const snode *N;          /* per piece: frame ends, left first (the sweep's) */
     uint32_t *hint;          /* per canonical point: its x node, POLAR_NONE */
     int fail;                /* 1: out of memory, 2: pieces not planar */
+    uint64_t steps;          /* search nodes and trapezoids visited */
 } dbuild;
 
 static uint32_t *dnode(const dbuild *b, uint32_t n)
@@ -1083,7 +1163,7 @@ static uint32_t ykind(const dbuild *b, uint32_t s)
  * trapezoid that held P when it came in, holds everything just right of P). */
 static uint32_t find_first(dbuild *b, uint32_t n, vec2 P, vec2 Q)
 {
-    for (;;) {
+    for (;; b->steps++) {
         const uint32_t *nd = dnode(b, n);
         uint32_t w = nd[0];
         if (KIND(w) == N_LEAF)
@@ -1108,7 +1188,7 @@ static uint32_t find_first(dbuild *b, uint32_t n, vec2 P, vec2 Q)
  * its x node, with Q pushed towards P (ties at Q go left). */
 static uint32_t find_last(dbuild *b, uint32_t n, vec2 Q, vec2 P)
 {
-    for (;;) {
+    for (;; b->steps++) {
         const uint32_t *nd = dnode(b, n);
         uint32_t w = nd[0];
         if (KIND(w) == N_LEAF)
@@ -1153,7 +1233,10 @@ static uint32_t follow_back(dbuild *b, uint32_t t, vec2 P, vec2 Q)
     while (lex_cmp(P, bpt(b, b->T[t].lp)) < 0) {
         int o = geom_orient(P, Q, bpt(b, b->T[t].lp));
         uint32_t nx = o > 0 ? b->T[t].nb[LL] : b->T[t].nb[UL];
-        if (o == 0 || nx == POLAR_NONE || k + 1 >= b->cap) {
+        /* the neighbour must be live and share the axis: the walk moves
+         * strictly leftwards, whatever the input */
+        if (o == 0 || nx == POLAR_NONE || k + 1 >= b->cap || b->T[nx].leaf == POLAR_NONE ||
+            b->T[nx].rp != b->T[t].lp) {
             b->fail = 2;
             return k;
         }
@@ -1186,7 +1269,8 @@ static uint32_t follow(dbuild *b, uint32_t l, uint32_t r)
         uint32_t t = b->list[k], nx;
         int o = geom_orient(P, Q, bpt(b, b->T[t].rp));
         nx = o > 0 ? b->T[t].nb[LR] : b->T[t].nb[UR];
-        if (o == 0 || nx == POLAR_NONE || k + 1 >= b->cap) {
+        if (o == 0 || nx == POLAR_NONE || k + 1 >= b->cap || b->T[nx].leaf == POLAR_NONE ||
+            b->T[nx].lp != b->T[t].rp) {
             b->fail = 2;
             return k;
         }
@@ -1316,6 +1400,7 @@ static void insert_seg(dbuild *b, uint32_t s, uint32_t rl, uint32_t rr)
     k = follow(b, l, r);
     if (b->fail)
         return;
+    b->steps += k + 1;
     first = b->list[0];
     last = b->list[k];
     for (j = 0; j < 4; j++) {
@@ -1365,34 +1450,6 @@ static uint64_t rng_step(uint64_t *st)
     return x;
 }
 
-static uint32_t trap_hash(uint32_t top, uint32_t bot, uint32_t lp, uint32_t mask)
-{
-    uint32_t h = top * 0x9e3779b1u ^ bot * 0x85ebca6bu ^ lp * 0xc2b2ae35u;
-    h ^= h >> 15;
-    h *= 0x2c1b3c6du;
-    h ^= h >> 12;
-    return h & mask;
-}
-
-/* The child word of DAG trapezoid t (see the section comment); POLAR_NONE
- * when a free trapezoid has no region of the sweep. */
-static uint32_t leaf_word(const dbuild *b, const sweep *w, const uint32_t *hash, uint32_t mask,
-                          uint8_t *hit, uint32_t t)
-{
-    const btrap *x = &b->T[t];
-    uint32_t h;
-    if (w->N[x->bot].cov != 0)
-        return w->N[x->bot].solid;
-    for (h = trap_hash(x->top, x->bot, x->lp, mask); hash[h] != POLAR_NONE; h = (h + 1) & mask) {
-        const polar_trap *r = &w->T[hash[h]];
-        if (r->top == x->top && r->bot == x->bot && r->lp == x->lp) {
-            hit[hash[h]] = 1;
-            return PACK(POLAR_CHILD_FREE, hash[h]);
-        }
-    }
-    return POLAR_NONE;
-}
-
 /* Child word c (tag << 30 | index) in the narrow form, tag << 19 | index. */
 static uint64_t narrow_child(uint32_t c)
 {
@@ -1414,45 +1471,26 @@ static void put_node(polar_map *m, uint32_t j, uint32_t t, uint32_t c0, uint32_t
     }
 }
 
-/* Leaves to child words, the inner nodes kept in the order they were made
- * (the top levels first; with the insertion order, nodes made together lie
- * together), narrow when every index fits, and counted in polar_memory
- * (rest). */
-static plx_status dag_keep(arena *a, polar *pd, polar_map *m, dbuild *b, const sweep *w,
+/* Leaves to child words (word[]: per trapezoid slot, set by the sweep),
+ * the inner nodes kept in the order they were made (the top levels first;
+ * with the insertion order, nodes made together lie together), narrow when
+ * every index fits, and counted in polar_memory (rest). */
+static plx_status dag_keep(arena *a, polar *pd, polar_map *m, dbuild *b, const uint32_t *word,
                            int flags)
 {
-    uint32_t mask = 1, i, j, nq = 0, *hash, *fw;
-    uint8_t *hit;
-    while (mask < 2 * w->ntrap + 2)
-        mask *= 2;
-    hash = scratch_n(a, mask, 4);
-    hit = scratch_n(a, w->ntrap, 1);
-    fw = scratch_n(a, b->nnode, 4);
-    if (!hash || !hit || !fw)
+    uint32_t i, j, nq = 0, *fw = scratch_n(a, b->nnode, 4);
+    if (!fw)
         return PLX_E_NOMEM;
-    mask--;
-    memset(hash, 0xff, ((size_t)mask + 1) * 4);
-    memset(hit, 0, w->ntrap);
-    for (i = 0; i < w->ntrap; i++) {
-        const polar_trap *r = &w->T[i];
-        uint32_t h = trap_hash(r->top, r->bot, r->lp, mask);
-        while (hash[h] != POLAR_NONE)
-            h = (h + 1) & mask;
-        hash[h] = i;
-    }
     /* fw: per build node its child word */
     for (i = 0; i < b->nnode; i++) {
         uint32_t w0 = dnode(b, i)[0];
         if (KIND(w0) != N_LEAF)
             fw[i] = PACK(POLAR_CHILD_NODE, nq++);
-        else if ((fw[i] = leaf_word(b, w, hash, mask, hit, IDX(w0))) == POLAR_NONE)
+        else if ((fw[i] = word[IDX(w0)]) == POLAR_NONE)
             return PLX_E_SCENE;
     }
-    for (i = 0; i < w->ntrap; i++)    /* every region of positive width is a leaf */
-        if (!hit[i] && lex_cmp(bpt(b, w->T[i].lp), bpt(b, w->T[i].rp)) < 0)
-            return PLX_E_SCENE;
     m->nnode = nq;
-    m->narrow = !(flags & POLAR_BUILD_WIDE_DAG) && nq < (1u << 19) && w->ntrap < (1u << 19) &&
+    m->narrow = !(flags & POLAR_BUILD_WIDE_DAG) && nq < (1u << 19) && m->ntrap < (1u << 19) &&
                 pd->nbld < (1u << 19) - 1 && pd->npts < (1u << 20) && pd->nseg < (1u << 20);
     m->node = keep_n(a, nq, m->narrow ? 8 : 12, &pd->bytes[3]);
     if (!m->node)
@@ -1517,73 +1555,114 @@ static plx_status insertion_order(arena *a, const polar *pd, uint32_t **out)
     return PLX_OK;
 }
 
-/* Builds the search DAG of map m (after its sweep w). */
-static plx_status build_dag(arena *a, polar *pd, polar_map *m, const sweep *w,
-                            const uint32_t *canon, const uint32_t *order, uint32_t nends,
-                            int flags)
+/* Builds the trapezoidal map of the wall pieces of m and its search DAG by
+ * randomized incremental insertion, into b (scratch). N: the pieces' frame
+ * ends (the sweep's snodes). */
+static plx_status build_dag(arena *a, polar *pd, polar_map *m, dbuild *b, const snode *N,
+                            const uint32_t *canon, const uint32_t *order, uint32_t nends)
 {
-    dbuild b;
     uint32_t nw = pd->nwall, i, t;
     if (nw >= (1u << 26) || pd->npts >= (1u << 26))
         return PLX_E_NOMEM;   /* indices must fit in 30 bits */
-    memset(&b, 0, sizeof b);
-    b.pd = pd;
-    b.a = a;
-    b.frame = m->frame;
-    b.canon = canon;
-    b.N = w->N;
+    memset(b, 0, sizeof *b);
+    b->pd = pd;
+    b->a = a;
+    b->frame = m->frame;
+    b->canon = canon;
+    b->N = N;
     /* trapezoid slots: at most 3 i + 1 live after i pieces; a new piece
      * crosses one trapezoid more than the axes it cuts, at most one per
      * wall end, and makes two per crossed one plus two: 3 n + 2 ends + 64 */
-    b.cap = 3 * nw + 2 * nends + 64;
+    b->cap = 3 * nw + 2 * nends + 64;
     /* expected about 8 nodes per piece; beyond 64 the shuffle has failed
      * beyond any reasonable chance (reported as out of memory) */
-    b.maxchunk = (uint32_t)(((uint64_t)64 * nw + 1024) >> NODE_BITS) + 1;
-    if (b.maxchunk > (1u << (30 - NODE_BITS)))
-        b.maxchunk = 1u << (30 - NODE_BITS);
-    b.T = scratch_n(a, b.cap, sizeof(btrap));
-    b.freel = scratch_n(a, b.cap, 4);
-    b.list = scratch_n(a, b.cap, 4);
-    b.up = scratch_n(a, b.cap, 4);
-    b.lo = scratch_n(a, b.cap, 4);
-    b.chunk = scratch_n(a, b.maxchunk, sizeof *b.chunk);
-    b.hint = scratch_n(a, pd->npts, 4);
-    if (!b.T || !b.freel || !b.list || !b.up || !b.lo || !b.chunk || !b.hint)
+    b->maxchunk = (uint32_t)(((uint64_t)64 * nw + 1024) >> NODE_BITS) + 1;
+    if (b->maxchunk > (1u << (30 - NODE_BITS)))
+        b->maxchunk = 1u << (30 - NODE_BITS);
+    b->T = scratch_n(a, b->cap, sizeof(btrap));
+    b->freel = scratch_n(a, b->cap, 4);
+    b->list = scratch_n(a, b->cap, 4);
+    b->up = scratch_n(a, b->cap, 4);
+    b->lo = scratch_n(a, b->cap, 4);
+    b->chunk = scratch_n(a, b->maxchunk, sizeof *b->chunk);
+    b->hint = scratch_n(a, pd->npts, 4);
+    if (!b->T || !b->freel || !b->list || !b->up || !b->lo || !b->chunk || !b->hint)
         return PLX_E_NOMEM;
-    memset(b.hint, 0xff, (size_t)pd->npts * 4);
-    t = new_trap(&b);
-    set_trap(&b, t, m->box_lo, m->box_hi, m->box_top, m->box_bot);
-    b.T[t].leaf = new_node(&b, N_LEAF, t, 0, 0);
-    for (i = 0; i < nw && !b.fail; i++)
-        insert_seg(&b, order[i], w->N[order[i]].li, w->N[order[i]].ri);
-    if (b.fail)
-        return b.fail == 1 ? PLX_E_NOMEM : PLX_E_SCENE;
-    return dag_keep(a, pd, m, &b, w, flags);
+    memset(b->hint, 0xff, (size_t)pd->npts * 4);
+    t = new_trap(b);
+    set_trap(b, t, m->box_lo, m->box_hi, m->box_top, m->box_bot);
+    b->T[t].leaf = new_node(b, N_LEAF, t, 0, 0);
+    for (i = 0; i < nw && !b->fail; i++)
+        insert_seg(b, order[i], N[order[i]].li, N[order[i]].ri);
+    if (b->fail)
+        return b->fail == 1 ? PLX_E_NOMEM : PLX_E_SCENE;
+    return PLX_OK;
 }
 
-/* Builds the trapezoidal map of one frame: the sweep, whose free regions
- * are kept, then (unless flags say otherwise) the search DAG. */
-static plx_status build_map(arena *a, polar *pd, polar_map *m, const wgrid *g,
-                            const uint32_t *inc_first, const uint32_t *inc, const uint32_t *evp,
-                            uint32_t nev, const uint32_t *order, int flags)
+/* Indexes the final map of b for the sweep: per piece the trapezoid below
+ * and above it at its (canonical) left end, per point one trapezoid whose
+ * left axis is that point's; w->word[] cleared. Also counts the live
+ * trapezoids into *nlive. */
+static plx_status index_map(arena *a, const polar *pd, const dbuild *b, const uint32_t *canon,
+                            sweep *w, uint32_t *nlive)
+{
+    uint32_t *bl = scratch_n(a, pd->nseg, 4), *al = scratch_n(a, pd->nseg, 4);
+    uint32_t *ro = scratch_n(a, pd->npts, 4), *word = scratch_n(a, b->ntrap, 4), t, n = 0;
+    if (!bl || !al || !ro || !word)
+        return PLX_E_NOMEM;
+    memset(bl, 0xff, (size_t)pd->nseg * 4);
+    memset(al, 0xff, (size_t)pd->nseg * 4);
+    memset(ro, 0xff, (size_t)pd->npts * 4);
+    memset(word, 0xff, (size_t)b->ntrap * 4);
+    for (t = 0; t < b->ntrap; t++) {
+        const btrap *x = &b->T[t];
+        if (x->leaf == POLAR_NONE)
+            continue;
+        n++;
+        if (canon[w->N[x->top].li] == x->lp)
+            bl[x->top] = t;
+        if (canon[w->N[x->bot].li] == x->lp)
+            al[x->bot] = t;
+        ro[x->lp] = t;
+    }
+    w->DT = b->T;
+    w->below_l = bl;
+    w->above_l = al;
+    w->right_of = ro;
+    w->word = word;
+    *nlive = n;
+    return PLX_OK;
+}
+
+/* Builds the trapezoidal map of one frame: the search DAG's map by
+ * randomized insertion, then the sweep, which uses it to place the events
+ * where pieces only start, checks that the pieces form a planar
+ * subdivision and that both maps agree, and makes the free regions (kept,
+ * in sweep order, with their adjacency); then the DAG is kept with its
+ * leaves mapped to those regions (unless flags say otherwise). */
+static plx_status build_map(arena *a, polar *pd, polar_map *m, const uint32_t *inc_first,
+                            const uint32_t *inc, const uint32_t *evp, uint32_t nev,
+                            const uint32_t *order, int flags, uint64_t *steps)
 {
     sweep w;
+    dbuild b;
     fpoint *ev, *tmp;
-    uint32_t i, j, s, t, *canon;
+    uint32_t i, j, s, t, *canon, nlive;
+    plx_status st;
     memset(&w, 0, sizeof w);
     w.pd = pd;
     w.m = m;
-    w.g = g;
     w.inc_first = inc_first;
     w.inc = inc;
     w.cap = 3 * pd->nwall + 8;
     w.N = scratch_n(a, pd->nseg, sizeof(snode));
     w.T = scratch_n(a, w.cap, sizeof(polar_trap));
     w.start = scratch_n(a, pd->nwall + 1, 4);
+    w.tmp = scratch_n(a, pd->nwall + 1, 4);
     ev = scratch_n(a, nev, sizeof(fpoint));
     tmp = scratch_n(a, nev, sizeof(fpoint));
     canon = scratch_n(a, pd->npts, 4);
-    if (!w.N || !w.T || !w.start || !ev || !tmp || !canon)
+    if (!w.N || !w.T || !w.start || !w.tmp || !ev || !tmp || !canon)
         return PLX_E_NOMEM;
     frame_box(pd, m);
     for (s = 0; s < pd->nseg; s++) {
@@ -1606,7 +1685,6 @@ static plx_status build_map(arena *a, polar *pd, polar_map *m, const wgrid *g,
         w.N[s].open = POLAR_NONE;
         w.N[s].prev = w.N[s].next = POLAR_NONE;
     }
-    w.N[m->box_bot].open = new_region(&w, m->box_lo, m->box_top, m->box_bot);
     for (i = 0; i < nev; i++) {
         ev[i].f = fpt(pd, m->frame, evp[i]);
         ev[i].i = evp[i];
@@ -1614,18 +1692,38 @@ static plx_status build_map(arena *a, polar *pd, polar_map *m, const wgrid *g,
     sort_fpoints(ev, tmp, nev);
     for (i = 0; i < pd->npts; i++)
         canon[i] = i;
-    for (i = 0; i < nev; i = j) {
+    for (i = 0; i < nev; i = j)
         for (j = i + 1; j < nev && lex_cmp(ev[j].f, ev[i].f) == 0; j++)
             canon[ev[j].i] = ev[i].i;
+    st = build_dag(a, pd, m, &b, w.N, canon, order, nev);
+    if (st == PLX_OK)
+        st = index_map(a, pd, &b, canon, &w, &nlive);
+    if (st != PLX_OK)
+        return st;
+    w.regd = scratch_n(a, w.cap, 4);
+    if (!w.regd)
+        return PLX_E_NOMEM;
+    w.N[m->box_bot].open = new_region(&w, m->box_lo, m->box_top, m->box_bot);
+    if (open_gap(&w, w.above_l[m->box_bot], m->box_lo, m->box_top, m->box_bot,
+                 w.N[m->box_bot].open) != 0)
+        return PLX_E_SCENE;
+    for (i = 0; i < nev; i = j) {
+        for (j = i + 1; j < nev && lex_cmp(ev[j].f, ev[i].f) == 0; j++)
+            ;
         if (sweep_event(&w, ev[i].f, ev[i].i, ev + i, j - i) != 0)
             return PLX_E_SCENE;
     }
     if (w.N[m->box_bot].next != POLAR_NONE || w.N[m->box_bot].open == POLAR_NONE)
         return PLX_E_SCENE;
     w.T[w.N[m->box_bot].open].rp = m->box_hi;
+    /* both maps the same: every live trapezoid of the DAG's map is one gap
+     * of the sweep, with the same sides */
     for (t = 0; t < w.ntrap; t++)
-        if (w.T[t].rp == POLAR_NONE)
+        if (w.T[t].rp == POLAR_NONE || b.T[w.regd[t]].rp != w.T[t].rp)
             return PLX_E_SCENE;
+    if (w.ngap != nlive)
+        return PLX_E_SCENE;
+    *steps += w.steps + b.steps;
     m->ntrap = w.ntrap;
     m->trap = keep_n(a, w.ntrap, sizeof(polar_trap), &pd->bytes[0]);
     if (!m->trap)
@@ -1634,9 +1732,9 @@ static plx_status build_map(arena *a, polar *pd, polar_map *m, const wgrid *g,
     /* polar_memory: the axes (lp, rp, nb) and the regions (top, bot) */
     pd->bytes[0] -= (size_t)w.ntrap * 8;
     pd->bytes[1] += (size_t)w.ntrap * 8;
-    if (!order)
+    if (flags & POLAR_BUILD_NO_DAG)
         return PLX_OK;
-    return build_dag(a, pd, m, &w, canon, order, nev, flags);
+    return dag_keep(a, pd, m, &b, w.word, flags);
 }
 
 /* Cuts the occluders' edges into wall pieces (pd->pts, pd->seg filled). */
@@ -1778,7 +1876,6 @@ plx_status polar_build_flags(arena *a, const scene *s, int flags, polar **out)
     arena_mark m0, m1;
     polar *pd;
     plx_status st;
-    wgrid g;
     uint32_t *inc_first = NULL, *inc = NULL, *evp = NULL, *order = NULL, nev = 0, i;
     if (!a || !s || !out)
         return PLX_E_INVALID;
@@ -1795,15 +1892,13 @@ plx_status polar_build_flags(arena *a, const scene *s, int flags, polar **out)
     pd->bytes[3] = sizeof(polar);
     st = make_walls(a, pd);
     if (st == PLX_OK)
-        st = build_grid(a, pd, &g, 0);
-    if (st == PLX_OK)
         st = build_incidence(a, pd, &inc_first, &inc, &evp, &nev);
-    if (st == PLX_OK && !(flags & POLAR_BUILD_NO_DAG))
+    if (st == PLX_OK)
         st = insertion_order(a, pd, &order);
     for (i = 0; st == PLX_OK && i < 2; i++) {
         arena_mark mm = arena_get_mark(a);
         pd->map[i].frame = (int)i;
-        st = build_map(a, pd, &pd->map[i], &g, inc_first, inc, evp, nev, order, flags);
+        st = build_map(a, pd, &pd->map[i], inc_first, inc, evp, nev, order, flags, &pd->steps);
         /* give back this map's scratch (kept memory grows from the other end) */
         mm.lo = a->lo;
         mm.used[PLX_PART_POLAR] = a->used[PLX_PART_POLAR];

@@ -138,6 +138,9 @@ typedef struct polar {
     double box[4];           /* s->bounds */
     polar_map map[2];        /* [0]: quadrants 0, 2   [1]: quadrants 1, 3 */
     size_t bytes[4];         /* axes, regions, polygons, rest (search DAGs, header) */
+    uint64_t steps;          /* construction work, for tests: DAG nodes and
+                              * trapezoids visited by the insertions, status
+                              * pieces walked and sorted by the sweeps */
 } polar;
 
 /* Builds the four diagrams of scene s. On success *out points into arena
