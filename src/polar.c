@@ -1100,7 +1100,9 @@ typedef struct dbuild {
     uint32_t nchunk, maxchunk, nnode;
     uint32_t *list, *up, *lo; /* per crossed trapezoid: it, its new upper / lower part */
     const uint32_t *canon;   /* per point: the first point at its position */
-    const snode *N;          /* per piece: frame ends, left first (the sweep's) */
+    const snode *N;          /* per piece: the sweep's data (y test kind) */
+    const vec2 *E;           /* per piece: frame ends, left then right */
+    vec2 P, Q;               /* the piece being inserted: its frame ends */
     uint32_t *hint;          /* per canonical point: its x node, POLAR_NONE */
     int fail;                /* 1: out of memory, 2: pieces not planar */
     uint64_t steps;          /* search nodes and trapezoids visited */
@@ -1158,6 +1160,12 @@ static uint32_t ykind(const dbuild *b, uint32_t s)
     return b->N[s].yk;
 }
 
+/* One insertion, its data gathered beforehand (in insertion order). */
+typedef struct irec {
+    vec2 P, Q;               /* frame ends, left first */
+    uint32_t s, l, r;        /* the piece, its canonical end points */
+} irec;
+
 /* Descends the DAG with the left end P of a new piece PQ, from node n:
  * the root, or the x node of P if P is already in the map (its cell, the
  * trapezoid that held P when it came in, holds everything just right of P). */
@@ -1171,10 +1179,10 @@ static uint32_t find_first(dbuild *b, uint32_t n, vec2 P, vec2 Q)
         if (KIND(w) == N_X) {
             n = lex_cmp(P, bpt(b, IDX(w))) < 0 ? nd[1] : nd[2];
         } else {
-            const snode *g = &b->N[IDX(w)];
-            int o = geom_orient(g->l, g->r, P);
+            const vec2 *g = &b->E[2 * (size_t)IDX(w)];
+            int o = geom_orient(g[0], g[1], P);
             if (o == 0)
-                o = geom_orient(g->l, g->r, Q);   /* a shared left end: the slopes */
+                o = geom_orient(g[0], g[1], Q);   /* a shared left end: the slopes */
             if (o == 0) {
                 b->fail = 2;
                 return POLAR_NONE;
@@ -1196,10 +1204,10 @@ static uint32_t find_last(dbuild *b, uint32_t n, vec2 Q, vec2 P)
         if (KIND(w) == N_X) {
             n = lex_cmp(Q, bpt(b, IDX(w))) <= 0 ? nd[1] : nd[2];
         } else {
-            const snode *g = &b->N[IDX(w)];
-            int o = geom_orient(g->l, g->r, Q);
+            const vec2 *g = &b->E[2 * (size_t)IDX(w)];
+            int o = geom_orient(g[0], g[1], Q);
             if (o == 0)
-                o = geom_orient(g->l, g->r, P);
+                o = geom_orient(g[0], g[1], P);
             if (o == 0) {
                 b->fail = 2;
                 return POLAR_NONE;
@@ -1256,7 +1264,7 @@ static uint32_t follow_back(dbuild *b, uint32_t t, vec2 P, vec2 Q)
  * leftwards), or at the root. */
 static uint32_t follow(dbuild *b, uint32_t l, uint32_t r)
 {
-    vec2 P = bpt(b, l), Q = bpt(b, r);
+    vec2 P = b->P, Q = b->Q;
     uint32_t k = 0;
     if (b->hint[l] == POLAR_NONE && b->hint[r] != POLAR_NONE) {
         uint32_t t = find_last(b, b->hint[r], Q, P);
@@ -1282,7 +1290,7 @@ static uint32_t follow(dbuild *b, uint32_t l, uint32_t r)
 /* Builds the chain of new trapezoids above (up = 1) or below the piece. */
 static void make_chain(dbuild *b, uint32_t s, uint32_t l, uint32_t r, uint32_t k, int up)
 {
-    vec2 P = bpt(b, l), Q = bpt(b, r);
+    vec2 P = b->P, Q = b->Q;
     uint32_t *part = up ? b->up : b->lo;
     uint32_t j, cur = new_trap(b);
     int fo = up ? UL : LL, fc = up ? UR : LR;     /* outer-side links */
@@ -1393,10 +1401,12 @@ static void replace_leaf(dbuild *b, uint32_t s, uint32_t l, uint32_t r, uint32_t
 }
 
 /* Inserts wall piece s (raw ends rl < rr in the frame). */
-static void insert_seg(dbuild *b, uint32_t s, uint32_t rl, uint32_t rr)
+static void insert_seg(dbuild *b, const irec *in)
 {
-    uint32_t l = b->canon[rl], r = b->canon[rr], k, j, first, last;
+    uint32_t s = in->s, l = in->l, r = in->r, k, j, first, last;
     uint32_t A = POLAR_NONE, B = POLAR_NONE, fnb[4], lnb[4];
+    b->P = in->P;
+    b->Q = in->Q;
     k = follow(b, l, r);
     if (b->fail)
         return;
@@ -1407,12 +1417,12 @@ static void insert_seg(dbuild *b, uint32_t s, uint32_t rl, uint32_t rr)
         fnb[j] = b->T[first].nb[j];
         lnb[j] = b->T[last].nb[j];
     }
-    if (lex_cmp(bpt(b, l), bpt(b, b->T[first].lp)) > 0) {
+    if (lex_cmp(b->P, bpt(b, b->T[first].lp)) > 0) {
         A = new_trap(b);
         if (!b->fail)
             set_trap(b, A, b->T[first].lp, l, b->T[first].top, b->T[first].bot);
     }
-    if (!b->fail && lex_cmp(bpt(b, r), bpt(b, b->T[last].rp)) < 0) {
+    if (!b->fail && lex_cmp(b->Q, bpt(b, b->T[last].rp)) < 0) {
         B = new_trap(b);
         if (!b->fail)
             set_trap(b, B, r, b->T[last].rp, b->T[last].top, b->T[last].bot);
@@ -1562,6 +1572,8 @@ static plx_status build_dag(arena *a, polar *pd, polar_map *m, dbuild *b, const 
                             const uint32_t *canon, const uint32_t *order, uint32_t nends)
 {
     uint32_t nw = pd->nwall, i, t;
+    vec2 *E;
+    irec *rec;
     if (nw >= (1u << 26) || pd->npts >= (1u << 26))
         return PLX_E_NOMEM;   /* indices must fit in 30 bits */
     memset(b, 0, sizeof *b);
@@ -1586,14 +1598,32 @@ static plx_status build_dag(arena *a, polar *pd, polar_map *m, dbuild *b, const 
     b->lo = scratch_n(a, b->cap, 4);
     b->chunk = scratch_n(a, b->maxchunk, sizeof *b->chunk);
     b->hint = scratch_n(a, pd->npts, 4);
-    if (!b->T || !b->freel || !b->list || !b->up || !b->lo || !b->chunk || !b->hint)
+    b->E = E = scratch_n(a, 2 * (size_t)pd->nseg, sizeof(vec2));
+    rec = scratch_n(a, nw, sizeof(irec));
+    if (!b->T || !b->freel || !b->list || !b->up || !b->lo || !b->chunk || !b->hint || !E ||
+        !rec)
         return PLX_E_NOMEM;
+    /* what the insertions read, packed: the ends of every piece, and per
+     * insertion its piece (gathered here, where the loads do not wait on
+     * one another) */
+    for (i = 0; i < pd->nseg; i++) {
+        E[2 * (size_t)i] = N[i].l;
+        E[2 * (size_t)i + 1] = N[i].r;
+    }
+    for (i = 0; i < nw; i++) {
+        const snode *g = &N[order[i]];
+        rec[i].P = g->l;
+        rec[i].Q = g->r;
+        rec[i].s = order[i];
+        rec[i].l = canon[g->li];
+        rec[i].r = canon[g->ri];
+    }
     memset(b->hint, 0xff, (size_t)pd->npts * 4);
     t = new_trap(b);
     set_trap(b, t, m->box_lo, m->box_hi, m->box_top, m->box_bot);
     b->T[t].leaf = new_node(b, N_LEAF, t, 0, 0);
     for (i = 0; i < nw && !b->fail; i++)
-        insert_seg(b, order[i], N[order[i]].li, N[order[i]].ri);
+        insert_seg(b, &rec[i]);
     if (b->fail)
         return b->fail == 1 ? PLX_E_NOMEM : PLX_E_SCENE;
     return PLX_OK;
