@@ -113,6 +113,15 @@ static int32_t seg_delta(const polar *pd, int frame, uint32_t s)
     return fwd ? g->cover : -g->cover;
 }
 
+/* n items of size bytes of arena scratch. */
+static void *scratch_n(arena *a, size_t n, size_t size)
+{
+    size_t bytes = arena_mul(n ? n : 1, size);
+    if (bytes == SIZE_MAX)
+        return NULL;
+    return arena_scratch(a, bytes, 16);
+}
+
 /* ---- wall pieces ------------------------------------------------------- */
 
 typedef struct split {
@@ -349,26 +358,89 @@ static int cmp_keyed(const void *x, const void *y)
     return (a->idx > b->idx) - (a->idx < b->idx);
 }
 
-/* Sweep over x of building boxes: every pair of occluders whose closed
- * boxes meet has its edges compared. */
-static void find_contacts(split_ctx *c, const scene *s, keyed *order, uint32_t nocc,
-                          uint32_t *active)
+/* The active boxes of find_contacts: a complete binary tree over the
+ * ranks of the occluders' lower y, each node holding the greatest upper y
+ * of the active boxes below it (-DBL_MAX: none). */
+typedef struct ytree {
+    uint32_t size;           /* leaves, a power of two */
+    double *mx;              /* nodes 1 .. 2 size - 1, leaves from size */
+    uint32_t *who;           /* per rank: its building */
+} ytree;
+
+static void ytree_set(ytree *t, uint32_t rank, double v)
 {
-    uint32_t i, k, nact = 0;
-    for (i = 0; i < nocc; i++) {
-        uint32_t b = order[i].idx, w = 0;
-        const double *bb = s->bld[b].box;
-        for (k = 0; k < nact; k++) {
-            const double *ab = s->bld[active[k]].box;
-            if (ab[2] < bb[0])
-                continue;        /* ends before: drop */
-            active[w++] = active[k];
-            if (ab[1] <= bb[3] && bb[1] <= ab[3])
-                meet_buildings(c, active[k], b);
-        }
-        nact = w;
-        active[nact++] = b;
+    uint32_t n = t->size + rank;
+    t->mx[n] = v;
+    for (n /= 2; n > 0; n /= 2)
+        t->mx[n] = fmax(t->mx[2 * n], t->mx[2 * n + 1]);
+}
+
+/* Meets building b with the active ones of rank < lim whose upper y is at
+ * least ylo, below node n (covering ranks [lo, lo + w)). */
+static void ytree_meet(split_ctx *c, const ytree *t, uint32_t n, uint32_t lo, uint32_t w,
+                       uint32_t lim, double ylo, uint32_t b)
+{
+    if (lo >= lim || t->mx[n] < ylo)
+        return;
+    if (w == 1) {
+        meet_buildings(c, t->who[lo], b);
+        return;
     }
+    ytree_meet(c, t, 2 * n, lo, w / 2, lim, ylo, b);
+    ytree_meet(c, t, 2 * n + 1, lo + w / 2, w / 2, lim, ylo, b);
+}
+
+/* Sweep over x of building boxes: every pair of occluders whose closed
+ * boxes meet has its edges compared. order: the nocc occluders by lower
+ * x. A box meets the active boxes (begun before it, not ended before its
+ * lower x) whose y ranges meet its own: those with lower y <= its upper y
+ * (a prefix of the ranks) and upper y >= its lower y (subtrees below that
+ * skipped). O(log n) per box and per pair of boxes that meet, whatever the
+ * layout. */
+static plx_status find_contacts(split_ctx *c, const scene *s, const keyed *order, uint32_t nocc)
+{
+    arena *a = c->a;
+    keyed *byy = scratch_n(a, nocc, sizeof(keyed)), *byx1 = scratch_n(a, nocc, sizeof(keyed));
+    uint32_t *rank = scratch_n(a, s->nbld, 4), i, k, e = 0;
+    ytree t;
+    t.size = 1;
+    while (t.size < nocc)
+        t.size *= 2;
+    t.mx = scratch_n(a, 2 * (size_t)t.size, sizeof(double));
+    t.who = scratch_n(a, t.size, 4);
+    if (!byy || !byx1 || !rank || !t.mx || !t.who)
+        return PLX_E_NOMEM;
+    for (i = 0; i < nocc; i++) {
+        uint32_t b = order[i].idx;
+        byy[i].key = s->bld[b].box[1];
+        byy[i].idx = b;
+        byx1[i].key = s->bld[b].box[2];
+        byx1[i].idx = b;
+    }
+    qsort(byy, nocc, sizeof(keyed), cmp_keyed);
+    qsort(byx1, nocc, sizeof(keyed), cmp_keyed);
+    for (i = 0; i < nocc; i++) {
+        rank[byy[i].idx] = i;
+        t.who[i] = byy[i].idx;
+    }
+    for (i = 1; i < 2 * t.size; i++)
+        t.mx[i] = -DBL_MAX;
+    for (i = 0; i < nocc; i++) {
+        uint32_t b = order[i].idx, lim = 0, hi = nocc;
+        const double *bb = s->bld[b].box;
+        for (; e < nocc && byx1[e].key < bb[0]; e++)   /* ended before: drop */
+            ytree_set(&t, rank[byx1[e].idx], -DBL_MAX);
+        while (lim < hi) {                            /* ranks with lower y <= bb[3] */
+            k = lim + (hi - lim) / 2;
+            if (byy[k].key <= bb[3])
+                lim = k + 1;
+            else
+                hi = k;
+        }
+        ytree_meet(c, &t, 1, 0, t.size, lim, bb[1], b);
+        ytree_set(&t, rank[b], bb[3]);
+    }
+    return PLX_OK;
 }
 
 typedef struct piece {
@@ -528,14 +600,6 @@ static void frame_box(const polar *pd, polar_map *m)
         if (lex_cmp(f, fpt(pd, m->frame, m->box_hi)) > 0)
             m->box_hi = p0 + i;
     }
-}
-
-static void *scratch_n(arena *a, size_t n, size_t size)
-{
-    size_t bytes = arena_mul(n ? n : 1, size);
-    if (bytes == SIZE_MAX)
-        return NULL;
-    return arena_scratch(a, bytes, 16);
 }
 
 static void *keep_n(arena *a, size_t n, size_t size, size_t *acc)
@@ -1774,7 +1838,8 @@ static plx_status make_walls(arena *a, polar *pd)
     edges e;
     split_ctx c;
     keyed *order;
-    uint32_t *active, *cut_first, i, j, nocc = 0, nextra, np = 0, nm = 0;
+    uint32_t *cut_first, i, j, nocc = 0, nextra, np = 0, nm = 0;
+    plx_status st;
     split *sp;
     piece *pc;
     e.n = count_edges(s);
@@ -1784,8 +1849,7 @@ static plx_status make_walls(arena *a, polar *pd)
     e.first = scratch_n(a, s->nbld, 4);
     e.count = scratch_n(a, s->nbld, 4);
     order = scratch_n(a, s->nbld, sizeof(keyed));
-    active = scratch_n(a, s->nbld, 4);
-    if (!e.a || !e.b || !e.bld || !e.first || !e.count || !order || !active)
+    if (!e.a || !e.b || !e.bld || !e.first || !e.count || !order)
         return PLX_E_NOMEM;
     fill_edges(s, &e);
     for (i = 0; i < s->nbld; i++) {
@@ -1803,7 +1867,9 @@ static plx_status make_walls(arena *a, polar *pd)
     c.a = a;
     pd->pts = (vec2 *)s->pts;   /* read only meanwhile */
     c.npts = s->npts;
-    find_contacts(&c, s, order, nocc, active);
+    st = find_contacts(&c, s, order, nocc);
+    if (st != PLX_OK)
+        return st;
     if (c.nomem)
         return PLX_E_NOMEM;
     nextra = c.npts - s->npts;
