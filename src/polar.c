@@ -509,20 +509,52 @@ static void sort_pkeys(pkey *v, pkey *tmp, uint32_t n)
         memcpy(v, src, (size_t)n * sizeof *v);
 }
 
-/* Sorts the cut points of one edge along it (insertion sort: few cuts). */
-static void sort_cuts(split *v, uint32_t n, const vec2 *P, int fwd)
+/* Is cut a before cut b along an edge (fwd: the edge runs in lexicographic
+ * order)? */
+static int cut_before(const split *a, const split *b, const vec2 *P, int fwd)
 {
-    uint32_t i, j;
-    for (i = 1; i < n; i++) {
-        split t = v[i];
-        for (j = i; j > 0; j--) {
-            int c = lex_cmp(P[v[j - 1].pt], P[t.pt]);
-            if (fwd ? c <= 0 : c >= 0)
-                break;
-            v[j] = v[j - 1];
+    int c = lex_cmp(P[a->pt], P[b->pt]);
+    return fwd ? c < 0 : c > 0;
+}
+
+/* Sorts the cut points of one edge along it: insertion sort in runs of 8
+ * (most edges have few cuts), then bottom-up merges (a long wall cut by
+ * many footprints: O(c log c)). Stable; tmp holds n. */
+static void sort_cuts(split *v, split *tmp, uint32_t n, const vec2 *P, int fwd)
+{
+    uint32_t i, j, w;
+    split *src = v, *dst = tmp;
+    for (i = 0; i < n; i += 8) {
+        uint32_t e = i + 8 < n ? i + 8 : n;
+        for (j = i + 1; j < e; j++) {
+            split t = v[j];
+            uint32_t k = j;
+            while (k > i && cut_before(&t, &v[k - 1], P, fwd)) {
+                v[k] = v[k - 1];
+                k--;
+            }
+            v[k] = t;
         }
-        v[j] = t;
     }
+    for (w = 8; w < n; w *= 2) {
+        for (i = 0; i < n; i += 2 * w) {
+            uint32_t a = i, am = i + w < n ? i + w : n, b = am, bm = i + 2 * w < n ? i + 2 * w : n;
+            uint32_t o = i;
+            while (a < am && b < bm)
+                dst[o++] = cut_before(&src[b], &src[a], P, fwd) ? src[b++] : src[a++];
+            while (a < am)
+                dst[o++] = src[a++];
+            while (b < bm)
+                dst[o++] = src[b++];
+        }
+        {
+            split *t = src;
+            src = dst;
+            dst = t;
+        }
+    }
+    if (src != v)
+        memcpy(v, src, (size_t)n * sizeof *v);
 }
 
 static void emit_piece(piece *out, uint32_t *n, const vec2 *P, uint32_t a, uint32_t b, int32_t bld)
@@ -1840,7 +1872,7 @@ static plx_status make_walls(arena *a, polar *pd)
     keyed *order;
     uint32_t *cut_first, i, j, nocc = 0, nextra, np = 0, nm = 0;
     plx_status st;
-    split *sp;
+    split *sp, *sptmp;
     piece *pc;
     e.n = count_edges(s);
     e.a = scratch_n(a, e.n, 4);
@@ -1901,13 +1933,14 @@ static plx_status make_walls(arena *a, polar *pd)
                 sp[cut_first[q->v[i].seg]++] = q->v[i];
     }
     pc = scratch_n(a, e.n + c.nsp, sizeof(piece));
-    if (!pc)
+    sptmp = scratch_n(a, c.nsp, sizeof(split));
+    if (!pc || !sptmp)
         return PLX_E_NOMEM;
     for (i = 0, j = 0; i < e.n; i++) {
         uint32_t j0 = j, prev = e.a[i], q;
         while (j < c.nsp && sp[j].seg == i)
             j++;
-        sort_cuts(sp + j0, j - j0, pd->pts, lex_cmp(pd->pts[e.a[i]], pd->pts[e.b[i]]) < 0);
+        sort_cuts(sp + j0, sptmp, j - j0, pd->pts, lex_cmp(pd->pts[e.a[i]], pd->pts[e.b[i]]) < 0);
         for (q = j0; q < j; q++) {
             emit_piece(pc, &np, pd->pts, prev, sp[q].pt, e.bld[i]);
             prev = sp[q].pt;

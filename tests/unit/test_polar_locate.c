@@ -606,21 +606,25 @@ static void test_comb_depth(void **state)
 
 /* ------------------------------------------------ construction work */
 
-/* Scenes hostile to a grid of walls. "stack": n thin boxes stacked in a
- * 1 m column and n side by side in a 1 m row (1 m x 1/(2n) m each, gaps
+/* Scenes hostile to a grid of walls, by kind. 1, "stack": n thin boxes
+ * stacked in a 1 m column and n side by side in a 1 m row (1 m x 1/(2n) m each, gaps
  * between them), in a Bounds box of 10 km set by two far boxes: a grid
  * sized for the 8 n walls has cells of about 100 m, so one cell holds all
  * of them, and finding the wall below each event by scanning cells (the
- * former sweep) examines O(n) walls per event, O(n^2) in all. "comb": the
- * comb above (n teeth on one long wall). */
-static void work_scene(fix *f, int stack, int n)
+ * former sweep) examines O(n) walls per event, O(n^2) in all. 0, "comb": the
+ * comb above (n teeth over one long wall); 2, "terrace": the teeth standing
+ * on it. */
+static void work_scene(fix *f, int kind, int n)
 {
     int i;
-    double w = stack ? 1.0 / n : 2000.0 / n;
-    if (!stack) {
+    double w = kind == 1 ? 1.0 / n : 2000.0 / n;
+    if (kind != 1) {
+        /* kind 2: the teeth stand on the long wall (a terrace: its top
+         * wall cut at every tooth's corners, the shared stretches left out) */
+        double y0 = kind ? 1 : 2;
         assert_true(ref_scene_add_box(&f->s, 0, 0, 2000, 1, 10, 0) >= 0);
         for (i = 0; i < n; i++)
-            assert_true(ref_scene_add_box(&f->s, i * w, 2, i * w + w / 2, 3, 10, 0) >= 0);
+            assert_true(ref_scene_add_box(&f->s, i * w, y0, i * w + w / 2, y0 + 1, 10, 0) >= 0);
         return;
     }
     assert_true(ref_scene_add_box(&f->s, -5000, -5000, -4999, -4999, 10, 0) >= 0);
@@ -633,7 +637,7 @@ static void work_scene(fix *f, int stack, int n)
 
 /* Builds the scene; returns the construction steps per piece and per
  * log2(pieces), and checks a few points against the brute force. */
-static double work_per_piece(int stack, int n)
+static double work_per_piece(int kind, int n)
 {
     fix *f = fix_new();
     polar_scan *g;
@@ -641,18 +645,19 @@ static double work_per_piece(int stack, int n)
     double per, lg;
     int i;
     memset(&st, 0, sizeof st);
-    work_scene(f, stack, n);
+    work_scene(f, kind, n);
     ref_scene_finish(&f->s);
     assert_int_equal(polar_build(&f->a, &f->s, &f->pd), PLX_OK);
     lg = log2((double)f->pd->nwall);
     per = (double)f->pd->steps / f->pd->nwall / lg;
     print_message("%s of %d: %u wall pieces, %llu construction steps = %.2f per piece "
-                  "per log2(pieces)\n", stack ? "stack" : "comb", n, f->pd->nwall,
+                  "per log2(pieces)\n", kind == 1 ? "stack" : kind ? "terrace" : "comb", n,
+                  f->pd->nwall,
                   (unsigned long long)f->pd->steps, per);
     assert_int_equal(polar_scan_new(&f->a, f->pd, &g), PLX_OK);
     for (i = 0; i < quick(400); i++) {
         vec2 p;
-        if (stack) {
+        if (kind == 1) {
             p.x = -0.5 + 4 * urand();
             p.y = -0.5 + 2 * urand();
         } else {
@@ -675,11 +680,11 @@ static double work_per_piece(int stack, int n)
  * build took 2.2 s for 4000 stacked pairs, 35 s for 16,000). */
 static void test_construction_work(void **state)
 {
-    int stack;
+    int kind;
     (void)state;
     rnd_state = 5u;
-    for (stack = 0; stack < 2; stack++) {
-        double w1 = work_per_piece(stack, 250), w2 = work_per_piece(stack, 4000);
+    for (kind = 0; kind < 3; kind++) {
+        double w1 = work_per_piece(kind, 250), w2 = work_per_piece(kind, 4000);
         assert_true(w1 < 6.0);
         assert_true(w2 < 6.0);
         assert_true(w2 < 2.0 * w1);
