@@ -1,19 +1,25 @@
 /* polar: quadrant polar diagrams as trapezoidal subdivisions (see polar.h).
  *
- * Construction, per subdivision: a plane sweep over the wall ends in a
- * frame where the axes are "vertical" and points are ordered
- * lexicographically by (u, v) (the trapezoidal map of de Berg et al.,
- * "Computational Geometry", ch. 6, built by a sweep rather than by
- * randomized insertion); whether a gap is solid is known when its floor
- * wall enters the sweep, so only free trapezoids are made. Points are
- * located by a search DAG: the same trapezoidal map built a second time by
- * randomized incremental insertion (see "the search DAG" below), its leaves
- * mapped to the sweep's free regions or marked solid. The sweep stays: it
- * checks that the pieces form a planar subdivision, gives the regions in a
- * deterministic order with their adjacency, and costs about a third of the
- * DAG's insertions. The grid of wall pieces the sweep uses (wall_below) is
- * scratch; polar_scan keeps one, with the former grid-scan point location,
- * as a reference for tests and benchmarks.
+ * Construction, per subdivision, in a frame where the axes are "vertical"
+ * and points are ordered lexicographically by (u, v) (the trapezoidal map
+ * of de Berg et al., "Computational Geometry", ch. 6):
+ * 1. the map and its search DAG by randomized incremental insertion of the
+ *    wall pieces (see "the search DAG" below; expected O(n log n));
+ * 2. a plane sweep over the wall ends (see "a plane sweep"), which reads
+ *    from that map the piece below every event where pieces only start
+ *    (O(1); the piece below is the floor of the map's trapezoid below the
+ *    lowest piece starting there), checks that the pieces form a planar
+ *    subdivision and that every gap it opens is a trapezoid of the map with
+ *    the same sides, and makes the free regions (whether a gap is solid is
+ *    known when its floor enters the sweep) in a deterministic order with
+ *    their adjacency, setting the DAG leaf of each: O(n log n) worst case;
+ * 3. the DAG kept, its leaves as child words (a free region or the owner
+ *    of a solid trapezoid).
+ * Before that, the footprints are cut at their contacts (make_walls).
+ * No grid is used; polar_scan keeps one, with the former grid-scan point
+ * location, as a reference for tests and benchmarks. pd->steps counts the
+ * searching work (DAG nodes and trapezoids visited by the insertions,
+ * status pieces walked and sorted by the sweeps) for the tests.
  */
 #include <float.h>
 #include <math.h>
@@ -649,8 +655,8 @@ static void *keep_n(arena *a, size_t n, size_t size, size_t *acc)
 /* ---- the grid of wall pieces ------------------------------------------ */
 
 /* Cell (x, y) lists the pieces whose bounding boxes meet it,
- * wall[cell[y nx + x] .. cell[.. + 1]). A construction temporary (and the
- * reference locator polar_scan). */
+ * wall[cell[y nx + x] .. cell[.. + 1]). Only for the reference locator
+ * polar_scan (the construction uses none). */
 typedef struct wgrid {
     uint32_t nx, ny;
     double sx, sy;           /* cells per metre */
@@ -757,10 +763,9 @@ static int seg_over(vec2 L, vec2 R, vec2 BL, vec2 BR)
  * among those whose span holds f strictly (lexicographically), found by
  * scanning the grid column of f downwards and stopping as soon as no unseen
  * piece can be higher; POLAR_NONE when there is none (the Bounds side).
- * Sets *on and returns POLAR_NONE when f is on a piece, or is the end of
- * one unless ends_ok (then pieces ending at f are passed over). */
-static uint32_t wall_below(const polar *pd, const wgrid *g, int frame, vec2 f, int ends_ok,
-                           int *on)
+ * Sets *on and returns POLAR_NONE when f is on a piece or is the end of
+ * one. O(1) expected for evenly spread walls, O(n) worst case. */
+static uint32_t wall_below(const polar *pd, const wgrid *g, int frame, vec2 f, int *on)
 {
     vec2 wp = polar_from_frame(frame, f), BL = f, BR = f;
     uint32_t best = POLAR_NONE, fixed, nx = g->nx;
@@ -796,8 +801,6 @@ static uint32_t wall_below(const polar *pd, const wgrid *g, int frame, vec2 f, i
             cl = lex_cmp(f, L);
             cr = lex_cmp(f, R);
             if (cl == 0 || cr == 0) {
-                if (ends_ok)
-                    continue;
                 *on = 1;
                 return POLAR_NONE;
             }
@@ -833,9 +836,16 @@ static uint32_t wall_below(const polar *pd, const wgrid *g, int frame, vec2 f, i
  * consecutive pieces lies one open trapezoid, which the next event between
  * them closes with the axis of that event's point. An event where pieces
  * end finds its place in the list through them; an event where pieces only
- * start finds the piece below it through the grid of walls (wall_below: the
- * nearest piece below whose span holds the point is exactly the status
- * piece below it). Only free trapezoids are made: whether the gap above a
+ * start reads the piece below it from the DAG's map, already built: the
+ * floor of the trapezoid below the lowest piece starting there, at its
+ * left end, which is the status piece below the point (no piece ends
+ * there); it is checked to be in the status and strictly below the point,
+ * and the piece above to be strictly above it. Pieces starting together
+ * are sorted by merge sort (O(d log d) at a point of degree d), so the
+ * sweep is O(n log n) worst case. Every gap it opens is looked up in the
+ * DAG's map the same way and must be a trapezoid there with the same left
+ * axis, floor and ceiling (and right axis, for free regions), each once,
+ * all of them. Only free trapezoids are made: whether the gap above a
  * piece is solid is known when the piece enters the status (footprints
  * counted from the bottom, as the piece below plus the piece's own change).
  * Every decision is a geom_orient sign or a lexicographic comparison. */
@@ -1173,14 +1183,14 @@ static plx_status build_incidence(arena *a, const polar *pd, uint32_t **inc_firs
  * (most are: polygon edges share their ends), the others from the root.
  * Measured (bench_polar): 4.4 to 4.9 inner nodes per piece (8 or 12
  * bytes each, see polar_map), search paths of about 2 log2 n nodes on
- * average; the build costs 1.5 to 3 times the rest of polar_build. The
- * sweep (run first) has already checked that the pieces do not cross; a
- * failure here is reported as PLX_E_SCENE all the same. In the end every
- * leaf becomes a child word: a free trapezoid is the sweep's region with
- * the same floor, ceiling and left axis (found through a hash; point
- * indices are made canonical, the first of the points sharing a position,
- * as the sweep's events are), a solid one carries the owner that
- * polar_locate reports. */
+ * average. It runs first, on pieces not yet checked: a walk only moves to
+ * a live neighbour sharing the axis it crosses (so it moves strictly
+ * along the frame order and ends), every index stays in range, and a
+ * failure is PLX_E_SCENE; the sweep then checks the result. Point indices
+ * are canonical (the first of the points sharing a position, as the
+ * sweep's events are). In the end every leaf becomes a child word, set by
+ * the sweep when it opens that trapezoid as a gap: its free region, or the
+ * owner that polar_locate reports inside a solid one. */
 
 #define NODE_BITS 14
 #define NODE_CHUNK (1u << NODE_BITS)
@@ -2205,7 +2215,7 @@ int32_t polar_scan_locate_frame(const polar_scan *g, int mi, vec2 f, int32_t *ow
     const polar *pd = g->pd;
     const polar_map *m = &pd->map[mi];
     int on;
-    uint32_t t, best = wall_below(pd, &g->g, m->frame, f, 0, &on);
+    uint32_t t, best = wall_below(pd, &g->g, m->frame, f, &on);
     if (owner)
         *owner = -1;
     if (on)
