@@ -852,10 +852,15 @@ static uint32_t wall_below(const polar *pd, const wgrid *g, int frame, vec2 f, i
 
 /* A trapezoid of the search DAG's map (see "the search DAG" below). */
 typedef struct btrap {
+    vec2 rc;                 /* frame coordinates of rp (walks read them) */
     uint32_t lp, rp, top, bot;
     uint32_t nb[4];
-    uint32_t leaf;           /* its leaf node; POLAR_NONE: slot free */
+    uint32_t leaf;           /* its leaf node; POLAR_NONE: slot free. Once
+                              * the map is built: UNSET, then the child word
+                              * the sweep gives it */
 } btrap;
+
+#define UNSET 0xfffffffeu    /* a live trapezoid the sweep has not reached */
 
 typedef struct snode {
     vec2 l, r;          /* frame ends, l before r */
@@ -884,9 +889,9 @@ typedef struct sweep {
      * above it at its left end, per point one trapezoid with that left
      * axis; each gap the sweep opens is one of them, whose child word it
      * sets in word[], and regd[] keeps it per region */
-    const btrap *DT;
+    btrap *DT;
     const uint32_t *below_l, *above_l, *right_of;
-    uint32_t *word, *regd;
+    uint32_t *regd;
     uint32_t ngap;      /* gaps opened, free or solid */
     uint64_t steps;     /* status pieces walked and start pieces sorted */
 } sweep;
@@ -954,13 +959,13 @@ static uint32_t new_region(sweep *w, uint32_t lp, uint32_t top, uint32_t bot)
  * Returns 0, or -1 when the two maps differ. */
 static int open_gap(sweep *w, uint32_t d, uint32_t pi, uint32_t top, uint32_t bot, uint32_t h)
 {
-    const btrap *t;
+    btrap *t;
     if (d == POLAR_NONE)
         return -1;
     t = &w->DT[d];
-    if (t->lp != pi || t->top != top || t->bot != bot || w->word[d] != POLAR_NONE)
+    if (t->lp != pi || t->top != top || t->bot != bot || t->leaf != UNSET)
         return -1;
-    w->word[d] = h != POLAR_NONE ? PACK(POLAR_CHILD_FREE, h) : w->N[bot].solid;
+    t->leaf = h != POLAR_NONE ? PACK(POLAR_CHILD_FREE, h) : w->N[bot].solid;
     if (h != POLAR_NONE)
         w->regd[h] = d;
     w->ngap++;
@@ -1208,6 +1213,7 @@ typedef struct dbuild {
     const uint32_t *canon;   /* per point: the first point at its position */
     const snode *N;          /* per piece: the sweep's data (y test kind) */
     const vec2 *E;           /* per piece: frame ends, left then right */
+    uint32_t *segl;          /* per piece: its canonical left end */
     vec2 P, Q;               /* the piece being inserted: its frame ends */
     uint32_t *hint;          /* per canonical point: its x node, POLAR_NONE */
     int fail;                /* 1: out of memory, 2: pieces not planar */
@@ -1330,10 +1336,12 @@ static void relink(dbuild *b, uint32_t x, int f, uint32_t old, uint32_t nw)
         b->T[x].nb[f] = nw;
 }
 
-static void set_trap(dbuild *b, uint32_t t, uint32_t lp, uint32_t rp, uint32_t top, uint32_t bot)
+static void set_trap(dbuild *b, uint32_t t, uint32_t lp, uint32_t rp, vec2 rc, uint32_t top,
+                     uint32_t bot)
 {
     b->T[t].lp = lp;
     b->T[t].rp = rp;
+    b->T[t].rc = rc;
     b->T[t].top = top;
     b->T[t].bot = bot;
 }
@@ -1379,9 +1387,9 @@ static uint32_t follow(dbuild *b, uint32_t l, uint32_t r)
     b->list[0] = find_first(b, b->hint[l] != POLAR_NONE ? b->hint[l] : 0, P, Q);
     if (b->fail)
         return 0;
-    while (lex_cmp(Q, bpt(b, b->T[b->list[k]].rp)) > 0) {
+    while (lex_cmp(Q, b->T[b->list[k]].rc) > 0) {
         uint32_t t = b->list[k], nx;
-        int o = geom_orient(P, Q, bpt(b, b->T[t].rp));
+        int o = geom_orient(P, Q, b->T[t].rc);
         nx = o > 0 ? b->T[t].nb[LR] : b->T[t].nb[UR];
         if (o == 0 || nx == POLAR_NONE || k + 1 >= b->cap || b->T[nx].leaf == POLAR_NONE ||
             b->T[nx].lp != b->T[t].rp) {
@@ -1403,25 +1411,26 @@ static void make_chain(dbuild *b, uint32_t s, uint32_t l, uint32_t r, uint32_t k
     if (b->fail)
         return;
     if (up)
-        set_trap(b, cur, l, r, b->T[b->list[0]].top, s);
+        set_trap(b, cur, l, r, Q, b->T[b->list[0]].top, s);
     else
-        set_trap(b, cur, l, r, s, b->T[b->list[0]].bot);
+        set_trap(b, cur, l, r, Q, s, b->T[b->list[0]].bot);
     part[0] = cur;
     for (j = 0; j < k; j++) {
         uint32_t t = b->list[j], t1 = b->list[j + 1], R = b->T[t].rp, nx, x;
-        int o = geom_orient(P, Q, bpt(b, R));
+        int o = geom_orient(P, Q, b->T[t].rc);
         if ((o > 0) != (up != 0)) {
             part[j + 1] = cur;        /* the axis at R is cut away: merge */
             continue;
         }
         b->T[cur].rp = R;
+        b->T[cur].rc = b->T[t].rc;
         nx = new_trap(b);
         if (b->fail)
             return;
         if (up)
-            set_trap(b, nx, R, r, b->T[t1].top, s);
+            set_trap(b, nx, R, r, Q, b->T[t1].top, s);
         else
-            set_trap(b, nx, R, r, s, b->T[t1].bot);
+            set_trap(b, nx, R, r, Q, s, b->T[t1].bot);
         x = b->T[t].nb[fc];
         b->T[cur].nb[fc] = x;
         relink(b, x, fo, t, cur);
@@ -1523,15 +1532,18 @@ static void insert_seg(dbuild *b, const irec *in)
         fnb[j] = b->T[first].nb[j];
         lnb[j] = b->T[last].nb[j];
     }
-    if (lex_cmp(b->P, bpt(b, b->T[first].lp)) > 0) {
+    /* the first trapezoid holds l (its left axis at or before l), the
+     * last r: A, B are needed unless those axes are l's and r's own
+     * (canonical indices: one index per position) */
+    if (l != b->T[first].lp) {
         A = new_trap(b);
         if (!b->fail)
-            set_trap(b, A, b->T[first].lp, l, b->T[first].top, b->T[first].bot);
+            set_trap(b, A, b->T[first].lp, l, b->P, b->T[first].top, b->T[first].bot);
     }
-    if (!b->fail && lex_cmp(b->Q, bpt(b, b->T[last].rp)) < 0) {
+    if (!b->fail && r != b->T[last].rp) {
         B = new_trap(b);
         if (!b->fail)
-            set_trap(b, B, r, b->T[last].rp, b->T[last].top, b->T[last].bot);
+            set_trap(b, B, r, b->T[last].rp, b->T[last].rc, b->T[last].top, b->T[last].bot);
     }
     if (!b->fail)
         make_chain(b, s, l, r, k, 1);
@@ -1587,12 +1599,11 @@ static void put_node(polar_map *m, uint32_t j, uint32_t t, uint32_t c0, uint32_t
     }
 }
 
-/* Leaves to child words (word[]: per trapezoid slot, set by the sweep),
+/* Leaves to child words (set by the sweep in the trapezoids' leaf field),
  * the inner nodes kept in the order they were made (the top levels first;
  * with the insertion order, nodes made together lie together), narrow when
  * every index fits, and counted in polar_memory (rest). */
-static plx_status dag_keep(arena *a, polar *pd, polar_map *m, dbuild *b, const uint32_t *word,
-                           int flags)
+static plx_status dag_keep(arena *a, polar *pd, polar_map *m, dbuild *b, int flags)
 {
     uint32_t i, j, nq = 0, *fw = scratch_n(a, b->nnode, 4);
     if (!fw)
@@ -1602,7 +1613,7 @@ static plx_status dag_keep(arena *a, polar *pd, polar_map *m, dbuild *b, const u
         uint32_t w0 = dnode(b, i)[0];
         if (KIND(w0) != N_LEAF)
             fw[i] = PACK(POLAR_CHILD_NODE, nq++);
-        else if ((fw[i] = word[IDX(w0)]) == POLAR_NONE)
+        else if ((fw[i] = b->T[IDX(w0)].leaf) == UNSET)
             return PLX_E_SCENE;
     }
     m->nnode = nq;
@@ -1705,9 +1716,10 @@ static plx_status build_dag(arena *a, polar *pd, polar_map *m, dbuild *b, const 
     b->chunk = scratch_n(a, b->maxchunk, sizeof *b->chunk);
     b->hint = scratch_n(a, pd->npts, 4);
     b->E = E = scratch_n(a, 2 * (size_t)pd->nseg, sizeof(vec2));
+    b->segl = scratch_n(a, pd->nseg, 4);
     rec = scratch_n(a, nw, sizeof(irec));
     if (!b->T || !b->freel || !b->list || !b->up || !b->lo || !b->chunk || !b->hint || !E ||
-        !rec)
+        !b->segl || !rec)
         return PLX_E_NOMEM;
     /* what the insertions read, packed: the ends of every piece, and per
      * insertion its piece (gathered here, where the loads do not wait on
@@ -1715,6 +1727,7 @@ static plx_status build_dag(arena *a, polar *pd, polar_map *m, dbuild *b, const 
     for (i = 0; i < pd->nseg; i++) {
         E[2 * (size_t)i] = N[i].l;
         E[2 * (size_t)i + 1] = N[i].r;
+        b->segl[i] = canon[N[i].li];
     }
     for (i = 0; i < nw; i++) {
         const snode *g = &N[order[i]];
@@ -1726,7 +1739,7 @@ static plx_status build_dag(arena *a, polar *pd, polar_map *m, dbuild *b, const 
     }
     memset(b->hint, 0xff, (size_t)pd->npts * 4);
     t = new_trap(b);
-    set_trap(b, t, m->box_lo, m->box_hi, m->box_top, m->box_bot);
+    set_trap(b, t, m->box_lo, m->box_hi, bpt(b, m->box_hi), m->box_top, m->box_bot);
     b->T[t].leaf = new_node(b, N_LEAF, t, 0, 0);
     for (i = 0; i < nw && !b->fail; i++)
         insert_seg(b, &rec[i]);
@@ -1737,27 +1750,27 @@ static plx_status build_dag(arena *a, polar *pd, polar_map *m, dbuild *b, const 
 
 /* Indexes the final map of b for the sweep: per piece the trapezoid below
  * and above it at its (canonical) left end, per point one trapezoid whose
- * left axis is that point's; w->word[] cleared. Also counts the live
- * trapezoids into *nlive. */
-static plx_status index_map(arena *a, const polar *pd, const dbuild *b, const uint32_t *canon,
-                            sweep *w, uint32_t *nlive)
+ * left axis is that point's; every live trapezoid marked UNSET. Also
+ * counts the live trapezoids into *nlive. */
+static plx_status index_map(arena *a, const polar *pd, dbuild *b, sweep *w, uint32_t *nlive)
 {
     uint32_t *bl = scratch_n(a, pd->nseg, 4), *al = scratch_n(a, pd->nseg, 4);
-    uint32_t *ro = scratch_n(a, pd->npts, 4), *word = scratch_n(a, b->ntrap, 4), t, n = 0;
-    if (!bl || !al || !ro || !word)
+    uint32_t *ro = scratch_n(a, pd->npts, 4), t, n = 0;
+    const uint32_t *segl = b->segl;
+    if (!bl || !al || !ro)
         return PLX_E_NOMEM;
     memset(bl, 0xff, (size_t)pd->nseg * 4);
     memset(al, 0xff, (size_t)pd->nseg * 4);
     memset(ro, 0xff, (size_t)pd->npts * 4);
-    memset(word, 0xff, (size_t)b->ntrap * 4);
     for (t = 0; t < b->ntrap; t++) {
-        const btrap *x = &b->T[t];
+        btrap *x = &b->T[t];
         if (x->leaf == POLAR_NONE)
             continue;
+        x->leaf = UNSET;
         n++;
-        if (canon[w->N[x->top].li] == x->lp)
+        if (segl[x->top] == x->lp)
             bl[x->top] = t;
-        if (canon[w->N[x->bot].li] == x->lp)
+        if (segl[x->bot] == x->lp)
             al[x->bot] = t;
         ro[x->lp] = t;
     }
@@ -1765,7 +1778,6 @@ static plx_status index_map(arena *a, const polar *pd, const dbuild *b, const ui
     w->below_l = bl;
     w->above_l = al;
     w->right_of = ro;
-    w->word = word;
     *nlive = n;
     return PLX_OK;
 }
@@ -1833,7 +1845,7 @@ static plx_status build_map(arena *a, polar *pd, polar_map *m, const uint32_t *i
             canon[ev[j].i] = ev[i].i;
     st = build_dag(a, pd, m, &b, w.N, canon, order, nev);
     if (st == PLX_OK)
-        st = index_map(a, pd, &b, canon, &w, &nlive);
+        st = index_map(a, pd, &b, &w, &nlive);
     if (st != PLX_OK)
         return st;
     w.regd = scratch_n(a, w.cap, 4);
@@ -1870,7 +1882,7 @@ static plx_status build_map(arena *a, polar *pd, polar_map *m, const uint32_t *i
     pd->bytes[1] += (size_t)w.ntrap * 8;
     if (flags & POLAR_BUILD_NO_DAG)
         return PLX_OK;
-    return dag_keep(a, pd, m, &b, w.word, flags);
+    return dag_keep(a, pd, m, &b, flags);
 }
 
 /* Cuts the occluders' edges into wall pieces (pd->pts, pd->seg filled). */
