@@ -855,12 +855,11 @@ typedef struct btrap {
     vec2 rc;                 /* frame coordinates of rp (walks read them) */
     uint32_t lp, rp, top, bot;
     uint32_t nb[4];
-    uint32_t leaf;           /* its leaf node; POLAR_NONE: slot free. Once
-                              * the map is built: UNSET, then the child word
-                              * the sweep gives it */
+    uint32_t leaf;           /* its leaf node (below 2^30); POLAR_NONE: slot
+                              * free; once the map is built, the sweep
+                              * replaces it by the trapezoid's child word
+                              * (tag 1 or 2: set) */
 } btrap;
-
-#define UNSET 0xfffffffeu    /* a live trapezoid the sweep has not reached */
 
 typedef struct snode {
     vec2 l, r;          /* frame ends, l before r */
@@ -963,7 +962,7 @@ static int open_gap(sweep *w, uint32_t d, uint32_t pi, uint32_t top, uint32_t bo
     if (d == POLAR_NONE)
         return -1;
     t = &w->DT[d];
-    if (t->lp != pi || t->top != top || t->bot != bot || t->leaf != UNSET)
+    if (t->lp != pi || t->top != top || t->bot != bot || POLAR_TAG(t->leaf) != 0)
         return -1;
     t->leaf = h != POLAR_NONE ? PACK(POLAR_CHILD_FREE, h) : w->N[bot].solid;
     if (h != POLAR_NONE)
@@ -1213,7 +1212,12 @@ typedef struct dbuild {
     const uint32_t *canon;   /* per point: the first point at its position */
     const snode *N;          /* per piece: the sweep's data (y test kind) */
     const vec2 *E;           /* per piece: frame ends, left then right */
-    uint32_t *segl;          /* per piece: its canonical left end */
+    uint32_t *segl, *segr;   /* per piece: its canonical left / right end */
+    /* the live trapezoids by role, kept up to date by every insertion: per
+     * point one whose left (rof) / right (lof) axis is the point's; per
+     * piece the one above (abl, abr) / below (bel, ber) it at its left /
+     * right end */
+    uint32_t *rof, *lof, *abl, *bel, *abr, *ber;
     vec2 P, Q;               /* the piece being inserted: its frame ends */
     uint32_t *hint;          /* per canonical point: its x node, POLAR_NONE */
     int fail;                /* 1: out of memory, 2: pieces not planar */
@@ -1346,6 +1350,68 @@ static void set_trap(dbuild *b, uint32_t t, uint32_t lp, uint32_t rp, vec2 rc, u
     b->T[t].bot = bot;
 }
 
+/* Records trapezoid t (just made, its sides final) in the roles it holds. */
+static void note_trap(dbuild *b, uint32_t t)
+{
+    const btrap *x = &b->T[t];
+    b->rof[x->lp] = t;
+    b->lof[x->rp] = t;
+    if (b->segl[x->top] == x->lp)
+        b->bel[x->top] = t;
+    if (b->segl[x->bot] == x->lp)
+        b->abl[x->bot] = t;
+    if (b->segr[x->top] == x->rp)
+        b->ber[x->top] = t;
+    if (b->segr[x->bot] == x->rp)
+        b->abr[x->bot] = t;
+}
+
+/* The trapezoid holding the points just right of end point p of the new
+ * piece (p = its left end, towards D = its right end Q) or just left of it
+ * (right end, towards D = P), p being in the map already: from one
+ * trapezoid whose axis on that side is p's, up or down across the pieces
+ * ending at p (the trapezoids by role), in O(1) per piece at p; at most
+ * WALK_MAX of them, else (or on anything unexpected) POLAR_NONE and the
+ * DAG is searched instead. */
+#define WALK_MAX 12
+static uint32_t walk_at(dbuild *b, uint32_t p, vec2 D, int right)
+{
+    const uint32_t *ends = right ? b->segl : b->segr;
+    const uint32_t *up = right ? b->abl : b->abr, *down = right ? b->bel : b->ber;
+    uint32_t t = right ? b->rof[p] : b->lof[p], n;
+    for (n = 0; n < WALK_MAX && t != POLAR_NONE; n++) {
+        const btrap *x = &b->T[t];
+        uint32_t e = right ? x->lp : x->rp;
+        const vec2 *g;
+        int o;
+        if (x->leaf == POLAR_NONE || e != p)
+            return POLAR_NONE;
+        b->steps++;
+        if (ends[x->top] == p) {
+            g = &b->E[2 * (size_t)x->top];
+            o = geom_orient(g[0], g[1], D);
+            if (o == 0)
+                return POLAR_NONE;    /* overlapping pieces: the DAG says so */
+            if (o > 0) {
+                t = up[x->top];
+                continue;
+            }
+        }
+        if (ends[x->bot] == p) {
+            g = &b->E[2 * (size_t)x->bot];
+            o = geom_orient(g[0], g[1], D);
+            if (o == 0)
+                return POLAR_NONE;
+            if (o < 0) {
+                t = down[x->bot];
+                continue;
+            }
+        }
+        return t;
+    }
+    return POLAR_NONE;
+}
+
 /* Follows the new piece leftwards from the trapezoid t holding its right
  * end r; returns k, the trapezoids crossed being list[0..k], left first. */
 static uint32_t follow_back(dbuild *b, uint32_t t, vec2 P, vec2 Q)
@@ -1381,10 +1447,14 @@ static uint32_t follow(dbuild *b, uint32_t l, uint32_t r)
     vec2 P = b->P, Q = b->Q;
     uint32_t k = 0;
     if (b->hint[l] == POLAR_NONE && b->hint[r] != POLAR_NONE) {
-        uint32_t t = find_last(b, b->hint[r], Q, P);
+        uint32_t t = walk_at(b, r, P, 0);
+        if (t == POLAR_NONE)
+            t = find_last(b, b->hint[r], Q, P);
         return b->fail ? 0 : follow_back(b, t, P, Q);
     }
-    b->list[0] = find_first(b, b->hint[l] != POLAR_NONE ? b->hint[l] : 0, P, Q);
+    b->list[0] = b->hint[l] != POLAR_NONE ? walk_at(b, l, Q, 1) : POLAR_NONE;
+    if (b->list[0] == POLAR_NONE)
+        b->list[0] = find_first(b, b->hint[l] != POLAR_NONE ? b->hint[l] : 0, P, Q);
     if (b->fail)
         return 0;
     while (lex_cmp(Q, b->T[b->list[k]].rc) > 0) {
@@ -1566,6 +1636,16 @@ static void insert_seg(dbuild *b, const irec *in)
         b->T[t].leaf = POLAR_NONE;
         b->freel[b->nfree++] = t;
     }
+    if (A != POLAR_NONE)
+        note_trap(b, A);
+    if (B != POLAR_NONE)
+        note_trap(b, B);
+    for (j = 0; j <= k; j++) {
+        if (j == 0 || b->up[j] != b->up[j - 1])
+            note_trap(b, b->up[j]);
+        if (j == 0 || b->lo[j] != b->lo[j - 1])
+            note_trap(b, b->lo[j]);
+    }
 }
 
 static uint64_t rng_step(uint64_t *st)
@@ -1613,7 +1693,7 @@ static plx_status dag_keep(arena *a, polar *pd, polar_map *m, dbuild *b, int fla
         uint32_t w0 = dnode(b, i)[0];
         if (KIND(w0) != N_LEAF)
             fw[i] = PACK(POLAR_CHILD_NODE, nq++);
-        else if ((fw[i] = b->T[IDX(w0)].leaf) == UNSET)
+        else if (POLAR_TAG(fw[i] = b->T[IDX(w0)].leaf) == POLAR_CHILD_NODE)
             return PLX_E_SCENE;
     }
     m->nnode = nq;
@@ -1717,10 +1797,24 @@ static plx_status build_dag(arena *a, polar *pd, polar_map *m, dbuild *b, const 
     b->hint = scratch_n(a, pd->npts, 4);
     b->E = E = scratch_n(a, 2 * (size_t)pd->nseg, sizeof(vec2));
     b->segl = scratch_n(a, pd->nseg, 4);
+    b->segr = scratch_n(a, pd->nseg, 4);
+    b->rof = scratch_n(a, pd->npts, 4);
+    b->lof = scratch_n(a, pd->npts, 4);
+    b->abl = scratch_n(a, pd->nseg, 4);
+    b->bel = scratch_n(a, pd->nseg, 4);
+    b->abr = scratch_n(a, pd->nseg, 4);
+    b->ber = scratch_n(a, pd->nseg, 4);
     rec = scratch_n(a, nw, sizeof(irec));
     if (!b->T || !b->freel || !b->list || !b->up || !b->lo || !b->chunk || !b->hint || !E ||
-        !b->segl || !rec)
+        !b->segl || !b->segr || !b->rof || !b->lof || !b->abl || !b->bel || !b->abr ||
+        !b->ber || !rec)
         return PLX_E_NOMEM;
+    memset(b->rof, 0xff, (size_t)pd->npts * 4);
+    memset(b->lof, 0xff, (size_t)pd->npts * 4);
+    memset(b->abl, 0xff, (size_t)pd->nseg * 4);
+    memset(b->bel, 0xff, (size_t)pd->nseg * 4);
+    memset(b->abr, 0xff, (size_t)pd->nseg * 4);
+    memset(b->ber, 0xff, (size_t)pd->nseg * 4);
     /* what the insertions read, packed: the ends of every piece, and per
      * insertion its piece (gathered here, where the loads do not wait on
      * one another) */
@@ -1728,6 +1822,7 @@ static plx_status build_dag(arena *a, polar *pd, polar_map *m, dbuild *b, const 
         E[2 * (size_t)i] = N[i].l;
         E[2 * (size_t)i + 1] = N[i].r;
         b->segl[i] = canon[N[i].li];
+        b->segr[i] = canon[N[i].ri];
     }
     for (i = 0; i < nw; i++) {
         const snode *g = &N[order[i]];
@@ -1741,44 +1836,11 @@ static plx_status build_dag(arena *a, polar *pd, polar_map *m, dbuild *b, const 
     t = new_trap(b);
     set_trap(b, t, m->box_lo, m->box_hi, bpt(b, m->box_hi), m->box_top, m->box_bot);
     b->T[t].leaf = new_node(b, N_LEAF, t, 0, 0);
+    note_trap(b, t);
     for (i = 0; i < nw && !b->fail; i++)
         insert_seg(b, &rec[i]);
     if (b->fail)
         return b->fail == 1 ? PLX_E_NOMEM : PLX_E_SCENE;
-    return PLX_OK;
-}
-
-/* Indexes the final map of b for the sweep: per piece the trapezoid below
- * and above it at its (canonical) left end, per point one trapezoid whose
- * left axis is that point's; every live trapezoid marked UNSET. Also
- * counts the live trapezoids into *nlive. */
-static plx_status index_map(arena *a, const polar *pd, dbuild *b, sweep *w, uint32_t *nlive)
-{
-    uint32_t *bl = scratch_n(a, pd->nseg, 4), *al = scratch_n(a, pd->nseg, 4);
-    uint32_t *ro = scratch_n(a, pd->npts, 4), t, n = 0;
-    const uint32_t *segl = b->segl;
-    if (!bl || !al || !ro)
-        return PLX_E_NOMEM;
-    memset(bl, 0xff, (size_t)pd->nseg * 4);
-    memset(al, 0xff, (size_t)pd->nseg * 4);
-    memset(ro, 0xff, (size_t)pd->npts * 4);
-    for (t = 0; t < b->ntrap; t++) {
-        btrap *x = &b->T[t];
-        if (x->leaf == POLAR_NONE)
-            continue;
-        x->leaf = UNSET;
-        n++;
-        if (segl[x->top] == x->lp)
-            bl[x->top] = t;
-        if (segl[x->bot] == x->lp)
-            al[x->bot] = t;
-        ro[x->lp] = t;
-    }
-    w->DT = b->T;
-    w->below_l = bl;
-    w->above_l = al;
-    w->right_of = ro;
-    *nlive = n;
     return PLX_OK;
 }
 
@@ -1844,10 +1906,13 @@ static plx_status build_map(arena *a, polar *pd, polar_map *m, const uint32_t *i
         for (j = i + 1; j < nev && lex_cmp(ev[j].f, ev[i].f) == 0; j++)
             canon[ev[j].i] = ev[i].i;
     st = build_dag(a, pd, m, &b, w.N, canon, order, nev);
-    if (st == PLX_OK)
-        st = index_map(a, pd, &b, &w, &nlive);
     if (st != PLX_OK)
         return st;
+    w.DT = b.T;
+    w.below_l = b.bel;
+    w.above_l = b.abl;
+    w.right_of = b.rof;
+    nlive = b.ntrap - b.nfree;
     w.regd = scratch_n(a, w.cap, 4);
     if (!w.regd)
         return PLX_E_NOMEM;
