@@ -1730,14 +1730,16 @@ static uint32_t spread16(uint32_t x)
  * random samples, which keeps the expected bounds of randomized
  * incremental construction (size, search path length); the spatial order
  * within a round makes consecutive insertions walk the same nodes (cache
- * hits). Deterministic: no global state. */
+ * hits). Sorted by a stable radix sort on 64-bit keys (ties: piece
+ * order). Deterministic: no global state. */
 static plx_status insertion_order(arena *a, const polar *pd, uint32_t **out)
 {
-    uint32_t i, n = pd->nwall, *order = scratch_n(a, n, 4);
-    keyed *k = scratch_n(a, n, sizeof(keyed));
+    uint32_t i, n = pd->nwall, d, *order = scratch_n(a, n, 4), *o2 = scratch_n(a, n, 4);
+    uint64_t *key = scratch_n(a, n, 8), *k2 = scratch_n(a, n, 8);
+    uint32_t *cnt = scratch_n(a, 65536, 4);
     uint64_t seed = 0x9e3779b97f4a7c15ull;
     double sx = 65535.0 / (pd->box[2] - pd->box[0]), sy = 65535.0 / (pd->box[3] - pd->box[1]);
-    if (!order || !k)
+    if (!order || !o2 || !key || !k2 || !cnt)
         return PLX_E_NOMEM;
     for (i = 0; i < n; i++) {
         const polar_seg *g = &pd->seg[i];
@@ -1751,13 +1753,36 @@ static plx_status insertion_order(arena *a, const polar *pd, uint32_t **out)
         }
         ux = (uint32_t)fmin(fmax(mx * sx, 0.0), 65535.0);
         uy = (uint32_t)fmin(fmax(my * sy, 0.0), 65535.0);
-        k[i].key = (double)(40 - round) * 4294967296.0 +
-                   (double)(spread16(ux) | (spread16(uy) << 1));
-        k[i].idx = i;
+        /* round (6 bits), then the Z-order of the midpoint (32) */
+        key[i] = (uint64_t)(40 - round) << 32 | (uint64_t)(spread16(ux) | (spread16(uy) << 1));
+        order[i] = i;
     }
-    qsort(k, n, sizeof(keyed), cmp_keyed);
-    for (i = 0; i < n; i++)
-        order[i] = k[i].idx;
+    for (d = 0; d < 48; d += 16) {          /* LSD radix sort, 16 bits a pass */
+        memset(cnt, 0, 65536 * 4);
+        for (i = 0; i < n; i++)
+            cnt[(key[i] >> d) & 0xffff]++;
+        {
+            uint32_t sum = 0, c;
+            for (i = 0; i < 65536; i++) {
+                c = cnt[i];
+                cnt[i] = sum;
+                sum += c;
+            }
+        }
+        for (i = 0; i < n; i++) {
+            uint32_t at = cnt[(key[i] >> d) & 0xffff]++;
+            k2[at] = key[i];
+            o2[at] = order[i];
+        }
+        {
+            uint64_t *tk = key;
+            uint32_t *to = order;
+            key = k2;
+            k2 = tk;
+            order = o2;
+            o2 = to;
+        }
+    }
     *out = order;
     return PLX_OK;
 }
