@@ -1172,9 +1172,9 @@ static plx_status build_incidence(arena *a, const polar *pd, uint32_t **inc_firs
 
 /* ---- the search DAG ---------------------------------------------------- */
 
-/* The trapezoidal map of the same wall pieces built again by randomized
- * incremental insertion (de Berg et al., ch. 6): every piece is located by
- * its frame-left end in the DAG built so far (a left end shared with an
+/* The trapezoidal map of the wall pieces built by randomized incremental
+ * insertion (de Berg et al., ch. 6): every piece is located by its
+ * frame-left end in the DAG built so far (a left end shared with an
  * earlier piece goes right at that point's x node, and at a y node of a
  * piece sharing it the other ends decide, i.e. the slopes), followed
  * through the trapezoids it crosses, and those are replaced by the pieces
@@ -1183,8 +1183,12 @@ static plx_status build_incidence(arena *a, const polar *pd, uint32_t **inc_firs
  * several parents). The order is random from a fixed seed (see
  * insertion_order), so the build is deterministic while the expected bounds
  * hold: O(n) nodes, O(log n) nodes on a search path, O(n log n) time. A
- * piece with an end already in the map is searched from that end's x node
- * (most are: polygon edges share their ends), the others from the root.
+ * piece with an end already in the map (about two thirds: polygon edges
+ * share their ends) is not searched in the DAG: the trapezoid holding its
+ * start is found among the few around that end (walk_at: the map's live
+ * trapezoids are kept by role, per point and per piece end, updated by
+ * every insertion; a walk longer than WALK_MAX falls back to the DAG from
+ * that end's x node), the others are searched from the root.
  * Measured (bench_polar): 4.4 to 4.9 inner nodes per piece (8 or 12
  * bytes each, see polar_map), search paths of about 2 log2 n nodes on
  * average. It runs first, on pieces not yet checked: a walk only moves to
