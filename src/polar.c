@@ -861,6 +861,19 @@ typedef struct btrap {
                               * (tag 1 or 2: set) */
 } btrap;
 
+/* The live trapezoids of the DAG's map by role (see walk_at), packed so
+ * that one record serves a whole update. Per piece: its canonical ends
+ * and the trapezoids above / below it at them; index 0: left end, 1:
+ * right end. Per point: a trapezoid whose left (0) / right (1) axis is the
+ * point's. POLAR_NONE: none yet. */
+typedef struct sroles {
+    uint32_t end[2], up[2], down[2];
+} sroles;
+
+typedef struct proles {
+    uint32_t side[2];
+} proles;
+
 typedef struct snode {
     vec2 l, r;          /* frame ends, l before r */
     int32_t cov;        /* footprints covering the gap above it */
@@ -889,7 +902,8 @@ typedef struct sweep {
      * axis; each gap the sweep opens is one of them, whose child word it
      * sets in word[], and regd[] keeps it per region */
     btrap *DT;
-    const uint32_t *below_l, *above_l, *right_of;
+    const sroles *SR;
+    const proles *PR;
     uint32_t *regd;
     uint32_t ngap;      /* gaps opened, free or solid */
     uint64_t steps;     /* status pieces walked and start pieces sorted */
@@ -1062,7 +1076,7 @@ static int sweep_event(sweep *w, vec2 P, uint32_t pi, const fpoint *pts, uint32_
          * every piece: that floor is the piece below P just right of P,
          * and no piece ends at P, so it is the status piece below P);
          * checked to be in the status and strictly below P */
-        uint32_t d = ns ? w->below_l[w->start[0]] : POLAR_NONE;
+        uint32_t d = ns ? w->SR[w->start[0]].down[0] : POLAR_NONE;
         if (d == POLAR_NONE)
             return -1;
         B = w->DT[d].bot;
@@ -1111,7 +1125,7 @@ static int sweep_event(sweep *w, vec2 P, uint32_t pi, const fpoint *pts, uint32_
             if (h == POLAR_NONE)
                 return -1;
         }
-        if (open_gap(w, j ? w->above_l[bot] : ns ? w->below_l[w->start[0]] : w->right_of[pi],
+        if (open_gap(w, j ? w->SR[bot].up[0] : ns ? w->SR[w->start[0]].down[0] : w->PR[pi].side[0],
                      pi, top, bot, h) != 0)
             return -1;
         N[bot].open = h;
@@ -1216,12 +1230,9 @@ typedef struct dbuild {
     const uint32_t *canon;   /* per point: the first point at its position */
     const snode *N;          /* per piece: the sweep's data (y test kind) */
     const vec2 *E;           /* per piece: frame ends, left then right */
-    uint32_t *segl, *segr;   /* per piece: its canonical left / right end */
-    /* the live trapezoids by role, kept up to date by every insertion: per
-     * point one whose left (rof) / right (lof) axis is the point's; per
-     * piece the one above (abl, abr) / below (bel, ber) it at its left /
-     * right end */
-    uint32_t *rof, *lof, *abl, *bel, *abr, *ber;
+    /* the live trapezoids by role, kept up to date by every insertion */
+    sroles *SR;
+    proles *PR;
     vec2 P, Q;               /* the piece being inserted: its frame ends */
     uint32_t *hint;          /* per canonical point: its x node, POLAR_NONE */
     int fail;                /* 1: out of memory, 2: pieces not planar */
@@ -1358,16 +1369,17 @@ static void set_trap(dbuild *b, uint32_t t, uint32_t lp, uint32_t rp, vec2 rc, u
 static void note_trap(dbuild *b, uint32_t t)
 {
     const btrap *x = &b->T[t];
-    b->rof[x->lp] = t;
-    b->lof[x->rp] = t;
-    if (b->segl[x->top] == x->lp)
-        b->bel[x->top] = t;
-    if (b->segl[x->bot] == x->lp)
-        b->abl[x->bot] = t;
-    if (b->segr[x->top] == x->rp)
-        b->ber[x->top] = t;
-    if (b->segr[x->bot] == x->rp)
-        b->abr[x->bot] = t;
+    sroles *top = &b->SR[x->top], *bot = &b->SR[x->bot];
+    b->PR[x->lp].side[0] = t;
+    b->PR[x->rp].side[1] = t;
+    if (top->end[0] == x->lp)
+        top->down[0] = t;
+    if (top->end[1] == x->rp)
+        top->down[1] = t;
+    if (bot->end[0] == x->lp)
+        bot->up[0] = t;
+    if (bot->end[1] == x->rp)
+        bot->up[1] = t;
 }
 
 /* The trapezoid holding the points just right of end point p of the new
@@ -1380,9 +1392,8 @@ static void note_trap(dbuild *b, uint32_t t)
 #define WALK_MAX 12
 static uint32_t walk_at(dbuild *b, uint32_t p, vec2 D, int right)
 {
-    const uint32_t *ends = right ? b->segl : b->segr;
-    const uint32_t *up = right ? b->abl : b->abr, *down = right ? b->bel : b->ber;
-    uint32_t t = right ? b->rof[p] : b->lof[p], n;
+    int k = right ? 0 : 1;
+    uint32_t t = b->PR[p].side[k], n;
     for (n = 0; n < WALK_MAX && t != POLAR_NONE; n++) {
         const btrap *x = &b->T[t];
         uint32_t e = right ? x->lp : x->rp;
@@ -1391,23 +1402,23 @@ static uint32_t walk_at(dbuild *b, uint32_t p, vec2 D, int right)
         if (x->leaf == POLAR_NONE || e != p)
             return POLAR_NONE;
         b->steps++;
-        if (ends[x->top] == p) {
+        if (b->SR[x->top].end[k] == p) {
             g = &b->E[2 * (size_t)x->top];
             o = geom_orient(g[0], g[1], D);
             if (o == 0)
                 return POLAR_NONE;    /* overlapping pieces: the DAG says so */
             if (o > 0) {
-                t = up[x->top];
+                t = b->SR[x->top].up[k];
                 continue;
             }
         }
-        if (ends[x->bot] == p) {
+        if (b->SR[x->bot].end[k] == p) {
             g = &b->E[2 * (size_t)x->bot];
             o = geom_orient(g[0], g[1], D);
             if (o == 0)
                 return POLAR_NONE;
             if (o < 0) {
-                t = down[x->bot];
+                t = b->SR[x->bot].down[k];
                 continue;
             }
         }
@@ -1796,8 +1807,8 @@ static plx_status insertion_order(arena *a, const polar *pd, uint32_t **out)
 static void prefetch_roles(const dbuild *b, const irec *in)
 {
 #if defined(__GNUC__)
-    __builtin_prefetch(&b->rof[in->l]);
-    __builtin_prefetch(&b->lof[in->r]);
+    __builtin_prefetch(&b->PR[in->l]);
+    __builtin_prefetch(&b->PR[in->r]);
     __builtin_prefetch(&b->hint[in->l]);
 #else
     (void)b;
@@ -1839,33 +1850,22 @@ static plx_status build_dag(arena *a, polar *pd, polar_map *m, dbuild *b, const 
     b->chunk = scratch_n(a, b->maxchunk, sizeof *b->chunk);
     b->hint = scratch_n(a, pd->npts, 4);
     b->E = E = scratch_n(a, 2 * (size_t)pd->nseg, sizeof(vec2));
-    b->segl = scratch_n(a, pd->nseg, 4);
-    b->segr = scratch_n(a, pd->nseg, 4);
-    b->rof = scratch_n(a, pd->npts, 4);
-    b->lof = scratch_n(a, pd->npts, 4);
-    b->abl = scratch_n(a, pd->nseg, 4);
-    b->bel = scratch_n(a, pd->nseg, 4);
-    b->abr = scratch_n(a, pd->nseg, 4);
-    b->ber = scratch_n(a, pd->nseg, 4);
+    b->SR = scratch_n(a, pd->nseg, sizeof(sroles));
+    b->PR = scratch_n(a, pd->npts, sizeof(proles));
     rec = scratch_n(a, nw, sizeof(irec));
     if (!b->T || !b->freel || !b->list || !b->up || !b->lo || !b->chunk || !b->hint || !E ||
-        !b->segl || !b->segr || !b->rof || !b->lof || !b->abl || !b->bel || !b->abr ||
-        !b->ber || !rec)
+        !b->SR || !b->PR || !rec)
         return PLX_E_NOMEM;
-    memset(b->rof, 0xff, (size_t)pd->npts * 4);
-    memset(b->lof, 0xff, (size_t)pd->npts * 4);
-    memset(b->abl, 0xff, (size_t)pd->nseg * 4);
-    memset(b->bel, 0xff, (size_t)pd->nseg * 4);
-    memset(b->abr, 0xff, (size_t)pd->nseg * 4);
-    memset(b->ber, 0xff, (size_t)pd->nseg * 4);
+    memset(b->SR, 0xff, (size_t)pd->nseg * sizeof(sroles));
+    memset(b->PR, 0xff, (size_t)pd->npts * sizeof(proles));
     /* what the insertions read, packed: the ends of every piece, and per
      * insertion its piece (gathered here, where the loads do not wait on
      * one another) */
     for (i = 0; i < pd->nseg; i++) {
         E[2 * (size_t)i] = N[i].l;
         E[2 * (size_t)i + 1] = N[i].r;
-        b->segl[i] = canon[N[i].li];
-        b->segr[i] = canon[N[i].ri];
+        b->SR[i].end[0] = canon[N[i].li];
+        b->SR[i].end[1] = canon[N[i].ri];
     }
     for (i = 0; i < nw; i++) {
         const snode *g = &N[order[i]];
@@ -1955,15 +1955,14 @@ static plx_status build_map(arena *a, polar *pd, polar_map *m, const uint32_t *i
     if (st != PLX_OK)
         return st;
     w.DT = b.T;
-    w.below_l = b.bel;
-    w.above_l = b.abl;
-    w.right_of = b.rof;
+    w.SR = b.SR;
+    w.PR = b.PR;
     nlive = b.ntrap - b.nfree;
     w.regd = scratch_n(a, w.cap, 4);
     if (!w.regd)
         return PLX_E_NOMEM;
     w.N[m->box_bot].open = new_region(&w, m->box_lo, m->box_top, m->box_bot);
-    if (open_gap(&w, w.above_l[m->box_bot], m->box_lo, m->box_top, m->box_bot,
+    if (open_gap(&w, b.SR[m->box_bot].up[0], m->box_lo, m->box_top, m->box_bot,
                  w.N[m->box_bot].open) != 0)
         return PLX_E_SCENE;
     for (i = 0; i < nev; i = j) {
