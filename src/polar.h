@@ -31,18 +31,25 @@
  *
  * Quadrants 0 and 2 (scan starting east and west) share one set of
  * horizontal axes, quadrants 1 and 3 one set of vertical axes: two planar
- * subdivisions, four labellings. Each subdivision is built by a plane sweep
- * over the wall ends (deterministic; O(n log n) for n footprint edges to
- * sort the ends, then O(1) per event for evenly spread walls: the sweep
- * status is a linked list, and an event where walls only start finds the
- * wall below it in a grid of the wall pieces, a construction temporary).
- * Points are located in O(log n) expected time by a search DAG per
- * subdivision: the trapezoidal map of the same walls built again by
- * randomized incremental insertion (de Berg et al., "Computational
- * Geometry", ch. 6; Seidel 1991) in a seeded random order (random rounds,
- * spatial order within a round: deterministic), its leaves mapped to the
- * sweep's free regions or marked solid (expected O(n) nodes, expected
- * O(n log n) to build). A ray walks from region to region
+ * subdivisions, four labellings. Each subdivision is the trapezoidal map
+ * of the wall pieces, built by randomized incremental insertion (de Berg
+ * et al., "Computational Geometry", ch. 6; Seidel 1991) in a seeded random
+ * order (random rounds, spatial order within a round: deterministic),
+ * which also gives its search DAG for point location: expected O(n) nodes,
+ * O(n log n) time to build, O(log n) per query, for n wall pieces. A plane
+ * sweep over the wall ends then checks that the pieces form a planar
+ * subdivision and that the insertion's map is that subdivision, and makes
+ * the free regions in a deterministic order with their adjacency: where
+ * walls only start, it reads the piece below the event from the map (the
+ * floor of the trapezoid below the lowest piece starting there), so each
+ * event costs O(1) plus O(d log d) for d pieces starting at it: O(n log n)
+ * in all, whatever the layout (no grid). Cutting the footprints at their
+ * contacts costs O(n log n) plus, per pair of footprints whose bounding
+ * boxes meet, O(log n) and a comparison of their edges near the other's
+ * box (O(1) for footprints of bounded size; the pairs of edges compared
+ * can number more than the contacts when many large boxes overlap). The
+ * DAG's leaves are mapped to the sweep's free regions or marked solid.
+ * A ray walks from region to region
  * through the stored adjacency until it leaves through a wall.
  *
  * Degenerate input: footprints that share walls exactly, touch at T-junctions
@@ -140,6 +147,9 @@ typedef struct polar {
     double box[4];           /* s->bounds */
     polar_map map[2];        /* [0]: quadrants 0, 2   [1]: quadrants 1, 3 */
     size_t bytes[4];         /* axes, regions, polygons, rest (search DAGs, header) */
+    uint64_t steps;          /* construction work, for tests: DAG nodes and
+                              * trapezoids visited by the insertions, status
+                              * pieces walked and sorted by the sweeps */
 } polar;
 
 /* Builds the four diagrams of scene s. On success *out points into arena
@@ -228,14 +238,16 @@ int32_t polar_locate_frame_ex(const polar *pd, const polar_map *m, vec2 f, int32
  * w[2] the child words, in the 32-bit forms above. */
 void polar_node(const polar_map *m, uint32_t n, uint32_t w[3] /* OUT */);
 
-/* polar_build with flags: POLAR_BUILD_NO_DAG skips the search DAGs (to time
- * the rest of the construction; point location and everything using it are
+/* polar_build with flags: POLAR_BUILD_NO_DAG does not keep the search DAGs
+ * (the trapezoidal maps are still built by insertion, the sweep needs them:
+ * this times keeping the nodes; point location and everything using it are
  * then unusable); POLAR_BUILD_WIDE_DAG stores every node in 12 bytes (to
  * test that layout on small scenes). */
 enum { POLAR_BUILD_NO_DAG = 1, POLAR_BUILD_WIDE_DAG = 2 };
 plx_status polar_build_flags(arena *a, const scene *s, int flags, polar **out /* OUT */);
 
-/* The former point location, kept as a reference: the nearest wall below
+/* The former point location, kept as a reference (the construction uses
+ * no grid): the nearest wall below
  * the point found by scanning a column of a grid of the wall pieces, then
  * the regions above that wall walked to the point (O(1) expected for evenly
  * spread walls, O(n) worst case). polar_scan_new keeps its grid and tables
