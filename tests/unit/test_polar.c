@@ -791,6 +791,63 @@ static void test_regions_tile_free_space(void **state)
     fixture_free(f);
 }
 
+/* Every region of every quadrant carries a label, and it is the object met
+ * first by the quadrant's start ray from the region's points (a building,
+ * or -1: the Bounds frame), checked by brute force at each region's
+ * centroid, which polar_locate must also place in that region. */
+static void test_every_region_labelled(void **state)
+{
+    static const double dirs[4][2] = { { 1, 0 }, { 0, 1 }, { -1, 0 }, { 0, -1 } };
+    fixture *f = fixture_new();
+    int q, frame_regions = 0, bld_regions = 0, bad = 0, checked = 0;
+    uint32_t i;
+    (void)state;
+    rnd_state = 4711u;
+    add_courtyard(f, 0, 0, 30, 30, 6);
+    add_l_shape(f, 40, 0, 10, 12);
+    add_rotated_box(f, 60, 5, 8, 4, 0.7);
+    scene_boxes(f, 30, 1);
+    fixture_build(f);
+    for (q = 0; q < 4; q++) {
+        uint32_t n = polar_region_count(f->pd, q);
+        for (i = 0; i < n; i++) {
+            vec2 c[4], m, e;
+            int32_t own, own2;
+            int solid, k, bb;
+            double a = 0;
+            assert_int_equal(polar_region(f->pd, q, i, c, &own, &solid), 4);
+            assert_int_equal(solid, 0);
+            assert_true(own >= -1 && own < (int32_t)f->s.nbld);
+            for (k = 0; k < 4; k++)
+                a += c[k].x * c[(k + 1) % 4].y - c[(k + 1) % 4].x * c[k].y;
+            if (0.5 * a < 1e-6)
+                continue;          /* a sliver: its centroid may sit on a side */
+            m.x = 0.25 * (c[0].x + c[1].x + c[2].x + c[3].x);
+            m.y = 0.25 * (c[0].y + c[1].y + c[2].y + c[3].y);
+            if (where(&f->s, m) != 0)
+                continue;
+            checked++;
+            if (polar_locate(f->pd, q, m, &own2) != (int32_t)i || own2 != own)
+                bad++;
+            e.x = m.x + dirs[q][0] * 1e4;
+            e.y = m.y + dirs[q][1] * 1e4;
+            brute_first(&f->s, m, e, &bb);
+            if (bb != own)
+                bad++;
+            if (own < 0)
+                frame_regions++;
+            else
+                bld_regions++;
+        }
+    }
+    print_message("every region labelled: %d regions checked (%d by a building, %d by the frame)\n",
+                  checked, bld_regions, frame_regions);
+    assert_int_equal(bad, 0);
+    assert_true(frame_regions > 0 && bld_regions > 0);
+    assert_true(checked > 400);
+    fixture_free(f);
+}
+
 static void test_memory_accounting(void **state)
 {
     fixture *f = fixture_new();
@@ -1091,6 +1148,7 @@ int main(void)
         cmocka_unit_test(test_shoot_exact_once),
         cmocka_unit_test(test_first_object),
         cmocka_unit_test(test_regions_tile_free_space),
+        cmocka_unit_test(test_every_region_labelled),
         cmocka_unit_test(test_memory_accounting),
         cmocka_unit_test(test_fault_injection),
         cmocka_unit_test(test_random_boxes),
