@@ -1,13 +1,17 @@
 #!/bin/sh
-# Runs every unit test binary and the command-line tests; prints one closing
-# line "N passed, N failed" and fails if any test failed.
+# Runs every unit test binary (PLX_TEST_JOBS at a time, default: the number
+# of processors) and the command-line tests; prints one closing line
+# "N passed, N failed" and fails if any test failed.
 # usage: tests/run_tests.sh BUILD_DIR TEST_BINARY...
 build=$1; shift
+jobs=${PLX_TEST_JOBS:-$(getconf _NPROCESSORS_ONLN 2>/dev/null || echo 2)}
 passed=0; failed=0; broken=""
-log=$(mktemp)
+logs=$(mktemp -d)
+for t in "$@"; do echo "$t"; done |
+    xargs -P "$jobs" -I {} sh -c 'n=$(basename "$1"); "$1" >"$2/$n.log" 2>&1; echo $? >"$2/$n.rc"' _ {} "$logs"
+sh tests/cli/run.sh "$build/polarlux" >"$logs/cli.log" 2>&1; echo $? >"$logs/cli.rc"
 for t in "$@"; do
-    name=$(basename "$t")
-    "$t" >"$log" 2>&1; rc=$?
+    name=$(basename "$t"); log="$logs/$name.log"; rc=$(cat "$logs/$name.rc" 2>/dev/null || echo 1)
     p=$(sed -n 's/^\[  PASSED  \] \([0-9]*\) test.*/\1/p' "$log" | tail -1)
     f=$(sed -n 's/^\[  FAILED  \] \([0-9]*\) test.*/\1/p' "$log" | tail -1)
     p=${p:-0}; f=${f:-0}
@@ -20,7 +24,7 @@ for t in "$@"; do
         echo "ok   $name: $p tests"
     fi
 done
-sh tests/cli/run.sh "$build/polarlux" >"$log" 2>&1; rc=$?
+log="$logs/cli.log"; rc=$(cat "$logs/cli.rc")
 p=$(sed -n 's/^cli: \([0-9]*\) passed, \([0-9]*\) failed$/\1/p' "$log")
 f=$(sed -n 's/^cli: \([0-9]*\) passed, \([0-9]*\) failed$/\2/p' "$log")
 p=${p:-0}; f=${f:-1}
@@ -30,7 +34,7 @@ if [ "$f" -ne 0 ] || [ "$rc" -ne 0 ]; then
 else
     echo "ok   cli: $p tests"
 fi
-rm -f "$log"
+rm -rf "$logs"
 [ -n "$broken" ] && echo "failing:$broken"
 echo "$passed passed, $failed failed"
 [ "$failed" -eq 0 ]
