@@ -18,6 +18,7 @@
 #include <float.h>
 #include <limits.h>
 #include "blocks.h"
+#include "msort.h"
 
 #define BLK_NONE UINT32_MAX
 #define BLK_ALIGN 8
@@ -695,38 +696,14 @@ static plx_status strips_build(arena *a, strips *st, const vec2 *pos, const seg 
 
 /* ---- sorting (no libc qsort in src/) ------------------------------------ */
 
-static int seg_less(const seg *x, const seg *y)
+static int seg_less(const seg *x, const seg *y, const void *ctx)
 {
+    (void)ctx;
     return x->u < y->u || (x->u == y->u && x->v < y->v);
 }
 
-/* Stable bottom-up merge sort of n segments by (u, v); tmp holds n. */
-static void seg_sort(seg *a, seg *tmp, uint32_t n)
-{
-    seg *src = a, *dst = tmp, *t;
-    size_t w, i, l, m, r, p, q, k;
-    for (w = 1; w < n; w *= 2) {
-        for (i = 0; i < n; i += 2 * w) {
-            l = i;
-            m = i + w < n ? i + w : n;
-            r = i + 2 * w < n ? i + 2 * w : n;
-            p = l;
-            q = m;
-            k = l;
-            while (p < m && q < r)
-                dst[k++] = seg_less(&src[q], &src[p]) ? src[q++] : src[p++];
-            while (p < m)
-                dst[k++] = src[p++];
-            while (q < r)
-                dst[k++] = src[q++];
-        }
-        t = src;
-        src = dst;
-        dst = t;
-    }
-    if (src != a)
-        memcpy(a, src, (size_t)n * sizeof(seg));
-}
+/* Segments by (u, v). */
+MSORT_DEFINE(seg_sort, seg, const void *, seg_less)
 
 /* Insertion sort of ids by key (short lists: hits on one edge, edges at
  * one vertex). */
@@ -1224,38 +1201,23 @@ static size_t cross_cell(const grid *og, const double *pbox, const crossing *x)
     return (size_t)cy * og->nx + cx;
 }
 
-/* Sorts the crossings into the order cross_pass() over a plain grid with
- * the geometry of og finds them: by cell, then by pieces (merge sort). */
-static void cross_sort(const grid *og, const double *pbox, crossing *xr, crossing *tmp,
-                       uint32_t n)
+/* The plain grid whose pass order cross_sort() reproduces. */
+typedef struct cross_order {
+    const grid *og;
+    const double *pbox;
+} cross_order;
+
+/* Is crossing x found before y by cross_pass() over a plain grid with the
+ * geometry of og: by cell, then by pieces? */
+static int cross_before(const crossing *x, const crossing *y, const cross_order *c)
 {
-    crossing *src = xr, *dst = tmp, *t;
-    size_t w, i, m, r, p, q, o;
-    for (w = 1; w < n; w *= 2) {
-        for (i = 0; i < n; i += 2 * w) {
-            m = i + w < n ? i + w : n;
-            r = i + 2 * w < n ? i + 2 * w : n;
-            p = i;
-            q = m;
-            o = i;
-            while (p < m && q < r) {
-                size_t cp = cross_cell(og, pbox, &src[p]), cq = cross_cell(og, pbox, &src[q]);
-                int qfirst = cq < cp || (cq == cp && (src[q].i < src[p].i ||
-                                                      (src[q].i == src[p].i && src[q].j < src[p].j)));
-                dst[o++] = qfirst ? src[q++] : src[p++];
-            }
-            while (p < m)
-                dst[o++] = src[p++];
-            while (q < r)
-                dst[o++] = src[q++];
-        }
-        t = src;
-        src = dst;
-        dst = t;
-    }
-    if (src != xr)
-        memcpy(xr, src, (size_t)n * sizeof(crossing));
+    size_t cx = cross_cell(c->og, c->pbox, x), cy = cross_cell(c->og, c->pbox, y);
+    return cx < cy || (cx == cy && (x->i < y->i || (x->i == y->i && x->j < y->j)));
 }
+
+/* Sorts the crossings into the order cross_pass() over a plain grid finds
+ * them. */
+MSORT_DEFINE(cross_sort, crossing, const cross_order *, cross_before)
 
 static void seg_push(seg *sg, uint32_t *n, uint32_t u, uint32_t v)
 {
@@ -1310,7 +1272,12 @@ static plx_status blk_segments(blk *k)
         crossing *xt;
         cross_pass_h(k, &hg, pbox, xr);
         SCRATCH(xt, nx, crossing);
-        cross_sort(&g, pbox, xr, xt, nx);
+        {
+            cross_order co;
+            co.og = &g;
+            co.pbox = pbox;
+            cross_sort(xr, xt, nx, &co);
+        }
     } else {
         cross_pass(k, &g, pbox, xr);
     }
@@ -1386,7 +1353,7 @@ static plx_status blk_segments(blk *k)
         }
         seg_push(raw, &n, prev, k->pb[i]);
     }
-    seg_sort(raw, tmp, n);
+    seg_sort(raw, tmp, n, NULL);
     k->ns = 0;
     for (i = 0; i < n; i = j) {
         int32_t w = 0;
@@ -1489,32 +1456,14 @@ typedef struct keyid {
     uint32_t id;
 } keyid;
 
-/* Stable bottom-up merge sort of n keys (no NaN); tmp holds n. */
-static void keyid_sort(keyid *a, keyid *tmp, uint32_t n)
+static int keyid_before(const keyid *a, const keyid *b, const void *ctx)
 {
-    keyid *src = a, *dst = tmp, *t;
-    size_t w, i, m, r, p, q, o;
-    for (w = 1; w < n; w *= 2) {
-        for (i = 0; i < n; i += 2 * w) {
-            m = i + w < n ? i + w : n;
-            r = i + 2 * w < n ? i + 2 * w : n;
-            p = i;
-            q = m;
-            o = i;
-            while (p < m && q < r)
-                dst[o++] = src[q].key < src[p].key ? src[q++] : src[p++];
-            while (p < m)
-                dst[o++] = src[p++];
-            while (q < r)
-                dst[o++] = src[q++];
-        }
-        t = src;
-        src = dst;
-        dst = t;
-    }
-    if (src != a)
-        memcpy(a, src, (size_t)n * sizeof(keyid));
+    (void)ctx;
+    return a->key < b->key;
 }
+
+/* Keys in increasing order, stable (no NaN). */
+MSORT_DEFINE(keyid_sort, keyid, const void *, keyid_before)
 
 /* What the sweep of one direction shares. box[4j..4j+3] is the box of
  * sub-edge j (minx, miny, maxx, maxy). */
@@ -1574,10 +1523,10 @@ static plx_status ray_counts_dir(const sweep *sw, int dir)
         arena_release(k->a, &mk);
         return PLX_OK;
     }
-    keyid_sort(qs, tmp, nq);
-    keyid_sort(ins, tmp, ne);
-    keyid_sort(del, tmp, ne);
-    keyid_sort(rl, tmp, ne);
+    keyid_sort(qs, tmp, nq, NULL);
+    keyid_sort(ins, tmp, ne, NULL);
+    keyid_sort(del, tmp, ne, NULL);
+    keyid_sort(rl, tmp, ne, NULL);
     for (j = 0; j < ne; j++)
         rank[rl[j].id] = j;
     SCRATCH(fen, (size_t)ne + 1, int64_t);

@@ -26,6 +26,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include "polar.h"
+#include "msort.h"
 #include "geom.h"
 
 enum { UL = 0, LL = 1, UR = 2, LR = 3 };
@@ -530,98 +531,34 @@ typedef struct pkey {
     uint32_t k;
 } pkey;
 
-static int pkey_before(const pkey *a, const pkey *b)
+static int pkey_before(const pkey *a, const pkey *b, const void *ctx)
 {
+    (void)ctx;
     int c = lex_cmp(a->lo, b->lo);
     if (c == 0)
         c = lex_cmp(a->hi, b->hi);
     return c < 0 || (c == 0 && a->k < b->k);
 }
 
-static void sort_pkeys(pkey *v, pkey *tmp, uint32_t n)
+MSORT_DEFINE(sort_pkeys, pkey, const void *, pkey_before)
+
+/* The direction of an edge for sorting its cuts: its points, and whether it
+ * runs in lexicographic order. */
+typedef struct cut_order {
+    const vec2 *P;
+    int fwd;
+} cut_order;
+
+/* Is cut a before cut b along the edge? */
+static int cut_before(const split *a, const split *b, const cut_order *o)
 {
-    uint32_t w, i, j;
-    pkey *src = v, *dst = tmp;
-    for (i = 0; i < n; i += 16) {
-        uint32_t e = i + 16 < n ? i + 16 : n;
-        for (j = i + 1; j < e; j++) {
-            pkey t = v[j];
-            uint32_t k = j;
-            while (k > i && pkey_before(&t, &v[k - 1])) {
-                v[k] = v[k - 1];
-                k--;
-            }
-            v[k] = t;
-        }
-    }
-    for (w = 16; w < n; w *= 2) {
-        for (i = 0; i < n; i += 2 * w) {
-            uint32_t a = i, am = i + w < n ? i + w : n, b = am, bm = i + 2 * w < n ? i + 2 * w : n;
-            uint32_t o = i;
-            while (a < am && b < bm)
-                dst[o++] = pkey_before(&src[b], &src[a]) ? src[b++] : src[a++];
-            while (a < am)
-                dst[o++] = src[a++];
-            while (b < bm)
-                dst[o++] = src[b++];
-        }
-        {
-            pkey *t = src;
-            src = dst;
-            dst = t;
-        }
-    }
-    if (src != v)
-        memcpy(v, src, (size_t)n * sizeof *v);
+    int c = lex_cmp(o->P[a->pt], o->P[b->pt]);
+    return o->fwd ? c < 0 : c > 0;
 }
 
-/* Is cut a before cut b along an edge (fwd: the edge runs in lexicographic
- * order)? */
-static int cut_before(const split *a, const split *b, const vec2 *P, int fwd)
-{
-    int c = lex_cmp(P[a->pt], P[b->pt]);
-    return fwd ? c < 0 : c > 0;
-}
-
-/* Sorts the cut points of one edge along it: insertion sort in runs of 8
- * (most edges have few cuts), then bottom-up merges (a long wall cut by
- * many footprints: O(c log c)). Stable; tmp holds n. */
-static void sort_cuts(split *v, split *tmp, uint32_t n, const vec2 *P, int fwd)
-{
-    uint32_t i, j, w;
-    split *src = v, *dst = tmp;
-    for (i = 0; i < n; i += 8) {
-        uint32_t e = i + 8 < n ? i + 8 : n;
-        for (j = i + 1; j < e; j++) {
-            split t = v[j];
-            uint32_t k = j;
-            while (k > i && cut_before(&t, &v[k - 1], P, fwd)) {
-                v[k] = v[k - 1];
-                k--;
-            }
-            v[k] = t;
-        }
-    }
-    for (w = 8; w < n; w *= 2) {
-        for (i = 0; i < n; i += 2 * w) {
-            uint32_t a = i, am = i + w < n ? i + w : n, b = am, bm = i + 2 * w < n ? i + 2 * w : n;
-            uint32_t o = i;
-            while (a < am && b < bm)
-                dst[o++] = cut_before(&src[b], &src[a], P, fwd) ? src[b++] : src[a++];
-            while (a < am)
-                dst[o++] = src[a++];
-            while (b < bm)
-                dst[o++] = src[b++];
-        }
-        {
-            split *t = src;
-            src = dst;
-            dst = t;
-        }
-    }
-    if (src != v)
-        memcpy(v, src, (size_t)n * sizeof *v);
-}
+/* Sorts the cut points of one edge along it (a long wall cut by many
+ * footprints: O(c log c)). */
+MSORT_DEFINE(sort_cuts, split, const cut_order *, cut_before)
 
 static void emit_piece(piece *out, uint32_t *n, const vec2 *P, uint32_t a, uint32_t b, int32_t bld)
 {
@@ -852,7 +789,10 @@ static plx_status cut_pieces(arena *a, split_ctx *c, const piece *in, uint32_t n
         uint8_t bent = 0;
         for (; j < c->nsp && sp[j].seg == i; j++)
             bent |= (uint8_t)(all_cuts || sp[j].rounded);
-        sort_cuts(sp + j0, sptmp, j - j0, P, lex_cmp(P[in[i].a], P[in[i].b]) < 0);
+        cut_order co;
+        co.P = P;
+        co.fwd = lex_cmp(P[in[i].a], P[in[i].b]) < 0;
+        sort_cuts(sp + j0, sptmp, j - j0, &co);
         for (k = j0; k < j; k++) {
             emit_piece(pc, &m, P, prev, sp[k].pt, in[i].bld);
             prev = sp[k].pt;
@@ -1243,49 +1183,14 @@ typedef struct sweep {
     uint64_t steps;     /* status pieces walked and start pieces sorted */
 } sweep;
 
-static int fp_before(const fpoint *a, const fpoint *b)
+static int fp_before(const fpoint *a, const fpoint *b, const void *ctx)
 {
+    (void)ctx;
     int c = lex_cmp(a->f, b->f);
     return c < 0 || (c == 0 && a->i < b->i);
 }
 
-/* Bottom-up merge sort (runs of 16 by insertion first); result in v. */
-static void sort_fpoints(fpoint *v, fpoint *tmp, uint32_t n)
-{
-    uint32_t w, i, j;
-    fpoint *src = v, *dst = tmp;
-    for (i = 0; i < n; i += 16) {
-        uint32_t e = i + 16 < n ? i + 16 : n;
-        for (j = i + 1; j < e; j++) {
-            fpoint t = v[j];
-            uint32_t k = j;
-            while (k > i && fp_before(&t, &v[k - 1])) {
-                v[k] = v[k - 1];
-                k--;
-            }
-            v[k] = t;
-        }
-    }
-    for (w = 16; w < n; w *= 2) {
-        for (i = 0; i < n; i += 2 * w) {
-            uint32_t a = i, am = i + w < n ? i + w : n, b = am, bm = i + 2 * w < n ? i + 2 * w : n;
-            uint32_t o = i;
-            while (a < am && b < bm)
-                dst[o++] = fp_before(&src[b], &src[a]) ? src[b++] : src[a++];
-            while (a < am)
-                dst[o++] = src[a++];
-            while (b < bm)
-                dst[o++] = src[b++];
-        }
-        {
-            fpoint *t = src;
-            src = dst;
-            dst = t;
-        }
-    }
-    if (src != v)
-        memcpy(v, src, (size_t)n * sizeof *v);
-}
+MSORT_DEFINE(sort_fpoints, fpoint, const void *, fp_before)
 
 static uint32_t new_region(sweep *w, uint32_t lp, uint32_t top, uint32_t bot)
 {
@@ -2279,7 +2184,7 @@ static plx_status build_map(arena *a, polar *pd, polar_map *m, const uint32_t *i
         ev[i].f = fpt(pd, m->frame, evp[i]);
         ev[i].i = evp[i];
     }
-    sort_fpoints(ev, tmp, nev);
+    sort_fpoints(ev, tmp, nev, NULL);
     for (i = 0; i < pd->npts; i++)
         canon[i] = i;
     for (i = 0; i < nev; i = j)
@@ -2424,7 +2329,7 @@ static plx_status make_walls(arena *a, polar *pd)
             ky[i].hi = pd->pts[pc[i].hi];
             ky[i].k = i;
         }
-        sort_pkeys(ky, tmp, np);
+        sort_pkeys(ky, tmp, np, NULL);
         for (i = 0; i < np; i++)
             pc2[i] = pc[ky[i].k];
         pc = pc2;
