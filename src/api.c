@@ -2,20 +2,6 @@
 #include <string.h>
 #include "engine.h"
 
-static plx_status need_scene(plx_engine *e, const char *fn)
-{
-    char msg[128];
-    strbuf b;
-    if (!eng_ok(e))
-        return PLX_E_INVALID;
-    if (e->sc)
-        return PLX_OK;
-    sb_init(&b, msg, sizeof msg);
-    sb_str(&b, fn);
-    sb_str(&b, ": no scene is loaded");
-    return eng_fail(e, PLX_E_NOSCENE, msg);
-}
-
 static plx_status bad_index(plx_engine *e, const char *fn, uint32_t i, uint32_t n)
 {
     char msg[160];
@@ -45,7 +31,7 @@ plx_status plx_scene_info_get(plx_engine *e, plx_scene_info *out)
 {
     const scene *s;
     uint32_t i;
-    plx_status st = need_scene(e, "plx_scene_info_get");
+    plx_status st = eng_need_scene(e, "plx_scene_info_get");
     if (st != PLX_OK || !out)
         return st != PLX_OK ? st : PLX_E_INVALID;
     s = e->sc;
@@ -83,7 +69,7 @@ plx_status plx_scene_info_get(plx_engine *e, plx_scene_info *out)
 plx_status plx_building_get(plx_engine *e, uint32_t i, plx_building *out)
 {
     const scene_building *b;
-    plx_status st = need_scene(e, "plx_building_get");
+    plx_status st = eng_need_scene(e, "plx_building_get");
     if (st != PLX_OK)
         return st;
     if (i >= e->sc->nbld)
@@ -105,7 +91,7 @@ plx_status plx_building_get(plx_engine *e, uint32_t i, plx_building *out)
 plx_status plx_lamp_get(plx_engine *e, uint32_t i, plx_lamp *out)
 {
     const scene_lamp *l;
-    plx_status st = need_scene(e, "plx_lamp_get");
+    plx_status st = eng_need_scene(e, "plx_lamp_get");
     if (st != PLX_OK)
         return st;
     if (i >= e->sc->nlamps)
@@ -127,7 +113,7 @@ plx_status plx_lamp_get(plx_engine *e, uint32_t i, plx_lamp *out)
 plx_status plx_block_get(plx_engine *e, uint32_t i, plx_block *out)
 {
     const scene_block *k;
-    plx_status st = need_scene(e, "plx_block_get");
+    plx_status st = eng_need_scene(e, "plx_block_get");
     if (st != PLX_OK)
         return st;
     if (i >= e->sc->nblocks)
@@ -152,7 +138,7 @@ static plx_status ring_out(const vec2 *pts, const scene_ring *r, const double **
 plx_status plx_building_ring(plx_engine *e, uint32_t i, uint32_t r, const double **xy, uint32_t *n)
 {
     const scene_building *b;
-    plx_status st = need_scene(e, "plx_building_ring");
+    plx_status st = eng_need_scene(e, "plx_building_ring");
     if (st != PLX_OK)
         return st;
     if (!xy || !n)
@@ -168,7 +154,7 @@ plx_status plx_building_ring(plx_engine *e, uint32_t i, uint32_t r, const double
 plx_status plx_block_ring(plx_engine *e, uint32_t i, uint32_t r, const double **xy, uint32_t *n)
 {
     const scene_block *k;
-    plx_status st = need_scene(e, "plx_block_ring");
+    plx_status st = eng_need_scene(e, "plx_block_ring");
     if (st != PLX_OK)
         return st;
     if (!xy || !n)

@@ -62,6 +62,20 @@ plx_status eng_fail(plx_engine *e, plx_status s, const char *msg)
     return s;
 }
 
+plx_status eng_need_scene(plx_engine *e, const char *fn)
+{
+    char msg[128];
+    strbuf b;
+    if (!eng_ok(e))
+        return PLX_E_INVALID;
+    if (e->sc)
+        return PLX_OK;
+    sb_init(&b, msg, sizeof msg);
+    sb_str(&b, fn);
+    sb_str(&b, ": no scene is loaded");
+    return eng_fail(e, PLX_E_NOSCENE, msg);
+}
+
 void eng_clear_error(plx_engine *e)
 {
     e->err[0] = '\0';

@@ -41,6 +41,9 @@ plx_status eng_nomem(plx_engine *e, const char *during);
 void eng_clear_error(plx_engine *e);
 void eng_log(plx_engine *e, plx_log_level level, const char *msg);
 uint64_t eng_clock(plx_engine *e);
+/* PLX_OK when e is a valid engine with a scene loaded; else PLX_E_INVALID,
+ * or PLX_E_NOSCENE with the error "FN: no scene is loaded". */
+plx_status eng_need_scene(plx_engine *e, const char *fn);
 /* Creates the lamp light object on first need (lightapi.c). */
 plx_status eng_need_light(plx_engine *e, const char *fn);
 /* E_indirect at a checked surface point, 0 without photon frames (indirectapi.c). */

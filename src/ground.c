@@ -158,26 +158,12 @@ plx_status ground_image_set(arena *a, scene *s, uint32_t w, uint32_t h, const ui
 
 /* ---- public API ---------------------------------------------------------------- */
 
-static plx_status need_scene(plx_engine *e, const char *fn)
-{
-    char msg[128];
-    strbuf b;
-    if (!eng_ok(e))
-        return PLX_E_INVALID;
-    if (e->sc)
-        return PLX_OK;
-    sb_init(&b, msg, sizeof msg);
-    sb_str(&b, fn);
-    sb_str(&b, ": no scene is loaded");
-    return eng_fail(e, PLX_E_NOSCENE, msg);
-}
-
 plx_status plx_set_ground_image(plx_engine *e, uint32_t width, uint32_t height, const uint8_t *rgb8,
                                 const double bounds[4])
 {
     const char *fn = "plx_set_ground_image";
     const double *box;
-    plx_status st = need_scene(e, fn);
+    plx_status st = eng_need_scene(e, fn);
     if (st != PLX_OK)
         return st;
     eng_clear_error(e);
@@ -207,7 +193,7 @@ plx_status plx_set_ground_image(plx_engine *e, uint32_t width, uint32_t height, 
 
 plx_status plx_ground_albedo_at(plx_engine *e, double x, double y, double rgb[3])
 {
-    plx_status st = need_scene(e, "plx_ground_albedo_at");
+    plx_status st = eng_need_scene(e, "plx_ground_albedo_at");
     if (st != PLX_OK)
         return st;
     if (!rgb || !isfinite(x) || !isfinite(y))
@@ -219,7 +205,7 @@ plx_status plx_ground_albedo_at(plx_engine *e, double x, double y, double rgb[3]
 plx_status plx_ground_image_get(plx_engine *e, plx_ground_image_info *out)
 {
     const scene *s;
-    plx_status st = need_scene(e, "plx_ground_image_get");
+    plx_status st = eng_need_scene(e, "plx_ground_image_get");
     if (st != PLX_OK)
         return st;
     if (!out)

@@ -8,16 +8,8 @@ static plx_status need_photons(plx_engine *e, const char *fn)
 {
     photon_config cfg;
     plx_status st;
-    if (!eng_ok(e))
-        return PLX_E_INVALID;
-    if (!e->sc) {
-        char msg[128];
-        strbuf b;
-        sb_init(&b, msg, sizeof msg);
-        sb_str(&b, fn);
-        sb_str(&b, ": no scene is loaded");
-        return eng_fail(e, PLX_E_NOSCENE, msg);
-    }
+    if ((st = eng_need_scene(e, fn)) != PLX_OK)
+        return st;
     if (e->ph)
         return PLX_OK;
     photon_config_default(&cfg);

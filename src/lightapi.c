@@ -11,18 +11,10 @@
 
 plx_status eng_need_light(plx_engine *e, const char *fn)
 {
-    char msg[128];
-    strbuf b;
     plx_status st;
     size_t cache;
-    if (!eng_ok(e))
-        return PLX_E_INVALID;
-    if (!e->sc) {
-        sb_init(&b, msg, sizeof msg);
-        sb_str(&b, fn);
-        sb_str(&b, ": no scene is loaded");
-        return eng_fail(e, PLX_E_NOSCENE, msg);
-    }
+    if ((st = eng_need_scene(e, fn)) != PLX_OK)
+        return st;
     if (e->lt)
         return PLX_OK;
     cache = e->cfg.lit_cache_bytes ? e->cfg.lit_cache_bytes : DEFAULT_LIT_CACHE;

@@ -9,20 +9,6 @@
 
 #define DEG 0.017453292519943295
 
-static plx_status need_scene(plx_engine *e, const char *fn)
-{
-    char msg[128];
-    strbuf b;
-    if (!eng_ok(e))
-        return PLX_E_INVALID;
-    if (e->sc)
-        return PLX_OK;
-    sb_init(&b, msg, sizeof msg);
-    sb_str(&b, fn);
-    sb_str(&b, ": no scene is loaded");
-    return eng_fail(e, PLX_E_NOSCENE, msg);
-}
-
 static plx_status build(plx_engine *e)
 {
     arena_mark m = arena_get_mark(&e->mem);
@@ -52,7 +38,7 @@ static plx_status build(plx_engine *e)
 
 plx_status plx_polar_build(plx_engine *e)
 {
-    plx_status st = need_scene(e, "plx_polar_build");
+    plx_status st = eng_need_scene(e, "plx_polar_build");
     if (st != PLX_OK || e->pd)
         return st;
     return build(e);
