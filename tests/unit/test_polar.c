@@ -23,6 +23,7 @@
 #include "arena.h"
 #include "engine.h"
 #include "polar.h"
+#include "polar_faults.h"
 #include "visibility.h"
 #include "ref_scene.h"
 #include "ref_vis.h"
@@ -874,28 +875,11 @@ static void test_fault_injection(void **state)
 {
     fixture *f = fixture_new();
     uint64_t k;
-    int done = 0;
     (void)state;
     rnd_state = 9u;
     scene_boxes(f, 8, 1);
     ref_scene_finish(&f->s);
-    for (k = 1; k < 200 && !done; k++) {
-        arena_mark m = arena_get_mark(&f->a);
-        plx_status st;
-        f->a.requests = 0;
-        f->a.fail_at = k;
-        st = polar_build(&f->a, &f->s, &f->pd);
-        f->a.fail_at = 0;
-        if (st == PLX_OK) {
-            done = 1;
-            break;
-        }
-        assert_int_equal(st, PLX_E_NOMEM);
-        assert_null(f->pd);
-        assert_int_equal(f->a.lo, m.lo);
-        assert_int_equal(f->a.hi, m.hi);
-    }
-    assert_true(done);
+    k = polar_build_each_failure(&f->a, &f->s, &f->pd, 199);
     assert_true(k > 5);
     fixture_free(f);
 }

@@ -29,6 +29,7 @@
 #include "engine.h"
 #include "geom.h"
 #include "polar.h"
+#include "polar_faults.h"
 #include "ref_scene.h"
 
 #define ARENA_BYTES ((size_t)64 << 20)
@@ -711,8 +712,7 @@ static void test_fault_injection(void **state)
 {
     fix *f = fix_new();
     uint64_t k;
-    int done = 0;
-    size_t need, scratch0;
+    size_t need;
     arena_mark m0;
     (void)state;
     rnd_state = 12u;
@@ -733,26 +733,7 @@ static void test_fault_injection(void **state)
     }
     ref_scene_finish(&f->s);
     m0 = arena_get_mark(&f->a);
-
-    scratch0 = f->a.used[PLX_PART_SCRATCH];
-    for (k = 1; k < 100000 && !done; k++) {
-        plx_status st;
-        f->a.requests = 0;
-        f->a.fail_at = k;
-        st = polar_build(&f->a, &f->s, &f->pd);
-        f->a.fail_at = 0;
-        if (st == PLX_OK) {
-            done = 1;
-            break;
-        }
-        assert_int_equal(st, PLX_E_NOMEM);
-        assert_null(f->pd);
-        assert_int_equal(f->a.lo, m0.lo);
-        assert_int_equal(f->a.hi, m0.hi);
-        assert_int_equal(f->a.used[PLX_PART_SCRATCH], scratch0);
-        assert_int_equal(f->a.used[PLX_PART_POLAR], m0.used[PLX_PART_POLAR]);
-    }
-    assert_true(done);
+    k = polar_build_each_failure(&f->a, &f->s, &f->pd, 99999);
     print_message("fault injection: %d requests, %u wall pieces, DAG nodes %u + %u\n", (int)k,
                   f->pd->nwall, f->pd->map[0].nnode, f->pd->map[1].nnode);
     assert_true(f->pd->map[0].nnode > 2 * 16384 && f->pd->map[1].nnode > 2 * 16384);

@@ -38,6 +38,7 @@
 #include "engine.h"
 #include "geom.h"
 #include "polar.h"
+#include "polar_faults.h"
 #include "visibility.h"
 #include "ref_scene.h"
 #include "ref_vis.h"
@@ -514,8 +515,6 @@ static void test_fault_injection(void **state)
     fix *f = fix_new();
     uint64_t k;
     int done = 0, kind = 0;
-    size_t scratch0;
-    arena_mark m0;
     (void)state;
     /* the first scene (of a few kinds) whose build takes two rounds or more */
     for (k = 0; !done && k < 400; k++) {
@@ -529,27 +528,7 @@ static void test_fault_injection(void **state)
         arena_init(&f->a, f->mem, ARENA_BYTES);
     }
     assert_true(done);
-    done = 0;
-    m0 = arena_get_mark(&f->a);
-    scratch0 = f->a.used[PLX_PART_SCRATCH];
-    for (k = 1; k < 100000 && !done; k++) {
-        plx_status st;
-        f->a.requests = 0;
-        f->a.fail_at = k;
-        st = polar_build(&f->a, &f->s, &f->pd);
-        f->a.fail_at = 0;
-        if (st == PLX_OK) {
-            done = 1;
-            break;
-        }
-        assert_int_equal(st, PLX_E_NOMEM);
-        assert_null(f->pd);
-        assert_int_equal(f->a.lo, m0.lo);
-        assert_int_equal(f->a.hi, m0.hi);
-        assert_int_equal(f->a.used[PLX_PART_SCRATCH], scratch0);
-        assert_int_equal(f->a.used[PLX_PART_POLAR], m0.used[PLX_PART_POLAR]);
-    }
-    assert_true(done);
+    k = polar_build_each_failure(&f->a, &f->s, &f->pd, 99999);
     print_message("fault injection: scene kind %d, %u rounds, %d requests, %u wall pieces\n",
                   kind, f->pd->wall_rounds, (int)k, f->pd->nwall);
     assert_true(k > 20);
