@@ -4,6 +4,7 @@
 #include <string.h>
 
 #include "photon.h"
+#include "geom.h"
 
 #define PI 3.14159265358979323846
 #define HEIGHT_TOL 1e-3   /* m: a splat's texels are at the photon's height */
@@ -794,33 +795,6 @@ size_t photon_bytes(const scene *s, const photon_config *cfg)
 
 /* ---- walls and blocks ----------------------------------------------------- */
 
-static double ring_area(const vec2 *p, uint32_t n)
-{
-    double a = 0.0;
-    uint32_t i;
-    for (i = 0; i < n; i++) {
-        const vec2 *u = &p[i], *v = &p[i + 1 == n ? 0 : i + 1];
-        a += u->x * v->y - v->x * u->y;
-    }
-    return 0.5 * a;
-}
-
-static int in_ring(const vec2 *p, uint32_t n, double x, double y)
-{
-    uint32_t k, in = 0;
-    const vec2 *a = &p[n - 1];
-    for (k = 0; k < n; k++) {
-        const vec2 *b = &p[k];
-        if ((a->y > y) != (b->y > y)) {
-            double xc = a->x + (y - a->y) * (b->x - a->x) / (b->y - a->y);
-            if (x < xc)
-                in ^= 1u;
-        }
-        a = b;
-    }
-    return (int)in;
-}
-
 /* Exposure and chart class of every wall. */
 static void walls_classify(photon_sys *ps)
 {
@@ -876,10 +850,14 @@ static void walls_classify(photon_sys *ps)
                 } else if (B->block < s->nblocks) {
                     const scene_block *K = &s->blocks[B->block];
                     uint32_t rr;
+                    vec2 probe;
+                    probe.x = qx;
+                    probe.y = qy;
                     for (rr = 1; rr < K->ring_count; rr++) {
                         const scene_ring *CR = &s->block_rings[K->ring_first + rr];
                         const vec2 *cp = &s->block_pts[CR->first];
-                        if (ring_area(cp, CR->count) < 0.0 && in_ring(cp, CR->count, qx, qy)) {
+                        if (geom_ring_area2(cp, CR->count) < 0.0 &&
+                            geom_point_in_ring(probe, cp, CR->count) == GEOM_INSIDE) {
                             cls = PHOTON_EDGE_INNER;
                             break;
                         }
