@@ -25,7 +25,7 @@
 #define PLX_GLRASTER_H
 
 #include <stdint.h>
-#include "render.h"
+#include "render/render.h"
 
 typedef struct glraster {
     render_backend be;              /* be.user = this */

@@ -1,4 +1,4 @@
-/* Ground image benchmark (src/ground.c): what the per-pixel ground albedo
+/* Ground image benchmark (src/scene/ground.c): what the per-pixel ground albedo
  * costs. On fixtures/ground-image.geojson with fixtures/ground-day.png:
  *  - a 1280x960 street view and a 1280x960 aerial view (direct light, no
  *    glows: every ground pixel looks its albedo up), and

@@ -1,4 +1,4 @@
-/* bench_light: lit regions per lamp and illuminance throughput (src/light.h),
+/* bench_light: lit regions per lamp and illuminance throughput (src/light/light.h),
  * side by side with the brute-force reference run in the same process.
  *
  * Scenes: `polarlux gen eixample 30 30` (generated here by plx_gen_city) and
@@ -22,8 +22,8 @@
 #include <time.h>
 
 #include "polarlux.h"
-#include "engine.h"
-#include "light.h"
+#include "base/engine.h"
+#include "light/light.h"
 #include "ref_light.h"
 
 static double now_s(void)

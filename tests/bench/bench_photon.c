@@ -1,4 +1,4 @@
-/* Photon benchmark (src/photon.h, src/trace.h), single thread:
+/* Photon benchmark (src/photon/photon.h, src/photon/trace.h), single thread:
  *  - the photon pass: ms per photon_step of 64K photons on
  *    `gen eixample 30 30` (generated in memory), target <= 10 ms;
  *  - rays per second of the grid caster against the brute-force caster
@@ -24,9 +24,9 @@
 #include <time.h>
 
 #include "polarlux.h"
-#include "engine.h"
-#include "trace.h"
-#include "photon.h"
+#include "base/engine.h"
+#include "photon/trace.h"
+#include "photon/photon.h"
 #include "ref_trace_old.h"
 
 #define BUDGET ((size_t)3 << 30)

@@ -1,5 +1,5 @@
 /* Polar diagram benchmark: construction time and memory of the four quadrant
- * diagrams (src/polar.h), and full-turn visibility queries (src/visibility.h)
+ * diagrams (src/polar/polar.h), and full-turn visibility queries (src/polar/visibility.h)
  * at random free pedestrian points, against the brute-force reference
  * tests/ref/ref_vis_fast (ref_vis's angular sweep with grid searches; the
  * same answers as ref_vis, see test_polar) run in the same process on the
@@ -35,9 +35,9 @@
 
 #include "polarlux.h"
 #include "port.h"
-#include "engine.h"
-#include "polar.h"
-#include "visibility.h"
+#include "base/engine.h"
+#include "polar/polar.h"
+#include "polar/visibility.h"
 #include "ref_vis.h"
 #include "ref_vis_fast.h"
 

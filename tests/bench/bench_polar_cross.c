@@ -7,7 +7,7 @@
  *   - overlapping: each grown by 0..2 cm over its neighbours, as in real
  *     map data at its worst: every wall crosses its neighbours' walls, so
  *     every crossing point is rounded and the pieces are searched again
- *     (src/polar.c, settle_pieces) until they meet only at their ends;
+ *     (src/polar/polar.c, settle_pieces) until they meet only at their ends;
  *   - some overlapping: one building in ten grown so, the others apart.
  * Printed per version: construction time (best of 3, with and without the
  * search DAGs), wall pieces, crossing points, rounds of the contact search
@@ -21,9 +21,9 @@
 
 #include "polarlux.h"
 #include "port.h"
-#include "arena.h"
-#include "scene.h"
-#include "polar.h"
+#include "base/arena.h"
+#include "base/scene.h"
+#include "polar/polar.h"
 #include "ref_scene.h"
 
 #define BUDGET ((size_t)2 << 30)

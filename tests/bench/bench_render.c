@@ -1,4 +1,4 @@
-/* Render benchmark (src/render.h): ms per frame of
+/* Render benchmark (src/render/render.h): ms per frame of
  *  - a 640x480 street view (eye 1.7 m in a street, looking along it), and
  *  - a 1024x768 aerial view (once the ground light map is built)
  * of `gen eixample 30 30` (14,400 buildings, ~16,000 lamps) generated in
@@ -21,9 +21,9 @@
 
 #include "polarlux.h"
 #include "port.h"
-#include "engine.h"
-#include "light.h"
-#include "render.h"
+#include "base/engine.h"
+#include "light/light.h"
+#include "render/render.h"
 #include "png/image_write.h"
 #ifdef PLX_HAVE_OSMESA
 #include "plx_osmesa.h"

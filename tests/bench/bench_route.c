@@ -9,7 +9,7 @@
 
 #include "polarlux.h"
 #include "port.h"
-#include "engine.h"
+#include "base/engine.h"
 #include "ref_light.h"
 
 #include "gen_text.h"

@@ -27,7 +27,7 @@
 #ifndef REF_LIGHT_H
 #define REF_LIGHT_H
 
-#include "scene.h"
+#include "base/scene.h"
 
 /* 1 if the open segment L->P meets some building's solid interior, else 0;
  * -1 if malloc fails (scratch of 4 + 2 * vertices-of-a-building values). */

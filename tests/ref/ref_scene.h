@@ -19,7 +19,7 @@
 #define REF_SCENE_H
 
 #include <stdint.h>
-#include "scene.h"
+#include "base/scene.h"
 
 /* Empty scene: no buildings, no lamps, ground albedo 0.15, bounds zero. */
 void ref_scene_init(scene *s);

@@ -1,4 +1,4 @@
-/* ref_trace_old: the grid caster of src/trace.c before the wall-grid
+/* ref_trace_old: the grid caster of src/photon/trace.c before the wall-grid
  * rewrite (see ref_trace_old.h). Kept verbatim but for the names. */
 #include <math.h>
 #include <string.h>

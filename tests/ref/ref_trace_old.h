@@ -16,9 +16,9 @@
 #include <stddef.h>
 #include <stdint.h>
 #include "polarlux.h"
-#include "arena.h"
-#include "scene.h"
-#include "trace.h"
+#include "base/arena.h"
+#include "base/scene.h"
+#include "photon/trace.h"
 
 typedef struct old_tracer {
     const scene *s;

@@ -48,7 +48,7 @@
 #define REF_VIS_H
 
 #include <stdint.h>
-#include "scene.h"
+#include "base/scene.h"
 
 typedef struct ref_vis_result {
     double area;         /* m^2 */

@@ -7,8 +7,8 @@
 #ifndef PLX_TEST_POLAR_FAULTS_H
 #define PLX_TEST_POLAR_FAULTS_H
 
-#include "arena.h"
-#include "polar.h"
+#include "base/arena.h"
+#include "polar/polar.h"
 
 static uint64_t polar_build_each_failure(arena *a, const scene *s, polar **pd, uint64_t max_k)
 {

@@ -10,9 +10,9 @@
 #include <time.h>
 #include <cmocka.h>
 
-#include "arena.h"
-#include "scene.h"
-#include "blocks.h"
+#include "base/arena.h"
+#include "base/scene.h"
+#include "scene/blocks.h"
 
 #define TOL 0.05
 

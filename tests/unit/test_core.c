@@ -7,8 +7,8 @@
 #include <string.h>
 #include <cmocka.h>
 
-#include "arena.h"
-#include "strbuf.h"
+#include "base/arena.h"
+#include "base/strbuf.h"
 
 static void test_arena_parts_and_marks(void **state)
 {

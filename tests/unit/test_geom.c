@@ -2,7 +2,7 @@
  * integer evaluation, segment meeting, point in ring, ring simplicity (sweep
  * against brute force, big rings, scratch exhaustion), distances, areas.
  *
- * Build: gcc -std=c99 ... tests/unit/test_geom.c src/geom.c src/arena.c
+ * Build: gcc -std=c99 ... tests/unit/test_geom.c src/base/geom.c src/base/arena.c
  *        -lcmocka -lm
  */
 #include <stdarg.h>
@@ -17,7 +17,7 @@
 #include <time.h>
 #include <cmocka.h>
 
-#include "geom.h"
+#include "base/geom.h"
 
 __extension__ typedef __int128 i128;
 

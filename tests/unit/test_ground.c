@@ -1,4 +1,4 @@
-/* ground: the ground's albedo from a day image (src/ground.c, issue #6).
+/* ground: the ground's albedo from a day image (src/scene/ground.c, issue #6).
  *
  * The loader's properties.ground_image and ground_image_bounds (accepted,
  * every rejection with its exact message, strict and lenient, lon/lat
@@ -25,12 +25,12 @@
 #include <unistd.h>
 
 #include "polarlux.h"
-#include "engine.h"
-#include "arena.h"
-#include "blocks.h"
-#include "ground.h"
-#include "trace.h"
-#include "photon.h"
+#include "base/engine.h"
+#include "base/arena.h"
+#include "scene/blocks.h"
+#include "scene/ground.h"
+#include "photon/trace.h"
+#include "photon/photon.h"
 #include "ref_scene.h"
 #include "png/image_write.h"
 

@@ -1,4 +1,4 @@
-/* Direct lamp light (src/light.h): both visibility paths against the
+/* Direct lamp light (src/light/light.h): both visibility paths against the
  * brute-force reference tests/ref/ref_light over random scenes and the
  * fixtures, hand-checked cases, lit polygons against point queries, the
  * region cache, point classification.
@@ -17,8 +17,8 @@
 #include <cmocka.h>
 
 #include "polarlux.h"
-#include "engine.h"
-#include "light.h"
+#include "base/engine.h"
+#include "light/light.h"
 #include "ref_light.h"
 #include "ref_scene.h"
 

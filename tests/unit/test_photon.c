@@ -19,11 +19,11 @@
 #include <cmocka.h>
 
 #include "polarlux.h"
-#include "engine.h"
-#include "arena.h"
-#include "blocks.h"
-#include "trace.h"
-#include "photon.h"
+#include "base/engine.h"
+#include "base/arena.h"
+#include "scene/blocks.h"
+#include "photon/trace.h"
+#include "photon/photon.h"
 #include "ref_scene.h"
 
 #define PI 3.14159265358979323846
@@ -121,7 +121,7 @@ static void fx_close(fixture *f)
     free(f->mem);
 }
 
-/* ---- brute-force ray casting, written independently of src/trace.c ------ */
+/* ---- brute-force ray casting, written independently of src/photon/trace.c ------ */
 
 /*
  * First hit by plane tests against every face of every building, with the

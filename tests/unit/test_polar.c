@@ -19,12 +19,12 @@
 #include <math.h>
 #include <cmocka.h>
 
-#include "scene.h"
-#include "arena.h"
-#include "engine.h"
-#include "polar.h"
+#include "base/scene.h"
+#include "base/arena.h"
+#include "base/engine.h"
+#include "polar/polar.h"
 #include "polar_faults.h"
-#include "visibility.h"
+#include "polar/visibility.h"
 #include "ref_scene.h"
 #include "ref_vis.h"
 #include "ref_vis_fast.h"

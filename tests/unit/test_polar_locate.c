@@ -24,11 +24,11 @@
 #include <math.h>
 #include <cmocka.h>
 
-#include "scene.h"
-#include "arena.h"
-#include "engine.h"
-#include "geom.h"
-#include "polar.h"
+#include "base/scene.h"
+#include "base/arena.h"
+#include "base/engine.h"
+#include "base/geom.h"
+#include "polar/polar.h"
 #include "polar_faults.h"
 #include "ref_scene.h"
 

@@ -1,7 +1,7 @@
 /* test_polar_robust: polar_build on scenes whose footprints cross (SPEC §1:
  * footprints may overlap; real map data overlaps by centimetres).
  *
- * Rounded crossing points bend the wall pieces by an ulp; src/polar.c cuts
+ * Rounded crossing points bend the wall pieces by an ulp; src/polar/polar.c cuts
  * the pieces again at the contacts that makes until none is left. Here, on
  * hundreds of random scenes made to be hard for that (rotated boxes
  * crossing lattice boxes and their collinear walls, near-collinear
@@ -33,13 +33,13 @@
 #include <math.h>
 #include <cmocka.h>
 
-#include "scene.h"
-#include "arena.h"
-#include "engine.h"
-#include "geom.h"
-#include "polar.h"
+#include "base/scene.h"
+#include "base/arena.h"
+#include "base/engine.h"
+#include "base/geom.h"
+#include "polar/polar.h"
 #include "polar_faults.h"
-#include "visibility.h"
+#include "polar/visibility.h"
 #include "ref_scene.h"
 #include "ref_vis.h"
 

@@ -9,7 +9,7 @@
 #include <math.h>
 #include <cmocka.h>
 
-#include "raster.h"
+#include "render/raster.h"
 
 /* ---- fixtures ------------------------------------------------------------ */
 

@@ -12,7 +12,7 @@
 #include <math.h>
 #include <cmocka.h>
 
-#include "scene.h"
+#include "base/scene.h"
 #include "ref_scene.h"
 #include "ref_vis.h"
 #include "ref_light.h"

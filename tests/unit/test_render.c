@@ -1,4 +1,4 @@
-/* test_render: the renderer (src/render.h, src/mesh.h) against an
+/* test_render: the renderer (src/render/render.h, src/render/mesh.h) against an
  * independent per-pixel reference written here.
  *
  * The reference follows SPEC §5 from scratch: one primary ray per pixel
@@ -37,11 +37,11 @@
 #include <cmocka.h>
 
 #include "polarlux.h"
-#include "engine.h"
-#include "render.h"
-#include "mesh.h"
-#include "light.h"
-#include "geom.h"
+#include "base/engine.h"
+#include "render/render.h"
+#include "render/mesh.h"
+#include "light/light.h"
+#include "base/geom.h"
 #include "ref_light.h"
 #include "png/image_write.h"
 #ifdef PLX_HAVE_OSMESA

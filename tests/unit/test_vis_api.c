@@ -13,7 +13,7 @@
 #include <cmocka.h>
 
 #include "polarlux.h"
-#include "engine.h"
+#include "base/engine.h"
 #include "ref_vis.h"
 
 #define MEM (256u << 20)

@@ -1,0 +1,86 @@
+/* indirectapi: the public face of the photon buffers (SPEC §4). */
+#include <string.h>
+
+#include "base/engine.h"
+#include "photon/photon.h"
+
+static plx_status need_photons(plx_engine *e, const char *fn)
+{
+    photon_config cfg;
+    plx_status st;
+    if ((st = eng_need_scene(e, fn)) != PLX_OK)
+        return st;
+    if (e->ph)
+        return PLX_OK;
+    photon_config_default(&cfg);
+    st = photon_create(&e->mem, e->sc, &cfg, &e->ph);
+    if (st == PLX_E_NOMEM)
+        return eng_nomem(e, "creating the photon buffers");
+    if (st != PLX_OK)
+        return eng_fail(e, st, "creating the photon buffers failed");
+    return PLX_OK;
+}
+
+plx_status plx_indirect_step(plx_engine *e, uint32_t photons, uint64_t seed)
+{
+    plx_status st = need_photons(e, "plx_indirect_step");
+    if (st != PLX_OK)
+        return st;
+    if (photons == 0)
+        return eng_fail(e, PLX_E_INVALID, "plx_indirect_step: photons must be > 0");
+    photon_step(e->ph, photons, seed);
+    return PLX_OK;
+}
+
+uint64_t plx_indirect_frames(const plx_engine *e)
+{
+    if (!eng_ok(e) || !e->ph)
+        return 0;
+    return e->ph->st.frames;
+}
+
+plx_status plx_indirect_set_viewer(plx_engine *e, const double eye[3], const double dir[3], double fov_deg)
+{
+    plx_status st = need_photons(e, "plx_indirect_set_viewer");
+    if (st != PLX_OK)
+        return st;
+    if (!eye)
+        return eng_fail(e, PLX_E_INVALID, "plx_indirect_set_viewer: eye is NULL");
+    st = photon_set_viewer(e->ph, eye, dir, fov_deg);
+    if (st == PLX_E_NOMEM)
+        return eng_nomem(e, "assigning chart levels");
+    return st;
+}
+
+plx_status plx_indirect_reset(plx_engine *e)
+{
+    if (!eng_ok(e))
+        return PLX_E_INVALID;
+    if (e->ph)
+        photon_reset(e->ph);
+    return PLX_OK;
+}
+
+/* E_indirect at a checked surface point (0 without frames). */
+double eng_indirect(plx_engine *e, const double P[3], const double n[3])
+{
+    return eng_indirect_rgb(e, P, n, NULL);
+}
+
+/* The same with its RGB version (each lamp's light weighted by its colour:
+ * the photons carry both). */
+double eng_indirect_rgb(plx_engine *e, const double P[3], const double n[3], double rgb[3])
+{
+    if (!e->ph || plx_indirect_frames(e) == 0) {
+        if (rgb)
+            rgb[0] = rgb[1] = rgb[2] = 0.0;
+        return 0.0;
+    }
+    return photon_indirect_rgb(e->ph, P, n, rgb);
+}
+
+plx_status plx_nightify(const uint8_t *day, size_t npx, const uint8_t *night, size_t nnight,
+                        double dark_threshold, uint8_t *out)
+{
+    return photon_hist_match(day, npx, night, nnight, dark_threshold, out) == 0 ? PLX_OK : PLX_E_INVALID;
+}

@@ -1,0 +1,103 @@
+/* renderapi: the public face of the renderer (SPEC §5). */
+#include <string.h>
+
+#include "base/engine.h"
+#include "light/light.h"
+#include "render/render.h"
+
+#define DEFAULT_MAX_W 1920
+#define DEFAULT_MAX_H 1080
+#define LIGHTMAP_MAX_BYTES ((size_t)256 << 20)
+
+void plx_render_opts_default(plx_render_opts *o)
+{
+    if (!o)
+        return;
+    memset(o, 0, sizeof *o);
+    o->exposure = 1.0;
+}
+
+/* The photon hook of the renderer: the RGB indirect term (each lamp's light
+ * weighted by its colour, carried by the photons; SPEC §5). */
+static void shade_indirect(void *user, const double P[3], const double n[3], double rgb[3])
+{
+    eng_indirect_rgb(user, P, n, rgb);
+}
+
+static plx_status need_render(plx_engine *e)
+{
+    int32_t w = e->cfg.render_max_width ? e->cfg.render_max_width : DEFAULT_MAX_W;
+    int32_t h = e->cfg.render_max_height ? e->cfg.render_max_height : DEFAULT_MAX_H;
+    plx_status st;
+    if (e->rd)
+        return PLX_OK;
+    st = eng_need_light(e, "plx_render");
+    if (st != PLX_OK)
+        return st;
+    st = render_create(&e->mem, e->sc, w, h, render_shade_light, e->lt, &e->rd);
+    if (st == PLX_E_NOMEM)
+        return eng_nomem(e, "creating the renderer (frame buffers and mesh)");
+    if (st != PLX_OK)
+        return eng_fail(e, st, "creating the renderer failed");
+    return PLX_OK;
+}
+
+plx_status plx_render(plx_engine *e, const plx_camera *cam, const plx_render_opts *o, uint8_t *rgb8,
+                      float *rgbf, plx_render_info *info)
+{
+    render_camera rc;
+    render_opts ro;
+    render_stats rs;
+    plx_render_opts def;
+    plx_status st;
+    if (!eng_ok(e))
+        return PLX_E_INVALID;
+    if (!e->sc)
+        return eng_fail(e, PLX_E_NOSCENE, "plx_render: no scene is loaded");
+    if (!cam)
+        return eng_fail(e, PLX_E_INVALID, "plx_render: camera is NULL");
+    if (!o) {
+        plx_render_opts_default(&def);
+        o = &def;
+    }
+    st = need_render(e);
+    if (st != PLX_OK)
+        return st;
+    if (o->aerial && e->lightmap_cell == 0.0) {
+        double cell = o->aerial_m_per_texel > 0 ? o->aerial_m_per_texel : 1.0;
+        st = render_lightmap_build(e->rd, cell, LIGHTMAP_MAX_BYTES);
+        if (st == PLX_E_NOMEM)
+            return eng_nomem(e, "building the aerial light map");
+        if (st != PLX_OK)
+            return eng_fail(e, st, render_error(e->rd));
+        e->lightmap_cell = cell;
+    }
+    memcpy(rc.eye, cam->eye, sizeof rc.eye);
+    memcpy(rc.target, cam->target, sizeof rc.target);
+    rc.fov_deg = cam->fov_deg;
+    rc.width = cam->width;
+    rc.height = cam->height;
+    render_opts_default(&ro);
+    ro.exposure = o->exposure;
+    ro.no_glow = o->no_glow;
+    ro.lightmap = o->aerial;
+    ro.cull = o->no_cull ? RENDER_CULL_NONE : RENDER_CULL_ALL;
+    ro.backend = o->backend;
+    if (!o->no_indirect && e->ph && plx_indirect_frames(e) > 0) {
+        ro.indirect = shade_indirect;
+        ro.indirect_user = e;
+    }
+    st = render_frame(e->rd, &rc, &ro, rgb8, rgbf, &rs);
+    if (st == PLX_E_NOMEM)
+        return eng_nomem(e, "rendering a frame");
+    if (st != PLX_OK)
+        return eng_fail(e, st, render_error(e->rd));
+    if (info) {
+        info->buildings = rs.buildings;
+        info->drawn = rs.drawn;
+        info->drawn_fraction = rs.drawn_fraction;
+        info->shaded_pixels = rs.shader_calls;
+    }
+    eng_clear_error(e);
+    return PLX_OK;
+}

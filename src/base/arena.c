@@ -1,0 +1,136 @@
+#include "base/arena.h"
+
+static size_t align_up(size_t v, size_t align)
+{
+    return (v + align - 1) & ~(align - 1);
+}
+
+void arena_init(arena *a, void *mem, size_t size)
+{
+    size_t off = (size_t)(-(uintptr_t)mem) & (PLX_ENGINE_ALIGN - 1);
+    size_t i;
+    a->base = (unsigned char *)mem + off;
+    a->cap = size > off ? size - off : 0;
+    a->lo = a->hi = 0;
+    a->peak_total = 0;
+    for (i = 0; i < PLX_PART_COUNT; i++) {
+        a->used[i] = a->peak[i] = a->budget[i] = 0;
+    }
+    a->requests = 0;
+    a->fail_at = 0;
+    a->failed_part = PLX_PART_ENGINE;
+    a->failed_size = 0;
+}
+
+size_t arena_mul(size_t n, size_t size)
+{
+    if (size != 0 && n > SIZE_MAX / size)
+        return SIZE_MAX;
+    return n * size;
+}
+
+static int refuse(arena *a, plx_part part, size_t size)
+{
+    a->failed_part = part;
+    a->failed_size = size;
+    return 0;
+}
+
+/* Counts the request and checks fault injection and the part budget. */
+static int admit(arena *a, plx_part part, size_t size)
+{
+    a->requests++;
+    if (a->fail_at != 0 && a->requests == a->fail_at)
+        return refuse(a, part, size);
+    if (a->budget[part] != 0 &&
+        (size > a->budget[part] || a->used[part] > a->budget[part] - size))
+        return refuse(a, part, size);
+    return 1;
+}
+
+static void account(arena *a, plx_part part, size_t bytes)
+{
+    size_t total = a->lo + a->hi;
+    a->used[part] += bytes;
+    if (a->used[part] > a->peak[part])
+        a->peak[part] = a->used[part];
+    if (total > a->peak_total)
+        a->peak_total = total;
+}
+
+void *arena_alloc(arena *a, plx_part part, size_t size, size_t align)
+{
+    size_t start, end;
+    if (!admit(a, part, size))
+        return NULL;
+    if (size == 0)
+        size = 1;
+    start = align_up(a->lo, align);
+    if (start < a->lo || start > a->cap - a->hi || size > a->cap - a->hi - start)
+        return refuse(a, part, size), NULL;
+    end = start + size;
+    {
+        size_t grown = end - a->lo;
+        a->lo = end;
+        account(a, part, grown);
+    }
+    return a->base + start;
+}
+
+void *arena_calloc(arena *a, plx_part part, size_t n, size_t size, size_t align)
+{
+    size_t bytes = arena_mul(n, size);
+    unsigned char *p;
+    size_t i;
+    if (bytes == SIZE_MAX)
+        return (void)admit(a, part, bytes), refuse(a, part, bytes), NULL;
+    p = arena_alloc(a, part, bytes, align);
+    if (p)
+        for (i = 0; i < bytes; i++)
+            p[i] = 0;
+    return p;
+}
+
+void *arena_scratch(arena *a, size_t size, size_t align)
+{
+    size_t top, start, avail;
+    if (!admit(a, PLX_PART_SCRATCH, size))
+        return NULL;
+    if (size == 0)
+        size = 1;
+    avail = a->cap - a->hi - a->lo;
+    if (size > avail)
+        return refuse(a, PLX_PART_SCRATCH, size), NULL;
+    top = a->cap - a->hi;
+    start = (top - size) & ~(align - 1);
+    if (start < a->lo)
+        return refuse(a, PLX_PART_SCRATCH, size), NULL;
+    a->hi = a->cap - start;
+    account(a, PLX_PART_SCRATCH, top - start);
+    return a->base + start;
+}
+
+arena_mark arena_get_mark(const arena *a)
+{
+    arena_mark m;
+    size_t i;
+    m.lo = a->lo;
+    m.hi = a->hi;
+    for (i = 0; i < PLX_PART_COUNT; i++)
+        m.used[i] = a->used[i];
+    return m;
+}
+
+void arena_release(arena *a, const arena_mark *m)
+{
+    size_t i;
+    a->lo = m->lo;
+    a->hi = m->hi;
+    for (i = 0; i < PLX_PART_COUNT; i++)
+        a->used[i] = m->used[i];
+}
+
+size_t arena_free_bytes(const arena *a)
+{
+    return a->cap - a->lo - a->hi;
+}

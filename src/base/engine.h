@@ -1,0 +1,56 @@
+/* engine: the object every public call hangs off. Internal layout. */
+#ifndef PLX_ENGINE_H
+#define PLX_ENGINE_H
+
+#include "polarlux.h"
+#include "base/arena.h"
+#include "base/scene.h"
+#include "base/strbuf.h"
+
+#define ENGINE_ERR_BYTES 512
+
+struct plx_engine {
+    uint32_t magic;
+    void *block;            /* the caller's block, as given */
+    arena mem;
+    plx_config cfg;
+    plx_port port;          /* copy of the caller's port, or all NULL */
+    arena_mark base;        /* the arena just after the engine object */
+    char err[ENGINE_ERR_BYTES];
+    uint32_t warnings;
+    scene *sc;              /* NULL until a scene is loaded */
+    struct polar *pd;       /* polar diagrams, built on first need */
+    uint64_t polar_ns;
+    vec2 *vis_poly;         /* visibility query results (PLX_PART_FRAME) */
+    uint32_t vis_poly_cap;
+    uint32_t *vis_ids;
+    uint32_t vis_ids_cap;
+    struct light *lt;       /* lamp light, created on first need */
+    const struct lit_region *lit_last; /* region of the last plx_lit_region_get */
+    struct render *rd;      /* renderer, created on first need */
+    struct photon_sys *ph;  /* photon buffers, created on first need */
+    double lightmap_cell;   /* light map texel size when built, else 0 */
+};
+
+#define ENGINE_MAGIC 0x504c5831u /* "PLX1" */
+
+/* Sets the last error to 'msg' (the text of 'b' when b is given) and returns s. */
+plx_status eng_fail(plx_engine *e, plx_status s, const char *msg);
+/* The standard out-of-memory error, naming the part that asked. */
+plx_status eng_nomem(plx_engine *e, const char *during);
+void eng_clear_error(plx_engine *e);
+void eng_log(plx_engine *e, plx_log_level level, const char *msg);
+uint64_t eng_clock(plx_engine *e);
+/* PLX_OK when e is a valid engine with a scene loaded; else PLX_E_INVALID,
+ * or PLX_E_NOSCENE with the error "FN: no scene is loaded". */
+plx_status eng_need_scene(plx_engine *e, const char *fn);
+/* Creates the lamp light object on first need (lightapi.c). */
+plx_status eng_need_light(plx_engine *e, const char *fn);
+/* E_indirect at a checked surface point, 0 without photon frames (indirectapi.c). */
+double eng_indirect(plx_engine *e, const double P[3], const double n[3]);
+/* The same, also writing its RGB version to rgb (may be NULL); returns the scalar. */
+double eng_indirect_rgb(plx_engine *e, const double P[3], const double n[3], double rgb[3] /* OUT */);
+/* Checks the engine handle for API misuse. */
+int eng_ok(const plx_engine *e);
+
+#endif

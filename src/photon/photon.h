@@ -1,0 +1,450 @@
+/* photon: indirect light by urban photon buffers (SPEC §4; argudo2012 §3,
+ * munoz2013 §3.1, §3.3-3.4), on the CPU, in memory fixed at creation.
+ *
+ * WHAT IS COMPUTED. E_indirect(P): the illuminance at surface point P carried
+ * by light after one or more diffuse bounces; the outgoing radiance of the
+ * indirect part is albedo / pi * E_indirect (SPEC §4), E_direct stays exact
+ * (light.h). Photons are traced from the lamps through the 2.5D scene
+ * (trace.h) and stored at the second and later surfaces they meet: the first
+ * hit is direct light and is not stored.
+ *
+ * LAMPS AND THE REACH WINDOW. A lamp of intensity I cd is an isotropic point
+ * emitting 4 pi I lm. SPEC §2 weights direct light by W(d/R); for the
+ * indirect light to come from the same direct light, a photon's flux is
+ * multiplied by W(d1/R), d1 = distance to its first hit. The expected flux
+ * density at first hits is then exactly E_direct (with its falloff and its
+ * cut at R), and every later bounce reflects that light. Photons whose
+ * first hit is at d1 >= R carry nothing and are not traced further (the
+ * first-hit ray is cast only to R).
+ *
+ * COLOUR. A photon carries PHOTON_CH = 4 weights: a colour-blind scalar
+ * flux (channel 0; what illuminance in lux reports, SPEC §2: colour is
+ * ignored) and an RGB flux (channels 1-3; what images use, each lamp's
+ * light weighted by its colour). A photon of lamp i starts with
+ * phi W (1, c_i). Charts, floor maps and ambient terms store all four, so
+ * a lookup gives E_indirect and its RGB version in one pass.
+ *
+ * BOUNCES. Lambertian: cosine-weighted directions about the normal, Russian
+ * roulette with one scalar survival probability p = the albedo's luminance
+ * (building albedo on walls, roofs and undersides, grey; on the ground the
+ * albedo at the hit, scene_ground_albedo: a ground image's pixel or the
+ * scene's ground_albedo, src/ground.c), and the survivor's weights become
+ * f_0 a_Y / p = f_0 and f_c a_c / p (photon_bounce): unbiased per channel,
+ * and for grey albedos every weight is unchanged, so a stored photon
+ * carries its emission flux times W. At most cfg.max_bounces surfaces
+ * after the first.
+ *
+ * CHARTS (where photons are stored; argudo2012 §3.2).
+ *  - Facades. Per block two cylindrical charts, outer walls and courtyard
+ *    walls, centred on the block's box centre: u = angle / 2 pi (from -pi),
+ *    v = z / (block's tallest height). A wall belongs to the courtyard chart
+ *    when it is an edge of a hole of its building, or when the point 1 cm in
+ *    front of its middle lies inside one of the block's courtyard rings
+ *    (clockwise rings of the block outline, blocks.h; a raised building over
+ *    a courtyard fills it in the outline, hence the first rule).
+ *    Only the exposed part of a wall is charted: the part not covered by
+ *    another building touching its front (a shared wall is exposed only
+ *    above the lower neighbour); this is decided at the wall's middle.
+ *    Each texel keeps the world area of the exposed facade that maps to it
+ *    (walls cut in pieces of <= 1/4 texel of angle), which is the Delta A
+ *    of the lookup. Several walls mapping to one texel (a wall seen edge-on
+ *    from the centre) share it: the method's known blur.
+ *  - Ground and roofs ("aerial" chart). An orthogonal chart over Bounds
+ *    with square texels, a height channel (the topmost horizontal surface at
+ *    the texel centre: a roof height or 0) and each texel's area = texel
+ *    area times the fraction of k x k probes whose top surface is that same
+ *    surface. Splats only reach texels of the photon's height (within 1 mm),
+ *    so roof and floor photons do not mix.
+ *  - Covered ground (ground under raised buildings: canopies, bridges,
+ *    min_height > 0). A second, sparse aerial layer on the same texel grid:
+ *    gcov maps an aerial texel to its slot in compact arrays (cov_*), and
+ *    only texels with covered ground get one; a slot's area is the texel
+ *    area times the fraction of k x k probes that are open ground under a
+ *    raised building (disjoint from the aerial chart's area there). Ground
+ *    photons in such a texel whose point is covered (trace_top > 0) are
+ *    splatted into this layer (same kernel, validity = a slot with area),
+ *    and a lookup at z = 0 under a canopy reads it. Capacity is bounded
+ *    from the scene alone (the aerial texels under the boxes of raised
+ *    buildings), so photon_bytes needs no tracer; scenes without raised
+ *    buildings allocate nothing for it.
+ *    Other horizontal surfaces that are not topmost (roofs under a raised
+ *    building, undersides) have no chart: photons there are counted as
+ *    lost and the lookup answers with the block's ambient term (undersides)
+ *    or the nearest texel of the right height (roofs).
+ *
+ * LEVELS (argudo2012 §3.6). Blocks get levels 0-4 from their distance d to
+ * the viewer (nearest point of the block's box, 0..tallest height) and the
+ * mean block diameter b: d < 3b level 0, < 6b level 1, < 12b level 2,
+ * < 24b level 3, else 4; with a view direction, a block outside the view
+ * cone is level 2 when d < 3b and level 4 otherwise (what is on screen is
+ * charted; nearby blocks off screen keep a coarse chart). Blocks are taken
+ * by increasing d and a full level passes the block to the next level with
+ * room (budgets cfg.level_blocks, argudo's 10/40/160/640). Level L charts
+ * are (chart_w >> L) x (chart_h >> L) texels, so every level's atlas has
+ * about the same size. A block keeps its chart (and its accumulated
+ * photons) while its level does not change; a block that changes level
+ * starts a fresh chart. Level 4 blocks have no chart: their facades get a
+ * constant ambient term, the mean facade irradiance of the block measured
+ * by the same photons (flux on its exposed facades / their area / frames).
+ *
+ * PROGRESSIVE ACCUMULATION. photon_step adds one frame of photons; charts
+ * count the frames they have received (M). Splat kernel: a cone of radius
+ * r(M) = rmin + (rmax - rmin) k / (k + M - 1) texels (cfg.kernel_*), so the
+ * first frames are blurry and later ones sharp; each splat's weights over
+ * the texels it may reach (charted, right height) are normalised, so a
+ * splat deposits exactly the photon's flux (else nearest valid texel; else
+ * lost). Lookup is O(1): E = (sum w Phi) / (sum w Delta A) / M over the
+ * 2 x 2 texels around P (bilinear weights w, valid texels only).
+ *
+ * NIGHT LIGHTING (munoz2013 §3.3-3.4). Lamps near the viewer get their own
+ * floor photon maps: a square of side 2R centred on the lamp, cfg.lamp_res^2
+ * texels with height channel, filled by cfg.lamp_photons photons of that
+ * lamp alone (deterministic: seeded by the lamp index), ground and roof
+ * photons only. They live in an LRU cache of fixed slots (capacity from
+ * cfg.lamp_slots or cfg.lamp_cache_bytes). The aerial chart and the floor
+ * maps are combined without counting any lamp twice, as munoz's
+ *   E(p) = sum_{i in L} + sum_{i in I, not in C} + sum_{i in C}:
+ *  - A (the aerial chart, progressive) holds the lamps never refined (L);
+ *  - I (improved aerial map, aerial resolution, one set of photons per
+ *    lamp) holds every refined lamp's horizontal photons. "Push": the first
+ *    time lamp i's floor map is computed, its photons are splatted into I
+ *    at aerial resolution, lamp i is marked refined, the progressive pass
+ *    stops splatting lamp i into A, and A restarts (M = 0) so that lamp i's
+ *    older photons leave it.
+ *  - C_i (cached floor map) replaces I's share of lamp i near the lamp: each
+ *    slot also keeps D_i, its in-square photons splatted at aerial
+ *    resolution, so E = A/M + I - sum_{i in C} D_i + sum_{i in C} C_i.
+ *    Evicting a lamp needs no update (I already holds it); recomputing it
+ *    gives the same photons, so D_i cancels its share of I again.
+ *  Facade charts always take every lamp's photons from the progressive pass.
+ *  Covered ground has no floor maps: A_cov (progressive) holds the unrefined
+ *  lamps and I_cov every refined lamp's covered-ground photons, pushed with
+ *  I; E = A_cov / M + I_cov (C_i and D_i leave covered photons out).
+ *
+ * COST OF A PASS (tests/bench/bench_photon.c, gen eixample 30 30, 64K
+ * photons, 1.25 rays each). Most photons end at their first hit, so the
+ * per-photon work is: the stratified lamp choice, a uniform direction,
+ * the lamp ray (trace_lamp_ray: the lamp's table), W and the roulette; a
+ * quarter of them bounce (cosine direction, a grid walk) and are stored.
+ * What keeps it short, with the same random numbers and the same bytes
+ * as the plain version (tests compare):
+ *  - directions take cos and sin of 2 pi u from a polynomial, not libm
+ *    (photon_sincos_turn; same random numbers in the same order);
+ *  - lamps are taken in order, so the next lamps' tables and the walls
+ *    they list are prefetched when the lamp changes (trace_lamp_prefetch);
+ *  - the bounce reads the albedo the caster hands over with the hit;
+ *  - a stored photon's chart, coordinates and radius are decided when it
+ *    arrives and its texel rows prefetched; it is splatted STORE_QUEUE
+ *    photons later, in arrival order (every sum in the same order);
+ *  - the splat visits only the texels within r (squared distances first),
+ *    without calls;
+ *  - helpers are static: under -fPIC exported functions are not inlined.
+ * Storing costs about a quarter of the pass, the caster about half.
+ *
+ * MEMORY. photon_create takes every buffer from the arena (part
+ * PLX_PART_PHOTON): the tracer, per-edge and per-block tables, the four
+ * level atlases, the aerial charts, the covered-ground layer, the lamp
+ * cache. A texel keeps its flux as PHOTON_CH floats (16 bytes: scalar and
+ * RGB) beside its area (and height) floats; cfg.lamp_cache_bytes is a byte
+ * budget, so colour halves the slots it holds. photon_set_viewer and
+ * photon_lamps_update use scratch memory (released before return); steps and
+ * lookups allocate nothing. One photon_sys must not be used from two threads
+ * at once. No global state: randomness comes from the seeds given.
+ */
+#ifndef PLX_PHOTON_H
+#define PLX_PHOTON_H
+
+#include <stddef.h>
+#include <stdint.h>
+#include "polarlux.h"
+#include "base/arena.h"
+#include "base/scene.h"
+#include "photon/trace.h"
+
+#define PHOTON_LEVELS 4        /* charted levels 0..3; level 4 = ambient */
+#define PHOTON_NONE 0xffffffffu
+#define PHOTON_KERNEL_MAXI 6   /* largest splat radius, texels */
+#define PHOTON_KERNEL_MAX ((double)PHOTON_KERNEL_MAXI)
+#define PHOTON_CH 4            /* flux channels per texel: scalar, R, G, B */
+
+typedef struct photon_config {
+    uint32_t chart_w, chart_h;      /* level 0 facade chart, texels (u around, v up); 256 x 32 */
+    uint32_t level_blocks[PHOTON_LEVELS]; /* blocks per level: 10, 40, 160, 640 */
+    uint32_t aerial_res;            /* aerial chart texels along the longer side of Bounds; 512 */
+    uint32_t coverage_probes;       /* k: k x k probes per horizontal texel for its area; 3 */
+    double kernel_max, kernel_min;  /* splat radius in texels, first frame / limit; 2.5, 1.0 */
+    double kernel_frames;           /* k of r(M); 8 */
+    uint32_t max_bounces;           /* surfaces after the first; 16 */
+    uint32_t lamp_res;              /* floor map side, texels; 64 */
+    uint32_t lamp_photons;          /* photons per floor map; 32768 */
+    double lamp_kernel;             /* floor map splat radius, texels; 1.5 */
+    uint32_t lamp_slots;            /* LRU capacity; 0 = as many as lamp_cache_bytes hold */
+    size_t lamp_cache_bytes;        /* used when lamp_slots is 0; 4 MiB */
+    double near_radius;             /* photon_lamps_update: lamps within this horizontal
+                                       distance of the viewer are refined; 60 m */
+    double cell_size;               /* tracer grid cell, m; 0 = automatic */
+} photon_config;
+
+void photon_config_default(photon_config *c /* OUT */);
+
+typedef struct photon_stats {
+    uint64_t frames;                /* photon_step calls since the last reset */
+    uint64_t photons;               /* photons emitted by photon_step */
+    uint64_t traced;                /* rays cast (all bounces) */
+    double emitted;                 /* lm emitted (sum of photon fluxes before W) */
+    double first;                   /* lm arriving at first hits, W applied */
+    double arrived;                 /* lm arriving at 2nd and later hits */
+    double stored_chart;            /* lm splatted into facade charts (levels 0-3) */
+    double stored_ambient;          /* lm counted in level-4 blocks' ambient terms */
+    double stored_aerial;           /* lm splatted into the aerial chart A */
+    double stored_covered;          /* lm splatted into the covered-ground layer A_cov */
+    double skipped_refined;         /* lm of refined lamps' horizontal photons (kept in I) */
+    double lost;                    /* lm arriving where there is no chart */
+    double escaped;                 /* lm leaving to the sky after a bounce */
+    double absorbed;                /* lm ended by Russian roulette */
+    double cut;                     /* lm ended by max_bounces */
+    double arrived_rgb[3];          /* RGB flux arriving at 2nd and later hits */
+    double stored_rgb[3];           /* RGB flux stored by the progressive pass: facade
+                                       charts, ambient terms, A and A_cov */
+    uint64_t lamp_hits, lamp_misses, lamp_evictions, lamp_refined;
+    uint64_t aerial_restarts;
+} photon_stats;
+
+typedef struct photon_level {
+    uint32_t w, h;                  /* chart texels */
+    uint32_t nslots;
+    float *flux;                    /* nslots * 2 charts * w * h * PHOTON_CH: accumulated lm */
+    float *area;                    /* nslots * 2 charts * w * h: world area of each texel, m^2 */
+    uint32_t *slot_block;           /* block in each slot or PHOTON_NONE */
+    uint32_t *slot_frames;          /* frames the slot has received */
+    uint32_t *free_slots;           /* stack of free slot indices */
+    uint32_t nfree;
+} photon_level;
+
+typedef struct photon_lamp_slot {
+    uint32_t lamp;                  /* PHOTON_NONE when empty */
+    uint32_t prev, next;            /* LRU list, most recent first */
+    double x0, y0, texel;           /* floor map origin (min corner) and texel size */
+    int32_t dx0, dy0;               /* D window origin in aerial texels */
+    float *flux;                    /* lamp_res^2 * PHOTON_CH */
+    float *area, *height;           /* lamp_res^2 each */
+    float *dwin;                    /* D_i: dwin_n^2 aerial texels * PHOTON_CH */
+} photon_lamp_slot;
+
+typedef struct photon_sys {
+    arena *a;
+    const scene *s;
+    photon_config cfg;
+    tracer *T;
+    /* walls (per scene point = edge start) */
+    uint8_t *eclass;                /* PHOTON_EDGE_* */
+    float *ez0, *ez1;               /* exposed height range */
+    /* blocks */
+    uint8_t *blevel;                /* 0..4 */
+    uint32_t *bslot;                /* slot in its level or PHOTON_NONE */
+    double *bcx, *bcy, *bhmax;      /* chart centre and height */
+    double *bfacade;                /* exposed facade area, m^2 */
+    double *bamb;                   /* facade flux accumulated, lm, PHOTON_CH per block
+                                       (ambient term) */
+    double mean_diam;               /* b */
+    uint32_t amb_frames;
+    photon_level lev[PHOTON_LEVELS];
+    uint32_t level_count[PHOTON_LEVELS + 1];
+    /* aerial chart */
+    uint32_t gw, gh;
+    double gx0, gy0, gtex;
+    float *gheight, *garea;
+    float *gflux;                   /* A: progressive, unrefined lamps; PHOTON_CH per texel */
+    float *gimp;                    /* I: refined lamps, one computation each; same */
+    uint32_t gframes;
+    /* covered ground (under raised buildings): sparse layer on the aerial grid */
+    uint32_t *gcov;                 /* per aerial texel: slot or PHOTON_NONE; NULL when
+                                       the scene has no raised building */
+    uint32_t ncov, cov_cap;         /* slots used, slots allocated */
+    float *cov_area;                /* per slot: covered ground area, m^2 */
+    float *cov_flux;                /* A_cov: PHOTON_CH per slot */
+    float *cov_imp;                 /* I_cov: PHOTON_CH per slot */
+    /* lamps */
+    double *lamp_cdf;               /* cumulative flux, nlamps */
+    double flux_total;
+    uint8_t *refined;
+    uint32_t *lamp_slot;            /* per lamp: cache slot or PHOTON_NONE */
+    photon_lamp_slot *slots;
+    uint32_t nslots, lru_head, lru_tail;
+    uint32_t dwin_n;                /* D window side, aerial texels */
+    double eye[3];
+    photon_stats st;
+} photon_sys;
+
+enum { PHOTON_EDGE_INTERNAL = 0, PHOTON_EDGE_OUTER = 1, PHOTON_EDGE_INNER = 2 };
+
+/*
+ * Creates the photon system for scene s, which must have its blocks
+ * (scene.nblocks > 0 when it has buildings; blocks_build) and must not
+ * change while the system lives. cfg NULL = defaults. Levels are first set
+ * for a viewer at the centre of Bounds, 1.7 m above the ground.
+ * Returns PLX_OK; PLX_E_INVALID (NULL argument, a config value out of
+ * range: zero sizes, chart_w or chart_h below 8, kernel radii not in
+ * (0, PHOTON_KERNEL_MAX], kernel_min > kernel_max, buildings without
+ * blocks); PLX_E_NOMEM (the arena is back where it was).
+ */
+plx_status photon_create(arena *a, const scene *s, const photon_config *cfg,
+                         photon_sys **out /* OUT */);
+
+/* Bytes photon_create would take from part PLX_PART_PHOTON. */
+size_t photon_bytes(const scene *s, const photon_config *cfg);
+
+/* Bytes of one lamp cache slot (the unit of cfg.lamp_cache_bytes). */
+size_t photon_lamp_slot_bytes(const scene *s, const photon_config *cfg);
+
+/*
+ * One progressive frame: n photons shared among the lamps in proportion to
+ * their flux (stratified), each carrying (total flux) / n lm, traced and
+ * splatted. Deterministic for (state, n, seed). Needs no memory.
+ */
+void photon_step(photon_sys *ps, uint32_t n, uint64_t seed);
+
+/*
+ * E_indirect (lux) at surface point P with outward unit normal n: the
+ * ground or a roof when n points up (n[2] > 0.5), an underside when down,
+ * else a wall (P within a few mm of it). O(1) apart from the lamp cache
+ * term (one test per cached lamp). Points on no surface, or with no frames
+ * yet, give 0.
+ */
+double photon_indirect(photon_sys *ps, const double P[3], const double n[3]);
+
+/* The same, also writing the RGB version of E_indirect to rgb (may be NULL):
+ * each lamp's light weighted by its colour (equals the scalar for white
+ * lamps and grey albedos). Returns the scalar. */
+double photon_indirect_rgb(photon_sys *ps, const double P[3], const double n[3],
+                           double rgb[3] /* OUT */);
+
+/*
+ * Levels for a viewer at eye looking along dir (unit; NULL = all around)
+ * with a full cone angle fov_deg. Blocks whose level changes get a new
+ * empty chart. Returns PLX_OK or PLX_E_NOMEM (scratch for sorting; levels
+ * unchanged).
+ */
+plx_status photon_set_viewer(photon_sys *ps, const double eye[3], const double dir[3],
+                             double fov_deg);
+
+/* Level of block b (0..4). */
+int photon_block_level(const photon_sys *ps, uint32_t b);
+
+/* Drops every accumulated photon (charts, ambient, A, I, the lamp cache and
+ * the refined marks); levels stay. For changed lamps. */
+void photon_reset(photon_sys *ps);
+
+/* ---- lamp floor maps (photon_night.c) --------------------------------- */
+
+/*
+ * Makes lamp i's floor map available: on a hit it becomes the most recently
+ * used; on a miss it is computed into the least recently used slot
+ * (evicting that lamp), and the first time also pushed into I (see above).
+ * Returns 1 on a hit, 0 on a miss, -1 when i is out of range or the cache
+ * has no slot. Uses no memory.
+ */
+int photon_lamp_request(photon_sys *ps, uint32_t lamp);
+
+/* Refines the lamps within cfg.near_radius (horizontally) of eye, nearest
+ * first, at most the cache capacity. Returns the number of misses (maps
+ * computed), or -1 when scratch memory runs out. */
+int photon_lamps_update(photon_sys *ps, const double eye[3]);
+
+/* Whether lamp i is in the cache (1/0), without touching the LRU order. */
+int photon_lamp_cached(const photon_sys *ps, uint32_t lamp);
+
+/* The cached lamps from most to least recently used: writes up to cap
+ * lamp indices, returns how many are cached. */
+uint32_t photon_lamp_lru(const photon_sys *ps, uint32_t *lamps /* OUT */, uint32_t cap);
+
+/* The floor-map share of E_indirect at (x, y, z) on the ground or a roof,
+ * PHOTON_CH channels: I - sum D_i + sum C_i (lux), 0 when nothing is
+ * refined. On covered ground (covered != 0) it is I_cov. */
+void photon_night_horizontal(const photon_sys *ps, double x, double y, double z, int covered,
+                             double e[PHOTON_CH] /* OUT */);
+
+/* ---- histogram matching (photon_hist.c; munoz2013 §3.1) --------------- */
+
+/*
+ * Histogram matching of an RGB8 image to a reference, channel by channel:
+ * each value v of channel c of src becomes the smallest w whose cumulative
+ * frequency in the reference channel reaches v's in src. Reference pixels
+ * whose luminance (0.2126 R + 0.7152 G + 0.0722 B, 0..255) is below
+ * dark_threshold are left out of the reference histograms (if that leaves
+ * none, all are used). src and out hold npx packed RGB pixels and may be
+ * the same buffer; ref holds nref pixels. Pure: no memory, no state.
+ * Returns 0, or -1 when a pointer is NULL or npx or nref is 0 (out
+ * untouched).
+ */
+int photon_hist_match(const uint8_t *src, size_t npx, const uint8_t *ref, size_t nref,
+                      double dark_threshold, uint8_t *out /* OUT */);
+
+/* ---- internal, shared by photon*.c ------------------------------------ */
+
+/* The reach window W(x) = (clamp(1 - x^4, 0, 1))^2. */
+double photon_window(double x);
+/* Splats the PHOTON_CH weights phi at continuous texel coordinates
+ * (fx, fy) of a w x h grid: cone of radius r (texels), texels valid when
+ * area > 0 and, with height given, |height - z| <= 1 mm; wrap: u periodic.
+ * flux holds PHOTON_CH floats per texel. Returns 1 when deposited, 0 when
+ * no valid texel was near (nothing deposited). */
+int photon_splat(float *flux, const float *area, const float *height, double z,
+                 uint32_t w, uint32_t h, int wrap, double fx, double fy, double r,
+                 const double phi[PHOTON_CH]);
+/* Ratio lookup over the 2 x 2 texels around (fx, fy): e = sum w F / sum w A
+ * per channel (0 when no valid texel). Returns e[0]. */
+double photon_gather(const float *flux, const float *area, const float *height, double z,
+                     uint32_t w, uint32_t h, int wrap, double fx, double fy,
+                     double e[PHOTON_CH] /* OUT */);
+/* The same on a sparse grid: grid texel k is stored in slot idx[k]
+ * (PHOTON_NONE: not charted); flux and area are per slot; no height, no
+ * wrap. */
+int photon_splat_sparse(float *flux, const float *area, const uint32_t *idx, uint32_t w,
+                        uint32_t h, double fx, double fy, double r, const double phi[PHOTON_CH]);
+double photon_gather_sparse(const float *flux, const float *area, const uint32_t *idx,
+                            uint32_t w, uint32_t h, double fx, double fy,
+                            double e[PHOTON_CH] /* OUT */);
+/* The same into a window of the grid: out holds ow x oh texels whose first
+ * is texel (ox, oy) of the w x h grid (no wrap); validity comes from the
+ * full grid's area and height. Parts falling outside the window are
+ * dropped. */
+int photon_splat_win(float *out, uint32_t ow, uint32_t oh, int32_t ox, int32_t oy,
+                     const float *area, const float *height, double z, uint32_t w, uint32_t h,
+                     double fx, double fy, double r, const double phi[PHOTON_CH]);
+/* photon_gather with the flux taken from such a window (0 outside it). */
+double photon_gather_win(const float *out, uint32_t ow, uint32_t oh, int32_t ox, int32_t oy,
+                         const float *area, const float *height, double z, uint32_t w,
+                         uint32_t h, double fx, double fy, double e[PHOTON_CH] /* OUT */);
+/* Receives a photon arriving at h (second or later hit) with weights f. */
+typedef void (*photon_store_fn)(photon_sys *ps, void *ctx, uint32_t lamp, const trace_hit *h,
+                                const double f[PHOTON_CH]);
+/* Traces one photon of flux phi (before W) from lamp: first hit, W, then
+ * bounces, calling store at every later hit; counts into st. */
+void photon_trace_lamp(photon_sys *ps, uint32_t lamp, double phi, uint64_t *rng,
+                       photon_stats *st, photon_store_fn store, void *ctx);
+/* The colour-blind albedo of an RGB albedo: its luminance (Rec. 709
+ * weights), exactly the common value when the three are equal. */
+double photon_albedo_scalar(const double rgb[3]);
+/* One diffuse bounce's Russian roulette with uniform u in [0, 1): returns 0
+ * (absorbed) when u >= p = photon_albedo_scalar(alb), else scales the RGB
+ * weights f[1..3] by alb_c / p (f[0] is kept) and returns 1. */
+int photon_bounce(double f[PHOTON_CH], const double alb[3], double u);
+/* Whether (x, y) is ground under a raised building that the covered-ground
+ * layer charts (its aerial texel has a slot and the point is covered). */
+int photon_covered_at(const photon_sys *ps, double x, double y);
+/* Random numbers (splitmix64 state). */
+uint64_t photon_rand(uint64_t *st);
+double photon_rand01(uint64_t *st);
+/* cos and sin of 2 pi u, u in [0, 1), by a polynomial (no libm call;
+ * within 2 ulps of libm). */
+void photon_sincos_turn(double u, double *c /* OUT */, double *s /* OUT */);
+/* Uniform direction on the unit sphere from two random numbers
+ * (z = 1 - 2 u1, azimuth 2 pi u2). */
+void photon_sphere_dir(uint64_t *st, double d[3] /* OUT */);
+/* Cosine-weighted direction about unit n (radius sqrt u1, azimuth 2 pi u2). */
+void photon_cosine_dir(uint64_t *st, const double n[3], double d[3] /* OUT */);
+/* Aerial texel coordinates of (x, y). */
+void photon_aerial_xy(const photon_sys *ps, double x, double y, double *fx, double *fy);
+
+#endif

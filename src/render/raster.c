@@ -1,0 +1,578 @@
+/* raster: the minimal software rasteriser. See raster.h for the conventions,
+ * the fixed-point format and the fill rule. */
+#include <stddef.h>
+#include <stdint.h>
+#include <string.h>
+#include <math.h>
+#include "render/raster.h"
+
+/* Fixed-point window coordinates: RASTER_SUBPIXEL_BITS fraction bits. */
+#define FIX_ONE  ((int64_t)1 << RASTER_SUBPIXEL_BITS)   /* one pixel */
+#define FIX_HALF (FIX_ONE / 2)                          /* pixel centre offset */
+/* Snapped coordinates are clamped to +-FIX_LIMIT. The guard band keeps valid
+ * input within +-(RASTER_MAX_DIM + RASTER_GUARD_PX) pixels, about 2^22.6
+ * units, so the clamp only guards against rounding at the guard planes. */
+#define FIX_LIMIT ((int64_t)1 << 24)
+
+/* Clip planes, applied in this order. */
+enum { PLANE_W = 0, PLANE_NEAR, PLANE_FAR, PLANE_LEFT, PLANE_RIGHT,
+       PLANE_BOTTOM, PLANE_TOP, PLANE_COUNT };
+/* A triangle clipped by PLANE_COUNT planes has at most 3 + PLANE_COUNT vertices. */
+#define POLY_MAX (3 + PLANE_COUNT)
+
+/* A vertex in window space: snapped position, depth, 1/w, attr/w. */
+typedef struct svert {
+    int64_t x, y;
+    double z;
+    float iw;
+    float a[RASTER_MAX_ATTRS];
+} svert;
+
+/* ---- small helpers ---------------------------------------------------- */
+
+static int64_t floor_div(int64_t a, int64_t b) /* b > 0 */
+{
+    int64_t q = a / b;
+    if ((a % b != 0) && (a < 0))
+        q--;
+    return q;
+}
+
+static int64_t ceil_div(int64_t a, int64_t b) /* b > 0 */
+{
+    return -floor_div(-a, b);
+}
+
+static int64_t min64(int64_t a, int64_t b) { return a < b ? a : b; }
+static int64_t max64(int64_t a, int64_t b) { return a > b ? a : b; }
+
+/* Twice the signed area of a, b, c in fixed units squared; > 0 when c lies
+ * on the interior side of every edge of the triangle a, b, c as defined by
+ * the edge function below (clockwise on screen, as y points down). */
+static int64_t area2(const svert *a, const svert *b, const svert *c)
+{
+    return (b->x - a->x) * (c->y - a->y) - (b->y - a->y) * (c->x - a->x);
+}
+
+static unsigned char to_u8(float v)
+{
+    if (!(v > 0.0f))            /* also NaN */
+        return 0;
+    if (v >= 1.0f)
+        return 255;
+    return (unsigned char)(v * 255.0f + 0.5f);
+}
+
+/* ---- per-format write paths ------------------------------------------ */
+
+static void store_rgba8(unsigned char *row, int64_t x, const float c[4])
+{
+    unsigned char *p = row + (size_t)x * 4;
+    p[0] = to_u8(c[0]);
+    p[1] = to_u8(c[1]);
+    p[2] = to_u8(c[2]);
+    p[3] = to_u8(c[3]);
+}
+
+static void store_rgb_f32(unsigned char *row, int64_t x, const float c[4])
+{
+    float *p = (float *)(void *)row + (size_t)x * 3;
+    p[0] = c[0];
+    p[1] = c[1];
+    p[2] = c[2];
+}
+
+static void store_rgba_f32(unsigned char *row, int64_t x, const float c[4])
+{
+    float *p = (float *)(void *)row + (size_t)x * 4;
+    p[0] = c[0];
+    p[1] = c[1];
+    p[2] = c[2];
+    p[3] = c[3];
+}
+
+static size_t format_bytes(raster_format f)
+{
+    switch (f) {
+    case RASTER_RGBA8:    return 4;
+    case RASTER_RGB_F32:  return 3 * sizeof(float);
+    case RASTER_RGBA_F32: return 4 * sizeof(float);
+    }
+    return 0;
+}
+
+/* ---- set-up ------------------------------------------------------------ */
+
+plx_status raster_init(raster_ctx *r, const raster_target *t, const char **why)
+{
+    const char *msg = NULL;
+    raster_target tt;
+    size_t bpp;
+
+    if (r == NULL || t == NULL) {
+        if (why) *why = "raster_init: context or target is NULL";
+        return PLX_E_INVALID;
+    }
+    tt = *t;
+    bpp = format_bytes(tt.format);
+    if (bpp == 0)
+        msg = "raster_init: unknown colour format";
+    else if (tt.width < 1 || tt.width > RASTER_MAX_DIM)
+        msg = "raster_init: width outside 1..RASTER_MAX_DIM";
+    else if (tt.height < 1 || tt.height > RASTER_MAX_DIM)
+        msg = "raster_init: height outside 1..RASTER_MAX_DIM";
+    if (msg == NULL && tt.color != NULL) {
+        if (tt.color_stride == 0)
+            tt.color_stride = bpp * (size_t)tt.width;
+        if (tt.color_stride < bpp * (size_t)tt.width)
+            msg = "raster_init: colour stride is shorter than one row";
+        else if (tt.format != RASTER_RGBA8 && tt.color_stride % sizeof(float) != 0)
+            msg = "raster_init: float colour stride is not a multiple of sizeof(float)";
+    }
+    if (msg == NULL && tt.depth != NULL) {
+        if (tt.depth_stride == 0)
+            tt.depth_stride = (size_t)tt.width;
+        if (tt.depth_stride < (size_t)tt.width)
+            msg = "raster_init: depth stride is shorter than one row";
+    }
+    if (msg != NULL) {
+        if (why) *why = msg;
+        return PLX_E_INVALID;
+    }
+
+    memset(r, 0, sizeof *r);
+    r->t = tt;
+    r->sx0 = 0;
+    r->sy0 = 0;
+    r->sx1 = tt.width;
+    r->sy1 = tt.height;
+    r->nattr = 0;
+    r->cull = RASTER_CULL_NONE;
+    r->depth_test = 1;
+    r->depth_write = 1;
+    r->frag = NULL;
+    r->user = NULL;
+    /* x/w = gx maps to RASTER_GUARD_PX pixels beyond the right edge. */
+    r->gx = (float)(1.0 + 2.0 * RASTER_GUARD_PX / (double)tt.width);
+    r->gy = (float)(1.0 + 2.0 * RASTER_GUARD_PX / (double)tt.height);
+    if (why) *why = NULL;
+    return PLX_OK;
+}
+
+void raster_set_fragment(raster_ctx *r, raster_fragment_fn fn, void *user, int nattr)
+{
+    if (nattr < 0) nattr = 0;
+    if (nattr > RASTER_MAX_ATTRS) nattr = RASTER_MAX_ATTRS;
+    r->frag = fn;
+    r->user = user;
+    r->nattr = nattr;
+}
+
+void raster_set_scissor(raster_ctx *r, int32_t x0, int32_t y0, int32_t x1, int32_t y1)
+{
+    if (x0 < 0) x0 = 0;
+    if (y0 < 0) y0 = 0;
+    if (x1 > r->t.width) x1 = r->t.width;
+    if (y1 > r->t.height) y1 = r->t.height;
+    if (x1 < x0) x1 = x0;
+    if (y1 < y0) y1 = y0;
+    r->sx0 = x0;
+    r->sy0 = y0;
+    r->sx1 = x1;
+    r->sy1 = y1;
+}
+
+void raster_set_cull(raster_ctx *r, raster_cull cull)
+{
+    r->cull = cull;
+}
+
+void raster_set_depth(raster_ctx *r, int test, int write)
+{
+    r->depth_test = test != 0;
+    r->depth_write = write != 0;
+}
+
+void raster_clear_color(raster_ctx *r, const float rgba[4])
+{
+    int32_t x, y;
+    unsigned char *row;
+
+    if (r->t.color == NULL)
+        return;
+    for (y = 0; y < r->t.height; y++) {
+        row = (unsigned char *)r->t.color + (size_t)y * r->t.color_stride;
+        for (x = 0; x < r->t.width; x++) {
+            switch (r->t.format) {
+            case RASTER_RGBA8:    store_rgba8(row, x, rgba); break;
+            case RASTER_RGB_F32:  store_rgb_f32(row, x, rgba); break;
+            case RASTER_RGBA_F32: store_rgba_f32(row, x, rgba); break;
+            }
+        }
+    }
+}
+
+void raster_clear_depth(raster_ctx *r, float depth)
+{
+    int32_t x, y;
+    float *row;
+
+    if (r->t.depth == NULL)
+        return;
+    for (y = 0; y < r->t.height; y++) {
+        row = r->t.depth + (size_t)y * r->t.depth_stride;
+        for (x = 0; x < r->t.width; x++)
+            row[x] = depth;
+    }
+}
+
+/* ---- clipping ---------------------------------------------------------- */
+
+/* Signed distance of clip-space point p to plane k; >= 0 is inside. */
+static float plane_dist(const raster_ctx *r, int k, const float *p)
+{
+    switch (k) {
+    case PLANE_W:      return p[3] - RASTER_W_EPSILON;
+    case PLANE_NEAR:   return p[2] + p[3];
+    case PLANE_FAR:    return p[3] - p[2];
+    case PLANE_LEFT:   return p[0] + r->gx * p[3];
+    case PLANE_RIGHT:  return r->gx * p[3] - p[0];
+    case PLANE_BOTTOM: return p[1] + r->gy * p[3];
+    default:           return r->gy * p[3] - p[1];
+    }
+}
+
+static unsigned outcode(const raster_ctx *r, const float *p)
+{
+    unsigned m = 0;
+    int k;
+    for (k = 0; k < PLANE_COUNT; k++)
+        if (plane_dist(r, k, p) < 0.0f)
+            m |= 1u << k;
+    return m;
+}
+
+/* The point where edge (in, out) crosses a plane, computed from the inside
+ * end so that both triangles sharing the edge get the same bits. */
+static void intersect(raster_vertex *o, const raster_vertex *in, const raster_vertex *out,
+                      float din, float dout, int nattr)
+{
+    float t = din / (din - dout);
+    int c;
+    for (c = 0; c < 4; c++)
+        o->pos[c] = in->pos[c] + t * (out->pos[c] - in->pos[c]);
+    for (c = 0; c < nattr; c++)
+        o->attr[c] = in->attr[c] + t * (out->attr[c] - in->attr[c]);
+}
+
+/* Clips polygon in[0..n) by plane k into out. Returns the new vertex count,
+ * or -1 when every vertex is inside (out untouched). */
+static int clip_plane(const raster_ctx *r, int k, const raster_vertex *in, int n,
+                      raster_vertex *out)
+{
+    float d[POLY_MAX];
+    int i, m = 0, any_out = 0;
+
+    for (i = 0; i < n; i++) {
+        d[i] = plane_dist(r, k, in[i].pos);
+        if (d[i] < 0.0f)
+            any_out = 1;
+    }
+    if (!any_out)
+        return -1;
+    for (i = 0; i < n; i++) {
+        int j = (i + 1 == n) ? 0 : i + 1;
+        int iin = d[i] >= 0.0f, jin = d[j] >= 0.0f;
+        if (iin)
+            out[m++] = in[i];
+        if (iin && !jin) {
+            if (d[i] > 0.0f)      /* d == 0: the crossing is in[i] itself */
+                intersect(&out[m++], &in[i], &in[j], d[i], d[j], r->nattr);
+        } else if (!iin && jin) {
+            if (d[j] > 0.0f)      /* d == 0: in[j] is emitted next */
+                intersect(&out[m++], &in[j], &in[i], d[j], d[i], r->nattr);
+        }
+    }
+    return m;
+}
+
+/* ---- window space -------------------------------------------------------- */
+
+static int64_t snap(double v)
+{
+    double f = floor(v * (double)FIX_ONE + 0.5);
+    if (f > (double)FIX_LIMIT) f = (double)FIX_LIMIT;
+    if (f < -(double)FIX_LIMIT) f = -(double)FIX_LIMIT;
+    return (int64_t)f;
+}
+
+static void project(const raster_ctx *r, const raster_vertex *v, svert *s)
+{
+    double w = (double)v->pos[3];
+    double z = ((double)v->pos[2] / w + 1.0) * 0.5;
+    int k;
+
+    s->x = snap(((double)v->pos[0] / w + 1.0) * 0.5 * (double)r->t.width);
+    s->y = snap((1.0 - (double)v->pos[1] / w) * 0.5 * (double)r->t.height);
+    if (!(z > 0.0)) z = 0.0;
+    if (z > 1.0) z = 1.0;
+    s->z = z;
+    s->iw = (float)(1.0 / w);
+    for (k = 0; k < r->nattr; k++)
+        s->a[k] = v->attr[k] * s->iw;
+}
+
+/* ---- triangle setup and pixel loop ---------------------------------------- */
+
+/* Edge a -> b of a triangle with positive area2: E(p) > 0 inside. */
+typedef struct edge {
+    int64_t dx, dy;      /* b - a */
+    int64_t ax, ay;
+    int64_t step_x;      /* change of E for one pixel to the right */
+    int64_t bias;        /* 0 for top-left edges, -1 otherwise */
+} edge;
+
+static void edge_setup(edge *e, const svert *a, const svert *b)
+{
+    e->dx = b->x - a->x;
+    e->dy = b->y - a->y;
+    e->ax = a->x;
+    e->ay = a->y;
+    e->step_x = -e->dy * FIX_ONE;
+    /* y points down. The interior normal is (-dy, dx): a left edge has the
+     * interior to its right (dy < 0); a top edge is horizontal with the
+     * interior below (dy == 0, dx > 0). Centres exactly on other edges are
+     * left to the neighbour: E + bias >= 0 is the coverage test. */
+    e->bias = (e->dy < 0 || (e->dy == 0 && e->dx > 0)) ? 0 : -1;
+}
+
+static int64_t edge_eval(const edge *e, int64_t px, int64_t py)
+{
+    return e->dx * (py - e->ay) - e->dy * (px - e->ax);
+}
+
+/* Draws triangle v0 v1 v2 with area2 == area > 0. */
+static size_t draw_triangle(raster_ctx *r, const svert *v0, const svert *v1,
+                            const svert *v2, int64_t area)
+{
+    const raster_target *t = &r->t;
+    edge e[3];
+    int64_t xmin, xmax, ymin, ymax, i0, i1, j0, j1, j;
+    double inv_area = 1.0 / (double)area;
+    double z0 = v0->z, dz1 = v1->z - v0->z, dz2 = v2->z - v0->z;
+    float iw0 = v0->iw, diw1 = v1->iw - v0->iw, diw2 = v2->iw - v0->iw;
+    float a0[RASTER_MAX_ATTRS], da1[RASTER_MAX_ATTRS], da2[RASTER_MAX_ATTRS];
+    float attr[RASTER_MAX_ATTRS];
+    int nattr = r->nattr, k;
+    int need_attr = nattr > 0;
+    int use_depth_test = r->depth_test && t->depth != NULL;
+    int use_depth_write = r->depth_write && t->depth != NULL;
+    size_t written = 0;
+
+    for (k = 0; k < nattr; k++) {
+        a0[k] = v0->a[k];
+        da1[k] = v1->a[k] - v0->a[k];
+        da2[k] = v2->a[k] - v0->a[k];
+    }
+    edge_setup(&e[0], v1, v2);  /* opposite v0 */
+    edge_setup(&e[1], v2, v0);  /* opposite v1: gives the weight of v1 */
+    edge_setup(&e[2], v0, v1);  /* opposite v2: gives the weight of v2 */
+
+    /* Pixels whose centre lies in the bounding box, within the scissor. */
+    xmin = min64(v0->x, min64(v1->x, v2->x));
+    xmax = max64(v0->x, max64(v1->x, v2->x));
+    ymin = min64(v0->y, min64(v1->y, v2->y));
+    ymax = max64(v0->y, max64(v1->y, v2->y));
+    i0 = max64(ceil_div(xmin - FIX_HALF, FIX_ONE), r->sx0);
+    i1 = min64(floor_div(xmax - FIX_HALF, FIX_ONE), (int64_t)r->sx1 - 1);
+    j0 = max64(ceil_div(ymin - FIX_HALF, FIX_ONE), r->sy0);
+    j1 = min64(floor_div(ymax - FIX_HALF, FIX_ONE), (int64_t)r->sy1 - 1);
+    if (i0 > i1 || j0 > j1)
+        return 0;
+
+    for (j = j0; j <= j1; j++) {
+        int64_t py = j * FIX_ONE + FIX_HALF;
+        int64_t px = i0 * FIX_ONE + FIX_HALF;
+        int64_t ev[3], lo = i0, hi = i1, e1, e2, x;
+        unsigned char *crow = NULL;
+        float *drow = NULL;
+
+        /* The exact span of covered centres on this row, from each edge:
+         * E(i) = ev + (i - i0) * step_x, covered when E(i) + bias >= 0. */
+        for (k = 0; k < 3; k++) {
+            int64_t eb, s = e[k].step_x;
+            ev[k] = edge_eval(&e[k], px, py);
+            eb = ev[k] + e[k].bias;
+            if (s > 0) {
+                if (eb < 0)
+                    lo = max64(lo, i0 + ceil_div(-eb, s));
+            } else if (s < 0) {
+                if (eb < 0)
+                    hi = i0 - 1;
+                else
+                    hi = min64(hi, i0 + eb / -s);
+            } else if (eb < 0) {
+                hi = i0 - 1;
+            }
+        }
+        if (lo > hi)
+            continue;
+
+        if (t->color != NULL)
+            crow = (unsigned char *)t->color + (size_t)j * t->color_stride;
+        if (t->depth != NULL)
+            drow = t->depth + (size_t)j * t->depth_stride;
+        e1 = ev[1] + (lo - i0) * e[1].step_x;
+        e2 = ev[2] + (lo - i0) * e[2].step_x;
+
+        for (x = lo; x <= hi; x++, e1 += e[1].step_x, e2 += e[2].step_x) {
+            double l1 = (double)e1 * inv_area, l2 = (double)e2 * inv_area;
+            float z = (float)(z0 + l1 * dz1 + l2 * dz2);
+            float rgba[4] = { 0.0f, 0.0f, 0.0f, 1.0f };
+
+            if (use_depth_test && !(z < drow[x]))
+                continue;
+            if (need_attr) {
+                float f1 = (float)l1, f2 = (float)l2;
+                float w = 1.0f / (iw0 + f1 * diw1 + f2 * diw2);
+                for (k = 0; k < nattr; k++)
+                    attr[k] = (a0[k] + f1 * da1[k] + f2 * da2[k]) * w;
+            }
+            if (r->frag != NULL) {
+                r->stats.fragments_shaded++;
+                if (!r->frag(r->user, (int32_t)x, (int32_t)j, z, attr, rgba))
+                    continue;
+            } else {
+                for (k = 0; k < nattr && k < 4; k++)
+                    rgba[k] = attr[k];
+            }
+            if (crow != NULL) {
+                switch (t->format) {
+                case RASTER_RGBA8:    store_rgba8(crow, x, rgba); break;
+                case RASTER_RGB_F32:  store_rgb_f32(crow, x, rgba); break;
+                case RASTER_RGBA_F32: store_rgba_f32(crow, x, rgba); break;
+                }
+            }
+            if (use_depth_write)
+                drow[x] = z;
+            written++;
+        }
+    }
+    r->stats.pixels_written += written;
+    return written;
+}
+
+/* Draws the convex polygon p[0..n) (clip space, inside every plane). */
+static size_t draw_polygon(raster_ctx *r, const raster_vertex *const *p, int n)
+{
+    svert s[POLY_MAX];
+    int64_t a[POLY_MAX], total = 0;
+    size_t written = 0;
+    int k;
+
+    for (k = 0; k < n; k++)
+        project(r, p[k], &s[k]);
+    for (k = 1; k + 1 < n; k++) {
+        a[k] = area2(&s[0], &s[k], &s[k + 1]);
+        total += a[k];
+    }
+    if (total == 0) {
+        r->stats.triangles_rejected++;
+        return 0;
+    }
+    /* total > 0 is clockwise on screen (y down), i.e. clockwise in NDC. */
+    if ((r->cull == RASTER_CULL_BACK && total > 0) ||
+        (r->cull == RASTER_CULL_FRONT && total < 0)) {
+        r->stats.triangles_culled++;
+        return 0;
+    }
+    for (k = 1; k + 1 < n; k++) {
+        if (total > 0 && a[k] > 0)
+            written += draw_triangle(r, &s[0], &s[k], &s[k + 1], a[k]);
+        else if (total < 0 && a[k] < 0)
+            written += draw_triangle(r, &s[0], &s[k + 1], &s[k], -a[k]);
+    }
+    return written;
+}
+
+static int valid_position(const float *p)
+{
+    int c;
+    for (c = 0; c < 4; c++)
+        if (!(fabsf(p[c]) <= RASTER_MAX_COORD))   /* also NaN */
+            return 0;
+    return 1;
+}
+
+size_t raster_triangle(raster_ctx *r, const raster_vertex *v0,
+                       const raster_vertex *v1, const raster_vertex *v2)
+{
+    raster_vertex buf[2][POLY_MAX];
+    const raster_vertex *tri[3];
+    const raster_vertex *poly[POLY_MAX];
+    unsigned m0, m1, m2;
+    int n, k, cur;
+
+    r->stats.triangles_in++;
+    if (!valid_position(v0->pos) || !valid_position(v1->pos) || !valid_position(v2->pos)) {
+        r->stats.triangles_rejected++;
+        return 0;
+    }
+    m0 = outcode(r, v0->pos);
+    m1 = outcode(r, v1->pos);
+    m2 = outcode(r, v2->pos);
+    if ((m0 & m1 & m2) != 0) {              /* all outside one plane */
+        r->stats.triangles_rejected++;
+        return 0;
+    }
+    if ((m0 | m1 | m2) == 0) {              /* all inside: no clipping */
+        tri[0] = v0;
+        tri[1] = v1;
+        tri[2] = v2;
+        return draw_polygon(r, tri, 3);
+    }
+
+    /* Clip by every plane in a fixed order (see raster.h for why). */
+    r->stats.triangles_clipped++;
+    buf[0][0] = *v0;
+    buf[0][1] = *v1;
+    buf[0][2] = *v2;
+    n = 3;
+    cur = 0;
+    for (k = 0; k < PLANE_COUNT; k++) {
+        int m = clip_plane(r, k, buf[cur], n, buf[1 - cur]);
+        if (m < 0)
+            continue;
+        cur = 1 - cur;
+        n = m;
+        if (n < 3) {
+            r->stats.triangles_rejected++;
+            return 0;
+        }
+    }
+    for (k = 0; k < n; k++)
+        poly[k] = &buf[cur][k];
+    return draw_polygon(r, poly, n);
+}
+
+size_t raster_triangles(raster_ctx *r, const raster_vertex *verts, size_t nvert,
+                        const uint32_t *idx, size_t ntri)
+{
+    size_t k, written = 0;
+
+    for (k = 0; k < ntri; k++) {
+        size_t i0 = 3 * k, i1 = 3 * k + 1, i2 = 3 * k + 2;
+        if (idx != NULL) {
+            i0 = idx[i0];
+            i1 = idx[i1];
+            i2 = idx[i2];
+        }
+        if (i0 >= nvert || i1 >= nvert || i2 >= nvert) {
+            r->stats.triangles_in++;
+            r->stats.triangles_rejected++;
+            continue;
+        }
+        written += raster_triangle(r, &verts[i0], &verts[i1], &verts[i2]);
+    }
+    return written;
+}

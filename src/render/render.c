@@ -1,0 +1,1269 @@
+/* render: night images on the CPU (see render.h). */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "render/render.h"
+#include "render/raster.h"
+#include "light/light.h"
+#include "base/geom.h"
+
+#define R_ALIGN 16
+#define PI 3.14159265358979323846
+#define TWO_PI (2.0 * PI)
+
+typedef struct cull_item { double key; uint32_t b; } cull_item;
+
+#define RENDER_TILE 8           /* shading tiles, pixels a side */
+#define RENDER_TILE_LAMPS 64    /* longest lamp list of a tile */
+
+struct render {
+    arena *a;
+    const scene *s;
+    mesh *m;
+    render_shade_fn shade;
+    void *user;
+    int32_t max_w, max_h;
+    float *depth;
+    uint32_t *id;
+    float *lin;
+    raster_vertex *vbuf;
+    float *clip;                /* 4 per vertex of one building */
+    render_backend soft;        /* the built-in backend (user = this) */
+    raster_ctx rc;              /* its rasteriser state during a frame */
+    /* culling */
+    cull_item *order;           /* nbld */
+    cull_item *heap;            /* nbld, min-heap by w_max */
+    uint32_t nheap;
+    double *wmin, *wmax;        /* nbld */
+    uint8_t *draw;              /* nbld */
+    double *bins;               /* RENDER_BINS */
+    /* frame state */
+    int32_t w, h;
+    uint32_t cur_id;
+    double eye[3], f[3], rt[3], up[3];
+    double sx, sy, za, zb, tanh_, aspect, near_, far_;
+    /* shading by tiles */
+    light *lt;                  /* the light module when shade is render_shade_light */
+    uint32_t *lamp_stamp;       /* nlamps (lt only) */
+    uint32_t stamp_now;
+    uint32_t tl[RENDER_TILE_LAMPS];
+    double tP[RENDER_TILE * RENDER_TILE][3], tN[RENDER_TILE * RENDER_TILE][3];
+    double tE[RENDER_TILE * RENDER_TILE][3];
+    uint8_t tcall[RENDER_TILE * RENDER_TILE];  /* 0 sky, 1 no shader, 2 shader */
+    /* light map */
+    float *lm;
+    size_t lm_cap;              /* floats */
+    uint32_t lm_nx, lm_ny;
+    double lm_x0, lm_y0, lm_cell;
+    uint64_t lm_shaded;
+    int lm_built;
+    double thr[255];
+    uint8_t *lut;               /* 65536: byte for the float bits >> 16 (a hint) */
+    const char *err;
+};
+
+/* ---- shaders ---------------------------------------------------------------- */
+
+void render_shade_light(void *user, const double P[3], const double n[3], double rgb[3])
+{
+    double E;
+    if (light_illuminance((light *)user, P, n, &E, rgb) != PLX_OK)
+        rgb[0] = rgb[1] = rgb[2] = 0.0;
+}
+
+void render_opts_default(render_opts *o)
+{
+    memset(o, 0, sizeof *o);
+    o->exposure = 1.0;
+    o->cull = RENDER_CULL_ALL;
+    o->near = 0.05;
+}
+
+/* ---- creation --------------------------------------------------------------- */
+
+static double srgb_decode(double e)
+{
+    return e <= 0.04045 ? e / 12.92 : pow((e + 0.055) / 1.055, 2.4);
+}
+
+size_t render_bytes(const scene *s, int32_t max_w, int32_t max_h)
+{
+    size_t px = (size_t)max_w * (size_t)max_h;
+    return px * 20 + (size_t)s->nbld * (2 * sizeof(cull_item) + 17) + RENDER_BINS * 8 + 65536 +
+           (size_t)s->nlamps * 4 + sizeof(render) + 4096;
+}
+
+const mesh *render_mesh(const render *r)
+{
+    return r->m;
+}
+
+const uint32_t *render_ids(const render *r)
+{
+    return r->id;
+}
+
+const char *render_error(const render *r)
+{
+    return r && r->err ? r->err : "";
+}
+
+uint8_t render_srgb8(const render *r, double v)
+{
+    int lo = 0, hi = 255;
+    /* the number of thresholds <= v (NaN gives 0) */
+    while (lo < hi) {
+        int mid = (lo + hi) / 2;
+        if (v >= r->thr[mid])
+            lo = mid + 1;
+        else
+            hi = mid;
+    }
+    return (uint8_t)lo;
+}
+
+/* ---- the software backend (raster.h) ------------------------------------------ */
+
+static int frag_id(void *user, int32_t x, int32_t y, float depth, const float *attr, float rgba[4])
+{
+    render *r = user;
+    (void)depth;
+    (void)attr;
+    (void)rgba;
+    r->id[(size_t)y * (size_t)r->w + (size_t)x] = r->cur_id;
+    return 1;
+}
+
+static int soft_begin(void *user, int32_t w, int32_t h, int cull_back)
+{
+    render *r = user;
+    raster_target tg;
+    memset(&tg, 0, sizeof tg);
+    tg.format = RASTER_RGBA8;
+    tg.width = w;
+    tg.height = h;
+    tg.color = NULL;
+    tg.depth = r->depth;
+    if (raster_init(&r->rc, &tg, NULL) != PLX_OK)
+        return -1;
+    memset(r->id, 0, (size_t)w * (size_t)h * sizeof *r->id);
+    raster_clear_depth(&r->rc, 1.0f);
+    raster_set_fragment(&r->rc, frag_id, r, 0);
+    raster_set_cull(&r->rc, cull_back ? RASTER_CULL_BACK : RASTER_CULL_NONE);
+    return 0;
+}
+
+static void soft_draw(void *user, const float *clip, uint32_t nv, const mesh_tri *tri, uint32_t ntri,
+                      uint32_t v_base)
+{
+    render *r = user;
+    uint32_t k;
+    for (k = 0; k < nv; k++)
+        memcpy(r->vbuf[k].pos, clip + 4 * (size_t)k, 4 * sizeof(float));
+    for (k = 0; k < ntri; k++) {
+        const mesh_tri *t = &tri[k];
+        r->cur_id = t->surf;
+        raster_triangle(&r->rc, &r->vbuf[t->v[0] - v_base], &r->vbuf[t->v[1] - v_base],
+                        &r->vbuf[t->v[2] - v_base]);
+    }
+}
+
+static int soft_finish(void *user, uint32_t *id, float *depth)
+{
+    render *r = user;
+    size_t px = (size_t)r->w * (size_t)r->h;
+    if (id != r->id)
+        memcpy(id, r->id, px * sizeof *id);
+    if (depth != r->depth)
+        memcpy(depth, r->depth, px * sizeof *depth);
+    return 0;
+}
+
+plx_status render_create(arena *a, const scene *s, int32_t max_w, int32_t max_h,
+                         render_shade_fn shade, void *user, render **out)
+{
+    arena_mark m0;
+    render *r;
+    size_t px;
+    plx_status st;
+    int k;
+    if (!a || !s || !shade || !out)
+        return PLX_E_INVALID;
+    *out = NULL;
+    if (max_w < 1 || max_h < 1 || max_w > RASTER_MAX_DIM || max_h > RASTER_MAX_DIM)
+        return PLX_E_INVALID;
+    m0 = arena_get_mark(a);
+    r = arena_calloc(a, PLX_PART_FRAME, 1, sizeof *r, R_ALIGN);
+    if (!r)
+        return PLX_E_NOMEM;
+    r->a = a;
+    r->s = s;
+    r->shade = shade;
+    r->user = user;
+    r->max_w = max_w;
+    r->max_h = max_h;
+    st = mesh_build(a, s, &r->m);
+    if (st != PLX_OK) {
+        arena_release(a, &m0);
+        return st;
+    }
+    px = (size_t)max_w * (size_t)max_h;
+    r->depth = arena_alloc(a, PLX_PART_FRAME, arena_mul(px, sizeof(float)), 64);
+    r->id = arena_alloc(a, PLX_PART_FRAME, arena_mul(px, sizeof(uint32_t)), 64);
+    r->lin = arena_alloc(a, PLX_PART_FRAME, arena_mul(px, 3 * sizeof(float)), 64);
+    r->vbuf = arena_alloc(a, PLX_PART_FRAME, arena_mul(r->m->max_bld_verts + 1, sizeof(raster_vertex)), 64);
+    r->clip = arena_alloc(a, PLX_PART_FRAME, arena_mul(r->m->max_bld_verts + 1, 4 * sizeof(float)), 64);
+    r->order = arena_alloc(a, PLX_PART_FRAME, arena_mul(s->nbld + 1, sizeof(cull_item)), R_ALIGN);
+    r->heap = arena_alloc(a, PLX_PART_FRAME, arena_mul(s->nbld + 1, sizeof(cull_item)), R_ALIGN);
+    r->wmin = arena_alloc(a, PLX_PART_FRAME, arena_mul(s->nbld + 1, sizeof(double)), R_ALIGN);
+    r->wmax = arena_alloc(a, PLX_PART_FRAME, arena_mul(s->nbld + 1, sizeof(double)), R_ALIGN);
+    r->draw = arena_alloc(a, PLX_PART_FRAME, s->nbld + 1, R_ALIGN);
+    r->bins = arena_alloc(a, PLX_PART_FRAME, RENDER_BINS * sizeof(double), R_ALIGN);
+    if (!r->depth || !r->id || !r->lin || !r->vbuf || !r->clip || !r->order || !r->heap || !r->wmin ||
+        !r->wmax || !r->draw || !r->bins) {
+        arena_release(a, &m0);
+        return PLX_E_NOMEM;
+    }
+    r->lut = arena_alloc(a, PLX_PART_FRAME, 65536, R_ALIGN);
+    if (shade == render_shade_light && user) {
+        r->lt = user;
+        r->lamp_stamp = arena_calloc(a, PLX_PART_FRAME, (size_t)s->nlamps + 1, sizeof(uint32_t), R_ALIGN);
+    }
+    if (!r->lut || (r->lt && !r->lamp_stamp)) {
+        arena_release(a, &m0);
+        return PLX_E_NOMEM;
+    }
+    for (k = 0; k < 255; k++)
+        r->thr[k] = srgb_decode((k + 0.5) / 255.0);
+    for (k = 0; k < 65536; k++) {
+        union { uint32_t u; float f; } cv;
+        cv.u = (uint32_t)k << 16;
+        r->lut[k] = render_srgb8(r, (double)cv.f);
+    }
+    r->soft.name = "soft";
+    r->soft.user = r;
+    r->soft.begin = soft_begin;
+    r->soft.draw = soft_draw;
+    r->soft.finish = soft_finish;
+    r->err = "";
+    *out = r;
+    return PLX_OK;
+}
+
+/* ---- camera ----------------------------------------------------------------- */
+
+static int setup_camera(render *r, const render_camera *c, const render_opts *o)
+{
+    double f[3], len, rl, t;
+    int k;
+    const double *b = r->s->bounds;
+    for (k = 0; k < 3; k++)
+        if (!isfinite(c->eye[k]) || !isfinite(c->target[k]))
+            return r->err = "render_frame: eye and target must be finite", 0;
+    if (!(c->fov_deg > 0.0 && c->fov_deg < 180.0))
+        return r->err = "render_frame: fov must be in (0, 180) degrees", 0;
+    if (c->width < 1 || c->height < 1 || c->width > r->max_w || c->height > r->max_h)
+        return r->err = "render_frame: image size outside 1 .. the render object's maximum", 0;
+    if (!(c->eye[2] > 0.0))
+        return r->err = "render_frame: the eye must be above the ground (z > 0)", 0;
+    if (!(o->near > 0.0) || !isfinite(o->near) || !isfinite(o->exposure))
+        return r->err = "render_frame: near must be > 0 and exposure finite", 0;
+    for (k = 0; k < 3; k++)
+        f[k] = c->target[k] - c->eye[k];
+    len = sqrt(f[0] * f[0] + f[1] * f[1] + f[2] * f[2]);
+    if (!(len > 0.0))
+        return r->err = "render_frame: eye and target are the same point", 0;
+    for (k = 0; k < 3; k++)
+        r->f[k] = f[k] / len;
+    /* right = f x z */
+    r->rt[0] = r->f[1];
+    r->rt[1] = -r->f[0];
+    r->rt[2] = 0.0;
+    rl = sqrt(r->rt[0] * r->rt[0] + r->rt[1] * r->rt[1]);
+    if (rl < 1e-12) {
+        r->rt[0] = 1.0;
+        r->rt[1] = 0.0;
+    } else {
+        r->rt[0] /= rl;
+        r->rt[1] /= rl;
+    }
+    /* up = right x f */
+    r->up[0] = r->rt[1] * r->f[2] - r->rt[2] * r->f[1];
+    r->up[1] = r->rt[2] * r->f[0] - r->rt[0] * r->f[2];
+    r->up[2] = r->rt[0] * r->f[1] - r->rt[1] * r->f[0];
+    for (k = 0; k < 3; k++)
+        r->eye[k] = c->eye[k];
+    r->w = c->width;
+    r->h = c->height;
+    r->tanh_ = tan(c->fov_deg * PI / 360.0);
+    r->aspect = (double)c->width / (double)c->height;
+    r->sx = 1.0 / (r->tanh_ * r->aspect);
+    r->sy = 1.0 / r->tanh_;
+    r->near_ = o->near;
+    /* far: beyond every corner of the scene box (buildings, lamps' reach) */
+    {
+        double hx = fmax(fabs(b[0] - c->eye[0]), fabs(b[2] - c->eye[0]));
+        double hy = fmax(fabs(b[1] - c->eye[1]), fabs(b[3] - c->eye[1]));
+        double hz = fmax(fabs(c->eye[2]), fabs(r->s->height_max - c->eye[2]));
+        uint32_t i;
+        for (i = 0; i < r->s->nlamps; i++) {
+            const scene_lamp *l = &r->s->lamps[i];
+            hx = fmax(hx, fabs(l->x - c->eye[0]) + l->radius);
+            hy = fmax(hy, fabs(l->y - c->eye[1]) + l->radius);
+            hz = fmax(hz, fabs(l->z - c->eye[2]) + l->radius);
+        }
+        t = sqrt(hx * hx + hy * hy + hz * hz);
+        r->far_ = 2.0 * t + 10.0 * o->near + 1.0;
+    }
+    r->za = (r->far_ + r->near_) / (r->far_ - r->near_);
+    r->zb = -2.0 * r->far_ * r->near_ / (r->far_ - r->near_);
+    return 1;
+}
+
+static void to_clip(const render *r, const double *X, double out[4])
+{
+    double v0 = X[0] - r->eye[0], v1 = X[1] - r->eye[1], v2 = X[2] - r->eye[2];
+    double w = v0 * r->f[0] + v1 * r->f[1] + v2 * r->f[2];
+    out[0] = (v0 * r->rt[0] + v1 * r->rt[1] + v2 * r->rt[2]) * r->sx;
+    out[1] = (v0 * r->up[0] + v1 * r->up[1] + v2 * r->up[2]) * r->sy;
+    out[2] = r->za * w + r->zb;
+    out[3] = w;
+}
+
+/* ---- culling ----------------------------------------------------------------- */
+
+static int cmp_item(const void *pa, const void *pb)
+{
+    const cull_item *a = pa, *b = pb;
+    if (a->key != b->key)
+        return a->key < b->key ? -1 : 1;
+    return (a->b > b->b) - (a->b < b->b);
+}
+
+static void heap_push(render *r, double key, uint32_t b)
+{
+    uint32_t i = r->nheap++;
+    while (i > 0) {
+        uint32_t p = (i - 1) / 2;
+        if (r->heap[p].key <= key)
+            break;
+        r->heap[i] = r->heap[p];
+        i = p;
+    }
+    r->heap[i].key = key;
+    r->heap[i].b = b;
+}
+
+static cull_item heap_pop(render *r)
+{
+    cull_item top = r->heap[0], last = r->heap[--r->nheap];
+    uint32_t i = 0, n = r->nheap;
+    for (;;) {
+        uint32_t c = 2 * i + 1;
+        if (c >= n)
+            break;
+        if (c + 1 < n && r->heap[c + 1].key < r->heap[c].key)
+            c++;
+        if (last.key <= r->heap[c].key)
+            break;
+        r->heap[i] = r->heap[c];
+        i = c;
+    }
+    if (n > 0)
+        r->heap[i] = last;
+    return top;
+}
+
+static int eye_in_box(const render *r, const double *box)
+{
+    return r->eye[0] >= box[0] && r->eye[0] <= box[3] && r->eye[1] >= box[1] && r->eye[1] <= box[4];
+}
+
+static double box_dist(const render *r, const double *box)
+{
+    double dx = fmax(0.0, fmax(box[0] - r->eye[0], r->eye[0] - box[3]));
+    double dy = fmax(0.0, fmax(box[1] - r->eye[1], r->eye[1] - box[4]));
+    return sqrt(dx * dx + dy * dy);
+}
+
+/* Bin index of azimuth a (any real), in 0..RENDER_BINS-1. */
+static int64_t bin_floor(double a)
+{
+    return (int64_t)floor((a + PI) * (RENDER_BINS / TWO_PI));
+}
+
+static uint32_t bin_wrap(int64_t k)
+{
+    int64_t m = k % RENDER_BINS;
+    return (uint32_t)(m < 0 ? m + RENDER_BINS : m);
+}
+
+/* Angle of (x, y) relative to the direction c (unit), in (-pi, pi]. */
+static double rel_angle(double cx, double cy, double x, double y)
+{
+    return atan2(cx * y - cy * x, cx * x + cy * y);
+}
+
+/* Inserts occluder b into the horizon. */
+static void occluder_insert(render *r, uint32_t b, double mu)
+{
+    const scene *s = r->s;
+    const mesh_bld *mb = &r->m->bld[b];
+    const scene_building *bd = &s->bld[b];
+    const scene_ring *rg = &s->rings[bd->ring_first];
+    double cx = 0.5 * (mb->box[0] + mb->box[3]) - r->eye[0];
+    double cy = 0.5 * (mb->box[1] + mb->box[4]) - r->eye[1];
+    double cl = sqrt(cx * cx + cy * cy), c0, lo = HUGE_VAL, hi = -HUGE_VAL, rfar = 0, rnear;
+    double dz, sO, ma, ms, slope;
+    int64_t k0, k1, k;
+    uint32_t i;
+    if (!(cl > 0))
+        return;
+    cx /= cl;
+    cy /= cl;
+    c0 = atan2(cy, cx);
+    for (i = 0; i < rg->count; i++) {
+        double x = s->pts[rg->first + i].x - r->eye[0], y = s->pts[rg->first + i].y - r->eye[1];
+        double a = rel_angle(cx, cy, x, y), d = sqrt(x * x + y * y);
+        lo = fmin(lo, a);
+        hi = fmax(hi, a);
+        rfar = fmax(rfar, d);
+    }
+    rnear = box_dist(r, mb->box);
+    if (!(rnear > 0))
+        return;
+    dz = bd->height - r->eye[2];
+    sO = dz >= 0 ? dz / (rfar * (1.0 + 1e-12)) : dz / (rnear * (1.0 - 1e-12));
+    /* margins: direction error 2 pixel angles */
+    slope = fmax(fabs(dz), fabs(r->eye[2])) / rnear;
+    ma = 2.0 * mu * sqrt(1.0 + slope * slope) + 1e-9;
+    ms = 2.0 * 2.0 * mu * (1.0 + sO * sO) + 1e-12;
+    sO -= ms;
+    lo += c0 + ma;
+    hi += c0 - ma;
+    if (!(hi > lo))
+        return;
+    k0 = bin_floor(lo) + 1;       /* first bin starting after lo */
+    k1 = bin_floor(hi) - 1;       /* last bin ending before hi */
+    /* bin k spans [k w - pi, (k + 1) w - pi]: check ends exactly */
+    for (k = k0; k <= k1 && k - k0 < RENDER_BINS; k++) {
+        uint32_t q = bin_wrap(k);
+        if (sO > r->bins[q])
+            r->bins[q] = sO;
+    }
+}
+
+/* Is building b hidden by the horizon? */
+static int hidden(render *r, uint32_t b, double mu)
+{
+    const mesh_bld *mb = &r->m->bld[b];
+    double cx = 0.5 * (mb->box[0] + mb->box[3]) - r->eye[0];
+    double cy = 0.5 * (mb->box[1] + mb->box[4]) - r->eye[1];
+    double cl = sqrt(cx * cx + cy * cy), c0, lo = HUGE_VAL, hi = -HUGE_VAL, rnear, rfar = 0;
+    double dz, sB, slope, ma, ms;
+    int64_t k0, k1, k;
+    int i;
+    if (!(cl > 0))
+        return 0;
+    cx /= cl;
+    cy /= cl;
+    c0 = atan2(cy, cx);
+    for (i = 0; i < 4; i++) {
+        double x = mb->box[(i & 1) ? 3 : 0] - r->eye[0], y = mb->box[(i & 2) ? 4 : 1] - r->eye[1];
+        double a = rel_angle(cx, cy, x, y);
+        lo = fmin(lo, a);
+        hi = fmax(hi, a);
+        rfar = fmax(rfar, sqrt(x * x + y * y));
+    }
+    rnear = box_dist(r, mb->box);
+    if (!(rnear > 0))
+        return 0;
+    dz = mb->box[5] - r->eye[2];
+    sB = dz >= 0 ? dz / (rnear * (1.0 - 1e-12)) : dz / (rfar * (1.0 + 1e-12));
+    slope = fmax(fabs(dz), fabs(mb->box[2] - r->eye[2])) / rnear;
+    ma = 2.0 * mu * sqrt(1.0 + slope * slope) + 1e-9;
+    ms = 2.0 * 2.0 * mu * (1.0 + sB * sB) + 1e-12;
+    sB += ms;
+    lo += c0 - ma;
+    hi += c0 + ma;
+    k0 = bin_floor(lo);
+    k1 = bin_floor(hi);
+    if (k1 - k0 >= RENDER_BINS / 2)
+        return 0;
+    for (k = k0; k <= k1; k++)
+        if (!(r->bins[bin_wrap(k)] > sB))
+            return 0;
+    return 1;
+}
+
+static int eye_inside_solid(const render *r)
+{
+    const scene *s = r->s;
+    uint32_t b, k;
+    vec2 p;
+    p.x = r->eye[0];
+    p.y = r->eye[1];
+    for (b = 0; b < s->nbld; b++) {
+        const scene_building *bd = &s->bld[b];
+        const scene_ring *rg;
+        int in;
+        if (p.x < bd->box[0] || p.x > bd->box[2] || p.y < bd->box[1] || p.y > bd->box[3])
+            continue;
+        if (!(r->eye[2] >= bd->min_height && r->eye[2] <= bd->height))
+            continue;
+        rg = &s->rings[bd->ring_first];
+        in = geom_point_in_ring(p, s->pts + rg->first, rg->count) != GEOM_OUTSIDE;
+        for (k = 1; in && k < bd->ring_count; k++) {
+            rg = &s->rings[bd->ring_first + k];
+            if (geom_point_in_ring(p, s->pts + rg->first, rg->count) == GEOM_INSIDE)
+                in = 0;
+        }
+        if (in)
+            return 1;
+    }
+    return 0;
+}
+
+static void cull(render *r, int mode, int inside, render_stats *st)
+{
+    const mesh *m = r->m;
+    uint32_t b, n = 0, i;
+    double mu = 2.0 * r->tanh_ / r->h;
+    double gap_a = 1e-3, gap_b = mu / (8.0 * r->eye[2]) + 4e-6 / r->near_;
+    for (b = 0; b < m->nbld; b++) {
+        const double *bx = m->bld[b].box;
+        double c[4], wmn = HUGE_VAL, wmx = -HUGE_VAL;
+        int out_l = 1, out_r = 1, out_b = 1, out_t = 1, out_n = 1, k;
+        for (k = 0; k < 8; k++) {
+            double X[3];
+            X[0] = bx[(k & 1) ? 3 : 0];
+            X[1] = bx[(k & 2) ? 4 : 1];
+            X[2] = bx[(k & 4) ? 5 : 2];
+            to_clip(r, X, c);
+            wmn = fmin(wmn, c[3]);
+            wmx = fmax(wmx, c[3]);
+            {
+                double tol = 1e-6 * fabs(c[3]) + 1e-9;
+                if (!(c[0] > c[3] + tol)) out_r = 0;
+                if (!(c[0] < -c[3] - tol)) out_l = 0;
+                if (!(c[1] > c[3] + tol)) out_t = 0;
+                if (!(c[1] < -c[3] - tol)) out_b = 0;
+                if (!(c[3] < r->near_ * (1.0 - 1e-6))) out_n = 0;
+            }
+        }
+        r->wmin[b] = wmn;
+        r->wmax[b] = wmx;
+        r->draw[b] = 1;
+        if ((mode & RENDER_CULL_FRUSTUM) && (out_l || out_r || out_t || out_b || out_n)) {
+            r->draw[b] = 0;
+            st->frustum_culled++;
+            continue;
+        }
+        if (m->bld[b].t_count == 0)
+            continue;
+        r->order[n].key = fmax(wmn, r->near_);
+        r->order[n].b = b;
+        n++;
+    }
+    if (!(mode & RENDER_CULL_OCCLUSION) || inside)
+        return;
+    qsort(r->order, n, sizeof *r->order, cmp_item);
+    for (i = 0; i < RENDER_BINS; i++)
+        r->bins[i] = -HUGE_VAL;
+    r->nheap = 0;
+    for (i = 0; i < n; i++) {
+        uint32_t bb = r->order[i].b;
+        double wb = r->order[i].key;
+        const mesh_bld *mb = &m->bld[bb];
+        while (r->nheap > 0) {
+            double wo = r->heap[0].key;
+            if (!(wo * (1.0 + gap_a + gap_b * wo) < wb))
+                break;
+            occluder_insert(r, heap_pop(r).b, mu);
+        }
+        if (!eye_in_box(r, mb->box)) {
+            if (hidden(r, bb, mu)) {
+                r->draw[bb] = 0;
+                st->occlusion_culled++;
+            }
+            if (mb->occluder)
+                heap_push(r, r->wmax[bb], bb);
+        }
+    }
+}
+
+/* ---- drawing ------------------------------------------------------------------ */
+
+static void draw_buildings(render *r, const render_backend *be, render_stats *st)
+{
+    const mesh *m = r->m;
+    uint32_t b, k;
+    for (b = 0; b < m->nbld; b++) {
+        const mesh_bld *mb = &m->bld[b];
+        if (!r->draw[b])
+            continue;
+        st->drawn++;
+        st->triangles_drawn += mb->t_count;
+        for (k = 0; k < mb->v_count; k++) {
+            double c[4];
+            float *v = &r->clip[4 * (size_t)k];
+            to_clip(r, &m->xyz[3 * (size_t)(mb->v_first + k)], c);
+            v[0] = (float)c[0];
+            v[1] = (float)c[1];
+            v[2] = (float)c[2];
+            v[3] = (float)c[3];
+        }
+        be->draw(be->user, r->clip, mb->v_count, &m->tri[mb->t_first], mb->t_count, mb->v_first);
+    }
+}
+
+/* Ground E_rgb from the light map, bilinear between texel centres. */
+static void lightmap_sample(const render *r, const double P[3], double rgb[3])
+{
+    double fx = (P[0] - r->lm_x0) / r->lm_cell - 0.5, fy = (P[1] - r->lm_y0) / r->lm_cell - 0.5;
+    double ix, iy, tx, ty, wgt[4];
+    int64_t i0, j0;
+    int k, c;
+    rgb[0] = rgb[1] = rgb[2] = 0.0;
+    if (!(fx > -1.0 && fy > -1.0 && fx < (double)r->lm_nx && fy < (double)r->lm_ny))
+        return;
+    ix = floor(fx);
+    iy = floor(fy);
+    tx = fx - ix;
+    ty = fy - iy;
+    i0 = (int64_t)ix;
+    j0 = (int64_t)iy;
+    wgt[0] = (1 - tx) * (1 - ty);
+    wgt[1] = tx * (1 - ty);
+    wgt[2] = (1 - tx) * ty;
+    wgt[3] = tx * ty;
+    for (k = 0; k < 4; k++) {
+        int64_t i = i0 + (k & 1), j = j0 + (k >> 1);
+        const float *t;
+        if (i < 0 || j < 0 || i >= (int64_t)r->lm_nx || j >= (int64_t)r->lm_ny)
+            continue;
+        t = &r->lm[3 * ((size_t)j * r->lm_nx + (size_t)i)];
+        for (c = 0; c < 3; c++)
+            rgb[c] += wgt[k] * t[c];
+    }
+}
+
+/* Lamps whose reach sphere meets box bx (minx, miny, minz, maxx, maxy,
+ * maxz), in lamp index order, into r->tl (at most RENDER_TILE_LAMPS);
+ * returns their number, or -1 when there are more (the caller then takes
+ * the light module's own lamp walk). */
+static int tile_lamps(render *r, const double bx[6])
+{
+    const light_grid *g = &r->lt->lgrid;
+    const scene *s = r->s;
+    uint32_t c0, c1, cx0, cx1, cy0, cy1, cx, cy, k;
+    int n = 0, i, j;
+    if (s->nlamps == 0 || g->nx == 0)
+        return 0;
+    c0 = light_grid_cell(g, bx[0], bx[1]);
+    c1 = light_grid_cell(g, bx[3], bx[4]);
+    cx0 = c0 % g->nx;
+    cy0 = c0 / g->nx;
+    cx1 = c1 % g->nx;
+    cy1 = c1 / g->nx;
+    if ((uint64_t)(cx1 - cx0 + 1) * (cy1 - cy0 + 1) > 16)
+        return -1;
+    if (++r->stamp_now == 0) {
+        memset(r->lamp_stamp, 0, s->nlamps * sizeof *r->lamp_stamp);
+        r->stamp_now = 1;
+    }
+    for (cy = cy0; cy <= cy1; cy++)
+        for (cx = cx0; cx <= cx1; cx++) {
+            uint32_t cell = cy * g->nx + cx;
+            for (k = g->start[cell]; k < g->start[cell + 1]; k++) {
+                uint32_t l = g->ids[k];
+                const scene_lamp *lp = &s->lamps[l];
+                double dx, dy, dz;
+                if (r->lamp_stamp[l] == r->stamp_now)
+                    continue;
+                r->lamp_stamp[l] = r->stamp_now;
+                if (!(lp->radius > 0.0) || !(lp->intensity > 0.0))
+                    continue;
+                dx = fmax(0.0, fmax(bx[0] - lp->x, lp->x - bx[3]));
+                dy = fmax(0.0, fmax(bx[1] - lp->y, lp->y - bx[4]));
+                dz = fmax(0.0, fmax(bx[2] - lp->z, lp->z - bx[5]));
+                /* the term is 0 from d >= R on (light.h, SPEC §2): a margin keeps rounding out */
+                if (!(dx * dx + dy * dy + dz * dz < lp->radius * lp->radius * (1.0 + 1e-9)))
+                    continue;
+                if (n == RENDER_TILE_LAMPS)
+                    return -1;
+                r->tl[n++] = l;
+            }
+        }
+    /* lamp index order (the order of the light module's walk) */
+    for (i = 1; i < n; i++) {
+        uint32_t v = r->tl[i];
+        for (j = i - 1; j >= 0 && r->tl[j] > v; j--)
+            r->tl[j + 1] = r->tl[j];
+        r->tl[j + 1] = v;
+    }
+    return n;
+}
+
+/* The sector of pseudo-angle a (light.h: sector i starts at sec_ang[i];
+ * angles before sec_ang[0] belong to the last, wrapping sector). */
+static uint32_t tile_find_sector(const double *ang, uint32_t nsec, double a)
+{
+    uint32_t lo = 0, hi = nsec;
+    if (a < ang[0])
+        return nsec - 1;
+    while (hi - lo > 1) {
+        uint32_t mid = (lo + hi) / 2;
+        if (ang[mid] <= a)
+            lo = mid;
+        else
+            hi = mid;
+    }
+    return lo;
+}
+
+/* SPEC §2's term of lamp lp at P facing n, without visibility: the light
+ * module's formula (light.c), operation for operation. */
+static double lamp_term(const scene_lamp *lp, const double P[3], const double n[3])
+{
+    double v[3], d2, d, x, x2, c, w, cw;
+    v[0] = lp->x - P[0];
+    v[1] = lp->y - P[1];
+    v[2] = lp->z - P[2];
+    d2 = v[0] * v[0] + v[1] * v[1] + v[2] * v[2];
+    if (d2 == 0.0 || !(lp->radius > 0.0) || !(d2 < lp->radius * lp->radius))
+        return 0.0;
+    d = sqrt(d2);
+    x = d / lp->radius;
+    x2 = x * x;
+    c = 1.0 - x2 * x2;
+    if (c <= 0.0)
+        return 0.0;
+    w = c * c;
+    cw = (n[0] * v[0] + n[1] * v[1] + n[2] * v[2]) / d;
+    if (!(cw > 0.0))
+        return 0.0;
+    return lp->intensity * cw / d2 * w;
+}
+
+/* Is every point whose ground projection lies in the convex hull of the nc
+ * points c (2 or 4: a segment or a box, none of them at the lamp's ground
+ * point O) visible from lamp l for sure? Through the lamp's sector index
+ * (light.h, litregion.c's light_region_visible): along w = P' - O a band
+ * covers t from t_lo = c / cross(w, e) (its lo line) on, and stops the
+ * segment O->P only if (min(t_hi, t2) - max(t_lo, t1)) |P - L| > 1e-9 with
+ * t2 <= 1; the term of lamp l is 0 unless |P - L| < R. So a band with
+ * t_lo >= 1 - eta/2, eta = 1e-9 / R, stops nothing at P -- neither a
+ * building beyond P nor the wall P lies on (t_lo = 1 there). With
+ * q(w) = cross(w, e) / c = 1 / t_lo, linear in w: if 0 < q <= 1 + eta/4 at
+ * every corner of the hull, the same holds over the hull, so t_lo >=
+ * 1 - eta/4 at every point of it (rounding of t_lo, ~1e-15 relative, is
+ * far inside the remaining eta/4). The bands looked at are those of every
+ * sector meeting the pseudo-angle range of the corners (the hull subtends
+ * less than 180 degrees from O: checked). Returns 0 when unsure: no
+ * region, a hull around O, a band from O itself (no lo line). */
+static int hull_visible(render *r, uint32_t l, const double (*c)[2], int nc)
+{
+    light *L = r->lt;
+    const lit_region *rg;
+    double wx[4], wy[4], base = 0.0, lo = 0.0, hi = 0.0, qmax;
+    uint32_t i0, i1, i, k;
+    int j;
+    if (L->pool_cap == 0 || !(r->s->lamps[l].radius > 0.0) ||
+        light_region_index(L, l, &rg) != PLX_OK || rg->nsec == 0)
+        return 0;
+    qmax = 1.0 + 0.25e-9 / r->s->lamps[l].radius;
+    for (j = 0; j < nc; j++) {
+        double d;
+        wx[j] = c[j][0] - rg->o[0];
+        wy[j] = c[j][1] - rg->o[1];
+        if (wx[j] == 0.0 && wy[j] == 0.0)
+            return 0;
+        if (j == 0) {
+            base = light_pseudo_angle(wx[0], wy[0]);
+            continue;
+        }
+        d = light_pseudo_angle(wx[j], wy[j]) - base;
+        if (d > 2.0) d -= 4.0;
+        if (d <= -2.0) d += 4.0;
+        lo = d < lo ? d : lo;
+        hi = d > hi ? d : hi;
+    }
+    /* O outside the hull: for a box, not inside it; for a segment, not on
+     * its line (checked by the spans below: a hull around O spans 2 or more) */
+    if (nc == 4 && rg->o[0] >= c[0][0] && rg->o[0] <= c[3][0] && rg->o[1] >= c[0][1] && rg->o[1] <= c[3][1])
+        return 0;
+    if (nc == 2 && !(wx[0] * wy[1] - wy[0] * wx[1] != 0.0))
+        return 0;
+    if (!(hi - lo < 1.999))
+        return 0;
+    lo += base - 1e-9;
+    hi += base + 1e-9;
+    lo = lo < 0.0 ? lo + 4.0 : lo >= 4.0 ? lo - 4.0 : lo;
+    hi = hi < 0.0 ? hi + 4.0 : hi >= 4.0 ? hi - 4.0 : hi;
+    i0 = tile_find_sector(rg->sec_ang, rg->nsec, lo);
+    i1 = tile_find_sector(rg->sec_ang, rg->nsec, hi);
+    for (i = i0;; i = (i + 1) % rg->nsec) {
+        for (k = rg->sec_first[i]; k < rg->sec_first[i + 1]; k++) {
+            const lit_band *b = &rg->band[k];
+            const lit_line *ln;
+            if (b->lo == LIT_NONE)
+                return 0;
+            ln = &rg->line[b->lo];
+            if (!(ln->c != 0.0) || !isfinite(ln->c))
+                return 0;
+            for (j = 0; j < nc; j++) {
+                double q = (wx[j] * ln->ey - wy[j] * ln->ex) / ln->c;
+                if (!(q > 0.0 && q <= qmax))
+                    return 0;
+            }
+        }
+        if (i == i1)
+            break;
+    }
+    return 1;
+}
+
+/* E_rgb at P from the tile's lamp list (the light shader's value); lamps
+ * whose bit is set in sure are visible without asking. */
+static void shade_tile_lamps(render *r, int nl, uint64_t sure, const double P[3], const double n[3],
+                             double rgb[3], render_stats *st)
+{
+    const scene *s = r->s;
+    int k;
+    rgb[0] = rgb[1] = rgb[2] = 0.0;
+    for (k = 0; k < nl; k++) {
+        uint32_t l = r->tl[k];
+        const scene_lamp *lp = &s->lamps[l];
+        double term = lamp_term(lp, P, n);
+        if (term == 0.0)
+            continue;
+        if ((sure >> k) & 1u)
+            st->visibility_skipped++;
+        else if (!light_visible(r->lt, l, P))
+            continue;
+        rgb[0] += term * lp->color[0];
+        rgb[1] += term * lp->color[1];
+        rgb[2] += term * lp->color[2];
+    }
+}
+
+/* The shading pass, by tiles of RENDER_TILE x RENDER_TILE pixels: first
+ * every pixel's hit point, then (light shader) the lamps whose reach meets
+ * the box of the tile's hit points, then the illuminance from that list. */
+static void shade_pass(render *r, const render_opts *o, render_stats *st)
+{
+    const mesh *m = r->m;
+    int32_t i, j, ti, tj;
+    double ta = r->tanh_ * r->aspect, tb = r->tanh_;
+    int use_lm = o->lightmap && r->lm_built;
+    double (*TP)[3] = r->tP, (*TN)[3] = r->tN;
+    for (tj = 0; tj < r->h; tj += RENDER_TILE)
+        for (ti = 0; ti < r->w; ti += RENDER_TILE) {
+            int32_t j1 = tj + RENDER_TILE < r->h ? tj + RENDER_TILE : r->h;
+            int32_t i1 = ti + RENDER_TILE < r->w ? ti + RENDER_TILE : r->w;
+            double bx[6] = { HUGE_VAL, HUGE_VAL, HUGE_VAL, -HUGE_VAL, -HUGE_VAL, -HUGE_VAL };
+            double gb[4] = { HUGE_VAL, HUGE_VAL, -HUGE_VAL, -HUGE_VAL };
+            double wmin = HUGE_VAL, wmax = -HUGE_VAL, wa[2] = { 0, 0 }, wb[2] = { 0, 0 };
+            int ncall = 0, nground = 0, nl = -1, q = 0;
+            uint32_t wall = MESH_SURF_NONE;   /* the one wall of the tile's wall pixels, if one */
+            uint64_t sure_g = 0, sure_w = 0;
+            /* 1: hit points; E = 0 (or the light map) in out for now */
+            for (j = tj; j < j1; j++) {
+                double bj = (1.0 - 2.0 * (j + 0.5) / r->h) * tb;
+                for (i = ti; i < i1; i++, q++) {
+                    size_t p = (size_t)j * (size_t)r->w + (size_t)i;
+                    double ai = (2.0 * (i + 0.5) / r->w - 1.0) * ta;
+                    double d[3], t, nd, E[3] = { 0, 0, 0 };
+                    double *P = TP[q], *n = TN[q];
+                    uint32_t sid = r->id[p];
+                    const mesh_surf *sf;
+                    float *out = &r->lin[3 * p];
+                    int k;
+                    r->tcall[q] = 0;
+                    d[0] = r->f[0] + ai * r->rt[0] + bj * r->up[0];
+                    d[1] = r->f[1] + ai * r->rt[1] + bj * r->up[1];
+                    d[2] = r->f[2] + ai * r->rt[2] + bj * r->up[2];
+                    if (sid == MESH_SURF_NONE) {
+                        if (!(d[2] < 0.0)) {
+                            st->sky_pixels++;
+                            out[0] = out[1] = out[2] = 0.0f;
+                            continue;
+                        }
+                        sid = MESH_SURF_GROUND;
+                        r->id[p] = sid;
+                    }
+                    sf = &m->surf[sid];
+                    nd = sf->n[0] * d[0] + sf->n[1] * d[1] + sf->n[2] * d[2];
+                    if (sid == MESH_SURF_GROUND) {
+                        t = -r->eye[2] / d[2];
+                        st->ground_pixels++;
+                    } else {
+                        t = (sf->d - (sf->n[0] * r->eye[0] + sf->n[1] * r->eye[1] + sf->n[2] * r->eye[2])) / nd;
+                        st->building_pixels++;
+                    }
+                    if (!isfinite(t) || t < 0.0)
+                        t = 0.0;
+                    for (k = 0; k < 3; k++) {
+                        P[k] = r->eye[k] + t * d[k];
+                        n[k] = nd > 0.0 ? -sf->n[k] : sf->n[k];
+                    }
+                    if (sid == MESH_SURF_GROUND)
+                        P[2] = 0.0;
+                    r->tcall[q] = 1;
+                    if (sf->lit && sid == MESH_SURF_GROUND && use_lm)
+                        lightmap_sample(r, P, E);
+                    else if (sf->lit) {
+                        r->tcall[q] = 2;
+                        ncall++;
+                        if (r->lt) {
+                            /* hit points are finite: plain comparisons */
+                            for (k = 0; k < 3; k++) {
+                                bx[k] = P[k] < bx[k] ? P[k] : bx[k];
+                                bx[3 + k] = P[k] > bx[3 + k] ? P[k] : bx[3 + k];
+                            }
+                            if (sid == MESH_SURF_GROUND) {
+                                nground++;
+                                gb[0] = P[0] < gb[0] ? P[0] : gb[0];
+                                gb[1] = P[1] < gb[1] ? P[1] : gb[1];
+                                gb[2] = P[0] > gb[2] ? P[0] : gb[2];
+                                gb[3] = P[1] > gb[3] ? P[1] : gb[3];
+                            } else if (sf->kind == MESH_KIND_WALL && wall != UINT32_MAX) {
+                                /* the ends of the wall pixels along the wall */
+                                double u = P[0] * -sf->n[1] + P[1] * sf->n[0];
+                                if (wall != MESH_SURF_NONE && wall != sid)
+                                    wall = UINT32_MAX;
+                                else {
+                                    wall = sid;
+                                    if (u < wmin) {
+                                        wmin = u;
+                                        wa[0] = P[0];
+                                        wa[1] = P[1];
+                                    }
+                                    if (u > wmax) {
+                                        wmax = u;
+                                        wb[0] = P[0];
+                                        wb[1] = P[1];
+                                    }
+                                }
+                            }
+                        }
+                    }
+                    for (k = 0; k < 3; k++)
+                        r->tE[q][k] = E[k];
+                }
+            }
+            /* 2: the tile's lamps */
+            if (ncall > 0 && r->lt)
+                nl = tile_lamps(r, bx);
+            if (nl > 0 && nground > 0) {
+                double hb[4][2];
+                int k;
+                hb[0][0] = hb[2][0] = gb[0];
+                hb[1][0] = hb[3][0] = gb[2];
+                hb[0][1] = hb[1][1] = gb[1];
+                hb[2][1] = hb[3][1] = gb[3];
+                for (k = 0; k < nl; k++)
+                    if (hull_visible(r, r->tl[k], (const double (*)[2])hb, 4))
+                        sure_g |= (uint64_t)1 << k;
+            }
+            if (nl > 0 && wall != MESH_SURF_NONE && wall != UINT32_MAX) {
+                double hs[2][2];
+                int k;
+                hs[0][0] = wa[0];
+                hs[0][1] = wa[1];
+                hs[1][0] = wb[0];
+                hs[1][1] = wb[1];
+                /* a single pixel: a point is a segment of length 0 (O not on it) */
+                for (k = 0; k < nl; k++)
+                    if (hull_visible(r, r->tl[k], (const double (*)[2])hs, 2))
+                        sure_w |= (uint64_t)1 << k;
+            }
+            /* 3: shade */
+            for (q = 0, j = tj; j < j1; j++)
+                for (i = ti; i < i1; i++, q++) {
+                    size_t p = (size_t)j * (size_t)r->w + (size_t)i;
+                    const mesh_surf *sf = &m->surf[r->id[p]];
+                    double *E = r->tE[q];
+                    float *out = &r->lin[3 * p];
+                    int k;
+                    if (!r->tcall[q])
+                        continue;
+                    if (r->tcall[q] == 2) {
+                        if (nl >= 0) {
+                            shade_tile_lamps(r, nl,
+                                             r->id[p] == MESH_SURF_GROUND ? sure_g
+                                             : r->id[p] == wall           ? sure_w
+                                                                          : 0,
+                                             TP[q], TN[q], E, st);
+                            st->shader_tiled++;
+                        } else
+                            r->shade(r->user, TP[q], TN[q], E);
+                        st->shader_calls++;
+                    }
+                    if (o->indirect) {
+                        double Ei[3] = { 0, 0, 0 };
+                        o->indirect(o->indirect_user, TP[q], TN[q], Ei);
+                        for (k = 0; k < 3; k++)
+                            E[k] += Ei[k];
+                    }
+                    if (r->id[p] == MESH_SURF_GROUND) {
+                        double alb[3]; /* per channel: the ground image (ground.c) */
+                        scene_ground_albedo(r->s, TP[q][0], TP[q][1], alb);
+                        for (k = 0; k < 3; k++)
+                            out[k] = (float)(alb[k] / PI * E[k]);
+                    } else {
+                        for (k = 0; k < 3; k++)
+                            out[k] = (float)(sf->albedo / PI * E[k]);
+                    }
+                }
+        }
+}
+
+static void glows(render *r, render_stats *st)
+{
+    const scene *s = r->s;
+    uint32_t l;
+    for (l = 0; l < s->nlamps; l++) {
+        const scene_lamp *lp = &s->lamps[l];
+        double X[3], c[4], px, py, rad, peak;
+        int32_t x0, x1, y0, y1, x, y;
+        X[0] = lp->x;
+        X[1] = lp->y;
+        X[2] = lp->z;
+        to_clip(r, X, c);
+        if (!(c[3] > r->near_) || !(lp->intensity > 0))
+            continue;
+        px = (c[0] / c[3] + 1.0) * 0.5 * r->w;
+        py = (1.0 - c[1] / c[3]) * 0.5 * r->h;
+        rad = 0.3 * r->sy * 0.5 * r->h / c[3];
+        rad = fmin(fmax(rad, 1.5), 48.0);
+        if (px < -rad || py < -rad || px > r->w + rad || py > r->h + rad)
+            continue;
+        if (px >= 0 && py >= 0 && px < r->w && py < r->h) {
+            size_t p = (size_t)(int32_t)py * (size_t)r->w + (size_t)(int32_t)px;
+            float dz = (float)((r->za * c[3] + r->zb) / c[3] * 0.5 + 0.5);
+            if (!(dz < r->depth[p]))
+                continue;
+        } else {
+            continue;
+        }
+        st->glows++;
+        peak = lp->intensity / 250.0;
+        x0 = (int32_t)floor(px - rad);
+        x1 = (int32_t)ceil(px + rad);
+        y0 = (int32_t)floor(py - rad);
+        y1 = (int32_t)ceil(py + rad);
+        if (x0 < 0) x0 = 0;
+        if (y0 < 0) y0 = 0;
+        if (x1 > r->w - 1) x1 = r->w - 1;
+        if (y1 > r->h - 1) y1 = r->h - 1;
+        for (y = y0; y <= y1; y++)
+            for (x = x0; x <= x1; x++) {
+                double dx = x + 0.5 - px, dy = y + 0.5 - py, q = (dx * dx + dy * dy) / (rad * rad), g;
+                float *out;
+                int k;
+                if (q >= 1.0)
+                    continue;
+                g = peak * (1.0 - q) * (1.0 - q);
+                out = &r->lin[3 * ((size_t)y * (size_t)r->w + (size_t)x)];
+                for (k = 0; k < 3; k++)
+                    out[k] += (float)(g * lp->color[k]);
+            }
+    }
+}
+
+plx_status render_frame(render *r, const render_camera *cam, const render_opts *o,
+                        uint8_t *rgb8, float *rgbf, render_stats *stats)
+{
+    render_stats st;
+    render_opts def;
+    const render_backend *be;
+    size_t px, p;
+    int inside;
+    if (!r)
+        return PLX_E_INVALID;
+    if (!cam) {
+        r->err = "render_frame: camera is NULL";
+        return PLX_E_INVALID;
+    }
+    if (!o) {
+        render_opts_default(&def);
+        o = &def;
+    }
+    if (!setup_camera(r, cam, o))
+        return PLX_E_INVALID;
+    memset(&st, 0, sizeof st);
+    st.buildings = r->s->nbld;
+    st.triangles = r->m->ntri;
+    px = (size_t)r->w * (size_t)r->h;
+    be = o->backend ? o->backend : &r->soft;
+    if (!be->begin || !be->draw || !be->finish) {
+        r->err = "render_frame: the backend lacks a function";
+        return PLX_E_INVALID;
+    }
+    inside = eye_inside_solid(r);
+    st.eye_inside = inside;
+    if (be->begin(be->user, r->w, r->h, !inside) != 0) {
+        r->err = "render_frame: the backend could not start the frame";
+        return PLX_E_UNSUPPORTED;
+    }
+    cull(r, o->cull, inside, &st);
+    draw_buildings(r, be, &st);
+    if (be->finish(be->user, r->id, r->depth) != 0) {
+        r->err = "render_frame: the backend could not read the frame back";
+        return PLX_E_UNSUPPORTED;
+    }
+    st.drawn_fraction = st.triangles ? (double)st.triangles_drawn / (double)st.triangles : 1.0;
+    shade_pass(r, o, &st);
+    if (!o->no_glow)
+        glows(r, &st);
+    if (rgbf)
+        memcpy(rgbf, r->lin, px * 3 * sizeof(float));
+    if (rgb8) {
+        double ex = o->exposure;
+        for (p = 0; p < 3 * px; p++) {
+            double v = (double)r->lin[p] * ex;
+            union { uint32_t u; float f; } cv;
+            int b;
+            cv.f = (float)v;
+            if (!(v > 0.0)) {
+                rgb8[p] = 0;
+                continue;
+            }
+            /* a hint from the table, then exact against the thresholds */
+            b = r->lut[cv.u >> 16];
+            while (b > 0 && v < r->thr[b - 1])
+                b--;
+            while (b < 255 && v >= r->thr[b])
+                b++;
+            rgb8[p] = (uint8_t)b;
+        }
+    }
+    r->err = "";
+    if (stats)
+        *stats = st;
+    return PLX_OK;
+}
+
+/* ---- light map ------------------------------------------------------------------ */
+
+plx_status render_lightmap_build(render *r, double cell, size_t max_bytes)
+{
+    const scene *s;
+    double x0 = HUGE_VAL, y0 = HUGE_VAL, x1 = -HUGE_VAL, y1 = -HUGE_VAL;
+    uint32_t l, nx, ny, i, j;
+    size_t need;
+    if (!r)
+        return PLX_E_INVALID;
+    s = r->s;
+    if (!(cell > 0.0) || !isfinite(cell) || max_bytes < 12) {
+        r->err = "render_lightmap_build: m_per_texel must be > 0 and max_bytes >= 12";
+        return PLX_E_INVALID;
+    }
+    for (l = 0; l < s->nlamps; l++) {
+        const scene_lamp *lp = &s->lamps[l];
+        double rg;
+        if (!(lp->radius > lp->z) || !(lp->intensity > 0))
+            continue;
+        rg = sqrt(lp->radius * lp->radius - lp->z * lp->z);
+        x0 = fmin(x0, lp->x - rg);
+        y0 = fmin(y0, lp->y - rg);
+        x1 = fmax(x1, lp->x + rg);
+        y1 = fmax(y1, lp->y + rg);
+    }
+    if (!(x1 > x0)) {
+        x0 = y0 = 0.0;
+        x1 = y1 = cell;
+    }
+    for (;;) {
+        double fx = ceil((x1 - x0) / cell), fy = ceil((y1 - y0) / cell);
+        if (fx < 1) fx = 1;
+        if (fy < 1) fy = 1;
+        if (fx * fy * 12.0 <= (double)max_bytes && fx < 1e8 && fy < 1e8) {
+            nx = (uint32_t)fx;
+            ny = (uint32_t)fy;
+            break;
+        }
+        cell *= 1.05;
+    }
+    need = (size_t)nx * ny * 3;
+    if (!r->lm || need > r->lm_cap) {
+        if (r->lm) {
+            r->err = "render_lightmap_build: the new map does not fit the first one's memory";
+            return PLX_E_NOMEM;
+        }
+        r->lm = arena_alloc(r->a, PLX_PART_FRAME, arena_mul(need, sizeof(float)), 64);
+        if (!r->lm) {
+            r->err = "render_lightmap_build: out of memory for the light map";
+            return PLX_E_NOMEM;
+        }
+        r->lm_cap = need;
+    }
+    r->lm_nx = nx;
+    r->lm_ny = ny;
+    r->lm_cell = cell;
+    /* centre the grid on the reach box */
+    r->lm_x0 = 0.5 * (x0 + x1) - 0.5 * nx * cell;
+    r->lm_y0 = 0.5 * (y0 + y1) - 0.5 * ny * cell;
+    r->lm_shaded = 0;
+    memset(r->lm, 0, need * sizeof(float));
+    /* mark texels some lamp reaches, using the map itself (channel 0 = 1) */
+    for (l = 0; l < s->nlamps; l++) {
+        const scene_lamp *lp = &s->lamps[l];
+        double rg;
+        int64_t a0, a1, b0, b1, a, b;
+        if (!(lp->radius > lp->z) || !(lp->intensity > 0))
+            continue;
+        rg = sqrt(lp->radius * lp->radius - lp->z * lp->z) * (1.0 + 1e-9) + 1e-9;
+        a0 = (int64_t)floor((lp->x - rg - r->lm_x0) / cell - 0.5);
+        a1 = (int64_t)ceil((lp->x + rg - r->lm_x0) / cell - 0.5);
+        b0 = (int64_t)floor((lp->y - rg - r->lm_y0) / cell - 0.5);
+        b1 = (int64_t)ceil((lp->y + rg - r->lm_y0) / cell - 0.5);
+        if (a0 < 0) a0 = 0;
+        if (b0 < 0) b0 = 0;
+        if (a1 > (int64_t)nx - 1) a1 = (int64_t)nx - 1;
+        if (b1 > (int64_t)ny - 1) b1 = (int64_t)ny - 1;
+        for (b = b0; b <= b1; b++)
+            for (a = a0; a <= a1; a++) {
+                double dx = r->lm_x0 + (a + 0.5) * cell - lp->x, dy = r->lm_y0 + (b + 0.5) * cell - lp->y;
+                if (dx * dx + dy * dy <= rg * rg)
+                    r->lm[3 * ((size_t)b * nx + (size_t)a)] = 1.0f;
+            }
+    }
+    for (j = 0; j < ny; j++)
+        for (i = 0; i < nx; i++) {
+            float *t = &r->lm[3 * ((size_t)j * nx + i)];
+            double P[3], n[3] = { 0.0, 0.0, 1.0 }, E[3];
+            if (t[0] == 0.0f)
+                continue;
+            P[0] = r->lm_x0 + (i + 0.5) * cell;
+            P[1] = r->lm_y0 + (j + 0.5) * cell;
+            P[2] = 0.0;
+            r->shade(r->user, P, n, E);
+            r->lm_shaded++;
+            t[0] = (float)E[0];
+            t[1] = (float)E[1];
+            t[2] = (float)E[2];
+        }
+    r->lm_built = 1;
+    r->err = "";
+    return PLX_OK;
+}
+
+void render_lightmap_get(const render *r, render_lightmap_info *out)
+{
+    memset(out, 0, sizeof *out);
+    if (!r || !r->lm_built)
+        return;
+    out->built = 1;
+    out->nx = r->lm_nx;
+    out->ny = r->lm_ny;
+    out->x0 = r->lm_x0;
+    out->y0 = r->lm_y0;
+    out->cell = r->lm_cell;
+    out->bytes = (size_t)r->lm_nx * r->lm_ny * 3 * sizeof(float);
+    out->shaded = r->lm_shaded;
+    out->rgb = r->lm;
+}
