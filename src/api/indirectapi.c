@@ -3,6 +3,7 @@
 
 #include "base/engine.h"
 #include "photon/photon.h"
+#include "photon/trace.h"
 
 static plx_status need_photons(plx_engine *e, const char *fn)
 {
@@ -77,6 +78,27 @@ double eng_indirect_rgb(plx_engine *e, const double P[3], const double n[3], dou
         return 0.0;
     }
     return photon_indirect_rgb(e->ph, P, n, rgb);
+}
+
+/* The indirect estimate at a point that is not on a surface facing out (a
+ * light meter in free air, README "How SPEC §2 is read"): the photon
+ * buffers' E_indirect on the horizontal surface straight below it (the
+ * topmost roof under the point, else the ground), facing up. */
+double eng_indirect_free(plx_engine *e, const double P[3], double rgb[3])
+{
+    static const double up[3] = { 0.0, 0.0, 1.0 };
+    double Q[3];
+    if (!e->ph || plx_indirect_frames(e) == 0) {
+        if (rgb)
+            rgb[0] = rgb[1] = rgb[2] = 0.0;
+        return 0.0;
+    }
+    Q[0] = P[0];
+    Q[1] = P[1];
+    Q[2] = trace_top(e->ph->T, P[0], P[1], NULL);
+    if (!(Q[2] <= P[2]))
+        Q[2] = 0.0;   /* under a raised building: its ground */
+    return photon_indirect_rgb(e->ph, Q, up, rgb);
 }
 
 plx_status plx_nightify(const uint8_t *day, size_t npx, const uint8_t *night, size_t nnight,

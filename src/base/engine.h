@@ -50,6 +50,9 @@ plx_status eng_need_light(plx_engine *e, const char *fn);
 double eng_indirect(plx_engine *e, const double P[3], const double n[3]);
 /* The same, also writing its RGB version to rgb (may be NULL); returns the scalar. */
 double eng_indirect_rgb(plx_engine *e, const double P[3], const double n[3], double rgb[3] /* OUT */);
+/* The indirect estimate at a free point (not on a surface facing out):
+ * the buffers' value on the horizontal surface below it (indirectapi.c). */
+double eng_indirect_free(plx_engine *e, const double P[3], double rgb[3] /* OUT */);
 /* Checks the engine handle for API misuse. */
 int eng_ok(const plx_engine *e);
 

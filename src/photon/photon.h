@@ -333,6 +333,9 @@ int photon_block_level(const photon_sys *ps, uint32_t b);
 
 /* Drops every accumulated photon (charts, ambient, A, I, the lamp cache and
  * the refined marks); levels stay. For changed lamps. */
+/* The lamps' photometry changed (plx_set_photometry): fluxes recomputed,
+ * every photon dropped. */
+void photon_lamps_changed(photon_sys *ps);
 void photon_reset(photon_sys *ps);
 
 /* ---- lamp floor maps (photon_night.c) --------------------------------- */
