@@ -61,5 +61,6 @@ int cmd_render(int argc, char **argv);
 int cmd_route(int argc, char **argv);
 int cmd_nightify(int argc, char **argv);
 int cmd_dark_spots(int argc, char **argv);
+int cmd_meter(int argc, char **argv);
 
 #endif

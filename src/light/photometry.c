@@ -121,9 +121,10 @@ static plx_status pm_next(pm_text *t, const char *what, double *v)
         t->pos++;
     }
     if (t->pos >= t->len) {
+        uint32_t last = t->line > 1 && t->len > 0 && t->s[t->len - 1] == '\n' ? t->line - 1 : t->line;
         sb_init(&m, tok, sizeof tok);
         sb_str(&m, what);
-        return pm_fail(t, t->line, "table too short: the file ends before ", tok);
+        return pm_fail(t, last, "table too short: the file ends before ", tok);
     }
     b = t->pos;
     while (t->pos < t->len && !pm_space(t->s[t->pos]) && t->s[t->pos] != ',' && t->s[t->pos] != '\n')

@@ -170,6 +170,17 @@ void photon_sphere_dir(uint64_t *st, double d[3])
     sphere_dir(st, d);
 }
 
+void photon_lamp_dir(const scene_lamp *Lp, uint64_t *rng, double d[3])
+{
+    sphere_dir(rng, d);
+    if (!Lp->photometry)
+        return;
+    /* rejection: directions uniform on the sphere kept with probability
+     * I(d) / peak leave with the distribution of I (SPEC §2.1) */
+    while (!(rng01(rng) * Lp->intensity < lamp_intensity(Lp, d)))
+        sphere_dir(rng, d);
+}
+
 static void cosine_dir(uint64_t *st, const double n[3], double d[3])
 {
     double u1 = rng01(st), u2 = rng01(st);
@@ -1586,13 +1597,7 @@ static void trace_lamp(photon_sys *ps, uint32_t lamp, double phi, uint64_t *rng,
     o[0] = Lp->x;
     o[1] = Lp->y;
     o[2] = Lp->z;
-    sphere_dir(rng, d);
-    if (Lp->photometry) {
-        /* rejection: directions uniform on the sphere kept with probability
-         * I(d) / peak leave with the distribution of I (SPEC §2.1) */
-        while (!(rng01(rng) * Lp->intensity < lamp_intensity(Lp, d)))
-            sphere_dir(rng, d);
-    }
+    photon_lamp_dir(Lp, rng, d);
     st->photons++;
     st->emitted += phi;
     st->traced++;
