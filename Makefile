@@ -7,6 +7,7 @@
 #   make asan       the same tests under AddressSanitizer + UBSan
 #   make valgrind   the unit tests under valgrind memcheck
 #   make bench      benchmarks (tests/bench)
+#   make check-identical BASE=rev   outputs byte-identical to revision rev
 #   make deps       install missing Debian packages (apt-get when root)
 #   make install PREFIX=/usr/local
 #   make clean
@@ -49,7 +50,7 @@ DEB_PACKAGES = libcjson-dev libcmocka-dev libpng-dev pkg-config
 
 .SECONDARY:
 .PHONY: all deps demo check check-full check-build unit cli-test asan valgrind bench install clean \
-        check-core-headers
+        check-core-headers check-identical
 
 all: $(LIB_A) $(LIB_SO) $(BIN)
 
@@ -144,6 +145,13 @@ valgrind: all $(TESTS)
 	  echo "valgrind $$t"; \
 	  PLX_TEST_QUICK=1 valgrind -q --error-exitcode=9 --leak-check=full --errors-for-leak-kinds=definite $$t >/dev/null || exit 1; \
 	done; echo "valgrind: clean"
+
+# The refactor check (not part of make check: it builds another revision):
+# every command on every fixture and two generated cities, byte for byte
+# against revision BASE (tests/check_identical.sh).
+BASE ?= 73d3a0e
+check-identical:
+	@sh tests/check_identical.sh $(BASE)
 
 bench: all $(BENCHES)
 	@for b in $(BENCHES); do echo "== $$b"; $$b || exit 1; done
