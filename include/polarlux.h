@@ -470,14 +470,11 @@ typedef int (*plx_write_fn)(void *ctx, const char *data, size_t len);
 plx_status plx_gen_city(const char *style, int nx, int ny, uint64_t seed,
                         plx_write_fn write, void *ctx);
 
-/* ---- POSIX port (port/posix) ----------------------------------------- */
+/* ---- Ports -------------------------------------------------------------- */
 
-/* The POSIX services: clock_gettime, stderr logging, stdio files. */
-const plx_port *plx_port_posix(void);
-/* Creates an engine in a block of 'budget' bytes taken from the C heap. */
-plx_status plx_engine_new(size_t budget, const plx_config *cfg, plx_engine **engine /* OUT */);
-/* Destroys an engine made by plx_engine_new and frees its block. */
-void plx_engine_free(plx_engine *e);
+/* The POSIX port (plx_port_posix, plx_engine_new, plx_engine_free) and the
+ * PNG/PFM files are not part of this library: see polarlux_port.h and
+ * libpolarlux-port. */
 
 #ifdef __cplusplus
 }
