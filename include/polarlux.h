@@ -470,6 +470,60 @@ typedef int (*plx_write_fn)(void *ctx, const char *data, size_t len);
 plx_status plx_gen_city(const char *style, int nx, int ny, uint64_t seed,
                         plx_write_fn write, void *ctx);
 
+/* ---- Embedding: coordinates and memory sizing -------------------------- */
+
+/*
+ * The SPEC §1 projection of the loaded lon/lat scene, for n points given as
+ * pairs (lon, lat degrees / x, y metres), in may equal out:
+ *   x = (lon - lon0) * 111320 * cos(lat0),  y = (lat - lat0) * 110540
+ * about the centre (lon0, lat0) of plx_scene_info; the forward direction is
+ * bit for bit what the loader did to the scene's coordinates. Non-finite
+ * input gives non-finite output (no check).
+ * Errors: PLX_E_NOSCENE; PLX_E_INVALID (the scene is in local metres, or an
+ * array NULL with n > 0). Reads the scene only: may run in several threads
+ * at once on one engine as long as no thread loads a scene meanwhile.
+ */
+plx_status plx_lonlat_to_local(plx_engine *e, size_t n, const double *lonlat, double *xy /* OUT */);
+plx_status plx_local_to_lonlat(plx_engine *e, size_t n, const double *xy, double *lonlat /* OUT */);
+
+/* What a GeoJSON text holds, counted without parsing it. */
+typedef struct plx_scene_size {
+    uint64_t text_bytes;   /* the text's length */
+    uint64_t json_values;  /* JSON values (objects, arrays, strings, numbers, literals; keys not) */
+    uint64_t string_bytes; /* bytes of every string, keys included, plus 1 each */
+    uint64_t features;     /* "Feature" strings */
+    uint64_t points;       /* "Point" strings: at least the lamps */
+    uint64_t positions;    /* arrays of numbers: vertices and points */
+    uint64_t rings;        /* arrays of positions: rings (at least the buildings) */
+} plx_scene_size;
+
+/*
+ * Counts text (len bytes, not necessarily NUL-terminated) in one pass, with
+ * no engine and no memory. Malformed text gives counts anyway (the load
+ * will say what is wrong). Errors: PLX_E_INVALID (out NULL, text NULL with
+ * len > 0). Thread-safe (touches only *out).
+ */
+plx_status plx_scene_size_scan(const char *text, size_t len, plx_scene_size *out /* OUT */);
+
+/* What the caller will do with the scene (OR them); loading is always counted. */
+#define PLX_USE_LOAD       0u
+#define PLX_USE_VISIBILITY 1u  /* polar diagrams: plx_visibility_get, plx_polar_* */
+#define PLX_USE_LIGHT      2u  /* plx_illuminance, plx_lamps_at, lit regions, routes */
+#define PLX_USE_RENDER     4u  /* plx_render at the config's largest frame (direct light,
+                                  aerial light map not included) */
+
+/*
+ * The block size (bytes, for plx_engine_create) that a scene of these
+ * counts needs for the uses asked, with the config's sizes (lit cache,
+ * largest frame; cfg NULL: the defaults). Counts the caller knows by other
+ * means may be given by hand: set positions (vertices + lamps), rings
+ * (buildings), points (lamps), features; text_bytes, json_values and
+ * string_bytes left 0 are then derived from them. Photon buffers
+ * (plx_indirect_step) are not included. Returns 0 when sz is NULL or the
+ * size does not fit in size_t. Pure function: thread-safe.
+ */
+size_t plx_memory_estimate(const plx_scene_size *sz, const plx_config *cfg, unsigned uses);
+
 /* ---- Ports -------------------------------------------------------------- */
 
 /* The POSIX port (plx_port_posix, plx_engine_new, plx_engine_free) and the
