@@ -4,6 +4,7 @@
 
 #include <stdio.h>
 #include "polarlux.h"
+#include "polarlux_port.h"
 
 /* Exit codes (README, "Exit codes"). */
 enum {
