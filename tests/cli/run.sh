@@ -122,6 +122,7 @@ expect ground-image-bad-strict 1 "polarlux info: $tmp/gi/bad\.geojson: propertie
 expect ground-image-bad-lenient 0 "warning: $tmp/gi/bad\.geojson: properties\.ground_image must be the path of a PNG file \(a non-empty string of at most 4096 bytes\); ignored" -- "$bin" info "$tmp/gi/bad.geojson"
 expect ground-image-nomem 3 "out of memory while storing the ground image" -- "$bin" info --mem 15K fixtures/ground-image.geojson
 # photometric lamps (SPEC §2.1), light meters anywhere (§2) and pedestrian metrics (§6)
+expect info-photometry 0 "^photometry: photometry/street-type2\\.ies \\(IES\\) for 584 lamps; lamp 0: peak 2966\\.8 cd, flux 6283\\.2 lm, dark from gamma 90\\.0 deg$" -- "$bin" info -q fixtures/helsinki-street-luminaires.geojson
 expect meter-help 0 "^usage: polarlux meter" -- "$bin" meter --help
 expect meter-unknown-option 2 "polarlux meter: unknown option '--bogus'" -- "$bin" meter --bogus x
 expect illum-free-air 0 "^50 10 1.5 [0-9.]+(e-?[0-9]+)? 0$" -- sh -c "echo '50 10 1.5 1 0 0' | '$bin' illum -q --no-indirect fixtures/tiny.geojson --points -"

@@ -198,6 +198,50 @@ static void test_parse_errors(void **state)
     free(b.mem);
 }
 
+static const photometry *parse_file(lab *b, const char *path)
+{
+    static char text[1 << 16];
+    FILE *f = fopen(path, "rb");
+    size_t n;
+    assert_non_null(f);
+    n = fread(text, 1, sizeof text - 1, f);
+    fclose(f);
+    text[n] = '\0';
+    return parse(b, text, PLX_OK);
+}
+
+/* The shipped files against the formulas of fixtures/make-photometry.py
+ * (values written with 2 or 3 decimals). */
+static void test_fixture_files(void **state)
+{
+    lab b = { 0 };
+    const photometry *p;
+    int g, c;
+    (void)state;
+    p = parse_file(&b, "fixtures/photometry/post-top.ldt");
+    assert_int_equal(p->format, 2);
+    assert_int_equal(p->nc, 1);
+    for (g = 0; g <= 180; g += 5) {
+        double r = g * PI / 180, want = 3 * (170 * sin(r) * sin(r) + 80 * fmax(0, cos(r)) + 15 * fmax(0, -cos(r)));
+        assert_true(fabs(photometry_at(p, 33, g) - want) < 3 * 0.0005 + 1e-9);
+    }
+    p = parse_file(&b, "fixtures/photometry/wall-down.ies");
+    assert_int_equal(p->format, 1);
+    for (c = 0; c <= 360; c += 15)
+        for (g = 0; g <= 90; g += 5) {
+            double r = g * PI / 180, cc = cos(c * PI / 180);
+            double want = 900 * pow(fmax(0, cos(r)), 1.2) * ((1 - sin(r)) + sin(r) * sqrt(fmax(0, cc)));
+            assert_true(fabs(photometry_at(p, c, g) - want) < 2 * 0.005 + 1e-9);
+        }
+    assert_true(photometry_at(p, 0, 90.5) == 0.0);
+    p = parse_file(&b, "fixtures/photometry/street-type2.ies");
+    assert_true(fabs(p->flux - 2 * PI * 1000) < 0.5);    /* the script's K: 6283 lm */
+    assert_true(photometry_at(p, 0, 90) == 0.0 && p->gamma_lit == 90.0);
+    assert_true(photometry_at(p, 90, 65) > photometry_at(p, 0, 65));       /* along the road */
+    assert_true(photometry_at(p, 0, 40) > photometry_at(p, 180, 40));      /* street side */
+    free(b.mem);
+}
+
 /* ---- scenes ------------------------------------------------------------------- */
 
 /* The bilateral table of test_ies_symmetries: C0 200 -> 100 over gamma 0..60,
@@ -457,6 +501,60 @@ static void test_full_cutoff_facade(void **state)
     free(mem);
 }
 
+static void test_render_uses_photometry(void **state)
+{
+    /* looking straight down from 100 m at the ground lit by two tilted,
+     * turned photometric lamps: every pixel is albedo / pi x E (SPEC §5) */
+    static const char scene_text[] =
+        "{\"type\":\"FeatureCollection\",\"properties\":{\"units\":\"m\"},\"features\":["
+        "{\"type\":\"Feature\",\"properties\":{\"height\":5},\"geometry\":{\"type\":\"Polygon\","
+        "\"coordinates\":[[[200,0],[210,0],[210,10],[200,10],[200,0]]]}},"
+        "{\"type\":\"Feature\",\"properties\":{\"lamp\":true,\"z\":6,\"radius\":30,\"photometry\":\"b.ies\","
+        "\"azimuth\":30,\"tilt\":5},\"geometry\":{\"type\":\"Point\",\"coordinates\":[-10,5]}},"
+        "{\"type\":\"Feature\",\"properties\":{\"lamp\":true,\"z\":5,\"radius\":25,\"photometry\":\"b.ies\","
+        "\"azimuth\":200,\"dimming\":0.7},\"geometry\":{\"type\":\"Point\",\"coordinates\":[12,-4]}}]}";
+    void *mem;
+    plx_engine *e = open_text(scene_text, &mem);
+    plx_camera cam;
+    plx_render_opts o;
+    float *img = malloc(sizeof(float) * 3 * 160 * 120);
+    double t = tan(20.0 * PI / 180.0);
+    int i, j, k, lit = 0;
+    (void)state;
+    assert_int_equal(plx_set_photometry(e, "b.ies", bilateral, strlen(bilateral), NULL), PLX_OK);
+    memset(&cam, 0, sizeof cam);
+    cam.eye[2] = 100.0;
+    cam.fov_deg = 40.0;
+    cam.width = 160;
+    cam.height = 120;
+    plx_render_opts_default(&o);
+    o.no_glow = 1;
+    o.no_indirect = 1;
+    assert_int_equal(plx_render(e, &cam, &o, NULL, img, NULL), PLX_OK);
+    for (j = 0; j < 120; j++)
+        for (i = 0; i < 160; i++) {
+            double a = (2.0 * (i + 0.5) / 160 - 1.0) * t * 160.0 / 120.0;
+            double b = (1.0 - 2.0 * (j + 0.5) / 120) * t;
+            double P[3] = { 100.0 * a, 100.0 * b, 0.0 }, n[3] = { 0, 0, 1 }, E, rgbE[3];
+            const float *out = img + 3 * ((size_t)j * 160 + i);
+            assert_int_equal(plx_illuminance(e, 1, P, n, &E, NULL, rgbE), PLX_OK);
+            for (k = 0; k < 3; k++) {
+                double want = 0.15 / PI * rgbE[k];
+                if (!(fabs(out[k] - want) <= 1e-6 * want + 1e-30)) {
+                    printf("pixel (%d, %d) at (%.3f, %.3f) channel %d: %.9g, want %.9g\n", i, j, P[0], P[1], k,
+                           out[k], want);
+                    fail();
+                }
+            }
+            lit += E > 0.0;
+        }
+    printf("  render: 19200 ground pixels equal 0.15 / pi x E, %d lit\n", lit);
+    assert_true(lit > 1000 && lit < 19000);
+    free(img);
+    plx_engine_destroy(e);
+    free(mem);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -464,10 +562,12 @@ int main(void)
         cmocka_unit_test(test_ies_symmetries),
         cmocka_unit_test(test_ldt_symmetries),
         cmocka_unit_test(test_parse_errors),
+        cmocka_unit_test(test_fixture_files),
         cmocka_unit_test(test_nadir_and_frame),
         cmocka_unit_test(test_semicylinder_hemisphere),
         cmocka_unit_test(test_photon_flux_and_directions),
         cmocka_unit_test(test_full_cutoff_facade),
+        cmocka_unit_test(test_render_uses_photometry),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
