@@ -172,12 +172,14 @@ void photon_sphere_dir(uint64_t *st, double d[3])
 
 void photon_lamp_dir(const scene_lamp *Lp, uint64_t *rng, double d[3])
 {
+    uint32_t tries = 0;
     sphere_dir(rng, d);
     if (!Lp->photometry)
         return;
     /* rejection: directions uniform on the sphere kept with probability
-     * I(d) / peak leave with the distribution of I (SPEC §2.1) */
-    while (!(rng01(rng) * Lp->intensity < lamp_intensity(Lp, d)))
+     * I(d) / peak leave with the distribution of I (SPEC §2.1); a table
+     * of (almost) no flux gives up after 2^24 tries */
+    while (!(rng01(rng) * Lp->intensity < lamp_intensity(Lp, d)) && ++tries < (1u << 24))
         sphere_dir(rng, d);
 }
 
