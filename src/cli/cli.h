@@ -47,6 +47,10 @@ int cli_indirect_option(const char *cmd, int argc, char **argv, int *i, cli_indi
  * dir (either may be NULL). Returns an exit code. */
 int cli_indirect_run(const char *cmd, plx_engine *e, const cli_indirect *ind, const double *eye,
                      const double *dir, double fov_deg);
+/* "polarlux CMD: warning: ..." on stderr unless --quiet (c may be NULL). */
+void cli_warn(const char *cmd, const cli_common *c, const char *fmt, ...);
+/* Why a result is dark: "the scene has no lamps", or that no light reaches it. */
+const char *cli_dark_reason(plx_engine *e);
 /* Maps a status to an exit code. */
 int cli_exit_code(plx_status s);
 

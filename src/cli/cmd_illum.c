@@ -111,6 +111,10 @@ int cmd_illum(int argc, char **argv)
         printf("%.17g %.17g %.17g %.17g %.17g\n", p[0], p[1], p[2], ed[k], ei[k]);
     }
     rc = failed ? EXIT_FAIL : EXIT_OK;
+    for (k = 0; k < pts.n && !(ed[k] + ei[k] > 0); k++)
+        ;
+    if (pts.n > 0 && k == pts.n)
+        cli_warn("illum", &c, "every point is dark (0 lx): %s", cli_dark_reason(e));
 done:
     free(ed);
     free(ei);

@@ -304,7 +304,13 @@ int cmd_render(int argc, char **argv)
         if (a.aerial) {
             default_aerial(e, &a.cam);
         } else if (default_street(e, &a.cam) != 0) {
-            fprintf(stderr, "polarlux render: found no free street spot beside a lamp; give --eye and --target\n");
+            plx_scene_info si;
+            plx_scene_info_get(e, &si);
+            if (si.lamps == 0)
+                fprintf(stderr, "polarlux render: the scene has no lamps, so the default street view (beside a "
+                                "lamp) has nowhere to stand; give --eye and --target, or --view aerial\n");
+            else
+                fprintf(stderr, "polarlux render: found no free street spot beside a lamp; give --eye and --target\n");
             plx_engine_free(e);
             return EXIT_FAIL;
         }
@@ -355,6 +361,13 @@ int cmd_render(int argc, char **argv)
         goto done;
     }
     rc = write_outputs(&a, rgb8, rgbf);
+    if (rc == EXIT_OK) {
+        size_t k, npx = (size_t)a.cam.width * a.cam.height * 3;
+        for (k = 0; k < npx && rgb8[k] == 0; k++)
+            ;
+        if (k == npx)
+            cli_warn("render", &a.c, "the image is entirely black: %s", cli_dark_reason(e));
+    }
     if (rc == EXIT_OK)
         printf("%s view %dx%d from (%.1f, %.1f, %.1f) to (%.1f, %.1f, %.1f): drew %u of %u buildings "
                "(%.2f%% of the geometry) in %.1f ms, written to %s\n",

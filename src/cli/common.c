@@ -144,6 +144,47 @@ static int load_ground_image(const char *cmd, const char *scene_path, plx_engine
     return EXIT_OK;
 }
 
+void cli_warn(const char *cmd, const cli_common *c, const char *fmt, ...)
+{
+    va_list ap;
+    if (c && c->quiet)
+        return;
+    fprintf(stderr, "polarlux %s: warning: ", cmd);
+    va_start(ap, fmt);
+    vfprintf(stderr, fmt, ap);
+    va_end(ap);
+    fprintf(stderr, "\n");
+}
+
+/* Commands whose results are light: they say so when the scene has none. */
+static int computes_light(const char *cmd)
+{
+    static const char *const names[] = { "illum", "lit", "heatmap", "render", "route", "dark-spots" };
+    size_t i;
+    for (i = 0; i < sizeof names / sizeof names[0]; i++)
+        if (strcmp(cmd, names[i]) == 0)
+            return 1;
+    return 0;
+}
+
+static void note_no_lamps(const char *cmd, const char *path, const cli_common *c, plx_engine *e)
+{
+    plx_scene_info si;
+    if (!computes_light(cmd) || plx_scene_info_get(e, &si) != PLX_OK || si.lamps > 0)
+        return;
+    cli_warn(cmd, c, "%s has no lamps%s, so every result is dark (0 lx); add lamps as Point features "
+             "with \"lamp\": true, or from another file with --lamps FILE", path,
+             si.skipped_lamps ? " (all were left out, see the warnings above)" : "");
+}
+
+const char *cli_dark_reason(plx_engine *e)
+{
+    plx_scene_info si;
+    if (plx_scene_info_get(e, &si) != PLX_OK || si.lamps == 0)
+        return "the scene has no lamps";
+    return "no lamp's light reaches it (each lamp lights only within its radius, and buildings cast shadows)";
+}
+
 int cli_open_scene(const char *cmd, const char *path, const cli_common *c, plx_engine **e)
 {
     int rc;
@@ -180,7 +221,9 @@ int cli_open_scene(const char *cmd, const char *path, const cli_common *c, plx_e
     if (rc != EXIT_OK) {
         plx_engine_free(*e);
         *e = NULL;
+        return rc;
     }
+    note_no_lamps(cmd, path, c, *e);
     return rc;
 }
 
