@@ -23,7 +23,7 @@ static const char help[] =
     "  --path FILE  draw these routes (GeoJSON LineStrings, as for 'polarlux\n"
     "             route') on the map, sampled every pixel and coloured by lux\n"
     "             on the same scale, outlined in cyan\n"
-    "  --mem SIZE, --strict, --quiet   as for 'polarlux info'\n";
+    "  --mem SIZE, --strict, --quiet, --lamps FILE   as for 'polarlux info'\n";
 
 /* A night palette on t in [0, 1]: black, deep blue, purple, orange, yellow, white. */
 static void palette(double t, uint8_t rgb[3])
@@ -272,6 +272,11 @@ int cmd_heatmap(int argc, char **argv)
     rc = cli_open_scene("heatmap", scene, &c, &e);
     if (rc != EXIT_OK)
         return rc;
+    if (o.have_box && (cli_option_local("heatmap", "--box", e, &o.box[0], &o.box[1]) != 0 ||
+                       cli_option_local("heatmap", "--box", e, &o.box[2], &o.box[3]) != 0)) {
+        plx_engine_free(e);
+        return EXIT_USAGE;
+    }
     if (o.res == 0) {
         plx_scene_info si;
         const double *b;

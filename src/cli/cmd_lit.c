@@ -16,7 +16,7 @@ static const char help[] =
     "  --lamp ID   the lamp's id (properties.id, e.g. node/314737872) or its\n"
     "              index among the loaded lamps (0, 1, ...)\n"
     "  -o FILE     output file (required)\n"
-    "  --mem SIZE, --strict, --quiet   as for 'polarlux info'\n";
+    "  --mem SIZE, --strict, --quiet, --lamps FILE   as for 'polarlux info'\n";
 
 /* The lamp index for ID: an id string first, else a whole number index. */
 static long find_lamp(plx_engine *e, const char *id)

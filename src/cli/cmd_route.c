@@ -25,7 +25,7 @@ static const char route_help[] =
     "  --step M         sampling step in metres (default 1)\n"
     "  --dark-lux LX    the dark threshold (default 1)\n"
     "  --geojson OUT    also write the lines with these numbers as properties\n"
-    "  --mem SIZE, --strict, --quiet   as for 'polarlux info'\n";
+    "  --mem SIZE, --strict, --quiet, --lamps FILE   as for 'polarlux info'\n";
 
 static const char spots_help[] =
     "usage: polarlux dark-spots SCENE [--res M] [--count N] [--spacing M] [--all] [-o OUT] [options]\n"
@@ -41,7 +41,7 @@ static const char spots_help[] =
     "  --spacing M   minimum distance between reported spots (default 10)\n"
     "  --all         also points out of every lamp's reach\n"
     "  -o OUT        write the GeoJSON to OUT instead of standard output\n"
-    "  --mem SIZE, --strict, --quiet   as for 'polarlux info'\n";
+    "  --mem SIZE, --strict, --quiet, --lamps FILE   as for 'polarlux info'\n";
 
 static void class_text(int c, char out[4])
 {
