@@ -43,6 +43,16 @@ void photon_config_default(photon_config *c)
     c->lamp_cache_bytes = (size_t)4 << 20;
     c->near_radius = 60.0;
     c->cell_size = 0.0;
+    c->coarsest_level = PHOTON_LEVELS;
+}
+
+void photon_config_gather(photon_config *c, const scene *s)
+{
+    photon_config_default(c);
+    c->coarsest_level = 2;
+    c->kernel_min = c->kernel_max = 4.0;
+    if (s && s->nblocks > c->level_blocks[2])
+        c->level_blocks[2] = s->nblocks;
 }
 
 static int config_ok(const photon_config *c)
@@ -56,7 +66,7 @@ static int config_ok(const photon_config *c)
         !(c->kernel_min > 0.0 && c->kernel_min <= c->kernel_max) ||
         !(c->kernel_frames >= 0.0) ||
         !(c->lamp_kernel > 0.0 && c->lamp_kernel <= PHOTON_KERNEL_MAX) ||
-        !(c->near_radius >= 0.0))
+        !(c->near_radius >= 0.0) || c->coarsest_level > PHOTON_LEVELS)
         return 0;
     for (L = 0; L < PHOTON_LEVELS; L++)
         if ((c->chart_w >> L) < 1 || (c->chart_h >> L) < 1)
@@ -1307,6 +1317,8 @@ plx_status photon_set_viewer(photon_sys *ps, const double eye[3], const double d
                     lvl = d < 3 * bsz ? 2 : 4;
             }
         }
+        if (lvl > (int)ps->cfg.coarsest_level)
+            lvl = (int)ps->cfg.coarsest_level;
         want[k] = (uint8_t)lvl;
         order[k].key = d;
         order[k].id = k;
@@ -1783,6 +1795,21 @@ double photon_indirect_rgb(photon_sys *ps, const double P[3], const double n[3],
         rgb[2] = e[3];
     }
     return e[0];
+}
+
+/* E_indirect at a surface a ray found (final_gather.c): the same lookups
+ * as photon_indirect_rgb, without the probe ray for walls. */
+void photon_indirect_hit(photon_sys *ps, const trace_hit *h, double e[PHOTON_CH])
+{
+    int c;
+    for (c = 0; c < PHOTON_CH; c++)
+        e[c] = 0.0;
+    if (h->kind == TRACE_WALL)
+        facade_lookup(ps, h, e);
+    else if (h->kind == TRACE_GROUND || h->kind == TRACE_ROOF)
+        horizontal_lookup(ps, h->p, e);
+    else if (h->kind == TRACE_UNDER && ps->s->bld[h->bld].block < ps->s->nblocks)
+        ambient(ps, ps->s->bld[h->bld].block, e);
 }
 
 double photon_indirect(photon_sys *ps, const double P[3], const double n[3])

@@ -183,9 +183,19 @@ typedef struct photon_config {
     double near_radius;             /* photon_lamps_update: lamps within this horizontal
                                        distance of the viewer are refined; 60 m */
     double cell_size;               /* tracer grid cell, m; 0 = automatic */
+    uint32_t coarsest_level;        /* photon_set_viewer gives no block a level above this
+                                       (while its level has room); PHOTON_LEVELS (4) = the
+                                       distance rule alone. Final gathering (final_gather.h)
+                                       reads later bounces at surfaces all around its points,
+                                       so it charts every block: 2 with level_blocks[2] =
+                                       every block (photon_config_gather) */
 } photon_config;
 
 void photon_config_default(photon_config *c /* OUT */);
+/* The configuration for final gathering at points: the default with every
+ * block charted at level 2 or finer (coarsest_level 2, level_blocks[2] =
+ * nblocks of s). */
+void photon_config_gather(photon_config *c /* OUT */, const scene *s);
 
 typedef struct photon_stats {
     uint64_t frames;                /* photon_step calls since the last reset */
@@ -334,6 +344,11 @@ int photon_block_level(const photon_sys *ps, uint32_t b);
 /* Drops every accumulated photon (charts, ambient, A, I, the lamp cache and
  * the refined marks); levels stay. For changed lamps. */
 void photon_reset(photon_sys *ps);
+
+/* E_indirect (PHOTON_CH channels: scalar, RGB) at the surface of hit h
+ * (a wall, the ground, a roof or an underside), as photon_indirect_rgb
+ * answers at h->p with h->n but without the probe ray. */
+void photon_indirect_hit(photon_sys *ps, const trace_hit *h, double e[PHOTON_CH] /* OUT */);
 
 /* ---- lamp floor maps (photon_night.c) --------------------------------- */
 
