@@ -24,7 +24,7 @@ static const char help[] =
     "\n"
     "  --points FILE  the points (required)\n"
     "  --photons N    photons per frame (default 65536)\n"
-    "  --frames K     progressive photon frames (default 8: 524,288 photons)\n"
+    "  --frames K     progressive photon frames (default 16: 1,048,576 photons)\n"
     "  --gather N     final gathering over N x N directions (default 32); 0: the\n"
     "                 photon buffers' own estimate at the point (the older\n"
     "                 method: give it --frames 256)\n"

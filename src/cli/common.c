@@ -187,7 +187,10 @@ int cli_open_scene(const char *cmd, const char *path, const cli_common *c, plx_e
 void cli_indirect_default(cli_indirect *ind)
 {
     ind->photons = 65536;
-    ind->frames = 256; /* 16.8M photons: the count whose error tests/unit/test_photon.c bounds by 10% */
+    ind->frames = 16; /* 1M photons for images, read through the wide lookup (photon.h
+                         lookup_radius): indirect light adds at most about the direct-only
+                         time of a street view (README, "Indirect light"); illum sets
+                         CLI_GATHER_FRAMES */
     ind->off = 0;
     ind->gather = -1;
 }

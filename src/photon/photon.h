@@ -189,6 +189,10 @@ typedef struct photon_config {
                                        reads later bounces at surfaces all around its points,
                                        so it charts every block: 2 with level_blocks[2] =
                                        every block (photon_config_gather) */
+    double lookup_radius;           /* lookups on facade charts and the aerial chart: 0 =
+                                       bilinear over 2 x 2 texels; r > 0 = cone of r texels
+                                       over the same surface (photon_gather_wide); 0, and 3
+                                       in photon_config_gather */
 } photon_config;
 
 void photon_config_default(photon_config *c /* OUT */);
@@ -412,6 +416,12 @@ int photon_splat(float *flux, const float *area, const float *height, double z,
 double photon_gather(const float *flux, const float *area, const float *height, double z,
                      uint32_t w, uint32_t h, int wrap, double fx, double fy,
                      double e[PHOTON_CH] /* OUT */);
+/* The wide lookup: cone weights w = 1 - dist / r over the valid texels
+ * (area > 0, height within 1 mm) within r texels of (fx, fy), e = sum w F /
+ * sum w A; photon_gather when r <= 0 or no texel is valid. */
+double photon_gather_wide(const float *flux, const float *area, const float *height, double z,
+                          uint32_t w, uint32_t h, int wrap, double fx, double fy, double r,
+                          double e[PHOTON_CH] /* OUT */);
 /* The same on a sparse grid: grid texel k is stored in slot idx[k]
  * (PHOTON_NONE: not charted); flux and area are per slot; no height, no
  * wrap. */

@@ -9,7 +9,7 @@
  *  - accuracy against the path tracer (tests/ref/ref_indirect.c) on ground
  *    and facade points of fixtures/eixample-4x4.geojson and, in the full
  *    run, of `gen oldtown 40 40`, at the default settings (the engine's
- *    photon configuration, 8 x 65536 photons, 32 x 32 directions) over six
+ *    photon configuration, 16 x 65536 photons, 32 x 32 directions) over six
  *    seeds, next to the photon buffers alone with as many photons;
  *  - identical bytes for a seed through the API, whatever the order of the
  *    points.
@@ -236,10 +236,13 @@ static plx_engine *engine_on(const char *path, const char *text, size_t len)
     return e;
 }
 
-/* Mean relative errors (gathered, photons alone) over the points and seeds. */
+/* Mean relative errors (gathered, photons alone) over the points and seeds;
+ * the photons alone are read as images read them (the wide lookup, photon.h
+ * lookup_radius) and with the 2 x 2 lookup (printed). */
 static void accuracy(const char *name, plx_engine *e, int npts, int paths, int seeds,
                      double *err_gather, double *err_photons)
 {
+    double e2 = 0.0, r0;
     double *P = malloc(sizeof *P * 3 * (size_t)npts), *N = malloc(sizeof *N * 3 * (size_t)npts);
     double *ref = malloc(sizeof *ref * (size_t)npts), noise = 0.0, eg = 0.0, ep = 0.0;
     int np, i, sd, k;
@@ -255,21 +258,26 @@ static void accuracy(const char *name, plx_engine *e, int npts, int paths, int s
     }
     for (sd = 0; sd < seeds; sd++) {
         assert_int_equal(plx_indirect_reset(e), PLX_OK);
-        for (k = 0; k < 8; k++)
+        for (k = 0; k < 16; k++)
             assert_int_equal(plx_indirect_step(e, 65536, 1000u * (uint64_t)sd + k + 1), PLX_OK);
         for (i = 0; i < np; i++) {
             double g = final_gather_rgb(e->ph, e->ph->T, e->lt, P + 3 * i, N + 3 * i,
                                         FINAL_GATHER_SIDE, (uint64_t)sd + 1, NULL);
-            double p = photon_indirect(e->ph, P + 3 * i, N + 3 * i);
+            double p = photon_indirect(e->ph, P + 3 * i, N + 3 * i), p2;
+            r0 = e->ph->cfg.lookup_radius;
+            e->ph->cfg.lookup_radius = 0.0;
+            p2 = photon_indirect(e->ph, P + 3 * i, N + 3 * i);
+            e->ph->cfg.lookup_radius = r0;
+            e2 += fabs(p2 - ref[i]) / ref[i];
             eg += fabs(g - ref[i]) / ref[i];
             ep += fabs(p - ref[i]) / ref[i];
         }
     }
     *err_gather = eg / (np * seeds);
     *err_photons = ep / (np * seeds);
-    printf("%s: %d points, reference %d paths (its noise %.4f), %d seeds of 8 x 65536 photons: "
-           "mean relative error gathered %.4f, photon buffers alone %.4f\n",
-           name, np, paths, noise, seeds, *err_gather, *err_photons);
+    printf("%s: %d points, reference %d paths (its noise %.4f), %d seeds of 16 x 65536 photons: "
+           "mean relative error gathered %.4f, photon buffers alone %.4f (2 x 2 lookup %.4f)\n",
+           name, np, paths, noise, seeds, *err_gather, *err_photons, e2 / (np * seeds));
     assert_true(noise < (quick_mode() ? 0.04 : 0.01));
     free(P);
     free(N);
