@@ -510,6 +510,17 @@ plx_status plx_indirect_set_viewer(plx_engine *e, const double eye[3], const dou
 /* Drops every accumulated photon (none yet: nothing to do). Errors: only
  * the invalid handle. Threads: engine. */
 plx_status plx_indirect_reset(plx_engine *e);
+/*
+ * How plx_illuminance and plx_indirect_rgb (and so routes) estimate
+ * E_indirect at points: final gathering over side x side stratified
+ * cosine-weighted directions (default 16: 256 directions), each gathering
+ * a (E_direct + E_photons) from the first surface it meets, E_direct exact,
+ * the photon buffers only for light that bounced before (README,
+ * "Indirect light"); side 0: the photon buffers' own estimate at the point
+ * (the older method). Images always read the photon buffers. Errors:
+ * PLX_E_INVALID (side > 1024).
+ */
+plx_status plx_indirect_set_gather(plx_engine *e, uint32_t side);
 
 /*
  * Histogram matching of a day orthophoto to a night palette (munoz2013
