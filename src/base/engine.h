@@ -50,6 +50,11 @@ plx_status eng_need_light(plx_engine *e, const char *fn);
 double eng_indirect(plx_engine *e, const double P[3], const double n[3]);
 /* The same, also writing its RGB version to rgb (may be NULL); returns the scalar. */
 double eng_indirect_rgb(plx_engine *e, const double P[3], const double n[3], double rgb[3] /* OUT */);
+/* Debug builds (PLX_DEBUG): asserts the invariants of a loaded scene (rings
+ * of at least 3 vertices inside the point array, buildings' and blocks'
+ * rings inside the ring arrays, every building in its block, lamps finite).
+ * Release builds: nothing. */
+void eng_check_scene(const scene *s);
 /* Checks the engine handle for API misuse. */
 int eng_ok(const plx_engine *e);
 

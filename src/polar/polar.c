@@ -28,6 +28,7 @@
 #include "polar/polar.h"
 #include "base/msort.h"
 #include "base/geom.h"
+#include "base/plx_assert.h"
 
 enum { UL = 0, LL = 1, UR = 2, LR = 3 };
 /* search nodes: a leaf, a point (x) test, a segment (y) test whose frame-left
@@ -2629,6 +2630,7 @@ int32_t polar_locate(const polar *pd, int q, vec2 p, int32_t *owner)
     quadrant_side(q, &mi, &top);
     m = &pd->map[mi];
     t = dag_locate(pd, m, to_frame(m->frame, p), owner, NULL);
+    PLX_ASSERT(t >= -3 && (t < 0 || (uint32_t)t < m->ntrap)); /* a region of this map */
     if (t >= 0 && owner)
         *owner = seg_owner(pd, top ? m->trap[t].top : m->trap[t].bot);
     return t;
@@ -2835,6 +2837,7 @@ int polar_region(const polar *pd, int q, uint32_t i, vec2 c[4], int32_t *owner, 
     c[3] = polar_from_frame(m->frame, seg_at(pd, m->frame, m->trap[i].top, ul));
     if (owner)
         *owner = seg_owner(pd, top ? m->trap[i].top : m->trap[i].bot);
+    PLX_ASSERT(!owner || (*owner >= -1 && *owner < (int32_t)pd->nbld)); /* a building or the frame */
     if (solid)
         *solid = 0;
     return 4;
