@@ -5,7 +5,8 @@
 #   make demo       build and run the main job on the bundled fixtures
 #   make check      unit + command-line tests, quick (long loops shortened)
 #   make check-full the same with the full loops and bounds (a few minutes)
-#   make asan       the same tests under AddressSanitizer + UBSan
+#   make asan       the same tests under AddressSanitizer + UBSan, with the
+#                   core's invariant checks (PLX_DEBUG, src/base/plx_assert.h)
 #   make valgrind   the unit tests under valgrind memcheck
 #   make bench      benchmarks (tests/bench)
 #   make check-identical BASE=rev   outputs byte-identical to revision rev
@@ -56,11 +57,11 @@ LIB_SO_REAL = $(BUILD)/libpolarlux.so.$(VERSION)
 LIB_SO = $(BUILD)/libpolarlux.so
 PORT_A = $(BUILD)/libpolarlux-port.a
 BIN    = $(BUILD)/polarlux
-DEB_PACKAGES = libcjson-dev libcmocka-dev libpng-dev pkg-config
+DEB_PACKAGES = libcjson-dev libcmocka-dev libpng-dev pkg-config python3-numpy python3-pytest
 
 .SECONDARY:
 .PHONY: all deps demo check check-full check-build unit cli-test asan valgrind bench install clean \
-        check-core-headers check-identical check-lib-split
+        check-core-headers check-identical check-lib-split check-examples check-python
 
 all: $(LIB_A) $(LIB_SO) $(PORT_A) $(BIN)
 
@@ -135,12 +136,43 @@ demo: all
 # photon count, ...); a few minutes. CI runs both.
 check: check-build
 	@PLX_TEST_QUICK=1 sh tests/run_tests.sh $(BUILD) $(TESTS)
+	@$(MAKE) --no-print-directory check-examples check-python
 
 check-full: check-build
 	@sh tests/run_tests.sh $(BUILD) $(TESTS)
+	@$(MAKE) --no-print-directory check-examples check-python
 
 check-build:
-	@$(MAKE) --no-print-directory -j$(JOBS) all $(TESTS) check-core-headers check-lib-split
+	@$(MAKE) --no-print-directory -j$(JOBS) all $(TESTS) $(EXAMPLES) check-core-headers check-lib-split
+
+# examples/: programs that embed the engine as an application would. Each
+# links the core library alone (no port, no libpng, no pthreads) and checks
+# its own results: make check runs them.
+EXAMPLES = $(patsubst examples/%.c,$(BUILD)/examples/%,$(wildcard examples/*.c))
+$(BUILD)/examples/%: examples/%.c $(LIB_A)
+	@mkdir -p $(@D)
+	$(CC) -Iinclude $(CFLAGS_ALL) -o $@ $< $(LIB_A) $(CORE_LIBS)
+
+# python/: the ctypes package over $(LIB_SO), tested with Debian's pytest and
+# numpy (/usr/bin/python3: a python3 earlier on PATH may not see them). A
+# run that collects no tests (pytest's exit 5) fails. Sanitizer builds skip
+# it, saying so: the interpreter cannot load an instrumented library.
+PYTHON ?= /usr/bin/python3
+check-python: $(LIB_SO) $(BIN)
+	@case "$(EXTRA_CFLAGS)" in *sanitize*) \
+	  echo "python: skipped in this sanitizer build (make check runs it)"; exit 0;; esac; \
+	log=$(CURDIR)/$(BUILD)/python-tests.log; \
+	(cd python && PYTHONDONTWRITEBYTECODE=1 POLARLUX_LIB=$(CURDIR)/$(LIB_SO) POLARLUX_BIN=$(CURDIR)/$(BIN) \
+	  $(PYTHON) -m pytest -q -p no:cacheprovider tests) >$$log 2>&1; rc=$$?; \
+	if [ $$rc -eq 5 ]; then echo "python: pytest collected no tests (exit 5)"; exit 1; fi; \
+	if [ $$rc -ne 0 ]; then cat $$log; echo "python: FAILED (pytest exit $$rc)"; exit 1; fi; \
+	echo "ok   python: $$(tail -1 $$log)"
+
+check-examples: $(EXAMPLES)
+	@for x in $(EXAMPLES); do \
+	  $$x >$$x.log 2>&1 || { cat $$x.log; echo "example $$x: FAILED"; exit 1; }; \
+	  echo "ok   example $$(basename $$x): $$(grep -c '^ok ' $$x.log) checks"; \
+	done
 
 unit: $(TESTS)
 	@for t in $(TESTS); do $$t || exit 1; done
@@ -175,7 +207,7 @@ check-core-headers:
 
 asan:
 	$(MAKE) BUILD=build/asan OPT="-O1 -g -fno-omit-frame-pointer" \
-	  EXTRA_CFLAGS="-fsanitize=address,undefined -fno-sanitize-recover=all" check
+	  EXTRA_CFLAGS="-fsanitize=address,undefined -fno-sanitize-recover=all -DPLX_DEBUG" check
 
 valgrind: all $(TESTS)
 	@for t in $(TESTS); do \

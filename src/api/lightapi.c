@@ -135,7 +135,7 @@ static plx_status point_loop(plx_engine *e, size_t n, const double *P, const dou
             light_illuminance(e->lt, p, nn, &o->E_direct[k], o->rgb ? o->rgb + 3 * k : NULL);
         if (o->E_indirect || o->rgb_ind) {
             double *ri = o->rgb_ind ? o->rgb_ind + 3 * k : NULL;
-            double Ei = where == 0 ? eng_indirect_rgb(e, p, nn, ri) : eng_indirect_free(e, p, ri);
+            double Ei = where == 0 ? eng_indirect_rgb(e, p, nn, ri) : eng_indirect_free(e, p, nn, ri);
             if (o->E_indirect)
                 o->E_indirect[k] = Ei;
         }

@@ -11,8 +11,9 @@ static const char help[] =
     "usage: polarlux meter SCENE --points FILE [--quantity h,v,sc,hs] [--height M] [options]\n"
     "\n"
     "Light meters (SPEC §6, EN 13201): direct illuminance at points in free air\n"
-    "or on surfaces. FILE has lines 'x y [z [ux uy]]' (local metres; '-' reads\n"
-    "standard input, '#' starts a comment): z defaults to --height, the facing\n"
+    "or on surfaces. FILE has lines 'x y [z [ux uy]]' (x y in the scene's\n"
+    "coordinates as for 'polarlux illum', or --points-crs; z in metres; '-'\n"
+    "reads standard input, '#' starts a comment): z defaults to --height, the facing\n"
     "direction (ux, uy) of E_v and E_sc to east (+x). Prints one line per point:\n"
     "'x y z' then the asked quantities in the order given, in lux:\n"
     "  h   horizontal illuminance E_h (normal +z)\n"
@@ -25,7 +26,7 @@ static const char help[] =
     "  --points FILE    the points (required)\n"
     "  --quantity LIST  comma-separated, any order (default h,v,sc,hs)\n"
     "  --height M       z of points that give none (default 1.5)\n"
-    "  --mem SIZE, --strict, --quiet   as for 'polarlux info'\n";
+    "  --mem SIZE, --strict, --quiet, --lamps FILE   as for 'polarlux info'\n";
 
 /* Parses "h,v,sc,hs" into PLX_METER_* indices; the count, or -1. */
 static int parse_quantities(const char *s, int q[16])
@@ -48,7 +49,7 @@ static int parse_quantities(const char *s, int q[16])
     return n;
 }
 
-static int run(plx_engine *e, const char *file, const points *pts, const int *q, int nq)
+static int run(plx_engine *e, const char *file, const points *pts, const double *given, const int *q, int nq)
 {
     size_t k;
     int failed = 0, i;
@@ -67,7 +68,7 @@ static int run(plx_engine *e, const char *file, const points *pts, const int *q,
             fprintf(stderr, "polarlux meter: %s\n", plx_last_error(e));
             return cli_exit_code(st);
         }
-        printf("%.17g %.17g %.17g", p[0], p[1], p[2]);
+        printf("%.17g %.17g %.17g", given[2 * k], given[2 * k + 1], p[2]);
         for (i = 0; i < nq; i++)
             printf(" %.17g", m[q[i]]);
         printf("\n");
@@ -82,7 +83,7 @@ int cmd_meter(int argc, char **argv)
     plx_engine *e;
     points pts;
     char err[512];
-    double fill[5] = { 0, 0, 1.5, 1, 0 };
+    double fill[5] = { 0, 0, 1.5, 1, 0 }, *given = NULL;
     int q[16] = { PLX_METER_H, PLX_METER_V, PLX_METER_SC, PLX_METER_HS }, nq = 4, i, rc;
     memset(&c, 0, sizeof c);
     for (i = 1; i < argc; i++) {
@@ -128,7 +129,10 @@ int cmd_meter(int argc, char **argv)
         points_free(&pts);
         return rc;
     }
-    rc = run(e, file, &pts, q, nq);
+    rc = cli_points_local("meter", e, &c, file, &pts, &given);
+    if (rc == EXIT_OK)
+        rc = run(e, file, &pts, given, q, nq);
+    free(given);
     if (rc == EXIT_OK && pts.n == 0)
         fprintf(stderr, "polarlux meter: %s holds no points\n", file);
     points_free(&pts);

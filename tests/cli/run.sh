@@ -63,7 +63,7 @@ expect vis-at 0 "^# visible: 3 of 3 buildings" -- "$bin" vis -q fixtures/tiny.ge
 expect vis-at-fov 0 "^2 C$" -- "$bin" vis -q fixtures/tiny.geojson --at 50,10 --dir 90 --fov 60
 expect vis-geojson 0 "" -- "$bin" vis -q fixtures/tiny.geojson --points "$tmp/p.txt" --geojson "$tmp/v.geojson"
 expect vis-geojson-loads 0 "^buildings: 2 " -- "$bin" info -q "$tmp/v.geojson"
-expect vis-helsinki-lonlat 0 "" -- "$bin" vis -q fixtures/helsinki-centre.geojson --at 0,0 --geojson "$tmp/h.geojson"
+expect vis-helsinki-lonlat 0 "" -- "$bin" vis -q fixtures/helsinki-centre.geojson --at 24.9442961,60.1716264 --geojson "$tmp/h.geojson"
 expect vis-helsinki-geojson-lonlat 0 "^coordinates: WGS84 lon/lat" -- "$bin" info -q "$tmp/h.geojson"
 expect draw-missing-q 2 "missing --polar Q" -- "$bin" draw fixtures/tiny.geojson -o "$tmp/d.png"
 expect draw-bad-q 2 "--polar '7' is not a quadrant 0..3" -- "$bin" draw fixtures/tiny.geojson --polar 7 -o "$tmp/d.png"
@@ -126,8 +126,9 @@ expect info-photometry 0 "^photometry: photometry/street-type2\\.ies \\(IES\\) f
 expect meter-help 0 "^usage: polarlux meter" -- "$bin" meter --help
 expect meter-unknown-option 2 "polarlux meter: unknown option '--bogus'" -- "$bin" meter --bogus x
 expect illum-free-air 0 "^50 10 1.5 [0-9.]+(e-?[0-9]+)? 0$" -- sh -c "echo '50 10 1.5 1 0 0' | '$bin' illum -q --no-indirect fixtures/tiny.geojson --points -"
-expect meter-columns 0 "^0 -431.5 1.5 [0-9.]+ [0-9.]+$" -- sh -c "echo '0 -431.5' | '$bin' meter -q fixtures/helsinki-street-luminaires.geojson --points - --quantity sc,h"
-expect meter-height 0 "^0 -431.5 3 [0-9.]+ [0-9.]+ [0-9.]+ [0-9.]+$" -- sh -c "echo '0 -431.5' | '$bin' meter -q fixtures/helsinki-centre.geojson --points - --height 3"
+expect meter-columns 0 "^0 -431.5 1.5 [0-9.]+ [0-9.]+$" -- sh -c "echo '0 -431.5' | '$bin' meter -q fixtures/helsinki-street-luminaires.geojson --points-crs local --points - --quantity sc,h"
+expect meter-height 0 "^0 -431.5 3 [0-9.]+ [0-9.]+ [0-9.]+ [0-9.]+$" -- sh -c "printf '# crs: local\\n0 -431.5\\n' | '$bin' meter -q fixtures/helsinki-centre.geojson --points - --height 3"
+expect meter-lonlat 0 "^24.944299+[0-9]* 60.16770+[0-9]* 1.5 [0-9.]+$" -- sh -c "echo '24.9443 60.1677' | '$bin' meter -q fixtures/helsinki-street-luminaires.geojson --points - --quantity sc"
 expect meter-inside 1 "polarlux meter: -:1: point \\(5, 5, 3\\) is inside a building's solid" -- sh -c "echo '5 5 3' | '$bin' meter -q fixtures/tiny.geojson --points -"
 expect meter-bad-quantity 2 "--quantity 'x' is not a list of h, v, sc, hs" -- "$bin" meter fixtures/tiny.geojson --points - --quantity x
 expect route-facial 0 "class_fr$" -- "$bin" route -q fixtures/helsinki-street-luminaires.geojson --path fixtures/helsinki-route.geojson --step 4
@@ -143,6 +144,7 @@ printf 'IESNA:LM-63-2002\nTILT=NONE\n1 -1 1 2 1 1 2 0 0 0\n1 1 0\n0 90\n0\n100\n
 expect photometry-short 1 "l\\.ies: line 7: table too short" -- "$bin" info "$tmp/ph/s.geojson"
 printf 'IESNA:LM-63-2002\nTILT=NONE\n1 -1 1 2 1 1 2 0 0 0\n1 1 0\n0 90\n0\n100 0\n' >"$tmp/ph/l.ies"
 expect photometry-nadir 0 "^0 0 0 2\\.768895999" -- sh -c "echo '0 0' | '$bin' illum -q --no-indirect '$tmp/ph/s.geojson' --points -"
+. tests/cli/gis.sh
 ls "$tmp"/*.tmp* >/dev/null 2>&1 && { echo "FAIL temporary files left"; fail=$((fail + 1)); }
 echo "cli: $pass passed, $fail failed"
 [ "$fail" -eq 0 ]
