@@ -57,6 +57,12 @@ double eng_indirect_rgb(plx_engine *e, const double P[3], const double n[3], dou
 /* E_indirect read from the photon buffers alone (images; indirectapi.c). */
 double eng_indirect_photons_rgb(plx_engine *e, const double P[3], const double n[3],
                                 double rgb[3] /* OUT */);
+
+/* Debug builds (PLX_DEBUG): asserts the invariants of a loaded scene (rings
+ * of at least 3 vertices inside the point array, buildings' and blocks'
+ * rings inside the ring arrays, every building in its block, lamps finite).
+ * Release builds: nothing. */
+void eng_check_scene(const scene *s);
 /* Checks the engine handle for API misuse. */
 int eng_ok(const plx_engine *e);
 

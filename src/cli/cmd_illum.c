@@ -29,7 +29,7 @@ static const char help[] =
     "                 photon buffers' own estimate at the point (the older\n"
     "                 method: give it --frames 256)\n"
     "  --no-indirect  direct light only (E_indirect 0)\n"
-    "  --mem SIZE, --strict, --quiet   as for 'polarlux info'\n";
+    "  --mem SIZE, --strict, --quiet, --lamps FILE   as for 'polarlux info'\n";
 
 int cmd_illum(int argc, char **argv)
 {
@@ -40,7 +40,7 @@ int cmd_illum(int argc, char **argv)
     plx_engine *e;
     points pts;
     char err[512];
-    double *ed, *ei;
+    double *ed, *ei, *given = NULL;
     size_t k;
     int i, rc, failed = 0;
     memset(&c, 0, sizeof c);
@@ -83,6 +83,12 @@ int cmd_illum(int argc, char **argv)
         points_free(&pts);
         return rc;
     }
+    rc = cli_points_local("illum", e, &c, file, &pts, &given);
+    if (rc != EXIT_OK) {
+        points_free(&pts);
+        plx_engine_free(e);
+        return rc;
+    }
     if (!ind.off && pts.n > 0) {
         double eye[3] = { 0, 0, 1.7 };
         for (k = 0; k < pts.n; k++) {
@@ -91,6 +97,7 @@ int cmd_illum(int argc, char **argv)
         }
         rc = cli_indirect_run("illum", e, &ind, eye, NULL, 360.0);
         if (rc != EXIT_OK) {
+            free(given);
             points_free(&pts);
             plx_engine_free(e);
             return rc;
@@ -114,10 +121,15 @@ int cmd_illum(int argc, char **argv)
             rc = cli_exit_code(st);
             goto done;
         }
-        printf("%.17g %.17g %.17g %.17g %.17g\n", p[0], p[1], p[2], ed[k], ei[k]);
+        printf("%.17g %.17g %.17g %.17g %.17g\n", given[2 * k], given[2 * k + 1], p[2], ed[k], ei[k]);
     }
     rc = failed ? EXIT_FAIL : EXIT_OK;
+    for (k = 0; k < pts.n && !(ed[k] + ei[k] > 0); k++)
+        ;
+    if (pts.n > 0 && k == pts.n)
+        cli_warn("illum", &c, "every point is dark (0 lx): %s", cli_dark_reason(e));
 done:
+    free(given);
     free(ed);
     free(ei);
     points_free(&pts);
