@@ -24,6 +24,7 @@ CPPFLAGS = -Iinclude -Isrc -Iport
 CFLAGS_ALL = $(WARN) $(FPFLAGS) $(OPT) -fPIC -MMD -MP $(EXTRA_CFLAGS)
 POSIX    = -D_POSIX_C_SOURCE=200809L
 LIBS     = -lcjson -lpng -lm -lpthread
+CLI_LIBS = -lsqlite3
 
 CORE_DIRS = base scene polar light photon render api
 CORE_SRC = $(foreach d,$(CORE_DIRS),$(wildcard src/$(d)/*.c))
@@ -45,7 +46,7 @@ LIB_SO = $(BUILD)/libpolarlux.so
 BIN    = $(BUILD)/polarlux
 
 VERSION = $(shell sed -n 's/^\#define PLX_VERSION_STRING "\(.*\)"/\1/p' include/polarlux.h)
-DEB_PACKAGES = libcjson-dev libcmocka-dev libpng-dev pkg-config
+DEB_PACKAGES = libcjson-dev libcmocka-dev libpng-dev pkg-config libsqlite3-dev
 
 .SECONDARY:
 .PHONY: all deps demo check check-full check-build unit cli-test asan valgrind bench install clean \
@@ -93,7 +94,7 @@ $(LIB_SO): $(CORE_OBJ) $(PORT_OBJ)
 	  -o $@ $^ $(LIBS)
 
 $(BIN): $(CLI_OBJ) $(LIB_A)
-	$(CC) $(CFLAGS_ALL) -o $@ $(CLI_OBJ) $(LIB_A) $(LIBS)
+	$(CC) $(CFLAGS_ALL) -o $@ $(CLI_OBJ) $(LIB_A) $(LIBS) $(CLI_LIBS)
 
 $(BUILD)/tests/test_%: $(BUILD)/tests/unit/test_%.o $(REF_OBJ) $(LIB_A)
 	$(CC) $(CFLAGS_ALL) -o $@ $< $(REF_OBJ) $(LIB_A) -lcmocka $(LIBS)

@@ -24,7 +24,7 @@ expect help 0 "^usage: polarlux COMMAND" -- "$bin" --help
 expect no-args 2 "^usage: polarlux COMMAND" -- "$bin"
 expect version 0 "^polarlux [0-9]+\.[0-9]+\.[0-9]+$" -- "$bin" --version
 expect unknown-command 2 "unknown command 'frobnicate'" -- "$bin" frobnicate
-for c in info gen vis draw illum lit heatmap render nightify route dark-spots; do
+for c in info gen vis draw illum lit heatmap render nightify route dark-spots tiles annotate; do
     expect "$c-help" 0 "^usage: polarlux $c" -- "$bin" $c --help
     expect "$c-unknown-option" 2 "polarlux $c: unknown option '--bogus'" -- "$bin" $c --bogus x
 done
