@@ -167,3 +167,35 @@ clean:
 	rm -rf build
 
 include tests/hardening.mk
+
+# ---- web map demo (Leaflet from the npm registry, served on 127.0.0.1) ---------
+# make web-deps   npm ci in web/ (Leaflet into web/node_modules; needs npm)
+# make web-data   tiles, the best-lit route and the scene for the page, in web/data
+# make web-demo   both, then serves web/ on http://127.0.0.1:$(WEB_PORT)/
+# make check-web  headless Chromium screenshot of the page, checked by its pixels
+WEB_PORT  ?= 8765
+WEB_SCENE ?= fixtures/helsinki-centre.geojson
+WEB_NET   ?= fixtures/helsinki-streets.geojson
+WEB_FROM  ?= 24.9400,60.1660
+WEB_TO    ?= 24.9480,60.1770
+.PHONY: web-deps web-data web-demo check-web
+
+web-deps: web/node_modules/leaflet/dist/leaflet.js
+
+web/node_modules/leaflet/dist/leaflet.js: web/package.json web/package-lock.json
+	cd web && npm ci --no-audit --no-fund
+	@touch $@
+
+web-data: $(BIN)
+	@mkdir -p web/data
+	$(BIN) tiles $(WEB_SCENE) --quiet --zoom 14-17 -o web/data/tiles
+	$(BIN) route $(WEB_SCENE) --quiet --network $(WEB_NET) --from $(WEB_FROM) --to $(WEB_TO) \
+	  --geojson web/data/route.geojson
+	cp $(WEB_SCENE) web/data/scene.geojson
+
+web-demo: web-deps web-data
+	@echo "serving web/ on http://127.0.0.1:$(WEB_PORT)/ (Ctrl-C stops)"
+	cd web && python3 -m http.server $(WEB_PORT) --bind 127.0.0.1
+
+check-web: web-deps web-data
+	@sh tests/web/check_web.sh web build/web
