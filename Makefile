@@ -99,6 +99,17 @@ $(BIN): $(CLI_OBJ) $(LIB_A)
 $(BUILD)/tests/test_%: $(BUILD)/tests/unit/test_%.o $(REF_OBJ) $(LIB_A)
 	$(CC) $(CFLAGS_ALL) -o $@ $< $(REF_OBJ) $(LIB_A) -lcmocka $(LIBS)
 
+# Tests and benches of the command's network and tile code link those objects.
+CLI_TEST_OBJ = $(addprefix $(BUILD)/src/cli/,network.o route_io.o geo_out.o tiles.o mbtiles.o cmd_heatmap.o \
+               canvas.o common.o cmd_network.o cmd_tiles.o cmd_route.o)
+CLI_TESTS = $(BUILD)/tests/test_network $(BUILD)/tests/test_tiles $(BUILD)/bench/bench_network
+$(CLI_TESTS): $(CLI_TEST_OBJ)
+$(BUILD)/tests/test_network $(BUILD)/tests/test_tiles: $(BUILD)/tests/test_%: $(BUILD)/tests/unit/test_%.o $(REF_OBJ) $(LIB_A)
+	$(CC) $(CFLAGS_ALL) -o $@ $< $(CLI_TEST_OBJ) $(REF_OBJ) $(LIB_A) -lcmocka $(LIBS) $(CLI_LIBS)
+$(BUILD)/bench/bench_network: $(BUILD)/tests/bench/bench_network.o $(REF_OBJ) $(LIB_A)
+	@mkdir -p $(@D)
+	$(CC) $(CFLAGS_ALL) -o $@ $< $(CLI_TEST_OBJ) $(REF_OBJ) $(LIB_A) $(LIBS) $(CLI_LIBS)
+
 $(BUILD)/bench/bench_%: $(BUILD)/tests/bench/bench_%.o $(REF_OBJ) $(LIB_A)
 	@mkdir -p $(@D)
 	$(CC) $(CFLAGS_ALL) -o $@ $< $(REF_OBJ) $(LIB_A) $(LIBS)

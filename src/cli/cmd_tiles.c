@@ -223,7 +223,7 @@ static int parse(int argc, char **argv, tiles_opts *o)
     return EXIT_OK;
 }
 
-#define MAX_TILES 200000L
+#define MAX_TILES 20000L
 
 int cmd_tiles(int argc, char **argv)
 {
