@@ -157,18 +157,10 @@ static int parse(net_opts *o, int argc, char **argv, const char *help)
 /* "X,Y" in the scene's coordinates to local metres. */
 static int parse_point(plx_engine *e, const char *s, double *x, double *y)
 {
-    plx_scene_info si;
     char extra;
     if (sscanf(s, "%lf,%lf%c", x, y, &extra) != 2 || !isfinite(*x) || !isfinite(*y))
         return -1;
-    plx_scene_info_get(e, &si);
-    if (si.lonlat) {
-        if (fabs(*x) > 180 || fabs(*y) > 90)
-            return -1;
-        *x = (*x - si.lon0) * 111320.0 * cos(si.lat0 * 3.14159265358979323846 / 180.0);
-        *y = (*y - si.lat0) * 110540.0;
-    }
-    return 0;
+    return cli_to_local(e, x, y);
 }
 
 /* Loads the network and scores its edges; prints the error and returns an

@@ -12,6 +12,7 @@
 #include <time.h>
 
 #include "polarlux.h"
+#include "polarlux_port.h"
 #include "port.h"
 #include "cli/network.h"
 

@@ -63,7 +63,7 @@ expect vis-at 0 "^# visible: 3 of 3 buildings" -- "$bin" vis -q fixtures/tiny.ge
 expect vis-at-fov 0 "^2 C$" -- "$bin" vis -q fixtures/tiny.geojson --at 50,10 --dir 90 --fov 60
 expect vis-geojson 0 "" -- "$bin" vis -q fixtures/tiny.geojson --points "$tmp/p.txt" --geojson "$tmp/v.geojson"
 expect vis-geojson-loads 0 "^buildings: 2 " -- "$bin" info -q "$tmp/v.geojson"
-expect vis-helsinki-lonlat 0 "" -- "$bin" vis -q fixtures/helsinki-centre.geojson --at 0,0 --geojson "$tmp/h.geojson"
+expect vis-helsinki-lonlat 0 "" -- "$bin" vis -q fixtures/helsinki-centre.geojson --at 24.9442961,60.1716264 --geojson "$tmp/h.geojson"
 expect vis-helsinki-geojson-lonlat 0 "^coordinates: WGS84 lon/lat" -- "$bin" info -q "$tmp/h.geojson"
 expect draw-missing-q 2 "missing --polar Q" -- "$bin" draw fixtures/tiny.geojson -o "$tmp/d.png"
 expect draw-bad-q 2 "--polar '7' is not a quadrant 0..3" -- "$bin" draw fixtures/tiny.geojson --polar 7 -o "$tmp/d.png"
@@ -121,28 +121,8 @@ printf '{"type": "FeatureCollection", "properties": {"units": "m", "ground_image
 expect ground-image-bad-strict 1 "polarlux info: $tmp/gi/bad\.geojson: properties\.ground_image must be the path of a PNG file" -- "$bin" info --strict "$tmp/gi/bad.geojson"
 expect ground-image-bad-lenient 0 "warning: $tmp/gi/bad\.geojson: properties\.ground_image must be the path of a PNG file \(a non-empty string of at most 4096 bytes\); ignored" -- "$bin" info "$tmp/gi/bad.geojson"
 expect ground-image-nomem 3 "out of memory while storing the ground image" -- "$bin" info --mem 15K fixtures/ground-image.geojson
-# ---- route --network, annotate (best-lit walking routes; issue 15) ----
-net="fixtures/net-detour.geojson --network fixtures/net-detour-streets.geojson"
-expect net-best-lit 0 "^best-lit +300\.0 +69\.0 .*\+50\.0%$" -- "$bin" route -q $net --from 0,0 --to 200,0 --geojson "$tmp/net.geojson"
-expect net-shortest 0 "^shortest +200\.0 +200\.0 +0\.000 +0\.000  - +\+0\.0%$" -- "$bin" route -q $net --from 0,0 --to 200,0
-expect net-geojson 0 "" -- sh -c "grep -q '\"route\":\"best-lit\"' '$tmp/net.geojson' && grep -q '\"route\":\"shortest\"' '$tmp/net.geojson' && grep -q '\"mean_lux\"' '$tmp/net.geojson'"
-expect net-light-weight 0 "^best-lit +200\.0 +200\.0 " -- "$bin" route -q $net --from 0,0 --to 200,0 --dark-weight 0.5
-expect net-max-detour 0 "^best-lit +200\.0 " -- "$bin" route -q $net --from 0,0 --to 200,0 --max-detour 0.2
-expect net-max-detour-says 0 "weight lowered from 3 by --max-detour 0\.2" -- "$bin" route -q $net --from 0,0 --to 200,0 --max-detour 0.2
-expect net-max-detour-loose 0 "^best-lit +300\.0 " -- "$bin" route -q $net --from 0,0 --to 200,0 --max-detour 0.6
-expect net-far-start 1 "route: --from 0,-80 is 80\.0 m from the nearest street of fixtures/net-detour-streets\.geojson \(more than --snap 50 m\)" -- "$bin" route -q $net --from 0,-80 --to 200,0
-expect net-unreachable 1 "no path from --from 0,0 to --to 410,400: they lie on unconnected parts of the network \(it has 2 parts\)" -- "$bin" route -q $net --from 0,0 --to 410,400
-printf '{"type":"FeatureCollection","properties":{"units":"m"},"features":[]}' >"$tmp/empty-net.json"
-expect net-empty 1 "route: $tmp/empty-net\.json: no LineString features" -- "$bin" route -q fixtures/net-detour.geojson --network "$tmp/empty-net.json" --from 0,0 --to 1,1
-expect net-missing-to 2 "--network needs --from X,Y and --to X,Y" -- "$bin" route -q $net --from 0,0
-expect net-help 0 "cost = length \+ W x dark metres" -- "$bin" route --network x --help
-expect net-helsinki 0 "^cost = length .*network [0-9]+ nodes, [0-9]+ edges" -- "$bin" route -q fixtures/helsinki-centre.geojson --network fixtures/helsinki-streets.geojson --from 24.9400,60.1660 --to 24.9480,60.1770
-expect annotate 0 "^annotate: 6 edges, 6 nodes, 570 m of street" -- "$bin" annotate -q $net -o "$tmp/ann.geojson" --csv "$tmp/ann.csv"
-expect annotate-csv 0 "^way/2,300\.000,69\.000,0\.000,0\.2300,9\.4414,0\.0000,-,1\.6900$" -- cat "$tmp/ann.csv"
-expect annotate-csv-head 0 "^osm_id,length_m,dark_m,blocked_m,dark_share,mean_lux,min_lux,class,factor$" -- cat "$tmp/ann.csv"
-expect annotate-missing-o 2 "missing -o OUT.geojson" -- "$bin" annotate -q $net
-expect tiles-metres 1 "the scene is in local metres, with no lon/lat" -- "$bin" tiles -q fixtures/tiny.geojson --zoom 15 -o "$tmp/t"
-expect tiles-quantity 2 "--quantity 'sc' is not available" -- "$bin" tiles -q fixtures/helsinki-centre.geojson --zoom 15 --quantity sc -o "$tmp/t"
+. tests/cli/gis.sh
+. tests/cli/network.sh
 ls "$tmp"/*.tmp* >/dev/null 2>&1 && { echo "FAIL temporary files left"; fail=$((fail + 1)); }
 echo "cli: $pass passed, $fail failed"
 [ "$fail" -eq 0 ]

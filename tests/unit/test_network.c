@@ -12,6 +12,7 @@
 #include <cmocka.h>
 
 #include "polarlux.h"
+#include "polarlux_port.h"
 #include "cli/network.h"
 
 #define MEM ((size_t)256 << 20)

@@ -14,6 +14,7 @@
 #include <sqlite3.h>
 
 #include "polarlux.h"
+#include "polarlux_port.h"
 #include "port.h"
 #include "cli/cli.h"
 #include "cli/tiles.h"
@@ -93,7 +94,12 @@ static void test_tile_pixels_equal_heatmap(void **state)
         tile_pixel_lonlat(16, ((x0 + x1) / 2) * 256.0 + p % TILE_SIZE + 0.5, ((y0 + y1) / 2) * 256.0 + p / TILE_SIZE + 0.5,
                           &lon, &lat);
         tile_local(&si, lon, lat, &gx, &gy);
-        snprintf(box, sizeof box, "%.17g,%.17g,%.17g,%.17g", gx - 0.005, gy - 0.005, gx + 0.005, gy + 0.005);
+        { /* --box takes the scene's own coordinates: lon/lat here */
+            double bx0 = gx - 0.005, by0 = gy - 0.005, bx1 = gx + 0.005, by1 = gy + 0.005;
+            cli_from_local(e, &bx0, &by0);
+            cli_from_local(e, &bx1, &by1);
+            snprintf(box, sizeof box, "%.17g,%.17g,%.17g,%.17g", bx0, by0, bx1, by1);
+        }
         snprintf(path, sizeof path, "build/test_tiles_hm_%d.png", (int)getpid());
         assert_int_equal(run(cmd_heatmap, 11, argv), 0);
         assert_int_equal(image_read_png_rgb8(path, NULL, 0, &img, &iw, &ih, NULL, 0), 0);
