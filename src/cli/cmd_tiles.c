@@ -84,6 +84,18 @@ static void lonlat_bounds(plx_engine *e, double b[4])
     b[3] = si.lat0 + si.bounds[3] / 110540.0;
 }
 
+/* The scene file's name without folder and extension (MBTiles "name"). */
+static const char *scene_name(const char *path, char *buf, size_t len)
+{
+    const char *base = strrchr(path, '/');
+    char *dot;
+    snprintf(buf, len, "%s", base ? base + 1 : path);
+    dot = strrchr(buf, '.');
+    if (dot && dot != buf)
+        *dot = '\0';
+    return buf;
+}
+
 static long count_tiles(plx_engine *e, const tiles_opts *o)
 {
     long total = 0, x0, y0, x1, y1;
@@ -103,7 +115,7 @@ static int run(plx_engine *e, const tiles_opts *o, double top)
     int z, rc = EXIT_OK, tty = isatty(2);
     tile_work w;
     mbtiles *mb = NULL;
-    char err[512];
+    char err[512], name[256];
     double b[4];
     memset(&w, 0, sizeof w);
     lonlat_bounds(e, b);
@@ -113,7 +125,7 @@ static int run(plx_engine *e, const tiles_opts *o, double top)
         return EXIT_FAIL;
     }
     if (ends_with(o->out, ".mbtiles") &&
-        !(mb = mbtiles_open(o->out, o->scene, b, (int)o->z0, (int)o->z1, top, err, sizeof err))) {
+        !(mb = mbtiles_open(o->out, scene_name(o->scene, name, sizeof name), b, (int)o->z0, (int)o->z1, top, err, sizeof err))) {
         fprintf(stderr, "polarlux tiles: %s\n", err);
         rc = EXIT_FAIL;
     }
