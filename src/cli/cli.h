@@ -96,5 +96,12 @@ int cmd_render(int argc, char **argv);
 int cmd_route(int argc, char **argv);
 int cmd_nightify(int argc, char **argv);
 int cmd_dark_spots(int argc, char **argv);
+/* route --network and annotate (cmd_network.c) */
+int cmd_route_network(int argc, char **argv);
+int cmd_annotate(int argc, char **argv);
+int cmd_tiles(int argc, char **argv);
+/* The heat map's colour scale (cmd_heatmap.c): 0 when lux is at or below its
+ * bottom (no light), else 1. */
+int heatmap_colour(double lux, double top, uint8_t rgb[3]);
 
 #endif

@@ -24,7 +24,7 @@ expect help 0 "^usage: polarlux COMMAND" -- "$bin" --help
 expect no-args 2 "^usage: polarlux COMMAND" -- "$bin"
 expect version 0 "^polarlux [0-9]+\.[0-9]+\.[0-9]+$" -- "$bin" --version
 expect unknown-command 2 "unknown command 'frobnicate'" -- "$bin" frobnicate
-for c in info gen vis draw illum lit heatmap render nightify route dark-spots; do
+for c in info gen vis draw illum lit heatmap render nightify route dark-spots tiles annotate; do
     expect "$c-help" 0 "^usage: polarlux $c" -- "$bin" $c --help
     expect "$c-unknown-option" 2 "polarlux $c: unknown option '--bogus'" -- "$bin" $c --bogus x
 done
@@ -128,6 +128,7 @@ expect ground-image-bad-strict 1 "polarlux info: $tmp/gi/bad\.geojson: propertie
 expect ground-image-bad-lenient 0 "warning: $tmp/gi/bad\.geojson: properties\.ground_image must be the path of a PNG file \(a non-empty string of at most 4096 bytes\); ignored" -- "$bin" info "$tmp/gi/bad.geojson"
 expect ground-image-nomem 3 "out of memory while storing the ground image" -- "$bin" info --mem 15K fixtures/ground-image.geojson
 . tests/cli/gis.sh
+. tests/cli/network.sh
 ls "$tmp"/*.tmp* >/dev/null 2>&1 && { echo "FAIL temporary files left"; fail=$((fail + 1)); }
 echo "cli: $pass passed, $fail failed"
 [ "$fail" -eq 0 ]
