@@ -50,7 +50,7 @@ DEB_PACKAGES = libcjson-dev libcmocka-dev libpng-dev pkg-config
 
 .SECONDARY:
 .PHONY: all deps demo check check-full check-build unit cli-test asan valgrind bench install clean \
-        check-core-headers check-identical
+        check-core-headers check-identical check-layers
 
 all: $(LIB_A) $(LIB_SO) $(BIN)
 
@@ -123,7 +123,13 @@ check-full: check-build
 	@sh tests/run_tests.sh $(BUILD) $(TESTS)
 
 check-build:
-	@$(MAKE) --no-print-directory -j$(JOBS) all $(TESTS) check-core-headers
+	@$(MAKE) --no-print-directory -j$(JOBS) all $(TESTS) check-core-headers check-layers
+
+# The include rule (tests/check_layers.sh): stages in data-flow order base <
+# scene < polar < light < photon < render < api, base/engine.h only in
+# src/api and src/base, no circles between files.
+check-layers:
+	@sh tests/check_layers.sh
 
 unit: $(TESTS)
 	@for t in $(TESTS); do $$t || exit 1; done

@@ -207,3 +207,19 @@ uint64_t plx_debug_fail_alloc(plx_engine *e, uint64_t k)
     e->mem.fail_at = k;
     return served;
 }
+
+void eng_warn(plx_engine *e, const char *msg)
+{
+    e->warnings++;
+    eng_log(e, PLX_LOG_WARN, msg);
+}
+
+int eng_strict(const plx_engine *e)
+{
+    return e->cfg.strict;
+}
+
+const plx_port *eng_port(const plx_engine *e)
+{
+    return &e->port;
+}

@@ -1,6 +1,6 @@
 /* litregion: per-lamp sector index (bands), lit ground and facade polygons,
  * and the LRU cache of regions (contract in light.h). */
-#include "light/light.h"
+#include "light/litregion.h"
 #include "base/geom.h"
 
 #include <math.h>

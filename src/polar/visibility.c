@@ -3,6 +3,7 @@
 #include <math.h>
 #include <string.h>
 #include "polar/visibility.h"
+#include "polar/locate.h"
 #include "base/geom.h"
 
 enum { UL = 0, LL = 1, UR = 2, LR = 3 };

@@ -5,7 +5,8 @@
 
 #include "render/render.h"
 #include "render/raster.h"
-#include "light/light.h"
+#include "light/illuminance.h"
+#include "light/litregion.h"
 #include "base/geom.h"
 
 #define R_ALIGN 16

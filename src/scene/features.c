@@ -5,7 +5,7 @@
 #include <string.h>
 #include <math.h>
 
-#include "scene/loader.h"
+#include "scene/features.h"
 #include "base/geom.h"
 
 #define MAX_COORD 1.0e7
@@ -133,7 +133,7 @@ static const char *copy_id(loader *ld, const cJSON *item)
     n = strlen(src);
     if (n > 200)
         n = 200;
-    dst = arena_alloc(&ld->e->mem, PLX_PART_SCENE, n + 1, 1);
+    dst = arena_alloc(ld->mem, PLX_PART_SCENE, n + 1, 1);
     if (!dst)
         return NULL;
     memcpy(dst, src, n);
@@ -236,7 +236,7 @@ static plx_status read_ring(loader *ld, const cJSON *jr, uint32_t ring, scene_ri
         sb_str(why, " (a ring needs at least 3)");
         return PLX_E_SCENE;
     }
-    simple = geom_ring_is_simple(&ld->e->mem, p, n, &ei, &ej);
+    simple = geom_ring_is_simple(ld->mem, p, n, &ei, &ej);
     if (simple < 0)
         return PLX_E_NOMEM;
     if (!simple) {
@@ -659,7 +659,7 @@ static plx_status set_frame(loader *ld, const counts *c)
 
 static void *alloc_array(loader *ld, size_t n, size_t size)
 {
-    return arena_alloc(&ld->e->mem, PLX_PART_SCENE, arena_mul(n ? n : 1, size), 16);
+    return arena_alloc(ld->mem, PLX_PART_SCENE, arena_mul(n ? n : 1, size), 16);
 }
 
 plx_status ld_features(loader *ld, cJSON *features)
@@ -795,13 +795,13 @@ static long lamp_host(const scene *s, const bgrid *g, const scene_lamp *l)
 plx_status ld_drop_buried_lamps(loader *ld)
 {
     scene *s = ld->s;
-    arena_mark m = arena_get_mark(&ld->e->mem);
+    arena_mark m = arena_get_mark(ld->mem);
     bgrid g;
     uint32_t i, kept = 0;
     if (s->nlamps == 0 || s->nbld == 0)
         return PLX_OK;
-    if (!bgrid_build(&ld->e->mem, s, &g)) {
-        arena_release(&ld->e->mem, &m);
+    if (!bgrid_build(ld->mem, s, &g)) {
+        arena_release(ld->mem, &m);
         return eng_nomem(ld->e, "checking lamps against buildings");
     }
     for (i = 0; i < s->nlamps; i++) {
@@ -818,8 +818,8 @@ plx_status ld_drop_buried_lamps(loader *ld)
                 sb_char(&b, ')');
             }
             sb_str(&b, "; left out");
-            if (ld->e->cfg.strict) {
-                arena_release(&ld->e->mem, &m);
+            if (eng_strict(ld->e)) {
+                arena_release(ld->mem, &m);
                 return ld_bad_feature(ld, s->lamps[i].feature, s->lamps[i].id, why);
             }
             ld_warn(ld, s->lamps[i].feature, s->lamps[i].id, why);
@@ -829,6 +829,6 @@ plx_status ld_drop_buried_lamps(loader *ld)
         s->lamps[kept++] = s->lamps[i];
     }
     s->nlamps = kept;
-    arena_release(&ld->e->mem, &m);
+    arena_release(ld->mem, &m);
     return PLX_OK;
 }

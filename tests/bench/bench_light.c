@@ -23,7 +23,8 @@
 
 #include "polarlux.h"
 #include "base/engine.h"
-#include "light/light.h"
+#include "light/illuminance.h"
+#include "light/litregion.h"
 #include "ref_light.h"
 
 static double now_s(void)
