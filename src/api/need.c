@@ -62,7 +62,12 @@ static plx_status need_photon(plx_engine *e)
 {
     photon_config cfg;
     plx_status st;
-    photon_config_default(&cfg);
+    /* final gathering reads the later bounces all around its points: every
+     * block gets a chart (photon.h, coarsest_level) */
+    if (!e->gather_set || e->gather_side > 0)
+        photon_config_gather(&cfg, e->sc);
+    else
+        photon_config_default(&cfg);
     st = photon_create(&e->mem, e->sc, &cfg, &e->ph);
     if (st == PLX_E_NOMEM)
         return eng_nomem(e, "creating the photon buffers");

@@ -9,7 +9,6 @@
 #include "photon/nightlight.h"
 
 #define HEIGHT_TOL 1e-3   /* m: as in photon.c */
-#define PROBE 0.01        /* m: exposure probes in front of a wall */
 
 /* ---- lookup ------------------------------------------------------------------------ */
 
@@ -51,8 +50,8 @@ static void facade_lookup(const photon_sys *ps, const trace_hit *h, double e[PHO
     cs = (size_t)lv->w * lv->h;
     base = (size_t)slot * 2 * cs + (ps->eclass[h->edge] == PHOTON_EDGE_INNER ? cs : 0);
     photon_chart_xy(ps, k, lv, h->p[0], h->p[1], h->p[2], &fx, &fy);
-    photon_gather(lv->flux + base * PHOTON_CH, lv->area + base, NULL, 0.0, lv->w, lv->h, 1, fx,
-                  fy, e);
+    photon_gather_wide(lv->flux + base * PHOTON_CH, lv->area + base, NULL, 0.0, lv->w, lv->h, 1,
+                       fx, fy, ps->cfg.lookup_radius, e);
     for (c = 0; c < PHOTON_CH; c++)
         e[c] /= fr;
 }
@@ -70,7 +69,8 @@ static void horizontal_lookup(const photon_sys *ps, const double P[3], double e[
         if (covered)
             photon_gather_sparse(ps->cov_flux, ps->cov_area, ps->gcov, ps->gw, ps->gh, fx, fy, e);
         else
-            photon_gather(ps->gflux, ps->garea, ps->gheight, P[2], ps->gw, ps->gh, 0, fx, fy, e);
+            photon_gather_wide(ps->gflux, ps->garea, ps->gheight, P[2], ps->gw, ps->gh, 0, fx, fy,
+                               ps->cfg.lookup_radius, e);
         for (c = 0; c < PHOTON_CH; c++)
             e[c] /= ps->gframes;
     }
@@ -124,6 +124,21 @@ double photon_indirect_rgb(photon_sys *ps, const double P[3], const double n[3],
         rgb[2] = e[3];
     }
     return e[0];
+}
+
+/* E_indirect at a surface a ray found (final_gather.c): the same lookups
+ * as photon_indirect_rgb, without the probe ray for walls. */
+void photon_indirect_hit(photon_sys *ps, const trace_hit *h, double e[PHOTON_CH])
+{
+    int c;
+    for (c = 0; c < PHOTON_CH; c++)
+        e[c] = 0.0;
+    if (h->kind == TRACE_WALL)
+        facade_lookup(ps, h, e);
+    else if (h->kind == TRACE_GROUND || h->kind == TRACE_ROOF)
+        horizontal_lookup(ps, h->p, e);
+    else if (h->kind == TRACE_UNDER && ps->s->bld[h->bld].block < ps->s->nblocks)
+        ambient(ps, ps->s->bld[h->bld].block, e);
 }
 
 double photon_indirect(photon_sys *ps, const double P[3], const double n[3])

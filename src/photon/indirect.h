@@ -19,4 +19,9 @@ double photon_indirect(photon_sys *ps, const double P[3], const double n[3]);
 double photon_indirect_rgb(photon_sys *ps, const double P[3], const double n[3],
                            double rgb[3] /* OUT */);
 
+/* E_indirect (PHOTON_CH channels: scalar, RGB) at the surface of hit h
+ * (a wall, the ground, a roof or an underside), as photon_indirect_rgb
+ * answers at h->p with h->n but without the probe ray. */
+void photon_indirect_hit(photon_sys *ps, const trace_hit *h, double e[PHOTON_CH] /* OUT */);
+
 #endif

@@ -98,6 +98,7 @@ int32_t polar_locate(const polar *pd, int q, vec2 p, int32_t *owner)
     quadrant_side(q, &mi, &top);
     m = &pd->map[mi];
     t = dag_locate(pd, m, to_frame(m->frame, p), owner, NULL);
+    PLX_ASSERT(t >= -3 && (t < 0 || (uint32_t)t < m->ntrap)); /* a region of this map */
     if (t >= 0 && owner)
         *owner = seg_owner(pd, top ? m->trap[t].top : m->trap[t].bot);
     return t;

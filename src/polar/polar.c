@@ -158,6 +158,7 @@ int polar_region(const polar *pd, int q, uint32_t i, vec2 c[4], int32_t *owner, 
     c[3] = polar_from_frame(m->frame, seg_at(pd, m->frame, m->trap[i].top, ul));
     if (owner)
         *owner = seg_owner(pd, top ? m->trap[i].top : m->trap[i].bot);
+    PLX_ASSERT(!owner || (*owner >= -1 && *owner < (int32_t)pd->nbld)); /* a building or the frame */
     if (solid)
         *solid = 0;
     return 4;

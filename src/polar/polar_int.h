@@ -20,6 +20,7 @@
 #include "polar/polar.h"
 #include "base/msort.h"
 #include "base/geom.h"
+#include "base/plx_assert.h"
 
 enum { UL = 0, LL = 1, UR = 2, LR = 3 };
 /* search nodes: a leaf, a point (x) test, a segment (y) test whose frame-left

@@ -17,7 +17,7 @@ typedef struct loader {
     uint32_t *feat_line;   /* line of each feature (scratch) */
     uint32_t *feat_col;    /* its column */
     uint32_t nfeat;
-    int metres;            /* properties.units == "m" */
+    int metres;            /* properties.units == "m", or a projected crs */
     double lon0, lat0, coslat;
     int gi_bounds_given;   /* properties.ground_image_bounds read (scene coordinates) */
     double gi_bounds[4];

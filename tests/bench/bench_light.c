@@ -22,6 +22,7 @@
 #include <time.h>
 
 #include "polarlux.h"
+#include "polarlux_port.h"
 #include "base/engine.h"
 #include "light/illuminance.h"
 #include "light/litregion.h"

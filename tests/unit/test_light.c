@@ -17,6 +17,7 @@
 #include <cmocka.h>
 
 #include "polarlux.h"
+#include "polarlux_port.h"
 #include "base/engine.h"
 #include "light/illuminance.h"
 #include "light/litregion.h"
