@@ -7,6 +7,7 @@
 
 #include "scene/features.h"
 #include "base/geom.h"
+#include "base/lonlat.h"
 
 #define MAX_COORD 1.0e7
 #define MAX_HEIGHT 1000.0
@@ -17,8 +18,6 @@
 #define DEFAULT_LAMP_Z 6.0
 #define DEFAULT_INTENSITY 1000.0
 #define DEFAULT_RADIUS 30.0
-#define M_PER_DEG_LON 111320.0
-#define M_PER_DEG_LAT 110540.0
 #define HOLE_PAIR_CHECK_LIMIT 4000000.0
 
 static const float default_color[3] = { 1.0f, 0.62f, 0.28f };
@@ -171,8 +170,7 @@ static int read_position(loader *ld, const cJSON *pos, vec2 *p, strbuf *why)
         return -1;
     }
     if (!ld->metres && ld->coslat != 0.0) {
-        vx = (vx - ld->lon0) * M_PER_DEG_LON * ld->coslat;
-        vy = (vy - ld->lat0) * M_PER_DEG_LAT;
+        lonlat_to_local(ld->lon0, ld->lat0, ld->coslat, &vx, &vy);
     }
     if (fabs(vx) > MAX_COORD || fabs(vy) > MAX_COORD) {
         sb_str(why, "is out of range (|coordinate| > 1e7 m)");
@@ -653,7 +651,7 @@ static plx_status set_frame(loader *ld, const counts *c)
     ld->s->lonlat = 1;
     ld->lon0 = ld->s->lon0 = 0.5 * (c->box[0] + c->box[2]);
     ld->lat0 = ld->s->lat0 = 0.5 * (c->box[1] + c->box[3]);
-    ld->coslat = cos(ld->lat0 * 3.14159265358979323846 / 180.0);
+    ld->coslat = lonlat_cos(ld->lat0);
     return PLX_OK;
 }
 

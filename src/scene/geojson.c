@@ -24,6 +24,7 @@
 #include <cjson/cJSON.h>
 
 #include "base/geom.h"
+#include "base/lonlat.h"
 #include "scene/blocks.h"
 #include "base/jsonscan.h"
 #include "scene/loader.h"
@@ -262,8 +263,7 @@ static plx_status place_ground_image(loader *ld)
             return bad_top_property(ld, "properties.ground_image_bounds must be lon/lat degrees like the "
                                         "scene's coordinates (lon -180..180, lat -90..90)");
         for (i = 0; i < 4; i += 2) {
-            b[i] = (b[i] - ld->lon0) * 111320.0 * ld->coslat;
-            b[i + 1] = (b[i + 1] - ld->lat0) * 110540.0;
+            lonlat_to_local(ld->lon0, ld->lat0, ld->coslat, &b[i], &b[i + 1]);
         }
     }
     for (i = 0; i < 4; i++)
