@@ -121,8 +121,8 @@ int cmd_lit(int argc, char **argv)
     cli_common c;
     const char *scene, *id = NULL, *out = NULL;
     const cli_opt opts[] = {
-        { "--lamp", NULL, &id, NULL, NULL, 0 },
-        { "-o", NULL, &out, NULL, NULL, 0 },
+        { "--lamp", NULL, &id, NULL, NULL, 0, NULL },
+        { "-o", NULL, &out, NULL, NULL, 0, NULL },
         CLI_OPT_END
     };
     cli_args pa;

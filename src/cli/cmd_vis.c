@@ -73,11 +73,11 @@ static int parse_fov(const char *v, void *dst)
 static int parse_args(int argc, char **argv, vis_opts *o)
 {
     const cli_opt opts[] = {
-        { "--points", NULL, &o->points, NULL, NULL, 0 },
-        { "--geojson", NULL, &o->geojson, NULL, NULL, 0 },
-        { "--at", NULL, o, parse_at, "--at '%s' is not X,Y", 0 },
-        { "--dir", NULL, &o->dir, parse_dir, "--dir '%s' is not a number of degrees", 0 },
-        { "--fov", NULL, &o->fov, parse_fov, "--fov '%s' is not a positive number of degrees", 0 },
+        { "--points", NULL, &o->points, NULL, NULL, 0, NULL },
+        { "--geojson", NULL, &o->geojson, NULL, NULL, 0, NULL },
+        { "--at", NULL, o, parse_at, "--at '%s' is not X,Y", 0, NULL },
+        { "--dir", NULL, &o->dir, parse_dir, "--dir '%s' is not a number of degrees", 0, NULL },
+        { "--fov", NULL, &o->fov, parse_fov, "--fov '%s' is not a positive number of degrees", 0, NULL },
         CLI_OPT_END
     };
     cli_args pa;

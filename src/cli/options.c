@@ -26,7 +26,7 @@ static int take_opt(const char *cmd, int argc, char **argv, int *i, const cli_op
         return EXIT_OK;
     }
     if (*i + 1 >= argc)
-        return cli_usage_error(cmd, "%s needs a value", a);
+        return o->need ? cli_usage_error(cmd, "%s", o->need) : cli_usage_error(cmd, "%s needs a value", a);
     ++*i;
     if (!o->parse) {
         *(const char **)o->dst = argv[*i];

@@ -20,9 +20,11 @@ typedef struct cli_opt {
     cli_parse_fn parse;     /* NULL: keep the value as it is */
     const char *bad;        /* usage message when parse fails ("%s": the value) */
     int flag;               /* 1: takes no value, sets *(int *)dst = 1 */
+    const char *need;       /* message when the value is missing (NULL:
+                             * "--x needs a value") */
 } cli_opt;
 
-#define CLI_OPT_END { NULL, NULL, NULL, NULL, NULL, 0 }
+#define CLI_OPT_END { NULL, NULL, NULL, NULL, NULL, 0, NULL }
 #define CLI_MAX_POS 8
 
 typedef struct cli_args {
