@@ -10,7 +10,7 @@ static plx_status need_lonlat(plx_engine *e, const char *fn, size_t n, const dou
 {
     char msg[200];
     strbuf b;
-    plx_status st = eng_need_scene(e, fn);
+    plx_status st = eng_need(e, ENG_SCENE, fn);
     if (st != PLX_OK)
         return st;
     sb_init(&b, msg, sizeof msg);
