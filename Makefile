@@ -63,7 +63,7 @@ DEB_PACKAGES = libcjson-dev libcmocka-dev libpng-dev pkg-config python3-numpy py
 
 .SECONDARY:
 .PHONY: all deps demo check check-full check-build unit cli-test asan valgrind bench install clean \
-        check-core-headers check-identical check-lib-split check-examples check-python
+        check-core-headers check-identical check-lib-split check-examples check-python check-layers
 
 all: $(LIB_A) $(LIB_SO) $(PORT_A) $(BIN)
 
@@ -156,7 +156,13 @@ check-full: check-build
 	@$(MAKE) --no-print-directory check-examples check-python
 
 check-build:
-	@$(MAKE) --no-print-directory -j$(JOBS) all $(TESTS) $(EXAMPLES) check-core-headers check-lib-split
+	@$(MAKE) --no-print-directory -j$(JOBS) all $(TESTS) $(EXAMPLES) check-core-headers check-lib-split check-layers
+
+# The include rule (tests/check_layers.sh): stages in data-flow order base <
+# scene < polar < light < photon < render < api, base/engine.h only in
+# src/api and src/base, no circles between files.
+check-layers:
+	@sh tests/check_layers.sh
 
 # examples/: programs that embed the engine as an application would. Each
 # links the core library alone (no port, no libpng, no pthreads) and checks

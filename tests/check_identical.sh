@@ -73,7 +73,10 @@ all_commands() {
         set -- $(bounds "$s")
         x0=$1 y0=$2 x1=$3 y1=$4
         if [ ! -f "$p" ]; then
+            # local metres whatever the scene's coordinates ('#' lines are
+            # comments to revisions that do not read the crs line)
             awk -v x0="$x0" -v y0="$y0" -v x1="$x1" -v y1="$y1" 'BEGIN {
+                print "# crs: local";
                 for (i = 1; i <= 5; i++) for (j = 1; j <= 5; j++)
                     printf "%.3f %.3f\n", x0 + (x1 - x0) * (i - 0.37) / 5, y0 + (y1 - y0) * (j - 0.61) / 5;
                 printf "%.3f %.3f 1.5 1 0 0\n", (x0 + x1) / 2, (y0 + y1) / 2 }' >"$p"

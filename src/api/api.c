@@ -31,7 +31,7 @@ plx_status plx_scene_info_get(plx_engine *e, plx_scene_info *out)
 {
     const scene *s;
     uint32_t i;
-    plx_status st = eng_need_scene(e, "plx_scene_info_get");
+    plx_status st = eng_need(e, ENG_SCENE, "plx_scene_info_get");
     if (st != PLX_OK || !out)
         return st != PLX_OK ? st : PLX_E_INVALID;
     s = e->sc;
@@ -69,7 +69,7 @@ plx_status plx_scene_info_get(plx_engine *e, plx_scene_info *out)
 plx_status plx_building_get(plx_engine *e, uint32_t i, plx_building *out)
 {
     const scene_building *b;
-    plx_status st = eng_need_scene(e, "plx_building_get");
+    plx_status st = eng_need(e, ENG_SCENE, "plx_building_get");
     if (st != PLX_OK)
         return st;
     if (i >= e->sc->nbld)
@@ -91,7 +91,7 @@ plx_status plx_building_get(plx_engine *e, uint32_t i, plx_building *out)
 plx_status plx_lamp_get(plx_engine *e, uint32_t i, plx_lamp *out)
 {
     const scene_lamp *l;
-    plx_status st = eng_need_scene(e, "plx_lamp_get");
+    plx_status st = eng_need(e, ENG_SCENE, "plx_lamp_get");
     if (st != PLX_OK)
         return st;
     if (i >= e->sc->nlamps)
@@ -113,7 +113,7 @@ plx_status plx_lamp_get(plx_engine *e, uint32_t i, plx_lamp *out)
 plx_status plx_block_get(plx_engine *e, uint32_t i, plx_block *out)
 {
     const scene_block *k;
-    plx_status st = eng_need_scene(e, "plx_block_get");
+    plx_status st = eng_need(e, ENG_SCENE, "plx_block_get");
     if (st != PLX_OK)
         return st;
     if (i >= e->sc->nblocks)
@@ -138,7 +138,7 @@ static plx_status ring_out(const vec2 *pts, const scene_ring *r, const double **
 plx_status plx_building_ring(plx_engine *e, uint32_t i, uint32_t r, const double **xy, uint32_t *n)
 {
     const scene_building *b;
-    plx_status st = eng_need_scene(e, "plx_building_ring");
+    plx_status st = eng_need(e, ENG_SCENE, "plx_building_ring");
     if (st != PLX_OK)
         return st;
     if (!xy || !n)
@@ -154,7 +154,7 @@ plx_status plx_building_ring(plx_engine *e, uint32_t i, uint32_t r, const double
 plx_status plx_block_ring(plx_engine *e, uint32_t i, uint32_t r, const double **xy, uint32_t *n)
 {
     const scene_block *k;
-    plx_status st = eng_need_scene(e, "plx_block_ring");
+    plx_status st = eng_need(e, ENG_SCENE, "plx_block_ring");
     if (st != PLX_OK)
         return st;
     if (!xy || !n)
@@ -169,7 +169,7 @@ plx_status plx_block_ring(plx_engine *e, uint32_t i, uint32_t r, const double **
 
 const char *plx_scene_crs(plx_engine *e)
 {
-    if (eng_need_scene(e, "plx_scene_crs") != PLX_OK)
+    if (eng_need(e, ENG_SCENE, "plx_scene_crs") != PLX_OK)
         return NULL;
     return e->sc->crs;
 }

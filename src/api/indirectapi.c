@@ -5,33 +5,14 @@
 #include "base/engine.h"
 #include "photon/photon.h"
 #include "photon/trace.h"
+#include "photon/indirect.h"
+#include "photon/photon_select.h"
 #include "photon/final_gather.h"
-
-static plx_status need_photons(plx_engine *e, const char *fn)
-{
-    photon_config cfg;
-    plx_status st;
-    if ((st = eng_need_scene(e, fn)) != PLX_OK)
-        return st;
-    if (e->ph)
-        return PLX_OK;
-    /* final gathering reads the later bounces all around its points: every
-     * block gets a chart (photon.h, coarsest_level) */
-    if (!e->gather_set || e->gather_side > 0)
-        photon_config_gather(&cfg, e->sc);
-    else
-        photon_config_default(&cfg);
-    st = photon_create(&e->mem, e->sc, &cfg, &e->ph);
-    if (st == PLX_E_NOMEM)
-        return eng_nomem(e, "creating the photon buffers");
-    if (st != PLX_OK)
-        return eng_fail(e, st, "creating the photon buffers failed");
-    return PLX_OK;
-}
+#include "render/nightify.h"
 
 plx_status plx_indirect_step(plx_engine *e, uint32_t photons, uint64_t seed)
 {
-    plx_status st = need_photons(e, "plx_indirect_step");
+    plx_status st = eng_need(e, ENG_PHOTON, "plx_indirect_step");
     if (st != PLX_OK)
         return st;
     if (photons == 0)
@@ -49,7 +30,7 @@ uint64_t plx_indirect_frames(const plx_engine *e)
 
 plx_status plx_indirect_set_viewer(plx_engine *e, const double eye[3], const double dir[3], double fov_deg)
 {
-    plx_status st = need_photons(e, "plx_indirect_set_viewer");
+    plx_status st = eng_need(e, ENG_PHOTON, "plx_indirect_set_viewer");
     if (st != PLX_OK)
         return st;
     if (!eye)
@@ -125,7 +106,7 @@ double eng_indirect_free(plx_engine *e, const double P[3], const double n[3], do
 plx_status plx_indirect_select_lamps(plx_engine *e, const double box[4], double margin,
                                       uint32_t *count)
 {
-    plx_status st = need_photons(e, "plx_indirect_select_lamps");
+    plx_status st = eng_need(e, ENG_PHOTON, "plx_indirect_select_lamps");
     uint32_t n;
     if (st != PLX_OK)
         return st;

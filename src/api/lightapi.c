@@ -5,26 +5,8 @@
 #include <string.h>
 
 #include "base/engine.h"
-#include "light/light.h"
-
-#define DEFAULT_LIT_CACHE ((size_t)16 << 20)
-
-plx_status eng_need_light(plx_engine *e, const char *fn)
-{
-    plx_status st;
-    size_t cache;
-    if ((st = eng_need_scene(e, fn)) != PLX_OK)
-        return st;
-    if (e->lt)
-        return PLX_OK;
-    cache = e->cfg.lit_cache_bytes ? e->cfg.lit_cache_bytes : DEFAULT_LIT_CACHE;
-    st = light_create(&e->mem, e->sc, cache, &e->lt);
-    if (st == PLX_E_NOMEM)
-        return eng_nomem(e, "setting up lamp light");
-    if (st != PLX_OK)
-        return eng_fail(e, st, "setting up lamp light failed");
-    return PLX_OK;
-}
+#include "light/illuminance.h"
+#include "light/litregion.h"
 
 static void where_text(strbuf *b, const plx_engine *e, light_where w, uint32_t bld, int normal_ok)
 {
@@ -152,7 +134,7 @@ plx_status plx_illuminance(plx_engine *e, size_t n, const double *P, const doubl
                            double *E_direct, double *E_indirect, double *rgb)
 {
     point_out o;
-    plx_status st = eng_need_light(e, "plx_illuminance");
+    plx_status st = eng_need(e, ENG_LIGHT, "plx_illuminance");
     if (st != PLX_OK)
         return st;
     if (n && (!P || !N || !E_direct))
@@ -173,7 +155,7 @@ plx_status plx_indirect_rgb(plx_engine *e, size_t n, const double *P, const doub
                             double *E_indirect, double *rgb)
 {
     point_out o;
-    plx_status st = eng_need_light(e, "plx_indirect_rgb");
+    plx_status st = eng_need(e, ENG_LIGHT, "plx_indirect_rgb");
     if (st != PLX_OK)
         return st;
     if (n && (!P || !N || !rgb))
@@ -189,7 +171,7 @@ plx_status plx_lamps_at(plx_engine *e, const double P[3], const double n[3], uin
                         double *lux, uint32_t cap, uint32_t *count)
 {
     int got;
-    plx_status st = eng_need_light(e, "plx_lamps_at");
+    plx_status st = eng_need(e, ENG_LIGHT, "plx_lamps_at");
     if (st != PLX_OK)
         return st;
     if (!P || !n || !count || (cap && (!ids || !lux)))
@@ -204,7 +186,7 @@ plx_status plx_lamps_at(plx_engine *e, const double P[3], const double n[3], uin
 plx_status plx_lit_region_get(plx_engine *e, uint32_t lamp, plx_lit_region *out)
 {
     const lit_region *r;
-    plx_status st = eng_need_light(e, "plx_lit_region_get");
+    plx_status st = eng_need(e, ENG_LIGHT, "plx_lit_region_get");
     if (st != PLX_OK)
         return st;
     if (!out)

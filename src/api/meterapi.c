@@ -5,6 +5,9 @@
 
 #include "base/engine.h"
 #include "light/light.h"
+#include "light/illuminance.h"
+#include "light/meter.h"
+#include "light/litregion.h"
 
 static const double p_mean[6] = { 15.0, 10.0, 7.5, 5.0, 3.0, 2.0 };
 static const double p_min[6] = { 3.0, 2.0, 1.5, 1.0, 0.6, 0.4 };
@@ -34,7 +37,7 @@ plx_status plx_meter(plx_engine *e, size_t n, const double *P, const double *U, 
     size_t k;
     int bad = 0;
     char first[ENGINE_ERR_BYTES];
-    plx_status st = eng_need_light(e, "plx_meter");
+    plx_status st = eng_need(e, ENG_LIGHT, "plx_meter");
     if (st != PLX_OK)
         return st;
     if (n && (!P || !out))
@@ -102,7 +105,7 @@ plx_status plx_route_facial(plx_engine *e, const double *xy, uint32_t n, double 
     uint32_t i;
     int c;
     double all[4] = { NAN, NAN, NAN, NAN };
-    plx_status st = eng_need_light(e, "plx_route_facial");
+    plx_status st = eng_need(e, ENG_LIGHT, "plx_route_facial");
     if (st != PLX_OK)
         return st;
     if (!xy || n < 2 || !(step > 0) || !isfinite(step) || !(height >= 0) || !isfinite(height))

@@ -6,7 +6,9 @@
 
 #include "base/engine.h"
 #include "light/light.h"
-#include "light/photometry.h"
+#include "light/illuminance.h"
+#include "light/litregion.h"
+#include "scene/photometry.h"
 #include "photon/photon.h"
 
 /* Lamp i is the first to name its path. */

@@ -3,15 +3,14 @@
  * with (lon0, lat0) the centre the loader chose (plx_scene_info). */
 #include <math.h>
 #include "base/engine.h"
+#include "base/lonlat.h"
 
-#define M_PER_DEG_LON 111320.0
-#define M_PER_DEG_LAT 110540.0
 
 static plx_status need_lonlat(plx_engine *e, const char *fn, size_t n, const double *in, const double *out)
 {
     char msg[200];
     strbuf b;
-    plx_status st = eng_need_scene(e, fn);
+    plx_status st = eng_need(e, ENG_SCENE, fn);
     if (st != PLX_OK)
         return st;
     sb_init(&b, msg, sizeof msg);
@@ -30,7 +29,7 @@ static plx_status need_lonlat(plx_engine *e, const char *fn, size_t n, const dou
 
 static double cos_lat0(const scene *s)
 {
-    return cos(s->lat0 * 3.14159265358979323846 / 180.0);
+    return lonlat_cos(s->lat0);
 }
 
 plx_status plx_lonlat_to_local(plx_engine *e, size_t n, const double *lonlat, double *xy)
@@ -42,9 +41,10 @@ plx_status plx_lonlat_to_local(plx_engine *e, size_t n, const double *lonlat, do
         return st;
     c = cos_lat0(e->sc);
     for (i = 0; i < n; i++) {
-        double lon = lonlat[2 * i], lat = lonlat[2 * i + 1];
-        xy[2 * i] = (lon - e->sc->lon0) * M_PER_DEG_LON * c;
-        xy[2 * i + 1] = (lat - e->sc->lat0) * M_PER_DEG_LAT;
+        double x = lonlat[2 * i], y = lonlat[2 * i + 1];
+        lonlat_to_local(e->sc->lon0, e->sc->lat0, c, &x, &y);
+        xy[2 * i] = x;
+        xy[2 * i + 1] = y;
     }
     return PLX_OK;
 }
@@ -59,8 +59,9 @@ plx_status plx_local_to_lonlat(plx_engine *e, size_t n, const double *xy, double
     c = cos_lat0(e->sc);
     for (i = 0; i < n; i++) {
         double x = xy[2 * i], y = xy[2 * i + 1];
-        lonlat[2 * i] = e->sc->lon0 + x / (M_PER_DEG_LON * c);
-        lonlat[2 * i + 1] = e->sc->lat0 + y / M_PER_DEG_LAT;
+        lonlat_from_local(e->sc->lon0, e->sc->lat0, c, &x, &y);
+        lonlat[2 * i] = x;
+        lonlat[2 * i + 1] = y;
     }
     return PLX_OK;
 }

@@ -4,44 +4,15 @@
 
 #include "base/engine.h"
 #include "polar/polar.h"
+#include "polar/locate.h"
 #include "polar/visibility.h"
 #include "base/geom.h"
 
 #define DEG 0.017453292519943295
 
-static plx_status build(plx_engine *e)
-{
-    arena_mark m = arena_get_mark(&e->mem);
-    uint64_t t0 = eng_clock(e);
-    plx_status st;
-    polar *pd;
-    st = polar_build(&e->mem, e->sc, &pd);
-    if (st == PLX_E_NOMEM)
-        return eng_nomem(e, "building the polar diagrams");
-    if (st != PLX_OK)
-        return eng_fail(e, st, "building the polar diagrams failed (empty or non-finite bounds)");
-    e->polar_ns = eng_clock(e) - t0;
-    e->vis_poly_cap = 4 * e->sc->npts + 64;
-    e->vis_ids_cap = e->sc->nbld + 1;
-    e->vis_poly = arena_alloc(&e->mem, PLX_PART_FRAME, arena_mul(e->vis_poly_cap, sizeof *e->vis_poly), 16);
-    e->vis_ids = arena_alloc(&e->mem, PLX_PART_FRAME, arena_mul(e->vis_ids_cap, sizeof *e->vis_ids), 16);
-    if (!e->vis_poly || !e->vis_ids) {
-        plx_status r = eng_nomem(e, "reserving visibility results");
-        arena_release(&e->mem, &m);
-        e->vis_poly = NULL;
-        e->vis_ids = NULL;
-        return r;
-    }
-    e->pd = pd;
-    return PLX_OK;
-}
-
 plx_status plx_polar_build(plx_engine *e)
 {
-    plx_status st = eng_need_scene(e, "plx_polar_build");
-    if (st != PLX_OK || e->pd)
-        return st;
-    return build(e);
+    return eng_need(e, ENG_POLAR, "plx_polar_build");
 }
 
 plx_status plx_polar_info_get(plx_engine *e, plx_polar_info *out)

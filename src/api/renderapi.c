@@ -2,11 +2,10 @@
 #include <string.h>
 
 #include "base/engine.h"
-#include "light/light.h"
+#include "light/illuminance.h"
+#include "light/litregion.h"
 #include "render/render.h"
 
-#define DEFAULT_MAX_W 1920
-#define DEFAULT_MAX_H 1080
 #define LIGHTMAP_MAX_BYTES ((size_t)256 << 20)
 
 void plx_render_opts_default(plx_render_opts *o)
@@ -22,24 +21,6 @@ void plx_render_opts_default(plx_render_opts *o)
 static void shade_indirect(void *user, const double P[3], const double n[3], double rgb[3])
 {
     eng_indirect_photons_rgb(user, P, n, rgb);
-}
-
-static plx_status need_render(plx_engine *e)
-{
-    int32_t w = e->cfg.render_max_width ? e->cfg.render_max_width : DEFAULT_MAX_W;
-    int32_t h = e->cfg.render_max_height ? e->cfg.render_max_height : DEFAULT_MAX_H;
-    plx_status st;
-    if (e->rd)
-        return PLX_OK;
-    st = eng_need_light(e, "plx_render");
-    if (st != PLX_OK)
-        return st;
-    st = render_create(&e->mem, e->sc, w, h, render_shade_light, e->lt, &e->rd);
-    if (st == PLX_E_NOMEM)
-        return eng_nomem(e, "creating the renderer (frame buffers and mesh)");
-    if (st != PLX_OK)
-        return eng_fail(e, st, "creating the renderer failed");
-    return PLX_OK;
 }
 
 plx_status plx_render(plx_engine *e, const plx_camera *cam, const plx_render_opts *o, uint8_t *rgb8,
@@ -60,7 +41,7 @@ plx_status plx_render(plx_engine *e, const plx_camera *cam, const plx_render_opt
         plx_render_opts_default(&def);
         o = &def;
     }
-    st = need_render(e);
+    st = eng_need(e, ENG_RENDER, "plx_render");
     if (st != PLX_OK)
         return st;
     if (o->aerial && e->lightmap_cell == 0.0) {

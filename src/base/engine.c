@@ -210,6 +210,22 @@ uint64_t plx_debug_fail_alloc(plx_engine *e, uint64_t k)
     return served;
 }
 
+void eng_warn(plx_engine *e, const char *msg)
+{
+    e->warnings++;
+    eng_log(e, PLX_LOG_WARN, msg);
+}
+
+int eng_strict(const plx_engine *e)
+{
+    return e->cfg.strict;
+}
+
+const plx_port *eng_port(const plx_engine *e)
+{
+    return &e->port;
+}
+
 #ifdef PLX_DEBUG
 static void check_rings(const scene_ring *rings, uint32_t first, uint32_t count, uint32_t nrings, uint32_t npts)
 {

@@ -6,8 +6,7 @@
 #include "base/arena.h"
 #include "base/scene.h"
 #include "base/strbuf.h"
-
-#define ENGINE_ERR_BYTES 512
+#include "base/context.h"
 
 struct plx_engine {
     uint32_t magic;
@@ -38,18 +37,15 @@ struct plx_engine {
 
 #define ENGINE_MAGIC 0x504c5831u /* "PLX1" */
 
-/* Sets the last error to 'msg' (the text of 'b' when b is given) and returns s. */
-plx_status eng_fail(plx_engine *e, plx_status s, const char *msg);
-/* The standard out-of-memory error, naming the part that asked. */
-plx_status eng_nomem(plx_engine *e, const char *during);
-void eng_clear_error(plx_engine *e);
-void eng_log(plx_engine *e, plx_log_level level, const char *msg);
-uint64_t eng_clock(plx_engine *e);
 /* PLX_OK when e is a valid engine with a scene loaded; else PLX_E_INVALID,
  * or PLX_E_NOSCENE with the error "FN: no scene is loaded". */
 plx_status eng_need_scene(plx_engine *e, const char *fn);
-/* Creates the lamp light object on first need (lightapi.c). */
-plx_status eng_need_light(plx_engine *e, const char *fn);
+/* What a call needs built first (api/need.c, the one place deciding it). */
+typedef enum eng_what { ENG_SCENE, ENG_POLAR, ENG_LIGHT, ENG_PHOTON, ENG_RENDER } eng_what;
+/* Builds what is missing of WHAT and what it depends on; PLX_OK when all is
+ * there. Errors name fn ("fn: no scene is loaded"), or the part that ran
+ * out of memory. */
+plx_status eng_need(plx_engine *e, eng_what what, const char *fn);
 /* E_indirect at a checked surface point, 0 without photon frames (indirectapi.c). */
 double eng_indirect(plx_engine *e, const double P[3], const double n[3]);
 /* The same, also writing its RGB version to rgb (may be NULL); returns the scalar. */

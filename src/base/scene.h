@@ -40,7 +40,7 @@ typedef struct scene_lamp {
     float color[3];       /* linear RGB */
     uint32_t feature;
     const char *id;
-    /* SPEC §2.1 (src/light/photometry.h): properties.photometry as written
+    /* SPEC §2.1 (src/scene/photometry.h): properties.photometry as written
      * (NULL: isotropic), its table once given (plx_set_photometry), the
      * frame (azimuth, tilt in degrees; cos/sin of both) and dimming. */
     const char *photometry;

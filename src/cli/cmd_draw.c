@@ -3,6 +3,7 @@
 
 #include "canvas.h"
 #include "cli.h"
+#include "options.h"
 
 static const char help[] =
     "usage: polarlux draw SCENE --polar Q -o OUT.png [--size PX] [options]\n"
@@ -80,43 +81,37 @@ static int draw(plx_engine *e, int q, const char *out, int size)
     return EXIT_OK;
 }
 
+static int parse_quadrant(const char *v, void *dst)
+{
+    return cli_parse_int(v, 0, 3, dst);
+}
+
+static int parse_size(const char *v, void *dst)
+{
+    return cli_parse_int(v, 16, 16384, dst);
+}
+
 int cmd_draw(int argc, char **argv)
 {
     cli_common c;
-    const char *scene = NULL, *out = NULL;
+    const char *scene, *out = NULL;
     long q = -1, size = 1600;
+    const cli_opt opts[] = {
+        { "--polar", NULL, &q, parse_quadrant, "--polar '%s' is not a quadrant 0..3", 0, NULL },
+        { "-o", NULL, &out, NULL, NULL, 0, NULL },
+        { "--size", NULL, &size, parse_size, "--size '%s' is not 16..16384 pixels", 0, NULL },
+        CLI_OPT_END
+    };
+    cli_args pa;
     plx_engine *e;
-    int i, rc;
+    int rc;
     memset(&c, 0, sizeof c);
-    for (i = 1; i < argc; i++) {
-        const char *a = argv[i];
-        int r = cli_common_option("draw", argc, argv, &i, &c);
-        if (r < 0)
-            return EXIT_USAGE;
-        if (r)
-            continue;
-        if (strcmp(a, "--help") == 0 || strcmp(a, "-h") == 0) {
-            fputs(help, stdout);
-            return EXIT_OK;
-        }
-        if ((strcmp(a, "--polar") == 0 || strcmp(a, "-o") == 0 || strcmp(a, "--size") == 0) && i + 1 >= argc)
-            return cli_usage_error("draw", "%s needs a value", a);
-        if (strcmp(a, "--polar") == 0) {
-            if (cli_parse_int(argv[++i], 0, 3, &q) != 0)
-                return cli_usage_error("draw", "--polar '%s' is not a quadrant 0..3", argv[i]);
-        } else if (strcmp(a, "-o") == 0) {
-            out = argv[++i];
-        } else if (strcmp(a, "--size") == 0) {
-            if (cli_parse_int(argv[++i], 16, 16384, &size) != 0)
-                return cli_usage_error("draw", "--size '%s' is not 16..16384 pixels", argv[i]);
-        } else if (a[0] == '-' && a[1] != '\0') {
-            return cli_usage_error("draw", "unknown option '%s'", a);
-        } else if (!scene) {
-            scene = a;
-        } else {
-            return cli_usage_error("draw", "unexpected argument '%s'", a);
-        }
-    }
+    rc = cli_options("draw", help, argc, argv, opts, &c, NULL, &pa);
+    if (rc != EXIT_OK)
+        return rc < 0 ? EXIT_OK : rc;
+    if (pa.npos > 1)
+        return cli_usage_error("draw", "unexpected argument '%s'", pa.pos[1]);
+    scene = pa.npos ? pa.pos[0] : NULL;
     if (!scene)
         return cli_usage_error("draw", "missing SCENE");
     if (q < 0)

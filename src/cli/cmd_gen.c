@@ -2,6 +2,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include "cli.h"
+#include "options.h"
 
 static const char help[] =
     "usage: polarlux gen STYLE NX NY [--seed S] [-o FILE]\n"
@@ -40,39 +41,35 @@ static int finish_file(sink *s, const char *tmp, const char *out)
     return EXIT_OK;
 }
 
+static int parse_seed(const char *v, void *dst)
+{
+    char *end;
+    *(unsigned long long *)dst = strtoull(v, &end, 10);
+    return *end != '\0' || end == v;
+}
+
 int cmd_gen(int argc, char **argv)
 {
-    const char *pos[3], *out = NULL;
+    const char *out = NULL;
     char tmp[4096];
     long nx, ny;
     unsigned long long seed = 1;
-    int npos = 0, i;
+    const cli_opt opts[] = {
+        { "--seed", NULL, &seed, parse_seed, "--seed '%s' is not a whole number", 0, "--seed needs a number" },
+        { "-o", NULL, &out, NULL, NULL, 0, "-o needs a file name" },
+        CLI_OPT_END
+    };
+    cli_args pa;
+    const char **pos = pa.pos;
+    int rc;
     plx_status st;
     sink s;
-    for (i = 1; i < argc; i++) {
-        if (strcmp(argv[i], "--help") == 0 || strcmp(argv[i], "-h") == 0) {
-            fputs(help, stdout);
-            return EXIT_OK;
-        } else if (strcmp(argv[i], "--seed") == 0) {
-            char *end;
-            if (i + 1 >= argc)
-                return cli_usage_error("gen", "--seed needs a number");
-            seed = strtoull(argv[++i], &end, 10);
-            if (*end != '\0' || end == argv[i])
-                return cli_usage_error("gen", "--seed '%s' is not a whole number", argv[i]);
-        } else if (strcmp(argv[i], "-o") == 0) {
-            if (i + 1 >= argc)
-                return cli_usage_error("gen", "-o needs a file name");
-            out = argv[++i];
-        } else if (argv[i][0] == '-' && argv[i][1] != '\0') {
-            return cli_usage_error("gen", "unknown option '%s'", argv[i]);
-        } else if (npos < 3) {
-            pos[npos++] = argv[i];
-        } else {
-            return cli_usage_error("gen", "too many arguments ('%s')", argv[i]);
-        }
-    }
-    if (npos < 3)
+    rc = cli_options("gen", help, argc, argv, opts, NULL, NULL, &pa);
+    if (rc != EXIT_OK)
+        return rc < 0 ? EXIT_OK : rc;
+    if (pa.npos > 3)
+        return cli_usage_error("gen", "too many arguments ('%s')", pa.pos[3]);
+    if (pa.npos < 3)
         return cli_usage_error("gen", "needs STYLE NX NY, e.g. 'polarlux gen eixample 30 30'");
     if (strcmp(pos[0], "grid") && strcmp(pos[0], "eixample") && strcmp(pos[0], "oldtown"))
         return cli_usage_error("gen", "unknown style '%s' (grid, eixample or oldtown)", pos[0]);

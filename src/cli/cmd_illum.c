@@ -4,6 +4,7 @@
 #include <string.h>
 
 #include "cli.h"
+#include "options.h"
 #include "points.h"
 
 static const char help[] =
@@ -45,34 +46,21 @@ int cmd_illum(int argc, char **argv)
     char err[512];
     double *ed, *ei, *given = NULL;
     size_t k;
-    int i, rc, failed = 0;
+    const cli_opt opts[] = {
+        { "--points", NULL, &file, NULL, NULL, 0, "--points needs a file" },
+        CLI_OPT_END
+    };
+    cli_args pa;
+    int rc, failed = 0;
     memset(&c, 0, sizeof c);
     cli_indirect_default(&ind);
     ind.frames = CLI_GATHER_FRAMES;
-    for (i = 1; i < argc; i++) {
-        int r = cli_common_option("illum", argc, argv, &i, &c);
-        if (r == 0)
-            r = cli_indirect_option("illum", argc, argv, &i, &ind);
-        if (r < 0)
-            return EXIT_USAGE;
-        if (r)
-            continue;
-        if (strcmp(argv[i], "--help") == 0 || strcmp(argv[i], "-h") == 0) {
-            fputs(help, stdout);
-            return EXIT_OK;
-        }
-        if (strcmp(argv[i], "--points") == 0) {
-            if (i + 1 >= argc)
-                return cli_usage_error("illum", "--points needs a file");
-            file = argv[++i];
-        } else if (argv[i][0] == '-' && argv[i][1] != '\0') {
-            return cli_usage_error("illum", "unknown option '%s'", argv[i]);
-        } else if (!scene) {
-            scene = argv[i];
-        } else {
-            return cli_usage_error("illum", "unexpected argument '%s'", argv[i]);
-        }
-    }
+    rc = cli_options("illum", help, argc, argv, opts, &c, &ind, &pa);
+    if (rc != EXIT_OK)
+        return rc < 0 ? EXIT_OK : rc;
+    if (pa.npos > 1)
+        return cli_usage_error("illum", "unexpected argument '%s'", pa.pos[1]);
+    scene = pa.npos ? pa.pos[0] : NULL;
     if (!scene)
         return cli_usage_error("illum", "missing SCENE");
     if (!file)

@@ -2,6 +2,7 @@
  * and memory per part. */
 #include <string.h>
 #include "cli.h"
+#include "options.h"
 
 static const char help[] =
     "usage: polarlux info SCENE [--mem SIZE] [--strict] [--quiet] [--lamps FILE]...\n"
@@ -65,24 +66,15 @@ int cmd_info(int argc, char **argv)
     plx_scene_info si;
     plx_polar_info pi;
     plx_ground_image_info gi;
-    int i, rc;
+    cli_args pa;
+    int rc;
     memset(&c, 0, sizeof c);
-    for (i = 1; i < argc; i++) {
-        int r = cli_common_option("info", argc, argv, &i, &c);
-        if (r < 0)
-            return EXIT_USAGE;
-        if (r)
-            continue;
-        if (strcmp(argv[i], "--help") == 0 || strcmp(argv[i], "-h") == 0) {
-            fputs(help, stdout);
-            return EXIT_OK;
-        }
-        if (argv[i][0] == '-' && argv[i][1] != '\0')
-            return cli_usage_error("info", "unknown option '%s'", argv[i]);
-        if (path)
-            return cli_usage_error("info", "one scene at a time ('%s' and '%s')", path, argv[i]);
-        path = argv[i];
-    }
+    rc = cli_options("info", help, argc, argv, NULL, &c, NULL, &pa);
+    if (rc != EXIT_OK)
+        return rc < 0 ? EXIT_OK : rc;
+    if (pa.npos > 1)
+        return cli_usage_error("info", "one scene at a time ('%s' and '%s')", pa.pos[0], pa.pos[1]);
+    path = pa.npos ? pa.pos[0] : NULL;
     if (!path)
         return cli_usage_error("info", "missing SCENE");
     rc = cli_open_scene("info", path, &c, &e);

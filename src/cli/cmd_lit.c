@@ -3,6 +3,7 @@
 #include <string.h>
 
 #include "cli.h"
+#include "options.h"
 #include "geo_out.h"
 
 static const char help[] =
@@ -118,34 +119,23 @@ static int write_region(plx_engine *e, uint32_t lamp, const char *out, const cli
 int cmd_lit(int argc, char **argv)
 {
     cli_common c;
-    const char *scene = NULL, *id = NULL, *out = NULL;
+    const char *scene, *id = NULL, *out = NULL;
+    const cli_opt opts[] = {
+        { "--lamp", NULL, &id, NULL, NULL, 0, NULL },
+        { "-o", NULL, &out, NULL, NULL, 0, NULL },
+        CLI_OPT_END
+    };
+    cli_args pa;
     plx_engine *e;
     long lamp;
-    int i, rc;
+    int rc;
     memset(&c, 0, sizeof c);
-    for (i = 1; i < argc; i++) {
-        int r = cli_common_option("lit", argc, argv, &i, &c);
-        if (r < 0)
-            return EXIT_USAGE;
-        if (r)
-            continue;
-        if (strcmp(argv[i], "--help") == 0 || strcmp(argv[i], "-h") == 0) {
-            fputs(help, stdout);
-            return EXIT_OK;
-        }
-        if ((strcmp(argv[i], "--lamp") == 0 || strcmp(argv[i], "-o") == 0) && i + 1 >= argc)
-            return cli_usage_error("lit", "%s needs a value", argv[i]);
-        if (strcmp(argv[i], "--lamp") == 0)
-            id = argv[++i];
-        else if (strcmp(argv[i], "-o") == 0)
-            out = argv[++i];
-        else if (argv[i][0] == '-' && argv[i][1] != '\0')
-            return cli_usage_error("lit", "unknown option '%s'", argv[i]);
-        else if (!scene)
-            scene = argv[i];
-        else
-            return cli_usage_error("lit", "unexpected argument '%s'", argv[i]);
-    }
+    rc = cli_options("lit", help, argc, argv, opts, &c, NULL, &pa);
+    if (rc != EXIT_OK)
+        return rc < 0 ? EXIT_OK : rc;
+    if (pa.npos > 1)
+        return cli_usage_error("lit", "unexpected argument '%s'", pa.pos[1]);
+    scene = pa.npos ? pa.pos[0] : NULL;
     if (!scene)
         return cli_usage_error("lit", "missing SCENE");
     if (!id)

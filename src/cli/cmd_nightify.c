@@ -4,6 +4,7 @@
 #include <string.h>
 
 #include "cli.h"
+#include "options.h"
 #include "png/image_write.h"
 
 static const char help[] =
@@ -18,34 +19,33 @@ static const char help[] =
     "  --dark-threshold T   luminance below which night pixels are left out of\n"
     "                       the reference histograms (default 10)\n";
 
+static int parse_dark(const char *v, void *dst)
+{
+    double *d = dst;
+    return cli_parse_double(v, d) != 0 || *d < 0 || *d > 255;
+}
+
 int cmd_nightify(int argc, char **argv)
 {
-    const char *pos[2], *out = NULL;
+    const char *out = NULL;
     double dark = 10.0;
-    int npos = 0, i, dw, dh, nw, nh, rc = EXIT_OK;
+    const cli_opt opts[] = {
+        { "-o", NULL, &out, NULL, NULL, 0, NULL },
+        { "--dark-threshold", NULL, &dark, parse_dark, "--dark-threshold '%s' is not 0..255", 0, NULL },
+        CLI_OPT_END
+    };
+    cli_args pa;
+    const char **pos = pa.pos;
+    int dw, dh, nw, nh, rc;
     uint8_t *day = NULL, *night = NULL;
     char err[512];
-    for (i = 1; i < argc; i++) {
-        if (strcmp(argv[i], "--help") == 0 || strcmp(argv[i], "-h") == 0) {
-            fputs(help, stdout);
-            return EXIT_OK;
-        } else if (strcmp(argv[i], "-o") == 0 || strcmp(argv[i], "--dark-threshold") == 0) {
-            if (i + 1 >= argc)
-                return cli_usage_error("nightify", "%s needs a value", argv[i]);
-            if (strcmp(argv[i], "-o") == 0) {
-                out = argv[++i];
-            } else if (cli_parse_double(argv[++i], &dark) != 0 || dark < 0 || dark > 255) {
-                return cli_usage_error("nightify", "--dark-threshold '%s' is not 0..255", argv[i]);
-            }
-        } else if (argv[i][0] == '-' && argv[i][1] != '\0') {
-            return cli_usage_error("nightify", "unknown option '%s'", argv[i]);
-        } else if (npos < 2) {
-            pos[npos++] = argv[i];
-        } else {
-            return cli_usage_error("nightify", "unexpected argument '%s'", argv[i]);
-        }
-    }
-    if (npos < 2)
+    rc = cli_options("nightify", help, argc, argv, opts, NULL, NULL, &pa);
+    if (rc != EXIT_OK)
+        return rc < 0 ? EXIT_OK : rc;
+    if (pa.npos > 2)
+        return cli_usage_error("nightify", "unexpected argument '%s'", pa.pos[2]);
+    rc = EXIT_OK;
+    if (pa.npos < 2)
         return cli_usage_error("nightify", "needs DAY.png and NIGHT.png");
     if (!out)
         return cli_usage_error("nightify", "missing -o OUT.png");

@@ -4,6 +4,7 @@
 #include <string.h>
 
 #include "cli.h"
+#include "options.h"
 #include "geo_out.h"
 #include "points.h"
 
@@ -50,47 +51,45 @@ static int parse_pair(const char *s, double v[2])
     return cli_parse_double(buf, &v[0]) || cli_parse_double(comma + 1, &v[1]) ? -1 : 0;
 }
 
+static int parse_at(const char *v, void *dst)
+{
+    vis_opts *o = dst;
+    if (parse_pair(v, o->at) != 0)
+        return -1;
+    o->have_at = 1;
+    return 0;
+}
+
+static int parse_dir(const char *v, void *dst)
+{
+    return cli_parse_double(v, dst) != 0 || !isfinite(*(double *)dst);
+}
+
+static int parse_fov(const char *v, void *dst)
+{
+    return cli_parse_double(v, dst) != 0 || !(*(double *)dst > 0);
+}
+
 static int parse_args(int argc, char **argv, vis_opts *o)
 {
-    int i;
+    const cli_opt opts[] = {
+        { "--points", NULL, &o->points, NULL, NULL, 0, NULL },
+        { "--geojson", NULL, &o->geojson, NULL, NULL, 0, NULL },
+        { "--at", NULL, o, parse_at, "--at '%s' is not X,Y", 0, NULL },
+        { "--dir", NULL, &o->dir, parse_dir, "--dir '%s' is not a number of degrees", 0, NULL },
+        { "--fov", NULL, &o->fov, parse_fov, "--fov '%s' is not a positive number of degrees", 0, NULL },
+        CLI_OPT_END
+    };
+    cli_args pa;
+    int rc;
     memset(o, 0, sizeof *o);
     o->fov = 360.0;
-    for (i = 1; i < argc; i++) {
-        const char *a = argv[i];
-        int r = cli_common_option("vis", argc, argv, &i, &o->c);
-        if (r < 0)
-            return EXIT_USAGE;
-        if (r)
-            continue;
-        if (strcmp(a, "--help") == 0 || strcmp(a, "-h") == 0) {
-            fputs(help, stdout);
-            return -1;
-        }
-        if ((strcmp(a, "--points") == 0 || strcmp(a, "--geojson") == 0 || strcmp(a, "--at") == 0 ||
-             strcmp(a, "--dir") == 0 || strcmp(a, "--fov") == 0) && i + 1 >= argc)
-            return cli_usage_error("vis", "%s needs a value", a);
-        if (strcmp(a, "--points") == 0) {
-            o->points = argv[++i];
-        } else if (strcmp(a, "--geojson") == 0) {
-            o->geojson = argv[++i];
-        } else if (strcmp(a, "--at") == 0) {
-            if (parse_pair(argv[++i], o->at) != 0)
-                return cli_usage_error("vis", "--at '%s' is not X,Y", argv[i]);
-            o->have_at = 1;
-        } else if (strcmp(a, "--dir") == 0) {
-            if (cli_parse_double(argv[++i], &o->dir) != 0 || !isfinite(o->dir))
-                return cli_usage_error("vis", "--dir '%s' is not a number of degrees", argv[i]);
-        } else if (strcmp(a, "--fov") == 0) {
-            if (cli_parse_double(argv[++i], &o->fov) != 0 || !(o->fov > 0))
-                return cli_usage_error("vis", "--fov '%s' is not a positive number of degrees", argv[i]);
-        } else if (a[0] == '-' && a[1] != '\0') {
-            return cli_usage_error("vis", "unknown option '%s'", a);
-        } else if (!o->scene) {
-            o->scene = a;
-        } else {
-            return cli_usage_error("vis", "unexpected argument '%s'", a);
-        }
-    }
+    rc = cli_options("vis", help, argc, argv, opts, &o->c, NULL, &pa);
+    if (rc != EXIT_OK)
+        return rc;
+    if (pa.npos > 1)
+        return cli_usage_error("vis", "unexpected argument '%s'", pa.pos[1]);
+    o->scene = pa.npos ? pa.pos[0] : NULL;
     if (!o->scene)
         return cli_usage_error("vis", "missing SCENE");
     if (!o->points == !o->have_at)

@@ -409,8 +409,20 @@ int cli_indirect_run(const char *cmd, plx_engine *e, const cli_indirect *ind, co
 
 /* ---- the scene's coordinates ---------------------------------------------- */
 
-#define CLI_M_PER_DEG_LON 111320.0
-#define CLI_M_PER_DEG_LAT 110540.0
+/* One point through the engine's projection (plx_lonlat_to_local or
+ * plx_local_to_lonlat), in place. */
+static int cli_project(plx_engine *e, plx_status (*fn)(plx_engine *, size_t, const double *, double *),
+                       double *x, double *y)
+{
+    double in[2], out[2];
+    in[0] = *x;
+    in[1] = *y;
+    if (fn(e, 1, in, out) != PLX_OK)
+        return -1;
+    *x = out[0];
+    *y = out[1];
+    return 0;
+}
 
 int cli_to_local(plx_engine *e, double *x, double *y)
 {
@@ -420,9 +432,7 @@ int cli_to_local(plx_engine *e, double *x, double *y)
         return 0;
     if (!(fabs(*x) <= 180.0 && fabs(*y) <= 90.0))
         return -1;
-    *x = (*x - si.lon0) * CLI_M_PER_DEG_LON * cos(si.lat0 * 3.14159265358979323846 / 180.0);
-    *y = (*y - si.lat0) * CLI_M_PER_DEG_LAT;
-    return 0;
+    return cli_project(e, plx_lonlat_to_local, x, y);
 }
 
 void cli_from_local(plx_engine *e, double *x, double *y)
@@ -431,8 +441,7 @@ void cli_from_local(plx_engine *e, double *x, double *y)
     plx_scene_info_get(e, &si);
     if (!si.lonlat)
         return;
-    *x = si.lon0 + *x / (CLI_M_PER_DEG_LON * cos(si.lat0 * 3.14159265358979323846 / 180.0));
-    *y = si.lat0 + *y / CLI_M_PER_DEG_LAT;
+    cli_project(e, plx_local_to_lonlat, x, y);
 }
 
 int cli_option_local(const char *cmd, const char *opt, plx_engine *e, double *x, double *y)

@@ -13,9 +13,7 @@ int geo_begin(geo_out *g, plx_engine *e)
     if (plx_scene_info_get(e, &si) != PLX_OK)
         return -1;
     g->lonlat = si.lonlat;
-    g->lon0 = si.lon0;
-    g->lat0 = si.lat0;
-    g->coslat = cos(si.lat0 * 3.14159265358979323846 / 180.0);
+    g->e = e;
     g->root = cJSON_CreateObject();
     cJSON_AddStringToObject(g->root, "type", "FeatureCollection");
     if (!g->lonlat) {
@@ -35,8 +33,12 @@ cJSON *geo_position(const geo_out *g, double x, double y, const double *z)
 {
     cJSON *a = cJSON_CreateArray();
     if (g->lonlat) {
-        x = g->lon0 + x / (111320.0 * g->coslat);
-        y = g->lat0 + y / 110540.0;
+        double xy[2], ll[2];
+        xy[0] = x;
+        xy[1] = y;
+        plx_local_to_lonlat(g->e, 1, xy, ll);
+        x = ll[0];
+        y = ll[1];
     }
     cJSON_AddItemToArray(a, cJSON_CreateNumber(x));
     cJSON_AddItemToArray(a, cJSON_CreateNumber(y));

@@ -10,7 +10,7 @@
 typedef struct geo_out {
     cJSON *root, *features;
     int lonlat;
-    double lon0, lat0, coslat;
+    plx_engine *e;        /* for plx_local_to_lonlat */
 } geo_out;
 
 /* Starts a FeatureCollection in the scene's frame; 0 on success. */

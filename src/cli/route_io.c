@@ -9,7 +9,7 @@
 
 typedef struct frame {
     int lonlat;           /* the path file is in lon/lat */
-    double lon0, lat0, coslat;
+    plx_engine *e;        /* for plx_lonlat_to_local */
 } frame;
 
 static int add_line(route_set *rs, size_t *cap, const char *name, const cJSON *coords, const frame *f,
@@ -52,8 +52,12 @@ static int add_line(route_set *rs, size_t *cap, const char *name, const cJSON *c
         vx = x->valuedouble;
         vy = y->valuedouble;
         if (f->lonlat) {
-            vx = (vx - f->lon0) * 111320.0 * f->coslat;
-            vy = (vy - f->lat0) * 110540.0;
+            double ll[2], xy[2];
+            ll[0] = vx;
+            ll[1] = vy;
+            plx_lonlat_to_local(f->e, 1, ll, xy);
+            vx = xy[0];
+            vy = xy[1];
         }
         l->xy[2 * k] = vx;
         l->xy[2 * k + 1] = vy;
@@ -106,9 +110,7 @@ static int set_frame(const cJSON *root, const cJSON *features, plx_engine *e, fr
         return -1;
     }
     f->lonlat = 1;
-    f->lon0 = si.lon0;
-    f->lat0 = si.lat0;
-    f->coslat = cos(si.lat0 * 3.14159265358979323846 / 180.0);
+    f->e = e;
     return 0;
 }
 

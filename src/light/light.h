@@ -109,46 +109,6 @@
 #define LIGHT_MIN_PIECE 1e-9  /* m: shorter contacts with a solid are grazing */
 #define LIT_NONE 0xffffffffu
 
-/* ---- lit regions ------------------------------------------------------ */
-
-/* An edge line relative to the lamp's ground point O: the points O + t w
- * of the line satisfy cross(t w, e) = c, so along a direction w the line is
- * met at t = c / cross(w, e). */
-typedef struct lit_line { double ex, ey, c; } lit_line;
-
-/* One interval of one building along the rays of a sector: from line lo
- * (LIT_NONE: from O itself, O inside the footprint) to line hi. */
-typedef struct lit_band { uint32_t bld, lo, hi; } lit_band;
-
-typedef struct lit_ring { uint32_t first, count; uint32_t wall; } lit_ring;
-/* wall: for facade rings the wall id = index in scene.pts of the wall's
- * first vertex (the wall runs to the next vertex of its ring); LIT_NONE for
- * ground rings. */
-
-typedef struct lit_pt3 { double x, y, z; } lit_pt3;
-
-typedef struct lit_region {
-    uint32_t lamp;
-    double o[3];              /* lamp position */
-    double reach;             /* R */
-    double ground_reach;      /* Rg = sqrt(R^2 - zL^2), 0 if zL >= R */
-    uint32_t ncand;           /* buildings in reach */
-    /* sector index: sector i starts at pseudo-angle sec_ang[i] (ascending,
-     * in [0, 4)); the last sector wraps round to sec_ang[0] + 4. */
-    uint32_t nsec;
-    const double *sec_ang;
-    const uint32_t *sec_first; /* nsec + 1 offsets into band */
-    const lit_band *band;      uint32_t nband;
-    const lit_line *line;      uint32_t nline;
-    /* output polygons (polygons == 1; an array is NULL when its count is 0) */
-    const lit_ring *ground;    uint32_t nground;
-    const vec2 *gpts;          uint32_t ngpts;
-    const lit_ring *facade;    uint32_t nfacade;
-    const lit_pt3 *fpts;       uint32_t nfpts;
-    int polygons;              /* 0: sector index only (what queries need) */
-    size_t bytes;              /* size of the region in the pool */
-} lit_region;
-
 /* ---- the light object -------------------------------------------------- */
 
 typedef struct light_grid {
@@ -160,7 +120,7 @@ typedef struct light_grid {
 } light_grid;
 
 typedef struct light_entry {
-    lit_region *reg;          /* NULL when not cached */
+    struct lit_region *reg;   /* NULL when not cached */
     uint32_t prev, next;      /* LRU list, most recent first */
     uint32_t aprev, anext;    /* address order in the pool */
 } light_entry;
@@ -205,60 +165,9 @@ plx_status light_create(arena *a, const scene *s, size_t cache_bytes, light **ou
 /* Bytes light_create takes besides the pool (for budgets and reports). */
 size_t light_base_bytes(const scene *s);
 
-/* E(P) in lux at surface point P with unit normal n (colour ignored) and,
- * when rgb is not NULL, the colour-weighted version. Visibility through the
- * lamps' lit regions (computed and cached on demand); a lamp whose region
- * cannot be had (larger than the pool, no scratch) is answered by the
- * segment path instead (counted in stats.fallbacks), so the result does not
- * depend on the cache. Returns PLX_OK or PLX_E_INVALID (NULL argument).
- * P is taken as given: see light_classify_point for checking it. */
-plx_status light_illuminance(light *L, const double P[3], const double n[3],
-                             double *E /* OUT */, double rgb[3] /* OUT, may be NULL */);
-
-/* The same by the segment path only (no cache, no memory). */
-plx_status light_illuminance_exact(light *L, const double P[3], const double n[3],
-                                   double *E /* OUT */, double rgb[3] /* OUT, may be NULL */);
-
-/* SPEC §6 at P (direct light, same visibility as light_illuminance):
- * out[0] E_h (= light_illuminance with n = +z), out[1] E_v(u), out[2]
- * E_sc(u), out[3] E_hs, lux; u a horizontal unit vector (x, y), the
- * facing direction (src/light/meter.c). */
-plx_status light_meter(light *L, const double P[3], const double u[2], double out[4] /* OUT */);
-
-/* Which lamps light P (facing n): writes up to cap lamp ids and their
- * uncoloured terms (lux) in lamp order, returns how many lamps light P
- * (may exceed cap; then only cap were written). Same visibility as
- * light_illuminance; ids and contrib may be NULL when cap is 0. */
-int light_lamps_at(light *L, const double P[3], const double n[3],
-                   uint32_t *ids /* OUT */, double *contrib /* OUT */, int cap);
-
-/* Visibility of P from lamp i: 1 visible, 0 blocked (whatever the distance
- * and the normal). By the lamp's region when it can be had, else by the
- * segment path. */
-int light_visible(light *L, uint32_t lamp, const double P[3]);
-
 /* 1 if the open segment A->B meets some building's solid interior by more
  * than LIGHT_MIN_PIECE, else 0 (segment path). */
 int light_segment_blocked(light *L, const double A[3], const double B[3]);
-
-/* The lit region of lamp i, from the cache or computed now (which may evict
- * other lamps' regions). The pointer stays valid until the next call on L
- * that computes a region (light_region, light_illuminance, light_lamps_at,
- * light_visible). Returns PLX_OK; PLX_E_INVALID (NULL argument, lamp out of
- * range); PLX_E_NOMEM when the region is larger than the whole pool, or
- * scratch memory runs out (the cache keeps what it held, L stays usable). */
-plx_status light_region(light *L, uint32_t lamp, const lit_region **out /* OUT */);
-
-/* The same without the polygons (only the sector index, about a tenth of
- * the size and time): what the visibility queries use. A cached full region
- * serves too; light_region replaces an index-only entry by a full one. */
-plx_status light_region_index(light *L, uint32_t lamp, const lit_region **out /* OUT */);
-
-/* Visibility of P from the lamp of region r through its sector index. */
-int light_region_visible(light *L, const lit_region *r, const double P[3]);
-
-/* Drops every cached region. */
-void light_cache_clear(light *L);
 
 /* Where a query point lies (for clear API errors), with a tolerance of
  * LIGHT_CLASSIFY_TOL metres:

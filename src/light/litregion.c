@@ -1,7 +1,8 @@
 /* litregion: per-lamp sector index (bands), lit ground and facade polygons,
  * and the LRU cache of regions (contract in light.h). */
 #include "light/light.h"
-#include "light/photometry.h"
+#include "scene/photometry.h"
+#include "light/litregion.h"
 #include "base/geom.h"
 #include "base/plx_assert.h"
 

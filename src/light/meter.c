@@ -1,7 +1,8 @@
 /* meter: the pedestrian quantities of SPEC §6 at a point (contract in
  * light.h, light_meter). */
-#include "light/light.h"
-#include "light/photometry.h"
+#include "light/meter.h"
+#include "light/illuminance.h"
+#include "scene/photometry.h"
 
 #include <math.h>
 

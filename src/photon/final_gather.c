@@ -4,6 +4,7 @@
 #include <string.h>
 
 #include "photon/final_gather.h"
+#include "photon/indirect.h"
 
 static uint64_t mix64(uint64_t z)
 {

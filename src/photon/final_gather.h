@@ -41,7 +41,7 @@
 #define PLX_FINAL_GATHER_H
 
 #include <stdint.h>
-#include "light/light.h"
+#include "light/illuminance.h"
 #include "photon/photon.h"
 
 /* Default side of the direction grid: 32 x 32 = 1024 directions. */

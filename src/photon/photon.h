@@ -319,21 +319,6 @@ size_t photon_lamp_slot_bytes(const scene *s, const photon_config *cfg);
 void photon_step(photon_sys *ps, uint32_t n, uint64_t seed);
 
 /*
- * E_indirect (lux) at surface point P with outward unit normal n: the
- * ground or a roof when n points up (n[2] > 0.5), an underside when down,
- * else a wall (P within a few mm of it). O(1) apart from the lamp cache
- * term (one test per cached lamp). Points on no surface, or with no frames
- * yet, give 0.
- */
-double photon_indirect(photon_sys *ps, const double P[3], const double n[3]);
-
-/* The same, also writing the RGB version of E_indirect to rgb (may be NULL):
- * each lamp's light weighted by its colour (equals the scalar for white
- * lamps and grey albedos). Returns the scalar. */
-double photon_indirect_rgb(photon_sys *ps, const double P[3], const double n[3],
-                           double rgb[3] /* OUT */);
-
-/*
  * Levels for a viewer at eye looking along dir (unit; NULL = all around)
  * with a full cone angle fov_deg. Blocks whose level changes get a new
  * empty chart. Returns PLX_OK or PLX_E_NOMEM (scratch for sorting; levels
@@ -356,70 +341,11 @@ void photon_lamp_dir(const scene_lamp *Lp, uint64_t *rng, double d[3] /* OUT */)
 void photon_lamps_changed(photon_sys *ps);
 void photon_reset(photon_sys *ps);
 
-/* E_indirect (PHOTON_CH channels: scalar, RGB) at the surface of hit h
- * (a wall, the ground, a roof or an underside), as photon_indirect_rgb
- * answers at h->p with h->n but without the probe ray. */
-void photon_indirect_hit(photon_sys *ps, const trace_hit *h, double e[PHOTON_CH] /* OUT */);
-
-/*
- * Photons only from the lamps that can matter for a region
- * (photon_select.c): the lamps whose reach (the disk of radius R about the
- * lamp, horizontally) comes within margin metres of box (x0, y0, x1, y1);
- * box NULL: every lamp again. The frame's photons are shared among the
- * chosen lamps by flux, so each carries the same flux as before and the
- * chosen lamps get more of them; the light of the others is left out (its
- * later bounces reach the region only over more than margin metres).
- * Drops every accumulated photon (photon_reset). Returns the number of
- * lamps chosen. Needs no memory.
- */
-uint32_t photon_select_lamps(photon_sys *ps, const double box[4], double margin);
-
-/* ---- lamp floor maps (photon_night.c) --------------------------------- */
-
-/*
- * Makes lamp i's floor map available: on a hit it becomes the most recently
- * used; on a miss it is computed into the least recently used slot
- * (evicting that lamp), and the first time also pushed into I (see above).
- * Returns 1 on a hit, 0 on a miss, -1 when i is out of range or the cache
- * has no slot. Uses no memory.
- */
-int photon_lamp_request(photon_sys *ps, uint32_t lamp);
-
-/* Refines the lamps within cfg.near_radius (horizontally) of eye, nearest
- * first, at most the cache capacity. Returns the number of misses (maps
- * computed), or -1 when scratch memory runs out. */
-int photon_lamps_update(photon_sys *ps, const double eye[3]);
-
-/* Whether lamp i is in the cache (1/0), without touching the LRU order. */
-int photon_lamp_cached(const photon_sys *ps, uint32_t lamp);
-
-/* The cached lamps from most to least recently used: writes up to cap
- * lamp indices, returns how many are cached. */
-uint32_t photon_lamp_lru(const photon_sys *ps, uint32_t *lamps /* OUT */, uint32_t cap);
-
-/* The floor-map share of E_indirect at (x, y, z) on the ground or a roof,
- * PHOTON_CH channels: I - sum D_i + sum C_i (lux), 0 when nothing is
- * refined. On covered ground (covered != 0) it is I_cov. */
-void photon_night_horizontal(const photon_sys *ps, double x, double y, double z, int covered,
-                             double e[PHOTON_CH] /* OUT */);
-
-/* ---- histogram matching (photon_hist.c; munoz2013 §3.1) --------------- */
-
-/*
- * Histogram matching of an RGB8 image to a reference, channel by channel:
- * each value v of channel c of src becomes the smallest w whose cumulative
- * frequency in the reference channel reaches v's in src. Reference pixels
- * whose luminance (0.2126 R + 0.7152 G + 0.0722 B, 0..255) is below
- * dark_threshold are left out of the reference histograms (if that leaves
- * none, all are used). src and out hold npx packed RGB pixels and may be
- * the same buffer; ref holds nref pixels. Pure: no memory, no state.
- * Returns 0, or -1 when a pointer is NULL or npx or nref is 0 (out
- * untouched).
- */
-int photon_hist_match(const uint8_t *src, size_t npx, const uint8_t *ref, size_t nref,
-                      double dark_threshold, uint8_t *out /* OUT */);
-
 /* ---- internal, shared by photon*.c ------------------------------------ */
+
+/* Facade chart coordinates of (x, y, z) for block k at level lv. */
+void photon_chart_xy(const photon_sys *ps, uint32_t k, const photon_level *lv, double x, double y,
+                     double z, double *fx /* OUT */, double *fy /* OUT */);
 
 /* The reach window W(x) = (clamp(1 - x^4, 0, 1))^2. */
 double photon_window(double x);

@@ -1,9 +1,12 @@
 /* photon_select: photons only from the lamps that can matter for a region
- * (photon.h, photon_select_lamps). */
+ * (photon_select.h). */
 #include <math.h>
 
 #include "photon/photon.h"
-#include "light/photometry.h"
+#include "scene/photometry.h"
+#include "photon/photon_select.h"
+
+#define SELECT_PI 3.14159265358979323846
 
 /* Horizontal distance from (x, y) to the box (0 inside). */
 static double box_distance(const double box[4], double x, double y)

@@ -1,6 +1,7 @@
 /* locate: point location in the search DAG of a diagram, and ray shooting
  * (the regions walked from the point's region to the first wall). */
 #include "polar/polar_int.h"
+#include "polar/locate.h"
 
 /* ---- queries ----------------------------------------------------------- */
 
@@ -31,7 +32,7 @@ void polar_node(const polar_map *m, uint32_t n, uint32_t w[3])
  * wall piece (y test: the nodes met are those whose regions hold f, so f
  * lies within the piece's span). -3 at a solid leaf, whose child word
  * carries the owner. */
-int32_t polar_dag_locate(const polar *pd, const polar_map *m, vec2 f, int32_t *owner,
+static int32_t dag_locate(const polar *pd, const polar_map *m, vec2 f, int32_t *owner,
                           uint32_t *depth)
 {
     uint32_t c = m->root, d = 0;
@@ -70,13 +71,13 @@ int32_t polar_dag_locate(const polar *pd, const polar_map *m, vec2 f, int32_t *o
 
 int32_t polar_locate_frame(const polar *pd, const polar_map *m, vec2 f)
 {
-    return polar_dag_locate(pd, m, f, NULL, NULL);
+    return dag_locate(pd, m, f, NULL, NULL);
 }
 
 int32_t polar_locate_frame_ex(const polar *pd, const polar_map *m, vec2 f, int32_t *owner,
-                              uint32_t *depth)
+                               uint32_t *depth)
 {
-    return polar_dag_locate(pd, m, f, owner, depth);
+    return dag_locate(pd, m, f, owner, depth);
 }
 
 
@@ -96,7 +97,7 @@ int32_t polar_locate(const polar *pd, int q, vec2 p, int32_t *owner)
         return -1;
     quadrant_side(q, &mi, &top);
     m = &pd->map[mi];
-    t = polar_dag_locate(pd, m, to_frame(m->frame, p), owner, NULL);
+    t = dag_locate(pd, m, to_frame(m->frame, p), owner, NULL);
     PLX_ASSERT(t >= -3 && (t < 0 || (uint32_t)t < m->ntrap)); /* a region of this map */
     if (t >= 0 && owner)
         *owner = seg_owner(pd, top ? m->trap[t].top : m->trap[t].bot);

@@ -206,8 +206,4 @@ plx_status polar_dag_build(arena *a, polar *pd, polar_map *m, dbuild *b, const s
                            const uint32_t *canon, const uint32_t *order, uint32_t nev);
 plx_status polar_dag_keep(arena *a, polar *pd, polar_map *m, dbuild *b, int flags);
 
-/* locate.c: the DAG descended from its root (see polar_locate_frame_ex). */
-int32_t polar_dag_locate(const polar *pd, const polar_map *m, vec2 f, int32_t *owner,
-                         uint32_t *depth);
-
 #endif

@@ -3,6 +3,7 @@
 #include <math.h>
 #include <string.h>
 #include "polar/visibility.h"
+#include "polar/locate.h"
 #include "base/geom.h"
 #include "base/plx_assert.h"
 

@@ -6,7 +6,10 @@
 #include "render/render.h"
 #include "render/raster.h"
 #include "light/light.h"
-#include "light/photometry.h"
+#include "scene/photometry.h"
+#include "render/lightmap.h"
+#include "light/illuminance.h"
+#include "light/litregion.h"
 #include "base/geom.h"
 
 #define R_ALIGN 16
@@ -52,13 +55,7 @@ struct render {
     double tP[RENDER_TILE * RENDER_TILE][3], tN[RENDER_TILE * RENDER_TILE][3];
     double tE[RENDER_TILE * RENDER_TILE][3];
     uint8_t tcall[RENDER_TILE * RENDER_TILE];  /* 0 sky, 1 no shader, 2 shader */
-    /* light map */
-    float *lm;
-    size_t lm_cap;              /* floats */
-    uint32_t lm_nx, lm_ny;
-    double lm_x0, lm_y0, lm_cell;
-    uint64_t lm_shaded;
-    int lm_built;
+    lightmap lm;                /* the aerial light map (lightmap.c) */
     double thr[255];
     uint8_t *lut;               /* 65536: byte for the float bits >> 16 (a hint) */
     const char *err;
@@ -619,37 +616,6 @@ static void draw_buildings(render *r, const render_backend *be, render_stats *st
     }
 }
 
-/* Ground E_rgb from the light map, bilinear between texel centres. */
-static void lightmap_sample(const render *r, const double P[3], double rgb[3])
-{
-    double fx = (P[0] - r->lm_x0) / r->lm_cell - 0.5, fy = (P[1] - r->lm_y0) / r->lm_cell - 0.5;
-    double ix, iy, tx, ty, wgt[4];
-    int64_t i0, j0;
-    int k, c;
-    rgb[0] = rgb[1] = rgb[2] = 0.0;
-    if (!(fx > -1.0 && fy > -1.0 && fx < (double)r->lm_nx && fy < (double)r->lm_ny))
-        return;
-    ix = floor(fx);
-    iy = floor(fy);
-    tx = fx - ix;
-    ty = fy - iy;
-    i0 = (int64_t)ix;
-    j0 = (int64_t)iy;
-    wgt[0] = (1 - tx) * (1 - ty);
-    wgt[1] = tx * (1 - ty);
-    wgt[2] = (1 - tx) * ty;
-    wgt[3] = tx * ty;
-    for (k = 0; k < 4; k++) {
-        int64_t i = i0 + (k & 1), j = j0 + (k >> 1);
-        const float *t;
-        if (i < 0 || j < 0 || i >= (int64_t)r->lm_nx || j >= (int64_t)r->lm_ny)
-            continue;
-        t = &r->lm[3 * ((size_t)j * r->lm_nx + (size_t)i)];
-        for (c = 0; c < 3; c++)
-            rgb[c] += wgt[k] * t[c];
-    }
-}
-
 /* Lamps whose reach sphere meets box bx (minx, miny, minz, maxx, maxy,
  * maxz), in lamp index order, into r->tl (at most RENDER_TILE_LAMPS);
  * returns their number, or -1 when there are more (the caller then takes
@@ -865,7 +831,7 @@ static void shade_pass(render *r, const render_opts *o, render_stats *st)
     const mesh *m = r->m;
     int32_t i, j, ti, tj;
     double ta = r->tanh_ * r->aspect, tb = r->tanh_;
-    int use_lm = o->lightmap && r->lm_built;
+    int use_lm = o->lightmap && r->lm.built;
     double (*TP)[3] = r->tP, (*TN)[3] = r->tN;
     for (tj = 0; tj < r->h; tj += RENDER_TILE)
         for (ti = 0; ti < r->w; ti += RENDER_TILE) {
@@ -921,7 +887,7 @@ static void shade_pass(render *r, const render_opts *o, render_stats *st)
                         P[2] = 0.0;
                     r->tcall[q] = 1;
                     if (sf->lit && sid == MESH_SURF_GROUND && use_lm)
-                        lightmap_sample(r, P, E);
+                        lightmap_sample(&r->lm, P, E);
                     else if (sf->lit) {
                         r->tcall[q] = 2;
                         ncall++;
@@ -1155,123 +1121,27 @@ plx_status render_frame(render *r, const render_camera *cam, const render_opts *
     return PLX_OK;
 }
 
-/* ---- light map ------------------------------------------------------------------ */
+/* ---- light map (lightmap.c) ------------------------------------------------------ */
 
 plx_status render_lightmap_build(render *r, double cell, size_t max_bytes)
 {
-    const scene *s;
-    double x0 = HUGE_VAL, y0 = HUGE_VAL, x1 = -HUGE_VAL, y1 = -HUGE_VAL;
-    uint32_t l, nx, ny, i, j;
-    size_t need;
     if (!r)
         return PLX_E_INVALID;
-    s = r->s;
-    if (!(cell > 0.0) || !isfinite(cell) || max_bytes < 12) {
-        r->err = "render_lightmap_build: m_per_texel must be > 0 and max_bytes >= 12";
-        return PLX_E_INVALID;
-    }
-    for (l = 0; l < s->nlamps; l++) {
-        const scene_lamp *lp = &s->lamps[l];
-        double rg;
-        if (!(lp->radius > lp->z) || !(lp->intensity > 0))
-            continue;
-        rg = sqrt(lp->radius * lp->radius - lp->z * lp->z);
-        x0 = fmin(x0, lp->x - rg);
-        y0 = fmin(y0, lp->y - rg);
-        x1 = fmax(x1, lp->x + rg);
-        y1 = fmax(y1, lp->y + rg);
-    }
-    if (!(x1 > x0)) {
-        x0 = y0 = 0.0;
-        x1 = y1 = cell;
-    }
-    for (;;) {
-        double fx = ceil((x1 - x0) / cell), fy = ceil((y1 - y0) / cell);
-        if (fx < 1) fx = 1;
-        if (fy < 1) fy = 1;
-        if (fx * fy * 12.0 <= (double)max_bytes && fx < 1e8 && fy < 1e8) {
-            nx = (uint32_t)fx;
-            ny = (uint32_t)fy;
-            break;
-        }
-        cell *= 1.05;
-    }
-    need = (size_t)nx * ny * 3;
-    if (!r->lm || need > r->lm_cap) {
-        if (r->lm) {
-            r->err = "render_lightmap_build: the new map does not fit the first one's memory";
-            return PLX_E_NOMEM;
-        }
-        r->lm = arena_alloc(r->a, PLX_PART_FRAME, arena_mul(need, sizeof(float)), 64);
-        if (!r->lm) {
-            r->err = "render_lightmap_build: out of memory for the light map";
-            return PLX_E_NOMEM;
-        }
-        r->lm_cap = need;
-    }
-    r->lm_nx = nx;
-    r->lm_ny = ny;
-    r->lm_cell = cell;
-    /* centre the grid on the reach box */
-    r->lm_x0 = 0.5 * (x0 + x1) - 0.5 * nx * cell;
-    r->lm_y0 = 0.5 * (y0 + y1) - 0.5 * ny * cell;
-    r->lm_shaded = 0;
-    memset(r->lm, 0, need * sizeof(float));
-    /* mark texels some lamp reaches, using the map itself (channel 0 = 1) */
-    for (l = 0; l < s->nlamps; l++) {
-        const scene_lamp *lp = &s->lamps[l];
-        double rg;
-        int64_t a0, a1, b0, b1, a, b;
-        if (!(lp->radius > lp->z) || !(lp->intensity > 0))
-            continue;
-        rg = sqrt(lp->radius * lp->radius - lp->z * lp->z) * (1.0 + 1e-9) + 1e-9;
-        a0 = (int64_t)floor((lp->x - rg - r->lm_x0) / cell - 0.5);
-        a1 = (int64_t)ceil((lp->x + rg - r->lm_x0) / cell - 0.5);
-        b0 = (int64_t)floor((lp->y - rg - r->lm_y0) / cell - 0.5);
-        b1 = (int64_t)ceil((lp->y + rg - r->lm_y0) / cell - 0.5);
-        if (a0 < 0) a0 = 0;
-        if (b0 < 0) b0 = 0;
-        if (a1 > (int64_t)nx - 1) a1 = (int64_t)nx - 1;
-        if (b1 > (int64_t)ny - 1) b1 = (int64_t)ny - 1;
-        for (b = b0; b <= b1; b++)
-            for (a = a0; a <= a1; a++) {
-                double dx = r->lm_x0 + (a + 0.5) * cell - lp->x, dy = r->lm_y0 + (b + 0.5) * cell - lp->y;
-                if (dx * dx + dy * dy <= rg * rg)
-                    r->lm[3 * ((size_t)b * nx + (size_t)a)] = 1.0f;
-            }
-    }
-    for (j = 0; j < ny; j++)
-        for (i = 0; i < nx; i++) {
-            float *t = &r->lm[3 * ((size_t)j * nx + i)];
-            double P[3], n[3] = { 0.0, 0.0, 1.0 }, E[3];
-            if (t[0] == 0.0f)
-                continue;
-            P[0] = r->lm_x0 + (i + 0.5) * cell;
-            P[1] = r->lm_y0 + (j + 0.5) * cell;
-            P[2] = 0.0;
-            r->shade(r->user, P, n, E);
-            r->lm_shaded++;
-            t[0] = (float)E[0];
-            t[1] = (float)E[1];
-            t[2] = (float)E[2];
-        }
-    r->lm_built = 1;
-    r->err = "";
-    return PLX_OK;
+    return lightmap_build(&r->lm, r->a, r->s, cell, max_bytes, r->shade, r->user, &r->err);
 }
 
 void render_lightmap_get(const render *r, render_lightmap_info *out)
 {
     memset(out, 0, sizeof *out);
-    if (!r || !r->lm_built)
+    if (!r || !r->lm.built)
         return;
     out->built = 1;
-    out->nx = r->lm_nx;
-    out->ny = r->lm_ny;
-    out->x0 = r->lm_x0;
-    out->y0 = r->lm_y0;
-    out->cell = r->lm_cell;
-    out->bytes = (size_t)r->lm_nx * r->lm_ny * 3 * sizeof(float);
-    out->shaded = r->lm_shaded;
-    out->rgb = r->lm;
+    out->nx = r->lm.nx;
+    out->ny = r->lm.ny;
+    out->x0 = r->lm.x0;
+    out->y0 = r->lm.y0;
+    out->cell = r->lm.cell;
+    out->bytes = (size_t)r->lm.nx * r->lm.ny * 3 * sizeof(float);
+    out->shaded = r->lm.shaded;
+    out->rgb = r->lm.rgb;
 }

@@ -5,9 +5,10 @@
 #include <string.h>
 #include <math.h>
 
-#include "scene/loader.h"
+#include "scene/features.h"
 #include "base/geom.h"
-#include "light/photometry.h"
+#include "scene/photometry.h"
+#include "base/lonlat.h"
 
 #define MAX_COORD 1.0e7
 #define MAX_HEIGHT 1000.0
@@ -18,8 +19,6 @@
 #define DEFAULT_LAMP_Z 6.0
 #define DEFAULT_INTENSITY 1000.0
 #define DEFAULT_RADIUS 30.0
-#define M_PER_DEG_LON 111320.0
-#define M_PER_DEG_LAT 110540.0
 #define HOLE_PAIR_CHECK_LIMIT 4000000.0
 
 static const float default_color[3] = { 1.0f, 0.62f, 0.28f };
@@ -134,7 +133,7 @@ static const char *copy_id(loader *ld, const cJSON *item)
     n = strlen(src);
     if (n > 200)
         n = 200;
-    dst = arena_alloc(&ld->e->mem, PLX_PART_SCENE, n + 1, 1);
+    dst = arena_alloc(ld->mem, PLX_PART_SCENE, n + 1, 1);
     if (!dst)
         return NULL;
     memcpy(dst, src, n);
@@ -172,8 +171,7 @@ static int read_position(loader *ld, const cJSON *pos, vec2 *p, strbuf *why)
         return -1;
     }
     if (!ld->metres && ld->coslat != 0.0) {
-        vx = (vx - ld->lon0) * M_PER_DEG_LON * ld->coslat;
-        vy = (vy - ld->lat0) * M_PER_DEG_LAT;
+        lonlat_to_local(ld->lon0, ld->lat0, ld->coslat, &vx, &vy);
     }
     if (fabs(vx) > MAX_COORD || fabs(vy) > MAX_COORD) {
         sb_str(why, "is out of range (|coordinate| > 1e7 m)");
@@ -237,7 +235,7 @@ static plx_status read_ring(loader *ld, const cJSON *jr, uint32_t ring, scene_ri
         sb_str(why, " (a ring needs at least 3)");
         return PLX_E_SCENE;
     }
-    simple = geom_ring_is_simple(&ld->e->mem, p, n, &ei, &ej);
+    simple = geom_ring_is_simple(ld->mem, p, n, &ei, &ej);
     if (simple < 0)
         return PLX_E_NOMEM;
     if (!simple) {
@@ -573,7 +571,7 @@ static plx_status read_lamp_photometry(loader *ld, uint32_t fi, const char *id, 
     photometry_lamp_frame(l);
     if (ph && cJSON_IsString(ph) && ph->valuestring[0] != '\0') {
         size_t n = strlen(ph->valuestring);
-        char *dst = arena_alloc(&ld->e->mem, PLX_PART_SCENE, n + 1, 1);
+        char *dst = arena_alloc(ld->mem, PLX_PART_SCENE, n + 1, 1);
         if (!dst)
             return eng_nomem(ld->e, "copying photometry paths");
         memcpy(dst, ph->valuestring, n + 1);
@@ -693,13 +691,13 @@ static plx_status set_frame(loader *ld, const counts *c)
     ld->s->lonlat = 1;
     ld->lon0 = ld->s->lon0 = 0.5 * (c->box[0] + c->box[2]);
     ld->lat0 = ld->s->lat0 = 0.5 * (c->box[1] + c->box[3]);
-    ld->coslat = cos(ld->lat0 * 3.14159265358979323846 / 180.0);
+    ld->coslat = lonlat_cos(ld->lat0);
     return PLX_OK;
 }
 
 static void *alloc_array(loader *ld, size_t n, size_t size)
 {
-    return arena_alloc(&ld->e->mem, PLX_PART_SCENE, arena_mul(n ? n : 1, size), 16);
+    return arena_alloc(ld->mem, PLX_PART_SCENE, arena_mul(n ? n : 1, size), 16);
 }
 
 plx_status ld_features(loader *ld, cJSON *features)
@@ -840,13 +838,13 @@ plx_status ld_drop_buried_lamps(loader *ld)
 plx_status ld_drop_buried_lamps_from(loader *ld, uint32_t first)
 {
     scene *s = ld->s;
-    arena_mark m = arena_get_mark(&ld->e->mem);
+    arena_mark m = arena_get_mark(ld->mem);
     bgrid g;
     uint32_t i, kept = first;
     if (s->nlamps <= first || s->nbld == 0)
         return PLX_OK;
-    if (!bgrid_build(&ld->e->mem, s, &g)) {
-        arena_release(&ld->e->mem, &m);
+    if (!bgrid_build(ld->mem, s, &g)) {
+        arena_release(ld->mem, &m);
         return eng_nomem(ld->e, "checking lamps against buildings");
     }
     for (i = first; i < s->nlamps; i++) {
@@ -863,8 +861,8 @@ plx_status ld_drop_buried_lamps_from(loader *ld, uint32_t first)
                 sb_char(&b, ')');
             }
             sb_str(&b, "; left out");
-            if (ld->e->cfg.strict) {
-                arena_release(&ld->e->mem, &m);
+            if (eng_strict(ld->e)) {
+                arena_release(ld->mem, &m);
                 return ld_bad_feature(ld, s->lamps[i].feature, s->lamps[i].id, why);
             }
             ld_warn(ld, s->lamps[i].feature, s->lamps[i].id, why);
@@ -874,6 +872,6 @@ plx_status ld_drop_buried_lamps_from(loader *ld, uint32_t first)
         s->lamps[kept++] = s->lamps[i];
     }
     s->nlamps = kept;
-    arena_release(&ld->e->mem, &m);
+    arena_release(ld->mem, &m);
     return PLX_OK;
 }

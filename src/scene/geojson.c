@@ -23,11 +23,13 @@
 #include <math.h>
 #include <cjson/cJSON.h>
 
-#include "base/engine.h"
 #include "base/geom.h"
+#include "base/lonlat.h"
 #include "scene/blocks.h"
 #include "base/jsonscan.h"
 #include "scene/loader.h"
+#include "scene/features.h"
+#include "scene/geojson.h"
 
 #define BOUNDS_MARGIN 50.0
 #define MAX_COORD 1.0e7
@@ -57,60 +59,6 @@ static void json_free(void *p)
 
 /* ---- messages ----------------------------------------------------------- */
 
-static void msg_where(loader *ld, strbuf *b, uint32_t fi, const char *id)
-{
-    if (ld->name) {
-        sb_str(b, ld->name);
-        sb_str(b, ": ");
-    }
-    sb_str(b, "feature ");
-    sb_uint(b, fi);
-    if (id || (ld->feat_line && fi < ld->nfeat && ld->feat_line[fi])) {
-        sb_str(b, " (");
-        if (id) {
-            sb_str(b, id);
-            if (ld->feat_line && ld->feat_line[fi])
-                sb_str(b, ", ");
-        }
-        if (ld->feat_line && fi < ld->nfeat && ld->feat_line[fi]) {
-            sb_str(b, "line ");
-            sb_uint(b, ld->feat_line[fi]);
-            sb_str(b, ", column ");
-            sb_uint(b, ld->feat_col[fi]);
-        }
-        sb_char(b, ')');
-    }
-    sb_str(b, ": ");
-}
-
-/* A feature-level problem: in strict mode the load fails, otherwise the
- * feature is skipped and reported. Returns PLX_OK to go on. */
-plx_status ld_bad_feature(loader *ld, uint32_t fi, const char *id, const char *why)
-{
-    char msg[ENGINE_ERR_BYTES];
-    strbuf b;
-    sb_init(&b, msg, sizeof msg);
-    msg_where(ld, &b, fi, id);
-    sb_str(&b, why);
-    if (ld->e->cfg.strict)
-        return eng_fail(ld->e, PLX_E_SCENE, msg);
-    ld->s->skipped_features++;
-    ld->e->warnings++;
-    eng_log(ld->e, PLX_LOG_WARN, msg);
-    return PLX_OK;
-}
-
-void ld_warn(loader *ld, uint32_t fi, const char *id, const char *why)
-{
-    char msg[ENGINE_ERR_BYTES];
-    strbuf b;
-    sb_init(&b, msg, sizeof msg);
-    msg_where(ld, &b, fi, id);
-    sb_str(&b, why);
-    ld->e->warnings++;
-    eng_log(ld->e, PLX_LOG_WARN, msg);
-}
-
 static plx_status fail_scene(loader *ld, const char *why)
 {
     char msg[ENGINE_ERR_BYTES];
@@ -131,7 +79,7 @@ static plx_status bad_top_property(loader *ld, const char *why)
 {
     char msg[ENGINE_ERR_BYTES];
     strbuf b;
-    if (ld->e->cfg.strict)
+    if (eng_strict(ld->e))
         return fail_scene(ld, why);
     sb_init(&b, msg, sizeof msg);
     if (ld->name) {
@@ -140,8 +88,7 @@ static plx_status bad_top_property(loader *ld, const char *why)
     }
     sb_str(&b, why);
     sb_str(&b, "; ignored");
-    ld->e->warnings++;
-    eng_log(ld->e, PLX_LOG_WARN, msg);
+    eng_warn(ld->e, msg);
     return PLX_OK;
 }
 
@@ -233,11 +180,11 @@ static plx_status parse_json(loader *ld, cJSON **root)
 {
     const char *end = NULL;
     cJSON_Hooks hooks;
-    const plx_port *port = &ld->e->port;
+    const plx_port *port = eng_port(ld->e);
     int oom;
     if (port->lock)
         port->lock(port->ctx);
-    json_arena = &ld->e->mem;
+    json_arena = ld->mem;
     json_oom = 0;
     hooks.malloc_fn = json_malloc;
     hooks.free_fn = json_free;
@@ -276,7 +223,7 @@ static plx_status read_ground_image(loader *ld, const cJSON *props)
             if (st != PLX_OK)
                 return st;
         } else {
-            char *path = arena_alloc(&ld->e->mem, PLX_PART_SCENE, n + 1, 1);
+            char *path = arena_alloc(ld->mem, PLX_PART_SCENE, n + 1, 1);
             if (!path)
                 return eng_nomem(ld->e, "loading the scene");
             memcpy(path, gi->valuestring, n + 1);
@@ -316,8 +263,7 @@ static plx_status place_ground_image(loader *ld)
             return bad_top_property(ld, "properties.ground_image_bounds must be lon/lat degrees like the "
                                         "scene's coordinates (lon -180..180, lat -90..90)");
         for (i = 0; i < 4; i += 2) {
-            b[i] = (b[i] - ld->lon0) * 111320.0 * ld->coslat;
-            b[i + 1] = (b[i + 1] - ld->lat0) * 110540.0;
+            lonlat_to_local(ld->lon0, ld->lat0, ld->coslat, &b[i], &b[i + 1]);
         }
     }
     for (i = 0; i < 4; i++)
@@ -364,7 +310,7 @@ static plx_status read_crs(loader *ld, const cJSON *root, const cJSON *props)
     n = strlen(name);
     if (n > 1000)
         return bad_top_property(ld, "the crs name is longer than 1000 bytes");
-    copy = arena_alloc(&ld->e->mem, PLX_PART_SCENE, n + 1, 1);
+    copy = arena_alloc(ld->mem, PLX_PART_SCENE, n + 1, 1);
     if (!copy)
         return eng_nomem(ld->e, "keeping the scene's crs");
     memcpy(copy, name, n + 1);
@@ -413,106 +359,6 @@ static plx_status read_collection(loader *ld, cJSON *root, cJSON **features)
     return PLX_OK;
 }
 
-/* ---- numbers in properties ------------------------------------------------ */
-
-/* Parses "12", "12.5", "-3e2", "12.5 m", "12m" (surrounding spaces allowed).
- * Returns 1 and the value, or 0 when the text is anything else. */
-static int parse_number_text(const char *s, double *out)
-{
-    double mant = 0.0;
-    int digits = 0, exp10 = 0, neg = 0, eneg = 0, e = 0, edigits = 0;
-    while (is_space(*s))
-        s++;
-    if (*s == '+' || *s == '-')
-        neg = (*s++ == '-');
-    /* digits past the 18th only scale the value (they are below its
-     * precision), so a long mantissa cannot overflow to inf */
-    for (; *s >= '0' && *s <= '9'; s++, digits = 1) {
-        if (mant < 1e18)
-            mant = mant * 10.0 + (*s - '0');
-        else if (exp10 < 10000)
-            exp10++;
-    }
-    if (*s == '.') {
-        for (s++; *s >= '0' && *s <= '9'; s++, digits = 1) {
-            if (mant < 1e18 && exp10 > -10000) {
-                mant = mant * 10.0 + (*s - '0');
-                exp10--;
-            }
-        }
-    }
-    if (digits == 0)
-        return 0;
-    if (*s == 'e' || *s == 'E') {
-        s++;
-        if (*s == '+' || *s == '-')
-            eneg = (*s++ == '-');
-        for (; *s >= '0' && *s <= '9'; s++, edigits = 1)
-            if (e < 10000)
-                e = e * 10 + (*s - '0');
-        if (edigits == 0)
-            return 0;
-        exp10 += eneg ? -e : e;
-    }
-    while (is_space(*s))
-        s++;
-    if (*s == 'm') {
-        s++;
-        while (is_space(*s))
-            s++;
-    }
-    if (*s != '\0')
-        return 0;
-    if (mant == 0.0)
-        exp10 = 0; /* "0e99999" is 0, not 0 * inf */
-    if (exp10 < 0)
-        mant /= pow(10.0, -exp10);
-    else if (exp10 > 0)
-        mant *= pow(10.0, exp10);
-    *out = neg ? -mant : mant;
-    return 1;
-}
-
-/* 1: a number (JSON number or numeric string), 0: absent/null, -1: other. */
-int ld_number(const cJSON *item, double *out)
-{
-    if (!item || cJSON_IsNull(item))
-        return 0;
-    if (cJSON_IsNumber(item)) {
-        *out = item->valuedouble;
-        return 1;
-    }
-    if (cJSON_IsString(item) && parse_number_text(item->valuestring, out))
-        return 1;
-    return -1;
-}
-
-/* A numeric property: 1 found, 0 absent; a value of the wrong kind is
- * ignored with a warning (SPEC §1) and reads as absent. */
-int ld_prop_number(loader *ld, uint32_t fi, const char *id, const cJSON *props,
-                   const char *key, double *out)
-{
-    const cJSON *item = props ? cJSON_GetObjectItemCaseSensitive(props, key) : NULL;
-    int r = ld_number(item, out);
-    if (r == -1) {
-        char why[200];
-        strbuf b;
-        sb_init(&b, why, sizeof why);
-        sb_str(&b, "property \"");
-        sb_str(&b, key);
-        sb_str(&b, "\" is not a number");
-        if (cJSON_IsString(item)) {
-            sb_str(&b, " (\"");
-            sb_strn(&b, item->valuestring, 40);
-            sb_str(&b, "\")");
-        }
-        sb_str(&b, "; ignored, the default applies");
-        ld_warn(ld, fi, id, why);
-        return 0;
-    }
-    return r;
-}
-
 /* ---- the load --------------------------------------------------------------- */
 
 static void finish_info(scene *s)
@@ -549,14 +395,14 @@ static int cmp_double(const void *a, const void *b)
 }
 
 /* Minimum, median and maximum building height (scratch memory). */
-static plx_status height_stats(plx_engine *e, scene *s)
+static plx_status height_stats(plx_engine *e, arena *a, scene *s)
 {
-    arena_mark m = arena_get_mark(&e->mem);
+    arena_mark m = arena_get_mark(a);
     double *h;
     uint32_t i, n = s->nbld;
     if (n == 0)
         return PLX_OK;
-    h = arena_scratch(&e->mem, arena_mul(n, sizeof *h), 8);
+    h = arena_scratch(a, arena_mul(n, sizeof *h), 8);
     if (!h)
         return eng_nomem(e, "computing height statistics");
     for (i = 0; i < n; i++)
@@ -565,15 +411,15 @@ static plx_status height_stats(plx_engine *e, scene *s)
     s->height_min = h[0];
     s->height_max = h[n - 1];
     s->height_median = n % 2 ? h[n / 2] : 0.5 * (h[n / 2 - 1] + h[n / 2]);
-    arena_release(&e->mem, &m);
+    arena_release(a, &m);
     return PLX_OK;
 }
 
-static plx_status load(plx_engine *e, loader *ld)
+static plx_status load(plx_engine *e, loader *ld, scene **out)
 {
     cJSON *root = NULL, *features = NULL;
     plx_status st;
-    scene *s = arena_calloc(&e->mem, PLX_PART_SCENE, 1, sizeof *s, 16);
+    scene *s = arena_calloc(ld->mem, PLX_PART_SCENE, 1, sizeof *s, 16);
     if (!s)
         return eng_nomem(e, "loading the scene");
     ld->s = s;
@@ -584,8 +430,8 @@ static plx_status load(plx_engine *e, loader *ld)
     if (st != PLX_OK)
         return st;
     ld->nfeat = (uint32_t)cJSON_GetArraySize(features);
-    ld->feat_line = arena_scratch(&e->mem, arena_mul(ld->nfeat + 1u, sizeof(uint32_t)), 4);
-    ld->feat_col = arena_scratch(&e->mem, arena_mul(ld->nfeat + 1u, sizeof(uint32_t)), 4);
+    ld->feat_line = arena_scratch(ld->mem, arena_mul(ld->nfeat + 1u, sizeof(uint32_t)), 4);
+    ld->feat_col = arena_scratch(ld->mem, arena_mul(ld->nfeat + 1u, sizeof(uint32_t)), 4);
     if (!ld->feat_line || !ld->feat_col)
         return eng_nomem(e, "indexing feature lines");
     jsonscan_feature_lines(ld->text, ld->len, ld->feat_line, ld->feat_col, ld->nfeat);
@@ -596,116 +442,31 @@ static plx_status load(plx_engine *e, loader *ld)
     st = place_ground_image(ld);
     if (st != PLX_OK)
         return st;
-    st = height_stats(e, s);
+    st = height_stats(e, ld->mem, s);
     if (st != PLX_OK)
         return st;
     st = ld_drop_buried_lamps(ld);
     if (st != PLX_OK)
         return st;
-    st = blocks_build(&e->mem, s, BLOCK_TOLERANCE);
+    st = blocks_build(ld->mem, s, BLOCK_TOLERANCE);
     if (st == PLX_E_NOMEM)
         return eng_nomem(e, "grouping buildings into blocks");
     if (st != PLX_OK)
         return eng_fail(e, st, "grouping buildings into blocks failed");
-    e->sc = s;
+    *out = s;
     return PLX_OK;
 }
 
-static void drop_scene(plx_engine *e)
-{
-    e->sc = NULL;
-    e->pd = NULL;
-    e->vis_poly = NULL;
-    e->vis_ids = NULL;
-    e->lt = NULL;
-    e->lit_last = NULL;
-    e->rd = NULL;
-    e->ph = NULL;
-    e->lightmap_cell = 0.0;
-    e->warnings = 0;
-    eng_clear_error(e);
-    e->mem.lo = e->base.lo;
-    {
-        size_t i;
-        for (i = 0; i < PLX_PART_COUNT; i++)
-            if (i != PLX_PART_SCRATCH)
-                e->mem.used[i] = e->base.used[i];
-    }
-}
-
-/* Loads text that may itself sit in scratch memory; gives back all scratch
- * memory taken after entry. */
-static plx_status load_text(plx_engine *e, const char *text, size_t len, const char *name)
+plx_status geojson_load(plx_engine *e, arena *a, const char *text, size_t len, const char *name,
+                        scene **out)
 {
     loader ld;
-    arena_mark m = arena_get_mark(&e->mem);
-    plx_status st;
-    uint64_t t0 = eng_clock(e);
     memset(&ld, 0, sizeof ld);
     ld.e = e;
+    ld.mem = a;
     ld.name = name;
     ld.text = text ? text : "";
     ld.len = len;
-    st = load(e, &ld);
-    if (st != PLX_OK) {
-        arena_release(&e->mem, &m);
-        e->sc = NULL;
-        return st;
-    }
-    e->mem.hi = m.hi;
-    e->mem.used[PLX_PART_SCRATCH] = m.used[PLX_PART_SCRATCH];
-    e->sc->load_ns = eng_clock(e) - t0;
-    eng_check_scene(e->sc);
-    return PLX_OK;
-}
-
-plx_status plx_load_geojson(plx_engine *e, const char *text, size_t len, const char *name)
-{
-    if (!eng_ok(e))
-        return PLX_E_INVALID;
-    drop_scene(e);
-    if (!text && len)
-        return eng_fail(e, PLX_E_INVALID, "plx_load_geojson: text is NULL");
-    return load_text(e, text, len, name);
-}
-
-plx_status plx_load_file(plx_engine *e, const char *path)
-{
-    char why[256];
-    size_t size = 0;
-    char *buf;
-    plx_status st;
-    arena_mark m;
-    strbuf b;
-    if (!eng_ok(e))
-        return PLX_E_INVALID;
-    drop_scene(e);
-    if (!path)
-        return eng_fail(e, PLX_E_INVALID, "plx_load_file: path is NULL");
-    if (!e->port.file_size || !e->port.file_read)
-        return eng_fail(e, PLX_E_UNSUPPORTED, "plx_load_file: this engine's port has no file system; use plx_load_geojson");
-    why[0] = '\0';
-    sb_init(&b, e->err, sizeof e->err);
-    if (e->port.file_size(e->port.ctx, path, &size, why, sizeof why) != 0) {
-        sb_str(&b, path);
-        sb_str(&b, ": ");
-        sb_str(&b, why);
-        return PLX_E_IO;
-    }
-    m = arena_get_mark(&e->mem);
-    buf = arena_scratch(&e->mem, size + 1, 16);
-    if (!buf)
-        return eng_nomem(e, "reading the scene file");
-    if (e->port.file_read(e->port.ctx, path, buf, size, why, sizeof why) != 0) {
-        arena_release(&e->mem, &m);
-        sb_str(&b, path);
-        sb_str(&b, ": ");
-        sb_str(&b, why);
-        return PLX_E_IO;
-    }
-    buf[size] = '\0';
-    st = load_text(e, buf, size, path);
-    e->mem.hi = m.hi;
-    e->mem.used[PLX_PART_SCRATCH] = m.used[PLX_PART_SCRATCH];
-    return st;
+    *out = NULL;
+    return load(e, &ld, out);
 }

@@ -19,4 +19,7 @@
 plx_status ground_image_set(arena *a, scene *s, uint32_t w, uint32_t h, const uint8_t *rgb,
                             const double box[4]);
 
+/* The luminance Y = 0.2126 R + 0.7152 G + 0.0722 B of a linear colour. */
+double ground_luminance(const double rgb[3]);
+
 #endif

@@ -1,12 +1,15 @@
-/* loader: state shared by the GeoJSON reading steps (geojson.c, features.c). */
+/* loader: state shared by the GeoJSON reading steps (geojson.c, features.c)
+ * and the helpers of loader.c. */
 #ifndef PLX_LOADER_H
 #define PLX_LOADER_H
 
 #include <cjson/cJSON.h>
-#include "base/engine.h"
+#include "base/context.h"
+#include "base/strbuf.h"
 
 typedef struct loader {
-    plx_engine *e;
+    plx_engine *e;         /* for errors and warnings only (base/context.h) */
+    arena *mem;
     scene *s;
     const char *name;      /* source name for messages, or NULL */
     const char *text;
@@ -28,12 +31,5 @@ int ld_prop_number(loader *ld, uint32_t fi, const char *id, const cJSON *props,
 /* Reports a bad feature; PLX_OK means skip it and go on (not strict). */
 plx_status ld_bad_feature(loader *ld, uint32_t fi, const char *id, const char *why);
 void ld_warn(loader *ld, uint32_t fi, const char *id, const char *why);
-
-/* Reads every feature into ld->s (features.c). */
-plx_status ld_features(loader *ld, cJSON *features);
-/* Leaves out lamps inside a building's solid, reporting each (features.c). */
-plx_status ld_drop_buried_lamps(loader *ld);
-/* The same for lamps first.. only (lamps added by plx_add_lamps). */
-plx_status ld_drop_buried_lamps_from(loader *ld, uint32_t first);
 
 #endif

@@ -28,7 +28,7 @@
 #include "polarlux_port.h"
 #include "base/engine.h"
 #include "photon/trace.h"
-#include "photon/photon.h"
+#include "photon/indirect.h"
 #include "photon/final_gather.h"
 #include "ref_indirect.h"
 
@@ -105,7 +105,7 @@ static plx_engine *prepared(const char *text_or_path, size_t len, int is_file, i
     const scene *s = e->sc;
     double eye[3];
     if ((old && plx_indirect_set_gather(e, 0) != PLX_OK) || plx_indirect_step(e, 1, 1) != PLX_OK ||
-        eng_need_light(e, "bench_gather") != PLX_OK) {
+        eng_need(e, ENG_LIGHT, "bench_gather") != PLX_OK) {
         fprintf(stderr, "bench_gather: setup failed\n");
         exit(1);
     }

@@ -24,7 +24,8 @@
 #include "polarlux.h"
 #include "polarlux_port.h"
 #include "base/engine.h"
-#include "light/light.h"
+#include "light/illuminance.h"
+#include "light/litregion.h"
 #include "ref_light.h"
 
 static double now_s(void)

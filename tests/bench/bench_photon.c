@@ -27,7 +27,8 @@
 #include "polarlux_port.h"
 #include "base/engine.h"
 #include "photon/trace.h"
-#include "photon/photon.h"
+#include "photon/indirect.h"
+#include "photon/nightlight.h"
 #include "ref_trace_old.h"
 
 #define BUDGET ((size_t)3 << 30)

@@ -37,6 +37,7 @@
 #include "port.h"
 #include "base/engine.h"
 #include "polar/polar.h"
+#include "polar/locate.h"
 #include "polar/visibility.h"
 #include "ref_polar_scan.h"
 #include "ref_vis.h"

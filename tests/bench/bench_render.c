@@ -22,7 +22,8 @@
 #include "polarlux.h"
 #include "port.h"
 #include "base/engine.h"
-#include "light/light.h"
+#include "light/illuminance.h"
+#include "light/litregion.h"
 #include "render/render.h"
 #include "png/image_write.h"
 #ifdef PLX_HAVE_OSMESA

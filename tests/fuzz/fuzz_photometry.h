@@ -11,7 +11,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "light/photometry.h"
+#include "scene/photometry.h"
 
 #define PCHECK(cond)                                                                     \
     do {                                                                                 \

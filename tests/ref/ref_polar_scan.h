@@ -3,7 +3,7 @@
 #ifndef REF_POLAR_SCAN_H
 #define REF_POLAR_SCAN_H
 
-#include "polar/polar.h"
+#include "polar/locate.h"
 
 /* The former point location, kept as a reference (the construction uses
  * no grid; tests/ref/ref_polar_scan.c): the nearest wall below

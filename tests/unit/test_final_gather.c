@@ -32,9 +32,9 @@
 #include "base/engine.h"
 #include "base/arena.h"
 #include "scene/blocks.h"
-#include "light/light.h"
+#include "light/illuminance.h"
 #include "photon/trace.h"
-#include "photon/photon.h"
+#include "photon/indirect.h"
 #include "photon/final_gather.h"
 #include "ref_scene.h"
 #include "ref_indirect.h"
@@ -235,7 +235,7 @@ static plx_engine *engine_on(const char *path, const char *text, size_t len)
     assert_int_equal(plx_engine_new((size_t)1 << 30, &cfg, &e), PLX_OK);
     assert_int_equal(path ? plx_load_file(e, path) : plx_load_geojson(e, text, len, "gen"),
                      PLX_OK);
-    assert_int_equal(eng_need_light(e, "test"), PLX_OK);
+    assert_int_equal(eng_need(e, ENG_LIGHT, "test"), PLX_OK);
     return e;
 }
 

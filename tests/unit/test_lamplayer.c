@@ -14,6 +14,8 @@
 #include <cmocka.h>
 
 #include "polarlux.h"
+#include "polarlux_port.h"
+#include "fixture.h"
 
 #define MEM (32u << 20)
 
@@ -24,20 +26,12 @@ static const char *bld_m =
 
 static plx_engine *load(const char *json, int strict, void **mem)
 {
-    plx_engine *e;
-    plx_config cfg;
-    plx_config_default(&cfg);
-    cfg.strict = strict;
-    *mem = malloc(MEM);
-    assert_int_equal(plx_engine_create(*mem, MEM, &cfg, &e), PLX_OK);
-    assert_int_equal(plx_load_geojson(e, json, strlen(json), "t"), PLX_OK);
-    return e;
+    return fixture_text(json, MEM, strict, mem);
 }
 
 static void done(plx_engine *e, void *mem)
 {
-    plx_engine_destroy(e);
-    free(mem);
+    fixture_done(e, mem);
 }
 
 static void lamp(plx_lamp *l, double x, double y, double z, double I)

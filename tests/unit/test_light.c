@@ -19,7 +19,8 @@
 #include "polarlux.h"
 #include "polarlux_port.h"
 #include "base/engine.h"
-#include "light/light.h"
+#include "light/illuminance.h"
+#include "light/litregion.h"
 #include "ref_light.h"
 #include "ref_scene.h"
 

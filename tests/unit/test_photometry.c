@@ -19,7 +19,7 @@
 
 #include "polarlux.h"
 #include "base/engine.h"
-#include "light/photometry.h"
+#include "scene/photometry.h"
 #include "photon/photon.h"
 
 #define PI 3.14159265358979323846

@@ -24,7 +24,9 @@
 #include "base/arena.h"
 #include "scene/blocks.h"
 #include "photon/trace.h"
-#include "photon/photon.h"
+#include "photon/indirect.h"
+#include "photon/nightlight.h"
+#include "render/nightify.h"
 #include "ref_scene.h"
 
 #define PI 3.14159265358979323846

@@ -24,6 +24,7 @@
 #include "base/arena.h"
 #include "base/engine.h"
 #include "polar/polar.h"
+#include "polar/locate.h"
 #include "polar_faults.h"
 #include "polar/visibility.h"
 #include "ref_scene.h"

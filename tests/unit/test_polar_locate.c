@@ -30,6 +30,7 @@
 #include "base/engine.h"
 #include "base/geom.h"
 #include "polar/polar.h"
+#include "polar/locate.h"
 #include "polar_faults.h"
 #include "ref_polar_scan.h"
 #include "ref_scene.h"

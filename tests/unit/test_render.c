@@ -38,10 +38,12 @@
 
 #include "polarlux.h"
 #include "polarlux_port.h"
+#include "fixture.h"
 #include "base/engine.h"
 #include "render/render.h"
 #include "render/mesh.h"
-#include "light/light.h"
+#include "light/illuminance.h"
+#include "light/litregion.h"
 #include "base/geom.h"
 #include "ref_light.h"
 #include "png/image_write.h"
@@ -60,18 +62,7 @@ static int quick(void)
 
 static plx_engine *open_scene(const char *path, void **mem)
 {
-    plx_engine *e;
-    plx_config cfg;
-    static plx_port port;
-    port = *plx_port_posix();
-    port.log = NULL;
-    plx_config_default(&cfg);
-    cfg.port = &port;
-    *mem = malloc(MEM);
-    assert_non_null(*mem);
-    assert_int_equal(plx_engine_create(*mem, MEM, &cfg, &e), PLX_OK);
-    assert_int_equal(plx_load_file(e, path), PLX_OK);
-    return e;
+    return fixture_file(path, MEM, mem);
 }
 
 /* The brute-force shader, fed per lamp only the buildings that can block

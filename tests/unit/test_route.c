@@ -12,18 +12,14 @@
 #include <cmocka.h>
 
 #include "polarlux.h"
+#include "polarlux_port.h"
+#include "fixture.h"
 
 #define MEM (64u << 20)
 
 static plx_engine *load(const char *json, void **mem)
 {
-    plx_engine *e;
-    plx_config cfg;
-    plx_config_default(&cfg);
-    *mem = malloc(MEM);
-    assert_int_equal(plx_engine_create(*mem, MEM, &cfg, &e), PLX_OK);
-    assert_int_equal(plx_load_geojson(e, json, strlen(json), "t"), PLX_OK);
-    return e;
+    return fixture_text(json, MEM, 0, mem);
 }
 
 static double window(double x)

@@ -14,6 +14,7 @@
 
 #include "polarlux.h"
 #include "polarlux_port.h"
+#include "fixture.h"
 #include "base/engine.h"
 #include "ref_vis.h"
 
@@ -21,18 +22,7 @@
 
 static plx_engine *open_scene(const char *path, void **mem)
 {
-    plx_engine *e;
-    plx_config cfg;
-    plx_port quiet = *plx_port_posix();
-    static plx_port port;
-    quiet.log = NULL;
-    port = quiet;
-    plx_config_default(&cfg);
-    cfg.port = &port;
-    *mem = malloc(MEM);
-    assert_int_equal(plx_engine_create(*mem, MEM, &cfg, &e), PLX_OK);
-    assert_int_equal(plx_load_file(e, path), PLX_OK);
-    return e;
+    return fixture_file(path, MEM, mem);
 }
 
 static uint64_t rng_next(uint64_t *s)

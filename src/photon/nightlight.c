@@ -1,11 +1,13 @@
-/* photon_night: per-lamp floor photon maps in an LRU cache and their
- * exchange with the aerial chart (munoz2013 §3.3-3.4; see photon.h). */
+/* nightlight: munoz2013's night lighting of the ground: per-lamp floor
+ * photon maps in an LRU cache and their exchange with the aerial chart
+ * (munoz2013 §3.3-3.4; see nightlight.h and photon.h). */
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
 #include "photon/photon.h"
-#include "light/photometry.h"
+#include "scene/photometry.h"
+#include "photon/nightlight.h"
 
 #define PI 3.14159265358979323846
 #define HEIGHT_TOL 1e-3

@@ -1,9 +1,9 @@
-/* photon_hist: histogram matching of RGB8 images (munoz2013 §3.1; see
- * photon.h). */
+/* nightify: histogram matching of RGB8 images (munoz2013 §3.1; see
+ * nightify.h). */
 #include <stddef.h>
 #include <stdint.h>
 
-#include "photon/photon.h"
+#include "render/nightify.h"
 
 int photon_hist_match(const uint8_t *src, size_t npx, const uint8_t *ref, size_t nref,
                       double dark_threshold, uint8_t *out)

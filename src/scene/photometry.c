@@ -1,6 +1,6 @@
 /* photometry: IES LM-63 and EULUMDAT parsing, symmetry completion and the
  * bilinear candela lookup (contract in photometry.h). */
-#include "light/photometry.h"
+#include "scene/photometry.h"
 #include "base/strbuf.h"
 
 #include <math.h>

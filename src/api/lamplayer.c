@@ -10,11 +10,11 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "base/engine.h"
 #include "base/strbuf.h"
-#include "scene/loader.h"
+#include "base/lonlat.h"
+#include "scene/features.h"
 
-#define M_PER_DEG_LON 111320.0
-#define M_PER_DEG_LAT 110540.0
 #define LAYER_MAX_COORD 1.0e7
 #define LAYER_MAX_HEIGHT 1000.0
 #define LAYER_MAX_RADIUS 1.0e5
@@ -64,8 +64,7 @@ static const char *layer_lamp(const scene *s, const plx_lamp *in, scene_lamp *ou
     if (s->lonlat) {
         if (fabs(x) > 180.0 || fabs(y) > 90.0)
             return "position is not lon/lat (the scene is in lon/lat)";
-        x = (x - s->lon0) * M_PER_DEG_LON * cos(s->lat0 * 3.14159265358979323846 / 180.0);
-        y = (y - s->lat0) * M_PER_DEG_LAT;
+        lonlat_to_local(s->lon0, s->lat0, lonlat_cos(s->lat0), &x, &y);
     }
     if (fabs(x) > LAYER_MAX_COORD || fabs(y) > LAYER_MAX_COORD)
         return "position is out of range (|coordinate| > 1e7 m)";
@@ -241,7 +240,7 @@ plx_status plx_add_lamps(plx_engine *e, const plx_lamp *lamps, uint32_t n, const
     scene *s;
     loader ld;
     uint32_t old;
-    plx_status st = eng_need_scene(e, "plx_add_lamps");
+    plx_status st = eng_need(e, ENG_SCENE, "plx_add_lamps");
     if (st != PLX_OK)
         return st;
     if (n > 0 && !lamps)
@@ -256,6 +255,7 @@ plx_status plx_add_lamps(plx_engine *e, const plx_lamp *lamps, uint32_t n, const
     if (st == PLX_OK) {
         memset(&ld, 0, sizeof ld);
         ld.e = e;
+        ld.mem = &e->mem;
         ld.s = s;
         ld.name = source;
         st = ld_drop_buried_lamps_from(&ld, old);

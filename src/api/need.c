@@ -1,0 +1,112 @@
+/* need: the one place that decides what must be built before a call, and
+ * builds it on first need. Every public call that reads something built
+ * from the scene asks eng_need(e, WHAT, fn) first:
+ *
+ *   ENG_SCENE   a scene is loaded (else PLX_E_NOSCENE "fn: no scene is loaded")
+ *   ENG_POLAR   the polar diagrams and the visibility result buffers
+ *   ENG_LIGHT   the lamp light object (grids, lit region cache)
+ *   ENG_PHOTON  the photon buffers
+ *   ENG_RENDER  the renderer, which needs ENG_LIGHT first
+ *
+ * Each part is kept in the engine until the next load drops them all
+ * (loadapi.c); a failed build leaves the engine as it was. */
+#include "base/engine.h"
+#include "polar/polar.h"
+#include "light/light.h"
+#include "photon/photon.h"
+#include "render/render.h"
+
+#define DEFAULT_LIT_CACHE ((size_t)16 << 20)
+#define DEFAULT_MAX_W 1920
+#define DEFAULT_MAX_H 1080
+
+static plx_status need_polar(plx_engine *e)
+{
+    arena_mark m = arena_get_mark(&e->mem);
+    uint64_t t0 = eng_clock(e);
+    plx_status st;
+    polar *pd;
+    st = polar_build(&e->mem, e->sc, &pd);
+    if (st == PLX_E_NOMEM)
+        return eng_nomem(e, "building the polar diagrams");
+    if (st != PLX_OK)
+        return eng_fail(e, st, "building the polar diagrams failed (empty or non-finite bounds)");
+    e->polar_ns = eng_clock(e) - t0;
+    e->vis_poly_cap = 4 * e->sc->npts + 64;
+    e->vis_ids_cap = e->sc->nbld + 1;
+    e->vis_poly = arena_alloc(&e->mem, PLX_PART_FRAME, arena_mul(e->vis_poly_cap, sizeof *e->vis_poly), 16);
+    e->vis_ids = arena_alloc(&e->mem, PLX_PART_FRAME, arena_mul(e->vis_ids_cap, sizeof *e->vis_ids), 16);
+    if (!e->vis_poly || !e->vis_ids) {
+        plx_status r = eng_nomem(e, "reserving visibility results");
+        arena_release(&e->mem, &m);
+        e->vis_poly = NULL;
+        e->vis_ids = NULL;
+        return r;
+    }
+    e->pd = pd;
+    return PLX_OK;
+}
+
+static plx_status need_light(plx_engine *e)
+{
+    size_t cache = e->cfg.lit_cache_bytes ? e->cfg.lit_cache_bytes : DEFAULT_LIT_CACHE;
+    plx_status st = light_create(&e->mem, e->sc, cache, &e->lt);
+    if (st == PLX_E_NOMEM)
+        return eng_nomem(e, "setting up lamp light");
+    if (st != PLX_OK)
+        return eng_fail(e, st, "setting up lamp light failed");
+    return PLX_OK;
+}
+
+static plx_status need_photon(plx_engine *e)
+{
+    photon_config cfg;
+    plx_status st;
+    /* final gathering reads the later bounces all around its points: every
+     * block gets a chart (photon.h, coarsest_level) */
+    if (!e->gather_set || e->gather_side > 0)
+        photon_config_gather(&cfg, e->sc);
+    else
+        photon_config_default(&cfg);
+    st = photon_create(&e->mem, e->sc, &cfg, &e->ph);
+    if (st == PLX_E_NOMEM)
+        return eng_nomem(e, "creating the photon buffers");
+    if (st != PLX_OK)
+        return eng_fail(e, st, "creating the photon buffers failed");
+    return PLX_OK;
+}
+
+static plx_status need_render(plx_engine *e)
+{
+    int32_t w = e->cfg.render_max_width ? e->cfg.render_max_width : DEFAULT_MAX_W;
+    int32_t h = e->cfg.render_max_height ? e->cfg.render_max_height : DEFAULT_MAX_H;
+    plx_status st = render_create(&e->mem, e->sc, w, h, render_shade_light, e->lt, &e->rd);
+    if (st == PLX_E_NOMEM)
+        return eng_nomem(e, "creating the renderer (frame buffers and mesh)");
+    if (st != PLX_OK)
+        return eng_fail(e, st, "creating the renderer failed");
+    return PLX_OK;
+}
+
+plx_status eng_need(plx_engine *e, eng_what what, const char *fn)
+{
+    plx_status st = eng_need_scene(e, fn);
+    if (st != PLX_OK)
+        return st;
+    switch (what) {
+    case ENG_SCENE:
+        return PLX_OK;
+    case ENG_POLAR:
+        return e->pd ? PLX_OK : need_polar(e);
+    case ENG_LIGHT:
+        return e->lt ? PLX_OK : need_light(e);
+    case ENG_PHOTON:
+        return e->ph ? PLX_OK : need_photon(e);
+    case ENG_RENDER:
+        if (e->rd)
+            return PLX_OK;
+        st = eng_need(e, ENG_LIGHT, fn);
+        return st != PLX_OK ? st : need_render(e);
+    }
+    return PLX_E_INVALID;
+}

@@ -1,0 +1,142 @@
+/* lightmap: the aerial light map (issue: aerial views): the exact ground
+ * illuminance E_rgb of every lamp (through the renderer's shader, 2.5D
+ * shadows, SPEC §2) stored once per texel over the lamps' reach, then read
+ * by the aerial view's ground pixels, bilinear between texel centres
+ * (munoz2013's precomputed ground lighting for views from above). */
+#include <math.h>
+#include <string.h>
+
+#include "render/lightmap.h"
+
+plx_status lightmap_build(lightmap *m, arena *mem, const scene *s, double cell, size_t max_bytes,
+                          lightmap_shade_fn shade, void *user, const char **err)
+{
+    double x0 = HUGE_VAL, y0 = HUGE_VAL, x1 = -HUGE_VAL, y1 = -HUGE_VAL;
+    uint32_t l, nx, ny, i, j;
+    size_t need;
+    if (!(cell > 0.0) || !isfinite(cell) || max_bytes < 12) {
+        *err = "render_lightmap_build: m_per_texel must be > 0 and max_bytes >= 12";
+        return PLX_E_INVALID;
+    }
+    for (l = 0; l < s->nlamps; l++) {
+        const scene_lamp *lp = &s->lamps[l];
+        double rg;
+        if (!(lp->radius > lp->z) || !(lp->intensity > 0))
+            continue;
+        rg = sqrt(lp->radius * lp->radius - lp->z * lp->z);
+        x0 = fmin(x0, lp->x - rg);
+        y0 = fmin(y0, lp->y - rg);
+        x1 = fmax(x1, lp->x + rg);
+        y1 = fmax(y1, lp->y + rg);
+    }
+    if (!(x1 > x0)) {
+        x0 = y0 = 0.0;
+        x1 = y1 = cell;
+    }
+    for (;;) {
+        double fx = ceil((x1 - x0) / cell), fy = ceil((y1 - y0) / cell);
+        if (fx < 1) fx = 1;
+        if (fy < 1) fy = 1;
+        if (fx * fy * 12.0 <= (double)max_bytes && fx < 1e8 && fy < 1e8) {
+            nx = (uint32_t)fx;
+            ny = (uint32_t)fy;
+            break;
+        }
+        cell *= 1.05;
+    }
+    need = (size_t)nx * ny * 3;
+    if (!m->rgb || need > m->cap) {
+        if (m->rgb) {
+            *err = "render_lightmap_build: the new map does not fit the first one's memory";
+            return PLX_E_NOMEM;
+        }
+        m->rgb = arena_alloc(mem, PLX_PART_FRAME, arena_mul(need, sizeof(float)), 64);
+        if (!m->rgb) {
+            *err = "render_lightmap_build: out of memory for the light map";
+            return PLX_E_NOMEM;
+        }
+        m->cap = need;
+    }
+    m->nx = nx;
+    m->ny = ny;
+    m->cell = cell;
+    /* centre the grid on the reach box */
+    m->x0 = 0.5 * (x0 + x1) - 0.5 * nx * cell;
+    m->y0 = 0.5 * (y0 + y1) - 0.5 * ny * cell;
+    m->shaded = 0;
+    memset(m->rgb, 0, need * sizeof(float));
+    /* mark texels some lamp reaches, using the map itself (channel 0 = 1) */
+    for (l = 0; l < s->nlamps; l++) {
+        const scene_lamp *lp = &s->lamps[l];
+        double rg;
+        int64_t a0, a1, b0, b1, a, b;
+        if (!(lp->radius > lp->z) || !(lp->intensity > 0))
+            continue;
+        rg = sqrt(lp->radius * lp->radius - lp->z * lp->z) * (1.0 + 1e-9) + 1e-9;
+        a0 = (int64_t)floor((lp->x - rg - m->x0) / cell - 0.5);
+        a1 = (int64_t)ceil((lp->x + rg - m->x0) / cell - 0.5);
+        b0 = (int64_t)floor((lp->y - rg - m->y0) / cell - 0.5);
+        b1 = (int64_t)ceil((lp->y + rg - m->y0) / cell - 0.5);
+        if (a0 < 0) a0 = 0;
+        if (b0 < 0) b0 = 0;
+        if (a1 > (int64_t)nx - 1) a1 = (int64_t)nx - 1;
+        if (b1 > (int64_t)ny - 1) b1 = (int64_t)ny - 1;
+        for (b = b0; b <= b1; b++)
+            for (a = a0; a <= a1; a++) {
+                double dx = m->x0 + (a + 0.5) * cell - lp->x, dy = m->y0 + (b + 0.5) * cell - lp->y;
+                if (dx * dx + dy * dy <= rg * rg)
+                    m->rgb[3 * ((size_t)b * nx + (size_t)a)] = 1.0f;
+            }
+    }
+    for (j = 0; j < ny; j++)
+        for (i = 0; i < nx; i++) {
+            float *t = &m->rgb[3 * ((size_t)j * nx + i)];
+            double P[3], n[3] = { 0.0, 0.0, 1.0 }, E[3];
+            if (t[0] == 0.0f)
+                continue;
+            P[0] = m->x0 + (i + 0.5) * cell;
+            P[1] = m->y0 + (j + 0.5) * cell;
+            P[2] = 0.0;
+            shade(user, P, n, E);
+            m->shaded++;
+            t[0] = (float)E[0];
+            t[1] = (float)E[1];
+            t[2] = (float)E[2];
+        }
+    m->built = 1;
+    *err = "";
+    return PLX_OK;
+}
+
+
+/* Ground E_rgb from the light map, bilinear between texel centres. */
+void lightmap_sample(const lightmap *m, const double P[3], double rgb[3])
+{
+    double fx = (P[0] - m->x0) / m->cell - 0.5, fy = (P[1] - m->y0) / m->cell - 0.5;
+    double ix, iy, tx, ty, wgt[4];
+    int64_t i0, j0;
+    int k, c;
+    rgb[0] = rgb[1] = rgb[2] = 0.0;
+    if (!(fx > -1.0 && fy > -1.0 && fx < (double)m->nx && fy < (double)m->ny))
+        return;
+    ix = floor(fx);
+    iy = floor(fy);
+    tx = fx - ix;
+    ty = fy - iy;
+    i0 = (int64_t)ix;
+    j0 = (int64_t)iy;
+    wgt[0] = (1 - tx) * (1 - ty);
+    wgt[1] = tx * (1 - ty);
+    wgt[2] = (1 - tx) * ty;
+    wgt[3] = tx * ty;
+    for (k = 0; k < 4; k++) {
+        int64_t i = i0 + (k & 1), j = j0 + (k >> 1);
+        const float *t;
+        if (i < 0 || j < 0 || i >= (int64_t)m->nx || j >= (int64_t)m->ny)
+            continue;
+        t = &m->rgb[3 * ((size_t)j * m->nx + (size_t)i)];
+        for (c = 0; c < 3; c++)
+            rgb[c] += wgt[k] * t[c];
+    }
+}
+
