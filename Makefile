@@ -9,6 +9,7 @@
 #                   core's invariant checks (PLX_DEBUG, src/base/plx_assert.h)
 #   make valgrind   the unit tests under valgrind memcheck
 #   make bench      benchmarks (tests/bench)
+#   make check-identical BASE=rev   outputs byte-identical to revision rev
 #   make deps       install missing Debian packages (apt-get when root); plain
 #                   make only checks them and names what is missing
 #   make man        regenerate man/polarlux.1 from the --help texts
@@ -61,8 +62,8 @@ BIN    = $(BUILD)/polarlux
 DEB_PACKAGES = libcjson-dev libcmocka-dev libpng-dev pkg-config python3-numpy python3-pytest
 
 .SECONDARY:
-.PHONY: all deps deps-check check-no-install man check-man demo check check-full check-build unit cli-test asan valgrind bench install clean \
-        check-core-headers check-lib-split check-examples check-python
+.PHONY: all deps deps-check check-no-install man check-man demo check check-full check-build unit cli-test asan \
+        valgrind bench install clean check-core-headers check-identical check-lib-split check-examples check-python
 
 all: $(LIB_A) $(LIB_SO) $(PORT_A) $(BIN)
 
@@ -246,6 +247,13 @@ valgrind: all $(TESTS)
 	  echo "valgrind $$t"; \
 	  PLX_TEST_QUICK=1 valgrind -q --error-exitcode=9 --leak-check=full --errors-for-leak-kinds=definite $$t >/dev/null || exit 1; \
 	done; echo "valgrind: clean"
+
+# The refactor check (not part of make check: it builds another revision):
+# every command on every fixture and two generated cities, byte for byte
+# against revision BASE (tests/check_identical.sh).
+BASE ?= 73d3a0e
+check-identical:
+	@sh tests/check_identical.sh $(BASE)
 
 bench: all $(BENCHES)
 	@for b in $(BENCHES); do echo "== $$b"; $$b || exit 1; done

@@ -207,6 +207,15 @@ typedef struct plx_scene_info {
  * Threads: engine (reads). */
 plx_status plx_scene_info_get(plx_engine *e, plx_scene_info *out /* OUT */);
 
+/* The scene's coordinate reference system as its file named it (a GeoJSON
+ * 2008 top-level "crs": {"type": "name", "properties": {"name": ...}}, or
+ * properties.crs as that object or a string), e.g.
+ * "urn:ogc:def:crs:EPSG::2154"; NULL when it named none (or no scene). A
+ * CRS other than WGS84 lon/lat (EPSG:4326, OGC CRS84) makes the load read
+ * coordinates as metres, as properties.units = "m" does. Valid until the
+ * next load. Threads: engine (reads). */
+const char *plx_scene_crs(plx_engine *e);
+
 /* ---- Ground albedo from a day image (README "Scene format") ------------- */
 
 /*
@@ -270,6 +279,28 @@ typedef struct plx_lamp {
     uint32_t feature;
     const char *id;
 } plx_lamp;
+
+/*
+ * Adds n lamps to the loaded scene: lamp layers from other files (the
+ * polarlux command's --lamps). Positions are in the scene's own
+ * coordinates: lon/lat degrees (x = lon, y = lat) on a lon/lat scene,
+ * projected with the scene's centre as at load; metres on a metre scene.
+ * z, intensity, radius and color as in the scene format (no defaults are
+ * applied here); 'feature' is the lamp's record number in its source (for
+ * messages) and 'id' is copied (may be NULL). 'source' (may be NULL) names
+ * the file in messages. As at load: a lamp out of range, or inside a
+ * building's solid, is left out with a warning (strict: the call fails and
+ * no lamp is added); a lamp within 1 mm on the ground of an earlier lamp is
+ * merged into it (the earlier kept) with a warning. A scene without
+ * buildings takes its Bounds from all lamps. Must come before anything
+ * computes light (illuminance, lit regions, photons, renders): PLX_E_INVALID
+ * after. Memory: a new lamp array in PLX_PART_SCENE (the old one stays held
+ * until the next load). Errors: PLX_E_NOSCENE, PLX_E_INVALID, PLX_E_SCENE
+ * (strict), PLX_E_NOMEM (no lamp added). Threads: engine. plx_memory_estimate
+ * counts only the scene's own lamps: add the layer's to sz.points and
+ * sz.positions.
+ */
+plx_status plx_add_lamps(plx_engine *e, const plx_lamp *lamps, uint32_t n, const char *source);
 
 typedef struct plx_block {
     uint32_t nbuildings;
@@ -481,6 +512,17 @@ plx_status plx_indirect_set_viewer(plx_engine *e, const double eye[3], const dou
 /* Drops every accumulated photon (none yet: nothing to do). Errors: only
  * the invalid handle. Threads: engine. */
 plx_status plx_indirect_reset(plx_engine *e);
+/*
+ * How plx_illuminance and plx_indirect_rgb (and so routes) estimate
+ * E_indirect at points: final gathering over side x side stratified
+ * cosine-weighted directions (default 16: 256 directions), each gathering
+ * a (E_direct + E_photons) from the first surface it meets, E_direct exact,
+ * the photon buffers only for light that bounced before (README,
+ * "Indirect light"); side 0: the photon buffers' own estimate at the point
+ * (the older method). Images always read the photon buffers. Errors:
+ * PLX_E_INVALID (side > 1024). Threads: engine.
+ */
+plx_status plx_indirect_set_gather(plx_engine *e, uint32_t side);
 
 /*
  * Histogram matching of a day orthophoto to a night palette (munoz2013

@@ -31,6 +31,7 @@
 #include "base/geom.h"
 #include "polar/polar.h"
 #include "polar_faults.h"
+#include "ref_polar_scan.h"
 #include "ref_scene.h"
 
 #define ARENA_BYTES ((size_t)64 << 20)
