@@ -10,7 +10,9 @@
 #   make valgrind   the unit tests under valgrind memcheck
 #   make bench      benchmarks (tests/bench)
 #   make check-identical BASE=rev   outputs byte-identical to revision rev
-#   make deps       install missing Debian packages (apt-get when root)
+#   make deps       install missing Debian packages (apt-get when root); plain
+#                   make only checks them and names what is missing
+#   make man        regenerate man/polarlux.1 from the --help texts
 #   make install PREFIX=/usr/local
 #   make clean
 
@@ -62,39 +64,60 @@ BIN    = $(BUILD)/polarlux
 DEB_PACKAGES = libcjson-dev libcmocka-dev libpng-dev pkg-config python3-numpy python3-pytest libsqlite3-dev
 
 .SECONDARY:
-.PHONY: all deps demo check check-full check-build unit cli-test asan valgrind bench install clean \
-        check-core-headers check-identical check-lib-split check-examples check-python check-layers
+.PHONY: all deps deps-check check-no-install man check-man demo check check-full check-build unit cli-test asan \
+        valgrind bench install clean check-core-headers check-identical check-lib-split check-examples check-python \
+        check-layers
 
 all: $(LIB_A) $(LIB_SO) $(PORT_A) $(BIN)
 
 # ---- dependencies ------------------------------------------------------------
-deps:
-	@missing=""; for p in $(DEB_PACKAGES); do \
+# Plain `make` never installs anything: it checks that the build's Debian
+# packages are there (when dpkg is) and stops naming the missing ones.
+# `make deps` installs every package of DEB_PACKAGES (with apt-get, as root)
+# and says which. The Python packages are needed by `make check` only.
+BUILD_PACKAGES = libcjson-dev libcmocka-dev libpng-dev pkg-config libsqlite3-dev
+missing_packages = for p in $(1); do \
 	  dpkg-query -W -f='$${Status}' $$p 2>/dev/null | grep -q "ok installed" || missing="$$missing $$p"; \
-	done; \
-	if [ -z "$$missing" ]; then exit 0; fi; \
+	done
+
+deps-check:
+	@command -v dpkg-query >/dev/null || exit 0; missing=""; \
+	$(call missing_packages,$(BUILD_PACKAGES)); \
+	if [ -n "$$missing" ]; then \
+	  echo "make: missing Debian packages:$$missing; 'make deps' installs them (as root)," \
+	    "or run: apt-get install$$missing" >&2; exit 1; fi
+
+# The rule above, checked: building runs no package manager.
+check-no-install:
+	@if $(MAKE) --no-print-directory -n -B all 2>/dev/null | grep -q 'apt-get update'; then \
+	  echo "check-no-install: plain make would run apt-get"; exit 1; fi
+
+deps:
+	@missing=""; $(call missing_packages,$(DEB_PACKAGES)); \
+	if [ -z "$$missing" ]; then echo "make deps: all installed: $(DEB_PACKAGES)"; exit 0; fi; \
 	if [ "$$(id -u)" = 0 ] && command -v apt-get >/dev/null; then \
-	  echo "make deps: installing$$missing"; \
+	  echo "make deps: installing$$missing (apt-get install)"; \
 	  (apt-get update -qq && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq$$missing) >/dev/null || \
 	  { echo "make deps: apt-get failed; run: apt-get install$$missing" >&2; exit 1; }; \
+	  echo "make deps: installed$$missing"; \
 	else \
 	  echo "make deps: missing packages; run as root: apt-get install$$missing" >&2; exit 1; \
 	fi
 
 # ---- objects -----------------------------------------------------------------
-$(BUILD)/src/%.o: src/%.c | deps
+$(BUILD)/src/%.o: src/%.c | deps-check
 	@mkdir -p $(@D)
 	$(CC) $(CPPFLAGS) $(CFLAGS_ALL) -c $< -o $@
 
-$(BUILD)/src/cli/%.o: src/cli/%.c | deps
+$(BUILD)/src/cli/%.o: src/cli/%.c | deps-check
 	@mkdir -p $(@D)
 	$(CC) $(CPPFLAGS) $(POSIX) $(CFLAGS_ALL) -c $< -o $@
 
-$(BUILD)/port/%.o: port/%.c | deps
+$(BUILD)/port/%.o: port/%.c | deps-check
 	@mkdir -p $(@D)
 	$(CC) $(CPPFLAGS) $(POSIX) $(CFLAGS_ALL) -c $< -o $@
 
-$(BUILD)/tests/%.o: tests/%.c | deps
+$(BUILD)/tests/%.o: tests/%.c | deps-check
 	@mkdir -p $(@D)
 	$(CC) $(CPPFLAGS) -Itests/ref $(POSIX) $(CFLAGS_ALL) -c $< -o $@
 
@@ -156,7 +179,8 @@ check-full: check-build
 	@$(MAKE) --no-print-directory check-examples check-python
 
 check-build:
-	@$(MAKE) --no-print-directory -j$(JOBS) all $(TESTS) $(EXAMPLES) check-core-headers check-lib-split check-layers
+	@$(MAKE) --no-print-directory -j$(JOBS) all $(TESTS) $(EXAMPLES) check-core-headers check-lib-split check-man \
+	  check-no-install check-layers
 
 # The include rule (tests/check_layers.sh): stages in data-flow order base <
 # scene < polar < light < photon < render < api, base/engine.h only in
@@ -171,6 +195,16 @@ EXAMPLES = $(patsubst examples/%.c,$(BUILD)/examples/%,$(wildcard examples/*.c))
 $(BUILD)/examples/%: examples/%.c $(LIB_A)
 	@mkdir -p $(@D)
 	$(CC) -Iinclude $(CFLAGS_ALL) -o $@ $< $(LIB_A) $(CORE_LIBS)
+
+# man/polarlux.1 is generated from the command's --help texts (man/mkman.sh)
+# and kept in the repository; check-man fails when it is not current.
+man: $(BIN)
+	sh man/mkman.sh $(BIN) > man/polarlux.1
+
+check-man: $(BIN)
+	@sh man/mkman.sh $(BIN) > $(BUILD)/polarlux.1
+	@cmp -s $(BUILD)/polarlux.1 man/polarlux.1 || { diff man/polarlux.1 $(BUILD)/polarlux.1 | head -20; \
+	  echo "check-man: man/polarlux.1 is not the current --help text: run 'make man' and commit it"; exit 1; }
 
 # python/: the ctypes package over $(LIB_SO), tested with Debian's pytest and
 # numpy (/usr/bin/python3: a python3 earlier on PATH may not see them). A
@@ -256,6 +290,8 @@ install: all
 	ln -sf $(SONAME) $(DESTDIR)$(PREFIX)/lib/libpolarlux.so
 	install -m 644 include/polarlux.h include/polarlux_port.h $(DESTDIR)$(PREFIX)/include/
 	install -m 755 $(BIN) $(DESTDIR)$(PREFIX)/bin/
+	install -d $(DESTDIR)$(PREFIX)/share/man/man1
+	install -m 644 man/polarlux.1 $(DESTDIR)$(PREFIX)/share/man/man1/
 	printf '%s\n' 'prefix=$(PREFIX)' 'libdir=$${prefix}/lib' 'includedir=$${prefix}/include' '' \
 	  'Name: polarlux' 'Description: exact night lighting of 2.5D cities (portable core)' \
 	  'Version: $(VERSION)' 'Libs: -L$${libdir} -lpolarlux' 'Libs.private: $(CORE_LIBS)' \

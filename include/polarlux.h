@@ -213,7 +213,7 @@ plx_status plx_scene_info_get(plx_engine *e, plx_scene_info *out /* OUT */);
  * "urn:ogc:def:crs:EPSG::2154"; NULL when it named none (or no scene). A
  * CRS other than WGS84 lon/lat (EPSG:4326, OGC CRS84) makes the load read
  * coordinates as metres, as properties.units = "m" does. Valid until the
- * next load. */
+ * next load. Threads: engine (reads). */
 const char *plx_scene_crs(plx_engine *e);
 
 /* ---- Ground albedo from a day image (README "Scene format") ------------- */
@@ -296,7 +296,9 @@ typedef struct plx_lamp {
  * computes light (illuminance, lit regions, photons, renders): PLX_E_INVALID
  * after. Memory: a new lamp array in PLX_PART_SCENE (the old one stays held
  * until the next load). Errors: PLX_E_NOSCENE, PLX_E_INVALID, PLX_E_SCENE
- * (strict), PLX_E_NOMEM (no lamp added).
+ * (strict), PLX_E_NOMEM (no lamp added). Threads: engine. plx_memory_estimate
+ * counts only the scene's own lamps: add the layer's to sz.points and
+ * sz.positions.
  */
 plx_status plx_add_lamps(plx_engine *e, const plx_lamp *lamps, uint32_t n, const char *source);
 
@@ -523,7 +525,7 @@ plx_status plx_indirect_reset(plx_engine *e);
  * the photon buffers only for light that bounced before (README,
  * "Indirect light"); side 0: the photon buffers' own estimate at the point
  * (the older method). Images always read the photon buffers. Errors:
- * PLX_E_INVALID (side > 1024).
+ * PLX_E_INVALID (side > 1024). Threads: engine.
  */
 plx_status plx_indirect_set_gather(plx_engine *e, uint32_t side);
 /*

@@ -3,6 +3,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "base/plx_assert.h"
 #include "render/render.h"
 #include "render/raster.h"
 #include "light/light.h"
@@ -643,9 +644,11 @@ static int tile_lamps(render *r, const double bx[6])
     for (cy = cy0; cy <= cy1; cy++)
         for (cx = cx0; cx <= cx1; cx++) {
             uint32_t cell = cy * g->nx + cx;
+            PLX_ASSERT(cx < g->nx && cy < g->ny); /* a cell of the lamp grid */
             for (k = g->start[cell]; k < g->start[cell + 1]; k++) {
                 uint32_t l = g->ids[k];
                 const scene_lamp *lp = &s->lamps[l];
+                PLX_ASSERT(l < s->nlamps);
                 double dx, dy, dz;
                 if (r->lamp_stamp[l] == r->stamp_now)
                     continue;

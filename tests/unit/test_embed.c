@@ -19,7 +19,7 @@
 #include "polarlux_port.h"
 #include "port.h"
 
-#define BIG ((size_t)1 << 30)
+#define BIG ((size_t)256 << 20)
 
 /* ---- projection ---------------------------------------------------------- */
 
@@ -161,6 +161,7 @@ static plx_status workflow(const char *text, size_t len, const plx_config *cfg, 
     plx_memory_report r;
     plx_status st;
     assert_non_null(mem);
+    memset(mem, 0xa5, size); /* the engine must not read its block before writing it */
     st = plx_engine_create(mem, size, cfg, &e);
     if (st == PLX_OK)
         st = plx_load_geojson(e, text, len, "estimate");
