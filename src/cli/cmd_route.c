@@ -24,7 +24,10 @@ static const char route_help[] =
     "  --path FILE      the routes (required)\n"
     "  --step M         sampling step in metres (default 1)\n"
     "  --dark-lux LX    the dark threshold (default 1)\n"
-    "  --geojson OUT    also write the lines with these numbers as properties\n"
+    "  --geojson OUT    also write one LineString feature per segment with flat\n"
+    "                   properties: name, line, segment, length_m, mean_lx, min_lx,\n"
+    "                   max_lx, uniformity, dark_share, p_class, blocked_m, and the\n"
+    "                   whole line's as line_length_m, line_mean_lx, ...\n"
     "  --mem SIZE, --strict, --quiet, --lamps FILE   as for 'polarlux info'\n";
 
 static const char spots_help[] =
@@ -62,20 +65,41 @@ static void print_row(const char *line, const char *seg, const plx_route_stats *
     printf("\n");
 }
 
-static cJSON *stats_json(const plx_route_stats *s)
+static void stats_props(cJSON *o, const char *prefix, const plx_route_stats *s)
 {
-    cJSON *o = cJSON_CreateObject();
-    char cls[4];
+    static const char *const keys[] = { "length_m", "mean_lx", "min_lx", "max_lx", "uniformity", "dark_share",
+                                         "blocked_m" };
+    double v[7];
+    char key[48], cls[4];
+    int k;
+    v[0] = s->length, v[1] = s->mean, v[2] = s->min, v[3] = s->max, v[4] = s->uniformity, v[5] = s->dark_share;
+    v[6] = s->blocked_length;
+    for (k = 0; k < 7; k++) {
+        snprintf(key, sizeof key, "%s%s", prefix, keys[k]);
+        cJSON_AddNumberToObject(o, key, v[k]);
+    }
     class_text(s->p_class, cls);
-    cJSON_AddNumberToObject(o, "length_m", s->length);
-    cJSON_AddNumberToObject(o, "mean_lx", s->mean);
-    cJSON_AddNumberToObject(o, "min_lx", s->min);
-    cJSON_AddNumberToObject(o, "max_lx", s->max);
-    cJSON_AddNumberToObject(o, "uniformity", s->uniformity);
-    cJSON_AddNumberToObject(o, "dark_share", s->dark_share);
-    cJSON_AddStringToObject(o, "p_class", cls);
-    cJSON_AddNumberToObject(o, "blocked_m", s->blocked_length);
-    return o;
+    snprintf(key, sizeof key, "%sp_class", prefix);
+    cJSON_AddStringToObject(o, key, cls);
+}
+
+/* One feature per segment, flat properties: the segment's numbers, and its
+ * line's name, index and totals (line_...), as GIS tools style them. */
+static void add_segments(geo_out *g, const route_line *l, size_t li, const plx_route_stats *tot,
+                         const plx_route_stats *seg)
+{
+    uint32_t k;
+    for (k = 0; k + 1 < l->n; k++) {
+        cJSON *props = cJSON_CreateObject(), *coords = cJSON_CreateArray();
+        cJSON_AddStringToObject(props, "name", l->name);
+        cJSON_AddNumberToObject(props, "line", (double)li);
+        cJSON_AddNumberToObject(props, "segment", k);
+        stats_props(props, "", &seg[k]);
+        stats_props(props, "line_", tot);
+        cJSON_AddItemToArray(coords, geo_position(g, l->xy[2 * k], l->xy[2 * k + 1], NULL));
+        cJSON_AddItemToArray(coords, geo_position(g, l->xy[2 * k + 2], l->xy[2 * k + 3], NULL));
+        geo_add(g, geo_geometry("LineString", coords), props);
+    }
 }
 
 typedef struct route_opts {
@@ -120,16 +144,8 @@ static int score_all(plx_engine *e, const route_opts *o, route_set *rs)
             snprintf(sname, sizeof sname, "%u", k);
             print_row("", sname, &seg[k]);
         }
-        if (g.root) {
-            cJSON *props = stats_json(&tot), *segs = cJSON_AddArrayToObject(props, "segments"), *coords;
-            cJSON_AddStringToObject(props, "name", l->name);
-            for (k = 0; k + 1 < l->n; k++)
-                cJSON_AddItemToArray(segs, stats_json(&seg[k]));
-            coords = cJSON_CreateArray();
-            for (k = 0; k < l->n; k++)
-                cJSON_AddItemToArray(coords, geo_position(&g, l->xy[2 * k], l->xy[2 * k + 1], NULL));
-            geo_add(&g, geo_geometry("LineString", coords), props);
-        }
+        if (g.root)
+            add_segments(&g, l, i, &tot, seg);
         free(seg);
     }
     if (g.root && rc == EXIT_OK && geo_write(&g, "route", o->geojson) != 0)

@@ -165,3 +165,19 @@ if [ -n "$timed" ]; then
     if [ $(( $(tail -1 "$tmp/rss-heat") - $(tail -1 "$tmp/rss-info") )) -le 40960 ]; then echo "ok   mem-heatmap-rss"; pass=$((pass + 1));
     else echo "FAIL mem-heatmap-rss: $(tail -1 "$tmp/rss-heat") KB vs $(tail -1 "$tmp/rss-info") KB"; fail=$((fail + 1)); fi
 fi
+
+# ---- route --geojson: one feature per segment, flat properties ----
+"$bin" route -q fixtures/helsinki-centre.geojson --path fixtures/helsinki-route.geojson --geojson "$tmp/rs.geojson" >"$tmp/rs.txt"
+if /usr/bin/python3 - "$tmp/rs.geojson" "$tmp/rs.txt" <<'PY'
+import json, sys
+d = json.load(open(sys.argv[1]))
+rows = [l.split() for l in open(sys.argv[2]) if l[:1] == ' ']   # segment rows of the table
+assert len(d['features']) == len(rows) and rows
+for f, r in zip(d['features'], rows):
+    p = f['properties']
+    assert all(not isinstance(v, (dict, list)) for v in p.values())
+    assert f['geometry']['type'] == 'LineString' and len(f['geometry']['coordinates']) == 2
+    assert int(r[0]) == p['segment'] and abs(float(r[2]) - p['mean_lx']) < 1e-3 and abs(float(r[1]) - p['length_m']) < 0.1
+    assert p['line_p_class'] in ('P1', 'P2', 'P3', 'P4', 'P5', 'P6', '-')
+PY
+then echo "ok   route-geojson-flat"; pass=$((pass + 1)); else echo "FAIL route-geojson-flat"; fail=$((fail + 1)); fi
