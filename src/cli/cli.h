@@ -4,6 +4,7 @@
 
 #include <stdio.h>
 #include "polarlux.h"
+#include "polarlux_port.h"
 
 /* Exit codes (README, "Exit codes"). */
 enum {
@@ -44,9 +45,14 @@ typedef struct cli_indirect {
     long photons;    /* per frame (default 65536) */
     long frames;     /* progressive frames (default 16) */
     int off;         /* --no-indirect */
+    long gather;     /* --gather N: final gathering side at points (0 = photon
+                        buffers only); -1 = the engine's default */
 } cli_indirect;
+/* Photon frames by default when points are answered by final gathering
+ * (illum): the photons carry only the later bounces (16 x 65536). */
+#define CLI_GATHER_FRAMES 16
 void cli_indirect_default(cli_indirect *ind);
-/* Handles --photons N, --frames K, --no-indirect at argv[*i]; 1 if consumed, -1 on error. */
+/* Handles --photons N, --frames K, --no-indirect, --gather N at argv[*i]; 1 if consumed, -1 on error. */
 int cli_indirect_option(const char *cmd, int argc, char **argv, int *i, cli_indirect *ind);
 /* Traces the frames (progress on a terminal), viewer at eye looking along
  * dir (either may be NULL). Returns an exit code. */

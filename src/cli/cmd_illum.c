@@ -13,16 +13,21 @@ static const char help[] =
     "metres and a unit normal; 'x y' alone means a ground point facing up,\n"
     "'x y z' a point facing up; '-' reads standard input). Prints one line\n"
     "'x y z E_direct E_indirect' per point, in lux. E_direct is exact (2.5D\n"
-    "shadows, SPEC §2); E_indirect comes from the photon buffers (SPEC §4),\n"
-    "traced first (--frames progressive frames of --photons photons; progress\n"
-    "on a terminal), 0 with --no-indirect.\n"
+    "shadows, SPEC §2); E_indirect (SPEC §4) is gathered over 32 x 32\n"
+    "directions: the light the surfaces around the point reflect, from their\n"
+    "exact E_direct, plus their later bounces from the photon buffers, traced\n"
+    "first (--frames progressive frames of --photons photons; progress on a\n"
+    "terminal); 0 with --no-indirect.\n"
     "A point on no surface (inside a building, in the air) or with a normal\n"
     "into a building prints 'x y z nan nan', is reported on stderr with its\n"
     "line, and makes the exit code 1.\n"
     "\n"
     "  --points FILE  the points (required)\n"
     "  --photons N    photons per frame (default 65536)\n"
-    "  --frames K     progressive photon frames (default 256: 16.8M photons)\n"
+    "  --frames K     progressive photon frames (default 16: 1,048,576 photons)\n"
+    "  --gather N     final gathering over N x N directions (default 32); 0: the\n"
+    "                 photon buffers' own estimate at the point (the older\n"
+    "                 method: give it --frames 256)\n"
     "  --no-indirect  direct light only (E_indirect 0)\n"
     "  --mem SIZE, --strict, --quiet, --lamps FILE   as for 'polarlux info'\n";
 
@@ -40,6 +45,7 @@ int cmd_illum(int argc, char **argv)
     int i, rc, failed = 0;
     memset(&c, 0, sizeof c);
     cli_indirect_default(&ind);
+    ind.frames = CLI_GATHER_FRAMES;
     for (i = 1; i < argc; i++) {
         int r = cli_common_option("illum", argc, argv, &i, &c);
         if (r == 0)

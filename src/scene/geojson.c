@@ -655,6 +655,7 @@ static plx_status load_text(plx_engine *e, const char *text, size_t len, const c
     e->mem.hi = m.hi;
     e->mem.used[PLX_PART_SCRATCH] = m.used[PLX_PART_SCRATCH];
     e->sc->load_ns = eng_clock(e) - t0;
+    eng_check_scene(e->sc);
     return PLX_OK;
 }
 
