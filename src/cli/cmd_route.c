@@ -112,12 +112,14 @@ static int score_all(plx_engine *e, const route_opts *o, route_set *rs)
 {
     geo_out g;
     size_t i;
+    cli_progress pr;
     int rc = EXIT_OK;
     memset(&g, 0, sizeof g);
     if (o->geojson && geo_begin(&g, e) != 0)
         return EXIT_FAIL;
     printf("%-8s %-5s %9s %9s %9s %9s %6s %6s %s\n", "line", "seg", "length_m", "mean_lx", "min_lx", "max_lx",
            "U0", "dark", "class");
+    cli_progress_start(&pr);
     for (i = 0; i < rs->n; i++) {
         const route_line *l = &rs->lines[i];
         plx_route_stats tot, *seg = malloc(sizeof *seg * l->n);
@@ -146,8 +148,10 @@ static int score_all(plx_engine *e, const route_opts *o, route_set *rs)
         }
         if (g.root)
             add_segments(&g, l, i, &tot, seg);
+        cli_progress_step(&pr, "route", i + 1, rs->n);
         free(seg);
     }
+    cli_progress_end(&pr);
     if (g.root && rc == EXIT_OK && geo_write(&g, "route", o->geojson) != 0)
         rc = EXIT_FAIL;
     geo_free(&g);
