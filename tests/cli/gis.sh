@@ -181,3 +181,47 @@ for f, r in zip(d['features'], rows):
     assert p['line_p_class'] in ('P1', 'P2', 'P3', 'P4', 'P5', 'P6', '-')
 PY
 then echo "ok   route-geojson-flat"; pass=$((pass + 1)); else echo "FAIL route-geojson-flat"; fail=$((fail + 1)); fi
+
+# ---- lit: one polygon per connected lit region, holes where shadows are ----
+# The union's area (from the written GeoJSON: outer rings less holes) equals
+# the summed area of the pieces the engine gives; no two polygons share an
+# edge (they would have merged).
+lit_union_check() {
+    name=$1; shift
+    "$bin" lit -q "$@" -o "$tmp/lu.geojson" >"$tmp/lu.txt" 2>&1 || { echo "FAIL $name: lit failed"; fail=$((fail + 1)); return; }
+    if /usr/bin/python3 - "$tmp/lu.geojson" "$tmp/lu.txt" <<'PY'
+import json, math, re, sys
+d = json.load(open(sys.argv[1]))
+txt = open(sys.argv[2]).read()
+pieces = float(re.search(r'\(pieces ([0-9.]+) m\^2\)', txt).group(1))
+lonlat = 'properties' not in d or d['properties'].get('units') != 'm'
+lat0 = 60.1716264
+def xy(p):
+    return (p[0] * 111320.0 * math.cos(math.radians(lat0)), p[1] * 110540.0) if lonlat else (p[0], p[1])
+def area(r):
+    r = [xy(p) for p in r]
+    r = [(x - r[0][0], y - r[0][1]) for x, y in r]
+    return 0.5 * sum(a[0] * b[1] - b[0] * a[1] for a, b in zip(r, r[1:]))
+ground = [f for f in d['features'] if f['properties'].get('kind') == 'ground']
+total, edges = 0.0, {}
+for f in ground:
+    rings = f['geometry']['coordinates']
+    assert area(rings[0]) > 0 and all(area(h) < 0 for h in rings[1:])
+    total += sum(area(r) for r in rings)
+    for r in rings:
+        for a, b in zip(r, r[1:]):
+            edges.setdefault((tuple(a), tuple(b)), set()).add(id(f))
+for (a, b), fs in edges.items():
+    assert not ((b, a) in edges and edges[(b, a)] - fs), 'two polygons share an edge'
+assert abs(total - pieces) <= 1e-6 * pieces + (1e-3 if lonlat else 1e-9), (total, pieces)
+PY
+    then echo "ok   $name"; pass=$((pass + 1)); else echo "FAIL $name"; cat "$tmp/lu.txt"; fail=$((fail + 1)); fi
+}
+expect lit-union-one 0 "1 lit ground polygons, 7 lit facade polygons, written to .*; the ground is the union of 17 pieces" -- "$bin" lit -q fixtures/tiny.geojson --lamp L1 -o "$tmp/lu1.geojson"
+lit_union_check lit-union-tiny fixtures/tiny.geojson --lamp L1
+lit_union_check lit-union-helsinki-hole fixtures/helsinki-centre.geojson --lamp 10
+expect lit-union-hole 0 "" -- /usr/bin/python3 -c "
+import json, sys
+d = json.load(open(sys.argv[1]))
+assert sum(len(f['geometry']['coordinates']) - 1 for f in d['features'] if f['properties'].get('kind') == 'ground') >= 1" "$tmp/lu.geojson"
+lit_union_check lit-union-helsinki fixtures/helsinki-centre.geojson --lamp 100
