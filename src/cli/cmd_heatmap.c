@@ -27,7 +27,8 @@ static const char help[] =
     "\n"
     "  --res M    metres per pixel (default: the longer side of Bounds / 1200)\n"
     "  -o FILE    output .png or .tif (required)\n"
-    "  --max LUX  top of the colour scale (default: the 98th percentile)\n"
+    "  --max LUX  a fixed scale from 0.1 lx to LUX (as 'polarlux tiles') instead\n"
+    "             of the percentiles\n"
     "  --box X0,Y0,X1,Y1  map only this box (the scene's coordinates: lon/lat on\n"
     "             a lon/lat scene) instead of Bounds\n"
     "  --path FILE  draw these routes (GeoJSON LineStrings, as for 'polarlux\n"
@@ -267,13 +268,18 @@ static double nice(double v, int down)
 }
 
 /* The scale: 2nd to 98th percentile of the lit pixels, widened to nice
- * values, at least one decade; --max sets the top. */
+ * values, at least one decade; --max gives the fixed scale 0.1 lx..max. */
 static void heat_scale(const heat_map *m, double user_top, double *lo, double *top)
 {
     size_t n = m->w * m->h;
     double p2 = lit_quantile(m->E, n, 0.02), p98 = lit_quantile(m->E, n, 0.98);
+    if (user_top > 0) { /* a fixed scale, the same as 'polarlux tiles' */
+        *lo = LUX_MIN;
+        *top = user_top;
+        return;
+    }
     *lo = p2 > 0 ? fmax(LUX_MIN, nice(p2, 1)) : LUX_MIN;
-    *top = user_top > 0 ? user_top : p98 > 0 ? nice(p98, 0) : 1.0;
+    *top = p98 > 0 ? nice(p98, 0) : 1.0;
     if (*lo > *top / 10.0)
         *lo = *top / 10.0;
 }
@@ -515,4 +521,13 @@ int cmd_heatmap(int argc, char **argv)
     rc = run(e, &o);
     plx_engine_free(e);
     return rc;
+}
+
+/* The heat map's colour of 'lux' on its scale topped at 'top', for other
+ * maps drawn in the same colours (polarlux tiles). Returns 0 when the lux
+ * is at or below the bottom of the scale (no light: black), else 1. */
+int heatmap_colour(double lux, double top, uint8_t rgb[3])
+{
+    palette(scale_t(lux, LUX_MIN, top), rgb);
+    return lux > LUX_MIN;
 }
