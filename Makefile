@@ -158,6 +158,23 @@ $(BUILD)/bench/bench_%: $(BUILD)/tests/bench/bench_%.o $(REF_OBJ) $(PORT_A) $(LI
 	$(CC) $(CFLAGS_ALL) -o $@ $< $(REF_OBJ) $(PORT_A) $(LIB_A) $(LIBS)
 
 -include port/osmesa/osmesa.mk
+
+# ---- GeoTIFF maps (libtiff + libgeotiff): linked to the command only -------------
+DEB_PACKAGES += libtiff-dev libgeotiff-dev
+GIS_CFLAGS = -I/usr/include/geotiff
+GIS_LIBS   = -lgeotiff -ltiff
+$(BUILD)/src/cli/geotiff.o: CPPFLAGS += $(GIS_CFLAGS)
+$(BIN): LIBS += $(GIS_LIBS)
+# tests/tools/tiff_probe reads a GeoTIFF back for tests/cli/gis.sh
+GIS_TOOLS = $(BUILD)/tests/tiff_probe
+$(BUILD)/tests/tiff_probe: tests/tools/tiff_probe.c | deps
+	@mkdir -p $(@D)
+	$(CC) $(CPPFLAGS) $(GIS_CFLAGS) $(POSIX) $(CFLAGS_ALL) -o $@ $< $(GIS_LIBS) -lm
+check-build: $(GIS_TOOLS)
+# the network and tile tests link cmd_heatmap.o, which writes GeoTIFFs
+CLI_TEST_OBJ += $(BUILD)/src/cli/geotiff.o
+$(CLI_TESTS): $(BUILD)/src/cli/geotiff.o
+CLI_LIBS += $(GIS_LIBS)
 -include $(shell find $(BUILD) -name '*.d' 2>/dev/null)
 
 # ---- the main job -------------------------------------------------------------

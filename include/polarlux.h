@@ -464,6 +464,13 @@ plx_status plx_indirect_rgb(plx_engine *e, size_t n, const double *P, const doub
 plx_status plx_lamps_at(plx_engine *e, const double P[3], const double n[3], uint32_t *ids /* OUT */,
                         double *lux /* OUT */, uint32_t cap, uint32_t *count /* OUT */);
 
+/* For n points P[3k..3k+2]: count[k] gets the number of lamps whose light
+ * can reach the point (intensity > 0 and distance below the lamp's radius),
+ * shadows aside. Uses the lamps' spatial index: the cost per point grows
+ * with the lamps in reach, not with all lamps. Errors: PLX_E_NOSCENE,
+ * PLX_E_INVALID (NULL arrays), PLX_E_NOMEM (setting up lamp light). */
+plx_status plx_lamps_in_reach(plx_engine *e, size_t n, const double *P, uint32_t *count /* OUT */);
+
 typedef struct plx_lit_region {
     uint32_t lamp;
     uint32_t nground;             /* lit ground polygons (z = 0) */

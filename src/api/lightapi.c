@@ -253,3 +253,16 @@ plx_status plx_lit_facade(plx_engine *e, uint32_t k, const double **xyz, uint32_
     *bld = building_of_vertex(e->sc, r->facade[k].wall);
     return PLX_OK;
 }
+
+plx_status plx_lamps_in_reach(plx_engine *e, size_t n, const double *P, uint32_t *count)
+{
+    size_t k;
+    plx_status st = eng_need(e, ENG_LIGHT, "plx_lamps_in_reach");
+    if (st != PLX_OK)
+        return st;
+    if (n > 0 && (!P || !count))
+        return eng_fail(e, PLX_E_INVALID, "plx_lamps_in_reach: P or count is NULL");
+    for (k = 0; k < n; k++)
+        count[k] = light_lamps_reaching(e->lt, P + 3 * k);
+    return PLX_OK;
+}

@@ -82,6 +82,18 @@ int cli_option_local(const char *cmd, const char *opt, plx_engine *e, double *x,
 struct points;
 int cli_points_local(const char *cmd, plx_engine *e, const cli_common *c, const char *path, struct points *p,
                      double **orig);
+/* Progress of long work on a terminal: a line "WHAT: N% (T s)" on stderr,
+ * only when stderr is a terminal and the work has run over a second. */
+typedef struct cli_progress {
+    int tty, shown;
+    unsigned long long t0, last;
+} cli_progress;
+void cli_progress_start(cli_progress *p);
+void cli_progress_step(cli_progress *p, const char *what, size_t done, size_t total);
+void cli_progress_end(cli_progress *p);
+/* The bytes the command may still allocate for its own buffers under the
+ * --mem budget: the budget less what the engine has touched (its peak). */
+size_t cli_buffer_budget(const plx_engine *e, const cli_common *c);
 /* Maps a status to an exit code. */
 int cli_exit_code(plx_status s);
 

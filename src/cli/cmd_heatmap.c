@@ -5,21 +5,32 @@
 
 #include "canvas.h"
 #include "cli.h"
+#include "geotiff.h"
 #include "route_io.h"
 
 static const char help[] =
-    "usage: polarlux heatmap SCENE [--res M] -o MAP.png [options]\n"
+    "usage: polarlux heatmap SCENE [--res M] -o MAP.png|MAP.tif [options]\n"
     "\n"
     "Writes a top-down map of the direct ground illuminance over Bounds: one\n"
     "pixel per M x M metres, sampled at the pixel centre (exact 2.5D shadows,\n"
-    "SPEC §2), coloured on a logarithmic scale with a legend in lux on the\n"
-    "right. Building footprints are grey, lamps white dots.\n"
+    "SPEC §2).\n"
+    "MAP.png: coloured on a logarithmic scale from the 2nd to the 98th\n"
+    "percentile of the lit pixels (rounded out to 1, 2, 5 x 10^k lx), with a\n"
+    "legend in lux, a scale bar and a north arrow; footprints grey, lamps white\n"
+    "dots (single pixels from 1 m per pixel). A world file MAP.pgw beside it\n"
+    "places the map in the scene's coordinates (lon/lat degrees or metres).\n"
+    "MAP.tif (or .tiff): a float32 GeoTIFF, band 1 the lux at pixel centres,\n"
+    "NaN under buildings, georeferenced in the scene's CRS: WGS84 (EPSG:4326)\n"
+    "for a lon/lat scene, the EPSG code of the scene's crs, else local metres.\n"
+    "The map is computed in strips so the command's buffers and the engine\n"
+    "together stay within --mem (exit 3 when even one row does not fit).\n"
     "\n"
     "  --res M    metres per pixel (default: the longer side of Bounds / 1200)\n"
-    "  -o FILE    output PNG (required)\n"
-    "  --max LUX  top of the colour scale (default: the next power of ten above\n"
-    "             the brightest pixel)\n"
-    "  --box X0,Y0,X1,Y1  map only this box (local metres) instead of Bounds\n"
+    "  -o FILE    output .png or .tif (required)\n"
+    "  --max LUX  a fixed scale from 0.1 lx to LUX (as 'polarlux tiles') instead\n"
+    "             of the percentiles\n"
+    "  --box X0,Y0,X1,Y1  map only this box (the scene's coordinates: lon/lat on\n"
+    "             a lon/lat scene) instead of Bounds\n"
     "  --path FILE  draw these routes (GeoJSON LineStrings, as for 'polarlux\n"
     "             route') on the map, sampled every pixel and coloured by lux\n"
     "             on the same scale, outlined in cyan\n"
@@ -52,27 +63,34 @@ static void palette(double t, uint8_t rgb[3])
 
 #define LUX_MIN 0.1
 
-static double scale_t(double lux, double top)
+/* Position of lux on the log colour scale from lo (0) to top (1). */
+static double scale_t(double lux, double lo, double top)
 {
-    if (!(lux > LUX_MIN))
+    if (!(lux > lo))
         return 0.0;
-    return log10(lux / LUX_MIN) / log10(top / LUX_MIN);
+    return log10(lux / lo) / log10(top / lo);
 }
 
-static void legend(canvas *c, int x0, double top)
+static void legend(canvas *c, int x0, double lo, double top)
 {
     static const uint8_t white[3] = { 230, 230, 230 };
     int y, h = c->h - 40, ts = c->h > 600 ? 2 : 1;
-    double v;
+    double v, marks[16];
+    int n = 0, k;
     for (y = 0; y < h; y++) {
         uint8_t rgb[3];
         palette(1.0 - (double)y / (h - 1), rgb);
         canvas_rect(c, x0 + 10, 20 + y, x0 + 30, 21 + y, rgb);
     }
-    for (v = LUX_MIN; v <= top * 1.0001; v *= 10.0) {
+    marks[n++] = lo;
+    for (v = pow(10.0, ceil(log10(lo) + 1e-9)); v < top * 0.9999 && n < 14; v *= 10.0)
+        if (v > lo * 1.5 && v < top / 1.5)
+            marks[n++] = v;
+    marks[n++] = top;
+    for (k = 0; k < n; k++) {
         char label[32];
-        int yy = 20 + (int)((1.0 - scale_t(v, top)) * (h - 1));
-        snprintf(label, sizeof label, v < 1 ? "%.1f lx" : "%.0f lx", v);
+        int yy = 20 + (int)((1.0 - scale_t(marks[k], lo, top)) * (h - 1));
+        snprintf(label, sizeof label, marks[k] < 1 ? "%.2g lx" : "%.0f lx", marks[k]);
         canvas_rect(c, x0 + 30, yy, x0 + 36, yy + 1, white);
         canvas_text(c, x0 + 40, yy - 3 * ts, ts, label, white);
     }
@@ -88,7 +106,8 @@ typedef struct heat_opts {
 } heat_opts;
 
 /* One segment a..b sampled every pixel: pass 0 the outline, pass 1 the fill. */
-static void draw_segment(plx_engine *e, canvas *c, const heat_opts *o, double top, const double *a, int pass)
+static void draw_segment(plx_engine *e, canvas *c, const heat_opts *o, double lo, double top, const double *a,
+                         int pass)
 {
     static const uint8_t outline[3] = { 0, 200, 255 };
     const double *b = a + 2;
@@ -109,13 +128,13 @@ static void draw_segment(plx_engine *e, canvas *c, const heat_opts *o, double to
         }
         if (plx_illuminance(e, 1, P, N, &E, &Ei, NULL) != PLX_OK)
             continue;
-        palette(scale_t(E + Ei, top), rgb);
+        palette(scale_t(E + Ei, lo, top), rgb);
         canvas_rect(c, px - 2, py - 2, px + 3, py + 3, rgb);
     }
 }
 
 /* Draws the routes of 'path' sampled every pixel, coloured by lux. */
-static int draw_routes(plx_engine *e, canvas *c, const heat_opts *o, double top)
+static int draw_routes(plx_engine *e, canvas *c, const heat_opts *o, double lo, double top)
 {
     route_set rs;
     char err[512];
@@ -129,44 +148,46 @@ static int draw_routes(plx_engine *e, canvas *c, const heat_opts *o, double top)
         for (i = 0; i < rs.n; i++) {
             uint32_t k;
             for (k = 0; k + 1 < rs.lines[i].n; k++)
-                draw_segment(e, c, o, top, rs.lines[i].xy + 2 * k, pass);
+                draw_segment(e, c, o, lo, top, rs.lines[i].xy + 2 * k, pass);
         }
     }
     route_free(&rs);
     return EXIT_OK;
 }
 
-static int run(plx_engine *e, const heat_opts *o)
+/* ---- the map: illuminance in strips under the --mem budget ---------------- */
+
+#define STRIP_BYTES_PER_PX (7 * sizeof(double)) /* P, N and E of a strip */
+
+typedef struct heat_map {
+    size_t w, h;
+    double box[4], res;
+    float *E;        /* w*h lux, NaN under buildings; top row first */
+    size_t strip;    /* rows per strip */
+} heat_map;
+
+/* Rows per strip so the command's buffers (fixed + strips) stay within the
+ * budget; 0 when not even one row fits. */
+static size_t strip_rows(size_t w, size_t h, size_t fixed, size_t budget)
 {
-    static const uint8_t grey[3] = { 60, 60, 66 }, white[3] = { 255, 255, 255 }, black[3] = { 0, 0, 0 };
-    plx_scene_info si;
-    canvas c;
-    double box[4], *P, *N, *E, top = 0.0;
-    size_t w, h, n, k;
-    int legend_w, map_w;
-    char err[512];
+    size_t per_row = w * STRIP_BYTES_PER_PX, r;
+    if (fixed + per_row > budget)
+        return 0;
+    r = (budget - fixed) / per_row;
+    if (r > h)
+        r = h;
+    return r > 4096 ? 4096 : r;
+}
+
+/* One strip of rows [y0, y1) into m->E. */
+static plx_status heat_strip(plx_engine *e, const heat_opts *o, heat_map *m, size_t y0, size_t y1, double *P,
+                             double *N, double *E)
+{
+    size_t n = (y1 - y0) * m->w, k;
     plx_status st;
-    double res = o->res;
-    plx_scene_info_get(e, &si);
-    memcpy(box, o->have_box ? o->box : si.bounds, sizeof box);
-    w = (size_t)ceil((box[2] - box[0]) / res);
-    h = (size_t)ceil((box[3] - box[1]) / res);
-    if (w < 1 || h < 1 || w * h > 50000000u) {
-        fprintf(stderr, "polarlux heatmap: --res %g gives %zux%zu pixels (at most 5e7)\n", res, w, h);
-        return EXIT_USAGE;
-    }
-    n = w * h;
-    P = malloc(sizeof *P * 3 * n);
-    N = malloc(sizeof *N * 3 * n);
-    E = malloc(sizeof *E * n);
-    if (!P || !N || !E) {
-        free(P), free(N), free(E);
-        fprintf(stderr, "polarlux heatmap: out of memory for %zu pixels\n", n);
-        return EXIT_FAIL;
-    }
     for (k = 0; k < n; k++) {
-        P[3 * k] = box[0] + (k % w + 0.5) * res;
-        P[3 * k + 1] = box[3] - (k / w + 0.5) * res;
+        P[3 * k] = m->box[0] + (k % m->w + 0.5) * m->res;
+        P[3 * k + 1] = m->box[3] - (y0 + k / m->w + 0.5) * m->res;
         P[3 * k + 2] = 0.0;
         N[3 * k] = N[3 * k + 1] = 0.0;
         N[3 * k + 2] = 1.0;
@@ -174,74 +195,287 @@ static int run(plx_engine *e, const heat_opts *o)
     if (o->quantity == PLX_METER_H) {
         st = plx_illuminance(e, n, P, N, E, NULL, NULL);
     } else {
-        double u[2], m[PLX_METER_COUNT];
+        double u[2], mv[PLX_METER_COUNT];
         u[0] = cos(o->facing * 3.14159265358979323846 / 180.0);
         u[1] = sin(o->facing * 3.14159265358979323846 / 180.0);
         st = PLX_OK;
         for (k = 0; k < n && (st == PLX_OK || st == PLX_E_RANGE); k++) {
             P[3 * k + 2] = o->height;
-            st = plx_meter(e, 1, P + 3 * k, u, m);
-            E[k] = m[o->quantity];
+            st = plx_meter(e, 1, P + 3 * k, u, mv);
+            E[k] = mv[o->quantity];
         }
     }
-    if (st != PLX_OK && st != PLX_E_RANGE) { /* RANGE: pixels under buildings */
-        fprintf(stderr, "polarlux heatmap: %s\n", plx_last_error(e));
-        free(P), free(N), free(E);
-        return cli_exit_code(st);
-    }
     for (k = 0; k < n; k++)
-        if (E[k] == E[k] && E[k] > top)
-            top = E[k];
-    if (!(top > 0))
-        cli_warn("heatmap", o->c, "every pixel of the map is dark (0 lx): %s", cli_dark_reason(e));
-    top = o->top > 0 ? o->top : pow(10.0, ceil(log10(fmax(top, 1.0))));
-    map_w = (int)w;
-    legend_w = h > 600 ? 150 : 90;
-    c.w = map_w + legend_w;
-    c.h = (int)h < 200 ? 200 : (int)h;
-    c.rgb = calloc((size_t)c.w * c.h, 3);
-    c.x0 = box[0];
-    c.y0 = box[3];
-    c.scale = 1.0 / res;
-    if (!c.rgb) {
+        m->E[y0 * m->w + k] = (float)E[k];
+    return st == PLX_E_RANGE ? PLX_OK : st; /* RANGE: pixels under buildings (NaN) */
+}
+
+static int heat_compute(plx_engine *e, const heat_opts *o, heat_map *m, size_t fixed, const cli_common *c)
+{
+    double probe[3] = { 0, 0, 0 }, up[3] = { 0, 0, 1 }, E0;
+    size_t y, budget;
+    double *P, *N, *E;
+    cli_progress pr;
+    plx_illuminance(e, 1, probe, up, &E0, NULL, NULL); /* builds the light first: its memory counts */
+    budget = cli_buffer_budget(e, c);
+    m->strip = strip_rows(m->w, m->h, fixed, budget);
+    if (m->strip == 0) {
+        fprintf(stderr, "polarlux heatmap: a %zux%zu map needs %zu bytes of buffers, and --mem leaves %zu after the "
+                        "engine; give more --mem or a coarser --res\n", m->w, m->h, fixed + m->w * STRIP_BYTES_PER_PX,
+                budget);
+        return EXIT_NOMEM;
+    }
+    P = malloc(sizeof *P * 3 * m->w * m->strip);
+    N = malloc(sizeof *N * 3 * m->w * m->strip);
+    E = malloc(sizeof *E * m->w * m->strip);
+    if (!P || !N || !E) {
         free(P), free(N), free(E);
+        fprintf(stderr, "polarlux heatmap: out of memory for a strip of %zu rows\n", m->strip);
+        return EXIT_FAIL;
+    }
+    cli_progress_start(&pr);
+    for (y = 0; y < m->h; y += m->strip) {
+        size_t y1 = y + m->strip < m->h ? y + m->strip : m->h;
+        plx_status st = heat_strip(e, o, m, y, y1, P, N, E);
+        if (st != PLX_OK) {
+            cli_progress_end(&pr);
+            fprintf(stderr, "polarlux heatmap: %s\n", plx_last_error(e));
+            free(P), free(N), free(E);
+            return cli_exit_code(st);
+        }
+        cli_progress_step(&pr, "heatmap", y1, m->h);
+    }
+    cli_progress_end(&pr);
+    free(P), free(N), free(E);
+    return EXIT_OK;
+}
+
+/* ---- the colour scale: robust percentiles ----------------------------------- */
+
+#define HIST_LO -3.0   /* log10 lux of the first bin */
+#define HIST_BINS 1000 /* 0.01 decade each: 1e-3 .. 1e7 lx */
+
+/* The p-th quantile (0..1) of the lit pixels (E > 0) from a log histogram;
+ * 0 when none is lit. */
+static double lit_quantile(const float *E, size_t n, double p)
+{
+    size_t hist[HIST_BINS];
+    size_t k, lit = 0, acc = 0, want;
+    memset(hist, 0, sizeof hist);
+    for (k = 0; k < n; k++) {
+        if (E[k] > 0) {
+            int b = (int)floor((log10(E[k]) - HIST_LO) * 100.0);
+            hist[b < 0 ? 0 : b >= HIST_BINS ? HIST_BINS - 1 : b]++;
+            lit++;
+        }
+    }
+    if (lit == 0)
+        return 0.0;
+    want = (size_t)ceil(p * lit);
+    for (k = 0; k < HIST_BINS; k++) {
+        acc += hist[k];
+        if (acc >= want && acc > 0)
+            return pow(10.0, HIST_LO + (k + 1) / 100.0); /* the bin's upper edge */
+    }
+    return pow(10.0, HIST_LO + HIST_BINS / 100.0);
+}
+
+/* The next value of 1, 2, 5 x 10^k at or above v (below v when down). */
+static double nice(double v, int down)
+{
+    double p = pow(10.0, floor(log10(v))), m = v / p;
+    if (down)
+        return (m >= 5 ? 5 : m >= 2 ? 2 : 1) * p;
+    return (m <= 1.0000001 ? 1 : m <= 2.0000001 ? 2 : m <= 5.0000001 ? 5 : 10) * p;
+}
+
+/* The scale: 2nd to 98th percentile of the lit pixels, widened to nice
+ * values, at least one decade; --max gives the fixed scale 0.1 lx..max. */
+static void heat_scale(const heat_map *m, double user_top, double *lo, double *top)
+{
+    size_t n = m->w * m->h;
+    double p2 = lit_quantile(m->E, n, 0.02), p98 = lit_quantile(m->E, n, 0.98);
+    if (user_top > 0) { /* a fixed scale, the same as 'polarlux tiles' */
+        *lo = LUX_MIN;
+        *top = user_top;
+        return;
+    }
+    *lo = p2 > 0 ? fmax(LUX_MIN, nice(p2, 1)) : LUX_MIN;
+    *top = p98 > 0 ? nice(p98, 0) : 1.0;
+    if (*lo > *top / 10.0)
+        *lo = *top / 10.0;
+}
+
+/* ---- the PNG ------------------------------------------------------------------ */
+
+/* A bar of a nice length near a fifth of the map, bottom left, labelled in
+ * metres (km from 1000 m). */
+static void scale_bar(canvas *c, int map_w, int map_h, double res)
+{
+    static const uint8_t white[3] = { 240, 240, 240 }, black[3] = { 0, 0, 0 };
+    double len = nice(map_w * res / 5.0, 1);
+    int px = (int)(len / res + 0.5), x0 = 12, y0 = map_h - 16, ts = map_h > 600 ? 2 : 1;
+    char label[32];
+    if (px < 8 || map_h < 60)
+        return;
+    if (len >= 1000)
+        snprintf(label, sizeof label, "%g km", len / 1000.0);
+    else
+        snprintf(label, sizeof label, "%g m", len);
+    canvas_rect(c, x0 - 2, y0 - 2 - 10 * ts, x0 + px + 2, y0 + 6, black);
+    canvas_rect(c, x0, y0, x0 + px, y0 + 4, white);
+    canvas_rect(c, x0, y0 - 4, x0 + 1, y0, white);
+    canvas_rect(c, x0 + px - 1, y0 - 4, x0 + px, y0, white);
+    canvas_text(c, x0, y0 - 2 - 9 * ts, ts, label, white);
+}
+
+/* An arrow pointing up (north: the map's top row is north) with an N,
+ * top right of the map. */
+static void north_arrow(canvas *c, int map_w, int map_h)
+{
+    static const uint8_t white[3] = { 240, 240, 240 }, black[3] = { 0, 0, 0 };
+    int ts = map_h > 600 ? 2 : 1, s = 10 * ts, cx = map_w - 14 - s / 2, y0 = 8, k;
+    if (map_w < 60 || map_h < 60)
+        return;
+    canvas_rect(c, cx - s / 2 - 3, y0 - 3, cx + s / 2 + 4, y0 + 2 * s + 10 * ts + 3, black);
+    for (k = 0; k < s; k++) /* the head: a triangle, one row per pixel */
+        canvas_rect(c, cx - k / 2, y0 + k, cx + k / 2 + 1, y0 + k + 1, white);
+    canvas_rect(c, cx - ts / 2, y0 + s, cx + ts / 2 + 1, y0 + 2 * s, white);
+    canvas_text(c, cx - 2 * ts, y0 + 2 * s + 2, ts, "N", white);
+}
+
+/* Lamps: 3x3 white dots at street scale, single dim pixels at city scale
+ * (res >= 1 m) so they do not hide the colours. */
+static void draw_lamps(plx_engine *e, canvas *c, const heat_map *m)
+{
+    static const uint8_t white[3] = { 255, 255, 255 }, dim[3] = { 200, 230, 255 };
+    plx_scene_info si;
+    uint32_t k;
+    int big = m->res < 1.0;
+    plx_scene_info_get(e, &si);
+    for (k = 0; k < si.lamps; k++) {
+        plx_lamp l;
+        int px, py;
+        plx_lamp_get(e, k, &l);
+        px = (int)floor((l.x - m->box[0]) / m->res);
+        py = (int)floor((m->box[3] - l.y) / m->res);
+        if (px < 0 || py < 0 || (size_t)px >= m->w || (size_t)py >= m->h)
+            continue;
+        if (big)
+            canvas_rect(c, px - 1, py - 1, px + 2, py + 2, white);
+        else
+            canvas_rect(c, px, py, px + 1, py + 1, dim);
+    }
+}
+
+static int write_png(plx_engine *e, const heat_opts *o, const heat_map *m, double lo, double top)
+{
+    static const uint8_t grey[3] = { 60, 60, 66 }, black[3] = { 0, 0, 0 };
+    canvas c;
+    raster_frame f;
+    size_t k, n = m->w * m->h;
+    char err[512];
+    int map_w = (int)m->w, legend_w = m->h > 600 ? 150 : 90;
+    c.w = map_w + legend_w;
+    c.h = (int)m->h < 200 ? 200 : (int)m->h;
+    c.rgb = calloc((size_t)c.w * c.h, 3);
+    c.x0 = m->box[0];
+    c.y0 = m->box[3];
+    c.scale = 1.0 / m->res;
+    if (!c.rgb) {
+        fprintf(stderr, "polarlux heatmap: out of memory for the %dx%d image\n", c.w, c.h);
         return EXIT_FAIL;
     }
     for (k = 0; k < n; k++) {
         uint8_t rgb[3];
-        if (E[k] != E[k])
+        if (m->E[k] != m->E[k])
             memcpy(rgb, grey, 3);
         else
-            palette(scale_t(E[k], top), rgb);
-        canvas_rect(&c, (int)(k % w), (int)(k / w), (int)(k % w) + 1, (int)(k / w) + 1, rgb);
+            palette(scale_t(m->E[k], lo, top), rgb);
+        canvas_rect(&c, (int)(k % m->w), (int)(k / m->w), (int)(k % m->w) + 1, (int)(k / m->w) + 1, rgb);
     }
-    for (k = 0; k < si.lamps; k++) {
-        plx_lamp l;
-        int px, py;
-        plx_lamp_get(e, (uint32_t)k, &l);
-        px = (int)((l.x - box[0]) / res);
-        py = (int)((box[3] - l.y) / res);
-        canvas_rect(&c, px - 1, py - 1, px + 2, py + 2, white);
-    }
-    free(P), free(N), free(E);
-    if (o->path && draw_routes(e, &c, o, top) != EXIT_OK) {
+    draw_lamps(e, &c, m);
+    if (o->path && draw_routes(e, &c, o, lo, top) != EXIT_OK) {
         canvas_free(&c);
         return EXIT_FAIL;
     }
+    scale_bar(&c, map_w, (int)m->h, m->res);
+    north_arrow(&c, map_w, (int)m->h);
     canvas_rect(&c, map_w, 0, c.w, c.h, black);
-    legend(&c, map_w, top);
-    if (canvas_write(&c, o->out, err, sizeof err) != 0) {
+    legend(&c, map_w, lo, top);
+    raster_frame_of(e, m->box, m->res, &f);
+    if (canvas_write(&c, o->out, err, sizeof err) != 0 || world_file_write(o->out, &f, err, sizeof err) != 0) {
         fprintf(stderr, "polarlux heatmap: %s\n", err);
         canvas_free(&c);
         return EXIT_FAIL;
     }
-    if (o->quantity != PLX_METER_H)
+    canvas_free(&c);
+    return EXIT_OK;
+}
+
+static int write_tiff(plx_engine *e, const heat_opts *o, const heat_map *m)
+{
+    raster_frame f;
+    char err[512];
+    raster_frame_of(e, m->box, m->res, &f);
+    if (geotiff_write(o->out, m->E, (int)m->w, (int)m->h, 1, &f,
+                      "polarlux heatmap: band 1 = direct horizontal ground illuminance E_h in lux at pixel "
+                      "centres; NaN under buildings", err, sizeof err) != 0) {
+        fprintf(stderr, "polarlux heatmap: %s\n", err);
+        return EXIT_FAIL;
+    }
+    return EXIT_OK;
+}
+
+static int run(plx_engine *e, const heat_opts *o)
+{
+    plx_scene_info si;
+    heat_map m;
+    double lo, top;
+    int rc, tiff = is_tiff_path(o->out);
+    size_t fixed, k, lit = 0;
+    memset(&m, 0, sizeof m);
+    plx_scene_info_get(e, &si);
+    memcpy(m.box, o->have_box ? o->box : si.bounds, sizeof m.box);
+    m.res = o->res;
+    m.w = (size_t)ceil((m.box[2] - m.box[0]) / m.res);
+    m.h = (size_t)ceil((m.box[3] - m.box[1]) / m.res);
+    if (m.w < 1 || m.h < 1 || m.w * m.h > 50000000u) {
+        fprintf(stderr, "polarlux heatmap: --res %g gives %zux%zu pixels (at most 5e7)\n", m.res, m.w, m.h);
+        return EXIT_USAGE;
+    }
+    /* the map's floats, and the PNG's canvas (map + legend, >= 200 rows) */
+    fixed = sizeof *m.E * m.w * m.h + (tiff ? 0 : 3 * (m.w + 150) * (m.h < 200 ? 200 : m.h));
+    m.E = malloc(sizeof *m.E * m.w * m.h);
+    if (!m.E) {
+        fprintf(stderr, "polarlux heatmap: out of memory for %zu pixels\n", m.w * m.h);
+        return EXIT_FAIL;
+    }
+    rc = heat_compute(e, o, &m, fixed, o->c);
+    if (rc != EXIT_OK) {
+        free(m.E);
+        return rc;
+    }
+    for (k = 0; k < m.w * m.h; k++)
+        lit += m.E[k] > 0;
+    if (lit == 0)
+        cli_warn("heatmap", o->c, "every pixel of the map is dark (0 lx): %s", cli_dark_reason(e));
+    heat_scale(&m, o->top, &lo, &top);
+    rc = tiff ? write_tiff(e, o, &m) : write_png(e, o, &m, lo, top);
+    if (rc == EXIT_OK && tiff)
+        printf("heatmap: %zux%zu pixels at %g m, float32 GeoTIFF of lux (%zu lit), written to %s\n", m.w, m.h,
+               m.res, lit, o->out);
+    else if (rc == EXIT_OK)
+        printf("heatmap: %zux%zu pixels at %g m, scale %g..%g lx (2nd-98th percentile of the %zu lit pixels), "
+               "written to %s (world file .pgw beside it)\n", m.w, m.h, m.res, lo, top, lit, o->out);
+    if (rc == EXIT_OK && o->quantity != PLX_METER_H)
         printf("heatmap: %s illuminance at %g m facing %g deg\n",
                o->quantity == PLX_METER_SC ? "semi-cylindrical" : o->quantity == PLX_METER_V ? "vertical"
                                                                 : "hemispherical", o->height, o->facing);
-    printf("heatmap: %zux%zu pixels at %g m, scale %g..%g lx, written to %s\n", w, h, res, LUX_MIN, top, o->out);
-    canvas_free(&c);
-    return EXIT_OK;
+    if (rc == EXIT_OK && m.strip < m.h)
+        printf("heatmap: computed in strips of %zu rows to stay within --mem\n", m.strip);
+    free(m.E);
+    return rc;
 }
 
 int cmd_heatmap(int argc, char **argv)
@@ -335,6 +569,6 @@ int cmd_heatmap(int argc, char **argv)
  * is at or below the bottom of the scale (no light: black), else 1. */
 int heatmap_colour(double lux, double top, uint8_t rgb[3])
 {
-    palette(scale_t(lux, top), rgb);
+    palette(scale_t(lux, LUX_MIN, top), rgb);
     return lux > LUX_MIN;
 }

@@ -45,6 +45,7 @@ int cmd_illum(int argc, char **argv)
     points pts;
     char err[512];
     double *ed, *ei, *given = NULL;
+    cli_progress pr;
     size_t k;
     const cli_opt opts[] = {
         { "--points", NULL, &file, NULL, NULL, 0, "--points needs a file" },
@@ -116,19 +117,23 @@ int cmd_illum(int argc, char **argv)
         rc = EXIT_FAIL;
         goto done;
     }
+    cli_progress_start(&pr);
     for (k = 0; k < pts.n; k++) {
         const double *p = pts.v + 6 * k;
         plx_status st = plx_illuminance(e, 1, p, p + 3, &ed[k], &ei[k], NULL);
+        cli_progress_step(&pr, "illum", k + 1, pts.n);
         if (st == PLX_E_RANGE) {
             fprintf(stderr, "polarlux illum: %s:%zu: %s\n", file, pts.line[k], plx_last_error(e));
             failed = 1;
         } else if (st != PLX_OK) {
+            cli_progress_end(&pr);
             fprintf(stderr, "polarlux illum: %s\n", plx_last_error(e));
             rc = cli_exit_code(st);
             goto done;
         }
         printf("%.17g %.17g %.17g %.17g %.17g\n", given[2 * k], given[2 * k + 1], p[2], ed[k], ei[k]);
     }
+    cli_progress_end(&pr);
     rc = failed ? EXIT_FAIL : EXIT_OK;
     for (k = 0; k < pts.n && !(ed[k] + ei[k] > 0); k++)
         ;

@@ -5,12 +5,16 @@
 #include "cli.h"
 #include "options.h"
 #include "geo_out.h"
+#include "lit_union.h"
 
 static const char help[] =
     "usage: polarlux lit SCENE --lamp ID -o OUT.geojson [options]\n"
     "\n"
-    "Writes the lit region of one lamp within its reach as GeoJSON: lit ground\n"
-    "polygons (z = 0, property kind = \"ground\") and lit facade polygons with\n"
+    "Writes the lit region of one lamp within its reach as GeoJSON: the lit\n"
+    "ground as one polygon per connected region with holes where shadows are\n"
+    "(z = 0, property kind = \"ground\"; the exact union of the engine's\n"
+    "pieces, whose summed area is printed beside the union's) and lit facade\n"
+    "polygons with\n"
     "3D coordinates (kind = \"facade\", with the building), plus the lamp as a\n"
     "point. Coordinates are lon/lat when the scene was lon/lat, else metres.\n"
     "\n"
@@ -37,8 +41,58 @@ static long find_lamp(plx_engine *e, const char *id)
     return -1;
 }
 
+/* The lit ground as one polygon per connected region, holes where shadows
+ * are (the exact union of the region's pieces, lit_union.c); *area gets
+ * its area and *pieces the pieces' summed area. */
+static int add_ground(plx_engine *e, geo_out *g, const plx_lit_region *r, size_t *npoly, double *area,
+                      double *pieces)
+{
+    const double **xy = malloc(sizeof *xy * (r->nground + 1));
+    uint32_t *n = malloc(sizeof *n * (r->nground + 1)), k;
+    lit_union u;
+    size_t i, j;
+    *npoly = 0;
+    *area = *pieces = 0.0;
+    if (!xy || !n) {
+        free(xy), free(n);
+        return -1;
+    }
+    for (k = 0; k < r->nground; k++) {
+        uint32_t m;
+        plx_lit_ground(e, k, &xy[k], &n[k]);
+        for (m = 0; m < n[k]; m++) {
+            uint32_t q = (m + 1) % n[k];
+            *pieces += 0.5 * (xy[k][2 * m] * xy[k][2 * q + 1] - xy[k][2 * q] * xy[k][2 * m + 1]);
+        }
+    }
+    if (lit_union_build(xy, n, r->nground, &u) != 0) {
+        free(xy), free(n);
+        return -1;
+    }
+    for (i = 0; i < u.nrings; i++) {
+        cJSON *rings, *props;
+        *area += u.rings[i].area;
+        if (u.rings[i].area <= 0)
+            continue;
+        rings = cJSON_CreateArray();
+        cJSON_AddItemToArray(rings, geo_ring(g, u.rings[i].xy, (uint32_t)u.rings[i].n, NULL));
+        for (j = 0; j < u.nrings; j++)
+            if (u.rings[j].outer == (long)i)
+                cJSON_AddItemToArray(rings, geo_ring(g, u.rings[j].xy, (uint32_t)u.rings[j].n, NULL));
+        props = cJSON_CreateObject();
+        cJSON_AddStringToObject(props, "kind", "ground");
+        geo_add(g, geo_geometry("Polygon", rings), props);
+        (*npoly)++;
+    }
+    lit_union_free(&u);
+    free(xy), free(n);
+    return 0;
+}
+
 static int write_region(plx_engine *e, uint32_t lamp, const char *out, const cli_common *c)
 {
+    size_t npoly;
+    double area, pieces;
     plx_lit_region r;
     plx_lamp l;
     geo_out g;
@@ -64,15 +118,10 @@ static int write_region(plx_engine *e, uint32_t lamp, const char *out, const cli
     cJSON_AddNumberToObject(props, "intensity", l.intensity);
     cJSON_AddNumberToObject(props, "radius", l.radius);
     geo_add(&g, geo_geometry("Point", geo_position(&g, l.x, l.y, NULL)), props);
-    for (k = 0; k < r.nground; k++) {
-        const double *xy;
-        uint32_t n;
-        cJSON *rings = cJSON_CreateArray();
-        plx_lit_ground(e, k, &xy, &n);
-        cJSON_AddItemToArray(rings, geo_ring(&g, xy, n, NULL));
-        props = cJSON_CreateObject();
-        cJSON_AddStringToObject(props, "kind", "ground");
-        geo_add(&g, geo_geometry("Polygon", rings), props);
+    if (add_ground(e, &g, &r, &npoly, &area, &pieces) != 0) {
+        geo_free(&g);
+        fprintf(stderr, "polarlux lit: out of memory\n");
+        return EXIT_FAIL;
     }
     for (k = 0; k < r.nfacade; k++) {
         const double *xyz;
@@ -111,8 +160,9 @@ static int write_region(plx_engine *e, uint32_t lamp, const char *out, const cli
         return EXIT_FAIL;
     }
     geo_free(&g);
-    printf("lamp %u (%s): %u lit ground polygons, %u lit facade polygons, written to %s\n", lamp,
-           l.id ? l.id : "-", r.nground, r.nfacade, out);
+    printf("lamp %u (%s): %zu lit ground polygons, %u lit facade polygons, written to %s; the ground is the union "
+           "of %u pieces: area %.6f m^2 (pieces %.6f m^2)\n", lamp, l.id ? l.id : "-", npoly, r.nfacade, out,
+           r.nground, area, pieces);
     return EXIT_OK;
 }
 

@@ -31,7 +31,10 @@ static const char route_help[] =
     "  --step M         sampling step in metres (default 1)\n"
     "  --dark-lux LX    the dark threshold (default 1)\n"
     "  --height M       height of the Ev/Esc meters above the path (default 1.5)\n"
-    "  --geojson OUT    also write the lines with these numbers as properties\n"
+    "  --geojson OUT    also write one LineString feature per segment with flat\n"
+    "                   properties: name, line, segment, length_m, mean_lx, min_lx,\n"
+    "                   max_lx, uniformity, dark_share, p_class, blocked_m, and the\n"
+    "                   whole line's as line_length_m, line_mean_lx, ...\n"
     "  --mem SIZE, --strict, --quiet, --lamps FILE   as for 'polarlux info'\n"
     "\n"
     "With --network STREETS --from X,Y --to X,Y: the best-lit route over a street\n"
@@ -84,26 +87,59 @@ static void print_row(const char *line, const char *seg, const plx_route_stats *
     printf("\n");
 }
 
-static cJSON *stats_json(const plx_route_stats *s, const double fac[4])
+static void stats_props(cJSON *o, const char *prefix, const plx_route_stats *s)
 {
-    cJSON *o = cJSON_CreateObject();
-    char cls[4], fr[4];
+    static const char *const keys[] = { "length_m", "mean_lx", "min_lx", "max_lx", "uniformity", "dark_share",
+                                         "blocked_m" };
+    double v[7];
+    char key[48], cls[4];
+    int k;
+    v[0] = s->length, v[1] = s->mean, v[2] = s->min, v[3] = s->max, v[4] = s->uniformity, v[5] = s->dark_share;
+    v[6] = s->blocked_length;
+    for (k = 0; k < 7; k++) {
+        snprintf(key, sizeof key, "%s%s", prefix, keys[k]);
+        cJSON_AddNumberToObject(o, key, v[k]);
+    }
     class_text(s->p_class, cls);
+    snprintf(key, sizeof key, "%sp_class", prefix);
+    cJSON_AddStringToObject(o, key, cls);
+}
+
+/* One feature per segment, flat properties: the segment's numbers, and its
+ * line's name, index and totals (line_...), as GIS tools style them. */
+/* The SPEC §6 facial-recognition numbers of a segment or line (fac: min
+ * E_v forward, backward, min E_sc forward, backward; -1 where not had). */
+static void facial_props(cJSON *o, const char *prefix, const plx_route_stats *s, const double fac[4])
+{
+    static const char *const keys[] = { "min_ev_fw_lx", "min_ev_bw_lx", "min_esc_fw_lx", "min_esc_bw_lx" };
+    char key[48], fr[4];
+    int k;
+    for (k = 0; k < 4; k++) {
+        snprintf(key, sizeof key, "%s%s", prefix, keys[k]);
+        cJSON_AddNumberToObject(o, key, fac[k] == fac[k] ? fac[k] : -1);
+    }
     class_text(facial_class(s, fac), fr);
-    cJSON_AddNumberToObject(o, "min_ev_fw_lx", fac[0] == fac[0] ? fac[0] : -1);
-    cJSON_AddNumberToObject(o, "min_ev_bw_lx", fac[1] == fac[1] ? fac[1] : -1);
-    cJSON_AddNumberToObject(o, "min_esc_fw_lx", fac[2] == fac[2] ? fac[2] : -1);
-    cJSON_AddNumberToObject(o, "min_esc_bw_lx", fac[3] == fac[3] ? fac[3] : -1);
-    cJSON_AddStringToObject(o, "p_class_facial", fr);
-    cJSON_AddNumberToObject(o, "length_m", s->length);
-    cJSON_AddNumberToObject(o, "mean_lx", s->mean);
-    cJSON_AddNumberToObject(o, "min_lx", s->min);
-    cJSON_AddNumberToObject(o, "max_lx", s->max);
-    cJSON_AddNumberToObject(o, "uniformity", s->uniformity);
-    cJSON_AddNumberToObject(o, "dark_share", s->dark_share);
-    cJSON_AddStringToObject(o, "p_class", cls);
-    cJSON_AddNumberToObject(o, "blocked_m", s->blocked_length);
-    return o;
+    snprintf(key, sizeof key, "%sp_class_facial", prefix);
+    cJSON_AddStringToObject(o, key, fr);
+}
+
+static void add_segments(geo_out *g, const route_line *l, size_t li, const plx_route_stats *tot,
+                         const plx_route_stats *seg, const double *ftot, const double *fac)
+{
+    uint32_t k;
+    for (k = 0; k + 1 < l->n; k++) {
+        cJSON *props = cJSON_CreateObject(), *coords = cJSON_CreateArray();
+        cJSON_AddStringToObject(props, "name", l->name);
+        cJSON_AddNumberToObject(props, "line", (double)li);
+        cJSON_AddNumberToObject(props, "segment", k);
+        stats_props(props, "", &seg[k]);
+        stats_props(props, "line_", tot);
+        facial_props(props, "", &seg[k], fac + 4 * k);
+        facial_props(props, "line_", tot, ftot);
+        cJSON_AddItemToArray(coords, geo_position(g, l->xy[2 * k], l->xy[2 * k + 1], NULL));
+        cJSON_AddItemToArray(coords, geo_position(g, l->xy[2 * k + 2], l->xy[2 * k + 3], NULL));
+        geo_add(g, geo_geometry("LineString", coords), props);
+    }
 }
 
 typedef struct route_opts {
@@ -116,12 +152,14 @@ static int score_all(plx_engine *e, const route_opts *o, route_set *rs)
 {
     geo_out g;
     size_t i;
+    cli_progress pr;
     int rc = EXIT_OK;
     memset(&g, 0, sizeof g);
     if (o->geojson && geo_begin(&g, e) != 0)
         return EXIT_FAIL;
     printf("%-8s %-5s %9s %9s %9s %9s %6s %6s %-5s %8s %8s %8s %8s %s\n", "line", "seg", "length_m", "mean_lx",
            "min_lx", "max_lx", "U0", "dark", "class", "Ev_fw", "Ev_bw", "Esc_fw", "Esc_bw", "class_fr");
+    cli_progress_start(&pr);
     for (i = 0; i < rs->n; i++) {
         const route_line *l = &rs->lines[i];
         plx_route_stats tot, *seg = malloc(sizeof *seg * l->n);
@@ -154,19 +192,13 @@ static int score_all(plx_engine *e, const route_opts *o, route_set *rs)
             snprintf(sname, sizeof sname, "%u", k);
             print_row("", sname, &seg[k], fac + 4 * k);
         }
-        if (g.root) {
-            cJSON *props = stats_json(&tot, ftot), *segs = cJSON_AddArrayToObject(props, "segments"), *coords;
-            cJSON_AddStringToObject(props, "name", l->name);
-            for (k = 0; k + 1 < l->n; k++)
-                cJSON_AddItemToArray(segs, stats_json(&seg[k], fac + 4 * k));
-            coords = cJSON_CreateArray();
-            for (k = 0; k < l->n; k++)
-                cJSON_AddItemToArray(coords, geo_position(&g, l->xy[2 * k], l->xy[2 * k + 1], NULL));
-            geo_add(&g, geo_geometry("LineString", coords), props);
-        }
+        if (g.root)
+            add_segments(&g, l, i, &tot, seg, ftot, fac);
+        cli_progress_step(&pr, "route", i + 1, rs->n);
         free(seg);
         free(fac);
     }
+    cli_progress_end(&pr);
     if (g.root && rc == EXIT_OK && geo_write(&g, "route", o->geojson) != 0)
         rc = EXIT_FAIL;
     geo_free(&g);
@@ -242,8 +274,10 @@ int cmd_route(int argc, char **argv)
 
 /* ---- dark spots ------------------------------------------------------------ */
 
+/* A street point of the grid: its index j * w + i and its lux. */
 typedef struct spot {
-    double x, y, lux;
+    uint32_t k;
+    double lux;
 } spot;
 
 static int cmp_spot(const void *a, const void *b)
@@ -251,123 +285,177 @@ static int cmp_spot(const void *a, const void *b)
     const spot *p = a, *q = b;
     if (p->lux != q->lux)
         return p->lux < q->lux ? -1 : 1;
-    if (p->y != q->y)
-        return p->y < q->y ? -1 : 1;
-    return (p->x > q->x) - (p->x < q->x);
+    return (p->k > q->k) - (p->k < q->k); /* then by y, then x: the grid order */
 }
 
-static int in_reach(plx_engine *e, uint32_t nlamps, double x, double y)
+#define SPOT_STRIP 65536 /* grid points per illuminance call */
+
+typedef struct spot_grid {
+    double x0, y0, res;
+    size_t w, h;
+    spot *s;
+    size_t n, cap;
+} spot_grid;
+
+static void spot_xy(const spot_grid *g, uint32_t k, double *x, double *y)
 {
-    uint32_t k;
-    for (k = 0; k < nlamps; k++) {
-        plx_lamp l;
-        plx_lamp_get(e, k, &l);
-        if ((l.x - x) * (l.x - x) + (l.y - y) * (l.y - y) + l.z * l.z < l.radius * l.radius)
-            return 1;
+    *x = g->x0 + (k % g->w + 0.5) * g->res;
+    *y = g->y0 + (k / g->w + 0.5) * g->res;
+}
+
+/* Grid points [k0, k1): those in some lamp's reach (all with --all) get
+ * their lux (direct + indirect) and join the street points. */
+static int spot_strip(plx_engine *e, spot_grid *g, size_t k0, size_t k1, int all, double *P, double *N,
+                      double *E, double *Ei, uint32_t *reach)
+{
+    size_t k, m = 0, n = k1 - k0;
+    plx_status st;
+    for (k = 0; k < n; k++) {
+        spot_xy(g, (uint32_t)(k0 + k), &P[3 * k], &P[3 * k + 1]);
+        P[3 * k + 2] = 0.0;
     }
-    return 0;
+    if (!all && (st = plx_lamps_in_reach(e, n, P, reach)) != PLX_OK)
+        goto fail;
+    for (k = 0; k < n; k++) {
+        if (!all && reach[k] == 0)
+            continue;
+        memmove(&P[3 * m], &P[3 * k], 3 * sizeof *P);
+        N[3 * m] = N[3 * m + 1] = 0.0;
+        N[3 * m + 2] = 1.0;
+        reach[m++] = (uint32_t)(k0 + k);
+    }
+    st = plx_illuminance(e, m, P, N, E, Ei, NULL);
+    if (st != PLX_OK && st != PLX_E_RANGE)
+        goto fail;
+    for (k = 0; k < m; k++) {
+        if (E[k] != E[k])
+            continue; /* under a building */
+        if (g->n == g->cap) {
+            size_t nc = g->cap ? 2 * g->cap : 4096;
+            spot *ns = realloc(g->s, nc * sizeof *ns);
+            if (!ns) {
+                fprintf(stderr, "polarlux dark-spots: out of memory for %zu street points\n", nc);
+                return EXIT_FAIL;
+            }
+            g->s = ns;
+            g->cap = nc;
+        }
+        g->s[g->n].k = reach[k];
+        g->s[g->n++].lux = E[k] + Ei[k];
+    }
+    return EXIT_OK;
+fail:
+    fprintf(stderr, "polarlux dark-spots: %s\n", plx_last_error(e));
+    return cli_exit_code(st);
+}
+
+/* Every street point of the grid, strip by strip (progress on a terminal). */
+static int spot_scan(plx_engine *e, spot_grid *g, int all)
+{
+    size_t total = g->w * g->h, k0;
+    double *P = malloc(sizeof *P * 3 * SPOT_STRIP), *N = malloc(sizeof *N * 3 * SPOT_STRIP);
+    double *E = malloc(sizeof *E * SPOT_STRIP), *Ei = malloc(sizeof *Ei * SPOT_STRIP);
+    uint32_t *reach = malloc(sizeof *reach * SPOT_STRIP);
+    cli_progress pr;
+    int rc = EXIT_OK;
+    if (!P || !N || !E || !Ei || !reach) {
+        fprintf(stderr, "polarlux dark-spots: out of memory\n");
+        rc = EXIT_FAIL;
+    }
+    cli_progress_start(&pr);
+    for (k0 = 0; rc == EXIT_OK && k0 < total; k0 += SPOT_STRIP) {
+        size_t k1 = k0 + SPOT_STRIP < total ? k0 + SPOT_STRIP : total;
+        rc = spot_strip(e, g, k0, k1, all, P, N, E, Ei, reach);
+        cli_progress_step(&pr, "dark-spots", k1, total);
+    }
+    cli_progress_end(&pr);
+    free(P), free(N), free(E), free(Ei), free(reach);
+    return rc;
 }
 
 static int find_spots(plx_engine *e, double res, long count, double spacing, int all, const char *out,
                       const cli_common *c)
 {
     plx_scene_info si;
-    size_t w, h, n = 0, k, cap;
-    double *P, *N, *E;
-    spot *s, *pick;
+    spot_grid g;
+    spot *pick = NULL;
     long npick = 0;
-    geo_out g;
-    int rc = EXIT_OK;
+    size_t k;
+    geo_out geo;
+    int rc;
     plx_scene_info_get(e, &si);
-    w = (size_t)floor((si.bounds[2] - si.bounds[0]) / res);
-    h = (size_t)floor((si.bounds[3] - si.bounds[1]) / res);
-    cap = w * h;
-    if (cap == 0 || cap > 20000000u) {
-        fprintf(stderr, "polarlux dark-spots: --res %g gives %zu grid points (1 to 2e7)\n", res, cap);
+    memset(&g, 0, sizeof g);
+    g.x0 = si.bounds[0];
+    g.y0 = si.bounds[1];
+    g.res = res;
+    g.w = (size_t)floor((si.bounds[2] - si.bounds[0]) / res);
+    g.h = (size_t)floor((si.bounds[3] - si.bounds[1]) / res);
+    if (g.w * g.h == 0 || g.w * g.h > 2000000000u) {
+        fprintf(stderr, "polarlux dark-spots: --res %g gives %zu grid points (1 to 2e9)\n", res, g.w * g.h);
         return EXIT_USAGE;
     }
-    P = malloc(sizeof *P * 3 * cap);
-    N = malloc(sizeof *N * 3 * cap);
-    E = malloc(sizeof *E * cap);
-    s = malloc(sizeof *s * cap);
+    rc = spot_scan(e, &g, all);
+    if (rc != EXIT_OK)
+        goto done;
+    if (g.n == 0)
+        cli_warn("dark-spots", c, "no street point is within a lamp's reach (%s), so there are no spots; "
+                 "--all takes every street point", si.lamps ? "the lamps are outside Bounds or their radius "
+                 "does not reach the ground" : "the scene has no lamps");
+    qsort(g.s, g.n, sizeof *g.s, cmp_spot);
+    if (g.n > 0 && !(g.s[g.n - 1].lux > 0))
+        cli_warn("dark-spots", c, "all %zu street points are dark (0 lx): %s", g.n, cli_dark_reason(e));
     pick = malloc(sizeof *pick * (size_t)count);
-    if (!P || !N || !E || !s || !pick) {
+    if (!pick) {
         fprintf(stderr, "polarlux dark-spots: out of memory\n");
         rc = EXIT_FAIL;
         goto done;
     }
-    for (k = 0; k < cap; k++) {
-        double x = si.bounds[0] + (k % w + 0.5) * res, y = si.bounds[1] + (k / w + 0.5) * res;
-        if (!all && !in_reach(e, si.lamps, x, y))
-            continue;
-        P[3 * n] = x;
-        P[3 * n + 1] = y;
-        P[3 * n + 2] = 0;
-        N[3 * n] = N[3 * n + 1] = 0;
-        N[3 * n + 2] = 1;
-        n++;
-    }
-    {
-        double *Ei = malloc(sizeof *Ei * (n + 1));
-        plx_status st = Ei ? plx_illuminance(e, n, P, N, E, Ei, NULL) : PLX_E_NOMEM;
-        if (st != PLX_OK && st != PLX_E_RANGE) {
-            fprintf(stderr, "polarlux dark-spots: %s\n", plx_last_error(e));
-            free(Ei);
-            rc = cli_exit_code(st);
-            goto done;
-        }
-        for (k = 0; k < n; k++)
-            E[k] += Ei[k];
-        free(Ei);
-    }
-    if (n == 0)
-        cli_warn("dark-spots", c, "no street point is within a lamp's reach (%s), so there are no spots; "
-                 "--all takes every street point", si.lamps ? "the lamps are outside Bounds or their radius "
-                 "does not reach the ground" : "the scene has no lamps");
-    for (k = 0, cap = 0; k < n; k++)
-        if (E[k] == E[k]) {
-            s[cap].x = P[3 * k];
-            s[cap].y = P[3 * k + 1];
-            s[cap++].lux = E[k];
-        }
-    qsort(s, cap, sizeof *s, cmp_spot);
-    if (cap > 0 && !(s[cap - 1].lux > 0))
-        cli_warn("dark-spots", c, "all %zu street points are dark (0 lx): %s", cap, cli_dark_reason(e));
-    for (k = 0; k < cap && npick < count; k++) {
+    for (k = 0; k < g.n && npick < count; k++) {
+        double x, y;
         long j;
-        for (j = 0; j < npick; j++)
-            if (hypot(pick[j].x - s[k].x, pick[j].y - s[k].y) < spacing)
+        spot_xy(&g, g.s[k].k, &x, &y);
+        for (j = 0; j < npick; j++) {
+            double px, py;
+            spot_xy(&g, pick[j].k, &px, &py);
+            if (hypot(px - x, py - y) < spacing)
                 break;
+        }
         if (j == npick)
-            pick[npick++] = s[k];
+            pick[npick++] = g.s[k];
     }
-    if (geo_begin(&g, e) != 0) {
+    if (geo_begin(&geo, e) != 0) {
         rc = EXIT_FAIL;
         goto done;
     }
     for (k = 0; k < (size_t)npick; k++) {
         cJSON *props = cJSON_CreateObject();
+        double x, y, sx, sy;
+        spot_xy(&g, pick[k].k, &x, &y);
+        sx = x;
+        sy = y;
+        cli_from_local(e, &sx, &sy);
         cJSON_AddNumberToObject(props, "rank", (double)k + 1);
         cJSON_AddNumberToObject(props, "lux", pick[k].lux);
-        cJSON_AddNumberToObject(props, "x", pick[k].x);
-        cJSON_AddNumberToObject(props, "y", pick[k].y);
-        geo_add(&g, geo_geometry("Point", geo_position(&g, pick[k].x, pick[k].y, NULL)), props);
+        cJSON_AddNumberToObject(props, "x", sx);
+        cJSON_AddNumberToObject(props, "y", sy);
+        geo_add(&geo, geo_geometry("Point", geo_position(&geo, x, y, NULL)), props);
     }
     if (out) {
-        if (geo_write(&g, "dark-spots", out) != 0)
+        if (geo_write(&geo, "dark-spots", out) != 0)
             rc = EXIT_FAIL;
         else
             fprintf(stderr, "dark-spots: %ld spots from %zu street points, darkest %.3f lx, written to %s\n",
-                    npick, cap, npick ? pick[0].lux : 0.0, out);
+                    npick, g.n, npick ? pick[0].lux : 0.0, out);
     } else {
-        char *text = cJSON_PrintUnformatted(g.root);
+        char *text = cJSON_PrintUnformatted(geo.root);
         if (text)
             puts(text);
         free(text);
     }
-    geo_free(&g);
+    geo_free(&geo);
 done:
-    free(P), free(N), free(E), free(s), free(pick);
+    free(g.s);
+    free(pick);
     return rc;
 }
 

@@ -117,6 +117,7 @@ static int run_points(plx_engine *e, const vis_opts *o, geo_out *g)
     size_t k;
     int failed = 0, rc;
     double *given = NULL;
+    cli_progress pr;
     if (points_read(o->points, 2, 2, NULL, &pts, err, sizeof err) != 0) {
         fprintf(stderr, "polarlux vis: %s\n", err);
         return EXIT_FAIL;
@@ -126,13 +127,16 @@ static int run_points(plx_engine *e, const vis_opts *o, geo_out *g)
         points_free(&pts);
         return rc;
     }
+    cli_progress_start(&pr);
     for (k = 0; k < pts.n; k++) {
         double x = pts.v[2 * k], y = pts.v[2 * k + 1], gx = given[2 * k], gy = given[2 * k + 1];
         plx_visibility v;
+        cli_progress_step(&pr, "vis", k + 1, pts.n);
         plx_status st = plx_visibility_get(e, x, y, o->dir, o->fov, &v);
         if (st != PLX_OK) {
             fprintf(stderr, "polarlux vis: %s:%zu: %s\n", o->points, pts.line[k], plx_last_error(e));
             if (st != PLX_E_RANGE) {
+                cli_progress_end(&pr);
                 points_free(&pts);
                 free(given);
                 return cli_exit_code(st);
@@ -146,6 +150,7 @@ static int run_points(plx_engine *e, const vis_opts *o, geo_out *g)
             add_polygon(g, &v, gx, gy);
     }
     points_free(&pts);
+    cli_progress_end(&pr);
     free(given);
     return failed ? EXIT_FAIL : EXIT_OK;
 }

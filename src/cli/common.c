@@ -512,3 +512,40 @@ int cli_points_local(const char *cmd, plx_engine *e, const cli_common *c, const 
     }
     return EXIT_OK;
 }
+
+/* ---- progress and the command's buffers ------------------------------------ */
+
+void cli_progress_start(cli_progress *p)
+{
+    p->tty = isatty(2);
+    p->shown = 0;
+    p->t0 = p->last = port_now_ns();
+}
+
+void cli_progress_step(cli_progress *p, const char *what, size_t done, size_t total)
+{
+    unsigned long long now;
+    if (!p->tty)
+        return;
+    now = port_now_ns();
+    if (now - p->t0 < 1000000000ull || (now - p->last < 100000000ull && done < total))
+        return;
+    p->last = now;
+    p->shown = 1;
+    fprintf(stderr, "\r%s: %3.0f%% (%.1f s)", what, total ? 100.0 * done / total : 100.0, (now - p->t0) / 1e9);
+}
+
+void cli_progress_end(cli_progress *p)
+{
+    if (p->shown)
+        fprintf(stderr, "\n");
+    p->shown = 0;
+}
+
+size_t cli_buffer_budget(const plx_engine *e, const cli_common *c)
+{
+    plx_memory_report m;
+    size_t mem = c->mem ? c->mem : CLI_DEFAULT_MEM;
+    plx_memory_get(e, &m);
+    return m.peak_total < mem ? mem - m.peak_total : 0;
+}

@@ -684,3 +684,20 @@ light_where light_classify_point(light *L, const double P[3], const double n[3],
         *normal_ok = ok0;
     return res;
 }
+
+uint32_t light_lamps_reaching(const light *L, const double P[3])
+{
+    const scene *s = L->s;
+    const light_grid *g = &L->lgrid;
+    uint32_t cell, k, count = 0;
+    if (s->nlamps == 0 || g->nx == 0)
+        return 0;
+    cell = light_grid_cell(g, P[0], P[1]);
+    for (k = cell == UINT32_MAX ? 0 : g->start[cell]; cell != UINT32_MAX && k < g->start[cell + 1]; k++) {
+        const scene_lamp *lp = &s->lamps[g->ids[k]];
+        double dx = lp->x - P[0], dy = lp->y - P[1], dz = lp->z - P[2];
+        if (lp->intensity > 0.0 && dx * dx + dy * dy + dz * dz < lp->radius * lp->radius)
+            count++;
+    }
+    return count;
+}

@@ -195,6 +195,11 @@ light_where light_classify_point(light *L, const double P[3], const double n[3],
  * with the angle from +x counter-clockwise (no trigonometry). */
 double light_pseudo_angle(double dx, double dy);
 
+/* The number of lamps whose light can reach P: intensity > 0 and P inside
+ * the sphere of radius R about the lamp (d < R), visibility aside. Walks
+ * only the lamps of P's cell of the lamp grid (cost: the lamps in reach). */
+uint32_t light_lamps_reaching(const light *L, const double P[3]);
+
 /* Internal, shared by light.c and litregion.c. */
 uint32_t light_grid_cell(const light_grid *g, double x, double y);
 int light_seg_blocked_by(light *L, uint32_t b, const double A[3], const double B[3],

@@ -291,8 +291,11 @@ static const char *crs_name(const cJSON *crs)
 /* 1 when the CRS names WGS84 lon/lat (EPSG:4326, OGC CRS84). */
 static int crs_is_lonlat(const char *name)
 {
-    size_t n = strlen(name);
-    return strstr(name, "CRS84") != NULL || (n >= 5 && strcmp(name + n - 5, ":4326") == 0);
+    size_t n = strlen(name), k;
+    for (k = 0; k + 5 <= n; k++)
+        if (strncmp(name + k, "CRS84", 5) == 0)
+            return 1;
+    return n >= 5 && strcmp(name + n - 5, ":4326") == 0;
 }
 
 /* Keeps the scene's CRS (copied into the scene) and reads a projected one

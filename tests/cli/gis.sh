@@ -111,3 +111,117 @@ printf 'x,y\n650030,6860030\n' >"$tmp/l93.csv"
 expect crs-layer-csv 0 "^lamps: 4$" -- "$bin" info -q "$tmp/l93.geojson" --lamps "$tmp/l93.csv"
 printf '# crs: EPSG:3857\nx,y\n650030,6860030\n' >"$tmp/l93b.csv"
 expect crs-layer-mismatch 1 "the lamps are in EPSG:3857 but the scene in urn:ogc:def:crs:EPSG::2154" -- "$bin" info -q "$tmp/l93.geojson" --lamps "$tmp/l93b.csv"
+
+# ---- GeoTIFF heat maps read back (tests/tools/tiff_probe, libtiff + libgeotiff) ----
+probe=$(dirname "$bin")/tests/tiff_probe
+# tiff_check NAME SCENE TIF PIXELS...: the pixel values equal illum at the
+# pixel centres (from the file's own tie point and scale) to float32 precision.
+tiff_check() {
+    name=$1; scene=$2; tif=$3; shift 3
+    "$probe" "$tif" "$@" >"$tmp/probe.txt" || { echo "FAIL $name: tiff_probe"; fail=$((fail + 1)); return; }
+    awk '/^scale/ { sx = $2; sy = $3 } /^tie/ { x0 = $4; y0 = $5 }
+         /^pixel/ { printf "%.17g %.17g\n", x0 + ($2 + 0.5) * sx, y0 - ($3 + 0.5) * sy }' "$tmp/probe.txt" >"$tmp/centres.txt"
+    "$bin" illum -q --no-indirect "$scene" --points "$tmp/centres.txt" >"$tmp/centres-E.txt" 2>/dev/null
+    if grep '^pixel' "$tmp/probe.txt" | paste - "$tmp/centres-E.txt" | awk '
+        { v = $4; e = $8; if (e == "nan") { if (v != "nan") bad = 1; next } d = v - e; if (d < 0) d = -d
+          if (d > 1e-6 * e + 1e-30) bad = 1; if (e > 0) lit++ }
+        END { exit !(NR > 0 && !bad && lit > 0) }'; then
+        echo "ok   $name"; pass=$((pass + 1)); else echo "FAIL $name"; paste "$tmp/probe.txt" "$tmp/centres-E.txt" | head; fail=$((fail + 1)); fi
+}
+expect tiff-tiny 0 "^heatmap: 80x60 pixels at 2 m, float32 GeoTIFF of lux" -- "$bin" heatmap -q fixtures/tiny.geojson --res 2 -o "$tmp/t.tif"
+expect tiff-tiny-georef 0 "^keys model 1 raster 1 geographic -1 projected 32767 units 9001$" -- "$probe" "$tmp/t.tif"
+expect tiff-tiny-size 0 "^size 80 60 bands 1 bits 32 format float$" -- "$probe" "$tmp/t.tif"
+expect tiff-tiny-tie 0 "^tie 0 0 -50 70$" -- "$probe" "$tmp/t.tif"
+tiff_check tiff-tiny-values fixtures/tiny.geojson "$tmp/t.tif" 35,25 38,26 40,27 41,28 44,30 45,22 50,30 30,20 52,25 10,50 0,0
+expect tiff-helsinki 0 "float32 GeoTIFF" -- "$bin" heatmap -q fixtures/helsinki-centre.geojson --res 8 -o "$tmp/h.tif"
+expect tiff-helsinki-wgs84 0 "^keys model 2 raster 1 geographic 4326 " -- "$probe" "$tmp/h.tif"
+tiff_check tiff-helsinki-values fixtures/helsinki-centre.geojson "$tmp/h.tif" 30,60 35,70 40,80 45,90 50,100 55,110 60,120 65,130 70,140 75,150 80,160 85,170
+expect tiff-l93 0 "float32 GeoTIFF" -- "$bin" heatmap -q "$tmp/l93.geojson" --res 2 -o "$tmp/l93.tif"
+expect tiff-l93-epsg 0 "^keys model 1 raster 1 geographic -1 projected 2154 " -- "$probe" "$tmp/l93.tif"
+tiff_check tiff-l93-values "$tmp/l93.geojson" "$tmp/l93.tif" 35,25 38,26 40,27 41,28 44,30 50,30
+# PNG: a world file beside it; the colour scale from the 2nd-98th percentile
+expect png-world 0 "world file \.pgw" -- "$bin" heatmap -q fixtures/tiny.geojson --res 2 -o "$tmp/w.png"
+if [ "$(sed -n '1p;4p;5p;6p' "$tmp/w.pgw" | tr '\n' ' ')" = "2 -2 -49 69 " ]; then echo "ok   png-world-file"; pass=$((pass + 1)); else echo "FAIL png-world-file"; cat "$tmp/w.pgw"; fail=$((fail + 1)); fi
+# Seven lamps at one spot no longer push the colour scale to 1000 lx
+/usr/bin/python3 -c "
+import json, sys
+d = json.load(open('fixtures/tiny.geojson'))
+d['features'] += [{'type': 'Feature', 'properties': {'lamp': True, 'z': 6, 'intensity': 1000},
+                   'geometry': {'type': 'Point', 'coordinates': [80, 40]}}] * 7
+json.dump(d, open(sys.argv[1], 'w'))" "$tmp/dup7.geojson"
+expect png-scale-robust 0 "scale 0\.1\.\.(10|20|50|100|200) lx \(2nd-98th percentile" -- "$bin" heatmap -q "$tmp/dup7.geojson" --res 0.5 -o "$tmp/dup7.png"
+
+# ---- --mem bounds the heat map's own buffers (strips) ----
+# --mem 40M: the engine takes ~32 MB of it; without strips this map alone
+# would take 54 MB of buffers.
+if [ -x /usr/bin/time ]; then timed="/usr/bin/time -f %M -o $tmp/rss-heat"; else timed=""; fi
+expect mem-heatmap-strips 0 "computed in strips of [0-9]+ rows to stay within --mem" -- $timed "$bin" heatmap -q fixtures/tiny.geojson --res 0.15 --mem 40M -o "$tmp/m40.png"
+expect mem-heatmap-whole 0 "^heatmap: 1067x800 " -- "$bin" heatmap -q fixtures/tiny.geojson --res 0.15 -o "$tmp/m1g.png"
+if cmp -s "$tmp/m40.png" "$tmp/m1g.png"; then echo "ok   mem-heatmap-same-map"; pass=$((pass + 1)); else echo "FAIL mem-heatmap-same-map"; fail=$((fail + 1)); fi
+expect mem-heatmap-too-small 3 "a 800x600 map needs [0-9]+ bytes of buffers, and --mem leaves [0-9]+ after the engine" -- "$bin" heatmap -q fixtures/tiny.geojson --res 0.2 --mem 28M -o "$tmp/m28.png"
+if [ -n "$timed" ]; then
+    /usr/bin/time -f "%M" -o "$tmp/rss-info" "$bin" info -q fixtures/tiny.geojson --mem 40M >/dev/null 2>&1
+    # peak resident KB above the same program loading the scene: at most --mem
+    if [ $(( $(tail -1 "$tmp/rss-heat") - $(tail -1 "$tmp/rss-info") )) -le 40960 ]; then echo "ok   mem-heatmap-rss"; pass=$((pass + 1));
+    else echo "FAIL mem-heatmap-rss: $(tail -1 "$tmp/rss-heat") KB vs $(tail -1 "$tmp/rss-info") KB"; fail=$((fail + 1)); fi
+fi
+
+# ---- route --geojson: one feature per segment, flat properties ----
+"$bin" route -q fixtures/helsinki-centre.geojson --path fixtures/helsinki-route.geojson --geojson "$tmp/rs.geojson" >"$tmp/rs.txt"
+if /usr/bin/python3 - "$tmp/rs.geojson" "$tmp/rs.txt" <<'PY'
+import json, sys
+d = json.load(open(sys.argv[1]))
+rows = [l.split() for l in open(sys.argv[2]) if l[:1] == ' ']   # segment rows of the table
+assert len(d['features']) == len(rows) and rows
+for f, r in zip(d['features'], rows):
+    p = f['properties']
+    assert all(not isinstance(v, (dict, list)) for v in p.values())
+    assert f['geometry']['type'] == 'LineString' and len(f['geometry']['coordinates']) == 2
+    assert int(r[0]) == p['segment'] and abs(float(r[2]) - p['mean_lx']) < 1e-3 and abs(float(r[1]) - p['length_m']) < 0.1
+    assert p['line_p_class'] in ('P1', 'P2', 'P3', 'P4', 'P5', 'P6', '-')
+PY
+then echo "ok   route-geojson-flat"; pass=$((pass + 1)); else echo "FAIL route-geojson-flat"; fail=$((fail + 1)); fi
+
+# ---- lit: one polygon per connected lit region, holes where shadows are ----
+# The union's area (from the written GeoJSON: outer rings less holes) equals
+# the summed area of the pieces the engine gives; no two polygons share an
+# edge (they would have merged).
+lit_union_check() {
+    name=$1; shift
+    "$bin" lit -q "$@" -o "$tmp/lu.geojson" >"$tmp/lu.txt" 2>&1 || { echo "FAIL $name: lit failed"; fail=$((fail + 1)); return; }
+    if /usr/bin/python3 - "$tmp/lu.geojson" "$tmp/lu.txt" <<'PY'
+import json, math, re, sys
+d = json.load(open(sys.argv[1]))
+txt = open(sys.argv[2]).read()
+pieces = float(re.search(r'\(pieces ([0-9.]+) m\^2\)', txt).group(1))
+lonlat = 'properties' not in d or d['properties'].get('units') != 'm'
+lat0 = 60.1716264
+def xy(p):
+    return (p[0] * 111320.0 * math.cos(math.radians(lat0)), p[1] * 110540.0) if lonlat else (p[0], p[1])
+def area(r):
+    r = [xy(p) for p in r]
+    r = [(x - r[0][0], y - r[0][1]) for x, y in r]
+    return 0.5 * sum(a[0] * b[1] - b[0] * a[1] for a, b in zip(r, r[1:]))
+ground = [f for f in d['features'] if f['properties'].get('kind') == 'ground']
+total, edges = 0.0, {}
+for f in ground:
+    rings = f['geometry']['coordinates']
+    assert area(rings[0]) > 0 and all(area(h) < 0 for h in rings[1:])
+    total += sum(area(r) for r in rings)
+    for r in rings:
+        for a, b in zip(r, r[1:]):
+            edges.setdefault((tuple(a), tuple(b)), set()).add(id(f))
+for (a, b), fs in edges.items():
+    assert not ((b, a) in edges and edges[(b, a)] - fs), 'two polygons share an edge'
+assert abs(total - pieces) <= 1e-6 * pieces + (1e-3 if lonlat else 1e-9), (total, pieces)
+PY
+    then echo "ok   $name"; pass=$((pass + 1)); else echo "FAIL $name"; cat "$tmp/lu.txt"; fail=$((fail + 1)); fi
+}
+expect lit-union-one 0 "1 lit ground polygons, 7 lit facade polygons, written to .*; the ground is the union of 17 pieces" -- "$bin" lit -q fixtures/tiny.geojson --lamp L1 -o "$tmp/lu1.geojson"
+lit_union_check lit-union-tiny fixtures/tiny.geojson --lamp L1
+lit_union_check lit-union-helsinki-hole fixtures/helsinki-centre.geojson --lamp 10
+expect lit-union-hole 0 "" -- /usr/bin/python3 -c "
+import json, sys
+d = json.load(open(sys.argv[1]))
+assert sum(len(f['geometry']['coordinates']) - 1 for f in d['features'] if f['properties'].get('kind') == 'ground') >= 1" "$tmp/lu.geojson"
+lit_union_check lit-union-helsinki fixtures/helsinki-centre.geojson --lamp 100
