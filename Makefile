@@ -48,7 +48,7 @@ VERSION = $(shell sed -n 's/^\#define PLX_VERSION_STRING "\(.*\)"/\1/p' include/
 DEB_PACKAGES = libcjson-dev libcmocka-dev libpng-dev pkg-config
 
 .SECONDARY:
-.PHONY: all deps demo check check-full check-build unit cli-test asan valgrind bench install clean \
+.PHONY: all deps demo check check-full check-build check-hostile-valgrind unit cli-test asan valgrind bench install clean \
         check-core-headers
 
 all: $(LIB_A) $(LIB_SO) $(BIN)
@@ -122,7 +122,17 @@ check-full: check-build
 	@sh tests/run_tests.sh $(BUILD) $(TESTS)
 
 check-build:
-	@$(MAKE) --no-print-directory -j$(JOBS) all $(TESTS) check-core-headers
+	@$(MAKE) --no-print-directory -j$(JOBS) all $(TESTS) check-core-headers $(BUILD)/tests/failwrite.so
+
+# The failing-disk stand-in of tests/cli/hostile.sh (an LD_PRELOAD shim).
+$(BUILD)/tests/failwrite.so: tests/cli/failwrite.c
+	@mkdir -p $(@D)
+	$(CC) -O1 -g -fPIC -shared -Wall -Wextra -Werror -o $@ $< -ldl
+
+# The hostile corpus (tests/cli/hostile.sh) under valgrind memcheck, for CI.
+check-hostile-valgrind: check-build
+	@PLX_HOSTILE_WRAP="valgrind -q --error-exitcode=9 --leak-check=full --errors-for-leak-kinds=definite" \
+	  sh tests/cli/hostile.sh $(BUILD)/polarlux
 
 unit: $(TESTS)
 	@for t in $(TESTS); do $$t || exit 1; done

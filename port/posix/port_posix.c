@@ -11,6 +11,7 @@
 
 #include "polarlux.h"
 #include "port.h"
+#include "posix/safe_out.h"
 
 static pthread_mutex_t json_mutex = PTHREAD_MUTEX_INITIALIZER;
 
@@ -143,41 +144,9 @@ char *port_read_text(const char *path, size_t *len, char *err, size_t errlen)
 
 int port_write_atomic(const char *path, const void *data, size_t len, char *err, size_t errlen)
 {
-    char tmp[4096];
-    int fd;
-    FILE *f;
-    if (snprintf(tmp, sizeof tmp, "%s.tmp.XXXXXX", path) >= (int)sizeof tmp) {
-        snprintf(err, errlen, "%s: path too long", path);
+    safe_out *o = safe_out_open(path, err, errlen);
+    if (!o)
         return -1;
-    }
-    fd = mkstemp(tmp);
-    if (fd < 0) {
-        snprintf(err, errlen, "%s: cannot create a temporary file beside it: %s", path, strerror(errno));
-        return -1;
-    }
-    f = fdopen(fd, "wb");
-    if (!f) {
-        snprintf(err, errlen, "%s: %s", path, strerror(errno));
-        close(fd);
-        unlink(tmp);
-        return -1;
-    }
-    if (fwrite(data, 1, len, f) != len || fflush(f) != 0) {
-        snprintf(err, errlen, "%s: write failed: %s", path, strerror(errno));
-        fclose(f);
-        unlink(tmp);
-        return -1;
-    }
-    if (fclose(f) != 0) {
-        snprintf(err, errlen, "%s: write failed: %s", path, strerror(errno));
-        unlink(tmp);
-        return -1;
-    }
-    chmod(tmp, 0644);
-    if (rename(tmp, path) != 0) {
-        snprintf(err, errlen, "%s: cannot rename the temporary file into place: %s", path, strerror(errno));
-        unlink(tmp);
-        return -1;
-    }
-    return 0;
+    safe_out_write(o, data, len);
+    return safe_out_commit(&o, 1, err, errlen);
 }

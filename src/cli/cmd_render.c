@@ -259,14 +259,29 @@ static void default_aerial(plx_engine *e, plx_camera *cam)
     cam->eye[2] = half / tan(cam->fov_deg * 0.008726646259971648);
 }
 
+/* The PNG and the PFM belong together: both are written, then both are
+ * renamed into place (safe_out_commit), or neither. */
 static int write_outputs(const render_args *a, const uint8_t *rgb8, const float *rgbf)
 {
     char err[512];
-    if (image_write_png_rgb8(a->out, a->cam.width, a->cam.height, rgb8, 0, err, sizeof err) != 0) {
+    safe_out *o[2] = { NULL, NULL };
+    size_t n = a->pfm ? 2 : 1;
+    o[0] = safe_out_open(a->out, err, sizeof err);
+    if (o[0] && a->pfm)
+        o[1] = safe_out_open(a->pfm, err, sizeof err);
+    if (!o[0] || (a->pfm && !o[1])) {
+        safe_out_abort(o[0]);
         fprintf(stderr, "polarlux render: %s\n", err);
         return EXIT_FAIL;
     }
-    if (a->pfm && image_write_pfm(a->pfm, a->cam.width, a->cam.height, rgbf, err, sizeof err) != 0) {
+    if (image_encode_png(o[0], a->out, a->cam.width, a->cam.height, rgb8, 0, err, sizeof err) != 0 ||
+        (a->pfm && image_encode_pfm(o[1], a->pfm, a->cam.width, a->cam.height, rgbf, err, sizeof err) != 0)) {
+        safe_out_abort(o[0]);
+        safe_out_abort(o[1]);
+        fprintf(stderr, "polarlux render: %s\n", err);
+        return EXIT_FAIL;
+    }
+    if (safe_out_commit(o, n, err, sizeof err) != 0) {
         fprintf(stderr, "polarlux render: %s\n", err);
         return EXIT_FAIL;
     }
