@@ -338,7 +338,7 @@ static int read_png(const char *path, uint8_t *buf, size_t cap, uint8_t **out, i
         fclose(f);
         set_err(err, errlen, "%s: '%s' is %lux%lu pixels: decoding needs %zu bytes, more than the %zu "
                 "the memory budget allows", op, path, (unsigned long)w, (unsigned long)h, need, max_bytes);
-        return -1;
+        return -2;
     }
     if (buf != NULL) {
         if (cap < need) {

@@ -82,7 +82,7 @@ int image_read_png_max(const char *path, int max_dim, uint8_t **out, int *width,
  * (width*height*3) exceed max_bytes is refused after reading the header,
  * before any pixel memory is taken: "read_png: 'big.png' is 1000000x1000000
  * pixels: decoding needs 3000000000000 bytes, more than the 1073741824 the
- * memory budget allows". Every reader refuses a file that is not a regular
+ * memory budget allows"; that refusal returns -2 (other failures -1). Every reader refuses a file that is not a regular
  * file (a FIFO, a device, a directory) without waiting on it.
  */
 int image_read_png_budget(const char *path, int max_dim, size_t max_bytes, uint8_t **out, int *width,

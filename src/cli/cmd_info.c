@@ -91,6 +91,7 @@ int cmd_info(int argc, char **argv)
                pi.nregions[2], pi.nregions[3]);
     } else {
         printf("polar diagrams: not built: %s\n", plx_last_error(e));
+        fprintf(stderr, "polarlux info: %s: polar diagrams not built: %s\n", path, plx_last_error(e));
         rc = plx_last_error(e)[0] && strstr(plx_last_error(e), "out of memory") ? EXIT_NOMEM : EXIT_FAIL;
     }
     print_memory(e);

@@ -14,7 +14,10 @@ static const char help[] =
     "place), leaving out NIGHT's pixels darker than the threshold (luminance\n"
     "0..255) so that unlit areas do not dominate the palette.\n"
     "\n"
-    "  -o FILE              output PNG (required)\n"
+    "  -o FILE              output PNG (- for standard output)\n"
+    "  --mem SIZE           memory for the decoded images (default 1G): an image\n"
+    "                       whose header claims more pixels is refused (exit 3)\n"
+    "                       before it is decoded\n"
     "  --dark-threshold T   luminance below which night pixels are left out of\n"
     "                       the reference histograms (default 10)\n";
 
@@ -22,10 +25,18 @@ int cmd_nightify(int argc, char **argv)
 {
     const char *pos[2], *out = NULL;
     double dark = 10.0;
-    int npos = 0, i, dw, dh, nw, nh, rc = EXIT_OK;
+    int npos = 0, i, dw = 0, dh = 0, nw, nh, rc = EXIT_OK, r;
     uint8_t *day = NULL, *night = NULL;
     char err[512];
+    cli_common c;
+    size_t mem;
+    memset(&c, 0, sizeof c);
     for (i = 1; i < argc; i++) {
+        r = cli_common_option("nightify", argc, argv, &i, &c);
+        if (r < 0)
+            return EXIT_USAGE;
+        if (r)
+            continue;
         if (strcmp(argv[i], "--help") == 0 || strcmp(argv[i], "-h") == 0) {
             fputs(help, stdout);
             return EXIT_OK;
@@ -49,10 +60,12 @@ int cmd_nightify(int argc, char **argv)
         return cli_usage_error("nightify", "needs DAY.png and NIGHT.png");
     if (!out)
         return cli_usage_error("nightify", "missing -o OUT.png");
-    if (image_read_png_rgb8(pos[0], NULL, 0, &day, &dw, &dh, err, sizeof err) != 0 ||
-        image_read_png_rgb8(pos[1], NULL, 0, &night, &nw, &nh, err, sizeof err) != 0) {
-        fprintf(stderr, "polarlux nightify: %s\n", err);
-        rc = EXIT_FAIL;
+    mem = c.mem ? c.mem : CLI_DEFAULT_MEM;
+    if ((r = image_read_png_budget(pos[0], 1000000, mem, &day, &dw, &dh, err, sizeof err)) != 0 ||
+        (r = image_read_png_budget(pos[1], 1000000, mem - (size_t)dw * dh * 3, &night, &nw, &nh, err,
+                                   sizeof err)) != 0) {
+        fprintf(stderr, "polarlux nightify: %s%s\n", err, r == -2 ? "; give it more with --mem" : "");
+        rc = r == -2 ? EXIT_NOMEM : EXIT_FAIL;
     } else if (plx_nightify(day, (size_t)dw * dh, night, (size_t)nw * nh, dark, day) != PLX_OK) {
         fprintf(stderr, "polarlux nightify: empty image\n");
         rc = EXIT_FAIL;

@@ -60,11 +60,7 @@ typedef struct render_args {
 
 static int parse_vec3(const char *s, double v[3])
 {
-    char extra;
-    return sscanf(s, "%lf,%lf,%lf%c", &v[0], &v[1], &v[2], &extra) == 3 && isfinite(v[0]) && isfinite(v[1]) &&
-                   isfinite(v[2])
-               ? 0
-               : -1;
+    return cli_parse_coords(s, v, 3) == 0 && fabs(v[2]) <= 1e5 ? 0 : -1;
 }
 
 static int parse_value(render_args *a, const char *opt, const char *val)
@@ -73,11 +69,11 @@ static int parse_value(render_args *a, const char *opt, const char *val)
     char extra;
     if (strcmp(opt, "--eye") == 0) {
         if (parse_vec3(val, a->cam.eye) != 0)
-            return cli_usage_error("render", "--eye '%s' is not X,Y,Z", val);
+            return cli_usage_error("render", "--eye '%s' is not X,Y,Z (finite, x and y within 1e7 m, z within 1e5 m)", val);
         a->have_eye = 1;
     } else if (strcmp(opt, "--target") == 0) {
         if (parse_vec3(val, a->cam.target) != 0)
-            return cli_usage_error("render", "--target '%s' is not X,Y,Z", val);
+            return cli_usage_error("render", "--target '%s' is not X,Y,Z (finite, x and y within 1e7 m, z within 1e5 m)", val);
         a->have_target = 1;
     } else if (strcmp(opt, "--fov") == 0) {
         if (cli_parse_double(val, &a->cam.fov_deg) != 0 || !(a->cam.fov_deg > 0 && a->cam.fov_deg < 180))
@@ -98,11 +94,11 @@ static int parse_value(render_args *a, const char *opt, const char *val)
         }
         return cli_usage_error("render", "--backend '%s' is not soft or osmesa", val);
     } else if (strcmp(opt, "--exposure") == 0) {
-        if (cli_parse_double(val, &a->opts.exposure) != 0 || !(a->opts.exposure >= 0))
-            return cli_usage_error("render", "--exposure '%s' is not a number >= 0", val);
+        if (cli_parse_real(val, 0, 1e9, &a->opts.exposure) != 0)
+            return cli_usage_error("render", "--exposure '%s' is not a number from 0 to 1e9", val);
     } else if (strcmp(opt, "--texel") == 0) {
-        if (cli_parse_double(val, &a->opts.aerial_m_per_texel) != 0 || !(a->opts.aerial_m_per_texel > 0))
-            return cli_usage_error("render", "--texel '%s' is not a positive number of metres", val);
+        if (cli_parse_real(val, 0.01, 1e4, &a->opts.aerial_m_per_texel) != 0)
+            return cli_usage_error("render", "--texel '%s' is not a number of metres from 0.01 to 1e4", val);
     } else if (strcmp(opt, "-o") == 0) {
         a->out = val;
     } else if (strcmp(opt, "--pfm") == 0) {
@@ -180,6 +176,27 @@ static int free_point(plx_engine *e, double x, double y)
 {
     plx_visibility v;
     return plx_visibility_get(e, x, y, 0, 1, &v) == PLX_OK;
+}
+
+/* A warning when the eye is inside a building's solid (over its footprint,
+ * between min_height and height): the image then shows the inside of its
+ * walls, which is seldom what was meant. */
+static void warn_eye_inside(plx_engine *e, const double *eye, int quiet)
+{
+    plx_visibility v;
+    plx_building b;
+    const char *msg, *at;
+    unsigned long k;
+    if (quiet || plx_visibility_get(e, eye[0], eye[1], 0, 1, &v) != PLX_E_RANGE)
+        return;
+    msg = plx_last_error(e);
+    at = strstr(msg, "is inside building ");
+    if (!at || sscanf(at, "is inside building %lu", &k) != 1 || plx_building_get(e, (uint32_t)k, &b) != PLX_OK)
+        return;
+    if (eye[2] > b.min_height && eye[2] < b.height)
+        fprintf(stderr, "polarlux render: warning: --eye (%g, %g, %g) is inside building %lu%s%s%s "
+                "(%g to %g m high): the image shows the inside of its walls\n", eye[0], eye[1], eye[2], k,
+                b.id ? " (" : "", b.id ? b.id : "", b.id ? ")" : "", b.min_height, b.height);
 }
 
 /* Default street camera: among the 40 lamps nearest the middle of Bounds and
@@ -315,6 +332,8 @@ int cmd_render(int argc, char **argv)
     rc = cli_open_scene("render", a.scene, &a.c, &e);
     if (rc != EXIT_OK)
         return rc;
+    if (a.have_eye)
+        warn_eye_inside(e, a.cam.eye, a.c.quiet);
     if (!a.have_eye) {
         if (a.aerial) {
             default_aerial(e, &a.cam);

@@ -36,20 +36,6 @@ typedef struct vis_opts {
     cli_common c;
 } vis_opts;
 
-static int parse_pair(const char *s, double v[2])
-{
-    char buf[128];
-    char *comma;
-    if (strlen(s) >= sizeof buf)
-        return -1;
-    strcpy(buf, s);
-    comma = strchr(buf, ',');
-    if (!comma)
-        return -1;
-    *comma = '\0';
-    return cli_parse_double(buf, &v[0]) || cli_parse_double(comma + 1, &v[1]) ? -1 : 0;
-}
-
 static int parse_args(int argc, char **argv, vis_opts *o)
 {
     int i;
@@ -74,14 +60,14 @@ static int parse_args(int argc, char **argv, vis_opts *o)
         } else if (strcmp(a, "--geojson") == 0) {
             o->geojson = argv[++i];
         } else if (strcmp(a, "--at") == 0) {
-            if (parse_pair(argv[++i], o->at) != 0)
-                return cli_usage_error("vis", "--at '%s' is not X,Y", argv[i]);
+            if (cli_parse_coords(argv[++i], o->at, 2) != 0)
+                return cli_usage_error("vis", "--at '%s' is not X,Y (finite, within 1e7 m)", argv[i]);
             o->have_at = 1;
         } else if (strcmp(a, "--dir") == 0) {
-            if (cli_parse_double(argv[++i], &o->dir) != 0 || !isfinite(o->dir))
+            if (cli_parse_real(argv[++i], -1e6, 1e6, &o->dir) != 0)
                 return cli_usage_error("vis", "--dir '%s' is not a number of degrees", argv[i]);
         } else if (strcmp(a, "--fov") == 0) {
-            if (cli_parse_double(argv[++i], &o->fov) != 0 || !(o->fov > 0))
+            if (cli_parse_real(argv[++i], 0, 1e6, &o->fov) != 0 || !(o->fov > 0))
                 return cli_usage_error("vis", "--fov '%s' is not a positive number of degrees", argv[i]);
         } else if (a[0] == '-' && a[1] != '\0') {
             return cli_usage_error("vis", "unknown option '%s'", a);

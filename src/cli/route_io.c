@@ -7,6 +7,9 @@
 #include "port.h"
 #include "route_io.h"
 
+/* The bound of scene coordinates (README, "Scene format"). */
+#define ROUTE_MAX_COORD 1e7
+
 typedef struct frame {
     int lonlat;           /* the path file is in lon/lat */
     double lon0, lat0, coslat;
@@ -54,6 +57,11 @@ static int add_line(route_set *rs, size_t *cap, const char *name, const cJSON *c
         if (f->lonlat) {
             vx = (vx - f->lon0) * 111320.0 * f->coslat;
             vy = (vy - f->lat0) * 110540.0;
+        }
+        if (fabs(vx) > ROUTE_MAX_COORD || fabs(vy) > ROUTE_MAX_COORD) {
+            snprintf(why, whylen, "position %u (%g, %g) is more than 1e7 m from the origin", k, vx, vy);
+            free(l->xy);
+            return -1;
         }
         l->xy[2 * k] = vx;
         l->xy[2 * k + 1] = vy;

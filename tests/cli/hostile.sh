@@ -111,6 +111,106 @@ if [ "$(id -u)" = 0 ] && unshare -m true 2>/dev/null; then
 else
     echo "skip tmpfs-full (needs root and unshare -m; the LD_PRELOAD stand-in above covers it)"
 fi
+# ---- hostile option values: exit 2 before any work, naming the option -------
+U="is not"   # every refusal says what is wrong with the value
+for v in inf -inf nan 1e400 0x1p2000; do
+    expect "heatmap-max-$v" 2 "^polarlux heatmap: --max '$v' $U a number of lux above 0.1 \(at most 1e9\)" -- heatmap $T --max $v -o "$tmp/h.png"
+    expect "heatmap-res-$v" 2 "^polarlux heatmap: --res '$v' $U a positive number of metres" -- heatmap $T --res $v -o "$tmp/h.png"
+    expect "route-step-$v" 2 "^polarlux route: --step '$v' $U a number of metres from 0.01 to 1e7" -- route $T --path fixtures/helsinki-route.geojson --step $v
+    expect "route-dark-$v" 2 "^polarlux route: --dark-lux '$v' $U a number of lux" -- route $T --path fixtures/helsinki-route.geojson --dark-lux $v
+    expect "render-fov-$v" 2 "^polarlux render: --fov '$v' $U between 0 and 180" -- render $T --fov $v -o "$tmp/r.png"
+    expect "render-exposure-$v" 2 "^polarlux render: --exposure '$v' $U a number from 0 to 1e9" -- render $T --exposure $v -o "$tmp/r.png"
+    expect "render-texel-$v" 2 "^polarlux render: --texel '$v' $U a number of metres from 0.01 to 1e4" -- render $T --texel $v -o "$tmp/r.png"
+    expect "vis-dir-$v" 2 "^polarlux vis: --dir '$v' $U a number of degrees" -- vis $T --at 30,30 --dir $v
+    expect "vis-fov-$v" 2 "^polarlux vis: --fov '$v' $U a positive number of degrees" -- vis $T --at 30,30 --fov $v
+    expect "dark-spots-res-$v" 2 "^polarlux dark-spots: --res '$v' $U a positive number of metres" -- dark-spots $T --res $v
+    expect "dark-spots-spacing-$v" 2 "^polarlux dark-spots: --spacing '$v' $U a number of metres" -- dark-spots $T --spacing $v
+    expect "nightify-threshold-$v" 2 "^polarlux nightify: --dark-threshold '$v' $U 0..255" -- nightify a.png b.png -o "$tmp/n.png" --dark-threshold $v
+    expect "info-mem-$v" 2 "^polarlux info: --mem '$v' $U a size" -- info --mem $v $T
+done
+for box in 0,0,inf,10 0,0,10,nan -inf,0,10,10 0,0,4294967296,4294967296 0,0,6442450944,8589934592 0,0,1e308,1e308 1,2,3 0,0,10,10,10 10,0,0,10; do
+    expect "heatmap-box-$box" 2 "^polarlux heatmap: --box '$box' $U X0,Y0,X1,Y1 with X1 > X0 and Y1 > Y0 \(finite, within 1e7 m\)" -- heatmap $T --res 1 --box $box -o "$tmp/h.png"
+done
+printf '50 10\n' >"$tmp/p.txt"
+expect heatmap-pixels 2 "^polarlux heatmap: --res 0.001 over a box of 10000000 x 10000000 m gives 10000000000x10000000000 pixels \(at most 5e7, 1e6 a side\)" -- heatmap -q $T --res 0.001 --box 0,0,1e7,1e7 -o "$tmp/h.png"
+expect heatmap-res-tiny 2 "^polarlux heatmap: --res 1e-300 over a box of " -- heatmap -q $T --res 1e-300 -o "$tmp/h.png"
+expect heatmap-max-huge 2 "^polarlux heatmap: --max '1e300'" -- heatmap $T --max 1e300 -o "$tmp/h.png"
+expect heatmap-max-ok 0 "scale 0.1..1e\+09 lx" -- heatmap -q $T --res 4 --max 1e9 -o "$tmp/h.png"
+expect dark-spots-res-tiny 2 "^polarlux dark-spots: --res 1e-300 gives inf grid points \(1 to 2e7\)$" -- dark-spots -q $T --res 1e-300
+expect dark-spots-count 2 "^polarlux dark-spots: --count '99999999999999999999' $U 1..1000000" -- dark-spots $T --count 99999999999999999999
+for eye in 1e9,0,2 0,-1e308,2 inf,0,2 0,0,1e6 0,0 0,0,2,2 ,, 1e7,0,2x; do
+    expect "render-eye-$eye" 2 "^polarlux render: --eye '$eye' $U X,Y,Z \(finite, x and y within 1e7 m, z within 1e5 m\)" -- render $T --eye $eye --target 50,10,2 -o "$tmp/r.png"
+done
+expect render-target-huge 2 "^polarlux render: --target '1e308,0,0' $U X,Y,Z" -- render $T --eye 30,30,2 --target 1e308,0,0 -o "$tmp/r.png"
+expect render-size-huge 2 "^polarlux render: --size '100000x100000' $U WxH \(1..8192 each\)" -- render $T --size 100000x100000 -o "$tmp/r.png"
+expect render-size-overflow 2 "^polarlux render: --size '99999999999999999999x2' $U WxH" -- render $T --size 99999999999999999999x2 -o "$tmp/r.png"
+expect render-photons-frames 2 "^polarlux render: --photons 100000000 x --frames 100000 is more than 4294967296 photons" -- render -q $T --photons 100000000 --frames 100000 -o "$tmp/r.png"
+expect illum-photons-frames 2 "^polarlux illum: --photons 70000 x --frames 100000 is more than 4294967296 photons" -- illum -q $T --points "$tmp/p.txt" --photons 70000 --frames 100000
+expect illum-photons-huge 2 "^polarlux illum: --photons '1e9' $U a whole number in range" -- illum $T --points - --photons 1e9
+for at in 1e9,0 0,1e308 nan,0 0,inf 1,2,3 1; do
+    expect "vis-at-$at" 2 "^polarlux vis: --at '$at' $U X,Y \(finite, within 1e7 m\)" -- vis $T --at $at
+done
+expect gen-n-huge 2 "^polarlux gen: NX and NY must be whole numbers from 1 to 1000" -- gen grid 100000 100000
+expect gen-seed-bad 2 "^polarlux gen: --seed '1e9' $U a whole number" -- gen grid 2 2 --seed 1e9
+expect draw-size-huge 2 "^polarlux draw: --size" -- draw $T --polar 0 --size 1000000 -o "$tmp/d.png"
+expect draw-polar-huge 2 "^polarlux draw: --polar '4294967296' $U a quadrant 0..3" -- draw $T --polar 4294967296 -o "$tmp/d.png"
+expect info-mem-huge 2 "^polarlux info: --mem '1e300' $U a size" -- info --mem 1e300 $T
+expect info-mem-exabyte 3 "^polarlux info: cannot create an engine of [0-9]+ bytes" -- info --mem 900000G $T
+# route paths: coordinates beyond 1e7 m, and more samples than allowed at --step
+printf '{"type":"FeatureCollection","properties":{"units":"m"},"features":[{"type":"Feature","properties":{},"geometry":{"type":"LineString","coordinates":[[-1e308,0],[1e308,0]]}}]}\n' >"$tmp/far.json"
+expect route-path-1e308 1 "^polarlux route: $tmp/far.json: feature 0: position 0 \(-1e\+308, 0\) is more than 1e7 m from the origin$" -- route -q $T --path "$tmp/far.json"
+expect heatmap-path-1e308 1 "^polarlux heatmap: $tmp/far.json: feature 0: position 0 \(-1e\+308, 0\) is more than 1e7 m from the origin$" -- heatmap -q $T --path "$tmp/far.json" -o "$tmp/h.png"
+printf '{"type":"FeatureCollection","properties":{"units":"m"},"features":[{"type":"Feature","properties":{},"geometry":{"type":"LineString","coordinates":[[0,0],[1e9,0]]}}]}\n' >"$tmp/far9.json"
+expect route-path-1e9 1 "position 1 \(1e\+09, 0\) is more than 1e7 m from the origin$" -- route -q $T --path "$tmp/far9.json"
+printf '{"type":"FeatureCollection","properties":{"units":"m"},"features":[{"type":"Feature","properties":{},"geometry":{"type":"LineString","coordinates":[[0,0],[9e6,0],[0,0],[9e6,0]]}}]}\n' >"$tmp/long.json"
+expect route-step-samples 2 "^polarlux route: --step 0.01 gives 2700000003 samples over the path's 27000000 m \(at most 1e8, 1e7 a segment\)" -- route -q $T --path "$tmp/long.json" --step 0.01
+expect route-step-segment 2 "^polarlux route: --step 0.5 gives 54000003 samples over the path's 27000000 m \(at most 1e8, 1e7 a segment\)" -- route -q $T --path "$tmp/long.json" --step 0.5
+
+# ---- special files as inputs: refused at once, never waited on ---------------
+mkfifo "$tmp/in.fifo"
+for f in "$tmp/in.fifo" /dev/zero "$tmp"; do
+    case $f in *fifo) kind="a FIFO";; /dev/zero) kind="a device";; *) kind="a directory";; esac
+    n=$(basename "$f")
+    expect "info-scene-$n" 1 "^polarlux info: $f: not a regular file \($kind\)$" -- info "$f"
+    expect "vis-points-$n" 1 "^polarlux vis: $f: not a regular file \($kind\)$" -- vis -q $T --points "$f"
+    expect "illum-points-$n" 1 "^polarlux illum: $f: not a regular file \($kind\)$" -- illum -q $T --points "$f"
+    expect "route-path-$n" 1 "^polarlux route: $f: not a regular file \($kind\)$" -- route -q $T --path "$f"
+    expect "heatmap-path-$n" 1 "^polarlux heatmap: $f: not a regular file \($kind\)$" -- heatmap -q $T --path "$f" -o "$tmp/h.png"
+    expect "nightify-day-$n" 1 "^polarlux nightify: read_png: '$f' is not a regular file$" -- nightify "$f" "$f" -o "$tmp/n.png"
+done
+mkdir -p "$tmp/gi"; cp fixtures/ground-image.geojson "$tmp/gi/s.geojson"; mkfifo "$tmp/gi/ground-day.png"
+expect ground-image-fifo 1 "^polarlux info: $tmp/gi/s.geojson: ground image 'ground-day.png': read_png: '$tmp/gi/ground-day.png' is not a regular file$" -- info "$tmp/gi/s.geojson"
+# text inputs read whole or refused
+printf '50 10\n50 12\0\n50 14\n' >"$tmp/nul.txt"
+expect points-nul 1 "^polarlux vis: $tmp/nul.txt:2: a NUL byte at byte 11 \(not a text file\?\)$" -- vis -q $T --points "$tmp/nul.txt"
+printf '50 10\n50 12' >"$tmp/trunc.txt"
+expect points-truncated 1 "^polarlux vis: $tmp/trunc.txt:2: the last line does not end with a newline \(truncated file\?\)$" -- vis -q $T --points "$tmp/trunc.txt"
+{ printf '50 10\n'; head -c 5000 /dev/zero | tr '\0' ' '; printf '50 12\n'; } >"$tmp/long.txt"
+expect points-long-line 1 "^polarlux illum: $tmp/long.txt:2: line longer than 4096 bytes$" -- illum -q $T --points "$tmp/long.txt"
+printf '50 10\0garbage' >"$tmp/nul2.txt"
+timeout 60 "$bin" vis -q $T --points - <"$tmp/nul2.txt" >/dev/null 2>"$tmp/err"; rc=$?
+if [ $rc -eq 1 ] && grep -q "^polarlux vis: <stdin>:1: a NUL byte at byte 5 (not a text file?)$" "$tmp/err"; then ok points-stdin-nul
+else bad "points-stdin-nul: exit $rc, $(cat "$tmp/err")"; fi
+# images: the decoded size counts against --mem before decoding
+/usr/bin/python3 - "$tmp" <<'PY'
+import struct, sys, zlib
+def png(path, w, h):
+    def chunk(t, d):
+        return struct.pack(">I", len(d)) + t + d + struct.pack(">I", zlib.crc32(t + d) & 0xffffffff)
+    ihdr = struct.pack(">IIBBBBB", w, h, 8, 2, 0, 0, 0)
+    open(path, "wb").write(b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", ihdr) + chunk(b"IDAT", zlib.compress(b"\0" * 64)) + chunk(b"IEND", b""))
+png(sys.argv[1] + "/huge.png", 1000000, 1000000)
+png(sys.argv[1] + "/mid.png", 1000, 1000)
+PY
+expect nightify-huge-header 3 "^polarlux nightify: read_png: '$tmp/huge.png' is 1000000x1000000 pixels: decoding needs 3000000000000 bytes, more than the 1073741824 the memory budget allows; give it more with --mem$" -- nightify "$tmp/huge.png" "$tmp/huge.png" -o "$tmp/n.png"
+expect nightify-mid-small-mem 3 "^polarlux nightify: read_png: '$tmp/mid.png' is 1000x1000 pixels: decoding needs 3000000 bytes, more than the 1048576 the memory budget allows" -- nightify --mem 1M "$tmp/mid.png" "$tmp/mid.png" -o "$tmp/n.png"
+cp "$tmp/mid.png" "$tmp/gi/ground-day.png.new"; rm "$tmp/gi/ground-day.png"; mv "$tmp/gi/ground-day.png.new" "$tmp/gi/ground-day.png"
+expect ground-image-over-mem 3 "^polarlux info: $tmp/gi/s.geojson: ground image 'ground-day.png': read_png: '$tmp/gi/ground-day.png' is 1000x1000 pixels: decoding needs 3000000 bytes, more than the 2097152 the memory budget allows; give it more with --mem$" -- info --mem 2M "$tmp/gi/s.geojson"
+# the eye inside a building: a warning
+expect render-eye-inside 0 "^polarlux render: warning: --eye \(5, 5, 3\) is inside building 0 \(A\) \(0 to 10 m high\): the image shows the inside of its walls$" -- render --no-indirect $T --eye 5,5,3 --target 50,10,2 --size 16x12 -o "$tmp/r.png"
+# exit 3 says so on stderr
+expect info-nomem-stderr 3 "out of memory" -- info --mem 8K fixtures/helsinki-centre.geojson
+
 ls "$tmp"/*.tmp* >/dev/null 2>&1 && bad "temporary files left: $(ls "$tmp"/*.tmp*)"
 echo "hostile: $pass passed, $fail failed"
 [ "$fail" -eq 0 ]
