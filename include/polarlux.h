@@ -147,6 +147,7 @@ typedef struct plx_scene_info {
     double height_min, height_median, height_max;
     double ground_albedo;
     uint64_t load_ns;         /* time the load took, by the port's clock */
+    uint32_t merged_lamps;    /* lamps merged into another at the same spot (README "Duplicate lamps") */
 } plx_scene_info;
 
 plx_status plx_scene_info_get(plx_engine *e, plx_scene_info *out /* OUT */);

@@ -85,6 +85,7 @@ typedef struct scene {
     double lon0, lat0;
     double height_min, height_median, height_max;
     uint32_t skipped_features, skipped_lamps, overlapping_pairs;
+    uint32_t merged_lamps;      /* duplicate lamps merged into others (lampmerge.c) */
     uint64_t load_ns;
 } scene;
 

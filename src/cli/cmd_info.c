@@ -67,6 +67,8 @@ int cmd_info(int argc, char **argv)
     printf("lamps: %u\n", si.lamps);
     printf("vertices: %u\n", si.vertices);
     printf("skipped: %u features, %u lamps inside buildings\n", si.skipped_features, si.skipped_lamps);
+    if (si.merged_lamps)
+        printf("duplicate lamps: %u merged into lamps at the same spot\n", si.merged_lamps);
     printf("overlapping pairs: %u\n", si.overlapping_pairs);
     if (si.lonlat)
         printf("coordinates: WGS84 lon/lat, projected about lon0 %.7f lat0 %.7f\n", si.lon0, si.lat0);

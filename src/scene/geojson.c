@@ -553,6 +553,9 @@ static plx_status load(plx_engine *e, loader *ld)
     st = ld_drop_buried_lamps(ld);
     if (st != PLX_OK)
         return st;
+    st = ld_merge_duplicate_lamps(ld);
+    if (st != PLX_OK)
+        return st;
     st = blocks_build(&e->mem, s, BLOCK_TOLERANCE);
     if (st == PLX_E_NOMEM)
         return eng_nomem(e, "grouping buildings into blocks");

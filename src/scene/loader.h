@@ -31,6 +31,8 @@ void ld_warn(loader *ld, uint32_t fi, const char *id, const char *why);
 
 /* Reads every feature into ld->s (features.c). */
 plx_status ld_features(loader *ld, cJSON *features);
+/* Merges lamps at one spot with one radius into one (lampmerge.c). */
+plx_status ld_merge_duplicate_lamps(loader *ld);
 /* Leaves out lamps inside a building's solid, reporting each (features.c). */
 plx_status ld_drop_buried_lamps(loader *ld);
 

@@ -210,6 +210,13 @@ cp "$tmp/mid.png" "$tmp/gi/ground-day.png.new"; rm "$tmp/gi/ground-day.png"; mv 
 expect ground-image-over-mem 3 "^polarlux info: $tmp/gi/s.geojson: ground image 'ground-day.png': read_png: '$tmp/gi/ground-day.png' is 1000x1000 pixels: decoding needs 3000000 bytes, more than the 2097152 the memory budget allows; give it more with --mem$" -- info --mem 2M "$tmp/gi/s.geojson"
 # the eye inside a building: a warning
 expect render-eye-inside 0 "^polarlux render: warning: --eye \(5, 5, 3\) is inside building 0 \(A\) \(0 to 10 m high\): the image shows the inside of its walls$" -- render --no-indirect $T --eye 5,5,3 --target 50,10,2 --size 16x12 -o "$tmp/r.png"
+# 1,000 lamps at one spot: merged into one with a warning (tests/unit/test_lampmerge.c checks the light)
+{ printf '{"type":"FeatureCollection","properties":{"units":"m"},"features":['
+  i=0; while [ $i -lt 999 ]; do printf '{"type":"Feature","properties":{"lamp":true,"intensity":10},"geometry":{"type":"Point","coordinates":[5,5]}},'; i=$((i + 1)); done
+  printf '{"type":"Feature","properties":{"lamp":true,"intensity":10},"geometry":{"type":"Point","coordinates":[5,5]}}]}\n'; } >"$tmp/dup.geojson"
+expect lamps-duplicate-warning 0 "warning: $tmp/dup.geojson: feature 0 \(line 1, column [0-9]+\): 1000 lamps at one spot \(5, 5, 6\) merged into this one: 10000 cd$" -- info "$tmp/dup.geojson"
+expect lamps-duplicate-info 0 "^duplicate lamps: 999 merged into lamps at the same spot$" -- info -q "$tmp/dup.geojson"
+expect lamps-duplicate-count 0 "^lamps: 1$" -- info -q "$tmp/dup.geojson"
 # exit 3 says so on stderr
 expect info-nomem-stderr 3 "out of memory" -- info --mem 8K fixtures/helsinki-centre.geojson
 
