@@ -4,7 +4,7 @@
 #include "cli.h"
 
 static const char help[] =
-    "usage: polarlux info SCENE [--mem SIZE] [--strict] [--quiet]\n"
+    "usage: polarlux info SCENE [--mem SIZE] [--strict] [--quiet] [--min-mem]\n"
     "\n"
     "Loads SCENE (GeoJSON, see README 'Scene format') and prints counts of\n"
     "buildings, blocks, courtyards, lamps and vertices, the bounds, building\n"
@@ -15,7 +15,54 @@ static const char help[] =
     "\n"
     "  --mem SIZE   memory budget of the engine (default 1G; e.g. 256M)\n"
     "  --strict     the first bad feature is an error (default: skip and report)\n"
-    "  --quiet      do not print warnings about skipped features\n";
+    "  --quiet      do not print warnings about skipped features\n"
+    "  --min-mem    also find the smallest --mem that loads SCENE and builds its\n"
+    "               polar diagrams, by bisection over loads (to 4 KiB; about 18\n"
+    "               loads), and print it\n";
+
+static void silent_log(void *ctx, plx_log_level level, const char *msg)
+{
+    (void)ctx, (void)level, (void)msg;
+}
+
+/* 1 when an engine of 'bytes' loads the scene and builds its polar diagrams. */
+static int fits(const char *path, const cli_common *c, size_t bytes)
+{
+    static plx_port port;
+    plx_config cfg;
+    plx_engine *e;
+    plx_polar_info pi;
+    int ok;
+    plx_config_default(&cfg);
+    port = *plx_port_posix();
+    port.log = silent_log;
+    cfg.port = &port;
+    cfg.strict = c->strict;
+    if (plx_engine_new(bytes, &cfg, &e) != PLX_OK)
+        return 0;
+    ok = plx_load_file(e, path) == PLX_OK && plx_polar_info_get(e, &pi) == PLX_OK;
+    plx_engine_free(e);
+    return ok;
+}
+
+/* The smallest budget that fits, by bisection between the engine minimum
+ * and 'hi' (known to fit), to 4 KiB; the load's memory use does not depend
+ * on the budget, so fitting is monotonic. */
+static void print_min_mem(const char *path, const cli_common *c, size_t hi)
+{
+    size_t lo = PLX_ENGINE_MIN_BYTES; /* does not fit (or is the minimum) */
+    int loads = 0;
+    while (hi - lo > 4096) {
+        size_t mid = lo + (hi - lo) / 2;
+        loads++;
+        if (fits(path, c, mid))
+            hi = mid;
+        else
+            lo = mid;
+    }
+    printf("smallest --mem: %zu bytes (%.2f MiB) loads the scene and builds its polar diagrams "
+           "(bisection, %d loads; a ground image needs its pixels on top)\n", hi, hi / 1048576.0, loads);
+}
 
 static void print_memory(const plx_engine *e)
 {
@@ -36,7 +83,7 @@ int cmd_info(int argc, char **argv)
     plx_scene_info si;
     plx_polar_info pi;
     plx_ground_image_info gi;
-    int i, rc;
+    int i, rc, min_mem = 0;
     memset(&c, 0, sizeof c);
     for (i = 1; i < argc; i++) {
         int r = cli_common_option("info", argc, argv, &i, &c);
@@ -47,6 +94,10 @@ int cmd_info(int argc, char **argv)
         if (strcmp(argv[i], "--help") == 0 || strcmp(argv[i], "-h") == 0) {
             fputs(help, stdout);
             return EXIT_OK;
+        }
+        if (strcmp(argv[i], "--min-mem") == 0) {
+            min_mem = 1;
+            continue;
         }
         if (argv[i][0] == '-' && argv[i][1] != '\0')
             return cli_usage_error("info", "unknown option '%s'", argv[i]);
@@ -98,5 +149,7 @@ int cmd_info(int argc, char **argv)
     }
     print_memory(e);
     plx_engine_free(e);
+    if (min_mem && rc == EXIT_OK)
+        print_min_mem(path, &c, c.mem ? c.mem : CLI_DEFAULT_MEM);
     return rc;
 }

@@ -217,6 +217,14 @@ expect render-eye-inside 0 "^polarlux render: warning: --eye \(5, 5, 3\) is insi
 expect lamps-duplicate-warning 0 "warning: $tmp/dup.geojson: feature 0 \(line 1, column [0-9]+\): 1000 lamps at one spot \(5, 5, 6\) merged into this one: 10000 cd$" -- info "$tmp/dup.geojson"
 expect lamps-duplicate-info 0 "^duplicate lamps: 999 merged into lamps at the same spot$" -- info -q "$tmp/dup.geojson"
 expect lamps-duplicate-count 0 "^lamps: 1$" -- info -q "$tmp/dup.geojson"
+# info --min-mem: the printed budget loads, 8 KiB less does not
+n=$("$bin" info -q --min-mem $T | sed -n 's/^smallest --mem: \([0-9]*\) bytes.*/\1/p')
+if [ -n "$n" ]; then
+    expect min-mem-fits 0 "^buildings: 4 " -- info -q --mem "$n" $T
+    expect min-mem-less 3 "out of memory" -- info -q --mem $((n - 8192)) $T
+else
+    bad "info --min-mem printed no budget"
+fi
 # exit 3 says so on stderr
 expect info-nomem-stderr 3 "out of memory" -- info --mem 8K fixtures/helsinki-centre.geojson
 
