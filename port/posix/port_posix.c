@@ -10,7 +10,7 @@
 #include <unistd.h>
 #include <sys/stat.h>
 
-#include "polarlux.h"
+#include "polarlux_port.h"
 #include "port.h"
 #include "posix/safe_out.h"
 

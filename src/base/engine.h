@@ -30,6 +30,10 @@ struct plx_engine {
     struct render *rd;      /* renderer, created on first need */
     struct photon_sys *ph;  /* photon buffers, created on first need */
     double lightmap_cell;   /* light map texel size when built, else 0 */
+    uint32_t gather_side;   /* final gathering at points: side^2 directions
+                               (0 = photon buffers only); set by
+                               plx_indirect_set_gather, else FINAL_GATHER_SIDE */
+    int gather_set;         /* plx_indirect_set_gather was called */
 };
 
 #define ENGINE_MAGIC 0x504c5831u /* "PLX1" */
@@ -50,6 +54,15 @@ plx_status eng_need_light(plx_engine *e, const char *fn);
 double eng_indirect(plx_engine *e, const double P[3], const double n[3]);
 /* The same, also writing its RGB version to rgb (may be NULL); returns the scalar. */
 double eng_indirect_rgb(plx_engine *e, const double P[3], const double n[3], double rgb[3] /* OUT */);
+/* E_indirect read from the photon buffers alone (images; indirectapi.c). */
+double eng_indirect_photons_rgb(plx_engine *e, const double P[3], const double n[3],
+                                double rgb[3] /* OUT */);
+
+/* Debug builds (PLX_DEBUG): asserts the invariants of a loaded scene (rings
+ * of at least 3 vertices inside the point array, buildings' and blocks'
+ * rings inside the ring arrays, every building in its block, lamps finite).
+ * Release builds: nothing. */
+void eng_check_scene(const scene *s);
 /* Checks the engine handle for API misuse. */
 int eng_ok(const plx_engine *e);
 

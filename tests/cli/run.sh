@@ -63,7 +63,7 @@ expect vis-at 0 "^# visible: 3 of 3 buildings" -- "$bin" vis -q fixtures/tiny.ge
 expect vis-at-fov 0 "^2 C$" -- "$bin" vis -q fixtures/tiny.geojson --at 50,10 --dir 90 --fov 60
 expect vis-geojson 0 "" -- "$bin" vis -q fixtures/tiny.geojson --points "$tmp/p.txt" --geojson "$tmp/v.geojson"
 expect vis-geojson-loads 0 "^buildings: 2 " -- "$bin" info -q "$tmp/v.geojson"
-expect vis-helsinki-lonlat 0 "" -- "$bin" vis -q fixtures/helsinki-centre.geojson --at 0,0 --geojson "$tmp/h.geojson"
+expect vis-helsinki-lonlat 0 "" -- "$bin" vis -q fixtures/helsinki-centre.geojson --at 24.9442961,60.1716264 --geojson "$tmp/h.geojson"
 expect vis-helsinki-geojson-lonlat 0 "^coordinates: WGS84 lon/lat" -- "$bin" info -q "$tmp/h.geojson"
 expect draw-missing-q 2 "missing --polar Q" -- "$bin" draw fixtures/tiny.geojson -o "$tmp/d.png"
 expect draw-bad-q 2 "--polar '7' is not a quadrant 0..3" -- "$bin" draw fixtures/tiny.geojson --polar 7 -o "$tmp/d.png"
@@ -121,6 +121,7 @@ printf '{"type": "FeatureCollection", "properties": {"units": "m", "ground_image
 expect ground-image-bad-strict 1 "polarlux info: $tmp/gi/bad\.geojson: properties\.ground_image must be the path of a PNG file" -- "$bin" info --strict "$tmp/gi/bad.geojson"
 expect ground-image-bad-lenient 0 "warning: $tmp/gi/bad\.geojson: properties\.ground_image must be the path of a PNG file \(a non-empty string of at most 4096 bytes\); ignored" -- "$bin" info "$tmp/gi/bad.geojson"
 expect ground-image-nomem 3 "out of memory while storing the ground image" -- "$bin" info --mem 15K fixtures/ground-image.geojson
+. tests/cli/gis.sh
 ls "$tmp"/*.tmp* >/dev/null 2>&1 && { echo "FAIL temporary files left"; fail=$((fail + 1)); }
 echo "cli: $pass passed, $fail failed"
 [ "$fail" -eq 0 ]
