@@ -181,7 +181,7 @@ $(BUILD)/tests/failwrite.so: tests/cli/failwrite.c
 
 # The hostile corpus (tests/cli/hostile.sh) under valgrind memcheck, for CI.
 check-hostile-valgrind: check-build
-	@PLX_HOSTILE_WRAP="valgrind -q --error-exitcode=9 --leak-check=full --errors-for-leak-kinds=definite" \
+	@PLX_HOSTILE_TIMEOUT=900 PLX_HOSTILE_WRAP="valgrind -q --error-exitcode=9 --leak-check=full --errors-for-leak-kinds=definite" \
 	  sh tests/cli/hostile.sh $(BUILD)/polarlux
 
 unit: $(TESTS)

@@ -177,7 +177,7 @@ static void test_hundred_thousand_at_one_spot(void **state)
     enum { K = 100000 };
     char one[400], other[400];
     size_t len = strlen(lamp(one, 2, 1, 6, 10, 30, "1,0.62,0.28"));
-    char *body = malloc((len + 1) * (K + 1) + 512), *p = body, *s1, *sk;
+    char *body = malloc((len + 1) * K + 8 * 400), *p = body, *s1, *sk;
     double E1[NP], Ek[NP], c1[3 * NP], ck[3 * NP];
     uint32_t n, m;
     int w, k;
