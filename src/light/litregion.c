@@ -1469,8 +1469,16 @@ static plx_status cache_insert(light *L, uint32_t lamp, const lit_region *r)
         return PLX_E_NOMEM;
     while (L->pool_cap - L->pool_live < n && L->lru_tail != LIT_NONE)
         evict(L, L->lru_tail);
-    if (L->pool_cap - L->pool_end < n)
+    if (L->pool_cap - L->pool_end < n) {
+        /* Compaction moves every live region: free a quarter of the pool
+         * beyond what this region needs first, so a full cache compacts once
+         * per cap/4 bytes inserted, not on every miss (amortised O(1) per
+         * byte instead of O(pool)). */
+        size_t keep = L->pool_cap - L->pool_cap / 4;
+        while (L->pool_live + n > keep && L->lru_tail != LIT_NONE)
+            evict(L, L->lru_tail);
         compact(L);
+    }
     PLX_ASSERT(L->pool_cap - L->pool_end >= n); /* eviction and compaction made room */
     dst = L->pool + L->pool_end;
     memcpy(dst, r, n);

@@ -345,11 +345,8 @@ static const char *crs_name(const cJSON *crs)
 /* 1 when the CRS names WGS84 lon/lat (EPSG:4326, OGC CRS84). */
 static int crs_is_lonlat(const char *name)
 {
-    size_t n = strlen(name), i;
-    int crs84 = 0;
-    for (i = 0; i + 5 <= n && !crs84; i++) /* strstr is not in the core's allowance (check-lib-split) */
-        crs84 = strncmp(name + i, "CRS84", 5) == 0;
-    return crs84 || (n >= 5 && strcmp(name + n - 5, ":4326") == 0);
+    size_t n = strlen(name);
+    return strstr(name, "CRS84") != NULL || (n >= 5 && strcmp(name + n - 5, ":4326") == 0);
 }
 
 /* Keeps the scene's CRS (copied into the scene) and reads a projected one
