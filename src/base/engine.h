@@ -54,6 +54,10 @@ plx_status eng_need_light(plx_engine *e, const char *fn);
 double eng_indirect(plx_engine *e, const double P[3], const double n[3]);
 /* The same, also writing its RGB version to rgb (may be NULL); returns the scalar. */
 double eng_indirect_rgb(plx_engine *e, const double P[3], const double n[3], double rgb[3] /* OUT */);
+/* The indirect estimate at a free point (not on a surface facing out):
+ * final gathering there, else the buffers' value on the horizontal surface
+ * below it (indirectapi.c). */
+double eng_indirect_free(plx_engine *e, const double P[3], const double n[3], double rgb[3] /* OUT */);
 /* E_indirect read from the photon buffers alone (images; indirectapi.c). */
 double eng_indirect_photons_rgb(plx_engine *e, const double P[3], const double n[3],
                                 double rgb[3] /* OUT */);
