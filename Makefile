@@ -66,7 +66,7 @@ DEB_PACKAGES = libcjson-dev libcmocka-dev libpng-dev pkg-config python3-numpy py
 .SECONDARY:
 .PHONY: all deps deps-check check-no-install man check-man demo check check-full check-build unit cli-test asan \
         valgrind bench install clean check-core-headers check-identical check-lib-split check-examples check-python \
-        check-layers
+        check-layers check-hostile-valgrind
 
 all: $(LIB_A) $(LIB_SO) $(PORT_A) $(BIN)
 
@@ -197,7 +197,7 @@ check-full: check-build
 
 check-build:
 	@$(MAKE) --no-print-directory -j$(JOBS) all $(TESTS) $(EXAMPLES) check-core-headers check-lib-split check-man \
-	  check-no-install check-layers
+	  check-no-install check-layers $(BUILD)/tests/failwrite.so
 
 # The include rule (tests/check_layers.sh): stages in data-flow order base <
 # scene < polar < light < photon < render < api, base/engine.h only in
@@ -243,6 +243,16 @@ check-examples: $(EXAMPLES)
 	  $$x >$$x.log 2>&1 || { cat $$x.log; echo "example $$x: FAILED"; exit 1; }; \
 	  echo "ok   example $$(basename $$x): $$(grep -c '^ok ' $$x.log) checks"; \
 	done
+
+# The failing-disk stand-in of tests/cli/hostile.sh (an LD_PRELOAD shim).
+$(BUILD)/tests/failwrite.so: tests/cli/failwrite.c
+	@mkdir -p $(@D)
+	$(CC) -O1 -g -fPIC -shared -Wall -Wextra -Werror -o $@ $< -ldl
+
+# The hostile corpus (tests/cli/hostile.sh) under valgrind memcheck, for CI.
+check-hostile-valgrind: check-build
+	@PLX_HOSTILE_TIMEOUT=900 PLX_HOSTILE_WRAP="valgrind -q --error-exitcode=9 --leak-check=full --errors-for-leak-kinds=definite" \
+	  sh tests/cli/hostile.sh $(BUILD)/polarlux
 
 unit: $(TESTS)
 	@for t in $(TESTS); do $$t || exit 1; done

@@ -111,7 +111,8 @@ typedef struct plx_config {
     const plx_port *port;             /* NULL: no platform services */
     int strict;                       /* 1: the first bad feature fails the load */
     size_t part_budget[PLX_PART_COUNT]; /* per-part byte limits, 0 = only the block limits */
-    size_t lit_cache_bytes;           /* pool for lamp lit regions (0: 16 MiB) */
+    size_t lit_cache_bytes;           /* pool for lamp lit regions (0: from the budget, an eighth of
+                                         the free bytes at first use, 256 KiB to 16 MiB) */
     int32_t render_max_width;         /* largest frame plx_render draws (0: 1920) */
     int32_t render_max_height;        /* (0: 1080) */
 } plx_config;
@@ -201,6 +202,7 @@ typedef struct plx_scene_info {
     double height_min, height_median, height_max;
     double ground_albedo;
     uint64_t load_ns;         /* time the load took, by the port's clock */
+    uint32_t merged_lamps;    /* lamps merged into another at the same spot (README "Duplicate lamps") */
 } plx_scene_info;
 
 /* Errors: PLX_E_NOSCENE, PLX_E_INVALID (out NULL). Allocates nothing.

@@ -11,6 +11,10 @@
 /* Reads a whole file into a malloc'd NUL-terminated buffer; NULL and a
  * reason in err on failure. The caller frees it. */
 char *port_read_text(const char *path, size_t *len, char *err, size_t errlen);
+/* Opens a file for reading without waiting on it (O_NONBLOCK, then
+ * fstat): a FIFO, a device or a directory is refused with "not a regular
+ * file (a FIFO)". Returns a blocking descriptor and the size, or -1. */
+int port_open_input(const char *path, size_t *size, char *err, size_t errlen);
 /* Writes data to path through a temporary file renamed into place, so a
  * crash never leaves a half-written file. 0 on success, else -1 and err. */
 int port_write_atomic(const char *path, const void *data, size_t len, char *err, size_t errlen);

@@ -7,9 +7,13 @@ build=$1; shift
 jobs=${PLX_TEST_JOBS:-$(getconf _NPROCESSORS_ONLN 2>/dev/null || echo 2)}
 passed=0; failed=0; broken=""
 logs=$(mktemp -d)
+# the hostile corpus (many short runs of the command) alongside the unit tests
+(sh tests/cli/hostile.sh "$build/polarlux" >"$logs/hostile.log" 2>&1; echo $? >"$logs/hostile.rc") &
+hostile_pid=$!
 for t in "$@"; do echo "$t"; done |
     xargs -P "$jobs" -I {} sh -c 'n=$(basename "$1"); "$1" >"$2/$n.log" 2>&1; echo $? >"$2/$n.rc"' _ {} "$logs"
 sh tests/cli/run.sh "$build/polarlux" >"$logs/cli.log" 2>&1; echo $? >"$logs/cli.rc"
+wait $hostile_pid
 for t in "$@"; do
     name=$(basename "$t"); log="$logs/$name.log"; rc=$(cat "$logs/$name.rc" 2>/dev/null || echo 1)
     p=$(sed -n 's/^\[  PASSED  \] \([0-9]*\) test.*/\1/p' "$log" | tail -1)
@@ -33,6 +37,16 @@ if [ "$f" -ne 0 ] || [ "$rc" -ne 0 ]; then
     broken="$broken cli"; echo "---- cli"; cat "$log"
 else
     echo "ok   cli: $p tests"
+fi
+log="$logs/hostile.log"; rc=$(cat "$logs/hostile.rc")
+p=$(sed -n 's/^hostile: \([0-9]*\) passed, \([0-9]*\) failed$/\1/p' "$log")
+f=$(sed -n 's/^hostile: \([0-9]*\) passed, \([0-9]*\) failed$/\2/p' "$log")
+p=${p:-0}; f=${f:-1}
+passed=$((passed + p)); failed=$((failed + f))
+if [ "$f" -ne 0 ] || [ "$rc" -ne 0 ]; then
+    broken="$broken hostile"; echo "---- hostile"; cat "$log"
+else
+    echo "ok   hostile: $p tests"
 fi
 rm -rf "$logs"
 [ -n "$broken" ] && echo "failing:$broken"

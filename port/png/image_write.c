@@ -9,9 +9,11 @@
 #include <stdlib.h>
 #include <string.h>
 #include <unistd.h>
+#include <sys/stat.h>
 #include <png.h>
 
 #include "image_write.h"
+#include "posix/safe_out.h"
 
 /* Largest width or height accepted (libpng's default user limit). */
 #define IMAGE_MAX_DIM 1000000
@@ -24,94 +26,6 @@ static void set_err(char *err, size_t errlen, const char *fmt, ...)
     va_start(ap, fmt);
     vsnprintf(err, errlen, fmt, ap);
     va_end(ap);
-}
-
-/* ---- temporary file, then rename ---------------------------------------- */
-
-/* Creates "<path>.tmp.<pid>.<n>" exclusively; returns it open for writing
- * with its malloc'd name in *tmp, or NULL with a message. */
-static FILE *temp_open(const char *op, const char *path, char **tmp, char *err, size_t errlen)
-{
-    size_t n = strlen(path) + 48;
-    char *t = malloc(n);
-    int fd = -1, k, e;
-    FILE *f;
-
-    *tmp = NULL;
-    if (t == NULL) {
-        set_err(err, errlen, "%s: '%s': out of memory for the temporary file name", op, path);
-        return NULL;
-    }
-    for (k = 0; k < 100; k++) {
-        snprintf(t, n, "%s.tmp.%ld.%d", path, (long)getpid(), k);
-        fd = open(t, O_WRONLY | O_CREAT | O_EXCL, 0666);
-        if (fd >= 0 || errno != EEXIST)
-            break;
-    }
-    if (fd < 0) {
-        set_err(err, errlen, "%s: cannot create a temporary file for '%s' ('%s'): %s",
-                op, path, t, strerror(errno));
-        free(t);
-        return NULL;
-    }
-    f = fdopen(fd, "wb");
-    if (f == NULL) {
-        e = errno;
-        close(fd);
-        unlink(t);
-        set_err(err, errlen, "%s: cannot open '%s' as a stream: %s", op, t, strerror(e));
-        free(t);
-        return NULL;
-    }
-    *tmp = t;
-    return f;
-}
-
-/* Gives up: closes and removes the temporary file. */
-static void temp_abort(FILE *f, char *tmp)
-{
-    fclose(f);
-    unlink(tmp);
-    free(tmp);
-}
-
-/* Flushes, syncs and closes f, then renames tmp to path. Always releases
- * f and tmp; on failure removes tmp and returns -1 with a message. */
-static int temp_commit(const char *op, FILE *f, char *tmp, const char *path,
-                       char *err, size_t errlen)
-{
-    int e;
-
-    errno = 0;
-    if (fflush(f) != 0) {
-        e = errno;
-        temp_abort(f, tmp);
-        set_err(err, errlen, "%s: cannot write '%s': %s", op, path, strerror(e));
-        return -1;
-    }
-    /* EINVAL: this kind of file cannot be synced; nothing more to do. */
-    if (fsync(fileno(f)) != 0 && errno != EINVAL) {
-        e = errno;
-        temp_abort(f, tmp);
-        set_err(err, errlen, "%s: cannot write '%s' to disk: %s", op, path, strerror(e));
-        return -1;
-    }
-    if (fclose(f) != 0) {
-        e = errno;
-        unlink(tmp);
-        free(tmp);
-        set_err(err, errlen, "%s: cannot close '%s': %s", op, path, strerror(e));
-        return -1;
-    }
-    if (rename(tmp, path) != 0) {
-        e = errno;
-        unlink(tmp);
-        set_err(err, errlen, "%s: cannot rename '%s' to '%s': %s", op, tmp, path, strerror(e));
-        free(tmp);
-        return -1;
-    }
-    free(tmp);
-    return 0;
 }
 
 static int check_size(const char *op, const char *path, int width, int height,
@@ -134,7 +48,8 @@ static int check_size(const char *op, const char *path, int width, int height,
 /* What went wrong inside libpng: the system error of our own I/O callbacks
  * if there was one, else libpng's message. */
 typedef struct png_io {
-    FILE *f;
+    FILE *f;            /* reading */
+    safe_out *out;      /* writing */
     int sys_errno;
     char msg[160];
 } png_io;
@@ -155,21 +70,15 @@ static void png_io_warning(png_structp png, png_const_charp msg)
 static void png_io_write(png_structp png, png_bytep data, size_t len)
 {
     png_io *io = png_get_io_ptr(png);
-    errno = 0;
-    if (fwrite(data, 1, len, io->f) != len) {
-        io->sys_errno = errno != 0 ? errno : EIO;
+    if (safe_out_write(io->out, data, len) != 0) {
+        io->sys_errno = safe_out_errno(io->out);
         png_error(png, "write failed");
     }
 }
 
 static void png_io_flush(png_structp png)
 {
-    png_io *io = png_get_io_ptr(png);
-    errno = 0;
-    if (fflush(io->f) != 0) {
-        io->sys_errno = errno != 0 ? errno : EIO;
-        png_error(png, "flush failed");
-    }
+    (void)png;          /* safe_out_commit flushes and syncs */
 }
 
 static const char *png_io_reason(const png_io *io)
@@ -209,13 +118,11 @@ static int png_encode(png_io *io, int width, int height, const uint8_t *rgb, siz
     return 0;
 }
 
-int image_write_png_rgb8(const char *path, int width, int height, const uint8_t *rgb,
-                         int stride, char *err, size_t errlen)
+int image_encode_png(safe_out *out, const char *path, int width, int height, const uint8_t *rgb,
+                     int stride, char *err, size_t errlen)
 {
     const char *op = "write_png";
     png_io io;
-    char *tmp;
-    FILE *f;
 
     if (check_size(op, path, width, height, rgb, err, errlen) != 0)
         return -1;
@@ -226,30 +133,56 @@ int image_write_png_rgb8(const char *path, int width, int height, const uint8_t 
                 op, path, stride, width * 3);
         return -1;
     }
-    f = temp_open(op, path, &tmp, err, errlen);
-    if (f == NULL)
-        return -1;
     memset(&io, 0, sizeof io);
-    io.f = f;
+    io.out = out;
     if (png_encode(&io, width, height, rgb, (size_t)stride) != 0) {
-        temp_abort(f, tmp);
         set_err(err, errlen, "%s: cannot write '%s': %s", op, path, png_io_reason(&io));
         return -1;
     }
-    return temp_commit(op, f, tmp, path, err, errlen);
+    return 0;
+}
+
+/* Opens path, runs one encoder, commits; the message prefixed with op. */
+static int write_one(const char *op, const char *path, int width, int height, const void *pixels,
+                     int stride, int pfm, char *err, size_t errlen)
+{
+    char why[600];
+    safe_out *o;
+    if (check_size(op, path, width, height, pixels, err, errlen) != 0)
+        return -1;
+    o = safe_out_open(path, why, sizeof why);
+    if (!o) {
+        set_err(err, errlen, "%s: %s", op, why);
+        return -1;
+    }
+    if ((pfm ? image_encode_pfm(o, path, width, height, pixels, err, errlen)
+             : image_encode_png(o, path, width, height, pixels, stride, err, errlen)) != 0) {
+        safe_out_abort(o);
+        return -1;
+    }
+    if (safe_out_commit(&o, 1, why, sizeof why) != 0) {
+        set_err(err, errlen, "%s: %s", op, why);
+        return -1;
+    }
+    return 0;
+}
+
+int image_write_png_rgb8(const char *path, int width, int height, const uint8_t *rgb,
+                         int stride, char *err, size_t errlen)
+{
+    return write_one("write_png", path, width, height, rgb, stride, 0, err, errlen);
 }
 
 /* ---- PFM writer ------------------------------------------------------------ */
 
-int image_write_pfm(const char *path, int width, int height, const float *rgb,
-                    char *err, size_t errlen)
+int image_encode_pfm(safe_out *out, const char *path, int width, int height, const float *rgb,
+                     char *err, size_t errlen)
 {
     const char *op = "write_pfm";
     size_t row_floats, i;
     unsigned char *row;
-    char *tmp;
-    FILE *f;
-    int y, e;
+    char head[64];
+    int y, n;
 
     if (check_size(op, path, width, height, rgb, err, errlen) != 0)
         return -1;
@@ -260,14 +193,8 @@ int image_write_pfm(const char *path, int width, int height, const float *rgb,
                 row_floats * 4);
         return -1;
     }
-    f = temp_open(op, path, &tmp, err, errlen);
-    if (f == NULL) {
-        free(row);
-        return -1;
-    }
-    errno = 0;
-    if (fprintf(f, "PF\n%d %d\n-1.0\n", width, height) < 0)
-        goto write_error;
+    n = snprintf(head, sizeof head, "PF\n%d %d\n-1.0\n", width, height);
+    safe_out_write(out, head, (size_t)n);
     /* PFM stores the bottom row first. */
     for (y = height - 1; y >= 0; y--) {
         const float *src = rgb + (size_t)y * row_floats;
@@ -279,25 +206,52 @@ int image_write_pfm(const char *path, int width, int height, const float *rgb,
             row[4 * i + 2] = (unsigned char)((u >> 16) & 0xFFu);
             row[4 * i + 3] = (unsigned char)((u >> 24) & 0xFFu);
         }
-        errno = 0;
-        if (fwrite(row, 4, row_floats, f) != row_floats)
-            goto write_error;
+        if (safe_out_write(out, row, row_floats * 4) != 0)
+            break;
     }
     free(row);
-    return temp_commit(op, f, tmp, path, err, errlen);
+    if (safe_out_errno(out) != 0) {
+        set_err(err, errlen, "%s: cannot write '%s': %s", op, path, strerror(safe_out_errno(out)));
+        return -1;
+    }
+    return 0;
+}
 
-write_error:
-    e = errno != 0 ? errno : EIO;
-    free(row);
-    temp_abort(f, tmp);
-    set_err(err, errlen, "%s: cannot write '%s': %s", op, path, strerror(e));
-    return -1;
+int image_write_pfm(const char *path, int width, int height, const float *rgb,
+                    char *err, size_t errlen)
+{
+    return write_one("write_pfm", path, width, height, rgb, 0, 1, err, errlen);
 }
 
 /* ---- PNG reader ------------------------------------------------------------ */
 
+/* Opens a file for reading without waiting on it: a FIFO, a device or a
+ * directory is refused (open with O_NONBLOCK, then fstat). */
+static FILE *open_input(const char *op, const char *path, char *err, size_t errlen)
+{
+    struct stat st;
+    FILE *f;
+    int fd = open(path, O_RDONLY | O_NONBLOCK | O_NOCTTY);
+    if (fd < 0) {
+        set_err(err, errlen, "%s: cannot open '%s': %s", op, path, strerror(errno));
+        return NULL;
+    }
+    if (fstat(fd, &st) != 0 || !S_ISREG(st.st_mode)) {
+        set_err(err, errlen, "%s: '%s' is not a regular file", op, path);
+        close(fd);
+        return NULL;
+    }
+    fcntl(fd, F_SETFL, fcntl(fd, F_GETFL) & ~O_NONBLOCK);
+    f = fdopen(fd, "rb");
+    if (f == NULL) {
+        set_err(err, errlen, "%s: cannot open '%s': %s", op, path, strerror(errno));
+        close(fd);
+    }
+    return f;
+}
+
 static int read_png(const char *path, uint8_t *buf, size_t cap, uint8_t **out, int *width,
-                    int *height, png_uint_32 max_dim, char *err, size_t errlen)
+                    int *height, png_uint_32 max_dim, size_t max_bytes, char *err, size_t errlen)
 {
     const char *op = "read_png";
     png_structp png;
@@ -317,11 +271,9 @@ static int read_png(const char *path, uint8_t *buf, size_t cap, uint8_t **out, i
         set_err(err, errlen, "%s: %s is NULL", op, path == NULL ? "path" : "out");
         return -1;
     }
-    f = fopen(path, "rb");
-    if (f == NULL) {
-        set_err(err, errlen, "%s: cannot open '%s': %s", op, path, strerror(errno));
+    f = open_input(op, path, err, errlen);
+    if (f == NULL)
         return -1;
-    }
     if (fread(sig, 1, sizeof sig, f) != sizeof sig || png_sig_cmp(sig, 0, sizeof sig) != 0) {
         fclose(f);
         set_err(err, errlen, "%s: '%s' is not a PNG file (bad signature)", op, path);
@@ -381,6 +333,13 @@ static int read_png(const char *path, uint8_t *buf, size_t cap, uint8_t **out, i
     need = row_bytes * (size_t)h;           /* <= 3e12: fits a 64-bit size_t */
     if (need / row_bytes != (size_t)h)
         png_error(png, "image too large for memory");
+    if (need > max_bytes) {
+        png_destroy_read_struct(&png, &info, NULL);
+        fclose(f);
+        set_err(err, errlen, "%s: '%s' is %lux%lu pixels: decoding needs %zu bytes, more than the %zu "
+                "the memory budget allows", op, path, (unsigned long)w, (unsigned long)h, need, max_bytes);
+        return -2;
+    }
     if (buf != NULL) {
         if (cap < need) {
             png_destroy_read_struct(&png, &info, NULL);
@@ -409,7 +368,7 @@ static int read_png(const char *path, uint8_t *buf, size_t cap, uint8_t **out, i
 int image_read_png_rgb8(const char *path, uint8_t *buf, size_t cap, uint8_t **out,
                         int *width, int *height, char *err, size_t errlen)
 {
-    return read_png(path, buf, cap, out, width, height, IMAGE_MAX_DIM, err, errlen);
+    return read_png(path, buf, cap, out, width, height, IMAGE_MAX_DIM, (size_t)-1, err, errlen);
 }
 
 int image_read_png_max(const char *path, int max_dim, uint8_t **out, int *width, int *height,
@@ -421,5 +380,17 @@ int image_read_png_max(const char *path, int max_dim, uint8_t **out, int *width,
         set_err(err, errlen, "read_png: max_dim %d is not 1..%d", max_dim, IMAGE_MAX_DIM);
         return -1;
     }
-    return read_png(path, NULL, 0, out, width, height, (png_uint_32)max_dim, err, errlen);
+    return read_png(path, NULL, 0, out, width, height, (png_uint_32)max_dim, (size_t)-1, err, errlen);
+}
+
+int image_read_png_budget(const char *path, int max_dim, size_t max_bytes, uint8_t **out, int *width,
+                          int *height, char *err, size_t errlen)
+{
+    if (max_dim < 1 || max_dim > IMAGE_MAX_DIM) {
+        if (out != NULL)
+            *out = NULL;
+        set_err(err, errlen, "read_png: max_dim %d is not 1..%d", max_dim, IMAGE_MAX_DIM);
+        return -1;
+    }
+    return read_png(path, NULL, 0, out, width, height, (png_uint_32)max_dim, max_bytes, err, errlen);
 }

@@ -3,10 +3,11 @@
  * Port code: uses stdio, POSIX and libpng. Images are rows of pixels, row 0
  * at the top (SPEC.md §5), 3 channels R G B.
  *
- * Every writer writes a temporary file beside the output
+ * Every writer goes through safe_out (port/posix/safe_out.h): a regular
+ * file is written to a temporary file beside the output
  * ("<path>.tmp.<pid>.<n>", created exclusively with mode 0666 & ~umask),
- * flushes it to disk (fsync), closes it, and only then renames it over
- * <path>. A crash, a full disk or any error therefore never leaves a partial
+ * flushed to disk (fsync), closed, and only then renamed over <path>; a
+ * device, FIFO or "-" is written directly. A crash, a full disk or any error therefore never leaves a partial
  * output: <path> is either the complete new image or whatever was there
  * before. On failure the temporary file is removed.
  *
@@ -22,6 +23,7 @@
 
 #include <stddef.h>
 #include <stdint.h>
+#include "posix/safe_out.h"
 
 /*
  * Writes an 8-bit RGB PNG (no interlace, tagged sRGB: the bytes are taken
@@ -74,5 +76,26 @@ int image_read_png_rgb8(const char *path, uint8_t *buf, size_t cap, uint8_t **ou
  */
 int image_read_png_max(const char *path, int max_dim, uint8_t **out, int *width, int *height,
                        char *err, size_t errlen);
+
+/*
+ * The same limited also by bytes: an image whose decoded pixels
+ * (width*height*3) exceed max_bytes is refused after reading the header,
+ * before any pixel memory is taken: "read_png: 'big.png' is 1000000x1000000
+ * pixels: decoding needs 3000000000000 bytes, more than the 1073741824 the
+ * memory budget allows"; that refusal returns -2 (other failures -1). Every reader refuses a file that is not a regular
+ * file (a FIFO, a device, a directory) without waiting on it.
+ */
+int image_read_png_budget(const char *path, int max_dim, size_t max_bytes, uint8_t **out, int *width,
+                          int *height, char *err, size_t errlen);
+
+/*
+ * Encoders into an output opened with safe_out_open (path only names it in
+ * messages): the caller commits (safe_out_commit) or aborts. Used to write
+ * outputs that belong together (an image and its PFM) in one commit.
+ */
+int image_encode_png(safe_out *out, const char *path, int width, int height, const uint8_t *rgb,
+                     int stride, char *err, size_t errlen);
+int image_encode_pfm(safe_out *out, const char *path, int width, int height, const float *rgb,
+                     char *err, size_t errlen);
 
 #endif

@@ -1,6 +1,7 @@
 /* The POSIX port: clock_gettime, stderr logging, stdio files, a pthread
  * mutex for JSON parsing, and engines in a malloc'd block. */
 #include <errno.h>
+#include <fcntl.h>
 #include <pthread.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -11,6 +12,7 @@
 
 #include "polarlux_port.h"
 #include "port.h"
+#include "posix/safe_out.h"
 
 static pthread_mutex_t json_mutex = PTHREAD_MUTEX_INITIALIZER;
 
@@ -34,40 +36,74 @@ static void posix_log(void *ctx, plx_log_level level, const char *msg)
     fprintf(stderr, "polarlux: %s: %s\n", tag[level <= PLX_LOG_INFO ? level : PLX_LOG_INFO], msg);
 }
 
-static int posix_file_size(void *ctx, const char *path, size_t *size, char *err, size_t errlen)
+/* Opens an input without ever waiting on it: O_NONBLOCK (a FIFO with no
+ * writer, a device) then fstat, so a FIFO, a device or a directory is
+ * refused at once; the descriptor is then made blocking again. -1 and a
+ * message on failure. */
+int port_open_input(const char *path, size_t *size, char *err, size_t errlen)
 {
     struct stat st;
-    (void)ctx;
-    if (stat(path, &st) != 0) {
+    int fd = open(path, O_RDONLY | O_NONBLOCK | O_NOCTTY);
+    if (fd < 0) {
         snprintf(err, errlen, "cannot open: %s", strerror(errno));
         return -1;
     }
-    if (!S_ISREG(st.st_mode)) {
-        snprintf(err, errlen, "not a regular file");
+    if (fstat(fd, &st) != 0 || !S_ISREG(st.st_mode)) {
+        snprintf(err, errlen, "not a regular file (%s)", S_ISDIR(st.st_mode) ? "a directory"
+                 : S_ISFIFO(st.st_mode) ? "a FIFO" : S_ISCHR(st.st_mode) || S_ISBLK(st.st_mode) ? "a device"
+                 : "a special file");
+        close(fd);
         return -1;
     }
-    *size = (size_t)st.st_size;
+    fcntl(fd, F_SETFL, fcntl(fd, F_GETFL) & ~O_NONBLOCK);
+    if (size)
+        *size = (size_t)st.st_size;
+    return fd;
+}
+
+/* Reads exactly size bytes from fd and closes it. */
+static int read_all(int fd, void *buf, size_t size, char *err, size_t errlen)
+{
+    size_t got = 0;
+    while (got < size) {
+        ssize_t r = read(fd, (char *)buf + got, size - got);
+        if (r < 0 && errno == EINTR)
+            continue;
+        if (r <= 0) {
+            snprintf(err, errlen, "read %zu of %zu bytes: %s", got, size,
+                     r < 0 ? strerror(errno) : "file changed while reading");
+            close(fd);
+            return -1;
+        }
+        got += (size_t)r;
+    }
+    close(fd);
+    return 0;
+}
+
+static int posix_file_size(void *ctx, const char *path, size_t *size, char *err, size_t errlen)
+{
+    int fd = port_open_input(path, size, err, errlen);
+    (void)ctx;
+    if (fd < 0)
+        return -1;
+    close(fd);
     return 0;
 }
 
 static int posix_file_read(void *ctx, const char *path, void *buf, size_t size, char *err, size_t errlen)
 {
-    FILE *f = fopen(path, "rb");
-    size_t got;
+    size_t now;
+    int fd = port_open_input(path, &now, err, errlen);
     (void)ctx;
-    if (!f) {
-        snprintf(err, errlen, "cannot open: %s", strerror(errno));
+    if (fd < 0)
+        return -1;
+    if (now != size) {
+        snprintf(err, errlen, "file changed while reading (%zu bytes, was %zu)", now, size);
+        close(fd);
         return -1;
     }
-    got = fread(buf, 1, size, f);
-    if (got != size || ferror(f)) {
-        snprintf(err, errlen, "read %zu of %zu bytes: %s", got, size,
-                 ferror(f) ? strerror(errno) : "file changed while reading");
-        fclose(f);
-        return -1;
-    }
-    fclose(f);
-    return 0;
+    return read_all(fd, buf, size, err, errlen);
 }
 
 static void posix_lock(void *ctx)
@@ -124,14 +160,16 @@ char *port_read_text(const char *path, size_t *len, char *err, size_t errlen)
 {
     size_t size;
     char *buf;
-    if (posix_file_size(NULL, path, &size, err, errlen) != 0)
+    int fd = port_open_input(path, &size, err, errlen);
+    if (fd < 0)
         return NULL;
-    buf = malloc(size + 1);
+    buf = size < (size_t)-1 ? malloc(size + 1) : NULL;
     if (!buf) {
         snprintf(err, errlen, "out of memory reading %zu bytes", size);
+        close(fd);
         return NULL;
     }
-    if (posix_file_read(NULL, path, buf, size, err, errlen) != 0) {
+    if (read_all(fd, buf, size, err, errlen) != 0) {
         free(buf);
         return NULL;
     }
@@ -143,41 +181,9 @@ char *port_read_text(const char *path, size_t *len, char *err, size_t errlen)
 
 int port_write_atomic(const char *path, const void *data, size_t len, char *err, size_t errlen)
 {
-    char tmp[4096];
-    int fd;
-    FILE *f;
-    if (snprintf(tmp, sizeof tmp, "%s.tmp.XXXXXX", path) >= (int)sizeof tmp) {
-        snprintf(err, errlen, "%s: path too long", path);
+    safe_out *o = safe_out_open(path, err, errlen);
+    if (!o)
         return -1;
-    }
-    fd = mkstemp(tmp);
-    if (fd < 0) {
-        snprintf(err, errlen, "%s: cannot create a temporary file beside it: %s", path, strerror(errno));
-        return -1;
-    }
-    f = fdopen(fd, "wb");
-    if (!f) {
-        snprintf(err, errlen, "%s: %s", path, strerror(errno));
-        close(fd);
-        unlink(tmp);
-        return -1;
-    }
-    if (fwrite(data, 1, len, f) != len || fflush(f) != 0) {
-        snprintf(err, errlen, "%s: write failed: %s", path, strerror(errno));
-        fclose(f);
-        unlink(tmp);
-        return -1;
-    }
-    if (fclose(f) != 0) {
-        snprintf(err, errlen, "%s: write failed: %s", path, strerror(errno));
-        unlink(tmp);
-        return -1;
-    }
-    chmod(tmp, 0644);
-    if (rename(tmp, path) != 0) {
-        snprintf(err, errlen, "%s: cannot rename the temporary file into place: %s", path, strerror(errno));
-        unlink(tmp);
-        return -1;
-    }
-    return 0;
+    safe_out_write(o, data, len);
+    return safe_out_commit(&o, 1, err, errlen);
 }

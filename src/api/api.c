@@ -53,6 +53,7 @@ plx_status plx_scene_info_get(plx_engine *e, plx_scene_info *out)
     out->vertices = s->npts;
     out->skipped_features = s->skipped_features;
     out->skipped_lamps = s->skipped_lamps;
+    out->merged_lamps = s->merged_lamps;
     out->overlapping_pairs = s->overlapping_pairs;
     out->lonlat = s->lonlat;
     out->lon0 = s->lon0;

@@ -16,7 +16,6 @@
 #include "photon/photon.h"
 #include "render/render.h"
 
-#define DEFAULT_LIT_CACHE ((size_t)16 << 20)
 #define DEFAULT_MAX_W 1920
 #define DEFAULT_MAX_H 1080
 
@@ -47,9 +46,22 @@ static plx_status need_polar(plx_engine *e)
     return PLX_OK;
 }
 
+/* The lit-region pool when plx_config.lit_cache_bytes is 0: sized from the
+ * budget, an eighth of the block's free bytes when light is first needed,
+ * at least LIT_CACHE_MIN and at most LIT_CACHE_MAX. A lamp whose region does
+ * not fit is answered by the segment path (same light, slower). */
+#define LIT_CACHE_MIN ((size_t)256 << 10)
+#define LIT_CACHE_MAX ((size_t)16 << 20)
+
+static size_t default_lit_cache(const arena *a)
+{
+    size_t c = arena_free_bytes(a) / 8;
+    return c < LIT_CACHE_MIN ? LIT_CACHE_MIN : c > LIT_CACHE_MAX ? LIT_CACHE_MAX : c;
+}
+
 static plx_status need_light(plx_engine *e)
 {
-    size_t cache = e->cfg.lit_cache_bytes ? e->cfg.lit_cache_bytes : DEFAULT_LIT_CACHE;
+    size_t cache = e->cfg.lit_cache_bytes ? e->cfg.lit_cache_bytes : default_lit_cache(&e->mem);
     plx_status st = light_create(&e->mem, e->sc, cache, &e->lt);
     if (st == PLX_E_NOMEM)
         return eng_nomem(e, "setting up lamp light");

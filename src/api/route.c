@@ -62,10 +62,13 @@ static plx_status score_segment(plx_engine *e, const double *a, const double *b,
                                 double dark_lux, acc *out)
 {
     double len = hypot(b[0] - a[0], b[1] - a[1]);
-    uint32_t k = (uint32_t)fmin(ceil(len / step), 1e7), i;
+    uint32_t k, i;
     arena_mark m = arena_get_mark(&e->mem);
     double *P, *N, *Ed, *Ei, w;
     plx_status st;
+    if (!(ceil(len / step) <= 1e7)) /* never sampled more coarsely than asked */
+        return eng_fail(e, PLX_E_INVALID, "plx_route_score: a segment needs more than 1e7 samples at this step");
+    k = (uint32_t)ceil(len / step);
     if (k < 1)
         k = 1;
     w = len / k;

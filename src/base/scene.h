@@ -96,6 +96,7 @@ typedef struct scene {
     const char *crs;      /* the scene's CRS name (top-level "crs" or properties.crs), or NULL */
     double height_min, height_median, height_max;
     uint32_t skipped_features, skipped_lamps, overlapping_pairs;
+    uint32_t merged_lamps;      /* duplicate lamps merged into others (lampmerge.c) */
     uint64_t load_ns;
 } scene;
 

@@ -35,6 +35,17 @@ size_t cli_parse_size(const char *s);
 /* Parses a decimal number / integer strictly; 0 on success. */
 int cli_parse_double(const char *s, double *out);
 int cli_parse_int(const char *s, long lo, long hi, long *out);
+/* Bounds of hostile option values (README, "Limits"): every number is
+ * finite (cli_parse_double refuses inf and nan); a coordinate is within
+ * CLI_MAX_COORD metres of the origin, as scene coordinates are. */
+#define CLI_MAX_COORD 1e7
+/* A finite number in [lo, hi]; 0 on success. */
+int cli_parse_real(const char *s, double lo, double hi, double *out);
+/* n comma-separated coordinates "X,Y[,Z...]", each finite and within
+ * +-CLI_MAX_COORD; 0 on success. */
+int cli_parse_coords(const char *s, double *v, int n);
+/* Most photons one run traces (--photons x --frames): about 18 minutes. */
+#define CLI_MAX_PHOTONS 4294967296.0
 /* Handles --mem, --strict, --quiet at argv[*i]; 1 if consumed, -1 on error. */
 int cli_common_option(const char *cmd, int argc, char **argv, int *i, cli_common *c);
 /* Creates an engine and loads the scene; prints the error and returns an

@@ -438,11 +438,15 @@ static int run(plx_engine *e, const heat_opts *o)
     plx_scene_info_get(e, &si);
     memcpy(m.box, o->have_box ? o->box : si.bounds, sizeof m.box);
     m.res = o->res;
-    m.w = (size_t)ceil((m.box[2] - m.box[0]) / m.res);
-    m.h = (size_t)ceil((m.box[3] - m.box[1]) / m.res);
-    if (m.w < 1 || m.h < 1 || m.w * m.h > 50000000u) {
-        fprintf(stderr, "polarlux heatmap: --res %g gives %zux%zu pixels (at most 5e7)\n", m.res, m.w, m.h);
-        return EXIT_USAGE;
+    {   /* counted in doubles: no integer overflow for any finite box */
+        double wd = ceil((m.box[2] - m.box[0]) / m.res), hd = ceil((m.box[3] - m.box[1]) / m.res);
+        if (!(wd >= 1 && hd >= 1 && wd * hd <= 5e7 && wd <= 1e6 && hd <= 1e6)) {
+            fprintf(stderr, "polarlux heatmap: --res %g over a box of %.0f x %.0f m gives %.0fx%.0f pixels "
+                    "(at most 5e7, 1e6 a side)\n", m.res, m.box[2] - m.box[0], m.box[3] - m.box[1], wd, hd);
+            return EXIT_USAGE;
+        }
+        m.w = (size_t)wd;
+        m.h = (size_t)hd;
     }
     /* the map's floats, and the PNG's canvas (map + legend, >= 200 rows) */
     fixed = sizeof *m.E * m.w * m.h + (tiff ? 0 : 3 * (m.w + 150) * (m.h < 200 ? 200 : m.h));
@@ -504,11 +508,11 @@ int cmd_heatmap(int argc, char **argv)
              strcmp(argv[i], "--height") == 0 || strcmp(argv[i], "--facing") == 0) && i + 1 >= argc)
             return cli_usage_error("heatmap", "%s needs a value", argv[i]);
         if (strcmp(argv[i], "--res") == 0) {
-            if (cli_parse_double(argv[++i], &o.res) != 0 || !(o.res > 0))
-                return cli_usage_error("heatmap", "--res '%s' is not a positive number of metres", argv[i]);
+            if (cli_parse_real(argv[++i], 0, CLI_MAX_COORD, &o.res) != 0 || !(o.res > 0))
+                return cli_usage_error("heatmap", "--res '%s' is not a positive number of metres (at most 1e7)", argv[i]);
         } else if (strcmp(argv[i], "--max") == 0) {
-            if (cli_parse_double(argv[++i], &o.top) != 0 || !(o.top > 0.1))
-                return cli_usage_error("heatmap", "--max '%s' is not a number of lux above 0.1", argv[i]);
+            if (cli_parse_real(argv[++i], 0.1, 1e9, &o.top) != 0 || !(o.top > 0.1))
+                return cli_usage_error("heatmap", "--max '%s' is not a number of lux above 0.1 (at most 1e9)", argv[i]);
         } else if (strcmp(argv[i], "--quantity") == 0) {
             const char *q = argv[++i];
             o.quantity = strcmp(q, "h") == 0 ? PLX_METER_H : strcmp(q, "v") == 0 ? PLX_METER_V
@@ -526,10 +530,9 @@ int cmd_heatmap(int argc, char **argv)
         } else if (strcmp(argv[i], "--path") == 0) {
             o.path = argv[++i];
         } else if (strcmp(argv[i], "--box") == 0) {
-            char extra;
-            if (sscanf(argv[++i], "%lf,%lf,%lf,%lf%c", &o.box[0], &o.box[1], &o.box[2], &o.box[3], &extra) != 4 ||
-                !(o.box[2] > o.box[0]) || !(o.box[3] > o.box[1]))
-                return cli_usage_error("heatmap", "--box '%s' is not X0,Y0,X1,Y1 with X1 > X0 and Y1 > Y0", argv[i]);
+            if (cli_parse_coords(argv[++i], o.box, 4) != 0 || !(o.box[2] > o.box[0]) || !(o.box[3] > o.box[1]))
+                return cli_usage_error("heatmap", "--box '%s' is not X0,Y0,X1,Y1 with X1 > X0 and Y1 > Y0 "
+                                       "(finite, within 1e7 m)", argv[i]);
             o.have_box = 1;
         } else if (argv[i][0] == '-' && argv[i][1] != '\0') {
             return cli_usage_error("heatmap", "unknown option '%s'", argv[i]);

@@ -2,10 +2,9 @@
  * and memory per part. */
 #include <string.h>
 #include "cli.h"
-#include "options.h"
 
 static const char help[] =
-    "usage: polarlux info SCENE [--mem SIZE] [--strict] [--quiet] [--lamps FILE]...\n"
+    "usage: polarlux info SCENE [--mem SIZE] [--strict] [--quiet] [--lamps FILE]... [--min-mem]\n"
     "\n"
     "Loads SCENE (GeoJSON, see README 'Scene format') and prints counts of\n"
     "buildings, blocks, courtyards, lamps and vertices, the bounds, building\n"
@@ -26,7 +25,55 @@ static const char help[] =
     "               scene, metres on a metre scene; a '# crs: NAME' line or a\n"
     "               GeoJSON crs must match the scene's). Lamps inside buildings\n"
     "               are left out and lamps at an earlier lamp's position merged,\n"
-    "               each with a warning.\n";
+    "               each with a warning.\n"
+    "  --min-mem    also find the smallest --mem that loads SCENE (the file alone)\n"
+    "               and builds its\n"
+    "               polar diagrams, by bisection over loads (to 4 KiB; about 18\n"
+    "               loads), and print it\n";
+
+static void silent_log(void *ctx, plx_log_level level, const char *msg)
+{
+    (void)ctx, (void)level, (void)msg;
+}
+
+/* 1 when an engine of 'bytes' loads the scene and builds its polar diagrams. */
+static int fits(const char *path, const cli_common *c, size_t bytes)
+{
+    static plx_port port;
+    plx_config cfg;
+    plx_engine *e;
+    plx_polar_info pi;
+    int ok;
+    plx_config_default(&cfg);
+    port = *plx_port_posix();
+    port.log = silent_log;
+    cfg.port = &port;
+    cfg.strict = c->strict;
+    if (plx_engine_new(bytes, &cfg, &e) != PLX_OK)
+        return 0;
+    ok = plx_load_file(e, path) == PLX_OK && plx_polar_info_get(e, &pi) == PLX_OK;
+    plx_engine_free(e);
+    return ok;
+}
+
+/* The smallest budget that fits, by bisection between the engine minimum
+ * and 'hi' (known to fit), to 4 KiB; the load's memory use does not depend
+ * on the budget, so fitting is monotonic. */
+static void print_min_mem(const char *path, const cli_common *c, size_t hi)
+{
+    size_t lo = PLX_ENGINE_MIN_BYTES; /* does not fit (or is the minimum) */
+    int loads = 0;
+    while (hi - lo > 4096) {
+        size_t mid = lo + (hi - lo) / 2;
+        loads++;
+        if (fits(path, c, mid))
+            hi = mid;
+        else
+            lo = mid;
+    }
+    printf("smallest --mem: %zu bytes (%.2f MiB) loads the scene and builds its polar diagrams "
+           "(bisection, %d loads; a ground image needs its pixels on top)\n", hi, hi / 1048576.0, loads);
+}
 
 static void print_memory(const plx_engine *e)
 {
@@ -66,15 +113,28 @@ int cmd_info(int argc, char **argv)
     plx_scene_info si;
     plx_polar_info pi;
     plx_ground_image_info gi;
-    cli_args pa;
-    int rc;
+    int i, rc, min_mem = 0;
     memset(&c, 0, sizeof c);
-    rc = cli_options("info", help, argc, argv, NULL, &c, NULL, &pa);
-    if (rc != EXIT_OK)
-        return rc < 0 ? EXIT_OK : rc;
-    if (pa.npos > 1)
-        return cli_usage_error("info", "one scene at a time ('%s' and '%s')", pa.pos[0], pa.pos[1]);
-    path = pa.npos ? pa.pos[0] : NULL;
+    for (i = 1; i < argc; i++) {
+        int r = cli_common_option("info", argc, argv, &i, &c);
+        if (r < 0)
+            return EXIT_USAGE;
+        if (r)
+            continue;
+        if (strcmp(argv[i], "--help") == 0 || strcmp(argv[i], "-h") == 0) {
+            fputs(help, stdout);
+            return EXIT_OK;
+        }
+        if (strcmp(argv[i], "--min-mem") == 0) {
+            min_mem = 1;
+            continue;
+        }
+        if (argv[i][0] == '-' && argv[i][1] != '\0')
+            return cli_usage_error("info", "unknown option '%s'", argv[i]);
+        if (path)
+            return cli_usage_error("info", "one scene at a time ('%s' and '%s')", path, argv[i]);
+        path = argv[i];
+    }
     if (!path)
         return cli_usage_error("info", "missing SCENE");
     rc = cli_open_scene("info", path, &c, &e);
@@ -90,6 +150,8 @@ int cmd_info(int argc, char **argv)
         printf("crs: %s\n", plx_scene_crs(e));
     printf("vertices: %u\n", si.vertices);
     printf("skipped: %u features, %u lamps inside buildings\n", si.skipped_features, si.skipped_lamps);
+    if (si.merged_lamps)
+        printf("duplicate lamps: %u merged into lamps at the same spot\n", si.merged_lamps);
     printf("overlapping pairs: %u\n", si.overlapping_pairs);
     if (si.lonlat)
         printf("coordinates: WGS84 lon/lat, projected about lon0 %.7f lat0 %.7f\n", si.lon0, si.lat0);
@@ -115,9 +177,12 @@ int cmd_info(int argc, char **argv)
                pi.nregions[2], pi.nregions[3]);
     } else {
         printf("polar diagrams: not built: %s\n", plx_last_error(e));
+        fprintf(stderr, "polarlux info: %s: polar diagrams not built: %s\n", path, plx_last_error(e));
         rc = plx_last_error(e)[0] && strstr(plx_last_error(e), "out of memory") ? EXIT_NOMEM : EXIT_FAIL;
     }
     print_memory(e);
     plx_engine_free(e);
+    if (min_mem && rc == EXIT_OK)
+        print_min_mem(path, &c, c.mem ? c.mem : CLI_DEFAULT_MEM);
     return rc;
 }

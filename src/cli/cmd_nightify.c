@@ -4,7 +4,6 @@
 #include <string.h>
 
 #include "cli.h"
-#include "options.h"
 #include "png/image_write.h"
 
 static const char help[] =
@@ -15,44 +14,58 @@ static const char help[] =
     "place), leaving out NIGHT's pixels darker than the threshold (luminance\n"
     "0..255) so that unlit areas do not dominate the palette.\n"
     "\n"
-    "  -o FILE              output PNG (required)\n"
+    "  -o FILE              output PNG (- for standard output)\n"
+    "  --mem SIZE           memory for the decoded images (default 1G): an image\n"
+    "                       whose header claims more pixels is refused (exit 3)\n"
+    "                       before it is decoded\n"
     "  --dark-threshold T   luminance below which night pixels are left out of\n"
     "                       the reference histograms (default 10)\n";
 
-static int parse_dark(const char *v, void *dst)
-{
-    double *d = dst;
-    return cli_parse_double(v, d) != 0 || *d < 0 || *d > 255;
-}
-
 int cmd_nightify(int argc, char **argv)
 {
-    const char *out = NULL;
+    const char *pos[2], *out = NULL;
     double dark = 10.0;
-    const cli_opt opts[] = {
-        { "-o", NULL, &out, NULL, NULL, 0, NULL },
-        { "--dark-threshold", NULL, &dark, parse_dark, "--dark-threshold '%s' is not 0..255", 0, NULL },
-        CLI_OPT_END
-    };
-    cli_args pa;
-    const char **pos = pa.pos;
-    int dw, dh, nw, nh, rc;
+    int npos = 0, i, dw = 0, dh = 0, nw, nh, rc = EXIT_OK, r;
     uint8_t *day = NULL, *night = NULL;
     char err[512];
-    rc = cli_options("nightify", help, argc, argv, opts, NULL, NULL, &pa);
-    if (rc != EXIT_OK)
-        return rc < 0 ? EXIT_OK : rc;
-    if (pa.npos > 2)
-        return cli_usage_error("nightify", "unexpected argument '%s'", pa.pos[2]);
-    rc = EXIT_OK;
-    if (pa.npos < 2)
+    cli_common c;
+    size_t mem;
+    memset(&c, 0, sizeof c);
+    for (i = 1; i < argc; i++) {
+        r = cli_common_option("nightify", argc, argv, &i, &c);
+        if (r < 0)
+            return EXIT_USAGE;
+        if (r)
+            continue;
+        if (strcmp(argv[i], "--help") == 0 || strcmp(argv[i], "-h") == 0) {
+            fputs(help, stdout);
+            return EXIT_OK;
+        } else if (strcmp(argv[i], "-o") == 0 || strcmp(argv[i], "--dark-threshold") == 0) {
+            if (i + 1 >= argc)
+                return cli_usage_error("nightify", "%s needs a value", argv[i]);
+            if (strcmp(argv[i], "-o") == 0) {
+                out = argv[++i];
+            } else if (cli_parse_double(argv[++i], &dark) != 0 || dark < 0 || dark > 255) {
+                return cli_usage_error("nightify", "--dark-threshold '%s' is not 0..255", argv[i]);
+            }
+        } else if (argv[i][0] == '-' && argv[i][1] != '\0') {
+            return cli_usage_error("nightify", "unknown option '%s'", argv[i]);
+        } else if (npos < 2) {
+            pos[npos++] = argv[i];
+        } else {
+            return cli_usage_error("nightify", "unexpected argument '%s'", argv[i]);
+        }
+    }
+    if (npos < 2)
         return cli_usage_error("nightify", "needs DAY.png and NIGHT.png");
     if (!out)
         return cli_usage_error("nightify", "missing -o OUT.png");
-    if (image_read_png_rgb8(pos[0], NULL, 0, &day, &dw, &dh, err, sizeof err) != 0 ||
-        image_read_png_rgb8(pos[1], NULL, 0, &night, &nw, &nh, err, sizeof err) != 0) {
-        fprintf(stderr, "polarlux nightify: %s\n", err);
-        rc = EXIT_FAIL;
+    mem = c.mem ? c.mem : CLI_DEFAULT_MEM;
+    if ((r = image_read_png_budget(pos[0], 1000000, mem, &day, &dw, &dh, err, sizeof err)) != 0 ||
+        (r = image_read_png_budget(pos[1], 1000000, mem - (size_t)dw * dh * 3, &night, &nw, &nh, err,
+                                   sizeof err)) != 0) {
+        fprintf(stderr, "polarlux nightify: %s%s\n", err, r == -2 ? "; give it more with --mem" : "");
+        rc = r == -2 ? EXIT_NOMEM : EXIT_FAIL;
     } else if (plx_nightify(day, (size_t)dw * dh, night, (size_t)nw * nh, dark, day) != PLX_OK) {
         fprintf(stderr, "polarlux nightify: empty image\n");
         rc = EXIT_FAIL;

@@ -60,11 +60,7 @@ typedef struct render_args {
 
 static int parse_vec3(const char *s, double v[3])
 {
-    char extra;
-    return sscanf(s, "%lf,%lf,%lf%c", &v[0], &v[1], &v[2], &extra) == 3 && isfinite(v[0]) && isfinite(v[1]) &&
-                   isfinite(v[2])
-               ? 0
-               : -1;
+    return cli_parse_coords(s, v, 3) == 0 && fabs(v[2]) <= 1e5 ? 0 : -1;
 }
 
 static int parse_value(render_args *a, const char *opt, const char *val)
@@ -73,11 +69,11 @@ static int parse_value(render_args *a, const char *opt, const char *val)
     char extra;
     if (strcmp(opt, "--eye") == 0) {
         if (parse_vec3(val, a->cam.eye) != 0)
-            return cli_usage_error("render", "--eye '%s' is not X,Y,Z", val);
+            return cli_usage_error("render", "--eye '%s' is not X,Y,Z (finite, x and y within 1e7 m, z within 1e5 m)", val);
         a->have_eye = 1;
     } else if (strcmp(opt, "--target") == 0) {
         if (parse_vec3(val, a->cam.target) != 0)
-            return cli_usage_error("render", "--target '%s' is not X,Y,Z", val);
+            return cli_usage_error("render", "--target '%s' is not X,Y,Z (finite, x and y within 1e7 m, z within 1e5 m)", val);
         a->have_target = 1;
     } else if (strcmp(opt, "--fov") == 0) {
         if (cli_parse_double(val, &a->cam.fov_deg) != 0 || !(a->cam.fov_deg > 0 && a->cam.fov_deg < 180))
@@ -98,11 +94,11 @@ static int parse_value(render_args *a, const char *opt, const char *val)
         }
         return cli_usage_error("render", "--backend '%s' is not soft or osmesa", val);
     } else if (strcmp(opt, "--exposure") == 0) {
-        if (cli_parse_double(val, &a->opts.exposure) != 0 || !(a->opts.exposure >= 0))
-            return cli_usage_error("render", "--exposure '%s' is not a number >= 0", val);
+        if (cli_parse_real(val, 0, 1e9, &a->opts.exposure) != 0)
+            return cli_usage_error("render", "--exposure '%s' is not a number from 0 to 1e9", val);
     } else if (strcmp(opt, "--texel") == 0) {
-        if (cli_parse_double(val, &a->opts.aerial_m_per_texel) != 0 || !(a->opts.aerial_m_per_texel > 0))
-            return cli_usage_error("render", "--texel '%s' is not a positive number of metres", val);
+        if (cli_parse_real(val, 0.01, 1e4, &a->opts.aerial_m_per_texel) != 0)
+            return cli_usage_error("render", "--texel '%s' is not a number of metres from 0.01 to 1e4", val);
     } else if (strcmp(opt, "-o") == 0) {
         a->out = val;
     } else if (strcmp(opt, "--pfm") == 0) {
@@ -182,6 +178,27 @@ static int free_point(plx_engine *e, double x, double y)
     return plx_visibility_get(e, x, y, 0, 1, &v) == PLX_OK;
 }
 
+/* A warning when the eye is inside a building's solid (over its footprint,
+ * between min_height and height): the image then shows the inside of its
+ * walls, which is seldom what was meant. */
+static void warn_eye_inside(plx_engine *e, const double *eye, int quiet)
+{
+    plx_visibility v;
+    plx_building b;
+    const char *msg, *at;
+    unsigned long k;
+    if (quiet || plx_visibility_get(e, eye[0], eye[1], 0, 1, &v) != PLX_E_RANGE)
+        return;
+    msg = plx_last_error(e);
+    at = strstr(msg, "is inside building ");
+    if (!at || sscanf(at, "is inside building %lu", &k) != 1 || plx_building_get(e, (uint32_t)k, &b) != PLX_OK)
+        return;
+    if (eye[2] > b.min_height && eye[2] < b.height)
+        fprintf(stderr, "polarlux render: warning: --eye (%g, %g, %g) is inside building %lu%s%s%s "
+                "(%g to %g m high): the image shows the inside of its walls\n", eye[0], eye[1], eye[2], k,
+                b.id ? " (" : "", b.id ? b.id : "", b.id ? ")" : "", b.min_height, b.height);
+}
+
 /* Default street camera: among the 40 lamps nearest the middle of Bounds and
  * 8 directions each, an eye 1.7 m high 12 m before the lamp with 40 m of free
  * ground past it, choosing the most enclosed view (the smallest visible area
@@ -259,14 +276,29 @@ static void default_aerial(plx_engine *e, plx_camera *cam)
     cam->eye[2] = half / tan(cam->fov_deg * 0.008726646259971648);
 }
 
+/* The PNG and the PFM belong together: both are written, then both are
+ * renamed into place (safe_out_commit), or neither. */
 static int write_outputs(const render_args *a, const uint8_t *rgb8, const float *rgbf)
 {
     char err[512];
-    if (image_write_png_rgb8(a->out, a->cam.width, a->cam.height, rgb8, 0, err, sizeof err) != 0) {
+    safe_out *o[2] = { NULL, NULL };
+    size_t n = a->pfm ? 2 : 1;
+    o[0] = safe_out_open(a->out, err, sizeof err);
+    if (o[0] && a->pfm)
+        o[1] = safe_out_open(a->pfm, err, sizeof err);
+    if (!o[0] || (a->pfm && !o[1])) {
+        safe_out_abort(o[0]);
         fprintf(stderr, "polarlux render: %s\n", err);
         return EXIT_FAIL;
     }
-    if (a->pfm && image_write_pfm(a->pfm, a->cam.width, a->cam.height, rgbf, err, sizeof err) != 0) {
+    if (image_encode_png(o[0], a->out, a->cam.width, a->cam.height, rgb8, 0, err, sizeof err) != 0 ||
+        (a->pfm && image_encode_pfm(o[1], a->pfm, a->cam.width, a->cam.height, rgbf, err, sizeof err) != 0)) {
+        safe_out_abort(o[0]);
+        safe_out_abort(o[1]);
+        fprintf(stderr, "polarlux render: %s\n", err);
+        return EXIT_FAIL;
+    }
+    if (safe_out_commit(o, n, err, sizeof err) != 0) {
         fprintf(stderr, "polarlux render: %s\n", err);
         return EXIT_FAIL;
     }
@@ -306,6 +338,8 @@ int cmd_render(int argc, char **argv)
         plx_engine_free(e);
         return EXIT_USAGE;
     }
+    if (a.have_eye)
+        warn_eye_inside(e, a.cam.eye, a.c.quiet);
     if (!a.have_eye) {
         if (a.aerial) {
             default_aerial(e, &a.cam);

@@ -148,6 +148,28 @@ typedef struct route_opts {
     cli_common c;
 } route_opts;
 
+/* The path's samples at --step, counted before any work: at most
+ * ROUTE_MAX_SAMPLES in all (and 1e7 a segment, the engine's limit). */
+#define ROUTE_MAX_SAMPLES 1e8
+static int check_samples(const route_opts *o, const route_set *rs)
+{
+    double total = 0, longest = 0, len = 0;
+    size_t i;
+    uint32_t k;
+    for (i = 0; i < rs->n; i++)
+        for (k = 0; k + 1 < rs->lines[i].n; k++) {
+            const double *a = rs->lines[i].xy + 2 * k;
+            double d = hypot(a[2] - a[0], a[3] - a[1]);
+            len += d;
+            total += ceil(d / o->step) + 1;
+            longest = fmax(longest, ceil(d / o->step));
+        }
+    if (total > ROUTE_MAX_SAMPLES || longest > 1e7)
+        return cli_usage_error("route", "--step %g gives %.0f samples over the path's %.0f m (at most 1e8, "
+                               "1e7 a segment)", o->step, total, len);
+    return EXIT_OK;
+}
+
 static int score_all(plx_engine *e, const route_opts *o, route_set *rs)
 {
     geo_out g;
@@ -238,14 +260,14 @@ int cmd_route(int argc, char **argv)
         } else if (strcmp(a, "--geojson") == 0) {
             o.geojson = argv[++i];
         } else if (strcmp(a, "--step") == 0) {
-            if (cli_parse_double(argv[++i], &o.step) != 0 || !(o.step >= 0.01))
-                return cli_usage_error("route", "--step '%s' is not a number of metres >= 0.01", argv[i]);
+            if (cli_parse_real(argv[++i], 0.01, CLI_MAX_COORD, &o.step) != 0)
+                return cli_usage_error("route", "--step '%s' is not a number of metres from 0.01 to 1e7", argv[i]);
         } else if (strcmp(a, "--height") == 0) {
             if (cli_parse_double(argv[++i], &o.height) != 0 || !(o.height >= 0) || !(o.height <= 1000))
                 return cli_usage_error("route", "--height '%s' is not a number of metres from 0 to 1000", argv[i]);
         } else if (strcmp(a, "--dark-lux") == 0) {
-            if (cli_parse_double(argv[++i], &o.dark) != 0 || !(o.dark >= 0))
-                return cli_usage_error("route", "--dark-lux '%s' is not a number of lux >= 0", argv[i]);
+            if (cli_parse_real(argv[++i], 0, 1e9, &o.dark) != 0)
+                return cli_usage_error("route", "--dark-lux '%s' is not a number of lux from 0 to 1e9", argv[i]);
         } else if (a[0] == '-' && a[1] != '\0') {
             return cli_usage_error("route", "unknown option '%s'", a);
         } else if (!o.scene) {
@@ -266,7 +288,9 @@ int cmd_route(int argc, char **argv)
         plx_engine_free(e);
         return EXIT_FAIL;
     }
-    rc = score_all(e, &o, &rs);
+    rc = check_samples(&o, &rs);
+    if (rc == EXIT_OK)
+        rc = score_all(e, &o, &rs);
     route_free(&rs);
     plx_engine_free(e);
     return rc;
@@ -388,11 +412,14 @@ static int find_spots(plx_engine *e, double res, long count, double spacing, int
     g.x0 = si.bounds[0];
     g.y0 = si.bounds[1];
     g.res = res;
-    g.w = (size_t)floor((si.bounds[2] - si.bounds[0]) / res);
-    g.h = (size_t)floor((si.bounds[3] - si.bounds[1]) / res);
-    if (g.w * g.h == 0 || g.w * g.h > 2000000000u) {
-        fprintf(stderr, "polarlux dark-spots: --res %g gives %zu grid points (1 to 2e9)\n", res, g.w * g.h);
-        return EXIT_USAGE;
+    {   /* counted in doubles: no integer overflow for any finite --res */
+        double wd = floor((si.bounds[2] - si.bounds[0]) / res), hd = floor((si.bounds[3] - si.bounds[1]) / res);
+        if (!(wd * hd >= 1 && wd * hd <= 2e9)) {
+            fprintf(stderr, "polarlux dark-spots: --res %g gives %.3g grid points (1 to 2e9)\n", res, wd * hd);
+            return EXIT_USAGE;
+        }
+        g.w = (size_t)wd;
+        g.h = (size_t)hd;
     }
     rc = spot_scan(e, &g, all);
     if (rc != EXIT_OK)
@@ -483,10 +510,10 @@ int cmd_dark_spots(int argc, char **argv)
              strcmp(a, "-o") == 0) && i + 1 >= argc)
             return cli_usage_error("dark-spots", "%s needs a value", a);
         if (strcmp(a, "--res") == 0) {
-            if (cli_parse_double(argv[++i], &res) != 0 || !(res > 0))
+            if (cli_parse_real(argv[++i], 0, CLI_MAX_COORD, &res) != 0 || !(res > 0))
                 return cli_usage_error("dark-spots", "--res '%s' is not a positive number of metres", argv[i]);
         } else if (strcmp(a, "--spacing") == 0) {
-            if (cli_parse_double(argv[++i], &spacing) != 0 || !(spacing >= 0))
+            if (cli_parse_real(argv[++i], 0, CLI_MAX_COORD, &spacing) != 0)
                 return cli_usage_error("dark-spots", "--spacing '%s' is not a number of metres >= 0", argv[i]);
         } else if (strcmp(a, "--count") == 0) {
             if (cli_parse_int(argv[++i], 1, 1000000, &count) != 0)

@@ -4,7 +4,6 @@
 #include <string.h>
 
 #include "cli.h"
-#include "options.h"
 #include "geo_out.h"
 #include "points.h"
 
@@ -37,59 +36,47 @@ typedef struct vis_opts {
     cli_common c;
 } vis_opts;
 
-static int parse_pair(const char *s, double v[2])
-{
-    char buf[128];
-    char *comma;
-    if (strlen(s) >= sizeof buf)
-        return -1;
-    strcpy(buf, s);
-    comma = strchr(buf, ',');
-    if (!comma)
-        return -1;
-    *comma = '\0';
-    return cli_parse_double(buf, &v[0]) || cli_parse_double(comma + 1, &v[1]) ? -1 : 0;
-}
-
-static int parse_at(const char *v, void *dst)
-{
-    vis_opts *o = dst;
-    if (parse_pair(v, o->at) != 0)
-        return -1;
-    o->have_at = 1;
-    return 0;
-}
-
-static int parse_dir(const char *v, void *dst)
-{
-    return cli_parse_double(v, dst) != 0 || !isfinite(*(double *)dst);
-}
-
-static int parse_fov(const char *v, void *dst)
-{
-    return cli_parse_double(v, dst) != 0 || !(*(double *)dst > 0);
-}
-
 static int parse_args(int argc, char **argv, vis_opts *o)
 {
-    const cli_opt opts[] = {
-        { "--points", NULL, &o->points, NULL, NULL, 0, NULL },
-        { "--geojson", NULL, &o->geojson, NULL, NULL, 0, NULL },
-        { "--at", NULL, o, parse_at, "--at '%s' is not X,Y", 0, NULL },
-        { "--dir", NULL, &o->dir, parse_dir, "--dir '%s' is not a number of degrees", 0, NULL },
-        { "--fov", NULL, &o->fov, parse_fov, "--fov '%s' is not a positive number of degrees", 0, NULL },
-        CLI_OPT_END
-    };
-    cli_args pa;
-    int rc;
+    int i;
     memset(o, 0, sizeof *o);
     o->fov = 360.0;
-    rc = cli_options("vis", help, argc, argv, opts, &o->c, NULL, &pa);
-    if (rc != EXIT_OK)
-        return rc;
-    if (pa.npos > 1)
-        return cli_usage_error("vis", "unexpected argument '%s'", pa.pos[1]);
-    o->scene = pa.npos ? pa.pos[0] : NULL;
+    for (i = 1; i < argc; i++) {
+        const char *a = argv[i];
+        int r = cli_common_option("vis", argc, argv, &i, &o->c);
+        if (r < 0)
+            return EXIT_USAGE;
+        if (r)
+            continue;
+        if (strcmp(a, "--help") == 0 || strcmp(a, "-h") == 0) {
+            fputs(help, stdout);
+            return -1;
+        }
+        if ((strcmp(a, "--points") == 0 || strcmp(a, "--geojson") == 0 || strcmp(a, "--at") == 0 ||
+             strcmp(a, "--dir") == 0 || strcmp(a, "--fov") == 0) && i + 1 >= argc)
+            return cli_usage_error("vis", "%s needs a value", a);
+        if (strcmp(a, "--points") == 0) {
+            o->points = argv[++i];
+        } else if (strcmp(a, "--geojson") == 0) {
+            o->geojson = argv[++i];
+        } else if (strcmp(a, "--at") == 0) {
+            if (cli_parse_coords(argv[++i], o->at, 2) != 0)
+                return cli_usage_error("vis", "--at '%s' is not X,Y (finite, within 1e7 m)", argv[i]);
+            o->have_at = 1;
+        } else if (strcmp(a, "--dir") == 0) {
+            if (cli_parse_real(argv[++i], -1e6, 1e6, &o->dir) != 0)
+                return cli_usage_error("vis", "--dir '%s' is not a number of degrees", argv[i]);
+        } else if (strcmp(a, "--fov") == 0) {
+            if (cli_parse_real(argv[++i], 0, 1e6, &o->fov) != 0 || !(o->fov > 0))
+                return cli_usage_error("vis", "--fov '%s' is not a positive number of degrees", argv[i]);
+        } else if (a[0] == '-' && a[1] != '\0') {
+            return cli_usage_error("vis", "unknown option '%s'", a);
+        } else if (!o->scene) {
+            o->scene = a;
+        } else {
+            return cli_usage_error("vis", "unexpected argument '%s'", a);
+        }
+    }
     if (!o->scene)
         return cli_usage_error("vis", "missing SCENE");
     if (!o->points == !o->have_at)
@@ -117,7 +104,6 @@ static int run_points(plx_engine *e, const vis_opts *o, geo_out *g)
     size_t k;
     int failed = 0, rc;
     double *given = NULL;
-    cli_progress pr;
     if (points_read(o->points, 2, 2, NULL, &pts, err, sizeof err) != 0) {
         fprintf(stderr, "polarlux vis: %s\n", err);
         return EXIT_FAIL;
@@ -127,16 +113,13 @@ static int run_points(plx_engine *e, const vis_opts *o, geo_out *g)
         points_free(&pts);
         return rc;
     }
-    cli_progress_start(&pr);
     for (k = 0; k < pts.n; k++) {
         double x = pts.v[2 * k], y = pts.v[2 * k + 1], gx = given[2 * k], gy = given[2 * k + 1];
         plx_visibility v;
-        cli_progress_step(&pr, "vis", k + 1, pts.n);
         plx_status st = plx_visibility_get(e, x, y, o->dir, o->fov, &v);
         if (st != PLX_OK) {
             fprintf(stderr, "polarlux vis: %s:%zu: %s\n", o->points, pts.line[k], plx_last_error(e));
             if (st != PLX_E_RANGE) {
-                cli_progress_end(&pr);
                 points_free(&pts);
                 free(given);
                 return cli_exit_code(st);
@@ -150,7 +133,6 @@ static int run_points(plx_engine *e, const vis_opts *o, geo_out *g)
             add_polygon(g, &v, gx, gy);
     }
     points_free(&pts);
-    cli_progress_end(&pr);
     free(given);
     return failed ? EXIT_FAIL : EXIT_OK;
 }

@@ -1,4 +1,5 @@
 #include <errno.h>
+#include <math.h>
 #include <stdarg.h>
 #include <stdlib.h>
 #include <string.h>
@@ -48,7 +49,31 @@ int cli_parse_double(const char *s, double *out)
     char *end;
     errno = 0;
     *out = strtod(s, &end);
-    return (errno || end == s || *end != '\0' || *out != *out) ? -1 : 0;
+    return (errno || end == s || *end != '\0' || !isfinite(*out)) ? -1 : 0;
+}
+
+int cli_parse_real(const char *s, double lo, double hi, double *out)
+{
+    return cli_parse_double(s, out) != 0 || !(*out >= lo && *out <= hi) ? -1 : 0;
+}
+
+int cli_parse_coords(const char *s, double *v, int n)
+{
+    const char *p = s;
+    int k;
+    for (k = 0; k < n; k++) {
+        char buf[64];
+        const char *comma = k + 1 < n ? strchr(p, ',') : p + strlen(p);
+        size_t len = comma ? (size_t)(comma - p) : 0;
+        if (!comma || len == 0 || len >= sizeof buf)
+            return -1;
+        memcpy(buf, p, len);
+        buf[len] = '\0';
+        if (cli_parse_real(buf, -CLI_MAX_COORD, CLI_MAX_COORD, &v[k]) != 0)
+            return -1;
+        p = comma + 1;
+    }
+    return 0;
 }
 
 int cli_parse_int(const char *s, long lo, long hi, long *out)
@@ -134,7 +159,7 @@ static int load_ground_image(const char *cmd, const char *scene_path, plx_engine
     char *full;
     size_t dir;
     uint8_t *px = NULL;
-    int w = 0, h = 0;
+    int w = 0, h = 0, rc;
     char err[600];
     plx_status st;
     if (plx_ground_image_get(e, &gi) != PLX_OK || !gi.path)
@@ -148,10 +173,13 @@ static int load_ground_image(const char *cmd, const char *scene_path, plx_engine
     }
     memcpy(full, scene_path, dir);
     strcpy(full + dir, gi.path);
-    if (image_read_png_max(full, 16384, &px, &w, &h, err, sizeof err) != 0) {
-        fprintf(stderr, "polarlux %s: %s: ground image '%s': %s\n", cmd, scene_path, gi.path, err);
+    /* the decoded pixels count against --mem before they are decoded */
+    rc = image_read_png_budget(full, 16384, mem, &px, &w, &h, err, sizeof err);
+    if (rc != 0) {
+        fprintf(stderr, "polarlux %s: %s: ground image '%s': %s%s\n", cmd, scene_path, gi.path, err,
+                rc == -2 ? "; give it more with --mem" : "");
         free(full);
-        return EXIT_FAIL;
+        return rc == -2 ? EXIT_NOMEM : EXIT_FAIL;
     }
     st = plx_set_ground_image(e, (uint32_t)w, (uint32_t)h, px, NULL);
     free(px);
@@ -381,6 +409,9 @@ int cli_indirect_run(const char *cmd, plx_engine *e, const cli_indirect *ind, co
     unsigned long long t0 = port_now_ns();
     if (ind->off || ind->frames == 0)
         return EXIT_OK;
+    if ((double)ind->photons * (double)ind->frames > CLI_MAX_PHOTONS)
+        return cli_usage_error(cmd, "--photons %ld x --frames %ld is more than %.0f photons", ind->photons,
+                               ind->frames, CLI_MAX_PHOTONS);
     if (ind->gather >= 0 && plx_indirect_set_gather(e, (uint32_t)ind->gather) != PLX_OK) {
         fprintf(stderr, "polarlux %s: %s\n", cmd, plx_last_error(e));
         return EXIT_USAGE;

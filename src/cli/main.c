@@ -1,6 +1,7 @@
 /* polarlux: the command-line program. */
 #include <string.h>
 #include "cli.h"
+#include "posix/safe_out.h"
 
 typedef struct command {
     const char *name;
@@ -38,6 +39,17 @@ static void usage(FILE *f)
                "            2 usage error, 3 memory budget too small (--mem)\n");
 }
 
+/* An output option given "-" (standard output): the data gets the real
+ * standard output and the command's own report lines go to stderr. */
+static void claim_stdout_for_data(int argc, char **argv)
+{
+    int i;
+    for (i = 2; i + 1 < argc; i++)
+        if ((strcmp(argv[i], "-o") == 0 || strcmp(argv[i], "--pfm") == 0 || strcmp(argv[i], "--geojson") == 0) &&
+            strcmp(argv[i + 1], "-") == 0)
+            safe_out_claim_stdout();
+}
+
 int main(int argc, char **argv)
 {
     size_t i;
@@ -53,6 +65,7 @@ int main(int argc, char **argv)
         printf("polarlux %s\n", PLX_VERSION_STRING);
         return EXIT_OK;
     }
+    claim_stdout_for_data(argc, argv);
     for (i = 0; i < sizeof commands / sizeof commands[0]; i++)
         if (strcmp(argv[1], commands[i].name) == 0)
             return commands[i].run(argc - 1, argv + 1);

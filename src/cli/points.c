@@ -121,12 +121,41 @@ int points_parse(const char *name, const char *text, int need, int cols, const d
     return 0;
 }
 
-static char *read_stdin(char *err, size_t errlen)
+int points_check_text(const char *name, const char *text, size_t len, char *err, size_t errlen)
+{
+    size_t i, line = 1, start = 0;
+    for (i = 0; i < len; i++) {
+        if (text[i] == '\0') {
+            snprintf(err, errlen, "%s:%zu: a NUL byte at byte %zu (not a text file?)", name, line, i);
+            return -1;
+        }
+        if (i - start >= POINTS_MAX_LINE) {
+            snprintf(err, errlen, "%s:%zu: line longer than %d bytes", name, line, POINTS_MAX_LINE);
+            return -1;
+        }
+        if (text[i] == '\n') {
+            line++;
+            start = i + 1;
+        }
+    }
+    if (len > 0 && text[len - 1] != '\n') {
+        snprintf(err, errlen, "%s:%zu: the last line does not end with a newline (truncated file?)", name, line);
+        return -1;
+    }
+    return 0;
+}
+
+static char *read_stdin(size_t *lenp, char *err, size_t errlen)
 {
     size_t len = 0, cap = 1 << 16, got;
     char *buf = malloc(cap);
     while (buf && (got = fread(buf + len, 1, cap - len - 1, stdin)) > 0) {
         len += got;
+        if (len + 1 == cap && cap >= POINTS_MAX_STDIN) {
+            snprintf(err, errlen, "standard input: more than %d MiB of points", POINTS_MAX_STDIN >> 20);
+            free(buf);
+            return NULL;
+        }
         if (len + 1 == cap) {
             char *nb = realloc(buf, cap * 2);
             if (!nb) {
@@ -143,6 +172,7 @@ static char *read_stdin(char *err, size_t errlen)
         return NULL;
     }
     buf[len] = '\0';
+    *lenp = len;
     return buf;
 }
 
@@ -151,17 +181,24 @@ int points_read(const char *path, int need, int cols, const double *fill, points
 {
     char *text;
     int rc;
+    size_t len = 0;
     char why[256];
+    const char *name = strcmp(path, "-") == 0 ? "<stdin>" : path;
+    memset(out, 0, sizeof *out);
     if (strcmp(path, "-") == 0) {
-        text = read_stdin(err, errlen);
+        text = read_stdin(&len, err, errlen);
     } else {
-        text = port_read_text(path, NULL, why, sizeof why);
+        text = port_read_text(path, &len, why, sizeof why);
         if (!text)
             snprintf(err, errlen, "%s: %s", path, why);
     }
     if (!text)
         return -1;
-    rc = points_parse(strcmp(path, "-") == 0 ? "<stdin>" : path, text, need, cols, fill, out, err, errlen);
+    if (points_check_text(name, text, len, err, errlen) != 0) {
+        free(text);
+        return -1;
+    }
+    rc = points_parse(name, text, need, cols, fill, out, err, errlen);
     free(text);
     return rc;
 }

@@ -19,7 +19,15 @@ typedef struct points {
  * "NAME:LINE: why" in err. */
 int points_parse(const char *name, const char *text, int need, int cols, const double *fill,
                  points *out, char *err, size_t errlen);
-/* Reads and parses a file ("-" is standard input). */
+/* Text inputs are read whole or refused: a NUL byte, a line longer than
+ * POINTS_MAX_LINE bytes or a last line without its newline is an error
+ * "NAME:LINE: why" (never the silent end of the file). Standard input is
+ * read up to POINTS_MAX_STDIN bytes. */
+#define POINTS_MAX_LINE 4096
+#define POINTS_MAX_STDIN (1 << 30)
+int points_check_text(const char *name, const char *text, size_t len, char *err, size_t errlen);
+/* Reads, checks and parses a file ("-" is standard input; a FIFO, a device
+ * or a directory is refused). */
 int points_read(const char *path, int need, int cols, const double *fill, points *out,
                 char *err, size_t errlen);
 void points_free(points *p);

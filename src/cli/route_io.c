@@ -7,6 +7,9 @@
 #include "port.h"
 #include "route_io.h"
 
+/* The bound of scene coordinates (README, "Scene format"). */
+#define ROUTE_MAX_COORD 1e7
+
 typedef struct frame {
     int lonlat;           /* the path file is in lon/lat */
     plx_engine *e;        /* for plx_lonlat_to_local */
@@ -58,6 +61,11 @@ static int add_line(route_set *rs, size_t *cap, const char *name, const cJSON *c
             plx_lonlat_to_local(f->e, 1, ll, xy);
             vx = xy[0];
             vy = xy[1];
+        }
+        if (fabs(vx) > ROUTE_MAX_COORD || fabs(vy) > ROUTE_MAX_COORD) {
+            snprintf(why, whylen, "position %u (%g, %g) is more than 1e7 m from the origin", k, vx, vy);
+            free(l->xy);
+            return -1;
         }
         l->xy[2 * k] = vx;
         l->xy[2 * k + 1] = vy;

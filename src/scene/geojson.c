@@ -25,6 +25,7 @@
 
 #include "base/geom.h"
 #include "base/lonlat.h"
+#include "scene/lampmerge.h"
 #include "scene/blocks.h"
 #include "base/jsonscan.h"
 #include "scene/loader.h"
@@ -449,6 +450,9 @@ static plx_status load(plx_engine *e, loader *ld, scene **out)
     if (st != PLX_OK)
         return st;
     st = ld_drop_buried_lamps(ld);
+    if (st != PLX_OK)
+        return st;
+    st = ld_merge_duplicate_lamps(ld);
     if (st != PLX_OK)
         return st;
     st = blocks_build(ld->mem, s, BLOCK_TOLERANCE);

@@ -1,0 +1,235 @@
+#!/bin/sh
+# The hostile corpus: absurd and non-finite option values, special files as
+# inputs and outputs (devices, FIFOs, directories, symlinks, "-"), a full
+# disk, for every command; each case with its exact exit code and message.
+# Every failure must say why on stderr (never only on stdout) and no case may
+# wait forever (each runs under timeout). PLX_HOSTILE_WRAP prefixes every
+# run of the command (make check-hostile-valgrind sets it to valgrind).
+# usage: tests/cli/hostile.sh path/to/polarlux ; prints "hostile: N passed, N failed".
+bin=$1
+build=$(dirname "$bin")
+shim="$build/tests/failwrite.so"
+tmp=$(mktemp -d)
+trap 'rm -rf "$tmp"' EXIT
+pass=0; fail=0
+pre=            # environment for the next runs (the failing-disk shim)
+T=fixtures/tiny.geojson
+ok() { echo "ok   $1"; pass=$((pass + 1)); }
+bad() { echo "FAIL $1"; fail=$((fail + 1)); }
+
+# expect NAME CODE PATTERN -- polarlux-args...: exit code CODE; on failure
+# PATTERN (grep -E) must be on stderr, on success in stdout+stderr.
+expect() {
+    name=$1; code=$2; pattern=$3; shift 4
+    timeout ${PLX_HOSTILE_TIMEOUT:-60} env $pre $PLX_HOSTILE_WRAP "$bin" "$@" >"$tmp/out" 2>"$tmp/err" </dev/null; rc=$?
+    if [ "$rc" -ne "$code" ]; then
+        bad "$name: exit $rc, want $code"; cat "$tmp/out" "$tmp/err" | sed 's/^/    /' | head -20; return
+    fi
+    where="$tmp/err"
+    [ "$code" -eq 0 ] && { cat "$tmp/out" "$tmp/err" >"$tmp/both"; where="$tmp/both"; }
+    if [ -n "$pattern" ] && ! grep -Eq -- "$pattern" "$where"; then
+        bad "$name: $( [ "$code" -eq 0 ] && echo output || echo stderr ) lacks /$pattern/"
+        cat "$tmp/out" "$tmp/err" | sed 's/^/    /' | head -20; return
+    fi
+    ok "$name"
+}
+is_png() { [ "$(head -c 4 "$1" | od -An -c | tr -d ' ')" = "211PNG" ]; }
+
+# ---- safe outputs ---------------------------------------------------------
+for dev in /dev/full /dev/null; do
+    [ -c $dev ] || continue
+    want=0; msg=""
+    [ $dev = /dev/full ] && { want=1; msg="cannot write '/dev/full': No space left on device"; }
+    expect "gen-o-$dev" $want "$msg" -- gen grid 3 3 -o $dev
+    expect "heatmap-o-$dev" $want "$msg" -- heatmap -q $T --res 2 -o $dev
+    expect "draw-o-$dev" $want "$msg" -- draw -q $T --polar 0 --size 50 -o $dev
+    expect "render-o-$dev" $want "$msg" -- render -q --no-indirect $T --size 16x12 -o $dev
+    expect "render-pfm-$dev" $want "$msg" -- render -q --no-indirect $T --size 16x12 -o "$tmp/r.png" --pfm $dev
+    expect "lit-o-$dev" $want "$msg" -- lit -q $T --lamp L1 -o $dev
+    expect "vis-geojson-$dev" $want "$msg" -- vis -q $T --at 30,30 --geojson $dev
+    if [ -c $dev ]; then ok "$dev-still-a-device"; else bad "$dev replaced"; fi
+done
+# a symlink is written through: the link stays, its target gets the PNG
+echo old >"$tmp/real.png"; ln -s real.png "$tmp/link.png"
+expect symlink-write 0 "" -- heatmap -q $T --res 2 -o "$tmp/link.png"
+if [ -L "$tmp/link.png" ] && is_png "$tmp/real.png"; then ok symlink-kept; else bad "symlink-kept"; fi
+ln -s nowhere/x.png "$tmp/dangling.png"
+expect symlink-dangling 1 "dangling.png' is a symbolic link to nowhere" -- heatmap -q $T --res 2 -o "$tmp/dangling.png"
+# a FIFO is written directly, never renamed over
+mkfifo "$tmp/fifo"
+cat "$tmp/fifo" >"$tmp/fifo.out" &
+expect fifo-write 0 "" -- gen grid 2 2 -o "$tmp/fifo"
+wait
+"$bin" gen grid 2 2 >"$tmp/gen.out"
+if [ -p "$tmp/fifo" ] && cmp -s "$tmp/fifo.out" "$tmp/gen.out"; then ok fifo-kept; else bad fifo-kept; fi
+# "-": the data on stdout, the report line on stderr
+timeout 60 "$bin" heatmap -q $T --res 2 -o - >"$tmp/stdout.png" 2>"$tmp/err"; rc=$?
+if [ $rc -eq 0 ] && is_png "$tmp/stdout.png" && grep -q "^heatmap: .* written to -" "$tmp/err"; then ok stdout-png
+else bad "stdout-png: exit $rc"; fi
+timeout 60 "$bin" render -q --no-indirect $T --size 16x12 -o "$tmp/r.png" --pfm - >"$tmp/stdout.pfm" 2>/dev/null; rc=$?
+if [ $rc -eq 0 ] && [ "$(head -c 2 "$tmp/stdout.pfm")" = "PF" ]; then ok stdout-pfm; else bad "stdout-pfm: exit $rc"; fi
+expect output-directory 1 "'$tmp' is a directory" -- gen grid 2 2 -o "$tmp"
+# a failing disk (LD_PRELOAD stand-in): exit 1, old targets untouched, no temporary file left
+if [ -f "$shim" ]; then
+    "$bin" gen grid 2 2 -o "$tmp/old.geojson"; cp "$tmp/old.geojson" "$tmp/old.copy"
+    for mode in ENOSPC EIO EFBIG SHORT; do
+        case $mode in ENOSPC|SHORT) why="No space left on device";; EIO) why="Input/output error";; EFBIG) why="File too large";; esac
+        pre="LD_PRELOAD=$shim ASAN_OPTIONS=verify_asan_link_order=0 PLX_FAILWRITE_MATCH=old.geojson.tmp
+             PLX_FAILWRITE_AFTER=5000 PLX_FAILWRITE_ERRNO=$mode"
+        expect "gen-disk-$mode" 1 "^polarlux gen: cannot write '$tmp/old.geojson': $why$" -- gen eixample 3 3 -o "$tmp/old.geojson"
+    done
+    pre="LD_PRELOAD=$shim ASAN_OPTIONS=verify_asan_link_order=0 PLX_FAILWRITE_MATCH=old.geojson.tmp PLX_FAILWRITE_AFTER=100000000 PLX_FAILWRITE_FSYNC=1"
+    expect gen-disk-fsync 1 "^polarlux gen: cannot write '$tmp/old.geojson': Input/output error$" -- gen eixample 3 3 -o "$tmp/old.geojson"
+    if cmp -s "$tmp/old.geojson" "$tmp/old.copy"; then ok gen-disk-old-kept; else bad gen-disk-old-kept; fi
+    # PNG + PFM belong together: the PFM fails, so neither is replaced
+    pre=
+    "$bin" render -q --no-indirect $T --size 16x12 -o "$tmp/pair.png" --pfm "$tmp/pair.pfm" >/dev/null
+    cp "$tmp/pair.png" "$tmp/pair.png.copy"; cp "$tmp/pair.pfm" "$tmp/pair.pfm.copy"
+    pre="LD_PRELOAD=$shim ASAN_OPTIONS=verify_asan_link_order=0 PLX_FAILWRITE_MATCH=pair.pfm.tmp"
+    expect render-pfm-fails 1 "^polarlux render: cannot write '$tmp/pair.pfm': No space left on device$" -- \
+        render -q --no-indirect $T --size 24x16 -o "$tmp/pair.png" --pfm "$tmp/pair.pfm"
+    pre=
+    if cmp -s "$tmp/pair.png" "$tmp/pair.png.copy" && cmp -s "$tmp/pair.pfm" "$tmp/pair.pfm.copy"; then
+        ok render-pair-kept; else bad render-pair-kept; fi
+else
+    bad "no $shim (make check builds it)"
+fi
+# a full small filesystem: a 64 KiB tmpfs in a mount namespace of its own, where permitted
+if [ "$(id -u)" = 0 ] && unshare -m true 2>/dev/null; then
+    mkdir -p "$tmp/mnt"
+    unshare -m sh -c "mount -t tmpfs -o size=64k tmpfs '$tmp/mnt' &&
+        '$bin' gen grid 2 2 -o '$tmp/mnt/c.geojson' && cp '$tmp/mnt/c.geojson' '$tmp/c.copy' &&
+        { '$bin' gen eixample 4 4 -o '$tmp/mnt/c.geojson' 2>'$tmp/mnt.err'; echo \$? >'$tmp/mnt.rc'; } ;
+        cmp -s '$tmp/mnt/c.geojson' '$tmp/c.copy' && echo same >'$tmp/mnt.same';
+        ls '$tmp/mnt' >'$tmp/mnt.ls'"
+    if [ "$(cat "$tmp/mnt.rc" 2>/dev/null)" = 1 ] && [ -f "$tmp/mnt.same" ] && [ "$(cat "$tmp/mnt.ls")" = c.geojson ] &&
+        grep -q "cannot write '$tmp/mnt/c.geojson': No space left on device" "$tmp/mnt.err"; then
+        ok tmpfs-full
+    else
+        bad "tmpfs-full: exit $(cat "$tmp/mnt.rc" 2>/dev/null), $(cat "$tmp/mnt.err" 2>/dev/null), files: $(cat "$tmp/mnt.ls" 2>/dev/null)"
+    fi
+else
+    echo "skip tmpfs-full (needs root and unshare -m; the LD_PRELOAD stand-in above covers it)"
+fi
+# ---- hostile option values: exit 2 before any work, naming the option -------
+U="is not"   # every refusal says what is wrong with the value
+values="inf -inf nan 1e400 0x1p2000"
+[ -n "$PLX_TEST_QUICK" ] && values="inf nan"   # make check: two of them
+for v in $values; do
+    expect "heatmap-max-$v" 2 "^polarlux heatmap: --max '$v' $U a number of lux above 0.1 \(at most 1e9\)" -- heatmap $T --max $v -o "$tmp/h.png"
+    expect "heatmap-res-$v" 2 "^polarlux heatmap: --res '$v' $U a positive number of metres" -- heatmap $T --res $v -o "$tmp/h.png"
+    expect "route-step-$v" 2 "^polarlux route: --step '$v' $U a number of metres from 0.01 to 1e7" -- route $T --path fixtures/helsinki-route.geojson --step $v
+    expect "route-dark-$v" 2 "^polarlux route: --dark-lux '$v' $U a number of lux" -- route $T --path fixtures/helsinki-route.geojson --dark-lux $v
+    expect "render-fov-$v" 2 "^polarlux render: --fov '$v' $U between 0 and 180" -- render $T --fov $v -o "$tmp/r.png"
+    expect "render-exposure-$v" 2 "^polarlux render: --exposure '$v' $U a number from 0 to 1e9" -- render $T --exposure $v -o "$tmp/r.png"
+    expect "render-texel-$v" 2 "^polarlux render: --texel '$v' $U a number of metres from 0.01 to 1e4" -- render $T --texel $v -o "$tmp/r.png"
+    expect "vis-dir-$v" 2 "^polarlux vis: --dir '$v' $U a number of degrees" -- vis $T --at 30,30 --dir $v
+    expect "vis-fov-$v" 2 "^polarlux vis: --fov '$v' $U a positive number of degrees" -- vis $T --at 30,30 --fov $v
+    expect "dark-spots-res-$v" 2 "^polarlux dark-spots: --res '$v' $U a positive number of metres" -- dark-spots $T --res $v
+    expect "dark-spots-spacing-$v" 2 "^polarlux dark-spots: --spacing '$v' $U a number of metres" -- dark-spots $T --spacing $v
+    expect "nightify-threshold-$v" 2 "^polarlux nightify: --dark-threshold '$v' $U 0..255" -- nightify a.png b.png -o "$tmp/n.png" --dark-threshold $v
+    expect "info-mem-$v" 2 "^polarlux info: --mem '$v' $U a size" -- info --mem $v $T
+done
+for box in 0,0,inf,10 0,0,10,nan -inf,0,10,10 0,0,4294967296,4294967296 0,0,6442450944,8589934592 0,0,1e308,1e308 1,2,3 0,0,10,10,10 10,0,0,10; do
+    expect "heatmap-box-$box" 2 "^polarlux heatmap: --box '$box' $U X0,Y0,X1,Y1 with X1 > X0 and Y1 > Y0 \(finite, within 1e7 m\)" -- heatmap $T --res 1 --box $box -o "$tmp/h.png"
+done
+printf '50 10\n' >"$tmp/p.txt"
+expect heatmap-pixels 2 "^polarlux heatmap: --res 0.001 over a box of 10000000 x 10000000 m gives 10000000000x10000000000 pixels \(at most 5e7, 1e6 a side\)" -- heatmap -q $T --res 0.001 --box 0,0,1e7,1e7 -o "$tmp/h.png"
+expect heatmap-res-tiny 2 "^polarlux heatmap: --res 1e-300 over a box of " -- heatmap -q $T --res 1e-300 -o "$tmp/h.png"
+expect heatmap-max-huge 2 "^polarlux heatmap: --max '1e300'" -- heatmap $T --max 1e300 -o "$tmp/h.png"
+expect heatmap-max-ok 0 "scale 0.1..1e\+09 lx" -- heatmap -q $T --res 4 --max 1e9 -o "$tmp/h.png"
+expect dark-spots-res-tiny 2 "^polarlux dark-spots: --res 1e-300 gives inf grid points \(1 to 2e9\)$" -- dark-spots -q $T --res 1e-300
+expect dark-spots-count 2 "^polarlux dark-spots: --count '99999999999999999999' $U 1..1000000" -- dark-spots $T --count 99999999999999999999
+for eye in 1e9,0,2 0,-1e308,2 inf,0,2 0,0,1e6 0,0 0,0,2,2 ,, 1e7,0,2x; do
+    expect "render-eye-$eye" 2 "^polarlux render: --eye '$eye' $U X,Y,Z \(finite, x and y within 1e7 m, z within 1e5 m\)" -- render $T --eye $eye --target 50,10,2 -o "$tmp/r.png"
+done
+expect render-target-huge 2 "^polarlux render: --target '1e308,0,0' $U X,Y,Z" -- render $T --eye 30,30,2 --target 1e308,0,0 -o "$tmp/r.png"
+expect render-size-huge 2 "^polarlux render: --size '100000x100000' $U WxH \(1..8192 each\)" -- render $T --size 100000x100000 -o "$tmp/r.png"
+expect render-size-overflow 2 "^polarlux render: --size '99999999999999999999x2' $U WxH" -- render $T --size 99999999999999999999x2 -o "$tmp/r.png"
+expect render-photons-frames 2 "^polarlux render: --photons 100000000 x --frames 100000 is more than 4294967296 photons" -- render -q $T --photons 100000000 --frames 100000 -o "$tmp/r.png"
+expect illum-photons-frames 2 "^polarlux illum: --photons 70000 x --frames 100000 is more than 4294967296 photons" -- illum -q $T --points "$tmp/p.txt" --photons 70000 --frames 100000
+expect illum-photons-huge 2 "^polarlux illum: --photons '1e9' $U a whole number in range" -- illum $T --points - --photons 1e9
+for at in 1e9,0 0,1e308 nan,0 0,inf 1,2,3 1; do
+    expect "vis-at-$at" 2 "^polarlux vis: --at '$at' $U X,Y \(finite, within 1e7 m\)" -- vis $T --at $at
+done
+expect gen-n-huge 2 "^polarlux gen: NX and NY must be whole numbers from 1 to 1000" -- gen grid 100000 100000
+expect gen-seed-bad 2 "^polarlux gen: --seed '1e9' $U a whole number" -- gen grid 2 2 --seed 1e9
+expect draw-size-huge 2 "^polarlux draw: --size" -- draw $T --polar 0 --size 1000000 -o "$tmp/d.png"
+expect draw-polar-huge 2 "^polarlux draw: --polar '4294967296' $U a quadrant 0..3" -- draw $T --polar 4294967296 -o "$tmp/d.png"
+expect info-mem-huge 2 "^polarlux info: --mem '1e300' $U a size" -- info --mem 1e300 $T
+pre=ASAN_OPTIONS=allocator_may_return_null=1   # a sanitizer build refuses the malloc itself
+expect info-mem-exabyte 3 "^polarlux info: cannot create an engine of [0-9]+ bytes" -- info --mem 900000G $T
+pre=
+# route paths: coordinates beyond 1e7 m, and more samples than allowed at --step
+printf '{"type":"FeatureCollection","properties":{"units":"m"},"features":[{"type":"Feature","properties":{},"geometry":{"type":"LineString","coordinates":[[-1e308,0],[1e308,0]]}}]}\n' >"$tmp/far.json"
+expect route-path-1e308 1 "^polarlux route: $tmp/far.json: feature 0: position 0 \(-1e\+308, 0\) is more than 1e7 m from the origin$" -- route -q $T --path "$tmp/far.json"
+expect heatmap-path-1e308 1 "^polarlux heatmap: $tmp/far.json: feature 0: position 0 \(-1e\+308, 0\) is more than 1e7 m from the origin$" -- heatmap -q $T --path "$tmp/far.json" -o "$tmp/h.png"
+printf '{"type":"FeatureCollection","properties":{"units":"m"},"features":[{"type":"Feature","properties":{},"geometry":{"type":"LineString","coordinates":[[0,0],[1e9,0]]}}]}\n' >"$tmp/far9.json"
+expect route-path-1e9 1 "position 1 \(1e\+09, 0\) is more than 1e7 m from the origin$" -- route -q $T --path "$tmp/far9.json"
+printf '{"type":"FeatureCollection","properties":{"units":"m"},"features":[{"type":"Feature","properties":{},"geometry":{"type":"LineString","coordinates":[[0,0],[9e6,0],[0,0],[9e6,0]]}}]}\n' >"$tmp/long.json"
+expect route-step-samples 2 "^polarlux route: --step 0.01 gives 2700000003 samples over the path's 27000000 m \(at most 1e8, 1e7 a segment\)" -- route -q $T --path "$tmp/long.json" --step 0.01
+expect route-step-segment 2 "^polarlux route: --step 0.5 gives 54000003 samples over the path's 27000000 m \(at most 1e8, 1e7 a segment\)" -- route -q $T --path "$tmp/long.json" --step 0.5
+
+# ---- special files as inputs: refused at once, never waited on ---------------
+mkfifo "$tmp/in.fifo"
+for f in "$tmp/in.fifo" /dev/zero "$tmp"; do
+    case $f in *fifo) kind="a FIFO";; /dev/zero) kind="a device";; *) kind="a directory";; esac
+    n=$(basename "$f")
+    expect "info-scene-$n" 1 "^polarlux info: $f: not a regular file \($kind\)$" -- info "$f"
+    expect "vis-points-$n" 1 "^polarlux vis: $f: not a regular file \($kind\)$" -- vis -q $T --points "$f"
+    expect "illum-points-$n" 1 "^polarlux illum: $f: not a regular file \($kind\)$" -- illum -q $T --points "$f"
+    expect "route-path-$n" 1 "^polarlux route: $f: not a regular file \($kind\)$" -- route -q $T --path "$f"
+    expect "heatmap-path-$n" 1 "^polarlux heatmap: $f: not a regular file \($kind\)$" -- heatmap -q $T --path "$f" -o "$tmp/h.png"
+    expect "nightify-day-$n" 1 "^polarlux nightify: read_png: '$f' is not a regular file$" -- nightify "$f" "$f" -o "$tmp/n.png"
+done
+mkdir -p "$tmp/gi"; cp fixtures/ground-image.geojson "$tmp/gi/s.geojson"; mkfifo "$tmp/gi/ground-day.png"
+expect ground-image-fifo 1 "^polarlux info: $tmp/gi/s.geojson: ground image 'ground-day.png': read_png: '$tmp/gi/ground-day.png' is not a regular file$" -- info "$tmp/gi/s.geojson"
+# text inputs read whole or refused
+printf '50 10\n50 12\0\n50 14\n' >"$tmp/nul.txt"
+expect points-nul 1 "^polarlux vis: $tmp/nul.txt:2: a NUL byte at byte 11 \(not a text file\?\)$" -- vis -q $T --points "$tmp/nul.txt"
+printf '50 10\n50 12' >"$tmp/trunc.txt"
+expect points-truncated 1 "^polarlux vis: $tmp/trunc.txt:2: the last line does not end with a newline \(truncated file\?\)$" -- vis -q $T --points "$tmp/trunc.txt"
+{ printf '50 10\n'; head -c 5000 /dev/zero | tr '\0' ' '; printf '50 12\n'; } >"$tmp/long.txt"
+expect points-long-line 1 "^polarlux illum: $tmp/long.txt:2: line longer than 4096 bytes$" -- illum -q $T --points "$tmp/long.txt"
+printf '50 10\0garbage' >"$tmp/nul2.txt"
+timeout 60 "$bin" vis -q $T --points - <"$tmp/nul2.txt" >/dev/null 2>"$tmp/err"; rc=$?
+if [ $rc -eq 1 ] && grep -q "^polarlux vis: <stdin>:1: a NUL byte at byte 5 (not a text file?)$" "$tmp/err"; then ok points-stdin-nul
+else bad "points-stdin-nul: exit $rc, $(cat "$tmp/err")"; fi
+# images: the decoded size counts against --mem before decoding
+/usr/bin/python3 - "$tmp" <<'PY'
+import struct, sys, zlib
+def png(path, w, h):
+    def chunk(t, d):
+        return struct.pack(">I", len(d)) + t + d + struct.pack(">I", zlib.crc32(t + d) & 0xffffffff)
+    ihdr = struct.pack(">IIBBBBB", w, h, 8, 2, 0, 0, 0)
+    open(path, "wb").write(b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", ihdr) + chunk(b"IDAT", zlib.compress(b"\0" * 64)) + chunk(b"IEND", b""))
+png(sys.argv[1] + "/huge.png", 1000000, 1000000)
+png(sys.argv[1] + "/mid.png", 1000, 1000)
+PY
+expect nightify-huge-header 3 "^polarlux nightify: read_png: '$tmp/huge.png' is 1000000x1000000 pixels: decoding needs 3000000000000 bytes, more than the 1073741824 the memory budget allows; give it more with --mem$" -- nightify "$tmp/huge.png" "$tmp/huge.png" -o "$tmp/n.png"
+expect nightify-mid-small-mem 3 "^polarlux nightify: read_png: '$tmp/mid.png' is 1000x1000 pixels: decoding needs 3000000 bytes, more than the 1048576 the memory budget allows" -- nightify --mem 1M "$tmp/mid.png" "$tmp/mid.png" -o "$tmp/n.png"
+cp "$tmp/mid.png" "$tmp/gi/ground-day.png.new"; rm "$tmp/gi/ground-day.png"; mv "$tmp/gi/ground-day.png.new" "$tmp/gi/ground-day.png"
+expect ground-image-over-mem 3 "^polarlux info: $tmp/gi/s.geojson: ground image 'ground-day.png': read_png: '$tmp/gi/ground-day.png' is 1000x1000 pixels: decoding needs 3000000 bytes, more than the 2097152 the memory budget allows; give it more with --mem$" -- info --mem 2M "$tmp/gi/s.geojson"
+# the eye inside a building: a warning
+expect render-eye-inside 0 "^polarlux render: warning: --eye \(5, 5, 3\) is inside building 0 \(A\) \(0 to 10 m high\): the image shows the inside of its walls$" -- render --no-indirect $T --eye 5,5,3 --target 50,10,2 --size 16x12 -o "$tmp/r.png"
+# 1,000 lamps at one spot: merged into one with a warning (tests/unit/test_lampmerge.c checks the light)
+{ printf '{"type":"FeatureCollection","properties":{"units":"m"},"features":['
+  i=0; while [ $i -lt 999 ]; do printf '{"type":"Feature","properties":{"lamp":true,"intensity":10},"geometry":{"type":"Point","coordinates":[5,5]}},'; i=$((i + 1)); done
+  printf '{"type":"Feature","properties":{"lamp":true,"intensity":10},"geometry":{"type":"Point","coordinates":[5,5]}}]}\n'; } >"$tmp/dup.geojson"
+expect lamps-duplicate-warning 0 "warning: $tmp/dup.geojson: feature 0 \(line 1, column [0-9]+\): 1000 lamps at one spot \(5, 5, 6\) merged into this one: 10000 cd$" -- info "$tmp/dup.geojson"
+expect lamps-duplicate-info 0 "^duplicate lamps: 999 merged into lamps at the same spot$" -- info -q "$tmp/dup.geojson"
+expect lamps-duplicate-count 0 "^lamps: 1$" -- info -q "$tmp/dup.geojson"
+# info --min-mem: the printed budget loads, 8 KiB less does not
+n=$("$bin" info -q --min-mem $T | sed -n 's/^smallest --mem: \([0-9]*\) bytes.*/\1/p')
+if [ -n "$n" ]; then
+    expect min-mem-fits 0 "^buildings: 4 " -- info -q --mem "$n" $T
+    expect min-mem-less 3 "out of memory" -- info -q --mem $((n - 8192)) $T
+else
+    bad "info --min-mem printed no budget"
+fi
+# exit 3 says so on stderr
+expect info-nomem-stderr 3 "out of memory" -- info --mem 8K fixtures/helsinki-centre.geojson
+
+ls "$tmp"/*.tmp* >/dev/null 2>&1 && bad "temporary files left: $(ls "$tmp"/*.tmp*)"
+echo "hostile: $pass passed, $fail failed"
+[ "$fail" -eq 0 ]
