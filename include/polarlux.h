@@ -470,6 +470,59 @@ typedef int (*plx_write_fn)(void *ctx, const char *data, size_t len);
 plx_status plx_gen_city(const char *style, int nx, int ny, uint64_t seed,
                         plx_write_fn write, void *ctx);
 
+/* ---- Bake files: build once, load without rebuilding (README "Bake files") */
+
+typedef struct plx_bake_opts {
+    int aerial;                 /* 1: build the aerial light map too */
+    double aerial_m_per_texel;  /* its resolution (0: 1 m) */
+    int no_indirect;            /* 1: no photon buffers */
+    int twin;                   /* 1: the twin engine (see plx_bake_save): the same memory
+                                   layout without the light map's shading */
+} plx_bake_opts;
+
+/*
+ * Builds everything queries and frames need for the loaded scene: polar
+ * diagrams, lamp light, photon buffers (levels for a viewer at the centre
+ * of Bounds, all around), the renderer and, with o->aerial, the aerial light
+ * map. Photon frames are then added with plx_indirect_step.
+ */
+plx_status plx_bake_prepare(plx_engine *e, const plx_bake_opts *o);
+
+/*
+ * Bytes of the bake file of e, and the file itself written into the
+ * caller's buffer (the core does no I/O). twin: a second engine in another
+ * block, with the same scene loaded (and the same ground image) and
+ * plx_bake_prepare called with the same options and twin = 1, but no photon
+ * frames; the words that differ between the two by exactly the distance of
+ * their blocks are the pointers, saved as offsets. Both blocks must have
+ * the same address modulo 64. Errors: PLX_E_INVALID (no twin of the same
+ * layout, buffer too small), PLX_E_UNSUPPORTED (a code address would be
+ * saved), PLX_E_NOSCENE.
+ */
+plx_status plx_bake_size(plx_engine *e, plx_engine *twin, size_t *bytes /* OUT */);
+plx_status plx_bake_save(plx_engine *e, plx_engine *twin, void *buf, size_t cap,
+                         size_t *written /* OUT */);
+
+/*
+ * Size first: checks the bake's header and checksum and gives the block
+ * size to pass to plx_bake_load (the image plus room for queries).
+ * Errors (one line in err): PLX_E_PARSE (not a bake, truncated, corrupt),
+ * PLX_E_UNSUPPORTED (another format version, architecture or build).
+ */
+plx_status plx_bake_block_size(const void *bake, size_t len, size_t *block_bytes /* OUT */, char *err,
+                               size_t errlen);
+
+/*
+ * Creates an engine in the caller's block from a bake: one copy of the
+ * image and the relocation of its pointers, no parsing, no rebuilding.
+ * cfg gives the port, strictness and part budgets (the lit cache and the
+ * render maximum stay the bake's). The bake buffer may be freed after.
+ * Errors as plx_bake_block_size, plus PLX_E_NOMEM (block too small) and
+ * PLX_E_INVALID; err gets one line.
+ */
+plx_status plx_bake_load(void *mem, size_t size, const plx_config *cfg, const void *bake, size_t len,
+                         plx_engine **engine /* OUT */, char *err, size_t errlen);
+
 /* ---- POSIX port (port/posix) ----------------------------------------- */
 
 /* The POSIX services: clock_gettime, stderr logging, stdio files. */

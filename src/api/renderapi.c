@@ -24,7 +24,7 @@ static void shade_indirect(void *user, const double P[3], const double n[3], dou
     eng_indirect_rgb(user, P, n, rgb);
 }
 
-static plx_status need_render(plx_engine *e)
+plx_status eng_need_render(plx_engine *e)
 {
     int32_t w = e->cfg.render_max_width ? e->cfg.render_max_width : DEFAULT_MAX_W;
     int32_t h = e->cfg.render_max_height ? e->cfg.render_max_height : DEFAULT_MAX_H;
@@ -39,6 +39,35 @@ static plx_status need_render(plx_engine *e)
         return eng_nomem(e, "creating the renderer (frame buffers and mesh)");
     if (st != PLX_OK)
         return eng_fail(e, st, "creating the renderer failed");
+    return PLX_OK;
+}
+
+/* A shader giving no light: the bake's twin engine builds its light map
+ * with it (same memory layout, none of the work; src/api/bake.c). */
+static void shade_none(void *user, const double P[3], const double n[3], double rgb[3])
+{
+    (void)user;
+    (void)P;
+    (void)n;
+    rgb[0] = rgb[1] = rgb[2] = 0.0;
+}
+
+plx_status eng_need_lightmap(plx_engine *e, double m_per_texel, int dark)
+{
+    double cell = m_per_texel > 0 ? m_per_texel : 1.0;
+    plx_status st = eng_need_render(e);
+    if (st != PLX_OK)
+        return st;
+    if (dark)
+        render_code_bind(e->rd, shade_none);
+    st = render_lightmap_build(e->rd, cell, LIGHTMAP_MAX_BYTES);
+    if (dark)
+        render_code_bind(e->rd, render_shade_light);
+    if (st == PLX_E_NOMEM)
+        return eng_nomem(e, "building the aerial light map");
+    if (st != PLX_OK)
+        return eng_fail(e, st, render_error(e->rd));
+    e->lightmap_cell = cell;
     return PLX_OK;
 }
 
@@ -60,17 +89,13 @@ plx_status plx_render(plx_engine *e, const plx_camera *cam, const plx_render_opt
         plx_render_opts_default(&def);
         o = &def;
     }
-    st = need_render(e);
+    st = eng_need_render(e);
     if (st != PLX_OK)
         return st;
     if (o->aerial && e->lightmap_cell == 0.0) {
-        double cell = o->aerial_m_per_texel > 0 ? o->aerial_m_per_texel : 1.0;
-        st = render_lightmap_build(e->rd, cell, LIGHTMAP_MAX_BYTES);
-        if (st == PLX_E_NOMEM)
-            return eng_nomem(e, "building the aerial light map");
+        st = eng_need_lightmap(e, o->aerial_m_per_texel, 0);
         if (st != PLX_OK)
-            return eng_fail(e, st, render_error(e->rd));
-        e->lightmap_cell = cell;
+            return st;
     }
     memcpy(rc.eye, cam->eye, sizeof rc.eye);
     memcpy(rc.target, cam->target, sizeof rc.target);

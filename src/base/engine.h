@@ -50,6 +50,11 @@ plx_status eng_need_light(plx_engine *e, const char *fn);
 double eng_indirect(plx_engine *e, const double P[3], const double n[3]);
 /* The same, also writing its RGB version to rgb (may be NULL); returns the scalar. */
 double eng_indirect_rgb(plx_engine *e, const double P[3], const double n[3], double rgb[3] /* OUT */);
+/* Creates the renderer on first need (renderapi.c). */
+plx_status eng_need_render(plx_engine *e);
+/* Builds the aerial light map at m_per_texel metres (0: 1 m) unless built;
+ * dark: with a shader giving no light (the bake's twin, bake.c). */
+plx_status eng_need_lightmap(plx_engine *e, double m_per_texel, int dark);
 /* Checks the engine handle for API misuse. */
 int eng_ok(const plx_engine *e);
 

@@ -34,6 +34,20 @@ int cli_common_option(const char *cmd, int argc, char **argv, int *i, cli_common
 /* Creates an engine and loads the scene; prints the error and returns an
  * exit code on failure (engine freed), EXIT_OK on success. */
 int cli_open_scene(const char *cmd, const char *path, const cli_common *c, plx_engine **e);
+/* A large block (2 MiB aligned, huge pages where offered); free() it. */
+void *cli_big_alloc(size_t size);
+/* The engine configuration of the common options (port, --strict, --quiet). */
+void cli_config(const cli_common *c, plx_config *cfg /* OUT */);
+/* Loads the scene file into the existing engine *e (and its ground image);
+ * on failure prints, frees the engine and returns an exit code. */
+int cli_load_scene(const char *cmd, const char *path, const cli_common *c, plx_engine **e);
+/* The bake file cli_open_scene loaded, if any (README "Bake files"). */
+typedef struct cli_bake_state {
+    int loaded;
+    size_t bytes;
+    unsigned long long load_ns;
+} cli_bake_state;
+extern cli_bake_state cli_bake_last;
 /* Photon frames for indirect light (--photons, --frames, --no-indirect). */
 typedef struct cli_indirect {
     long photons;    /* per frame (default 65536) */
@@ -61,5 +75,6 @@ int cmd_render(int argc, char **argv);
 int cmd_route(int argc, char **argv);
 int cmd_nightify(int argc, char **argv);
 int cmd_dark_spots(int argc, char **argv);
+int cmd_bake(int argc, char **argv);
 
 #endif

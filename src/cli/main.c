@@ -20,6 +20,7 @@ static const command commands[] = {
     { "nightify", cmd_nightify, "turn a day orthophoto into night colours (histogram matching)" },
     { "route", cmd_route, "how well lit is a route: lux statistics and EN 13201 P-class" },
     { "dark-spots", cmd_dark_spots, "the darkest points of the street area as GeoJSON" },
+    { "bake", cmd_bake, "build everything once and save it in one file that loads at once" },
 };
 
 static void usage(FILE *f)

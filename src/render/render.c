@@ -251,6 +251,33 @@ plx_status render_create(arena *a, const scene *s, int32_t max_w, int32_t max_h,
     return PLX_OK;
 }
 
+size_t render_struct_bytes(void)
+{
+    return sizeof(render);
+}
+
+void render_code_unbind(render *r)
+{
+    r->shade = NULL;
+    r->soft.name = NULL;
+    r->soft.begin = NULL;
+    r->soft.draw = NULL;
+    r->soft.finish = NULL;
+    memset(&r->rc, 0, sizeof r->rc);
+    r->err = NULL;
+}
+
+void render_code_bind(render *r, render_shade_fn shade)
+{
+    r->shade = shade;
+    r->soft.name = "soft";
+    r->soft.user = r;
+    r->soft.begin = soft_begin;
+    r->soft.draw = soft_draw;
+    r->soft.finish = soft_finish;
+    r->err = "";
+}
+
 /* ---- camera ----------------------------------------------------------------- */
 
 static int setup_camera(render *r, const render_camera *c, const render_opts *o)

@@ -303,6 +303,17 @@ typedef struct render_lightmap_info {
 
 void render_lightmap_get(const render *r, render_lightmap_info *out /* OUT */);
 
+/* Code addresses held by the render object (the shader, the built-in
+ * backend's functions, the rasteriser's fragment function, the error text)
+ * differ between processes: render_code_unbind clears them (before the
+ * object's memory is saved in a bake), render_code_bind sets them again
+ * with shade as the shader (after a bake is loaded). The shader's user
+ * pointer is kept. */
+void render_code_unbind(render *r);
+/* sizeof the render object (opaque elsewhere). */
+size_t render_struct_bytes(void);
+void render_code_bind(render *r, render_shade_fn shade);
+
 /* One fixed sentence about the last failure ("" after success). */
 const char *render_error(const render *r);
 

@@ -121,6 +121,27 @@ printf '{"type": "FeatureCollection", "properties": {"units": "m", "ground_image
 expect ground-image-bad-strict 1 "polarlux info: $tmp/gi/bad\.geojson: properties\.ground_image must be the path of a PNG file" -- "$bin" info --strict "$tmp/gi/bad.geojson"
 expect ground-image-bad-lenient 0 "warning: $tmp/gi/bad\.geojson: properties\.ground_image must be the path of a PNG file \(a non-empty string of at most 4096 bytes\); ignored" -- "$bin" info "$tmp/gi/bad.geojson"
 expect ground-image-nomem 3 "out of memory while storing the ground image" -- "$bin" info --mem 15K fixtures/ground-image.geojson
+# ---- bake files (README "Bake files") ----
+expect bake-help 0 "^usage: polarlux bake" -- "$bin" bake --help
+expect bake-unknown-option 2 "polarlux bake: unknown option '--bogus'" -- "$bin" bake --bogus x
+expect bake-missing-out 2 "missing -o CITY.plxb" -- "$bin" bake fixtures/tiny.geojson
+expect bake-tiny 0 "^baked fixtures/eixample-4x4\.geojson into .*: [0-9]+ bytes .*engine memory in use [0-9]+ bytes" -- \
+    "$bin" bake -q fixtures/eixample-4x4.geojson --frames 2 --photons 4000 --texel 2 --max-size 160x120 -o "$tmp/e.plxb"
+expect bake-info 0 "^bake: [0-9]+ bytes \([0-9.]+ MB\) loaded in [0-9.]+ ms" -- "$bin" info "$tmp/e.plxb"
+expect bake-info-memory 0 "^memory: [0-9]+ bytes in use" -- "$bin" info "$tmp/e.plxb"
+printf '0.5 0.5\n10 -3\n61 61\n' >"$tmp/bp.txt"
+"$bin" vis -q fixtures/eixample-4x4.geojson --points "$tmp/bp.txt" >"$tmp/v1" 2>&1
+expect bake-vis 0 "" -- "$bin" vis -q "$tmp/e.plxb" --points "$tmp/bp.txt"
+if cmp -s "$tmp/out" "$tmp/v1"; then echo "ok   bake-vis-same"; pass=$((pass + 1)); else echo "FAIL bake-vis-same"; fail=$((fail + 1)); fi
+"$bin" render -q fixtures/eixample-4x4.geojson --no-indirect --size 160x120 -o "$tmp/r1.png" --pfm "$tmp/r1.pfm" >/dev/null 2>&1
+expect bake-render 0 "street view 160x120" -- "$bin" render -q "$tmp/e.plxb" --no-indirect --size 160x120 -o "$tmp/r2.png" --pfm "$tmp/r2.pfm"
+if cmp -s "$tmp/r1.pfm" "$tmp/r2.pfm"; then echo "ok   bake-render-same"; pass=$((pass + 1)); else echo "FAIL bake-render-same"; fail=$((fail + 1)); fi
+head -c 5000 "$tmp/e.plxb" >"$tmp/cut.plxb"
+expect bake-truncated 1 "^polarlux info: $tmp/cut\.plxb: truncated bake file: 5000 bytes, the header says [0-9]+$" -- "$bin" info "$tmp/cut.plxb"
+expect bake-version 1 "^polarlux render: tests/corpus/bake-version-99\.plxb: bake format version 99, this polarlux reads version 1; bake the scene again$" -- \
+    "$bin" render tests/corpus/bake-version-99.plxb -o "$tmp/x.png"
+expect bake-arch 1 "bake made on another architecture" -- "$bin" vis tests/corpus/bake-big-endian.plxb --at 0,0
+expect bake-nomem 3 "the block is too small for the bake" -- "$bin" info --mem 64K "$tmp/e.plxb"
 ls "$tmp"/*.tmp* >/dev/null 2>&1 && { echo "FAIL temporary files left"; fail=$((fail + 1)); }
 echo "cli: $pass passed, $fail failed"
 [ "$fail" -eq 0 ]
