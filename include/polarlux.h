@@ -406,7 +406,16 @@ typedef struct plx_render_opts {
     int no_indirect;            /* 1: direct light only even when photons were traced */
     const plx_backend *backend; /* visibility pass: NULL = the built-in software rasteriser;
                                    or a port's, e.g. port/osmesa/plx_osmesa.h */
+    int auto_exposure;          /* 1: the exposure is chosen from the image (a high percentile of
+                                   the lit pixels' luminance near white) and a tone curve keeps
+                                   the highlights near lamps; exposure is then ignored. rgbf
+                                   stays linear radiance. README "Automatic exposure" */
+    int aa;                     /* anti-aliasing: aa x aa samples per pixel on a regular grid,
+                                   averaged in linear radiance (0 or 1: one sample at the pixel
+                                   centre, SPEC §5); at most PLX_RENDER_MAX_AA */
 } plx_render_opts;
+
+#define PLX_RENDER_MAX_AA 16
 
 void plx_render_opts_default(plx_render_opts *o /* OUT */);
 
@@ -414,6 +423,7 @@ typedef struct plx_render_info {
     uint32_t buildings, drawn;  /* buildings in the scene, drawn after culling */
     double drawn_fraction;      /* triangles drawn / triangles of the scene */
     uint64_t shaded_pixels;
+    double exposure;            /* the exposure applied (the chosen one with auto_exposure) */
 } plx_render_info;
 
 /*

@@ -71,6 +71,56 @@ plx_status eng_need_lightmap(plx_engine *e, double m_per_texel, int dark)
     return PLX_OK;
 }
 
+/* Anti-aliasing: n x n frames with the sample point moved within the
+ * pixel on a regular grid, their linear images averaged (summed in sample
+ * order, so the bytes are the same every time), then tone mapped with the
+ * exposure of the first sample's frame. The sum lives in PLX_PART_FRAME,
+ * taken on first use for the largest frame. */
+static plx_status render_aa(plx_engine *e, const render_camera *rc, render_opts *ro, int n, uint8_t *rgb8,
+                            float *rgbf, render_stats *rs)
+{
+    size_t px = (size_t)rc->width * (size_t)rc->height, p, maxpx;
+    double ex = 1.0, inv = 1.0 / ((double)n * n);
+    plx_status st = PLX_OK;
+    int a, b;
+    if (rc->width < 1 || rc->height < 1)
+        px = 0;
+    maxpx = (size_t)(e->cfg.render_max_width ? e->cfg.render_max_width : DEFAULT_MAX_W) *
+            (size_t)(e->cfg.render_max_height ? e->cfg.render_max_height : DEFAULT_MAX_H);
+    if (!e->aa_sum) {
+        e->aa_sum = arena_alloc(&e->mem, PLX_PART_FRAME, arena_mul(maxpx, 3 * sizeof(float)), 64);
+        if (!e->aa_sum)
+            return PLX_E_NOMEM;
+    }
+    for (b = 0; b < n && st == PLX_OK; b++)
+        for (a = 0; a < n && st == PLX_OK; a++) {
+            const float *lin;
+            ro->shift[0] = (a + 0.5) / n - 0.5;
+            ro->shift[1] = (b + 0.5) / n - 0.5;
+            st = render_frame(e->rd, rc, ro, NULL, NULL, rs);
+            if (st != PLX_OK)
+                break;
+            lin = render_linear(e->rd);
+            if (a == 0 && b == 0) {
+                ex = rs->exposure;
+                memcpy(e->aa_sum, lin, px * 3 * sizeof(float));
+            } else {
+                for (p = 0; p < 3 * px; p++)
+                    e->aa_sum[p] += lin[p];
+            }
+        }
+    if (st != PLX_OK)
+        return st;
+    for (p = 0; p < 3 * px; p++)
+        e->aa_sum[p] = (float)(e->aa_sum[p] * inv);
+    if (rgbf)
+        memcpy(rgbf, e->aa_sum, px * 3 * sizeof(float));
+    if (rgb8)
+        render_tonemap(e->rd, e->aa_sum, px, ex, ro->auto_exposure, rgb8);
+    rs->exposure = ex;
+    return PLX_OK;
+}
+
 plx_status plx_render(plx_engine *e, const plx_camera *cam, const plx_render_opts *o, uint8_t *rgb8,
                       float *rgbf, plx_render_info *info)
 {
@@ -85,6 +135,8 @@ plx_status plx_render(plx_engine *e, const plx_camera *cam, const plx_render_opt
         return eng_fail(e, PLX_E_NOSCENE, "plx_render: no scene is loaded");
     if (!cam)
         return eng_fail(e, PLX_E_INVALID, "plx_render: camera is NULL");
+    if (o && (o->aa < 0 || o->aa > PLX_RENDER_MAX_AA))
+        return eng_fail(e, PLX_E_INVALID, "plx_render: aa must be 0..16 (samples per pixel side)");
     if (!o) {
         plx_render_opts_default(&def);
         o = &def;
@@ -108,11 +160,15 @@ plx_status plx_render(plx_engine *e, const plx_camera *cam, const plx_render_opt
     ro.lightmap = o->aerial;
     ro.cull = o->no_cull ? RENDER_CULL_NONE : RENDER_CULL_ALL;
     ro.backend = o->backend;
+    ro.auto_exposure = o->auto_exposure;
     if (!o->no_indirect && e->ph && plx_indirect_frames(e) > 0) {
         ro.indirect = shade_indirect;
         ro.indirect_user = e;
     }
-    st = render_frame(e->rd, &rc, &ro, rgb8, rgbf, &rs);
+    if (o->aa > 1)
+        st = render_aa(e, &rc, &ro, o->aa, rgb8, rgbf, &rs);
+    else
+        st = render_frame(e->rd, &rc, &ro, rgb8, rgbf, &rs);
     if (st == PLX_E_NOMEM)
         return eng_nomem(e, "rendering a frame");
     if (st != PLX_OK)
@@ -122,6 +178,7 @@ plx_status plx_render(plx_engine *e, const plx_camera *cam, const plx_render_opt
         info->drawn = rs.drawn;
         info->drawn_fraction = rs.drawn_fraction;
         info->shaded_pixels = rs.shader_calls;
+        info->exposure = rs.exposure;
     }
     eng_clear_error(e);
     return PLX_OK;

@@ -30,6 +30,7 @@ struct plx_engine {
     struct render *rd;      /* renderer, created on first need */
     struct photon_sys *ph;  /* photon buffers, created on first need */
     double lightmap_cell;   /* light map texel size when built, else 0 */
+    float *aa_sum;          /* anti-aliasing sum (PLX_PART_FRAME), taken on first need */
 };
 
 #define ENGINE_MAGIC 0x504c5831u /* "PLX1" */

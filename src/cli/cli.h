@@ -76,5 +76,6 @@ int cmd_route(int argc, char **argv);
 int cmd_nightify(int argc, char **argv);
 int cmd_dark_spots(int argc, char **argv);
 int cmd_bake(int argc, char **argv);
+int cmd_walk(int argc, char **argv);
 
 #endif

@@ -19,7 +19,7 @@
 static const char help[] =
     "usage: polarlux render SCENE [--eye X,Y,Z --target X,Y,Z] [--fov DEG] [--size WxH]\n"
     "                       [--view street|aerial] [--backend soft|osmesa] [--exposure E]\n"
-    "                       [--no-indirect] [--no-glow] [--texel M] -o OUT.png [--pfm OUT.pfm]\n"
+    "                       [--no-indirect] [--no-glow] [--aa N] [--texel M] -o OUT.png [--pfm OUT.pfm]\n"
     "\n"
     "Renders the scene at night through a pinhole camera (SPEC §5: up is +z,\n"
     "vertical field of view, pixel centres): ground, facades and roofs lit by\n"
@@ -37,8 +37,14 @@ static const char help[] =
     "  --view V         street (default) or aerial: aerial takes the ground from a\n"
     "                   light map of exact illuminance built once at --texel metres\n"
     "  --texel M        aerial light map resolution (default 1 m)\n"
-    "  --exposure E     radiance multiplier before sRGB (default 1.0, SPEC §5)\n"
+    "  --exposure E     radiance multiplier before sRGB, no tone curve (SPEC §5;\n"
+    "                   --exposure 1 is the reference image). Default: automatic:\n"
+    "                   the 97th percentile of the lit surface pixels' luminance\n"
+    "                   near white and a tone curve keeping highlights near lamps;\n"
+    "                   the exposure chosen is printed\n"
     "  --no-glow        no lamp glows: every pixel is exactly SPEC §5's radiance\n"
+    "  --aa N           anti-aliasing: N x N samples per pixel, averaged in linear\n"
+    "                   radiance (default 1: one sample at each pixel centre, SPEC §5)\n"
     "  --no-indirect    direct light only (default: indirect light from the photon\n"
     "                   buffers, traced first; progress on a terminal)\n"
     "  --photons N      photons per frame (default 65536)\n"
@@ -100,9 +106,15 @@ static int parse_value(render_args *a, const char *opt, const char *val)
     } else if (strcmp(opt, "--exposure") == 0) {
         if (cli_parse_double(val, &a->opts.exposure) != 0 || !(a->opts.exposure >= 0))
             return cli_usage_error("render", "--exposure '%s' is not a number >= 0", val);
+        a->opts.auto_exposure = 0;
     } else if (strcmp(opt, "--texel") == 0) {
         if (cli_parse_double(val, &a->opts.aerial_m_per_texel) != 0 || !(a->opts.aerial_m_per_texel > 0))
             return cli_usage_error("render", "--texel '%s' is not a positive number of metres", val);
+    } else if (strcmp(opt, "--aa") == 0) {
+        long n;
+        if (cli_parse_int(val, 1, PLX_RENDER_MAX_AA, &n) != 0)
+            return cli_usage_error("render", "--aa '%s' is not a whole number from 1 to %d", val, PLX_RENDER_MAX_AA);
+        a->opts.aa = (int)n;
     } else if (strcmp(opt, "-o") == 0) {
         a->out = val;
     } else if (strcmp(opt, "--pfm") == 0) {
@@ -116,11 +128,12 @@ static int parse_value(render_args *a, const char *opt, const char *val)
 static int parse_args(int argc, char **argv, render_args *a)
 {
     static const char *const valued[] = { "--eye", "--target", "--fov", "--size", "--view", "--backend",
-                                          "--exposure", "--texel", "-o", "--pfm" };
+                                          "--exposure", "--texel", "-o", "--pfm", "--aa" };
     int i;
     size_t k;
     memset(a, 0, sizeof *a);
     plx_render_opts_default(&a->opts);
+    a->opts.auto_exposure = 1; /* until --exposure */
     cli_indirect_default(&a->ind);
     a->cam.fov_deg = 60.0;
     a->cam.width = 640;
@@ -361,6 +374,9 @@ int cmd_render(int argc, char **argv)
                a.aerial ? "aerial" : "street", a.cam.width, a.cam.height, a.cam.eye[0], a.cam.eye[1], a.cam.eye[2],
                a.cam.target[0], a.cam.target[1], a.cam.target[2], info.drawn, info.buildings,
                100.0 * info.drawn_fraction, (port_now_ns() - t0) / 1e6, a.out);
+    if (rc == EXIT_OK && a.opts.auto_exposure)
+        printf("exposure: %.4g (automatic: a high percentile of the lit surfaces' luminance near white, "
+               "tone curve; --exposure 1 for SPEC §5's linear image)\n", info.exposure);
 done:
 #ifdef PLX_HAVE_OSMESA
     plx_osmesa_close(om);

@@ -21,6 +21,7 @@ static const command commands[] = {
     { "route", cmd_route, "how well lit is a route: lux statistics and EN 13201 P-class" },
     { "dark-spots", cmd_dark_spots, "the darkest points of the street area as GeoJSON" },
     { "bake", cmd_bake, "build everything once and save it in one file that loads at once" },
+    { "walk", cmd_walk, "frames along a camera path (PNG frames, contact sheet, frame times)" },
 };
 
 static void usage(FILE *f)
