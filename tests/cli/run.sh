@@ -142,6 +142,25 @@ expect bake-version 1 "^polarlux render: tests/corpus/bake-version-99\.plxb: bak
     "$bin" render tests/corpus/bake-version-99.plxb -o "$tmp/x.png"
 expect bake-arch 1 "bake made on another architecture" -- "$bin" vis tests/corpus/bake-big-endian.plxb --at 0,0
 expect bake-nomem 3 "the block is too small for the bake" -- "$bin" info --mem 64K "$tmp/e.plxb"
+# ---- walk (README "Walking through a city") ----
+expect walk-help 0 "^usage: polarlux walk" -- "$bin" walk --help
+expect walk-unknown-option 2 "polarlux walk: unknown option '--bogus'" -- "$bin" walk --bogus x
+expect walk-missing-path 2 "missing --path CAMERA.geojson" -- "$bin" walk "$tmp/e.plxb" -o "$tmp/w"
+printf '{"type":"Feature","properties":{"units":"m"},"geometry":{"type":"LineString","coordinates":[[298.6,265.5,1.7],[270,294,1.7],[262,330]]}}' >"$tmp/path.geojson"
+expect walk-exact 0 "^frame time: median [0-9.]+ ms, p95 [0-9.]+ ms, mean [0-9.]+ ms: [0-9.]+ frames per second" -- \
+    "$bin" walk -q "$tmp/e.plxb" --path "$tmp/path.geojson" --size 160x120 --fps 0.2 --aa 1 --no-indirect --no-glow --exposure 1 -o "$tmp/w1"
+set -- $(sed -n '3p' "$tmp/w1/cameras.txt")
+"$bin" render -q "$tmp/e.plxb" --size 160x120 --no-indirect --no-glow --exposure 1 --eye "$2,$3,$4" --target "$5,$6,$7" -o "$tmp/w1r.png" >/dev/null 2>&1
+if cmp -s "$tmp/w1/frame-0002.png" "$tmp/w1r.png"; then echo "ok   walk-exact-equals-render"; pass=$((pass + 1)); else echo "FAIL walk-exact-equals-render"; fail=$((fail + 1)); fi
+expect walk-default 0 "^walk: [0-9]+ frames 160x120 .*aa 2" -- "$bin" walk -q "$tmp/e.plxb" --path "$tmp/path.geojson" --size 160x120 --fps 0.1 -o "$tmp/w2"
+set -- $(sed -n '2p' "$tmp/w2/cameras.txt")
+"$bin" render -q "$tmp/e.plxb" --size 160x120 --aa 2 --eye "$2,$3,$4" --target "$5,$6,$7" -o "$tmp/w2r.png" >/dev/null 2>&1
+if cmp -s "$tmp/w2/frame-0001.png" "$tmp/w2r.png"; then echo "ok   walk-default-equals-render"; pass=$((pass + 1)); else echo "FAIL walk-default-equals-render"; fail=$((fail + 1)); fi
+if [ -s "$tmp/w2/contact.png" ]; then echo "ok   walk-contact-sheet"; pass=$((pass + 1)); else echo "FAIL walk-contact-sheet"; fail=$((fail + 1)); fi
+printf '{"type":"LineString","coordinates":[[1,2]]}' >"$tmp/short.geojson"
+expect walk-short-path 1 "^polarlux walk: $tmp/short\.geojson: the LineString needs at least 2 positions$" -- "$bin" walk -q "$tmp/e.plxb" --path "$tmp/short.geojson" -o "$tmp/w3"
+expect render-aa-bad 2 "--aa '0' is not a whole number from 1 to 16" -- "$bin" render fixtures/tiny.geojson --aa 0 -o "$tmp/x.png"
+expect render-auto-exposure 0 "^exposure: [0-9.e+-]+ \(automatic" -- "$bin" render -q "$tmp/e.plxb" --size 160x120 -o "$tmp/ae.png"
 ls "$tmp"/*.tmp* >/dev/null 2>&1 && { echo "FAIL temporary files left"; fail=$((fail + 1)); }
 echo "cli: $pass passed, $fail failed"
 [ "$fail" -eq 0 ]

@@ -95,7 +95,7 @@ static plx_engine *load(const unsigned char *file, size_t len, void **mem)
     return e;
 }
 
-static const double pts[][2] = { { 0.5, 0.5 }, { 10.0, -3.0 }, { -40.0, 22.0 }, { 61.0, 61.0 }, { -7.0, -70.0 } };
+static const double pts[][2] = { { 298.6, 265.5 }, { 150.0, 3.0 }, { -30.0, 22.0 }, { 61.0, 61.0 }, { 400.0, 560.0 } };
 #define NPTS (sizeof pts / sizeof pts[0])
 
 static void same_vis(plx_engine *x, plx_engine *y)
@@ -135,8 +135,8 @@ static void same_illum(plx_engine *x, plx_engine *y, int indirect)
     double P[3 * N], Nn[3 * N], e1[N], i1[N], c1[3 * N], e2[N], i2[N], c2[3 * N];
     int k;
     for (k = 0; k < N; k++) {
-        P[3 * k] = -90.0 + 180.0 * (k % 8) / 7.0 + 0.37;
-        P[3 * k + 1] = -90.0 + 180.0 * (k / 8) / 7.0 + 0.61;
+        P[3 * k] = -30.0 + 590.0 * (k % 8) / 7.0 + 0.37;
+        P[3 * k + 1] = -30.0 + 590.0 * (k / 8) / 7.0 + 0.61;
         P[3 * k + 2] = 0.0;
         Nn[3 * k] = Nn[3 * k + 1] = 0.0;
         Nn[3 * k + 2] = 1.0;
@@ -161,11 +161,13 @@ static void same_render(plx_engine *x, plx_engine *y, int aerial, int no_indirec
     cam.height = 120;
     cam.fov_deg = 60;
     if (aerial) {
-        cam.eye[2] = 300.0;
-        cam.target[1] = 1.0;
+        cam.eye[0] = cam.target[0] = 266.0;
+        cam.eye[1] = 266.0;
+        cam.target[1] = 267.0;
+        cam.eye[2] = 500.0;
     } else {
-        cam.eye[0] = -45.0; cam.eye[1] = -9.5; cam.eye[2] = 1.7;
-        cam.target[0] = 10.0; cam.target[1] = -9.5; cam.target[2] = 3.0;
+        cam.eye[0] = 298.6; cam.eye[1] = 265.5; cam.eye[2] = 1.7;
+        cam.target[0] = 261.8; cam.target[1] = 302.3; cam.target[2] = 3.0;
     }
     plx_render_opts_default(&o);
     o.aerial = aerial;
