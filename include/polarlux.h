@@ -376,6 +376,29 @@ plx_status plx_indirect_set_viewer(plx_engine *e, const double eye[3], const dou
 /* Drops every accumulated photon. */
 plx_status plx_indirect_reset(plx_engine *e);
 
+#define PLX_REFINE_LRU_MAX 64
+
+typedef struct plx_refine_stats {
+    uint32_t misses_now;        /* floor maps computed by this call */
+    uint64_t hits, misses, evictions, refined; /* lamp cache totals since creation or reset */
+    uint32_t slots;             /* cache capacity (lamps) */
+    double near_radius;         /* lamps within this horizontal distance are refined, m */
+    uint32_t cached;            /* lamps in the cache now ... */
+    uint32_t lru[PLX_REFINE_LRU_MAX]; /* ... the first of them, most recently used first */
+} plx_refine_stats;
+
+/*
+ * Near-viewer refinement (munoz2013 §3.3-3.4, README "Walking through a
+ * city"): the lamps within near_radius of eye (horizontally), nearest
+ * first, up to the cache capacity, get their own floor photon maps, kept
+ * in an LRU cache; a lamp's map is pushed into the improved aerial map the
+ * first time, and the progressive aerial chart then restarts without that
+ * lamp (further plx_indirect_step frames fill it again). out (may be NULL)
+ * gets the cache's counters. Errors: PLX_E_NOSCENE (no photon buffers yet),
+ * PLX_E_INVALID, PLX_E_NOMEM (scratch).
+ */
+plx_status plx_indirect_refine(plx_engine *e, const double eye[3], plx_refine_stats *out /* OUT */);
+
 /*
  * Histogram matching of a day orthophoto to a night palette (munoz2013
  * §3.1): each channel of day (npx RGB8 pixels) is mapped so its histogram

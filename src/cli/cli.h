@@ -61,6 +61,11 @@ int cli_indirect_option(const char *cmd, int argc, char **argv, int *i, cli_indi
  * dir (either may be NULL). Returns an exit code. */
 int cli_indirect_run(const char *cmd, plx_engine *e, const cli_indirect *ind, const double *eye,
                      const double *dir, double fov_deg);
+/* Near-viewer refinement at eye (plx_indirect_refine); when lamps were
+ * newly refined, 'frames' photon frames of 'photons' refill the aerial
+ * chart. Prints the error and returns an exit code. */
+int cli_refine(const char *cmd, plx_engine *e, const double eye[3], long frames, long photons,
+               plx_refine_stats *rs /* OUT */);
 /* Maps a status to an exit code. */
 int cli_exit_code(plx_status s);
 

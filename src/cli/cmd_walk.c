@@ -32,11 +32,17 @@ static const char help[] =
     "  --exposure E     fixed exposure, no tone curve (default: automatic per frame)\n"
     "  --no-glow, --no-indirect, --view V, --photons N, --frames K   as for render\n"
     "  --max-frames N   at most N frames (default 1000)\n"
+    "  --refine         near-viewer refinement (munoz2013 §3.3-3.4): before each frame\n"
+    "                   the lamps near the eye get floor photon maps in an LRU cache,\n"
+    "                   pushed into the aerial map; then --refine-frames K photon\n"
+    "                   frames (default 2) refill the aerial chart. Prints the cache's\n"
+    "                   hits, misses and evictions\n"
     "  --mem SIZE, --strict, --quiet   as for 'polarlux info'\n";
 
 typedef struct walk_args {
     const char *scene, *path, *dir;
-    int w, h, aerial;
+    int w, h, aerial, refine;
+    long refine_frames;
     long max_frames;
     double fps, speed, fov;
     plx_render_opts opts;
@@ -76,6 +82,9 @@ static int parse_value(walk_args *a, const char *opt, const char *val)
         if (strcmp(val, "street") && strcmp(val, "aerial"))
             return cli_usage_error("walk", "--view '%s' is not street or aerial", val);
         a->aerial = strcmp(val, "aerial") == 0;
+    } else if (strcmp(opt, "--refine-frames") == 0) {
+        if (cli_parse_int(val, 0, 100000, &a->refine_frames) != 0)
+            return cli_usage_error("walk", "--refine-frames '%s' is not a whole number >= 0", val);
     } else if (strcmp(opt, "--max-frames") == 0) {
         if (cli_parse_int(val, 1, 1000000, &a->max_frames) != 0)
             return cli_usage_error("walk", "--max-frames '%s' is not a whole number >= 1", val);
@@ -88,7 +97,7 @@ static int parse_value(walk_args *a, const char *opt, const char *val)
 static int parse_args(int argc, char **argv, walk_args *a)
 {
     static const char *const valued[] = { "--path", "-o", "--size", "--fps", "--speed", "--fov", "--aa",
-                                          "--exposure", "--view", "--max-frames" };
+                                          "--exposure", "--view", "--max-frames", "--refine-frames" };
     int i;
     size_t k;
     memset(a, 0, sizeof *a);
@@ -102,6 +111,7 @@ static int parse_args(int argc, char **argv, walk_args *a)
     a->speed = 1.4;
     a->fov = 60;
     a->max_frames = 1000;
+    a->refine_frames = 2;
     for (i = 1; i < argc; i++) {
         const char *s = argv[i];
         int r = cli_common_option("walk", argc, argv, &i, &a->c);
@@ -117,6 +127,10 @@ static int parse_args(int argc, char **argv, walk_args *a)
         }
         if (strcmp(s, "--no-glow") == 0) {
             a->opts.no_glow = 1;
+            continue;
+        }
+        if (strcmp(s, "--refine") == 0) {
+            a->refine = 1;
             continue;
         }
         for (k = 0; k < sizeof valued / sizeof valued[0]; k++)
@@ -188,6 +202,8 @@ typedef struct walk_run {
     uint8_t *thumbs[16];
     int nthumb;
     FILE *cams;
+    plx_refine_stats rs;
+    double refine_ms;
 } walk_run;
 
 static int frame(const walk_args *a, plx_engine *e, const walk_path *wp, walk_run *wr, long k, double step)
@@ -202,6 +218,14 @@ static int frame(const walk_args *a, plx_engine *e, const walk_path *wp, walk_ru
     cam.fov_deg = a->fov;
     cam.width = a->w;
     cam.height = a->h;
+    if (a->refine && !a->ind.off) {
+        int rc;
+        t0 = port_now_ns();
+        rc = cli_refine("walk", e, cam.eye, a->refine_frames, a->ind.photons, &wr->rs);
+        wr->refine_ms += (port_now_ns() - t0) / 1e6;
+        if (rc != EXIT_OK)
+            return rc;
+    }
     t0 = port_now_ns();
     st = plx_render(e, &cam, &a->opts, wr->rgb8, NULL, &info);
     wr->ms[k] = (port_now_ns() - t0) / 1e6;
@@ -267,6 +291,11 @@ static int run(const walk_args *a, plx_engine *e, const walk_path *wp)
                L, a->speed, a->fps, a->opts.aa > 1 ? a->opts.aa : 1, a->dir);
         printf("frame time: median %.2f ms, p95 %.2f ms, mean %.2f ms: %.1f frames per second (rendering only)\n",
                med, p95, sum / wr.n, 1000.0 * wr.n / sum);
+        if (a->refine && !a->ind.off)
+            printf("refinement: %llu hits, %llu misses, %llu evictions, %llu lamps refined (%u slots, %.0f m); "
+                   "%.1f ms in all (floor maps and refill frames)\n", (unsigned long long)wr.rs.hits,
+                   (unsigned long long)wr.rs.misses, (unsigned long long)wr.rs.evictions,
+                   (unsigned long long)wr.rs.refined, wr.rs.slots, wr.rs.near_radius, wr.refine_ms);
     }
     if (wr.cams)
         fclose(wr.cams);

@@ -335,3 +335,23 @@ int cli_indirect_run(const char *cmd, plx_engine *e, const cli_indirect *ind, co
         fprintf(stderr, "\n");
     return EXIT_OK;
 }
+
+int cli_refine(const char *cmd, plx_engine *e, const double eye[3], long frames, long photons,
+               plx_refine_stats *rs)
+{
+    plx_status st = plx_indirect_refine(e, eye, rs);
+    long k;
+    if (st != PLX_OK) {
+        fprintf(stderr, "polarlux %s: %s\n", cmd, plx_last_error(e));
+        return cli_exit_code(st);
+    }
+    /* a newly refined lamp restarts the progressive aerial chart: refill it */
+    for (k = 0; rs->misses_now > 0 && k < frames; k++) {
+        st = plx_indirect_step(e, (uint32_t)photons, plx_indirect_frames(e) + 1);
+        if (st != PLX_OK) {
+            fprintf(stderr, "polarlux %s: %s\n", cmd, plx_last_error(e));
+            return cli_exit_code(st);
+        }
+    }
+    return EXIT_OK;
+}
