@@ -1,12 +1,15 @@
 # polarlux — build, test and install. See README.md.
 #
-#   make            libraries (build/libpolarlux.a, .so) and build/polarlux
+#   make            the core library (build/libpolarlux.a, libpolarlux.so), the
+#                   POSIX/PNG port library (build/libpolarlux-port.a) and build/polarlux
 #   make demo       build and run the main job on the bundled fixtures
 #   make check      unit + command-line tests, quick (long loops shortened)
 #   make check-full the same with the full loops and bounds (a few minutes)
-#   make asan       the same tests under AddressSanitizer + UBSan
+#   make asan       the same tests under AddressSanitizer + UBSan, with the
+#                   core's invariant checks (PLX_DEBUG, src/base/plx_assert.h)
 #   make valgrind   the unit tests under valgrind memcheck
 #   make bench      benchmarks (tests/bench)
+#   make check-identical BASE=rev   outputs byte-identical to revision rev
 #   make deps       install missing Debian packages (apt-get when root)
 #   make install PREFIX=/usr/local
 #   make clean
@@ -23,6 +26,10 @@ FPFLAGS  = -ffp-contract=off
 CPPFLAGS = -Iinclude -Isrc -Iport
 CFLAGS_ALL = $(WARN) $(FPFLAGS) $(OPT) -fPIC -MMD -MP $(EXTRA_CFLAGS)
 POSIX    = -D_POSIX_C_SOURCE=200809L
+# The core needs cJSON and libm only; the port (port/posix, port/png) adds
+# libpng and pthreads. Programs link both: $(PORT_A) $(LIB_A) $(LIBS).
+CORE_LIBS = -lcjson -lm
+PORT_LIBS = -lpng -lpthread
 LIBS     = -lcjson -lpng -lm -lpthread
 
 CORE_DIRS = base scene polar light photon render api
@@ -40,18 +47,23 @@ REF_OBJ  = $(REF_SRC:%.c=$(BUILD)/%.o)
 TESTS    = $(TEST_SRC:tests/unit/%.c=$(BUILD)/tests/%)
 BENCHES  = $(BENCH_SRC:tests/bench/%.c=$(BUILD)/bench/%)
 
-LIB_A  = $(BUILD)/libpolarlux.a
-LIB_SO = $(BUILD)/libpolarlux.so
-BIN    = $(BUILD)/polarlux
-
 VERSION = $(shell sed -n 's/^\#define PLX_VERSION_STRING "\(.*\)"/\1/p' include/polarlux.h)
-DEB_PACKAGES = libcjson-dev libcmocka-dev libpng-dev pkg-config
+VERSION_MAJOR = $(firstword $(subst ., ,$(VERSION)))
+
+# libpolarlux.so -> libpolarlux.so.MAJOR (the SONAME) -> libpolarlux.so.VERSION
+LIB_A  = $(BUILD)/libpolarlux.a
+SONAME = libpolarlux.so.$(VERSION_MAJOR)
+LIB_SO_REAL = $(BUILD)/libpolarlux.so.$(VERSION)
+LIB_SO = $(BUILD)/libpolarlux.so
+PORT_A = $(BUILD)/libpolarlux-port.a
+BIN    = $(BUILD)/polarlux
+DEB_PACKAGES = libcjson-dev libcmocka-dev libpng-dev pkg-config python3-numpy python3-pytest
 
 .SECONDARY:
 .PHONY: all deps demo check check-full check-build unit cli-test asan valgrind bench install clean \
-        check-core-headers
+        check-core-headers check-identical check-lib-split check-examples check-python
 
-all: $(LIB_A) $(LIB_SO) $(BIN)
+all: $(LIB_A) $(LIB_SO) $(PORT_A) $(BIN)
 
 # ---- dependencies ------------------------------------------------------------
 deps:
@@ -84,23 +96,30 @@ $(BUILD)/tests/%.o: tests/%.c | deps
 	@mkdir -p $(@D)
 	$(CC) $(CPPFLAGS) -Itests/ref $(POSIX) $(CFLAGS_ALL) -c $< -o $@
 
-$(LIB_A): $(CORE_OBJ) $(PORT_OBJ)
+$(LIB_A): $(CORE_OBJ)
 	@rm -f $@
 	ar rcs $@ $^
 
-$(LIB_SO): $(CORE_OBJ) $(PORT_OBJ)
-	$(CC) -shared \
-	  -o $@ $^ $(LIBS)
+$(PORT_A): $(PORT_OBJ)
+	@rm -f $@
+	ar rcs $@ $^
 
-$(BIN): $(CLI_OBJ) $(LIB_A)
-	$(CC) $(CFLAGS_ALL) -o $@ $(CLI_OBJ) $(LIB_A) $(LIBS)
+$(LIB_SO_REAL): $(CORE_OBJ)
+	$(CC) -shared -Wl,-soname,$(SONAME) -o $@ $^ $(CORE_LIBS)
 
-$(BUILD)/tests/test_%: $(BUILD)/tests/unit/test_%.o $(REF_OBJ) $(LIB_A)
-	$(CC) $(CFLAGS_ALL) -o $@ $< $(REF_OBJ) $(LIB_A) -lcmocka $(LIBS)
+$(LIB_SO): $(LIB_SO_REAL)
+	ln -sf $(notdir $(LIB_SO_REAL)) $(BUILD)/$(SONAME)
+	ln -sf $(SONAME) $@
 
-$(BUILD)/bench/bench_%: $(BUILD)/tests/bench/bench_%.o $(REF_OBJ) $(LIB_A)
+$(BIN): $(CLI_OBJ) $(PORT_A) $(LIB_A)
+	$(CC) $(CFLAGS_ALL) -o $@ $(CLI_OBJ) $(PORT_A) $(LIB_A) $(LIBS)
+
+$(BUILD)/tests/test_%: $(BUILD)/tests/unit/test_%.o $(REF_OBJ) $(PORT_A) $(LIB_A)
+	$(CC) $(CFLAGS_ALL) -o $@ $< $(REF_OBJ) $(PORT_A) $(LIB_A) -lcmocka $(LIBS)
+
+$(BUILD)/bench/bench_%: $(BUILD)/tests/bench/bench_%.o $(REF_OBJ) $(PORT_A) $(LIB_A)
 	@mkdir -p $(@D)
-	$(CC) $(CFLAGS_ALL) -o $@ $< $(REF_OBJ) $(LIB_A) $(LIBS)
+	$(CC) $(CFLAGS_ALL) -o $@ $< $(REF_OBJ) $(PORT_A) $(LIB_A) $(LIBS)
 
 -include port/osmesa/osmesa.mk
 -include $(shell find $(BUILD) -name '*.d' 2>/dev/null)
@@ -117,15 +136,66 @@ demo: all
 # photon count, ...); a few minutes. CI runs both.
 check: check-build
 	@PLX_TEST_QUICK=1 sh tests/run_tests.sh $(BUILD) $(TESTS)
+	@$(MAKE) --no-print-directory check-examples check-python
 
 check-full: check-build
 	@sh tests/run_tests.sh $(BUILD) $(TESTS)
+	@$(MAKE) --no-print-directory check-examples check-python
 
 check-build:
-	@$(MAKE) --no-print-directory -j$(JOBS) all $(TESTS) check-core-headers
+	@$(MAKE) --no-print-directory -j$(JOBS) all $(TESTS) $(EXAMPLES) check-core-headers check-lib-split
+
+# examples/: programs that embed the engine as an application would. Each
+# links the core library alone (no port, no libpng, no pthreads) and checks
+# its own results: make check runs them.
+EXAMPLES = $(patsubst examples/%.c,$(BUILD)/examples/%,$(wildcard examples/*.c))
+$(BUILD)/examples/%: examples/%.c $(LIB_A)
+	@mkdir -p $(@D)
+	$(CC) -Iinclude $(CFLAGS_ALL) -o $@ $< $(LIB_A) $(CORE_LIBS)
+
+# python/: the ctypes package over $(LIB_SO), tested with Debian's pytest and
+# numpy (/usr/bin/python3: a python3 earlier on PATH may not see them). A
+# run that collects no tests (pytest's exit 5) fails. Sanitizer builds skip
+# it, saying so: the interpreter cannot load an instrumented library.
+PYTHON ?= /usr/bin/python3
+check-python: $(LIB_SO) $(BIN)
+	@case "$(EXTRA_CFLAGS)" in *sanitize*) \
+	  echo "python: skipped in this sanitizer build (make check runs it)"; exit 0;; esac; \
+	log=$(CURDIR)/$(BUILD)/python-tests.log; \
+	(cd python && PYTHONDONTWRITEBYTECODE=1 POLARLUX_LIB=$(CURDIR)/$(LIB_SO) POLARLUX_BIN=$(CURDIR)/$(BIN) \
+	  $(PYTHON) -m pytest -q -p no:cacheprovider tests) >$$log 2>&1; rc=$$?; \
+	if [ $$rc -eq 5 ]; then echo "python: pytest collected no tests (exit 5)"; exit 1; fi; \
+	if [ $$rc -ne 0 ]; then cat $$log; echo "python: FAILED (pytest exit $$rc)"; exit 1; fi; \
+	echo "ok   python: $$(tail -1 $$log)"
+
+check-examples: $(EXAMPLES)
+	@for x in $(EXAMPLES); do \
+	  $$x >$$x.log 2>&1 || { cat $$x.log; echo "example $$x: FAILED"; exit 1; }; \
+	  echo "ok   example $$(basename $$x): $$(grep -c '^ok ' $$x.log) checks"; \
+	done
 
 unit: $(TESTS)
 	@for t in $(TESTS); do $$t || exit 1; done
+
+# The core library stands alone: libpolarlux.a asks only for cJSON, libm and
+# the C functions a bare-metal libc has (the list of check-freestanding) and
+# never for libpng, pthreads or stdio; libpolarlux.so needs only libcjson,
+# libm and libc, and carries its SONAME.
+LIB_ALLOWED_RE = ^(cJSON_[A-Za-z]+|sincos|_GLOBAL_OFFSET_TABLE_|__stack_chk_fail|__[a-z_]+_chk|__(asan|ubsan|sanitizer|sancov|lsan)_[A-Za-z0-9_]+|__sanitizer_cov_.*)$$
+check-lib-split: $(LIB_A) $(LIB_SO)
+	@t=$$(mktemp -d); \
+	nm -u $(LIB_A) | awk 'NF==2{print $$2}' | sort -u >$$t/u; \
+	nm --defined-only $(LIB_A) | awk 'NF==3{print $$3}' | sort -u >$$t/d; \
+	bad=$$(comm -23 $$t/u $$t/d | grep -vE '$(LIB_ALLOWED_RE)' | grep -vxF "$$(printf '%s\n' $(FS_ALLOWED))"); \
+	rm -rf $$t; \
+	if [ -n "$$bad" ]; then echo "check-lib-split: libpolarlux.a needs symbols outside the core's allowance:" $$bad; exit 1; fi; \
+	needed=$$(readelf -d $(LIB_SO_REAL) | sed -n 's/.*(NEEDED).*\[\(.*\)\]/\1/p' | tr '\n' ' '); \
+	for n in $$needed; do case $$n in libcjson.so.*|libm.so.*|libc.so.*) ;; \
+	  *) echo "check-lib-split: libpolarlux.so needs $$n"; exit 1;; esac; done; \
+	soname=$$(readelf -d $(LIB_SO_REAL) | sed -n 's/.*(SONAME).*\[\(.*\)\]/\1/p'); \
+	[ "$$soname" = "$(SONAME)" ] || { echo "check-lib-split: SONAME '$$soname', want $(SONAME)"; exit 1; }; \
+	[ "$$(readlink $(LIB_SO))" = "$(SONAME)" ] && [ "$$(readlink $(BUILD)/$(SONAME))" = "$(notdir $(LIB_SO_REAL))" ] || \
+	  { echo "check-lib-split: $(LIB_SO) -> $(SONAME) -> $(notdir $(LIB_SO_REAL)) links are wrong"; exit 1; }
 
 # The core may include only these C headers: no I/O, no OS.
 check-core-headers:
@@ -137,7 +207,7 @@ check-core-headers:
 
 asan:
 	$(MAKE) BUILD=build/asan OPT="-O1 -g -fno-omit-frame-pointer" \
-	  EXTRA_CFLAGS="-fsanitize=address,undefined -fno-sanitize-recover=all" check
+	  EXTRA_CFLAGS="-fsanitize=address,undefined -fno-sanitize-recover=all -DPLX_DEBUG" check
 
 valgrind: all $(TESTS)
 	@for t in $(TESTS); do \
@@ -145,22 +215,38 @@ valgrind: all $(TESTS)
 	  PLX_TEST_QUICK=1 valgrind -q --error-exitcode=9 --leak-check=full --errors-for-leak-kinds=definite $$t >/dev/null || exit 1; \
 	done; echo "valgrind: clean"
 
+# The refactor check (not part of make check: it builds another revision):
+# every command on every fixture and two generated cities, byte for byte
+# against revision BASE (tests/check_identical.sh).
+BASE ?= 73d3a0e
+check-identical:
+	@sh tests/check_identical.sh $(BASE)
+
 bench: all $(BENCHES)
 	@for b in $(BENCHES); do echo "== $$b"; $$b || exit 1; done
 
 # ---- install ------------------------------------------------------------------
+# Two pkg-config files: polarlux (the core: cJSON and libm) and
+# polarlux-port (the POSIX port and PNG files, which add libpng and pthreads).
 install: all
 	install -d $(DESTDIR)$(PREFIX)/lib $(DESTDIR)$(PREFIX)/include $(DESTDIR)$(PREFIX)/bin \
 	  $(DESTDIR)$(PREFIX)/lib/pkgconfig
-	install -m 644 $(LIB_A) $(DESTDIR)$(PREFIX)/lib/
-	install -m 755 $(LIB_SO) $(DESTDIR)$(PREFIX)/lib/
-	install -m 644 include/polarlux.h $(DESTDIR)$(PREFIX)/include/
+	install -m 644 $(LIB_A) $(PORT_A) $(DESTDIR)$(PREFIX)/lib/
+	install -m 755 $(LIB_SO_REAL) $(DESTDIR)$(PREFIX)/lib/
+	ln -sf $(notdir $(LIB_SO_REAL)) $(DESTDIR)$(PREFIX)/lib/$(SONAME)
+	ln -sf $(SONAME) $(DESTDIR)$(PREFIX)/lib/libpolarlux.so
+	install -m 644 include/polarlux.h include/polarlux_port.h $(DESTDIR)$(PREFIX)/include/
 	install -m 755 $(BIN) $(DESTDIR)$(PREFIX)/bin/
 	printf '%s\n' 'prefix=$(PREFIX)' 'libdir=$${prefix}/lib' 'includedir=$${prefix}/include' '' \
-	  'Name: polarlux' 'Description: exact night lighting of 2.5D cities' \
-	  'Version: $(VERSION)' 'Libs: -L$${libdir} -lpolarlux' 'Libs.private: $(LIBS)' \
-	  'Requires.private: libcjson libpng' 'Cflags: -I$${includedir}' \
+	  'Name: polarlux' 'Description: exact night lighting of 2.5D cities (portable core)' \
+	  'Version: $(VERSION)' 'Libs: -L$${libdir} -lpolarlux' 'Libs.private: $(CORE_LIBS)' \
+	  'Requires.private: libcjson' 'Cflags: -I$${includedir}' \
 	  > $(DESTDIR)$(PREFIX)/lib/pkgconfig/polarlux.pc
+	printf '%s\n' 'prefix=$(PREFIX)' 'libdir=$${prefix}/lib' 'includedir=$${prefix}/include' '' \
+	  'Name: polarlux-port' 'Description: polarlux POSIX port and PNG/PFM files' \
+	  'Version: $(VERSION)' 'Requires: polarlux' 'Libs: -L$${libdir} -lpolarlux-port' \
+	  'Libs.private: $(PORT_LIBS)' 'Requires.private: libpng' 'Cflags: -I$${includedir}' \
+	  > $(DESTDIR)$(PREFIX)/lib/pkgconfig/polarlux-port.pc
 
 clean:
 	rm -rf build

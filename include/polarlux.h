@@ -8,8 +8,30 @@
  *    names the part that asked; the engine stays usable.
  *  - Functions returning plx_status return PLX_OK (0) on success. On failure
  *    plx_last_error() holds one line saying what failed, where and why.
- *  - Out parameters are marked OUT. Pointers returned by the engine stay
- *    valid until the next call that loads a scene or destroys the engine.
+ *  - Out parameters are marked OUT.
+ *
+ * Each call below states three things:
+ *  - Errors: the plx_status values it returns. Besides those listed, every
+ *    call taking an engine returns PLX_E_INVALID for a NULL or destroyed
+ *    engine (then plx_last_error says "invalid engine handle"), and every
+ *    call that may take memory returns PLX_E_NOMEM when the block (or a
+ *    part's budget) is short: the message names the part and the bytes, and
+ *    the engine stays usable with what it held before.
+ *  - Lifetime: how long what it returns stays valid. Unless said otherwise,
+ *    pointers into the engine (ids, rings, arrays) stay valid until the next
+ *    plx_load_geojson / plx_load_file or plx_engine_destroy, whichever comes
+ *    first. Nothing the engine returns is ever freed by the caller.
+ *  - Threads: "engine" means the call may change the engine (caches built on
+ *    first need, result buffers, the error message): calls on one engine
+ *    must not overlap; different engines may be used from different threads
+ *    at the same time. "engine (reads)" means the call only reads the
+ *    engine: any number may run at once on one engine while no "engine" call
+ *    runs on it. "any" means the call touches no engine and no shared state.
+ *    Loading parses JSON with cJSON, whose allocation hooks are process-wide:
+ *    plx_load_* hold the port's lock (plx_port.lock) around the parse, so
+ *    engines loading in several threads at once need a port with a lock
+ *    (plx_port_posix has one), and an application's own cJSON hooks are
+ *    reset to cJSON's defaults after each load.
  */
 #ifndef POLARLUX_H
 #define POLARLUX_H
@@ -40,7 +62,8 @@ typedef enum plx_status {
     PLX_STATUS_COUNT
 } plx_status;
 
-/* A short fixed description of a status code ("out of memory", ...). */
+/* A short fixed description of a status code ("out of memory", ...);
+ * "unknown status" outside the enum. Lifetime: static. Threads: any. */
 const char *plx_strerror(plx_status s);
 
 /* Parts of the engine's memory, for budgets and reports. */
@@ -55,6 +78,8 @@ typedef enum plx_part {
     PLX_PART_COUNT
 } plx_part;
 
+/* "engine", "scene", ... ("unknown" outside the enum). Lifetime: static.
+ * Threads: any. */
 const char *plx_part_name(plx_part p);
 
 /* Log levels passed to plx_port.log. */
@@ -91,7 +116,8 @@ typedef struct plx_config {
     int32_t render_max_height;        /* (0: 1080) */
 } plx_config;
 
-/* Fills cfg with the defaults: no port, lenient loading, no part limits. */
+/* Fills cfg with the defaults: no port, lenient loading, no part limits
+ * (NULL: nothing). Threads: any. */
 void plx_config_default(plx_config *cfg);
 
 typedef struct plx_engine plx_engine;
@@ -104,30 +130,58 @@ typedef struct plx_engine plx_engine;
 /*
  * Creates an engine inside the caller's block 'mem' of 'size' bytes. The
  * engine object itself lives in the block; the caller keeps ownership and
- * frees it after plx_engine_destroy. Fails with PLX_E_INVALID when mem is
- * NULL or size < PLX_ENGINE_MIN_BYTES.
+ * frees it after plx_engine_destroy. cfg (may be NULL: the defaults) and
+ * its port table are copied; the port's ctx must outlive the engine.
+ * plx_memory_estimate says what size a scene needs.
+ * Errors: PLX_E_INVALID (mem or engine NULL, size < PLX_ENGINE_MIN_BYTES),
+ * PLX_E_NOMEM (the block cannot hold the engine object after alignment).
+ * Lifetime: *engine is valid until plx_engine_destroy. Threads: any (it
+ * touches only the block).
  */
 plx_status plx_engine_create(void *mem, size_t size, const plx_config *cfg,
                              plx_engine **engine /* OUT */);
-/* Ends the engine; the block may then be reused or freed by the caller. */
+/* Ends the engine; the block may then be reused or freed by the caller.
+ * Every pointer the engine gave out dies with it; a later call with the
+ * handle returns PLX_E_INVALID (as long as the block is not reused). NULL
+ * or a destroyed handle: no-op. Threads: engine. */
 void plx_engine_destroy(plx_engine *e);
-/* The block the engine was created in (the 'mem' given to plx_engine_create). */
+/* The block the engine was created in (the 'mem' given to plx_engine_create);
+ * NULL for an invalid handle. Threads: engine (reads). */
 void *plx_engine_block(const plx_engine *e);
 
-/* The last error message of this engine ("" after a success). Never NULL. */
+/* The message of the last failing call of this engine. Loads, visibility,
+ * illuminance, routes, renders and plx_set_ground_image clear it ("") when
+ * they succeed; the getters leave it as it was. Never NULL ("invalid engine
+ * handle" for a bad handle). Lifetime: the text lives in the engine and
+ * changes with the next call that fails or clears it. Threads: engine (reads). */
 const char *plx_last_error(const plx_engine *e);
 
-/* Number of warnings (skipped features, ignored properties) of the last load. */
+/* Number of warnings (skipped features, ignored properties) of the last load
+ * (0 for an invalid handle). Threads: engine (reads). */
 uint32_t plx_warning_count(const plx_engine *e);
 
 /*
  * Loads a scene from GeoJSON text (not necessarily NUL-terminated). 'name'
  * (may be NULL) prefixes messages. The previous scene and everything derived
  * from it are dropped first. On failure no scene is loaded and all memory the
- * load took is given back.
+ * load took is given back. Bad features are skipped with a warning through
+ * the port's log (or fail the load with plx_config.strict).
+ * Errors: PLX_E_INVALID (text NULL with len > 0), PLX_E_PARSE (malformed
+ * JSON, or nested deeper than 1000 levels: byte offset, line and column in
+ * the message), PLX_E_SCENE (not a FeatureCollection, unknown units, a bad
+ * feature with strict), PLX_E_NOMEM (the parse tree or the scene does not
+ * fit). Lifetime: text and name are not kept (ids are copied); everything
+ * derived from the previous scene (polar diagrams, lamp light, renderer,
+ * photons, ground image, pointers from every getter) is dropped at entry,
+ * even when the load fails. Threads: engine; see the header comment on the
+ * JSON lock.
  */
 plx_status plx_load_geojson(plx_engine *e, const char *text, size_t len, const char *name);
-/* The same from a file, read through the engine's port. */
+/* The same from a file, read through the engine's port into scratch memory
+ * (the file's bytes count against the block during the load).
+ * Errors: those of plx_load_geojson, and PLX_E_INVALID (path NULL),
+ * PLX_E_UNSUPPORTED (the port has no file_size/file_read), PLX_E_IO (the
+ * port could not read it: the message names the path and why). */
 plx_status plx_load_file(plx_engine *e, const char *path);
 
 typedef struct plx_scene_info {
@@ -149,7 +203,18 @@ typedef struct plx_scene_info {
     uint64_t load_ns;         /* time the load took, by the port's clock */
 } plx_scene_info;
 
+/* Errors: PLX_E_NOSCENE, PLX_E_INVALID (out NULL). Allocates nothing.
+ * Threads: engine (reads). */
 plx_status plx_scene_info_get(plx_engine *e, plx_scene_info *out /* OUT */);
+
+/* The scene's coordinate reference system as its file named it (a GeoJSON
+ * 2008 top-level "crs": {"type": "name", "properties": {"name": ...}}, or
+ * properties.crs as that object or a string), e.g.
+ * "urn:ogc:def:crs:EPSG::2154"; NULL when it named none (or no scene). A
+ * CRS other than WGS84 lon/lat (EPSG:4326, OGC CRS84) makes the load read
+ * coordinates as metres, as properties.units = "m" does. Valid until the
+ * next load. */
+const char *plx_scene_crs(plx_engine *e);
 
 /* ---- Ground albedo from a day image (README "Scene format") ------------- */
 
@@ -176,7 +241,7 @@ plx_status plx_scene_info_get(plx_engine *e, plx_scene_info *out /* OUT */);
  * rebuilt. Loading a scene drops the image.
  * Errors: PLX_E_NOSCENE; PLX_E_INVALID (sizes outside 1..16384, rgb8 NULL,
  * bounds not finite and increasing, a black image); PLX_E_NOMEM (the old
- * image stays).
+ * image stays). Lifetime: rgb8 is not kept. Threads: engine.
  */
 plx_status plx_set_ground_image(plx_engine *e, uint32_t width, uint32_t height, const uint8_t *rgb8,
                                 const double bounds[4]);
@@ -190,9 +255,13 @@ typedef struct plx_ground_image_info {
     double mean_luminance;    /* its luminance (the ground albedo unless pixels were clamped) */
 } plx_ground_image_info;
 
+/* Errors: PLX_E_NOSCENE, PLX_E_INVALID (out NULL). Lifetime: path points
+ * into the scene (until the next load). Threads: engine (reads). */
 plx_status plx_ground_image_get(plx_engine *e, plx_ground_image_info *out /* OUT */);
 
-/* The ground's albedo per channel at (x, y) (local metres). */
+/* The ground's albedo per channel at (x, y) (local metres).
+ * Errors: PLX_E_NOSCENE, PLX_E_INVALID (x or y not finite, rgb NULL).
+ * Threads: engine (reads). */
 plx_status plx_ground_albedo_at(plx_engine *e, double x, double y, double rgb[3] /* OUT */);
 
 typedef struct plx_building {
@@ -211,6 +280,26 @@ typedef struct plx_lamp {
     const char *id;
 } plx_lamp;
 
+/*
+ * Adds n lamps to the loaded scene: lamp layers from other files (the
+ * polarlux command's --lamps). Positions are in the scene's own
+ * coordinates: lon/lat degrees (x = lon, y = lat) on a lon/lat scene,
+ * projected with the scene's centre as at load; metres on a metre scene.
+ * z, intensity, radius and color as in the scene format (no defaults are
+ * applied here); 'feature' is the lamp's record number in its source (for
+ * messages) and 'id' is copied (may be NULL). 'source' (may be NULL) names
+ * the file in messages. As at load: a lamp out of range, or inside a
+ * building's solid, is left out with a warning (strict: the call fails and
+ * no lamp is added); a lamp within 1 mm on the ground of an earlier lamp is
+ * merged into it (the earlier kept) with a warning. A scene without
+ * buildings takes its Bounds from all lamps. Must come before anything
+ * computes light (illuminance, lit regions, photons, renders): PLX_E_INVALID
+ * after. Memory: a new lamp array in PLX_PART_SCENE (the old one stays held
+ * until the next load). Errors: PLX_E_NOSCENE, PLX_E_INVALID, PLX_E_SCENE
+ * (strict), PLX_E_NOMEM (no lamp added).
+ */
+plx_status plx_add_lamps(plx_engine *e, const plx_lamp *lamps, uint32_t n, const char *source);
+
 typedef struct plx_block {
     uint32_t nbuildings;
     const uint32_t *buildings; /* building indices */
@@ -218,18 +307,26 @@ typedef struct plx_block {
     double box[4];
 } plx_block;
 
+/* Building, lamp and block i. Errors: PLX_E_NOSCENE, PLX_E_RANGE (i not
+ * below the count of plx_scene_info), PLX_E_INVALID (out NULL). Lifetime:
+ * id and buildings point into the scene (until the next load). Allocate
+ * nothing. Threads: engine (reads) for valid arguments (an error writes the
+ * message). */
 plx_status plx_building_get(plx_engine *e, uint32_t i, plx_building *out /* OUT */);
 plx_status plx_lamp_get(plx_engine *e, uint32_t i, plx_lamp *out /* OUT */);
 plx_status plx_block_get(plx_engine *e, uint32_t i, plx_block *out /* OUT */);
 /* Ring r of building i: n vertices as x,y pairs in local metres, no closing
  * vertex; ring 0 is the outer ring (counter-clockwise), the rest holes
- * (clockwise). */
+ * (clockwise). Errors: PLX_E_NOSCENE, PLX_E_RANGE (i or r out of range),
+ * PLX_E_INVALID (xy or n NULL). Lifetime: *xy points into the scene (until
+ * the next load). Threads: as plx_building_get. */
 plx_status plx_building_ring(plx_engine *e, uint32_t i, uint32_t r,
                              const double **xy /* OUT */, uint32_t *n /* OUT */);
 /* Ring r of block i: ring 0 the outer boundary of the union of its
  * footprints (counter-clockwise, the largest), then its courtyards
  * (clockwise), then any further counter-clockwise rings (parts of the union
- * joined to the rest only at a point). See src/blocks.h for the rules. */
+ * joined to the rest only at a point). See src/scene/blocks.h for the rules.
+ * Errors, lifetime and threads as plx_building_ring. */
 plx_status plx_block_ring(plx_engine *e, uint32_t i, uint32_t r,
                           const double **xy /* OUT */, uint32_t *n /* OUT */);
 
@@ -240,12 +337,14 @@ typedef struct plx_memory_report {
     size_t used_total, peak_total;   /* all parts together */
 } plx_memory_report;
 
+/* All zero for an invalid handle; out NULL: nothing. Threads: engine (reads). */
 void plx_memory_get(const plx_engine *e, plx_memory_report *out /* OUT */);
 
 /*
  * Fault injection for tests: the k-th memory request from now on (k >= 1)
  * fails as if the block were exhausted; k = 0 switches it off. Returns the
- * number of memory requests served since the last call.
+ * number of memory requests served since the last call (0 for an invalid
+ * handle). Threads: engine.
  */
 uint64_t plx_debug_fail_alloc(plx_engine *e, uint64_t k);
 
@@ -255,7 +354,11 @@ uint64_t plx_debug_fail_alloc(plx_engine *e, uint64_t k);
  * Builds the four quadrant polar diagrams of the loaded scene (part
  * PLX_PART_POLAR) and the query result buffers (PLX_PART_FRAME). Queries
  * build them on first need; calling this first puts the cost up front.
- * Errors: PLX_E_NOSCENE, PLX_E_NOMEM (nothing kept).
+ * Built once per scene: later calls return at once.
+ * Errors: PLX_E_NOSCENE, PLX_E_NOMEM (nothing kept), PLX_E_INVALID
+ * (non-finite Bounds), PLX_E_SCENE (the construction's own cross-checks of
+ * its two maps disagree: a bug to report, not an input error).
+ * Threads: engine.
  */
 plx_status plx_polar_build(plx_engine *e);
 
@@ -268,7 +371,8 @@ typedef struct plx_polar_info {
     uint32_t vertices;        /* footprint vertices of the occluders */
 } plx_polar_info;
 
-/* Builds the diagrams if needed, then describes them. */
+/* Builds the diagrams if needed, then describes them. Errors: those of
+ * plx_polar_build, PLX_E_INVALID (out NULL). Threads: engine. */
 plx_status plx_polar_info_get(plx_engine *e, plx_polar_info *out /* OUT */);
 
 /*
@@ -278,6 +382,9 @@ plx_status plx_polar_info_get(plx_engine *e, plx_polar_info *out /* OUT */);
  * region's points: a building, or -1 for the Bounds frame, which encloses
  * the scene and is met first where the start ray reaches the box) and
  * whether the region is inside a footprint in *solid.
+ * Errors: those of plx_polar_build; PLX_E_INVALID (q outside 0..3, an
+ * output NULL); PLX_E_RANGE (i not below the region count). Threads: engine
+ * (they build the diagrams on first need; once built, engine (reads)).
  */
 plx_status plx_polar_region_count(plx_engine *e, int q, uint32_t *count /* OUT */);
 plx_status plx_polar_region(plx_engine *e, int q, uint32_t i, double xy[8] /* OUT */,
@@ -295,10 +402,13 @@ typedef struct plx_visibility {
  * The exact visibility polygon and visible set of the free point (x, y),
  * buildings infinitely tall, over the directions dir_deg ± fov_deg/2
  * (degrees counter-clockwise from +x, east); fov_deg >= 360 is the full turn.
- * The arrays in out stay valid until the next visibility query or load.
+ * Builds the polar diagrams on first need.
  * Errors: PLX_E_RANGE when the point is outside Bounds, on a wall or inside a
  * footprint (the message says which building); PLX_E_INVALID for non-finite
- * input or fov_deg <= 0; PLX_E_NOSCENE; PLX_E_NOMEM.
+ * input, fov_deg <= 0 or out NULL; PLX_E_NOSCENE; PLX_E_NOMEM.
+ * Lifetime: out->xy and out->visible point into engine buffers that the
+ * next plx_visibility_get overwrites; a load drops them.
+ * Threads: engine (the result buffers are the engine's).
  */
 plx_status plx_visibility_get(plx_engine *e, double x, double y, double dir_deg, double fov_deg,
                               plx_visibility *out /* OUT */);
@@ -315,6 +425,12 @@ plx_status plx_visibility_get(plx_engine *e, double x, double y, double dir_deg,
  * returns PLX_E_RANGE naming the first such point; the others are filled.
  * Lamp lit regions are computed on first need and cached (part
  * PLX_PART_LIT, pool size from plx_config.lit_cache_bytes).
+ * Errors: PLX_E_NOSCENE; PLX_E_INVALID (P, N or E_direct NULL with n > 0);
+ * PLX_E_RANGE (some point not on a surface, non-finite, or a normal not of
+ * unit length within 1e-6: the others are still filled); PLX_E_NOMEM
+ * (setting up lamp light). Lifetime: nothing kept from the arrays. Threads:
+ * engine (the lit-region cache changes; may evict the polygons of
+ * plx_lit_ground / plx_lit_facade).
  */
 plx_status plx_illuminance(plx_engine *e, size_t n, const double *P, const double *N,
                            double *E_direct /* OUT */, double *E_indirect /* OUT */,
@@ -327,14 +443,17 @@ plx_status plx_illuminance(plx_engine *e, size_t n, const double *P, const doubl
  * colour-blind E_indirect (lux, as plx_illuminance reports it) goes to
  * E_indirect (may be NULL). 0 until indirect light is computed. Same
  * checks as plx_illuminance (NaN and PLX_E_RANGE for points not on a
- * surface); PLX_E_INVALID when P, N or rgb is NULL with n > 0.
+ * surface); PLX_E_INVALID when P, N or rgb is NULL with n > 0;
+ * PLX_E_NOSCENE; PLX_E_NOMEM (setting up lamp light). Threads: engine.
  */
 plx_status plx_indirect_rgb(plx_engine *e, size_t n, const double *P, const double *N,
                             double *E_indirect /* OUT */, double *rgb /* OUT */);
 
 /* Is P (normal n) lit, and by which lamps: up to cap lamp indices and their
  * terms in lux, in lamp order; *count gets the number of lamps lighting P
- * (which may exceed cap). Same checks as plx_illuminance. */
+ * (which may exceed cap). Same checks as plx_illuminance (PLX_E_RANGE for a
+ * point not on a surface); PLX_E_INVALID (P, n or count NULL, or ids/lux
+ * NULL with cap > 0); PLX_E_NOSCENE; PLX_E_NOMEM. Threads: engine. */
 plx_status plx_lamps_at(plx_engine *e, const double P[3], const double n[3], uint32_t *ids /* OUT */,
                         double *lux /* OUT */, uint32_t cap, uint32_t *count /* OUT */);
 
@@ -347,12 +466,22 @@ typedef struct plx_lit_region {
 /*
  * The lit region of a lamp within its reach. The polygons are read with
  * plx_lit_ground / plx_lit_facade and stay valid until the next call that
- * computes light (illuminance, another lamp's region) or a load.
+ * computes light (plx_illuminance, plx_indirect_rgb, plx_lamps_at,
+ * plx_route_score, plx_render, another plx_lit_region_get: any may evict it
+ * from the cache) or a load.
+ * Errors: PLX_E_NOSCENE; PLX_E_INVALID (out NULL); PLX_E_RANGE (no such
+ * lamp); PLX_E_NOMEM (the region does not fit the lit cache: raise
+ * plx_config.lit_cache_bytes); PLX_E_UNSUPPORTED (the lamp's reach crosses
+ * more than 64 building intervals along some direction: no polygons, light
+ * unaffected). Threads: engine.
  */
 plx_status plx_lit_region_get(plx_engine *e, uint32_t lamp, plx_lit_region *out /* OUT */);
-/* Ground polygon k: n vertices, x,y pairs. */
+/* Ground polygon k of the last plx_lit_region_get: n vertices, x,y pairs.
+ * Errors: PLX_E_RANGE (no region got yet, k out of range, an output NULL).
+ * Lifetime: as the region (see above). Threads: engine (reads). */
 plx_status plx_lit_ground(plx_engine *e, uint32_t k, const double **xy /* OUT */, uint32_t *n /* OUT */);
-/* Facade polygon k: n vertices, x,y,z triples, on the wall of building *bld. */
+/* Facade polygon k: n vertices, x,y,z triples, on the wall of building
+ * *bld. Errors, lifetime and threads as plx_lit_ground. */
 plx_status plx_lit_facade(plx_engine *e, uint32_t k, const double **xyz /* OUT */, uint32_t *n /* OUT */,
                           uint32_t *bld /* OUT */);
 
@@ -364,17 +493,34 @@ plx_status plx_lit_facade(plx_engine *e, uint32_t k, const double **xyz /* OUT *
  * photon buffers (part PLX_PART_PHOTON, created on first need). After one or
  * more frames plx_illuminance fills E_indirect and plx_render adds indirect
  * light. Deterministic for (frames so far, photons, seed).
- * Errors: PLX_E_NOSCENE, PLX_E_INVALID (photons == 0), PLX_E_NOMEM.
+ * Errors: PLX_E_NOSCENE, PLX_E_INVALID (photons == 0), PLX_E_NOMEM (the
+ * buffers are about 40 MiB with the defaults; plx_memory_estimate leaves
+ * them out). Threads: engine.
  */
 plx_status plx_indirect_step(plx_engine *e, uint32_t photons, uint64_t seed);
-/* Frames accumulated so far (0 before the first step or after a reset). */
+/* Frames accumulated so far (0 before the first step or after a reset, or
+ * for an invalid handle). Threads: engine (reads). */
 uint64_t plx_indirect_frames(const plx_engine *e);
 /* Chart resolution levels for a viewer at eye looking along dir (unit, or
  * NULL for all around) with a full cone of fov_deg (argudo2012 §3.6); blocks
- * whose level changes start again. */
+ * whose level changes start again. Errors: PLX_E_NOSCENE, PLX_E_INVALID
+ * (eye NULL), PLX_E_NOMEM. Creates the photon buffers on first need.
+ * Threads: engine. */
 plx_status plx_indirect_set_viewer(plx_engine *e, const double eye[3], const double dir[3], double fov_deg);
-/* Drops every accumulated photon. */
+/* Drops every accumulated photon (none yet: nothing to do). Errors: only
+ * the invalid handle. Threads: engine. */
 plx_status plx_indirect_reset(plx_engine *e);
+/*
+ * How plx_illuminance and plx_indirect_rgb (and so routes) estimate
+ * E_indirect at points: final gathering over side x side stratified
+ * cosine-weighted directions (default 16: 256 directions), each gathering
+ * a (E_direct + E_photons) from the first surface it meets, E_direct exact,
+ * the photon buffers only for light that bounced before (README,
+ * "Indirect light"); side 0: the photon buffers' own estimate at the point
+ * (the older method). Images always read the photon buffers. Errors:
+ * PLX_E_INVALID (side > 1024).
+ */
+plx_status plx_indirect_set_gather(plx_engine *e, uint32_t side);
 
 #define PLX_REFINE_LRU_MAX 64
 
@@ -403,7 +549,10 @@ plx_status plx_indirect_refine(plx_engine *e, const double eye[3], plx_refine_st
  * Histogram matching of a day orthophoto to a night palette (munoz2013
  * §3.1): each channel of day (npx RGB8 pixels) is mapped so its histogram
  * follows night's (nnight pixels), leaving out night pixels darker than
- * dark_threshold (luminance 0..255). out may be day. Needs no engine.
+ * dark_threshold (luminance 0..255). out may be day. Needs no engine and
+ * allocates nothing (when every night pixel is darker than the threshold,
+ * all are used). Errors: PLX_E_INVALID (a NULL array, npx or nnight 0).
+ * Threads: any.
  */
 plx_status plx_nightify(const uint8_t *day, size_t npx, const uint8_t *night, size_t nnight,
                         double dark_threshold, uint8_t *out /* OUT */);
@@ -440,6 +589,7 @@ typedef struct plx_render_opts {
 
 #define PLX_RENDER_MAX_AA 16
 
+/* Exposure 1, everything else off (NULL: nothing). Threads: any. */
 void plx_render_opts_default(plx_render_opts *o /* OUT */);
 
 typedef struct plx_render_info {
@@ -455,9 +605,13 @@ typedef struct plx_render_info {
  * linear radiance); either may be NULL. Indirect light is added when photon
  * frames were traced (plx_indirect_step) unless o->no_indirect. The
  * renderer's own buffers come from the engine (PLX_PART_FRAME) on first use.
- * Errors: PLX_E_INVALID (bad camera: eye below the ground, eye == target,
- * size above the maximum), PLX_E_NOSCENE, PLX_E_NOMEM, PLX_E_UNSUPPORTED
- * (o->backend could not draw the frame).
+ * Lamp light, the renderer's frame buffers and mesh (sized for the
+ * config's largest frame) and, with o->aerial, the aerial light map are
+ * built on first need and kept until the next load.
+ * Errors: PLX_E_INVALID (cam NULL; bad camera: eye below the ground, eye ==
+ * target, size above the maximum), PLX_E_NOSCENE, PLX_E_NOMEM,
+ * PLX_E_UNSUPPORTED (o->backend could not draw the frame). Lifetime: the
+ * caller's buffers are written, not kept. Threads: engine.
  */
 plx_status plx_render(plx_engine *e, const plx_camera *cam, const plx_render_opts *o, uint8_t *rgb8 /* OUT */,
                       float *rgbf /* OUT */, plx_render_info *info /* OUT */);
@@ -482,12 +636,16 @@ typedef struct plx_route_stats {
  * whole line, segments (may be NULL) n-1 entries, one per segment. The
  * P-class is the best class whose mean and minimum the line meets (P1 15/3,
  * P2 10/2, P3 7.5/1.5, P4 5/1, P5 3/0.6, P6 2/0.4 lx).
- * Errors: PLX_E_INVALID (n < 2, step <= 0, non-finite input), PLX_E_NOMEM.
+ * Samples inside a footprint are not scored (blocked_length).
+ * Errors: PLX_E_INVALID (xy NULL, n < 2, step <= 0, dark_lux < 0,
+ * non-finite input), PLX_E_NOSCENE, PLX_E_NOMEM (the samples of one segment
+ * are held in scratch: 64 bytes a sample). Threads: engine.
  */
 plx_status plx_route_score(plx_engine *e, const double *xy, uint32_t n, double step, double dark_lux,
                            plx_route_stats *total /* OUT */, plx_route_stats *segments /* OUT */);
 
-/* The EN 13201 P-class (1..6, 0 for none) met by mean and minimum lux. */
+/* The EN 13201 P-class (1..6, 0 for none) met by mean and minimum lux.
+ * Threads: any. */
 int plx_p_class(double mean, double min);
 
 /* ---- Procedural cities (plx gen) ------------------------------------- */
@@ -499,6 +657,9 @@ typedef int (*plx_write_fn)(void *ctx, const char *data, size_t len);
  * Writes a procedural city as a GeoJSON FeatureCollection in metres.
  * style: "grid", "eixample" or "oldtown"; nx, ny: blocks along x and y.
  * Deterministic for a seed. Needs no engine and allocates nothing.
+ * Errors: PLX_E_INVALID (unknown style, nx or ny outside 1..1000, style or
+ * write NULL), PLX_E_IO (write returned non-zero: stopped there).
+ * Threads: any (write is called from the calling thread only).
  */
 plx_status plx_gen_city(const char *style, int nx, int ny, uint64_t seed,
                         plx_write_fn write, void *ctx);
@@ -556,14 +717,65 @@ plx_status plx_bake_block_size(const void *bake, size_t len, size_t *block_bytes
 plx_status plx_bake_load(void *mem, size_t size, const plx_config *cfg, const void *bake, size_t len,
                          plx_engine **engine /* OUT */, char *err, size_t errlen);
 
-/* ---- POSIX port (port/posix) ----------------------------------------- */
+/* ---- Embedding: coordinates and memory sizing -------------------------- */
 
-/* The POSIX services: clock_gettime, stderr logging, stdio files. */
-const plx_port *plx_port_posix(void);
-/* Creates an engine in a block of 'budget' bytes taken from the C heap. */
-plx_status plx_engine_new(size_t budget, const plx_config *cfg, plx_engine **engine /* OUT */);
-/* Destroys an engine made by plx_engine_new and frees its block. */
-void plx_engine_free(plx_engine *e);
+/*
+ * The SPEC §1 projection of the loaded lon/lat scene, for n points given as
+ * pairs (lon, lat degrees / x, y metres), in may equal out:
+ *   x = (lon - lon0) * 111320 * cos(lat0),  y = (lat - lat0) * 110540
+ * about the centre (lon0, lat0) of plx_scene_info; the forward direction is
+ * bit for bit what the loader did to the scene's coordinates. Non-finite
+ * input gives non-finite output (no check).
+ * Errors: PLX_E_NOSCENE; PLX_E_INVALID (the scene is in local metres, or an
+ * array NULL with n > 0). Reads the scene only: may run in several threads
+ * at once on one engine as long as no thread loads a scene meanwhile.
+ */
+plx_status plx_lonlat_to_local(plx_engine *e, size_t n, const double *lonlat, double *xy /* OUT */);
+plx_status plx_local_to_lonlat(plx_engine *e, size_t n, const double *xy, double *lonlat /* OUT */);
+
+/* What a GeoJSON text holds, counted without parsing it. */
+typedef struct plx_scene_size {
+    uint64_t text_bytes;   /* the text's length */
+    uint64_t json_values;  /* JSON values (objects, arrays, strings, numbers, literals; keys not) */
+    uint64_t string_bytes; /* bytes of every string, keys included, plus 1 each */
+    uint64_t features;     /* "Feature" strings */
+    uint64_t points;       /* "Point" strings: at least the lamps */
+    uint64_t positions;    /* arrays of numbers: vertices and points */
+    uint64_t rings;        /* arrays of positions: rings (at least the buildings) */
+} plx_scene_size;
+
+/*
+ * Counts text (len bytes, not necessarily NUL-terminated) in one pass, with
+ * no engine and no memory. Malformed text gives counts anyway (the load
+ * will say what is wrong). Errors: PLX_E_INVALID (out NULL, text NULL with
+ * len > 0). Thread-safe (touches only *out).
+ */
+plx_status plx_scene_size_scan(const char *text, size_t len, plx_scene_size *out /* OUT */);
+
+/* What the caller will do with the scene (OR them); loading is always counted. */
+#define PLX_USE_LOAD       0u
+#define PLX_USE_VISIBILITY 1u  /* polar diagrams: plx_visibility_get, plx_polar_* */
+#define PLX_USE_LIGHT      2u  /* plx_illuminance, plx_lamps_at, lit regions, routes */
+#define PLX_USE_RENDER     4u  /* plx_render at the config's largest frame (direct light,
+                                  aerial light map not included) */
+
+/*
+ * The block size (bytes, for plx_engine_create) that a scene of these
+ * counts needs for the uses asked, with the config's sizes (lit cache,
+ * largest frame; cfg NULL: the defaults). Counts the caller knows by other
+ * means may be given by hand: set positions (vertices + lamps), rings
+ * (buildings), points (lamps), features; text_bytes, json_values and
+ * string_bytes left 0 are then derived from them. Photon buffers
+ * (plx_indirect_step) are not included. Returns 0 when sz is NULL or the
+ * size does not fit in size_t. Pure function: thread-safe.
+ */
+size_t plx_memory_estimate(const plx_scene_size *sz, const plx_config *cfg, unsigned uses);
+
+/* ---- Ports -------------------------------------------------------------- */
+
+/* The POSIX port (plx_port_posix, plx_engine_new, plx_engine_free) and the
+ * PNG/PFM files are not part of this library: see polarlux_port.h and
+ * libpolarlux-port. */
 
 #ifdef __cplusplus
 }

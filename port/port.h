@@ -6,7 +6,7 @@
 #define PLX_PORT_H
 
 #include <stddef.h>
-#include "polarlux.h"
+#include "polarlux_port.h"
 
 /* Reads a whole file into a malloc'd NUL-terminated buffer; NULL and a
  * reason in err on failure. The caller frees it. */

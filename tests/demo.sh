@@ -10,7 +10,7 @@ echo "== $scene: central Helsinki, OpenStreetMap (c) OpenStreetMap contributors,
 "$bin" info --quiet "$scene"
 echo
 echo "== night images"
-"$bin" render --quiet "$scene" --eye -45,-434,1.7 --target 120,-426,5 --exposure 0.4 \
+"$bin" render --quiet "$scene" --eye 24.943483,60.167700,1.7 --target 24.946463,60.167773,5 --exposure 0.4 \
     -o "$out/helsinki-street.png" --pfm "$out/helsinki-street.pfm"
 "$bin" render --quiet "$scene" --view aerial --size 720x1080 --texel 2 --exposure 0.4 -o "$out/helsinki-aerial.png"
 "$bin" heatmap --quiet "$scene" -o "$out/helsinki-heatmap.png"
@@ -18,8 +18,8 @@ echo
 echo "== how well lit are two walks (EN 13201 P-classes)"
 "$bin" route --quiet "$scene" --path fixtures/helsinki-route.geojson --geojson "$out/helsinki-route.geojson"
 echo
-echo "== visibility from a pedestrian at (0, -431.5) looking east"
-"$bin" vis --quiet "$scene" --at 0,-431.5 --dir 0 --fov 90 | tail -2
+echo "== visibility from a pedestrian at (24.944296, 60.167723) looking east"
+"$bin" vis --quiet "$scene" --at 24.944296,60.167723 --dir 0 --fov 90 | tail -2
 echo
 echo "== kiosk: bake the district once, then walk along a street from the bake"
 "$bin" bake --quiet "$scene" --frames 64 --texel 2 --max-size 640x480 -o "$out/helsinki.plxb"

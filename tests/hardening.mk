@@ -42,11 +42,11 @@ FUZZ_OPTS ?= -timeout=20 -rss_limit_mb=4096 -max_len=65536 -print_final_stats=1
 
 fuzz-build:
 	$(MAKE) BUILD=$(FUZZ_BUILD) CC=$(FUZZ_CC) OPT="-O1 -g -fno-omit-frame-pointer" \
-	  EXTRA_CFLAGS="-fsanitize=fuzzer-no-link $(FUZZ_SAN)" $(FUZZ_BUILD)/libpolarlux.a
+	  EXTRA_CFLAGS="-fsanitize=fuzzer-no-link $(FUZZ_SAN) -DPLX_DEBUG" $(FUZZ_BUILD)/libpolarlux.a $(FUZZ_BUILD)/libpolarlux-port.a
 	@for n in $(FUZZ_NAMES); do \
 	  echo "$(FUZZ_CC) ... tests/fuzz/$$n.c -o $(FUZZ_BUILD)/$$n"; \
 	  $(FUZZ_CC) $(CPPFLAGS) $(POSIX) $(WARN) $(FPFLAGS) -O1 -g -fsanitize=fuzzer $(FUZZ_SAN) \
-	    tests/fuzz/$$n.c -o $(FUZZ_BUILD)/$$n $(FUZZ_BUILD)/libpolarlux.a $(LIBS) || exit 1; \
+	    tests/fuzz/$$n.c -o $(FUZZ_BUILD)/$$n $(FUZZ_BUILD)/libpolarlux-port.a $(FUZZ_BUILD)/libpolarlux.a $(LIBS) || exit 1; \
 	done
 
 fuzz_seeds = $(or $(FUZZ_SEEDS_$(1)),fixtures)
@@ -61,10 +61,10 @@ fuzz: fuzz-build
 REPLAY_BUILD = build/fuzz-replay
 fuzz-replay:
 	$(MAKE) BUILD=$(REPLAY_BUILD) OPT="-O1 -g -fno-omit-frame-pointer" \
-	  EXTRA_CFLAGS="$(FUZZ_SAN)" $(REPLAY_BUILD)/libpolarlux.a
+	  EXTRA_CFLAGS="$(FUZZ_SAN) -DPLX_DEBUG" $(REPLAY_BUILD)/libpolarlux.a $(REPLAY_BUILD)/libpolarlux-port.a
 	@for n in $(FUZZ_NAMES); do \
 	  $(CC) $(CPPFLAGS) $(POSIX) $(WARN) $(FPFLAGS) -O1 -g $(FUZZ_SAN) tests/fuzz/$$n.c \
-	    tests/fuzz/replay_main.c -o $(REPLAY_BUILD)/$$n $(REPLAY_BUILD)/libpolarlux.a $(LIBS) || exit 1; \
+	    tests/fuzz/replay_main.c -o $(REPLAY_BUILD)/$$n $(REPLAY_BUILD)/libpolarlux-port.a $(REPLAY_BUILD)/libpolarlux.a $(LIBS) || exit 1; \
 	done
 	@$(foreach n,$(FUZZ_NAMES),$(REPLAY_BUILD)/$(n) $(call fuzz_seeds,$(n)) && ) \
 	echo "fuzz-replay: $(words $(FUZZ_NAMES)) targets clean"
@@ -151,7 +151,7 @@ FS_BUILD   = build/freestanding
 FS_FLAGS   = -ffreestanding -mthumb -mcpu=cortex-m4 -Os -ffunction-sections -fdata-sections
 FS_OBJ     = $(CORE_SRC:src/%.c=$(FS_BUILD)/%.o)
 # string.h, qsort and every C99 math.h function (double and float)
-FS_ALLOWED = memcpy memmove memset memcmp memchr strlen strcmp strncmp strchr qsort \
+FS_ALLOWED = memcpy memmove memset memcmp memchr strlen strcmp strncmp strchr strstr qsort \
              acos asin atan atan2 cos sin tan acosh asinh atanh cosh sinh tanh exp exp2 \
              expm1 frexp ldexp log log10 log1p log2 logb modf scalbn cbrt fabs hypot \
              pow sqrt erf erfc lgamma tgamma ceil floor nearbyint rint lrint llrint \

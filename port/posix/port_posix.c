@@ -9,7 +9,7 @@
 #include <unistd.h>
 #include <sys/stat.h>
 
-#include "polarlux.h"
+#include "polarlux_port.h"
 #include "port.h"
 
 static pthread_mutex_t json_mutex = PTHREAD_MUTEX_INITIALIZER;

@@ -166,3 +166,10 @@ plx_status plx_block_ring(plx_engine *e, uint32_t i, uint32_t r, const double **
         return bad_index(e, "plx_block_ring (ring)", r, k->ring_count);
     return ring_out(e->sc->block_pts, &e->sc->block_rings[k->ring_first + r], xy, n);
 }
+
+const char *plx_scene_crs(plx_engine *e)
+{
+    if (eng_need_scene(e, "plx_scene_crs") != PLX_OK)
+        return NULL;
+    return e->sc->crs;
+}

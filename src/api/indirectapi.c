@@ -3,6 +3,7 @@
 
 #include "base/engine.h"
 #include "photon/photon.h"
+#include "photon/final_gather.h"
 
 static plx_status need_photons(plx_engine *e, const char *fn)
 {
@@ -12,7 +13,12 @@ static plx_status need_photons(plx_engine *e, const char *fn)
         return st;
     if (e->ph)
         return PLX_OK;
-    photon_config_default(&cfg);
+    /* final gathering reads the later bounces all around its points: every
+     * block gets a chart (photon.h, coarsest_level) */
+    if (!e->gather_set || e->gather_side > 0)
+        photon_config_gather(&cfg, e->sc);
+    else
+        photon_config_default(&cfg);
     st = photon_create(&e->mem, e->sc, &cfg, &e->ph);
     if (st == PLX_E_NOMEM)
         return eng_nomem(e, "creating the photon buffers");
@@ -93,9 +99,19 @@ double eng_indirect(plx_engine *e, const double P[3], const double n[3])
     return eng_indirect_rgb(e, P, n, NULL);
 }
 
-/* The same with its RGB version (each lamp's light weighted by its colour:
- * the photons carry both). */
+/* The same with its RGB version: final gathering unless it is off
+ * (final_gather.h), else the photon buffers' own estimate. */
 double eng_indirect_rgb(plx_engine *e, const double P[3], const double n[3], double rgb[3])
+{
+    uint32_t side = e->gather_set ? e->gather_side : FINAL_GATHER_SIDE;
+    if (!e->ph || plx_indirect_frames(e) == 0 || side == 0 || !e->lt)
+        return eng_indirect_photons_rgb(e, P, n, rgb);
+    return final_gather_rgb(e->ph, e->ph->T, e->lt, P, n, side, 1, rgb);
+}
+
+/* The photon buffers alone (what images read). */
+double eng_indirect_photons_rgb(plx_engine *e, const double P[3], const double n[3],
+                                double rgb[3])
 {
     if (!e->ph || plx_indirect_frames(e) == 0) {
         if (rgb)
@@ -103,6 +119,17 @@ double eng_indirect_rgb(plx_engine *e, const double P[3], const double n[3], dou
         return 0.0;
     }
     return photon_indirect_rgb(e->ph, P, n, rgb);
+}
+
+plx_status plx_indirect_set_gather(plx_engine *e, uint32_t side)
+{
+    if (!eng_ok(e))
+        return PLX_E_INVALID;
+    if (side > 1024)
+        return eng_fail(e, PLX_E_INVALID, "plx_indirect_set_gather: side must be at most 1024");
+    e->gather_side = side;
+    e->gather_set = 1;
+    return PLX_OK;
 }
 
 plx_status plx_nightify(const uint8_t *day, size_t npx, const uint8_t *night, size_t nnight,

@@ -21,7 +21,7 @@ void plx_render_opts_default(plx_render_opts *o)
  * weighted by its colour, carried by the photons; SPEC §5). */
 static void shade_indirect(void *user, const double P[3], const double n[3], double rgb[3])
 {
-    eng_indirect_rgb(user, P, n, rgb);
+    eng_indirect_photons_rgb(user, P, n, rgb);
 }
 
 plx_status eng_need_render(plx_engine *e)

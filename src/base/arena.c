@@ -1,7 +1,14 @@
 #include "base/arena.h"
+#include "base/plx_assert.h"
+
+/* Invariants (PLX_ASSERT in debug builds): lo + hi <= cap; the base is
+ * PLX_ENGINE_ALIGN-aligned; every block handed out lies inside the free
+ * middle and is aligned to its request (up to the base's alignment); marks
+ * are released in stack order within the block. */
 
 static size_t align_up(size_t v, size_t align)
 {
+    PLX_ASSERT(align != 0 && (align & (align - 1)) == 0 && align <= 64);
     return (v + align - 1) & ~(align - 1);
 }
 
@@ -20,6 +27,7 @@ void arena_init(arena *a, void *mem, size_t size)
     a->fail_at = 0;
     a->failed_part = PLX_PART_ENGINE;
     a->failed_size = 0;
+    PLX_ASSERT(((uintptr_t)a->base & (PLX_ENGINE_ALIGN - 1)) == 0 || a->cap == 0);
 }
 
 size_t arena_mul(size_t n, size_t size)
@@ -51,6 +59,8 @@ static int admit(arena *a, plx_part part, size_t size)
 static void account(arena *a, plx_part part, size_t bytes)
 {
     size_t total = a->lo + a->hi;
+    PLX_ASSERT((unsigned)part < PLX_PART_COUNT);
+    PLX_ASSERT(a->lo <= a->cap && a->hi <= a->cap - a->lo);
     a->used[part] += bytes;
     if (a->used[part] > a->peak[part])
         a->peak[part] = a->used[part];
@@ -69,6 +79,7 @@ void *arena_alloc(arena *a, plx_part part, size_t size, size_t align)
     if (start < a->lo || start > a->cap - a->hi || size > a->cap - a->hi - start)
         return refuse(a, part, size), NULL;
     end = start + size;
+    PLX_ASSERT(part != PLX_PART_SCRATCH && start % align == 0);
     {
         size_t grown = end - a->lo;
         a->lo = end;
@@ -105,6 +116,7 @@ void *arena_scratch(arena *a, size_t size, size_t align)
     start = (top - size) & ~(align - 1);
     if (start < a->lo)
         return refuse(a, PLX_PART_SCRATCH, size), NULL;
+    PLX_ASSERT((align & (align - 1)) == 0 && start % align == 0 && start >= a->lo);
     a->hi = a->cap - start;
     account(a, PLX_PART_SCRATCH, top - start);
     return a->base + start;
@@ -124,6 +136,7 @@ arena_mark arena_get_mark(const arena *a)
 void arena_release(arena *a, const arena_mark *m)
 {
     size_t i;
+    PLX_ASSERT(m->lo <= a->cap && m->hi <= a->cap - m->lo);
     a->lo = m->lo;
     a->hi = m->hi;
     for (i = 0; i < PLX_PART_COUNT; i++)

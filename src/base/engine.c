@@ -1,4 +1,6 @@
 #include "base/engine.h"
+#include "base/plx_assert.h"
+#include <math.h>
 #include <string.h>
 
 static const char *const status_text[PLX_STATUS_COUNT] = {
@@ -206,4 +208,38 @@ uint64_t plx_debug_fail_alloc(plx_engine *e, uint64_t k)
     e->mem.requests = 0;
     e->mem.fail_at = k;
     return served;
+}
+
+#ifdef PLX_DEBUG
+static void check_rings(const scene_ring *rings, uint32_t first, uint32_t count, uint32_t nrings, uint32_t npts)
+{
+    uint32_t r;
+    PLX_ASSERT(first <= nrings && count <= nrings - first);
+    for (r = first; r < first + count; r++)
+        PLX_ASSERT(rings[r].count >= 3 && rings[r].first <= npts && rings[r].count <= npts - rings[r].first);
+}
+#endif
+
+void eng_check_scene(const scene *s)
+{
+#ifdef PLX_DEBUG
+    uint32_t i, k;
+    for (i = 0; i < s->nbld; i++) {
+        const scene_building *b = &s->bld[i];
+        PLX_ASSERT(b->ring_count >= 1 && b->block < s->nblocks);
+        PLX_ASSERT(b->min_height >= 0.0 && b->min_height < b->height);
+        check_rings(s->rings, b->ring_first, b->ring_count, s->nrings, s->npts);
+    }
+    for (k = 0; k < s->nblocks; k++) {
+        const scene_block *g = &s->blocks[k];
+        PLX_ASSERT(g->bld_count >= 1 && g->bld_first <= s->nbld && g->bld_count <= s->nbld - g->bld_first);
+        for (i = g->bld_first; i < g->bld_first + g->bld_count; i++)
+            PLX_ASSERT(s->block_bld[i] < s->nbld && s->bld[s->block_bld[i]].block == k);
+        check_rings(s->block_rings, g->ring_first, g->ring_count, s->nblock_rings, s->nblock_pts);
+    }
+    for (i = 0; i < s->nlamps; i++)
+        PLX_ASSERT(isfinite(s->lamps[i].x) && isfinite(s->lamps[i].y) && s->lamps[i].z >= 0.0);
+#else
+    (void)s;
+#endif
 }

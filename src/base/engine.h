@@ -31,6 +31,10 @@ struct plx_engine {
     struct photon_sys *ph;  /* photon buffers, created on first need */
     double lightmap_cell;   /* light map texel size when built, else 0 */
     float *aa_sum;          /* anti-aliasing sum (PLX_PART_FRAME), taken on first need */
+    uint32_t gather_side;   /* final gathering at points: side^2 directions
+                               (0 = photon buffers only); set by
+                               plx_indirect_set_gather, else FINAL_GATHER_SIDE */
+    int gather_set;         /* plx_indirect_set_gather was called */
 };
 
 #define ENGINE_MAGIC 0x504c5831u /* "PLX1" */
@@ -56,6 +60,15 @@ plx_status eng_need_render(plx_engine *e);
 /* Builds the aerial light map at m_per_texel metres (0: 1 m) unless built;
  * dark: with a shader giving no light (the bake's twin, bake.c). */
 plx_status eng_need_lightmap(plx_engine *e, double m_per_texel, int dark);
+/* E_indirect read from the photon buffers alone (images; indirectapi.c). */
+double eng_indirect_photons_rgb(plx_engine *e, const double P[3], const double n[3],
+                                double rgb[3] /* OUT */);
+
+/* Debug builds (PLX_DEBUG): asserts the invariants of a loaded scene (rings
+ * of at least 3 vertices inside the point array, buildings' and blocks'
+ * rings inside the ring arrays, every building in its block, lamps finite).
+ * Release builds: nothing. */
+void eng_check_scene(const scene *s);
 /* Checks the engine handle for API misuse. */
 int eng_ok(const plx_engine *e);
 

@@ -83,6 +83,7 @@ typedef struct scene {
     scene_ground_image *gimg;   /* pixels given by plx_set_ground_image, or NULL */
     int lonlat;
     double lon0, lat0;
+    const char *crs;      /* the scene's CRS name (top-level "crs" or properties.crs), or NULL */
     double height_min, height_median, height_max;
     uint32_t skipped_features, skipped_lamps, overlapping_pairs;
     uint64_t load_ns;

@@ -4,6 +4,7 @@
 
 #include <stdio.h>
 #include "polarlux.h"
+#include "polarlux_port.h"
 
 /* Exit codes (README, "Exit codes"). */
 enum {
@@ -13,11 +14,16 @@ enum {
     EXIT_NOMEM = 3   /* the memory budget (--mem) is too small */
 };
 
+#define CLI_MAX_LAMP_FILES 16
+
 typedef struct cli_common {
     size_t mem;      /* engine budget in bytes (--mem) */
     int strict;      /* --strict */
     int quiet;       /* --quiet: no warnings on stderr */
     int render_w, render_h; /* largest frame the engine will render (0: default) */
+    const char *lamp_files[CLI_MAX_LAMP_FILES]; /* --lamps FILE, in order */
+    int nlamp_files;
+    const char *points_crs; /* --points-crs: lonlat, local, or a CRS name (NULL: the file says, or the scene's) */
 } cli_common;
 
 #define CLI_DEFAULT_MEM ((size_t)1 << 30)
@@ -53,9 +59,14 @@ typedef struct cli_indirect {
     long photons;    /* per frame (default 65536) */
     long frames;     /* progressive frames (default 16) */
     int off;         /* --no-indirect */
+    long gather;     /* --gather N: final gathering side at points (0 = photon
+                        buffers only); -1 = the engine's default */
 } cli_indirect;
+/* Photon frames by default when points are answered by final gathering
+ * (illum): the photons carry only the later bounces (16 x 65536). */
+#define CLI_GATHER_FRAMES 16
 void cli_indirect_default(cli_indirect *ind);
-/* Handles --photons N, --frames K, --no-indirect at argv[*i]; 1 if consumed, -1 on error. */
+/* Handles --photons N, --frames K, --no-indirect, --gather N at argv[*i]; 1 if consumed, -1 on error. */
 int cli_indirect_option(const char *cmd, int argc, char **argv, int *i, cli_indirect *ind);
 /* Traces the frames (progress on a terminal), viewer at eye looking along
  * dir (either may be NULL). Returns an exit code. */
@@ -66,6 +77,27 @@ int cli_indirect_run(const char *cmd, plx_engine *e, const cli_indirect *ind, co
  * chart. Prints the error and returns an exit code. */
 int cli_refine(const char *cmd, plx_engine *e, const double eye[3], long frames, long photons,
                plx_refine_stats *rs /* OUT */);
+/* "polarlux CMD: warning: ..." on stderr unless --quiet (c may be NULL). */
+void cli_warn(const char *cmd, const cli_common *c, const char *fmt, ...);
+/* Why a result is dark: "the scene has no lamps", or that no light reaches it. */
+const char *cli_dark_reason(plx_engine *e);
+/* Coordinates of options (--at, --eye, --box, ...) are the scene's own:
+ * lon/lat degrees on a lon/lat scene, metres on a metre scene. These turn
+ * them into the engine's local metres and back; to_local returns -1 when a
+ * lon/lat position is out of range. */
+int cli_to_local(plx_engine *e, double *x, double *y);
+void cli_from_local(plx_engine *e, double *x, double *y);
+/* A "--opt X,Y" value in the scene's coordinates turned to local metres
+ * (prints the error and returns -1 when out of range). */
+int cli_option_local(const char *cmd, const char *opt, plx_engine *e, double *x, double *y);
+/* Turns the first two columns of each row of p to local metres. The frame
+ * is --points-crs (c->points_crs), else the file's '# crs: NAME' line, else
+ * the scene's own coordinates; NAME is lonlat, local (the engine's metres)
+ * or the scene's CRS name. *orig (may be NULL) gets a malloc'd copy of the
+ * given x,y pairs. Prints the error and returns an exit code. */
+struct points;
+int cli_points_local(const char *cmd, plx_engine *e, const cli_common *c, const char *path, struct points *p,
+                     double **orig);
 /* Maps a status to an exit code. */
 int cli_exit_code(plx_status s);
 

@@ -16,7 +16,7 @@ static const char help[] =
     "  --polar Q     quadrant 0..3 (required)\n"
     "  -o OUT.png    output image (required)\n"
     "  --size PX     pixels on the longer side (default 1600)\n"
-    "  --mem SIZE, --strict, --quiet   as for 'polarlux info'\n";
+    "  --mem SIZE, --strict, --quiet, --lamps FILE   as for 'polarlux info'\n";
 
 /* A stable colour for a building index. */
 static void owner_colour(int32_t owner, uint8_t rgb[3])

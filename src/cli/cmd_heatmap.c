@@ -23,7 +23,7 @@ static const char help[] =
     "  --path FILE  draw these routes (GeoJSON LineStrings, as for 'polarlux\n"
     "             route') on the map, sampled every pixel and coloured by lux\n"
     "             on the same scale, outlined in cyan\n"
-    "  --mem SIZE, --strict, --quiet   as for 'polarlux info'\n";
+    "  --mem SIZE, --strict, --quiet, --lamps FILE   as for 'polarlux info'\n";
 
 /* A night palette on t in [0, 1]: black, deep blue, purple, orange, yellow, white. */
 static void palette(double t, uint8_t rgb[3])
@@ -75,6 +75,7 @@ typedef struct heat_opts {
     double res, top, box[4];
     int have_box;
     const char *out, *path;
+    const cli_common *c;
 } heat_opts;
 
 /* One segment a..b sampled every pixel: pass 0 the outline, pass 1 the fill. */
@@ -170,6 +171,8 @@ static int run(plx_engine *e, const heat_opts *o)
     for (k = 0; k < n; k++)
         if (E[k] == E[k] && E[k] > top)
             top = E[k];
+    if (!(top > 0))
+        cli_warn("heatmap", o->c, "every pixel of the map is dark (0 lx): %s", cli_dark_reason(e));
     top = o->top > 0 ? o->top : pow(10.0, ceil(log10(fmax(top, 1.0))));
     map_w = (int)w;
     legend_w = h > 600 ? 150 : 90;
@@ -269,6 +272,11 @@ int cmd_heatmap(int argc, char **argv)
     rc = cli_open_scene("heatmap", scene, &c, &e);
     if (rc != EXIT_OK)
         return rc;
+    if (o.have_box && (cli_option_local("heatmap", "--box", e, &o.box[0], &o.box[1]) != 0 ||
+                       cli_option_local("heatmap", "--box", e, &o.box[2], &o.box[3]) != 0)) {
+        plx_engine_free(e);
+        return EXIT_USAGE;
+    }
     if (o.res == 0) {
         plx_scene_info si;
         const double *b;
@@ -276,6 +284,7 @@ int cmd_heatmap(int argc, char **argv)
         b = o.have_box ? o.box : si.bounds;
         o.res = fmax(b[2] - b[0], b[3] - b[1]) / 1200.0;
     }
+    o.c = &c;
     rc = run(e, &o);
     plx_engine_free(e);
     return rc;

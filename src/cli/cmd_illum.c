@@ -13,18 +13,23 @@ static const char help[] =
     "metres and a unit normal; 'x y' alone means a ground point facing up,\n"
     "'x y z' a point facing up; '-' reads standard input). Prints one line\n"
     "'x y z E_direct E_indirect' per point, in lux. E_direct is exact (2.5D\n"
-    "shadows, SPEC §2); E_indirect comes from the photon buffers (SPEC §4),\n"
-    "traced first (--frames progressive frames of --photons photons; progress\n"
-    "on a terminal), 0 with --no-indirect.\n"
+    "shadows, SPEC §2); E_indirect (SPEC §4) is gathered over 32 x 32\n"
+    "directions: the light the surfaces around the point reflect, from their\n"
+    "exact E_direct, plus their later bounces from the photon buffers, traced\n"
+    "first (--frames progressive frames of --photons photons; progress on a\n"
+    "terminal); 0 with --no-indirect.\n"
     "A point on no surface (inside a building, in the air) or with a normal\n"
     "into a building prints 'x y z nan nan', is reported on stderr with its\n"
     "line, and makes the exit code 1.\n"
     "\n"
     "  --points FILE  the points (required)\n"
     "  --photons N    photons per frame (default 65536)\n"
-    "  --frames K     progressive photon frames (default 256: 16.8M photons)\n"
+    "  --frames K     progressive photon frames (default 16: 1,048,576 photons)\n"
+    "  --gather N     final gathering over N x N directions (default 32); 0: the\n"
+    "                 photon buffers' own estimate at the point (the older\n"
+    "                 method: give it --frames 256)\n"
     "  --no-indirect  direct light only (E_indirect 0)\n"
-    "  --mem SIZE, --strict, --quiet   as for 'polarlux info'\n";
+    "  --mem SIZE, --strict, --quiet, --lamps FILE   as for 'polarlux info'\n";
 
 int cmd_illum(int argc, char **argv)
 {
@@ -35,11 +40,12 @@ int cmd_illum(int argc, char **argv)
     plx_engine *e;
     points pts;
     char err[512];
-    double *ed, *ei;
+    double *ed, *ei, *given = NULL;
     size_t k;
     int i, rc, failed = 0;
     memset(&c, 0, sizeof c);
     cli_indirect_default(&ind);
+    ind.frames = CLI_GATHER_FRAMES;
     for (i = 1; i < argc; i++) {
         int r = cli_common_option("illum", argc, argv, &i, &c);
         if (r == 0)
@@ -77,6 +83,12 @@ int cmd_illum(int argc, char **argv)
         points_free(&pts);
         return rc;
     }
+    rc = cli_points_local("illum", e, &c, file, &pts, &given);
+    if (rc != EXIT_OK) {
+        points_free(&pts);
+        plx_engine_free(e);
+        return rc;
+    }
     if (!ind.off && pts.n > 0) {
         double eye[3] = { 0, 0, 1.7 };
         for (k = 0; k < pts.n; k++) {
@@ -85,6 +97,7 @@ int cmd_illum(int argc, char **argv)
         }
         rc = cli_indirect_run("illum", e, &ind, eye, NULL, 360.0);
         if (rc != EXIT_OK) {
+            free(given);
             points_free(&pts);
             plx_engine_free(e);
             return rc;
@@ -108,10 +121,15 @@ int cmd_illum(int argc, char **argv)
             rc = cli_exit_code(st);
             goto done;
         }
-        printf("%.17g %.17g %.17g %.17g %.17g\n", p[0], p[1], p[2], ed[k], ei[k]);
+        printf("%.17g %.17g %.17g %.17g %.17g\n", given[2 * k], given[2 * k + 1], p[2], ed[k], ei[k]);
     }
     rc = failed ? EXIT_FAIL : EXIT_OK;
+    for (k = 0; k < pts.n && !(ed[k] + ei[k] > 0); k++)
+        ;
+    if (pts.n > 0 && k == pts.n)
+        cli_warn("illum", &c, "every point is dark (0 lx): %s", cli_dark_reason(e));
 done:
+    free(given);
     free(ed);
     free(ei);
     points_free(&pts);

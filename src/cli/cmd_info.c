@@ -4,7 +4,7 @@
 #include "cli.h"
 
 static const char help[] =
-    "usage: polarlux info SCENE [--mem SIZE] [--strict] [--quiet]\n"
+    "usage: polarlux info SCENE [--mem SIZE] [--strict] [--quiet] [--lamps FILE]...\n"
     "\n"
     "Loads SCENE (GeoJSON, see README 'Scene format') and prints counts of\n"
     "buildings, blocks, courtyards, lamps and vertices, the bounds, building\n"
@@ -15,7 +15,17 @@ static const char help[] =
     "\n"
     "  --mem SIZE   memory budget of the engine (default 1G; e.g. 256M)\n"
     "  --strict     the first bad feature is an error (default: skip and report)\n"
-    "  --quiet      do not print warnings about skipped features\n";
+    "  --quiet      do not print warnings about skipped features\n"
+    "  --lamps FILE add the lamps of another file to the scene (repeatable):\n"
+    "               GeoJSON Points (each a lamp unless \"lamp\": false; when some\n"
+    "               carry \"lamp\": true or highway=street_lamp, only those) with\n"
+    "               the scene's lamp properties, or CSV with a header naming x,y\n"
+    "               or lon,lat columns and optionally z, intensity, radius, id.\n"
+    "               Positions in the scene's coordinates (lon/lat on a lon/lat\n"
+    "               scene, metres on a metre scene; a '# crs: NAME' line or a\n"
+    "               GeoJSON crs must match the scene's). Lamps inside buildings\n"
+    "               are left out and lamps at an earlier lamp's position merged,\n"
+    "               each with a warning.\n";
 
 static void print_memory(const plx_engine *e)
 {
@@ -65,6 +75,8 @@ int cmd_info(int argc, char **argv)
            si.raised, si.holes);
     printf("blocks: %u with %u courtyards\n", si.blocks, si.courtyards);
     printf("lamps: %u\n", si.lamps);
+    if (plx_scene_crs(e))
+        printf("crs: %s\n", plx_scene_crs(e));
     printf("vertices: %u\n", si.vertices);
     printf("skipped: %u features, %u lamps inside buildings\n", si.skipped_features, si.skipped_lamps);
     printf("overlapping pairs: %u\n", si.overlapping_pairs);

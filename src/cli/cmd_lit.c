@@ -16,7 +16,7 @@ static const char help[] =
     "  --lamp ID   the lamp's id (properties.id, e.g. node/314737872) or its\n"
     "              index among the loaded lamps (0, 1, ...)\n"
     "  -o FILE     output file (required)\n"
-    "  --mem SIZE, --strict, --quiet   as for 'polarlux info'\n";
+    "  --mem SIZE, --strict, --quiet, --lamps FILE   as for 'polarlux info'\n";
 
 /* The lamp index for ID: an id string first, else a whole number index. */
 static long find_lamp(plx_engine *e, const char *id)
@@ -36,7 +36,7 @@ static long find_lamp(plx_engine *e, const char *id)
     return -1;
 }
 
-static int write_region(plx_engine *e, uint32_t lamp, const char *out)
+static int write_region(plx_engine *e, uint32_t lamp, const char *out, const cli_common *c)
 {
     plx_lit_region r;
     plx_lamp l;
@@ -53,6 +53,9 @@ static int write_region(plx_engine *e, uint32_t lamp, const char *out)
         return EXIT_FAIL;
     }
     plx_lamp_get(e, lamp, &l);
+    if (r.nground == 0 && r.nfacade == 0)
+        cli_warn("lit", c, "lamp %u lights nothing: %s", lamp,
+                 l.intensity > 0 ? "its radius does not reach the ground or a facade" : "its intensity is 0 cd");
     props = cJSON_CreateObject();
     cJSON_AddStringToObject(props, "kind", "lamp");
     cJSON_AddStringToObject(props, "id", l.id ? l.id : "");
@@ -157,7 +160,7 @@ int cmd_lit(int argc, char **argv)
         fprintf(stderr, "polarlux lit: no lamp with id or index '%s' in %s\n", id, scene);
         rc = EXIT_FAIL;
     } else {
-        rc = write_region(e, (uint32_t)lamp, out);
+        rc = write_region(e, (uint32_t)lamp, out, &c);
     }
     plx_engine_free(e);
     return rc;

@@ -51,12 +51,12 @@ static const char help[] =
     "  --no-indirect    direct light only (default: indirect light from the photon\n"
     "                   buffers, traced first; progress on a terminal)\n"
     "  --photons N      photons per frame (default 65536)\n"
-    "  --frames K       progressive photon frames for the still image (default 256)\n"
+    "  --frames K       progressive photon frames for the still image (default 16)\n"
     "  --backend B      raster pass: soft (default, built in) or osmesa (OpenGL into\n"
     "                   an OSMesa buffer; " OSMESA_STATE "); the same image\n"
     "  -o FILE          output PNG (required)\n"
     "  --pfm FILE       also write the linear radiance as PFM\n"
-    "  --mem SIZE, --strict, --quiet   as for 'polarlux info'\n";
+    "  --mem SIZE, --strict, --quiet, --lamps FILE   as for 'polarlux info'\n";
 
 typedef struct render_args {
     const char *scene, *out, *pfm;
@@ -302,6 +302,7 @@ int cmd_render(int argc, char **argv)
     float *rgbf = NULL;
     unsigned long long t0;
     plx_status st;
+    int prec;
 #ifdef PLX_HAVE_OSMESA
     plx_osmesa *om = NULL;
 #endif
@@ -320,11 +321,22 @@ int cmd_render(int argc, char **argv)
     rc = cli_open_scene("render", a.scene, &a.c, &e);
     if (rc != EXIT_OK)
         return rc;
+    if (a.have_eye && (cli_option_local("render", "--eye", e, &a.cam.eye[0], &a.cam.eye[1]) != 0 ||
+                       cli_option_local("render", "--target", e, &a.cam.target[0], &a.cam.target[1]) != 0)) {
+        plx_engine_free(e);
+        return EXIT_USAGE;
+    }
     if (!a.have_eye) {
         if (a.aerial) {
             default_aerial(e, &a.cam);
         } else if (default_street(e, &a.cam) != 0) {
-            fprintf(stderr, "polarlux render: found no free street spot beside a lamp; give --eye and --target\n");
+            plx_scene_info si;
+            plx_scene_info_get(e, &si);
+            if (si.lamps == 0)
+                fprintf(stderr, "polarlux render: the scene has no lamps, so the default street view (beside a "
+                                "lamp) has nowhere to stand; give --eye and --target, or --view aerial\n");
+            else
+                fprintf(stderr, "polarlux render: found no free street spot beside a lamp; give --eye and --target\n");
             plx_engine_free(e);
             return EXIT_FAIL;
         }
@@ -382,11 +394,25 @@ int cmd_render(int argc, char **argv)
         goto done;
     }
     rc = write_outputs(&a, rgb8, rgbf);
+    {
+        plx_scene_info si;
+        plx_scene_info_get(e, &si);
+        prec = si.lonlat ? 7 : 1;
+    }
+    cli_from_local(e, &a.cam.eye[0], &a.cam.eye[1]);
+    cli_from_local(e, &a.cam.target[0], &a.cam.target[1]);
+    if (rc == EXIT_OK) {
+        size_t k, npx = (size_t)a.cam.width * a.cam.height * 3;
+        for (k = 0; k < npx && rgb8[k] == 0; k++)
+            ;
+        if (k == npx)
+            cli_warn("render", &a.c, "the image is entirely black: %s", cli_dark_reason(e));
+    }
     if (rc == EXIT_OK)
-        printf("%s view %dx%d from (%.1f, %.1f, %.1f) to (%.1f, %.1f, %.1f): drew %u of %u buildings "
+        printf("%s view %dx%d from (%.*f, %.*f, %.1f) to (%.*f, %.*f, %.1f): drew %u of %u buildings "
                "(%.2f%% of the geometry) in %.1f ms, written to %s\n",
-               a.aerial ? "aerial" : "street", a.cam.width, a.cam.height, a.cam.eye[0], a.cam.eye[1], a.cam.eye[2],
-               a.cam.target[0], a.cam.target[1], a.cam.target[2], info.drawn, info.buildings,
+               a.aerial ? "aerial" : "street", a.cam.width, a.cam.height, prec, a.cam.eye[0], prec, a.cam.eye[1],
+               a.cam.eye[2], prec, a.cam.target[0], prec, a.cam.target[1], a.cam.target[2], info.drawn, info.buildings,
                100.0 * info.drawn_fraction, (port_now_ns() - t0) / 1e6, a.out);
     if (rc == EXIT_OK && a.opts.auto_exposure)
         printf("exposure: %.4g (automatic: a high percentile of the lit surfaces' luminance near white, "

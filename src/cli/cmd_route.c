@@ -25,7 +25,7 @@ static const char route_help[] =
     "  --step M         sampling step in metres (default 1)\n"
     "  --dark-lux LX    the dark threshold (default 1)\n"
     "  --geojson OUT    also write the lines with these numbers as properties\n"
-    "  --mem SIZE, --strict, --quiet   as for 'polarlux info'\n";
+    "  --mem SIZE, --strict, --quiet, --lamps FILE   as for 'polarlux info'\n";
 
 static const char spots_help[] =
     "usage: polarlux dark-spots SCENE [--res M] [--count N] [--spacing M] [--all] [-o OUT] [options]\n"
@@ -41,7 +41,7 @@ static const char spots_help[] =
     "  --spacing M   minimum distance between reported spots (default 10)\n"
     "  --all         also points out of every lamp's reach\n"
     "  -o OUT        write the GeoJSON to OUT instead of standard output\n"
-    "  --mem SIZE, --strict, --quiet   as for 'polarlux info'\n";
+    "  --mem SIZE, --strict, --quiet, --lamps FILE   as for 'polarlux info'\n";
 
 static void class_text(int c, char out[4])
 {
@@ -112,6 +112,9 @@ static int score_all(plx_engine *e, const route_opts *o, route_set *rs)
             break;
         }
         snprintf(name, sizeof name, "%s", l->name);
+        if (tot.samples > 0 && !(tot.max > 0))
+            cli_warn("route", &o->c, "%s: line %s is entirely dark (0 lx): %s", o->path, l->name,
+                     cli_dark_reason(e));
         print_row(name, "all", &tot);
         for (k = 0; k + 1 < l->n; k++) {
             snprintf(sname, sizeof sname, "%u", k);
@@ -223,7 +226,8 @@ static int in_reach(plx_engine *e, uint32_t nlamps, double x, double y)
     return 0;
 }
 
-static int find_spots(plx_engine *e, double res, long count, double spacing, int all, const char *out)
+static int find_spots(plx_engine *e, double res, long count, double spacing, int all, const char *out,
+                      const cli_common *c)
 {
     plx_scene_info si;
     size_t w, h, n = 0, k, cap;
@@ -274,6 +278,10 @@ static int find_spots(plx_engine *e, double res, long count, double spacing, int
             E[k] += Ei[k];
         free(Ei);
     }
+    if (n == 0)
+        cli_warn("dark-spots", c, "no street point is within a lamp's reach (%s), so there are no spots; "
+                 "--all takes every street point", si.lamps ? "the lamps are outside Bounds or their radius "
+                 "does not reach the ground" : "the scene has no lamps");
     for (k = 0, cap = 0; k < n; k++)
         if (E[k] == E[k]) {
             s[cap].x = P[3 * k];
@@ -281,6 +289,8 @@ static int find_spots(plx_engine *e, double res, long count, double spacing, int
             s[cap++].lux = E[k];
         }
     qsort(s, cap, sizeof *s, cmp_spot);
+    if (cap > 0 && !(s[cap - 1].lux > 0))
+        cli_warn("dark-spots", c, "all %zu street points are dark (0 lx): %s", cap, cli_dark_reason(e));
     for (k = 0; k < cap && npick < count; k++) {
         long j;
         for (j = 0; j < npick; j++)
@@ -368,7 +378,7 @@ int cmd_dark_spots(int argc, char **argv)
     rc = cli_open_scene("dark-spots", scene, &c, &e);
     if (rc != EXIT_OK)
         return rc;
-    rc = find_spots(e, res, count, spacing, all, out);
+    rc = find_spots(e, res, count, spacing, all, out, &c);
     plx_engine_free(e);
     return rc;
 }

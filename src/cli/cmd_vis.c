@@ -27,7 +27,7 @@ static const char help[] =
     "  --fov DEG      horizontal field of view (default 360: the full turn)\n"
     "  --geojson OUT  also write the visibility polygons (lon/lat when the scene\n"
     "                 was lon/lat), with area and the visible building count\n"
-    "  --mem SIZE, --strict, --quiet   as for 'polarlux info'\n";
+    "  --mem SIZE, --strict, --quiet, --lamps FILE   as for 'polarlux info'\n";
 
 typedef struct vis_opts {
     const char *scene, *points, *geojson;
@@ -116,30 +116,38 @@ static int run_points(plx_engine *e, const vis_opts *o, geo_out *g)
     points pts;
     char err[512];
     size_t k;
-    int failed = 0;
+    int failed = 0, rc;
+    double *given = NULL;
     if (points_read(o->points, 2, 2, NULL, &pts, err, sizeof err) != 0) {
         fprintf(stderr, "polarlux vis: %s\n", err);
         return EXIT_FAIL;
     }
+    rc = cli_points_local("vis", e, &o->c, o->points, &pts, &given);
+    if (rc != EXIT_OK) {
+        points_free(&pts);
+        return rc;
+    }
     for (k = 0; k < pts.n; k++) {
-        double x = pts.v[2 * k], y = pts.v[2 * k + 1];
+        double x = pts.v[2 * k], y = pts.v[2 * k + 1], gx = given[2 * k], gy = given[2 * k + 1];
         plx_visibility v;
         plx_status st = plx_visibility_get(e, x, y, o->dir, o->fov, &v);
         if (st != PLX_OK) {
             fprintf(stderr, "polarlux vis: %s:%zu: %s\n", o->points, pts.line[k], plx_last_error(e));
             if (st != PLX_E_RANGE) {
                 points_free(&pts);
+                free(given);
                 return cli_exit_code(st);
             }
-            printf("%.17g %.17g nan 0\n", x, y);
+            printf("%.17g %.17g nan 0\n", gx, gy);
             failed = 1;
             continue;
         }
-        printf("%.17g %.17g %.17g %u\n", x, y, v.area, v.nverts);
+        printf("%.17g %.17g %.17g %u\n", gx, gy, v.area, v.nverts);
         if (g->root)
-            add_polygon(g, &v, x, y);
+            add_polygon(g, &v, gx, gy);
     }
     points_free(&pts);
+    free(given);
     return failed ? EXIT_FAIL : EXIT_OK;
 }
 
@@ -148,9 +156,19 @@ static int run_at(plx_engine *e, const vis_opts *o, geo_out *g)
     plx_visibility v;
     plx_scene_info si;
     uint32_t i, vis_verts = 0, all_verts = 0, occluders = 0;
-    plx_status st = plx_visibility_get(e, o->at[0], o->at[1], o->dir, o->fov, &v);
+    double at[2];
+    plx_status st;
+    at[0] = o->at[0];
+    at[1] = o->at[1];
+    if (cli_option_local("vis", "--at", e, &at[0], &at[1]) != 0)
+        return EXIT_USAGE;
+    st = plx_visibility_get(e, at[0], at[1], o->dir, o->fov, &v);
     if (st != PLX_OK) {
-        fprintf(stderr, "polarlux vis: %s\n", plx_last_error(e));
+        if (at[0] != o->at[0] || at[1] != o->at[1])
+            fprintf(stderr, "polarlux vis: --at %.7f,%.7f (local %.3f, %.3f m): %s\n", o->at[0], o->at[1], at[0],
+                    at[1], plx_last_error(e));
+        else
+            fprintf(stderr, "polarlux vis: %s\n", plx_last_error(e));
         return cli_exit_code(st);
     }
     plx_scene_info_get(e, &si);
@@ -169,7 +187,7 @@ static int run_at(plx_engine *e, const vis_opts *o, geo_out *g)
         all_verts += n;
         occluders++;
     }
-    printf("# visible buildings from (%.6f, %.6f), dir %.3f, fov %.3f\n", o->at[0], o->at[1], o->dir, o->fov);
+    printf("# visible buildings from (%.7f, %.7f), dir %.3f, fov %.3f\n", o->at[0], o->at[1], o->dir, o->fov);
     for (i = 0; i < v.nvisible; i++) {
         plx_building b;
         uint32_t r;

@@ -4,6 +4,9 @@
 #include <string.h>
 
 #include "cli.h"
+#include "lamp_layer.h"
+#include "points.h"
+#include <math.h>
 #include "port.h"
 #include "png/image_write.h"
 #include <unistd.h>
@@ -65,6 +68,26 @@ int cli_common_option(const char *cmd, int argc, char **argv, int *i, cli_common
     }
     if (strcmp(a, "--quiet") == 0 || strcmp(a, "-q") == 0) {
         c->quiet = 1;
+        return 1;
+    }
+    if (strcmp(a, "--points-crs") == 0) {
+        if (*i + 1 >= argc) {
+            cli_usage_error(cmd, "--points-crs needs lonlat, local or the scene's CRS name");
+            return -1;
+        }
+        c->points_crs = argv[++*i];
+        return 1;
+    }
+    if (strcmp(a, "--lamps") == 0) {
+        if (*i + 1 >= argc) {
+            cli_usage_error(cmd, "--lamps needs a GeoJSON or CSV file of lamps");
+            return -1;
+        }
+        if (c->nlamp_files == CLI_MAX_LAMP_FILES) {
+            cli_usage_error(cmd, "at most %d --lamps files", CLI_MAX_LAMP_FILES);
+            return -1;
+        }
+        c->lamp_files[c->nlamp_files++] = argv[++*i];
         return 1;
     }
     if (strcmp(a, "--mem") == 0) {
@@ -142,6 +165,47 @@ static int load_ground_image(const char *cmd, const char *scene_path, plx_engine
     }
     free(full);
     return EXIT_OK;
+}
+
+void cli_warn(const char *cmd, const cli_common *c, const char *fmt, ...)
+{
+    va_list ap;
+    if (c && c->quiet)
+        return;
+    fprintf(stderr, "polarlux %s: warning: ", cmd);
+    va_start(ap, fmt);
+    vfprintf(stderr, fmt, ap);
+    va_end(ap);
+    fprintf(stderr, "\n");
+}
+
+/* Commands whose results are light: they say so when the scene has none. */
+static int computes_light(const char *cmd)
+{
+    static const char *const names[] = { "illum", "lit", "heatmap", "render", "route", "dark-spots" };
+    size_t i;
+    for (i = 0; i < sizeof names / sizeof names[0]; i++)
+        if (strcmp(cmd, names[i]) == 0)
+            return 1;
+    return 0;
+}
+
+static void note_no_lamps(const char *cmd, const char *path, const cli_common *c, plx_engine *e)
+{
+    plx_scene_info si;
+    if (!computes_light(cmd) || plx_scene_info_get(e, &si) != PLX_OK || si.lamps > 0)
+        return;
+    cli_warn(cmd, c, "%s has no lamps%s, so every result is dark (0 lx); add lamps as Point features "
+             "with \"lamp\": true, or from another file with --lamps FILE", path,
+             si.skipped_lamps ? " (all were left out, see the warnings above)" : "");
+}
+
+const char *cli_dark_reason(plx_engine *e)
+{
+    plx_scene_info si;
+    if (plx_scene_info_get(e, &si) != PLX_OK || si.lamps == 0)
+        return "the scene has no lamps";
+    return "no lamp's light reaches it (each lamp lights only within its radius, and buildings cast shadows)";
 }
 
 void cli_config(const cli_common *c, plx_config *cfg)
@@ -244,8 +308,14 @@ int cli_open_scene(const char *cmd, const char *path, const cli_common *c, plx_e
 {
     plx_config cfg;
     plx_status st;
-    if (is_bake(path))
+    if (is_bake(path)) {
+        if (c->nlamp_files > 0) {
+            fprintf(stderr, "polarlux %s: %s: --lamps cannot be added to a bake file; give them to 'polarlux bake'\n",
+                    cmd, path);
+            return EXIT_USAGE;
+        }
         return open_bake(cmd, path, c, e);
+    }
     cli_config(c, &cfg);
     st = plx_engine_new(c->mem ? c->mem : CLI_DEFAULT_MEM, &cfg, e);
     if (st != PLX_OK) {
@@ -258,7 +328,7 @@ int cli_open_scene(const char *cmd, const char *path, const cli_common *c, plx_e
 
 int cli_load_scene(const char *cmd, const char *path, const cli_common *c, plx_engine **e)
 {
-    int rc;
+    int rc, k;
     plx_status st;
     st = plx_load_file(*e, path);
     if (st != PLX_OK) {
@@ -274,15 +344,29 @@ int cli_load_scene(const char *cmd, const char *path, const cli_common *c, plx_e
     if (rc != EXIT_OK) {
         plx_engine_free(*e);
         *e = NULL;
+        return rc;
     }
+    for (k = 0; k < c->nlamp_files; k++) {
+        rc = lamp_layer_add(cmd, c->lamp_files[k], *e, c->quiet);
+        if (rc != EXIT_OK) {
+            plx_engine_free(*e);
+            *e = NULL;
+            return rc;
+        }
+    }
+    note_no_lamps(cmd, path, c, *e);
     return rc;
 }
 
 void cli_indirect_default(cli_indirect *ind)
 {
     ind->photons = 65536;
-    ind->frames = 256; /* 16.8M photons: the count whose error tests/unit/test_photon.c bounds by 10% */
+    ind->frames = 16; /* 1M photons for images, read through the wide lookup (photon.h
+                         lookup_radius): indirect light adds at most about the direct-only
+                         time of a street view (README, "Indirect light"); illum sets
+                         CLI_GATHER_FRAMES */
     ind->off = 0;
+    ind->gather = -1;
 }
 
 int cli_indirect_option(const char *cmd, int argc, char **argv, int *i, cli_indirect *ind)
@@ -290,6 +374,13 @@ int cli_indirect_option(const char *cmd, int argc, char **argv, int *i, cli_indi
     const char *a = argv[*i];
     if (strcmp(a, "--no-indirect") == 0) {
         ind->off = 1;
+        return 1;
+    }
+    if (strcmp(a, "--gather") == 0) {
+        if (*i + 1 >= argc || cli_parse_int(argv[++*i], 0, 1024, &ind->gather)) {
+            cli_usage_error(cmd, "--gather needs a whole number from 0 to 1024");
+            return -1;
+        }
         return 1;
     }
     if (strcmp(a, "--photons") != 0 && strcmp(a, "--frames") != 0)
@@ -314,6 +405,10 @@ int cli_indirect_run(const char *cmd, plx_engine *e, const cli_indirect *ind, co
     unsigned long long t0 = port_now_ns();
     if (ind->off || ind->frames == 0 || plx_indirect_frames(e) > 0)
         return EXIT_OK; /* off, or traced already (a bake) */
+    if (ind->gather >= 0 && plx_indirect_set_gather(e, (uint32_t)ind->gather) != PLX_OK) {
+        fprintf(stderr, "polarlux %s: %s\n", cmd, plx_last_error(e));
+        return EXIT_USAGE;
+    }
     if (eye) {
         plx_status st = plx_indirect_set_viewer(e, eye, dir, fov_deg);
         if (st != PLX_OK) {
@@ -333,6 +428,103 @@ int cli_indirect_run(const char *cmd, plx_engine *e, const cli_indirect *ind, co
     }
     if (tty)
         fprintf(stderr, "\n");
+    return EXIT_OK;
+}
+
+/* ---- the scene's coordinates ---------------------------------------------- */
+
+#define CLI_M_PER_DEG_LON 111320.0
+#define CLI_M_PER_DEG_LAT 110540.0
+
+int cli_to_local(plx_engine *e, double *x, double *y)
+{
+    plx_scene_info si;
+    plx_scene_info_get(e, &si);
+    if (!si.lonlat)
+        return 0;
+    if (!(fabs(*x) <= 180.0 && fabs(*y) <= 90.0))
+        return -1;
+    *x = (*x - si.lon0) * CLI_M_PER_DEG_LON * cos(si.lat0 * 3.14159265358979323846 / 180.0);
+    *y = (*y - si.lat0) * CLI_M_PER_DEG_LAT;
+    return 0;
+}
+
+void cli_from_local(plx_engine *e, double *x, double *y)
+{
+    plx_scene_info si;
+    plx_scene_info_get(e, &si);
+    if (!si.lonlat)
+        return;
+    *x = si.lon0 + *x / (CLI_M_PER_DEG_LON * cos(si.lat0 * 3.14159265358979323846 / 180.0));
+    *y = si.lat0 + *y / CLI_M_PER_DEG_LAT;
+}
+
+int cli_option_local(const char *cmd, const char *opt, plx_engine *e, double *x, double *y)
+{
+    if (cli_to_local(e, x, y) == 0)
+        return 0;
+    fprintf(stderr, "polarlux %s: %s %g,%g is not lon/lat, and the scene is in lon/lat: coordinate options take "
+                    "the scene's own coordinates\n", cmd, opt, *x, *y);
+    return -1;
+}
+
+/* 1: lon/lat, 0: local metres, -1: unknown name. */
+static int frame_of(plx_engine *e, const char *name)
+{
+    plx_scene_info si;
+    const char *crs = plx_scene_crs(e);
+    plx_scene_info_get(e, &si);
+    if (strcmp(name, "lonlat") == 0 || strcmp(name, "EPSG:4326") == 0 || strcmp(name, "WGS84") == 0)
+        return 1;
+    if (strcmp(name, "local") == 0)
+        return 0;
+    if (crs && strcmp(name, crs) == 0)
+        return si.lonlat;
+    return -1;
+}
+
+int cli_points_local(const char *cmd, plx_engine *e, const cli_common *c, const char *path, struct points *p,
+                     double **orig)
+{
+    plx_scene_info si;
+    const char *name = c->points_crs ? c->points_crs : p->crs[0] ? p->crs : NULL;
+    int lonlat;
+    size_t k;
+    plx_scene_info_get(e, &si);
+    lonlat = name ? frame_of(e, name) : si.lonlat;
+    if (lonlat < 0) {
+        fprintf(stderr, "polarlux %s: %s: points crs '%s' is not lonlat, local or the scene's CRS (%s)\n", cmd,
+                path, name, plx_scene_crs(e) ? plx_scene_crs(e) : "none named");
+        return c->points_crs ? EXIT_USAGE : EXIT_FAIL;
+    }
+    if (lonlat && !si.lonlat) {
+        fprintf(stderr, "polarlux %s: %s: the points are in lon/lat but the scene is in metres\n", cmd, path);
+        return EXIT_FAIL;
+    }
+    if (orig) {
+        *orig = malloc(sizeof **orig * 2 * (p->n + 1));
+        if (!*orig) {
+            fprintf(stderr, "polarlux %s: %s: out of memory\n", cmd, path);
+            return EXIT_FAIL;
+        }
+        for (k = 0; k < p->n; k++) {
+            (*orig)[2 * k] = p->v[k * (size_t)p->cols];
+            (*orig)[2 * k + 1] = p->v[k * (size_t)p->cols + 1];
+        }
+    }
+    for (k = 0; lonlat && k < p->n; k++) {
+        double *row = p->v + k * (size_t)p->cols;
+        if (cli_to_local(e, &row[0], &row[1]) != 0) {
+            fprintf(stderr, "polarlux %s: %s:%zu: %g %g is not lon/lat (the points are in lon/lat: %s)\n", cmd,
+                    path, p->line[k], row[0], row[1],
+                    name ? "their crs says so" : "the scene's coordinates; '# crs: local' for metres");
+            if (orig) {
+                free(*orig);
+                *orig = NULL;
+            }
+            return EXIT_FAIL;
+        }
+    }
     return EXIT_OK;
 }
 

@@ -22,6 +22,11 @@ int geo_begin(geo_out *g, plx_engine *e)
         cJSON *p = cJSON_AddObjectToObject(g->root, "properties");
         cJSON_AddStringToObject(p, "units", "m");
     }
+    if (plx_scene_crs(e)) { /* the scene's CRS, GeoJSON 2008 style */
+        cJSON *crs = cJSON_AddObjectToObject(g->root, "crs");
+        cJSON_AddStringToObject(crs, "type", "name");
+        cJSON_AddStringToObject(cJSON_AddObjectToObject(crs, "properties"), "name", plx_scene_crs(e));
+    }
     g->features = cJSON_AddArrayToObject(g->root, "features");
     return g->root && g->features ? 0 : -1;
 }

@@ -1,5 +1,6 @@
 /* GeoJSON output of the command (visibility polygons, lit regions, routes):
- * coordinates go back to WGS84 lon/lat when the scene came in lon/lat. */
+ * coordinates go back to WGS84 lon/lat when the scene came in lon/lat, and
+ * the scene's crs (plx_scene_crs) is written back as a top-level "crs". */
 #ifndef PLX_CLI_GEO_OUT_H
 #define PLX_CLI_GEO_OUT_H
 

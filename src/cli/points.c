@@ -53,6 +53,24 @@ static int parse_row(const char *s, const char *end, double *row, int cols, cons
     return k;
 }
 
+/* "# crs: NAME" (spaces free) copies NAME into crs. */
+static void crs_line(const char *t, const char *end, char *crs, size_t len)
+{
+    size_t n;
+    for (t++; t < end && (*t == ' ' || *t == '\t'); t++)
+        ;
+    if (end - t < 4 || strncmp(t, "crs:", 4) != 0)
+        return;
+    for (t += 4; t < end && (*t == ' ' || *t == '\t'); t++)
+        ;
+    for (n = (size_t)(end - t); n > 0 && (t[n - 1] == ' ' || t[n - 1] == '\r' || t[n - 1] == '\t'); n--)
+        ;
+    if (n >= len)
+        n = len - 1;
+    memcpy(crs, t, n);
+    crs[n] = '\0';
+}
+
 int points_parse(const char *name, const char *text, int need, int cols, const double *fill,
                  points *out, char *err, size_t errlen)
 {
@@ -69,6 +87,8 @@ int points_parse(const char *name, const char *text, int need, int cols, const d
         lineno++;
         for (t = s; t < end && sep(*t); t++)
             ;
+        if (t < end && *t == '#')
+            crs_line(t, end, out->crs, sizeof out->crs);
         if (t == end || *t == '#') {
             s = *end ? end + 1 : end;
             continue;

@@ -10,6 +10,7 @@ typedef struct points {
     size_t n;
     int cols;
     size_t *line;     /* source line of each row */
+    char crs[64];     /* a '# crs: NAME' line's NAME ("" if none) */
 } points;
 
 /* Parses text (NUL-terminated). Each row needs at least 'need' numbers;

@@ -2,6 +2,7 @@
  * and the LRU cache of regions (contract in light.h). */
 #include "light/light.h"
 #include "base/geom.h"
+#include "base/plx_assert.h"
 
 #include <math.h>
 #include <stdlib.h>
@@ -1470,6 +1471,7 @@ static plx_status cache_insert(light *L, uint32_t lamp, const lit_region *r)
         evict(L, L->lru_tail);
     if (L->pool_cap - L->pool_end < n)
         compact(L);
+    PLX_ASSERT(L->pool_cap - L->pool_end >= n); /* eviction and compaction made room */
     dst = L->pool + L->pool_end;
     memcpy(dst, r, n);
     L->ent[lamp].reg = (lit_region *)(void *)dst;
@@ -1530,6 +1532,9 @@ static plx_status region_get(light *L, uint32_t lamp, int polygons, const lit_re
     st = region_compute(L, lamp, polygons);
     if (st == PLX_OK)
         *out = L->ent[lamp].reg;
+    /* the cache stays inside its pool; a region got is at the LRU head */
+    PLX_ASSERT(L->pool_end <= L->pool_cap && L->pool_live <= L->pool_end);
+    PLX_ASSERT(st != PLX_OK || (*out && L->lru_head == lamp));
     return st;
 }
 

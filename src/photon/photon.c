@@ -43,6 +43,17 @@ void photon_config_default(photon_config *c)
     c->lamp_cache_bytes = (size_t)4 << 20;
     c->near_radius = 60.0;
     c->cell_size = 0.0;
+    c->coarsest_level = PHOTON_LEVELS;
+}
+
+void photon_config_gather(photon_config *c, const scene *s)
+{
+    photon_config_default(c);
+    c->coarsest_level = 2;
+    c->kernel_min = c->kernel_max = 4.0;
+    c->lookup_radius = 3.0;
+    if (s && s->nblocks > c->level_blocks[2])
+        c->level_blocks[2] = s->nblocks;
 }
 
 static int config_ok(const photon_config *c)
@@ -56,7 +67,8 @@ static int config_ok(const photon_config *c)
         !(c->kernel_min > 0.0 && c->kernel_min <= c->kernel_max) ||
         !(c->kernel_frames >= 0.0) ||
         !(c->lamp_kernel > 0.0 && c->lamp_kernel <= PHOTON_KERNEL_MAX) ||
-        !(c->near_radius >= 0.0))
+        !(c->near_radius >= 0.0) || c->coarsest_level > PHOTON_LEVELS ||
+        !(c->lookup_radius >= 0.0 && c->lookup_radius <= 16.0))
         return 0;
     for (L = 0; L < PHOTON_LEVELS; L++)
         if ((c->chart_w >> L) < 1 || (c->chart_h >> L) < 1)
@@ -537,6 +549,38 @@ double photon_gather(const float *flux, const float *area, const float *height, 
 {
     grid g = grid_full(area, height, NULL, z, w, h, wrap);
     return gather_any(flux, &g, fx, fy, e);
+}
+
+/* The wide lookup (cfg.lookup_radius r > 0): e = sum w F / sum w A over the
+ * valid texels (same surface: charted, same height) whose centres lie
+ * within r texels, w = 1 - dist / r; else the 2 x 2 lookup. */
+double photon_gather_wide(const float *flux, const float *area, const float *height, double z,
+                          uint32_t w, uint32_t h, int wrap, double fx, double fy, double r,
+                          double e[PHOTON_CH])
+{
+    grid g = grid_full(area, height, NULL, z, w, h, wrap);
+    double sf[PHOTON_CH] = {0.0, 0.0, 0.0, 0.0}, sa = 0.0;
+    int ri = (int)ceil(r), ci = (int)floor(fx), cj = (int)floor(fy), a, b, c;
+    if (r <= 0.0 || !(fx > -2.0 && fy > -2.0 && fx < (double)w + 2.0 && fy < (double)h + 2.0))
+        return gather_any(flux, &g, fx, fy, e);
+    for (b = cj - ri; b <= cj + ri; b++)
+        for (a = ci - ri; a <= ci + ri; a++) {
+            double dx = a + 0.5 - fx, dy = b + 0.5 - fy, d = sqrt(dx * dx + dy * dy), wt;
+            int i = column(a, w, wrap);
+            size_t k;
+            if (d >= r || b < 0 || b >= (int)h || i < 0 || !gvalid(&g, i, b))
+                continue;
+            wt = 1.0 - d / r;
+            k = (size_t)b * w + (size_t)i;
+            for (c = 0; c < PHOTON_CH; c++)
+                sf[c] += wt * flux[k * PHOTON_CH + (size_t)c];
+            sa += wt * texel_area(&g, k);
+        }
+    if (!(sa > 0.0))
+        return gather_any(flux, &g, fx, fy, e);
+    for (c = 0; c < PHOTON_CH; c++)
+        e[c] = sf[c] / sa;
+    return e[0];
 }
 
 double photon_gather_sparse(const float *flux, const float *area, const uint32_t *idx,
@@ -1307,6 +1351,8 @@ plx_status photon_set_viewer(photon_sys *ps, const double eye[3], const double d
                     lvl = d < 3 * bsz ? 2 : 4;
             }
         }
+        if (lvl > (int)ps->cfg.coarsest_level)
+            lvl = (int)ps->cfg.coarsest_level;
         want[k] = (uint8_t)lvl;
         order[k].key = d;
         order[k].id = k;
@@ -1710,8 +1756,8 @@ static void facade_lookup(const photon_sys *ps, const trace_hit *h, double e[PHO
     cs = (size_t)lv->w * lv->h;
     base = (size_t)slot * 2 * cs + (ps->eclass[h->edge] == PHOTON_EDGE_INNER ? cs : 0);
     chart_xy(ps, k, lv, h->p[0], h->p[1], h->p[2], &fx, &fy);
-    photon_gather(lv->flux + base * PHOTON_CH, lv->area + base, NULL, 0.0, lv->w, lv->h, 1, fx,
-                  fy, e);
+    photon_gather_wide(lv->flux + base * PHOTON_CH, lv->area + base, NULL, 0.0, lv->w, lv->h, 1,
+                       fx, fy, ps->cfg.lookup_radius, e);
     for (c = 0; c < PHOTON_CH; c++)
         e[c] /= fr;
 }
@@ -1729,7 +1775,8 @@ static void horizontal_lookup(const photon_sys *ps, const double P[3], double e[
         if (covered)
             photon_gather_sparse(ps->cov_flux, ps->cov_area, ps->gcov, ps->gw, ps->gh, fx, fy, e);
         else
-            photon_gather(ps->gflux, ps->garea, ps->gheight, P[2], ps->gw, ps->gh, 0, fx, fy, e);
+            photon_gather_wide(ps->gflux, ps->garea, ps->gheight, P[2], ps->gw, ps->gh, 0, fx, fy,
+                               ps->cfg.lookup_radius, e);
         for (c = 0; c < PHOTON_CH; c++)
             e[c] /= ps->gframes;
     }
@@ -1783,6 +1830,21 @@ double photon_indirect_rgb(photon_sys *ps, const double P[3], const double n[3],
         rgb[2] = e[3];
     }
     return e[0];
+}
+
+/* E_indirect at a surface a ray found (final_gather.c): the same lookups
+ * as photon_indirect_rgb, without the probe ray for walls. */
+void photon_indirect_hit(photon_sys *ps, const trace_hit *h, double e[PHOTON_CH])
+{
+    int c;
+    for (c = 0; c < PHOTON_CH; c++)
+        e[c] = 0.0;
+    if (h->kind == TRACE_WALL)
+        facade_lookup(ps, h, e);
+    else if (h->kind == TRACE_GROUND || h->kind == TRACE_ROOF)
+        horizontal_lookup(ps, h->p, e);
+    else if (h->kind == TRACE_UNDER && ps->s->bld[h->bld].block < ps->s->nblocks)
+        ambient(ps, ps->s->bld[h->bld].block, e);
 }
 
 double photon_indirect(photon_sys *ps, const double P[3], const double n[3])

@@ -183,9 +183,23 @@ typedef struct photon_config {
     double near_radius;             /* photon_lamps_update: lamps within this horizontal
                                        distance of the viewer are refined; 60 m */
     double cell_size;               /* tracer grid cell, m; 0 = automatic */
+    uint32_t coarsest_level;        /* photon_set_viewer gives no block a level above this
+                                       (while its level has room); PHOTON_LEVELS (4) = the
+                                       distance rule alone. Final gathering (final_gather.h)
+                                       reads later bounces at surfaces all around its points,
+                                       so it charts every block: 2 with level_blocks[2] =
+                                       every block (photon_config_gather) */
+    double lookup_radius;           /* lookups on facade charts and the aerial chart: 0 =
+                                       bilinear over 2 x 2 texels; r > 0 = cone of r texels
+                                       over the same surface (photon_gather_wide); 0, and 3
+                                       in photon_config_gather */
 } photon_config;
 
 void photon_config_default(photon_config *c /* OUT */);
+/* The configuration for final gathering at points: the default with every
+ * block charted at level 2 or finer (coarsest_level 2, level_blocks[2] =
+ * nblocks of s). */
+void photon_config_gather(photon_config *c /* OUT */, const scene *s);
 
 typedef struct photon_stats {
     uint64_t frames;                /* photon_step calls since the last reset */
@@ -335,6 +349,11 @@ int photon_block_level(const photon_sys *ps, uint32_t b);
  * the refined marks); levels stay. For changed lamps. */
 void photon_reset(photon_sys *ps);
 
+/* E_indirect (PHOTON_CH channels: scalar, RGB) at the surface of hit h
+ * (a wall, the ground, a roof or an underside), as photon_indirect_rgb
+ * answers at h->p with h->n but without the probe ray. */
+void photon_indirect_hit(photon_sys *ps, const trace_hit *h, double e[PHOTON_CH] /* OUT */);
+
 /* ---- lamp floor maps (photon_night.c) --------------------------------- */
 
 /*
@@ -397,6 +416,12 @@ int photon_splat(float *flux, const float *area, const float *height, double z,
 double photon_gather(const float *flux, const float *area, const float *height, double z,
                      uint32_t w, uint32_t h, int wrap, double fx, double fy,
                      double e[PHOTON_CH] /* OUT */);
+/* The wide lookup: cone weights w = 1 - dist / r over the valid texels
+ * (area > 0, height within 1 mm) within r texels of (fx, fy), e = sum w F /
+ * sum w A; photon_gather when r <= 0 or no texel is valid. */
+double photon_gather_wide(const float *flux, const float *area, const float *height, double z,
+                          uint32_t w, uint32_t h, int wrap, double fx, double fy, double r,
+                          double e[PHOTON_CH] /* OUT */);
 /* The same on a sparse grid: grid texel k is stored in slot idx[k]
  * (PHOTON_NONE: not charted); flux and area are per slot; no height, no
  * wrap. */

@@ -246,16 +246,4 @@ void polar_node(const polar_map *m, uint32_t n, uint32_t w[3] /* OUT */);
 enum { POLAR_BUILD_NO_DAG = 1, POLAR_BUILD_WIDE_DAG = 2 };
 plx_status polar_build_flags(arena *a, const scene *s, int flags, polar **out /* OUT */);
 
-/* The former point location, kept as a reference (the construction uses
- * no grid): the nearest wall below
- * the point found by scanning a column of a grid of the wall pieces, then
- * the regions above that wall walked to the point (O(1) expected for evenly
- * spread walls, O(n) worst case). polar_scan_new keeps its grid and tables
- * in arena memory (part PLX_PART_POLAR, not counted in polar_memory);
- * polar_scan_locate_frame answers as polar_locate_frame_ex (owner may be
- * NULL), for map mi (0 or 1). */
-typedef struct polar_scan polar_scan;
-plx_status polar_scan_new(arena *a, const polar *pd, polar_scan **out /* OUT */);
-int32_t polar_scan_locate_frame(const polar_scan *g, int mi, vec2 f, int32_t *owner);
-
 #endif

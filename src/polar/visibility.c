@@ -4,6 +4,7 @@
 #include <string.h>
 #include "polar/visibility.h"
 #include "base/geom.h"
+#include "base/plx_assert.h"
 
 enum { UL = 0, LL = 1, UR = 2, LR = 3 };
 #define CHUNK 256
@@ -648,6 +649,11 @@ plx_status vis_query(const polar *pd, vec2 p, double a0, double a1, int full_cir
             }
         }
     }
+#ifdef PLX_DEBUG
+    /* the visible set is strictly ascending building indices */
+    for (i = 1; !w.nomem && out->vis && i < out->nvis && i < out->vis_cap; i++)
+        PLX_ASSERT(out->vis[i - 1] < out->vis[i] && out->vis[i] < pd->nbld);
+#endif
     if (w.nomem)
         st = PLX_E_NOMEM;
     if ((out->poly && out->npoly > out->poly_cap) || (out->vis && out->nvis > out->vis_cap))

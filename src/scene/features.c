@@ -794,17 +794,22 @@ static long lamp_host(const scene *s, const bgrid *g, const scene_lamp *l)
 
 plx_status ld_drop_buried_lamps(loader *ld)
 {
+    return ld_drop_buried_lamps_from(ld, 0);
+}
+
+plx_status ld_drop_buried_lamps_from(loader *ld, uint32_t first)
+{
     scene *s = ld->s;
     arena_mark m = arena_get_mark(&ld->e->mem);
     bgrid g;
-    uint32_t i, kept = 0;
-    if (s->nlamps == 0 || s->nbld == 0)
+    uint32_t i, kept = first;
+    if (s->nlamps <= first || s->nbld == 0)
         return PLX_OK;
     if (!bgrid_build(&ld->e->mem, s, &g)) {
         arena_release(&ld->e->mem, &m);
         return eng_nomem(ld->e, "checking lamps against buildings");
     }
-    for (i = 0; i < s->nlamps; i++) {
+    for (i = first; i < s->nlamps; i++) {
         long host = lamp_host(s, &g, &s->lamps[i]);
         if (host >= 0) {
             char why[200];

@@ -330,6 +330,50 @@ static plx_status place_ground_image(loader *ld)
     return PLX_OK;
 }
 
+/* The CRS name of a GeoJSON 2008 "crs" member ({"type": "name",
+ * "properties": {"name": "urn:ogc:def:crs:EPSG::2154"}}) or of
+ * properties.crs (that object, or the name as a string); NULL if none. */
+static const char *crs_name(const cJSON *crs)
+{
+    const cJSON *name;
+    if (cJSON_IsString(crs))
+        return crs->valuestring;
+    name = cJSON_GetObjectItemCaseSensitive(cJSON_GetObjectItemCaseSensitive(crs, "properties"), "name");
+    return cJSON_IsString(name) ? name->valuestring : NULL;
+}
+
+/* 1 when the CRS names WGS84 lon/lat (EPSG:4326, OGC CRS84). */
+static int crs_is_lonlat(const char *name)
+{
+    size_t n = strlen(name);
+    return strstr(name, "CRS84") != NULL || (n >= 5 && strcmp(name + n - 5, ":4326") == 0);
+}
+
+/* Keeps the scene's CRS (copied into the scene) and reads a projected one
+ * as metres. */
+static plx_status read_crs(loader *ld, const cJSON *root, const cJSON *props)
+{
+    const cJSON *c = cJSON_GetObjectItemCaseSensitive(root, "crs");
+    const char *name = c ? crs_name(c) : NULL;
+    char *copy;
+    size_t n;
+    if (!name && cJSON_IsObject(props))
+        name = crs_name(cJSON_GetObjectItemCaseSensitive(props, "crs"));
+    if (!name || !*name)
+        return PLX_OK;
+    n = strlen(name);
+    if (n > 1000)
+        return bad_top_property(ld, "the crs name is longer than 1000 bytes");
+    copy = arena_alloc(&ld->e->mem, PLX_PART_SCENE, n + 1, 1);
+    if (!copy)
+        return eng_nomem(ld->e, "keeping the scene's crs");
+    memcpy(copy, name, n + 1);
+    ld->s->crs = copy;
+    if (!crs_is_lonlat(name))
+        ld->metres = 1;
+    return PLX_OK;
+}
+
 static plx_status read_collection(loader *ld, cJSON *root, cJSON **features)
 {
     cJSON *type, *props;
@@ -344,6 +388,11 @@ static plx_status read_collection(loader *ld, cJSON *root, cJSON **features)
     props = cJSON_GetObjectItemCaseSensitive(root, "properties");
     ld->metres = 0;
     ld->s->ground_albedo = DEFAULT_GROUND_ALBEDO;
+    {
+        plx_status st = read_crs(ld, root, props);
+        if (st != PLX_OK)
+            return st;
+    }
     if (cJSON_IsObject(props)) {
         cJSON *units = cJSON_GetObjectItemCaseSensitive(props, "units");
         cJSON *ga = cJSON_GetObjectItemCaseSensitive(props, "ground_albedo");
@@ -606,6 +655,7 @@ static plx_status load_text(plx_engine *e, const char *text, size_t len, const c
     e->mem.hi = m.hi;
     e->mem.used[PLX_PART_SCRATCH] = m.used[PLX_PART_SCRATCH];
     e->sc->load_ns = eng_clock(e) - t0;
+    eng_check_scene(e->sc);
     return PLX_OK;
 }
 

@@ -14,7 +14,7 @@ typedef struct loader {
     uint32_t *feat_line;   /* line of each feature (scratch) */
     uint32_t *feat_col;    /* its column */
     uint32_t nfeat;
-    int metres;            /* properties.units == "m" */
+    int metres;            /* properties.units == "m", or a projected crs */
     double lon0, lat0, coslat;
     int gi_bounds_given;   /* properties.ground_image_bounds read (scene coordinates) */
     double gi_bounds[4];
@@ -33,5 +33,7 @@ void ld_warn(loader *ld, uint32_t fi, const char *id, const char *why);
 plx_status ld_features(loader *ld, cJSON *features);
 /* Leaves out lamps inside a building's solid, reporting each (features.c). */
 plx_status ld_drop_buried_lamps(loader *ld);
+/* The same for lamps first.. only (lamps added by plx_add_lamps). */
+plx_status ld_drop_buried_lamps_from(loader *ld, uint32_t first);
 
 #endif

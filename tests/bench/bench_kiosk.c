@@ -20,6 +20,7 @@
 #include <time.h>
 
 #include "polarlux.h"
+#include "polarlux_port.h"
 #include "port.h"
 #include "gen_text.h"
 

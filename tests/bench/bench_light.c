@@ -22,6 +22,7 @@
 #include <time.h>
 
 #include "polarlux.h"
+#include "polarlux_port.h"
 #include "base/engine.h"
 #include "light/light.h"
 #include "ref_light.h"

@@ -24,6 +24,7 @@
 #include <time.h>
 
 #include "polarlux.h"
+#include "polarlux_port.h"
 #include "base/engine.h"
 #include "photon/trace.h"
 #include "photon/photon.h"

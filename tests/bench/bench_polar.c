@@ -38,6 +38,7 @@
 #include "base/engine.h"
 #include "polar/polar.h"
 #include "polar/visibility.h"
+#include "ref_polar_scan.h"
 #include "ref_vis.h"
 #include "ref_vis_fast.h"
 

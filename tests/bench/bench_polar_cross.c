@@ -7,7 +7,7 @@
  *   - overlapping: each grown by 0..2 cm over its neighbours, as in real
  *     map data at its worst: every wall crosses its neighbours' walls, so
  *     every crossing point is rounded and the pieces are searched again
- *     (src/polar/polar.c, settle_pieces) until they meet only at their ends;
+ *     (src/polar/walls.c, settle_pieces) until they meet only at their ends;
  *   - some overlapping: one building in ten grown so, the others apart.
  * Printed per version: construction time (best of 3, with and without the
  * search DAGs), wall pieces, crossing points, rounds of the contact search

@@ -63,7 +63,7 @@ expect vis-at 0 "^# visible: 3 of 3 buildings" -- "$bin" vis -q fixtures/tiny.ge
 expect vis-at-fov 0 "^2 C$" -- "$bin" vis -q fixtures/tiny.geojson --at 50,10 --dir 90 --fov 60
 expect vis-geojson 0 "" -- "$bin" vis -q fixtures/tiny.geojson --points "$tmp/p.txt" --geojson "$tmp/v.geojson"
 expect vis-geojson-loads 0 "^buildings: 2 " -- "$bin" info -q "$tmp/v.geojson"
-expect vis-helsinki-lonlat 0 "" -- "$bin" vis -q fixtures/helsinki-centre.geojson --at 0,0 --geojson "$tmp/h.geojson"
+expect vis-helsinki-lonlat 0 "" -- "$bin" vis -q fixtures/helsinki-centre.geojson --at 24.9442961,60.1716264 --geojson "$tmp/h.geojson"
 expect vis-helsinki-geojson-lonlat 0 "^coordinates: WGS84 lon/lat" -- "$bin" info -q "$tmp/h.geojson"
 expect draw-missing-q 2 "missing --polar Q" -- "$bin" draw fixtures/tiny.geojson -o "$tmp/d.png"
 expect draw-bad-q 2 "--polar '7' is not a quadrant 0..3" -- "$bin" draw fixtures/tiny.geojson --polar 7 -o "$tmp/d.png"
@@ -161,6 +161,7 @@ printf '{"type":"LineString","coordinates":[[1,2]]}' >"$tmp/short.geojson"
 expect walk-short-path 1 "^polarlux walk: $tmp/short\.geojson: the LineString needs at least 2 positions$" -- "$bin" walk -q "$tmp/e.plxb" --path "$tmp/short.geojson" -o "$tmp/w3"
 expect render-aa-bad 2 "--aa '0' is not a whole number from 1 to 16" -- "$bin" render fixtures/tiny.geojson --aa 0 -o "$tmp/x.png"
 expect render-auto-exposure 0 "^exposure: [0-9.e+-]+ \(automatic" -- "$bin" render -q "$tmp/e.plxb" --size 160x120 -o "$tmp/ae.png"
+. tests/cli/gis.sh
 ls "$tmp"/*.tmp* >/dev/null 2>&1 && { echo "FAIL temporary files left"; fail=$((fail + 1)); }
 echo "cli: $pass passed, $fail failed"
 [ "$fail" -eq 0 ]

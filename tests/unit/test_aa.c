@@ -20,6 +20,7 @@
 #include <cmocka.h>
 
 #include "polarlux.h"
+#include "polarlux_port.h"
 
 #define MEM ((size_t)256 << 20)
 

@@ -22,6 +22,7 @@
 #include <cmocka.h>
 
 #include "polarlux.h"
+#include "polarlux_port.h"
 
 #define MEM ((size_t)160 << 20)
 #define SCENE "fixtures/eixample-4x4.geojson"

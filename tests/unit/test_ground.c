@@ -25,6 +25,7 @@
 #include <unistd.h>
 
 #include "polarlux.h"
+#include "polarlux_port.h"
 #include "base/engine.h"
 #include "base/arena.h"
 #include "scene/blocks.h"

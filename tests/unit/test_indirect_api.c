@@ -12,6 +12,7 @@
 #include <cmocka.h>
 
 #include "polarlux.h"
+#include "polarlux_port.h"
 
 #define MEM (128u << 20)
 

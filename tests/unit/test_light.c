@@ -17,6 +17,7 @@
 #include <cmocka.h>
 
 #include "polarlux.h"
+#include "polarlux_port.h"
 #include "base/engine.h"
 #include "light/light.h"
 #include "ref_light.h"

@@ -19,6 +19,7 @@
 #include <cmocka.h>
 
 #include "polarlux.h"
+#include "polarlux_port.h"
 #include "base/engine.h"
 #include "base/arena.h"
 #include "scene/blocks.h"

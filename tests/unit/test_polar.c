@@ -19,6 +19,7 @@
 #include <math.h>
 #include <cmocka.h>
 
+#include "polarlux_port.h"
 #include "base/scene.h"
 #include "base/arena.h"
 #include "base/engine.h"

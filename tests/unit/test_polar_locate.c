@@ -24,12 +24,14 @@
 #include <math.h>
 #include <cmocka.h>
 
+#include "polarlux_port.h"
 #include "base/scene.h"
 #include "base/arena.h"
 #include "base/engine.h"
 #include "base/geom.h"
 #include "polar/polar.h"
 #include "polar_faults.h"
+#include "ref_polar_scan.h"
 #include "ref_scene.h"
 
 #define ARENA_BYTES ((size_t)64 << 20)

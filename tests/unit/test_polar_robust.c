@@ -1,7 +1,7 @@
 /* test_polar_robust: polar_build on scenes whose footprints cross (SPEC §1:
  * footprints may overlap; real map data overlaps by centimetres).
  *
- * Rounded crossing points bend the wall pieces by an ulp; src/polar/polar.c cuts
+ * Rounded crossing points bend the wall pieces by an ulp; src/polar/walls.c cuts
  * the pieces again at the contacts that makes until none is left. Here, on
  * hundreds of random scenes made to be hard for that (rotated boxes
  * crossing lattice boxes and their collinear walls, near-collinear

@@ -16,6 +16,7 @@
 #include <cmocka.h>
 
 #include "polarlux.h"
+#include "polarlux_port.h"
 
 #define MEM ((size_t)256 << 20)
 

@@ -37,6 +37,7 @@
 #include <cmocka.h>
 
 #include "polarlux.h"
+#include "polarlux_port.h"
 #include "base/engine.h"
 #include "render/render.h"
 #include "render/mesh.h"

@@ -13,6 +13,7 @@
 #include <cmocka.h>
 
 #include "polarlux.h"
+#include "polarlux_port.h"
 #include "base/engine.h"
 #include "ref_vis.h"
 

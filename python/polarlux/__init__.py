@@ -1,0 +1,270 @@
+"""polarlux for Python: exact night lighting of 2.5D cities, over libpolarlux.so.
+
+    import polarlux
+    s = polarlux.Scene.from_file("fixtures/helsinki-centre.geojson")
+    E_direct, E_indirect = s.illuminance(points_xy)          # (N,) lux
+    areas = s.visibility_areas(points_xy)                     # (N,) m^2, NaN where not free
+    total, segments = s.route_score(line_xy, step=1.0)
+    img = s.render(eye=(x, y, 1.7), target=(x2, y2, 1.0), size=(640, 480))   # (480, 640, 3) uint8
+
+Coordinates are the scene's local metres (SPEC §1); lon/lat scenes convert
+with Scene.lonlat_to_local / local_to_lonlat. Arrays go in and come out as
+numpy arrays of float64 (images uint8 or float32). See README "Python".
+"""
+import ctypes
+
+import numpy as np
+
+from . import _lib
+from ._lib import lib
+
+__all__ = ["Scene", "PolarluxError", "MemoryBudgetError", "memory_estimate", "scene_size",
+           "USE_VISIBILITY", "USE_LIGHT", "USE_RENDER"]
+
+USE_VISIBILITY, USE_LIGHT, USE_RENDER = _lib.USE_VISIBILITY, _lib.USE_LIGHT, _lib.USE_RENDER
+
+
+class PolarluxError(Exception):
+    """A call failed: .status is the plx_status name, str() the engine's one-line message."""
+
+    def __init__(self, status, message):
+        self.status = _lib.STATUS_NAMES[status] if 0 <= status < len(_lib.STATUS_NAMES) else str(status)
+        self.code = status
+        super().__init__(f"{self.status}: {message}")
+
+
+class MemoryBudgetError(PolarluxError):
+    """PLX_E_NOMEM: the engine's block is too small (pass a larger mem=)."""
+
+
+def _raise(status, message):
+    cls = MemoryBudgetError if status == _lib.E_NOMEM else PolarluxError
+    raise cls(status, message)
+
+
+def _as_bytes(text):
+    return text.encode("utf-8") if isinstance(text, str) else bytes(text)
+
+
+def _dptr(a):
+    return a.ctypes.data_as(_lib.c_double_p)
+
+
+def _points(a, cols, what):
+    a = np.ascontiguousarray(a, dtype=np.float64)
+    if a.ndim == 1 and a.size == cols:
+        a = a.reshape(1, cols)
+    if a.ndim != 2 or a.shape[1] != cols:
+        raise ValueError(f"{what} must have shape (N, {cols}), not {a.shape}")
+    return a
+
+
+def _config(lit_cache_bytes=0, render_max=(0, 0), strict=False, port=None):
+    cfg = _lib.Config()
+    lib.plx_config_default(ctypes.byref(cfg))
+    cfg.strict = 1 if strict else 0
+    cfg.lit_cache_bytes = int(lit_cache_bytes)
+    cfg.render_max_width, cfg.render_max_height = int(render_max[0]), int(render_max[1])
+    if port is not None:
+        cfg.port = ctypes.pointer(port)
+    return cfg
+
+
+def scene_size(text):
+    """plx_scene_size_scan: what a GeoJSON text holds, counted without parsing (a dict)."""
+    data = _as_bytes(text)
+    sz = _lib.padded(_lib.SceneSize)
+    st = lib.plx_scene_size_scan(data, len(data), ctypes.byref(sz))
+    if st != _lib.OK:
+        _raise(st, "plx_scene_size_scan failed")
+    return {name: getattr(sz, name) for name, _ in _lib.SceneSize._fields_}
+
+
+def memory_estimate(text, uses=USE_VISIBILITY | USE_LIGHT | USE_RENDER, lit_cache_bytes=0, render_max=(0, 0)):
+    """plx_memory_estimate: the block (bytes) a scene needs for these uses."""
+    data = _as_bytes(text)
+    sz = _lib.padded(_lib.SceneSize)
+    lib.plx_scene_size_scan(data, len(data), ctypes.byref(sz))
+    cfg = _config(lit_cache_bytes, render_max)
+    return int(lib.plx_memory_estimate(ctypes.byref(sz), ctypes.byref(cfg), uses))
+
+
+class Scene:
+    """One engine with one loaded scene.
+
+    mem: the engine's block in bytes; None sizes it with plx_memory_estimate
+    for visibility, light and rendering at render_max (default 1920x1080).
+    Warnings of the load (skipped features, ignored properties) are in
+    .warnings; strict=True makes the first one an error.
+    """
+
+    def __init__(self, text, name="scene", mem=None, strict=False, lit_cache_bytes=0, render_max=(0, 0)):
+        data = _as_bytes(text)
+        self.warnings = []
+        self._log = _lib.LOG_FN(self._on_log)
+        self._port = _lib.Port()
+        self._port.log = self._log
+        self._cfg = _config(lit_cache_bytes, render_max, strict, self._port)
+        if mem is None:
+            mem = memory_estimate(data, USE_VISIBILITY | USE_LIGHT | USE_RENDER, lit_cache_bytes, render_max)
+        # np.empty: the pages are taken by the OS only when the engine touches them
+        self._block = np.empty(int(mem), dtype=np.uint8)
+        self._e = ctypes.c_void_p()
+        st = lib.plx_engine_create(self._block.ctypes.data_as(ctypes.c_void_p), self._block.size,
+                                   ctypes.byref(self._cfg), ctypes.byref(self._e))
+        if st != _lib.OK:
+            _raise(st, "plx_engine_create failed (mem too small?)")
+        self._check(lib.plx_load_geojson(self._e, data, len(data), name.encode("utf-8")))
+        info = _lib.padded(_lib.SceneInfo)
+        self._check(lib.plx_scene_info_get(self._e, ctypes.byref(info)))
+        self.info = {name: (list(getattr(info, name)) if name == "bounds" else getattr(info, name))
+                     for name, _ in _lib.SceneInfo._fields_}
+
+    @classmethod
+    def from_file(cls, path, **kw):
+        """Loads a GeoJSON file (read here; the core reads no files)."""
+        with open(path, "rb") as f:
+            data = f.read()
+        kw.setdefault("name", str(path))
+        return cls(data, **kw)
+
+    def _on_log(self, ctx, level, msg):
+        self.warnings.append(msg.decode("utf-8", "replace"))
+
+    def _check(self, st):
+        if st != _lib.OK:
+            _raise(st, lib.plx_last_error(self._e).decode("utf-8", "replace"))
+
+    def close(self):
+        """Ends the engine and gives its block back."""
+        if self._e:
+            lib.plx_engine_destroy(self._e)
+            self._e = ctypes.c_void_p()
+            self._block = None
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc):
+        self.close()
+
+    def __del__(self):
+        try:
+            self.close()
+        except Exception:
+            pass
+
+    # ---- memory ----------------------------------------------------------------
+    def memory(self):
+        """plx_memory_get: capacity, used_total, peak_total (bytes)."""
+        r = _lib.padded(_lib.MemoryReport)
+        lib.plx_memory_get(self._e, ctypes.byref(r))
+        return {"capacity": r.capacity, "used_total": r.used_total, "peak_total": r.peak_total}
+
+    # ---- coordinates -------------------------------------------------------------
+    def lonlat_to_local(self, lonlat):
+        """(N, 2) lon/lat degrees -> (N, 2) local metres (SPEC §1); lon/lat scenes only."""
+        a = _points(lonlat, 2, "lonlat")
+        out = np.empty_like(a)
+        self._check(lib.plx_lonlat_to_local(self._e, a.shape[0], _dptr(a), _dptr(out)))
+        return out
+
+    def local_to_lonlat(self, xy):
+        """(N, 2) local metres -> (N, 2) lon/lat degrees."""
+        a = _points(xy, 2, "xy")
+        out = np.empty_like(a)
+        self._check(lib.plx_local_to_lonlat(self._e, a.shape[0], _dptr(a), _dptr(out)))
+        return out
+
+    # ---- light -------------------------------------------------------------------
+    def illuminance(self, points, normals=None):
+        """Illuminance (lux) at surface points: (N, 2) ground points facing up, or
+        (N, 3) points with (N, 3) unit normals. Returns (E_direct, E_indirect),
+        two (N,) arrays; NaN for a point on no surface or with its normal into a
+        building (the others are computed)."""
+        pts = np.ascontiguousarray(points, dtype=np.float64)
+        if pts.ndim == 2 and pts.shape[1] == 2:
+            pts = np.column_stack([pts, np.zeros(pts.shape[0])])
+        pts = _points(pts, 3, "points")
+        if normals is None:
+            nrm = np.zeros_like(pts)
+            nrm[:, 2] = 1.0
+        else:
+            nrm = _points(normals, 3, "normals")
+            if nrm.shape != pts.shape:
+                raise ValueError("normals must have the shape of points")
+        n = pts.shape[0]
+        ed, ei = np.empty(n), np.empty(n)
+        st = lib.plx_illuminance(self._e, n, _dptr(pts), _dptr(nrm), _dptr(ed), _dptr(ei), None)
+        if st not in (_lib.OK, _lib.E_RANGE):
+            self._check(st)
+        return ed, ei
+
+    # ---- visibility -----------------------------------------------------------------
+    def visibility(self, x, y, dir_deg=0.0, fov_deg=360.0):
+        """The exact visibility polygon from (x, y): {"area", "polygon" (M, 2),
+        "visible" (K,) building indices}. Raises PolarluxError (PLX_E_RANGE)
+        for a point that is not free."""
+        v = _lib.padded(_lib.Visibility)
+        self._check(lib.plx_visibility_get(self._e, float(x), float(y), float(dir_deg), float(fov_deg),
+                                           ctypes.byref(v)))
+        poly = np.ctypeslib.as_array(v.xy, shape=(v.nverts * 2,)).reshape(-1, 2).copy() if v.nverts else \
+            np.empty((0, 2))
+        vis = np.ctypeslib.as_array(v.visible, shape=(v.nvisible,)).astype(np.int64) if v.nvisible else \
+            np.empty(0, dtype=np.int64)
+        return {"area": v.area, "polygon": poly, "visible": vis}
+
+    def visibility_areas(self, points, dir_deg=0.0, fov_deg=360.0):
+        """(N, 2) viewpoints -> (N,) visible areas in m^2 (SPEC §3); NaN where the
+        point is not free (inside a building, on a wall, outside Bounds)."""
+        pts = _points(points, 2, "points")
+        out = np.empty(pts.shape[0])
+        v = _lib.padded(_lib.Visibility)
+        for i, (x, y) in enumerate(pts):
+            st = lib.plx_visibility_get(self._e, x, y, float(dir_deg), float(fov_deg), ctypes.byref(v))
+            if st == _lib.E_RANGE:
+                out[i] = np.nan
+                continue
+            self._check(st)
+            out[i] = v.area
+        return out
+
+    # ---- routes --------------------------------------------------------------------
+    def route_score(self, xy, step=1.0, dark_lux=1.0):
+        """How well lit is the polyline xy (N, 2): returns (total, segments):
+        total a dict (length, mean, min, max, uniformity, dark_share, p_class,
+        samples, blocked_length), segments a dict of (N-1,) arrays of the same."""
+        a = _points(xy, 2, "xy")
+        n = a.shape[0]
+        if n < 2:
+            raise ValueError("a route needs 2 or more vertices")
+        total = _lib.padded(_lib.RouteStats)
+        segs = (_lib.RouteStats * (n - 1))()
+        self._check(lib.plx_route_score(self._e, _dptr(a), n, float(step), float(dark_lux),
+                                        ctypes.byref(total), segs))
+        names = [f for f, _ in _lib.RouteStats._fields_]
+        tot = {f: getattr(total, f) for f in names}
+        seg = {f: np.array([getattr(s, f) for s in segs]) for f in names}
+        return tot, seg
+
+    # ---- images ---------------------------------------------------------------------
+    def render(self, eye, target, fov_deg=60.0, size=(640, 480), exposure=1.0, aerial=False, glow=True,
+               linear=False):
+        """A night image (SPEC §5) as an (H, W, 3) uint8 sRGB array; with
+        linear=True also the (H, W, 3) float32 linear radiance: (rgb8, rgbf)."""
+        w, h = int(size[0]), int(size[1])
+        cam = _lib.Camera()
+        cam.eye[:] = [float(v) for v in eye]
+        cam.target[:] = [float(v) for v in target]
+        cam.fov_deg, cam.width, cam.height = float(fov_deg), w, h
+        opts = _lib.padded(_lib.RenderOpts)
+        lib.plx_render_opts_default(ctypes.byref(opts))
+        opts.exposure, opts.aerial, opts.no_glow = float(exposure), int(bool(aerial)), int(not glow)
+        rgb8 = np.zeros((h, w, 3), dtype=np.uint8)
+        rgbf = np.zeros((h, w, 3), dtype=np.float32) if linear else None
+        info = _lib.padded(_lib.RenderInfo)
+        self._check(lib.plx_render(self._e, ctypes.byref(cam), ctypes.byref(opts),
+                                   rgb8.ctypes.data_as(_lib.c_uint8_p),
+                                   rgbf.ctypes.data_as(ctypes.POINTER(ctypes.c_float)) if linear else None,
+                                   ctypes.byref(info)))
+        return (rgb8, rgbf) if linear else rgb8

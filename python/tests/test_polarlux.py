@@ -1,0 +1,184 @@
+"""Tests of the Python package over libpolarlux.so. Results are compared with
+the polarlux command (a separate program over the static library:
+$POLARLUX_BIN, default build/polarlux), with SPEC formulas written out here,
+and with numpy sums over the package's own point queries."""
+import os
+import subprocess
+
+import numpy as np
+import pytest
+
+import polarlux
+
+ROOT = os.path.abspath(os.path.join(os.path.dirname(__file__), "..", ".."))
+BIN = os.environ.get("POLARLUX_BIN", os.path.join(ROOT, "build", "polarlux"))
+TINY = os.path.join(ROOT, "fixtures", "tiny.geojson")
+HELSINKI = os.path.join(ROOT, "fixtures", "helsinki-centre.geojson")
+EIXAMPLE = os.path.join(ROOT, "fixtures", "eixample-4x4.geojson")
+
+
+def run_cli(*args, stdin=None):
+    r = subprocess.run([BIN, *args], input=stdin, capture_output=True, text=True)
+    return r.returncode, r.stdout, r.stderr
+
+
+def street_points(scene, n, seed):
+    """n random ground points over the scene's box (some inside buildings)."""
+    b = scene.info["bounds"]
+    rng = np.random.default_rng(seed)
+    return np.column_stack([rng.uniform(b[0] + 40, b[2] - 40, n), rng.uniform(b[1] + 40, b[3] - 40, n)])
+
+
+def test_load_file_and_string_agree():
+    a = polarlux.Scene.from_file(TINY)
+    with open(TINY) as f:
+        b = polarlux.Scene(f.read())
+    assert a.info["buildings"] == b.info["buildings"] == 4
+    assert a.info["lamps"] == b.info["lamps"] == 3
+    assert a.info["courtyards"] == 1
+    assert any("lamp is inside building 0 (A); left out" in w for w in a.warnings)
+
+
+@pytest.mark.parametrize("path", [TINY, EIXAMPLE, HELSINKI])
+def test_illuminance_matches_the_command(path):
+    s = polarlux.Scene.from_file(path)
+    pts = street_points(s, 300, 1) if path != TINY else np.array([[30, 12], [50, 10], [35, 2], [5, 5]], float)
+    ed, ei = s.illuminance(pts)
+    text = "# crs: local\n" + "".join(f"{x!r} {y!r}\n" for x, y in pts)  # the engine's metres
+    rc, out, _ = run_cli("illum", path, "--points", "-", "-q", "--no-indirect", stdin=text)
+    rows = np.array([[float(v) for v in line.split()] for line in out.splitlines()])
+    assert rows.shape == (len(pts), 5)
+    assert rc == (1 if np.isnan(ed).any() else 0)
+    assert np.array_equal(np.isnan(ed), np.isnan(rows[:, 3]))
+    ok = ~np.isnan(ed)
+    assert ok.sum() > 0
+    np.testing.assert_allclose(ed[ok], rows[ok, 3], rtol=1e-12, atol=1e-12)
+    assert (ei[ok] == 0).all()  # no photons traced through the package
+
+
+def test_illuminance_under_a_lamp_is_spec_formula():
+    # one lamp, nothing in its reach: E = I cos / d^2 W(d/R) (SPEC §2)
+    text = ('{"type":"FeatureCollection","properties":{"units":"m"},"features":['
+            '{"type":"Feature","properties":{"lamp":true,"z":5,"intensity":800,"radius":25},'
+            '"geometry":{"type":"Point","coordinates":[0,0]}}]}')
+    s = polarlux.Scene(text)
+    pts = np.array([[0.0, 0.0], [3.0, 4.0], [10.0, -2.0], [30.0, 0.0]])
+    ed, _ = s.illuminance(pts)
+    d = np.sqrt((pts ** 2).sum(1) + 25.0)
+    w = np.clip(1 - (d / 25.0) ** 4, 0, 1) ** 2
+    np.testing.assert_allclose(ed, 800.0 * (5.0 / d) / d ** 2 * w, rtol=1e-12, atol=1e-15)
+    # a wall point facing the lamp, (N, 3) points with normals
+    ed3, _ = s.illuminance([[0.0, 0.0, 0.0]], normals=[[0.0, 0.0, 1.0]])
+    assert ed3[0] == ed[0]
+
+
+@pytest.mark.parametrize("path", [TINY, HELSINKI])
+def test_visibility_areas_match_the_command(path):
+    s = polarlux.Scene.from_file(path)
+    pts = street_points(s, 60, 2) if path != TINY else np.array([[50, 10], [30, 15], [5, 5]], float)
+    areas = s.visibility_areas(pts)
+    text = "# crs: local\n" + "".join(f"{x!r} {y!r}\n" for x, y in pts)  # the engine's metres
+    _, out, _ = run_cli("vis", "-q", path, "--points", "-", stdin=text)
+    cli = np.array([float(line.split()[2]) for line in out.splitlines()])
+    assert np.array_equal(np.isnan(areas), np.isnan(cli))
+    ok = ~np.isnan(areas)
+    assert ok.sum() > 0
+    np.testing.assert_allclose(areas[ok], cli[ok], rtol=1e-12)
+    if path == TINY:
+        assert areas[0] == 100.0 and np.isnan(areas[2])  # the courtyard; inside building A
+        v = s.visibility(50, 10)
+        assert v["area"] == 100.0 and v["polygon"].shape == (4, 2) and list(v["visible"]) == [2]
+        with pytest.raises(polarlux.PolarluxError) as err:
+            s.visibility(5, 5)
+        assert err.value.status == "PLX_E_RANGE" and "inside building 0 (A)" in str(err.value)
+
+
+def test_route_score_is_the_trapezoid_rule_over_illuminance():
+    s = polarlux.Scene.from_file(EIXAMPLE)
+    b = s.info["bounds"]
+    y = 0.5 * (b[1] + b[3])
+    line = np.array([[b[0] + 60, y], [b[2] - 60, y], [b[2] - 60, y + 37.5]])
+    total, seg = s.route_score(line, step=1.0, dark_lux=2.0)
+    ints, lengths = [], []
+    for (x0, y0), (x1, y1) in zip(line[:-1], line[1:]):
+        length = np.hypot(x1 - x0, y1 - y0)
+        k = int(np.ceil(length / 1.0))
+        t = np.arange(k + 1) / k
+        ed, ei = s.illuminance(np.column_stack([x0 + t * (x1 - x0), y0 + t * (y1 - y0)]))
+        e = ed + ei
+        w = np.full(k + 1, length / k)
+        w[0] = w[-1] = length / k / 2
+        ok = ~np.isnan(e)
+        ints.append((w[ok] * e[ok]).sum())
+        lengths.append(w[ok].sum())
+    np.testing.assert_allclose(seg["mean"], np.array(ints) / np.array(lengths), rtol=1e-12)
+    np.testing.assert_allclose(total["mean"], sum(ints) / sum(lengths), rtol=1e-12)
+    assert seg["length"].shape == (2,)
+    # EN 13201 P-classes (SPEC §6 table): the best class whose mean and minimum are met
+    table = [(15.0, 3.0), (10.0, 2.0), (7.5, 1.5), (5.0, 1.0), (3.0, 0.6), (2.0, 0.4)]
+    want = next((k + 1 for k, (m, lo) in enumerate(table) if total["mean"] >= m and total["min"] >= lo), 0)
+    assert total["p_class"] == want
+
+
+def read_pfm(path):
+    with open(path, "rb") as f:
+        assert f.readline().strip() == b"PF"
+        w, h = (int(v) for v in f.readline().split())
+        scale = float(f.readline())
+        data = np.frombuffer(f.read(), dtype="<f4" if scale < 0 else ">f4")
+    return data.reshape(h, w, 3)[::-1]
+
+
+def test_render_matches_the_command(tmp_path):
+    s = polarlux.Scene.from_file(EIXAMPLE)
+    eye, target = (10.0, -30.0, 40.0), (60.0, 60.0, 0.0)
+    img, lin = s.render(eye, target, fov_deg=50, size=(96, 64), linear=True)
+    assert img.shape == (64, 96, 3) and img.dtype == np.uint8
+    assert lin.shape == (64, 96, 3) and lin.dtype == np.float32
+    assert 0 < (img.sum(axis=2) > 0).mean() < 1
+    rc, _, err = run_cli("render", "-q", EIXAMPLE, "--eye", "10,-30,40", "--target", "60,60,0", "--fov", "50",
+                         "--size", "96x64", "--no-indirect", "-o", str(tmp_path / "r.png"),
+                         "--pfm", str(tmp_path / "r.pfm"))
+    assert rc == 0, err
+    assert np.array_equal(read_pfm(tmp_path / "r.pfm"), lin)
+
+
+def test_projection_round_trip_and_formula():
+    s = polarlux.Scene.from_file(HELSINKI)
+    assert s.info["lonlat"] == 1
+    lon0, lat0 = s.info["lon0"], s.info["lat0"]
+    ll = np.array([[24.94, 60.17], [24.95, 60.168], [lon0, lat0]])
+    xy = s.lonlat_to_local(ll)
+    np.testing.assert_allclose(xy[:, 0], (ll[:, 0] - lon0) * 111320.0 * np.cos(np.radians(lat0)), atol=1e-9)
+    np.testing.assert_allclose(xy[:, 1], (ll[:, 1] - lat0) * 110540.0, atol=1e-9)
+    np.testing.assert_allclose(s.local_to_lonlat(xy), ll, atol=1e-12)
+    metres = polarlux.Scene.from_file(TINY)
+    with pytest.raises(polarlux.PolarluxError) as err:
+        metres.lonlat_to_local([[24.9, 60.1]])
+    assert err.value.status == "PLX_E_INVALID" and "local metres" in str(err.value)
+
+
+def test_memory_estimate_sizes_the_block():
+    with open(HELSINKI, "rb") as f:
+        text = f.read()
+    size = polarlux.scene_size(text)
+    assert size["text_bytes"] == len(text) and size["features"] > 1000
+    need = polarlux.memory_estimate(text, polarlux.USE_VISIBILITY | polarlux.USE_LIGHT | polarlux.USE_RENDER,
+                                    render_max=(320, 240))
+    s = polarlux.Scene(text, mem=need, render_max=(320, 240))
+    assert s.memory()["capacity"] <= need
+    s.visibility_areas(street_points(s, 5, 3))
+    s.illuminance(street_points(s, 100, 4))
+    s.render((0, -300, 200), (0, 0, 0), size=(320, 240))
+    assert s.memory()["peak_total"] <= need
+    with pytest.raises(polarlux.MemoryBudgetError):
+        polarlux.Scene(text, mem=64 * 1024)
+
+
+def test_errors_name_the_place():
+    with pytest.raises(polarlux.PolarluxError) as err:
+        polarlux.Scene('{"type": "FeatureCollection",\n "features": [,]}', name="bad.json")
+    assert err.value.status == "PLX_E_PARSE"
+    assert "bad.json: malformed JSON at byte 44 (line 2, column 15)" in str(err.value)
+    with pytest.raises(ValueError):
+        polarlux.Scene.from_file(TINY).illuminance(np.zeros((3, 4)))

@@ -1,0 +1,213 @@
+/* polar_int.h: what the parts of the polar diagram construction share
+ * (private to src/polar/; see polar.h for the diagrams themselves).
+ *
+ *   walls.c    the footprints cut at their contacts into wall pieces
+ *   trapmap.c  the trapezoidal map and its search DAG (randomized insertion)
+ *   sweep.c    the plane sweep that checks the map and makes the labelled
+ *              free regions with their adjacency (build_map of one frame)
+ *   locate.c   point location in the search DAG and ray shooting
+ *   polar.c    the build of the four diagrams, frames, regions for drawing
+ *
+ * The small helpers are inline: they run in the hot loops of all of them.
+ */
+#ifndef PLX_POLAR_INT_H
+#define PLX_POLAR_INT_H
+
+#include <float.h>
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+#include "polar/polar.h"
+#include "base/msort.h"
+#include "base/geom.h"
+#include "base/plx_assert.h"
+
+enum { UL = 0, LL = 1, UR = 2, LR = 3 };
+/* search nodes: a leaf, a point (x) test, a segment (y) test whose frame-left
+ * end is seg.a (N_Y) or seg.b (N_YB); the same kinds as POLAR_NODE_* */
+enum { N_LEAF = 0, N_X = POLAR_NODE_X, N_Y = POLAR_NODE_Y, N_YB = POLAR_NODE_YB };
+#define KIND(w) ((w) >> 30)
+#define IDX(w) ((w) & 0x3fffffffu)
+#define PACK(k, i) (((uint32_t)(k) << 30) | (uint32_t)(i))
+
+/* ---- frames and small helpers ----------------------------------------- */
+
+static inline vec2 to_frame(int frame, vec2 w)
+{
+    vec2 f;
+    if (frame == 0) {
+        f.x = w.y;
+        f.y = -w.x;
+    } else {
+        f = w;
+    }
+    return f;
+}
+
+/* Point i in a frame (the inline twin of polar_fpt, for the hot loops). */
+static inline vec2 fpt(const polar *pd, int frame, uint32_t i)
+{
+    vec2 w = pd->pts[i], f;
+    if (frame == 0) {
+        f.x = w.y;
+        f.y = -w.x;
+    } else {
+        f = w;
+    }
+    return f;
+}
+
+static inline int lex_cmp(vec2 a, vec2 b)
+{
+    if (a.x < b.x)
+        return -1;
+    if (a.x > b.x)
+        return 1;
+    if (a.y < b.y)
+        return -1;
+    if (a.y > b.y)
+        return 1;
+    return 0;
+}
+
+/* Left and right end (frame order) of segment s. */
+static inline void seg_ends(const polar *pd, int frame, uint32_t s, uint32_t *l, uint32_t *r)
+{
+    const polar_seg *g = &pd->seg[s];
+    if (lex_cmp(fpt(pd, frame, g->a), fpt(pd, frame, g->b)) < 0) {
+        *l = g->a;
+        *r = g->b;
+    } else {
+        *l = g->b;
+        *r = g->a;
+    }
+}
+
+/* Footprints entered when crossing segment s upwards in the frame. */
+static inline int32_t seg_delta(const polar *pd, int frame, uint32_t s)
+{
+    const polar_seg *g = &pd->seg[s];
+    int fwd = lex_cmp(fpt(pd, frame, g->a), fpt(pd, frame, g->b)) < 0;
+    return fwd ? g->cover : -g->cover;
+}
+
+/* n items of size bytes of arena scratch. */
+static inline void *scratch_n(arena *a, size_t n, size_t size)
+{
+    size_t bytes = arena_mul(n ? n : 1, size);
+    if (bytes == SIZE_MAX)
+        return NULL;
+    return arena_scratch(a, bytes, 16);
+}
+
+static inline void *keep_n(arena *a, size_t n, size_t size, size_t *acc)
+{
+    size_t bytes = arena_mul(n ? n : 1, size);
+    void *p;
+    if (bytes == SIZE_MAX)
+        return NULL;
+    p = arena_alloc(a, PLX_PART_POLAR, bytes, 16);
+    if (p)
+        *acc += bytes;
+    return p;
+}
+static inline int32_t seg_owner(const polar *pd, uint32_t s)
+{
+    return pd->seg[s].bld[0] < 0 ? -1 : pd->seg[s].bld[0];
+}
+
+
+/* Which map and which side (1 = top, 0 = bottom) hold quadrant q's start wall. */
+static inline void quadrant_side(int q, int *map, int *top)
+{
+    *map = q & 1;
+    *top = (q == 1 || q == 2);
+}
+
+
+/* ---- shared by the search DAG (trapmap.c) and the sweep (sweep.c) ---- */
+
+/* A trapezoid of the search DAG's map (see "the search DAG" below). */
+typedef struct btrap {
+    vec2 rc;                 /* frame coordinates of rp (walks read them) */
+    uint32_t lp, rp, top, bot;
+    uint32_t nb[4];
+    uint32_t leaf;           /* its leaf node (below 2^30); POLAR_NONE: slot
+                              * free; once the map is built, the sweep
+                              * replaces it by the trapezoid's child word
+                              * (tag 1 or 2: set) */
+} btrap;
+
+/* The live trapezoids of the DAG's map by role (see walk_at), packed so
+ * that one record serves a whole update. Per piece: its canonical ends
+ * and the trapezoids above / below it at them; index 0: left end, 1:
+ * right end. Per point: a trapezoid whose left (0) / right (1) axis is the
+ * point's. POLAR_NONE: none yet. */
+typedef struct sroles {
+    uint32_t end[2], up[2], down[2];
+} sroles;
+
+typedef struct proles {
+    uint32_t side[2];
+} proles;
+
+typedef struct snode {
+    vec2 l, r;          /* frame ends, l before r */
+    int32_t cov;        /* footprints covering the gap above it */
+    uint32_t open;      /* the free region open above it, or POLAR_NONE */
+    uint32_t prev, next; /* status list; prev == POLAR_NONE: not in it */
+    uint32_t li, ri;    /* point indices of l and r */
+    uint32_t solid;     /* child word of a solid trapezoid on it (search DAG) */
+    uint32_t yk;        /* its search node kind: N_Y (l is seg.a) or N_YB */
+} snode;
+
+#define NODE_BITS 14
+#define NODE_CHUNK (1u << NODE_BITS)
+
+typedef struct dbuild {
+    const polar *pd;
+    arena *a;
+    int frame;
+    btrap *T;
+    uint32_t ntrap, cap;     /* slots used, slots available */
+    uint32_t *freel, nfree;  /* slots of replaced trapezoids */
+    uint32_t (**chunk)[3];   /* nodes in chunks of NODE_CHUNK (scratch) */
+    uint32_t nchunk, maxchunk, nnode;
+    uint32_t *list, *up, *lo; /* per crossed trapezoid: it, its new upper / lower part */
+    const uint32_t *canon;   /* per point: the first point at its position */
+    const snode *N;          /* per piece: the sweep's data (y test kind) */
+    const vec2 *E;           /* per piece: frame ends, left then right */
+    /* the live trapezoids by role, kept up to date by every insertion */
+    sroles *SR;
+    proles *PR;
+    vec2 P, Q;               /* the piece being inserted: its frame ends */
+    uint32_t *hint;          /* per canonical point: its x node, POLAR_NONE */
+    int fail;                /* 1: out of memory, 2: pieces not planar */
+    uint64_t steps;          /* search nodes and trapezoids visited */
+} dbuild;
+
+
+/* walls.c: cuts the occluders' edges into wall pieces (pd->pts, pd->seg
+ * filled, the Bounds box added). */
+plx_status polar_make_walls(arena *a, polar *pd);
+
+/* sweep.c: walls incident to each point and the sweep events; the map of
+ * one frame (search DAG, sweep, regions kept). */
+plx_status polar_incidence(arena *a, const polar *pd, uint32_t **inc_first, uint32_t **inc,
+                           uint32_t **evp, uint32_t *nev);
+plx_status polar_map_build(arena *a, polar *pd, polar_map *m, const uint32_t *inc_first,
+                           const uint32_t *inc, const uint32_t *evp, uint32_t nev,
+                           const uint32_t *order, int flags, uint64_t *steps);
+
+/* trapmap.c: the random insertion order; the map and DAG of one frame by
+ * randomized insertion; the DAG kept with its leaves as child words. */
+plx_status polar_insertion_order(arena *a, const polar *pd, uint32_t **out);
+plx_status polar_dag_build(arena *a, polar *pd, polar_map *m, dbuild *b, const snode *N,
+                           const uint32_t *canon, const uint32_t *order, uint32_t nev);
+plx_status polar_dag_keep(arena *a, polar *pd, polar_map *m, dbuild *b, int flags);
+
+/* locate.c: the DAG descended from its root (see polar_locate_frame_ex). */
+int32_t polar_dag_locate(const polar *pd, const polar_map *m, vec2 f, int32_t *owner,
+                         uint32_t *depth);
+
+#endif

@@ -1,0 +1,427 @@
+/* sweep: the trapezoidal map of one frame checked and labelled by a plane
+ * sweep over the wall ends (see below), which makes the free regions with
+ * their adjacency; build_map of one frame (search DAG, then sweep). */
+#include "polar/polar_int.h"
+
+/* ---- trapezoidal map construction: a plane sweep ---------------------- */
+
+/* The sweep runs over the wall ends in frame order (lexicographic (u, v),
+ * i.e. a sweep line turned by an infinitesimal angle, so equal u needs no
+ * special case). The status is the list of wall pieces crossing the sweep
+ * line, bottom to top, headed by the Bounds side at the bottom; between two
+ * consecutive pieces lies one open trapezoid, which the next event between
+ * them closes with the axis of that event's point. An event where pieces
+ * end finds its place in the list through them; an event where pieces only
+ * start reads the piece below it from the DAG's map, already built: the
+ * floor of the trapezoid below the lowest piece starting there, at its
+ * left end, which is the status piece below the point (no piece ends
+ * there); it is checked to be in the status and strictly below the point,
+ * and the piece above to be strictly above it. Pieces starting together
+ * are sorted by merge sort (O(d log d) at a point of degree d), so the
+ * sweep is O(n log n) worst case. Every gap it opens is looked up in the
+ * DAG's map the same way and must be a trapezoid there with the same left
+ * axis, floor and ceiling (and right axis, for free regions), each once,
+ * all of them. Only free trapezoids are made: whether the gap above a
+ * piece is solid is known when the piece enters the status (footprints
+ * counted from the bottom, as the piece below plus the piece's own change).
+ * Every decision is a geom_orient sign or a lexicographic comparison. */
+
+typedef struct fpoint {
+    vec2 f;             /* frame coordinates */
+    uint32_t i;         /* point index */
+} fpoint;
+
+typedef struct sweep {
+    const polar *pd;
+    polar_map *m;
+    snode *N;           /* per segment (walls and Bounds sides) */
+    polar_trap *T;
+    uint32_t ntrap, cap;
+    const uint32_t *inc_first, *inc; /* walls incident to each point */
+    uint32_t *start, *tmp; /* scratch: pieces starting at the event */
+    /* the final map of the search DAG: per piece the trapezoid below /
+     * above it at its left end, per point one trapezoid with that left
+     * axis; each gap the sweep opens is one of them, whose child word it
+     * sets in word[], and regd[] keeps it per region */
+    btrap *DT;
+    const sroles *SR;
+    const proles *PR;
+    uint32_t *regd;
+    uint32_t ngap;      /* gaps opened, free or solid */
+    uint64_t steps;     /* status pieces walked and start pieces sorted */
+} sweep;
+
+static int fp_before(const fpoint *a, const fpoint *b, const void *ctx)
+{
+    (void)ctx;
+    int c = lex_cmp(a->f, b->f);
+    return c < 0 || (c == 0 && a->i < b->i);
+}
+
+MSORT_DEFINE(sort_fpoints, fpoint, const void *, fp_before)
+
+static uint32_t new_region(sweep *w, uint32_t lp, uint32_t top, uint32_t bot)
+{
+    polar_trap *t;
+    if (w->ntrap >= w->cap)
+        return POLAR_NONE;
+    t = &w->T[w->ntrap];
+    t->lp = lp;
+    t->rp = POLAR_NONE;
+    t->top = top;
+    t->bot = bot;
+    t->nb[0] = t->nb[1] = t->nb[2] = t->nb[3] = POLAR_NONE;
+    return w->ntrap++;
+}
+
+/* The gap above bot opened at point pi (below top) is trapezoid d of the
+ * DAG's map: checked, and its child word set (region h, or solid).
+ * Returns 0, or -1 when the two maps differ. */
+static int open_gap(sweep *w, uint32_t d, uint32_t pi, uint32_t top, uint32_t bot, uint32_t h)
+{
+    btrap *t;
+    if (d == POLAR_NONE)
+        return -1;
+    t = &w->DT[d];
+    if (t->lp != pi || t->top != top || t->bot != bot || POLAR_TAG(t->leaf) != 0)
+        return -1;
+    t->leaf = h != POLAR_NONE ? PACK(POLAR_CHILD_FREE, h) : w->N[bot].solid;
+    if (h != POLAR_NONE)
+        w->regd[h] = d;
+    w->ngap++;
+    return 0;
+}
+
+/* Does piece y start below piece x (both starting at the same point)?
+ * Sets *flat when they are collinear. */
+static int start_below(const snode *N, uint32_t y, uint32_t x, int *flat)
+{
+    int o = geom_orient(N[y].l, N[y].r, N[x].r);
+    if (o == 0)
+        *flat = 1;
+    return o > 0;
+}
+
+/* Sorts the n pieces w->start[] starting at one point bottom to top
+ * (insertion sort for a few, else bottom-up merge sort: O(n log n) at a
+ * point of any degree). Returns 0, or -1 when two are collinear (two
+ * neighbours in the order are always compared, so it is seen). */
+static int sort_starts(sweep *w, uint32_t n)
+{
+    const snode *N = w->N;
+    uint32_t *src = w->start, *dst = w->tmp, i, j, wd;
+    int flat = 0;
+    for (i = 0; i < n; i += 8) {
+        uint32_t e = i + 8 < n ? i + 8 : n;
+        for (j = i + 1; j < e; j++) {
+            uint32_t t = src[j], k = j;
+            while (k > i && start_below(N, t, src[k - 1], &flat)) {
+                src[k] = src[k - 1];
+                k--;
+            }
+            src[k] = t;
+        }
+    }
+    for (wd = 8; wd < n; wd *= 2) {
+        for (i = 0; i < n; i += 2 * wd) {
+            uint32_t a = i, am = i + wd < n ? i + wd : n, b = am, bm = i + 2 * wd < n ? i + 2 * wd : n;
+            uint32_t o = i;
+            while (a < am && b < bm)
+                dst[o++] = start_below(N, src[b], src[a], &flat) ? src[b++] : src[a++];
+            while (a < am)
+                dst[o++] = src[a++];
+            while (b < bm)
+                dst[o++] = src[b++];
+        }
+        {
+            uint32_t *t = src;
+            src = dst;
+            dst = t;
+        }
+    }
+    if (src != w->start)
+        memcpy(w->start, src, (size_t)n * 4);
+    w->steps += n;
+    return flat ? -1 : 0;
+}
+
+/* One event: the walls ending and starting at frame point P (point index
+ * pi, the points pts[0..npts-1] all at P). Returns 0, or -1 when the walls
+ * are not a planar subdivision (pieces crossing after rounding). */
+static int sweep_event(sweep *w, vec2 P, uint32_t pi, const fpoint *pts, uint32_t npts)
+{
+    snode *N = w->N;
+    const polar_map *m = w->m;
+    uint32_t x, y, B, A, last = POLAR_NONE, some_end = POLAR_NONE, k = 0, nend = 0, ns = 0;
+    uint32_t G0, Gk, H0 = POLAR_NONE, Hm = POLAR_NONE, i, j;
+    /* the walls starting here, bottom to top; those ending here counted */
+    for (i = 0; i < npts; i++) {
+        uint32_t p = pts[i].i;
+        for (j = w->inc_first[p]; j < w->inc_first[p + 1]; j++) {
+            uint32_t s = w->inc[j];
+            if (lex_cmp(N[s].l, P) == 0) {
+                w->start[ns++] = s;
+            } else {
+                nend++;
+                some_end = s;
+            }
+        }
+    }
+    if (ns > 1 && sort_starts(w, ns) != 0)
+        return -1;
+    /* B: the status piece below P */
+    if (nend > 0) {
+        x = some_end;
+        if (N[x].prev == POLAR_NONE)
+            return -1;
+        while ((y = N[x].prev) != m->box_bot && lex_cmp(N[y].r, P) == 0)
+            x = y;
+        B = N[x].prev;
+    } else {
+        /* only starts: the floor of the trapezoid below the lowest piece
+         * starting here, at its left end, in the DAG's map (the map has
+         * every piece: that floor is the piece below P just right of P,
+         * and no piece ends at P, so it is the status piece below P);
+         * checked to be in the status and strictly below P */
+        uint32_t d = ns ? w->SR[w->start[0]].down[0] : POLAR_NONE;
+        if (d == POLAR_NONE)
+            return -1;
+        B = w->DT[d].bot;
+        if (B != m->box_bot &&
+            (B >= w->pd->nseg || N[B].prev == POLAR_NONE || geom_orient(N[B].l, N[B].r, P) <= 0))
+            return -1;
+    }
+    /* the pieces ending at P follow B */
+    for (y = N[B].next; y != POLAR_NONE && lex_cmp(N[y].r, P) == 0; y = N[y].next) {
+        last = y;
+        k++;
+    }
+    w->steps += k + ns;
+    if (k != nend)
+        return -1;
+    A = y;
+    if (A != POLAR_NONE && geom_orient(N[A].l, N[A].r, P) >= 0)
+        return -1;
+    /* close the gaps B..e1, e1..e2, ..., ek..A */
+    G0 = N[B].open;
+    Gk = k ? N[last].open : G0;
+    if (G0 != POLAR_NONE)
+        w->T[G0].rp = pi;
+    for (y = N[B].next, i = 0; i < k; i++) {
+        x = N[y].next;
+        if (N[y].open != POLAR_NONE)
+            w->T[N[y].open].rp = pi;
+        N[y].prev = N[y].next = POLAR_NONE;
+        y = x;
+    }
+    /* open the gaps B..s1, s1..s2, ..., sm..A and link s1..sm in */
+    for (j = 0; j <= ns; j++) {
+        uint32_t bot = j ? w->start[j - 1] : B;
+        uint32_t top = j < ns ? w->start[j] : (A == POLAR_NONE ? m->box_top : A);
+        uint32_t h = POLAR_NONE;
+        if (j > 0) {
+            const polar_seg *g = &w->pd->seg[bot];
+            int32_t d = lex_cmp(fpt(w->pd, m->frame, g->a), P) == 0 ? g->cover : -g->cover;
+            uint32_t below = j > 1 ? w->start[j - 2] : B;
+            N[bot].cov = N[below].cov + d;
+            N[bot].prev = below;
+            N[below].next = bot;
+        }
+        if (N[bot].cov == 0) {
+            h = new_region(w, pi, top, bot);
+            if (h == POLAR_NONE)
+                return -1;
+        }
+        if (open_gap(w, j ? w->SR[bot].up[0] : ns ? w->SR[w->start[0]].down[0] : w->PR[pi].side[0],
+                     pi, top, bot, h) != 0)
+            return -1;
+        N[bot].open = h;
+        if (j == 0)
+            H0 = h;
+        if (j == ns) {
+            Hm = h;
+            N[bot].next = A;
+            if (A != POLAR_NONE)
+                N[A].prev = bot;
+        }
+    }
+    if (G0 != POLAR_NONE)
+        w->T[G0].nb[LR] = H0;
+    if (Gk != POLAR_NONE)
+        w->T[Gk].nb[UR] = Hm;
+    if (H0 != POLAR_NONE)
+        w->T[H0].nb[LL] = G0;
+    if (Hm != POLAR_NONE)
+        w->T[Hm].nb[UL] = Gk;
+    return 0;
+}
+
+/* Walls incident to each point (both frames), and the points that are
+ * wall ends: the events of the sweeps. */
+plx_status polar_incidence(arena *a, const polar *pd, uint32_t **inc_first, uint32_t **inc,
+                           uint32_t **evp, uint32_t *nev)
+{
+    uint32_t i, s, n = 0, *f, *v, *e;
+    f = scratch_n(a, (size_t)pd->npts + 1, 4);
+    v = scratch_n(a, (size_t)pd->nwall * 2, 4);
+    e = scratch_n(a, pd->npts, 4);
+    if (!f || !v || !e)
+        return PLX_E_NOMEM;
+    memset(f, 0, ((size_t)pd->npts + 1) * 4);
+    for (s = 0; s < pd->nwall; s++) {
+        f[pd->seg[s].a + 1]++;
+        f[pd->seg[s].b + 1]++;
+    }
+    for (i = 0; i < pd->npts; i++) {
+        if (f[i + 1] > 0)
+            e[n++] = i;
+        f[i + 1] += f[i];
+    }
+    for (s = 0; s < pd->nwall; s++) {
+        v[f[pd->seg[s].a]++] = s;
+        v[f[pd->seg[s].b]++] = s;
+    }
+    for (i = pd->npts; i > 0; i--)
+        f[i] = f[i - 1];
+    f[0] = 0;
+    *inc_first = f;
+    *inc = v;
+    *evp = e;
+    *nev = n;
+    return PLX_OK;
+}
+
+
+/* Box sides and corners as seen in a frame: top, bottom, lowest, highest. */
+static void frame_box(const polar *pd, polar_map *m)
+{
+    uint32_t i, s0 = pd->nwall, p0 = pd->npts - 4;
+    double vmax = -DBL_MAX, vmin = DBL_MAX;
+    for (i = 0; i < 4; i++) {
+        const polar_seg *g = &pd->seg[s0 + i];
+        vec2 a = fpt(pd, m->frame, g->a), b = fpt(pd, m->frame, g->b);
+        if (a.y == b.y && a.y > vmax) {
+            vmax = a.y;
+            m->box_top = s0 + i;
+        }
+        if (a.y == b.y && a.y < vmin) {
+            vmin = a.y;
+            m->box_bot = s0 + i;
+        }
+    }
+    m->box_lo = m->box_hi = p0;
+    for (i = 1; i < 4; i++) {
+        vec2 f = fpt(pd, m->frame, p0 + i);
+        if (lex_cmp(f, fpt(pd, m->frame, m->box_lo)) < 0)
+            m->box_lo = p0 + i;
+        if (lex_cmp(f, fpt(pd, m->frame, m->box_hi)) > 0)
+            m->box_hi = p0 + i;
+    }
+}
+
+
+/* Builds the trapezoidal map of one frame: the search DAG's map by
+ * randomized insertion, then the sweep, which uses it to place the events
+ * where pieces only start, checks that the pieces form a planar
+ * subdivision and that both maps agree, and makes the free regions (kept,
+ * in sweep order, with their adjacency); then the DAG is kept with its
+ * leaves mapped to those regions (unless flags say otherwise). */
+plx_status polar_map_build(arena *a, polar *pd, polar_map *m, const uint32_t *inc_first,
+                           const uint32_t *inc, const uint32_t *evp, uint32_t nev,
+                           const uint32_t *order, int flags, uint64_t *steps)
+{
+    sweep w;
+    dbuild b;
+    fpoint *ev, *tmp;
+    uint32_t i, j, s, t, *canon, nlive;
+    plx_status st;
+    memset(&w, 0, sizeof w);
+    w.pd = pd;
+    w.m = m;
+    w.inc_first = inc_first;
+    w.inc = inc;
+    w.cap = 3 * pd->nwall + 8;
+    w.N = scratch_n(a, pd->nseg, sizeof(snode));
+    w.T = scratch_n(a, w.cap, sizeof(polar_trap));
+    w.start = scratch_n(a, pd->nwall + 1, 4);
+    w.tmp = scratch_n(a, pd->nwall + 1, 4);
+    ev = scratch_n(a, nev, sizeof(fpoint));
+    tmp = scratch_n(a, nev, sizeof(fpoint));
+    canon = scratch_n(a, pd->npts, 4);
+    if (!w.N || !w.T || !w.start || !w.tmp || !ev || !tmp || !canon)
+        return PLX_E_NOMEM;
+    frame_box(pd, m);
+    for (s = 0; s < pd->nseg; s++) {
+        uint32_t l, r;
+        seg_ends(pd, m->frame, s, &l, &r);
+        w.N[s].l = fpt(pd, m->frame, l);
+        w.N[s].r = fpt(pd, m->frame, r);
+        w.N[s].li = l;
+        w.N[s].ri = r;
+        {
+            /* polar_locate's owner inside the solid above s: the footprint
+             * entered across s, if any (see locate in polar_scan) */
+            const polar_seg *gs = &pd->seg[s];
+            int32_t own = (l == gs->a ? gs->cover : -gs->cover) > 0 && gs->bld[0] >= 0 ? gs->bld[0]
+                                                                                     : -1;
+            w.N[s].solid = PACK(POLAR_CHILD_SOLID, (uint32_t)(own + 1));
+            w.N[s].yk = l == gs->a ? N_Y : N_YB;
+        }
+        w.N[s].cov = 0;
+        w.N[s].open = POLAR_NONE;
+        w.N[s].prev = w.N[s].next = POLAR_NONE;
+    }
+    for (i = 0; i < nev; i++) {
+        ev[i].f = fpt(pd, m->frame, evp[i]);
+        ev[i].i = evp[i];
+    }
+    sort_fpoints(ev, tmp, nev, NULL);
+    for (i = 0; i < pd->npts; i++)
+        canon[i] = i;
+    for (i = 0; i < nev; i = j)
+        for (j = i + 1; j < nev && lex_cmp(ev[j].f, ev[i].f) == 0; j++)
+            canon[ev[j].i] = ev[i].i;
+    st = polar_dag_build(a, pd, m, &b, w.N, canon, order, nev);
+    if (st != PLX_OK)
+        return st;
+    w.DT = b.T;
+    w.SR = b.SR;
+    w.PR = b.PR;
+    nlive = b.ntrap - b.nfree;
+    w.regd = scratch_n(a, w.cap, 4);
+    if (!w.regd)
+        return PLX_E_NOMEM;
+    w.N[m->box_bot].open = new_region(&w, m->box_lo, m->box_top, m->box_bot);
+    if (open_gap(&w, b.SR[m->box_bot].up[0], m->box_lo, m->box_top, m->box_bot,
+                 w.N[m->box_bot].open) != 0)
+        return PLX_E_SCENE;
+    for (i = 0; i < nev; i = j) {
+        for (j = i + 1; j < nev && lex_cmp(ev[j].f, ev[i].f) == 0; j++)
+            ;
+        if (sweep_event(&w, ev[i].f, ev[i].i, ev + i, j - i) != 0)
+            return PLX_E_SCENE;
+    }
+    if (w.N[m->box_bot].next != POLAR_NONE || w.N[m->box_bot].open == POLAR_NONE)
+        return PLX_E_SCENE;
+    w.T[w.N[m->box_bot].open].rp = m->box_hi;
+    /* both maps the same: every live trapezoid of the DAG's map is one gap
+     * of the sweep, with the same sides */
+    for (t = 0; t < w.ntrap; t++)
+        if (w.T[t].rp == POLAR_NONE || b.T[w.regd[t]].rp != w.T[t].rp)
+            return PLX_E_SCENE;
+    if (w.ngap != nlive)
+        return PLX_E_SCENE;
+    *steps += w.steps + b.steps;
+    m->ntrap = w.ntrap;
+    m->trap = keep_n(a, w.ntrap, sizeof(polar_trap), &pd->bytes[0]);
+    if (!m->trap)
+        return PLX_E_NOMEM;
+    memcpy(m->trap, w.T, (size_t)w.ntrap * sizeof(polar_trap));
+    /* polar_memory: the axes (lp, rp, nb) and the regions (top, bot) */
+    pd->bytes[0] -= (size_t)w.ntrap * 8;
+    pd->bytes[1] += (size_t)w.ntrap * 8;
+    if (flags & POLAR_BUILD_NO_DAG)
+        return PLX_OK;
+    return polar_dag_keep(a, pd, m, &b, flags);
+}
+

@@ -1,0 +1,684 @@
+/* trapmap: the trapezoidal map of the wall pieces and its search DAG, by
+ * randomized incremental insertion (see below). */
+#include "polar/polar_int.h"
+
+/* ---- the search DAG ---------------------------------------------------- */
+
+/* The trapezoidal map of the wall pieces built by randomized incremental
+ * insertion (de Berg et al., ch. 6): every piece is located by its
+ * frame-left end in the DAG built so far (a left end shared with an
+ * earlier piece goes right at that point's x node, and at a y node of a
+ * piece sharing it the other ends decide, i.e. the slopes), followed
+ * through the trapezoids it crosses, and those are replaced by the pieces
+ * left, right, above and below it (runs of pieces above or below whose
+ * separating axis the new piece cuts away are merged, so one leaf may have
+ * several parents). The order is random from a fixed seed (see
+ * insertion_order), so the build is deterministic while the expected bounds
+ * hold: O(n) nodes, O(log n) nodes on a search path, O(n log n) time. A
+ * piece with an end already in the map (about two thirds: polygon edges
+ * share their ends) is not searched in the DAG: the trapezoid holding its
+ * start is found among the few around that end (walk_at: the map's live
+ * trapezoids are kept by role, per point and per piece end, updated by
+ * every insertion; a walk longer than WALK_MAX falls back to the DAG from
+ * that end's x node), the others are searched from the root.
+ * Measured (bench_polar): 4.4 to 4.9 inner nodes per piece (8 or 12
+ * bytes each, see polar_map), search paths of about 2 log2 n nodes on
+ * average. It runs first, on pieces not yet checked: a walk only moves to
+ * a live neighbour sharing the axis it crosses (so it moves strictly
+ * along the frame order and ends), every index stays in range, and a
+ * failure is PLX_E_SCENE; the sweep then checks the result. Point indices
+ * are canonical (the first of the points sharing a position, as the
+ * sweep's events are). In the end every leaf becomes a child word, set by
+ * the sweep when it opens that trapezoid as a gap: its free region, or the
+ * owner that polar_locate reports inside a solid one. */
+
+static uint32_t *dnode(const dbuild *b, uint32_t n)
+{
+    return b->chunk[n >> NODE_BITS][n & (NODE_CHUNK - 1)];
+}
+
+static vec2 bpt(const dbuild *b, uint32_t i)
+{
+    return fpt(b->pd, b->frame, i);
+}
+
+static uint32_t new_trap(dbuild *b)
+{
+    uint32_t t;
+    if (b->nfree > 0) {
+        t = b->freel[--b->nfree];
+    } else {
+        if (b->ntrap >= b->cap) {
+            b->fail = 1;
+            return 0;
+        }
+        t = b->ntrap++;
+    }
+    b->T[t].nb[0] = b->T[t].nb[1] = b->T[t].nb[2] = b->T[t].nb[3] = POLAR_NONE;
+    b->T[t].leaf = POLAR_NONE;
+    return t;
+}
+
+static uint32_t new_node(dbuild *b, uint32_t kind, uint32_t idx, uint32_t c0, uint32_t c1)
+{
+    uint32_t n = b->nnode, *nd;
+    if (n == b->nchunk * NODE_CHUNK) {
+        if (b->nchunk == b->maxchunk ||
+            !(b->chunk[b->nchunk] = arena_scratch(b->a, (size_t)NODE_CHUNK * 12, 16))) {
+            b->fail = 1;
+            return 0;
+        }
+        b->nchunk++;
+    }
+    b->nnode++;
+    nd = dnode(b, n);
+    nd[0] = PACK(kind, idx);
+    nd[1] = c0;
+    nd[2] = c1;
+    return n;
+}
+
+/* The y test of piece s: its kind by which end is frame-left. */
+static uint32_t ykind(const dbuild *b, uint32_t s)
+{
+    return b->N[s].yk;
+}
+
+/* One insertion, its data gathered beforehand (in insertion order). */
+typedef struct irec {
+    vec2 P, Q;               /* frame ends, left first */
+    uint32_t s, l, r;        /* the piece, its canonical end points */
+} irec;
+
+/* Descends the DAG with the left end P of a new piece PQ, from node n:
+ * the root, or the x node of P if P is already in the map (its cell, the
+ * trapezoid that held P when it came in, holds everything just right of P). */
+static uint32_t find_first(dbuild *b, uint32_t n, vec2 P, vec2 Q)
+{
+    for (;; b->steps++) {
+        const uint32_t *nd = dnode(b, n);
+        uint32_t w = nd[0];
+        if (KIND(w) == N_LEAF)
+            return IDX(w);
+        if (KIND(w) == N_X) {
+            n = lex_cmp(P, bpt(b, IDX(w))) < 0 ? nd[1] : nd[2];
+        } else {
+            const vec2 *g = &b->E[2 * (size_t)IDX(w)];
+            int o = geom_orient(g[0], g[1], P);
+            if (o == 0)
+                o = geom_orient(g[0], g[1], Q);   /* a shared left end: the slopes */
+            if (o == 0) {
+                b->fail = 2;
+                return POLAR_NONE;
+            }
+            n = o > 0 ? nd[2] : nd[1];
+        }
+    }
+}
+
+/* The same from the right end Q of the new piece, known to the map: from
+ * its x node, with Q pushed towards P (ties at Q go left). */
+static uint32_t find_last(dbuild *b, uint32_t n, vec2 Q, vec2 P)
+{
+    for (;; b->steps++) {
+        const uint32_t *nd = dnode(b, n);
+        uint32_t w = nd[0];
+        if (KIND(w) == N_LEAF)
+            return IDX(w);
+        if (KIND(w) == N_X) {
+            n = lex_cmp(Q, bpt(b, IDX(w))) <= 0 ? nd[1] : nd[2];
+        } else {
+            const vec2 *g = &b->E[2 * (size_t)IDX(w)];
+            int o = geom_orient(g[0], g[1], Q);
+            if (o == 0)
+                o = geom_orient(g[0], g[1], P);
+            if (o == 0) {
+                b->fail = 2;
+                return POLAR_NONE;
+            }
+            n = o > 0 ? nd[2] : nd[1];
+        }
+    }
+}
+
+/* Replaces the neighbour link 'old' of trapezoid x on side f. */
+static void relink(dbuild *b, uint32_t x, int f, uint32_t old, uint32_t nw)
+{
+    if (x != POLAR_NONE && b->T[x].nb[f] == old)
+        b->T[x].nb[f] = nw;
+}
+
+static void set_trap(dbuild *b, uint32_t t, uint32_t lp, uint32_t rp, vec2 rc, uint32_t top,
+                     uint32_t bot)
+{
+    b->T[t].lp = lp;
+    b->T[t].rp = rp;
+    b->T[t].rc = rc;
+    b->T[t].top = top;
+    b->T[t].bot = bot;
+}
+
+/* Records trapezoid t (just made, its sides final) in the roles it holds. */
+static void note_trap(dbuild *b, uint32_t t)
+{
+    const btrap *x = &b->T[t];
+    sroles *top = &b->SR[x->top], *bot = &b->SR[x->bot];
+    b->PR[x->lp].side[0] = t;
+    b->PR[x->rp].side[1] = t;
+    if (top->end[0] == x->lp)
+        top->down[0] = t;
+    if (top->end[1] == x->rp)
+        top->down[1] = t;
+    if (bot->end[0] == x->lp)
+        bot->up[0] = t;
+    if (bot->end[1] == x->rp)
+        bot->up[1] = t;
+}
+
+/* The trapezoid holding the points just right of end point p of the new
+ * piece (p = its left end, towards D = its right end Q) or just left of it
+ * (right end, towards D = P), p being in the map already: from one
+ * trapezoid whose axis on that side is p's, up or down across the pieces
+ * ending at p (the trapezoids by role), in O(1) per piece at p; at most
+ * WALK_MAX of them, else (or on anything unexpected) POLAR_NONE and the
+ * DAG is searched instead. */
+#define WALK_MAX 12
+static uint32_t walk_at(dbuild *b, uint32_t p, vec2 D, int right)
+{
+    int k = right ? 0 : 1;
+    uint32_t t = b->PR[p].side[k], n;
+    for (n = 0; n < WALK_MAX && t != POLAR_NONE; n++) {
+        const btrap *x = &b->T[t];
+        uint32_t e = right ? x->lp : x->rp;
+        const vec2 *g;
+        int o;
+        if (x->leaf == POLAR_NONE || e != p)
+            return POLAR_NONE;
+        b->steps++;
+        if (b->SR[x->top].end[k] == p) {
+            g = &b->E[2 * (size_t)x->top];
+            o = geom_orient(g[0], g[1], D);
+            if (o == 0)
+                return POLAR_NONE;    /* overlapping pieces: the DAG says so */
+            if (o > 0) {
+                t = b->SR[x->top].up[k];
+                continue;
+            }
+        }
+        if (b->SR[x->bot].end[k] == p) {
+            g = &b->E[2 * (size_t)x->bot];
+            o = geom_orient(g[0], g[1], D);
+            if (o == 0)
+                return POLAR_NONE;
+            if (o < 0) {
+                t = b->SR[x->bot].down[k];
+                continue;
+            }
+        }
+        return t;
+    }
+    return POLAR_NONE;
+}
+
+/* Follows the new piece leftwards from the trapezoid t holding its right
+ * end r; returns k, the trapezoids crossed being list[0..k], left first. */
+static uint32_t follow_back(dbuild *b, uint32_t t, vec2 P, vec2 Q)
+{
+    uint32_t k = 0, i;
+    b->list[0] = t;
+    while (lex_cmp(P, bpt(b, b->T[t].lp)) < 0) {
+        int o = geom_orient(P, Q, bpt(b, b->T[t].lp));
+        uint32_t nx = o > 0 ? b->T[t].nb[LL] : b->T[t].nb[UL];
+        /* the neighbour must be live and share the axis: the walk moves
+         * strictly leftwards, whatever the input */
+        if (o == 0 || nx == POLAR_NONE || k + 1 >= b->cap || b->T[nx].leaf == POLAR_NONE ||
+            b->T[nx].rp != b->T[t].lp) {
+            b->fail = 2;
+            return k;
+        }
+        b->list[++k] = t = nx;
+    }
+    for (i = 0; i < k - i; i++) {
+        uint32_t x = b->list[i];
+        b->list[i] = b->list[k - i];
+        b->list[k - i] = x;
+    }
+    return k;
+}
+
+/* Follows the new piece (ends l < r) through the map; returns k, the
+ * trapezoids crossed being list[0..k]. The search starts at the x node of
+ * l, or of r when only r is in the map (then the piece is followed
+ * leftwards), or at the root. */
+static uint32_t follow(dbuild *b, uint32_t l, uint32_t r)
+{
+    vec2 P = b->P, Q = b->Q;
+    uint32_t k = 0;
+    if (b->hint[l] == POLAR_NONE && b->hint[r] != POLAR_NONE) {
+        uint32_t t = walk_at(b, r, P, 0);
+        if (t == POLAR_NONE)
+            t = find_last(b, b->hint[r], Q, P);
+        return b->fail ? 0 : follow_back(b, t, P, Q);
+    }
+    b->list[0] = b->hint[l] != POLAR_NONE ? walk_at(b, l, Q, 1) : POLAR_NONE;
+    if (b->list[0] == POLAR_NONE)
+        b->list[0] = find_first(b, b->hint[l] != POLAR_NONE ? b->hint[l] : 0, P, Q);
+    if (b->fail)
+        return 0;
+    while (lex_cmp(Q, b->T[b->list[k]].rc) > 0) {
+        uint32_t t = b->list[k], nx;
+        int o = geom_orient(P, Q, b->T[t].rc);
+        nx = o > 0 ? b->T[t].nb[LR] : b->T[t].nb[UR];
+        if (o == 0 || nx == POLAR_NONE || k + 1 >= b->cap || b->T[nx].leaf == POLAR_NONE ||
+            b->T[nx].lp != b->T[t].rp) {
+            b->fail = 2;
+            return k;
+        }
+        b->list[++k] = nx;
+    }
+    return k;
+}
+
+/* Builds the chain of new trapezoids above (up = 1) or below the piece. */
+static void make_chain(dbuild *b, uint32_t s, uint32_t l, uint32_t r, uint32_t k, int up)
+{
+    vec2 P = b->P, Q = b->Q;
+    uint32_t *part = up ? b->up : b->lo;
+    uint32_t j, cur = new_trap(b);
+    int fo = up ? UL : LL, fc = up ? UR : LR;     /* outer-side links */
+    if (b->fail)
+        return;
+    if (up)
+        set_trap(b, cur, l, r, Q, b->T[b->list[0]].top, s);
+    else
+        set_trap(b, cur, l, r, Q, s, b->T[b->list[0]].bot);
+    part[0] = cur;
+    for (j = 0; j < k; j++) {
+        uint32_t t = b->list[j], t1 = b->list[j + 1], R = b->T[t].rp, nx, x;
+        int o = geom_orient(P, Q, b->T[t].rc);
+        if ((o > 0) != (up != 0)) {
+            part[j + 1] = cur;        /* the axis at R is cut away: merge */
+            continue;
+        }
+        b->T[cur].rp = R;
+        b->T[cur].rc = b->T[t].rc;
+        nx = new_trap(b);
+        if (b->fail)
+            return;
+        if (up)
+            set_trap(b, nx, R, r, Q, b->T[t1].top, s);
+        else
+            set_trap(b, nx, R, r, Q, s, b->T[t1].bot);
+        x = b->T[t].nb[fc];
+        b->T[cur].nb[fc] = x;
+        relink(b, x, fo, t, cur);
+        b->T[cur].nb[up ? LR : UR] = nx;
+        b->T[nx].nb[up ? LL : UL] = cur;
+        x = b->T[t1].nb[fo];
+        b->T[nx].nb[fo] = x;
+        relink(b, x, fc, t1, nx);
+        cur = nx;
+        part[j + 1] = cur;
+    }
+}
+
+/* Links the new trapezoids at one end of the inserted piece: E (the old
+ * first / last crossed trapezoid) had neighbours enb on that side; X is
+ * the new trapezoid beyond the end or POLAR_NONE; U, L the new parts above
+ * and below at that end. left: the left end. */
+static void link_end(dbuild *b, int left, uint32_t E, const uint32_t *enb, uint32_t X,
+                     uint32_t U, uint32_t L)
+{
+    int ou = left ? UL : UR, ol = left ? LL : LR;     /* outer sides */
+    int iu = left ? UR : UL, il = left ? LR : LL;     /* their far sides */
+    if (X != POLAR_NONE) {
+        b->T[X].nb[ou] = enb[ou];
+        b->T[X].nb[ol] = enb[ol];
+        relink(b, enb[ou], iu, E, X);
+        relink(b, enb[ou], il, E, X);
+        relink(b, enb[ol], iu, E, X);
+        relink(b, enb[ol], il, E, X);
+        b->T[X].nb[iu] = U;
+        b->T[X].nb[il] = L;
+        b->T[U].nb[ou] = X;
+        b->T[L].nb[ol] = X;
+    } else {
+        b->T[U].nb[ou] = enb[ou];
+        b->T[L].nb[ol] = enb[ol];
+        relink(b, enb[ou], iu, E, U);
+        relink(b, enb[ou], il, E, L);
+        relink(b, enb[ol], iu, E, U);
+        relink(b, enb[ol], il, E, L);
+    }
+}
+
+static void leaf_of(dbuild *b, uint32_t t)
+{
+    if (t != POLAR_NONE && b->T[t].leaf == POLAR_NONE)
+        b->T[t].leaf = new_node(b, N_LEAF, t, 0, 0);
+}
+
+/* The old leaf n of crossed trapezoid j becomes the search for its parts:
+ * x tests at new ends (A left, B right), then the y test of s. */
+static void replace_leaf(dbuild *b, uint32_t s, uint32_t l, uint32_t r, uint32_t n, uint32_t j,
+                         uint32_t A, uint32_t B)
+{
+    uint32_t y0 = b->T[b->lo[j]].leaf, y1 = b->T[b->up[j]].leaf, inner, xq, *nd;
+    uint32_t ky = ykind(b, s);
+    if (A == POLAR_NONE && B == POLAR_NONE) {
+        nd = dnode(b, n);
+        nd[0] = PACK(ky, s);
+        nd[1] = y0;
+        nd[2] = y1;
+        return;
+    }
+    inner = new_node(b, ky, s, y0, y1);
+    if (A != POLAR_NONE) {
+        xq = B != POLAR_NONE ? new_node(b, N_X, r, inner, b->T[B].leaf) : inner;
+        if (b->fail)
+            return;
+        nd = dnode(b, n);
+        nd[0] = PACK(N_X, l);
+        nd[1] = b->T[A].leaf;
+        nd[2] = xq;
+        b->hint[l] = n;
+        if (B != POLAR_NONE)
+            b->hint[r] = xq;
+    } else if (!b->fail) {
+        nd = dnode(b, n);
+        nd[0] = PACK(N_X, r);
+        nd[1] = inner;
+        nd[2] = b->T[B].leaf;
+        b->hint[r] = n;
+    }
+}
+
+/* Inserts wall piece s (raw ends rl < rr in the frame). */
+static void insert_seg(dbuild *b, const irec *in)
+{
+    uint32_t s = in->s, l = in->l, r = in->r, k, j, first, last;
+    uint32_t A = POLAR_NONE, B = POLAR_NONE, fnb[4], lnb[4];
+    b->P = in->P;
+    b->Q = in->Q;
+    k = follow(b, l, r);
+    if (b->fail)
+        return;
+    b->steps += k + 1;
+    first = b->list[0];
+    last = b->list[k];
+    for (j = 0; j < 4; j++) {
+        fnb[j] = b->T[first].nb[j];
+        lnb[j] = b->T[last].nb[j];
+    }
+    /* the first trapezoid holds l (its left axis at or before l), the
+     * last r: A, B are needed unless those axes are l's and r's own
+     * (canonical indices: one index per position) */
+    if (l != b->T[first].lp) {
+        A = new_trap(b);
+        if (!b->fail)
+            set_trap(b, A, b->T[first].lp, l, b->P, b->T[first].top, b->T[first].bot);
+    }
+    if (!b->fail && r != b->T[last].rp) {
+        B = new_trap(b);
+        if (!b->fail)
+            set_trap(b, B, r, b->T[last].rp, b->T[last].rc, b->T[last].top, b->T[last].bot);
+    }
+    if (!b->fail)
+        make_chain(b, s, l, r, k, 1);
+    if (!b->fail)
+        make_chain(b, s, l, r, k, 0);
+    if (b->fail)
+        return;
+    link_end(b, 1, first, fnb, A, b->up[0], b->lo[0]);
+    link_end(b, 0, last, lnb, B, b->up[k], b->lo[k]);
+    leaf_of(b, A);
+    leaf_of(b, B);
+    for (j = 0; j <= k; j++) {
+        leaf_of(b, b->up[j]);
+        leaf_of(b, b->lo[j]);
+    }
+    for (j = 0; j <= k && !b->fail; j++) {
+        uint32_t t = b->list[j];
+        replace_leaf(b, s, l, r, b->T[t].leaf, j, j == 0 ? A : POLAR_NONE,
+                     j == k ? B : POLAR_NONE);
+        b->T[t].leaf = POLAR_NONE;
+        b->freel[b->nfree++] = t;
+    }
+    if (A != POLAR_NONE)
+        note_trap(b, A);
+    if (B != POLAR_NONE)
+        note_trap(b, B);
+    for (j = 0; j <= k; j++) {
+        if (j == 0 || b->up[j] != b->up[j - 1])
+            note_trap(b, b->up[j]);
+        if (j == 0 || b->lo[j] != b->lo[j - 1])
+            note_trap(b, b->lo[j]);
+    }
+}
+
+static uint64_t rng_step(uint64_t *st)
+{
+    uint64_t x = *st;
+    x ^= x << 13;
+    x ^= x >> 7;
+    x ^= x << 17;
+    *st = x;
+    return x;
+}
+
+/* Child word c (tag << 30 | index) in the narrow form, tag << 19 | index. */
+static uint64_t narrow_child(uint32_t c)
+{
+    return (uint64_t)(POLAR_TAG(c) << 19 | POLAR_IDX(c));
+}
+
+/* Stores inner node j of m: test t, children c0, c1 (32-bit forms). */
+static void put_node(polar_map *m, uint32_t j, uint32_t t, uint32_t c0, uint32_t c1)
+{
+    if (m->narrow) {
+        uint64_t x = (uint64_t)(KIND(t) << 20 | IDX(t)) | narrow_child(c0) << 22 |
+                     narrow_child(c1) << 43;
+        m->node[2 * (size_t)j] = (uint32_t)x;
+        m->node[2 * (size_t)j + 1] = (uint32_t)(x >> 32);
+    } else {
+        m->node[3 * (size_t)j] = t;
+        m->node[3 * (size_t)j + 1] = c0;
+        m->node[3 * (size_t)j + 2] = c1;
+    }
+}
+
+/* Leaves to child words (set by the sweep in the trapezoids' leaf field),
+ * the inner nodes kept in the order they were made (the top levels first;
+ * with the insertion order, nodes made together lie together), narrow when
+ * every index fits, and counted in polar_memory (rest). */
+plx_status polar_dag_keep(arena *a, polar *pd, polar_map *m, dbuild *b, int flags)
+{
+    uint32_t i, j, nq = 0, *fw = scratch_n(a, b->nnode, 4);
+    if (!fw)
+        return PLX_E_NOMEM;
+    /* fw: per build node its child word */
+    for (i = 0; i < b->nnode; i++) {
+        uint32_t w0 = dnode(b, i)[0];
+        if (KIND(w0) != N_LEAF)
+            fw[i] = PACK(POLAR_CHILD_NODE, nq++);
+        else if (POLAR_TAG(fw[i] = b->T[IDX(w0)].leaf) == POLAR_CHILD_NODE)
+            return PLX_E_SCENE;
+    }
+    m->nnode = nq;
+    m->narrow = !(flags & POLAR_BUILD_WIDE_DAG) && nq < (1u << 19) && m->ntrap < (1u << 19) &&
+                pd->nbld < (1u << 19) - 1 && pd->npts < (1u << 20) && pd->nseg < (1u << 20);
+    m->node = keep_n(a, nq, m->narrow ? 8 : 12, &pd->bytes[3]);
+    if (!m->node)
+        return PLX_E_NOMEM;
+    for (i = 0, j = 0; i < b->nnode; i++) {
+        const uint32_t *nd = dnode(b, i);
+        if (KIND(nd[0]) == N_LEAF)
+            continue;
+        put_node(m, j++, nd[0], fw[nd[1]], fw[nd[2]]);
+    }
+    m->root = fw[0];
+    return PLX_OK;
+}
+
+static uint32_t spread16(uint32_t x)
+{
+    x &= 0xffffu;
+    x = (x | (x << 8)) & 0x00ff00ffu;
+    x = (x | (x << 4)) & 0x0f0f0f0fu;
+    x = (x | (x << 2)) & 0x33333333u;
+    x = (x | (x << 1)) & 0x55555555u;
+    return x;
+}
+
+/* The insertion order of the wall pieces, shared by both maps: a biased
+ * randomized insertion order (Amenta, Choi, Rote 2003). Every piece draws
+ * a round from a seeded generator (the last round holds about half of
+ * them, the one before a quarter, ...); rounds go in order and, within a
+ * round, pieces follow a Z-order curve of their midpoints. The rounds are
+ * random samples, which keeps the expected bounds of randomized
+ * incremental construction (size, search path length); the spatial order
+ * within a round makes consecutive insertions walk the same nodes (cache
+ * hits). Sorted by a stable radix sort on 64-bit keys (ties: piece
+ * order). Deterministic: no global state. */
+plx_status polar_insertion_order(arena *a, const polar *pd, uint32_t **out)
+{
+    uint32_t i, n = pd->nwall, d, *order = scratch_n(a, n, 4), *o2 = scratch_n(a, n, 4);
+    uint64_t *key = scratch_n(a, n, 8), *k2 = scratch_n(a, n, 8);
+    uint32_t *cnt = scratch_n(a, 65536, 4);
+    uint64_t seed = 0x9e3779b97f4a7c15ull;
+    double sx = 65535.0 / (pd->box[2] - pd->box[0]), sy = 65535.0 / (pd->box[3] - pd->box[1]);
+    if (!order || !o2 || !key || !k2 || !cnt)
+        return PLX_E_NOMEM;
+    for (i = 0; i < n; i++) {
+        const polar_seg *g = &pd->seg[i];
+        vec2 pa = pd->pts[g->a], pb = pd->pts[g->b];
+        uint64_t r = rng_step(&seed) >> 20;
+        uint32_t round = 0, ux, uy;
+        double mx = 0.5 * (pa.x + pb.x) - pd->box[0], my = 0.5 * (pa.y + pb.y) - pd->box[1];
+        while (round < 40 && (r & 1u)) {   /* round 40 - t with probability 2^-(t+1) */
+            round++;
+            r >>= 1;
+        }
+        ux = (uint32_t)fmin(fmax(mx * sx, 0.0), 65535.0);
+        uy = (uint32_t)fmin(fmax(my * sy, 0.0), 65535.0);
+        /* round (6 bits), then the Z-order of the midpoint (32) */
+        key[i] = (uint64_t)(40 - round) << 32 | (uint64_t)(spread16(ux) | (spread16(uy) << 1));
+        order[i] = i;
+    }
+    for (d = 0; d < 48; d += 16) {          /* LSD radix sort, 16 bits a pass */
+        memset(cnt, 0, 65536 * 4);
+        for (i = 0; i < n; i++)
+            cnt[(key[i] >> d) & 0xffff]++;
+        {
+            uint32_t sum = 0, c;
+            for (i = 0; i < 65536; i++) {
+                c = cnt[i];
+                cnt[i] = sum;
+                sum += c;
+            }
+        }
+        for (i = 0; i < n; i++) {
+            uint32_t at = cnt[(key[i] >> d) & 0xffff]++;
+            k2[at] = key[i];
+            o2[at] = order[i];
+        }
+        {
+            uint64_t *tk = key;
+            uint32_t *to = order;
+            key = k2;
+            k2 = tk;
+            order = o2;
+            o2 = to;
+        }
+    }
+    *out = order;
+    return PLX_OK;
+}
+
+/* Asks the cache for what insertion in will read first (a hint only;
+ * nothing where the compiler offers no prefetch). */
+static void prefetch_roles(const dbuild *b, const irec *in)
+{
+#if defined(__GNUC__)
+    __builtin_prefetch(&b->PR[in->l]);
+    __builtin_prefetch(&b->PR[in->r]);
+    __builtin_prefetch(&b->hint[in->l]);
+#else
+    (void)b;
+    (void)in;
+#endif
+}
+
+/* Builds the trapezoidal map of the wall pieces of m and its search DAG by
+ * randomized incremental insertion, into b (scratch). N: the pieces' frame
+ * ends (the sweep's snodes). */
+plx_status polar_dag_build(arena *a, polar *pd, polar_map *m, dbuild *b, const snode *N,
+                            const uint32_t *canon, const uint32_t *order, uint32_t nends)
+{
+    uint32_t nw = pd->nwall, i, t;
+    vec2 *E;
+    irec *rec;
+    if (nw >= (1u << 26) || pd->npts >= (1u << 26))
+        return PLX_E_NOMEM;   /* indices must fit in 30 bits */
+    memset(b, 0, sizeof *b);
+    b->pd = pd;
+    b->a = a;
+    b->frame = m->frame;
+    b->canon = canon;
+    b->N = N;
+    /* trapezoid slots: at most 3 i + 1 live after i pieces; a new piece
+     * crosses one trapezoid more than the axes it cuts, at most one per
+     * wall end, and makes two per crossed one plus two: 3 n + 2 ends + 64 */
+    b->cap = 3 * nw + 2 * nends + 64;
+    /* expected about 8 nodes per piece; beyond 64 the shuffle has failed
+     * beyond any reasonable chance (reported as out of memory) */
+    b->maxchunk = (uint32_t)(((uint64_t)64 * nw + 1024) >> NODE_BITS) + 1;
+    if (b->maxchunk > (1u << (30 - NODE_BITS)))
+        b->maxchunk = 1u << (30 - NODE_BITS);
+    b->T = scratch_n(a, b->cap, sizeof(btrap));
+    b->freel = scratch_n(a, b->cap, 4);
+    b->list = scratch_n(a, b->cap, 4);
+    b->up = scratch_n(a, b->cap, 4);
+    b->lo = scratch_n(a, b->cap, 4);
+    b->chunk = scratch_n(a, b->maxchunk, sizeof *b->chunk);
+    b->hint = scratch_n(a, pd->npts, 4);
+    b->E = E = scratch_n(a, 2 * (size_t)pd->nseg, sizeof(vec2));
+    b->SR = scratch_n(a, pd->nseg, sizeof(sroles));
+    b->PR = scratch_n(a, pd->npts, sizeof(proles));
+    rec = scratch_n(a, nw, sizeof(irec));
+    if (!b->T || !b->freel || !b->list || !b->up || !b->lo || !b->chunk || !b->hint || !E ||
+        !b->SR || !b->PR || !rec)
+        return PLX_E_NOMEM;
+    memset(b->SR, 0xff, (size_t)pd->nseg * sizeof(sroles));
+    memset(b->PR, 0xff, (size_t)pd->npts * sizeof(proles));
+    /* what the insertions read, packed: the ends of every piece, and per
+     * insertion its piece (gathered here, where the loads do not wait on
+     * one another) */
+    for (i = 0; i < pd->nseg; i++) {
+        E[2 * (size_t)i] = N[i].l;
+        E[2 * (size_t)i + 1] = N[i].r;
+        b->SR[i].end[0] = canon[N[i].li];
+        b->SR[i].end[1] = canon[N[i].ri];
+    }
+    for (i = 0; i < nw; i++) {
+        const snode *g = &N[order[i]];
+        rec[i].P = g->l;
+        rec[i].Q = g->r;
+        rec[i].s = order[i];
+        rec[i].l = canon[g->li];
+        rec[i].r = canon[g->ri];
+    }
+    memset(b->hint, 0xff, (size_t)pd->npts * 4);
+    t = new_trap(b);
+    set_trap(b, t, m->box_lo, m->box_hi, bpt(b, m->box_hi), m->box_top, m->box_bot);
+    b->T[t].leaf = new_node(b, N_LEAF, t, 0, 0);
+    note_trap(b, t);
+    for (i = 0; i < nw && !b->fail; i++) {
+        if (i + 8 < nw)
+            prefetch_roles(b, &rec[i + 8]);
+        insert_seg(b, &rec[i]);
+    }
+    if (b->fail)
+        return b->fail == 1 ? PLX_E_NOMEM : PLX_E_SCENE;
+    return PLX_OK;
+}
