@@ -114,6 +114,8 @@ typedef struct plx_config {
     size_t lit_cache_bytes;           /* pool for lamp lit regions (0: 16 MiB) */
     int32_t render_max_width;         /* largest frame plx_render draws (0: 1920) */
     int32_t render_max_height;        /* (0: 1080) */
+    size_t lightmap_bytes;            /* the aerial light map's budget (12 bytes a texel; the texel
+                                         grows from the one asked for until the map fits; 0: 48 MiB) */
 } plx_config;
 
 /* Fills cfg with the defaults: no port, lenient loading, no part limits

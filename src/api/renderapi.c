@@ -7,7 +7,7 @@
 
 #define DEFAULT_MAX_W 1920
 #define DEFAULT_MAX_H 1080
-#define LIGHTMAP_MAX_BYTES ((size_t)256 << 20)
+#define LIGHTMAP_MAX_BYTES ((size_t)48 << 20) /* plx_config.lightmap_bytes 0 */
 
 void plx_render_opts_default(plx_render_opts *o)
 {
@@ -60,7 +60,7 @@ plx_status eng_need_lightmap(plx_engine *e, double m_per_texel, int dark)
         return st;
     if (dark)
         render_code_bind(e->rd, shade_none);
-    st = render_lightmap_build(e->rd, cell, LIGHTMAP_MAX_BYTES);
+    st = render_lightmap_build(e->rd, cell, e->cfg.lightmap_bytes ? e->cfg.lightmap_bytes : LIGHTMAP_MAX_BYTES);
     if (dark)
         render_code_bind(e->rd, render_shade_light);
     if (st == PLX_E_NOMEM)
