@@ -692,8 +692,7 @@ plx_status plx_bake_prepare(plx_engine *e, const plx_bake_opts *o);
  * frames; the words that differ between the two by exactly the distance of
  * their blocks are the pointers, saved as offsets. Both blocks must have
  * the same address modulo 64. Errors: PLX_E_INVALID (no twin of the same
- * layout, buffer too small), PLX_E_UNSUPPORTED (a code address would be
- * saved), PLX_E_NOSCENE.
+ * layout, buffer too small), PLX_E_NOSCENE.
  */
 plx_status plx_bake_size(plx_engine *e, plx_engine *twin, size_t *bytes /* OUT */);
 plx_status plx_bake_save(plx_engine *e, plx_engine *twin, void *buf, size_t cap,

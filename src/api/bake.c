@@ -14,9 +14,10 @@
  * the twin's word at the same place is the same address moved by the
  * distance between the blocks; data words (the same in both, or numbers
  * that differ otherwise) never move by exactly that distance. Code
- * addresses (the renderer's shader and backend functions) are cleared
- * before saving and set again after loading; any other word that looks
- * like an address of this program's code or constants fails the bake.
+ * addresses (the renderer's shader and backend functions, the port) are
+ * cleared before saving and set again after loading: they are the only
+ * addresses outside the arena that the structures hold (strings the scene
+ * keeps are copied into the arena).
  *
  * File layout (README "Bake files"): a 128-byte header, the image padded to
  * 8 bytes, then nrel 32-bit word indices. Native byte order: the header
@@ -37,7 +38,6 @@
 #define BAKE_ALIGN 64u
 #define BAKE_PAGE 4096u
 #define BAKE_SLACK ((uint64_t)32 << 20) /* room for queries' scratch */
-#define BAKE_CODE_WINDOW ((uintptr_t)64 << 20)
 
 enum {
     H_MAGIC = 0, H_VERSION = 8, H_ENDIAN = 12, H_SIZES = 16, H_LAYOUT = 20, H_LENGTH = 24,
@@ -211,17 +211,6 @@ static plx_status scan_savable(plx_engine *e, plx_engine *t, unsigned char *out,
     return st;
 }
 
-static const char code_marker[] = "polarlux bake";
-
-/* Whether w could be an address of this program's code or constants: near
- * a string constant or a function of the library. */
-static int near_code(uint64_t w)
-{
-    uintptr_t a = (uintptr_t)(const void *)code_marker;
-    uintptr_t b = (uintptr_t)(const void *)plx_strerror(PLX_OK);
-    return (w >= (uint64_t)(a - BAKE_CODE_WINDOW) && w < (uint64_t)(a + BAKE_CODE_WINDOW)) ||
-           (w >= (uint64_t)(b - BAKE_CODE_WINDOW) && w < (uint64_t)(b + BAKE_CODE_WINDOW));
-}
 
 static void layout_fill(bake_layout *L)
 {
@@ -230,17 +219,6 @@ static void layout_fill(bake_layout *L)
     L->pages_at = L->bitmap_at + pad8((L->npages + 7) / 8);
     L->rel_at = L->pages_at + L->pages_present * BAKE_PAGE;
     L->total = L->rel_at + 4 * L->nrel;
-}
-
-static plx_status code_word(plx_engine *e, size_t at)
-{
-    char msg[160];
-    strbuf b;
-    sb_init(&b, msg, sizeof msg);
-    sb_str(&b, "plx_bake_save: the word at offset ");
-    sb_uint(&b, at);
-    sb_str(&b, " of the engine looks like a code address; it cannot be baked");
-    return eng_fail(e, PLX_E_UNSUPPORTED, msg);
 }
 
 /* Walks the image page by page: pointers become offsets (and relocations),
@@ -267,8 +245,6 @@ static plx_status scan(plx_engine *e, plx_engine *t, unsigned char *out, bake_la
                     put32(out + L->rel_at + 4 * n, (uint32_t)(start / 8 + i));
                 n++;
                 any = 1;
-            } else if (wa == wb && wa != 0 && near_code(wa)) {
-                return code_word(e, start + 8 * i);
             }
         }
         for (i = 0; i < BAKE_PAGE / 8; i++)
