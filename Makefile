@@ -31,6 +31,8 @@ POSIX    = -D_POSIX_C_SOURCE=200809L
 CORE_LIBS = -lcjson -lm
 PORT_LIBS = -lpng -lpthread
 LIBS     = -lcjson -lpng -lm -lpthread
+# The command alone also links SQLite (polarlux tiles to MBTiles).
+CLI_LIBS = -lsqlite3
 
 CORE_DIRS = base scene polar light photon render api
 CORE_SRC = $(foreach d,$(CORE_DIRS),$(wildcard src/$(d)/*.c))
@@ -57,7 +59,7 @@ LIB_SO_REAL = $(BUILD)/libpolarlux.so.$(VERSION)
 LIB_SO = $(BUILD)/libpolarlux.so
 PORT_A = $(BUILD)/libpolarlux-port.a
 BIN    = $(BUILD)/polarlux
-DEB_PACKAGES = libcjson-dev libcmocka-dev libpng-dev pkg-config python3-numpy python3-pytest
+DEB_PACKAGES = libcjson-dev libcmocka-dev libpng-dev pkg-config python3-numpy python3-pytest libsqlite3-dev
 
 .SECONDARY:
 .PHONY: all deps demo check check-full check-build unit cli-test asan valgrind bench install clean \
@@ -112,10 +114,21 @@ $(LIB_SO): $(LIB_SO_REAL)
 	ln -sf $(SONAME) $@
 
 $(BIN): $(CLI_OBJ) $(PORT_A) $(LIB_A)
-	$(CC) $(CFLAGS_ALL) -o $@ $(CLI_OBJ) $(PORT_A) $(LIB_A) $(LIBS)
+	$(CC) $(CFLAGS_ALL) -o $@ $(CLI_OBJ) $(PORT_A) $(LIB_A) $(LIBS) $(CLI_LIBS)
 
 $(BUILD)/tests/test_%: $(BUILD)/tests/unit/test_%.o $(REF_OBJ) $(PORT_A) $(LIB_A)
 	$(CC) $(CFLAGS_ALL) -o $@ $< $(REF_OBJ) $(PORT_A) $(LIB_A) -lcmocka $(LIBS)
+
+# Tests and benches of the command's network and tile code link those objects.
+CLI_TEST_OBJ = $(addprefix $(BUILD)/src/cli/,network.o route_io.o geo_out.o tiles.o mbtiles.o cmd_heatmap.o \
+               canvas.o common.o cmd_network.o cmd_tiles.o cmd_route.o lamp_layer.o bigmem.o)
+CLI_TESTS = $(BUILD)/tests/test_network $(BUILD)/tests/test_tiles $(BUILD)/bench/bench_network
+$(CLI_TESTS): $(CLI_TEST_OBJ)
+$(BUILD)/tests/test_network $(BUILD)/tests/test_tiles: $(BUILD)/tests/test_%: $(BUILD)/tests/unit/test_%.o $(REF_OBJ) $(PORT_A) $(LIB_A)
+	$(CC) $(CFLAGS_ALL) -o $@ $< $(CLI_TEST_OBJ) $(REF_OBJ) $(PORT_A) $(LIB_A) -lcmocka $(LIBS) $(CLI_LIBS)
+$(BUILD)/bench/bench_network: $(BUILD)/tests/bench/bench_network.o $(REF_OBJ) $(PORT_A) $(LIB_A)
+	@mkdir -p $(@D)
+	$(CC) $(CFLAGS_ALL) -o $@ $< $(CLI_TEST_OBJ) $(REF_OBJ) $(PORT_A) $(LIB_A) $(LIBS) $(CLI_LIBS)
 
 $(BUILD)/bench/bench_%: $(BUILD)/tests/bench/bench_%.o $(REF_OBJ) $(PORT_A) $(LIB_A)
 	@mkdir -p $(@D)
@@ -252,3 +265,35 @@ clean:
 	rm -rf build
 
 include tests/hardening.mk
+
+# ---- web map demo (Leaflet from the npm registry, served on 127.0.0.1) ---------
+# make web-deps   npm ci in web/ (Leaflet into web/node_modules; needs npm)
+# make web-data   tiles, the best-lit route and the scene for the page, in web/data
+# make web-demo   both, then serves web/ on http://127.0.0.1:$(WEB_PORT)/
+# make check-web  headless Chromium screenshot of the page, checked by its pixels
+WEB_PORT  ?= 8765
+WEB_SCENE ?= fixtures/helsinki-centre.geojson
+WEB_NET   ?= fixtures/helsinki-streets.geojson
+WEB_FROM  ?= 24.9400,60.1660
+WEB_TO    ?= 24.9480,60.1770
+.PHONY: web-deps web-data web-demo check-web
+
+web-deps: web/node_modules/leaflet/dist/leaflet.js
+
+web/node_modules/leaflet/dist/leaflet.js: web/package.json web/package-lock.json
+	cd web && npm ci --no-audit --no-fund
+	@touch $@
+
+web-data: $(BIN)
+	@mkdir -p web/data
+	$(BIN) tiles $(WEB_SCENE) --quiet --zoom 14-17 -o web/data/tiles
+	$(BIN) route $(WEB_SCENE) --quiet --network $(WEB_NET) --from $(WEB_FROM) --to $(WEB_TO) \
+	  --geojson web/data/route.geojson
+	cp $(WEB_SCENE) web/data/scene.geojson
+
+web-demo: web-deps web-data
+	@echo "serving web/ on http://127.0.0.1:$(WEB_PORT)/ (Ctrl-C stops)"
+	cd web && python3 -m http.server $(WEB_PORT) --bind 127.0.0.1
+
+check-web: web-deps web-data
+	@sh tests/web/check_web.sh web build/web

@@ -523,6 +523,16 @@ plx_status plx_indirect_reset(plx_engine *e);
  * PLX_E_INVALID (side > 1024).
  */
 plx_status plx_indirect_set_gather(plx_engine *e, uint32_t side);
+/*
+ * Photons only from the lamps that can matter for a region: the lamps
+ * whose reach comes within margin metres of box (x0, y0, x1, y1, local
+ * metres); box NULL: every lamp. Drops the accumulated photons; count (may
+ * be NULL) gets the number of lamps chosen. `illum` chooses by the box of
+ * its points with a margin of 100 m. Errors: PLX_E_NOSCENE, PLX_E_INVALID
+ * (an empty box, a negative or non-finite margin), PLX_E_NOMEM.
+ */
+plx_status plx_indirect_select_lamps(plx_engine *e, const double box[4], double margin,
+                                     uint32_t *count /* OUT */);
 
 #define PLX_REFINE_LRU_MAX 64
 

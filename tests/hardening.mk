@@ -151,7 +151,7 @@ FS_BUILD   = build/freestanding
 FS_FLAGS   = -ffreestanding -mthumb -mcpu=cortex-m4 -Os -ffunction-sections -fdata-sections
 FS_OBJ     = $(CORE_SRC:src/%.c=$(FS_BUILD)/%.o)
 # string.h, qsort and every C99 math.h function (double and float)
-FS_ALLOWED = memcpy memmove memset memcmp memchr strlen strcmp strncmp strchr strstr qsort \
+FS_ALLOWED = memcpy memmove memset memcmp memchr strlen strcmp strncmp strchr strrchr strstr qsort \
              acos asin atan atan2 cos sin tan acosh asinh atanh cosh sinh tanh exp exp2 \
              expm1 frexp ldexp log log10 log1p log2 logb modf scalbn cbrt fabs hypot \
              pow sqrt erf erfc lgamma tgamma ceil floor nearbyint rint lrint llrint \

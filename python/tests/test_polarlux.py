@@ -44,7 +44,7 @@ def test_illuminance_matches_the_command(path):
     s = polarlux.Scene.from_file(path)
     pts = street_points(s, 300, 1) if path != TINY else np.array([[30, 12], [50, 10], [35, 2], [5, 5]], float)
     ed, ei = s.illuminance(pts)
-    text = "# crs: local\n" + "".join(f"{x!r} {y!r}\n" for x, y in pts)  # the engine's metres
+    text = "# crs: local\n" + "".join(f"{x!r} {y!r}\n" for x, y in pts)
     rc, out, _ = run_cli("illum", path, "--points", "-", "-q", "--no-indirect", stdin=text)
     rows = np.array([[float(v) for v in line.split()] for line in out.splitlines()])
     assert rows.shape == (len(pts), 5)
@@ -77,7 +77,7 @@ def test_visibility_areas_match_the_command(path):
     s = polarlux.Scene.from_file(path)
     pts = street_points(s, 60, 2) if path != TINY else np.array([[50, 10], [30, 15], [5, 5]], float)
     areas = s.visibility_areas(pts)
-    text = "# crs: local\n" + "".join(f"{x!r} {y!r}\n" for x, y in pts)  # the engine's metres
+    text = "# crs: local\n" + "".join(f"{x!r} {y!r}\n" for x, y in pts)
     _, out, _ = run_cli("vis", "-q", path, "--points", "-", stdin=text)
     cli = np.array([float(line.split()[2]) for line in out.splitlines()])
     assert np.array_equal(np.isnan(areas), np.isnan(cli))

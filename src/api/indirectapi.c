@@ -1,4 +1,5 @@
 /* indirectapi: the public face of the photon buffers (SPEC §4). */
+#include <math.h>
 #include <string.h>
 
 #include "base/engine.h"
@@ -119,6 +120,23 @@ double eng_indirect_photons_rgb(plx_engine *e, const double P[3], const double n
         return 0.0;
     }
     return photon_indirect_rgb(e->ph, P, n, rgb);
+}
+
+plx_status plx_indirect_select_lamps(plx_engine *e, const double box[4], double margin,
+                                      uint32_t *count)
+{
+    plx_status st = need_photons(e, "plx_indirect_select_lamps");
+    uint32_t n;
+    if (st != PLX_OK)
+        return st;
+    if (box && !(box[0] <= box[2] && box[1] <= box[3] && margin >= 0.0 && isfinite(margin)))
+        return eng_fail(e, PLX_E_INVALID,
+                        "plx_indirect_select_lamps: the box needs x0 <= x1, y0 <= y1 and a "
+                        "finite margin >= 0");
+    n = photon_select_lamps(e->ph, box, margin);
+    if (count)
+        *count = n;
+    return PLX_OK;
 }
 
 plx_status plx_indirect_set_gather(plx_engine *e, uint32_t side)

@@ -65,6 +65,9 @@ typedef struct cli_indirect {
 /* Photon frames by default when points are answered by final gathering
  * (illum): the photons carry only the later bounces (16 x 65536). */
 #define CLI_GATHER_FRAMES 16
+/* illum: photons from the lamps whose reach comes within this many metres
+ * of the points' box (plx_indirect_select_lamps). */
+#define CLI_SELECT_MARGIN 100.0
 void cli_indirect_default(cli_indirect *ind);
 /* Handles --photons N, --frames K, --no-indirect, --gather N at argv[*i]; 1 if consumed, -1 on error. */
 int cli_indirect_option(const char *cmd, int argc, char **argv, int *i, cli_indirect *ind);
@@ -114,5 +117,12 @@ int cmd_nightify(int argc, char **argv);
 int cmd_dark_spots(int argc, char **argv);
 int cmd_bake(int argc, char **argv);
 int cmd_walk(int argc, char **argv);
+/* route --network and annotate (cmd_network.c) */
+int cmd_route_network(int argc, char **argv);
+int cmd_annotate(int argc, char **argv);
+int cmd_tiles(int argc, char **argv);
+/* The heat map's colour scale (cmd_heatmap.c): 0 when lux is at or below its
+ * bottom (no light), else 1. */
+int heatmap_colour(double lux, double top, uint8_t rgb[3]);
 
 #endif

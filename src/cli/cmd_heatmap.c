@@ -289,3 +289,12 @@ int cmd_heatmap(int argc, char **argv)
     plx_engine_free(e);
     return rc;
 }
+
+/* The heat map's colour of 'lux' on its scale topped at 'top', for other
+ * maps drawn in the same colours (polarlux tiles). Returns 0 when the lux
+ * is at or below the bottom of the scale (no light: black), else 1. */
+int heatmap_colour(double lux, double top, uint8_t rgb[3])
+{
+    palette(scale_t(lux, top), rgb);
+    return lux > LUX_MIN;
+}

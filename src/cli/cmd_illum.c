@@ -17,7 +17,8 @@ static const char help[] =
     "directions: the light the surfaces around the point reflect, from their\n"
     "exact E_direct, plus their later bounces from the photon buffers, traced\n"
     "first (--frames progressive frames of --photons photons; progress on a\n"
-    "terminal); 0 with --no-indirect.\n"
+    "terminal; only from the lamps whose reach comes within 100 m of the\n"
+    "points); 0 with --no-indirect.\n"
     "A point on no surface (inside a building, in the air) or with a normal\n"
     "into a building prints 'x y z nan nan', is reported on stderr with its\n"
     "line, and makes the exit code 1.\n"
@@ -90,10 +91,25 @@ int cmd_illum(int argc, char **argv)
         return rc;
     }
     if (!ind.off && pts.n > 0) {
-        double eye[3] = { 0, 0, 1.7 };
+        double eye[3] = { 0, 0, 1.7 }, box[4];
+        box[0] = box[2] = pts.v[0];
+        box[1] = box[3] = pts.v[1];
         for (k = 0; k < pts.n; k++) {
             eye[0] += pts.v[6 * k] / pts.n;
             eye[1] += pts.v[6 * k + 1] / pts.n;
+            box[0] = fmin(box[0], pts.v[6 * k]);
+            box[1] = fmin(box[1], pts.v[6 * k + 1]);
+            box[2] = fmax(box[2], pts.v[6 * k]);
+            box[3] = fmax(box[3], pts.v[6 * k + 1]);
+        }
+        /* photons only from the lamps within 100 m of the points' box
+         * (the gather setting first: it decides the photon configuration) */
+        if ((ind.gather >= 0 && plx_indirect_set_gather(e, (uint32_t)ind.gather) != PLX_OK) ||
+            plx_indirect_select_lamps(e, box, CLI_SELECT_MARGIN, NULL) != PLX_OK) {
+            fprintf(stderr, "polarlux illum: %s\n", plx_last_error(e));
+            points_free(&pts);
+            plx_engine_free(e);
+            return EXIT_FAIL;
         }
         rc = cli_indirect_run("illum", e, &ind, eye, NULL, 360.0);
         if (rc != EXIT_OK) {

@@ -25,7 +25,10 @@ static const char route_help[] =
     "  --step M         sampling step in metres (default 1)\n"
     "  --dark-lux LX    the dark threshold (default 1)\n"
     "  --geojson OUT    also write the lines with these numbers as properties\n"
-    "  --mem SIZE, --strict, --quiet, --lamps FILE   as for 'polarlux info'\n";
+    "  --mem SIZE, --strict, --quiet, --lamps FILE   as for 'polarlux info'\n"
+    "\n"
+    "With --network STREETS --from X,Y --to X,Y: the best-lit route over a street\n"
+    "network ('polarlux route --network x --help').\n";
 
 static const char spots_help[] =
     "usage: polarlux dark-spots SCENE [--res M] [--count N] [--spacing M] [--all] [-o OUT] [options]\n"
@@ -145,6 +148,9 @@ int cmd_route(int argc, char **argv)
     route_set rs;
     char err[512];
     int i, rc;
+    for (i = 1; i < argc; i++) /* the best-lit route over a street network: cmd_network.c */
+        if (strcmp(argv[i], "--network") == 0)
+            return cmd_route_network(argc, argv);
     memset(&o, 0, sizeof o);
     o.step = 1.0;
     o.dark = 1.0;

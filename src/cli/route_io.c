@@ -127,13 +127,31 @@ static void line_name(const cJSON *ft, size_t k, char *out, size_t len)
         snprintf(out, len, "#%zu", k);
 }
 
+/* The feature's id for keyed outputs: osm_id, @id, id (properties), then
+ * the feature's own id; strings as they are, numbers as integers. */
+static void line_id(const cJSON *ft, char *out, size_t len)
+{
+    static const char *const keys[3] = { "osm_id", "@id", "id" };
+    const cJSON *props = cJSON_GetObjectItemCaseSensitive(ft, "properties"), *v = NULL;
+    int k;
+    for (k = 0; k < 3 && !v; k++)
+        v = cJSON_GetObjectItemCaseSensitive(props, keys[k]);
+    if (!v)
+        v = cJSON_GetObjectItemCaseSensitive(ft, "id");
+    out[0] = '\0';
+    if (cJSON_IsString(v))
+        snprintf(out, len, "%s", v->valuestring);
+    else if (cJSON_IsNumber(v))
+        snprintf(out, len, "%.0f", v->valuedouble);
+}
+
 int route_parse(const char *name, const char *text, size_t len, plx_engine *e, route_set *out,
                 char *err, size_t errlen)
 {
     cJSON *root = cJSON_ParseWithLength(text, len);
     const cJSON *features, *ft, *type;
     frame f;
-    size_t cap = 0, k = 0;
+    size_t cap = 0, k = 0, first = 0;
     char why[256];
     memset(out, 0, sizeof *out);
     if (!root) {
@@ -168,6 +186,10 @@ int route_parse(const char *name, const char *text, size_t len, plx_engine *e, r
         } else {
             snprintf(why, sizeof why, "geometry is not a LineString or MultiLineString");
             bad = 1;
+        }
+        for (; !bad && first < out->n; first++) {
+            line_id(ft, out->lines[first].id, sizeof out->lines[first].id);
+            out->lines[first].feature = (uint32_t)k;
         }
         if (bad) {
             snprintf(err, errlen, "%s: feature %zu: %s", name, k, why);

@@ -11,6 +11,8 @@ typedef struct route_line {
     char name[32];     /* properties.name, id, or "#k" */
     double *xy;        /* n vertices in the scene's local metres */
     uint32_t n;
+    char id[40];       /* properties.osm_id, @id, id or the feature's id; "" if none */
+    uint32_t feature;  /* index of the feature in the file */
 } route_line;
 
 typedef struct route_set {

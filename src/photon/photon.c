@@ -565,12 +565,15 @@ double photon_gather_wide(const float *flux, const float *area, const float *hei
         return gather_any(flux, &g, fx, fy, e);
     for (b = cj - ri; b <= cj + ri; b++)
         for (a = ci - ri; a <= ci + ri; a++) {
-            double dx = a + 0.5 - fx, dy = b + 0.5 - fy, d = sqrt(dx * dx + dy * dy), wt;
-            int i = column(a, w, wrap);
+            double dx = a + 0.5 - fx, dy = b + 0.5 - fy, d2 = dx * dx + dy * dy, wt;
+            int i;
             size_t k;
-            if (d >= r || b < 0 || b >= (int)h || i < 0 || !gvalid(&g, i, b))
+            if (d2 >= r * r || b < 0 || b >= (int)h)
                 continue;
-            wt = 1.0 - d / r;
+            i = column(a, w, wrap);
+            if (i < 0 || !gvalid(&g, i, b))
+                continue;
+            wt = 1.0 - sqrt(d2) / r;
             k = (size_t)b * w + (size_t)i;
             for (c = 0; c < PHOTON_CH; c++)
                 sf[c] += wt * flux[k * PHOTON_CH + (size_t)c];

@@ -15,6 +15,8 @@
  *
  * Usage: bench_gather [PATHS [NPTS]]  (reference paths per point, default
  * 60000; points per scene, half ground and half facade, default 32)
+ *        bench_gather points N      (N points of `gen oldtown 40 40` for
+ *                                    timing `polarlux illum`; README)
  */
 #include <math.h>
 #include <stdio.h>
@@ -23,6 +25,7 @@
 #include <time.h>
 
 #include "polarlux.h"
+#include "polarlux_port.h"
 #include "base/engine.h"
 #include "photon/trace.h"
 #include "photon/photon.h"
@@ -166,10 +169,34 @@ static void bench_scene(const char *name, const char *text_or_path, size_t len, 
     plx_engine_free(en);
 }
 
+/* "bench_gather points N": N points (half ground, half facade) of `gen
+ * oldtown 40 40` as lines 'x y z nx ny nz', for timing `polarlux illum`. */
+static int write_points(int n)
+{
+    text t = {NULL, 0, 0};
+    plx_engine *e;
+    double *P = malloc(sizeof *P * 3 * (size_t)n), *N = malloc(sizeof *N * 3 * (size_t)n);
+    int np, i;
+    if (!P || !N || plx_gen_city("oldtown", 40, 40, 1, append, &t) != PLX_OK)
+        return 1;
+    e = prepared(t.buf, t.len, 0, 0);
+    np = ref_indirect_points(e->ph->T, e->sc, n / 2, n - n / 2, 77, P, N);
+    for (i = 0; i < np; i++)
+        printf("%.17g %.17g %.17g %.17g %.17g %.17g\n", P[3 * i], P[3 * i + 1], P[3 * i + 2],
+               N[3 * i], N[3 * i + 1], N[3 * i + 2]);
+    plx_engine_free(e);
+    free(t.buf);
+    free(P);
+    free(N);
+    return np == n ? 0 : 1;
+}
+
 int main(int argc, char **argv)
 {
     int paths = argc > 1 ? atoi(argv[1]) : 60000, npts = argc > 2 ? atoi(argv[2]) : 32;
     text t = {NULL, 0, 0};
+    if (argc > 2 && strcmp(argv[1], "points") == 0)
+        return write_points(atoi(argv[2]));
     bench_scene("eixample-4x4", "fixtures/eixample-4x4.geojson", 0, 1, paths, npts);
     if (plx_gen_city("oldtown", 40, 40, 1, append, &t) != PLX_OK) {
         fprintf(stderr, "bench_gather: gen failed\n");

@@ -24,7 +24,7 @@ expect help 0 "^usage: polarlux COMMAND" -- "$bin" --help
 expect no-args 2 "^usage: polarlux COMMAND" -- "$bin"
 expect version 0 "^polarlux [0-9]+\.[0-9]+\.[0-9]+$" -- "$bin" --version
 expect unknown-command 2 "unknown command 'frobnicate'" -- "$bin" frobnicate
-for c in info gen vis draw illum lit heatmap render nightify route dark-spots; do
+for c in info gen vis draw illum lit heatmap render nightify route dark-spots tiles annotate; do
     expect "$c-help" 0 "^usage: polarlux $c" -- "$bin" $c --help
     expect "$c-unknown-option" 2 "polarlux $c: unknown option '--bogus'" -- "$bin" $c --bogus x
 done
@@ -79,6 +79,12 @@ if grep -q "^50 10 0 15.46737485749[0-9]* 0$" "$tmp/out"; then echo "FAIL illum-
 expect illum-bad-frames 2 "--frames 'x' is not a whole number" -- "$bin" illum -q fixtures/tiny.geojson --points "$tmp/i.txt" --frames x
 expect illum-inside 1 "i.txt:3: point \(5, 5, 3\) is inside a building's solid" -- "$bin" illum -q --frames 2 fixtures/tiny.geojson --points "$tmp/i.txt"
 expect illum-missing 2 "missing --points FILE" -- "$bin" illum fixtures/tiny.geojson
+# illum --gather: final gathering (N x N directions) or, with 0, the photon
+# buffers alone; both give a positive E_indirect in the lit courtyard
+expect illum-gather-bad 2 "--gather needs a whole number from 0 to 1024" -- "$bin" illum -q fixtures/tiny.geojson --points "$tmp/i.txt" --gather 2000
+expect illum-gather-8 1 "^50 10 0 15\.46737485749[0-9]* [0-9.]*[1-9][0-9.]*(e-?[0-9]+)?$" -- "$bin" illum -q --frames 2 --photons 20000 --gather 8 fixtures/tiny.geojson --points "$tmp/i.txt"
+expect illum-gather-0 1 "^50 10 0 15\.46737485749[0-9]* [0-9.]*[1-9][0-9.]*(e-?[0-9]+)?$" -- "$bin" illum -q --frames 2 --photons 20000 --gather 0 fixtures/tiny.geojson --points "$tmp/i.txt"
+expect illum-help-gather 0 "--gather N +final gathering over N x N directions" -- "$bin" illum --help
 expect lit-L1 0 "^lamp 0 \(L1\): [0-9]+ lit ground polygons, [0-9]+ lit facade polygons" -- "$bin" lit -q fixtures/tiny.geojson --lamp L1 -o "$tmp/lit.geojson"
 expect lit-index 0 "^lamp 1 \(L2\)" -- "$bin" lit -q fixtures/tiny.geojson --lamp 1 -o "$tmp/lit2.geojson"
 expect lit-no-lamp 1 "no lamp with id or index 'L9'" -- "$bin" lit -q fixtures/tiny.geojson --lamp L9 -o "$tmp/lit3.geojson"
@@ -162,6 +168,7 @@ expect walk-short-path 1 "^polarlux walk: $tmp/short\.geojson: the LineString ne
 expect render-aa-bad 2 "--aa '0' is not a whole number from 1 to 16" -- "$bin" render fixtures/tiny.geojson --aa 0 -o "$tmp/x.png"
 expect render-auto-exposure 0 "^exposure: [0-9.e+-]+ \(automatic" -- "$bin" render -q "$tmp/e.plxb" --size 160x120 -o "$tmp/ae.png"
 . tests/cli/gis.sh
+. tests/cli/network.sh
 ls "$tmp"/*.tmp* >/dev/null 2>&1 && { echo "FAIL temporary files left"; fail=$((fail + 1)); }
 echo "cli: $pass passed, $fail failed"
 [ "$fail" -eq 0 ]

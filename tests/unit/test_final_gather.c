@@ -11,6 +11,8 @@
  *    run, of `gen oldtown 40 40`, at the default settings (the engine's
  *    photon configuration, 16 x 65536 photons, 32 x 32 directions) over six
  *    seeds, next to the photon buffers alone with as many photons;
+ *  - photons only from the lamps near the asked point
+ *    (plx_indirect_select_lamps), still against the path tracer;
  *  - identical bytes for a seed through the API, whatever the order of the
  *    points.
  * PLX_TEST_QUICK=1 (make check) runs the accuracy on eixample only, with
@@ -314,6 +316,47 @@ static void test_accuracy(void **state)
     }
 }
 
+/* ---- photons from the lamps near the asked point ---------------------------- */
+
+/* Each point asked alone with photons only from the lamps whose reach
+ * comes within 100 m of it (plx_indirect_select_lamps): a fraction of the
+ * scene's lamps, and the answer still matches the path tracer (the lamps
+ * left out reach the point only over more than 100 m). */
+static void test_select_lamps(void **state)
+{
+    plx_engine *e = engine_on("fixtures/eixample-4x4.geojson", NULL, 0);
+    int npts = quick_mode() ? 2 : 8, paths = quick_mode() ? 6000 : 40000, np, i, k;
+    double P[3 * 8], N[3 * 8], err = 0.0, bound = quick_mode() ? 0.10 : 0.05;
+    double bad[4] = {10, 0, 0, 10};
+    uint32_t chosen, total = 0;
+    (void)state;
+    assert_int_equal(plx_indirect_step(e, 1, 1), PLX_OK);
+    assert_int_equal(plx_indirect_select_lamps(e, bad, 100.0, NULL), PLX_E_INVALID);
+    np = ref_indirect_points(e->ph->T, e->sc, npts / 2, npts - npts / 2, 515, P, N);
+    assert_int_equal(np, npts);
+    for (i = 0; i < np; i++) {
+        double box[4] = {P[3 * i], P[3 * i + 1], P[3 * i], P[3 * i + 1]};
+        double ref = ref_indirect_paths(e->ph->T, e->sc, P + 3 * i, N + 3 * i, paths, 70 + i,
+                                        NULL);
+        double g;
+        assert_int_equal(plx_indirect_select_lamps(e, box, 100.0, &chosen), PLX_OK);
+        assert_true(chosen > 0 && chosen < e->sc->nlamps);
+        assert_int_equal(plx_indirect_frames(e), 0);
+        total += chosen;
+        for (k = 0; k < 16; k++)
+            assert_int_equal(plx_indirect_step(e, 65536, 31 + k), PLX_OK);
+        g = final_gather_rgb(e->ph, e->ph->T, e->lt, P + 3 * i, N + 3 * i, FINAL_GATHER_SIDE, 1,
+                             NULL);
+        err += fabs(g - ref) / ref / np;
+    }
+    printf("lamps chosen per point: %.1f of %u; mean relative error %.4f (bound %.2f)\n",
+           (double)total / np, e->sc->nlamps, err, bound);
+    assert_true(err <= bound);
+    assert_int_equal(plx_indirect_select_lamps(e, NULL, 0.0, &chosen), PLX_OK);
+    assert_int_equal(chosen, e->sc->nlamps);
+    plx_engine_free(e);
+}
+
 /* ---- same bytes ------------------------------------------------------------------ */
 
 static void answers(double *E, const double *P, const double *N, int n, int reverse)
@@ -358,6 +401,7 @@ int main(void)
         cmocka_unit_test(test_one_bounce_wall),
         cmocka_unit_test(test_energy_closed_room),
         cmocka_unit_test(test_accuracy),
+        cmocka_unit_test(test_select_lamps),
         cmocka_unit_test(test_same_bytes),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

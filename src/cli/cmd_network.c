@@ -1,0 +1,562 @@
+/* polarlux route --network (the best-lit walking route) and polarlux
+ * annotate (every street edge with its light, for routing engines). */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "cli.h"
+#include "geo_out.h"
+#include "network.h"
+#include "port.h"
+
+static const char route_help[] =
+    "usage: polarlux route SCENE --network STREETS --from X,Y --to X,Y [--dark-lux LX]\n"
+    "                      [--dark-weight W] [--max-detour F] [--geojson OUT] [options]\n"
+    "\n"
+    "Finds the best-lit walking route and the shortest route between two points\n"
+    "of a street network and prints them side by side: metres, dark metres, min\n"
+    "and mean lux, EN 13201 P-class and the detour the light costs.\n"
+    "STREETS is GeoJSON LineStrings (e.g. OpenStreetMap highway=* ways), joined\n"
+    "where they share a vertex (the exact same coordinates), in the scene's\n"
+    "coordinate rules (lon/lat projected with the scene's projection, or metres\n"
+    "with properties.units = \"m\"). X,Y are in the scene's coordinates (lon,lat\n"
+    "for a lon/lat scene) and are snapped to the nearest point of a street.\n"
+    "Each edge is scored once as 'polarlux route --path' scores a line. The\n"
+    "search (Dijkstra) minimises\n"
+    "    cost = length + W x dark metres\n"
+    "where dark metres are the metres below --dark-lux plus the metres inside\n"
+    "building footprints (passages, whose light is unknown). W = 0 gives the\n"
+    "shortest route.\n"
+    "\n"
+    "  --network FILE   the street network (required)\n"
+    "  --from X,Y       start (required)\n"
+    "  --to X,Y         end (required)\n"
+    "  --dark-lux LX    the dark threshold (default 1)\n"
+    "  --dark-weight W  extra cost of a dark metre in metres (default 3)\n"
+    "  --max-detour F   the best-lit route may be at most (1 + F) times as long\n"
+    "                   as the shortest: W is lowered to the largest weight whose\n"
+    "                   route keeps within it (bisection to W/1000)\n"
+    "  --snap M         the ends may lie at most M metres from a street (default 50)\n"
+    "  --step M         sampling step in metres (default 1)\n"
+    "  --geojson OUT    write both routes as LineStrings (properties route,\n"
+    "                   length_m, dark_m, min_lux, mean_lux, class, ...)\n"
+    "  --mem SIZE, --strict, --quiet   as for 'polarlux info'\n";
+
+static const char annotate_help[] =
+    "usage: polarlux annotate SCENE --network STREETS -o OUT.geojson [--csv OUT.csv]\n"
+    "                         [--dark-lux LX] [--dark-weight W] [--step M] [options]\n"
+    "\n"
+    "Scores every edge of a street network (as 'polarlux route --network' does)\n"
+    "and writes it as a GeoJSON LineString with its light: osm_id, name, from and\n"
+    "to node, length_m, scored_m, blocked_m, dark_m, dark_share, mean_lux,\n"
+    "min_lux, max_lux, uniformity, class, cost (length + W x dark metres) and\n"
+    "factor (cost / length, >= 1). With --csv, one row per way id (properties\n"
+    "osm_id, @id or id, else the feature's id, else #FEATURE) summed over its\n"
+    "edges: osm_id,length_m,dark_m,blocked_m,dark_share,mean_lux,min_lux,class,factor,\n"
+    "for routing engines that take per-way weights.\n"
+    "\n"
+    "  --network FILE   the street network (required)\n"
+    "  -o OUT           the annotated GeoJSON (required)\n"
+    "  --csv OUT        the per-way CSV\n"
+    "  --dark-lux LX, --dark-weight W, --step M   as for 'polarlux route --network'\n"
+    "  --mem SIZE, --strict, --quiet   as for 'polarlux info'\n";
+
+typedef struct net_opts {
+    const char *cmd, *scene, *network, *geojson, *out, *csv, *from_s, *to_s;
+    double dark, weight, detour, snap, step;
+    int have_detour;
+    cli_common c;
+} net_opts;
+
+static int is_valued(const char *a)
+{
+    static const char *const names[] = { "--network", "--from", "--to", "--dark-lux", "--dark-weight",
+                                         "--max-detour", "--snap", "--step", "--geojson", "-o", "--csv" };
+    size_t k;
+    for (k = 0; k < sizeof names / sizeof names[0]; k++)
+        if (strcmp(a, names[k]) == 0)
+            return 1;
+    return 0;
+}
+
+static int number_option(const net_opts *o, const char *a, const char *v, double *out, double lo)
+{
+    if (cli_parse_double(v, out) != 0 || !(*out >= lo) || !isfinite(*out))
+        return cli_usage_error(o->cmd, "%s '%s' is not a number >= %g", a, v, lo);
+    return 0;
+}
+
+static int value_option(net_opts *o, const char *a, const char *v)
+{
+    if (strcmp(a, "--network") == 0)
+        o->network = v;
+    else if (strcmp(a, "--from") == 0)
+        o->from_s = v;
+    else if (strcmp(a, "--to") == 0)
+        o->to_s = v;
+    else if (strcmp(a, "--geojson") == 0)
+        o->geojson = v;
+    else if (strcmp(a, "-o") == 0)
+        o->out = v;
+    else if (strcmp(a, "--csv") == 0)
+        o->csv = v;
+    else if (strcmp(a, "--dark-lux") == 0)
+        return number_option(o, a, v, &o->dark, 0);
+    else if (strcmp(a, "--dark-weight") == 0)
+        return number_option(o, a, v, &o->weight, 0);
+    else if (strcmp(a, "--snap") == 0)
+        return number_option(o, a, v, &o->snap, 0);
+    else if (strcmp(a, "--max-detour") == 0) {
+        o->have_detour = 1;
+        return number_option(o, a, v, &o->detour, 0);
+    } else if (strcmp(a, "--step") == 0)
+        return number_option(o, a, v, &o->step, 0.01);
+    return 0;
+}
+
+/* Parses the options shared by route --network and annotate; -1 for --help
+ * (printed), else an exit code. */
+static int parse(net_opts *o, int argc, char **argv, const char *help)
+{
+    int i;
+    o->dark = 1.0;
+    o->weight = 3.0;
+    o->snap = 50.0;
+    o->step = 1.0;
+    for (i = 1; i < argc; i++) {
+        const char *a = argv[i];
+        int r = cli_common_option(o->cmd, argc, argv, &i, &o->c);
+        if (r < 0)
+            return EXIT_USAGE;
+        if (r)
+            continue;
+        if (strcmp(a, "--help") == 0 || strcmp(a, "-h") == 0) {
+            fputs(help, stdout);
+            return -1;
+        }
+        if (is_valued(a)) {
+            if (i + 1 >= argc)
+                return cli_usage_error(o->cmd, "%s needs a value", a);
+            if (value_option(o, a, argv[++i]) != 0)
+                return EXIT_USAGE;
+        } else if (a[0] == '-' && a[1] != '\0') {
+            return cli_usage_error(o->cmd, "unknown option '%s'", a);
+        } else if (!o->scene) {
+            o->scene = a;
+        } else {
+            return cli_usage_error(o->cmd, "unexpected argument '%s'", a);
+        }
+    }
+    if (!o->scene)
+        return cli_usage_error(o->cmd, "missing SCENE");
+    if (!o->network)
+        return cli_usage_error(o->cmd, "missing --network STREETS");
+    return EXIT_OK;
+}
+
+/* "X,Y" in the scene's coordinates to local metres. */
+static int parse_point(plx_engine *e, const char *s, double *x, double *y)
+{
+    char extra;
+    if (sscanf(s, "%lf,%lf%c", x, y, &extra) != 2 || !isfinite(*x) || !isfinite(*y))
+        return -1;
+    return cli_to_local(e, x, y);
+}
+
+/* Loads the network and scores its edges; prints the error and returns an
+ * exit code on failure. */
+static int load_network(const net_opts *o, plx_engine *e, network *net)
+{
+    route_set rs;
+    char err[512];
+    plx_status st;
+    if (route_read(o->network, e, &rs, err, sizeof err) != 0) {
+        fprintf(stderr, "polarlux %s: %s\n", o->cmd, err);
+        return EXIT_FAIL;
+    }
+    if (net_build(net, &rs, err, sizeof err) != 0) {
+        fprintf(stderr, "polarlux %s: %s: %s\n", o->cmd, o->network, err);
+        return EXIT_FAIL;
+    }
+    st = net_score(net, e, o->step, o->dark, 1);
+    if (st != PLX_OK) {
+        fprintf(stderr, "polarlux %s: %s: scoring the edges: %s\n", o->cmd, o->network, plx_last_error(e));
+        net_free(net);
+        return cli_exit_code(st);
+    }
+    return EXIT_OK;
+}
+
+static void class_text(int c, char out[4])
+{
+    if (c)
+        snprintf(out, 4, "P%d", c);
+    else
+        strcpy(out, "-");
+}
+
+static double route_mean(const net_route *r)
+{
+    return r->scored > 0 ? r->integral / r->scored : 0.0;
+}
+
+static void print_route(const char *name, const net_route *r, double shortest)
+{
+    char cls[4];
+    class_text(r->p_class, cls);
+    printf("%-9s %9.1f %9.1f %9.3f %9.3f  %-5s %+7.1f%%\n", name, r->length, r->dark + r->blocked, r->min,
+           route_mean(r), cls, shortest > 0 ? 100.0 * (r->length / shortest - 1.0) : 0.0);
+}
+
+static cJSON *route_props(const char *name, const net_route *r, double shortest, double weight)
+{
+    cJSON *p = cJSON_CreateObject();
+    char cls[4];
+    class_text(r->p_class, cls);
+    cJSON_AddStringToObject(p, "route", name);
+    cJSON_AddNumberToObject(p, "length_m", r->length);
+    cJSON_AddNumberToObject(p, "dark_m", r->dark + r->blocked);
+    cJSON_AddNumberToObject(p, "min_lux", r->min);
+    cJSON_AddNumberToObject(p, "mean_lux", route_mean(r));
+    cJSON_AddStringToObject(p, "class", cls);
+    cJSON_AddNumberToObject(p, "blocked_m", r->blocked);
+    cJSON_AddNumberToObject(p, "detour_pct", shortest > 0 ? 100.0 * (r->length / shortest - 1.0) : 0.0);
+    cJSON_AddNumberToObject(p, "dark_weight", weight);
+    cJSON_AddNumberToObject(p, "cost", r->cost);
+    return p;
+}
+
+static int write_routes(const net_opts *o, plx_engine *e, const net_route *best, const net_route *shortest,
+                        double weight)
+{
+    geo_out g;
+    const net_route *r[2] = { best, shortest };
+    static const char *const names[2] = { "best-lit", "shortest" };
+    int k, rc = EXIT_OK;
+    if (geo_begin(&g, e) != 0)
+        return EXIT_FAIL;
+    for (k = 0; k < 2; k++) {
+        cJSON *coords = cJSON_CreateArray();
+        uint32_t i;
+        for (i = 0; i < r[k]->n; i++)
+            cJSON_AddItemToArray(coords, geo_position(&g, r[k]->xy[2 * i], r[k]->xy[2 * i + 1], NULL));
+        geo_add(&g, geo_geometry("LineString", coords),
+                route_props(names[k], r[k], shortest->length, k == 0 ? weight : 0.0));
+    }
+    if (geo_write(&g, o->cmd, o->geojson) != 0)
+        rc = EXIT_FAIL;
+    geo_free(&g);
+    return rc;
+}
+
+/* The best-lit route within --max-detour: bisection on the weight between
+ * 0 (the shortest route, always within) and W. Route length does not fall
+ * as the weight grows, so the largest feasible weight is found. */
+static int cap_detour(network *net, plx_engine *e, const net_snap *a, const net_snap *b, const net_opts *o,
+                      const net_route *shortest, net_route *best, double *weight)
+{
+    double lo = 0, hi = o->weight, cap = (1.0 + o->detour) * shortest->length;
+    char err[256];
+    net_route_free(best);
+    *best = *shortest;
+    best->xy = malloc(sizeof *best->xy * 2 * (shortest->n + 1));
+    if (!best->xy)
+        return -1;
+    memcpy(best->xy, shortest->xy, sizeof *best->xy * 2 * shortest->n);
+    *weight = 0;
+    while (hi - lo > o->weight * 1e-3) {
+        double mid = 0.5 * (lo + hi);
+        net_route r;
+        if (net_route_find(net, e, a, b, mid, &r, err, sizeof err) != 0)
+            return -1;
+        if (r.length <= cap) {
+            lo = mid;
+            net_route_free(best);
+            *best = r;
+            *weight = mid;
+        } else {
+            hi = mid;
+            net_route_free(&r);
+        }
+    }
+    return 0;
+}
+
+static int snap_end(const net_opts *o, plx_engine *e, const network *net, const char *opt, const char *val,
+                    net_snap *s)
+{
+    double x, y;
+    if (parse_point(e, val, &x, &y) != 0) {
+        cli_usage_error(o->cmd, "%s '%s' is not X,Y in the scene's coordinates (lon,lat for a lon/lat scene)",
+                        opt, val);
+        return EXIT_USAGE;
+    }
+    net_snap_point(net, x, y, s);
+    if (s->dist > o->snap) {
+        fprintf(stderr, "polarlux %s: %s %s is %.1f m from the nearest street of %s (more than --snap %g m)\n",
+                o->cmd, opt, val, s->dist, o->network, o->snap);
+        return EXIT_FAIL;
+    }
+    return EXIT_OK;
+}
+
+static int find_routes(const net_opts *o, plx_engine *e, network *net)
+{
+    net_snap a, b;
+    net_route shortest, best;
+    double weight = o->weight;
+    char err[256];
+    int rc = snap_end(o, e, net, "--from", o->from_s, &a), r1, r2;
+    if (rc == EXIT_OK)
+        rc = snap_end(o, e, net, "--to", o->to_s, &b);
+    if (rc != EXIT_OK)
+        return rc;
+    r1 = net_route_find(net, e, &a, &b, 0.0, &shortest, err, sizeof err);
+    r2 = r1 == 0 ? net_route_find(net, e, &a, &b, o->weight, &best, err, sizeof err) : r1;
+    if (r1 == 1 || r2 == 1) {
+        fprintf(stderr, "polarlux %s: %s: no path from --from %s to --to %s: they lie on unconnected parts of the "
+                        "network (it has %u parts)\n", o->cmd, o->network, o->from_s, o->to_s, net_components(net));
+        rc = EXIT_FAIL;
+    } else if (r1 < 0 || r2 < 0) {
+        fprintf(stderr, "polarlux %s: %s\n", o->cmd, err);
+        rc = EXIT_FAIL;
+    }
+    if (rc == EXIT_OK && o->have_detour && best.length > (1.0 + o->detour) * shortest.length &&
+        cap_detour(net, e, &a, &b, o, &shortest, &best, &weight) != 0) {
+        fprintf(stderr, "polarlux %s: out of memory while capping the detour\n", o->cmd);
+        rc = EXIT_FAIL;
+    }
+    if (rc == EXIT_OK) {
+        printf("%-9s %9s %9s %9s %9s  %-5s %8s\n", "route", "length_m", "dark_m", "min_lx", "mean_lx", "class",
+               "detour");
+        print_route("best-lit", &best, shortest.length);
+        print_route("shortest", &shortest, shortest.length);
+        printf("cost = length + %g x dark metres (below %g lx or inside footprints)", weight, o->dark);
+        if (weight != o->weight)
+            printf("; weight lowered from %g by --max-detour %g", o->weight, o->detour);
+        printf("; network %u nodes, %u edges; ends %.1f m and %.1f m from the streets\n", net->nnodes, net->nedges,
+               a.dist, b.dist);
+        if (best.dark + best.blocked > 0 && !o->c.quiet)
+            fprintf(stderr, "polarlux %s: note: the best-lit route still has %.1f dark metres\n", o->cmd,
+                    best.dark + best.blocked);
+        if (o->geojson)
+            rc = write_routes(o, e, &best, &shortest, weight);
+    }
+    if (r1 == 0)
+        net_route_free(&shortest);
+    if (r2 == 0)
+        net_route_free(&best);
+    return rc;
+}
+
+int cmd_route_network(int argc, char **argv)
+{
+    net_opts o;
+    plx_engine *e;
+    network net;
+    int rc;
+    memset(&o, 0, sizeof o);
+    o.cmd = "route";
+    rc = parse(&o, argc, argv, route_help);
+    if (rc != EXIT_OK)
+        return rc < 0 ? EXIT_OK : rc;
+    if (!o.from_s || !o.to_s)
+        return cli_usage_error("route", "--network needs --from X,Y and --to X,Y");
+    if (o.out || o.csv)
+        return cli_usage_error("route", "-o and --csv belong to 'polarlux annotate'");
+    rc = cli_open_scene("route", o.scene, &o.c, &e);
+    if (rc != EXIT_OK)
+        return rc;
+    rc = load_network(&o, e, &net);
+    if (rc == EXIT_OK) {
+        rc = find_routes(&o, e, &net);
+        net_free(&net);
+    }
+    plx_engine_free(e);
+    return rc;
+}
+
+/* ---- annotate ------------------------------------------------------------- */
+
+static const char *edge_id(const network *net, const net_edge *ed, char buf[48])
+{
+    const route_line *l = &net->lines.lines[ed->line];
+    if (l->id[0])
+        return l->id;
+    snprintf(buf, 48, "#%u", l->feature);
+    return buf;
+}
+
+static int write_edges(const net_opts *o, plx_engine *e, const network *net)
+{
+    geo_out g;
+    uint32_t i, k;
+    int rc = EXIT_OK;
+    if (geo_begin(&g, e) != 0)
+        return EXIT_FAIL;
+    for (i = 0; i < net->nedges; i++) {
+        const net_edge *ed = &net->edges[i];
+        const route_line *l = &net->lines.lines[ed->line];
+        cJSON *p = cJSON_CreateObject(), *coords = cJSON_CreateArray();
+        double dark = ed->dark + ed->s.blocked_length, cost = ed->length + o->weight * dark;
+        char cls[4], buf[48];
+        class_text(ed->s.p_class, cls);
+        cJSON_AddStringToObject(p, "osm_id", edge_id(net, ed, buf));
+        cJSON_AddStringToObject(p, "name", l->name);
+        cJSON_AddNumberToObject(p, "edge", i);
+        cJSON_AddNumberToObject(p, "from", ed->a);
+        cJSON_AddNumberToObject(p, "to", ed->b);
+        cJSON_AddNumberToObject(p, "length_m", ed->length);
+        cJSON_AddNumberToObject(p, "scored_m", ed->s.length);
+        cJSON_AddNumberToObject(p, "blocked_m", ed->s.blocked_length);
+        cJSON_AddNumberToObject(p, "dark_m", dark);
+        cJSON_AddNumberToObject(p, "dark_share", ed->length > 0 ? dark / ed->length : 0.0);
+        cJSON_AddNumberToObject(p, "mean_lux", ed->s.mean);
+        cJSON_AddNumberToObject(p, "min_lux", ed->s.min);
+        cJSON_AddNumberToObject(p, "max_lux", ed->s.max);
+        cJSON_AddNumberToObject(p, "uniformity", ed->s.uniformity);
+        cJSON_AddStringToObject(p, "class", cls);
+        cJSON_AddNumberToObject(p, "cost", cost);
+        cJSON_AddNumberToObject(p, "factor", ed->length > 0 ? cost / ed->length : 1.0);
+        for (k = ed->v0; k <= ed->v1; k++)
+            cJSON_AddItemToArray(coords, geo_position(&g, l->xy[2 * k], l->xy[2 * k + 1], NULL));
+        geo_add(&g, geo_geometry("LineString", coords), p);
+    }
+    if (geo_write(&g, "annotate", o->out) != 0)
+        rc = EXIT_FAIL;
+    geo_free(&g);
+    return rc;
+}
+
+/* Sums of the edges of one way id. */
+typedef struct way_sum {
+    char id[48];
+    uint32_t first;
+    double length, dark, blocked, scored, integral, min;
+} way_sum;
+
+static int cmp_id(const void *pa, const void *pb)
+{
+    const way_sum *a = pa, *b = pb;
+    int c = strcmp(a->id, b->id);
+    return c ? c : (a->first > b->first) - (a->first < b->first);
+}
+
+static int cmp_first(const void *pa, const void *pb)
+{
+    const way_sum *a = pa, *b = pb;
+    return (a->first > b->first) - (a->first < b->first);
+}
+
+static void csv_row(FILE *f, const way_sum *w, double weight)
+{
+    double mean = w->scored > 0 ? w->integral / w->scored : 0.0, min = w->scored > 0 ? w->min : 0.0;
+    double dark = w->dark + w->blocked;
+    char cls[4];
+    const char *c;
+    class_text(w->scored > 0 ? plx_p_class(mean, min) : 0, cls);
+    if (strpbrk(w->id, ",\"\n")) {
+        fputc('"', f);
+        for (c = w->id; *c; c++) {
+            if (*c == '"')
+                fputc('"', f);
+            fputc(*c, f);
+        }
+        fputc('"', f);
+    } else {
+        fputs(w->id, f);
+    }
+    fprintf(f, ",%.3f,%.3f,%.3f,%.4f,%.4f,%.4f,%s,%.4f\n", w->length, dark, w->blocked,
+            w->length > 0 ? dark / w->length : 0.0, mean, min, cls,
+            w->length > 0 ? (w->length + weight * dark) / w->length : 1.0);
+}
+
+/* One row per way id, in the order the ways first appear. */
+static int write_csv(const net_opts *o, const network *net)
+{
+    way_sum *w = calloc((size_t)net->nedges + 1, sizeof *w);
+    uint32_t i, n = 0;
+    FILE *f;
+    if (!w)
+        return EXIT_FAIL;
+    for (i = 0; i < net->nedges; i++) {
+        const net_edge *ed = &net->edges[i];
+        char buf[48];
+        snprintf(w[i].id, sizeof w[i].id, "%s", edge_id(net, ed, buf));
+        w[i].first = i;
+        w[i].length = ed->length;
+        w[i].dark = ed->dark;
+        w[i].blocked = ed->s.blocked_length;
+        w[i].scored = ed->s.length;
+        w[i].integral = ed->s.mean * ed->s.length;
+        w[i].min = ed->s.length > 0 ? ed->s.min : INFINITY;
+    }
+    qsort(w, net->nedges, sizeof *w, cmp_id);
+    for (i = 0; i < net->nedges; i++) {
+        if (n > 0 && strcmp(w[n - 1].id, w[i].id) == 0) {
+            way_sum *t = &w[n - 1];
+            t->length += w[i].length;
+            t->dark += w[i].dark;
+            t->blocked += w[i].blocked;
+            t->scored += w[i].scored;
+            t->integral += w[i].integral;
+            t->min = fmin(t->min, w[i].min);
+        } else {
+            w[n++] = w[i];
+        }
+    }
+    qsort(w, n, sizeof *w, cmp_first);
+    f = fopen(o->csv, "w");
+    if (!f) {
+        fprintf(stderr, "polarlux annotate: %s: cannot write\n", o->csv);
+        free(w);
+        return EXIT_FAIL;
+    }
+    fprintf(f, "osm_id,length_m,dark_m,blocked_m,dark_share,mean_lux,min_lux,class,factor\n");
+    for (i = 0; i < n; i++)
+        csv_row(f, &w[i], o->weight);
+    free(w);
+    if (fclose(f) != 0) {
+        fprintf(stderr, "polarlux annotate: %s: write failed\n", o->csv);
+        return EXIT_FAIL;
+    }
+    return EXIT_OK;
+}
+
+int cmd_annotate(int argc, char **argv)
+{
+    net_opts o;
+    plx_engine *e;
+    network net;
+    int rc;
+    memset(&o, 0, sizeof o);
+    o.cmd = "annotate";
+    rc = parse(&o, argc, argv, annotate_help);
+    if (rc != EXIT_OK)
+        return rc < 0 ? EXIT_OK : rc;
+    if (!o.out)
+        return cli_usage_error("annotate", "missing -o OUT.geojson");
+    if (o.from_s || o.to_s || o.geojson || o.have_detour)
+        return cli_usage_error("annotate", "--from, --to, --geojson and --max-detour belong to 'polarlux route'");
+    rc = cli_open_scene("annotate", o.scene, &o.c, &e);
+    if (rc != EXIT_OK)
+        return rc;
+    rc = load_network(&o, e, &net);
+    if (rc == EXIT_OK) {
+        double dark = 0, len = 0;
+        uint32_t i;
+        rc = write_edges(&o, e, &net);
+        if (rc == EXIT_OK && o.csv)
+            rc = write_csv(&o, &net);
+        for (i = 0; i < net.nedges; i++) {
+            dark += net.edges[i].dark + net.edges[i].s.blocked_length;
+            len += net.edges[i].length;
+        }
+        if (rc == EXIT_OK)
+            printf("annotate: %u edges, %u nodes, %.0f m of street, %.0f m dark (below %g lx), written to %s%s%s\n",
+                   net.nedges, net.nnodes, len, dark, o.dark, o.out, o.csv ? " and " : "", o.csv ? o.csv : "");
+        net_free(&net);
+    }
+    plx_engine_free(e);
+    return rc;
+}

@@ -1,0 +1,271 @@
+/* polarlux tiles SCENE --zoom Z0-Z1 -o OUT: web-map raster tiles of the
+ * ground illuminance (a folder OUT/z/x/y.png or an MBTiles file). */
+#include <errno.h>
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include "cli.h"
+#include "port.h"
+#include "tiles.h"
+
+static const char help[] =
+    "usage: polarlux tiles SCENE --zoom Z0[-Z1] [--quantity h] [--max LUX] -o OUT [options]\n"
+    "\n"
+    "Writes web-map raster tiles (Web Mercator, XYZ numbering, 256 x 256 pixels)\n"
+    "of the direct ground illuminance E_h over the scene's Bounds, in the colours\n"
+    "of 'polarlux heatmap' (logarithmic scale from 0.1 lx to --max); pixels with\n"
+    "no light (0.1 lx or less, or inside a footprint) are transparent. Each\n"
+    "pixel is the ground point under its centre. The scene must be in lon/lat.\n"
+    "OUT ending in .mbtiles is an MBTiles 1.3 file (SQLite; metadata name,\n"
+    "format, type, version, bounds, center, minzoom, maxzoom, description);\n"
+    "otherwise OUT is a folder receiving OUT/z/x/y.png.\n"
+    "\n"
+    "  --zoom Z0-Z1   zoom levels (0..22; one level: --zoom Z)\n"
+    "  --quantity h   the horizontal illuminance E_h on the ground (the only one\n"
+    "                 for now)\n"
+    "  --max LUX      top of the colour scale (default: as 'polarlux heatmap' with\n"
+    "                 its default resolution, the next power of ten above the\n"
+    "                 brightest pixel)\n"
+    "  -o OUT         folder or .mbtiles file (required)\n"
+    "  --mem SIZE, --strict, --quiet   as for 'polarlux info'\n";
+
+typedef struct tiles_opts {
+    const char *scene, *out;
+    long z0, z1;
+    double top;
+    cli_common c;
+} tiles_opts;
+
+static int ends_with(const char *s, const char *suffix)
+{
+    size_t n = strlen(s), m = strlen(suffix);
+    return n >= m && strcmp(s + n - m, suffix) == 0;
+}
+
+static int make_dir(const char *path)
+{
+    return mkdir(path, 0777) == 0 || errno == EEXIST ? 0 : -1;
+}
+
+/* Writes OUT/z/x/y.png, making the folders. */
+static int write_file(const tiles_opts *o, int z, long x, long y, const uint8_t *png, size_t len)
+{
+    char path[4096], err[512];
+    snprintf(path, sizeof path, "%s/%d", o->out, z);
+    if (make_dir(o->out) != 0 || make_dir(path) != 0) {
+        fprintf(stderr, "polarlux tiles: %s: cannot make the folder: %s\n", path, strerror(errno));
+        return -1;
+    }
+    snprintf(path, sizeof path, "%s/%d/%ld", o->out, z, x);
+    if (make_dir(path) != 0) {
+        fprintf(stderr, "polarlux tiles: %s: cannot make the folder: %s\n", path, strerror(errno));
+        return -1;
+    }
+    snprintf(path, sizeof path, "%s/%d/%ld/%ld.png", o->out, z, x, y);
+    if (port_write_atomic(path, png, len, err, sizeof err) != 0) {
+        fprintf(stderr, "polarlux tiles: %s\n", err);
+        return -1;
+    }
+    return 0;
+}
+
+static void lonlat_bounds(plx_engine *e, double b[4])
+{
+    plx_scene_info si;
+    double c;
+    plx_scene_info_get(e, &si);
+    c = 111320.0 * cos(si.lat0 * 3.14159265358979323846 / 180.0);
+    b[0] = si.lon0 + si.bounds[0] / c;
+    b[1] = si.lat0 + si.bounds[1] / 110540.0;
+    b[2] = si.lon0 + si.bounds[2] / c;
+    b[3] = si.lat0 + si.bounds[3] / 110540.0;
+}
+
+/* The scene file's name without folder and extension (MBTiles "name"). */
+static const char *scene_name(const char *path, char *buf, size_t len)
+{
+    const char *base = strrchr(path, '/');
+    char *dot;
+    snprintf(buf, len, "%s", base ? base + 1 : path);
+    dot = strrchr(buf, '.');
+    if (dot && dot != buf)
+        *dot = '\0';
+    return buf;
+}
+
+static long count_tiles(plx_engine *e, const tiles_opts *o)
+{
+    long total = 0, x0, y0, x1, y1;
+    int z;
+    for (z = (int)o->z0; z <= o->z1; z++) {
+        tile_range(e, z, &x0, &y0, &x1, &y1);
+        total += (x1 - x0 + 1) * (y1 - y0 + 1);
+    }
+    return total;
+}
+
+/* Renders and stores every tile; returns an exit code. */
+static int run(plx_engine *e, const tiles_opts *o, double top)
+{
+    uint8_t *rgba = malloc(TILE_SIZE * TILE_SIZE * 4);
+    long total = count_tiles(e, o), done = 0, lit_tiles = 0, x0, y0, x1, y1, x, y;
+    int z, rc = EXIT_OK, tty = isatty(2);
+    tile_work w;
+    mbtiles *mb = NULL;
+    char err[512], name[256];
+    double b[4];
+    memset(&w, 0, sizeof w);
+    lonlat_bounds(e, b);
+    if (!rgba || tile_work_init(&w) != 0) {
+        fprintf(stderr, "polarlux tiles: out of memory\n");
+        free(rgba);
+        return EXIT_FAIL;
+    }
+    if (ends_with(o->out, ".mbtiles") &&
+        !(mb = mbtiles_open(o->out, scene_name(o->scene, name, sizeof name), b, (int)o->z0, (int)o->z1, top, err, sizeof err))) {
+        fprintf(stderr, "polarlux tiles: %s\n", err);
+        rc = EXIT_FAIL;
+    }
+    for (z = (int)o->z0; z <= o->z1 && rc == EXIT_OK; z++) {
+        tile_range(e, z, &x0, &y0, &x1, &y1);
+        for (y = y0; y <= y1 && rc == EXIT_OK; y++)
+            for (x = x0; x <= x1 && rc == EXIT_OK; x++) {
+                uint8_t *png;
+                size_t len;
+                long lit = tile_render(e, &w, z, x, y, top, rgba);
+                if (lit < 0) {
+                    fprintf(stderr, "polarlux tiles: tile %d/%ld/%ld: %s\n", z, x, y, plx_last_error(e));
+                    rc = EXIT_FAIL;
+                    break;
+                }
+                lit_tiles += lit > 0;
+                if (tile_png(rgba, &png, &len) != 0) {
+                    fprintf(stderr, "polarlux tiles: tile %d/%ld/%ld: PNG encoding failed\n", z, x, y);
+                    rc = EXIT_FAIL;
+                    break;
+                }
+                if (mb ? mbtiles_put(mb, z, x, y, png, len, err, sizeof err) != 0 : write_file(o, z, x, y, png, len) != 0) {
+                    if (mb)
+                        fprintf(stderr, "polarlux tiles: %s\n", err);
+                    rc = EXIT_FAIL;
+                }
+                free(png);
+                if (tty && (++done % 16 == 0 || done == total))
+                    fprintf(stderr, "\rtiles: %ld / %ld", done, total);
+            }
+    }
+    if (tty && done >= 16)
+        fprintf(stderr, "\n");
+    if (mb && mbtiles_close(mb, rc == EXIT_OK, err, sizeof err) != 0) {
+        fprintf(stderr, "polarlux tiles: %s\n", err);
+        rc = EXIT_FAIL;
+    }
+    if (rc == EXIT_OK) {
+        printf("tiles: %ld tiles at zoom %ld-%ld (%ld with light), scale 0.1..%g lx, written to %s\n", total, o->z0,
+               o->z1, lit_tiles, top, o->out);
+        if (lit_tiles == 0)
+            fprintf(stderr, "polarlux tiles: note: no tile has light (every pixel at or below 0.1 lx)\n");
+    }
+    tile_work_free(&w);
+    free(rgba);
+    return rc;
+}
+
+static int parse_zoom(const char *s, tiles_opts *o)
+{
+    char a[32], *dash;
+    snprintf(a, sizeof a, "%s", s);
+    dash = strchr(a, '-');
+    if (dash)
+        *dash = '\0';
+    if (cli_parse_int(a, 0, 22, &o->z0) != 0)
+        return -1;
+    o->z1 = o->z0;
+    if (dash && cli_parse_int(dash + 1, 0, 22, &o->z1) != 0)
+        return -1;
+    return o->z1 >= o->z0 ? 0 : -1;
+}
+
+static int parse(int argc, char **argv, tiles_opts *o)
+{
+    int i, have_zoom = 0;
+    for (i = 1; i < argc; i++) {
+        const char *a = argv[i];
+        int r = cli_common_option("tiles", argc, argv, &i, &o->c);
+        if (r < 0)
+            return EXIT_USAGE;
+        if (r)
+            continue;
+        if (strcmp(a, "--help") == 0 || strcmp(a, "-h") == 0) {
+            fputs(help, stdout);
+            return -1;
+        }
+        if ((strcmp(a, "--zoom") == 0 || strcmp(a, "--quantity") == 0 || strcmp(a, "--max") == 0 ||
+             strcmp(a, "-o") == 0) && i + 1 >= argc)
+            return cli_usage_error("tiles", "%s needs a value", a);
+        if (strcmp(a, "--zoom") == 0) {
+            if (parse_zoom(argv[++i], o) != 0)
+                return cli_usage_error("tiles", "--zoom '%s' is not Z or Z0-Z1 with 0 <= Z0 <= Z1 <= 22", argv[i]);
+            have_zoom = 1;
+        } else if (strcmp(a, "--quantity") == 0) {
+            if (strcmp(argv[++i], "h") != 0)
+                return cli_usage_error("tiles", "--quantity '%s' is not available (only h, the ground E_h)", argv[i]);
+        } else if (strcmp(a, "--max") == 0) {
+            if (cli_parse_double(argv[++i], &o->top) != 0 || !(o->top > 0.1))
+                return cli_usage_error("tiles", "--max '%s' is not a number of lux above 0.1", argv[i]);
+        } else if (strcmp(a, "-o") == 0) {
+            o->out = argv[++i];
+        } else if (a[0] == '-' && a[1] != '\0') {
+            return cli_usage_error("tiles", "unknown option '%s'", a);
+        } else if (!o->scene) {
+            o->scene = a;
+        } else {
+            return cli_usage_error("tiles", "unexpected argument '%s'", a);
+        }
+    }
+    if (!o->scene)
+        return cli_usage_error("tiles", "missing SCENE");
+    if (!have_zoom)
+        return cli_usage_error("tiles", "missing --zoom Z0-Z1");
+    if (!o->out)
+        return cli_usage_error("tiles", "missing -o OUT (a folder or a .mbtiles file)");
+    return EXIT_OK;
+}
+
+#define MAX_TILES 20000L
+
+int cmd_tiles(int argc, char **argv)
+{
+    tiles_opts o;
+    plx_engine *e;
+    plx_scene_info si;
+    long n;
+    int rc;
+    memset(&o, 0, sizeof o);
+    rc = parse(argc, argv, &o);
+    if (rc != EXIT_OK)
+        return rc < 0 ? EXIT_OK : rc;
+    rc = cli_open_scene("tiles", o.scene, &o.c, &e);
+    if (rc != EXIT_OK)
+        return rc;
+    plx_scene_info_get(e, &si);
+    if (!si.lonlat) {
+        fprintf(stderr, "polarlux tiles: %s: the scene is in local metres, with no lon/lat to place tiles on the "
+                        "map (web-map tiles need a scene in WGS84 lon/lat)\n", o.scene);
+        plx_engine_free(e);
+        return EXIT_FAIL;
+    }
+    n = count_tiles(e, &o);
+    if (n > MAX_TILES) {
+        fprintf(stderr, "polarlux tiles: --zoom %ld-%ld covers the scene with %ld tiles (at most %ld)\n", o.z0, o.z1,
+                n, MAX_TILES);
+        plx_engine_free(e);
+        return EXIT_USAGE;
+    }
+    rc = run(e, &o, o.top > 0 ? o.top : tile_default_top(e));
+    plx_engine_free(e);
+    return rc;
+}

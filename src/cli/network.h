@@ -1,0 +1,76 @@
+/* A street network for walking routes: GeoJSON lines joined where they share
+ * a vertex, each edge scored once for light, and the best-lit route between
+ * two points (Dijkstra on length + weight x dark metres).
+ *
+ * Nodes are the positions (exact coordinates after projection) where a line
+ * ends or that two or more line vertices share; an edge is the piece of a
+ * line between two consecutive nodes along it. */
+#ifndef PLX_CLI_NETWORK_H
+#define PLX_CLI_NETWORK_H
+
+#include <stddef.h>
+#include <stdint.h>
+#include "polarlux.h"
+#include "route_io.h"
+
+typedef struct net_edge {
+    uint32_t a, b;          /* end nodes (a at vertex v0, b at v1) */
+    uint32_t line, v0, v1;  /* the piece: vertices v0..v1 of line */
+    double length;          /* geometric length in metres */
+    double dark;            /* metres scored below the dark threshold */
+    plx_route_stats s;      /* the piece scored as plx_route_score scores a line */
+} net_edge;
+
+typedef struct network {
+    route_set lines;        /* the source lines (owned) */
+    double *node_xy;        /* 2 per node */
+    uint32_t nnodes, nedges;
+    net_edge *edges;
+    uint32_t *adj_first;    /* node i's edges: adj[adj_first[i] .. adj_first[i+1]) */
+    uint32_t *adj;
+    double step, dark_lux;  /* how the edges were scored */
+    /* search scratch, sized for nnodes + 2 */
+    double *dist;
+    uint32_t *prev;
+    void *heap;             /* heap_cap entries of the search's priority queue */
+    size_t heap_cap;
+} network;
+
+/* Builds the graph from lines (taking them over: they are freed by
+ * net_free, also on failure). 0, or -1 with a message in err. */
+int net_build(network *net, route_set *lines, char *err, size_t errlen);
+/* Scores every edge (plx_route_score over the piece, sampled every step
+ * metres); progress on stderr when it is a terminal. A plx_status. */
+plx_status net_score(network *net, plx_engine *e, double step, double dark_lux, int progress);
+void net_free(network *net);
+
+/* A route: its edges and the sums over them. */
+typedef struct net_route {
+    double length, dark, blocked, scored, integral, min, max, cost;
+    int p_class;
+    double *xy;            /* the polyline, n vertices, malloc'd */
+    uint32_t n;
+} net_route;
+
+/* A point snapped onto the network: edge, segment k of the piece and the
+ * position on it, at distance 'dist' from the point asked for. */
+typedef struct net_snap {
+    uint32_t edge, seg;
+    double x, y, dist;
+} net_snap;
+
+/* The nearest point of the network to (x, y); -1 when there are no edges. */
+int net_snap_point(const network *net, double x, double y, net_snap *out);
+
+/* The cheapest route from a to b with cost = length + weight x (dark +
+ * blocked metres). The partial edges from the snapped points to the ends of
+ * their edges are scored with e. 0 on success, 1 when b cannot be reached
+ * from a, -1 when out of memory or scoring failed (message in err). */
+int net_route_find(network *net, plx_engine *e, const net_snap *a, const net_snap *b, double weight,
+                   net_route *out, char *err, size_t errlen);
+void net_route_free(net_route *r);
+
+/* The number of connected parts of the network (for messages). */
+uint32_t net_components(const network *net);
+
+#endif

@@ -1,0 +1,364 @@
+/* Street networks (src/cli/network.c): lines joined at shared vertices,
+ * edges scored as plx_route_score scores lines, and Dijkstra's routes
+ * against hand-computed answers and an independent Bellman-Ford. */
+#include <stdarg.h>
+#include <stddef.h>
+#include <setjmp.h>
+#include <stdint.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <cmocka.h>
+
+#include "polarlux.h"
+#include "polarlux_port.h"
+#include "cli/network.h"
+
+#define MEM ((size_t)256 << 20)
+
+static plx_engine *load_file(const char *path, void **mem)
+{
+    plx_engine *e;
+    plx_config cfg;
+    static plx_port quiet;
+    quiet = *plx_port_posix();
+    quiet.log = NULL;
+    plx_config_default(&cfg);
+    cfg.port = &quiet;
+    *mem = malloc(MEM);
+    assert_non_null(*mem);
+    assert_int_equal(plx_engine_create(*mem, MEM, &cfg, &e), PLX_OK);
+    assert_int_equal(plx_load_file(e, path), PLX_OK);
+    return e;
+}
+
+static plx_engine *load_text(const char *json, void **mem)
+{
+    plx_engine *e;
+    plx_config cfg;
+    plx_config_default(&cfg);
+    *mem = malloc(MEM);
+    assert_non_null(*mem);
+    assert_int_equal(plx_engine_create(*mem, MEM, &cfg, &e), PLX_OK);
+    assert_int_equal(plx_load_geojson(e, json, strlen(json), "t"), PLX_OK);
+    return e;
+}
+
+static void open_net(plx_engine *e, const char *path, network *net)
+{
+    route_set rs;
+    char err[512];
+    if (route_read(path, e, &rs, err, sizeof err) != 0)
+        fail_msg("%s", err);
+    assert_int_equal(net_build(net, &rs, err, sizeof err), 0);
+    assert_int_equal(net_score(net, e, 1.0, 1.0, 0), PLX_OK);
+}
+
+static void snap(const network *net, double x, double y, net_snap *s)
+{
+    assert_int_equal(net_snap_point(net, x, y, s), 0);
+}
+
+/* fixtures/net-detour: a dark straight street (0,0)-(200,0) and a detour
+ * over y = 50 under a row of lamps. The detour wins exactly when the
+ * weight passes (L_detour - L_short) / (D_short - D_detour). */
+static void test_detour_only_when_weight_says_so(void **state)
+{
+    void *mem;
+    plx_engine *e = load_file("fixtures/net-detour.geojson", &mem);
+    network net;
+    net_snap a, b;
+    net_route r0, rbig, rlo, rhi;
+    char err[256];
+    double wstar;
+    (void)state;
+    open_net(e, "fixtures/net-detour-streets.geojson", &net);
+    assert_int_equal(net.nedges, 6); /* shortcut and detour cut at the spur's ends, spur, island */
+    assert_int_equal(net.nnodes, 8 - 2); /* (0,0) (100,0) (200,0) (100,50), island ends */
+    snap(&net, 0, 0, &a);
+    snap(&net, 200, 0, &b);
+    assert_int_equal(net_route_find(&net, e, &a, &b, 0.0, &r0, err, sizeof err), 0);
+    assert_true(fabs(r0.length - 200.0) < 1e-9);
+    assert_true(fabs(r0.dark - 200.0) < 1e-6); /* no lamp reaches y = 0 (all 50 m away, R 30) */
+    assert_true(fabs(r0.cost - 200.0) < 1e-9);
+    assert_int_equal(net_route_find(&net, e, &a, &b, 100.0, &rbig, err, sizeof err), 0);
+    assert_true(fabs(rbig.length - 300.0) < 1e-9);
+    assert_true(rbig.dark > 10 && rbig.dark < 100); /* the two legs down to y = 0 */
+    assert_true(fabs(rbig.cost - (rbig.length + 100.0 * rbig.dark)) < 1e-6);
+    wstar = (rbig.length - r0.length) / (r0.dark - rbig.dark);
+    assert_int_equal(net_route_find(&net, e, &a, &b, 0.99 * wstar, &rlo, err, sizeof err), 0);
+    assert_int_equal(net_route_find(&net, e, &a, &b, 1.01 * wstar, &rhi, err, sizeof err), 0);
+    assert_true(fabs(rlo.length - 200.0) < 1e-9);
+    assert_true(fabs(rhi.length - 300.0) < 1e-9);
+    assert_true(rhi.min == 0.0 && rhi.integral > 0);
+    net_route_free(&r0);
+    net_route_free(&rbig);
+    net_route_free(&rlo);
+    net_route_free(&rhi);
+    net_free(&net);
+    plx_engine_destroy(e);
+    free(mem);
+}
+
+/* Each line's edges add up to the line scored whole by plx_route_score
+ * (what 'polarlux route --path' prints), on the real Helsinki network. */
+static void test_edges_equal_route_scores(void **state)
+{
+    void *mem;
+    plx_engine *e = load_file("fixtures/helsinki-centre.geojson", &mem);
+    network net;
+    size_t i;
+    uint32_t k, checked = 0, cut = 0;
+    (void)state;
+    open_net(e, "fixtures/helsinki-streets.geojson", &net);
+    assert_true(net.nedges > net.lines.n);
+    for (i = 0; i < net.lines.n; i++) {
+        const route_line *l = &net.lines.lines[i];
+        plx_route_stats whole;
+        double len = 0, dark = 0, integral = 0, blocked = 0, mn = INFINITY, geo = 0;
+        uint32_t pieces = 0;
+        if (getenv("PLX_TEST_QUICK") && i % 4)
+            continue;
+        assert_int_equal(plx_route_score(e, l->xy, l->n, 1.0, 1.0, &whole, NULL), PLX_OK);
+        for (k = 0; k < net.nedges; k++) {
+            const net_edge *ed = &net.edges[k];
+            if (ed->line != i)
+                continue;
+            pieces++;
+            len += ed->s.length;
+            dark += ed->dark;
+            integral += ed->s.mean * ed->s.length;
+            blocked += ed->s.blocked_length;
+            geo += ed->length;
+            if (ed->s.length > 0)
+                mn = fmin(mn, ed->s.min);
+        }
+        assert_true(pieces >= 1);
+        cut += pieces > 1;
+        assert_true(fabs(len - whole.length) <= 1e-9 * (1 + whole.length));
+        assert_true(fabs(blocked - whole.blocked_length) <= 1e-9 * (1 + whole.length));
+        assert_true(fabs(dark - whole.dark_share * whole.length) <= 1e-9 * (1 + whole.length));
+        assert_true(fabs(integral - whole.mean * whole.length) <= 1e-9 * (1 + whole.mean * whole.length));
+        if (whole.length > 0)
+            assert_true(mn == whole.min);
+        assert_true(fabs(geo - (whole.length + whole.blocked_length)) <= 1e-6 * (1 + geo));
+        checked++;
+    }
+    assert_true(checked > 100);
+    assert_true(cut > 100); /* real ways meet in the middle of other ways */
+    net_free(&net);
+    plx_engine_destroy(e);
+    free(mem);
+}
+
+/* A route's sums equal plx_route_score over its own polyline, also when it
+ * starts and ends inside edges. */
+static void test_route_equals_its_polyline(void **state)
+{
+    void *mem;
+    plx_engine *e = load_file("fixtures/net-detour.geojson", &mem);
+    network net;
+    net_snap a, b;
+    net_route r;
+    plx_route_stats s;
+    char err[256];
+    static const double ends[4][4] = { { 50, 0, 150, 0 }, { 20, 1, 80, -1 }, { 80, 0, 20, 0 }, { 30, 45, 170, 5 } };
+    static const double expect_len[4] = { 100, 60, 60, -1 };
+    int i;
+    (void)state;
+    open_net(e, "fixtures/net-detour-streets.geojson", &net);
+    for (i = 0; i < 4; i++) {
+        snap(&net, ends[i][0], ends[i][1], &a);
+        snap(&net, ends[i][2], ends[i][3], &b);
+        assert_int_equal(net_route_find(&net, e, &a, &b, i == 3 ? 50.0 : 0.0, &r, err, sizeof err), 0);
+        if (expect_len[i] > 0)
+            assert_true(fabs(r.length - expect_len[i]) < 1e-9);
+        assert_true(r.xy[0] == a.x && r.xy[1] == a.y);
+        assert_true(r.xy[2 * r.n - 2] == b.x && r.xy[2 * r.n - 1] == b.y);
+        assert_int_equal(plx_route_score(e, r.xy, r.n, 1.0, 1.0, &s, NULL), PLX_OK);
+        assert_true(fabs(s.length - r.scored) < 1e-9);
+        assert_true(fabs(s.dark_share * s.length - r.dark) < 1e-9);
+        assert_true(fabs(s.mean * s.length - r.integral) < 1e-9 * (1 + r.integral));
+        net_route_free(&r);
+    }
+    net_free(&net);
+    plx_engine_destroy(e);
+    free(mem);
+}
+
+/* ---- random grids against Bellman-Ford -------------------------------------- */
+
+static uint64_t rng;
+static double rnd(void)
+{
+    rng = rng * 6364136223846793005ull + 1442695040888963407ull;
+    return (double)(rng >> 11) / 9007199254740992.0;
+}
+
+static char *grid_scene(int seed)
+{
+    char *buf = malloc(1 << 16);
+    size_t n = 0;
+    int k;
+    rng = 1000 + (uint64_t)seed;
+    n += (size_t)sprintf(buf + n, "{\"type\":\"FeatureCollection\",\"properties\":{\"units\":\"m\"},\"features\":["
+                                  "{\"type\":\"Feature\",\"properties\":{},\"geometry\":{\"type\":\"Polygon\","
+                                  "\"coordinates\":[[[-12,-12],[-10,-12],[-10,-10],[-12,-10]]]}},"
+                                  "{\"type\":\"Feature\",\"properties\":{},\"geometry\":{\"type\":\"Polygon\","
+                                  "\"coordinates\":[[[23,23],[37,23],[37,37],[23,37]]]}},"
+                                  "{\"type\":\"Feature\",\"properties\":{},\"geometry\":{\"type\":\"Polygon\","
+                                  "\"coordinates\":[[[110,110],[112,110],[112,112],[110,112]]]}}");
+    for (k = 0; k < 6; k++)
+        n += (size_t)sprintf(buf + n, ",{\"type\":\"Feature\",\"properties\":{\"lamp\":true,\"radius\":25},"
+                                      "\"geometry\":{\"type\":\"Point\",\"coordinates\":[%.1f,%.1f]}}",
+                             rnd() * 100, rnd() * 100);
+    sprintf(buf + n, "]}");
+    return buf;
+}
+
+/* A 6 x 6 grid, 20 m apart, each grid edge present with probability 0.75,
+ * some with a middle vertex, some lines running over two grid edges. */
+static void grid_lines(int seed, route_set *rs)
+{
+    size_t cap = 128;
+    int i, j, d;
+    rng = 7 + (uint64_t)seed * 31;
+    rs->lines = calloc(cap, sizeof *rs->lines);
+    rs->n = 0;
+    for (i = 0; i < 6; i++)
+        for (j = 0; j < 6; j++)
+            for (d = 0; d < 2; d++) {
+                int i2 = i + (d == 0), j2 = j + (d == 1), two = rnd() < 0.2, mid = rnd() < 0.3, m = 0;
+                route_line *l;
+                if (i2 + two * (d == 0) > 5 || j2 + two * (d == 1) > 5 || rnd() > 0.75)
+                    continue;
+                l = &rs->lines[rs->n++];
+                l->xy = malloc(sizeof *l->xy * 8);
+                l->xy[m++] = 20.0 * i;
+                l->xy[m++] = 20.0 * j;
+                if (mid) {
+                    l->xy[m++] = 20.0 * i + 10.0 * (d == 0) + 3.0 * (d == 1);
+                    l->xy[m++] = 20.0 * j + 10.0 * (d == 1) + 3.0 * (d == 0);
+                }
+                l->xy[m++] = 20.0 * i2;
+                l->xy[m++] = 20.0 * j2;
+                if (two) {
+                    l->xy[m++] = 20.0 * (i2 + (d == 0));
+                    l->xy[m++] = 20.0 * (j2 + (d == 1));
+                }
+                l->n = (uint32_t)m / 2;
+                snprintf(l->name, sizeof l->name, "g%zu", rs->n);
+            }
+    { /* an island: its two nodes are numbered last */
+        route_line *l = &rs->lines[rs->n++];
+        static const double island[4] = { 91, 95, 97, 95 };
+        l->xy = malloc(sizeof island);
+        memcpy(l->xy, island, sizeof island);
+        l->n = 2;
+    }
+}
+
+static double bellman_ford(const network *net, uint32_t s, uint32_t t, double w)
+{
+    double *d = malloc(sizeof *d * net->nnodes), res;
+    uint32_t it, k;
+    for (k = 0; k < net->nnodes; k++)
+        d[k] = INFINITY;
+    d[s] = 0;
+    for (it = 0; it < net->nnodes; it++)
+        for (k = 0; k < net->nedges; k++) {
+            const net_edge *ed = &net->edges[k];
+            double c = ed->length + w * (ed->s.dark_share * ed->s.length + ed->s.blocked_length);
+            if (d[ed->a] + c < d[ed->b])
+                d[ed->b] = d[ed->a] + c;
+            if (d[ed->b] + c < d[ed->a])
+                d[ed->a] = d[ed->b] + c;
+        }
+    res = d[t];
+    free(d);
+    return res;
+}
+
+static void test_random_grids_against_bellman_ford(void **state)
+{
+    int seed, rounds = getenv("PLX_TEST_QUICK") ? 6 : 30, reached = 0, unreached = 0;
+    static const double weights[3] = { 0.0, 0.7, 4.0 };
+    (void)state;
+    for (seed = 0; seed < rounds; seed++) {
+        void *mem;
+        char *scene = grid_scene(seed), err[256];
+        plx_engine *e = load_text(scene, &mem);
+        network net;
+        route_set rs;
+        uint32_t q;
+        grid_lines(seed, &rs);
+        assert_int_equal(net_build(&net, &rs, err, sizeof err), 0);
+        assert_int_equal(net_score(&net, e, 1.0, 1.0, 0), PLX_OK);
+        for (q = 0; q < 12; q++) {
+            uint32_t s = (uint32_t)(rnd() * net.nnodes), t = q == 11 ? net.nnodes - 1 : (uint32_t)(rnd() * net.nnodes);
+            double w = weights[q % 3], want = bellman_ford(&net, s, t, w);
+            net_snap a, b;
+            net_route r;
+            int rc;
+            snap(&net, net.node_xy[2 * s], net.node_xy[2 * s + 1], &a);
+            snap(&net, net.node_xy[2 * t], net.node_xy[2 * t + 1], &b);
+            assert_true(a.dist == 0 && b.dist == 0);
+            rc = net_route_find(&net, e, &a, &b, w, &r, err, sizeof err);
+            if (want == INFINITY) {
+                assert_int_equal(rc, 1);
+                unreached++;
+                continue;
+            }
+            assert_int_equal(rc, 0);
+            assert_true(fabs(r.cost - want) <= 1e-9 * (1 + want));
+            assert_true(fabs(r.cost - (r.length + w * (r.dark + r.blocked))) <= 1e-9 * (1 + want));
+            reached++;
+            net_route_free(&r);
+        }
+        net_free(&net);
+        plx_engine_destroy(e);
+        free(mem);
+        free(scene);
+    }
+    assert_true(reached > 10);
+    assert_true(unreached > 0);
+}
+
+static void test_snap_and_empty(void **state)
+{
+    void *mem;
+    plx_engine *e = load_file("fixtures/net-detour.geojson", &mem);
+    network net;
+    net_snap s;
+    route_set rs;
+    char err[256];
+    static const char empty[] = "{\"type\":\"FeatureCollection\",\"properties\":{\"units\":\"m\"},\"features\":[]}";
+    (void)state;
+    open_net(e, "fixtures/net-detour-streets.geojson", &net);
+    snap(&net, 50, -30, &s);
+    assert_true(fabs(s.dist - 30) < 1e-12 && s.x == 50 && s.y == 0);
+    snap(&net, 430, 404, &s);
+    assert_true(fabs(s.dist - hypot(10, 4)) < 1e-12);
+    net_free(&net);
+    assert_int_equal(route_parse("empty.geojson", empty, strlen(empty), e, &rs, err, sizeof err), -1);
+    assert_string_equal(err, "empty.geojson: no LineString features");
+    memset(&rs, 0, sizeof rs);
+    assert_int_equal(net_build(&net, &rs, err, sizeof err), 0);
+    assert_int_equal(net_snap_point(&net, 0, 0, &s), -1);
+    net_free(&net);
+    plx_engine_destroy(e);
+    free(mem);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_detour_only_when_weight_says_so),
+        cmocka_unit_test(test_edges_equal_route_scores),
+        cmocka_unit_test(test_route_equals_its_polyline),
+        cmocka_unit_test(test_random_grids_against_bellman_ford),
+        cmocka_unit_test(test_snap_and_empty),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}

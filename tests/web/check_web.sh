@@ -1,0 +1,28 @@
+#!/bin/sh
+# make check-web: serves WEB_DIR on 127.0.0.1, opens index.html in Debian's
+# headless Chromium, saves a screenshot to OUT_DIR/web-demo.png and checks
+# from its pixels that the light tiles and both routes are drawn.
+# usage: tests/web/check_web.sh WEB_DIR OUT_DIR
+web=$1; out=$2
+mkdir -p "$out"
+for b in chromium chromium-browser; do command -v $b >/dev/null && browser=$b && break; done
+[ -n "$browser" ] || { echo "check-web: chromium not found (apt-get install chromium)"; exit 1; }
+port=$(python3 -c 'import socket; s = socket.socket(); s.bind(("127.0.0.1", 0)); print(s.getsockname()[1])')
+python3 -m http.server "$port" --bind 127.0.0.1 --directory "$web" >"$out/http.log" 2>&1 &
+server=$!
+trap 'kill $server 2>/dev/null' EXIT
+i=0
+until python3 -c "import urllib.request; urllib.request.urlopen('http://127.0.0.1:$port/index.html', timeout=1)" 2>/dev/null; do
+    i=$((i + 1)); [ $i -gt 50 ] && { echo "check-web: the server did not start"; exit 1; }; sleep 0.1
+done
+rm -f "$out/web-demo.png"
+timeout 120 "$browser" --headless --no-sandbox --disable-gpu --hide-scrollbars --window-size=1100,900 \
+    --virtual-time-budget=15000 --screenshot="$out/web-demo.png" "http://127.0.0.1:$port/index.html" \
+    >"$out/chromium.log" 2>&1
+[ -s "$out/web-demo.png" ] || { echo "check-web: no screenshot"; cat "$out/chromium.log"; exit 1; }
+echo "check-web: screenshot $out/web-demo.png"
+if python3 tests/web/png_pixels.py "$out/web-demo.png"; then
+    echo "web: 1 passed, 0 failed"
+else
+    echo "web: 0 passed, 1 failed"; exit 1
+fi
