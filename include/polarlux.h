@@ -701,7 +701,8 @@ plx_status plx_bake_prepare(plx_engine *e, const plx_bake_opts *o);
  * plx_bake_prepare called with the same options and twin = 1, but no photon
  * frames; the words that differ between the two by exactly the distance of
  * their blocks are the pointers, saved as offsets. Both blocks must have
- * the same address modulo 64. Errors: PLX_E_INVALID (no twin of the same
+ * the same address modulo 64, and be zero-filled when the engines were
+ * created (padding and never-written bytes are saved too). Errors: PLX_E_INVALID (no twin of the same
  * layout, buffer too small), PLX_E_NOSCENE.
  */
 plx_status plx_bake_size(plx_engine *e, plx_engine *twin, size_t *bytes /* OUT */);

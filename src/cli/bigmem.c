@@ -20,3 +20,4 @@ void *cli_big_alloc(size_t size)
 #endif
     return p;
 }
+

@@ -42,6 +42,7 @@ int cli_common_option(const char *cmd, int argc, char **argv, int *i, cli_common
 int cli_open_scene(const char *cmd, const char *path, const cli_common *c, plx_engine **e);
 /* A large block (2 MiB aligned, huge pages where offered); free() it. */
 void *cli_big_alloc(size_t size);
+
 /* The engine configuration of the common options (port, --strict, --quiet). */
 void cli_config(const cli_common *c, plx_config *cfg /* OUT */);
 /* Loads the scene file into the existing engine *e (and its ground image);

@@ -92,8 +92,8 @@ static int parse_args(int argc, char **argv, bake_args *a)
     return EXIT_OK;
 }
 
-/* An engine in a 64-byte aligned block (the twin must sit alike), with the
- * scene loaded and everything prepared. */
+/* An engine in a zeroed block (calloc: the twin's sits alike modulo 64),
+ * with the scene loaded and everything prepared. */
 static int make_engine(const bake_args *a, int twin, plx_engine **e)
 {
     size_t mem = a->c.mem ? a->c.mem : CLI_DEFAULT_MEM;
@@ -103,7 +103,10 @@ static int make_engine(const bake_args *a, int twin, plx_engine **e)
     plx_status st;
     int rc;
     *e = NULL;
-    if (!(block = cli_big_alloc(mem))) {
+    /* zeros (calloc of a large block takes fresh pages, nothing written):
+     * the bake saves every byte of the arena's used end, padding and
+     * never-written bytes included, which must be defined */
+    if (!(block = calloc(1, mem))) {
         fprintf(stderr, "polarlux bake: cannot take a block of %zu bytes\n", mem);
         return EXIT_NOMEM;
     }

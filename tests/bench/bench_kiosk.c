@@ -49,7 +49,7 @@ static plx_engine *engine(void **mem, int max_w, int max_h, int quiet)
     plx_config cfg;
     static plx_port silent;
     plx_engine *e = NULL;
-    if (posix_memalign(mem, 1 << 21, MEM) != 0)
+    if (!(*mem = calloc(1, MEM)))
         return NULL;
     plx_config_default(&cfg);
     silent = *plx_port_posix();

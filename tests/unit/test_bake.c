@@ -40,6 +40,7 @@ static plx_engine *make(void **mem, int twin, int aerial)
     plx_bake_opts o;
     plx_engine *e = NULL;
     assert_int_equal(posix_memalign(mem, 64, MEM), 0);
+    memset(*mem, 0, MEM); /* the bake saves every byte of the used arena, padding included */
     plx_config_default(&cfg);
     cfg.port = plx_port_posix();
     cfg.render_max_width = 320;
