@@ -418,18 +418,22 @@ plx_status plx_visibility_get(plx_engine *e, double x, double y, double dir_deg,
 /* ---- Lamp light (SPEC §2) -------------------------------------------------- */
 
 /*
- * Direct illuminance E (lux) at n surface points P[3k..3k+2] with unit
- * normals N[3k..3k+2] (SPEC §2, exact 2.5D visibility). E_indirect gets the
- * photon-buffer estimate (0 until indirect light is computed; may be NULL).
- * rgb (may be NULL) gets 3 values per point: each lamp's term weighted by its
- * colour. A point that is not on a surface (inside a building's solid, in
- * the air) or whose normal points into the solid gets NaN, and the call
- * returns PLX_E_RANGE naming the first such point; the others are filled.
+ * Direct illuminance E (lux) at n points P[3k..3k+2] with unit normals
+ * N[3k..3k+2] (SPEC §2, exact 2.5D visibility): light meters anywhere, on a
+ * surface or in free air, any unit normal. E_indirect gets the photon-buffer
+ * estimate (0 until indirect light is computed; may be NULL): at a surface
+ * point facing out the buffers' value there, at any other point the value
+ * on the horizontal surface straight below it (the topmost roof under the
+ * point, else the ground). rgb (may be NULL) gets 3 values per point: each
+ * lamp's term weighted by its colour. A point strictly inside a building's
+ * solid (or below the ground) gets NaN, and the call returns PLX_E_RANGE
+ * naming the first such point; the others are filled.
  * Lamp lit regions are computed on first need and cached (part
  * PLX_PART_LIT, pool size from plx_config.lit_cache_bytes).
  * Errors: PLX_E_NOSCENE; PLX_E_INVALID (P, N or E_direct NULL with n > 0);
- * PLX_E_RANGE (some point not on a surface, non-finite, or a normal not of
- * unit length within 1e-6: the others are still filled); PLX_E_NOMEM
+ * PLX_E_RANGE (some point strictly inside a solid or below the ground,
+ * non-finite, or a normal not of unit length within 1e-6: the others are
+ * still filled); PLX_E_NOMEM
  * (setting up lamp light). Lifetime: nothing kept from the arrays. Threads:
  * engine (the lit-region cache changes; may evict the polygons of
  * plx_lit_ground / plx_lit_facade).
@@ -444,8 +448,9 @@ plx_status plx_illuminance(plx_engine *e, size_t n, const double *P, const doubl
  * light weighted by its colour (equal to E_indirect for white lamps); the
  * colour-blind E_indirect (lux, as plx_illuminance reports it) goes to
  * E_indirect (may be NULL). 0 until indirect light is computed. Same
- * checks as plx_illuminance (NaN and PLX_E_RANGE for points not on a
- * surface); PLX_E_INVALID when P, N or rgb is NULL with n > 0;
+ * checks as plx_illuminance (NaN and PLX_E_RANGE for points strictly
+ * inside a solid; free points get the estimate from the surface below);
+ * PLX_E_INVALID when P, N or rgb is NULL with n > 0;
  * PLX_E_NOSCENE; PLX_E_NOMEM (setting up lamp light). Threads: engine.
  */
 plx_status plx_indirect_rgb(plx_engine *e, size_t n, const double *P, const double *N,
@@ -454,7 +459,7 @@ plx_status plx_indirect_rgb(plx_engine *e, size_t n, const double *P, const doub
 /* Is P (normal n) lit, and by which lamps: up to cap lamp indices and their
  * terms in lux, in lamp order; *count gets the number of lamps lighting P
  * (which may exceed cap). Same checks as plx_illuminance (PLX_E_RANGE for a
- * point not on a surface); PLX_E_INVALID (P, n or count NULL, or ids/lux
+ * point strictly inside a solid); PLX_E_INVALID (P, n or count NULL, or ids/lux
  * NULL with cap > 0); PLX_E_NOSCENE; PLX_E_NOMEM. Threads: engine. */
 plx_status plx_lamps_at(plx_engine *e, const double P[3], const double n[3], uint32_t *ids /* OUT */,
                         double *lux /* OUT */, uint32_t cap, uint32_t *count /* OUT */);
@@ -659,6 +664,80 @@ plx_status plx_route_score(plx_engine *e, const double *xy, uint32_t n, double s
 /* The EN 13201 P-class (1..6, 0 for none) met by mean and minimum lux.
  * Threads: any. */
 int plx_p_class(double mean, double min);
+
+/* ---- Photometric lamps and pedestrian metrics (SPEC §2.1, §6) ---------- */
+
+/*
+ * A lamp may name an IES LM-63 or EULUMDAT file (properties.photometry, a
+ * path relative to the scene file's folder). The core reads no files: the
+ * caller reads each path the scene names and hands the bytes over (the
+ * polarlux command does this for every scene it loads). Until then such a
+ * lamp gives no light (its intensity reads 0).
+ *
+ * plx_photometry_count / plx_photometry_path: the distinct paths named by
+ * the scene's lamps, as written, k = 0 .. count-1 (PLX_E_RANGE past it).
+ * plx_set_photometry parses data[0..len) (IES when a line starts with
+ * "TILT=", else EULUMDAT; 'name' prefixes messages) into part
+ * PLX_PART_SCENE and gives it to every lamp naming 'path'; those lamps'
+ * intensity becomes dimming x the table's peak. Cached light (lit regions,
+ * photons) is dropped. Errors: PLX_E_PARSE "NAME: line L: why" (bad number,
+ * table too short, unsupported tilt or photometric type, ...);
+ * PLX_E_INVALID when no lamp names path; PLX_E_NOSCENE; PLX_E_NOMEM.
+ * Lifetime: *path lives until the next load; data is not kept (the table
+ * is, until the next load). Threads: engine.
+ */
+uint32_t plx_photometry_count(plx_engine *e);
+plx_status plx_photometry_path(plx_engine *e, uint32_t k, const char **path /* OUT */);
+plx_status plx_set_photometry(plx_engine *e, const char *path, const char *data, size_t len,
+                              const char *name);
+
+typedef struct plx_lamp_photometry {
+    const char *path;         /* properties.photometry, or NULL (isotropic) */
+    int loaded;               /* the file was given */
+    int format;               /* 1 IES, 2 EULUMDAT, 0 none */
+    double azimuth, tilt;     /* degrees: C = 0 counter-clockwise from east; tilt raises C = 0 */
+    double dimming;           /* 0..1 */
+    double peak_cd;           /* dimming x the table's largest value (the intensity when isotropic) */
+    double flux_lm;           /* total flux: the integral of I over the sphere */
+    double gamma_lit;         /* degrees from nadir beyond which I = 0 (180 when isotropic) */
+} plx_lamp_photometry;
+
+plx_status plx_lamp_photometry_get(plx_engine *e, uint32_t lamp, plx_lamp_photometry *out /* OUT */);
+/* I(omega) of lamp 'lamp' toward the direction dir (need not be unit) from
+ * the lamp, in cd; *c_deg and *gamma_deg (may be NULL) get the direction's
+ * C and gamma in the lamp's frame. Errors: PLX_E_NOSCENE, PLX_E_RANGE (lamp
+ * out of range), PLX_E_INVALID (dir zero or not finite, NULL arguments).
+ * Threads: engine (reads). */
+plx_status plx_lamp_intensity(plx_engine *e, uint32_t lamp, const double dir[3], double *cd /* OUT */,
+                              double *c_deg /* OUT */, double *gamma_deg /* OUT */);
+
+/* SPEC §6 quantities, direct light: out[4k..4k+3] = E_h, E_v(u), E_sc(u),
+ * E_hs (lux) at P[3k..3k+2]; U[2k..2k+1] the horizontal facing direction u
+ * (normalised here; NULL: east, +x). A point strictly inside a solid or
+ * below the ground gets NaN and the call returns PLX_E_RANGE naming the
+ * first; PLX_E_INVALID for a zero or non-finite u; PLX_E_NOSCENE;
+ * PLX_E_NOMEM (setting up lamp light). Threads: engine (the lit-region
+ * cache changes, as plx_illuminance). */
+enum { PLX_METER_H = 0, PLX_METER_V, PLX_METER_SC, PLX_METER_HS, PLX_METER_COUNT };
+plx_status plx_meter(plx_engine *e, size_t n, const double *P, const double *U, double *out /* OUT */);
+
+/* EN 13201-2 P class (1..6, 0 none) with the facial-recognition criterion:
+ * mean and min E_h and also min E_v and min E_sc (SPEC §6 table). */
+int plx_p_class_facial(double mean, double min, double min_ev, double min_esc);
+
+/*
+ * min E_v and min E_sc at 'height' m above the polyline (xy, n vertices),
+ * sampled like plx_route_score (each segment into ceil(length/step) equal
+ * parts, ends included; samples inside a building's solid left out), facing
+ * along the segment (dir 0: from vertex i to i+1) and back (dir 1).
+ * seg (may be NULL): 4 values per segment, min_ev[0], min_ev[1], min_esc[0],
+ * min_esc[1]; total (may be NULL) the same over the line (each direction's
+ * minimum over all segments). A segment with no sample gets NaN.
+ * Errors: PLX_E_INVALID (n < 2, step <= 0, height < 0, non-finite input),
+ * PLX_E_NOSCENE, PLX_E_NOMEM. Threads: engine.
+ */
+plx_status plx_route_facial(plx_engine *e, const double *xy, uint32_t n, double step, double height,
+                            double *seg /* OUT */, double total[4] /* OUT */);
 
 /* ---- Procedural cities (plx gen) ------------------------------------- */
 

@@ -38,6 +38,8 @@ FUZZ_SAN      = -fsanitize=address,undefined -fno-sanitize-recover=all
 FUZZ_SEEDS_fuzz_geojson = fixtures tests/corpus
 FUZZ_SEEDS_fuzz_scene   = fixtures tests/corpus
 FUZZ_SEEDS_fuzz_bake    = tests/corpus
+FUZZ_SEEDS_fuzz_ies     = fixtures/photometry tests/fuzz/seeds-photometry
+FUZZ_SEEDS_fuzz_ldt     = fixtures/photometry tests/fuzz/seeds-photometry
 FUZZ_OPTS ?= -timeout=20 -rss_limit_mb=4096 -max_len=65536 -print_final_stats=1
 
 fuzz-build:

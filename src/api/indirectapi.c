@@ -4,6 +4,7 @@
 
 #include "base/engine.h"
 #include "photon/photon.h"
+#include "photon/trace.h"
 #include "photon/final_gather.h"
 
 static plx_status need_photons(plx_engine *e, const char *fn)
@@ -120,6 +121,31 @@ double eng_indirect_photons_rgb(plx_engine *e, const double P[3], const double n
         return 0.0;
     }
     return photon_indirect_rgb(e->ph, P, n, rgb);
+}
+
+/* The indirect estimate at a point that is not on a surface facing out (a
+ * light meter in free air, README "How SPEC §2 is read"): final gathering
+ * at the point itself when it is on (it needs no surface); without it the
+ * photon buffers' E_indirect on the horizontal surface straight below the
+ * point (the topmost roof under it, else the ground), facing up. */
+double eng_indirect_free(plx_engine *e, const double P[3], const double n[3], double rgb[3])
+{
+    static const double up[3] = { 0.0, 0.0, 1.0 };
+    uint32_t side = e->gather_set ? e->gather_side : FINAL_GATHER_SIDE;
+    double Q[3];
+    if (e->ph && plx_indirect_frames(e) > 0 && side > 0 && e->lt)
+        return eng_indirect_rgb(e, P, n, rgb);
+    if (!e->ph || plx_indirect_frames(e) == 0) {
+        if (rgb)
+            rgb[0] = rgb[1] = rgb[2] = 0.0;
+        return 0.0;
+    }
+    Q[0] = P[0];
+    Q[1] = P[1];
+    Q[2] = trace_top(e->ph->T, P[0], P[1], NULL);
+    if (!(Q[2] <= P[2]))
+        Q[2] = 0.0;   /* under a raised building: its ground */
+    return photon_indirect_rgb(e->ph, Q, up, rgb);
 }
 
 plx_status plx_indirect_select_lamps(plx_engine *e, const double box[4], double margin,

@@ -47,8 +47,10 @@ static void where_text(strbuf *b, const plx_engine *e, light_where w, uint32_t b
     }
 }
 
-/* 0 when P with normal n is a surface point facing out, else the reason in
- * the engine's error message (for point k). */
+/* 0 when P with normal n is a surface point facing out, 1 for any other
+ * point that is not strictly inside a solid (free air, a normal facing
+ * into a surface: a light meter), else -1 with the reason in the engine's
+ * error message (for point k). */
 static int check_point(plx_engine *e, size_t k, const double P[3], const double n[3])
 {
     uint32_t bld = UINT32_MAX;
@@ -78,9 +80,14 @@ static int check_point(plx_engine *e, size_t k, const double P[3], const double 
         eng_fail(e, PLX_E_RANGE, msg);
         return -1;
     }
+    if (P[2] < -LIGHT_CLASSIFY_TOL) {
+        sb_str(&b, "is below the ground");
+        eng_fail(e, PLX_E_RANGE, msg);
+        return -1;
+    }
     w = light_classify_point(e->lt, P, n, &bld, &normal_ok);
-    if (w != LIGHT_INSIDE && w != LIGHT_AIR && normal_ok)
-        return 0;
+    if (w != LIGHT_INSIDE)   /* SPEC §2: any other point, any unit normal */
+        return w != LIGHT_AIR && normal_ok ? 0 : 1;
     where_text(&b, e, w, bld, normal_ok);
     eng_fail(e, PLX_E_RANGE, msg);
     return -1;
@@ -117,7 +124,8 @@ static plx_status point_loop(plx_engine *e, size_t n, const double *P, const dou
     first[0] = '\0';
     for (k = 0; k < n; k++) {
         const double *p = P + 3 * k, *nn = N + 3 * k;
-        if (check_point(e, k, p, nn) != 0) {
+        int where = check_point(e, k, p, nn);
+        if (where < 0) {
             point_nan(o, k);
             if (!bad++)
                 memcpy(first, e->err, sizeof first);
@@ -126,7 +134,8 @@ static plx_status point_loop(plx_engine *e, size_t n, const double *P, const dou
         if (o->E_direct)
             light_illuminance(e->lt, p, nn, &o->E_direct[k], o->rgb ? o->rgb + 3 * k : NULL);
         if (o->E_indirect || o->rgb_ind) {
-            double Ei = eng_indirect_rgb(e, p, nn, o->rgb_ind ? o->rgb_ind + 3 * k : NULL);
+            double *ri = o->rgb_ind ? o->rgb_ind + 3 * k : NULL;
+            double Ei = where == 0 ? eng_indirect_rgb(e, p, nn, ri) : eng_indirect_free(e, p, nn, ri);
             if (o->E_indirect)
                 o->E_indirect[k] = Ei;
         }
@@ -185,7 +194,7 @@ plx_status plx_lamps_at(plx_engine *e, const double P[3], const double n[3], uin
         return st;
     if (!P || !n || !count || (cap && (!ids || !lux)))
         return eng_fail(e, PLX_E_INVALID, "plx_lamps_at: NULL argument");
-    if (check_point(e, 0, P, n) != 0)
+    if (check_point(e, 0, P, n) < 0)
         return PLX_E_RANGE;
     got = light_lamps_at(e->lt, P, n, ids, lux, (int)(cap > 0x7fffffffu ? 0x7fffffff : cap));
     *count = got < 0 ? 0 : (uint32_t)got;

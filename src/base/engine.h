@@ -60,6 +60,10 @@ plx_status eng_need_render(plx_engine *e);
 /* Builds the aerial light map at m_per_texel metres (0: 1 m) unless built;
  * dark: with a shader giving no light (the bake's twin, bake.c). */
 plx_status eng_need_lightmap(plx_engine *e, double m_per_texel, int dark);
+/* The indirect estimate at a free point (not on a surface facing out):
+ * final gathering there, else the buffers' value on the horizontal surface
+ * below it (indirectapi.c). */
+double eng_indirect_free(plx_engine *e, const double P[3], const double n[3], double rgb[3] /* OUT */);
 /* E_indirect read from the photon buffers alone (images; indirectapi.c). */
 double eng_indirect_photons_rgb(plx_engine *e, const double P[3], const double n[3],
                                 double rgb[3] /* OUT */);

@@ -30,13 +30,23 @@ typedef struct scene_building {
     const char *id;       /* source id string, or NULL */
 } scene_building;
 
+struct photometry;
+
 typedef struct scene_lamp {
     double x, y, z;
-    double intensity;     /* cd */
+    double intensity;     /* cd; a photometric lamp: dimming x the table's peak
+                             (0 until its file is given) */
     double radius;        /* influence radius R, m */
     float color[3];       /* linear RGB */
     uint32_t feature;
     const char *id;
+    /* SPEC §2.1 (src/light/photometry.h): properties.photometry as written
+     * (NULL: isotropic), its table once given (plx_set_photometry), the
+     * frame (azimuth, tilt in degrees; cos/sin of both) and dimming. */
+    const char *photometry;
+    const struct photometry *phot;
+    double azimuth, tilt, dimming;
+    double frame[4];
 } scene_lamp;
 
 /* The ground's albedo from a day image (src/ground.c; README "Scene

@@ -118,6 +118,7 @@ int cmd_nightify(int argc, char **argv);
 int cmd_dark_spots(int argc, char **argv);
 int cmd_bake(int argc, char **argv);
 int cmd_walk(int argc, char **argv);
+int cmd_meter(int argc, char **argv);
 /* route --network and annotate (cmd_network.c) */
 int cmd_route_network(int argc, char **argv);
 int cmd_annotate(int argc, char **argv);

@@ -23,6 +23,13 @@ static const char help[] =
     "  --path FILE  draw these routes (GeoJSON LineStrings, as for 'polarlux\n"
     "             route') on the map, sampled every pixel and coloured by lux\n"
     "             on the same scale, outlined in cyan\n"
+    "  --quantity Q  what to map (SPEC §6): h ground illuminance (default),\n"
+    "             sc semi-cylindrical, v vertical, hs hemispherical illuminance;\n"
+    "             v and sc face --facing, all but h are taken --height above\n"
+    "             the ground (direct light)\n"
+    "  --height M the meters' height for v, sc, hs (default 1.5)\n"
+    "  --facing DEG  facing direction of v and sc, degrees counter-clockwise\n"
+    "             from east (default 0)\n"
     "  --mem SIZE, --strict, --quiet, --lamps FILE   as for 'polarlux info'\n";
 
 /* A night palette on t in [0, 1]: black, deep blue, purple, orange, yellow, white. */
@@ -74,6 +81,8 @@ static void legend(canvas *c, int x0, double top)
 typedef struct heat_opts {
     double res, top, box[4];
     int have_box;
+    int quantity;             /* PLX_METER_*; H maps the ground */
+    double height, facing;
     const char *out, *path;
     const cli_common *c;
 } heat_opts;
@@ -162,7 +171,19 @@ static int run(plx_engine *e, const heat_opts *o)
         N[3 * k] = N[3 * k + 1] = 0.0;
         N[3 * k + 2] = 1.0;
     }
-    st = plx_illuminance(e, n, P, N, E, NULL, NULL);
+    if (o->quantity == PLX_METER_H) {
+        st = plx_illuminance(e, n, P, N, E, NULL, NULL);
+    } else {
+        double u[2], m[PLX_METER_COUNT];
+        u[0] = cos(o->facing * 3.14159265358979323846 / 180.0);
+        u[1] = sin(o->facing * 3.14159265358979323846 / 180.0);
+        st = PLX_OK;
+        for (k = 0; k < n && (st == PLX_OK || st == PLX_E_RANGE); k++) {
+            P[3 * k + 2] = o->height;
+            st = plx_meter(e, 1, P + 3 * k, u, m);
+            E[k] = m[o->quantity];
+        }
+    }
     if (st != PLX_OK && st != PLX_E_RANGE) { /* RANGE: pixels under buildings */
         fprintf(stderr, "polarlux heatmap: %s\n", plx_last_error(e));
         free(P), free(N), free(E);
@@ -214,6 +235,10 @@ static int run(plx_engine *e, const heat_opts *o)
         canvas_free(&c);
         return EXIT_FAIL;
     }
+    if (o->quantity != PLX_METER_H)
+        printf("heatmap: %s illuminance at %g m facing %g deg\n",
+               o->quantity == PLX_METER_SC ? "semi-cylindrical" : o->quantity == PLX_METER_V ? "vertical"
+                                                                : "hemispherical", o->height, o->facing);
     printf("heatmap: %zux%zu pixels at %g m, scale %g..%g lx, written to %s\n", w, h, res, LUX_MIN, top, o->out);
     canvas_free(&c);
     return EXIT_OK;
@@ -228,6 +253,8 @@ int cmd_heatmap(int argc, char **argv)
     int i, rc;
     memset(&c, 0, sizeof c);
     memset(&o, 0, sizeof o);
+    o.quantity = PLX_METER_H;
+    o.height = 1.5;
     for (i = 1; i < argc; i++) {
         int r = cli_common_option("heatmap", argc, argv, &i, &c);
         if (r < 0)
@@ -239,7 +266,8 @@ int cmd_heatmap(int argc, char **argv)
             return EXIT_OK;
         }
         if ((strcmp(argv[i], "--res") == 0 || strcmp(argv[i], "-o") == 0 || strcmp(argv[i], "--max") == 0 ||
-             strcmp(argv[i], "--box") == 0 || strcmp(argv[i], "--path") == 0) && i + 1 >= argc)
+             strcmp(argv[i], "--box") == 0 || strcmp(argv[i], "--path") == 0 || strcmp(argv[i], "--quantity") == 0 ||
+             strcmp(argv[i], "--height") == 0 || strcmp(argv[i], "--facing") == 0) && i + 1 >= argc)
             return cli_usage_error("heatmap", "%s needs a value", argv[i]);
         if (strcmp(argv[i], "--res") == 0) {
             if (cli_parse_double(argv[++i], &o.res) != 0 || !(o.res > 0))
@@ -247,6 +275,18 @@ int cmd_heatmap(int argc, char **argv)
         } else if (strcmp(argv[i], "--max") == 0) {
             if (cli_parse_double(argv[++i], &o.top) != 0 || !(o.top > 0.1))
                 return cli_usage_error("heatmap", "--max '%s' is not a number of lux above 0.1", argv[i]);
+        } else if (strcmp(argv[i], "--quantity") == 0) {
+            const char *q = argv[++i];
+            o.quantity = strcmp(q, "h") == 0 ? PLX_METER_H : strcmp(q, "v") == 0 ? PLX_METER_V
+                       : strcmp(q, "sc") == 0 ? PLX_METER_SC : strcmp(q, "hs") == 0 ? PLX_METER_HS : -1;
+            if (o.quantity < 0)
+                return cli_usage_error("heatmap", "--quantity '%s' is not h, v, sc or hs", q);
+        } else if (strcmp(argv[i], "--height") == 0) {
+            if (cli_parse_double(argv[++i], &o.height) != 0 || !(o.height >= 0) || !(o.height <= 1000))
+                return cli_usage_error("heatmap", "--height '%s' is not a number of metres from 0 to 1000", argv[i]);
+        } else if (strcmp(argv[i], "--facing") == 0) {
+            if (cli_parse_double(argv[++i], &o.facing) != 0 || !isfinite(o.facing))
+                return cli_usage_error("heatmap", "--facing '%s' is not a number of degrees", argv[i]);
         } else if (strcmp(argv[i], "-o") == 0) {
             o.out = argv[++i];
         } else if (strcmp(argv[i], "--path") == 0) {

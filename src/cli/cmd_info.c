@@ -38,6 +38,25 @@ static void print_memory(const plx_engine *e)
         printf("  %-8s %12zu bytes  (peak %zu)\n", plx_part_name((plx_part)p), m.used[p], m.peak[p]);
 }
 
+/* One line per photometry file the lamps name (SPEC §2.1). */
+static void print_photometry(plx_engine *e, uint32_t nlamps)
+{
+    uint32_t k, n = plx_photometry_count(e), l;
+    for (k = 0; k < n; k++) {
+        const char *p;
+        plx_lamp_photometry ph;
+        uint32_t used = 0, first = 0;
+        if (plx_photometry_path(e, k, &p) != PLX_OK)
+            return;
+        for (l = 0; l < nlamps; l++)
+            if (plx_lamp_photometry_get(e, l, &ph) == PLX_OK && ph.path && strcmp(ph.path, p) == 0 && !used++)
+                first = l;
+        plx_lamp_photometry_get(e, first, &ph);
+        printf("photometry: %s (%s) for %u lamps; lamp %u: peak %.1f cd, flux %.1f lm, dark from gamma %.1f deg\n",
+               p, ph.format == 1 ? "IES" : "EULUMDAT", used, first, ph.peak_cd, ph.flux_lm, ph.gamma_lit);
+    }
+}
+
 int cmd_info(int argc, char **argv)
 {
     cli_common c;
@@ -94,6 +113,7 @@ int cmd_info(int argc, char **argv)
                gi.bounds[0], gi.bounds[1], gi.bounds[2], gi.bounds[3],
                gi.bounds_given ? "" : " (the bounds)", gi.mean_albedo[0], gi.mean_albedo[1],
                gi.mean_albedo[2], gi.mean_luminance);
+    print_photometry(e, si.lamps);
     printf("load time: %.2f ms\n", si.load_ns / 1e6);
     if (cli_bake_last.loaded)
         printf("bake: %zu bytes (%.1f MB) loaded in %.2f ms (read, check, copy, relocate)\n", cli_bake_last.bytes,

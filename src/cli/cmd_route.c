@@ -20,10 +20,17 @@ static const char route_help[] =
     "length below --dark-lux, and the EN 13201 P-class met (P1 15/3 lx ... P6\n"
     "2/0.4 lx, mean / minimum; '-' for none). Path inside building footprints is\n"
     "not scored and its length is reported.\n"
+    "SPEC §6 (EN 13201-2): the last columns are the minimum vertical (Ev) and\n"
+    "semi-cylindrical (Esc) illuminance at --height above the path (default\n"
+    "1.5 m), facing along the segment ('fw', first vertex to last) and back\n"
+    "('bw'), direct light, and the P-class with the facial-recognition\n"
+    "criterion too ('class_fr': also min Ev and min Esc over both ways,\n"
+    "P1 5/5 ... P6 0.6/0.2 lx).\n"
     "\n"
     "  --path FILE      the routes (required)\n"
     "  --step M         sampling step in metres (default 1)\n"
     "  --dark-lux LX    the dark threshold (default 1)\n"
+    "  --height M       height of the Ev/Esc meters above the path (default 1.5)\n"
     "  --geojson OUT    also write the lines with these numbers as properties\n"
     "  --mem SIZE, --strict, --quiet, --lamps FILE   as for 'polarlux info'\n"
     "\n"
@@ -54,22 +61,40 @@ static void class_text(int c, char out[4])
         strcpy(out, "-");
 }
 
-static void print_row(const char *line, const char *seg, const plx_route_stats *s)
+/* The P class with the facial-recognition criterion (SPEC §6): E_v and
+ * E_sc at 1.5 m facing both ways; fac = min Ev fw, bw, min Esc fw, bw. */
+static int facial_class(const plx_route_stats *s, const double fac[4])
 {
-    char cls[4];
+    double ev = fmin(fac[0], fac[1]), esc = fmin(fac[2], fac[3]);
+    if (s->samples == 0 || ev != ev || esc != esc)
+        return 0;
+    return plx_p_class_facial(s->mean, s->min, ev, esc);
+}
+
+static void print_row(const char *line, const char *seg, const plx_route_stats *s, const double fac[4])
+{
+    char cls[4], fr[4];
     class_text(s->p_class, cls);
-    printf("%-8s %-5s %9.1f %9.3f %9.3f %9.3f %6.3f %6.3f %-3s", line, seg, s->length, s->mean, s->min,
-           s->max, s->uniformity, s->dark_share, cls);
+    class_text(facial_class(s, fac), fr);
+    printf("%-8s %-5s %9.1f %9.3f %9.3f %9.3f %6.3f %6.3f %-5s %8.3f %8.3f %8.3f %8.3f %-3s", line, seg,
+           s->length, s->mean, s->min, s->max, s->uniformity, s->dark_share, cls, fac[0], fac[1], fac[2], fac[3],
+           fr);
     if (s->blocked_length > 0)
         printf("  (%.1f m inside buildings)", s->blocked_length);
     printf("\n");
 }
 
-static cJSON *stats_json(const plx_route_stats *s)
+static cJSON *stats_json(const plx_route_stats *s, const double fac[4])
 {
     cJSON *o = cJSON_CreateObject();
-    char cls[4];
+    char cls[4], fr[4];
     class_text(s->p_class, cls);
+    class_text(facial_class(s, fac), fr);
+    cJSON_AddNumberToObject(o, "min_ev_fw_lx", fac[0] == fac[0] ? fac[0] : -1);
+    cJSON_AddNumberToObject(o, "min_ev_bw_lx", fac[1] == fac[1] ? fac[1] : -1);
+    cJSON_AddNumberToObject(o, "min_esc_fw_lx", fac[2] == fac[2] ? fac[2] : -1);
+    cJSON_AddNumberToObject(o, "min_esc_bw_lx", fac[3] == fac[3] ? fac[3] : -1);
+    cJSON_AddStringToObject(o, "p_class_facial", fr);
     cJSON_AddNumberToObject(o, "length_m", s->length);
     cJSON_AddNumberToObject(o, "mean_lx", s->mean);
     cJSON_AddNumberToObject(o, "min_lx", s->min);
@@ -83,7 +108,7 @@ static cJSON *stats_json(const plx_route_stats *s)
 
 typedef struct route_opts {
     const char *scene, *path, *geojson;
-    double step, dark;
+    double step, dark, height;
     cli_common c;
 } route_opts;
 
@@ -95,22 +120,28 @@ static int score_all(plx_engine *e, const route_opts *o, route_set *rs)
     memset(&g, 0, sizeof g);
     if (o->geojson && geo_begin(&g, e) != 0)
         return EXIT_FAIL;
-    printf("%-8s %-5s %9s %9s %9s %9s %6s %6s %s\n", "line", "seg", "length_m", "mean_lx", "min_lx", "max_lx",
-           "U0", "dark", "class");
+    printf("%-8s %-5s %9s %9s %9s %9s %6s %6s %-5s %8s %8s %8s %8s %s\n", "line", "seg", "length_m", "mean_lx",
+           "min_lx", "max_lx", "U0", "dark", "class", "Ev_fw", "Ev_bw", "Esc_fw", "Esc_bw", "class_fr");
     for (i = 0; i < rs->n; i++) {
         const route_line *l = &rs->lines[i];
         plx_route_stats tot, *seg = malloc(sizeof *seg * l->n);
+        double *fac = malloc(sizeof(double) * 4 * l->n), ftot[4];
         char name[32], sname[16];
         uint32_t k;
         plx_status st;
-        if (!seg) {
+        if (!seg || !fac) {
+            free(seg);
+            free(fac);
             rc = EXIT_FAIL;
             break;
         }
         st = plx_route_score(e, l->xy, l->n, o->step, o->dark, &tot, seg);
+        if (st == PLX_OK)
+            st = plx_route_facial(e, l->xy, l->n, o->step, o->height, fac, ftot);
         if (st != PLX_OK) {
             fprintf(stderr, "polarlux route: %s: line %zu: %s\n", o->path, i, plx_last_error(e));
             free(seg);
+            free(fac);
             rc = cli_exit_code(st);
             break;
         }
@@ -118,22 +149,23 @@ static int score_all(plx_engine *e, const route_opts *o, route_set *rs)
         if (tot.samples > 0 && !(tot.max > 0))
             cli_warn("route", &o->c, "%s: line %s is entirely dark (0 lx): %s", o->path, l->name,
                      cli_dark_reason(e));
-        print_row(name, "all", &tot);
+        print_row(name, "all", &tot, ftot);
         for (k = 0; k + 1 < l->n; k++) {
             snprintf(sname, sizeof sname, "%u", k);
-            print_row("", sname, &seg[k]);
+            print_row("", sname, &seg[k], fac + 4 * k);
         }
         if (g.root) {
-            cJSON *props = stats_json(&tot), *segs = cJSON_AddArrayToObject(props, "segments"), *coords;
+            cJSON *props = stats_json(&tot, ftot), *segs = cJSON_AddArrayToObject(props, "segments"), *coords;
             cJSON_AddStringToObject(props, "name", l->name);
             for (k = 0; k + 1 < l->n; k++)
-                cJSON_AddItemToArray(segs, stats_json(&seg[k]));
+                cJSON_AddItemToArray(segs, stats_json(&seg[k], fac + 4 * k));
             coords = cJSON_CreateArray();
             for (k = 0; k < l->n; k++)
                 cJSON_AddItemToArray(coords, geo_position(&g, l->xy[2 * k], l->xy[2 * k + 1], NULL));
             geo_add(&g, geo_geometry("LineString", coords), props);
         }
         free(seg);
+        free(fac);
     }
     if (g.root && rc == EXIT_OK && geo_write(&g, "route", o->geojson) != 0)
         rc = EXIT_FAIL;
@@ -154,6 +186,7 @@ int cmd_route(int argc, char **argv)
     memset(&o, 0, sizeof o);
     o.step = 1.0;
     o.dark = 1.0;
+    o.height = 1.5;
     for (i = 1; i < argc; i++) {
         const char *a = argv[i];
         int r = cli_common_option("route", argc, argv, &i, &o.c);
@@ -166,7 +199,7 @@ int cmd_route(int argc, char **argv)
             return EXIT_OK;
         }
         if ((strcmp(a, "--path") == 0 || strcmp(a, "--step") == 0 || strcmp(a, "--dark-lux") == 0 ||
-             strcmp(a, "--geojson") == 0) && i + 1 >= argc)
+             strcmp(a, "--geojson") == 0 || strcmp(a, "--height") == 0) && i + 1 >= argc)
             return cli_usage_error("route", "%s needs a value", a);
         if (strcmp(a, "--path") == 0) {
             o.path = argv[++i];
@@ -175,6 +208,9 @@ int cmd_route(int argc, char **argv)
         } else if (strcmp(a, "--step") == 0) {
             if (cli_parse_double(argv[++i], &o.step) != 0 || !(o.step >= 0.01))
                 return cli_usage_error("route", "--step '%s' is not a number of metres >= 0.01", argv[i]);
+        } else if (strcmp(a, "--height") == 0) {
+            if (cli_parse_double(argv[++i], &o.height) != 0 || !(o.height >= 0) || !(o.height <= 1000))
+                return cli_usage_error("route", "--height '%s' is not a number of metres from 0 to 1000", argv[i]);
         } else if (strcmp(a, "--dark-lux") == 0) {
             if (cli_parse_double(argv[++i], &o.dark) != 0 || !(o.dark >= 0))
                 return cli_usage_error("route", "--dark-lux '%s' is not a number of lux >= 0", argv[i]);

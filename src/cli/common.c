@@ -167,6 +167,80 @@ static int load_ground_image(const char *cmd, const char *scene_path, plx_engine
     return EXIT_OK;
 }
 
+/* Reads a whole file into a malloc'd buffer; NULL with errno set. */
+static char *read_all(const char *path, size_t *len)
+{
+    FILE *f = fopen(path, "rb");
+    char *buf = NULL, *nb;
+    size_t cap = 0, n = 0, got;
+    if (!f)
+        return NULL;
+    for (;;) {
+        if (n == cap) {
+            cap = cap ? 2 * cap : 65536;
+            nb = realloc(buf, cap);
+            if (!nb || cap > ((size_t)64 << 20)) {
+                free(nb ? nb : buf);
+                fclose(f);
+                errno = EFBIG;
+                return NULL;
+            }
+            buf = nb;
+        }
+        got = fread(buf + n, 1, cap - n, f);
+        n += got;
+        if (got == 0)
+            break;
+    }
+    if (ferror(f)) {
+        free(buf);
+        fclose(f);
+        errno = EIO;
+        return NULL;
+    }
+    fclose(f);
+    *len = n;
+    return buf;
+}
+
+/* The photometry files the scene's lamps name (properties.photometry,
+ * relative to the scene file's folder unless absolute), read and given to
+ * the engine (SPEC §2.1). Prints the error and returns an exit code. */
+static int load_photometry(const char *cmd, const char *scene_path, plx_engine *e)
+{
+    uint32_t k, n = plx_photometry_count(e);
+    const char *slash = strrchr(scene_path, '/');
+    for (k = 0; k < n; k++) {
+        const char *p;
+        char *full, *data;
+        size_t dir, len = 0;
+        plx_status st;
+        if (plx_photometry_path(e, k, &p) != PLX_OK)
+            return EXIT_FAIL;
+        dir = p[0] == '/' || !slash ? 0 : (size_t)(slash - scene_path) + 1;
+        full = malloc(dir + strlen(p) + 1);
+        if (!full)
+            return EXIT_NOMEM;
+        memcpy(full, scene_path, dir);
+        strcpy(full + dir, p);
+        data = read_all(full, &len);
+        if (!data) {
+            fprintf(stderr, "polarlux %s: %s: photometry file %s: cannot read: %s\n", cmd, scene_path, full,
+                    strerror(errno));
+            free(full);
+            return EXIT_FAIL;
+        }
+        st = plx_set_photometry(e, p, data, len, full);
+        free(data);
+        free(full);
+        if (st != PLX_OK) {
+            fprintf(stderr, "polarlux %s: %s: %s\n", cmd, scene_path, plx_last_error(e));
+            return st == PLX_E_NOMEM ? EXIT_NOMEM : EXIT_FAIL;
+        }
+    }
+    return EXIT_OK;
+}
+
 void cli_warn(const char *cmd, const cli_common *c, const char *fmt, ...)
 {
     va_list ap;
@@ -182,7 +256,7 @@ void cli_warn(const char *cmd, const cli_common *c, const char *fmt, ...)
 /* Commands whose results are light: they say so when the scene has none. */
 static int computes_light(const char *cmd)
 {
-    static const char *const names[] = { "illum", "lit", "heatmap", "render", "route", "dark-spots" };
+    static const char *const names[] = { "illum", "lit", "heatmap", "render", "route", "dark-spots", "meter" };
     size_t i;
     for (i = 0; i < sizeof names / sizeof names[0]; i++)
         if (strcmp(cmd, names[i]) == 0)
@@ -341,6 +415,8 @@ int cli_load_scene(const char *cmd, const char *path, const cli_common *c, plx_e
         return st == PLX_E_INVALID ? EXIT_FAIL : cli_exit_code(st);
     }
     rc = load_ground_image(cmd, path, *e, c->mem ? c->mem : CLI_DEFAULT_MEM);
+    if (rc == EXIT_OK)
+        rc = load_photometry(cmd, path, *e);
     if (rc != EXIT_OK) {
         plx_engine_free(*e);
         *e = NULL;

@@ -2,6 +2,7 @@
  * (contract in light.h; lit regions and the cache are in litregion.c). */
 #include "light/light.h"
 #include "base/geom.h"
+#include "light/photometry.h"
 
 #include <math.h>
 #include <string.h>
@@ -155,7 +156,7 @@ static plx_status build_grids(light *L, arena *a)
         double R = lp->radius;
         box[i][0] = 1.0;
         box[i][2] = 0.0;   /* left out unless the lamp can light anything */
-        if (!(R > 0.0) || !isfinite(R) || !(lp->intensity != 0.0))
+        if (!(R > 0.0) || !isfinite(R) || !(lp->intensity != 0.0 || lp->photometry))
             continue;
         box[i][0] = lp->x - R;
         box[i][1] = lp->y - R;
@@ -543,7 +544,7 @@ int light_segment_blocked(light *L, const double A[3], const double B[3])
  * contribute. */
 static double lamp_geom_term(const scene_lamp *lp, const double P[3], const double n[3])
 {
-    double v[3], d2, d, x, cw, w;
+    double v[3], d2, d, x, cw, w, u[3];
     v[0] = lp->x - P[0];
     v[1] = lp->y - P[1];
     v[2] = lp->z - P[2];
@@ -556,7 +557,12 @@ static double lamp_geom_term(const scene_lamp *lp, const double P[3], const doub
     cw = (n[0] * v[0] + n[1] * v[1] + n[2] * v[2]) / d;
     if (w == 0.0 || !(cw > 0.0))
         return 0.0;
-    return lp->intensity * cw / d2 * w;
+    if (!lp->photometry)
+        return lp->intensity * cw / d2 * w;
+    u[0] = -v[0] / d;   /* from the lamp toward P */
+    u[1] = -v[1] / d;
+    u[2] = -v[2] / d;
+    return lamp_intensity(lp, u) * cw / d2 * w;
 }
 
 /* Visibility of P from lamp i by the segment path. */

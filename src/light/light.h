@@ -219,6 +219,12 @@ plx_status light_illuminance(light *L, const double P[3], const double n[3],
 plx_status light_illuminance_exact(light *L, const double P[3], const double n[3],
                                    double *E /* OUT */, double rgb[3] /* OUT, may be NULL */);
 
+/* SPEC §6 at P (direct light, same visibility as light_illuminance):
+ * out[0] E_h (= light_illuminance with n = +z), out[1] E_v(u), out[2]
+ * E_sc(u), out[3] E_hs, lux; u a horizontal unit vector (x, y), the
+ * facing direction (src/light/meter.c). */
+plx_status light_meter(light *L, const double P[3], const double u[2], double out[4] /* OUT */);
+
 /* Which lamps light P (facing n): writes up to cap lamp ids and their
  * uncoloured terms (lux) in lamp order, returns how many lamps light P
  * (may exceed cap; then only cap were written). Same visibility as

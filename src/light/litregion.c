@@ -1,6 +1,7 @@
 /* litregion: per-lamp sector index (bands), lit ground and facade polygons,
  * and the LRU cache of regions (contract in light.h). */
 #include "light/light.h"
+#include "light/photometry.h"
 #include "base/geom.h"
 #include "base/plx_assert.h"
 
@@ -51,6 +52,7 @@ typedef struct lr_work {
     const scene *s;
     vec2 o;
     double zl, R, Rg;
+    double zcap;             /* facades lit only below this height (a cut-off lamp's horizon) */
     uint32_t *cand, ncand;
     unsigned char *cstate;   /* 0 O outside, 1 strictly inside, 2 on the boundary */
     lr_edge *edge;
@@ -1262,9 +1264,11 @@ static plx_status facade_wall(lr_work *w, uint32_t e, fwall *f)
     f->e = vsub(B, A);
     f->a3 = A;
     f->mw = bd->min_height;
-    f->hw = bd->height;
+    f->hw = bd->height < w->zcap ? bd->height : w->zcap;
     f->wall = ed->va;
     f->open = NULL;
+    if (!(f->hw > f->mw))
+        return PLX_OK;
     qa = f->e.x * f->e.x + f->e.y * f->e.y;
     qb = f->a.x * f->e.x + f->a.y * f->e.y;
     qc = f->a.x * f->a.x + f->a.y * f->a.y - w->R * w->R;
@@ -1469,8 +1473,16 @@ static plx_status cache_insert(light *L, uint32_t lamp, const lit_region *r)
         return PLX_E_NOMEM;
     while (L->pool_cap - L->pool_live < n && L->lru_tail != LIT_NONE)
         evict(L, L->lru_tail);
-    if (L->pool_cap - L->pool_end < n)
+    if (L->pool_cap - L->pool_end < n) {
+        /* Compaction moves every live region: free a quarter of the pool
+         * beyond what this region needs first, so a full cache compacts once
+         * per cap/4 bytes inserted, not on every miss (amortised O(1) per
+         * byte instead of O(pool)). */
+        size_t keep = L->pool_cap - L->pool_cap / 4;
+        while (L->pool_live + n > keep && L->lru_tail != LIT_NONE)
+            evict(L, L->lru_tail);
         compact(L);
+    }
     PLX_ASSERT(L->pool_cap - L->pool_end >= n); /* eviction and compaction made room */
     dst = L->pool + L->pool_end;
     memcpy(dst, r, n);
@@ -1498,6 +1510,16 @@ static plx_status region_compute(light *L, uint32_t lamp, int polygons)
     w.zl = lp->z;
     w.R = lp->radius > 0.0 ? lp->radius : 0.0;
     w.Rg = w.R > w.zl ? sqrt(w.R * w.R - w.zl * w.zl) : 0.0;
+    /* SPEC §2.1: a lamp whose I is 0 from gamma_lit <= 90 deg on (untilted)
+     * lights nothing above its horizon, and no ground beyond zL tan(gamma_lit) */
+    w.zcap = INFINITY;
+    if (lp->photometry && lp->tilt == 0.0) {
+        double gl = lp->phot ? lp->phot->gamma_lit : 0.0;
+        if (gl <= 90.0)
+            w.zcap = w.zl;
+        if (gl < 90.0 && w.zl * tan(gl * 3.14159265358979323846 / 180.0) < w.Rg)
+            w.Rg = w.zl * tan(gl * 3.14159265358979323846 / 180.0);
+    }
     st = region_work(&w, lamp);
     if (st == PLX_OK)
         st = region_output(&w, lamp, polygons);

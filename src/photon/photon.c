@@ -5,6 +5,7 @@
 
 #include "photon/photon.h"
 #include "base/geom.h"
+#include "light/photometry.h"
 
 #define PI 3.14159265358979323846
 #define HEIGHT_TOL 1e-3   /* m: a splat's texels are at the photon's height */
@@ -179,6 +180,19 @@ static inline void sphere_dir(uint64_t *st, double d[3])
 void photon_sphere_dir(uint64_t *st, double d[3])
 {
     sphere_dir(st, d);
+}
+
+void photon_lamp_dir(const scene_lamp *Lp, uint64_t *rng, double d[3])
+{
+    uint32_t tries = 0;
+    sphere_dir(rng, d);
+    if (!Lp->photometry)
+        return;
+    /* rejection: directions uniform on the sphere kept with probability
+     * I(d) / peak leave with the distribution of I (SPEC §2.1); a table
+     * of (almost) no flux gives up after 2^24 tries */
+    while (!(rng01(rng) * Lp->intensity < lamp_intensity(Lp, d)) && ++tries < (1u << 24))
+        sphere_dir(rng, d);
 }
 
 static void cosine_dir(uint64_t *st, const double n[3], double d[3])
@@ -1175,6 +1189,26 @@ static void aerial_build(photon_sys *ps)
 
 /* ---- creation ---------------------------------------------------------------- */
 
+/* Each lamp's flux (SPEC §2.1: the integral of I, 4 pi I when isotropic)
+ * as the cumulative table the photons are shared by. */
+static void lamp_fluxes(photon_sys *ps)
+{
+    const scene *s = ps->s;
+    uint32_t i;
+    ps->flux_total = 0.0;
+    for (i = 0; i < s->nlamps; i++) {
+        double f = s->lamps[i].intensity > 0.0 && s->lamps[i].radius > 0.0 ? lamp_flux(&s->lamps[i]) : 0.0;
+        ps->flux_total += f;
+        ps->lamp_cdf[i] = ps->flux_total;
+    }
+}
+
+void photon_lamps_changed(photon_sys *ps)
+{
+    lamp_fluxes(ps);
+    photon_reset(ps);
+}
+
 plx_status photon_create(arena *a, const scene *s, const photon_config *cfg, photon_sys **out)
 {
     arena_mark m;
@@ -1227,15 +1261,9 @@ plx_status photon_create(arena *a, const scene *s, const photon_config *cfg, pho
         lv->nfree = lv->nslots;
     }
     aerial_build(ps);
-    ps->flux_total = 0.0;
-    for (i = 0; i < s->nlamps; i++) {
-        double f = s->lamps[i].intensity > 0.0 && s->lamps[i].radius > 0.0
-                       ? 4.0 * PI * s->lamps[i].intensity
-                       : 0.0;
-        ps->flux_total += f;
-        ps->lamp_cdf[i] = ps->flux_total;
+    lamp_fluxes(ps);
+    for (i = 0; i < s->nlamps; i++)
         ps->lamp_slot[i] = PHOTON_NONE;
-    }
     for (i = 0; i < ps->nslots; i++) {
         ps->slots[i].lamp = PHOTON_NONE;
         ps->slots[i].prev = i == 0 ? PHOTON_NONE : i - 1;
@@ -1620,7 +1648,7 @@ static void trace_lamp(photon_sys *ps, uint32_t lamp, double phi, uint64_t *rng,
     o[0] = Lp->x;
     o[1] = Lp->y;
     o[2] = Lp->z;
-    sphere_dir(rng, d);
+    photon_lamp_dir(Lp, rng, d);
     st->photons++;
     st->emitted += phi;
     st->traced++;

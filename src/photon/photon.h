@@ -347,6 +347,13 @@ int photon_block_level(const photon_sys *ps, uint32_t b);
 
 /* Drops every accumulated photon (charts, ambient, A, I, the lamp cache and
  * the refined marks); levels stay. For changed lamps. */
+/* The lamps' photometry changed (plx_set_photometry): fluxes recomputed,
+ * every photon dropped. */
+/* A photon's first direction from lamp Lp: uniform on the sphere when
+ * isotropic, else distributed as its I(omega) (rejection sampling against
+ * the peak; Lp must have flux > 0). */
+void photon_lamp_dir(const scene_lamp *Lp, uint64_t *rng, double d[3] /* OUT */);
+void photon_lamps_changed(photon_sys *ps);
 void photon_reset(photon_sys *ps);
 
 /* E_indirect (PHOTON_CH channels: scalar, RGB) at the surface of hit h

@@ -5,6 +5,7 @@
 #include <string.h>
 
 #include "photon/photon.h"
+#include "light/photometry.h"
 
 #define PI 3.14159265358979323846
 #define HEIGHT_TOL 1e-3
@@ -86,8 +87,8 @@ static void lamp_compute(photon_sys *ps, uint32_t i, photon_lamp_slot *sl)
     c.sl = sl;
     c.push = !ps->refined[i];
     n = ps->cfg.lamp_photons;
-    if (n > 0 && L->intensity > 0.0 && L->radius > 0.0) {
-        phi = 4.0 * PI * L->intensity / n;
+    if (n > 0 && L->intensity > 0.0 && L->radius > 0.0 && lamp_flux(L) > 0.0) {
+        phi = lamp_flux(L) / n;
         /* deterministic per lamp: a recomputation gives the same photons */
         rng = 0x6a09e667f3bcc909ull ^ ((uint64_t)i * 0x9e3779b97f4a7c15ull);
         rng = photon_rand(&rng);

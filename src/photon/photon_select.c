@@ -3,8 +3,7 @@
 #include <math.h>
 
 #include "photon/photon.h"
-
-#define SELECT_PI 3.14159265358979323846
+#include "light/photometry.h"
 
 /* Horizontal distance from (x, y) to the box (0 inside). */
 static double box_distance(const double box[4], double x, double y)
@@ -21,7 +20,8 @@ uint32_t photon_select_lamps(photon_sys *ps, const double box[4], double margin)
     ps->flux_total = 0.0;
     for (i = 0; i < s->nlamps; i++) {
         const scene_lamp *L = &s->lamps[i];
-        double f = L->intensity > 0.0 && L->radius > 0.0 ? 4.0 * SELECT_PI * L->intensity : 0.0;
+        /* SPEC §2.1: the integral of I (4 pi I when isotropic) */
+        double f = L->intensity > 0.0 && L->radius > 0.0 ? lamp_flux(L) : 0.0;
         if (f > 0.0 && box && !(box_distance(box, L->x, L->y) <= L->radius + margin))
             f = 0.0;
         n += f > 0.0;

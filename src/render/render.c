@@ -7,6 +7,7 @@
 #include "render/exposure.h"
 #include "render/raster.h"
 #include "light/light.h"
+#include "light/photometry.h"
 #include "base/geom.h"
 
 #define R_ALIGN 16
@@ -779,6 +780,13 @@ static double lamp_term(const scene_lamp *lp, const double P[3], const double n[
     cw = (n[0] * v[0] + n[1] * v[1] + n[2] * v[2]) / d;
     if (!(cw > 0.0))
         return 0.0;
+    if (lp->photometry) {
+        double u[3];
+        u[0] = -v[0] / d;
+        u[1] = -v[1] / d;
+        u[2] = -v[2] / d;
+        return lamp_intensity(lp, u) * cw / d2 * w;
+    }
     return lp->intensity * cw / d2 * w;
 }
 

@@ -7,6 +7,7 @@
 
 #include "scene/loader.h"
 #include "base/geom.h"
+#include "light/photometry.h"
 
 #define MAX_COORD 1.0e7
 #define MAX_HEIGHT 1000.0
@@ -547,6 +548,43 @@ static void read_color(loader *ld, uint32_t fi, const char *id, const cJSON *pro
     ld_warn(ld, fi, id, "property \"color\" is not [r, g, b] of numbers >= 0; ignored, the default applies");
 }
 
+/* properties.photometry (a path, kept as written: the core reads no files;
+ * the table comes through plx_set_photometry), azimuth (else OSM's compass
+ * "direction": azimuth = 90 - direction), tilt and dimming (SPEC §2.1).
+ * Returns PLX_E_NOMEM, or PLX_OK with a reason in why for a bad value. */
+static plx_status read_lamp_photometry(loader *ld, uint32_t fi, const char *id, const cJSON *props,
+                                       scene_lamp *l, strbuf *why)
+{
+    const cJSON *ph = props ? cJSON_GetObjectItemCaseSensitive(props, "photometry") : NULL;
+    double dir;
+    l->dimming = 1.0;
+    if (!ld_prop_number(ld, fi, id, props, "azimuth", &l->azimuth) &&
+        ld_prop_number(ld, fi, id, props, "direction", &dir))
+        l->azimuth = 90.0 - dir;
+    ld_prop_number(ld, fi, id, props, "tilt", &l->tilt);
+    ld_prop_number(ld, fi, id, props, "dimming", &l->dimming);
+    if (!(l->dimming >= 0.0 && l->dimming <= 1.0)) {
+        sb_str(why, "lamp dimming ");
+        sb_num(why, l->dimming, 6);
+        sb_str(why, " is out of range (0 to 1)");
+    } else if (!(fabs(l->azimuth) <= 1e6) || !(fabs(l->tilt) <= 180.0)) {
+        sb_str(why, "lamp azimuth or tilt is out of range (|azimuth| <= 1e6, |tilt| <= 180 degrees)");
+    }
+    photometry_lamp_frame(l);
+    if (ph && cJSON_IsString(ph) && ph->valuestring[0] != '\0') {
+        size_t n = strlen(ph->valuestring);
+        char *dst = arena_alloc(&ld->e->mem, PLX_PART_SCENE, n + 1, 1);
+        if (!dst)
+            return eng_nomem(ld->e, "copying photometry paths");
+        memcpy(dst, ph->valuestring, n + 1);
+        l->photometry = dst;
+        l->intensity = 0.0;   /* dark until the table is given */
+    } else if (ph && !cJSON_IsNull(ph)) {
+        ld_warn(ld, fi, id, "property \"photometry\" is not a file path; ignored, the lamp is isotropic");
+    }
+    return PLX_OK;
+}
+
 static plx_status read_lamp(loader *ld, const cJSON *f, const cJSON *props, uint32_t fi, const char *id)
 {
     scene_lamp *l = &ld->s->lamps[ld->s->nlamps];
@@ -582,9 +620,11 @@ static plx_status read_lamp(loader *ld, const cJSON *f, const cJSON *props, uint
         sb_num(&why, l->radius, 6);
         sb_str(&why, " m is out of range (> 0 and <= 100000 m)");
     }
+    if (why.len == 0 && read_lamp_photometry(ld, fi, id, props, l, &why) != PLX_OK)
+        return PLX_E_NOMEM;
     if (why.len)
         return ld_bad_feature(ld, fi, id, whybuf);
-    if (l->intensity == 0.0)
+    if (l->intensity == 0.0 && !l->photometry)
         ld_warn(ld, fi, id, "lamp intensity is 0 cd: it gives no light");
     read_color(ld, fi, id, props, l->color);
     l->x = p.x;

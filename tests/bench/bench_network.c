@@ -138,7 +138,7 @@ int main(void)
     /* room for every lamp's lit region: with the default 16 MiB pool a
      * city-wide network overflows the cache, and each miss then compacts the
      * whole pool (see README, "Street networks") */
-    cfg.lit_cache_bytes = (size_t)256 << 20;
+    if (!getenv("BENCH_DEFAULT_CACHE")) cfg.lit_cache_bytes = (size_t)256 << 20;
     if (plx_gen_city("eixample", N, N, 1, append, &txt) != PLX_OK ||
         plx_engine_new((size_t)1 << 30, &cfg, &e) != PLX_OK ||
         plx_load_geojson(e, txt.buf, txt.len, "eixample") != PLX_OK) {

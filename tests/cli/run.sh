@@ -167,6 +167,29 @@ printf '{"type":"LineString","coordinates":[[1,2]]}' >"$tmp/short.geojson"
 expect walk-short-path 1 "^polarlux walk: $tmp/short\.geojson: the LineString needs at least 2 positions$" -- "$bin" walk -q "$tmp/e.plxb" --path "$tmp/short.geojson" -o "$tmp/w3"
 expect render-aa-bad 2 "--aa '0' is not a whole number from 1 to 16" -- "$bin" render fixtures/tiny.geojson --aa 0 -o "$tmp/x.png"
 expect render-auto-exposure 0 "^exposure: [0-9.e+-]+ \(automatic" -- "$bin" render -q "$tmp/e.plxb" --size 160x120 -o "$tmp/ae.png"
+# photometric lamps (SPEC §2.1), light meters anywhere (§2) and pedestrian metrics (§6)
+expect info-photometry 0 "^photometry: photometry/street-type2\\.ies \\(IES\\) for 584 lamps; lamp 0: peak 2966\\.8 cd, flux 6283\\.2 lm, dark from gamma 90\\.0 deg$" -- "$bin" info -q fixtures/helsinki-street-luminaires.geojson
+expect meter-help 0 "^usage: polarlux meter" -- "$bin" meter --help
+expect meter-unknown-option 2 "polarlux meter: unknown option '--bogus'" -- "$bin" meter --bogus x
+expect illum-free-air 0 "^50 10 1.5 [0-9.]+(e-?[0-9]+)? 0$" -- sh -c "echo '50 10 1.5 1 0 0' | '$bin' illum -q --no-indirect fixtures/tiny.geojson --points -"
+expect meter-columns 0 "^0 -431.5 1.5 [0-9.]+ [0-9.]+$" -- sh -c "echo '0 -431.5' | '$bin' meter -q fixtures/helsinki-street-luminaires.geojson --points-crs local --points - --quantity sc,h"
+expect meter-height 0 "^0 -431.5 3 [0-9.]+ [0-9.]+ [0-9.]+ [0-9.]+$" -- sh -c "printf '# crs: local\\n0 -431.5\\n' | '$bin' meter -q fixtures/helsinki-centre.geojson --points - --height 3"
+expect meter-lonlat 0 "^24.944299+[0-9]* 60.16770+[0-9]* 1.5 [0-9.]+$" -- sh -c "echo '24.9443 60.1677' | '$bin' meter -q fixtures/helsinki-street-luminaires.geojson --points - --quantity sc"
+expect meter-inside 1 "polarlux meter: -:1: point \\(5, 5, 3\\) is inside a building's solid" -- sh -c "echo '5 5 3' | '$bin' meter -q fixtures/tiny.geojson --points -"
+expect meter-bad-quantity 2 "--quantity 'x' is not a list of h, v, sc, hs" -- "$bin" meter fixtures/tiny.geojson --points - --quantity x
+expect route-facial 0 "class_fr$" -- "$bin" route -q fixtures/helsinki-street-luminaires.geojson --path fixtures/helsinki-route.geojson --step 4
+expect heatmap-sc 0 "^heatmap: semi-cylindrical illuminance at 1.5 m facing 90 deg" -- "$bin" heatmap -q fixtures/tiny.geojson --quantity sc --facing 90 --res 1 -o "$tmp/sc.png"
+mkdir -p "$tmp/ph"
+printf '{"type":"FeatureCollection","properties":{"units":"m"},"features":[{"type":"Feature","properties":{"lamp":true,"photometry":"l.ies"},"geometry":{"type":"Point","coordinates":[0,0]}}]}' >"$tmp/ph/s.geojson"
+expect photometry-missing 1 "^polarlux info: $tmp/ph/s\\.geojson: photometry file $tmp/ph/l\\.ies: cannot read: No such file or directory$" -- "$bin" info "$tmp/ph/s.geojson"
+printf 'IESNA:LM-63-2002\nTILT=NONE\n1 -1 1 2 1 1 2 0 0 0\n1 1 0\n0 90\n0\n100 abc\n' >"$tmp/ph/l.ies"
+expect photometry-bad-number 1 "^polarlux info: $tmp/ph/s\\.geojson: $tmp/ph/l\\.ies: line 7: bad number 'abc' for the candela values$" -- "$bin" info "$tmp/ph/s.geojson"
+printf 'IESNA:LM-63-2002\nTILT=lamp.tlt\n' >"$tmp/ph/l.ies"
+expect photometry-tilt 1 "l\\.ies: line 2: unsupported tilt" -- "$bin" info "$tmp/ph/s.geojson"
+printf 'IESNA:LM-63-2002\nTILT=NONE\n1 -1 1 2 1 1 2 0 0 0\n1 1 0\n0 90\n0\n100\n' >"$tmp/ph/l.ies"
+expect photometry-short 1 "l\\.ies: line 7: table too short" -- "$bin" info "$tmp/ph/s.geojson"
+printf 'IESNA:LM-63-2002\nTILT=NONE\n1 -1 1 2 1 1 2 0 0 0\n1 1 0\n0 90\n0\n100 0\n' >"$tmp/ph/l.ies"
+expect photometry-nadir 0 "^0 0 0 2\\.768895999" -- sh -c "echo '0 0' | '$bin' illum -q --no-indirect '$tmp/ph/s.geojson' --points -"
 . tests/cli/gis.sh
 . tests/cli/network.sh
 ls "$tmp"/*.tmp* >/dev/null 2>&1 && { echo "FAIL temporary files left"; fail=$((fail + 1)); }

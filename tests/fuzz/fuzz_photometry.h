@@ -1,0 +1,61 @@
+/* Shared by fuzz_ies.c and fuzz_ldt.c: photometry_parse on arbitrary bytes
+ * must either fail with one line "NAME: line L: why" and give its memory
+ * back, or give a table whose every lookup is finite, within [0, peak],
+ * with a finite non-negative flux. A failed check aborts (a crash). */
+#ifndef FUZZ_PHOTOMETRY_H
+#define FUZZ_PHOTOMETRY_H
+
+#include <math.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "light/photometry.h"
+
+#define PCHECK(cond)                                                                     \
+    do {                                                                                 \
+        if (!(cond)) {                                                                   \
+            fprintf(stderr, "FUZZ CHECK failed at %s:%d: %s\n", __FILE__, __LINE__, #cond); \
+            abort();                                                                     \
+        }                                                                                \
+    } while (0)
+
+static void fuzz_photometry(const char *text, size_t len)
+{
+    static void *mem;
+    static arena a;
+    const photometry *p = NULL;
+    char err[512];
+    arena_mark m;
+    plx_status st;
+    int i, j;
+    if (!mem) {
+        mem = malloc(64u << 20);
+        PCHECK(mem != NULL);
+        arena_init(&a, mem, 64u << 20);
+    }
+    m = arena_get_mark(&a);
+    st = photometry_parse(&a, PLX_PART_SCENE, text, len, "fuzz.ies", &p, err, sizeof err);
+    if (st != PLX_OK) {
+        PCHECK(st == PLX_E_PARSE || st == PLX_E_NOMEM);
+        PCHECK(p == NULL);
+        PCHECK(strncmp(err, "fuzz.ies: ", 10) == 0 && strchr(err, '\n') == NULL);
+        PCHECK(a.lo == m.lo && a.hi == m.hi);
+        return;
+    }
+    PCHECK(p && p->ng >= 1 && p->nc >= 1 && p->nrows >= 1);
+    PCHECK(isfinite(p->peak) && p->peak >= 0.0);
+    PCHECK(isfinite(p->flux) && p->flux >= 0.0);
+    PCHECK(p->flux <= 4.0 * 3.14159265358979323846 * p->peak * (1.0 + 1e-9) + 1e-300);
+    for (i = 0; i < (int)p->nc; i++)
+        PCHECK(p->c[i] >= 0.0 && p->c[i] < 360.0 && (i == 0 || p->c[i] > p->c[i - 1]) && p->row[i] < p->nrows);
+    for (i = -2; i <= 38; i++)
+        for (j = -1; j <= 19; j++) {
+            double v = photometry_at(p, i * 10.3 - 7.0, j * 9.7);
+            PCHECK(isfinite(v) && v >= 0.0 && v <= p->peak * (1.0 + 1e-12));
+        }
+    arena_release(&a, &m);
+}
+
+#endif
