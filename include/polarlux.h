@@ -115,6 +115,8 @@ typedef struct plx_config {
                                          the free bytes at first use, 256 KiB to 16 MiB) */
     int32_t render_max_width;         /* largest frame plx_render draws (0: 1920) */
     int32_t render_max_height;        /* (0: 1080) */
+    size_t lightmap_bytes;            /* the aerial light map's budget (12 bytes a texel; the texel
+                                         grows from the one asked for until the map fits; 0: 48 MiB) */
 } plx_config;
 
 /* Fills cfg with the defaults: no port, lenient loading, no part limits
@@ -548,6 +550,29 @@ plx_status plx_indirect_set_gather(plx_engine *e, uint32_t side);
 plx_status plx_indirect_select_lamps(plx_engine *e, const double box[4], double margin,
                                      uint32_t *count /* OUT */);
 
+#define PLX_REFINE_LRU_MAX 64
+
+typedef struct plx_refine_stats {
+    uint32_t misses_now;        /* floor maps computed by this call */
+    uint64_t hits, misses, evictions, refined; /* lamp cache totals since creation or reset */
+    uint32_t slots;             /* cache capacity (lamps) */
+    double near_radius;         /* lamps within this horizontal distance are refined, m */
+    uint32_t cached;            /* lamps in the cache now ... */
+    uint32_t lru[PLX_REFINE_LRU_MAX]; /* ... the first of them, most recently used first */
+} plx_refine_stats;
+
+/*
+ * Near-viewer refinement (munoz2013 §3.3-3.4, README "Walking through a
+ * city"): the lamps within near_radius of eye (horizontally), nearest
+ * first, up to the cache capacity, get their own floor photon maps, kept
+ * in an LRU cache; a lamp's map is pushed into the improved aerial map the
+ * first time, and the progressive aerial chart then restarts without that
+ * lamp (further plx_indirect_step frames fill it again). out (may be NULL)
+ * gets the cache's counters. Errors: PLX_E_NOSCENE (no photon buffers yet),
+ * PLX_E_INVALID, PLX_E_NOMEM (scratch).
+ */
+plx_status plx_indirect_refine(plx_engine *e, const double eye[3], plx_refine_stats *out /* OUT */);
+
 /*
  * Histogram matching of a day orthophoto to a night palette (munoz2013
  * §3.1): each channel of day (npx RGB8 pixels) is mapped so its histogram
@@ -581,7 +606,16 @@ typedef struct plx_render_opts {
     int no_indirect;            /* 1: direct light only even when photons were traced */
     const plx_backend *backend; /* visibility pass: NULL = the built-in software rasteriser;
                                    or a port's, e.g. port/osmesa/plx_osmesa.h */
+    int auto_exposure;          /* 1: the exposure is chosen from the image (a high percentile of
+                                   the lit pixels' luminance near white) and a tone curve keeps
+                                   the highlights near lamps; exposure is then ignored. rgbf
+                                   stays linear radiance. README "Automatic exposure" */
+    int aa;                     /* anti-aliasing: aa x aa samples per pixel on a regular grid,
+                                   averaged in linear radiance (0 or 1: one sample at the pixel
+                                   centre, SPEC §5); at most PLX_RENDER_MAX_AA */
 } plx_render_opts;
+
+#define PLX_RENDER_MAX_AA 16
 
 /* Exposure 1, everything else off (NULL: nothing). Threads: any. */
 void plx_render_opts_default(plx_render_opts *o /* OUT */);
@@ -590,6 +624,7 @@ typedef struct plx_render_info {
     uint32_t buildings, drawn;  /* buildings in the scene, drawn after culling */
     double drawn_fraction;      /* triangles drawn / triangles of the scene */
     uint64_t shaded_pixels;
+    double exposure;            /* the exposure applied (the chosen one with auto_exposure) */
 } plx_render_info;
 
 /*
@@ -730,6 +765,59 @@ typedef int (*plx_write_fn)(void *ctx, const char *data, size_t len);
  */
 plx_status plx_gen_city(const char *style, int nx, int ny, uint64_t seed,
                         plx_write_fn write, void *ctx);
+
+/* ---- Bake files: build once, load without rebuilding (README "Bake files") */
+
+typedef struct plx_bake_opts {
+    int aerial;                 /* 1: build the aerial light map too */
+    double aerial_m_per_texel;  /* its resolution (0: 1 m) */
+    int no_indirect;            /* 1: no photon buffers */
+    int twin;                   /* 1: the twin engine (see plx_bake_save): the same memory
+                                   layout without the light map's shading */
+} plx_bake_opts;
+
+/*
+ * Builds everything queries and frames need for the loaded scene: polar
+ * diagrams, lamp light, photon buffers (levels for a viewer at the centre
+ * of Bounds, all around), the renderer and, with o->aerial, the aerial light
+ * map. Photon frames are then added with plx_indirect_step.
+ */
+plx_status plx_bake_prepare(plx_engine *e, const plx_bake_opts *o);
+
+/*
+ * Bytes of the bake file of e, and the file itself written into the
+ * caller's buffer (the core does no I/O). twin: a second engine in another
+ * block, with the same scene loaded (and the same ground image) and
+ * plx_bake_prepare called with the same options and twin = 1, but no photon
+ * frames; the words that differ between the two by exactly the distance of
+ * their blocks are the pointers, saved as offsets. Both blocks must have
+ * the same address modulo 64, and be zero-filled when the engines were
+ * created (padding and never-written bytes are saved too). Errors: PLX_E_INVALID (no twin of the same
+ * layout, buffer too small), PLX_E_NOSCENE.
+ */
+plx_status plx_bake_size(plx_engine *e, plx_engine *twin, size_t *bytes /* OUT */);
+plx_status plx_bake_save(plx_engine *e, plx_engine *twin, void *buf, size_t cap,
+                         size_t *written /* OUT */);
+
+/*
+ * Size first: checks the bake's header and checksum and gives the block
+ * size to pass to plx_bake_load (the image plus room for queries).
+ * Errors (one line in err): PLX_E_PARSE (not a bake, truncated, corrupt),
+ * PLX_E_UNSUPPORTED (another format version, architecture or build).
+ */
+plx_status plx_bake_block_size(const void *bake, size_t len, size_t *block_bytes /* OUT */, char *err,
+                               size_t errlen);
+
+/*
+ * Creates an engine in the caller's block from a bake: one copy of the
+ * image and the relocation of its pointers, no parsing, no rebuilding.
+ * cfg gives the port, strictness and part budgets (the lit cache and the
+ * render maximum stay the bake's). The bake buffer may be freed after.
+ * Errors as plx_bake_block_size, plus PLX_E_NOMEM (block too small) and
+ * PLX_E_INVALID; err gets one line.
+ */
+plx_status plx_bake_load(void *mem, size_t size, const plx_config *cfg, const void *bake, size_t len,
+                         plx_engine **engine /* OUT */, char *err, size_t errlen);
 
 /* ---- Embedding: coordinates and memory sizing -------------------------- */
 

@@ -37,6 +37,7 @@ FUZZ_SAN      = -fsanitize=address,undefined -fno-sanitize-recover=all
 # go to build/fuzz/corpus/NAME, crashes to build/fuzz/crash-NAME-*.
 FUZZ_SEEDS_fuzz_geojson = fixtures tests/corpus
 FUZZ_SEEDS_fuzz_scene   = fixtures tests/corpus
+FUZZ_SEEDS_fuzz_bake    = tests/corpus
 FUZZ_SEEDS_fuzz_ies     = fixtures/photometry tests/fuzz/seeds-photometry
 FUZZ_SEEDS_fuzz_ldt     = fixtures/photometry tests/fuzz/seeds-photometry
 FUZZ_OPTS ?= -timeout=20 -rss_limit_mb=4096 -max_len=65536 -print_final_stats=1

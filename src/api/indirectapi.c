@@ -6,6 +6,7 @@
 #include "photon/photon.h"
 #include "photon/trace.h"
 #include "photon/indirect.h"
+#include "photon/nightlight.h"
 #include "photon/photon_select.h"
 #include "photon/final_gather.h"
 #include "render/nightify.h"
@@ -39,6 +40,32 @@ plx_status plx_indirect_set_viewer(plx_engine *e, const double eye[3], const dou
     if (st == PLX_E_NOMEM)
         return eng_nomem(e, "assigning chart levels");
     return st;
+}
+
+plx_status plx_indirect_refine(plx_engine *e, const double eye[3], plx_refine_stats *out)
+{
+    int misses;
+    if (!eng_ok(e))
+        return PLX_E_INVALID;
+    if (!eye)
+        return eng_fail(e, PLX_E_INVALID, "plx_indirect_refine: eye is NULL");
+    if (!e->ph)
+        return eng_fail(e, PLX_E_NOSCENE, "plx_indirect_refine: no photon buffers (trace indirect light first)");
+    misses = photon_lamps_update(e->ph, eye);
+    if (misses < 0)
+        return eng_nomem(e, "choosing the lamps near the viewer");
+    if (out) {
+        memset(out, 0, sizeof *out);
+        out->misses_now = (uint32_t)misses;
+        out->hits = e->ph->st.lamp_hits;
+        out->misses = e->ph->st.lamp_misses;
+        out->evictions = e->ph->st.lamp_evictions;
+        out->refined = e->ph->st.lamp_refined;
+        out->slots = e->ph->nslots;
+        out->near_radius = e->ph->cfg.near_radius;
+        out->cached = photon_lamp_lru(e->ph, out->lru, PLX_REFINE_LRU_MAX);
+    }
+    return PLX_OK;
 }
 
 plx_status plx_indirect_reset(plx_engine *e)

@@ -6,7 +6,9 @@
 #include "light/litregion.h"
 #include "render/render.h"
 
-#define LIGHTMAP_MAX_BYTES ((size_t)256 << 20)
+#define DEFAULT_MAX_W 1920
+#define DEFAULT_MAX_H 1080
+#define LIGHTMAP_MAX_BYTES ((size_t)48 << 20) /* plx_config.lightmap_bytes 0 */
 
 void plx_render_opts_default(plx_render_opts *o)
 {
@@ -23,6 +25,90 @@ static void shade_indirect(void *user, const double P[3], const double n[3], dou
     eng_indirect_photons_rgb(user, P, n, rgb);
 }
 
+plx_status eng_need_render(plx_engine *e)
+{
+    return eng_need(e, ENG_RENDER, "plx_render");
+}
+
+/* A shader giving no light: the bake's twin engine builds its light map
+ * with it (same memory layout, none of the work; src/api/bake.c). */
+static void shade_none(void *user, const double P[3], const double n[3], double rgb[3])
+{
+    (void)user;
+    (void)P;
+    (void)n;
+    rgb[0] = rgb[1] = rgb[2] = 0.0;
+}
+
+plx_status eng_need_lightmap(plx_engine *e, double m_per_texel, int dark)
+{
+    double cell = m_per_texel > 0 ? m_per_texel : 1.0;
+    plx_status st = eng_need_render(e);
+    if (st != PLX_OK)
+        return st;
+    if (dark)
+        render_code_bind(e->rd, shade_none);
+    st = render_lightmap_build(e->rd, cell, e->cfg.lightmap_bytes ? e->cfg.lightmap_bytes : LIGHTMAP_MAX_BYTES);
+    if (dark)
+        render_code_bind(e->rd, render_shade_light);
+    if (st == PLX_E_NOMEM)
+        return eng_nomem(e, "building the aerial light map");
+    if (st != PLX_OK)
+        return eng_fail(e, st, render_error(e->rd));
+    e->lightmap_cell = cell;
+    return PLX_OK;
+}
+
+/* Anti-aliasing: n x n frames with the sample point moved within the
+ * pixel on a regular grid, their linear images averaged (summed in sample
+ * order, so the bytes are the same every time), then tone mapped with the
+ * exposure of the first sample's frame. The sum lives in PLX_PART_FRAME,
+ * taken on first use for the largest frame. */
+static plx_status render_aa(plx_engine *e, const render_camera *rc, render_opts *ro, int n, uint8_t *rgb8,
+                            float *rgbf, render_stats *rs)
+{
+    size_t px = (size_t)rc->width * (size_t)rc->height, p, maxpx;
+    double ex = 1.0, inv = 1.0 / ((double)n * n);
+    plx_status st = PLX_OK;
+    int a, b;
+    if (rc->width < 1 || rc->height < 1)
+        px = 0;
+    maxpx = (size_t)(e->cfg.render_max_width ? e->cfg.render_max_width : DEFAULT_MAX_W) *
+            (size_t)(e->cfg.render_max_height ? e->cfg.render_max_height : DEFAULT_MAX_H);
+    if (!e->aa_sum) {
+        e->aa_sum = arena_alloc(&e->mem, PLX_PART_FRAME, arena_mul(maxpx, 3 * sizeof(float)), 64);
+        if (!e->aa_sum)
+            return PLX_E_NOMEM;
+    }
+    for (b = 0; b < n && st == PLX_OK; b++)
+        for (a = 0; a < n && st == PLX_OK; a++) {
+            const float *lin;
+            ro->shift[0] = (a + 0.5) / n - 0.5;
+            ro->shift[1] = (b + 0.5) / n - 0.5;
+            st = render_frame(e->rd, rc, ro, NULL, NULL, rs);
+            if (st != PLX_OK)
+                break;
+            lin = render_linear(e->rd);
+            if (a == 0 && b == 0) {
+                ex = rs->exposure;
+                memcpy(e->aa_sum, lin, px * 3 * sizeof(float));
+            } else {
+                for (p = 0; p < 3 * px; p++)
+                    e->aa_sum[p] += lin[p];
+            }
+        }
+    if (st != PLX_OK)
+        return st;
+    for (p = 0; p < 3 * px; p++)
+        e->aa_sum[p] = (float)(e->aa_sum[p] * inv);
+    if (rgbf)
+        memcpy(rgbf, e->aa_sum, px * 3 * sizeof(float));
+    if (rgb8)
+        render_tonemap(e->rd, e->aa_sum, px, ex, ro->auto_exposure, rgb8);
+    rs->exposure = ex;
+    return PLX_OK;
+}
+
 plx_status plx_render(plx_engine *e, const plx_camera *cam, const plx_render_opts *o, uint8_t *rgb8,
                       float *rgbf, plx_render_info *info)
 {
@@ -37,6 +123,8 @@ plx_status plx_render(plx_engine *e, const plx_camera *cam, const plx_render_opt
         return eng_fail(e, PLX_E_NOSCENE, "plx_render: no scene is loaded");
     if (!cam)
         return eng_fail(e, PLX_E_INVALID, "plx_render: camera is NULL");
+    if (o && (o->aa < 0 || o->aa > PLX_RENDER_MAX_AA))
+        return eng_fail(e, PLX_E_INVALID, "plx_render: aa must be 0..16 (samples per pixel side)");
     if (!o) {
         plx_render_opts_default(&def);
         o = &def;
@@ -45,13 +133,9 @@ plx_status plx_render(plx_engine *e, const plx_camera *cam, const plx_render_opt
     if (st != PLX_OK)
         return st;
     if (o->aerial && e->lightmap_cell == 0.0) {
-        double cell = o->aerial_m_per_texel > 0 ? o->aerial_m_per_texel : 1.0;
-        st = render_lightmap_build(e->rd, cell, LIGHTMAP_MAX_BYTES);
-        if (st == PLX_E_NOMEM)
-            return eng_nomem(e, "building the aerial light map");
+        st = eng_need_lightmap(e, o->aerial_m_per_texel, 0);
         if (st != PLX_OK)
-            return eng_fail(e, st, render_error(e->rd));
-        e->lightmap_cell = cell;
+            return st;
     }
     memcpy(rc.eye, cam->eye, sizeof rc.eye);
     memcpy(rc.target, cam->target, sizeof rc.target);
@@ -64,11 +148,15 @@ plx_status plx_render(plx_engine *e, const plx_camera *cam, const plx_render_opt
     ro.lightmap = o->aerial;
     ro.cull = o->no_cull ? RENDER_CULL_NONE : RENDER_CULL_ALL;
     ro.backend = o->backend;
+    ro.auto_exposure = o->auto_exposure;
     if (!o->no_indirect && e->ph && plx_indirect_frames(e) > 0) {
         ro.indirect = shade_indirect;
         ro.indirect_user = e;
     }
-    st = render_frame(e->rd, &rc, &ro, rgb8, rgbf, &rs);
+    if (o->aa > 1)
+        st = render_aa(e, &rc, &ro, o->aa, rgb8, rgbf, &rs);
+    else
+        st = render_frame(e->rd, &rc, &ro, rgb8, rgbf, &rs);
     if (st == PLX_E_NOMEM)
         return eng_nomem(e, "rendering a frame");
     if (st != PLX_OK)
@@ -78,6 +166,7 @@ plx_status plx_render(plx_engine *e, const plx_camera *cam, const plx_render_opt
         info->drawn = rs.drawn;
         info->drawn_fraction = rs.drawn_fraction;
         info->shaded_pixels = rs.shader_calls;
+        info->exposure = rs.exposure;
     }
     eng_clear_error(e);
     return PLX_OK;

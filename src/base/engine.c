@@ -137,6 +137,7 @@ plx_status plx_engine_create(void *mem, size_t size, const plx_config *cfg,
         *out = NULL;
     if (!mem || !out || size < PLX_ENGINE_MIN_BYTES)
         return PLX_E_INVALID;
+    memset(&a, 0, sizeof a); /* padding too: a bake saves the engine's bytes */
     arena_init(&a, mem, size);
     e = arena_alloc(&a, PLX_PART_ENGINE, sizeof *e, 16);
     if (!e)

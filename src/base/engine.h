@@ -29,6 +29,7 @@ struct plx_engine {
     struct render *rd;      /* renderer, created on first need */
     struct photon_sys *ph;  /* photon buffers, created on first need */
     double lightmap_cell;   /* light map texel size when built, else 0 */
+    float *aa_sum;          /* anti-aliasing sum (PLX_PART_FRAME), taken on first need */
     uint32_t gather_side;   /* final gathering at points: side^2 directions
                                (0 = photon buffers only); set by
                                plx_indirect_set_gather, else FINAL_GATHER_SIDE */
@@ -50,6 +51,11 @@ plx_status eng_need(plx_engine *e, eng_what what, const char *fn);
 double eng_indirect(plx_engine *e, const double P[3], const double n[3]);
 /* The same, also writing its RGB version to rgb (may be NULL); returns the scalar. */
 double eng_indirect_rgb(plx_engine *e, const double P[3], const double n[3], double rgb[3] /* OUT */);
+/* Creates the renderer on first need (renderapi.c). */
+plx_status eng_need_render(plx_engine *e);
+/* Builds the aerial light map at m_per_texel metres (0: 1 m) unless built;
+ * dark: with a shader giving no light (the bake's twin, bake.c). */
+plx_status eng_need_lightmap(plx_engine *e, double m_per_texel, int dark);
 /* The indirect estimate at a free point (not on a surface facing out):
  * final gathering there, else the buffers' value on the horizontal surface
  * below it (indirectapi.c). */

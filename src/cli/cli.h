@@ -51,6 +51,21 @@ int cli_common_option(const char *cmd, int argc, char **argv, int *i, cli_common
 /* Creates an engine and loads the scene; prints the error and returns an
  * exit code on failure (engine freed), EXIT_OK on success. */
 int cli_open_scene(const char *cmd, const char *path, const cli_common *c, plx_engine **e);
+/* A large block (2 MiB aligned, huge pages where offered); free() it. */
+void *cli_big_alloc(size_t size);
+
+/* The engine configuration of the common options (port, --strict, --quiet). */
+void cli_config(const cli_common *c, plx_config *cfg /* OUT */);
+/* Loads the scene file into the existing engine *e (and its ground image);
+ * on failure prints, frees the engine and returns an exit code. */
+int cli_load_scene(const char *cmd, const char *path, const cli_common *c, plx_engine **e);
+/* The bake file cli_open_scene loaded, if any (README "Bake files"). */
+typedef struct cli_bake_state {
+    int loaded;
+    size_t bytes;
+    unsigned long long load_ns;
+} cli_bake_state;
+extern cli_bake_state cli_bake_last;
 /* Photon frames for indirect light (--photons, --frames, --no-indirect). */
 typedef struct cli_indirect {
     long photons;    /* per frame (default 65536) */
@@ -72,6 +87,11 @@ int cli_indirect_option(const char *cmd, int argc, char **argv, int *i, cli_indi
  * dir (either may be NULL). Returns an exit code. */
 int cli_indirect_run(const char *cmd, plx_engine *e, const cli_indirect *ind, const double *eye,
                      const double *dir, double fov_deg);
+/* Near-viewer refinement at eye (plx_indirect_refine); when lamps were
+ * newly refined, 'frames' photon frames of 'photons' refill the aerial
+ * chart. Prints the error and returns an exit code. */
+int cli_refine(const char *cmd, plx_engine *e, const double eye[3], long frames, long photons,
+               plx_refine_stats *rs /* OUT */);
 /* "polarlux CMD: warning: ..." on stderr unless --quiet (c may be NULL). */
 void cli_warn(const char *cmd, const cli_common *c, const char *fmt, ...);
 /* Why a result is dark: "the scene has no lamps", or that no light reaches it. */
@@ -119,6 +139,8 @@ int cmd_render(int argc, char **argv);
 int cmd_route(int argc, char **argv);
 int cmd_nightify(int argc, char **argv);
 int cmd_dark_spots(int argc, char **argv);
+int cmd_bake(int argc, char **argv);
+int cmd_walk(int argc, char **argv);
 int cmd_meter(int argc, char **argv);
 /* route --network and annotate (cmd_network.c) */
 int cmd_route_network(int argc, char **argv);

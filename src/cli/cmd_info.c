@@ -169,6 +169,9 @@ int cmd_info(int argc, char **argv)
                gi.mean_albedo[2], gi.mean_luminance);
     print_photometry(e, si.lamps);
     printf("load time: %.2f ms\n", si.load_ns / 1e6);
+    if (cli_bake_last.loaded)
+        printf("bake: %zu bytes (%.1f MB) loaded in %.2f ms (read, check, copy, relocate)\n", cli_bake_last.bytes,
+               cli_bake_last.bytes / 1048576.0, cli_bake_last.load_ns / 1e6);
     if (plx_polar_info_get(e, &pi) == PLX_OK) {
         printf("polar diagrams: built in %.2f ms; %zu bytes = axes %zu + regions %zu + polygons %zu + rest (search DAGs) %zu"
                " (%.1f bytes per footprint vertex); regions per quadrant %u %u %u %u\n",

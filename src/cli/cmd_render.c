@@ -19,7 +19,7 @@
 static const char help[] =
     "usage: polarlux render SCENE [--eye X,Y,Z --target X,Y,Z] [--fov DEG] [--size WxH]\n"
     "                       [--view street|aerial] [--backend soft|osmesa] [--exposure E]\n"
-    "                       [--no-indirect] [--no-glow] [--texel M] -o OUT.png [--pfm OUT.pfm]\n"
+    "                       [--no-indirect] [--no-glow] [--aa N] [--texel M] -o OUT.png [--pfm OUT.pfm]\n"
     "\n"
     "Renders the scene at night through a pinhole camera (SPEC §5: up is +z,\n"
     "vertical field of view, pixel centres): ground, facades and roofs lit by\n"
@@ -37,8 +37,17 @@ static const char help[] =
     "  --view V         street (default) or aerial: aerial takes the ground from a\n"
     "                   light map of exact illuminance built once at --texel metres\n"
     "  --texel M        aerial light map resolution (default 1 m)\n"
-    "  --exposure E     radiance multiplier before sRGB (default 1.0, SPEC §5)\n"
+    "  --exposure E     radiance multiplier before sRGB, no tone curve (SPEC §5;\n"
+    "                   --exposure 1 is the reference image). Default: automatic:\n"
+    "                   the 97th percentile of the lit surface pixels' luminance\n"
+    "                   near white and a tone curve keeping highlights near lamps;\n"
+    "                   the exposure chosen is printed\n"
     "  --no-glow        no lamp glows: every pixel is exactly SPEC §5's radiance\n"
+    "  --refine         near-viewer refinement (munoz2013 §3.3-3.4): the lamps near\n"
+    "                   the eye get their own floor photon maps (LRU cache, pushed\n"
+    "                   into the aerial map); 16 more photon frames refill the chart\n"
+    "  --aa N           anti-aliasing: N x N samples per pixel, averaged in linear\n"
+    "                   radiance (default 1: one sample at each pixel centre, SPEC §5)\n"
     "  --no-indirect    direct light only (default: indirect light from the photon\n"
     "                   buffers, traced first; progress on a terminal)\n"
     "  --photons N      photons per frame (default 65536)\n"
@@ -51,7 +60,7 @@ static const char help[] =
 
 typedef struct render_args {
     const char *scene, *out, *pfm;
-    int have_eye, have_target, aerial, osmesa;
+    int have_eye, have_target, aerial, osmesa, refine;
     plx_camera cam;
     plx_render_opts opts;
     cli_common c;
@@ -96,9 +105,15 @@ static int parse_value(render_args *a, const char *opt, const char *val)
     } else if (strcmp(opt, "--exposure") == 0) {
         if (cli_parse_real(val, 0, 1e9, &a->opts.exposure) != 0)
             return cli_usage_error("render", "--exposure '%s' is not a number from 0 to 1e9", val);
+        a->opts.auto_exposure = 0;
     } else if (strcmp(opt, "--texel") == 0) {
         if (cli_parse_real(val, 0.01, 1e4, &a->opts.aerial_m_per_texel) != 0)
             return cli_usage_error("render", "--texel '%s' is not a number of metres from 0.01 to 1e4", val);
+    } else if (strcmp(opt, "--aa") == 0) {
+        long n;
+        if (cli_parse_int(val, 1, PLX_RENDER_MAX_AA, &n) != 0)
+            return cli_usage_error("render", "--aa '%s' is not a whole number from 1 to %d", val, PLX_RENDER_MAX_AA);
+        a->opts.aa = (int)n;
     } else if (strcmp(opt, "-o") == 0) {
         a->out = val;
     } else if (strcmp(opt, "--pfm") == 0) {
@@ -112,11 +127,12 @@ static int parse_value(render_args *a, const char *opt, const char *val)
 static int parse_args(int argc, char **argv, render_args *a)
 {
     static const char *const valued[] = { "--eye", "--target", "--fov", "--size", "--view", "--backend",
-                                          "--exposure", "--texel", "-o", "--pfm" };
+                                          "--exposure", "--texel", "-o", "--pfm", "--aa" };
     int i;
     size_t k;
     memset(a, 0, sizeof *a);
     plx_render_opts_default(&a->opts);
+    a->opts.auto_exposure = 1; /* until --exposure */
     cli_indirect_default(&a->ind);
     a->cam.fov_deg = 60.0;
     a->cam.width = 640;
@@ -136,6 +152,10 @@ static int parse_args(int argc, char **argv, render_args *a)
         }
         if (strcmp(s, "--no-glow") == 0) {
             a->opts.no_glow = 1;
+            continue;
+        }
+        if (strcmp(s, "--refine") == 0) {
+            a->refine = 1;
             continue;
         }
         for (k = 0; k < sizeof valued / sizeof valued[0]; k++)
@@ -365,6 +385,13 @@ int cmd_render(int argc, char **argv)
             dir[k] /= len;
         rc = cli_indirect_run("render", e, &a.ind, a.cam.eye, a.aerial || !(len > 0) ? NULL : dir,
                               a.cam.fov_deg * a.cam.width / a.cam.height);
+        if (rc == EXIT_OK && a.refine && !a.ind.off) {
+            plx_refine_stats rs;
+            rc = cli_refine("render", e, a.cam.eye, 16, a.ind.photons, &rs);
+            if (rc == EXIT_OK)
+                printf("refinement: %u lamps near the eye got floor maps (%u cached of %u slots)\n", rs.misses_now,
+                       rs.cached, rs.slots);
+        }
         if (rc != EXIT_OK) {
             plx_engine_free(e);
             return rc;
@@ -421,6 +448,9 @@ int cmd_render(int argc, char **argv)
                a.aerial ? "aerial" : "street", a.cam.width, a.cam.height, prec, a.cam.eye[0], prec, a.cam.eye[1],
                a.cam.eye[2], prec, a.cam.target[0], prec, a.cam.target[1], a.cam.target[2], info.drawn, info.buildings,
                100.0 * info.drawn_fraction, (port_now_ns() - t0) / 1e6, a.out);
+    if (rc == EXIT_OK && a.opts.auto_exposure)
+        printf("exposure: %.4g (automatic: a high percentile of the lit surfaces' luminance near white, "
+               "tone curve; --exposure 1 for SPEC §5's linear image)\n", info.exposure);
 done:
 #ifdef PLX_HAVE_OSMESA
     plx_osmesa_close(om);

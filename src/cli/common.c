@@ -3,6 +3,7 @@
 #include <stdarg.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 
 #include "cli.h"
 #include "lamp_layer.h"
@@ -310,28 +311,131 @@ const char *cli_dark_reason(plx_engine *e)
     return "no lamp's light reaches it (each lamp lights only within its radius, and buildings cast shadows)";
 }
 
-int cli_open_scene(const char *cmd, const char *path, const cli_common *c, plx_engine **e)
+void cli_config(const cli_common *c, plx_config *cfg)
 {
-    int rc, k;
     static plx_port quiet_port;
+    plx_config_default(cfg);
+    cfg->port = plx_port_posix();
+    if (c->quiet) {
+        quiet_port = *cfg->port;
+        quiet_port.log = quiet_log;
+        cfg->port = &quiet_port;
+    }
+    cfg->strict = c->strict;
+    cfg->render_max_width = c->render_w;
+    cfg->render_max_height = c->render_h;
+}
+
+cli_bake_state cli_bake_last;
+
+/* Whether path starts with the bake magic (README "Bake files"). */
+static int is_bake(const char *path)
+{
+    char head[8];
+    struct stat sb;
+    FILE *f;
+    int yes;
+    /* only a regular file can be a bake: a FIFO or device is left to the
+     * scene reader, which refuses it without waiting on it */
+    if (stat(path, &sb) != 0 || !S_ISREG(sb.st_mode) || !(f = fopen(path, "rb")))
+        return 0;
+    yes = fread(head, 1, 8, f) == 8 && memcmp(head, "PLXBAKE", 8) == 0;
+    fclose(f);
+    return yes;
+}
+
+/* A whole file in a block of cli_big_alloc; NULL and a reason on failure. */
+static char *read_big(const char *path, size_t *len, char *err, size_t errlen)
+{
+    FILE *f = fopen(path, "rb");
+    char *buf = NULL;
+    long n;
+    if (!f || fseek(f, 0, SEEK_END) != 0 || (n = ftell(f)) < 0 || fseek(f, 0, SEEK_SET) != 0) {
+        snprintf(err, errlen, "cannot read: %s", strerror(errno));
+    } else if (!(buf = cli_big_alloc((size_t)n + 1))) {
+        snprintf(err, errlen, "out of memory reading %ld bytes", n);
+    } else if (fread(buf, 1, (size_t)n, f) != (size_t)n) {
+        snprintf(err, errlen, "read failed: %s", ferror(f) ? strerror(errno) : "the file shrank");
+        free(buf);
+        buf = NULL;
+    } else {
+        *len = (size_t)n;
+    }
+    if (f)
+        fclose(f);
+    return buf;
+}
+
+/* An engine from a bake file: the file read once, the block sized by the
+ * bake (or --mem), the image copied and relocated. */
+static int open_bake(const char *cmd, const char *path, const cli_common *c, plx_engine **e)
+{
+    char err[512];
+    size_t len, need;
+    char *data;
+    void *mem;
     plx_config cfg;
     plx_status st;
-    plx_config_default(&cfg);
-    cfg.port = plx_port_posix();
-    if (c->quiet) {
-        quiet_port = *cfg.port;
-        quiet_port.log = quiet_log;
-        cfg.port = &quiet_port;
+    unsigned long long t0 = port_now_ns();
+    data = read_big(path, &len, err, sizeof err);
+    if (!data) {
+        fprintf(stderr, "polarlux %s: %s: %s\n", cmd, path, err);
+        return EXIT_FAIL;
     }
-    cfg.strict = c->strict;
-    cfg.render_max_width = c->render_w;
-    cfg.render_max_height = c->render_h;
+    st = plx_bake_block_size(data, len, &need, err, sizeof err);
+    if (st != PLX_OK) {
+        fprintf(stderr, "polarlux %s: %s: %s\n", cmd, path, err);
+        free(data);
+        return EXIT_FAIL;
+    }
+    if (c->mem)
+        need = c->mem;
+    mem = cli_big_alloc(need);
+    if (!mem) {
+        fprintf(stderr, "polarlux %s: %s: cannot take a block of %zu bytes for the bake\n", cmd, path, need);
+        free(data);
+        return EXIT_NOMEM;
+    }
+    cli_config(c, &cfg);
+    st = plx_bake_load(mem, need, &cfg, data, len, e, err, sizeof err);
+    free(data);
+    if (st != PLX_OK) {
+        fprintf(stderr, "polarlux %s: %s: %s\n", cmd, path, err);
+        free(mem);
+        return st == PLX_E_NOMEM ? EXIT_NOMEM : EXIT_FAIL;
+    }
+    cli_bake_last.loaded = 1;
+    cli_bake_last.bytes = len;
+    cli_bake_last.load_ns = port_now_ns() - t0;
+    return EXIT_OK;
+}
+
+int cli_open_scene(const char *cmd, const char *path, const cli_common *c, plx_engine **e)
+{
+    plx_config cfg;
+    plx_status st;
+    if (is_bake(path)) {
+        if (c->nlamp_files > 0) {
+            fprintf(stderr, "polarlux %s: %s: --lamps cannot be added to a bake file; give them to 'polarlux bake'\n",
+                    cmd, path);
+            return EXIT_USAGE;
+        }
+        return open_bake(cmd, path, c, e);
+    }
+    cli_config(c, &cfg);
     st = plx_engine_new(c->mem ? c->mem : CLI_DEFAULT_MEM, &cfg, e);
     if (st != PLX_OK) {
         fprintf(stderr, "polarlux %s: cannot create an engine of %zu bytes: %s\n", cmd,
                 c->mem ? c->mem : CLI_DEFAULT_MEM, plx_strerror(st));
         return cli_exit_code(st);
     }
+    return cli_load_scene(cmd, path, c, e);
+}
+
+int cli_load_scene(const char *cmd, const char *path, const cli_common *c, plx_engine **e)
+{
+    int rc, k;
+    plx_status st;
     st = plx_load_file(*e, path);
     if (st != PLX_OK) {
         fprintf(stderr, "polarlux %s: %s\n", cmd, plx_last_error(*e));
@@ -407,8 +511,8 @@ int cli_indirect_run(const char *cmd, plx_engine *e, const cli_indirect *ind, co
     long k;
     int tty = isatty(2);
     unsigned long long t0 = port_now_ns();
-    if (ind->off || ind->frames == 0)
-        return EXIT_OK;
+    if (ind->off || ind->frames == 0 || plx_indirect_frames(e) > 0)
+        return EXIT_OK; /* off, or traced already (a bake) */
     if ((double)ind->photons * (double)ind->frames > CLI_MAX_PHOTONS)
         return cli_usage_error(cmd, "--photons %ld x --frames %ld is more than %.0f photons", ind->photons,
                                ind->frames, CLI_MAX_PHOTONS);
@@ -579,4 +683,24 @@ size_t cli_buffer_budget(const plx_engine *e, const cli_common *c)
     size_t mem = c->mem ? c->mem : CLI_DEFAULT_MEM;
     plx_memory_get(e, &m);
     return m.peak_total < mem ? mem - m.peak_total : 0;
+}
+
+int cli_refine(const char *cmd, plx_engine *e, const double eye[3], long frames, long photons,
+               plx_refine_stats *rs)
+{
+    plx_status st = plx_indirect_refine(e, eye, rs);
+    long k;
+    if (st != PLX_OK) {
+        fprintf(stderr, "polarlux %s: %s\n", cmd, plx_last_error(e));
+        return cli_exit_code(st);
+    }
+    /* a newly refined lamp restarts the progressive aerial chart: refill it */
+    for (k = 0; rs->misses_now > 0 && k < frames; k++) {
+        st = plx_indirect_step(e, (uint32_t)photons, plx_indirect_frames(e) + 1);
+        if (st != PLX_OK) {
+            fprintf(stderr, "polarlux %s: %s\n", cmd, plx_last_error(e));
+            return cli_exit_code(st);
+        }
+    }
+    return EXIT_OK;
 }

@@ -21,6 +21,8 @@ static const command commands[] = {
     { "nightify", cmd_nightify, "turn a day orthophoto into night colours (histogram matching)" },
     { "route", cmd_route, "how well lit is a route: lux statistics and EN 13201 P-class" },
     { "dark-spots", cmd_dark_spots, "the darkest points of the street area as GeoJSON" },
+    { "bake", cmd_bake, "build everything once and save it in one file that loads at once" },
+    { "walk", cmd_walk, "frames along a camera path (PNG frames, contact sheet, frame times)" },
     { "meter", cmd_meter, "pedestrian light meters: E_h, E_v, E_sc, E_hs at points (EN 13201)" },
     { "tiles", cmd_tiles, "web-map raster tiles of the ground light (folder z/x/y.png or MBTiles)" },
     { "annotate", cmd_annotate, "every street of a network with its light (GeoJSON, CSV by way id)" },

@@ -5,6 +5,7 @@
 
 #include "base/plx_assert.h"
 #include "render/render.h"
+#include "render/exposure.h"
 #include "render/raster.h"
 #include "light/light.h"
 #include "scene/photometry.h"
@@ -48,6 +49,7 @@ struct render {
     uint32_t cur_id;
     double eye[3], f[3], rt[3], up[3];
     double sx, sy, za, zb, tanh_, aspect, near_, far_;
+    double shift[2], shx, shy;  /* sample point offset in pixels, and in NDC */
     /* shading by tiles */
     light *lt;                  /* the light module when shade is render_shade_light */
     uint32_t *lamp_stamp;       /* nlamps (lt only) */
@@ -250,6 +252,33 @@ plx_status render_create(arena *a, const scene *s, int32_t max_w, int32_t max_h,
     return PLX_OK;
 }
 
+size_t render_struct_bytes(void)
+{
+    return sizeof(render);
+}
+
+void render_code_unbind(render *r)
+{
+    r->shade = NULL;
+    r->soft.name = NULL;
+    r->soft.begin = NULL;
+    r->soft.draw = NULL;
+    r->soft.finish = NULL;
+    memset(&r->rc, 0, sizeof r->rc);
+    r->err = NULL;
+}
+
+void render_code_bind(render *r, render_shade_fn shade)
+{
+    r->shade = shade;
+    r->soft.name = "soft";
+    r->soft.user = r;
+    r->soft.begin = soft_begin;
+    r->soft.draw = soft_draw;
+    r->soft.finish = soft_finish;
+    r->err = "";
+}
+
 /* ---- camera ----------------------------------------------------------------- */
 
 static int setup_camera(render *r, const render_camera *c, const render_opts *o)
@@ -300,6 +329,12 @@ static int setup_camera(render *r, const render_camera *c, const render_opts *o)
     r->sx = 1.0 / (r->tanh_ * r->aspect);
     r->sy = 1.0 / r->tanh_;
     r->near_ = o->near;
+    /* the sample point within each pixel (anti-aliasing), as a shift of
+     * the image in normalised device coordinates */
+    r->shift[0] = isfinite(o->shift[0]) ? o->shift[0] : 0.0;
+    r->shift[1] = isfinite(o->shift[1]) ? o->shift[1] : 0.0;
+    r->shx = 2.0 * r->shift[0] / c->width;
+    r->shy = 2.0 * r->shift[1] / c->height;
     /* far: beyond every corner of the scene box (buildings, lamps' reach) */
     {
         double hx = fmax(fabs(b[0] - c->eye[0]), fabs(b[2] - c->eye[0]));
@@ -324,8 +359,8 @@ static void to_clip(const render *r, const double *X, double out[4])
 {
     double v0 = X[0] - r->eye[0], v1 = X[1] - r->eye[1], v2 = X[2] - r->eye[2];
     double w = v0 * r->f[0] + v1 * r->f[1] + v2 * r->f[2];
-    out[0] = (v0 * r->rt[0] + v1 * r->rt[1] + v2 * r->rt[2]) * r->sx;
-    out[1] = (v0 * r->up[0] + v1 * r->up[1] + v2 * r->up[2]) * r->sy;
+    out[0] = (v0 * r->rt[0] + v1 * r->rt[1] + v2 * r->rt[2]) * r->sx - r->shx * w;
+    out[1] = (v0 * r->up[0] + v1 * r->up[1] + v2 * r->up[2]) * r->sy + r->shy * w;
     out[2] = r->za * w + r->zb;
     out[3] = w;
 }
@@ -848,10 +883,10 @@ static void shade_pass(render *r, const render_opts *o, render_stats *st)
             uint64_t sure_g = 0, sure_w = 0;
             /* 1: hit points; E = 0 (or the light map) in out for now */
             for (j = tj; j < j1; j++) {
-                double bj = (1.0 - 2.0 * (j + 0.5) / r->h) * tb;
+                double bj = (1.0 - 2.0 * (j + 0.5 + r->shift[1]) / r->h) * tb;
                 for (i = ti; i < i1; i++, q++) {
                     size_t p = (size_t)j * (size_t)r->w + (size_t)i;
-                    double ai = (2.0 * (i + 0.5) / r->w - 1.0) * ta;
+                    double ai = (2.0 * (i + 0.5 + r->shift[0]) / r->w - 1.0) * ta;
                     double d[3], t, nd, E[3] = { 0, 0, 0 };
                     double *P = TP[q], *n = TN[q];
                     uint32_t sid = r->id[p];
@@ -1051,13 +1086,42 @@ static void glows(render *r, render_stats *st)
     }
 }
 
+void render_tonemap(const render *r, const float *lin, size_t px, double ex, int curve, uint8_t *rgb8)
+{
+    size_t p;
+    for (p = 0; p < 3 * px; p++) {
+        double v = (double)lin[p] * ex;
+        union { uint32_t u; float f; } cv;
+        int b;
+        if (curve)
+            v = exposure_curve(v);
+        cv.f = (float)v;
+        if (!(v > 0.0)) {
+            rgb8[p] = 0;
+            continue;
+        }
+        /* a hint from the table, then exact against the thresholds */
+        b = r->lut[cv.u >> 16];
+        while (b > 0 && v < r->thr[b - 1])
+            b--;
+        while (b < 255 && v >= r->thr[b])
+            b++;
+        rgb8[p] = (uint8_t)b;
+    }
+}
+
+const float *render_linear(const render *r)
+{
+    return r->lin;
+}
+
 plx_status render_frame(render *r, const render_camera *cam, const render_opts *o,
                         uint8_t *rgb8, float *rgbf, render_stats *stats)
 {
     render_stats st;
     render_opts def;
     const render_backend *be;
-    size_t px, p;
+    size_t px;
     int inside;
     if (!r)
         return PLX_E_INVALID;
@@ -1094,30 +1158,14 @@ plx_status render_frame(render *r, const render_camera *cam, const render_opts *
     }
     st.drawn_fraction = st.triangles ? (double)st.triangles_drawn / (double)st.triangles : 1.0;
     shade_pass(r, o, &st);
+    /* the exposure from the lit surfaces, before the glows */
+    st.exposure = o->auto_exposure ? exposure_auto(r->lin, r->id, px) : o->exposure;
     if (!o->no_glow)
         glows(r, &st);
     if (rgbf)
         memcpy(rgbf, r->lin, px * 3 * sizeof(float));
-    if (rgb8) {
-        double ex = o->exposure;
-        for (p = 0; p < 3 * px; p++) {
-            double v = (double)r->lin[p] * ex;
-            union { uint32_t u; float f; } cv;
-            int b;
-            cv.f = (float)v;
-            if (!(v > 0.0)) {
-                rgb8[p] = 0;
-                continue;
-            }
-            /* a hint from the table, then exact against the thresholds */
-            b = r->lut[cv.u >> 16];
-            while (b > 0 && v < r->thr[b - 1])
-                b--;
-            while (b < 255 && v >= r->thr[b])
-                b++;
-            rgb8[p] = (uint8_t)b;
-        }
-    }
+    if (rgb8)
+        render_tonemap(r, r->lin, px, st.exposure, o->auto_exposure, rgb8);
     r->err = "";
     if (stats)
         *stats = st;

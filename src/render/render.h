@@ -236,6 +236,9 @@ typedef struct render_opts {
     render_shade_fn indirect;  /* added to E_rgb when not NULL (photon hook) */
     void *indirect_user;
     const render_backend *backend;  /* pass 1; NULL: the built-in software rasteriser */
+    int auto_exposure;         /* 1: exposure from the image and the tone curve (exposure.h) */
+    double shift[2];           /* the sample point of each pixel: its centre + shift (pixels,
+                                  x right, y down; |shift| < 0.5); 0 0 is SPEC §5's centre */
 } render_opts;
 
 void render_opts_default(render_opts *o /* OUT */);
@@ -251,6 +254,7 @@ typedef struct render_stats {
     uint64_t ground_pixels, building_pixels, sky_pixels;
     uint32_t glows;            /* lamp discs drawn */
     int eye_inside;            /* the eye is inside a solid */
+    double exposure;           /* the exposure applied (chosen when auto_exposure) */
 } render_stats;
 
 typedef struct render render;
@@ -280,6 +284,14 @@ plx_status render_frame(render *r, const render_camera *cam, const render_opts *
                         uint8_t *rgb8 /* OUT */, float *rgbf /* OUT */,
                         render_stats *stats /* OUT */);
 
+/* Tone mapping of px pixels of linear RGB: times ex, through the tone
+ * curve when curve (exposure.h), into sRGB bytes (SPEC §5's exact
+ * thresholds). What render_frame does to its own image. */
+void render_tonemap(const render *r, const float *lin, size_t px, double ex, int curve,
+                    uint8_t *rgb8 /* OUT */);
+/* The linear image of the last frame (width*height*3). Valid until the next frame. */
+const float *render_linear(const render *r);
+
 /* The surface id buffer of the last frame (width*height, row 0 on top;
  * MESH_SURF_NONE for sky, MESH_SURF_GROUND for ground) -- for tests and
  * picking. Valid until the next frame. */
@@ -302,6 +314,17 @@ typedef struct render_lightmap_info {
 } render_lightmap_info;
 
 void render_lightmap_get(const render *r, render_lightmap_info *out /* OUT */);
+
+/* Code addresses held by the render object (the shader, the built-in
+ * backend's functions, the rasteriser's fragment function, the error text)
+ * differ between processes: render_code_unbind clears them (before the
+ * object's memory is saved in a bake), render_code_bind sets them again
+ * with shade as the shader (after a bake is loaded). The shader's user
+ * pointer is kept. */
+void render_code_unbind(render *r);
+/* sizeof the render object (opaque elsewhere). */
+size_t render_struct_bytes(void);
+void render_code_bind(render *r, render_shade_fn shade);
 
 /* One fixed sentence about the last failure ("" after success). */
 const char *render_error(const render *r);

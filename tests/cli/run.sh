@@ -127,6 +127,46 @@ printf '{"type": "FeatureCollection", "properties": {"units": "m", "ground_image
 expect ground-image-bad-strict 1 "polarlux info: $tmp/gi/bad\.geojson: properties\.ground_image must be the path of a PNG file" -- "$bin" info --strict "$tmp/gi/bad.geojson"
 expect ground-image-bad-lenient 0 "warning: $tmp/gi/bad\.geojson: properties\.ground_image must be the path of a PNG file \(a non-empty string of at most 4096 bytes\); ignored" -- "$bin" info "$tmp/gi/bad.geojson"
 expect ground-image-nomem 3 "out of memory while storing the ground image" -- "$bin" info --mem 15K fixtures/ground-image.geojson
+# ---- bake files (README "Bake files") ----
+expect bake-help 0 "^usage: polarlux bake" -- "$bin" bake --help
+expect bake-unknown-option 2 "polarlux bake: unknown option '--bogus'" -- "$bin" bake --bogus x
+expect bake-missing-out 2 "missing -o CITY.plxb" -- "$bin" bake fixtures/tiny.geojson
+expect bake-tiny 0 "^baked fixtures/eixample-4x4\.geojson into .*: [0-9]+ bytes .*engine memory in use [0-9]+ bytes" -- \
+    "$bin" bake -q fixtures/eixample-4x4.geojson --frames 2 --photons 4000 --texel 2 --max-size 160x120 -o "$tmp/e.plxb"
+expect bake-info 0 "^bake: [0-9]+ bytes \([0-9.]+ MB\) loaded in [0-9.]+ ms" -- "$bin" info "$tmp/e.plxb"
+expect bake-info-memory 0 "^memory: [0-9]+ bytes in use" -- "$bin" info "$tmp/e.plxb"
+printf '0.5 0.5\n10 -3\n61 61\n' >"$tmp/bp.txt"
+"$bin" vis -q fixtures/eixample-4x4.geojson --points "$tmp/bp.txt" >"$tmp/v1" 2>&1
+expect bake-vis 0 "" -- "$bin" vis -q "$tmp/e.plxb" --points "$tmp/bp.txt"
+if cmp -s "$tmp/out" "$tmp/v1"; then echo "ok   bake-vis-same"; pass=$((pass + 1)); else echo "FAIL bake-vis-same"; fail=$((fail + 1)); fi
+"$bin" render -q fixtures/eixample-4x4.geojson --no-indirect --size 160x120 -o "$tmp/r1.png" --pfm "$tmp/r1.pfm" >/dev/null 2>&1
+expect bake-render 0 "street view 160x120" -- "$bin" render -q "$tmp/e.plxb" --no-indirect --size 160x120 -o "$tmp/r2.png" --pfm "$tmp/r2.pfm"
+if cmp -s "$tmp/r1.pfm" "$tmp/r2.pfm"; then echo "ok   bake-render-same"; pass=$((pass + 1)); else echo "FAIL bake-render-same"; fail=$((fail + 1)); fi
+head -c 5000 "$tmp/e.plxb" >"$tmp/cut.plxb"
+expect bake-truncated 1 "^polarlux info: $tmp/cut\.plxb: truncated bake file: 5000 bytes, the header says [0-9]+$" -- "$bin" info "$tmp/cut.plxb"
+expect bake-version 1 "^polarlux render: tests/corpus/bake-version-99\.plxb: bake format version 99, this polarlux reads version 1; bake the scene again$" -- \
+    "$bin" render tests/corpus/bake-version-99.plxb -o "$tmp/x.png"
+expect bake-arch 1 "bake made on another architecture" -- "$bin" vis tests/corpus/bake-big-endian.plxb --at 0,0
+expect bake-nomem 3 "the block is too small for the bake" -- "$bin" info --mem 64K "$tmp/e.plxb"
+# ---- walk (README "Walking through a city") ----
+expect walk-help 0 "^usage: polarlux walk" -- "$bin" walk --help
+expect walk-unknown-option 2 "polarlux walk: unknown option '--bogus'" -- "$bin" walk --bogus x
+expect walk-missing-path 2 "missing --path CAMERA.geojson" -- "$bin" walk "$tmp/e.plxb" -o "$tmp/w"
+printf '{"type":"Feature","properties":{"units":"m"},"geometry":{"type":"LineString","coordinates":[[298.6,265.5,1.7],[270,294,1.7],[262,330]]}}' >"$tmp/path.geojson"
+expect walk-exact 0 "^frame time: median [0-9.]+ ms, p95 [0-9.]+ ms, mean [0-9.]+ ms: [0-9.]+ frames per second" -- \
+    "$bin" walk -q "$tmp/e.plxb" --path "$tmp/path.geojson" --size 160x120 --fps 0.2 --aa 1 --no-indirect --no-glow --exposure 1 -o "$tmp/w1"
+set -- $(sed -n '3p' "$tmp/w1/cameras.txt")
+"$bin" render -q "$tmp/e.plxb" --size 160x120 --no-indirect --no-glow --exposure 1 --eye "$2,$3,$4" --target "$5,$6,$7" -o "$tmp/w1r.png" >/dev/null 2>&1
+if cmp -s "$tmp/w1/frame-0002.png" "$tmp/w1r.png"; then echo "ok   walk-exact-equals-render"; pass=$((pass + 1)); else echo "FAIL walk-exact-equals-render"; fail=$((fail + 1)); fi
+expect walk-default 0 "^walk: [0-9]+ frames 160x120 .*aa 2" -- "$bin" walk -q "$tmp/e.plxb" --path "$tmp/path.geojson" --size 160x120 --fps 0.1 -o "$tmp/w2"
+set -- $(sed -n '2p' "$tmp/w2/cameras.txt")
+"$bin" render -q "$tmp/e.plxb" --size 160x120 --aa 2 --eye "$2,$3,$4" --target "$5,$6,$7" -o "$tmp/w2r.png" >/dev/null 2>&1
+if cmp -s "$tmp/w2/frame-0001.png" "$tmp/w2r.png"; then echo "ok   walk-default-equals-render"; pass=$((pass + 1)); else echo "FAIL walk-default-equals-render"; fail=$((fail + 1)); fi
+if [ -s "$tmp/w2/contact.png" ]; then echo "ok   walk-contact-sheet"; pass=$((pass + 1)); else echo "FAIL walk-contact-sheet"; fail=$((fail + 1)); fi
+printf '{"type":"LineString","coordinates":[[1,2]]}' >"$tmp/short.geojson"
+expect walk-short-path 1 "^polarlux walk: $tmp/short\.geojson: the LineString needs at least 2 positions$" -- "$bin" walk -q "$tmp/e.plxb" --path "$tmp/short.geojson" -o "$tmp/w3"
+expect render-aa-bad 2 "--aa '0' is not a whole number from 1 to 16" -- "$bin" render fixtures/tiny.geojson --aa 0 -o "$tmp/x.png"
+expect render-auto-exposure 0 "^exposure: [0-9.e+-]+ \(automatic" -- "$bin" render -q "$tmp/e.plxb" --size 160x120 -o "$tmp/ae.png"
 # photometric lamps (SPEC §2.1), light meters anywhere (§2) and pedestrian metrics (§6)
 expect info-photometry 0 "^photometry: photometry/street-type2\\.ies \\(IES\\) for 584 lamps; lamp 0: peak 2966\\.8 cd, flux 6283\\.2 lm, dark from gamma 90\\.0 deg$" -- "$bin" info -q fixtures/helsinki-street-luminaires.geojson
 expect meter-help 0 "^usage: polarlux meter" -- "$bin" meter --help

@@ -1,0 +1,196 @@
+/* polarlux bake SCENE -o city.plxb: everything built once, saved in one file
+ * that every command taking a SCENE loads without rebuilding. */
+#include <stdlib.h>
+#include <string.h>
+
+#include "cli.h"
+#include "port.h"
+
+static const char help[] =
+    "usage: polarlux bake SCENE -o CITY.plxb [--photons N] [--frames K] [--no-indirect]\n"
+    "                     [--no-aerial] [--texel M] [--max-size WxH] [--mem SIZE] [--strict] [--quiet]\n"
+    "\n"
+    "Loads SCENE and builds everything queries and frames need: polar diagrams,\n"
+    "lamp light, photon buffers with K frames of N photons (levels for a viewer\n"
+    "at the centre, all around), the renderer for frames up to --max-size and\n"
+    "the aerial light map; then writes it all to one file. Every command that\n"
+    "takes a SCENE also takes the bake file and starts at once (README 'Bake\n"
+    "files'). Prints the file size, the engine memory in use and the times.\n"
+    "\n"
+    "  -o FILE         the bake file (required)\n"
+    "  --photons N     photons per frame (default 65536)\n"
+    "  --frames K      photon frames (default 256)\n"
+    "  --no-indirect   no photon buffers\n"
+    "  --no-aerial     no aerial light map\n"
+    "  --texel M       aerial light map resolution (default 1 m, coarser if the budget needs)\n"
+    "  --max-size WxH  the largest frame the loaded engine renders (default 1024x768)\n"
+    "  --mem SIZE, --strict, --quiet   as for 'polarlux info'\n"
+    "\n"
+    "Exit codes: 0 written, 1 the scene or the file failed, 2 usage, 3 --mem too small.\n";
+
+typedef struct bake_args {
+    const char *scene, *out;
+    cli_common c;
+    cli_indirect ind;
+    plx_bake_opts o;
+} bake_args;
+
+static int parse_args(int argc, char **argv, bake_args *a)
+{
+    int i;
+    long w, h;
+    char extra;
+    memset(a, 0, sizeof *a);
+    cli_indirect_default(&a->ind);
+    a->o.aerial = 1;
+    a->c.render_w = 1024;
+    a->c.render_h = 768;
+    for (i = 1; i < argc; i++) {
+        const char *s = argv[i];
+        int r = cli_common_option("bake", argc, argv, &i, &a->c);
+        if (r == 0)
+            r = cli_indirect_option("bake", argc, argv, &i, &a->ind);
+        if (r < 0)
+            return EXIT_USAGE;
+        if (r)
+            continue;
+        if (strcmp(s, "--help") == 0 || strcmp(s, "-h") == 0) {
+            fputs(help, stdout);
+            return -1;
+        }
+        if (strcmp(s, "--no-aerial") == 0) {
+            a->o.aerial = 0;
+        } else if (strcmp(s, "-o") == 0 || strcmp(s, "--texel") == 0 || strcmp(s, "--max-size") == 0) {
+            const char *v;
+            if (i + 1 >= argc)
+                return cli_usage_error("bake", "%s needs a value", s);
+            v = argv[++i];
+            if (strcmp(s, "-o") == 0) {
+                a->out = v;
+            } else if (strcmp(s, "--texel") == 0) {
+                if (cli_parse_double(v, &a->o.aerial_m_per_texel) != 0 || !(a->o.aerial_m_per_texel > 0))
+                    return cli_usage_error("bake", "--texel '%s' is not a positive number of metres", v);
+            } else {
+                if (sscanf(v, "%ldx%ld%c", &w, &h, &extra) != 2 || w < 1 || h < 1 || w > 8192 || h > 8192)
+                    return cli_usage_error("bake", "--max-size '%s' is not WxH (1..8192 each)", v);
+                a->c.render_w = (int)w;
+                a->c.render_h = (int)h;
+            }
+        } else if (s[0] == '-' && s[1] != '\0') {
+            return cli_usage_error("bake", "unknown option '%s'", s);
+        } else if (!a->scene) {
+            a->scene = s;
+        } else {
+            return cli_usage_error("bake", "unexpected argument '%s'", s);
+        }
+    }
+    if (!a->scene)
+        return cli_usage_error("bake", "missing SCENE");
+    if (!a->out)
+        return cli_usage_error("bake", "missing -o CITY.plxb");
+    a->o.no_indirect = a->ind.off;
+    return EXIT_OK;
+}
+
+/* An engine in a zeroed block (calloc: the twin's sits alike modulo 64),
+ * with the scene loaded and everything prepared. */
+static int make_engine(const bake_args *a, int twin, plx_engine **e)
+{
+    size_t mem = a->c.mem ? a->c.mem : CLI_DEFAULT_MEM;
+    plx_config cfg;
+    plx_bake_opts o = a->o;
+    void *block;
+    plx_status st;
+    int rc;
+    *e = NULL;
+    /* zeros (calloc of a large block takes fresh pages, nothing written):
+     * the bake saves every byte of the arena's used end, padding and
+     * never-written bytes included, which must be defined */
+    if (!(block = calloc(1, mem))) {
+        fprintf(stderr, "polarlux bake: cannot take a block of %zu bytes\n", mem);
+        return EXIT_NOMEM;
+    }
+    cli_config(&a->c, &cfg);
+    if (twin) {
+        static plx_port silent;
+        silent = *cfg.port;
+        silent.log = NULL; /* the twin's warnings were printed once already */
+        cfg.port = &silent;
+    }
+    st = plx_engine_create(block, mem, &cfg, e);
+    if (st != PLX_OK) {
+        fprintf(stderr, "polarlux bake: cannot create an engine of %zu bytes: %s\n", mem, plx_strerror(st));
+        free(block);
+        return cli_exit_code(st);
+    }
+    rc = cli_load_scene("bake", a->scene, &a->c, e);
+    if (rc != EXIT_OK)
+        return rc;
+    o.twin = twin;
+    st = plx_bake_prepare(*e, &o);
+    if (st != PLX_OK) {
+        fprintf(stderr, "polarlux bake: %s\n", plx_last_error(*e));
+        plx_engine_free(*e);
+        *e = NULL;
+        return st == PLX_E_NOMEM ? EXIT_NOMEM : EXIT_FAIL;
+    }
+    return EXIT_OK;
+}
+
+static int save(const bake_args *a, plx_engine *e, plx_engine *t, size_t *bytes)
+{
+    char err[512];
+    void *buf;
+    plx_status st = plx_bake_size(e, t, bytes);
+    if (st == PLX_OK) {
+        buf = malloc(*bytes);
+        if (!buf) {
+            fprintf(stderr, "polarlux bake: out of memory for a %zu-byte file\n", *bytes);
+            return EXIT_FAIL;
+        }
+        st = plx_bake_save(e, t, buf, *bytes, bytes);
+        if (st == PLX_OK && port_write_atomic(a->out, buf, *bytes, err, sizeof err) != 0) {
+            fprintf(stderr, "polarlux bake: %s\n", err);
+            free(buf);
+            return EXIT_FAIL;
+        }
+        free(buf);
+    }
+    if (st != PLX_OK) {
+        fprintf(stderr, "polarlux bake: %s\n", plx_last_error(e));
+        return EXIT_FAIL;
+    }
+    return EXIT_OK;
+}
+
+int cmd_bake(int argc, char **argv)
+{
+    bake_args a;
+    plx_engine *e = NULL, *t = NULL;
+    plx_memory_report m;
+    unsigned long long t0 = port_now_ns(), t1, t2;
+    size_t bytes = 0;
+    int rc = parse_args(argc, argv, &a);
+    if (rc != EXIT_OK)
+        return rc < 0 ? EXIT_OK : rc;
+    rc = make_engine(&a, 0, &e);
+    t1 = port_now_ns();
+    if (rc == EXIT_OK)
+        rc = cli_indirect_run("bake", e, &a.ind, NULL, NULL, 60.0);
+    t2 = port_now_ns();
+    if (rc == EXIT_OK)
+        rc = make_engine(&a, 1, &t);
+    if (rc == EXIT_OK)
+        rc = save(&a, e, t, &bytes);
+    if (rc == EXIT_OK) {
+        plx_memory_get(e, &m);
+        printf("baked %s into %s: %zu bytes (%.1f MB); engine memory in use %zu bytes (%.1f MB)\n", a.scene,
+               a.out, bytes, bytes / 1048576.0, m.used_total, m.used_total / 1048576.0);
+        printf("times: load and build %.0f ms, photons %.0f ms (%ld x %ld), twin and save %.0f ms, "
+               "total %.2f s\n", (t1 - t0) / 1e6, (t2 - t1) / 1e6, a.ind.off ? 0L : a.ind.frames,
+               a.ind.photons, (port_now_ns() - t2) / 1e6, (port_now_ns() - t0) / 1e9);
+    }
+    plx_engine_free(t);
+    plx_engine_free(e);
+    return rc;
+}

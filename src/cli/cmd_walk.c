@@ -1,0 +1,339 @@
+/* polarlux walk: frames along a camera path (README "Walking through a city"). */
+#include <errno.h>
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+
+#include "cli.h"
+#include "port.h"
+#include "png/image_write.h"
+#include "walk_path.h"
+
+static const char help[] =
+    "usage: polarlux walk SCENE|BAKE --path CAMERA.geojson -o DIR [--size WxH] [--fps F]\n"
+    "                     [--speed M/S] [--fov DEG] [--aa N] [--exposure E] [--no-glow]\n"
+    "                     [--no-indirect] [--view street|aerial] [--max-frames N]\n"
+    "\n"
+    "Renders frames along a camera path and writes DIR/frame-0001.png ...,\n"
+    "DIR/cameras.txt (frame, eye, target) and DIR/contact.png (a contact sheet\n"
+    "of up to 16 frames). Everything is built once (or loaded from a bake) and\n"
+    "reused by every frame. Prints the render time per frame (median, p95)\n"
+    "and frames per second.\n"
+    "\n"
+    "  --path FILE      a GeoJSON LineString of eye positions [x, y] or [x, y, z]\n"
+    "                   (z default 1.7 m); the eye looks 10 m ahead along the path,\n"
+    "                   or at properties.targets (one [x, y, z] per position)\n"
+    "  --size WxH       frame size (default 640x480)\n"
+    "  --fps F          frames per second of the walk (default 25)\n"
+    "  --speed M/S      walking speed along the path (default 1.4)\n"
+    "  --fov DEG        vertical field of view (default 60)\n"
+    "  --aa N           N x N samples per pixel (default 2; 1: pixel centres, SPEC §5)\n"
+    "  --exposure E     fixed exposure, no tone curve (default: automatic per frame)\n"
+    "  --no-glow, --no-indirect, --view V, --photons N, --frames K   as for render\n"
+    "  --max-frames N   at most N frames (default 1000)\n"
+    "  --refine         near-viewer refinement (munoz2013 §3.3-3.4): before each frame\n"
+    "                   the lamps near the eye get floor photon maps in an LRU cache,\n"
+    "                   pushed into the aerial map; then --refine-frames K photon\n"
+    "                   frames (default 2) refill the aerial chart. Prints the cache's\n"
+    "                   hits, misses and evictions\n"
+    "  --mem SIZE, --strict, --quiet   as for 'polarlux info'\n";
+
+typedef struct walk_args {
+    const char *scene, *path, *dir;
+    int w, h, aerial, refine;
+    long refine_frames;
+    long max_frames;
+    double fps, speed, fov;
+    plx_render_opts opts;
+    cli_common c;
+    cli_indirect ind;
+} walk_args;
+
+static int parse_value(walk_args *a, const char *opt, const char *val)
+{
+    long w, h, n;
+    char extra;
+    if (strcmp(opt, "--path") == 0) {
+        a->path = val;
+    } else if (strcmp(opt, "-o") == 0) {
+        a->dir = val;
+    } else if (strcmp(opt, "--size") == 0) {
+        if (sscanf(val, "%ldx%ld%c", &w, &h, &extra) != 2 || w < 1 || h < 1 || w > 8192 || h > 8192)
+            return cli_usage_error("walk", "--size '%s' is not WxH (1..8192 each)", val);
+        a->w = (int)w;
+        a->h = (int)h;
+    } else if (strcmp(opt, "--fps") == 0 || strcmp(opt, "--speed") == 0) {
+        double *v = strcmp(opt, "--fps") == 0 ? &a->fps : &a->speed;
+        if (cli_parse_double(val, v) != 0 || !(*v > 0) || *v > 1e4)
+            return cli_usage_error("walk", "%s '%s' is not a positive number", opt, val);
+    } else if (strcmp(opt, "--fov") == 0) {
+        if (cli_parse_double(val, &a->fov) != 0 || !(a->fov > 0 && a->fov < 180))
+            return cli_usage_error("walk", "--fov '%s' is not between 0 and 180 degrees", val);
+    } else if (strcmp(opt, "--aa") == 0) {
+        if (cli_parse_int(val, 1, PLX_RENDER_MAX_AA, &n) != 0)
+            return cli_usage_error("walk", "--aa '%s' is not a whole number from 1 to %d", val, PLX_RENDER_MAX_AA);
+        a->opts.aa = (int)n;
+    } else if (strcmp(opt, "--exposure") == 0) {
+        if (cli_parse_double(val, &a->opts.exposure) != 0 || !(a->opts.exposure >= 0))
+            return cli_usage_error("walk", "--exposure '%s' is not a number >= 0", val);
+        a->opts.auto_exposure = 0;
+    } else if (strcmp(opt, "--view") == 0) {
+        if (strcmp(val, "street") && strcmp(val, "aerial"))
+            return cli_usage_error("walk", "--view '%s' is not street or aerial", val);
+        a->aerial = strcmp(val, "aerial") == 0;
+    } else if (strcmp(opt, "--refine-frames") == 0) {
+        if (cli_parse_int(val, 0, 100000, &a->refine_frames) != 0)
+            return cli_usage_error("walk", "--refine-frames '%s' is not a whole number >= 0", val);
+    } else if (strcmp(opt, "--max-frames") == 0) {
+        if (cli_parse_int(val, 1, 1000000, &a->max_frames) != 0)
+            return cli_usage_error("walk", "--max-frames '%s' is not a whole number >= 1", val);
+    } else {
+        return -1;
+    }
+    return EXIT_OK;
+}
+
+static int parse_args(int argc, char **argv, walk_args *a)
+{
+    static const char *const valued[] = { "--path", "-o", "--size", "--fps", "--speed", "--fov", "--aa",
+                                          "--exposure", "--view", "--max-frames", "--refine-frames" };
+    int i;
+    size_t k;
+    memset(a, 0, sizeof *a);
+    plx_render_opts_default(&a->opts);
+    a->opts.auto_exposure = 1;
+    a->opts.aa = 2;
+    cli_indirect_default(&a->ind);
+    a->w = 640;
+    a->h = 480;
+    a->fps = 25;
+    a->speed = 1.4;
+    a->fov = 60;
+    a->max_frames = 1000;
+    a->refine_frames = 2;
+    for (i = 1; i < argc; i++) {
+        const char *s = argv[i];
+        int r = cli_common_option("walk", argc, argv, &i, &a->c);
+        if (r == 0)
+            r = cli_indirect_option("walk", argc, argv, &i, &a->ind);
+        if (r < 0)
+            return EXIT_USAGE;
+        if (r)
+            continue;
+        if (strcmp(s, "--help") == 0 || strcmp(s, "-h") == 0) {
+            fputs(help, stdout);
+            return -1;
+        }
+        if (strcmp(s, "--no-glow") == 0) {
+            a->opts.no_glow = 1;
+            continue;
+        }
+        if (strcmp(s, "--refine") == 0) {
+            a->refine = 1;
+            continue;
+        }
+        for (k = 0; k < sizeof valued / sizeof valued[0]; k++)
+            if (strcmp(s, valued[k]) == 0)
+                break;
+        if (k < sizeof valued / sizeof valued[0]) {
+            if (i + 1 >= argc)
+                return cli_usage_error("walk", "%s needs a value", s);
+            r = parse_value(a, s, argv[++i]);
+            if (r != EXIT_OK)
+                return r;
+        } else if (s[0] == '-' && s[1] != '\0') {
+            return cli_usage_error("walk", "unknown option '%s'", s);
+        } else if (!a->scene) {
+            a->scene = s;
+        } else {
+            return cli_usage_error("walk", "unexpected argument '%s'", s);
+        }
+    }
+    if (!a->scene)
+        return cli_usage_error("walk", "missing SCENE");
+    if (!a->path)
+        return cli_usage_error("walk", "missing --path CAMERA.geojson");
+    if (!a->dir)
+        return cli_usage_error("walk", "missing -o DIR");
+    a->opts.aerial = a->aerial;
+    a->opts.no_indirect = a->ind.off;
+    return EXIT_OK;
+}
+
+static int cmp_double(const void *x, const void *y)
+{
+    double a = *(const double *)x, b = *(const double *)y;
+    return (a > b) - (a < b);
+}
+
+/* A contact sheet: up to 16 frames spread over the walk, 4 to a row,
+ * each shrunk by an integer factor (box filter) to at most 400 pixels wide. */
+static int contact_sheet(const walk_args *a, uint8_t *const *thumbs, int nthumb, int f, char *err, size_t errlen)
+{
+    int tw = a->w / f, th = a->h / f, cols = nthumb < 4 ? nthumb : 4, rows = (nthumb + 3) / 4, k, x, y, c;
+    int W = cols * tw, H = rows * th, rc;
+    uint8_t *sheet = calloc((size_t)W * H * 3, 1);
+    char path[4096];
+    if (!sheet)
+        return snprintf(err, errlen, "out of memory for the contact sheet"), -1;
+    for (k = 0; k < nthumb; k++)
+        for (y = 0; y < th; y++)
+            for (x = 0; x < tw; x++)
+                for (c = 0; c < 3; c++) {
+                    unsigned sum = 0;
+                    int i, j;
+                    for (j = 0; j < f; j++)
+                        for (i = 0; i < f; i++)
+                            sum += thumbs[k][((size_t)(y * f + j) * a->w + (size_t)(x * f + i)) * 3 + c];
+                    sheet[((size_t)((k / 4) * th + y) * W + (size_t)((k % 4) * tw + x)) * 3 + c] =
+                        (uint8_t)((sum + (unsigned)(f * f) / 2) / (unsigned)(f * f));
+                }
+    snprintf(path, sizeof path, "%s/contact.png", a->dir);
+    rc = image_write_png_rgb8(path, W, H, sheet, 0, err, errlen);
+    free(sheet);
+    return rc;
+}
+
+typedef struct walk_run {
+    long n;
+    double *ms;
+    uint8_t *rgb8;
+    uint8_t *thumbs[16];
+    int nthumb;
+    FILE *cams;
+    plx_refine_stats rs;
+    double refine_ms;
+} walk_run;
+
+static int frame(const walk_args *a, plx_engine *e, const walk_path *wp, walk_run *wr, long k, double step)
+{
+    plx_camera cam;
+    plx_render_info info;
+    char path[4096], err[512];
+    unsigned long long t0;
+    plx_status st;
+    memset(&cam, 0, sizeof cam);
+    walk_path_camera(wp, k * step, cam.eye, cam.target);
+    cam.fov_deg = a->fov;
+    cam.width = a->w;
+    cam.height = a->h;
+    if (a->refine && !a->ind.off) {
+        int rc;
+        t0 = port_now_ns();
+        rc = cli_refine("walk", e, cam.eye, a->refine_frames, a->ind.photons, &wr->rs);
+        wr->refine_ms += (port_now_ns() - t0) / 1e6;
+        if (rc != EXIT_OK)
+            return rc;
+    }
+    t0 = port_now_ns();
+    st = plx_render(e, &cam, &a->opts, wr->rgb8, NULL, &info);
+    wr->ms[k] = (port_now_ns() - t0) / 1e6;
+    if (st != PLX_OK) {
+        fprintf(stderr, "polarlux walk: frame %ld at (%.2f, %.2f, %.2f): %s\n", k + 1, cam.eye[0], cam.eye[1],
+                cam.eye[2], plx_last_error(e));
+        return cli_exit_code(st);
+    }
+    fprintf(wr->cams, "%ld %.17g %.17g %.17g %.17g %.17g %.17g %.6g\n", k + 1, cam.eye[0], cam.eye[1], cam.eye[2],
+            cam.target[0], cam.target[1], cam.target[2], info.exposure);
+    snprintf(path, sizeof path, "%s/frame-%04ld.png", a->dir, k + 1);
+    if (image_write_png_rgb8(path, a->w, a->h, wr->rgb8, 0, err, sizeof err) != 0) {
+        fprintf(stderr, "polarlux walk: %s\n", err);
+        return EXIT_FAIL;
+    }
+    if (wr->nthumb < 16 && k == (wr->n >= 16 ? (wr->nthumb * (wr->n - 1)) / 15 : wr->nthumb)) {
+        wr->thumbs[wr->nthumb] = malloc((size_t)a->w * a->h * 3);
+        if (wr->thumbs[wr->nthumb])
+            memcpy(wr->thumbs[wr->nthumb++], wr->rgb8, (size_t)a->w * a->h * 3);
+    }
+    return EXIT_OK;
+}
+
+static int run(const walk_args *a, plx_engine *e, const walk_path *wp)
+{
+    walk_run wr;
+    double L = walk_path_length(wp), step = a->speed / a->fps, *sorted;
+    char path[4096], err[512];
+    int rc = EXIT_OK, f;
+    long k;
+    memset(&wr, 0, sizeof wr);
+    wr.n = (long)floor(L / step) + 1;
+    if (wr.n > a->max_frames)
+        wr.n = a->max_frames;
+    wr.ms = malloc(sizeof *wr.ms * (size_t)wr.n);
+    sorted = malloc(sizeof *sorted * (size_t)wr.n);
+    wr.rgb8 = malloc((size_t)a->w * a->h * 3);
+    snprintf(path, sizeof path, "%s/cameras.txt", a->dir);
+    wr.cams = fopen(path, "w");
+    if (!wr.ms || !sorted || !wr.rgb8 || !wr.cams) {
+        fprintf(stderr, "polarlux walk: %s\n", wr.cams ? "out of memory" : path);
+        rc = EXIT_FAIL;
+    } else {
+        fprintf(wr.cams, "# frame eye_x eye_y eye_z target_x target_y target_z exposure\n");
+    }
+    for (k = 0; rc == EXIT_OK && k < wr.n; k++)
+        rc = frame(a, e, wp, &wr, k, step);
+    for (f = 1; a->w / f > 400; f++)
+        ;
+    if (rc == EXIT_OK && contact_sheet(a, wr.thumbs, wr.nthumb, f, err, sizeof err) != 0) {
+        fprintf(stderr, "polarlux walk: %s\n", err);
+        rc = EXIT_FAIL;
+    }
+    if (rc == EXIT_OK) {
+        double med, p95, sum = 0;
+        memcpy(sorted, wr.ms, sizeof *sorted * (size_t)wr.n);
+        qsort(sorted, (size_t)wr.n, sizeof *sorted, cmp_double);
+        for (k = 0; k < wr.n; k++)
+            sum += sorted[k];
+        med = sorted[wr.n / 2];
+        p95 = sorted[(size_t)ceil(0.95 * wr.n) - 1];
+        printf("walk: %ld frames %dx%d (%.1f m at %.2f m/s, %g fps, aa %d), written to %s/\n", wr.n, a->w, a->h,
+               L, a->speed, a->fps, a->opts.aa > 1 ? a->opts.aa : 1, a->dir);
+        printf("frame time: median %.2f ms, p95 %.2f ms, mean %.2f ms: %.1f frames per second (rendering only)\n",
+               med, p95, sum / wr.n, 1000.0 * wr.n / sum);
+        if (a->refine && !a->ind.off)
+            printf("refinement: %llu hits, %llu misses, %llu evictions, %llu lamps refined (%u slots, %.0f m); "
+                   "%.1f ms in all (floor maps and refill frames)\n", (unsigned long long)wr.rs.hits,
+                   (unsigned long long)wr.rs.misses, (unsigned long long)wr.rs.evictions,
+                   (unsigned long long)wr.rs.refined, wr.rs.slots, wr.rs.near_radius, wr.refine_ms);
+    }
+    if (wr.cams)
+        fclose(wr.cams);
+    for (k = 0; k < wr.nthumb; k++)
+        free(wr.thumbs[k]);
+    free(wr.ms);
+    free(sorted);
+    free(wr.rgb8);
+    return rc;
+}
+
+int cmd_walk(int argc, char **argv)
+{
+    walk_args a;
+    walk_path wp;
+    plx_engine *e;
+    char err[600];
+    int rc = parse_args(argc, argv, &a);
+    if (rc != EXIT_OK)
+        return rc < 0 ? EXIT_OK : rc;
+    if (mkdir(a.dir, 0755) != 0 && errno != EEXIST) {
+        fprintf(stderr, "polarlux walk: %s: cannot create the folder: %s\n", a.dir, strerror(errno));
+        return EXIT_FAIL;
+    }
+    a.c.render_w = a.w;
+    a.c.render_h = a.h;
+    rc = cli_open_scene("walk", a.scene, &a.c, &e);
+    if (rc != EXIT_OK)
+        return rc;
+    if (walk_path_read(a.path, e, &wp, err, sizeof err) != 0) {
+        fprintf(stderr, "polarlux walk: %s\n", err);
+        plx_engine_free(e);
+        return EXIT_FAIL;
+    }
+    rc = cli_indirect_run("walk", e, &a.ind, NULL, NULL, a.fov);
+    if (rc == EXIT_OK)
+        rc = run(&a, e, &wp);
+    walk_path_free(&wp);
+    plx_engine_free(e);
+    return rc;
+}

@@ -1,0 +1,214 @@
+/* Camera paths for polarlux walk (README "Walking through a city"). */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <cjson/cJSON.h>
+
+#include "port.h"
+#include "walk_path.h"
+
+#define EYE_HEIGHT 1.7   /* m, for positions without a height */
+#define LOOK_AHEAD 10.0  /* m along the path */
+
+static int lonlat_range(const cJSON *coords)
+{
+    const cJSON *pos;
+    cJSON_ArrayForEach(pos, coords) {
+        double x = cJSON_GetArrayItem(pos, 0) ? cJSON_GetArrayItem(pos, 0)->valuedouble : 1e9;
+        double y = cJSON_GetArrayItem(pos, 1) ? cJSON_GetArrayItem(pos, 1)->valuedouble : 1e9;
+        if (!(x >= -180 && x <= 180 && y >= -90 && y <= 90))
+            return 0;
+    }
+    return 1;
+}
+
+/* Reads n positions [x, y(, z)] into out (3 per position). */
+static int read_positions(const cJSON *coords, int project, const plx_scene_info *si, double *out, int n,
+                          char *why, size_t whylen)
+{
+    double coslat = cos(si->lat0 * 3.14159265358979323846 / 180.0);
+    int k;
+    for (k = 0; k < n; k++) {
+        const cJSON *pos = cJSON_GetArrayItem(coords, k);
+        const cJSON *x = cJSON_GetArrayItem(pos, 0), *y = cJSON_GetArrayItem(pos, 1), *z = cJSON_GetArrayItem(pos, 2);
+        if (!cJSON_IsNumber(x) || !cJSON_IsNumber(y) || (z && !cJSON_IsNumber(z)) || !isfinite(x->valuedouble) ||
+            !isfinite(y->valuedouble) || (z && !isfinite(z->valuedouble))) {
+            snprintf(why, whylen, "position %d is not [x, y] or [x, y, z] of finite numbers", k);
+            return -1;
+        }
+        out[3 * k] = x->valuedouble;
+        out[3 * k + 1] = y->valuedouble;
+        out[3 * k + 2] = z ? z->valuedouble : EYE_HEIGHT;
+        if (project) {
+            out[3 * k] = (out[3 * k] - si->lon0) * 111320.0 * coslat;
+            out[3 * k + 1] = (out[3 * k + 1] - si->lat0) * 110540.0;
+        }
+        if (!(out[3 * k + 2] > 0)) {
+            snprintf(why, whylen, "position %d: the eye must be above the ground (z > 0)", k);
+            return -1;
+        }
+    }
+    return 0;
+}
+
+static const cJSON *first_line(const cJSON *root, const cJSON **props)
+{
+    const cJSON *type = cJSON_GetObjectItemCaseSensitive(root, "type"), *ft;
+    *props = NULL;
+    if (cJSON_IsString(type) && strcmp(type->valuestring, "LineString") == 0)
+        return root;
+    if (cJSON_IsString(type) && strcmp(type->valuestring, "Feature") == 0) {
+        const cJSON *g = cJSON_GetObjectItemCaseSensitive(root, "geometry");
+        *props = cJSON_GetObjectItemCaseSensitive(root, "properties");
+        return first_line(g, &ft) ? g : NULL;
+    }
+    cJSON_ArrayForEach(ft, cJSON_GetObjectItemCaseSensitive(root, "features")) {
+        const cJSON *p, *g = first_line(ft, &p);
+        if (g) {
+            *props = p;
+            return g;
+        }
+    }
+    return NULL;
+}
+
+/* properties.units = "m": the path is in local metres (as for scenes). */
+static int metres_props(const cJSON *props)
+{
+    const cJSON *u = cJSON_GetObjectItemCaseSensitive(props, "units");
+    return cJSON_IsString(u) && strcmp(u->valuestring, "m") == 0;
+}
+
+static int metres(const cJSON *root)
+{
+    return root && metres_props(cJSON_GetObjectItemCaseSensitive(root, "properties"));
+}
+
+static int parse(const cJSON *root, plx_engine *e, walk_path *wp, char *why, size_t whylen)
+{
+    const cJSON *props, *line = first_line(root, &props), *coords, *targets;
+    plx_scene_info si;
+    int n, project;
+    if (!line) {
+        snprintf(why, whylen, "no LineString (a Feature, a FeatureCollection or a bare geometry)");
+        return -1;
+    }
+    coords = cJSON_GetObjectItemCaseSensitive(line, "coordinates");
+    n = cJSON_GetArraySize(coords);
+    if (!cJSON_IsArray(coords) || n < 2) {
+        snprintf(why, whylen, "the LineString needs at least 2 positions");
+        return -1;
+    }
+    plx_scene_info_get(e, &si);
+    project = si.lonlat && lonlat_range(coords) && !metres(root) && !metres(props ? root : NULL);
+    if (props && metres_props(props))
+        project = 0;
+    wp->n = (uint32_t)n;
+    wp->eye = malloc(sizeof(double) * 3 * (size_t)n);
+    targets = cJSON_GetObjectItemCaseSensitive(props, "targets");
+    if (targets && (!cJSON_IsArray(targets) || cJSON_GetArraySize(targets) != n)) {
+        snprintf(why, whylen, "properties.targets must hold one [x, y, z] per position (%d)", n);
+        return -1;
+    }
+    if (targets)
+        wp->target = malloc(sizeof(double) * 3 * (size_t)n);
+    if (!wp->eye || (targets && !wp->target)) {
+        snprintf(why, whylen, "out of memory");
+        return -1;
+    }
+    if (read_positions(coords, project, &si, wp->eye, n, why, whylen) != 0)
+        return -1;
+    if (targets && read_positions(targets, project, &si, wp->target, n, why, whylen) != 0) {
+        char inner[320];
+        snprintf(inner, sizeof inner, "%s", why);
+        snprintf(why, whylen, "properties.targets: %.200s", inner);
+        return -1;
+    }
+    return 0;
+}
+
+int walk_path_read(const char *path, plx_engine *e, walk_path *wp, char *err, size_t errlen)
+{
+    size_t len;
+    char why[300];
+    char *text;
+    cJSON *root;
+    int rc;
+    memset(wp, 0, sizeof *wp);
+    text = port_read_text(path, &len, why, sizeof why);
+    if (!text) {
+        snprintf(err, errlen, "%s: %s", path, why);
+        return -1;
+    }
+    root = cJSON_ParseWithLength(text, len);
+    free(text);
+    if (!root) {
+        snprintf(err, errlen, "%s: malformed JSON", path);
+        return -1;
+    }
+    rc = parse(root, e, wp, why, sizeof why);
+    cJSON_Delete(root);
+    if (rc != 0) {
+        snprintf(err, errlen, "%s: %s", path, why);
+        walk_path_free(wp);
+        return -1;
+    }
+    return 0;
+}
+
+void walk_path_free(walk_path *wp)
+{
+    free(wp->eye);
+    free(wp->target);
+    memset(wp, 0, sizeof *wp);
+}
+
+double walk_path_length(const walk_path *wp)
+{
+    double L = 0;
+    uint32_t k;
+    for (k = 1; k < wp->n; k++)
+        L += hypot(hypot(wp->eye[3 * k] - wp->eye[3 * k - 3], wp->eye[3 * k + 1] - wp->eye[3 * k - 2]),
+                   wp->eye[3 * k + 2] - wp->eye[3 * k - 1]);
+    return L;
+}
+
+/* The point at arc length s (clamped to the path; beyond its end it goes on
+ * along the last segment), of the eye polyline or, with the same
+ * parameter, of the targets. */
+static void at(const walk_path *wp, const double *pts, double s, double out[3])
+{
+    uint32_t k;
+    double acc = 0;
+    for (k = 1; k < wp->n; k++) {
+        const double *a = wp->eye + 3 * (k - 1), *b = wp->eye + 3 * k;
+        double seg = hypot(hypot(b[0] - a[0], b[1] - a[1]), b[2] - a[2]), t;
+        int c;
+        if (s > acc + seg && k + 1 < wp->n) {
+            acc += seg;
+            continue;
+        }
+        t = seg > 0 ? (s - acc) / seg : 0;
+        if (t < 0)
+            t = 0;
+        if (pts != wp->eye && t > 1)
+            t = 1;
+        for (c = 0; c < 3; c++)
+            out[c] = pts[3 * (k - 1) + c] + t * (pts[3 * k + c] - pts[3 * (k - 1) + c]);
+        return;
+    }
+}
+
+void walk_path_camera(const walk_path *wp, double s, double eye[3], double target[3])
+{
+    at(wp, wp->eye, s, eye);
+    if (wp->target) {
+        at(wp, wp->target, s, target);
+    } else {
+        at(wp, wp->eye, s + LOOK_AHEAD, target);
+        target[2] = eye[2];
+    }
+    if (target[0] == eye[0] && target[1] == eye[1] && target[2] == eye[2])
+        target[0] += 1.0;
+}

@@ -1,0 +1,62 @@
+/* exposure: automatic exposure and the tone curve of night images
+ * (README "Automatic exposure").
+ *
+ * A night street is mostly black with small, very bright patches under the
+ * lamps, so the mean says little. The exposure maps a high percentile of
+ * the luminance of the lit surface pixels (EXPOSURE_PERCENTILE of the
+ * pixels with Y > 0 that show a surface, not the sky) to EXPOSURE_KEY; the
+ * tone curve (extended Reinhard, white point EXPOSURE_WHITE) then rolls
+ * off the highlights near lamps instead of clipping them. The percentile
+ * comes from a histogram of log2 Y in eighth stops: O(pixels), no sort,
+ * the same for any pixel order.
+ */
+#include <math.h>
+#include <string.h>
+
+#include "render/exposure.h"
+
+#define BINS 512           /* log2 Y from -32 to +32 in eighth stops */
+#define LOG_MIN (-32.0)
+#define PER_STOP 8.0
+
+static double luminance(const float *c)
+{
+    return 0.2126 * c[0] + 0.7152 * c[1] + 0.0722 * c[2];
+}
+
+double exposure_auto(const float *lin, const uint32_t *id, size_t px)
+{
+    uint32_t hist[BINS];
+    size_t p, n = 0, want, acc = 0;
+    int b;
+    memset(hist, 0, sizeof hist);
+    for (p = 0; p < px; p++) {
+        double y = luminance(lin + 3 * p), l;
+        if (id[p] == EXPOSURE_SKY || !(y > 0.0) || !isfinite(y))
+            continue;
+        l = (log2(y) - LOG_MIN) * PER_STOP;
+        b = l < 0 ? 0 : l >= BINS ? BINS - 1 : (int)l;
+        hist[b]++;
+        n++;
+    }
+    if (n == 0)
+        return 1.0;
+    want = (size_t)ceil(EXPOSURE_PERCENTILE * (double)n);
+    for (b = 0; b < BINS; b++) {
+        acc += hist[b];
+        if (acc >= want)
+            break;
+    }
+    if (b >= BINS)
+        b = BINS - 1;
+    /* the bin's upper edge, so the chosen pixel is at most the key */
+    return EXPOSURE_KEY / exp2(LOG_MIN + (b + 1) / PER_STOP);
+}
+
+double exposure_curve(double v)
+{
+    const double w2 = EXPOSURE_WHITE * EXPOSURE_WHITE;
+    if (!(v > 0.0))
+        return 0.0;
+    return v * (1.0 + v / w2) / (1.0 + v);
+}

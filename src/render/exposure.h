@@ -1,0 +1,18 @@
+/* exposure: automatic exposure and the tone curve (exposure.c). */
+#ifndef PLX_EXPOSURE_H
+#define PLX_EXPOSURE_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#define EXPOSURE_PERCENTILE 0.995 /* of the lit surface pixels' luminance ... */
+#define EXPOSURE_KEY 1.0         /* ... mapped to this value before the curve */
+#define EXPOSURE_WHITE 4.0       /* the tone curve reaches 1 here */
+#define EXPOSURE_SKY 0u          /* the id of sky pixels (MESH_SURF_NONE) */
+
+/* The exposure for px pixels of linear RGB lin with surface ids id. */
+double exposure_auto(const float *lin, const uint32_t *id, size_t px);
+/* The tone curve: v (1 + v / W^2) / (1 + v), 0 for v <= 0 or NaN. */
+double exposure_curve(double v);
+
+#endif

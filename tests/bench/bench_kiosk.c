@@ -1,0 +1,240 @@
+/* bench_kiosk: bake once, then walk at frame rate (issue "Kiosk mode").
+ *
+ * City: gen eixample 30 30 (14,400 buildings). In one process:
+ *  - baseline, today's render path from the GeoJSON: load, photon frames,
+ *    one 640x480 street frame with indirect light, one 1024x768 aerial
+ *    frame (which builds the light map);
+ *  - the bake: load, plx_bake_prepare (polar, light, photons, renderer,
+ *    light map), the same photon frames, the twin, plx_bake_save;
+ *  - loading the bake into a block touched beforehand (median of 5);
+ *  - a street walk (640x480, indirect, one sample per pixel) and an aerial
+ *    walk (1024x768) from the loaded engine: median and p95 per frame.
+ * Wall-clock and thread CPU times: the build machine is shared, CPU time
+ * is the steadier figure. PLX_BENCH_FRAMES photon frames of 65,536
+ * (default 64; the command's default is 256).
+ */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+#include "polarlux.h"
+#include "polarlux_port.h"
+#include "port.h"
+#include "gen_text.h"
+
+#define MEM ((size_t)1536 << 20)
+
+static double cpu_ms(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+    return ts.tv_sec * 1e3 + ts.tv_nsec / 1e6;
+}
+
+static double wall_ms(void)
+{
+    return port_now_ns() / 1e6;
+}
+
+static int cmp_double(const void *x, const void *y)
+{
+    double a = *(const double *)x, b = *(const double *)y;
+    return (a > b) - (a < b);
+}
+
+static plx_engine *engine(void **mem, int max_w, int max_h, int quiet)
+{
+    plx_config cfg;
+    static plx_port silent;
+    plx_engine *e = NULL;
+    if (!(*mem = calloc(1, MEM)))
+        return NULL;
+    plx_config_default(&cfg);
+    silent = *plx_port_posix();
+    if (quiet)
+        silent.log = NULL;
+    cfg.port = &silent;
+    cfg.render_max_width = max_w;
+    cfg.render_max_height = max_h;
+    if (plx_engine_create(*mem, MEM, &cfg, &e) != PLX_OK)
+        return NULL;
+    return e;
+}
+
+static int trace(plx_engine *e, int frames)
+{
+    int k;
+    for (k = 0; k < frames; k++)
+        if (plx_indirect_step(e, 65536, (uint64_t)k + 1) != PLX_OK)
+            return -1;
+    return 0;
+}
+
+static void street_cam(plx_camera *c, double s)
+{
+    memset(c, 0, sizeof *c);
+    c->eye[0] = 133.0;
+    c->eye[1] = 1000.0 + s;
+    c->eye[2] = 1.7;
+    c->target[0] = 133.0;
+    c->target[1] = 1400.0 + s;
+    c->target[2] = 6.0;
+    c->fov_deg = 60;
+    c->width = 640;
+    c->height = 480;
+}
+
+static void aerial_cam(plx_camera *c, double s)
+{
+    memset(c, 0, sizeof *c);
+    c->eye[0] = 1900.0 + s;
+    c->eye[1] = 1100.0;
+    c->eye[2] = 700.0;
+    c->target[0] = 1950.0 + s;
+    c->target[1] = 1900.0;
+    c->fov_deg = 50;
+    c->width = 1024;
+    c->height = 768;
+}
+
+/* n frames along a path: median and p95 wall ms, mean CPU ms. */
+static void walk(plx_engine *e, int aerial, int n, uint8_t *rgb8, double *med, double *p95, double *cpu)
+{
+    double *t = malloc(sizeof *t * (size_t)n), c0 = cpu_ms();
+    plx_render_opts o;
+    int k;
+    plx_render_opts_default(&o);
+    o.aerial = aerial;
+    o.auto_exposure = 1;
+    for (k = 0; k < n; k++) {
+        plx_camera cam;
+        double w0 = wall_ms();
+        if (aerial)
+            aerial_cam(&cam, 4.0 * k);
+        else
+            street_cam(&cam, 1.4 * k);
+        if (plx_render(e, &cam, &o, rgb8, NULL, NULL) != PLX_OK)
+            printf("  render failed: %s\n", plx_last_error(e));
+        t[k] = wall_ms() - w0;
+    }
+    *cpu = (cpu_ms() - c0) / n;
+    qsort(t, (size_t)n, sizeof *t, cmp_double);
+    *med = t[n / 2];
+    *p95 = t[(int)ceil(0.95 * n) - 1];
+    free(t);
+}
+
+int main(void)
+{
+    text city = { NULL, 0, 0 };
+    void *ma, *mb, *mc, *md;
+    plx_engine *a, *b, *c, *d;
+    plx_render_opts o;
+    plx_camera cam;
+    plx_bake_opts bo;
+    plx_memory_report m;
+    uint8_t *rgb8 = malloc(1024 * 768 * 3);
+    const char *env = getenv("PLX_BENCH_FRAMES");
+    int frames = env ? atoi(env) : 64, k;
+    double w0, c0, cb, cl = 0, base_load, base_ph, base_street, base_aerial, bake_w, bake_c, loads[5];
+    double sm, sp, sc, am, ap, ac;
+    size_t len = 0, need = 0;
+    unsigned char *file;
+    char err[256];
+    if (plx_gen_city("eixample", 30, 30, 1, append, &city) != PLX_OK || !rgb8)
+        return 1;
+    printf("city: gen eixample 30 30 (%.1f MB of GeoJSON); photons: %d frames x 65,536\n", city.len / 1e6, frames);
+
+    /* baseline: today's render path from the GeoJSON */
+    d = engine(&md, 1024, 768, 1);
+    cb = cpu_ms();
+    w0 = wall_ms();
+    if (!d || plx_load_geojson(d, city.buf, city.len, "eixample") != PLX_OK)
+        return 1;
+    base_load = wall_ms() - w0;
+    w0 = wall_ms();
+    trace(d, frames);
+    base_ph = wall_ms() - w0;
+    plx_render_opts_default(&o);
+    street_cam(&cam, 0);
+    w0 = wall_ms();
+    plx_render(d, &cam, &o, rgb8, NULL, NULL);
+    base_street = wall_ms() - w0;
+    o.aerial = 1;
+    aerial_cam(&cam, 0);
+    w0 = wall_ms();
+    plx_render(d, &cam, &o, rgb8, NULL, NULL);
+    base_aerial = wall_ms() - w0;
+    cb = cpu_ms() - cb;
+    plx_memory_get(d, &m);
+    printf("baseline (render from the GeoJSON): load %.0f ms, photons %.0f ms, first street frame %.0f ms, "
+           "first aerial frame %.0f ms (light map included), wall; %.2f s CPU in all; engine memory %.1f MB\n",
+           base_load, base_ph, base_street, base_aerial, cb / 1e3, m.used_total / 1048576.0);
+    plx_engine_destroy(d);
+    free(md);
+
+    /* the bake */
+    memset(&bo, 0, sizeof bo);
+    bo.aerial = 1;
+    w0 = wall_ms();
+    c0 = cpu_ms();
+    a = engine(&ma, 1024, 768, 1);
+    b = engine(&mb, 1024, 768, 1);
+    if (!a || !b || plx_load_geojson(a, city.buf, city.len, "eixample") != PLX_OK ||
+        plx_bake_prepare(a, &bo) != PLX_OK || trace(a, frames) != 0)
+        return 1;
+    bo.twin = 1;
+    if (plx_load_geojson(b, city.buf, city.len, "eixample") != PLX_OK || plx_bake_prepare(b, &bo) != PLX_OK ||
+        plx_bake_size(a, b, &need) != PLX_OK)
+        return 1;
+    file = malloc(need);
+    if (!file || plx_bake_save(a, b, file, need, &len) != PLX_OK)
+        return 1;
+    bake_w = wall_ms() - w0;
+    bake_c = cpu_ms() - c0;
+    plx_memory_get(a, &m);
+    printf("bake: %.2f s wall, %.2f s CPU (target 10 s); file %.1f MB; engine memory %.1f MB\n", bake_w / 1e3,
+           bake_c / 1e3, len / 1048576.0, m.used_total / 1048576.0);
+    plx_engine_destroy(a);
+    plx_engine_destroy(b);
+    free(ma);
+    free(mb);
+
+    /* loading, into a block touched beforehand */
+    if (plx_bake_block_size(file, len, &need, err, sizeof err) != PLX_OK || posix_memalign(&mc, 1 << 21, need) != 0)
+        return 1;
+    memset(mc, 0, need);
+    for (k = 0; k < 5; k++) {
+        double c1 = cpu_ms();
+        w0 = wall_ms();
+        if (plx_bake_load(mc, need, NULL, file, len, &c, err, sizeof err) != PLX_OK) {
+            printf("load failed: %s\n", err);
+            return 1;
+        }
+        loads[k] = wall_ms() - w0;
+        cl += cpu_ms() - c1;
+        if (k < 4)
+            plx_engine_destroy(c);
+    }
+    qsort(loads, 5, sizeof *loads, cmp_double);
+    printf("load: median %.1f ms of 5 wall, %.1f ms CPU mean (target 50 ms), a %zu-byte block touched beforehand\n",
+           loads[2], cl / 5, need);
+
+    /* walks from the loaded engine */
+    walk(c, 0, 20, rgb8, &sm, &sp, &sc);
+    walk(c, 1, 10, rgb8, &am, &ap, &ac);
+    printf("street walk 640x480 with indirect, 20 frames: median %.1f ms, p95 %.1f ms, CPU %.1f ms/frame "
+           "(target 10 ms); %.1fx the baseline's first frame (%.0f ms), %.0fx its load + photons + frame\n",
+           sm, sp, sc, base_street / sm, base_street, (base_load + base_ph + base_street) / sm);
+    printf("aerial walk 1024x768 with indirect, 10 frames: median %.1f ms, p95 %.1f ms, CPU %.1f ms/frame "
+           "(target 5 ms); %.1fx the baseline's first aerial frame (%.0f ms)\n",
+           am, ap, ac, base_aerial / am, base_aerial);
+    plx_engine_destroy(c);
+    free(mc);
+    free(file);
+    free(rgb8);
+    free(city.buf);
+    return 0;
+}

@@ -1,0 +1,174 @@
+/* test_aa: automatic exposure (src/render/exposure.c) and anti-aliasing
+ * (plx_render_opts.aa), through the public API.
+ *
+ *  - Automatic exposure: the chosen exposure maps the 99.5th percentile of
+ *    the lit pixels' luminance (computed here by sorting) to the key within
+ *    the histogram's eighth of a stop, and every byte is the sRGB encoding
+ *    (written here with pow) of the tone curve of exposure x radiance.
+ *  - aa = N equals rendering N times larger with one sample per pixel and
+ *    averaging each N x N block (the sample points are the same).
+ *  - aa = 1 is the plain image, byte for byte.
+ */
+#include <stdarg.h>
+#include <stddef.h>
+#include <setjmp.h>
+#include <stdint.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <cmocka.h>
+
+#include "polarlux.h"
+#include "polarlux_port.h"
+
+#define MEM ((size_t)256 << 20)
+
+static plx_engine *open_eixample(void **mem)
+{
+    plx_config cfg;
+    plx_engine *e = NULL;
+    *mem = malloc(MEM);
+    assert_non_null(*mem);
+    plx_config_default(&cfg);
+    cfg.port = plx_port_posix();
+    cfg.render_max_width = 480;
+    cfg.render_max_height = 360;
+    assert_int_equal(plx_engine_create(*mem, MEM, &cfg, &e), PLX_OK);
+    assert_int_equal(plx_load_file(e, "fixtures/eixample-4x4.geojson"), PLX_OK);
+    return e;
+}
+
+static void street(plx_camera *cam, int w, int h)
+{
+    memset(cam, 0, sizeof *cam);
+    cam->eye[0] = 298.6; cam->eye[1] = 265.5; cam->eye[2] = 1.7;
+    cam->target[0] = 261.8; cam->target[1] = 302.3; cam->target[2] = 3.0;
+    cam->fov_deg = 60;
+    cam->width = w;
+    cam->height = h;
+}
+
+static int cmp_double(const void *x, const void *y)
+{
+    double a = *(const double *)x, b = *(const double *)y;
+    return (a > b) - (a < b);
+}
+
+static double srgb(double v)
+{
+    double s = v <= 0.0031308 ? 12.92 * v : 1.055 * pow(v, 1.0 / 2.4) - 0.055;
+    return fmin(fmax(s, 0.0), 1.0);
+}
+
+static void test_auto_exposure(void **state)
+{
+    void *mem;
+    plx_engine *e = open_eixample(&mem);
+    plx_camera cam;
+    plx_render_opts o;
+    plx_render_info info;
+    size_t px = 160 * 120, p, n = 0, off = 0;
+    uint8_t *rgb8 = malloc(px * 3);
+    float *lin = malloc(sizeof(float) * px * 3);
+    double *y = malloc(sizeof(double) * px), yp, key = 1.0;
+    (void)state;
+    street(&cam, 160, 120);
+    plx_render_opts_default(&o);
+    o.auto_exposure = 1;
+    o.no_glow = 1;
+    o.exposure = 123.0; /* ignored */
+    assert_int_equal(plx_render(e, &cam, &o, rgb8, lin, &info), PLX_OK);
+    for (p = 0; p < px; p++) {
+        double v = 0.2126 * lin[3 * p] + 0.7152 * lin[3 * p + 1] + 0.0722 * lin[3 * p + 2];
+        if (v > 0)
+            y[n++] = v;
+    }
+    assert_true(n > px / 4);
+    qsort(y, n, sizeof *y, cmp_double);
+    yp = y[(size_t)ceil(0.995 * n) - 1];
+    assert_true(info.exposure * yp <= key * (1 + 1e-9));
+    assert_true(info.exposure * yp > key * pow(2.0, -1.0 / 8.0) * (1 - 1e-6));
+    for (p = 0; p < 3 * px; p++) {
+        double v = info.exposure * lin[p], t = v > 0 ? v * (1 + v / 16.0) / (1 + v) : 0;
+        long want = lround(255.0 * srgb(t));
+        assert_true(labs((long)rgb8[p] - want) <= 1);
+        off += (long)rgb8[p] != want;
+    }
+    assert_true(off * 1000 < 3 * px); /* off by one only at rounding ties */
+    free(rgb8); free(lin); free(y);
+    plx_engine_destroy(e);
+    free(mem);
+}
+
+/* aa = n at w x h against one sample per pixel at n w x n h, averaged. */
+static void aa_against_supersampling(plx_engine *e, int n)
+{
+    enum { W = 160, H = 120 };
+    plx_camera cam;
+    plx_render_opts o;
+    float *small = malloc(sizeof(float) * W * H * 3), *big = malloc(sizeof(float) * W * H * 3 * n * n);
+    size_t p, close = 0;
+    double err = 0;
+    int i, j, a, b, c;
+    plx_render_opts_default(&o);
+    o.no_glow = 1;
+    o.aa = n;
+    street(&cam, W, H);
+    assert_int_equal(plx_render(e, &cam, &o, NULL, small, NULL), PLX_OK);
+    o.aa = 1;
+    street(&cam, W * n, H * n);
+    assert_int_equal(plx_render(e, &cam, &o, NULL, big, NULL), PLX_OK);
+    for (j = 0; j < H; j++)
+        for (i = 0; i < W; i++)
+            for (c = 0; c < 3; c++) {
+                double sum = 0, got = small[((size_t)j * W + i) * 3 + c], d;
+                for (b = 0; b < n; b++)
+                    for (a = 0; a < n; a++)
+                        sum += big[((size_t)(j * n + b) * W * n + (size_t)(i * n + a)) * 3 + c];
+                sum /= n * n;
+                d = fabs(got - sum);
+                err += d;
+                close += d <= 1e-5 * fmax(1.0, fabs(sum));
+            }
+    p = (size_t)W * H * 3;
+    /* the same sample points: equal but for the last bits of the ray
+     * directions, which may flip a sample exactly on an edge */
+    assert_true(close * 1000 >= p * 998);
+    assert_true(err / p < 1e-3);
+    free(small);
+    free(big);
+}
+
+static void test_aa(void **state)
+{
+    void *mem;
+    plx_engine *e = open_eixample(&mem);
+    plx_camera cam;
+    plx_render_opts o;
+    uint8_t *a8 = malloc(160 * 120 * 3), *b8 = malloc(160 * 120 * 3);
+    (void)state;
+    aa_against_supersampling(e, 2);
+    aa_against_supersampling(e, 3);
+    /* aa 1 is the plain image */
+    street(&cam, 160, 120);
+    plx_render_opts_default(&o);
+    assert_int_equal(plx_render(e, &cam, &o, a8, NULL, NULL), PLX_OK);
+    o.aa = 1;
+    assert_int_equal(plx_render(e, &cam, &o, b8, NULL, NULL), PLX_OK);
+    assert_memory_equal(a8, b8, 160 * 120 * 3);
+    o.aa = 17;
+    assert_int_equal(plx_render(e, &cam, &o, b8, NULL, NULL), PLX_E_INVALID);
+    free(a8); free(b8);
+    plx_engine_destroy(e);
+    free(mem);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_auto_exposure),
+        cmocka_unit_test(test_aa),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}

@@ -1,0 +1,385 @@
+/* test_bake: bake files (src/api/bake.c, README "Bake files").
+ *
+ *  - Round trip: an engine prepared and traced (A), its twin (B), the bake
+ *    written and loaded into a third block (C) at another address: vis,
+ *    illum and render (street and aerial, with indirect light, bytes of the
+ *    8-bit and float images) give identical bytes in A and C, and direct
+ *    light and visibility equal an engine loaded from the GeoJSON (D).
+ *  - Damaged files made from a real bake: every truncation length class,
+ *    a flipped byte, another version, architecture and build, a block too
+ *    small: the exact status and message, no engine.
+ *  - The corpus tests/corpus/bake-*.plxb with exact outcomes.
+ *  - A twin that is not laid out alike is refused.
+ */
+#include <stdarg.h>
+#include <stddef.h>
+#include <setjmp.h>
+#include <stdint.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <cmocka.h>
+
+#include "polarlux.h"
+#include "polarlux_port.h"
+
+#define MEM ((size_t)160 << 20)
+#define SCENE "fixtures/eixample-4x4.geojson"
+
+typedef struct baked {
+    void *ma, *mb;
+    plx_engine *a, *b;
+    unsigned char *file;
+    size_t len;
+} baked;
+
+static plx_engine *make(void **mem, int twin, int aerial)
+{
+    plx_config cfg;
+    plx_bake_opts o;
+    plx_engine *e = NULL;
+    assert_int_equal(posix_memalign(mem, 64, MEM), 0);
+    memset(*mem, 0, MEM); /* the bake saves every byte of the used arena, padding included */
+    plx_config_default(&cfg);
+    cfg.port = plx_port_posix();
+    cfg.render_max_width = 320;
+    cfg.render_max_height = 240;
+    cfg.lit_cache_bytes = 4u << 20;
+    assert_int_equal(plx_engine_create(*mem, MEM, &cfg, &e), PLX_OK);
+    assert_int_equal(plx_load_file(e, SCENE), PLX_OK);
+    memset(&o, 0, sizeof o);
+    o.aerial = aerial;
+    o.aerial_m_per_texel = 2.0;
+    o.twin = twin;
+    assert_int_equal(plx_bake_prepare(e, &o), PLX_OK);
+    return e;
+}
+
+static void bake_make(baked *k)
+{
+    size_t size = 0;
+    uint64_t f;
+    k->a = make(&k->ma, 0, 1);
+    for (f = 1; f <= 3; f++)
+        assert_int_equal(plx_indirect_step(k->a, 20000, f), PLX_OK);
+    k->b = make(&k->mb, 1, 1);
+    assert_int_equal(plx_bake_size(k->a, k->b, &size), PLX_OK);
+    k->file = malloc(size);
+    assert_non_null(k->file);
+    assert_int_equal(plx_bake_save(k->a, k->b, k->file, size, &k->len), PLX_OK);
+    assert_int_equal(k->len, size);
+}
+
+static void bake_free(baked *k)
+{
+    plx_engine_destroy(k->a);
+    plx_engine_destroy(k->b);
+    free(k->ma);
+    free(k->mb);
+    free(k->file);
+}
+
+/* Loads a file into a fresh block at an address 16 bytes past 64-byte
+ * alignment (the loader must shift it). */
+static plx_engine *load(const unsigned char *file, size_t len, void **mem)
+{
+    size_t need = 0;
+    char err[256];
+    plx_config cfg;
+    plx_engine *e = NULL;
+    assert_int_equal(plx_bake_block_size(file, len, &need, err, sizeof err), PLX_OK);
+    *mem = malloc(need + 64);
+    assert_non_null(*mem);
+    plx_config_default(&cfg);
+    cfg.port = plx_port_posix();
+    assert_int_equal(plx_bake_load((char *)*mem + 16, need + 48, &cfg, file, len, &e, err, sizeof err), PLX_OK);
+    return e;
+}
+
+static const double pts[][2] = { { 298.6, 265.5 }, { 150.0, 3.0 }, { -30.0, 22.0 }, { 61.0, 61.0 }, { 400.0, 560.0 } };
+#define NPTS (sizeof pts / sizeof pts[0])
+
+static void same_vis(plx_engine *x, plx_engine *y)
+{
+    size_t i;
+    for (i = 0; i < NPTS; i++) {
+        plx_visibility u, v;
+        plx_status s1 = plx_visibility_get(x, pts[i][0], pts[i][1], 30.0, 360.0, &u);
+        double *xy;
+        uint32_t *vis, n, nv;
+        if (s1 != PLX_OK) {
+            assert_int_equal(plx_visibility_get(y, pts[i][0], pts[i][1], 30.0, 360.0, &v), s1);
+            continue;
+        }
+        n = u.nverts;
+        nv = u.nvisible;
+        xy = malloc(sizeof *xy * 2 * (n + 1));
+        vis = malloc(sizeof *vis * (nv + 1));
+        memcpy(xy, u.xy, sizeof *xy * 2 * n);
+        memcpy(vis, u.visible, sizeof *vis * nv);
+        assert_int_equal(plx_visibility_get(y, pts[i][0], pts[i][1], 30.0, 360.0, &v), PLX_OK);
+        assert_memory_equal(&u.area, &v.area, sizeof u.area);
+        assert_int_equal(v.nverts, n);
+        assert_int_equal(v.nvisible, nv);
+        assert_memory_equal(v.xy, xy, sizeof *xy * 2 * n);
+        assert_memory_equal(v.visible, vis, sizeof *vis * nv);
+        free(xy);
+        free(vis);
+    }
+}
+
+/* Ground points facing up on a grid over the scene: E_direct, E_indirect
+ * and rgb byte for byte (the status too: points inside footprints fail). */
+static void same_illum(plx_engine *x, plx_engine *y, int indirect)
+{
+    enum { N = 64 };
+    double P[3 * N], Nn[3 * N], e1[N], i1[N], c1[3 * N], e2[N], i2[N], c2[3 * N];
+    int k;
+    for (k = 0; k < N; k++) {
+        P[3 * k] = -30.0 + 590.0 * (k % 8) / 7.0 + 0.37;
+        P[3 * k + 1] = -30.0 + 590.0 * (k / 8) / 7.0 + 0.61;
+        P[3 * k + 2] = 0.0;
+        Nn[3 * k] = Nn[3 * k + 1] = 0.0;
+        Nn[3 * k + 2] = 1.0;
+    }
+    assert_int_equal(plx_illuminance(x, N, P, Nn, e1, indirect ? i1 : NULL, c1),
+                     plx_illuminance(y, N, P, Nn, e2, indirect ? i2 : NULL, c2));
+    assert_memory_equal(e1, e2, sizeof e1);
+    assert_memory_equal(c1, c2, sizeof c1);
+    if (indirect)
+        assert_memory_equal(i1, i2, sizeof i1);
+}
+
+static void same_render(plx_engine *x, plx_engine *y, int aerial, int no_indirect)
+{
+    plx_camera cam;
+    plx_render_opts o;
+    size_t px = 160 * 120;
+    uint8_t *a8 = malloc(px * 3), *b8 = malloc(px * 3);
+    float *af = malloc(sizeof(float) * px * 3), *bf = malloc(sizeof(float) * px * 3);
+    memset(&cam, 0, sizeof cam);
+    cam.width = 160;
+    cam.height = 120;
+    cam.fov_deg = 60;
+    if (aerial) {
+        cam.eye[0] = cam.target[0] = 266.0;
+        cam.eye[1] = 266.0;
+        cam.target[1] = 267.0;
+        cam.eye[2] = 500.0;
+    } else {
+        cam.eye[0] = 298.6; cam.eye[1] = 265.5; cam.eye[2] = 1.7;
+        cam.target[0] = 261.8; cam.target[1] = 302.3; cam.target[2] = 3.0;
+    }
+    plx_render_opts_default(&o);
+    o.aerial = aerial;
+    o.aerial_m_per_texel = 2.0;
+    o.no_indirect = no_indirect;
+    assert_int_equal(plx_render(x, &cam, &o, a8, af, NULL), PLX_OK);
+    assert_int_equal(plx_render(y, &cam, &o, b8, bf, NULL), PLX_OK);
+    assert_memory_equal(a8, b8, px * 3);
+    assert_memory_equal(af, bf, sizeof(float) * px * 3);
+    free(a8); free(b8); free(af); free(bf);
+}
+
+static void test_round_trip(void **state)
+{
+    baked k;
+    void *mc, *md;
+    plx_engine *c, *d;
+    (void)state;
+    bake_make(&k);
+    c = load(k.file, k.len, &mc);
+    assert_int_equal(plx_indirect_frames(c), 3);
+    same_vis(k.a, c);
+    same_illum(k.a, c, 1);
+    same_render(k.a, c, 0, 0);
+    same_render(k.a, c, 1, 0);
+    /* against an engine that never saw a bake: direct light and visibility */
+    d = make(&md, 0, 0);
+    same_vis(d, c);
+    same_illum(d, c, 0);
+    same_render(d, c, 0, 1);
+    /* a bake of the loaded engine's own twin-free state still loads alike twice */
+    plx_engine_destroy(d);
+    free(md);
+    plx_engine_destroy(c);
+    free(mc);
+    bake_free(&k);
+}
+
+/* ---- damaged files ----------------------------------------------------------- */
+
+static uint64_t fnv_lanes(const unsigned char *f, size_t len)
+{
+    /* the file's checksum recomputed the way the README describes it */
+    uint64_t h[4], w;
+    unsigned char head[128];
+    const unsigned char *parts[2];
+    size_t lens[2], i, p;
+    int k;
+    for (k = 0; k < 4; k++)
+        h[k] = 0xcbf29ce484222325ull ^ (uint64_t)k;
+    memcpy(head, f, 128);
+    memset(head + 32, 0, 8);
+    parts[0] = head; lens[0] = 128;
+    parts[1] = f + 128; lens[1] = len - 128;
+    for (p = 0; p < 2; p++) {
+        for (i = 0; i + 32 <= lens[p]; i += 32)
+            for (k = 0; k < 4; k++) {
+                memcpy(&w, parts[p] + i + 8 * k, 8);
+                h[k] = (h[k] ^ w) * 0x00000100000001b3ull;
+            }
+        for (; i < lens[p]; i++)
+            h[0] = (h[0] ^ parts[p][i]) * 0x00000100000001b3ull;
+    }
+    w = h[0];
+    for (k = 1; k < 4; k++)
+        w = (w ^ h[k]) * 0x00000100000001b3ull;
+    return w;
+}
+
+static void expect_fail(const unsigned char *f, size_t len, plx_status want, const char *msg)
+{
+    char err[256];
+    size_t need = 12345;
+    void *mem = malloc(1 << 20);
+    plx_engine *e = (plx_engine *)&need;
+    err[0] = '\0';
+    assert_int_equal(plx_bake_block_size(f, len, &need, err, sizeof err), want);
+    assert_string_equal(err, msg);
+    err[0] = '\0';
+    assert_int_equal(plx_bake_load(mem, 1 << 20, NULL, f, len, &e, err, sizeof err), want);
+    assert_null(e);
+    assert_string_equal(err, msg);
+    free(mem);
+}
+
+static void test_damaged(void **state)
+{
+    baked k;
+    unsigned char *f;
+    char msg[200];
+    size_t need;
+    char err[256];
+    void *mem;
+    plx_engine *e = NULL;
+    uint64_t sum;
+    (void)state;
+    bake_make(&k);
+    f = malloc(k.len);
+    /* the checksum is what the README says */
+    memcpy(&sum, k.file + 32, 8);
+    assert_true(sum == fnv_lanes(k.file, k.len));
+    expect_fail(k.file, 0, PLX_E_PARSE, "not a polarlux bake file (no PLXBAKE magic)");
+    expect_fail(k.file, 100, PLX_E_PARSE, "truncated bake file: 100 bytes, shorter than its 128-byte header");
+    snprintf(msg, sizeof msg, "truncated bake file: %zu bytes, the header says %zu", k.len / 2, k.len);
+    expect_fail(k.file, k.len / 2, PLX_E_PARSE, msg);
+    snprintf(msg, sizeof msg, "truncated bake file: %zu bytes, the header says %zu", k.len - 1, k.len);
+    expect_fail(k.file, k.len - 1, PLX_E_PARSE, msg);
+    /* a flipped bit anywhere in the body */
+    memcpy(f, k.file, k.len);
+    f[k.len / 3] ^= 0x10;
+    expect_fail(f, k.len, PLX_E_PARSE, "corrupt bake file: checksum mismatch");
+    memcpy(f, k.file, k.len);
+    f[k.len - 1] ^= 0x01;
+    expect_fail(f, k.len, PLX_E_PARSE, "corrupt bake file: checksum mismatch");
+    /* header fields */
+    memcpy(f, k.file, k.len);
+    f[8] = 2;
+    expect_fail(f, k.len, PLX_E_UNSUPPORTED, "bake format version 2, this polarlux reads version 1; bake the scene again");
+    memcpy(f, k.file, k.len);
+    f[12] ^= 0xff;
+    expect_fail(f, k.len, PLX_E_UNSUPPORTED, "bake made on another architecture (byte order or pointer, size_t, "
+                "double, long sizes differ); bake the scene again on this machine");
+    memcpy(f, k.file, k.len);
+    f[16] = 4;
+    expect_fail(f, k.len, PLX_E_UNSUPPORTED, "bake made on another architecture (byte order or pointer, size_t, "
+                "double, long sizes differ); bake the scene again on this machine");
+    memcpy(f, k.file, k.len);
+    f[20] ^= 1;
+    expect_fail(f, k.len, PLX_E_UNSUPPORTED, "bake made by a different build of polarlux (its structures differ); "
+                "bake the scene again");
+    memcpy(f, k.file, k.len);
+    f[48] ^= 1; /* relocation count: the layout no longer adds up */
+    expect_fail(f, k.len, PLX_E_PARSE, "corrupt bake file: inconsistent header");
+    /* a block too small */
+    assert_int_equal(plx_bake_block_size(k.file, k.len, &need, err, sizeof err), PLX_OK);
+    mem = malloc(1 << 20);
+    assert_int_equal(plx_bake_load(mem, 1 << 20, NULL, k.file, k.len, &e, err, sizeof err), PLX_E_NOMEM);
+    assert_null(e);
+    assert_non_null(strstr(err, "the block is too small for the bake: it needs "));
+    free(mem);
+    free(f);
+    bake_free(&k);
+}
+
+/* ---- the corpus ----------------------------------------------------------------- */
+
+typedef struct corpus_row {
+    const char *file;
+    plx_status st;
+    const char *msg;
+} corpus_row;
+
+static const corpus_row corpus[] = {
+    { "bake-empty.plxb", PLX_E_PARSE, "not a polarlux bake file (no PLXBAKE magic)" },
+    { "bake-geojson.plxb", PLX_E_PARSE, "not a polarlux bake file (no PLXBAKE magic)" },
+    { "bake-magic-only.plxb", PLX_E_PARSE, "truncated bake file: 8 bytes, shorter than its 128-byte header" },
+    { "bake-version-99.plxb", PLX_E_UNSUPPORTED,
+      "bake format version 99, this polarlux reads version 1; bake the scene again" },
+    { "bake-big-endian.plxb", PLX_E_UNSUPPORTED,
+      "bake made on another architecture (byte order or pointer, size_t, double, long sizes differ); "
+      "bake the scene again on this machine" },
+    { "bake-32bit.plxb", PLX_E_UNSUPPORTED,
+      "bake made on another architecture (byte order or pointer, size_t, double, long sizes differ); "
+      "bake the scene again on this machine" },
+};
+
+static void test_corpus(void **state)
+{
+    size_t i;
+    (void)state;
+    for (i = 0; i < sizeof corpus / sizeof corpus[0]; i++) {
+        char path[256];
+        unsigned char buf[4096];
+        size_t n;
+        FILE *fp;
+        snprintf(path, sizeof path, "tests/corpus/%s", corpus[i].file);
+        fp = fopen(path, "rb");
+        if (!fp)
+            fail_msg("cannot open %s", path);
+        n = fread(buf, 1, sizeof buf, fp);
+        fclose(fp);
+        expect_fail(buf, n, corpus[i].st, corpus[i].msg);
+    }
+}
+
+static void test_twin_mismatch(void **state)
+{
+    void *ma, *mb;
+    plx_engine *a, *b;
+    size_t size;
+    (void)state;
+    a = make(&ma, 0, 1);
+    b = make(&mb, 1, 0); /* no light map: laid out otherwise */
+    assert_int_equal(plx_bake_size(a, b, &size), PLX_E_INVALID);
+    assert_non_null(strstr(plx_last_error(a), "the twin engine is not laid out as this one"));
+    assert_int_equal(plx_bake_size(a, a, &size), PLX_E_INVALID);
+    assert_int_equal(plx_bake_size(a, NULL, &size), PLX_E_INVALID);
+    plx_engine_destroy(a);
+    plx_engine_destroy(b);
+    free(ma);
+    free(mb);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_round_trip),
+        cmocka_unit_test(test_damaged),
+        cmocka_unit_test(test_corpus),
+        cmocka_unit_test(test_twin_mismatch),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
