@@ -178,7 +178,11 @@ CLI_LIBS += $(GIS_LIBS)
 -include $(shell find $(BUILD) -name '*.d' 2>/dev/null)
 
 # ---- the main job -------------------------------------------------------------
-demo: all
+# The README's two commands set up what is missing through make deps (which
+# says what it installs); plain make only builds and names what is missing.
+demo:
+	@$(MAKE) --no-print-directory deps
+	@$(MAKE) --no-print-directory -j$(JOBS) all
 	@sh tests/demo.sh $(BIN)
 
 # ---- tests --------------------------------------------------------------------
@@ -196,6 +200,7 @@ check-full: check-build
 	@$(MAKE) --no-print-directory check-examples check-python
 
 check-build:
+	@$(MAKE) --no-print-directory deps
 	@$(MAKE) --no-print-directory -j$(JOBS) all $(TESTS) $(EXAMPLES) check-core-headers check-lib-split check-man \
 	  check-no-install check-layers $(BUILD)/tests/failwrite.so
 
