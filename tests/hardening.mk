@@ -188,7 +188,7 @@ check-freestanding:
 
 # ---- toolchains ----------------------------------------------------------------------
 HARDENING_PACKAGES = clang libclang-rt-14-dev valgrind file gcc-aarch64-linux-gnu libc6-dev-arm64-cross qemu-user \
-                     libcjson-dev:arm64 libcmocka-dev:arm64 libpng-dev:arm64 \
+                     libcjson-dev:arm64 libcmocka-dev:arm64 libpng-dev:arm64 libsqlite3-dev:arm64 libtiff-dev:arm64 libgeotiff-dev:arm64 \
                      gcc-arm-none-eabi libnewlib-arm-none-eabi
 
 hardening-deps:
