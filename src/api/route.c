@@ -118,6 +118,9 @@ plx_status plx_route_score(plx_engine *e, const double *xy, uint32_t n, double s
 {
     acc all, seg;
     uint32_t i;
+    plx_status st;
+    arena_mark m0;
+    int built;
     if (!eng_ok(e))
         return PLX_E_INVALID;
     if (!xy || n < 2 || !(step > 0) || !isfinite(step) || !(dark_lux >= 0))
@@ -125,11 +128,24 @@ plx_status plx_route_score(plx_engine *e, const double *xy, uint32_t n, double s
     for (i = 0; i < 2 * n; i++)
         if (!isfinite(xy[i]))
             return eng_fail(e, PLX_E_INVALID, "plx_route_score: a vertex is not finite");
+    /* the light object is built here, before score_segment takes its arena
+     * mark: built inside plx_illuminance it would lie above the mark, and the
+     * release would hand its memory out again while e->lt still points at it */
+    built = e->lt == NULL;
+    m0 = arena_get_mark(&e->mem);
+    st = eng_need(e, ENG_LIGHT, "plx_route_score");
+    if (st != PLX_OK)
+        return st;
     acc_init(&all);
     for (i = 0; i + 1 < n; i++) {
-        plx_status st = score_segment(e, xy + 2 * i, xy + 2 * i + 2, step, dark_lux, &seg);
-        if (st != PLX_OK)
+        st = score_segment(e, xy + 2 * i, xy + 2 * i + 2, step, dark_lux, &seg);
+        if (st != PLX_OK) {
+            if (built) { /* a failed call leaves the engine as it was */
+                e->lt = NULL;
+                arena_release(&e->mem, &m0);
+            }
             return st;
+        }
         if (segments)
             acc_stats(&seg, &segments[i]);
         acc_merge(&all, &seg);

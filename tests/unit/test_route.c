@@ -245,6 +245,37 @@ static void test_fault_injection(void **state)
     }
 }
 
+/* A first route score builds the lamp light and keeps it: the engine holds
+ * the same bytes of lit-region memory as after a first plx_illuminance (a
+ * build inside the per-segment arena mark was released with the samples,
+ * leaving e->lt pointing at memory the renderer then reused). */
+static void test_light_kept_after_first_score(void **state)
+{
+    static const char scene[] = "{\"type\":\"FeatureCollection\",\"properties\":{\"units\":\"m\"},\"features\":["
+                                "{\"type\":\"Feature\",\"properties\":{\"lamp\":true},"
+                                "\"geometry\":{\"type\":\"Point\",\"coordinates\":[0,5]}}]}";
+    double xy[4] = { -10, 0, 10, 0 }, P[3] = { 0, 8, 0 }, N[3] = { 0, 0, 1 }, E, Ei;
+    void *mem1, *mem2;
+    plx_engine *e1 = load(scene, &mem1), *e2 = load(scene, &mem2);
+    plx_memory_report r1, r2, again;
+    plx_route_stats t;
+    (void)state;
+    assert_int_equal(plx_route_score(e1, xy, 2, 1.0, 1.0, &t, NULL), PLX_OK);
+    assert_int_equal(plx_illuminance(e2, 1, P, N, &E, &Ei, NULL), PLX_OK);
+    plx_memory_get(e1, &r1);
+    plx_memory_get(e2, &r2);
+    assert_true(r2.used[PLX_PART_LIT] > 0);
+    assert_int_equal(r1.used[PLX_PART_LIT], r2.used[PLX_PART_LIT]);
+    /* a second score builds nothing more */
+    assert_int_equal(plx_route_score(e1, xy, 2, 1.0, 1.0, &t, NULL), PLX_OK);
+    plx_memory_get(e1, &again);
+    assert_int_equal(again.used_total, r1.used_total);
+    plx_engine_destroy(e1);
+    plx_engine_destroy(e2);
+    free(mem1);
+    free(mem2);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -255,6 +286,7 @@ int main(void)
         cmocka_unit_test(test_p_class_boundaries),
         cmocka_unit_test(test_errors),
         cmocka_unit_test(test_fault_injection),
+        cmocka_unit_test(test_light_kept_after_first_score),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
