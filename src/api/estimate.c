@@ -225,8 +225,14 @@ size_t plx_memory_estimate(const plx_scene_size *sz, const plx_config *cfg, unsi
         high = step(&kept, high, est_polar(&c));
     if (uses & PLX_USE_LIGHT)
         high = step(&kept, high, est_light(&c, cfg));
-    if (uses & PLX_USE_RENDER)
-        high = step(&kept, high, est_render(&c, cfg));
+    if (uses & PLX_USE_RENDER) {
+        /* a frame computes the lit regions it shades with on demand: one
+         * region's output scratch on top of the frame's buffers */
+        phase r = est_render(&c, cfg), l = est_light(&c, cfg);
+        if (l.scratch > r.scratch)
+            r.scratch = l.scratch;
+        high = step(&kept, high, r);
+    }
     high += PLX_ENGINE_ALIGN + PLX_ENGINE_MIN_BYTES;
     if (!(high < (double)((size_t)-1 / 2)))
         return 0;
