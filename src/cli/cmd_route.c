@@ -428,7 +428,8 @@ static int find_spots(plx_engine *e, double res, long count, double spacing, int
         cli_warn("dark-spots", c, "no street point is within a lamp's reach (%s), so there are no spots; "
                  "--all takes every street point", si.lamps ? "the lamps are outside Bounds or their radius "
                  "does not reach the ground" : "the scene has no lamps");
-    qsort(g.s, g.n, sizeof *g.s, cmp_spot);
+    if (g.n > 1) /* g.s is NULL when there are no spots: qsort's base must not be */
+        qsort(g.s, g.n, sizeof *g.s, cmp_spot);
     if (g.n > 0 && !(g.s[g.n - 1].lux > 0))
         cli_warn("dark-spots", c, "all %zu street points are dark (0 lx): %s", g.n, cli_dark_reason(e));
     pick = malloc(sizeof *pick * (size_t)count);
