@@ -91,6 +91,10 @@ if [ -f "$shim" ]; then
     pre=
     if cmp -s "$tmp/pair.png" "$tmp/pair.png.copy" && cmp -s "$tmp/pair.pfm" "$tmp/pair.pfm.copy"; then
         ok render-pair-kept; else bad render-pair-kept; fi
+elif [ -n "${PLX_NO_SHIM:-}" ]; then
+    # a cross build run under qemu-user: a host LD_PRELOAD shim cannot reach
+    # the emulated program's writes (check-arm64 sets PLX_NO_SHIM)
+    echo "skip failing-disk shim cases: $PLX_NO_SHIM"
 else
     bad "no $shim (make check builds it)"
 fi
