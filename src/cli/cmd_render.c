@@ -51,7 +51,7 @@ static const char help[] =
     "  --no-indirect    direct light only (default: indirect light from the photon\n"
     "                   buffers, traced first; progress on a terminal)\n"
     "  --photons N      photons per frame (default 65536)\n"
-    "  --frames K       progressive photon frames for the still image (default 16)\n"
+    "  --frames K       progressive photon frames for the still image (default 4)\n"
     "  --backend B      raster pass: soft (default, built in) or osmesa (OpenGL into\n"
     "                   an OSMesa buffer; " OSMESA_STATE "); the same image\n"
     "  -o FILE          output PNG (required)\n"
