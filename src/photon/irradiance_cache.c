@@ -209,6 +209,27 @@ static const icache_rec *record(icache *c, photon_sys *ps, light *L, const plane
     return r;
 }
 
+/* Whether the horizontal segment from P (5 cm above its surface) to the
+ * vertex Q meets a wall: on coarse grids a ground cell may span a small
+ * building, and the street beyond it is the same height of ground. */
+static int blocked(tracer *T, const double P[3], const double Q[3])
+{
+    double o[3], d[3], l;
+    trace_hit h;
+    d[0] = Q[0] - P[0];
+    d[1] = Q[1] - P[1];
+    d[2] = 0.0;
+    l = sqrt(d[0] * d[0] + d[1] * d[1]);
+    if (!(l > 1e-9))
+        return 0;
+    d[0] /= l;
+    d[1] /= l;
+    o[0] = P[0];
+    o[1] = P[1];
+    o[2] = P[2] + 0.05;
+    return trace_ray(T, o, d, l, &h) != TRACE_SKY;
+}
+
 /* Bilinear over the valid vertices of P's cell at level l; 0 when none
  * of them is valid (with weight). */
 static int level_value(icache *c, photon_sys *ps, light *L, const plane *pl, const double P[3],
@@ -234,6 +255,12 @@ static int level_value(icache *c, photon_sys *ps, light *L, const plane *pl, con
             r = record(c, ps, L, pl, l, i + a, j + b);
             if (!(r->flags & REC_VALID))
                 continue;
+            if (!pl->wall && l >= ICACHE_LEVEL_SEG) {
+                double Q[3];
+                vertex_point(pl, sp, i + a, j + b, Q);
+                if (blocked(ps->T, P, Q))
+                    continue;
+            }
             ws += w;
             for (k = 0; k < 3; k++)
                 acc[k] += w * r->e[k];
@@ -273,13 +300,18 @@ void icache_lookup(icache *c, photon_sys *ps, light *L, const double P[3], const
         return;
     }
     lf = log2(fmax(c->kappa * sqrt(dx * dx + dy * dy + dz * dz), fmax(c->smin, ICACHE_S0)) / ICACHE_S0);
-    if (!(lf < ICACHE_LEVELS - 1))
-        lf = ICACHE_LEVELS - 1;
+    if (!(lf < ICACHE_LEVEL_MAX + 1.0)) {
+        photon_indirect_rgb(ps, P, n, rgb); /* far: the photon buffers */
+        return;
+    }
     l0 = (int)floor(lf);
     t = lf - l0;
     level_or_finer(c, ps, L, &pl, P, l0, rgb);
-    if (t > 0.0 && l0 + 1 < ICACHE_LEVELS) {
-        level_or_finer(c, ps, L, &pl, P, l0 + 1, r1);
+    if (t > 0.0) {
+        if (l0 < ICACHE_LEVEL_MAX)
+            level_or_finer(c, ps, L, &pl, P, l0 + 1, r1);
+        else
+            photon_indirect_rgb(ps, P, n, r1);
         for (k = 0; k < 3; k++)
             rgb[k] = (1.0 - t) * rgb[k] + t * r1[k];
     }

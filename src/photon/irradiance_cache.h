@@ -20,12 +20,20 @@
  * pixels); l = log2(s / s0) is fractional and the two levels around it are
  * blended (trilinear, as a mip map), so there is no seam where the level
  * changes. Within a level, bilinear weights over the cell's four vertices.
+ * The coarsest level is ICACHE_LEVEL_MAX (8 m): beyond the distance that
+ * asks for it (53 m) the cache blends into the photon buffers' own lookup
+ * (photon_indirect_rgb), which alone answers beyond twice that: records
+ * farther apart would blur the light over whole streets and courtyards
+ * (aerial views read the photon buffers).
  *
  * VALID VERTICES. A vertex is valid when it lies on the same surface: on
  * the ground or a roof, when the topmost surface over it (trace_top) has
  * the same height as over P (within 1 mm: open ground stays open ground,
- * a roof stays that roof's height); on a wall, when a probe ray from 5 mm in
- * front of it meets the same edge. Invalid vertices get no weight and the
+ * a roof stays that roof's height) and, on grids of 4 m and coarser, no
+ * wall stands between P and it (a horizontal ray 5 cm above the surface:
+ * a cell may span a small building, with the same ground beyond it); on a
+ * wall, when a probe ray from 5 mm in front of it meets the same edge and
+ * no building stands against it there. Invalid vertices get no weight and the
  * others are renormalised; a level whose four vertices are all invalid
  * (a sliver of a surface smaller than the cell) is replaced by the next
  * finer one, down to level 0, and below that P is gathered itself.
@@ -55,7 +63,8 @@
 #define ICACHE_S0 0.25        /* level 0 grid spacing, m */
 #define ICACHE_SMIN 2.0       /* spacing asked for near the eye, m */
 #define ICACHE_KAPPA 0.15     /* spacing asked for farther, per metre of distance */
-#define ICACHE_LEVELS 12      /* levels 0..11: 0.25 m .. 512 m */
+#define ICACHE_LEVEL_MAX 5    /* coarsest level: 8 m (farther: photon buffers) */
+#define ICACHE_LEVEL_SEG 4    /* from 4 m on, a ground vertex behind a wall is left out */
 #define ICACHE_RECORDS 65536  /* table slots (power of two) */
 
 typedef struct icache_rec icache_rec;
