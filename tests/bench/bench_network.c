@@ -172,7 +172,7 @@ int main(void)
     t_build = (port_now_ns() - t0) / 1e9;
     t0 = port_now_ns();
     c0 = cpu_ms();
-    if (net_score(&net, e, 1.0, 1.0, 0) != PLX_OK)
+    if (net_score(&net, e, 1.0, 1.0, 1.5, 0) != PLX_OK)
         return 1;
     t_score = (port_now_ns() - t0) / 1e9;
     cpu_score = cpu_ms() - c0;
