@@ -15,12 +15,12 @@ static const char help[] =
     "usage: polarlux tiles SCENE --zoom Z0[-Z1] [--quantity h|sc] [--max LUX] -o OUT [options]\n"
     "\n"
     "Writes web-map raster tiles (Web Mercator, XYZ numbering, 256 x 256 pixels)\n"
-    "of the direct ground illuminance E_h (or, with --quantity sc, the direct\n"
+    "of the direct ground illuminance E_h (with --quantity sc: the direct\n"
     "semi-cylindrical illuminance E_sc above the ground) over the scene's Bounds,\n"
-    "in the colours\n"
-    "of 'polarlux heatmap' (logarithmic scale from 0.1 lx to --max); pixels with\n"
-    "no light (0.1 lx or less, or inside a footprint) are transparent. Each\n"
-    "pixel is the ground point under its centre. The scene must be in lon/lat.\n"
+    "in the colours of 'polarlux heatmap' (logarithmic scale from 0.1 lx to\n"
+    "--max); pixels with no light (0.1 lx or less, or inside a footprint or\n"
+    "solid) are transparent. Each pixel is the ground point under its centre.\n"
+    "The scene must be in lon/lat.\n"
     "OUT ending in .mbtiles is an MBTiles 1.3 file (SQLite; metadata name,\n"
     "format, type, version, bounds, center, minzoom, maxzoom, description);\n"
     "otherwise OUT is a folder receiving OUT/z/x/y.png.\n"
@@ -214,7 +214,7 @@ static int parse_zoom(const char *s, tiles_opts *o)
 
 static int parse(int argc, char **argv, tiles_opts *o)
 {
-    int i, have_zoom = 0;
+    int i, have_zoom = 0, sc_option = 0;
     o->q.quantity = PLX_METER_H;
     o->q.height = 1.5;
     o->q.facing_min = 1;
@@ -242,9 +242,11 @@ static int parse(int argc, char **argv, tiles_opts *o)
             if (o->q.quantity < 0)
                 return cli_usage_error("tiles", "--quantity '%s' is not h (ground E_h) or sc (E_sc)", q);
         } else if (strcmp(a, "--height") == 0) {
+            sc_option = 1;
             if (cli_parse_double(argv[++i], &o->q.height) != 0 || !(o->q.height >= 0) || !(o->q.height <= 1000))
                 return cli_usage_error("tiles", "--height '%s' is not a number of metres from 0 to 1000", argv[i]);
         } else if (strcmp(a, "--facing") == 0) {
+            sc_option = 1;
             o->q.facing_min = strcmp(argv[++i], "min") == 0;
             if (!o->q.facing_min && (cli_parse_double(argv[i], &o->q.facing) != 0 || !isfinite(o->q.facing)))
                 return cli_usage_error("tiles", "--facing '%s' is not a number of degrees or min", argv[i]);
@@ -267,6 +269,8 @@ static int parse(int argc, char **argv, tiles_opts *o)
         return cli_usage_error("tiles", "missing --zoom Z0-Z1");
     if (!o->out)
         return cli_usage_error("tiles", "missing -o OUT (a folder or a .mbtiles file)");
+    if (sc_option && o->q.quantity != PLX_METER_SC)
+        return cli_usage_error("tiles", "--height and --facing need --quantity sc (E_h is on the ground)");
     return EXIT_OK;
 }
 
