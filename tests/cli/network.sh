@@ -30,6 +30,6 @@ expect annotate-missing-o 2 "missing -o OUT.geojson" -- "$bin" annotate -q $net
 expect tiles-metres 1 "the scene is in local metres, with no lon/lat" -- "$bin" tiles -q fixtures/tiny.geojson --zoom 15 -o "$tmp/t"
 expect tiles-quantity 2 "--quantity 'v' is not h \(ground E_h\) or sc \(E_sc\)" -- "$bin" tiles -q fixtures/helsinki-centre.geojson --zoom 15 --quantity v -o "$tmp/t"
 expect tiles-facing 2 "--facing 'west' is not a number of degrees or min" -- "$bin" tiles -q fixtures/helsinki-centre.geojson --zoom 15 --quantity sc --facing west -o "$tmp/t"
-expect tiles-sc 0 "^tiles: [0-9]+ tiles at zoom 14-14 \([0-9]+ with light\) of direct semi-cylindrical illuminance E_sc at 1\.5 m, the least over every facing direction, scale 0\.1\.\.100 lx" -- "$bin" tiles -q fixtures/helsinki-centre.geojson --zoom 14 --quantity sc --max 100 -o "$tmp/sc.mbtiles"
+expect tiles-sc 0 "^tiles: [0-9]+ tiles at zoom 12-12 \([0-9]+ with light\) of direct semi-cylindrical illuminance E_sc at 1\.5 m, the least over every facing direction, scale 0\.1\.\.100 lx" -- "$bin" tiles -q fixtures/helsinki-centre.geojson --zoom 12 --quantity sc --max 100 -o "$tmp/sc.mbtiles"
 expect tiles-facing-h 2 "--height and --facing need --quantity sc" -- "$bin" tiles -q fixtures/helsinki-centre.geojson --zoom 15 --facing 90 -o "$tmp/t"
 expect heatmap-facing-min 2 "--facing min needs --quantity sc" -- "$bin" heatmap -q fixtures/helsinki-centre.geojson --quantity v --facing min -o "$tmp/v.png"
