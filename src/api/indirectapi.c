@@ -74,6 +74,7 @@ plx_status plx_indirect_reset(plx_engine *e)
         return PLX_E_INVALID;
     if (e->ph)
         photon_reset(e->ph);
+    e->lightmap_cell = 0.0; /* the aerial map's indirect layer was gathered over the old photons */
     return PLX_OK;
 }
 

@@ -6,6 +6,7 @@
 #include "light/litregion.h"
 #include "render/render.h"
 #include "photon/irradiance_cache.h"
+#include "photon/trace.h"
 
 #define DEFAULT_MAX_W 1920
 #define DEFAULT_MAX_H 1080
@@ -19,6 +20,13 @@ void plx_render_opts_default(plx_render_opts *o)
     o->exposure = 1.0;
 }
 
+/* Whether images gather their indirect light (the irradiance cache) rather
+ * than read the photon buffers (plx_indirect_set_gather 0). */
+static int gathering(const plx_engine *e)
+{
+    return e->ic && e->lt && e->ph && !(e->gather_set && e->gather_side == 0);
+}
+
 /* The photon hook of the renderer: the RGB indirect term (each lamp's light
  * weighted by its colour; SPEC §5) from the irradiance cache (final
  * gathers at sparse points of each surface, irradiance_cache.h), or the
@@ -26,7 +34,7 @@ void plx_render_opts_default(plx_render_opts *o)
 static void shade_indirect(void *user, const double P[3], const double n[3], double rgb[3])
 {
     plx_engine *e = user;
-    if (e->ic && e->lt && !(e->gather_set && e->gather_side == 0))
+    if (gathering(e))
         icache_lookup(e->ic, e->ph, e->lt, P, n, rgb);
     else
         eng_indirect_photons_rgb(e, P, n, rgb);
@@ -48,15 +56,41 @@ static void shade_none(void *user, const double P[3], const double n[3], double 
     rgb[0] = rgb[1] = rgb[2] = 0.0;
 }
 
+/* The aerial light map's indirect layer (render_lightmap_build_ind): the
+ * irradiance cache at the topmost surface over (x, y), ground or roof, on
+ * its ICACHE_AERIAL grid (records 4 m apart, none across a wall or a roof
+ * edge: irradiance_cache.h). */
+static int lightmap_indirect(void *user, double x, double y, double rgb[3], double *z)
+{
+    plx_engine *e = user;
+    double P[3], n[3] = { 0.0, 0.0, 1.0 };
+    P[0] = x;
+    P[1] = y;
+    P[2] = trace_top(e->ph->T, x, y, NULL);
+    *z = P[2];
+    icache_lookup(e->ic, e->ph, e->lt, P, n, rgb);
+    return 1;
+}
+
 plx_status eng_need_lightmap(plx_engine *e, double m_per_texel, int dark)
 {
     double cell = m_per_texel > 0 ? m_per_texel : 1.0;
+    size_t bytes = e->cfg.lightmap_bytes ? e->cfg.lightmap_bytes : LIGHTMAP_MAX_BYTES;
     plx_status st = eng_need_render(e);
     if (st != PLX_OK)
         return st;
     if (dark)
         render_code_bind(e->rd, shade_none);
-    st = render_lightmap_build(e->rd, cell, e->cfg.lightmap_bytes ? e->cfg.lightmap_bytes : LIGHTMAP_MAX_BYTES);
+    if (e->ic) {
+        /* the layer's memory in every engine with a cache (a bake's twin
+         * too); its values when images gather over traced photons */
+        int fill = !dark && gathering(e) && plx_indirect_frames(e) > 0;
+        if (fill)
+            icache_set_spacing(e->ic, ICACHE_AERIAL);
+        st = render_lightmap_build_ind(e->rd, cell, bytes, lightmap_indirect, fill ? e : NULL);
+        icache_set_spacing(e->ic, 0.0);
+    } else
+        st = render_lightmap_build(e->rd, cell, bytes);
     if (dark)
         render_code_bind(e->rd, render_shade_light);
     if (st == PLX_E_NOMEM)
@@ -140,6 +174,12 @@ plx_status plx_render(plx_engine *e, const plx_camera *cam, const plx_render_opt
     st = eng_need(e, ENG_RENDER, "plx_render");
     if (st != PLX_OK)
         return st;
+    if (o->aerial && e->lightmap_cell != 0.0 && !o->no_indirect && gathering(e) && plx_indirect_frames(e) > 0) {
+        render_lightmap_info li;
+        render_lightmap_get(e->rd, &li);
+        if (!li.has_ind)
+            e->lightmap_cell = 0.0; /* built before the photons (a bake): again, with its indirect layer */
+    }
     if (o->aerial && e->lightmap_cell == 0.0) {
         st = eng_need_lightmap(e, o->aerial_m_per_texel, 0);
         if (st != PLX_OK)
@@ -160,8 +200,11 @@ plx_status plx_render(plx_engine *e, const plx_camera *cam, const plx_render_opt
     if (!o->no_indirect && e->ph && plx_indirect_frames(e) > 0) {
         ro.indirect = shade_indirect;
         ro.indirect_user = e;
-        if (e->ic)
+        if (e->ic) {
             icache_set_view(e->ic, rc.eye);
+            /* from above: the aerial grid for the pixels the map's layer leaves (walls) */
+            icache_set_spacing(e->ic, o->aerial ? ICACHE_AERIAL : 0.0);
+        }
     }
     if (o->aa > 1)
         st = render_aa(e, &rc, &ro, o->aa, rgb8, rgbf, &rs);

@@ -29,6 +29,7 @@ typedef struct plane {
     double o[3];          /* grid origin: (0, 0, z) or the edge's first vertex */
     double t[3], n[3];    /* grid u axis (x or along the wall), normal */
     double top;           /* horizontal: topmost height over P (trace_top) */
+    uint32_t bld;         /* a roof's building (trace_top) */
     uint32_t edge;
 } plane;
 
@@ -65,6 +66,11 @@ plx_status icache_create(arena *a, icache **out)
 void icache_set_view(icache *c, const double eye[3])
 {
     memcpy(c->eye, eye, sizeof c->eye);
+}
+
+void icache_set_spacing(icache *c, double s)
+{
+    c->fixed = s > 0.0 ? s : 0.0;
 }
 
 static void flush(icache *c)
@@ -123,8 +129,12 @@ static int plane_of(tracer *T, const scene *s, const double P[3], const double n
     trace_hit h;
     memset(pl, 0, sizeof *pl);
     if (n[2] > 0.5) {
-        pl->top = trace_top(T, P[0], P[1], NULL);
-        pl->code = ((uint64_t)1 << 62) | (mm(P[2]) << 30) | mm(pl->top);
+        pl->top = trace_top(T, P[0], P[1], &pl->bld);
+        if (!(pl->top > HEIGHT_TOL))
+            pl->bld = 0;
+        /* a roof is its building's own surface: roofs of one height
+         * elsewhere (across a street or a courtyard) are others */
+        pl->code = ((uint64_t)1 << 62) | (mix64(pl->bld ^ mix64((mm(P[2]) << 30) | mm(pl->top))) >> 2);
         pl->o[2] = P[2];
         pl->t[0] = 1.0;
         pl->n[2] = 1.0;
@@ -163,8 +173,11 @@ static void vertex_point(const plane *pl, double sp, int64_t i, int64_t j, doubl
 static int vertex_valid(tracer *T, const plane *pl, const double Q[3])
 {
     trace_hit h;
-    if (!pl->wall)
-        return fabs(trace_top(T, Q[0], Q[1], NULL) - pl->top) <= HEIGHT_TOL;
+    if (!pl->wall) {
+        uint32_t b = 0;
+        double top = trace_top(T, Q[0], Q[1], &b);
+        return fabs(top - pl->top) <= HEIGHT_TOL && (!(top > HEIGHT_TOL) || b == pl->bld);
+    }
     if (!(Q[2] > 0.0) || !probe_wall(T, Q, pl->n, &h) || h.edge != pl->edge)
         return 0;
     /* not behind a building standing against the wall */
@@ -297,6 +310,11 @@ void icache_lookup(icache *c, photon_sys *ps, light *L, const double P[3], const
     }
     if (!plane_of(ps->T, ps->s, P, n, &pl)) {
         photon_indirect_rgb(ps, P, n, rgb);
+        return;
+    }
+    if (c->fixed > 0.0) {
+        level_or_finer(c, ps, L, &pl, P, (int)fmin(floor(log2(fmax(c->fixed, ICACHE_S0) / ICACHE_S0)),
+                                                   ICACHE_LEVEL_MAX), rgb);
         return;
     }
     lf = log2(fmax(c->kappa * sqrt(dx * dx + dy * dy + dz * dz), fmax(c->smin, ICACHE_S0)) / ICACHE_S0);

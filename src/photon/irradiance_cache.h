@@ -67,6 +67,7 @@
 #define ICACHE_LEVEL_MAX 5    /* coarsest level: 8 m (farther: photon buffers) */
 #define ICACHE_LEVEL_SEG 4    /* from 4 m on, a ground vertex behind a wall is left out */
 #define ICACHE_RECORDS 65536  /* table slots (power of two) */
+#define ICACHE_AERIAL 4.0     /* spacing for views from above, m (icache_set_spacing) */
 
 typedef struct icache_rec icache_rec;
 
@@ -77,6 +78,7 @@ typedef struct icache {
     double eye[3];            /* the viewer: spacing grows with distance from it */
     double kappa;             /* spacing per metre of distance (ICACHE_KAPPA) */
     double smin;              /* smallest spacing asked for, m (ICACHE_SMIN) */
+    double fixed;             /* > 0: this spacing everywhere (icache_set_spacing) */
     uint64_t stamp;           /* state of the photon buffers the records belong to */
     uint64_t gathered;        /* records computed since creation */
     uint64_t direct;          /* points gathered themselves (no valid vertex) */
@@ -93,6 +95,13 @@ plx_status icache_create(arena *a, icache **out /* OUT */);
  * distance d from it is kappa d, at least smin. Records already made stay
  * valid. */
 void icache_set_view(icache *c, const double eye[3]);
+
+/* Views from above (the aerial light map and frames): every lookup uses
+ * the level of spacing s (rounded down to a power of two times ICACHE_S0,
+ * at most ICACHE_LEVEL_MAX), whatever the distance to the eye, and never
+ * the photon buffers' own lookup for points that have a surface grid.
+ * s = 0: back to spacing by distance (icache_set_view). Records stay valid. */
+void icache_set_spacing(icache *c, double s);
 
 /* RGB E_indirect (lux) at surface point P with unit normal n (a pixel's
  * point), from the records around it (computed as needed). ps must have

@@ -2,20 +2,71 @@
  * illuminance E_rgb of every lamp (through the renderer's shader, 2.5D
  * shadows, SPEC §2) stored once per texel over the lamps' reach, then read
  * by the aerial view's ground pixels, bilinear between texel centres
- * (munoz2013's precomputed ground lighting for views from above). */
+ * (munoz2013's precomputed ground lighting for views from above).
+ * Optionally a second layer: E_indirect at the topmost surface over each
+ * texel (ground or roof, as seen from above) and its height, read by the
+ * aerial view's ground and roof pixels with weights only on texels of the
+ * pixel's own surface (issue #13: no light across edges). */
 #include <math.h>
 #include <string.h>
 
 #include "render/lightmap.h"
 
+/* The indirect layer: memory (as the first build took it) and values. */
+static plx_status ind_alloc(lightmap *m, arena *mem, size_t need, const char **err)
+{
+    if (m->ind && need <= m->ind_cap)
+        return PLX_OK;
+    if (m->ind) {
+        *err = "render_lightmap_build: the new map does not fit the first one's memory";
+        return PLX_E_NOMEM;
+    }
+    m->ind = arena_alloc(mem, PLX_PART_FRAME, arena_mul(need, sizeof(float)), 64);
+    if (!m->ind) {
+        *err = "render_lightmap_build: out of memory for the light map's indirect layer";
+        return PLX_E_NOMEM;
+    }
+    m->ind_cap = need;
+    return PLX_OK;
+}
+
+static void ind_fill(lightmap *m, lightmap_ind_fn fn, void *user)
+{
+    uint32_t i, j;
+    for (j = 0; j < m->ny; j++)
+        for (i = 0; i < m->nx; i++) {
+            size_t t = (size_t)j * m->nx + i;
+            float *o = &m->ind[4 * t];
+            double rgb[3], z;
+            o[0] = -1.0f;
+            o[1] = o[2] = o[3] = 0.0f;
+            if (!user ||
+                !fn(user, m->x0 + (i + 0.5) * m->cell, m->y0 + (j + 0.5) * m->cell, rgb, &z))
+                continue;
+            o[0] = (float)rgb[0];
+            o[1] = (float)rgb[1];
+            o[2] = (float)rgb[2];
+            o[3] = (float)z;
+        }
+}
+
 plx_status lightmap_build(lightmap *m, arena *mem, const scene *s, double cell, size_t max_bytes,
                           lightmap_shade_fn shade, void *user, const char **err)
 {
+    return lightmap_build_ind(m, mem, s, cell, max_bytes, shade, user, NULL, NULL, err);
+}
+
+plx_status lightmap_build_ind(lightmap *m, arena *mem, const scene *s, double cell, size_t max_bytes,
+                              lightmap_shade_fn shade, void *user, lightmap_ind_fn ind_fn, void *ind_user,
+                              const char **err)
+{
+    double per = ind_fn ? 28.0 : 12.0; /* bytes a texel */
+    plx_status st;
     double x0 = HUGE_VAL, y0 = HUGE_VAL, x1 = -HUGE_VAL, y1 = -HUGE_VAL;
     uint32_t l, nx, ny, i, j;
     size_t need;
-    if (!(cell > 0.0) || !isfinite(cell) || max_bytes < 12) {
-        *err = "render_lightmap_build: m_per_texel must be > 0 and max_bytes >= 12";
+    if (!(cell > 0.0) || !isfinite(cell) || (double)max_bytes < per) {
+        *err = "render_lightmap_build: m_per_texel must be > 0 and max_bytes >= 12 (28 with indirect light)";
         return PLX_E_INVALID;
     }
     for (l = 0; l < s->nlamps; l++) {
@@ -37,7 +88,7 @@ plx_status lightmap_build(lightmap *m, arena *mem, const scene *s, double cell, 
         double fx = ceil((x1 - x0) / cell), fy = ceil((y1 - y0) / cell);
         if (fx < 1) fx = 1;
         if (fy < 1) fy = 1;
-        if (fx * fy * 12.0 <= (double)max_bytes && fx < 1e8 && fy < 1e8) {
+        if (fx * fy * per <= (double)max_bytes && fx < 1e8 && fy < 1e8) {
             nx = (uint32_t)fx;
             ny = (uint32_t)fy;
             break;
@@ -57,6 +108,8 @@ plx_status lightmap_build(lightmap *m, arena *mem, const scene *s, double cell, 
         }
         m->cap = need;
     }
+    if (ind_fn && (st = ind_alloc(m, mem, (size_t)nx * ny * 4, err)) != PLX_OK)
+        return st;
     m->nx = nx;
     m->ny = ny;
     m->cell = cell;
@@ -87,6 +140,12 @@ plx_status lightmap_build(lightmap *m, arena *mem, const scene *s, double cell, 
                 if (dx * dx + dy * dy <= rg * rg)
                     m->rgb[3 * ((size_t)b * nx + (size_t)a)] = 1.0f;
             }
+    }
+    /* the indirect layer first, while the map marks the reached texels */
+    m->has_ind = 0;
+    if (ind_fn) {
+        ind_fill(m, ind_fn, ind_user);
+        m->has_ind = ind_user != NULL;
     }
     for (j = 0; j < ny; j++)
         for (i = 0; i < nx; i++) {
@@ -140,3 +199,44 @@ void lightmap_sample(const lightmap *m, const double P[3], double rgb[3])
     }
 }
 
+
+int lightmap_sample_ind(const lightmap *m, const double P[3], double rgb[3])
+{
+    double fx, fy, tx, ty, ws = 0.0;
+    int64_t i0, j0;
+    int k, c, reached = 0;
+    rgb[0] = rgb[1] = rgb[2] = 0.0;
+    if (!m->has_ind)
+        return 0;
+    fx = (P[0] - m->x0) / m->cell - 0.5;
+    fy = (P[1] - m->y0) / m->cell - 0.5;
+    if (!(fx > -1.0 && fy > -1.0 && fx < (double)m->nx && fy < (double)m->ny))
+        return 1; /* off the map: beyond every lamp's reach */
+    i0 = (int64_t)floor(fx);
+    j0 = (int64_t)floor(fy);
+    tx = fx - (double)i0;
+    ty = fy - (double)j0;
+    for (k = 0; k < 4; k++) {
+        int64_t i = i0 + (k & 1), j = j0 + (k >> 1);
+        double w = ((k & 1) ? tx : 1.0 - tx) * ((k >> 1) ? ty : 1.0 - ty);
+        const float *t;
+        if (i < 0 || j < 0 || i >= (int64_t)m->nx || j >= (int64_t)m->ny)
+            continue;
+        t = &m->ind[4 * ((size_t)j * m->nx + (size_t)i)];
+        if (t[0] < 0.0f)
+            continue;
+        reached = 1;
+        if (fabs(t[3] - P[2]) > 0.01 || !(w > 0.0))
+            continue;
+        ws += w;
+        for (c = 0; c < 3; c++)
+            rgb[c] += w * t[c];
+    }
+    if (!(ws > 1e-6)) {
+        rgb[0] = rgb[1] = rgb[2] = 0.0;
+        return !reached;
+    }
+    for (c = 0; c < 3; c++)
+        rgb[c] /= ws;
+    return 1;
+}

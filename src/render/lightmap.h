@@ -13,11 +13,22 @@ typedef struct lightmap {
     double x0, y0, cell;
     uint64_t shaded;            /* texels shaded by the last build */
     int built;
+    float *ind;                 /* E_indirect RGB at the topmost surface and that
+                                   surface's height, 4 floats a texel (ind[0] < 0:
+                                   none); NULL when built without lightmap_ind_fn */
+    size_t ind_cap;             /* floats */
+    int has_ind;                /* the last build filled ind */
 } lightmap;
 
 /* E_rgb at ground point P with unit normal n (the renderer's shader). */
 typedef void (*lightmap_shade_fn)(void *user, const double P[3], const double n[3],
                                   double rgb[3]);
+
+/* E_indirect RGB (lux) at the topmost surface over ground point (x, y)
+ * (the ground, or a roof seen from above) and that surface's height *z;
+ * 0 when there is no value there (the caller's point reads elsewhere). */
+typedef int (*lightmap_ind_fn)(void *user, double x, double y, double rgb[3] /* OUT */,
+                               double *z /* OUT */);
 
 /* Builds the map of scene s with texels of cell metres (grown by 5% steps
  * until the map fits max_bytes) over the box of every lamp's ground reach,
@@ -26,6 +37,24 @@ typedef void (*lightmap_shade_fn)(void *user, const double P[3], const double n[
  * it. Returns PLX_OK, PLX_E_INVALID or PLX_E_NOMEM with *err set. */
 plx_status lightmap_build(lightmap *m, arena *mem, const scene *s, double cell, size_t max_bytes,
                           lightmap_shade_fn shade, void *user, const char **err /* OUT */);
+
+/* The same, and with ind_fn non-NULL also the indirect layer (ind): for
+ * each texel some lamp reaches, ind_fn at its centre (16 more bytes a
+ * texel, counted in max_bytes). ind_user NULL: the layer is allocated and
+ * left empty (a bake's twin engine: same memory, none of the work). */
+plx_status lightmap_build_ind(lightmap *m, arena *mem, const scene *s, double cell, size_t max_bytes,
+                              lightmap_shade_fn shade, void *user, lightmap_ind_fn ind_fn, void *ind_user,
+                              const char **err /* OUT */);
+
+/* E_indirect at P (a horizontal surface point seen from above, P[2] its
+ * height) from the indirect layer: bilinear over the four texel centres
+ * around P whose topmost surface has P's height (within 1 cm), weights
+ * renormalised, so light does not cross a roof edge or a wall foot; 0
+ * when no lamp reaches any of them (beyond every lamp's reach: no light
+ * spreads there). Returns 0 (rgb 0) when the map cannot say: no layer, or
+ * the texels around are reached but none is on P's surface (a surface
+ * narrower than a texel). */
+int lightmap_sample_ind(const lightmap *m, const double P[3], double rgb[3] /* OUT */);
 
 /* Ground E_rgb at P from the map, bilinear between texel centres (0 off
  * the map). */

@@ -1016,7 +1016,9 @@ static void shade_pass(render *r, const render_opts *o, render_stats *st)
                     }
                     if (o->indirect) {
                         double Ei[3] = { 0, 0, 0 };
-                        o->indirect(o->indirect_user, TP[q], TN[q], Ei);
+                        /* aerial: ground and roofs from the map's indirect layer */
+                        if (!(use_lm && TN[q][2] > 0.5 && lightmap_sample_ind(&r->lm, TP[q], Ei)))
+                            o->indirect(o->indirect_user, TP[q], TN[q], Ei);
                         for (k = 0; k < 3; k++)
                             E[k] += Ei[k];
                     }
@@ -1181,6 +1183,13 @@ plx_status render_lightmap_build(render *r, double cell, size_t max_bytes)
     return lightmap_build(&r->lm, r->a, r->s, cell, max_bytes, r->shade, r->user, &r->err);
 }
 
+plx_status render_lightmap_build_ind(render *r, double cell, size_t max_bytes, lightmap_ind_fn ind, void *user)
+{
+    if (!r || !ind)
+        return PLX_E_INVALID;
+    return lightmap_build_ind(&r->lm, r->a, r->s, cell, max_bytes, r->shade, r->user, ind, user, &r->err);
+}
+
 void render_lightmap_get(const render *r, render_lightmap_info *out)
 {
     memset(out, 0, sizeof *out);
@@ -1195,4 +1204,6 @@ void render_lightmap_get(const render *r, render_lightmap_info *out)
     out->bytes = (size_t)r->lm.nx * r->lm.ny * 3 * sizeof(float);
     out->shaded = r->lm.shaded;
     out->rgb = r->lm.rgb;
+    out->has_ind = r->lm.has_ind;
+    out->ind = r->lm.ind;
 }

@@ -178,6 +178,7 @@
 #include "base/scene.h"
 #include "base/arena.h"
 #include "render/mesh.h"
+#include "render/lightmap.h"
 
 #define RENDER_BINS 4096
 
@@ -304,6 +305,15 @@ const uint32_t *render_ids(const render *r);
  * PLX_E_INVALID (m_per_texel <= 0, max_bytes < 12), PLX_E_NOMEM. */
 plx_status render_lightmap_build(render *r, double m_per_texel, size_t max_bytes);
 
+/* The same with the map's indirect layer (lightmap.h, lightmap_build_ind;
+ * 28 bytes per texel): ind(user, x, y, ...) gives E_indirect at the topmost
+ * surface over each reached texel centre. Aerial frames with an indirect
+ * hook then read their ground and roof pixels' indirect term from it (the
+ * hook only where the layer has no texel of the pixel's surface around it:
+ * walls, slivers narrower than a texel, beyond the lamps' reach nothing). */
+plx_status render_lightmap_build_ind(render *r, double m_per_texel, size_t max_bytes, lightmap_ind_fn ind,
+                                     void *user);
+
 typedef struct render_lightmap_info {
     int built;
     uint32_t nx, ny;
@@ -311,6 +321,8 @@ typedef struct render_lightmap_info {
     size_t bytes;
     uint64_t shaded;           /* texels the shader was called for */
     const float *rgb;          /* nx*ny*3, row j = y0 + j cell */
+    int has_ind;               /* the indirect layer is filled (render_lightmap_build_ind) */
+    const float *ind;          /* nx*ny*4: E_indirect RGB, topmost height (ind[0] < 0: none) */
 } render_lightmap_info;
 
 void render_lightmap_get(const render *r, render_lightmap_info *out /* OUT */);

@@ -237,11 +237,173 @@ static void test_image_same_bytes(void **state)
     plx_engine_free(e2);
 }
 
+/* ---- aerial views: the light map's indirect layer ---------------------------- */
+
+typedef struct gbuf {
+    char *p;
+    size_t n, cap;
+} gbuf;
+
+static int gbuf_write(void *user, const char *data, size_t len)
+{
+    gbuf *b = user;
+    if (b->n + len + 1 > b->cap) {
+        size_t cap = 2 * (b->n + len + 1);
+        char *q = realloc(b->p, cap);
+        if (!q)
+            return -1;
+        b->p = q;
+        b->cap = cap;
+    }
+    memcpy(b->p + b->n, data, len);
+    b->n += len;
+    return 0;
+}
+
+#define AW 200
+#define AH 150
+
+/* Kind and surface met through pixel (i, j) of a straight-down camera:
+ * the ground, or a roof (its building); 0 for anything else. */
+static uint64_t aerial_surface(tracer *T, const plx_camera *c, int i, int j, trace_hit *h)
+{
+    double th = tan(c->fov_deg * PI / 360.0), d[3], l;
+    d[0] = ((i + 0.5) / c->width * 2.0 - 1.0) * th * c->width / c->height;
+    d[1] = (1.0 - (j + 0.5) / c->height * 2.0) * th;
+    d[2] = -1.0;
+    l = sqrt(d[0] * d[0] + d[1] * d[1] + 1.0);
+    d[0] /= l;
+    d[1] /= l;
+    d[2] /= l;
+    if (trace_ray(T, c->eye, d, 2.0 * c->eye[2], h) == TRACE_SKY)
+        return 0;
+    if (h->kind == TRACE_ROOF)
+        return ((uint64_t)1 << 40) | h->bld;
+    if (h->kind == TRACE_GROUND)
+        return (uint64_t)2 << 40;
+    return 0;
+}
+
+
+/* An aerial view of a generated Eixample of 2 x 2 blocks (courtyards closed
+ * on every side), straight down, through the API with and without indirect
+ * light. Candidate pixels on a grid, on open ground or a roof, 2 pixels
+ * from any edge; a short path-traced estimate sorts them: lit ones
+ * (E_indirect > 0.3 lx), of which maxn spread over the list are compared
+ * against a long reference (mean relative error), and dark ones (under
+ * 0.01 lx by 4 sigma: closed courtyards, roofs no wall looks down on),
+ * where the image must add almost nothing. Printed beside: the photon
+ * buffers' lookup at the same points (what aerial views read before). */
+static void test_aerial_accuracy(void **state)
+{
+    plx_engine *e;
+    plx_config cfg;
+    static plx_port port;
+    plx_render_opts o;
+    plx_camera c;
+    plx_scene_info si;
+    gbuf g = { NULL, 0, 0 };
+    float *with = malloc(sizeof *with * 3 * AW * AH), *without = malloc(sizeof *with * 3 * AW * AH);
+    int step = quick_mode() ? 6 : 3, paths = quick_mode() ? 5000 : 40000;
+    int maxn = quick_mode() ? 10 : 50, i, j, n = 0, roofs = 0, dark = 0, nlit = 0, k;
+    int *lit = malloc(sizeof *lit * AW * AH);
+    double bound = quick_mode() ? 0.2 : 0.12, err = 0.0, err_old = 0.0, noise = 0.0, dark_max = 0.0;
+    double dark_old = 0.0;
+    (void)state;
+    assert_true(with && without && lit);
+    assert_int_equal(plx_gen_city("eixample", 2, 2, 1, gbuf_write, &g), PLX_OK);
+    port = *plx_port_posix();
+    port.log = NULL;
+    plx_config_default(&cfg);
+    cfg.port = &port;
+    assert_int_equal(plx_engine_new((size_t)1 << 29, &cfg, &e), PLX_OK);
+    assert_int_equal(plx_load_geojson(e, g.p, g.n, "eixample-2x2"), PLX_OK);
+    free(g.p);
+    plx_scene_info_get(e, &si);
+    memset(&c, 0, sizeof c);
+    c.fov_deg = 40.0;
+    c.width = AW;
+    c.height = AH;
+    c.eye[0] = c.target[0] = 0.5 * (si.bounds[0] + si.bounds[2]);
+    c.eye[1] = c.target[1] = 0.5 * (si.bounds[1] + si.bounds[3]);
+    c.eye[2] = 0.5 * fmax(si.bounds[3] - si.bounds[1], (si.bounds[2] - si.bounds[0]) * AH / AW) /
+               tan(c.fov_deg * PI / 360.0);
+    for (k = 0; k < 4; k++) /* the command's default: 4 x 65536 photons */
+        assert_int_equal(plx_indirect_step(e, 65536, (uint64_t)k + 1), PLX_OK);
+    plx_render_opts_default(&o);
+    o.no_glow = 1;
+    o.aerial = 1;
+    o.no_indirect = 1;
+    assert_int_equal(plx_render(e, &c, &o, NULL, without, NULL), PLX_OK);
+    o.no_indirect = 0;
+    assert_int_equal(plx_render(e, &c, &o, NULL, with, NULL), PLX_OK);
+    for (j = step / 2; j < AH; j += step)
+        for (i = step / 2; i < AW; i += step) {
+            double nrm[3] = { 0, 0, 1 }, se, ref, img, rgb_old[3];
+            int di, dj, same;
+            trace_hit h, h2;
+            uint64_t id = aerial_surface(e->ph->T, &c, i, j, &h);
+            same = id != 0;
+            for (dj = -2; dj <= 2 && same; dj += 2)
+                for (di = -2; di <= 2 && same; di += 2)
+                    same = aerial_surface(e->ph->T, &c, i + di, j + dj, &h2) == id;
+            if (!same)
+                continue;
+            ref = ref_indirect_paths(e->ph->T, e->sc, h.p, nrm, 300, 7u + (uint64_t)(j * AW + i), &se);
+            if (ref > 0.3) {
+                lit[nlit++] = j * AW + i;
+            } else if (ref + 4.0 * se < 0.01) {
+                /* dark (closed courtyards, roofs no wall sees): no light added */
+                double a = h.kind == TRACE_ROOF ? e->sc->bld[h.bld].albedo : e->sc->ground_albedo;
+                img = (with[3 * (j * AW + i)] - without[3 * (j * AW + i)]) * PI / a;
+                photon_indirect_rgb(e->ph, h.p, nrm, rgb_old);
+                dark_max = fmax(dark_max, img);
+                dark_old = fmax(dark_old, rgb_old[0]);
+                dark++;
+            }
+        }
+    for (k = 0; k < maxn && k < nlit; k++) {
+        int q = lit[(int)((k + 0.5) * nlit / maxn)];
+        double nrm[3] = { 0, 0, 1 }, se, ref, img, rgb_old[3], a;
+        trace_hit h;
+        aerial_surface(e->ph->T, &c, q % AW, q / AW, &h);
+        ref = ref_indirect_paths(e->ph->T, e->sc, h.p, nrm, paths, 900u + (uint64_t)k, &se);
+        a = h.kind == TRACE_ROOF ? e->sc->bld[h.bld].albedo : e->sc->ground_albedo;
+        img = (with[3 * q] - without[3 * q]) * PI / a;
+        photon_indirect_rgb(e->ph, h.p, nrm, rgb_old);
+        err += fabs(img - ref) / ref;
+        err_old += fabs(rgb_old[0] - ref) / ref;
+        noise += se / ref;
+        roofs += h.kind == TRACE_ROOF;
+        n++;
+    }
+    assert_true(n >= maxn / 2);
+    err /= n;
+    err_old /= n;
+    noise /= n;
+    printf("aerial view %dx%d of a generated eixample 2x2, %d lit pixels (%d on roofs), reference %d paths "
+           "(its noise %.4f), 4 x 65536 photons: mean relative error of the image's E_indirect %.4f "
+           "(irradiance cache: %llu records), photon buffers alone %.4f; bound %.2f%s; %d dark pixels, "
+           "most indirect light added there %.4f lx (photon buffers %.4f lx)\n",
+           AW, AH, n, roofs, paths, noise, err, (unsigned long long)e->ic->gathered, err_old, bound,
+           quick_mode() ? " (quick mode)" : "", dark, dark_max, dark_old);
+    assert_true(noise < (quick_mode() ? 0.06 : 0.02));
+    assert_true(err <= bound);
+    assert_true(err < err_old);
+    assert_true(dark >= 4);
+    assert_true(dark_max <= 0.03);
+    free(lit);
+    free(with);
+    free(without);
+    plx_engine_free(e);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_image_accuracy),
         cmocka_unit_test(test_image_same_bytes),
+        cmocka_unit_test(test_aerial_accuracy),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
