@@ -115,7 +115,8 @@ typedef struct plx_config {
                                          the free bytes at first use, 256 KiB to 16 MiB) */
     int32_t render_max_width;         /* largest frame plx_render draws (0: 1920) */
     int32_t render_max_height;        /* (0: 1080) */
-    size_t lightmap_bytes;            /* the aerial light map's budget (12 bytes a texel; the texel
+    size_t lightmap_bytes;            /* the aerial light map's budget (12 bytes a texel, 28 with its
+                                         indirect layer (README "Aerial views' indirect light"); the texel
                                          grows from the one asked for until the map fits; 0: 48 MiB) */
 } plx_config;
 
@@ -600,7 +601,9 @@ typedef struct plx_backend plx_backend;
 typedef struct plx_render_opts {
     double exposure;            /* radiance multiplier before sRGB (SPEC default 1) */
     int no_glow;                /* 1: no lamp glows: every pixel is SPEC §5's radiance */
-    int aerial;                 /* 1: ground from the aerial light map (built once) */
+    int aerial;                 /* 1: ground from the aerial light map (built once; with photons
+                                   traced, its indirect layer lights ground and roofs; a reset
+                                   of the photons rebuilds it on the next aerial frame) */
     double aerial_m_per_texel;  /* light map resolution (0: 1 m, coarser if the budget needs) */
     int no_cull;                /* 1: draw every building (the culled image is identical) */
     int no_indirect;            /* 1: direct light only even when photons were traced */

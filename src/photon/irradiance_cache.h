@@ -7,7 +7,8 @@
  * the gathered surfaces, the photon buffers for the later bounces only)
  * would give at P, approximated by interpolating gathers ("records") made
  * at the vertices of a square grid laid on P's own surface:
- *  - the ground and each roof: the plane z = P.z, grid over (x, y);
+ *  - the ground and each roof: the plane z = P.z, grid over (x, y) (a
+ *    roof: its own building's, not others of the same height);
  *  - a wall: the plane of its edge (the edge a 2 cm probe ray from P meets),
  *    grid over (u, z), u the distance along the edge from its first vertex.
  * Records are keyed by (surface, level, grid cell): two surfaces never
@@ -27,10 +28,16 @@
  * farther apart would blur the light over whole streets and courtyards
  * (aerial views read the photon buffers).
  *
+ * VIEWS FROM ABOVE (icache_set_spacing). The aerial light map's indirect
+ * layer and aerial frames use one level, ICACHE_AERIAL (4 m) everywhere,
+ * and never the photon buffers for points with a grid: light stays on
+ * the surface it was gathered on (the records' grids respect walls and
+ * roof edges), where the buffers' coarse records spread it 100 m.
+ *
  * VALID VERTICES. A vertex is valid when it lies on the same surface: on
  * the ground or a roof, when the topmost surface over it (trace_top) has
  * the same height as over P (within 1 mm: open ground stays open ground,
- * a roof stays that roof's height) and, on grids of 4 m and coarser, no
+ * a roof stays that roof's height, and the same building) and, on grids of 4 m and coarser, no
  * wall stands between P and it (a horizontal ray 5 cm above the surface:
  * a cell may span a small building, with the same ground beyond it); on a
  * wall, when a probe ray from 5 mm in front of it meets the same edge and

@@ -150,6 +150,9 @@
  * four nearest texel centres (texels outside the map are 0); walls, roofs
  * and undersides are still shaded exactly per pixel. The map's pitch is the
  * one asked for, enlarged when needed to stay within the byte budget.
+ * With an indirect layer (render_lightmap_build_ind) ground and roof
+ * pixels of aerial frames take their indirect term from it too (no
+ * per-pixel gathers: the frame costs what a direct-only one does).
  *
  * Backends (render_backend below). Only pass (1) is pluggable: a backend
  * takes the visible buildings' triangles, already in clip space (the core
