@@ -82,6 +82,11 @@ size_t jsonscan_number_len(const char *text, size_t len, size_t off)
     return p - off;
 }
 
+/* Bytes that matter when skipping a container: 1 brackets, 2 a quote. */
+static const unsigned char skip_class[256] = {
+    ['"'] = 2, ['['] = 1, [']'] = 1, ['{'] = 1, ['}'] = 1,
+};
+
 size_t jsonscan_skip(const char *text, size_t len, size_t off)
 {
     size_t i = off;
@@ -100,16 +105,19 @@ size_t jsonscan_skip(const char *text, size_t len, size_t off)
         break;
     }
     while (i < len) {
-        char c = text[i];
+        unsigned char c = (unsigned char)text[i];
+        if (!skip_class[c]) {
+            i++;
+            continue;
+        }
         if (c == '"') {
             i = string_end(text, len, i) + 1;
             continue;
         }
         if (c == '[' || c == '{') {
             depth++;
-        } else if (c == ']' || c == '}') {
-            if (--depth == 0)
-                return i + 1;
+        } else if (--depth == 0) {
+            return i + 1;
         }
         i++;
     }
@@ -292,6 +300,22 @@ int jsonscan_string_is(const char *text, size_t len, size_t off, const char *s)
     return !k.differs && s[k.n] == '\0';
 }
 
+/* 1 when the key string at off equals key: byte for byte when the text has
+ * no escape or NUL there, else unescaped. */
+int jsonscan_key_is(const char *text, size_t len, size_t off, const char *key)
+{
+    size_t i = off + 1, k = 0;
+    while (i < len && key[k] != '\0' && text[i] == key[k] && text[i] != '\\') {
+        i++;
+        k++;
+    }
+    if (i < len && key[k] == '\0' && text[i] == '"')
+        return 1;
+    if (i < len && text[i] != '\\' && text[i] != '\0')
+        return 0; /* a plain byte differs (or the key ended early, or the string did) */
+    return jsonscan_string_is(text, len, off, key);
+}
+
 size_t jsonscan_get(const char *text, size_t len, size_t obj, const char *key)
 {
     size_t p;
@@ -300,7 +324,7 @@ size_t jsonscan_get(const char *text, size_t len, size_t obj, const char *key)
     p = jsonscan_ws(text, len, obj + 1);
     while (p < len && text[p] == '"') {
         size_t v = member_value(text, len, p);
-        if (jsonscan_string_is(text, len, p, key))
+        if (jsonscan_key_is(text, len, p, key))
             return v;
         p = jsonscan_ws(text, len, jsonscan_skip(text, len, v));
         if (p >= len || text[p] != ',')

@@ -47,6 +47,9 @@ size_t jsonscan_next(const char *text, size_t len, size_t off, int in_object);
  * obj is not an object. */
 size_t jsonscan_get(const char *text, size_t len, size_t obj, const char *key);
 
+/* 1 when the key (a string) at off equals key, as jsonscan_get compares. */
+int jsonscan_key_is(const char *text, size_t len, size_t off, const char *key);
+
 /* The string at off unescaped, up to its first NUL (a C string): copies at
  * most cap - 1 bytes and a NUL into buf (cap may be 0) and returns the full
  * length. */

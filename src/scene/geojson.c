@@ -427,7 +427,13 @@ plx_status geojson_load(plx_engine *e, arena *a, const char *text, size_t len, c
                         scene **out)
 {
     loader ld;
+    ld_cache cache;
+    int i;
     memset(&ld, 0, sizeof ld);
+    memset(&cache, 0, sizeof cache);
+    for (i = 0; i < LD_OBJECTS; i++)
+        cache.obj[i].obj = JV_NONE;
+    ld.cache = &cache;
     ld.e = e;
     ld.mem = a;
     ld.name = name;

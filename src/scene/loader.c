@@ -192,9 +192,68 @@ js_kind ld_kind(const loader *ld, jv v)
     return jsonscan_kind(ld->text, v);
 }
 
+static ld_members *members_of(const loader *ld, jv obj)
+{
+    ld_cache *c = ld->cache;
+    ld_members *m;
+    uint32_t i;
+    for (i = 0; i < LD_OBJECTS; i++)
+        if (c->obj[i].obj == obj)
+            return &c->obj[i];
+    m = &c->obj[c->turn];
+    c->turn = (c->turn + 1) % LD_OBJECTS;
+    m->obj = obj;
+    m->n = 0;
+    m->done = 0;
+    m->next = jsonscan_ws(ld->text, ld->len, obj + 1);
+    if (m->next >= ld->len || ld->text[m->next] != '"')
+        m->done = 1;
+    return m;
+}
+
+/* Finds one more member of m's object; 0 when there is none. The value of
+ * the last member found is skipped only when a member after it is asked
+ * for (a feature's coordinates are not skipped to find its geometry). */
+static int members_more(const loader *ld, ld_members *m)
+{
+    const char *t = ld->text;
+    size_t p = m->next, v;
+    if (m->done)
+        return 0;
+    if (p == JV_NONE) {
+        p = jsonscan_ws(t, ld->len, jsonscan_skip(t, ld->len, m->val[m->n - 1]));
+        if (p >= ld->len || t[p] != ',') {
+            m->done = 1;
+            return 0;
+        }
+        p = jsonscan_ws(t, ld->len, p + 1);
+    }
+    if (m->n == LD_MEMBERS) {
+        m->done = -1;
+        return 0;
+    }
+    v = jsonscan_ws(t, ld->len, jsonscan_skip(t, ld->len, p)); /* the ':' after the key */
+    v = jsonscan_ws(t, ld->len, v + 1);
+    m->key[m->n] = p;
+    m->val[m->n++] = v;
+    m->next = JV_NONE;
+    return 1;
+}
+
 jv ld_get(const loader *ld, jv obj, const char *key)
 {
-    return jsonscan_get(ld->text, ld->len, obj, key);
+    ld_members *m;
+    uint32_t i;
+    if (!ld->cache || ld_kind(ld, obj) != JS_OBJECT)
+        return jsonscan_get(ld->text, ld->len, obj, key);
+    m = members_of(ld, obj);
+    for (i = 0;; i++) {
+        if (i == m->n && !members_more(ld, m))
+            break;
+        if (jsonscan_key_is(ld->text, ld->len, m->key[i], key))
+            return m->val[i];
+    }
+    return m->done < 0 ? jsonscan_get(ld->text, ld->len, obj, key) : JV_NONE;
 }
 
 jv ld_first(const loader *ld, jv c)

@@ -13,6 +13,23 @@
 typedef size_t jv;
 #define JV_NONE JSONSCAN_NONE
 
+/* Members of a few objects, found as far as lookups needed them (ld_get):
+ * a lookup in a feature or its properties scans each member once. */
+#define LD_MEMBERS 32
+#define LD_OBJECTS 4
+typedef struct ld_members {
+    jv obj;                /* JV_NONE: unused */
+    uint32_t n;            /* members found so far */
+    int done;              /* 1: all found; -1: more than LD_MEMBERS */
+    size_t next;           /* where the next member's key starts (JV_NONE: after val[n - 1]) */
+    size_t key[LD_MEMBERS], val[LD_MEMBERS];
+} ld_members;
+
+typedef struct ld_cache {
+    ld_members obj[LD_OBJECTS];
+    uint32_t turn;         /* the entry replaced next */
+} ld_cache;
+
 typedef struct loader {
     plx_engine *e;         /* for errors and warnings only (base/context.h) */
     arena *mem;
@@ -29,6 +46,7 @@ typedef struct loader {
     int gi_bounds_given;   /* properties.ground_image_bounds read (scene coordinates) */
     double gi_bounds[4];
     int oom;               /* a scratch allocation failed inside a reader (ld_number) */
+    ld_cache *cache;       /* NULL: every lookup scans (geojson.c sets one up) */
 } loader;
 
 /* 1: a number (JSON number or numeric string with optional unit m),
