@@ -70,17 +70,17 @@ static int lamps_walk(light *L, const double P[3], const double n[3], int exact,
                       double *E, double rgb[3], uint32_t *ids, double *contrib, int cap)
 {
     const scene *s = L->s;
-    const light_grid *g = &L->lgrid;
+    const bucketgrid *g = &L->lgrid;
     uint32_t cell, k;
     int count = 0;
     double e = 0.0, c[3] = { 0.0, 0.0, 0.0 };
     if (s->nlamps == 0 || g->nx == 0)
         cell = UINT32_MAX;
     else
-        cell = light_grid_cell(g, P[0], P[1]);
+        cell = bucketgrid_cell(g, P[0], P[1]);
     for (k = cell == UINT32_MAX ? 0 : g->start[cell];
          cell != UINT32_MAX && k < g->start[cell + 1]; k++) {
-        uint32_t i = g->ids[k];
+        uint32_t i = g->item[k];
         double term = lamp_geom_term(&s->lamps[i], P, n);
         if (term == 0.0)
             continue;

@@ -3,6 +3,7 @@
 #include <string.h>
 
 #include "photon/trace.h"
+#include "base/bucketgrid.h"
 
 #define TRACE_MAX_CELLS (1u << 22)
 
@@ -68,17 +69,8 @@ static void grid_spec(const scene *s, double cell_size, gridspec *g)
 static void cell_range(const gridspec *g, double lo, double hi, double org, uint32_t n,
                        uint32_t *i0, uint32_t *i1)
 {
-    double a = floor((lo - g->pad - org) * g->inv), b = floor((hi + g->pad - org) * g->inv);
-    if (a < 0.0)
-        a = 0.0;
-    if (b > (double)(n - 1))
-        b = (double)(n - 1);
-    if (b < 0.0)
-        b = 0.0;
-    if (a > (double)(n - 1))
-        a = (double)(n - 1);
-    *i0 = (uint32_t)a;
-    *i1 = (uint32_t)b;
+    *i0 = bucketgrid_index(lo - g->pad, org, g->inv, n);
+    *i1 = bucketgrid_index(hi + g->pad, org, g->inv, n);
 }
 
 /* Whether segment p->q comes within pad of cell (ci, cj): clipping of the

@@ -658,14 +658,14 @@ static void draw_buildings(render *r, const render_backend *be, render_stats *st
  * the light module's own lamp walk). */
 static int tile_lamps(render *r, const double bx[6])
 {
-    const light_grid *g = &r->lt->lgrid;
+    const bucketgrid *g = &r->lt->lgrid;
     const scene *s = r->s;
     uint32_t c0, c1, cx0, cx1, cy0, cy1, cx, cy, k;
     int n = 0, i, j;
     if (s->nlamps == 0 || g->nx == 0)
         return 0;
-    c0 = light_grid_cell(g, bx[0], bx[1]);
-    c1 = light_grid_cell(g, bx[3], bx[4]);
+    c0 = bucketgrid_cell(g, bx[0], bx[1]);
+    c1 = bucketgrid_cell(g, bx[3], bx[4]);
     cx0 = c0 % g->nx;
     cy0 = c0 / g->nx;
     cx1 = c1 % g->nx;
@@ -681,7 +681,7 @@ static int tile_lamps(render *r, const double bx[6])
             uint32_t cell = cy * g->nx + cx;
             PLX_ASSERT(cx < g->nx && cy < g->ny); /* a cell of the lamp grid */
             for (k = g->start[cell]; k < g->start[cell + 1]; k++) {
-                uint32_t l = g->ids[k];
+                uint32_t l = g->item[k];
                 const scene_lamp *lp = &s->lamps[l];
                 PLX_ASSERT(l < s->nlamps);
                 double dx, dy, dz;
