@@ -20,6 +20,7 @@
 
 #include "polarlux.h"
 #include "polarlux_port.h"
+#include "fixture.h"
 #include "base/engine.h"
 #include "base/arena.h"
 #include "scene/blocks.h"
@@ -970,17 +971,8 @@ static void test_one_bounce_wall(void **state)
 
 static plx_engine *open_fixture(const char *path, void **mem, size_t bytes)
 {
-    plx_engine *e;
-    plx_config cfg;
-    plx_port port = *plx_port_posix();
-    port.log = NULL;
-    plx_config_default(&cfg);
-    cfg.port = &port;
-    *mem = malloc(bytes);
-    assert_non_null(*mem);
-    assert_int_equal(plx_engine_create(*mem, bytes, &cfg, &e), PLX_OK);
-    assert_int_equal(plx_load_file(e, path), PLX_OK);
-    e->cfg.port = NULL; /* the local port goes out of scope */
+    plx_engine *e = fixture_file(path, bytes, mem);
+    e->cfg.port = NULL; /* what follows runs without a port */
     e->port.log = NULL;
     return e;
 }
