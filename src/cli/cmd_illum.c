@@ -48,7 +48,7 @@ int cmd_illum(int argc, char **argv)
     cli_progress pr;
     size_t k;
     const cli_opt opts[] = {
-        { "--points", NULL, &file, NULL, NULL, 0, "--points needs a file" },
+        { "--points", NULL, &file, NULL, NULL, 0, "--points needs a file", NULL, NULL },
         CLI_OPT_END
     };
     cli_args pa;

@@ -4,6 +4,9 @@
 
 #include "options.h"
 
+#define STR_(x) #x
+#define STR(x) STR_(x)
+
 int cli_opt_double(const char *value, void *dst)
 {
     return cli_parse_double(value, dst);
@@ -11,9 +14,15 @@ int cli_opt_double(const char *value, void *dst)
 
 static const cli_opt *find_opt(const cli_opt *opts, const char *a)
 {
-    for (; opts && opts->name; opts++)
-        if (strcmp(a, opts->name) == 0 || (opts->alt && strcmp(a, opts->alt) == 0))
+    for (; opts && (opts->name || opts->more); opts++) {
+        if (!opts->name) {
+            const cli_opt *o = find_opt(opts->more, a);
+            if (o)
+                return o;
+        } else if (strcmp(a, opts->name) == 0 || (opts->alt && strcmp(a, opts->alt) == 0)) {
             return opts;
+        }
+    }
     return NULL;
 }
 
@@ -21,6 +30,8 @@ static const cli_opt *find_opt(const cli_opt *opts, const char *a)
 static int take_opt(const char *cmd, int argc, char **argv, int *i, const cli_opt *o)
 {
     const char *a = argv[*i];
+    if (o->given)
+        *o->given = 1;
     if (o->flag) {
         *(int *)o->dst = 1;
         return EXIT_OK;
@@ -37,11 +48,13 @@ static int take_opt(const char *cmd, int argc, char **argv, int *i, const cli_op
     return EXIT_OK;
 }
 
-int cli_options(const char *cmd, const char *help, int argc, char **argv, const cli_opt *opts,
-                cli_common *c, cli_indirect *ind, cli_args *out)
+int cli_options_n(const char *cmd, const char *help, int argc, char **argv, const cli_opt *opts,
+                  cli_common *c, cli_indirect *ind, int maxpos, cli_args *out)
 {
     int i;
     memset(out, 0, sizeof *out);
+    if (maxpos > CLI_MAX_POS)
+        maxpos = CLI_MAX_POS;
     for (i = 1; i < argc; i++) {
         const char *a = argv[i];
         const cli_opt *o;
@@ -65,11 +78,64 @@ int cli_options(const char *cmd, const char *help, int argc, char **argv, const 
                 return EXIT_USAGE;
         } else if (a[0] == '-' && a[1] != '\0') {
             return cli_usage_error(cmd, "unknown option '%s'", a);
-        } else if (out->npos < CLI_MAX_POS) {
+        } else if (out->npos < maxpos) {
             out->pos[out->npos++] = a;
         } else {
             return cli_usage_error(cmd, "unexpected argument '%s'", a);
         }
     }
     return EXIT_OK;
+}
+
+int cli_options(const char *cmd, const char *help, int argc, char **argv, const cli_opt *opts,
+                cli_common *c, cli_indirect *ind, cli_args *out)
+{
+    return cli_options_n(cmd, help, argc, argv, opts, c, ind, CLI_MAX_POS, out);
+}
+
+/* ---- the view options of render and walk ---------------------------------- */
+
+static int parse_size(const char *v, void *dst)
+{
+    long *wh = dst, w, h;
+    char extra;
+    if (sscanf(v, "%ldx%ld%c", &w, &h, &extra) != 2 || w < 1 || h < 1 || w > 8192 || h > 8192)
+        return -1;
+    wh[0] = w;
+    wh[1] = h;
+    return 0;
+}
+
+static int parse_fov(const char *v, void *dst)
+{
+    double *fov = dst;
+    return cli_parse_double(v, fov) != 0 || !(*fov > 0 && *fov < 180) ? -1 : 0;
+}
+
+static int parse_aa(const char *v, void *dst)
+{
+    return cli_parse_int(v, 1, PLX_RENDER_MAX_AA, dst);
+}
+
+static int parse_view(const char *v, void *dst)
+{
+    if (strcmp(v, "street") && strcmp(v, "aerial"))
+        return -1;
+    *(int *)dst = strcmp(v, "aerial") == 0;
+    return 0;
+}
+
+void cli_view_opts(cli_view *v, cli_opt *frag)
+{
+    const cli_opt f[CLI_VIEW_NOPTS] = {
+        CLI_OPT_VAL("--size", v->size, parse_size, "--size '%s' is not WxH (1..8192 each)"),
+        CLI_OPT_VAL("--fov", &v->fov, parse_fov, "--fov '%s' is not between 0 and 180 degrees"),
+        CLI_OPT_VAL("--aa", &v->aa, parse_aa,
+                    "--aa '%s' is not a whole number from 1 to " STR(PLX_RENDER_MAX_AA)),
+        CLI_OPT_VAL("--view", &v->aerial, parse_view, "--view '%s' is not street or aerial"),
+        CLI_OPT_FLAG("--no-glow", &v->no_glow),
+        CLI_OPT_FLAG("--refine", &v->refine),
+        CLI_OPT_END
+    };
+    memcpy(frag, f, sizeof f);
 }

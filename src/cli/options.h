@@ -2,9 +2,11 @@
  * options in a table; cli_options walks argv once: the common options
  * (--mem, --strict, --quiet, ... : cli_common_option), the indirect-light
  * options when the command takes them (cli_indirect_option), --help/-h,
- * then the table; anything else not starting with '-' is a positional
- * argument. Messages are the commands' usual ones ("polarlux CMD: --x
- * needs a value", "unknown option '--y'"). */
+ * then the table (and the tables it links with CLI_OPT_MORE, such as the
+ * view options of render and walk); anything else not starting with '-' is
+ * a positional argument. Messages are the commands' usual ones ("polarlux
+ * CMD: --x needs a value", "unknown option '--y'", "unexpected argument
+ * 'z'"). */
 #ifndef PLX_CLI_OPTIONS_H
 #define PLX_CLI_OPTIONS_H
 
@@ -22,9 +24,17 @@ typedef struct cli_opt {
     int flag;               /* 1: takes no value, sets *(int *)dst = 1 */
     const char *need;       /* message when the value is missing (NULL:
                              * "--x needs a value") */
+    int *given;             /* set to 1 when the option is met, or NULL */
+    const struct cli_opt *more; /* with name NULL: also the options of this table */
 } cli_opt;
 
-#define CLI_OPT_END { NULL, NULL, NULL, NULL, NULL, 0, NULL }
+/* Table entries: a value kept as given (const char **dst), a value parsed
+ * into dst (message 'bad' when it does not parse), a flag (int *dst). */
+#define CLI_OPT_STR(name, dst) { name, NULL, dst, NULL, NULL, 0, NULL, NULL, NULL }
+#define CLI_OPT_VAL(name, dst, parse, bad) { name, NULL, dst, parse, bad, 0, NULL, NULL, NULL }
+#define CLI_OPT_FLAG(name, dst) { name, NULL, dst, NULL, NULL, 1, NULL, NULL, NULL }
+#define CLI_OPT_MORE(table) { NULL, NULL, NULL, NULL, NULL, 0, NULL, NULL, table }
+#define CLI_OPT_END { NULL, NULL, NULL, NULL, NULL, 0, NULL, NULL, NULL }
 #define CLI_MAX_POS 8
 
 typedef struct cli_args {
@@ -39,7 +49,29 @@ typedef struct cli_args {
 int cli_options(const char *cmd, const char *help, int argc, char **argv, const cli_opt *opts,
                 cli_common *c, cli_indirect *ind, cli_args *out);
 
+/* The same with at most maxpos (0..CLI_MAX_POS) positionals: the one after
+ * is "unexpected argument" where it stands, before the options after it. */
+int cli_options_n(const char *cmd, const char *help, int argc, char **argv, const cli_opt *opts,
+                  cli_common *c, cli_indirect *ind, int maxpos, cli_args *out);
+
 /* Parsers for the table (dst: double *, long *). */
 int cli_opt_double(const char *value, void *dst);
+
+/* ---- the view options of render and walk ---------------------------------- */
+
+typedef struct cli_view {
+    long size[2];           /* --size WxH (1..8192 each) */
+    double fov;             /* --fov (0..180 degrees) */
+    long aa;                /* --aa (1..PLX_RENDER_MAX_AA) */
+    int aerial;             /* --view street|aerial */
+    int no_glow, refine;    /* --no-glow, --refine */
+} cli_view;
+
+#define CLI_VIEW_NOPTS 7
+
+/* Fills frag (CLI_VIEW_NOPTS entries, the last CLI_OPT_END) with the view
+ * options writing into v, for a table to link with CLI_OPT_MORE(frag).
+ * v keeps its defaults until an option changes them. */
+void cli_view_opts(cli_view *v, cli_opt *frag);
 
 #endif
