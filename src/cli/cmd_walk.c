@@ -6,6 +6,7 @@
 #include <sys/stat.h>
 
 #include "cli.h"
+#include "options.h"
 #include "port.h"
 #include "png/image_write.h"
 #include "walk_path.h"
@@ -50,106 +51,75 @@ typedef struct walk_args {
     cli_indirect ind;
 } walk_args;
 
-static int parse_value(walk_args *a, const char *opt, const char *val)
+static int parse_rate(const char *val, void *dst)
 {
-    long w, h, n;
-    char extra;
-    if (strcmp(opt, "--path") == 0) {
-        a->path = val;
-    } else if (strcmp(opt, "-o") == 0) {
-        a->dir = val;
-    } else if (strcmp(opt, "--size") == 0) {
-        if (sscanf(val, "%ldx%ld%c", &w, &h, &extra) != 2 || w < 1 || h < 1 || w > 8192 || h > 8192)
-            return cli_usage_error("walk", "--size '%s' is not WxH (1..8192 each)", val);
-        a->w = (int)w;
-        a->h = (int)h;
-    } else if (strcmp(opt, "--fps") == 0 || strcmp(opt, "--speed") == 0) {
-        double *v = strcmp(opt, "--fps") == 0 ? &a->fps : &a->speed;
-        if (cli_parse_double(val, v) != 0 || !(*v > 0) || *v > 1e4)
-            return cli_usage_error("walk", "%s '%s' is not a positive number", opt, val);
-    } else if (strcmp(opt, "--fov") == 0) {
-        if (cli_parse_double(val, &a->fov) != 0 || !(a->fov > 0 && a->fov < 180))
-            return cli_usage_error("walk", "--fov '%s' is not between 0 and 180 degrees", val);
-    } else if (strcmp(opt, "--aa") == 0) {
-        if (cli_parse_int(val, 1, PLX_RENDER_MAX_AA, &n) != 0)
-            return cli_usage_error("walk", "--aa '%s' is not a whole number from 1 to %d", val, PLX_RENDER_MAX_AA);
-        a->opts.aa = (int)n;
-    } else if (strcmp(opt, "--exposure") == 0) {
-        if (cli_parse_double(val, &a->opts.exposure) != 0 || !(a->opts.exposure >= 0))
-            return cli_usage_error("walk", "--exposure '%s' is not a number >= 0", val);
-        a->opts.auto_exposure = 0;
-    } else if (strcmp(opt, "--view") == 0) {
-        if (strcmp(val, "street") && strcmp(val, "aerial"))
-            return cli_usage_error("walk", "--view '%s' is not street or aerial", val);
-        a->aerial = strcmp(val, "aerial") == 0;
-    } else if (strcmp(opt, "--refine-frames") == 0) {
-        if (cli_parse_int(val, 0, 100000, &a->refine_frames) != 0)
-            return cli_usage_error("walk", "--refine-frames '%s' is not a whole number >= 0", val);
-    } else if (strcmp(opt, "--max-frames") == 0) {
-        if (cli_parse_int(val, 1, 1000000, &a->max_frames) != 0)
-            return cli_usage_error("walk", "--max-frames '%s' is not a whole number >= 1", val);
-    } else {
-        return -1;
-    }
-    return EXIT_OK;
+    double *v = dst;
+    return cli_parse_double(val, v) != 0 || !(*v > 0) || *v > 1e4 ? -1 : 0;
+}
+
+static int parse_exposure(const char *val, void *dst)
+{
+    double *v = dst;
+    return cli_parse_double(val, v) != 0 || !(*v >= 0) ? -1 : 0;
+}
+
+static int parse_refine_frames(const char *val, void *dst)
+{
+    return cli_parse_int(val, 0, 100000, dst);
+}
+
+static int parse_max_frames(const char *val, void *dst)
+{
+    return cli_parse_int(val, 1, 1000000, dst);
 }
 
 static int parse_args(int argc, char **argv, walk_args *a)
 {
-    static const char *const valued[] = { "--path", "-o", "--size", "--fps", "--speed", "--fov", "--aa",
-                                          "--exposure", "--view", "--max-frames", "--refine-frames" };
-    int i;
-    size_t k;
+    cli_view v;
+    cli_opt view[CLI_VIEW_NOPTS];
+    int exposure = 0, rc;
+    const cli_opt opts[] = {
+        CLI_OPT_STR("--path", &a->path),
+        CLI_OPT_STR("-o", &a->dir),
+        CLI_OPT_VAL("--fps", &a->fps, parse_rate, "--fps '%s' is not a positive number"),
+        CLI_OPT_VAL("--speed", &a->speed, parse_rate, "--speed '%s' is not a positive number"),
+        { "--exposure", NULL, &a->opts.exposure, parse_exposure, "--exposure '%s' is not a number >= 0", 0, NULL,
+          &exposure, NULL },
+        CLI_OPT_VAL("--refine-frames", &a->refine_frames, parse_refine_frames,
+                    "--refine-frames '%s' is not a whole number >= 0"),
+        CLI_OPT_VAL("--max-frames", &a->max_frames, parse_max_frames, "--max-frames '%s' is not a whole number >= 1"),
+        CLI_OPT_MORE(view),
+        CLI_OPT_END
+    };
+    cli_args pa;
     memset(a, 0, sizeof *a);
     plx_render_opts_default(&a->opts);
     a->opts.auto_exposure = 1;
-    a->opts.aa = 2;
     cli_indirect_default(&a->ind);
-    a->w = 640;
-    a->h = 480;
     a->fps = 25;
     a->speed = 1.4;
-    a->fov = 60;
     a->max_frames = 1000;
     a->refine_frames = 2;
-    for (i = 1; i < argc; i++) {
-        const char *s = argv[i];
-        int r = cli_common_option("walk", argc, argv, &i, &a->c);
-        if (r == 0)
-            r = cli_indirect_option("walk", argc, argv, &i, &a->ind);
-        if (r < 0)
-            return EXIT_USAGE;
-        if (r)
-            continue;
-        if (strcmp(s, "--help") == 0 || strcmp(s, "-h") == 0) {
-            fputs(help, stdout);
-            return -1;
-        }
-        if (strcmp(s, "--no-glow") == 0) {
-            a->opts.no_glow = 1;
-            continue;
-        }
-        if (strcmp(s, "--refine") == 0) {
-            a->refine = 1;
-            continue;
-        }
-        for (k = 0; k < sizeof valued / sizeof valued[0]; k++)
-            if (strcmp(s, valued[k]) == 0)
-                break;
-        if (k < sizeof valued / sizeof valued[0]) {
-            if (i + 1 >= argc)
-                return cli_usage_error("walk", "%s needs a value", s);
-            r = parse_value(a, s, argv[++i]);
-            if (r != EXIT_OK)
-                return r;
-        } else if (s[0] == '-' && s[1] != '\0') {
-            return cli_usage_error("walk", "unknown option '%s'", s);
-        } else if (!a->scene) {
-            a->scene = s;
-        } else {
-            return cli_usage_error("walk", "unexpected argument '%s'", s);
-        }
-    }
+    memset(&v, 0, sizeof v);
+    v.size[0] = 640;
+    v.size[1] = 480;
+    v.fov = 60;
+    v.aa = 2;
+    v.no_glow = a->opts.no_glow;
+    cli_view_opts(&v, view);
+    rc = cli_options_n("walk", help, argc, argv, opts, &a->c, &a->ind, 1, &pa);
+    if (rc != EXIT_OK)
+        return rc;
+    a->scene = pa.npos ? pa.pos[0] : NULL;
+    a->w = (int)v.size[0];
+    a->h = (int)v.size[1];
+    a->fov = v.fov;
+    a->opts.aa = (int)v.aa;
+    a->opts.no_glow = v.no_glow;
+    a->aerial = v.aerial;
+    a->refine = v.refine;
+    if (exposure)
+        a->opts.auto_exposure = 0;
     if (!a->scene)
         return cli_usage_error("walk", "missing SCENE");
     if (!a->path)
