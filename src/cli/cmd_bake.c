@@ -67,7 +67,7 @@ static int parse_args(int argc, char **argv, bake_args *a)
     cli_args pa;
     memset(a, 0, sizeof *a);
     cli_indirect_default(&a->ind);
-    rc = cli_options_n("bake", help, argc, argv, opts, &a->c, &a->ind, 1, &pa);
+    rc = cli_options_n("bake", help, argc, argv, opts, &a->c, &a->ind, 1, NULL, &pa);
     if (rc != EXIT_OK)
         return rc;
     a->scene = pa.npos ? pa.pos[0] : NULL;

@@ -124,7 +124,7 @@ static int parse_args(int argc, char **argv, render_args *a)
     v.aa = a->opts.aa;
     v.no_glow = a->opts.no_glow;
     cli_view_opts(&v, view);
-    rc = cli_options_n("render", help, argc, argv, opts, &a->c, &a->ind, 1, &pa);
+    rc = cli_options_n("render", help, argc, argv, opts, &a->c, &a->ind, 1, NULL, &pa);
     if (rc != EXIT_OK)
         return rc;
     a->scene = pa.npos ? pa.pos[0] : NULL;

@@ -107,7 +107,7 @@ static int parse_args(int argc, char **argv, walk_args *a)
     v.aa = 2;
     v.no_glow = a->opts.no_glow;
     cli_view_opts(&v, view);
-    rc = cli_options_n("walk", help, argc, argv, opts, &a->c, &a->ind, 1, &pa);
+    rc = cli_options_n("walk", help, argc, argv, opts, &a->c, &a->ind, 1, NULL, &pa);
     if (rc != EXIT_OK)
         return rc;
     a->scene = pa.npos ? pa.pos[0] : NULL;

@@ -49,7 +49,7 @@ static int take_opt(const char *cmd, int argc, char **argv, int *i, const cli_op
 }
 
 int cli_options_n(const char *cmd, const char *help, int argc, char **argv, const cli_opt *opts,
-                  cli_common *c, cli_indirect *ind, int maxpos, cli_args *out)
+                  cli_common *c, cli_indirect *ind, int maxpos, const char *toomany, cli_args *out)
 {
     int i;
     memset(out, 0, sizeof *out);
@@ -81,7 +81,7 @@ int cli_options_n(const char *cmd, const char *help, int argc, char **argv, cons
         } else if (out->npos < maxpos) {
             out->pos[out->npos++] = a;
         } else {
-            return cli_usage_error(cmd, "unexpected argument '%s'", a);
+            return cli_usage_error(cmd, toomany ? toomany : "unexpected argument '%s'", a);
         }
     }
     return EXIT_OK;
@@ -90,7 +90,7 @@ int cli_options_n(const char *cmd, const char *help, int argc, char **argv, cons
 int cli_options(const char *cmd, const char *help, int argc, char **argv, const cli_opt *opts,
                 cli_common *c, cli_indirect *ind, cli_args *out)
 {
-    return cli_options_n(cmd, help, argc, argv, opts, c, ind, CLI_MAX_POS, out);
+    return cli_options_n(cmd, help, argc, argv, opts, c, ind, CLI_MAX_POS, NULL, out);
 }
 
 /* ---- the view options of render and walk ---------------------------------- */

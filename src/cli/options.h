@@ -50,9 +50,10 @@ int cli_options(const char *cmd, const char *help, int argc, char **argv, const 
                 cli_common *c, cli_indirect *ind, cli_args *out);
 
 /* The same with at most maxpos (0..CLI_MAX_POS) positionals: the one after
- * is "unexpected argument" where it stands, before the options after it. */
+ * is a usage error where it stands, before the options after it, with
+ * message toomany ("%s": the argument; NULL: "unexpected argument '%s'"). */
 int cli_options_n(const char *cmd, const char *help, int argc, char **argv, const cli_opt *opts,
-                  cli_common *c, cli_indirect *ind, int maxpos, cli_args *out);
+                  cli_common *c, cli_indirect *ind, int maxpos, const char *toomany, cli_args *out);
 
 /* Parsers for the table (dst: double *, long *). */
 int cli_opt_double(const char *value, void *dst);
