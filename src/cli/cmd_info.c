@@ -2,6 +2,7 @@
  * and memory per part. */
 #include <string.h>
 #include "cli.h"
+#include "options.h"
 
 static const char help[] =
     "usage: polarlux info SCENE [--mem SIZE] [--strict] [--quiet] [--lamps FILE]... [--min-mem]\n"
@@ -113,28 +114,14 @@ int cmd_info(int argc, char **argv)
     plx_scene_info si;
     plx_polar_info pi;
     plx_ground_image_info gi;
-    int i, rc, min_mem = 0;
+    int rc, min_mem = 0;
+    const cli_opt opts[] = { CLI_OPT_FLAG("--min-mem", &min_mem), CLI_OPT_END };
+    cli_args pa;
     memset(&c, 0, sizeof c);
-    for (i = 1; i < argc; i++) {
-        int r = cli_common_option("info", argc, argv, &i, &c);
-        if (r < 0)
-            return EXIT_USAGE;
-        if (r)
-            continue;
-        if (strcmp(argv[i], "--help") == 0 || strcmp(argv[i], "-h") == 0) {
-            fputs(help, stdout);
-            return EXIT_OK;
-        }
-        if (strcmp(argv[i], "--min-mem") == 0) {
-            min_mem = 1;
-            continue;
-        }
-        if (argv[i][0] == '-' && argv[i][1] != '\0')
-            return cli_usage_error("info", "unknown option '%s'", argv[i]);
-        if (path)
-            return cli_usage_error("info", "one scene at a time ('%s' and '%s')", path, argv[i]);
-        path = argv[i];
-    }
+    rc = cli_options_n("info", help, argc, argv, opts, &c, NULL, 1, "one scene at a time ('%2$s' and '%1$s')", &pa);
+    if (rc != EXIT_OK)
+        return rc < 0 ? EXIT_OK : rc;
+    path = pa.npos ? pa.pos[0] : NULL;
     if (!path)
         return cli_usage_error("info", "missing SCENE");
     rc = cli_open_scene("info", path, &c, &e);

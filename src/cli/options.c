@@ -81,7 +81,8 @@ int cli_options_n(const char *cmd, const char *help, int argc, char **argv, cons
         } else if (out->npos < maxpos) {
             out->pos[out->npos++] = a;
         } else {
-            return cli_usage_error(cmd, toomany ? toomany : "unexpected argument '%s'", a);
+            return cli_usage_error(cmd, toomany ? toomany : "unexpected argument '%s'", a,
+                                   out->npos ? out->pos[out->npos - 1] : "");
         }
     }
     return EXIT_OK;

@@ -51,7 +51,8 @@ int cli_options(const char *cmd, const char *help, int argc, char **argv, const 
 
 /* The same with at most maxpos (0..CLI_MAX_POS) positionals: the one after
  * is a usage error where it stands, before the options after it, with
- * message toomany ("%s": the argument; NULL: "unexpected argument '%s'"). */
+ * message toomany (given the argument, then the positional before it: "%s"
+ * or "%2$s ... %1$s"; NULL: "unexpected argument '%s'"). */
 int cli_options_n(const char *cmd, const char *help, int argc, char **argv, const cli_opt *opts,
                   cli_common *c, cli_indirect *ind, int maxpos, const char *toomany, cli_args *out);
 
