@@ -12,6 +12,12 @@ int cli_opt_double(const char *value, void *dst)
     return cli_parse_double(value, dst);
 }
 
+int cli_opt_height(const char *value, void *dst)
+{
+    double *h = dst;
+    return cli_parse_double(value, h) != 0 || !(*h >= 0) || !(*h <= 1000) ? -1 : 0;
+}
+
 static const cli_opt *find_opt(const cli_opt *opts, const char *a)
 {
     for (; opts && (opts->name || opts->more); opts++) {

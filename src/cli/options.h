@@ -58,6 +58,8 @@ int cli_options_n(const char *cmd, const char *help, int argc, char **argv, cons
 
 /* Parsers for the table (dst: double *, long *). */
 int cli_opt_double(const char *value, void *dst);
+/* A height in metres from 0 to 1000 (dst: double *). */
+int cli_opt_height(const char *value, void *dst);
 
 /* ---- the view options of render and walk ---------------------------------- */
 
