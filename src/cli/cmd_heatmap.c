@@ -503,12 +503,6 @@ static int parse_quantity(const char *q, void *dst)
     return *k < 0 ? -1 : 0;
 }
 
-static int parse_height(const char *v, void *dst)
-{
-    double *h = dst;
-    return cli_parse_double(v, h) != 0 || !(*h >= 0) || !(*h <= 1000) ? -1 : 0;
-}
-
 static int parse_facing(const char *v, void *dst)
 {
     double *f = dst;
@@ -532,7 +526,7 @@ int cmd_heatmap(int argc, char **argv)
         CLI_OPT_VAL("--res", &o.res, parse_res, "--res '%s' is not a positive number of metres (at most 1e7)"),
         CLI_OPT_VAL("--max", &o.top, parse_max, "--max '%s' is not a number of lux above 0.1 (at most 1e9)"),
         CLI_OPT_VAL("--quantity", &o.quantity, parse_quantity, "--quantity '%s' is not h, v, sc or hs"),
-        CLI_OPT_VAL("--height", &o.height, parse_height, "--height '%s' is not a number of metres from 0 to 1000"),
+        CLI_OPT_VAL("--height", &o.height, cli_opt_height, "--height '%s' is not a number of metres from 0 to 1000"),
         CLI_OPT_VAL("--facing", &o.facing, parse_facing, "--facing '%s' is not a number of degrees"),
         CLI_OPT_STR("-o", &o.out),
         CLI_OPT_STR("--path", &o.path),

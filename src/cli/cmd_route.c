@@ -233,12 +233,6 @@ static int parse_step(const char *v, void *dst)
     return cli_parse_real(v, 0.01, CLI_MAX_COORD, dst);
 }
 
-static int parse_height(const char *v, void *dst)
-{
-    double *h = dst;
-    return cli_parse_double(v, h) != 0 || !(*h >= 0) || !(*h <= 1000) ? -1 : 0;
-}
-
 static int parse_dark_lux(const char *v, void *dst)
 {
     return cli_parse_real(v, 0, 1e9, dst);
@@ -255,7 +249,7 @@ int cmd_route(int argc, char **argv)
         CLI_OPT_STR("--path", &o.path),
         CLI_OPT_STR("--geojson", &o.geojson),
         CLI_OPT_VAL("--step", &o.step, parse_step, "--step '%s' is not a number of metres from 0.01 to 1e7"),
-        CLI_OPT_VAL("--height", &o.height, parse_height, "--height '%s' is not a number of metres from 0 to 1000"),
+        CLI_OPT_VAL("--height", &o.height, cli_opt_height, "--height '%s' is not a number of metres from 0 to 1000"),
         CLI_OPT_VAL("--dark-lux", &o.dark, parse_dark_lux, "--dark-lux '%s' is not a number of lux from 0 to 1e9"),
         CLI_OPT_END
     };
