@@ -52,12 +52,25 @@ static const double *item_box(const double *box, const vec2 *pts, uint32_t i, do
     return b;
 }
 
-static void place(bucketgrid *g, const uint32_t r[4], uint32_t id)
+/* One pass over the items: counts them into start (place 0) or places
+ * their ids at the cursors (place 1). */
+static void fill_pass(bucketgrid *g, const double *box, const vec2 *pts, uint32_t n, int place)
 {
-    uint32_t x, y;
-    for (y = r[1]; y <= r[3]; y++)
-        for (x = r[0]; x <= r[2]; x++)
-            g->item[g->start[(size_t)y * g->nx + x]++] = id;
+    uint32_t i, x, y, r[4];
+    double b[4];
+    for (i = 0; i < n; i++) {
+        const double *bi = item_box(box, pts, i, b);
+        if (box && !(bi[0] <= bi[2]))
+            continue;
+        bucketgrid_range(g, bi, r);
+        if (!place) {
+            bucketgrid_count(g, r);
+            continue;
+        }
+        for (y = r[1]; y <= r[3]; y++)
+            for (x = r[0]; x <= r[2]; x++)
+                g->item[g->start[(size_t)y * g->nx + x]++] = i;
+    }
 }
 
 static void *grid_mem(arena *a, plx_part part, size_t n, size_t align, int zero)
@@ -76,31 +89,17 @@ plx_status bucketgrid_fill(bucketgrid *g, arena *a, plx_part part, size_t align,
                            const vec2 *pts, uint32_t n)
 {
     size_t total;
-    uint32_t i, r[4];
-    double b[4];
     g->start = grid_mem(a, part, (size_t)g->nx * g->ny + 1, align, 1);
     if (!g->start)
         return PLX_E_NOMEM;
-    for (i = 0; i < n; i++) {
-        const double *bi = item_box(box, pts, i, b);
-        if (box && !(bi[0] <= bi[2]))
-            continue;
-        bucketgrid_range(g, bi, r);
-        bucketgrid_count(g, r);
-    }
+    fill_pass(g, box, pts, n, 0);
     total = bucketgrid_offsets(g);
     if (total == SIZE_MAX)
         return PLX_E_NOMEM;
     g->item = grid_mem(a, part, total + (part != PLX_PART_SCRATCH), align, 0);
     if (!g->item)
         return PLX_E_NOMEM;
-    for (i = 0; i < n; i++) {
-        const double *bi = item_box(box, pts, i, b);
-        if (box && !(bi[0] <= bi[2]))
-            continue;
-        bucketgrid_range(g, bi, r);
-        place(g, r, i);
-    }
+    fill_pass(g, box, pts, n, 1);
     bucketgrid_rewind(g);
     return PLX_OK;
 }
