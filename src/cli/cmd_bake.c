@@ -42,17 +42,6 @@ static int parse_texel(const char *v, void *dst)
     return cli_parse_double(v, t) != 0 || !(*t > 0) ? -1 : 0;
 }
 
-static int parse_max_size(const char *v, void *dst)
-{
-    long *wh = dst, w, h;
-    char extra;
-    if (sscanf(v, "%ldx%ld%c", &w, &h, &extra) != 2 || w < 1 || h < 1 || w > 8192 || h > 8192)
-        return -1;
-    wh[0] = w;
-    wh[1] = h;
-    return 0;
-}
-
 static int parse_args(int argc, char **argv, bake_args *a)
 {
     long size[2] = { 1024, 768 };
@@ -61,7 +50,7 @@ static int parse_args(int argc, char **argv, bake_args *a)
         CLI_OPT_FLAG("--no-aerial", &no_aerial),
         CLI_OPT_STR("-o", &a->out),
         CLI_OPT_VAL("--texel", &a->o.aerial_m_per_texel, parse_texel, "--texel '%s' is not a positive number of metres"),
-        CLI_OPT_VAL("--max-size", size, parse_max_size, "--max-size '%s' is not WxH (1..8192 each)"),
+        CLI_OPT_VAL("--max-size", size, cli_opt_size, "--max-size '%s' is not WxH (1..8192 each)"),
         CLI_OPT_END
     };
     cli_args pa;

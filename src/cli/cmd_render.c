@@ -117,12 +117,7 @@ static int parse_args(int argc, char **argv, render_args *a)
     plx_render_opts_default(&a->opts);
     a->opts.auto_exposure = 1; /* until --exposure */
     cli_indirect_default(&a->ind);
-    memset(&v, 0, sizeof v);
-    v.fov = 60.0;
-    v.size[0] = 640;
-    v.size[1] = 480;
-    v.aa = a->opts.aa;
-    v.no_glow = a->opts.no_glow;
+    cli_view_init(&v, 640, 480, 60.0, &a->opts);
     cli_view_opts(&v, view);
     rc = cli_options_n("render", help, argc, argv, opts, &a->c, &a->ind, 1, NULL, &pa);
     if (rc != EXIT_OK)
@@ -131,8 +126,7 @@ static int parse_args(int argc, char **argv, render_args *a)
     a->cam.fov_deg = v.fov;
     a->cam.width = (int32_t)v.size[0];
     a->cam.height = (int32_t)v.size[1];
-    a->opts.aa = (int)v.aa;
-    a->opts.no_glow = v.no_glow;
+    cli_view_apply(&v, &a->opts);
     a->aerial = v.aerial;
     a->refine = v.refine;
     if (exposure)
@@ -148,7 +142,6 @@ static int parse_args(int argc, char **argv, render_args *a)
     if (a->have_eye && a->cam.eye[0] == a->cam.target[0] && a->cam.eye[1] == a->cam.target[1] &&
         a->cam.eye[2] == a->cam.target[2])
         return cli_usage_error("render", "--eye and --target are the same point");
-    a->opts.aerial = a->aerial;
     a->opts.no_indirect = a->ind.off;
     return EXIT_OK;
 }

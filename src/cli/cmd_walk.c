@@ -100,12 +100,8 @@ static int parse_args(int argc, char **argv, walk_args *a)
     a->speed = 1.4;
     a->max_frames = 1000;
     a->refine_frames = 2;
-    memset(&v, 0, sizeof v);
-    v.size[0] = 640;
-    v.size[1] = 480;
-    v.fov = 60;
-    v.aa = 2;
-    v.no_glow = a->opts.no_glow;
+    a->opts.aa = 2;
+    cli_view_init(&v, 640, 480, 60, &a->opts);
     cli_view_opts(&v, view);
     rc = cli_options_n("walk", help, argc, argv, opts, &a->c, &a->ind, 1, NULL, &pa);
     if (rc != EXIT_OK)
@@ -114,8 +110,7 @@ static int parse_args(int argc, char **argv, walk_args *a)
     a->w = (int)v.size[0];
     a->h = (int)v.size[1];
     a->fov = v.fov;
-    a->opts.aa = (int)v.aa;
-    a->opts.no_glow = v.no_glow;
+    cli_view_apply(&v, &a->opts);
     a->aerial = v.aerial;
     a->refine = v.refine;
     if (exposure)
@@ -126,7 +121,6 @@ static int parse_args(int argc, char **argv, walk_args *a)
         return cli_usage_error("walk", "missing --path CAMERA.geojson");
     if (!a->dir)
         return cli_usage_error("walk", "missing -o DIR");
-    a->opts.aerial = a->aerial;
     a->opts.no_indirect = a->ind.off;
     return EXIT_OK;
 }

@@ -102,7 +102,7 @@ int cli_options(const char *cmd, const char *help, int argc, char **argv, const 
 
 /* ---- the view options of render and walk ---------------------------------- */
 
-static int parse_size(const char *v, void *dst)
+int cli_opt_size(const char *v, void *dst)
 {
     long *wh = dst, w, h;
     char extra;
@@ -132,10 +132,27 @@ static int parse_view(const char *v, void *dst)
     return 0;
 }
 
+void cli_view_init(cli_view *v, long w, long h, double fov, const plx_render_opts *o)
+{
+    memset(v, 0, sizeof *v);
+    v->size[0] = w;
+    v->size[1] = h;
+    v->fov = fov;
+    v->aa = o->aa;
+    v->no_glow = o->no_glow;
+}
+
+void cli_view_apply(const cli_view *v, plx_render_opts *o)
+{
+    o->aa = (int)v->aa;
+    o->no_glow = v->no_glow;
+    o->aerial = v->aerial;
+}
+
 void cli_view_opts(cli_view *v, cli_opt *frag)
 {
     const cli_opt f[CLI_VIEW_NOPTS] = {
-        CLI_OPT_VAL("--size", v->size, parse_size, "--size '%s' is not WxH (1..8192 each)"),
+        CLI_OPT_VAL("--size", v->size, cli_opt_size, "--size '%s' is not WxH (1..8192 each)"),
         CLI_OPT_VAL("--fov", &v->fov, parse_fov, "--fov '%s' is not between 0 and 180 degrees"),
         CLI_OPT_VAL("--aa", &v->aa, parse_aa,
                     "--aa '%s' is not a whole number from 1 to " STR(PLX_RENDER_MAX_AA)),

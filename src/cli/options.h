@@ -61,6 +61,9 @@ int cli_opt_double(const char *value, void *dst);
 /* A height in metres from 0 to 1000 (dst: double *). */
 int cli_opt_height(const char *value, void *dst);
 
+/* WxH with 1..8192 each (dst: long[2]). */
+int cli_opt_size(const char *value, void *dst);
+
 /* ---- the view options of render and walk ---------------------------------- */
 
 typedef struct cli_view {
@@ -73,9 +76,15 @@ typedef struct cli_view {
 
 #define CLI_VIEW_NOPTS 7
 
+/* Defaults: w x h pixels, fov degrees, o's anti-aliasing and glow, the
+ * street view, no refinement. */
+void cli_view_init(cli_view *v, long w, long h, double fov, const plx_render_opts *o);
+
 /* Fills frag (CLI_VIEW_NOPTS entries, the last CLI_OPT_END) with the view
- * options writing into v, for a table to link with CLI_OPT_MORE(frag).
- * v keeps its defaults until an option changes them. */
+ * options writing into v, for a table to link with CLI_OPT_MORE(frag). */
 void cli_view_opts(cli_view *v, cli_opt *frag);
+
+/* After parsing: the anti-aliasing, glow and view into o. */
+void cli_view_apply(const cli_view *v, plx_render_opts *o);
 
 #endif
