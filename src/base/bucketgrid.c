@@ -8,7 +8,6 @@ void bucketgrid_frame(bucketgrid *g, double x0, double y0, double cell, uint32_t
 {
     g->x0 = x0;
     g->y0 = y0;
-    g->cell = cell;
     g->sx = g->sy = 1.0 / cell;
     g->nx = nx;
     g->ny = ny;

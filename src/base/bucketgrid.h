@@ -22,7 +22,6 @@
 typedef struct bucketgrid {
     double x0, y0;    /* low corner of the frame */
     double sx, sy;    /* cells per metre along x and y */
-    double cell;      /* cell size (m) when set by bucketgrid_frame, else 0 */
     uint32_t nx, ny;
     uint32_t *start;  /* nx * ny + 1 offsets into item */
     uint32_t *item;

@@ -35,8 +35,8 @@ static const vec2 *ring_pts(const scene *s, uint32_t r, uint32_t *n)
 
 /* Sets the grid frame over the union of the boxes (a box with min > max is
  * left out) with cells of about 'cell' metres, at most about 'maxcells' of
- * them. */
-static void grid_frame(bucketgrid *g, const double (*box)[4], uint32_t n, double cell,
+ * them; returns the cell size. */
+static double grid_frame(bucketgrid *g, const double (*box)[4], uint32_t n, double cell,
                        double maxcells)
 {
     double lo[2] = { 0.0, 0.0 }, hi[2] = { 1.0, 1.0 }, w, h;
@@ -58,6 +58,7 @@ static void grid_frame(bucketgrid *g, const double (*box)[4], uint32_t n, double
     if ((w / cell + 1.0) * (h / cell + 1.0) > maxcells)
         cell = sqrt((w + cell) * (h + cell) / maxcells) + 1e-9;
     bucketgrid_frame(g, lo[0], lo[1], cell, (uint32_t)(w / cell) + 1, (uint32_t)(h / cell) + 1);
+    return cell;
 }
 
 static plx_status build_grids(light *L, arena *a)
@@ -73,8 +74,8 @@ static plx_status build_grids(light *L, arena *a)
         memcpy(box[i], s->bld[i].box, sizeof box[i]);
         size += sqrt((box[i][2] - box[i][0]) * (box[i][3] - box[i][1]));
     }
-    grid_frame(&L->bgrid, (const double (*)[4])box, s->nbld,
-               s->nbld ? 1.5 * size / s->nbld : 1.0, 4.0 * s->nbld + 64.0);
+    L->bcell = grid_frame(&L->bgrid, (const double (*)[4])box, s->nbld,
+                          s->nbld ? 1.5 * size / s->nbld : 1.0, 4.0 * s->nbld + 64.0);
     st = bucketgrid_fill(&L->bgrid, a, PLX_PART_LIT, LIGHT_ALIGN, box[0], NULL, s->nbld);
     for (i = 0, n = 0; st == PLX_OK && i < s->nlamps; i++) {
         const scene_lamp *lp = &s->lamps[i];
@@ -442,14 +443,14 @@ int light_segment_blocked(light *L, const double A[3], const double B[3])
     if (len3 == 0.0)
         return 0;
     stamp = next_stamp(L);
-    pad = 1e-9 * g->cell;
+    pad = 1e-9 * L->bcell;
     ylo = (A[1] < B[1] ? A[1] : B[1]);
     yhi = (A[1] < B[1] ? B[1] : A[1]);
     iy0 = bucketgrid_index(ylo - pad, g->y0, g->sy, g->ny);
     iy1 = bucketgrid_index(yhi + pad, g->y0, g->sy, g->ny);
     for (iy = iy0; iy <= iy1; iy++) {
         double x0, x1;
-        row_span(A, B, g->y0 + iy * g->cell - pad, g->y0 + (iy + 1) * g->cell + pad, &x0, &x1);
+        row_span(A, B, g->y0 + iy * L->bcell - pad, g->y0 + (iy + 1) * L->bcell + pad, &x0, &x1);
         if (iy == 0 || iy == g->ny - 1) {   /* clamped rows: whole span */
             x0 = A[0] < B[0] ? A[0] : B[0];
             x1 = A[0] < B[0] ? B[0] : A[0];

@@ -129,6 +129,7 @@ typedef struct light {
     const scene *s;
     bucketgrid bgrid;         /* buildings, by box */
     bucketgrid lgrid;         /* lamps, by the box of their reach disk */
+    double bcell;             /* bgrid's cell size (m) */
     uint32_t *stamp;          /* per building: last visit */
     uint32_t stamp_now;
     uint32_t maxv;            /* most ring vertices of one building */
