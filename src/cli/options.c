@@ -1,4 +1,5 @@
 /* options: the one option loop of the commands (see options.h). */
+#include <math.h>
 #include <stdio.h>
 #include <string.h>
 
@@ -16,6 +17,13 @@ int cli_opt_height(const char *value, void *dst)
 {
     double *h = dst;
     return cli_parse_double(value, h) != 0 || !(*h >= 0) || !(*h <= 1000) ? -1 : 0;
+}
+
+int cli_opt_facing(const char *value, void *dst)
+{
+    heat_quantity *q = dst;
+    q->facing_min = strcmp(value, "min") == 0;
+    return !q->facing_min && (cli_parse_double(value, &q->facing) != 0 || !isfinite(q->facing)) ? -1 : 0;
 }
 
 static const cli_opt *find_opt(const cli_opt *opts, const char *a)
@@ -36,6 +44,7 @@ static const cli_opt *find_opt(const cli_opt *opts, const char *a)
 static int take_opt(const char *cmd, int argc, char **argv, int *i, const cli_opt *o)
 {
     const char *a = argv[*i];
+    int r;
     if (o->given)
         *o->given = 1;
     if (o->flag) {
@@ -49,7 +58,10 @@ static int take_opt(const char *cmd, int argc, char **argv, int *i, const cli_op
         *(const char **)o->dst = argv[*i];
         return EXIT_OK;
     }
-    if (o->parse(argv[*i], o->dst) != 0)
+    r = o->parse(argv[*i], o->dst);
+    if (r == -2)
+        return EXIT_USAGE;
+    if (r != 0)
         return cli_usage_error(cmd, o->bad, argv[*i]);
     return EXIT_OK;
 }

@@ -12,7 +12,8 @@
 
 #include "cli.h"
 
-/* Parses value into dst; 0 on success. */
+/* Parses value into dst; 0 on success, -1 for the entry's 'bad' message,
+ * -2 when it printed a message of its own. */
 typedef int (*cli_parse_fn)(const char *value, void *dst);
 
 typedef struct cli_opt {
@@ -60,6 +61,9 @@ int cli_options_n(const char *cmd, const char *help, int argc, char **argv, cons
 int cli_opt_double(const char *value, void *dst);
 /* A height in metres from 0 to 1000 (dst: double *). */
 int cli_opt_height(const char *value, void *dst);
+/* A facing direction in degrees, or min (dst: heat_quantity *: its facing
+ * and facing_min). */
+int cli_opt_facing(const char *value, void *dst);
 
 /* WxH with 1..8192 each (dst: long[2]). */
 int cli_opt_size(const char *value, void *dst);
