@@ -70,16 +70,39 @@ static plx_status need_light(plx_engine *e)
     return PLX_OK;
 }
 
+/* The photon buffers' budget when plx_config.photon_bytes is 0: half the
+ * block's free bytes when they are first needed (the other half stays for
+ * what a frame needs after them: lamp light, the renderer, its scratch). */
+static size_t default_photon_budget(const arena *a)
+{
+    return arena_free_bytes(a) / 2;
+}
+
 static plx_status need_photon(plx_engine *e)
 {
     photon_config cfg;
     plx_status st;
+    int steps;
     /* final gathering reads the later bounces all around its points: every
      * block gets a chart (photon.h, coarsest_level) */
     if (!e->gather_set || e->gather_side > 0)
         photon_config_gather(&cfg, e->sc);
     else
         photon_config_default(&cfg);
+    e->ph_full = photon_bytes(e->sc, &cfg);
+    e->ph_budget = e->cfg.photon_bytes ? e->cfg.photon_bytes : default_photon_budget(&e->mem);
+    steps = photon_config_fit(&cfg, e->sc, e->ph_budget);
+    if (steps < 0) {
+        strbuf b;
+        sb_init(&b, e->err, sizeof e->err);
+        sb_str(&b, "out of memory while creating the photon buffers: ");
+        sb_uint(&b, photon_bytes(e->sc, &cfg));
+        sb_str(&b, " bytes at their lowest quality, more than their budget of ");
+        sb_uint(&b, e->ph_budget);
+        sb_str(&b, e->cfg.photon_bytes ? " (plx_config.photon_bytes)" : " (half the free memory)");
+        return PLX_E_NOMEM;
+    }
+    e->ph_reductions = (uint32_t)steps;
     st = photon_create(&e->mem, e->sc, &cfg, &e->ph);
     if (st == PLX_E_NOMEM)
         return eng_nomem(e, "creating the photon buffers");
