@@ -197,6 +197,7 @@ check: check-build
 
 check-full: check-build
 	@sh tests/run_tests.sh $(BUILD) $(TESTS)
+	@sh tests/cli/memory_city.sh $(BUILD)/polarlux
 	@$(MAKE) --no-print-directory check-examples check-python
 
 check-build:
