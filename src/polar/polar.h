@@ -156,7 +156,7 @@ typedef struct polar {
  * bytes a footprint vertex plus POLAR_SCRATCH_FIXED (tests/unit/
  * test_polar_scratch.c measures it on growing rings; README "Memory
  * budgets"). */
-#define POLAR_SCRATCH_PER_VERTEX 1152
+#define POLAR_SCRATCH_PER_VERTEX 896
 #define POLAR_SCRATCH_FIXED ((size_t)1 << 20)
 
 /* Builds the four diagrams of scene s. On success *out points into arena

@@ -14,6 +14,9 @@
 #include <string.h>
 #include <cmocka.h>
 
+#include "polarlux.h"
+#include "polarlux_port.h"
+#include "base/engine.h"
 #include "base/arena.h"
 #include "polar/polar.h"
 #include "ref_scene.h"
@@ -70,6 +73,52 @@ static void test_scratch_per_vertex(void **state)
     }
 }
 
+typedef struct text {
+    char *p;
+    size_t n, cap;
+} text;
+
+static int put(void *ctx, const char *data, size_t len)
+{
+    text *t = ctx;
+    if (t->n + len + 1 > t->cap) {
+        t->cap = 2 * (t->n + len + 1);
+        t->p = realloc(t->p, t->cap);
+        assert_non_null(t->p);
+    }
+    memcpy(t->p + t->n, data, len);
+    t->n += len;
+    return 0;
+}
+
+/* The same bound on generated cities (footprints touching their
+ * neighbours: walls cut at contacts), measured through the engine: the
+ * scratch high-water mark of plx_polar_build after the load. */
+static void test_scratch_cities(void **state)
+{
+    static const char *style[] = { "eixample", "oldtown", "grid" };
+    int k, side = quick_mode() ? 8 : 24;
+    (void)state;
+    for (k = 0; k < 3; k++) {
+        text t = { NULL, 0, 0 };
+        plx_engine *e;
+        plx_scene_info si;
+        size_t scratch;
+        assert_int_equal(plx_gen_city(style[k], side, side, 1, put, &t), PLX_OK);
+        assert_int_equal(plx_engine_new((size_t)512 << 20, NULL, &e), PLX_OK);
+        assert_int_equal(plx_load_geojson(e, t.p, t.n, style[k]), PLX_OK);
+        assert_int_equal(plx_scene_info_get(e, &si), PLX_OK);
+        e->mem.peak[PLX_PART_SCRATCH] = e->mem.used[PLX_PART_SCRATCH];
+        assert_int_equal(plx_polar_build(e), PLX_OK);
+        scratch = e->mem.peak[PLX_PART_SCRATCH];
+        printf("gen %s %d %d (%u vertices): scratch %zu bytes (%.1f a vertex)\n", style[k], side, side,
+               si.vertices, scratch, (double)scratch / si.vertices);
+        assert_true(scratch <= (size_t)POLAR_SCRATCH_PER_VERTEX * si.vertices + POLAR_SCRATCH_FIXED);
+        plx_engine_free(e);
+        free(t.p);
+    }
+}
+
 /* The block the issue asks for: a 10^6-vertex ring in 256 MiB (printed,
  * not asserted: see README "Memory budgets"). */
 static void test_big_ring(void **state)
@@ -91,6 +140,7 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_scratch_per_vertex),
+        cmocka_unit_test(test_scratch_cities),
         cmocka_unit_test(test_big_ring),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
