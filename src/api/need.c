@@ -14,6 +14,7 @@
 #include "polar/polar.h"
 #include "light/light.h"
 #include "photon/photon.h"
+#include "photon/irradiance_cache.h"
 #include "render/render.h"
 
 #define DEFAULT_MAX_W 1920
@@ -98,28 +99,35 @@ static plx_status need_photon(plx_engine *e)
 {
     photon_config cfg;
     plx_status st;
+    arena_mark m;
     int steps;
+    size_t icb = icache_bytes(); /* the images' irradiance cache comes with them */
     /* final gathering reads the later bounces all around its points: every
      * block gets a chart (photon.h, coarsest_level) */
     if (!e->gather_set || e->gather_side > 0)
         photon_config_gather(&cfg, e->sc);
     else
         photon_config_default(&cfg);
-    e->ph_full = photon_bytes(e->sc, &cfg);
+    e->ph_full = photon_bytes(e->sc, &cfg) + icb;
     e->ph_budget = e->cfg.photon_bytes ? e->cfg.photon_bytes : default_photon_budget(e);
-    steps = photon_config_fit(&cfg, e->sc, e->ph_budget);
+    steps = photon_config_fit(&cfg, e->sc, e->ph_budget > icb ? e->ph_budget - icb : 0);
     if (steps < 0) {
         strbuf b;
         sb_init(&b, e->err, sizeof e->err);
         sb_str(&b, "out of memory while creating the photon buffers: ");
-        sb_uint(&b, photon_bytes(e->sc, &cfg));
+        sb_uint(&b, photon_bytes(e->sc, &cfg) + icb);
         sb_str(&b, " bytes at their lowest quality, more than their budget of ");
         sb_uint(&b, e->ph_budget);
         sb_str(&b, e->cfg.photon_bytes ? " (plx_config.photon_bytes)" : " (half the free memory left after the renderer)");
         return PLX_E_NOMEM;
     }
     e->ph_reductions = (uint32_t)steps;
+    m = arena_get_mark(&e->mem);
     st = photon_create(&e->mem, e->sc, &cfg, &e->ph);
+    if (st == PLX_OK && (st = icache_create(&e->mem, &e->ic)) != PLX_OK) {
+        arena_release(&e->mem, &m); /* as it was: no photon buffers */
+        e->ph = NULL;
+    }
     if (st == PLX_E_NOMEM)
         return eng_nomem(e, "creating the photon buffers");
     if (st != PLX_OK)

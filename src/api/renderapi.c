@@ -5,6 +5,7 @@
 #include "light/illuminance.h"
 #include "light/litregion.h"
 #include "render/render.h"
+#include "photon/irradiance_cache.h"
 
 #define DEFAULT_MAX_W 1920
 #define DEFAULT_MAX_H 1080
@@ -19,11 +20,18 @@ void plx_render_opts_default(plx_render_opts *o)
 }
 
 /* The photon hook of the renderer: the RGB indirect term (each lamp's light
- * weighted by its colour, carried by the photons; SPEC §5). */
+ * weighted by its colour; SPEC §5) from the irradiance cache (final
+ * gathers at sparse points of each surface, irradiance_cache.h), or the
+ * photon buffers alone when gathering is off (plx_indirect_set_gather 0). */
 static void shade_indirect(void *user, const double P[3], const double n[3], double rgb[3])
 {
-    eng_indirect_photons_rgb(user, P, n, rgb);
+    plx_engine *e = user;
+    if (e->ic && e->lt && !(e->gather_set && e->gather_side == 0))
+        icache_lookup(e->ic, e->ph, e->lt, P, n, rgb);
+    else
+        eng_indirect_photons_rgb(e, P, n, rgb);
 }
+
 
 plx_status eng_need_render(plx_engine *e)
 {
@@ -161,6 +169,8 @@ plx_status plx_render(plx_engine *e, const plx_camera *cam, const plx_render_opt
     if (!o->no_indirect && e->ph && plx_indirect_frames(e) > 0) {
         ro.indirect = shade_indirect;
         ro.indirect_user = e;
+        if (e->ic)
+            icache_set_view(e->ic, rc.eye);
     }
     if (o->aa > 1)
         st = render_aa(e, &rc, &ro, o->aa, rgb8, rgbf, &rs);

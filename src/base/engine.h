@@ -30,6 +30,7 @@ struct plx_engine {
     struct photon_sys *ph;  /* photon buffers, created on first need */
     size_t ph_full, ph_budget; /* their default-quality size and the budget they fit */
     uint32_t ph_reductions; /* quality steps taken to fit it (need.c) */
+    struct icache *ic;      /* images' irradiance cache, created with the photon buffers */
     double lightmap_cell;   /* light map texel size when built, else 0 */
     float *aa_sum;          /* anti-aliasing sum (PLX_PART_FRAME), taken on first need */
     uint32_t gather_side;   /* final gathering at points: side^2 directions
