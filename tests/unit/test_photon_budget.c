@@ -169,6 +169,11 @@ static void test_reduced_quality(void **state)
     for (q = 2; q <= 16; q *= 2) {
         double sum = 0.0, n = 0.0;
         do_run(&r, full.info.full_bytes / (size_t)q);
+        if (q > 4 && r.st == PLX_E_NOMEM) {   /* below the lowest quality */
+            printf("budget 1/%d of the default: below the lowest quality\n", q);
+            done(&r);
+            break;
+        }
         assert_int_equal(r.st, PLX_OK);
         for (i = 0; i < NPTS; i++)
             if (full.Ei[i] > 0.0) {
