@@ -33,7 +33,8 @@ class Port(ctypes.Structure):
 class Config(ctypes.Structure):
     _fields_ = [("port", ctypes.POINTER(Port)), ("strict", ctypes.c_int),
                 ("part_budget", ctypes.c_size_t * PART_COUNT), ("lit_cache_bytes", ctypes.c_size_t),
-                ("render_max_width", ctypes.c_int32), ("render_max_height", ctypes.c_int32)]
+                ("render_max_width", ctypes.c_int32), ("render_max_height", ctypes.c_int32),
+                ("lightmap_bytes", ctypes.c_size_t), ("photon_bytes", ctypes.c_size_t)]
 
 
 class SceneInfo(ctypes.Structure):

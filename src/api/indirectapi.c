@@ -68,6 +68,29 @@ plx_status plx_indirect_refine(plx_engine *e, const double eye[3], plx_refine_st
     return PLX_OK;
 }
 
+plx_status plx_indirect_info_get(plx_engine *e, plx_indirect_info *out)
+{
+    const photon_sys *ps;
+    if (!eng_ok(e) || !out)
+        return PLX_E_INVALID;
+    memset(out, 0, sizeof *out);
+    if (!e->ph)
+        return eng_fail(e, PLX_E_NOSCENE, "plx_indirect_info_get: no photon buffers (trace indirect light first)");
+    ps = e->ph;
+    out->bytes = e->mem.used[PLX_PART_PHOTON];
+    out->full_bytes = e->ph_full;
+    out->budget = e->ph_budget;
+    out->reductions = e->ph_reductions;
+    out->lamp_tables = !ps->cfg.no_lamp_tables;
+    out->chart_w = ps->cfg.chart_w;
+    out->chart_h = ps->cfg.chart_h;
+    out->aerial_w = ps->gw;
+    out->aerial_h = ps->gh;
+    out->aerial_texel = ps->gtex;
+    out->lamp_slots = ps->nslots;
+    return PLX_OK;
+}
+
 plx_status plx_indirect_reset(plx_engine *e)
 {
     if (!eng_ok(e))

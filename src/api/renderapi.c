@@ -9,7 +9,7 @@
 
 #define DEFAULT_MAX_W 1920
 #define DEFAULT_MAX_H 1080
-#define LIGHTMAP_MAX_BYTES ((size_t)48 << 20) /* plx_config.lightmap_bytes 0 */
+#define LIGHTMAP_MAX_BYTES ((size_t)48 << 20) /* plx_config.lightmap_bytes 0: at most this */
 
 void plx_render_opts_default(plx_render_opts *o)
 {
@@ -48,6 +48,15 @@ static void shade_none(void *user, const double P[3], const double n[3], double 
     rgb[0] = rgb[1] = rgb[2] = 0.0;
 }
 
+/* The light map's budget when plx_config.lightmap_bytes is 0: half the
+ * block's free bytes when it is built, at most LIGHTMAP_MAX_BYTES (its
+ * texel grows until it fits, render_lightmap_build). */
+static size_t default_lightmap(const plx_engine *e)
+{
+    size_t half = arena_free_bytes(&e->mem) / 2;
+    return half < 12 ? 12 : half < LIGHTMAP_MAX_BYTES ? half : LIGHTMAP_MAX_BYTES;
+}
+
 plx_status eng_need_lightmap(plx_engine *e, double m_per_texel, int dark)
 {
     double cell = m_per_texel > 0 ? m_per_texel : 1.0;
@@ -56,7 +65,7 @@ plx_status eng_need_lightmap(plx_engine *e, double m_per_texel, int dark)
         return st;
     if (dark)
         render_code_bind(e->rd, shade_none);
-    st = render_lightmap_build(e->rd, cell, e->cfg.lightmap_bytes ? e->cfg.lightmap_bytes : LIGHTMAP_MAX_BYTES);
+    st = render_lightmap_build(e->rd, cell, e->cfg.lightmap_bytes ? e->cfg.lightmap_bytes : default_lightmap(e));
     if (dark)
         render_code_bind(e->rd, render_shade_light);
     if (st == PLX_E_NOMEM)

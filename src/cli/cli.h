@@ -86,6 +86,8 @@ void cli_indirect_default(cli_indirect *ind);
 int cli_indirect_option(const char *cmd, int argc, char **argv, int *i, cli_indirect *ind);
 /* Traces the frames (progress on a terminal), viewer at eye looking along
  * dir (either may be NULL). Returns an exit code. */
+/* A line on stderr when the photon buffers were fitted below the default quality. */
+void cli_indirect_note(const char *cmd, plx_engine *e);
 int cli_indirect_run(const char *cmd, plx_engine *e, const cli_indirect *ind, const double *eye,
                      const double *dir, double fov_deg);
 /* Near-viewer refinement at eye (plx_indirect_refine); when lamps were

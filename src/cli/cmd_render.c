@@ -244,6 +244,9 @@ static int default_street(plx_engine *e, plx_camera *cam)
     lamp_rank *r;
     double cx, cy, best = INFINITY;
     uint32_t i, n;
+    plx_status st = plx_polar_build(e); /* the search below asks for visibility */
+    if (st != PLX_OK)
+        return st == PLX_E_NOMEM ? -2 : -1;
     plx_scene_info_get(e, &si);
     cx = 0.5 * (si.bounds[0] + si.bounds[2]);
     cy = 0.5 * (si.bounds[1] + si.bounds[3]);
@@ -366,7 +369,11 @@ int cmd_render(int argc, char **argv)
     if (!a.have_eye) {
         if (a.aerial) {
             default_aerial(e, &a.cam);
-        } else if (default_street(e, &a.cam) != 0) {
+        } else if ((rc = default_street(e, &a.cam)) == -2) {
+            fprintf(stderr, "polarlux render: %s\n", plx_last_error(e));
+            plx_engine_free(e);
+            return EXIT_NOMEM;
+        } else if (rc != 0) {
             plx_scene_info si;
             plx_scene_info_get(e, &si);
             if (si.lamps == 0)

@@ -173,6 +173,13 @@ plx_status trace_create(arena *a, plx_part part, const scene *s, double cell_siz
  * per lamp, a lamp needing more gets none). */
 size_t trace_bytes(const scene *s, double cell_size);
 
+/* The same with the lamp tables on (tables 1, what trace_create builds) or
+ * off (0: no tables, every lamp ray walks the grid: the same hits, first
+ * rays about 2x slower; README "Photon buffers"). */
+plx_status trace_create_ex(arena *a, plx_part part, const scene *s, double cell_size, int tables,
+                           tracer **out /* OUT */);
+size_t trace_bytes_ex(const scene *s, double cell_size, int tables);
+
 /*
  * First surface hit by o + t d, 0 < t < tmax (tmax may be INFINITY); d must
  * be a unit vector, o finite with o[2] >= 0. Fills h and returns its kind
