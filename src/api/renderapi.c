@@ -25,6 +25,20 @@ static void shade_indirect(void *user, const double P[3], const double n[3], dou
     eng_indirect_photons_rgb(user, P, n, rgb);
 }
 
+/* The port's parallel-for and the number of workers for a frame
+ * (plx_config.threads; 0: the port's cores). */
+static void set_workers(const plx_engine *e, render_opts *ro)
+{
+    int n = e->cfg.threads;
+    if (!e->port.parallel_for)
+        return;
+    if (n <= 0)
+        n = e->port.cores ? e->port.cores(e->port.ctx) : 1;
+    ro->par = e->port.parallel_for;
+    ro->par_ctx = e->port.ctx;
+    ro->workers = n < 1 ? 1 : n > PLX_MAX_THREADS ? PLX_MAX_THREADS : n;
+}
+
 plx_status eng_need_render(plx_engine *e)
 {
     return eng_need(e, ENG_RENDER, "plx_render");
@@ -152,7 +166,9 @@ plx_status plx_render(plx_engine *e, const plx_camera *cam, const plx_render_opt
     if (!o->no_indirect && e->ph && plx_indirect_frames(e) > 0) {
         ro.indirect = shade_indirect;
         ro.indirect_user = e;
+        ro.indirect_mt = 1;   /* the photon buffers are only read (indirect.c) */
     }
+    set_workers(e, &ro);
     if (o->aa > 1)
         st = render_aa(e, &rc, &ro, o->aa, rgb8, rgbf, &rs);
     else

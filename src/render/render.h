@@ -227,6 +227,14 @@ struct plx_backend {
     int (*finish)(void *user, uint32_t *id /* OUT */, float *depth /* OUT */);
 };
 
+/* A parallel-for (plx_port.parallel_for): job(arg, worker, k) for k = 0 ..
+ * njobs-1 on up to 'workers' threads, worker in 0 .. workers-1, the calls
+ * of one worker one after another; returns 0 when all ran, -1 when none
+ * did. */
+typedef void (*render_job_fn)(void *arg, int worker, uint32_t k);
+typedef int (*render_par_fn)(void *ctx, int workers, uint32_t njobs, render_job_fn job, void *arg);
+#define RENDER_MAX_WORKERS 16
+
 typedef struct render_opts {
     double exposure;           /* radiance multiplier before sRGB, default 1 */
     int no_glow;               /* 1: no lamp discs (exact SPEC §5 pixels) */
@@ -239,6 +247,10 @@ typedef struct render_opts {
     int auto_exposure;         /* 1: exposure from the image and the tone curve (exposure.h) */
     double shift[2];           /* the sample point of each pixel: its centre + shift (pixels,
                                   x right, y down; |shift| < 0.5); 0 0 is SPEC §5's centre */
+    render_par_fn par;         /* the shading pass's parallel-for (NULL: one thread) */
+    void *par_ctx;
+    int workers;               /* workers it may use (1 .. RENDER_MAX_WORKERS; more are cut) */
+    int indirect_mt;           /* 1: indirect may be called from several threads at once */
 } render_opts;
 
 void render_opts_default(render_opts *o /* OUT */);
