@@ -5,6 +5,8 @@
 #include "light/illuminance.h"
 #include "light/litregion.h"
 #include "render/render.h"
+#include "photon/trace.h"
+#include "photon/photon.h"
 
 #define DEFAULT_MAX_W 1920
 #define DEFAULT_MAX_H 1080
@@ -23,6 +25,14 @@ void plx_render_opts_default(plx_render_opts *o)
 static void shade_indirect(void *user, const double P[3], const double n[3], double rgb[3])
 {
     eng_indirect_photons_rgb(user, P, n, rgb);
+}
+
+/* The indirect ground map's surface height (the photon tracer's topmost
+ * roof over the point, or 0: what the aerial chart is taken on). */
+static double top_height(void *user, double x, double y)
+{
+    plx_engine *e = user;
+    return e->ph ? trace_top(e->ph->T, x, y, NULL) : 0.0;
 }
 
 /* The port's parallel-for and the number of workers for a frame
@@ -167,6 +177,9 @@ plx_status plx_render(plx_engine *e, const plx_camera *cam, const plx_render_opt
         ro.indirect = shade_indirect;
         ro.indirect_user = e;
         ro.indirect_mt = 1;   /* the photon buffers are only read (indirect.c) */
+        ro.indirect_map = 1;  /* aerial ground: the indirect ground map (render/indmap.h) */
+        ro.indirect_key = e->indirect_gen;
+        ro.top = top_height;
     }
     set_workers(e, &ro);
     if (o->aa > 1)

@@ -29,6 +29,7 @@ struct plx_engine {
     struct render *rd;      /* renderer, created on first need */
     struct photon_sys *ph;  /* photon buffers, created on first need */
     double lightmap_cell;   /* light map texel size when built, else 0 */
+    uint64_t indirect_gen;  /* +1 at every change of the photon buffers (the indirect map's key) */
     float *aa_sum;          /* anti-aliasing sum (PLX_PART_FRAME), taken on first need */
     uint32_t gather_side;   /* final gathering at points: side^2 directions
                                (0 = photon buffers only); set by

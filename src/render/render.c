@@ -10,6 +10,7 @@
 #include "light/light.h"
 #include "scene/photometry.h"
 #include "render/lightmap.h"
+#include "render/indmap.h"
 #include "light/illuminance.h"
 #include "light/litregion.h"
 #include "base/geom.h"
@@ -30,6 +31,8 @@ typedef struct shade_ws {
     uint32_t tl[RENDER_TILE_LAMPS];
     double tP[TILE_PX][3], tN[TILE_PX][3], tE[TILE_PX][3];
     uint8_t tcall[TILE_PX];     /* 0 sky, 1 no shader, 2 shader */
+    double tI[TILE_PX][3];      /* indirect from the indirect ground map ... */
+    uint8_t tind[TILE_PX];      /* ... when 1 (else the hook's) */
     render_stats st;            /* the shading pass's counters of this worker */
 } shade_ws;
 
@@ -65,6 +68,7 @@ struct render {
     shade_ws ws[RENDER_MAX_WORKERS];  /* one per worker of the shading pass */
     uint8_t *defer;             /* per tile of the largest frame: left to the serial pass */
     lightmap lm;                /* the aerial light map (lightmap.c) */
+    indmap im;                  /* its indirect twin (indmap.c) */
     double thr[255];
     uint8_t *lut;               /* 65536: byte for the float bits >> 16 (a hint) */
     const char *err;
@@ -930,6 +934,13 @@ static void tile_grow(tile_state *t, const mesh_surf *sf, uint32_t sid, const do
     }
 }
 
+/* Whether this frame's ground pixels take the indirect term from the
+ * indirect ground map (render_opts.indirect_map; built for its key). */
+static int indmap_usable(const render *r, const render_opts *o)
+{
+    return o->indirect && o->indirect_map && r->im.built && r->im.key == o->indirect_key;
+}
+
 /* Step 1 of a tile: every pixel's hit point and normal; E = 0 (or the
  * light map's, when sample) for now; sky pixels written. */
 static void tile_points(render *r, shade_ws *w, const render_opts *o, tile_state *t, int sample)
@@ -937,6 +948,7 @@ static void tile_points(render *r, shade_ws *w, const render_opts *o, tile_state
     const mesh *m = r->m;
     double ta = r->tanh_ * r->aspect, tb = r->tanh_;
     int use_lm = o->lightmap && r->lm.built;
+    int use_im = use_lm && sample && indmap_usable(r, o);
     int32_t i, j;
     int q = 0, k;
     for (k = 0; k < 3; k++) {
@@ -994,6 +1006,7 @@ static void tile_points(render *r, shade_ws *w, const render_opts *o, tile_state
             if (sid == MESH_SURF_GROUND)
                 P[2] = 0.0;
             w->tcall[q] = 1;
+            w->tind[q] = use_im && n[2] > 0.5 && indmap_sample(&r->im, P, w->tI[q]);
             if (sf->lit && sid == MESH_SURF_GROUND && use_lm) {
                 if (sample)
                     lightmap_sample(&r->lm, P, E);
@@ -1075,7 +1088,10 @@ static int tile_shade(render *r, shade_ws *w, const render_opts *o, tile_state *
                     r->shade(r->user, w->tP[q], w->tN[q], E);
                 t->calls++;
             }
-            if (o->indirect) {
+            if (w->tind[q]) {
+                for (k = 0; k < 3; k++)
+                    E[k] += w->tI[q][k];
+            } else if (o->indirect) {
                 double Ei[3] = { 0, 0, 0 };
                 o->indirect(o->indirect_user, w->tP[q], w->tN[q], Ei);
                 for (k = 0; k < 3; k++)
@@ -1352,6 +1368,11 @@ plx_status render_frame(render *r, const render_camera *cam, const render_opts *
         return PLX_E_UNSUPPORTED;
     }
     st.drawn_fraction = st.triangles ? (double)st.triangles_drawn / (double)st.triangles : 1.0;
+    if (o->lightmap && r->lm.built && o->indirect && o->indirect_map &&
+        (!r->im.built || r->im.key != o->indirect_key))
+        /* out of memory: the frame takes the hook per pixel (indmap_usable) */
+        (void)indmap_build(&r->im, r->a, &r->lm, o->indirect, o->indirect_user, o->top, o->indirect_user,
+                           o->indirect_key, o->indirect_mt ? o->par : NULL, o->par_ctx, o->workers);
     shade_pass(r, o, &st);
     /* the exposure from the lit surfaces, before the glows */
     st.exposure = o->auto_exposure ? exposure_auto(r->lin, r->id, px) : o->exposure;
@@ -1373,6 +1394,7 @@ plx_status render_lightmap_build(render *r, double cell, size_t max_bytes)
 {
     if (!r)
         return PLX_E_INVALID;
+    r->im.built = 0;   /* over the old map's box */
     return lightmap_build(&r->lm, r->a, r->s, cell, max_bytes, r->shade, r->user, &r->err);
 }
 

@@ -251,6 +251,12 @@ typedef struct render_opts {
     void *par_ctx;
     int workers;               /* workers it may use (1 .. RENDER_MAX_WORKERS; more are cut) */
     int indirect_mt;           /* 1: indirect may be called from several threads at once */
+    int indirect_map;          /* 1: with lightmap, ground pixels read indirect from the indirect
+                                  ground map (indmap.h), built from indirect when indirect_key
+                                  differs from the last build's */
+    uint64_t indirect_key;     /* changes whenever what indirect returns changes */
+    double (*top)(void *user, double x, double y);  /* the map's surface height at (x, y): the
+                                  topmost roof or 0 (NULL: the ground); user is indirect_user */
 } render_opts;
 
 void render_opts_default(render_opts *o /* OUT */);
