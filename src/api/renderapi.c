@@ -72,7 +72,14 @@ plx_status eng_need_lightmap(plx_engine *e, double m_per_texel, int dark)
         return st;
     if (dark)
         render_code_bind(e->rd, shade_none);
-    st = render_lightmap_build(e->rd, cell, e->cfg.lightmap_bytes ? e->cfg.lightmap_bytes : LIGHTMAP_MAX_BYTES);
+    {
+        render_opts ro;
+        render_opts_default(&ro);
+        ro.workers = 1;
+        set_workers(e, &ro);
+        st = render_lightmap_build_par(e->rd, cell, e->cfg.lightmap_bytes ? e->cfg.lightmap_bytes : LIGHTMAP_MAX_BYTES,
+                                       ro.par, ro.par_ctx, ro.workers);
+    }
     if (dark)
         render_code_bind(e->rd, render_shade_light);
     if (st == PLX_E_NOMEM)

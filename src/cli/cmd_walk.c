@@ -13,7 +13,7 @@
 static const char help[] =
     "usage: polarlux walk SCENE|BAKE --path CAMERA.geojson -o DIR [--size WxH] [--fps F]\n"
     "                     [--speed M/S] [--fov DEG] [--aa N] [--exposure E] [--no-glow]\n"
-    "                     [--no-indirect] [--view street|aerial] [--max-frames N]\n"
+    "                     [--no-indirect] [--view street|aerial] [--max-frames N] [--threads N]\n"
     "\n"
     "Renders frames along a camera path and writes DIR/frame-0001.png ...,\n"
     "DIR/cameras.txt (frame, eye, target) and DIR/contact.png (a contact sheet\n"
@@ -37,6 +37,8 @@ static const char help[] =
     "                   pushed into the aerial map; then --refine-frames K photon\n"
     "                   frames (default 2) refill the aerial chart. Prints the cache's\n"
     "                   hits, misses and evictions\n"
+    "  --threads N      threads for each frame (default: the number of processors);\n"
+    "                   the same bytes for any N\n"
     "  --mem SIZE, --strict, --quiet   as for 'polarlux info'\n";
 
 typedef struct walk_args {

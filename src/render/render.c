@@ -1392,10 +1392,21 @@ plx_status render_frame(render *r, const render_camera *cam, const render_opts *
 
 plx_status render_lightmap_build(render *r, double cell, size_t max_bytes)
 {
+    return render_lightmap_build_par(r, cell, max_bytes, NULL, NULL, 1);
+}
+
+plx_status render_lightmap_build_par(render *r, double cell, size_t max_bytes, render_par_fn par, void *ctx,
+                                     int workers)
+{
+    lightmap_par lp;
     if (!r)
         return PLX_E_INVALID;
     r->im.built = 0;   /* over the old map's box */
-    return lightmap_build(&r->lm, r->a, r->s, cell, max_bytes, r->shade, r->user, &r->err);
+    lp.par = par;
+    lp.ctx = ctx;
+    lp.workers = workers > RENDER_MAX_WORKERS ? RENDER_MAX_WORKERS : workers;
+    lp.lt = r->shade == render_shade_light ? r->lt : NULL;
+    return lightmap_build(&r->lm, r->a, r->s, cell, max_bytes, r->shade, r->user, &lp, &r->err);
 }
 
 void render_lightmap_get(const render *r, render_lightmap_info *out)

@@ -321,6 +321,10 @@ const uint32_t *render_ids(const render *r);
  * place when the new map fits the first one's memory. Returns PLX_OK,
  * PLX_E_INVALID (m_per_texel <= 0, max_bytes < 12), PLX_E_NOMEM. */
 plx_status render_lightmap_build(render *r, double m_per_texel, size_t max_bytes);
+/* The same with its rows on a parallel-for (lightmap.h: with the light
+ * module's shader; the same map for any number of workers). */
+plx_status render_lightmap_build_par(render *r, double m_per_texel, size_t max_bytes, render_par_fn par,
+                                     void *ctx, int workers);
 
 typedef struct render_lightmap_info {
     int built;
