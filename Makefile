@@ -361,6 +361,7 @@ web/node_modules/leaflet/dist/leaflet.js: web/package.json web/package-lock.json
 web-data: $(BIN)
 	@mkdir -p web/data
 	$(BIN) tiles $(WEB_SCENE) --quiet --zoom 14-17 -o web/data/tiles
+	$(BIN) tiles $(WEB_SCENE) --quiet --zoom 14-17 --quantity sc -o web/data/tiles-sc
 	$(BIN) route $(WEB_SCENE) --quiet --network $(WEB_NET) --from $(WEB_FROM) --to $(WEB_TO) \
 	  --geojson web/data/route.geojson
 	cp $(WEB_SCENE) web/data/scene.geojson

@@ -1,13 +1,13 @@
 /* glraster: the renderer's visibility pass through OpenGL 1.1 (see glraster.h).
  * No context creation here: only GL calls on the current context. */
 #include <string.h>
-#include <GL/gl.h>
 
 #include "glraster.h"
 
 static int gl_begin(void *user, int32_t w, int32_t h, int cull_back)
 {
     glraster *g = user;
+    const gl_api *api = g->api;
     if (w < 1 || h < 1 || w > g->max_w || h > g->max_h) {
         g->err = "the frame is larger than the GL buffers";
         return -1;
@@ -18,62 +18,62 @@ static int gl_begin(void *user, int32_t w, int32_t h, int cull_back)
     }
     g->w = w;
     g->h = h;
-    while (glGetError() != GL_NO_ERROR)
+    while (api->GetError() != GL_NO_ERROR)
         ;
-    glViewport(0, 0, w, h);
-    glScissor(0, 0, w, h);
-    glEnable(GL_SCISSOR_TEST);
-    glDisable(GL_DITHER);
-    glDisable(GL_BLEND);
-    glDisable(GL_LIGHTING);
-    glDisable(GL_TEXTURE_2D);
-    glDisable(GL_ALPHA_TEST);
-    glDisable(GL_STENCIL_TEST);
-    glDisable(GL_POLYGON_SMOOTH);
-    glDisable(GL_FOG);
-    glPolygonMode(GL_FRONT_AND_BACK, GL_FILL);
-    glShadeModel(GL_FLAT);
-    glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
-    glMatrixMode(GL_PROJECTION);
-    glLoadIdentity();
-    glMatrixMode(GL_MODELVIEW);
-    glLoadIdentity();
-    glDepthRange(0.0, 1.0);
-    glEnable(GL_DEPTH_TEST);
-    glDepthFunc(GL_LESS);
-    glDepthMask(GL_TRUE);
-    glFrontFace(GL_CCW);
-    glCullFace(GL_BACK);
+    api->Viewport(0, 0, w, h);
+    api->Scissor(0, 0, w, h);
+    api->Enable(GL_SCISSOR_TEST);
+    api->Disable(GL_DITHER);
+    api->Disable(GL_BLEND);
+    api->Disable(GL_LIGHTING);
+    api->Disable(GL_TEXTURE_2D);
+    api->Disable(GL_ALPHA_TEST);
+    api->Disable(GL_STENCIL_TEST);
+    api->Disable(GL_POLYGON_SMOOTH);
+    api->Disable(GL_FOG);
+    api->PolygonMode(GL_FRONT_AND_BACK, GL_FILL);
+    api->ShadeModel(GL_FLAT);
+    api->ColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
+    api->MatrixMode(GL_PROJECTION);
+    api->LoadIdentity();
+    api->MatrixMode(GL_MODELVIEW);
+    api->LoadIdentity();
+    api->DepthRange(0.0, 1.0);
+    api->Enable(GL_DEPTH_TEST);
+    api->DepthFunc(GL_LESS);
+    api->DepthMask(GL_TRUE);
+    api->FrontFace(GL_CCW);
+    api->CullFace(GL_BACK);
     if (cull_back)
-        glEnable(GL_CULL_FACE);
+        api->Enable(GL_CULL_FACE);
     else
-        glDisable(GL_CULL_FACE);
-    glClearColor(0.0f, 0.0f, 0.0f, 0.0f);
-    glClearDepth(1.0);
-    glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
+        api->Disable(GL_CULL_FACE);
+    api->ClearColor(0.0f, 0.0f, 0.0f, 0.0f);
+    api->ClearDepth(1.0);
+    api->Clear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
     return 0;
 }
 
 static void gl_draw(void *user, const float *clip, uint32_t nv, const mesh_tri *tri, uint32_t ntri,
                     uint32_t v_base)
 {
+    const gl_api *api = ((glraster *)user)->api;
     uint32_t k;
     int i;
-    (void)user;
-    glBegin(GL_TRIANGLES);
+    api->Begin(GL_TRIANGLES);
     for (k = 0; k < ntri; k++) {
         uint32_t id = tri[k].surf;
-        glColor4ub((GLubyte)(id & 255u), (GLubyte)((id >> 8) & 255u), (GLubyte)((id >> 16) & 255u),
+        api->Color4ub((GLubyte)(id & 255u), (GLubyte)((id >> 8) & 255u), (GLubyte)((id >> 16) & 255u),
                    (GLubyte)(id >> 24));
         for (i = 0; i < 3; i++) {
             uint32_t v = tri[k].v[i] - v_base;
             if (v < nv)
-                glVertex4fv(clip + 4 * (size_t)v);
+                api->Vertex4fv(clip + 4 * (size_t)v);
             else
-                glVertex4f(0.0f, 0.0f, 0.0f, 1.0f);  /* never: keeps the triple aligned */
+                api->Vertex4f(0.0f, 0.0f, 0.0f, 1.0f);  /* never: keeps the triple aligned */
         }
     }
-    glEnd();
+    api->End();
 }
 
 /* Swaps rows j and h-1-j of a w x h array of 4-byte elements. */
@@ -94,13 +94,14 @@ static void flip_rows(void *buf, int32_t w, int32_t h)
 static int gl_finish(void *user, uint32_t *id, float *depth)
 {
     glraster *g = user;
+    const gl_api *api = g->api;
     size_t p, px = (size_t)g->w * (size_t)g->h;
     unsigned char *bytes = (unsigned char *)id;
-    glPixelStorei(GL_PACK_ALIGNMENT, 4);
-    glPixelStorei(GL_PACK_ROW_LENGTH, 0);
-    glReadPixels(0, 0, g->w, g->h, GL_RGBA, GL_UNSIGNED_BYTE, id);
-    glReadPixels(0, 0, g->w, g->h, GL_DEPTH_COMPONENT, GL_FLOAT, depth);
-    if (glGetError() != GL_NO_ERROR) {
+    api->PixelStorei(GL_PACK_ALIGNMENT, 4);
+    api->PixelStorei(GL_PACK_ROW_LENGTH, 0);
+    api->ReadPixels(0, 0, g->w, g->h, GL_RGBA, GL_UNSIGNED_BYTE, id);
+    api->ReadPixels(0, 0, g->w, g->h, GL_DEPTH_COMPONENT, GL_FLOAT, depth);
+    if (api->GetError() != GL_NO_ERROR) {
         g->err = "glReadPixels failed";
         return -1;
     }
@@ -114,9 +115,11 @@ static int gl_finish(void *user, uint32_t *id, float *depth)
     return 0;
 }
 
-void glraster_init(glraster *g, int32_t max_w, int32_t max_h, int (*make_current)(void *ctx), void *ctx)
+void glraster_init(glraster *g, const gl_api *api, int32_t max_w, int32_t max_h,
+                   int (*make_current)(void *ctx), void *ctx)
 {
     memset(g, 0, sizeof *g);
+    g->api = api;
     g->max_w = max_w;
     g->max_h = max_h;
     g->make_current = make_current;

@@ -26,16 +26,20 @@
 
 #include <stdint.h>
 #include "render/render.h"
+#include "gl_api.h"
 
 typedef struct glraster {
     render_backend be;              /* be.user = this */
+    const gl_api *api;              /* the GL functions (gl_api.h) */
     int32_t max_w, max_h, w, h;
     int (*make_current)(void *ctx);  /* returns 0 on success */
     void *ctx;
     const char *err;                /* last failure, "" when none */
 } glraster;
 
-/* Fills g (and g->be) for frames up to max_w x max_h. */
-void glraster_init(glraster *g, int32_t max_w, int32_t max_h, int (*make_current)(void *ctx), void *ctx);
+/* Fills g (and g->be) for frames up to max_w x max_h, drawing through api
+ * (which must outlive g). */
+void glraster_init(glraster *g, const gl_api *api, int32_t max_w, int32_t max_h,
+                   int (*make_current)(void *ctx), void *ctx);
 
 #endif

@@ -6,7 +6,9 @@
 #  - build/libpolarlux_osmesa.a holds glraster.o (GL calls, no context) and
 #    plx_osmesa.o (the OSMesa context); libpolarlux itself never needs GL;
 #  - the CLI's render command and the render test and bench are compiled with
-#    -DPLX_HAVE_OSMESA and linked with that archive and -lOSMesa.
+#    -DPLX_HAVE_OSMESA and linked with that archive and -ldl: libOSMesa
+#    itself is opened with dlopen on the first `--backend osmesa` frame
+#    (port/osmesa/gl_api.h says why), so other commands never load it.
 OSMESA ?= auto
 ifeq ($(OSMESA),auto)
 OSMESA := $(shell pkg-config --exists osmesa 2>/dev/null && \
@@ -24,7 +26,7 @@ $(OSMESA_STAMP):
 
 ifeq ($(OSMESA),1)
 OSMESA_CFLAGS := $(shell pkg-config --cflags osmesa)
-OSMESA_LIBS   := $(shell pkg-config --libs osmesa)
+OSMESA_LIBS   := -ldl
 OSMESA_SRC     = $(wildcard port/osmesa/*.c)
 OSMESA_OBJ     = $(OSMESA_SRC:%.c=$(BUILD)/%.o)
 OSMESA_A       = $(BUILD)/libpolarlux_osmesa.a

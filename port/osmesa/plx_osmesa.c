@@ -1,12 +1,13 @@
 /* plx_osmesa: an OSMesa context for glraster (see plx_osmesa.h). */
 #include <stdio.h>
 #include <stdlib.h>
-#include <GL/osmesa.h>
 
 #include "plx_osmesa.h"
 #include "glraster.h"
 
 struct plx_osmesa {
+    gl_api api;
+    osmesa_api osm;
     glraster gl;
     OSMesaContext ctx;
     unsigned char *buf;
@@ -27,7 +28,7 @@ const char *__lsan_default_suppressions(void)
 static int make_current(void *user)
 {
     plx_osmesa *om = user;
-    return OSMesaMakeCurrent(om->ctx, om->buf, GL_UNSIGNED_BYTE, om->w, om->h) ? 0 : -1;
+    return om->osm.MakeCurrent(om->ctx, om->buf, GL_UNSIGNED_BYTE, om->w, om->h) ? 0 : -1;
 }
 
 plx_osmesa *plx_osmesa_open(int32_t max_w, int32_t max_h, char *err, size_t errlen)
@@ -49,17 +50,21 @@ plx_osmesa *plx_osmesa_open(int32_t max_w, int32_t max_h, char *err, size_t errl
     }
     om->w = max_w;
     om->h = max_h;
+    if (gl_api_load(&om->api, &om->osm, err, errlen) != 0) {
+        plx_osmesa_close(om);
+        return NULL;
+    }
     /* the deepest depth buffer the driver gives */
     for (k = 0; k < sizeof depths / sizeof depths[0] && !om->ctx; k++)
-        om->ctx = OSMesaCreateContextExt(OSMESA_RGBA, depths[k], 0, 0, NULL);
+        om->ctx = om->osm.CreateContextExt(OSMESA_RGBA, depths[k], 0, 0, NULL);
     if (!om->ctx || make_current(om) != 0) {
         if (errlen)
             snprintf(err, errlen, "osmesa: cannot create an RGBA context with a depth buffer");
         plx_osmesa_close(om);
         return NULL;
     }
-    OSMesaPixelStore(OSMESA_Y_UP, 1);
-    glraster_init(&om->gl, max_w, max_h, make_current, om);
+    om->osm.PixelStore(OSMESA_Y_UP, 1);
+    glraster_init(&om->gl, &om->api, max_w, max_h, make_current, om);
     om->gl.be.name = "osmesa";
     return om;
 }
@@ -79,7 +84,7 @@ void plx_osmesa_close(plx_osmesa *om)
     if (!om)
         return;
     if (om->ctx)
-        OSMesaDestroyContext(om->ctx);
+        om->osm.DestroyContext(om->ctx);
     free(om->buf);
     free(om);
 }

@@ -20,7 +20,8 @@
  *
  * Build: only when `pkg-config --exists osmesa` (port/osmesa/osmesa.mk);
  * programs built with it see PLX_HAVE_OSMESA. Not part of libpolarlux:
- * link build/libpolarlux_osmesa.a and -lOSMesa as well.
+ * link build/libpolarlux_osmesa.a and -ldl as well; libOSMesa is opened at
+ * run time by the first plx_osmesa_open (gl_api.h).
  *
  * Memory: the context and a max_w x max_h RGBA8 buffer from the C heap,
  * freed by plx_osmesa_close. One object per thread; the context is made

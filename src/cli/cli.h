@@ -150,5 +150,19 @@ int cmd_tiles(int argc, char **argv);
 /* The heat map's colour scale (cmd_heatmap.c): 0 when lux is at or below its
  * bottom (no light), else 1. */
 int heatmap_colour(double lux, double top, uint8_t rgb[3]);
+/* What a heat map or a tile maps (cmd_heatmap.c): quantity PLX_METER_H is
+ * the direct E_h on the ground; V, SC and HS are plx_meter's at 'height'
+ * metres, v and sc facing 'facing' degrees counter-clockwise from east or,
+ * for sc with facing_min, the least E_sc over every horizontal facing
+ * direction. */
+typedef struct heat_quantity {
+    int quantity;
+    double height, facing;
+    int facing_min;
+} heat_quantity;
+/* The quantity at the ground point (x, y): PLX_OK, or PLX_E_RANGE and NaN
+ * when the point (or its meter) is inside a solid; other errors as
+ * plx_meter. */
+plx_status heatmap_value(plx_engine *e, const heat_quantity *q, double x, double y, double *out);
 
 #endif

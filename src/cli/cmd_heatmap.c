@@ -40,7 +40,8 @@ static const char help[] =
     "             the ground (direct light)\n"
     "  --height M the meters' height for v, sc, hs (default 1.5)\n"
     "  --facing DEG  facing direction of v and sc, degrees counter-clockwise\n"
-    "             from east (default 0)\n"
+    "             from east (default 0); for sc also 'min': the least E_sc over\n"
+    "             every horizontal facing direction (as 'polarlux tiles')\n"
     "  --mem SIZE, --strict, --quiet, --lamps FILE   as for 'polarlux info'\n";
 
 /* A night palette on t in [0, 1]: black, deep blue, purple, orange, yellow, white. */
@@ -99,8 +100,7 @@ static void legend(canvas *c, int x0, double lo, double top)
 typedef struct heat_opts {
     double res, top, box[4];
     int have_box;
-    int quantity;             /* PLX_METER_*; H maps the ground */
-    double height, facing;
+    heat_quantity q;          /* q.quantity PLX_METER_*; H maps the ground */
     const char *out, *path;
     const cli_common *c;
 } heat_opts;
@@ -192,18 +192,12 @@ static plx_status heat_strip(plx_engine *e, const heat_opts *o, heat_map *m, siz
         N[3 * k] = N[3 * k + 1] = 0.0;
         N[3 * k + 2] = 1.0;
     }
-    if (o->quantity == PLX_METER_H) {
+    if (o->q.quantity == PLX_METER_H) {
         st = plx_illuminance(e, n, P, N, E, NULL, NULL);
     } else {
-        double u[2], mv[PLX_METER_COUNT];
-        u[0] = cos(o->facing * 3.14159265358979323846 / 180.0);
-        u[1] = sin(o->facing * 3.14159265358979323846 / 180.0);
         st = PLX_OK;
-        for (k = 0; k < n && (st == PLX_OK || st == PLX_E_RANGE); k++) {
-            P[3 * k + 2] = o->height;
-            st = plx_meter(e, 1, P + 3 * k, u, mv);
-            E[k] = mv[o->quantity];
-        }
+        for (k = 0; k < n && (st == PLX_OK || st == PLX_E_RANGE); k++)
+            st = heatmap_value(e, &o->q, P[3 * k], P[3 * k + 1], &E[k]);
     }
     for (k = 0; k < n; k++)
         m->E[y0 * m->w + k] = (float)E[k];
@@ -472,10 +466,13 @@ static int run(plx_engine *e, const heat_opts *o)
     else if (rc == EXIT_OK)
         printf("heatmap: %zux%zu pixels at %g m, scale %g..%g lx (2nd-98th percentile of the %zu lit pixels), "
                "written to %s (world file .pgw beside it)\n", m.w, m.h, m.res, lo, top, lit, o->out);
-    if (rc == EXIT_OK && o->quantity != PLX_METER_H)
+    if (rc == EXIT_OK && o->q.quantity != PLX_METER_H && o->q.facing_min)
+        printf("heatmap: semi-cylindrical illuminance at %g m, the least over every facing direction\n",
+               o->q.height);
+    else if (rc == EXIT_OK && o->q.quantity != PLX_METER_H)
         printf("heatmap: %s illuminance at %g m facing %g deg\n",
-               o->quantity == PLX_METER_SC ? "semi-cylindrical" : o->quantity == PLX_METER_V ? "vertical"
-                                                                : "hemispherical", o->height, o->facing);
+               o->q.quantity == PLX_METER_SC ? "semi-cylindrical" : o->q.quantity == PLX_METER_V ? "vertical"
+                                                                    : "hemispherical", o->q.height, o->q.facing);
     if (rc == EXIT_OK && m.strip < m.h)
         printf("heatmap: computed in strips of %zu rows to stay within --mem\n", m.strip);
     free(m.E);
@@ -491,8 +488,8 @@ int cmd_heatmap(int argc, char **argv)
     int i, rc;
     memset(&c, 0, sizeof c);
     memset(&o, 0, sizeof o);
-    o.quantity = PLX_METER_H;
-    o.height = 1.5;
+    o.q.quantity = PLX_METER_H;
+    o.q.height = 1.5;
     for (i = 1; i < argc; i++) {
         int r = cli_common_option("heatmap", argc, argv, &i, &c);
         if (r < 0)
@@ -515,16 +512,17 @@ int cmd_heatmap(int argc, char **argv)
                 return cli_usage_error("heatmap", "--max '%s' is not a number of lux above 0.1 (at most 1e9)", argv[i]);
         } else if (strcmp(argv[i], "--quantity") == 0) {
             const char *q = argv[++i];
-            o.quantity = strcmp(q, "h") == 0 ? PLX_METER_H : strcmp(q, "v") == 0 ? PLX_METER_V
-                       : strcmp(q, "sc") == 0 ? PLX_METER_SC : strcmp(q, "hs") == 0 ? PLX_METER_HS : -1;
-            if (o.quantity < 0)
+            o.q.quantity = strcmp(q, "h") == 0 ? PLX_METER_H : strcmp(q, "v") == 0 ? PLX_METER_V
+                         : strcmp(q, "sc") == 0 ? PLX_METER_SC : strcmp(q, "hs") == 0 ? PLX_METER_HS : -1;
+            if (o.q.quantity < 0)
                 return cli_usage_error("heatmap", "--quantity '%s' is not h, v, sc or hs", q);
         } else if (strcmp(argv[i], "--height") == 0) {
-            if (cli_parse_double(argv[++i], &o.height) != 0 || !(o.height >= 0) || !(o.height <= 1000))
+            if (cli_parse_double(argv[++i], &o.q.height) != 0 || !(o.q.height >= 0) || !(o.q.height <= 1000))
                 return cli_usage_error("heatmap", "--height '%s' is not a number of metres from 0 to 1000", argv[i]);
         } else if (strcmp(argv[i], "--facing") == 0) {
-            if (cli_parse_double(argv[++i], &o.facing) != 0 || !isfinite(o.facing))
-                return cli_usage_error("heatmap", "--facing '%s' is not a number of degrees", argv[i]);
+            o.q.facing_min = strcmp(argv[++i], "min") == 0;
+            if (!o.q.facing_min && (cli_parse_double(argv[i], &o.q.facing) != 0 || !isfinite(o.q.facing)))
+                return cli_usage_error("heatmap", "--facing '%s' is not a number of degrees or min", argv[i]);
         } else if (strcmp(argv[i], "-o") == 0) {
             o.out = argv[++i];
         } else if (strcmp(argv[i], "--path") == 0) {
@@ -546,6 +544,8 @@ int cmd_heatmap(int argc, char **argv)
         return cli_usage_error("heatmap", "missing SCENE");
     if (!o.out)
         return cli_usage_error("heatmap", "missing -o MAP.png");
+    if (o.q.facing_min && o.q.quantity != PLX_METER_SC)
+        return cli_usage_error("heatmap", "--facing min needs --quantity sc (the least E_sc over every direction)");
     rc = cli_open_scene("heatmap", scene, &c, &e);
     if (rc != EXIT_OK)
         return rc;
@@ -565,6 +565,49 @@ int cmd_heatmap(int argc, char **argv)
     rc = run(e, &o);
     plx_engine_free(e);
     return rc;
+}
+
+/* E_sc(u) = sum of I W (|w_h| + u.w_h) / (pi d^2) (SPEC §6, as light_meter
+ * computes it) is affine in the unit vector u: S + u.V. Facing east, west
+ * and north give S = (E_e + E_w) / 2, V = ((E_e - E_w) / 2, E_n - S), and
+ * the least over every direction is S - |V| (u = -V / |V|). */
+static plx_status sc_least(plx_engine *e, const double P[3], double *out)
+{
+    static const double U[6] = { 1, 0, -1, 0, 0, 1 };
+    double Pr[9], m[3 * PLX_METER_COUNT], S, vx, vy;
+    plx_status st;
+    int k;
+    for (k = 0; k < 9; k++)
+        Pr[k] = P[k % 3];
+    st = plx_meter(e, 3, Pr, U, m);
+    if (st != PLX_OK) {
+        *out = NAN;
+        return st;
+    }
+    S = 0.5 * (m[PLX_METER_SC] + m[PLX_METER_COUNT + PLX_METER_SC]);
+    vx = 0.5 * (m[PLX_METER_SC] - m[PLX_METER_COUNT + PLX_METER_SC]);
+    vy = m[2 * PLX_METER_COUNT + PLX_METER_SC] - S;
+    *out = fmax(0.0, S - hypot(vx, vy)); /* >= 0 but for rounding */
+    return PLX_OK;
+}
+
+plx_status heatmap_value(plx_engine *e, const heat_quantity *q, double x, double y, double *out)
+{
+    double P[3], N[3] = { 0, 0, 1 }, u[2], m[PLX_METER_COUNT];
+    plx_status st;
+    P[0] = x;
+    P[1] = y;
+    P[2] = 0.0;
+    if (q->quantity == PLX_METER_H)
+        return plx_illuminance(e, 1, P, N, out, NULL, NULL);
+    P[2] = q->height;
+    if (q->quantity == PLX_METER_SC && q->facing_min)
+        return sc_least(e, P, out);
+    u[0] = cos(q->facing * 3.14159265358979323846 / 180.0);
+    u[1] = sin(q->facing * 3.14159265358979323846 / 180.0);
+    st = plx_meter(e, 1, P, u, m);
+    *out = st == PLX_OK || st == PLX_E_RANGE ? m[q->quantity] : NAN;
+    return st;
 }
 
 /* The heat map's colour of 'lux' on its scale topped at 'top', for other

@@ -15,7 +15,10 @@ static const char route_help[] =
     "\n"
     "Finds the best-lit walking route and the shortest route between two points\n"
     "of a street network and prints them side by side: metres, dark metres, min\n"
-    "and mean lux, EN 13201 P-class and the detour the light costs.\n"
+    "and mean lux, min vertical (Ev) and semi-cylindrical (Esc) illuminance at\n"
+    "--height facing both ways along the route, the EN 13201 P-class of E_h\n"
+    "alone (class_h) and with every SPEC §6 criterion (class: mean and min E_h,\n"
+    "min Ev, min Esc) and the detour the light costs.\n"
     "STREETS is GeoJSON LineStrings (e.g. OpenStreetMap highway=* ways), joined\n"
     "where they share a vertex (the exact same coordinates), in the scene's\n"
     "coordinate rules (lon/lat projected with the scene's projection, or metres\n"
@@ -38,8 +41,10 @@ static const char route_help[] =
     "                   route keeps within it (bisection to W/1000)\n"
     "  --snap M         the ends may lie at most M metres from a street (default 50)\n"
     "  --step M         sampling step in metres (default 1)\n"
+    "  --height M       height of the Ev/Esc meters above the street (default 1.5)\n"
     "  --geojson OUT    write both routes as LineStrings (properties route,\n"
-    "                   length_m, dark_m, min_lux, mean_lux, class, ...)\n"
+    "                   length_m, dark_m, min_lux, mean_lux, min_ev_lux,\n"
+    "                   min_sc_lux, class, class_h, ...)\n"
     "  --mem SIZE, --strict, --quiet   as for 'polarlux info'\n";
 
 static const char annotate_help[] =
@@ -49,21 +54,27 @@ static const char annotate_help[] =
     "Scores every edge of a street network (as 'polarlux route --network' does)\n"
     "and writes it as a GeoJSON LineString with its light: osm_id, name, from and\n"
     "to node, length_m, scored_m, blocked_m, dark_m, dark_share, mean_lux,\n"
-    "min_lux, max_lux, uniformity, class, cost (length + W x dark metres) and\n"
-    "factor (cost / length, >= 1). With --csv, one row per way id (properties\n"
-    "osm_id, @id or id, else the feature's id, else #FEATURE) summed over its\n"
-    "edges: osm_id,length_m,dark_m,blocked_m,dark_share,mean_lux,min_lux,class,factor,\n"
-    "for routing engines that take per-way weights.\n"
+    "min_lux, max_lux, uniformity, the SPEC §6 minima at --height facing along\n"
+    "the edge's coordinates (fw) and back (bw): min_ev_fw_lux, min_ev_bw_lux,\n"
+    "min_sc_fw_lux, min_sc_bw_lux, and over both ways min_ev_lux, min_sc_lux\n"
+    "(-1: no meter outside a solid), class (every SPEC §6 criterion), class_h\n"
+    "(E_h alone), cost (length + W x dark metres) and factor (cost / length,\n"
+    ">= 1). With --csv, one row per way id (properties osm_id, @id or id, else\n"
+    "the feature's id, else #FEATURE) summed over its edges:\n"
+    "osm_id,length_m,dark_m,blocked_m,dark_share,mean_lux,min_lux,class,factor,\n"
+    "min_ev_lux,min_sc_lux,class_h, for routing engines that take per-way\n"
+    "weights.\n"
     "\n"
     "  --network FILE   the street network (required)\n"
     "  -o OUT           the annotated GeoJSON (required)\n"
     "  --csv OUT        the per-way CSV\n"
-    "  --dark-lux LX, --dark-weight W, --step M   as for 'polarlux route --network'\n"
+    "  --dark-lux LX, --dark-weight W, --step M, --height M   as for 'polarlux\n"
+    "                   route --network'\n"
     "  --mem SIZE, --strict, --quiet   as for 'polarlux info'\n";
 
 typedef struct net_opts {
     const char *cmd, *scene, *network, *geojson, *out, *csv, *from_s, *to_s;
-    double dark, weight, detour, snap, step;
+    double dark, weight, detour, snap, step, height;
     int have_detour;
     cli_common c;
 } net_opts;
@@ -71,7 +82,8 @@ typedef struct net_opts {
 static int is_valued(const char *a)
 {
     static const char *const names[] = { "--network", "--from", "--to", "--dark-lux", "--dark-weight",
-                                         "--max-detour", "--snap", "--step", "--geojson", "-o", "--csv" };
+                                         "--max-detour", "--snap", "--step", "--geojson", "-o", "--csv",
+                                         "--height" };
     size_t k;
     for (k = 0; k < sizeof names / sizeof names[0]; k++)
         if (strcmp(a, names[k]) == 0)
@@ -111,6 +123,12 @@ static int value_option(net_opts *o, const char *a, const char *v)
         return number_option(o, a, v, &o->detour, 0);
     } else if (strcmp(a, "--step") == 0)
         return number_option(o, a, v, &o->step, 0.01);
+    else if (strcmp(a, "--height") == 0) {
+        if (number_option(o, a, v, &o->height, 0) != 0)
+            return -1;
+        if (o->height > 1000)
+            return cli_usage_error(o->cmd, "--height '%s' is not a number of metres from 0 to 1000", v);
+    }
     return 0;
 }
 
@@ -123,6 +141,7 @@ static int parse(net_opts *o, int argc, char **argv, const char *help)
     o->weight = 3.0;
     o->snap = 50.0;
     o->step = 1.0;
+    o->height = 1.5;
     for (i = 1; i < argc; i++) {
         const char *a = argv[i];
         int r = cli_common_option(o->cmd, argc, argv, &i, &o->c);
@@ -178,7 +197,7 @@ static int load_network(const net_opts *o, plx_engine *e, network *net)
         fprintf(stderr, "polarlux %s: %s: %s\n", o->cmd, o->network, err);
         return EXIT_FAIL;
     }
-    st = net_score(net, e, o->step, o->dark, 1);
+    st = net_score(net, e, o->step, o->dark, o->height, 1);
     if (st != PLX_OK) {
         fprintf(stderr, "polarlux %s: %s: scoring the edges: %s\n", o->cmd, o->network, plx_last_error(e));
         net_free(net);
@@ -200,12 +219,20 @@ static double route_mean(const net_route *r)
     return r->scored > 0 ? r->integral / r->scored : 0.0;
 }
 
+/* A SPEC §6 minimum for output: -1 when there was no meter (NaN). */
+static double or_none(double v)
+{
+    return v == v ? v : -1.0;
+}
+
 static void print_route(const char *name, const net_route *r, double shortest)
 {
-    char cls[4];
+    char cls[4], clh[4];
     class_text(r->p_class, cls);
-    printf("%-9s %9.1f %9.1f %9.3f %9.3f  %-5s %+7.1f%%\n", name, r->length, r->dark + r->blocked, r->min,
-           route_mean(r), cls, shortest > 0 ? 100.0 * (r->length / shortest - 1.0) : 0.0);
+    class_text(r->p_class_h, clh);
+    printf("%-9s %9.1f %9.1f %9.3f %9.3f %9.3f %9.3f  %-7s %-5s %+7.1f%%\n", name, r->length, r->dark + r->blocked,
+           r->min, route_mean(r), or_none(r->min_ev), or_none(r->min_esc), clh, cls,
+           shortest > 0 ? 100.0 * (r->length / shortest - 1.0) : 0.0);
 }
 
 static cJSON *route_props(const char *name, const net_route *r, double shortest, double weight)
@@ -218,7 +245,11 @@ static cJSON *route_props(const char *name, const net_route *r, double shortest,
     cJSON_AddNumberToObject(p, "dark_m", r->dark + r->blocked);
     cJSON_AddNumberToObject(p, "min_lux", r->min);
     cJSON_AddNumberToObject(p, "mean_lux", route_mean(r));
+    cJSON_AddNumberToObject(p, "min_ev_lux", or_none(r->min_ev));
+    cJSON_AddNumberToObject(p, "min_sc_lux", or_none(r->min_esc));
     cJSON_AddStringToObject(p, "class", cls);
+    class_text(r->p_class_h, cls);
+    cJSON_AddStringToObject(p, "class_h", cls);
     cJSON_AddNumberToObject(p, "blocked_m", r->blocked);
     cJSON_AddNumberToObject(p, "detour_pct", shortest > 0 ? 100.0 * (r->length / shortest - 1.0) : 0.0);
     cJSON_AddNumberToObject(p, "dark_weight", weight);
@@ -327,15 +358,15 @@ static int find_routes(const net_opts *o, plx_engine *e, network *net)
         rc = EXIT_FAIL;
     }
     if (rc == EXIT_OK) {
-        printf("%-9s %9s %9s %9s %9s  %-5s %8s\n", "route", "length_m", "dark_m", "min_lx", "mean_lx", "class",
-               "detour");
+        printf("%-9s %9s %9s %9s %9s %9s %9s  %-7s %-5s %8s\n", "route", "length_m", "dark_m", "min_lx", "mean_lx",
+               "min_Ev", "min_Esc", "class_h", "class", "detour");
         print_route("best-lit", &best, shortest.length);
         print_route("shortest", &shortest, shortest.length);
         printf("cost = length + %g x dark metres (below %g lx or inside footprints)", weight, o->dark);
         if (weight != o->weight)
             printf("; weight lowered from %g by --max-detour %g", o->weight, o->detour);
-        printf("; network %u nodes, %u edges; ends %.1f m and %.1f m from the streets\n", net->nnodes, net->nedges,
-               a.dist, b.dist);
+        printf("; Ev, Esc at %g m facing both ways; network %u nodes, %u edges; ends %.1f m and %.1f m from the "
+               "streets\n", o->height, net->nnodes, net->nedges, a.dist, b.dist);
         if (best.dark + best.blocked > 0 && !o->c.quiet)
             fprintf(stderr, "polarlux %s: note: the best-lit route still has %.1f dark metres\n", o->cmd,
                     best.dark + best.blocked);
@@ -378,6 +409,15 @@ int cmd_route_network(int argc, char **argv)
 
 /* ---- annotate ------------------------------------------------------------- */
 
+/* The SPEC §6 class of mean and min E_h and min E_v, E_sc over both ways
+ * (0 with no E_h sample or no meter). */
+static int full_class(double scored, double mean, double min, double min_ev, double min_esc)
+{
+    if (!(scored > 0) || min_ev != min_ev || min_esc != min_esc)
+        return 0;
+    return plx_p_class_facial(mean, min, min_ev, min_esc);
+}
+
 static const char *edge_id(const network *net, const net_edge *ed, char buf[48])
 {
     const route_line *l = &net->lines.lines[ed->line];
@@ -399,8 +439,9 @@ static int write_edges(const net_opts *o, plx_engine *e, const network *net)
         const route_line *l = &net->lines.lines[ed->line];
         cJSON *p = cJSON_CreateObject(), *coords = cJSON_CreateArray();
         double dark = ed->dark + ed->s.blocked_length, cost = ed->length + o->weight * dark;
+        double ev = fmin(ed->fac[0], ed->fac[1]), esc = fmin(ed->fac[2], ed->fac[3]);
         char cls[4], buf[48];
-        class_text(ed->s.p_class, cls);
+        class_text(full_class(ed->s.length, ed->s.mean, ed->s.min, ev, esc), cls);
         cJSON_AddStringToObject(p, "osm_id", edge_id(net, ed, buf));
         cJSON_AddStringToObject(p, "name", l->name);
         cJSON_AddNumberToObject(p, "edge", i);
@@ -415,7 +456,15 @@ static int write_edges(const net_opts *o, plx_engine *e, const network *net)
         cJSON_AddNumberToObject(p, "min_lux", ed->s.min);
         cJSON_AddNumberToObject(p, "max_lux", ed->s.max);
         cJSON_AddNumberToObject(p, "uniformity", ed->s.uniformity);
+        cJSON_AddNumberToObject(p, "min_ev_fw_lux", or_none(ed->fac[0]));
+        cJSON_AddNumberToObject(p, "min_ev_bw_lux", or_none(ed->fac[1]));
+        cJSON_AddNumberToObject(p, "min_sc_fw_lux", or_none(ed->fac[2]));
+        cJSON_AddNumberToObject(p, "min_sc_bw_lux", or_none(ed->fac[3]));
+        cJSON_AddNumberToObject(p, "min_ev_lux", or_none(ev));
+        cJSON_AddNumberToObject(p, "min_sc_lux", or_none(esc));
         cJSON_AddStringToObject(p, "class", cls);
+        class_text(ed->s.p_class, cls);
+        cJSON_AddStringToObject(p, "class_h", cls);
         cJSON_AddNumberToObject(p, "cost", cost);
         cJSON_AddNumberToObject(p, "factor", ed->length > 0 ? cost / ed->length : 1.0);
         for (k = ed->v0; k <= ed->v1; k++)
@@ -432,7 +481,7 @@ static int write_edges(const net_opts *o, plx_engine *e, const network *net)
 typedef struct way_sum {
     char id[48];
     uint32_t first;
-    double length, dark, blocked, scored, integral, min;
+    double length, dark, blocked, scored, integral, min, min_ev, min_esc; /* min_ev, min_esc NaN: none */
 } way_sum;
 
 static int cmp_id(const void *pa, const void *pb)
@@ -452,9 +501,10 @@ static void csv_row(FILE *f, const way_sum *w, double weight)
 {
     double mean = w->scored > 0 ? w->integral / w->scored : 0.0, min = w->scored > 0 ? w->min : 0.0;
     double dark = w->dark + w->blocked;
-    char cls[4];
+    char cls[4], clh[4];
     const char *c;
-    class_text(w->scored > 0 ? plx_p_class(mean, min) : 0, cls);
+    class_text(full_class(w->scored, mean, min, w->min_ev, w->min_esc), cls);
+    class_text(w->scored > 0 ? plx_p_class(mean, min) : 0, clh);
     if (strpbrk(w->id, ",\"\n")) {
         fputc('"', f);
         for (c = w->id; *c; c++) {
@@ -466,9 +516,10 @@ static void csv_row(FILE *f, const way_sum *w, double weight)
     } else {
         fputs(w->id, f);
     }
-    fprintf(f, ",%.3f,%.3f,%.3f,%.4f,%.4f,%.4f,%s,%.4f\n", w->length, dark, w->blocked,
+    fprintf(f, ",%.3f,%.3f,%.3f,%.4f,%.4f,%.4f,%s,%.4f,%.4f,%.4f,%s\n", w->length, dark, w->blocked,
             w->length > 0 ? dark / w->length : 0.0, mean, min, cls,
-            w->length > 0 ? (w->length + weight * dark) / w->length : 1.0);
+            w->length > 0 ? (w->length + weight * dark) / w->length : 1.0, or_none(w->min_ev), or_none(w->min_esc),
+            clh);
 }
 
 /* One row per way id, in the order the ways first appear. */
@@ -490,6 +541,8 @@ static int write_csv(const net_opts *o, const network *net)
         w[i].scored = ed->s.length;
         w[i].integral = ed->s.mean * ed->s.length;
         w[i].min = ed->s.length > 0 ? ed->s.min : INFINITY;
+        w[i].min_ev = fmin(ed->fac[0], ed->fac[1]);
+        w[i].min_esc = fmin(ed->fac[2], ed->fac[3]);
     }
     qsort(w, net->nedges, sizeof *w, cmp_id);
     for (i = 0; i < net->nedges; i++) {
@@ -501,6 +554,8 @@ static int write_csv(const net_opts *o, const network *net)
             t->scored += w[i].scored;
             t->integral += w[i].integral;
             t->min = fmin(t->min, w[i].min);
+            t->min_ev = fmin(t->min_ev, w[i].min_ev); /* fmin skips a NaN */
+            t->min_esc = fmin(t->min_esc, w[i].min_esc);
         } else {
             w[n++] = w[i];
         }
@@ -512,7 +567,8 @@ static int write_csv(const net_opts *o, const network *net)
         free(w);
         return EXIT_FAIL;
     }
-    fprintf(f, "osm_id,length_m,dark_m,blocked_m,dark_share,mean_lux,min_lux,class,factor\n");
+    fprintf(f, "osm_id,length_m,dark_m,blocked_m,dark_share,mean_lux,min_lux,class,factor,min_ev_lux,min_sc_lux,"
+               "class_h\n");
     for (i = 0; i < n; i++)
         csv_row(f, &w[i], o->weight);
     free(w);

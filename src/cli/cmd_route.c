@@ -304,21 +304,40 @@ typedef struct spot {
     double lux;
 } spot;
 
-static int cmp_spot(const void *a, const void *b)
+/* The order spots are taken in: darkest first, then by y, then x (the grid
+ * order). */
+static int spot_before(const spot *p, const spot *q)
 {
-    const spot *p = a, *q = b;
     if (p->lux != q->lux)
-        return p->lux < q->lux ? -1 : 1;
-    return (p->k > q->k) - (p->k < q->k); /* then by y, then x: the grid order */
+        return p->lux < q->lux;
+    return p->k < q->k;
 }
 
-#define SPOT_STRIP 65536 /* grid points per illuminance call */
+static int cmp_spot(const void *a, const void *b)
+{
+    return spot_before(a, b) ? -1 : spot_before(b, a) ? 1 : 0;
+}
 
+#define SPOT_STRIP 65536 /* grid points per illuminance call, at most */
+#define SPOT_POINT_BYTES (3 * sizeof(double) * 2 + 2 * sizeof(double) + sizeof(uint32_t))
+#define SPOT_MIN_CANDIDATES 1024
+
+/* The street points are not all kept: a pass over the grid keeps the `cap`
+ * darkest of those after `after` (in spot_before's order) in a max-heap,
+ * so the command's buffers stay within --mem however fine --res is. The
+ * spacing rule then takes them in order; when it runs out of candidates
+ * before --count spots, the next pass continues after the last one. The
+ * spots are those of one sort of every street point, pass or no pass. */
 typedef struct spot_grid {
     double x0, y0, res;
-    size_t w, h;
-    spot *s;
+    size_t w, h, strip;
+    spot *heap;          /* max-heap of the darkest candidates of this pass */
     size_t n, cap;
+    spot after;          /* this pass takes spots after this one ... */
+    int has_after;       /* ... when set */
+    size_t offered;      /* street points after `after` seen this pass */
+    size_t street;       /* street points of the grid (first pass) */
+    double max_lux;      /* the brightest street point (first pass) */
 } spot_grid;
 
 static void spot_xy(const spot_grid *g, uint32_t k, double *x, double *y)
@@ -327,8 +346,44 @@ static void spot_xy(const spot_grid *g, uint32_t k, double *x, double *y)
     *y = g->y0 + (k / g->w + 0.5) * g->res;
 }
 
+static void heap_swap(spot *h, size_t a, size_t b)
+{
+    spot t = h[a];
+    h[a] = h[b];
+    h[b] = t;
+}
+
+/* Offers one street point to this pass's candidates. */
+static void spot_offer(spot_grid *g, spot s)
+{
+    spot *h = g->heap;
+    size_t i;
+    if (g->has_after && !spot_before(&g->after, &s))
+        return;
+    g->offered++;
+    if (g->n < g->cap) {
+        for (i = g->n++, h[i] = s; i > 0 && spot_before(&h[(i - 1) / 2], &h[i]); i = (i - 1) / 2)
+            heap_swap(h, i, (i - 1) / 2);
+        return;
+    }
+    if (!spot_before(&s, &h[0]))
+        return;
+    h[0] = s;
+    for (i = 0;;) {
+        size_t l = 2 * i + 1, r = l + 1, m = i;
+        if (l < g->n && spot_before(&h[m], &h[l]))
+            m = l;
+        if (r < g->n && spot_before(&h[m], &h[r]))
+            m = r;
+        if (m == i)
+            break;
+        heap_swap(h, i, m);
+        i = m;
+    }
+}
+
 /* Grid points [k0, k1): those in some lamp's reach (all with --all) get
- * their lux (direct + indirect) and join the street points. */
+ * their lux (direct + indirect); street points are offered. */
 static int spot_strip(plx_engine *e, spot_grid *g, size_t k0, size_t k1, int all, double *P, double *N,
                       double *E, double *Ei, uint32_t *reach)
 {
@@ -352,20 +407,16 @@ static int spot_strip(plx_engine *e, spot_grid *g, size_t k0, size_t k1, int all
     if (st != PLX_OK && st != PLX_E_RANGE)
         goto fail;
     for (k = 0; k < m; k++) {
+        spot s;
         if (E[k] != E[k])
             continue; /* under a building */
-        if (g->n == g->cap) {
-            size_t nc = g->cap ? 2 * g->cap : 4096;
-            spot *ns = realloc(g->s, nc * sizeof *ns);
-            if (!ns) {
-                fprintf(stderr, "polarlux dark-spots: out of memory for %zu street points\n", nc);
-                return EXIT_FAIL;
-            }
-            g->s = ns;
-            g->cap = nc;
+        s.k = reach[k];
+        s.lux = E[k] + Ei[k];
+        if (!g->has_after) {
+            g->street++;
+            g->max_lux = g->street == 1 || s.lux > g->max_lux ? s.lux : g->max_lux;
         }
-        g->s[g->n].k = reach[k];
-        g->s[g->n++].lux = E[k] + Ei[k];
+        spot_offer(g, s);
     }
     return EXIT_OK;
 fail:
@@ -373,28 +424,101 @@ fail:
     return cli_exit_code(st);
 }
 
-/* Every street point of the grid, strip by strip (progress on a terminal). */
-static int spot_scan(plx_engine *e, spot_grid *g, int all)
+/* One pass over every grid point, strip by strip (progress on a terminal);
+ * leaves this pass's candidates sorted in g->heap[0 .. n). */
+static int spot_pass(plx_engine *e, spot_grid *g, int all, int pass)
 {
     size_t total = g->w * g->h, k0;
-    double *P = malloc(sizeof *P * 3 * SPOT_STRIP), *N = malloc(sizeof *N * 3 * SPOT_STRIP);
-    double *E = malloc(sizeof *E * SPOT_STRIP), *Ei = malloc(sizeof *Ei * SPOT_STRIP);
-    uint32_t *reach = malloc(sizeof *reach * SPOT_STRIP);
+    double *P = malloc(sizeof *P * 3 * g->strip), *N = malloc(sizeof *N * 3 * g->strip);
+    double *E = malloc(sizeof *E * g->strip), *Ei = malloc(sizeof *Ei * g->strip);
+    uint32_t *reach = malloc(sizeof *reach * g->strip);
+    char what[48];
     cli_progress pr;
     int rc = EXIT_OK;
     if (!P || !N || !E || !Ei || !reach) {
         fprintf(stderr, "polarlux dark-spots: out of memory\n");
         rc = EXIT_FAIL;
     }
+    snprintf(what, sizeof what, pass > 1 ? "dark-spots (pass %d)" : "dark-spots", pass);
+    g->n = g->offered = 0;
     cli_progress_start(&pr);
-    for (k0 = 0; rc == EXIT_OK && k0 < total; k0 += SPOT_STRIP) {
-        size_t k1 = k0 + SPOT_STRIP < total ? k0 + SPOT_STRIP : total;
+    for (k0 = 0; rc == EXIT_OK && k0 < total; k0 += g->strip) {
+        size_t k1 = k0 + g->strip < total ? k0 + g->strip : total;
         rc = spot_strip(e, g, k0, k1, all, P, N, E, Ei, reach);
-        cli_progress_step(&pr, "dark-spots", k1, total);
+        cli_progress_step(&pr, what, k1, total);
     }
     cli_progress_end(&pr);
     free(P), free(N), free(E), free(Ei), free(reach);
+    if (g->n > 1) /* the heap is empty (maybe NULL) when there are no spots */
+        qsort(g->heap, g->n, sizeof *g->heap, cmp_spot);
     return rc;
+}
+
+/* Sizes the strip and the candidate heap from what --mem leaves the
+ * command; 0, or the exit code after a message. */
+static int spot_buffers(plx_engine *e, const cli_common *c, spot_grid *g, long count)
+{
+    size_t budget = cli_buffer_budget(e, c), total = g->w * g->h;
+    size_t pick = sizeof(spot) * (size_t)count, fixed, need;
+    g->strip = budget / 4 / SPOT_POINT_BYTES;
+    g->strip = g->strip > SPOT_STRIP ? SPOT_STRIP : g->strip < 64 ? 64 : g->strip;
+    fixed = g->strip * SPOT_POINT_BYTES + pick;
+    need = fixed + sizeof(spot) * SPOT_MIN_CANDIDATES;
+    if (budget < need) {
+        fprintf(stderr, "polarlux dark-spots: --mem leaves %zu bytes for the command's own buffers; "
+                "it needs %zu (grid strips, %ld spots, %d candidates): raise --mem\n", budget, need, count,
+                SPOT_MIN_CANDIDATES);
+        return EXIT_NOMEM;
+    }
+    g->cap = (budget - fixed) / sizeof(spot);
+    g->cap = g->cap > total ? total : g->cap;
+    g->heap = malloc(sizeof *g->heap * (g->cap ? g->cap : 1));
+    if (!g->heap) {
+        fprintf(stderr, "polarlux dark-spots: out of memory for %zu candidate points\n", g->cap);
+        return EXIT_FAIL;
+    }
+    return EXIT_OK;
+}
+
+/* Takes this pass's candidates in order, each at least `spacing` from every
+ * spot taken before. */
+static void spot_take(const spot_grid *g, double spacing, long count, spot *pick, long *npick)
+{
+    size_t k;
+    for (k = 0; k < g->n && *npick < count; k++) {
+        double x, y;
+        long j;
+        spot_xy(g, g->heap[k].k, &x, &y);
+        for (j = 0; j < *npick; j++) {
+            double px, py;
+            spot_xy(g, pick[j].k, &px, &py);
+            if (hypot(px - x, py - y) < spacing)
+                break;
+        }
+        if (j == *npick)
+            pick[(*npick)++] = g->heap[k];
+    }
+}
+
+/* The spots, as many passes as the candidates' room asks for. */
+static int spot_search(plx_engine *e, spot_grid *g, int all, double spacing, long count, spot *pick,
+                       long *npick)
+{
+    int pass, rc;
+    for (pass = 1;; pass++) {
+        rc = spot_pass(e, g, all, pass);
+        if (rc != EXIT_OK)
+            return rc;
+        spot_take(g, spacing, count, pick, npick);
+        if (*npick == count || g->offered <= g->n)
+            break;
+        g->after = g->heap[g->n - 1];
+        g->has_after = 1;
+    }
+    if (pass > 1)
+        fprintf(stderr, "dark-spots: %d passes over the grid: --mem leaves room for %zu of the %zu street "
+                "points at a time\n", pass, g->cap, g->street);
+    return EXIT_OK;
 }
 
 static int find_spots(plx_engine *e, double res, long count, double spacing, int all, const char *out,
@@ -403,8 +527,7 @@ static int find_spots(plx_engine *e, double res, long count, double spacing, int
     plx_scene_info si;
     spot_grid g;
     spot *pick = NULL;
-    long npick = 0;
-    size_t k;
+    long npick = 0, k;
     geo_out geo;
     int rc;
     plx_scene_info_get(e, &si);
@@ -421,41 +544,29 @@ static int find_spots(plx_engine *e, double res, long count, double spacing, int
         g.w = (size_t)wd;
         g.h = (size_t)hd;
     }
-    rc = spot_scan(e, &g, all);
+    rc = spot_buffers(e, c, &g, count);
     if (rc != EXIT_OK)
         goto done;
-    if (g.n == 0)
-        cli_warn("dark-spots", c, "no street point is within a lamp's reach (%s), so there are no spots; "
-                 "--all takes every street point", si.lamps ? "the lamps are outside Bounds or their radius "
-                 "does not reach the ground" : "the scene has no lamps");
-    if (g.n > 1) /* g.s is NULL when there are no spots: qsort's base must not be */
-        qsort(g.s, g.n, sizeof *g.s, cmp_spot);
-    if (g.n > 0 && !(g.s[g.n - 1].lux > 0))
-        cli_warn("dark-spots", c, "all %zu street points are dark (0 lx): %s", g.n, cli_dark_reason(e));
     pick = malloc(sizeof *pick * (size_t)count);
     if (!pick) {
         fprintf(stderr, "polarlux dark-spots: out of memory\n");
         rc = EXIT_FAIL;
         goto done;
     }
-    for (k = 0; k < g.n && npick < count; k++) {
-        double x, y;
-        long j;
-        spot_xy(&g, g.s[k].k, &x, &y);
-        for (j = 0; j < npick; j++) {
-            double px, py;
-            spot_xy(&g, pick[j].k, &px, &py);
-            if (hypot(px - x, py - y) < spacing)
-                break;
-        }
-        if (j == npick)
-            pick[npick++] = g.s[k];
-    }
+    rc = spot_search(e, &g, all, spacing, count, pick, &npick);
+    if (rc != EXIT_OK)
+        goto done;
+    if (g.street == 0)
+        cli_warn("dark-spots", c, "no street point is within a lamp's reach (%s), so there are no spots; "
+                 "--all takes every street point", si.lamps ? "the lamps are outside Bounds or their radius "
+                 "does not reach the ground" : "the scene has no lamps");
+    if (g.street > 0 && !(g.max_lux > 0))
+        cli_warn("dark-spots", c, "all %zu street points are dark (0 lx): %s", g.street, cli_dark_reason(e));
     if (geo_begin(&geo, e) != 0) {
         rc = EXIT_FAIL;
         goto done;
     }
-    for (k = 0; k < (size_t)npick; k++) {
+    for (k = 0; k < npick; k++) {
         cJSON *props = cJSON_CreateObject();
         double x, y, sx, sy;
         spot_xy(&g, pick[k].k, &x, &y);
@@ -473,7 +584,7 @@ static int find_spots(plx_engine *e, double res, long count, double spacing, int
             rc = EXIT_FAIL;
         else
             fprintf(stderr, "dark-spots: %ld spots from %zu street points, darkest %.3f lx, written to %s\n",
-                    npick, g.n, npick ? pick[0].lux : 0.0, out);
+                    npick, g.street, npick ? pick[0].lux : 0.0, out);
     } else {
         char *text = cJSON_PrintUnformatted(geo.root);
         if (text)
@@ -482,7 +593,7 @@ static int find_spots(plx_engine *e, double res, long count, double spacing, int
     }
     geo_free(&geo);
 done:
-    free(g.s);
+    free(g.heap);
     free(pick);
     return rc;
 }

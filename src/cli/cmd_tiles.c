@@ -12,23 +12,30 @@
 #include "tiles.h"
 
 static const char help[] =
-    "usage: polarlux tiles SCENE --zoom Z0[-Z1] [--quantity h] [--max LUX] -o OUT [options]\n"
+    "usage: polarlux tiles SCENE --zoom Z0[-Z1] [--quantity h|sc] [--max LUX] -o OUT [options]\n"
     "\n"
     "Writes web-map raster tiles (Web Mercator, XYZ numbering, 256 x 256 pixels)\n"
-    "of the direct ground illuminance E_h over the scene's Bounds, in the colours\n"
-    "of 'polarlux heatmap' (logarithmic scale from 0.1 lx to --max); pixels with\n"
-    "no light (0.1 lx or less, or inside a footprint) are transparent. Each\n"
-    "pixel is the ground point under its centre. The scene must be in lon/lat.\n"
+    "of the direct ground illuminance E_h (with --quantity sc: the direct\n"
+    "semi-cylindrical illuminance E_sc above the ground) over the scene's Bounds,\n"
+    "in the colours of 'polarlux heatmap' (logarithmic scale from 0.1 lx to\n"
+    "--max); pixels with no light (0.1 lx or less, or inside a footprint or\n"
+    "solid) are transparent. Each pixel is the ground point under its centre.\n"
+    "The scene must be in lon/lat.\n"
     "OUT ending in .mbtiles is an MBTiles 1.3 file (SQLite; metadata name,\n"
     "format, type, version, bounds, center, minzoom, maxzoom, description);\n"
     "otherwise OUT is a folder receiving OUT/z/x/y.png.\n"
     "\n"
     "  --zoom Z0-Z1   zoom levels (0..22; one level: --zoom Z)\n"
-    "  --quantity h   the horizontal illuminance E_h on the ground (the only one\n"
-    "                 for now)\n"
-    "  --max LUX      top of the colour scale (default: as 'polarlux heatmap' with\n"
-    "                 its default resolution, the next power of ten above the\n"
-    "                 brightest pixel)\n"
+    "  --quantity Q   h: the horizontal illuminance E_h on the ground (default);\n"
+    "                 sc: the semi-cylindrical illuminance E_sc (SPEC §6) --height\n"
+    "                 above it, facing --facing\n"
+    "  --height M     height of the sc meters (default 1.5)\n"
+    "  --facing F     sc's facing direction: 'min' (default), the least E_sc over\n"
+    "                 every horizontal direction (the face worst lit), or degrees\n"
+    "                 counter-clockwise from east (as 'polarlux heatmap --facing')\n"
+    "  --max LUX      top of the colour scale (default: as 'polarlux heatmap' of\n"
+    "                 the quantity with its default resolution, the next power of\n"
+    "                 ten above the brightest pixel)\n"
     "  -o OUT         folder or .mbtiles file (required)\n"
     "  --mem SIZE, --strict, --quiet   as for 'polarlux info'\n";
 
@@ -36,6 +43,7 @@ typedef struct tiles_opts {
     const char *scene, *out;
     long z0, z1;
     double top;
+    heat_quantity q;
     cli_common c;
 } tiles_opts;
 
@@ -107,6 +115,18 @@ static long count_tiles(plx_engine *e, const tiles_opts *o)
     return total;
 }
 
+/* What the tiles map, for the summary line and the MBTiles description. */
+static void quantity_text(const heat_quantity *q, char *buf, size_t len)
+{
+    if (q->quantity == PLX_METER_H)
+        snprintf(buf, len, "direct ground illuminance E_h");
+    else if (q->facing_min)
+        snprintf(buf, len, "direct semi-cylindrical illuminance E_sc at %g m, the least over every facing direction",
+                 q->height);
+    else
+        snprintf(buf, len, "direct semi-cylindrical illuminance E_sc at %g m facing %g deg", q->height, q->facing);
+}
+
 /* Renders and stores every tile; returns an exit code. */
 static int run(plx_engine *e, const tiles_opts *o, double top)
 {
@@ -115,7 +135,7 @@ static int run(plx_engine *e, const tiles_opts *o, double top)
     int z, rc = EXIT_OK, tty = isatty(2);
     tile_work w;
     mbtiles *mb = NULL;
-    char err[512], name[256];
+    char err[512], name[256], what[160];
     double b[4];
     memset(&w, 0, sizeof w);
     lonlat_bounds(e, b);
@@ -124,8 +144,11 @@ static int run(plx_engine *e, const tiles_opts *o, double top)
         free(rgba);
         return EXIT_FAIL;
     }
+    w.q = o->q;
+    quantity_text(&o->q, what, sizeof what);
     if (ends_with(o->out, ".mbtiles") &&
-        !(mb = mbtiles_open(o->out, scene_name(o->scene, name, sizeof name), b, (int)o->z0, (int)o->z1, top, err, sizeof err))) {
+        !(mb = mbtiles_open(o->out, scene_name(o->scene, name, sizeof name), b, (int)o->z0, (int)o->z1, what, top, err,
+                             sizeof err))) {
         fprintf(stderr, "polarlux tiles: %s\n", err);
         rc = EXIT_FAIL;
     }
@@ -164,8 +187,8 @@ static int run(plx_engine *e, const tiles_opts *o, double top)
         rc = EXIT_FAIL;
     }
     if (rc == EXIT_OK) {
-        printf("tiles: %ld tiles at zoom %ld-%ld (%ld with light), scale 0.1..%g lx, written to %s\n", total, o->z0,
-               o->z1, lit_tiles, top, o->out);
+        printf("tiles: %ld tiles at zoom %ld-%ld (%ld with light) of %s, scale 0.1..%g lx, written to %s\n", total,
+               o->z0, o->z1, lit_tiles, what, top, o->out);
         if (lit_tiles == 0)
             fprintf(stderr, "polarlux tiles: note: no tile has light (every pixel at or below 0.1 lx)\n");
     }
@@ -191,7 +214,10 @@ static int parse_zoom(const char *s, tiles_opts *o)
 
 static int parse(int argc, char **argv, tiles_opts *o)
 {
-    int i, have_zoom = 0;
+    int i, have_zoom = 0, sc_option = 0;
+    o->q.quantity = PLX_METER_H;
+    o->q.height = 1.5;
+    o->q.facing_min = 1;
     for (i = 1; i < argc; i++) {
         const char *a = argv[i];
         int r = cli_common_option("tiles", argc, argv, &i, &o->c);
@@ -204,15 +230,26 @@ static int parse(int argc, char **argv, tiles_opts *o)
             return -1;
         }
         if ((strcmp(a, "--zoom") == 0 || strcmp(a, "--quantity") == 0 || strcmp(a, "--max") == 0 ||
-             strcmp(a, "-o") == 0) && i + 1 >= argc)
+             strcmp(a, "-o") == 0 || strcmp(a, "--height") == 0 || strcmp(a, "--facing") == 0) && i + 1 >= argc)
             return cli_usage_error("tiles", "%s needs a value", a);
         if (strcmp(a, "--zoom") == 0) {
             if (parse_zoom(argv[++i], o) != 0)
                 return cli_usage_error("tiles", "--zoom '%s' is not Z or Z0-Z1 with 0 <= Z0 <= Z1 <= 22", argv[i]);
             have_zoom = 1;
         } else if (strcmp(a, "--quantity") == 0) {
-            if (strcmp(argv[++i], "h") != 0)
-                return cli_usage_error("tiles", "--quantity '%s' is not available (only h, the ground E_h)", argv[i]);
+            const char *q = argv[++i];
+            o->q.quantity = strcmp(q, "h") == 0 ? PLX_METER_H : strcmp(q, "sc") == 0 ? PLX_METER_SC : -1;
+            if (o->q.quantity < 0)
+                return cli_usage_error("tiles", "--quantity '%s' is not h (ground E_h) or sc (E_sc)", q);
+        } else if (strcmp(a, "--height") == 0) {
+            sc_option = 1;
+            if (cli_parse_double(argv[++i], &o->q.height) != 0 || !(o->q.height >= 0) || !(o->q.height <= 1000))
+                return cli_usage_error("tiles", "--height '%s' is not a number of metres from 0 to 1000", argv[i]);
+        } else if (strcmp(a, "--facing") == 0) {
+            sc_option = 1;
+            o->q.facing_min = strcmp(argv[++i], "min") == 0;
+            if (!o->q.facing_min && (cli_parse_double(argv[i], &o->q.facing) != 0 || !isfinite(o->q.facing)))
+                return cli_usage_error("tiles", "--facing '%s' is not a number of degrees or min", argv[i]);
         } else if (strcmp(a, "--max") == 0) {
             if (cli_parse_double(argv[++i], &o->top) != 0 || !(o->top > 0.1))
                 return cli_usage_error("tiles", "--max '%s' is not a number of lux above 0.1", argv[i]);
@@ -232,6 +269,8 @@ static int parse(int argc, char **argv, tiles_opts *o)
         return cli_usage_error("tiles", "missing --zoom Z0-Z1");
     if (!o->out)
         return cli_usage_error("tiles", "missing -o OUT (a folder or a .mbtiles file)");
+    if (sc_option && o->q.quantity != PLX_METER_SC)
+        return cli_usage_error("tiles", "--height and --facing need --quantity sc (E_h is on the ground)");
     return EXIT_OK;
 }
 
@@ -265,7 +304,7 @@ int cmd_tiles(int argc, char **argv)
         plx_engine_free(e);
         return EXIT_USAGE;
     }
-    rc = run(e, &o, o.top > 0 ? o.top : tile_default_top(e));
+    rc = run(e, &o, o.top > 0 ? o.top : tile_default_top(e, &o.q));
     plx_engine_free(e);
     return rc;
 }

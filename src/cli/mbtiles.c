@@ -33,9 +33,10 @@ static int add_meta(mbtiles *m, const char *name, const char *value)
     return rc;
 }
 
-static int write_metadata(mbtiles *m, const char *name, const double b[4], int z0, int z1, double top)
+static int write_metadata(mbtiles *m, const char *name, const double b[4], int z0, int z1, const char *what,
+                          double top)
 {
-    char v[256];
+    char v[512];
     int rc = 0;
     rc |= add_meta(m, "name", name);
     rc |= add_meta(m, "format", "png");
@@ -50,15 +51,15 @@ static int write_metadata(mbtiles *m, const char *name, const double b[4], int z
     snprintf(v, sizeof v, "%d", z1);
     rc |= add_meta(m, "maxzoom", v);
     snprintf(v, sizeof v,
-             "Direct ground illuminance E_h by polarlux, logarithmic colour scale 0.1..%g lx "
+             "%s by polarlux, logarithmic colour scale 0.1..%g lx "
              "(the heat map's); transparent where there is no light",
-             top);
+             what, top);
     rc |= add_meta(m, "description", v);
     return rc;
 }
 
-mbtiles *mbtiles_open(const char *path, const char *name, const double bounds[4], int z0, int z1, double top,
-                      char *err, size_t errlen)
+mbtiles *mbtiles_open(const char *path, const char *name, const double bounds[4], int z0, int z1,
+                      const char *what, double top, char *err, size_t errlen)
 {
     static const char schema[] =
         "PRAGMA journal_mode = OFF; PRAGMA synchronous = OFF; BEGIN;"
@@ -78,7 +79,7 @@ mbtiles *mbtiles_open(const char *path, const char *name, const double bounds[4]
     snprintf(m->tmp, n, "%s.tmp.%ld", path, (long)getpid());
     unlink(m->tmp);
     if (sqlite3_open(m->tmp, &m->db) != SQLITE_OK || sqlite3_exec(m->db, schema, NULL, NULL, NULL) != SQLITE_OK ||
-        write_metadata(m, name, bounds, z0, z1, top) != 0 ||
+        write_metadata(m, name, bounds, z0, z1, what, top) != 0 ||
         sqlite3_prepare_v2(m->db, "INSERT INTO tiles VALUES (?, ?, ?, ?)", -1, &m->put, NULL) != SQLITE_OK) {
         sql_fail(m, "cannot create the MBTiles file", err, errlen);
         mbtiles_close(m, 0, NULL, 0);

@@ -182,16 +182,19 @@ int net_build(network *net, route_set *lines, char *err, size_t errlen)
     return 0;
 }
 
-plx_status net_score(network *net, plx_engine *e, double step, double dark_lux, int progress)
+plx_status net_score(network *net, plx_engine *e, double step, double dark_lux, double height, int progress)
 {
     uint32_t i, shown = 0;
     net->step = step;
     net->dark_lux = dark_lux;
+    net->height = height;
     progress = progress && isatty(2);
     for (i = 0; i < net->nedges; i++) {
         net_edge *ed = &net->edges[i];
         const route_line *l = &net->lines.lines[ed->line];
         plx_status st = plx_route_score(e, l->xy + 2 * ed->v0, ed->v1 - ed->v0 + 1, step, dark_lux, &ed->s, NULL);
+        if (st == PLX_OK)
+            st = plx_route_facial(e, l->xy + 2 * ed->v0, ed->v1 - ed->v0 + 1, step, height, NULL, ed->fac);
         if (st != PLX_OK)
             return st;
         ed->dark = ed->s.dark_share * ed->s.length;
@@ -256,6 +259,7 @@ typedef struct walk_edge {
     uint32_t u, v;
     double cost, length, dark;
     plx_route_stats s;
+    double fac[4];
     double *xy; /* pieces only: their polyline from u to v */
     uint32_t n;
 } walk_edge;
@@ -307,6 +311,8 @@ static int make_piece(network *net, plx_engine *e, const net_snap *p, const net_
     w->u = u;
     w->v = v;
     st = plx_route_score(e, w->xy, n, net->step, net->dark_lux, &w->s, NULL);
+    if (st == PLX_OK)
+        st = plx_route_facial(e, w->xy, n, net->step, net->height, NULL, w->fac);
     if (st != PLX_OK)
         return -1;
     w->length = piece_length(w->xy, n);
@@ -449,8 +455,11 @@ static int append_xy(net_route *r, const double *xy, uint32_t n, int reverse)
     return 0;
 }
 
-static void add_stats(net_route *r, double length, double dark, const plx_route_stats *s)
+/* fmin ignores a NaN argument: NaN stays only while no edge had a meter. */
+static void add_stats(net_route *r, double length, double dark, const plx_route_stats *s, const double fac[4])
 {
+    r->min_ev = fmin(r->min_ev, fmin(fac[0], fac[1]));
+    r->min_esc = fmin(r->min_esc, fmin(fac[2], fac[3]));
     r->length += length;
     r->dark += dark;
     r->blocked += s->blocked_length;
@@ -487,12 +496,12 @@ static int collect(network *net, const query *q, net_route *r)
         if (x >= net->nedges) {
             const walk_edge *w = &q->piece[x - net->nedges];
             rc = append_xy(r, w->xy, w->n, w->u != v);
-            add_stats(r, w->length, w->dark, &w->s);
+            add_stats(r, w->length, w->dark, &w->s, w->fac);
             v = w->u == v ? w->v : w->u;
         } else {
             const net_edge *ed = &net->edges[x];
             rc = append_xy(r, net->lines.lines[ed->line].xy + 2 * ed->v0, ed->v1 - ed->v0 + 1, ed->a != v);
-            add_stats(r, ed->length, ed->dark, &ed->s);
+            add_stats(r, ed->length, ed->dark, &ed->s, ed->fac);
             v = ed->a == v ? ed->b : ed->a;
         }
         if (rc != 0) {
@@ -513,6 +522,7 @@ int net_route_find(network *net, plx_engine *e, const net_snap *a, const net_sna
     memset(&q, 0, sizeof q);
     out->min = INFINITY;
     out->max = -INFINITY;
+    out->min_ev = out->min_esc = NAN;
     if (make_pieces(net, e, a, b, weight, &q) != 0) {
         snprintf(err, errlen, "scoring the ends of the route failed: %s", plx_last_error(e));
         free_pieces(&q);
@@ -528,7 +538,9 @@ int net_route_find(network *net, plx_engine *e, const net_snap *a, const net_sna
         out->cost = net->dist[q.T];
         if (out->scored > 0) {
             double mean = out->integral / out->scored;
-            out->p_class = plx_p_class(mean, out->min);
+            out->p_class_h = plx_p_class(mean, out->min);
+            if (out->min_ev == out->min_ev && out->min_esc == out->min_esc)
+                out->p_class = plx_p_class_facial(mean, out->min, out->min_ev, out->min_esc);
         } else {
             out->min = out->max = 0;
         }

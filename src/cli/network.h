@@ -19,6 +19,8 @@ typedef struct net_edge {
     double length;          /* geometric length in metres */
     double dark;            /* metres scored below the dark threshold */
     plx_route_stats s;      /* the piece scored as plx_route_score scores a line */
+    double fac[4];          /* SPEC §6 at the network's height, as plx_route_facial's total: min E_v
+                               facing v0 to v1 (fw), back (bw), min E_sc fw, bw; NaN: no sample */
 } net_edge;
 
 typedef struct network {
@@ -29,6 +31,7 @@ typedef struct network {
     uint32_t *adj_first;    /* node i's edges: adj[adj_first[i] .. adj_first[i+1]) */
     uint32_t *adj;
     double step, dark_lux;  /* how the edges were scored */
+    double height;          /* the E_v and E_sc meters' height above the street */
     /* search scratch, sized for nnodes + 2 */
     double *dist;
     uint32_t *prev;
@@ -40,14 +43,19 @@ typedef struct network {
  * net_free, also on failure). 0, or -1 with a message in err. */
 int net_build(network *net, route_set *lines, char *err, size_t errlen);
 /* Scores every edge (plx_route_score over the piece, sampled every step
- * metres); progress on stderr when it is a terminal. A plx_status. */
-plx_status net_score(network *net, plx_engine *e, double step, double dark_lux, int progress);
+ * metres, and plx_route_facial with its meters 'height' above it);
+ * progress on stderr when it is a terminal. A plx_status. */
+plx_status net_score(network *net, plx_engine *e, double step, double dark_lux, double height, int progress);
 void net_free(network *net);
 
-/* A route: its edges and the sums over them. */
+/* A route: its edges and the sums over them. min_ev and min_esc are the
+ * minima over its edges facing both ways (NaN: no meter outside a solid);
+ * p_class is the SPEC §6 class with every criterion (mean and min E_h, min
+ * E_v, min E_sc), p_class_h the class of E_h alone (0: none). */
 typedef struct net_route {
     double length, dark, blocked, scored, integral, min, max, cost;
-    int p_class;
+    double min_ev, min_esc;
+    int p_class, p_class_h;
     double *xy;            /* the polyline, n vertices, malloc'd */
     uint32_t n;
 } net_route;

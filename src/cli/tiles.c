@@ -46,6 +46,10 @@ int tile_work_init(tile_work *w)
     w->P = malloc(sizeof *w->P * 3 * n);
     w->N = malloc(sizeof *w->N * 3 * n);
     w->E = malloc(sizeof *w->E * n);
+    memset(&w->q, 0, sizeof w->q);
+    w->q.quantity = PLX_METER_H;
+    w->q.height = 1.5;
+    w->q.facing_min = 1;
     if (w->P && w->N && w->E)
         return 0;
     tile_work_free(w);
@@ -76,7 +80,11 @@ long tile_render(plx_engine *e, tile_work *w, int z, long x, long y, double top,
         w->N[3 * k] = w->N[3 * k + 1] = 0.0;
         w->N[3 * k + 2] = 1.0;
     }
-    st = plx_illuminance(e, n, w->P, w->N, w->E, NULL, NULL);
+    if (w->q.quantity == PLX_METER_H)
+        st = plx_illuminance(e, n, w->P, w->N, w->E, NULL, NULL);
+    else
+        for (k = 0, st = PLX_OK; k < n && (st == PLX_OK || st == PLX_E_RANGE); k++)
+            st = heatmap_value(e, &w->q, w->P[3 * k], w->P[3 * k + 1], &w->E[k]);
     if (st != PLX_OK && st != PLX_E_RANGE) /* RANGE: pixels under buildings */
         return -1;
     for (k = 0; k < n; k++) {
@@ -91,7 +99,7 @@ long tile_render(plx_engine *e, tile_work *w, int z, long x, long y, double top,
     return lit;
 }
 
-double tile_default_top(plx_engine *e)
+double tile_default_top(plx_engine *e, const heat_quantity *q)
 {
     plx_scene_info si;
     double res, top = 0, P[3 * 1024], N[3 * 1024], E[1024];
@@ -109,7 +117,11 @@ double tile_default_top(plx_engine *e)
             N[3 * i] = N[3 * i + 1] = 0;
             N[3 * i + 2] = 1;
         }
-        plx_illuminance(e, n, P, N, E, NULL, NULL);
+        if (q->quantity == PLX_METER_H)
+            plx_illuminance(e, n, P, N, E, NULL, NULL);
+        else
+            for (i = 0; i < n; i++)
+                heatmap_value(e, q, P[3 * i], P[3 * i + 1], &E[i]);
         for (i = 0; i < n; i++)
             if (E[i] == E[i] && E[i] > top)
                 top = E[i];

@@ -2,7 +2,7 @@
 # sourced by tests/cli/run.sh (uses its expect, $bin, $tmp).
 net="fixtures/net-detour.geojson --network fixtures/net-detour-streets.geojson"
 expect net-best-lit 0 "^best-lit +300\.0 +69\.0 .*\+50\.0%$" -- "$bin" route -q $net --from 0,0 --to 200,0 --geojson "$tmp/net.geojson"
-expect net-shortest 0 "^shortest +200\.0 +200\.0 +0\.000 +0\.000  - +\+0\.0%$" -- "$bin" route -q $net --from 0,0 --to 200,0
+expect net-shortest 0 "^shortest +200\.0 +200\.0 +0\.000 +0\.000 +0\.000 +0\.000  - +- +\+0\.0%$" -- "$bin" route -q $net --from 0,0 --to 200,0
 expect net-geojson 0 "" -- sh -c "grep -q '\"route\":\"best-lit\"' '$tmp/net.geojson' && grep -q '\"route\":\"shortest\"' '$tmp/net.geojson' && grep -q '\"mean_lux\"' '$tmp/net.geojson'"
 expect net-light-weight 0 "^best-lit +200\.0 +200\.0 " -- "$bin" route -q $net --from 0,0 --to 200,0 --dark-weight 0.5
 expect net-max-detour 0 "^best-lit +200\.0 " -- "$bin" route -q $net --from 0,0 --to 200,0 --max-detour 0.2
@@ -16,8 +16,20 @@ expect net-missing-to 2 "--network needs --from X,Y and --to X,Y" -- "$bin" rout
 expect net-help 0 "cost = length \+ W x dark metres" -- "$bin" route --network x --help
 expect net-helsinki 0 "^cost = length .*network [0-9]+ nodes, [0-9]+ edges" -- "$bin" route -q fixtures/helsinki-centre.geojson --network fixtures/helsinki-streets.geojson --from 24.9400,60.1660 --to 24.9480,60.1770
 expect annotate 0 "^annotate: 6 edges, 6 nodes, 570 m of street" -- "$bin" annotate -q $net -o "$tmp/ann.geojson" --csv "$tmp/ann.csv"
-expect annotate-csv 0 "^way/2,300\.000,69\.000,0\.000,0\.2300,9\.4414,0\.0000,-,1\.6900$" -- cat "$tmp/ann.csv"
-expect annotate-csv-head 0 "^osm_id,length_m,dark_m,blocked_m,dark_share,mean_lux,min_lux,class,factor$" -- cat "$tmp/ann.csv"
+expect annotate-csv 0 "^way/2,300\.000,69\.000,0\.000,0\.2300,9\.4414,0\.0000,-,1\.6900,0\.0000,0\.0000,-$" -- cat "$tmp/ann.csv"
+expect annotate-csv-head 0 "^osm_id,length_m,dark_m,blocked_m,dark_share,mean_lux,min_lux,class,factor,min_ev_lux,min_sc_lux,class_h$" -- cat "$tmp/ann.csv"
+# the SPEC §6 class with the facial criterion: P1 on the ground, P5 with min E_v 1.287 lx (P4 needs 1.5),
+# as 'route --path' gives on the same line (its class_fr)
+fac="fixtures/net-facial.geojson --network fixtures/net-facial-streets.geojson"
+expect net-facial 0 "^best-lit +40\.0 +0\.0 +32\.072 +40\.647 +1\.287 +2\.070  P1 +P5 " -- "$bin" route -q $fac --from 0,0 --to 40,0 --geojson "$tmp/fac.geojson"
+expect net-facial-geojson 0 "" -- sh -c "grep -q '\"min_sc_lux\":2\.07' '$tmp/fac.geojson' && grep -q '\"class\":\"P5\",\"class_h\":\"P1\"' '$tmp/fac.geojson'"
+expect net-facial-path 0 "^lit-street all .* P1 +1\.287 +1\.287 +2\.070 +2\.070 P5" -- "$bin" route -q fixtures/net-facial.geojson --path fixtures/net-facial-streets.geojson
+expect annotate-facial 0 "^way/10,40\.000,0\.000,0\.000,0\.0000,40\.6465,32\.0721,P5,1\.0000,1\.2870,2\.0701,P1$" -- sh -c "'$bin' annotate -q $fac -o '$tmp/fac-ann.geojson' --csv '$tmp/fac.csv' >/dev/null && cat '$tmp/fac.csv'"
+expect annotate-facial-geojson 0 "" -- grep -q '"min_sc_fw_lux":2\.07.*"min_sc_lux":2\.07.*"class":"P5","class_h":"P1"' "$tmp/fac-ann.geojson"
 expect annotate-missing-o 2 "missing -o OUT.geojson" -- "$bin" annotate -q $net
 expect tiles-metres 1 "the scene is in local metres, with no lon/lat" -- "$bin" tiles -q fixtures/tiny.geojson --zoom 15 -o "$tmp/t"
-expect tiles-quantity 2 "--quantity 'sc' is not available" -- "$bin" tiles -q fixtures/helsinki-centre.geojson --zoom 15 --quantity sc -o "$tmp/t"
+expect tiles-quantity 2 "--quantity 'v' is not h \(ground E_h\) or sc \(E_sc\)" -- "$bin" tiles -q fixtures/helsinki-centre.geojson --zoom 15 --quantity v -o "$tmp/t"
+expect tiles-facing 2 "--facing 'west' is not a number of degrees or min" -- "$bin" tiles -q fixtures/helsinki-centre.geojson --zoom 15 --quantity sc --facing west -o "$tmp/t"
+expect tiles-sc 0 "^tiles: [0-9]+ tiles at zoom 12-12 \([0-9]+ with light\) of direct semi-cylindrical illuminance E_sc at 1\.5 m, the least over every facing direction, scale 0\.1\.\.100 lx" -- "$bin" tiles -q fixtures/helsinki-centre.geojson --zoom 12 --quantity sc --max 100 -o "$tmp/sc.mbtiles"
+expect tiles-facing-h 2 "--height and --facing need --quantity sc" -- "$bin" tiles -q fixtures/helsinki-centre.geojson --zoom 15 --facing 90 -o "$tmp/t"
+expect heatmap-facing-min 2 "--facing min needs --quantity sc" -- "$bin" heatmap -q fixtures/helsinki-centre.geojson --quantity v --facing min -o "$tmp/v.png"

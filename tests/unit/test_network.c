@@ -52,7 +52,7 @@ static void open_net(plx_engine *e, const char *path, network *net)
     if (route_read(path, e, &rs, err, sizeof err) != 0)
         fail_msg("%s", err);
     assert_int_equal(net_build(net, &rs, err, sizeof err), 0);
-    assert_int_equal(net_score(net, e, 1.0, 1.0, 0), PLX_OK);
+    assert_int_equal(net_score(net, e, 1.0, 1.0, 1.5, 0), PLX_OK);
 }
 
 static void snap(const network *net, double x, double y, net_snap *s)
@@ -109,18 +109,22 @@ static void test_edges_equal_route_scores(void **state)
     plx_engine *e = load_file("fixtures/helsinki-centre.geojson", &mem);
     network net;
     size_t i;
-    uint32_t k, checked = 0, cut = 0;
+    uint32_t k, checked = 0, cut = 0, facial = 0;
     (void)state;
     open_net(e, "fixtures/helsinki-streets.geojson", &net);
     assert_true(net.nedges > net.lines.n);
     for (i = 0; i < net.lines.n; i++) {
         const route_line *l = &net.lines.lines[i];
         plx_route_stats whole;
-        double len = 0, dark = 0, integral = 0, blocked = 0, mn = INFINITY, geo = 0;
+        double len = 0, dark = 0, integral = 0, blocked = 0, mn = INFINITY, geo = 0, fac[4], efac[4];
         uint32_t pieces = 0;
+        int c;
         if (getenv("PLX_TEST_QUICK") && i % 4)
             continue;
         assert_int_equal(plx_route_score(e, l->xy, l->n, 1.0, 1.0, &whole, NULL), PLX_OK);
+        assert_int_equal(plx_route_facial(e, l->xy, l->n, 1.0, 1.5, NULL, fac), PLX_OK);
+        for (c = 0; c < 4; c++)
+            efac[c] = NAN;
         for (k = 0; k < net.nedges; k++) {
             const net_edge *ed = &net.edges[k];
             if (ed->line != i)
@@ -133,7 +137,13 @@ static void test_edges_equal_route_scores(void **state)
             geo += ed->length;
             if (ed->s.length > 0)
                 mn = fmin(mn, ed->s.min);
+            for (c = 0; c < 4; c++) /* fw, bw along the line's own order in both */
+                efac[c] = fmin(efac[c], ed->fac[c]);
         }
+        for (c = 0; c < 4; c++) /* the same samples: exactly equal (or both without a meter) */
+            assert_true(fac[c] == efac[c] || (fac[c] != fac[c] && efac[c] != efac[c]));
+        if (fac[2] == fac[2])
+            facial++;
         assert_true(pieces >= 1);
         cut += pieces > 1;
         assert_true(fabs(len - whole.length) <= 1e-9 * (1 + whole.length));
@@ -146,6 +156,7 @@ static void test_edges_equal_route_scores(void **state)
         checked++;
     }
     assert_true(checked > 100);
+    assert_true(facial > 100);
     assert_true(cut > 100); /* real ways meet in the middle of other ways */
     net_free(&net);
     plx_engine_destroy(e);
@@ -163,6 +174,7 @@ static void test_route_equals_its_polyline(void **state)
     net_route r;
     plx_route_stats s;
     char err[256];
+    double fac[4];
     static const double ends[4][4] = { { 50, 0, 150, 0 }, { 20, 1, 80, -1 }, { 80, 0, 20, 0 }, { 30, 45, 170, 5 } };
     static const double expect_len[4] = { 100, 60, 60, -1 };
     int i;
@@ -180,11 +192,114 @@ static void test_route_equals_its_polyline(void **state)
         assert_true(fabs(s.length - r.scored) < 1e-9);
         assert_true(fabs(s.dark_share * s.length - r.dark) < 1e-9);
         assert_true(fabs(s.mean * s.length - r.integral) < 1e-9 * (1 + r.integral));
+        /* SPEC §6 minima over both ways: the route's edges against the polyline */
+        assert_int_equal(plx_route_facial(e, r.xy, r.n, 1.0, 1.5, NULL, fac), PLX_OK);
+        assert_true(r.min_ev == fmin(fac[0], fac[1]) && r.min_esc == fmin(fac[2], fac[3]));
+        assert_int_equal(r.p_class, plx_p_class_facial(s.mean, s.min, r.min_ev, r.min_esc));
+        assert_int_equal(r.p_class_h, s.p_class);
         net_route_free(&r);
     }
     net_free(&net);
     plx_engine_destroy(e);
     free(mem);
+}
+
+/* ---- the facial-recognition criterion decides the class ------------------- */
+
+/* A street (0,0)-(20,0)-(40,0) and its lamps (isotropic, 5 m high, reach
+ * 30 m): 1000 cd on the street's axis at x = 0, 10, .., 40, and with
+ * 'sides' also 100 cd on both sides at y = +-6 from x = -20 to 60. */
+static char *lamp_scene(int sides)
+{
+    char *buf = malloc(1 << 14);
+    size_t n = 0;
+    int x, y, pass;
+    n += (size_t)sprintf(buf + n, "{\"type\":\"FeatureCollection\",\"properties\":{\"units\":\"m\"},\"features\":["
+                                  "{\"type\":\"Feature\",\"properties\":{},\"geometry\":{\"type\":\"Polygon\","
+                                  "\"coordinates\":[[[100,100],[110,100],[110,110],[100,110]]]}}");
+    for (pass = 0; pass <= sides; pass++)
+        for (x = pass ? -20 : 0; x <= (pass ? 60 : 40); x += 10)
+            for (y = pass ? -6 : 0; y <= (pass ? 6 : 0); y += 12)
+                n += (size_t)sprintf(buf + n, ",{\"type\":\"Feature\",\"properties\":{\"lamp\":true,\"z\":5,"
+                                              "\"intensity\":%d,\"radius\":30},\"geometry\":{\"type\":"
+                                              "\"Point\",\"coordinates\":[%d,%d]}}", pass ? 100 : 1000, x, y);
+    sprintf(buf + n, "]}");
+    return buf;
+}
+
+/* EN 13201-2 Table 3 as SPEC §6 prints it: mean, min E_h, min E_v, min E_sc. */
+static int table_class(double mean, double min, double ev, double esc)
+{
+    static const double t[6][4] = { { 15, 3, 5, 5 }, { 10, 2, 3, 2 }, { 7.5, 1.5, 2.5, 1.5 },
+                                    { 5, 1, 1.5, 1 }, { 3, 0.6, 1, 0.6 }, { 2, 0.4, 0.6, 0.2 } };
+    int k;
+    for (k = 0; k < 6; k++)
+        if (mean >= t[k][0] && min >= t[k][1] && ev >= t[k][2] && esc >= t[k][3])
+            return k + 1;
+    return 0;
+}
+
+/* The route from (0,0) to (40,0) against the meters taken by hand at its
+ * 41 samples (x = 0, 1, .., 40: two segments of 20 m at step 1 m): E_h on
+ * the ground (trapezoid mean), E_v and E_sc at 1.5 m facing +x and -x. */
+static void test_class_depends_on_facial_criterion(void **state)
+{
+    int sides;
+    (void)state;
+    for (sides = 0; sides < 2; sides++) {
+        void *mem;
+        char *scene = lamp_scene(sides), err[256];
+        plx_engine *e = load_text(scene, &mem);
+        network net;
+        route_set rs;
+        net_snap a, b;
+        net_route r;
+        double integral = 0, mn = INFINITY, ev = INFINITY, esc = INFINITY;
+        int x, d;
+        memset(&rs, 0, sizeof rs);
+        rs.lines = calloc(1, sizeof *rs.lines);
+        rs.n = 1;
+        rs.lines[0].n = 3;
+        rs.lines[0].xy = calloc(6, sizeof(double));
+        rs.lines[0].xy[2] = 20;
+        rs.lines[0].xy[4] = 40;
+        assert_int_equal(net_build(&net, &rs, err, sizeof err), 0);
+        assert_int_equal(net_score(&net, e, 1.0, 1.0, 1.5, 0), PLX_OK);
+        snap(&net, 0, 0, &a);
+        snap(&net, 40, 0, &b);
+        assert_int_equal(net_route_find(&net, e, &a, &b, 3.0, &r, err, sizeof err), 0);
+        for (x = 0; x <= 40; x++) {
+            double P[3] = { x, 0, 0 }, N[3] = { 0, 0, 1 }, Ed, Ei, m[4];
+            assert_int_equal(plx_illuminance(e, 1, P, N, &Ed, &Ei, NULL), PLX_OK);
+            integral += (x == 0 || x == 40 ? 0.5 : 1.0) * (Ed + Ei); /* x = 20: 1/2 from each segment */
+            mn = fmin(mn, Ed + Ei);
+            P[2] = 1.5;
+            for (d = -1; d <= 1; d += 2) {
+                double u[2] = { d, 0 };
+                assert_int_equal(plx_meter(e, 1, P, u, m), PLX_OK);
+                ev = fmin(ev, m[PLX_METER_V]);
+                esc = fmin(esc, m[PLX_METER_SC]);
+            }
+        }
+        assert_true(fabs(r.length - 40) < 1e-12 && fabs(r.integral - integral) < 1e-9 * integral);
+        assert_true(r.min == mn && fabs(r.min_ev - ev) < 1e-12 && fabs(r.min_esc - esc) < 1e-12);
+        assert_int_equal(r.p_class_h, table_class(integral / 40, mn, INFINITY, INFINITY)); /* E_h alone */
+        assert_int_equal(r.p_class, table_class(integral / 40, mn, ev, esc));
+        if (!sides) { /* at either end, facing out, every lamp is behind (or overhead): no light on a face */
+            assert_true(r.min_ev == 0 && r.min_esc == 0);
+            assert_int_equal(r.p_class_h, 1);
+            assert_int_equal(r.p_class, 0);
+        } else { /* faint lamps ahead and beside everywhere: the face is lit, less well than the ground */
+            assert_true(r.min_ev > 0.6 && r.min_esc > 0.2);
+            assert_int_equal(r.p_class_h, 1);
+            assert_true(r.p_class > 1 && r.p_class < 6);
+        }
+        net_route_free(&r);
+        net_free(&net);
+        plx_engine_destroy(e);
+        free(mem);
+        free(scene);
+    }
 }
 
 /* ---- random grids against Bellman-Ford -------------------------------------- */
@@ -294,7 +409,7 @@ static void test_random_grids_against_bellman_ford(void **state)
         uint32_t q;
         grid_lines(seed, &rs);
         assert_int_equal(net_build(&net, &rs, err, sizeof err), 0);
-        assert_int_equal(net_score(&net, e, 1.0, 1.0, 0), PLX_OK);
+        assert_int_equal(net_score(&net, e, 1.0, 1.0, 1.5, 0), PLX_OK);
         for (q = 0; q < 12; q++) {
             uint32_t s = (uint32_t)(rnd() * net.nnodes), t = q == 11 ? net.nnodes - 1 : (uint32_t)(rnd() * net.nnodes);
             double w = weights[q % 3], want = bellman_ford(&net, s, t, w);
@@ -357,6 +472,7 @@ int main(void)
         cmocka_unit_test(test_detour_only_when_weight_says_so),
         cmocka_unit_test(test_edges_equal_route_scores),
         cmocka_unit_test(test_route_equals_its_polyline),
+        cmocka_unit_test(test_class_depends_on_facial_criterion),
         cmocka_unit_test(test_random_grids_against_bellman_ford),
         cmocka_unit_test(test_snap_and_empty),
     };

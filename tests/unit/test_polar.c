@@ -203,9 +203,16 @@ static int vis_agrees(fixture *f, vec2 p, int full, double a0, double a1, int ve
 }
 
 /* Random free points of the scene, full turn and random ranges. */
-static void random_vis(fixture *f, int npts)
+/* make check (PLX_TEST_QUICK) checks a quarter of the random points;
+ * check-full all of them. */
+static int quick_share(int npts)
 {
-    int i, n = 0, bad = 0, tries = 0;
+    return getenv("PLX_TEST_QUICK") && npts >= 40 ? npts / 4 : npts;
+}
+
+static void random_vis(fixture *f, int npts_full)
+{
+    int i, n = 0, bad = 0, tries = 0, npts = quick_share(npts_full);
     const double *bx = f->s.bounds;
     while (n < npts && tries < 50 * npts) {
         vec2 p;
@@ -258,9 +265,9 @@ static double brute_first(const scene *s, vec2 p, vec2 q, int *bld)
 
 /* Checks locate and shoot at random points (random directions avoid
  * degenerate grazing, which the hand-made tests cover). */
-static void random_locate_shoot(fixture *f, int npts)
+static void random_locate_shoot(fixture *f, int npts_full)
 {
-    int n, bad = 0;
+    int n, bad = 0, npts = quick_share(npts_full);
     const double *bx = f->s.bounds;
     static const double dirs[4][2] = { { 1, 0 }, { 0, 1 }, { -1, 0 }, { 0, -1 } };
     for (n = 0; n < npts; n++) {
@@ -1083,6 +1090,8 @@ static void test_fixture_helsinki_slow_ref(void **state)
     polar *pd;
     int n = 0, tries = 0;
     (void)state;
+    if (getenv("PLX_TEST_QUICK")) /* about 2 s a point: check-full only */
+        skip();
     quiet.log = NULL;
     plx_config_default(&cfg);
     cfg.port = &quiet;

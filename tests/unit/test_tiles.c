@@ -63,18 +63,19 @@ static void test_mercator(void **state)
 
 /* A tile's pixels equal the heat map's pixel at the same ground point: the
  * heat map is drawn over a 1 cm box centred on the pixel's ground point,
- * at 1 cm a pixel, with the same top of scale. */
-static void test_tile_pixels_equal_heatmap(void **state)
+ * at 1 cm a pixel, with the same top of scale and quantity (sc: E_sc at
+ * 1.5 m, the least over every facing direction, both). n pixels, half lit. */
+static void check_tile_against_heatmap(plx_engine *e, int sc, int n)
 {
-    plx_engine *e = load();
     plx_scene_info si;
     tile_work w;
     uint8_t *rgba = malloc(TILE_SIZE * TILE_SIZE * 4);
     long x0, y0, x1, y1, lit;
-    int k, lit_checked = 0, dark_checked = 0, n = getenv("PLX_TEST_QUICK") ? 12 : 40;
-    (void)state;
+    int k, lit_checked = 0, dark_checked = 0;
     plx_scene_info_get(e, &si);
     assert_int_equal(tile_work_init(&w), 0);
+    if (sc)
+        w.q.quantity = PLX_METER_SC; /* tile_work_init: 1.5 m, the least over directions */
     tile_range(e, 16, &x0, &y0, &x1, &y1);
     lit = tile_render(e, &w, 16, (x0 + x1) / 2, (y0 + y1) / 2, 100.0, rgba);
     assert_true(lit > 1000 && lit < TILE_SIZE * TILE_SIZE);
@@ -84,7 +85,7 @@ static void test_tile_pixels_equal_heatmap(void **state)
         double lon, lat, gx, gy;
         char box[256], path[64];
         const char *argv[] = { "heatmap", SCENE, "--quiet", "--box", box, "--res", "0.01", "--max", "100", "-o",
-                               path };
+                               path, "--quantity", "sc", "--facing", "min" };
         uint8_t *img;
         int iw, ih;
         while ((rgba[4 * p + 3] != 0) != want_lit && tries++ < TILE_SIZE * TILE_SIZE)
@@ -101,7 +102,7 @@ static void test_tile_pixels_equal_heatmap(void **state)
             snprintf(box, sizeof box, "%.17g,%.17g,%.17g,%.17g", bx0, by0, bx1, by1);
         }
         snprintf(path, sizeof path, "build/test_tiles_hm_%d.png", (int)getpid());
-        assert_int_equal(run(cmd_heatmap, 11, argv), 0);
+        assert_int_equal(run(cmd_heatmap, sc ? 15 : 11, argv), 0);
         assert_int_equal(image_read_png_rgb8(path, NULL, 0, &img, &iw, &ih, NULL, 0), 0);
         if (want_lit) {
             assert_memory_equal(img, rgba + 4 * p, 3);
@@ -117,6 +118,63 @@ static void test_tile_pixels_equal_heatmap(void **state)
     assert_true(lit_checked >= n / 2 - 1 && dark_checked >= n / 2 - 1);
     tile_work_free(&w);
     free(rgba);
+}
+
+static void test_tile_pixels_equal_heatmap(void **state)
+{
+    plx_engine *e = load();
+    (void)state;
+    check_tile_against_heatmap(e, 0, getenv("PLX_TEST_QUICK") ? 6 : 40);
+    plx_engine_free(e);
+}
+
+static void test_sc_tile_pixels_equal_heatmap(void **state)
+{
+    plx_engine *e = load();
+    (void)state;
+    check_tile_against_heatmap(e, 1, getenv("PLX_TEST_QUICK") ? 6 : 40);
+    plx_engine_free(e);
+}
+
+/* The sc reading of tiles ('--facing min'): the least E_sc over every
+ * horizontal facing direction, against plx_meter facing 3600 directions
+ * (E_sc is smooth in the direction, so the sampled minimum lies within
+ * |V| (1 - cos(pi / 3600)) above the true one); a fixed direction is
+ * plx_meter's own number. Points along Esplanadi, some under buildings. */
+static void test_sc_least_over_directions(void **state)
+{
+    plx_engine *e = load();
+    heat_quantity q = { PLX_METER_SC, 1.5, 0.0, 1 }, q30 = { PLX_METER_SC, 1.5, 30.0, 0 };
+    int k, j, lit = 0, solid = 0;
+    (void)state;
+    for (k = 0; k < 24; k++) {
+        double x = -120 + 25 * k, y = -430 + 7 * (k % 5), least, brute = INFINITY, bmax = 0, v30;
+        double P[3] = { x, y, 1.5 }, m[PLX_METER_COUNT], u[2];
+        plx_status st = heatmap_value(e, &q, x, y, &least);
+        if (st == PLX_E_RANGE) {
+            assert_true(least != least);
+            solid++;
+            continue;
+        }
+        assert_int_equal(st, PLX_OK);
+        for (j = 0; j < 3600; j++) {
+            u[0] = cos(j * 3.14159265358979323846 / 1800);
+            u[1] = sin(j * 3.14159265358979323846 / 1800);
+            assert_int_equal(plx_meter(e, 1, P, u, m), PLX_OK);
+            brute = fmin(brute, m[PLX_METER_SC]);
+            bmax = fmax(bmax, m[PLX_METER_SC]);
+        }
+        assert_true(least <= brute + 1e-9 * (1 + brute));
+        assert_true(brute - least <= 1e-6 * (1 + bmax));
+        lit += least > 0.5;
+        u[0] = cos(30 * 3.14159265358979323846 / 180);
+        u[1] = sin(30 * 3.14159265358979323846 / 180);
+        assert_int_equal(plx_meter(e, 1, P, u, m), PLX_OK);
+        assert_int_equal(heatmap_value(e, &q30, x, y, &v30), PLX_OK);
+        assert_true(v30 == m[PLX_METER_SC]);
+    }
+    assert_true(lit >= 5);
+    print_message("sc least: %d lit points, %d inside solids\n", lit, solid);
     plx_engine_free(e);
 }
 
@@ -211,6 +269,8 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_mercator),
         cmocka_unit_test(test_tile_pixels_equal_heatmap),
+        cmocka_unit_test(test_sc_tile_pixels_equal_heatmap),
+        cmocka_unit_test(test_sc_least_over_directions),
         cmocka_unit_test(test_mbtiles_read_back),
         cmocka_unit_test(test_errors),
     };
