@@ -150,6 +150,17 @@
  * four nearest texel centres (texels outside the map are 0); walls, roofs
  * and undersides are still shaded exactly per pixel. The map's pitch is the
  * one asked for, enlarged when needed to stay within the byte budget.
+ * With render_opts.indirect_map the indirect term of pixels facing up
+ * (ground and roofs) comes from the indirect ground map (indmap.h), built
+ * from the indirect hook at its texel centres for indirect_key.
+ *
+ * Threads (render_opts.par, workers). The shading pass and the map builds
+ * may run on a parallel-for: rows of tiles (rows of texels) as jobs, each
+ * worker with its own tile buffers. The light object's region cache is
+ * filled on the calling thread first and only read by the workers; a tile
+ * that needs more is shaded after them on the calling thread, as one
+ * thread does. A pixel depends on its tile alone, so the bytes are the
+ * same for any number of workers (tests/unit/test_threads.c).
  *
  * Backends (render_backend below). Only pass (1) is pluggable: a backend
  * takes the visible buildings' triangles, already in clip space (the core

@@ -67,6 +67,7 @@ static plx_engine *engine(void **mem, int max_w, int max_h, int quiet)
     cfg.port = &silent;
     cfg.render_max_width = max_w;
     cfg.render_max_height = max_h;
+    cfg.threads = 1;   /* the baseline and the bake on one thread (thread CPU times) */
     if (plx_engine_create(*mem, MEM, &cfg, &e) != PLX_OK)
         return NULL;
     return e;
