@@ -183,7 +183,10 @@ plx_status plx_render(plx_engine *e, const plx_camera *cam, const plx_render_opt
     if (!o->no_indirect && e->ph && plx_indirect_frames(e) > 0) {
         ro.indirect = shade_indirect;
         ro.indirect_user = e;
-        ro.indirect_mt = 1;   /* the photon buffers are only read (indirect.c) */
+        /* the photon buffers are only read (indirect.c), so the hook may run on
+         * several workers; a lookup that fills a cache as it reads must not
+         * set this without a lock or a cache per worker */
+        ro.indirect_mt = 1;
         ro.indirect_map = 1;  /* aerial ground: the indirect ground map (render/indmap.h) */
         ro.indirect_key = e->indirect_gen;
         ro.top = top_height;
