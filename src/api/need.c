@@ -14,6 +14,7 @@
 #include "polar/polar.h"
 #include "light/light.h"
 #include "photon/photon.h"
+#include "photon/irradiance_cache.h"
 #include "render/render.h"
 
 #define DEFAULT_MAX_W 1920
@@ -80,7 +81,12 @@ static plx_status need_photon(plx_engine *e)
         photon_config_gather(&cfg, e->sc);
     else
         photon_config_default(&cfg);
+    arena_mark m = arena_get_mark(&e->mem);
     st = photon_create(&e->mem, e->sc, &cfg, &e->ph);
+    if (st == PLX_OK && (st = icache_create(&e->mem, &e->ic)) != PLX_OK) {
+        arena_release(&e->mem, &m); /* as it was: no photon buffers */
+        e->ph = NULL;
+    }
     if (st == PLX_E_NOMEM)
         return eng_nomem(e, "creating the photon buffers");
     if (st != PLX_OK)

@@ -7,6 +7,7 @@
 #include "render/render.h"
 #include "photon/trace.h"
 #include "photon/photon.h"
+#include "photon/irradiance_cache.h"
 
 #define DEFAULT_MAX_W 1920
 #define DEFAULT_MAX_H 1080
@@ -20,9 +21,28 @@ void plx_render_opts_default(plx_render_opts *o)
     o->exposure = 1.0;
 }
 
+/* Whether images read the irradiance cache (shade_indirect). */
+static int icache_on(const plx_engine *e)
+{
+    return e->ic && e->lt && !(e->gather_set && e->gather_side == 0);
+}
+
 /* The photon hook of the renderer: the RGB indirect term (each lamp's light
- * weighted by its colour, carried by the photons; SPEC §5). */
+ * weighted by its colour; SPEC §5) from the irradiance cache (final
+ * gathers at sparse points of each surface, irradiance_cache.h), or the
+ * photon buffers alone when gathering is off (plx_indirect_set_gather 0). */
 static void shade_indirect(void *user, const double P[3], const double n[3], double rgb[3])
+{
+    plx_engine *e = user;
+    if (icache_on(e))
+        icache_lookup(e->ic, e->ph, e->lt, P, n, rgb);
+    else
+        eng_indirect_photons_rgb(e, P, n, rgb);
+}
+
+/* The photon buffers alone: what the aerial indirect map is built from
+ * (they do not depend on the eye, and are only read: safe on workers). */
+static void shade_photons(void *user, const double P[3], const double n[3], double rgb[3])
 {
     eng_indirect_photons_rgb(user, P, n, rgb);
 }
@@ -183,11 +203,14 @@ plx_status plx_render(plx_engine *e, const plx_camera *cam, const plx_render_opt
     if (!o->no_indirect && e->ph && plx_indirect_frames(e) > 0) {
         ro.indirect = shade_indirect;
         ro.indirect_user = e;
-        /* the photon buffers are only read (indirect.c), so the hook may run on
-         * several workers; a lookup that fills a cache as it reads must not
-         * set this without a lock or a cache per worker */
-        ro.indirect_mt = 1;
-        ro.indirect_map = 1;  /* aerial ground: the indirect ground map (render/indmap.h) */
+        if (e->ic)
+            icache_set_view(e->ic, rc.eye);
+        /* the photon buffers are only read (indirect.c), so that hook may run
+         * on several workers; the irradiance cache fills its table and asks
+         * the light object as it reads: one thread */
+        ro.indirect_mt = !icache_on(e);
+        ro.indirect_map = 1;  /* aerial ground and roofs: the indirect ground map (render/indmap.h) */
+        ro.indirect_far = shade_photons;
         ro.indirect_key = e->indirect_gen;
         ro.top = top_height;
     }

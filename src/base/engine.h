@@ -28,6 +28,7 @@ struct plx_engine {
     const struct lit_region *lit_last; /* region of the last plx_lit_region_get */
     struct render *rd;      /* renderer, created on first need */
     struct photon_sys *ph;  /* photon buffers, created on first need */
+    struct icache *ic;      /* images' irradiance cache, created with the photon buffers */
     double lightmap_cell;   /* light map texel size when built, else 0 */
     uint64_t indirect_gen;  /* +1 at every change of the photon buffers (the indirect map's key) */
     float *aa_sum;          /* anti-aliasing sum (PLX_PART_FRAME), taken on first need */

@@ -20,7 +20,8 @@ static const char help[] =
     "\n"
     "  -o FILE         the bake file (required)\n"
     "  --photons N     photons per frame (default 65536)\n"
-    "  --frames K      photon frames (default 256)\n"
+    "  --frames K      photon frames (default 16: the points' final gathering\n"
+    "                  reads them too)\n"
     "  --no-indirect   no photon buffers\n"
     "  --no-aerial     no aerial light map\n"
     "  --texel M       aerial light map resolution (default 1 m, coarser if the budget needs)\n"
@@ -45,6 +46,7 @@ static int parse_args(int argc, char **argv, bake_args *a)
     char extra;
     memset(a, 0, sizeof *a);
     cli_indirect_default(&a->ind);
+    a->ind.frames = CLI_GATHER_FRAMES; /* illum on the bake gathers over them */
     a->o.aerial = 1;
     a->c.render_w = 1024;
     a->c.render_h = 768;

@@ -49,10 +49,12 @@ static const char help[] =
     "                   into the aerial map); 16 more photon frames refill the chart\n"
     "  --aa N           anti-aliasing: N x N samples per pixel, averaged in linear\n"
     "                   radiance (default 1: one sample at each pixel centre, SPEC §5)\n"
-    "  --no-indirect    direct light only (default: indirect light from the photon\n"
-    "                   buffers, traced first; progress on a terminal)\n"
+    "  --no-indirect    direct light only (default: indirect light by final gathers\n"
+    "                   at sparse points of each surface, interpolated; photons,\n"
+    "                   traced first, carry the later bounces; progress on a terminal)\n"
     "  --photons N      photons per frame (default 65536)\n"
-    "  --frames K       progressive photon frames for the still image (default 16)\n"
+    "  --frames K       progressive photon frames for the still image (default 4;\n"
+    "                   16 for --view aerial, which reads the photon buffers)\n"
     "  --backend B      raster pass: soft (default, built in) or osmesa (OpenGL into\n"
     "                   an OSMesa buffer; " OSMESA_STATE "); the same image\n"
     "  -o FILE          output PNG (required)\n"
@@ -386,6 +388,8 @@ int cmd_render(int argc, char **argv)
         len = sqrt(dir[0] * dir[0] + dir[1] * dir[1] + dir[2] * dir[2]);
         for (k = 0; k < 3 && len > 0; k++)
             dir[k] /= len;
+        if (a.aerial && !a.ind.frames_given)
+            a.ind.frames = CLI_GATHER_FRAMES; /* aerial views read the photon buffers */
         rc = cli_indirect_run("render", e, &a.ind, a.cam.eye, a.aerial || !(len > 0) ? NULL : dir,
                               a.cam.fov_deg * a.cam.width / a.cam.height);
         if (rc == EXIT_OK && a.refine && !a.ind.off) {

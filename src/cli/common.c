@@ -481,10 +481,10 @@ int cli_load_scene(const char *cmd, const char *path, const cli_common *c, plx_e
 void cli_indirect_default(cli_indirect *ind)
 {
     ind->photons = 65536;
-    ind->frames = 16; /* 1M photons for images, read through the wide lookup (photon.h
-                         lookup_radius): indirect light adds at most about the direct-only
-                         time of a street view (README, "Indirect light"); illum sets
-                         CLI_GATHER_FRAMES */
+    ind->frames = 4; /* 262,144 photons for images: they carry only the later bounces,
+                        the irradiance cache gathers the first from the exact direct light
+                        (README, "Indirect light"); illum sets CLI_GATHER_FRAMES */
+    ind->frames_given = 0;
     ind->off = 0;
     ind->gather = -1;
 }
@@ -514,6 +514,7 @@ int cli_indirect_option(const char *cmd, int argc, char **argv, int *i, cli_indi
         cli_usage_error(cmd, "%s '%s' is not a whole number in range", a, argv[*i]);
         return -1;
     }
+    ind->frames_given |= strcmp(a, "--frames") == 0;
     return 1;
 }
 

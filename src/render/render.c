@@ -1371,8 +1371,9 @@ plx_status render_frame(render *r, const render_camera *cam, const render_opts *
     if (o->lightmap && r->lm.built && o->indirect && o->indirect_map &&
         (!r->im.built || r->im.key != o->indirect_key))
         /* out of memory: the frame takes the hook per pixel (indmap_usable) */
-        (void)indmap_build(&r->im, r->a, &r->lm, o->indirect, o->indirect_user, o->top, o->indirect_user,
-                           o->indirect_key, o->indirect_mt ? o->par : NULL, o->par_ctx, o->workers);
+        (void)indmap_build(&r->im, r->a, &r->lm, o->indirect_far ? o->indirect_far : o->indirect,
+                           o->indirect_user, o->top, o->indirect_user, o->indirect_key,
+                           o->indirect_far || o->indirect_mt ? o->par : NULL, o->par_ctx, o->workers);
     shade_pass(r, o, &st);
     /* the exposure from the lit surfaces, before the glows */
     st.exposure = o->auto_exposure ? exposure_auto(r->lin, r->id, px) : o->exposure;

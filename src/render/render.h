@@ -265,7 +265,10 @@ typedef struct render_opts {
     int indirect_map;          /* 1: with lightmap, ground pixels read indirect from the indirect
                                   ground map (indmap.h), built from indirect when indirect_key
                                   differs from the last build's */
-    uint64_t indirect_key;     /* changes whenever what indirect returns changes */
+    uint64_t indirect_key;     /* changes whenever what indirect_far returns changes */
+    render_shade_fn indirect_far; /* the hook the indirect ground map is built from (NULL:
+                                  indirect): one that does not depend on the eye and is safe
+                                  on several threads (its user is indirect_user) */
     double (*top)(void *user, double x, double y);  /* the map's surface height at (x, y): the
                                   topmost roof or 0 (NULL: the ground); user is indirect_user */
 } render_opts;

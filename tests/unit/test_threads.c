@@ -2,7 +2,9 @@
  * (plx_config.threads, plx_port.parallel_for; src/render/render.c's
  * shading pass).
  *
- * The eixample fixture with photon frames (indirect light), a street view
+ * The eixample fixture with photon frames (indirect light from the photon
+ * buffers: final gathering off, since the irradiance cache keeps a frame
+ * on one thread), a street view
  * and an aerial view, rendered with threads = 1 (the calling thread only),
  * 2 through the POSIX port's pthreads, and 3 through a port whose
  * parallel-for runs the jobs backwards on changing worker ids (a fixed
@@ -65,6 +67,9 @@ static void render_pair(int threads, const plx_port *port, int small_cache, fram
     assert_int_equal(plx_load_file(e, "fixtures/eixample-4x4.geojson"), PLX_OK);
     for (k = 0; k < 2; k++)
         assert_int_equal(plx_indirect_step(e, 20000, 7), PLX_OK);
+    /* images read the photon buffers (the irradiance cache keeps a frame on
+     * one thread: renderapi.c) */
+    assert_int_equal(plx_indirect_set_gather(e, 0), PLX_OK);
     for (v = 0; v < 2; v++) {
         memset(&cam, 0, sizeof cam);
         if (v == 0) {

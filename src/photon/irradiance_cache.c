@@ -1,0 +1,318 @@
+/* irradiance_cache: final gathers at sparse surface points, interpolated
+ * for images (irradiance_cache.h). */
+#include <math.h>
+#include <string.h>
+
+#include "photon/irradiance_cache.h"
+#include "photon/final_gather.h"
+#include "photon/indirect.h"
+
+#define ICACHE_SEED 0x1ca4e5eedull
+#define HEIGHT_TOL 1e-3   /* m: one surface's height, as in photon.c */
+#define PROBE_OFF 0.005   /* m: a wall probe starts this far in front */
+#define PROBE_LEN 0.02    /* m: and looks this far back */
+#define COORD_BIAS ((int64_t)1 << 28)
+#define COORD_MASK (((uint64_t)1 << 29) - 1)
+
+struct icache_rec {
+    uint64_t k1, k2;      /* surface; level and vertex */
+    float e[3];           /* RGB E_indirect at the vertex */
+    uint32_t flags;       /* REC_USED, REC_VALID */
+};
+
+enum { REC_USED = 1, REC_VALID = 2 };
+
+/* The surface a pixel's point lies on: its key and its grid frame. */
+typedef struct plane {
+    uint64_t code;        /* kind in the top bits, then what tells it apart */
+    int wall;
+    double o[3];          /* grid origin: (0, 0, z) or the edge's first vertex */
+    double t[3], n[3];    /* grid u axis (x or along the wall), normal */
+    double top;           /* horizontal: topmost height over P (trace_top) */
+    uint32_t edge;
+} plane;
+
+static uint64_t mix64(uint64_t z)
+{
+    z += 0x9e3779b97f4a7c15ull;
+    z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ull;
+    z = (z ^ (z >> 27)) * 0x94d049bb133111ebull;
+    return z ^ (z >> 31);
+}
+
+size_t icache_bytes(void)
+{
+    return sizeof(icache) + 64 + (size_t)ICACHE_RECORDS * sizeof(icache_rec) + 64;
+}
+
+plx_status icache_create(arena *a, icache **out)
+{
+    arena_mark m = arena_get_mark(a);
+    icache *c = arena_calloc(a, PLX_PART_PHOTON, 1, sizeof *c, 64);
+    if (c)
+        c->tab = arena_calloc(a, PLX_PART_PHOTON, ICACHE_RECORDS, sizeof(icache_rec), 64);
+    if (!c || !c->tab) {
+        arena_release(a, &m);
+        return PLX_E_NOMEM;
+    }
+    c->side = ICACHE_SIDE;
+    c->kappa = ICACHE_KAPPA;
+    c->smin = ICACHE_SMIN;
+    *out = c;
+    return PLX_OK;
+}
+
+void icache_set_view(icache *c, const double eye[3])
+{
+    memcpy(c->eye, eye, sizeof c->eye);
+}
+
+static void flush(icache *c)
+{
+    memset(c->tab, 0, (size_t)ICACHE_RECORDS * sizeof(icache_rec));
+    c->used = 0;
+    c->flushes++;
+}
+
+static uint64_t dbits(double x)
+{
+    uint64_t b;
+    memcpy(&b, &x, sizeof b);
+    return b;
+}
+
+/* What the records were gathered from: any new photon frame, reset or
+ * refined lamp changes these sums and counts. */
+static uint64_t photon_stamp(const photon_sys *ps)
+{
+    const photon_stats *st = &ps->st;
+    uint64_t h = mix64(st->frames ^ 0x5eedull);
+    h = mix64(h ^ st->photons);
+    h = mix64(h ^ dbits(st->emitted));
+    h = mix64(h ^ dbits(st->arrived));
+    h = mix64(h ^ dbits(st->stored_chart));
+    h = mix64(h ^ dbits(st->stored_aerial));
+    h = mix64(h ^ st->lamp_refined);
+    h = mix64(h ^ st->aerial_restarts);
+    return mix64(h ^ dbits(ps->flux_total));
+}
+
+/* A wall probe: the edge whose wall is within 2 cm behind P along -n. */
+static int probe_wall(tracer *T, const double P[3], const double n[3], trace_hit *h)
+{
+    double o[3], d[3];
+    int k;
+    for (k = 0; k < 3; k++) {
+        o[k] = P[k] + PROBE_OFF * n[k];
+        d[k] = -n[k];
+    }
+    if (!(o[2] >= 0.0))
+        return 0;
+    return trace_ray(T, o, d, PROBE_LEN, h) == TRACE_WALL;
+}
+
+static uint64_t mm(double z)
+{
+    return (uint64_t)(int64_t)llround(z * 1000.0) & 0x3fffffffull;
+}
+
+/* P's surface: 1 with pl filled, 0 when it has no grid (undersides,
+ * points no probe ties to a wall). */
+static int plane_of(tracer *T, const scene *s, const double P[3], const double n[3], plane *pl)
+{
+    trace_hit h;
+    memset(pl, 0, sizeof *pl);
+    if (n[2] > 0.5) {
+        pl->top = trace_top(T, P[0], P[1], NULL);
+        pl->code = ((uint64_t)1 << 62) | (mm(P[2]) << 30) | mm(pl->top);
+        pl->o[2] = P[2];
+        pl->t[0] = 1.0;
+        pl->n[2] = 1.0;
+        return 1;
+    }
+    if (n[2] < -0.5 || !probe_wall(T, P, n, &h))
+        return 0;
+    pl->wall = 1;
+    pl->edge = h.edge;
+    pl->code = ((uint64_t)2 << 62) | h.edge;
+    pl->o[0] = s->pts[h.edge].x;
+    pl->o[1] = s->pts[h.edge].y;
+    pl->n[0] = h.n[0];
+    pl->n[1] = h.n[1];
+    pl->t[0] = -h.n[1];
+    pl->t[1] = h.n[0];
+    return 1;
+}
+
+/* The point of vertex (i, j) of spacing sp. */
+static void vertex_point(const plane *pl, double sp, int64_t i, int64_t j, double Q[3])
+{
+    double u = (double)i * sp, v = (double)j * sp;
+    if (pl->wall) {
+        Q[0] = pl->o[0] + u * pl->t[0];
+        Q[1] = pl->o[1] + u * pl->t[1];
+        Q[2] = v;
+    } else {
+        Q[0] = u;
+        Q[1] = v;
+        Q[2] = pl->o[2];
+    }
+}
+
+/* Whether Q lies on pl's surface (irradiance_cache.h, VALID VERTICES). */
+static int vertex_valid(tracer *T, const plane *pl, const double Q[3])
+{
+    trace_hit h;
+    if (!pl->wall)
+        return fabs(trace_top(T, Q[0], Q[1], NULL) - pl->top) <= HEIGHT_TOL;
+    if (!(Q[2] > 0.0) || !probe_wall(T, Q, pl->n, &h) || h.edge != pl->edge)
+        return 0;
+    /* not behind a building standing against the wall */
+    return trace_top(T, Q[0] + 0.01 * pl->n[0], Q[1] + 0.01 * pl->n[1], NULL) < Q[2];
+}
+
+/* The record of vertex (i, j) at level l, gathered on first need. */
+static const icache_rec *record(icache *c, photon_sys *ps, light *L, const plane *pl, int l,
+                                int64_t i, int64_t j)
+{
+    uint64_t k2 = ((uint64_t)l << 58) | (((uint64_t)(i + COORD_BIAS) & COORD_MASK) << 29) |
+                  ((uint64_t)(j + COORD_BIAS) & COORD_MASK);
+    uint32_t mask = ICACHE_RECORDS - 1, at;
+    icache_rec *r;
+    double Q[3], rgb[3];
+    at = (uint32_t)mix64(pl->code ^ mix64(k2)) & mask;
+    for (;;) {
+        r = &c->tab[at];
+        if (!(r->flags & REC_USED))
+            break;
+        if (r->k1 == pl->code && r->k2 == k2)
+            return r;
+        at = (at + 1) & mask;
+    }
+    if (c->used >= ICACHE_RECORDS / 4 * 3) {
+        flush(c);
+        return record(c, ps, L, pl, l, i, j);
+    }
+    c->used++;
+    r->k1 = pl->code;
+    r->k2 = k2;
+    r->flags = REC_USED;
+    vertex_point(pl, ICACHE_S0 * ldexp(1.0, l), i, j, Q);
+    if (vertex_valid(ps->T, pl, Q)) {
+        final_gather_rgb(ps, ps->T, L, Q, pl->n, c->side, ICACHE_SEED, rgb);
+        r->e[0] = (float)rgb[0];
+        r->e[1] = (float)rgb[1];
+        r->e[2] = (float)rgb[2];
+        r->flags |= REC_VALID;
+        c->gathered++;
+    }
+    return r;
+}
+
+/* Whether the horizontal segment from P (5 cm above its surface) to the
+ * vertex Q meets a wall: on coarse grids a ground cell may span a small
+ * building, and the street beyond it is the same height of ground. */
+static int blocked(tracer *T, const double P[3], const double Q[3])
+{
+    double o[3], d[3], l;
+    trace_hit h;
+    d[0] = Q[0] - P[0];
+    d[1] = Q[1] - P[1];
+    d[2] = 0.0;
+    l = sqrt(d[0] * d[0] + d[1] * d[1]);
+    if (!(l > 1e-9))
+        return 0;
+    d[0] /= l;
+    d[1] /= l;
+    o[0] = P[0];
+    o[1] = P[1];
+    o[2] = P[2] + 0.05;
+    return trace_ray(T, o, d, l, &h) != TRACE_SKY;
+}
+
+/* Bilinear over the valid vertices of P's cell at level l; 0 when none
+ * of them is valid (with weight). */
+static int level_value(icache *c, photon_sys *ps, light *L, const plane *pl, const double P[3],
+                       int l, double rgb[3])
+{
+    double sp = ICACHE_S0 * ldexp(1.0, l), d[3], fu, fv, wu, wv, ws = 0.0, acc[3] = {0, 0, 0};
+    int64_t i, j;
+    int a, b, k;
+    for (k = 0; k < 3; k++)
+        d[k] = P[k] - pl->o[k];
+    fu = (d[0] * pl->t[0] + d[1] * pl->t[1]) / sp;
+    fv = (pl->wall ? P[2] : P[1]) / sp;
+    i = (int64_t)floor(fu);
+    j = (int64_t)floor(fv);
+    wu = fu - (double)i;
+    wv = fv - (double)j;
+    for (b = 0; b < 2; b++)
+        for (a = 0; a < 2; a++) {
+            double w = (a ? wu : 1.0 - wu) * (b ? wv : 1.0 - wv);
+            const icache_rec *r;
+            if (!(w > 0.0))
+                continue;
+            r = record(c, ps, L, pl, l, i + a, j + b);
+            if (!(r->flags & REC_VALID))
+                continue;
+            if (!pl->wall && l >= ICACHE_LEVEL_SEG) {
+                double Q[3];
+                vertex_point(pl, sp, i + a, j + b, Q);
+                if (blocked(ps->T, P, Q))
+                    continue;
+            }
+            ws += w;
+            for (k = 0; k < 3; k++)
+                acc[k] += w * r->e[k];
+        }
+    if (!(ws > 1e-6))
+        return 0;
+    for (k = 0; k < 3; k++)
+        rgb[k] = acc[k] / ws;
+    return 1;
+}
+
+/* Level l, or the finest level below it with a valid vertex, or P itself. */
+static void level_or_finer(icache *c, photon_sys *ps, light *L, const plane *pl,
+                           const double P[3], int l, double rgb[3])
+{
+    for (; l >= 0; l--)
+        if (level_value(c, ps, L, pl, P, l, rgb))
+            return;
+    c->direct++;
+    final_gather_rgb(ps, ps->T, L, P, pl->n, c->side, ICACHE_SEED, rgb);
+}
+
+void icache_lookup(icache *c, photon_sys *ps, light *L, const double P[3], const double n[3],
+                   double rgb[3])
+{
+    double dx = P[0] - c->eye[0], dy = P[1] - c->eye[1], dz = P[2] - c->eye[2], lf, t, r1[3];
+    uint64_t stamp = photon_stamp(ps);
+    plane pl;
+    int l0, k;
+    if (stamp != c->stamp) {
+        if (c->used)
+            flush(c);
+        c->stamp = stamp;
+    }
+    if (!plane_of(ps->T, ps->s, P, n, &pl)) {
+        photon_indirect_rgb(ps, P, n, rgb);
+        return;
+    }
+    lf = log2(fmax(c->kappa * sqrt(dx * dx + dy * dy + dz * dz), fmax(c->smin, ICACHE_S0)) / ICACHE_S0);
+    if (!(lf < ICACHE_LEVEL_MAX + 1.0)) {
+        photon_indirect_rgb(ps, P, n, rgb); /* far: the photon buffers */
+        return;
+    }
+    l0 = (int)floor(lf);
+    t = lf - l0;
+    level_or_finer(c, ps, L, &pl, P, l0, rgb);
+    if (t > 0.0) {
+        if (l0 < ICACHE_LEVEL_MAX)
+            level_or_finer(c, ps, L, &pl, P, l0 + 1, r1);
+        else
+            photon_indirect_rgb(ps, P, n, r1);
+        for (k = 0; k < 3; k++)
+            rgb[k] = (1.0 - t) * rgb[k] + t * r1[k];
+    }
+}

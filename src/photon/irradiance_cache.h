@@ -1,0 +1,103 @@
+/* irradiance_cache: E_indirect for images by final gathering at sparse
+ * surface points, interpolated (Ward's irradiance caching, on a fixed grid
+ * per surface instead of his adaptive record radii).
+ *
+ * WHAT IS COMPUTED. For a pixel's surface point P with normal n, the RGB
+ * E_indirect that final_gather_rgb (final_gather.h: exact direct light at
+ * the gathered surfaces, the photon buffers for the later bounces only)
+ * would give at P, approximated by interpolating gathers ("records") made
+ * at the vertices of a square grid laid on P's own surface:
+ *  - the ground and each roof: the plane z = P.z, grid over (x, y);
+ *  - a wall: the plane of its edge (the edge a 2 cm probe ray from P meets),
+ *    grid over (u, z), u the distance along the edge from its first vertex.
+ * Records are keyed by (surface, level, grid cell): two surfaces never
+ * share one, so light does not leak across a wall foot, a roof edge or a
+ * building corner (the edges the interpolation respects).
+ *
+ * SPACING. The grid of level l has spacing s_l = ICACHE_S0 2^l. A point at
+ * distance d from the eye wants s = max(kappa d, smin) (ICACHE_KAPPA 0.15,
+ * an angle of about 9 degrees, and ICACHE_SMIN 2 m: indirect light changes
+ * over metres, whatever the image size, and 16 x 16 directions per record
+ * cost about 0.25 ms); l = log2(s / s0) is fractional and the two levels around it are
+ * blended (trilinear, as a mip map), so there is no seam where the level
+ * changes. Within a level, bilinear weights over the cell's four vertices.
+ * The coarsest level is ICACHE_LEVEL_MAX (8 m): beyond the distance that
+ * asks for it (53 m) the cache blends into the photon buffers' own lookup
+ * (photon_indirect_rgb), which alone answers beyond twice that: records
+ * farther apart would blur the light over whole streets and courtyards
+ * (aerial views read the photon buffers).
+ *
+ * VALID VERTICES. A vertex is valid when it lies on the same surface: on
+ * the ground or a roof, when the topmost surface over it (trace_top) has
+ * the same height as over P (within 1 mm: open ground stays open ground,
+ * a roof stays that roof's height) and, on grids of 4 m and coarser, no
+ * wall stands between P and it (a horizontal ray 5 cm above the surface:
+ * a cell may span a small building, with the same ground beyond it); on a
+ * wall, when a probe ray from 5 mm in front of it meets the same edge and
+ * no building stands against it there. Invalid vertices get no weight and the
+ * others are renormalised; a level whose four vertices are all invalid
+ * (a sliver of a surface smaller than the cell) is replaced by the next
+ * finer one, down to level 0, and below that P is gathered itself.
+ * Undersides and points no probe finds read the photon buffers.
+ *
+ * RECORDS. Each record is a final gather of ICACHE_SIDE^2 directions at its
+ * vertex (the seed and the vertex's coordinates seed its jitter, so a
+ * record's value does not depend on which pixel asked first: the same
+ * camera gives the same bytes). A record is computed when a pixel first
+ * needs it and kept in an open-addressed table of fixed size taken from
+ * the arena at creation; a full table (3/4) is emptied and refilled, which
+ * changes no value. The table is emptied as well when the photon buffers
+ * changed (new frames, a reset, refined lamps) or the light changed.
+ *
+ * Not for two threads at once (the table fills during lookups).
+ */
+#ifndef PLX_IRRADIANCE_CACHE_H
+#define PLX_IRRADIANCE_CACHE_H
+
+#include <stddef.h>
+#include <stdint.h>
+#include "base/arena.h"
+#include "light/illuminance.h"
+#include "photon/photon.h"
+
+#define ICACHE_SIDE 16        /* gather directions per record: 16 x 16 */
+#define ICACHE_S0 0.25        /* level 0 grid spacing, m */
+#define ICACHE_SMIN 2.0       /* spacing asked for near the eye, m */
+#define ICACHE_KAPPA 0.15     /* spacing asked for farther, per metre of distance */
+#define ICACHE_LEVEL_MAX 5    /* coarsest level: 8 m (farther: photon buffers) */
+#define ICACHE_LEVEL_SEG 4    /* from 4 m on, a ground vertex behind a wall is left out */
+#define ICACHE_RECORDS 65536  /* table slots (power of two) */
+
+typedef struct icache_rec icache_rec;
+
+typedef struct icache {
+    icache_rec *tab;          /* ICACHE_RECORDS slots */
+    uint32_t used;
+    uint32_t side;            /* gather side per record */
+    double eye[3];            /* the viewer: spacing grows with distance from it */
+    double kappa;             /* spacing per metre of distance (ICACHE_KAPPA) */
+    double smin;              /* smallest spacing asked for, m (ICACHE_SMIN) */
+    uint64_t stamp;           /* state of the photon buffers the records belong to */
+    uint64_t gathered;        /* records computed since creation */
+    uint64_t direct;          /* points gathered themselves (no valid vertex) */
+    uint64_t flushes;         /* times the table was emptied */
+} icache;
+
+/* Bytes icache_create takes from part PLX_PART_PHOTON. */
+size_t icache_bytes(void);
+
+/* The cache, empty, in the arena; PLX_E_NOMEM when it does not fit. */
+plx_status icache_create(arena *a, icache **out /* OUT */);
+
+/* The viewer for the lookups that follow: the grid spacing asked for at
+ * distance d from it is kappa d, at least smin. Records already made stay
+ * valid. */
+void icache_set_view(icache *c, const double eye[3]);
+
+/* RGB E_indirect (lux) at surface point P with unit normal n (a pixel's
+ * point), from the records around it (computed as needed). ps must have
+ * frames; L is the lamp light the gathers read. */
+void icache_lookup(icache *c, photon_sys *ps, light *L, const double P[3], const double n[3],
+                   double rgb[3] /* OUT */);
+
+#endif

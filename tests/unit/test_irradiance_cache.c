@@ -1,0 +1,247 @@
+/* irradiance_cache: the indirect light of an image (src/photon/irradiance_cache.h)
+ * against the independent path tracer (tests/ref/ref_indirect.c).
+ *
+ * A street view of fixtures/eixample-4x4.geojson is rendered through the API
+ * twice (linear floats, no glows), with and without indirect light; their
+ * difference at a pixel is the indirect radiance a/pi E_indirect the image
+ * shows there. Sample pixels are chosen on a grid, each kept when the ray
+ * through its centre (the renderer's camera, written out here) meets the
+ * ground or a wall within 60 m and the rays 2 pixels around it meet the same
+ * surface (no pixel on an edge). At the point that ray meets, the path
+ * tracer gives E_indirect; the image's E_indirect is pi / a times the
+ * difference in the red channel (the fixture's lamps have the default
+ * colour, whose red is 1: red E_indirect equals the colour-blind one the
+ * path tracer gives, with grey albedos). Printed beside it: the photon buffers alone at the same
+ * points, read as images read them before (the wide lookup).
+ *
+ * Also: the same camera gives the same bytes, whatever was rendered before
+ * (records do not depend on the order pixels asked for them).
+ * PLX_TEST_QUICK=1 (make check): fewer pixels and paths, a looser bound. */
+#include <stdarg.h>
+#include <stddef.h>
+#include <setjmp.h>
+#include <stdint.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <cmocka.h>
+
+#include "polarlux.h"
+#include "polarlux_port.h"
+#include "base/engine.h"
+#include "photon/trace.h"
+#include "photon/indirect.h"
+#include "photon/irradiance_cache.h"
+#include "ref_indirect.h"
+
+#define PI 3.14159265358979323846
+#define W 320
+#define H 240
+
+static int quick_mode(void)
+{
+    const char *v = getenv("PLX_TEST_QUICK");
+    return v && v[0] && v[0] != '0';
+}
+
+static plx_engine *engine_on(const char *path)
+{
+    plx_engine *e;
+    plx_config cfg;
+    static plx_port port;
+    port = *plx_port_posix();
+    port.log = NULL;
+    plx_config_default(&cfg);
+    cfg.port = &port;
+    assert_int_equal(plx_engine_new((size_t)1 << 30, &cfg, &e), PLX_OK);
+    assert_int_equal(plx_load_file(e, path), PLX_OK);
+    return e;
+}
+
+static void camera(plx_camera *c)
+{
+    memset(c, 0, sizeof *c);
+    c->eye[0] = 298.6;
+    c->eye[1] = 265.5;
+    c->eye[2] = 1.7;
+    c->target[0] = 261.8;
+    c->target[1] = 302.3;
+    c->target[2] = 3.0;
+    c->fov_deg = 60.0;
+    c->width = W;
+    c->height = H;
+}
+
+/* The ray through the centre of pixel (i, j), as render.c projects. */
+static void pixel_ray(const plx_camera *c, int i, int j, double d[3])
+{
+    double f[3], rt[3], up[3], l, x, y, th = tan(c->fov_deg * PI / 360.0);
+    int k;
+    for (k = 0; k < 3; k++)
+        f[k] = c->target[k] - c->eye[k];
+    l = sqrt(f[0] * f[0] + f[1] * f[1] + f[2] * f[2]);
+    for (k = 0; k < 3; k++)
+        f[k] /= l;
+    l = sqrt(f[0] * f[0] + f[1] * f[1]);
+    rt[0] = f[1] / l;
+    rt[1] = -f[0] / l;
+    rt[2] = 0.0;
+    up[0] = rt[1] * f[2] - rt[2] * f[1];
+    up[1] = rt[2] * f[0] - rt[0] * f[2];
+    up[2] = rt[0] * f[1] - rt[1] * f[0];
+    x = ((i + 0.5) / c->width * 2.0 - 1.0) * th * c->width / c->height;
+    y = (1.0 - (j + 0.5) / c->height * 2.0) * th;
+    for (k = 0; k < 3; k++)
+        d[k] = f[k] + x * rt[k] + y * up[k];
+    l = sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+    for (k = 0; k < 3; k++)
+        d[k] /= l;
+}
+
+/* Kind and surface met through pixel (i, j): 0 for the sky or beyond 60 m. */
+static uint64_t pixel_surface(tracer *T, const plx_camera *c, int i, int j, trace_hit *h)
+{
+    double d[3];
+    pixel_ray(c, i, j, d);
+    if (trace_ray(T, c->eye, d, 60.0, h) == TRACE_SKY)
+        return 0;
+    if (h->kind == TRACE_WALL)
+        return ((uint64_t)1 << 40) | h->edge;
+    if (h->kind == TRACE_GROUND)
+        return (uint64_t)2 << 40;
+    return 0;
+}
+
+static void render_pair(plx_engine *e, const plx_camera *c, float *with, float *without)
+{
+    plx_render_opts o;
+    plx_render_opts_default(&o);
+    o.no_glow = 1;
+    o.no_indirect = 1;
+    assert_int_equal(plx_render(e, c, &o, NULL, without, NULL), PLX_OK);
+    o.no_indirect = 0;
+    assert_int_equal(plx_render(e, c, &o, NULL, with, NULL), PLX_OK);
+}
+
+/* The sample pixels: candidates on a grid (no edge within 2 pixels), maxn
+ * of them spread evenly over the list; their points, normals, albedos and
+ * the reference there. Returns how many (those too dark are dropped). */
+static int sample_pixels(plx_engine *e, const plx_camera *c, int step, int maxn, int paths,
+                         int *px, trace_hit *hit, double *ref, double *noise)
+{
+    int i, j, k, n = 0, ncand = 0, *cand = malloc(sizeof *cand * W * H);
+    assert_non_null(cand);
+    for (j = step / 2; j < H; j += step)
+        for (i = step / 2; i < W; i += step) {
+            trace_hit h, h2;
+            uint64_t id = pixel_surface(e->ph->T, c, i, j, &h);
+            int di, dj, same = id != 0;
+            for (dj = -2; dj <= 2 && same; dj += 2)
+                for (di = -2; di <= 2 && same; di += 2)
+                    same = pixel_surface(e->ph->T, c, i + di, j + dj, &h2) == id;
+            if (same)
+                cand[ncand++] = j * W + i;
+        }
+    *noise = 0.0;
+    for (k = 0; k < maxn && k < ncand; k++) {
+        int q = cand[(int)((k + 0.5) * ncand / maxn)];
+        double se;
+        pixel_surface(e->ph->T, c, q % W, q / W, &hit[n]);
+        ref[n] = ref_indirect_paths(e->ph->T, e->sc, hit[n].p, hit[n].n, paths, 500u + (uint64_t)k,
+                                    &se);
+        if (!(ref[n] > 0.05))
+            continue; /* too dark for a relative error (beyond the lamps' light) */
+        *noise += se / ref[n];
+        px[n++] = q;
+    }
+    free(cand);
+    if (n > 0)
+        *noise /= n;
+    return n;
+}
+
+static void test_image_accuracy(void **state)
+{
+    plx_engine *e = engine_on("fixtures/eixample-4x4.geojson");
+    float *with = malloc(sizeof *with * 3 * W * H), *without = malloc(sizeof *with * 3 * W * H);
+    int step = quick_mode() ? 20 : 8, paths = quick_mode() ? 4000 : 40000;
+    int maxn = quick_mode() ? 10 : 60, seeds = quick_mode() ? 1 : 6, px[60], n, k, sd, walls = 0;
+    double bound = quick_mode() ? 0.12 : 0.08, err = 0.0, err_old = 0.0, noise, ref[60];
+    trace_hit hit[60];
+    plx_camera c;
+    (void)state;
+    assert_true(with && without);
+    camera(&c);
+    assert_int_equal(plx_indirect_step(e, 1, 1), PLX_OK); /* the tracer */
+    n = sample_pixels(e, &c, step, maxn, paths, px, hit, ref, &noise);
+    assert_true(n >= maxn / 2);
+    for (sd = 0; sd < seeds; sd++) {
+        assert_int_equal(plx_indirect_reset(e), PLX_OK);
+        for (k = 0; k < 4; k++) /* the command's default: 4 x 65536 photons */
+            assert_int_equal(plx_indirect_step(e, 65536, 100u * (uint64_t)sd + (uint64_t)k + 1),
+                             PLX_OK);
+        render_pair(e, &c, with, without);
+        for (k = 0; k < n; k++) {
+            /* red: the lamps' default colour has red 1 */
+            const trace_hit *h = &hit[k];
+            double a = h->kind == TRACE_WALL ? h->albedo : e->sc->ground_albedo, rgb_old[3];
+            double img = (with[3 * px[k]] - without[3 * px[k]]) * PI / a;
+            photon_indirect_rgb(e->ph, h->p, h->n, rgb_old);
+            err += fabs(img - ref[k]) / ref[k];
+            err_old += fabs(rgb_old[0] - ref[k]) / ref[k];
+            walls += sd == 0 && h->kind == TRACE_WALL;
+        }
+    }
+    err /= n * seeds;
+    err_old /= n * seeds;
+    printf("street view %dx%d of eixample-4x4, %d pixels (%d on walls), reference %d paths "
+           "(its noise %.4f), %d seed%s of 4 x 65536 photons: mean relative error of the "
+           "image's E_indirect %.4f (irradiance cache: %llu records), photon buffers alone "
+           "%.4f; bound %.2f%s\n",
+           W, H, n, walls, paths, noise, seeds, seeds > 1 ? "s" : "", err,
+           (unsigned long long)e->ic->gathered, err_old, bound, quick_mode() ? " (quick mode)" : "");
+    assert_true(noise < (quick_mode() ? 0.05 : 0.015));
+    assert_true(err <= bound);
+    assert_true(err < err_old);
+    free(with);
+    free(without);
+    plx_engine_free(e);
+}
+
+/* The same camera, the same bytes: after another view filled the cache, and
+ * in a fresh engine. */
+static void test_image_same_bytes(void **state)
+{
+    plx_engine *e1 = engine_on("fixtures/eixample-4x4.geojson");
+    plx_engine *e2 = engine_on("fixtures/eixample-4x4.geojson");
+    uint8_t *a = malloc(3 * W * H), *b = malloc(3 * W * H);
+    plx_render_opts o;
+    plx_camera c, other;
+    (void)state;
+    assert_true(a && b);
+    camera(&c);
+    other = c;
+    other.eye[0] -= 30.0;
+    other.target[1] += 20.0;
+    plx_render_opts_default(&o);
+    assert_int_equal(plx_indirect_step(e1, 16384, 3), PLX_OK);
+    assert_int_equal(plx_indirect_step(e2, 16384, 3), PLX_OK);
+    assert_int_equal(plx_render(e1, &c, &o, a, NULL, NULL), PLX_OK);
+    assert_int_equal(plx_render(e2, &other, &o, b, NULL, NULL), PLX_OK);
+    assert_int_equal(plx_render(e2, &c, &o, b, NULL, NULL), PLX_OK);
+    assert_memory_equal(a, b, 3 * W * H);
+    free(a);
+    free(b);
+    plx_engine_free(e1);
+    plx_engine_free(e2);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_image_accuracy),
+        cmocka_unit_test(test_image_same_bytes),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
