@@ -27,11 +27,10 @@
  *    at the same time. "engine (reads)" means the call only reads the
  *    engine: any number may run at once on one engine while no "engine" call
  *    runs on it. "any" means the call touches no engine and no shared state.
- *    Loading parses JSON with cJSON, whose allocation hooks are process-wide:
- *    plx_load_* hold the port's lock (plx_port.lock) around the parse, so
- *    engines loading in several threads at once need a port with a lock
- *    (plx_port_posix has one), and an application's own cJSON hooks are
- *    reset to cJSON's defaults after each load.
+ *    Loading reads the JSON text in place with the engine's own reader
+ *    (no cJSON, no process-wide state): engines may load in several threads
+ *    at once without a lock, and an application's own cJSON hooks are left
+ *    as they are.
  */
 #ifndef POLARLUX_H
 #define POLARLUX_H
@@ -74,7 +73,7 @@ typedef enum plx_part {
     PLX_PART_LIT,        /* lamp lit regions */
     PLX_PART_PHOTON,     /* photon buffers */
     PLX_PART_FRAME,      /* frame buffers, query results */
-    PLX_PART_SCRATCH,    /* temporary memory during a call (JSON parse tree, ...) */
+    PLX_PART_SCRATCH,    /* temporary memory during a call (a loaded file's bytes, ...) */
     PLX_PART_COUNT
 } plx_part;
 
@@ -101,8 +100,9 @@ typedef struct plx_port {
     int (*file_size)(void *ctx, const char *path, size_t *size, char *err, size_t errlen);
     /* Read exactly 'size' bytes of the file into buf; 0 on success. */
     int (*file_read)(void *ctx, const char *path, void *buf, size_t size, char *err, size_t errlen);
-    /* A process-wide lock held around JSON parsing (cJSON's allocation hooks
-     * are process-wide). Needed only when engines load in several threads. */
+    /* A process-wide lock. No longer taken by the core (loads touch no
+     * process-wide state since the streaming loader); kept so existing port
+     * tables still compile. */
     void (*lock)(void *ctx);
     void (*unlock)(void *ctx);
     /* A parallel-for (NULL: everything runs on the calling thread): calls
@@ -188,12 +188,12 @@ uint32_t plx_warning_count(const plx_engine *e);
  * Errors: PLX_E_INVALID (text NULL with len > 0), PLX_E_PARSE (malformed
  * JSON, or nested deeper than 1000 levels: byte offset, line and column in
  * the message), PLX_E_SCENE (not a FeatureCollection, unknown units, a bad
- * feature with strict), PLX_E_NOMEM (the parse tree or the scene does not
- * fit). Lifetime: text and name are not kept (ids are copied); everything
+ * feature with strict), PLX_E_NOMEM (the scene does not fit: the text is
+ * read in place, one feature at a time, with 8 bytes a feature of scratch).
+ * Lifetime: text and name are not kept (ids are copied); everything
  * derived from the previous scene (polar diagrams, lamp light, renderer,
  * photons, ground image, pointers from every getter) is dropped at entry,
- * even when the load fails. Threads: engine; see the header comment on the
- * JSON lock.
+ * even when the load fails. Threads: engine (no process-wide state).
  */
 plx_status plx_load_geojson(plx_engine *e, const char *text, size_t len, const char *name);
 /* The same from a file, read through the engine's port into scratch memory

@@ -37,6 +37,7 @@ FUZZ_SAN      = -fsanitize=address,undefined -fno-sanitize-recover=all
 # go to build/fuzz/corpus/NAME, crashes to build/fuzz/crash-NAME-*.
 FUZZ_SEEDS_fuzz_geojson = fixtures tests/corpus
 FUZZ_SEEDS_fuzz_scene   = fixtures tests/corpus
+FUZZ_SEEDS_fuzz_jsoncheck = fixtures tests/corpus
 FUZZ_SEEDS_fuzz_bake    = tests/corpus
 FUZZ_SEEDS_fuzz_ies     = fixtures/photometry tests/fuzz/seeds-photometry
 FUZZ_SEEDS_fuzz_ldt     = fixtures/photometry tests/fuzz/seeds-photometry
@@ -152,7 +153,8 @@ FS_CC     ?= arm-none-eabi-gcc
 FS_BUILD   = build/freestanding
 FS_FLAGS   = -ffreestanding -mthumb -mcpu=cortex-m4 -Os -ffunction-sections -fdata-sections
 FS_OBJ     = $(CORE_SRC:src/%.c=$(FS_BUILD)/%.o)
-# string.h, qsort and every C99 math.h function (double and float)
+# string.h, qsort, strtod (the scene's numbers, read as cJSON read them) and
+# every C99 math.h function (double and float)
 FS_ALLOWED = memcpy memmove memset memcmp memchr strlen strcmp strncmp strchr strrchr strstr qsort \
              acos asin atan atan2 cos sin tan acosh asinh atanh cosh sinh tanh exp exp2 \
              expm1 frexp ldexp log log10 log1p log2 logb modf scalbn cbrt fabs hypot \
@@ -163,7 +165,8 @@ FS_ALLOWED = memcpy memmove memset memcmp memchr strlen strcmp strncmp strchr st
              log1pf log2f logbf modff scalbnf cbrtf fabsf hypotf powf sqrtf erff erfcf \
              lgammaf tgammaf ceilf floorf nearbyintf rintf lrintf llrintf roundf \
              lroundf llroundf truncf fmodf remainderf remquof copysignf nanf nextafterf \
-             fdimf fmaxf fminf fmaf
+             fdimf fmaxf fminf fmaf \
+             strtod
 
 $(FS_BUILD)/include/cjson/cJSON.h: /usr/include/cjson/cJSON.h
 	@mkdir -p $(@D)

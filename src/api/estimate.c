@@ -8,7 +8,6 @@
  * checks that the result covers the measured high-water mark on every
  * fixture and generated cities, and stays within 4x of it. */
 #include <string.h>
-#include <cjson/cJSON.h>
 #include "polarlux.h"
 
 #define SCAN_DEPTH 64
@@ -156,14 +155,17 @@ typedef struct phase {
 } phase;
 
 /* Loading: the scene kept (points, rings, buildings, lamps, blocks, ids);
- * the parse tree (one JSON node a value, strings copied) and the loader's
- * scratch (cleaned rings, block outlines). */
+ * the loader streams the text (src/scene/geojson.c: no parse tree), so its
+ * scratch is the line index (8 bytes a feature), one ring's checks and the
+ * block outlines (measured about 25 bytes a vertex). Kept: 16 bytes a
+ * vertex and the block outlines, a building (80) and its blocks a ring, a
+ * lamp (136) a point, and every string at most (ids, paths). The text itself is the caller's (plx_load_geojson);
+ * plx_load_file reads it into the block: add text_bytes for that. */
 static phase est_load(const est *c)
 {
     phase p;
-    double node = (double)sizeof(cJSON) + 8.0;
-    p.kept = 16384.0 + 80.0 * c->positions + 512.0 * c->rings + 64.0 * c->features + c->strings;
-    p.scratch = node * c->values + 2.0 * c->strings + 128.0 * c->positions + 1024.0 * c->rings;
+    p.kept = 4096.0 + 40.0 * c->positions + 160.0 * c->rings + 144.0 * c->points + c->strings;
+    p.scratch = 8192.0 + 16.0 * c->features + 32.0 * c->positions + 64.0 * c->rings;
     return p;
 }
 

@@ -1,7 +1,10 @@
-/* features: reads buildings and lamps out of the parsed FeatureCollection
- * (SPEC §1). Pass 1 counts and finds the coordinate frame; pass 2 fills the
- * scene, checking every feature and skipping (or, strict, failing on) bad ones.
- */
+/* features: reads buildings and lamps out of the FeatureCollection's text,
+ * one feature at a time, in place (SPEC §1). Pass 1 counts, finds the
+ * coordinate frame and where each feature starts (for messages); pass 2
+ * fills the scene, checking every feature and skipping (or, strict, failing
+ * on) bad ones. Values are read as cJSON read them before: a member is the
+ * first with its key, and the children of an object are its members'
+ * values. */
 #include <string.h>
 #include <math.h>
 
@@ -30,37 +33,40 @@ typedef struct counts {
     int lonlat_ok;     /* every coordinate within lon/lat range */
 } counts;
 
-static const char *geom_type(const cJSON *f)
+/* The members of a feature that the passes look at, found once. */
+typedef struct feat {
+    jv f, props, geom, type, coords;
+} feat;
+
+static void feat_find(const loader *ld, jv f, feat *m)
 {
-    const cJSON *g = cJSON_GetObjectItemCaseSensitive(f, "geometry");
-    const cJSON *t = cJSON_GetObjectItemCaseSensitive(g, "type");
-    return cJSON_IsString(t) ? t->valuestring : NULL;
+    m->f = f;
+    m->props = ld_get(ld, f, "properties");
+    m->geom = ld_get(ld, f, "geometry");
+    m->type = ld_get(ld, m->geom, "type");
+    if (ld_kind(ld, m->type) != JS_STRING)
+        m->type = JV_NONE;
+    m->coords = ld_get(ld, m->geom, "coordinates");
 }
 
-static const cJSON *coords_of(const cJSON *f)
+static int is_lamp(const loader *ld, jv props)
 {
-    return cJSON_GetObjectItemCaseSensitive(cJSON_GetObjectItemCaseSensitive(f, "geometry"), "coordinates");
-}
-
-static int is_lamp(const cJSON *props)
-{
-    const cJSON *lamp = cJSON_GetObjectItemCaseSensitive(props, "lamp");
-    const cJSON *hw = cJSON_GetObjectItemCaseSensitive(props, "highway");
-    if (cJSON_IsTrue(lamp))
+    jv lamp = ld_get(ld, props, "lamp");
+    if (ld_kind(ld, lamp) == JS_TRUE)
         return 1;
-    return cJSON_IsString(hw) && strcmp(hw->valuestring, "street_lamp") == 0;
+    return ld_str_is(ld, ld_get(ld, props, "highway"), "street_lamp");
 }
 
 /* ---- pass 1 --------------------------------------------------------------- */
 
-static void count_position(counts *c, const cJSON *pos)
+static void count_position(const loader *ld, counts *c, jv pos)
 {
-    const cJSON *x = cJSON_GetArrayItem(pos, 0), *y = cJSON_GetArrayItem(pos, 1);
+    jv x = ld_item(ld, pos, 0), y = ld_item(ld, pos, 1);
     double vx, vy;
-    if (!cJSON_IsNumber(x) || !cJSON_IsNumber(y))
+    if (ld_kind(ld, x) != JS_NUMBER || ld_kind(ld, y) != JS_NUMBER)
         return;
-    vx = x->valuedouble;
-    vy = y->valuedouble;
+    vx = ld_double(ld, x);
+    vy = ld_double(ld, y);
     if (!isfinite(vx) || !isfinite(vy))
         return;
     if (!c->any) {
@@ -76,96 +82,126 @@ static void count_position(counts *c, const cJSON *pos)
         c->lonlat_ok = 0;
 }
 
-static void count_polygon(counts *c, const cJSON *poly)
+static void count_polygon(const loader *ld, counts *c, jv poly)
 {
-    const cJSON *ring, *pos;
+    jv ring, pos;
     c->parts++;
-    cJSON_ArrayForEach(ring, poly) {
+    LD_EACH(ld, poly, ring) {
         c->rings++;
-        cJSON_ArrayForEach(pos, ring) {
+        LD_EACH(ld, ring, pos) {
             c->positions++;
-            count_position(c, pos);
+            count_position(ld, c, pos);
         }
     }
 }
 
-static void count_features(const cJSON *features, counts *c)
+/* Where the feature at f starts for messages: the first byte after the
+ * '[' or ',' before it that is not a space, tab or line end. */
+static size_t feature_start(const loader *ld, jv f)
 {
-    const cJSON *f, *part;
+    size_t p = f;
+    while (p > 0 && ld->text[p - 1] != ',' && ld->text[p - 1] != '[')
+        p--;
+    while (p < f && (ld->text[p] == ' ' || ld->text[p] == '\t' || ld->text[p] == '\r' || ld->text[p] == '\n'))
+        p++;
+    return p;
+}
+
+/* Line and column of every feature, counted on from the previous one. */
+typedef struct liner {
+    size_t off, line_start;
+    uint32_t line;
+} liner;
+
+static void liner_to(const loader *ld, liner *l, size_t off, uint32_t *line, uint32_t *col)
+{
+    for (; l->off < off; l->off++)
+        if (ld->text[l->off] == '\n') {
+            l->line++;
+            l->line_start = l->off + 1;
+        }
+    *line = l->line;
+    *col = (uint32_t)(off - l->line_start + 1);
+}
+
+static void count_features(loader *ld, jv features, counts *c)
+{
+    jv f, part;
+    uint32_t fi = 0;
+    liner l = { 0, 0, 1 };
     memset(c, 0, sizeof *c);
     c->lonlat_ok = 1;
-    cJSON_ArrayForEach(f, features) {
-        const char *t = geom_type(f);
-        const cJSON *co = coords_of(f);
-        if (!t || !cJSON_IsArray(co))
+    LD_EACH(ld, features, f) {
+        feat m;
+        liner_to(ld, &l, feature_start(ld, f), &ld->feat_line[fi], &ld->feat_col[fi]);
+        fi++;
+        feat_find(ld, f, &m);
+        if (m.type == JV_NONE || ld_kind(ld, m.coords) != JS_ARRAY)
             continue;
-        if (strcmp(t, "Polygon") == 0) {
-            count_polygon(c, co);
-        } else if (strcmp(t, "MultiPolygon") == 0) {
-            cJSON_ArrayForEach(part, co)
-                count_polygon(c, part);
-        } else if (strcmp(t, "Point") == 0 &&
-                   is_lamp(cJSON_GetObjectItemCaseSensitive(f, "properties"))) {
+        if (ld_str_is(ld, m.type, "Polygon")) {
+            count_polygon(ld, c, m.coords);
+        } else if (ld_str_is(ld, m.type, "MultiPolygon")) {
+            LD_EACH(ld, m.coords, part)
+                count_polygon(ld, c, part);
+        } else if (ld_str_is(ld, m.type, "Point") && is_lamp(ld, m.props)) {
             c->lamps++;
-            count_position(c, co);
+            count_position(ld, c, m.coords);
         }
     }
 }
 
 /* ---- ids ---------------------------------------------------------------------- */
 
-static const char *copy_id(loader *ld, const cJSON *item)
+static const char *copy_id(loader *ld, jv item)
 {
-    char tmp[64];
-    const char *src;
+    char tmp[201];
     size_t n;
     char *dst;
     strbuf b;
-    if (cJSON_IsString(item)) {
-        src = item->valuestring;
-    } else if (cJSON_IsNumber(item)) {
-        sb_init(&b, tmp, sizeof tmp);
-        sb_num(&b, item->valuedouble, 17);
-        src = tmp;
+    if (ld_kind(ld, item) == JS_STRING) {
+        n = ld_str(ld, item, tmp, sizeof tmp);
+    } else if (ld_kind(ld, item) == JS_NUMBER) {
+        sb_init(&b, tmp, 64);
+        sb_num(&b, ld_double(ld, item), 17);
+        n = strlen(tmp);
     } else {
         return NULL;
     }
-    n = strlen(src);
     if (n > 200)
         n = 200;
     dst = arena_alloc(ld->mem, PLX_PART_SCENE, n + 1, 1);
     if (!dst)
         return NULL;
-    memcpy(dst, src, n);
+    memcpy(dst, tmp, n);
     dst[n] = '\0';
     return dst;
 }
 
-static const cJSON *id_item(const cJSON *f, const cJSON *props)
+static jv id_item(const loader *ld, jv f, jv props)
 {
     static const char *const keys[] = { "id", "@id", "osm_id" };
     size_t i;
     for (i = 0; i < sizeof keys / sizeof keys[0]; i++) {
-        const cJSON *it = cJSON_GetObjectItemCaseSensitive(props, keys[i]);
-        if (cJSON_IsString(it) || cJSON_IsNumber(it))
+        jv it = ld_get(ld, props, keys[i]);
+        if (ld_kind(ld, it) == JS_STRING || ld_kind(ld, it) == JS_NUMBER)
             return it;
     }
-    return cJSON_GetObjectItemCaseSensitive(f, "id");
+    return ld_get(ld, f, "id");
 }
 
 /* ---- coordinates -------------------------------------------------------------- */
 
 /* Reads one position into p; 0 on success, else writes why. */
-static int read_position(loader *ld, const cJSON *pos, vec2 *p, strbuf *why)
+static int read_position(loader *ld, jv pos, vec2 *p, strbuf *why)
 {
-    const cJSON *x = cJSON_GetArrayItem(pos, 0), *y = cJSON_GetArrayItem(pos, 1);
+    jv x = ld_first(ld, pos), y = x != JV_NONE ? ld_next(ld, pos, x) : JV_NONE;
     double vx, vy;
-    if (!cJSON_IsArray(pos) || !cJSON_IsNumber(x) || !cJSON_IsNumber(y)) {
+    if (ld_kind(ld, pos) != JS_ARRAY || ld_kind(ld, x) != JS_NUMBER || ld_kind(ld, y) != JS_NUMBER) {
         sb_str(why, "is not a position [x, y] of numbers");
         return -1;
     }
-    vx = x->valuedouble;
-    vy = y->valuedouble;
+    vx = ld_double(ld, x);
+    vy = ld_double(ld, y);
     if (!isfinite(vx) || !isfinite(vy)) {
         sb_str(why, "has a non-finite number");
         return -1;
@@ -191,19 +227,19 @@ static void why_ring(strbuf *why, uint32_t ring)
 
 /* Reads, cleans and checks ring number 'ring' of a polygon into s->pts.
  * Returns PLX_OK, PLX_E_SCENE with 'why' filled, or PLX_E_NOMEM. */
-static plx_status read_ring(loader *ld, const cJSON *jr, uint32_t ring, scene_ring *out, strbuf *why)
+static plx_status read_ring(loader *ld, jv jr, uint32_t ring, scene_ring *out, strbuf *why)
 {
     scene *s = ld->s;
     vec2 *p = s->pts + s->npts;
     uint32_t n = 0, k = 0, ei, ej;
-    const cJSON *pos;
+    jv pos;
     int simple;
-    if (!cJSON_IsArray(jr)) {
+    if (ld_kind(ld, jr) != JS_ARRAY) {
         why_ring(why, ring);
         sb_str(why, " is not an array of positions");
         return PLX_E_SCENE;
     }
-    cJSON_ArrayForEach(pos, jr) {
+    LD_EACH(ld, jr, pos) {
         vec2 v;
         if (read_position(ld, pos, &v, why) != 0) {
             char tmp[160];
@@ -369,7 +405,7 @@ typedef struct bprops {
     double height, min_height, albedo;
 } bprops;
 
-static plx_status read_bprops(loader *ld, uint32_t fi, const char *id, const cJSON *props,
+static plx_status read_bprops(loader *ld, uint32_t fi, const char *id, jv props,
                               bprops *bp, int *ok)
 {
     char why[200];
@@ -407,7 +443,7 @@ static plx_status read_bprops(loader *ld, uint32_t fi, const char *id, const cJS
         sb_str(&b, " m");
         if (from_levels)
             sb_str(&b, " (from building:levels)");
-        else if (!cJSON_GetObjectItemCaseSensitive(props, "height"))
+        else if (ld_get(ld, props, "height") == JV_NONE)
             sb_str(&b, " (the default)");
     } else if (!isfinite(bp->albedo) || bp->albedo < 0.0 || bp->albedo > 1.0) {
         sb_str(&b, "albedo ");
@@ -422,19 +458,19 @@ static plx_status read_bprops(loader *ld, uint32_t fi, const char *id, const cJS
 
 /* Reads one polygon (outer ring + holes) as a building. On PLX_E_SCENE 'why'
  * says what is wrong and nothing was added. */
-static plx_status read_polygon(loader *ld, const cJSON *poly, const bprops *bp,
+static plx_status read_polygon(loader *ld, jv poly, const bprops *bp,
                                uint32_t fi, const char *id, strbuf *why)
 {
     scene *s = ld->s;
     uint32_t npts0 = s->npts, nrings0 = s->nrings, r = 0, i;
     scene_building *bd;
-    const cJSON *jr;
+    jv jr;
     plx_status st;
-    if (!cJSON_IsArray(poly) || cJSON_GetArraySize(poly) < 1) {
+    if (ld_kind(ld, poly) != JS_ARRAY || ld_first(ld, poly) == JV_NONE) {
         sb_str(why, "a polygon has no rings");
         return PLX_E_SCENE;
     }
-    cJSON_ArrayForEach(jr, poly) {
+    LD_EACH(ld, poly, jr) {
         st = read_ring(ld, jr, r, &s->rings[s->nrings], why);
         if (st != PLX_OK) {
             s->npts = npts0;
@@ -469,12 +505,12 @@ static plx_status read_polygon(loader *ld, const cJSON *poly, const bprops *bp,
     return PLX_OK;
 }
 
-static plx_status read_building(loader *ld, const cJSON *f, const cJSON *props, int multi,
+static plx_status read_building(loader *ld, const feat *m, jv props, int multi,
                                 uint32_t fi, const char *id)
 {
     scene *s = ld->s;
     uint32_t npts0 = s->npts, nrings0 = s->nrings, nbld0 = s->nbld;
-    const cJSON *co = coords_of(f), *part;
+    jv co = m->coords, part;
     char whybuf[300];
     strbuf why;
     bprops bp;
@@ -484,17 +520,17 @@ static plx_status read_building(loader *ld, const cJSON *f, const cJSON *props, 
     if (st != PLX_OK || !ok)
         return st;
     sb_init(&why, whybuf, sizeof whybuf);
-    if (!cJSON_IsArray(co)) {
+    if (ld_kind(ld, co) != JS_ARRAY) {
         sb_str(&why, "geometry has no \"coordinates\" array");
         st = PLX_E_SCENE;
     } else if (!multi) {
         st = read_polygon(ld, co, &bp, fi, id, &why);
     } else {
         uint32_t k = 0;
-        st = cJSON_GetArraySize(co) ? PLX_OK : PLX_E_SCENE;
+        st = ld_first(ld, co) != JV_NONE ? PLX_OK : PLX_E_SCENE;
         if (st != PLX_OK)
             sb_str(&why, "MultiPolygon has no polygons");
-        cJSON_ArrayForEach(part, co) {
+        LD_EACH(ld, co, part) {
             st = read_polygon(ld, part, &bp, fi, id, &why);
             if (st != PLX_OK) {
                 char tmp[300];
@@ -523,20 +559,20 @@ static plx_status read_building(loader *ld, const cJSON *f, const cJSON *props, 
 
 /* ---- lamps ------------------------------------------------------------------------ */
 
-static void read_color(loader *ld, uint32_t fi, const char *id, const cJSON *props, float c[3])
+static void read_color(loader *ld, uint32_t fi, const char *id, jv props, float c[3])
 {
-    const cJSON *col = cJSON_GetObjectItemCaseSensitive(props, "color"), *v;
+    jv col = ld_get(ld, props, "color"), v;
     float tmp[3];
     int k = 0;
     memcpy(c, default_color, sizeof tmp);
-    if (!col || cJSON_IsNull(col))
+    if (col == JV_NONE || ld_kind(ld, col) == JS_NULL)
         return;
-    if (cJSON_IsArray(col) && cJSON_GetArraySize(col) == 3) {
-        cJSON_ArrayForEach(v, col) {
-            if (!cJSON_IsNumber(v) || !isfinite(v->valuedouble) || v->valuedouble < 0.0 ||
-                v->valuedouble > 1.0e6)
+    if (ld_kind(ld, col) == JS_ARRAY && ld_count(ld, col) == 3) {
+        LD_EACH(ld, col, v) {
+            double d = ld_kind(ld, v) == JS_NUMBER ? ld_double(ld, v) : -1.0;
+            if (!isfinite(d) || d < 0.0 || d > 1.0e6)
                 break;
-            tmp[k++] = (float)v->valuedouble;
+            tmp[k++] = (float)d;
         }
         if (k == 3) {
             memcpy(c, tmp, sizeof tmp);
@@ -550,10 +586,11 @@ static void read_color(loader *ld, uint32_t fi, const char *id, const cJSON *pro
  * the table comes through plx_set_photometry), azimuth (else OSM's compass
  * "direction": azimuth = 90 - direction), tilt and dimming (SPEC §2.1).
  * Returns PLX_E_NOMEM, or PLX_OK with a reason in why for a bad value. */
-static plx_status read_lamp_photometry(loader *ld, uint32_t fi, const char *id, const cJSON *props,
+static plx_status read_lamp_photometry(loader *ld, uint32_t fi, const char *id, jv props,
                                        scene_lamp *l, strbuf *why)
 {
-    const cJSON *ph = props ? cJSON_GetObjectItemCaseSensitive(props, "photometry") : NULL;
+    jv ph = ld_get(ld, props, "photometry");
+    size_t n = ld_str(ld, ph, NULL, 0);
     double dir;
     l->dimming = 1.0;
     if (!ld_prop_number(ld, fi, id, props, "azimuth", &l->azimuth) &&
@@ -569,21 +606,20 @@ static plx_status read_lamp_photometry(loader *ld, uint32_t fi, const char *id, 
         sb_str(why, "lamp azimuth or tilt is out of range (|azimuth| <= 1e6, |tilt| <= 180 degrees)");
     }
     photometry_lamp_frame(l);
-    if (ph && cJSON_IsString(ph) && ph->valuestring[0] != '\0') {
-        size_t n = strlen(ph->valuestring);
+    if (n > 0) {
         char *dst = arena_alloc(ld->mem, PLX_PART_SCENE, n + 1, 1);
         if (!dst)
             return eng_nomem(ld->e, "copying photometry paths");
-        memcpy(dst, ph->valuestring, n + 1);
+        ld_str(ld, ph, dst, n + 1);
         l->photometry = dst;
         l->intensity = 0.0;   /* dark until the table is given */
-    } else if (ph && !cJSON_IsNull(ph)) {
+    } else if (ph != JV_NONE && ld_kind(ld, ph) != JS_NULL) {
         ld_warn(ld, fi, id, "property \"photometry\" is not a file path; ignored, the lamp is isotropic");
     }
     return PLX_OK;
 }
 
-static plx_status read_lamp(loader *ld, const cJSON *f, const cJSON *props, uint32_t fi, const char *id)
+static plx_status read_lamp(loader *ld, const feat *m, jv props, uint32_t fi, const char *id)
 {
     scene_lamp *l = &ld->s->lamps[ld->s->nlamps];
     char whybuf[200];
@@ -594,7 +630,7 @@ static plx_status read_lamp(loader *ld, const cJSON *f, const cJSON *props, uint
     l->z = DEFAULT_LAMP_Z;
     l->intensity = DEFAULT_INTENSITY;
     l->radius = DEFAULT_RADIUS;
-    if (read_position(ld, coords_of(f), &p, &why) != 0) {
+    if (read_position(ld, m->coords, &p, &why) != 0) {
         char tmp[200];
         strbuf t;
         sb_init(&t, tmp, sizeof tmp);
@@ -635,45 +671,47 @@ static plx_status read_lamp(loader *ld, const cJSON *f, const cJSON *props, uint
 
 /* ---- pass 2 ------------------------------------------------------------------------- */
 
-static plx_status read_feature(loader *ld, const cJSON *f, uint32_t fi)
+static plx_status read_feature(loader *ld, jv f, uint32_t fi)
 {
-    const cJSON *props, *geom;
-    const char *id = NULL, *t;
-    char why[200];
+    feat m;
+    jv props, lamp;
+    const char *id = NULL;
+    char why[200], type[41];
     strbuf b;
-    if (!cJSON_IsObject(f))
+    if (ld_kind(ld, f) != JS_OBJECT)
         return ld_bad_feature(ld, fi, NULL, "is not a JSON object");
-    props = cJSON_GetObjectItemCaseSensitive(f, "properties");
-    if (props && !cJSON_IsObject(props) && !cJSON_IsNull(props)) {
+    feat_find(ld, f, &m);
+    props = m.props;
+    if (props != JV_NONE && ld_kind(ld, props) != JS_OBJECT && ld_kind(ld, props) != JS_NULL) {
         ld_warn(ld, fi, NULL, "\"properties\" is not an object; ignored");
-        props = NULL;
+        props = JV_NONE;
     }
-    if (id_item(f, props)) {
-        id = copy_id(ld, id_item(f, props));
+    if (id_item(ld, f, props) != JV_NONE) {
+        id = copy_id(ld, id_item(ld, f, props));
         if (!id)
             return eng_nomem(ld->e, "copying feature ids");
     }
-    geom = cJSON_GetObjectItemCaseSensitive(f, "geometry");
-    if (!cJSON_IsObject(geom))
+    if (ld_kind(ld, m.geom) != JS_OBJECT)
         return ld_bad_feature(ld, fi, id, "has no geometry object");
-    t = geom_type(f);
-    if (!t)
+    if (m.type == JV_NONE)
         return ld_bad_feature(ld, fi, id, "geometry has no \"type\" string");
-    if (strcmp(t, "Polygon") == 0)
-        return read_building(ld, f, props, 0, fi, id);
-    if (strcmp(t, "MultiPolygon") == 0)
-        return read_building(ld, f, props, 1, fi, id);
-    if (strcmp(t, "Point") == 0) {
-        const cJSON *lamp = cJSON_GetObjectItemCaseSensitive(props, "lamp");
-        if (is_lamp(props))
-            return read_lamp(ld, f, props, fi, id);
-        if (lamp && !cJSON_IsBool(lamp) && !cJSON_IsNull(lamp))
+    if (ld_str_is(ld, m.type, "Polygon"))
+        return read_building(ld, &m, props, 0, fi, id);
+    if (ld_str_is(ld, m.type, "MultiPolygon"))
+        return read_building(ld, &m, props, 1, fi, id);
+    if (ld_str_is(ld, m.type, "Point")) {
+        lamp = ld_get(ld, props, "lamp");
+        if (is_lamp(ld, props))
+            return read_lamp(ld, &m, props, fi, id);
+        if (lamp != JV_NONE && ld_kind(ld, lamp) != JS_TRUE && ld_kind(ld, lamp) != JS_FALSE &&
+            ld_kind(ld, lamp) != JS_NULL)
             ld_warn(ld, fi, id, "property \"lamp\" is not true or false; ignored, the point is not a lamp");
         return PLX_OK;
     }
+    ld_str(ld, m.type, type, sizeof type);
     sb_init(&b, why, sizeof why);
     sb_str(&b, "geometry type \"");
-    sb_strn(&b, t, 40);
+    sb_str(&b, type);
     sb_str(&b, "\" is not used in scenes (Polygon, MultiPolygon or Point)");
     return ld_bad_feature(ld, fi, id, why);
 }
@@ -700,14 +738,19 @@ static void *alloc_array(loader *ld, size_t n, size_t size)
     return arena_alloc(ld->mem, PLX_PART_SCENE, arena_mul(n ? n : 1, size), 16);
 }
 
-plx_status ld_features(loader *ld, cJSON *features)
+plx_status ld_features(loader *ld, jv features)
 {
     scene *s = ld->s;
     counts c;
-    const cJSON *f;
+    jv f;
     uint32_t fi = 0;
     plx_status st;
-    count_features(features, &c);
+    ld->nfeat = ld_count(ld, features);
+    ld->feat_line = arena_scratch(ld->mem, arena_mul(ld->nfeat + 1u, sizeof(uint32_t)), 4);
+    ld->feat_col = arena_scratch(ld->mem, arena_mul(ld->nfeat + 1u, sizeof(uint32_t)), 4);
+    if (!ld->feat_line || !ld->feat_col)
+        return eng_nomem(ld->e, "indexing feature lines");
+    count_features(ld, features, &c);
     if (c.positions > 0xfffffff0u || c.rings > 0xfffffff0u)
         return eng_fail(ld->e, PLX_E_SCENE, "the scene has more than 4e9 vertices");
     st = set_frame(ld, &c);
@@ -719,8 +762,10 @@ plx_status ld_features(loader *ld, cJSON *features)
     s->lamps = alloc_array(ld, c.lamps, sizeof *s->lamps);
     if (!s->pts || !s->rings || !s->bld || !s->lamps)
         return eng_nomem(ld->e, "loading the scene");
-    cJSON_ArrayForEach(f, features) {
+    LD_EACH(ld, features, f) {
         st = read_feature(ld, f, fi++);
+        if (st == PLX_OK && ld->oom)
+            st = eng_nomem(ld->e, "reading a numeric property");
         if (st != PLX_OK)
             return st;
     }

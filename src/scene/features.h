@@ -6,7 +6,7 @@
 #include "scene/loader.h"
 
 /* Reads every feature into ld->s (features.c). */
-plx_status ld_features(loader *ld, cJSON *features);
+plx_status ld_features(loader *ld, jv features);
 /* Leaves out lamps inside a building's solid, reporting each (features.c). */
 plx_status ld_drop_buried_lamps(loader *ld);
 

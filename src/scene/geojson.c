@@ -1,10 +1,14 @@
 /* geojson: GeoJSON FeatureCollection -> scene (SPEC §1).
  *
- * The text is parsed by cJSON into scratch memory of the engine's arena
- * (cJSON's allocation hooks point at the arena for the length of the parse),
- * then read in two passes: one counts and finds the coordinate frame, one
- * fills the scene arrays. All scratch memory is given back before return;
- * on failure the scene part is given back too.
+ * The text is streamed, never parsed into a tree: one pass checks it
+ * (base/jsoncheck.c: the grammar and error positions of cJSON, which read
+ * it before), then the features are read in place one at a time, in two
+ * passes (features.c): one counts and finds the coordinate frame, one fills
+ * the scene arrays. Besides the scene itself, the load holds a line index
+ * of 8 bytes a feature and what one feature's checks need (rings are checked
+ * where they lie in the scene's arrays); all of it scratch, given back
+ * before return; on failure the scene part is given back too. Nothing
+ * process-wide is touched (no cJSON hooks, no static state).
  *
  * Top-level properties: units, ground_albedo (fatal when wrong), and
  * ground_image / ground_image_bounds (README "Scene format"): the path is
@@ -12,16 +16,10 @@
  * plx_set_ground_image, src/ground.c) and the bounds are projected like the
  * features once the frame is known; a bad value is fatal when strict and
  * ignored with a warning otherwise.
- *
- * cJSON's hooks are process-wide, so the hook functions must find the arena
- * through one static pointer: the single piece of mutable static state in
- * the core, forced by cJSON's API. The port's lock (when given) serialises
- * loads of different engines running in different threads.
  */
 #include <string.h>
 #include <stdlib.h> /* qsort */
 #include <math.h>
-#include <cjson/cJSON.h>
 
 #include "base/geom.h"
 #include "base/lonlat.h"
@@ -41,22 +39,6 @@
 #define DEFAULT_GROUND_ALBEDO 0.15
 #define BLOCK_TOLERANCE 0.05
 #define MAX_IMAGE_PATH 4096
-
-static arena *json_arena; /* see the header comment */
-static int json_oom;
-
-static void *json_malloc(size_t n)
-{
-    void *p = json_arena ? arena_scratch(json_arena, n, 16) : NULL;
-    if (!p)
-        json_oom = 1;
-    return p;
-}
-
-static void json_free(void *p)
-{
-    (void)p; /* scratch is given back as a whole after the load */
-}
 
 /* ---- messages ----------------------------------------------------------- */
 
@@ -147,10 +129,10 @@ static plx_status parse_error(loader *ld, const char *at)
         sb_str(&b, ": ");
     }
     if (off < ld->len && (ld->text[off] == '[' || ld->text[off] == '{') &&
-        depth_at(ld, off) >= CJSON_NESTING_LIMIT) {
+        depth_at(ld, off) >= JSONSCAN_DEPTH) {
         /* well-formed maybe, but deeper than cJSON parses */
         sb_str(&b, "JSON nested deeper than ");
-        sb_uint(&b, CJSON_NESTING_LIMIT);
+        sb_uint(&b, JSONSCAN_DEPTH);
         sb_str(&b, " levels at byte ");
         sb_uint(&b, off);
         sb_str(&b, " (line ");
@@ -177,33 +159,20 @@ static int is_space(char c)
     return c == ' ' || c == '\t' || c == '\r' || c == '\n';
 }
 
-static plx_status parse_json(loader *ld, cJSON **root)
+/* Checks the whole text; a value followed by anything but white space (up
+ * to a NUL byte) is malformed. */
+static plx_status check_json(loader *ld)
 {
-    const char *end = NULL;
-    cJSON_Hooks hooks;
-    const plx_port *port = eng_port(ld->e);
-    int oom;
-    if (port->lock)
-        port->lock(port->ctx);
-    json_arena = ld->mem;
-    json_oom = 0;
-    hooks.malloc_fn = json_malloc;
-    hooks.free_fn = json_free;
-    cJSON_InitHooks(&hooks);
-    *root = cJSON_ParseWithLengthOpts(ld->text, ld->len, &end, 0);
-    cJSON_InitHooks(NULL);
-    json_arena = NULL;
-    oom = json_oom;
-    if (port->unlock)
-        port->unlock(port->ctx);
-    if (oom)
-        return eng_nomem(ld->e, "parsing JSON");
-    if (!*root)
-        return parse_error(ld, end);
-    while (end && (size_t)(end - ld->text) < ld->len && is_space(*end))
+    size_t end, p = 0;
+    if (!jsonscan_check(ld->text, ld->len, &end))
+        return parse_error(ld, ld->text + end);
+    while (end < ld->len && is_space(ld->text[end]))
         end++;
-    if (end && (size_t)(end - ld->text) < ld->len && *end != '\0')
-        return parse_error(ld, end);
+    if (end < ld->len && ld->text[end] != '\0')
+        return parse_error(ld, ld->text + end);
+    if (ld->len >= 5 && memcmp(ld->text, "\xEF\xBB\xBF", 3) == 0)
+        p = 3; /* a UTF-8 byte order mark */
+    ld->root = jsonscan_ws(ld->text, ld->len, p);
     return PLX_OK;
 }
 
@@ -212,12 +181,11 @@ static plx_status parse_json(loader *ld, cJSON **root)
 /* properties.ground_image (a path, kept as written: the core reads no
  * files) and properties.ground_image_bounds (kept in scene coordinates
  * until the frame is known; place_ground_image). */
-static plx_status read_ground_image(loader *ld, const cJSON *props)
+static plx_status read_ground_image(loader *ld, jv props)
 {
-    const cJSON *gi = cJSON_GetObjectItemCaseSensitive(props, "ground_image");
-    const cJSON *gb = cJSON_GetObjectItemCaseSensitive(props, "ground_image_bounds");
-    if (gi && !cJSON_IsNull(gi)) {
-        size_t n = cJSON_IsString(gi) ? strlen(gi->valuestring) : 0;
+    jv gi = ld_get(ld, props, "ground_image"), gb = ld_get(ld, props, "ground_image_bounds");
+    if (gi != JV_NONE && ld_kind(ld, gi) != JS_NULL) {
+        size_t n = ld_str(ld, gi, NULL, 0);
         if (n == 0 || n > MAX_IMAGE_PATH) {
             plx_status st = bad_top_property(ld, "properties.ground_image must be the path of a PNG file "
                                                  "(a non-empty string of at most 4096 bytes)");
@@ -227,17 +195,17 @@ static plx_status read_ground_image(loader *ld, const cJSON *props)
             char *path = arena_alloc(ld->mem, PLX_PART_SCENE, n + 1, 1);
             if (!path)
                 return eng_nomem(ld->e, "loading the scene");
-            memcpy(path, gi->valuestring, n + 1);
+            ld_str(ld, gi, path, n + 1);
             ld->s->ground_image = path;
         }
     }
-    if (gb && !cJSON_IsNull(gb)) {
+    if (gb != JV_NONE && ld_kind(ld, gb) != JS_NULL) {
         double v[4];
-        int i, ok = cJSON_IsArray(gb) && cJSON_GetArraySize(gb) == 4;
+        int i, ok = ld_kind(ld, gb) == JS_ARRAY && ld_count(ld, gb) == 4;
         for (i = 0; ok && i < 4; i++) {
-            const cJSON *it = cJSON_GetArrayItem(gb, i);
-            ok = cJSON_IsNumber(it) && isfinite(it->valuedouble);
-            v[i] = ok ? it->valuedouble : 0.0;
+            jv it = ld_item(ld, gb, (uint32_t)i);
+            ok = ld_kind(ld, it) == JS_NUMBER && isfinite(ld_double(ld, it));
+            v[i] = ok ? ld_double(ld, it) : 0.0;
         }
         if (!ok || !(v[0] < v[2] && v[1] < v[3]))
             return bad_top_property(ld, "properties.ground_image_bounds must be [x0, y0, x1, y1]: "
@@ -279,14 +247,15 @@ static plx_status place_ground_image(loader *ld)
 
 /* The CRS name of a GeoJSON 2008 "crs" member ({"type": "name",
  * "properties": {"name": "urn:ogc:def:crs:EPSG::2154"}}) or of
- * properties.crs (that object, or the name as a string); NULL if none. */
-static const char *crs_name(const cJSON *crs)
+ * properties.crs (that object, or the name as a string): the string value,
+ * JV_NONE if none. */
+static jv crs_name(const loader *ld, jv crs)
 {
-    const cJSON *name;
-    if (cJSON_IsString(crs))
-        return crs->valuestring;
-    name = cJSON_GetObjectItemCaseSensitive(cJSON_GetObjectItemCaseSensitive(crs, "properties"), "name");
-    return cJSON_IsString(name) ? name->valuestring : NULL;
+    jv name;
+    if (ld_kind(ld, crs) == JS_STRING)
+        return crs;
+    name = ld_get(ld, ld_get(ld, crs, "properties"), "name");
+    return ld_kind(ld, name) == JS_STRING ? name : JV_NONE;
 }
 
 /* 1 when the CRS names WGS84 lon/lat (EPSG:4326, OGC CRS84). */
@@ -301,66 +270,62 @@ static int crs_is_lonlat(const char *name)
 
 /* Keeps the scene's CRS (copied into the scene) and reads a projected one
  * as metres. */
-static plx_status read_crs(loader *ld, const cJSON *root, const cJSON *props)
+static plx_status read_crs(loader *ld, jv props)
 {
-    const cJSON *c = cJSON_GetObjectItemCaseSensitive(root, "crs");
-    const char *name = c ? crs_name(c) : NULL;
+    jv c = ld_get(ld, ld->root, "crs");
+    jv name = c != JV_NONE ? crs_name(ld, c) : JV_NONE;
     char *copy;
     size_t n;
-    if (!name && cJSON_IsObject(props))
-        name = crs_name(cJSON_GetObjectItemCaseSensitive(props, "crs"));
-    if (!name || !*name)
+    if (name == JV_NONE && ld_kind(ld, props) == JS_OBJECT)
+        name = crs_name(ld, ld_get(ld, props, "crs"));
+    n = name != JV_NONE ? ld_str(ld, name, NULL, 0) : 0;
+    if (n == 0)
         return PLX_OK;
-    n = strlen(name);
     if (n > 1000)
         return bad_top_property(ld, "the crs name is longer than 1000 bytes");
     copy = arena_alloc(ld->mem, PLX_PART_SCENE, n + 1, 1);
     if (!copy)
         return eng_nomem(ld->e, "keeping the scene's crs");
-    memcpy(copy, name, n + 1);
+    ld_str(ld, name, copy, n + 1);
     ld->s->crs = copy;
-    if (!crs_is_lonlat(name))
+    if (!crs_is_lonlat(copy))
         ld->metres = 1;
     return PLX_OK;
 }
 
-static plx_status read_collection(loader *ld, cJSON *root, cJSON **features)
+static plx_status read_collection(loader *ld, jv *features)
 {
-    cJSON *type, *props;
-    if (!cJSON_IsObject(root))
+    jv props, units, ga;
+    plx_status st;
+    if (ld_kind(ld, ld->root) != JS_OBJECT)
         return fail_scene(ld, "the top-level value is not a JSON object (expected a GeoJSON FeatureCollection)");
-    type = cJSON_GetObjectItemCaseSensitive(root, "type");
-    if (!cJSON_IsString(type) || strcmp(type->valuestring, "FeatureCollection") != 0)
+    if (!ld_str_is(ld, ld_get(ld, ld->root, "type"), "FeatureCollection"))
         return fail_scene(ld, "the top-level object is not a FeatureCollection (\"type\" must be \"FeatureCollection\")");
-    *features = cJSON_GetObjectItemCaseSensitive(root, "features");
-    if (!cJSON_IsArray(*features))
+    *features = ld_get(ld, ld->root, "features");
+    if (ld_kind(ld, *features) != JS_ARRAY)
         return fail_scene(ld, "the FeatureCollection has no \"features\" array");
-    props = cJSON_GetObjectItemCaseSensitive(root, "properties");
+    props = ld_get(ld, ld->root, "properties");
     ld->metres = 0;
     ld->s->ground_albedo = DEFAULT_GROUND_ALBEDO;
-    {
-        plx_status st = read_crs(ld, root, props);
-        if (st != PLX_OK)
-            return st;
+    st = read_crs(ld, props);
+    if (st != PLX_OK || ld_kind(ld, props) != JS_OBJECT)
+        return st;
+    units = ld_get(ld, props, "units");
+    ga = ld_get(ld, props, "ground_albedo");
+    if (units != JV_NONE) {
+        if (ld_str_is(ld, units, "m"))
+            ld->metres = 1;
+        else
+            return fail_scene(ld, "properties.units must be \"m\" (metres) when given; leave it out for WGS84 lon/lat");
     }
-    if (cJSON_IsObject(props)) {
-        cJSON *units = cJSON_GetObjectItemCaseSensitive(props, "units");
-        cJSON *ga = cJSON_GetObjectItemCaseSensitive(props, "ground_albedo");
-        if (units) {
-            if (cJSON_IsString(units) && strcmp(units->valuestring, "m") == 0)
-                ld->metres = 1;
-            else
-                return fail_scene(ld, "properties.units must be \"m\" (metres) when given; leave it out for WGS84 lon/lat");
-        }
-        if (ga) {
-            double v;
-            if (ld_number(ga, &v) != 1 || !(v >= 0.0 && v <= 1.0))
-                return fail_scene(ld, "properties.ground_albedo must be a number from 0 to 1");
-            ld->s->ground_albedo = v;
-        }
-        return read_ground_image(ld, props);
+    if (ga != JV_NONE) {
+        double v;
+        if (ld_number(ld, ga, &v) != 1 || !(v >= 0.0 && v <= 1.0))
+            return ld->oom ? eng_nomem(ld->e, "loading the scene")
+                           : fail_scene(ld, "properties.ground_albedo must be a number from 0 to 1");
+        ld->s->ground_albedo = v;
     }
-    return PLX_OK;
+    return read_ground_image(ld, props);
 }
 
 /* ---- the load --------------------------------------------------------------- */
@@ -421,24 +386,18 @@ static plx_status height_stats(plx_engine *e, arena *a, scene *s)
 
 static plx_status load(plx_engine *e, loader *ld, scene **out)
 {
-    cJSON *root = NULL, *features = NULL;
+    jv features = JV_NONE;
     plx_status st;
     scene *s = arena_calloc(ld->mem, PLX_PART_SCENE, 1, sizeof *s, 16);
     if (!s)
         return eng_nomem(e, "loading the scene");
     ld->s = s;
-    st = parse_json(ld, &root);
+    st = check_json(ld);
     if (st != PLX_OK)
         return st;
-    st = read_collection(ld, root, &features);
+    st = read_collection(ld, &features);
     if (st != PLX_OK)
         return st;
-    ld->nfeat = (uint32_t)cJSON_GetArraySize(features);
-    ld->feat_line = arena_scratch(ld->mem, arena_mul(ld->nfeat + 1u, sizeof(uint32_t)), 4);
-    ld->feat_col = arena_scratch(ld->mem, arena_mul(ld->nfeat + 1u, sizeof(uint32_t)), 4);
-    if (!ld->feat_line || !ld->feat_col)
-        return eng_nomem(e, "indexing feature lines");
-    jsonscan_feature_lines(ld->text, ld->len, ld->feat_line, ld->feat_col, ld->nfeat);
     st = ld_features(ld, features);
     if (st != PLX_OK)
         return st;
@@ -468,7 +427,13 @@ plx_status geojson_load(plx_engine *e, arena *a, const char *text, size_t len, c
                         scene **out)
 {
     loader ld;
+    ld_cache cache;
+    int i;
     memset(&ld, 0, sizeof ld);
+    memset(&cache, 0, sizeof cache);
+    for (i = 0; i < LD_OBJECTS; i++)
+        cache.obj[i].obj = JV_NONE;
+    ld.cache = &cache;
     ld.e = e;
     ld.mem = a;
     ld.name = name;

@@ -3,6 +3,7 @@
  * (strict or lenient, SPEC §1), numbers in properties. */
 #include <math.h>
 #include <string.h>
+#include <stdlib.h> /* strtod */
 
 #include "scene/loader.h"
 
@@ -125,37 +126,56 @@ static int parse_number_text(const char *s, double *out)
     return 1;
 }
 
-/* 1: a number (JSON number or numeric string), 0: absent/null, -1: other. */
-int ld_number(const cJSON *item, double *out)
+/* 1: a number (JSON number or numeric string), 0: absent/null, -1: other.
+ * A numeric string longer than a line is unescaped into scratch memory;
+ * when that fails, ld->oom is set and the value reads as absent. */
+int ld_number(loader *ld, jv item, double *out)
 {
-    if (!item || cJSON_IsNull(item))
+    char small[256], *text = small;
+    size_t n;
+    int r;
+    arena_mark m;
+    js_kind k = ld_kind(ld, item);
+    if (k == JS_NONE || k == JS_NULL)
         return 0;
-    if (cJSON_IsNumber(item)) {
-        *out = item->valuedouble;
+    if (k == JS_NUMBER) {
+        *out = ld_double(ld, item);
         return 1;
     }
-    if (cJSON_IsString(item) && parse_number_text(item->valuestring, out))
-        return 1;
-    return -1;
+    if (k != JS_STRING)
+        return -1;
+    n = ld_str(ld, item, small, sizeof small);
+    m = arena_get_mark(ld->mem);
+    if (n >= sizeof small) {
+        text = arena_scratch(ld->mem, n + 1, 1);
+        if (!text) {
+            ld->oom = 1;
+            return 0;
+        }
+        ld_str(ld, item, text, n + 1);
+    }
+    r = parse_number_text(text, out) ? 1 : -1;
+    arena_release(ld->mem, &m);
+    return r;
 }
 
 /* A numeric property: 1 found, 0 absent; a value of the wrong kind is
  * ignored with a warning (SPEC §1) and reads as absent. */
-int ld_prop_number(loader *ld, uint32_t fi, const char *id, const cJSON *props,
-                   const char *key, double *out)
+int ld_prop_number(loader *ld, uint32_t fi, const char *id, jv props, const char *key, double *out)
 {
-    const cJSON *item = props ? cJSON_GetObjectItemCaseSensitive(props, key) : NULL;
-    int r = ld_number(item, out);
+    jv item = ld_get(ld, props, key);
+    int r = ld_number(ld, item, out);
     if (r == -1) {
-        char why[200];
+        char why[200], head[41];
         strbuf b;
         sb_init(&b, why, sizeof why);
         sb_str(&b, "property \"");
         sb_str(&b, key);
         sb_str(&b, "\" is not a number");
-        if (cJSON_IsString(item)) {
+        if (ld_kind(ld, item) == JS_STRING) {
+            ld_str(ld, item, head, sizeof head);
             sb_str(&b, " (\"");
-            sb_strn(&b, item->valuestring, 40);
+            sb_str(&b, head);
             sb_str(&b, "\")");
         }
         sb_str(&b, "; ignored, the default applies");
@@ -165,3 +185,123 @@ int ld_prop_number(loader *ld, uint32_t fi, const char *id, const cJSON *props,
     return r;
 }
 
+/* ---- JSON values in place ------------------------------------------------------ */
+
+js_kind ld_kind(const loader *ld, jv v)
+{
+    return jsonscan_kind(ld->text, v);
+}
+
+static ld_members *members_of(const loader *ld, jv obj)
+{
+    ld_cache *c = ld->cache;
+    ld_members *m;
+    uint32_t i;
+    for (i = 0; i < LD_OBJECTS; i++)
+        if (c->obj[i].obj == obj)
+            return &c->obj[i];
+    m = &c->obj[c->turn];
+    c->turn = (c->turn + 1) % LD_OBJECTS;
+    m->obj = obj;
+    m->n = 0;
+    m->done = 0;
+    m->next = jsonscan_ws(ld->text, ld->len, obj + 1);
+    if (m->next >= ld->len || ld->text[m->next] != '"')
+        m->done = 1;
+    return m;
+}
+
+/* Finds one more member of m's object; 0 when there is none. The value of
+ * the last member found is skipped only when a member after it is asked
+ * for (a feature's coordinates are not skipped to find its geometry). */
+static int members_more(const loader *ld, ld_members *m)
+{
+    const char *t = ld->text;
+    size_t p = m->next, v;
+    if (m->done)
+        return 0;
+    if (p == JV_NONE) {
+        p = jsonscan_ws(t, ld->len, jsonscan_skip(t, ld->len, m->val[m->n - 1]));
+        if (p >= ld->len || t[p] != ',') {
+            m->done = 1;
+            return 0;
+        }
+        p = jsonscan_ws(t, ld->len, p + 1);
+    }
+    if (m->n == LD_MEMBERS) {
+        m->done = -1;
+        return 0;
+    }
+    v = jsonscan_ws(t, ld->len, jsonscan_skip(t, ld->len, p)); /* the ':' after the key */
+    v = jsonscan_ws(t, ld->len, v + 1);
+    m->key[m->n] = p;
+    m->val[m->n++] = v;
+    m->next = JV_NONE;
+    return 1;
+}
+
+jv ld_get(const loader *ld, jv obj, const char *key)
+{
+    ld_members *m;
+    uint32_t i;
+    if (!ld->cache || ld_kind(ld, obj) != JS_OBJECT)
+        return jsonscan_get(ld->text, ld->len, obj, key);
+    m = members_of(ld, obj);
+    for (i = 0;; i++) {
+        if (i == m->n && !members_more(ld, m))
+            break;
+        if (jsonscan_key_is(ld->text, ld->len, m->key[i], key))
+            return m->val[i];
+    }
+    return m->done < 0 ? jsonscan_get(ld->text, ld->len, obj, key) : JV_NONE;
+}
+
+jv ld_first(const loader *ld, jv c)
+{
+    return jsonscan_first(ld->text, ld->len, c);
+}
+
+jv ld_next(const loader *ld, jv c, jv child)
+{
+    return jsonscan_next(ld->text, ld->len, child, ld->text[c] == '{');
+}
+
+uint32_t ld_count(const loader *ld, jv c)
+{
+    uint32_t n = 0;
+    jv it;
+    LD_EACH(ld, c, it)
+        n++;
+    return n;
+}
+
+jv ld_item(const loader *ld, jv c, uint32_t i)
+{
+    jv it;
+    LD_EACH(ld, c, it)
+        if (i-- == 0)
+            return it;
+    return JV_NONE;
+}
+
+/* The checked text holds a number here, ended by a byte strtod stops at
+ * (',', ']', '}' or white space: numbers are read inside containers only). */
+double ld_double(const loader *ld, jv v)
+{
+    return strtod(ld->text + v, NULL);
+}
+
+int ld_str_is(const loader *ld, jv v, const char *s)
+{
+    return jsonscan_string_is(ld->text, ld->len, v, s);
+}
+
+size_t ld_str(const loader *ld, jv v, char *buf, size_t cap)
+{
+    if (ld_kind(ld, v) != JS_STRING) {
+        if (cap)
+            buf[0] = '\0';
+        return 0;
+    }
+    return jsonscan_string(ld->text, ld->len, v, buf, cap);
+}
