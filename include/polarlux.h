@@ -105,7 +105,20 @@ typedef struct plx_port {
      * tables still compile. */
     void (*lock)(void *ctx);
     void (*unlock)(void *ctx);
+    /* A parallel-for (NULL: everything runs on the calling thread): calls
+     * job(arg, worker, k) once for each k = 0 .. njobs-1 on up to 'workers'
+     * threads (worker in 0 .. workers-1 names the thread; the calls of one
+     * worker come one after another; the calling thread may be one of
+     * them) and returns when all are done, in any order. Returns 0, or -1
+     * when it ran no job (the core then runs them itself). */
+    int (*parallel_for)(void *ctx, int workers, uint32_t njobs,
+                        void (*job)(void *arg, int worker, uint32_t k), void *arg);
+    /* The number of processors: the default number of workers (NULL: 1). */
+    int (*cores)(void *ctx);
 } plx_port;
+
+/* Most workers the core asks a parallel-for for. */
+#define PLX_MAX_THREADS 16
 
 typedef struct plx_config {
     const plx_port *port;             /* NULL: no platform services */
@@ -122,6 +135,9 @@ typedef struct plx_config {
     size_t photon_bytes;              /* the photon buffers' budget (0: from the budget, half the free
                                          bytes when they are first needed); their quality is lowered
                                          step by step until they fit (plx_indirect_info_get) */
+    int threads;                      /* workers of a frame's shading (port.parallel_for): 0 = the
+                                         port's cores, 1 = the calling thread only, at most
+                                         PLX_MAX_THREADS; the results are the same bytes for any */
 } plx_config;
 
 /* Fills cfg with the defaults: no port, lenient loading, no part limits

@@ -24,6 +24,7 @@ typedef struct cli_common {
     const char *lamp_files[CLI_MAX_LAMP_FILES]; /* --lamps FILE, in order */
     int nlamp_files;
     const char *points_crs; /* --points-crs: lonlat, local, or a CRS name (NULL: the file says, or the scene's) */
+    int threads;     /* --threads N: workers of a frame (0: the number of processors) */
 } cli_common;
 
 #define CLI_DEFAULT_MEM ((size_t)1 << 30)

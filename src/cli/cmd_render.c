@@ -19,7 +19,8 @@
 static const char help[] =
     "usage: polarlux render SCENE [--eye X,Y,Z --target X,Y,Z] [--fov DEG] [--size WxH]\n"
     "                       [--view street|aerial] [--backend soft|osmesa] [--exposure E]\n"
-    "                       [--no-indirect] [--no-glow] [--aa N] [--texel M] -o OUT.png [--pfm OUT.pfm]\n"
+    "                       [--no-indirect] [--no-glow] [--aa N] [--texel M] [--threads N]\n"
+    "                       -o OUT.png [--pfm OUT.pfm]\n"
     "\n"
     "Renders the scene at night through a pinhole camera (SPEC §5: up is +z,\n"
     "vertical field of view, pixel centres): ground, facades and roofs lit by\n"
@@ -59,6 +60,8 @@ static const char help[] =
     "                   an OSMesa buffer; " OSMESA_STATE "); the same image\n"
     "  -o FILE          output PNG (required)\n"
     "  --pfm FILE       also write the linear radiance as PFM\n"
+    "  --threads N      threads for the frame (default: the number of processors);\n"
+    "                   the same bytes for any N\n"
     "  --mem SIZE, --strict, --quiet, --lamps FILE   as for 'polarlux info'\n";
 
 typedef struct render_args {

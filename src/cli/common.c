@@ -116,6 +116,17 @@ int cli_common_option(const char *cmd, int argc, char **argv, int *i, cli_common
         c->lamp_files[c->nlamp_files++] = argv[++*i];
         return 1;
     }
+    if (strcmp(a, "--threads") == 0) {
+        char *end = NULL;
+        long n = *i + 1 < argc ? strtol(argv[*i + 1], &end, 10) : 0;
+        if (*i + 1 >= argc || end == argv[*i + 1] || *end != '\0' || n < 1 || n > PLX_MAX_THREADS) {
+            cli_usage_error(cmd, "--threads needs a number of threads from 1 to %d", PLX_MAX_THREADS);
+            return -1;
+        }
+        ++*i;
+        c->threads = (int)n;
+        return 1;
+    }
     if (strcmp(a, "--mem") == 0) {
         if (*i + 1 >= argc) {
             cli_usage_error(cmd, "--mem needs a size, e.g. --mem 512M");
@@ -324,6 +335,7 @@ void cli_config(const cli_common *c, plx_config *cfg)
     cfg->strict = c->strict;
     cfg->render_max_width = c->render_w;
     cfg->render_max_height = c->render_h;
+    cfg->threads = c->threads;
 }
 
 cli_bake_state cli_bake_last;

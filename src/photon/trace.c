@@ -623,7 +623,6 @@ static void cell_test(tracer *T, size_t c, double za, double zb, const double o[
     if (zlo > C->top)
         return; /* above every roof in the cell */
     k1 = C[1].w0;
-    T->tests += k1 - C->w0;
     for (k = C->w0; k < k1; k++) {
         uint32_t e = T->wids[k];
         const trace_wall *w = &T->walls[e];
@@ -690,7 +689,6 @@ static void ray_begin(tracer *T, const double o[3], const double d[3], double tm
             bs->kind = TRACE_GROUND;
         }
     }
-    T->rays++;
 }
 
 /* Cuts [*t0, *t1] to the slab lo <= o + t d <= hi of one axis (inv = 1 / d);
@@ -831,7 +829,6 @@ int trace_lamp_ray(tracer *T, uint32_t lamp, const double d[3], trace_hit *h)
     if (d[0] != 0.0 || d[1] != 0.0) {
         uint32_t sk = sector_of(d[0], d[1]);
         k1 = sec[sk + 1];
-        T->tests += k1 - sec[sk];
         for (k = sec[sk]; k < k1; k++)
             wall_test(&T->walls[T->lref[k]], T->lref[k], o, d, &bs);
     }
@@ -884,7 +881,6 @@ int trace_ray_brute(tracer *T, const double o[3], const double d[3], double tmax
             const scene_ring *R = &s->rings[B->ring_first + r];
             uint32_t k;
             for (k = 0; k < R->count; k++) {
-                T->tests++;
                 wall_test(&T->walls[R->first + k], R->first + k, o, d, &bs);
             }
         }
