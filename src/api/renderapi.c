@@ -5,11 +5,13 @@
 #include "light/illuminance.h"
 #include "light/litregion.h"
 #include "render/render.h"
+#include "photon/trace.h"
+#include "photon/photon.h"
 #include "photon/irradiance_cache.h"
 
 #define DEFAULT_MAX_W 1920
 #define DEFAULT_MAX_H 1080
-#define LIGHTMAP_MAX_BYTES ((size_t)48 << 20) /* plx_config.lightmap_bytes 0 */
+#define LIGHTMAP_MAX_BYTES ((size_t)48 << 20) /* plx_config.lightmap_bytes 0: at most this */
 
 void plx_render_opts_default(plx_render_opts *o)
 {
@@ -19,6 +21,12 @@ void plx_render_opts_default(plx_render_opts *o)
     o->exposure = 1.0;
 }
 
+/* Whether images read the irradiance cache (shade_indirect). */
+static int icache_on(const plx_engine *e)
+{
+    return e->ic && e->lt && !(e->gather_set && e->gather_side == 0);
+}
+
 /* The photon hook of the renderer: the RGB indirect term (each lamp's light
  * weighted by its colour; SPEC §5) from the irradiance cache (final
  * gathers at sparse points of each surface, irradiance_cache.h), or the
@@ -26,12 +34,40 @@ void plx_render_opts_default(plx_render_opts *o)
 static void shade_indirect(void *user, const double P[3], const double n[3], double rgb[3])
 {
     plx_engine *e = user;
-    if (e->ic && e->lt && !(e->gather_set && e->gather_side == 0))
+    if (icache_on(e))
         icache_lookup(e->ic, e->ph, e->lt, P, n, rgb);
     else
         eng_indirect_photons_rgb(e, P, n, rgb);
 }
 
+/* The photon buffers alone: what the aerial indirect map is built from
+ * (they do not depend on the eye, and are only read: safe on workers). */
+static void shade_photons(void *user, const double P[3], const double n[3], double rgb[3])
+{
+    eng_indirect_photons_rgb(user, P, n, rgb);
+}
+
+/* The indirect ground map's surface height (the photon tracer's topmost
+ * roof over the point, or 0: what the aerial chart is taken on). */
+static double top_height(void *user, double x, double y)
+{
+    plx_engine *e = user;
+    return e->ph ? trace_top(e->ph->T, x, y, NULL) : 0.0;
+}
+
+/* The port's parallel-for and the number of workers for a frame
+ * (plx_config.threads; 0: the port's cores). */
+static void set_workers(const plx_engine *e, render_opts *ro)
+{
+    int n = e->cfg.threads;
+    if (!e->port.parallel_for)
+        return;
+    if (n <= 0)
+        n = e->port.cores ? e->port.cores(e->port.ctx) : 1;
+    ro->par = e->port.parallel_for;
+    ro->par_ctx = e->port.ctx;
+    ro->workers = n < 1 ? 1 : n > PLX_MAX_THREADS ? PLX_MAX_THREADS : n;
+}
 
 plx_status eng_need_render(plx_engine *e)
 {
@@ -48,6 +84,15 @@ static void shade_none(void *user, const double P[3], const double n[3], double 
     rgb[0] = rgb[1] = rgb[2] = 0.0;
 }
 
+/* The light map's budget when plx_config.lightmap_bytes is 0: half the
+ * block's free bytes when it is built, at most LIGHTMAP_MAX_BYTES (its
+ * texel grows until it fits, render_lightmap_build). */
+static size_t default_lightmap(const plx_engine *e)
+{
+    size_t half = arena_free_bytes(&e->mem) / 2;
+    return half < 12 ? 12 : half < LIGHTMAP_MAX_BYTES ? half : LIGHTMAP_MAX_BYTES;
+}
+
 plx_status eng_need_lightmap(plx_engine *e, double m_per_texel, int dark)
 {
     double cell = m_per_texel > 0 ? m_per_texel : 1.0;
@@ -56,7 +101,14 @@ plx_status eng_need_lightmap(plx_engine *e, double m_per_texel, int dark)
         return st;
     if (dark)
         render_code_bind(e->rd, shade_none);
-    st = render_lightmap_build(e->rd, cell, e->cfg.lightmap_bytes ? e->cfg.lightmap_bytes : LIGHTMAP_MAX_BYTES);
+    {
+        render_opts ro;
+        render_opts_default(&ro);
+        ro.workers = 1;
+        set_workers(e, &ro);
+        st = render_lightmap_build_par(e->rd, cell, e->cfg.lightmap_bytes ? e->cfg.lightmap_bytes : default_lightmap(e),
+                                       ro.par, ro.par_ctx, ro.workers);
+    }
     if (dark)
         render_code_bind(e->rd, render_shade_light);
     if (st == PLX_E_NOMEM)
@@ -162,7 +214,16 @@ plx_status plx_render(plx_engine *e, const plx_camera *cam, const plx_render_opt
         ro.indirect_user = e;
         if (e->ic)
             icache_set_view(e->ic, rc.eye);
+        /* the photon buffers are only read (indirect.c), so that hook may run
+         * on several workers; the irradiance cache fills its table and asks
+         * the light object as it reads: one thread */
+        ro.indirect_mt = !icache_on(e);
+        ro.indirect_map = 1;  /* aerial ground and roofs: the indirect ground map (render/indmap.h) */
+        ro.indirect_far = shade_photons;
+        ro.indirect_key = e->indirect_gen;
+        ro.top = top_height;
     }
+    set_workers(e, &ro);
     if (o->aa > 1)
         st = render_aa(e, &rc, &ro, o->aa, rgb8, rgbf, &rs);
     else

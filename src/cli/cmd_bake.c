@@ -9,7 +9,8 @@
 
 static const char help[] =
     "usage: polarlux bake SCENE -o CITY.plxb [--photons N] [--frames K] [--no-indirect]\n"
-    "                     [--no-aerial] [--texel M] [--max-size WxH] [--mem SIZE] [--strict] [--quiet]\n"
+    "                     [--no-aerial] [--texel M] [--max-size WxH] [--threads N] [--mem SIZE]\n"
+    "                     [--strict] [--quiet]\n"
     "\n"
     "Loads SCENE and builds everything queries and frames need: polar diagrams,\n"
     "lamp light, photon buffers with K frames of N photons (levels for a viewer\n"
@@ -26,6 +27,8 @@ static const char help[] =
     "  --no-aerial     no aerial light map\n"
     "  --texel M       aerial light map resolution (default 1 m, coarser if the budget needs)\n"
     "  --max-size WxH  the largest frame the loaded engine renders (default 1024x768)\n"
+    "  --threads N     threads for the aerial light map (default: the number of\n"
+    "                  processors); the same map for any N\n"
     "  --mem SIZE, --strict, --quiet   as for 'polarlux info'\n"
     "\n"
     "Exit codes: 0 written, 1 the scene or the file failed, 2 usage, 3 --mem too small.\n";

@@ -20,7 +20,8 @@
 static const char help[] =
     "usage: polarlux render SCENE [--eye X,Y,Z --target X,Y,Z] [--fov DEG] [--size WxH]\n"
     "                       [--view street|aerial] [--backend soft|osmesa] [--exposure E]\n"
-    "                       [--no-indirect] [--no-glow] [--aa N] [--texel M] -o OUT.png [--pfm OUT.pfm]\n"
+    "                       [--no-indirect] [--no-glow] [--aa N] [--texel M] [--threads N]\n"
+    "                       -o OUT.png [--pfm OUT.pfm]\n"
     "\n"
     "Renders the scene at night through a pinhole camera (SPEC §5: up is +z,\n"
     "vertical field of view, pixel centres): ground, facades and roofs lit by\n"
@@ -60,6 +61,8 @@ static const char help[] =
     "                   an OSMesa buffer; " OSMESA_STATE "); the same image\n"
     "  -o FILE          output PNG (required)\n"
     "  --pfm FILE       also write the linear radiance as PFM\n"
+    "  --threads N      threads for the frame (default: the number of processors);\n"
+    "                   the same bytes for any N\n"
     "  --mem SIZE, --strict, --quiet, --lamps FILE   as for 'polarlux info'\n";
 
 typedef struct render_args {
@@ -199,6 +202,9 @@ static int default_street(plx_engine *e, plx_camera *cam)
     lamp_rank *r;
     double cx, cy, best = INFINITY;
     uint32_t i, n;
+    plx_status st = plx_polar_build(e); /* the search below asks for visibility */
+    if (st != PLX_OK)
+        return st == PLX_E_NOMEM ? -2 : -1;
     plx_scene_info_get(e, &si);
     cx = 0.5 * (si.bounds[0] + si.bounds[2]);
     cy = 0.5 * (si.bounds[1] + si.bounds[3]);
@@ -321,7 +327,11 @@ int cmd_render(int argc, char **argv)
     if (!a.have_eye) {
         if (a.aerial) {
             default_aerial(e, &a.cam);
-        } else if (default_street(e, &a.cam) != 0) {
+        } else if ((rc = default_street(e, &a.cam)) == -2) {
+            fprintf(stderr, "polarlux render: %s\n", plx_last_error(e));
+            plx_engine_free(e);
+            return EXIT_NOMEM;
+        } else if (rc != 0) {
             plx_scene_info si;
             plx_scene_info_get(e, &si);
             if (si.lamps == 0)

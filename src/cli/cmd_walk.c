@@ -14,10 +14,11 @@
 static const char help[] =
     "usage: polarlux walk SCENE|BAKE --path CAMERA.geojson -o DIR [--size WxH] [--fps F]\n"
     "                     [--speed M/S] [--fov DEG] [--aa N] [--exposure E] [--no-glow]\n"
-    "                     [--no-indirect] [--view street|aerial] [--max-frames N]\n"
+    "                     [--no-indirect] [--view street|aerial] [--max-frames N] [--threads N]\n"
     "\n"
     "Renders frames along a camera path and writes DIR/frame-0001.png ...,\n"
-    "DIR/cameras.txt (frame, eye, target) and DIR/contact.png (a contact sheet\n"
+    "DIR/cameras.txt (frame, eye, target), DIR/walk.png (the frames as an animated\n"
+    "PNG, 1/F s each, looping) and DIR/contact.png (a contact sheet\n"
     "of up to 16 frames). Everything is built once (or loaded from a bake) and\n"
     "reused by every frame. Prints the render time per frame (median, p95)\n"
     "and frames per second.\n"
@@ -38,6 +39,8 @@ static const char help[] =
     "                   pushed into the aerial map; then --refine-frames K photon\n"
     "                   frames (default 2) refill the aerial chart. Prints the cache's\n"
     "                   hits, misses and evictions\n"
+    "  --threads N      threads for each frame (default: the number of processors);\n"
+    "                   the same bytes for any N\n"
     "  --mem SIZE, --strict, --quiet   as for 'polarlux info'\n";
 
 typedef struct walk_args {
@@ -159,6 +162,33 @@ static int contact_sheet(const walk_args *a, uint8_t *const *thumbs, int nthumb,
     return rc;
 }
 
+/* The animated PNG DIR/walk.png from the n frame files, 1/fps s each. */
+static int animation(const walk_args *a, long n, char *err, size_t errlen)
+{
+    char path[4096], **names = calloc((size_t)n, sizeof *names);
+    double d = 1000.0 / a->fps;
+    unsigned num = d < 1.0 ? 1u : d > 65535.0 ? 65535u : (unsigned)(d + 0.5);
+    long k;
+    int rc = -1;
+    if (!names)
+        return snprintf(err, errlen, "out of memory for the animation"), -1;
+    for (k = 0; k < n; k++) {
+        names[k] = malloc(strlen(a->dir) + 32);
+        if (!names[k])
+            break;
+        sprintf(names[k], "%s/frame-%04ld.png", a->dir, k + 1);
+    }
+    snprintf(path, sizeof path, "%s/walk.png", a->dir);
+    if (k == n)
+        rc = image_write_apng(path, (const char *const *)names, (int)n, num, 1000, err, errlen);
+    else
+        snprintf(err, errlen, "out of memory for the animation");
+    for (k = 0; k < n; k++)
+        free(names[k]);
+    free(names);
+    return rc;
+}
+
 typedef struct walk_run {
     long n;
     double *ms;
@@ -240,6 +270,10 @@ static int run(const walk_args *a, plx_engine *e, const walk_path *wp)
     for (f = 1; a->w / f > 400; f++)
         ;
     if (rc == EXIT_OK && contact_sheet(a, wr.thumbs, wr.nthumb, f, err, sizeof err) != 0) {
+        fprintf(stderr, "polarlux walk: %s\n", err);
+        rc = EXIT_FAIL;
+    }
+    if (rc == EXIT_OK && animation(a, wr.n, err, sizeof err) != 0) {
         fprintf(stderr, "polarlux walk: %s\n", err);
         rc = EXIT_FAIL;
     }
