@@ -105,7 +105,20 @@ typedef struct plx_port {
      * tables still compile. */
     void (*lock)(void *ctx);
     void (*unlock)(void *ctx);
+    /* A parallel-for (NULL: everything runs on the calling thread): calls
+     * job(arg, worker, k) once for each k = 0 .. njobs-1 on up to 'workers'
+     * threads (worker in 0 .. workers-1 names the thread; the calls of one
+     * worker come one after another; the calling thread may be one of
+     * them) and returns when all are done, in any order. Returns 0, or -1
+     * when it ran no job (the core then runs them itself). */
+    int (*parallel_for)(void *ctx, int workers, uint32_t njobs,
+                        void (*job)(void *arg, int worker, uint32_t k), void *arg);
+    /* The number of processors: the default number of workers (NULL: 1). */
+    int (*cores)(void *ctx);
 } plx_port;
+
+/* Most workers the core asks a parallel-for for. */
+#define PLX_MAX_THREADS 16
 
 typedef struct plx_config {
     const plx_port *port;             /* NULL: no platform services */
@@ -116,8 +129,16 @@ typedef struct plx_config {
     int32_t render_max_width;         /* largest frame plx_render draws (0: 1920) */
     int32_t render_max_height;        /* (0: 1080) */
     size_t lightmap_bytes;            /* the aerial light map's budget (12 bytes a texel, 28 with its
-                                         indirect layer (README "Aerial views' indirect light"); the texel
-                                         grows from the one asked for until the map fits; 0: 48 MiB) */
+                                         indirect layer (README "Aerial views' indirect light"); the
+                                         texel grows from the one asked for until the map fits; 0:
+                                         from the budget, half the free bytes when the map is built,
+                                         at most 48 MiB) */
+    size_t photon_bytes;              /* the photon buffers' budget (0: from the budget, half the free
+                                         bytes when they are first needed); their quality is lowered
+                                         step by step until they fit (plx_indirect_info_get) */
+    int threads;                      /* workers of a frame's shading (port.parallel_for): 0 = the
+                                         port's cores, 1 = the calling thread only, at most
+                                         PLX_MAX_THREADS; the results are the same bytes for any */
 } plx_config;
 
 /* Fills cfg with the defaults: no port, lenient loading, no part limits
@@ -526,6 +547,23 @@ uint64_t plx_indirect_frames(const plx_engine *e);
  * (eye NULL), PLX_E_NOMEM. Creates the photon buffers on first need.
  * Threads: engine. */
 plx_status plx_indirect_set_viewer(plx_engine *e, const double eye[3], const double dir[3], double fov_deg);
+/* The sizes the photon buffers were given (README "Memory budgets"). */
+typedef struct plx_indirect_info {
+    size_t bytes;               /* held by the photon buffers (part PLX_PART_PHOTON) */
+    size_t full_bytes;          /* what the default quality would take */
+    size_t budget;              /* the budget they were fitted to */
+    uint32_t reductions;        /* quality steps taken to fit (0: the default quality) */
+    int lamp_tables;            /* 1: the ray caster keeps per-lamp tables (0: same light, slower) */
+    uint32_t chart_w, chart_h;  /* facade chart texels at the finest level (default 256 x 32) */
+    uint32_t aerial_w, aerial_h; /* ground and roof chart texels */
+    double aerial_texel;        /* its texel side, m */
+    uint32_t lamp_slots;        /* floor maps the near-viewer cache holds */
+} plx_indirect_info;
+
+/* Fills out once the photon buffers exist. Errors: PLX_E_INVALID (out
+ * NULL), PLX_E_NOSCENE (no photon buffers yet). Threads: engine (reads). */
+plx_status plx_indirect_info_get(plx_engine *e, plx_indirect_info *out /* OUT */);
+
 /* Drops every accumulated photon (none yet: nothing to do). Errors: only
  * the invalid handle. Threads: engine. */
 plx_status plx_indirect_reset(plx_engine *e);

@@ -18,6 +18,11 @@ int port_open_input(const char *path, size_t *size, char *err, size_t errlen);
 /* Writes data to path through a temporary file renamed into place, so a
  * crash never leaves a half-written file. 0 on success, else -1 and err. */
 int port_write_atomic(const char *path, const void *data, size_t len, char *err, size_t errlen);
+/* plx_port_posix's parallel-for (pthreads, port/posix/parallel.c) and
+ * processor count (sysconf, 1 .. PLX_MAX_THREADS). */
+int port_parallel_for(void *ctx, int workers, uint32_t njobs, void (*job)(void *arg, int worker, uint32_t k),
+                      void *arg);
+int port_cores(void *ctx);
 /* Monotonic clock in nanoseconds. */
 unsigned long long port_now_ns(void);
 

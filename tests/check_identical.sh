@@ -50,7 +50,7 @@ IN=$OUT/in
 # scene derived from its bounds.
 "$CACHE/polarlux" gen eixample 6 6 -o "$IN/gen-eixample-6x6.geojson" || exit 2
 "$CACHE/polarlux" gen oldtown 8 8 -o "$IN/gen-oldtown-8x8.geojson" || exit 2
-SCENES="$(ls fixtures/*.geojson | grep -v -- '-route\.geojson$') $IN/gen-eixample-6x6.geojson $IN/gen-oldtown-8x8.geojson"
+SCENES="$(ls fixtures/*.geojson | grep -v -- '-route\.geojson$' | grep -v -- '-walk\.geojson$') $IN/gen-eixample-6x6.geojson $IN/gen-oldtown-8x8.geojson"
 
 # bounds X0 Y0 X1 Y1 of a scene, from 'info'
 bounds() {

@@ -35,6 +35,16 @@ int image_write_png_rgb8(const char *path, int width, int height, const uint8_t 
                          int stride, char *err, size_t errlen);
 
 /*
+ * Writes an animated PNG (APNG, looping forever) at path from the n PNG
+ * files frames[0..n-1], all of one size and format (as image_write_png_rgb8
+ * writes them), each shown delay_num / delay_den seconds (each below
+ * 65536). The frames' compressed data is copied, not encoded again; a
+ * viewer without APNG shows the first frame (port/png/apng.c).
+ */
+int image_write_apng(const char *path, const char *const *frames, int n, unsigned delay_num, unsigned delay_den,
+                     char *err, size_t errlen);
+
+/*
  * Writes a colour PFM: header "PF\n<width> <height>\n-1.0\n" (negative
  * scale = little-endian), then width*height*3 IEEE floats in little-endian
  * byte order on every host, rows from the bottom of the image to the top as

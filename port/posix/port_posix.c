@@ -120,6 +120,7 @@ static void posix_unlock(void *ctx)
 
 static const plx_port posix_port = {
     NULL, posix_clock, posix_log, posix_file_size, posix_file_read, posix_lock, posix_unlock,
+    port_parallel_for, port_cores,
 };
 
 const plx_port *plx_port_posix(void)

@@ -27,13 +27,16 @@ LOG_FN = ctypes.CFUNCTYPE(None, ctypes.c_void_p, ctypes.c_int, ctypes.c_char_p)
 class Port(ctypes.Structure):
     _fields_ = [("ctx", ctypes.c_void_p), ("clock_ns", ctypes.c_void_p), ("log", LOG_FN),
                 ("file_size", ctypes.c_void_p), ("file_read", ctypes.c_void_p),
-                ("lock", ctypes.c_void_p), ("unlock", ctypes.c_void_p)]
+                ("lock", ctypes.c_void_p), ("unlock", ctypes.c_void_p),
+                ("parallel_for", ctypes.c_void_p), ("cores", ctypes.c_void_p)]
 
 
 class Config(ctypes.Structure):
     _fields_ = [("port", ctypes.POINTER(Port)), ("strict", ctypes.c_int),
                 ("part_budget", ctypes.c_size_t * PART_COUNT), ("lit_cache_bytes", ctypes.c_size_t),
-                ("render_max_width", ctypes.c_int32), ("render_max_height", ctypes.c_int32)]
+                ("render_max_width", ctypes.c_int32), ("render_max_height", ctypes.c_int32),
+                ("lightmap_bytes", ctypes.c_size_t), ("photon_bytes", ctypes.c_size_t),
+                ("threads", ctypes.c_int)]
 
 
 class SceneInfo(ctypes.Structure):
@@ -65,12 +68,14 @@ class Camera(ctypes.Structure):
 class RenderOpts(ctypes.Structure):
     _fields_ = [("exposure", ctypes.c_double), ("no_glow", ctypes.c_int), ("aerial", ctypes.c_int),
                 ("aerial_m_per_texel", ctypes.c_double), ("no_cull", ctypes.c_int),
-                ("no_indirect", ctypes.c_int), ("backend", ctypes.c_void_p)]
+                ("no_indirect", ctypes.c_int), ("backend", ctypes.c_void_p),
+                ("auto_exposure", ctypes.c_int), ("aa", ctypes.c_int)]
 
 
 class RenderInfo(ctypes.Structure):
     _fields_ = [("buildings", ctypes.c_uint32), ("drawn", ctypes.c_uint32),
-                ("drawn_fraction", ctypes.c_double), ("shaded_pixels", ctypes.c_uint64)]
+                ("drawn_fraction", ctypes.c_double), ("shaded_pixels", ctypes.c_uint64),
+                ("exposure", ctypes.c_double)]
 
 
 class SceneSize(ctypes.Structure):

@@ -38,6 +38,7 @@ plx_status plx_set_ground_image(plx_engine *e, uint32_t width, uint32_t height, 
     /* photons traced with the old ground are no longer right */
     if (e->ph)
         photon_reset(e->ph);
+    e->indirect_gen++;
     return PLX_OK;
 }
 

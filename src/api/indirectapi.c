@@ -19,6 +19,7 @@ plx_status plx_indirect_step(plx_engine *e, uint32_t photons, uint64_t seed)
     if (photons == 0)
         return eng_fail(e, PLX_E_INVALID, "plx_indirect_step: photons must be > 0");
     photon_step(e->ph, photons, seed);
+    e->indirect_gen++;
     return PLX_OK;
 }
 
@@ -37,6 +38,7 @@ plx_status plx_indirect_set_viewer(plx_engine *e, const double eye[3], const dou
     if (!eye)
         return eng_fail(e, PLX_E_INVALID, "plx_indirect_set_viewer: eye is NULL");
     st = photon_set_viewer(e->ph, eye, dir, fov_deg);
+    e->indirect_gen++;
     if (st == PLX_E_NOMEM)
         return eng_nomem(e, "assigning chart levels");
     return st;
@@ -52,6 +54,7 @@ plx_status plx_indirect_refine(plx_engine *e, const double eye[3], plx_refine_st
     if (!e->ph)
         return eng_fail(e, PLX_E_NOSCENE, "plx_indirect_refine: no photon buffers (trace indirect light first)");
     misses = photon_lamps_update(e->ph, eye);
+    e->indirect_gen++;   /* floor maps, and the order they are summed in */
     if (misses < 0)
         return eng_nomem(e, "choosing the lamps near the viewer");
     if (out) {
@@ -68,6 +71,29 @@ plx_status plx_indirect_refine(plx_engine *e, const double eye[3], plx_refine_st
     return PLX_OK;
 }
 
+plx_status plx_indirect_info_get(plx_engine *e, plx_indirect_info *out)
+{
+    const photon_sys *ps;
+    if (!eng_ok(e) || !out)
+        return PLX_E_INVALID;
+    memset(out, 0, sizeof *out);
+    if (!e->ph)
+        return eng_fail(e, PLX_E_NOSCENE, "plx_indirect_info_get: no photon buffers (trace indirect light first)");
+    ps = e->ph;
+    out->bytes = e->mem.used[PLX_PART_PHOTON];
+    out->full_bytes = e->ph_full;
+    out->budget = e->ph_budget;
+    out->reductions = e->ph_reductions;
+    out->lamp_tables = !ps->cfg.no_lamp_tables;
+    out->chart_w = ps->cfg.chart_w;
+    out->chart_h = ps->cfg.chart_h;
+    out->aerial_w = ps->gw;
+    out->aerial_h = ps->gh;
+    out->aerial_texel = ps->gtex;
+    out->lamp_slots = ps->nslots;
+    return PLX_OK;
+}
+
 plx_status plx_indirect_reset(plx_engine *e)
 {
     if (!eng_ok(e))
@@ -75,6 +101,7 @@ plx_status plx_indirect_reset(plx_engine *e)
     if (e->ph)
         photon_reset(e->ph);
     e->lightmap_cell = 0.0; /* the aerial map's indirect layer was gathered over the old photons */
+    e->indirect_gen++;
     return PLX_OK;
 }
 
@@ -143,6 +170,7 @@ plx_status plx_indirect_select_lamps(plx_engine *e, const double box[4], double 
                         "plx_indirect_select_lamps: the box needs x0 <= x1, y0 <= y1 and a "
                         "finite margin >= 0");
     n = photon_select_lamps(e->ph, box, margin);
+    e->indirect_gen++;
     if (count)
         *count = n;
     return PLX_OK;
@@ -156,6 +184,7 @@ plx_status plx_indirect_set_gather(plx_engine *e, uint32_t side)
         return eng_fail(e, PLX_E_INVALID, "plx_indirect_set_gather: side must be at most 1024");
     e->gather_side = side;
     e->gather_set = 1;
+    e->indirect_gen++;
     return PLX_OK;
 }
 

@@ -71,17 +71,70 @@ static plx_status need_light(plx_engine *e)
     return PLX_OK;
 }
 
+/* The photon buffers' budget when plx_config.photon_bytes is 0: half the
+ * block's free bytes when they are first needed, after setting aside what
+ * a frame still needs when it is not built yet: the renderer (its buffers,
+ * render_bytes, and its mesh, about MESH_PT bytes a footprint vertex and
+ * MESH_BLD a building: 284 and 170 measured on gen eixample 30 30) and the
+ * lamp light's grids. The other half stays for the lit-region cache and a
+ * frame's scratch; when even the lowest quality does not fit the half, it
+ * may take more of that room (the lit cache is sized from what is left). */
+#define MESH_PT 320
+#define MESH_BLD 192
+
+/* The free bytes once the renderer and the lamp grids are set aside. */
+static size_t photon_room(const plx_engine *e)
+{
+    const scene *s = e->sc;
+    size_t free_b = arena_free_bytes(&e->mem), keep = 0;
+    if (!e->rd) {
+        int32_t w = e->cfg.render_max_width ? e->cfg.render_max_width : DEFAULT_MAX_W;
+        int32_t h = e->cfg.render_max_height ? e->cfg.render_max_height : DEFAULT_MAX_H;
+        keep += render_bytes(s, w, h) + (size_t)MESH_PT * s->npts + (size_t)MESH_BLD * s->nbld;
+    }
+    if (!e->lt)
+        keep += light_base_bytes(s);
+    return free_b > keep ? free_b - keep : free_b / 2;
+}
+
+/* The default quality: final gathering reads the later bounces all around
+ * its points, so every block gets a chart (photon.h, coarsest_level). */
+static void photon_config_pick(const plx_engine *e, photon_config *cfg)
+{
+    if (!e->gather_set || e->gather_side > 0)
+        photon_config_gather(cfg, e->sc);
+    else
+        photon_config_default(cfg);
+}
+
 static plx_status need_photon(plx_engine *e)
 {
     photon_config cfg;
     plx_status st;
-    /* final gathering reads the later bounces all around its points: every
-     * block gets a chart (photon.h, coarsest_level) */
-    if (!e->gather_set || e->gather_side > 0)
-        photon_config_gather(&cfg, e->sc);
-    else
-        photon_config_default(&cfg);
-    arena_mark m = arena_get_mark(&e->mem);
+    arena_mark m;
+    int steps;
+    size_t icb = icache_bytes(); /* the images' irradiance cache comes with them */
+    photon_config_pick(e, &cfg);
+    e->ph_full = photon_bytes(e->sc, &cfg) + icb;
+    e->ph_budget = e->cfg.photon_bytes ? e->cfg.photon_bytes : photon_room(e) / 2;
+    steps = photon_config_fit(&cfg, e->sc, e->ph_budget > icb ? e->ph_budget - icb : 0);
+    if (steps < 0 && !e->cfg.photon_bytes && photon_bytes(e->sc, &cfg) + icb <= photon_room(e)) {
+        e->ph_budget = photon_bytes(e->sc, &cfg) + icb; /* the lowest quality, beyond the half */
+        photon_config_pick(e, &cfg);
+        steps = photon_config_fit(&cfg, e->sc, e->ph_budget - icb);
+    }
+    if (steps < 0) {
+        strbuf b;
+        sb_init(&b, e->err, sizeof e->err);
+        sb_str(&b, "out of memory while creating the photon buffers: ");
+        sb_uint(&b, photon_bytes(e->sc, &cfg) + icb);
+        sb_str(&b, " bytes at their lowest quality, more than their budget of ");
+        sb_uint(&b, e->ph_budget);
+        sb_str(&b, e->cfg.photon_bytes ? " (plx_config.photon_bytes)" : " (the free memory left after the renderer)");
+        return PLX_E_NOMEM;
+    }
+    e->ph_reductions = (uint32_t)steps;
+    m = arena_get_mark(&e->mem);
     st = photon_create(&e->mem, e->sc, &cfg, &e->ph);
     if (st == PLX_OK && (st = icache_create(&e->mem, &e->ic)) != PLX_OK) {
         arena_release(&e->mem, &m); /* as it was: no photon buffers */

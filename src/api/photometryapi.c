@@ -80,6 +80,7 @@ plx_status plx_set_photometry(plx_engine *e, const char *path, const char *data,
         light_cache_clear(e->lt);
     if (e->ph)
         photon_lamps_changed(e->ph);
+    e->indirect_gen++;
     e->lightmap_cell = 0.0;
     eng_clear_error(e);
     return PLX_OK;

@@ -5,12 +5,13 @@
 #include "light/illuminance.h"
 #include "light/litregion.h"
 #include "render/render.h"
-#include "photon/irradiance_cache.h"
 #include "photon/trace.h"
+#include "photon/photon.h"
+#include "photon/irradiance_cache.h"
 
 #define DEFAULT_MAX_W 1920
 #define DEFAULT_MAX_H 1080
-#define LIGHTMAP_MAX_BYTES ((size_t)48 << 20) /* plx_config.lightmap_bytes 0 */
+#define LIGHTMAP_MAX_BYTES ((size_t)48 << 20) /* plx_config.lightmap_bytes 0: at most this */
 
 void plx_render_opts_default(plx_render_opts *o)
 {
@@ -20,11 +21,11 @@ void plx_render_opts_default(plx_render_opts *o)
     o->exposure = 1.0;
 }
 
-/* Whether images gather their indirect light (the irradiance cache) rather
- * than read the photon buffers (plx_indirect_set_gather 0). */
-static int gathering(const plx_engine *e)
+/* Whether images read the irradiance cache (shade_indirect) rather than
+ * the photon buffers (plx_indirect_set_gather 0). */
+static int icache_on(const plx_engine *e)
 {
-    return e->ic && e->lt && e->ph && !(e->gather_set && e->gather_side == 0);
+    return e->ic && e->lt && !(e->gather_set && e->gather_side == 0);
 }
 
 /* The photon hook of the renderer: the RGB indirect term (each lamp's light
@@ -34,12 +35,40 @@ static int gathering(const plx_engine *e)
 static void shade_indirect(void *user, const double P[3], const double n[3], double rgb[3])
 {
     plx_engine *e = user;
-    if (gathering(e))
+    if (icache_on(e))
         icache_lookup(e->ic, e->ph, e->lt, P, n, rgb);
     else
         eng_indirect_photons_rgb(e, P, n, rgb);
 }
 
+/* The photon buffers alone: what the aerial indirect map is built from
+ * (they do not depend on the eye, and are only read: safe on workers). */
+static void shade_photons(void *user, const double P[3], const double n[3], double rgb[3])
+{
+    eng_indirect_photons_rgb(user, P, n, rgb);
+}
+
+/* The indirect ground map's surface height (the photon tracer's topmost
+ * roof over the point, or 0: what the aerial chart is taken on). */
+static double top_height(void *user, double x, double y)
+{
+    plx_engine *e = user;
+    return e->ph ? trace_top(e->ph->T, x, y, NULL) : 0.0;
+}
+
+/* The port's parallel-for and the number of workers for a frame
+ * (plx_config.threads; 0: the port's cores). */
+static void set_workers(const plx_engine *e, render_opts *ro)
+{
+    int n = e->cfg.threads;
+    if (!e->port.parallel_for)
+        return;
+    if (n <= 0)
+        n = e->port.cores ? e->port.cores(e->port.ctx) : 1;
+    ro->par = e->port.parallel_for;
+    ro->par_ctx = e->port.ctx;
+    ro->workers = n < 1 ? 1 : n > PLX_MAX_THREADS ? PLX_MAX_THREADS : n;
+}
 
 plx_status eng_need_render(plx_engine *e)
 {
@@ -72,25 +101,50 @@ static int lightmap_indirect(void *user, double x, double y, double rgb[3], doub
     return 1;
 }
 
+/* Whether the aerial map's indirect layer is filled: images gather over
+ * traced photons. */
+static int layer_on(const plx_engine *e)
+{
+    return icache_on(e) && e->ph && plx_indirect_frames(e) > 0;
+}
+
+/* The light map's budget when plx_config.lightmap_bytes is 0: half the
+ * block's free bytes when it is built, at most LIGHTMAP_MAX_BYTES (its
+ * texel grows until it fits, render_lightmap_build: 12 bytes a texel, 28
+ * with the indirect layer). */
+static size_t default_lightmap(const plx_engine *e)
+{
+    size_t half = arena_free_bytes(&e->mem) / 2, least = e->ic ? 28 : 12;
+    return half < least ? least : half < LIGHTMAP_MAX_BYTES ? half : LIGHTMAP_MAX_BYTES;
+}
+
 plx_status eng_need_lightmap(plx_engine *e, double m_per_texel, int dark)
 {
     double cell = m_per_texel > 0 ? m_per_texel : 1.0;
-    size_t bytes = e->cfg.lightmap_bytes ? e->cfg.lightmap_bytes : LIGHTMAP_MAX_BYTES;
+    size_t bytes;
     plx_status st = eng_need_render(e);
     if (st != PLX_OK)
         return st;
+    bytes = e->cfg.lightmap_bytes ? e->cfg.lightmap_bytes : default_lightmap(e);
     if (dark)
         render_code_bind(e->rd, shade_none);
-    if (e->ic) {
-        /* the layer's memory in every engine with a cache (a bake's twin
-         * too); its values when images gather over traced photons */
-        int fill = !dark && gathering(e) && plx_indirect_frames(e) > 0;
-        if (fill)
-            icache_set_spacing(e->ic, ICACHE_AERIAL);
-        st = render_lightmap_build_ind(e->rd, cell, bytes, lightmap_indirect, fill ? e : NULL);
-        icache_set_spacing(e->ic, 0.0);
-    } else
-        st = render_lightmap_build(e->rd, cell, bytes);
+    {
+        render_opts ro;
+        render_opts_default(&ro);
+        ro.workers = 1;
+        set_workers(e, &ro);
+        if (e->ic) {
+            /* the layer's memory in every engine with a cache (a bake's twin
+             * too); its values when images gather over traced photons */
+            int fill = !dark && layer_on(e);
+            if (fill)
+                icache_set_spacing(e->ic, ICACHE_AERIAL);
+            st = render_lightmap_build_ind(e->rd, cell, bytes, lightmap_indirect, fill ? e : NULL, ro.par,
+                                           ro.par_ctx, ro.workers);
+            icache_set_spacing(e->ic, 0.0);
+        } else
+            st = render_lightmap_build_par(e->rd, cell, bytes, ro.par, ro.par_ctx, ro.workers);
+    }
     if (dark)
         render_code_bind(e->rd, render_shade_light);
     if (st == PLX_E_NOMEM)
@@ -174,11 +228,13 @@ plx_status plx_render(plx_engine *e, const plx_camera *cam, const plx_render_opt
     st = eng_need(e, ENG_RENDER, "plx_render");
     if (st != PLX_OK)
         return st;
-    if (o->aerial && e->lightmap_cell != 0.0 && !o->no_indirect && gathering(e) && plx_indirect_frames(e) > 0) {
+    if (o->aerial && e->lightmap_cell != 0.0 && !o->no_indirect && e->ic && e->ph && plx_indirect_frames(e) > 0) {
         render_lightmap_info li;
         render_lightmap_get(e->rd, &li);
-        if (!li.has_ind)
-            e->lightmap_cell = 0.0; /* built before the photons (a bake): again, with its indirect layer */
+        /* built before the photons (a bake), or gathering switched since:
+         * again, with (without) its indirect layer */
+        if (li.has_ind != layer_on(e))
+            e->lightmap_cell = 0.0;
     }
     if (o->aerial && e->lightmap_cell == 0.0) {
         st = eng_need_lightmap(e, o->aerial_m_per_texel, 0);
@@ -205,7 +261,18 @@ plx_status plx_render(plx_engine *e, const plx_camera *cam, const plx_render_opt
             /* from above: the aerial grid for the pixels the map's layer leaves (walls) */
             icache_set_spacing(e->ic, o->aerial ? ICACHE_AERIAL : 0.0);
         }
+        /* the photon buffers are only read (indirect.c), so that hook may run
+         * on several workers; the irradiance cache fills its table and asks
+         * the light object as it reads: one thread */
+        ro.indirect_mt = !icache_on(e);
+        /* aerial ground and roofs: the light map's indirect layer; without one
+         * (not gathering) the indirect ground map (render/indmap.h) */
+        ro.indirect_map = 1;
+        ro.indirect_far = shade_photons;
+        ro.indirect_key = e->indirect_gen;
+        ro.top = top_height;
     }
+    set_workers(e, &ro);
     if (o->aa > 1)
         st = render_aa(e, &rc, &ro, o->aa, rgb8, rgbf, &rs);
     else

@@ -28,8 +28,11 @@ struct plx_engine {
     const struct lit_region *lit_last; /* region of the last plx_lit_region_get */
     struct render *rd;      /* renderer, created on first need */
     struct photon_sys *ph;  /* photon buffers, created on first need */
+    size_t ph_full, ph_budget; /* their default-quality size and the budget they fit */
+    uint32_t ph_reductions; /* quality steps taken to fit it (need.c) */
     struct icache *ic;      /* images' irradiance cache, created with the photon buffers */
     double lightmap_cell;   /* light map texel size when built, else 0 */
+    uint64_t indirect_gen;  /* +1 at every change of the photon buffers (the indirect map's key) */
     float *aa_sum;          /* anti-aliasing sum (PLX_PART_FRAME), taken on first need */
     uint32_t gather_side;   /* final gathering at points: side^2 directions
                                (0 = photon buffers only); set by

@@ -24,6 +24,7 @@ typedef struct cli_common {
     const char *lamp_files[CLI_MAX_LAMP_FILES]; /* --lamps FILE, in order */
     int nlamp_files;
     const char *points_crs; /* --points-crs: lonlat, local, or a CRS name (NULL: the file says, or the scene's) */
+    int threads;     /* --threads N: workers of a frame (0: the number of processors) */
 } cli_common;
 
 #define CLI_DEFAULT_MEM ((size_t)1 << 30)
@@ -86,6 +87,8 @@ void cli_indirect_default(cli_indirect *ind);
 int cli_indirect_option(const char *cmd, int argc, char **argv, int *i, cli_indirect *ind);
 /* Traces the frames (progress on a terminal), viewer at eye looking along
  * dir (either may be NULL). Returns an exit code. */
+/* A line on stderr when the photon buffers were fitted below the default quality. */
+void cli_indirect_note(const char *cmd, plx_engine *e);
 int cli_indirect_run(const char *cmd, plx_engine *e, const cli_indirect *ind, const double *eye,
                      const double *dir, double fov_deg);
 /* Near-viewer refinement at eye (plx_indirect_refine); when lamps were

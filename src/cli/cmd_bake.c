@@ -4,11 +4,13 @@
 #include <string.h>
 
 #include "cli.h"
+#include "options.h"
 #include "port.h"
 
 static const char help[] =
     "usage: polarlux bake SCENE -o CITY.plxb [--photons N] [--frames K] [--no-indirect]\n"
-    "                     [--no-aerial] [--texel M] [--max-size WxH] [--mem SIZE] [--strict] [--quiet]\n"
+    "                     [--no-aerial] [--texel M] [--max-size WxH] [--threads N] [--mem SIZE]\n"
+    "                     [--strict] [--quiet]\n"
     "\n"
     "Loads SCENE and builds everything queries and frames need: polar diagrams,\n"
     "lamp light, photon buffers with K frames of N photons (levels for a viewer\n"
@@ -25,6 +27,8 @@ static const char help[] =
     "  --no-aerial     no aerial light map\n"
     "  --texel M       aerial light map resolution (default 1 m, coarser if the budget needs)\n"
     "  --max-size WxH  the largest frame the loaded engine renders (default 1024x768)\n"
+    "  --threads N     threads for the aerial light map (default: the number of\n"
+    "                  processors); the same map for any N\n"
     "  --mem SIZE, --strict, --quiet   as for 'polarlux info'\n"
     "\n"
     "Exit codes: 0 written, 1 the scene or the file failed, 2 usage, 3 --mem too small.\n";
@@ -36,56 +40,34 @@ typedef struct bake_args {
     plx_bake_opts o;
 } bake_args;
 
+static int parse_texel(const char *v, void *dst)
+{
+    double *t = dst;
+    return cli_parse_double(v, t) != 0 || !(*t > 0) ? -1 : 0;
+}
+
 static int parse_args(int argc, char **argv, bake_args *a)
 {
-    int i;
-    long w, h;
-    char extra;
+    long size[2] = { 1024, 768 };
+    int no_aerial = 0, rc;
+    const cli_opt opts[] = {
+        CLI_OPT_FLAG("--no-aerial", &no_aerial),
+        CLI_OPT_STR("-o", &a->out),
+        CLI_OPT_VAL("--texel", &a->o.aerial_m_per_texel, parse_texel, "--texel '%s' is not a positive number of metres"),
+        CLI_OPT_VAL("--max-size", size, cli_opt_size, "--max-size '%s' is not WxH (1..8192 each)"),
+        CLI_OPT_END
+    };
+    cli_args pa;
     memset(a, 0, sizeof *a);
     cli_indirect_default(&a->ind);
     a->ind.frames = CLI_GATHER_FRAMES; /* illum on the bake gathers over them */
-    a->o.aerial = 1;
-    a->c.render_w = 1024;
-    a->c.render_h = 768;
-    for (i = 1; i < argc; i++) {
-        const char *s = argv[i];
-        int r = cli_common_option("bake", argc, argv, &i, &a->c);
-        if (r == 0)
-            r = cli_indirect_option("bake", argc, argv, &i, &a->ind);
-        if (r < 0)
-            return EXIT_USAGE;
-        if (r)
-            continue;
-        if (strcmp(s, "--help") == 0 || strcmp(s, "-h") == 0) {
-            fputs(help, stdout);
-            return -1;
-        }
-        if (strcmp(s, "--no-aerial") == 0) {
-            a->o.aerial = 0;
-        } else if (strcmp(s, "-o") == 0 || strcmp(s, "--texel") == 0 || strcmp(s, "--max-size") == 0) {
-            const char *v;
-            if (i + 1 >= argc)
-                return cli_usage_error("bake", "%s needs a value", s);
-            v = argv[++i];
-            if (strcmp(s, "-o") == 0) {
-                a->out = v;
-            } else if (strcmp(s, "--texel") == 0) {
-                if (cli_parse_double(v, &a->o.aerial_m_per_texel) != 0 || !(a->o.aerial_m_per_texel > 0))
-                    return cli_usage_error("bake", "--texel '%s' is not a positive number of metres", v);
-            } else {
-                if (sscanf(v, "%ldx%ld%c", &w, &h, &extra) != 2 || w < 1 || h < 1 || w > 8192 || h > 8192)
-                    return cli_usage_error("bake", "--max-size '%s' is not WxH (1..8192 each)", v);
-                a->c.render_w = (int)w;
-                a->c.render_h = (int)h;
-            }
-        } else if (s[0] == '-' && s[1] != '\0') {
-            return cli_usage_error("bake", "unknown option '%s'", s);
-        } else if (!a->scene) {
-            a->scene = s;
-        } else {
-            return cli_usage_error("bake", "unexpected argument '%s'", s);
-        }
-    }
+    rc = cli_options_n("bake", help, argc, argv, opts, &a->c, &a->ind, 1, NULL, &pa);
+    if (rc != EXIT_OK)
+        return rc;
+    a->scene = pa.npos ? pa.pos[0] : NULL;
+    a->o.aerial = !no_aerial;
+    a->c.render_w = (int)size[0];
+    a->c.render_h = (int)size[1];
     if (!a->scene)
         return cli_usage_error("bake", "missing SCENE");
     if (!a->out)

@@ -97,9 +97,9 @@ int cmd_draw(int argc, char **argv)
     const char *scene, *out = NULL;
     long q = -1, size = 1600;
     const cli_opt opts[] = {
-        { "--polar", NULL, &q, parse_quadrant, "--polar '%s' is not a quadrant 0..3", 0, NULL },
-        { "-o", NULL, &out, NULL, NULL, 0, NULL },
-        { "--size", NULL, &size, parse_size, "--size '%s' is not 16..16384 pixels", 0, NULL },
+        { "--polar", NULL, &q, parse_quadrant, "--polar '%s' is not a quadrant 0..3", 0, NULL, NULL, NULL },
+        { "-o", NULL, &out, NULL, NULL, 0, NULL, NULL, NULL },
+        { "--size", NULL, &size, parse_size, "--size '%s' is not 16..16384 pixels", 0, NULL, NULL, NULL },
         CLI_OPT_END
     };
     cli_args pa;

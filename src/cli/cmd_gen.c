@@ -2,6 +2,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include "cli.h"
+#include "options.h"
 #include "posix/safe_out.h"
 
 static const char help[] =
@@ -27,38 +28,34 @@ static int write_out(void *ctx, const char *data, size_t len)
     return safe_out_write(ctx, data, len);
 }
 
+static int parse_seed(const char *v, void *dst)
+{
+    char *end;
+    *(unsigned long long *)dst = strtoull(v, &end, 10);
+    return *end != '\0' || end == v ? -1 : 0;
+}
+
 int cmd_gen(int argc, char **argv)
 {
-    const char *pos[3], *out = NULL;
+    const char **pos, *out = NULL;
     char err[600];
     safe_out *o;
     long nx, ny;
     unsigned long long seed = 1;
-    int npos = 0, i;
+    int npos, rc;
     plx_status st;
-    for (i = 1; i < argc; i++) {
-        if (strcmp(argv[i], "--help") == 0 || strcmp(argv[i], "-h") == 0) {
-            fputs(help, stdout);
-            return EXIT_OK;
-        } else if (strcmp(argv[i], "--seed") == 0) {
-            char *end;
-            if (i + 1 >= argc)
-                return cli_usage_error("gen", "--seed needs a number");
-            seed = strtoull(argv[++i], &end, 10);
-            if (*end != '\0' || end == argv[i])
-                return cli_usage_error("gen", "--seed '%s' is not a whole number", argv[i]);
-        } else if (strcmp(argv[i], "-o") == 0) {
-            if (i + 1 >= argc)
-                return cli_usage_error("gen", "-o needs a file name");
-            out = argv[++i];
-        } else if (argv[i][0] == '-' && argv[i][1] != '\0') {
-            return cli_usage_error("gen", "unknown option '%s'", argv[i]);
-        } else if (npos < 3) {
-            pos[npos++] = argv[i];
-        } else {
-            return cli_usage_error("gen", "too many arguments ('%s')", argv[i]);
-        }
-    }
+    const cli_opt opts[] = {
+        { "--seed", NULL, &seed, parse_seed, "--seed '%s' is not a whole number", 0, "--seed needs a number", NULL,
+          NULL },
+        { "-o", NULL, &out, NULL, NULL, 0, "-o needs a file name", NULL, NULL },
+        CLI_OPT_END
+    };
+    cli_args pa;
+    rc = cli_options_n("gen", help, argc, argv, opts, NULL, NULL, 3, "too many arguments ('%s')", &pa);
+    if (rc != EXIT_OK)
+        return rc < 0 ? EXIT_OK : rc;
+    pos = pa.pos;
+    npos = pa.npos;
     if (npos < 3)
         return cli_usage_error("gen", "needs STYLE NX NY, e.g. 'polarlux gen eixample 30 30'");
     if (strcmp(pos[0], "grid") && strcmp(pos[0], "eixample") && strcmp(pos[0], "oldtown"))

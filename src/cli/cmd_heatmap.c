@@ -5,6 +5,7 @@
 
 #include "canvas.h"
 #include "cli.h"
+#include "options.h"
 #include "geotiff.h"
 #include "route_io.h"
 
@@ -479,67 +480,60 @@ static int run(plx_engine *e, const heat_opts *o)
     return rc;
 }
 
+static int parse_res(const char *v, void *dst)
+{
+    double *r = dst;
+    return cli_parse_real(v, 0, CLI_MAX_COORD, r) != 0 || !(*r > 0) ? -1 : 0;
+}
+
+static int parse_max(const char *v, void *dst)
+{
+    double *t = dst;
+    return cli_parse_real(v, 0.1, 1e9, t) != 0 || !(*t > 0.1) ? -1 : 0;
+}
+
+static int parse_quantity(const char *q, void *dst)
+{
+    int *k = dst;
+    *k = strcmp(q, "h") == 0 ? PLX_METER_H : strcmp(q, "v") == 0 ? PLX_METER_V
+       : strcmp(q, "sc") == 0 ? PLX_METER_SC : strcmp(q, "hs") == 0 ? PLX_METER_HS : -1;
+    return *k < 0 ? -1 : 0;
+}
+
+static int parse_box(const char *v, void *dst)
+{
+    double *b = dst;
+    return cli_parse_coords(v, b, 4) != 0 || !(b[2] > b[0]) || !(b[3] > b[1]) ? -1 : 0;
+}
+
 int cmd_heatmap(int argc, char **argv)
 {
     cli_common c;
     const char *scene = NULL;
     heat_opts o;
     plx_engine *e;
-    int i, rc;
+    int rc;
+    const cli_opt opts[] = {
+        CLI_OPT_VAL("--res", &o.res, parse_res, "--res '%s' is not a positive number of metres (at most 1e7)"),
+        CLI_OPT_VAL("--max", &o.top, parse_max, "--max '%s' is not a number of lux above 0.1 (at most 1e9)"),
+        CLI_OPT_VAL("--quantity", &o.q.quantity, parse_quantity, "--quantity '%s' is not h, v, sc or hs"),
+        CLI_OPT_VAL("--height", &o.q.height, cli_opt_height, "--height '%s' is not a number of metres from 0 to 1000"),
+        CLI_OPT_VAL("--facing", &o.q, cli_opt_facing, "--facing '%s' is not a number of degrees or min"),
+        CLI_OPT_STR("-o", &o.out),
+        CLI_OPT_STR("--path", &o.path),
+        { "--box", NULL, o.box, parse_box,
+          "--box '%s' is not X0,Y0,X1,Y1 with X1 > X0 and Y1 > Y0 (finite, within 1e7 m)", 0, NULL, &o.have_box, NULL },
+        CLI_OPT_END
+    };
+    cli_args pa;
     memset(&c, 0, sizeof c);
     memset(&o, 0, sizeof o);
     o.q.quantity = PLX_METER_H;
     o.q.height = 1.5;
-    for (i = 1; i < argc; i++) {
-        int r = cli_common_option("heatmap", argc, argv, &i, &c);
-        if (r < 0)
-            return EXIT_USAGE;
-        if (r)
-            continue;
-        if (strcmp(argv[i], "--help") == 0 || strcmp(argv[i], "-h") == 0) {
-            fputs(help, stdout);
-            return EXIT_OK;
-        }
-        if ((strcmp(argv[i], "--res") == 0 || strcmp(argv[i], "-o") == 0 || strcmp(argv[i], "--max") == 0 ||
-             strcmp(argv[i], "--box") == 0 || strcmp(argv[i], "--path") == 0 || strcmp(argv[i], "--quantity") == 0 ||
-             strcmp(argv[i], "--height") == 0 || strcmp(argv[i], "--facing") == 0) && i + 1 >= argc)
-            return cli_usage_error("heatmap", "%s needs a value", argv[i]);
-        if (strcmp(argv[i], "--res") == 0) {
-            if (cli_parse_real(argv[++i], 0, CLI_MAX_COORD, &o.res) != 0 || !(o.res > 0))
-                return cli_usage_error("heatmap", "--res '%s' is not a positive number of metres (at most 1e7)", argv[i]);
-        } else if (strcmp(argv[i], "--max") == 0) {
-            if (cli_parse_real(argv[++i], 0.1, 1e9, &o.top) != 0 || !(o.top > 0.1))
-                return cli_usage_error("heatmap", "--max '%s' is not a number of lux above 0.1 (at most 1e9)", argv[i]);
-        } else if (strcmp(argv[i], "--quantity") == 0) {
-            const char *q = argv[++i];
-            o.q.quantity = strcmp(q, "h") == 0 ? PLX_METER_H : strcmp(q, "v") == 0 ? PLX_METER_V
-                         : strcmp(q, "sc") == 0 ? PLX_METER_SC : strcmp(q, "hs") == 0 ? PLX_METER_HS : -1;
-            if (o.q.quantity < 0)
-                return cli_usage_error("heatmap", "--quantity '%s' is not h, v, sc or hs", q);
-        } else if (strcmp(argv[i], "--height") == 0) {
-            if (cli_parse_double(argv[++i], &o.q.height) != 0 || !(o.q.height >= 0) || !(o.q.height <= 1000))
-                return cli_usage_error("heatmap", "--height '%s' is not a number of metres from 0 to 1000", argv[i]);
-        } else if (strcmp(argv[i], "--facing") == 0) {
-            o.q.facing_min = strcmp(argv[++i], "min") == 0;
-            if (!o.q.facing_min && (cli_parse_double(argv[i], &o.q.facing) != 0 || !isfinite(o.q.facing)))
-                return cli_usage_error("heatmap", "--facing '%s' is not a number of degrees or min", argv[i]);
-        } else if (strcmp(argv[i], "-o") == 0) {
-            o.out = argv[++i];
-        } else if (strcmp(argv[i], "--path") == 0) {
-            o.path = argv[++i];
-        } else if (strcmp(argv[i], "--box") == 0) {
-            if (cli_parse_coords(argv[++i], o.box, 4) != 0 || !(o.box[2] > o.box[0]) || !(o.box[3] > o.box[1]))
-                return cli_usage_error("heatmap", "--box '%s' is not X0,Y0,X1,Y1 with X1 > X0 and Y1 > Y0 "
-                                       "(finite, within 1e7 m)", argv[i]);
-            o.have_box = 1;
-        } else if (argv[i][0] == '-' && argv[i][1] != '\0') {
-            return cli_usage_error("heatmap", "unknown option '%s'", argv[i]);
-        } else if (!scene) {
-            scene = argv[i];
-        } else {
-            return cli_usage_error("heatmap", "unexpected argument '%s'", argv[i]);
-        }
-    }
+    rc = cli_options_n("heatmap", help, argc, argv, opts, &c, NULL, 1, NULL, &pa);
+    if (rc != EXIT_OK)
+        return rc < 0 ? EXIT_OK : rc;
+    scene = pa.npos ? pa.pos[0] : NULL;
     if (!scene)
         return cli_usage_error("heatmap", "missing SCENE");
     if (!o.out)

@@ -48,7 +48,7 @@ int cmd_illum(int argc, char **argv)
     cli_progress pr;
     size_t k;
     const cli_opt opts[] = {
-        { "--points", NULL, &file, NULL, NULL, 0, "--points needs a file" },
+        { "--points", NULL, &file, NULL, NULL, 0, "--points needs a file", NULL, NULL },
         CLI_OPT_END
     };
     cli_args pa;
@@ -95,12 +95,15 @@ int cmd_illum(int argc, char **argv)
         }
         /* photons only from the lamps within 100 m of the points' box
          * (the gather setting first: it decides the photon configuration) */
-        if ((ind.gather >= 0 && plx_indirect_set_gather(e, (uint32_t)ind.gather) != PLX_OK) ||
-            plx_indirect_select_lamps(e, box, CLI_SELECT_MARGIN, NULL) != PLX_OK) {
+        plx_status sst = ind.gather >= 0 ? plx_indirect_set_gather(e, (uint32_t)ind.gather) : PLX_OK;
+        if (sst == PLX_OK)
+            sst = plx_indirect_select_lamps(e, box, CLI_SELECT_MARGIN, NULL);
+        if (sst != PLX_OK) {
             fprintf(stderr, "polarlux illum: %s\n", plx_last_error(e));
+            free(given);
             points_free(&pts);
             plx_engine_free(e);
-            return EXIT_FAIL;
+            return sst == PLX_E_NOMEM ? EXIT_NOMEM : EXIT_FAIL;
         }
         rc = cli_indirect_run("illum", e, &ind, eye, NULL, 360.0);
         if (rc != EXIT_OK) {

@@ -2,9 +2,11 @@
  * and memory per part. */
 #include <string.h>
 #include "cli.h"
+#include "options.h"
 
 static const char help[] =
     "usage: polarlux info SCENE [--mem SIZE] [--strict] [--quiet] [--lamps FILE]... [--min-mem]\n"
+    "                     [--photons]\n"
     "\n"
     "Loads SCENE (GeoJSON, see README 'Scene format') and prints counts of\n"
     "buildings, blocks, courtyards, lamps and vertices, the bounds, building\n"
@@ -29,7 +31,11 @@ static const char help[] =
     "  --min-mem    also find the smallest --mem that loads SCENE (the file alone)\n"
     "               and builds its\n"
     "               polar diagrams, by bisection over loads (to 4 KiB; about 18\n"
-    "               loads), and print it\n";
+    "               loads), and print it\n"
+    "  --photons    also create the photon buffers (no photons traced) and print\n"
+    "               the sizes chosen at this --mem: bytes, the default quality's\n"
+    "               bytes, the budget, the quality steps taken to fit it, chart\n"
+    "               and aerial texels, lamp floor maps, lamp ray tables\n";
 
 static void silent_log(void *ctx, plx_log_level level, const char *msg)
 {
@@ -75,6 +81,33 @@ static void print_min_mem(const char *path, const cli_common *c, size_t hi)
            "(bisection, %d loads; a ground image needs its pixels on top)\n", hi, hi / 1048576.0, loads);
 }
 
+/* The photon buffers at this budget (created when missing). */
+static int print_photons(plx_engine *e, const char *path, const plx_scene_info *si)
+{
+    double eye[3];
+    plx_indirect_info pi;
+    plx_status st;
+    eye[0] = 0.5 * (si->bounds[0] + si->bounds[2]);
+    eye[1] = 0.5 * (si->bounds[1] + si->bounds[3]);
+    eye[2] = 1.7;
+    st = plx_indirect_info_get(e, &pi);
+    if (st == PLX_E_NOSCENE) {
+        st = plx_indirect_set_viewer(e, eye, NULL, 360.0);
+        if (st == PLX_OK)
+            st = plx_indirect_info_get(e, &pi);
+    }
+    if (st != PLX_OK) {
+        printf("photon buffers: not created: %s\n", plx_last_error(e));
+        fprintf(stderr, "polarlux info: %s: photon buffers not created: %s\n", path, plx_last_error(e));
+        return cli_exit_code(st);
+    }
+    printf("photon buffers: %zu bytes (default quality %zu, budget %zu): %u quality steps; facade charts %ux%u, "
+           "aerial chart %ux%u texels of %.2f m, %u lamp floor maps, lamp ray tables %s\n",
+           pi.bytes, pi.full_bytes, pi.budget, pi.reductions, pi.chart_w, pi.chart_h, pi.aerial_w, pi.aerial_h,
+           pi.aerial_texel, pi.lamp_slots, pi.lamp_tables ? "on" : "off");
+    return EXIT_OK;
+}
+
 static void print_memory(const plx_engine *e)
 {
     plx_memory_report m;
@@ -113,28 +146,14 @@ int cmd_info(int argc, char **argv)
     plx_scene_info si;
     plx_polar_info pi;
     plx_ground_image_info gi;
-    int i, rc, min_mem = 0;
+    int rc, min_mem = 0, photons = 0;
+    const cli_opt opts[] = { CLI_OPT_FLAG("--min-mem", &min_mem), CLI_OPT_FLAG("--photons", &photons), CLI_OPT_END };
+    cli_args pa;
     memset(&c, 0, sizeof c);
-    for (i = 1; i < argc; i++) {
-        int r = cli_common_option("info", argc, argv, &i, &c);
-        if (r < 0)
-            return EXIT_USAGE;
-        if (r)
-            continue;
-        if (strcmp(argv[i], "--help") == 0 || strcmp(argv[i], "-h") == 0) {
-            fputs(help, stdout);
-            return EXIT_OK;
-        }
-        if (strcmp(argv[i], "--min-mem") == 0) {
-            min_mem = 1;
-            continue;
-        }
-        if (argv[i][0] == '-' && argv[i][1] != '\0')
-            return cli_usage_error("info", "unknown option '%s'", argv[i]);
-        if (path)
-            return cli_usage_error("info", "one scene at a time ('%s' and '%s')", path, argv[i]);
-        path = argv[i];
-    }
+    rc = cli_options_n("info", help, argc, argv, opts, &c, NULL, 1, "one scene at a time ('%2$s' and '%1$s')", &pa);
+    if (rc != EXIT_OK)
+        return rc < 0 ? EXIT_OK : rc;
+    path = pa.npos ? pa.pos[0] : NULL;
     if (!path)
         return cli_usage_error("info", "missing SCENE");
     rc = cli_open_scene("info", path, &c, &e);
@@ -183,6 +202,8 @@ int cmd_info(int argc, char **argv)
         fprintf(stderr, "polarlux info: %s: polar diagrams not built: %s\n", path, plx_last_error(e));
         rc = plx_last_error(e)[0] && strstr(plx_last_error(e), "out of memory") ? EXIT_NOMEM : EXIT_FAIL;
     }
+    if (photons && rc == EXIT_OK && si.lamps > 0)
+        rc = print_photons(e, path, &si);
     print_memory(e);
     plx_engine_free(e);
     if (min_mem && rc == EXIT_OK)

@@ -171,8 +171,8 @@ int cmd_lit(int argc, char **argv)
     cli_common c;
     const char *scene, *id = NULL, *out = NULL;
     const cli_opt opts[] = {
-        { "--lamp", NULL, &id, NULL, NULL, 0, NULL },
-        { "-o", NULL, &out, NULL, NULL, 0, NULL },
+        { "--lamp", NULL, &id, NULL, NULL, 0, NULL, NULL, NULL },
+        { "-o", NULL, &out, NULL, NULL, 0, NULL, NULL, NULL },
         CLI_OPT_END
     };
     cli_args pa;

@@ -5,6 +5,7 @@
 #include <string.h>
 
 #include "cli.h"
+#include "options.h"
 #include "points.h"
 
 static const char help[] =
@@ -76,6 +77,17 @@ static int run(plx_engine *e, const char *file, const points *pts, const double 
     return failed ? EXIT_FAIL : EXIT_OK;
 }
 
+typedef struct quantities {
+    int q[16], n;
+} quantities;
+
+static int parse_list(const char *s, void *dst)
+{
+    quantities *l = dst;
+    l->n = parse_quantities(s, l->q);
+    return l->n <= 0 ? -1 : 0;
+}
+
 int cmd_meter(int argc, char **argv)
 {
     cli_common c;
@@ -84,38 +96,20 @@ int cmd_meter(int argc, char **argv)
     points pts;
     char err[512];
     double fill[5] = { 0, 0, 1.5, 1, 0 }, *given = NULL;
-    int q[16] = { PLX_METER_H, PLX_METER_V, PLX_METER_SC, PLX_METER_HS }, nq = 4, i, rc;
+    quantities ql = { { PLX_METER_H, PLX_METER_V, PLX_METER_SC, PLX_METER_HS }, 4 };
+    int *q = ql.q, rc;
+    const cli_opt opts[] = {
+        CLI_OPT_STR("--points", &file),
+        CLI_OPT_VAL("--quantity", &ql, parse_list, "--quantity '%s' is not a list of h, v, sc, hs"),
+        CLI_OPT_VAL("--height", &fill[2], cli_opt_height, "--height '%s' is not a number of metres from 0 to 1000"),
+        CLI_OPT_END
+    };
+    cli_args pa;
     memset(&c, 0, sizeof c);
-    for (i = 1; i < argc; i++) {
-        const char *a = argv[i];
-        int r = cli_common_option("meter", argc, argv, &i, &c);
-        if (r < 0)
-            return EXIT_USAGE;
-        if (r)
-            continue;
-        if (strcmp(a, "--help") == 0 || strcmp(a, "-h") == 0) {
-            fputs(help, stdout);
-            return EXIT_OK;
-        }
-        if ((strcmp(a, "--points") == 0 || strcmp(a, "--quantity") == 0 || strcmp(a, "--height") == 0) &&
-            i + 1 >= argc)
-            return cli_usage_error("meter", "%s needs a value", a);
-        if (strcmp(a, "--points") == 0) {
-            file = argv[++i];
-        } else if (strcmp(a, "--quantity") == 0) {
-            if ((nq = parse_quantities(argv[++i], q)) <= 0)
-                return cli_usage_error("meter", "--quantity '%s' is not a list of h, v, sc, hs", argv[i]);
-        } else if (strcmp(a, "--height") == 0) {
-            if (cli_parse_double(argv[++i], &fill[2]) != 0 || !(fill[2] >= 0) || !(fill[2] <= 1000))
-                return cli_usage_error("meter", "--height '%s' is not a number of metres from 0 to 1000", argv[i]);
-        } else if (a[0] == '-' && a[1] != '\0') {
-            return cli_usage_error("meter", "unknown option '%s'", a);
-        } else if (!scene) {
-            scene = a;
-        } else {
-            return cli_usage_error("meter", "unexpected argument '%s'", a);
-        }
-    }
+    rc = cli_options_n("meter", help, argc, argv, opts, &c, NULL, 1, NULL, &pa);
+    if (rc != EXIT_OK)
+        return rc < 0 ? EXIT_OK : rc;
+    scene = pa.npos ? pa.pos[0] : NULL;
     if (!scene)
         return cli_usage_error("meter", "missing SCENE");
     if (!file)
@@ -131,7 +125,7 @@ int cmd_meter(int argc, char **argv)
     }
     rc = cli_points_local("meter", e, &c, file, &pts, &given);
     if (rc == EXIT_OK)
-        rc = run(e, file, &pts, given, q, nq);
+        rc = run(e, file, &pts, given, q, ql.n);
     free(given);
     if (rc == EXIT_OK && pts.n == 0)
         fprintf(stderr, "polarlux meter: %s holds no points\n", file);

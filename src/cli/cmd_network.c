@@ -5,6 +5,7 @@
 #include <string.h>
 
 #include "cli.h"
+#include "options.h"
 #include "geo_out.h"
 #include "network.h"
 #include "port.h"
@@ -79,55 +80,27 @@ typedef struct net_opts {
     cli_common c;
 } net_opts;
 
-static int is_valued(const char *a)
+static int parse_number(const char *v, void *dst)
 {
-    static const char *const names[] = { "--network", "--from", "--to", "--dark-lux", "--dark-weight",
-                                         "--max-detour", "--snap", "--step", "--geojson", "-o", "--csv",
-                                         "--height" };
-    size_t k;
-    for (k = 0; k < sizeof names / sizeof names[0]; k++)
-        if (strcmp(a, names[k]) == 0)
-            return 1;
-    return 0;
+    double *d = dst;
+    return cli_parse_double(v, d) != 0 || !(*d >= 0) || !isfinite(*d) ? -1 : 0;
 }
 
-static int number_option(const net_opts *o, const char *a, const char *v, double *out, double lo)
+static int parse_step(const char *v, void *dst)
 {
-    if (cli_parse_double(v, out) != 0 || !(*out >= lo) || !isfinite(*out))
-        return cli_usage_error(o->cmd, "%s '%s' is not a number >= %g", a, v, lo);
-    return 0;
+    double *d = dst;
+    return cli_parse_double(v, d) != 0 || !(*d >= 0.01) || !isfinite(*d) ? -1 : 0;
 }
 
-static int value_option(net_opts *o, const char *a, const char *v)
+/* A number >= 0, then at most 1000 (its own message; dst: the net_opts). */
+static int parse_height(const char *v, void *dst)
 {
-    if (strcmp(a, "--network") == 0)
-        o->network = v;
-    else if (strcmp(a, "--from") == 0)
-        o->from_s = v;
-    else if (strcmp(a, "--to") == 0)
-        o->to_s = v;
-    else if (strcmp(a, "--geojson") == 0)
-        o->geojson = v;
-    else if (strcmp(a, "-o") == 0)
-        o->out = v;
-    else if (strcmp(a, "--csv") == 0)
-        o->csv = v;
-    else if (strcmp(a, "--dark-lux") == 0)
-        return number_option(o, a, v, &o->dark, 0);
-    else if (strcmp(a, "--dark-weight") == 0)
-        return number_option(o, a, v, &o->weight, 0);
-    else if (strcmp(a, "--snap") == 0)
-        return number_option(o, a, v, &o->snap, 0);
-    else if (strcmp(a, "--max-detour") == 0) {
-        o->have_detour = 1;
-        return number_option(o, a, v, &o->detour, 0);
-    } else if (strcmp(a, "--step") == 0)
-        return number_option(o, a, v, &o->step, 0.01);
-    else if (strcmp(a, "--height") == 0) {
-        if (number_option(o, a, v, &o->height, 0) != 0)
-            return -1;
-        if (o->height > 1000)
-            return cli_usage_error(o->cmd, "--height '%s' is not a number of metres from 0 to 1000", v);
+    net_opts *o = dst;
+    if (parse_number(v, &o->height) != 0)
+        return -1;
+    if (o->height > 1000) {
+        cli_usage_error(o->cmd, "--height '%s' is not a number of metres from 0 to 1000", v);
+        return -2;
     }
     return 0;
 }
@@ -136,36 +109,33 @@ static int value_option(net_opts *o, const char *a, const char *v)
  * (printed), else an exit code. */
 static int parse(net_opts *o, int argc, char **argv, const char *help)
 {
-    int i;
+    int rc;
+    const cli_opt opts[] = {
+        CLI_OPT_STR("--network", &o->network),
+        CLI_OPT_STR("--from", &o->from_s),
+        CLI_OPT_STR("--to", &o->to_s),
+        CLI_OPT_STR("--geojson", &o->geojson),
+        CLI_OPT_STR("-o", &o->out),
+        CLI_OPT_STR("--csv", &o->csv),
+        CLI_OPT_VAL("--dark-lux", &o->dark, parse_number, "--dark-lux '%s' is not a number >= 0"),
+        CLI_OPT_VAL("--dark-weight", &o->weight, parse_number, "--dark-weight '%s' is not a number >= 0"),
+        CLI_OPT_VAL("--snap", &o->snap, parse_number, "--snap '%s' is not a number >= 0"),
+        { "--max-detour", NULL, &o->detour, parse_number, "--max-detour '%s' is not a number >= 0", 0, NULL,
+          &o->have_detour, NULL },
+        CLI_OPT_VAL("--step", &o->step, parse_step, "--step '%s' is not a number >= 0.01"),
+        CLI_OPT_VAL("--height", o, parse_height, "--height '%s' is not a number >= 0"),
+        CLI_OPT_END
+    };
+    cli_args pa;
     o->dark = 1.0;
     o->weight = 3.0;
     o->snap = 50.0;
     o->step = 1.0;
     o->height = 1.5;
-    for (i = 1; i < argc; i++) {
-        const char *a = argv[i];
-        int r = cli_common_option(o->cmd, argc, argv, &i, &o->c);
-        if (r < 0)
-            return EXIT_USAGE;
-        if (r)
-            continue;
-        if (strcmp(a, "--help") == 0 || strcmp(a, "-h") == 0) {
-            fputs(help, stdout);
-            return -1;
-        }
-        if (is_valued(a)) {
-            if (i + 1 >= argc)
-                return cli_usage_error(o->cmd, "%s needs a value", a);
-            if (value_option(o, a, argv[++i]) != 0)
-                return EXIT_USAGE;
-        } else if (a[0] == '-' && a[1] != '\0') {
-            return cli_usage_error(o->cmd, "unknown option '%s'", a);
-        } else if (!o->scene) {
-            o->scene = a;
-        } else {
-            return cli_usage_error(o->cmd, "unexpected argument '%s'", a);
-        }
-    }
+    rc = cli_options_n(o->cmd, help, argc, argv, opts, &o->c, NULL, 1, NULL, &pa);
+    if (rc != EXIT_OK)
+        return rc;
+    o->scene = pa.npos ? pa.pos[0] : NULL;
     if (!o->scene)
         return cli_usage_error(o->cmd, "missing SCENE");
     if (!o->network)

@@ -4,6 +4,7 @@
 #include <string.h>
 
 #include "cli.h"
+#include "options.h"
 #include "png/image_write.h"
 
 static const char help[] =
@@ -21,41 +22,33 @@ static const char help[] =
     "  --dark-threshold T   luminance below which night pixels are left out of\n"
     "                       the reference histograms (default 10)\n";
 
+static int parse_dark(const char *v, void *dst)
+{
+    double *d = dst;
+    return cli_parse_double(v, d) != 0 || *d < 0 || *d > 255 ? -1 : 0;
+}
+
 int cmd_nightify(int argc, char **argv)
 {
-    const char *pos[2], *out = NULL;
+    const char **pos, *out = NULL;
     double dark = 10.0;
-    int npos = 0, i, dw = 0, dh = 0, nw, nh, rc = EXIT_OK, r;
+    int npos, dw = 0, dh = 0, nw, nh, rc = EXIT_OK, r;
     uint8_t *day = NULL, *night = NULL;
     char err[512];
     cli_common c;
     size_t mem;
+    const cli_opt opts[] = {
+        CLI_OPT_STR("-o", &out),
+        CLI_OPT_VAL("--dark-threshold", &dark, parse_dark, "--dark-threshold '%s' is not 0..255"),
+        CLI_OPT_END
+    };
+    cli_args pa;
     memset(&c, 0, sizeof c);
-    for (i = 1; i < argc; i++) {
-        r = cli_common_option("nightify", argc, argv, &i, &c);
-        if (r < 0)
-            return EXIT_USAGE;
-        if (r)
-            continue;
-        if (strcmp(argv[i], "--help") == 0 || strcmp(argv[i], "-h") == 0) {
-            fputs(help, stdout);
-            return EXIT_OK;
-        } else if (strcmp(argv[i], "-o") == 0 || strcmp(argv[i], "--dark-threshold") == 0) {
-            if (i + 1 >= argc)
-                return cli_usage_error("nightify", "%s needs a value", argv[i]);
-            if (strcmp(argv[i], "-o") == 0) {
-                out = argv[++i];
-            } else if (cli_parse_double(argv[++i], &dark) != 0 || dark < 0 || dark > 255) {
-                return cli_usage_error("nightify", "--dark-threshold '%s' is not 0..255", argv[i]);
-            }
-        } else if (argv[i][0] == '-' && argv[i][1] != '\0') {
-            return cli_usage_error("nightify", "unknown option '%s'", argv[i]);
-        } else if (npos < 2) {
-            pos[npos++] = argv[i];
-        } else {
-            return cli_usage_error("nightify", "unexpected argument '%s'", argv[i]);
-        }
-    }
+    rc = cli_options_n("nightify", help, argc, argv, opts, &c, NULL, 2, NULL, &pa);
+    if (rc != EXIT_OK)
+        return rc < 0 ? EXIT_OK : rc;
+    pos = pa.pos;
+    npos = pa.npos;
     if (npos < 2)
         return cli_usage_error("nightify", "needs DAY.png and NIGHT.png");
     if (!out)

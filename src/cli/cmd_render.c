@@ -4,6 +4,7 @@
 #include <string.h>
 
 #include "cli.h"
+#include "options.h"
 #include "port.h"
 #include "png/image_write.h"
 #ifdef PLX_HAVE_OSMESA
@@ -19,7 +20,8 @@
 static const char help[] =
     "usage: polarlux render SCENE [--eye X,Y,Z --target X,Y,Z] [--fov DEG] [--size WxH]\n"
     "                       [--view street|aerial] [--backend soft|osmesa] [--exposure E]\n"
-    "                       [--no-indirect] [--no-glow] [--aa N] [--texel M] -o OUT.png [--pfm OUT.pfm]\n"
+    "                       [--no-indirect] [--no-glow] [--aa N] [--texel M] [--threads N]\n"
+    "                       -o OUT.png [--pfm OUT.pfm]\n"
     "\n"
     "Renders the scene at night through a pinhole camera (SPEC §5: up is +z,\n"
     "vertical field of view, pixel centres): ground, facades and roofs lit by\n"
@@ -59,6 +61,8 @@ static const char help[] =
     "                   an OSMesa buffer; " OSMESA_STATE "); the same image\n"
     "  -o FILE          output PNG (required)\n"
     "  --pfm FILE       also write the linear radiance as PFM\n"
+    "  --threads N      threads for the frame (default: the number of processors);\n"
+    "                   the same bytes for any N\n"
     "  --mem SIZE, --strict, --quiet, --lamps FILE   as for 'polarlux info'\n";
 
 typedef struct render_args {
@@ -70,114 +74,69 @@ typedef struct render_args {
     cli_indirect ind;
 } render_args;
 
-static int parse_vec3(const char *s, double v[3])
+static int parse_vec3(const char *s, void *dst)
 {
+    double *v = dst;
     return cli_parse_coords(s, v, 3) == 0 && fabs(v[2]) <= 1e5 ? 0 : -1;
 }
 
-static int parse_value(render_args *a, const char *opt, const char *val)
+static int parse_backend(const char *s, void *dst)
 {
-    long w, h;
-    char extra;
-    if (strcmp(opt, "--eye") == 0) {
-        if (parse_vec3(val, a->cam.eye) != 0)
-            return cli_usage_error("render", "--eye '%s' is not X,Y,Z (finite, x and y within 1e7 m, z within 1e5 m)", val);
-        a->have_eye = 1;
-    } else if (strcmp(opt, "--target") == 0) {
-        if (parse_vec3(val, a->cam.target) != 0)
-            return cli_usage_error("render", "--target '%s' is not X,Y,Z (finite, x and y within 1e7 m, z within 1e5 m)", val);
-        a->have_target = 1;
-    } else if (strcmp(opt, "--fov") == 0) {
-        if (cli_parse_double(val, &a->cam.fov_deg) != 0 || !(a->cam.fov_deg > 0 && a->cam.fov_deg < 180))
-            return cli_usage_error("render", "--fov '%s' is not between 0 and 180 degrees", val);
-    } else if (strcmp(opt, "--size") == 0) {
-        if (sscanf(val, "%ldx%ld%c", &w, &h, &extra) != 2 || w < 1 || h < 1 || w > 8192 || h > 8192)
-            return cli_usage_error("render", "--size '%s' is not WxH (1..8192 each)", val);
-        a->cam.width = (int32_t)w;
-        a->cam.height = (int32_t)h;
-    } else if (strcmp(opt, "--view") == 0) {
-        if (strcmp(val, "street") && strcmp(val, "aerial"))
-            return cli_usage_error("render", "--view '%s' is not street or aerial", val);
-        a->aerial = strcmp(val, "aerial") == 0;
-    } else if (strcmp(opt, "--backend") == 0) {
-        if (strcmp(val, "soft") == 0 || strcmp(val, "osmesa") == 0) {
-            a->osmesa = strcmp(val, "osmesa") == 0;
-            return EXIT_OK;
-        }
-        return cli_usage_error("render", "--backend '%s' is not soft or osmesa", val);
-    } else if (strcmp(opt, "--exposure") == 0) {
-        if (cli_parse_real(val, 0, 1e9, &a->opts.exposure) != 0)
-            return cli_usage_error("render", "--exposure '%s' is not a number from 0 to 1e9", val);
-        a->opts.auto_exposure = 0;
-    } else if (strcmp(opt, "--texel") == 0) {
-        if (cli_parse_real(val, 0.01, 1e4, &a->opts.aerial_m_per_texel) != 0)
-            return cli_usage_error("render", "--texel '%s' is not a number of metres from 0.01 to 1e4", val);
-    } else if (strcmp(opt, "--aa") == 0) {
-        long n;
-        if (cli_parse_int(val, 1, PLX_RENDER_MAX_AA, &n) != 0)
-            return cli_usage_error("render", "--aa '%s' is not a whole number from 1 to %d", val, PLX_RENDER_MAX_AA);
-        a->opts.aa = (int)n;
-    } else if (strcmp(opt, "-o") == 0) {
-        a->out = val;
-    } else if (strcmp(opt, "--pfm") == 0) {
-        a->pfm = val;
-    } else {
+    if (strcmp(s, "soft") && strcmp(s, "osmesa"))
         return -1;
-    }
-    return EXIT_OK;
+    *(int *)dst = strcmp(s, "osmesa") == 0;
+    return 0;
+}
+
+static int parse_exposure(const char *s, void *dst)
+{
+    return cli_parse_real(s, 0, 1e9, dst);
+}
+
+static int parse_texel(const char *s, void *dst)
+{
+    return cli_parse_real(s, 0.01, 1e4, dst);
 }
 
 static int parse_args(int argc, char **argv, render_args *a)
 {
-    static const char *const valued[] = { "--eye", "--target", "--fov", "--size", "--view", "--backend",
-                                          "--exposure", "--texel", "-o", "--pfm", "--aa" };
-    int i;
-    size_t k;
+    cli_view v;
+    cli_opt view[CLI_VIEW_NOPTS];
+    int exposure = 0, rc;
+    const cli_opt opts[] = {
+        { "--eye", NULL, a->cam.eye, parse_vec3,
+          "--eye '%s' is not X,Y,Z (finite, x and y within 1e7 m, z within 1e5 m)", 0, NULL, &a->have_eye, NULL },
+        { "--target", NULL, a->cam.target, parse_vec3,
+          "--target '%s' is not X,Y,Z (finite, x and y within 1e7 m, z within 1e5 m)", 0, NULL, &a->have_target, NULL },
+        CLI_OPT_VAL("--backend", &a->osmesa, parse_backend, "--backend '%s' is not soft or osmesa"),
+        { "--exposure", NULL, &a->opts.exposure, parse_exposure, "--exposure '%s' is not a number from 0 to 1e9", 0,
+          NULL, &exposure, NULL },
+        CLI_OPT_VAL("--texel", &a->opts.aerial_m_per_texel, parse_texel,
+                    "--texel '%s' is not a number of metres from 0.01 to 1e4"),
+        CLI_OPT_STR("-o", &a->out),
+        CLI_OPT_STR("--pfm", &a->pfm),
+        CLI_OPT_MORE(view),
+        CLI_OPT_END
+    };
+    cli_args pa;
     memset(a, 0, sizeof *a);
     plx_render_opts_default(&a->opts);
     a->opts.auto_exposure = 1; /* until --exposure */
     cli_indirect_default(&a->ind);
-    a->cam.fov_deg = 60.0;
-    a->cam.width = 640;
-    a->cam.height = 480;
-    for (i = 1; i < argc; i++) {
-        const char *s = argv[i];
-        int r = cli_common_option("render", argc, argv, &i, &a->c);
-        if (r == 0)
-            r = cli_indirect_option("render", argc, argv, &i, &a->ind);
-        if (r < 0)
-            return EXIT_USAGE;
-        if (r)
-            continue;
-        if (strcmp(s, "--help") == 0 || strcmp(s, "-h") == 0) {
-            fputs(help, stdout);
-            return -1;
-        }
-        if (strcmp(s, "--no-glow") == 0) {
-            a->opts.no_glow = 1;
-            continue;
-        }
-        if (strcmp(s, "--refine") == 0) {
-            a->refine = 1;
-            continue;
-        }
-        for (k = 0; k < sizeof valued / sizeof valued[0]; k++)
-            if (strcmp(s, valued[k]) == 0)
-                break;
-        if (k < sizeof valued / sizeof valued[0]) {
-            if (i + 1 >= argc)
-                return cli_usage_error("render", "%s needs a value", s);
-            r = parse_value(a, s, argv[++i]);
-            if (r != EXIT_OK)
-                return r;
-        } else if (s[0] == '-' && s[1] != '\0') {
-            return cli_usage_error("render", "unknown option '%s'", s);
-        } else if (!a->scene) {
-            a->scene = s;
-        } else {
-            return cli_usage_error("render", "unexpected argument '%s'", s);
-        }
-    }
+    cli_view_init(&v, 640, 480, 60.0, &a->opts);
+    cli_view_opts(&v, view);
+    rc = cli_options_n("render", help, argc, argv, opts, &a->c, &a->ind, 1, NULL, &pa);
+    if (rc != EXIT_OK)
+        return rc;
+    a->scene = pa.npos ? pa.pos[0] : NULL;
+    a->cam.fov_deg = v.fov;
+    a->cam.width = (int32_t)v.size[0];
+    a->cam.height = (int32_t)v.size[1];
+    cli_view_apply(&v, &a->opts);
+    a->aerial = v.aerial;
+    a->refine = v.refine;
+    if (exposure)
+        a->opts.auto_exposure = 0;
     if (!a->scene)
         return cli_usage_error("render", "missing SCENE");
     if (!a->out)
@@ -189,7 +148,6 @@ static int parse_args(int argc, char **argv, render_args *a)
     if (a->have_eye && a->cam.eye[0] == a->cam.target[0] && a->cam.eye[1] == a->cam.target[1] &&
         a->cam.eye[2] == a->cam.target[2])
         return cli_usage_error("render", "--eye and --target are the same point");
-    a->opts.aerial = a->aerial;
     a->opts.no_indirect = a->ind.off;
     return EXIT_OK;
 }
@@ -244,6 +202,9 @@ static int default_street(plx_engine *e, plx_camera *cam)
     lamp_rank *r;
     double cx, cy, best = INFINITY;
     uint32_t i, n;
+    plx_status st = plx_polar_build(e); /* the search below asks for visibility */
+    if (st != PLX_OK)
+        return st == PLX_E_NOMEM ? -2 : -1;
     plx_scene_info_get(e, &si);
     cx = 0.5 * (si.bounds[0] + si.bounds[2]);
     cy = 0.5 * (si.bounds[1] + si.bounds[3]);
@@ -366,7 +327,11 @@ int cmd_render(int argc, char **argv)
     if (!a.have_eye) {
         if (a.aerial) {
             default_aerial(e, &a.cam);
-        } else if (default_street(e, &a.cam) != 0) {
+        } else if ((rc = default_street(e, &a.cam)) == -2) {
+            fprintf(stderr, "polarlux render: %s\n", plx_last_error(e));
+            plx_engine_free(e);
+            return EXIT_NOMEM;
+        } else if (rc != 0) {
             plx_scene_info si;
             plx_scene_info_get(e, &si);
             if (si.lamps == 0)

@@ -4,6 +4,7 @@
 #include <string.h>
 
 #include "cli.h"
+#include "options.h"
 #include "geo_out.h"
 #include "port.h"
 #include "route_io.h"
@@ -227,6 +228,16 @@ static int score_all(plx_engine *e, const route_opts *o, route_set *rs)
     return rc;
 }
 
+static int parse_step(const char *v, void *dst)
+{
+    return cli_parse_real(v, 0.01, CLI_MAX_COORD, dst);
+}
+
+static int parse_dark_lux(const char *v, void *dst)
+{
+    return cli_parse_real(v, 0, 1e9, dst);
+}
+
 int cmd_route(int argc, char **argv)
 {
     route_opts o;
@@ -234,6 +245,15 @@ int cmd_route(int argc, char **argv)
     route_set rs;
     char err[512];
     int i, rc;
+    const cli_opt opts[] = {
+        CLI_OPT_STR("--path", &o.path),
+        CLI_OPT_STR("--geojson", &o.geojson),
+        CLI_OPT_VAL("--step", &o.step, parse_step, "--step '%s' is not a number of metres from 0.01 to 1e7"),
+        CLI_OPT_VAL("--height", &o.height, cli_opt_height, "--height '%s' is not a number of metres from 0 to 1000"),
+        CLI_OPT_VAL("--dark-lux", &o.dark, parse_dark_lux, "--dark-lux '%s' is not a number of lux from 0 to 1e9"),
+        CLI_OPT_END
+    };
+    cli_args pa;
     for (i = 1; i < argc; i++) /* the best-lit route over a street network: cmd_network.c */
         if (strcmp(argv[i], "--network") == 0)
             return cmd_route_network(argc, argv);
@@ -241,41 +261,10 @@ int cmd_route(int argc, char **argv)
     o.step = 1.0;
     o.dark = 1.0;
     o.height = 1.5;
-    for (i = 1; i < argc; i++) {
-        const char *a = argv[i];
-        int r = cli_common_option("route", argc, argv, &i, &o.c);
-        if (r < 0)
-            return EXIT_USAGE;
-        if (r)
-            continue;
-        if (strcmp(a, "--help") == 0 || strcmp(a, "-h") == 0) {
-            fputs(route_help, stdout);
-            return EXIT_OK;
-        }
-        if ((strcmp(a, "--path") == 0 || strcmp(a, "--step") == 0 || strcmp(a, "--dark-lux") == 0 ||
-             strcmp(a, "--geojson") == 0 || strcmp(a, "--height") == 0) && i + 1 >= argc)
-            return cli_usage_error("route", "%s needs a value", a);
-        if (strcmp(a, "--path") == 0) {
-            o.path = argv[++i];
-        } else if (strcmp(a, "--geojson") == 0) {
-            o.geojson = argv[++i];
-        } else if (strcmp(a, "--step") == 0) {
-            if (cli_parse_real(argv[++i], 0.01, CLI_MAX_COORD, &o.step) != 0)
-                return cli_usage_error("route", "--step '%s' is not a number of metres from 0.01 to 1e7", argv[i]);
-        } else if (strcmp(a, "--height") == 0) {
-            if (cli_parse_double(argv[++i], &o.height) != 0 || !(o.height >= 0) || !(o.height <= 1000))
-                return cli_usage_error("route", "--height '%s' is not a number of metres from 0 to 1000", argv[i]);
-        } else if (strcmp(a, "--dark-lux") == 0) {
-            if (cli_parse_real(argv[++i], 0, 1e9, &o.dark) != 0)
-                return cli_usage_error("route", "--dark-lux '%s' is not a number of lux from 0 to 1e9", argv[i]);
-        } else if (a[0] == '-' && a[1] != '\0') {
-            return cli_usage_error("route", "unknown option '%s'", a);
-        } else if (!o.scene) {
-            o.scene = a;
-        } else {
-            return cli_usage_error("route", "unexpected argument '%s'", a);
-        }
-    }
+    rc = cli_options_n("route", route_help, argc, argv, opts, &o.c, NULL, 1, NULL, &pa);
+    if (rc != EXIT_OK)
+        return rc < 0 ? EXIT_OK : rc;
+    o.scene = pa.npos ? pa.pos[0] : NULL;
     if (!o.scene)
         return cli_usage_error("route", "missing SCENE");
     if (!o.path)
@@ -598,50 +587,44 @@ done:
     return rc;
 }
 
+static int parse_res(const char *v, void *dst)
+{
+    double *r = dst;
+    return cli_parse_real(v, 0, CLI_MAX_COORD, r) != 0 || !(*r > 0) ? -1 : 0;
+}
+
+static int parse_spacing(const char *v, void *dst)
+{
+    return cli_parse_real(v, 0, CLI_MAX_COORD, dst);
+}
+
+static int parse_count(const char *v, void *dst)
+{
+    return cli_parse_int(v, 1, 1000000, dst);
+}
+
 int cmd_dark_spots(int argc, char **argv)
 {
     cli_common c;
     const char *scene = NULL, *out = NULL;
     double res = 2.0, spacing = 10.0;
     long count = 50;
-    int all = 0, i, rc;
+    int all = 0, rc;
     plx_engine *e;
+    const cli_opt opts[] = {
+        CLI_OPT_VAL("--res", &res, parse_res, "--res '%s' is not a positive number of metres"),
+        CLI_OPT_VAL("--spacing", &spacing, parse_spacing, "--spacing '%s' is not a number of metres >= 0"),
+        CLI_OPT_VAL("--count", &count, parse_count, "--count '%s' is not 1..1000000"),
+        CLI_OPT_FLAG("--all", &all),
+        CLI_OPT_STR("-o", &out),
+        CLI_OPT_END
+    };
+    cli_args pa;
     memset(&c, 0, sizeof c);
-    for (i = 1; i < argc; i++) {
-        const char *a = argv[i];
-        int r = cli_common_option("dark-spots", argc, argv, &i, &c);
-        if (r < 0)
-            return EXIT_USAGE;
-        if (r)
-            continue;
-        if (strcmp(a, "--help") == 0 || strcmp(a, "-h") == 0) {
-            fputs(spots_help, stdout);
-            return EXIT_OK;
-        }
-        if ((strcmp(a, "--res") == 0 || strcmp(a, "--count") == 0 || strcmp(a, "--spacing") == 0 ||
-             strcmp(a, "-o") == 0) && i + 1 >= argc)
-            return cli_usage_error("dark-spots", "%s needs a value", a);
-        if (strcmp(a, "--res") == 0) {
-            if (cli_parse_real(argv[++i], 0, CLI_MAX_COORD, &res) != 0 || !(res > 0))
-                return cli_usage_error("dark-spots", "--res '%s' is not a positive number of metres", argv[i]);
-        } else if (strcmp(a, "--spacing") == 0) {
-            if (cli_parse_real(argv[++i], 0, CLI_MAX_COORD, &spacing) != 0)
-                return cli_usage_error("dark-spots", "--spacing '%s' is not a number of metres >= 0", argv[i]);
-        } else if (strcmp(a, "--count") == 0) {
-            if (cli_parse_int(argv[++i], 1, 1000000, &count) != 0)
-                return cli_usage_error("dark-spots", "--count '%s' is not 1..1000000", argv[i]);
-        } else if (strcmp(a, "--all") == 0) {
-            all = 1;
-        } else if (strcmp(a, "-o") == 0) {
-            out = argv[++i];
-        } else if (a[0] == '-' && a[1] != '\0') {
-            return cli_usage_error("dark-spots", "unknown option '%s'", a);
-        } else if (!scene) {
-            scene = a;
-        } else {
-            return cli_usage_error("dark-spots", "unexpected argument '%s'", a);
-        }
-    }
+    rc = cli_options_n("dark-spots", spots_help, argc, argv, opts, &c, NULL, 1, NULL, &pa);
+    if (rc != EXIT_OK)
+        return rc < 0 ? EXIT_OK : rc;
+    scene = pa.npos ? pa.pos[0] : NULL;
     if (!scene)
         return cli_usage_error("dark-spots", "missing SCENE");
     rc = cli_open_scene("dark-spots", scene, &c, &e);

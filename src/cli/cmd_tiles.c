@@ -8,6 +8,7 @@
 #include <unistd.h>
 
 #include "cli.h"
+#include "options.h"
 #include "port.h"
 #include "tiles.h"
 
@@ -197,8 +198,10 @@ static int run(plx_engine *e, const tiles_opts *o, double top)
     return rc;
 }
 
-static int parse_zoom(const char *s, tiles_opts *o)
+/* Z or Z0-Z1 into o->z0, o->z1 (dst: the tiles_opts). */
+static int parse_zoom(const char *s, void *dst)
 {
+    tiles_opts *o = dst;
     char a[32], *dash;
     snprintf(a, sizeof a, "%s", s);
     dash = strchr(a, '-');
@@ -212,57 +215,42 @@ static int parse_zoom(const char *s, tiles_opts *o)
     return o->z1 >= o->z0 ? 0 : -1;
 }
 
+static int parse_quantity(const char *q, void *dst)
+{
+    int *k = dst;
+    *k = strcmp(q, "h") == 0 ? PLX_METER_H : strcmp(q, "sc") == 0 ? PLX_METER_SC : -1;
+    return *k < 0 ? -1 : 0;
+}
+
+static int parse_max(const char *s, void *dst)
+{
+    double *t = dst;
+    return cli_parse_double(s, t) != 0 || !(*t > 0.1) ? -1 : 0;
+}
+
 static int parse(int argc, char **argv, tiles_opts *o)
 {
-    int i, have_zoom = 0, sc_option = 0;
+    int have_zoom = 0, sc_option = 0, rc;
+    const cli_opt opts[] = {
+        { "--zoom", NULL, o, parse_zoom, "--zoom '%s' is not Z or Z0-Z1 with 0 <= Z0 <= Z1 <= 22", 0, NULL, &have_zoom,
+          NULL },
+        CLI_OPT_VAL("--quantity", &o->q.quantity, parse_quantity, "--quantity '%s' is not h (ground E_h) or sc (E_sc)"),
+        { "--height", NULL, &o->q.height, cli_opt_height, "--height '%s' is not a number of metres from 0 to 1000", 0,
+          NULL, &sc_option, NULL },
+        { "--facing", NULL, &o->q, cli_opt_facing, "--facing '%s' is not a number of degrees or min", 0, NULL,
+          &sc_option, NULL },
+        CLI_OPT_VAL("--max", &o->top, parse_max, "--max '%s' is not a number of lux above 0.1"),
+        CLI_OPT_STR("-o", &o->out),
+        CLI_OPT_END
+    };
+    cli_args pa;
     o->q.quantity = PLX_METER_H;
     o->q.height = 1.5;
     o->q.facing_min = 1;
-    for (i = 1; i < argc; i++) {
-        const char *a = argv[i];
-        int r = cli_common_option("tiles", argc, argv, &i, &o->c);
-        if (r < 0)
-            return EXIT_USAGE;
-        if (r)
-            continue;
-        if (strcmp(a, "--help") == 0 || strcmp(a, "-h") == 0) {
-            fputs(help, stdout);
-            return -1;
-        }
-        if ((strcmp(a, "--zoom") == 0 || strcmp(a, "--quantity") == 0 || strcmp(a, "--max") == 0 ||
-             strcmp(a, "-o") == 0 || strcmp(a, "--height") == 0 || strcmp(a, "--facing") == 0) && i + 1 >= argc)
-            return cli_usage_error("tiles", "%s needs a value", a);
-        if (strcmp(a, "--zoom") == 0) {
-            if (parse_zoom(argv[++i], o) != 0)
-                return cli_usage_error("tiles", "--zoom '%s' is not Z or Z0-Z1 with 0 <= Z0 <= Z1 <= 22", argv[i]);
-            have_zoom = 1;
-        } else if (strcmp(a, "--quantity") == 0) {
-            const char *q = argv[++i];
-            o->q.quantity = strcmp(q, "h") == 0 ? PLX_METER_H : strcmp(q, "sc") == 0 ? PLX_METER_SC : -1;
-            if (o->q.quantity < 0)
-                return cli_usage_error("tiles", "--quantity '%s' is not h (ground E_h) or sc (E_sc)", q);
-        } else if (strcmp(a, "--height") == 0) {
-            sc_option = 1;
-            if (cli_parse_double(argv[++i], &o->q.height) != 0 || !(o->q.height >= 0) || !(o->q.height <= 1000))
-                return cli_usage_error("tiles", "--height '%s' is not a number of metres from 0 to 1000", argv[i]);
-        } else if (strcmp(a, "--facing") == 0) {
-            sc_option = 1;
-            o->q.facing_min = strcmp(argv[++i], "min") == 0;
-            if (!o->q.facing_min && (cli_parse_double(argv[i], &o->q.facing) != 0 || !isfinite(o->q.facing)))
-                return cli_usage_error("tiles", "--facing '%s' is not a number of degrees or min", argv[i]);
-        } else if (strcmp(a, "--max") == 0) {
-            if (cli_parse_double(argv[++i], &o->top) != 0 || !(o->top > 0.1))
-                return cli_usage_error("tiles", "--max '%s' is not a number of lux above 0.1", argv[i]);
-        } else if (strcmp(a, "-o") == 0) {
-            o->out = argv[++i];
-        } else if (a[0] == '-' && a[1] != '\0') {
-            return cli_usage_error("tiles", "unknown option '%s'", a);
-        } else if (!o->scene) {
-            o->scene = a;
-        } else {
-            return cli_usage_error("tiles", "unexpected argument '%s'", a);
-        }
-    }
+    rc = cli_options_n("tiles", help, argc, argv, opts, &o->c, NULL, 1, NULL, &pa);
+    if (rc != EXIT_OK)
+        return rc;
+    o->scene = pa.npos ? pa.pos[0] : NULL;
     if (!o->scene)
         return cli_usage_error("tiles", "missing SCENE");
     if (!have_zoom)

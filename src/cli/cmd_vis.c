@@ -4,6 +4,7 @@
 #include <string.h>
 
 #include "cli.h"
+#include "options.h"
 #include "geo_out.h"
 #include "points.h"
 
@@ -37,47 +38,40 @@ typedef struct vis_opts {
     cli_common c;
 } vis_opts;
 
+static int parse_at(const char *v, void *dst)
+{
+    return cli_parse_coords(v, dst, 2);
+}
+
+static int parse_dir(const char *v, void *dst)
+{
+    return cli_parse_real(v, -1e6, 1e6, dst);
+}
+
+static int parse_fov(const char *v, void *dst)
+{
+    double *f = dst;
+    return cli_parse_real(v, 0, 1e6, f) != 0 || !(*f > 0) ? -1 : 0;
+}
+
 static int parse_args(int argc, char **argv, vis_opts *o)
 {
-    int i;
+    int rc;
+    const cli_opt opts[] = {
+        CLI_OPT_STR("--points", &o->points),
+        CLI_OPT_STR("--geojson", &o->geojson),
+        { "--at", NULL, o->at, parse_at, "--at '%s' is not X,Y (finite, within 1e7 m)", 0, NULL, &o->have_at, NULL },
+        CLI_OPT_VAL("--dir", &o->dir, parse_dir, "--dir '%s' is not a number of degrees"),
+        CLI_OPT_VAL("--fov", &o->fov, parse_fov, "--fov '%s' is not a positive number of degrees"),
+        CLI_OPT_END
+    };
+    cli_args pa;
     memset(o, 0, sizeof *o);
     o->fov = 360.0;
-    for (i = 1; i < argc; i++) {
-        const char *a = argv[i];
-        int r = cli_common_option("vis", argc, argv, &i, &o->c);
-        if (r < 0)
-            return EXIT_USAGE;
-        if (r)
-            continue;
-        if (strcmp(a, "--help") == 0 || strcmp(a, "-h") == 0) {
-            fputs(help, stdout);
-            return -1;
-        }
-        if ((strcmp(a, "--points") == 0 || strcmp(a, "--geojson") == 0 || strcmp(a, "--at") == 0 ||
-             strcmp(a, "--dir") == 0 || strcmp(a, "--fov") == 0) && i + 1 >= argc)
-            return cli_usage_error("vis", "%s needs a value", a);
-        if (strcmp(a, "--points") == 0) {
-            o->points = argv[++i];
-        } else if (strcmp(a, "--geojson") == 0) {
-            o->geojson = argv[++i];
-        } else if (strcmp(a, "--at") == 0) {
-            if (cli_parse_coords(argv[++i], o->at, 2) != 0)
-                return cli_usage_error("vis", "--at '%s' is not X,Y (finite, within 1e7 m)", argv[i]);
-            o->have_at = 1;
-        } else if (strcmp(a, "--dir") == 0) {
-            if (cli_parse_real(argv[++i], -1e6, 1e6, &o->dir) != 0)
-                return cli_usage_error("vis", "--dir '%s' is not a number of degrees", argv[i]);
-        } else if (strcmp(a, "--fov") == 0) {
-            if (cli_parse_real(argv[++i], 0, 1e6, &o->fov) != 0 || !(o->fov > 0))
-                return cli_usage_error("vis", "--fov '%s' is not a positive number of degrees", argv[i]);
-        } else if (a[0] == '-' && a[1] != '\0') {
-            return cli_usage_error("vis", "unknown option '%s'", a);
-        } else if (!o->scene) {
-            o->scene = a;
-        } else {
-            return cli_usage_error("vis", "unexpected argument '%s'", a);
-        }
-    }
+    rc = cli_options_n("vis", help, argc, argv, opts, &o->c, NULL, 1, NULL, &pa);
+    if (rc != EXIT_OK)
+        return rc;
+    o->scene = pa.npos ? pa.pos[0] : NULL;
     if (!o->scene)
         return cli_usage_error("vis", "missing SCENE");
     if (!o->points == !o->have_at)

@@ -6,6 +6,7 @@
 #include <sys/stat.h>
 
 #include "cli.h"
+#include "options.h"
 #include "port.h"
 #include "png/image_write.h"
 #include "walk_path.h"
@@ -13,10 +14,11 @@
 static const char help[] =
     "usage: polarlux walk SCENE|BAKE --path CAMERA.geojson -o DIR [--size WxH] [--fps F]\n"
     "                     [--speed M/S] [--fov DEG] [--aa N] [--exposure E] [--no-glow]\n"
-    "                     [--no-indirect] [--view street|aerial] [--max-frames N]\n"
+    "                     [--no-indirect] [--view street|aerial] [--max-frames N] [--threads N]\n"
     "\n"
     "Renders frames along a camera path and writes DIR/frame-0001.png ...,\n"
-    "DIR/cameras.txt (frame, eye, target) and DIR/contact.png (a contact sheet\n"
+    "DIR/cameras.txt (frame, eye, target), DIR/walk.png (the frames as an animated\n"
+    "PNG, 1/F s each, looping) and DIR/contact.png (a contact sheet\n"
     "of up to 16 frames). Everything is built once (or loaded from a bake) and\n"
     "reused by every frame. Prints the render time per frame (median, p95)\n"
     "and frames per second.\n"
@@ -37,6 +39,8 @@ static const char help[] =
     "                   pushed into the aerial map; then --refine-frames K photon\n"
     "                   frames (default 2) refill the aerial chart. Prints the cache's\n"
     "                   hits, misses and evictions\n"
+    "  --threads N      threads for each frame (default: the number of processors);\n"
+    "                   the same bytes for any N\n"
     "  --mem SIZE, --strict, --quiet   as for 'polarlux info'\n";
 
 typedef struct walk_args {
@@ -50,113 +54,76 @@ typedef struct walk_args {
     cli_indirect ind;
 } walk_args;
 
-static int parse_value(walk_args *a, const char *opt, const char *val)
+static int parse_rate(const char *val, void *dst)
 {
-    long w, h, n;
-    char extra;
-    if (strcmp(opt, "--path") == 0) {
-        a->path = val;
-    } else if (strcmp(opt, "-o") == 0) {
-        a->dir = val;
-    } else if (strcmp(opt, "--size") == 0) {
-        if (sscanf(val, "%ldx%ld%c", &w, &h, &extra) != 2 || w < 1 || h < 1 || w > 8192 || h > 8192)
-            return cli_usage_error("walk", "--size '%s' is not WxH (1..8192 each)", val);
-        a->w = (int)w;
-        a->h = (int)h;
-    } else if (strcmp(opt, "--fps") == 0 || strcmp(opt, "--speed") == 0) {
-        double *v = strcmp(opt, "--fps") == 0 ? &a->fps : &a->speed;
-        if (cli_parse_double(val, v) != 0 || !(*v > 0) || *v > 1e4)
-            return cli_usage_error("walk", "%s '%s' is not a positive number", opt, val);
-    } else if (strcmp(opt, "--fov") == 0) {
-        if (cli_parse_double(val, &a->fov) != 0 || !(a->fov > 0 && a->fov < 180))
-            return cli_usage_error("walk", "--fov '%s' is not between 0 and 180 degrees", val);
-    } else if (strcmp(opt, "--aa") == 0) {
-        if (cli_parse_int(val, 1, PLX_RENDER_MAX_AA, &n) != 0)
-            return cli_usage_error("walk", "--aa '%s' is not a whole number from 1 to %d", val, PLX_RENDER_MAX_AA);
-        a->opts.aa = (int)n;
-    } else if (strcmp(opt, "--exposure") == 0) {
-        if (cli_parse_double(val, &a->opts.exposure) != 0 || !(a->opts.exposure >= 0))
-            return cli_usage_error("walk", "--exposure '%s' is not a number >= 0", val);
-        a->opts.auto_exposure = 0;
-    } else if (strcmp(opt, "--view") == 0) {
-        if (strcmp(val, "street") && strcmp(val, "aerial"))
-            return cli_usage_error("walk", "--view '%s' is not street or aerial", val);
-        a->aerial = strcmp(val, "aerial") == 0;
-    } else if (strcmp(opt, "--refine-frames") == 0) {
-        if (cli_parse_int(val, 0, 100000, &a->refine_frames) != 0)
-            return cli_usage_error("walk", "--refine-frames '%s' is not a whole number >= 0", val);
-    } else if (strcmp(opt, "--max-frames") == 0) {
-        if (cli_parse_int(val, 1, 1000000, &a->max_frames) != 0)
-            return cli_usage_error("walk", "--max-frames '%s' is not a whole number >= 1", val);
-    } else {
-        return -1;
-    }
-    return EXIT_OK;
+    double *v = dst;
+    return cli_parse_double(val, v) != 0 || !(*v > 0) || *v > 1e4 ? -1 : 0;
+}
+
+static int parse_exposure(const char *val, void *dst)
+{
+    double *v = dst;
+    return cli_parse_double(val, v) != 0 || !(*v >= 0) ? -1 : 0;
+}
+
+static int parse_refine_frames(const char *val, void *dst)
+{
+    return cli_parse_int(val, 0, 100000, dst);
+}
+
+static int parse_max_frames(const char *val, void *dst)
+{
+    return cli_parse_int(val, 1, 1000000, dst);
 }
 
 static int parse_args(int argc, char **argv, walk_args *a)
 {
-    static const char *const valued[] = { "--path", "-o", "--size", "--fps", "--speed", "--fov", "--aa",
-                                          "--exposure", "--view", "--max-frames", "--refine-frames" };
-    int i;
-    size_t k;
+    cli_view v;
+    cli_opt view[CLI_VIEW_NOPTS];
+    int exposure = 0, rc;
+    const cli_opt opts[] = {
+        CLI_OPT_STR("--path", &a->path),
+        CLI_OPT_STR("-o", &a->dir),
+        CLI_OPT_VAL("--fps", &a->fps, parse_rate, "--fps '%s' is not a positive number"),
+        CLI_OPT_VAL("--speed", &a->speed, parse_rate, "--speed '%s' is not a positive number"),
+        { "--exposure", NULL, &a->opts.exposure, parse_exposure, "--exposure '%s' is not a number >= 0", 0, NULL,
+          &exposure, NULL },
+        CLI_OPT_VAL("--refine-frames", &a->refine_frames, parse_refine_frames,
+                    "--refine-frames '%s' is not a whole number >= 0"),
+        CLI_OPT_VAL("--max-frames", &a->max_frames, parse_max_frames, "--max-frames '%s' is not a whole number >= 1"),
+        CLI_OPT_MORE(view),
+        CLI_OPT_END
+    };
+    cli_args pa;
     memset(a, 0, sizeof *a);
     plx_render_opts_default(&a->opts);
     a->opts.auto_exposure = 1;
-    a->opts.aa = 2;
     cli_indirect_default(&a->ind);
-    a->w = 640;
-    a->h = 480;
     a->fps = 25;
     a->speed = 1.4;
-    a->fov = 60;
     a->max_frames = 1000;
     a->refine_frames = 2;
-    for (i = 1; i < argc; i++) {
-        const char *s = argv[i];
-        int r = cli_common_option("walk", argc, argv, &i, &a->c);
-        if (r == 0)
-            r = cli_indirect_option("walk", argc, argv, &i, &a->ind);
-        if (r < 0)
-            return EXIT_USAGE;
-        if (r)
-            continue;
-        if (strcmp(s, "--help") == 0 || strcmp(s, "-h") == 0) {
-            fputs(help, stdout);
-            return -1;
-        }
-        if (strcmp(s, "--no-glow") == 0) {
-            a->opts.no_glow = 1;
-            continue;
-        }
-        if (strcmp(s, "--refine") == 0) {
-            a->refine = 1;
-            continue;
-        }
-        for (k = 0; k < sizeof valued / sizeof valued[0]; k++)
-            if (strcmp(s, valued[k]) == 0)
-                break;
-        if (k < sizeof valued / sizeof valued[0]) {
-            if (i + 1 >= argc)
-                return cli_usage_error("walk", "%s needs a value", s);
-            r = parse_value(a, s, argv[++i]);
-            if (r != EXIT_OK)
-                return r;
-        } else if (s[0] == '-' && s[1] != '\0') {
-            return cli_usage_error("walk", "unknown option '%s'", s);
-        } else if (!a->scene) {
-            a->scene = s;
-        } else {
-            return cli_usage_error("walk", "unexpected argument '%s'", s);
-        }
-    }
+    a->opts.aa = 2;
+    cli_view_init(&v, 640, 480, 60, &a->opts);
+    cli_view_opts(&v, view);
+    rc = cli_options_n("walk", help, argc, argv, opts, &a->c, &a->ind, 1, NULL, &pa);
+    if (rc != EXIT_OK)
+        return rc;
+    a->scene = pa.npos ? pa.pos[0] : NULL;
+    a->w = (int)v.size[0];
+    a->h = (int)v.size[1];
+    a->fov = v.fov;
+    cli_view_apply(&v, &a->opts);
+    a->aerial = v.aerial;
+    a->refine = v.refine;
+    if (exposure)
+        a->opts.auto_exposure = 0;
     if (!a->scene)
         return cli_usage_error("walk", "missing SCENE");
     if (!a->path)
         return cli_usage_error("walk", "missing --path CAMERA.geojson");
     if (!a->dir)
         return cli_usage_error("walk", "missing -o DIR");
-    a->opts.aerial = a->aerial;
     a->opts.no_indirect = a->ind.off;
     return EXIT_OK;
 }
@@ -192,6 +159,33 @@ static int contact_sheet(const walk_args *a, uint8_t *const *thumbs, int nthumb,
     snprintf(path, sizeof path, "%s/contact.png", a->dir);
     rc = image_write_png_rgb8(path, W, H, sheet, 0, err, errlen);
     free(sheet);
+    return rc;
+}
+
+/* The animated PNG DIR/walk.png from the n frame files, 1/fps s each. */
+static int animation(const walk_args *a, long n, char *err, size_t errlen)
+{
+    char path[4096], **names = calloc((size_t)n, sizeof *names);
+    double d = 1000.0 / a->fps;
+    unsigned num = d < 1.0 ? 1u : d > 65535.0 ? 65535u : (unsigned)(d + 0.5);
+    long k;
+    int rc = -1;
+    if (!names)
+        return snprintf(err, errlen, "out of memory for the animation"), -1;
+    for (k = 0; k < n; k++) {
+        names[k] = malloc(strlen(a->dir) + 32);
+        if (!names[k])
+            break;
+        sprintf(names[k], "%s/frame-%04ld.png", a->dir, k + 1);
+    }
+    snprintf(path, sizeof path, "%s/walk.png", a->dir);
+    if (k == n)
+        rc = image_write_apng(path, (const char *const *)names, (int)n, num, 1000, err, errlen);
+    else
+        snprintf(err, errlen, "out of memory for the animation");
+    for (k = 0; k < n; k++)
+        free(names[k]);
+    free(names);
     return rc;
 }
 
@@ -276,6 +270,10 @@ static int run(const walk_args *a, plx_engine *e, const walk_path *wp)
     for (f = 1; a->w / f > 400; f++)
         ;
     if (rc == EXIT_OK && contact_sheet(a, wr.thumbs, wr.nthumb, f, err, sizeof err) != 0) {
+        fprintf(stderr, "polarlux walk: %s\n", err);
+        rc = EXIT_FAIL;
+    }
+    if (rc == EXIT_OK && animation(a, wr.n, err, sizeof err) != 0) {
         fprintf(stderr, "polarlux walk: %s\n", err);
         rc = EXIT_FAIL;
     }

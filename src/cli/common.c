@@ -116,6 +116,17 @@ int cli_common_option(const char *cmd, int argc, char **argv, int *i, cli_common
         c->lamp_files[c->nlamp_files++] = argv[++*i];
         return 1;
     }
+    if (strcmp(a, "--threads") == 0) {
+        char *end = NULL;
+        long n = *i + 1 < argc ? strtol(argv[*i + 1], &end, 10) : 0;
+        if (*i + 1 >= argc || end == argv[*i + 1] || *end != '\0' || n < 1 || n > PLX_MAX_THREADS) {
+            cli_usage_error(cmd, "--threads needs a number of threads from 1 to %d", PLX_MAX_THREADS);
+            return -1;
+        }
+        ++*i;
+        c->threads = (int)n;
+        return 1;
+    }
     if (strcmp(a, "--mem") == 0) {
         if (*i + 1 >= argc) {
             cli_usage_error(cmd, "--mem needs a size, e.g. --mem 512M");
@@ -324,6 +335,7 @@ void cli_config(const cli_common *c, plx_config *cfg)
     cfg->strict = c->strict;
     cfg->render_max_width = c->render_w;
     cfg->render_max_height = c->render_h;
+    cfg->threads = c->threads;
 }
 
 cli_bake_state cli_bake_last;
@@ -506,6 +518,21 @@ int cli_indirect_option(const char *cmd, int argc, char **argv, int *i, cli_indi
     return 1;
 }
 
+/* A word on stderr when the photon buffers were made smaller than the
+ * default quality to fit --mem (README "Memory budgets"). */
+void cli_indirect_note(const char *cmd, plx_engine *e)
+{
+    plx_indirect_info pi;
+    if (plx_indirect_info_get(e, &pi) != PLX_OK || pi.reductions == 0)
+        return;
+    fprintf(stderr,
+            "polarlux %s: indirect light at reduced quality to fit --mem: photon buffers %.1f MiB "
+            "instead of %.1f (%u steps: facade charts %ux%u, aerial chart %ux%u texels of %.1f m, "
+            "%u lamp floor maps, lamp ray tables %s)\n",
+            cmd, pi.bytes / 1048576.0, pi.full_bytes / 1048576.0, pi.reductions, pi.chart_w, pi.chart_h,
+            pi.aerial_w, pi.aerial_h, pi.aerial_texel, pi.lamp_slots, pi.lamp_tables ? "on" : "off");
+}
+
 int cli_indirect_run(const char *cmd, plx_engine *e, const cli_indirect *ind, const double *eye,
                      const double *dir, double fov_deg)
 {
@@ -534,6 +561,8 @@ int cli_indirect_run(const char *cmd, plx_engine *e, const cli_indirect *ind, co
             fprintf(stderr, "%spolarlux %s: %s\n", tty ? "\n" : "", cmd, plx_last_error(e));
             return cli_exit_code(st);
         }
+        if (k == 0)
+            cli_indirect_note(cmd, e);
         if (tty)
             fprintf(stderr, "\rindirect light: frame %ld/%ld (%ld photons each), %.1f s", k + 1, ind->frames,
                     ind->photons, (port_now_ns() - t0) / 1e9);

@@ -1,19 +1,42 @@
 /* options: the one option loop of the commands (see options.h). */
+#include <math.h>
 #include <stdio.h>
 #include <string.h>
 
 #include "options.h"
+
+#define STR_(x) #x
+#define STR(x) STR_(x)
 
 int cli_opt_double(const char *value, void *dst)
 {
     return cli_parse_double(value, dst);
 }
 
+int cli_opt_height(const char *value, void *dst)
+{
+    double *h = dst;
+    return cli_parse_double(value, h) != 0 || !(*h >= 0) || !(*h <= 1000) ? -1 : 0;
+}
+
+int cli_opt_facing(const char *value, void *dst)
+{
+    heat_quantity *q = dst;
+    q->facing_min = strcmp(value, "min") == 0;
+    return !q->facing_min && (cli_parse_double(value, &q->facing) != 0 || !isfinite(q->facing)) ? -1 : 0;
+}
+
 static const cli_opt *find_opt(const cli_opt *opts, const char *a)
 {
-    for (; opts && opts->name; opts++)
-        if (strcmp(a, opts->name) == 0 || (opts->alt && strcmp(a, opts->alt) == 0))
+    for (; opts && (opts->name || opts->more); opts++) {
+        if (!opts->name) {
+            const cli_opt *o = find_opt(opts->more, a);
+            if (o)
+                return o;
+        } else if (strcmp(a, opts->name) == 0 || (opts->alt && strcmp(a, opts->alt) == 0)) {
             return opts;
+        }
+    }
     return NULL;
 }
 
@@ -21,6 +44,9 @@ static const cli_opt *find_opt(const cli_opt *opts, const char *a)
 static int take_opt(const char *cmd, int argc, char **argv, int *i, const cli_opt *o)
 {
     const char *a = argv[*i];
+    int r;
+    if (o->given)
+        *o->given = 1;
     if (o->flag) {
         *(int *)o->dst = 1;
         return EXIT_OK;
@@ -32,16 +58,21 @@ static int take_opt(const char *cmd, int argc, char **argv, int *i, const cli_op
         *(const char **)o->dst = argv[*i];
         return EXIT_OK;
     }
-    if (o->parse(argv[*i], o->dst) != 0)
+    r = o->parse(argv[*i], o->dst);
+    if (r == -2)
+        return EXIT_USAGE;
+    if (r != 0)
         return cli_usage_error(cmd, o->bad, argv[*i]);
     return EXIT_OK;
 }
 
-int cli_options(const char *cmd, const char *help, int argc, char **argv, const cli_opt *opts,
-                cli_common *c, cli_indirect *ind, cli_args *out)
+int cli_options_n(const char *cmd, const char *help, int argc, char **argv, const cli_opt *opts,
+                  cli_common *c, cli_indirect *ind, int maxpos, const char *toomany, cli_args *out)
 {
     int i;
     memset(out, 0, sizeof *out);
+    if (maxpos > CLI_MAX_POS)
+        maxpos = CLI_MAX_POS;
     for (i = 1; i < argc; i++) {
         const char *a = argv[i];
         const cli_opt *o;
@@ -65,11 +96,82 @@ int cli_options(const char *cmd, const char *help, int argc, char **argv, const 
                 return EXIT_USAGE;
         } else if (a[0] == '-' && a[1] != '\0') {
             return cli_usage_error(cmd, "unknown option '%s'", a);
-        } else if (out->npos < CLI_MAX_POS) {
+        } else if (out->npos < maxpos) {
             out->pos[out->npos++] = a;
         } else {
-            return cli_usage_error(cmd, "unexpected argument '%s'", a);
+            return cli_usage_error(cmd, toomany ? toomany : "unexpected argument '%s'", a,
+                                   out->npos ? out->pos[out->npos - 1] : "");
         }
     }
     return EXIT_OK;
+}
+
+int cli_options(const char *cmd, const char *help, int argc, char **argv, const cli_opt *opts,
+                cli_common *c, cli_indirect *ind, cli_args *out)
+{
+    return cli_options_n(cmd, help, argc, argv, opts, c, ind, CLI_MAX_POS, NULL, out);
+}
+
+/* ---- the view options of render and walk ---------------------------------- */
+
+int cli_opt_size(const char *v, void *dst)
+{
+    long *wh = dst, w, h;
+    char extra;
+    if (sscanf(v, "%ldx%ld%c", &w, &h, &extra) != 2 || w < 1 || h < 1 || w > 8192 || h > 8192)
+        return -1;
+    wh[0] = w;
+    wh[1] = h;
+    return 0;
+}
+
+static int parse_fov(const char *v, void *dst)
+{
+    double *fov = dst;
+    return cli_parse_double(v, fov) != 0 || !(*fov > 0 && *fov < 180) ? -1 : 0;
+}
+
+static int parse_aa(const char *v, void *dst)
+{
+    return cli_parse_int(v, 1, PLX_RENDER_MAX_AA, dst);
+}
+
+static int parse_view(const char *v, void *dst)
+{
+    if (strcmp(v, "street") && strcmp(v, "aerial"))
+        return -1;
+    *(int *)dst = strcmp(v, "aerial") == 0;
+    return 0;
+}
+
+void cli_view_init(cli_view *v, long w, long h, double fov, const plx_render_opts *o)
+{
+    memset(v, 0, sizeof *v);
+    v->size[0] = w;
+    v->size[1] = h;
+    v->fov = fov;
+    v->aa = o->aa;
+    v->no_glow = o->no_glow;
+}
+
+void cli_view_apply(const cli_view *v, plx_render_opts *o)
+{
+    o->aa = (int)v->aa;
+    o->no_glow = v->no_glow;
+    o->aerial = v->aerial;
+}
+
+void cli_view_opts(cli_view *v, cli_opt *frag)
+{
+    const cli_opt f[CLI_VIEW_NOPTS] = {
+        CLI_OPT_VAL("--size", v->size, cli_opt_size, "--size '%s' is not WxH (1..8192 each)"),
+        CLI_OPT_VAL("--fov", &v->fov, parse_fov, "--fov '%s' is not between 0 and 180 degrees"),
+        CLI_OPT_VAL("--aa", &v->aa, parse_aa,
+                    "--aa '%s' is not a whole number from 1 to " STR(PLX_RENDER_MAX_AA)),
+        CLI_OPT_VAL("--view", &v->aerial, parse_view, "--view '%s' is not street or aerial"),
+        CLI_OPT_FLAG("--no-glow", &v->no_glow),
+        CLI_OPT_FLAG("--refine", &v->refine),
+        CLI_OPT_END
+    };
+    memcpy(frag, f, sizeof f);
 }

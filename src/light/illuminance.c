@@ -70,17 +70,17 @@ static int lamps_walk(light *L, const double P[3], const double n[3], int exact,
                       double *E, double rgb[3], uint32_t *ids, double *contrib, int cap)
 {
     const scene *s = L->s;
-    const light_grid *g = &L->lgrid;
+    const bucketgrid *g = &L->lgrid;
     uint32_t cell, k;
     int count = 0;
     double e = 0.0, c[3] = { 0.0, 0.0, 0.0 };
     if (s->nlamps == 0 || g->nx == 0)
         cell = UINT32_MAX;
     else
-        cell = light_grid_cell(g, P[0], P[1]);
+        cell = bucketgrid_cell(g, P[0], P[1]);
     for (k = cell == UINT32_MAX ? 0 : g->start[cell];
          cell != UINT32_MAX && k < g->start[cell + 1]; k++) {
-        uint32_t i = g->ids[k];
+        uint32_t i = g->item[k];
         double term = lamp_geom_term(&s->lamps[i], P, n);
         if (term == 0.0)
             continue;
@@ -101,6 +101,52 @@ static int lamps_walk(light *L, const double P[3], const double n[3], int exact,
     if (rgb)
         memcpy(rgb, c, sizeof c);
     return count;
+}
+
+int light_illuminance_cached(const light *L, const double P[3], const double n[3], double rgb[3])
+{
+    const scene *s = L->s;
+    const bucketgrid *g = &L->lgrid;
+    uint32_t cell, k;
+    double c[3] = { 0.0, 0.0, 0.0 };
+    if (L->pool_cap == 0)
+        return -1;
+    cell = s->nlamps == 0 || g->nx == 0 ? UINT32_MAX : bucketgrid_cell(g, P[0], P[1]);
+    for (k = cell == UINT32_MAX ? 0 : g->start[cell]; cell != UINT32_MAX && k < g->start[cell + 1]; k++) {
+        uint32_t i = g->item[k];
+        const lit_region *r = L->ent[i].reg;
+        double term = lamp_geom_term(&s->lamps[i], P, n);
+        if (term == 0.0)
+            continue;
+        if (!r || (P[0] == r->o[0] && P[1] == r->o[1]))
+            return -1;
+        if (!light_region_visible((light *)L, r, P))
+            continue;
+        c[0] += term * s->lamps[i].color[0];
+        c[1] += term * s->lamps[i].color[1];
+        c[2] += term * s->lamps[i].color[2];
+    }
+    memcpy(rgb, c, sizeof c);
+    return 0;
+}
+
+void light_cache_box(light *L, double x0, double y0, double x1, double y1)
+{
+    const scene *s = L->s;
+    const bucketgrid *g = &L->lgrid;
+    uint32_t c0, c1, cx, cy, k;
+    if (s->nlamps == 0 || g->nx == 0 || L->pool_cap == 0)
+        return;
+    c0 = bucketgrid_cell(g, x0, y0);
+    c1 = bucketgrid_cell(g, x1, y1);
+    for (cy = c0 / g->nx; cy <= c1 / g->nx; cy++)
+        for (cx = c0 % g->nx; cx <= c1 % g->nx; cx++)
+            for (k = g->start[cy * g->nx + cx]; k < g->start[cy * g->nx + cx + 1]; k++) {
+                const lit_region *r;
+                uint32_t i = g->item[k];
+                if (!L->ent[i].reg && s->lamps[i].radius > 0.0 && s->lamps[i].intensity > 0.0)
+                    (void)light_region_index(L, i, &r);
+            }
 }
 
 plx_status light_illuminance(light *L, const double P[3], const double n[3],

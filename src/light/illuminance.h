@@ -30,4 +30,17 @@ int light_lamps_at(light *L, const double P[3], const double n[3],
  * segment path. */
 int light_visible(light *L, uint32_t lamp, const double P[3]);
 
+/* light_illuminance's rgb at P (pool_cap > 0) reading the region cache
+ * only: nothing in L changes, so several threads may call it at once
+ * (while no one else uses L). Returns 0 with rgb written, the same values
+ * as light_illuminance; or -1 (rgb undefined) when a lamp that reaches P
+ * has no region in the cache or P lies straight under it (the segment
+ * path, which uses L's buffers). */
+int light_illuminance_cached(const light *L, const double P[3], const double n[3], double rgb[3] /* OUT */);
+
+/* Puts in the cache the region of every lamp whose ground reach box meets
+ * the box x0 <= x <= x1, y0 <= y <= y1 (as light_visible would on first
+ * need), from the lamp grid's cells over the box. */
+void light_cache_box(light *L, double x0, double y0, double x1, double y1);
+
 #endif

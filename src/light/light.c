@@ -33,34 +33,10 @@ static const vec2 *ring_pts(const scene *s, uint32_t r, uint32_t *n)
 
 /* ---- uniform grids -------------------------------------------------------- */
 
-static uint32_t clamp_index(double v, uint32_t n)
-{
-    if (!(v > 0.0))
-        return 0;
-    if (v >= (double)n)
-        return n - 1;
-    return (uint32_t)v;
-}
-
-uint32_t light_grid_cell(const light_grid *g, double x, double y)
-{
-    uint32_t ix = clamp_index((x - g->x0) * g->inv, g->nx);
-    uint32_t iy = clamp_index((y - g->y0) * g->inv, g->ny);
-    return iy * g->nx + ix;
-}
-
-/* Cell ranges covered by box b. */
-static void grid_range(const light_grid *g, const double b[4], uint32_t r[4])
-{
-    r[0] = clamp_index((b[0] - g->x0) * g->inv, g->nx);
-    r[1] = clamp_index((b[1] - g->y0) * g->inv, g->ny);
-    r[2] = clamp_index((b[2] - g->x0) * g->inv, g->nx);
-    r[3] = clamp_index((b[3] - g->y0) * g->inv, g->ny);
-}
-
-/* Sets the grid frame over the union of the boxes (skip[i] set: left out)
- * with cells of about 'cell' metres, at most about 'maxcells' of them. */
-static void grid_frame(light_grid *g, const double (*box)[4], uint32_t n, double cell,
+/* Sets the grid frame over the union of the boxes (a box with min > max is
+ * left out) with cells of about 'cell' metres, at most about 'maxcells' of
+ * them; returns the cell size. */
+static double grid_frame(bucketgrid *g, const double (*box)[4], uint32_t n, double cell,
                        double maxcells)
 {
     double lo[2] = { 0.0, 0.0 }, hi[2] = { 1.0, 1.0 }, w, h;
@@ -81,52 +57,8 @@ static void grid_frame(light_grid *g, const double (*box)[4], uint32_t n, double
         cell = 1.0;
     if ((w / cell + 1.0) * (h / cell + 1.0) > maxcells)
         cell = sqrt((w + cell) * (h + cell) / maxcells) + 1e-9;
-    g->x0 = lo[0];
-    g->y0 = lo[1];
-    g->cell = cell;
-    g->inv = 1.0 / cell;
-    g->nx = (uint32_t)(w / cell) + 1;
-    g->ny = (uint32_t)(h / cell) + 1;
-}
-
-/* Builds the grid's lists (boxes with min > max are left out). */
-static plx_status grid_fill(arena *a, light_grid *g, const double (*box)[4], uint32_t n)
-{
-    size_t ncell = (size_t)g->nx * g->ny, total = 0;
-    uint32_t i, x, y, r[4];
-    size_t c;
-    g->start = arena_calloc(a, PLX_PART_LIT, ncell + 1, sizeof *g->start, LIGHT_ALIGN);
-    if (!g->start)
-        return PLX_E_NOMEM;
-    for (i = 0; i < n; i++) {
-        if (!(box[i][0] <= box[i][2]))
-            continue;
-        grid_range(g, box[i], r);
-        for (y = r[1]; y <= r[3]; y++)
-            for (x = r[0]; x <= r[2]; x++)
-                g->start[(size_t)y * g->nx + x + 1]++;
-    }
-    for (c = 0; c < ncell; c++) {
-        total += g->start[c + 1];
-        if (total > UINT32_MAX)
-            return PLX_E_NOMEM;
-        g->start[c + 1] = (uint32_t)total;
-    }
-    g->ids = arena_alloc(a, PLX_PART_LIT, arena_mul(total + 1, sizeof *g->ids), LIGHT_ALIGN);
-    if (!g->ids)
-        return PLX_E_NOMEM;
-    for (i = 0; i < n; i++) {
-        if (!(box[i][0] <= box[i][2]))
-            continue;
-        grid_range(g, box[i], r);
-        for (y = r[1]; y <= r[3]; y++)
-            for (x = r[0]; x <= r[2]; x++)
-                g->ids[g->start[(size_t)y * g->nx + x]++] = i;
-    }
-    for (c = ncell; c > 0; c--)
-        g->start[c] = g->start[c - 1];
-    g->start[0] = 0;
-    return PLX_OK;
+    bucketgrid_frame(g, lo[0], lo[1], cell, (uint32_t)(w / cell) + 1, (uint32_t)(h / cell) + 1);
+    return cell;
 }
 
 static plx_status build_grids(light *L, arena *a)
@@ -142,9 +74,9 @@ static plx_status build_grids(light *L, arena *a)
         memcpy(box[i], s->bld[i].box, sizeof box[i]);
         size += sqrt((box[i][2] - box[i][0]) * (box[i][3] - box[i][1]));
     }
-    grid_frame(&L->bgrid, (const double (*)[4])box, s->nbld,
-               s->nbld ? 1.5 * size / s->nbld : 1.0, 4.0 * s->nbld + 64.0);
-    st = grid_fill(a, &L->bgrid, (const double (*)[4])box, s->nbld);
+    L->bcell = grid_frame(&L->bgrid, (const double (*)[4])box, s->nbld,
+                          s->nbld ? 1.5 * size / s->nbld : 1.0, 4.0 * s->nbld + 64.0);
+    st = bucketgrid_fill(&L->bgrid, a, PLX_PART_LIT, LIGHT_ALIGN, box[0], NULL, s->nbld);
     for (i = 0, n = 0; st == PLX_OK && i < s->nlamps; i++) {
         const scene_lamp *lp = &s->lamps[i];
         double R = lp->radius;
@@ -162,7 +94,7 @@ static plx_status build_grids(light *L, arena *a)
     if (st == PLX_OK) {
         grid_frame(&L->lgrid, (const double (*)[4])box, s->nlamps,
                    n ? 0.5 * reach / n : 1.0, 16.0 * n + 64.0);
-        st = grid_fill(a, &L->lgrid, (const double (*)[4])box, s->nlamps);
+        st = bucketgrid_fill(&L->lgrid, a, PLX_PART_LIT, LIGHT_ALIGN, box[0], NULL, s->nlamps);
     }
     return st;
 }
@@ -464,10 +396,10 @@ static uint32_t next_stamp(light *L)
 static int cell_blocks(light *L, uint32_t cell, uint32_t stamp, const double A[3],
                        const double B[3], double len3)
 {
-    const light_grid *g = &L->bgrid;
+    const bucketgrid *g = &L->bgrid;
     uint32_t k;
     for (k = g->start[cell]; k < g->start[cell + 1]; k++) {
-        uint32_t b = g->ids[k];
+        uint32_t b = g->item[k];
         if (L->stamp[b] == stamp)
             continue;
         L->stamp[b] = stamp;
@@ -501,7 +433,7 @@ static void row_span(const double A[3], const double B[3], double y0, double y1,
 
 int light_segment_blocked(light *L, const double A[3], const double B[3])
 {
-    const light_grid *g = &L->bgrid;
+    const bucketgrid *g = &L->bgrid;
     double v[3], len3, pad, ylo, yhi;
     uint32_t stamp, iy0, iy1, iy, ix0, ix1, ix;
     if (L->s->nbld == 0)
@@ -511,20 +443,20 @@ int light_segment_blocked(light *L, const double A[3], const double B[3])
     if (len3 == 0.0)
         return 0;
     stamp = next_stamp(L);
-    pad = 1e-9 * g->cell;
+    pad = 1e-9 * L->bcell;
     ylo = (A[1] < B[1] ? A[1] : B[1]);
     yhi = (A[1] < B[1] ? B[1] : A[1]);
-    iy0 = clamp_index((ylo - pad - g->y0) * g->inv, g->ny);
-    iy1 = clamp_index((yhi + pad - g->y0) * g->inv, g->ny);
+    iy0 = bucketgrid_index(ylo - pad, g->y0, g->sy, g->ny);
+    iy1 = bucketgrid_index(yhi + pad, g->y0, g->sy, g->ny);
     for (iy = iy0; iy <= iy1; iy++) {
         double x0, x1;
-        row_span(A, B, g->y0 + iy * g->cell - pad, g->y0 + (iy + 1) * g->cell + pad, &x0, &x1);
+        row_span(A, B, g->y0 + iy * L->bcell - pad, g->y0 + (iy + 1) * L->bcell + pad, &x0, &x1);
         if (iy == 0 || iy == g->ny - 1) {   /* clamped rows: whole span */
             x0 = A[0] < B[0] ? A[0] : B[0];
             x1 = A[0] < B[0] ? B[0] : A[0];
         }
-        ix0 = clamp_index((x0 - pad - g->x0) * g->inv, g->nx);
-        ix1 = clamp_index((x1 + pad - g->x0) * g->inv, g->nx);
+        ix0 = bucketgrid_index(x0 - pad, g->x0, g->sx, g->nx);
+        ix1 = bucketgrid_index(x1 + pad, g->x0, g->sx, g->nx);
         for (ix = ix0; ix <= ix1; ix++)
             if (cell_blocks(L, iy * g->nx + ix, stamp, A, B, len3))
                 return 1;
@@ -647,7 +579,7 @@ static light_where pick_surface(const where_acc *w, const double P[3], const dou
 light_where light_classify_point(light *L, const double P[3], const double n[3],
                                  uint32_t *bld, int *normal_ok)
 {
-    const light_grid *g = &L->bgrid;
+    const bucketgrid *g = &L->bgrid;
     const double tol = LIGHT_CLASSIFY_TOL;
     double box[4];
     uint32_t r[4], x, y, k, stamp, b0 = UINT32_MAX;
@@ -659,12 +591,12 @@ light_where light_classify_point(light *L, const double P[3], const double n[3],
     if (L->s->nbld) {
         box[0] = P[0] - tol; box[1] = P[1] - tol;
         box[2] = P[0] + tol; box[3] = P[1] + tol;
-        grid_range(g, box, r);
+        bucketgrid_range(g, box, r);
         stamp = next_stamp(L);
         for (y = r[1]; y <= r[3]; y++)
             for (x = r[0]; x <= r[2]; x++)
                 for (k = g->start[y * g->nx + x]; k < g->start[y * g->nx + x + 1]; k++) {
-                    uint32_t b = g->ids[k];
+                    uint32_t b = g->item[k];
                     const double *bb = L->s->bld[b].box;
                     if (L->stamp[b] == stamp || P[0] < bb[0] - tol || P[0] > bb[2] + tol ||
                         P[1] < bb[1] - tol || P[1] > bb[3] + tol)
@@ -688,13 +620,13 @@ light_where light_classify_point(light *L, const double P[3], const double n[3],
 uint32_t light_lamps_reaching(const light *L, const double P[3])
 {
     const scene *s = L->s;
-    const light_grid *g = &L->lgrid;
+    const bucketgrid *g = &L->lgrid;
     uint32_t cell, k, count = 0;
     if (s->nlamps == 0 || g->nx == 0)
         return 0;
-    cell = light_grid_cell(g, P[0], P[1]);
+    cell = bucketgrid_cell(g, P[0], P[1]);
     for (k = cell == UINT32_MAX ? 0 : g->start[cell]; cell != UINT32_MAX && k < g->start[cell + 1]; k++) {
-        const scene_lamp *lp = &s->lamps[g->ids[k]];
+        const scene_lamp *lp = &s->lamps[g->item[k]];
         double dx = lp->x - P[0], dy = lp->y - P[1], dz = lp->z - P[2];
         if (lp->intensity > 0.0 && dx * dx + dy * dy + dz * dz < lp->radius * lp->radius)
             count++;

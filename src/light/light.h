@@ -105,19 +105,12 @@
 #include "polarlux.h"
 #include "base/scene.h"
 #include "base/arena.h"
+#include "base/bucketgrid.h"
 
 #define LIGHT_MIN_PIECE 1e-9  /* m: shorter contacts with a solid are grazing */
 #define LIT_NONE 0xffffffffu
 
 /* ---- the light object -------------------------------------------------- */
-
-typedef struct light_grid {
-    double x0, y0, inv;       /* origin and 1 / cell size */
-    double cell;
-    uint32_t nx, ny;
-    uint32_t *start;          /* nx * ny + 1 offsets into ids */
-    uint32_t *ids;
-} light_grid;
 
 typedef struct light_entry {
     struct lit_region *reg;   /* NULL when not cached */
@@ -134,8 +127,9 @@ typedef struct light_stats {
 typedef struct light {
     arena *a;
     const scene *s;
-    light_grid bgrid;         /* buildings, by box */
-    light_grid lgrid;         /* lamps, by the box of their reach disk */
+    bucketgrid bgrid;         /* buildings, by box */
+    bucketgrid lgrid;         /* lamps, by the box of their reach disk */
+    double bcell;             /* bgrid's cell size (m) */
     uint32_t *stamp;          /* per building: last visit */
     uint32_t stamp_now;
     uint32_t maxv;            /* most ring vertices of one building */
@@ -201,7 +195,6 @@ double light_pseudo_angle(double dx, double dy);
 uint32_t light_lamps_reaching(const light *L, const double P[3]);
 
 /* Internal, shared by light.c and litregion.c. */
-uint32_t light_grid_cell(const light_grid *g, double x, double y);
 int light_seg_blocked_by(light *L, uint32_t b, const double A[3], const double B[3],
                          double len3);
 

@@ -137,7 +137,7 @@ static unsigned char o_state(const scene *s, uint32_t b, vec2 o)
 static plx_status gather(lr_work *w)
 {
     light *L = w->L;
-    const light_grid *g = &L->bgrid;
+    const bucketgrid *g = &L->bgrid;
     double box[4];
     uint32_t x, y, k, n = 0, stamp, r0, r1, c0, c1;
     if (w->s->nbld == 0) {
@@ -148,8 +148,8 @@ static plx_status gather(lr_work *w)
     }
     box[0] = w->o.x - w->R; box[1] = w->o.y - w->R;
     box[2] = w->o.x + w->R; box[3] = w->o.y + w->R;
-    c0 = light_grid_cell(g, box[0], box[1]);
-    c1 = light_grid_cell(g, box[2], box[3]);
+    c0 = bucketgrid_cell(g, box[0], box[1]);
+    c1 = bucketgrid_cell(g, box[2], box[3]);
     r0 = c0 / g->nx; r1 = c1 / g->nx;
     for (y = r0; y <= r1; y++)
         n += g->start[y * g->nx + c1 % g->nx + 1] - g->start[y * g->nx + c0 % g->nx];
@@ -166,7 +166,7 @@ static plx_status gather(lr_work *w)
     for (y = r0; y <= r1; y++)
         for (x = c0 % g->nx; x <= c1 % g->nx; x++)
             for (k = g->start[y * g->nx + x]; k < g->start[y * g->nx + x + 1]; k++) {
-                uint32_t b = g->ids[k];
+                uint32_t b = g->item[k];
                 if (L->stamp[b] == stamp)
                     continue;
                 L->stamp[b] = stamp;

@@ -18,7 +18,7 @@ plx_status light_meter(light *L, const double P[3], const double u[2], double ou
 {
     static const double up[3] = { 0.0, 0.0, 1.0 };
     const scene *s;
-    const light_grid *g;
+    const bucketgrid *g;
     uint32_t cell, k;
     plx_status st;
     if (!L || !P || !u || !out)
@@ -30,9 +30,9 @@ plx_status light_meter(light *L, const double P[3], const double u[2], double ou
         return st;
     if (s->nlamps == 0 || g->nx == 0)
         return PLX_OK;
-    cell = light_grid_cell(g, P[0], P[1]);
+    cell = bucketgrid_cell(g, P[0], P[1]);
     for (k = g->start[cell]; k < g->start[cell + 1]; k++) {
-        uint32_t i = g->ids[k];
+        uint32_t i = g->item[k];
         const scene_lamp *lp = &s->lamps[i];
         double v[3], d2, d, w, om[3], back[3], I, base, h, ud, ev, esc, ehs;
         v[0] = lp->x - P[0];

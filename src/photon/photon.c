@@ -849,9 +849,49 @@ size_t photon_bytes(const scene *s, const photon_config *cfg)
     if (t.bytes == SIZE_MAX)
         return SIZE_MAX;
     {
-        size_t tb = trace_bytes(s, c.cell_size);
+        size_t tb = trace_bytes_ex(s, c.cell_size, !c.no_lamp_tables);
         return t.bytes + tb < t.bytes ? SIZE_MAX : t.bytes + tb;
     }
+}
+
+/* One quality step of photon_config_fit: 0 facade charts, 1 aerial chart,
+ * 2 lamp cache (first: it serves refinement only); 0 when that one is at
+ * its floor. */
+static int fit_step(photon_config *c, const scene *s, int which)
+{
+    if (which == 0 && c->chart_h >= 2 * PHOTON_FIT_CHART_H && c->chart_w >= 16) {
+        c->chart_w /= 2;
+        c->chart_h /= 2;
+        return 1;
+    }
+    if (which == 1 && c->aerial_res >= 2 * PHOTON_FIT_AERIAL) {
+        c->aerial_res /= 2;
+        return 1;
+    }
+    if (which == 2 && c->lamp_slots == 0 && c->lamp_cache_bytes >= 4 * photon_lamp_slot_bytes(s, c)) {
+        c->lamp_cache_bytes /= 2;
+        return 1;
+    }
+    return 0;
+}
+
+int photon_config_fit(photon_config *c, const scene *s, size_t budget)
+{
+    int steps = 0, turn = 2, tried;
+    while (photon_bytes(s, c) > budget) {
+        if (!c->no_lamp_tables) {
+            c->no_lamp_tables = 1;
+            steps++;
+            continue;
+        }
+        for (tried = 0; tried < 3 && !fit_step(c, s, turn); tried++)
+            turn = (turn + 1) % 3;
+        if (tried == 3)
+            return -1;
+        turn = (turn + 1) % 3;
+        steps++;
+    }
+    return steps;
 }
 
 /* ---- walls and blocks ----------------------------------------------------- */
@@ -1241,7 +1281,7 @@ plx_status photon_create(arena *a, const scene *s, const photon_config *cfg, pho
     ps->a = a;
     ps->s = s;
     ps->cfg = c;
-    st = trace_create(a, PLX_PART_PHOTON, s, c.cell_size, &ps->T);
+    st = trace_create_ex(a, PLX_PART_PHOTON, s, c.cell_size, !c.no_lamp_tables, &ps->T);
     if (st != PLX_OK) {
         arena_release(a, &m);
         return st;

@@ -183,6 +183,8 @@ typedef struct photon_config {
     double near_radius;             /* photon_lamps_update: lamps within this horizontal
                                        distance of the viewer are refined; 60 m */
     double cell_size;               /* tracer grid cell, m; 0 = automatic */
+    int no_lamp_tables;             /* 1: the tracer keeps no per-lamp ray tables (the same
+                                       hits, first rays about 2x slower; trace_create_ex) */
     uint32_t coarsest_level;        /* photon_set_viewer gives no block a level above this
                                        (while its level has room); PHOTON_LEVELS (4) = the
                                        distance rule alone. Final gathering (final_gather.h)
@@ -307,6 +309,22 @@ plx_status photon_create(arena *a, const scene *s, const photon_config *cfg,
 
 /* Bytes photon_create would take from part PLX_PART_PHOTON. */
 size_t photon_bytes(const scene *s, const photon_config *cfg);
+
+/*
+ * Lowers the quality of c until photon_bytes(s, c) <= budget, step by step:
+ * first the tracer's lamp tables go (the same light, slower), then in turn
+ * the lamp cache is halved (down to two floor maps; it serves only
+ * near-viewer refinement), the facade charts are halved each way (down to
+ * PHOTON_FIT_CHART_H texels high at level 0) and the aerial chart is
+ * halved each way (down to PHOTON_FIT_AERIAL texels along the longer
+ * side). Returns the number of steps taken (0:
+ * c already fits), or -1 when even the smallest sizes do not fit (c is
+ * then at those sizes). The photon count is not touched: coarser charts
+ * blur the indirect light, they do not make it noisier.
+ */
+#define PHOTON_FIT_CHART_H 8
+#define PHOTON_FIT_AERIAL 64
+int photon_config_fit(photon_config *c, const scene *s, size_t budget);
 
 /* Bytes of one lamp cache slot (the unit of cfg.lamp_cache_bytes). */
 size_t photon_lamp_slot_bytes(const scene *s, const photon_config *cfg);

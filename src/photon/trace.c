@@ -3,6 +3,7 @@
 #include <string.h>
 
 #include "photon/trace.h"
+#include "base/bucketgrid.h"
 
 #define TRACE_MAX_CELLS (1u << 22)
 
@@ -68,17 +69,8 @@ static void grid_spec(const scene *s, double cell_size, gridspec *g)
 static void cell_range(const gridspec *g, double lo, double hi, double org, uint32_t n,
                        uint32_t *i0, uint32_t *i1)
 {
-    double a = floor((lo - g->pad - org) * g->inv), b = floor((hi + g->pad - org) * g->inv);
-    if (a < 0.0)
-        a = 0.0;
-    if (b > (double)(n - 1))
-        b = (double)(n - 1);
-    if (b < 0.0)
-        b = 0.0;
-    if (a > (double)(n - 1))
-        a = (double)(n - 1);
-    *i0 = (uint32_t)a;
-    *i1 = (uint32_t)b;
+    *i0 = bucketgrid_index(lo - g->pad, org, g->inv, n);
+    *i1 = bucketgrid_index(hi + g->pad, org, g->inv, n);
 }
 
 /* Whether segment p->q comes within pad of cell (ci, cj): clipping of the
@@ -297,12 +289,16 @@ static int lamp_small(const gridspec *g, const scene_lamp *L)
  * allocated, the starts, the cursors moved to the ends by placing, and the
  * starts again.
  */
-static int lamp_tables(tracer *T, arena *a, plx_part part, const gridspec *g)
+static int lamp_tables(tracer *T, arena *a, plx_part part, const gridspec *g, int tables)
 {
     const scene *s = T->s;
     const uint32_t W = TRACE_SECTORS + 2;
     size_t total = 0;
     uint32_t l, k;
+    if (!tables) {   /* every lamp's rays walk the grid (the same hits) */
+        T->lfast = arena_calloc(a, part, s->nlamps ? s->nlamps : 1, 1, 64);
+        return T->lfast != NULL;
+    }
     T->lsec = arena_calloc(a, part, (size_t)s->nlamps * W + 1, sizeof(uint32_t), 64);
     T->lfast = arena_calloc(a, part, s->nlamps ? s->nlamps : 1, 1, 64);
     if (!T->lsec || !T->lfast)
@@ -342,6 +338,11 @@ static int lamp_tables(tracer *T, arena *a, plx_part part, const gridspec *g)
 
 size_t trace_bytes(const scene *s, double cell_size)
 {
+    return trace_bytes_ex(s, cell_size, 1);
+}
+
+size_t trace_bytes_ex(const scene *s, double cell_size, int tables)
+{
     gridspec g;
     size_t cells, refs, nw;
     if (!s)
@@ -354,7 +355,8 @@ size_t trace_bytes(const scene *s, double cell_size)
            (size_t)(s->npts ? s->npts : 1) * (sizeof(trace_wall) + sizeof(uint32_t)) + 2 * 64 +
            (size_t)(s->nbld ? s->nbld : 1) * 2 * sizeof(double) + 64 +
            (cells + 1) * sizeof(uint32_t) + 64 + (refs ? refs : 1) * sizeof(uint32_t) + 64 +
-           lamp_bytes(s->nlamps, (size_t)s->nlamps * TRACE_LAMP_REFS);
+           (tables ? lamp_bytes(s->nlamps, (size_t)s->nlamps * TRACE_LAMP_REFS)
+                   : (size_t)(s->nlamps ? s->nlamps : 1) + 64);
 }
 
 /* Turns counts in cnt[1..cells] into starts in cnt[0..cells]; with
@@ -380,6 +382,12 @@ static void prefix(uint32_t *cnt, trace_cell *cl, size_t cells, int placed)
 
 plx_status trace_create(arena *a, plx_part part, const scene *s, double cell_size,
                         tracer **out)
+{
+    return trace_create_ex(a, part, s, cell_size, 1, out);
+}
+
+plx_status trace_create_ex(arena *a, plx_part part, const scene *s, double cell_size, int tables,
+                           tracer **out)
 {
     arena_mark m;
     tracer *T;
@@ -446,7 +454,7 @@ plx_status trace_create(arena *a, plx_part part, const scene *s, double cell_siz
     }
     for (i = 0; i <= cells; i++)
         T->cells[i].r0 = T->start[i];
-    if (!lamp_tables(T, a, part, &g))
+    if (!lamp_tables(T, a, part, &g, tables))
         goto nomem;
     for (i = 0; i < cells; i++) {
         trace_cell *C = &T->cells[i];
@@ -607,7 +615,6 @@ static void cell_test(tracer *T, size_t c, double za, double zb, const double o[
     if (zlo > C->top)
         return; /* above every roof in the cell */
     k1 = C[1].w0;
-    T->tests += k1 - C->w0;
     for (k = C->w0; k < k1; k++) {
         uint32_t e = T->wids[k];
         const trace_wall *w = &T->walls[e];
@@ -674,7 +681,6 @@ static void ray_begin(tracer *T, const double o[3], const double d[3], double tm
             bs->kind = TRACE_GROUND;
         }
     }
-    T->rays++;
 }
 
 /* Cuts [*t0, *t1] to the slab lo <= o + t d <= hi of one axis (inv = 1 / d);
@@ -801,7 +807,7 @@ int trace_ray(tracer *T, const double o[3], const double d[3], double tmax, trac
 int trace_lamp_ray(tracer *T, uint32_t lamp, const double d[3], trace_hit *h)
 {
     const scene_lamp *L = &T->s->lamps[lamp];
-    const uint32_t *sec = &T->lsec[(size_t)lamp * (TRACE_SECTORS + 2)];
+    const uint32_t *sec;
     double o[3];
     best bs;
     uint32_t k, k1;
@@ -810,11 +816,11 @@ int trace_lamp_ray(tracer *T, uint32_t lamp, const double d[3], trace_hit *h)
     o[2] = L->z;
     if (!T->lfast[lamp])
         return trace_ray(T, o, d, L->radius, h);
+    sec = &T->lsec[(size_t)lamp * (TRACE_SECTORS + 2)];
     ray_begin(T, o, d, L->radius, &bs);
     if (d[0] != 0.0 || d[1] != 0.0) {
         uint32_t sk = sector_of(d[0], d[1]);
         k1 = sec[sk + 1];
-        T->tests += k1 - sec[sk];
         for (k = sec[sk]; k < k1; k++)
             wall_test(&T->walls[T->lref[k]], T->lref[k], o, d, &bs);
     }
@@ -830,7 +836,7 @@ void trace_lamp_prefetch(const tracer *T, uint32_t lamp, int stage)
 {
     const uint32_t *sec;
     uint32_t k, k1;
-    if (lamp >= T->s->nlamps)
+    if (lamp >= T->s->nlamps || !T->lsec)
         return;
     sec = &T->lsec[(size_t)lamp * (TRACE_SECTORS + 2)];
     if (stage == 0) {
@@ -867,7 +873,6 @@ int trace_ray_brute(tracer *T, const double o[3], const double d[3], double tmax
             const scene_ring *R = &s->rings[B->ring_first + r];
             uint32_t k;
             for (k = 0; k < R->count; k++) {
-                T->tests++;
                 wall_test(&T->walls[R->first + k], R->first + k, o, d, &bs);
             }
         }

@@ -54,9 +54,10 @@
  * the faces it could hit, so the same answer (a tie may go the other
  * way).
  *
- * Tracing writes only the counters (rays, tests): a tracer must not be
- * used by two threads at once (make one per thread: they share nothing
- * but the scene).
+ * Tracing writes nothing in the tracer (trace_ray, trace_top and the
+ * lamp rays only read it), so several threads may trace with one tracer
+ * at once: the renderer's workers do (README "Threads"). Building it is
+ * single-threaded.
  *
  * Degenerate cases: faces are closed (a ray touching an edge of a roof or a
  * wall exactly hits it; "on the outline" is to rounding, exact for
@@ -156,7 +157,6 @@ typedef struct tracer {
     uint32_t *lref;
     uint8_t *lfast;        /* per lamp: 1 if it has a table */
     double zmax;           /* tallest building */
-    uint64_t rays, tests;  /* counters: rays cast, wall records examined */
 } tracer;
 
 /*
@@ -172,6 +172,13 @@ plx_status trace_create(arena *a, plx_part part, const scene *s, double cell_siz
  * (same rule; the lamp tables are counted at TRACE_LAMP_REFS references
  * per lamp, a lamp needing more gets none). */
 size_t trace_bytes(const scene *s, double cell_size);
+
+/* The same with the lamp tables on (tables 1, what trace_create builds) or
+ * off (0: no tables, every lamp ray walks the grid: the same hits, first
+ * rays about 2x slower; README "Photon buffers"). */
+plx_status trace_create_ex(arena *a, plx_part part, const scene *s, double cell_size, int tables,
+                           tracer **out /* OUT */);
+size_t trace_bytes_ex(const scene *s, double cell_size, int tables);
 
 /*
  * First surface hit by o + t d, 0 < t < tmax (tmax may be INFINITY); d must

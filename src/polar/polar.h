@@ -152,6 +152,13 @@ typedef struct polar {
                               * pieces walked and sorted by the sweeps */
 } polar;
 
+/* The build's scratch high-water mark: at most POLAR_SCRATCH_PER_VERTEX
+ * bytes a footprint vertex plus POLAR_SCRATCH_FIXED (tests/unit/
+ * test_polar_scratch.c measures it on growing rings; README "Memory
+ * budgets"). */
+#define POLAR_SCRATCH_PER_VERTEX 896
+#define POLAR_SCRATCH_FIXED ((size_t)1 << 20)
+
 /* Builds the four diagrams of scene s. On success *out points into arena
  * memory (PLX_PART_POLAR) valid until that memory is released; the scene must
  * stay unchanged meanwhile. Fails with PLX_E_NOMEM (nothing kept, scratch

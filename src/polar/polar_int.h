@@ -174,6 +174,8 @@ typedef struct dbuild {
     uint32_t (**chunk)[3];   /* nodes in chunks of NODE_CHUNK (scratch) */
     uint32_t nchunk, maxchunk, nnode;
     uint32_t *list, *up, *lo; /* per crossed trapezoid: it, its new upper / lower part */
+    uint32_t lcap;           /* their length: a piece crosses one trapezoid more than the
+                              * axes it cuts, each at a distinct point (ends + box + 4) */
     const uint32_t *canon;   /* per point: the first point at its position */
     const snode *N;          /* per piece: the sweep's data (y test kind) */
     const vec2 *E;           /* per piece: frame ends, left then right */

@@ -231,7 +231,7 @@ static uint32_t follow_back(dbuild *b, uint32_t t, vec2 P, vec2 Q)
         uint32_t nx = o > 0 ? b->T[t].nb[LL] : b->T[t].nb[UL];
         /* the neighbour must be live and share the axis: the walk moves
          * strictly leftwards, whatever the input */
-        if (o == 0 || nx == POLAR_NONE || k + 1 >= b->cap || b->T[nx].leaf == POLAR_NONE ||
+        if (o == 0 || nx == POLAR_NONE || k + 1 >= b->lcap || b->T[nx].leaf == POLAR_NONE ||
             b->T[nx].rp != b->T[t].lp) {
             b->fail = 2;
             return k;
@@ -269,7 +269,7 @@ static uint32_t follow(dbuild *b, uint32_t l, uint32_t r)
         uint32_t t = b->list[k], nx;
         int o = geom_orient(P, Q, b->T[t].rc);
         nx = o > 0 ? b->T[t].nb[LR] : b->T[t].nb[UR];
-        if (o == 0 || nx == POLAR_NONE || k + 1 >= b->cap || b->T[nx].leaf == POLAR_NONE ||
+        if (o == 0 || nx == POLAR_NONE || k + 1 >= b->lcap || b->T[nx].leaf == POLAR_NONE ||
             b->T[nx].lp != b->T[t].rp) {
             b->fail = 2;
             return k;
@@ -635,11 +635,12 @@ plx_status polar_dag_build(arena *a, polar *pd, polar_map *m, dbuild *b, const s
     b->maxchunk = (uint32_t)(((uint64_t)64 * nw + 1024) >> NODE_BITS) + 1;
     if (b->maxchunk > (1u << (30 - NODE_BITS)))
         b->maxchunk = 1u << (30 - NODE_BITS);
+    b->lcap = nends + 8;
     b->T = scratch_n(a, b->cap, sizeof(btrap));
     b->freel = scratch_n(a, b->cap, 4);
-    b->list = scratch_n(a, b->cap, 4);
-    b->up = scratch_n(a, b->cap, 4);
-    b->lo = scratch_n(a, b->cap, 4);
+    b->list = scratch_n(a, b->lcap, 4);
+    b->up = scratch_n(a, b->lcap, 4);
+    b->lo = scratch_n(a, b->lcap, 4);
     b->chunk = scratch_n(a, b->maxchunk, sizeof *b->chunk);
     b->hint = scratch_n(a, pd->npts, 4);
     b->E = E = scratch_n(a, 2 * (size_t)pd->nseg, sizeof(vec2));

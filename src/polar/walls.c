@@ -4,6 +4,7 @@
  * pieces made consistent again after rounding; coinciding pieces merged,
  * party walls (cover 0) left out, the Bounds box added. */
 #include "polar/polar_int.h"
+#include "base/bucketgrid.h"
 
 /* ---- wall pieces ------------------------------------------------------- */
 
@@ -471,8 +472,8 @@ static void emit_piece(piece *out, uint32_t *n, const vec2 *P, uint32_t a, uint3
 #define WALL_ROUNDS 64
 
 
-/* Uniform grid over the dirty pieces: cell c lists item[cell[c] ..
- * cell[c + 1]), the dirty pieces whose bounding boxes meet it, with their
+/* Uniform grid over the dirty pieces: cell c lists item[b.start[c] ..
+ * b.start[c + 1]), the dirty pieces whose bounding boxes meet it, with their
  * boxes (read in the cell's order, not from the points). */
 typedef struct ditem {
     double bx[4];
@@ -480,9 +481,8 @@ typedef struct ditem {
 } ditem;
 
 typedef struct dgrid {
-    double x0, y0, x1, y1, sx, sy;
-    uint32_t nx, ny;
-    uint32_t *cell;
+    bucketgrid b;     /* frame and offsets (b.item unused) */
+    double x1, y1;    /* high corner of the frame */
     ditem *item;
 } dgrid;
 
@@ -495,86 +495,63 @@ static void piece_box(const vec2 *P, const piece *q, double *bx)
     bx[3] = dmax(a.y, b.y);
 }
 
-/* Monotone in v, so a point of two boxes falls in a cell of both ranges. */
-static uint32_t dcell(double v, double v0, double scale, uint32_t n)
-{
-    double c = floor((v - v0) * scale);
-    if (!(c > 0.0))
-        return 0;
-    if (c >= (double)n)
-        return n - 1;
-    return (uint32_t)c;
-}
-
-static void dgrid_range(const dgrid *g, const double *bx, uint32_t *r)
-{
-    r[0] = dcell(bx[0], g->x0, g->sx, g->nx);
-    r[1] = dcell(bx[1], g->y0, g->sy, g->ny);
-    r[2] = dcell(bx[2], g->x0, g->sx, g->nx);
-    r[3] = dcell(bx[3], g->y0, g->sy, g->ny);
-}
-
 /* Cells of about the area per dirty piece, at most 5 nd + 1 of them. */
 static void dgrid_size(dgrid *g, const vec2 *P, const piece *pc, const uint32_t *dl, uint32_t nd)
 {
     double bx[4], w, h, cs;
     uint32_t i;
-    g->x0 = g->y0 = DBL_MAX;
+    g->b.x0 = g->b.y0 = DBL_MAX;
     g->x1 = g->y1 = -DBL_MAX;
     for (i = 0; i < nd; i++) {
         piece_box(P, &pc[dl[i]], bx);
-        g->x0 = fmin(g->x0, bx[0]);
-        g->y0 = fmin(g->y0, bx[1]);
+        g->b.x0 = fmin(g->b.x0, bx[0]);
+        g->b.y0 = fmin(g->b.y0, bx[1]);
         g->x1 = fmax(g->x1, bx[2]);
         g->y1 = fmax(g->y1, bx[3]);
     }
-    w = g->x1 - g->x0;
-    h = g->y1 - g->y0;
+    w = g->x1 - g->b.x0;
+    h = g->y1 - g->b.y0;
     cs = sqrt(w * h / nd);
     if (!(cs > 0.0))
         cs = fmax(w, h) / nd;
-    g->nx = cs > 0.0 ? (uint32_t)fmin(w / cs, 2.0 * nd) + 1 : 1;
-    g->ny = cs > 0.0 ? (uint32_t)fmin(h / cs, 2.0 * nd) + 1 : 1;
-    g->sx = w > 0.0 ? g->nx / w : 0.0;
-    g->sy = h > 0.0 ? g->ny / h : 0.0;
+    g->b.nx = cs > 0.0 ? (uint32_t)fmin(w / cs, 2.0 * nd) + 1 : 1;
+    g->b.ny = cs > 0.0 ? (uint32_t)fmin(h / cs, 2.0 * nd) + 1 : 1;
+    g->b.sx = w > 0.0 ? g->b.nx / w : 0.0;
+    g->b.sy = h > 0.0 ? g->b.ny / h : 0.0;
 }
 
 static plx_status dgrid_build(arena *a, dgrid *g, const vec2 *P, const piece *pc,
                               const uint32_t *dl, uint32_t nd)
 {
     uint32_t i, x, y, r[4], nc;
+    size_t total;
     double bx[4];
     dgrid_size(g, P, pc, dl, nd);
-    nc = g->nx * g->ny;
-    g->cell = scratch_n(a, (size_t)nc + 1, 4);
-    if (!g->cell)
+    nc = g->b.nx * g->b.ny;
+    g->b.start = scratch_n(a, (size_t)nc + 1, 4);
+    if (!g->b.start)
         return PLX_E_NOMEM;
-    memset(g->cell, 0, ((size_t)nc + 1) * 4);
+    memset(g->b.start, 0, ((size_t)nc + 1) * 4);
     for (i = 0; i < nd; i++) {
         piece_box(P, &pc[dl[i]], bx);
-        dgrid_range(g, bx, r);
-        for (y = r[1]; y <= r[3]; y++)
-            for (x = r[0]; x <= r[2]; x++)
-                g->cell[y * g->nx + x + 1]++;
+        bucketgrid_range(&g->b, bx, r);
+        bucketgrid_count(&g->b, r);
     }
-    for (i = 0; i < nc; i++)
-        g->cell[i + 1] += g->cell[i];
-    g->item = scratch_n(a, g->cell[nc], sizeof(ditem));
+    total = bucketgrid_offsets(&g->b);
+    g->item = total == SIZE_MAX ? NULL : scratch_n(a, total, sizeof(ditem));
     if (!g->item)
         return PLX_E_NOMEM;
     for (i = 0; i < nd; i++) {
         piece_box(P, &pc[dl[i]], bx);
-        dgrid_range(g, bx, r);
+        bucketgrid_range(&g->b, bx, r);
         for (y = r[1]; y <= r[3]; y++)
             for (x = r[0]; x <= r[2]; x++) {
-                ditem *t = &g->item[g->cell[y * g->nx + x]++];
+                ditem *t = &g->item[g->b.start[y * g->b.nx + x]++];
                 memcpy(t->bx, bx, sizeof bx);
                 t->d = dl[i];
             }
     }
-    for (i = nc; i > 0; i--)
-        g->cell[i] = g->cell[i - 1];
-    g->cell[0] = 0;
+    bucketgrid_rewind(&g->b);
     return PLX_OK;
 }
 
@@ -583,16 +560,16 @@ static plx_status dgrid_build(arena *a, dgrid *g, const vec2 *P, const piece *pc
 static void meet_in_cell(split_ctx *c, const piece *pc, const uint8_t *dirty, const dgrid *g,
                          uint32_t s, const double *bs, uint32_t x, uint32_t y)
 {
-    uint32_t k, cl = y * g->nx + x;
-    for (k = g->cell[cl]; k < g->cell[cl + 1]; k++) {
+    uint32_t k, cl = y * g->b.nx + x;
+    for (k = g->b.start[cl]; k < g->b.start[cl + 1]; k++) {
         uint32_t d = g->item[k].d;
         const double *bd = g->item[k].bx;
         if (d == s || (dirty[s] && s > d))
             continue;
         if (bd[2] < bs[0] || bd[0] > bs[2] || bd[3] < bs[1] || bd[1] > bs[3])
             continue;
-        if (dcell(dmax(bs[0], bd[0]), g->x0, g->sx, g->nx) != x ||
-            dcell(dmax(bs[1], bd[1]), g->y0, g->sy, g->ny) != y)
+        if (bucketgrid_index(dmax(bs[0], bd[0]), g->b.x0, g->b.sx, g->b.nx) != x ||
+            bucketgrid_index(dmax(bs[1], bd[1]), g->b.y0, g->b.sy, g->b.ny) != y)
             continue;
         meet_segs(c, s, pc[s].a, pc[s].b, d, pc[d].a, pc[d].b);
     }
@@ -607,9 +584,9 @@ static void meet_pieces(split_ctx *c, const piece *pc, uint32_t np, const uint8_
     double bs[4];
     for (s = 0; s < np && !c->nomem; s++) {
         piece_box(P, &pc[s], bs);
-        if (bs[2] < g->x0 || bs[0] > g->x1 || bs[3] < g->y0 || bs[1] > g->y1)
+        if (bs[2] < g->b.x0 || bs[0] > g->x1 || bs[3] < g->b.y0 || bs[1] > g->y1)
             continue;
-        dgrid_range(g, bs, r);
+        bucketgrid_range(&g->b, bs, r);
         for (y = r[1]; y <= r[3]; y++)
             for (x = r[0]; x <= r[2]; x++)
                 meet_in_cell(c, pc, dirty, g, s, bs, x, y);
@@ -753,6 +730,8 @@ static void add_box(polar *pd, uint32_t p0)
 
 
 /* The occluders' edges as pieces, uncut. */
+static plx_status polar_make_walls_in(arena *a, polar *pd);
+
 static piece *edge_pieces(arena *a, const edges *e)
 {
     piece *pc = scratch_n(a, e->n, sizeof(piece));
@@ -822,8 +801,23 @@ static plx_status cut_edges(arena *a, polar *pd, piece **pc, uint32_t *np)
     return st;
 }
 
-/* Cuts the occluders' edges into wall pieces (pd->pts, pd->seg filled). */
+/* Cuts the occluders' edges into wall pieces (pd->pts, pd->seg filled);
+ * gives back its scratch (contacts, pieces, sort keys: about 170 bytes a
+ * vertex) before the maps are built. */
 plx_status polar_make_walls(arena *a, polar *pd)
+{
+    arena_mark m0 = arena_get_mark(a), m1;
+    plx_status st = polar_make_walls_in(a, pd);
+    if (st != PLX_OK)
+        return st;
+    m1 = arena_get_mark(a);
+    m1.hi = m0.hi;
+    m1.used[PLX_PART_SCRATCH] = m0.used[PLX_PART_SCRATCH];
+    arena_release(a, &m1);
+    return PLX_OK;
+}
+
+static plx_status polar_make_walls_in(arena *a, polar *pd)
 {
     uint32_t i, j, np = 0, nm = 0;
     piece *pc;

@@ -11,6 +11,76 @@
 #include <string.h>
 
 #include "render/lightmap.h"
+#include "light/illuminance.h"
+
+/* A texel waiting for its light has t[1] = -1 (E is never negative). */
+static void shade_row(lightmap *m, uint32_t j, lightmap_shade_fn shade, void *user)
+{
+    uint32_t i;
+    for (i = 0; i < m->nx; i++) {
+        float *t = &m->rgb[3 * ((size_t)j * m->nx + i)];
+        double P[3], n[3] = { 0.0, 0.0, 1.0 }, E[3];
+        if (!(t[1] < 0.0f))
+            continue;
+        P[0] = m->x0 + (i + 0.5) * m->cell;
+        P[1] = m->y0 + (j + 0.5) * m->cell;
+        P[2] = 0.0;
+        shade(user, P, n, E);
+        t[0] = (float)E[0];
+        t[1] = (float)E[1];
+        t[2] = (float)E[2];
+    }
+}
+
+typedef struct band_job {
+    lightmap *m;
+    const struct light *lt;
+    uint32_t j0;
+} band_job;
+
+/* A row on a worker: the light cache read only; stops at the first texel
+ * it cannot answer (left waiting for shade_row). */
+static void cached_row(void *arg, int worker, uint32_t k)
+{
+    band_job *jb = arg;
+    lightmap *m = jb->m;
+    uint32_t i, j = jb->j0 + k;
+    (void)worker;
+    for (i = 0; i < m->nx; i++) {
+        float *t = &m->rgb[3 * ((size_t)j * m->nx + i)];
+        double P[3], n[3] = { 0.0, 0.0, 1.0 }, E[3];
+        if (!(t[1] < 0.0f))
+            continue;
+        P[0] = m->x0 + (i + 0.5) * m->cell;
+        P[1] = m->y0 + (j + 0.5) * m->cell;
+        P[2] = 0.0;
+        if (light_illuminance_cached(jb->lt, P, n, E) != 0)
+            return;
+        t[0] = (float)E[0];
+        t[1] = (float)E[1];
+        t[2] = (float)E[2];
+    }
+}
+
+/* Every row by bands: the band's lamp regions cached, its rows on the
+ * workers, then what they left on this thread. */
+static void shade_bands(lightmap *m, lightmap_shade_fn shade, void *user, const lightmap_par *p)
+{
+    uint32_t j0, j;
+    for (j0 = 0; j0 < m->ny; j0 += LIGHTMAP_BAND) {
+        uint32_t j1 = j0 + LIGHTMAP_BAND < m->ny ? j0 + LIGHTMAP_BAND : m->ny;
+        band_job jb;
+        light_cache_box(p->lt, m->x0, m->y0 + j0 * m->cell, m->x0 + m->nx * m->cell, m->y0 + j1 * m->cell);
+        jb.m = m;
+        jb.lt = p->lt;
+        jb.j0 = j0;
+        if (p->par(p->ctx, p->workers, j1 - j0, cached_row, &jb) != 0)
+            for (j = j0; j < j1; j++)
+                cached_row(&jb, 0, j - j0);
+        for (j = j0; j < j1; j++)
+            shade_row(m, j, shade, user);
+    }
+}
 
 /* The indirect layer: memory (as the first build took it) and values. */
 static plx_status ind_alloc(lightmap *m, arena *mem, size_t need, const char **err)
@@ -51,19 +121,20 @@ static void ind_fill(lightmap *m, lightmap_ind_fn fn, void *user)
 }
 
 plx_status lightmap_build(lightmap *m, arena *mem, const scene *s, double cell, size_t max_bytes,
-                          lightmap_shade_fn shade, void *user, const char **err)
+                          lightmap_shade_fn shade, void *user, const lightmap_par *par, const char **err)
 {
-    return lightmap_build_ind(m, mem, s, cell, max_bytes, shade, user, NULL, NULL, err);
+    return lightmap_build_ind(m, mem, s, cell, max_bytes, shade, user, par, NULL, NULL, err);
 }
 
 plx_status lightmap_build_ind(lightmap *m, arena *mem, const scene *s, double cell, size_t max_bytes,
-                              lightmap_shade_fn shade, void *user, lightmap_ind_fn ind_fn, void *ind_user,
-                              const char **err)
+                              lightmap_shade_fn shade, void *user, const lightmap_par *par,
+                              lightmap_ind_fn ind_fn, void *ind_user, const char **err)
 {
     double per = ind_fn ? 28.0 : 12.0; /* bytes a texel */
     plx_status st;
+    size_t t, ntex;
     double x0 = HUGE_VAL, y0 = HUGE_VAL, x1 = -HUGE_VAL, y1 = -HUGE_VAL;
-    uint32_t l, nx, ny, i, j;
+    uint32_t l, nx, ny, j;
     size_t need;
     if (!(cell > 0.0) || !isfinite(cell) || (double)max_bytes < per) {
         *err = "render_lightmap_build: m_per_texel must be > 0 and max_bytes >= 12 (28 with indirect light)";
@@ -138,30 +209,23 @@ plx_status lightmap_build_ind(lightmap *m, arena *mem, const scene *s, double ce
             for (a = a0; a <= a1; a++) {
                 double dx = m->x0 + (a + 0.5) * cell - lp->x, dy = m->y0 + (b + 0.5) * cell - lp->y;
                 if (dx * dx + dy * dy <= rg * rg)
-                    m->rgb[3 * ((size_t)b * nx + (size_t)a)] = 1.0f;
+                    m->rgb[3 * ((size_t)b * nx + (size_t)a) + 1] = -1.0f;
             }
     }
-    /* the indirect layer first, while the map marks the reached texels */
+    /* the indirect layer (on this thread: the irradiance cache fills its table) */
     m->has_ind = 0;
     if (ind_fn) {
         ind_fill(m, ind_fn, ind_user);
         m->has_ind = ind_user != NULL;
     }
-    for (j = 0; j < ny; j++)
-        for (i = 0; i < nx; i++) {
-            float *t = &m->rgb[3 * ((size_t)j * nx + i)];
-            double P[3], n[3] = { 0.0, 0.0, 1.0 }, E[3];
-            if (t[0] == 0.0f)
-                continue;
-            P[0] = m->x0 + (i + 0.5) * cell;
-            P[1] = m->y0 + (j + 0.5) * cell;
-            P[2] = 0.0;
-            shade(user, P, n, E);
-            m->shaded++;
-            t[0] = (float)E[0];
-            t[1] = (float)E[1];
-            t[2] = (float)E[2];
-        }
+    ntex = (size_t)nx * ny;
+    for (t = 0; t < ntex; t++)
+        m->shaded += m->rgb[3 * t + 1] < 0.0f;
+    if (par && par->par && par->lt && par->workers >= 2)
+        shade_bands(m, shade, user, par);
+    else
+        for (j = 0; j < ny; j++)
+            shade_row(m, j, shade, user);
     m->built = 1;
     *err = "";
     return PLX_OK;

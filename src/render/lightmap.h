@@ -30,21 +30,40 @@ typedef void (*lightmap_shade_fn)(void *user, const double P[3], const double n[
 typedef int (*lightmap_ind_fn)(void *user, double x, double y, double rgb[3] /* OUT */,
                                double *z /* OUT */);
 
+/* Building on several threads: par runs jobs (render.h's parallel-for),
+ * lt is the light object when the shader is the light module's (else
+ * NULL: one thread). */
+typedef struct lightmap_par {
+    int (*par)(void *ctx, int workers, uint32_t njobs, void (*job)(void *arg, int worker, uint32_t k),
+               void *arg);
+    void *ctx;
+    int workers;
+    struct light *lt;
+} lightmap_par;
+
 /* Builds the map of scene s with texels of cell metres (grown by 5% steps
  * until the map fits max_bytes) over the box of every lamp's ground reach,
  * shading each texel some lamp reaches with shade(user, ...). The first
  * build takes the memory from mem (part PLX_PART_FRAME); a later one must fit
- * it. Returns PLX_OK, PLX_E_INVALID or PLX_E_NOMEM with *err set. */
+ * it. With par (workers >= 2 and lt): by bands of LIGHTMAP_BAND rows, the
+ * regions of the lamps reaching a band cached first on this thread, then
+ * its rows on the workers through light_illuminance_cached; a texel it
+ * cannot answer is left, with the rest of its row, to this thread after
+ * them (the shader). The same map for any number of workers. Returns
+ * PLX_OK, PLX_E_INVALID or PLX_E_NOMEM with *err set. */
+#define LIGHTMAP_BAND 16
 plx_status lightmap_build(lightmap *m, arena *mem, const scene *s, double cell, size_t max_bytes,
-                          lightmap_shade_fn shade, void *user, const char **err /* OUT */);
+                          lightmap_shade_fn shade, void *user, const lightmap_par *par /* may be NULL */,
+                          const char **err /* OUT */);
 
 /* The same, and with ind_fn non-NULL also the indirect layer (ind): for
  * each texel some lamp reaches, ind_fn at its centre (16 more bytes a
- * texel, counted in max_bytes). ind_user NULL: the layer is allocated and
+ * texel, counted in max_bytes; filled on the calling thread before the
+ * direct part, which par may spread). ind_user NULL: the layer is allocated and
  * left empty (a bake's twin engine: same memory, none of the work). */
 plx_status lightmap_build_ind(lightmap *m, arena *mem, const scene *s, double cell, size_t max_bytes,
-                              lightmap_shade_fn shade, void *user, lightmap_ind_fn ind_fn, void *ind_user,
-                              const char **err /* OUT */);
+                              lightmap_shade_fn shade, void *user, const lightmap_par *par /* may be NULL */,
+                              lightmap_ind_fn ind_fn, void *ind_user, const char **err /* OUT */);
 
 /* E_indirect at P (a horizontal surface point seen from above, P[2] its
  * height) from the indirect layer: bilinear over the four texel centres

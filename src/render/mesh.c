@@ -5,6 +5,7 @@
 
 #include "render/mesh.h"
 #include "base/geom.h"
+#include "base/bucketgrid.h"
 
 #define MESH_ALIGN 16
 
@@ -333,16 +334,14 @@ static uint32_t column(const colpt *c, uint32_t n, vec2 p, double lo, double hi,
 /* ---- lamps near surfaces -------------------------------------------------- */
 
 typedef struct lgrid {
-    double x0, y0, cell;
-    uint32_t nx, ny;
-    uint32_t *start, *ids;
+    bucketgrid b;     /* lamps by position */
     double rmax;
 } lgrid;
 
 static int lgrid_build(arena *a, const scene *s, lgrid *g)
 {
     uint32_t i, nc;
-    double minx = HUGE_VAL, miny = HUGE_VAL, maxx = -HUGE_VAL, maxy = -HUGE_VAL;
+    double minx = HUGE_VAL, miny = HUGE_VAL, maxx = -HUGE_VAL, maxy = -HUGE_VAL, cell;
     memset(g, 0, sizeof *g);
     if (s->nlamps == 0)
         return 0;
@@ -355,36 +354,23 @@ static int lgrid_build(arena *a, const scene *s, lgrid *g)
         maxy = fmax(maxy, l->y);
         g->rmax = fmax(g->rmax, l->radius);
     }
-    g->cell = fmax(g->rmax, 1.0);
-    g->nx = (uint32_t)fmin((maxx - minx) / g->cell + 1.0, 4096.0);
-    g->ny = (uint32_t)fmin((maxy - miny) / g->cell + 1.0, 4096.0);
-    g->cell = fmax(g->cell, fmax((maxx - minx) / g->nx, (maxy - miny) / g->ny) * (1.0 + 1e-9));
-    g->x0 = minx;
-    g->y0 = miny;
-    nc = g->nx * g->ny;
-    g->start = arena_scratch(a, arena_mul(nc + 1, sizeof(uint32_t)), MESH_ALIGN);
-    g->ids = arena_scratch(a, arena_mul(s->nlamps, sizeof(uint32_t)), MESH_ALIGN);
-    if (!g->start || !g->ids)
+    cell = fmax(g->rmax, 1.0);
+    g->b.nx = (uint32_t)fmin((maxx - minx) / cell + 1.0, 4096.0);
+    g->b.ny = (uint32_t)fmin((maxy - miny) / cell + 1.0, 4096.0);
+    cell = fmax(cell, fmax((maxx - minx) / g->b.nx, (maxy - miny) / g->b.ny) * (1.0 + 1e-9));
+    bucketgrid_frame(&g->b, minx, miny, cell, g->b.nx, g->b.ny);
+    nc = g->b.nx * g->b.ny;
+    g->b.start = arena_scratch(a, arena_mul(nc + 1, sizeof(uint32_t)), MESH_ALIGN);
+    g->b.item = arena_scratch(a, arena_mul(s->nlamps, sizeof(uint32_t)), MESH_ALIGN);
+    if (!g->b.start || !g->b.item)
         return -1;
-    memset(g->start, 0, (nc + 1) * sizeof(uint32_t));
-    for (i = 0; i < s->nlamps; i++) {
-        uint32_t cx = (uint32_t)fmin((s->lamps[i].x - minx) / g->cell, g->nx - 1.0);
-        uint32_t cy = (uint32_t)fmin((s->lamps[i].y - miny) / g->cell, g->ny - 1.0);
-        g->start[cy * g->nx + cx + 1]++;
-    }
-    for (i = 0; i < nc; i++)
-        g->start[i + 1] += g->start[i];
-    {
-        /* fill using a moving cursor in start (shifted back after) */
-        for (i = 0; i < s->nlamps; i++) {
-            uint32_t cx = (uint32_t)fmin((s->lamps[i].x - minx) / g->cell, g->nx - 1.0);
-            uint32_t cy = (uint32_t)fmin((s->lamps[i].y - miny) / g->cell, g->ny - 1.0);
-            g->ids[g->start[cy * g->nx + cx]++] = i;
-        }
-        for (i = nc; i > 0; i--)
-            g->start[i] = g->start[i - 1];
-        g->start[0] = 0;
-    }
+    memset(g->b.start, 0, (nc + 1) * sizeof(uint32_t));
+    for (i = 0; i < s->nlamps; i++)
+        g->b.start[bucketgrid_cell(&g->b, s->lamps[i].x, s->lamps[i].y) + 1]++;
+    bucketgrid_offsets(&g->b);
+    for (i = 0; i < s->nlamps; i++)
+        g->b.item[g->b.start[bucketgrid_cell(&g->b, s->lamps[i].x, s->lamps[i].y)]++] = i;
+    bucketgrid_rewind(&g->b);
     return 0;
 }
 
@@ -414,23 +400,20 @@ static double box_d2(double px, double py, const double *box)
 static int surf_lit(const scene *s, const lgrid *g, int kind, vec2 a, vec2 b, const double *n,
                     const double *box, double zlo, double zhi)
 {
-    int64_t cx0, cx1, cy0, cy1, cx, cy;
-    double bx0 = box[0] - g->rmax, bx1 = box[2] + g->rmax, by0 = box[1] - g->rmax, by1 = box[3] + g->rmax;
-    if (!g->start)
+    uint32_t r[4], cx, cy;
+    double q[4];
+    q[0] = box[0] - g->rmax;
+    q[1] = box[1] - g->rmax;
+    q[2] = box[2] + g->rmax;
+    q[3] = box[3] + g->rmax;
+    if (!g->b.start)
         return 0;
-    cx0 = (int64_t)floor((bx0 - g->x0) / g->cell);
-    cx1 = (int64_t)floor((bx1 - g->x0) / g->cell);
-    cy0 = (int64_t)floor((by0 - g->y0) / g->cell);
-    cy1 = (int64_t)floor((by1 - g->y0) / g->cell);
-    if (cx0 < 0) cx0 = 0;
-    if (cy0 < 0) cy0 = 0;
-    if (cx1 >= (int64_t)g->nx) cx1 = (int64_t)g->nx - 1;
-    if (cy1 >= (int64_t)g->ny) cy1 = (int64_t)g->ny - 1;
-    for (cy = cy0; cy <= cy1; cy++)
-        for (cx = cx0; cx <= cx1; cx++) {
-            uint32_t k, c = (uint32_t)(cy * (int64_t)g->nx + cx);
-            for (k = g->start[c]; k < g->start[c + 1]; k++) {
-                const scene_lamp *l = &s->lamps[g->ids[k]];
+    bucketgrid_range(&g->b, q, r);
+    for (cy = r[1]; cy <= r[3]; cy++)
+        for (cx = r[0]; cx <= r[2]; cx++) {
+            uint32_t k, c = cy * g->b.nx + cx;
+            for (k = g->b.start[c]; k < g->b.start[c + 1]; k++) {
+                const scene_lamp *l = &s->lamps[g->b.item[k]];
                 double h2, dz, d;
                 if (!(l->radius > 0) || !(l->intensity > 0))
                     continue;

@@ -10,6 +10,7 @@
 #include "light/light.h"
 #include "scene/photometry.h"
 #include "render/lightmap.h"
+#include "render/indmap.h"
 #include "light/illuminance.h"
 #include "light/litregion.h"
 #include "base/geom.h"
@@ -22,6 +23,18 @@ typedef struct cull_item { double key; uint32_t b; } cull_item;
 
 #define RENDER_TILE 8           /* shading tiles, pixels a side */
 #define RENDER_TILE_LAMPS 64    /* longest lamp list of a tile */
+#define TILE_PX (RENDER_TILE * RENDER_TILE)
+
+/* What one worker of the shading pass works in: a tile's hit points,
+ * normals and E, its lamp list, and its counters. */
+typedef struct shade_ws {
+    uint32_t tl[RENDER_TILE_LAMPS];
+    double tP[TILE_PX][3], tN[TILE_PX][3], tE[TILE_PX][3];
+    uint8_t tcall[TILE_PX];     /* 0 sky, 1 no shader, 2 shader */
+    double tI[TILE_PX][3];      /* indirect from the indirect ground map ... */
+    uint8_t tind[TILE_PX];      /* ... when 1 (else the hook's) */
+    render_stats st;            /* the shading pass's counters of this worker */
+} shade_ws;
 
 struct render {
     arena *a;
@@ -52,13 +65,10 @@ struct render {
     double shift[2], shx, shy;  /* sample point offset in pixels, and in NDC */
     /* shading by tiles */
     light *lt;                  /* the light module when shade is render_shade_light */
-    uint32_t *lamp_stamp;       /* nlamps (lt only) */
-    uint32_t stamp_now;
-    uint32_t tl[RENDER_TILE_LAMPS];
-    double tP[RENDER_TILE * RENDER_TILE][3], tN[RENDER_TILE * RENDER_TILE][3];
-    double tE[RENDER_TILE * RENDER_TILE][3];
-    uint8_t tcall[RENDER_TILE * RENDER_TILE];  /* 0 sky, 1 no shader, 2 shader */
+    shade_ws ws[RENDER_MAX_WORKERS];  /* one per worker of the shading pass */
+    uint8_t *defer;             /* per tile of the largest frame: left to the serial pass */
     lightmap lm;                /* the aerial light map (lightmap.c) */
+    indmap im;                  /* its indirect twin (indmap.c) */
     double thr[255];
     uint8_t *lut;               /* 65536: byte for the float bits >> 16 (a hint) */
     const char *err;
@@ -91,8 +101,9 @@ static double srgb_decode(double e)
 size_t render_bytes(const scene *s, int32_t max_w, int32_t max_h)
 {
     size_t px = (size_t)max_w * (size_t)max_h;
-    return px * 20 + (size_t)s->nbld * (2 * sizeof(cull_item) + 17) + RENDER_BINS * 8 + 65536 +
-           (size_t)s->nlamps * 4 + sizeof(render) + 4096;
+    size_t tiles = (size_t)((max_w + RENDER_TILE - 1) / RENDER_TILE) * (size_t)((max_h + RENDER_TILE - 1) / RENDER_TILE);
+    return px * 20 + tiles + (size_t)s->nbld * (2 * sizeof(cull_item) + 17) + RENDER_BINS * 8 + 65536 +
+           sizeof(render) + 4096;
 }
 
 const mesh *render_mesh(const render *r)
@@ -227,11 +238,12 @@ plx_status render_create(arena *a, const scene *s, int32_t max_w, int32_t max_h,
         return PLX_E_NOMEM;
     }
     r->lut = arena_alloc(a, PLX_PART_FRAME, 65536, R_ALIGN);
-    if (shade == render_shade_light && user) {
+    r->defer = arena_alloc(a, PLX_PART_FRAME,
+                           (size_t)((max_w + RENDER_TILE - 1) / RENDER_TILE) *
+                               (size_t)((max_h + RENDER_TILE - 1) / RENDER_TILE), R_ALIGN);
+    if (shade == render_shade_light && user)
         r->lt = user;
-        r->lamp_stamp = arena_calloc(a, PLX_PART_FRAME, (size_t)s->nlamps + 1, sizeof(uint32_t), R_ALIGN);
-    }
-    if (!r->lut || (r->lt && !r->lamp_stamp)) {
+    if (!r->lut || !r->defer) {
         arena_release(a, &m0);
         return PLX_E_NOMEM;
     }
@@ -653,41 +665,35 @@ static void draw_buildings(render *r, const render_backend *be, render_stats *st
 }
 
 /* Lamps whose reach sphere meets box bx (minx, miny, minz, maxx, maxy,
- * maxz), in lamp index order, into r->tl (at most RENDER_TILE_LAMPS);
+ * maxz), in lamp index order, into tl (at most RENDER_TILE_LAMPS);
  * returns their number, or -1 when there are more (the caller then takes
- * the light module's own lamp walk). */
-static int tile_lamps(render *r, const double bx[6])
+ * the light module's own lamp walk). A lamp in several grid cells is
+ * taken once (looked up in the list so far). */
+static int tile_lamps(const render *r, const double bx[6], uint32_t *tl)
 {
-    const light_grid *g = &r->lt->lgrid;
+    const bucketgrid *g = &r->lt->lgrid;
     const scene *s = r->s;
     uint32_t c0, c1, cx0, cx1, cy0, cy1, cx, cy, k;
     int n = 0, i, j;
     if (s->nlamps == 0 || g->nx == 0)
         return 0;
-    c0 = light_grid_cell(g, bx[0], bx[1]);
-    c1 = light_grid_cell(g, bx[3], bx[4]);
+    c0 = bucketgrid_cell(g, bx[0], bx[1]);
+    c1 = bucketgrid_cell(g, bx[3], bx[4]);
     cx0 = c0 % g->nx;
     cy0 = c0 / g->nx;
     cx1 = c1 % g->nx;
     cy1 = c1 / g->nx;
     if ((uint64_t)(cx1 - cx0 + 1) * (cy1 - cy0 + 1) > 16)
         return -1;
-    if (++r->stamp_now == 0) {
-        memset(r->lamp_stamp, 0, s->nlamps * sizeof *r->lamp_stamp);
-        r->stamp_now = 1;
-    }
     for (cy = cy0; cy <= cy1; cy++)
         for (cx = cx0; cx <= cx1; cx++) {
             uint32_t cell = cy * g->nx + cx;
             PLX_ASSERT(cx < g->nx && cy < g->ny); /* a cell of the lamp grid */
             for (k = g->start[cell]; k < g->start[cell + 1]; k++) {
-                uint32_t l = g->ids[k];
+                uint32_t l = g->item[k];
                 const scene_lamp *lp = &s->lamps[l];
                 PLX_ASSERT(l < s->nlamps);
                 double dx, dy, dz;
-                if (r->lamp_stamp[l] == r->stamp_now)
-                    continue;
-                r->lamp_stamp[l] = r->stamp_now;
                 if (!(lp->radius > 0.0) || !(lp->intensity > 0.0))
                     continue;
                 dx = fmax(0.0, fmax(bx[0] - lp->x, lp->x - bx[3]));
@@ -696,17 +702,21 @@ static int tile_lamps(render *r, const double bx[6])
                 /* the term is 0 from d >= R on (light.h, SPEC §2): a margin keeps rounding out */
                 if (!(dx * dx + dy * dy + dz * dz < lp->radius * lp->radius * (1.0 + 1e-9)))
                     continue;
+                for (i = 0; i < n && tl[i] != l; i++)
+                    ;
+                if (i < n)
+                    continue;
                 if (n == RENDER_TILE_LAMPS)
                     return -1;
-                r->tl[n++] = l;
+                tl[n++] = l;
             }
         }
     /* lamp index order (the order of the light module's walk) */
     for (i = 1; i < n; i++) {
-        uint32_t v = r->tl[i];
-        for (j = i - 1; j >= 0 && r->tl[j] > v; j--)
-            r->tl[j + 1] = r->tl[j];
-        r->tl[j + 1] = v;
+        uint32_t v = tl[i];
+        for (j = i - 1; j >= 0 && tl[j] > v; j--)
+            tl[j + 1] = tl[j];
+        tl[j + 1] = v;
     }
     return n;
 }
@@ -775,15 +785,20 @@ static double lamp_term(const scene_lamp *lp, const double P[3], const double n[
  * sector meeting the pseudo-angle range of the corners (the hull subtends
  * less than 180 degrees from O: checked). Returns 0 when unsure: no
  * region, a hull around O, a band from O itself (no lo line). */
-static int hull_visible(render *r, uint32_t l, const double (*c)[2], int nc)
+static int hull_visible(render *r, uint32_t l, const double (*c)[2], int nc, int ro)
 {
     light *L = r->lt;
-    const lit_region *rg;
+    const lit_region *rg = NULL;
     double wx[4], wy[4], base = 0.0, lo = 0.0, hi = 0.0, qmax;
     uint32_t i0, i1, i, k;
     int j;
-    if (L->pool_cap == 0 || !(r->s->lamps[l].radius > 0.0) ||
-        light_region_index(L, l, &rg) != PLX_OK || rg->nsec == 0)
+    if (L->pool_cap == 0 || !(r->s->lamps[l].radius > 0.0))
+        return 0;
+    if (ro)
+        rg = L->ent[l].reg;   /* read-only: the cache as it is (no LRU move) */
+    else if (light_region_index(L, l, &rg) != PLX_OK)
+        rg = NULL;
+    if (!rg || rg->nsec == 0)
         return 0;
     qmax = 1.0 + 0.25e-9 / r->s->lamps[l].radius;
     for (j = 0; j < nc; j++) {
@@ -837,202 +852,399 @@ static int hull_visible(render *r, uint32_t l, const double (*c)[2], int nc)
     return 1;
 }
 
+/* One tile of the shading pass: its pixels, box, wall and lamp list, and
+ * its counters (added to the worker's when the tile is done). */
+typedef struct tile_state {
+    int32_t ti, tj, i1, j1;
+    double bx[6];               /* box of the hit points the shader is called for */
+    double gb[4];               /* box of those on the ground */
+    double wa[2], wb[2], wmin, wmax;
+    uint32_t wall;              /* the one wall of the tile's wall pixels, if one */
+    int ncall, nground, nl;
+    uint64_t sure_g, sure_w;
+    uint64_t sky, ground, building, calls, tiled, skipped;
+} tile_state;
+
 /* E_rgb at P from the tile's lamp list (the light shader's value); lamps
- * whose bit is set in sure are visible without asking. */
-static void shade_tile_lamps(render *r, int nl, uint64_t sure, const double P[3], const double n[3],
-                             double rgb[3], render_stats *st)
+ * whose bit is set in sure are visible without asking. ro: the regions
+ * are read from the cache as they are (tile_light checked that each is
+ * there); returns -1 when a point needs the segment path (P straight
+ * under a lamp, which uses the light object's buffers), else 0. */
+static int shade_tile_lamps(render *r, const uint32_t *tl, int nl, uint64_t sure, int ro, const double P[3],
+                            const double n[3], double rgb[3], tile_state *t)
 {
     const scene *s = r->s;
     int k;
     rgb[0] = rgb[1] = rgb[2] = 0.0;
     for (k = 0; k < nl; k++) {
-        uint32_t l = r->tl[k];
+        uint32_t l = tl[k];
         const scene_lamp *lp = &s->lamps[l];
         double term = lamp_term(lp, P, n);
         if (term == 0.0)
             continue;
         if ((sure >> k) & 1u)
-            st->visibility_skipped++;
-        else if (!light_visible(r->lt, l, P))
+            t->skipped++;
+        else if (ro) {
+            const lit_region *rg = r->lt->ent[l].reg;
+            if (P[0] == rg->o[0] && P[1] == rg->o[1])
+                return -1;
+            if (!light_region_visible(r->lt, rg, P))
+                continue;
+        } else if (!light_visible(r->lt, l, P))
             continue;
         rgb[0] += term * lp->color[0];
         rgb[1] += term * lp->color[1];
         rgb[2] += term * lp->color[2];
     }
+    return 0;
+}
+
+/* Grows the tile's boxes (and its one wall) by hit point P on surface sid. */
+static void tile_grow(tile_state *t, const mesh_surf *sf, uint32_t sid, const double P[3])
+{
+    int k;
+    for (k = 0; k < 3; k++) {
+        t->bx[k] = P[k] < t->bx[k] ? P[k] : t->bx[k];
+        t->bx[3 + k] = P[k] > t->bx[3 + k] ? P[k] : t->bx[3 + k];
+    }
+    if (sid == MESH_SURF_GROUND) {
+        t->nground++;
+        t->gb[0] = P[0] < t->gb[0] ? P[0] : t->gb[0];
+        t->gb[1] = P[1] < t->gb[1] ? P[1] : t->gb[1];
+        t->gb[2] = P[0] > t->gb[2] ? P[0] : t->gb[2];
+        t->gb[3] = P[1] > t->gb[3] ? P[1] : t->gb[3];
+    } else if (sf->kind == MESH_KIND_WALL && t->wall != UINT32_MAX) {
+        /* the ends of the wall pixels along the wall */
+        double u = P[0] * -sf->n[1] + P[1] * sf->n[0];
+        if (t->wall != MESH_SURF_NONE && t->wall != sid)
+            t->wall = UINT32_MAX;
+        else {
+            t->wall = sid;
+            if (u < t->wmin) {
+                t->wmin = u;
+                t->wa[0] = P[0];
+                t->wa[1] = P[1];
+            }
+            if (u > t->wmax) {
+                t->wmax = u;
+                t->wb[0] = P[0];
+                t->wb[1] = P[1];
+            }
+        }
+    }
+}
+
+/* Whether this frame's ground pixels take the indirect term from the
+ * indirect ground map (render_opts.indirect_map; built for its key). */
+static int indmap_usable(const render *r, const render_opts *o)
+{
+    return o->indirect && o->indirect_map && r->im.built && r->im.key == o->indirect_key;
+}
+
+/* Step 1 of a tile: every pixel's hit point and normal; E = 0 (or the
+ * light map's, when sample) for now; sky pixels written. */
+static void tile_points(render *r, shade_ws *w, const render_opts *o, tile_state *t, int sample)
+{
+    const mesh *m = r->m;
+    double ta = r->tanh_ * r->aspect, tb = r->tanh_;
+    int use_lm = o->lightmap && r->lm.built;
+    int use_im = use_lm && sample && indmap_usable(r, o);
+    int32_t i, j;
+    int q = 0, k;
+    for (k = 0; k < 3; k++) {
+        t->bx[k] = HUGE_VAL;
+        t->bx[3 + k] = -HUGE_VAL;
+    }
+    t->gb[0] = t->gb[1] = HUGE_VAL;
+    t->gb[2] = t->gb[3] = -HUGE_VAL;
+    t->wmin = HUGE_VAL;
+    t->wmax = -HUGE_VAL;
+    t->wa[0] = t->wa[1] = t->wb[0] = t->wb[1] = 0.0;
+    t->wall = MESH_SURF_NONE;
+    t->ncall = t->nground = 0;
+    t->nl = -1;
+    t->sure_g = t->sure_w = 0;
+    t->sky = t->ground = t->building = t->calls = t->tiled = t->skipped = 0;
+    for (j = t->tj; j < t->j1; j++) {
+        double bj = (1.0 - 2.0 * (j + 0.5 + r->shift[1]) / r->h) * tb;
+        for (i = t->ti; i < t->i1; i++, q++) {
+            size_t p = (size_t)j * (size_t)r->w + (size_t)i;
+            double ai = (2.0 * (i + 0.5 + r->shift[0]) / r->w - 1.0) * ta;
+            double d[3], tt, nd, E[3] = { 0, 0, 0 };
+            double *P = w->tP[q], *n = w->tN[q];
+            uint32_t sid = r->id[p];
+            const mesh_surf *sf;
+            float *out = &r->lin[3 * p];
+            w->tcall[q] = 0;
+            d[0] = r->f[0] + ai * r->rt[0] + bj * r->up[0];
+            d[1] = r->f[1] + ai * r->rt[1] + bj * r->up[1];
+            d[2] = r->f[2] + ai * r->rt[2] + bj * r->up[2];
+            if (sid == MESH_SURF_NONE) {
+                if (!(d[2] < 0.0)) {
+                    t->sky++;
+                    out[0] = out[1] = out[2] = 0.0f;
+                    continue;
+                }
+                sid = MESH_SURF_GROUND;
+                r->id[p] = sid;
+            }
+            sf = &m->surf[sid];
+            nd = sf->n[0] * d[0] + sf->n[1] * d[1] + sf->n[2] * d[2];
+            if (sid == MESH_SURF_GROUND) {
+                tt = -r->eye[2] / d[2];
+                t->ground++;
+            } else {
+                tt = (sf->d - (sf->n[0] * r->eye[0] + sf->n[1] * r->eye[1] + sf->n[2] * r->eye[2])) / nd;
+                t->building++;
+            }
+            if (!isfinite(tt) || tt < 0.0)
+                tt = 0.0;
+            for (k = 0; k < 3; k++) {
+                P[k] = r->eye[k] + tt * d[k];
+                n[k] = nd > 0.0 ? -sf->n[k] : sf->n[k];
+            }
+            if (sid == MESH_SURF_GROUND)
+                P[2] = 0.0;
+            w->tcall[q] = 1;
+            /* facing up: the map's indirect layer (the indirect ground map without one) */
+            w->tind[q] = use_lm && sample && o->indirect && n[2] > 0.5 &&
+                         (r->lm.has_ind ? lightmap_sample_ind(&r->lm, P, w->tI[q])
+                                        : use_im && indmap_sample(&r->im, P, w->tI[q]));
+            if (sf->lit && sid == MESH_SURF_GROUND && use_lm) {
+                if (sample)
+                    lightmap_sample(&r->lm, P, E);
+            } else if (sf->lit) {
+                w->tcall[q] = 2;
+                t->ncall++;
+                if (r->lt) /* hit points are finite: plain comparisons */
+                    tile_grow(t, sf, sid, P);
+            }
+            for (k = 0; k < 3; k++)
+                w->tE[q][k] = E[k];
+        }
+    }
+}
+
+/* Step 2: the tile's lamps and which of them light its ground (or its one
+ * wall) for sure. ro: nothing in the light object is changed; returns -1
+ * when the tile needs it (more lamps than a list holds, a lamp's region
+ * not in the cache), else 0. */
+static int tile_light(render *r, shade_ws *w, tile_state *t, int ro)
+{
+    int k;
+    if (t->ncall > 0 && r->lt)
+        t->nl = tile_lamps(r, t->bx, w->tl);
+    if (ro && t->ncall > 0) {
+        if (t->nl < 0)
+            return -1;
+        for (k = 0; k < t->nl; k++)
+            if (!r->lt->ent[w->tl[k]].reg)
+                return -1;
+    }
+    if (t->nl > 0 && t->nground > 0) {
+        double hb[4][2];
+        hb[0][0] = hb[2][0] = t->gb[0];
+        hb[1][0] = hb[3][0] = t->gb[2];
+        hb[0][1] = hb[1][1] = t->gb[1];
+        hb[2][1] = hb[3][1] = t->gb[3];
+        for (k = 0; k < t->nl; k++)
+            if (hull_visible(r, w->tl[k], (const double (*)[2])hb, 4, ro))
+                t->sure_g |= (uint64_t)1 << k;
+    }
+    if (t->nl > 0 && t->wall != MESH_SURF_NONE && t->wall != UINT32_MAX) {
+        double hs[2][2];
+        hs[0][0] = t->wa[0];
+        hs[0][1] = t->wa[1];
+        hs[1][0] = t->wb[0];
+        hs[1][1] = t->wb[1];
+        /* a single pixel: a point is a segment of length 0 (O not on it) */
+        for (k = 0; k < t->nl; k++)
+            if (hull_visible(r, w->tl[k], (const double (*)[2])hs, 2, ro))
+                t->sure_w |= (uint64_t)1 << k;
+    }
+    return 0;
+}
+
+/* Step 3: shade every pixel of the tile. Returns -1 (ro only) when a pixel
+ * needs the light object's buffers, else 0. */
+static int tile_shade(render *r, shade_ws *w, const render_opts *o, tile_state *t, int ro)
+{
+    const mesh *m = r->m;
+    int32_t i, j;
+    int q = 0;
+    for (j = t->tj; j < t->j1; j++)
+        for (i = t->ti; i < t->i1; i++, q++) {
+            size_t p = (size_t)j * (size_t)r->w + (size_t)i;
+            const mesh_surf *sf = &m->surf[r->id[p]];
+            double *E = w->tE[q];
+            float *out = &r->lin[3 * p];
+            int k;
+            if (!w->tcall[q])
+                continue;
+            if (w->tcall[q] == 2) {
+                if (t->nl >= 0) {
+                    uint64_t sure = r->id[p] == MESH_SURF_GROUND ? t->sure_g : r->id[p] == t->wall ? t->sure_w : 0;
+                    if (shade_tile_lamps(r, w->tl, t->nl, sure, ro, w->tP[q], w->tN[q], E, t) != 0)
+                        return -1;
+                    t->tiled++;
+                } else
+                    r->shade(r->user, w->tP[q], w->tN[q], E);
+                t->calls++;
+            }
+            if (w->tind[q]) {
+                for (k = 0; k < 3; k++)
+                    E[k] += w->tI[q][k];
+            } else if (o->indirect) {
+                double Ei[3] = { 0, 0, 0 };
+                o->indirect(o->indirect_user, w->tP[q], w->tN[q], Ei);
+                for (k = 0; k < 3; k++)
+                    E[k] += Ei[k];
+            }
+            if (r->id[p] == MESH_SURF_GROUND) {
+                double alb[3]; /* per channel: the ground image (ground.c) */
+                scene_ground_albedo(r->s, w->tP[q][0], w->tP[q][1], alb);
+                for (k = 0; k < 3; k++)
+                    out[k] = (float)(alb[k] / PI * E[k]);
+            } else {
+                for (k = 0; k < 3; k++)
+                    out[k] = (float)(sf->albedo / PI * E[k]);
+            }
+        }
+    return 0;
+}
+
+static void tile_init(const render *r, tile_state *t, int32_t ti, int32_t tj)
+{
+    t->ti = ti;
+    t->tj = tj;
+    t->i1 = ti + RENDER_TILE < r->w ? ti + RENDER_TILE : r->w;
+    t->j1 = tj + RENDER_TILE < r->h ? tj + RENDER_TILE : r->h;
+}
+
+static void tile_count(render_stats *st, const tile_state *t)
+{
+    st->sky_pixels += t->sky;
+    st->ground_pixels += t->ground;
+    st->building_pixels += t->building;
+    st->shader_calls += t->calls;
+    st->shader_tiled += t->tiled;
+    st->visibility_skipped += t->skipped;
+}
+
+/* A whole tile on the calling thread, as one thread does it. */
+static void tile_serial(render *r, const render_opts *o, int32_t ti, int32_t tj)
+{
+    tile_state t;
+    tile_init(r, &t, ti, tj);
+    tile_points(r, &r->ws[0], o, &t, 1);
+    (void)tile_light(r, &r->ws[0], &t, 0);
+    (void)tile_shade(r, &r->ws[0], o, &t, 0);
+    tile_count(&r->ws[0].st, &t);
+}
+
+/* Before the workers start: the lamp regions every tile will ask for are
+ * put in the light object's cache (hit points and lamp lists only). */
+static void tile_warm(render *r, const render_opts *o, int32_t ti, int32_t tj)
+{
+    tile_state t;
+    shade_ws *w = &r->ws[0];
+    int k;
+    tile_init(r, &t, ti, tj);
+    tile_points(r, w, o, &t, 0);
+    if (t.ncall == 0)
+        return;
+    t.nl = tile_lamps(r, t.bx, w->tl);
+    for (k = 0; k < t.nl; k++) {
+        const lit_region *rg;
+        if (!r->lt->ent[w->tl[k]].reg)
+            (void)light_region_index(r->lt, w->tl[k], &rg);
+    }
+}
+
+typedef struct shade_job {
+    render *r;
+    const render_opts *o;
+    uint8_t *defer;             /* per tile: 1 when a worker left it to the serial pass */
+    int32_t tw;                 /* tiles in a row */
+} shade_job;
+
+/* One row of tiles on worker 'worker' (render_job_fn). */
+static void shade_row(void *arg, int worker, uint32_t row)
+{
+    shade_job *jb = arg;
+    render *r = jb->r;
+    shade_ws *w = &r->ws[worker];
+    int32_t ti, tj = (int32_t)row * RENDER_TILE;
+    for (ti = 0; ti < r->w; ti += RENDER_TILE) {
+        tile_state t;
+        size_t k = (size_t)row * (size_t)jb->tw + (size_t)(ti / RENDER_TILE);
+        tile_init(r, &t, ti, tj);
+        tile_points(r, w, jb->o, &t, 1);
+        if (tile_light(r, w, &t, 1) != 0 || tile_shade(r, w, jb->o, &t, 1) != 0) {
+            jb->defer[k] = 1;
+            continue;
+        }
+        jb->defer[k] = 0;
+        tile_count(&w->st, &t);
+    }
+}
+
+/* How many workers the shading pass of this frame may use: several only
+ * with a parallel-for, the light module's shader and a thread-safe
+ * indirect hook (or none). */
+static int shade_workers(const render *r, const render_opts *o)
+{
+    int n = o->workers;
+    if (!o->par || n < 2 || !r->lt || (o->indirect && !o->indirect_mt))
+        return 1;
+    return n > RENDER_MAX_WORKERS ? RENDER_MAX_WORKERS : n;
 }
 
 /* The shading pass, by tiles of RENDER_TILE x RENDER_TILE pixels: first
  * every pixel's hit point, then (light shader) the lamps whose reach meets
- * the box of the tile's hit points, then the illuminance from that list. */
+ * the box of the tile's hit points, then the illuminance from that list.
+ * With several workers: the regions the tiles need are cached first (on
+ * this thread), the workers shade rows of tiles reading the light object
+ * only, and the tiles a worker could not finish that way are shaded here
+ * after them, as one thread does. A tile's pixels depend on the tile
+ * alone, so the image is the same bytes for any number of workers. */
 static void shade_pass(render *r, const render_opts *o, render_stats *st)
 {
-    const mesh *m = r->m;
-    int32_t i, j, ti, tj;
-    double ta = r->tanh_ * r->aspect, tb = r->tanh_;
-    int use_lm = o->lightmap && r->lm.built;
-    double (*TP)[3] = r->tP, (*TN)[3] = r->tN;
-    for (tj = 0; tj < r->h; tj += RENDER_TILE)
-        for (ti = 0; ti < r->w; ti += RENDER_TILE) {
-            int32_t j1 = tj + RENDER_TILE < r->h ? tj + RENDER_TILE : r->h;
-            int32_t i1 = ti + RENDER_TILE < r->w ? ti + RENDER_TILE : r->w;
-            double bx[6] = { HUGE_VAL, HUGE_VAL, HUGE_VAL, -HUGE_VAL, -HUGE_VAL, -HUGE_VAL };
-            double gb[4] = { HUGE_VAL, HUGE_VAL, -HUGE_VAL, -HUGE_VAL };
-            double wmin = HUGE_VAL, wmax = -HUGE_VAL, wa[2] = { 0, 0 }, wb[2] = { 0, 0 };
-            int ncall = 0, nground = 0, nl = -1, q = 0;
-            uint32_t wall = MESH_SURF_NONE;   /* the one wall of the tile's wall pixels, if one */
-            uint64_t sure_g = 0, sure_w = 0;
-            /* 1: hit points; E = 0 (or the light map) in out for now */
-            for (j = tj; j < j1; j++) {
-                double bj = (1.0 - 2.0 * (j + 0.5 + r->shift[1]) / r->h) * tb;
-                for (i = ti; i < i1; i++, q++) {
-                    size_t p = (size_t)j * (size_t)r->w + (size_t)i;
-                    double ai = (2.0 * (i + 0.5 + r->shift[0]) / r->w - 1.0) * ta;
-                    double d[3], t, nd, E[3] = { 0, 0, 0 };
-                    double *P = TP[q], *n = TN[q];
-                    uint32_t sid = r->id[p];
-                    const mesh_surf *sf;
-                    float *out = &r->lin[3 * p];
-                    int k;
-                    r->tcall[q] = 0;
-                    d[0] = r->f[0] + ai * r->rt[0] + bj * r->up[0];
-                    d[1] = r->f[1] + ai * r->rt[1] + bj * r->up[1];
-                    d[2] = r->f[2] + ai * r->rt[2] + bj * r->up[2];
-                    if (sid == MESH_SURF_NONE) {
-                        if (!(d[2] < 0.0)) {
-                            st->sky_pixels++;
-                            out[0] = out[1] = out[2] = 0.0f;
-                            continue;
-                        }
-                        sid = MESH_SURF_GROUND;
-                        r->id[p] = sid;
-                    }
-                    sf = &m->surf[sid];
-                    nd = sf->n[0] * d[0] + sf->n[1] * d[1] + sf->n[2] * d[2];
-                    if (sid == MESH_SURF_GROUND) {
-                        t = -r->eye[2] / d[2];
-                        st->ground_pixels++;
-                    } else {
-                        t = (sf->d - (sf->n[0] * r->eye[0] + sf->n[1] * r->eye[1] + sf->n[2] * r->eye[2])) / nd;
-                        st->building_pixels++;
-                    }
-                    if (!isfinite(t) || t < 0.0)
-                        t = 0.0;
-                    for (k = 0; k < 3; k++) {
-                        P[k] = r->eye[k] + t * d[k];
-                        n[k] = nd > 0.0 ? -sf->n[k] : sf->n[k];
-                    }
-                    if (sid == MESH_SURF_GROUND)
-                        P[2] = 0.0;
-                    r->tcall[q] = 1;
-                    if (sf->lit && sid == MESH_SURF_GROUND && use_lm)
-                        lightmap_sample(&r->lm, P, E);
-                    else if (sf->lit) {
-                        r->tcall[q] = 2;
-                        ncall++;
-                        if (r->lt) {
-                            /* hit points are finite: plain comparisons */
-                            for (k = 0; k < 3; k++) {
-                                bx[k] = P[k] < bx[k] ? P[k] : bx[k];
-                                bx[3 + k] = P[k] > bx[3 + k] ? P[k] : bx[3 + k];
-                            }
-                            if (sid == MESH_SURF_GROUND) {
-                                nground++;
-                                gb[0] = P[0] < gb[0] ? P[0] : gb[0];
-                                gb[1] = P[1] < gb[1] ? P[1] : gb[1];
-                                gb[2] = P[0] > gb[2] ? P[0] : gb[2];
-                                gb[3] = P[1] > gb[3] ? P[1] : gb[3];
-                            } else if (sf->kind == MESH_KIND_WALL && wall != UINT32_MAX) {
-                                /* the ends of the wall pixels along the wall */
-                                double u = P[0] * -sf->n[1] + P[1] * sf->n[0];
-                                if (wall != MESH_SURF_NONE && wall != sid)
-                                    wall = UINT32_MAX;
-                                else {
-                                    wall = sid;
-                                    if (u < wmin) {
-                                        wmin = u;
-                                        wa[0] = P[0];
-                                        wa[1] = P[1];
-                                    }
-                                    if (u > wmax) {
-                                        wmax = u;
-                                        wb[0] = P[0];
-                                        wb[1] = P[1];
-                                    }
-                                }
-                            }
-                        }
-                    }
-                    for (k = 0; k < 3; k++)
-                        r->tE[q][k] = E[k];
-                }
-            }
-            /* 2: the tile's lamps */
-            if (ncall > 0 && r->lt)
-                nl = tile_lamps(r, bx);
-            if (nl > 0 && nground > 0) {
-                double hb[4][2];
-                int k;
-                hb[0][0] = hb[2][0] = gb[0];
-                hb[1][0] = hb[3][0] = gb[2];
-                hb[0][1] = hb[1][1] = gb[1];
-                hb[2][1] = hb[3][1] = gb[3];
-                for (k = 0; k < nl; k++)
-                    if (hull_visible(r, r->tl[k], (const double (*)[2])hb, 4))
-                        sure_g |= (uint64_t)1 << k;
-            }
-            if (nl > 0 && wall != MESH_SURF_NONE && wall != UINT32_MAX) {
-                double hs[2][2];
-                int k;
-                hs[0][0] = wa[0];
-                hs[0][1] = wa[1];
-                hs[1][0] = wb[0];
-                hs[1][1] = wb[1];
-                /* a single pixel: a point is a segment of length 0 (O not on it) */
-                for (k = 0; k < nl; k++)
-                    if (hull_visible(r, r->tl[k], (const double (*)[2])hs, 2))
-                        sure_w |= (uint64_t)1 << k;
-            }
-            /* 3: shade */
-            for (q = 0, j = tj; j < j1; j++)
-                for (i = ti; i < i1; i++, q++) {
-                    size_t p = (size_t)j * (size_t)r->w + (size_t)i;
-                    const mesh_surf *sf = &m->surf[r->id[p]];
-                    double *E = r->tE[q];
-                    float *out = &r->lin[3 * p];
-                    int k;
-                    if (!r->tcall[q])
-                        continue;
-                    if (r->tcall[q] == 2) {
-                        if (nl >= 0) {
-                            shade_tile_lamps(r, nl,
-                                             r->id[p] == MESH_SURF_GROUND ? sure_g
-                                             : r->id[p] == wall           ? sure_w
-                                                                          : 0,
-                                             TP[q], TN[q], E, st);
-                            st->shader_tiled++;
-                        } else
-                            r->shade(r->user, TP[q], TN[q], E);
-                        st->shader_calls++;
-                    }
-                    if (o->indirect) {
-                        double Ei[3] = { 0, 0, 0 };
-                        /* aerial: ground and roofs from the map's indirect layer */
-                        if (!(use_lm && TN[q][2] > 0.5 && lightmap_sample_ind(&r->lm, TP[q], Ei)))
-                            o->indirect(o->indirect_user, TP[q], TN[q], Ei);
-                        for (k = 0; k < 3; k++)
-                            E[k] += Ei[k];
-                    }
-                    if (r->id[p] == MESH_SURF_GROUND) {
-                        double alb[3]; /* per channel: the ground image (ground.c) */
-                        scene_ground_albedo(r->s, TP[q][0], TP[q][1], alb);
-                        for (k = 0; k < 3; k++)
-                            out[k] = (float)(alb[k] / PI * E[k]);
-                    } else {
-                        for (k = 0; k < 3; k++)
-                            out[k] = (float)(sf->albedo / PI * E[k]);
-                    }
-                }
-        }
+    int nw = shade_workers(r, o), k;
+    int32_t ti, tj;
+    for (k = 0; k < nw; k++)
+        memset(&r->ws[k].st, 0, sizeof r->ws[k].st);
+    if (nw == 1) {
+        for (tj = 0; tj < r->h; tj += RENDER_TILE)
+            for (ti = 0; ti < r->w; ti += RENDER_TILE)
+                tile_serial(r, o, ti, tj);
+    } else {
+        shade_job jb;
+        uint32_t rows = (uint32_t)((r->h + RENDER_TILE - 1) / RENDER_TILE), row;
+        jb.r = r;
+        jb.o = o;
+        jb.defer = r->defer;
+        jb.tw = (r->w + RENDER_TILE - 1) / RENDER_TILE;
+        for (tj = 0; tj < r->h; tj += RENDER_TILE)
+            for (ti = 0; ti < r->w; ti += RENDER_TILE)
+                tile_warm(r, o, ti, tj);
+        if (o->par(o->par_ctx, nw, rows, shade_row, &jb) != 0)
+            for (row = 0; row < rows; row++)
+                shade_row(&jb, 0, row);
+        for (tj = 0; tj < r->h; tj += RENDER_TILE)
+            for (ti = 0; ti < r->w; ti += RENDER_TILE)
+                if (r->defer[(size_t)(tj / RENDER_TILE) * (size_t)jb.tw + (size_t)(ti / RENDER_TILE)])
+                    tile_serial(r, o, ti, tj);
+    }
+    for (k = 0; k < nw; k++) {
+        const render_stats *ws = &r->ws[k].st;
+        st->sky_pixels += ws->sky_pixels;
+        st->ground_pixels += ws->ground_pixels;
+        st->building_pixels += ws->building_pixels;
+        st->shader_calls += ws->shader_calls;
+        st->shader_tiled += ws->shader_tiled;
+        st->visibility_skipped += ws->visibility_skipped;
+    }
 }
 
 static void glows(render *r, render_stats *st)
@@ -1159,6 +1371,12 @@ plx_status render_frame(render *r, const render_camera *cam, const render_opts *
         return PLX_E_UNSUPPORTED;
     }
     st.drawn_fraction = st.triangles ? (double)st.triangles_drawn / (double)st.triangles : 1.0;
+    if (o->lightmap && r->lm.built && !r->lm.has_ind && o->indirect && o->indirect_map &&
+        (!r->im.built || r->im.key != o->indirect_key))
+        /* out of memory: the frame takes the hook per pixel (indmap_usable) */
+        (void)indmap_build(&r->im, r->a, &r->lm, o->indirect_far ? o->indirect_far : o->indirect,
+                           o->indirect_user, o->top, o->indirect_user, o->indirect_key,
+                           o->indirect_far || o->indirect_mt ? o->par : NULL, o->par_ctx, o->workers);
     shade_pass(r, o, &st);
     /* the exposure from the lit surfaces, before the glows */
     st.exposure = o->auto_exposure ? exposure_auto(r->lin, r->id, px) : o->exposure;
@@ -1178,16 +1396,35 @@ plx_status render_frame(render *r, const render_camera *cam, const render_opts *
 
 plx_status render_lightmap_build(render *r, double cell, size_t max_bytes)
 {
-    if (!r)
-        return PLX_E_INVALID;
-    return lightmap_build(&r->lm, r->a, r->s, cell, max_bytes, r->shade, r->user, &r->err);
+    return render_lightmap_build_par(r, cell, max_bytes, NULL, NULL, 1);
 }
 
-plx_status render_lightmap_build_ind(render *r, double cell, size_t max_bytes, lightmap_ind_fn ind, void *user)
+plx_status render_lightmap_build_par(render *r, double cell, size_t max_bytes, render_par_fn par, void *ctx,
+                                     int workers)
 {
+    lightmap_par lp;
+    if (!r)
+        return PLX_E_INVALID;
+    r->im.built = 0;   /* over the old map's box */
+    lp.par = par;
+    lp.ctx = ctx;
+    lp.workers = workers > RENDER_MAX_WORKERS ? RENDER_MAX_WORKERS : workers;
+    lp.lt = r->shade == render_shade_light ? r->lt : NULL;
+    return lightmap_build(&r->lm, r->a, r->s, cell, max_bytes, r->shade, r->user, &lp, &r->err);
+}
+
+plx_status render_lightmap_build_ind(render *r, double cell, size_t max_bytes, lightmap_ind_fn ind, void *user,
+                                     render_par_fn par, void *ctx, int workers)
+{
+    lightmap_par lp;
     if (!r || !ind)
         return PLX_E_INVALID;
-    return lightmap_build_ind(&r->lm, r->a, r->s, cell, max_bytes, r->shade, r->user, ind, user, &r->err);
+    r->im.built = 0;   /* over the old map's box */
+    lp.par = par;
+    lp.ctx = ctx;
+    lp.workers = workers > RENDER_MAX_WORKERS ? RENDER_MAX_WORKERS : workers;
+    lp.lt = r->shade == render_shade_light ? r->lt : NULL;
+    return lightmap_build_ind(&r->lm, r->a, r->s, cell, max_bytes, r->shade, r->user, &lp, ind, user, &r->err);
 }
 
 void render_lightmap_get(const render *r, render_lightmap_info *out)

@@ -152,7 +152,19 @@
  * one asked for, enlarged when needed to stay within the byte budget.
  * With an indirect layer (render_lightmap_build_ind) ground and roof
  * pixels of aerial frames take their indirect term from it too (no
- * per-pixel gathers: the frame costs what a direct-only one does).
+ * per-pixel gathers: the frame costs what a direct-only one does). When
+ * the map has no filled layer (images not gathering: plx_indirect_set_gather
+ * 0), render_opts.indirect_map makes them read the indirect ground map
+ * (indmap.h) instead, built from the indirect hook at its texel centres
+ * for indirect_key.
+ *
+ * Threads (render_opts.par, workers). The shading pass and the map builds
+ * may run on a parallel-for: rows of tiles (rows of texels) as jobs, each
+ * worker with its own tile buffers. The light object's region cache is
+ * filled on the calling thread first and only read by the workers; a tile
+ * that needs more is shaded after them on the calling thread, as one
+ * thread does. A pixel depends on its tile alone, so the bytes are the
+ * same for any number of workers (tests/unit/test_threads.c).
  *
  * Backends (render_backend below). Only pass (1) is pluggable: a backend
  * takes the visible buildings' triangles, already in clip space (the core
@@ -231,6 +243,14 @@ struct plx_backend {
     int (*finish)(void *user, uint32_t *id /* OUT */, float *depth /* OUT */);
 };
 
+/* A parallel-for (plx_port.parallel_for): job(arg, worker, k) for k = 0 ..
+ * njobs-1 on up to 'workers' threads, worker in 0 .. workers-1, the calls
+ * of one worker one after another; returns 0 when all ran, -1 when none
+ * did. */
+typedef void (*render_job_fn)(void *arg, int worker, uint32_t k);
+typedef int (*render_par_fn)(void *ctx, int workers, uint32_t njobs, render_job_fn job, void *arg);
+#define RENDER_MAX_WORKERS 16
+
 typedef struct render_opts {
     double exposure;           /* radiance multiplier before sRGB, default 1 */
     int no_glow;               /* 1: no lamp discs (exact SPEC §5 pixels) */
@@ -243,6 +263,19 @@ typedef struct render_opts {
     int auto_exposure;         /* 1: exposure from the image and the tone curve (exposure.h) */
     double shift[2];           /* the sample point of each pixel: its centre + shift (pixels,
                                   x right, y down; |shift| < 0.5); 0 0 is SPEC §5's centre */
+    render_par_fn par;         /* the shading pass's parallel-for (NULL: one thread) */
+    void *par_ctx;
+    int workers;               /* workers it may use (1 .. RENDER_MAX_WORKERS; more are cut) */
+    int indirect_mt;           /* 1: indirect may be called from several threads at once */
+    int indirect_map;          /* 1: with lightmap, ground pixels read indirect from the indirect
+                                  ground map (indmap.h), built from indirect when indirect_key
+                                  differs from the last build's */
+    uint64_t indirect_key;     /* changes whenever what indirect_far returns changes */
+    render_shade_fn indirect_far; /* the hook the indirect ground map is built from (NULL:
+                                  indirect): one that does not depend on the eye and is safe
+                                  on several threads (its user is indirect_user) */
+    double (*top)(void *user, double x, double y);  /* the map's surface height at (x, y): the
+                                  topmost roof or 0 (NULL: the ground); user is indirect_user */
 } render_opts;
 
 void render_opts_default(render_opts *o /* OUT */);
@@ -307,15 +340,21 @@ const uint32_t *render_ids(const render *r);
  * place when the new map fits the first one's memory. Returns PLX_OK,
  * PLX_E_INVALID (m_per_texel <= 0, max_bytes < 12), PLX_E_NOMEM. */
 plx_status render_lightmap_build(render *r, double m_per_texel, size_t max_bytes);
+/* The same with its rows on a parallel-for (lightmap.h: with the light
+ * module's shader; the same map for any number of workers). */
+plx_status render_lightmap_build_par(render *r, double m_per_texel, size_t max_bytes, render_par_fn par,
+                                     void *ctx, int workers);
 
 /* The same with the map's indirect layer (lightmap.h, lightmap_build_ind;
  * 28 bytes per texel): ind(user, x, y, ...) gives E_indirect at the topmost
  * surface over each reached texel centre. Aerial frames with an indirect
  * hook then read their ground and roof pixels' indirect term from it (the
  * hook only where the layer has no texel of the pixel's surface around it:
- * walls, slivers narrower than a texel, beyond the lamps' reach nothing). */
+ * walls, slivers narrower than a texel, beyond the lamps' reach nothing).
+ * ind is called on this thread; the direct part's rows as
+ * render_lightmap_build_par. */
 plx_status render_lightmap_build_ind(render *r, double m_per_texel, size_t max_bytes, lightmap_ind_fn ind,
-                                     void *user);
+                                     void *user, render_par_fn par, void *ctx, int workers);
 
 typedef struct render_lightmap_info {
     int built;

@@ -19,6 +19,7 @@
 #include <limits.h>
 #include "scene/blocks.h"
 #include "base/msort.h"
+#include "base/bucketgrid.h"
 
 #define BLK_NONE UINT32_MAX
 #define BLK_ALIGN 8
@@ -313,31 +314,18 @@ static void uf_unite(uint32_t *p, uint32_t i, uint32_t j)
 
 /* ---- uniform grid over boxes or points ----------------------------------- */
 
-typedef struct grid {
-    double x0, y0, inv;
-    uint32_t nx, ny;
-    uint32_t *start;  /* nx*ny + 1 offsets into item */
-    uint32_t *item;
-} grid;
-
-static uint32_t grid_cell1(double v, double v0, double inv, uint32_t n)
-{
-    double f = (v - v0) * inv;
-    if (!(f >= 0.0))
-        return 0;
-    if (f >= (double)n)
-        return n - 1;
-    return (uint32_t)f;
-}
+typedef bucketgrid grid;
 
 /* Cell range r = {x0, y0, x1, y1} covered by a box. */
 static void grid_range(const grid *g, double minx, double miny, double maxx, double maxy,
                        uint32_t r[4])
 {
-    r[0] = grid_cell1(minx, g->x0, g->inv, g->nx);
-    r[1] = grid_cell1(miny, g->y0, g->inv, g->ny);
-    r[2] = grid_cell1(maxx, g->x0, g->inv, g->nx);
-    r[3] = grid_cell1(maxy, g->y0, g->inv, g->ny);
+    double b[4];
+    b[0] = minx;
+    b[1] = miny;
+    b[2] = maxx;
+    b[3] = maxy;
+    bucketgrid_range(g, b, r);
 }
 
 static void item_box(const double *box, const vec2 *pts, uint32_t i, double b[4])
@@ -390,7 +378,7 @@ static void grid_size(grid *g, const double *box, const vec2 *pts, uint32_t n, d
             dnx = dny = 1.0;
         g->nx = (uint32_t)dnx;
         g->ny = (uint32_t)dny;
-        g->inv = 1.0 / cs;
+        g->sx = g->sy = 1.0 / cs;
         if (g->nx == 1 && g->ny == 1)
             break;
         for (i = 0; i < n; i++) {
@@ -407,39 +395,8 @@ static void grid_size(grid *g, const double *box, const vec2 *pts, uint32_t n, d
 static plx_status grid_build(arena *a, grid *g, const double *box, const vec2 *pts, uint32_t n,
                              double min_cs)
 {
-    double b[4];
-    size_t ncell, nitem;
-    uint32_t i, c, r[4], x, y;
     grid_size(g, box, pts, n, min_cs);
-    ncell = (size_t)g->nx * g->ny;
-    g->start = arena_scratch(a, arena_mul(ncell + 1, sizeof(uint32_t)), BLK_ALIGN);
-    if (!g->start)
-        return PLX_E_NOMEM;
-    memset(g->start, 0, (ncell + 1) * sizeof(uint32_t));
-    for (i = 0; i < n; i++) {
-        item_box(box, pts, i, b);
-        grid_range(g, b[0], b[1], b[2], b[3], r);
-        for (y = r[1]; y <= r[3]; y++)
-            for (x = r[0]; x <= r[2]; x++)
-                g->start[(size_t)y * g->nx + x + 1]++;
-    }
-    for (c = 0; c < ncell; c++)
-        g->start[c + 1] += g->start[c];
-    nitem = g->start[ncell];
-    g->item = arena_scratch(a, arena_mul(nitem, sizeof(uint32_t)), BLK_ALIGN);
-    if (!g->item)
-        return PLX_E_NOMEM;
-    for (i = 0; i < n; i++) {
-        item_box(box, pts, i, b);
-        grid_range(g, b[0], b[1], b[2], b[3], r);
-        for (y = r[1]; y <= r[3]; y++)
-            for (x = r[0]; x <= r[2]; x++)
-                g->item[g->start[(size_t)y * g->nx + x]++] = i;
-    }
-    for (c = (uint32_t)ncell; c > 0; c--)
-        g->start[c] = g->start[c - 1];
-    g->start[0] = 0;
-    return PLX_OK;
+    return bucketgrid_fill(g, a, PLX_PART_SCRATCH, BLK_ALIGN, box, pts, n);
 }
 
 /* Is cell c the one holding the low corner of the intersection of two
@@ -448,7 +405,7 @@ static int grid_owns_pair(const grid *g, uint32_t c, const double *b1, const dou
 {
     double x = b1[0] > b2[0] ? b1[0] : b2[0];
     double y = b1[1] > b2[1] ? b1[1] : b2[1];
-    uint32_t cx = grid_cell1(x, g->x0, g->inv, g->nx), cy = grid_cell1(y, g->y0, g->inv, g->ny);
+    uint32_t cx = bucketgrid_index(x, g->x0, g->sx, g->nx), cy = bucketgrid_index(y, g->y0, g->sy, g->ny);
     return (size_t)cy * g->nx + cx == c;
 }
 
@@ -655,8 +612,8 @@ static plx_status strips_build(arena *a, strips *st, const vec2 *pos, const seg 
         for (k = 0; k < ns; k++) {
             u = seg_coord(pos, sg[k].u, axis);
             v = seg_coord(pos, sg[k].v, axis);
-            i0 = grid_cell1(u < v ? u : v, lo, st->inv, st->n);
-            i1 = grid_cell1(u < v ? v : u, lo, st->inv, st->n);
+            i0 = bucketgrid_index(u < v ? u : v, lo, st->inv, st->n);
+            i1 = bucketgrid_index(u < v ? v : u, lo, st->inv, st->n);
             items += (double)(i1 - i0 + 1);
         }
         if (items <= cap)
@@ -670,8 +627,8 @@ static plx_status strips_build(arena *a, strips *st, const vec2 *pos, const seg 
     for (k = 0; k < ns; k++) {
         u = seg_coord(pos, sg[k].u, axis);
         v = seg_coord(pos, sg[k].v, axis);
-        i0 = grid_cell1(u < v ? u : v, lo, st->inv, st->n);
-        i1 = grid_cell1(u < v ? v : u, lo, st->inv, st->n);
+        i0 = bucketgrid_index(u < v ? u : v, lo, st->inv, st->n);
+        i1 = bucketgrid_index(u < v ? v : u, lo, st->inv, st->n);
         for (i = i0; i <= i1; i++)
             st->start[i + 1]++;
     }
@@ -683,8 +640,8 @@ static plx_status strips_build(arena *a, strips *st, const vec2 *pos, const seg 
     for (k = 0; k < ns; k++) {
         u = seg_coord(pos, sg[k].u, axis);
         v = seg_coord(pos, sg[k].v, axis);
-        i0 = grid_cell1(u < v ? u : v, lo, st->inv, st->n);
-        i1 = grid_cell1(u < v ? v : u, lo, st->inv, st->n);
+        i0 = bucketgrid_index(u < v ? u : v, lo, st->inv, st->n);
+        i1 = bucketgrid_index(u < v ? v : u, lo, st->inv, st->n);
         for (i = i0; i <= i1; i++)
             st->item[st->start[i]++] = k;
     }
@@ -868,8 +825,8 @@ static plx_status blk_cluster(blk *k, uint32_t *cid)
                     v = k->vp[j];
                     if (hgrid_cell(v.x, h.x0, h.inv) != x || hgrid_cell(v.y, h.y0, h.inv) != y)
                         continue;
-                    ox = grid_cell1(v.x, g.x0, g.inv, g.nx);
-                    oy = grid_cell1(v.y, g.y0, g.inv, g.ny);
+                    ox = bucketgrid_index(v.x, g.x0, g.sx, g.nx);
+                    oy = bucketgrid_index(v.y, g.y0, g.sy, g.ny);
                     if (ox < ro[0] || ox > ro[2] || oy < ro[1] || oy > ro[3])
                         continue; /* the plain grid would not look at it */
                     if (dist2(p, v) <= k->tol2)
@@ -986,8 +943,8 @@ static uint32_t edge_hits_h(const blk *k, const hgrid *h, const grid *og, double
                 if (w == u || w == v || hgrid_cell(p.x, h->x0, h->inv) != cc[0] ||
                     hgrid_cell(p.y, h->y0, h->inv) != cc[1])
                     continue;
-                ox = grid_cell1(p.x, og->x0, og->inv, og->nx);
-                oy = grid_cell1(p.y, og->y0, og->inv, og->ny);
+                ox = bucketgrid_index(p.x, og->x0, og->sx, og->nx);
+                oy = bucketgrid_index(p.y, og->y0, og->sy, og->ny);
                 if (ox < ro[0] || ox > ro[2] || oy < ro[1] || oy > ro[3])
                     continue; /* the plain grid would not look at it */
                 t = ((p.x - a.x) * dx + (p.y - a.y) * dy) / l2;
@@ -1007,12 +964,12 @@ static uint32_t edge_hits_h(const blk *k, const hgrid *h, const grid *og, double
         double tt = ht[i];
         uint64_t ki;
         vec2 p = k->cp[ti];
-        ki = ((uint64_t)grid_cell1(p.y, og->y0, og->inv, og->ny) * og->nx +
-              grid_cell1(p.x, og->x0, og->inv, og->nx)) << 32 | ti;
+        ki = ((uint64_t)bucketgrid_index(p.y, og->y0, og->sy, og->ny) * og->nx +
+              bucketgrid_index(p.x, og->x0, og->sx, og->nx)) << 32 | ti;
         for (j = i; j > 0; j--) {
             vec2 o = k->cp[hw[j - 1]];
-            uint64_t kj = ((uint64_t)grid_cell1(o.y, og->y0, og->inv, og->ny) * og->nx +
-                           grid_cell1(o.x, og->x0, og->inv, og->nx)) << 32 | hw[j - 1];
+            uint64_t kj = ((uint64_t)bucketgrid_index(o.y, og->y0, og->sy, og->ny) * og->nx +
+                           bucketgrid_index(o.x, og->x0, og->sx, og->nx)) << 32 | hw[j - 1];
             if (kj <= ki)
                 break;
             hw[j] = hw[j - 1];
@@ -1196,8 +1153,8 @@ static uint32_t cross_pass_h(const blk *k, const hgrid *h, const double *pbox, c
 static size_t cross_cell(const grid *og, const double *pbox, const crossing *x)
 {
     const double *b1 = pbox + 4 * (size_t)x->i, *b2 = pbox + 4 * (size_t)x->j;
-    uint32_t cx = grid_cell1(b1[0] > b2[0] ? b1[0] : b2[0], og->x0, og->inv, og->nx);
-    uint32_t cy = grid_cell1(b1[1] > b2[1] ? b1[1] : b2[1], og->y0, og->inv, og->ny);
+    uint32_t cx = bucketgrid_index(b1[0] > b2[0] ? b1[0] : b2[0], og->x0, og->sx, og->nx);
+    uint32_t cy = bucketgrid_index(b1[1] > b2[1] ? b1[1] : b2[1], og->y0, og->sy, og->ny);
     return (size_t)cy * og->nx + cx;
 }
 
@@ -1441,7 +1398,7 @@ static plx_status ray_counts_strips(blk *k, int64_t *wsum)
         if (dir < 0)
             continue;
         sp = dir == 0 ? &rows : &cols;
-        row = grid_cell1(dir == 0 ? m.y : m.x, sp->v0, sp->inv, sp->n);
+        row = bucketgrid_index(dir == 0 ? m.y : m.x, sp->v0, sp->inv, sp->n);
         for (e = sp->start[row]; e < sp->start[row + 1]; e++)
             if (sp->item[e] != i)
                 w += ray_hit(k, sp->item[e], m, dir);

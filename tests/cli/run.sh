@@ -163,6 +163,13 @@ set -- $(sed -n '2p' "$tmp/w2/cameras.txt")
 "$bin" render -q "$tmp/e.plxb" --size 160x120 --aa 2 --eye "$2,$3,$4" --target "$5,$6,$7" -o "$tmp/w2r.png" >/dev/null 2>&1
 if cmp -s "$tmp/w2/frame-0001.png" "$tmp/w2r.png"; then echo "ok   walk-default-equals-render"; pass=$((pass + 1)); else echo "FAIL walk-default-equals-render"; fail=$((fail + 1)); fi
 if [ -s "$tmp/w2/contact.png" ]; then echo "ok   walk-contact-sheet"; pass=$((pass + 1)); else echo "FAIL walk-contact-sheet"; fail=$((fail + 1)); fi
+# the animated PNG against the frame files (an independent reader: tests/cli/apng_check.py)
+if /usr/bin/python3 tests/cli/apng_check.py "$tmp/w2/walk.png" "$tmp/w2"/frame-*.png >/dev/null; then echo "ok   walk-apng"; pass=$((pass + 1)); else echo "FAIL walk-apng"; fail=$((fail + 1)); fi
+# threads (README "Threads"): the same bytes with 1 and 2
+"$bin" render -q fixtures/eixample-4x4.geojson --view aerial --frames 2 --size 160x120 --threads 1 -o "$tmp/t1.png" --pfm "$tmp/t1.pfm" >/dev/null 2>&1
+"$bin" render -q fixtures/eixample-4x4.geojson --view aerial --frames 2 --size 160x120 --threads 2 -o "$tmp/t2.png" --pfm "$tmp/t2.pfm" >/dev/null 2>&1
+if cmp -s "$tmp/t1.png" "$tmp/t2.png" && cmp -s "$tmp/t1.pfm" "$tmp/t2.pfm"; then echo "ok   render-threads-same"; pass=$((pass + 1)); else echo "FAIL render-threads-same"; fail=$((fail + 1)); fi
+expect render-threads-bad 2 "--threads needs a number of threads from 1 to 16" -- "$bin" render fixtures/tiny.geojson --threads 0 -o "$tmp/x.png"
 printf '{"type":"LineString","coordinates":[[1,2]]}' >"$tmp/short.geojson"
 expect walk-short-path 1 "^polarlux walk: $tmp/short\.geojson: the LineString needs at least 2 positions$" -- "$bin" walk -q "$tmp/e.plxb" --path "$tmp/short.geojson" -o "$tmp/w3"
 expect render-aa-bad 2 "--aa '0' is not a whole number from 1 to 16" -- "$bin" render fixtures/tiny.geojson --aa 0 -o "$tmp/x.png"

@@ -11,6 +11,7 @@
 #include <string.h>
 
 #include "polarlux.h"
+#include "../ref/ref_bake_sum.h"
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size);
 
@@ -23,36 +24,6 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size);
     } while (0)
 
 #define BLOCK ((size_t)8 << 20)
-
-/* The file checksum (README "Bake files"): FNV-1a over 64-bit words in
- * four lanes, the header with its checksum field as 0, then the body. */
-static uint64_t file_sum(const uint8_t *f, size_t len)
-{
-    uint64_t h[4], w;
-    uint8_t head[128];
-    const uint8_t *parts[2];
-    size_t lens[2], i, p;
-    int k;
-    for (k = 0; k < 4; k++)
-        h[k] = 0xcbf29ce484222325ull ^ (uint64_t)k;
-    memcpy(head, f, 128);
-    memset(head + 32, 0, 8);
-    parts[0] = head; lens[0] = 128;
-    parts[1] = f + 128; lens[1] = len - 128;
-    for (p = 0; p < 2; p++) {
-        for (i = 0; i + 32 <= lens[p]; i += 32)
-            for (k = 0; k < 4; k++) {
-                memcpy(&w, parts[p] + i + 8 * k, 8);
-                h[k] = (h[k] ^ w) * 0x00000100000001b3ull;
-            }
-        for (; i < lens[p]; i++)
-            h[0] = (h[0] ^ parts[p][i]) * 0x00000100000001b3ull;
-    }
-    w = h[0];
-    for (k = 1; k < 4; k++)
-        w = (w ^ h[k]) * 0x00000100000001b3ull;
-    return w;
-}
 
 static void one(const uint8_t *f, size_t len, void *mem)
 {
@@ -81,7 +52,6 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
 {
     static void *mem;
     uint8_t *fixed;
-    uint64_t v;
     if (!mem && !(mem = malloc(BLOCK)))
         return 0;
     one(data, size, mem);
@@ -91,10 +61,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     if (!fixed)
         return 0;
     memcpy(fixed, data, size);
-    v = size;
-    memcpy(fixed + 24, &v, 8);
-    v = file_sum(fixed, size);
-    memcpy(fixed + 32, &v, 8);
+    ref_bake_reseal(fixed, size);
     one(fixed, size, mem);
     free(fixed);
     return 0;

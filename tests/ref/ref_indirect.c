@@ -82,19 +82,18 @@ double ref_indirect_direct(tracer *T, const scene *s, const double Q[3], const d
     return e;
 }
 
-double ref_indirect_paths(tracer *T, const scene *s, const double P[3], const double n[3],
-                          int paths, uint64_t seed, double *sd)
+double ref_indirect_paths_rgb(tracer *T, const scene *s, const double P[3], const double n[3],
+                              int paths, uint64_t seed, double rgb[3], double *sd)
 {
-    double sum = 0.0, sum2 = 0.0;
+    double sum = 0.0, sum2 = 0.0, srgb[3] = {0.0, 0.0, 0.0};
     uint64_t rs = seed * 0x2545f4914f6cdd1dull + 0x1234567ull;
-    int k;
+    int k, c;
     for (k = 0; k < paths; k++) {
         double p[3] = {P[0], P[1], P[2]}, nn[3] = {n[0], n[1], n[2]}, x = 0.0;
         int depth;
         for (depth = 0; depth < 30; depth++) {
-            double d[3], o[3], a;
+            double d[3], o[3], a, drgb[3];
             trace_hit h;
-            int c;
             cosine_dir(&rs, nn, d);
             for (c = 0; c < 3; c++)
                 o[c] = p[c] + 1e-6 * nn[c];
@@ -103,7 +102,10 @@ double ref_indirect_paths(tracer *T, const scene *s, const double P[3], const do
             if (trace_ray(T, o, d, INFINITY, &h) == TRACE_SKY)
                 break;
             a = h.kind == TRACE_GROUND ? s->ground_albedo : s->bld[h.bld].albedo;
-            x += a * ref_indirect_direct(T, s, h.p, h.n, NULL);
+            x += a * ref_indirect_direct(T, s, h.p, h.n, rgb ? drgb : NULL);
+            if (rgb)
+                for (c = 0; c < 3; c++)
+                    srgb[c] += a * drgb[c];
             if (uni(&rs) >= a)
                 break;
             memcpy(p, h.p, sizeof p);
@@ -112,11 +114,20 @@ double ref_indirect_paths(tracer *T, const scene *s, const double P[3], const do
         sum += x;
         sum2 += x * x;
     }
+    if (rgb)
+        for (c = 0; c < 3; c++)
+            rgb[c] = srgb[c] / paths;
     if (sd) {
         double m = sum / paths, var = sum2 / paths - m * m;
         *sd = sqrt((var > 0.0 ? var : 0.0) / paths);
     }
     return sum / paths;
+}
+
+double ref_indirect_paths(tracer *T, const scene *s, const double P[3], const double n[3],
+                          int paths, uint64_t seed, double *sd)
+{
+    return ref_indirect_paths_rgb(T, s, P, n, paths, seed, NULL, sd);
 }
 
 int ref_indirect_points(tracer *T, const scene *s, int nground, int nfacade, uint64_t seed,

@@ -31,6 +31,11 @@ double ref_indirect_direct(tracer *T, const scene *s, const double Q[3], const d
 double ref_indirect_paths(tracer *T, const scene *s, const double P[3], const double n[3],
                           int paths, uint64_t seed, double *sd /* OUT */);
 
+/* The same paths; rgb (may be NULL) also gets the colour-weighted E_indirect
+ * (each lamp's term weighted by its colour). */
+double ref_indirect_paths_rgb(tracer *T, const scene *s, const double P[3], const double n[3],
+                              int paths, uint64_t seed, double rgb[3] /* OUT */, double *sd /* OUT */);
+
 /* nground ground points then nfacade facade points, as above, away from
  * the bounds by 60 m; P and N hold 3 doubles per point. Returns the number
  * written (fewer when 100,000 tries were not enough). */

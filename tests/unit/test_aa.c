@@ -21,22 +21,18 @@
 
 #include "polarlux.h"
 #include "polarlux_port.h"
+#include "fixture.h"
 
 #define MEM ((size_t)256 << 20)
 
 static plx_engine *open_eixample(void **mem)
 {
     plx_config cfg;
-    plx_engine *e = NULL;
-    *mem = malloc(MEM);
-    assert_non_null(*mem);
     plx_config_default(&cfg);
     cfg.port = plx_port_posix();
     cfg.render_max_width = 480;
     cfg.render_max_height = 360;
-    assert_int_equal(plx_engine_create(*mem, MEM, &cfg, &e), PLX_OK);
-    assert_int_equal(plx_load_file(e, "fixtures/eixample-4x4.geojson"), PLX_OK);
-    return e;
+    return fixture_load_file(fixture_engine_cfg(MEM, &cfg, mem), "fixtures/eixample-4x4.geojson");
 }
 
 static void street(plx_camera *cam, int w, int h)

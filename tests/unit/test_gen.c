@@ -23,6 +23,7 @@
 #include <cjson/cJSON.h>
 
 #include "polarlux.h"
+#include "fixture.h"
 
 static int quick(void); /* PLX_TEST_QUICK: skip exact checks of big cities */
 
@@ -734,16 +735,12 @@ static int quick(void)
 
 static void load_info(const buf *t, plx_scene_info *si, uint32_t *warnings)
 {
-    size_t mem = (size_t)512 << 20;
-    void *block = malloc(mem);
-    plx_engine *e;
-    assert_non_null(block);
-    assert_int_equal(plx_engine_create(block, mem, NULL, &e), PLX_OK);
+    void *block;
+    plx_engine *e = fixture_engine_cfg((size_t)512 << 20, NULL, &block);
     assert_int_equal(plx_load_geojson(e, t->data, t->len, "gen"), PLX_OK);
     assert_int_equal(plx_scene_info_get(e, si), PLX_OK);
     *warnings = plx_warning_count(e);
-    plx_engine_destroy(e);
-    free(block);
+    fixture_done(e, block);
 }
 
 static void test_engine_eixample_30(void **state)

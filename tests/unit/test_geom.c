@@ -18,6 +18,8 @@
 #include <cmocka.h>
 
 #include "base/geom.h"
+#include "base/arena.h"
+#include "base/bucketgrid.h"
 
 __extension__ typedef __int128 i128;
 
@@ -1186,9 +1188,98 @@ static void test_ring_area2(void **state)
     }
 }
 
+/* ---- the bucket grid (base/bucketgrid.h) against brute force ------------ */
+
+static double rnd_unit(uint64_t *s)
+{
+    *s = *s * 6364136223846793005ull + 1442695040888963407ull;
+    return (double)(*s >> 11) / 9007199254740992.0;
+}
+
+/* Every item whose box meets query box q is listed in a cell of q's range
+ * (brute force over all items), each cell's ids ascend, and a cell lists
+ * only items whose boxes meet it. */
+static void check_bucketgrid(const bucketgrid *g, const double *box, uint32_t n, const double q[4])
+{
+    uint32_t r[4], x, y, k, i;
+    bucketgrid_range(g, q, r);
+    for (i = 0; i < n; i++) {
+        const double *b = box + 4 * (size_t)i;
+        int meets = b[0] <= b[2] && !(b[2] < q[0] || b[0] > q[2] || b[3] < q[1] || b[1] > q[3]), found = 0;
+        for (y = r[1]; y <= r[3] && !found; y++)
+            for (x = r[0]; x <= r[2] && !found; x++)
+                for (k = g->start[y * g->nx + x]; k < g->start[y * g->nx + x + 1]; k++)
+                    found |= g->item[k] == i;
+        if (meets)
+            assert_true(found);
+    }
+    for (y = 0; y < g->ny; y++)
+        for (x = 0; x < g->nx; x++)
+            for (k = g->start[y * g->nx + x]; k < g->start[y * g->nx + x + 1]; k++) {
+                const double *b = box + 4 * (size_t)g->item[k];
+                uint32_t br[4];
+                bucketgrid_range(g, b, br);
+                assert_true(b[0] <= b[2]);
+                assert_true(x >= br[0] && x <= br[2] && y >= br[1] && y <= br[3]);
+                if (k > g->start[y * g->nx + x])
+                    assert_true(g->item[k] > g->item[k - 1]);
+            }
+}
+
+static void test_bucketgrid_vs_brute(void **state)
+{
+    static unsigned char block[1 << 20];
+    double box[4 * 300], q[4];
+    uint32_t n = 300, i, t;
+    uint64_t seed = 7;
+    arena a;
+    bucketgrid g;
+    (void)state;
+    for (i = 0; i < n; i++) {
+        double x = rnd_unit(&seed) * 100.0, y = rnd_unit(&seed) * 60.0;
+        double w = rnd_unit(&seed) * 8.0, h = rnd_unit(&seed) * 8.0;
+        box[4 * i] = x;
+        box[4 * i + 1] = y;
+        box[4 * i + 2] = i % 17 == 0 ? x - 1.0 : x + w; /* some empty boxes, left out */
+        box[4 * i + 3] = y + h;
+    }
+    for (t = 0; t < 2; t++) {
+        arena_init(&a, block, sizeof block);
+        memset(&g, 0, sizeof g);
+        bucketgrid_frame(&g, t ? 10.0 : 0.0, 0.0, t ? 3.7 : 10.0, t ? 20 : 11, t ? 12 : 7);
+        assert_int_equal(bucketgrid_fill(&g, &a, t ? PLX_PART_LIT : PLX_PART_SCRATCH, 16, box, NULL, n), PLX_OK);
+        for (i = 0; i < 200; i++) {
+            q[0] = rnd_unit(&seed) * 140.0 - 20.0;
+            q[1] = rnd_unit(&seed) * 100.0 - 20.0;
+            q[2] = q[0] + rnd_unit(&seed) * 30.0;
+            q[3] = q[1] + rnd_unit(&seed) * 30.0;
+            check_bucketgrid(&g, box, n, q);
+        }
+    }
+    /* points: each in exactly one cell, the clamped one */
+    {
+        vec2 p[50];
+        arena_init(&a, block, sizeof block);
+        for (i = 0; i < 50; i++) {
+            p[i].x = rnd_unit(&seed) * 200.0 - 50.0;
+            p[i].y = rnd_unit(&seed) * 200.0 - 50.0;
+        }
+        bucketgrid_frame(&g, 0.0, 0.0, 25.0, 4, 4);
+        assert_int_equal(bucketgrid_fill(&g, &a, PLX_PART_SCRATCH, 16, NULL, p, 50), PLX_OK);
+        assert_int_equal(g.start[16], 50);
+        for (i = 0; i < 50; i++) {
+            uint32_t c = bucketgrid_cell(&g, p[i].x, p[i].y), k, hits = 0;
+            for (k = g.start[c]; k < g.start[c + 1]; k++)
+                hits += g.item[k] == i;
+            assert_int_equal(hits, 1);
+        }
+    }
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_bucketgrid_vs_brute),
         cmocka_unit_test(test_orient_basic),
         cmocka_unit_test(test_orient_random_vs_int128),
         cmocka_unit_test(test_orient_near_collinear),

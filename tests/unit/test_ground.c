@@ -22,6 +22,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include <cmocka.h>
+#include "fixture.h"
 #include <unistd.h>
 
 #include "polarlux.h"
@@ -44,54 +45,9 @@ static int quick_mode(void)
     return v && v[0] && v[0] != '0';
 }
 
-/* ---- an engine with a log book ------------------------------------------ */
-
-typedef struct logbook {
-    int n;
-    char all[8192];
-} logbook;
-
-static void log_to_book(void *ctx, plx_log_level level, const char *msg)
-{
-    logbook *b = ctx;
-    size_t len = strlen(b->all);
-    (void)level;
-    b->n++;
-    snprintf(b->all + len, sizeof b->all - len, "%s\n", msg);
-}
-
-typedef struct fixture {
-    void *mem;
-    plx_engine *e;
-    plx_port port;
-    logbook book;
-} fixture;
-
-static fixture *open_engine(int strict)
-{
-    fixture *f = calloc(1, sizeof *f);
-    plx_config cfg;
-    f->mem = malloc(MEM);
-    f->port = *plx_port_posix();
-    f->port.ctx = &f->book;
-    f->port.log = log_to_book;
-    plx_config_default(&cfg);
-    cfg.port = &f->port;
-    cfg.strict = strict;
-    assert_int_equal(plx_engine_create(f->mem, MEM, &cfg, &f->e), PLX_OK);
-    return f;
-}
-
-static void close_engine(fixture *f)
-{
-    plx_engine_destroy(f->e);
-    free(f->mem);
-    free(f);
-}
-
 /* A scene in metres with one building [0,10]^2 and a lamp; props is the
  * inside of the top-level properties object after "units". */
-static plx_status load_props(fixture *f, const char *props)
+static plx_status load_props(fixture_log *f, const char *props)
 {
     char json[2048];
     snprintf(json, sizeof json,
@@ -153,7 +109,7 @@ static int near(double a, double b, double rel)
 
 static void test_loader_accepts(void **state)
 {
-    fixture *f = open_engine(1);
+    fixture_log *f = fixture_open(1, MEM);
     plx_ground_image_info gi;
     plx_scene_info si;
     double rgb[3];
@@ -181,7 +137,7 @@ static void test_loader_accepts(void **state)
     assert_int_equal(load_props(f, ""), PLX_OK);
     assert_int_equal(plx_ground_image_get(f->e, &gi), PLX_OK);
     assert_null(gi.path);
-    close_engine(f);
+    fixture_close(f);
 }
 
 typedef struct bad_case {
@@ -217,7 +173,7 @@ static void test_loader_rejects(void **state)
     int strict;
     (void)state;
     for (strict = 0; strict <= 1; strict++) {
-        fixture *f = open_engine(strict);
+        fixture_log *f = fixture_open(strict, MEM);
         for (k = 0; k < sizeof cases / sizeof cases[0]; k++) {
             const char *why = cases[k].msg == NULL ? msg_path
                               : cases[k].msg[0] == 'b'
@@ -261,7 +217,7 @@ static void test_loader_rejects(void **state)
             free(props);
         }
         free(long_props);
-        close_engine(f);
+        fixture_close(f);
     }
 }
 
@@ -283,7 +239,7 @@ static void test_loader_lonlat(void **state)
         " \"features\": [\n"
         "  {\"type\": \"Feature\", \"properties\": {\"lamp\": true}, \"geometry\": {\"type\": \"Point\",\n"
         "   \"coordinates\": [24.9430, 60.1665]}}]}";
-    fixture *f = open_engine(1);
+    fixture_log *f = fixture_open(1, MEM);
     plx_ground_image_info gi;
     double lon0 = 0.5 * (24.9410 + 24.9430), lat0 = 0.5 * (60.1655 + 60.1665);
     double c = cos(lat0 * PI / 180.0), want[4];
@@ -317,7 +273,7 @@ static void test_loader_lonlat(void **state)
     assert_string_equal(plx_last_error(f->e),
                         "ll.geojson: properties.ground_image_bounds must be lon/lat degrees like the scene's "
                         "coordinates (lon -180..180, lat -90..90)");
-    close_engine(f);
+    fixture_close(f);
 }
 
 /* ---- lookup ---------------------------------------------------------------- */
@@ -353,7 +309,7 @@ static void check_at(plx_engine *e, double x, double y, const uint8_t *px, doubl
 
 static void test_lookup(void **state)
 {
-    fixture *f = open_engine(1);
+    fixture_log *f = fixture_open(1, MEM);
     uint8_t px[36];
     double scale;
     int i, j;
@@ -406,14 +362,14 @@ static void test_lookup(void **state)
         assert_int_equal(plx_ground_albedo_at(f->e, NAN, 0, rgb), PLX_E_INVALID);
         assert_int_equal(plx_ground_albedo_at(f->e, 0, 0, NULL), PLX_E_INVALID);
     }
-    close_engine(f);
+    fixture_close(f);
 }
 
 /* Over all pixels the mean luminance of the albedo is the ground albedo;
  * a bright pixel is clamped to 0.95 and then pulls the mean down. */
 static void test_normalisation(void **state)
 {
-    fixture *f = open_engine(1);
+    fixture_log *f = fixture_open(1, MEM);
     enum { W = 37, H = 23 };
     static uint8_t px[W * H * 3];
     double sum = 0.0, bx[4] = { -37, -23, 37, 23 };
@@ -456,12 +412,12 @@ static void test_normalisation(void **state)
         printf("one white pixel clamped: mean luminance %.4f\n", gi.mean_luminance);
         assert_true(gi.mean_luminance < 0.23 * 0.9);
     }
-    close_engine(f);
+    fixture_close(f);
 }
 
 static void test_api_errors(void **state)
 {
-    fixture *f = open_engine(1);
+    fixture_log *f = fixture_open(1, MEM);
     uint8_t px[12] = { 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12 };
     uint8_t black[12] = { 0 };
     double bad[4] = { 0, 0, -1, 1 }, inf[4] = { 0, 0, INFINITY, 1 }, rgb[3];
@@ -501,7 +457,7 @@ static void test_api_errors(void **state)
     assert_int_equal(load_props(f, ""), PLX_OK);
     assert_int_equal(plx_ground_albedo_at(f->e, 0, 0, rgb), PLX_OK);
     assert_true(rgb[0] == 0.15);
-    close_engine(f);
+    fixture_close(f);
 }
 
 /* Out of memory at either allocation: PLX_E_NOMEM, the memory back where
@@ -509,7 +465,7 @@ static void test_api_errors(void **state)
  * memory. */
 static void test_nomem_and_replace(void **state)
 {
-    fixture *f = open_engine(1);
+    fixture_log *f = fixture_open(1, MEM);
     uint8_t a[2 * 2 * 3] = { 200, 10, 10, 10, 200, 10, 10, 10, 200, 100, 100, 100 };
     uint8_t *big = malloc(100 * 100 * 3);
     double rgb_a[3], rgb[3];
@@ -559,13 +515,13 @@ static void test_nomem_and_replace(void **state)
     assert_int_equal(plx_ground_albedo_at(f->e, -40, 60, rgb), PLX_OK);
     assert_memory_equal(rgb, rgb_a, sizeof rgb);
     free(big);
-    close_engine(f);
+    fixture_close(f);
 }
 
 /* Setting an image drops photons traced with the old ground. */
 static void test_photons_dropped(void **state)
 {
-    fixture *f = open_engine(1);
+    fixture_log *f = fixture_open(1, MEM);
     uint8_t px[3] = { 120, 130, 140 };
     (void)state;
     assert_int_equal(load_props(f, ""), PLX_OK);
@@ -575,7 +531,7 @@ static void test_photons_dropped(void **state)
     assert_true(plx_indirect_frames(f->e) == 0);
     assert_int_equal(plx_indirect_step(f->e, 2000, 1), PLX_OK);
     assert_true(plx_indirect_frames(f->e) == 1);
-    close_engine(f);
+    fixture_close(f);
 }
 
 /* ---- render of the fixture ---------------------------------------------- */
@@ -586,7 +542,7 @@ static void test_photons_dropped(void **state)
  * ground point (SPEC §5: right is +x, up is +y looking down). */
 static void test_render_fixture(void **state)
 {
-    fixture *f = open_engine(1);
+    fixture_log *f = fixture_open(1, MEM);
     plx_camera cam;
     plx_render_opts o;
     uint8_t *png = NULL;
@@ -659,7 +615,7 @@ static void test_render_fixture(void **state)
     assert_true(ratio_sum[1][0] > 1.5 * ratio_sum[1][1]);
     free(img);
     free(png);
-    close_engine(f);
+    fixture_close(f);
 }
 
 /* ---- photons: the ground's roulette ---------------------------------------- */

@@ -13,23 +13,13 @@
 
 #include "polarlux.h"
 #include "polarlux_port.h"
+#include "fixture.h"
 
 #define MEM (128u << 20)
 
 static plx_engine *open_tiny(void **mem)
 {
-    plx_engine *e;
-    plx_config cfg;
-    plx_port quiet = *plx_port_posix();
-    static plx_port port;
-    quiet.log = NULL;
-    port = quiet;
-    plx_config_default(&cfg);
-    cfg.port = &port;
-    *mem = malloc(MEM);
-    assert_int_equal(plx_engine_create(*mem, MEM, &cfg, &e), PLX_OK);
-    assert_int_equal(plx_load_file(e, "fixtures/tiny.geojson"), PLX_OK);
-    return e;
+    return fixture_file("fixtures/tiny.geojson", MEM, mem);
 }
 
 static void test_frames_and_values(void **state)

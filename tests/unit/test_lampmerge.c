@@ -15,38 +15,17 @@
 #include <cmocka.h>
 
 #include "polarlux.h"
+#include "fixture.h"
 
 #define MEM (256u << 20)
 
-typedef struct logbook {
-    int warnings;
-    char last[512];
-} logbook;
-
-static void log_fn(void *ctx, plx_log_level level, const char *msg)
+static plx_engine *load(const char *json, void **mem, fixture_book *lb, plx_port *port)
 {
-    logbook *lb = ctx;
-    if (level == PLX_LOG_WARN) {
-        lb->warnings++;
-        snprintf(lb->last, sizeof lb->last, "%s", msg);
-    }
-}
-
-static plx_engine *load(const char *json, void **mem, logbook *lb, plx_port *port)
-{
-    plx_engine *e;
-    plx_config cfg;
-    plx_config_default(&cfg);
     memset(port, 0, sizeof *port);
     memset(lb, 0, sizeof *lb);
     port->ctx = lb;
-    port->log = log_fn;
-    cfg.port = port;
-    *mem = malloc(MEM);
-    assert_non_null(*mem);
-    assert_int_equal(plx_engine_create(*mem, MEM, &cfg, &e), PLX_OK);
-    assert_int_equal(plx_load_geojson(e, json, strlen(json), "t"), PLX_OK);
-    return e;
+    port->log = fixture_book_log;
+    return fixture_load_text(fixture_engine(MEM, 0, port, mem), json, "t");
 }
 
 static void done(plx_engine *e, void *mem)
@@ -83,7 +62,7 @@ static const double N[3 * NP] = { 0, 0, 1, 0, 0, 1, 0, 0, 1, 0, 0, 1, 0, 0, 1, 0
 static void light(const char *json, double *E, double *rgb, uint32_t *nlamps, uint32_t *merged, int *warnings)
 {
     void *mem;
-    logbook lb;
+    fixture_book lb;
     plx_port port;
     plx_scene_info si;
     plx_engine *e = load(json, &mem, &lb, &port);
@@ -129,7 +108,7 @@ static void test_two_lamps_coloured(void **state)
         near(c12[k], c1[k] + c2[k]);
     {   /* the merged lamp: intensities summed, colour weighted by intensity */
         void *mem;
-        logbook lb;
+        fixture_book lb;
         plx_port port;
         plx_lamp l;
         plx_engine *e = load(s12, &mem, &lb, &port);
@@ -138,7 +117,7 @@ static void test_two_lamps_coloured(void **state)
         near(l.color[0], (float)0.25);
         near(l.color[1], (float)0.375);
         near(l.color[2], (float)0.75);
-        assert_non_null(strstr(lb.last, "2 lamps at one spot (2, 1, 6) merged into this one: 4000 cd"));
+        assert_non_null(strstr(lb.last_warn, "2 lamps at one spot (2, 1, 6) merged into this one: 4000 cd"));
         done(e, mem);
     }
     free(s1);

@@ -11,58 +11,14 @@
 #include <stdlib.h>
 #include <string.h>
 #include <cmocka.h>
+#include "fixture.h"
 
 #include "polarlux.h"
 #include "port.h"
 
 #define MEM (64u << 20)
 
-typedef struct logbook {
-    int n;
-    char last[512];
-    char all[8192];
-} logbook;
-
-static void log_to_book(void *ctx, plx_log_level level, const char *msg)
-{
-    logbook *b = ctx;
-    size_t len = strlen(b->all);
-    (void)level;
-    b->n++;
-    snprintf(b->last, sizeof b->last, "%s", msg);
-    snprintf(b->all + len, sizeof b->all - len, "%s\n", msg);
-}
-
-typedef struct fixture {
-    void *mem;
-    plx_engine *e;
-    plx_port port;
-    logbook book;
-} fixture;
-
-static fixture *open_engine(int strict)
-{
-    fixture *f = calloc(1, sizeof *f);
-    plx_config cfg;
-    f->mem = malloc(MEM);
-    f->port = *plx_port_posix();
-    f->port.ctx = &f->book;
-    f->port.log = log_to_book;
-    plx_config_default(&cfg);
-    cfg.port = &f->port;
-    cfg.strict = strict;
-    assert_int_equal(plx_engine_create(f->mem, MEM, &cfg, &f->e), PLX_OK);
-    return f;
-}
-
-static void close_engine(fixture *f)
-{
-    plx_engine_destroy(f->e);
-    free(f->mem);
-    free(f);
-}
-
-static plx_status load_str(fixture *f, const char *json)
+static plx_status load_str(fixture_log *f, const char *json)
 {
     return plx_load_geojson(f->e, json, strlen(json), "t.geojson");
 }
@@ -71,7 +27,7 @@ static plx_status load_str(fixture *f, const char *json)
 
 static void test_tiny_counts(void **state)
 {
-    fixture *f = open_engine(0);
+    fixture_log *f = fixture_open(0, MEM);
     plx_scene_info si;
     plx_building b;
     plx_lamp l;
@@ -105,7 +61,7 @@ static void test_tiny_counts(void **state)
     assert_string_equal(l.id, "L4"); /* under the canopy: kept */
     assert_non_null(strstr(f->book.all, "feature 6 (L3, line 18, column 3): lamp is inside building 0 (A); left out"));
     assert_int_equal(plx_lamp_get(f->e, 3, &l), PLX_E_RANGE);
-    close_engine(f);
+    fixture_close(f);
 }
 
 static double ring_area(const double *xy, uint32_t n)
@@ -121,7 +77,7 @@ static double ring_area(const double *xy, uint32_t n)
 
 static void test_tiny_rings_and_blocks(void **state)
 {
-    fixture *f = open_engine(0);
+    fixture_log *f = fixture_open(0, MEM);
     plx_scene_info si;
     const double *xy;
     uint32_t n, i, found_ab = 0, found_c = 0;
@@ -154,14 +110,14 @@ static void test_tiny_rings_and_blocks(void **state)
         }
     }
     assert_true(found_ab && found_c);
-    close_engine(f);
+    fixture_close(f);
 }
 
 /* ---- lon/lat projection ---------------------------------------------------------- */
 
 static void test_lonlat_projection(void **state)
 {
-    fixture *f = open_engine(0);
+    fixture_log *f = fixture_open(0, MEM);
     plx_scene_info si;
     plx_lamp l;
     const double *xy;
@@ -188,7 +144,7 @@ static void test_lonlat_projection(void **state)
     assert_int_equal(plx_building_ring(f->e, 0, 0, &xy, &n), PLX_OK);
     assert_true(fabs(xy[0] - (-0.002 * 111320 * c)) < 1e-6);
     assert_true(fabs(xy[1] - (-0.001 * 110540)) < 1e-6);
-    close_engine(f);
+    fixture_close(f);
 }
 
 /* ---- validation errors, each with its exact message ----------------------------- */
@@ -256,14 +212,14 @@ static void test_bad_features_strict(void **state)
     size_t i;
     (void)state;
     for (i = 0; i < sizeof bad_cases / sizeof bad_cases[0]; i++) {
-        fixture *f = open_engine(1);
+        fixture_log *f = fixture_open(1, MEM);
         char *json = collection_of(&bad_cases[i]);
         plx_status st = load_str(f, json);
         if (st != PLX_E_SCENE || strcmp(plx_last_error(f->e), bad_cases[i].message) != 0)
             fail_msg("case %zu: status %d, message\n  got:  %s\n  want: %s", i, st,
                      plx_last_error(f->e), bad_cases[i].message);
         free(json);
-        close_engine(f);
+        fixture_close(f);
     }
 }
 
@@ -272,7 +228,7 @@ static void test_bad_features_skipped(void **state)
     size_t i;
     (void)state;
     for (i = 0; i < sizeof bad_cases / sizeof bad_cases[0]; i++) {
-        fixture *f = open_engine(0);
+        fixture_log *f = fixture_open(0, MEM);
         char *json = collection_of(&bad_cases[i]);
         plx_scene_info si;
         assert_int_equal(load_str(f, json), PLX_OK);
@@ -281,7 +237,7 @@ static void test_bad_features_skipped(void **state)
         assert_int_equal(si.buildings + si.lamps, 0);
         assert_string_equal(f->book.last, bad_cases[i].message);
         free(json);
-        close_engine(f);
+        fixture_close(f);
     }
 }
 
@@ -289,7 +245,7 @@ static void test_bad_features_skipped(void **state)
 
 static void test_malformed_json(void **state)
 {
-    fixture *f = open_engine(0);
+    fixture_log *f = fixture_open(0, MEM);
     (void)state;
     assert_int_equal(load_str(f, "{\"type\": \"FeatureCollection\",\n  \"features\": [1, 2,, 3]}"), PLX_E_PARSE);
     assert_string_equal(plx_last_error(f->e), "t.geojson: malformed JSON at byte 50 (line 2, column 21)");
@@ -309,12 +265,12 @@ static void test_malformed_json(void **state)
                      PLX_E_SCENE);
     /* after all that the engine still loads a good scene */
     assert_int_equal(plx_load_file(f->e, "fixtures/tiny.geojson"), PLX_OK);
-    close_engine(f);
+    fixture_close(f);
 }
 
 static void test_deep_nesting(void **state)
 {
-    fixture *f = open_engine(0);
+    fixture_log *f = fixture_open(0, MEM);
     size_t n = 100000, i;
     char *s = malloc(2 * n + 1);
     (void)state;
@@ -325,7 +281,7 @@ static void test_deep_nesting(void **state)
     s[2 * n] = '\0';
     assert_int_equal(load_str(f, s), PLX_E_PARSE);
     free(s);
-    close_engine(f);
+    fixture_close(f);
 }
 
 /* ---- numbers in properties ----------------------------------------------------------- */
@@ -340,7 +296,7 @@ static void test_number_strings(void **state)
     size_t i;
     (void)state;
     for (i = 0; i < sizeof cases / sizeof cases[0]; i++) {
-        fixture *f = open_engine(0);
+        fixture_log *f = fixture_open(0, MEM);
         char json[512];
         plx_building b;
         snprintf(json, sizeof json,
@@ -353,7 +309,7 @@ static void test_number_strings(void **state)
             fail_msg("height %s: got %g with %u warnings", cases[i].value, b.height, plx_warning_count(f->e));
         if (cases[i].warns)
             assert_non_null(strstr(f->book.last, "property \"height\" is not a number"));
-        close_engine(f);
+        fixture_close(f);
     }
 }
 
@@ -361,7 +317,7 @@ static void test_number_strings(void **state)
 
 static void fault_inject_file(const char *path)
 {
-    fixture *f = open_engine(0);
+    fixture_log *f = fixture_open(0, MEM);
     plx_memory_report before, after;
     uint64_t k;
     plx_status st = PLX_E_NOMEM;
@@ -381,7 +337,7 @@ static void fault_inject_file(const char *path)
     assert_true(k > 3);
     plx_debug_fail_alloc(f->e, 0);
     assert_int_equal(plx_load_file(f->e, path), PLX_OK);
-    close_engine(f);
+    fixture_close(f);
 }
 
 static void test_fault_injection_tiny(void **state)
@@ -451,7 +407,7 @@ static void test_no_port(void **state)
 
 static void test_two_engines(void **state)
 {
-    fixture *a = open_engine(0), *b = open_engine(0);
+    fixture_log *a = fixture_open(0, MEM), *b = fixture_open(0, MEM);
     plx_scene_info sa, sb;
     (void)state;
     assert_int_equal(plx_load_file(a->e, "fixtures/tiny.geojson"), PLX_OK);
@@ -463,15 +419,15 @@ static void test_two_engines(void **state)
     assert_int_equal(load_str(a, "{"), PLX_E_PARSE);
     assert_int_equal(plx_scene_info_get(a->e, &sa), PLX_E_NOSCENE);
     assert_int_equal(plx_scene_info_get(b->e, &sb), PLX_OK);
-    close_engine(a);
-    close_engine(b);
+    fixture_close(a);
+    fixture_close(b);
 }
 
 /* ---- generated and real districts ------------------------------------------------- */
 
 static void test_eixample_blocks(void **state)
 {
-    fixture *f = open_engine(0);
+    fixture_log *f = fixture_open(0, MEM);
     plx_scene_info si;
     uint32_t i;
     (void)state;
@@ -487,12 +443,12 @@ static void test_eixample_blocks(void **state)
         assert_int_equal(k.nbuildings, 16);
         assert_int_equal(k.nrings, 2);
     }
-    close_engine(f);
+    fixture_close(f);
 }
 
 static void test_helsinki(void **state)
 {
-    fixture *f = open_engine(0);
+    fixture_log *f = fixture_open(0, MEM);
     plx_scene_info si;
     (void)state;
     assert_int_equal(plx_load_file(f->e, "fixtures/helsinki-centre.geojson"), PLX_OK);
@@ -512,7 +468,7 @@ static void test_helsinki(void **state)
     assert_int_equal(si.overlapping_pairs, 7);
     assert_non_null(strstr(f->book.all, "(way/234871779, line "));
     assert_non_null(strstr(f->book.all, "min_height 18 m is not below height 12 m (the default)"));
-    close_engine(f);
+    fixture_close(f);
 }
 
 int main(void)

@@ -14,6 +14,7 @@
 
 #include "polarlux.h"
 #include "polarlux_port.h"
+#include "fixture.h"
 #include "base/engine.h"
 #include "ref_light.h"
 #include "ref_scene.h"
@@ -32,18 +33,7 @@ static double uni(double a, double b)
 
 static plx_engine *open_scene(const char *path, void **mem)
 {
-    plx_engine *e;
-    plx_config cfg;
-    static plx_port port;
-    port = *plx_port_posix();
-    port.log = NULL;
-    plx_config_default(&cfg);
-    cfg.port = &port;
-    *mem = malloc(MEM);
-    assert_non_null(*mem);
-    assert_int_equal(plx_engine_create(*mem, MEM, &cfg, &e), PLX_OK);
-    assert_int_equal(plx_load_file(e, path), PLX_OK);
-    return e;
+    return fixture_file(path, MEM, mem);
 }
 
 static void random_unit(double n[3])
@@ -167,16 +157,12 @@ static void test_free_air_cases(void **state)
         "\"coordinates\":[[[0,0],[10,0],[10,10],[0,10],[0,0]]]}},"
         "{\"type\":\"Feature\",\"properties\":{\"lamp\":true,\"z\":5,\"intensity\":800,\"radius\":40},"
         "\"geometry\":{\"type\":\"Point\",\"coordinates\":[15,5]}}]}";
-    void *mem = malloc(MEM);
-    plx_engine *e;
-    plx_config cfg;
+    void *mem;
+    plx_engine *e = fixture_text(text, MEM, 0, &mem);
     double P[9] = { 10.0001, 5, 3, 15, 2, 1.5, 5, 5, 5 }, N[9] = { 1, 0, 0, 1, 0, 0, 0, 0, 1 }, E[3];
     double d2a = 4.9999 * 4.9999 + 4, x;
     double wa;
     (void)state;
-    plx_config_default(&cfg);
-    assert_int_equal(plx_engine_create(mem, MEM, &cfg, &e), PLX_OK);
-    assert_int_equal(plx_load_geojson(e, text, sizeof text - 1, "meter"), PLX_OK);
     assert_int_equal(plx_illuminance(e, 3, P, N, E, NULL, NULL), PLX_E_RANGE);
     assert_non_null(strstr(plx_last_error(e), "inside"));
     x = sqrt(d2a) / 40;
@@ -185,8 +171,7 @@ static void test_free_air_cases(void **state)
     /* (15, 2, 1.5) facing east: the lamp is due north-ish, n.w = 0 */
     assert_true(E[1] == 0.0);
     assert_true(isnan(E[2]));
-    plx_engine_destroy(e);
-    free(mem);
+    fixture_done(e, mem);
 }
 
 int main(void)

@@ -13,36 +13,19 @@
 
 #include "polarlux.h"
 #include "polarlux_port.h"
+#include "fixture.h"
 #include "cli/network.h"
 
 #define MEM ((size_t)256 << 20)
 
 static plx_engine *load_file(const char *path, void **mem)
 {
-    plx_engine *e;
-    plx_config cfg;
-    static plx_port quiet;
-    quiet = *plx_port_posix();
-    quiet.log = NULL;
-    plx_config_default(&cfg);
-    cfg.port = &quiet;
-    *mem = malloc(MEM);
-    assert_non_null(*mem);
-    assert_int_equal(plx_engine_create(*mem, MEM, &cfg, &e), PLX_OK);
-    assert_int_equal(plx_load_file(e, path), PLX_OK);
-    return e;
+    return fixture_file(path, MEM, mem);
 }
 
 static plx_engine *load_text(const char *json, void **mem)
 {
-    plx_engine *e;
-    plx_config cfg;
-    plx_config_default(&cfg);
-    *mem = malloc(MEM);
-    assert_non_null(*mem);
-    assert_int_equal(plx_engine_create(*mem, MEM, &cfg, &e), PLX_OK);
-    assert_int_equal(plx_load_geojson(e, json, strlen(json), "t"), PLX_OK);
-    return e;
+    return fixture_text(json, MEM, 0, mem);
 }
 
 static void open_net(plx_engine *e, const char *path, network *net)

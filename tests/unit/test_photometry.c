@@ -18,6 +18,7 @@
 #include <cmocka.h>
 
 #include "polarlux.h"
+#include "fixture.h"
 #include "base/engine.h"
 #include "scene/photometry.h"
 #include "photon/photon.h"
@@ -250,13 +251,7 @@ static const char bilateral[] = "TILT=NONE\n1 -1 1 2 3 1 2 0 0 0 1 1 0\n0 60\n0 
 
 static plx_engine *open_text(const char *text, void **mem)
 {
-    plx_engine *e;
-    plx_config cfg;
-    plx_config_default(&cfg);
-    *mem = malloc(MEM);
-    assert_int_equal(plx_engine_create(*mem, MEM, &cfg, &e), PLX_OK);
-    assert_int_equal(plx_load_geojson(e, text, strlen(text), "scene"), PLX_OK);
-    return e;
+    return fixture_load_text(fixture_engine(MEM, 0, NULL, mem), text, "scene");
 }
 
 static double window(double d, double R)

@@ -20,6 +20,7 @@
 
 #include "polarlux.h"
 #include "polarlux_port.h"
+#include "fixture.h"
 #include "base/engine.h"
 #include "base/arena.h"
 #include "scene/blocks.h"
@@ -28,6 +29,7 @@
 #include "photon/nightlight.h"
 #include "render/nightify.h"
 #include "ref_scene.h"
+#include "ref_indirect.h"
 
 #define PI 3.14159265358979323846
 
@@ -62,38 +64,6 @@ static void sphere_dir(uint64_t *s, double d[3])
     d[0] = r * cos(p);
     d[1] = r * sin(p);
     d[2] = z;
-}
-
-/* Cosine-weighted direction about unit n by the polar map (sqrt u1, 2 pi
- * u2) with libm's cos and sin: the reference path tracer's own sampler,
- * independent of the photon pass's (photon_cosine_dir, polynomial). */
-static void ref_cosine_dir(uint64_t *s, const double n[3], double d[3])
-{
-    double u1 = urand(s), u2 = urand(s), r = sqrt(u1), p = 2.0 * PI * u2;
-    double a = r * cos(p), b = r * sin(p), c = sqrt(1.0 - u1), t[3], bt[3], l;
-    if (fabs(n[2]) < 0.9) {
-        t[0] = -n[1];
-        t[1] = n[0];
-        t[2] = 0.0;
-    } else {
-        t[0] = 0.0;
-        t[1] = -n[2];
-        t[2] = n[1];
-    }
-    l = sqrt(t[0] * t[0] + t[1] * t[1] + t[2] * t[2]);
-    t[0] /= l;
-    t[1] /= l;
-    t[2] /= l;
-    bt[0] = n[1] * t[2] - n[2] * t[1];
-    bt[1] = n[2] * t[0] - n[0] * t[2];
-    bt[2] = n[0] * t[1] - n[1] * t[0];
-    d[0] = a * t[0] + b * bt[0] + c * n[0];
-    d[1] = a * t[1] + b * bt[1] + c * n[1];
-    d[2] = a * t[2] + b * bt[2] + c * n[2];
-    l = sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
-    d[0] /= l;
-    d[1] /= l;
-    d[2] /= l;
 }
 
 /* ---- a scene from arrays with its blocks, in an arena on the heap ------- */
@@ -970,112 +940,18 @@ static void test_one_bounce_wall(void **state)
 
 static plx_engine *open_fixture(const char *path, void **mem, size_t bytes)
 {
-    plx_engine *e;
-    plx_config cfg;
-    plx_port port = *plx_port_posix();
-    port.log = NULL;
-    plx_config_default(&cfg);
-    cfg.port = &port;
-    *mem = malloc(bytes);
-    assert_non_null(*mem);
-    assert_int_equal(plx_engine_create(*mem, bytes, &cfg, &e), PLX_OK);
-    assert_int_equal(plx_load_file(e, path), PLX_OK);
-    e->cfg.port = NULL; /* the local port goes out of scope */
+    plx_engine *e = fixture_file(path, bytes, mem);
+    e->cfg.port = NULL; /* what follows runs without a port */
     e->port.log = NULL;
     return e;
 }
 
-/* Direct light at Q (SPEC §2), lamps within reach, visibility by shadow
- * rays; rgb (may be NULL) gets each lamp's term weighted by its colour. */
-static double direct_at(tracer *T, const scene *s, const double Q[3], const double n[3],
-                        double rgb[3])
-{
-    double e = 0.0;
-    uint32_t i;
-    if (rgb)
-        rgb[0] = rgb[1] = rgb[2] = 0.0;
-    for (i = 0; i < s->nlamps; i++) {
-        const scene_lamp *L = &s->lamps[i];
-        double w[3] = {L->x - Q[0], L->y - Q[1], L->z - Q[2]}, d, c, o[3], x;
-        trace_hit h;
-        if (fabs(w[0]) >= L->radius || fabs(w[1]) >= L->radius)
-            continue;
-        d = sqrt(w[0] * w[0] + w[1] * w[1] + w[2] * w[2]);
-        if (d >= L->radius || d == 0.0)
-            continue;
-        w[0] /= d;
-        w[1] /= d;
-        w[2] /= d;
-        c = w[0] * n[0] + w[1] * n[1] + w[2] * n[2];
-        if (c <= 0.0)
-            continue;
-        o[0] = Q[0] + 1e-6 * n[0];
-        o[1] = Q[1] + 1e-6 * n[1];
-        o[2] = Q[2] + 1e-6 * n[2];
-        if (trace_ray(T, o, w, d - 1e-6, &h) != TRACE_SKY)
-            continue;
-        x = d / L->radius;
-        c = L->intensity * c / (d * d) * (1 - x * x * x * x) * (1 - x * x * x * x);
-        e += c;
-        if (rgb) {
-            int k;
-            for (k = 0; k < 3; k++)
-                rgb[k] += c * L->color[k];
-        }
-    }
-    return e;
-}
-
-/* Path-traced E_indirect at P: X = a(Q1) E_d(Q1) + [prob a(Q1)] X(Q1),
- * Q1 found by a cosine-weighted ray from P (albedos are grey). With rgb,
- * also its colour-weighted version and with sd the standard error of the
- * scalar. */
-static double reference_indirect_rgb(tracer *T, const scene *s, const double P[3],
-                                     const double n[3], int paths, uint64_t seed, double rgb[3],
-                                     double *sd)
-{
-    double sum = 0.0, sum2 = 0.0, srgb[3] = {0, 0, 0};
-    int k, c;
-    uint64_t rs = seed * 0x2545f4914f6cdd1dull;
-    rs = rng_next(&rs);
-    for (k = 0; k < paths; k++) {
-        double p[3] = {P[0], P[1], P[2]}, nn[3] = {n[0], n[1], n[2]}, x = 0.0;
-        int depth;
-        for (depth = 0; depth < 30; depth++) {
-            double d[3], o[3], a, drgb[3];
-            trace_hit h;
-            ref_cosine_dir(&rs, nn, d);
-            o[0] = p[0] + 1e-6 * nn[0];
-            o[1] = p[1] + 1e-6 * nn[1];
-            o[2] = p[2] + 1e-6 * nn[2];
-            if (trace_ray(T, o, d, INFINITY, &h) == TRACE_SKY)
-                break;
-            a = h.kind == TRACE_GROUND ? s->ground_albedo : s->bld[h.bld].albedo;
-            x += a * direct_at(T, s, h.p, h.n, drgb);
-            for (c = 0; c < 3; c++)
-                srgb[c] += a * drgb[c];
-            if (urand(&rs) >= a)
-                break;
-            memcpy(p, h.p, sizeof p);
-            memcpy(nn, h.n, sizeof nn);
-        }
-        sum += x;
-        sum2 += x * x;
-    }
-    if (rgb)
-        for (c = 0; c < 3; c++)
-            rgb[c] = srgb[c] / paths;
-    if (sd) {
-        double m = sum / paths, var = sum2 / paths - m * m;
-        *sd = sqrt((var > 0.0 ? var : 0.0) / paths);
-    }
-    return sum / paths;
-}
-
+/* The reference: tests/ref/ref_indirect's path tracer (its own cosine
+ * sampler with libm, SPEC §2 direct light by shadow rays). */
 static double reference_indirect(tracer *T, const scene *s, const double P[3],
                                  const double n[3], int paths, uint64_t seed)
 {
-    return reference_indirect_rgb(T, s, P, n, paths, seed, NULL, NULL);
+    return ref_indirect_paths(T, s, P, n, paths, seed, NULL);
 }
 
 static void test_accuracy_eixample(void **state)
@@ -1489,7 +1365,7 @@ static void test_two_colour_street(void **state)
             ph[0] += E;
             for (k = 0; k < 3; k++)
                 ph[1 + k] += rgb[k];
-            E = reference_indirect_rgb(ps->T, &f.s, P, N, paths, 700 + 10 * side + i, rgb, NULL);
+            E = ref_indirect_paths_rgb(ps->T, &f.s, P, N, paths, 700 + 10 * side + i, rgb, NULL);
             rf[0] += E;
             for (k = 0; k < 3; k++)
                 rf[1 + k] += rgb[k];
@@ -1546,7 +1422,7 @@ static void test_covered_canopy(void **state)
         double P[3] = {pts[i][0], pts[i][1], 0.0}, sd, ref, est;
         assert_true(photon_covered_at(ps, P[0], P[1]));
         est = prog[i] = photon_indirect(ps, P, up);
-        ref = reference_indirect_rgb(ps->T, &f.s, P, up, paths, 900 + i, NULL, &sd);
+        ref = ref_indirect_paths_rgb(ps->T, &f.s, P, up, paths, 900 + i, NULL, &sd);
         printf("  (%4.1f %4.1f): %7.3f lx, %7.3f +- %.3f lx\n", P[0], P[1], est, ref, sd);
         assert_true(ref > 0.0 && est > 0.5 * ref);
         err += fabs(est - ref) / ref;

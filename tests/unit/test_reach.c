@@ -12,6 +12,7 @@
 #include <cmocka.h>
 
 #include "polarlux.h"
+#include "fixture.h"
 
 #define MEM (64u << 20)
 
@@ -25,9 +26,8 @@ static double rnd(void)
 static void test_reach_equals_all_lamps(void **state)
 {
     char *json = malloc(1 << 20), *p;
-    void *mem = malloc(MEM);
+    void *mem;
     plx_engine *e;
-    plx_config cfg;
     plx_scene_info si;
     int i, k, nl = 600, np = getenv("PLX_TEST_QUICK") ? 4000 : 40000, inside = 0;
     (void)state;
@@ -39,9 +39,7 @@ static void test_reach_equals_all_lamps(void **state)
                         "\"radius\":%.3f},\"geometry\":{\"type\":\"Point\",\"coordinates\":[%.3f,%.3f]}}",
                      12 + 10 * rnd(), i % 7 == 0 ? 0.0 : 1000.0, 15 + 60 * rnd(), -400 + 800 * rnd(), -400 + 800 * rnd());
     strcpy(p, "]}");
-    plx_config_default(&cfg);
-    assert_int_equal(plx_engine_create(mem, MEM, &cfg, &e), PLX_OK);
-    assert_int_equal(plx_load_geojson(e, json, strlen(json), "t"), PLX_OK);
+    e = fixture_text(json, MEM, 0, &mem);
     plx_scene_info_get(e, &si);
     assert_int_equal(si.lamps, (uint32_t)nl);
     for (k = 0; k < np; k++) {
@@ -72,8 +70,7 @@ static void test_reach_equals_all_lamps(void **state)
     }
     assert_true(inside > np / 4 && inside < np);
     assert_int_equal(plx_lamps_in_reach(e, 1, NULL, NULL), PLX_E_INVALID);
-    plx_engine_destroy(e);
-    free(mem);
+    fixture_done(e, mem);
     free(json);
 }
 

@@ -17,6 +17,7 @@
 
 #include "polarlux.h"
 #include "polarlux_port.h"
+#include "fixture.h"
 
 #define MEM ((size_t)256 << 20)
 
@@ -88,18 +89,13 @@ static void model_update(model *m, plx_engine *e, const double eye[3], double ra
 
 static void test_lru_along_path(void **state)
 {
-    void *mem = malloc(MEM);
-    plx_config cfg;
-    plx_engine *e = NULL;
+    void *mem;
+    plx_engine *e = fixture_load_file(fixture_engine(MEM, 0, plx_port_posix(), &mem), "fixtures/eixample-4x4.geojson");
     plx_refine_stats rs;
     static model m;
     double eye[3] = { 0, 0, 1.7 };
     int k, steps = getenv("PLX_TEST_QUICK") ? 40 : 80;
     (void)state;
-    plx_config_default(&cfg);
-    cfg.port = plx_port_posix();
-    assert_int_equal(plx_engine_create(mem, MEM, &cfg, &e), PLX_OK);
-    assert_int_equal(plx_load_file(e, "fixtures/eixample-4x4.geojson"), PLX_OK);
     assert_int_equal(plx_indirect_refine(e, eye, &rs), PLX_E_NOSCENE);
     assert_int_equal(plx_indirect_step(e, 5000, 1), PLX_OK);
     memset(&m, 0, sizeof m);
@@ -136,8 +132,7 @@ static void test_lru_along_path(void **state)
            (unsigned long long)rs.hits, (unsigned long long)rs.misses, (unsigned long long)rs.evictions,
            (unsigned long long)rs.refined, rs.slots);
     free(m.lru);
-    plx_engine_destroy(e);
-    free(mem);
+    fixture_done(e, mem);
 }
 
 int main(void)

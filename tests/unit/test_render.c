@@ -817,9 +817,8 @@ static void test_cull_over_low_roof(void **state)
         "\"geometry\":{\"type\":\"Point\",\"coordinates\":[0,30]}},"
         "{\"type\":\"Feature\",\"properties\":{\"lamp\":true,\"z\":8,\"radius\":60},"
         "\"geometry\":{\"type\":\"Point\",\"coordinates\":[0,0]}}]}";
-    void *mem = malloc(MEM);
-    plx_engine *e;
-    plx_config cfg;
+    void *mem;
+    plx_engine *e = fixture_load_text(fixture_engine(MEM, 0, NULL, &mem), text, "low");
     render *r;
     render_camera cam = { { 0, 0, 7 }, { 0, 45, 8 }, 60, 96, 72 };
     render_opts o;
@@ -828,9 +827,6 @@ static void test_cull_over_low_roof(void **state)
     size_t p, tall = 0;
     double z;
     (void)state;
-    plx_config_default(&cfg);
-    assert_int_equal(plx_engine_create(mem, MEM, &cfg, &e), PLX_OK);
-    assert_int_equal(plx_load_geojson(e, text, strlen(text), "low"), PLX_OK);
     assert_int_equal(render_create(&e->mem, e->sc, 96, 72, pos_shade, NULL, &r), PLX_OK);
     render_opts_default(&o);
     for (z = 1.5; z < 40; z += 2.5) {
@@ -971,13 +967,9 @@ static void test_mesh_awkward(void **state)
         "{\"type\":\"Feature\",\"properties\":{\"height\":12},\"geometry\":{\"type\":\"Polygon\",\"coordinates\":["
         "[[0,20],[12,20],[12,32],[2,32],[2,24],[8,24],[8,28],[6,28],[6,26],[4,26],[4,30],[10,30],[10,22],"
         "[0,22],[0,20]]]}}]}";
-    void *mem = malloc(MEM);
-    plx_engine *e;
-    plx_config cfg;
+    void *mem;
+    plx_engine *e = fixture_load_text(fixture_engine(MEM, 0, NULL, &mem), text, "awkward");
     (void)state;
-    plx_config_default(&cfg);
-    assert_int_equal(plx_engine_create(mem, MEM, &cfg, &e), PLX_OK);
-    assert_int_equal(plx_load_geojson(e, text, strlen(text), "awkward"), PLX_OK);
     assert_int_equal(e->sc->nbld, 4);
     check_mesh_of(e, "awkward");
     plx_engine_destroy(e);
