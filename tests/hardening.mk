@@ -115,13 +115,13 @@ ARM64_TESTS  = $(TEST_SRC:tests/unit/%.c=$(ARM64_BUILD)/tests/%)
 check-arm64-build:
 	@command -v $(ARM64_CC) >/dev/null && command -v $(ARM64_QEMU) >/dev/null || \
 	  { echo "check-arm64: needs $(ARM64_CC) and $(ARM64_QEMU) (make hardening-deps)" >&2; exit 1; }
-	$(MAKE) BUILD=$(ARM64_BUILD) CC=$(ARM64_CC) $(ARM64_BUILD)/polarlux $(ARM64_TESTS)
+	$(MAKE) BUILD=$(ARM64_BUILD) CC=$(ARM64_CC) $(ARM64_BUILD)/polarlux $(ARM64_TESTS) $(ARM64_BUILD)/tests/tiff_probe
 
 # Each binary gets a wrapper script running it under qemu, so the ordinary
 # test runner (and the cli tests) run the arm64 programs unchanged.
 check-arm64: check-arm64-build all
 	@rm -rf $(ARM64_RUN); mkdir -p $(ARM64_RUN)/tests
-	@for b in $(ARM64_BUILD)/polarlux $(ARM64_TESTS); do \
+	@for b in $(ARM64_BUILD)/polarlux $(ARM64_TESTS) $(ARM64_BUILD)/tests/tiff_probe; do \
 	  w=$(ARM64_RUN)/$${b#$(ARM64_BUILD)/}; \
 	  printf '#!/bin/sh\nexec %s %s "$$@"\n' "$(ARM64_QEMU)" "$(CURDIR)/$$b" >$$w; chmod +x $$w; \
 	done
