@@ -230,7 +230,7 @@ lit_union_check lit-union-helsinki fixtures/helsinki-centre.geojson --lamp 100
 # A tight --mem keeps only some candidates at a time and takes more passes
 # over the grid; the spots must be those of one sort of every street point.
 if [ -z "$PLX_TEST_QUICK" ]; then
-    expect spots-mem-roomy 0 "" -- "$bin" dark-spots -q fixtures/tiny.geojson --res 0.2 --count 30 --spacing 8 -o "$tmp/spots-roomy.geojson"
-    expect spots-mem-tight 0 "dark-spots: [0-9]+ passes over the grid: --mem leaves room for" -- "$bin" dark-spots fixtures/tiny.geojson --res 0.2 --count 30 --spacing 8 --mem 600K -o "$tmp/spots-tight.geojson"
+    expect spots-mem-roomy 0 "" -- "$bin" dark-spots -q fixtures/tiny.geojson --res 0.1 --count 30 --spacing 8 -o "$tmp/spots-roomy.geojson"
+    expect spots-mem-tight 0 "dark-spots: [0-9]+ passes over the grid: --mem leaves room for" -- "$bin" dark-spots fixtures/tiny.geojson --res 0.1 --count 30 --spacing 8 --mem 600K -o "$tmp/spots-tight.geojson"
     if cmp -s "$tmp/spots-roomy.geojson" "$tmp/spots-tight.geojson"; then pass=$((pass + 1)); else echo "FAIL spots-mem-same: tight --mem changed the spots"; fail=$((fail + 1)); fi
 fi
