@@ -82,22 +82,31 @@ static void shade_bands(lightmap *m, lightmap_shade_fn shade, void *user, const 
     }
 }
 
-/* The indirect layer: memory (as the first build took it) and values. */
-static plx_status ind_alloc(lightmap *m, arena *mem, size_t need, const char **err)
+/* A float array of the map that keeps the memory its first build took:
+ * later builds must fit it (the arena cannot grow an older block). */
+static plx_status keep_floats(float **p, size_t *cap, arena *mem, size_t need, const char *what,
+                              const char **err)
 {
-    if (m->ind && need <= m->ind_cap)
+    if (*p && need <= *cap)
         return PLX_OK;
-    if (m->ind) {
+    if (*p) {
         *err = "render_lightmap_build: the new map does not fit the first one's memory";
         return PLX_E_NOMEM;
     }
-    m->ind = arena_alloc(mem, PLX_PART_FRAME, arena_mul(need, sizeof(float)), 64);
-    if (!m->ind) {
-        *err = "render_lightmap_build: out of memory for the light map's indirect layer";
+    *p = arena_alloc(mem, PLX_PART_FRAME, arena_mul(need, sizeof(float)), 64);
+    if (!*p) {
+        *err = what;
         return PLX_E_NOMEM;
     }
-    m->ind_cap = need;
+    *cap = need;
     return PLX_OK;
+}
+
+/* The indirect layer: memory (as the first build took it) and values. */
+static plx_status ind_alloc(lightmap *m, arena *mem, size_t need, const char **err)
+{
+    return keep_floats(&m->ind, &m->ind_cap, mem, need,
+                       "render_lightmap_build: out of memory for the light map's indirect layer", err);
 }
 
 static void ind_fill(lightmap *m, lightmap_ind_fn fn, void *user)
@@ -167,18 +176,9 @@ plx_status lightmap_build_ind(lightmap *m, arena *mem, const scene *s, double ce
         cell *= 1.05;
     }
     need = (size_t)nx * ny * 3;
-    if (!m->rgb || need > m->cap) {
-        if (m->rgb) {
-            *err = "render_lightmap_build: the new map does not fit the first one's memory";
-            return PLX_E_NOMEM;
-        }
-        m->rgb = arena_alloc(mem, PLX_PART_FRAME, arena_mul(need, sizeof(float)), 64);
-        if (!m->rgb) {
-            *err = "render_lightmap_build: out of memory for the light map";
-            return PLX_E_NOMEM;
-        }
-        m->cap = need;
-    }
+    st = keep_floats(&m->rgb, &m->cap, mem, need, "render_lightmap_build: out of memory for the light map", err);
+    if (st != PLX_OK)
+        return st;
     if (ind_fn && (st = ind_alloc(m, mem, (size_t)nx * ny * 4, err)) != PLX_OK)
         return st;
     m->nx = nx;
