@@ -395,7 +395,8 @@ static plx_status check_file(const unsigned char *f, size_t len, bake_layout *L,
     L->nrel = (size_t)get64(f + H_NREL);
     L->pages_present = (size_t)get64(f + H_PAGES);
     if (img < sizeof(struct plx_engine) || img > ((uint64_t)1 << 34) || get64(f + H_NREL) > len / 4 ||
-        get64(f + H_PAGES) > len / BAKE_PAGE || get64(f + H_BASEMOD) >= BAKE_ALIGN)
+        get64(f + H_PAGES) > len / BAKE_PAGE || get64(f + H_BASEMOD) >= BAKE_ALIGN ||
+        get64(f + H_BASEMOD) % PLX_ENGINE_ALIGN != 0)
         return say(err, errlen, PLX_E_PARSE, "corrupt bake file: inconsistent header", 0, NULL, 0, NULL);
     layout_fill(L);
     if (L->total != len || L->pages_present > L->npages || popcount(f + L->bitmap_at, L->npages) != L->pages_present)

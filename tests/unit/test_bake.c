@@ -22,6 +22,7 @@
 #include <cmocka.h>
 
 #include "polarlux.h"
+#include "../ref/ref_bake_sum.h"
 #include "polarlux_port.h"
 #include "ref_bake_sum.h"
 
@@ -275,6 +276,12 @@ static void test_damaged(void **state)
     memcpy(f, k.file, k.len);
     f[48] ^= 1; /* relocation count: the layout no longer adds up */
     expect_fail(f, k.len, PLX_E_PARSE, "corrupt bake file: inconsistent header");
+    /* the saved alignment of the block is not one an engine can start at
+     * (found by fuzz_bake: the engine was read from a misaligned address) */
+    memcpy(f, k.file, k.len);
+    f[56] = (unsigned char)(f[56] + 7) & 63;
+    ref_bake_reseal(f, k.len);
+    expect_fail(f, k.len, PLX_E_PARSE, "corrupt bake file: inconsistent header");
     /* a block too small */
     assert_int_equal(plx_bake_block_size(k.file, k.len, &need, err, sizeof err), PLX_OK);
     mem = malloc(1 << 20);
@@ -306,6 +313,7 @@ static const corpus_row corpus[] = {
     { "bake-32bit.plxb", PLX_E_UNSUPPORTED,
       "bake made on another architecture (byte order or pointer, size_t, double, long sizes differ); "
       "bake the scene again on this machine" },
+    { "bake-misaligned-base.plxb", PLX_E_PARSE, "corrupt bake file: inconsistent header" },
 };
 
 static void test_corpus(void **state)
