@@ -12,6 +12,7 @@
  * a lamp. A group whose intensities are all 0 keeps the first colour.
  * Sorting the lamps makes this O(n log n); a warning names each of the first
  * LAMPMERGE_WARN groups, then one line counts the rest. */
+#include <float.h>
 #include <string.h>
 
 #include "base/msort.h"
@@ -41,25 +42,58 @@ static int same_spot(const scene_lamp *p, const scene_lamp *q)
     return p->x == q->x && p->y == q->y && p->z == q->z && p->radius == q->radius;
 }
 
-/* Merges lamps order[i0 .. i1-1] into the first of them; marks the others. */
-static void merge_group(scene_lamp *l, const uint32_t *order, uint32_t i0, uint32_t i1, uint8_t *gone)
+/* Merges lamps order[i0 .. i1-1] into the first of them; marks the others.
+ * Returns -1 (nothing changed) when their intensities add up beyond the
+ * largest double. */
+static int merge_group(scene_lamp *l, const uint32_t *order, uint32_t i0, uint32_t i1, uint8_t *gone)
 {
     scene_lamp *m = &l[order[i0]];
     double sum = 0, c[3] = { 0, 0, 0 };
     uint32_t i;
     int k;
+    for (i = i0; i < i1; i++)
+        sum += l[order[i]].intensity;
+    if (!(sum <= DBL_MAX))
+        return -1;
     for (i = i0; i < i1; i++) {
         const scene_lamp *p = &l[order[i]];
-        sum += p->intensity;
         for (k = 0; k < 3; k++)
-            c[k] += p->intensity * (double)p->color[k];
+            c[k] += sum > 0 ? p->intensity / sum * (double)p->color[k] : 0.0;
         if (i > i0)
             gone[order[i]] = 1;
     }
     if (sum > 0)
         for (k = 0; k < 3; k++)
-            m->color[k] = (float)(c[k] / sum);
+            m->color[k] = (float)c[k];
     m->intensity = sum;
+    return 0;
+}
+
+/* A group whose intensities overflow: a bad feature (the first lamp's);
+ * without --strict every lamp of the group is dropped. */
+static plx_status drop_group(loader *ld, scene *s, const uint32_t *order, uint32_t i0, uint32_t i1, uint8_t *gone)
+{
+    const scene_lamp *m = &s->lamps[order[i0]];
+    char why[200];
+    strbuf b;
+    uint32_t i;
+    plx_status st;
+    sb_init(&b, why, sizeof why);
+    sb_uint(&b, i1 - i0);
+    sb_str(&b, " lamps at one spot (");
+    sb_num(&b, m->x, 10);
+    sb_str(&b, ", ");
+    sb_num(&b, m->y, 10);
+    sb_str(&b, ", ");
+    sb_num(&b, m->z, 10);
+    sb_str(&b, "): their intensities add up beyond the largest number; the lamps are dropped");
+    st = ld_bad_feature(ld, m->feature, m->id, why);
+    if (st != PLX_OK)
+        return st;
+    s->skipped_features += i1 - i0 - 1;
+    for (i = i0; i < i1; i++)
+        gone[order[i]] = 1;
+    return PLX_OK;
 }
 
 static void warn_group(loader *ld, const scene_lamp *m, uint32_t n)
@@ -122,7 +156,14 @@ plx_status ld_merge_duplicate_lamps(loader *ld)
             ;
         if (j - i < 2)
             continue;
-        merge_group(s->lamps, order, i, j, gone);
+        if (merge_group(s->lamps, order, i, j, gone) != 0) {
+            plx_status st = drop_group(ld, s, order, i, j, gone);
+            if (st != PLX_OK) {
+                arena_release(ld->mem, &mark);
+                return st;
+            }
+            continue;
+        }
         s->merged_lamps += j - i - 1;
         if (groups++ < LAMPMERGE_WARN) {
             warn_group(ld, &s->lamps[order[i]], j - i);

@@ -232,6 +232,14 @@ static const corpus_case corpus[] = {
       "feature 3 (huge, line 5, column 1): lamp radius 100001 m is out of range (> 0 and <= 100000 m)\n",
       0, 1, 4, 0,
       "|ok" },
+    { "lamps-overflowing-sum.geojson", PLX_OK,
+      NULL,
+      "feature 0 (big-a, line 2, column 1): 3 lamps at one spot (0, 0, 6): their intensities add up beyond the "
+      "largest number; the lamps are dropped",
+      "feature 0 (big-a, line 2, column 1): 3 lamps at one spot (0, 0, 6): their intensities add up beyond the "
+      "largest number; the lamps are dropped\n",
+      0, 1, 3, 0,
+      "|ok" },
     { "lamps-zero-intensity.geojson", PLX_OK,
       NULL,
       "feature 3 (neg, line 5, column 1): lamp intensity -1e-9 cd is negative or not finite",
