@@ -23,9 +23,10 @@ static int lonlat_range(const cJSON *coords)
     return 1;
 }
 
-/* Reads n positions [x, y(, z)] into out (3 per position). */
+/* Reads n positions [x, y(, z)] into out (3 per position); eyes must be
+ * above the ground, targets may lie on it (an aerial camera looking down). */
 static int read_positions(const cJSON *coords, int project, const plx_scene_info *si, double *out, int n,
-                          char *why, size_t whylen)
+                          int eyes, char *why, size_t whylen)
 {
     double coslat = cos(si->lat0 * 3.14159265358979323846 / 180.0);
     int k;
@@ -44,7 +45,7 @@ static int read_positions(const cJSON *coords, int project, const plx_scene_info
             out[3 * k] = (out[3 * k] - si->lon0) * 111320.0 * coslat;
             out[3 * k + 1] = (out[3 * k + 1] - si->lat0) * 110540.0;
         }
-        if (!(out[3 * k + 2] > 0)) {
+        if (eyes && !(out[3 * k + 2] > 0)) {
             snprintf(why, whylen, "position %d: the eye must be above the ground (z > 0)", k);
             return -1;
         }
@@ -117,9 +118,9 @@ static int parse(const cJSON *root, plx_engine *e, walk_path *wp, char *why, siz
         snprintf(why, whylen, "out of memory");
         return -1;
     }
-    if (read_positions(coords, project, &si, wp->eye, n, why, whylen) != 0)
+    if (read_positions(coords, project, &si, wp->eye, n, 1, why, whylen) != 0)
         return -1;
-    if (targets && read_positions(targets, project, &si, wp->target, n, why, whylen) != 0) {
+    if (targets && read_positions(targets, project, &si, wp->target, n, 0, why, whylen) != 0) {
         char inner[320];
         snprintf(inner, sizeof inner, "%s", why);
         snprintf(why, whylen, "properties.targets: %.200s", inner);
