@@ -290,6 +290,9 @@ static plx_status measure(plx_engine *e, plx_engine *twin, const char *fn, bake_
         return st;
     if ((st = check_twin(e, twin, fn)) != PLX_OK)
         return st;
+    /* photon frames came after plx_bake_prepare: the aerial map's indirect
+     * layer is gathered now, so aerial frames of the bake start at once */
+    eng_lightmap_layer(e);
     return scan_savable(e, twin, NULL, L);
 }
 

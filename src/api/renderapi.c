@@ -108,6 +108,16 @@ static int layer_on(const plx_engine *e)
     return icache_on(e) && e->ph && plx_indirect_frames(e) > 0;
 }
 
+/* Whether the aerial light map carries its indirect layer. */
+static int aerial_layer(const plx_engine *e)
+{
+    render_lightmap_info li;
+    if (e->lightmap_cell == 0.0 || !e->rd)
+        return 0;
+    render_lightmap_get(e->rd, &li);
+    return li.has_ind;
+}
+
 /* The light map's budget when plx_config.lightmap_bytes is 0: half the
  * block's free bytes when it is built, at most LIGHTMAP_MAX_BYTES (its
  * texel grows until it fits, render_lightmap_build: 12 bytes a texel, 28
@@ -153,6 +163,22 @@ plx_status eng_need_lightmap(plx_engine *e, double m_per_texel, int dark)
         return eng_fail(e, st, render_error(e->rd));
     e->lightmap_cell = cell;
     return PLX_OK;
+}
+
+/* The light map's indirect layer gathered now when images gather over
+ * traced photons and the map was built without it (before the photons:
+ * plx_bake_prepare, or a first aerial frame before plx_indirect_step).
+ * Only the layer: the direct part stays. */
+void eng_lightmap_layer(plx_engine *e)
+{
+    plx_status st;
+    if (e->lightmap_cell == 0.0 || !e->ic || !layer_on(e) || aerial_layer(e))
+        return;
+    icache_set_spacing(e->ic, ICACHE_AERIAL);
+    st = render_lightmap_fill_ind(e->rd, lightmap_indirect, e);
+    icache_set_spacing(e->ic, 0.0);
+    if (st != PLX_OK)
+        e->lightmap_cell = 0.0; /* no layer memory: the next aerial frame builds the map whole */
 }
 
 /* Anti-aliasing: n x n frames with the sample point moved within the
@@ -229,11 +255,10 @@ plx_status plx_render(plx_engine *e, const plx_camera *cam, const plx_render_opt
     if (st != PLX_OK)
         return st;
     if (o->aerial && e->lightmap_cell != 0.0 && !o->no_indirect && e->ic && e->ph && plx_indirect_frames(e) > 0) {
-        render_lightmap_info li;
-        render_lightmap_get(e->rd, &li);
-        /* built before the photons (a bake), or gathering switched since:
-         * again, with (without) its indirect layer */
-        if (li.has_ind != layer_on(e))
+        /* built before the photons: its indirect layer gathered now;
+         * gathering switched off since: the map again, without the layer */
+        eng_lightmap_layer(e);
+        if (aerial_layer(e) && !layer_on(e))
             e->lightmap_cell = 0.0;
     }
     if (o->aerial && e->lightmap_cell == 0.0) {
@@ -271,6 +296,14 @@ plx_status plx_render(plx_engine *e, const plx_camera *cam, const plx_render_opt
         ro.indirect_far = shade_photons;
         ro.indirect_key = e->indirect_gen;
         ro.top = top_height;
+        if (o->aerial && aerial_layer(e)) {
+            /* from above, the map's layer gives the ground and the roofs;
+             * the walls left (seen at a slant, a few pixels each) read the
+             * photon buffers: read only, so on every worker, and no
+             * gathering while the view moves */
+            ro.indirect = shade_photons;
+            ro.indirect_mt = 1;
+        }
     }
     set_workers(e, &ro);
     if (o->aa > 1)

@@ -60,6 +60,9 @@ plx_status eng_need_render(plx_engine *e);
 /* Builds the aerial light map at m_per_texel metres (0: 1 m) unless built;
  * dark: with a shader giving no light (the bake's twin, bake.c). */
 plx_status eng_need_lightmap(plx_engine *e, double m_per_texel, int dark);
+/* The aerial map's indirect layer gathered when photons came after the map
+ * (renderapi.c). */
+void eng_lightmap_layer(plx_engine *e);
 /* The indirect estimate at a free point (not on a surface facing out):
  * final gathering there, else the buffers' value on the horizontal surface
  * below it (indirectapi.c). */

@@ -170,7 +170,7 @@ int cmd_bake(int argc, char **argv)
         plx_memory_get(e, &m);
         printf("baked %s into %s: %zu bytes (%.1f MB); engine memory in use %zu bytes (%.1f MB)\n", a.scene,
                a.out, bytes, bytes / 1048576.0, m.used_total, m.used_total / 1048576.0);
-        printf("times: load and build %.0f ms, photons %.0f ms (%ld x %ld), twin and save %.0f ms, "
+        printf("times: load and build %.0f ms, photons %.0f ms (%ld x %ld), aerial indirect layer, twin and save %.0f ms, "
                "total %.2f s\n", (t1 - t0) / 1e6, (t2 - t1) / 1e6, a.ind.off ? 0L : a.ind.frames,
                a.ind.photons, (port_now_ns() - t2) / 1e6, (port_now_ns() - t0) / 1e9);
     }

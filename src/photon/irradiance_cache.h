@@ -29,10 +29,11 @@
  * (aerial views read the photon buffers).
  *
  * VIEWS FROM ABOVE (icache_set_spacing). The aerial light map's indirect
- * layer and aerial frames use one level, ICACHE_AERIAL (4 m) everywhere,
- * and never the photon buffers for points with a grid: light stays on
- * the surface it was gathered on (the records' grids respect walls and
- * roof edges), where the buffers' coarse records spread it 100 m.
+ * layer uses one level, ICACHE_AERIAL (4 m) everywhere, and never the
+ * photon buffers for points with a grid: light stays on the surface it was
+ * gathered on (the records' grids respect walls and roof edges), where the
+ * buffers' coarse records spread it 100 m. (Aerial frames read the layer
+ * for the ground and roofs and the photon buffers for walls.)
  *
  * VALID VERTICES. A vertex is valid when it lies on the same surface: on
  * the ground or a roof, when the topmost surface over it (trace_top) has
@@ -74,7 +75,8 @@
 #define ICACHE_LEVEL_MAX 5    /* coarsest level: 8 m (farther: photon buffers) */
 #define ICACHE_LEVEL_SEG 4    /* from 4 m on, a ground vertex behind a wall is left out */
 #define ICACHE_RECORDS 65536  /* table slots (power of two) */
-#define ICACHE_AERIAL 4.0     /* spacing for views from above, m (icache_set_spacing) */
+#define ICACHE_AERIAL 4.0     /* spacing for the aerial map's layer, m (icache_set_spacing;
+                                 8 m gathers a quarter of the records, less accurately) */
 
 typedef struct icache_rec icache_rec;
 

@@ -129,6 +129,15 @@ static void ind_fill(lightmap *m, lightmap_ind_fn fn, void *user)
         }
 }
 
+plx_status lightmap_fill_ind(lightmap *m, lightmap_ind_fn ind_fn, void *ind_user)
+{
+    if (!m->built || !m->ind || !ind_fn || (size_t)m->nx * m->ny * 4 > m->ind_cap)
+        return PLX_E_INVALID;
+    ind_fill(m, ind_fn, ind_user);
+    m->has_ind = ind_user != NULL;
+    return PLX_OK;
+}
+
 plx_status lightmap_build(lightmap *m, arena *mem, const scene *s, double cell, size_t max_bytes,
                           lightmap_shade_fn shade, void *user, const lightmap_par *par, const char **err)
 {

@@ -65,6 +65,12 @@ plx_status lightmap_build_ind(lightmap *m, arena *mem, const scene *s, double ce
                               lightmap_shade_fn shade, void *user, const lightmap_par *par /* may be NULL */,
                               lightmap_ind_fn ind_fn, void *ind_user, const char **err /* OUT */);
 
+/* Fills the indirect layer of a built map again (its memory as built):
+ * ind_fn at every texel centre, the direct part left alone. For the light
+ * gathered after the map was built (photon frames added since). Returns
+ * PLX_E_INVALID when the map was built without a layer. */
+plx_status lightmap_fill_ind(lightmap *m, lightmap_ind_fn ind_fn, void *ind_user);
+
 /* E_indirect at P (a horizontal surface point seen from above, P[2] its
  * height) from the indirect layer: bilinear over the four texel centres
  * around P whose topmost surface has P's height (within 1 cm), weights

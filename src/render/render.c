@@ -1427,6 +1427,13 @@ plx_status render_lightmap_build_ind(render *r, double cell, size_t max_bytes, l
     return lightmap_build_ind(&r->lm, r->a, r->s, cell, max_bytes, r->shade, r->user, &lp, ind, user, &r->err);
 }
 
+plx_status render_lightmap_fill_ind(render *r, lightmap_ind_fn ind, void *user)
+{
+    if (!r)
+        return PLX_E_INVALID;
+    return lightmap_fill_ind(&r->lm, ind, user);
+}
+
 void render_lightmap_get(const render *r, render_lightmap_info *out)
 {
     memset(out, 0, sizeof *out);

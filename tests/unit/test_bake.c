@@ -23,6 +23,9 @@
 
 #include "polarlux.h"
 #include "../ref/ref_bake_sum.h"
+#include "base/engine.h"
+#include "render/render.h"
+#include "photon/irradiance_cache.h"
 #include "polarlux_port.h"
 #include "ref_bake_sum.h"
 
@@ -210,6 +213,38 @@ static void test_round_trip(void **state)
     bake_free(&k);
 }
 
+/* The aerial map's indirect layer: a bake made before its photons gathers
+ * it while saving, so the loaded engine's aerial frames gather nothing,
+ * and they equal those of an engine that never saw a bake (its map built
+ * whole, layer and all, at its first aerial frame). */
+static void test_aerial_layer_in_bake(void **state)
+{
+    baked k;
+    void *mc, *md;
+    plx_engine *c, *d;
+    render_lightmap_info li;
+    uint64_t f, g0;
+    (void)state;
+    bake_make(&k);
+    render_lightmap_get(k.a->rd, &li);
+    assert_true(li.built && li.has_ind);
+    assert_true(k.a->ic->gathered > 0);
+    c = load(k.file, k.len, &mc);
+    render_lightmap_get(c->rd, &li);
+    assert_true(li.built && li.has_ind);
+    g0 = c->ic->gathered;
+    d = make(&md, 0, 0);
+    for (f = 1; f <= 3; f++)
+        assert_int_equal(plx_indirect_step(d, 20000, f), PLX_OK);
+    same_render(d, c, 1, 0);
+    assert_true(c->ic->gathered == g0);
+    plx_engine_destroy(d);
+    free(md);
+    plx_engine_destroy(c);
+    free(mc);
+    bake_free(&k);
+}
+
 /* ---- damaged files ----------------------------------------------------------- */
 
 static void expect_fail(const unsigned char *f, size_t len, plx_status want, const char *msg)
@@ -357,6 +392,7 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_round_trip),
+        cmocka_unit_test(test_aerial_layer_in_bake),
         cmocka_unit_test(test_damaged),
         cmocka_unit_test(test_corpus),
         cmocka_unit_test(test_twin_mismatch),
