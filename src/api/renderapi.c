@@ -85,19 +85,29 @@ static void shade_none(void *user, const double P[3], const double n[3], double 
     rgb[0] = rgb[1] = rgb[2] = 0.0;
 }
 
-/* The aerial light map's indirect layer (render_lightmap_build_ind): the
+/* What one worker filling the aerial map's indirect layer reads through:
+ * an irradiance cache and a light object of its own (both fill as they
+ * are read), the engine's photon buffers and tracer (only read). */
+typedef struct layer_worker {
+    plx_engine *e;
+    icache *ic;
+    light *lt;
+} layer_worker;
+
+/* The aerial light map's indirect layer (render_lightmap_fill_ind): the
  * irradiance cache at the topmost surface over (x, y), ground or roof, on
  * its ICACHE_AERIAL grid (records 4 m apart, none across a wall or a roof
- * edge: irradiance_cache.h). */
+ * edge: irradiance_cache.h). A record's value does not depend on which
+ * cache gathers it, so the layer is the same for any number of workers. */
 static int lightmap_indirect(void *user, double x, double y, double rgb[3], double *z)
 {
-    plx_engine *e = user;
+    layer_worker *w = user;
     double P[3], n[3] = { 0.0, 0.0, 1.0 };
     P[0] = x;
     P[1] = y;
-    P[2] = trace_top(e->ph->T, x, y, NULL);
+    P[2] = trace_top(w->e->ph->T, x, y, NULL);
     *z = P[2];
-    icache_lookup(e->ic, e->ph, e->lt, P, n, rgb);
+    icache_lookup(w->ic, w->e->ph, w->lt, P, n, rgb);
     return 1;
 }
 
@@ -143,16 +153,10 @@ plx_status eng_need_lightmap(plx_engine *e, double m_per_texel, int dark)
         render_opts_default(&ro);
         ro.workers = 1;
         set_workers(e, &ro);
-        if (e->ic) {
-            /* the layer's memory in every engine with a cache (a bake's twin
-             * too); its values when images gather over traced photons */
-            int fill = !dark && layer_on(e);
-            if (fill)
-                icache_set_spacing(e->ic, ICACHE_AERIAL);
-            st = render_lightmap_build_ind(e->rd, cell, bytes, lightmap_indirect, fill ? e : NULL, ro.par,
-                                           ro.par_ctx, ro.workers);
-            icache_set_spacing(e->ic, 0.0);
-        } else
+        if (e->ic) /* the layer's memory in every engine with a cache (a bake's twin too) */
+            st = render_lightmap_build_ind(e->rd, cell, bytes, lightmap_indirect, NULL, ro.par, ro.par_ctx,
+                                           ro.workers);
+        else
             st = render_lightmap_build_par(e->rd, cell, bytes, ro.par, ro.par_ctx, ro.workers);
     }
     if (dark)
@@ -162,21 +166,53 @@ plx_status eng_need_lightmap(plx_engine *e, double m_per_texel, int dark)
     if (st != PLX_OK)
         return eng_fail(e, st, render_error(e->rd));
     e->lightmap_cell = cell;
+    if (!dark) /* its values when images gather over traced photons */
+        eng_lightmap_layer(e);
     return PLX_OK;
 }
 
 /* The light map's indirect layer gathered now when images gather over
  * traced photons and the map was built without it (before the photons:
  * plx_bake_prepare, or a first aerial frame before plx_indirect_step).
- * Only the layer: the direct part stays. */
+ * Only the layer: the direct part stays. On the port's workers, each with
+ * a cache and a light object of its own taken from the block for the
+ * while (the first worker uses the engine's); as many as fit. */
 void eng_lightmap_layer(plx_engine *e)
 {
+    layer_worker w[RENDER_MAX_WORKERS];
+    void *users[RENDER_MAX_WORKERS];
+    render_opts ro;
+    arena_mark m;
     plx_status st;
+    int n, k;
     if (e->lightmap_cell == 0.0 || !e->ic || !layer_on(e) || aerial_layer(e))
         return;
-    icache_set_spacing(e->ic, ICACHE_AERIAL);
-    st = render_lightmap_fill_ind(e->rd, lightmap_indirect, e);
+    render_opts_default(&ro);
+    ro.workers = 1;
+    set_workers(e, &ro);
+    n = ro.workers > RENDER_MAX_WORKERS ? RENDER_MAX_WORKERS : ro.workers;
+    m = arena_get_mark(&e->mem);
+    w[0].e = e;
+    w[0].ic = e->ic;
+    w[0].lt = e->lt;
+    for (k = 1; k < n; k++) {
+        w[k].e = e;
+        if (icache_create(&e->mem, &w[k].ic) != PLX_OK ||
+            light_create(&e->mem, e->sc, e->lt->pool_cap, &w[k].lt) != PLX_OK)
+            break;
+    }
+    n = k;
+    for (k = 0; k < n; k++) {
+        icache_set_spacing(w[k].ic, ICACHE_AERIAL);
+        users[k] = &w[k];
+    }
+    st = render_lightmap_fill_ind(e->rd, lightmap_indirect, users, ro.par, ro.par_ctx, n);
+    for (k = 1; k < n; k++) {
+        e->ic->gathered += w[k].ic->gathered;
+        e->ic->direct += w[k].ic->direct;
+    }
     icache_set_spacing(e->ic, 0.0);
+    arena_release(&e->mem, &m);
     if (st != PLX_OK)
         e->lightmap_cell = 0.0; /* no layer memory: the next aerial frame builds the map whole */
 }

@@ -109,32 +109,70 @@ static plx_status ind_alloc(lightmap *m, arena *mem, size_t need, const char **e
                        "render_lightmap_build: out of memory for the light map's indirect layer", err);
 }
 
-static void ind_fill(lightmap *m, lightmap_ind_fn fn, void *user)
+/* Row j of the indirect layer (-1: no value; user NULL: all empty). */
+static void ind_row(lightmap *m, uint32_t j, lightmap_ind_fn fn, void *user)
 {
-    uint32_t i, j;
-    for (j = 0; j < m->ny; j++)
-        for (i = 0; i < m->nx; i++) {
-            size_t t = (size_t)j * m->nx + i;
-            float *o = &m->ind[4 * t];
-            double rgb[3], z;
-            o[0] = -1.0f;
-            o[1] = o[2] = o[3] = 0.0f;
-            if (!user ||
-                !fn(user, m->x0 + (i + 0.5) * m->cell, m->y0 + (j + 0.5) * m->cell, rgb, &z))
-                continue;
-            o[0] = (float)rgb[0];
-            o[1] = (float)rgb[1];
-            o[2] = (float)rgb[2];
-            o[3] = (float)z;
-        }
+    uint32_t i;
+    for (i = 0; i < m->nx; i++) {
+        size_t t = (size_t)j * m->nx + i;
+        float *o = &m->ind[4 * t];
+        double rgb[3], z;
+        o[0] = -1.0f;
+        o[1] = o[2] = o[3] = 0.0f;
+        if (!user || !fn(user, m->x0 + (i + 0.5) * m->cell, m->y0 + (j + 0.5) * m->cell, rgb, &z))
+            continue;
+        o[0] = (float)rgb[0];
+        o[1] = (float)rgb[1];
+        o[2] = (float)rgb[2];
+        o[3] = (float)z;
+    }
 }
 
-plx_status lightmap_fill_ind(lightmap *m, lightmap_ind_fn ind_fn, void *ind_user)
+static void ind_fill(lightmap *m, lightmap_ind_fn fn, void *user)
 {
-    if (!m->built || !m->ind || !ind_fn || (size_t)m->nx * m->ny * 4 > m->ind_cap)
+    uint32_t j;
+    for (j = 0; j < m->ny; j++)
+        ind_row(m, j, fn, user);
+}
+
+/* Bands of rows for the workers: a band is one job, its rows in order, so
+ * a worker's cache keeps the records its next rows share. */
+#define IND_BANDS_PER_WORKER 4
+
+typedef struct ind_job {
+    lightmap *m;
+    lightmap_ind_fn fn;
+    void *const *users;
+    uint32_t rows;       /* per band */
+} ind_job;
+
+static void ind_band(void *arg, int worker, uint32_t k)
+{
+    ind_job *jb = arg;
+    uint32_t j, j1 = (k + 1) * jb->rows < jb->m->ny ? (k + 1) * jb->rows : jb->m->ny;
+    for (j = k * jb->rows; j < j1; j++)
+        ind_row(jb->m, j, jb->fn, jb->users[worker]);
+}
+
+plx_status lightmap_fill_ind(lightmap *m, lightmap_ind_fn ind_fn, void *const *users, int workers,
+                             const lightmap_par *par)
+{
+    ind_job jb;
+    uint32_t bands;
+    if (!m->built || !m->ind || !ind_fn || !users || workers < 1 ||
+        (size_t)m->nx * m->ny * 4 > m->ind_cap)
         return PLX_E_INVALID;
-    ind_fill(m, ind_fn, ind_user);
-    m->has_ind = ind_user != NULL;
+    m->has_ind = 0;
+    bands = (uint32_t)workers * IND_BANDS_PER_WORKER;
+    jb.m = m;
+    jb.fn = ind_fn;
+    jb.users = users;
+    jb.rows = (m->ny + bands - 1) / bands;
+    bands = jb.rows ? (m->ny + jb.rows - 1) / jb.rows : 0;
+    if (workers < 2 || !par || !par->par || !users[0] ||
+        par->par(par->ctx, workers, bands, ind_band, &jb) != 0)
+        ind_fill(m, ind_fn, users[0]);
+    m->has_ind = users[0] != NULL;
     return PLX_OK;
 }
 

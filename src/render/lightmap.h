@@ -67,9 +67,14 @@ plx_status lightmap_build_ind(lightmap *m, arena *mem, const scene *s, double ce
 
 /* Fills the indirect layer of a built map again (its memory as built):
  * ind_fn at every texel centre, the direct part left alone. For the light
- * gathered after the map was built (photon frames added since). Returns
+ * gathered after the map was built (photon frames added since). With
+ * workers >= 2 and par, bands of rows run on the workers, worker w
+ * calling ind_fn with users[w] (each its own state: ind_fn must give a
+ * texel the same value whoever asks, and the layer is then the same for
+ * any number of workers); otherwise users[0] on this thread. Returns
  * PLX_E_INVALID when the map was built without a layer. */
-plx_status lightmap_fill_ind(lightmap *m, lightmap_ind_fn ind_fn, void *ind_user);
+plx_status lightmap_fill_ind(lightmap *m, lightmap_ind_fn ind_fn, void *const *users, int workers,
+                             const lightmap_par *par /* may be NULL */);
 
 /* E_indirect at P (a horizontal surface point seen from above, P[2] its
  * height) from the indirect layer: bilinear over the four texel centres

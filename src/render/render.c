@@ -1427,11 +1427,17 @@ plx_status render_lightmap_build_ind(render *r, double cell, size_t max_bytes, l
     return lightmap_build_ind(&r->lm, r->a, r->s, cell, max_bytes, r->shade, r->user, &lp, ind, user, &r->err);
 }
 
-plx_status render_lightmap_fill_ind(render *r, lightmap_ind_fn ind, void *user)
+plx_status render_lightmap_fill_ind(render *r, lightmap_ind_fn ind, void *const *users, render_par_fn par,
+                                    void *ctx, int workers)
 {
+    lightmap_par lp;
     if (!r)
         return PLX_E_INVALID;
-    return lightmap_fill_ind(&r->lm, ind, user);
+    lp.par = par;
+    lp.ctx = ctx;
+    lp.workers = workers > RENDER_MAX_WORKERS ? RENDER_MAX_WORKERS : workers;
+    lp.lt = NULL;
+    return lightmap_fill_ind(&r->lm, ind, users, lp.workers, &lp);
 }
 
 void render_lightmap_get(const render *r, render_lightmap_info *out)

@@ -356,9 +356,11 @@ plx_status render_lightmap_build_par(render *r, double m_per_texel, size_t max_b
 plx_status render_lightmap_build_ind(render *r, double m_per_texel, size_t max_bytes, lightmap_ind_fn ind,
                                      void *user, render_par_fn par, void *ctx, int workers);
 
-/* The built map's indirect layer filled again by ind (lightmap_fill_ind),
- * its direct part kept: PLX_E_INVALID without a layer. */
-plx_status render_lightmap_fill_ind(render *r, lightmap_ind_fn ind, void *user);
+/* The built map's indirect layer filled again by ind (lightmap_fill_ind:
+ * users[w] for worker w of par), its direct part kept: PLX_E_INVALID
+ * without a layer. */
+plx_status render_lightmap_fill_ind(render *r, lightmap_ind_fn ind, void *const *users, render_par_fn par,
+                                    void *ctx, int workers);
 
 typedef struct render_lightmap_info {
     int built;
