@@ -234,12 +234,19 @@ check-man: $(BIN)
 # run that collects no tests (pytest's exit 5) fails. Sanitizer builds skip
 # it, saying so: the interpreter cannot load an instrumented library.
 PYTHON ?= /usr/bin/python3
-check-python: $(LIB_SO) $(BIN)
+# tests/abi_sizes.c prints the C layout of the structures the package mirrors
+# with ctypes; python/tests/test_abi.py compares it (and runs first).
+ABI_SIZES = $(BUILD)/tests/abi_sizes
+$(ABI_SIZES): tests/abi_sizes.c include/polarlux.h include/polarlux_port.h
+	@mkdir -p $(@D)
+	$(CC) -Iinclude $(CFLAGS_ALL) -o $@ $<
+check-python: $(LIB_SO) $(BIN) $(ABI_SIZES)
 	@case "$(EXTRA_CFLAGS)" in *sanitize*) \
 	  echo "python: skipped in this sanitizer build (make check runs it)"; exit 0;; esac; \
 	log=$(CURDIR)/$(BUILD)/python-tests.log; \
 	(cd python && PYTHONDONTWRITEBYTECODE=1 POLARLUX_LIB=$(CURDIR)/$(LIB_SO) POLARLUX_BIN=$(CURDIR)/$(BIN) \
-	  $(PYTHON) -m pytest -q -p no:cacheprovider tests) >$$log 2>&1; rc=$$?; \
+	  POLARLUX_ABI_SIZES=$(CURDIR)/$(ABI_SIZES) \
+	  $(PYTHON) -m pytest -q -rs -p no:cacheprovider tests) >$$log 2>&1; rc=$$?; \
 	if [ $$rc -eq 5 ]; then echo "python: pytest collected no tests (exit 5)"; exit 1; fi; \
 	if [ $$rc -ne 0 ]; then cat $$log; echo "python: FAILED (pytest exit $$rc)"; exit 1; fi; \
 	echo "ok   python: $$(tail -1 $$log)"

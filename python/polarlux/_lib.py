@@ -2,7 +2,9 @@
 
 Structures the engine fills are given buffers larger than the structures
 declared here (see _padded), so a library whose structures grew at the end
-cannot write past them.
+cannot write past them. Each structure names the C structure it mirrors
+(_c_name_); python/tests/test_abi.py compares sizes and field offsets with
+the C compiler's (tests/abi_sizes.c), so keep both in step with the headers.
 """
 import ctypes
 import ctypes.util
@@ -25,6 +27,7 @@ LOG_FN = ctypes.CFUNCTYPE(None, ctypes.c_void_p, ctypes.c_int, ctypes.c_char_p)
 
 
 class Port(ctypes.Structure):
+    _c_name_ = "plx_port"
     _fields_ = [("ctx", ctypes.c_void_p), ("clock_ns", ctypes.c_void_p), ("log", LOG_FN),
                 ("file_size", ctypes.c_void_p), ("file_read", ctypes.c_void_p),
                 ("lock", ctypes.c_void_p), ("unlock", ctypes.c_void_p),
@@ -32,6 +35,7 @@ class Port(ctypes.Structure):
 
 
 class Config(ctypes.Structure):
+    _c_name_ = "plx_config"
     _fields_ = [("port", ctypes.POINTER(Port)), ("strict", ctypes.c_int),
                 ("part_budget", ctypes.c_size_t * PART_COUNT), ("lit_cache_bytes", ctypes.c_size_t),
                 ("render_max_width", ctypes.c_int32), ("render_max_height", ctypes.c_int32),
@@ -40,32 +44,38 @@ class Config(ctypes.Structure):
 
 
 class SceneInfo(ctypes.Structure):
+    _c_name_ = "plx_scene_info"
     _fields_ = [(n, ctypes.c_uint32) for n in
                 ("buildings", "raised", "blocks", "courtyards", "holes", "lamps", "vertices",
                  "skipped_features", "skipped_lamps", "overlapping_pairs")] + [
                 ("lonlat", ctypes.c_int), ("lon0", ctypes.c_double), ("lat0", ctypes.c_double),
                 ("bounds", ctypes.c_double * 4), ("height_min", ctypes.c_double),
                 ("height_median", ctypes.c_double), ("height_max", ctypes.c_double),
-                ("ground_albedo", ctypes.c_double), ("load_ns", ctypes.c_uint64)]
+                ("ground_albedo", ctypes.c_double), ("load_ns", ctypes.c_uint64),
+                ("merged_lamps", ctypes.c_uint32)]
 
 
 class Visibility(ctypes.Structure):
+    _c_name_ = "plx_visibility"
     _fields_ = [("area", ctypes.c_double), ("nverts", ctypes.c_uint32), ("xy", c_double_p),
                 ("nvisible", ctypes.c_uint32), ("visible", c_uint32_p)]
 
 
 class RouteStats(ctypes.Structure):
+    _c_name_ = "plx_route_stats"
     _fields_ = [("length", ctypes.c_double), ("mean", ctypes.c_double), ("min", ctypes.c_double),
                 ("max", ctypes.c_double), ("uniformity", ctypes.c_double), ("dark_share", ctypes.c_double),
                 ("p_class", ctypes.c_int), ("samples", ctypes.c_uint32), ("blocked_length", ctypes.c_double)]
 
 
 class Camera(ctypes.Structure):
+    _c_name_ = "plx_camera"
     _fields_ = [("eye", ctypes.c_double * 3), ("target", ctypes.c_double * 3), ("fov_deg", ctypes.c_double),
                 ("width", ctypes.c_int32), ("height", ctypes.c_int32)]
 
 
 class RenderOpts(ctypes.Structure):
+    _c_name_ = "plx_render_opts"
     _fields_ = [("exposure", ctypes.c_double), ("no_glow", ctypes.c_int), ("aerial", ctypes.c_int),
                 ("aerial_m_per_texel", ctypes.c_double), ("no_cull", ctypes.c_int),
                 ("no_indirect", ctypes.c_int), ("backend", ctypes.c_void_p),
@@ -73,17 +83,20 @@ class RenderOpts(ctypes.Structure):
 
 
 class RenderInfo(ctypes.Structure):
+    _c_name_ = "plx_render_info"
     _fields_ = [("buildings", ctypes.c_uint32), ("drawn", ctypes.c_uint32),
                 ("drawn_fraction", ctypes.c_double), ("shaded_pixels", ctypes.c_uint64),
                 ("exposure", ctypes.c_double)]
 
 
 class SceneSize(ctypes.Structure):
+    _c_name_ = "plx_scene_size"
     _fields_ = [(n, ctypes.c_uint64) for n in
                 ("text_bytes", "json_values", "string_bytes", "features", "points", "positions", "rings")]
 
 
 class MemoryReport(ctypes.Structure):
+    _c_name_ = "plx_memory_report"
     _fields_ = [("capacity", ctypes.c_size_t), ("used", ctypes.c_size_t * PART_COUNT),
                 ("peak", ctypes.c_size_t * PART_COUNT), ("used_total", ctypes.c_size_t),
                 ("peak_total", ctypes.c_size_t)]
