@@ -25,5 +25,8 @@ int port_parallel_for(void *ctx, int workers, uint32_t njobs, void (*job)(void *
 int port_cores(void *ctx);
 /* Monotonic clock in nanoseconds. */
 unsigned long long port_now_ns(void);
+/* The message fmt, ... into err (errlen bytes, cut to fit); nothing when
+ * err is NULL or errlen 0. */
+void port_set_err(char *err, size_t errlen, const char *fmt, ...);
 
 #endif

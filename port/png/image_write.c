@@ -3,7 +3,6 @@
 #include <errno.h>
 #include <fcntl.h>
 #include <limits.h>
-#include <stdarg.h>
 #include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -13,30 +12,21 @@
 #include <png.h>
 
 #include "image_write.h"
+#include "port.h"
 #include "posix/safe_out.h"
 
 /* Largest width or height accepted (libpng's default user limit). */
 #define IMAGE_MAX_DIM 1000000
 
-static void set_err(char *err, size_t errlen, const char *fmt, ...)
-{
-    va_list ap;
-    if (err == NULL || errlen == 0)
-        return;
-    va_start(ap, fmt);
-    vsnprintf(err, errlen, fmt, ap);
-    va_end(ap);
-}
-
 static int check_size(const char *op, const char *path, int width, int height,
                       const void *pixels, char *err, size_t errlen)
 {
     if (path == NULL || pixels == NULL) {
-        set_err(err, errlen, "%s: %s is NULL", op, path == NULL ? "path" : "pixel buffer");
+        port_set_err(err, errlen, "%s: %s is NULL", op, path == NULL ? "path" : "pixel buffer");
         return -1;
     }
     if (width < 1 || width > IMAGE_MAX_DIM || height < 1 || height > IMAGE_MAX_DIM) {
-        set_err(err, errlen, "%s: '%s': size %dx%d outside 1..%d", op, path, width, height,
+        port_set_err(err, errlen, "%s: '%s': size %dx%d outside 1..%d", op, path, width, height,
                 IMAGE_MAX_DIM);
         return -1;
     }
@@ -129,14 +119,14 @@ int image_encode_png(safe_out *out, const char *path, int width, int height, con
     if (stride == 0)
         stride = width * 3;     /* width <= 1e6: no overflow */
     if (stride < width * 3) {
-        set_err(err, errlen, "%s: '%s': stride %d is shorter than a row of %d bytes",
+        port_set_err(err, errlen, "%s: '%s': stride %d is shorter than a row of %d bytes",
                 op, path, stride, width * 3);
         return -1;
     }
     memset(&io, 0, sizeof io);
     io.out = out;
     if (png_encode(&io, width, height, rgb, (size_t)stride) != 0) {
-        set_err(err, errlen, "%s: cannot write '%s': %s", op, path, png_io_reason(&io));
+        port_set_err(err, errlen, "%s: cannot write '%s': %s", op, path, png_io_reason(&io));
         return -1;
     }
     return 0;
@@ -152,7 +142,7 @@ static int write_one(const char *op, const char *path, int width, int height, co
         return -1;
     o = safe_out_open(path, why, sizeof why);
     if (!o) {
-        set_err(err, errlen, "%s: %s", op, why);
+        port_set_err(err, errlen, "%s: %s", op, why);
         return -1;
     }
     if ((pfm ? image_encode_pfm(o, path, width, height, pixels, err, errlen)
@@ -161,7 +151,7 @@ static int write_one(const char *op, const char *path, int width, int height, co
         return -1;
     }
     if (safe_out_commit(&o, 1, why, sizeof why) != 0) {
-        set_err(err, errlen, "%s: %s", op, why);
+        port_set_err(err, errlen, "%s: %s", op, why);
         return -1;
     }
     return 0;
@@ -189,7 +179,7 @@ int image_encode_pfm(safe_out *out, const char *path, int width, int height, con
     row_floats = (size_t)width * 3;
     row = malloc(row_floats * 4);
     if (row == NULL) {
-        set_err(err, errlen, "%s: '%s': out of memory for a row of %zu bytes", op, path,
+        port_set_err(err, errlen, "%s: '%s': out of memory for a row of %zu bytes", op, path,
                 row_floats * 4);
         return -1;
     }
@@ -211,7 +201,7 @@ int image_encode_pfm(safe_out *out, const char *path, int width, int height, con
     }
     free(row);
     if (safe_out_errno(out) != 0) {
-        set_err(err, errlen, "%s: cannot write '%s': %s", op, path, strerror(safe_out_errno(out)));
+        port_set_err(err, errlen, "%s: cannot write '%s': %s", op, path, strerror(safe_out_errno(out)));
         return -1;
     }
     return 0;
@@ -233,18 +223,18 @@ static FILE *open_input(const char *op, const char *path, char *err, size_t errl
     FILE *f;
     int fd = open(path, O_RDONLY | O_NONBLOCK | O_NOCTTY);
     if (fd < 0) {
-        set_err(err, errlen, "%s: cannot open '%s': %s", op, path, strerror(errno));
+        port_set_err(err, errlen, "%s: cannot open '%s': %s", op, path, strerror(errno));
         return NULL;
     }
     if (fstat(fd, &st) != 0 || !S_ISREG(st.st_mode)) {
-        set_err(err, errlen, "%s: '%s' is not a regular file", op, path);
+        port_set_err(err, errlen, "%s: '%s' is not a regular file", op, path);
         close(fd);
         return NULL;
     }
     fcntl(fd, F_SETFL, fcntl(fd, F_GETFL) & ~O_NONBLOCK);
     f = fdopen(fd, "rb");
     if (f == NULL) {
-        set_err(err, errlen, "%s: cannot open '%s': %s", op, path, strerror(errno));
+        port_set_err(err, errlen, "%s: cannot open '%s': %s", op, path, strerror(errno));
         close(fd);
     }
     return f;
@@ -268,7 +258,7 @@ static int read_png(const char *path, uint8_t *buf, size_t cap, uint8_t **out, i
     if (out != NULL)
         *out = NULL;
     if (path == NULL || out == NULL) {
-        set_err(err, errlen, "%s: %s is NULL", op, path == NULL ? "path" : "out");
+        port_set_err(err, errlen, "%s: %s is NULL", op, path == NULL ? "path" : "out");
         return -1;
     }
     f = open_input(op, path, err, errlen);
@@ -276,7 +266,7 @@ static int read_png(const char *path, uint8_t *buf, size_t cap, uint8_t **out, i
         return -1;
     if (fread(sig, 1, sizeof sig, f) != sizeof sig || png_sig_cmp(sig, 0, sizeof sig) != 0) {
         fclose(f);
-        set_err(err, errlen, "%s: '%s' is not a PNG file (bad signature)", op, path);
+        port_set_err(err, errlen, "%s: '%s' is not a PNG file (bad signature)", op, path);
         return -1;
     }
 
@@ -287,7 +277,7 @@ static int read_png(const char *path, uint8_t *buf, size_t cap, uint8_t **out, i
     if (info == NULL) {
         png_destroy_read_struct(&png, NULL, NULL);
         fclose(f);
-        set_err(err, errlen, "%s: '%s': libpng could not set up (out of memory)", op, path);
+        port_set_err(err, errlen, "%s: '%s': libpng could not set up (out of memory)", op, path);
         return -1;
     }
     if (setjmp(png_jmpbuf(png))) {
@@ -295,7 +285,7 @@ static int read_png(const char *path, uint8_t *buf, size_t cap, uint8_t **out, i
         fclose(f);
         if (owned)
             free(pixels);
-        set_err(err, errlen, "%s: cannot decode '%s': %s", op, path, png_io_reason(&io));
+        port_set_err(err, errlen, "%s: cannot decode '%s': %s", op, path, png_io_reason(&io));
         return -1;
     }
     png_init_io(png, f);
@@ -326,7 +316,7 @@ static int read_png(const char *path, uint8_t *buf, size_t cap, uint8_t **out, i
     if (w > max_dim || h > max_dim) {
         png_destroy_read_struct(&png, &info, NULL);
         fclose(f);
-        set_err(err, errlen, "%s: '%s' is %lux%lu pixels, larger than the %lux%lu allowed", op, path,
+        port_set_err(err, errlen, "%s: '%s' is %lux%lu pixels, larger than the %lux%lu allowed", op, path,
                 (unsigned long)w, (unsigned long)h, (unsigned long)max_dim, (unsigned long)max_dim);
         return -1;
     }
@@ -336,7 +326,7 @@ static int read_png(const char *path, uint8_t *buf, size_t cap, uint8_t **out, i
     if (need > max_bytes) {
         png_destroy_read_struct(&png, &info, NULL);
         fclose(f);
-        set_err(err, errlen, "%s: '%s' is %lux%lu pixels: decoding needs %zu bytes, more than the %zu "
+        port_set_err(err, errlen, "%s: '%s' is %lux%lu pixels: decoding needs %zu bytes, more than the %zu "
                 "the memory budget allows", op, path, (unsigned long)w, (unsigned long)h, need, max_bytes);
         return -2;
     }
@@ -344,7 +334,7 @@ static int read_png(const char *path, uint8_t *buf, size_t cap, uint8_t **out, i
         if (cap < need) {
             png_destroy_read_struct(&png, &info, NULL);
             fclose(f);
-            set_err(err, errlen, "%s: '%s': buffer of %zu bytes given, the %lux%lu image needs %zu",
+            port_set_err(err, errlen, "%s: '%s': buffer of %zu bytes given, the %lux%lu image needs %zu",
                     op, path, cap, (unsigned long)w, (unsigned long)h, need);
             return -1;
         }
@@ -377,7 +367,7 @@ int image_read_png_max(const char *path, int max_dim, uint8_t **out, int *width,
     if (max_dim < 1 || max_dim > IMAGE_MAX_DIM) {
         if (out != NULL)
             *out = NULL;
-        set_err(err, errlen, "read_png: max_dim %d is not 1..%d", max_dim, IMAGE_MAX_DIM);
+        port_set_err(err, errlen, "read_png: max_dim %d is not 1..%d", max_dim, IMAGE_MAX_DIM);
         return -1;
     }
     return read_png(path, NULL, 0, out, width, height, (png_uint_32)max_dim, (size_t)-1, err, errlen);
@@ -389,7 +379,7 @@ int image_read_png_budget(const char *path, int max_dim, size_t max_bytes, uint8
     if (max_dim < 1 || max_dim > IMAGE_MAX_DIM) {
         if (out != NULL)
             *out = NULL;
-        set_err(err, errlen, "read_png: max_dim %d is not 1..%d", max_dim, IMAGE_MAX_DIM);
+        port_set_err(err, errlen, "read_png: max_dim %d is not 1..%d", max_dim, IMAGE_MAX_DIM);
         return -1;
     }
     return read_png(path, NULL, 0, out, width, height, (png_uint_32)max_dim, max_bytes, err, errlen);

@@ -6,13 +6,13 @@
 #include <errno.h>
 #include <fcntl.h>
 #include <limits.h>
-#include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <unistd.h>
 #include <sys/stat.h>
 
+#include "port.h"
 #include "safe_out.h"
 
 #define SAFE_OUT_BUF 65536
@@ -31,16 +31,6 @@ struct safe_out {
 
 /* The descriptor "-" writes to (standard output unless claimed). */
 static int stdout_fd = 1;
-
-static void set_err(char *err, size_t errlen, const char *fmt, ...)
-{
-    va_list ap;
-    if (err == NULL || errlen == 0)
-        return;
-    va_start(ap, fmt);
-    vsnprintf(err, errlen, fmt, ap);
-    va_end(ap);
-}
 
 void safe_out_claim_stdout(void)
 {
@@ -70,7 +60,7 @@ static int open_temp(safe_out *o, char *err, size_t errlen)
     int k;
     o->tmp = malloc(n);
     if (!o->tmp) {
-        set_err(err, errlen, "'%s': out of memory for the temporary file name", o->target);
+        port_set_err(err, errlen, "'%s': out of memory for the temporary file name", o->target);
         return -1;
     }
     for (k = 0; k < 1000; k++) {
@@ -80,7 +70,7 @@ static int open_temp(safe_out *o, char *err, size_t errlen)
             break;
     }
     if (o->fd < 0) {
-        set_err(err, errlen, "cannot create a temporary file for '%s' ('%s'): %s", o->target, o->tmp,
+        port_set_err(err, errlen, "cannot create a temporary file for '%s' ('%s'): %s", o->target, o->tmp,
                 strerror(errno));
         return -1;
     }
@@ -93,7 +83,7 @@ static int open_direct(safe_out *o, char *err, size_t errlen)
 {
     o->fd = open(o->target, O_WRONLY | O_NOCTTY);
     if (o->fd < 0) {
-        set_err(err, errlen, "cannot open '%s': %s", o->target, strerror(errno));
+        port_set_err(err, errlen, "cannot open '%s': %s", o->target, strerror(errno));
         return -1;
     }
     o->close_fd = 1;
@@ -113,12 +103,12 @@ safe_out *safe_out_open(const char *path, char *err, size_t errlen)
     struct stat st;
     int rc;
     if (!path || !*path) {
-        set_err(err, errlen, "empty output file name");
+        port_set_err(err, errlen, "empty output file name");
         return NULL;
     }
     o = calloc(1, sizeof *o);
     if (!o) {
-        set_err(err, errlen, "'%s': out of memory", path);
+        port_set_err(err, errlen, "'%s': out of memory", path);
         return NULL;
     }
     o->fd = -1;
@@ -134,7 +124,7 @@ safe_out *safe_out_open(const char *path, char *err, size_t errlen)
     if (lstat(path, &st) == 0 && S_ISLNK(st.st_mode)) {
         char *real = realpath(path, NULL);
         if (!real) {
-            set_err(err, errlen, "'%s' is a symbolic link to nowhere: %s", path, strerror(errno));
+            port_set_err(err, errlen, "'%s' is a symbolic link to nowhere: %s", path, strerror(errno));
             free_out(o);
             return NULL;
         }
@@ -143,12 +133,12 @@ safe_out *safe_out_open(const char *path, char *err, size_t errlen)
         o->target = dup_str(path);
     }
     if (!o->target) {
-        set_err(err, errlen, "'%s': out of memory", path);
+        port_set_err(err, errlen, "'%s': out of memory", path);
         free_out(o);
         return NULL;
     }
     if (stat(o->target, &st) == 0 && S_ISDIR(st.st_mode)) {
-        set_err(err, errlen, "'%s' is a directory", path);
+        port_set_err(err, errlen, "'%s' is a directory", path);
         free_out(o);
         return NULL;
     }
@@ -262,13 +252,13 @@ int safe_out_commit(safe_out **outs, size_t n, char *err, size_t errlen)
     for (i = 0; i < n && rc == 0; i++) {
         int e = finish_one(outs[i]);
         if (e) {
-            set_err(err, errlen, "cannot write '%s': %s", outs[i]->target, strerror(e));
+            port_set_err(err, errlen, "cannot write '%s': %s", outs[i]->target, strerror(e));
             rc = -1;
         }
     }
     for (i = 0; i < n && rc == 0; i++) {
         if (outs[i]->tmp && rename(outs[i]->tmp, outs[i]->target) != 0) {
-            set_err(err, errlen, "cannot rename '%s' to '%s': %s", outs[i]->tmp, outs[i]->target,
+            port_set_err(err, errlen, "cannot rename '%s' to '%s': %s", outs[i]->tmp, outs[i]->target,
                     strerror(errno));
             rc = -1;
             break;

@@ -101,8 +101,7 @@ static int parse_texel(const char *s, void *dst)
 static int parse_args(int argc, char **argv, render_args *a)
 {
     cli_view v;
-    cli_opt view[CLI_VIEW_NOPTS];
-    int exposure = 0, rc;
+    int rc;
     const cli_opt opts[] = {
         { "--eye", NULL, a->cam.eye, parse_vec3,
           "--eye '%s' is not X,Y,Z (finite, x and y within 1e7 m, z within 1e5 m)", 0, NULL, &a->have_eye, NULL },
@@ -110,21 +109,17 @@ static int parse_args(int argc, char **argv, render_args *a)
           "--target '%s' is not X,Y,Z (finite, x and y within 1e7 m, z within 1e5 m)", 0, NULL, &a->have_target, NULL },
         CLI_OPT_VAL("--backend", &a->osmesa, parse_backend, "--backend '%s' is not soft or osmesa"),
         { "--exposure", NULL, &a->opts.exposure, parse_exposure, "--exposure '%s' is not a number from 0 to 1e9", 0,
-          NULL, &exposure, NULL },
+          NULL, &v.exposure, NULL },
         CLI_OPT_VAL("--texel", &a->opts.aerial_m_per_texel, parse_texel,
                     "--texel '%s' is not a number of metres from 0.01 to 1e4"),
         CLI_OPT_STR("-o", &a->out),
         CLI_OPT_STR("--pfm", &a->pfm),
-        CLI_OPT_MORE(view),
+        CLI_OPT_MORE(v.frag),
         CLI_OPT_END
     };
     cli_args pa;
     memset(a, 0, sizeof *a);
-    plx_render_opts_default(&a->opts);
-    a->opts.auto_exposure = 1; /* until --exposure */
-    cli_indirect_default(&a->ind);
-    cli_view_init(&v, 640, 480, 60.0, &a->opts);
-    cli_view_opts(&v, view);
+    cli_view_init(&v, 640, 480, 60.0, &a->opts, &a->ind);
     rc = cli_options_n("render", help, argc, argv, opts, &a->c, &a->ind, 1, NULL, &pa);
     if (rc != EXIT_OK)
         return rc;
@@ -132,11 +127,9 @@ static int parse_args(int argc, char **argv, render_args *a)
     a->cam.fov_deg = v.fov;
     a->cam.width = (int32_t)v.size[0];
     a->cam.height = (int32_t)v.size[1];
-    cli_view_apply(&v, &a->opts);
+    cli_view_apply(&v, &a->ind, &a->opts);
     a->aerial = v.aerial;
     a->refine = v.refine;
-    if (exposure)
-        a->opts.auto_exposure = 0;
     if (!a->scene)
         return cli_usage_error("render", "missing SCENE");
     if (!a->out)
@@ -148,7 +141,6 @@ static int parse_args(int argc, char **argv, render_args *a)
     if (a->have_eye && a->cam.eye[0] == a->cam.target[0] && a->cam.eye[1] == a->cam.target[1] &&
         a->cam.eye[2] == a->cam.target[2])
         return cli_usage_error("render", "--eye and --target are the same point");
-    a->opts.no_indirect = a->ind.off;
     return EXIT_OK;
 }
 

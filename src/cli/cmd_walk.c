@@ -79,33 +79,28 @@ static int parse_max_frames(const char *val, void *dst)
 static int parse_args(int argc, char **argv, walk_args *a)
 {
     cli_view v;
-    cli_opt view[CLI_VIEW_NOPTS];
-    int exposure = 0, rc;
+    int rc;
     const cli_opt opts[] = {
         CLI_OPT_STR("--path", &a->path),
         CLI_OPT_STR("-o", &a->dir),
         CLI_OPT_VAL("--fps", &a->fps, parse_rate, "--fps '%s' is not a positive number"),
         CLI_OPT_VAL("--speed", &a->speed, parse_rate, "--speed '%s' is not a positive number"),
         { "--exposure", NULL, &a->opts.exposure, parse_exposure, "--exposure '%s' is not a number >= 0", 0, NULL,
-          &exposure, NULL },
+          &v.exposure, NULL },
         CLI_OPT_VAL("--refine-frames", &a->refine_frames, parse_refine_frames,
                     "--refine-frames '%s' is not a whole number >= 0"),
         CLI_OPT_VAL("--max-frames", &a->max_frames, parse_max_frames, "--max-frames '%s' is not a whole number >= 1"),
-        CLI_OPT_MORE(view),
+        CLI_OPT_MORE(v.frag),
         CLI_OPT_END
     };
     cli_args pa;
     memset(a, 0, sizeof *a);
-    plx_render_opts_default(&a->opts);
-    a->opts.auto_exposure = 1;
-    cli_indirect_default(&a->ind);
+    cli_view_init(&v, 640, 480, 60, &a->opts, &a->ind);
+    v.aa = 2;
     a->fps = 25;
     a->speed = 1.4;
     a->max_frames = 1000;
     a->refine_frames = 2;
-    a->opts.aa = 2;
-    cli_view_init(&v, 640, 480, 60, &a->opts);
-    cli_view_opts(&v, view);
     rc = cli_options_n("walk", help, argc, argv, opts, &a->c, &a->ind, 1, NULL, &pa);
     if (rc != EXIT_OK)
         return rc;
@@ -113,18 +108,15 @@ static int parse_args(int argc, char **argv, walk_args *a)
     a->w = (int)v.size[0];
     a->h = (int)v.size[1];
     a->fov = v.fov;
-    cli_view_apply(&v, &a->opts);
+    cli_view_apply(&v, &a->ind, &a->opts);
     a->aerial = v.aerial;
     a->refine = v.refine;
-    if (exposure)
-        a->opts.auto_exposure = 0;
     if (!a->scene)
         return cli_usage_error("walk", "missing SCENE");
     if (!a->path)
         return cli_usage_error("walk", "missing --path CAMERA.geojson");
     if (!a->dir)
         return cli_usage_error("walk", "missing -o DIR");
-    a->opts.no_indirect = a->ind.off;
     return EXIT_OK;
 }
 

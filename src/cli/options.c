@@ -144,24 +144,7 @@ static int parse_view(const char *v, void *dst)
     return 0;
 }
 
-void cli_view_init(cli_view *v, long w, long h, double fov, const plx_render_opts *o)
-{
-    memset(v, 0, sizeof *v);
-    v->size[0] = w;
-    v->size[1] = h;
-    v->fov = fov;
-    v->aa = o->aa;
-    v->no_glow = o->no_glow;
-}
-
-void cli_view_apply(const cli_view *v, plx_render_opts *o)
-{
-    o->aa = (int)v->aa;
-    o->no_glow = v->no_glow;
-    o->aerial = v->aerial;
-}
-
-void cli_view_opts(cli_view *v, cli_opt *frag)
+static void view_opts(cli_view *v)
 {
     const cli_opt f[CLI_VIEW_NOPTS] = {
         CLI_OPT_VAL("--size", v->size, cli_opt_size, "--size '%s' is not WxH (1..8192 each)"),
@@ -173,5 +156,29 @@ void cli_view_opts(cli_view *v, cli_opt *frag)
         CLI_OPT_FLAG("--refine", &v->refine),
         CLI_OPT_END
     };
-    memcpy(frag, f, sizeof f);
+    memcpy(v->frag, f, sizeof f);
+}
+
+void cli_view_init(cli_view *v, long w, long h, double fov, plx_render_opts *o, cli_indirect *ind)
+{
+    plx_render_opts_default(o);
+    o->auto_exposure = 1; /* until --exposure */
+    cli_indirect_default(ind);
+    memset(v, 0, sizeof *v);
+    v->size[0] = w;
+    v->size[1] = h;
+    v->fov = fov;
+    v->aa = o->aa;
+    v->no_glow = o->no_glow;
+    view_opts(v);
+}
+
+void cli_view_apply(const cli_view *v, const cli_indirect *ind, plx_render_opts *o)
+{
+    o->aa = (int)v->aa;
+    o->no_glow = v->no_glow;
+    o->aerial = v->aerial;
+    if (v->exposure)
+        o->auto_exposure = 0;
+    o->no_indirect = ind->off;
 }

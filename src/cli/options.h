@@ -70,25 +70,28 @@ int cli_opt_size(const char *value, void *dst);
 
 /* ---- the view options of render and walk ---------------------------------- */
 
+#define CLI_VIEW_NOPTS 7
+
 typedef struct cli_view {
     long size[2];           /* --size WxH (1..8192 each) */
     double fov;             /* --fov (0..180 degrees) */
     long aa;                /* --aa (1..PLX_RENDER_MAX_AA) */
     int aerial;             /* --view street|aerial */
     int no_glow, refine;    /* --no-glow, --refine */
+    int exposure;           /* --exposure was given (the command's own table
+                             * entry sets it): no automatic exposure */
+    cli_opt frag[CLI_VIEW_NOPTS]; /* the options above (the last entry
+                             * CLI_OPT_END), for CLI_OPT_MORE(v.frag) */
 } cli_view;
 
-#define CLI_VIEW_NOPTS 7
+/* The defaults of render and walk: o the default render options with
+ * automatic exposure (until --exposure), ind the default indirect light;
+ * v w x h pixels, fov degrees, o's anti-aliasing and glow, the street view,
+ * no refinement, and its options in v->frag. */
+void cli_view_init(cli_view *v, long w, long h, double fov, plx_render_opts *o, cli_indirect *ind);
 
-/* Defaults: w x h pixels, fov degrees, o's anti-aliasing and glow, the
- * street view, no refinement. */
-void cli_view_init(cli_view *v, long w, long h, double fov, const plx_render_opts *o);
-
-/* Fills frag (CLI_VIEW_NOPTS entries, the last CLI_OPT_END) with the view
- * options writing into v, for a table to link with CLI_OPT_MORE(frag). */
-void cli_view_opts(cli_view *v, cli_opt *frag);
-
-/* After parsing: the anti-aliasing, glow and view into o. */
-void cli_view_apply(const cli_view *v, plx_render_opts *o);
+/* After parsing: the anti-aliasing, glow, view, exposure and --no-indirect
+ * into o. */
+void cli_view_apply(const cli_view *v, const cli_indirect *ind, plx_render_opts *o);
 
 #endif

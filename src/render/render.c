@@ -254,12 +254,7 @@ plx_status render_create(arena *a, const scene *s, int32_t max_w, int32_t max_h,
         cv.u = (uint32_t)k << 16;
         r->lut[k] = render_srgb8(r, (double)cv.f);
     }
-    r->soft.name = "soft";
-    r->soft.user = r;
-    r->soft.begin = soft_begin;
-    r->soft.draw = soft_draw;
-    r->soft.finish = soft_finish;
-    r->err = "";
+    render_code_bind(r, shade);
     *out = r;
     return PLX_OK;
 }
@@ -1161,6 +1156,19 @@ static void tile_warm(render *r, const render_opts *o, int32_t ti, int32_t tj)
     }
 }
 
+/* fn on each tile, row after row; with defer (tw tiles a row), only on the
+ * tiles marked in it. */
+typedef void (*tile_fn)(render *r, const render_opts *o, int32_t ti, int32_t tj);
+
+static void each_tile(render *r, const render_opts *o, tile_fn fn, const uint8_t *defer, int32_t tw)
+{
+    int32_t ti, tj;
+    for (tj = 0; tj < r->h; tj += RENDER_TILE)
+        for (ti = 0; ti < r->w; ti += RENDER_TILE)
+            if (!defer || defer[(size_t)(tj / RENDER_TILE) * (size_t)tw + (size_t)(ti / RENDER_TILE)])
+                fn(r, o, ti, tj);
+}
+
 typedef struct shade_job {
     render *r;
     const render_opts *o;
@@ -1211,13 +1219,10 @@ static int shade_workers(const render *r, const render_opts *o)
 static void shade_pass(render *r, const render_opts *o, render_stats *st)
 {
     int nw = shade_workers(r, o), k;
-    int32_t ti, tj;
     for (k = 0; k < nw; k++)
         memset(&r->ws[k].st, 0, sizeof r->ws[k].st);
     if (nw == 1) {
-        for (tj = 0; tj < r->h; tj += RENDER_TILE)
-            for (ti = 0; ti < r->w; ti += RENDER_TILE)
-                tile_serial(r, o, ti, tj);
+        each_tile(r, o, tile_serial, NULL, 0);
     } else {
         shade_job jb;
         uint32_t rows = (uint32_t)((r->h + RENDER_TILE - 1) / RENDER_TILE), row;
@@ -1225,16 +1230,11 @@ static void shade_pass(render *r, const render_opts *o, render_stats *st)
         jb.o = o;
         jb.defer = r->defer;
         jb.tw = (r->w + RENDER_TILE - 1) / RENDER_TILE;
-        for (tj = 0; tj < r->h; tj += RENDER_TILE)
-            for (ti = 0; ti < r->w; ti += RENDER_TILE)
-                tile_warm(r, o, ti, tj);
+        each_tile(r, o, tile_warm, NULL, 0);
         if (o->par(o->par_ctx, nw, rows, shade_row, &jb) != 0)
             for (row = 0; row < rows; row++)
                 shade_row(&jb, 0, row);
-        for (tj = 0; tj < r->h; tj += RENDER_TILE)
-            for (ti = 0; ti < r->w; ti += RENDER_TILE)
-                if (r->defer[(size_t)(tj / RENDER_TILE) * (size_t)jb.tw + (size_t)(ti / RENDER_TILE)])
-                    tile_serial(r, o, ti, tj);
+        each_tile(r, o, tile_serial, r->defer, jb.tw);
     }
     for (k = 0; k < nw; k++) {
         const render_stats *ws = &r->ws[k].st;

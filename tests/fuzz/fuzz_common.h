@@ -12,16 +12,9 @@
 #include <string.h>
 
 #include "polarlux.h"
+#include "fuzz_check.h"
 
 #define FUZZ_MEM (256u << 20)
-
-#define CHECK(cond)                                                                      \
-    do {                                                                                 \
-        if (!(cond)) {                                                                   \
-            fprintf(stderr, "FUZZ CHECK failed at %s:%d: %s\n", __FILE__, __LINE__, #cond); \
-            abort();                                                                     \
-        }                                                                                \
-    } while (0)
 
 typedef struct fuzz_log {
     uint32_t lines;

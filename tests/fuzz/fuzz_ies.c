@@ -18,7 +18,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
         return 0;
     }
     buf = malloc(sizeof head - 1 + size + 1);
-    PCHECK(buf != NULL);
+    CHECK(buf != NULL);
     memcpy(buf, head, sizeof head - 1);
     if (size)
         memcpy(buf + sizeof head - 1, data, size);

@@ -12,14 +12,7 @@
 #include <string.h>
 
 #include "scene/photometry.h"
-
-#define PCHECK(cond)                                                                     \
-    do {                                                                                 \
-        if (!(cond)) {                                                                   \
-            fprintf(stderr, "FUZZ CHECK failed at %s:%d: %s\n", __FILE__, __LINE__, #cond); \
-            abort();                                                                     \
-        }                                                                                \
-    } while (0)
+#include "fuzz_check.h"
 
 static void fuzz_photometry(const char *text, size_t len)
 {
@@ -32,28 +25,28 @@ static void fuzz_photometry(const char *text, size_t len)
     int i, j;
     if (!mem) {
         mem = malloc(64u << 20);
-        PCHECK(mem != NULL);
+        CHECK(mem != NULL);
         arena_init(&a, mem, 64u << 20);
     }
     m = arena_get_mark(&a);
     st = photometry_parse(&a, PLX_PART_SCENE, text, len, "fuzz.ies", &p, err, sizeof err);
     if (st != PLX_OK) {
-        PCHECK(st == PLX_E_PARSE || st == PLX_E_NOMEM);
-        PCHECK(p == NULL);
-        PCHECK(strncmp(err, "fuzz.ies: ", 10) == 0 && strchr(err, '\n') == NULL);
-        PCHECK(a.lo == m.lo && a.hi == m.hi);
+        CHECK(st == PLX_E_PARSE || st == PLX_E_NOMEM);
+        CHECK(p == NULL);
+        CHECK(strncmp(err, "fuzz.ies: ", 10) == 0 && strchr(err, '\n') == NULL);
+        CHECK(a.lo == m.lo && a.hi == m.hi);
         return;
     }
-    PCHECK(p && p->ng >= 1 && p->nc >= 1 && p->nrows >= 1);
-    PCHECK(isfinite(p->peak) && p->peak >= 0.0);
-    PCHECK(isfinite(p->flux) && p->flux >= 0.0);
-    PCHECK(p->flux <= 4.0 * 3.14159265358979323846 * p->peak * (1.0 + 1e-9) + 1e-300);
+    CHECK(p && p->ng >= 1 && p->nc >= 1 && p->nrows >= 1);
+    CHECK(isfinite(p->peak) && p->peak >= 0.0);
+    CHECK(isfinite(p->flux) && p->flux >= 0.0);
+    CHECK(p->flux <= 4.0 * 3.14159265358979323846 * p->peak * (1.0 + 1e-9) + 1e-300);
     for (i = 0; i < (int)p->nc; i++)
-        PCHECK(p->c[i] >= 0.0 && p->c[i] < 360.0 && (i == 0 || p->c[i] > p->c[i - 1]) && p->row[i] < p->nrows);
+        CHECK(p->c[i] >= 0.0 && p->c[i] < 360.0 && (i == 0 || p->c[i] > p->c[i - 1]) && p->row[i] < p->nrows);
     for (i = -2; i <= 38; i++)
         for (j = -1; j <= 19; j++) {
             double v = photometry_at(p, i * 10.3 - 7.0, j * 9.7);
-            PCHECK(isfinite(v) && v >= 0.0 && v <= p->peak * (1.0 + 1e-12));
+            CHECK(isfinite(v) && v >= 0.0 && v <= p->peak * (1.0 + 1e-12));
         }
     arena_release(&a, &m);
 }

@@ -77,6 +77,21 @@ static inline void fixture_done(plx_engine *e, void *mem)
     free(mem);
 }
 
+/* An engine from plx_engine_new (a block of 'bytes'; free it with
+ * plx_engine_free) through the POSIX port without its log, holding the
+ * scene of the file path, or when path is NULL of text (len bytes, named
+ * "gen" in messages). */
+static inline plx_engine *fixture_new(size_t bytes, const char *path, const char *text, size_t len)
+{
+    plx_engine *e;
+    plx_config cfg;
+    plx_config_default(&cfg);
+    cfg.port = fixture_quiet_port();
+    assert_int_equal(plx_engine_new(bytes, &cfg, &e), PLX_OK);
+    assert_int_equal(path ? plx_load_file(e, path) : plx_load_geojson(e, text, len, "gen"), PLX_OK);
+    return e;
+}
+
 /* ---- an engine with a log book ------------------------------------------ */
 
 /* The engine's messages: how many, the warnings among them, the last

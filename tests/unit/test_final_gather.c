@@ -38,6 +38,7 @@
 #include "photon/final_gather.h"
 #include "ref_scene.h"
 #include "ref_indirect.h"
+#include "fixture.h"
 
 #define PI 3.14159265358979323846
 
@@ -225,16 +226,7 @@ static void test_energy_closed_room(void **state)
 
 static plx_engine *engine_on(const char *path, const char *text, size_t len)
 {
-    plx_engine *e;
-    plx_config cfg;
-    static plx_port port;
-    port = *plx_port_posix();
-    port.log = NULL;
-    plx_config_default(&cfg);
-    cfg.port = &port;
-    assert_int_equal(plx_engine_new((size_t)1 << 30, &cfg, &e), PLX_OK);
-    assert_int_equal(path ? plx_load_file(e, path) : plx_load_geojson(e, text, len, "gen"),
-                     PLX_OK);
+    plx_engine *e = fixture_new((size_t)1 << 30, path, text, len);
     assert_int_equal(eng_need(e, ENG_LIGHT, "test"), PLX_OK);
     return e;
 }

@@ -34,6 +34,7 @@
 #include "photon/indirect.h"
 #include "photon/irradiance_cache.h"
 #include "ref_indirect.h"
+#include "fixture.h"
 
 #define PI 3.14159265358979323846
 #define W 320
@@ -43,20 +44,6 @@ static int quick_mode(void)
 {
     const char *v = getenv("PLX_TEST_QUICK");
     return v && v[0] && v[0] != '0';
-}
-
-static plx_engine *engine_on(const char *path)
-{
-    plx_engine *e;
-    plx_config cfg;
-    static plx_port port;
-    port = *plx_port_posix();
-    port.log = NULL;
-    plx_config_default(&cfg);
-    cfg.port = &port;
-    assert_int_equal(plx_engine_new((size_t)1 << 30, &cfg, &e), PLX_OK);
-    assert_int_equal(plx_load_file(e, path), PLX_OK);
-    return e;
 }
 
 static void camera(plx_camera *c)
@@ -163,7 +150,7 @@ static int sample_pixels(plx_engine *e, const plx_camera *c, int step, int maxn,
 
 static void test_image_accuracy(void **state)
 {
-    plx_engine *e = engine_on("fixtures/eixample-4x4.geojson");
+    plx_engine *e = fixture_new((size_t)1 << 30, "fixtures/eixample-4x4.geojson", NULL, 0);
     float *with = malloc(sizeof *with * 3 * W * H), *without = malloc(sizeof *with * 3 * W * H);
     int step = quick_mode() ? 20 : 8, paths = quick_mode() ? 4000 : 40000;
     int maxn = quick_mode() ? 10 : 60, seeds = quick_mode() ? 1 : 6, px[60], n, k, sd, walls = 0;
@@ -213,8 +200,8 @@ static void test_image_accuracy(void **state)
  * in a fresh engine. */
 static void test_image_same_bytes(void **state)
 {
-    plx_engine *e1 = engine_on("fixtures/eixample-4x4.geojson");
-    plx_engine *e2 = engine_on("fixtures/eixample-4x4.geojson");
+    plx_engine *e1 = fixture_new((size_t)1 << 30, "fixtures/eixample-4x4.geojson", NULL, 0);
+    plx_engine *e2 = fixture_new((size_t)1 << 30, "fixtures/eixample-4x4.geojson", NULL, 0);
     uint8_t *a = malloc(3 * W * H), *b = malloc(3 * W * H);
     plx_render_opts o;
     plx_camera c, other;
