@@ -92,7 +92,31 @@ typedef struct layer_worker {
     plx_engine *e;
     icache *ic;
     light *lt;
+    arena mem;   /* the worker's own (workers > 0): its light computes regions in its scratch */
 } layer_worker;
+
+/* Bytes of a worker's arena: its light object (grids and a region cache
+ * like the engine's), its cache's table, and scratch for computing a
+ * region as large as the cache holds (litregion.c writes its output into
+ * the free room, then keeps what fits the cache). */
+static size_t layer_worker_bytes(const plx_engine *e)
+{
+    return light_base_bytes(e->sc) + 2 * e->lt->pool_cap + icache_bytes() + ((size_t)8 << 20);
+}
+
+/* Worker k's arena, cache and light object, from the engine's block. */
+static int layer_worker_new(plx_engine *e, layer_worker *w)
+{
+    size_t bytes = layer_worker_bytes(e);
+    void *mem = arena_alloc(&e->mem, PLX_PART_LIT, bytes, 64);
+    w->e = e;
+    if (!mem)
+        return -1;
+    arena_init(&w->mem, mem, bytes);
+    if (icache_create(&w->mem, &w->ic) != PLX_OK || light_create(&w->mem, e->sc, e->lt->pool_cap, &w->lt) != PLX_OK)
+        return -1;
+    return 0;
+}
 
 /* The aerial light map's indirect layer (render_lightmap_fill_ind): the
  * irradiance cache at the topmost surface over (x, y), ground or roof, on
@@ -195,13 +219,11 @@ void eng_lightmap_layer(plx_engine *e)
     w[0].e = e;
     w[0].ic = e->ic;
     w[0].lt = e->lt;
-    for (k = 1; k < n; k++) {
-        w[k].e = e;
-        if (icache_create(&e->mem, &w[k].ic) != PLX_OK ||
-            light_create(&e->mem, e->sc, e->lt->pool_cap, &w[k].lt) != PLX_OK)
+    for (k = 1; k < n; k++)
+        if (layer_worker_new(e, &w[k]) != 0)
             break;
-    }
     n = k;
+    e->layer_workers = n;
     for (k = 0; k < n; k++) {
         icache_set_spacing(w[k].ic, ICACHE_AERIAL);
         users[k] = &w[k];

@@ -32,6 +32,7 @@ struct plx_engine {
     uint32_t ph_reductions; /* quality steps taken to fit it (need.c) */
     struct icache *ic;      /* images' irradiance cache, created with the photon buffers */
     double lightmap_cell;   /* light map texel size when built, else 0 */
+    int layer_workers;      /* workers that gathered the map's indirect layer last (eng_lightmap_layer) */
     uint64_t indirect_gen;  /* +1 at every change of the photon buffers (the indirect map's key) */
     float *aa_sum;          /* anti-aliasing sum (PLX_PART_FRAME), taken on first need */
     uint32_t gather_side;   /* final gathering at points: side^2 directions
