@@ -833,8 +833,12 @@ plx_status plx_bake_prepare(plx_engine *e, const plx_bake_opts *o);
  * frames; the words that differ between the two by exactly the distance of
  * their blocks are the pointers, saved as offsets. Both blocks must have
  * the same address modulo 64, and be zero-filled when the engines were
- * created (padding and never-written bytes are saved too). Errors: PLX_E_INVALID (no twin of the same
- * layout, buffer too small), PLX_E_NOSCENE.
+ * created (padding and never-written bytes are saved too). With an aerial
+ * map and photon frames, the first of these calls gathers the map's
+ * indirect layer (on plx_config.threads workers; the bulk of a large
+ * city's bake), so the loaded engine's aerial frames gather nothing.
+ * Errors: PLX_E_INVALID (no twin of the same layout, buffer too small),
+ * PLX_E_NOSCENE.
  */
 plx_status plx_bake_size(plx_engine *e, plx_engine *twin, size_t *bytes /* OUT */);
 plx_status plx_bake_save(plx_engine *e, plx_engine *twin, void *buf, size_t cap,
