@@ -69,6 +69,19 @@ static int merge_group(scene_lamp *l, const uint32_t *order, uint32_t i0, uint32
     return 0;
 }
 
+/* "N lamps at one spot (x, y, z)" */
+static void spot_words(strbuf *b, const scene_lamp *m, uint32_t n)
+{
+    sb_uint(b, n);
+    sb_str(b, " lamps at one spot (");
+    sb_num(b, m->x, 10);
+    sb_str(b, ", ");
+    sb_num(b, m->y, 10);
+    sb_str(b, ", ");
+    sb_num(b, m->z, 10);
+    sb_str(b, ")");
+}
+
 /* A group whose intensities overflow: a bad feature (the first lamp's);
  * without --strict every lamp of the group is dropped. */
 static plx_status drop_group(loader *ld, scene *s, const uint32_t *order, uint32_t i0, uint32_t i1, uint8_t *gone)
@@ -79,14 +92,8 @@ static plx_status drop_group(loader *ld, scene *s, const uint32_t *order, uint32
     uint32_t i;
     plx_status st;
     sb_init(&b, why, sizeof why);
-    sb_uint(&b, i1 - i0);
-    sb_str(&b, " lamps at one spot (");
-    sb_num(&b, m->x, 10);
-    sb_str(&b, ", ");
-    sb_num(&b, m->y, 10);
-    sb_str(&b, ", ");
-    sb_num(&b, m->z, 10);
-    sb_str(&b, "): their intensities add up beyond the largest number; the lamps are dropped");
+    spot_words(&b, m, i1 - i0);
+    sb_str(&b, ": their intensities add up beyond the largest number; the lamps are dropped");
     st = ld_bad_feature(ld, m->feature, m->id, why);
     if (st != PLX_OK)
         return st;
@@ -101,14 +108,8 @@ static void warn_group(loader *ld, const scene_lamp *m, uint32_t n)
     char why[200];
     strbuf b;
     sb_init(&b, why, sizeof why);
-    sb_uint(&b, n);
-    sb_str(&b, " lamps at one spot (");
-    sb_num(&b, m->x, 10);
-    sb_str(&b, ", ");
-    sb_num(&b, m->y, 10);
-    sb_str(&b, ", ");
-    sb_num(&b, m->z, 10);
-    sb_str(&b, ") merged into this one: ");
+    spot_words(&b, m, n);
+    sb_str(&b, " merged into this one: ");
     sb_num(&b, m->intensity, 10);
     sb_str(&b, " cd");
     ld_warn(ld, m->feature, m->id, why);
