@@ -666,6 +666,10 @@ typedef struct plx_render_info {
     double drawn_fraction;      /* triangles drawn / triangles of the scene */
     uint64_t shaded_pixels;
     double exposure;            /* the exposure applied (the chosen one with auto_exposure) */
+    uint64_t indirect_lookups;  /* points whose indirect light was looked up (the irradiance
+                                   cache or the photon buffers), all --aa passes together;
+                                   street frames that gather ask only the corners of 4x4
+                                   blocks on one surface and the pixels the blocks leave */
 } plx_render_info;
 
 /*

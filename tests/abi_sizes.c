@@ -129,6 +129,7 @@ static void render_info(void)
     FIELD(plx_render_info, drawn_fraction);
     FIELD(plx_render_info, shaded_pixels);
     FIELD(plx_render_info, exposure);
+    FIELD(plx_render_info, indirect_lookups);
 }
 
 static void scene_size(void)

@@ -29,6 +29,7 @@
 #include "light/light.h"
 #include "light/litregion.h"
 #include "photon/photon.h"
+#include "photon/irradiance_cache.h"
 #include "polar/polar.h"
 #include "render/render.h"
 
@@ -118,7 +119,9 @@ static uint32_t layout_print(void)
     const size_t sz[] = { sizeof(struct plx_engine), sizeof(scene), sizeof(scene_building),
                           sizeof(scene_lamp), sizeof(light), sizeof(lit_region), sizeof(photon_sys),
                           sizeof(photon_config), sizeof(photon_lamp_slot), sizeof(arena),
-                          sizeof(plx_config), sizeof(render_opts), PLX_PART_COUNT };
+                          sizeof(plx_config), sizeof(render_opts), render_struct_bytes(),
+                          sizeof(render_stats), sizeof(icache), sizeof(polar), sizeof(polar_trap),
+                          PLX_PART_COUNT };
     uint64_t h = FNV_BASIS;
     size_t i;
     for (i = 0; i < sizeof sz / sizeof sz[0]; i++)

@@ -250,6 +250,7 @@ static plx_status render_aa(plx_engine *e, const render_camera *rc, render_opts 
     size_t px = (size_t)rc->width * (size_t)rc->height, p, maxpx;
     double ex = 1.0, inv = 1.0 / ((double)n * n);
     plx_status st = PLX_OK;
+    uint64_t lookups = 0;
     int a, b;
     if (rc->width < 1 || rc->height < 1)
         px = 0;
@@ -268,6 +269,7 @@ static plx_status render_aa(plx_engine *e, const render_camera *rc, render_opts 
             st = render_frame(e->rd, rc, ro, NULL, NULL, rs);
             if (st != PLX_OK)
                 break;
+            lookups += rs->indirect_calls;
             lin = render_linear(e->rd);
             if (a == 0 && b == 0) {
                 ex = rs->exposure;
@@ -286,6 +288,7 @@ static plx_status render_aa(plx_engine *e, const render_camera *rc, render_opts 
     if (rgb8)
         render_tonemap(e->rd, e->aa_sum, px, ex, ro->auto_exposure, rgb8);
     rs->exposure = ex;
+    rs->indirect_calls = lookups;
     return PLX_OK;
 }
 
@@ -382,6 +385,7 @@ plx_status plx_render(plx_engine *e, const plx_camera *cam, const plx_render_opt
         info->drawn_fraction = rs.drawn_fraction;
         info->shaded_pixels = rs.shader_calls;
         info->exposure = rs.exposure;
+        info->indirect_lookups = rs.indirect_calls;
     }
     eng_clear_error(e);
     return PLX_OK;

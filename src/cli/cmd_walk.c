@@ -149,7 +149,7 @@ static int contact_sheet(const walk_args *a, uint8_t *const *thumbs, int nthumb,
                         (uint8_t)((sum + (unsigned)(f * f) / 2) / (unsigned)(f * f));
                 }
     snprintf(path, sizeof path, "%s/contact.png", a->dir);
-    rc = image_write_png_rgb8(path, W, H, sheet, 0, err, errlen);
+    rc = image_write_png_rgb8_fast(path, W, H, sheet, 0, err, errlen);
     free(sheet);
     return rc;
 }
@@ -190,6 +190,7 @@ typedef struct walk_run {
     FILE *cams;
     plx_refine_stats rs;
     double refine_ms;
+    uint64_t lookups;          /* indirect lookups, all frames */
 } walk_run;
 
 static int frame(const walk_args *a, plx_engine *e, const walk_path *wp, walk_run *wr, long k, double step)
@@ -215,6 +216,7 @@ static int frame(const walk_args *a, plx_engine *e, const walk_path *wp, walk_ru
     t0 = port_now_ns();
     st = plx_render(e, &cam, &a->opts, wr->rgb8, NULL, &info);
     wr->ms[k] = (port_now_ns() - t0) / 1e6;
+    wr->lookups += info.indirect_lookups;
     if (st != PLX_OK) {
         fprintf(stderr, "polarlux walk: frame %ld at (%.2f, %.2f, %.2f): %s\n", k + 1, cam.eye[0], cam.eye[1],
                 cam.eye[2], plx_last_error(e));
@@ -281,6 +283,9 @@ static int run(const walk_args *a, plx_engine *e, const walk_path *wp)
                L, a->speed, a->fps, a->opts.aa > 1 ? a->opts.aa : 1, a->dir);
         printf("frame time: median %.2f ms, p95 %.2f ms, mean %.2f ms: %.1f frames per second (rendering only)\n",
                med, p95, sum / wr.n, 1000.0 * wr.n / sum);
+        if (wr.lookups)
+            printf("indirect light: %.0f lookups a frame on average, for %.0f samples\n",
+                   (double)wr.lookups / wr.n, (double)a->w * a->h * (a->opts.aa > 1 ? a->opts.aa * a->opts.aa : 1));
         if (a->refine && !a->ind.off)
             printf("refinement: %llu hits, %llu misses, %llu evictions, %llu lamps refined (%u slots, %.0f m); "
                    "%.1f ms in all (floor maps and refill frames)\n", (unsigned long long)wr.rs.hits,

@@ -871,7 +871,7 @@ typedef struct tile_state {
     uint32_t wall;              /* the one wall of the tile's wall pixels, if one */
     int ncall, nground, nl;
     uint64_t sure_g, sure_w;
-    uint64_t sky, ground, building, calls, tiled, skipped;
+    uint64_t sky, ground, building, calls, tiled, skipped, icalls;
 } tile_state;
 
 /* E_rgb at P from the tile's lamp list (the light shader's value); lamps
@@ -1012,7 +1012,7 @@ static void tile_points(render *r, shade_ws *w, const render_opts *o, tile_state
     t->ncall = t->nground = 0;
     t->nl = -1;
     t->sure_g = t->sure_w = 0;
-    t->sky = t->ground = t->building = t->calls = t->tiled = t->skipped = 0;
+    t->sky = t->ground = t->building = t->calls = t->tiled = t->skipped = t->icalls = 0;
     for (j = t->tj; j < t->j1; j++) {
         for (i = t->ti; i < t->i1; i++, q++) {
             size_t p = (size_t)j * (size_t)r->w + (size_t)i;
@@ -1166,7 +1166,7 @@ static int corner_used(const render *r, int32_t a, int32_t b)
 
 /* Before the shading pass: ground ids, the one-surface blocks and the
  * hook's value at their corners. */
-static void sparse_corners(render *r, const render_opts *o)
+static void sparse_corners(render *r, const render_opts *o, render_stats *st)
 {
     int32_t a, b, i, j;
     double P[3], n[3], Ei[3];
@@ -1179,8 +1179,12 @@ static void sparse_corners(render *r, const render_opts *o)
                 (void)pixel_hit(r, i, j, &sid, P, n); /* the ground: its id */
     for (b = 0; b < r->nby; b++)
         for (a = 0; a < r->nbx; a++)
+        {
             r->blk[(size_t)b * (size_t)r->nbx + (size_t)a] =
                 (uint8_t)block_one_surface(r, a, b, o->indirect_span);
+            st->indirect_blocks += r->blk[(size_t)b * (size_t)r->nbx + (size_t)a];
+        }
+    st->indirect_nblocks = (uint64_t)r->nbx * (uint64_t)r->nby;
     for (b = 0; b <= r->nby; b++)
         for (a = 0; a <= r->nbx; a++) {
             float *c = &r->ind[3 * ((size_t)b * (size_t)(r->nbx + 1) + (size_t)a)];
@@ -1189,6 +1193,7 @@ static void sparse_corners(render *r, const render_opts *o)
                 continue;
             Ei[0] = Ei[1] = Ei[2] = 0.0;
             o->indirect(o->indirect_user, P, n, Ei);
+            st->indirect_calls++;
             for (k = 0; k < 3; k++)
                 c[k] = (float)Ei[k];
         }
@@ -1217,7 +1222,7 @@ static void sparse_at(const render *r, int32_t i, int32_t j, double E[3])
 }
 
 /* After the shading pass: the pixels of the other blocks ask the hook. */
-static void sparse_rest(render *r, const render_opts *o)
+static void sparse_rest(render *r, const render_opts *o, render_stats *st)
 {
     int32_t i, j;
     for (j = 0; j < r->h; j++)
@@ -1231,6 +1236,7 @@ static void sparse_rest(render *r, const render_opts *o)
                 !pixel_hit(r, i, j, &sid, P, n))
                 continue;
             o->indirect(o->indirect_user, P, n, Ei);
+            st->indirect_calls++;
             if (sid == MESH_SURF_GROUND)
                 scene_ground_albedo(r->s, P[0], P[1], alb);
             else
@@ -1274,6 +1280,7 @@ static int tile_shade(render *r, shade_ws *w, const render_opts *o, tile_state *
             } else if (o->indirect) {
                 double Ei[3] = { 0, 0, 0 };
                 o->indirect(o->indirect_user, w->tP[q], w->tN[q], Ei);
+                t->icalls++;
                 for (k = 0; k < 3; k++)
                     E[k] += Ei[k];
             }
@@ -1306,6 +1313,7 @@ static void tile_count(render_stats *st, const tile_state *t)
     st->shader_calls += t->calls;
     st->shader_tiled += t->tiled;
     st->visibility_skipped += t->skipped;
+    st->indirect_calls += t->icalls;
 }
 
 /* A whole tile on the calling thread, as one thread does it. */
@@ -1426,6 +1434,7 @@ static void shade_pass(render *r, const render_opts *o, render_stats *st)
         st->shader_calls += ws->shader_calls;
         st->shader_tiled += ws->shader_tiled;
         st->visibility_skipped += ws->visibility_skipped;
+        st->indirect_calls += ws->indirect_calls;
     }
 }
 
@@ -1561,10 +1570,10 @@ plx_status render_frame(render *r, const render_camera *cam, const render_opts *
                            o->indirect_far || o->indirect_mt ? o->par : NULL, o->par_ctx, o->workers);
     r->sparse = o->indirect && o->indirect_sparse && !o->lightmap && o->indirect_span > 0.0;
     if (r->sparse)
-        sparse_corners(r, o);
+        sparse_corners(r, o, &st);
     shade_pass(r, o, &st);
     if (r->sparse)
-        sparse_rest(r, o);
+        sparse_rest(r, o, &st);
     /* the exposure from the lit surfaces, before the glows */
     st.exposure = o->auto_exposure ? exposure_auto(r->lin, r->id, px) : o->exposure;
     if (!o->no_glow)

@@ -298,6 +298,9 @@ typedef struct render_stats {
     uint64_t shader_tiled;     /* of which answered from a tile's lamp list */
     uint64_t visibility_skipped; /* lamp visibility known from the tile (no query) */
     uint64_t ground_pixels, building_pixels, sky_pixels;
+    uint64_t indirect_calls;   /* calls of the indirect hook (sparse: corners and the pixels left) */
+    uint64_t indirect_blocks;  /* sparse: blocks interpolated, of */
+    uint64_t indirect_nblocks; /* the frame's blocks */
     uint32_t glows;            /* lamp discs drawn */
     int eye_inside;            /* the eye is inside a solid */
     double exposure;           /* the exposure applied (chosen when auto_exposure) */
