@@ -288,8 +288,8 @@ static void test_map_peak(void **state)
     assert_int_equal(plx_gen_city("eixample", n, n, 1, grow_write, &g), PLX_OK);
     assert_int_equal(plx_scene_size_scan(g.buf, g.len, &sz), PLX_OK);
     write_file(path, g.buf, g.len);
+    measured_load(&mp, NULL, &g, block, &mt, &at); /* first: the loader's first run warms up */
     measured_load(&mp, path, NULL, block, &mm, &am);
-    measured_load(&mp, NULL, &g, block, &mt, &at);
     measured_load(&rp, path, NULL, block + g.len, &mr, &ar);
     window = 8 * (size_t)sz.features + 32 * (size_t)sz.positions + ((size_t)1 << 20);
     print_message("gen eixample %d %d, %zu bytes: load peak with file_map %zu, text in memory %zu, read into "
@@ -306,7 +306,7 @@ static void test_map_peak(void **state)
      * (its pages are the page cache's, counted in RssFile while mapped) */
     if (am >= 0 && ar >= 0) {
         assert_true((size_t)am <= mm.peak_total + ((size_t)512 << 10));
-        assert_true((size_t)ar >= (size_t)am + g.len - g.len / 8);
+        assert_true((size_t)ar >= (size_t)am + g.len - g.len / 4);
     }
     free(g.buf);
     unlink(path);
