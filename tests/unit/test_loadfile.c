@@ -17,7 +17,7 @@
  *    empty file give the same status and message with and without
  *    file_map; a port without file_map still loads, one with only file_map
  *    too. */
-#define _DEFAULT_SOURCE /* MAP_ANONYMOUS */
+#define _DEFAULT_SOURCE /* MAP_ANONYMOUS, madvise */
 #include <dirent.h>
 #include <setjmp.h>
 #include <stdarg.h>
@@ -96,6 +96,9 @@ static void eng_open(eng *x, size_t size, const plx_port *port)
     x->size = size;
     x->block = mmap(NULL, size, PROT_READ | PROT_WRITE, MAP_PRIVATE | MAP_ANONYMOUS, -1, 0);
     assert_true(x->block != MAP_FAILED);
+#ifdef MADV_NOHUGEPAGE
+    madvise(x->block, size, MADV_NOHUGEPAGE); /* pages of 4 KiB, even where huge pages are always on */
+#endif
     assert_int_equal(plx_engine_create(x->block, size, &cfg, &x->e), PLX_OK);
 }
 
