@@ -79,7 +79,7 @@ static const char *png_io_reason(const png_io *io)
 /* ---- PNG writer ----------------------------------------------------------- */
 
 /* Encodes the image into io->f. Returns 0, or -1 with the reason in io. */
-static int png_encode(png_io *io, int width, int height, const uint8_t *rgb, size_t step)
+static int png_encode(png_io *io, int width, int height, const uint8_t *rgb, size_t step, int level)
 {
     png_structp png;
     png_infop info;
@@ -97,6 +97,8 @@ static int png_encode(png_io *io, int width, int height, const uint8_t *rgb, siz
         return -1;
     }
     png_set_write_fn(png, io, png_io_write, png_io_flush);
+    if (level >= 0)
+        png_set_compression_level(png, level);
     png_set_IHDR(png, info, (png_uint_32)width, (png_uint_32)height, 8, PNG_COLOR_TYPE_RGB,
                  PNG_INTERLACE_NONE, PNG_COMPRESSION_TYPE_DEFAULT, PNG_FILTER_TYPE_DEFAULT);
     png_set_sRGB(png, info, PNG_sRGB_INTENT_PERCEPTUAL);
@@ -110,6 +112,12 @@ static int png_encode(png_io *io, int width, int height, const uint8_t *rgb, siz
 
 int image_encode_png(safe_out *out, const char *path, int width, int height, const uint8_t *rgb,
                      int stride, char *err, size_t errlen)
+{
+    return image_encode_png_level(out, path, width, height, rgb, stride, -1, err, errlen);
+}
+
+int image_encode_png_level(safe_out *out, const char *path, int width, int height, const uint8_t *rgb,
+                           int stride, int level, char *err, size_t errlen)
 {
     const char *op = "write_png";
     png_io io;
@@ -125,7 +133,7 @@ int image_encode_png(safe_out *out, const char *path, int width, int height, con
     }
     memset(&io, 0, sizeof io);
     io.out = out;
-    if (png_encode(&io, width, height, rgb, (size_t)stride) != 0) {
+    if (png_encode(&io, width, height, rgb, (size_t)stride, level) != 0) {
         port_set_err(err, errlen, "%s: cannot write '%s': %s", op, path, png_io_reason(&io));
         return -1;
     }
@@ -134,7 +142,7 @@ int image_encode_png(safe_out *out, const char *path, int width, int height, con
 
 /* Opens path, runs one encoder, commits; the message prefixed with op. */
 static int write_one(const char *op, const char *path, int width, int height, const void *pixels,
-                     int stride, int pfm, char *err, size_t errlen)
+                     int stride, int pfm, int level, char *err, size_t errlen)
 {
     char why[600];
     safe_out *o;
@@ -146,7 +154,7 @@ static int write_one(const char *op, const char *path, int width, int height, co
         return -1;
     }
     if ((pfm ? image_encode_pfm(o, path, width, height, pixels, err, errlen)
-             : image_encode_png(o, path, width, height, pixels, stride, err, errlen)) != 0) {
+             : image_encode_png_level(o, path, width, height, pixels, stride, level, err, errlen)) != 0) {
         safe_out_abort(o);
         return -1;
     }
@@ -160,7 +168,13 @@ static int write_one(const char *op, const char *path, int width, int height, co
 int image_write_png_rgb8(const char *path, int width, int height, const uint8_t *rgb,
                          int stride, char *err, size_t errlen)
 {
-    return write_one("write_png", path, width, height, rgb, stride, 0, err, errlen);
+    return write_one("write_png", path, width, height, rgb, stride, 0, -1, err, errlen);
+}
+
+int image_write_png_rgb8_fast(const char *path, int width, int height, const uint8_t *rgb,
+                              int stride, char *err, size_t errlen)
+{
+    return write_one("write_png", path, width, height, rgb, stride, 0, 1, err, errlen);
 }
 
 /* ---- PFM writer ------------------------------------------------------------ */
@@ -210,7 +224,7 @@ int image_encode_pfm(safe_out *out, const char *path, int width, int height, con
 int image_write_pfm(const char *path, int width, int height, const float *rgb,
                     char *err, size_t errlen)
 {
-    return write_one("write_pfm", path, width, height, rgb, 0, 1, err, errlen);
+    return write_one("write_pfm", path, width, height, rgb, 0, 1, -1, err, errlen);
 }
 
 /* ---- PNG reader ------------------------------------------------------------ */

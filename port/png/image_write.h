@@ -34,6 +34,11 @@
 int image_write_png_rgb8(const char *path, int width, int height, const uint8_t *rgb,
                          int stride, char *err, size_t errlen);
 
+/* The same at zlib's fastest level (1): for frames written one after
+ * another (walk), where the default level costs as much as the frame. */
+int image_write_png_rgb8_fast(const char *path, int width, int height, const uint8_t *rgb,
+                              int stride, char *err, size_t errlen);
+
 /*
  * Writes an animated PNG (APNG, looping forever) at path from the n PNG
  * files frames[0..n-1], all of one size and format (as image_write_png_rgb8
@@ -105,6 +110,9 @@ int image_read_png_budget(const char *path, int max_dim, size_t max_bytes, uint8
  */
 int image_encode_png(safe_out *out, const char *path, int width, int height, const uint8_t *rgb,
                      int stride, char *err, size_t errlen);
+/* image_encode_png at zlib level 0..9 (-1: the library's default, 6). */
+int image_encode_png_level(safe_out *out, const char *path, int width, int height, const uint8_t *rgb,
+                           int stride, int level, char *err, size_t errlen);
 int image_encode_pfm(safe_out *out, const char *path, int width, int height, const float *rgb,
                      char *err, size_t errlen);
 

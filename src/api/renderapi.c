@@ -348,6 +348,10 @@ plx_status plx_render(plx_engine *e, const plx_camera *cam, const plx_render_opt
          * on several workers; the irradiance cache fills its table and asks
          * the light object as it reads: one thread */
         ro.indirect_mt = !icache_on(e);
+        /* the cache at the corners of 4 x 4 blocks on one surface, each
+         * block within one record spacing of the cache at its distance */
+        ro.indirect_sparse = icache_on(e);
+        ro.indirect_span = ICACHE_KAPPA;
         /* aerial ground and roofs: the light map's indirect layer; without one
          * (not gathering) the indirect ground map (render/indmap.h) */
         ro.indirect_map = 1;

@@ -223,7 +223,7 @@ static int frame(const walk_args *a, plx_engine *e, const walk_path *wp, walk_ru
     fprintf(wr->cams, "%ld %.17g %.17g %.17g %.17g %.17g %.17g %.6g\n", k + 1, cam.eye[0], cam.eye[1], cam.eye[2],
             cam.target[0], cam.target[1], cam.target[2], info.exposure);
     snprintf(path, sizeof path, "%s/frame-%04ld.png", a->dir, k + 1);
-    if (image_write_png_rgb8(path, a->w, a->h, wr->rgb8, 0, err, sizeof err) != 0) {
+    if (image_write_png_rgb8_fast(path, a->w, a->h, wr->rgb8, 0, err, sizeof err) != 0) {
         fprintf(stderr, "polarlux walk: %s\n", err);
         return EXIT_FAIL;
     }

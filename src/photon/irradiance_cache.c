@@ -76,6 +76,7 @@ void icache_set_spacing(icache *c, double s)
 static void flush(icache *c)
 {
     memset(c->tab, 0, (size_t)ICACHE_RECORDS * sizeof(icache_rec));
+    memset(c->last, 0, sizeof c->last);
     c->used = 0;
     c->flushes++;
 }
@@ -222,6 +223,33 @@ static const icache_rec *record(icache *c, photon_sys *ps, light *L, const plane
     return r;
 }
 
+/* Vertex v (0..3: +a, +2b) of cell (i, j) at level l: from the level's
+ * last cell when it is this one, else from the table (record). */
+static const icache_rec *cell_record(icache *c, photon_sys *ps, light *L, const plane *pl, int l,
+                                     int64_t i, int64_t j, int v)
+{
+    icache_cell *lc = &c->last[l];
+    const icache_rec *r;
+    if (!lc->set || lc->code != pl->code || lc->i != i || lc->j != j) {
+        memset(lc, 0, sizeof *lc);
+        lc->set = 1;
+        lc->code = pl->code;
+        lc->i = i;
+        lc->j = j;
+    }
+    if (lc->r[v])
+        return &c->tab[lc->r[v] - 1];
+    r = record(c, ps, L, pl, l, i + (v & 1), j + (v >> 1));
+    if (!lc->set) { /* the table was emptied to make room: this cell again */
+        lc->set = 1;
+        lc->code = pl->code;
+        lc->i = i;
+        lc->j = j;
+    }
+    lc->r[v] = (uint32_t)(r - c->tab) + 1;
+    return r;
+}
+
 /* Whether the horizontal segment from P (5 cm above its surface) to the
  * vertex Q meets a wall: on coarse grids a ground cell may span a small
  * building, and the street beyond it is the same height of ground. */
@@ -265,7 +293,7 @@ static int level_value(icache *c, photon_sys *ps, light *L, const plane *pl, con
             const icache_rec *r;
             if (!(w > 0.0))
                 continue;
-            r = record(c, ps, L, pl, l, i + a, j + b);
+            r = cell_record(c, ps, L, pl, l, i, j, 2 * b + a);
             if (!(r->flags & REC_VALID))
                 continue;
             if (!pl->wall && l >= ICACHE_LEVEL_SEG) {

@@ -80,6 +80,17 @@
 
 typedef struct icache_rec icache_rec;
 
+/* The last cell looked up at one level, and the records of its four
+ * vertices fetched so far (0: not yet): neighbouring pixels share
+ * cells, and reuse them without hashing. Emptied with the table. */
+typedef struct icache_cell {
+    uint64_t code;            /* the surface */
+    int64_t i, j;             /* the cell */
+    int set;                  /* 0: none */
+    uint32_t r[4];            /* vertices (i, j), (i+1, j), (i, j+1), (i+1, j+1): the
+                               * slot plus one (indices, not pointers: bakes move it) */
+} icache_cell;
+
 typedef struct icache {
     icache_rec *tab;          /* ICACHE_RECORDS slots */
     uint32_t used;
@@ -92,6 +103,7 @@ typedef struct icache {
     uint64_t gathered;        /* records computed since creation */
     uint64_t direct;          /* points gathered themselves (no valid vertex) */
     uint64_t flushes;         /* times the table was emptied */
+    icache_cell last[ICACHE_LEVEL_MAX + 1]; /* per level: the last cell looked up */
 } icache;
 
 /* Bytes icache_create takes from part PLX_PART_PHOTON. */

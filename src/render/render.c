@@ -24,6 +24,7 @@ typedef struct cull_item { double key; uint32_t b; } cull_item;
 #define RENDER_TILE 8           /* shading tiles, pixels a side */
 #define RENDER_TILE_LAMPS 64    /* longest lamp list of a tile */
 #define TILE_PX (RENDER_TILE * RENDER_TILE)
+#define IND_STEP 4              /* sparse indirect: corners every IND_STEP pixels */
 
 /* What one worker of the shading pass works in: a tile's hit points,
  * normals and E, its lamp list, and its counters. */
@@ -67,6 +68,13 @@ struct render {
     light *lt;                  /* the light module when shade is render_shade_light */
     shade_ws ws[RENDER_MAX_WORKERS];  /* one per worker of the shading pass */
     uint8_t *defer;             /* per tile of the largest frame: left to the serial pass */
+    /* sparse indirect (render_opts.indirect_sparse): per block of IND_STEP
+     * pixels a side, whether one surface covers it with its corners; the
+     * hook's value at each corner of the grid (RGB) */
+    uint8_t *blk;
+    float *ind;
+    int32_t nbx, nby;           /* blocks a row, rows of blocks */
+    int sparse;                 /* this frame's indirect is sparse */
     lightmap lm;                /* the aerial light map (lightmap.c) */
     indmap im;                  /* its indirect twin (indmap.c) */
     double thr[255];
@@ -102,8 +110,9 @@ size_t render_bytes(const scene *s, int32_t max_w, int32_t max_h)
 {
     size_t px = (size_t)max_w * (size_t)max_h;
     size_t tiles = (size_t)((max_w + RENDER_TILE - 1) / RENDER_TILE) * (size_t)((max_h + RENDER_TILE - 1) / RENDER_TILE);
+    size_t corners = (size_t)(max_w / IND_STEP + 2) * (size_t)(max_h / IND_STEP + 2);
     return px * 20 + tiles + (size_t)s->nbld * (2 * sizeof(cull_item) + 17) + RENDER_BINS * 8 + 65536 +
-           sizeof(render) + 4096;
+           corners * (1 + 3 * sizeof(float)) + sizeof(render) + 4096;
 }
 
 const mesh *render_mesh(const render *r)
@@ -241,9 +250,14 @@ plx_status render_create(arena *a, const scene *s, int32_t max_w, int32_t max_h,
     r->defer = arena_alloc(a, PLX_PART_FRAME,
                            (size_t)((max_w + RENDER_TILE - 1) / RENDER_TILE) *
                                (size_t)((max_h + RENDER_TILE - 1) / RENDER_TILE), R_ALIGN);
+    r->blk = arena_alloc(a, PLX_PART_FRAME, (size_t)(max_w / IND_STEP + 2) * (size_t)(max_h / IND_STEP + 2),
+                         R_ALIGN);
+    r->ind = arena_alloc(a, PLX_PART_FRAME,
+                         arena_mul((size_t)(max_w / IND_STEP + 2) * (size_t)(max_h / IND_STEP + 2),
+                                   3 * sizeof(float)), R_ALIGN);
     if (shade == render_shade_light && user)
         r->lt = user;
-    if (!r->lut || !r->defer) {
+    if (!r->lut || !r->defer || !r->blk || !r->ind) {
         arena_release(a, &m0);
         return PLX_E_NOMEM;
     }
@@ -936,12 +950,51 @@ static int indmap_usable(const render *r, const render_opts *o)
     return o->indirect && o->indirect_map && r->im.built && r->im.key == o->indirect_key;
 }
 
+/* Pixel (i, j)'s sample ray and what it meets: the surface (a pixel no
+ * building covers that looks down is the ground, and its id is set so),
+ * the hit point and the normal facing the eye. Returns 0 for the sky. */
+static int pixel_hit(render *r, int32_t i, int32_t j, uint32_t *sid_out, double P[3], double n[3])
+{
+    double ta = r->tanh_ * r->aspect, tb = r->tanh_;
+    double bj = (1.0 - 2.0 * (j + 0.5 + r->shift[1]) / r->h) * tb;
+    double ai = (2.0 * (i + 0.5 + r->shift[0]) / r->w - 1.0) * ta;
+    size_t p = (size_t)j * (size_t)r->w + (size_t)i;
+    double d[3], tt, nd;
+    uint32_t sid = r->id[p];
+    const mesh_surf *sf;
+    int k;
+    d[0] = r->f[0] + ai * r->rt[0] + bj * r->up[0];
+    d[1] = r->f[1] + ai * r->rt[1] + bj * r->up[1];
+    d[2] = r->f[2] + ai * r->rt[2] + bj * r->up[2];
+    if (sid == MESH_SURF_NONE) {
+        if (!(d[2] < 0.0))
+            return 0;
+        sid = MESH_SURF_GROUND;
+        r->id[p] = sid;
+    }
+    sf = &r->m->surf[sid];
+    nd = sf->n[0] * d[0] + sf->n[1] * d[1] + sf->n[2] * d[2];
+    if (sid == MESH_SURF_GROUND)
+        tt = -r->eye[2] / d[2];
+    else
+        tt = (sf->d - (sf->n[0] * r->eye[0] + sf->n[1] * r->eye[1] + sf->n[2] * r->eye[2])) / nd;
+    if (!isfinite(tt) || tt < 0.0)
+        tt = 0.0;
+    for (k = 0; k < 3; k++) {
+        P[k] = r->eye[k] + tt * d[k];
+        n[k] = nd > 0.0 ? -sf->n[k] : sf->n[k];
+    }
+    if (sid == MESH_SURF_GROUND)
+        P[2] = 0.0;
+    *sid_out = sid;
+    return 1;
+}
+
 /* Step 1 of a tile: every pixel's hit point and normal; E = 0 (or the
  * light map's, when sample) for now; sky pixels written. */
 static void tile_points(render *r, shade_ws *w, const render_opts *o, tile_state *t, int sample)
 {
     const mesh *m = r->m;
-    double ta = r->tanh_ * r->aspect, tb = r->tanh_;
     int use_lm = o->lightmap && r->lm.built;
     int use_im = use_lm && sample && indmap_usable(r, o);
     int32_t i, j;
@@ -961,45 +1014,24 @@ static void tile_points(render *r, shade_ws *w, const render_opts *o, tile_state
     t->sure_g = t->sure_w = 0;
     t->sky = t->ground = t->building = t->calls = t->tiled = t->skipped = 0;
     for (j = t->tj; j < t->j1; j++) {
-        double bj = (1.0 - 2.0 * (j + 0.5 + r->shift[1]) / r->h) * tb;
         for (i = t->ti; i < t->i1; i++, q++) {
             size_t p = (size_t)j * (size_t)r->w + (size_t)i;
-            double ai = (2.0 * (i + 0.5 + r->shift[0]) / r->w - 1.0) * ta;
-            double d[3], tt, nd, E[3] = { 0, 0, 0 };
+            double E[3] = { 0, 0, 0 };
             double *P = w->tP[q], *n = w->tN[q];
-            uint32_t sid = r->id[p];
+            uint32_t sid;
             const mesh_surf *sf;
             float *out = &r->lin[3 * p];
             w->tcall[q] = 0;
-            d[0] = r->f[0] + ai * r->rt[0] + bj * r->up[0];
-            d[1] = r->f[1] + ai * r->rt[1] + bj * r->up[1];
-            d[2] = r->f[2] + ai * r->rt[2] + bj * r->up[2];
-            if (sid == MESH_SURF_NONE) {
-                if (!(d[2] < 0.0)) {
-                    t->sky++;
-                    out[0] = out[1] = out[2] = 0.0f;
-                    continue;
-                }
-                sid = MESH_SURF_GROUND;
-                r->id[p] = sid;
+            if (!pixel_hit(r, i, j, &sid, P, n)) {
+                t->sky++;
+                out[0] = out[1] = out[2] = 0.0f;
+                continue;
             }
             sf = &m->surf[sid];
-            nd = sf->n[0] * d[0] + sf->n[1] * d[1] + sf->n[2] * d[2];
-            if (sid == MESH_SURF_GROUND) {
-                tt = -r->eye[2] / d[2];
-                t->ground++;
-            } else {
-                tt = (sf->d - (sf->n[0] * r->eye[0] + sf->n[1] * r->eye[1] + sf->n[2] * r->eye[2])) / nd;
-                t->building++;
-            }
-            if (!isfinite(tt) || tt < 0.0)
-                tt = 0.0;
-            for (k = 0; k < 3; k++) {
-                P[k] = r->eye[k] + tt * d[k];
-                n[k] = nd > 0.0 ? -sf->n[k] : sf->n[k];
-            }
             if (sid == MESH_SURF_GROUND)
-                P[2] = 0.0;
+                t->ground++;
+            else
+                t->building++;
             w->tcall[q] = 1;
             /* facing up: the map's indirect layer (the indirect ground map without one) */
             w->tind[q] = use_lm && sample && o->indirect && n[2] > 0.5 &&
@@ -1060,6 +1092,154 @@ static int tile_light(render *r, shade_ws *w, tile_state *t, int ro)
     return 0;
 }
 
+/* ---- sparse indirect (render_opts.indirect_sparse) ---------------------
+ * The indirect hook is asked at the corners of blocks of IND_STEP pixels a
+ * side, before the shading pass; a block whose pixels and corners all lie
+ * on one surface takes its pixels' indirect term bilinearly from its
+ * corners, and every other pixel asks the hook itself after the pass. The
+ * hook is only ever called on this thread, in this order: the image is
+ * the same bytes for any number of workers. */
+
+static int32_t corner_x(const render *r, int32_t a)
+{
+    int32_t x = a * IND_STEP;
+    return x < r->w ? x : r->w - 1;
+}
+
+static int32_t corner_y(const render *r, int32_t b)
+{
+    int32_t y = b * IND_STEP;
+    return y < r->h ? y : r->h - 1;
+}
+
+/* The block of column i (row j): the last block takes the last pixels. */
+static int32_t block_of(int32_t i, int32_t nb)
+{
+    int32_t a = i / IND_STEP;
+    return a < nb ? a : nb - 1;
+}
+
+/* Whether block (a, b), its far corners included, lies on one surface,
+ * and its corners' hit points lie within span times the distance of the
+ * nearest of them from the eye (seen at a grazing angle, a block spans
+ * far more of the surface than its neighbours nearer the eye). */
+static int block_one_surface(render *r, int32_t a, int32_t b, double span)
+{
+    int32_t x0 = corner_x(r, a), x1 = corner_x(r, a + 1), y0 = corner_y(r, b), y1 = corner_y(r, b + 1), x, y;
+    uint32_t sid = r->id[(size_t)y0 * (size_t)r->w + (size_t)x0], cs;
+    double C[4][3], n[3], lo[3], hi[3], dmin = HUGE_VAL, ext = 0.0;
+    int c, k;
+    if (sid == MESH_SURF_NONE)
+        return 0;
+    for (y = y0; y <= y1; y++)
+        for (x = x0; x <= x1; x++)
+            if (r->id[(size_t)y * (size_t)r->w + (size_t)x] != sid)
+                return 0;
+    for (c = 0; c < 4; c++) {
+        double d2 = 0.0;
+        (void)pixel_hit(r, c & 1 ? x1 : x0, c & 2 ? y1 : y0, &cs, C[c], n);
+        for (k = 0; k < 3; k++) {
+            double dk = C[c][k] - r->eye[k];
+            d2 += dk * dk;
+            lo[k] = c ? fmin(lo[k], C[c][k]) : C[c][k];
+            hi[k] = c ? fmax(hi[k], C[c][k]) : C[c][k];
+        }
+        dmin = fmin(dmin, sqrt(d2));
+    }
+    for (k = 0; k < 3; k++)
+        ext = fmax(ext, hi[k] - lo[k]);
+    return ext <= span * dmin;
+}
+
+/* Whether corner (a, b) is a corner of a one-surface block. */
+static int corner_used(const render *r, int32_t a, int32_t b)
+{
+    int32_t da, db;
+    for (db = -1; db <= 0; db++)
+        for (da = -1; da <= 0; da++) {
+            int32_t x = a + da, y = b + db;
+            if (x >= 0 && y >= 0 && x < r->nbx && y < r->nby && r->blk[(size_t)y * (size_t)r->nbx + (size_t)x])
+                return 1;
+        }
+    return 0;
+}
+
+/* Before the shading pass: ground ids, the one-surface blocks and the
+ * hook's value at their corners. */
+static void sparse_corners(render *r, const render_opts *o)
+{
+    int32_t a, b, i, j;
+    double P[3], n[3], Ei[3];
+    uint32_t sid;
+    r->nbx = r->w > 1 ? (r->w - 1 + IND_STEP - 1) / IND_STEP : 1;
+    r->nby = r->h > 1 ? (r->h - 1 + IND_STEP - 1) / IND_STEP : 1;
+    for (j = 0; j < r->h; j++)
+        for (i = 0; i < r->w; i++)
+            if (r->id[(size_t)j * (size_t)r->w + (size_t)i] == MESH_SURF_NONE)
+                (void)pixel_hit(r, i, j, &sid, P, n); /* the ground: its id */
+    for (b = 0; b < r->nby; b++)
+        for (a = 0; a < r->nbx; a++)
+            r->blk[(size_t)b * (size_t)r->nbx + (size_t)a] =
+                (uint8_t)block_one_surface(r, a, b, o->indirect_span);
+    for (b = 0; b <= r->nby; b++)
+        for (a = 0; a <= r->nbx; a++) {
+            float *c = &r->ind[3 * ((size_t)b * (size_t)(r->nbx + 1) + (size_t)a)];
+            int k;
+            if (!corner_used(r, a, b) || !pixel_hit(r, corner_x(r, a), corner_y(r, b), &sid, P, n))
+                continue;
+            Ei[0] = Ei[1] = Ei[2] = 0.0;
+            o->indirect(o->indirect_user, P, n, Ei);
+            for (k = 0; k < 3; k++)
+                c[k] = (float)Ei[k];
+        }
+}
+
+/* Pixel (i, j)'s indirect term added to E when its block lies on one
+ * surface (bilinear over the block's corners). */
+static void sparse_at(const render *r, int32_t i, int32_t j, double E[3])
+{
+    int32_t a = block_of(i, r->nbx), b = block_of(j, r->nby);
+    int32_t x0 = corner_x(r, a), x1 = corner_x(r, a + 1), y0 = corner_y(r, b), y1 = corner_y(r, b + 1);
+    const float *c00, *c10, *c01, *c11;
+    double fx, fy;
+    size_t row = (size_t)(r->nbx + 1);
+    int k;
+    if (!r->blk[(size_t)b * (size_t)r->nbx + (size_t)a])
+        return;
+    fx = x1 > x0 ? (double)(i - x0) / (double)(x1 - x0) : 0.0;
+    fy = y1 > y0 ? (double)(j - y0) / (double)(y1 - y0) : 0.0;
+    c00 = &r->ind[3 * ((size_t)b * row + (size_t)a)];
+    c10 = c00 + 3;
+    c01 = c00 + 3 * row;
+    c11 = c01 + 3;
+    for (k = 0; k < 3; k++)
+        E[k] += (1.0 - fy) * ((1.0 - fx) * c00[k] + fx * c10[k]) + fy * ((1.0 - fx) * c01[k] + fx * c11[k]);
+}
+
+/* After the shading pass: the pixels of the other blocks ask the hook. */
+static void sparse_rest(render *r, const render_opts *o)
+{
+    int32_t i, j;
+    for (j = 0; j < r->h; j++)
+        for (i = 0; i < r->w; i++) {
+            size_t p = (size_t)j * (size_t)r->w + (size_t)i;
+            float *out = &r->lin[3 * p];
+            double P[3], n[3], Ei[3] = { 0, 0, 0 }, alb[3];
+            uint32_t sid;
+            int k;
+            if (r->blk[(size_t)block_of(j, r->nby) * (size_t)r->nbx + (size_t)block_of(i, r->nbx)] ||
+                !pixel_hit(r, i, j, &sid, P, n))
+                continue;
+            o->indirect(o->indirect_user, P, n, Ei);
+            if (sid == MESH_SURF_GROUND)
+                scene_ground_albedo(r->s, P[0], P[1], alb);
+            else
+                alb[0] = alb[1] = alb[2] = r->m->surf[sid].albedo;
+            for (k = 0; k < 3; k++)
+                out[k] = (float)((double)out[k] + alb[k] / PI * Ei[k]);
+        }
+}
+
 /* Step 3: shade every pixel of the tile. Returns -1 (ro only) when a pixel
  * needs the light object's buffers, else 0. */
 static int tile_shade(render *r, shade_ws *w, const render_opts *o, tile_state *t, int ro)
@@ -1089,6 +1269,8 @@ static int tile_shade(render *r, shade_ws *w, const render_opts *o, tile_state *
             if (w->tind[q]) {
                 for (k = 0; k < 3; k++)
                     E[k] += w->tI[q][k];
+            } else if (o->indirect && r->sparse) {
+                sparse_at(r, i, j, E); /* the pixels it leaves: sparse_rest */
             } else if (o->indirect) {
                 double Ei[3] = { 0, 0, 0 };
                 o->indirect(o->indirect_user, w->tP[q], w->tN[q], Ei);
@@ -1203,7 +1385,7 @@ static void shade_row(void *arg, int worker, uint32_t row)
 static int shade_workers(const render *r, const render_opts *o)
 {
     int n = o->workers;
-    if (!o->par || n < 2 || !r->lt || (o->indirect && !o->indirect_mt))
+    if (!o->par || n < 2 || !r->lt || (o->indirect && !o->indirect_mt && !r->sparse))
         return 1;
     return n > RENDER_MAX_WORKERS ? RENDER_MAX_WORKERS : n;
 }
@@ -1377,7 +1559,12 @@ plx_status render_frame(render *r, const render_camera *cam, const render_opts *
         (void)indmap_build(&r->im, r->a, &r->lm, o->indirect_far ? o->indirect_far : o->indirect,
                            o->indirect_user, o->top, o->indirect_user, o->indirect_key,
                            o->indirect_far || o->indirect_mt ? o->par : NULL, o->par_ctx, o->workers);
+    r->sparse = o->indirect && o->indirect_sparse && !o->lightmap && o->indirect_span > 0.0;
+    if (r->sparse)
+        sparse_corners(r, o);
     shade_pass(r, o, &st);
+    if (r->sparse)
+        sparse_rest(r, o);
     /* the exposure from the lit surfaces, before the glows */
     st.exposure = o->auto_exposure ? exposure_auto(r->lin, r->id, px) : o->exposure;
     if (!o->no_glow)

@@ -276,6 +276,15 @@ typedef struct render_opts {
                                   on several threads (its user is indirect_user) */
     double (*top)(void *user, double x, double y);  /* the map's surface height at (x, y): the
                                   topmost roof or 0 (NULL: the ground); user is indirect_user */
+    int indirect_sparse;       /* 1 (not with lightmap): indirect is asked at the corners of
+                                  blocks of 4 x 4 pixels, on this thread before the shading
+                                  pass; a block on one surface (its pixels and corners),
+                                  whose corners lie within indirect_span times the distance
+                                  of the nearest of them from the eye, is interpolated
+                                  bilinearly; the other pixels ask indirect after the pass.
+                                  The shading pass may then use workers whatever
+                                  indirect_mt says */
+    double indirect_span;      /* see indirect_sparse (> 0, else no sparse indirect) */
 } render_opts;
 
 void render_opts_default(render_opts *o /* OUT */);

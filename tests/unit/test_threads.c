@@ -3,8 +3,8 @@
  * shading pass).
  *
  * The eixample fixture with photon frames (indirect light from the photon
- * buffers: final gathering off, since the irradiance cache keeps a frame
- * on one thread), a street view
+ * buffers: final gathering off; test_gather_same_bytes: on, through the
+ * irradiance cache), a street view
  * and an aerial view, rendered with threads = 1 (the calling thread only),
  * 2 through the POSIX port's pthreads, and 3 through a port whose
  * parallel-for runs the jobs backwards on changing worker ids (a fixed
@@ -46,8 +46,10 @@ typedef struct frame {
 } frame;
 
 /* Renders the street and the aerial view with the given threads and port;
- * small_cache: a lamp-region cache of 64 KiB. */
-static void render_pair(int threads, const plx_port *port, int small_cache, frame *out)
+ * small_cache: a lamp-region cache of 64 KiB; gather: images gather with
+ * the irradiance cache (else they read the photon buffers), and only the
+ * street view is drawn (out[1] zeroed). */
+static void render_pair_g(int threads, const plx_port *port, int small_cache, int gather, frame *out)
 {
     plx_config cfg;
     plx_engine *e = NULL;
@@ -67,10 +69,10 @@ static void render_pair(int threads, const plx_port *port, int small_cache, fram
     assert_int_equal(plx_load_file(e, "fixtures/eixample-4x4.geojson"), PLX_OK);
     for (k = 0; k < 2; k++)
         assert_int_equal(plx_indirect_step(e, 20000, 7), PLX_OK);
-    /* images read the photon buffers (the irradiance cache keeps a frame on
-     * one thread: renderapi.c) */
-    assert_int_equal(plx_indirect_set_gather(e, 0), PLX_OK);
-    for (v = 0; v < 2; v++) {
+    if (!gather)
+        assert_int_equal(plx_indirect_set_gather(e, 0), PLX_OK);
+    memset(&out[1], 0, sizeof out[1]);
+    for (v = 0; v < (gather ? 1 : 2); v++) { /* gathering: the street view */
         memset(&cam, 0, sizeof cam);
         if (v == 0) {
             cam.eye[0] = 298.6; cam.eye[1] = 265.5; cam.eye[2] = 1.7;
@@ -89,6 +91,11 @@ static void render_pair(int threads, const plx_port *port, int small_cache, fram
     }
     plx_engine_destroy(e);
     free(mem);
+}
+
+static void render_pair(int threads, const plx_port *port, int small_cache, frame *out)
+{
+    render_pair_g(threads, port, small_cache, 0, out);
 }
 
 static void check_same(const frame *a, const frame *b)
@@ -124,6 +131,25 @@ static void test_same_bytes(void **state)
     render_pair(1, plx_port_posix(), 1, one);
     render_pair(2, &back, 1, other);
     check_same(one, other);
+}
+
+/* Street frames gathering with the irradiance cache: the cache is asked on
+ * the calling thread only (at the corners of the sparse blocks, then the
+ * pixels they leave), the direct light on the workers: the same bytes. */
+static void test_gather_same_bytes(void **state)
+{
+    static frame one[2], other[2];
+    plx_port back = *plx_port_posix();
+    (void)state;
+    back.parallel_for = backwards_for;
+    render_pair_g(1, plx_port_posix(), 0, 1, one);
+    assert_true(one[0].info.shaded_pixels > W * H / 4);
+    render_pair_g(3, &back, 0, 1, other);
+    check_same(one, other);
+    if (!getenv("PLX_TEST_QUICK")) {
+        render_pair_g(2, plx_port_posix(), 0, 1, other);
+        check_same(one, other);
+    }
 }
 
 /* The aerial map's indirect layer gathered by the irradiance cache on the
@@ -187,6 +213,7 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_same_bytes),
+        cmocka_unit_test(test_gather_same_bytes),
         cmocka_unit_test(test_aerial_layer_same_bytes),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
