@@ -115,6 +115,20 @@ typedef struct plx_port {
                         void (*job)(void *arg, int worker, uint32_t k), void *arg);
     /* The number of processors: the default number of workers (NULL: 1). */
     int (*cores)(void *ctx);
+    /* A read-only view of a whole file, for plx_load_file (NULL: the file
+     * is read with file_size/file_read into the engine's block instead).
+     * Gives *data (size bytes, no NUL after them: *data may be NULL when
+     * size is 0) valid until file_unmap(ctx, *handle); 0 on success, else -1
+     * with a reason in err and nothing to unmap. The bytes must not change
+     * while mapped. POSIX: mmap of a regular file (a FIFO, a device or a
+     * directory is refused at once, as file_size does; a file truncated by
+     * another process during the load makes the process take SIGBUS). A
+     * board maps the file where it lies, e.g. memory-mapped (XIP) flash.
+     * Added after cores so port tables written before keep their layout. */
+    int (*file_map)(void *ctx, const char *path, const void **data, size_t *size, void **handle,
+                    char *err, size_t errlen);
+    /* Ends a view file_map gave (called once for each successful map). */
+    void (*file_unmap)(void *ctx, void *handle);
 } plx_port;
 
 /* Most workers the core asks a parallel-for for. */
@@ -202,11 +216,15 @@ uint32_t plx_warning_count(const plx_engine *e);
  * even when the load fails. Threads: engine (no process-wide state).
  */
 plx_status plx_load_geojson(plx_engine *e, const char *text, size_t len, const char *name);
-/* The same from a file, read through the engine's port into scratch memory
- * (the file's bytes count against the block during the load).
+/* The same from a file, through the engine's port: read in place from the
+ * port's file_map view when it has one (the file's bytes are not in the
+ * block; the view is ended before returning, on success and failure), else
+ * read with file_size/file_read into scratch memory (the file's bytes then
+ * count against the block during the load).
  * Errors: those of plx_load_geojson, and PLX_E_INVALID (path NULL),
- * PLX_E_UNSUPPORTED (the port has no file_size/file_read), PLX_E_IO (the
- * port could not read it: the message names the path and why). */
+ * PLX_E_UNSUPPORTED (the port has neither file_map nor
+ * file_size/file_read), PLX_E_IO (the port could not map or read it: the
+ * message names the path and why). */
 plx_status plx_load_file(plx_engine *e, const char *path);
 
 typedef struct plx_scene_info {

@@ -32,6 +32,8 @@ static void port(void)
     FIELD(plx_port, unlock);
     FIELD(plx_port, parallel_for);
     FIELD(plx_port, cores);
+    FIELD(plx_port, file_map);
+    FIELD(plx_port, file_unmap);
 }
 
 static void config(void)

@@ -1,5 +1,6 @@
-/* The POSIX port: clock_gettime, stderr logging, stdio files, a pthread
- * mutex for JSON parsing, and engines in a malloc'd block. */
+/* The POSIX port: clock_gettime, stderr logging, files read whole or
+ * mapped read-only (mmap), a pthread mutex (no longer taken by the core),
+ * and engines in a malloc'd block. */
 #include <errno.h>
 #include <fcntl.h>
 #include <stdarg.h>
@@ -9,6 +10,7 @@
 #include <string.h>
 #include <time.h>
 #include <unistd.h>
+#include <sys/mman.h>
 #include <sys/stat.h>
 
 #include "polarlux_port.h"
@@ -117,6 +119,64 @@ static int posix_file_read(void *ctx, const char *path, void *buf, size_t size, 
     return read_all(fd, buf, size, err, errlen);
 }
 
+/* What file_unmap needs: the mapping and its length. */
+typedef struct posix_map {
+    void *addr;
+    size_t len;
+} posix_map;
+
+/* A private read-only mapping of the whole file (plx_port.file_map): the
+ * same refusals as file_size (port_open_input: never waits on a FIFO or a
+ * device). An empty file maps nothing (mmap refuses length 0). The kernel
+ * is told the file will be read in order (POSIX_MADV_SEQUENTIAL: more read-ahead,
+ * and pages already read are the first dropped under memory pressure). */
+static int posix_file_map(void *ctx, const char *path, const void **data, size_t *size, void **handle,
+                          char *err, size_t errlen)
+{
+    posix_map *m;
+    size_t n;
+    int fd = port_open_input(path, &n, err, errlen);
+    (void)ctx;
+    *data = NULL;
+    *size = 0;
+    *handle = NULL;
+    if (fd < 0)
+        return -1;
+    if (n == 0) {
+        close(fd);
+        return 0;
+    }
+    m = malloc(sizeof *m);
+    if (!m) {
+        snprintf(err, errlen, "out of memory");
+        close(fd);
+        return -1;
+    }
+    m->addr = mmap(NULL, n, PROT_READ, MAP_PRIVATE, fd, 0);
+    close(fd); /* the mapping keeps the file */
+    if (m->addr == MAP_FAILED) {
+        snprintf(err, errlen, "cannot map %zu bytes: %s", n, strerror(errno));
+        free(m);
+        return -1;
+    }
+    m->len = n;
+    posix_madvise(m->addr, n, POSIX_MADV_SEQUENTIAL);
+    *data = m->addr;
+    *size = n;
+    *handle = m;
+    return 0;
+}
+
+static void posix_file_unmap(void *ctx, void *handle)
+{
+    posix_map *m = handle;
+    (void)ctx;
+    if (!m)
+        return;
+    munmap(m->addr, m->len);
+    free(m);
+}
+
 static void posix_lock(void *ctx)
 {
     (void)ctx;
@@ -131,7 +191,7 @@ static void posix_unlock(void *ctx)
 
 static const plx_port posix_port = {
     NULL, posix_clock, posix_log, posix_file_size, posix_file_read, posix_lock, posix_unlock,
-    port_parallel_for, port_cores,
+    port_parallel_for, port_cores, posix_file_map, posix_file_unmap,
 };
 
 const plx_port *plx_port_posix(void)

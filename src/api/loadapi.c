@@ -1,6 +1,8 @@
 /* loadapi: loading a scene (src/scene/geojson.c reads it): the engine's
  * previous scene and everything built on it dropped, the text read from
- * memory or through the port's file functions, scratch memory given back. */
+ * memory, from the port's read-only view of a file (file_map: never copied)
+ * or through its file_size/file_read into scratch memory, scratch memory
+ * given back. */
 #include <string.h>
 
 #include "base/engine.h"
@@ -58,43 +60,73 @@ plx_status plx_load_geojson(plx_engine *e, const char *text, size_t len, const c
     return load_text(e, text, len, name);
 }
 
-plx_status plx_load_file(plx_engine *e, const char *path)
+/* "path: why" as the engine's error. */
+static plx_status io_fail(plx_engine *e, const char *path, const char *why)
+{
+    strbuf b;
+    sb_init(&b, e->err, sizeof e->err);
+    sb_str(&b, path);
+    sb_str(&b, ": ");
+    sb_str(&b, why);
+    return PLX_E_IO;
+}
+
+/* Through the port's file_map: the text is read where the port maps it,
+ * never copied into the block; unmapped on every path. */
+static plx_status load_mapped(plx_engine *e, const char *path)
+{
+    char why[256];
+    const void *data = NULL;
+    void *handle = NULL;
+    size_t size = 0;
+    plx_status st;
+    why[0] = '\0';
+    if (e->port.file_map(e->port.ctx, path, &data, &size, &handle, why, sizeof why) != 0)
+        return io_fail(e, path, why);
+    if (!data && size)
+        st = eng_fail(e, PLX_E_IO, "plx_load_file: the port mapped no bytes");
+    else
+        st = load_text(e, data ? (const char *)data : "", size, path);
+    e->port.file_unmap(e->port.ctx, handle);
+    return st;
+}
+
+/* Through file_size/file_read: the whole file into scratch memory. */
+static plx_status load_read(plx_engine *e, const char *path)
 {
     char why[256];
     size_t size = 0;
     char *buf;
     plx_status st;
     arena_mark m;
-    strbuf b;
-    if (!eng_ok(e))
-        return PLX_E_INVALID;
-    drop_scene(e);
-    if (!path)
-        return eng_fail(e, PLX_E_INVALID, "plx_load_file: path is NULL");
-    if (!e->port.file_size || !e->port.file_read)
-        return eng_fail(e, PLX_E_UNSUPPORTED, "plx_load_file: this engine's port has no file system; use plx_load_geojson");
     why[0] = '\0';
-    sb_init(&b, e->err, sizeof e->err);
-    if (e->port.file_size(e->port.ctx, path, &size, why, sizeof why) != 0) {
-        sb_str(&b, path);
-        sb_str(&b, ": ");
-        sb_str(&b, why);
-        return PLX_E_IO;
-    }
+    if (e->port.file_size(e->port.ctx, path, &size, why, sizeof why) != 0)
+        return io_fail(e, path, why);
     m = arena_get_mark(&e->mem);
     buf = arena_scratch(&e->mem, size + 1, 16);
     if (!buf)
         return eng_nomem(e, "reading the scene file");
     if (e->port.file_read(e->port.ctx, path, buf, size, why, sizeof why) != 0) {
         arena_release(&e->mem, &m);
-        sb_str(&b, path);
-        sb_str(&b, ": ");
-        sb_str(&b, why);
-        return PLX_E_IO;
+        return io_fail(e, path, why);
     }
     buf[size] = '\0';
     st = load_text(e, buf, size, path);
     e->mem.hi = m.hi;
     e->mem.used[PLX_PART_SCRATCH] = m.used[PLX_PART_SCRATCH];
     return st;
+}
+
+plx_status plx_load_file(plx_engine *e, const char *path)
+{
+    if (!eng_ok(e))
+        return PLX_E_INVALID;
+    drop_scene(e);
+    if (!path)
+        return eng_fail(e, PLX_E_INVALID, "plx_load_file: path is NULL");
+    if (e->port.file_map && e->port.file_unmap)
+        return load_mapped(e, path);
+    if (!e->port.file_size || !e->port.file_read)
+        return eng_fail(e, PLX_E_UNSUPPORTED, "plx_load_file: this engine's port has no file system; use plx_load_geojson");
+    return load_read(e, path);
 }

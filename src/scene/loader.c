@@ -5,6 +5,7 @@
 #include <string.h>
 #include <stdlib.h> /* strtod */
 
+#include "base/plx_assert.h"
 #include "scene/loader.h"
 
 static int is_space(char c)
@@ -284,10 +285,22 @@ jv ld_item(const loader *ld, jv c, uint32_t i)
     return JV_NONE;
 }
 
-/* The checked text holds a number here, ended by a byte strtod stops at
- * (',', ']', '}' or white space: numbers are read inside containers only). */
+/* The number at v, by strtod on a NUL-terminated copy of the bytes it
+ * reads (jsonscan_number_len, bounded by the text's end): the text may be a
+ * mapped file with nothing after its last byte. A number longer than the
+ * copy (64 characters or more, rare) is read in place: the checked text
+ * holds numbers inside containers only, so a byte strtod stops at (',',
+ * ']', '}' or white space) follows it before the end. */
 double ld_double(const loader *ld, jv v)
 {
+    char buf[64];
+    size_t n = jsonscan_number_len(ld->text, ld->len, v);
+    if (n < sizeof buf) {
+        memcpy(buf, ld->text + v, n);
+        buf[n] = '\0';
+        return strtod(buf, NULL);
+    }
+    PLX_ASSERT(v + n < ld->len);
     return strtod(ld->text + v, NULL);
 }
 
