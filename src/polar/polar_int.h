@@ -127,11 +127,12 @@ static inline void quadrant_side(int q, int *map, int *top)
 
 /* ---- shared by the search DAG (trapmap.c) and the sweep (sweep.c) ---- */
 
-/* A trapezoid of the search DAG's map (see "the search DAG" below). */
+/* A trapezoid of the search DAG's map (see "the search DAG" below). 36
+ * bytes: the frame coordinates of rp are read from the points. */
 typedef struct btrap {
-    vec2 rc;                 /* frame coordinates of rp (walks read them) */
     uint32_t lp, rp, top, bot;
-    uint32_t nb[4];
+    uint32_t nb[4];          /* neighbours; in a free slot nb[0] links the
+                              * next free slot */
     uint32_t leaf;           /* its leaf node (below 2^30); POLAR_NONE: slot
                               * free; once the map is built, the sweep
                               * replaces it by the trapezoid's child word
@@ -151,12 +152,13 @@ typedef struct proles {
     uint32_t side[2];
 } proles;
 
+/* The sweep's data per piece (its frame ends are in a separate array, E:
+ * E[2 s] left, E[2 s + 1] right, which the insertions read too). */
 typedef struct snode {
-    vec2 l, r;          /* frame ends, l before r */
     int32_t cov;        /* footprints covering the gap above it */
     uint32_t open;      /* the free region open above it, or POLAR_NONE */
     uint32_t prev, next; /* status list; prev == POLAR_NONE: not in it */
-    uint32_t li, ri;    /* point indices of l and r */
+    uint32_t li, ri;    /* point indices of its left and right ends */
     uint32_t solid;     /* child word of a solid trapezoid on it (search DAG) */
     uint32_t yk;        /* its search node kind: N_Y (l is seg.a) or N_YB */
 } snode;
@@ -168,9 +170,13 @@ typedef struct dbuild {
     const polar *pd;
     arena *a;
     int frame;
-    btrap *T;
-    uint32_t ntrap, cap;     /* slots used, slots available */
-    uint32_t *freel, nfree;  /* slots of replaced trapezoids */
+    btrap *T;                /* slots, in the low end of the arena (grown
+                              * TRAP_STEP at a time while the map is built,
+                              * given back by polar_dag_free_traps) */
+    uint32_t ntrap, tcap, cap; /* slots used, slots allocated, the bound */
+    uint32_t freel, nfree;   /* the last freed slot (its nb[0] links the
+                              * one freed before), free slots */
+    arena_mark tmark;        /* the arena before the slots */
     uint32_t (**chunk)[3];   /* nodes in chunks of NODE_CHUNK (scratch) */
     uint32_t nchunk, maxchunk, nnode;
     uint32_t *list, *up, *lo; /* per crossed trapezoid: it, its new upper / lower part */
@@ -179,6 +185,7 @@ typedef struct dbuild {
     const uint32_t *canon;   /* per point: the first point at its position */
     const snode *N;          /* per piece: the sweep's data (y test kind) */
     const vec2 *E;           /* per piece: frame ends, left then right */
+    const uint32_t *order;   /* the insertion order */
     /* the live trapezoids by role, kept up to date by every insertion */
     sroles *SR;
     proles *PR;
@@ -205,7 +212,11 @@ plx_status polar_map_build(arena *a, polar *pd, polar_map *m, const uint32_t *in
  * randomized insertion; the DAG kept with its leaves as child words. */
 plx_status polar_insertion_order(arena *a, const polar *pd, uint32_t **out);
 plx_status polar_dag_build(arena *a, polar *pd, polar_map *m, dbuild *b, const snode *N,
-                           const uint32_t *canon, const uint32_t *order, uint32_t nev);
-plx_status polar_dag_keep(arena *a, polar *pd, polar_map *m, dbuild *b, int flags);
+                           const vec2 *E, const uint32_t *canon, const uint32_t *order,
+                           uint32_t nev);
+plx_status polar_dag_words(arena *a, dbuild *b, uint32_t **fw, uint32_t *nq);
+void polar_dag_free_traps(arena *a, dbuild *b);
+plx_status polar_dag_keep(arena *a, polar *pd, polar_map *m, dbuild *b, const uint32_t *fw,
+                          uint32_t nq, int flags);
 
 #endif

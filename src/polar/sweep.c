@@ -35,6 +35,7 @@ typedef struct sweep {
     const polar *pd;
     polar_map *m;
     snode *N;           /* per segment (walls and Bounds sides) */
+    const vec2 *E;      /* per segment: frame ends, left then right */
     polar_trap *T;
     uint32_t ntrap, cap;
     const uint32_t *inc_first, *inc; /* walls incident to each point */
@@ -50,6 +51,10 @@ typedef struct sweep {
     uint32_t ngap;      /* gaps opened, free or solid */
     uint64_t steps;     /* status pieces walked and start pieces sorted */
 } sweep;
+
+/* The frame ends of piece s. */
+#define EL(w, s) ((w)->E[2 * (size_t)(s)])
+#define ER(w, s) ((w)->E[2 * (size_t)(s) + 1])
 
 static int fp_before(const fpoint *a, const fpoint *b, const void *ctx)
 {
@@ -94,9 +99,9 @@ static int open_gap(sweep *w, uint32_t d, uint32_t pi, uint32_t top, uint32_t bo
 
 /* Does piece y start below piece x (both starting at the same point)?
  * Sets *flat when they are collinear. */
-static int start_below(const snode *N, uint32_t y, uint32_t x, int *flat)
+static int start_below(const vec2 *E, uint32_t y, uint32_t x, int *flat)
 {
-    int o = geom_orient(N[y].l, N[y].r, N[x].r);
+    int o = geom_orient(E[2 * (size_t)y], E[2 * (size_t)y + 1], E[2 * (size_t)x + 1]);
     if (o == 0)
         *flat = 1;
     return o > 0;
@@ -108,14 +113,14 @@ static int start_below(const snode *N, uint32_t y, uint32_t x, int *flat)
  * neighbours in the order are always compared, so it is seen). */
 static int sort_starts(sweep *w, uint32_t n)
 {
-    const snode *N = w->N;
+    const vec2 *E = w->E;
     uint32_t *src = w->start, *dst = w->tmp, i, j, wd;
     int flat = 0;
     for (i = 0; i < n; i += 8) {
         uint32_t e = i + 8 < n ? i + 8 : n;
         for (j = i + 1; j < e; j++) {
             uint32_t t = src[j], k = j;
-            while (k > i && start_below(N, t, src[k - 1], &flat)) {
+            while (k > i && start_below(E, t, src[k - 1], &flat)) {
                 src[k] = src[k - 1];
                 k--;
             }
@@ -127,7 +132,7 @@ static int sort_starts(sweep *w, uint32_t n)
             uint32_t a = i, am = i + wd < n ? i + wd : n, b = am, bm = i + 2 * wd < n ? i + 2 * wd : n;
             uint32_t o = i;
             while (a < am && b < bm)
-                dst[o++] = start_below(N, src[b], src[a], &flat) ? src[b++] : src[a++];
+                dst[o++] = start_below(E, src[b], src[a], &flat) ? src[b++] : src[a++];
             while (a < am)
                 dst[o++] = src[a++];
             while (b < bm)
@@ -159,7 +164,7 @@ static int sweep_event(sweep *w, vec2 P, uint32_t pi, const fpoint *pts, uint32_
         uint32_t p = pts[i].i;
         for (j = w->inc_first[p]; j < w->inc_first[p + 1]; j++) {
             uint32_t s = w->inc[j];
-            if (lex_cmp(N[s].l, P) == 0) {
+            if (lex_cmp(EL(w, s), P) == 0) {
                 w->start[ns++] = s;
             } else {
                 nend++;
@@ -174,7 +179,7 @@ static int sweep_event(sweep *w, vec2 P, uint32_t pi, const fpoint *pts, uint32_
         x = some_end;
         if (N[x].prev == POLAR_NONE)
             return -1;
-        while ((y = N[x].prev) != m->box_bot && lex_cmp(N[y].r, P) == 0)
+        while ((y = N[x].prev) != m->box_bot && lex_cmp(ER(w, y), P) == 0)
             x = y;
         B = N[x].prev;
     } else {
@@ -188,11 +193,11 @@ static int sweep_event(sweep *w, vec2 P, uint32_t pi, const fpoint *pts, uint32_
             return -1;
         B = w->DT[d].bot;
         if (B != m->box_bot &&
-            (B >= w->pd->nseg || N[B].prev == POLAR_NONE || geom_orient(N[B].l, N[B].r, P) <= 0))
+            (B >= w->pd->nseg || N[B].prev == POLAR_NONE || geom_orient(EL(w, B), ER(w, B), P) <= 0))
             return -1;
     }
     /* the pieces ending at P follow B */
-    for (y = N[B].next; y != POLAR_NONE && lex_cmp(N[y].r, P) == 0; y = N[y].next) {
+    for (y = N[B].next; y != POLAR_NONE && lex_cmp(ER(w, y), P) == 0; y = N[y].next) {
         last = y;
         k++;
     }
@@ -200,7 +205,7 @@ static int sweep_event(sweep *w, vec2 P, uint32_t pi, const fpoint *pts, uint32_
     if (k != nend)
         return -1;
     A = y;
-    if (A != POLAR_NONE && geom_orient(N[A].l, N[A].r, P) >= 0)
+    if (A != POLAR_NONE && geom_orient(EL(w, A), ER(w, A), P) >= 0)
         return -1;
     /* close the gaps B..e1, e1..e2, ..., ek..A */
     G0 = N[B].open;
@@ -320,12 +325,70 @@ static void frame_box(const polar *pd, polar_map *m)
 }
 
 
+/* Per piece: its frame ends (E) and the sweep's data (N); per point its
+ * canonical index (the first event point at its position): ev sorted. */
+static void frame_pieces(polar *pd, polar_map *m, snode *N, vec2 *E)
+{
+    uint32_t s;
+    for (s = 0; s < pd->nseg; s++) {
+        uint32_t l, r;
+        /* polar_locate's owner inside the solid above s: the footprint
+         * entered across s, if any (see locate in polar_scan) */
+        const polar_seg *gs = &pd->seg[s];
+        int32_t own;
+        seg_ends(pd, m->frame, s, &l, &r);
+        own = (l == gs->a ? gs->cover : -gs->cover) > 0 && gs->bld[0] >= 0 ? gs->bld[0] : -1;
+        E[2 * (size_t)s] = fpt(pd, m->frame, l);
+        E[2 * (size_t)s + 1] = fpt(pd, m->frame, r);
+        N[s].li = l;
+        N[s].ri = r;
+        N[s].solid = PACK(POLAR_CHILD_SOLID, (uint32_t)(own + 1));
+        N[s].yk = l == gs->a ? N_Y : N_YB;
+        N[s].cov = 0;
+        N[s].open = POLAR_NONE;
+        N[s].prev = N[s].next = POLAR_NONE;
+    }
+}
+
+/* The sweep over the events ev[0..nev-1] (sorted), with the DAG's map b. */
+static plx_status run_sweep(sweep *w, const dbuild *b, const fpoint *ev, uint32_t nev)
+{
+    polar_map *m = w->m;
+    uint32_t i, j, t;
+    w->N[m->box_bot].open = new_region(w, m->box_lo, m->box_top, m->box_bot);
+    if (open_gap(w, b->SR[m->box_bot].up[0], m->box_lo, m->box_top, m->box_bot,
+                 w->N[m->box_bot].open) != 0)
+        return PLX_E_SCENE;
+    for (i = 0; i < nev; i = j) {
+        for (j = i + 1; j < nev && lex_cmp(ev[j].f, ev[i].f) == 0; j++)
+            ;
+        if (sweep_event(w, ev[i].f, ev[i].i, ev + i, j - i) != 0)
+            return PLX_E_SCENE;
+    }
+    if (w->N[m->box_bot].next != POLAR_NONE || w->N[m->box_bot].open == POLAR_NONE)
+        return PLX_E_SCENE;
+    w->T[w->N[m->box_bot].open].rp = m->box_hi;
+    /* both maps the same: every live trapezoid of the DAG's map is one gap
+     * of the sweep, with the same sides */
+    for (t = 0; t < w->ntrap; t++)
+        if (w->T[t].rp == POLAR_NONE || b->T[w->regd[t]].rp != w->T[t].rp)
+            return PLX_E_SCENE;
+    if (w->ngap != b->ntrap - b->nfree)
+        return PLX_E_SCENE;
+    return PLX_OK;
+}
+
 /* Builds the trapezoidal map of one frame: the search DAG's map by
  * randomized insertion, then the sweep, which uses it to place the events
  * where pieces only start, checks that the pieces form a planar
  * subdivision and that both maps agree, and makes the free regions (kept,
  * in sweep order, with their adjacency); then the DAG is kept with its
- * leaves mapped to those regions (unless flags say otherwise). */
+ * leaves mapped to those regions (unless flags say otherwise).
+ * Scratch, in stack order: per piece N (32 bytes) and E (32), the events
+ * (24 a point), canonical indices; the insertion's (roles, hints, lists,
+ * search nodes; its trapezoid slots, 36 bytes, in the low end, given back
+ * before the kept arrays are made); the sweep's regions (at most one per
+ * live trapezoid of the map) and lists. */
 plx_status polar_map_build(arena *a, polar *pd, polar_map *m, const uint32_t *inc_first,
                            const uint32_t *inc, const uint32_t *evp, uint32_t nev,
                            const uint32_t *order, int flags, uint64_t *steps)
@@ -333,85 +396,64 @@ plx_status polar_map_build(arena *a, polar *pd, polar_map *m, const uint32_t *in
     sweep w;
     dbuild b;
     fpoint *ev, *tmp;
-    uint32_t i, j, s, t, *canon, nlive;
+    vec2 *E;
+    uint32_t i, j, *canon, nlive, *fw = NULL, nq = 0;
+    arena_mark mk;
     plx_status st;
     memset(&w, 0, sizeof w);
+    memset(&b, 0, sizeof b);
     w.pd = pd;
     w.m = m;
     w.inc_first = inc_first;
     w.inc = inc;
-    w.cap = 3 * pd->nwall + 8;
     w.N = scratch_n(a, pd->nseg, sizeof(snode));
-    w.T = scratch_n(a, w.cap, sizeof(polar_trap));
-    w.start = scratch_n(a, pd->nwall + 1, 4);
-    w.tmp = scratch_n(a, pd->nwall + 1, 4);
+    w.E = E = scratch_n(a, 2 * (size_t)pd->nseg, sizeof(vec2));
     ev = scratch_n(a, nev, sizeof(fpoint));
-    tmp = scratch_n(a, nev, sizeof(fpoint));
     canon = scratch_n(a, pd->npts, 4);
-    if (!w.N || !w.T || !w.start || !w.tmp || !ev || !tmp || !canon)
+    if (!w.N || !E || !ev || !canon)
         return PLX_E_NOMEM;
     frame_box(pd, m);
-    for (s = 0; s < pd->nseg; s++) {
-        uint32_t l, r;
-        seg_ends(pd, m->frame, s, &l, &r);
-        w.N[s].l = fpt(pd, m->frame, l);
-        w.N[s].r = fpt(pd, m->frame, r);
-        w.N[s].li = l;
-        w.N[s].ri = r;
-        {
-            /* polar_locate's owner inside the solid above s: the footprint
-             * entered across s, if any (see locate in polar_scan) */
-            const polar_seg *gs = &pd->seg[s];
-            int32_t own = (l == gs->a ? gs->cover : -gs->cover) > 0 && gs->bld[0] >= 0 ? gs->bld[0]
-                                                                                     : -1;
-            w.N[s].solid = PACK(POLAR_CHILD_SOLID, (uint32_t)(own + 1));
-            w.N[s].yk = l == gs->a ? N_Y : N_YB;
-        }
-        w.N[s].cov = 0;
-        w.N[s].open = POLAR_NONE;
-        w.N[s].prev = w.N[s].next = POLAR_NONE;
-    }
+    frame_pieces(pd, m, w.N, E);
     for (i = 0; i < nev; i++) {
         ev[i].f = fpt(pd, m->frame, evp[i]);
         ev[i].i = evp[i];
     }
+    mk = arena_get_mark(a);
+    tmp = scratch_n(a, nev, sizeof(fpoint));
+    if (!tmp)
+        return PLX_E_NOMEM;
     sort_fpoints(ev, tmp, nev, NULL);
+    arena_release(a, &mk);
     for (i = 0; i < pd->npts; i++)
         canon[i] = i;
     for (i = 0; i < nev; i = j)
         for (j = i + 1; j < nev && lex_cmp(ev[j].f, ev[i].f) == 0; j++)
             canon[ev[j].i] = ev[i].i;
-    st = polar_dag_build(a, pd, m, &b, w.N, canon, order, nev);
+    st = polar_dag_build(a, pd, m, &b, w.N, E, canon, order, nev);
     if (st != PLX_OK)
         return st;
     w.DT = b.T;
     w.SR = b.SR;
     w.PR = b.PR;
+    /* every region is a live trapezoid of the map, each once (open_gap) */
     nlive = b.ntrap - b.nfree;
+    w.cap = nlive;
+    w.T = scratch_n(a, w.cap, sizeof(polar_trap));
     w.regd = scratch_n(a, w.cap, 4);
-    if (!w.regd)
+    w.start = scratch_n(a, pd->nwall + 1, 4);
+    w.tmp = scratch_n(a, pd->nwall + 1, 4);
+    if (!w.T || !w.regd || !w.start || !w.tmp)
         return PLX_E_NOMEM;
-    w.N[m->box_bot].open = new_region(&w, m->box_lo, m->box_top, m->box_bot);
-    if (open_gap(&w, b.SR[m->box_bot].up[0], m->box_lo, m->box_top, m->box_bot,
-                 w.N[m->box_bot].open) != 0)
-        return PLX_E_SCENE;
-    for (i = 0; i < nev; i = j) {
-        for (j = i + 1; j < nev && lex_cmp(ev[j].f, ev[i].f) == 0; j++)
-            ;
-        if (sweep_event(&w, ev[i].f, ev[i].i, ev + i, j - i) != 0)
-            return PLX_E_SCENE;
-    }
-    if (w.N[m->box_bot].next != POLAR_NONE || w.N[m->box_bot].open == POLAR_NONE)
-        return PLX_E_SCENE;
-    w.T[w.N[m->box_bot].open].rp = m->box_hi;
-    /* both maps the same: every live trapezoid of the DAG's map is one gap
-     * of the sweep, with the same sides */
-    for (t = 0; t < w.ntrap; t++)
-        if (w.T[t].rp == POLAR_NONE || b.T[w.regd[t]].rp != w.T[t].rp)
-            return PLX_E_SCENE;
-    if (w.ngap != nlive)
-        return PLX_E_SCENE;
+    st = run_sweep(&w, &b, ev, nev);
+    if (st != PLX_OK)
+        return st;
     *steps += w.steps + b.steps;
+    if (!(flags & POLAR_BUILD_NO_DAG)) {
+        st = polar_dag_words(a, &b, &fw, &nq);
+        if (st != PLX_OK)
+            return st;
+    }
+    polar_dag_free_traps(a, &b);
     m->ntrap = w.ntrap;
     m->trap = keep_n(a, w.ntrap, sizeof(polar_trap), &pd->bytes[0]);
     if (!m->trap)
@@ -422,6 +464,5 @@ plx_status polar_map_build(arena *a, polar *pd, polar_map *m, const uint32_t *in
     pd->bytes[1] += (size_t)w.ntrap * 8;
     if (flags & POLAR_BUILD_NO_DAG)
         return PLX_OK;
-    return polar_dag_keep(a, pd, m, &b, flags);
+    return polar_dag_keep(a, pd, m, &b, fw, nq, flags);
 }
-

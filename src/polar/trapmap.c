@@ -42,13 +42,37 @@ static vec2 bpt(const dbuild *b, uint32_t i)
     return fpt(b->pd, b->frame, i);
 }
 
+/* Slots are allocated TRAP_STEP at a time from the low end of the arena,
+ * where nothing else is allocated while the map is built, so they stay one
+ * array; b->cap bounds them (see polar_dag_build). */
+#define TRAP_STEP 2048u
+
+static int grow_traps(dbuild *b)
+{
+    uint32_t step = b->cap - b->tcap < TRAP_STEP ? b->cap - b->tcap : TRAP_STEP;
+    btrap *p;
+    if (step == 0)
+        return 0;
+    p = arena_alloc(b->a, PLX_PART_POLAR, (size_t)step * sizeof(btrap), 16);
+    if (!p)
+        return 0;
+    if (!b->T)
+        b->T = p;
+    else if (p != b->T + b->tcap)
+        return 0;             /* not contiguous: cannot happen (see above) */
+    b->tcap += step;
+    return 1;
+}
+
 static uint32_t new_trap(dbuild *b)
 {
     uint32_t t;
     if (b->nfree > 0) {
-        t = b->freel[--b->nfree];
+        t = b->freel;
+        b->freel = b->T[t].nb[0];
+        b->nfree--;
     } else {
-        if (b->ntrap >= b->cap) {
+        if (b->ntrap >= b->tcap && !grow_traps(b)) {
             b->fail = 1;
             return 0;
         }
@@ -57,6 +81,20 @@ static uint32_t new_trap(dbuild *b)
     b->T[t].nb[0] = b->T[t].nb[1] = b->T[t].nb[2] = b->T[t].nb[3] = POLAR_NONE;
     b->T[t].leaf = POLAR_NONE;
     return t;
+}
+
+/* Frame coordinates of the right axis point of trapezoid t. */
+static vec2 trc(const dbuild *b, uint32_t t)
+{
+    return fpt(b->pd, b->frame, b->T[t].rp);
+}
+
+/* Gives slot t back (its leaf already POLAR_NONE). */
+static void free_trap(dbuild *b, uint32_t t)
+{
+    b->T[t].nb[0] = b->freel;
+    b->freel = t;
+    b->nfree++;
 }
 
 static uint32_t new_node(dbuild *b, uint32_t kind, uint32_t idx, uint32_t c0, uint32_t c1)
@@ -148,12 +186,10 @@ static void relink(dbuild *b, uint32_t x, int f, uint32_t old, uint32_t nw)
         b->T[x].nb[f] = nw;
 }
 
-static void set_trap(dbuild *b, uint32_t t, uint32_t lp, uint32_t rp, vec2 rc, uint32_t top,
-                     uint32_t bot)
+static void set_trap(dbuild *b, uint32_t t, uint32_t lp, uint32_t rp, uint32_t top, uint32_t bot)
 {
     b->T[t].lp = lp;
     b->T[t].rp = rp;
-    b->T[t].rc = rc;
     b->T[t].top = top;
     b->T[t].bot = bot;
 }
@@ -265,9 +301,13 @@ static uint32_t follow(dbuild *b, uint32_t l, uint32_t r)
         b->list[0] = find_first(b, b->hint[l] != POLAR_NONE ? b->hint[l] : 0, P, Q);
     if (b->fail)
         return 0;
-    while (lex_cmp(Q, b->T[b->list[k]].rc) > 0) {
+    for (;;) {
         uint32_t t = b->list[k], nx;
-        int o = geom_orient(P, Q, b->T[t].rc);
+        vec2 rc = trc(b, t);
+        int o;
+        if (lex_cmp(Q, rc) <= 0)
+            break;
+        o = geom_orient(P, Q, rc);
         nx = o > 0 ? b->T[t].nb[LR] : b->T[t].nb[UR];
         if (o == 0 || nx == POLAR_NONE || k + 1 >= b->lcap || b->T[nx].leaf == POLAR_NONE ||
             b->T[nx].lp != b->T[t].rp) {
@@ -289,26 +329,25 @@ static void make_chain(dbuild *b, uint32_t s, uint32_t l, uint32_t r, uint32_t k
     if (b->fail)
         return;
     if (up)
-        set_trap(b, cur, l, r, Q, b->T[b->list[0]].top, s);
+        set_trap(b, cur, l, r, b->T[b->list[0]].top, s);
     else
-        set_trap(b, cur, l, r, Q, s, b->T[b->list[0]].bot);
+        set_trap(b, cur, l, r, s, b->T[b->list[0]].bot);
     part[0] = cur;
     for (j = 0; j < k; j++) {
         uint32_t t = b->list[j], t1 = b->list[j + 1], R = b->T[t].rp, nx, x;
-        int o = geom_orient(P, Q, b->T[t].rc);
+        int o = geom_orient(P, Q, trc(b, t));
         if ((o > 0) != (up != 0)) {
             part[j + 1] = cur;        /* the axis at R is cut away: merge */
             continue;
         }
         b->T[cur].rp = R;
-        b->T[cur].rc = b->T[t].rc;
         nx = new_trap(b);
         if (b->fail)
             return;
         if (up)
-            set_trap(b, nx, R, r, Q, b->T[t1].top, s);
+            set_trap(b, nx, R, r, b->T[t1].top, s);
         else
-            set_trap(b, nx, R, r, Q, s, b->T[t1].bot);
+            set_trap(b, nx, R, r, s, b->T[t1].bot);
         x = b->T[t].nb[fc];
         b->T[cur].nb[fc] = x;
         relink(b, x, fo, t, cur);
@@ -416,12 +455,12 @@ static void insert_seg(dbuild *b, const irec *in)
     if (l != b->T[first].lp) {
         A = new_trap(b);
         if (!b->fail)
-            set_trap(b, A, b->T[first].lp, l, b->P, b->T[first].top, b->T[first].bot);
+            set_trap(b, A, b->T[first].lp, l, b->T[first].top, b->T[first].bot);
     }
     if (!b->fail && r != b->T[last].rp) {
         B = new_trap(b);
         if (!b->fail)
-            set_trap(b, B, r, b->T[last].rp, b->T[last].rc, b->T[last].top, b->T[last].bot);
+            set_trap(b, B, r, b->T[last].rp, b->T[last].top, b->T[last].bot);
     }
     if (!b->fail)
         make_chain(b, s, l, r, k, 1);
@@ -442,7 +481,7 @@ static void insert_seg(dbuild *b, const irec *in)
         replace_leaf(b, s, l, r, b->T[t].leaf, j, j == 0 ? A : POLAR_NONE,
                      j == k ? B : POLAR_NONE);
         b->T[t].leaf = POLAR_NONE;
-        b->freel[b->nfree++] = t;
+        free_trap(b, t);
     }
     if (A != POLAR_NONE)
         note_trap(b, A);
@@ -487,16 +526,14 @@ static void put_node(polar_map *m, uint32_t j, uint32_t t, uint32_t c0, uint32_t
     }
 }
 
-/* Leaves to child words (set by the sweep in the trapezoids' leaf field),
- * the inner nodes kept in the order they were made (the top levels first;
- * with the insertion order, nodes made together lie together), narrow when
- * every index fits, and counted in polar_memory (rest). */
-plx_status polar_dag_keep(arena *a, polar *pd, polar_map *m, dbuild *b, int flags)
+/* Leaves to child words (set by the sweep in the trapezoids' leaf field):
+ * fw[i], per build node i, its child word, and nq the inner nodes (scratch;
+ * the slots are read here for the last time). */
+plx_status polar_dag_words(arena *a, dbuild *b, uint32_t **fw_out, uint32_t *nq_out)
 {
-    uint32_t i, j, nq = 0, *fw = scratch_n(a, b->nnode, 4);
+    uint32_t i, nq = 0, *fw = scratch_n(a, b->nnode, 4);
     if (!fw)
         return PLX_E_NOMEM;
-    /* fw: per build node its child word */
     for (i = 0; i < b->nnode; i++) {
         uint32_t w0 = dnode(b, i)[0];
         if (KIND(w0) != N_LEAF)
@@ -504,6 +541,33 @@ plx_status polar_dag_keep(arena *a, polar *pd, polar_map *m, dbuild *b, int flag
         else if (POLAR_TAG(fw[i] = b->T[IDX(w0)].leaf) == POLAR_CHILD_NODE)
             return PLX_E_SCENE;
     }
+    *fw_out = fw;
+    *nq_out = nq;
+    return PLX_OK;
+}
+
+/* Gives the trapezoid slots back: the low end of the arena as it was
+ * before them (nothing was allocated there since). */
+void polar_dag_free_traps(arena *a, dbuild *b)
+{
+    arena_mark m = arena_get_mark(a);
+    if (!b->T)
+        return;
+    m.lo = b->tmark.lo;
+    m.used[PLX_PART_POLAR] = b->tmark.used[PLX_PART_POLAR];
+    arena_release(a, &m);
+    b->T = NULL;
+    b->tcap = 0;
+}
+
+/* The inner nodes kept in the order they were made (the top levels first;
+ * with the insertion order, nodes made together lie together), their
+ * children as child words (fw, polar_dag_words), narrow when every index
+ * fits, and counted in polar_memory (rest). */
+plx_status polar_dag_keep(arena *a, polar *pd, polar_map *m, dbuild *b, const uint32_t *fw,
+                          uint32_t nq, int flags)
+{
+    uint32_t i, j;
     m->nnode = nq;
     m->narrow = !(flags & POLAR_BUILD_WIDE_DAG) && nq < (1u << 19) && m->ntrap < (1u << 19) &&
                 pd->nbld < (1u << 19) - 1 && pd->npts < (1u << 20) && pd->nseg < (1u << 20);
@@ -542,12 +606,18 @@ static uint32_t spread16(uint32_t x)
  * order). Deterministic: no global state. */
 plx_status polar_insertion_order(arena *a, const polar *pd, uint32_t **out)
 {
-    uint32_t i, n = pd->nwall, d, *order = scratch_n(a, n, 4), *o2 = scratch_n(a, n, 4);
-    uint64_t *key = scratch_n(a, n, 8), *k2 = scratch_n(a, n, 8);
-    uint32_t *cnt = scratch_n(a, 65536, 4);
+    uint32_t i, n = pd->nwall, d, *out0 = scratch_n(a, n, 4), *order, *o2;
+    arena_mark mk = arena_get_mark(a);  /* the sort's own scratch is given back */
+    uint64_t *key, *k2;
+    uint32_t *cnt;
     uint64_t seed = 0x9e3779b97f4a7c15ull;
     double sx = 65535.0 / (pd->box[2] - pd->box[0]), sy = 65535.0 / (pd->box[3] - pd->box[1]);
-    if (!order || !o2 || !key || !k2 || !cnt)
+    order = scratch_n(a, n, 4);
+    o2 = scratch_n(a, n, 4);
+    key = scratch_n(a, n, 8);
+    k2 = scratch_n(a, n, 8);
+    cnt = scratch_n(a, 65536, 4);
+    if (!out0 || !order || !o2 || !key || !k2 || !cnt)
         return PLX_E_NOMEM;
     for (i = 0; i < n; i++) {
         const polar_seg *g = &pd->seg[i];
@@ -591,33 +661,45 @@ plx_status polar_insertion_order(arena *a, const polar *pd, uint32_t **out)
             o2 = to;
         }
     }
-    *out = order;
+    memcpy(out0, order, (size_t)n * 4);
+    arena_release(a, &mk);
+    *out = out0;
     return PLX_OK;
 }
 
-/* Asks the cache for what insertion in will read first (a hint only;
- * nothing where the compiler offers no prefetch). */
-static void prefetch_roles(const dbuild *b, const irec *in)
+/* Asks the cache for what insertion i + 8 will read first (its ends'
+ * roles and hints; the piece's own data was asked for 8 insertions
+ * before). A hint only; nothing where the compiler offers no prefetch. */
+static void prefetch_ahead(const dbuild *b, uint32_t i, uint32_t nw)
 {
 #if defined(__GNUC__)
-    __builtin_prefetch(&b->PR[in->l]);
-    __builtin_prefetch(&b->PR[in->r]);
-    __builtin_prefetch(&b->hint[in->l]);
+    if (i + 16 < nw) {
+        uint32_t s = b->order[i + 16];
+        __builtin_prefetch(&b->SR[s]);
+        __builtin_prefetch(&b->E[2 * (size_t)s]);
+    }
+    if (i + 8 < nw) {
+        const sroles *r = &b->SR[b->order[i + 8]];
+        __builtin_prefetch(&b->PR[r->end[0]]);
+        __builtin_prefetch(&b->PR[r->end[1]]);
+        __builtin_prefetch(&b->hint[r->end[0]]);
+    }
 #else
     (void)b;
-    (void)in;
+    (void)i;
+    (void)nw;
 #endif
 }
 
 /* Builds the trapezoidal map of the wall pieces of m and its search DAG by
- * randomized incremental insertion, into b (scratch). N: the pieces' frame
- * ends (the sweep's snodes). */
+ * randomized incremental insertion, into b (scratch, the trapezoid slots
+ * in the low end of the arena). N: the pieces' ends and y test kinds (the
+ * sweep's snodes); E: their frame ends. */
 plx_status polar_dag_build(arena *a, polar *pd, polar_map *m, dbuild *b, const snode *N,
-                            const uint32_t *canon, const uint32_t *order, uint32_t nends)
+                           const vec2 *E, const uint32_t *canon, const uint32_t *order,
+                           uint32_t nends)
 {
     uint32_t nw = pd->nwall, i, t;
-    vec2 *E;
-    irec *rec;
     if (nw >= (1u << 26) || pd->npts >= (1u << 26))
         return PLX_E_NOMEM;   /* indices must fit in 30 bits */
     memset(b, 0, sizeof *b);
@@ -626,9 +708,12 @@ plx_status polar_dag_build(arena *a, polar *pd, polar_map *m, dbuild *b, const s
     b->frame = m->frame;
     b->canon = canon;
     b->N = N;
+    b->E = E;
+    b->order = order;
     /* trapezoid slots: at most 3 i + 1 live after i pieces; a new piece
      * crosses one trapezoid more than the axes it cuts, at most one per
-     * wall end, and makes two per crossed one plus two: 3 n + 2 ends + 64 */
+     * wall end, and makes two per crossed one plus two: 3 n + 2 ends + 64
+     * (the bound; slots are allocated as they are used, about 2 a piece) */
     b->cap = 3 * nw + 2 * nends + 64;
     /* expected about 8 nodes per piece; beyond 64 the shuffle has failed
      * beyond any reasonable chance (reported as out of memory) */
@@ -636,48 +721,39 @@ plx_status polar_dag_build(arena *a, polar *pd, polar_map *m, dbuild *b, const s
     if (b->maxchunk > (1u << (30 - NODE_BITS)))
         b->maxchunk = 1u << (30 - NODE_BITS);
     b->lcap = nends + 8;
-    b->T = scratch_n(a, b->cap, sizeof(btrap));
-    b->freel = scratch_n(a, b->cap, 4);
     b->list = scratch_n(a, b->lcap, 4);
     b->up = scratch_n(a, b->lcap, 4);
     b->lo = scratch_n(a, b->lcap, 4);
     b->chunk = scratch_n(a, b->maxchunk, sizeof *b->chunk);
     b->hint = scratch_n(a, pd->npts, 4);
-    b->E = E = scratch_n(a, 2 * (size_t)pd->nseg, sizeof(vec2));
     b->SR = scratch_n(a, pd->nseg, sizeof(sroles));
     b->PR = scratch_n(a, pd->npts, sizeof(proles));
-    rec = scratch_n(a, nw, sizeof(irec));
-    if (!b->T || !b->freel || !b->list || !b->up || !b->lo || !b->chunk || !b->hint || !E ||
-        !b->SR || !b->PR || !rec)
+    if (!b->list || !b->up || !b->lo || !b->chunk || !b->hint || !b->SR || !b->PR)
         return PLX_E_NOMEM;
     memset(b->SR, 0xff, (size_t)pd->nseg * sizeof(sroles));
     memset(b->PR, 0xff, (size_t)pd->npts * sizeof(proles));
-    /* what the insertions read, packed: the ends of every piece, and per
-     * insertion its piece (gathered here, where the loads do not wait on
-     * one another) */
     for (i = 0; i < pd->nseg; i++) {
-        E[2 * (size_t)i] = N[i].l;
-        E[2 * (size_t)i + 1] = N[i].r;
         b->SR[i].end[0] = canon[N[i].li];
         b->SR[i].end[1] = canon[N[i].ri];
     }
-    for (i = 0; i < nw; i++) {
-        const snode *g = &N[order[i]];
-        rec[i].P = g->l;
-        rec[i].Q = g->r;
-        rec[i].s = order[i];
-        rec[i].l = canon[g->li];
-        rec[i].r = canon[g->ri];
-    }
     memset(b->hint, 0xff, (size_t)pd->npts * 4);
+    b->tmark = arena_get_mark(a);
     t = new_trap(b);
-    set_trap(b, t, m->box_lo, m->box_hi, bpt(b, m->box_hi), m->box_top, m->box_bot);
+    if (b->fail)
+        return PLX_E_NOMEM;
+    set_trap(b, t, m->box_lo, m->box_hi, m->box_top, m->box_bot);
     b->T[t].leaf = new_node(b, N_LEAF, t, 0, 0);
     note_trap(b, t);
     for (i = 0; i < nw && !b->fail; i++) {
-        if (i + 8 < nw)
-            prefetch_roles(b, &rec[i + 8]);
-        insert_seg(b, &rec[i]);
+        irec in;
+        uint32_t s = order[i];
+        prefetch_ahead(b, i, nw);
+        in.P = E[2 * (size_t)s];
+        in.Q = E[2 * (size_t)s + 1];
+        in.s = s;
+        in.l = b->SR[s].end[0];
+        in.r = b->SR[s].end[1];
+        insert_seg(b, &in);
     }
     if (b->fail)
         return b->fail == 1 ? PLX_E_NOMEM : PLX_E_SCENE;
