@@ -158,7 +158,6 @@ typedef struct snode {
     int32_t cov;        /* footprints covering the gap above it */
     uint32_t open;      /* the free region open above it, or POLAR_NONE */
     uint32_t prev, next; /* status list; prev == POLAR_NONE: not in it */
-    uint32_t li, ri;    /* point indices of its left and right ends */
     uint32_t solid;     /* child word of a solid trapezoid on it (search DAG) */
     uint32_t yk;        /* its search node kind: N_Y (l is seg.a) or N_YB */
 } snode;
@@ -181,8 +180,8 @@ typedef struct dbuild {
     uint32_t nchunk, maxchunk, nnode;
     uint32_t *list, *up, *lo; /* per crossed trapezoid: it, its new upper / lower part */
     uint32_t lcap;           /* their length: a piece crosses one trapezoid more than the
-                              * axes it cuts, each at a distinct point (ends + box + 4) */
-    const uint32_t *canon;   /* per point: the first point at its position */
+                              * axes it cuts, each at a distinct event position
+                              * between its ends (the longest such run + 8) */
     const snode *N;          /* per piece: the sweep's data (y test kind) */
     const vec2 *E;           /* per piece: frame ends, left then right */
     const uint32_t *order;   /* the insertion order */
@@ -212,11 +211,16 @@ plx_status polar_map_build(arena *a, polar *pd, polar_map *m, const uint32_t *in
  * randomized insertion; the DAG kept with its leaves as child words. */
 plx_status polar_insertion_order(arena *a, const polar *pd, uint32_t **out);
 plx_status polar_dag_build(arena *a, polar *pd, polar_map *m, dbuild *b, const snode *N,
-                           const vec2 *E, const uint32_t *canon, const uint32_t *order,
-                           uint32_t nev);
-plx_status polar_dag_words(arena *a, dbuild *b, uint32_t **fw, uint32_t *nq);
+                           const vec2 *E, sroles *SR, const uint32_t *order, uint32_t span);
+/* The inner nodes' ranks among the build nodes (see polar_dag_words). */
+typedef struct dag_rank {
+    uint64_t *bits;          /* bit i: build node i is inner */
+    uint32_t *before;        /* inner nodes before node 64 k */
+    uint32_t nq;             /* inner nodes */
+} dag_rank;
+plx_status polar_dag_words(arena *a, dbuild *b, dag_rank *rk);
 void polar_dag_free_traps(arena *a, dbuild *b);
-plx_status polar_dag_keep(arena *a, polar *pd, polar_map *m, dbuild *b, const uint32_t *fw,
-                          uint32_t nq, int flags);
+plx_status polar_dag_keep(arena *a, polar *pd, polar_map *m, dbuild *b, const dag_rank *rk,
+                          int flags);
 
 #endif

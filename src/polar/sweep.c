@@ -52,6 +52,11 @@ typedef struct sweep {
     uint64_t steps;     /* status pieces walked and start pieces sorted */
 } sweep;
 
+/* A sorted event: its point index, EV_SAME when at the position of the one
+ * before. */
+#define EV_SAME 0x80000000u
+#define EV_POINT 0x7fffffffu
+
 /* The frame ends of piece s. */
 #define EL(w, s) ((w)->E[2 * (size_t)(s)])
 #define ER(w, s) ((w)->E[2 * (size_t)(s) + 1])
@@ -153,7 +158,7 @@ static int sort_starts(sweep *w, uint32_t n)
 /* One event: the walls ending and starting at frame point P (point index
  * pi, the points pts[0..npts-1] all at P). Returns 0, or -1 when the walls
  * are not a planar subdivision (pieces crossing after rounding). */
-static int sweep_event(sweep *w, vec2 P, uint32_t pi, const fpoint *pts, uint32_t npts)
+static int sweep_event(sweep *w, vec2 P, uint32_t pi, const uint32_t *pts, uint32_t npts)
 {
     snode *N = w->N;
     const polar_map *m = w->m;
@@ -161,7 +166,7 @@ static int sweep_event(sweep *w, vec2 P, uint32_t pi, const fpoint *pts, uint32_
     uint32_t G0, Gk, H0 = POLAR_NONE, Hm = POLAR_NONE, i, j;
     /* the walls starting here, bottom to top; those ending here counted */
     for (i = 0; i < npts; i++) {
-        uint32_t p = pts[i].i;
+        uint32_t p = pts[i] & EV_POINT;
         for (j = w->inc_first[p]; j < w->inc_first[p + 1]; j++) {
             uint32_t s = w->inc[j];
             if (lex_cmp(EL(w, s), P) == 0) {
@@ -325,11 +330,14 @@ static void frame_box(const polar *pd, polar_map *m)
 }
 
 
-/* Per piece: its frame ends (E) and the sweep's data (N); per point its
- * canonical index (the first event point at its position): ev sorted. */
-static void frame_pieces(polar *pd, polar_map *m, snode *N, vec2 *E)
+/* Per piece: its frame ends (E), the sweep's data (N) and its canonical
+ * ends (SR, all else unset: POLAR_NONE); canon: per point the first event
+ * point at its position. */
+static void frame_pieces(polar *pd, polar_map *m, snode *N, vec2 *E, sroles *SR,
+                         const uint32_t *canon)
 {
     uint32_t s;
+    memset(SR, 0xff, (size_t)pd->nseg * sizeof(sroles));
     for (s = 0; s < pd->nseg; s++) {
         uint32_t l, r;
         /* polar_locate's owner inside the solid above s: the footprint
@@ -340,8 +348,8 @@ static void frame_pieces(polar *pd, polar_map *m, snode *N, vec2 *E)
         own = (l == gs->a ? gs->cover : -gs->cover) > 0 && gs->bld[0] >= 0 ? gs->bld[0] : -1;
         E[2 * (size_t)s] = fpt(pd, m->frame, l);
         E[2 * (size_t)s + 1] = fpt(pd, m->frame, r);
-        N[s].li = l;
-        N[s].ri = r;
+        SR[s].end[0] = canon[l];
+        SR[s].end[1] = canon[r];
         N[s].solid = PACK(POLAR_CHILD_SOLID, (uint32_t)(own + 1));
         N[s].yk = l == gs->a ? N_Y : N_YB;
         N[s].cov = 0;
@@ -350,8 +358,49 @@ static void frame_pieces(polar *pd, polar_map *m, snode *N, vec2 *E)
     }
 }
 
-/* The sweep over the events ev[0..nev-1] (sorted), with the DAG's map b. */
-static plx_status run_sweep(sweep *w, const dbuild *b, const fpoint *ev, uint32_t nev)
+/* The events in sweep order (evs, EV_SAME marking a position already
+ * seen), the canonical point of every point, and the longest run of
+ * event positions from a wall piece's left end to its right end: a piece
+ * crosses at most one trapezoid per position strictly between its ends,
+ * plus one (the insertion's lists are sized by it). canon and the sort's
+ * buffers are scratch given back by the caller. */
+static plx_status sort_events(arena *a, const polar *pd, int frame, const uint32_t *evp,
+                              uint32_t nev, uint32_t *evs, uint32_t *canon, uint32_t *span)
+{
+    fpoint *ev = scratch_n(a, nev, sizeof(fpoint)), *tmp = scratch_n(a, nev, sizeof(fpoint));
+    uint32_t *rank = scratch_n(a, pd->npts, 4), i, j, nd = 0, s;
+    if (!ev || !tmp || !rank)
+        return PLX_E_NOMEM;
+    for (i = 0; i < nev; i++) {
+        ev[i].f = fpt(pd, frame, evp[i]);
+        ev[i].i = evp[i];
+    }
+    sort_fpoints(ev, tmp, nev, NULL);
+    for (i = 0; i < pd->npts; i++) {
+        canon[i] = i;
+        rank[i] = 0;
+    }
+    for (i = 0; i < nev; i = j, nd++) {
+        evs[i] = ev[i].i;
+        rank[ev[i].i] = nd;
+        for (j = i + 1; j < nev && lex_cmp(ev[j].f, ev[i].f) == 0; j++) {
+            canon[ev[j].i] = ev[i].i;
+            rank[ev[j].i] = nd;
+            evs[j] = ev[j].i | EV_SAME;
+        }
+    }
+    *span = 0;
+    for (s = 0; s < pd->nwall; s++) {
+        uint32_t ra = rank[pd->seg[s].a], rb = rank[pd->seg[s].b];
+        uint32_t d = ra > rb ? ra - rb : rb - ra;
+        if (d > *span)
+            *span = d;
+    }
+    return PLX_OK;
+}
+
+/* The sweep over the sorted events evs[0..nev-1], with the DAG's map b. */
+static plx_status run_sweep(sweep *w, const dbuild *b, const uint32_t *evs, uint32_t nev)
 {
     polar_map *m = w->m;
     uint32_t i, j, t;
@@ -360,9 +409,9 @@ static plx_status run_sweep(sweep *w, const dbuild *b, const fpoint *ev, uint32_
                  w->N[m->box_bot].open) != 0)
         return PLX_E_SCENE;
     for (i = 0; i < nev; i = j) {
-        for (j = i + 1; j < nev && lex_cmp(ev[j].f, ev[i].f) == 0; j++)
+        for (j = i + 1; j < nev && (evs[j] & EV_SAME); j++)
             ;
-        if (sweep_event(w, ev[i].f, ev[i].i, ev + i, j - i) != 0)
+        if (sweep_event(w, fpt(w->pd, m->frame, evs[i]), evs[i], evs + i, j - i) != 0)
             return PLX_E_SCENE;
     }
     if (w->N[m->box_bot].next != POLAR_NONE || w->N[m->box_bot].open == POLAR_NONE)
@@ -395,11 +444,14 @@ plx_status polar_map_build(arena *a, polar *pd, polar_map *m, const uint32_t *in
 {
     sweep w;
     dbuild b;
-    fpoint *ev, *tmp;
     vec2 *E;
-    uint32_t i, j, *canon, nlive, *fw = NULL, nq = 0;
+    uint32_t *evs, *canon, nlive, span;
+    sroles *SR;
+    dag_rank rk;
     arena_mark mk;
     plx_status st;
+    if (pd->npts >= (1u << 26) || pd->nwall >= (1u << 26))
+        return PLX_E_NOMEM;   /* indices must fit in 30 bits (26 here) */
     memset(&w, 0, sizeof w);
     memset(&b, 0, sizeof b);
     w.pd = pd;
@@ -408,28 +460,21 @@ plx_status polar_map_build(arena *a, polar *pd, polar_map *m, const uint32_t *in
     w.inc = inc;
     w.N = scratch_n(a, pd->nseg, sizeof(snode));
     w.E = E = scratch_n(a, 2 * (size_t)pd->nseg, sizeof(vec2));
-    ev = scratch_n(a, nev, sizeof(fpoint));
-    canon = scratch_n(a, pd->npts, 4);
-    if (!w.N || !E || !ev || !canon)
+    SR = scratch_n(a, pd->nseg, sizeof(sroles));
+    evs = scratch_n(a, nev, 4);
+    if (!w.N || !E || !SR || !evs)
         return PLX_E_NOMEM;
     frame_box(pd, m);
-    frame_pieces(pd, m, w.N, E);
-    for (i = 0; i < nev; i++) {
-        ev[i].f = fpt(pd, m->frame, evp[i]);
-        ev[i].i = evp[i];
-    }
     mk = arena_get_mark(a);
-    tmp = scratch_n(a, nev, sizeof(fpoint));
-    if (!tmp)
+    canon = scratch_n(a, pd->npts, 4);
+    if (!canon)
         return PLX_E_NOMEM;
-    sort_fpoints(ev, tmp, nev, NULL);
+    st = sort_events(a, pd, m->frame, evp, nev, evs, canon, &span);
+    if (st != PLX_OK)
+        return st;
+    frame_pieces(pd, m, w.N, E, SR, canon);
     arena_release(a, &mk);
-    for (i = 0; i < pd->npts; i++)
-        canon[i] = i;
-    for (i = 0; i < nev; i = j)
-        for (j = i + 1; j < nev && lex_cmp(ev[j].f, ev[i].f) == 0; j++)
-            canon[ev[j].i] = ev[i].i;
-    st = polar_dag_build(a, pd, m, &b, w.N, E, canon, order, nev);
+    st = polar_dag_build(a, pd, m, &b, w.N, E, SR, order, span);
     if (st != PLX_OK)
         return st;
     w.DT = b.T;
@@ -444,12 +489,12 @@ plx_status polar_map_build(arena *a, polar *pd, polar_map *m, const uint32_t *in
     w.tmp = scratch_n(a, pd->nwall + 1, 4);
     if (!w.T || !w.regd || !w.start || !w.tmp)
         return PLX_E_NOMEM;
-    st = run_sweep(&w, &b, ev, nev);
+    st = run_sweep(&w, &b, evs, nev);
     if (st != PLX_OK)
         return st;
     *steps += w.steps + b.steps;
     if (!(flags & POLAR_BUILD_NO_DAG)) {
-        st = polar_dag_words(a, &b, &fw, &nq);
+        st = polar_dag_words(a, &b, &rk);
         if (st != PLX_OK)
             return st;
     }
@@ -464,5 +509,5 @@ plx_status polar_map_build(arena *a, polar *pd, polar_map *m, const uint32_t *in
     pd->bytes[1] += (size_t)w.ntrap * 8;
     if (flags & POLAR_BUILD_NO_DAG)
         return PLX_OK;
-    return polar_dag_keep(a, pd, m, &b, fw, nq, flags);
+    return polar_dag_keep(a, pd, m, &b, &rk, flags);
 }

@@ -526,24 +526,51 @@ static void put_node(polar_map *m, uint32_t j, uint32_t t, uint32_t c0, uint32_t
     }
 }
 
-/* Leaves to child words (set by the sweep in the trapezoids' leaf field):
- * fw[i], per build node i, its child word, and nq the inner nodes (scratch;
- * the slots are read here for the last time). */
-plx_status polar_dag_words(arena *a, dbuild *b, uint32_t **fw_out, uint32_t *nq_out)
+/* Leaves to child words (set by the sweep in the trapezoids' leaf field,
+ * copied here into the leaf nodes' second word; the slots are read here
+ * for the last time), and the inner nodes' ranks: a bit per build node
+ * (inner) and the inner nodes before every 64 (rk: 12 bytes per 64
+ * nodes of scratch). */
+plx_status polar_dag_words(arena *a, dbuild *b, dag_rank *rk)
 {
-    uint32_t i, nq = 0, *fw = scratch_n(a, b->nnode, 4);
-    if (!fw)
+    uint32_t i, nw64 = (b->nnode + 63) / 64, nq = 0;
+    rk->bits = scratch_n(a, nw64, 8);
+    rk->before = scratch_n(a, nw64, 4);
+    if (!rk->bits || !rk->before)
         return PLX_E_NOMEM;
+    memset(rk->bits, 0, (size_t)nw64 * 8);
     for (i = 0; i < b->nnode; i++) {
-        uint32_t w0 = dnode(b, i)[0];
-        if (KIND(w0) != N_LEAF)
-            fw[i] = PACK(POLAR_CHILD_NODE, nq++);
-        else if (POLAR_TAG(fw[i] = b->T[IDX(w0)].leaf) == POLAR_CHILD_NODE)
+        uint32_t *nd = dnode(b, i);
+        if ((i & 63) == 0)
+            rk->before[i >> 6] = nq;
+        if (KIND(nd[0]) != N_LEAF) {
+            rk->bits[i >> 6] |= (uint64_t)1 << (i & 63);
+            nq++;
+        } else if (POLAR_TAG(nd[1] = b->T[IDX(nd[0])].leaf) == POLAR_CHILD_NODE) {
             return PLX_E_SCENE;
+        }
     }
-    *fw_out = fw;
-    *nq_out = nq;
+    rk->nq = nq;
     return PLX_OK;
+}
+
+static uint32_t popcount64(uint64_t x)
+{
+    x = x - ((x >> 1) & 0x5555555555555555ull);
+    x = (x & 0x3333333333333333ull) + ((x >> 2) & 0x3333333333333333ull);
+    x = (x + (x >> 4)) & 0x0f0f0f0f0f0f0f0full;
+    return (uint32_t)((x * 0x0101010101010101ull) >> 56);
+}
+
+/* The child word of build node c: its leaf's word, or the inner node's
+ * index among the kept ones. */
+static uint32_t child_word(const dbuild *b, const dag_rank *rk, uint32_t c)
+{
+    const uint32_t *nd = dnode(b, c);
+    uint64_t below = ((uint64_t)1 << (c & 63)) - 1;
+    if (KIND(nd[0]) == N_LEAF)
+        return nd[1];
+    return PACK(POLAR_CHILD_NODE, rk->before[c >> 6] + popcount64(rk->bits[c >> 6] & below));
 }
 
 /* Gives the trapezoid slots back: the low end of the arena as it was
@@ -564,10 +591,10 @@ void polar_dag_free_traps(arena *a, dbuild *b)
  * with the insertion order, nodes made together lie together), their
  * children as child words (fw, polar_dag_words), narrow when every index
  * fits, and counted in polar_memory (rest). */
-plx_status polar_dag_keep(arena *a, polar *pd, polar_map *m, dbuild *b, const uint32_t *fw,
-                          uint32_t nq, int flags)
+plx_status polar_dag_keep(arena *a, polar *pd, polar_map *m, dbuild *b, const dag_rank *rk,
+                          int flags)
 {
-    uint32_t i, j;
+    uint32_t i, j, nq = rk->nq;
     m->nnode = nq;
     m->narrow = !(flags & POLAR_BUILD_WIDE_DAG) && nq < (1u << 19) && m->ntrap < (1u << 19) &&
                 pd->nbld < (1u << 19) - 1 && pd->npts < (1u << 20) && pd->nseg < (1u << 20);
@@ -578,9 +605,9 @@ plx_status polar_dag_keep(arena *a, polar *pd, polar_map *m, dbuild *b, const ui
         const uint32_t *nd = dnode(b, i);
         if (KIND(nd[0]) == N_LEAF)
             continue;
-        put_node(m, j++, nd[0], fw[nd[1]], fw[nd[2]]);
+        put_node(m, j++, nd[0], child_word(b, rk, nd[1]), child_word(b, rk, nd[2]));
     }
-    m->root = fw[0];
+    m->root = child_word(b, rk, 0);
     return PLX_OK;
 }
 
@@ -696,8 +723,7 @@ static void prefetch_ahead(const dbuild *b, uint32_t i, uint32_t nw)
  * in the low end of the arena). N: the pieces' ends and y test kinds (the
  * sweep's snodes); E: their frame ends. */
 plx_status polar_dag_build(arena *a, polar *pd, polar_map *m, dbuild *b, const snode *N,
-                           const vec2 *E, const uint32_t *canon, const uint32_t *order,
-                           uint32_t nends)
+                           const vec2 *E, sroles *SR, const uint32_t *order, uint32_t span)
 {
     uint32_t nw = pd->nwall, i, t;
     if (nw >= (1u << 26) || pd->npts >= (1u << 26))
@@ -706,36 +732,31 @@ plx_status polar_dag_build(arena *a, polar *pd, polar_map *m, dbuild *b, const s
     b->pd = pd;
     b->a = a;
     b->frame = m->frame;
-    b->canon = canon;
     b->N = N;
     b->E = E;
+    b->SR = SR;
     b->order = order;
     /* trapezoid slots: at most 3 i + 1 live after i pieces; a new piece
-     * crosses one trapezoid more than the axes it cuts, at most one per
-     * wall end, and makes two per crossed one plus two: 3 n + 2 ends + 64
-     * (the bound; slots are allocated as they are used, about 2 a piece) */
-    b->cap = 3 * nw + 2 * nends + 64;
+     * crosses one trapezoid more than the axes it cuts (at most span - 1,
+     * one per event position strictly between its ends) and makes two per
+     * crossed one plus two: 3 n + 2 span + 64 (the bound; slots are
+     * allocated as they are used, about 2 a piece) */
+    b->cap = 3 * nw + 2 * span + 64;
     /* expected about 8 nodes per piece; beyond 64 the shuffle has failed
      * beyond any reasonable chance (reported as out of memory) */
     b->maxchunk = (uint32_t)(((uint64_t)64 * nw + 1024) >> NODE_BITS) + 1;
     if (b->maxchunk > (1u << (30 - NODE_BITS)))
         b->maxchunk = 1u << (30 - NODE_BITS);
-    b->lcap = nends + 8;
+    b->lcap = span + 8;
     b->list = scratch_n(a, b->lcap, 4);
     b->up = scratch_n(a, b->lcap, 4);
     b->lo = scratch_n(a, b->lcap, 4);
     b->chunk = scratch_n(a, b->maxchunk, sizeof *b->chunk);
     b->hint = scratch_n(a, pd->npts, 4);
-    b->SR = scratch_n(a, pd->nseg, sizeof(sroles));
     b->PR = scratch_n(a, pd->npts, sizeof(proles));
-    if (!b->list || !b->up || !b->lo || !b->chunk || !b->hint || !b->SR || !b->PR)
+    if (!b->list || !b->up || !b->lo || !b->chunk || !b->hint || !b->PR)
         return PLX_E_NOMEM;
-    memset(b->SR, 0xff, (size_t)pd->nseg * sizeof(sroles));
     memset(b->PR, 0xff, (size_t)pd->npts * sizeof(proles));
-    for (i = 0; i < pd->nseg; i++) {
-        b->SR[i].end[0] = canon[N[i].li];
-        b->SR[i].end[1] = canon[N[i].ri];
-    }
     memset(b->hint, 0xff, (size_t)pd->npts * 4);
     b->tmark = arena_get_mark(a);
     t = new_trap(b);
