@@ -219,7 +219,8 @@ typedef struct dag_rank {
     uint32_t nq;             /* inner nodes */
 } dag_rank;
 plx_status polar_dag_words(arena *a, dbuild *b, dag_rank *rk);
-void polar_dag_free_traps(arena *a, dbuild *b);
+plx_status polar_keep_regions(arena *a, polar *pd, polar_map *m, dbuild *b, uint32_t *regd,
+                              uint32_t nreg);
 plx_status polar_dag_keep(arena *a, polar *pd, polar_map *m, dbuild *b, const dag_rank *rk,
                           int flags);
 

@@ -36,14 +36,16 @@ typedef struct sweep {
     polar_map *m;
     snode *N;           /* per segment (walls and Bounds sides) */
     const vec2 *E;      /* per segment: frame ends, left then right */
-    polar_trap *T;
-    uint32_t ntrap, cap;
+    uint32_t ntrap, cap; /* regions made, the most there can be */
+    uint32_t nclosed;   /* regions closed */
     const uint32_t *inc_first, *inc; /* walls incident to each point */
     uint32_t *start, *tmp; /* scratch: pieces starting at the event */
     /* the final map of the search DAG: per piece the trapezoid below /
      * above it at its left end, per point one trapezoid with that left
      * axis; each gap the sweep opens is one of them, whose child word it
-     * sets in word[], and regd[] keeps it per region */
+     * sets in its leaf field; a free one is a region, kept in the slot
+     * (its adjacency in nb: the slot's own is not read again), and regd[]
+     * names that slot per region */
     btrap *DT;
     const sroles *SR;
     const proles *PR;
@@ -70,35 +72,49 @@ static int fp_before(const fpoint *a, const fpoint *b, const void *ctx)
 
 MSORT_DEFINE(sort_fpoints, fpoint, const void *, fp_before)
 
-static uint32_t new_region(sweep *w, uint32_t lp, uint32_t top, uint32_t bot)
+/* The slot of region h. */
+static btrap *region(const sweep *w, uint32_t h)
 {
-    polar_trap *t;
-    if (w->ntrap >= w->cap)
-        return POLAR_NONE;
-    t = &w->T[w->ntrap];
-    t->lp = lp;
-    t->rp = POLAR_NONE;
-    t->top = top;
-    t->bot = bot;
-    t->nb[0] = t->nb[1] = t->nb[2] = t->nb[3] = POLAR_NONE;
-    return w->ntrap++;
+    return &w->DT[w->regd[h]];
 }
 
 /* The gap above bot opened at point pi (below top) is trapezoid d of the
- * DAG's map: checked, and its child word set (region h, or solid).
- * Returns 0, or -1 when the two maps differ. */
-static int open_gap(sweep *w, uint32_t d, uint32_t pi, uint32_t top, uint32_t bot, uint32_t h)
+ * DAG's map: checked, and its child word set: a new region *h if free,
+ * else solid (*h = POLAR_NONE). Returns 0, or -1 when the two maps
+ * differ. */
+static int open_gap(sweep *w, uint32_t d, uint32_t pi, uint32_t top, uint32_t bot, int free,
+                    uint32_t *h)
 {
     btrap *t;
+    *h = POLAR_NONE;
     if (d == POLAR_NONE)
         return -1;
     t = &w->DT[d];
     if (t->lp != pi || t->top != top || t->bot != bot || POLAR_TAG(t->leaf) != 0)
         return -1;
-    t->leaf = h != POLAR_NONE ? PACK(POLAR_CHILD_FREE, h) : w->N[bot].solid;
-    if (h != POLAR_NONE)
-        w->regd[h] = d;
+    if (free) {
+        if (w->ntrap >= w->cap)
+            return -1;
+        *h = w->ntrap++;
+        w->regd[*h] = d;
+        t->nb[0] = t->nb[1] = t->nb[2] = t->nb[3] = POLAR_NONE;
+        t->leaf = PACK(POLAR_CHILD_FREE, *h);
+    } else {
+        t->leaf = w->N[bot].solid;
+    }
     w->ngap++;
+    return 0;
+}
+
+/* Region h closed by the axis of point pi, which must be its right axis in
+ * the DAG's map. Returns 0, or -1 when the two maps differ. */
+static int close_region(sweep *w, uint32_t h, uint32_t pi)
+{
+    if (h == POLAR_NONE)
+        return 0;
+    if (region(w, h)->rp != pi)
+        return -1;
+    w->nclosed++;
     return 0;
 }
 
@@ -215,12 +231,12 @@ static int sweep_event(sweep *w, vec2 P, uint32_t pi, const uint32_t *pts, uint3
     /* close the gaps B..e1, e1..e2, ..., ek..A */
     G0 = N[B].open;
     Gk = k ? N[last].open : G0;
-    if (G0 != POLAR_NONE)
-        w->T[G0].rp = pi;
+    if (close_region(w, G0, pi) != 0)
+        return -1;
     for (y = N[B].next, i = 0; i < k; i++) {
         x = N[y].next;
-        if (N[y].open != POLAR_NONE)
-            w->T[N[y].open].rp = pi;
+        if (close_region(w, N[y].open, pi) != 0)
+            return -1;
         N[y].prev = N[y].next = POLAR_NONE;
         y = x;
     }
@@ -228,7 +244,7 @@ static int sweep_event(sweep *w, vec2 P, uint32_t pi, const uint32_t *pts, uint3
     for (j = 0; j <= ns; j++) {
         uint32_t bot = j ? w->start[j - 1] : B;
         uint32_t top = j < ns ? w->start[j] : (A == POLAR_NONE ? m->box_top : A);
-        uint32_t h = POLAR_NONE;
+        uint32_t h;
         if (j > 0) {
             const polar_seg *g = &w->pd->seg[bot];
             int32_t d = lex_cmp(fpt(w->pd, m->frame, g->a), P) == 0 ? g->cover : -g->cover;
@@ -237,13 +253,8 @@ static int sweep_event(sweep *w, vec2 P, uint32_t pi, const uint32_t *pts, uint3
             N[bot].prev = below;
             N[below].next = bot;
         }
-        if (N[bot].cov == 0) {
-            h = new_region(w, pi, top, bot);
-            if (h == POLAR_NONE)
-                return -1;
-        }
         if (open_gap(w, j ? w->SR[bot].up[0] : ns ? w->SR[w->start[0]].down[0] : w->PR[pi].side[0],
-                     pi, top, bot, h) != 0)
+                     pi, top, bot, N[bot].cov == 0, &h) != 0)
             return -1;
         N[bot].open = h;
         if (j == 0)
@@ -256,13 +267,13 @@ static int sweep_event(sweep *w, vec2 P, uint32_t pi, const uint32_t *pts, uint3
         }
     }
     if (G0 != POLAR_NONE)
-        w->T[G0].nb[LR] = H0;
+        region(w, G0)->nb[LR] = H0;
     if (Gk != POLAR_NONE)
-        w->T[Gk].nb[UR] = Hm;
+        region(w, Gk)->nb[UR] = Hm;
     if (H0 != POLAR_NONE)
-        w->T[H0].nb[LL] = G0;
+        region(w, H0)->nb[LL] = G0;
     if (Hm != POLAR_NONE)
-        w->T[Hm].nb[UL] = Gk;
+        region(w, Hm)->nb[UL] = Gk;
     return 0;
 }
 
@@ -403,10 +414,9 @@ static plx_status sort_events(arena *a, const polar *pd, int frame, const uint32
 static plx_status run_sweep(sweep *w, const dbuild *b, const uint32_t *evs, uint32_t nev)
 {
     polar_map *m = w->m;
-    uint32_t i, j, t;
-    w->N[m->box_bot].open = new_region(w, m->box_lo, m->box_top, m->box_bot);
-    if (open_gap(w, b->SR[m->box_bot].up[0], m->box_lo, m->box_top, m->box_bot,
-                 w->N[m->box_bot].open) != 0)
+    uint32_t i, j;
+    if (open_gap(w, b->SR[m->box_bot].up[0], m->box_lo, m->box_top, m->box_bot, 1,
+                 &w->N[m->box_bot].open) != 0)
         return PLX_E_SCENE;
     for (i = 0; i < nev; i = j) {
         for (j = i + 1; j < nev && (evs[j] & EV_SAME); j++)
@@ -416,12 +426,11 @@ static plx_status run_sweep(sweep *w, const dbuild *b, const uint32_t *evs, uint
     }
     if (w->N[m->box_bot].next != POLAR_NONE || w->N[m->box_bot].open == POLAR_NONE)
         return PLX_E_SCENE;
-    w->T[w->N[m->box_bot].open].rp = m->box_hi;
     /* both maps the same: every live trapezoid of the DAG's map is one gap
-     * of the sweep, with the same sides */
-    for (t = 0; t < w->ntrap; t++)
-        if (w->T[t].rp == POLAR_NONE || b->T[w->regd[t]].rp != w->T[t].rp)
-            return PLX_E_SCENE;
+     * of the sweep, with the same sides (every region closed, where the
+     * map's right axis is) */
+    if (close_region(w, w->N[m->box_bot].open, m->box_hi) != 0 || w->nclosed != w->ntrap)
+        return PLX_E_SCENE;
     if (w->ngap != b->ntrap - b->nfree)
         return PLX_E_SCENE;
     return PLX_OK;
@@ -483,11 +492,10 @@ plx_status polar_map_build(arena *a, polar *pd, polar_map *m, const uint32_t *in
     /* every region is a live trapezoid of the map, each once (open_gap) */
     nlive = b.ntrap - b.nfree;
     w.cap = nlive;
-    w.T = scratch_n(a, w.cap, sizeof(polar_trap));
     w.regd = scratch_n(a, w.cap, 4);
     w.start = scratch_n(a, pd->nwall + 1, 4);
     w.tmp = scratch_n(a, pd->nwall + 1, 4);
-    if (!w.T || !w.regd || !w.start || !w.tmp)
+    if (!w.regd || !w.start || !w.tmp)
         return PLX_E_NOMEM;
     st = run_sweep(&w, &b, evs, nev);
     if (st != PLX_OK)
@@ -498,12 +506,9 @@ plx_status polar_map_build(arena *a, polar *pd, polar_map *m, const uint32_t *in
         if (st != PLX_OK)
             return st;
     }
-    polar_dag_free_traps(a, &b);
-    m->ntrap = w.ntrap;
-    m->trap = keep_n(a, w.ntrap, sizeof(polar_trap), &pd->bytes[0]);
-    if (!m->trap)
-        return PLX_E_NOMEM;
-    memcpy(m->trap, w.T, (size_t)w.ntrap * sizeof(polar_trap));
+    st = polar_keep_regions(a, pd, m, &b, w.regd, w.ntrap);
+    if (st != PLX_OK)
+        return st;
     /* polar_memory: the axes (lp, rp, nb) and the regions (top, bot) */
     pd->bytes[0] -= (size_t)w.ntrap * 8;
     pd->bytes[1] += (size_t)w.ntrap * 8;

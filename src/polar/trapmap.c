@@ -573,18 +573,71 @@ static uint32_t child_word(const dbuild *b, const dag_rank *rk, uint32_t c)
     return PACK(POLAR_CHILD_NODE, rk->before[c >> 6] + popcount64(rk->bits[c >> 6] & below));
 }
 
-/* Gives the trapezoid slots back: the low end of the arena as it was
- * before them (nothing was allocated there since). */
-void polar_dag_free_traps(arena *a, dbuild *b)
+/* The regions kept where the trapezoid slots were (no copy: the slots
+ * are the last thing in the low end of the arena): every slot cut to its
+ * first 32 bytes, which are a polar_trap, then region h moved from slot
+ * regd[h] to place h, following chains of moves (a place is written only
+ * once the slot there has been moved; regd is one-to-one), and the rest
+ * given back. The low end is then as if the regions had been allocated
+ * after the slots were given back, as keep_n would. Marks on regd: bit 31. */
+#define MOVED 0x80000000u
+plx_status polar_keep_regions(arena *a, polar *pd, polar_map *m, dbuild *b, uint32_t *regd,
+                              uint32_t nreg)
 {
-    arena_mark m = arena_get_mark(a);
-    if (!b->T)
-        return;
-    m.lo = b->tmark.lo;
-    m.used[PLX_PART_POLAR] = b->tmark.used[PLX_PART_POLAR];
-    arena_release(a, &m);
+    polar_trap *R = (polar_trap *)(void *)b->T;
+    uint32_t i, h, nw64 = (b->ntrap + 63) / 64;
+    uint64_t *needed = scratch_n(a, nw64, 8);
+    arena_mark mk;
+    size_t end;
+    if (!needed)
+        return PLX_E_NOMEM;
+    PLX_ASSERT(sizeof(polar_trap) == 32 && sizeof(btrap) == 36 && nreg <= b->ntrap);
+    for (i = 0; i < b->ntrap; i++)
+        memmove(&R[i], &b->T[i], sizeof(polar_trap));
+    memset(needed, 0, (size_t)nw64 * 8);
+    for (h = 0; h < nreg; h++)
+        needed[regd[h] >> 6] |= (uint64_t)1 << (regd[h] & 63);
+    /* chains that start at a place whose slot no region needs */
+    for (h = 0; h < nreg; h++) {
+        uint32_t cur = h;
+        if (needed[h >> 6] >> (h & 63) & 1)
+            continue;
+        while (cur < nreg && !(regd[cur] & MOVED)) {
+            uint32_t src = regd[cur];
+            R[cur] = R[src];
+            regd[cur] |= MOVED;
+            cur = src;
+        }
+    }
+    /* the rest are cycles */
+    for (h = 0; h < nreg; h++) {
+        polar_trap first;
+        uint32_t cur = h;
+        if (regd[h] & MOVED)
+            continue;
+        first = R[h];
+        for (;;) {
+            uint32_t src = regd[cur];
+            regd[cur] |= MOVED;
+            if (src == h) {
+                R[cur] = first;
+                break;
+            }
+            R[cur] = R[src];
+            cur = src;
+        }
+    }
+    /* the low end: the slots' mark plus the regions, as arena_alloc counts */
+    end = (size_t)((unsigned char *)(R + nreg) - a->base);
+    mk = arena_get_mark(a);
+    mk.lo = end;
+    mk.used[PLX_PART_POLAR] = b->tmark.used[PLX_PART_POLAR] + (end - b->tmark.lo);
+    arena_release(a, &mk);
+    pd->bytes[0] += (size_t)nreg * sizeof(polar_trap);
+    m->trap = R;
+    m->ntrap = nreg;
     b->T = NULL;
-    b->tcap = 0;
+    return PLX_OK;
 }
 
 /* The inner nodes kept in the order they were made (the top levels first;
