@@ -1497,10 +1497,11 @@ static void glows(render *r, render_stats *st)
     }
 }
 
-void render_tonemap(const render *r, const float *lin, size_t px, double ex, int curve, uint8_t *rgb8)
+static void tonemap_range(const render *r, const float *lin, size_t p0, size_t p1, double ex, int curve,
+                          uint8_t *rgb8)
 {
     size_t p;
-    for (p = 0; p < 3 * px; p++) {
+    for (p = p0; p < p1; p++) {
         double v = (double)lin[p] * ex;
         union { uint32_t u; float f; } cv;
         int b;
@@ -1519,6 +1520,50 @@ void render_tonemap(const render *r, const float *lin, size_t px, double ex, int
             b++;
         rgb8[p] = (uint8_t)b;
     }
+}
+
+void render_tonemap(const render *r, const float *lin, size_t px, double ex, int curve, uint8_t *rgb8)
+{
+    tonemap_range(r, lin, 0, 3 * px, ex, curve, rgb8);
+}
+
+#define TONEMAP_CHUNK 65536     /* values a job */
+
+typedef struct tonemap_job {
+    const render *r;
+    const float *lin;
+    size_t n;
+    double ex;
+    int curve;
+    uint8_t *rgb8;
+} tonemap_job;
+
+static void tonemap_chunk(void *arg, int worker, uint32_t k)
+{
+    const tonemap_job *jb = arg;
+    size_t p0 = (size_t)k * TONEMAP_CHUNK, p1 = p0 + TONEMAP_CHUNK < jb->n ? p0 + TONEMAP_CHUNK : jb->n;
+    (void)worker;
+    tonemap_range(jb->r, jb->lin, p0, p1, jb->ex, jb->curve, jb->rgb8);
+}
+
+void render_tonemap_par(const render *r, const float *lin, size_t px, double ex, int curve, uint8_t *rgb8,
+                        const render_opts *o)
+{
+    tonemap_job jb;
+    uint32_t jobs = (uint32_t)((3 * px + TONEMAP_CHUNK - 1) / TONEMAP_CHUNK);
+    if (!o || !o->par || o->workers < 2 || jobs < 2) {
+        render_tonemap(r, lin, px, ex, curve, rgb8);
+        return;
+    }
+    jb.r = r;
+    jb.lin = lin;
+    jb.n = 3 * px;
+    jb.ex = ex;
+    jb.curve = curve;
+    jb.rgb8 = rgb8;
+    if (o->par(o->par_ctx, o->workers > RENDER_MAX_WORKERS ? RENDER_MAX_WORKERS : o->workers, jobs,
+               tonemap_chunk, &jb) != 0)
+        render_tonemap(r, lin, px, ex, curve, rgb8);
 }
 
 const float *render_linear(const render *r)
@@ -1590,7 +1635,7 @@ plx_status render_frame(render *r, const render_camera *cam, const render_opts *
     if (rgbf)
         memcpy(rgbf, r->lin, px * 3 * sizeof(float));
     if (rgb8)
-        render_tonemap(r, r->lin, px, st.exposure, o->auto_exposure, rgb8);
+        render_tonemap_par(r, r->lin, px, st.exposure, o->auto_exposure, rgb8, o);
     r->err = "";
     if (stats)
         *stats = st;
