@@ -370,13 +370,15 @@ static void frame_pieces(polar *pd, polar_map *m, snode *N, vec2 *E, sroles *SR,
 }
 
 /* The events in sweep order (evs, EV_SAME marking a position already
- * seen), the canonical point of every point, and the longest run of
- * event positions from a wall piece's left end to its right end: a piece
+ * seen), the canonical point of every point, the longest run of event
+ * positions from a wall piece's left end to its right end (a piece
  * crosses at most one trapezoid per position strictly between its ends,
- * plus one (the insertion's lists are sized by it). canon and the sort's
- * buffers are scratch given back by the caller. */
+ * plus one: the insertion's lists are sized by it) and the most walls at
+ * one position (the sweep's lists of pieces starting at an event). canon
+ * and the sort's buffers are scratch given back by the caller. */
 static plx_status sort_events(arena *a, const polar *pd, int frame, const uint32_t *evp,
-                              uint32_t nev, uint32_t *evs, uint32_t *canon, uint32_t *span)
+                              uint32_t nev, const uint32_t *inc_first, uint32_t *evs,
+                              uint32_t *canon, uint32_t *span, uint32_t *maxdeg)
 {
     fpoint *ev = scratch_n(a, nev, sizeof(fpoint)), *tmp = scratch_n(a, nev, sizeof(fpoint));
     uint32_t *rank = scratch_n(a, pd->npts, 4), i, j, nd = 0, s;
@@ -391,14 +393,19 @@ static plx_status sort_events(arena *a, const polar *pd, int frame, const uint32
         canon[i] = i;
         rank[i] = 0;
     }
+    *maxdeg = 0;
     for (i = 0; i < nev; i = j, nd++) {
+        uint32_t deg = inc_first[ev[i].i + 1] - inc_first[ev[i].i];
         evs[i] = ev[i].i;
         rank[ev[i].i] = nd;
         for (j = i + 1; j < nev && lex_cmp(ev[j].f, ev[i].f) == 0; j++) {
             canon[ev[j].i] = ev[i].i;
             rank[ev[j].i] = nd;
             evs[j] = ev[j].i | EV_SAME;
+            deg += inc_first[ev[j].i + 1] - inc_first[ev[j].i];
         }
+        if (deg > *maxdeg)
+            *maxdeg = deg;
     }
     *span = 0;
     for (s = 0; s < pd->nwall; s++) {
@@ -442,11 +449,15 @@ static plx_status run_sweep(sweep *w, const dbuild *b, const uint32_t *evs, uint
  * subdivision and that both maps agree, and makes the free regions (kept,
  * in sweep order, with their adjacency); then the DAG is kept with its
  * leaves mapped to those regions (unless flags say otherwise).
- * Scratch, in stack order: per piece N (32 bytes) and E (32), the events
- * (24 a point), canonical indices; the insertion's (roles, hints, lists,
- * search nodes; its trapezoid slots, 36 bytes, in the low end, given back
- * before the kept arrays are made); the sweep's regions (at most one per
- * live trapezoid of the map) and lists. */
+ * Memory, in stack order: per piece N (24 bytes), E (32) and SR (24), the
+ * sorted events (4 a point); the sort's buffers and canonical indices
+ * (given back before the insertion); the insertion's hints and roles (4 +
+ * 8 a point), lists (by the longest piece) and search nodes (12 bytes
+ * each, about 6 a piece, chunks); its trapezoid slots (36 bytes, about 2 a
+ * piece) in the low end of the arena. The sweep's regions live in those
+ * slots (regd: 4 bytes per live trapezoid names them), and are kept in
+ * place (polar_keep_regions) before the search nodes are (scratch).
+ * README "Polar build scratch". */
 plx_status polar_map_build(arena *a, polar *pd, polar_map *m, const uint32_t *inc_first,
                            const uint32_t *inc, const uint32_t *evp, uint32_t nev,
                            const uint32_t *order, int flags, uint64_t *steps)
@@ -454,7 +465,7 @@ plx_status polar_map_build(arena *a, polar *pd, polar_map *m, const uint32_t *in
     sweep w;
     dbuild b;
     vec2 *E;
-    uint32_t *evs, *canon, nlive, span;
+    uint32_t *evs, *canon, nlive, span, maxdeg;
     sroles *SR;
     dag_rank rk;
     arena_mark mk;
@@ -478,7 +489,7 @@ plx_status polar_map_build(arena *a, polar *pd, polar_map *m, const uint32_t *in
     canon = scratch_n(a, pd->npts, 4);
     if (!canon)
         return PLX_E_NOMEM;
-    st = sort_events(a, pd, m->frame, evp, nev, evs, canon, &span);
+    st = sort_events(a, pd, m->frame, evp, nev, inc_first, evs, canon, &span, &maxdeg);
     if (st != PLX_OK)
         return st;
     frame_pieces(pd, m, w.N, E, SR, canon);
@@ -493,8 +504,8 @@ plx_status polar_map_build(arena *a, polar *pd, polar_map *m, const uint32_t *in
     nlive = b.ntrap - b.nfree;
     w.cap = nlive;
     w.regd = scratch_n(a, w.cap, 4);
-    w.start = scratch_n(a, pd->nwall + 1, 4);
-    w.tmp = scratch_n(a, pd->nwall + 1, 4);
+    w.start = scratch_n(a, (size_t)maxdeg + 1, 4);
+    w.tmp = scratch_n(a, (size_t)maxdeg + 1, 4);
     if (!w.regd || !w.start || !w.tmp)
         return PLX_E_NOMEM;
     st = run_sweep(&w, &b, evs, nev);
