@@ -730,7 +730,7 @@ static void add_box(polar *pd, uint32_t p0)
 
 
 /* The occluders' edges as pieces, uncut. */
-static plx_status polar_make_walls_in(arena *a, polar *pd);
+static plx_status polar_make_walls_in(arena *a, polar *pd, const arena_mark *m0);
 
 static piece *edge_pieces(arena *a, const edges *e)
 {
@@ -802,12 +802,12 @@ static plx_status cut_edges(arena *a, polar *pd, piece **pc, uint32_t *np)
 }
 
 /* Cuts the occluders' edges into wall pieces (pd->pts, pd->seg filled);
- * gives back its scratch (contacts, pieces, sort keys: about 170 bytes a
- * vertex) before the maps are built. */
+ * gives back its scratch (contacts, pieces, sort keys) before the maps are
+ * built. */
 plx_status polar_make_walls(arena *a, polar *pd)
 {
     arena_mark m0 = arena_get_mark(a), m1;
-    plx_status st = polar_make_walls_in(a, pd);
+    plx_status st = polar_make_walls_in(a, pd, &m0);
     if (st != PLX_OK)
         return st;
     m1 = arena_get_mark(a);
@@ -817,7 +817,26 @@ plx_status polar_make_walls(arena *a, polar *pd)
     return PLX_OK;
 }
 
-static plx_status polar_make_walls_in(arena *a, polar *pd)
+/* Gives back the scratch taken since m0 except the n pieces pc, which
+ * are moved to its start (scratch grows down from the top: the pieces end
+ * where m0's scratch ends); returns where they are now. */
+static piece *keep_only_pieces(arena *a, const arena_mark *m0, piece *pc, uint32_t n)
+{
+    size_t bytes = (size_t)n * sizeof(piece), top = a->cap - m0->hi, start;
+    arena_mark mk = arena_get_mark(a);
+    unsigned char *dst;
+    start = (top - bytes) & ~(size_t)15;
+    dst = a->base + start;
+    PLX_ASSERT((unsigned char *)pc <= dst);
+    if (bytes)
+        memmove(dst, pc, bytes);
+    mk.hi = a->cap - start;
+    mk.used[PLX_PART_SCRATCH] = m0->used[PLX_PART_SCRATCH] + (mk.hi - m0->hi);
+    arena_release(a, &mk);
+    return (piece *)(void *)dst;
+}
+
+static plx_status polar_make_walls_in(arena *a, polar *pd, const arena_mark *m0)
 {
     uint32_t i, j, np = 0, nm = 0;
     piece *pc;
@@ -831,6 +850,9 @@ static plx_status polar_make_walls_in(arena *a, polar *pd)
         return PLX_E_NOMEM;
     if (pd->npts)
         memcpy(pd->pts, P, (size_t)pd->npts * sizeof(vec2));
+    /* only the pieces are left to read: the contacts, edges and points
+     * (about 90 bytes a vertex) given back before the pieces are sorted */
+    pc = keep_only_pieces(a, m0, pc, np);
     {
         pkey *ky = scratch_n(a, np, sizeof(pkey)), *tmp = scratch_n(a, np, sizeof(pkey));
         piece *pc2 = scratch_n(a, np, sizeof(piece));
