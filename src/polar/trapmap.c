@@ -562,15 +562,14 @@ static uint32_t popcount64(uint64_t x)
     return (uint32_t)((x * 0x0101010101010101ull) >> 56);
 }
 
-/* The child word of build node c: its leaf's word, or the inner node's
- * index among the kept ones. */
+/* The child word of build node c: the inner node's index among the kept
+ * ones (from the bitmap alone), or its leaf's word. */
 static uint32_t child_word(const dbuild *b, const dag_rank *rk, uint32_t c)
 {
-    const uint32_t *nd = dnode(b, c);
-    uint64_t below = ((uint64_t)1 << (c & 63)) - 1;
-    if (KIND(nd[0]) == N_LEAF)
-        return nd[1];
-    return PACK(POLAR_CHILD_NODE, rk->before[c >> 6] + popcount64(rk->bits[c >> 6] & below));
+    uint64_t w = rk->bits[c >> 6], below = ((uint64_t)1 << (c & 63)) - 1;
+    if (w >> (c & 63) & 1)
+        return PACK(POLAR_CHILD_NODE, rk->before[c >> 6] + popcount64(w & below));
+    return dnode(b, c)[1];
 }
 
 /* The regions kept where the trapezoid slots were (no copy: the slots

@@ -1,9 +1,11 @@
 /* The polar build's memory per footprint vertex on growing rings (one
- * building, a star polygon of n vertices): the scratch high-water mark of
- * polar_build over n stays under POLAR_SCRATCH_PER_VERTEX (polar.h, README
- * "Memory budgets") plus a constant, and so does what it keeps. Rings of
- * 1,000 to 100,000 vertices (PLX_TEST_QUICK: to 10,000); the 10^6-vertex
- * ring of the issue is printed with PLX_POLAR_RING_BIG=1. */
+ * building, a star polygon of n vertices): the arena's high-water mark
+ * during polar_build beyond what the diagrams keep (its scratch, and the
+ * trapezoid slots it takes from the low end for a while) over n stays
+ * under POLAR_SCRATCH_PER_VERTEX (polar.h, README "Polar build scratch")
+ * plus a constant. Rings of 1,000 to 100,000 vertices (PLX_TEST_QUICK: to
+ * 10,000); the 10^6-vertex ring of the issue is printed with
+ * PLX_POLAR_RING_BIG=1. */
 #include <stdarg.h>
 #include <stddef.h>
 #include <setjmp.h>
@@ -126,8 +128,10 @@ static void test_scratch_cities(void **state)
     }
 }
 
-/* The block the issue asks for: a 10^6-vertex ring in 256 MiB (printed,
- * not asserted: see README "Memory budgets"). */
+/* The block the issue asks for: a 10^6-vertex ring in 256 MiB. Not met:
+ * it needs about 405 MB (202 of them kept), so the ring is built in a
+ * 400 MiB block (asserted) and tried in 256 MiB (printed); see README
+ * "Polar build scratch". */
 static void test_big_ring(void **state)
 {
     const char *v = getenv("PLX_POLAR_RING_BIG");
@@ -138,9 +142,13 @@ static void test_big_ring(void **state)
         printf("10^6-vertex ring: PLX_POLAR_RING_BIG=1 runs it\n");
         return;
     }
-    st = ring_build(1000000, (size_t)2 << 30, &scratch, &kept);
-    printf("10^6-vertex ring in 2 GiB: status %d, scratch %zu bytes, kept %zu, both %zu\n", (int)st, scratch,
-           kept, scratch + kept);
+    st = ring_build(1000000, (size_t)400 << 20, &scratch, &kept);
+    printf("10^6-vertex ring in 400 MiB: status %d, scratch %zu bytes, kept %zu, both %zu\n", (int)st,
+           scratch, kept, scratch + kept);
+    assert_int_equal(st, PLX_OK);
+    assert_true(scratch <= (size_t)POLAR_SCRATCH_PER_VERTEX * 1000000 + POLAR_SCRATCH_FIXED);
+    st = ring_build(1000000, (size_t)256 << 20, &scratch, &kept);
+    printf("10^6-vertex ring in 256 MiB: status %d (%s)\n", (int)st, st == PLX_OK ? "built" : "does not fit");
 }
 
 int main(void)
