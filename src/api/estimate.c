@@ -170,13 +170,14 @@ static phase est_load(const est *c)
 }
 
 /* Polar diagrams: four maps, their search DAGs and the visibility buffers
- * (measured 170-250 bytes a vertex); the construction's scratch (measured
- * up to about 1,000 bytes a vertex over a fixed part of about 460 KB). */
+ * (measured 170-250 bytes a vertex); the construction's scratch and
+ * trapezoid slots beyond them (measured up to about 250 bytes a vertex
+ * over a fixed part of about 50 KB; POLAR_SCRATCH_PER_VERTEX). */
 static phase est_polar(const est *c)
 {
     phase p;
     p.kept = 8192.0 + 320.0 * c->positions;
-    p.scratch = 512.0 * 1024.0 + 1100.0 * c->positions;
+    p.scratch = 64.0 * 1024.0 + 300.0 * c->positions;
     return p;
 }
 

@@ -162,7 +162,7 @@ typedef struct snode {
     uint32_t yk;        /* its search node kind: N_Y (l is seg.a) or N_YB */
 } snode;
 
-#define NODE_BITS 14
+#define NODE_BITS 12
 #define NODE_CHUNK (1u << NODE_BITS)
 
 typedef struct dbuild {

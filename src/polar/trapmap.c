@@ -683,6 +683,8 @@ static uint32_t spread16(uint32_t x)
  * within a round makes consecutive insertions walk the same nodes (cache
  * hits). Sorted by a stable radix sort on 64-bit keys (ties: piece
  * order). Deterministic: no global state. */
+#define RADIX_BITS 11
+#define RADIX (1u << RADIX_BITS)
 plx_status polar_insertion_order(arena *a, const polar *pd, uint32_t **out)
 {
     uint32_t i, n = pd->nwall, d, *out0 = scratch_n(a, n, 4), *order, *o2;
@@ -695,7 +697,7 @@ plx_status polar_insertion_order(arena *a, const polar *pd, uint32_t **out)
     o2 = scratch_n(a, n, 4);
     key = scratch_n(a, n, 8);
     k2 = scratch_n(a, n, 8);
-    cnt = scratch_n(a, 65536, 4);
+    cnt = scratch_n(a, RADIX, 4);
     if (!out0 || !order || !o2 || !key || !k2 || !cnt)
         return PLX_E_NOMEM;
     for (i = 0; i < n; i++) {
@@ -714,20 +716,20 @@ plx_status polar_insertion_order(arena *a, const polar *pd, uint32_t **out)
         key[i] = (uint64_t)(40 - round) << 32 | (uint64_t)(spread16(ux) | (spread16(uy) << 1));
         order[i] = i;
     }
-    for (d = 0; d < 48; d += 16) {          /* LSD radix sort, 16 bits a pass */
-        memset(cnt, 0, 65536 * 4);
+    for (d = 0; d < 44; d += RADIX_BITS) {  /* LSD radix sort: 4 passes of 11 bits */
+        memset(cnt, 0, RADIX * 4);
         for (i = 0; i < n; i++)
-            cnt[(key[i] >> d) & 0xffff]++;
+            cnt[(key[i] >> d) & (RADIX - 1)]++;
         {
             uint32_t sum = 0, c;
-            for (i = 0; i < 65536; i++) {
+            for (i = 0; i < RADIX; i++) {
                 c = cnt[i];
                 cnt[i] = sum;
                 sum += c;
             }
         }
         for (i = 0; i < n; i++) {
-            uint32_t at = cnt[(key[i] >> d) & 0xffff]++;
+            uint32_t at = cnt[(key[i] >> d) & (RADIX - 1)]++;
             k2[at] = key[i];
             o2[at] = order[i];
         }

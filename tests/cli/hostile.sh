@@ -235,7 +235,7 @@ fi
 expect info-nomem-stderr 3 "out of memory" -- info --mem 8K fixtures/helsinki-centre.geojson
 # exit 3 on stderr from the later stages too: the default street view's search
 # (polar diagrams) and the photon buffers, not exit 1 with another reason
-expect render-nomem-street 3 "^polarlux render: out of memory while building the polar diagrams" -- render -q $T --size 16x12 --mem 300K -o "$tmp/r.png"
+expect render-nomem-street 3 "^polarlux render: out of memory while building the polar diagrams" -- render -q $T --size 16x12 --mem 32K -o "$tmp/r.png"
 expect illum-nomem-photons 3 "^polarlux illum: out of memory while creating the photon buffers: [0-9]+ bytes at their lowest quality" -- illum -q $T --points "$tmp/p.txt" --mem 300K
 expect info-photons-default 0 "^photon buffers: [0-9]+ bytes \(default quality [0-9]+, budget [0-9]+\): 0 quality steps; facade charts 256x32, .*lamp ray tables on$" -- info -q --photons fixtures/helsinki-centre.geojson
 expect info-photons-reduced 0 "^photon buffers: [0-9]+ bytes \(default quality [0-9]+, budget [0-9]+\): [1-9][0-9]* quality steps; .*lamp ray tables off$" -- info -q --photons --mem 12M fixtures/helsinki-centre.geojson
