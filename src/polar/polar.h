@@ -160,7 +160,7 @@ typedef struct polar {
  * and the trapezoid slots) is at most POLAR_SCRATCH_PER_VERTEX bytes a
  * footprint vertex plus POLAR_SCRATCH_FIXED: a block must hold the
  * diagrams and that (tests/unit/test_polar_scratch.c measures it on
- * growing rings and generated cities: 210 bytes a vertex on a
+ * growing rings and generated cities: 209 bytes a vertex on a
  * 100,000-vertex ring, 127 on gen eixample 24 24; README "Polar build
  * scratch"). */
 #define POLAR_SCRATCH_PER_VERTEX 256
