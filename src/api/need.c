@@ -3,7 +3,8 @@
  * from the scene asks eng_need(e, WHAT, fn) first:
  *
  *   ENG_SCENE   a scene is loaded (else PLX_E_NOSCENE "fn: no scene is loaded")
- *   ENG_POLAR   the polar diagrams and the visibility result buffers
+ *   ENG_POLAR   the polar diagrams (the visibility result buffers come with
+ *               the first visibility query: eng_need_vis_buffers)
  *   ENG_LIGHT   the lamp light object (grids, lit region cache)
  *   ENG_PHOTON  the photon buffers
  *   ENG_RENDER  the renderer, which needs ENG_LIGHT first
@@ -22,7 +23,6 @@
 
 static plx_status need_polar(plx_engine *e)
 {
-    arena_mark m = arena_get_mark(&e->mem);
     uint64_t t0 = eng_clock(e);
     plx_status st;
     polar *pd;
@@ -32,6 +32,15 @@ static plx_status need_polar(plx_engine *e)
     if (st != PLX_OK)
         return eng_fail(e, st, "building the polar diagrams failed (empty or non-finite bounds)");
     e->polar_ns = eng_clock(e) - t0;
+    e->pd = pd;
+    return PLX_OK;
+}
+
+plx_status eng_need_vis_buffers(plx_engine *e)
+{
+    arena_mark m = arena_get_mark(&e->mem);
+    if (e->vis_poly)
+        return PLX_OK;
     e->vis_poly_cap = 4 * e->sc->npts + 64;
     e->vis_ids_cap = e->sc->nbld + 1;
     e->vis_poly = arena_alloc(&e->mem, PLX_PART_FRAME, arena_mul(e->vis_poly_cap, sizeof *e->vis_poly), 16);
@@ -43,7 +52,6 @@ static plx_status need_polar(plx_engine *e)
         e->vis_ids = NULL;
         return r;
     }
-    e->pd = pd;
     return PLX_OK;
 }
 

@@ -180,11 +180,17 @@ plx_status plx_visibility_get(plx_engine *e, double x, double y, double dir_deg,
 {
     vis_result r;
     vec2 p;
+    arena_mark m;
+    int fresh;
     plx_status st = plx_polar_build(e);
     if (st != PLX_OK)
         return st;
     if (!out)
         return eng_fail(e, PLX_E_INVALID, "plx_visibility_get: out is NULL");
+    fresh = e->vis_poly == NULL;
+    m = arena_get_mark(&e->mem);
+    if ((st = eng_need_vis_buffers(e)) != PLX_OK)
+        return st;
     memset(out, 0, sizeof *out);
     if (!isfinite(x) || !isfinite(y) || !isfinite(dir_deg) || !(fov_deg > 0.0))
         return eng_fail(e, PLX_E_INVALID, "plx_visibility_get: x, y, dir must be finite and fov > 0");
@@ -201,8 +207,14 @@ plx_status plx_visibility_get(plx_engine *e, double x, double y, double dir_deg,
         st = vis_query(e->pd, p, (dir_deg - fov_deg / 2) * DEG, (dir_deg + fov_deg / 2) * DEG, 0, &e->mem, &r);
     if (st == PLX_E_RANGE)
         return not_free(e, p);
-    if (st == PLX_E_NOMEM)
+    if (st == PLX_E_NOMEM) {
+        if (fresh) { /* a failed call leaves the engine as it was */
+            arena_release(&e->mem, &m);
+            e->vis_poly = NULL;
+            e->vis_ids = NULL;
+        }
         return eng_nomem(e, "computing visibility");
+    }
     if (st != PLX_OK)
         return eng_fail(e, st, "plx_visibility_get: invalid query");
     eng_clear_error(e);

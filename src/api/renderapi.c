@@ -286,7 +286,7 @@ static plx_status render_aa(plx_engine *e, const render_camera *rc, render_opts 
     if (rgbf)
         memcpy(rgbf, e->aa_sum, px * 3 * sizeof(float));
     if (rgb8)
-        render_tonemap(e->rd, e->aa_sum, px, ex, ro->auto_exposure, rgb8);
+        render_tonemap_par(e->rd, e->aa_sum, px, ex, ro->auto_exposure, rgb8, ro);
     rs->exposure = ex;
     rs->indirect_calls = lookups;
     return PLX_OK;
@@ -368,6 +368,8 @@ plx_status plx_render(plx_engine *e, const plx_camera *cam, const plx_render_opt
              * gathering while the view moves */
             ro.indirect = shade_photons;
             ro.indirect_mt = 1;
+            /* the walls sparse too (the buffers' wide lookup is smooth) */
+            ro.indirect_sparse = 1;
         }
     }
     set_workers(e, &ro);

@@ -56,6 +56,9 @@ plx_status eng_need(plx_engine *e, eng_what what, const char *fn);
 double eng_indirect(plx_engine *e, const double P[3], const double n[3]);
 /* The same, also writing its RGB version to rgb (may be NULL); returns the scalar. */
 double eng_indirect_rgb(plx_engine *e, const double P[3], const double n[3], double rgb[3] /* OUT */);
+/* The visibility results' buffers (4 points a footprint vertex, an id a
+ * building), taken at the first visibility query (need.c). */
+plx_status eng_need_vis_buffers(plx_engine *e);
 /* Creates the renderer on first need (renderapi.c). */
 plx_status eng_need_render(plx_engine *e);
 /* Builds the aerial light map at m_per_texel metres (0: 1 m) unless built;

@@ -126,32 +126,52 @@ static int cmp_double(const void *x, const void *y)
     return (a > b) - (a < b);
 }
 
-/* A contact sheet: up to 16 frames spread over the walk, 4 to a row,
- * each shrunk by an integer factor (box filter) to at most 400 pixels wide. */
-static int contact_sheet(const walk_args *a, uint8_t *const *thumbs, int nthumb, int f, char *err, size_t errlen)
+/* The contact sheet: up to 16 frames spread over the walk, 4 to a row,
+ * each shrunk by an integer factor f (box filter) to at most 400 pixels
+ * wide, drawn into the sheet as each is rendered (the frames themselves
+ * are not kept). */
+typedef struct sheet {
+    uint8_t *px;               /* W x H x 3, NULL: none */
+    int f, tw, th, W, H, n;    /* n: cells filled */
+    int skipped;               /* 1: no sheet (the budget) */
+} sheet;
+
+static void sheet_plan(sheet *sh, const walk_args *a, long frames)
 {
-    int tw = a->w / f, th = a->h / f, cols = nthumb < 4 ? nthumb : 4, rows = (nthumb + 3) / 4, k, x, y, c;
-    int W = cols * tw, H = rows * th, rc;
-    uint8_t *sheet = calloc((size_t)W * H * 3, 1);
+    int cells = frames < 16 ? (int)frames : 16, cols = cells < 4 ? cells : 4;
+    memset(sh, 0, sizeof *sh);
+    for (sh->f = 1; a->w / sh->f > 400; sh->f++)
+        ;
+    sh->tw = a->w / sh->f;
+    sh->th = a->h / sh->f;
+    sh->W = cols * sh->tw;
+    sh->H = (cells + 3) / 4 * sh->th;
+}
+
+/* Frame rgb shrunk into cell k. */
+static void sheet_put(sheet *sh, const walk_args *a, const uint8_t *rgb, int k)
+{
+    int x, y, c, f = sh->f;
+    for (y = 0; y < sh->th; y++)
+        for (x = 0; x < sh->tw; x++)
+            for (c = 0; c < 3; c++) {
+                unsigned sum = 0;
+                int i, j;
+                for (j = 0; j < f; j++)
+                    for (i = 0; i < f; i++)
+                        sum += rgb[((size_t)(y * f + j) * a->w + (size_t)(x * f + i)) * 3 + c];
+                sh->px[((size_t)((k / 4) * sh->th + y) * sh->W + (size_t)((k % 4) * sh->tw + x)) * 3 + c] =
+                    (uint8_t)((sum + (unsigned)(f * f) / 2) / (unsigned)(f * f));
+            }
+}
+
+static int contact_sheet(const walk_args *a, const sheet *sh, char *err, size_t errlen)
+{
     char path[4096];
-    if (!sheet)
-        return snprintf(err, errlen, "out of memory for the contact sheet"), -1;
-    for (k = 0; k < nthumb; k++)
-        for (y = 0; y < th; y++)
-            for (x = 0; x < tw; x++)
-                for (c = 0; c < 3; c++) {
-                    unsigned sum = 0;
-                    int i, j;
-                    for (j = 0; j < f; j++)
-                        for (i = 0; i < f; i++)
-                            sum += thumbs[k][((size_t)(y * f + j) * a->w + (size_t)(x * f + i)) * 3 + c];
-                    sheet[((size_t)((k / 4) * th + y) * W + (size_t)((k % 4) * tw + x)) * 3 + c] =
-                        (uint8_t)((sum + (unsigned)(f * f) / 2) / (unsigned)(f * f));
-                }
+    if (!sh->px)
+        return 0;
     snprintf(path, sizeof path, "%s/contact.png", a->dir);
-    rc = image_write_png_rgb8_fast(path, W, H, sheet, 0, err, errlen);
-    free(sheet);
-    return rc;
+    return image_write_png_rgb8_fast(path, sh->W, sh->H, sh->px, 0, err, errlen);
 }
 
 /* The animated PNG DIR/walk.png from the n frame files, 1/fps s each. */
@@ -185,8 +205,7 @@ typedef struct walk_run {
     long n;
     double *ms;
     uint8_t *rgb8;
-    uint8_t *thumbs[16];
-    int nthumb;
+    sheet sh;
     FILE *cams;
     plx_refine_stats rs;
     double refine_ms;
@@ -229,10 +248,21 @@ static int frame(const walk_args *a, plx_engine *e, const walk_path *wp, walk_ru
         fprintf(stderr, "polarlux walk: %s\n", err);
         return EXIT_FAIL;
     }
-    if (wr->nthumb < 16 && k == (wr->n >= 16 ? (wr->nthumb * (wr->n - 1)) / 15 : wr->nthumb)) {
-        wr->thumbs[wr->nthumb] = malloc((size_t)a->w * a->h * 3);
-        if (wr->thumbs[wr->nthumb])
-            memcpy(wr->thumbs[wr->nthumb++], wr->rgb8, (size_t)a->w * a->h * 3);
+    if (wr->sh.n < 16 && k == (wr->n >= 16 ? (wr->sh.n * (wr->n - 1)) / 15 : wr->sh.n)) {
+        if (!wr->sh.px && !wr->sh.skipped) {
+            /* the command's own buffers count in --mem: the frame and the sheet */
+            size_t need = (size_t)wr->sh.W * wr->sh.H * 3, frame_bytes = (size_t)a->w * a->h * 3;
+            size_t budget = cli_buffer_budget(e, &a->c);
+            if (need + frame_bytes > budget || !(wr->sh.px = calloc(need, 1))) {
+                fprintf(stderr, "polarlux walk: no contact sheet: it needs %.1f MB beside the engine and the "
+                        "frame, and --mem leaves %.1f MB\n", need / 1e6,
+                        budget > frame_bytes ? (budget - frame_bytes) / 1e6 : 0.0);
+                wr->sh.skipped = 1;
+            }
+        }
+        if (wr->sh.px)
+            sheet_put(&wr->sh, a, wr->rgb8, wr->sh.n);
+        wr->sh.n++;
     }
     return EXIT_OK;
 }
@@ -242,12 +272,13 @@ static int run(const walk_args *a, plx_engine *e, const walk_path *wp)
     walk_run wr;
     double L = walk_path_length(wp), step = a->speed / a->fps, *sorted;
     char path[4096], err[512];
-    int rc = EXIT_OK, f;
+    int rc = EXIT_OK;
     long k;
     memset(&wr, 0, sizeof wr);
     wr.n = (long)floor(L / step) + 1;
     if (wr.n > a->max_frames)
         wr.n = a->max_frames;
+    sheet_plan(&wr.sh, a, wr.n);
     wr.ms = malloc(sizeof *wr.ms * (size_t)wr.n);
     sorted = malloc(sizeof *sorted * (size_t)wr.n);
     wr.rgb8 = malloc((size_t)a->w * a->h * 3);
@@ -261,9 +292,7 @@ static int run(const walk_args *a, plx_engine *e, const walk_path *wp)
     }
     for (k = 0; rc == EXIT_OK && k < wr.n; k++)
         rc = frame(a, e, wp, &wr, k, step);
-    for (f = 1; a->w / f > 400; f++)
-        ;
-    if (rc == EXIT_OK && contact_sheet(a, wr.thumbs, wr.nthumb, f, err, sizeof err) != 0) {
+    if (rc == EXIT_OK && contact_sheet(a, &wr.sh, err, sizeof err) != 0) {
         fprintf(stderr, "polarlux walk: %s\n", err);
         rc = EXIT_FAIL;
     }
@@ -294,8 +323,7 @@ static int run(const walk_args *a, plx_engine *e, const walk_path *wp)
     }
     if (wr.cams)
         fclose(wr.cams);
-    for (k = 0; k < wr.nthumb; k++)
-        free(wr.thumbs[k]);
+    free(wr.sh.px);
     free(wr.ms);
     free(sorted);
     free(wr.rgb8);

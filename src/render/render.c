@@ -80,6 +80,7 @@ struct render {
     float *ind;
     int32_t nbx, nby;           /* blocks a row, rows of blocks */
     int sparse;                 /* this frame's indirect is sparse */
+    int sparse_up;              /* and its pixels facing up read the light map's layer */
     lightmap lm;                /* the aerial light map (lightmap.c) */
     indmap im;                  /* its indirect twin (indmap.c) */
     double thr[255];
@@ -1183,6 +1184,8 @@ static int block_one_surface(render *r, int32_t a, int32_t b, double span)
         for (x = x0; x <= x1; x++)
             if (r->id[(size_t)y * (size_t)r->w + (size_t)x] != sid)
                 return 0;
+    if (r->sparse_up && (sid == MESH_SURF_GROUND || r->m->surf[sid].n[2] > 0.5))
+        return 0; /* facing up: the light map's indirect layer */
     for (c = 0; c < 4; c++) {
         double d2 = 0.0;
         (void)pixel_hit(r, c & 1 ? x1 : x0, c & 2 ? y1 : y0, &cs, C[c], n);
@@ -1283,6 +1286,9 @@ static void sparse_rest(render *r, const render_opts *o, render_stats *st)
             if (r->blk[(size_t)block_of(j, r->nby) * (size_t)r->nbx + (size_t)block_of(i, r->nbx)] ||
                 !pixel_hit(r, i, j, &sid, P, n))
                 continue;
+            if (r->sparse_up && n[2] > 0.5 && lightmap_sample_ind(&r->lm, P, Ei))
+                continue; /* the shading pass took the layer's value (tile_points) */
+            Ei[0] = Ei[1] = Ei[2] = 0.0;
             o->indirect(o->indirect_user, P, n, Ei);
             st->indirect_calls++;
             if (sid == MESH_SURF_GROUND)
@@ -1539,10 +1545,11 @@ static void glows(render *r, render_stats *st)
     }
 }
 
-void render_tonemap(const render *r, const float *lin, size_t px, double ex, int curve, uint8_t *rgb8)
+static void tonemap_range(const render *r, const float *lin, size_t p0, size_t p1, double ex, int curve,
+                          uint8_t *rgb8)
 {
     size_t p;
-    for (p = 0; p < 3 * px; p++) {
+    for (p = p0; p < p1; p++) {
         double v = (double)lin[p] * ex;
         union { uint32_t u; float f; } cv;
         int b;
@@ -1561,6 +1568,50 @@ void render_tonemap(const render *r, const float *lin, size_t px, double ex, int
             b++;
         rgb8[p] = (uint8_t)b;
     }
+}
+
+void render_tonemap(const render *r, const float *lin, size_t px, double ex, int curve, uint8_t *rgb8)
+{
+    tonemap_range(r, lin, 0, 3 * px, ex, curve, rgb8);
+}
+
+#define TONEMAP_CHUNK 65536     /* values a job */
+
+typedef struct tonemap_job {
+    const render *r;
+    const float *lin;
+    size_t n;
+    double ex;
+    int curve;
+    uint8_t *rgb8;
+} tonemap_job;
+
+static void tonemap_chunk(void *arg, int worker, uint32_t k)
+{
+    const tonemap_job *jb = arg;
+    size_t p0 = (size_t)k * TONEMAP_CHUNK, p1 = p0 + TONEMAP_CHUNK < jb->n ? p0 + TONEMAP_CHUNK : jb->n;
+    (void)worker;
+    tonemap_range(jb->r, jb->lin, p0, p1, jb->ex, jb->curve, jb->rgb8);
+}
+
+void render_tonemap_par(const render *r, const float *lin, size_t px, double ex, int curve, uint8_t *rgb8,
+                        const render_opts *o)
+{
+    tonemap_job jb;
+    uint32_t jobs = (uint32_t)((3 * px + TONEMAP_CHUNK - 1) / TONEMAP_CHUNK);
+    if (!o || !o->par || o->workers < 2 || jobs < 2) {
+        render_tonemap(r, lin, px, ex, curve, rgb8);
+        return;
+    }
+    jb.r = r;
+    jb.lin = lin;
+    jb.n = 3 * px;
+    jb.ex = ex;
+    jb.curve = curve;
+    jb.rgb8 = rgb8;
+    if (o->par(o->par_ctx, o->workers > RENDER_MAX_WORKERS ? RENDER_MAX_WORKERS : o->workers, jobs,
+               tonemap_chunk, &jb) != 0)
+        render_tonemap(r, lin, px, ex, curve, rgb8);
 }
 
 const float *render_linear(const render *r)
@@ -1617,7 +1668,10 @@ plx_status render_frame(render *r, const render_camera *cam, const render_opts *
         (void)indmap_build(&r->im, r->a, &r->lm, o->indirect_far ? o->indirect_far : o->indirect,
                            o->indirect_user, o->top, o->indirect_user, o->indirect_key,
                            o->indirect_far || o->indirect_mt ? o->par : NULL, o->par_ctx, o->workers);
-    r->sparse = o->indirect && o->indirect_sparse && !o->lightmap && o->indirect_span > 0.0;
+    /* from above: the pixels facing up read the map's indirect layer, the
+     * others (walls) go sparse */
+    r->sparse_up = o->lightmap && r->lm.built && r->lm.has_ind;
+    r->sparse = o->indirect && o->indirect_sparse && o->indirect_span > 0.0 && (!o->lightmap || r->sparse_up);
     if (r->sparse)
         sparse_corners(r, o, &st);
     shade_pass(r, o, &st);
@@ -1630,7 +1684,7 @@ plx_status render_frame(render *r, const render_camera *cam, const render_opts *
     if (rgbf)
         memcpy(rgbf, r->lin, px * 3 * sizeof(float));
     if (rgb8)
-        render_tonemap(r, r->lin, px, st.exposure, o->auto_exposure, rgb8);
+        render_tonemap_par(r, r->lin, px, st.exposure, o->auto_exposure, rgb8, o);
     r->err = "";
     if (stats)
         *stats = st;

@@ -338,6 +338,9 @@ plx_status render_frame(render *r, const render_camera *cam, const render_opts *
  * thresholds). What render_frame does to its own image. */
 void render_tonemap(const render *r, const float *lin, size_t px, double ex, int curve,
                     uint8_t *rgb8 /* OUT */);
+/* The same on o's parallel-for (each value on its own: the same bytes). */
+void render_tonemap_par(const render *r, const float *lin, size_t px, double ex, int curve,
+                        uint8_t *rgb8 /* OUT */, const render_opts *o);
 /* The linear image of the last frame (width*height*3). Valid until the next frame. */
 const float *render_linear(const render *r);
 
