@@ -1177,6 +1177,7 @@ static int block_one_surface(render *r, int32_t a, int32_t b, double span)
     int32_t x0 = corner_x(r, a), x1 = corner_x(r, a + 1), y0 = corner_y(r, b), y1 = corner_y(r, b + 1), x, y;
     uint32_t sid = r->id[(size_t)y0 * (size_t)r->w + (size_t)x0], cs;
     double C[4][3], n[3], lo[3], hi[3], dmin = HUGE_VAL, ext = 0.0;
+    mesh_surf sfv;
     int c, k;
     if (sid == MESH_SURF_NONE)
         return 0;
@@ -1184,7 +1185,7 @@ static int block_one_surface(render *r, int32_t a, int32_t b, double span)
         for (x = x0; x <= x1; x++)
             if (r->id[(size_t)y * (size_t)r->w + (size_t)x] != sid)
                 return 0;
-    if (r->sparse_up && (sid == MESH_SURF_GROUND || r->m->surf[sid].n[2] > 0.5))
+    if (r->sparse_up && (sid == MESH_SURF_GROUND || surf_get(r, sid, &sfv)->n[2] > 0.5))
         return 0; /* facing up: the light map's indirect layer */
     for (c = 0; c < 4; c++) {
         double d2 = 0.0;
