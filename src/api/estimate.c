@@ -192,8 +192,8 @@ static phase est_light(const est *c, const plx_config *cfg)
 }
 
 /* Images: 20 bytes a pixel of the largest frame (depth, id, linear RGB),
- * the mesh's compact records (mesh.h: about 16 bytes a footprint vertex
- * and 24 a building) and culling tables, a 64 KB tone-mapping table and the
+ * the mesh's compact records (mesh.h: about 12 bytes a footprint vertex
+ * and 20 a building) and culling tables, a 64 KB tone-mapping table and the
  * surface cache; the mesh's construction in scratch. */
 static phase est_render(const est *c, const plx_config *cfg)
 {

@@ -83,13 +83,13 @@ static plx_status need_light(plx_engine *e)
  * block's free bytes when they are first needed, after setting aside what
  * a frame still needs when it is not built yet: the renderer (its buffers,
  * render_bytes, and its mesh, about MESH_PT bytes a footprint vertex and
- * MESH_BLD a building: 1,054,554 bytes measured on gen eixample 30 30's
- * 64,800 vertices and 14,400 buildings, 1,382,400 reckoned) and the
+ * MESH_BLD a building: 739,178 bytes measured on gen eixample 30 30's
+ * 64,800 vertices and 14,400 buildings, 1,065,600 reckoned) and the
  * lamp light's grids. The other half stays for the lit-region cache and a
  * frame's scratch; when even the lowest quality does not fit the half, it
  * may take more of that room (the lit cache is sized from what is left). */
-#define MESH_PT 16
-#define MESH_BLD 24
+#define MESH_PT 12
+#define MESH_BLD 20
 
 /* The free bytes once the renderer and the lamp grids are set aside. */
 static size_t photon_room(const plx_engine *e)

@@ -463,6 +463,58 @@ static uint32_t ring_next(const scene *s, const scene_building *bd, uint32_t pt)
     return pt;
 }
 
+/* First and one past the last footprint vertex of building b. */
+static void bld_span(const scene *s, uint32_t b, uint32_t *first, uint32_t *end)
+{
+    const scene_building *bd = &s->bld[b];
+    const scene_ring *last = &s->rings[bd->ring_first + bd->ring_count - 1];
+    *first = s->rings[bd->ring_first].first;
+    *end = last->first + last->count;
+}
+
+/* The building of footprint vertex pt (UINT32_MAX: none). */
+static uint32_t pt_building(const mesh *m, uint32_t pt)
+{
+    const scene *s = m->s;
+    uint32_t lo = 0, hi = s->nbld, f, e;
+    if (m->pt_bld)
+        return m->pt_bld[pt];
+    /* the last building whose first vertex is <= pt */
+    while (lo < hi) {
+        uint32_t mid = lo + (hi - lo) / 2;
+        bld_span(s, mid, &f, &e);
+        if (f <= pt)
+            lo = mid + 1;
+        else
+            hi = mid;
+    }
+    if (lo == 0)
+        return UINT32_MAX;
+    bld_span(s, lo - 1, &f, &e);
+    return pt < e ? lo - 1 : UINT32_MAX;
+}
+
+/* Do the buildings' rings, and their vertices, run in order without
+ * overlaps (then pt_building searches)? */
+static int rings_in_order(const scene *s)
+{
+    uint32_t b, r, prev_end = 0;
+    for (b = 0; b < s->nbld; b++) {
+        const scene_building *bd = &s->bld[b];
+        if (bd->ring_count == 0 || (uint64_t)bd->ring_first + bd->ring_count > s->nrings)
+            return 0;
+        for (r = 0; r < bd->ring_count; r++) {
+            const scene_ring *rg = &s->rings[bd->ring_first + r];
+            if (rg->first < prev_end || (uint64_t)rg->first + rg->count > s->npts)
+                return 0;
+            if (r > 0 && rg->first != prev_end)
+                return 0;
+            prev_end = rg->first + rg->count;
+        }
+    }
+    return 1;
+}
+
 static void set_lit(mesh *m, uint32_t id, int on)
 {
     if (on)
@@ -487,7 +539,7 @@ void mesh_surface(const mesh *m, uint32_t id, mesh_surf *out)
     }
     if (id < 2u + s->npts) {
         uint32_t pt = id - 2u;
-        b = m->pt_bld[pt];
+        b = pt_building(m, pt);
         if (b >= s->nbld)
             return;
         bd = &s->bld[b];
@@ -516,12 +568,18 @@ static uint32_t roof_at(const mesh *m, uint32_t q)
     return m->roof16 ? m->roof16[q] : m->roof32[q];
 }
 
+/* Local vertex of split k. */
+static uint32_t split_v(const mesh *m, uint32_t k)
+{
+    return m->split16 ? m->split16[k] : m->split32[k];
+}
+
 /* First split of local vertex v among splits [lo, hi) of a building. */
 static uint32_t split_find(const mesh *m, uint32_t lo, uint32_t hi, uint32_t v)
 {
     while (lo < hi) {
         uint32_t mid = lo + (hi - lo) / 2;
-        if (m->split_at[mid] < v)
+        if (split_v(m, mid) < v)
             lo = mid + 1;
         else
             hi = mid;
@@ -536,7 +594,7 @@ static uint32_t put_column(const mesh *m, uint32_t b, uint32_t v, vec2 p, double
     uint32_t e = m->bld[b + 1].split_first, k = split_find(m, m->bld[b].split_first, e, v);
     double *o = xyz + 3 * (size_t)nv;
     o[0] = p.x; o[1] = p.y; o[2] = bd->min_height; o += 3; nv++;
-    for (; k < e && m->split_at[k] == v; k++) {
+    for (; k < e && split_v(m, k) == v; k++) {
         o[0] = p.x; o[1] = p.y; o[2] = m->split_z[k]; o += 3; nv++;
     }
     o[0] = p.x; o[1] = p.y; o[2] = bd->height; nv++;
@@ -667,7 +725,7 @@ static void count(mesh *m, const colpt *col, uint32_t ncol, uint32_t *nsplit, ui
 {
     const scene *s = m->s;
     uint32_t b, r, i, f;
-    for (i = 0; i < s->npts; i++)
+    for (i = 0; m->pt_bld && i < s->npts; i++)
         m->pt_bld[i] = UINT32_MAX;
     for (b = 0; b < s->nbld; b++) {
         const scene_building *bd = &s->bld[b];
@@ -683,7 +741,8 @@ static void count(mesh *m, const colpt *col, uint32_t ncol, uint32_t *nsplit, ui
                 nvb += ca + cb;
                 ntb += ca + cb - 2;
                 *nsplit += ca - 2;
-                m->pt_bld[rg->first + i] = b;
+                if (m->pt_bld)
+                    m->pt_bld[rg->first + i] = b;
             }
         }
         nvb += ntot * (bd->min_height > 0 ? 2 : 1);
@@ -715,7 +774,10 @@ static int fill(arena *a, mesh *m, uint32_t b, const colpt *col, uint32_t ncol, 
             vec2 pa = s->pts[rg->first + i], pb = s->pts[rg->first + (i + 1) % rg->count];
             uint32_t fa, ca = column(col, ncol, pa, lo, hi, &fa);
             for (k = 1; k + 1 < ca; k++) {
-                m->split_at[*nsplit] = off + i;
+                if (m->split16)
+                    m->split16[*nsplit] = (uint16_t)(off + i);
+                else
+                    m->split32[*nsplit] = off + i;
                 m->split_z[*nsplit] = col[fa + k].z;
                 (*nsplit)++;
             }
@@ -766,6 +828,7 @@ plx_status mesh_build(arena *a, const scene *s, mesh **out)
     uint32_t ncol = 0, b, nsplit = 0, roof_cap = 0, maxring = 0, nroof = 0, *tris, *roof;
     lgrid lg;
     size_t lo0;
+    int ordered;
 
     if (!a || !s || !out)
         return PLX_E_INVALID;
@@ -779,17 +842,22 @@ plx_status mesh_build(arena *a, const scene *s, mesh **out)
     m->nbld = s->nbld;
     m->nsurf = 2 + s->npts + 2 * s->nbld;
     m->bld = arena_calloc(a, PLX_PART_FRAME, s->nbld + 1, sizeof *m->bld, MESH_ALIGN);
-    m->pt_bld = arena_alloc(a, PLX_PART_FRAME, arena_mul((size_t)s->npts + 1, sizeof *m->pt_bld), MESH_ALIGN);
+    ordered = rings_in_order(s);
+    if (!ordered)
+        m->pt_bld = arena_alloc(a, PLX_PART_FRAME, arena_mul((size_t)s->npts + 1, sizeof *m->pt_bld), MESH_ALIGN);
     m->lit = arena_calloc(a, PLX_PART_FRAME, m->nsurf / 8 + 1, 1, MESH_ALIGN);
     col = columns(a, s, &ncol);
-    if (!m->bld || !m->pt_bld || !m->lit || !col)
+    if (!m->bld || (!m->pt_bld && !ordered) || !m->lit || !col)
         goto nomem;
     count(m, col, ncol, &nsplit, &roof_cap, &maxring);
-    m->split_at = arena_alloc(a, PLX_PART_FRAME, arena_mul((size_t)nsplit + 1, sizeof *m->split_at), MESH_ALIGN);
+    if (maxring <= 65535u)
+        m->split16 = arena_alloc(a, PLX_PART_FRAME, arena_mul((size_t)nsplit + 1, sizeof *m->split16), MESH_ALIGN);
+    else
+        m->split32 = arena_alloc(a, PLX_PART_FRAME, arena_mul((size_t)nsplit + 1, sizeof *m->split32), MESH_ALIGN);
     m->split_z = arena_alloc(a, PLX_PART_FRAME, arena_mul((size_t)nsplit + 1, sizeof *m->split_z), MESH_ALIGN);
     tris = arena_scratch(a, arena_mul(3 * (size_t)maxring, sizeof *tris), MESH_ALIGN);
     roof = arena_scratch(a, arena_mul((size_t)roof_cap + 1, sizeof *roof), MESH_ALIGN);
-    if (!m->split_at || !m->split_z || !tris || !roof || lgrid_build(a, s, &lg) != 0)
+    if ((!m->split16 && !m->split32) || !m->split_z || !tris || !roof || lgrid_build(a, s, &lg) != 0)
         goto nomem;
     set_lit(m, MESH_SURF_GROUND, s->nlamps > 0);
     nsplit = 0;

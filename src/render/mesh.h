@@ -65,7 +65,9 @@
  * as (local vertex, height) pairs. A surface's plane, albedo, kind and
  * building (mesh_surface) are derived from the scene with the expressions
  * used when the mesh was built; only its 'lit' flag is kept, one bit a
- * surface, with the building of each footprint vertex (4 bytes).
+ * surface (a wall's building is found by a binary search over the
+ * buildings' first vertices when the scene's rings run in building order,
+ * as the loader makes them; else it is kept, 4 bytes a footprint vertex).
  *
  * Memory: everything in part PLX_PART_FRAME, construction scratch released
  * before return. No global state.
@@ -100,7 +102,7 @@ typedef struct mesh_tri {
 
 typedef struct mesh_bld {
     uint32_t roof_first;  /* first roof index (3 a triangle; the next building's ends them) */
-    uint32_t split_first; /* first split (mesh.split_at/split_z; the next building's ends them) */
+    uint32_t split_first; /* first split (mesh.split16/32, split_z; the next building's ends them) */
     uint32_t v_count, t_count;  /* what mesh_building writes */
 } mesh_bld;
 
@@ -110,9 +112,11 @@ typedef struct mesh {
     mesh_bld *bld;        /* nbld + 1 */
     uint16_t *roof16;     /* roof indices, local to the building's ring vertices */
     uint32_t *roof32;     /* (one of the two; roof32 when a building has 65,536+) */
-    uint32_t *split_at;   /* local ring vertex of each split, by vertex then height */
+    uint16_t *split16;    /* local ring vertex of each split, by vertex then height */
+    uint32_t *split32;    /* (16 bits as the roofs') */
     double *split_z;      /* its height */
-    uint32_t *pt_bld;     /* npts: building of each footprint vertex */
+    uint32_t *pt_bld;     /* npts: building of each footprint vertex; NULL when the
+                           * buildings' rings and vertices run in order (searched) */
     uint8_t *lit;         /* a bit per surface id: mesh_surf.lit */
     uint32_t max_bld_verts;  /* most vertices of one building */
     uint32_t max_bld_tris;   /* most triangles of one building */
@@ -144,22 +148,6 @@ void mesh_surface(const mesh *m, uint32_t id, mesh_surf *out /* OUT */);
 static inline int mesh_lit(const mesh *m, uint32_t id)
 {
     return (m->lit[id >> 3] >> (id & 7u)) & 1u;
-}
-
-/* Surface id's albedo (the ground's constant for MESH_SURF_GROUND). */
-static inline double mesh_albedo(const mesh *m, uint32_t id)
-{
-    const scene *s = m->s;
-    uint32_t b;
-    if (id < 2u)
-        return id == MESH_SURF_GROUND ? s->ground_albedo : 0.0;
-    if (id < 2u + s->npts)
-        b = m->pt_bld[id - 2u];
-    else {
-        b = id - 2u - s->npts;
-        b = b < s->nbld ? b : b - s->nbld;
-    }
-    return b < s->nbld ? s->bld[b].albedo : 0.0;
 }
 
 /* Building b's box: minx, miny, minz, maxx, maxy, maxz. */

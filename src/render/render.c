@@ -1282,6 +1282,7 @@ static void sparse_rest(render *r, const render_opts *o, render_stats *st)
             size_t p = (size_t)j * (size_t)r->w + (size_t)i;
             float *out = &r->lin[3 * p];
             double P[3], n[3], Ei[3] = { 0, 0, 0 }, alb[3];
+            mesh_surf sfv;
             uint32_t sid;
             int k;
             if (r->blk[(size_t)block_of(j, r->nby) * (size_t)r->nbx + (size_t)block_of(i, r->nbx)] ||
@@ -1295,7 +1296,7 @@ static void sparse_rest(render *r, const render_opts *o, render_stats *st)
             if (sid == MESH_SURF_GROUND)
                 scene_ground_albedo(r->s, P[0], P[1], alb);
             else
-                alb[0] = alb[1] = alb[2] = mesh_albedo(r->m, sid);
+                alb[0] = alb[1] = alb[2] = surf_get(r, sid, &sfv)->albedo;
             for (k = 0; k < 3; k++)
                 out[k] = (float)((double)out[k] + alb[k] / PI * Ei[k]);
         }
@@ -1305,7 +1306,6 @@ static void sparse_rest(render *r, const render_opts *o, render_stats *st)
  * needs the light object's buffers, else 0. */
 static int tile_shade(render *r, shade_ws *w, const render_opts *o, tile_state *t, int ro)
 {
-    const mesh *m = r->m;
     int32_t i, j;
     int q = 0;
     for (j = t->tj; j < t->j1; j++)
@@ -1344,7 +1344,8 @@ static int tile_shade(render *r, shade_ws *w, const render_opts *o, tile_state *
                 for (k = 0; k < 3; k++)
                     out[k] = (float)(alb[k] / PI * E[k]);
             } else {
-                double albedo = mesh_albedo(m, r->id[p]);
+                mesh_surf sfv;
+                double albedo = surf_get(r, r->id[p], &sfv)->albedo;
                 for (k = 0; k < 3; k++)
                     out[k] = (float)(albedo / PI * E[k]);
             }

@@ -970,9 +970,8 @@ static int cmp_dedge(const void *pa, const void *pb)
     return 0;
 }
 
-static void check_mesh_of(plx_engine *e, const char *path)
+static void check_mesh_scene(plx_engine *e, const scene *s, const char *path, int want_search)
 {
-    const scene *s = e->sc;
     mesh *m;
     uint32_t b, k, open_edges = 0, nv = 0, ntri = 0;
     dedge *ed;
@@ -980,6 +979,8 @@ static void check_mesh_of(plx_engine *e, const char *path)
     mesh_tri *tri;
     assert_int_equal(mesh_build(&e->mem, s, &m), PLX_OK);
     assert_int_equal(m->bad_holes, 0);
+    /* walls find their building by a search, or by the kept table */
+    assert_int_equal(m->pt_bld == NULL, want_search);
     ed = malloc((3 * (size_t)m->max_bld_tris + 1) * sizeof *ed);
     xyz = malloc((3 * (size_t)m->max_bld_verts + 1) * sizeof *xyz);
     tri = malloc(((size_t)m->max_bld_tris + 1) * sizeof *tri);
@@ -1052,11 +1053,30 @@ static void check_mesh_of(plx_engine *e, const char *path)
     free(tri);
 }
 
+static void check_mesh_of(plx_engine *e, const char *path)
+{
+    check_mesh_scene(e, e->sc, path, 1);
+}
+
+/* The same buildings listed backwards: their rings no longer run in
+ * building order, so the mesh keeps each footprint vertex's building. */
+static void check_mesh_reversed(plx_engine *e, const char *path)
+{
+    scene s = *e->sc;
+    uint32_t b;
+    s.bld = malloc((s.nbld + 1) * sizeof *s.bld);
+    for (b = 0; b < s.nbld; b++)
+        s.bld[b] = e->sc->bld[s.nbld - 1 - b];
+    check_mesh_scene(e, &s, path, s.nbld < 2);
+    free(s.bld);
+}
+
 static void check_mesh(const char *path)
 {
     void *mem;
     plx_engine *e = open_scene(path, &mem);
     check_mesh_of(e, path);
+    check_mesh_reversed(e, path);
     plx_engine_destroy(e);
     free(mem);
 }
