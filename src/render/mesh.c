@@ -476,9 +476,12 @@ static void bld_span(const scene *s, uint32_t b, uint32_t *first, uint32_t *end)
 static uint32_t pt_building(const mesh *m, uint32_t pt)
 {
     const scene *s = m->s;
-    uint32_t lo = 0, hi = s->nbld, f, e;
+    uint32_t lo, hi, f, e, k = pt / MESH_HINT_PTS;
     if (m->pt_bld)
         return m->pt_bld[pt];
+    /* between the hints around pt */
+    lo = m->pt_hint[k];
+    hi = m->pt_hint[k + 1] + 1 < s->nbld ? m->pt_hint[k + 1] + 1 : s->nbld;
     /* the last building whose first vertex is <= pt */
     while (lo < hi) {
         uint32_t mid = lo + (hi - lo) / 2;
@@ -492,6 +495,24 @@ static uint32_t pt_building(const mesh *m, uint32_t pt)
         return UINT32_MAX;
     bld_span(s, lo - 1, &f, &e);
     return pt < e ? lo - 1 : UINT32_MAX;
+}
+
+/* pt_hint[k]: the last building whose first vertex is <= k MESH_HINT_PTS
+ * (0 when none), for k up to npts / MESH_HINT_PTS + 1. */
+static void make_hints(mesh *m)
+{
+    const scene *s = m->s;
+    uint32_t k, b = 0, nk = s->npts / MESH_HINT_PTS + 2, f, e;
+    for (k = 0; k < nk; k++) {
+        uint64_t at = (uint64_t)k * MESH_HINT_PTS;
+        while (b + 1 < s->nbld) {
+            bld_span(s, b + 1, &f, &e);
+            if (f > at)
+                break;
+            b++;
+        }
+        m->pt_hint[k] = b;
+    }
 }
 
 /* Do the buildings' rings, and their vertices, run in order without
@@ -845,9 +866,13 @@ plx_status mesh_build(arena *a, const scene *s, mesh **out)
     ordered = rings_in_order(s);
     if (!ordered)
         m->pt_bld = arena_alloc(a, PLX_PART_FRAME, arena_mul((size_t)s->npts + 1, sizeof *m->pt_bld), MESH_ALIGN);
+    else if ((m->pt_hint = arena_alloc(a, PLX_PART_FRAME,
+                                       arena_mul((size_t)s->npts / MESH_HINT_PTS + 2, sizeof *m->pt_hint),
+                                       MESH_ALIGN)) != NULL)
+        make_hints(m);
     m->lit = arena_calloc(a, PLX_PART_FRAME, m->nsurf / 8 + 1, 1, MESH_ALIGN);
     col = columns(a, s, &ncol);
-    if (!m->bld || (!m->pt_bld && !ordered) || !m->lit || !col)
+    if (!m->bld || (!m->pt_bld && !m->pt_hint) || !m->lit || !col)
         goto nomem;
     count(m, col, ncol, &nsplit, &roof_cap, &maxring);
     if (maxring <= 65535u)

@@ -65,9 +65,10 @@
  * as (local vertex, height) pairs. A surface's plane, albedo, kind and
  * building (mesh_surface) are derived from the scene with the expressions
  * used when the mesh was built; only its 'lit' flag is kept, one bit a
- * surface (a wall's building is found by a binary search over the
- * buildings' first vertices when the scene's rings run in building order,
- * as the loader makes them; else it is kept, 4 bytes a footprint vertex).
+ * surface (a wall's building is found by a search over the buildings'
+ * first vertices when the scene's rings run in building order, as the
+ * loader makes them, starting from a hint every 64 vertices; else it is
+ * kept, 4 bytes a footprint vertex).
  *
  * Memory: everything in part PLX_PART_FRAME, construction scratch released
  * before return. No global state.
@@ -82,6 +83,7 @@
 #include "base/arena.h"
 
 #define MESH_SURF_NONE 0u
+#define MESH_HINT_PTS 64u
 #define MESH_SURF_GROUND 1u
 
 enum { MESH_KIND_GROUND = 0, MESH_KIND_WALL, MESH_KIND_ROOF, MESH_KIND_UNDER };
@@ -117,6 +119,8 @@ typedef struct mesh {
     double *split_z;      /* its height */
     uint32_t *pt_bld;     /* npts: building of each footprint vertex; NULL when the
                            * buildings' rings and vertices run in order (searched) */
+    uint32_t *pt_hint;    /* then per MESH_HINT_PTS vertices from 0: the last building
+                           * starting at or before it (npts / MESH_HINT_PTS + 2) */
     uint8_t *lit;         /* a bit per surface id: mesh_surf.lit */
     uint32_t max_bld_verts;  /* most vertices of one building */
     uint32_t max_bld_tris;   /* most triangles of one building */
