@@ -583,6 +583,23 @@ void mesh_surface(const mesh *m, uint32_t id, mesh_surf *out)
     out->bld = b;
 }
 
+double mesh_albedo(const mesh *m, uint32_t id)
+{
+    const scene *s = m->s;
+    uint32_t b;
+    if (id == MESH_SURF_GROUND)
+        return s->ground_albedo;
+    if (id < 2u || id >= m->nsurf)
+        return 0.0;
+    if (id < 2u + s->npts)
+        b = pt_building(m, id - 2u);
+    else {
+        b = id - 2u - s->npts;
+        b = b < s->nbld ? b : b - s->nbld;
+    }
+    return b < s->nbld ? s->bld[b].albedo : 0.0;
+}
+
 /* Roof index q of the mesh. */
 static uint32_t roof_at(const mesh *m, uint32_t q)
 {

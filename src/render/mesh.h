@@ -149,6 +149,9 @@ void mesh_building(const mesh *m, uint32_t b, double *xyz, mesh_tri *tri);
 /* Surface id's record (MESH_SURF_NONE: all zero). */
 void mesh_surface(const mesh *m, uint32_t id, mesh_surf *out /* OUT */);
 
+/* Its albedo alone (mesh_surface(m, id).albedo). */
+double mesh_albedo(const mesh *m, uint32_t id);
+
 static inline int mesh_lit(const mesh *m, uint32_t id)
 {
     return (m->lit[id >> 3] >> (id & 7u)) & 1u;

@@ -25,7 +25,6 @@ typedef struct cull_item { double key; uint32_t b; } cull_item;
 #define RENDER_TILE_LAMPS 64    /* longest lamp list of a tile */
 #define TILE_PX (RENDER_TILE * RENDER_TILE)
 #define IND_STEP 4              /* sparse indirect: corners every IND_STEP pixels */
-#define RENDER_SURF_CACHE 2048  /* surfaces kept by surf_get (a power of 2) */
 
 /* What one worker of the shading pass works in: a tile's hit points,
  * normals and E, its lamp list, and its counters. */
@@ -978,6 +977,13 @@ static const mesh_surf *surf_get(const render *r, uint32_t sid, mesh_surf *tmp)
     return tmp;
 }
 
+/* Surface sid's albedo (cached, or mesh_albedo). */
+static double surf_albedo(const render *r, uint32_t sid)
+{
+    uint32_t k = sid & (RENDER_SURF_CACHE - 1u);
+    return r->sc_id[k] == sid ? r->sc[k].albedo : mesh_albedo(r->m, sid);
+}
+
 /* Puts the surfaces of the frame's pixels (and the ground) in the cache,
  * before the shading pass (whose workers only read it): a surface's slot
  * is its id modulo RENDER_SURF_CACHE, the last one seen keeps it. */
@@ -1282,7 +1288,6 @@ static void sparse_rest(render *r, const render_opts *o, render_stats *st)
             size_t p = (size_t)j * (size_t)r->w + (size_t)i;
             float *out = &r->lin[3 * p];
             double P[3], n[3], Ei[3] = { 0, 0, 0 }, alb[3];
-            mesh_surf sfv;
             uint32_t sid;
             int k;
             if (r->blk[(size_t)block_of(j, r->nby) * (size_t)r->nbx + (size_t)block_of(i, r->nbx)] ||
@@ -1296,7 +1301,7 @@ static void sparse_rest(render *r, const render_opts *o, render_stats *st)
             if (sid == MESH_SURF_GROUND)
                 scene_ground_albedo(r->s, P[0], P[1], alb);
             else
-                alb[0] = alb[1] = alb[2] = surf_get(r, sid, &sfv)->albedo;
+                alb[0] = alb[1] = alb[2] = surf_albedo(r, sid);
             for (k = 0; k < 3; k++)
                 out[k] = (float)((double)out[k] + alb[k] / PI * Ei[k]);
         }
@@ -1344,8 +1349,7 @@ static int tile_shade(render *r, shade_ws *w, const render_opts *o, tile_state *
                 for (k = 0; k < 3; k++)
                     out[k] = (float)(alb[k] / PI * E[k]);
             } else {
-                mesh_surf sfv;
-                double albedo = surf_get(r, r->id[p], &sfv)->albedo;
+                double albedo = surf_albedo(r, r->id[p]);
                 for (k = 0; k < 3; k++)
                     out[k] = (float)(albedo / PI * E[k]);
             }

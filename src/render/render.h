@@ -402,6 +402,10 @@ void render_lightmap_get(const render *r, render_lightmap_info *out /* OUT */);
  * with shade as the shader (after a bake is loaded). The shader's user
  * pointer is kept. */
 void render_code_unbind(render *r);
+/* Surface records the renderer keeps, by id modulo this (a power of 2;
+ * render.c's surf_get). */
+#define RENDER_SURF_CACHE 4096
+
 /* sizeof the render object (opaque elsewhere). */
 size_t render_struct_bytes(void);
 void render_code_bind(render *r, render_shade_fn shade);

@@ -1016,7 +1016,7 @@ static void check_mesh_scene(plx_engine *e, const scene *s, const char *path, in
                 assert_true(fabs(off) <= 1e-9 * (fabs(sf.d) + fabs(pj[0]) + fabs(pj[1]) + fabs(pj[2]) + 1.0));
             }
             assert_int_equal(sf.bld, b);
-            assert_true(sf.albedo == bd->albedo);
+            assert_true(sf.albedo == bd->albedo && mesh_albedo(m, t->surf) == sf.albedo);
             assert_int_equal(sf.kind, t->surf == mesh_roof_id(s, b) ? MESH_KIND_ROOF
                                       : t->surf == mesh_under_id(s, b) ? MESH_KIND_UNDER : MESH_KIND_WALL);
             if (t->surf == mesh_roof_id(s, b))
