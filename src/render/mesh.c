@@ -439,21 +439,280 @@ static int surf_lit(const scene *s, const lgrid *g, int kind, vec2 a, vec2 b, co
 
 /* ---- the mesh ------------------------------------------------------------ */
 
-static void put_v(mesh *m, uint32_t *nv, double x, double y, double z)
+/* A wall's plane from its footprint edge a -> b (n[2] = 0). */
+static void wall_plane(vec2 pa, vec2 pb, double *n, double *d)
 {
-    m->xyz[3 * *nv] = x;
-    m->xyz[3 * *nv + 1] = y;
-    m->xyz[3 * *nv + 2] = z;
-    (*nv)++;
+    double dx = pb.x - pa.x, dy = pb.y - pa.y, len = sqrt(dx * dx + dy * dy);
+    n[0] = n[1] = n[2] = 0.0;
+    if (len > 0) {
+        n[0] = dy / len;
+        n[1] = -dx / len;
+    }
+    *d = n[0] * pa.x + n[1] * pa.y;
 }
 
-static void put_t(mesh *m, uint32_t a, uint32_t b, uint32_t c, uint32_t surf)
+/* The vertex after pt on its ring (pt is in building bd). */
+static uint32_t ring_next(const scene *s, const scene_building *bd, uint32_t pt)
 {
-    mesh_tri *t = &m->tri[m->ntri++];
+    uint32_t r;
+    for (r = 0; r < bd->ring_count; r++) {
+        const scene_ring *rg = &s->rings[bd->ring_first + r];
+        if (pt >= rg->first && pt < rg->first + rg->count)
+            return pt + 1 < rg->first + rg->count ? pt + 1 : rg->first;
+    }
+    return pt;
+}
+
+/* First and one past the last footprint vertex of building b. */
+static void bld_span(const scene *s, uint32_t b, uint32_t *first, uint32_t *end)
+{
+    const scene_building *bd = &s->bld[b];
+    const scene_ring *last = &s->rings[bd->ring_first + bd->ring_count - 1];
+    *first = s->rings[bd->ring_first].first;
+    *end = last->first + last->count;
+}
+
+/* The building of footprint vertex pt (UINT32_MAX: none). */
+static uint32_t pt_building(const mesh *m, uint32_t pt)
+{
+    const scene *s = m->s;
+    uint32_t lo, hi, f, e, k = pt / MESH_HINT_PTS;
+    if (m->pt_bld)
+        return m->pt_bld[pt];
+    /* between the hints around pt */
+    lo = m->pt_hint[k];
+    hi = m->pt_hint[k + 1] + 1 < s->nbld ? m->pt_hint[k + 1] + 1 : s->nbld;
+    /* the last building whose first vertex is <= pt */
+    while (lo < hi) {
+        uint32_t mid = lo + (hi - lo) / 2;
+        bld_span(s, mid, &f, &e);
+        if (f <= pt)
+            lo = mid + 1;
+        else
+            hi = mid;
+    }
+    if (lo == 0)
+        return UINT32_MAX;
+    bld_span(s, lo - 1, &f, &e);
+    return pt < e ? lo - 1 : UINT32_MAX;
+}
+
+/* pt_hint[k]: the last building whose first vertex is <= k MESH_HINT_PTS
+ * (0 when none), for k up to npts / MESH_HINT_PTS + 1. */
+static void make_hints(mesh *m)
+{
+    const scene *s = m->s;
+    uint32_t k, b = 0, nk = s->npts / MESH_HINT_PTS + 2, f, e;
+    for (k = 0; k < nk; k++) {
+        uint64_t at = (uint64_t)k * MESH_HINT_PTS;
+        while (b + 1 < s->nbld) {
+            bld_span(s, b + 1, &f, &e);
+            if (f > at)
+                break;
+            b++;
+        }
+        m->pt_hint[k] = b;
+    }
+}
+
+/* Do the buildings' rings, and their vertices, run in order without
+ * overlaps (then pt_building searches)? */
+static int rings_in_order(const scene *s)
+{
+    uint32_t b, r, prev_end = 0;
+    for (b = 0; b < s->nbld; b++) {
+        const scene_building *bd = &s->bld[b];
+        if (bd->ring_count == 0 || (uint64_t)bd->ring_first + bd->ring_count > s->nrings)
+            return 0;
+        for (r = 0; r < bd->ring_count; r++) {
+            const scene_ring *rg = &s->rings[bd->ring_first + r];
+            if (rg->first < prev_end || (uint64_t)rg->first + rg->count > s->npts)
+                return 0;
+            if (r > 0 && rg->first != prev_end)
+                return 0;
+            prev_end = rg->first + rg->count;
+        }
+    }
+    return 1;
+}
+
+static void set_lit(mesh *m, uint32_t id, int on)
+{
+    if (on)
+        m->lit[id >> 3] |= (uint8_t)(1u << (id & 7u));
+}
+
+void mesh_surface(const mesh *m, uint32_t id, mesh_surf *out)
+{
+    const scene *s = m->s;
+    const scene_building *bd;
+    uint32_t b;
+    memset(out, 0, sizeof *out);
+    if (id == MESH_SURF_NONE || id >= m->nsurf)
+        return;
+    out->lit = (uint8_t)mesh_lit(m, id);
+    if (id == MESH_SURF_GROUND) {
+        out->n[2] = 1.0;
+        out->albedo = s->ground_albedo;
+        out->bld = UINT32_MAX;
+        out->kind = MESH_KIND_GROUND;
+        return;
+    }
+    if (id < 2u + s->npts) {
+        uint32_t pt = id - 2u;
+        b = pt_building(m, pt);
+        if (b >= s->nbld)
+            return;
+        bd = &s->bld[b];
+        wall_plane(s->pts[pt], s->pts[ring_next(s, bd, pt)], out->n, &out->d);
+        out->kind = MESH_KIND_WALL;
+    } else if (id < 2u + s->npts + s->nbld) {
+        b = id - 2u - s->npts;
+        bd = &s->bld[b];
+        out->n[2] = 1.0;
+        out->d = bd->height;
+        out->kind = MESH_KIND_ROOF;
+    } else {
+        b = id - 2u - s->npts - s->nbld;
+        bd = &s->bld[b];
+        out->n[2] = -1.0;
+        out->d = -bd->min_height;
+        out->kind = MESH_KIND_UNDER;
+    }
+    out->albedo = bd->albedo;
+    out->bld = b;
+}
+
+double mesh_albedo(const mesh *m, uint32_t id)
+{
+    const scene *s = m->s;
+    uint32_t b;
+    if (id == MESH_SURF_GROUND)
+        return s->ground_albedo;
+    if (id < 2u || id >= m->nsurf)
+        return 0.0;
+    if (id < 2u + s->npts)
+        b = pt_building(m, id - 2u);
+    else {
+        b = id - 2u - s->npts;
+        b = b < s->nbld ? b : b - s->nbld;
+    }
+    return b < s->nbld ? s->bld[b].albedo : 0.0;
+}
+
+/* Roof index q of the mesh. */
+static uint32_t roof_at(const mesh *m, uint32_t q)
+{
+    return m->roof16 ? m->roof16[q] : m->roof32[q];
+}
+
+/* Local vertex of split k. */
+static uint32_t split_v(const mesh *m, uint32_t k)
+{
+    return m->split16 ? m->split16[k] : m->split32[k];
+}
+
+/* First split of local vertex v among splits [lo, hi) of a building. */
+static uint32_t split_find(const mesh *m, uint32_t lo, uint32_t hi, uint32_t v)
+{
+    while (lo < hi) {
+        uint32_t mid = lo + (hi - lo) / 2;
+        if (split_v(m, mid) < v)
+            lo = mid + 1;
+        else
+            hi = mid;
+    }
+    return lo;
+}
+
+/* Writes the column of local vertex v at p: bottom, splits, top. */
+static uint32_t put_column(const mesh *m, uint32_t b, uint32_t v, vec2 p, double *xyz, uint32_t nv)
+{
+    const scene_building *bd = &m->s->bld[b];
+    uint32_t e = m->bld[b + 1].split_first, k = split_find(m, m->bld[b].split_first, e, v);
+    double *o = xyz + 3 * (size_t)nv;
+    o[0] = p.x; o[1] = p.y; o[2] = bd->min_height; o += 3; nv++;
+    for (; k < e && split_v(m, k) == v; k++) {
+        o[0] = p.x; o[1] = p.y; o[2] = m->split_z[k]; o += 3; nv++;
+    }
+    o[0] = p.x; o[1] = p.y; o[2] = bd->height; nv++;
+    return nv;
+}
+
+static void put_t(mesh_tri *tri, uint32_t *nt, uint32_t a, uint32_t b, uint32_t c, uint32_t surf)
+{
+    mesh_tri *t = &tri[(*nt)++];
     t->v[0] = a;
     t->v[1] = b;
     t->v[2] = c;
     t->surf = surf;
+}
+
+/* Building b's walls; returns the vertex count (*nt triangles). */
+static uint32_t put_walls(const mesh *m, uint32_t b, double *xyz, mesh_tri *tri, uint32_t *nt)
+{
+    const scene *s = m->s;
+    const scene_building *bd = &s->bld[b];
+    uint32_t r, i, nv = 0, off = 0;
+    for (r = 0; r < bd->ring_count; r++) {
+        const scene_ring *rg = &s->rings[bd->ring_first + r];
+        for (i = 0; i < rg->count; i++) {
+            uint32_t j = (i + 1) % rg->count, L0 = nv, R0, ca, cb, li = 0, ri = 0;
+            uint32_t wid = mesh_wall_id(s, rg->first + i);
+            R0 = put_column(m, b, off + i, s->pts[rg->first + i], xyz, nv);
+            nv = put_column(m, b, off + j, s->pts[rg->first + j], xyz, R0);
+            ca = R0 - L0;
+            cb = nv - R0;
+            /* zip the columns; (L_i, R_j, R_j+1) and (L_i, R_j, L_i+1)
+             * are counter-clockwise seen from outside (right of a->b) */
+            while (li + 1 < ca || ri + 1 < cb) {
+                if (ri + 1 < cb &&
+                    (li + 1 >= ca || xyz[3 * (size_t)(R0 + ri + 1) + 2] <= xyz[3 * (size_t)(L0 + li + 1) + 2])) {
+                    put_t(tri, nt, L0 + li, R0 + ri, R0 + ri + 1, wid);
+                    ri++;
+                } else {
+                    put_t(tri, nt, L0 + li, R0 + ri, L0 + li + 1, wid);
+                    li++;
+                }
+            }
+        }
+        off += rg->count;
+    }
+    return nv;
+}
+
+/* The ring vertices of building bd at height z from xyz vertex nv on. */
+static uint32_t put_ring_verts(const scene *s, const scene_building *bd, double z, double *xyz, uint32_t nv)
+{
+    uint32_t r, k;
+    for (r = 0; r < bd->ring_count; r++) {
+        const scene_ring *rg = &s->rings[bd->ring_first + r];
+        for (k = 0; k < rg->count; k++, nv++) {
+            xyz[3 * (size_t)nv] = s->pts[rg->first + k].x;
+            xyz[3 * (size_t)nv + 1] = s->pts[rg->first + k].y;
+            xyz[3 * (size_t)nv + 2] = z;
+        }
+    }
+    return nv;
+}
+
+void mesh_building(const mesh *m, uint32_t b, double *xyz, mesh_tri *tri)
+{
+    const scene *s = m->s;
+    const scene_building *bd = &s->bld[b];
+    uint32_t nt = 0, nv, base, ubase, q, q0 = m->bld[b].roof_first, q1 = m->bld[b + 1].roof_first;
+    uint32_t rid = mesh_roof_id(s, b), uid = mesh_under_id(s, b);
+    nv = put_walls(m, b, xyz, tri, &nt);
+    base = nv;
+    nv = put_ring_verts(s, bd, bd->height, xyz, nv);
+    for (q = q0; q < q1; q += 3)
+        put_t(tri, &nt, base + roof_at(m, q), base + roof_at(m, q + 1), base + roof_at(m, q + 2), rid);
+    if (bd->min_height > 0) {
+        ubase = nv;
+        nv = put_ring_verts(s, bd, bd->min_height, xyz, nv);
+        for (q = q0; q < q1; q += 3)
+            put_t(tri, &nt, ubase + roof_at(m, q), ubase + roof_at(m, q + 2), ubase + roof_at(m, q + 1), uid);
+    }
 }
 
 /* Position of scene point t among the building's ring vertices, rings in order. */
@@ -469,14 +728,145 @@ static uint32_t local_index(const scene *s, const scene_building *bd, uint32_t t
     return 0;
 }
 
+/* The sorted, distinct column points: every ring vertex at its building's
+ * bottom and top (scratch). */
+static colpt *columns(arena *a, const scene *s, uint32_t *ncol)
+{
+    colpt *col = arena_scratch(a, arena_mul(2 * (size_t)s->npts + 1, sizeof *col), MESH_ALIGN);
+    uint32_t b, r, i, n = 0, k = 0;
+    if (!col)
+        return NULL;
+    for (b = 0; b < s->nbld; b++) {
+        const scene_building *bd = &s->bld[b];
+        for (r = 0; r < bd->ring_count; r++) {
+            const scene_ring *rg = &s->rings[bd->ring_first + r];
+            for (i = 0; i < rg->count; i++) {
+                vec2 p = s->pts[rg->first + i];
+                col[n].x = p.x; col[n].y = p.y; col[n].z = bd->min_height; n++;
+                col[n].x = p.x; col[n].y = p.y; col[n].z = bd->height; n++;
+            }
+        }
+    }
+    qsort(col, n, sizeof *col, cmp_colpt);
+    for (i = 0; i < n; i++)
+        if (k == 0 || cmp_colpt(&col[k - 1], &col[i]) != 0)
+            col[k++] = col[i];
+    *ncol = k;
+    return col;
+}
+
+/* Count pass: each building's vertices and wall triangles, the splits,
+ * the footprint vertices' buildings; *roof_cap: roof indices at most;
+ * *maxring: most ring vertices (+ 2 a hole) of one building. */
+static void count(mesh *m, const colpt *col, uint32_t ncol, uint32_t *nsplit, uint32_t *roof_cap,
+                  uint32_t *maxring)
+{
+    const scene *s = m->s;
+    uint32_t b, r, i, f;
+    for (i = 0; m->pt_bld && i < s->npts; i++)
+        m->pt_bld[i] = UINT32_MAX;
+    for (b = 0; b < s->nbld; b++) {
+        const scene_building *bd = &s->bld[b];
+        mesh_bld *mb = &m->bld[b];
+        uint32_t ntot = 0, nvb = 0, ntb = 0;
+        for (r = 0; r < bd->ring_count; r++) {
+            const scene_ring *rg = &s->rings[bd->ring_first + r];
+            ntot += rg->count;
+            for (i = 0; i < rg->count; i++) {
+                uint32_t j = (i + 1) % rg->count;
+                uint32_t ca = column(col, ncol, s->pts[rg->first + i], bd->min_height, bd->height, &f);
+                uint32_t cb = column(col, ncol, s->pts[rg->first + j], bd->min_height, bd->height, &f);
+                nvb += ca + cb;
+                ntb += ca + cb - 2;
+                *nsplit += ca - 2;
+                if (m->pt_bld)
+                    m->pt_bld[rg->first + i] = b;
+            }
+        }
+        nvb += ntot * (bd->min_height > 0 ? 2 : 1);
+        mb->v_count = nvb;
+        mb->t_count = ntb;  /* the roof's added in the fill pass */
+        *roof_cap += 3 * (ntot + 2 * (bd->ring_count - 1));
+        if (ntot + 2 * bd->ring_count > *maxring)
+            *maxring = ntot + 2 * bd->ring_count;
+        if (nvb > m->max_bld_verts)
+            m->max_bld_verts = nvb;
+    }
+    m->split_verts = *nsplit;
+}
+
+/* Fill pass for building b: its splits, its roof (into roof, local
+ * indices; returns how many, or -1 out of scratch) and its lit bits. */
+static int fill(arena *a, mesh *m, uint32_t b, const colpt *col, uint32_t ncol, const lgrid *lg,
+                uint32_t *tris, uint32_t *roof, uint32_t *nsplit)
+{
+    const scene *s = m->s;
+    const scene_building *bd = &s->bld[b];
+    double lo = bd->min_height, hi = bd->height, n[3], d;
+    uint32_t r, i, k, off = 0, q;
+    int nt;
+    m->bld[b].split_first = *nsplit;
+    for (r = 0; r < bd->ring_count; r++) {
+        const scene_ring *rg = &s->rings[bd->ring_first + r];
+        for (i = 0; i < rg->count; i++) {
+            vec2 pa = s->pts[rg->first + i], pb = s->pts[rg->first + (i + 1) % rg->count];
+            uint32_t fa, ca = column(col, ncol, pa, lo, hi, &fa);
+            for (k = 1; k + 1 < ca; k++) {
+                if (m->split16)
+                    m->split16[*nsplit] = (uint16_t)(off + i);
+                else
+                    m->split32[*nsplit] = off + i;
+                m->split_z[*nsplit] = col[fa + k].z;
+                (*nsplit)++;
+            }
+            wall_plane(pa, pb, n, &d);
+            set_lit(m, mesh_wall_id(s, rg->first + i), surf_lit(s, lg, MESH_KIND_WALL, pa, pb, n, bd->box, lo, hi));
+        }
+        off += rg->count;
+    }
+    nt = mesh_triangulate(a, s, bd->ring_first, bd->ring_count, tris, &m->fallbacks, &m->bad_holes);
+    if (nt < 0)
+        return -1;
+    for (q = 0; q < 3 * (uint32_t)nt; q++)
+        roof[q] = local_index(s, bd, tris[q]);
+    m->bld[b].t_count += (uint32_t)nt * (lo > 0 ? 2 : 1);
+    n[0] = n[1] = 0.0;
+    n[2] = 1.0;
+    set_lit(m, mesh_roof_id(s, b), surf_lit(s, lg, MESH_KIND_ROOF, s->pts[0], s->pts[0], n, bd->box, hi, hi));
+    n[2] = -1.0;
+    set_lit(m, mesh_under_id(s, b),
+            lo > 0 && surf_lit(s, lg, MESH_KIND_UNDER, s->pts[0], s->pts[0], n, bd->box, lo, lo));
+    return nt;
+}
+
+/* The roof indices from scratch into the mesh, 16 bits when they fit. */
+static int keep_roofs(arena *a, mesh *m, const uint32_t *roof, uint32_t n, uint32_t maxring)
+{
+    uint32_t q;
+    if (maxring <= 65535u) {
+        m->roof16 = arena_alloc(a, PLX_PART_FRAME, arena_mul(n + 1, sizeof *m->roof16), MESH_ALIGN);
+        if (!m->roof16)
+            return -1;
+        for (q = 0; q < n; q++)
+            m->roof16[q] = (uint16_t)roof[q];
+    } else {
+        m->roof32 = arena_alloc(a, PLX_PART_FRAME, arena_mul(n + 1, sizeof *m->roof32), MESH_ALIGN);
+        if (!m->roof32)
+            return -1;
+        memcpy(m->roof32, roof, n * sizeof *roof);
+    }
+    return 0;
+}
+
 plx_status mesh_build(arena *a, const scene *s, mesh **out)
 {
     arena_mark m0;
     mesh *m;
     colpt *col;
-    uint32_t ncol = 0, i, b, nv_cap = 0, nt_cap = 0, maxv = 0, *tris = NULL, maxring = 0;
+    uint32_t ncol = 0, b, nsplit = 0, roof_cap = 0, maxring = 0, nroof = 0, *tris, *roof;
     lgrid lg;
     size_t lo0;
+    int ordered;
 
     if (!a || !s || !out)
         return PLX_E_INVALID;
@@ -489,175 +879,46 @@ plx_status mesh_build(arena *a, const scene *s, mesh **out)
     m->s = s;
     m->nbld = s->nbld;
     m->nsurf = 2 + s->npts + 2 * s->nbld;
-
-    /* Column heights: every ring vertex at its building's bottom and top. */
-    col = arena_scratch(a, arena_mul(2 * (size_t)s->npts + 1, sizeof *col), MESH_ALIGN);
-    if (!col)
-        goto nomem;
-    for (b = 0; b < s->nbld; b++) {
-        const scene_building *bd = &s->bld[b];
-        uint32_t r, ntot = 0;
-        for (r = 0; r < bd->ring_count; r++) {
-            const scene_ring *rg = &s->rings[bd->ring_first + r];
-            ntot += rg->count;
-            for (i = 0; i < rg->count; i++) {
-                vec2 p = s->pts[rg->first + i];
-                col[ncol].x = p.x; col[ncol].y = p.y; col[ncol].z = bd->min_height; ncol++;
-                col[ncol].x = p.x; col[ncol].y = p.y; col[ncol].z = bd->height; ncol++;
-            }
-        }
-        if (ntot + 2 * bd->ring_count > maxring)
-            maxring = ntot + 2 * bd->ring_count;
-    }
-    qsort(col, ncol, sizeof *col, cmp_colpt);
-    {
-        uint32_t k = 0;
-        for (i = 0; i < ncol; i++)
-            if (k == 0 || cmp_colpt(&col[k - 1], &col[i]) != 0)
-                col[k++] = col[i];
-        ncol = k;
-    }
-
-    /* Count. */
-    for (b = 0; b < s->nbld; b++) {
-        const scene_building *bd = &s->bld[b];
-        uint32_t r, ntot = 0, nvb = 0, ntb = 0, f;
-        for (r = 0; r < bd->ring_count; r++) {
-            const scene_ring *rg = &s->rings[bd->ring_first + r];
-            ntot += rg->count;
-            for (i = 0; i < rg->count; i++) {
-                uint32_t j = (i + 1) % rg->count;
-                uint32_t ca = column(col, ncol, s->pts[rg->first + i], bd->min_height, bd->height, &f);
-                uint32_t cb = column(col, ncol, s->pts[rg->first + j], bd->min_height, bd->height, &f);
-                nvb += ca + cb;
-                ntb += ca + cb - 2;
-                m->split_verts += ca - 2;
-            }
-        }
-        nvb += ntot * (bd->min_height > 0 ? 2 : 1);
-        ntb += (ntot + 2 * (bd->ring_count - 1)) * (bd->min_height > 0 ? 2 : 1);
-        nv_cap += nvb;
-        nt_cap += ntb;
-        if (nvb > maxv)
-            maxv = nvb;
-    }
-    m->max_bld_verts = maxv;
-    m->xyz = arena_alloc(a, PLX_PART_FRAME, arena_mul(3 * (size_t)nv_cap, sizeof(double)), MESH_ALIGN);
-    m->tri = arena_alloc(a, PLX_PART_FRAME, arena_mul(nt_cap, sizeof *m->tri), MESH_ALIGN);
-    m->surf = arena_calloc(a, PLX_PART_FRAME, m->nsurf, sizeof *m->surf, MESH_ALIGN);
     m->bld = arena_calloc(a, PLX_PART_FRAME, s->nbld + 1, sizeof *m->bld, MESH_ALIGN);
+    ordered = rings_in_order(s);
+    if (!ordered)
+        m->pt_bld = arena_alloc(a, PLX_PART_FRAME, arena_mul((size_t)s->npts + 1, sizeof *m->pt_bld), MESH_ALIGN);
+    else if ((m->pt_hint = arena_alloc(a, PLX_PART_FRAME,
+                                       arena_mul((size_t)s->npts / MESH_HINT_PTS + 2, sizeof *m->pt_hint),
+                                       MESH_ALIGN)) != NULL)
+        make_hints(m);
+    m->lit = arena_calloc(a, PLX_PART_FRAME, m->nsurf / 8 + 1, 1, MESH_ALIGN);
+    col = columns(a, s, &ncol);
+    if (!m->bld || (!m->pt_bld && !m->pt_hint) || !m->lit || !col)
+        goto nomem;
+    count(m, col, ncol, &nsplit, &roof_cap, &maxring);
+    if (maxring <= 65535u)
+        m->split16 = arena_alloc(a, PLX_PART_FRAME, arena_mul((size_t)nsplit + 1, sizeof *m->split16), MESH_ALIGN);
+    else
+        m->split32 = arena_alloc(a, PLX_PART_FRAME, arena_mul((size_t)nsplit + 1, sizeof *m->split32), MESH_ALIGN);
+    m->split_z = arena_alloc(a, PLX_PART_FRAME, arena_mul((size_t)nsplit + 1, sizeof *m->split_z), MESH_ALIGN);
     tris = arena_scratch(a, arena_mul(3 * (size_t)maxring, sizeof *tris), MESH_ALIGN);
-    if (!m->xyz || !m->tri || !m->surf || !m->bld || !tris)
+    roof = arena_scratch(a, arena_mul((size_t)roof_cap + 1, sizeof *roof), MESH_ALIGN);
+    if ((!m->split16 && !m->split32) || !m->split_z || !tris || !roof || lgrid_build(a, s, &lg) != 0)
         goto nomem;
-    if (lgrid_build(a, s, &lg) != 0)
-        goto nomem;
-
-    m->surf[MESH_SURF_GROUND].n[2] = 1.0;
-    /* the constant; render.c shades ground pixels with scene_ground_albedo */
-    m->surf[MESH_SURF_GROUND].albedo = s->ground_albedo;
-    m->surf[MESH_SURF_GROUND].bld = UINT32_MAX;
-    m->surf[MESH_SURF_GROUND].kind = MESH_KIND_GROUND;
-    m->surf[MESH_SURF_GROUND].lit = s->nlamps > 0;
-
-    /* Fill. */
+    set_lit(m, MESH_SURF_GROUND, s->nlamps > 0);
+    nsplit = 0;
     for (b = 0; b < s->nbld; b++) {
-        const scene_building *bd = &s->bld[b];
-        mesh_bld *mb = &m->bld[b];
-        uint32_t r, nv = m->nv, f, rid = mesh_roof_id(s, b), uid = mesh_under_id(s, b);
-        double lo = bd->min_height, hi = bd->height;
         int nt;
-        mb->v_first = m->nv;
-        mb->t_first = m->ntri;
-        mb->box[0] = bd->box[0]; mb->box[1] = bd->box[1]; mb->box[2] = lo;
-        mb->box[3] = bd->box[2]; mb->box[4] = bd->box[3]; mb->box[5] = hi;
-        mb->occluder = lo == 0.0 && bd->ring_count == 1;
-        for (r = 0; r < bd->ring_count; r++) {
-            const scene_ring *rg = &s->rings[bd->ring_first + r];
-            for (i = 0; i < rg->count; i++) {
-                uint32_t j = (i + 1) % rg->count, fa, fb, ca, cb, k, L0, R0, li = 0, ri = 0;
-                uint32_t wid = mesh_wall_id(s, rg->first + i);
-                vec2 pa = s->pts[rg->first + i], pb = s->pts[rg->first + j];
-                mesh_surf *sf = &m->surf[wid];
-                double dx = pb.x - pa.x, dy = pb.y - pa.y, len = sqrt(dx * dx + dy * dy);
-                ca = column(col, ncol, pa, lo, hi, &fa);
-                cb = column(col, ncol, pb, lo, hi, &fb);
-                L0 = nv;
-                for (k = 0; k < ca; k++)
-                    put_v(m, &nv, pa.x, pa.y, col[fa + k].z);
-                R0 = nv;
-                for (k = 0; k < cb; k++)
-                    put_v(m, &nv, pb.x, pb.y, col[fb + k].z);
-                /* zip the columns; (L_i, R_j, R_j+1) and (L_i, R_j, L_i+1)
-                 * are counter-clockwise seen from outside (right of a->b) */
-                while (li + 1 < ca || ri + 1 < cb) {
-                    if (ri + 1 < cb && (li + 1 >= ca || col[fb + ri + 1].z <= col[fa + li + 1].z)) {
-                        put_t(m, L0 + li, R0 + ri, R0 + ri + 1, wid);
-                        ri++;
-                    } else {
-                        put_t(m, L0 + li, R0 + ri, L0 + li + 1, wid);
-                        li++;
-                    }
-                }
-                sf->kind = MESH_KIND_WALL;
-                sf->bld = b;
-                sf->albedo = bd->albedo;
-                if (len > 0) {
-                    sf->n[0] = dy / len;
-                    sf->n[1] = -dx / len;
-                }
-                sf->d = sf->n[0] * pa.x + sf->n[1] * pa.y;
-                sf->lit = (uint8_t)surf_lit(s, &lg, MESH_KIND_WALL, pa, pb, sf->n, bd->box, lo, hi);
-            }
-        }
-        m->nv = nv;
-        /* roof (and underside) */
-        nt = mesh_triangulate(a, s, bd->ring_first, bd->ring_count, tris, &m->fallbacks, &m->bad_holes);
+        m->bld[b].roof_first = nroof;
+        nt = fill(a, m, b, col, ncol, &lg, tris, roof + nroof, &nsplit);
         if (nt < 0)
             goto nomem;
-        {
-            uint32_t base = m->nv, k, q;
-            for (r = 0; r < bd->ring_count; r++) {
-                const scene_ring *rg = &s->rings[bd->ring_first + r];
-                for (k = 0; k < rg->count; k++)
-                    put_v(m, &nv, s->pts[rg->first + k].x, s->pts[rg->first + k].y, hi);
-            }
-            /* tris hold scene.pts indices: make them local to the roof */
-            for (q = 0; q < 3 * (uint32_t)nt; q++)
-                tris[q] = local_index(s, bd, tris[q]);
-            for (q = 0; q < (uint32_t)nt; q++)
-                put_t(m, base + tris[3 * q], base + tris[3 * q + 1], base + tris[3 * q + 2], rid);
-            if (lo > 0) {
-                uint32_t ubase = nv;
-                for (r = 0; r < bd->ring_count; r++) {
-                    const scene_ring *rg = &s->rings[bd->ring_first + r];
-                    for (k = 0; k < rg->count; k++)
-                        put_v(m, &nv, s->pts[rg->first + k].x, s->pts[rg->first + k].y, lo);
-                }
-                for (q = 0; q < (uint32_t)nt; q++)
-                    put_t(m, ubase + tris[3 * q], ubase + tris[3 * q + 2], ubase + tris[3 * q + 1], uid);
-            }
-            m->nv = nv;
-        }
-        {
-            mesh_surf *sf = &m->surf[rid];
-            sf->n[2] = 1.0;
-            sf->d = hi;
-            sf->albedo = bd->albedo;
-            sf->bld = b;
-            sf->kind = MESH_KIND_ROOF;
-            sf->lit = (uint8_t)surf_lit(s, &lg, MESH_KIND_ROOF, s->pts[0], s->pts[0], sf->n, bd->box, hi, hi);
-            sf = &m->surf[uid];
-            sf->n[2] = -1.0;
-            sf->d = -lo;
-            sf->albedo = bd->albedo;
-            sf->bld = b;
-            sf->kind = MESH_KIND_UNDER;
-            sf->lit = lo > 0 && surf_lit(s, &lg, MESH_KIND_UNDER, s->pts[0], s->pts[0], sf->n, bd->box, lo, lo);
-        }
-        mb->v_count = m->nv - mb->v_first;
-        mb->t_count = m->ntri - mb->t_first;
-        (void)f;
+        nroof += 3 * (uint32_t)nt;
+        m->nv += m->bld[b].v_count;
+        m->ntri += m->bld[b].t_count;
+        if (m->bld[b].t_count > m->max_bld_tris)
+            m->max_bld_tris = m->bld[b].t_count;
     }
+    m->bld[s->nbld].roof_first = nroof;
+    m->bld[s->nbld].split_first = nsplit;
+    if (keep_roofs(a, m, roof, nroof, maxring) != 0)
+        goto nomem;
     release_scratch(a, &m0);
     m->bytes = a->lo - lo0;
     *out = m;

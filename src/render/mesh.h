@@ -55,6 +55,21 @@
  * ground aside) and watertight: every edge is shared by two of its
  * triangles with the same two vertices (bit-identical coordinates).
  *
+ * What is kept. The triangles are not stored: mesh_building writes one
+ * building's vertices and triangles when it is drawn, the same doubles in
+ * the same order every time, from the scene's footprints and a compact
+ * record per building: the roof's triangles as indices local to the
+ * building's ring vertices (16 bits when every building has fewer than
+ * 65,536 ring vertices), and the column heights strictly between a
+ * building's bottom and top at its ring vertices (the T-junction splits),
+ * as (local vertex, height) pairs. A surface's plane, albedo, kind and
+ * building (mesh_surface) are derived from the scene with the expressions
+ * used when the mesh was built; only its 'lit' flag is kept, one bit a
+ * surface (a wall's building is found by a search over the buildings'
+ * first vertices when the scene's rings run in building order, as the
+ * loader makes them, starting from a hint every 64 vertices; else it is
+ * kept, 4 bytes a footprint vertex).
+ *
  * Memory: everything in part PLX_PART_FRAME, construction scratch released
  * before return. No global state.
  */
@@ -68,6 +83,7 @@
 #include "base/arena.h"
 
 #define MESH_SURF_NONE 0u
+#define MESH_HINT_PTS 64u
 #define MESH_SURF_GROUND 1u
 
 enum { MESH_KIND_GROUND = 0, MESH_KIND_WALL, MESH_KIND_ROOF, MESH_KIND_UNDER };
@@ -87,20 +103,27 @@ typedef struct mesh_tri {
 } mesh_tri;
 
 typedef struct mesh_bld {
-    uint32_t v_first, v_count;
-    uint32_t t_first, t_count;
-    double box[6];        /* minx, miny, minz, maxx, maxy, maxz */
-    uint8_t occluder;     /* stands on the ground and has no holes (render.h) */
+    uint32_t roof_first;  /* first roof index (3 a triangle; the next building's ends them) */
+    uint32_t split_first; /* first split (mesh.split16/32, split_z; the next building's ends them) */
+    uint32_t v_count, t_count;  /* what mesh_building writes */
 } mesh_bld;
 
 typedef struct mesh {
     const scene *s;
-    uint32_t nv, ntri, nsurf, nbld;
-    double *xyz;          /* 3 doubles per vertex, world metres */
-    mesh_tri *tri;
-    mesh_surf *surf;      /* nsurf = 2 + npts + 2 nbld, indexed by surface id */
-    mesh_bld *bld;
+    uint32_t nv, ntri, nsurf, nbld;  /* nv, ntri: over all buildings */
+    mesh_bld *bld;        /* nbld + 1 */
+    uint16_t *roof16;     /* roof indices, local to the building's ring vertices */
+    uint32_t *roof32;     /* (one of the two; roof32 when a building has 65,536+) */
+    uint16_t *split16;    /* local ring vertex of each split, by vertex then height */
+    uint32_t *split32;    /* (16 bits as the roofs') */
+    double *split_z;      /* its height */
+    uint32_t *pt_bld;     /* npts: building of each footprint vertex; NULL when the
+                           * buildings' rings and vertices run in order (searched) */
+    uint32_t *pt_hint;    /* then per MESH_HINT_PTS vertices from 0: the last building
+                           * starting at or before it (npts / MESH_HINT_PTS + 2) */
+    uint8_t *lit;         /* a bit per surface id: mesh_surf.lit */
     uint32_t max_bld_verts;  /* most vertices of one building */
+    uint32_t max_bld_tris;   /* most triangles of one building */
     uint32_t split_verts;    /* vertices added on wall columns (T-junctions) */
     uint32_t fallbacks;      /* relaxed ear-clipping steps */
     uint32_t bad_holes;      /* holes left out of roofs */
@@ -115,6 +138,43 @@ plx_status mesh_build(arena *a, const scene *s, mesh **out /* OUT */);
 static inline uint32_t mesh_wall_id(const scene *s, uint32_t pt) { (void)s; return 2u + pt; }
 static inline uint32_t mesh_roof_id(const scene *s, uint32_t b) { return 2u + s->npts + b; }
 static inline uint32_t mesh_under_id(const scene *s, uint32_t b) { return 2u + s->npts + s->nbld + b; }
+
+/* Building b's vertices (3 doubles each, bld[b].v_count of them, at most
+ * max_bld_verts) into xyz and its triangles (bld[b].t_count, at most
+ * max_bld_tris; vertex indices 0..v_count-1, local to the building) into
+ * tri: walls ring by ring and edge by edge, then the roof, then the
+ * underside. */
+void mesh_building(const mesh *m, uint32_t b, double *xyz, mesh_tri *tri);
+
+/* Surface id's record (MESH_SURF_NONE: all zero). */
+void mesh_surface(const mesh *m, uint32_t id, mesh_surf *out /* OUT */);
+
+/* Its albedo alone (mesh_surface(m, id).albedo). */
+double mesh_albedo(const mesh *m, uint32_t id);
+
+static inline int mesh_lit(const mesh *m, uint32_t id)
+{
+    return (m->lit[id >> 3] >> (id & 7u)) & 1u;
+}
+
+/* Building b's box: minx, miny, minz, maxx, maxy, maxz. */
+static inline void mesh_box(const mesh *m, uint32_t b, double box[6])
+{
+    const scene_building *bd = &m->s->bld[b];
+    box[0] = bd->box[0];
+    box[1] = bd->box[1];
+    box[2] = bd->min_height;
+    box[3] = bd->box[2];
+    box[4] = bd->box[3];
+    box[5] = bd->height;
+}
+
+/* Does building b stand on the ground with no holes (render.h)? */
+static inline int mesh_occluder(const mesh *m, uint32_t b)
+{
+    const scene_building *bd = &m->s->bld[b];
+    return bd->min_height == 0.0 && bd->ring_count == 1;
+}
 
 /* Triangulates one footprint (ring r0 with nr rings: outer then holes) of
  * scene s into tris (counter-clockwise in xy; each triangle three indices

@@ -54,6 +54,10 @@ struct render {
     /* culling */
     cull_item *order;           /* nbld */
     cull_item *heap;            /* nbld, min-heap by w_max */
+    double *gxyz;               /* one building's vertices (mesh_building) */
+    mesh_tri *gtri;             /* and its triangles */
+    uint32_t *sc_id;            /* RENDER_SURF_CACHE: surfaces seen (surf_get), by id */
+    mesh_surf *sc;
     uint32_t nheap;
     double *wmin, *wmax;        /* nbld */
     uint8_t *draw;              /* nbld */
@@ -113,7 +117,8 @@ size_t render_bytes(const scene *s, int32_t max_w, int32_t max_h)
     size_t tiles = (size_t)((max_w + RENDER_TILE - 1) / RENDER_TILE) * (size_t)((max_h + RENDER_TILE - 1) / RENDER_TILE);
     size_t corners = (size_t)(max_w / IND_STEP + 2) * (size_t)(max_h / IND_STEP + 2);
     return px * 20 + tiles + (size_t)s->nbld * (2 * sizeof(cull_item) + 17) + RENDER_BINS * 8 + 65536 +
-           corners * (1 + 3 * sizeof(float)) + sizeof(render) + 4096;
+           corners * (1 + 3 * sizeof(float)) + RENDER_SURF_CACHE * (sizeof(uint32_t) + sizeof(mesh_surf)) +
+           sizeof(render) + 4096;
 }
 
 const mesh *render_mesh(const render *r)
@@ -236,13 +241,18 @@ plx_status render_create(arena *a, const scene *s, int32_t max_w, int32_t max_h,
     r->lin = arena_alloc(a, PLX_PART_FRAME, arena_mul(px, 3 * sizeof(float)), 64);
     r->vbuf = arena_alloc(a, PLX_PART_FRAME, arena_mul(r->m->max_bld_verts + 1, sizeof(raster_vertex)), 64);
     r->clip = arena_alloc(a, PLX_PART_FRAME, arena_mul(r->m->max_bld_verts + 1, 4 * sizeof(float)), 64);
+    r->gxyz = arena_alloc(a, PLX_PART_FRAME, arena_mul(r->m->max_bld_verts + 1, 3 * sizeof(double)), 64);
+    r->gtri = arena_alloc(a, PLX_PART_FRAME, arena_mul(r->m->max_bld_tris + 1, sizeof(mesh_tri)), 64);
+    r->sc_id = arena_calloc(a, PLX_PART_FRAME, RENDER_SURF_CACHE, sizeof(uint32_t), 64);
+    r->sc = arena_calloc(a, PLX_PART_FRAME, RENDER_SURF_CACHE, sizeof(mesh_surf), 64);
     r->order = arena_alloc(a, PLX_PART_FRAME, arena_mul(s->nbld + 1, sizeof(cull_item)), R_ALIGN);
     r->heap = arena_alloc(a, PLX_PART_FRAME, arena_mul(s->nbld + 1, sizeof(cull_item)), R_ALIGN);
     r->wmin = arena_alloc(a, PLX_PART_FRAME, arena_mul(s->nbld + 1, sizeof(double)), R_ALIGN);
     r->wmax = arena_alloc(a, PLX_PART_FRAME, arena_mul(s->nbld + 1, sizeof(double)), R_ALIGN);
     r->draw = arena_alloc(a, PLX_PART_FRAME, s->nbld + 1, R_ALIGN);
     r->bins = arena_alloc(a, PLX_PART_FRAME, RENDER_BINS * sizeof(double), R_ALIGN);
-    if (!r->depth || !r->id || !r->lin || !r->vbuf || !r->clip || !r->order || !r->heap || !r->wmin ||
+    if (!r->depth || !r->id || !r->lin || !r->vbuf || !r->clip || !r->gxyz || !r->gtri || !r->sc_id || !r->sc ||
+        !r->order || !r->heap || !r->wmin ||
         !r->wmax || !r->draw || !r->bins) {
         arena_release(a, &m0);
         return PLX_E_NOMEM;
@@ -465,15 +475,17 @@ static double rel_angle(double cx, double cy, double x, double y)
 static void occluder_insert(render *r, uint32_t b, double mu)
 {
     const scene *s = r->s;
-    const mesh_bld *mb = &r->m->bld[b];
     const scene_building *bd = &s->bld[b];
+    double box[6];
     const scene_ring *rg = &s->rings[bd->ring_first];
-    double cx = 0.5 * (mb->box[0] + mb->box[3]) - r->eye[0];
-    double cy = 0.5 * (mb->box[1] + mb->box[4]) - r->eye[1];
-    double cl = sqrt(cx * cx + cy * cy), c0, lo = HUGE_VAL, hi = -HUGE_VAL, rfar = 0, rnear;
+    double cx, cy, cl, c0, lo = HUGE_VAL, hi = -HUGE_VAL, rfar = 0, rnear;
     double dz, sO, ma, ms, slope;
     int64_t k0, k1, k;
     uint32_t i;
+    mesh_box(r->m, b, box);
+    cx = 0.5 * (box[0] + box[3]) - r->eye[0];
+    cy = 0.5 * (box[1] + box[4]) - r->eye[1];
+    cl = sqrt(cx * cx + cy * cy);
     if (!(cl > 0))
         return;
     cx /= cl;
@@ -486,7 +498,7 @@ static void occluder_insert(render *r, uint32_t b, double mu)
         hi = fmax(hi, a);
         rfar = fmax(rfar, d);
     }
-    rnear = box_dist(r, mb->box);
+    rnear = box_dist(r, box);
     if (!(rnear > 0))
         return;
     dz = bd->height - r->eye[2];
@@ -513,31 +525,32 @@ static void occluder_insert(render *r, uint32_t b, double mu)
 /* Is building b hidden by the horizon? */
 static int hidden(render *r, uint32_t b, double mu)
 {
-    const mesh_bld *mb = &r->m->bld[b];
-    double cx = 0.5 * (mb->box[0] + mb->box[3]) - r->eye[0];
-    double cy = 0.5 * (mb->box[1] + mb->box[4]) - r->eye[1];
-    double cl = sqrt(cx * cx + cy * cy), c0, lo = HUGE_VAL, hi = -HUGE_VAL, rnear, rfar = 0;
+    double box[6], cx, cy, cl, c0, lo = HUGE_VAL, hi = -HUGE_VAL, rnear, rfar = 0;
     double dz, sB, slope, ma, ms;
     int64_t k0, k1, k;
     int i;
+    mesh_box(r->m, b, box);
+    cx = 0.5 * (box[0] + box[3]) - r->eye[0];
+    cy = 0.5 * (box[1] + box[4]) - r->eye[1];
+    cl = sqrt(cx * cx + cy * cy);
     if (!(cl > 0))
         return 0;
     cx /= cl;
     cy /= cl;
     c0 = atan2(cy, cx);
     for (i = 0; i < 4; i++) {
-        double x = mb->box[(i & 1) ? 3 : 0] - r->eye[0], y = mb->box[(i & 2) ? 4 : 1] - r->eye[1];
+        double x = box[(i & 1) ? 3 : 0] - r->eye[0], y = box[(i & 2) ? 4 : 1] - r->eye[1];
         double a = rel_angle(cx, cy, x, y);
         lo = fmin(lo, a);
         hi = fmax(hi, a);
         rfar = fmax(rfar, sqrt(x * x + y * y));
     }
-    rnear = box_dist(r, mb->box);
+    rnear = box_dist(r, box);
     if (!(rnear > 0))
         return 0;
-    dz = mb->box[5] - r->eye[2];
+    dz = box[5] - r->eye[2];
     sB = dz >= 0 ? dz / (rnear * (1.0 - 1e-12)) : dz / (rfar * (1.0 + 1e-12));
-    slope = fmax(fabs(dz), fabs(mb->box[2] - r->eye[2])) / rnear;
+    slope = fmax(fabs(dz), fabs(box[2] - r->eye[2])) / rnear;
     ma = 2.0 * mu * sqrt(1.0 + slope * slope) + 1e-9;
     ms = 2.0 * 2.0 * mu * (1.0 + sB * sB) + 1e-12;
     sB += ms;
@@ -588,9 +601,9 @@ static void cull(render *r, int mode, int inside, render_stats *st)
     double mu = 2.0 * r->tanh_ / r->h;
     double gap_a = 1e-3, gap_b = mu / (8.0 * r->eye[2]) + 4e-6 / r->near_;
     for (b = 0; b < m->nbld; b++) {
-        const double *bx = m->bld[b].box;
-        double c[4], wmn = HUGE_VAL, wmx = -HUGE_VAL;
+        double bx[6], c[4], wmn = HUGE_VAL, wmx = -HUGE_VAL;
         int out_l = 1, out_r = 1, out_b = 1, out_t = 1, out_n = 1, k;
+        mesh_box(m, b, bx);
         for (k = 0; k < 8; k++) {
             double X[3];
             X[0] = bx[(k & 1) ? 3 : 0];
@@ -631,19 +644,20 @@ static void cull(render *r, int mode, int inside, render_stats *st)
     for (i = 0; i < n; i++) {
         uint32_t bb = r->order[i].b;
         double wb = r->order[i].key;
-        const mesh_bld *mb = &m->bld[bb];
+        double box[6];
+        mesh_box(m, bb, box);
         while (r->nheap > 0) {
             double wo = r->heap[0].key;
             if (!(wo * (1.0 + gap_a + gap_b * wo) < wb))
                 break;
             occluder_insert(r, heap_pop(r).b, mu);
         }
-        if (!eye_in_box(r, mb->box)) {
+        if (!eye_in_box(r, box)) {
             if (hidden(r, bb, mu)) {
                 r->draw[bb] = 0;
                 st->occlusion_culled++;
             }
-            if (mb->occluder)
+            if (mesh_occluder(m, bb))
                 heap_push(r, r->wmax[bb], bb);
         }
     }
@@ -661,16 +675,17 @@ static void draw_buildings(render *r, const render_backend *be, render_stats *st
             continue;
         st->drawn++;
         st->triangles_drawn += mb->t_count;
+        mesh_building(m, b, r->gxyz, r->gtri);
         for (k = 0; k < mb->v_count; k++) {
             double c[4];
             float *v = &r->clip[4 * (size_t)k];
-            to_clip(r, &m->xyz[3 * (size_t)(mb->v_first + k)], c);
+            to_clip(r, &r->gxyz[3 * (size_t)k], c);
             v[0] = (float)c[0];
             v[1] = (float)c[1];
             v[2] = (float)c[2];
             v[3] = (float)c[3];
         }
-        be->draw(be->user, r->clip, mb->v_count, &m->tri[mb->t_first], mb->t_count, mb->v_first);
+        be->draw(be->user, r->clip, mb->v_count, r->gtri, mb->t_count, 0);
     }
 }
 
@@ -951,6 +966,44 @@ static int indmap_usable(const render *r, const render_opts *o)
     return o->indirect && o->indirect_map && r->im.built && r->im.key == o->indirect_key;
 }
 
+/* Surface sid's record: from the cache when it holds it, else made in
+ * tmp (the same values: mesh_surface). */
+static const mesh_surf *surf_get(const render *r, uint32_t sid, mesh_surf *tmp)
+{
+    uint32_t k = sid & (RENDER_SURF_CACHE - 1u);
+    if (r->sc_id[k] == sid)
+        return &r->sc[k];
+    mesh_surface(r->m, sid, tmp);
+    return tmp;
+}
+
+/* Surface sid's albedo (cached, or mesh_albedo). */
+static double surf_albedo(const render *r, uint32_t sid)
+{
+    uint32_t k = sid & (RENDER_SURF_CACHE - 1u);
+    return r->sc_id[k] == sid ? r->sc[k].albedo : mesh_albedo(r->m, sid);
+}
+
+/* Puts the surfaces of the frame's pixels (and the ground) in the cache,
+ * before the shading pass (whose workers only read it): a surface's slot
+ * is its id modulo RENDER_SURF_CACHE, the last one seen keeps it. */
+static void surf_cache_fill(render *r)
+{
+    size_t p, px = (size_t)r->w * (size_t)r->h;
+    uint32_t last = MESH_SURF_NONE, sid, k;
+    for (p = 0; p <= px; p++) {
+        sid = p < px ? r->id[p] : MESH_SURF_GROUND;
+        if (sid == last)
+            continue;
+        last = sid;
+        k = sid & (RENDER_SURF_CACHE - 1u);
+        if (r->sc_id[k] != sid) {
+            mesh_surface(r->m, sid, &r->sc[k]);
+            r->sc_id[k] = sid;
+        }
+    }
+}
+
 /* Pixel (i, j)'s sample ray and what it meets: the surface (a pixel no
  * building covers that looks down is the ground, and its id is set so),
  * the hit point and the normal facing the eye. Returns 0 for the sky. */
@@ -962,6 +1015,7 @@ static int pixel_hit(render *r, int32_t i, int32_t j, uint32_t *sid_out, double 
     size_t p = (size_t)j * (size_t)r->w + (size_t)i;
     double d[3], tt, nd;
     uint32_t sid = r->id[p];
+    mesh_surf sfv;
     const mesh_surf *sf;
     int k;
     d[0] = r->f[0] + ai * r->rt[0] + bj * r->up[0];
@@ -973,7 +1027,7 @@ static int pixel_hit(render *r, int32_t i, int32_t j, uint32_t *sid_out, double 
         sid = MESH_SURF_GROUND;
         r->id[p] = sid;
     }
-    sf = &r->m->surf[sid];
+    sf = surf_get(r, sid, &sfv);
     nd = sf->n[0] * d[0] + sf->n[1] * d[1] + sf->n[2] * d[2];
     if (sid == MESH_SURF_GROUND)
         tt = -r->eye[2] / d[2];
@@ -995,7 +1049,6 @@ static int pixel_hit(render *r, int32_t i, int32_t j, uint32_t *sid_out, double 
  * light map's, when sample) for now; sky pixels written. */
 static void tile_points(render *r, shade_ws *w, const render_opts *o, tile_state *t, int sample)
 {
-    const mesh *m = r->m;
     int use_lm = o->lightmap && r->lm.built;
     int use_im = use_lm && sample && indmap_usable(r, o);
     int32_t i, j;
@@ -1020,6 +1073,7 @@ static void tile_points(render *r, shade_ws *w, const render_opts *o, tile_state
             double E[3] = { 0, 0, 0 };
             double *P = w->tP[q], *n = w->tN[q];
             uint32_t sid;
+            mesh_surf sfv;
             const mesh_surf *sf;
             float *out = &r->lin[3 * p];
             w->tcall[q] = 0;
@@ -1028,7 +1082,7 @@ static void tile_points(render *r, shade_ws *w, const render_opts *o, tile_state
                 out[0] = out[1] = out[2] = 0.0f;
                 continue;
             }
-            sf = &m->surf[sid];
+            sf = surf_get(r, sid, &sfv);
             if (sid == MESH_SURF_GROUND)
                 t->ground++;
             else
@@ -1129,6 +1183,7 @@ static int block_one_surface(render *r, int32_t a, int32_t b, double span)
     int32_t x0 = corner_x(r, a), x1 = corner_x(r, a + 1), y0 = corner_y(r, b), y1 = corner_y(r, b + 1), x, y;
     uint32_t sid = r->id[(size_t)y0 * (size_t)r->w + (size_t)x0], cs;
     double C[4][3], n[3], lo[3], hi[3], dmin = HUGE_VAL, ext = 0.0;
+    mesh_surf sfv;
     int c, k;
     if (sid == MESH_SURF_NONE)
         return 0;
@@ -1136,7 +1191,7 @@ static int block_one_surface(render *r, int32_t a, int32_t b, double span)
         for (x = x0; x <= x1; x++)
             if (r->id[(size_t)y * (size_t)r->w + (size_t)x] != sid)
                 return 0;
-    if (r->sparse_up && (sid == MESH_SURF_GROUND || r->m->surf[sid].n[2] > 0.5))
+    if (r->sparse_up && (sid == MESH_SURF_GROUND || surf_get(r, sid, &sfv)->n[2] > 0.5))
         return 0; /* facing up: the light map's indirect layer */
     for (c = 0; c < 4; c++) {
         double d2 = 0.0;
@@ -1246,7 +1301,7 @@ static void sparse_rest(render *r, const render_opts *o, render_stats *st)
             if (sid == MESH_SURF_GROUND)
                 scene_ground_albedo(r->s, P[0], P[1], alb);
             else
-                alb[0] = alb[1] = alb[2] = r->m->surf[sid].albedo;
+                alb[0] = alb[1] = alb[2] = surf_albedo(r, sid);
             for (k = 0; k < 3; k++)
                 out[k] = (float)((double)out[k] + alb[k] / PI * Ei[k]);
         }
@@ -1256,13 +1311,11 @@ static void sparse_rest(render *r, const render_opts *o, render_stats *st)
  * needs the light object's buffers, else 0. */
 static int tile_shade(render *r, shade_ws *w, const render_opts *o, tile_state *t, int ro)
 {
-    const mesh *m = r->m;
     int32_t i, j;
     int q = 0;
     for (j = t->tj; j < t->j1; j++)
         for (i = t->ti; i < t->i1; i++, q++) {
             size_t p = (size_t)j * (size_t)r->w + (size_t)i;
-            const mesh_surf *sf = &m->surf[r->id[p]];
             double *E = w->tE[q];
             float *out = &r->lin[3 * p];
             int k;
@@ -1296,8 +1349,9 @@ static int tile_shade(render *r, shade_ws *w, const render_opts *o, tile_state *
                 for (k = 0; k < 3; k++)
                     out[k] = (float)(alb[k] / PI * E[k]);
             } else {
+                double albedo = surf_albedo(r, r->id[p]);
                 for (k = 0; k < 3; k++)
-                    out[k] = (float)(sf->albedo / PI * E[k]);
+                    out[k] = (float)(albedo / PI * E[k]);
             }
         }
     return 0;
@@ -1612,6 +1666,7 @@ plx_status render_frame(render *r, const render_camera *cam, const render_opts *
         r->err = "render_frame: the backend could not read the frame back";
         return PLX_E_UNSUPPORTED;
     }
+    surf_cache_fill(r);
     st.drawn_fraction = st.triangles ? (double)st.triangles_drawn / (double)st.triangles : 1.0;
     if (o->lightmap && r->lm.built && !r->lm.has_ind && o->indirect && o->indirect_map &&
         (!r->im.built || r->im.key != o->indirect_key))

@@ -178,9 +178,13 @@
  * Both cull back faces as raster.h's RASTER_CULL_BACK does unless the eye
  * is inside a solid.
  *
- * Memory: render_create takes the mesh, the frame buffers for the largest
+ * Memory: render_create takes the mesh (its compact records: the triangles
+ * of a building are made by mesh_building when it is drawn, into buffers
+ * for the largest building), the frame buffers for the largest
  * image (depth, ids, linear colour: 20 bytes per pixel), the culling
- * arrays and (light shader) 4 bytes per lamp from the arena (part
+ * arrays, a cache of RENDER_SURF_CACHE (2048) surface records filled from
+ * each frame's ids before the shading pass (its workers only read it) and
+ * (light shader) 4 bytes per lamp from the arena (part
  * PLX_PART_FRAME); the light map is taken there when built. render_frame allocates nothing. No global state; one render
  * object must not be used by two threads at once.
  */
@@ -234,7 +238,8 @@ struct plx_backend {
     /* Draws ntri triangles over nv vertices: triangle k has the clip-space
      * vertices clip[4 (tri[k].v[i] - v_base) ..] (x, y, z, w floats, OpenGL
      * clip space as in raster.h; tri[k].v[i] - v_base < nv) and the surface
-     * id tri[k].surf. */
+     * id tri[k].surf. The renderer passes one building at a time, its
+     * triangles made for this call (v_base 0). */
     void (*draw)(void *user, const float *clip, uint32_t nv, const mesh_tri *tri, uint32_t ntri,
                  uint32_t v_base);
     /* Ends the frame: writes the id of every pixel to id[w*h] and its window
@@ -397,6 +402,10 @@ void render_lightmap_get(const render *r, render_lightmap_info *out /* OUT */);
  * with shade as the shader (after a bake is loaded). The shader's user
  * pointer is kept. */
 void render_code_unbind(render *r);
+/* Surface records the renderer keeps, by id modulo this (a power of 2;
+ * render.c's surf_get). */
+#define RENDER_SURF_CACHE 4096
+
 /* sizeof the render object (opaque elsewhere). */
 size_t render_struct_bytes(void);
 void render_code_bind(render *r, render_shade_fn shade);

@@ -970,41 +970,60 @@ static int cmp_dedge(const void *pa, const void *pb)
     return 0;
 }
 
-static void check_mesh_of(plx_engine *e, const char *path)
+static void check_mesh_scene(plx_engine *e, const scene *s, const char *path, int want_search)
 {
-    const scene *s = e->sc;
     mesh *m;
-    uint32_t b, k, open_edges = 0;
+    uint32_t b, k, open_edges = 0, nv = 0, ntri = 0;
     dedge *ed;
+    double *xyz;
+    mesh_tri *tri;
     assert_int_equal(mesh_build(&e->mem, s, &m), PLX_OK);
     assert_int_equal(m->bad_holes, 0);
-    ed = malloc((3 * (size_t)m->ntri + 1) * sizeof *ed);
+    /* walls find their building by a search, or by the kept table */
+    assert_int_equal(m->pt_bld == NULL, want_search);
+    ed = malloc((3 * (size_t)m->max_bld_tris + 1) * sizeof *ed);
+    xyz = malloc((3 * (size_t)m->max_bld_verts + 1) * sizeof *xyz);
+    tri = malloc(((size_t)m->max_bld_tris + 1) * sizeof *tri);
     for (b = 0; b < s->nbld; b++) {
         const scene_building *bd = &s->bld[b];
         const mesh_bld *mb = &m->bld[b];
         double want = 0, got = 0;
         uint32_t r, ne = 0, i;
+        assert_true(mb->v_count <= m->max_bld_verts && mb->t_count <= m->max_bld_tris);
+        mesh_building(m, b, xyz, tri);
+        nv += mb->v_count;
+        ntri += mb->t_count;
         for (r = 0; r < bd->ring_count; r++) {
             const scene_ring *rg = &s->rings[bd->ring_first + r];
             want += geom_ring_area2(s->pts + rg->first, rg->count) * 0.5;
         }
         for (k = 0; k < mb->t_count; k++) {
-            const mesh_tri *t = &m->tri[mb->t_first + k];
-            const double *p0 = &m->xyz[3 * t->v[0]], *p1 = &m->xyz[3 * t->v[1]], *p2 = &m->xyz[3 * t->v[2]];
+            const mesh_tri *t = &tri[k];
+            const double *p0 = &xyz[3 * t->v[0]], *p1 = &xyz[3 * t->v[1]], *p2 = &xyz[3 * t->v[2]];
             double nx = (p1[1] - p0[1]) * (p2[2] - p0[2]) - (p1[2] - p0[2]) * (p2[1] - p0[1]);
             double ny = (p1[2] - p0[2]) * (p2[0] - p0[0]) - (p1[0] - p0[0]) * (p2[2] - p0[2]);
             double nz = (p1[0] - p0[0]) * (p2[1] - p0[1]) - (p1[1] - p0[1]) * (p2[0] - p0[0]);
-            const mesh_surf *sf = &m->surf[t->surf];
+            mesh_surf sf;
             int j;
-            assert_true(t->v[0] >= mb->v_first && t->v[0] < mb->v_first + mb->v_count);
-            /* every triangle faces out of the solid */
-            assert_true(nx * sf->n[0] + ny * sf->n[1] + nz * sf->n[2] > 0);
-            assert_int_equal(sf->bld, b);
+            mesh_surface(m, t->surf, &sf);
+            for (j = 0; j < 3; j++)
+                assert_true(t->v[j] < mb->v_count);
+            /* every triangle faces out of the solid, and lies on its surface's plane */
+            assert_true(nx * sf.n[0] + ny * sf.n[1] + nz * sf.n[2] > 0);
+            for (j = 0; j < 3; j++) {
+                const double *pj = &xyz[3 * t->v[j]];
+                double off = sf.n[0] * pj[0] + sf.n[1] * pj[1] + sf.n[2] * pj[2] - sf.d;
+                assert_true(fabs(off) <= 1e-9 * (fabs(sf.d) + fabs(pj[0]) + fabs(pj[1]) + fabs(pj[2]) + 1.0));
+            }
+            assert_int_equal(sf.bld, b);
+            assert_true(sf.albedo == bd->albedo && mesh_albedo(m, t->surf) == sf.albedo);
+            assert_int_equal(sf.kind, t->surf == mesh_roof_id(s, b) ? MESH_KIND_ROOF
+                                      : t->surf == mesh_under_id(s, b) ? MESH_KIND_UNDER : MESH_KIND_WALL);
             if (t->surf == mesh_roof_id(s, b))
                 got += 0.5 * nz;
             for (j = 0; j < 3; j++) {
-                memcpy(ed[ne].a, &m->xyz[3 * t->v[j]], 3 * sizeof(double));
-                memcpy(ed[ne].b, &m->xyz[3 * t->v[(j + 1) % 3]], 3 * sizeof(double));
+                memcpy(ed[ne].a, &xyz[3 * t->v[j]], 3 * sizeof(double));
+                memcpy(ed[ne].b, &xyz[3 * t->v[(j + 1) % 3]], 3 * sizeof(double));
                 ne++;
             }
         }
@@ -1024,10 +1043,32 @@ static void check_mesh_of(plx_engine *e, const char *path)
             }
         }
     }
+    assert_int_equal(nv, m->nv);
+    assert_int_equal(ntri, m->ntri);
     print_message("%s: %u vertices, %u triangles, %u column split vertices, %u ear fallbacks, %zu bytes\n",
                   path, m->nv, m->ntri, m->split_verts, m->fallbacks, m->bytes);
     assert_int_equal(open_edges, 0);
     free(ed);
+    free(xyz);
+    free(tri);
+}
+
+static void check_mesh_of(plx_engine *e, const char *path)
+{
+    check_mesh_scene(e, e->sc, path, 1);
+}
+
+/* The same buildings listed backwards: their rings no longer run in
+ * building order, so the mesh keeps each footprint vertex's building. */
+static void check_mesh_reversed(plx_engine *e, const char *path)
+{
+    scene s = *e->sc;
+    uint32_t b;
+    s.bld = malloc((s.nbld + 1) * sizeof *s.bld);
+    for (b = 0; b < s.nbld; b++)
+        s.bld[b] = e->sc->bld[s.nbld - 1 - b];
+    check_mesh_scene(e, &s, path, s.nbld < 2);
+    free(s.bld);
 }
 
 static void check_mesh(const char *path)
@@ -1035,6 +1076,7 @@ static void check_mesh(const char *path)
     void *mem;
     plx_engine *e = open_scene(path, &mem);
     check_mesh_of(e, path);
+    check_mesh_reversed(e, path);
     plx_engine_destroy(e);
     free(mem);
 }
