@@ -368,8 +368,8 @@ plx_status plx_render(plx_engine *e, const plx_camera *cam, const plx_render_opt
              * gathering while the view moves */
             ro.indirect = shade_photons;
             ro.indirect_mt = 1;
-            /* the walls sparse too (the buffers' wide lookup is smooth) */
-            ro.indirect_sparse = 1;
+            /* (not sparse, README "Images: an irradiance cache") */
+            ro.indirect_sparse = 0;
         }
     }
     set_workers(e, &ro);

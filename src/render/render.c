@@ -79,7 +79,6 @@ struct render {
     float *ind;
     int32_t nbx, nby;           /* blocks a row, rows of blocks */
     int sparse;                 /* this frame's indirect is sparse */
-    int sparse_up;              /* and its pixels facing up read the light map's layer */
     lightmap lm;                /* the aerial light map (lightmap.c) */
     indmap im;                  /* its indirect twin (indmap.c) */
     double thr[255];
@@ -1183,7 +1182,6 @@ static int block_one_surface(render *r, int32_t a, int32_t b, double span)
     int32_t x0 = corner_x(r, a), x1 = corner_x(r, a + 1), y0 = corner_y(r, b), y1 = corner_y(r, b + 1), x, y;
     uint32_t sid = r->id[(size_t)y0 * (size_t)r->w + (size_t)x0], cs;
     double C[4][3], n[3], lo[3], hi[3], dmin = HUGE_VAL, ext = 0.0;
-    mesh_surf sfv;
     int c, k;
     if (sid == MESH_SURF_NONE)
         return 0;
@@ -1191,8 +1189,6 @@ static int block_one_surface(render *r, int32_t a, int32_t b, double span)
         for (x = x0; x <= x1; x++)
             if (r->id[(size_t)y * (size_t)r->w + (size_t)x] != sid)
                 return 0;
-    if (r->sparse_up && (sid == MESH_SURF_GROUND || surf_get(r, sid, &sfv)->n[2] > 0.5))
-        return 0; /* facing up: the light map's indirect layer */
     for (c = 0; c < 4; c++) {
         double d2 = 0.0;
         (void)pixel_hit(r, c & 1 ? x1 : x0, c & 2 ? y1 : y0, &cs, C[c], n);
@@ -1293,9 +1289,6 @@ static void sparse_rest(render *r, const render_opts *o, render_stats *st)
             if (r->blk[(size_t)block_of(j, r->nby) * (size_t)r->nbx + (size_t)block_of(i, r->nbx)] ||
                 !pixel_hit(r, i, j, &sid, P, n))
                 continue;
-            if (r->sparse_up && n[2] > 0.5 && lightmap_sample_ind(&r->lm, P, Ei))
-                continue; /* the shading pass took the layer's value (tile_points) */
-            Ei[0] = Ei[1] = Ei[2] = 0.0;
             o->indirect(o->indirect_user, P, n, Ei);
             st->indirect_calls++;
             if (sid == MESH_SURF_GROUND)
@@ -1674,10 +1667,7 @@ plx_status render_frame(render *r, const render_camera *cam, const render_opts *
         (void)indmap_build(&r->im, r->a, &r->lm, o->indirect_far ? o->indirect_far : o->indirect,
                            o->indirect_user, o->top, o->indirect_user, o->indirect_key,
                            o->indirect_far || o->indirect_mt ? o->par : NULL, o->par_ctx, o->workers);
-    /* from above: the pixels facing up read the map's indirect layer, the
-     * others (walls) go sparse */
-    r->sparse_up = o->lightmap && r->lm.built && r->lm.has_ind;
-    r->sparse = o->indirect && o->indirect_sparse && o->indirect_span > 0.0 && (!o->lightmap || r->sparse_up);
+    r->sparse = o->indirect && o->indirect_sparse && !o->lightmap && o->indirect_span > 0.0;
     if (r->sparse)
         sparse_corners(r, o, &st);
     shade_pass(r, o, &st);
