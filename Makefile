@@ -268,7 +268,7 @@ $(BUILD)/tests/failwrite.so: tests/cli/failwrite.c
 # (.ci/run). Since OSMesa is opened on first use, a case starts in about
 # 1.2 s of CPU under valgrind (it was 13 s with libLLVM mapped at start).
 check-hostile-valgrind: all $(BUILD)/tests/failwrite.so
-	@PLX_HOSTILE_TIMEOUT=900 PLX_HOSTILE_WRAP="valgrind -q --error-exitcode=9 --leak-check=full --errors-for-leak-kinds=definite" \
+	@PLX_HOSTILE_TIMEOUT=900 PLX_HOSTILE_WRAP="valgrind -q --error-exitcode=9 --leak-check=full --errors-for-leak-kinds=definite --suppressions=$(CURDIR)/tests/valgrind.supp" \
 	  sh tests/cli/hostile.sh $(BUILD)/polarlux
 
 unit: $(TESTS)
@@ -309,7 +309,7 @@ asan:
 valgrind: all $(TESTS)
 	@for t in $(TESTS); do \
 	  echo "valgrind $$t"; \
-	  PLX_TEST_QUICK=1 valgrind -q --error-exitcode=9 --leak-check=full --errors-for-leak-kinds=definite $$t >/dev/null || exit 1; \
+	  PLX_TEST_QUICK=1 valgrind -q --error-exitcode=9 --leak-check=full --errors-for-leak-kinds=definite --suppressions=tests/valgrind.supp $$t >/dev/null || exit 1; \
 	done; echo "valgrind: clean"
 
 # The refactor check (not part of make check: it builds another revision):
