@@ -111,6 +111,28 @@ static inline void *keep_n(arena *a, size_t n, size_t size, size_t *acc)
         *acc += bytes;
     return p;
 }
+/* The packed search nodes (polar_map): a field of 'width' bits (1 to 32)
+ * at bit 'off' of w[], which may run on into the next word. */
+static inline uint32_t bits_get(const uint64_t *w, uint64_t off, uint32_t width)
+{
+    size_t i = (size_t)(off >> 6);
+    uint32_t sh = (uint32_t)(off & 63);
+    uint64_t x = w[i] >> sh;
+    if (sh + width > 64)
+        x |= w[i + 1] << (64 - sh);
+    return (uint32_t)(x & (((uint64_t)1 << width) - 1));
+}
+
+/* Sets such a field, all zero before. */
+static inline void bits_put(uint64_t *w, uint64_t off, uint32_t width, uint32_t v)
+{
+    size_t i = (size_t)(off >> 6);
+    uint32_t sh = (uint32_t)(off & 63);
+    w[i] |= (uint64_t)v << sh;
+    if (sh + width > 64)
+        w[i + 1] |= (uint64_t)v >> (64 - sh);
+}
+
 static inline int32_t seg_owner(const polar *pd, uint32_t s)
 {
     return pd->seg[s].bld[0] < 0 ? -1 : pd->seg[s].bld[0];

@@ -520,10 +520,48 @@ static void put_node(polar_map *m, uint32_t j, uint32_t t, uint32_t c0, uint32_t
         m->node[2 * (size_t)j] = (uint32_t)x;
         m->node[2 * (size_t)j + 1] = (uint32_t)(x >> 32);
     } else {
-        m->node[3 * (size_t)j] = t;
-        m->node[3 * (size_t)j + 1] = c0;
-        m->node[3 * (size_t)j + 2] = c1;
+        uint64_t off = (uint64_t)j * m->pbits;
+        uint32_t k = KIND(t), c[2], i;
+        c[0] = c0;
+        c[1] = c1;
+        bits_put(m->pnode, off, m->tbits,
+                 IDX(t) + (k == N_X ? 0 : k == N_Y ? m->tcut[0] : m->tcut[1]));
+        off += m->tbits;
+        for (i = 0; i < 2; i++, off += m->cbits) {
+            uint32_t tag = POLAR_TAG(c[i]);
+            bits_put(m->pnode, off, m->cbits,
+                     POLAR_IDX(c[i]) + (tag == POLAR_CHILD_NODE ? 0
+                                        : tag == POLAR_CHILD_FREE ? m->nnode
+                                                                  : m->nnode + m->ntrap));
+        }
     }
+}
+
+/* Bits needed for the numbers below n. */
+static uint32_t bits_for(uint64_t n)
+{
+    uint32_t b = 1;
+    while (b < 32 && ((uint64_t)1 << b) < n)
+        b++;
+    return b;
+}
+
+/* The packed form's field widths (see polar_map) and its words, zeroed. */
+static plx_status packed_nodes(arena *a, polar *pd, polar_map *m)
+{
+    size_t nw;
+    m->tcut[0] = pd->npts;
+    m->tcut[1] = pd->npts + pd->nseg;
+    m->tbits = bits_for((uint64_t)pd->npts + 2 * (uint64_t)pd->nseg);
+    m->cbits = bits_for((uint64_t)m->nnode + m->ntrap + pd->nbld + 1);
+    m->pbits = m->tbits + 2 * m->cbits;
+    /* one word more: a field may be read from two words */
+    nw = (size_t)(((uint64_t)m->nnode * m->pbits + 63) / 64) + 1;
+    m->pnode = keep_n(a, nw, 8, &pd->bytes[3]);
+    if (!m->pnode)
+        return PLX_E_NOMEM;
+    memset(m->pnode, 0, nw * 8);
+    return PLX_OK;
 }
 
 /* Leaves to child words (set by the sweep in the trapezoids' leaf field,
@@ -650,9 +688,13 @@ plx_status polar_dag_keep(arena *a, polar *pd, polar_map *m, dbuild *b, const da
     m->nnode = nq;
     m->narrow = !(flags & POLAR_BUILD_WIDE_DAG) && nq < (1u << 19) && m->ntrap < (1u << 19) &&
                 pd->nbld < (1u << 19) - 1 && pd->npts < (1u << 20) && pd->nseg < (1u << 20);
-    m->node = keep_n(a, nq, m->narrow ? 8 : 12, &pd->bytes[3]);
-    if (!m->node)
+    if (m->narrow) {
+        m->node = keep_n(a, nq, 8, &pd->bytes[3]);
+        if (!m->node)
+            return PLX_E_NOMEM;
+    } else if (packed_nodes(a, pd, m) != PLX_OK) {
         return PLX_E_NOMEM;
+    }
     for (i = 0, j = 0; i < b->nnode; i++) {
         const uint32_t *nd = dnode(b, i);
         if (KIND(nd[0]) == N_LEAF)
