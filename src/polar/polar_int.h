@@ -174,8 +174,15 @@ typedef struct proles {
     uint32_t side[2];
 } proles;
 
-/* The sweep's data per piece (its frame ends are in a separate array, E:
- * E[2 s] left, E[2 s + 1] right, which the insertions read too). */
+/* The frame end k (0: left, 1: right) of piece s: its canonical end point
+ * SR[s].end[k], at the same position as the piece's own. */
+static inline vec2 pend(const polar *pd, int frame, const sroles *SR, uint32_t s, int k)
+{
+    return fpt(pd, frame, SR[s].end[k]);
+}
+
+/* The sweep's data per piece (its frame ends are read through its
+ * canonical ends, pend). */
 typedef struct snode {
     int32_t cov;        /* footprints covering the gap above it */
     uint32_t open;      /* the free region open above it, or POLAR_NONE */
@@ -205,7 +212,6 @@ typedef struct dbuild {
                               * axes it cuts, each at a distinct event position
                               * between its ends (the longest such run + 8) */
     const snode *N;          /* per piece: the sweep's data (y test kind) */
-    const vec2 *E;           /* per piece: frame ends, left then right */
     const uint32_t *order;   /* the insertion order */
     /* the live trapezoids by role, kept up to date by every insertion */
     sroles *SR;
@@ -233,7 +239,7 @@ plx_status polar_map_build(arena *a, polar *pd, polar_map *m, const uint32_t *in
  * randomized insertion; the DAG kept with its leaves as child words. */
 plx_status polar_insertion_order(arena *a, const polar *pd, uint32_t **out);
 plx_status polar_dag_build(arena *a, polar *pd, polar_map *m, dbuild *b, const snode *N,
-                           const vec2 *E, sroles *SR, const uint32_t *order, uint32_t span);
+                           sroles *SR, const uint32_t *order, uint32_t span);
 /* The inner nodes' ranks among the build nodes (see polar_dag_words). */
 typedef struct dag_rank {
     uint64_t *bits;          /* bit i: build node i is inner */

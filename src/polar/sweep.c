@@ -35,7 +35,6 @@ typedef struct sweep {
     const polar *pd;
     polar_map *m;
     snode *N;           /* per segment (walls and Bounds sides) */
-    const vec2 *E;      /* per segment: frame ends, left then right */
     uint32_t ntrap, cap; /* regions made, the most there can be */
     uint32_t nclosed;   /* regions closed */
     const uint32_t *inc_first, *inc; /* walls incident to each point */
@@ -60,8 +59,8 @@ typedef struct sweep {
 #define EV_POINT 0x7fffffffu
 
 /* The frame ends of piece s. */
-#define EL(w, s) ((w)->E[2 * (size_t)(s)])
-#define ER(w, s) ((w)->E[2 * (size_t)(s) + 1])
+#define EL(w, s) pend((w)->pd, (w)->m->frame, (w)->SR, (s), 0)
+#define ER(w, s) pend((w)->pd, (w)->m->frame, (w)->SR, (s), 1)
 
 static int fp_before(const fpoint *a, const fpoint *b, const void *ctx)
 {
@@ -120,9 +119,9 @@ static int close_region(sweep *w, uint32_t h, uint32_t pi)
 
 /* Does piece y start below piece x (both starting at the same point)?
  * Sets *flat when they are collinear. */
-static int start_below(const vec2 *E, uint32_t y, uint32_t x, int *flat)
+static int start_below(const sweep *w, uint32_t y, uint32_t x, int *flat)
 {
-    int o = geom_orient(E[2 * (size_t)y], E[2 * (size_t)y + 1], E[2 * (size_t)x + 1]);
+    int o = geom_orient(EL(w, y), ER(w, y), ER(w, x));
     if (o == 0)
         *flat = 1;
     return o > 0;
@@ -134,14 +133,13 @@ static int start_below(const vec2 *E, uint32_t y, uint32_t x, int *flat)
  * neighbours in the order are always compared, so it is seen). */
 static int sort_starts(sweep *w, uint32_t n)
 {
-    const vec2 *E = w->E;
     uint32_t *src = w->start, *dst = w->tmp, i, j, wd;
     int flat = 0;
     for (i = 0; i < n; i += 8) {
         uint32_t e = i + 8 < n ? i + 8 : n;
         for (j = i + 1; j < e; j++) {
             uint32_t t = src[j], k = j;
-            while (k > i && start_below(E, t, src[k - 1], &flat)) {
+            while (k > i && start_below(w, t, src[k - 1], &flat)) {
                 src[k] = src[k - 1];
                 k--;
             }
@@ -153,7 +151,7 @@ static int sort_starts(sweep *w, uint32_t n)
             uint32_t a = i, am = i + wd < n ? i + wd : n, b = am, bm = i + 2 * wd < n ? i + 2 * wd : n;
             uint32_t o = i;
             while (a < am && b < bm)
-                dst[o++] = start_below(E, src[b], src[a], &flat) ? src[b++] : src[a++];
+                dst[o++] = start_below(w, src[b], src[a], &flat) ? src[b++] : src[a++];
             while (a < am)
                 dst[o++] = src[a++];
             while (b < bm)
@@ -341,10 +339,10 @@ static void frame_box(const polar *pd, polar_map *m)
 }
 
 
-/* Per piece: its frame ends (E), the sweep's data (N) and its canonical
- * ends (SR, all else unset: POLAR_NONE); canon: per point the first event
- * point at its position. */
-static void frame_pieces(polar *pd, polar_map *m, snode *N, vec2 *E, sroles *SR,
+/* Per piece: the sweep's data (N) and its canonical ends (SR, all else
+ * unset: POLAR_NONE); canon: per point the first event point at its
+ * position. */
+static void frame_pieces(polar *pd, polar_map *m, snode *N, sroles *SR,
                          const uint32_t *canon)
 {
     uint32_t s;
@@ -357,8 +355,6 @@ static void frame_pieces(polar *pd, polar_map *m, snode *N, vec2 *E, sroles *SR,
         int32_t own;
         seg_ends(pd, m->frame, s, &l, &r);
         own = (l == gs->a ? gs->cover : -gs->cover) > 0 && gs->bld[0] >= 0 ? gs->bld[0] : -1;
-        E[2 * (size_t)s] = fpt(pd, m->frame, l);
-        E[2 * (size_t)s + 1] = fpt(pd, m->frame, r);
         SR[s].end[0] = canon[l];
         SR[s].end[1] = canon[r];
         N[s].solid = PACK(POLAR_CHILD_SOLID, (uint32_t)(own + 1));
@@ -449,7 +445,7 @@ static plx_status run_sweep(sweep *w, const dbuild *b, const uint32_t *evs, uint
  * subdivision and that both maps agree, and makes the free regions (kept,
  * in sweep order, with their adjacency); then the DAG is kept with its
  * leaves mapped to those regions (unless flags say otherwise).
- * Memory, in stack order: per piece N (24 bytes), E (32) and SR (24), the
+ * Memory, in stack order: per piece N (24 bytes) and SR (24), the
  * sorted events (4 a point); the sort's buffers and canonical indices
  * (given back before the insertion); the insertion's hints and roles (4 +
  * 8 a point), lists (by the longest piece) and search nodes (12 bytes
@@ -464,7 +460,6 @@ plx_status polar_map_build(arena *a, polar *pd, polar_map *m, const uint32_t *in
 {
     sweep w;
     dbuild b;
-    vec2 *E;
     uint32_t *evs, *canon, nlive, span, maxdeg;
     sroles *SR;
     dag_rank rk;
@@ -479,10 +474,9 @@ plx_status polar_map_build(arena *a, polar *pd, polar_map *m, const uint32_t *in
     w.inc_first = inc_first;
     w.inc = inc;
     w.N = scratch_n(a, pd->nseg, sizeof(snode));
-    w.E = E = scratch_n(a, 2 * (size_t)pd->nseg, sizeof(vec2));
-    SR = scratch_n(a, pd->nseg, sizeof(sroles));
+    w.SR = SR = scratch_n(a, pd->nseg, sizeof(sroles));
     evs = scratch_n(a, nev, 4);
-    if (!w.N || !E || !SR || !evs)
+    if (!w.N || !SR || !evs)
         return PLX_E_NOMEM;
     frame_box(pd, m);
     mk = arena_get_mark(a);
@@ -492,9 +486,9 @@ plx_status polar_map_build(arena *a, polar *pd, polar_map *m, const uint32_t *in
     st = sort_events(a, pd, m->frame, evp, nev, inc_first, evs, canon, &span, &maxdeg);
     if (st != PLX_OK)
         return st;
-    frame_pieces(pd, m, w.N, E, SR, canon);
+    frame_pieces(pd, m, w.N, SR, canon);
     arena_release(a, &mk);
-    st = polar_dag_build(a, pd, m, &b, w.N, E, SR, order, span);
+    st = polar_dag_build(a, pd, m, &b, w.N, SR, order, span);
     if (st != PLX_OK)
         return st;
     w.DT = b.T;

@@ -141,10 +141,11 @@ static uint32_t find_first(dbuild *b, uint32_t n, vec2 P, vec2 Q)
         if (KIND(w) == N_X) {
             n = lex_cmp(P, bpt(b, IDX(w))) < 0 ? nd[1] : nd[2];
         } else {
-            const vec2 *g = &b->E[2 * (size_t)IDX(w)];
-            int o = geom_orient(g[0], g[1], P);
+            vec2 g0 = pend(b->pd, b->frame, b->SR, IDX(w), 0);
+            vec2 g1 = pend(b->pd, b->frame, b->SR, IDX(w), 1);
+            int o = geom_orient(g0, g1, P);
             if (o == 0)
-                o = geom_orient(g[0], g[1], Q);   /* a shared left end: the slopes */
+                o = geom_orient(g0, g1, Q);   /* a shared left end: the slopes */
             if (o == 0) {
                 b->fail = 2;
                 return POLAR_NONE;
@@ -166,10 +167,11 @@ static uint32_t find_last(dbuild *b, uint32_t n, vec2 Q, vec2 P)
         if (KIND(w) == N_X) {
             n = lex_cmp(Q, bpt(b, IDX(w))) <= 0 ? nd[1] : nd[2];
         } else {
-            const vec2 *g = &b->E[2 * (size_t)IDX(w)];
-            int o = geom_orient(g[0], g[1], Q);
+            vec2 g0 = pend(b->pd, b->frame, b->SR, IDX(w), 0);
+            vec2 g1 = pend(b->pd, b->frame, b->SR, IDX(w), 1);
+            int o = geom_orient(g0, g1, Q);
             if (o == 0)
-                o = geom_orient(g[0], g[1], P);
+                o = geom_orient(g0, g1, P);
             if (o == 0) {
                 b->fail = 2;
                 return POLAR_NONE;
@@ -226,14 +228,13 @@ static uint32_t walk_at(dbuild *b, uint32_t p, vec2 D, int right)
     for (n = 0; n < WALK_MAX && t != POLAR_NONE; n++) {
         const btrap *x = &b->T[t];
         uint32_t e = right ? x->lp : x->rp;
-        const vec2 *g;
         int o;
         if (x->leaf == POLAR_NONE || e != p)
             return POLAR_NONE;
         b->steps++;
         if (b->SR[x->top].end[k] == p) {
-            g = &b->E[2 * (size_t)x->top];
-            o = geom_orient(g[0], g[1], D);
+            o = geom_orient(pend(b->pd, b->frame, b->SR, x->top, 0),
+                             pend(b->pd, b->frame, b->SR, x->top, 1), D);
             if (o == 0)
                 return POLAR_NONE;    /* overlapping pieces: the DAG says so */
             if (o > 0) {
@@ -242,8 +243,8 @@ static uint32_t walk_at(dbuild *b, uint32_t p, vec2 D, int right)
             }
         }
         if (b->SR[x->bot].end[k] == p) {
-            g = &b->E[2 * (size_t)x->bot];
-            o = geom_orient(g[0], g[1], D);
+            o = geom_orient(pend(b->pd, b->frame, b->SR, x->bot, 0),
+                             pend(b->pd, b->frame, b->SR, x->bot, 1), D);
             if (o == 0)
                 return POLAR_NONE;
             if (o < 0) {
@@ -799,13 +800,14 @@ static void prefetch_ahead(const dbuild *b, uint32_t i, uint32_t nw)
     if (i + 16 < nw) {
         uint32_t s = b->order[i + 16];
         __builtin_prefetch(&b->SR[s]);
-        __builtin_prefetch(&b->E[2 * (size_t)s]);
     }
     if (i + 8 < nw) {
         const sroles *r = &b->SR[b->order[i + 8]];
         __builtin_prefetch(&b->PR[r->end[0]]);
         __builtin_prefetch(&b->PR[r->end[1]]);
         __builtin_prefetch(&b->hint[r->end[0]]);
+        __builtin_prefetch(&b->pd->pts[r->end[0]]);
+        __builtin_prefetch(&b->pd->pts[r->end[1]]);
     }
 #else
     (void)b;
@@ -817,9 +819,9 @@ static void prefetch_ahead(const dbuild *b, uint32_t i, uint32_t nw)
 /* Builds the trapezoidal map of the wall pieces of m and its search DAG by
  * randomized incremental insertion, into b (scratch, the trapezoid slots
  * in the low end of the arena). N: the pieces' ends and y test kinds (the
- * sweep's snodes); E: their frame ends. */
+ * sweep's snodes); SR: their canonical ends (pend). */
 plx_status polar_dag_build(arena *a, polar *pd, polar_map *m, dbuild *b, const snode *N,
-                           const vec2 *E, sroles *SR, const uint32_t *order, uint32_t span)
+                           sroles *SR, const uint32_t *order, uint32_t span)
 {
     uint32_t nw = pd->nwall, i, t;
     if (nw >= (1u << 26) || pd->npts >= (1u << 26))
@@ -829,7 +831,6 @@ plx_status polar_dag_build(arena *a, polar *pd, polar_map *m, dbuild *b, const s
     b->a = a;
     b->frame = m->frame;
     b->N = N;
-    b->E = E;
     b->SR = SR;
     b->order = order;
     /* trapezoid slots: at most 3 i + 1 live after i pieces; a new piece
@@ -865,8 +866,8 @@ plx_status polar_dag_build(arena *a, polar *pd, polar_map *m, dbuild *b, const s
         irec in;
         uint32_t s = order[i];
         prefetch_ahead(b, i, nw);
-        in.P = E[2 * (size_t)s];
-        in.Q = E[2 * (size_t)s + 1];
+        in.P = pend(pd, m->frame, SR, s, 0);
+        in.Q = pend(pd, m->frame, SR, s, 1);
         in.s = s;
         in.l = b->SR[s].end[0];
         in.r = b->SR[s].end[1];
