@@ -185,10 +185,8 @@ static inline vec2 pend(const polar *pd, int frame, const sroles *SR, uint32_t s
  * canonical ends, pend). */
 typedef struct snode {
     int32_t cov;        /* footprints covering the gap above it */
-    uint32_t open;      /* the free region open above it, or POLAR_NONE */
+    uint32_t open;      /* the slot of the free region open above it, or POLAR_NONE */
     uint32_t prev, next; /* status list; prev == POLAR_NONE: not in it */
-    uint32_t solid;     /* child word of a solid trapezoid on it (search DAG) */
-    uint32_t yk;        /* its search node kind: N_Y (l is seg.a) or N_YB */
 } snode;
 
 #define NODE_BITS 12
@@ -211,7 +209,6 @@ typedef struct dbuild {
     uint32_t lcap;           /* their length: a piece crosses one trapezoid more than the
                               * axes it cuts, each at a distinct event position
                               * between its ends (the longest such run + 8) */
-    const snode *N;          /* per piece: the sweep's data (y test kind) */
     const uint32_t *order;   /* the insertion order */
     /* the live trapezoids by role, kept up to date by every insertion */
     sroles *SR;
@@ -230,15 +227,15 @@ plx_status polar_make_walls(arena *a, polar *pd);
 /* sweep.c: walls incident to each point and the sweep events; the map of
  * one frame (search DAG, sweep, regions kept). */
 plx_status polar_incidence(arena *a, const polar *pd, uint32_t **inc_first, uint32_t **inc,
-                           uint32_t **evp, uint32_t *nev);
+                           uint32_t *nev);
 plx_status polar_map_build(arena *a, polar *pd, polar_map *m, const uint32_t *inc_first,
-                           const uint32_t *inc, const uint32_t *evp, uint32_t nev,
+                           const uint32_t *inc, uint32_t nev,
                            const uint32_t *order, int flags, uint64_t *steps);
 
 /* trapmap.c: the random insertion order; the map and DAG of one frame by
  * randomized insertion; the DAG kept with its leaves as child words. */
 plx_status polar_insertion_order(arena *a, const polar *pd, uint32_t **out);
-plx_status polar_dag_build(arena *a, polar *pd, polar_map *m, dbuild *b, const snode *N,
+plx_status polar_dag_build(arena *a, polar *pd, polar_map *m, dbuild *b,
                            sroles *SR, const uint32_t *order, uint32_t span);
 /* The inner nodes' ranks among the build nodes (see polar_dag_words). */
 typedef struct dag_rank {

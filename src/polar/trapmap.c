@@ -119,7 +119,8 @@ static uint32_t new_node(dbuild *b, uint32_t kind, uint32_t idx, uint32_t c0, ui
 /* The y test of piece s: its kind by which end is frame-left. */
 static uint32_t ykind(const dbuild *b, uint32_t s)
 {
-    return b->N[s].yk;
+    const polar_seg *g = &b->pd->seg[s];
+    return lex_cmp(bpt(b, g->a), bpt(b, g->b)) < 0 ? N_Y : N_YB;
 }
 
 /* One insertion, its data gathered beforehand (in insertion order). */
@@ -818,9 +819,9 @@ static void prefetch_ahead(const dbuild *b, uint32_t i, uint32_t nw)
 
 /* Builds the trapezoidal map of the wall pieces of m and its search DAG by
  * randomized incremental insertion, into b (scratch, the trapezoid slots
- * in the low end of the arena). N: the pieces' ends and y test kinds (the
- * sweep's snodes); SR: their canonical ends (pend). */
-plx_status polar_dag_build(arena *a, polar *pd, polar_map *m, dbuild *b, const snode *N,
+ * in the low end of the arena). SR: the pieces' canonical ends (pend),
+ * the rest of it unset. */
+plx_status polar_dag_build(arena *a, polar *pd, polar_map *m, dbuild *b,
                            sroles *SR, const uint32_t *order, uint32_t span)
 {
     uint32_t nw = pd->nwall, i, t;
@@ -830,7 +831,6 @@ plx_status polar_dag_build(arena *a, polar *pd, polar_map *m, dbuild *b, const s
     b->pd = pd;
     b->a = a;
     b->frame = m->frame;
-    b->N = N;
     b->SR = SR;
     b->order = order;
     /* trapezoid slots: at most 3 i + 1 live after i pieces; a new piece
