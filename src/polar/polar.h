@@ -118,15 +118,14 @@ typedef struct polar_trap {
  * w0 | w1 << 32 hold the test as kind << 20 | index in bits 0-21 and the
  * children as tag << 19 | index in bits 22-42 and 43-63 (up to 2^19 nodes,
  * regions and buildings, 2^20 points and pieces); otherwise packed in
- * pbits bits a node (node j at bit j * pbits of the 64-bit words pnode[],
- * a field running on into the next word where it does not fit): the test
- * as one number, a point index for POLAR_NODE_X, npts + a piece index for
- * POLAR_NODE_Y, npts + nseg + a piece index for POLAR_NODE_YB, in tbits
- * bits; each child as one number, an inner node below nnode, nnode + a
- * free region below nnode + ntrap, else nnode + ntrap + the solid
- * trapezoid's owner plus one, in cbits bits (about 8.5 bytes a node on a
- * 10^6-vertex ring, where the three words took 12). polar_node() unpacks
- * either. */
+ * tbits + 2 cbits bits a node (pack = tbits | cbits << 8; node j at bit j
+ * (tbits + 2 cbits) of node[] read as 64-bit words, a field running on
+ * into the next word where it does not fit): the test as kind <<
+ * (tbits - 2) | index; each child as one number, an inner node below
+ * nnode, nnode + a free region below nnode + ntrap, else nnode + ntrap +
+ * the solid trapezoid's owner plus one, in cbits bits (8.5 bytes a node on
+ * a 10^6-vertex ring, where the three words took 12). polar_node()
+ * unpacks either. */
 #define POLAR_TAG(w) ((w) >> 30)
 #define POLAR_IDX(w) ((w) & 0x3fffffffu)
 enum { POLAR_CHILD_NODE = 0, POLAR_CHILD_FREE = 1, POLAR_CHILD_SOLID = 2 };
@@ -136,16 +135,14 @@ typedef struct polar_map {
     int frame;
     uint32_t ntrap;          /* free regions */
     polar_trap *trap;
-    uint32_t *node;          /* inner search nodes when narrow (see above):
-                              * 2 words each */
-    uint64_t *pnode;         /* the same packed, when not narrow */
+    uint32_t *node;          /* inner search nodes (see above): 2 words each
+                              * when narrow, else packed 64-bit words */
     uint32_t nnode;
     uint32_t root;           /* child word of the root */
     int narrow;
-    uint32_t tbits, cbits, pbits; /* packed: bits of a test, a child, a node */
-    uint32_t tcut[2];        /* packed tests: npts, npts + nseg */
     uint32_t box_top, box_bot; /* segment indices of the Bounds sides on top/bottom */
     uint32_t box_lo, box_hi;   /* point indices of the extreme Bounds corners */
+    uint32_t pack;           /* packed nodes: tbits | cbits << 8 (see above) */
 } polar_map;
 
 typedef struct polar {

@@ -522,16 +522,16 @@ static void put_node(polar_map *m, uint32_t j, uint32_t t, uint32_t c0, uint32_t
         m->node[2 * (size_t)j] = (uint32_t)x;
         m->node[2 * (size_t)j + 1] = (uint32_t)(x >> 32);
     } else {
-        uint64_t off = (uint64_t)j * m->pbits;
-        uint32_t k = KIND(t), c[2], i;
+        uint64_t *pw = (uint64_t *)(void *)m->node;
+        uint32_t tb = m->pack & 0xffu, cb = m->pack >> 8, c[2], i;
+        uint64_t off = (uint64_t)j * (tb + 2 * cb);
         c[0] = c0;
         c[1] = c1;
-        bits_put(m->pnode, off, m->tbits,
-                 IDX(t) + (k == N_X ? 0 : k == N_Y ? m->tcut[0] : m->tcut[1]));
-        off += m->tbits;
-        for (i = 0; i < 2; i++, off += m->cbits) {
+        bits_put(pw, off, tb, KIND(t) << (tb - 2) | IDX(t));
+        off += tb;
+        for (i = 0; i < 2; i++, off += cb) {
             uint32_t tag = POLAR_TAG(c[i]);
-            bits_put(m->pnode, off, m->cbits,
+            bits_put(pw, off, cb,
                      POLAR_IDX(c[i]) + (tag == POLAR_CHILD_NODE ? 0
                                         : tag == POLAR_CHILD_FREE ? m->nnode
                                                                   : m->nnode + m->ntrap));
@@ -552,17 +552,15 @@ static uint32_t bits_for(uint64_t n)
 static plx_status packed_nodes(arena *a, polar *pd, polar_map *m)
 {
     size_t nw;
-    m->tcut[0] = pd->npts;
-    m->tcut[1] = pd->npts + pd->nseg;
-    m->tbits = bits_for((uint64_t)pd->npts + 2 * (uint64_t)pd->nseg);
-    m->cbits = bits_for((uint64_t)m->nnode + m->ntrap + pd->nbld + 1);
-    m->pbits = m->tbits + 2 * m->cbits;
+    uint32_t tb = 2 + bits_for(pd->npts > pd->nseg ? pd->npts : pd->nseg);
+    uint32_t cb = bits_for((uint64_t)m->nnode + m->ntrap + pd->nbld + 1);
+    m->pack = tb | cb << 8;
     /* one word more: a field may be read from two words */
-    nw = (size_t)(((uint64_t)m->nnode * m->pbits + 63) / 64) + 1;
-    m->pnode = keep_n(a, nw, 8, &pd->bytes[3]);
-    if (!m->pnode)
+    nw = (size_t)(((uint64_t)m->nnode * (tb + 2 * cb) + 63) / 64) + 1;
+    m->node = keep_n(a, nw, 8, &pd->bytes[3]);
+    if (!m->node)
         return PLX_E_NOMEM;
-    memset(m->pnode, 0, nw * 8);
+    memset(m->node, 0, nw * 8);
     return PLX_OK;
 }
 
