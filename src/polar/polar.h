@@ -168,10 +168,10 @@ typedef struct polar {
  * and the trapezoid slots) is at most POLAR_SCRATCH_PER_VERTEX bytes a
  * footprint vertex plus POLAR_SCRATCH_FIXED: a block must hold the
  * diagrams and that (tests/unit/test_polar_scratch.c measures it on
- * growing rings and generated cities: 209 bytes a vertex on a
- * 100,000-vertex ring, 127 on gen eixample 24 24; README "Polar build
+ * growing rings and generated cities: 157 bytes a vertex on a
+ * 100,000-vertex ring, 96 on gen eixample 24 24; README "Polar build
  * scratch"). */
-#define POLAR_SCRATCH_PER_VERTEX 256
+#define POLAR_SCRATCH_PER_VERTEX 200
 #define POLAR_SCRATCH_FIXED ((size_t)1 << 20)
 
 /* Builds the four diagrams of scene s. On success *out points into arena
