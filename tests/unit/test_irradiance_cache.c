@@ -33,6 +33,7 @@
 #include "photon/trace.h"
 #include "photon/indirect.h"
 #include "photon/irradiance_cache.h"
+#include "render/render.h"
 #include "ref_indirect.h"
 #include "fixture.h"
 
@@ -196,6 +197,15 @@ static void test_image_accuracy(void **state)
     plx_engine_free(e);
 }
 
+/* The test camera, and another one 30 m away that fills the cache first. */
+static void two_views(plx_camera *c, plx_camera *other)
+{
+    camera(c);
+    *other = *c;
+    other->eye[0] -= 30.0;
+    other->target[1] += 20.0;
+}
+
 /* The same camera, the same bytes: after another view filled the cache, and
  * in a fresh engine. */
 static void test_image_same_bytes(void **state)
@@ -207,10 +217,7 @@ static void test_image_same_bytes(void **state)
     plx_camera c, other;
     (void)state;
     assert_true(a && b);
-    camera(&c);
-    other = c;
-    other.eye[0] -= 30.0;
-    other.target[1] += 20.0;
+    two_views(&c, &other);
     plx_render_opts_default(&o);
     assert_int_equal(plx_indirect_step(e1, 16384, 3), PLX_OK);
     assert_int_equal(plx_indirect_step(e2, 16384, 3), PLX_OK);
@@ -224,28 +231,61 @@ static void test_image_same_bytes(void **state)
     plx_engine_free(e2);
 }
 
-/* ---- aerial views: the light map's indirect layer ---------------------------- */
-
-typedef struct gbuf {
-    char *p;
-    size_t n, cap;
-} gbuf;
-
-static int gbuf_write(void *user, const char *data, size_t len)
+/* The caches' sizes come from the budget and change no byte: the
+ * smallest irradiance-cache table (ICACHE_RECORDS_MIN slots: it is
+ * emptied and refilled during the frames, asserted) and a renderer made
+ * for 64x48 frames (64 surface slots, render_surf_slots) give the frames
+ * of the default sizes. */
+static void test_small_caches_same_bytes(void **state)
 {
-    gbuf *b = user;
-    if (b->n + len + 1 > b->cap) {
-        size_t cap = 2 * (b->n + len + 1);
-        char *q = realloc(b->p, cap);
-        if (!q)
-            return -1;
-        b->p = q;
-        b->cap = cap;
-    }
-    memcpy(b->p + b->n, data, len);
-    b->n += len;
-    return 0;
+    plx_engine *e1 = fixture_new((size_t)1 << 30, "fixtures/eixample-4x4.geojson", NULL, 0);
+    plx_engine *e2 = fixture_new((size_t)1 << 30, "fixtures/eixample-4x4.geojson", NULL, 0);
+    plx_engine *e3;
+    plx_config cfg;
+    uint8_t *a = malloc(3 * W * H), *b = malloc(3 * W * H);
+    plx_render_opts o;
+    plx_camera c, other;
+    (void)state;
+    assert_true(a && b);
+    two_views(&c, &other);
+    plx_render_opts_default(&o);
+    assert_int_equal(plx_indirect_step(e1, 16384, 3), PLX_OK);
+    assert_int_equal(plx_indirect_step(e2, 16384, 3), PLX_OK);
+    assert_int_equal(e1->ic->nrec, ICACHE_RECORDS);
+    assert_int_equal(icache_create(&e2->mem, ICACHE_RECORDS_MIN, &e2->ic), PLX_OK);
+    assert_int_equal(icache_create(&e2->mem, 3000, &e2->ic), PLX_E_INVALID);
+    assert_int_equal(plx_render(e1, &c, &o, a, NULL, NULL), PLX_OK);
+    assert_int_equal(plx_render(e2, &other, &o, b, NULL, NULL), PLX_OK);
+    assert_int_equal(plx_render(e2, &c, &o, b, NULL, NULL), PLX_OK);
+    printf("table of %u slots: emptied %llu times, %llu records gathered (default table: %llu)\n",
+           (unsigned)e2->ic->nrec, (unsigned long long)e2->ic->flushes, (unsigned long long)e2->ic->gathered,
+           (unsigned long long)e1->ic->gathered);
+    assert_true(e2->ic->flushes > 0);
+    assert_memory_equal(a, b, 3 * W * H);
+
+    plx_config_default(&cfg);
+    cfg.port = fixture_quiet_port();
+    cfg.render_max_width = 64;
+    cfg.render_max_height = 48;
+    assert_int_equal(plx_engine_new((size_t)1 << 30, &cfg, &e3), PLX_OK);
+    assert_int_equal(plx_load_file(e3, "fixtures/eixample-4x4.geojson"), PLX_OK);
+    assert_int_equal(plx_indirect_step(e3, 16384, 3), PLX_OK);
+    assert_int_equal(render_surf_slots(e3->sc, 64, 48), 64);
+    assert_int_equal(render_surf_slots(e3->sc, W, H), 2048);
+    c.width = other.width = 64;
+    c.height = other.height = 48;
+    assert_int_equal(plx_render(e1, &c, &o, a, NULL, NULL), PLX_OK);
+    assert_int_equal(plx_render(e3, &other, &o, b, NULL, NULL), PLX_OK);
+    assert_int_equal(plx_render(e3, &c, &o, b, NULL, NULL), PLX_OK);
+    assert_memory_equal(a, b, 3 * 64 * 48);
+    free(a);
+    free(b);
+    plx_engine_free(e1);
+    plx_engine_free(e2);
+    plx_engine_free(e3);
 }
+
+/* ---- aerial views: the light map's indirect layer ---------------------------- */
 
 #define AW 200
 #define AH 150
@@ -289,7 +329,7 @@ static void test_aerial_accuracy(void **state)
     plx_render_opts o;
     plx_camera c;
     plx_scene_info si;
-    gbuf g = { NULL, 0, 0 };
+    fixture_city g;
     float *with = malloc(sizeof *with * 3 * AW * AH), *without = malloc(sizeof *with * 3 * AW * AH);
     int step = quick_mode() ? 6 : 3, paths = quick_mode() ? 5000 : 40000;
     int maxn = quick_mode() ? 10 : 50, i, j, n = 0, roofs = 0, dark = 0, nlit = 0, k;
@@ -298,14 +338,14 @@ static void test_aerial_accuracy(void **state)
     double dark_old = 0.0;
     (void)state;
     assert_true(with && without && lit);
-    assert_int_equal(plx_gen_city("eixample", 2, 2, 1, gbuf_write, &g), PLX_OK);
+    fixture_gen("eixample", 2, 2, 1, &g);
     port = *plx_port_posix();
     port.log = NULL;
     plx_config_default(&cfg);
     cfg.port = &port;
     assert_int_equal(plx_engine_new((size_t)1 << 29, &cfg, &e), PLX_OK);
-    assert_int_equal(plx_load_geojson(e, g.p, g.n, "eixample-2x2"), PLX_OK);
-    free(g.p);
+    assert_int_equal(plx_load_geojson(e, g.buf, g.len, "eixample-2x2"), PLX_OK);
+    free(g.buf);
     plx_scene_info_get(e, &si);
     memset(&c, 0, sizeof c);
     c.fov_deg = 40.0;
@@ -390,6 +430,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_image_accuracy),
         cmocka_unit_test(test_image_same_bytes),
+        cmocka_unit_test(test_small_caches_same_bytes),
         cmocka_unit_test(test_aerial_accuracy),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
