@@ -96,9 +96,9 @@ static uint32_t solid_word(const polar *pd, int frame, uint32_t s)
 }
 
 /* The gap above bot opened at point pi (below top) is trapezoid d of the
- * DAG's map: checked, and its child word set: a new region if free (*h =
- * d, its slot), else solid (*h = POLAR_NONE). Returns 0, or -1 when the
- * two maps differ. */
+ * DAG's map: checked, and its child word set: a new region when it is
+ * free, *h = d (its slot), else solid, *h = POLAR_NONE. Returns 0, or -1
+ * when the two maps differ. */
 static int open_gap(sweep *w, uint32_t d, uint32_t pi, uint32_t top, uint32_t bot, int free,
                     uint32_t *h)
 {
