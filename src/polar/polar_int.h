@@ -203,8 +203,12 @@ typedef struct dbuild {
     uint32_t freel, nfree;   /* the last freed slot (its nb[0] links the
                               * one freed before), free slots */
     arena_mark tmark;        /* the arena before the slots */
-    uint32_t (**chunk)[3];   /* nodes in chunks of NODE_CHUNK (scratch) */
+    uint64_t **chunk;        /* nodes in chunks of NODE_CHUNK (scratch),
+                              * packed in bits: a test (kind << (tb - 2) |
+                              * index) and two children of cb bits each */
     uint32_t nchunk, maxchunk, nnode;
+    uint32_t tb, cb, stride; /* field widths and the bits of one node */
+    size_t cwords;           /* 64-bit words of one chunk */
     uint32_t *list, *up, *lo; /* per crossed trapezoid: it, its new upper / lower part */
     uint32_t lcap;           /* their length: a piece crosses one trapezoid more than the
                               * axes it cuts, each at a distinct event position

@@ -32,9 +32,47 @@
  * the sweep when it opens that trapezoid as a gap: its free region, or the
  * owner that polar_locate reports inside a solid one. */
 
-static uint32_t *dnode(const dbuild *b, uint32_t n)
+static uint32_t bits_for(uint64_t n);
+
+/* Build node n: its chunk, *off the bit of its first field there. */
+static uint64_t *nchunk_of(const dbuild *b, uint32_t n, uint64_t *off)
 {
-    return b->chunk[n >> NODE_BITS][n & (NODE_CHUNK - 1)];
+    *off = (uint64_t)(n & (NODE_CHUNK - 1)) * b->stride;
+    return b->chunk[n >> NODE_BITS];
+}
+
+/* The test of the node at bit off of chunk w, as kind << 30 | index. */
+static uint32_t ntest(const dbuild *b, const uint64_t *w, uint64_t off)
+{
+    uint32_t v = bits_get(w, off, b->tb);
+    return PACK(v >> (b->tb - 2), v & ((1u << (b->tb - 2)) - 1));
+}
+
+/* Its child k (0, 1). */
+static uint32_t nchild(const dbuild *b, const uint64_t *w, uint64_t off, int k)
+{
+    return bits_get(w, off + b->tb + (k ? b->cb : 0), b->cb);
+}
+
+/* Sets a field of bits_get's form (v below 2^width). */
+static void field_set(uint64_t *w, uint64_t off, uint32_t width, uint32_t v)
+{
+    size_t i = (size_t)(off >> 6);
+    uint32_t sh = (uint32_t)(off & 63);
+    uint64_t mask = ((uint64_t)1 << width) - 1;
+    w[i] = (w[i] & ~(mask << sh)) | (uint64_t)v << sh;
+    if (sh + width > 64)
+        w[i + 1] = (w[i + 1] & ~(mask >> (64 - sh))) | (uint64_t)v >> (64 - sh);
+}
+
+/* Build node n becomes test t (kind << 30 | index), children c0, c1. */
+static void nset(const dbuild *b, uint32_t n, uint32_t t, uint32_t c0, uint32_t c1)
+{
+    uint64_t off;
+    uint64_t *w = nchunk_of(b, n, &off);
+    field_set(w, off, b->tb, KIND(t) << (b->tb - 2) | IDX(t));
+    field_set(w, off + b->tb, b->cb, c0);
+    field_set(w, off + b->tb + b->cb, b->cb, c1);
 }
 
 static vec2 bpt(const dbuild *b, uint32_t i)
@@ -99,20 +137,18 @@ static void free_trap(dbuild *b, uint32_t t)
 
 static uint32_t new_node(dbuild *b, uint32_t kind, uint32_t idx, uint32_t c0, uint32_t c1)
 {
-    uint32_t n = b->nnode, *nd;
+    uint32_t n = b->nnode;
     if (n == b->nchunk * NODE_CHUNK) {
         if (b->nchunk == b->maxchunk ||
-            !(b->chunk[b->nchunk] = arena_scratch(b->a, (size_t)NODE_CHUNK * 12, 16))) {
+            !(b->chunk[b->nchunk] = arena_scratch(b->a, b->cwords * 8, 16))) {
             b->fail = 1;
             return 0;
         }
+        memset(b->chunk[b->nchunk], 0, b->cwords * 8);
         b->nchunk++;
     }
     b->nnode++;
-    nd = dnode(b, n);
-    nd[0] = PACK(kind, idx);
-    nd[1] = c0;
-    nd[2] = c1;
+    nset(b, n, PACK(kind, idx), c0, c1);
     return n;
 }
 
@@ -135,12 +171,13 @@ typedef struct irec {
 static uint32_t find_first(dbuild *b, uint32_t n, vec2 P, vec2 Q)
 {
     for (;; b->steps++) {
-        const uint32_t *nd = dnode(b, n);
-        uint32_t w = nd[0];
+        uint64_t off;
+        const uint64_t *cw = nchunk_of(b, n, &off);
+        uint32_t w = ntest(b, cw, off);
         if (KIND(w) == N_LEAF)
             return IDX(w);
         if (KIND(w) == N_X) {
-            n = lex_cmp(P, bpt(b, IDX(w))) < 0 ? nd[1] : nd[2];
+            n = nchild(b, cw, off, !(lex_cmp(P, bpt(b, IDX(w))) < 0));
         } else {
             vec2 g0 = pend(b->pd, b->frame, b->SR, IDX(w), 0);
             vec2 g1 = pend(b->pd, b->frame, b->SR, IDX(w), 1);
@@ -151,7 +188,7 @@ static uint32_t find_first(dbuild *b, uint32_t n, vec2 P, vec2 Q)
                 b->fail = 2;
                 return POLAR_NONE;
             }
-            n = o > 0 ? nd[2] : nd[1];
+            n = nchild(b, cw, off, o > 0);
         }
     }
 }
@@ -161,12 +198,13 @@ static uint32_t find_first(dbuild *b, uint32_t n, vec2 P, vec2 Q)
 static uint32_t find_last(dbuild *b, uint32_t n, vec2 Q, vec2 P)
 {
     for (;; b->steps++) {
-        const uint32_t *nd = dnode(b, n);
-        uint32_t w = nd[0];
+        uint64_t off;
+        const uint64_t *cw = nchunk_of(b, n, &off);
+        uint32_t w = ntest(b, cw, off);
         if (KIND(w) == N_LEAF)
             return IDX(w);
         if (KIND(w) == N_X) {
-            n = lex_cmp(Q, bpt(b, IDX(w))) <= 0 ? nd[1] : nd[2];
+            n = nchild(b, cw, off, !(lex_cmp(Q, bpt(b, IDX(w))) <= 0));
         } else {
             vec2 g0 = pend(b->pd, b->frame, b->SR, IDX(w), 0);
             vec2 g1 = pend(b->pd, b->frame, b->SR, IDX(w), 1);
@@ -177,7 +215,7 @@ static uint32_t find_last(dbuild *b, uint32_t n, vec2 Q, vec2 P)
                 b->fail = 2;
                 return POLAR_NONE;
             }
-            n = o > 0 ? nd[2] : nd[1];
+            n = nchild(b, cw, off, o > 0);
         }
     }
 }
@@ -404,13 +442,10 @@ static void leaf_of(dbuild *b, uint32_t t)
 static void replace_leaf(dbuild *b, uint32_t s, uint32_t l, uint32_t r, uint32_t n, uint32_t j,
                          uint32_t A, uint32_t B)
 {
-    uint32_t y0 = b->T[b->lo[j]].leaf, y1 = b->T[b->up[j]].leaf, inner, xq, *nd;
+    uint32_t y0 = b->T[b->lo[j]].leaf, y1 = b->T[b->up[j]].leaf, inner, xq;
     uint32_t ky = ykind(b, s);
     if (A == POLAR_NONE && B == POLAR_NONE) {
-        nd = dnode(b, n);
-        nd[0] = PACK(ky, s);
-        nd[1] = y0;
-        nd[2] = y1;
+        nset(b, n, PACK(ky, s), y0, y1);
         return;
     }
     inner = new_node(b, ky, s, y0, y1);
@@ -418,18 +453,12 @@ static void replace_leaf(dbuild *b, uint32_t s, uint32_t l, uint32_t r, uint32_t
         xq = B != POLAR_NONE ? new_node(b, N_X, r, inner, b->T[B].leaf) : inner;
         if (b->fail)
             return;
-        nd = dnode(b, n);
-        nd[0] = PACK(N_X, l);
-        nd[1] = b->T[A].leaf;
-        nd[2] = xq;
+        nset(b, n, PACK(N_X, l), b->T[A].leaf, xq);
         b->hint[l] = n;
         if (B != POLAR_NONE)
             b->hint[r] = xq;
     } else if (!b->fail) {
-        nd = dnode(b, n);
-        nd[0] = PACK(N_X, r);
-        nd[1] = inner;
-        nd[2] = b->T[B].leaf;
+        nset(b, n, PACK(N_X, r), inner, b->T[B].leaf);
         b->hint[r] = n;
     }
 }
@@ -578,15 +607,21 @@ plx_status polar_dag_words(arena *a, dbuild *b, dag_rank *rk)
         return PLX_E_NOMEM;
     memset(rk->bits, 0, (size_t)nw64 * 8);
     for (i = 0; i < b->nnode; i++) {
-        uint32_t *nd = dnode(b, i);
+        uint64_t off;
+        const uint64_t *cw = nchunk_of(b, i, &off);
+        uint32_t t = ntest(b, cw, off), c;
         if ((i & 63) == 0)
             rk->before[i >> 6] = nq;
-        if (KIND(nd[0]) != N_LEAF) {
+        if (KIND(t) != N_LEAF) {
             rk->bits[i >> 6] |= (uint64_t)1 << (i & 63);
             nq++;
-        } else if (POLAR_TAG(nd[1] = b->T[IDX(nd[0])].leaf) == POLAR_CHILD_NODE) {
-            return PLX_E_SCENE;
+            continue;
         }
+        /* a leaf: its child word's tag and index as its children */
+        c = b->T[IDX(t)].leaf;
+        if (POLAR_TAG(c) == POLAR_CHILD_NODE || (uint64_t)POLAR_IDX(c) >> b->cb)
+            return PLX_E_SCENE;
+        nset(b, i, t, POLAR_TAG(c), POLAR_IDX(c));
     }
     rk->nq = nq;
     return PLX_OK;
@@ -607,7 +642,11 @@ static uint32_t child_word(const dbuild *b, const dag_rank *rk, uint32_t c)
     uint64_t w = rk->bits[c >> 6], below = ((uint64_t)1 << (c & 63)) - 1;
     if (w >> (c & 63) & 1)
         return PACK(POLAR_CHILD_NODE, rk->before[c >> 6] + popcount64(w & below));
-    return dnode(b, c)[1];
+    {
+        uint64_t off;
+        const uint64_t *cw = nchunk_of(b, c, &off);
+        return PACK(nchild(b, cw, off, 0), nchild(b, cw, off, 1));
+    }
 }
 
 /* The regions kept where the trapezoid slots were (no copy: the slots
@@ -696,10 +735,13 @@ plx_status polar_dag_keep(arena *a, polar *pd, polar_map *m, dbuild *b, const da
         return PLX_E_NOMEM;
     }
     for (i = 0, j = 0; i < b->nnode; i++) {
-        const uint32_t *nd = dnode(b, i);
-        if (KIND(nd[0]) == N_LEAF)
+        uint64_t off;
+        const uint64_t *cw = nchunk_of(b, i, &off);
+        uint32_t t = ntest(b, cw, off);
+        if (KIND(t) == N_LEAF)
             continue;
-        put_node(m, j++, nd[0], child_word(b, rk, nd[1]), child_word(b, rk, nd[2]));
+        put_node(m, j++, t, child_word(b, rk, nchild(b, cw, off, 0)),
+                 child_word(b, rk, nchild(b, cw, off, 1)));
     }
     m->root = child_word(b, rk, 0);
     return PLX_OK;
@@ -842,6 +884,25 @@ plx_status polar_dag_build(arena *a, polar *pd, polar_map *m, dbuild *b,
     b->maxchunk = (uint32_t)(((uint64_t)64 * nw + 1024) >> NODE_BITS) + 1;
     if (b->maxchunk > (1u << (30 - NODE_BITS)))
         b->maxchunk = 1u << (30 - NODE_BITS);
+    /* node fields: a test's index (a point, a piece or, in a leaf, a slot)
+     * and the children (a node, or in a leaf its child word's tag and
+     * index: a region, below the slots, or an owner plus one) */
+    {
+        uint64_t most = pd->npts > pd->nseg ? pd->npts : pd->nseg;
+        uint64_t kids = (uint64_t)b->maxchunk * NODE_CHUNK;
+        if (most < b->cap)
+            most = b->cap;
+        if (kids < b->cap)
+            kids = b->cap;
+        if (kids < (uint64_t)pd->nbld + 1)
+            kids = (uint64_t)pd->nbld + 1;
+        b->tb = 2 + bits_for(most);
+        b->cb = bits_for(kids);
+        if (b->tb > 32)
+            return PLX_E_NOMEM;
+        b->stride = b->tb + 2 * b->cb;
+        b->cwords = ((size_t)NODE_CHUNK * b->stride + 63) / 64 + 1;
+    }
     b->lcap = span + 8;
     b->list = scratch_n(a, b->lcap, 4);
     b->up = scratch_n(a, b->lcap, 4);
