@@ -211,8 +211,9 @@ vec2 polar_from_frame(int frame, vec2 f);
 /* polar_build with flags: POLAR_BUILD_NO_DAG does not keep the search DAGs
  * (the trapezoidal maps are still built by insertion, the sweep needs them:
  * this times keeping the nodes; point location and everything using it are
- * then unusable); POLAR_BUILD_WIDE_DAG stores every node packed (to
- * test that layout on small scenes). */
+ * then unusable); POLAR_BUILD_WIDE_DAG stores every node packed, and
+ * packs the nodes while they are built too (to test those layouts on
+ * small scenes). */
 enum { POLAR_BUILD_NO_DAG = 1, POLAR_BUILD_WIDE_DAG = 2 };
 plx_status polar_build_flags(arena *a, const scene *s, int flags, polar **out /* OUT */);
 

@@ -191,6 +191,10 @@ typedef struct snode {
 
 #define NODE_BITS 12
 #define NODE_CHUNK (1u << NODE_BITS)
+/* Search nodes are packed in bits while built beyond this many pieces
+ * (slower to read and write, a quarter smaller: README "Polar build
+ * scratch"). */
+#define PACKED_NODES_FROM (1u << 17)
 
 typedef struct dbuild {
     const polar *pd;
@@ -203,11 +207,16 @@ typedef struct dbuild {
     uint32_t freel, nfree;   /* the last freed slot (its nb[0] links the
                               * one freed before), free slots */
     arena_mark tmark;        /* the arena before the slots */
-    uint64_t **chunk;        /* nodes in chunks of NODE_CHUNK (scratch),
-                              * packed in bits: a test (kind << (tb - 2) |
-                              * index) and two children of cb bits each */
+    uint64_t **chunk;        /* nodes in chunks of NODE_CHUNK (scratch):
+                              * three 32-bit words (the test kind << 30 |
+                              * index, two children), or with more than
+                              * PACKED_NODES_FROM pieces packed in bits: the
+                              * test as kind << (tb - 2) | index and the
+                              * children in cb bits each */
     uint32_t nchunk, maxchunk, nnode;
-    uint32_t tb, cb, stride; /* field widths and the bits of one node */
+    int packed;
+    uint32_t tb, cb, stride; /* field widths; a node's bits (packed) or
+                              * 32-bit words */
     size_t cwords;           /* 64-bit words of one chunk */
     uint32_t *list, *up, *lo; /* per crossed trapezoid: it, its new upper / lower part */
     uint32_t lcap;           /* their length: a piece crosses one trapezoid more than the
@@ -240,7 +249,7 @@ plx_status polar_map_build(arena *a, polar *pd, polar_map *m, const uint32_t *in
  * randomized insertion; the DAG kept with its leaves as child words. */
 plx_status polar_insertion_order(arena *a, const polar *pd, uint32_t **out);
 plx_status polar_dag_build(arena *a, polar *pd, polar_map *m, dbuild *b,
-                           sroles *SR, const uint32_t *order, uint32_t span);
+                           sroles *SR, const uint32_t *order, uint32_t span, int flags);
 /* The inner nodes' ranks among the build nodes (see polar_dag_words). */
 typedef struct dag_rank {
     uint64_t *bits;          /* bit i: build node i is inner */

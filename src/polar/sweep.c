@@ -514,7 +514,7 @@ plx_status polar_map_build(arena *a, polar *pd, polar_map *m, const uint32_t *in
         return st;
     frame_pieces(pd, m, w.N, SR, canon);
     arena_release(a, &mk);
-    st = polar_dag_build(a, pd, m, &b, SR, order, span);
+    st = polar_dag_build(a, pd, m, &b, SR, order, span, flags);
     if (st != PLX_OK)
         return st;
     w.DT = b.T;

@@ -34,23 +34,30 @@
 
 static uint32_t bits_for(uint64_t n);
 
-/* Build node n: its chunk, *off the bit of its first field there. */
-static uint64_t *nchunk_of(const dbuild *b, uint32_t n, uint64_t *off)
+/* Build node n: its chunk, *off where it starts there: the bit of its
+ * first field (packed), or of its first 32-bit word (three words). */
+static inline uint64_t *nchunk_of(const dbuild *b, uint32_t n, uint64_t *off, int packed)
 {
-    *off = (uint64_t)(n & (NODE_CHUNK - 1)) * b->stride;
+    *off = (uint64_t)(n & (NODE_CHUNK - 1)) * (packed ? b->stride : 3);
     return b->chunk[n >> NODE_BITS];
 }
 
-/* The test of the node at bit off of chunk w, as kind << 30 | index. */
-static uint32_t ntest(const dbuild *b, const uint64_t *w, uint64_t off)
+/* The test of the node at off in chunk w, as kind << 30 | index. */
+static inline uint32_t ntest(const dbuild *b, const uint64_t *w, uint64_t off, int packed)
 {
-    uint32_t v = bits_get(w, off, b->tb);
+    uint32_t v;
+    if (!packed)
+        return ((const uint32_t *)(const void *)w)[off];
+    v = bits_get(w, off, b->tb);
     return PACK(v >> (b->tb - 2), v & ((1u << (b->tb - 2)) - 1));
 }
 
 /* Its child k (0, 1). */
-static uint32_t nchild(const dbuild *b, const uint64_t *w, uint64_t off, int k)
+static inline uint32_t nchild(const dbuild *b, const uint64_t *w, uint64_t off, int k,
+                              int packed)
 {
+    if (!packed)
+        return ((const uint32_t *)(const void *)w)[off + 1 + (k ? 1 : 0)];
     return bits_get(w, off + b->tb + (k ? b->cb : 0), b->cb);
 }
 
@@ -69,7 +76,14 @@ static void field_set(uint64_t *w, uint64_t off, uint32_t width, uint32_t v)
 static void nset(const dbuild *b, uint32_t n, uint32_t t, uint32_t c0, uint32_t c1)
 {
     uint64_t off;
-    uint64_t *w = nchunk_of(b, n, &off);
+    uint64_t *w = nchunk_of(b, n, &off, b->packed);
+    if (!b->packed) {
+        uint32_t *nd = (uint32_t *)(void *)w + off;
+        nd[0] = t;
+        nd[1] = c0;
+        nd[2] = c1;
+        return;
+    }
     field_set(w, off, b->tb, KIND(t) << (b->tb - 2) | IDX(t));
     field_set(w, off + b->tb, b->cb, c0);
     field_set(w, off + b->tb + b->cb, b->cb, c1);
@@ -144,7 +158,8 @@ static uint32_t new_node(dbuild *b, uint32_t kind, uint32_t idx, uint32_t c0, ui
             b->fail = 1;
             return 0;
         }
-        memset(b->chunk[b->nchunk], 0, b->cwords * 8);
+        if (b->packed)
+            memset(b->chunk[b->nchunk], 0, b->cwords * 8);
         b->nchunk++;
     }
     b->nnode++;
@@ -165,59 +180,51 @@ typedef struct irec {
     uint32_t s, l, r;        /* the piece, its canonical end points */
 } irec;
 
+/* Descends the DAG with end A of a new piece AD from node n to a leaf's
+ * trapezoid: x tests send A left when before the point (or at it, with
+ * ties_left), y tests by A's side of the piece or, when A is on its line
+ * (a shared end), by D's (the slopes). packed: b->packed, a constant in
+ * each of the two copies the compiler makes (the hot loop of the
+ * insertion). */
+static inline uint32_t descend(dbuild *b, uint32_t n, vec2 A, vec2 D, int ties_left, int packed)
+{
+    for (;; b->steps++) {
+        uint64_t off;
+        const uint64_t *cw = nchunk_of(b, n, &off, packed);
+        uint32_t w = ntest(b, cw, off, packed);
+        if (KIND(w) == N_LEAF)
+            return IDX(w);
+        if (KIND(w) == N_X) {
+            int c = lex_cmp(A, bpt(b, IDX(w)));
+            n = nchild(b, cw, off, !(c < 0 || (ties_left && c == 0)), packed);
+        } else {
+            vec2 g0 = pend(b->pd, b->frame, b->SR, IDX(w), 0);
+            vec2 g1 = pend(b->pd, b->frame, b->SR, IDX(w), 1);
+            int o = geom_orient(g0, g1, A);
+            if (o == 0)
+                o = geom_orient(g0, g1, D);
+            if (o == 0) {
+                b->fail = 2;
+                return POLAR_NONE;
+            }
+            n = nchild(b, cw, off, o > 0, packed);
+        }
+    }
+}
+
 /* Descends the DAG with the left end P of a new piece PQ, from node n:
  * the root, or the x node of P if P is already in the map (its cell, the
  * trapezoid that held P when it came in, holds everything just right of P). */
 static uint32_t find_first(dbuild *b, uint32_t n, vec2 P, vec2 Q)
 {
-    for (;; b->steps++) {
-        uint64_t off;
-        const uint64_t *cw = nchunk_of(b, n, &off);
-        uint32_t w = ntest(b, cw, off);
-        if (KIND(w) == N_LEAF)
-            return IDX(w);
-        if (KIND(w) == N_X) {
-            n = nchild(b, cw, off, !(lex_cmp(P, bpt(b, IDX(w))) < 0));
-        } else {
-            vec2 g0 = pend(b->pd, b->frame, b->SR, IDX(w), 0);
-            vec2 g1 = pend(b->pd, b->frame, b->SR, IDX(w), 1);
-            int o = geom_orient(g0, g1, P);
-            if (o == 0)
-                o = geom_orient(g0, g1, Q);   /* a shared left end: the slopes */
-            if (o == 0) {
-                b->fail = 2;
-                return POLAR_NONE;
-            }
-            n = nchild(b, cw, off, o > 0);
-        }
-    }
+    return b->packed ? descend(b, n, P, Q, 0, 1) : descend(b, n, P, Q, 0, 0);
 }
 
 /* The same from the right end Q of the new piece, known to the map: from
  * its x node, with Q pushed towards P (ties at Q go left). */
 static uint32_t find_last(dbuild *b, uint32_t n, vec2 Q, vec2 P)
 {
-    for (;; b->steps++) {
-        uint64_t off;
-        const uint64_t *cw = nchunk_of(b, n, &off);
-        uint32_t w = ntest(b, cw, off);
-        if (KIND(w) == N_LEAF)
-            return IDX(w);
-        if (KIND(w) == N_X) {
-            n = nchild(b, cw, off, !(lex_cmp(Q, bpt(b, IDX(w))) <= 0));
-        } else {
-            vec2 g0 = pend(b->pd, b->frame, b->SR, IDX(w), 0);
-            vec2 g1 = pend(b->pd, b->frame, b->SR, IDX(w), 1);
-            int o = geom_orient(g0, g1, Q);
-            if (o == 0)
-                o = geom_orient(g0, g1, P);
-            if (o == 0) {
-                b->fail = 2;
-                return POLAR_NONE;
-            }
-            n = nchild(b, cw, off, o > 0);
-        }
-    }
+    return b->packed ? descend(b, n, Q, P, 1, 1) : descend(b, n, Q, P, 1, 0);
 }
 
 /* Replaces the neighbour link 'old' of trapezoid x on side f. */
@@ -608,8 +615,8 @@ plx_status polar_dag_words(arena *a, dbuild *b, dag_rank *rk)
     memset(rk->bits, 0, (size_t)nw64 * 8);
     for (i = 0; i < b->nnode; i++) {
         uint64_t off;
-        const uint64_t *cw = nchunk_of(b, i, &off);
-        uint32_t t = ntest(b, cw, off), c;
+        const uint64_t *cw = nchunk_of(b, i, &off, b->packed);
+        uint32_t t = ntest(b, cw, off, b->packed), c;
         if ((i & 63) == 0)
             rk->before[i >> 6] = nq;
         if (KIND(t) != N_LEAF) {
@@ -644,8 +651,8 @@ static uint32_t child_word(const dbuild *b, const dag_rank *rk, uint32_t c)
         return PACK(POLAR_CHILD_NODE, rk->before[c >> 6] + popcount64(w & below));
     {
         uint64_t off;
-        const uint64_t *cw = nchunk_of(b, c, &off);
-        return PACK(nchild(b, cw, off, 0), nchild(b, cw, off, 1));
+        const uint64_t *cw = nchunk_of(b, c, &off, b->packed);
+        return PACK(nchild(b, cw, off, 0, b->packed), nchild(b, cw, off, 1, b->packed));
     }
 }
 
@@ -736,12 +743,12 @@ plx_status polar_dag_keep(arena *a, polar *pd, polar_map *m, dbuild *b, const da
     }
     for (i = 0, j = 0; i < b->nnode; i++) {
         uint64_t off;
-        const uint64_t *cw = nchunk_of(b, i, &off);
-        uint32_t t = ntest(b, cw, off);
+        const uint64_t *cw = nchunk_of(b, i, &off, b->packed);
+        uint32_t t = ntest(b, cw, off, b->packed);
         if (KIND(t) == N_LEAF)
             continue;
-        put_node(m, j++, t, child_word(b, rk, nchild(b, cw, off, 0)),
-                 child_word(b, rk, nchild(b, cw, off, 1)));
+        put_node(m, j++, t, child_word(b, rk, nchild(b, cw, off, 0, b->packed)),
+                 child_word(b, rk, nchild(b, cw, off, 1, b->packed)));
     }
     m->root = child_word(b, rk, 0);
     return PLX_OK;
@@ -860,9 +867,10 @@ static void prefetch_ahead(const dbuild *b, uint32_t i, uint32_t nw)
 /* Builds the trapezoidal map of the wall pieces of m and its search DAG by
  * randomized incremental insertion, into b (scratch, the trapezoid slots
  * in the low end of the arena). SR: the pieces' canonical ends (pend),
- * the rest of it unset. */
+ * the rest of it unset. The nodes are packed in bits beyond
+ * PACKED_NODES_FROM pieces or with POLAR_BUILD_WIDE_DAG in flags. */
 plx_status polar_dag_build(arena *a, polar *pd, polar_map *m, dbuild *b,
-                           sroles *SR, const uint32_t *order, uint32_t span)
+                           sroles *SR, const uint32_t *order, uint32_t span, int flags)
 {
     uint32_t nw = pd->nwall, i, t;
     if (nw >= (1u << 26) || pd->npts >= (1u << 26))
@@ -900,8 +908,10 @@ plx_status polar_dag_build(arena *a, polar *pd, polar_map *m, dbuild *b,
         b->cb = bits_for(kids);
         if (b->tb > 32)
             return PLX_E_NOMEM;
-        b->stride = b->tb + 2 * b->cb;
-        b->cwords = ((size_t)NODE_CHUNK * b->stride + 63) / 64 + 1;
+        b->packed = nw > PACKED_NODES_FROM || (flags & POLAR_BUILD_WIDE_DAG);
+        b->stride = b->packed ? b->tb + 2 * b->cb : 3;
+        b->cwords = b->packed ? ((size_t)NODE_CHUNK * b->stride + 63) / 64 + 1
+                              : (size_t)NODE_CHUNK * 3 / 2;
     }
     b->lcap = span + 8;
     b->list = scratch_n(a, b->lcap, 4);

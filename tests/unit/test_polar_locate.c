@@ -513,7 +513,8 @@ static void test_random_degenerate(void **state)
 
 /* Points on a fine lattice over a lattice scene: they fall on walls, at
  * vertices and on the axes of vertices in both frames far more often than
- * random points do. Once with nodes of 8 bytes, once of 12. */
+ * random points do. Once with nodes of 8 bytes, once packed (with the
+ * nodes packed while built too). */
 static void lattice_points(int flags)
 {
     fix *f = fix_new();
