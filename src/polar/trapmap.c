@@ -42,13 +42,23 @@ static inline uint64_t *nchunk_of(const dbuild *b, uint32_t n, uint64_t *off, in
     return b->chunk[n >> NODE_BITS];
 }
 
+/* bits_get without its branch (a chunk has a word more at its end): the
+ * descent reads two fields a node, at offsets the data decides. */
+static inline uint32_t field_get(const uint64_t *w, uint64_t off, uint32_t width)
+{
+    size_t i = (size_t)(off >> 6);
+    uint32_t sh = (uint32_t)(off & 63);
+    uint64_t x = (w[i] >> sh) | ((w[i + 1] << 1) << (63 - sh));
+    return (uint32_t)(x & (((uint64_t)1 << width) - 1));
+}
+
 /* The test of the node at off in chunk w, as kind << 30 | index. */
 static inline uint32_t ntest(const dbuild *b, const uint64_t *w, uint64_t off, int packed)
 {
     uint32_t v;
     if (!packed)
         return ((const uint32_t *)(const void *)w)[off];
-    v = bits_get(w, off, b->tb);
+    v = field_get(w, off, b->tb);
     return PACK(v >> (b->tb - 2), v & ((1u << (b->tb - 2)) - 1));
 }
 
@@ -58,7 +68,7 @@ static inline uint32_t nchild(const dbuild *b, const uint64_t *w, uint64_t off, 
 {
     if (!packed)
         return ((const uint32_t *)(const void *)w)[off + 1 + (k ? 1 : 0)];
-    return bits_get(w, off + b->tb + (k ? b->cb : 0), b->cb);
+    return field_get(w, off + b->tb + (k ? b->cb : 0), b->cb);
 }
 
 /* Sets a field of bits_get's form (v below 2^width). */
