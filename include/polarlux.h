@@ -837,11 +837,13 @@ typedef struct plx_bake_opts {
     int no_indirect;            /* 1: no photon buffers */
     int twin;                   /* 1: the twin engine (see plx_bake_save): the same memory
                                    layout without the light map's shading */
+    int no_polar;               /* 1: no polar diagrams (frames do not read them; a
+                                   query on the loaded bake builds them on need) */
 } plx_bake_opts;
 
 /*
  * Builds everything queries and frames need for the loaded scene: polar
- * diagrams, lamp light, photon buffers (levels for a viewer at the centre
+ * diagrams (unless o->no_polar), lamp light, photon buffers (levels for a viewer at the centre
  * of Bounds, all around), the renderer and, with o->aerial, the aerial light
  * map. Photon frames are then added with plx_indirect_step.
  */

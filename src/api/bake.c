@@ -151,7 +151,8 @@ plx_status plx_bake_prepare(plx_engine *e, const plx_bake_opts *o)
         return st;
     if (!o)
         return eng_fail(e, PLX_E_INVALID, "plx_bake_prepare: options are NULL");
-    if ((st = plx_polar_build(e)) != PLX_OK || (st = eng_need(e, ENG_LIGHT, "plx_bake_prepare")) != PLX_OK)
+    if ((!o->no_polar && (st = plx_polar_build(e)) != PLX_OK) ||
+        (st = eng_need(e, ENG_LIGHT, "plx_bake_prepare")) != PLX_OK)
         return st;
     eye[0] = 0.5 * (e->sc->bounds[0] + e->sc->bounds[2]);
     eye[1] = 0.5 * (e->sc->bounds[1] + e->sc->bounds[3]);

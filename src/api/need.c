@@ -125,13 +125,25 @@ static plx_status need_photon(plx_engine *e)
     plx_status st;
     arena_mark m;
     int steps;
-    size_t icb = icache_bytes(); /* the images' irradiance cache comes with them */
+    uint32_t nrec;
+    size_t icb;
     photon_config_pick(e, &cfg);
-    e->ph_full = photon_bytes(e->sc, &cfg) + icb;
+    /* full quality: the buffers at their default size, the largest table */
+    e->ph_full = photon_bytes(e->sc, &cfg) + icache_bytes(ICACHE_RECORDS);
     e->ph_budget = e->cfg.photon_bytes ? e->cfg.photon_bytes : photon_room(e) / 2;
+    /* the images' irradiance cache comes with them, its table sized from
+     * the same budget (icache_records_for) */
+    nrec = icache_records_for(e->ph_budget);
+    icb = icache_bytes(nrec);
     steps = photon_config_fit(&cfg, e->sc, e->ph_budget > icb ? e->ph_budget - icb : 0);
-    if (steps < 0 && !e->cfg.photon_bytes && photon_bytes(e->sc, &cfg) + icb <= photon_room(e)) {
-        e->ph_budget = photon_bytes(e->sc, &cfg) + icb; /* the lowest quality, beyond the half */
+    if (steps < 0 && !e->cfg.photon_bytes &&
+        photon_bytes(e->sc, &cfg) + icache_bytes(ICACHE_RECORDS_MIN) <= photon_room(e)) {
+        /* the lowest quality, beyond the half; the table keeps its share
+         * of the half when that fits too */
+        while (nrec > ICACHE_RECORDS_MIN && photon_bytes(e->sc, &cfg) + icache_bytes(nrec) > photon_room(e))
+            nrec /= 2;
+        icb = icache_bytes(nrec);
+        e->ph_budget = photon_bytes(e->sc, &cfg) + icb;
         photon_config_pick(e, &cfg);
         steps = photon_config_fit(&cfg, e->sc, e->ph_budget - icb);
     }
@@ -139,7 +151,7 @@ static plx_status need_photon(plx_engine *e)
         strbuf b;
         sb_init(&b, e->err, sizeof e->err);
         sb_str(&b, "out of memory while creating the photon buffers: ");
-        sb_uint(&b, photon_bytes(e->sc, &cfg) + icb);
+        sb_uint(&b, photon_bytes(e->sc, &cfg) + icache_bytes(ICACHE_RECORDS_MIN));
         sb_str(&b, " bytes at their lowest quality, more than their budget of ");
         sb_uint(&b, e->ph_budget);
         sb_str(&b, e->cfg.photon_bytes ? " (plx_config.photon_bytes)" : " (the free memory left after the renderer)");
@@ -148,7 +160,7 @@ static plx_status need_photon(plx_engine *e)
     e->ph_reductions = (uint32_t)steps;
     m = arena_get_mark(&e->mem);
     st = photon_create(&e->mem, e->sc, &cfg, &e->ph);
-    if (st == PLX_OK && (st = icache_create(&e->mem, &e->ic)) != PLX_OK) {
+    if (st == PLX_OK && (st = icache_create(&e->mem, nrec, &e->ic)) != PLX_OK) {
         arena_release(&e->mem, &m); /* as it was: no photon buffers */
         e->ph = NULL;
     }

@@ -101,7 +101,7 @@ typedef struct layer_worker {
  * the free room, then keeps what fits the cache). */
 static size_t layer_worker_bytes(const plx_engine *e)
 {
-    return light_base_bytes(e->sc) + 2 * e->lt->pool_cap + icache_bytes() + ((size_t)8 << 20);
+    return light_base_bytes(e->sc) + 2 * e->lt->pool_cap + icache_bytes(e->ic->nrec) + ((size_t)8 << 20);
 }
 
 /* Worker k's arena, cache and light object, from the engine's block. */
@@ -113,7 +113,7 @@ static int layer_worker_new(plx_engine *e, layer_worker *w)
     if (!mem)
         return -1;
     arena_init(&w->mem, mem, bytes);
-    if (icache_create(&w->mem, &w->ic) != PLX_OK || light_create(&w->mem, e->sc, e->lt->pool_cap, &w->lt) != PLX_OK)
+    if (icache_create(&w->mem, e->ic->nrec, &w->ic) != PLX_OK || light_create(&w->mem, e->sc, e->lt->pool_cap, &w->lt) != PLX_OK)
         return -1;
     return 0;
 }

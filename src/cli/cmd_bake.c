@@ -9,8 +9,8 @@
 
 static const char help[] =
     "usage: polarlux bake SCENE -o CITY.plxb [--photons N] [--frames K] [--no-indirect]\n"
-    "                     [--no-aerial] [--texel M] [--max-size WxH] [--threads N] [--mem SIZE]\n"
-    "                     [--strict] [--quiet]\n"
+    "                     [--no-aerial] [--no-polar] [--texel M] [--max-size WxH]\n"
+    "                     [--threads N] [--mem SIZE] [--strict] [--quiet]\n"
     "\n"
     "Loads SCENE and builds everything queries and frames need: polar diagrams,\n"
     "lamp light, photon buffers with K frames of N photons (levels for a viewer\n"
@@ -27,6 +27,8 @@ static const char help[] =
     "                  reads them too)\n"
     "  --no-indirect   no photon buffers\n"
     "  --no-aerial     no aerial light map\n"
+    "  --no-polar      no polar diagrams: frames do not need them (a bake for a\n"
+    "                  walk in a small --mem); queries build them when asked\n"
     "  --texel M       aerial light map resolution (default 1 m, coarser if the budget needs)\n"
     "  --max-size WxH  the largest frame the loaded engine renders (default 1024x768)\n"
     "  --threads N     threads for the aerial light map and its indirect layer\n"
@@ -54,6 +56,7 @@ static int parse_args(int argc, char **argv, bake_args *a)
     int no_aerial = 0, rc;
     const cli_opt opts[] = {
         CLI_OPT_FLAG("--no-aerial", &no_aerial),
+        CLI_OPT_FLAG("--no-polar", &a->o.no_polar),
         CLI_OPT_STR("-o", &a->out),
         CLI_OPT_VAL("--texel", &a->o.aerial_m_per_texel, parse_texel, "--texel '%s' is not a positive number of metres"),
         CLI_OPT_VAL("--max-size", size, cli_opt_size, "--max-size '%s' is not WxH (1..8192 each)"),

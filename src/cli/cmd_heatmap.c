@@ -370,7 +370,7 @@ static int write_png(plx_engine *e, const heat_opts *o, const heat_map *m, doubl
     raster_frame f;
     size_t k, n = m->w * m->h;
     char err[512];
-    int map_w = (int)m->w, legend_w = m->h > 600 ? 150 : 90;
+    int map_w = (int)m->w, legend_w = m->h > 600 ? 150 : 90, world = 0;
     c.w = map_w + legend_w;
     c.h = (int)m->h < 200 ? 200 : (int)m->h;
     c.rgb = calloc((size_t)c.w * c.h, 3);
@@ -399,11 +399,13 @@ static int write_png(plx_engine *e, const heat_opts *o, const heat_map *m, doubl
     canvas_rect(&c, map_w, 0, c.w, c.h, black);
     legend(&c, map_w, lo, top);
     raster_frame_of(e, m->box, m->res, &f);
-    if (canvas_write(&c, o->out, err, sizeof err) != 0 || world_file_write(o->out, &f, err, sizeof err) != 0) {
+    if (canvas_write(&c, o->out, err, sizeof err) != 0 || (world = world_file_write(o->out, &f, err, sizeof err)) < 0) {
         fprintf(stderr, "polarlux heatmap: %s\n", err);
         canvas_free(&c);
         return EXIT_FAIL;
     }
+    if (world == 1)
+        fprintf(stderr, "polarlux heatmap: no world file (.pgw) for '%s': it is not a regular file\n", o->out);
     canvas_free(&c);
     return EXIT_OK;
 }
@@ -466,7 +468,8 @@ static int run(plx_engine *e, const heat_opts *o)
                m.res, lit, o->out);
     else if (rc == EXIT_OK)
         printf("heatmap: %zux%zu pixels at %g m, scale %g..%g lx (2nd-98th percentile of the %zu lit pixels), "
-               "written to %s (world file .pgw beside it)\n", m.w, m.h, m.res, lo, top, lit, o->out);
+               "written to %s%s\n", m.w, m.h, m.res, lo, top, lit, o->out,
+               world_file_wanted(o->out) ? " (world file .pgw beside it)" : "");
     if (rc == EXIT_OK && o->q.quantity != PLX_METER_H && o->q.facing_min)
         printf("heatmap: semi-cylindrical illuminance at %g m, the least over every facing direction\n",
                o->q.height);

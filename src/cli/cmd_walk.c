@@ -136,16 +136,38 @@ typedef struct sheet {
     int skipped;               /* 1: no sheet (the budget) */
 } sheet;
 
-static void sheet_plan(sheet *sh, const walk_args *a, long frames)
+/* The sheet's size with frames shrunk by f. */
+static void sheet_size(sheet *sh, const walk_args *a, long frames, int f)
 {
     int cells = frames < 16 ? (int)frames : 16, cols = cells < 4 ? cells : 4;
-    memset(sh, 0, sizeof *sh);
-    for (sh->f = 1; a->w / sh->f > 400; sh->f++)
-        ;
+    sh->f = f;
     sh->tw = a->w / sh->f;
     sh->th = a->h / sh->f;
     sh->W = cols * sh->tw;
     sh->H = (cells + 3) / 4 * sh->th;
+}
+
+static void sheet_plan(sheet *sh, const walk_args *a, long frames)
+{
+    int f;
+    memset(sh, 0, sizeof *sh);
+    for (f = 1; a->w / f > 400; f++)
+        ;
+    sheet_size(sh, a, frames, f);
+}
+
+/* A smaller sheet when the budget leaves too little room for the planned
+ * one: frames shrunk further, down to 80 pixels wide; 0 when even that
+ * does not fit. */
+static int sheet_fit(sheet *sh, const walk_args *a, long frames, size_t room)
+{
+    int f = sh->f;
+    while ((size_t)sh->W * sh->H * 3 > room) {
+        if (a->w / (f + 1) < 80)
+            return 0;
+        sheet_size(sh, a, frames, ++f);
+    }
+    return 1;
 }
 
 /* Frame rgb shrunk into cell k. */
@@ -252,12 +274,16 @@ static int frame(const walk_args *a, plx_engine *e, const walk_path *wp, walk_ru
         if (!wr->sh.px && !wr->sh.skipped) {
             /* the command's own buffers count in --mem: the frame and the sheet */
             size_t need = (size_t)wr->sh.W * wr->sh.H * 3, frame_bytes = (size_t)a->w * a->h * 3;
-            size_t budget = cli_buffer_budget(e, &a->c);
-            if (need + frame_bytes > budget || !(wr->sh.px = calloc(need, 1))) {
+            size_t budget = cli_buffer_budget(e, &a->c), room = budget > frame_bytes ? budget - frame_bytes : 0;
+            int f = wr->sh.f;
+            if (!sheet_fit(&wr->sh, a, wr->n, room) || !(wr->sh.px = calloc((size_t)wr->sh.W * wr->sh.H * 3, 1))) {
                 fprintf(stderr, "polarlux walk: no contact sheet: it needs %.1f MB beside the engine and the "
-                        "frame, and --mem leaves %.1f MB\n", need / 1e6,
-                        budget > frame_bytes ? (budget - frame_bytes) / 1e6 : 0.0);
+                        "frame (%.1f MB with frames %d pixels wide), and --mem leaves %.1f MB\n", need / 1e6,
+                        (double)wr->sh.W * wr->sh.H * 3 / 1e6, wr->sh.tw, room / 1e6);
                 wr->sh.skipped = 1;
+            } else if (wr->sh.f != f) {
+                fprintf(stderr, "polarlux walk: contact sheet with frames %d pixels wide (not %d) to fit --mem: "
+                        "%.1f MB left beside the engine and the frame\n", wr->sh.tw, a->w / f, room / 1e6);
             }
         }
         if (wr->sh.px)

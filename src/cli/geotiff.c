@@ -11,8 +11,10 @@
 #include <geotiffio.h>
 #include <geo_normalize.h>
 #include <xtiffio.h>
+#include <sys/stat.h>
 
 #include "geotiff.h"
+#include "posix/safe_out.h"
 
 #define M_PER_DEG_LON 111320.0
 #define M_PER_DEG_LAT 110540.0
@@ -165,13 +167,26 @@ int geotiff_write(const char *path, const float *v, int w, int h, int nb, const 
     return rc;
 }
 
+int world_file_wanted(const char *png_path)
+{
+    struct stat st;
+    if (strcmp(png_path, "-") == 0)
+        return 0;
+    if (stat(png_path, &st) != 0)
+        return 1;
+    return S_ISREG(st.st_mode);
+}
+
 int world_file_write(const char *png_path, const raster_frame *f, char *err, size_t errlen)
 {
     size_t n = strlen(png_path);
     const char *dot = strrchr(png_path, '.'), *slash = strrchr(png_path, '/');
-    char *path = malloc(n + 8);
-    FILE *fp;
-    int rc = 0;
+    char *path, text[256];
+    safe_out *o;
+    int len, rc;
+    if (!world_file_wanted(png_path))
+        return 1;
+    path = malloc(n + 8);
     if (!path) {
         snprintf(err, errlen, "%s: out of memory", png_path);
         return -1;
@@ -180,16 +195,13 @@ int world_file_write(const char *png_path, const raster_frame *f, char *err, siz
         n = (size_t)(dot - png_path);
     memcpy(path, png_path, n);
     strcpy(path + n, ".pgw");
-    fp = fopen(path, "w");
-    if (!fp) {
-        snprintf(err, errlen, "%s: cannot write the world file: %s", path, strerror(errno));
-        free(path);
-        return -1;
-    }
-    fprintf(fp, "%.17g\n0\n0\n%.17g\n%.17g\n%.17g\n", f->sx, -f->sy, f->x0 + 0.5 * f->sx, f->y0 - 0.5 * f->sy);
-    if (fclose(fp) != 0) {
-        snprintf(err, errlen, "%s: cannot write the world file: %s", path, strerror(errno));
-        rc = -1;
+    len = snprintf(text, sizeof text, "%.17g\n0\n0\n%.17g\n%.17g\n%.17g\n", f->sx, -f->sy, f->x0 + 0.5 * f->sx,
+                   f->y0 - 0.5 * f->sy);
+    o = safe_out_open(path, err, errlen);
+    rc = -1;
+    if (o) {
+        (void)safe_out_write(o, text, (size_t)len); /* a failure is sticky: the commit reports it */
+        rc = safe_out_commit(&o, 1, err, errlen);
     }
     free(path);
     return rc;

@@ -41,21 +41,33 @@ static uint64_t mix64(uint64_t z)
     return z ^ (z >> 31);
 }
 
-size_t icache_bytes(void)
+uint32_t icache_records_for(size_t budget)
 {
-    return sizeof(icache) + 64 + (size_t)ICACHE_RECORDS * sizeof(icache_rec) + 64;
+    uint32_t n = ICACHE_RECORDS;
+    while (n > ICACHE_RECORDS_MIN && (size_t)n * sizeof(icache_rec) > budget / 16)
+        n /= 2;
+    return n;
 }
 
-plx_status icache_create(arena *a, icache **out)
+size_t icache_bytes(uint32_t nrec)
+{
+    return sizeof(icache) + 64 + (size_t)nrec * sizeof(icache_rec) + 64;
+}
+
+plx_status icache_create(arena *a, uint32_t nrec, icache **out)
 {
     arena_mark m = arena_get_mark(a);
-    icache *c = arena_calloc(a, PLX_PART_PHOTON, 1, sizeof *c, 64);
+    icache *c;
+    if (nrec < ICACHE_RECORDS_MIN || nrec > ICACHE_RECORDS || (nrec & (nrec - 1)))
+        return PLX_E_INVALID;
+    c = arena_calloc(a, PLX_PART_PHOTON, 1, sizeof *c, 64);
     if (c)
-        c->tab = arena_calloc(a, PLX_PART_PHOTON, ICACHE_RECORDS, sizeof(icache_rec), 64);
+        c->tab = arena_calloc(a, PLX_PART_PHOTON, nrec, sizeof(icache_rec), 64);
     if (!c || !c->tab) {
         arena_release(a, &m);
         return PLX_E_NOMEM;
     }
+    c->nrec = nrec;
     c->side = ICACHE_SIDE;
     c->kappa = ICACHE_KAPPA;
     c->smin = ICACHE_SMIN;
@@ -75,7 +87,7 @@ void icache_set_spacing(icache *c, double s)
 
 static void flush(icache *c)
 {
-    memset(c->tab, 0, (size_t)ICACHE_RECORDS * sizeof(icache_rec));
+    memset(c->tab, 0, (size_t)c->nrec * sizeof(icache_rec));
     memset(c->last, 0, sizeof c->last);
     c->used = 0;
     c->flushes++;
@@ -191,7 +203,7 @@ static const icache_rec *record(icache *c, photon_sys *ps, light *L, const plane
 {
     uint64_t k2 = ((uint64_t)l << 58) | (((uint64_t)(i + COORD_BIAS) & COORD_MASK) << 29) |
                   ((uint64_t)(j + COORD_BIAS) & COORD_MASK);
-    uint32_t mask = ICACHE_RECORDS - 1, at;
+    uint32_t mask = c->nrec - 1, at;
     icache_rec *r;
     double Q[3], rgb[3];
     at = (uint32_t)mix64(pl->code ^ mix64(k2)) & mask;
@@ -203,7 +215,7 @@ static const icache_rec *record(icache *c, photon_sys *ps, light *L, const plane
             return r;
         at = (at + 1) & mask;
     }
-    if (c->used >= ICACHE_RECORDS / 4 * 3) {
+    if (c->used >= c->nrec / 4 * 3) {
         flush(c);
         return record(c, ps, L, pl, l, i, j);
     }

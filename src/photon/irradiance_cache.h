@@ -52,9 +52,11 @@
  * vertex (the seed and the vertex's coordinates seed its jitter, so a
  * record's value does not depend on which pixel asked first: the same
  * camera gives the same bytes). A record is computed when a pixel first
- * needs it and kept in an open-addressed table of fixed size taken from
- * the arena at creation; a full table (3/4) is emptied and refilled, which
- * changes no value. The table is emptied as well when the photon buffers
+ * needs it and kept in an open-addressed table taken from the arena at
+ * creation, its size chosen by the caller from its budget
+ * (icache_records_for); a full table (3/4) is emptied and refilled, which
+ * changes no value: a smaller table gives the same bytes, and only
+ * gathers more records again. The table is emptied as well when the photon buffers
  * changed (new frames, a reset, refined lamps) or the light changed.
  *
  * Not for two threads at once (the table fills during lookups).
@@ -74,7 +76,8 @@
 #define ICACHE_KAPPA 0.15     /* spacing asked for farther, per metre of distance */
 #define ICACHE_LEVEL_MAX 5    /* coarsest level: 8 m (farther: photon buffers) */
 #define ICACHE_LEVEL_SEG 4    /* from 4 m on, a ground vertex behind a wall is left out */
-#define ICACHE_RECORDS 65536  /* table slots (power of two) */
+#define ICACHE_RECORDS 65536  /* table slots at most (a power of two: 2 MiB) */
+#define ICACHE_RECORDS_MIN 1024 /* and at least (32 KiB); icache_records_for */
 #define ICACHE_AERIAL 4.0     /* spacing for the aerial map's layer, m (icache_set_spacing;
                                  8 m gathers a quarter of the records, less accurately) */
 
@@ -92,7 +95,8 @@ typedef struct icache_cell {
 } icache_cell;
 
 typedef struct icache {
-    icache_rec *tab;          /* ICACHE_RECORDS slots */
+    icache_rec *tab;          /* nrec slots */
+    uint32_t nrec;            /* a power of two, ICACHE_RECORDS_MIN..ICACHE_RECORDS */
     uint32_t used;
     uint32_t side;            /* gather side per record */
     double eye[3];            /* the viewer: spacing grows with distance from it */
@@ -106,11 +110,18 @@ typedef struct icache {
     icache_cell last[ICACHE_LEVEL_MAX + 1]; /* per level: the last cell looked up */
 } icache;
 
-/* Bytes icache_create takes from part PLX_PART_PHOTON. */
-size_t icache_bytes(void);
+/* The table's slots for a budget of 'budget' bytes (the photon buffers'
+ * and the cache's together): the largest power of two whose table takes
+ * at most 1/16 of it, within ICACHE_RECORDS_MIN..ICACHE_RECORDS. */
+uint32_t icache_records_for(size_t budget);
 
-/* The cache, empty, in the arena; PLX_E_NOMEM when it does not fit. */
-plx_status icache_create(arena *a, icache **out /* OUT */);
+/* Bytes icache_create takes from part PLX_PART_PHOTON for nrec slots. */
+size_t icache_bytes(uint32_t nrec);
+
+/* The cache, empty, with nrec slots (a power of two, at least
+ * ICACHE_RECORDS_MIN, at most ICACHE_RECORDS; else PLX_E_INVALID) in the
+ * arena; PLX_E_NOMEM when it does not fit. */
+plx_status icache_create(arena *a, uint32_t nrec, icache **out /* OUT */);
 
 /* The viewer for the lookups that follow: the grid spacing asked for at
  * distance d from it is kappa d, at least smin. Records already made stay

@@ -56,8 +56,9 @@ struct render {
     cull_item *heap;            /* nbld, min-heap by w_max */
     double *gxyz;               /* one building's vertices (mesh_building) */
     mesh_tri *gtri;             /* and its triangles */
-    uint32_t *sc_id;            /* RENDER_SURF_CACHE: surfaces seen (surf_get), by id */
+    uint32_t *sc_id;            /* sc_mask + 1 slots: surfaces seen (surf_get), by id */
     mesh_surf *sc;
+    uint32_t sc_mask;           /* render_surf_slots - 1 */
     uint32_t nheap;
     double *wmin, *wmax;        /* nbld */
     uint8_t *draw;              /* nbld */
@@ -110,13 +111,22 @@ static double srgb_decode(double e)
     return e <= 0.04045 ? e / 12.92 : pow((e + 0.055) / 1.055, 2.4);
 }
 
+uint32_t render_surf_slots(const scene *s, int32_t max_w, int32_t max_h)
+{
+    size_t px = (size_t)max_w * (size_t)max_h, nsurf = 2 + (size_t)s->npts + 2 * (size_t)s->nbld;
+    uint32_t n = 64;
+    while (n < RENDER_SURF_CACHE && n < nsurf && n < px / 64)
+        n *= 2;
+    return n;
+}
+
 size_t render_bytes(const scene *s, int32_t max_w, int32_t max_h)
 {
     size_t px = (size_t)max_w * (size_t)max_h;
     size_t tiles = (size_t)((max_w + RENDER_TILE - 1) / RENDER_TILE) * (size_t)((max_h + RENDER_TILE - 1) / RENDER_TILE);
     size_t corners = (size_t)(max_w / IND_STEP + 2) * (size_t)(max_h / IND_STEP + 2);
     return px * 20 + tiles + (size_t)s->nbld * (2 * sizeof(cull_item) + 17) + RENDER_BINS * 8 + 65536 +
-           corners * (1 + 3 * sizeof(float)) + RENDER_SURF_CACHE * (sizeof(uint32_t) + sizeof(mesh_surf)) +
+           corners * (1 + 3 * sizeof(float)) + render_surf_slots(s, max_w, max_h) * (sizeof(uint32_t) + sizeof(mesh_surf)) +
            sizeof(render) + 4096;
 }
 
@@ -242,8 +252,9 @@ plx_status render_create(arena *a, const scene *s, int32_t max_w, int32_t max_h,
     r->clip = arena_alloc(a, PLX_PART_FRAME, arena_mul(r->m->max_bld_verts + 1, 4 * sizeof(float)), 64);
     r->gxyz = arena_alloc(a, PLX_PART_FRAME, arena_mul(r->m->max_bld_verts + 1, 3 * sizeof(double)), 64);
     r->gtri = arena_alloc(a, PLX_PART_FRAME, arena_mul(r->m->max_bld_tris + 1, sizeof(mesh_tri)), 64);
-    r->sc_id = arena_calloc(a, PLX_PART_FRAME, RENDER_SURF_CACHE, sizeof(uint32_t), 64);
-    r->sc = arena_calloc(a, PLX_PART_FRAME, RENDER_SURF_CACHE, sizeof(mesh_surf), 64);
+    r->sc_mask = render_surf_slots(s, max_w, max_h) - 1u;
+    r->sc_id = arena_calloc(a, PLX_PART_FRAME, r->sc_mask + 1u, sizeof(uint32_t), 64);
+    r->sc = arena_calloc(a, PLX_PART_FRAME, r->sc_mask + 1u, sizeof(mesh_surf), 64);
     r->order = arena_alloc(a, PLX_PART_FRAME, arena_mul(s->nbld + 1, sizeof(cull_item)), R_ALIGN);
     r->heap = arena_alloc(a, PLX_PART_FRAME, arena_mul(s->nbld + 1, sizeof(cull_item)), R_ALIGN);
     r->wmin = arena_alloc(a, PLX_PART_FRAME, arena_mul(s->nbld + 1, sizeof(double)), R_ALIGN);
@@ -969,7 +980,7 @@ static int indmap_usable(const render *r, const render_opts *o)
  * tmp (the same values: mesh_surface). */
 static const mesh_surf *surf_get(const render *r, uint32_t sid, mesh_surf *tmp)
 {
-    uint32_t k = sid & (RENDER_SURF_CACHE - 1u);
+    uint32_t k = sid & r->sc_mask;
     if (r->sc_id[k] == sid)
         return &r->sc[k];
     mesh_surface(r->m, sid, tmp);
@@ -979,13 +990,13 @@ static const mesh_surf *surf_get(const render *r, uint32_t sid, mesh_surf *tmp)
 /* Surface sid's albedo (cached, or mesh_albedo). */
 static double surf_albedo(const render *r, uint32_t sid)
 {
-    uint32_t k = sid & (RENDER_SURF_CACHE - 1u);
+    uint32_t k = sid & r->sc_mask;
     return r->sc_id[k] == sid ? r->sc[k].albedo : mesh_albedo(r->m, sid);
 }
 
 /* Puts the surfaces of the frame's pixels (and the ground) in the cache,
  * before the shading pass (whose workers only read it): a surface's slot
- * is its id modulo RENDER_SURF_CACHE, the last one seen keeps it. */
+ * is its id modulo the cache's slots, the last one seen keeps it. */
 static void surf_cache_fill(render *r)
 {
     size_t p, px = (size_t)r->w * (size_t)r->h;
@@ -995,7 +1006,7 @@ static void surf_cache_fill(render *r)
         if (sid == last)
             continue;
         last = sid;
-        k = sid & (RENDER_SURF_CACHE - 1u);
+        k = sid & r->sc_mask;
         if (r->sc_id[k] != sid) {
             mesh_surface(r->m, sid, &r->sc[k]);
             r->sc_id[k] = sid;

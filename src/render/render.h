@@ -182,7 +182,7 @@
  * of a building are made by mesh_building when it is drawn, into buffers
  * for the largest building), the frame buffers for the largest
  * image (depth, ids, linear colour: 20 bytes per pixel), the culling
- * arrays, a cache of RENDER_SURF_CACHE (2048) surface records filled from
+ * arrays, a cache of render_surf_slots (64..4096) surface records filled from
  * each frame's ids before the shading pass (its workers only read it) and
  * (light shader) 4 bytes per lamp from the arena (part
  * PLX_PART_FRAME); the light map is taken there when built. render_frame allocates nothing. No global state; one render
@@ -402,9 +402,14 @@ void render_lightmap_get(const render *r, render_lightmap_info *out /* OUT */);
  * with shade as the shader (after a bake is loaded). The shader's user
  * pointer is kept. */
 void render_code_unbind(render *r);
-/* Surface records the renderer keeps, by id modulo this (a power of 2;
- * render.c's surf_get). */
+/* Surface records the renderer keeps, by id modulo their number (a power
+ * of 2; render.c's surf_get): at most this many. */
 #define RENDER_SURF_CACHE 4096
+/* Their number for a scene and the largest frame: one per surface of the
+ * scene (every one cached), at most one per 64 pixels and
+ * RENDER_SURF_CACHE, at least 64. A record not cached is made again when
+ * read (the same values), so the number changes no byte of a frame. */
+uint32_t render_surf_slots(const scene *s, int32_t max_w, int32_t max_h);
 
 /* sizeof the render object (opaque elsewhere). */
 size_t render_struct_bytes(void);

@@ -63,9 +63,18 @@ wait
 "$bin" gen grid 2 2 >"$tmp/gen.out"
 if [ -p "$tmp/fifo" ] && cmp -s "$tmp/fifo.out" "$tmp/gen.out"; then ok fifo-kept; else bad fifo-kept; fi
 # "-": the data on stdout, the report line on stderr
-timeout 60 "$bin" heatmap -q $T --res 2 -o - >"$tmp/stdout.png" 2>"$tmp/err"; rc=$?
-if [ $rc -eq 0 ] && is_png "$tmp/stdout.png" && grep -q "^heatmap: .* written to -" "$tmp/err"; then ok stdout-png
+# (and no world file "-.pgw" in the working folder: the map has no folder)
+mkdir "$tmp/cwd"
+binabs=$(cd "$(dirname "$bin")" && pwd)/$(basename "$bin")
+(cd "$tmp/cwd" && timeout 60 "$binabs" heatmap -q "$OLDPWD/$T" --res 2 -o - >"$tmp/stdout.png" 2>"$tmp/err"); rc=$?
+if [ $rc -eq 0 ] && is_png "$tmp/stdout.png" && grep -q "^heatmap: .* written to -$" "$tmp/err" &&
+   grep -q "no world file (.pgw) for '-'" "$tmp/err" && [ -z "$(ls -A "$tmp/cwd")" ]; then ok stdout-png
 else bad "stdout-png: exit $rc"; fi
+# a FIFO map gets no world file "fifo.pgw" beside it either
+cat "$tmp/fifo" >/dev/null &
+expect heatmap-fifo-no-world 0 "no world file \\(\\.pgw\\) for '$tmp/fifo'" -- heatmap -q $T --res 2 -o "$tmp/fifo"
+wait
+if [ ! -e "$tmp/fifo.pgw" ]; then ok heatmap-fifo-no-pgw; else bad heatmap-fifo-no-pgw; fi
 timeout 60 "$bin" render -q --no-indirect $T --size 16x12 -o "$tmp/r.png" --pfm - >"$tmp/stdout.pfm" 2>/dev/null; rc=$?
 if [ $rc -eq 0 ] && [ "$(head -c 2 "$tmp/stdout.pfm")" = "PF" ]; then ok stdout-pfm; else bad "stdout-pfm: exit $rc"; fi
 expect output-directory 1 "'$tmp' is a directory" -- gen grid 2 2 -o "$tmp"

@@ -5,8 +5,9 @@
 # from the budget and renders 640x480 street frames with indirect light and
 # a short walk, at the smallest budget that works today (MEM, 64M); and the
 # 5-frame walk at the 32M of the issue (since the renderer stopped holding
-# the city's triangles; photon buffers at their lowest quality, no contact
-# sheet: README "Memory budgets").
+# the city's triangles; photon buffers at their lowest quality, a smaller contact
+# sheet: README "Memory budgets"); and a frames-only bake made in 32M,
+# walked in 32M.
 # usage: tests/cli/memory_city.sh path/to/polarlux ; prints "memory-city: N passed, N failed".
 bin=$1
 MEM=${PLX_CITY_MEM:-64M}
@@ -38,5 +39,18 @@ else bad "walk-640x480-$MEM: exit $rc"; fi
 if [ $rc -eq 0 ] && [ -s "$tmp/walk32/frame-0005.png" ] && grep -q "^walk: 5 frames 640x480" "$tmp/out"; then
     ok "walk-640x480-32M: $(grep '^frame time' "$tmp/out")"
 else bad "walk-640x480-32M: exit $rc"; fi
+# its contact sheet shrinks its frames to fit what --mem leaves
+if [ -s "$tmp/walk32/contact.png" ] && grep -q "contact sheet with frames [0-9]* pixels wide (not 320) to fit --mem" "$tmp/err"; then
+    ok "walk-32M-smaller-sheet"
+else bad "walk-32M-smaller-sheet"; fi
+# a kiosk in 32M: a bake made in 32M for frames only (no polar diagrams, no
+# aerial map, frames up to 640x480), then the walk from it in 32M
+"$bin" bake -q --mem 32M --no-polar --no-aerial --max-size 640x480 "$tmp/city.geojson" -o "$tmp/k.plxb" >"$tmp/out" 2>"$tmp/err"; rc=$?
+if [ $rc -eq 0 ] && [ -s "$tmp/k.plxb" ]; then ok "bake-32M: $(grep '^baked' "$tmp/out" | sed 's/.*: //')"
+else bad "bake-32M: exit $rc"; fi
+"$bin" walk -q --mem 32M --aa 1 --max-frames 5 "$tmp/k.plxb" --path "$tmp/path.geojson" -o "$tmp/walkk" >"$tmp/out" 2>"$tmp/err"; rc=$?
+if [ $rc -eq 0 ] && [ -s "$tmp/walkk/frame-0005.png" ] && grep -q "^walk: 5 frames 640x480" "$tmp/out"; then
+    ok "walk-bake-640x480-32M: $(grep '^frame time' "$tmp/out")"
+else bad "walk-bake-640x480-32M: exit $rc"; fi
 echo "memory-city: $pass passed, $fail failed"
 [ "$fail" -eq 0 ]

@@ -142,6 +142,14 @@ if cmp -s "$tmp/out" "$tmp/v1"; then echo "ok   bake-vis-same"; pass=$((pass + 1
 "$bin" render -q fixtures/eixample-4x4.geojson --no-indirect --size 160x120 -o "$tmp/r1.png" --pfm "$tmp/r1.pfm" >/dev/null 2>&1
 expect bake-render 0 "street view 160x120" -- "$bin" render -q "$tmp/e.plxb" --no-indirect --size 160x120 -o "$tmp/r2.png" --pfm "$tmp/r2.pfm"
 if cmp -s "$tmp/r1.pfm" "$tmp/r2.pfm"; then echo "ok   bake-render-same"; pass=$((pass + 1)); else echo "FAIL bake-render-same"; fail=$((fail + 1)); fi
+# a bake without polar diagrams (for frames in a small block): smaller, and a
+# visibility query on it builds them on need, with the same answers
+expect bake-no-polar 0 "^baked " -- \
+    "$bin" bake -q fixtures/eixample-4x4.geojson --no-polar --frames 2 --photons 4000 --texel 2 --max-size 160x120 -o "$tmp/np.plxb"
+if [ "$(wc -c <"$tmp/np.plxb")" -lt "$(wc -c <"$tmp/e.plxb")" ]; then echo "ok   bake-no-polar-smaller"; pass=$((pass + 1))
+else echo "FAIL bake-no-polar-smaller"; fail=$((fail + 1)); fi
+expect bake-no-polar-vis 0 "" -- "$bin" vis -q "$tmp/np.plxb" --points "$tmp/bp.txt"
+if cmp -s "$tmp/out" "$tmp/v1"; then echo "ok   bake-no-polar-vis-same"; pass=$((pass + 1)); else echo "FAIL bake-no-polar-vis-same"; fail=$((fail + 1)); fi
 head -c 5000 "$tmp/e.plxb" >"$tmp/cut.plxb"
 expect bake-truncated 1 "^polarlux info: $tmp/cut\.plxb: truncated bake file: 5000 bytes, the header says [0-9]+$" -- "$bin" info "$tmp/cut.plxb"
 expect bake-version 1 "^polarlux render: tests/corpus/bake-version-99\.plxb: bake format version 99, this polarlux reads version 1; bake the scene again$" -- \

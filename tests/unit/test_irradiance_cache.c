@@ -33,6 +33,7 @@
 #include "photon/trace.h"
 #include "photon/indirect.h"
 #include "photon/irradiance_cache.h"
+#include "render/render.h"
 #include "ref_indirect.h"
 #include "fixture.h"
 
@@ -224,6 +225,63 @@ static void test_image_same_bytes(void **state)
     plx_engine_free(e2);
 }
 
+/* The caches' sizes come from the budget and change no byte: the
+ * smallest irradiance-cache table (ICACHE_RECORDS_MIN slots: it is
+ * emptied and refilled during the frames, asserted) and a renderer made
+ * for 64x48 frames (64 surface slots, render_surf_slots) give the frames
+ * of the default sizes. */
+static void test_small_caches_same_bytes(void **state)
+{
+    plx_engine *e1 = fixture_new((size_t)1 << 30, "fixtures/eixample-4x4.geojson", NULL, 0);
+    plx_engine *e2 = fixture_new((size_t)1 << 30, "fixtures/eixample-4x4.geojson", NULL, 0);
+    plx_engine *e3;
+    plx_config cfg;
+    uint8_t *a = malloc(3 * W * H), *b = malloc(3 * W * H);
+    plx_render_opts o;
+    plx_camera c, other;
+    (void)state;
+    assert_true(a && b);
+    camera(&c);
+    other = c;
+    other.eye[0] -= 30.0;
+    other.target[1] += 20.0;
+    plx_render_opts_default(&o);
+    assert_int_equal(plx_indirect_step(e1, 16384, 3), PLX_OK);
+    assert_int_equal(plx_indirect_step(e2, 16384, 3), PLX_OK);
+    assert_int_equal(e1->ic->nrec, ICACHE_RECORDS);
+    assert_int_equal(icache_create(&e2->mem, ICACHE_RECORDS_MIN, &e2->ic), PLX_OK);
+    assert_int_equal(icache_create(&e2->mem, 3000, &e2->ic), PLX_E_INVALID);
+    assert_int_equal(plx_render(e1, &c, &o, a, NULL, NULL), PLX_OK);
+    assert_int_equal(plx_render(e2, &other, &o, b, NULL, NULL), PLX_OK);
+    assert_int_equal(plx_render(e2, &c, &o, b, NULL, NULL), PLX_OK);
+    printf("table of %u slots: emptied %llu times, %llu records gathered (default table: %llu)\n",
+           (unsigned)e2->ic->nrec, (unsigned long long)e2->ic->flushes, (unsigned long long)e2->ic->gathered,
+           (unsigned long long)e1->ic->gathered);
+    assert_true(e2->ic->flushes > 0);
+    assert_memory_equal(a, b, 3 * W * H);
+
+    plx_config_default(&cfg);
+    cfg.port = fixture_quiet_port();
+    cfg.render_max_width = 64;
+    cfg.render_max_height = 48;
+    assert_int_equal(plx_engine_new((size_t)1 << 30, &cfg, &e3), PLX_OK);
+    assert_int_equal(plx_load_file(e3, "fixtures/eixample-4x4.geojson"), PLX_OK);
+    assert_int_equal(plx_indirect_step(e3, 16384, 3), PLX_OK);
+    assert_int_equal(render_surf_slots(e3->sc, 64, 48), 64);
+    assert_int_equal(render_surf_slots(e3->sc, W, H), 2048);
+    c.width = other.width = 64;
+    c.height = other.height = 48;
+    assert_int_equal(plx_render(e1, &c, &o, a, NULL, NULL), PLX_OK);
+    assert_int_equal(plx_render(e3, &other, &o, b, NULL, NULL), PLX_OK);
+    assert_int_equal(plx_render(e3, &c, &o, b, NULL, NULL), PLX_OK);
+    assert_memory_equal(a, b, 3 * 64 * 48);
+    free(a);
+    free(b);
+    plx_engine_free(e1);
+    plx_engine_free(e2);
+    plx_engine_free(e3);
+}
+
 /* ---- aerial views: the light map's indirect layer ---------------------------- */
 
 typedef struct gbuf {
@@ -390,6 +448,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_image_accuracy),
         cmocka_unit_test(test_image_same_bytes),
+        cmocka_unit_test(test_small_caches_same_bytes),
         cmocka_unit_test(test_aerial_accuracy),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

@@ -18,6 +18,7 @@
 
 #include "polarlux.h"
 #include "polarlux_port.h"
+#include "photon/irradiance_cache.h"
 
 #define MEM ((size_t)256 << 20)
 #define SCENE "fixtures/eixample-4x4.geojson"
@@ -128,15 +129,35 @@ static void test_budgets_kept(void **state)
     done(&full);
 }
 
-/* One byte less than the default size: the lamp ray tables go, nothing
- * else, and the light is the same (lamp rays walk the grid instead). */
+/* Just below the default size the irradiance cache's table shrinks first
+ * (its share of the budget, icache_records_for), the buffers whole; with
+ * the buffers one byte short the lamp ray tables go, nothing else, and the
+ * light is the same (lamp rays walk the grid instead). */
 static void test_no_tables_same_light(void **state)
 {
     run full, r;
     int i, lit = 0;
+    uint32_t n = ICACHE_RECORDS;
+    size_t P, b;
     (void)state;
     do_run(&full, 0);
+    P = full.info.full_bytes - icache_bytes(ICACHE_RECORDS);
     do_run(&r, full.info.full_bytes - 1);
+    assert_int_equal(r.st, PLX_OK);
+    assert_int_equal(r.info.reductions, 0);
+    assert_true(r.info.lamp_tables);
+    assert_true(r.info.bytes < full.info.bytes);
+    printf("one byte below the default size: the table shrinks, %zu bytes instead of %zu\n", r.info.bytes,
+           full.info.bytes);
+    for (i = 0; i < NPTS; i++)
+        assert_true(r.Ei[i] == full.Ei[i]);
+    done(&r);
+    b = P - 1 + icache_bytes(n);
+    while (n > ICACHE_RECORDS_MIN && icache_records_for(b) < n) {
+        n /= 2;
+        b = P - 1 + icache_bytes(n);
+    }
+    do_run(&r, b);
     assert_int_equal(r.st, PLX_OK);
     assert_int_equal(r.info.reductions, 1);
     assert_false(r.info.lamp_tables);
