@@ -34,8 +34,10 @@
 int image_write_png_rgb8(const char *path, int width, int height, const uint8_t *rgb,
                          int stride, char *err, size_t errlen);
 
-/* The same at zlib's fastest level (1): for frames written one after
- * another (walk), where the default level costs as much as the frame. */
+/* The same at zlib's fastest level (1) and with the "up" row filter only
+ * (libpng tries all five filters on every row by default): for frames
+ * written one after another (walk), where the default costs as much as the
+ * frame. */
 int image_write_png_rgb8_fast(const char *path, int width, int height, const uint8_t *rgb,
                               int stride, char *err, size_t errlen);
 

@@ -122,7 +122,8 @@ static uint32_t layout_print(void)
                           sizeof(plx_config), sizeof(render_opts), render_struct_bytes(),
                           sizeof(render_stats), sizeof(icache), sizeof(polar), sizeof(polar_trap),
                           PLX_PART_COUNT, sizeof(mesh), sizeof(mesh_bld),
-                          sizeof(mesh_surf), RENDER_SURF_CACHE };
+                          sizeof(mesh_surf), RENDER_SURF_CACHE,
+                          2 /* the polar DAG's wide nodes bit-packed (not a size: bump on such changes) */ };
     uint64_t h = FNV_BASIS;
     size_t i;
     for (i = 0; i < sizeof sz / sizeof sz[0]; i++)

@@ -16,9 +16,18 @@ static void node_get(const polar_map *m, uint32_t n, uint32_t w[3])
         w[1] = PACK(c0 >> 19, c0 & 0x7ffffu);
         w[2] = PACK(c1 >> 19, c1 & 0x7ffffu);
     } else {
-        w[0] = m->node[3 * (size_t)n];
-        w[1] = m->node[3 * (size_t)n + 1];
-        w[2] = m->node[3 * (size_t)n + 2];
+        const uint64_t *pw = (const uint64_t *)(const void *)m->node;
+        uint32_t tb = m->pack & 0xffu, cb = m->pack >> 8, i;
+        uint64_t off = (uint64_t)n * (tb + 2 * cb);
+        uint32_t t = bits_get(pw, off, tb);
+        w[0] = PACK(t >> (tb - 2), t & ((1u << (tb - 2)) - 1));
+        off += tb;
+        for (i = 1; i < 3; i++, off += cb) {
+            uint32_t c = bits_get(pw, off, cb);
+            w[i] = c < m->nnode ? PACK(POLAR_CHILD_NODE, c)
+                   : c - m->nnode < m->ntrap ? PACK(POLAR_CHILD_FREE, c - m->nnode)
+                                             : PACK(POLAR_CHILD_SOLID, c - m->nnode - m->ntrap);
+        }
     }
 }
 

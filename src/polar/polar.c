@@ -69,7 +69,7 @@ plx_status polar_build_flags(arena *a, const scene *s, int flags, polar **out)
     arena_mark m0, m1;
     polar *pd;
     plx_status st;
-    uint32_t *inc_first = NULL, *inc = NULL, *evp = NULL, *order = NULL, nev = 0, i;
+    uint32_t *inc_first = NULL, *inc = NULL, *order = NULL, nev = 0, i;
     if (!a || !s || !out)
         return PLX_E_INVALID;
     *out = NULL;
@@ -85,13 +85,13 @@ plx_status polar_build_flags(arena *a, const scene *s, int flags, polar **out)
     pd->bytes[3] = sizeof(polar);
     st = polar_make_walls(a, pd);
     if (st == PLX_OK)
-        st = polar_incidence(a, pd, &inc_first, &inc, &evp, &nev);
+        st = polar_incidence(a, pd, &inc_first, &inc, &nev);
     if (st == PLX_OK)
         st = polar_insertion_order(a, pd, &order);
     for (i = 0; st == PLX_OK && i < 2; i++) {
         arena_mark mm = arena_get_mark(a);
         pd->map[i].frame = (int)i;
-        st = polar_map_build(a, pd, &pd->map[i], inc_first, inc, evp, nev, order, flags, &pd->steps);
+        st = polar_map_build(a, pd, &pd->map[i], inc_first, inc, nev, order, flags, &pd->steps);
         /* give back this map's scratch (kept memory grows from the other end) */
         mm.lo = a->lo;
         mm.used[PLX_PART_POLAR] = a->used[PLX_PART_POLAR];

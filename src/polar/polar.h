@@ -117,8 +117,15 @@ typedef struct polar_trap {
  * Stored in 8 bytes a node ("narrow") when all indices fit: the 64 bits
  * w0 | w1 << 32 hold the test as kind << 20 | index in bits 0-21 and the
  * children as tag << 19 | index in bits 22-42 and 43-63 (up to 2^19 nodes,
- * regions and buildings, 2^20 points and pieces); otherwise in 12 bytes,
- * the three words. polar_node() unpacks either. */
+ * regions and buildings, 2^20 points and pieces); otherwise packed in
+ * tbits + 2 cbits bits a node (pack = tbits | cbits << 8; node j at bit j
+ * (tbits + 2 cbits) of node[] read as 64-bit words, a field running on
+ * into the next word where it does not fit): the test as kind <<
+ * (tbits - 2) | index; each child as one number, an inner node below
+ * nnode, nnode + a free region below nnode + ntrap, else nnode + ntrap +
+ * the solid trapezoid's owner plus one, in cbits bits (8.5 bytes a node on
+ * a 10^6-vertex ring, where the three words took 12). polar_node()
+ * unpacks either. */
 #define POLAR_TAG(w) ((w) >> 30)
 #define POLAR_IDX(w) ((w) & 0x3fffffffu)
 enum { POLAR_CHILD_NODE = 0, POLAR_CHILD_FREE = 1, POLAR_CHILD_SOLID = 2 };
@@ -129,12 +136,13 @@ typedef struct polar_map {
     uint32_t ntrap;          /* free regions */
     polar_trap *trap;
     uint32_t *node;          /* inner search nodes (see above): 2 words each
-                              * when narrow, else 3 */
+                              * when narrow, else packed 64-bit words */
     uint32_t nnode;
     uint32_t root;           /* child word of the root */
     int narrow;
     uint32_t box_top, box_bot; /* segment indices of the Bounds sides on top/bottom */
     uint32_t box_lo, box_hi;   /* point indices of the extreme Bounds corners */
+    uint32_t pack;           /* packed nodes: tbits | cbits << 8 (see above) */
 } polar_map;
 
 typedef struct polar {
@@ -160,10 +168,10 @@ typedef struct polar {
  * and the trapezoid slots) is at most POLAR_SCRATCH_PER_VERTEX bytes a
  * footprint vertex plus POLAR_SCRATCH_FIXED: a block must hold the
  * diagrams and that (tests/unit/test_polar_scratch.c measures it on
- * growing rings and generated cities: 209 bytes a vertex on a
- * 100,000-vertex ring, 127 on gen eixample 24 24; README "Polar build
+ * growing rings and generated cities: 157 bytes a vertex on a
+ * 100,000-vertex ring, 96 on gen eixample 24 24; README "Polar build
  * scratch"). */
-#define POLAR_SCRATCH_PER_VERTEX 256
+#define POLAR_SCRATCH_PER_VERTEX 200
 #define POLAR_SCRATCH_FIXED ((size_t)1 << 20)
 
 /* Builds the four diagrams of scene s. On success *out points into arena
@@ -203,7 +211,7 @@ vec2 polar_from_frame(int frame, vec2 f);
 /* polar_build with flags: POLAR_BUILD_NO_DAG does not keep the search DAGs
  * (the trapezoidal maps are still built by insertion, the sweep needs them:
  * this times keeping the nodes; point location and everything using it are
- * then unusable); POLAR_BUILD_WIDE_DAG stores every node in 12 bytes (to
+ * then unusable); POLAR_BUILD_WIDE_DAG stores every node packed (to
  * test that layout on small scenes). */
 enum { POLAR_BUILD_NO_DAG = 1, POLAR_BUILD_WIDE_DAG = 2 };
 plx_status polar_build_flags(arena *a, const scene *s, int flags, polar **out /* OUT */);

@@ -111,6 +111,28 @@ static inline void *keep_n(arena *a, size_t n, size_t size, size_t *acc)
         *acc += bytes;
     return p;
 }
+/* The packed search nodes (polar_map): a field of 'width' bits (1 to 32)
+ * at bit 'off' of w[], which may run on into the next word. */
+static inline uint32_t bits_get(const uint64_t *w, uint64_t off, uint32_t width)
+{
+    size_t i = (size_t)(off >> 6);
+    uint32_t sh = (uint32_t)(off & 63);
+    uint64_t x = w[i] >> sh;
+    if (sh + width > 64)
+        x |= w[i + 1] << (64 - sh);
+    return (uint32_t)(x & (((uint64_t)1 << width) - 1));
+}
+
+/* Sets such a field, all zero before. */
+static inline void bits_put(uint64_t *w, uint64_t off, uint32_t width, uint32_t v)
+{
+    size_t i = (size_t)(off >> 6);
+    uint32_t sh = (uint32_t)(off & 63);
+    w[i] |= (uint64_t)v << sh;
+    if (sh + width > 64)
+        w[i + 1] |= (uint64_t)v >> (64 - sh);
+}
+
 static inline int32_t seg_owner(const polar *pd, uint32_t s)
 {
     return pd->seg[s].bld[0] < 0 ? -1 : pd->seg[s].bld[0];
@@ -152,14 +174,19 @@ typedef struct proles {
     uint32_t side[2];
 } proles;
 
-/* The sweep's data per piece (its frame ends are in a separate array, E:
- * E[2 s] left, E[2 s + 1] right, which the insertions read too). */
+/* The frame end k (0: left, 1: right) of piece s: its canonical end point
+ * SR[s].end[k], at the same position as the piece's own. */
+static inline vec2 pend(const polar *pd, int frame, const sroles *SR, uint32_t s, int k)
+{
+    return fpt(pd, frame, SR[s].end[k]);
+}
+
+/* The sweep's data per piece (its frame ends are read through its
+ * canonical ends, pend). */
 typedef struct snode {
     int32_t cov;        /* footprints covering the gap above it */
-    uint32_t open;      /* the free region open above it, or POLAR_NONE */
+    uint32_t open;      /* the slot of the free region open above it, or POLAR_NONE */
     uint32_t prev, next; /* status list; prev == POLAR_NONE: not in it */
-    uint32_t solid;     /* child word of a solid trapezoid on it (search DAG) */
-    uint32_t yk;        /* its search node kind: N_Y (l is seg.a) or N_YB */
 } snode;
 
 #define NODE_BITS 12
@@ -182,8 +209,6 @@ typedef struct dbuild {
     uint32_t lcap;           /* their length: a piece crosses one trapezoid more than the
                               * axes it cuts, each at a distinct event position
                               * between its ends (the longest such run + 8) */
-    const snode *N;          /* per piece: the sweep's data (y test kind) */
-    const vec2 *E;           /* per piece: frame ends, left then right */
     const uint32_t *order;   /* the insertion order */
     /* the live trapezoids by role, kept up to date by every insertion */
     sroles *SR;
@@ -202,16 +227,16 @@ plx_status polar_make_walls(arena *a, polar *pd);
 /* sweep.c: walls incident to each point and the sweep events; the map of
  * one frame (search DAG, sweep, regions kept). */
 plx_status polar_incidence(arena *a, const polar *pd, uint32_t **inc_first, uint32_t **inc,
-                           uint32_t **evp, uint32_t *nev);
+                           uint32_t *nev);
 plx_status polar_map_build(arena *a, polar *pd, polar_map *m, const uint32_t *inc_first,
-                           const uint32_t *inc, const uint32_t *evp, uint32_t nev,
+                           const uint32_t *inc, uint32_t nev,
                            const uint32_t *order, int flags, uint64_t *steps);
 
 /* trapmap.c: the random insertion order; the map and DAG of one frame by
  * randomized insertion; the DAG kept with its leaves as child words. */
 plx_status polar_insertion_order(arena *a, const polar *pd, uint32_t **out);
-plx_status polar_dag_build(arena *a, polar *pd, polar_map *m, dbuild *b, const snode *N,
-                           const vec2 *E, sroles *SR, const uint32_t *order, uint32_t span);
+plx_status polar_dag_build(arena *a, polar *pd, polar_map *m, dbuild *b,
+                           sroles *SR, const uint32_t *order, uint32_t span);
 /* The inner nodes' ranks among the build nodes (see polar_dag_words). */
 typedef struct dag_rank {
     uint64_t *bits;          /* bit i: build node i is inner */

@@ -35,7 +35,6 @@ typedef struct sweep {
     const polar *pd;
     polar_map *m;
     snode *N;           /* per segment (walls and Bounds sides) */
-    const vec2 *E;      /* per segment: frame ends, left then right */
     uint32_t ntrap, cap; /* regions made, the most there can be */
     uint32_t nclosed;   /* regions closed */
     const uint32_t *inc_first, *inc; /* walls incident to each point */
@@ -44,12 +43,11 @@ typedef struct sweep {
      * above it at its left end, per point one trapezoid with that left
      * axis; each gap the sweep opens is one of them, whose child word it
      * sets in its leaf field; a free one is a region, kept in the slot
-     * (its adjacency in nb: the slot's own is not read again), and regd[]
-     * names that slot per region */
+     * (its adjacency in nb: the slot's own is not read again), the
+     * status naming it by its slot (snode.open) */
     btrap *DT;
     const sroles *SR;
     const proles *PR;
-    uint32_t *regd;
     uint32_t ngap;      /* gaps opened, free or solid */
     uint64_t steps;     /* status pieces walked and start pieces sorted */
 } sweep;
@@ -60,8 +58,8 @@ typedef struct sweep {
 #define EV_POINT 0x7fffffffu
 
 /* The frame ends of piece s. */
-#define EL(w, s) ((w)->E[2 * (size_t)(s)])
-#define ER(w, s) ((w)->E[2 * (size_t)(s) + 1])
+#define EL(w, s) pend((w)->pd, (w)->m->frame, (w)->SR, (s), 0)
+#define ER(w, s) pend((w)->pd, (w)->m->frame, (w)->SR, (s), 1)
 
 static int fp_before(const fpoint *a, const fpoint *b, const void *ctx)
 {
@@ -73,15 +71,34 @@ static int fp_before(const fpoint *a, const fpoint *b, const void *ctx)
 MSORT_DEFINE(sort_fpoints, fpoint, const void *, fp_before)
 
 /* The slot of region h. */
-static btrap *region(const sweep *w, uint32_t h)
+static btrap *region(const sweep *w, uint32_t d)
 {
-    return &w->DT[w->regd[h]];
+    return &w->DT[d];
+}
+
+/* The region index of the free trapezoid in slot d (or POLAR_NONE). */
+static uint32_t regno(const sweep *w, uint32_t d)
+{
+    return d == POLAR_NONE ? POLAR_NONE : POLAR_IDX(w->DT[d].leaf);
+}
+
+/* The child word of a solid trapezoid above piece s: the owner
+ * polar_locate reports inside it, the footprint entered across s, if any
+ * (see locate in polar_scan), plus one. */
+static uint32_t solid_word(const polar *pd, int frame, uint32_t s)
+{
+    const polar_seg *gs = &pd->seg[s];
+    uint32_t l, r;
+    int32_t own;
+    seg_ends(pd, frame, s, &l, &r);
+    own = (l == gs->a ? gs->cover : -gs->cover) > 0 && gs->bld[0] >= 0 ? gs->bld[0] : -1;
+    return PACK(POLAR_CHILD_SOLID, (uint32_t)(own + 1));
 }
 
 /* The gap above bot opened at point pi (below top) is trapezoid d of the
- * DAG's map: checked, and its child word set: a new region *h if free,
- * else solid (*h = POLAR_NONE). Returns 0, or -1 when the two maps
- * differ. */
+ * DAG's map: checked, and its child word set: a new region when it is
+ * free, *h = d (its slot), else solid, *h = POLAR_NONE. Returns 0, or -1
+ * when the two maps differ. */
 static int open_gap(sweep *w, uint32_t d, uint32_t pi, uint32_t top, uint32_t bot, int free,
                     uint32_t *h)
 {
@@ -95,19 +112,19 @@ static int open_gap(sweep *w, uint32_t d, uint32_t pi, uint32_t top, uint32_t bo
     if (free) {
         if (w->ntrap >= w->cap)
             return -1;
-        *h = w->ntrap++;
-        w->regd[*h] = d;
+        *h = d;
         t->nb[0] = t->nb[1] = t->nb[2] = t->nb[3] = POLAR_NONE;
-        t->leaf = PACK(POLAR_CHILD_FREE, *h);
+        t->leaf = PACK(POLAR_CHILD_FREE, w->ntrap++);
     } else {
-        t->leaf = w->N[bot].solid;
+        t->leaf = solid_word(w->pd, w->m->frame, bot);
     }
     w->ngap++;
     return 0;
 }
 
-/* Region h closed by the axis of point pi, which must be its right axis in
- * the DAG's map. Returns 0, or -1 when the two maps differ. */
+/* The region in slot h closed by the axis of point pi, which must be its
+ * right axis in the DAG's map. Returns 0, or -1 when the two maps
+ * differ. */
 static int close_region(sweep *w, uint32_t h, uint32_t pi)
 {
     if (h == POLAR_NONE)
@@ -120,9 +137,9 @@ static int close_region(sweep *w, uint32_t h, uint32_t pi)
 
 /* Does piece y start below piece x (both starting at the same point)?
  * Sets *flat when they are collinear. */
-static int start_below(const vec2 *E, uint32_t y, uint32_t x, int *flat)
+static int start_below(const sweep *w, uint32_t y, uint32_t x, int *flat)
 {
-    int o = geom_orient(E[2 * (size_t)y], E[2 * (size_t)y + 1], E[2 * (size_t)x + 1]);
+    int o = geom_orient(EL(w, y), ER(w, y), ER(w, x));
     if (o == 0)
         *flat = 1;
     return o > 0;
@@ -134,14 +151,13 @@ static int start_below(const vec2 *E, uint32_t y, uint32_t x, int *flat)
  * neighbours in the order are always compared, so it is seen). */
 static int sort_starts(sweep *w, uint32_t n)
 {
-    const vec2 *E = w->E;
     uint32_t *src = w->start, *dst = w->tmp, i, j, wd;
     int flat = 0;
     for (i = 0; i < n; i += 8) {
         uint32_t e = i + 8 < n ? i + 8 : n;
         for (j = i + 1; j < e; j++) {
             uint32_t t = src[j], k = j;
-            while (k > i && start_below(E, t, src[k - 1], &flat)) {
+            while (k > i && start_below(w, t, src[k - 1], &flat)) {
                 src[k] = src[k - 1];
                 k--;
             }
@@ -153,7 +169,7 @@ static int sort_starts(sweep *w, uint32_t n)
             uint32_t a = i, am = i + wd < n ? i + wd : n, b = am, bm = i + 2 * wd < n ? i + 2 * wd : n;
             uint32_t o = i;
             while (a < am && b < bm)
-                dst[o++] = start_below(E, src[b], src[a], &flat) ? src[b++] : src[a++];
+                dst[o++] = start_below(w, src[b], src[a], &flat) ? src[b++] : src[a++];
             while (a < am)
                 dst[o++] = src[a++];
             while (b < bm)
@@ -267,26 +283,25 @@ static int sweep_event(sweep *w, vec2 P, uint32_t pi, const uint32_t *pts, uint3
         }
     }
     if (G0 != POLAR_NONE)
-        region(w, G0)->nb[LR] = H0;
+        region(w, G0)->nb[LR] = regno(w, H0);
     if (Gk != POLAR_NONE)
-        region(w, Gk)->nb[UR] = Hm;
+        region(w, Gk)->nb[UR] = regno(w, Hm);
     if (H0 != POLAR_NONE)
-        region(w, H0)->nb[LL] = G0;
+        region(w, H0)->nb[LL] = regno(w, G0);
     if (Hm != POLAR_NONE)
-        region(w, Hm)->nb[UL] = Gk;
+        region(w, Hm)->nb[UL] = regno(w, Gk);
     return 0;
 }
 
-/* Walls incident to each point (both frames), and the points that are
- * wall ends: the events of the sweeps. */
+/* Walls incident to each point (both frames), and the number of points
+ * that are wall ends: the events of the sweeps. */
 plx_status polar_incidence(arena *a, const polar *pd, uint32_t **inc_first, uint32_t **inc,
-                           uint32_t **evp, uint32_t *nev)
+                           uint32_t *nev)
 {
-    uint32_t i, s, n = 0, *f, *v, *e;
+    uint32_t i, s, n = 0, *f, *v;
     f = scratch_n(a, (size_t)pd->npts + 1, 4);
     v = scratch_n(a, (size_t)pd->nwall * 2, 4);
-    e = scratch_n(a, pd->npts, 4);
-    if (!f || !v || !e)
+    if (!f || !v)
         return PLX_E_NOMEM;
     memset(f, 0, ((size_t)pd->npts + 1) * 4);
     for (s = 0; s < pd->nwall; s++) {
@@ -295,7 +310,7 @@ plx_status polar_incidence(arena *a, const polar *pd, uint32_t **inc_first, uint
     }
     for (i = 0; i < pd->npts; i++) {
         if (f[i + 1] > 0)
-            e[n++] = i;
+            n++;
         f[i + 1] += f[i];
     }
     for (s = 0; s < pd->nwall; s++) {
@@ -307,7 +322,6 @@ plx_status polar_incidence(arena *a, const polar *pd, uint32_t **inc_first, uint
     f[0] = 0;
     *inc_first = f;
     *inc = v;
-    *evp = e;
     *nev = n;
     return PLX_OK;
 }
@@ -341,28 +355,19 @@ static void frame_box(const polar *pd, polar_map *m)
 }
 
 
-/* Per piece: its frame ends (E), the sweep's data (N) and its canonical
- * ends (SR, all else unset: POLAR_NONE); canon: per point the first event
- * point at its position. */
-static void frame_pieces(polar *pd, polar_map *m, snode *N, vec2 *E, sroles *SR,
+/* Per piece: the sweep's data (N) and its canonical ends (SR, all else
+ * unset: POLAR_NONE); canon: per point the first event point at its
+ * position. */
+static void frame_pieces(polar *pd, polar_map *m, snode *N, sroles *SR,
                          const uint32_t *canon)
 {
     uint32_t s;
     memset(SR, 0xff, (size_t)pd->nseg * sizeof(sroles));
     for (s = 0; s < pd->nseg; s++) {
         uint32_t l, r;
-        /* polar_locate's owner inside the solid above s: the footprint
-         * entered across s, if any (see locate in polar_scan) */
-        const polar_seg *gs = &pd->seg[s];
-        int32_t own;
         seg_ends(pd, m->frame, s, &l, &r);
-        own = (l == gs->a ? gs->cover : -gs->cover) > 0 && gs->bld[0] >= 0 ? gs->bld[0] : -1;
-        E[2 * (size_t)s] = fpt(pd, m->frame, l);
-        E[2 * (size_t)s + 1] = fpt(pd, m->frame, r);
         SR[s].end[0] = canon[l];
         SR[s].end[1] = canon[r];
-        N[s].solid = PACK(POLAR_CHILD_SOLID, (uint32_t)(own + 1));
-        N[s].yk = l == gs->a ? N_Y : N_YB;
         N[s].cov = 0;
         N[s].open = POLAR_NONE;
         N[s].prev = N[s].next = POLAR_NONE;
@@ -376,17 +381,19 @@ static void frame_pieces(polar *pd, polar_map *m, snode *N, vec2 *E, sroles *SR,
  * plus one: the insertion's lists are sized by it) and the most walls at
  * one position (the sweep's lists of pieces starting at an event). canon
  * and the sort's buffers are scratch given back by the caller. */
-static plx_status sort_events(arena *a, const polar *pd, int frame, const uint32_t *evp,
-                              uint32_t nev, const uint32_t *inc_first, uint32_t *evs,
+static plx_status sort_events(arena *a, const polar *pd, int frame, uint32_t nev,
+                              const uint32_t *inc_first, uint32_t *evs,
                               uint32_t *canon, uint32_t *span, uint32_t *maxdeg)
 {
     fpoint *ev = scratch_n(a, nev, sizeof(fpoint)), *tmp = scratch_n(a, nev, sizeof(fpoint));
     uint32_t *rank = scratch_n(a, pd->npts, 4), i, j, nd = 0, s;
     if (!ev || !tmp || !rank)
         return PLX_E_NOMEM;
-    for (i = 0; i < nev; i++) {
-        ev[i].f = fpt(pd, frame, evp[i]);
-        ev[i].i = evp[i];
+    for (i = 0, j = 0; i < pd->npts && j < nev; i++) {
+        if (inc_first[i + 1] == inc_first[i])
+            continue;
+        ev[j].f = fpt(pd, frame, i);
+        ev[j++].i = i;
     }
     sort_fpoints(ev, tmp, nev, NULL);
     for (i = 0; i < pd->npts; i++) {
@@ -443,13 +450,28 @@ static plx_status run_sweep(sweep *w, const dbuild *b, const uint32_t *evs, uint
     return PLX_OK;
 }
 
+/* Per region its slot, named by the region's child word in the slot's leaf
+ * field: written over the insertion's point roles (b->PR, not read after
+ * the sweep) when they are long enough, else new scratch. */
+static uint32_t *region_slots(arena *a, const polar *pd, const dbuild *b, uint32_t nreg)
+{
+    uint32_t t, *regd = nreg <= 2 * (uint64_t)pd->npts ? (uint32_t *)(void *)b->PR
+                                                        : scratch_n(a, nreg, 4);
+    if (!regd)
+        return NULL;
+    for (t = 0; t < b->ntrap; t++)
+        if (POLAR_TAG(b->T[t].leaf) == POLAR_CHILD_FREE)
+            regd[POLAR_IDX(b->T[t].leaf)] = t;
+    return regd;
+}
+
 /* Builds the trapezoidal map of one frame: the search DAG's map by
  * randomized insertion, then the sweep, which uses it to place the events
  * where pieces only start, checks that the pieces form a planar
  * subdivision and that both maps agree, and makes the free regions (kept,
  * in sweep order, with their adjacency); then the DAG is kept with its
  * leaves mapped to those regions (unless flags say otherwise).
- * Memory, in stack order: per piece N (24 bytes), E (32) and SR (24), the
+ * Memory, in stack order: per piece N (24 bytes) and SR (24), the
  * sorted events (4 a point); the sort's buffers and canonical indices
  * (given back before the insertion); the insertion's hints and roles (4 +
  * 8 a point), lists (by the longest piece) and search nodes (12 bytes
@@ -459,13 +481,12 @@ static plx_status run_sweep(sweep *w, const dbuild *b, const uint32_t *evs, uint
  * place (polar_keep_regions) before the search nodes are (scratch).
  * README "Polar build scratch". */
 plx_status polar_map_build(arena *a, polar *pd, polar_map *m, const uint32_t *inc_first,
-                           const uint32_t *inc, const uint32_t *evp, uint32_t nev,
+                           const uint32_t *inc, uint32_t nev,
                            const uint32_t *order, int flags, uint64_t *steps)
 {
     sweep w;
     dbuild b;
-    vec2 *E;
-    uint32_t *evs, *canon, nlive, span, maxdeg;
+    uint32_t *evs, *canon, *regd, nlive, span, maxdeg;
     sroles *SR;
     dag_rank rk;
     arena_mark mk;
@@ -479,22 +500,21 @@ plx_status polar_map_build(arena *a, polar *pd, polar_map *m, const uint32_t *in
     w.inc_first = inc_first;
     w.inc = inc;
     w.N = scratch_n(a, pd->nseg, sizeof(snode));
-    w.E = E = scratch_n(a, 2 * (size_t)pd->nseg, sizeof(vec2));
-    SR = scratch_n(a, pd->nseg, sizeof(sroles));
+    w.SR = SR = scratch_n(a, pd->nseg, sizeof(sroles));
     evs = scratch_n(a, nev, 4);
-    if (!w.N || !E || !SR || !evs)
+    if (!w.N || !SR || !evs)
         return PLX_E_NOMEM;
     frame_box(pd, m);
     mk = arena_get_mark(a);
     canon = scratch_n(a, pd->npts, 4);
     if (!canon)
         return PLX_E_NOMEM;
-    st = sort_events(a, pd, m->frame, evp, nev, inc_first, evs, canon, &span, &maxdeg);
+    st = sort_events(a, pd, m->frame, nev, inc_first, evs, canon, &span, &maxdeg);
     if (st != PLX_OK)
         return st;
-    frame_pieces(pd, m, w.N, E, SR, canon);
+    frame_pieces(pd, m, w.N, SR, canon);
     arena_release(a, &mk);
-    st = polar_dag_build(a, pd, m, &b, w.N, E, SR, order, span);
+    st = polar_dag_build(a, pd, m, &b, SR, order, span);
     if (st != PLX_OK)
         return st;
     w.DT = b.T;
@@ -503,21 +523,23 @@ plx_status polar_map_build(arena *a, polar *pd, polar_map *m, const uint32_t *in
     /* every region is a live trapezoid of the map, each once (open_gap) */
     nlive = b.ntrap - b.nfree;
     w.cap = nlive;
-    w.regd = scratch_n(a, w.cap, 4);
     w.start = scratch_n(a, (size_t)maxdeg + 1, 4);
     w.tmp = scratch_n(a, (size_t)maxdeg + 1, 4);
-    if (!w.regd || !w.start || !w.tmp)
+    if (!w.start || !w.tmp)
         return PLX_E_NOMEM;
     st = run_sweep(&w, &b, evs, nev);
     if (st != PLX_OK)
         return st;
+    regd = region_slots(a, pd, &b, w.ntrap);
+    if (!regd)
+        return PLX_E_NOMEM;
     *steps += w.steps + b.steps;
     if (!(flags & POLAR_BUILD_NO_DAG)) {
         st = polar_dag_words(a, &b, &rk);
         if (st != PLX_OK)
             return st;
     }
-    st = polar_keep_regions(a, pd, m, &b, w.regd, w.ntrap);
+    st = polar_keep_regions(a, pd, m, &b, regd, w.ntrap);
     if (st != PLX_OK)
         return st;
     /* polar_memory: the axes (lp, rp, nb) and the regions (top, bot) */

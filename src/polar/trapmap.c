@@ -119,7 +119,8 @@ static uint32_t new_node(dbuild *b, uint32_t kind, uint32_t idx, uint32_t c0, ui
 /* The y test of piece s: its kind by which end is frame-left. */
 static uint32_t ykind(const dbuild *b, uint32_t s)
 {
-    return b->N[s].yk;
+    const polar_seg *g = &b->pd->seg[s];
+    return lex_cmp(bpt(b, g->a), bpt(b, g->b)) < 0 ? N_Y : N_YB;
 }
 
 /* One insertion, its data gathered beforehand (in insertion order). */
@@ -141,10 +142,11 @@ static uint32_t find_first(dbuild *b, uint32_t n, vec2 P, vec2 Q)
         if (KIND(w) == N_X) {
             n = lex_cmp(P, bpt(b, IDX(w))) < 0 ? nd[1] : nd[2];
         } else {
-            const vec2 *g = &b->E[2 * (size_t)IDX(w)];
-            int o = geom_orient(g[0], g[1], P);
+            vec2 g0 = pend(b->pd, b->frame, b->SR, IDX(w), 0);
+            vec2 g1 = pend(b->pd, b->frame, b->SR, IDX(w), 1);
+            int o = geom_orient(g0, g1, P);
             if (o == 0)
-                o = geom_orient(g[0], g[1], Q);   /* a shared left end: the slopes */
+                o = geom_orient(g0, g1, Q);   /* a shared left end: the slopes */
             if (o == 0) {
                 b->fail = 2;
                 return POLAR_NONE;
@@ -166,10 +168,11 @@ static uint32_t find_last(dbuild *b, uint32_t n, vec2 Q, vec2 P)
         if (KIND(w) == N_X) {
             n = lex_cmp(Q, bpt(b, IDX(w))) <= 0 ? nd[1] : nd[2];
         } else {
-            const vec2 *g = &b->E[2 * (size_t)IDX(w)];
-            int o = geom_orient(g[0], g[1], Q);
+            vec2 g0 = pend(b->pd, b->frame, b->SR, IDX(w), 0);
+            vec2 g1 = pend(b->pd, b->frame, b->SR, IDX(w), 1);
+            int o = geom_orient(g0, g1, Q);
             if (o == 0)
-                o = geom_orient(g[0], g[1], P);
+                o = geom_orient(g0, g1, P);
             if (o == 0) {
                 b->fail = 2;
                 return POLAR_NONE;
@@ -226,14 +229,13 @@ static uint32_t walk_at(dbuild *b, uint32_t p, vec2 D, int right)
     for (n = 0; n < WALK_MAX && t != POLAR_NONE; n++) {
         const btrap *x = &b->T[t];
         uint32_t e = right ? x->lp : x->rp;
-        const vec2 *g;
         int o;
         if (x->leaf == POLAR_NONE || e != p)
             return POLAR_NONE;
         b->steps++;
         if (b->SR[x->top].end[k] == p) {
-            g = &b->E[2 * (size_t)x->top];
-            o = geom_orient(g[0], g[1], D);
+            o = geom_orient(pend(b->pd, b->frame, b->SR, x->top, 0),
+                             pend(b->pd, b->frame, b->SR, x->top, 1), D);
             if (o == 0)
                 return POLAR_NONE;    /* overlapping pieces: the DAG says so */
             if (o > 0) {
@@ -242,8 +244,8 @@ static uint32_t walk_at(dbuild *b, uint32_t p, vec2 D, int right)
             }
         }
         if (b->SR[x->bot].end[k] == p) {
-            g = &b->E[2 * (size_t)x->bot];
-            o = geom_orient(g[0], g[1], D);
+            o = geom_orient(pend(b->pd, b->frame, b->SR, x->bot, 0),
+                             pend(b->pd, b->frame, b->SR, x->bot, 1), D);
             if (o == 0)
                 return POLAR_NONE;
             if (o < 0) {
@@ -520,10 +522,46 @@ static void put_node(polar_map *m, uint32_t j, uint32_t t, uint32_t c0, uint32_t
         m->node[2 * (size_t)j] = (uint32_t)x;
         m->node[2 * (size_t)j + 1] = (uint32_t)(x >> 32);
     } else {
-        m->node[3 * (size_t)j] = t;
-        m->node[3 * (size_t)j + 1] = c0;
-        m->node[3 * (size_t)j + 2] = c1;
+        uint64_t *pw = (uint64_t *)(void *)m->node;
+        uint32_t tb = m->pack & 0xffu, cb = m->pack >> 8, c[2], i;
+        uint64_t off = (uint64_t)j * (tb + 2 * cb);
+        c[0] = c0;
+        c[1] = c1;
+        bits_put(pw, off, tb, KIND(t) << (tb - 2) | IDX(t));
+        off += tb;
+        for (i = 0; i < 2; i++, off += cb) {
+            uint32_t tag = POLAR_TAG(c[i]);
+            bits_put(pw, off, cb,
+                     POLAR_IDX(c[i]) + (tag == POLAR_CHILD_NODE ? 0
+                                        : tag == POLAR_CHILD_FREE ? m->nnode
+                                                                  : m->nnode + m->ntrap));
+        }
     }
+}
+
+/* Bits needed for the numbers below n. */
+static uint32_t bits_for(uint64_t n)
+{
+    uint32_t b = 1;
+    while (b < 32 && ((uint64_t)1 << b) < n)
+        b++;
+    return b;
+}
+
+/* The packed form's field widths (see polar_map) and its words, zeroed. */
+static plx_status packed_nodes(arena *a, polar *pd, polar_map *m)
+{
+    size_t nw;
+    uint32_t tb = 2 + bits_for(pd->npts > pd->nseg ? pd->npts : pd->nseg);
+    uint32_t cb = bits_for((uint64_t)m->nnode + m->ntrap + pd->nbld + 1);
+    m->pack = tb | cb << 8;
+    /* one word more: a field may be read from two words */
+    nw = (size_t)(((uint64_t)m->nnode * (tb + 2 * cb) + 63) / 64) + 1;
+    m->node = keep_n(a, nw, 8, &pd->bytes[3]);
+    if (!m->node)
+        return PLX_E_NOMEM;
+    memset(m->node, 0, nw * 8);
+    return PLX_OK;
 }
 
 /* Leaves to child words (set by the sweep in the trapezoids' leaf field,
@@ -650,9 +688,13 @@ plx_status polar_dag_keep(arena *a, polar *pd, polar_map *m, dbuild *b, const da
     m->nnode = nq;
     m->narrow = !(flags & POLAR_BUILD_WIDE_DAG) && nq < (1u << 19) && m->ntrap < (1u << 19) &&
                 pd->nbld < (1u << 19) - 1 && pd->npts < (1u << 20) && pd->nseg < (1u << 20);
-    m->node = keep_n(a, nq, m->narrow ? 8 : 12, &pd->bytes[3]);
-    if (!m->node)
+    if (m->narrow) {
+        m->node = keep_n(a, nq, 8, &pd->bytes[3]);
+        if (!m->node)
+            return PLX_E_NOMEM;
+    } else if (packed_nodes(a, pd, m) != PLX_OK) {
         return PLX_E_NOMEM;
+    }
     for (i = 0, j = 0; i < b->nnode; i++) {
         const uint32_t *nd = dnode(b, i);
         if (KIND(nd[0]) == N_LEAF)
@@ -757,13 +799,14 @@ static void prefetch_ahead(const dbuild *b, uint32_t i, uint32_t nw)
     if (i + 16 < nw) {
         uint32_t s = b->order[i + 16];
         __builtin_prefetch(&b->SR[s]);
-        __builtin_prefetch(&b->E[2 * (size_t)s]);
     }
     if (i + 8 < nw) {
         const sroles *r = &b->SR[b->order[i + 8]];
         __builtin_prefetch(&b->PR[r->end[0]]);
         __builtin_prefetch(&b->PR[r->end[1]]);
         __builtin_prefetch(&b->hint[r->end[0]]);
+        __builtin_prefetch(&b->pd->pts[r->end[0]]);
+        __builtin_prefetch(&b->pd->pts[r->end[1]]);
     }
 #else
     (void)b;
@@ -774,10 +817,10 @@ static void prefetch_ahead(const dbuild *b, uint32_t i, uint32_t nw)
 
 /* Builds the trapezoidal map of the wall pieces of m and its search DAG by
  * randomized incremental insertion, into b (scratch, the trapezoid slots
- * in the low end of the arena). N: the pieces' ends and y test kinds (the
- * sweep's snodes); E: their frame ends. */
-plx_status polar_dag_build(arena *a, polar *pd, polar_map *m, dbuild *b, const snode *N,
-                           const vec2 *E, sroles *SR, const uint32_t *order, uint32_t span)
+ * in the low end of the arena). SR: the pieces' canonical ends (pend),
+ * the rest of it unset. */
+plx_status polar_dag_build(arena *a, polar *pd, polar_map *m, dbuild *b,
+                           sroles *SR, const uint32_t *order, uint32_t span)
 {
     uint32_t nw = pd->nwall, i, t;
     if (nw >= (1u << 26) || pd->npts >= (1u << 26))
@@ -786,8 +829,6 @@ plx_status polar_dag_build(arena *a, polar *pd, polar_map *m, dbuild *b, const s
     b->pd = pd;
     b->a = a;
     b->frame = m->frame;
-    b->N = N;
-    b->E = E;
     b->SR = SR;
     b->order = order;
     /* trapezoid slots: at most 3 i + 1 live after i pieces; a new piece
@@ -823,8 +864,8 @@ plx_status polar_dag_build(arena *a, polar *pd, polar_map *m, dbuild *b, const s
         irec in;
         uint32_t s = order[i];
         prefetch_ahead(b, i, nw);
-        in.P = E[2 * (size_t)s];
-        in.Q = E[2 * (size_t)s + 1];
+        in.P = pend(pd, m->frame, SR, s, 0);
+        in.Q = pend(pd, m->frame, SR, s, 1);
         in.s = s;
         in.l = b->SR[s].end[0];
         in.r = b->SR[s].end[1];

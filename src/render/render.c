@@ -37,6 +37,13 @@ typedef struct shade_ws {
     render_stats st;            /* the shading pass's counters of this worker */
 } shade_ws;
 
+/* A grid corner's sample: whether its ray meets a surface, the point and
+ * the normal (pixel_hit). */
+typedef struct corner_hit {
+    double P[3], n[3];
+    int hit;
+} corner_hit;
+
 struct render {
     arena *a;
     const scene *s;
@@ -78,6 +85,7 @@ struct render {
      * hook's value at each corner of the grid (RGB) */
     uint8_t *blk;
     float *ind;
+    corner_hit *crow;           /* two rows of corners' hit points (max_w / IND_STEP + 2 each) */
     int32_t nbx, nby;           /* blocks a row, rows of blocks */
     int sparse;                 /* this frame's indirect is sparse */
     lightmap lm;                /* the aerial light map (lightmap.c) */
@@ -126,7 +134,7 @@ size_t render_bytes(const scene *s, int32_t max_w, int32_t max_h)
     size_t tiles = (size_t)((max_w + RENDER_TILE - 1) / RENDER_TILE) * (size_t)((max_h + RENDER_TILE - 1) / RENDER_TILE);
     size_t corners = (size_t)(max_w / IND_STEP + 2) * (size_t)(max_h / IND_STEP + 2);
     return px * 20 + tiles + (size_t)s->nbld * (2 * sizeof(cull_item) + 17) + RENDER_BINS * 8 + 65536 +
-           corners * (1 + 3 * sizeof(float)) + render_surf_slots(s, max_w, max_h) * (sizeof(uint32_t) + sizeof(mesh_surf)) +
+           corners * (1 + 3 * sizeof(float)) + 2 * (size_t)(max_w / IND_STEP + 2) * sizeof(corner_hit) + render_surf_slots(s, max_w, max_h) * (sizeof(uint32_t) + sizeof(mesh_surf)) +
            sizeof(render) + 4096;
 }
 
@@ -276,9 +284,10 @@ plx_status render_create(arena *a, const scene *s, int32_t max_w, int32_t max_h,
     r->ind = arena_alloc(a, PLX_PART_FRAME,
                          arena_mul((size_t)(max_w / IND_STEP + 2) * (size_t)(max_h / IND_STEP + 2),
                                    3 * sizeof(float)), R_ALIGN);
+    r->crow = arena_alloc(a, PLX_PART_FRAME, 2 * (size_t)(max_w / IND_STEP + 2) * sizeof(corner_hit), R_ALIGN);
     if (shade == render_shade_light && user)
         r->lt = user;
-    if (!r->lut || !r->defer || !r->blk || !r->ind) {
+    if (!r->lut || !r->defer || !r->blk || !r->ind || !r->crow) {
         arena_release(a, &m0);
         return PLX_E_NOMEM;
     }
@@ -1184,15 +1193,26 @@ static int32_t block_of(int32_t i, int32_t nb)
     return a < nb ? a : nb - 1;
 }
 
+/* The hit points of the corners of row b of the grid. */
+static void corner_row(render *r, int32_t b, corner_hit *row)
+{
+    int32_t a;
+    uint32_t sid;
+    for (a = 0; a <= r->nbx; a++)
+        row[a].hit = pixel_hit(r, corner_x(r, a), corner_y(r, b), &sid, row[a].P, row[a].n);
+}
+
 /* Whether block (a, b), its far corners included, lies on one surface,
- * and its corners' hit points lie within span times the distance of the
- * nearest of them from the eye (seen at a grazing angle, a block spans
- * far more of the surface than its neighbours nearer the eye). */
-static int block_one_surface(render *r, int32_t a, int32_t b, double span)
+ * and its corners' hit points (top: row b, bot: row b + 1) lie within
+ * span times the distance of the nearest of them from the eye (seen at a
+ * grazing angle, a block spans far more of the surface than its
+ * neighbours nearer the eye). */
+static int block_one_surface(const render *r, int32_t a, int32_t b, double span, const corner_hit *top,
+                             const corner_hit *bot)
 {
     int32_t x0 = corner_x(r, a), x1 = corner_x(r, a + 1), y0 = corner_y(r, b), y1 = corner_y(r, b + 1), x, y;
-    uint32_t sid = r->id[(size_t)y0 * (size_t)r->w + (size_t)x0], cs;
-    double C[4][3], n[3], lo[3], hi[3], dmin = HUGE_VAL, ext = 0.0;
+    uint32_t sid = r->id[(size_t)y0 * (size_t)r->w + (size_t)x0];
+    double lo[3], hi[3], dmin = HUGE_VAL, ext = 0.0;
     int c, k;
     if (sid == MESH_SURF_NONE)
         return 0;
@@ -1201,13 +1221,13 @@ static int block_one_surface(render *r, int32_t a, int32_t b, double span)
             if (r->id[(size_t)y * (size_t)r->w + (size_t)x] != sid)
                 return 0;
     for (c = 0; c < 4; c++) {
+        const double *C = (c & 2 ? bot : top)[a + (c & 1)].P;
         double d2 = 0.0;
-        (void)pixel_hit(r, c & 1 ? x1 : x0, c & 2 ? y1 : y0, &cs, C[c], n);
         for (k = 0; k < 3; k++) {
-            double dk = C[c][k] - r->eye[k];
+            double dk = C[k] - r->eye[k];
             d2 += dk * dk;
-            lo[k] = c ? fmin(lo[k], C[c][k]) : C[c][k];
-            hi[k] = c ? fmax(hi[k], C[c][k]) : C[c][k];
+            lo[k] = c ? fmin(lo[k], C[k]) : C[k];
+            hi[k] = c ? fmax(hi[k], C[k]) : C[k];
         }
         dmin = fmin(dmin, sqrt(d2));
     }
@@ -1229,39 +1249,53 @@ static int corner_used(const render *r, int32_t a, int32_t b)
     return 0;
 }
 
+/* The hook at the used corners of row b (the blocks above and below it
+ * known), left to right. */
+static void corner_gather(render *r, const render_opts *o, render_stats *st, int32_t b, const corner_hit *row)
+{
+    int32_t a;
+    for (a = 0; a <= r->nbx; a++) {
+        float *c = &r->ind[3 * ((size_t)b * (size_t)(r->nbx + 1) + (size_t)a)];
+        double Ei[3] = { 0.0, 0.0, 0.0 };
+        int k;
+        if (!row[a].hit || !corner_used(r, a, b))
+            continue;
+        o->indirect(o->indirect_user, row[a].P, row[a].n, Ei);
+        st->indirect_calls++;
+        for (k = 0; k < 3; k++)
+            c[k] = (float)Ei[k];
+    }
+}
+
 /* Before the shading pass: ground ids, the one-surface blocks and the
- * hook's value at their corners. */
+ * hook's value at their corners, row by row (each corner's hit point
+ * found once, two rows of them kept). */
 static void sparse_corners(render *r, const render_opts *o, render_stats *st)
 {
     int32_t a, b, i, j;
-    double P[3], n[3], Ei[3];
+    double P[3], n[3];
     uint32_t sid;
+    corner_hit *row[2];
     r->nbx = r->w > 1 ? (r->w - 1 + IND_STEP - 1) / IND_STEP : 1;
     r->nby = r->h > 1 ? (r->h - 1 + IND_STEP - 1) / IND_STEP : 1;
+    row[0] = r->crow;
+    row[1] = r->crow + r->nbx + 1;
     for (j = 0; j < r->h; j++)
         for (i = 0; i < r->w; i++)
             if (r->id[(size_t)j * (size_t)r->w + (size_t)i] == MESH_SURF_NONE)
                 (void)pixel_hit(r, i, j, &sid, P, n); /* the ground: its id */
-    for (b = 0; b < r->nby; b++)
-        for (a = 0; a < r->nbx; a++)
-        {
-            r->blk[(size_t)b * (size_t)r->nbx + (size_t)a] =
-                (uint8_t)block_one_surface(r, a, b, o->indirect_span);
-            st->indirect_blocks += r->blk[(size_t)b * (size_t)r->nbx + (size_t)a];
+    corner_row(r, 0, row[0]);
+    for (b = 0; b < r->nby; b++) {
+        corner_row(r, b + 1, row[(b + 1) & 1]);
+        for (a = 0; a < r->nbx; a++) {
+            uint8_t one = (uint8_t)block_one_surface(r, a, b, o->indirect_span, row[b & 1], row[(b + 1) & 1]);
+            r->blk[(size_t)b * (size_t)r->nbx + (size_t)a] = one;
+            st->indirect_blocks += one;
         }
+        corner_gather(r, o, st, b, row[b & 1]);
+    }
+    corner_gather(r, o, st, r->nby, row[r->nby & 1]);
     st->indirect_nblocks = (uint64_t)r->nbx * (uint64_t)r->nby;
-    for (b = 0; b <= r->nby; b++)
-        for (a = 0; a <= r->nbx; a++) {
-            float *c = &r->ind[3 * ((size_t)b * (size_t)(r->nbx + 1) + (size_t)a)];
-            int k;
-            if (!corner_used(r, a, b) || !pixel_hit(r, corner_x(r, a), corner_y(r, b), &sid, P, n))
-                continue;
-            Ei[0] = Ei[1] = Ei[2] = 0.0;
-            o->indirect(o->indirect_user, P, n, Ei);
-            st->indirect_calls++;
-            for (k = 0; k < 3; k++)
-                c[k] = (float)Ei[k];
-        }
 }
 
 /* Pixel (i, j)'s indirect term added to E when its block lies on one

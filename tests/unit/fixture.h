@@ -141,4 +141,36 @@ static inline void fixture_close(fixture_log *f)
     free(f);
 }
 
+/* ---- a generated city as text ------------------------------------------- */
+
+/* Text grown by plx_gen_city's writer (always NUL-terminated; free buf). */
+typedef struct fixture_city {
+    char *buf;
+    size_t len, cap;
+} fixture_city;
+
+static inline int fixture_city_put(void *ctx, const char *data, size_t len)
+{
+    fixture_city *t = ctx;
+    if (t->len + len + 1 > t->cap) {
+        size_t cap = t->cap ? t->cap : (size_t)1 << 20;
+        while (cap < t->len + len + 1)
+            cap *= 2;
+        t->buf = realloc(t->buf, cap);
+        assert_non_null(t->buf);
+        t->cap = cap;
+    }
+    memcpy(t->buf + t->len, data, len);
+    t->len += len;
+    t->buf[t->len] = '\0';
+    return 0;
+}
+
+/* plx_gen_city(style, nx, ny, seed) into *t (asserted). */
+static inline void fixture_gen(const char *style, int nx, int ny, uint64_t seed, fixture_city *t)
+{
+    memset(t, 0, sizeof *t);
+    assert_int_equal(plx_gen_city(style, nx, ny, seed, fixture_city_put, t), PLX_OK);
+}
+
 #endif

@@ -18,6 +18,7 @@
 #include "polarlux.h"
 #include "polarlux_port.h"
 #include "port.h"
+#include "fixture.h"
 
 #define BIG ((size_t)256 << 20)
 
@@ -131,21 +132,6 @@ static void check_scan(const char *text, size_t len, const char *name)
 }
 
 /* ---- the estimate ----------------------------------------------------------- */
-
-typedef struct textbuf { char *p; size_t n, cap; } textbuf;
-
-static int to_buf(void *ctx, const char *d, size_t n)
-{
-    textbuf *b = ctx;
-    if (b->n + n + 1 > b->cap) {
-        b->cap = 2 * (b->n + n + 1);
-        b->p = realloc(b->p, b->cap);
-        assert_non_null(b->p);
-    }
-    memcpy(b->p + b->n, d, n);
-    b->n += n;
-    return 0;
-}
 
 #define FRAME_W 320
 #define FRAME_H 240
@@ -262,13 +248,13 @@ static void test_scan_and_estimate_generated(void **state)
     size_t i;
     (void)state;
     for (i = 0; i < 3; i++) {
-        textbuf b = { NULL, 0, 0 };
+        fixture_city b;
         char name[64];
-        assert_int_equal(plx_gen_city(styles[i], n[i], n[i], 7, to_buf, &b), PLX_OK);
+        fixture_gen(styles[i], n[i], n[i], 7, &b);
         snprintf(name, sizeof name, "gen %s %d %d", styles[i], n[i], n[i]);
-        check_scan(b.p, b.n, name);
-        check_estimate(b.p, b.n, name);
-        free(b.p);
+        check_scan(b.buf, b.len, name);
+        check_estimate(b.buf, b.len, name);
+        free(b.buf);
     }
     print_message("worst estimate / high-water: %.2fx\n", worst_ratio);
 }

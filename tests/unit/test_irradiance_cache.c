@@ -197,6 +197,15 @@ static void test_image_accuracy(void **state)
     plx_engine_free(e);
 }
 
+/* The test camera, and another one 30 m away that fills the cache first. */
+static void two_views(plx_camera *c, plx_camera *other)
+{
+    camera(c);
+    *other = *c;
+    other->eye[0] -= 30.0;
+    other->target[1] += 20.0;
+}
+
 /* The same camera, the same bytes: after another view filled the cache, and
  * in a fresh engine. */
 static void test_image_same_bytes(void **state)
@@ -208,10 +217,7 @@ static void test_image_same_bytes(void **state)
     plx_camera c, other;
     (void)state;
     assert_true(a && b);
-    camera(&c);
-    other = c;
-    other.eye[0] -= 30.0;
-    other.target[1] += 20.0;
+    two_views(&c, &other);
     plx_render_opts_default(&o);
     assert_int_equal(plx_indirect_step(e1, 16384, 3), PLX_OK);
     assert_int_equal(plx_indirect_step(e2, 16384, 3), PLX_OK);
@@ -278,10 +284,7 @@ static void test_small_caches_same_bytes(void **state)
     plx_camera c, other;
     (void)state;
     assert_true(a && b);
-    camera(&c);
-    other = c;
-    other.eye[0] -= 30.0;
-    other.target[1] += 20.0;
+    two_views(&c, &other);
     plx_render_opts_default(&o);
     assert_int_equal(plx_indirect_step(e1, 16384, 3), PLX_OK);
     assert_int_equal(plx_indirect_step(e2, 16384, 3), PLX_OK);
@@ -320,27 +323,6 @@ static void test_small_caches_same_bytes(void **state)
 }
 
 /* ---- aerial views: the light map's indirect layer ---------------------------- */
-
-typedef struct gbuf {
-    char *p;
-    size_t n, cap;
-} gbuf;
-
-static int gbuf_write(void *user, const char *data, size_t len)
-{
-    gbuf *b = user;
-    if (b->n + len + 1 > b->cap) {
-        size_t cap = 2 * (b->n + len + 1);
-        char *q = realloc(b->p, cap);
-        if (!q)
-            return -1;
-        b->p = q;
-        b->cap = cap;
-    }
-    memcpy(b->p + b->n, data, len);
-    b->n += len;
-    return 0;
-}
 
 #define AW 200
 #define AH 150
@@ -384,7 +366,7 @@ static void test_aerial_accuracy(void **state)
     plx_render_opts o;
     plx_camera c;
     plx_scene_info si;
-    gbuf g = { NULL, 0, 0 };
+    fixture_city g;
     float *with = malloc(sizeof *with * 3 * AW * AH), *without = malloc(sizeof *with * 3 * AW * AH);
     int step = quick_mode() ? 6 : 3, paths = quick_mode() ? 5000 : 40000;
     int maxn = quick_mode() ? 10 : 50, i, j, n = 0, roofs = 0, dark = 0, nlit = 0, k;
@@ -393,14 +375,14 @@ static void test_aerial_accuracy(void **state)
     double dark_old = 0.0;
     (void)state;
     assert_true(with && without && lit);
-    assert_int_equal(plx_gen_city("eixample", 2, 2, 1, gbuf_write, &g), PLX_OK);
+    fixture_gen("eixample", 2, 2, 1, &g);
     port = *plx_port_posix();
     port.log = NULL;
     plx_config_default(&cfg);
     cfg.port = &port;
     assert_int_equal(plx_engine_new((size_t)1 << 29, &cfg, &e), PLX_OK);
-    assert_int_equal(plx_load_geojson(e, g.p, g.n, "eixample-2x2"), PLX_OK);
-    free(g.p);
+    assert_int_equal(plx_load_geojson(e, g.buf, g.len, "eixample-2x2"), PLX_OK);
+    free(g.buf);
     plx_scene_info_get(e, &si);
     memset(&c, 0, sizeof c);
     c.fov_deg = 40.0;

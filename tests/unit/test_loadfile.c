@@ -34,6 +34,7 @@
 #include "polarlux.h"
 #include "polarlux_port.h"
 #include "port.h"
+#include "fixture.h"
 
 static char tmpdir[512];
 
@@ -242,31 +243,9 @@ static plx_port guarded_port(void)
 
 /* ---- the load peak ------------------------------------------------------------- */
 
-typedef struct growing {
-    char *buf;
-    size_t len, cap;
-} growing;
-
-static int grow_write(void *ctx, const char *data, size_t len)
-{
-    growing *g = ctx;
-    if (g->len + len > g->cap) {
-        size_t cap = g->cap ? g->cap : 1u << 20;
-        while (cap < g->len + len)
-            cap *= 2;
-        g->buf = realloc(g->buf, cap);
-        if (!g->buf)
-            return 1;
-        g->cap = cap;
-    }
-    memcpy(g->buf + g->len, data, len);
-    g->len += len;
-    return 0;
-}
-
 /* Loads path (or text when path is NULL) into a fresh engine; the engine's
  * report and the growth of RssAnon in bytes. */
-static void measured_load(const plx_port *port, const char *path, const growing *text, size_t block,
+static void measured_load(const plx_port *port, const char *path, const fixture_city *text, size_t block,
                           plx_memory_report *m, long *anon)
 {
     eng x;
@@ -287,14 +266,14 @@ static void test_map_peak(void **state)
     int quick = getenv("PLX_TEST_QUICK") != NULL, n = quick ? 12 : 86;
     size_t block = quick ? (size_t)8 << 20 : (size_t)64 << 20;
     const char *path = tmp_path("city.geojson");
-    growing g = { NULL, 0, 0 };
+    fixture_city g;
     plx_port mp = quiet_port(), rp = read_port();
     plx_memory_report mm, mt, mr;
     plx_scene_size sz;
     long am, at, ar;
     size_t window;
     (void)state;
-    assert_int_equal(plx_gen_city("eixample", n, n, 1, grow_write, &g), PLX_OK);
+    fixture_gen("eixample", n, n, 1, &g);
     assert_int_equal(plx_scene_size_scan(g.buf, g.len, &sz), PLX_OK);
     write_file(path, g.buf, g.len);
     measured_load(&mp, NULL, &g, block, &mt, &at); /* first: the loader's first run warms up */

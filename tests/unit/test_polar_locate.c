@@ -536,7 +536,7 @@ static void lattice_points(int flags)
             check_point(f->pd, g, p, &st);
         }
     }
-    report(flags & POLAR_BUILD_WIDE_DAG ? "lattice points, 12-byte nodes"
+    report(flags & POLAR_BUILD_WIDE_DAG ? "lattice points, packed nodes"
                                         : "lattice points, 8-byte nodes", &st);
     assert_int_equal(st.dag_scan_diff, 0);
     assert_int_equal(st.brute_bad, 0);

@@ -4,8 +4,8 @@
  * trapezoid slots it takes from the low end for a while) over n stays
  * under POLAR_SCRATCH_PER_VERTEX (polar.h, README "Polar build scratch")
  * plus a constant. Rings of 1,000 to 100,000 vertices (PLX_TEST_QUICK: to
- * 10,000); the 10^6-vertex ring of the issue is printed with
- * PLX_POLAR_RING_BIG=1. */
+ * 10,000), their diagrams checked against brute force at 100 points; the
+ * 10^6-vertex ring of the issue with PLX_POLAR_RING_BIG=1 (about 6 s). */
 #include <stdarg.h>
 #include <stddef.h>
 #include <setjmp.h>
@@ -21,6 +21,7 @@
 #include "base/engine.h"
 #include "base/arena.h"
 #include "polar/polar.h"
+#include "polar/locate.h"
 #include "ref_scene.h"
 
 #define PI 3.14159265358979323846
@@ -31,9 +32,63 @@ static int quick_mode(void)
     return v && v[0] && v[0] != '0';
 }
 
+/* Is p inside the polygon xy of n vertices (crossing number)? */
+static int inside_ring(const double *xy, uint32_t n, double px, double py)
+{
+    uint32_t i, j;
+    int in = 0;
+    for (i = 0, j = n - 1; i < n; j = i++) {
+        double xi = xy[2 * i], yi = xy[2 * i + 1], xj = xy[2 * j], yj = xy[2 * j + 1];
+        if ((yi > py) != (yj > py) && px < xj + (py - yj) * (xi - xj) / (yi - yj))
+            in = !in;
+    }
+    return in;
+}
+
+/* Does the ray from p in direction d meet an edge of the polygon? */
+static int ray_hits_ring(const double *xy, uint32_t n, double px, double py, double dx, double dy)
+{
+    uint32_t i, j;
+    for (i = 0, j = n - 1; i < n; j = i++) {
+        double ax = xy[2 * j] - px, ay = xy[2 * j + 1] - py, bx = xy[2 * i] - px, by = xy[2 * i + 1] - py;
+        double ca = dx * ay - dy * ax, cb = dx * by - dy * bx;   /* across the ray's line */
+        double la = dx * ax + dy * ay, lb = dx * bx + dy * by;   /* along it */
+        if ((ca > 0) != (cb > 0) && la + (lb - la) * (ca / (ca - cb)) > 0)
+            return 1;
+    }
+    return 0;
+}
+
+/* The diagrams of the ring against brute force at 'count' pseudo-random
+ * points: inside the star (polar_locate -3) or in a region labelled with
+ * the building when the quadrant's start ray meets the ring, else the
+ * frame. Returns the number of disagreements. */
+static uint32_t ring_answers(const polar *pd, const double *xy, uint32_t n, uint32_t count)
+{
+    static const double dir[4][2] = { { 1, 0 }, { 0, 1 }, { -1, 0 }, { 0, -1 } };
+    uint32_t k, bad = 0, seed = 12345u;
+    for (k = 0; k < count; k++) {
+        vec2 p;
+        int q, in;
+        seed = seed * 1103515245u + 12345u;
+        p.x = -990.0 + 1980.0 * ((seed >> 8) / 16777216.0);
+        seed = seed * 1103515245u + 12345u;
+        p.y = -990.0 + 1980.0 * ((seed >> 8) / 16777216.0);
+        in = inside_ring(xy, n, p.x, p.y);
+        for (q = 0; q < 4; q++) {
+            int32_t owner, r = polar_locate(pd, q, p, &owner);
+            if (in ? r != -3 : (r < 0 || owner != (ray_hits_ring(xy, n, p.x, p.y, dir[q][0], dir[q][1]) ? 0 : -1)))
+                bad++;
+        }
+    }
+    return bad;
+}
+
 /* Builds the diagrams of a star of n vertices in a block of 'bytes';
- * returns the status and the scratch and kept bytes. */
-static plx_status ring_build(uint32_t n, size_t bytes, size_t *scratch, size_t *kept)
+ * returns the status and the scratch and kept bytes, and with check > 0
+ * the disagreements with brute force at that many points in *bad. */
+static plx_status ring_build_check(uint32_t n, size_t bytes, size_t *scratch, size_t *kept, uint32_t check,
+                                   uint32_t *bad)
 {
     scene s;
     arena a;
@@ -59,10 +114,17 @@ static plx_status ring_build(uint32_t n, size_t bytes, size_t *scratch, size_t *
     *kept = a.used[PLX_PART_POLAR];
     *scratch = a.peak_total - *kept;
     assert_true(a.peak[PLX_PART_SCRATCH] <= *scratch);
+    if (st == PLX_OK && check > 0)
+        *bad = ring_answers(pd, xy, n, check);
     ref_scene_free(&s);
     free(xy);
     free(mem);
     return st;
+}
+
+static plx_status ring_build(uint32_t n, size_t bytes, size_t *scratch, size_t *kept)
+{
+    return ring_build_check(n, bytes, scratch, kept, 0, NULL);
 }
 
 static void test_scratch_per_vertex(void **state)
@@ -71,7 +133,9 @@ static void test_scratch_per_vertex(void **state)
     (void)state;
     for (n = 1000; n <= nmax; n *= 10) {
         size_t scratch, kept;
-        assert_int_equal(ring_build(n, (size_t)1 << 30, &scratch, &kept), PLX_OK);
+        uint32_t bad = 0;
+        assert_int_equal(ring_build_check(n, (size_t)1 << 30, &scratch, &kept, 100, &bad), PLX_OK);
+        assert_int_equal(bad, 0);
         printf("ring of %u vertices: scratch %zu bytes (%.1f a vertex), kept %zu (%.1f a vertex)\n", n, scratch,
                (double)scratch / n, kept, (double)kept / n);
         assert_true(scratch <= (size_t)POLAR_SCRATCH_PER_VERTEX * n + POLAR_SCRATCH_FIXED);
@@ -129,23 +193,26 @@ static void test_scratch_cities(void **state)
 }
 
 /* The block the issue asks for: a 10^6-vertex ring in 256 MiB. Not met:
- * it needs about 405 MB (202 of them kept), so the ring is built in a
- * 400 MiB block (asserted) and tried in 256 MiB (printed); see README
- * "Polar build scratch". */
+ * it needs about 327 MB (172 of them kept; 405 before the packed DAG
+ * nodes), so the ring is built in a 320 MiB block (asserted, its answers
+ * at 200 points against brute force: its DAG nodes are the packed ones)
+ * and tried in 256 MiB (printed); see README "Polar build scratch". */
 static void test_big_ring(void **state)
 {
     const char *v = getenv("PLX_POLAR_RING_BIG");
     size_t scratch, kept;
     plx_status st;
+    uint32_t bad = 0;
     (void)state;
     if (!v || v[0] != '1') {
         printf("10^6-vertex ring: PLX_POLAR_RING_BIG=1 runs it\n");
         return;
     }
-    st = ring_build(1000000, (size_t)400 << 20, &scratch, &kept);
-    printf("10^6-vertex ring in 400 MiB: status %d, scratch %zu bytes, kept %zu, both %zu\n", (int)st,
-           scratch, kept, scratch + kept);
+    st = ring_build_check(1000000, (size_t)320 << 20, &scratch, &kept, 200, &bad);
+    printf("10^6-vertex ring in 320 MiB: status %d, scratch %zu bytes, kept %zu, both %zu; "
+           "%u of 800 answers differ from brute force\n", (int)st, scratch, kept, scratch + kept, bad);
     assert_int_equal(st, PLX_OK);
+    assert_int_equal(bad, 0);
     assert_true(scratch <= (size_t)POLAR_SCRATCH_PER_VERTEX * 1000000 + POLAR_SCRATCH_FIXED);
     st = ring_build(1000000, (size_t)256 << 20, &scratch, &kept);
     printf("10^6-vertex ring in 256 MiB: status %d (%s)\n", (int)st, st == PLX_OK ? "built" : "does not fit");

@@ -26,6 +26,7 @@
 #include "polarlux_port.h"
 #include "port.h"
 #include "base/jsonscan.h"
+#include "fixture.h"
 
 /* ---- the same values as cJSON ----------------------------------------------- */
 
@@ -297,28 +298,6 @@ static void test_app_hooks_survive_a_load(void **state)
 
 /* ---- the load peak (#16) ------------------------------------------------------------ */
 
-typedef struct growing {
-    char *buf;
-    size_t len, cap;
-} growing;
-
-static int grow_write(void *ctx, const char *data, size_t len)
-{
-    growing *g = ctx;
-    if (g->len + len > g->cap) {
-        size_t cap = g->cap ? g->cap : 1u << 20;
-        while (cap < g->len + len)
-            cap *= 2;
-        g->buf = realloc(g->buf, cap);
-        if (!g->buf)
-            return 1;
-        g->cap = cap;
-    }
-    memcpy(g->buf + g->len, data, len);
-    g->len += len;
-    return 0;
-}
-
 static long max_rss_kib(void)
 {
     struct rusage ru;
@@ -330,7 +309,7 @@ static void test_load_peak(void **state)
 {
     int quick = getenv("PLX_TEST_QUICK") != NULL, n = quick ? 12 : 86;
     size_t block = quick ? (size_t)8 << 20 : (size_t)64 << 20; /* the --mem stated */
-    growing g = { NULL, 0, 0 };
+    fixture_city g;
     plx_scene_size sz;
     plx_memory_report m;
     plx_engine *e;
@@ -338,7 +317,7 @@ static void test_load_peak(void **state)
     size_t window;
     long rss0, rss1;
     (void)state;
-    assert_int_equal(plx_gen_city("eixample", n, n, 1, grow_write, &g), PLX_OK);
+    fixture_gen("eixample", n, n, 1, &g);
     assert_int_equal(plx_scene_size_scan(g.buf, g.len, &sz), PLX_OK);
     plx_config_default(&cfg);
     assert_int_equal(plx_engine_new(block, &cfg, &e), PLX_OK);
