@@ -123,7 +123,8 @@ static uint32_t layout_print(void)
                           sizeof(render_stats), sizeof(icache), sizeof(polar), sizeof(polar_trap),
                           PLX_PART_COUNT, sizeof(mesh), sizeof(mesh_bld),
                           sizeof(mesh_surf), RENDER_SURF_CACHE,
-                          2 /* the polar DAG's wide nodes bit-packed (not a size: bump on such changes) */ };
+                          3 /* format changes that keep the sizes (bump on such changes): 2 the polar
+                               DAG's wide nodes bit-packed, 3 aerial records keyed apart, 8 m */ };
     uint64_t h = FNV_BASIS;
     size_t i;
     for (i = 0; i < sizeof sz / sizeof sz[0]; i++)
