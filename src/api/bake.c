@@ -123,7 +123,8 @@ static uint32_t layout_print(void)
                           sizeof(render_stats), sizeof(icache), sizeof(polar), sizeof(polar_trap),
                           PLX_PART_COUNT, sizeof(mesh), sizeof(mesh_bld),
                           sizeof(mesh_surf), RENDER_SURF_CACHE,
-                          2 /* the polar DAG's wide nodes bit-packed (not a size: bump on such changes) */ };
+                          3 /* format changes that keep the sizes (bump on such changes): 2 the polar
+                               DAG's wide nodes bit-packed, 3 aerial records keyed apart, 8 m */ };
     uint64_t h = FNV_BASIS;
     size_t i;
     for (i = 0; i < sizeof sz / sizeof sz[0]; i++)
@@ -180,10 +181,18 @@ typedef struct bake_layout {
 
 static plx_status scan(plx_engine *e, plx_engine *t, unsigned char *out, bake_layout *L);
 
+/* What make_savable takes out of an engine, put back by restore_code. */
+typedef struct savable_keep {
+    plx_port port;
+    uint64_t polar_ns, load_ns;   /* times measured while baking: not saved, so that
+                                     two bakes of a scene are the same bytes */
+} savable_keep;
+
 /* Clears what must not be saved: cached lamp regions (pointers inside the
  * pool, rebuilt on demand), code addresses (the renderer's, the port's),
- * the last region read. *keep gets the port back for restore_code. */
-static void make_savable(plx_engine *e, plx_port *keep)
+ * the last region read, the build times. *keep gets them back for
+ * restore_code. */
+static void make_savable(plx_engine *e, savable_keep *keep)
 {
     if (e->lt) {
         light_cache_clear(e->lt);
@@ -193,22 +202,31 @@ static void make_savable(plx_engine *e, plx_port *keep)
     if (e->rd)
         render_code_unbind(e->rd);
     e->lit_last = NULL;
-    *keep = e->port;
+    keep->port = e->port;
     memset(&e->port, 0, sizeof e->port);
+    keep->polar_ns = e->polar_ns;
+    e->polar_ns = 0;
+    keep->load_ns = e->sc ? e->sc->load_ns : 0;
+    if (e->sc)
+        e->sc->load_ns = 0;
 }
 
-static void restore_code(plx_engine *e, const plx_port *keep)
+static void restore_code(plx_engine *e, const savable_keep *keep)
 {
     if (e->rd)
         render_code_bind(e->rd, render_shade_light);
-    if (keep)
-        e->port = *keep;
+    if (keep) {
+        e->port = keep->port;
+        e->polar_ns = keep->polar_ns;
+        if (e->sc)
+            e->sc->load_ns = keep->load_ns;
+    }
 }
 
 /* Scans (and writes when out is given) with both engines made savable. */
 static plx_status scan_savable(plx_engine *e, plx_engine *t, unsigned char *out, bake_layout *L)
 {
-    plx_port pe, pt;
+    savable_keep pe, pt;
     plx_status st;
     make_savable(e, &pe);
     make_savable(t, &pt);

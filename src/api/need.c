@@ -171,11 +171,18 @@ static plx_status need_photon(plx_engine *e)
     return PLX_OK;
 }
 
+void eng_render_max(const plx_engine *e, int32_t *w, int32_t *h)
+{
+    *w = e->cfg.render_max_width ? e->cfg.render_max_width : DEFAULT_MAX_W;
+    *h = e->cfg.render_max_height ? e->cfg.render_max_height : DEFAULT_MAX_H;
+}
+
 static plx_status need_render(plx_engine *e)
 {
-    int32_t w = e->cfg.render_max_width ? e->cfg.render_max_width : DEFAULT_MAX_W;
-    int32_t h = e->cfg.render_max_height ? e->cfg.render_max_height : DEFAULT_MAX_H;
-    plx_status st = render_create(&e->mem, e->sc, w, h, render_shade_light, e->lt, &e->rd);
+    int32_t w, h;
+    plx_status st;
+    eng_render_max(e, &w, &h);
+    st = render_create(&e->mem, e->sc, w, h, render_shade_light, e->lt, &e->rd);
     if (st == PLX_E_NOMEM)
         return eng_nomem(e, "creating the renderer (frame buffers and mesh)");
     if (st != PLX_OK)

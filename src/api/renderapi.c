@@ -292,6 +292,28 @@ static plx_status render_aa(plx_engine *e, const render_camera *rc, render_opts 
     return PLX_OK;
 }
 
+/* PLX_E_INVALID, saying the sizes, when the camera's frame is empty or
+ * larger than the engine's renderer draws. */
+static plx_status frame_fits(plx_engine *e, const plx_camera *cam)
+{
+    int32_t w, h;
+    strbuf b;
+    eng_render_max(e, &w, &h);
+    if (cam->width >= 1 && cam->height >= 1 && cam->width <= w && cam->height <= h)
+        return PLX_OK;
+    sb_init(&b, e->err, sizeof e->err);
+    sb_str(&b, "plx_render: a ");
+    sb_int(&b, cam->width);
+    sb_str(&b, "x");
+    sb_int(&b, cam->height);
+    sb_str(&b, " frame is outside 1x1 .. ");
+    sb_int(&b, w);
+    sb_str(&b, "x");
+    sb_int(&b, h);
+    sb_str(&b, ", the largest this engine draws (plx_config.render_max_width/height; a bake's --max-size)");
+    return PLX_E_INVALID;
+}
+
 plx_status plx_render(plx_engine *e, const plx_camera *cam, const plx_render_opts *o, uint8_t *rgb8,
                       float *rgbf, plx_render_info *info)
 {
@@ -314,6 +336,8 @@ plx_status plx_render(plx_engine *e, const plx_camera *cam, const plx_render_opt
     }
     st = eng_need(e, ENG_RENDER, "plx_render");
     if (st != PLX_OK)
+        return st;
+    if ((st = frame_fits(e, cam)) != PLX_OK)
         return st;
     if (o->aerial && e->lightmap_cell != 0.0 && !o->no_indirect && e->ic && e->ph && plx_indirect_frames(e) > 0) {
         /* built before the photons: its indirect layer gathered now;

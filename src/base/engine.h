@@ -61,6 +61,9 @@ double eng_indirect_rgb(plx_engine *e, const double P[3], const double n[3], dou
 plx_status eng_need_vis_buffers(plx_engine *e);
 /* Creates the renderer on first need (renderapi.c). */
 plx_status eng_need_render(plx_engine *e);
+/* The largest frame the engine's renderer draws (plx_config.render_max_*,
+ * their defaults for 0; a bake's as it was made). */
+void eng_render_max(const plx_engine *e, int32_t *w, int32_t *h);
 /* Builds the aerial light map at m_per_texel metres (0: 1 m) unless built;
  * dark: with a shader giving no light (the bake's twin, bake.c). */
 plx_status eng_need_lightmap(plx_engine *e, double m_per_texel, int dark);

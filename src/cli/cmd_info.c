@@ -187,14 +187,19 @@ int cmd_info(int argc, char **argv)
                gi.bounds_given ? "" : " (the bounds)", gi.mean_albedo[0], gi.mean_albedo[1],
                gi.mean_albedo[2], gi.mean_luminance);
     print_photometry(e, si.lamps);
-    printf("load time: %.2f ms\n", si.load_ns / 1e6);
+    if (!cli_bake_last.loaded) /* a bake's line below says how long it took */
+        printf("load time: %.2f ms\n", si.load_ns / 1e6);
     if (cli_bake_last.loaded)
         printf("bake: %zu bytes (%.1f MB) loaded in %.2f ms (read, check, copy, relocate)\n", cli_bake_last.bytes,
                cli_bake_last.bytes / 1048576.0, cli_bake_last.load_ns / 1e6);
     if (plx_polar_info_get(e, &pi) == PLX_OK) {
-        printf("polar diagrams: built in %.2f ms; %zu bytes = axes %zu + regions %zu + polygons %zu + rest (search DAGs) %zu"
+        if (pi.build_ns == 0 && cli_bake_last.loaded)
+            printf("polar diagrams: from the bake; ");
+        else
+            printf("polar diagrams: built in %.2f ms; ", pi.build_ns / 1e6);
+        printf("%zu bytes = axes %zu + regions %zu + polygons %zu + rest (search DAGs) %zu"
                " (%.1f bytes per footprint vertex); regions per quadrant %u %u %u %u\n",
-               pi.build_ns / 1e6, pi.total, pi.axes, pi.regions, pi.polygons, pi.rest,
+               pi.total, pi.axes, pi.regions, pi.polygons, pi.rest,
                pi.vertices ? (double)pi.total / pi.vertices : 0.0, pi.nregions[0], pi.nregions[1],
                pi.nregions[2], pi.nregions[3]);
     } else {

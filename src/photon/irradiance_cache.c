@@ -82,7 +82,11 @@ void icache_set_view(icache *c, const double eye[3])
 
 void icache_set_spacing(icache *c, double s)
 {
+    uint32_t side = s > 0.0 ? ICACHE_AERIAL_SIDE : ICACHE_SIDE;
     c->fixed = s > 0.0 ? s : 0.0;
+    if (side != c->side) /* the last cells hold the other kind's records */
+        memset(c->last, 0, sizeof c->last);
+    c->side = side;
 }
 
 static void flush(icache *c)
@@ -201,8 +205,8 @@ static int vertex_valid(tracer *T, const plane *pl, const double Q[3])
 static const icache_rec *record(icache *c, photon_sys *ps, light *L, const plane *pl, int l,
                                 int64_t i, int64_t j)
 {
-    uint64_t k2 = ((uint64_t)l << 58) | (((uint64_t)(i + COORD_BIAS) & COORD_MASK) << 29) |
-                  ((uint64_t)(j + COORD_BIAS) & COORD_MASK);
+    uint64_t k2 = ((uint64_t)(c->side != ICACHE_SIDE) << 62) | ((uint64_t)l << 58) |
+                  (((uint64_t)(i + COORD_BIAS) & COORD_MASK) << 29) | ((uint64_t)(j + COORD_BIAS) & COORD_MASK);
     uint32_t mask = c->nrec - 1, at;
     icache_rec *r;
     double Q[3], rgb[3];

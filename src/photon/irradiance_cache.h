@@ -29,7 +29,9 @@
  * (aerial views read the photon buffers).
  *
  * VIEWS FROM ABOVE (icache_set_spacing). The aerial light map's indirect
- * layer uses one level, ICACHE_AERIAL (4 m) everywhere, and never the
+ * layer uses one level, ICACHE_AERIAL (8 m) everywhere, records of
+ * ICACHE_AERIAL_SIDE^2 directions (kept apart from the street views'
+ * records of the same level: their own key bit), and never the
  * photon buffers for points with a grid: light stays on the surface it was
  * gathered on (the records' grids respect walls and roof edges), where the
  * buffers' coarse records spread it 100 m. (Aerial frames read the layer
@@ -78,8 +80,10 @@
 #define ICACHE_LEVEL_SEG 4    /* from 4 m on, a ground vertex behind a wall is left out */
 #define ICACHE_RECORDS 65536  /* table slots at most (a power of two: 2 MiB) */
 #define ICACHE_RECORDS_MIN 1024 /* and at least (32 KiB); icache_records_for */
-#define ICACHE_AERIAL 4.0     /* spacing for the aerial map's layer, m (icache_set_spacing;
-                                 8 m gathers a quarter of the records, less accurately) */
+#define ICACHE_AERIAL 8.0     /* spacing for the aerial map's layer, m (icache_set_spacing) */
+#define ICACHE_AERIAL_SIDE 24 /* and its records' gather side: 24 x 24 (README "Aerial
+                                 views' indirect light": more accurate than 4 m and 16 x 16,
+                                 and a third less work) */
 
 typedef struct icache_rec icache_rec;
 

@@ -572,29 +572,41 @@ double photon_gather_wide(const float *flux, const float *area, const float *hei
                           uint32_t w, uint32_t h, int wrap, double fx, double fy, double r,
                           double e[PHOTON_CH])
 {
-    grid g = grid_full(area, height, NULL, z, w, h, wrap);
-    double sf[PHOTON_CH] = {0.0, 0.0, 0.0, 0.0}, sa = 0.0;
+    double sf[PHOTON_CH] = {0.0, 0.0, 0.0, 0.0}, sa = 0.0, r2 = r * r;
     int ri = (int)ceil(r), ci = (int)floor(fx), cj = (int)floor(fy), a, b, c;
-    if (r <= 0.0 || !(fx > -2.0 && fy > -2.0 && fx < (double)w + 2.0 && fy < (double)h + 2.0))
+    if (r <= 0.0 || !(fx > -2.0 && fy > -2.0 && fx < (double)w + 2.0 && fy < (double)h + 2.0)) {
+        grid g = grid_full(area, height, NULL, z, w, h, wrap);
         return gather_any(flux, &g, fx, fy, e);
-    for (b = cj - ri; b <= cj + ri; b++)
+    }
+    /* rows in order, each texel's terms as gvalid and texel_area give them */
+    for (b = cj - ri < 0 ? 0 : cj - ri; b <= cj + ri && b < (int)h; b++) {
+        double dy = b + 0.5 - fy, dy2 = dy * dy;
+        size_t row = (size_t)b * w;
         for (a = ci - ri; a <= ci + ri; a++) {
-            double dx = a + 0.5 - fx, dy = b + 0.5 - fy, d2 = dx * dx + dy * dy, wt;
+            double dx = a + 0.5 - fx, d2 = dx * dx + dy2, wt, ar;
+            const float *f;
             int i;
             size_t k;
-            if (d2 >= r * r || b < 0 || b >= (int)h)
+            if (d2 >= r2)
                 continue;
             i = column(a, w, wrap);
-            if (i < 0 || !gvalid(&g, i, b))
+            if (i < 0)
+                continue;
+            k = row + (size_t)i;
+            ar = (double)area[k];
+            if (!(area[k] > 0.0f) || (height && fabs((double)height[k] - z) > HEIGHT_TOL))
                 continue;
             wt = 1.0 - sqrt(d2) / r;
-            k = (size_t)b * w + (size_t)i;
+            f = flux + k * PHOTON_CH;
             for (c = 0; c < PHOTON_CH; c++)
-                sf[c] += wt * flux[k * PHOTON_CH + (size_t)c];
-            sa += wt * texel_area(&g, k);
+                sf[c] += wt * f[c];
+            sa += wt * ar;
         }
-    if (!(sa > 0.0))
+    }
+    if (!(sa > 0.0)) {
+        grid g = grid_full(area, height, NULL, z, w, h, wrap);
         return gather_any(flux, &g, fx, fy, e);
+    }
     for (c = 0; c < PHOTON_CH; c++)
         e[c] = sf[c] / sa;
     return e[0];
