@@ -42,14 +42,30 @@ static inline uint64_t *nchunk_of(const dbuild *b, uint32_t n, uint64_t *off, in
     return b->chunk[n >> NODE_BITS];
 }
 
-/* bits_get without its branch (a chunk has a word more at its end): the
- * descent reads two fields a node, at offsets the data decides. */
-static inline uint32_t field_get(const uint64_t *w, uint64_t off, uint32_t width)
+/* A field of 1 to 63 bits at bit off of w[], read and written without a
+ * branch (a chunk has a word more at its end; the offsets are the data's,
+ * so a branch on them would be mispredicted often). */
+static inline uint64_t field_get(const uint64_t *w, uint64_t off, uint32_t width)
 {
     size_t i = (size_t)(off >> 6);
     uint32_t sh = (uint32_t)(off & 63);
     uint64_t x = (w[i] >> sh) | ((w[i + 1] << 1) << (63 - sh));
-    return (uint32_t)(x & (((uint64_t)1 << width) - 1));
+    return x & (((uint64_t)1 << width) - 1);
+}
+
+static inline void field_set(uint64_t *w, uint64_t off, uint32_t width, uint64_t v)
+{
+    size_t i = (size_t)(off >> 6);
+    uint32_t sh = (uint32_t)(off & 63);
+    uint64_t mask = ((uint64_t)1 << width) - 1;
+    w[i] = (w[i] & ~(mask << sh)) | v << sh;
+    w[i + 1] = (w[i + 1] & ~((mask >> 1) >> (63 - sh))) | ((v >> 1) >> (63 - sh));
+}
+
+/* The test of a packed node (its first field) as kind << 30 | index. */
+static inline uint32_t unpack_test(const dbuild *b, uint32_t v)
+{
+    return PACK(v >> (b->tb - 2), v & ((1u << (b->tb - 2)) - 1));
 }
 
 /* The test of the node at off in chunk w, as kind << 30 | index. */
@@ -58,8 +74,8 @@ static inline uint32_t ntest(const dbuild *b, const uint64_t *w, uint64_t off, i
     uint32_t v;
     if (!packed)
         return ((const uint32_t *)(const void *)w)[off];
-    v = field_get(w, off, b->tb);
-    return PACK(v >> (b->tb - 2), v & ((1u << (b->tb - 2)) - 1));
+    v = (uint32_t)field_get(w, off, b->tb);
+    return unpack_test(b, v);
 }
 
 /* Its child k (0, 1). */
@@ -68,22 +84,11 @@ static inline uint32_t nchild(const dbuild *b, const uint64_t *w, uint64_t off, 
 {
     if (!packed)
         return ((const uint32_t *)(const void *)w)[off + 1 + (k ? 1 : 0)];
-    return field_get(w, off + b->tb + (k ? b->cb : 0), b->cb);
-}
-
-/* Sets a field of bits_get's form (v below 2^width). */
-static void field_set(uint64_t *w, uint64_t off, uint32_t width, uint32_t v)
-{
-    size_t i = (size_t)(off >> 6);
-    uint32_t sh = (uint32_t)(off & 63);
-    uint64_t mask = ((uint64_t)1 << width) - 1;
-    w[i] = (w[i] & ~(mask << sh)) | (uint64_t)v << sh;
-    if (sh + width > 64)
-        w[i + 1] = (w[i + 1] & ~(mask >> (64 - sh))) | (uint64_t)v >> (64 - sh);
+    return (uint32_t)field_get(w, off + b->tb + (k ? b->cb : 0), b->cb);
 }
 
 /* Build node n becomes test t (kind << 30 | index), children c0, c1. */
-static void nset(const dbuild *b, uint32_t n, uint32_t t, uint32_t c0, uint32_t c1)
+static inline void nset(const dbuild *b, uint32_t n, uint32_t t, uint32_t c0, uint32_t c1)
 {
     uint64_t off;
     uint64_t *w = nchunk_of(b, n, &off, b->packed);
@@ -94,8 +99,8 @@ static void nset(const dbuild *b, uint32_t n, uint32_t t, uint32_t c0, uint32_t 
         nd[2] = c1;
         return;
     }
-    field_set(w, off, b->tb, KIND(t) << (b->tb - 2) | IDX(t));
-    field_set(w, off + b->tb, b->cb, c0);
+    /* the test and the first child in one field (tb + cb < 64) */
+    field_set(w, off, b->tb + b->cb, (uint64_t)(KIND(t) << (b->tb - 2) | IDX(t)) | (uint64_t)c0 << b->tb);
     field_set(w, off + b->tb + b->cb, b->cb, c1);
 }
 
@@ -199,14 +204,21 @@ typedef struct irec {
 static inline uint32_t descend(dbuild *b, uint32_t n, vec2 A, vec2 D, int ties_left, int packed)
 {
     for (;; b->steps++) {
-        uint64_t off;
+        uint64_t off, v = 0;
         const uint64_t *cw = nchunk_of(b, n, &off, packed);
-        uint32_t w = ntest(b, cw, off, packed);
+        uint32_t w;
+        int right;
+        if (packed) {
+            v = field_get(cw, off, b->tb + b->cb);   /* the test and child 0 */
+            w = unpack_test(b, (uint32_t)v & ((1u << b->tb) - 1));
+        } else {
+            w = ntest(b, cw, off, 0);
+        }
         if (KIND(w) == N_LEAF)
             return IDX(w);
         if (KIND(w) == N_X) {
             int c = lex_cmp(A, bpt(b, IDX(w)));
-            n = nchild(b, cw, off, !(c < 0 || (ties_left && c == 0)), packed);
+            right = !(c < 0 || (ties_left && c == 0));
         } else {
             vec2 g0 = pend(b->pd, b->frame, b->SR, IDX(w), 0);
             vec2 g1 = pend(b->pd, b->frame, b->SR, IDX(w), 1);
@@ -217,8 +229,9 @@ static inline uint32_t descend(dbuild *b, uint32_t n, vec2 A, vec2 D, int ties_l
                 b->fail = 2;
                 return POLAR_NONE;
             }
-            n = nchild(b, cw, off, o > 0, packed);
+            right = o > 0;
         }
+        n = packed && !right ? (uint32_t)(v >> b->tb) : nchild(b, cw, off, right, packed);
     }
 }
 
@@ -625,7 +638,7 @@ plx_status polar_dag_words(arena *a, dbuild *b, dag_rank *rk)
     memset(rk->bits, 0, (size_t)nw64 * 8);
     for (i = 0; i < b->nnode; i++) {
         uint64_t off;
-        const uint64_t *cw = nchunk_of(b, i, &off, b->packed);
+        uint64_t *cw = nchunk_of(b, i, &off, b->packed);
         uint32_t t = ntest(b, cw, off, b->packed), c;
         if ((i & 63) == 0)
             rk->before[i >> 6] = nq;
@@ -638,7 +651,11 @@ plx_status polar_dag_words(arena *a, dbuild *b, dag_rank *rk)
         c = b->T[IDX(t)].leaf;
         if (POLAR_TAG(c) == POLAR_CHILD_NODE || (uint64_t)POLAR_IDX(c) >> b->cb)
             return PLX_E_SCENE;
-        nset(b, i, t, POLAR_TAG(c), POLAR_IDX(c));
+        if (b->packed)
+            field_set(cw, off + b->tb, 2 * b->cb,
+                      POLAR_TAG(c) | (uint64_t)POLAR_IDX(c) << b->cb);
+        else
+            nset(b, i, t, POLAR_TAG(c), POLAR_IDX(c));
     }
     rk->nq = nq;
     return PLX_OK;
@@ -916,8 +933,8 @@ plx_status polar_dag_build(arena *a, polar *pd, polar_map *m, dbuild *b,
             kids = (uint64_t)pd->nbld + 1;
         b->tb = 2 + bits_for(most);
         b->cb = bits_for(kids);
-        if (b->tb > 32)
-            return PLX_E_NOMEM;
+        if (b->tb + b->cb > 63 || 2 * b->cb > 63)
+            return PLX_E_NOMEM;   /* cannot happen: indices fit in 26 bits */
         b->packed = nw > PACKED_NODES_FROM || (flags & POLAR_BUILD_WIDE_DAG);
         b->stride = b->packed ? b->tb + 2 * b->cb : 3;
         b->cwords = b->packed ? ((size_t)NODE_CHUNK * b->stride + 63) / 64 + 1
