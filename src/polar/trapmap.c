@@ -87,21 +87,29 @@ static inline uint32_t nchild(const dbuild *b, const uint64_t *w, uint64_t off, 
     return (uint32_t)field_get(w, off + b->tb + (k ? b->cb : 0), b->cb);
 }
 
+/* Packed build node n becomes test t, children c0, c1 (see nset). */
+static void nset_packed(const dbuild *b, uint32_t n, uint32_t t, uint32_t c0, uint32_t c1)
+{
+    uint64_t off;
+    uint64_t *w = nchunk_of(b, n, &off, 1);
+    /* the test and the first child in one field (tb + cb < 64) */
+    field_set(w, off, b->tb + b->cb, (uint64_t)(KIND(t) << (b->tb - 2) | IDX(t)) | (uint64_t)c0 << b->tb);
+    field_set(w, off + b->tb + b->cb, b->cb, c1);
+}
+
 /* Build node n becomes test t (kind << 30 | index), children c0, c1. */
 static inline void nset(const dbuild *b, uint32_t n, uint32_t t, uint32_t c0, uint32_t c1)
 {
     uint64_t off;
-    uint64_t *w = nchunk_of(b, n, &off, b->packed);
-    if (!b->packed) {
-        uint32_t *nd = (uint32_t *)(void *)w + off;
-        nd[0] = t;
-        nd[1] = c0;
-        nd[2] = c1;
+    uint32_t *nd;
+    if (b->packed) {
+        nset_packed(b, n, t, c0, c1);
         return;
     }
-    /* the test and the first child in one field (tb + cb < 64) */
-    field_set(w, off, b->tb + b->cb, (uint64_t)(KIND(t) << (b->tb - 2) | IDX(t)) | (uint64_t)c0 << b->tb);
-    field_set(w, off + b->tb + b->cb, b->cb, c1);
+    nd = (uint32_t *)(void *)nchunk_of(b, n, &off, 0) + off;
+    nd[0] = t;
+    nd[1] = c0;
+    nd[2] = c1;
 }
 
 static vec2 bpt(const dbuild *b, uint32_t i)
