@@ -87,6 +87,24 @@ static inline uint32_t nchild(const dbuild *b, const uint64_t *w, uint64_t off, 
     return (uint32_t)field_get(w, off + b->tb + (k ? b->cb : 0), b->cb);
 }
 
+/* Build node n: its test (kind << 30 | index) and children. */
+static inline void nread(const dbuild *b, uint32_t n, uint32_t *t, uint32_t c[2])
+{
+    uint64_t off, v;
+    const uint64_t *w = nchunk_of(b, n, &off, b->packed);
+    if (!b->packed) {
+        const uint32_t *nd = (const uint32_t *)(const void *)w + off;
+        *t = nd[0];
+        c[0] = nd[1];
+        c[1] = nd[2];
+        return;
+    }
+    v = field_get(w, off, b->tb + b->cb);
+    *t = unpack_test(b, (uint32_t)v & ((1u << b->tb) - 1));
+    c[0] = (uint32_t)(v >> b->tb);
+    c[1] = (uint32_t)field_get(w, off + b->tb + b->cb, b->cb);
+}
+
 /* Packed build node n becomes test t, children c0, c1 (see nset). */
 static void nset_packed(const dbuild *b, uint32_t n, uint32_t t, uint32_t c0, uint32_t c1)
 {
@@ -685,9 +703,9 @@ static uint32_t child_word(const dbuild *b, const dag_rank *rk, uint32_t c)
     if (w >> (c & 63) & 1)
         return PACK(POLAR_CHILD_NODE, rk->before[c >> 6] + popcount64(w & below));
     {
-        uint64_t off;
-        const uint64_t *cw = nchunk_of(b, c, &off, b->packed);
-        return PACK(nchild(b, cw, off, 0, b->packed), nchild(b, cw, off, 1, b->packed));
+        uint32_t t, k[2];
+        nread(b, c, &t, k);
+        return PACK(k[0], k[1]);
     }
 }
 
@@ -777,13 +795,11 @@ plx_status polar_dag_keep(arena *a, polar *pd, polar_map *m, dbuild *b, const da
         return PLX_E_NOMEM;
     }
     for (i = 0, j = 0; i < b->nnode; i++) {
-        uint64_t off;
-        const uint64_t *cw = nchunk_of(b, i, &off, b->packed);
-        uint32_t t = ntest(b, cw, off, b->packed);
-        if (KIND(t) == N_LEAF)
-            continue;
-        put_node(m, j++, t, child_word(b, rk, nchild(b, cw, off, 0, b->packed)),
-                 child_word(b, rk, nchild(b, cw, off, 1, b->packed)));
+        uint32_t t, c[2];
+        if (!(rk->bits[i >> 6] >> (i & 63) & 1))
+            continue;             /* a leaf */
+        nread(b, i, &t, c);
+        put_node(m, j++, t, child_word(b, rk, c[0]), child_word(b, rk, c[1]));
     }
     m->root = child_word(b, rk, 0);
     return PLX_OK;
