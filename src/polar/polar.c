@@ -88,6 +88,8 @@ plx_status polar_build_flags(arena *a, const scene *s, int flags, polar **out)
         st = polar_incidence(a, pd, &inc_first, &inc, &nev);
     if (st == PLX_OK)
         st = polar_insertion_order(a, pd, &order);
+    if (pd->nwall > PACKED_NODES_FROM && arena_free_bytes(a) / PACKED_NODES_ROOM < pd->nwall)
+        flags |= POLAR_BUILD_PACKED;
     for (i = 0; st == PLX_OK && i < 2; i++) {
         arena_mark mm = arena_get_mark(a);
         pd->map[i].frame = (int)i;

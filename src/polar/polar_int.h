@@ -191,10 +191,17 @@ typedef struct snode {
 
 #define NODE_BITS 12
 #define NODE_CHUNK (1u << NODE_BITS)
-/* Search nodes are packed in bits while built beyond this many pieces
- * (slower to read and write, a quarter smaller: README "Polar build
- * scratch"). */
+/* Search nodes are packed in bits while built (a quarter smaller, 15%
+ * slower to build: README "Polar build scratch") in both maps beyond this
+ * many pieces when the block has less than PACKED_NODES_ROOM bytes a
+ * piece left for the maps (what they take with three-word nodes: the
+ * first map kept, about 70 bytes a piece, and the second's build, about
+ * 205: 8 nodes of 12 bytes, 2 slots of 36, the pieces' and points' roles
+ * and sweep data; 275 on the 10^6-vertex ring); POLAR_BUILD_PACKED
+ * (polar_map_build's flags) says so. */
 #define PACKED_NODES_FROM (1u << 17)
+#define PACKED_NODES_ROOM 288u
+enum { POLAR_BUILD_PACKED = 1 << 8 };
 
 typedef struct dbuild {
     const polar *pd;
@@ -209,8 +216,8 @@ typedef struct dbuild {
     arena_mark tmark;        /* the arena before the slots */
     uint64_t **chunk;        /* nodes in chunks of NODE_CHUNK (scratch):
                               * three 32-bit words (the test kind << 30 |
-                              * index, two children), or with more than
-                              * PACKED_NODES_FROM pieces packed in bits: the
+                              * index, two children), or (PACKED_NODES_FROM)
+                              * packed in bits: the
                               * test as kind << (tb - 2) | index and the
                               * children in cb bits each */
     uint32_t nchunk, maxchunk, nnode;

@@ -918,8 +918,9 @@ static void prefetch_ahead(const dbuild *b, uint32_t i, uint32_t nw)
 /* Builds the trapezoidal map of the wall pieces of m and its search DAG by
  * randomized incremental insertion, into b (scratch, the trapezoid slots
  * in the low end of the arena). SR: the pieces' canonical ends (pend),
- * the rest of it unset. The nodes are packed in bits beyond
- * PACKED_NODES_FROM pieces or with POLAR_BUILD_WIDE_DAG in flags. */
+ * the rest of it unset. The nodes are packed in bits with
+ * POLAR_BUILD_PACKED (a large scene in a tight block, PACKED_NODES_FROM)
+ * or POLAR_BUILD_WIDE_DAG in flags. */
 plx_status polar_dag_build(arena *a, polar *pd, polar_map *m, dbuild *b,
                            sroles *SR, const uint32_t *order, uint32_t span, int flags)
 {
@@ -959,7 +960,7 @@ plx_status polar_dag_build(arena *a, polar *pd, polar_map *m, dbuild *b,
         b->cb = bits_for(kids);
         if (b->tb + b->cb > 63 || 2 * b->cb > 63)
             return PLX_E_NOMEM;   /* cannot happen: indices fit in 26 bits */
-        b->packed = nw > PACKED_NODES_FROM || (flags & POLAR_BUILD_WIDE_DAG);
+        b->packed = (flags & (POLAR_BUILD_PACKED | POLAR_BUILD_WIDE_DAG)) != 0;
         b->stride = b->packed ? b->tb + 2 * b->cb : 3;
         b->cwords = b->packed ? ((size_t)NODE_CHUNK * b->stride + 63) / 64 + 1
                               : (size_t)NODE_CHUNK * 3 / 2;
