@@ -475,7 +475,8 @@ static uint32_t *region_slots(arena *a, const polar *pd, const dbuild *b, uint32
  * sorted events (4 a point); the sort's buffers and canonical indices
  * (given back before the insertion); the insertion's hints and roles (4 +
  * 8 a point), lists (by the longest piece) and search nodes (12 bytes
- * each, about 6 a piece, chunks); its trapezoid slots (36 bytes, about 2 a
+ * each, or packed in bits for a large scene in a tight block, about 6 a
+ * piece, chunks); its trapezoid slots (36 bytes, about 2 a
  * piece) in the low end of the arena. The sweep's regions live in those
  * slots (regd: 4 bytes per live trapezoid names them), and are kept in
  * place (polar_keep_regions) before the search nodes are (scratch).
