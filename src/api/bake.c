@@ -186,6 +186,8 @@ typedef struct savable_keep {
     plx_port port;
     uint64_t polar_ns, load_ns;   /* times measured while baking: not saved, so that
                                      two bakes of a scene are the same bytes */
+    uint64_t ic_gathered, ic_direct, ic_flushes; /* the counters, given back */
+    light_stats lt_st;
 } savable_keep;
 
 /* Clears what must not be saved: cached lamp regions (pointers inside the
@@ -194,8 +196,15 @@ typedef struct savable_keep {
  * restore_code. */
 static void make_savable(plx_engine *e, savable_keep *keep)
 {
+    if (e->ic) { /* records do not depend on who gathers them: none saved */
+        keep->ic_gathered = e->ic->gathered;
+        keep->ic_direct = e->ic->direct;
+        keep->ic_flushes = e->ic->flushes;
+        icache_clear(e->ic);
+    }
     if (e->lt) {
-        light_cache_clear(e->lt);
+        keep->lt_st = e->lt->st;
+        light_cache_reset(e->lt);
         if (e->lt->pool)
             memset(e->lt->pool, 0, e->lt->pool_cap);
     }
@@ -216,6 +225,13 @@ static void restore_code(plx_engine *e, const savable_keep *keep)
     if (e->rd)
         render_code_bind(e->rd, render_shade_light);
     if (keep) {
+        if (e->ic) {
+            e->ic->gathered = keep->ic_gathered;
+            e->ic->direct = keep->ic_direct;
+            e->ic->flushes = keep->ic_flushes;
+        }
+        if (e->lt)
+            e->lt->st = keep->lt_st;
         e->port = keep->port;
         e->polar_ns = keep->polar_ns;
         if (e->sc)

@@ -1578,6 +1578,14 @@ void light_cache_clear(light *L)
     L->pool_end = 0;
 }
 
+void light_cache_reset(light *L)
+{
+    light_cache_clear(L);
+    memset(&L->st, 0, sizeof L->st);
+    memset(L->stamp, 0, sizeof *L->stamp * (L->s->nbld + 1));
+    L->stamp_now = 0; /* the next visit is 1: no building is marked */
+}
+
 /* ---- visibility through a region --------------------------------------------------- */
 
 static int band_blocks(const lit_region *r, const lit_band *b, const scene_building *bd,

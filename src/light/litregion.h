@@ -64,5 +64,8 @@ int light_region_visible(light *L, const lit_region *r, const double P[3]);
 
 /* Drops every cached region. */
 void light_cache_clear(light *L);
+/* The same, and the counters and visit marks back to zero: the object as
+ * a fresh one (a bake saves it so, whatever was computed before). */
+void light_cache_reset(light *L);
 
 #endif

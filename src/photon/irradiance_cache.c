@@ -97,6 +97,13 @@ static void flush(icache *c)
     c->flushes++;
 }
 
+void icache_clear(icache *c)
+{
+    flush(c);
+    c->stamp = 0;
+    c->gathered = c->direct = c->flushes = 0;
+}
+
 static uint64_t dbits(double x)
 {
     uint64_t b;

@@ -127,6 +127,10 @@ size_t icache_bytes(uint32_t nrec);
  * arena; PLX_E_NOMEM when it does not fit. */
 plx_status icache_create(arena *a, uint32_t nrec, icache **out /* OUT */);
 
+/* Empty, as created (records, counters): what a bake saves, so that the
+ * file does not depend on which worker gathered what. */
+void icache_clear(icache *c);
+
 /* The viewer for the lookups that follow: the grid spacing asked for at
  * distance d from it is kappa d, at least smin. Records already made stay
  * valid. */
