@@ -7,13 +7,16 @@ build=$1; shift
 jobs=${PLX_TEST_JOBS:-$(getconf _NPROCESSORS_ONLN 2>/dev/null || echo 2)}
 passed=0; failed=0; broken=""
 logs=$(mktemp -d)
-# the hostile corpus (many short runs of the command) alongside the unit tests
+# the command-line tests and the hostile corpus (many short runs of the
+# command, mostly one core each) alongside the unit tests
 (sh tests/cli/hostile.sh "$build/polarlux" >"$logs/hostile.log" 2>&1; echo $? >"$logs/hostile.rc") &
 hostile_pid=$!
+(sh tests/cli/run.sh "$build/polarlux" >"$logs/cli.log" 2>&1; echo $? >"$logs/cli.rc") &
+cli_pid=$!
 for t in "$@"; do echo "$t"; done |
     xargs -P "$jobs" -I {} sh -c 'n=$(basename "$1"); "$1" >"$2/$n.log" 2>&1; echo $? >"$2/$n.rc"' _ {} "$logs"
-sh tests/cli/run.sh "$build/polarlux" >"$logs/cli.log" 2>&1; echo $? >"$logs/cli.rc"
 wait $hostile_pid
+wait $cli_pid
 for t in "$@"; do
     name=$(basename "$t"); log="$logs/$name.log"; rc=$(cat "$logs/$name.rc" 2>/dev/null || echo 1)
     p=$(sed -n 's/^\[  PASSED  \] \([0-9]*\) test.*/\1/p' "$log" | tail -1)

@@ -86,6 +86,23 @@ static void bake_free(baked *k)
     free(k->file);
 }
 
+/* One bake for the tests that read it (made once: the group's setup). */
+static baked shared;
+
+static int shared_make(void **state)
+{
+    (void)state;
+    bake_make(&shared);
+    return 0;
+}
+
+static int shared_free(void **state)
+{
+    (void)state;
+    bake_free(&shared);
+    return 0;
+}
+
 /* Loads a file into a fresh block at an address 16 bytes past 64-byte
  * alignment (the loader must shift it). */
 static plx_engine *load(const unsigned char *file, size_t len, void **mem)
@@ -190,11 +207,10 @@ static void same_render(plx_engine *x, plx_engine *y, int aerial, int no_indirec
 
 static void test_round_trip(void **state)
 {
-    baked k;
+    baked k = shared;
     void *mc, *md;
     plx_engine *c, *d;
     (void)state;
-    bake_make(&k);
     c = load(k.file, k.len, &mc);
     assert_int_equal(plx_indirect_frames(c), 3);
     same_vis(k.a, c);
@@ -211,7 +227,6 @@ static void test_round_trip(void **state)
     free(md);
     plx_engine_destroy(c);
     free(mc);
-    bake_free(&k);
 }
 
 /* The aerial map's indirect layer: a bake made before its photons gathers
@@ -220,13 +235,12 @@ static void test_round_trip(void **state)
  * whole, layer and all, at its first aerial frame). */
 static void test_aerial_layer_in_bake(void **state)
 {
-    baked k;
+    baked k = shared;
     void *mc, *md;
     plx_engine *c, *d;
     render_lightmap_info li;
     uint64_t f, g0;
     (void)state;
-    bake_make(&k);
     render_lightmap_get(k.a->rd, &li);
     assert_true(li.built && li.has_ind);
     assert_true(k.a->ic->gathered > 0);
@@ -244,7 +258,6 @@ static void test_aerial_layer_in_bake(void **state)
     free(md);
     plx_engine_destroy(c);
     free(mc);
-    bake_free(&k);
 }
 
 /* ---- damaged files ----------------------------------------------------------- */
@@ -267,7 +280,7 @@ static void expect_fail(const unsigned char *f, size_t len, plx_status want, con
 
 static void test_damaged(void **state)
 {
-    baked k;
+    baked k = shared;
     unsigned char *f;
     char msg[200];
     size_t need;
@@ -276,7 +289,6 @@ static void test_damaged(void **state)
     plx_engine *e = NULL;
     uint64_t sum;
     (void)state;
-    bake_make(&k);
     f = malloc(k.len);
     /* the checksum is what the README says */
     memcpy(&sum, k.file + 32, 8);
@@ -327,7 +339,6 @@ static void test_damaged(void **state)
     assert_non_null(strstr(err, "the block is too small for the bake: it needs "));
     free(mem);
     free(f);
-    bake_free(&k);
 }
 
 /* ---- the corpus ----------------------------------------------------------------- */
@@ -398,5 +409,5 @@ int main(void)
         cmocka_unit_test(test_corpus),
         cmocka_unit_test(test_twin_mismatch),
     };
-    return cmocka_run_group_tests(tests, NULL, NULL);
+    return cmocka_run_group_tests(tests, shared_make, shared_free);
 }
