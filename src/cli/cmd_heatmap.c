@@ -7,6 +7,7 @@
 #include "cli.h"
 #include "options.h"
 #include "geotiff.h"
+#include "png/image_write.h"
 #include "route_io.h"
 
 static const char help[] =
@@ -363,14 +364,44 @@ static void draw_lamps(plx_engine *e, canvas *c, const heat_map *m)
     }
 }
 
+/* The map and its world file belong together: both are written, then both
+ * renamed into place (safe_out_commit), or neither. "-", a device or a
+ * FIFO gets no world file (a line on stderr says so). */
+static int write_map(const canvas *c, const char *out, const raster_frame *f)
+{
+    char err[512], *wpath = world_file_wanted(out) ? world_file_path(out) : NULL;
+    safe_out *o[2] = { NULL, NULL };
+    size_t n = wpath ? 2 : 1;
+    int rc = EXIT_FAIL;
+    if (!wpath && world_file_wanted(out))
+        snprintf(err, sizeof err, "%s: out of memory", out);
+    else if ((o[0] = safe_out_open(out, err, sizeof err)) && (!wpath || (o[1] = safe_out_open(wpath, err, sizeof err)))) {
+        if (image_encode_png(o[0], out, c->w, c->h, c->rgb, 0, err, sizeof err) != 0) {
+            safe_out_abort(o[0]);
+            safe_out_abort(o[1]);
+        } else {
+            if (wpath)
+                (void)world_file_encode(o[1], f);
+            rc = safe_out_commit(o, n, err, sizeof err) == 0 ? EXIT_OK : EXIT_FAIL;
+        }
+    } else {
+        safe_out_abort(o[0]);
+    }
+    if (rc != EXIT_OK)
+        fprintf(stderr, "polarlux heatmap: %s\n", err);
+    else if (!wpath)
+        fprintf(stderr, "polarlux heatmap: no world file (.pgw) for '%s': it is not a regular file\n", out);
+    free(wpath);
+    return rc;
+}
+
 static int write_png(plx_engine *e, const heat_opts *o, const heat_map *m, double lo, double top)
 {
     static const uint8_t grey[3] = { 60, 60, 66 }, black[3] = { 0, 0, 0 };
     canvas c;
     raster_frame f;
     size_t k, n = m->w * m->h;
-    char err[512];
-    int map_w = (int)m->w, legend_w = m->h > 600 ? 150 : 90, world = 0;
+    int map_w = (int)m->w, legend_w = m->h > 600 ? 150 : 90, rc;
     c.w = map_w + legend_w;
     c.h = (int)m->h < 200 ? 200 : (int)m->h;
     c.rgb = calloc((size_t)c.w * c.h, 3);
@@ -399,15 +430,9 @@ static int write_png(plx_engine *e, const heat_opts *o, const heat_map *m, doubl
     canvas_rect(&c, map_w, 0, c.w, c.h, black);
     legend(&c, map_w, lo, top);
     raster_frame_of(e, m->box, m->res, &f);
-    if (canvas_write(&c, o->out, err, sizeof err) != 0 || (world = world_file_write(o->out, &f, err, sizeof err)) < 0) {
-        fprintf(stderr, "polarlux heatmap: %s\n", err);
-        canvas_free(&c);
-        return EXIT_FAIL;
-    }
-    if (world == 1)
-        fprintf(stderr, "polarlux heatmap: no world file (.pgw) for '%s': it is not a regular file\n", o->out);
+    rc = write_map(&c, o->out, &f);
     canvas_free(&c);
-    return EXIT_OK;
+    return rc;
 }
 
 static int write_tiff(plx_engine *e, const heat_opts *o, const heat_map *m)

@@ -177,32 +177,24 @@ int world_file_wanted(const char *png_path)
     return S_ISREG(st.st_mode);
 }
 
-int world_file_write(const char *png_path, const raster_frame *f, char *err, size_t errlen)
+char *world_file_path(const char *png_path)
 {
     size_t n = strlen(png_path);
     const char *dot = strrchr(png_path, '.'), *slash = strrchr(png_path, '/');
-    char *path, text[256];
-    safe_out *o;
-    int len, rc;
-    if (!world_file_wanted(png_path))
-        return 1;
-    path = malloc(n + 8);
-    if (!path) {
-        snprintf(err, errlen, "%s: out of memory", png_path);
-        return -1;
-    }
+    char *path = malloc(n + 8);
+    if (!path)
+        return NULL;
     if (dot && (!slash || dot > slash))
         n = (size_t)(dot - png_path);
     memcpy(path, png_path, n);
     strcpy(path + n, ".pgw");
-    len = snprintf(text, sizeof text, "%.17g\n0\n0\n%.17g\n%.17g\n%.17g\n", f->sx, -f->sy, f->x0 + 0.5 * f->sx,
-                   f->y0 - 0.5 * f->sy);
-    o = safe_out_open(path, err, errlen);
-    rc = -1;
-    if (o) {
-        (void)safe_out_write(o, text, (size_t)len); /* a failure is sticky: the commit reports it */
-        rc = safe_out_commit(&o, 1, err, errlen);
-    }
-    free(path);
-    return rc;
+    return path;
+}
+
+int world_file_encode(safe_out *out, const raster_frame *f)
+{
+    char text[256];
+    int len = snprintf(text, sizeof text, "%.17g\n0\n0\n%.17g\n%.17g\n%.17g\n", f->sx, -f->sy,
+                       f->x0 + 0.5 * f->sx, f->y0 - 0.5 * f->sy);
+    return safe_out_write(out, text, (size_t)len); /* a failure is sticky: the commit reports it */
 }

@@ -5,6 +5,7 @@
 
 #include <stddef.h>
 #include "polarlux.h"
+#include "posix/safe_out.h"
 
 /* Where a north-up raster lies: the upper-left corner of its upper-left
  * pixel (x0, y0) and the pixel size (sx, sy > 0) in the CRS's units. */
@@ -28,15 +29,16 @@ void raster_frame_of(plx_engine *e, const double box[4], double res, raster_fram
  * (may be NULL) go to the image description. 0, or -1 with err. */
 int geotiff_write(const char *path, const float *v, int w, int h, int nb, const raster_frame *f,
                   const char *description, char *err, size_t errlen);
-/* Writes the world file of a PNG (path with its extension replaced by
- * .pgw): the pixel size and the centre of the upper-left pixel, through
- * a safe output (port/posix/safe_out.h). 0; 1 when the PNG goes to "-",
- * a device or a FIFO (no folder beside it: nothing written); -1 with err. */
 /* Whether png_path names a regular file or a name not yet taken (a
  * symlink followed): only then is there a folder to put a world file in
  * beside it; "-", a device or a FIFO get none. */
 int world_file_wanted(const char *png_path);
-int world_file_write(const char *png_path, const raster_frame *f, char *err, size_t errlen);
+/* The world file's name for a PNG (its extension replaced by .pgw;
+ * malloc'd, NULL when out of memory). */
+char *world_file_path(const char *png_path);
+/* The world file (the pixel size and the centre of the upper-left pixel)
+ * written to out; 0, or -1 (sticky in out: safe_out_commit reports it). */
+int world_file_encode(safe_out *out, const raster_frame *f);
 /* 1 when path ends in .tif or .tiff (any case). */
 int is_tiff_path(const char *path);
 

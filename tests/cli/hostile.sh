@@ -100,6 +100,15 @@ if [ -f "$shim" ]; then
     pre=
     if cmp -s "$tmp/pair.png" "$tmp/pair.png.copy" && cmp -s "$tmp/pair.pfm" "$tmp/pair.pfm.copy"; then
         ok render-pair-kept; else bad render-pair-kept; fi
+    # the map and its world file belong together too: the .pgw fails, neither is replaced
+    "$bin" heatmap -q $T --res 2 -o "$tmp/map.png" >/dev/null 2>&1
+    cp "$tmp/map.png" "$tmp/map.png.copy"; cp "$tmp/map.pgw" "$tmp/map.pgw.copy"
+    pre="LD_PRELOAD=$shim ASAN_OPTIONS=verify_asan_link_order=0 PLX_FAILWRITE_MATCH=map.pgw.tmp"
+    expect heatmap-pgw-fails 1 "^polarlux heatmap: cannot write '$tmp/map.pgw': No space left on device$" -- \
+        heatmap -q $T --res 3 -o "$tmp/map.png"
+    pre=
+    if cmp -s "$tmp/map.png" "$tmp/map.png.copy" && cmp -s "$tmp/map.pgw" "$tmp/map.pgw.copy" &&
+       [ -z "$(ls "$tmp" | grep '\.tmp\.')" ]; then ok heatmap-pair-kept; else bad heatmap-pair-kept; fi
 elif [ -n "${PLX_NO_SHIM:-}" ]; then
     # a cross build run under qemu-user: a host LD_PRELOAD shim cannot reach
     # the emulated program's writes (check-arm64 sets PLX_NO_SHIM)
