@@ -126,12 +126,7 @@ static int layer_worker_new(plx_engine *e, layer_worker *w)
 static int lightmap_indirect(void *user, double x, double y, double rgb[3], double *z)
 {
     layer_worker *w = user;
-    double P[3], n[3] = { 0.0, 0.0, 1.0 };
-    P[0] = x;
-    P[1] = y;
-    P[2] = trace_top(w->e->ph->T, x, y, NULL);
-    *z = P[2];
-    icache_lookup(w->ic, w->e->ph, w->lt, P, n, rgb);
+    *z = icache_lookup_top(w->ic, w->e->ph, w->lt, x, y, rgb);
     return 1;
 }
 

@@ -11,6 +11,7 @@
 #define HEIGHT_TOL 1e-3   /* m: one surface's height, as in photon.c */
 #define PROBE_OFF 0.005   /* m: a wall probe starts this far in front */
 #define PROBE_LEN 0.02    /* m: and looks this far back */
+#define BLOCK_DZ 0.05     /* m: the segment tests run this far above the surface */
 #define COORD_BIAS ((int64_t)1 << 28)
 #define COORD_MASK (((uint64_t)1 << 29) - 1)
 
@@ -146,6 +147,21 @@ static uint64_t mm(double z)
     return (uint64_t)(int64_t)llround(z * 1000.0) & 0x3fffffffull;
 }
 
+/* The surface of a point P facing up whose topmost surface (trace_top)
+ * is top, of building bld: the ground or a roof. */
+static void plane_up(const double P[3], double top, uint32_t bld, plane *pl)
+{
+    memset(pl, 0, sizeof *pl);
+    pl->top = top;
+    pl->bld = top > HEIGHT_TOL ? bld : 0;
+    /* a roof is its building's own surface: roofs of one height
+     * elsewhere (across a street or a courtyard) are others */
+    pl->code = ((uint64_t)1 << 62) | (mix64(pl->bld ^ mix64((mm(P[2]) << 30) | mm(pl->top))) >> 2);
+    pl->o[2] = P[2];
+    pl->t[0] = 1.0;
+    pl->n[2] = 1.0;
+}
+
 /* P's surface: 1 with pl filled, 0 when it has no grid (undersides,
  * points no probe ties to a wall). */
 static int plane_of(tracer *T, const scene *s, const double P[3], const double n[3], plane *pl)
@@ -153,15 +169,9 @@ static int plane_of(tracer *T, const scene *s, const double P[3], const double n
     trace_hit h;
     memset(pl, 0, sizeof *pl);
     if (n[2] > 0.5) {
-        pl->top = trace_top(T, P[0], P[1], &pl->bld);
-        if (!(pl->top > HEIGHT_TOL))
-            pl->bld = 0;
-        /* a roof is its building's own surface: roofs of one height
-         * elsewhere (across a street or a courtyard) are others */
-        pl->code = ((uint64_t)1 << 62) | (mix64(pl->bld ^ mix64((mm(P[2]) << 30) | mm(pl->top))) >> 2);
-        pl->o[2] = P[2];
-        pl->t[0] = 1.0;
-        pl->n[2] = 1.0;
+        uint32_t bld;
+        double top = trace_top(T, P[0], P[1], &bld);
+        plane_up(P, top, bld, pl);
         return 1;
     }
     if (n[2] < -0.5 || !probe_wall(T, P, n, &h))
@@ -255,7 +265,7 @@ static const icache_rec *cell_record(icache *c, photon_sys *ps, light *L, const 
     const icache_rec *r;
     if (!lc->set || lc->code != pl->code || lc->i != i || lc->j != j) {
         memset(lc, 0, sizeof *lc);
-        lc->set = 1;
+        lc->set = ICACHE_CELL_SET;
         lc->code = pl->code;
         lc->i = i;
         lc->j = j;
@@ -264,7 +274,7 @@ static const icache_rec *cell_record(icache *c, photon_sys *ps, light *L, const 
         return &c->tab[lc->r[v] - 1];
     r = record(c, ps, L, pl, l, i + (v & 1), j + (v >> 1));
     if (!lc->set) { /* the table was emptied to make room: this cell again */
-        lc->set = 1;
+        lc->set = ICACHE_CELL_SET;
         lc->code = pl->code;
         lc->i = i;
         lc->j = j;
@@ -290,8 +300,27 @@ static int blocked(tracer *T, const double P[3], const double Q[3])
     d[1] /= l;
     o[0] = P[0];
     o[1] = P[1];
-    o[2] = P[2] + 0.05;
+    o[2] = P[2] + BLOCK_DZ;
     return trace_ray(T, o, d, l, &h) != TRACE_SKY;
+}
+
+/* Whether P's cell (i, j) at level l, spacing sp, of a horizontal
+ * surface has no wall at the height of the segment tests (blocked): then
+ * none of them can meet one. Kept with the level's last cell (cell_record
+ * set it to this cell). The surface's points lie within 1 mm of one
+ * height (its code holds it in mm), so walls within 1 mm of the segments'
+ * height z count. */
+static int cell_clear(icache *c, tracer *T, const plane *pl, int l, int64_t i, int64_t j, double sp,
+                      double z)
+{
+    icache_cell *lc = &c->last[l];
+    if (!lc->set || lc->code != pl->code || lc->i != i || lc->j != j)
+        return 0;
+    if (lc->set == ICACHE_CELL_SET)
+        lc->set = trace_box_clear(T, (double)i * sp, (double)j * sp, (double)(i + 1) * sp,
+                                  (double)(j + 1) * sp, z - HEIGHT_TOL, z + HEIGHT_TOL)
+                      ? ICACHE_CELL_CLEAR : ICACHE_CELL_WALLS;
+    return lc->set == ICACHE_CELL_CLEAR;
 }
 
 /* Bilinear over the valid vertices of P's cell at level l; 0 when none
@@ -319,7 +348,8 @@ static int level_value(icache *c, photon_sys *ps, light *L, const plane *pl, con
             r = cell_record(c, ps, L, pl, l, i, j, 2 * b + a);
             if (!(r->flags & REC_VALID))
                 continue;
-            if (!pl->wall && l >= ICACHE_LEVEL_SEG) {
+            if (!pl->wall && l >= ICACHE_LEVEL_SEG &&
+                !cell_clear(c, ps->T, pl, l, i, j, sp, P[2] + BLOCK_DZ)) {
                 double Q[3];
                 vertex_point(pl, sp, i + a, j + b, Q);
                 if (blocked(ps->T, P, Q))
@@ -347,25 +377,55 @@ static void level_or_finer(icache *c, photon_sys *ps, light *L, const plane *pl,
     final_gather_rgb(ps, ps->T, L, P, pl->n, c->side, ICACHE_SEED, rgb);
 }
 
-void icache_lookup(icache *c, photon_sys *ps, light *L, const double P[3], const double n[3],
-                   double rgb[3])
+/* The table's records belong to the photon buffers as they are. */
+static void check_stamp(icache *c, const photon_sys *ps)
 {
-    double dx = P[0] - c->eye[0], dy = P[1] - c->eye[1], dz = P[2] - c->eye[2], lf, t, r1[3];
     uint64_t stamp = photon_stamp(ps);
-    plane pl;
-    int l0, k;
     if (stamp != c->stamp) {
         if (c->used)
             flush(c);
         c->stamp = stamp;
     }
+}
+
+/* A fixed spacing's level (icache_set_spacing). */
+static int fixed_level(const icache *c)
+{
+    return (int)fmin(floor(log2(fmax(c->fixed, ICACHE_S0) / ICACHE_S0)), ICACHE_LEVEL_MAX);
+}
+
+double icache_lookup_top(icache *c, photon_sys *ps, light *L, double x, double y, double rgb[3])
+{
+    double P[3];
+    uint32_t bld;
+    plane pl;
+    P[0] = x;
+    P[1] = y;
+    P[2] = trace_top(ps->T, x, y, &bld);
+    if (!(c->fixed > 0.0)) {
+        static const double up[3] = { 0.0, 0.0, 1.0 };
+        icache_lookup(c, ps, L, P, up, rgb);
+        return P[2];
+    }
+    check_stamp(c, ps);
+    plane_up(P, P[2], bld, &pl);
+    level_or_finer(c, ps, L, &pl, P, fixed_level(c), rgb);
+    return P[2];
+}
+
+void icache_lookup(icache *c, photon_sys *ps, light *L, const double P[3], const double n[3],
+                   double rgb[3])
+{
+    double dx = P[0] - c->eye[0], dy = P[1] - c->eye[1], dz = P[2] - c->eye[2], lf, t, r1[3];
+    plane pl;
+    int l0, k;
+    check_stamp(c, ps);
     if (!plane_of(ps->T, ps->s, P, n, &pl)) {
         photon_indirect_rgb(ps, P, n, rgb);
         return;
     }
     if (c->fixed > 0.0) {
-        level_or_finer(c, ps, L, &pl, P, (int)fmin(floor(log2(fmax(c->fixed, ICACHE_S0) / ICACHE_S0)),
-                                                   ICACHE_LEVEL_MAX), rgb);
+        level_or_finer(c, ps, L, &pl, P, fixed_level(c), rgb);
         return;
     }
     lf = log2(fmax(c->kappa * sqrt(dx * dx + dy * dy + dz * dz), fmax(c->smin, ICACHE_S0)) / ICACHE_S0);

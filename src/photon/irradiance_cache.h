@@ -93,10 +93,15 @@ typedef struct icache_rec icache_rec;
 typedef struct icache_cell {
     uint64_t code;            /* the surface */
     int64_t i, j;             /* the cell */
-    int set;                  /* 0: none */
+    int set;                  /* 0: none; else ICACHE_CELL_SET, and on ground and roof
+                               * cells of 4 m and more whether a wall may stand in it at
+                               * the height of the segment tests (trace_box_clear):
+                               * ICACHE_CELL_CLEAR none, ICACHE_CELL_WALLS one may */
     uint32_t r[4];            /* vertices (i, j), (i+1, j), (i, j+1), (i+1, j+1): the
                                * slot plus one (indices, not pointers: bakes move it) */
 } icache_cell;
+
+enum { ICACHE_CELL_SET = 1, ICACHE_CELL_CLEAR = 2, ICACHE_CELL_WALLS = 3 };
 
 typedef struct icache {
     icache_rec *tab;          /* nrec slots */
@@ -148,5 +153,11 @@ void icache_set_spacing(icache *c, double s);
  * frames; L is the lamp light the gathers read. */
 void icache_lookup(icache *c, photon_sys *ps, light *L, const double P[3], const double n[3],
                    double rgb[3] /* OUT */);
+
+/* The same at the topmost surface over (x, y), the ground or a roof
+ * (trace_top), facing up; returns its height. What the aerial light map's
+ * layer asks (one trace_top for both). */
+double icache_lookup_top(icache *c, photon_sys *ps, light *L, double x, double y,
+                         double rgb[3] /* OUT */);
 
 #endif

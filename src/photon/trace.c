@@ -882,6 +882,71 @@ int trace_ray_brute(tracer *T, const double o[3], const double d[3], double tmax
     return finish(o, d, &bs, h);
 }
 
+/* Whether segment p + u e (0 <= u <= 1) comes into the box lo..hi
+ * (Liang-Barsky on the parameter). */
+static int seg_meets_box(double px, double py, double ex, double ey, const double lo[2],
+                         const double hi[2])
+{
+    double a[2], e[2], u0 = 0.0, u1 = 1.0;
+    int k;
+    a[0] = px;
+    a[1] = py;
+    e[0] = ex;
+    e[1] = ey;
+    for (k = 0; k < 2; k++) {
+        if (e[k] == 0.0) {
+            if (a[k] < lo[k] || a[k] > hi[k])
+                return 0;
+        } else {
+            double ua = (lo[k] - a[k]) / e[k], ub = (hi[k] - a[k]) / e[k];
+            if (ua > ub) {
+                double x = ua;
+                ua = ub;
+                ub = x;
+            }
+            if (ua > u0)
+                u0 = ua;
+            if (ub < u1)
+                u1 = ub;
+        }
+    }
+    return u0 <= u1;
+}
+
+int trace_box_clear(const tracer *T, double x0, double y0, double x1, double y1, double z0,
+                    double z1)
+{
+    double lo[2], hi[2], big = fabs(x0), m;
+    uint32_t i0, i1, j0, j1, ci, cj, k;
+    if (fabs(y0) > big)
+        big = fabs(y0);
+    if (fabs(x1) > big)
+        big = fabs(x1);
+    if (fabs(y1) > big)
+        big = fabs(y1);
+    m = TRACE_BOX_PAD * (1.0 + big);
+    lo[0] = x0 - m;
+    lo[1] = y0 - m;
+    hi[0] = x1 + m;
+    hi[1] = y1 + m;
+    if (!(z0 <= T->zmax))
+        return 1; /* above every wall (a horizontal ray there meets none) */
+    i0 = (uint32_t)cell_of(lo[0], T->x0, T->inv, T->nx);
+    i1 = (uint32_t)cell_of(hi[0], T->x0, T->inv, T->nx);
+    j0 = (uint32_t)cell_of(lo[1], T->y0, T->inv, T->ny);
+    j1 = (uint32_t)cell_of(hi[1], T->y0, T->inv, T->ny);
+    for (cj = j0; cj <= j1; cj++)
+        for (ci = i0; ci <= i1; ci++) {
+            const trace_cell *C = &T->cells[(size_t)cj * T->nx + ci];
+            for (k = C->w0; k < C[1].w0; k++) {
+                const trace_wall *w = &T->walls[T->wids[k]];
+                if (z1 >= w->zlo && z0 <= w->zhi && seg_meets_box(w->px, w->py, w->ex, w->ey, lo, hi))
+                    return 0;
+            }
+        }
+    return 1;
+}
+
 double trace_top(tracer *T, double x, double y, uint32_t *bld)
 {
     double fx = floor((x - T->x0) * T->inv), fy = floor((y - T->y0) * T->inv);

@@ -213,6 +213,16 @@ void trace_lamp_prefetch(const tracer *T, uint32_t lamp, int stage);
 int trace_ray_brute(tracer *T, const double o[3], const double d[3], double tmax,
                     trace_hit *h /* OUT */);
 
+/* Whether no wall can stop a horizontal ray at a height in [z0, z1] that
+ * runs inside the box x0..x1, y0..y1 (closed): 1 when no wall whose
+ * [min_height, height] meets [z0, z1] comes within TRACE_BOX_PAD
+ * (relative) of the box, so trace_ray of such a ray returns TRACE_SKY; 0
+ * when one may (conservative: the wall's facing is not looked at). Reads
+ * the grid's lists only. */
+int trace_box_clear(const tracer *T, double x0, double y0, double x1, double y1, double z0,
+                    double z1);
+#define TRACE_BOX_PAD 1e-6
+
 /* Height of the topmost horizontal surface above (x, y): the tallest roof
  * over the point (point strictly inside the footprint, even-odd; on an edge
  * either way), 0 if none (the ground); *bld gets the building or TRACE_NONE
