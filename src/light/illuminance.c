@@ -24,17 +24,20 @@ static double window(double x)
  * contribute. */
 static double lamp_geom_term(const scene_lamp *lp, const double P[3], const double n[3])
 {
-    double v[3], d2, d, x, cw, w, u[3];
+    double v[3], d2, d, x, cw, w, u[3], dot;
     v[0] = lp->x - P[0];
     v[1] = lp->y - P[1];
     v[2] = lp->z - P[2];
     d2 = v[0] * v[0] + v[1] * v[1] + v[2] * v[2];
     if (d2 == 0.0 || !(lp->radius > 0.0) || !(d2 < lp->radius * lp->radius))
         return 0.0;
+    dot = n[0] * v[0] + n[1] * v[1] + n[2] * v[2];
+    if (!(dot > 0.0)) /* behind the surface (cw below would not be > 0) */
+        return 0.0;
     d = sqrt(d2);
     x = d / lp->radius;
     w = window(x);
-    cw = (n[0] * v[0] + n[1] * v[1] + n[2] * v[2]) / d;
+    cw = dot / d;
     if (w == 0.0 || !(cw > 0.0))
         return 0.0;
     if (!lp->photometry)
