@@ -57,4 +57,17 @@ double final_gather_rgb(photon_sys *ps, tracer *T, light *L, const double P[3],
                         const double n[3], uint32_t side, uint64_t seed,
                         double rgb[3] /* OUT */);
 
+/*
+ * The same with E_later read at one direction of each later x later block
+ * of strata (one chosen uniformly per block from a stream of its own),
+ * weighted later^2: an unbiased estimate of the same integral with later^2
+ * times fewer photon lookups (E_later is the smooth, small part; the exact
+ * E_direct is still taken at every direction, the directions are those of
+ * final_gather_rgb). later 1 (or a later side is not a multiple of) is
+ * final_gather_rgb itself.
+ */
+double final_gather_rgb_later(photon_sys *ps, tracer *T, light *L, const double P[3],
+                              const double n[3], uint32_t side, uint32_t later, uint64_t seed,
+                              double rgb[3] /* OUT */);
+
 #endif

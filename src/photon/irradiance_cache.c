@@ -218,6 +218,13 @@ static int vertex_valid(tracer *T, const plane *pl, const double Q[3])
     return trace_top(T, Q[0] + 0.01 * pl->n[0], Q[1] + 0.01 * pl->n[1], NULL) < Q[2];
 }
 
+/* The records' E_later step (final_gather_rgb_later): views from above
+ * read it at one direction in ICACHE_AERIAL_LATER^2. */
+static uint32_t later_of(const icache *c)
+{
+    return c->fixed > 0.0 ? ICACHE_AERIAL_LATER : 1;
+}
+
 /* The record of vertex (i, j) at level l, gathered on first need. */
 static const icache_rec *record(icache *c, photon_sys *ps, light *L, const plane *pl, int l,
                                 int64_t i, int64_t j)
@@ -246,7 +253,7 @@ static const icache_rec *record(icache *c, photon_sys *ps, light *L, const plane
     r->flags = REC_USED;
     vertex_point(pl, ICACHE_S0 * ldexp(1.0, l), i, j, Q);
     if (vertex_valid(ps->T, pl, Q)) {
-        final_gather_rgb(ps, ps->T, L, Q, pl->n, c->side, ICACHE_SEED, rgb);
+        final_gather_rgb_later(ps, ps->T, L, Q, pl->n, c->side, later_of(c), ICACHE_SEED, rgb);
         r->e[0] = (float)rgb[0];
         r->e[1] = (float)rgb[1];
         r->e[2] = (float)rgb[2];
@@ -374,7 +381,7 @@ static void level_or_finer(icache *c, photon_sys *ps, light *L, const plane *pl,
         if (level_value(c, ps, L, pl, P, l, rgb))
             return;
     c->direct++;
-    final_gather_rgb(ps, ps->T, L, P, pl->n, c->side, ICACHE_SEED, rgb);
+    final_gather_rgb_later(ps, ps->T, L, P, pl->n, c->side, later_of(c), ICACHE_SEED, rgb);
 }
 
 /* The table's records belong to the photon buffers as they are. */

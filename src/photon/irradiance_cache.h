@@ -84,6 +84,9 @@
 #define ICACHE_AERIAL_SIDE 24 /* and its records' gather side: 24 x 24 (README "Aerial
                                  views' indirect light": more accurate than 4 m and 16 x 16,
                                  and a third less work) */
+#define ICACHE_AERIAL_LATER 3 /* and E_later read at one direction of each 3 x 3 strata
+                                 (final_gather_rgb_later; README "Aerial views'
+                                 indirect light") */
 
 typedef struct icache_rec icache_rec;
 
