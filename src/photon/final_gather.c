@@ -112,6 +112,7 @@ static void gather(photon_sys *ps, tracer *T, light *L, const double P[3], const
                    uint32_t side, uint32_t later, uint64_t rs, int depth, double sum[4])
 {
     double t[3], b[3], o[3], inv = 1.0 / side, wl = (double)later * later;
+    trace_horizon hz;
     uint64_t lseed = mix64(rs ^ 0x3c6ef372fe94f82bull);
     uint32_t i, j;
     int c;
@@ -120,6 +121,10 @@ static void gather(photon_sys *ps, tracer *T, light *L, const double P[3], const
         o[c] = P[c] + 1e-6 * n[c];
     if (o[2] < 0.0)
         o[2] = 0.0;
+    if (n[2] == 1.0) /* every ray goes up: those over the horizon need no walk */
+        trace_horizon_make(T, o, &hz);
+    else
+        hz.on = 0;
     for (c = 0; c < 4; c++)
         sum[c] = 0.0;
     for (i = 0; i < side; i++)
@@ -133,7 +138,7 @@ static void gather(photon_sys *ps, tracer *T, light *L, const double P[3], const
             cy *= r;
             for (c = 0; c < 3; c++)
                 d[c] = cx * t[c] + cy * b[c] + cz * n[c];
-            if (trace_ray(T, o, d, INFINITY, &h) == TRACE_SKY)
+            if (trace_horizon_sky(&hz, d) || trace_ray(T, o, d, INFINITY, &h) == TRACE_SKY)
                 continue;
             hit_exitance(ps, T, L, &h, mix64(rs++), depth,
                          later == 1 ? 1.0 : later_cell(lseed, later, i, j) ? wl : 0.0, x);

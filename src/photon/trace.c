@@ -175,15 +175,17 @@ static size_t lamp_bytes(uint32_t nl, size_t nref)
 /* Sector of direction (x, y) (not both 0): TRACE_SECTORS equal steps of the
  * pseudo-angle in [0, 4) that grows counter-clockwise from +x (a quarter
  * turn per unit), so the sectors of a direction span are consecutive. */
+static double pseudo_angle(double x, double y)
+{
+    double ax = fabs(x), ay = fabs(y);
+    if (y >= 0.0)
+        return x >= 0.0 ? ay / (ax + ay) : 1.0 + ax / (ax + ay);
+    return x < 0.0 ? 2.0 + ay / (ax + ay) : 3.0 + ax / (ax + ay);
+}
+
 static uint32_t sector_of(double x, double y)
 {
-    double ax = fabs(x), ay = fabs(y), a;
-    uint32_t k;
-    if (y >= 0.0)
-        a = x >= 0.0 ? ay / (ax + ay) : 1.0 + ax / (ax + ay);
-    else
-        a = x < 0.0 ? 2.0 + ay / (ax + ay) : 3.0 + ax / (ax + ay);
-    k = (uint32_t)(a * (TRACE_SECTORS / 4.0));
+    uint32_t k = (uint32_t)(pseudo_angle(x, y) * (TRACE_SECTORS / 4.0));
     return k >= TRACE_SECTORS ? k - TRACE_SECTORS : k;
 }
 
@@ -945,6 +947,99 @@ int trace_box_clear(const tracer *T, double x0, double y0, double x1, double y1,
             }
         }
     return 1;
+}
+
+/* Horizon sector of pseudo-angle a (any real: taken modulo 4). */
+static uint32_t horizon_sector(double a)
+{
+    int64_t k = (int64_t)floor(a * (TRACE_HORIZON_SECTORS / 4.0));
+    k %= TRACE_HORIZON_SECTORS;
+    return (uint32_t)(k < 0 ? k + TRACE_HORIZON_SECTORS : k);
+}
+
+/* Building b's share of the horizon from o: the sectors its box spans
+ * (one more each side) get at least the tangent over its nearest point;
+ * 0 when o lies within pad of the box (no shortcut then). */
+static int horizon_add(const tracer *T, uint32_t b, const double o[3], double pad,
+                       trace_horizon *hz)
+{
+    const scene_building *B = &T->s->bld[b];
+    double hgt = T->hz[2 * b + 1], dx, dy, dist, tn, a[4], lo, hi;
+    uint32_t k, k0, n;
+    int c;
+    if (hgt < o[2])
+        return 1; /* a ray going up from o stays above it */
+    dx = fmax(fmax(B->box[0] - o[0], o[0] - B->box[2]), 0.0);
+    dy = fmax(fmax(B->box[1] - o[1], o[1] - B->box[3]), 0.0);
+    dist = sqrt(dx * dx + dy * dy);
+    if (!(dist < hz->r))
+        return 1;
+    if (!(dist > 2.0 * pad))
+        return 0;
+    tn = (hgt - o[2] + TRACE_HORIZON_DZ) / (dist - pad);
+    for (c = 0; c < 4; c++)
+        a[c] = pseudo_angle(B->box[c & 1 ? 2 : 0] - o[0], B->box[c & 2 ? 3 : 1] - o[1]);
+    lo = fmin(fmin(a[0], a[1]), fmin(a[2], a[3]));
+    hi = fmax(fmax(a[0], a[1]), fmax(a[2], a[3]));
+    if (hi - lo > 2.0) { /* the span crosses pseudo-angle 0: from hi to lo + 4 */
+        double l2 = 4.0, h2 = 0.0;
+        for (c = 0; c < 4; c++) {
+            if (a[c] >= 2.0 && a[c] < l2)
+                l2 = a[c];
+            if (a[c] < 2.0 && a[c] > h2)
+                h2 = a[c];
+        }
+        lo = l2;
+        hi = h2 + 4.0;
+    }
+    k0 = horizon_sector(lo);
+    n = (horizon_sector(hi) + TRACE_HORIZON_SECTORS - k0) % TRACE_HORIZON_SECTORS + 3;
+    k0 += TRACE_HORIZON_SECTORS - 1;
+    if (n > TRACE_HORIZON_SECTORS)
+        n = TRACE_HORIZON_SECTORS;
+    for (k = 0; k < n; k++) {
+        double *t = &hz->tan[(k0 + k) % TRACE_HORIZON_SECTORS];
+        if (tn > *t)
+            *t = tn;
+    }
+    return 1;
+}
+
+void trace_horizon_make(const tracer *T, const double o[3], trace_horizon *hz)
+{
+    double big = fmax(fmax(fabs(o[0]), fabs(o[1])), 1.0), pad = TRACE_BOX_PAD * big;
+    uint32_t i0, i1, j0, j1, ci, cj, k;
+    memset(hz, 0, sizeof *hz);
+    if (!(o[2] >= 0.0 && o[2] <= T->zmax))
+        return; /* above every building trace_ray answers at once */
+    hz->o[0] = o[0];
+    hz->o[1] = o[1];
+    hz->o[2] = o[2];
+    hz->zmax = T->zmax;
+    hz->r = 2.0 * (T->zmax - o[2]) + T->cell;
+    i0 = (uint32_t)cell_of(o[0] - hz->r, T->x0, T->inv, T->nx);
+    i1 = (uint32_t)cell_of(o[0] + hz->r, T->x0, T->inv, T->nx);
+    j0 = (uint32_t)cell_of(o[1] - hz->r, T->y0, T->inv, T->ny);
+    j1 = (uint32_t)cell_of(o[1] + hz->r, T->y0, T->inv, T->ny);
+    for (cj = j0; cj <= j1; cj++)
+        for (ci = i0; ci <= i1; ci++) {
+            size_t c = (size_t)cj * T->nx + ci;
+            for (k = T->start[c]; k < T->start[c + 1]; k++)
+                if (!horizon_add(T, T->ids[k], o, pad, hz))
+                    return; /* o on or in a building's box */
+        }
+    hz->on = 1;
+}
+
+int trace_horizon_sky(const trace_horizon *hz, const double d[3])
+{
+    double h2 = d[0] * d[0] + d[1] * d[1], h;
+    if (!hz->on || !(d[2] > 0.0) || !(h2 > 0.0))
+        return 0;
+    h = sqrt(h2);
+    /* above every building within r, and above the tallest beyond r */
+    return d[2] > hz->tan[horizon_sector(pseudo_angle(d[0], d[1]))] * h * (1.0 + 1e-9) &&
+           hz->o[2] + hz->r * (d[2] / h) > hz->zmax + TRACE_HORIZON_DZ;
 }
 
 double trace_top(tracer *T, double x, double y, uint32_t *bld)

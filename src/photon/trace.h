@@ -223,6 +223,32 @@ int trace_box_clear(const tracer *T, double x0, double y0, double x1, double y1,
                     double z1);
 #define TRACE_BOX_PAD 1e-6
 
+/* The horizon from a point o for rays going up (final gathers at the
+ * ground and roofs): per sector of directions (TRACE_HORIZON_SECTORS equal
+ * steps of a pseudo-angle), an elevation tangent that every building
+ * within r stays under (its height over o at the nearest point of its
+ * box, the box's sectors and one more each side), so a ray above it in
+ * its sector, and above the tallest building beyond r, meets nothing:
+ * trace_ray would return TRACE_SKY. r is twice the tallest building's
+ * height over o plus a cell. Conservative by TRACE_HORIZON_DZ in height
+ * and TRACE_BOX_PAD (relative) in distance. */
+#define TRACE_HORIZON_SECTORS 64
+#define TRACE_HORIZON_DZ 1e-6
+
+typedef struct trace_horizon {
+    double o[3];
+    double r, zmax;
+    int on;            /* 0: o is above every building, in a building's box, or on its edge */
+    double tan[TRACE_HORIZON_SECTORS];
+} trace_horizon;
+
+/* The horizon from o (o[2] >= 0). Reads the grid's building lists. */
+void trace_horizon_make(const tracer *T, const double o[3], trace_horizon *hz /* OUT */);
+
+/* 1 when the ray o + t d (unit d, t > 0, o the horizon's point) certainly
+ * meets nothing, 0 when it may (then trace it). */
+int trace_horizon_sky(const trace_horizon *hz, const double d[3]);
+
 /* Height of the topmost horizontal surface above (x, y): the tallest roof
  * over the point (point strictly inside the footprint, even-odd; on an edge
  * either way), 0 if none (the ground); *bld gets the building or TRACE_NONE

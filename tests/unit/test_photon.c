@@ -525,6 +525,85 @@ static void rays_from(ray_check *c, uint64_t *rs, double x, double y, double z, 
     }
 }
 
+/* trace_horizon_sky and trace_box_clear only ever claim what the walk
+ * (and testing every building) finds: rays going up from points on the
+ * ground and on roofs (as final gathers cast them: 1e-6 m above, some at
+ * a wall's foot), and horizontal rays inside boxes said to be clear. */
+static void test_trace_horizon(void **state)
+{
+    fixture f;
+    tracer *T;
+    uint64_t rs = 91;
+    int pts = quick_mode() ? 150 : 1500, p, k, rays = 0, sky = 0, skipped = 0, boxes = 0, clear = 0;
+    (void)state;
+    fx_open(&f, 8u << 20);
+    random_city(&f, 5);
+    fx_finish(&f);
+    assert_int_equal(trace_create(&f.a, PLX_PART_PHOTON, &f.s, 0.0, &T), PLX_OK);
+    for (p = 0; p < pts; p++) {
+        double o[3], d[3];
+        trace_horizon hz;
+        trace_hit h, h2;
+        o[0] = f.s.bounds[0] + (f.s.bounds[2] - f.s.bounds[0]) * urand(&rs);
+        o[1] = f.s.bounds[1] + (f.s.bounds[3] - f.s.bounds[1]) * urand(&rs);
+        if (p % 5 == 0) { /* at a wall's foot */
+            const vec2 *q = &f.s.pts[(uint32_t)(urand(&rs) * f.s.npts) % f.s.npts];
+            o[0] = q->x + 1e-7 * (urand(&rs) - 0.5);
+            o[1] = q->y + 1e-7 * (urand(&rs) - 0.5);
+        }
+        o[2] = trace_top(T, o[0], o[1], NULL) + 1e-6;
+        trace_horizon_make(T, o, &hz);
+        for (k = 0; k < 200; k++) {
+            double u1 = urand(&rs), u2 = urand(&rs), r = sqrt(u1);
+            d[0] = r * cos(2.0 * PI * u2);
+            d[1] = r * sin(2.0 * PI * u2);
+            d[2] = sqrt(1.0 - u1);
+            rays++;
+            if (!trace_horizon_sky(&hz, d))
+                continue;
+            skipped++;
+            sky += trace_ray(T, o, d, INFINITY, &h) == TRACE_SKY &&
+                   trace_ray_brute(T, o, d, INFINITY, &h2) == TRACE_SKY;
+        }
+    }
+    for (p = 0; p < pts; p++) {
+        double x0 = f.s.bounds[0] + (f.s.bounds[2] - f.s.bounds[0]) * urand(&rs), y0 =
+            f.s.bounds[1] + (f.s.bounds[3] - f.s.bounds[1]) * urand(&rs), sz = 2.0 + 14.0 * urand(&rs);
+        double z = p % 3 ? 25.0 * urand(&rs) : 0.05, o[3], q[3], d[3], l;
+        trace_hit h;
+        boxes++;
+        if (!trace_box_clear(T, x0, y0, x0 + sz, y0 + sz, z, z))
+            continue;
+        clear++;
+        for (k = 0; k < 20; k++) {
+            o[0] = x0 + sz * urand(&rs);
+            o[1] = y0 + sz * urand(&rs);
+            q[0] = x0 + sz * (k & 1);
+            q[1] = y0 + sz * ((k >> 1) & 1);
+            if (k >= 4) {
+                q[0] = x0 + sz * urand(&rs);
+                q[1] = y0 + sz * urand(&rs);
+            }
+            d[0] = q[0] - o[0];
+            d[1] = q[1] - o[1];
+            d[2] = 0.0;
+            l = hypot(d[0], d[1]);
+            if (!(l > 1e-9))
+                continue;
+            d[0] /= l;
+            d[1] /= l;
+            o[2] = z;
+            assert_int_equal(trace_ray_brute(T, o, d, l, &h), TRACE_SKY);
+        }
+    }
+    printf("horizon: %d upward rays, %d said to meet nothing (all do: %d); boxes: %d of %d clear\n", rays,
+           skipped, sky, clear, boxes);
+    assert_int_equal(sky, skipped);
+    assert_true(skipped > rays / 5);
+    assert_true(clear > boxes / 10 && clear < boxes);
+    fx_close(&f);
+}
+
 static void test_trace_degenerate(void **state)
 {
     fixture f;
@@ -1786,6 +1865,7 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_trace_vs_brute),
+        cmocka_unit_test(test_trace_horizon),
         cmocka_unit_test(test_trace_degenerate),
         cmocka_unit_test(test_trace_lamp_rays),
         cmocka_unit_test(test_energy_closed_box),
