@@ -977,6 +977,7 @@ static int horizon_add(const tracer *T, uint32_t b, const double o[3], double pa
     if (!(dist > 2.0 * pad))
         return 0;
     tn = (hgt - o[2] + TRACE_HORIZON_DZ) / (dist - pad);
+    tn *= tn * (1.0 + 1e-9); /* kept squared, and a hair up */
     for (c = 0; c < 4; c++)
         a[c] = pseudo_angle(B->box[c & 1 ? 2 : 0] - o[0], B->box[c & 2 ? 3 : 1] - o[1]);
     lo = fmin(fmin(a[0], a[1]), fmin(a[2], a[3]));
@@ -998,7 +999,7 @@ static int horizon_add(const tracer *T, uint32_t b, const double o[3], double pa
     if (n > TRACE_HORIZON_SECTORS)
         n = TRACE_HORIZON_SECTORS;
     for (k = 0; k < n; k++) {
-        double *t = &hz->tan[(k0 + k) % TRACE_HORIZON_SECTORS];
+        double *t = &hz->tan2[(k0 + k) % TRACE_HORIZON_SECTORS];
         if (tn > *t)
             *t = tn;
     }
@@ -1012,11 +1013,9 @@ void trace_horizon_make(const tracer *T, const double o[3], trace_horizon *hz)
     memset(hz, 0, sizeof *hz);
     if (!(o[2] >= 0.0 && o[2] <= T->zmax))
         return; /* above every building trace_ray answers at once */
-    hz->o[0] = o[0];
-    hz->o[1] = o[1];
-    hz->o[2] = o[2];
-    hz->zmax = T->zmax;
     hz->r = 2.0 * (T->zmax - o[2]) + T->cell;
+    hz->rise2 = (T->zmax + TRACE_HORIZON_DZ - o[2]) / hz->r;
+    hz->rise2 *= hz->rise2 * (1.0 + 1e-9);
     i0 = (uint32_t)cell_of(o[0] - hz->r, T->x0, T->inv, T->nx);
     i1 = (uint32_t)cell_of(o[0] + hz->r, T->x0, T->inv, T->nx);
     j0 = (uint32_t)cell_of(o[1] - hz->r, T->y0, T->inv, T->ny);
@@ -1033,13 +1032,16 @@ void trace_horizon_make(const tracer *T, const double o[3], trace_horizon *hz)
 
 int trace_horizon_sky(const trace_horizon *hz, const double d[3])
 {
-    double h2 = d[0] * d[0] + d[1] * d[1], h;
+    double h2 = d[0] * d[0] + d[1] * d[1], z2 = d[2] * d[2];
+    uint32_t k;
     if (!hz->on || !(d[2] > 0.0) || !(h2 > 0.0))
         return 0;
-    h = sqrt(h2);
-    /* above every building within r, and above the tallest beyond r */
-    return d[2] > hz->tan[horizon_sector(pseudo_angle(d[0], d[1]))] * h * (1.0 + 1e-9) &&
-           hz->o[2] + hz->r * (d[2] / h) > hz->zmax + TRACE_HORIZON_DZ;
+    /* above the tallest building beyond r: o_z + r d_z / |d_xy| over it */
+    if (!(z2 > hz->rise2 * h2))
+        return 0;
+    /* and above every building within r in its sector */
+    k = (uint32_t)(pseudo_angle(d[0], d[1]) * (TRACE_HORIZON_SECTORS / 4.0));
+    return z2 > hz->tan2[k >= TRACE_HORIZON_SECTORS ? k - TRACE_HORIZON_SECTORS : k] * h2;
 }
 
 double trace_top(tracer *T, double x, double y, uint32_t *bld)

@@ -236,10 +236,10 @@ int trace_box_clear(const tracer *T, double x0, double y0, double x1, double y1,
 #define TRACE_HORIZON_DZ 1e-6
 
 typedef struct trace_horizon {
-    double o[3];
-    double r, zmax;
+    double r;          /* buildings within r are in the sectors */
+    double rise2;      /* squared elevation tangent over the tallest building at r */
     int on;            /* 0: o is above every building, in a building's box, or on its edge */
-    double tan[TRACE_HORIZON_SECTORS];
+    double tan2[TRACE_HORIZON_SECTORS]; /* squared tangents (a hair up) */
 } trace_horizon;
 
 /* The horizon from o (o[2] >= 0). Reads the grid's building lists. */
