@@ -243,15 +243,15 @@ static plx_status sectors(lr_work *w, uint32_t nv)
 
 static uint32_t find_sector(const double *bang, uint32_t nsec, double a)
 {
-    uint32_t lo = 0, hi = nsec;
+    uint32_t lo = 0, n = nsec;
     if (a < bang[0])
         return nsec - 1;
-    while (hi - lo > 1) {
-        uint32_t mid = (lo + hi) / 2;
-        if (bang[mid] <= a)
-            lo = mid;
-        else
-            hi = mid;
+    /* the last sector starting at or before a, halving [lo, lo + n) with
+     * a select rather than a branch (the comparison is unpredictable) */
+    while (n > 1) {
+        uint32_t half = n / 2;
+        lo = bang[lo + half] <= a ? lo + half : lo;
+        n -= half;
     }
     return lo;
 }

@@ -33,6 +33,11 @@
  * the air (the hemisphere above its normal); nothing here needs P to be on
  * a surface.
  *
+ * RAYS. At a point facing straight up every ray goes up; those over the
+ * point's horizon (trace_horizon_sky, made once per gather) meet nothing
+ * and are not walked: the same answers, most of the rays of a ground
+ * point in a street.
+ *
  * MEMORY. None: one ray and one direct-light answer per direction (the
  * light object's region cache is filled on demand from its own pool). Not
  * for two threads at once (the tracer's counters, the light cache).

@@ -30,8 +30,10 @@
  *
  * VIEWS FROM ABOVE (icache_set_spacing). The aerial light map's indirect
  * layer uses one level, ICACHE_AERIAL (8 m) everywhere, records of
- * ICACHE_AERIAL_SIDE^2 directions (kept apart from the street views'
- * records of the same level: their own key bit), and never the
+ * ICACHE_AERIAL_SIDE^2 directions that read the photon buffers (E_later)
+ * at one direction of each ICACHE_AERIAL_LATER^2 strata
+ * (final_gather_rgb_later; E_direct at every direction), kept apart from
+ * the street views' records of the same level (their own key bit), never the
  * photon buffers for points with a grid: light stays on the surface it was
  * gathered on (the records' grids respect walls and roof edges), where the
  * buffers' coarse records spread it 100 m. (Aerial frames read the layer
@@ -42,7 +44,8 @@
  * the same height as over P (within 1 mm: open ground stays open ground,
  * a roof stays that roof's height, and the same building) and, on grids of 4 m and coarser, no
  * wall stands between P and it (a horizontal ray 5 cm above the surface:
- * a cell may span a small building, with the same ground beyond it); on a
+ * a cell may span a small building, with the same ground beyond it; none
+ * is cast in a cell where trace_box_clear finds no wall at that height); on a
  * wall, when a probe ray from 5 mm in front of it meets the same edge and
  * no building stands against it there. Invalid vertices get no weight and the
  * others are renormalised; a level whose four vertices are all invalid
