@@ -185,7 +185,8 @@ static void test_energy_closed_room(void **state)
     fixture f;
     double xy[16] = {0, 0, 20, 0, 20, 20, 0, 20, 5, 5, 5, 15, 15, 15, 15, 5};
     uint32_t rn[2] = {4, 4}, b;
-    double a = 0.5, sd = 0.0, si = 0.0, sfirst = 0.0, ratio, s24 = 0.0, s24l = 0.0;
+    double a = 0.5, sd = 0.0, si = 0.0, sfirst = 0.0, ratio, s24 = 0.0, s24l = 0.0, sd24 = 0.0;
+    int n24 = 0;
     int face, i, j, k;
     (void)state;
     fx_open(&f, 256u << 20);
@@ -205,15 +206,20 @@ static void test_energy_closed_room(void **state)
                 room_point(face, i, j, P, n);
                 assert_int_equal(light_illuminance(f.lt, P, n, &ed, NULL), PLX_OK);
                 sd += ed;
+                if ((i + j) % 7 == 0)
+                    sd24 += ed;
                 si += final_gather_rgb(f.ps, f.ps->T, f.lt, P, n, 16, 3, NULL);
                 e1 = final_gather_rgb(NULL, f.ps->T, f.lt, P, n, 16, 3, NULL);
                 sfirst += e1;
                 /* E_later at one direction of each 3 x 3 strata (the aerial
                  * layer's records): the directions and E_direct are the same */
-                s24 += final_gather_rgb(f.ps, f.ps->T, f.lt, P, n, 24, 5, NULL);
                 s24l += final_gather_rgb_later(f.ps, f.ps->T, f.lt, P, n, 24, 3, 5, NULL);
-                assert_true(final_gather_rgb_later(NULL, f.ps->T, f.lt, P, n, 24, 3, 5, NULL) ==
-                            final_gather_rgb(NULL, f.ps->T, f.lt, P, n, 24, 5, NULL));
+                if ((i + j) % 7 == 0) {
+                    s24 += final_gather_rgb(f.ps, f.ps->T, f.lt, P, n, 24, 5, NULL);
+                    n24++;
+                    assert_true(final_gather_rgb_later(NULL, f.ps->T, f.lt, P, n, 24, 3, 5, NULL) ==
+                                final_gather_rgb(NULL, f.ps->T, f.lt, P, n, 24, 5, NULL));
+                }
                 if (getenv("SHOWFACE"))
                     printf("face %d: direct %.3f gathered %.3f first %.3f\n", face, ed,
                            final_gather_rgb(f.ps, f.ps->T, f.lt, P, n, 16, 3, NULL), e1);
@@ -223,11 +229,11 @@ static void test_energy_closed_room(void **state)
            "%.3f); ratio %.4f, expected a / (1 - a) = %.4f (bound 5%%)\n",
            a, sd / 600, si / 600, sfirst / 600, ratio, a / (1 - a));
     assert_true(fabs(ratio - a / (1 - a)) < 0.05 * a / (1 - a));
-    printf("the same points, 24 x 24 directions: ratio %.4f with E_later at every direction, %.4f at "
-           "one in each 3 x 3 strata (bound 5%% of the expected)\n", s24 / sd, s24l / sd);
-    assert_true(fabs(s24 / sd - a / (1 - a)) < 0.05 * a / (1 - a));
+    printf("24 x 24 directions: ratio %.4f with E_later at one direction in each 3 x 3 strata (all "
+           "600 points), %.4f at every direction (%d of them; bound 5%% of the expected)\n",
+           s24l / sd, s24 / sd24, n24);
     assert_true(fabs(s24l / sd - a / (1 - a)) < 0.05 * a / (1 - a));
-    assert_true(s24l != s24); /* E_later was read elsewhere */
+    assert_true(fabs(s24 / sd24 - a / (1 - a)) < 0.05 * a / (1 - a));
     /* the first bounce alone carries a of it: the photons' share matters */
     assert_true(fabs(sfirst / sd - a) < 0.03 * a);
     fx_close(&f);
