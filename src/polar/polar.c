@@ -66,7 +66,7 @@ plx_status polar_build(arena *a, const scene *s, polar **out)
 
 plx_status polar_build_flags(arena *a, const scene *s, int flags, polar **out)
 {
-    arena_mark m0, m1;
+    arena_mark m0, m1, mi;
     polar *pd;
     plx_status st;
     uint32_t *inc_first = NULL, *inc = NULL, *order = NULL, nev = 0, i;
@@ -84,12 +84,27 @@ plx_status polar_build_flags(arena *a, const scene *s, int flags, polar **out)
     memcpy(pd->box, s->bounds, sizeof pd->box);
     pd->bytes[3] = sizeof(polar);
     st = polar_make_walls(a, pd);
+    mi = arena_get_mark(a);
     if (st == PLX_OK)
         st = polar_incidence(a, pd, &inc_first, &inc, &nev);
     if (st == PLX_OK)
         st = polar_insertion_order(a, pd, &order);
     if (pd->nwall > PACKED_NODES_FROM && arena_free_bytes(a) / PACKED_NODES_ROOM < pd->nwall)
         flags |= POLAR_BUILD_PACKED;
+    if (st == PLX_OK && (flags & (POLAR_BUILD_PACKED | POLAR_BUILD_WIDE_DAG))) {
+        /* the packed build makes each map's incidence after its insertion
+         * (polar_map_build): the shared one is given back, the insertion
+         * order moved down in its place */
+        uint32_t *o2;
+        arena_release(a, &mi);
+        o2 = scratch_n(a, pd->nwall, 4);
+        if (!o2)
+            st = PLX_E_NOMEM;
+        else
+            memmove(o2, order, (size_t)pd->nwall * 4);
+        order = o2;
+        inc_first = inc = NULL;
+    }
     for (i = 0; st == PLX_OK && i < 2; i++) {
         arena_mark mm = arena_get_mark(a);
         pd->map[i].frame = (int)i;

@@ -236,6 +236,11 @@ typedef struct dbuild {
     vec2 P, Q;               /* the piece being inserted: its frame ends */
     uint32_t *hint;          /* per canonical point: its x node, POLAR_NONE */
     int fail;                /* 1: out of memory, 2: pieces not planar */
+    int compact;             /* 1: the leaves dropped (polar_dag_compact):
+                              * nnode inner nodes in rank order, a child
+                              * below nnode an inner node, else nnode + a
+                              * slot, then (polar_dag_resolve) nnode + a
+                              * region or nnode + regions + solid word */
     uint64_t steps;          /* search nodes and trapezoids visited */
 } dbuild;
 
@@ -264,6 +269,8 @@ typedef struct dag_rank {
     uint32_t nq;             /* inner nodes */
 } dag_rank;
 plx_status polar_dag_words(arena *a, dbuild *b, dag_rank *rk);
+plx_status polar_dag_compact(arena *a, dbuild *b);
+plx_status polar_dag_resolve(dbuild *b, uint32_t nreg);
 plx_status polar_keep_regions(arena *a, polar *pd, polar_map *m, dbuild *b, uint32_t *regd,
                               uint32_t nreg);
 plx_status polar_dag_keep(arena *a, polar *pd, polar_map *m, dbuild *b, const dag_rank *rk,

@@ -355,8 +355,8 @@ static void frame_box(const polar *pd, polar_map *m)
 }
 
 
-/* Per piece: the sweep's data (N) and its canonical ends (SR, all else
- * unset: POLAR_NONE); canon: per point the first event point at its
+/* Per piece: the sweep's data (N, unless NULL: made later) and its
+ * canonical ends (SR, all else unset: POLAR_NONE); canon: per point the first event point at its
  * position. */
 static void frame_pieces(polar *pd, polar_map *m, snode *N, sroles *SR,
                          const uint32_t *canon)
@@ -368,10 +368,27 @@ static void frame_pieces(polar *pd, polar_map *m, snode *N, sroles *SR,
         seg_ends(pd, m->frame, s, &l, &r);
         SR[s].end[0] = canon[l];
         SR[s].end[1] = canon[r];
+        if (!N)
+            continue;
         N[s].cov = 0;
         N[s].open = POLAR_NONE;
         N[s].prev = N[s].next = POLAR_NONE;
     }
+}
+
+/* The sweep's data per piece, made after the insertion (the late order). */
+static snode *new_snodes(arena *a, const polar *pd)
+{
+    snode *N = scratch_n(a, pd->nseg, sizeof(snode));
+    uint32_t s;
+    if (!N)
+        return NULL;
+    for (s = 0; s < pd->nseg; s++) {
+        N[s].cov = 0;
+        N[s].open = POLAR_NONE;
+        N[s].prev = N[s].next = POLAR_NONE;
+    }
+    return N;
 }
 
 /* The events in sweep order (evs, EV_SAME marking a position already
@@ -480,6 +497,9 @@ static uint32_t *region_slots(arena *a, const polar *pd, const dbuild *b, uint32
  * piece) in the low end of the arena. The sweep's regions live in those
  * slots (regd: 4 bytes per live trapezoid names them), and are kept in
  * place (polar_keep_regions) before the search nodes are (scratch).
+ * With no incidence given (the packed build, see polar_build), N and the
+ * incidence are made after the insertion instead, once the DAG's leaves
+ * are dropped (polar_dag_compact), and given back before the DAG is kept.
  * README "Polar build scratch". */
 plx_status polar_map_build(arena *a, polar *pd, polar_map *m, const uint32_t *inc_first,
                            const uint32_t *inc, uint32_t nev,
@@ -487,29 +507,38 @@ plx_status polar_map_build(arena *a, polar *pd, polar_map *m, const uint32_t *in
 {
     sweep w;
     dbuild b;
-    uint32_t *evs, *canon, *regd, nlive, span, maxdeg;
+    uint32_t *evs, *canon, *regd, nlive, span, maxdeg, *tf, *ti, tn;
     sroles *SR;
     dag_rank rk;
-    arena_mark mk;
+    arena_mark mk, ms;
     plx_status st;
+    int late = inc_first == NULL;
     if (pd->npts >= (1u << 26) || pd->nwall >= (1u << 26))
         return PLX_E_NOMEM;   /* indices must fit in 30 bits (26 here) */
     memset(&w, 0, sizeof w);
     memset(&b, 0, sizeof b);
+    memset(&rk, 0, sizeof rk);
     w.pd = pd;
     w.m = m;
-    w.inc_first = inc_first;
-    w.inc = inc;
-    w.N = scratch_n(a, pd->nseg, sizeof(snode));
+    if (!late && !(w.N = scratch_n(a, pd->nseg, sizeof(snode))))
+        return PLX_E_NOMEM;
     w.SR = SR = scratch_n(a, pd->nseg, sizeof(sroles));
     evs = scratch_n(a, nev, 4);
-    if (!w.N || !SR || !evs)
+    if (!SR || !evs)
         return PLX_E_NOMEM;
     frame_box(pd, m);
     mk = arena_get_mark(a);
     canon = scratch_n(a, pd->npts, 4);
     if (!canon)
         return PLX_E_NOMEM;
+    if (late) {
+        /* the incidence for the sort alone, given back with it */
+        st = polar_incidence(a, pd, &tf, &ti, &tn);
+        if (st != PLX_OK)
+            return st;
+        PLX_ASSERT(tn == nev);
+        inc_first = tf;
+    }
     st = sort_events(a, pd, m->frame, nev, inc_first, evs, canon, &span, &maxdeg);
     if (st != PLX_OK)
         return st;
@@ -518,6 +547,23 @@ plx_status polar_map_build(arena *a, polar *pd, polar_map *m, const uint32_t *in
     st = polar_dag_build(a, pd, m, &b, SR, order, span, flags);
     if (st != PLX_OK)
         return st;
+    ms = arena_get_mark(a);
+    if (late) {
+        st = polar_dag_compact(a, &b);
+        if (st != PLX_OK)
+            return st;
+        ms = arena_get_mark(a);
+        w.N = new_snodes(a, pd);
+        if (!w.N)
+            return PLX_E_NOMEM;
+        st = polar_incidence(a, pd, &tf, &ti, &tn);
+        if (st != PLX_OK)
+            return st;
+        inc_first = tf;
+        inc = ti;
+    }
+    w.inc_first = inc_first;
+    w.inc = inc;
     w.DT = b.T;
     w.SR = b.SR;
     w.PR = b.PR;
@@ -536,7 +582,7 @@ plx_status polar_map_build(arena *a, polar *pd, polar_map *m, const uint32_t *in
         return PLX_E_NOMEM;
     *steps += w.steps + b.steps;
     if (!(flags & POLAR_BUILD_NO_DAG)) {
-        st = polar_dag_words(a, &b, &rk);
+        st = b.compact ? polar_dag_resolve(&b, w.ntrap) : polar_dag_words(a, &b, &rk);
         if (st != PLX_OK)
             return st;
     }
@@ -546,6 +592,14 @@ plx_status polar_map_build(arena *a, polar *pd, polar_map *m, const uint32_t *in
     /* polar_memory: the axes (lp, rp, nb) and the regions (top, bot) */
     pd->bytes[0] -= (size_t)w.ntrap * 8;
     pd->bytes[1] += (size_t)w.ntrap * 8;
+    if (b.compact) {
+        /* the sweep's data, the incidence and lists given back (the
+         * compacted nodes lie below them) */
+        arena_mark r = arena_get_mark(a);
+        r.hi = ms.hi;
+        r.used[PLX_PART_SCRATCH] = ms.used[PLX_PART_SCRATCH];
+        arena_release(a, &r);
+    }
     if (flags & POLAR_BUILD_NO_DAG)
         return PLX_OK;
     return polar_dag_keep(a, pd, m, &b, &rk, flags);

@@ -709,6 +709,112 @@ static uint32_t child_word(const dbuild *b, const dag_rank *rk, uint32_t c)
     }
 }
 
+/* The packed build's DAG before the sweep (the late order of
+ * polar_map_build): the leaves dropped and the inner nodes moved down to
+ * their ranks in place, their children renamed first (an inner node by
+ * its rank, a leaf by nq + its slot, nq the inner nodes; the leaves are
+ * read, not written); then the chunks past the last inner node and the
+ * rank bitmap are given back, and b->nnode is nq (b->compact). Nothing is
+ * done when the nodes are not packed, the root is a leaf or a child field
+ * could not hold nq + a slot + a solid word. */
+plx_status polar_dag_compact(arena *a, dbuild *b)
+{
+    arena_mark mk = arena_get_mark(a), r;
+    uint32_t i, j, k, nq = 0, nw64 = (b->nnode + 63) / 64, keep, *before;
+    uint64_t *bits, off;
+    if (!b->packed || b->nnode == 0)
+        return PLX_OK;
+    bits = scratch_n(a, nw64, 8);
+    before = scratch_n(a, nw64, 4);
+    if (!bits || !before)
+        return PLX_E_NOMEM;
+    memset(bits, 0, (size_t)nw64 * 8);
+    for (i = 0; i < b->nnode; i++) {
+        const uint64_t *cw = nchunk_of(b, i, &off, 1);
+        if ((i & 63) == 0)
+            before[i >> 6] = nq;
+        if (KIND(ntest(b, cw, off, 1)) != N_LEAF) {
+            bits[i >> 6] |= (uint64_t)1 << (i & 63);
+            nq++;
+        }
+    }
+    if (!(bits[0] & 1) || (uint64_t)nq + b->cap + b->pd->nbld + 1 > ((uint64_t)1 << b->cb)) {
+        arena_release(a, &mk);
+        return PLX_OK;
+    }
+    for (i = 0; i < b->nnode; i++) {
+        uint64_t *cw;
+        if (!(bits[i >> 6] >> (i & 63) & 1))
+            continue;
+        cw = nchunk_of(b, i, &off, 1);
+        for (k = 0; k < 2; k++) {
+            uint64_t at = off + b->tb + (k ? b->cb : 0), w, coff;
+            uint32_t c = (uint32_t)field_get(cw, at, b->cb), v;
+            w = bits[c >> 6];
+            if (w >> (c & 63) & 1) {
+                v = before[c >> 6] + popcount64(w & (((uint64_t)1 << (c & 63)) - 1));
+            } else {
+                const uint64_t *lw = nchunk_of(b, c, &coff, 1);
+                v = nq + IDX(ntest(b, lw, coff, 1));
+            }
+            field_set(cw, at, b->cb, v);
+        }
+    }
+    for (i = 0, j = 0; i < b->nnode; i++) {
+        if (!(bits[i >> 6] >> (i & 63) & 1))
+            continue;
+        if (j != i) {
+            uint64_t ioff, joff, x, y;
+            const uint64_t *src = nchunk_of(b, i, &ioff, 1);
+            uint64_t *dst;
+            x = field_get(src, ioff, b->tb + b->cb);
+            y = field_get(src, ioff + b->tb + b->cb, b->cb);
+            dst = nchunk_of(b, j, &joff, 1);
+            field_set(dst, joff, b->tb + b->cb, x);
+            field_set(dst, joff + b->tb + b->cb, b->cb, y);
+        }
+        j++;
+    }
+    /* the chunks are the last scratch before the bitmap: everything past
+     * chunk keep - 1 goes */
+    keep = (nq + NODE_CHUNK - 1) >> NODE_BITS;
+    r = arena_get_mark(a);
+    r.hi = a->cap - (size_t)((unsigned char *)(void *)b->chunk[keep - 1] - a->base);
+    r.used[PLX_PART_SCRATCH] -= a->hi - r.hi;
+    arena_release(a, &r);
+    b->nchunk = keep;
+    b->nnode = nq;
+    b->compact = 1;
+    return PLX_OK;
+}
+
+/* The compacted DAG's leaf children (nq + a slot) made the child words the
+ * sweep set in the slots: nq + a free region, or nq + nreg + a solid
+ * trapezoid's owner plus one (read before the slots become the regions). */
+plx_status polar_dag_resolve(dbuild *b, uint32_t nreg)
+{
+    uint32_t j, k, nq = b->nnode;
+    for (j = 0; j < nq; j++) {
+        uint64_t off;
+        uint64_t *cw = nchunk_of(b, j, &off, 1);
+        for (k = 0; k < 2; k++) {
+            uint64_t at = off + b->tb + (k ? b->cb : 0);
+            uint32_t v = (uint32_t)field_get(cw, at, b->cb), c;
+            if (v < nq)
+                continue;
+            if (v - nq >= b->ntrap)
+                return PLX_E_SCENE;
+            c = b->T[v - nq].leaf;
+            if (POLAR_TAG(c) == POLAR_CHILD_NODE ||
+                (POLAR_TAG(c) == POLAR_CHILD_FREE && POLAR_IDX(c) >= nreg))
+                return PLX_E_SCENE;
+            field_set(cw, at, b->cb,
+                      nq + POLAR_IDX(c) + (POLAR_TAG(c) == POLAR_CHILD_FREE ? 0 : nreg));
+        }
+    }
+    return PLX_OK;
+}
+
 /* The regions kept where the trapezoid slots were (no copy: the slots
  * are the last thing in the low end of the arena): every slot cut to its
  * first 32 bytes, which are a polar_trap, then region h moved from slot
@@ -783,7 +889,7 @@ plx_status polar_keep_regions(arena *a, polar *pd, polar_map *m, dbuild *b, uint
 plx_status polar_dag_keep(arena *a, polar *pd, polar_map *m, dbuild *b, const dag_rank *rk,
                           int flags)
 {
-    uint32_t i, j, nq = rk->nq;
+    uint32_t i, j, nq = b->compact ? b->nnode : rk->nq;
     m->nnode = nq;
     m->narrow = !(flags & POLAR_BUILD_WIDE_DAG) && nq < (1u << 19) && m->ntrap < (1u << 19) &&
                 pd->nbld < (1u << 19) - 1 && pd->npts < (1u << 20) && pd->nseg < (1u << 20);
@@ -793,6 +899,20 @@ plx_status polar_dag_keep(arena *a, polar *pd, polar_map *m, dbuild *b, const da
             return PLX_E_NOMEM;
     } else if (packed_nodes(a, pd, m) != PLX_OK) {
         return PLX_E_NOMEM;
+    }
+    if (b->compact) {
+        /* children: an inner node, nq + a region, nq + ntrap + a solid word */
+        for (j = 0; j < nq; j++) {
+            uint32_t t, c[2], k;
+            nread(b, j, &t, c);
+            for (k = 0; k < 2; k++)
+                c[k] = c[k] < nq               ? PACK(POLAR_CHILD_NODE, c[k])
+                       : c[k] - nq < m->ntrap ? PACK(POLAR_CHILD_FREE, c[k] - nq)
+                                              : PACK(POLAR_CHILD_SOLID, c[k] - nq - m->ntrap);
+            put_node(m, j, t, c[0], c[1]);
+        }
+        m->root = PACK(POLAR_CHILD_NODE, 0);
+        return PLX_OK;
     }
     for (i = 0, j = 0; i < b->nnode; i++) {
         uint32_t t, c[2];

@@ -113,7 +113,7 @@ static plx_status ring_build_check(uint32_t n, size_t bytes, size_t *scratch, si
      * trapezoid slots the build takes in the low end for a while */
     *kept = a.used[PLX_PART_POLAR];
     *scratch = a.peak_total - *kept;
-    assert_true(a.peak[PLX_PART_SCRATCH] <= *scratch);
+    assert_true(a.peak[PLX_PART_SCRATCH] <= a.peak_total);
     if (st == PLX_OK && check > 0)
         *bad = ring_answers(pd, xy, n, check);
     ref_scene_free(&s);
