@@ -45,7 +45,7 @@ typedef struct sweep {
      * sets in its leaf field; a free one is a region, kept in the slot
      * (its adjacency in nb: the slot's own is not read again), the
      * status naming it by its slot (snode.open) */
-    btrap *DT;
+    const dbuild *DT;        /* the map's slots (tget, tset) */
     const sroles *SR;
     const proles *PR;
     uint32_t ngap;      /* gaps opened, free or solid */
@@ -70,16 +70,10 @@ static int fp_before(const fpoint *a, const fpoint *b, const void *ctx)
 
 MSORT_DEFINE(sort_fpoints, fpoint, const void *, fp_before)
 
-/* The slot of region h. */
-static btrap *region(const sweep *w, uint32_t d)
-{
-    return &w->DT[d];
-}
-
 /* The region index of the free trapezoid in slot d (or POLAR_NONE). */
 static uint32_t regno(const sweep *w, uint32_t d)
 {
-    return d == POLAR_NONE ? POLAR_NONE : POLAR_IDX(w->DT[d].leaf);
+    return d == POLAR_NONE ? POLAR_NONE : POLAR_IDX(tget(w->DT, d, F_LEAF));
 }
 
 /* The child word of a solid trapezoid above piece s: the owner
@@ -102,21 +96,23 @@ static uint32_t solid_word(const polar *pd, int frame, uint32_t s)
 static int open_gap(sweep *w, uint32_t d, uint32_t pi, uint32_t top, uint32_t bot, int free,
                     uint32_t *h)
 {
-    btrap *t;
+    const dbuild *b = w->DT;
+    int k;
     *h = POLAR_NONE;
     if (d == POLAR_NONE)
         return -1;
-    t = &w->DT[d];
-    if (t->lp != pi || t->top != top || t->bot != bot || POLAR_TAG(t->leaf) != 0)
+    if (tget(b, d, F_LP) != pi || tget(b, d, F_TOP) != top || tget(b, d, F_BOT) != bot ||
+        POLAR_TAG(tget(b, d, F_LEAF)) != 0)
         return -1;
     if (free) {
         if (w->ntrap >= w->cap)
             return -1;
         *h = d;
-        t->nb[0] = t->nb[1] = t->nb[2] = t->nb[3] = POLAR_NONE;
-        t->leaf = PACK(POLAR_CHILD_FREE, w->ntrap++);
+        for (k = 0; k < 4; k++)
+            tset(b, d, F_NB + k, POLAR_NONE);
+        tset(b, d, F_LEAF, PACK(POLAR_CHILD_FREE, w->ntrap++));
     } else {
-        t->leaf = solid_word(w->pd, w->m->frame, bot);
+        tset(b, d, F_LEAF, solid_word(w->pd, w->m->frame, bot));
     }
     w->ngap++;
     return 0;
@@ -129,7 +125,7 @@ static int close_region(sweep *w, uint32_t h, uint32_t pi)
 {
     if (h == POLAR_NONE)
         return 0;
-    if (region(w, h)->rp != pi)
+    if (tget(w->DT, h, F_RP) != pi)
         return -1;
     w->nclosed++;
     return 0;
@@ -228,7 +224,7 @@ static int sweep_event(sweep *w, vec2 P, uint32_t pi, const uint32_t *pts, uint3
         uint32_t d = ns ? w->SR[w->start[0]].down[0] : POLAR_NONE;
         if (d == POLAR_NONE)
             return -1;
-        B = w->DT[d].bot;
+        B = tget(w->DT, d, F_BOT);
         if (B != m->box_bot &&
             (B >= w->pd->nseg || N[B].prev == POLAR_NONE || geom_orient(EL(w, B), ER(w, B), P) <= 0))
             return -1;
@@ -283,13 +279,13 @@ static int sweep_event(sweep *w, vec2 P, uint32_t pi, const uint32_t *pts, uint3
         }
     }
     if (G0 != POLAR_NONE)
-        region(w, G0)->nb[LR] = regno(w, H0);
+        tset(w->DT, G0, F_NB + LR, regno(w, H0));
     if (Gk != POLAR_NONE)
-        region(w, Gk)->nb[UR] = regno(w, Hm);
+        tset(w->DT, Gk, F_NB + UR, regno(w, Hm));
     if (H0 != POLAR_NONE)
-        region(w, H0)->nb[LL] = regno(w, G0);
+        tset(w->DT, H0, F_NB + LL, regno(w, G0));
     if (Hm != POLAR_NONE)
-        region(w, Hm)->nb[UL] = regno(w, Gk);
+        tset(w->DT, Hm, F_NB + UL, regno(w, Gk));
     return 0;
 }
 
@@ -476,9 +472,11 @@ static uint32_t *region_slots(arena *a, const polar *pd, const dbuild *b, uint32
                                                         : scratch_n(a, nreg, 4);
     if (!regd)
         return NULL;
-    for (t = 0; t < b->ntrap; t++)
-        if (POLAR_TAG(b->T[t].leaf) == POLAR_CHILD_FREE)
-            regd[POLAR_IDX(b->T[t].leaf)] = t;
+    for (t = 0; t < b->ntrap; t++) {
+        uint32_t c = tget(b, t, F_LEAF);
+        if (POLAR_TAG(c) == POLAR_CHILD_FREE)
+            regd[POLAR_IDX(c)] = t;
+    }
     return regd;
 }
 
@@ -564,7 +562,7 @@ plx_status polar_map_build(arena *a, polar *pd, polar_map *m, const uint32_t *in
     }
     w.inc_first = inc_first;
     w.inc = inc;
-    w.DT = b.T;
+    w.DT = &b;
     w.SR = b.SR;
     w.PR = b.PR;
     /* every region is a live trapezoid of the map, each once (open_gap) */

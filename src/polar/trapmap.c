@@ -42,26 +42,6 @@ static inline uint64_t *nchunk_of(const dbuild *b, uint32_t n, uint64_t *off, in
     return b->chunk[n >> NODE_BITS];
 }
 
-/* A field of 1 to 63 bits at bit off of w[], read and written without a
- * branch (a chunk has a word more at its end; the offsets are the data's,
- * so a branch on them would be mispredicted often). */
-static inline uint64_t field_get(const uint64_t *w, uint64_t off, uint32_t width)
-{
-    size_t i = (size_t)(off >> 6);
-    uint32_t sh = (uint32_t)(off & 63);
-    uint64_t x = (w[i] >> sh) | ((w[i + 1] << 1) << (63 - sh));
-    return x & (((uint64_t)1 << width) - 1);
-}
-
-static inline void field_set(uint64_t *w, uint64_t off, uint32_t width, uint64_t v)
-{
-    size_t i = (size_t)(off >> 6);
-    uint32_t sh = (uint32_t)(off & 63);
-    uint64_t mask = ((uint64_t)1 << width) - 1;
-    w[i] = (w[i] & ~(mask << sh)) | v << sh;
-    w[i + 1] = (w[i + 1] & ~((mask >> 1) >> (63 - sh))) | ((v >> 1) >> (63 - sh));
-}
-
 /* The test of a packed node (its first field) as kind << 30 | index. */
 static inline uint32_t unpack_test(const dbuild *b, uint32_t v)
 {
@@ -140,12 +120,30 @@ static vec2 bpt(const dbuild *b, uint32_t i)
  * array; b->cap bounds them (see polar_dag_build). */
 #define TRAP_STEP 2048u
 
+static int grow_packed_traps(dbuild *b, uint32_t step)
+{
+    /* 2,048 slots are whole words; the first step has a word more */
+    size_t words = ((size_t)step * b->sw + 63) / 64 + (b->TW ? 0 : 1);
+    uint64_t *p = arena_alloc(b->a, PLX_PART_POLAR, words * 8, 8);
+    if (!p)
+        return 0;
+    memset(p, 0, words * 8);
+    if (!b->TW)
+        b->TW = p;
+    else if (p != b->TW + (size_t)b->tcap * b->sw / 64 + 1)
+        return 0;             /* not contiguous: cannot happen */
+    b->tcap += step;
+    return 1;
+}
+
 static int grow_traps(dbuild *b)
 {
     uint32_t step = b->cap - b->tcap < TRAP_STEP ? b->cap - b->tcap : TRAP_STEP;
     btrap *p;
     if (step == 0)
         return 0;
+    if (b->tpk)
+        return grow_packed_traps(b, step);
     p = arena_alloc(b->a, PLX_PART_POLAR, (size_t)step * sizeof(btrap), 16);
     if (!p)
         return 0;
@@ -162,7 +160,7 @@ static uint32_t new_trap(dbuild *b)
     uint32_t t;
     if (b->nfree > 0) {
         t = b->freel;
-        b->freel = b->T[t].nb[0];
+        b->freel = tget(b, t, F_NB + 0);
         b->nfree--;
     } else {
         if (b->ntrap >= b->tcap && !grow_traps(b)) {
@@ -171,21 +169,24 @@ static uint32_t new_trap(dbuild *b)
         }
         t = b->ntrap++;
     }
-    b->T[t].nb[0] = b->T[t].nb[1] = b->T[t].nb[2] = b->T[t].nb[3] = POLAR_NONE;
-    b->T[t].leaf = POLAR_NONE;
+    tset(b, t, F_NB + 0, POLAR_NONE);
+    tset(b, t, F_NB + 1, POLAR_NONE);
+    tset(b, t, F_NB + 2, POLAR_NONE);
+    tset(b, t, F_NB + 3, POLAR_NONE);
+    tset(b, t, F_LEAF, POLAR_NONE);
     return t;
 }
 
 /* Frame coordinates of the right axis point of trapezoid t. */
 static vec2 trc(const dbuild *b, uint32_t t)
 {
-    return fpt(b->pd, b->frame, b->T[t].rp);
+    return fpt(b->pd, b->frame, tget(b, t, F_RP));
 }
 
 /* Gives slot t back (its leaf already POLAR_NONE). */
 static void free_trap(dbuild *b, uint32_t t)
 {
-    b->T[t].nb[0] = b->freel;
+    tset(b, t, F_NB + 0, b->freel);
     b->freel = t;
     b->nfree++;
 }
@@ -279,32 +280,32 @@ static uint32_t find_last(dbuild *b, uint32_t n, vec2 Q, vec2 P)
 /* Replaces the neighbour link 'old' of trapezoid x on side f. */
 static void relink(dbuild *b, uint32_t x, int f, uint32_t old, uint32_t nw)
 {
-    if (x != POLAR_NONE && b->T[x].nb[f] == old)
-        b->T[x].nb[f] = nw;
+    if (x != POLAR_NONE && tget(b, x, F_NB + (f)) == old)
+        tset(b, x, F_NB + (f), nw);
 }
 
 static void set_trap(dbuild *b, uint32_t t, uint32_t lp, uint32_t rp, uint32_t top, uint32_t bot)
 {
-    b->T[t].lp = lp;
-    b->T[t].rp = rp;
-    b->T[t].top = top;
-    b->T[t].bot = bot;
+    tset(b, t, F_LP, lp);
+    tset(b, t, F_RP, rp);
+    tset(b, t, F_TOP, top);
+    tset(b, t, F_BOT, bot);
 }
 
 /* Records trapezoid t (just made, its sides final) in the roles it holds. */
 static void note_trap(dbuild *b, uint32_t t)
 {
-    const btrap *x = &b->T[t];
-    sroles *top = &b->SR[x->top], *bot = &b->SR[x->bot];
-    b->PR[x->lp].side[0] = t;
-    b->PR[x->rp].side[1] = t;
-    if (top->end[0] == x->lp)
+    uint32_t lp = tget(b, t, F_LP), rp = tget(b, t, F_RP);
+    sroles *top = &b->SR[tget(b, t, F_TOP)], *bot = &b->SR[tget(b, t, F_BOT)];
+    b->PR[lp].side[0] = t;
+    b->PR[rp].side[1] = t;
+    if (top->end[0] == lp)
         top->down[0] = t;
-    if (top->end[1] == x->rp)
+    if (top->end[1] == rp)
         top->down[1] = t;
-    if (bot->end[0] == x->lp)
+    if (bot->end[0] == lp)
         bot->up[0] = t;
-    if (bot->end[1] == x->rp)
+    if (bot->end[1] == rp)
         bot->up[1] = t;
 }
 
@@ -321,29 +322,30 @@ static uint32_t walk_at(dbuild *b, uint32_t p, vec2 D, int right)
     int k = right ? 0 : 1;
     uint32_t t = b->PR[p].side[k], n;
     for (n = 0; n < WALK_MAX && t != POLAR_NONE; n++) {
-        const btrap *x = &b->T[t];
-        uint32_t e = right ? x->lp : x->rp;
+        uint32_t e = tget(b, t, right ? F_LP : F_RP), xt, xb;
         int o;
-        if (x->leaf == POLAR_NONE || e != p)
+        if (tget(b, t, F_LEAF) == POLAR_NONE || e != p)
             return POLAR_NONE;
         b->steps++;
-        if (b->SR[x->top].end[k] == p) {
-            o = geom_orient(pend(b->pd, b->frame, b->SR, x->top, 0),
-                             pend(b->pd, b->frame, b->SR, x->top, 1), D);
+        xt = tget(b, t, F_TOP);
+        xb = tget(b, t, F_BOT);
+        if (b->SR[xt].end[k] == p) {
+            o = geom_orient(pend(b->pd, b->frame, b->SR, xt, 0),
+                             pend(b->pd, b->frame, b->SR, xt, 1), D);
             if (o == 0)
                 return POLAR_NONE;    /* overlapping pieces: the DAG says so */
             if (o > 0) {
-                t = b->SR[x->top].up[k];
+                t = b->SR[xt].up[k];
                 continue;
             }
         }
-        if (b->SR[x->bot].end[k] == p) {
-            o = geom_orient(pend(b->pd, b->frame, b->SR, x->bot, 0),
-                             pend(b->pd, b->frame, b->SR, x->bot, 1), D);
+        if (b->SR[xb].end[k] == p) {
+            o = geom_orient(pend(b->pd, b->frame, b->SR, xb, 0),
+                             pend(b->pd, b->frame, b->SR, xb, 1), D);
             if (o == 0)
                 return POLAR_NONE;
             if (o < 0) {
-                t = b->SR[x->bot].down[k];
+                t = b->SR[xb].down[k];
                 continue;
             }
         }
@@ -358,13 +360,13 @@ static uint32_t follow_back(dbuild *b, uint32_t t, vec2 P, vec2 Q)
 {
     uint32_t k = 0, i;
     b->list[0] = t;
-    while (lex_cmp(P, bpt(b, b->T[t].lp)) < 0) {
-        int o = geom_orient(P, Q, bpt(b, b->T[t].lp));
-        uint32_t nx = o > 0 ? b->T[t].nb[LL] : b->T[t].nb[UL];
+    while (lex_cmp(P, bpt(b, tget(b, t, F_LP))) < 0) {
+        int o = geom_orient(P, Q, bpt(b, tget(b, t, F_LP)));
+        uint32_t nx = o > 0 ? tget(b, t, F_NB + (LL)) : tget(b, t, F_NB + (UL));
         /* the neighbour must be live and share the axis: the walk moves
          * strictly leftwards, whatever the input */
-        if (o == 0 || nx == POLAR_NONE || k + 1 >= b->lcap || b->T[nx].leaf == POLAR_NONE ||
-            b->T[nx].rp != b->T[t].lp) {
+        if (o == 0 || nx == POLAR_NONE || k + 1 >= b->lcap || tget(b, nx, F_LEAF) == POLAR_NONE ||
+            tget(b, nx, F_RP) != tget(b, t, F_LP)) {
             b->fail = 2;
             return k;
         }
@@ -404,9 +406,9 @@ static uint32_t follow(dbuild *b, uint32_t l, uint32_t r)
         if (lex_cmp(Q, rc) <= 0)
             break;
         o = geom_orient(P, Q, rc);
-        nx = o > 0 ? b->T[t].nb[LR] : b->T[t].nb[UR];
-        if (o == 0 || nx == POLAR_NONE || k + 1 >= b->lcap || b->T[nx].leaf == POLAR_NONE ||
-            b->T[nx].lp != b->T[t].rp) {
+        nx = o > 0 ? tget(b, t, F_NB + (LR)) : tget(b, t, F_NB + (UR));
+        if (o == 0 || nx == POLAR_NONE || k + 1 >= b->lcap || tget(b, nx, F_LEAF) == POLAR_NONE ||
+            tget(b, nx, F_LP) != tget(b, t, F_RP)) {
             b->fail = 2;
             return k;
         }
@@ -425,32 +427,32 @@ static void make_chain(dbuild *b, uint32_t s, uint32_t l, uint32_t r, uint32_t k
     if (b->fail)
         return;
     if (up)
-        set_trap(b, cur, l, r, b->T[b->list[0]].top, s);
+        set_trap(b, cur, l, r, tget(b, b->list[0], F_TOP), s);
     else
-        set_trap(b, cur, l, r, s, b->T[b->list[0]].bot);
+        set_trap(b, cur, l, r, s, tget(b, b->list[0], F_BOT));
     part[0] = cur;
     for (j = 0; j < k; j++) {
-        uint32_t t = b->list[j], t1 = b->list[j + 1], R = b->T[t].rp, nx, x;
+        uint32_t t = b->list[j], t1 = b->list[j + 1], R = tget(b, t, F_RP), nx, x;
         int o = geom_orient(P, Q, trc(b, t));
         if ((o > 0) != (up != 0)) {
             part[j + 1] = cur;        /* the axis at R is cut away: merge */
             continue;
         }
-        b->T[cur].rp = R;
+        tset(b, cur, F_RP, R);
         nx = new_trap(b);
         if (b->fail)
             return;
         if (up)
-            set_trap(b, nx, R, r, b->T[t1].top, s);
+            set_trap(b, nx, R, r, tget(b, t1, F_TOP), s);
         else
-            set_trap(b, nx, R, r, s, b->T[t1].bot);
-        x = b->T[t].nb[fc];
-        b->T[cur].nb[fc] = x;
+            set_trap(b, nx, R, r, s, tget(b, t1, F_BOT));
+        x = tget(b, t, F_NB + (fc));
+        tset(b, cur, F_NB + (fc), x);
         relink(b, x, fo, t, cur);
-        b->T[cur].nb[up ? LR : UR] = nx;
-        b->T[nx].nb[up ? LL : UL] = cur;
-        x = b->T[t1].nb[fo];
-        b->T[nx].nb[fo] = x;
+        tset(b, cur, F_NB + (up ? LR : UR), nx);
+        tset(b, nx, F_NB + (up ? LL : UL), cur);
+        x = tget(b, t1, F_NB + (fo));
+        tset(b, nx, F_NB + (fo), x);
         relink(b, x, fc, t1, nx);
         cur = nx;
         part[j + 1] = cur;
@@ -467,19 +469,19 @@ static void link_end(dbuild *b, int left, uint32_t E, const uint32_t *enb, uint3
     int ou = left ? UL : UR, ol = left ? LL : LR;     /* outer sides */
     int iu = left ? UR : UL, il = left ? LR : LL;     /* their far sides */
     if (X != POLAR_NONE) {
-        b->T[X].nb[ou] = enb[ou];
-        b->T[X].nb[ol] = enb[ol];
+        tset(b, X, F_NB + (ou), enb[ou]);
+        tset(b, X, F_NB + (ol), enb[ol]);
         relink(b, enb[ou], iu, E, X);
         relink(b, enb[ou], il, E, X);
         relink(b, enb[ol], iu, E, X);
         relink(b, enb[ol], il, E, X);
-        b->T[X].nb[iu] = U;
-        b->T[X].nb[il] = L;
-        b->T[U].nb[ou] = X;
-        b->T[L].nb[ol] = X;
+        tset(b, X, F_NB + (iu), U);
+        tset(b, X, F_NB + (il), L);
+        tset(b, U, F_NB + (ou), X);
+        tset(b, L, F_NB + (ol), X);
     } else {
-        b->T[U].nb[ou] = enb[ou];
-        b->T[L].nb[ol] = enb[ol];
+        tset(b, U, F_NB + (ou), enb[ou]);
+        tset(b, L, F_NB + (ol), enb[ol]);
         relink(b, enb[ou], iu, E, U);
         relink(b, enb[ou], il, E, L);
         relink(b, enb[ol], iu, E, U);
@@ -489,8 +491,8 @@ static void link_end(dbuild *b, int left, uint32_t E, const uint32_t *enb, uint3
 
 static void leaf_of(dbuild *b, uint32_t t)
 {
-    if (t != POLAR_NONE && b->T[t].leaf == POLAR_NONE)
-        b->T[t].leaf = new_node(b, N_LEAF, t, 0, 0);
+    if (t != POLAR_NONE && tget(b, t, F_LEAF) == POLAR_NONE)
+        tset(b, t, F_LEAF, new_node(b, N_LEAF, t, 0, 0));
 }
 
 /* The old leaf n of crossed trapezoid j becomes the search for its parts:
@@ -498,7 +500,7 @@ static void leaf_of(dbuild *b, uint32_t t)
 static void replace_leaf(dbuild *b, uint32_t s, uint32_t l, uint32_t r, uint32_t n, uint32_t j,
                          uint32_t A, uint32_t B)
 {
-    uint32_t y0 = b->T[b->lo[j]].leaf, y1 = b->T[b->up[j]].leaf, inner, xq;
+    uint32_t y0 = tget(b, b->lo[j], F_LEAF), y1 = tget(b, b->up[j], F_LEAF), inner, xq;
     uint32_t ky = ykind(b, s);
     if (A == POLAR_NONE && B == POLAR_NONE) {
         nset(b, n, PACK(ky, s), y0, y1);
@@ -506,15 +508,15 @@ static void replace_leaf(dbuild *b, uint32_t s, uint32_t l, uint32_t r, uint32_t
     }
     inner = new_node(b, ky, s, y0, y1);
     if (A != POLAR_NONE) {
-        xq = B != POLAR_NONE ? new_node(b, N_X, r, inner, b->T[B].leaf) : inner;
+        xq = B != POLAR_NONE ? new_node(b, N_X, r, inner, tget(b, B, F_LEAF)) : inner;
         if (b->fail)
             return;
-        nset(b, n, PACK(N_X, l), b->T[A].leaf, xq);
+        nset(b, n, PACK(N_X, l), tget(b, A, F_LEAF), xq);
         b->hint[l] = n;
         if (B != POLAR_NONE)
             b->hint[r] = xq;
     } else if (!b->fail) {
-        nset(b, n, PACK(N_X, r), inner, b->T[B].leaf);
+        nset(b, n, PACK(N_X, r), inner, tget(b, B, F_LEAF));
         b->hint[r] = n;
     }
 }
@@ -533,21 +535,21 @@ static void insert_seg(dbuild *b, const irec *in)
     first = b->list[0];
     last = b->list[k];
     for (j = 0; j < 4; j++) {
-        fnb[j] = b->T[first].nb[j];
-        lnb[j] = b->T[last].nb[j];
+        fnb[j] = tget(b, first, F_NB + (j));
+        lnb[j] = tget(b, last, F_NB + (j));
     }
     /* the first trapezoid holds l (its left axis at or before l), the
      * last r: A, B are needed unless those axes are l's and r's own
      * (canonical indices: one index per position) */
-    if (l != b->T[first].lp) {
+    if (l != tget(b, first, F_LP)) {
         A = new_trap(b);
         if (!b->fail)
-            set_trap(b, A, b->T[first].lp, l, b->T[first].top, b->T[first].bot);
+            set_trap(b, A, tget(b, first, F_LP), l, tget(b, first, F_TOP), tget(b, first, F_BOT));
     }
-    if (!b->fail && r != b->T[last].rp) {
+    if (!b->fail && r != tget(b, last, F_RP)) {
         B = new_trap(b);
         if (!b->fail)
-            set_trap(b, B, r, b->T[last].rp, b->T[last].top, b->T[last].bot);
+            set_trap(b, B, r, tget(b, last, F_RP), tget(b, last, F_TOP), tget(b, last, F_BOT));
     }
     if (!b->fail)
         make_chain(b, s, l, r, k, 1);
@@ -565,9 +567,9 @@ static void insert_seg(dbuild *b, const irec *in)
     }
     for (j = 0; j <= k && !b->fail; j++) {
         uint32_t t = b->list[j];
-        replace_leaf(b, s, l, r, b->T[t].leaf, j, j == 0 ? A : POLAR_NONE,
+        replace_leaf(b, s, l, r, tget(b, t, F_LEAF), j, j == 0 ? A : POLAR_NONE,
                      j == k ? B : POLAR_NONE);
-        b->T[t].leaf = POLAR_NONE;
+        tset(b, t, F_LEAF, POLAR_NONE);
         free_trap(b, t);
     }
     if (A != POLAR_NONE)
@@ -674,7 +676,7 @@ plx_status polar_dag_words(arena *a, dbuild *b, dag_rank *rk)
             continue;
         }
         /* a leaf: its child word's tag and index as its children */
-        c = b->T[IDX(t)].leaf;
+        c = tget(b, IDX(t), F_LEAF);
         if (POLAR_TAG(c) == POLAR_CHILD_NODE || (uint64_t)POLAR_IDX(c) >> b->cb)
             return PLX_E_SCENE;
         if (b->packed)
@@ -804,7 +806,7 @@ plx_status polar_dag_resolve(dbuild *b, uint32_t nreg)
                 continue;
             if (v - nq >= b->ntrap)
                 return PLX_E_SCENE;
-            c = b->T[v - nq].leaf;
+            c = tget(b, v - nq, F_LEAF);
             if (POLAR_TAG(c) == POLAR_CHILD_NODE ||
                 (POLAR_TAG(c) == POLAR_CHILD_FREE && POLAR_IDX(c) >= nreg))
                 return PLX_E_SCENE;
@@ -815,18 +817,54 @@ plx_status polar_dag_resolve(dbuild *b, uint32_t nreg)
     return PLX_OK;
 }
 
+/* Record i of the regions being kept: a packed slot (b->tpk: read as a
+ * region, its leaf field left alone), else a polar_trap of R. */
+static void rec_get(const dbuild *b, const polar_trap *R, uint32_t i, polar_trap *r)
+{
+    int k;
+    if (!b->tpk) {
+        *r = R[i];
+        return;
+    }
+    r->lp = tget(b, i, F_LP);
+    r->rp = tget(b, i, F_RP);
+    r->top = tget(b, i, F_TOP);
+    r->bot = tget(b, i, F_BOT);
+    for (k = 0; k < 4; k++)
+        r->nb[k] = tget(b, i, F_NB + k);
+}
+
+static void rec_put(const dbuild *b, polar_trap *R, uint32_t i, const polar_trap *r)
+{
+    int k;
+    if (!b->tpk) {
+        R[i] = *r;
+        return;
+    }
+    tset(b, i, F_LP, r->lp);
+    tset(b, i, F_RP, r->rp);
+    tset(b, i, F_TOP, r->top);
+    tset(b, i, F_BOT, r->bot);
+    for (k = 0; k < 4; k++)
+        tset(b, i, F_NB + k, r->nb[k]);
+}
+
 /* The regions kept where the trapezoid slots were (no copy: the slots
  * are the last thing in the low end of the arena): every slot cut to its
- * first 32 bytes, which are a polar_trap, then region h moved from slot
- * regd[h] to place h, following chains of moves (a place is written only
- * once the slot there has been moved; regd is one-to-one), and the rest
- * given back. The low end is then as if the regions had been allocated
- * after the slots were given back, as keep_n would. Marks on regd: bit 31. */
+ * first 32 bytes, which are a polar_trap (packed slots: left as they
+ * are), then region h moved from slot regd[h] to place h, following
+ * chains of moves (a place is written only once the slot there has been
+ * moved; regd is one-to-one); packed slots are then widened to
+ * polar_traps from the last down (record h ends at or before byte 32 h:
+ * a slot has at most 256 bits), the low end grown first where the
+ * regions need more than the slots had. The rest is given back. The low
+ * end is then as if the regions had been allocated after the slots were
+ * given back, as keep_n would. Marks on regd: bit 31. */
 #define MOVED 0x80000000u
 plx_status polar_keep_regions(arena *a, polar *pd, polar_map *m, dbuild *b, uint32_t *regd,
                               uint32_t nreg)
 {
-    polar_trap *R = (polar_trap *)(void *)b->T;
+    polar_trap *R = b->tpk ? (polar_trap *)(void *)b->TW : (polar_trap *)(void *)b->T;
     uint32_t i, h, nw64 = (b->ntrap + 63) / 64;
     uint64_t *needed = scratch_n(a, nw64, 8);
     arena_mark mk;
@@ -834,8 +872,18 @@ plx_status polar_keep_regions(arena *a, polar *pd, polar_map *m, dbuild *b, uint
     if (!needed)
         return PLX_E_NOMEM;
     PLX_ASSERT(sizeof(polar_trap) == 32 && sizeof(btrap) == 36 && nreg <= b->ntrap);
-    for (i = 0; i < b->ntrap; i++)
-        memmove(&R[i], &b->T[i], sizeof(polar_trap));
+    PLX_ASSERT(!b->tpk || b->sw <= 256);
+    if (b->tpk) {
+        size_t have = ((size_t)b->tcap * b->sw + 63) / 64 * 8 + 8, want = (size_t)nreg * 32;
+        if (want > have) {
+            unsigned char *p = arena_alloc(a, PLX_PART_POLAR, want - have, 8);
+            if (!p || p != (unsigned char *)(void *)R + have)
+                return PLX_E_NOMEM;
+        }
+    } else {
+        for (i = 0; i < b->ntrap; i++)
+            memmove(&R[i], &b->T[i], sizeof(polar_trap));
+    }
     memset(needed, 0, (size_t)nw64 * 8);
     for (h = 0; h < nreg; h++)
         needed[regd[h] >> 6] |= (uint64_t)1 << (regd[h] & 63);
@@ -846,27 +894,37 @@ plx_status polar_keep_regions(arena *a, polar *pd, polar_map *m, dbuild *b, uint
             continue;
         while (cur < nreg && !(regd[cur] & MOVED)) {
             uint32_t src = regd[cur];
-            R[cur] = R[src];
+            polar_trap r;
+            rec_get(b, R, src, &r);
+            rec_put(b, R, cur, &r);
             regd[cur] |= MOVED;
             cur = src;
         }
     }
     /* the rest are cycles */
     for (h = 0; h < nreg; h++) {
-        polar_trap first;
+        polar_trap first, r;
         uint32_t cur = h;
         if (regd[h] & MOVED)
             continue;
-        first = R[h];
+        rec_get(b, R, h, &first);
         for (;;) {
             uint32_t src = regd[cur];
             regd[cur] |= MOVED;
             if (src == h) {
-                R[cur] = first;
+                rec_put(b, R, cur, &first);
                 break;
             }
-            R[cur] = R[src];
+            rec_get(b, R, src, &r);
+            rec_put(b, R, cur, &r);
             cur = src;
+        }
+    }
+    if (b->tpk) {
+        for (h = nreg; h-- > 0;) {
+            polar_trap r;
+            rec_get(b, R, h, &r);
+            R[h] = r;
         }
     }
     /* the low end: the slots' mark plus the regions, as arena_alloc counts */
@@ -879,6 +937,7 @@ plx_status polar_keep_regions(arena *a, polar *pd, polar_map *m, dbuild *b, uint
     m->trap = R;
     m->ntrap = nreg;
     b->T = NULL;
+    b->TW = NULL;
     return PLX_OK;
 }
 
@@ -1085,6 +1144,19 @@ plx_status polar_dag_build(arena *a, polar *pd, polar_map *m, dbuild *b,
         b->cwords = b->packed ? ((size_t)NODE_CHUNK * b->stride + 63) / 64 + 1
                               : (size_t)NODE_CHUNK * 3 / 2;
     }
+    if (b->packed) {
+        /* the slots packed too: points and pieces, links (all ones: none),
+         * the leaf word (a node, or a child word's tag and index) */
+        uint32_t f, off = 0, pb = bits_for(pd->npts > pd->nseg ? pd->npts : pd->nseg);
+        uint32_t sb = bits_for((uint64_t)b->cap + 1);
+        for (f = 0; f < 9; f++) {
+            b->swid[f] = f < F_NB ? pb : f < F_LEAF ? sb : 2 + b->cb;
+            b->soff[f] = off;
+            off += b->swid[f];
+        }
+        b->sw = off;
+        b->tpk = 1;
+    }
     b->lcap = span + 8;
     b->list = scratch_n(a, b->lcap, 4);
     b->up = scratch_n(a, b->lcap, 4);
@@ -1101,7 +1173,7 @@ plx_status polar_dag_build(arena *a, polar *pd, polar_map *m, dbuild *b,
     if (b->fail)
         return PLX_E_NOMEM;
     set_trap(b, t, m->box_lo, m->box_hi, m->box_top, m->box_bot);
-    b->T[t].leaf = new_node(b, N_LEAF, t, 0, 0);
+    tset(b, t, F_LEAF, new_node(b, N_LEAF, t, 0, 0));
     note_trap(b, t);
     for (i = 0; i < nw && !b->fail; i++) {
         irec in;
