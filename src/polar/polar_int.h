@@ -276,16 +276,12 @@ static inline void field_set(uint64_t *w, uint64_t off, uint32_t width, uint64_t
 /* The fields of a trapezoid slot, in btrap's order (nb[k] is F_NB + k). */
 enum { F_LP = 0, F_RP = 1, F_TOP = 2, F_BOT = 3, F_NB = 4, F_LEAF = 8 };
 
-/* Field f of slot t. */
-static inline uint32_t tget(const dbuild *b, uint32_t t, int f)
+/* Field f of packed slot t. */
+static inline uint32_t tget_packed(const dbuild *b, uint32_t t, int f)
 {
-    uint64_t v, ones;
-    uint32_t w;
-    if (!b->tpk)
-        return ((const uint32_t *)(const void *)&b->T[t])[f];
-    w = b->swid[f];
-    v = field_get(b->TW, (uint64_t)t * b->sw + b->soff[f], w);
-    ones = ((uint64_t)1 << w) - 1;
+    uint32_t w = b->swid[f];
+    uint64_t v = field_get(b->TW, (uint64_t)t * b->sw + b->soff[f], w);
+    uint64_t ones = ((uint64_t)1 << w) - 1;
     if (f >= F_NB && v == ones)
         return POLAR_NONE;
     if (f == F_LEAF)
@@ -293,21 +289,34 @@ static inline uint32_t tget(const dbuild *b, uint32_t t, int f)
     return (uint32_t)v;
 }
 
-/* Slot t's field f becomes x. */
-static inline void tset(const dbuild *b, uint32_t t, int f, uint32_t x)
+/* Packed slot t's field f becomes x. */
+static inline void tset_packed(const dbuild *b, uint32_t t, int f, uint32_t x)
 {
+    uint32_t w = b->swid[f];
     uint64_t v = x;
-    uint32_t w;
-    if (!b->tpk) {
-        ((uint32_t *)(void *)&b->T[t])[f] = x;
-        return;
-    }
-    w = b->swid[f];
     if (f >= F_NB && x == POLAR_NONE)
         v = ((uint64_t)1 << w) - 1;
     else if (f == F_LEAF)
         v = (uint64_t)KIND(x) << (w - 2) | IDX(x);
     field_set(b->TW, (uint64_t)t * b->sw + b->soff[f], w, v);
+}
+
+/* Field f of slot t, either layout (outside the insertion's hot loops,
+ * which are compiled once for each: trapins.h). */
+static inline uint32_t tget(const dbuild *b, uint32_t t, int f)
+{
+    if (b->tpk)
+        return tget_packed(b, t, f);
+    return ((const uint32_t *)(const void *)&b->T[t])[f];
+}
+
+/* Slot t's field f becomes x. */
+static inline void tset(const dbuild *b, uint32_t t, int f, uint32_t x)
+{
+    if (b->tpk)
+        tset_packed(b, t, f, x);
+    else
+        ((uint32_t *)(void *)&b->T[t])[f] = x;
 }
 
 /* walls.c: cuts the occluders' edges into wall pieces (pd->pts, pd->seg

@@ -46,6 +46,7 @@ typedef struct sweep {
      * (its adjacency in nb: the slot's own is not read again), the
      * status naming it by its slot (snode.open) */
     const dbuild *DT;        /* the map's slots (tget, tset) */
+    btrap *T;                /* the same when not packed, else NULL */
     const sroles *SR;
     const proles *PR;
     uint32_t ngap;      /* gaps opened, free or solid */
@@ -71,15 +72,28 @@ static int fp_before(const fpoint *a, const fpoint *b, const void *ctx)
 MSORT_DEFINE(sort_fpoints, fpoint, const void *, fp_before)
 
 /* The region index of the free trapezoid in slot d (or POLAR_NONE). */
-static uint32_t regno(const sweep *w, uint32_t d)
+static inline uint32_t regno(const sweep *w, uint32_t d)
 {
-    return d == POLAR_NONE ? POLAR_NONE : POLAR_IDX(tget(w->DT, d, F_LEAF));
+    if (d == POLAR_NONE)
+        return POLAR_NONE;
+    return POLAR_IDX(w->T ? w->T[d].leaf : tget_packed(w->DT, d, F_LEAF));
+}
+
+/* Region h's link on side f becomes r (nothing when h is POLAR_NONE). */
+static inline void set_link(sweep *w, uint32_t h, int f, uint32_t r)
+{
+    if (h == POLAR_NONE)
+        return;
+    if (w->T)
+        w->T[h].nb[f] = r;
+    else
+        tset_packed(w->DT, h, F_NB + f, r);
 }
 
 /* The child word of a solid trapezoid above piece s: the owner
  * polar_locate reports inside it, the footprint entered across s, if any
  * (see locate in polar_scan), plus one. */
-static uint32_t solid_word(const polar *pd, int frame, uint32_t s)
+static inline uint32_t solid_word(const polar *pd, int frame, uint32_t s)
 {
     const polar_seg *gs = &pd->seg[s];
     uint32_t l, r;
@@ -93,26 +107,48 @@ static uint32_t solid_word(const polar *pd, int frame, uint32_t s)
  * DAG's map: checked, and its child word set: a new region when it is
  * free, *h = d (its slot), else solid, *h = POLAR_NONE. Returns 0, or -1
  * when the two maps differ. */
-static int open_gap(sweep *w, uint32_t d, uint32_t pi, uint32_t top, uint32_t bot, int free,
-                    uint32_t *h)
+static int open_gap_packed(sweep *w, uint32_t d, uint32_t pi, uint32_t top, uint32_t bot,
+                           int free, uint32_t *h)
 {
     const dbuild *b = w->DT;
     int k;
-    *h = POLAR_NONE;
-    if (d == POLAR_NONE)
-        return -1;
-    if (tget(b, d, F_LP) != pi || tget(b, d, F_TOP) != top || tget(b, d, F_BOT) != bot ||
-        POLAR_TAG(tget(b, d, F_LEAF)) != 0)
+    if (tget_packed(b, d, F_LP) != pi || tget_packed(b, d, F_TOP) != top ||
+        tget_packed(b, d, F_BOT) != bot || POLAR_TAG(tget_packed(b, d, F_LEAF)) != 0)
         return -1;
     if (free) {
         if (w->ntrap >= w->cap)
             return -1;
         *h = d;
         for (k = 0; k < 4; k++)
-            tset(b, d, F_NB + k, POLAR_NONE);
-        tset(b, d, F_LEAF, PACK(POLAR_CHILD_FREE, w->ntrap++));
+            tset_packed(b, d, F_NB + k, POLAR_NONE);
+        tset_packed(b, d, F_LEAF, PACK(POLAR_CHILD_FREE, w->ntrap++));
     } else {
-        tset(b, d, F_LEAF, solid_word(w->pd, w->m->frame, bot));
+        tset_packed(b, d, F_LEAF, solid_word(w->pd, w->m->frame, bot));
+    }
+    w->ngap++;
+    return 0;
+}
+
+static int open_gap(sweep *w, uint32_t d, uint32_t pi, uint32_t top, uint32_t bot, int free,
+                    uint32_t *h)
+{
+    btrap *t;
+    *h = POLAR_NONE;
+    if (d == POLAR_NONE)
+        return -1;
+    if (!w->T)
+        return open_gap_packed(w, d, pi, top, bot, free, h);
+    t = &w->T[d];
+    if (t->lp != pi || t->top != top || t->bot != bot || POLAR_TAG(t->leaf) != 0)
+        return -1;
+    if (free) {
+        if (w->ntrap >= w->cap)
+            return -1;
+        *h = d;
+        t->nb[0] = t->nb[1] = t->nb[2] = t->nb[3] = POLAR_NONE;
+        t->leaf = PACK(POLAR_CHILD_FREE, w->ntrap++);
+    } else {
+        t->leaf = solid_word(w->pd, w->m->frame, bot);
     }
     w->ngap++;
     return 0;
@@ -121,11 +157,11 @@ static int open_gap(sweep *w, uint32_t d, uint32_t pi, uint32_t top, uint32_t bo
 /* The region in slot h closed by the axis of point pi, which must be its
  * right axis in the DAG's map. Returns 0, or -1 when the two maps
  * differ. */
-static int close_region(sweep *w, uint32_t h, uint32_t pi)
+static inline int close_region(sweep *w, uint32_t h, uint32_t pi)
 {
     if (h == POLAR_NONE)
         return 0;
-    if (tget(w->DT, h, F_RP) != pi)
+    if ((w->T ? w->T[h].rp : tget_packed(w->DT, h, F_RP)) != pi)
         return -1;
     w->nclosed++;
     return 0;
@@ -224,7 +260,7 @@ static int sweep_event(sweep *w, vec2 P, uint32_t pi, const uint32_t *pts, uint3
         uint32_t d = ns ? w->SR[w->start[0]].down[0] : POLAR_NONE;
         if (d == POLAR_NONE)
             return -1;
-        B = tget(w->DT, d, F_BOT);
+        B = w->T ? w->T[d].bot : tget_packed(w->DT, d, F_BOT);
         if (B != m->box_bot &&
             (B >= w->pd->nseg || N[B].prev == POLAR_NONE || geom_orient(EL(w, B), ER(w, B), P) <= 0))
             return -1;
@@ -278,14 +314,10 @@ static int sweep_event(sweep *w, vec2 P, uint32_t pi, const uint32_t *pts, uint3
                 N[A].prev = bot;
         }
     }
-    if (G0 != POLAR_NONE)
-        tset(w->DT, G0, F_NB + LR, regno(w, H0));
-    if (Gk != POLAR_NONE)
-        tset(w->DT, Gk, F_NB + UR, regno(w, Hm));
-    if (H0 != POLAR_NONE)
-        tset(w->DT, H0, F_NB + LL, regno(w, G0));
-    if (Hm != POLAR_NONE)
-        tset(w->DT, Hm, F_NB + UL, regno(w, Gk));
+    set_link(w, G0, LR, regno(w, H0));
+    set_link(w, Gk, UR, regno(w, Hm));
+    set_link(w, H0, LL, regno(w, G0));
+    set_link(w, Hm, UL, regno(w, Gk));
     return 0;
 }
 
@@ -563,6 +595,7 @@ plx_status polar_map_build(arena *a, polar *pd, polar_map *m, const uint32_t *in
     w.inc_first = inc_first;
     w.inc = inc;
     w.DT = &b;
+    w.T = b.tpk ? NULL : b.T;
     w.SR = b.SR;
     w.PR = b.PR;
     /* every region is a live trapezoid of the map, each once (open_gap) */

@@ -155,42 +155,6 @@ static int grow_traps(dbuild *b)
     return 1;
 }
 
-static uint32_t new_trap(dbuild *b)
-{
-    uint32_t t;
-    if (b->nfree > 0) {
-        t = b->freel;
-        b->freel = tget(b, t, F_NB + 0);
-        b->nfree--;
-    } else {
-        if (b->ntrap >= b->tcap && !grow_traps(b)) {
-            b->fail = 1;
-            return 0;
-        }
-        t = b->ntrap++;
-    }
-    tset(b, t, F_NB + 0, POLAR_NONE);
-    tset(b, t, F_NB + 1, POLAR_NONE);
-    tset(b, t, F_NB + 2, POLAR_NONE);
-    tset(b, t, F_NB + 3, POLAR_NONE);
-    tset(b, t, F_LEAF, POLAR_NONE);
-    return t;
-}
-
-/* Frame coordinates of the right axis point of trapezoid t. */
-static vec2 trc(const dbuild *b, uint32_t t)
-{
-    return fpt(b->pd, b->frame, tget(b, t, F_RP));
-}
-
-/* Gives slot t back (its leaf already POLAR_NONE). */
-static void free_trap(dbuild *b, uint32_t t)
-{
-    tset(b, t, F_NB + 0, b->freel);
-    b->freel = t;
-    b->nfree++;
-}
-
 static uint32_t new_node(dbuild *b, uint32_t kind, uint32_t idx, uint32_t c0, uint32_t c1)
 {
     uint32_t n = b->nnode;
@@ -210,7 +174,7 @@ static uint32_t new_node(dbuild *b, uint32_t kind, uint32_t idx, uint32_t c0, ui
 }
 
 /* The y test of piece s: its kind by which end is frame-left. */
-static uint32_t ykind(const dbuild *b, uint32_t s)
+static inline uint32_t ykind(const dbuild *b, uint32_t s)
 {
     const polar_seg *g = &b->pd->seg[s];
     return lex_cmp(bpt(b, g->a), bpt(b, g->b)) < 0 ? N_Y : N_YB;
@@ -277,312 +241,56 @@ static uint32_t find_last(dbuild *b, uint32_t n, vec2 Q, vec2 P)
     return b->packed ? descend(b, n, Q, P, 1, 1) : descend(b, n, Q, P, 1, 0);
 }
 
-/* Replaces the neighbour link 'old' of trapezoid x on side f. */
-static void relink(dbuild *b, uint32_t x, int f, uint32_t old, uint32_t nw)
+/* Asks the cache for what insertion i + 8 will read first (its ends'
+ * roles and hints; the piece's own data was asked for 8 insertions
+ * before). A hint only; nothing where the compiler offers no prefetch. */
+static inline void prefetch_ahead(const dbuild *b, uint32_t i, uint32_t nw)
 {
-    if (x != POLAR_NONE && tget(b, x, F_NB + (f)) == old)
-        tset(b, x, F_NB + (f), nw);
+#if defined(__GNUC__)
+    if (i + 16 < nw) {
+        uint32_t s = b->order[i + 16];
+        __builtin_prefetch(&b->SR[s]);
+    }
+    if (i + 8 < nw) {
+        const sroles *r = &b->SR[b->order[i + 8]];
+        __builtin_prefetch(&b->PR[r->end[0]]);
+        __builtin_prefetch(&b->PR[r->end[1]]);
+        __builtin_prefetch(&b->hint[r->end[0]]);
+        __builtin_prefetch(&b->pd->pts[r->end[0]]);
+        __builtin_prefetch(&b->pd->pts[r->end[1]]);
+    }
+#else
+    (void)b;
+    (void)i;
+    (void)nw;
+#endif
 }
 
-static void set_trap(dbuild *b, uint32_t t, uint32_t lp, uint32_t rp, uint32_t top, uint32_t bot)
-{
-    tset(b, t, F_LP, lp);
-    tset(b, t, F_RP, rp);
-    tset(b, t, F_TOP, top);
-    tset(b, t, F_BOT, bot);
-}
-
-/* Records trapezoid t (just made, its sides final) in the roles it holds. */
-static void note_trap(dbuild *b, uint32_t t)
-{
-    uint32_t lp = tget(b, t, F_LP), rp = tget(b, t, F_RP);
-    sroles *top = &b->SR[tget(b, t, F_TOP)], *bot = &b->SR[tget(b, t, F_BOT)];
-    b->PR[lp].side[0] = t;
-    b->PR[rp].side[1] = t;
-    if (top->end[0] == lp)
-        top->down[0] = t;
-    if (top->end[1] == rp)
-        top->down[1] = t;
-    if (bot->end[0] == lp)
-        bot->up[0] = t;
-    if (bot->end[1] == rp)
-        bot->up[1] = t;
-}
-
-/* The trapezoid holding the points just right of end point p of the new
- * piece (p = its left end, towards D = its right end Q) or just left of it
- * (right end, towards D = P), p being in the map already: from one
- * trapezoid whose axis on that side is p's, up or down across the pieces
- * ending at p (the trapezoids by role), in O(1) per piece at p; at most
- * WALK_MAX of them, else (or on anything unexpected) POLAR_NONE and the
- * DAG is searched instead. */
+/* The insertion's slot work (trapins.h), once for each slot layout. */
 #define WALK_MAX 12
-static uint32_t walk_at(dbuild *b, uint32_t p, vec2 D, int right)
-{
-    int k = right ? 0 : 1;
-    uint32_t t = b->PR[p].side[k], n;
-    for (n = 0; n < WALK_MAX && t != POLAR_NONE; n++) {
-        uint32_t e = tget(b, t, right ? F_LP : F_RP), xt, xb;
-        int o;
-        if (tget(b, t, F_LEAF) == POLAR_NONE || e != p)
-            return POLAR_NONE;
-        b->steps++;
-        xt = tget(b, t, F_TOP);
-        xb = tget(b, t, F_BOT);
-        if (b->SR[xt].end[k] == p) {
-            o = geom_orient(pend(b->pd, b->frame, b->SR, xt, 0),
-                             pend(b->pd, b->frame, b->SR, xt, 1), D);
-            if (o == 0)
-                return POLAR_NONE;    /* overlapping pieces: the DAG says so */
-            if (o > 0) {
-                t = b->SR[xt].up[k];
-                continue;
-            }
-        }
-        if (b->SR[xb].end[k] == p) {
-            o = geom_orient(pend(b->pd, b->frame, b->SR, xb, 0),
-                             pend(b->pd, b->frame, b->SR, xb, 1), D);
-            if (o == 0)
-                return POLAR_NONE;
-            if (o < 0) {
-                t = b->SR[xb].down[k];
-                continue;
-            }
-        }
-        return t;
-    }
-    return POLAR_NONE;
-}
-
-/* Follows the new piece leftwards from the trapezoid t holding its right
- * end r; returns k, the trapezoids crossed being list[0..k], left first. */
-static uint32_t follow_back(dbuild *b, uint32_t t, vec2 P, vec2 Q)
-{
-    uint32_t k = 0, i;
-    b->list[0] = t;
-    while (lex_cmp(P, bpt(b, tget(b, t, F_LP))) < 0) {
-        int o = geom_orient(P, Q, bpt(b, tget(b, t, F_LP)));
-        uint32_t nx = o > 0 ? tget(b, t, F_NB + (LL)) : tget(b, t, F_NB + (UL));
-        /* the neighbour must be live and share the axis: the walk moves
-         * strictly leftwards, whatever the input */
-        if (o == 0 || nx == POLAR_NONE || k + 1 >= b->lcap || tget(b, nx, F_LEAF) == POLAR_NONE ||
-            tget(b, nx, F_RP) != tget(b, t, F_LP)) {
-            b->fail = 2;
-            return k;
-        }
-        b->list[++k] = t = nx;
-    }
-    for (i = 0; i < k - i; i++) {
-        uint32_t x = b->list[i];
-        b->list[i] = b->list[k - i];
-        b->list[k - i] = x;
-    }
-    return k;
-}
-
-/* Follows the new piece (ends l < r) through the map; returns k, the
- * trapezoids crossed being list[0..k]. The search starts at the x node of
- * l, or of r when only r is in the map (then the piece is followed
- * leftwards), or at the root. */
-static uint32_t follow(dbuild *b, uint32_t l, uint32_t r)
-{
-    vec2 P = b->P, Q = b->Q;
-    uint32_t k = 0;
-    if (b->hint[l] == POLAR_NONE && b->hint[r] != POLAR_NONE) {
-        uint32_t t = walk_at(b, r, P, 0);
-        if (t == POLAR_NONE)
-            t = find_last(b, b->hint[r], Q, P);
-        return b->fail ? 0 : follow_back(b, t, P, Q);
-    }
-    b->list[0] = b->hint[l] != POLAR_NONE ? walk_at(b, l, Q, 1) : POLAR_NONE;
-    if (b->list[0] == POLAR_NONE)
-        b->list[0] = find_first(b, b->hint[l] != POLAR_NONE ? b->hint[l] : 0, P, Q);
-    if (b->fail)
-        return 0;
-    for (;;) {
-        uint32_t t = b->list[k], nx;
-        vec2 rc = trc(b, t);
-        int o;
-        if (lex_cmp(Q, rc) <= 0)
-            break;
-        o = geom_orient(P, Q, rc);
-        nx = o > 0 ? tget(b, t, F_NB + (LR)) : tget(b, t, F_NB + (UR));
-        if (o == 0 || nx == POLAR_NONE || k + 1 >= b->lcap || tget(b, nx, F_LEAF) == POLAR_NONE ||
-            tget(b, nx, F_LP) != tget(b, t, F_RP)) {
-            b->fail = 2;
-            return k;
-        }
-        b->list[++k] = nx;
-    }
-    return k;
-}
-
-/* Builds the chain of new trapezoids above (up = 1) or below the piece. */
-static void make_chain(dbuild *b, uint32_t s, uint32_t l, uint32_t r, uint32_t k, int up)
-{
-    vec2 P = b->P, Q = b->Q;
-    uint32_t *part = up ? b->up : b->lo;
-    uint32_t j, cur = new_trap(b);
-    int fo = up ? UL : LL, fc = up ? UR : LR;     /* outer-side links */
-    if (b->fail)
-        return;
-    if (up)
-        set_trap(b, cur, l, r, tget(b, b->list[0], F_TOP), s);
-    else
-        set_trap(b, cur, l, r, s, tget(b, b->list[0], F_BOT));
-    part[0] = cur;
-    for (j = 0; j < k; j++) {
-        uint32_t t = b->list[j], t1 = b->list[j + 1], R = tget(b, t, F_RP), nx, x;
-        int o = geom_orient(P, Q, trc(b, t));
-        if ((o > 0) != (up != 0)) {
-            part[j + 1] = cur;        /* the axis at R is cut away: merge */
-            continue;
-        }
-        tset(b, cur, F_RP, R);
-        nx = new_trap(b);
-        if (b->fail)
-            return;
-        if (up)
-            set_trap(b, nx, R, r, tget(b, t1, F_TOP), s);
-        else
-            set_trap(b, nx, R, r, s, tget(b, t1, F_BOT));
-        x = tget(b, t, F_NB + (fc));
-        tset(b, cur, F_NB + (fc), x);
-        relink(b, x, fo, t, cur);
-        tset(b, cur, F_NB + (up ? LR : UR), nx);
-        tset(b, nx, F_NB + (up ? LL : UL), cur);
-        x = tget(b, t1, F_NB + (fo));
-        tset(b, nx, F_NB + (fo), x);
-        relink(b, x, fc, t1, nx);
-        cur = nx;
-        part[j + 1] = cur;
-    }
-}
-
-/* Links the new trapezoids at one end of the inserted piece: E (the old
- * first / last crossed trapezoid) had neighbours enb on that side; X is
- * the new trapezoid beyond the end or POLAR_NONE; U, L the new parts above
- * and below at that end. left: the left end. */
-static void link_end(dbuild *b, int left, uint32_t E, const uint32_t *enb, uint32_t X,
-                     uint32_t U, uint32_t L)
-{
-    int ou = left ? UL : UR, ol = left ? LL : LR;     /* outer sides */
-    int iu = left ? UR : UL, il = left ? LR : LL;     /* their far sides */
-    if (X != POLAR_NONE) {
-        tset(b, X, F_NB + (ou), enb[ou]);
-        tset(b, X, F_NB + (ol), enb[ol]);
-        relink(b, enb[ou], iu, E, X);
-        relink(b, enb[ou], il, E, X);
-        relink(b, enb[ol], iu, E, X);
-        relink(b, enb[ol], il, E, X);
-        tset(b, X, F_NB + (iu), U);
-        tset(b, X, F_NB + (il), L);
-        tset(b, U, F_NB + (ou), X);
-        tset(b, L, F_NB + (ol), X);
-    } else {
-        tset(b, U, F_NB + (ou), enb[ou]);
-        tset(b, L, F_NB + (ol), enb[ol]);
-        relink(b, enb[ou], iu, E, U);
-        relink(b, enb[ou], il, E, L);
-        relink(b, enb[ol], iu, E, U);
-        relink(b, enb[ol], il, E, L);
-    }
-}
-
-static void leaf_of(dbuild *b, uint32_t t)
-{
-    if (t != POLAR_NONE && tget(b, t, F_LEAF) == POLAR_NONE)
-        tset(b, t, F_LEAF, new_node(b, N_LEAF, t, 0, 0));
-}
-
-/* The old leaf n of crossed trapezoid j becomes the search for its parts:
- * x tests at new ends (A left, B right), then the y test of s. */
-static void replace_leaf(dbuild *b, uint32_t s, uint32_t l, uint32_t r, uint32_t n, uint32_t j,
-                         uint32_t A, uint32_t B)
-{
-    uint32_t y0 = tget(b, b->lo[j], F_LEAF), y1 = tget(b, b->up[j], F_LEAF), inner, xq;
-    uint32_t ky = ykind(b, s);
-    if (A == POLAR_NONE && B == POLAR_NONE) {
-        nset(b, n, PACK(ky, s), y0, y1);
-        return;
-    }
-    inner = new_node(b, ky, s, y0, y1);
-    if (A != POLAR_NONE) {
-        xq = B != POLAR_NONE ? new_node(b, N_X, r, inner, tget(b, B, F_LEAF)) : inner;
-        if (b->fail)
-            return;
-        nset(b, n, PACK(N_X, l), tget(b, A, F_LEAF), xq);
-        b->hint[l] = n;
-        if (B != POLAR_NONE)
-            b->hint[r] = xq;
-    } else if (!b->fail) {
-        nset(b, n, PACK(N_X, r), inner, tget(b, B, F_LEAF));
-        b->hint[r] = n;
-    }
-}
-
-/* Inserts wall piece s (raw ends rl < rr in the frame). */
-static void insert_seg(dbuild *b, const irec *in)
-{
-    uint32_t s = in->s, l = in->l, r = in->r, k, j, first, last;
-    uint32_t A = POLAR_NONE, B = POLAR_NONE, fnb[4], lnb[4];
-    b->P = in->P;
-    b->Q = in->Q;
-    k = follow(b, l, r);
-    if (b->fail)
-        return;
-    b->steps += k + 1;
-    first = b->list[0];
-    last = b->list[k];
-    for (j = 0; j < 4; j++) {
-        fnb[j] = tget(b, first, F_NB + (j));
-        lnb[j] = tget(b, last, F_NB + (j));
-    }
-    /* the first trapezoid holds l (its left axis at or before l), the
-     * last r: A, B are needed unless those axes are l's and r's own
-     * (canonical indices: one index per position) */
-    if (l != tget(b, first, F_LP)) {
-        A = new_trap(b);
-        if (!b->fail)
-            set_trap(b, A, tget(b, first, F_LP), l, tget(b, first, F_TOP), tget(b, first, F_BOT));
-    }
-    if (!b->fail && r != tget(b, last, F_RP)) {
-        B = new_trap(b);
-        if (!b->fail)
-            set_trap(b, B, r, tget(b, last, F_RP), tget(b, last, F_TOP), tget(b, last, F_BOT));
-    }
-    if (!b->fail)
-        make_chain(b, s, l, r, k, 1);
-    if (!b->fail)
-        make_chain(b, s, l, r, k, 0);
-    if (b->fail)
-        return;
-    link_end(b, 1, first, fnb, A, b->up[0], b->lo[0]);
-    link_end(b, 0, last, lnb, B, b->up[k], b->lo[k]);
-    leaf_of(b, A);
-    leaf_of(b, B);
-    for (j = 0; j <= k; j++) {
-        leaf_of(b, b->up[j]);
-        leaf_of(b, b->lo[j]);
-    }
-    for (j = 0; j <= k && !b->fail; j++) {
-        uint32_t t = b->list[j];
-        replace_leaf(b, s, l, r, tget(b, t, F_LEAF), j, j == 0 ? A : POLAR_NONE,
-                     j == k ? B : POLAR_NONE);
-        tset(b, t, F_LEAF, POLAR_NONE);
-        free_trap(b, t);
-    }
-    if (A != POLAR_NONE)
-        note_trap(b, A);
-    if (B != POLAR_NONE)
-        note_trap(b, B);
-    for (j = 0; j <= k; j++) {
-        if (j == 0 || b->up[j] != b->up[j - 1])
-            note_trap(b, b->up[j]);
-        if (j == 0 || b->lo[j] != b->lo[j - 1])
-            note_trap(b, b->lo[j]);
-    }
-}
+enum { F_lp = F_LP, F_rp = F_RP, F_top = F_TOP, F_bot = F_BOT, F_leaf = F_LEAF };
+#define SLOTFN(name) name##_w
+#define TG(b, t, f) ((b)->T[t].f)
+#define TS(b, t, f, v) ((b)->T[t].f = (v))
+#define TGN(b, t, k) ((b)->T[t].nb[k])
+#define TSN(b, t, k, v) ((b)->T[t].nb[k] = (v))
+#include "polar/trapins.h"
+#undef SLOTFN
+#undef TG
+#undef TS
+#undef TGN
+#undef TSN
+#define SLOTFN(name) name##_p
+#define TG(b, t, f) tget_packed(b, t, F_##f)
+#define TS(b, t, f, v) tset_packed(b, t, F_##f, v)
+#define TGN(b, t, k) tget_packed(b, t, F_NB + (k))
+#define TSN(b, t, k, v) tset_packed(b, t, F_NB + (k), v)
+#include "polar/trapins.h"
+#undef SLOTFN
+#undef TG
+#undef TS
+#undef TGN
+#undef TSN
 
 static uint64_t rng_step(uint64_t *st)
 {
@@ -601,7 +309,7 @@ static uint64_t narrow_child(uint32_t c)
 }
 
 /* Stores inner node j of m: test t, children c0, c1 (32-bit forms). */
-static void put_node(polar_map *m, uint32_t j, uint32_t t, uint32_t c0, uint32_t c1)
+static inline void put_node(polar_map *m, uint32_t j, uint32_t t, uint32_t c0, uint32_t c1)
 {
     if (m->narrow) {
         uint64_t x = (uint64_t)(KIND(t) << 20 | IDX(t)) | narrow_child(c0) << 22 |
@@ -819,10 +527,10 @@ plx_status polar_dag_resolve(dbuild *b, uint32_t nreg)
 
 /* Record i of the regions being kept: a packed slot (b->tpk: read as a
  * region, its leaf field left alone), else a polar_trap of R. */
-static void rec_get(const dbuild *b, const polar_trap *R, uint32_t i, polar_trap *r)
+static inline void rec_get(const dbuild *b, const polar_trap *R, uint32_t i, polar_trap *r)
 {
     int k;
-    if (!b->tpk) {
+    if (!b->TW) {
         *r = R[i];
         return;
     }
@@ -834,10 +542,10 @@ static void rec_get(const dbuild *b, const polar_trap *R, uint32_t i, polar_trap
         r->nb[k] = tget(b, i, F_NB + k);
 }
 
-static void rec_put(const dbuild *b, polar_trap *R, uint32_t i, const polar_trap *r)
+static inline void rec_put(const dbuild *b, polar_trap *R, uint32_t i, const polar_trap *r)
 {
     int k;
-    if (!b->tpk) {
+    if (!b->TW) {
         R[i] = *r;
         return;
     }
@@ -1069,31 +777,6 @@ plx_status polar_insertion_order(arena *a, const polar *pd, uint32_t **out)
     return PLX_OK;
 }
 
-/* Asks the cache for what insertion i + 8 will read first (its ends'
- * roles and hints; the piece's own data was asked for 8 insertions
- * before). A hint only; nothing where the compiler offers no prefetch. */
-static void prefetch_ahead(const dbuild *b, uint32_t i, uint32_t nw)
-{
-#if defined(__GNUC__)
-    if (i + 16 < nw) {
-        uint32_t s = b->order[i + 16];
-        __builtin_prefetch(&b->SR[s]);
-    }
-    if (i + 8 < nw) {
-        const sroles *r = &b->SR[b->order[i + 8]];
-        __builtin_prefetch(&b->PR[r->end[0]]);
-        __builtin_prefetch(&b->PR[r->end[1]]);
-        __builtin_prefetch(&b->hint[r->end[0]]);
-        __builtin_prefetch(&b->pd->pts[r->end[0]]);
-        __builtin_prefetch(&b->pd->pts[r->end[1]]);
-    }
-#else
-    (void)b;
-    (void)i;
-    (void)nw;
-#endif
-}
-
 /* Builds the trapezoidal map of the wall pieces of m and its search DAG by
  * randomized incremental insertion, into b (scratch, the trapezoid slots
  * in the low end of the arena). SR: the pieces' canonical ends (pend),
@@ -1103,7 +786,7 @@ static void prefetch_ahead(const dbuild *b, uint32_t i, uint32_t nw)
 plx_status polar_dag_build(arena *a, polar *pd, polar_map *m, dbuild *b,
                            sroles *SR, const uint32_t *order, uint32_t span, int flags)
 {
-    uint32_t nw = pd->nwall, i, t;
+    uint32_t nw = pd->nwall;
     if (nw >= (1u << 26) || pd->npts >= (1u << 26))
         return PLX_E_NOMEM;   /* indices must fit in 30 bits */
     memset(b, 0, sizeof *b);
@@ -1169,23 +852,10 @@ plx_status polar_dag_build(arena *a, polar *pd, polar_map *m, dbuild *b,
     memset(b->PR, 0xff, (size_t)pd->npts * sizeof(proles));
     memset(b->hint, 0xff, (size_t)pd->npts * 4);
     b->tmark = arena_get_mark(a);
-    t = new_trap(b);
-    if (b->fail)
-        return PLX_E_NOMEM;
-    set_trap(b, t, m->box_lo, m->box_hi, m->box_top, m->box_bot);
-    tset(b, t, F_LEAF, new_node(b, N_LEAF, t, 0, 0));
-    note_trap(b, t);
-    for (i = 0; i < nw && !b->fail; i++) {
-        irec in;
-        uint32_t s = order[i];
-        prefetch_ahead(b, i, nw);
-        in.P = pend(pd, m->frame, SR, s, 0);
-        in.Q = pend(pd, m->frame, SR, s, 1);
-        in.s = s;
-        in.l = b->SR[s].end[0];
-        in.r = b->SR[s].end[1];
-        insert_seg(b, &in);
-    }
+    if (b->tpk)
+        insert_all_p(b, m, nw);
+    else
+        insert_all_w(b, m, nw);
     if (b->fail)
         return b->fail == 1 ? PLX_E_NOMEM : PLX_E_SCENE;
     return PLX_OK;
