@@ -198,7 +198,11 @@ typedef struct snode {
  * first map kept, about 70 bytes a piece, and the second's build, about
  * 205: 8 nodes of 12 bytes, 2 slots of 36, the pieces' and points' roles
  * and sweep data; 275 on the 10^6-vertex ring); POLAR_BUILD_PACKED
- * (polar_map_build's flags) says so. */
+ * (polar_map_build's flags) says so. That packed build also packs the
+ * trapezoid slots, makes each map's incidence and the sweep's piece data
+ * after the insertion, drops the DAG's leaves before the sweep and holds
+ * the first map's regions in bits while the second is built (the ring in
+ * 256 MiB). */
 #define PACKED_NODES_FROM (1u << 17)
 #define PACKED_NODES_ROOM 288u
 enum { POLAR_BUILD_PACKED = 1 << 8 };
