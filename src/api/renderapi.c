@@ -41,6 +41,18 @@ static void shade_indirect(void *user, const double P[3], const double n[3], dou
         eng_indirect_photons_rgb(e, P, n, rgb);
 }
 
+/* shade_indirect's value when it needs no gather (the cache's records
+ * all there): changes nothing, so the workers may ask it at once; 0 when
+ * only shade_indirect can say. */
+static int shade_indirect_try(void *user, const double P[3], const double n[3], double rgb[3])
+{
+    plx_engine *e = user;
+    if (icache_on(e))
+        return icache_peek(e->ic, e->ph, P, n, rgb);
+    eng_indirect_photons_rgb(e, P, n, rgb);
+    return 1;
+}
+
 /* The photon buffers alone: what the aerial indirect map is built from
  * (they do not depend on the eye, and are only read: safe on workers). */
 static void shade_photons(void *user, const double P[3], const double n[3], double rgb[3])
@@ -379,6 +391,8 @@ plx_status plx_render(plx_engine *e, const plx_camera *cam, const plx_render_opt
          * block within one record spacing of the cache at its distance */
         ro.indirect_sparse = icache_on(e);
         ro.indirect_span = ICACHE_KAPPA;
+        /* and tried on the workers first: the records already there */
+        ro.indirect_try = shade_indirect_try;
         /* aerial ground and roofs: the light map's indirect layer; without one
          * (not gathering) the indirect ground map (render/indmap.h) */
         ro.indirect_map = 1;
@@ -394,6 +408,7 @@ plx_status plx_render(plx_engine *e, const plx_camera *cam, const plx_render_opt
             ro.indirect_mt = 1;
             /* (not sparse, README "Images: an irradiance cache") */
             ro.indirect_sparse = 0;
+            ro.indirect_try = NULL;
         }
     }
     set_workers(e, &ro);

@@ -8,6 +8,7 @@
 #include "cli.h"
 #include "options.h"
 #include "port.h"
+#include "frame_writer.h"
 #include "png/image_write.h"
 #include "walk_path.h"
 
@@ -232,13 +233,71 @@ typedef struct walk_run {
     plx_refine_stats rs;
     double refine_ms;
     uint64_t lookups;          /* indirect lookups, all frames */
+    uint8_t *buf[2];           /* with the writer: frame k is rendered into buf[k & 1] */
+    frame_writer fw;
+    int writer;                /* 1: frames written on the writer's thread */
 } walk_run;
+
+/* After the first frame (the engine at its peak): the frames are written
+ * on a thread of their own, beside the next frame's rendering, when --mem
+ * leaves room for a second frame buffer beside the first and the planned
+ * contact sheet; else each frame is written before the next is rendered. */
+static void writer_plan(const walk_args *a, plx_engine *e, walk_run *wr)
+{
+    size_t frame_bytes = (size_t)a->w * a->h * 3, sheet_bytes = (size_t)wr->sh.W * wr->sh.H * 3;
+    if (wr->n < 2 || cli_buffer_budget(e, &a->c) < 2 * frame_bytes + sheet_bytes)
+        return;
+    wr->buf[0] = wr->rgb8;
+    wr->buf[1] = malloc(frame_bytes);
+    if (!wr->buf[1])
+        return;
+    if (frame_writer_start(&wr->fw) != 0) {
+        free(wr->buf[1]);
+        wr->buf[1] = NULL;
+        return;
+    }
+    wr->writer = 1;
+}
+
+/* Frame k's PNG: handed to the writer, or written now. */
+static int write_frame(const walk_args *a, walk_run *wr, long k)
+{
+    char path[4096], err[512];
+    snprintf(path, sizeof path, "%s/frame-%04ld.png", a->dir, k + 1);
+    if (wr->writer) {
+        if (frame_writer_put(&wr->fw, path, wr->rgb8, a->w, a->h) == 0)
+            return EXIT_OK;
+        fprintf(stderr, "polarlux walk: %s\n", wr->fw.err);
+        return EXIT_FAIL;
+    }
+    if (image_write_png_rgb8_fast(path, a->w, a->h, wr->rgb8, 0, err, sizeof err) != 0) {
+        fprintf(stderr, "polarlux walk: %s\n", err);
+        return EXIT_FAIL;
+    }
+    return EXIT_OK;
+}
+
+/* The writer's last frame written and its thread ended (rc kept unless
+ * that write failed). */
+static int writer_end(walk_run *wr, int rc)
+{
+    if (!wr->writer)
+        return rc;
+    wr->writer = 0;
+    wr->rgb8 = wr->buf[0];
+    free(wr->buf[1]);
+    wr->buf[1] = NULL;
+    if (frame_writer_stop(&wr->fw) != 0 && rc == EXIT_OK) {
+        fprintf(stderr, "polarlux walk: %s\n", wr->fw.err);
+        return EXIT_FAIL;
+    }
+    return rc;
+}
 
 static int frame(const walk_args *a, plx_engine *e, const walk_path *wp, walk_run *wr, long k, double step)
 {
     plx_camera cam;
     plx_render_info info;
-    char path[4096], err[512];
     unsigned long long t0;
     plx_status st;
     memset(&cam, 0, sizeof cam);
@@ -254,6 +313,8 @@ static int frame(const walk_args *a, plx_engine *e, const walk_path *wp, walk_ru
         if (rc != EXIT_OK)
             return rc;
     }
+    if (wr->writer) /* the other buffer: the writer may still read the last frame */
+        wr->rgb8 = wr->buf[k & 1];
     t0 = port_now_ns();
     st = plx_render(e, &cam, &a->opts, wr->rgb8, NULL, &info);
     wr->ms[k] = (port_now_ns() - t0) / 1e6;
@@ -265,15 +326,12 @@ static int frame(const walk_args *a, plx_engine *e, const walk_path *wp, walk_ru
     }
     fprintf(wr->cams, "%ld %.17g %.17g %.17g %.17g %.17g %.17g %.6g\n", k + 1, cam.eye[0], cam.eye[1], cam.eye[2],
             cam.target[0], cam.target[1], cam.target[2], info.exposure);
-    snprintf(path, sizeof path, "%s/frame-%04ld.png", a->dir, k + 1);
-    if (image_write_png_rgb8_fast(path, a->w, a->h, wr->rgb8, 0, err, sizeof err) != 0) {
-        fprintf(stderr, "polarlux walk: %s\n", err);
-        return EXIT_FAIL;
-    }
+    if (k == 0)
+        writer_plan(a, e, wr);
     if (wr->sh.n < 16 && k == (wr->n >= 16 ? (wr->sh.n * (wr->n - 1)) / 15 : wr->sh.n)) {
         if (!wr->sh.px && !wr->sh.skipped) {
             /* the command's own buffers count in --mem: the frame and the sheet */
-            size_t need = (size_t)wr->sh.W * wr->sh.H * 3, frame_bytes = (size_t)a->w * a->h * 3;
+            size_t need = (size_t)wr->sh.W * wr->sh.H * 3, frame_bytes = (size_t)a->w * a->h * 3 * (wr->writer ? 2 : 1);
             size_t budget = cli_buffer_budget(e, &a->c), room = budget > frame_bytes ? budget - frame_bytes : 0;
             int f = wr->sh.f;
             if (!sheet_fit(&wr->sh, a, wr->n, room) || !(wr->sh.px = calloc((size_t)wr->sh.W * wr->sh.H * 3, 1))) {
@@ -290,7 +348,7 @@ static int frame(const walk_args *a, plx_engine *e, const walk_path *wp, walk_ru
             sheet_put(&wr->sh, a, wr->rgb8, wr->sh.n);
         wr->sh.n++;
     }
-    return EXIT_OK;
+    return write_frame(a, wr, k);
 }
 
 static int run(const walk_args *a, plx_engine *e, const walk_path *wp)
@@ -318,6 +376,7 @@ static int run(const walk_args *a, plx_engine *e, const walk_path *wp)
     }
     for (k = 0; rc == EXIT_OK && k < wr.n; k++)
         rc = frame(a, e, wp, &wr, k, step);
+    rc = writer_end(&wr, rc);
     if (rc == EXIT_OK && contact_sheet(a, &wr.sh, err, sizeof err) != 0) {
         fprintf(stderr, "polarlux walk: %s\n", err);
         rc = EXIT_FAIL;

@@ -208,24 +208,34 @@ static int vertex_valid(tracer *T, const plane *pl, const double Q[3])
     return trace_top(T, Q[0] + 0.01 * pl->n[0], Q[1] + 0.01 * pl->n[1], NULL) < Q[2];
 }
 
-/* The record of vertex (i, j) at level l, gathered on first need. */
-static const icache_rec *record(icache *c, photon_sys *ps, light *L, const plane *pl, int l,
-                                int64_t i, int64_t j)
+/* Vertex (i, j) at level l's slot: the one holding its record, or the
+ * free slot where it goes. */
+static icache_rec *slot(const icache *c, const plane *pl, int l, int64_t i, int64_t j, uint64_t *k2_out)
 {
     uint64_t k2 = ((uint64_t)(c->side != ICACHE_SIDE) << 62) | ((uint64_t)l << 58) |
                   (((uint64_t)(i + COORD_BIAS) & COORD_MASK) << 29) | ((uint64_t)(j + COORD_BIAS) & COORD_MASK);
     uint32_t mask = c->nrec - 1, at;
     icache_rec *r;
-    double Q[3], rgb[3];
     at = (uint32_t)mix64(pl->code ^ mix64(k2)) & mask;
     for (;;) {
         r = &c->tab[at];
-        if (!(r->flags & REC_USED))
+        if (!(r->flags & REC_USED) || (r->k1 == pl->code && r->k2 == k2))
             break;
-        if (r->k1 == pl->code && r->k2 == k2)
-            return r;
         at = (at + 1) & mask;
     }
+    *k2_out = k2;
+    return r;
+}
+
+/* The record of vertex (i, j) at level l, gathered on first need. */
+static const icache_rec *record(icache *c, photon_sys *ps, light *L, const plane *pl, int l,
+                                int64_t i, int64_t j)
+{
+    uint64_t k2;
+    icache_rec *r = slot(c, pl, l, i, j, &k2);
+    double Q[3], rgb[3];
+    if (r->flags & REC_USED)
+        return r;
     if (c->used >= c->nrec / 4 * 3) {
         flush(c);
         return record(c, ps, L, pl, l, i, j);
@@ -295,9 +305,10 @@ static int blocked(tracer *T, const double P[3], const double Q[3])
 }
 
 /* Bilinear over the valid vertices of P's cell at level l; 0 when none
- * of them is valid (with weight). */
+ * of them is valid (with weight). With miss (a peek): the records are
+ * only looked for, and *miss set (0 returned) when one is not there. */
 static int level_value(icache *c, photon_sys *ps, light *L, const plane *pl, const double P[3],
-                       int l, double rgb[3])
+                       int l, double rgb[3], int *miss)
 {
     double sp = ICACHE_S0 * ldexp(1.0, l), d[3], fu, fv, wu, wv, ws = 0.0, acc[3] = {0, 0, 0};
     int64_t i, j;
@@ -316,7 +327,15 @@ static int level_value(icache *c, photon_sys *ps, light *L, const plane *pl, con
             const icache_rec *r;
             if (!(w > 0.0))
                 continue;
-            r = cell_record(c, ps, L, pl, l, i, j, 2 * b + a);
+            if (miss) {
+                uint64_t k2;
+                r = slot(c, pl, l, i + a, j + b, &k2);
+                if (!(r->flags & REC_USED)) {
+                    *miss = 1;
+                    return 0;
+                }
+            } else
+                r = cell_record(c, ps, L, pl, l, i, j, 2 * b + a);
             if (!(r->flags & REC_VALID))
                 continue;
             if (!pl->wall && l >= ICACHE_LEVEL_SEG) {
@@ -336,25 +355,35 @@ static int level_value(icache *c, photon_sys *ps, light *L, const plane *pl, con
     return 1;
 }
 
-/* Level l, or the finest level below it with a valid vertex, or P itself. */
+/* Level l, or the finest level below it with a valid vertex, or P itself
+ * (a peek: *miss set instead of gathering). */
 static void level_or_finer(icache *c, photon_sys *ps, light *L, const plane *pl,
-                           const double P[3], int l, double rgb[3])
+                           const double P[3], int l, double rgb[3], int *miss)
 {
     for (; l >= 0; l--)
-        if (level_value(c, ps, L, pl, P, l, rgb))
+        if (level_value(c, ps, L, pl, P, l, rgb, miss) || (miss && *miss))
             return;
+    if (miss) {
+        *miss = 1;
+        return;
+    }
     c->direct++;
     final_gather_rgb(ps, ps->T, L, P, pl->n, c->side, ICACHE_SEED, rgb);
 }
 
-void icache_lookup(icache *c, photon_sys *ps, light *L, const double P[3], const double n[3],
-                   double rgb[3])
+/* icache_lookup, or with miss its peek (nothing changed). */
+static void lookup(icache *c, photon_sys *ps, light *L, const double P[3], const double n[3], double rgb[3],
+                   int *miss)
 {
     double dx = P[0] - c->eye[0], dy = P[1] - c->eye[1], dz = P[2] - c->eye[2], lf, t, r1[3];
     uint64_t stamp = photon_stamp(ps);
     plane pl;
     int l0, k;
     if (stamp != c->stamp) {
+        if (miss) {
+            *miss = 1;
+            return;
+        }
         if (c->used)
             flush(c);
         c->stamp = stamp;
@@ -365,7 +394,7 @@ void icache_lookup(icache *c, photon_sys *ps, light *L, const double P[3], const
     }
     if (c->fixed > 0.0) {
         level_or_finer(c, ps, L, &pl, P, (int)fmin(floor(log2(fmax(c->fixed, ICACHE_S0) / ICACHE_S0)),
-                                                   ICACHE_LEVEL_MAX), rgb);
+                                                   ICACHE_LEVEL_MAX), rgb, miss);
         return;
     }
     lf = log2(fmax(c->kappa * sqrt(dx * dx + dy * dy + dz * dz), fmax(c->smin, ICACHE_S0)) / ICACHE_S0);
@@ -375,13 +404,26 @@ void icache_lookup(icache *c, photon_sys *ps, light *L, const double P[3], const
     }
     l0 = (int)floor(lf);
     t = lf - l0;
-    level_or_finer(c, ps, L, &pl, P, l0, rgb);
-    if (t > 0.0) {
+    level_or_finer(c, ps, L, &pl, P, l0, rgb, miss);
+    if (t > 0.0 && !(miss && *miss)) {
         if (l0 < ICACHE_LEVEL_MAX)
-            level_or_finer(c, ps, L, &pl, P, l0 + 1, r1);
+            level_or_finer(c, ps, L, &pl, P, l0 + 1, r1, miss);
         else
             photon_indirect_rgb(ps, P, n, r1);
         for (k = 0; k < 3; k++)
             rgb[k] = (1.0 - t) * rgb[k] + t * r1[k];
     }
+}
+
+void icache_lookup(icache *c, photon_sys *ps, light *L, const double P[3], const double n[3],
+                   double rgb[3])
+{
+    lookup(c, ps, L, P, n, rgb, NULL);
+}
+
+int icache_peek(icache *c, photon_sys *ps, const double P[3], const double n[3], double rgb[3])
+{
+    int miss = 0;
+    lookup(c, ps, NULL, P, n, rgb, &miss);
+    return !miss;
 }

@@ -149,4 +149,11 @@ void icache_set_spacing(icache *c, double s);
 void icache_lookup(icache *c, photon_sys *ps, light *L, const double P[3], const double n[3],
                    double rgb[3] /* OUT */);
 
+/* icache_lookup's value when every record it reads is in the table (and
+ * the photons are those the table was gathered from): 1 with rgb, the
+ * same bits icache_lookup gives; else 0 (it would gather). Changes
+ * nothing (not even the last-cell memo), so several threads may peek at
+ * once while nothing looks up. */
+int icache_peek(icache *c, photon_sys *ps, const double P[3], const double n[3], double rgb[3] /* OUT */);
+
 #endif

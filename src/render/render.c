@@ -86,6 +86,8 @@ struct render {
     uint8_t *blk;
     float *ind;
     corner_hit *crow;           /* two rows of corners' hit points (max_w / IND_STEP + 2 each) */
+    int32_t *stop;              /* per row of corners, then per pixel row: where the workers'
+                                   tries stopped (render_opts.indirect_try) */
     int32_t nbx, nby;           /* blocks a row, rows of blocks */
     int sparse;                 /* this frame's indirect is sparse */
     lightmap lm;                /* the aerial light map (lightmap.c) */
@@ -128,6 +130,12 @@ uint32_t render_surf_slots(const scene *s, int32_t max_w, int32_t max_h)
     return n;
 }
 
+/* Rows of corners and of pixels of a frame max_h high (render.stop). */
+static size_t stop_rows(int32_t max_h)
+{
+    return (size_t)(max_h / IND_STEP + 2) + (size_t)max_h;
+}
+
 size_t render_bytes(const scene *s, int32_t max_w, int32_t max_h)
 {
     size_t px = (size_t)max_w * (size_t)max_h;
@@ -135,6 +143,7 @@ size_t render_bytes(const scene *s, int32_t max_w, int32_t max_h)
     size_t corners = (size_t)(max_w / IND_STEP + 2) * (size_t)(max_h / IND_STEP + 2);
     return px * 20 + tiles + (size_t)s->nbld * (2 * sizeof(cull_item) + 17) + RENDER_BINS * 8 + 65536 +
            corners * (1 + 3 * sizeof(float)) + 2 * (size_t)(max_w / IND_STEP + 2) * sizeof(corner_hit) + render_surf_slots(s, max_w, max_h) * (sizeof(uint32_t) + sizeof(mesh_surf)) +
+           stop_rows(max_h) * sizeof(int32_t) +
            sizeof(render) + 4096;
 }
 
@@ -285,9 +294,10 @@ plx_status render_create(arena *a, const scene *s, int32_t max_w, int32_t max_h,
                          arena_mul((size_t)(max_w / IND_STEP + 2) * (size_t)(max_h / IND_STEP + 2),
                                    3 * sizeof(float)), R_ALIGN);
     r->crow = arena_alloc(a, PLX_PART_FRAME, 2 * (size_t)(max_w / IND_STEP + 2) * sizeof(corner_hit), R_ALIGN);
+    r->stop = arena_alloc(a, PLX_PART_FRAME, stop_rows(max_h) * sizeof(int32_t), R_ALIGN);
     if (shade == render_shade_light && user)
         r->lt = user;
-    if (!r->lut || !r->defer || !r->blk || !r->ind || !r->crow) {
+    if (!r->lut || !r->defer || !r->blk || !r->ind || !r->crow || !r->stop) {
         arena_release(a, &m0);
         return PLX_E_NOMEM;
     }
@@ -1171,8 +1181,12 @@ static int tile_light(render *r, shade_ws *w, tile_state *t, int ro)
  * side, before the shading pass; a block whose pixels and corners all lie
  * on one surface takes its pixels' indirect term bilinearly from its
  * corners, and every other pixel asks the hook itself after the pass. The
- * hook is only ever called on this thread, in this order: the image is
- * the same bytes for any number of workers. */
+ * hook is only ever called on this thread. With render_opts.indirect_try
+ * and workers, the workers first try each row of corners (then of pixels)
+ * left to right and stop at the first point the try cannot answer; this
+ * thread then asks the hook from there on, row after row. The try gives
+ * the hook's own bits, so the image is the same bytes for any number of
+ * workers. */
 
 static int32_t corner_x(const render *r, int32_t a)
 {
@@ -1249,41 +1263,145 @@ static int corner_used(const render *r, int32_t a, int32_t b)
     return 0;
 }
 
+/* Corner (a, b)'s value from the hook (try: from indirect_try; returns 0
+ * when it cannot say), stored in r->ind. */
+static int corner_value(render *r, const render_opts *o, int32_t a, int32_t b, const corner_hit *h, int try)
+{
+    float *c = &r->ind[3 * ((size_t)b * (size_t)(r->nbx + 1) + (size_t)a)];
+    double Ei[3] = { 0.0, 0.0, 0.0 };
+    int k;
+    if (try) {
+        if (!o->indirect_try(o->indirect_user, h->P, h->n, Ei))
+            return 0;
+    } else
+        o->indirect(o->indirect_user, h->P, h->n, Ei);
+    for (k = 0; k < 3; k++)
+        c[k] = (float)Ei[k];
+    return 1;
+}
+
 /* The hook at the used corners of row b (the blocks above and below it
- * known), left to right. */
-static void corner_gather(render *r, const render_opts *o, render_stats *st, int32_t b, const corner_hit *row)
+ * known) from corner a0 on, left to right. */
+static void corner_gather(render *r, const render_opts *o, render_stats *st, int32_t b, const corner_hit *row,
+                          int32_t a0)
 {
     int32_t a;
+    for (a = a0; a <= r->nbx; a++)
+        if (row[a].hit && corner_used(r, a, b)) {
+            (void)corner_value(r, o, a, b, &row[a], 0);
+            st->indirect_calls++;
+        }
+}
+
+/* The workers' share of the sparse indirect (render_opts.indirect_try). */
+typedef struct try_job {
+    render *r;
+    const render_opts *o;
+    uint64_t calls[RENDER_MAX_WORKERS];
+} try_job;
+
+/* Corner row b on a worker: tried left to right up to the first miss
+ * (render_job_fn; r->stop[b] is where this thread goes on). */
+static void corner_try_row(void *arg, int worker, uint32_t b)
+{
+    try_job *jb = arg;
+    render *r = jb->r;
+    int32_t a;
     for (a = 0; a <= r->nbx; a++) {
-        float *c = &r->ind[3 * ((size_t)b * (size_t)(r->nbx + 1) + (size_t)a)];
-        double Ei[3] = { 0.0, 0.0, 0.0 };
-        int k;
-        if (!row[a].hit || !corner_used(r, a, b))
+        corner_hit h;
+        uint32_t sid;
+        if (!corner_used(r, a, (int32_t)b))
             continue;
-        o->indirect(o->indirect_user, row[a].P, row[a].n, Ei);
-        st->indirect_calls++;
-        for (k = 0; k < 3; k++)
-            c[k] = (float)Ei[k];
+        /* the ground ids are in place: this pixel_hit writes nothing */
+        h.hit = pixel_hit(r, corner_x(r, a), corner_y(r, (int32_t)b), &sid, h.P, h.n);
+        if (!h.hit)
+            continue;
+        if (!corner_value(r, jb->o, a, (int32_t)b, &h, 1))
+            break;
+        jb->calls[worker]++;
     }
+    r->stop[b] = a;
+}
+
+/* How many workers may try the hook (0: none, the hook on this thread). */
+static int try_workers(const render_opts *o)
+{
+    if (!o->indirect_try || !o->par || o->workers < 2)
+        return 0;
+    return o->workers > RENDER_MAX_WORKERS ? RENDER_MAX_WORKERS : o->workers;
+}
+
+/* fn on rows 0 .. n - 1 on the workers; 0 when the port could not run them. */
+static int try_rows(render *r, const render_opts *o, render_stats *st, uint32_t n, render_job_fn fn)
+{
+    try_job jb;
+    int nw = try_workers(o), k;
+    memset(&jb, 0, sizeof jb);
+    jb.r = r;
+    jb.o = o;
+    if (nw == 0 || o->par(o->par_ctx, nw, n, fn, &jb) != 0)
+        return 0;
+    for (k = 0; k < nw; k++)
+        st->indirect_calls += jb.calls[k];
+    return 1;
+}
+
+/* Each row of corners from where the workers stopped, on this thread. */
+static void corners_rest(render *r, const render_opts *o, render_stats *st)
+{
+    int32_t a, b;
+    for (b = 0; b <= r->nby; b++) {
+        corner_hit h;
+        uint32_t sid;
+        for (a = r->stop[b]; a <= r->nbx; a++)
+            if (corner_used(r, a, b)) {
+                h.hit = pixel_hit(r, corner_x(r, a), corner_y(r, b), &sid, h.P, h.n);
+                if (h.hit) {
+                    (void)corner_value(r, o, a, b, &h, 0);
+                    st->indirect_calls++;
+                }
+            }
+    }
+}
+
+/* Pixel row j's ground pixels get the ground's id (pixel_hit writes it;
+ * each pixel on its own: render_job_fn). */
+static void ground_row(void *arg, int worker, uint32_t j)
+{
+    render *r = arg;
+    double P[3], n[3];
+    uint32_t sid;
+    int32_t i;
+    (void)worker;
+    for (i = 0; i < r->w; i++)
+        if (r->id[(size_t)j * (size_t)r->w + (size_t)i] == MESH_SURF_NONE)
+            (void)pixel_hit(r, i, (int32_t)j, &sid, P, n);
+}
+
+static void ground_ids(render *r, const render_opts *o)
+{
+    uint32_t j;
+    int nw = o->par && o->workers > 1 ? (o->workers > RENDER_MAX_WORKERS ? RENDER_MAX_WORKERS : o->workers) : 1;
+    if (nw > 1 && o->par(o->par_ctx, nw, (uint32_t)r->h, ground_row, r) == 0)
+        return;
+    for (j = 0; j < (uint32_t)r->h; j++)
+        ground_row(r, 0, j);
 }
 
 /* Before the shading pass: ground ids, the one-surface blocks and the
  * hook's value at their corners, row by row (each corner's hit point
- * found once, two rows of them kept). */
+ * found once, two rows of them kept; with tries, the hook's values after
+ * the blocks, on the workers first). */
 static void sparse_corners(render *r, const render_opts *o, render_stats *st)
 {
-    int32_t a, b, i, j;
-    double P[3], n[3];
-    uint32_t sid;
+    int32_t a, b;
     corner_hit *row[2];
     r->nbx = r->w > 1 ? (r->w - 1 + IND_STEP - 1) / IND_STEP : 1;
     r->nby = r->h > 1 ? (r->h - 1 + IND_STEP - 1) / IND_STEP : 1;
     row[0] = r->crow;
     row[1] = r->crow + r->nbx + 1;
-    for (j = 0; j < r->h; j++)
-        for (i = 0; i < r->w; i++)
-            if (r->id[(size_t)j * (size_t)r->w + (size_t)i] == MESH_SURF_NONE)
-                (void)pixel_hit(r, i, j, &sid, P, n); /* the ground: its id */
+    int tries = try_workers(o) > 0;
+    ground_ids(r, o);
     corner_row(r, 0, row[0]);
     for (b = 0; b < r->nby; b++) {
         corner_row(r, b + 1, row[(b + 1) & 1]);
@@ -1292,9 +1410,18 @@ static void sparse_corners(render *r, const render_opts *o, render_stats *st)
             r->blk[(size_t)b * (size_t)r->nbx + (size_t)a] = one;
             st->indirect_blocks += one;
         }
-        corner_gather(r, o, st, b, row[b & 1]);
+        if (!tries)
+            corner_gather(r, o, st, b, row[b & 1], 0);
     }
-    corner_gather(r, o, st, r->nby, row[r->nby & 1]);
+    if (!tries)
+        corner_gather(r, o, st, r->nby, row[r->nby & 1], 0);
+    else if (try_rows(r, o, st, (uint32_t)r->nby + 1, corner_try_row))
+        corners_rest(r, o, st);
+    else { /* the port could not run them: every corner here */
+        for (b = 0; b <= r->nby; b++)
+            r->stop[b] = 0;
+        corners_rest(r, o, st);
+    }
     st->indirect_nblocks = (uint64_t)r->nbx * (uint64_t)r->nby;
 }
 
@@ -1321,28 +1448,52 @@ static void sparse_at(const render *r, int32_t i, int32_t j, double E[3])
 }
 
 /* After the shading pass: the pixels of the other blocks ask the hook. */
+/* Pixel row j's pixels the blocks leave, from pixel i0 on: the hook's
+ * term added (try: stops at the first the try cannot answer); returns
+ * where it stopped (r->w: the row is done) and counts the calls. */
+static int32_t rest_row(render *r, const render_opts *o, int32_t j, int32_t i0, int try, uint64_t *calls)
+{
+    int32_t i;
+    for (i = i0; i < r->w; i++) {
+        size_t p = (size_t)j * (size_t)r->w + (size_t)i;
+        float *out = &r->lin[3 * p];
+        double P[3], n[3], Ei[3] = { 0, 0, 0 }, alb[3];
+        uint32_t sid;
+        int k;
+        if (r->blk[(size_t)block_of(j, r->nby) * (size_t)r->nbx + (size_t)block_of(i, r->nbx)] ||
+            !pixel_hit(r, i, j, &sid, P, n))
+            continue;
+        if (!try)
+            o->indirect(o->indirect_user, P, n, Ei);
+        else if (!o->indirect_try(o->indirect_user, P, n, Ei))
+            break;
+        (*calls)++;
+        if (sid == MESH_SURF_GROUND)
+            scene_ground_albedo(r->s, P[0], P[1], alb);
+        else
+            alb[0] = alb[1] = alb[2] = surf_albedo(r, sid);
+        for (k = 0; k < 3; k++)
+            out[k] = (float)((double)out[k] + alb[k] / PI * Ei[k]);
+    }
+    return i;
+}
+
+/* Pixel row j on a worker (render_job_fn; r->stop after the corner rows). */
+static void rest_try_row(void *arg, int worker, uint32_t j)
+{
+    try_job *jb = arg;
+    render *r = jb->r;
+    r->stop[r->nby + 1 + (int32_t)j] = rest_row(r, jb->o, (int32_t)j, 0, 1, &jb->calls[worker]);
+}
+
 static void sparse_rest(render *r, const render_opts *o, render_stats *st)
 {
-    int32_t i, j;
+    int32_t j, *stop = r->stop + r->nby + 1;
+    if (!try_rows(r, o, st, (uint32_t)r->h, rest_try_row))
+        for (j = 0; j < r->h; j++)
+            stop[j] = 0;
     for (j = 0; j < r->h; j++)
-        for (i = 0; i < r->w; i++) {
-            size_t p = (size_t)j * (size_t)r->w + (size_t)i;
-            float *out = &r->lin[3 * p];
-            double P[3], n[3], Ei[3] = { 0, 0, 0 }, alb[3];
-            uint32_t sid;
-            int k;
-            if (r->blk[(size_t)block_of(j, r->nby) * (size_t)r->nbx + (size_t)block_of(i, r->nbx)] ||
-                !pixel_hit(r, i, j, &sid, P, n))
-                continue;
-            o->indirect(o->indirect_user, P, n, Ei);
-            st->indirect_calls++;
-            if (sid == MESH_SURF_GROUND)
-                scene_ground_albedo(r->s, P[0], P[1], alb);
-            else
-                alb[0] = alb[1] = alb[2] = surf_albedo(r, sid);
-            for (k = 0; k < 3; k++)
-                out[k] = (float)((double)out[k] + alb[k] / PI * Ei[k]);
-        }
+        (void)rest_row(r, o, j, stop[j], 0, &st->indirect_calls);
 }
 
 /* Step 3: shade every pixel of the tile. Returns -1 (ro only) when a pixel
@@ -1462,6 +1613,7 @@ typedef struct shade_job {
     const render_opts *o;
     uint8_t *defer;             /* per tile: 1 when a worker left it to the serial pass */
     int32_t tw;                 /* tiles in a row */
+    int again;                  /* only the tiles defer marks */
 } shade_job;
 
 /* One row of tiles on worker 'worker' (render_job_fn). */
@@ -1474,6 +1626,8 @@ static void shade_row(void *arg, int worker, uint32_t row)
     for (ti = 0; ti < r->w; ti += RENDER_TILE) {
         tile_state t;
         size_t k = (size_t)row * (size_t)jb->tw + (size_t)(ti / RENDER_TILE);
+        if (jb->again && !jb->defer[k])
+            continue;
         tile_init(r, &t, ti, tj);
         tile_points(r, w, jb->o, &t, 1);
         if (tile_light(r, w, &t, 1) != 0 || tile_shade(r, w, jb->o, &t, 1) != 0) {
@@ -1483,6 +1637,15 @@ static void shade_row(void *arg, int worker, uint32_t row)
         jb->defer[k] = 0;
         tile_count(&w->st, &t);
     }
+}
+
+static int any_deferred(const uint8_t *defer, size_t n)
+{
+    size_t k;
+    for (k = 0; k < n; k++)
+        if (defer[k])
+            return 1;
+    return 0;
 }
 
 /* How many workers the shading pass of this frame may use: several only
@@ -1499,11 +1662,14 @@ static int shade_workers(const render *r, const render_opts *o)
 /* The shading pass, by tiles of RENDER_TILE x RENDER_TILE pixels: first
  * every pixel's hit point, then (light shader) the lamps whose reach meets
  * the box of the tile's hit points, then the illuminance from that list.
- * With several workers: the regions the tiles need are cached first (on
- * this thread), the workers shade rows of tiles reading the light object
- * only, and the tiles a worker could not finish that way are shaded here
- * after them, as one thread does. A tile's pixels depend on the tile
- * alone, so the image is the same bytes for any number of workers. */
+ * With several workers: the workers shade rows of tiles reading the light
+ * object only; the tiles they could not finish that way (a lamp region not
+ * in the cache: most tiles of a first frame, few along a walk) get their
+ * regions cached on this thread, then the workers try them again, and
+ * what is still left is shaded here, as one thread does. (Caching every
+ * tile's regions first cost every frame a serial pass over all hit
+ * points.) A tile's pixels depend on the tile alone, so the image is the
+ * same bytes for any number of workers. */
 static void shade_pass(render *r, const render_opts *o, render_stats *st)
 {
     int nw = shade_workers(r, o), k;
@@ -1518,11 +1684,18 @@ static void shade_pass(render *r, const render_opts *o, render_stats *st)
         jb.o = o;
         jb.defer = r->defer;
         jb.tw = (r->w + RENDER_TILE - 1) / RENDER_TILE;
-        each_tile(r, o, tile_warm, NULL, 0);
+        jb.again = 0;
         if (o->par(o->par_ctx, nw, rows, shade_row, &jb) != 0)
             for (row = 0; row < rows; row++)
                 shade_row(&jb, 0, row);
-        each_tile(r, o, tile_serial, r->defer, jb.tw);
+        if (any_deferred(jb.defer, (size_t)rows * (size_t)jb.tw)) {
+            each_tile(r, o, tile_warm, r->defer, jb.tw);
+            jb.again = 1;
+            if (o->par(o->par_ctx, nw, rows, shade_row, &jb) != 0)
+                for (row = 0; row < rows; row++)
+                    shade_row(&jb, 0, row);
+            each_tile(r, o, tile_serial, r->defer, jb.tw);
+        }
     }
     for (k = 0; k < nw; k++) {
         const render_stats *ws = &r->ws[k].st;

@@ -290,6 +290,11 @@ typedef struct render_opts {
                                   The shading pass may then use workers whatever
                                   indirect_mt says */
     double indirect_span;      /* see indirect_sparse (> 0, else no sparse indirect) */
+    int (*indirect_try)(void *user, const double P[3], const double n[3], double rgb[3]);
+                               /* sparse, with workers: indirect's value (the same bits) when
+                                  it can be had without changing anything, so on several
+                                  workers at once, else 0 (NULL: indirect alone, on this
+                                  thread); user is indirect_user */
 } render_opts;
 
 void render_opts_default(render_opts *o /* OUT */);

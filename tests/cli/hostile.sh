@@ -109,6 +109,14 @@ if [ -f "$shim" ]; then
     pre=
     if cmp -s "$tmp/map.png" "$tmp/map.png.copy" && cmp -s "$tmp/map.pgw" "$tmp/map.pgw.copy" &&
        [ -z "$(ls "$tmp" | grep '\.tmp\.')" ]; then ok heatmap-pair-kept; else bad heatmap-pair-kept; fi
+    # walk writes its frames on a thread of their own: a failed frame still stops it with exit 1
+    printf '{"type":"LineString","coordinates":[[0,0,1.7],[10,0,1.7]]}' >"$tmp/walk.geojson"
+    pre="LD_PRELOAD=$shim ASAN_OPTIONS=verify_asan_link_order=0 PLX_FAILWRITE_MATCH=frame-0003.png.tmp"
+    expect walk-frame-fails 1 "^polarlux walk: write_png: cannot write '$tmp/w/frame-0003.png': No space left on device$" -- \
+        walk -q $T --path "$tmp/walk.geojson" --size 32x24 --fps 1 --no-indirect -o "$tmp/w"
+    pre=
+    if [ -s "$tmp/w/frame-0002.png" ] && [ ! -e "$tmp/w/frame-0003.png" ] && [ ! -e "$tmp/w/walk.png" ] &&
+       [ -z "$(ls "$tmp/w" | grep '\.tmp')" ]; then ok walk-frame-fails-clean; else bad walk-frame-fails-clean; fi
 elif [ -n "${PLX_NO_SHIM:-}" ]; then
     # a cross build run under qemu-user: a host LD_PRELOAD shim cannot reach
     # the emulated program's writes (check-arm64 sets PLX_NO_SHIM)

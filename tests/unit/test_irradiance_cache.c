@@ -298,6 +298,70 @@ static void test_image_after_aerial_same_bytes(void **state)
     plx_engine_free(e2);
 }
 
+/* icache_peek (what the frame's workers ask first): at points of a view
+ * and of a second view 30 m away, every 3rd pixel out to 60 m, after a
+ * frame of the first view filled the table. A peek changes no byte of the
+ * cache; where it answers, it gives icache_lookup's bits; where it does
+ * not (records of the second view not yet gathered: asserted to happen),
+ * the lookup gathers and the peek answers after it with the lookup's bits
+ * (unless no record of the point's cell is valid: the lookup gathers at the
+ * point itself, every time). */
+static void test_peek_same_bits(void **state)
+{
+    plx_engine *e = fixture_new((size_t)1 << 30, "fixtures/eixample-4x4.geojson", NULL, 0);
+    size_t tab = (size_t)ICACHE_RECORDS * 32;
+    unsigned char *before = malloc(tab + sizeof(icache));
+    plx_render_opts o;
+    plx_camera c, other;
+    uint32_t answered = 0, missed = 0, v, i, j;
+    int full;
+    (void)state;
+    assert_non_null(before);
+    two_views(&c, &other);
+    plx_render_opts_default(&o);
+    assert_int_equal(plx_indirect_step(e, 16384, 3), PLX_OK);
+    assert_int_equal(plx_render(e, &c, &o, NULL, NULL, NULL), PLX_OK);
+    assert_int_equal(e->ic->nrec, ICACHE_RECORDS);
+    for (v = 0; v < 2; v++)
+        for (j = 1; j < H; j += 3)
+            for (i = 1; i < W; i += 3) {
+                trace_hit h;
+                double peek[3], look[3];
+                if (!pixel_surface(e->ph->T, v ? &other : &c, (int)i, (int)j, &h))
+                    continue;
+                icache_set_view(e->ic, (v ? &other : &c)->eye);
+                memcpy(before, e->ic, sizeof(icache));
+                full = (answered + missed) % 64 == 0; /* the whole table now and then */
+                if (full)
+                    memcpy(before + sizeof(icache), e->ic->tab, tab);
+                if (icache_peek(e->ic, e->ph, h.p, h.n, peek)) {
+                    answered++;
+                    assert_memory_equal(before, e->ic, sizeof(icache));
+                    if (full)
+                        assert_memory_equal(before + sizeof(icache), e->ic->tab, tab);
+                    icache_lookup(e->ic, e->ph, e->lt, h.p, h.n, look);
+                    assert_memory_equal(peek, look, sizeof peek);
+                } else {
+                    uint64_t direct = e->ic->direct;
+                    missed++;
+                    assert_memory_equal(before, e->ic, sizeof(icache));
+                    if (full)
+                        assert_memory_equal(before + sizeof(icache), e->ic->tab, tab);
+                    icache_lookup(e->ic, e->ph, e->lt, h.p, h.n, look);
+                    if (e->ic->direct != direct)
+                        continue; /* no vertex of its cell is valid: gathered at the point */
+                    assert_true(icache_peek(e->ic, e->ph, h.p, h.n, peek));
+                    assert_memory_equal(peek, look, sizeof peek);
+                }
+            }
+    printf("peeks: %u answered, %u would gather\n", (unsigned)answered, (unsigned)missed);
+    assert_true(answered > 1000);
+    assert_true(missed > 10);
+    assert_int_equal(e->ic->flushes, 0);
+    free(before);
+    plx_engine_free(e);
+}
+
 /* ---- aerial views: the light map's indirect layer ---------------------------- */
 
 #define AW 200
@@ -444,6 +508,7 @@ int main(void)
         cmocka_unit_test(test_image_accuracy),
         cmocka_unit_test(test_image_same_bytes),
         cmocka_unit_test(test_image_after_aerial_same_bytes),
+        cmocka_unit_test(test_peek_same_bits),
         cmocka_unit_test(test_aerial_accuracy),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
