@@ -198,7 +198,11 @@ typedef struct snode {
  * first map kept, about 70 bytes a piece, and the second's build, about
  * 205: 8 nodes of 12 bytes, 2 slots of 36, the pieces' and points' roles
  * and sweep data; 275 on the 10^6-vertex ring); POLAR_BUILD_PACKED
- * (polar_map_build's flags) says so. */
+ * (polar_map_build's flags) says so. That packed build also packs the
+ * trapezoid slots, makes each map's incidence and the sweep's piece data
+ * after the insertion, drops the DAG's leaves before the sweep and holds
+ * the first map's regions in bits while the second is built (the ring in
+ * 256 MiB). */
 #define PACKED_NODES_FROM (1u << 17)
 #define PACKED_NODES_ROOM 288u
 enum { POLAR_BUILD_PACKED = 1 << 8 };
@@ -235,10 +239,89 @@ typedef struct dbuild {
     proles *PR;
     vec2 P, Q;               /* the piece being inserted: its frame ends */
     uint32_t *hint;          /* per canonical point: its x node, POLAR_NONE */
+    uint64_t *TW;            /* the slots packed in bits (tpk), TRAP_STEP
+                              * at a time from the low end, as T */
+    int tpk;                 /* 1: slots packed (the packed build): slot t
+                              * at bit t sw, field f at soff[f], swid[f]
+                              * bits, all ones for POLAR_NONE (a link or
+                              * a leaf), a leaf word as tag << (swid - 2) |
+                              * index */
+    uint32_t sw, soff[9], swid[9];
     int fail;                /* 1: out of memory, 2: pieces not planar */
+    int compact;             /* 1: the leaves dropped (polar_dag_compact):
+                              * nnode inner nodes in rank order, a child
+                              * below nnode an inner node, else nnode + a
+                              * slot, then (polar_dag_resolve) nnode + a
+                              * region or nnode + regions + solid word */
     uint64_t steps;          /* search nodes and trapezoids visited */
 } dbuild;
 
+
+/* A field of 1 to 63 bits at bit off of w[], read and written without a
+ * branch (w has a word more after the last field; the offsets are the
+ * data's, so a branch on them would be mispredicted often). */
+static inline uint64_t field_get(const uint64_t *w, uint64_t off, uint32_t width)
+{
+    size_t i = (size_t)(off >> 6);
+    uint32_t sh = (uint32_t)(off & 63);
+    uint64_t x = (w[i] >> sh) | ((w[i + 1] << 1) << (63 - sh));
+    return x & (((uint64_t)1 << width) - 1);
+}
+
+static inline void field_set(uint64_t *w, uint64_t off, uint32_t width, uint64_t v)
+{
+    size_t i = (size_t)(off >> 6);
+    uint32_t sh = (uint32_t)(off & 63);
+    uint64_t mask = ((uint64_t)1 << width) - 1;
+    w[i] = (w[i] & ~(mask << sh)) | v << sh;
+    w[i + 1] = (w[i + 1] & ~((mask >> 1) >> (63 - sh))) | ((v >> 1) >> (63 - sh));
+}
+
+/* The fields of a trapezoid slot, in btrap's order (nb[k] is F_NB + k). */
+enum { F_LP = 0, F_RP = 1, F_TOP = 2, F_BOT = 3, F_NB = 4, F_LEAF = 8 };
+
+/* Field f of packed slot t. */
+static inline uint32_t tget_packed(const dbuild *b, uint32_t t, int f)
+{
+    uint32_t w = b->swid[f];
+    uint64_t v = field_get(b->TW, (uint64_t)t * b->sw + b->soff[f], w);
+    uint64_t ones = ((uint64_t)1 << w) - 1;
+    if (f >= F_NB && v == ones)
+        return POLAR_NONE;
+    if (f == F_LEAF)
+        return PACK(v >> (w - 2), v & (ones >> 2));
+    return (uint32_t)v;
+}
+
+/* Packed slot t's field f becomes x. */
+static inline void tset_packed(const dbuild *b, uint32_t t, int f, uint32_t x)
+{
+    uint32_t w = b->swid[f];
+    uint64_t v = x;
+    if (f >= F_NB && x == POLAR_NONE)
+        v = ((uint64_t)1 << w) - 1;
+    else if (f == F_LEAF)
+        v = (uint64_t)KIND(x) << (w - 2) | IDX(x);
+    field_set(b->TW, (uint64_t)t * b->sw + b->soff[f], w, v);
+}
+
+/* Field f of slot t, either layout (outside the insertion's hot loops,
+ * which are compiled once for each: trapins.h). */
+static inline uint32_t tget(const dbuild *b, uint32_t t, int f)
+{
+    if (b->tpk)
+        return tget_packed(b, t, f);
+    return ((const uint32_t *)(const void *)&b->T[t])[f];
+}
+
+/* Slot t's field f becomes x. */
+static inline void tset(const dbuild *b, uint32_t t, int f, uint32_t x)
+{
+    if (b->tpk)
+        tset_packed(b, t, f, x);
+    else
+        ((uint32_t *)(void *)&b->T[t])[f] = x;
+}
 
 /* walls.c: cuts the occluders' edges into wall pieces (pd->pts, pd->seg
  * filled, the Bounds box added). */
@@ -264,6 +347,8 @@ typedef struct dag_rank {
     uint32_t nq;             /* inner nodes */
 } dag_rank;
 plx_status polar_dag_words(arena *a, dbuild *b, dag_rank *rk);
+plx_status polar_dag_compact(arena *a, dbuild *b);
+plx_status polar_dag_resolve(dbuild *b, uint32_t nreg);
 plx_status polar_keep_regions(arena *a, polar *pd, polar_map *m, dbuild *b, uint32_t *regd,
                               uint32_t nreg);
 plx_status polar_dag_keep(arena *a, polar *pd, polar_map *m, dbuild *b, const dag_rank *rk,

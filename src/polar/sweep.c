@@ -45,7 +45,8 @@ typedef struct sweep {
      * sets in its leaf field; a free one is a region, kept in the slot
      * (its adjacency in nb: the slot's own is not read again), the
      * status naming it by its slot (snode.open) */
-    btrap *DT;
+    const dbuild *DT;        /* the map's slots (tget, tset) */
+    btrap *T;                /* the same when not packed, else NULL */
     const sroles *SR;
     const proles *PR;
     uint32_t ngap;      /* gaps opened, free or solid */
@@ -70,22 +71,29 @@ static int fp_before(const fpoint *a, const fpoint *b, const void *ctx)
 
 MSORT_DEFINE(sort_fpoints, fpoint, const void *, fp_before)
 
-/* The slot of region h. */
-static btrap *region(const sweep *w, uint32_t d)
+/* The region index of the free trapezoid in slot d (or POLAR_NONE). */
+static inline uint32_t regno(const sweep *w, uint32_t d)
 {
-    return &w->DT[d];
+    if (d == POLAR_NONE)
+        return POLAR_NONE;
+    return POLAR_IDX(w->T ? w->T[d].leaf : tget_packed(w->DT, d, F_LEAF));
 }
 
-/* The region index of the free trapezoid in slot d (or POLAR_NONE). */
-static uint32_t regno(const sweep *w, uint32_t d)
+/* Region h's link on side f becomes r (nothing when h is POLAR_NONE). */
+static inline void set_link(sweep *w, uint32_t h, int f, uint32_t r)
 {
-    return d == POLAR_NONE ? POLAR_NONE : POLAR_IDX(w->DT[d].leaf);
+    if (h == POLAR_NONE)
+        return;
+    if (w->T)
+        w->T[h].nb[f] = r;
+    else
+        tset_packed(w->DT, h, F_NB + f, r);
 }
 
 /* The child word of a solid trapezoid above piece s: the owner
  * polar_locate reports inside it, the footprint entered across s, if any
  * (see locate in polar_scan), plus one. */
-static uint32_t solid_word(const polar *pd, int frame, uint32_t s)
+static inline uint32_t solid_word(const polar *pd, int frame, uint32_t s)
 {
     const polar_seg *gs = &pd->seg[s];
     uint32_t l, r;
@@ -99,6 +107,28 @@ static uint32_t solid_word(const polar *pd, int frame, uint32_t s)
  * DAG's map: checked, and its child word set: a new region when it is
  * free, *h = d (its slot), else solid, *h = POLAR_NONE. Returns 0, or -1
  * when the two maps differ. */
+static int open_gap_packed(sweep *w, uint32_t d, uint32_t pi, uint32_t top, uint32_t bot,
+                           int free, uint32_t *h)
+{
+    const dbuild *b = w->DT;
+    int k;
+    if (tget_packed(b, d, F_LP) != pi || tget_packed(b, d, F_TOP) != top ||
+        tget_packed(b, d, F_BOT) != bot || POLAR_TAG(tget_packed(b, d, F_LEAF)) != 0)
+        return -1;
+    if (free) {
+        if (w->ntrap >= w->cap)
+            return -1;
+        *h = d;
+        for (k = 0; k < 4; k++)
+            tset_packed(b, d, F_NB + k, POLAR_NONE);
+        tset_packed(b, d, F_LEAF, PACK(POLAR_CHILD_FREE, w->ntrap++));
+    } else {
+        tset_packed(b, d, F_LEAF, solid_word(w->pd, w->m->frame, bot));
+    }
+    w->ngap++;
+    return 0;
+}
+
 static int open_gap(sweep *w, uint32_t d, uint32_t pi, uint32_t top, uint32_t bot, int free,
                     uint32_t *h)
 {
@@ -106,7 +136,9 @@ static int open_gap(sweep *w, uint32_t d, uint32_t pi, uint32_t top, uint32_t bo
     *h = POLAR_NONE;
     if (d == POLAR_NONE)
         return -1;
-    t = &w->DT[d];
+    if (!w->T)
+        return open_gap_packed(w, d, pi, top, bot, free, h);
+    t = &w->T[d];
     if (t->lp != pi || t->top != top || t->bot != bot || POLAR_TAG(t->leaf) != 0)
         return -1;
     if (free) {
@@ -125,11 +157,11 @@ static int open_gap(sweep *w, uint32_t d, uint32_t pi, uint32_t top, uint32_t bo
 /* The region in slot h closed by the axis of point pi, which must be its
  * right axis in the DAG's map. Returns 0, or -1 when the two maps
  * differ. */
-static int close_region(sweep *w, uint32_t h, uint32_t pi)
+static inline int close_region(sweep *w, uint32_t h, uint32_t pi)
 {
     if (h == POLAR_NONE)
         return 0;
-    if (region(w, h)->rp != pi)
+    if ((w->T ? w->T[h].rp : tget_packed(w->DT, h, F_RP)) != pi)
         return -1;
     w->nclosed++;
     return 0;
@@ -228,7 +260,7 @@ static int sweep_event(sweep *w, vec2 P, uint32_t pi, const uint32_t *pts, uint3
         uint32_t d = ns ? w->SR[w->start[0]].down[0] : POLAR_NONE;
         if (d == POLAR_NONE)
             return -1;
-        B = w->DT[d].bot;
+        B = w->T ? w->T[d].bot : tget_packed(w->DT, d, F_BOT);
         if (B != m->box_bot &&
             (B >= w->pd->nseg || N[B].prev == POLAR_NONE || geom_orient(EL(w, B), ER(w, B), P) <= 0))
             return -1;
@@ -282,14 +314,10 @@ static int sweep_event(sweep *w, vec2 P, uint32_t pi, const uint32_t *pts, uint3
                 N[A].prev = bot;
         }
     }
-    if (G0 != POLAR_NONE)
-        region(w, G0)->nb[LR] = regno(w, H0);
-    if (Gk != POLAR_NONE)
-        region(w, Gk)->nb[UR] = regno(w, Hm);
-    if (H0 != POLAR_NONE)
-        region(w, H0)->nb[LL] = regno(w, G0);
-    if (Hm != POLAR_NONE)
-        region(w, Hm)->nb[UL] = regno(w, Gk);
+    set_link(w, G0, LR, regno(w, H0));
+    set_link(w, Gk, UR, regno(w, Hm));
+    set_link(w, H0, LL, regno(w, G0));
+    set_link(w, Hm, UL, regno(w, Gk));
     return 0;
 }
 
@@ -355,8 +383,8 @@ static void frame_box(const polar *pd, polar_map *m)
 }
 
 
-/* Per piece: the sweep's data (N) and its canonical ends (SR, all else
- * unset: POLAR_NONE); canon: per point the first event point at its
+/* Per piece: the sweep's data (N, unless NULL: made later) and its
+ * canonical ends (SR, all else unset: POLAR_NONE); canon: per point the first event point at its
  * position. */
 static void frame_pieces(polar *pd, polar_map *m, snode *N, sroles *SR,
                          const uint32_t *canon)
@@ -368,10 +396,27 @@ static void frame_pieces(polar *pd, polar_map *m, snode *N, sroles *SR,
         seg_ends(pd, m->frame, s, &l, &r);
         SR[s].end[0] = canon[l];
         SR[s].end[1] = canon[r];
+        if (!N)
+            continue;
         N[s].cov = 0;
         N[s].open = POLAR_NONE;
         N[s].prev = N[s].next = POLAR_NONE;
     }
+}
+
+/* The sweep's data per piece, made after the insertion (the late order). */
+static snode *new_snodes(arena *a, const polar *pd)
+{
+    snode *N = scratch_n(a, pd->nseg, sizeof(snode));
+    uint32_t s;
+    if (!N)
+        return NULL;
+    for (s = 0; s < pd->nseg; s++) {
+        N[s].cov = 0;
+        N[s].open = POLAR_NONE;
+        N[s].prev = N[s].next = POLAR_NONE;
+    }
+    return N;
 }
 
 /* The events in sweep order (evs, EV_SAME marking a position already
@@ -459,9 +504,11 @@ static uint32_t *region_slots(arena *a, const polar *pd, const dbuild *b, uint32
                                                         : scratch_n(a, nreg, 4);
     if (!regd)
         return NULL;
-    for (t = 0; t < b->ntrap; t++)
-        if (POLAR_TAG(b->T[t].leaf) == POLAR_CHILD_FREE)
-            regd[POLAR_IDX(b->T[t].leaf)] = t;
+    for (t = 0; t < b->ntrap; t++) {
+        uint32_t c = tget(b, t, F_LEAF);
+        if (POLAR_TAG(c) == POLAR_CHILD_FREE)
+            regd[POLAR_IDX(c)] = t;
+    }
     return regd;
 }
 
@@ -480,6 +527,9 @@ static uint32_t *region_slots(arena *a, const polar *pd, const dbuild *b, uint32
  * piece) in the low end of the arena. The sweep's regions live in those
  * slots (regd: 4 bytes per live trapezoid names them), and are kept in
  * place (polar_keep_regions) before the search nodes are (scratch).
+ * With no incidence given (the packed build, see polar_build), N and the
+ * incidence are made after the insertion instead, once the DAG's leaves
+ * are dropped (polar_dag_compact), and given back before the DAG is kept.
  * README "Polar build scratch". */
 plx_status polar_map_build(arena *a, polar *pd, polar_map *m, const uint32_t *inc_first,
                            const uint32_t *inc, uint32_t nev,
@@ -487,29 +537,38 @@ plx_status polar_map_build(arena *a, polar *pd, polar_map *m, const uint32_t *in
 {
     sweep w;
     dbuild b;
-    uint32_t *evs, *canon, *regd, nlive, span, maxdeg;
+    uint32_t *evs, *canon, *regd, nlive, span, maxdeg, *tf, *ti, tn;
     sroles *SR;
     dag_rank rk;
-    arena_mark mk;
+    arena_mark mk, ms;
     plx_status st;
+    int late = inc_first == NULL;
     if (pd->npts >= (1u << 26) || pd->nwall >= (1u << 26))
         return PLX_E_NOMEM;   /* indices must fit in 30 bits (26 here) */
     memset(&w, 0, sizeof w);
     memset(&b, 0, sizeof b);
+    memset(&rk, 0, sizeof rk);
     w.pd = pd;
     w.m = m;
-    w.inc_first = inc_first;
-    w.inc = inc;
-    w.N = scratch_n(a, pd->nseg, sizeof(snode));
+    if (!late && !(w.N = scratch_n(a, pd->nseg, sizeof(snode))))
+        return PLX_E_NOMEM;
     w.SR = SR = scratch_n(a, pd->nseg, sizeof(sroles));
     evs = scratch_n(a, nev, 4);
-    if (!w.N || !SR || !evs)
+    if (!SR || !evs)
         return PLX_E_NOMEM;
     frame_box(pd, m);
     mk = arena_get_mark(a);
     canon = scratch_n(a, pd->npts, 4);
     if (!canon)
         return PLX_E_NOMEM;
+    if (late) {
+        /* the incidence for the sort alone, given back with it */
+        st = polar_incidence(a, pd, &tf, &ti, &tn);
+        if (st != PLX_OK)
+            return st;
+        PLX_ASSERT(tn == nev);
+        inc_first = tf;
+    }
     st = sort_events(a, pd, m->frame, nev, inc_first, evs, canon, &span, &maxdeg);
     if (st != PLX_OK)
         return st;
@@ -518,7 +577,25 @@ plx_status polar_map_build(arena *a, polar *pd, polar_map *m, const uint32_t *in
     st = polar_dag_build(a, pd, m, &b, SR, order, span, flags);
     if (st != PLX_OK)
         return st;
-    w.DT = b.T;
+    ms = arena_get_mark(a);
+    if (late) {
+        st = polar_dag_compact(a, &b);
+        if (st != PLX_OK)
+            return st;
+        ms = arena_get_mark(a);
+        w.N = new_snodes(a, pd);
+        if (!w.N)
+            return PLX_E_NOMEM;
+        st = polar_incidence(a, pd, &tf, &ti, &tn);
+        if (st != PLX_OK)
+            return st;
+        inc_first = tf;
+        inc = ti;
+    }
+    w.inc_first = inc_first;
+    w.inc = inc;
+    w.DT = &b;
+    w.T = b.tpk ? NULL : b.T;
     w.SR = b.SR;
     w.PR = b.PR;
     /* every region is a live trapezoid of the map, each once (open_gap) */
@@ -536,7 +613,7 @@ plx_status polar_map_build(arena *a, polar *pd, polar_map *m, const uint32_t *in
         return PLX_E_NOMEM;
     *steps += w.steps + b.steps;
     if (!(flags & POLAR_BUILD_NO_DAG)) {
-        st = polar_dag_words(a, &b, &rk);
+        st = b.compact ? polar_dag_resolve(&b, w.ntrap) : polar_dag_words(a, &b, &rk);
         if (st != PLX_OK)
             return st;
     }
@@ -546,6 +623,14 @@ plx_status polar_map_build(arena *a, polar *pd, polar_map *m, const uint32_t *in
     /* polar_memory: the axes (lp, rp, nb) and the regions (top, bot) */
     pd->bytes[0] -= (size_t)w.ntrap * 8;
     pd->bytes[1] += (size_t)w.ntrap * 8;
+    if (b.compact) {
+        /* the sweep's data, the incidence and lists given back (the
+         * compacted nodes lie below them) */
+        arena_mark r = arena_get_mark(a);
+        r.hi = ms.hi;
+        r.used[PLX_PART_SCRATCH] = ms.used[PLX_PART_SCRATCH];
+        arena_release(a, &r);
+    }
     if (flags & POLAR_BUILD_NO_DAG)
         return PLX_OK;
     return polar_dag_keep(a, pd, m, &b, &rk, flags);

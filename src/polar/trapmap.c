@@ -42,26 +42,6 @@ static inline uint64_t *nchunk_of(const dbuild *b, uint32_t n, uint64_t *off, in
     return b->chunk[n >> NODE_BITS];
 }
 
-/* A field of 1 to 63 bits at bit off of w[], read and written without a
- * branch (a chunk has a word more at its end; the offsets are the data's,
- * so a branch on them would be mispredicted often). */
-static inline uint64_t field_get(const uint64_t *w, uint64_t off, uint32_t width)
-{
-    size_t i = (size_t)(off >> 6);
-    uint32_t sh = (uint32_t)(off & 63);
-    uint64_t x = (w[i] >> sh) | ((w[i + 1] << 1) << (63 - sh));
-    return x & (((uint64_t)1 << width) - 1);
-}
-
-static inline void field_set(uint64_t *w, uint64_t off, uint32_t width, uint64_t v)
-{
-    size_t i = (size_t)(off >> 6);
-    uint32_t sh = (uint32_t)(off & 63);
-    uint64_t mask = ((uint64_t)1 << width) - 1;
-    w[i] = (w[i] & ~(mask << sh)) | v << sh;
-    w[i + 1] = (w[i + 1] & ~((mask >> 1) >> (63 - sh))) | ((v >> 1) >> (63 - sh));
-}
-
 /* The test of a packed node (its first field) as kind << 30 | index. */
 static inline uint32_t unpack_test(const dbuild *b, uint32_t v)
 {
@@ -140,12 +120,30 @@ static vec2 bpt(const dbuild *b, uint32_t i)
  * array; b->cap bounds them (see polar_dag_build). */
 #define TRAP_STEP 2048u
 
+static int grow_packed_traps(dbuild *b, uint32_t step)
+{
+    /* 2,048 slots are whole words; the first step has a word more */
+    size_t words = ((size_t)step * b->sw + 63) / 64 + (b->TW ? 0 : 1);
+    uint64_t *p = arena_alloc(b->a, PLX_PART_POLAR, words * 8, 8);
+    if (!p)
+        return 0;
+    memset(p, 0, words * 8);
+    if (!b->TW)
+        b->TW = p;
+    else if (p != b->TW + (size_t)b->tcap * b->sw / 64 + 1)
+        return 0;             /* not contiguous: cannot happen */
+    b->tcap += step;
+    return 1;
+}
+
 static int grow_traps(dbuild *b)
 {
     uint32_t step = b->cap - b->tcap < TRAP_STEP ? b->cap - b->tcap : TRAP_STEP;
     btrap *p;
     if (step == 0)
         return 0;
+    if (b->tpk)
+        return grow_packed_traps(b, step);
     p = arena_alloc(b->a, PLX_PART_POLAR, (size_t)step * sizeof(btrap), 16);
     if (!p)
         return 0;
@@ -155,39 +153,6 @@ static int grow_traps(dbuild *b)
         return 0;             /* not contiguous: cannot happen (see above) */
     b->tcap += step;
     return 1;
-}
-
-static uint32_t new_trap(dbuild *b)
-{
-    uint32_t t;
-    if (b->nfree > 0) {
-        t = b->freel;
-        b->freel = b->T[t].nb[0];
-        b->nfree--;
-    } else {
-        if (b->ntrap >= b->tcap && !grow_traps(b)) {
-            b->fail = 1;
-            return 0;
-        }
-        t = b->ntrap++;
-    }
-    b->T[t].nb[0] = b->T[t].nb[1] = b->T[t].nb[2] = b->T[t].nb[3] = POLAR_NONE;
-    b->T[t].leaf = POLAR_NONE;
-    return t;
-}
-
-/* Frame coordinates of the right axis point of trapezoid t. */
-static vec2 trc(const dbuild *b, uint32_t t)
-{
-    return fpt(b->pd, b->frame, b->T[t].rp);
-}
-
-/* Gives slot t back (its leaf already POLAR_NONE). */
-static void free_trap(dbuild *b, uint32_t t)
-{
-    b->T[t].nb[0] = b->freel;
-    b->freel = t;
-    b->nfree++;
 }
 
 static uint32_t new_node(dbuild *b, uint32_t kind, uint32_t idx, uint32_t c0, uint32_t c1)
@@ -209,7 +174,7 @@ static uint32_t new_node(dbuild *b, uint32_t kind, uint32_t idx, uint32_t c0, ui
 }
 
 /* The y test of piece s: its kind by which end is frame-left. */
-static uint32_t ykind(const dbuild *b, uint32_t s)
+static inline uint32_t ykind(const dbuild *b, uint32_t s)
 {
     const polar_seg *g = &b->pd->seg[s];
     return lex_cmp(bpt(b, g->a), bpt(b, g->b)) < 0 ? N_Y : N_YB;
@@ -276,311 +241,56 @@ static uint32_t find_last(dbuild *b, uint32_t n, vec2 Q, vec2 P)
     return b->packed ? descend(b, n, Q, P, 1, 1) : descend(b, n, Q, P, 1, 0);
 }
 
-/* Replaces the neighbour link 'old' of trapezoid x on side f. */
-static void relink(dbuild *b, uint32_t x, int f, uint32_t old, uint32_t nw)
+/* Asks the cache for what insertion i + 8 will read first (its ends'
+ * roles and hints; the piece's own data was asked for 8 insertions
+ * before). A hint only; nothing where the compiler offers no prefetch. */
+static inline void prefetch_ahead(const dbuild *b, uint32_t i, uint32_t nw)
 {
-    if (x != POLAR_NONE && b->T[x].nb[f] == old)
-        b->T[x].nb[f] = nw;
+#if defined(__GNUC__)
+    if (i + 16 < nw) {
+        uint32_t s = b->order[i + 16];
+        __builtin_prefetch(&b->SR[s]);
+    }
+    if (i + 8 < nw) {
+        const sroles *r = &b->SR[b->order[i + 8]];
+        __builtin_prefetch(&b->PR[r->end[0]]);
+        __builtin_prefetch(&b->PR[r->end[1]]);
+        __builtin_prefetch(&b->hint[r->end[0]]);
+        __builtin_prefetch(&b->pd->pts[r->end[0]]);
+        __builtin_prefetch(&b->pd->pts[r->end[1]]);
+    }
+#else
+    (void)b;
+    (void)i;
+    (void)nw;
+#endif
 }
 
-static void set_trap(dbuild *b, uint32_t t, uint32_t lp, uint32_t rp, uint32_t top, uint32_t bot)
-{
-    b->T[t].lp = lp;
-    b->T[t].rp = rp;
-    b->T[t].top = top;
-    b->T[t].bot = bot;
-}
-
-/* Records trapezoid t (just made, its sides final) in the roles it holds. */
-static void note_trap(dbuild *b, uint32_t t)
-{
-    const btrap *x = &b->T[t];
-    sroles *top = &b->SR[x->top], *bot = &b->SR[x->bot];
-    b->PR[x->lp].side[0] = t;
-    b->PR[x->rp].side[1] = t;
-    if (top->end[0] == x->lp)
-        top->down[0] = t;
-    if (top->end[1] == x->rp)
-        top->down[1] = t;
-    if (bot->end[0] == x->lp)
-        bot->up[0] = t;
-    if (bot->end[1] == x->rp)
-        bot->up[1] = t;
-}
-
-/* The trapezoid holding the points just right of end point p of the new
- * piece (p = its left end, towards D = its right end Q) or just left of it
- * (right end, towards D = P), p being in the map already: from one
- * trapezoid whose axis on that side is p's, up or down across the pieces
- * ending at p (the trapezoids by role), in O(1) per piece at p; at most
- * WALK_MAX of them, else (or on anything unexpected) POLAR_NONE and the
- * DAG is searched instead. */
+/* The insertion's slot work (trapins.h), once for each slot layout. */
 #define WALK_MAX 12
-static uint32_t walk_at(dbuild *b, uint32_t p, vec2 D, int right)
-{
-    int k = right ? 0 : 1;
-    uint32_t t = b->PR[p].side[k], n;
-    for (n = 0; n < WALK_MAX && t != POLAR_NONE; n++) {
-        const btrap *x = &b->T[t];
-        uint32_t e = right ? x->lp : x->rp;
-        int o;
-        if (x->leaf == POLAR_NONE || e != p)
-            return POLAR_NONE;
-        b->steps++;
-        if (b->SR[x->top].end[k] == p) {
-            o = geom_orient(pend(b->pd, b->frame, b->SR, x->top, 0),
-                             pend(b->pd, b->frame, b->SR, x->top, 1), D);
-            if (o == 0)
-                return POLAR_NONE;    /* overlapping pieces: the DAG says so */
-            if (o > 0) {
-                t = b->SR[x->top].up[k];
-                continue;
-            }
-        }
-        if (b->SR[x->bot].end[k] == p) {
-            o = geom_orient(pend(b->pd, b->frame, b->SR, x->bot, 0),
-                             pend(b->pd, b->frame, b->SR, x->bot, 1), D);
-            if (o == 0)
-                return POLAR_NONE;
-            if (o < 0) {
-                t = b->SR[x->bot].down[k];
-                continue;
-            }
-        }
-        return t;
-    }
-    return POLAR_NONE;
-}
-
-/* Follows the new piece leftwards from the trapezoid t holding its right
- * end r; returns k, the trapezoids crossed being list[0..k], left first. */
-static uint32_t follow_back(dbuild *b, uint32_t t, vec2 P, vec2 Q)
-{
-    uint32_t k = 0, i;
-    b->list[0] = t;
-    while (lex_cmp(P, bpt(b, b->T[t].lp)) < 0) {
-        int o = geom_orient(P, Q, bpt(b, b->T[t].lp));
-        uint32_t nx = o > 0 ? b->T[t].nb[LL] : b->T[t].nb[UL];
-        /* the neighbour must be live and share the axis: the walk moves
-         * strictly leftwards, whatever the input */
-        if (o == 0 || nx == POLAR_NONE || k + 1 >= b->lcap || b->T[nx].leaf == POLAR_NONE ||
-            b->T[nx].rp != b->T[t].lp) {
-            b->fail = 2;
-            return k;
-        }
-        b->list[++k] = t = nx;
-    }
-    for (i = 0; i < k - i; i++) {
-        uint32_t x = b->list[i];
-        b->list[i] = b->list[k - i];
-        b->list[k - i] = x;
-    }
-    return k;
-}
-
-/* Follows the new piece (ends l < r) through the map; returns k, the
- * trapezoids crossed being list[0..k]. The search starts at the x node of
- * l, or of r when only r is in the map (then the piece is followed
- * leftwards), or at the root. */
-static uint32_t follow(dbuild *b, uint32_t l, uint32_t r)
-{
-    vec2 P = b->P, Q = b->Q;
-    uint32_t k = 0;
-    if (b->hint[l] == POLAR_NONE && b->hint[r] != POLAR_NONE) {
-        uint32_t t = walk_at(b, r, P, 0);
-        if (t == POLAR_NONE)
-            t = find_last(b, b->hint[r], Q, P);
-        return b->fail ? 0 : follow_back(b, t, P, Q);
-    }
-    b->list[0] = b->hint[l] != POLAR_NONE ? walk_at(b, l, Q, 1) : POLAR_NONE;
-    if (b->list[0] == POLAR_NONE)
-        b->list[0] = find_first(b, b->hint[l] != POLAR_NONE ? b->hint[l] : 0, P, Q);
-    if (b->fail)
-        return 0;
-    for (;;) {
-        uint32_t t = b->list[k], nx;
-        vec2 rc = trc(b, t);
-        int o;
-        if (lex_cmp(Q, rc) <= 0)
-            break;
-        o = geom_orient(P, Q, rc);
-        nx = o > 0 ? b->T[t].nb[LR] : b->T[t].nb[UR];
-        if (o == 0 || nx == POLAR_NONE || k + 1 >= b->lcap || b->T[nx].leaf == POLAR_NONE ||
-            b->T[nx].lp != b->T[t].rp) {
-            b->fail = 2;
-            return k;
-        }
-        b->list[++k] = nx;
-    }
-    return k;
-}
-
-/* Builds the chain of new trapezoids above (up = 1) or below the piece. */
-static void make_chain(dbuild *b, uint32_t s, uint32_t l, uint32_t r, uint32_t k, int up)
-{
-    vec2 P = b->P, Q = b->Q;
-    uint32_t *part = up ? b->up : b->lo;
-    uint32_t j, cur = new_trap(b);
-    int fo = up ? UL : LL, fc = up ? UR : LR;     /* outer-side links */
-    if (b->fail)
-        return;
-    if (up)
-        set_trap(b, cur, l, r, b->T[b->list[0]].top, s);
-    else
-        set_trap(b, cur, l, r, s, b->T[b->list[0]].bot);
-    part[0] = cur;
-    for (j = 0; j < k; j++) {
-        uint32_t t = b->list[j], t1 = b->list[j + 1], R = b->T[t].rp, nx, x;
-        int o = geom_orient(P, Q, trc(b, t));
-        if ((o > 0) != (up != 0)) {
-            part[j + 1] = cur;        /* the axis at R is cut away: merge */
-            continue;
-        }
-        b->T[cur].rp = R;
-        nx = new_trap(b);
-        if (b->fail)
-            return;
-        if (up)
-            set_trap(b, nx, R, r, b->T[t1].top, s);
-        else
-            set_trap(b, nx, R, r, s, b->T[t1].bot);
-        x = b->T[t].nb[fc];
-        b->T[cur].nb[fc] = x;
-        relink(b, x, fo, t, cur);
-        b->T[cur].nb[up ? LR : UR] = nx;
-        b->T[nx].nb[up ? LL : UL] = cur;
-        x = b->T[t1].nb[fo];
-        b->T[nx].nb[fo] = x;
-        relink(b, x, fc, t1, nx);
-        cur = nx;
-        part[j + 1] = cur;
-    }
-}
-
-/* Links the new trapezoids at one end of the inserted piece: E (the old
- * first / last crossed trapezoid) had neighbours enb on that side; X is
- * the new trapezoid beyond the end or POLAR_NONE; U, L the new parts above
- * and below at that end. left: the left end. */
-static void link_end(dbuild *b, int left, uint32_t E, const uint32_t *enb, uint32_t X,
-                     uint32_t U, uint32_t L)
-{
-    int ou = left ? UL : UR, ol = left ? LL : LR;     /* outer sides */
-    int iu = left ? UR : UL, il = left ? LR : LL;     /* their far sides */
-    if (X != POLAR_NONE) {
-        b->T[X].nb[ou] = enb[ou];
-        b->T[X].nb[ol] = enb[ol];
-        relink(b, enb[ou], iu, E, X);
-        relink(b, enb[ou], il, E, X);
-        relink(b, enb[ol], iu, E, X);
-        relink(b, enb[ol], il, E, X);
-        b->T[X].nb[iu] = U;
-        b->T[X].nb[il] = L;
-        b->T[U].nb[ou] = X;
-        b->T[L].nb[ol] = X;
-    } else {
-        b->T[U].nb[ou] = enb[ou];
-        b->T[L].nb[ol] = enb[ol];
-        relink(b, enb[ou], iu, E, U);
-        relink(b, enb[ou], il, E, L);
-        relink(b, enb[ol], iu, E, U);
-        relink(b, enb[ol], il, E, L);
-    }
-}
-
-static void leaf_of(dbuild *b, uint32_t t)
-{
-    if (t != POLAR_NONE && b->T[t].leaf == POLAR_NONE)
-        b->T[t].leaf = new_node(b, N_LEAF, t, 0, 0);
-}
-
-/* The old leaf n of crossed trapezoid j becomes the search for its parts:
- * x tests at new ends (A left, B right), then the y test of s. */
-static void replace_leaf(dbuild *b, uint32_t s, uint32_t l, uint32_t r, uint32_t n, uint32_t j,
-                         uint32_t A, uint32_t B)
-{
-    uint32_t y0 = b->T[b->lo[j]].leaf, y1 = b->T[b->up[j]].leaf, inner, xq;
-    uint32_t ky = ykind(b, s);
-    if (A == POLAR_NONE && B == POLAR_NONE) {
-        nset(b, n, PACK(ky, s), y0, y1);
-        return;
-    }
-    inner = new_node(b, ky, s, y0, y1);
-    if (A != POLAR_NONE) {
-        xq = B != POLAR_NONE ? new_node(b, N_X, r, inner, b->T[B].leaf) : inner;
-        if (b->fail)
-            return;
-        nset(b, n, PACK(N_X, l), b->T[A].leaf, xq);
-        b->hint[l] = n;
-        if (B != POLAR_NONE)
-            b->hint[r] = xq;
-    } else if (!b->fail) {
-        nset(b, n, PACK(N_X, r), inner, b->T[B].leaf);
-        b->hint[r] = n;
-    }
-}
-
-/* Inserts wall piece s (raw ends rl < rr in the frame). */
-static void insert_seg(dbuild *b, const irec *in)
-{
-    uint32_t s = in->s, l = in->l, r = in->r, k, j, first, last;
-    uint32_t A = POLAR_NONE, B = POLAR_NONE, fnb[4], lnb[4];
-    b->P = in->P;
-    b->Q = in->Q;
-    k = follow(b, l, r);
-    if (b->fail)
-        return;
-    b->steps += k + 1;
-    first = b->list[0];
-    last = b->list[k];
-    for (j = 0; j < 4; j++) {
-        fnb[j] = b->T[first].nb[j];
-        lnb[j] = b->T[last].nb[j];
-    }
-    /* the first trapezoid holds l (its left axis at or before l), the
-     * last r: A, B are needed unless those axes are l's and r's own
-     * (canonical indices: one index per position) */
-    if (l != b->T[first].lp) {
-        A = new_trap(b);
-        if (!b->fail)
-            set_trap(b, A, b->T[first].lp, l, b->T[first].top, b->T[first].bot);
-    }
-    if (!b->fail && r != b->T[last].rp) {
-        B = new_trap(b);
-        if (!b->fail)
-            set_trap(b, B, r, b->T[last].rp, b->T[last].top, b->T[last].bot);
-    }
-    if (!b->fail)
-        make_chain(b, s, l, r, k, 1);
-    if (!b->fail)
-        make_chain(b, s, l, r, k, 0);
-    if (b->fail)
-        return;
-    link_end(b, 1, first, fnb, A, b->up[0], b->lo[0]);
-    link_end(b, 0, last, lnb, B, b->up[k], b->lo[k]);
-    leaf_of(b, A);
-    leaf_of(b, B);
-    for (j = 0; j <= k; j++) {
-        leaf_of(b, b->up[j]);
-        leaf_of(b, b->lo[j]);
-    }
-    for (j = 0; j <= k && !b->fail; j++) {
-        uint32_t t = b->list[j];
-        replace_leaf(b, s, l, r, b->T[t].leaf, j, j == 0 ? A : POLAR_NONE,
-                     j == k ? B : POLAR_NONE);
-        b->T[t].leaf = POLAR_NONE;
-        free_trap(b, t);
-    }
-    if (A != POLAR_NONE)
-        note_trap(b, A);
-    if (B != POLAR_NONE)
-        note_trap(b, B);
-    for (j = 0; j <= k; j++) {
-        if (j == 0 || b->up[j] != b->up[j - 1])
-            note_trap(b, b->up[j]);
-        if (j == 0 || b->lo[j] != b->lo[j - 1])
-            note_trap(b, b->lo[j]);
-    }
-}
+enum { F_lp = F_LP, F_rp = F_RP, F_top = F_TOP, F_bot = F_BOT, F_leaf = F_LEAF };
+#define SLOTFN(name) name##_w
+#define TG(b, t, f) ((b)->T[t].f)
+#define TS(b, t, f, v) ((b)->T[t].f = (v))
+#define TGN(b, t, k) ((b)->T[t].nb[k])
+#define TSN(b, t, k, v) ((b)->T[t].nb[k] = (v))
+#include "polar/trapins.h"
+#undef SLOTFN
+#undef TG
+#undef TS
+#undef TGN
+#undef TSN
+#define SLOTFN(name) name##_p
+#define TG(b, t, f) tget_packed(b, t, F_##f)
+#define TS(b, t, f, v) tset_packed(b, t, F_##f, v)
+#define TGN(b, t, k) tget_packed(b, t, F_NB + (k))
+#define TSN(b, t, k, v) tset_packed(b, t, F_NB + (k), v)
+#include "polar/trapins.h"
+#undef SLOTFN
+#undef TG
+#undef TS
+#undef TGN
+#undef TSN
 
 static uint64_t rng_step(uint64_t *st)
 {
@@ -599,7 +309,7 @@ static uint64_t narrow_child(uint32_t c)
 }
 
 /* Stores inner node j of m: test t, children c0, c1 (32-bit forms). */
-static void put_node(polar_map *m, uint32_t j, uint32_t t, uint32_t c0, uint32_t c1)
+static inline void put_node(polar_map *m, uint32_t j, uint32_t t, uint32_t c0, uint32_t c1)
 {
     if (m->narrow) {
         uint64_t x = (uint64_t)(KIND(t) << 20 | IDX(t)) | narrow_child(c0) << 22 |
@@ -674,7 +384,7 @@ plx_status polar_dag_words(arena *a, dbuild *b, dag_rank *rk)
             continue;
         }
         /* a leaf: its child word's tag and index as its children */
-        c = b->T[IDX(t)].leaf;
+        c = tget(b, IDX(t), F_LEAF);
         if (POLAR_TAG(c) == POLAR_CHILD_NODE || (uint64_t)POLAR_IDX(c) >> b->cb)
             return PLX_E_SCENE;
         if (b->packed)
@@ -709,18 +419,160 @@ static uint32_t child_word(const dbuild *b, const dag_rank *rk, uint32_t c)
     }
 }
 
+/* The packed build's DAG before the sweep (the late order of
+ * polar_map_build): the leaves dropped and the inner nodes moved down to
+ * their ranks in place, their children renamed first (an inner node by
+ * its rank, a leaf by nq + its slot, nq the inner nodes; the leaves are
+ * read, not written); then the chunks past the last inner node and the
+ * rank bitmap are given back, and b->nnode is nq (b->compact). Nothing is
+ * done when the nodes are not packed, the root is a leaf or a child field
+ * could not hold nq + a slot + a solid word. */
+plx_status polar_dag_compact(arena *a, dbuild *b)
+{
+    arena_mark mk = arena_get_mark(a), r;
+    uint32_t i, j, k, nq = 0, nw64 = (b->nnode + 63) / 64, keep, *before;
+    uint64_t *bits, off;
+    if (!b->packed || b->nnode == 0)
+        return PLX_OK;
+    bits = scratch_n(a, nw64, 8);
+    before = scratch_n(a, nw64, 4);
+    if (!bits || !before)
+        return PLX_E_NOMEM;
+    memset(bits, 0, (size_t)nw64 * 8);
+    for (i = 0; i < b->nnode; i++) {
+        const uint64_t *cw = nchunk_of(b, i, &off, 1);
+        if ((i & 63) == 0)
+            before[i >> 6] = nq;
+        if (KIND(ntest(b, cw, off, 1)) != N_LEAF) {
+            bits[i >> 6] |= (uint64_t)1 << (i & 63);
+            nq++;
+        }
+    }
+    if (!(bits[0] & 1) || (uint64_t)nq + b->cap + b->pd->nbld + 1 > ((uint64_t)1 << b->cb)) {
+        arena_release(a, &mk);
+        return PLX_OK;
+    }
+    for (i = 0; i < b->nnode; i++) {
+        uint64_t *cw;
+        if (!(bits[i >> 6] >> (i & 63) & 1))
+            continue;
+        cw = nchunk_of(b, i, &off, 1);
+        for (k = 0; k < 2; k++) {
+            uint64_t at = off + b->tb + (k ? b->cb : 0), w, coff;
+            uint32_t c = (uint32_t)field_get(cw, at, b->cb), v;
+            w = bits[c >> 6];
+            if (w >> (c & 63) & 1) {
+                v = before[c >> 6] + popcount64(w & (((uint64_t)1 << (c & 63)) - 1));
+            } else {
+                const uint64_t *lw = nchunk_of(b, c, &coff, 1);
+                v = nq + IDX(ntest(b, lw, coff, 1));
+            }
+            field_set(cw, at, b->cb, v);
+        }
+    }
+    for (i = 0, j = 0; i < b->nnode; i++) {
+        if (!(bits[i >> 6] >> (i & 63) & 1))
+            continue;
+        if (j != i) {
+            uint64_t ioff, joff, x, y;
+            const uint64_t *src = nchunk_of(b, i, &ioff, 1);
+            uint64_t *dst;
+            x = field_get(src, ioff, b->tb + b->cb);
+            y = field_get(src, ioff + b->tb + b->cb, b->cb);
+            dst = nchunk_of(b, j, &joff, 1);
+            field_set(dst, joff, b->tb + b->cb, x);
+            field_set(dst, joff + b->tb + b->cb, b->cb, y);
+        }
+        j++;
+    }
+    /* the chunks are the last scratch before the bitmap: everything past
+     * chunk keep - 1 goes */
+    keep = (nq + NODE_CHUNK - 1) >> NODE_BITS;
+    r = arena_get_mark(a);
+    r.hi = a->cap - (size_t)((unsigned char *)(void *)b->chunk[keep - 1] - a->base);
+    r.used[PLX_PART_SCRATCH] -= a->hi - r.hi;
+    arena_release(a, &r);
+    b->nchunk = keep;
+    b->nnode = nq;
+    b->compact = 1;
+    return PLX_OK;
+}
+
+/* The compacted DAG's leaf children (nq + a slot) made the child words the
+ * sweep set in the slots: nq + a free region, or nq + nreg + a solid
+ * trapezoid's owner plus one (read before the slots become the regions). */
+plx_status polar_dag_resolve(dbuild *b, uint32_t nreg)
+{
+    uint32_t j, k, nq = b->nnode;
+    for (j = 0; j < nq; j++) {
+        uint64_t off;
+        uint64_t *cw = nchunk_of(b, j, &off, 1);
+        for (k = 0; k < 2; k++) {
+            uint64_t at = off + b->tb + (k ? b->cb : 0);
+            uint32_t v = (uint32_t)field_get(cw, at, b->cb), c;
+            if (v < nq)
+                continue;
+            if (v - nq >= b->ntrap)
+                return PLX_E_SCENE;
+            c = tget(b, v - nq, F_LEAF);
+            if (POLAR_TAG(c) == POLAR_CHILD_NODE ||
+                (POLAR_TAG(c) == POLAR_CHILD_FREE && POLAR_IDX(c) >= nreg))
+                return PLX_E_SCENE;
+            field_set(cw, at, b->cb,
+                      nq + POLAR_IDX(c) + (POLAR_TAG(c) == POLAR_CHILD_FREE ? 0 : nreg));
+        }
+    }
+    return PLX_OK;
+}
+
+/* Record i of the regions being kept: a packed slot (b->tpk: read as a
+ * region, its leaf field left alone), else a polar_trap of R. */
+static inline void rec_get(const dbuild *b, const polar_trap *R, uint32_t i, polar_trap *r)
+{
+    int k;
+    if (!b->TW) {
+        *r = R[i];
+        return;
+    }
+    r->lp = tget(b, i, F_LP);
+    r->rp = tget(b, i, F_RP);
+    r->top = tget(b, i, F_TOP);
+    r->bot = tget(b, i, F_BOT);
+    for (k = 0; k < 4; k++)
+        r->nb[k] = tget(b, i, F_NB + k);
+}
+
+static inline void rec_put(const dbuild *b, polar_trap *R, uint32_t i, const polar_trap *r)
+{
+    int k;
+    if (!b->TW) {
+        R[i] = *r;
+        return;
+    }
+    tset(b, i, F_LP, r->lp);
+    tset(b, i, F_RP, r->rp);
+    tset(b, i, F_TOP, r->top);
+    tset(b, i, F_BOT, r->bot);
+    for (k = 0; k < 4; k++)
+        tset(b, i, F_NB + k, r->nb[k]);
+}
+
 /* The regions kept where the trapezoid slots were (no copy: the slots
  * are the last thing in the low end of the arena): every slot cut to its
- * first 32 bytes, which are a polar_trap, then region h moved from slot
- * regd[h] to place h, following chains of moves (a place is written only
- * once the slot there has been moved; regd is one-to-one), and the rest
- * given back. The low end is then as if the regions had been allocated
- * after the slots were given back, as keep_n would. Marks on regd: bit 31. */
+ * first 32 bytes, which are a polar_trap (packed slots: left as they
+ * are), then region h moved from slot regd[h] to place h, following
+ * chains of moves (a place is written only once the slot there has been
+ * moved; regd is one-to-one); packed slots are then widened to
+ * polar_traps from the last down (record h ends at or before byte 32 h:
+ * a slot has at most 256 bits), the low end grown first where the
+ * regions need more than the slots had. The rest is given back. The low
+ * end is then as if the regions had been allocated after the slots were
+ * given back, as keep_n would. Marks on regd: bit 31. */
 #define MOVED 0x80000000u
 plx_status polar_keep_regions(arena *a, polar *pd, polar_map *m, dbuild *b, uint32_t *regd,
                               uint32_t nreg)
 {
-    polar_trap *R = (polar_trap *)(void *)b->T;
+    polar_trap *R = b->tpk ? (polar_trap *)(void *)b->TW : (polar_trap *)(void *)b->T;
     uint32_t i, h, nw64 = (b->ntrap + 63) / 64;
     uint64_t *needed = scratch_n(a, nw64, 8);
     arena_mark mk;
@@ -728,8 +580,18 @@ plx_status polar_keep_regions(arena *a, polar *pd, polar_map *m, dbuild *b, uint
     if (!needed)
         return PLX_E_NOMEM;
     PLX_ASSERT(sizeof(polar_trap) == 32 && sizeof(btrap) == 36 && nreg <= b->ntrap);
-    for (i = 0; i < b->ntrap; i++)
-        memmove(&R[i], &b->T[i], sizeof(polar_trap));
+    PLX_ASSERT(!b->tpk || b->sw <= 256);
+    if (b->tpk) {
+        size_t have = ((size_t)b->tcap * b->sw + 63) / 64 * 8 + 8, want = (size_t)nreg * 32;
+        if (want > have) {
+            unsigned char *p = arena_alloc(a, PLX_PART_POLAR, want - have, 8);
+            if (!p || p != (unsigned char *)(void *)R + have)
+                return PLX_E_NOMEM;
+        }
+    } else {
+        for (i = 0; i < b->ntrap; i++)
+            memmove(&R[i], &b->T[i], sizeof(polar_trap));
+    }
     memset(needed, 0, (size_t)nw64 * 8);
     for (h = 0; h < nreg; h++)
         needed[regd[h] >> 6] |= (uint64_t)1 << (regd[h] & 63);
@@ -740,27 +602,37 @@ plx_status polar_keep_regions(arena *a, polar *pd, polar_map *m, dbuild *b, uint
             continue;
         while (cur < nreg && !(regd[cur] & MOVED)) {
             uint32_t src = regd[cur];
-            R[cur] = R[src];
+            polar_trap r;
+            rec_get(b, R, src, &r);
+            rec_put(b, R, cur, &r);
             regd[cur] |= MOVED;
             cur = src;
         }
     }
     /* the rest are cycles */
     for (h = 0; h < nreg; h++) {
-        polar_trap first;
+        polar_trap first, r;
         uint32_t cur = h;
         if (regd[h] & MOVED)
             continue;
-        first = R[h];
+        rec_get(b, R, h, &first);
         for (;;) {
             uint32_t src = regd[cur];
             regd[cur] |= MOVED;
             if (src == h) {
-                R[cur] = first;
+                rec_put(b, R, cur, &first);
                 break;
             }
-            R[cur] = R[src];
+            rec_get(b, R, src, &r);
+            rec_put(b, R, cur, &r);
             cur = src;
+        }
+    }
+    if (b->tpk) {
+        for (h = nreg; h-- > 0;) {
+            polar_trap r;
+            rec_get(b, R, h, &r);
+            R[h] = r;
         }
     }
     /* the low end: the slots' mark plus the regions, as arena_alloc counts */
@@ -773,6 +645,7 @@ plx_status polar_keep_regions(arena *a, polar *pd, polar_map *m, dbuild *b, uint
     m->trap = R;
     m->ntrap = nreg;
     b->T = NULL;
+    b->TW = NULL;
     return PLX_OK;
 }
 
@@ -783,7 +656,7 @@ plx_status polar_keep_regions(arena *a, polar *pd, polar_map *m, dbuild *b, uint
 plx_status polar_dag_keep(arena *a, polar *pd, polar_map *m, dbuild *b, const dag_rank *rk,
                           int flags)
 {
-    uint32_t i, j, nq = rk->nq;
+    uint32_t i, j, nq = b->compact ? b->nnode : rk->nq;
     m->nnode = nq;
     m->narrow = !(flags & POLAR_BUILD_WIDE_DAG) && nq < (1u << 19) && m->ntrap < (1u << 19) &&
                 pd->nbld < (1u << 19) - 1 && pd->npts < (1u << 20) && pd->nseg < (1u << 20);
@@ -793,6 +666,20 @@ plx_status polar_dag_keep(arena *a, polar *pd, polar_map *m, dbuild *b, const da
             return PLX_E_NOMEM;
     } else if (packed_nodes(a, pd, m) != PLX_OK) {
         return PLX_E_NOMEM;
+    }
+    if (b->compact) {
+        /* children: an inner node, nq + a region, nq + ntrap + a solid word */
+        for (j = 0; j < nq; j++) {
+            uint32_t t, c[2], k;
+            nread(b, j, &t, c);
+            for (k = 0; k < 2; k++)
+                c[k] = c[k] < nq               ? PACK(POLAR_CHILD_NODE, c[k])
+                       : c[k] - nq < m->ntrap ? PACK(POLAR_CHILD_FREE, c[k] - nq)
+                                              : PACK(POLAR_CHILD_SOLID, c[k] - nq - m->ntrap);
+            put_node(m, j, t, c[0], c[1]);
+        }
+        m->root = PACK(POLAR_CHILD_NODE, 0);
+        return PLX_OK;
     }
     for (i = 0, j = 0; i < b->nnode; i++) {
         uint32_t t, c[2];
@@ -890,31 +777,6 @@ plx_status polar_insertion_order(arena *a, const polar *pd, uint32_t **out)
     return PLX_OK;
 }
 
-/* Asks the cache for what insertion i + 8 will read first (its ends'
- * roles and hints; the piece's own data was asked for 8 insertions
- * before). A hint only; nothing where the compiler offers no prefetch. */
-static void prefetch_ahead(const dbuild *b, uint32_t i, uint32_t nw)
-{
-#if defined(__GNUC__)
-    if (i + 16 < nw) {
-        uint32_t s = b->order[i + 16];
-        __builtin_prefetch(&b->SR[s]);
-    }
-    if (i + 8 < nw) {
-        const sroles *r = &b->SR[b->order[i + 8]];
-        __builtin_prefetch(&b->PR[r->end[0]]);
-        __builtin_prefetch(&b->PR[r->end[1]]);
-        __builtin_prefetch(&b->hint[r->end[0]]);
-        __builtin_prefetch(&b->pd->pts[r->end[0]]);
-        __builtin_prefetch(&b->pd->pts[r->end[1]]);
-    }
-#else
-    (void)b;
-    (void)i;
-    (void)nw;
-#endif
-}
-
 /* Builds the trapezoidal map of the wall pieces of m and its search DAG by
  * randomized incremental insertion, into b (scratch, the trapezoid slots
  * in the low end of the arena). SR: the pieces' canonical ends (pend),
@@ -924,7 +786,7 @@ static void prefetch_ahead(const dbuild *b, uint32_t i, uint32_t nw)
 plx_status polar_dag_build(arena *a, polar *pd, polar_map *m, dbuild *b,
                            sroles *SR, const uint32_t *order, uint32_t span, int flags)
 {
-    uint32_t nw = pd->nwall, i, t;
+    uint32_t nw = pd->nwall;
     if (nw >= (1u << 26) || pd->npts >= (1u << 26))
         return PLX_E_NOMEM;   /* indices must fit in 30 bits */
     memset(b, 0, sizeof *b);
@@ -965,6 +827,19 @@ plx_status polar_dag_build(arena *a, polar *pd, polar_map *m, dbuild *b,
         b->cwords = b->packed ? ((size_t)NODE_CHUNK * b->stride + 63) / 64 + 1
                               : (size_t)NODE_CHUNK * 3 / 2;
     }
+    if (b->packed) {
+        /* the slots packed too: points and pieces, links (all ones: none),
+         * the leaf word (a node, or a child word's tag and index) */
+        uint32_t f, off = 0, pb = bits_for(pd->npts > pd->nseg ? pd->npts : pd->nseg);
+        uint32_t sb = bits_for((uint64_t)b->cap + 1);
+        for (f = 0; f < 9; f++) {
+            b->swid[f] = f < F_NB ? pb : f < F_LEAF ? sb : 2 + b->cb;
+            b->soff[f] = off;
+            off += b->swid[f];
+        }
+        b->sw = off;
+        b->tpk = 1;
+    }
     b->lcap = span + 8;
     b->list = scratch_n(a, b->lcap, 4);
     b->up = scratch_n(a, b->lcap, 4);
@@ -977,23 +852,10 @@ plx_status polar_dag_build(arena *a, polar *pd, polar_map *m, dbuild *b,
     memset(b->PR, 0xff, (size_t)pd->npts * sizeof(proles));
     memset(b->hint, 0xff, (size_t)pd->npts * 4);
     b->tmark = arena_get_mark(a);
-    t = new_trap(b);
-    if (b->fail)
-        return PLX_E_NOMEM;
-    set_trap(b, t, m->box_lo, m->box_hi, m->box_top, m->box_bot);
-    b->T[t].leaf = new_node(b, N_LEAF, t, 0, 0);
-    note_trap(b, t);
-    for (i = 0; i < nw && !b->fail; i++) {
-        irec in;
-        uint32_t s = order[i];
-        prefetch_ahead(b, i, nw);
-        in.P = pend(pd, m->frame, SR, s, 0);
-        in.Q = pend(pd, m->frame, SR, s, 1);
-        in.s = s;
-        in.l = b->SR[s].end[0];
-        in.r = b->SR[s].end[1];
-        insert_seg(b, &in);
-    }
+    if (b->tpk)
+        insert_all_p(b, m, nw);
+    else
+        insert_all_w(b, m, nw);
     if (b->fail)
         return b->fail == 1 ? PLX_E_NOMEM : PLX_E_SCENE;
     return PLX_OK;

@@ -15,7 +15,7 @@
 
 #include "render/exposure.h"
 
-#define BINS 512           /* log2 Y from -32 to +32 in eighth stops */
+#define BINS EXPOSURE_BINS
 #define LOG_MIN (-32.0)
 #define PER_STOP 8.0
 
@@ -24,21 +24,26 @@ static double luminance(const float *c)
     return 0.2126 * c[0] + 0.7152 * c[1] + 0.0722 * c[2];
 }
 
-double exposure_auto(const float *lin, const uint32_t *id, size_t px)
+void exposure_count(const float *lin, const uint32_t *id, size_t p0, size_t p1, uint32_t hist[EXPOSURE_BINS])
 {
-    uint32_t hist[BINS];
-    size_t p, n = 0, want, acc = 0;
-    int b;
-    memset(hist, 0, sizeof hist);
-    for (p = 0; p < px; p++) {
+    size_t p;
+    for (p = p0; p < p1; p++) {
         double y = luminance(lin + 3 * p), l;
+        int b;
         if (id[p] == EXPOSURE_SKY || !(y > 0.0) || !isfinite(y))
             continue;
         l = (log2(y) - LOG_MIN) * PER_STOP;
         b = l < 0 ? 0 : l >= BINS ? BINS - 1 : (int)l;
         hist[b]++;
-        n++;
     }
+}
+
+double exposure_from(const uint32_t hist[EXPOSURE_BINS])
+{
+    size_t n = 0, want, acc = 0;
+    int b;
+    for (b = 0; b < BINS; b++)
+        n += hist[b];
     if (n == 0)
         return 1.0;
     want = (size_t)ceil(EXPOSURE_PERCENTILE * (double)n);
@@ -51,6 +56,14 @@ double exposure_auto(const float *lin, const uint32_t *id, size_t px)
         b = BINS - 1;
     /* the bin's upper edge, so the chosen pixel is at most the key */
     return EXPOSURE_KEY / exp2(LOG_MIN + (b + 1) / PER_STOP);
+}
+
+double exposure_auto(const float *lin, const uint32_t *id, size_t px)
+{
+    uint32_t hist[BINS];
+    memset(hist, 0, sizeof hist);
+    exposure_count(lin, id, 0, px, hist);
+    return exposure_from(hist);
 }
 
 double exposure_curve(double v)

@@ -10,8 +10,14 @@
 #define EXPOSURE_WHITE 4.0       /* the tone curve reaches 1 here */
 #define EXPOSURE_SKY 0u          /* the id of sky pixels (MESH_SURF_NONE) */
 
+#define EXPOSURE_BINS 512        /* log2 Y from -32 to +32 in eighth stops */
+
 /* The exposure for px pixels of linear RGB lin with surface ids id. */
 double exposure_auto(const float *lin, const uint32_t *id, size_t px);
+/* exposure_auto in parts: pixels p0 .. p1 - 1 counted into hist (added to
+ * it), and the exposure from the sum of the parts' counts. */
+void exposure_count(const float *lin, const uint32_t *id, size_t p0, size_t p1, uint32_t hist[EXPOSURE_BINS]);
+double exposure_from(const uint32_t hist[EXPOSURE_BINS]);
 /* The tone curve: v (1 + v / W^2) / (1 + v), 0 for v <= 0 or NaN. */
 double exposure_curve(double v);
 

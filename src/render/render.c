@@ -86,6 +86,7 @@ struct render {
     uint8_t *blk;
     float *ind;
     corner_hit *crow;           /* two rows of corners' hit points (max_w / IND_STEP + 2 each) */
+    uint32_t hist[RENDER_MAX_WORKERS][EXPOSURE_BINS]; /* automatic exposure's counts, by part */
     int32_t *stop;              /* per row of corners, then per pixel row: where the workers'
                                    tries stopped (render_opts.indirect_try) */
     int32_t nbx, nby;           /* blocks a row, rows of blocks */
@@ -1831,6 +1832,32 @@ void render_tonemap_par(const render *r, const float *lin, size_t px, double ex,
         render_tonemap(r, lin, px, ex, curve, rgb8);
 }
 
+/* Part k of RENDER_MAX_WORKERS of the exposure's pixels counted into
+ * hist[k] (render_job_fn). */
+static void exposure_part(void *arg, int worker, uint32_t k)
+{
+    render *r = arg;
+    size_t px = (size_t)r->w * (size_t)r->h, p0 = px * k / RENDER_MAX_WORKERS, p1 = px * (k + 1) / RENDER_MAX_WORKERS;
+    (void)worker;
+    memset(r->hist[k], 0, sizeof r->hist[k]);
+    exposure_count(r->lin, r->id, p0, p1, r->hist[k]);
+}
+
+/* exposure_auto over the frame, its parts counted on the workers (the
+ * counts are summed: the same exposure for any number of them). */
+static double exposure_par(render *r, const render_opts *o)
+{
+    uint32_t k, b;
+    int nw = o->par && o->workers > 1 ? (o->workers > RENDER_MAX_WORKERS ? RENDER_MAX_WORKERS : o->workers) : 1;
+    if (nw < 2 || o->par(o->par_ctx, nw, RENDER_MAX_WORKERS, exposure_part, r) != 0)
+        for (k = 0; k < RENDER_MAX_WORKERS; k++)
+            exposure_part(r, 0, k);
+    for (k = 1; k < RENDER_MAX_WORKERS; k++)
+        for (b = 0; b < EXPOSURE_BINS; b++)
+            r->hist[0][b] += r->hist[k][b];
+    return exposure_from(r->hist[0]);
+}
+
 const float *render_linear(const render *r)
 {
     return r->lin;
@@ -1892,7 +1919,7 @@ plx_status render_frame(render *r, const render_camera *cam, const render_opts *
     if (r->sparse)
         sparse_rest(r, o, &st);
     /* the exposure from the lit surfaces, before the glows */
-    st.exposure = o->auto_exposure ? exposure_auto(r->lin, r->id, px) : o->exposure;
+    st.exposure = o->auto_exposure ? exposure_par(r, o) : o->exposure;
     if (!o->no_glow)
         glows(r, &st);
     if (rgbf)

@@ -42,6 +42,7 @@
 #include "base/engine.h"
 #include "render/render.h"
 #include "render/mesh.h"
+#include "render/exposure.h"
 #include "light/illuminance.h"
 #include "light/litregion.h"
 #include "base/geom.h"
@@ -1415,6 +1416,69 @@ static void test_fault_injection(void **state)
     free(mem);
 }
 
+static int cmp_dbl(const void *a, const void *b)
+{
+    double x = *(const double *)a, y = *(const double *)b;
+    return x < y ? -1 : x > y;
+}
+
+/* Automatic exposure against brute force: on random images (sky pixels,
+ * black, NaN and infinite pixels among them) the lit pixel at the 99.5th
+ * percentile of the sorted luminances (the independent answer) is mapped
+ * to within an eighth of a stop below the key; counting the pixels in
+ * random parts and summing gives the same exposure (what the frame's
+ * workers do). */
+static void test_exposure_parts(void **state)
+{
+    enum { N = 20000 };
+    float *lin = malloc(sizeof *lin * 3 * N);
+    uint32_t *id = malloc(sizeof *id * N), hist[EXPOSURE_BINS];
+    double *y = malloc(sizeof *y * N);
+    uint64_t seed = 7;
+    int round;
+    (void)state;
+    assert_true(lin && id && y);
+    for (round = 0; round < 40; round++) {
+        size_t p, n = 0, cut[8];
+        double e, yp;
+        int k;
+        for (p = 0; p < N; p++) {
+            int c;
+            seed = seed * 6364136223846793005ull + 1442695040888963407ull;
+            id[p] = (seed >> 60) == 0 ? EXPOSURE_SKY : 1u + (uint32_t)(seed >> 40) % 50u;
+            for (c = 0; c < 3; c++) {
+                seed = seed * 6364136223846793005ull + 1442695040888963407ull;
+                lin[3 * p + c] = (seed >> 59) == 0 ? 0.0f : (float)exp2(((double)(seed >> 11) / 9007199254740992.0) * 40.0 - 20.0 + round % 5);
+            }
+            if (p % 997 == 0)
+                lin[3 * p] = (p / 997) % 2 ? NAN : INFINITY;
+            {
+                double Y = 0.2126 * lin[3 * p] + 0.7152 * lin[3 * p + 1] + 0.0722 * lin[3 * p + 2];
+                if (id[p] != EXPOSURE_SKY && Y > 0.0 && isfinite(Y))
+                    y[n++] = Y;
+            }
+        }
+        e = exposure_auto(lin, id, N);
+        qsort(y, n, sizeof *y, cmp_dbl);
+        yp = y[(size_t)ceil(0.995 * (double)n) - 1];
+        assert_true(yp * e <= EXPOSURE_KEY * (1.0 + 1e-12));
+        assert_true(yp * e > EXPOSURE_KEY * exp2(-0.125) * (1.0 - 1e-12));
+        cut[0] = 0;
+        cut[7] = N;
+        for (k = 1; k < 7; k++) {
+            seed = seed * 6364136223846793005ull + 1442695040888963407ull;
+            cut[k] = cut[k - 1] + (size_t)(seed >> 33) % (N - cut[k - 1] + 1) / 2;
+        }
+        memset(hist, 0, sizeof hist);
+        for (k = 0; k < 7; k++)
+            exposure_count(lin, id, cut[k], cut[k + 1], hist);
+        assert_true(exposure_from(hist) == e);
+    }
+    free(lin);
+    free(id);
+    free(y);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -1434,6 +1498,7 @@ int main(void)
         cmocka_unit_test(test_errors_and_glow),
         cmocka_unit_test(test_eye_inside_solid),
         cmocka_unit_test(test_fault_injection),
+        cmocka_unit_test(test_exposure_parts),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
