@@ -281,13 +281,15 @@ static int write_frame(const walk_args *a, walk_run *wr, long k)
  * that write failed). */
 static int writer_end(walk_run *wr, int rc)
 {
+    int failed;
     if (!wr->writer)
         return rc;
+    failed = frame_writer_stop(&wr->fw) != 0; /* first: it may still read buf[1] */
     wr->writer = 0;
     wr->rgb8 = wr->buf[0];
     free(wr->buf[1]);
     wr->buf[1] = NULL;
-    if (frame_writer_stop(&wr->fw) != 0 && rc == EXIT_OK) {
+    if (failed && rc == EXIT_OK) {
         fprintf(stderr, "polarlux walk: %s\n", wr->fw.err);
         return EXIT_FAIL;
     }
