@@ -73,21 +73,17 @@ static void cell_range(const gridspec *g, double lo, double hi, double org, uint
     *i1 = bucketgrid_index(hi + g->pad, org, g->inv, n);
 }
 
-/* Whether segment p->q comes within pad of cell (ci, cj): clipping of the
- * segment's parameter to the padded box (Liang-Barsky). */
-static int seg_meets_cell(const gridspec *g, const vec2 *p, const vec2 *q, uint32_t ci,
-                          uint32_t cj)
+/* Whether segment p + u e (0 <= u <= 1) comes into the box lo..hi
+ * (Liang-Barsky on the parameter). */
+static int seg_meets_box(double px, double py, double ex, double ey, const double lo[2],
+                         const double hi[2])
 {
-    double lo[2], hi[2], a[2], e[2], u0 = 0.0, u1 = 1.0;
+    double a[2], e[2], u0 = 0.0, u1 = 1.0;
     int k;
-    lo[0] = g->x0 + ci * g->cell - g->pad;
-    hi[0] = g->x0 + (ci + 1) * g->cell + g->pad;
-    lo[1] = g->y0 + cj * g->cell - g->pad;
-    hi[1] = g->y0 + (cj + 1) * g->cell + g->pad;
-    a[0] = p->x;
-    a[1] = p->y;
-    e[0] = q->x - p->x;
-    e[1] = q->y - p->y;
+    a[0] = px;
+    a[1] = py;
+    e[0] = ex;
+    e[1] = ey;
     for (k = 0; k < 2; k++) {
         if (e[k] == 0.0) {
             if (a[k] < lo[k] || a[k] > hi[k])
@@ -106,6 +102,19 @@ static int seg_meets_cell(const gridspec *g, const vec2 *p, const vec2 *q, uint3
         }
     }
     return u0 <= u1;
+}
+
+/* Whether segment p->q comes within pad of cell (ci, cj): clipping of the
+ * segment's parameter to the padded box (Liang-Barsky, seg_meets_box). */
+static int seg_meets_cell(const gridspec *g, const vec2 *p, const vec2 *q, uint32_t ci,
+                          uint32_t cj)
+{
+    double lo[2], hi[2];
+    lo[0] = g->x0 + ci * g->cell - g->pad;
+    hi[0] = g->x0 + (ci + 1) * g->cell + g->pad;
+    lo[1] = g->y0 + cj * g->cell - g->pad;
+    hi[1] = g->y0 + (cj + 1) * g->cell + g->pad;
+    return seg_meets_box(p->x, p->y, q->x - p->x, q->y - p->y, lo, hi);
 }
 
 /*
@@ -882,37 +891,6 @@ int trace_ray_brute(tracer *T, const double o[3], const double d[3], double tmax
             cap_test(T, b, -INFINITY, INFINITY, o, d, &bs);
     }
     return finish(o, d, &bs, h);
-}
-
-/* Whether segment p + u e (0 <= u <= 1) comes into the box lo..hi
- * (Liang-Barsky on the parameter). */
-static int seg_meets_box(double px, double py, double ex, double ey, const double lo[2],
-                         const double hi[2])
-{
-    double a[2], e[2], u0 = 0.0, u1 = 1.0;
-    int k;
-    a[0] = px;
-    a[1] = py;
-    e[0] = ex;
-    e[1] = ey;
-    for (k = 0; k < 2; k++) {
-        if (e[k] == 0.0) {
-            if (a[k] < lo[k] || a[k] > hi[k])
-                return 0;
-        } else {
-            double ua = (lo[k] - a[k]) / e[k], ub = (hi[k] - a[k]) / e[k];
-            if (ua > ub) {
-                double x = ua;
-                ua = ub;
-                ub = x;
-            }
-            if (ua > u0)
-                u0 = ua;
-            if (ub < u1)
-                u1 = ub;
-        }
-    }
-    return u0 <= u1;
 }
 
 int trace_box_clear(const tracer *T, double x0, double y0, double x1, double y1, double z0,
