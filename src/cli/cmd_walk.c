@@ -353,6 +353,23 @@ static int frame(const walk_args *a, plx_engine *e, const walk_path *wp, walk_ru
     return write_frame(a, wr, k);
 }
 
+/* A path whose eye stays this high, drawn as street views: a word on
+ * stderr (metres above the ground). */
+#define WALK_HIGH 100.0
+
+static void view_hint(const walk_args *a, const walk_path *wp)
+{
+    double zmin = HUGE_VAL;
+    uint32_t k;
+    if (a->aerial)
+        return;
+    for (k = 0; k < wp->n; k++)
+        zmin = fmin(zmin, wp->eye[3 * k + 2]);
+    if (zmin >= WALK_HIGH)
+        cli_warn("walk", &a->c, "the eye stays %.0f m or more above the ground: --view aerial draws views "
+                 "from above faster (the ground and roofs from the aerial light map)", zmin);
+}
+
 static int run(const walk_args *a, plx_engine *e, const walk_path *wp)
 {
     walk_run wr;
@@ -361,6 +378,7 @@ static int run(const walk_args *a, plx_engine *e, const walk_path *wp)
     int rc = EXIT_OK;
     long k;
     memset(&wr, 0, sizeof wr);
+    view_hint(a, wp);
     wr.n = (long)floor(L / step) + 1;
     if (wr.n > a->max_frames)
         wr.n = a->max_frames;

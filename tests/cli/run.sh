@@ -188,6 +188,9 @@ if /usr/bin/python3 tests/cli/apng_check.py "$tmp/w2/walk.png" "$tmp/w2"/frame-*
 "$bin" render -q fixtures/eixample-4x4.geojson --view aerial --frames 2 --size 160x120 --threads 2 -o "$tmp/t2.png" --pfm "$tmp/t2.pfm" >/dev/null 2>&1
 if cmp -s "$tmp/t1.png" "$tmp/t2.png" && cmp -s "$tmp/t1.pfm" "$tmp/t2.pfm"; then echo "ok   render-threads-same"; pass=$((pass + 1)); else echo "FAIL render-threads-same"; fail=$((fail + 1)); fi
 expect render-threads-bad 2 "--threads needs a number of threads from 1 to 16" -- "$bin" render fixtures/tiny.geojson --threads 0 -o "$tmp/x.png"
+printf '{"type":"LineString","coordinates":[[0,0,200],[10,0,250]]}' >"$tmp/high.geojson"
+expect walk-high-street-hint 0 "^polarlux walk: warning: the eye stays 200 m or more above the ground: --view aerial draws views from above faster" -- \
+    "$bin" walk "$tmp/e.plxb" --path "$tmp/high.geojson" --size 32x24 --fps 0.5 --aa 1 --no-indirect -o "$tmp/wh"
 printf '{"type":"LineString","coordinates":[[1,2]]}' >"$tmp/short.geojson"
 expect walk-short-path 1 "^polarlux walk: $tmp/short\.geojson: the LineString needs at least 2 positions$" -- "$bin" walk -q "$tmp/e.plxb" --path "$tmp/short.geojson" -o "$tmp/w3"
 expect render-aa-bad 2 "--aa '0' is not a whole number from 1 to 16" -- "$bin" render fixtures/tiny.geojson --aa 0 -o "$tmp/x.png"
