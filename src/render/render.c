@@ -1324,12 +1324,20 @@ static void corner_try_row(void *arg, int worker, uint32_t b)
     r->stop[b] = a;
 }
 
+/* The workers a parallel-for of this frame may use: 1 without one, at
+ * most RENDER_MAX_WORKERS. */
+static int par_workers(const render_opts *o)
+{
+    if (!o || !o->par || o->workers < 2)
+        return 1;
+    return o->workers > RENDER_MAX_WORKERS ? RENDER_MAX_WORKERS : o->workers;
+}
+
 /* How many workers may try the hook (0: none, the hook on this thread). */
 static int try_workers(const render_opts *o)
 {
-    if (!o->indirect_try || !o->par || o->workers < 2)
-        return 0;
-    return o->workers > RENDER_MAX_WORKERS ? RENDER_MAX_WORKERS : o->workers;
+    int nw = par_workers(o);
+    return o->indirect_try && nw > 1 ? nw : 0;
 }
 
 /* fn on rows 0 .. n - 1 on the workers; 0 when the port could not run them. */
@@ -1382,7 +1390,7 @@ static void ground_row(void *arg, int worker, uint32_t j)
 static void ground_ids(render *r, const render_opts *o)
 {
     uint32_t j;
-    int nw = o->par && o->workers > 1 ? (o->workers > RENDER_MAX_WORKERS ? RENDER_MAX_WORKERS : o->workers) : 1;
+    int nw = par_workers(o);
     if (nw > 1 && o->par(o->par_ctx, nw, (uint32_t)r->h, ground_row, r) == 0)
         return;
     for (j = 0; j < (uint32_t)r->h; j++)
@@ -1654,10 +1662,9 @@ static int any_deferred(const uint8_t *defer, size_t n)
  * indirect hook (or none). */
 static int shade_workers(const render *r, const render_opts *o)
 {
-    int n = o->workers;
-    if (!o->par || n < 2 || !r->lt || (o->indirect && !o->indirect_mt && !r->sparse))
+    if (!r->lt || (o->indirect && !o->indirect_mt && !r->sparse))
         return 1;
-    return n > RENDER_MAX_WORKERS ? RENDER_MAX_WORKERS : n;
+    return par_workers(o);
 }
 
 /* The shading pass, by tiles of RENDER_TILE x RENDER_TILE pixels: first
@@ -1817,7 +1824,7 @@ void render_tonemap_par(const render *r, const float *lin, size_t px, double ex,
 {
     tonemap_job jb;
     uint32_t jobs = (uint32_t)((3 * px + TONEMAP_CHUNK - 1) / TONEMAP_CHUNK);
-    if (!o || !o->par || o->workers < 2 || jobs < 2) {
+    if (par_workers(o) < 2 || jobs < 2) {
         render_tonemap(r, lin, px, ex, curve, rgb8);
         return;
     }
@@ -1827,8 +1834,7 @@ void render_tonemap_par(const render *r, const float *lin, size_t px, double ex,
     jb.ex = ex;
     jb.curve = curve;
     jb.rgb8 = rgb8;
-    if (o->par(o->par_ctx, o->workers > RENDER_MAX_WORKERS ? RENDER_MAX_WORKERS : o->workers, jobs,
-               tonemap_chunk, &jb) != 0)
+    if (o->par(o->par_ctx, par_workers(o), jobs, tonemap_chunk, &jb) != 0)
         render_tonemap(r, lin, px, ex, curve, rgb8);
 }
 
@@ -1848,7 +1854,7 @@ static void exposure_part(void *arg, int worker, uint32_t k)
 static double exposure_par(render *r, const render_opts *o)
 {
     uint32_t k, b;
-    int nw = o->par && o->workers > 1 ? (o->workers > RENDER_MAX_WORKERS ? RENDER_MAX_WORKERS : o->workers) : 1;
+    int nw = par_workers(o);
     if (nw < 2 || o->par(o->par_ctx, nw, RENDER_MAX_WORKERS, exposure_part, r) != 0)
         for (k = 0; k < RENDER_MAX_WORKERS; k++)
             exposure_part(r, 0, k);
