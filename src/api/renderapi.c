@@ -5,6 +5,8 @@
 #include "light/illuminance.h"
 #include "light/litregion.h"
 #include "render/render.h"
+#include "render/mesh.h"
+#include "photon/indirect.h"
 #include "photon/trace.h"
 #include "photon/photon.h"
 #include "photon/irradiance_cache.h"
@@ -59,6 +61,34 @@ static int shade_indirect_try(void *user, const double P[3], const double n[3], 
 static void shade_photons(void *user, const double P[3], const double n[3], double rgb[3])
 {
     eng_indirect_photons_rgb(user, P, n, rgb);
+}
+
+/* shade_photons with the pixel's surface known: on a wall, the wall's own
+ * facade chart at P, without the probe ray that finds the wall from P
+ * (photon_indirect_hit; the same wall but where the probe would meet
+ * another: a corner, a wall shared by two buildings). */
+static void shade_photons_surf(void *user, uint32_t sid, uint32_t bld, const double P[3], const double n[3],
+                               double rgb[3])
+{
+    plx_engine *e = user;
+    const scene *s = e->sc;
+    trace_hit h;
+    double v[PHOTON_CH];
+    if (!e->ph || plx_indirect_frames(e) == 0 || sid < mesh_wall_id(s, 0) || sid >= mesh_roof_id(s, 0) ||
+        bld >= s->nbld) {
+        shade_photons(user, P, n, rgb);
+        return;
+    }
+    memset(&h, 0, sizeof h);
+    h.kind = TRACE_WALL;
+    h.bld = bld;
+    h.edge = sid - mesh_wall_id(s, 0);
+    memcpy(h.p, P, sizeof h.p);
+    memcpy(h.n, n, sizeof h.n);
+    photon_indirect_hit(e->ph, &h, v);
+    rgb[0] = v[1];
+    rgb[1] = v[2];
+    rgb[2] = v[3];
 }
 
 /* The indirect ground map's surface height (the photon tracer's topmost
@@ -442,6 +472,7 @@ plx_status plx_render(plx_engine *e, const plx_camera *cam, const plx_render_opt
              * photon buffers: read only, so on every worker, and no
              * gathering while the view moves */
             ro.indirect = shade_photons;
+            ro.indirect_surf = shade_photons_surf;
             ro.indirect_mt = 1;
             /* (not sparse, README "Images: an irradiance cache") */
             ro.indirect_sparse = 0;

@@ -1562,7 +1562,12 @@ static int tile_shade(render *r, shade_ws *w, const render_opts *o, tile_state *
                 sparse_at(r, i, j, E); /* the pixels it leaves: sparse_rest */
             } else if (o->indirect) {
                 double Ei[3] = { 0, 0, 0 };
-                o->indirect(o->indirect_user, w->tP[q], w->tN[q], Ei);
+                if (o->indirect_surf) {
+                    mesh_surf sfv;
+                    const mesh_surf *sf = surf_get(r, r->id[p], &sfv);
+                    o->indirect_surf(o->indirect_user, r->id[p], sf->bld, w->tP[q], w->tN[q], Ei);
+                } else
+                    o->indirect(o->indirect_user, w->tP[q], w->tN[q], Ei);
                 t->icalls++;
                 for (k = 0; k < 3; k++)
                     E[k] += Ei[k];

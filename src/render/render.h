@@ -295,6 +295,11 @@ typedef struct render_opts {
                                   it can be had without changing anything, so on several
                                   workers at once, else 0 (NULL: indirect alone, on this
                                   thread); user is indirect_user */
+    void (*indirect_surf)(void *user, uint32_t sid, uint32_t bld, const double P[3], const double n[3],
+                          double rgb[3]);
+                               /* not sparse: called instead of indirect for each pixel, with
+                                  the pixel's surface id and its building (mesh.h); the same
+                                  rules (indirect_mt) and user */
     uint8_t *mask;             /* adaptive anti-aliasing's later samples (render_aa_mask): only
                                   the pixels whose byte is 1 are shaded, lit by indirect light
                                   and glows, and written; the others keep what the linear image
