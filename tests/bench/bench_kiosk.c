@@ -18,6 +18,7 @@
  * (default 64; the command's default is 256).
  */
 #include <math.h>
+#include <pthread.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -151,37 +152,64 @@ static void walk(plx_engine *e, int aerial, int n, uint8_t *rgb8, double *med, d
     free(t);
 }
 
+/* The twin: loaded and prepared (on a thread of its own when the bake
+ * has more than one, as `polarlux bake` does). */
+typedef struct twin_job {
+    text city;
+    plx_engine *b;
+    int rc;
+} twin_job;
+
+static void *twin_prepare(void *p)
+{
+    twin_job *j = p;
+    plx_bake_opts bo;
+    memset(&bo, 0, sizeof bo);
+    bo.aerial = 1;
+    bo.twin = 1;
+    j->rc = j->b && plx_load_geojson(j->b, j->city.buf, j->city.len, "eixample") == PLX_OK &&
+                    plx_bake_prepare(j->b, &bo) == PLX_OK ? 0 : -1;
+    return NULL;
+}
+
 /* Bakes the city on `threads` workers: load, plx_bake_prepare (polar,
- * light, photons, renderer, light map), the photon frames, the twin,
- * plx_bake_save (which gathers the aerial layer). Wall ms, CPU ms of the
- * process (every thread), the engine's memory. */
+ * light, photons, renderer, light map), the photon frames, the twin
+ * (alongside with 2 threads), plx_bake_save (which gathers the aerial
+ * layer). Wall ms, CPU ms of the process (every thread), the engine's
+ * memory. */
 static int bake(text city, int frames, int threads, unsigned char **file, size_t *len, double *wall, double *cpu,
                 plx_memory_report *m)
 {
     void *ma, *mb;
-    plx_engine *a, *b;
+    plx_engine *a;
     plx_bake_opts bo;
+    twin_job tj;
+    pthread_t th;
+    int alongside, ok;
     size_t need = 0;
     double w0 = wall_ms(), c0 = proc_ms();
     memset(&bo, 0, sizeof bo);
     bo.aerial = 1;
     a = engine(&ma, 1024, 768, 1, threads);
-    b = engine(&mb, 1024, 768, 1, threads);
-    if (!a || !b || plx_load_geojson(a, city.buf, city.len, "eixample") != PLX_OK ||
-        plx_bake_prepare(a, &bo) != PLX_OK || trace(a, frames) != 0)
-        return -1;
-    bo.twin = 1;
-    if (plx_load_geojson(b, city.buf, city.len, "eixample") != PLX_OK || plx_bake_prepare(b, &bo) != PLX_OK ||
-        plx_bake_size(a, b, &need) != PLX_OK)
+    tj.city = city;
+    tj.b = engine(&mb, 1024, 768, 1, threads);
+    alongside = threads > 1 && pthread_create(&th, NULL, twin_prepare, &tj) == 0;
+    ok = a && plx_load_geojson(a, city.buf, city.len, "eixample") == PLX_OK && plx_bake_prepare(a, &bo) == PLX_OK &&
+         trace(a, frames) == 0;
+    if (alongside)
+        pthread_join(th, NULL);
+    else
+        twin_prepare(&tj);
+    if (!ok || tj.rc != 0 || plx_bake_size(a, tj.b, &need) != PLX_OK)
         return -1;
     *file = malloc(need);
-    if (!*file || plx_bake_save(a, b, *file, need, len) != PLX_OK)
+    if (!*file || plx_bake_save(a, tj.b, *file, need, len) != PLX_OK)
         return -1;
     *wall = wall_ms() - w0;
     *cpu = proc_ms() - c0;
     plx_memory_get(a, m);
     plx_engine_destroy(a);
-    plx_engine_destroy(b);
+    plx_engine_destroy(tj.b);
     free(ma);
     free(mb);
     return 0;
