@@ -71,6 +71,9 @@ static int visible_exact(light *L, uint32_t i, const double P[3])
 int light_visible(light *L, uint32_t lamp, const double P[3])
 {
     const lit_region *r;
+    int v = lamp < L->s->nlamps ? light_lamp_visible_cached(L, lamp, P) : -1;
+    if (v >= 0)
+        return v;
     if (L->pool_cap && light_region_index(L, lamp, &r) == PLX_OK)
         return light_region_visible(L, r, P);
     if (L->pool_cap)

@@ -1623,7 +1623,7 @@ static double band_overlap(const lit_region *r, const lit_band *b, const scene_b
     return y - x;
 }
 
-int light_region_visible(light *L, const lit_region *r, const double P[3])
+static inline int region_visible(light *L, const lit_region *r, const double P[3])
 {
     vec2 w;
     double len3 = -1.0;
@@ -1648,4 +1648,22 @@ int light_region_visible(light *L, const lit_region *r, const double P[3])
         }
     }
     return 1;
+}
+
+int light_region_visible(light *L, const lit_region *r, const double P[3])
+{
+    return region_visible(L, r, P);
+}
+
+int light_lamp_visible_cached(light *L, uint32_t lamp, const double P[3])
+{
+    const lit_region *r = L->ent[lamp].reg;
+    if (!r)
+        return -1;
+    L->st.hits++;
+    if (L->lru_head != lamp) {
+        lru_unlink(L, lamp);
+        lru_front(L, lamp);
+    }
+    return region_visible(L, r, P);
 }
