@@ -671,7 +671,10 @@ typedef struct plx_render_opts {
                                    stays linear radiance. README "Automatic exposure" */
     int aa;                     /* anti-aliasing: aa x aa samples per pixel on a regular grid,
                                    averaged in linear radiance (0 or 1: one sample at the pixel
-                                   centre, SPEC §5); at most PLX_RENDER_MAX_AA */
+                                   centre, SPEC §5); at most PLX_RENDER_MAX_AA. Adaptive unless
+                                   aa_full: the later samples only where the first sample's
+                                   image has an edge (README "Anti-aliasing") */
+    int aa_full;                /* 1: every pixel takes all aa x aa samples */
 } plx_render_opts;
 
 #define PLX_RENDER_MAX_AA 16

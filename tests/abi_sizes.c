@@ -121,6 +121,7 @@ static void render_opts(void)
     FIELD(plx_render_opts, backend);
     FIELD(plx_render_opts, auto_exposure);
     FIELD(plx_render_opts, aa);
+    FIELD(plx_render_opts, aa_full);
 }
 
 static void render_info(void)

@@ -80,7 +80,8 @@ class RenderOpts(ctypes.Structure):
     _fields_ = [("exposure", ctypes.c_double), ("no_glow", ctypes.c_int), ("aerial", ctypes.c_int),
                 ("aerial_m_per_texel", ctypes.c_double), ("no_cull", ctypes.c_int),
                 ("no_indirect", ctypes.c_int), ("backend", ctypes.c_void_p),
-                ("auto_exposure", ctypes.c_int), ("aa", ctypes.c_int)]
+                ("auto_exposure", ctypes.c_int), ("aa", ctypes.c_int),
+                ("aa_full", ctypes.c_int)]
 
 
 class RenderInfo(ctypes.Structure):

@@ -35,6 +35,9 @@ struct plx_engine {
     int layer_workers;      /* workers that gathered the map's indirect layer last (eng_lightmap_layer) */
     uint64_t indirect_gen;  /* +1 at every change of the photon buffers (the indirect map's key) */
     float *aa_sum;          /* anti-aliasing sum (PLX_PART_FRAME), taken on first need */
+    uint32_t *aa_id;        /* adaptive anti-aliasing: the first sample's surface ids, */
+    uint8_t *aa_mask;       /* the pixels the later samples shade (1 byte each) and */
+    uint8_t *aa_rgb;        /* the first sample's 8-bit image (PLX_PART_FRAME, on first need) */
     uint32_t gather_side;   /* final gathering at points: side^2 directions
                                (0 = photon buffers only); set by
                                plx_indirect_set_gather, else FINAL_GATHER_SIDE */

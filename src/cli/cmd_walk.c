@@ -14,8 +14,9 @@
 
 static const char help[] =
     "usage: polarlux walk SCENE|BAKE --path CAMERA.geojson -o DIR [--size WxH] [--fps F]\n"
-    "                     [--speed M/S] [--fov DEG] [--aa N] [--exposure E] [--no-glow]\n"
-    "                     [--no-indirect] [--view street|aerial] [--max-frames N] [--threads N]\n"
+    "                     [--speed M/S] [--fov DEG] [--aa N [--aa-full]] [--exposure E]\n"
+    "                     [--no-glow] [--no-indirect] [--view street|aerial] [--max-frames N]\n"
+    "                     [--threads N]\n"
     "\n"
     "Renders frames along a camera path and writes DIR/frame-0001.png ...,\n"
     "DIR/cameras.txt (frame, eye, target), DIR/walk.png (the frames as an animated\n"
@@ -31,7 +32,8 @@ static const char help[] =
     "  --fps F          frames per second of the walk (default 25)\n"
     "  --speed M/S      walking speed along the path (default 1.4)\n"
     "  --fov DEG        vertical field of view (default 60)\n"
-    "  --aa N           N x N samples per pixel (default 2; 1: pixel centres, SPEC §5)\n"
+    "  --aa N           N x N samples per pixel (default 2; 1: pixel centres, SPEC §5),\n"
+    "                   the later ones only at edges, as for render (--aa-full: all)\n"
     "  --exposure E     fixed exposure, no tone curve (default: automatic per frame)\n"
     "  --no-glow, --no-indirect, --view V, --photons N, --frames K   as for render\n"
     "  --max-frames N   at most N frames (default 1000)\n"

@@ -152,6 +152,7 @@ static void view_opts(cli_view *v)
         CLI_OPT_VAL("--aa", &v->aa, parse_aa,
                     "--aa '%s' is not a whole number from 1 to " STR(PLX_RENDER_MAX_AA)),
         CLI_OPT_VAL("--view", &v->aerial, parse_view, "--view '%s' is not street or aerial"),
+        CLI_OPT_FLAG("--aa-full", &v->aa_full),
         CLI_OPT_FLAG("--no-glow", &v->no_glow),
         CLI_OPT_FLAG("--refine", &v->refine),
         CLI_OPT_END
@@ -176,6 +177,7 @@ void cli_view_init(cli_view *v, long w, long h, double fov, plx_render_opts *o, 
 void cli_view_apply(const cli_view *v, const cli_indirect *ind, plx_render_opts *o)
 {
     o->aa = (int)v->aa;
+    o->aa_full = v->aa_full;
     o->no_glow = v->no_glow;
     o->aerial = v->aerial;
     if (v->exposure)

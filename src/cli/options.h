@@ -70,7 +70,7 @@ int cli_opt_size(const char *value, void *dst);
 
 /* ---- the view options of render and walk ---------------------------------- */
 
-#define CLI_VIEW_NOPTS 7
+#define CLI_VIEW_NOPTS 8
 
 typedef struct cli_view {
     long size[2];           /* --size WxH (1..8192 each) */
@@ -78,6 +78,7 @@ typedef struct cli_view {
     long aa;                /* --aa (1..PLX_RENDER_MAX_AA) */
     int aerial;             /* --view street|aerial */
     int no_glow, refine;    /* --no-glow, --refine */
+    int aa_full;            /* --aa-full */
     int exposure;           /* --exposure was given (the command's own table
                              * entry sets it): no automatic exposure */
     cli_opt frag[CLI_VIEW_NOPTS]; /* the options above (the last entry

@@ -1037,20 +1037,26 @@ static void surf_cache_fill(render *r)
 /* Pixel (i, j)'s sample ray and what it meets: the surface (a pixel no
  * building covers that looks down is the ground, and its id is set so),
  * the hit point and the normal facing the eye. Returns 0 for the sky. */
-static int pixel_hit(render *r, int32_t i, int32_t j, uint32_t *sid_out, double P[3], double n[3])
+/* Pixel (i, j)'s sample ray direction (not unit). */
+static void pixel_dir(const render *r, int32_t i, int32_t j, double d[3])
 {
     double ta = r->tanh_ * r->aspect, tb = r->tanh_;
     double bj = (1.0 - 2.0 * (j + 0.5 + r->shift[1]) / r->h) * tb;
     double ai = (2.0 * (i + 0.5 + r->shift[0]) / r->w - 1.0) * ta;
+    d[0] = r->f[0] + ai * r->rt[0] + bj * r->up[0];
+    d[1] = r->f[1] + ai * r->rt[1] + bj * r->up[1];
+    d[2] = r->f[2] + ai * r->rt[2] + bj * r->up[2];
+}
+
+static int pixel_hit(render *r, int32_t i, int32_t j, uint32_t *sid_out, double P[3], double n[3])
+{
     size_t p = (size_t)j * (size_t)r->w + (size_t)i;
     double d[3], tt, nd;
     uint32_t sid = r->id[p];
     mesh_surf sfv;
     const mesh_surf *sf;
     int k;
-    d[0] = r->f[0] + ai * r->rt[0] + bj * r->up[0];
-    d[1] = r->f[1] + ai * r->rt[1] + bj * r->up[1];
-    d[2] = r->f[2] + ai * r->rt[2] + bj * r->up[2];
+    pixel_dir(r, i, j, d);
     if (sid == MESH_SURF_NONE) {
         if (!(d[2] < 0.0))
             return 0;
@@ -1107,6 +1113,8 @@ static void tile_points(render *r, shade_ws *w, const render_opts *o, tile_state
             const mesh_surf *sf;
             float *out = &r->lin[3 * p];
             w->tcall[q] = 0;
+            if (o->mask && !o->mask[p])
+                continue;
             if (!pixel_hit(r, i, j, &sid, P, n)) {
                 t->sky++;
                 out[0] = out[1] = out[2] = 0.0f;
@@ -1258,7 +1266,7 @@ static int corner_used(const render *r, int32_t a, int32_t b)
     for (db = -1; db <= 0; db++)
         for (da = -1; da <= 0; da++) {
             int32_t x = a + da, y = b + db;
-            if (x >= 0 && y >= 0 && x < r->nbx && y < r->nby && r->blk[(size_t)y * (size_t)r->nbx + (size_t)x])
+            if (x >= 0 && y >= 0 && x < r->nbx && y < r->nby && r->blk[(size_t)y * (size_t)r->nbx + (size_t)x] == 1)
                 return 1;
         }
     return 0;
@@ -1378,13 +1386,17 @@ static void corners_rest(render *r, const render_opts *o, render_stats *st)
 static void ground_row(void *arg, int worker, uint32_t j)
 {
     render *r = arg;
-    double P[3], n[3];
-    uint32_t sid;
+    double d[3];
     int32_t i;
     (void)worker;
-    for (i = 0; i < r->w; i++)
-        if (r->id[(size_t)j * (size_t)r->w + (size_t)i] == MESH_SURF_NONE)
-            (void)pixel_hit(r, i, (int32_t)j, &sid, P, n);
+    for (i = 0; i < r->w; i++) {
+        uint32_t *id = &r->id[(size_t)j * (size_t)r->w + (size_t)i];
+        if (*id != MESH_SURF_NONE)
+            continue;
+        pixel_dir(r, i, (int32_t)j, d);   /* as pixel_hit decides */
+        if (d[2] < 0.0)
+            *id = MESH_SURF_GROUND;
+    }
 }
 
 static void ground_ids(render *r, const render_opts *o)
@@ -1401,6 +1413,18 @@ static void ground_ids(render *r, const render_opts *o)
  * hook's value at their corners, row by row (each corner's hit point
  * found once, two rows of them kept; with tries, the hook's values after
  * the blocks, on the workers first). */
+/* Whether a pixel of block (a, b), its far corners included, is shaded
+ * in this sample (render_opts.mask). */
+static int block_masked(const render *r, const render_opts *o, int32_t a, int32_t b)
+{
+    int32_t x0 = corner_x(r, a), x1 = corner_x(r, a + 1), y0 = corner_y(r, b), y1 = corner_y(r, b + 1), x, y;
+    for (y = y0; y <= y1; y++)
+        for (x = x0; x <= x1; x++)
+            if (o->mask[(size_t)y * (size_t)r->w + (size_t)x])
+                return 1;
+    return 0;
+}
+
 static void sparse_corners(render *r, const render_opts *o, render_stats *st)
 {
     int32_t a, b;
@@ -1416,8 +1440,10 @@ static void sparse_corners(render *r, const render_opts *o, render_stats *st)
         corner_row(r, b + 1, row[(b + 1) & 1]);
         for (a = 0; a < r->nbx; a++) {
             uint8_t one = (uint8_t)block_one_surface(r, a, b, o->indirect_span, row[b & 1], row[(b + 1) & 1]);
-            r->blk[(size_t)b * (size_t)r->nbx + (size_t)a] = one;
             st->indirect_blocks += one;
+            if (one && o->mask && !block_masked(r, o, a, b))
+                one = 2; /* one surface, no pixel shaded in this sample: corners not asked */
+            r->blk[(size_t)b * (size_t)r->nbx + (size_t)a] = one;
         }
         if (!tries)
             corner_gather(r, o, st, b, row[b & 1], 0);
@@ -1470,7 +1496,7 @@ static int32_t rest_row(render *r, const render_opts *o, int32_t j, int32_t i0, 
         uint32_t sid;
         int k;
         if (r->blk[(size_t)block_of(j, r->nby) * (size_t)r->nbx + (size_t)block_of(i, r->nbx)] ||
-            !pixel_hit(r, i, j, &sid, P, n))
+            (o->mask && !o->mask[p]) || !pixel_hit(r, i, j, &sid, P, n))
             continue;
         if (!try)
             o->indirect(o->indirect_user, P, n, Ei);
@@ -1717,56 +1743,93 @@ static void shade_pass(render *r, const render_opts *o, render_stats *st)
     }
 }
 
-static void glows(render *r, render_stats *st)
+/* Lamp lp's glow disc: centre (px, py), radius rad in pixels and the
+ * pixels box[4] (x0, y0, x1, y1) it may touch, when the lamp is in front of
+ * the eye, inside the frame and not hidden at its own pixel (the depth
+ * buffer); else 0. */
+static int glow_disc(const render *r, const scene_lamp *lp, double g[3], int32_t box[4])
+{
+    double X[3], c[4], px, py, rad;
+    size_t p;
+    float dz;
+    X[0] = lp->x;
+    X[1] = lp->y;
+    X[2] = lp->z;
+    to_clip(r, X, c);
+    if (!(c[3] > r->near_) || !(lp->intensity > 0))
+        return 0;
+    px = (c[0] / c[3] + 1.0) * 0.5 * r->w;
+    py = (1.0 - c[1] / c[3]) * 0.5 * r->h;
+    rad = 0.3 * r->sy * 0.5 * r->h / c[3];
+    rad = fmin(fmax(rad, 1.5), 48.0);
+    if (!(px >= 0 && py >= 0 && px < r->w && py < r->h))
+        return 0;
+    p = (size_t)(int32_t)py * (size_t)r->w + (size_t)(int32_t)px;
+    dz = (float)((r->za * c[3] + r->zb) / c[3] * 0.5 + 0.5);
+    if (!(dz < r->depth[p]))
+        return 0;
+    g[0] = px;
+    g[1] = py;
+    g[2] = rad;
+    box[0] = (int32_t)floor(px - rad);
+    box[2] = (int32_t)ceil(px + rad);
+    box[1] = (int32_t)floor(py - rad);
+    box[3] = (int32_t)ceil(py + rad);
+    if (box[0] < 0) box[0] = 0;
+    if (box[1] < 0) box[1] = 0;
+    if (box[2] > r->w - 1) box[2] = r->w - 1;
+    if (box[3] > r->h - 1) box[3] = r->h - 1;
+    return 1;
+}
+
+/* Pixel (x, y)'s place in glow disc g: (d / rad)^2, 1 or more outside. */
+static double glow_q(const double g[3], int32_t x, int32_t y)
+{
+    double dx = x + 0.5 - g[0], dy = y + 0.5 - g[1];
+    return (dx * dx + dy * dy) / (g[2] * g[2]);
+}
+
+static void glows(render *r, const render_opts *o, render_stats *st)
 {
     const scene *s = r->s;
     uint32_t l;
     for (l = 0; l < s->nlamps; l++) {
         const scene_lamp *lp = &s->lamps[l];
-        double X[3], c[4], px, py, rad, peak;
-        int32_t x0, x1, y0, y1, x, y;
-        X[0] = lp->x;
-        X[1] = lp->y;
-        X[2] = lp->z;
-        to_clip(r, X, c);
-        if (!(c[3] > r->near_) || !(lp->intensity > 0))
+        double g[3], peak;
+        int32_t b[4], x, y;
+        if (!glow_disc(r, lp, g, b))
             continue;
-        px = (c[0] / c[3] + 1.0) * 0.5 * r->w;
-        py = (1.0 - c[1] / c[3]) * 0.5 * r->h;
-        rad = 0.3 * r->sy * 0.5 * r->h / c[3];
-        rad = fmin(fmax(rad, 1.5), 48.0);
-        if (px < -rad || py < -rad || px > r->w + rad || py > r->h + rad)
-            continue;
-        if (px >= 0 && py >= 0 && px < r->w && py < r->h) {
-            size_t p = (size_t)(int32_t)py * (size_t)r->w + (size_t)(int32_t)px;
-            float dz = (float)((r->za * c[3] + r->zb) / c[3] * 0.5 + 0.5);
-            if (!(dz < r->depth[p]))
-                continue;
-        } else {
-            continue;
-        }
         st->glows++;
         peak = lp->intensity / 250.0;
-        x0 = (int32_t)floor(px - rad);
-        x1 = (int32_t)ceil(px + rad);
-        y0 = (int32_t)floor(py - rad);
-        y1 = (int32_t)ceil(py + rad);
-        if (x0 < 0) x0 = 0;
-        if (y0 < 0) y0 = 0;
-        if (x1 > r->w - 1) x1 = r->w - 1;
-        if (y1 > r->h - 1) y1 = r->h - 1;
-        for (y = y0; y <= y1; y++)
-            for (x = x0; x <= x1; x++) {
-                double dx = x + 0.5 - px, dy = y + 0.5 - py, q = (dx * dx + dy * dy) / (rad * rad), g;
+        for (y = b[1]; y <= b[3]; y++)
+            for (x = b[0]; x <= b[2]; x++) {
+                size_t p = (size_t)y * (size_t)r->w + (size_t)x;
+                double q = glow_q(g, x, y), v;
                 float *out;
                 int k;
-                if (q >= 1.0)
+                if (q >= 1.0 || (o->mask && !o->mask[p]))
                     continue;
-                g = peak * (1.0 - q) * (1.0 - q);
-                out = &r->lin[3 * ((size_t)y * (size_t)r->w + (size_t)x)];
+                v = peak * (1.0 - q) * (1.0 - q);
+                out = &r->lin[3 * p];
                 for (k = 0; k < 3; k++)
-                    out[k] += (float)(g * lp->color[k]);
+                    out[k] += (float)(v * lp->color[k]);
             }
+    }
+}
+
+/* Marks in mask the pixels of every glow disc seen in this frame. */
+static void glow_mark(const render *r, uint8_t *mask)
+{
+    uint32_t l;
+    for (l = 0; l < r->s->nlamps; l++) {
+        double g[3];
+        int32_t b[4], x, y;
+        if (!glow_disc(r, &r->s->lamps[l], g, b))
+            continue;
+        for (y = b[1]; y <= b[3]; y++)
+            for (x = b[0]; x <= b[2]; x++)
+                if (glow_q(g, x, y) < 1.0)
+                    mask[(size_t)y * (size_t)r->w + (size_t)x] = 1;
     }
 }
 
@@ -1864,6 +1927,74 @@ static double exposure_par(render *r, const render_opts *o)
     return exposure_from(r->hist[0]);
 }
 
+/* ---- adaptive anti-aliasing (render_aa_mask, render_opts.mask) ------------------- */
+
+/* A pixel's surface as the mask compares it: the ground and the sky are
+ * one (a later sample's ground pixels may not carry the ground's id yet). */
+static uint32_t mask_class(uint32_t id)
+{
+    return id == MESH_SURF_GROUND ? MESH_SURF_NONE : id;
+}
+
+/* Marks the pixels whose surface is not the first sample's, and those of
+ * the glows this sample sees. */
+static void mask_update(render *r, const render_opts *o)
+{
+    size_t p, px = (size_t)r->w * (size_t)r->h;
+    if (o->mask_id)
+        for (p = 0; p < px; p++)
+            if (mask_class(r->id[p]) != mask_class(o->mask_id[p]))
+                o->mask[p] = 1;
+    if (!o->no_glow)
+        glow_mark(r, o->mask);
+}
+
+/* Whether pixels p and q differ: surface id, or a channel more than level
+ * steps apart in rgb. */
+static inline int px_differ(const uint8_t *rgb, const uint32_t *id, size_t p, size_t q, int level)
+{
+    const uint8_t *a = rgb + 3 * p, *b = rgb + 3 * q;
+    int d0 = (int)a[0] - (int)b[0], d1 = (int)a[1] - (int)b[1], d2 = (int)a[2] - (int)b[2];
+    return (id[p] != id[q]) | (d0 > level) | (d0 < -level) | (d1 > level) | (d1 < -level) | (d2 > level) |
+           (d2 < -level);
+}
+
+/* Marks p and q when they differ. */
+static inline void mask_pair(const uint8_t *rgb, const uint32_t *id, uint8_t *mask, size_t p, size_t q, int level)
+{
+    if (px_differ(rgb, id, p, q, level))
+        mask[p] = mask[q] = 1;
+}
+
+size_t render_aa_mask(render *r, const render_opts *o, double ex, int curve, int level, uint8_t *rgb, uint32_t *id0,
+                      uint8_t *mask)
+{
+    size_t px = (size_t)r->w * (size_t)r->h, n = 0, p, w = (size_t)r->w;
+    int32_t i, j;
+    render_tonemap_par(r, r->lin, px, ex, curve, rgb, o);
+    memcpy(id0, r->id, px * sizeof *id0);
+    memset(mask, 0, px);
+    /* each pair of 8-neighbours once: right, down, down-right, down-left */
+    for (j = 0; j < r->h; j++)
+        for (i = 0; i < r->w; i++) {
+            p = (size_t)j * w + (size_t)i;
+            if (i + 1 < r->w)
+                mask_pair(rgb, id0, mask, p, p + 1, level);
+            if (j + 1 < r->h) {
+                mask_pair(rgb, id0, mask, p, p + w, level);
+                if (i + 1 < r->w)
+                    mask_pair(rgb, id0, mask, p, p + w + 1, level);
+                if (i > 0)
+                    mask_pair(rgb, id0, mask, p, p + w - 1, level);
+            }
+        }
+    if (!o->no_glow)
+        glow_mark(r, mask); /* a glow the first sample sees: every sample adds its own */
+    for (p = 0; p < px; p++)
+        n += mask[p];
+    return n;
+}
+
 const float *render_linear(const render *r)
 {
     return r->lin;
@@ -1911,6 +2042,8 @@ plx_status render_frame(render *r, const render_camera *cam, const render_opts *
         return PLX_E_UNSUPPORTED;
     }
     surf_cache_fill(r);
+    if (o->mask)
+        mask_update(r, o);
     st.drawn_fraction = st.triangles ? (double)st.triangles_drawn / (double)st.triangles : 1.0;
     if (o->lightmap && r->lm.built && !r->lm.has_ind && o->indirect && o->indirect_map &&
         (!r->im.built || r->im.key != o->indirect_key))
@@ -1927,7 +2060,7 @@ plx_status render_frame(render *r, const render_camera *cam, const render_opts *
     /* the exposure from the lit surfaces, before the glows */
     st.exposure = o->auto_exposure ? exposure_par(r, o) : o->exposure;
     if (!o->no_glow)
-        glows(r, &st);
+        glows(r, o, &st);
     if (rgbf)
         memcpy(rgbf, r->lin, px * 3 * sizeof(float));
     if (rgb8)

@@ -295,9 +295,17 @@ typedef struct render_opts {
                                   it can be had without changing anything, so on several
                                   workers at once, else 0 (NULL: indirect alone, on this
                                   thread); user is indirect_user */
+    uint8_t *mask;             /* adaptive anti-aliasing's later samples (render_aa_mask): only
+                                  the pixels whose byte is 1 are shaded, lit by indirect light
+                                  and glows, and written; the others keep what the linear image
+                                  held. First, a pixel whose surface is not mask_id's (a
+                                  building's surface id; the ground and the sky count as one)
+                                  gets its byte set to 1. NULL: every pixel */
+    const uint32_t *mask_id;   /* with mask: the first sample's surface ids */
 } render_opts;
 
 void render_opts_default(render_opts *o /* OUT */);
+
 
 typedef struct render_stats {
     uint32_t buildings;        /* in the scene */
@@ -351,6 +359,16 @@ void render_tonemap(const render *r, const float *lin, size_t px, double ex, int
 /* The same on o's parallel-for (each value on its own: the same bytes). */
 void render_tonemap_par(const render *r, const float *lin, size_t px, double ex, int curve,
                         uint8_t *rgb8 /* OUT */, const render_opts *o);
+
+/* Adaptive anti-aliasing, after the frame of the first sample (its exposure
+ * ex, curve as render_opts.auto_exposure): tone maps the linear image into
+ * rgb (3 bytes a pixel, scratch), copies the surface ids into id0 and
+ * marks in mask (1 byte a pixel) every pixel that differs from one of its
+ * 8 neighbours: another surface id, or a channel more than level steps
+ * apart in the 8-bit image. Returns the pixels marked. */
+size_t render_aa_mask(render *r, const render_opts *o, double ex, int curve, int level, uint8_t *rgb, uint32_t *id0,
+                      uint8_t *mask);
+
 /* The linear image of the last frame (width*height*3). Valid until the next frame. */
 const float *render_linear(const render *r);
 

@@ -116,8 +116,11 @@ static void aerial_cam(plx_camera *c, double s)
 /* n frames along a path: median and p95 wall ms, mean CPU ms of the
  * process (every thread). A first frame before them (the aerial one
  * builds the indirect map) is timed alone into *first (wall ms). */
-static void walk(plx_engine *e, int aerial, int n, uint8_t *rgb8, double *med, double *p95, double *cpu,
-                 double *first)
+/* n frames along the street or aerial path: wall-clock median and p95,
+ * process CPU per frame, and the first frame's wall-clock time before
+ * them; aa x aa samples (full: every pixel all of them). */
+static void walk(plx_engine *e, int aerial, int aa, int full, int n, uint8_t *rgb8, double *med, double *p95,
+                 double *cpu, double *first)
 {
     double *t = malloc(sizeof *t * (size_t)n), c0, f0 = wall_ms();
     plx_render_opts o;
@@ -126,6 +129,8 @@ static void walk(plx_engine *e, int aerial, int n, uint8_t *rgb8, double *med, d
     plx_render_opts_default(&o);
     o.aerial = aerial;
     o.auto_exposure = 1;
+    o.aa = aa;
+    o.aa_full = full;
     if (aerial)
         aerial_cam(&cam0, -4.0);
     else
@@ -323,8 +328,8 @@ int main(void)
                 return 1;
             }
         }
-        walk(c, 0, 20, rgb8, &sm, &sp, &sc, &sf);
-        walk(c, 1, 10, rgb8, &am, &ap, &ac, &af);
+        walk(c, 0, 1, 0, 20, rgb8, &sm, &sp, &sc, &sf);
+        walk(c, 1, 1, 0, 10, rgb8, &am, &ap, &ac, &af);
         printf("%d thread%s:\n", k + 1, k ? "s" : "");
         printf("  street walk 640x480 with indirect, 20 frames: median %.1f ms, p95 %.1f ms, CPU %.1f ms/frame "
                "(target 10 ms); %.1fx the baseline's first frame (%.0f ms), %.0fx its load + photons + frame; "
@@ -334,6 +339,15 @@ int main(void)
                "(target 5 ms); %.1fx the baseline's first aerial frame (%.0f ms); first frame (builds the "
                "indirect map) %.0f ms\n",
                am, ap, ac, base_aerial / am, base_aerial, af);
+    }
+    {
+        /* walk's default: 2 x 2 samples, adaptive, against every sample */
+        double dm, dp, dc, df, fm, fp, fc, ff;
+        walk(c, 0, 2, 0, 20, rgb8, &dm, &dp, &dc, &df);
+        walk(c, 0, 2, 1, 20, rgb8, &fm, &fp, &fc, &ff);
+        printf("2 threads, street walk 640x480 with --aa 2 (walk's default), 20 frames: adaptive median %.1f ms, "
+               "CPU %.1f ms/frame; every sample (--aa-full) median %.1f ms, CPU %.1f ms/frame; %.2fx\n",
+               dm, dc, fm, fc, fc / dc);
     }
     plx_engine_destroy(c);
     free(mc);

@@ -8,6 +8,11 @@
  *  - aa = N equals rendering N times larger with one sample per pixel and
  *    averaging each N x N block (the sample points are the same).
  *  - aa = 1 is the plain image, byte for byte.
+ *  - Adaptive anti-aliasing (aa without aa_full): every pixel is either
+ *    the full pass's value or its first sample's (taken from the image N
+ *    times larger), and wherever the full pass's byte differs from the
+ *    first sample's by more than 2 it is the full pass's; in 8 bits it is
+ *    within 2 of the full pass everywhere.
  */
 #include <stdarg.h>
 #include <stddef.h>
@@ -110,6 +115,7 @@ static void aa_against_supersampling(plx_engine *e, int n)
     plx_render_opts_default(&o);
     o.no_glow = 1;
     o.aa = n;
+    o.aa_full = 1;
     street(&cam, W, H);
     assert_int_equal(plx_render(e, &cam, &o, NULL, small, NULL), PLX_OK);
     o.aa = 1;
@@ -160,11 +166,91 @@ static void test_aa(void **state)
     free(mem);
 }
 
+/* Equal within float rounding (the ray directions' last bits). */
+static int near_equal(double a, double b)
+{
+    return fabs(a - b) <= 1e-5 * fmax(1.0, fabs(b));
+}
+
+/* Adaptive against full anti-aliasing at n x n, glows on, automatic
+ * exposure; the first samples from one sample per pixel at n w x n h
+ * (sparse: the indirect light is interpolated over blocks of 4 x 4 pixels
+ * of each image, so the larger one's first samples are not the same
+ * values; only the full pass's are checked then). */
+static void aa_adaptive(plx_engine *e, int n, int sparse)
+{
+    enum { W = 160, H = 120 };
+    plx_camera cam;
+    plx_render_opts o;
+    plx_render_info ia, iff;
+    size_t px = (size_t)W * H, p, full = 0, first = 0, far8 = 0;
+    float *ad = malloc(sizeof(float) * px * 3), *fu = malloc(sizeof(float) * px * 3);
+    float *big = malloc(sizeof(float) * px * 3 * n * n);
+    uint8_t *ad8 = malloc(px * 3), *fu8 = malloc(px * 3);
+    int i, j, c, maxd = 0;
+    plx_render_opts_default(&o);
+    o.auto_exposure = 1;
+    o.aa = n;
+    street(&cam, W, H);
+    assert_int_equal(plx_render(e, &cam, &o, ad8, ad, &ia), PLX_OK);
+    o.aa_full = 1;
+    assert_int_equal(plx_render(e, &cam, &o, fu8, fu, &iff), PLX_OK);
+    assert_true(ia.exposure == iff.exposure);  /* the first sample's, both */
+    o.aa = 1;
+    o.aa_full = 0;
+    street(&cam, W * n, H * n);
+    assert_int_equal(plx_render(e, &cam, &o, NULL, big, NULL), PLX_OK);
+    for (j = 0; j < H; j++)
+        for (i = 0; i < W; i++) {
+            const float *f0 = big + ((size_t)(j * n) * W * n + (size_t)(i * n)) * 3;
+            int is_full = 1, is_first = 1, d8 = 0;
+            p = (size_t)j * W + i;
+            for (c = 0; c < 3; c++) {
+                int d = abs((int)ad8[3 * p + c] - (int)fu8[3 * p + c]);
+                is_full &= near_equal(ad[3 * p + c], fu[3 * p + c]);
+                is_first &= near_equal(ad[3 * p + c], f0[c]);
+                maxd = d > maxd ? d : maxd;
+                d8 |= fabs(fu[3 * p + c] - f0[c]) * ia.exposure > 0.02;
+            }
+            /* one or the other */
+            assert_true(is_full || is_first || sparse);
+            full += is_full;
+            first += is_first && !is_full;
+            /* a pixel whose samples differ much took them all */
+            if (d8 && !is_full && !sparse)
+                far8++;
+        }
+    if (sparse)
+        first = px - full;
+    print_message("aa %d adaptive%s: %zu of %zu pixels took every sample, %zu the first only; "
+                  "8-bit difference to the full pass at most %d; %zu pixels far from their "
+                  "first sample left at it\n", n, sparse ? " (indirect)" : "", full, px, first, maxd, far8);
+    assert_true(first > px / 4 && full > px / 50);  /* both kinds: the mask does something */
+    assert_true(maxd <= 2);
+    assert_int_equal(far8, 0);
+    free(ad); free(fu); free(big); free(ad8); free(fu8);
+}
+
+static void test_aa_adaptive(void **state)
+{
+    void *mem;
+    plx_engine *e = open_eixample(&mem);
+    (void)state;
+    aa_adaptive(e, 2, 0);
+    aa_adaptive(e, 3, 0);
+    /* with indirect light (sparse street lookups) too */
+    assert_int_equal(plx_indirect_step(e, 16384, 1), PLX_OK);
+    aa_adaptive(e, 2, 1);
+    plx_engine_destroy(e);
+    free(mem);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_auto_exposure),
         cmocka_unit_test(test_aa),
+        cmocka_unit_test(test_aa_adaptive),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
