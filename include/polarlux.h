@@ -691,6 +691,11 @@ typedef struct plx_render_info {
                                    cache or the photon buffers), all --aa passes together;
                                    street frames that gather ask only the corners of 4x4
                                    blocks on one surface and the pixels the blocks leave */
+    uint64_t aa_later;          /* aa > 1: pixels the later samples shaded, all passes together
+                                   ((aa * aa - 1) * width * height when every sample is taken) */
+    int aa_adaptive;            /* aa > 1: 1 when the later samples were adaptive; 0 with
+                                   aa_full, or when the block had no room for the adaptive
+                                   buffers (8 bytes a pixel of the largest frame) */
 } plx_render_info;
 
 /*

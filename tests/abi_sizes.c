@@ -133,6 +133,8 @@ static void render_info(void)
     FIELD(plx_render_info, shaded_pixels);
     FIELD(plx_render_info, exposure);
     FIELD(plx_render_info, indirect_lookups);
+    FIELD(plx_render_info, aa_later);
+    FIELD(plx_render_info, aa_adaptive);
 }
 
 static void scene_size(void)

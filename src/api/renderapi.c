@@ -252,45 +252,49 @@ void eng_lightmap_layer(plx_engine *e)
  * order, so the bytes are the same every time), then tone mapped with the
  * exposure of the first sample's frame. The sum lives in PLX_PART_FRAME,
  * taken on first use for the largest frame. */
-/* The adaptive anti-aliasing's buffers (PLX_PART_FRAME, on first need). */
-static plx_status aa_buffers(plx_engine *e, size_t maxpx, int adaptive)
+/* The anti-aliasing sum, and for adaptive anti-aliasing its buffers
+ * (PLX_PART_FRAME, on first need). Returns whether it can be adaptive (a
+ * block with no room for them takes every sample: the sum alone), or -1
+ * without room for the sum. */
+static int aa_buffers(plx_engine *e, size_t maxpx, int adaptive)
 {
     if (!e->aa_sum)
         e->aa_sum = arena_alloc(&e->mem, PLX_PART_FRAME, arena_mul(maxpx, 3 * sizeof(float)), 64);
     if (!e->aa_sum)
-        return PLX_E_NOMEM;
+        return -1;
     if (!adaptive)
-        return PLX_OK;
+        return 0;
     if (!e->aa_id)
         e->aa_id = arena_alloc(&e->mem, PLX_PART_FRAME, arena_mul(maxpx, sizeof(uint32_t)), 64);
     if (e->aa_id && !e->aa_rgb)
         e->aa_rgb = arena_alloc(&e->mem, PLX_PART_FRAME, arena_mul(maxpx, 3), 64);
     if (e->aa_rgb && !e->aa_mask)
         e->aa_mask = arena_alloc(&e->mem, PLX_PART_FRAME, maxpx, 64);
-    return e->aa_mask ? PLX_OK : PLX_E_NOMEM;
+    return e->aa_mask != NULL;
 }
 
 /* n x n samples a pixel, averaged in linear radiance. The first sample is
- * a whole frame; its exposure is the image's. Adaptive (not full): the
+ * a whole frame; its exposure is the image's. Adaptive (not full, and
+ * room for its buffers in the block, else every sample): the
  * later samples shade only the pixels render_aa_mask marks (an edge in the
  * first sample's 3 x 3 neighbourhood) and those where they meet another
  * surface; every other pixel keeps the first sample's value for them. The
  * pixels shaded are the same values a full pass gives them (README
  * "Anti-aliasing"). */
 static plx_status render_aa(plx_engine *e, const render_camera *rc, render_opts *ro, int n, int full,
-                            uint8_t *rgb8, float *rgbf, render_stats *rs)
+                            uint8_t *rgb8, float *rgbf, render_stats *rs, plx_render_info *info)
 {
     size_t px = (size_t)rc->width * (size_t)rc->height, p, maxpx;
     double ex = 1.0, inv = 1.0 / ((double)n * n);
     plx_status st = PLX_OK;
-    uint64_t lookups = 0;
-    int a, b, curve = ro->auto_exposure;
+    uint64_t lookups = 0, later = 0;
+    int a, b, curve = ro->auto_exposure, adaptive;
     if (rc->width < 1 || rc->height < 1)
         px = 0;
     maxpx = (size_t)(e->cfg.render_max_width ? e->cfg.render_max_width : DEFAULT_MAX_W) *
             (size_t)(e->cfg.render_max_height ? e->cfg.render_max_height : DEFAULT_MAX_H);
-    if ((st = aa_buffers(e, maxpx, !full)) != PLX_OK)
-        return st;
+    if ((adaptive = aa_buffers(e, maxpx, !full)) < 0)
+        return PLX_E_NOMEM;
     for (b = 0; b < n && st == PLX_OK; b++)
         for (a = 0; a < n && st == PLX_OK; a++) {
             const float *lin;
@@ -306,7 +310,7 @@ static plx_status render_aa(plx_engine *e, const render_camera *rc, render_opts 
                 memcpy(e->aa_sum, lin, px * 3 * sizeof(float));
                 /* the later samples: the first one's exposure */
                 ro->auto_exposure = 0;
-                if (!full && px > 0) {
+                if (adaptive && px > 0) {
                     (void)render_aa_mask(e->rd, ro, ex, curve, AA_LEVEL, e->aa_rgb, e->aa_id, e->aa_mask);
                     ro->mask = e->aa_mask;
                     ro->mask_id = e->aa_id;
@@ -314,6 +318,7 @@ static plx_status render_aa(plx_engine *e, const render_camera *rc, render_opts 
             } else {
                 for (p = 0; p < 3 * px; p++)
                     e->aa_sum[p] += lin[p];
+                later += rs->sky_pixels + rs->ground_pixels + rs->building_pixels;
             }
         }
     ro->auto_exposure = curve;
@@ -329,6 +334,10 @@ static plx_status render_aa(plx_engine *e, const render_camera *rc, render_opts 
         render_tonemap_par(e->rd, e->aa_sum, px, ex, curve, rgb8, ro);
     rs->exposure = ex;
     rs->indirect_calls = lookups;
+    if (info) {
+        info->aa_later = later;
+        info->aa_adaptive = adaptive;
+    }
     return PLX_OK;
 }
 
@@ -440,8 +449,12 @@ plx_status plx_render(plx_engine *e, const plx_camera *cam, const plx_render_opt
         }
     }
     set_workers(e, &ro);
+    if (info) {
+        info->aa_later = 0;
+        info->aa_adaptive = 0;
+    }
     if (o->aa > 1)
-        st = render_aa(e, &rc, &ro, o->aa, o->aa_full, rgb8, rgbf, &rs);
+        st = render_aa(e, &rc, &ro, o->aa, o->aa_full, rgb8, rgbf, &rs, info);
     else
         st = render_frame(e->rd, &rc, &ro, rgb8, rgbf, &rs);
     if (st == PLX_E_NOMEM)

@@ -100,6 +100,14 @@ int cli_refine(const char *cmd, plx_engine *e, const double eye[3], long frames,
 void cli_warn(const char *cmd, const cli_common *c, const char *fmt, ...);
 /* Why a result is dark: "the scene has no lamps", or that no light reaches it. */
 const char *cli_dark_reason(plx_engine *e);
+
+/* After a frame with o->aa > 1: a warning when the anti-aliasing was to be
+ * adaptive but the block had no room for it (every sample taken). */
+void cli_aa_warn(const char *cmd, const cli_common *c, const plx_render_opts *o, const plx_render_info *info);
+
+/* The share of the pixels the later anti-aliasing samples shaded, in
+ * percent of (aa * aa - 1) * px pixels. */
+double cli_aa_share(const plx_render_opts *o, uint64_t later, double px);
 /* Coordinates of options (--at, --eye, --box, ...) are the scene's own:
  * lon/lat degrees on a lon/lat scene, metres on a metre scene. These turn
  * them into the engine's local metres and back; to_local returns -1 when a

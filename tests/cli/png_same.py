@@ -1,8 +1,9 @@
 """Whether two 8-bit RGB PNG files hold the same pixels, whatever their
 compression level and row filters (decoded with zlib alone by
 tests/web/png_pixels.py, independently of libpng). Exit 0 when the same,
-1 otherwise.
-usage: /usr/bin/python3 png_same.py A.png B.png
+1 otherwise. With --within N: the same size and no byte more than N apart
+(prints the largest difference and the share of identical bytes).
+usage: /usr/bin/python3 png_same.py [--within N] A.png B.png
 """
 import os
 import sys
@@ -16,5 +17,24 @@ def pixels(path):
     return w, h, bpp, [bytes(r) for r in rows]
 
 
+def within(a, b, n):
+    wa, ha, ba, ra = pixels(a)
+    wb, hb, bb, rb = pixels(b)
+    if (wa, ha, ba) != (wb, hb, bb):
+        print("sizes differ")
+        return False
+    worst, same, total = 0, 0, 0
+    for x, y in zip(ra, rb):
+        for u, v in zip(x, y):
+            d = abs(u - v)
+            worst = max(worst, d)
+            same += d == 0
+            total += 1
+    print("largest difference %d, %.1f%% of the bytes identical" % (worst, 100.0 * same / total))
+    return worst <= n
+
+
 if __name__ == "__main__":
+    if sys.argv[1] == "--within":
+        sys.exit(0 if within(sys.argv[3], sys.argv[4], int(sys.argv[2])) else 1)
     sys.exit(0 if pixels(sys.argv[1]) == pixels(sys.argv[2]) else 1)

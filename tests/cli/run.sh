@@ -203,6 +203,12 @@ expect walk-high-street-hint 0 "^polarlux walk: warning: the eye stays 200 m or 
 printf '{"type":"LineString","coordinates":[[1,2]]}' >"$tmp/short.geojson"
 expect walk-short-path 1 "^polarlux walk: $tmp/short\.geojson: the LineString needs at least 2 positions$" -- "$bin" walk -q "$tmp/e.plxb" --path "$tmp/short.geojson" -o "$tmp/w3"
 expect render-aa-bad 2 "--aa '0' is not a whole number from 1 to 16" -- "$bin" render fixtures/tiny.geojson --aa 0 -o "$tmp/x.png"
+# adaptive anti-aliasing (README "Anti-aliasing") against every sample
+expect render-aa-adaptive 0 "^anti-aliasing 2x2: the later samples shaded [0-9.]+% of the pixels \(adaptive" -- \
+    "$bin" render -q "$tmp/e.plxb" --size 160x120 --aa 2 -o "$tmp/aa2.png"
+expect render-aa-full 0 "^anti-aliasing 2x2: the later samples shaded 100\.0% of the pixels \(every sample\)" -- \
+    "$bin" render -q "$tmp/e.plxb" --size 160x120 --aa 2 --aa-full -o "$tmp/aa2f.png"
+if /usr/bin/python3 tests/cli/png_same.py --within 2 "$tmp/aa2.png" "$tmp/aa2f.png" >/dev/null; then echo "ok   render-aa-adaptive-near-full"; pass=$((pass + 1)); else echo "FAIL render-aa-adaptive-near-full"; fail=$((fail + 1)); fi
 expect render-auto-exposure 0 "^exposure: [0-9.e+-]+ \(automatic" -- "$bin" render -q "$tmp/e.plxb" --size 160x120 -o "$tmp/ae.png"
 # photometric lamps (SPEC §2.1), light meters anywhere (§2) and pedestrian metrics (§6)
 expect info-photometry 0 "^photometry: photometry/street-type2\\.ies \\(IES\\) for 584 lamps; lamp 0: peak 2966\\.8 cd, flux 6283\\.2 lm, dark from gamma 90\\.0 deg$" -- "$bin" info -q fixtures/helsinki-street-luminaires.geojson
