@@ -13,8 +13,9 @@
  *  - a street walk (640x480, indirect, one sample per pixel) and an aerial
  *    walk (1024x768) from the loaded engine: median and p95 per frame,
  *    with one thread and then with two (the POSIX port's parallel-for).
- * Wall-clock and thread CPU times: the build machine is shared, CPU time
- * is the steadier figure. PLX_BENCH_FRAMES photon frames of 65,536
+ * Wall-clock and CPU times (the baseline's of its thread, the bakes' and
+ * the walks' of the process, every thread): the build machine is shared,
+ * CPU time is the steadier figure. PLX_BENCH_FRAMES photon frames of 65,536
  * (default 64; the command's default is 256).
  */
 #include <math.h>
