@@ -188,6 +188,10 @@ typedef struct savable_keep {
                                      two bakes of a scene are the same bytes */
     uint64_t ic_gathered, ic_direct, ic_flushes; /* the counters, given back */
     light_stats lt_st;
+    size_t peak_total, peak[PLX_PART_COUNT]; /* the build's peaks: saved as the image's use, so that
+                                                bakes made with any number of workers are the same bytes */
+    uint64_t requests;
+    int threads, layer_workers;
 } savable_keep;
 
 /* Clears what must not be saved: cached lamp regions (pointers inside the
@@ -218,6 +222,16 @@ static void make_savable(plx_engine *e, savable_keep *keep)
     keep->load_ns = e->sc ? e->sc->load_ns : 0;
     if (e->sc)
         e->sc->load_ns = 0;
+    keep->peak_total = e->mem.peak_total;
+    memcpy(keep->peak, e->mem.peak, sizeof keep->peak);
+    e->mem.peak_total = e->mem.lo + e->mem.hi;
+    memcpy(e->mem.peak, e->mem.used, sizeof e->mem.peak);
+    keep->requests = e->mem.requests; /* the workers' arenas are requests too; plx_bake_load counts anew */
+    e->mem.requests = 0;
+    keep->threads = e->cfg.threads;
+    e->cfg.threads = 0;   /* plx_bake_load sets the loaded engine's */
+    keep->layer_workers = e->layer_workers;
+    e->layer_workers = 0;
 }
 
 static void restore_code(plx_engine *e, const savable_keep *keep)
@@ -236,6 +250,11 @@ static void restore_code(plx_engine *e, const savable_keep *keep)
         e->polar_ns = keep->polar_ns;
         if (e->sc)
             e->sc->load_ns = keep->load_ns;
+        e->mem.peak_total = keep->peak_total;
+        memcpy(e->mem.peak, keep->peak, sizeof e->mem.peak);
+        e->mem.requests = keep->requests;
+        e->cfg.threads = keep->threads;
+        e->layer_workers = keep->layer_workers;
     }
 }
 

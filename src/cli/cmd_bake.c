@@ -1,5 +1,7 @@
 /* polarlux bake SCENE -o city.plxb: everything built once, saved in one file
  * that every command taking a SCENE loads without rebuilding. */
+#include <pthread.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -82,15 +84,13 @@ static int parse_args(int argc, char **argv, bake_args *a)
 }
 
 /* An engine in a zeroed block (calloc: the twin's sits alike modulo 64),
- * with the scene loaded and everything prepared. */
-static int make_engine(const bake_args *a, int twin, plx_engine **e)
+ * with the scene loaded. */
+static int load_engine(const bake_args *a, int twin, plx_engine **e)
 {
     size_t mem = a->c.mem ? a->c.mem : CLI_DEFAULT_MEM;
     plx_config cfg;
-    plx_bake_opts o = a->o;
     void *block;
     plx_status st;
-    int rc;
     *e = NULL;
     /* zeros (calloc of a large block takes fresh pages, nothing written):
      * the bake saves every byte of the arena's used end, padding and
@@ -112,18 +112,40 @@ static int make_engine(const bake_args *a, int twin, plx_engine **e)
         free(block);
         return cli_exit_code(st);
     }
-    rc = cli_load_scene("bake", a->scene, &a->c, e);
-    if (rc != EXIT_OK)
-        return rc;
+    return cli_load_scene("bake", a->scene, &a->c, e);
+}
+
+/* Everything prepared (plx_bake_prepare); a failure's line goes to err
+ * (the twin's is printed only when the engine itself did not fail). */
+static int prepare_engine(const bake_args *a, int twin, plx_engine **e, char *err, size_t errlen)
+{
+    plx_bake_opts o = a->o;
+    plx_status st;
     o.twin = twin;
     st = plx_bake_prepare(*e, &o);
-    if (st != PLX_OK) {
-        fprintf(stderr, "polarlux bake: %s\n", plx_last_error(*e));
-        plx_engine_free(*e);
-        *e = NULL;
-        return st == PLX_E_NOMEM ? EXIT_NOMEM : EXIT_FAIL;
-    }
-    return EXIT_OK;
+    if (st == PLX_OK)
+        return EXIT_OK;
+    snprintf(err, errlen, "polarlux bake: %s\n", plx_last_error(*e));
+    plx_engine_free(*e);
+    *e = NULL;
+    return st == PLX_E_NOMEM ? EXIT_NOMEM : EXIT_FAIL;
+}
+
+/* The twin, prepared on a thread of its own while the engine builds and
+ * traces its photons (with more than one thread: they do not depend on
+ * each other, and the twin's work is the engine's again). */
+typedef struct twin_job {
+    const bake_args *a;
+    plx_engine *t;
+    int rc;
+    char err[512];
+} twin_job;
+
+static void *twin_prepare(void *p)
+{
+    twin_job *j = p;
+    j->rc = prepare_engine(j->a, 1, &j->t, j->err, sizeof j->err);
+    return NULL;
 }
 
 static int save(const bake_args *a, plx_engine *e, plx_engine *t, size_t *bytes)
@@ -158,17 +180,37 @@ int cmd_bake(int argc, char **argv)
     plx_engine *e = NULL, *t = NULL;
     plx_memory_report m;
     unsigned long long t0 = port_now_ns(), t1, t2;
+    char err[512];
+    twin_job tj;
+    pthread_t th;
+    int alongside;
     size_t bytes = 0;
     int rc = parse_args(argc, argv, &a);
     if (rc != EXIT_OK)
         return rc < 0 ? EXIT_OK : rc;
-    rc = make_engine(&a, 0, &e);
+    tj.a = &a;
+    tj.t = NULL;
+    tj.rc = EXIT_FAIL;
+    tj.err[0] = '\0';
+    rc = load_engine(&a, 0, &e);
+    if (rc == EXIT_OK)
+        rc = load_engine(&a, 1, &tj.t);
+    alongside = rc == EXIT_OK && a.c.threads != 1 && pthread_create(&th, NULL, twin_prepare, &tj) == 0;
+    if (rc == EXIT_OK && (rc = prepare_engine(&a, 0, &e, err, sizeof err)) != EXIT_OK)
+        fputs(err, stderr);
     t1 = port_now_ns();
     if (rc == EXIT_OK)
         rc = cli_indirect_run("bake", e, &a.ind, NULL, NULL, 60.0);
     t2 = port_now_ns();
-    if (rc == EXIT_OK)
-        rc = make_engine(&a, 1, &t);
+    if (alongside)
+        pthread_join(th, NULL);
+    else if (rc == EXIT_OK)
+        twin_prepare(&tj);
+    t = tj.t;
+    if (rc == EXIT_OK && tj.rc != EXIT_OK) {
+        fputs(tj.err, stderr);
+        rc = tj.rc;
+    }
     if (rc == EXIT_OK)
         rc = save(&a, e, t, &bytes);
     if (rc == EXIT_OK) {

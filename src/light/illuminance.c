@@ -48,6 +48,16 @@ static double lamp_geom_term(const scene_lamp *lp, const double P[3], const doub
     return lamp_intensity(lp, u) * cw / d2 * w;
 }
 
+/* Whether lamp_geom_term's first two tests pass (within the reach, in
+ * front of the surface), with its arithmetic: 0 means its term is 0. Most
+ * lamps listed in a point's cell fail them; this spares them the call. */
+static inline int lamp_in_front(const scene_lamp *lp, const double P[3], const double n[3])
+{
+    double v0 = lp->x - P[0], v1 = lp->y - P[1], v2 = lp->z - P[2];
+    double d2 = v0 * v0 + v1 * v1 + v2 * v2;
+    return d2 < lp->radius * lp->radius && n[0] * v0 + n[1] * v1 + n[2] * v2 > 0.0;
+}
+
 /* Visibility of P from lamp i by the segment path. */
 static int visible_exact(light *L, uint32_t i, const double P[3])
 {
@@ -61,6 +71,9 @@ static int visible_exact(light *L, uint32_t i, const double P[3])
 int light_visible(light *L, uint32_t lamp, const double P[3])
 {
     const lit_region *r;
+    int v = lamp < L->s->nlamps ? light_lamp_visible_cached(L, lamp, P) : -1;
+    if (v >= 0)
+        return v;
     if (L->pool_cap && light_region_index(L, lamp, &r) == PLX_OK)
         return light_region_visible(L, r, P);
     if (L->pool_cap)
@@ -84,7 +97,10 @@ static int lamps_walk(light *L, const double P[3], const double n[3], int exact,
     for (k = cell == UINT32_MAX ? 0 : g->start[cell];
          cell != UINT32_MAX && k < g->start[cell + 1]; k++) {
         uint32_t i = g->item[k];
-        double term = lamp_geom_term(&s->lamps[i], P, n);
+        double term;
+        if (!lamp_in_front(&s->lamps[i], P, n))
+            continue;
+        term = lamp_geom_term(&s->lamps[i], P, n);
         if (term == 0.0)
             continue;
         if (!(exact ? visible_exact(L, i, P) : light_visible(L, i, P)))

@@ -1588,13 +1588,15 @@ void light_cache_reset(light *L)
 
 /* ---- visibility through a region --------------------------------------------------- */
 
-static int band_blocks(const lit_region *r, const lit_band *b, const scene_building *bd,
-                       vec2 w, double zp, double len3)
+/* The part of the segment from the lamp to P (as a fraction of it) that
+ * band b's building covers; <= 0 when none. */
+static double band_overlap(const lit_region *r, const lit_band *b, const scene_building *bd,
+                           vec2 w, double zp)
 {
     double t1, t2, ta = 0.0, tb = INFINITY, dz = zp - r->o[2], x, y;
     if (dz == 0.0) {
         if (!(r->o[2] > bd->min_height && r->o[2] < bd->height))
-            return 0;
+            return 0.0;
         t1 = 0.0;
         t2 = 1.0;
     } else {
@@ -1618,25 +1620,50 @@ static int band_blocks(const lit_region *r, const lit_band *b, const scene_build
     }
     x = ta > t1 ? ta : t1;
     y = tb < t2 ? tb : t2;
-    return (y - x) * len3 > LIGHT_MIN_PIECE;
+    return y - x;
 }
 
-int light_region_visible(light *L, const lit_region *r, const double P[3])
+static inline int region_visible(light *L, const lit_region *r, const double P[3])
 {
     vec2 w;
-    double d[3], len3;
+    double len3 = -1.0;
     uint32_t i, k;
     w.x = P[0] - r->o[0];
     w.y = P[1] - r->o[1];
     if (w.x == 0.0 && w.y == 0.0)
         return !light_segment_blocked(L, r->o, P);
-    d[0] = w.x; d[1] = w.y; d[2] = P[2] - r->o[2];
-    len3 = sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
     i = find_sector(r->sec_ang, r->nsec, light_pseudo_angle(w.x, w.y));
     for (k = r->sec_first[i]; k < r->sec_first[i + 1]; k++) {
         const lit_band *b = &r->band[k];
-        if (band_blocks(r, b, &L->s->bld[b->bld], w, P[2], len3))
-            return 0;
+        double ov = band_overlap(r, b, &L->s->bld[b->bld], w, P[2]);
+        /* blocked by more than LIGHT_MIN_PIECE of 3D length (the length
+         * taken only when a band covers some of the segment: most do not) */
+        if (ov > 0.0) {
+            if (len3 < 0.0) {
+                double dz = P[2] - r->o[2];
+                len3 = sqrt(w.x * w.x + w.y * w.y + dz * dz);
+            }
+            if (ov * len3 > LIGHT_MIN_PIECE)
+                return 0;
+        }
     }
     return 1;
+}
+
+int light_region_visible(light *L, const lit_region *r, const double P[3])
+{
+    return region_visible(L, r, P);
+}
+
+int light_lamp_visible_cached(light *L, uint32_t lamp, const double P[3])
+{
+    const lit_region *r = L->ent[lamp].reg;
+    if (!r)
+        return -1;
+    L->st.hits++;
+    if (L->lru_head != lamp) {
+        lru_unlink(L, lamp);
+        lru_front(L, lamp);
+    }
+    return region_visible(L, r, P);
 }

@@ -61,6 +61,11 @@ plx_status light_region_index(light *L, uint32_t lamp, const lit_region **out /*
 
 /* Visibility of P from the lamp of region r through its sector index. */
 int light_region_visible(light *L, const lit_region *r, const double P[3]);
+/* The same through lamp's region when the cache holds it (counted as a
+ * hit and made the most recent, as light_region_index does); -1 when it
+ * does not (ask light_region_index). The illuminance's path at every
+ * lamp of every point: none of light_region_index's checks. */
+int light_lamp_visible_cached(light *L, uint32_t lamp, const double P[3]);
 
 /* Drops every cached region. */
 void light_cache_clear(light *L);

@@ -508,7 +508,7 @@ typedef struct best {
  * u = ((p - o) x d) / (d x e); the signs are compared without dividing and
  * combined without branching (they are unpredictable; a crossing is rare).
  */
-static void wall_test(const trace_wall *w, uint32_t e, const double o[3], const double d[3],
+static inline void wall_test(const trace_wall *w, uint32_t e, const double o[3], const double d[3],
                       best *bs)
 {
     double den = d[0] * w->ey - d[1] * w->ex;

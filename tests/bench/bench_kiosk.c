@@ -5,16 +5,21 @@
  *    one 640x480 street frame with indirect light, one 1024x768 aerial
  *    frame (which builds the light map);
  *  - the bake: load, plx_bake_prepare (polar, light, photons, renderer,
- *    light map), the same photon frames, the twin, plx_bake_save;
+ *    light map), the same photon frames, the twin, plx_bake_save; on one
+ *    thread, then again on two (the POSIX port's parallel-for): the
+ *    ratio of their wall times, and whether the two files are the same
+ *    bytes;
  *  - loading the bake into a block touched beforehand (median of 5);
  *  - a street walk (640x480, indirect, one sample per pixel) and an aerial
  *    walk (1024x768) from the loaded engine: median and p95 per frame,
  *    with one thread and then with two (the POSIX port's parallel-for).
- * Wall-clock and thread CPU times: the build machine is shared, CPU time
- * is the steadier figure. PLX_BENCH_FRAMES photon frames of 65,536
+ * Wall-clock and CPU times (the baseline's of its thread, the bakes' and
+ * the walks' of the process, every thread): the build machine is shared,
+ * CPU time is the steadier figure. PLX_BENCH_FRAMES photon frames of 65,536
  * (default 64; the command's default is 256).
  */
 #include <math.h>
+#include <pthread.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -53,7 +58,7 @@ static int cmp_double(const void *x, const void *y)
     return (a > b) - (a < b);
 }
 
-static plx_engine *engine(void **mem, int max_w, int max_h, int quiet)
+static plx_engine *engine(void **mem, int max_w, int max_h, int quiet, int threads)
 {
     plx_config cfg;
     static plx_port silent;
@@ -67,7 +72,7 @@ static plx_engine *engine(void **mem, int max_w, int max_h, int quiet)
     cfg.port = &silent;
     cfg.render_max_width = max_w;
     cfg.render_max_height = max_h;
-    cfg.threads = 1;   /* the baseline and the bake on one thread (thread CPU times) */
+    cfg.threads = threads; /* the baseline and the first bake on one thread (thread CPU times) */
     if (plx_engine_create(*mem, MEM, &cfg, &e) != PLX_OK)
         return NULL;
     return e;
@@ -153,29 +158,100 @@ static void walk(plx_engine *e, int aerial, int aa, int full, int n, uint8_t *rg
     free(t);
 }
 
+/* The twin: loaded and prepared (on a thread of its own when the bake
+ * has more than one, as `polarlux bake` does). */
+typedef struct twin_job {
+    text city;
+    plx_engine *b;
+    int rc;
+} twin_job;
+
+static void *twin_prepare(void *p)
+{
+    twin_job *j = p;
+    plx_bake_opts bo;
+    memset(&bo, 0, sizeof bo);
+    bo.aerial = 1;
+    bo.twin = 1;
+    j->rc = j->b && plx_load_geojson(j->b, j->city.buf, j->city.len, "eixample") == PLX_OK &&
+                    plx_bake_prepare(j->b, &bo) == PLX_OK ? 0 : -1;
+    return NULL;
+}
+
+/* Bakes the city on `threads` workers: load, plx_bake_prepare (polar,
+ * light, photons, renderer, light map), the photon frames, the twin
+ * (alongside with 2 threads), plx_bake_save (which gathers the aerial
+ * layer). Wall ms, CPU ms of the process (every thread), the engine's
+ * memory. */
+static int bake(text city, int frames, int threads, unsigned char **file, size_t *len, double *wall, double *cpu,
+                plx_memory_report *m)
+{
+    void *ma, *mb;
+    plx_engine *a;
+    plx_bake_opts bo;
+    twin_job tj;
+    pthread_t th;
+    int alongside, ok;
+    size_t need = 0;
+    double w0 = wall_ms(), c0 = proc_ms();
+    memset(&bo, 0, sizeof bo);
+    bo.aerial = 1;
+    a = engine(&ma, 1024, 768, 1, threads);
+    tj.city = city;
+    tj.b = engine(&mb, 1024, 768, 1, threads);
+    alongside = threads > 1 && pthread_create(&th, NULL, twin_prepare, &tj) == 0;
+    ok = a && plx_load_geojson(a, city.buf, city.len, "eixample") == PLX_OK && plx_bake_prepare(a, &bo) == PLX_OK &&
+         trace(a, frames) == 0;
+    if (alongside)
+        pthread_join(th, NULL);
+    else
+        twin_prepare(&tj);
+    if (!ok || tj.rc != 0 || plx_bake_size(a, tj.b, &need) != PLX_OK)
+        return -1;
+    *file = malloc(need);
+    if (!*file || plx_bake_save(a, tj.b, *file, need, len) != PLX_OK)
+        return -1;
+    *wall = wall_ms() - w0;
+    *cpu = proc_ms() - c0;
+    plx_memory_get(a, m);
+    plx_engine_destroy(a);
+    plx_engine_destroy(tj.b);
+    free(ma);
+    free(mb);
+    return 0;
+}
+
+/* Whether two bake files are the same bytes, but for the header's record
+ * of the building engine's peak memory (bytes 72-79: the workers' arenas
+ * raise it) and the checksum over the header (bytes 32-39). */
+static int same_bake(const unsigned char *f, size_t n, const unsigned char *g, size_t m)
+{
+    return n == m && n > 128 && memcmp(f, g, 32) == 0 && memcmp(f + 40, g + 40, 32) == 0 &&
+           memcmp(f + 80, g + 80, n - 80) == 0;
+}
+
 int main(void)
 {
     text city = { NULL, 0, 0 };
-    void *ma, *mb, *mc, *md;
-    plx_engine *a, *b, *c, *d;
+    void *mc, *md;
+    plx_engine *c, *d;
     plx_render_opts o;
     plx_camera cam;
-    plx_bake_opts bo;
     plx_memory_report m;
     uint8_t *rgb8 = malloc(1024 * 768 * 3);
     const char *env = getenv("PLX_BENCH_FRAMES");
     int frames = env ? atoi(env) : 64, k;
-    double w0, c0, cb, cl = 0, base_load, base_ph, base_street, base_aerial, bake_w, bake_c, loads[5];
+    double w0, cb, cl = 0, base_load, base_ph, base_street, base_aerial, bake_w, bake_c, bake2_w, bake2_c, loads[5];
     double sm, sp, sc, am, ap, ac;
-    size_t len = 0, need = 0;
-    unsigned char *file;
+    size_t len = 0, len2 = 0, need = 0;
+    unsigned char *file, *file2;
     char err[256];
     if (plx_gen_city("eixample", 30, 30, 1, append, &city) != PLX_OK || !rgb8)
         return 1;
     printf("city: gen eixample 30 30 (%.1f MB of GeoJSON); photons: %d frames x 65,536\n", city.len / 1e6, frames);
 
     /* baseline: today's render path from the GeoJSON */
-    d = engine(&md, 1024, 768, 1);
+    d = engine(&md, 1024, 768, 1, 1);
     cb = cpu_ms();
     w0 = wall_ms();
     if (!d || plx_load_geojson(d, city.buf, city.len, "eixample") != PLX_OK)
@@ -202,32 +278,20 @@ int main(void)
     plx_engine_destroy(d);
     free(md);
 
-    /* the bake */
-    memset(&bo, 0, sizeof bo);
-    bo.aerial = 1;
-    w0 = wall_ms();
-    c0 = cpu_ms();
-    a = engine(&ma, 1024, 768, 1);
-    b = engine(&mb, 1024, 768, 1);
-    if (!a || !b || plx_load_geojson(a, city.buf, city.len, "eixample") != PLX_OK ||
-        plx_bake_prepare(a, &bo) != PLX_OK || trace(a, frames) != 0)
+    /* the bake, on one thread, then on two (the POSIX port's parallel-for) */
+    if (bake(city, frames, 1, &file, &len, &bake_w, &bake_c, &m) != 0)
         return 1;
-    bo.twin = 1;
-    if (plx_load_geojson(b, city.buf, city.len, "eixample") != PLX_OK || plx_bake_prepare(b, &bo) != PLX_OK ||
-        plx_bake_size(a, b, &need) != PLX_OK)
+    printf("bake, 1 thread: %.2f s wall, %.2f s CPU (target 10 s); file %.1f MB; engine memory %.1f MB\n",
+           bake_w / 1e3, bake_c / 1e3, len / 1048576.0, m.used_total / 1048576.0);
+    if (bake(city, frames, 2, &file2, &len2, &bake2_w, &bake2_c, &m) != 0)
         return 1;
-    file = malloc(need);
-    if (!file || plx_bake_save(a, b, file, need, &len) != PLX_OK)
-        return 1;
-    bake_w = wall_ms() - w0;
-    bake_c = cpu_ms() - c0;
-    plx_memory_get(a, &m);
-    printf("bake: %.2f s wall, %.2f s CPU (target 10 s); file %.1f MB; engine memory %.1f MB\n", bake_w / 1e3,
-           bake_c / 1e3, len / 1048576.0, m.used_total / 1048576.0);
-    plx_engine_destroy(a);
-    plx_engine_destroy(b);
-    free(ma);
-    free(mb);
+    printf("bake, 2 threads: %.2f s wall, %.2f s CPU of the process; %.2fx the 1-thread wall time; "
+           "the file %s\n",
+           bake2_w / 1e3, bake2_c / 1e3, bake_w / bake2_w,
+           same_bake(file, len, file2, len2) ? "the same bytes as with 1 thread (the header's peak memory "
+                                                "of the build and the checksum over it aside)"
+                                              : "DIFFERS from the 1-thread file");
+    free(file2);
 
     /* loading, into a block touched beforehand */
     if (plx_bake_block_size(file, len, &need, err, sizeof err) != PLX_OK || posix_memalign(&mc, 1 << 21, need) != 0)
