@@ -685,7 +685,7 @@ void plx_render_opts_default(plx_render_opts *o /* OUT */);
 typedef struct plx_render_info {
     uint32_t buildings, drawn;  /* buildings in the scene, drawn after culling */
     double drawn_fraction;      /* triangles drawn / triangles of the scene */
-    uint64_t shaded_pixels;
+    uint64_t shaded_pixels;     /* the direct-light shader's calls, all --aa passes together */
     double exposure;            /* the exposure applied (the chosen one with auto_exposure) */
     uint64_t indirect_lookups;  /* points whose indirect light was looked up (the irradiance
                                    cache or the photon buffers), all --aa passes together;

@@ -342,6 +342,18 @@ static plx_status check_twin(plx_engine *e, plx_engine *t, const char *fn)
     return eng_fail(e, PLX_E_INVALID, msg);
 }
 
+/* The room a loaded bake's block keeps beside the image: queries' scratch,
+ * and with a renderer, anti-aliasing's buffers for its largest frame (20
+ * bytes a pixel: the sum and the adaptive buffers, README "Anti-aliasing"). */
+static uint64_t bake_slack(const plx_engine *e)
+{
+    int32_t w = 0, h = 0;
+    if (!e->rd)
+        return BAKE_SLACK;
+    eng_render_max(e, &w, &h);
+    return BAKE_SLACK + (uint64_t)20 * (uint64_t)w * (uint64_t)h;
+}
+
 static plx_status measure(plx_engine *e, plx_engine *twin, const char *fn, bake_layout *L)
 {
     plx_status st;
@@ -389,7 +401,7 @@ plx_status plx_bake_save(plx_engine *e, plx_engine *twin, void *buf, size_t cap,
     put64(f + H_IMAGE, L.image);
     put64(f + H_NREL, L.nrel);
     put64(f + H_BASEMOD, (uintptr_t)e->mem.base & (BAKE_ALIGN - 1));
-    put64(f + H_SLACK, BAKE_SLACK);
+    put64(f + H_SLACK, bake_slack(e));
     put64(f + H_PEAK, e->mem.peak_total);
     put64(f + H_PAGES, L.pages_present);
     put64(f + H_SUM, file_sum(f, L.total));

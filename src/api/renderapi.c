@@ -282,25 +282,25 @@ void eng_lightmap_layer(plx_engine *e)
  * order, so the bytes are the same every time), then tone mapped with the
  * exposure of the first sample's frame. The sum lives in PLX_PART_FRAME,
  * taken on first use for the largest frame. */
-/* The anti-aliasing sum, and for adaptive anti-aliasing its buffers
- * (PLX_PART_FRAME, on first need). Returns whether it can be adaptive (a
- * block with no room for them takes every sample: the sum alone), or -1
- * without room for the sum. */
-static int aa_buffers(plx_engine *e, size_t maxpx, int adaptive)
+/* The adaptive anti-aliasing's buffers (PLX_PART_FRAME, on first need,
+ * all three or none): whether they are there. Taken after the first
+ * sample's frame, so that what that frame builds (the indirect ground map)
+ * comes first; a block with no room for them takes every sample. */
+static int aa_adaptive_buffers(plx_engine *e, size_t maxpx)
 {
-    if (!e->aa_sum)
-        e->aa_sum = arena_alloc(&e->mem, PLX_PART_FRAME, arena_mul(maxpx, 3 * sizeof(float)), 64);
-    if (!e->aa_sum)
-        return -1;
-    if (!adaptive)
-        return 0;
-    if (!e->aa_id)
-        e->aa_id = arena_alloc(&e->mem, PLX_PART_FRAME, arena_mul(maxpx, sizeof(uint32_t)), 64);
-    if (e->aa_id && !e->aa_rgb)
-        e->aa_rgb = arena_alloc(&e->mem, PLX_PART_FRAME, arena_mul(maxpx, 3), 64);
-    if (e->aa_rgb && !e->aa_mask)
-        e->aa_mask = arena_alloc(&e->mem, PLX_PART_FRAME, maxpx, 64);
-    return e->aa_mask != NULL;
+    arena_mark m;
+    if (e->aa_mask)
+        return 1;
+    m = arena_get_mark(&e->mem);
+    e->aa_id = arena_alloc(&e->mem, PLX_PART_FRAME, arena_mul(maxpx, sizeof(uint32_t)), 64);
+    e->aa_rgb = e->aa_id ? arena_alloc(&e->mem, PLX_PART_FRAME, arena_mul(maxpx, 3), 64) : NULL;
+    e->aa_mask = e->aa_rgb ? arena_alloc(&e->mem, PLX_PART_FRAME, maxpx, 64) : NULL;
+    if (e->aa_mask)
+        return 1;
+    arena_release(&e->mem, &m);
+    e->aa_id = NULL;
+    e->aa_rgb = NULL;
+    return 0;
 }
 
 /* n x n samples a pixel, averaged in linear radiance. The first sample is
@@ -317,13 +317,15 @@ static plx_status render_aa(plx_engine *e, const render_camera *rc, render_opts 
     size_t px = (size_t)rc->width * (size_t)rc->height, p, maxpx;
     double ex = 1.0, inv = 1.0 / ((double)n * n);
     plx_status st = PLX_OK;
-    uint64_t lookups = 0, later = 0;
-    int a, b, curve = ro->auto_exposure, adaptive;
+    uint64_t lookups = 0, later = 0, calls = 0;
+    int a, b, curve = ro->auto_exposure, adaptive = 0;
     if (rc->width < 1 || rc->height < 1)
         px = 0;
     maxpx = (size_t)(e->cfg.render_max_width ? e->cfg.render_max_width : DEFAULT_MAX_W) *
             (size_t)(e->cfg.render_max_height ? e->cfg.render_max_height : DEFAULT_MAX_H);
-    if ((adaptive = aa_buffers(e, maxpx, !full)) < 0)
+    if (!e->aa_sum)
+        e->aa_sum = arena_alloc(&e->mem, PLX_PART_FRAME, arena_mul(maxpx, 3 * sizeof(float)), 64);
+    if (!e->aa_sum)
         return PLX_E_NOMEM;
     for (b = 0; b < n && st == PLX_OK; b++)
         for (a = 0; a < n && st == PLX_OK; a++) {
@@ -334,12 +336,14 @@ static plx_status render_aa(plx_engine *e, const render_camera *rc, render_opts 
             if (st != PLX_OK)
                 break;
             lookups += rs->indirect_calls;
+            calls += rs->shader_calls;
             lin = render_linear(e->rd);
             if (a == 0 && b == 0) {
                 ex = rs->exposure;
                 memcpy(e->aa_sum, lin, px * 3 * sizeof(float));
                 /* the later samples: the first one's exposure */
                 ro->auto_exposure = 0;
+                adaptive = !full && aa_adaptive_buffers(e, maxpx);
                 if (adaptive && px > 0) {
                     (void)render_aa_mask(e->rd, ro, ex, curve, AA_LEVEL, e->aa_rgb, e->aa_id, e->aa_mask);
                     ro->mask = e->aa_mask;
@@ -364,6 +368,7 @@ static plx_status render_aa(plx_engine *e, const render_camera *rc, render_opts 
         render_tonemap_par(e->rd, e->aa_sum, px, ex, curve, rgb8, ro);
     rs->exposure = ex;
     rs->indirect_calls = lookups;
+    rs->shader_calls = calls;
     if (info) {
         info->aa_later = later;
         info->aa_adaptive = adaptive;

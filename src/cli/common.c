@@ -738,9 +738,10 @@ int cli_refine(const char *cmd, plx_engine *e, const double eye[3], long frames,
 void cli_aa_warn(const char *cmd, const cli_common *c, const plx_render_opts *o, const plx_render_info *info)
 {
     if (o->aa > 1 && !o->aa_full && !info->aa_adaptive)
-        cli_warn(cmd, c, "--mem leaves no room for adaptive anti-aliasing (8 bytes a pixel of the largest "
-                 "frame): every pixel takes all %dx%d samples (slower; the image differs from the adaptive "
-                 "one by about 1 in 255)", o->aa, o->aa);
+        cli_warn(cmd, c, "the engine's memory block (--mem; for a bake without --mem, the bake's own room) "
+                 "leaves no room for adaptive anti-aliasing (8 bytes a pixel of the largest frame): every "
+                 "pixel takes all %dx%d samples (slower; the image differs from the adaptive one by about 1 "
+                 "in 255)", o->aa, o->aa);
 }
 
 double cli_aa_share(const plx_render_opts *o, uint64_t later, double px)

@@ -8,11 +8,12 @@
  *  - aa = N equals rendering N times larger with one sample per pixel and
  *    averaging each N x N block (the sample points are the same).
  *  - aa = 1 is the plain image, byte for byte.
- *  - Adaptive anti-aliasing (aa without aa_full): every pixel is either
- *    the full pass's value or its first sample's (taken from the image N
- *    times larger), and wherever the full pass's byte differs from the
- *    first sample's by more than 2 it is the full pass's; in 8 bits it is
- *    within 2 of the full pass everywhere.
+ *  - Adaptive anti-aliasing (aa without aa_full): every pixel the later
+ *    samples shaded (the engine's mask) is the full pass's value, bit for
+ *    bit; every other one is its first sample's (taken from the image N
+ *    times larger), and wherever the full pass differs from the first
+ *    sample by more than 2% of white the pixel was shaded; in 8 bits the
+ *    image is within 2 of the full pass everywhere.
  */
 #include <stdarg.h>
 #include <stddef.h>
@@ -27,6 +28,7 @@
 #include "polarlux.h"
 #include "polarlux_port.h"
 #include "fixture.h"
+#include "base/engine.h"
 
 #define MEM ((size_t)256 << 20)
 
@@ -176,7 +178,7 @@ static int near_equal(double a, double b)
  * exposure; the first samples from one sample per pixel at n w x n h
  * (sparse: the indirect light is interpolated over blocks of 4 x 4 pixels
  * of each image, so the larger one's first samples are not the same
- * values; only the full pass's are checked then). */
+ * values; only the shaded pixels against the full pass are checked then). */
 static void aa_adaptive(plx_engine *e, int n, int sparse)
 {
     enum { W = 160, H = 120 };
@@ -186,13 +188,15 @@ static void aa_adaptive(plx_engine *e, int n, int sparse)
     size_t px = (size_t)W * H, p, full = 0, first = 0, far8 = 0;
     float *ad = malloc(sizeof(float) * px * 3), *fu = malloc(sizeof(float) * px * 3);
     float *big = malloc(sizeof(float) * px * 3 * n * n);
-    uint8_t *ad8 = malloc(px * 3), *fu8 = malloc(px * 3);
+    uint8_t *ad8 = malloc(px * 3), *fu8 = malloc(px * 3), *mask = malloc(px);
     int i, j, c, maxd = 0;
     plx_render_opts_default(&o);
     o.auto_exposure = 1;
     o.aa = n;
     street(&cam, W, H);
     assert_int_equal(plx_render(e, &cam, &o, ad8, ad, &ia), PLX_OK);
+    assert_true(ia.aa_adaptive && e->aa_mask);
+    memcpy(mask, e->aa_mask, px);  /* the pixels the later samples shaded */
     o.aa_full = 1;
     assert_int_equal(plx_render(e, &cam, &o, fu8, fu, &iff), PLX_OK);
     assert_true(ia.exposure == iff.exposure);  /* the first sample's, both */
@@ -207,28 +211,29 @@ static void aa_adaptive(plx_engine *e, int n, int sparse)
             p = (size_t)j * W + i;
             for (c = 0; c < 3; c++) {
                 int d = abs((int)ad8[3 * p + c] - (int)fu8[3 * p + c]);
-                is_full &= near_equal(ad[3 * p + c], fu[3 * p + c]);
+                is_full &= ad[3 * p + c] == fu[3 * p + c];   /* the same rays: the same bits */
                 is_first &= near_equal(ad[3 * p + c], f0[c]);
                 maxd = d > maxd ? d : maxd;
                 d8 |= fabs(fu[3 * p + c] - f0[c]) * ia.exposure > 0.02;
             }
-            /* one or the other */
-            assert_true(is_full || is_first || sparse);
-            full += is_full;
-            first += is_first && !is_full;
+            /* shaded: the full pass's value; else the first sample's */
+            if (mask[p])
+                assert_true(is_full);
+            else
+                assert_true(is_first || sparse);
+            full += mask[p] != 0;
+            first += !mask[p];
             /* a pixel whose samples differ much took them all */
-            if (d8 && !is_full && !sparse)
+            if (d8 && !mask[p] && !sparse)
                 far8++;
         }
-    if (sparse)
-        first = px - full;
     print_message("aa %d adaptive%s: %zu of %zu pixels took every sample, %zu the first only; "
                   "8-bit difference to the full pass at most %d; %zu pixels far from their "
                   "first sample left at it\n", n, sparse ? " (indirect)" : "", full, px, first, maxd, far8);
     assert_true(first > px / 4 && full > px / 50);  /* both kinds: the mask does something */
     assert_true(maxd <= 2);
     assert_int_equal(far8, 0);
-    free(ad); free(fu); free(big); free(ad8); free(fu8);
+    free(ad); free(fu); free(big); free(ad8); free(fu8); free(mask);
 }
 
 static void test_aa_adaptive(void **state)
