@@ -338,7 +338,8 @@ static plx_status check_twin(plx_engine *e, plx_engine *t, const char *fn)
     sb_init(&b, msg, sizeof msg);
     sb_str(&b, fn);
     sb_str(&b, ": the twin engine is not laid out as this one (load the same scene and call "
-               "plx_bake_prepare with the same options and twin = 1, in a block aligned alike)");
+               "plx_bake_prepare with the same options and twin = 1, in a block aligned alike; "
+               "anti-aliased frames take memory: render them on both engines or on neither)");
     return eng_fail(e, PLX_E_INVALID, msg);
 }
 

@@ -101,8 +101,9 @@ void cli_warn(const char *cmd, const cli_common *c, const char *fmt, ...);
 /* Why a result is dark: "the scene has no lamps", or that no light reaches it. */
 const char *cli_dark_reason(plx_engine *e);
 
-/* After a frame with o->aa > 1: a warning when the anti-aliasing was to be
- * adaptive but the block had no room for it (every sample taken). */
+/* After a frame: a warning when the anti-aliasing (o->aa > 1) was to be
+ * adaptive but the block had no room for it (every sample taken), or when
+ * --aa-full comes without --aa 2 or more. */
 void cli_aa_warn(const char *cmd, const cli_common *c, const plx_render_opts *o, const plx_render_info *info);
 
 /* The share of the pixels the later anti-aliasing samples shaded, in

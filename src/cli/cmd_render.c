@@ -412,8 +412,9 @@ int cmd_render(int argc, char **argv)
                a.aerial ? "aerial" : "street", a.cam.width, a.cam.height, prec, a.cam.eye[0], prec, a.cam.eye[1],
                a.cam.eye[2], prec, a.cam.target[0], prec, a.cam.target[1], a.cam.target[2], info.drawn, info.buildings,
                100.0 * info.drawn_fraction, (port_now_ns() - t0) / 1e6, a.out);
-    if (rc == EXIT_OK && a.opts.aa > 1) {
+    if (rc == EXIT_OK)
         cli_aa_warn("render", &a.c, &a.opts, &info);
+    if (rc == EXIT_OK && a.opts.aa > 1) {
         printf("anti-aliasing %dx%d: the later samples shaded %.1f%% of the pixels (%s)\n", a.opts.aa, a.opts.aa,
                cli_aa_share(&a.opts, info.aa_later, (double)a.cam.width * a.cam.height),
                info.aa_adaptive ? "adaptive: edges and glows; --aa-full for all" : "every sample");

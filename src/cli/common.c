@@ -737,6 +737,8 @@ int cli_refine(const char *cmd, plx_engine *e, const double eye[3], long frames,
 
 void cli_aa_warn(const char *cmd, const cli_common *c, const plx_render_opts *o, const plx_render_info *info)
 {
+    if (o->aa_full && o->aa <= 1)
+        cli_warn(cmd, c, "--aa-full has no effect without --aa 2 or more (one sample a pixel)");
     if (o->aa > 1 && !o->aa_full && !info->aa_adaptive)
         cli_warn(cmd, c, "the engine's memory block (--mem; for a bake without --mem, the bake's own room) "
                  "leaves no room for adaptive anti-aliasing (8 bytes a pixel of the largest frame): every "
