@@ -11,8 +11,6 @@
 #include "photon/photon.h"
 #include "photon/irradiance_cache.h"
 
-#define DEFAULT_MAX_W 1920
-#define DEFAULT_MAX_H 1080
 #define AA_LEVEL 2  /* adaptive anti-aliasing: a step of more than this in the 8-bit image is an edge */
 #define LIGHTMAP_MAX_BYTES ((size_t)48 << 20) /* plx_config.lightmap_bytes 0: at most this */
 
@@ -277,11 +275,6 @@ void eng_lightmap_layer(plx_engine *e)
         e->lightmap_cell = 0.0; /* no layer memory: the next aerial frame builds the map whole */
 }
 
-/* Anti-aliasing: n x n frames with the sample point moved within the
- * pixel on a regular grid, their linear images averaged (summed in sample
- * order, so the bytes are the same every time), then tone mapped with the
- * exposure of the first sample's frame. The sum lives in PLX_PART_FRAME,
- * taken on first use for the largest frame. */
 /* The adaptive anti-aliasing's buffers (PLX_PART_FRAME, on first need,
  * all three or none): whether they are there. Taken after the first
  * sample's frame, so that what that frame builds (the indirect ground map)
@@ -303,8 +296,11 @@ static int aa_adaptive_buffers(plx_engine *e, size_t maxpx)
     return 0;
 }
 
-/* n x n samples a pixel, averaged in linear radiance. The first sample is
- * a whole frame; its exposure is the image's. Adaptive (not full, and
+/* Anti-aliasing: n x n frames with the sample point moved within the
+ * pixel on a regular grid, their linear images averaged (summed in sample
+ * order, so the bytes are the same every time), then tone mapped with the
+ * exposure of the first sample's frame. The sum lives in PLX_PART_FRAME,
+ * taken on first use for the largest frame. Adaptive (not full, and
  * room for its buffers in the block, else every sample): the
  * later samples shade only the pixels render_aa_mask marks (an edge in the
  * first sample's 3 x 3 neighbourhood) and those where they meet another
@@ -319,10 +315,11 @@ static plx_status render_aa(plx_engine *e, const render_camera *rc, render_opts 
     plx_status st = PLX_OK;
     uint64_t lookups = 0, later = 0, calls = 0;
     int a, b, curve = ro->auto_exposure, adaptive = 0;
+    int32_t mw, mh;
     if (rc->width < 1 || rc->height < 1)
         px = 0;
-    maxpx = (size_t)(e->cfg.render_max_width ? e->cfg.render_max_width : DEFAULT_MAX_W) *
-            (size_t)(e->cfg.render_max_height ? e->cfg.render_max_height : DEFAULT_MAX_H);
+    eng_render_max(e, &mw, &mh);
+    maxpx = (size_t)mw * (size_t)mh;
     if (!e->aa_sum)
         e->aa_sum = arena_alloc(&e->mem, PLX_PART_FRAME, arena_mul(maxpx, 3 * sizeof(float)), 64);
     if (!e->aa_sum)

@@ -106,9 +106,10 @@ const char *cli_dark_reason(plx_engine *e);
  * --aa-full comes without --aa 2 or more. */
 void cli_aa_warn(const char *cmd, const cli_common *c, const plx_render_opts *o, const plx_render_info *info);
 
-/* The share of the pixels the later anti-aliasing samples shaded, in
- * percent of (aa * aa - 1) * px pixels. */
-double cli_aa_share(const plx_render_opts *o, uint64_t later, double px);
+/* With o->aa > 1, the line saying which share of px pixels (all frames
+ * together) the later anti-aliasing samples shaded, later of them, and
+ * whether they were adaptive. */
+void cli_aa_print(const plx_render_opts *o, uint64_t later, double px, int adaptive);
 /* Coordinates of options (--at, --eye, --box, ...) are the scene's own:
  * lon/lat degrees on a lon/lat scene, metres on a metre scene. These turn
  * them into the engine's local metres and back; to_local returns -1 when a

@@ -414,11 +414,8 @@ int cmd_render(int argc, char **argv)
                100.0 * info.drawn_fraction, (port_now_ns() - t0) / 1e6, a.out);
     if (rc == EXIT_OK)
         cli_aa_warn("render", &a.c, &a.opts, &info);
-    if (rc == EXIT_OK && a.opts.aa > 1) {
-        printf("anti-aliasing %dx%d: the later samples shaded %.1f%% of the pixels (%s)\n", a.opts.aa, a.opts.aa,
-               cli_aa_share(&a.opts, info.aa_later, (double)a.cam.width * a.cam.height),
-               info.aa_adaptive ? "adaptive: edges and glows; --aa-full for all" : "every sample");
-    }
+    if (rc == EXIT_OK)
+        cli_aa_print(&a.opts, info.aa_later, (double)a.cam.width * a.cam.height, info.aa_adaptive);
     if (rc == EXIT_OK && a.opts.auto_exposure)
         printf("exposure: %.4g (automatic: a high percentile of the lit surfaces' luminance near white, "
                "tone curve; --exposure 1 for SPEC §5's linear image)\n", info.exposure);

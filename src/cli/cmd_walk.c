@@ -429,10 +429,7 @@ static int run(const walk_args *a, plx_engine *e, const walk_path *wp)
         if (wr.lookups)
             printf("indirect light: %.0f lookups a frame on average, for %.0f samples\n",
                    (double)wr.lookups / wr.n, (double)a->w * a->h * (a->opts.aa > 1 ? a->opts.aa * a->opts.aa : 1));
-        if (a->opts.aa > 1)
-            printf("anti-aliasing %dx%d: the later samples shaded %.1f%% of the pixels (%s)\n", a->opts.aa,
-                   a->opts.aa, cli_aa_share(&a->opts, wr.aa_later, (double)a->w * a->h * wr.n),
-                   wr.aa_adaptive ? "adaptive: edges and glows; --aa-full for all" : "every sample");
+        cli_aa_print(&a->opts, wr.aa_later, (double)a->w * a->h * wr.n, wr.aa_adaptive);
         if (a->refine && !a->ind.off)
             printf("refinement: %llu hits, %llu misses, %llu evictions, %llu lamps refined (%u slots, %.0f m); "
                    "%.1f ms in all (floor maps and refill frames)\n", (unsigned long long)wr.rs.hits,

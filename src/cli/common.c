@@ -746,8 +746,11 @@ void cli_aa_warn(const char *cmd, const cli_common *c, const plx_render_opts *o,
                  "in 255)", o->aa, o->aa);
 }
 
-double cli_aa_share(const plx_render_opts *o, uint64_t later, double px)
+void cli_aa_print(const plx_render_opts *o, uint64_t later, double px, int adaptive)
 {
     double all = ((double)o->aa * o->aa - 1.0) * px;
-    return all > 0.0 ? 100.0 * (double)later / all : 0.0;
+    if (o->aa > 1)
+        printf("anti-aliasing %dx%d: the later samples shaded %.1f%% of the pixels (%s)\n", o->aa, o->aa,
+               all > 0.0 ? 100.0 * (double)later / all : 0.0,
+               adaptive ? "adaptive: edges and glows; --aa-full for all" : "every sample");
 }

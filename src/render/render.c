@@ -1409,10 +1409,6 @@ static void ground_ids(render *r, const render_opts *o)
         ground_row(r, 0, j);
 }
 
-/* Before the shading pass: ground ids, the one-surface blocks and the
- * hook's value at their corners, row by row (each corner's hit point
- * found once, two rows of them kept; with tries, the hook's values after
- * the blocks, on the workers first). */
 /* Whether a pixel of block (a, b), its far corners included, is shaded
  * in this sample (render_opts.mask). */
 static int block_masked(const render *r, const render_opts *o, int32_t a, int32_t b)
@@ -1425,6 +1421,12 @@ static int block_masked(const render *r, const render_opts *o, int32_t a, int32_
     return 0;
 }
 
+/* Before the shading pass: ground ids, the one-surface blocks and the
+ * hook's value at their corners, row by row (each corner's hit point
+ * found once, two rows of them kept; with tries, the hook's values after
+ * the blocks, on the workers first). A later anti-aliasing sample asks
+ * only the corners of blocks holding a pixel it shades (blk 2: one
+ * surface, none shaded). */
 static void sparse_corners(render *r, const render_opts *o, render_stats *st)
 {
     int32_t a, b;
