@@ -1966,35 +1966,102 @@ static inline int px_differ(const uint8_t *rgb, const uint32_t *id, size_t p, si
            (d2 < -level);
 }
 
-/* Marks p and q when they differ. */
-static inline void mask_pair(const uint8_t *rgb, const uint32_t *id, uint8_t *mask, size_t p, size_t q, int level)
+/* The pairs of 8-neighbours a pixel starts (each pair once, from its
+ * upper or left pixel), as bits of the first pass. */
+#define MASK_RIGHT 1u
+#define MASK_DOWN 2u
+#define MASK_DOWN_RIGHT 4u
+#define MASK_DOWN_LEFT 8u
+#define MASK_ROWS 16    /* rows a job */
+
+typedef struct mask_job {
+    const render *r;
+    const uint8_t *rgb;
+    const uint32_t *id;
+    uint8_t *bits, *out;
+    int level;
+} mask_job;
+
+/* Rows of job k: for each pixel, which of the pairs it starts (right,
+ * down, down-right, down-left) differ. */
+static void mask_bits_rows(void *arg, int worker, uint32_t k)
 {
-    if (px_differ(rgb, id, p, q, level))
-        mask[p] = mask[q] = 1;
+    const mask_job *jb = arg;
+    int32_t w = jb->r->w, h = jb->r->h, i, j, j1 = (int32_t)(k + 1) * MASK_ROWS;
+    (void)worker;
+    for (j = (int32_t)k * MASK_ROWS; j < j1 && j < h; j++)
+        for (i = 0; i < w; i++) {
+            size_t p = (size_t)j * (size_t)w + (size_t)i, ws = (size_t)w;
+            unsigned b = 0;
+            if (i + 1 < w && px_differ(jb->rgb, jb->id, p, p + 1, jb->level))
+                b |= MASK_RIGHT;
+            if (j + 1 < h) {
+                if (px_differ(jb->rgb, jb->id, p, p + ws, jb->level))
+                    b |= MASK_DOWN;
+                if (i + 1 < w && px_differ(jb->rgb, jb->id, p, p + ws + 1, jb->level))
+                    b |= MASK_DOWN_RIGHT;
+                if (i > 0 && px_differ(jb->rgb, jb->id, p, p + ws - 1, jb->level))
+                    b |= MASK_DOWN_LEFT;
+            }
+            jb->bits[p] = (uint8_t)b;
+        }
+}
+
+/* Rows of job k: a pixel is marked when a pair it starts differs, or a
+ * pair that ends at it (from its left, upper, upper-left or upper-right
+ * neighbour). */
+static void mask_or_rows(void *arg, int worker, uint32_t k)
+{
+    const mask_job *jb = arg;
+    const uint8_t *bt = jb->bits;
+    int32_t w = jb->r->w, h = jb->r->h, i, j, j1 = (int32_t)(k + 1) * MASK_ROWS;
+    (void)worker;
+    for (j = (int32_t)k * MASK_ROWS; j < j1 && j < h; j++)
+        for (i = 0; i < w; i++) {
+            size_t p = (size_t)j * (size_t)w + (size_t)i, ws = (size_t)w;
+            unsigned m = bt[p] != 0;
+            if (i > 0)
+                m |= (bt[p - 1] & MASK_RIGHT) != 0;
+            if (j > 0) {
+                m |= (bt[p - ws] & MASK_DOWN) != 0;
+                if (i > 0)
+                    m |= (bt[p - ws - 1] & MASK_DOWN_RIGHT) != 0;
+                if (i + 1 < w)
+                    m |= (bt[p - ws + 1] & MASK_DOWN_LEFT) != 0;
+            }
+            jb->out[p] = (uint8_t)m;
+        }
+}
+
+/* Runs fn over every job of rows on the workers, or here. */
+static void mask_pass(const render_opts *o, render_job_fn fn, mask_job *jb, uint32_t jobs)
+{
+    uint32_t k;
+    if (par_workers(o) < 2 || jobs < 2 || o->par(o->par_ctx, par_workers(o), jobs, fn, jb) != 0)
+        for (k = 0; k < jobs; k++)
+            fn(jb, 0, k);
 }
 
 size_t render_aa_mask(render *r, const render_opts *o, double ex, int curve, int level, uint8_t *rgb, uint32_t *id0,
                       uint8_t *mask)
 {
-    size_t px = (size_t)r->w * (size_t)r->h, n = 0, p, w = (size_t)r->w;
-    int32_t i, j;
+    size_t px = (size_t)r->w * (size_t)r->h, n = 0, p;
+    uint32_t jobs = (uint32_t)((r->h + MASK_ROWS - 1) / MASK_ROWS);
+    mask_job jb;
     render_tonemap_par(r, r->lin, px, ex, curve, rgb, o);
     memcpy(id0, r->id, px * sizeof *id0);
-    memset(mask, 0, px);
-    /* each pair of 8-neighbours once: right, down, down-right, down-left */
-    for (j = 0; j < r->h; j++)
-        for (i = 0; i < r->w; i++) {
-            p = (size_t)j * w + (size_t)i;
-            if (i + 1 < r->w)
-                mask_pair(rgb, id0, mask, p, p + 1, level);
-            if (j + 1 < r->h) {
-                mask_pair(rgb, id0, mask, p, p + w, level);
-                if (i + 1 < r->w)
-                    mask_pair(rgb, id0, mask, p, p + w + 1, level);
-                if (i > 0)
-                    mask_pair(rgb, id0, mask, p, p + w - 1, level);
-            }
-        }
+    jb.r = r;
+    jb.rgb = rgb;
+    jb.id = id0;
+    jb.level = level;
+    /* two passes on the workers, each pixel writing only its own byte: the
+     * pairs' bits into mask, then the marks into rgb (free by then: the
+     * first pass is its last reader), copied back to mask */
+    jb.bits = mask;
+    jb.out = rgb;
+    mask_pass(o, mask_bits_rows, &jb, jobs);
+    mask_pass(o, mask_or_rows, &jb, jobs);
+    memcpy(mask, rgb, px);
     if (!o->no_glow)
         glow_mark(r, mask); /* a glow the first sample sees: every sample adds its own */
     for (p = 0; p < px; p++)
