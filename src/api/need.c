@@ -100,8 +100,8 @@ static size_t photon_room(const plx_engine *e)
     const scene *s = e->sc;
     size_t free_b = arena_free_bytes(&e->mem), keep = 0;
     if (!e->rd) {
-        int32_t w = e->cfg.render_max_width ? e->cfg.render_max_width : DEFAULT_MAX_W;
-        int32_t h = e->cfg.render_max_height ? e->cfg.render_max_height : DEFAULT_MAX_H;
+        int32_t w, h;
+        eng_render_max(e, &w, &h);
         keep += render_bytes(s, w, h) + (size_t)MESH_PT * s->npts + (size_t)MESH_BLD * s->nbld;
     }
     if (!e->lt)

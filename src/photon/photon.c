@@ -69,7 +69,7 @@ static int config_ok(const photon_config *c)
         !(c->kernel_frames >= 0.0) ||
         !(c->lamp_kernel > 0.0 && c->lamp_kernel <= PHOTON_KERNEL_MAX) ||
         !(c->near_radius >= 0.0) || c->coarsest_level > PHOTON_LEVELS ||
-        !(c->lookup_radius >= 0.0 && c->lookup_radius <= 16.0))
+        !(c->lookup_radius >= 0.0 && c->lookup_radius <= PHOTON_LOOKUP_MAX))
         return 0;
     for (L = 0; L < PHOTON_LEVELS; L++)
         if ((c->chart_w >> L) < 1 || (c->chart_h >> L) < 1)
@@ -565,25 +565,34 @@ double photon_gather(const float *flux, const float *area, const float *height, 
     return gather_any(flux, &g, fx, fy, e);
 }
 
-/* The wide lookup (cfg.lookup_radius r > 0): e = sum w F / sum w A over the
- * valid texels (same surface: charted, same height) whose centres lie
- * within r texels, w = 1 - dist / r; else the 2 x 2 lookup. */
+/* The wide lookup (cfg.lookup_radius r, 0 < r <= PHOTON_LOOKUP_MAX): e =
+ * sum w F / sum w A over the valid texels (same surface: charted, same
+ * height) whose centres lie within r texels, w = 1 - dist / r; else the
+ * 2 x 2 lookup. */
 double photon_gather_wide(const float *flux, const float *area, const float *height, double z,
                           uint32_t w, uint32_t h, int wrap, double fx, double fy, double r,
                           double e[PHOTON_CH])
 {
-    double sf[PHOTON_CH] = {0.0, 0.0, 0.0, 0.0}, sa = 0.0, r2 = r * r;
+    double sf[PHOTON_CH] = {0.0, 0.0, 0.0, 0.0}, sa = 0.0, r2 = r * r, dx2[2 * PHOTON_LOOKUP_MAXI + 1];
     int ri = (int)ceil(r), ci = (int)floor(fx), cj = (int)floor(fy), a, b, c;
-    if (r <= 0.0 || !(fx > -2.0 && fy > -2.0 && fx < (double)w + 2.0 && fy < (double)h + 2.0)) {
+    if (r <= 0.0 || r > PHOTON_LOOKUP_MAX ||
+        !(fx > -2.0 && fy > -2.0 && fx < (double)w + 2.0 && fy < (double)h + 2.0)) {
         grid g = grid_full(area, height, NULL, z, w, h, wrap);
         return gather_any(flux, &g, fx, fy, e);
+    }
+    /* each column's dx^2 once, for every row */
+    for (a = ci - ri; a <= ci + ri; a++) {
+        double dx = a + 0.5 - fx;
+        dx2[a - ci + ri] = dx * dx;
     }
     /* rows in order, each texel's terms as gvalid and texel_area give them */
     for (b = cj - ri < 0 ? 0 : cj - ri; b <= cj + ri && b < (int)h; b++) {
         double dy = b + 0.5 - fy, dy2 = dy * dy;
         size_t row = (size_t)b * w;
+        if (dy2 >= r2)
+            continue; /* d2 >= dy2 for every texel of the row */
         for (a = ci - ri; a <= ci + ri; a++) {
-            double dx = a + 0.5 - fx, d2 = dx * dx + dy2, wt, ar;
+            double d2 = dx2[a - ci + ri] + dy2, wt, ar;
             const float *f;
             int i;
             size_t k;

@@ -165,6 +165,8 @@
 #define PHOTON_NONE 0xffffffffu
 #define PHOTON_KERNEL_MAXI 6   /* largest splat radius, texels */
 #define PHOTON_KERNEL_MAX ((double)PHOTON_KERNEL_MAXI)
+#define PHOTON_LOOKUP_MAXI 16  /* largest lookup_radius, texels */
+#define PHOTON_LOOKUP_MAX ((double)PHOTON_LOOKUP_MAXI)
 #define PHOTON_CH 4            /* flux channels per texel: scalar, R, G, B */
 
 typedef struct photon_config {
