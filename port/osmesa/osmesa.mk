@@ -19,10 +19,14 @@ endif
 # Objects that change with the setting are rebuilt when it changes.
 OSMESA_CLIENTS = $(BUILD)/src/cli/cmd_render.o $(BUILD)/tests/unit/test_render.o \
                  $(BUILD)/tests/bench/bench_render.o
-OSMESA_STAMP   = $(BUILD)/.osmesa-$(OSMESA)
+# The stamp holds the setting and is rewritten (its time moved) only when
+# the setting changes; it always exists, so the Makefile's .SECONDARY does
+# not let a missing stamp pass for an up-to-date one.
+OSMESA_STAMP   = $(BUILD)/.osmesa
+$(shell mkdir -p $(BUILD) && [ "$$(cat $(OSMESA_STAMP) 2>/dev/null)" = "$(OSMESA)" ] || \
+  echo "$(OSMESA)" > $(OSMESA_STAMP))
 $(OSMESA_CLIENTS): $(OSMESA_STAMP)
-$(OSMESA_STAMP):
-	@mkdir -p $(@D); rm -f $(BUILD)/.osmesa-*; touch $@
+$(OSMESA_STAMP): ;
 
 ifeq ($(OSMESA),1)
 OSMESA_CFLAGS := $(shell pkg-config --cflags osmesa)
