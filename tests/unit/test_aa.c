@@ -14,6 +14,10 @@
  *    times larger), and wherever the full pass differs from the first
  *    sample by more than 2% of white the pixel was shaded; in 8 bits the
  *    image is within 2 of the full pass everywhere.
+ *  - The adaptive mask (render_aa_mask, without glows) on 1 and on 2
+ *    workers equals a brute force: a pixel is marked when one of its 8
+ *    neighbours has another surface id or a channel more than 2 steps
+ *    apart in the 8-bit first sample.
  */
 #include <stdarg.h>
 #include <stddef.h>
@@ -29,6 +33,7 @@
 #include "polarlux_port.h"
 #include "fixture.h"
 #include "base/engine.h"
+#include "render/render.h"
 
 #define MEM ((size_t)256 << 20)
 
@@ -250,12 +255,84 @@ static void test_aa_adaptive(void **state)
     free(mem);
 }
 
+/* Brute force: pixel (i, j) against each of its 8 neighbours. */
+static int brute_mark(const uint8_t *rgb, const uint32_t *id, int w, int h, int i, int j, int level)
+{
+    int di, dj, c;
+    for (dj = -1; dj <= 1; dj++)
+        for (di = -1; di <= 1; di++) {
+            int x = i + di, y = j + dj;
+            size_t p = (size_t)j * w + i, q = (size_t)y * w + x;
+            if ((di == 0 && dj == 0) || x < 0 || y < 0 || x >= w || y >= h)
+                continue;
+            if (id[p] != id[q])
+                return 1;
+            for (c = 0; c < 3; c++)
+                if (abs((int)rgb[3 * p + c] - (int)rgb[3 * q + c]) > level)
+                    return 1;
+        }
+    return 0;
+}
+
+static void mask_against_brute(plx_engine *e, int w, int h, int workers)
+{
+    plx_camera cam;
+    plx_render_opts o;
+    plx_render_info info;
+    render_opts ro;
+    size_t px = (size_t)w * h, p, marked = 0, n;
+    uint8_t *rgb8 = malloc(px * 3), *scratch = malloc(px * 3), *mask = malloc(px);
+    uint32_t *id = malloc(px * sizeof *id), *id0 = malloc(px * sizeof *id0);
+    int i, j, level;
+    plx_render_opts_default(&o);
+    o.auto_exposure = 1;
+    street(&cam, w, h);
+    assert_int_equal(plx_render(e, &cam, &o, rgb8, NULL, &info), PLX_OK);
+    memcpy(id, render_ids(e->rd), px * sizeof *id);
+    render_opts_default(&ro);
+    ro.no_glow = 1;
+    ro.par = e->port.parallel_for;
+    ro.par_ctx = e->port.ctx;
+    ro.workers = workers;
+    for (level = 0; level <= 2; level += 2) {
+        n = render_aa_mask(e->rd, &ro, info.exposure, 1, level, scratch, id0, mask);
+        marked = 0;
+        for (j = 0; j < h; j++)
+            for (i = 0; i < w; i++) {
+                p = (size_t)j * w + i;
+                assert_int_equal(id0[p], id[p]);
+                assert_int_equal(mask[p], brute_mark(rgb8, id, w, h, i, j, level));
+                marked += mask[p];
+            }
+        assert_int_equal(n, marked);
+        assert_true(marked > 0 && marked < px); /* edges, and flat parts */
+    }
+    print_message("mask %dx%d on %d workers: %zu of %zu pixels marked (level 2), as the brute force\n", w, h,
+                  workers, marked, px);
+    free(rgb8); free(scratch); free(mask); free(id); free(id0);
+}
+
+static void test_aa_mask(void **state)
+{
+    void *mem;
+    plx_engine *e = open_eixample(&mem);
+    (void)state;
+    /* bands of 16 rows: a height that is not a multiple, and one band */
+    mask_against_brute(e, 160, 120, 1);
+    mask_against_brute(e, 160, 120, 2);
+    mask_against_brute(e, 97, 45, 2);
+    mask_against_brute(e, 31, 9, 2);
+    plx_engine_destroy(e);
+    free(mem);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_auto_exposure),
         cmocka_unit_test(test_aa),
         cmocka_unit_test(test_aa_adaptive),
+        cmocka_unit_test(test_aa_mask),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
