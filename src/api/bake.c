@@ -43,7 +43,7 @@
 
 enum {
     H_MAGIC = 0, H_VERSION = 8, H_ENDIAN = 12, H_SIZES = 16, H_LAYOUT = 20, H_LENGTH = 24,
-    H_SUM = 32, H_IMAGE = 40, H_NREL = 48, H_BASEMOD = 56, H_SLACK = 64, H_PEAK = 72, H_PAGES = 80
+    H_SUM = 32, H_IMAGE = 40, H_NREL = 48, H_BASEMOD = 56, H_SLACK = 64, H_RESERVED = 72, H_PAGES = 80
 };
 
 /* ---- checksum: FNV-1a over 64-bit words, four interleaved lanes ---------- */
@@ -403,7 +403,10 @@ plx_status plx_bake_save(plx_engine *e, plx_engine *twin, void *buf, size_t cap,
     put64(f + H_NREL, L.nrel);
     put64(f + H_BASEMOD, (uintptr_t)e->mem.base & (BAKE_ALIGN - 1));
     put64(f + H_SLACK, bake_slack(e));
-    put64(f + H_PEAK, e->mem.peak_total);
+    /* 0: files of before 2026-11-25 hold the build's peak memory here, which
+     * the layer's workers raised, so that bakes on 1 and N threads differed;
+     * nothing reads it */
+    put64(f + H_RESERVED, 0);
     put64(f + H_PAGES, L.pages_present);
     put64(f + H_SUM, file_sum(f, L.total));
     if (written)
