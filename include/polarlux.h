@@ -129,6 +129,16 @@ typedef struct plx_port {
                     char *err, size_t errlen);
     /* Ends a view file_map gave (called once for each successful map). */
     void (*file_unmap)(void *ctx, void *handle);
+    /* Progress of long work, for a progress line (NULL: none). Before a
+     * stage the calling thread calls progress(ctx, what, 0, total); while
+     * it runs, any worker of parallel_for calls progress(ctx, what, n,
+     * total) for n more units done (n >= 1: the port sums them, so it
+     * must be thread-safe); after it, the calling thread calls
+     * progress(ctx, what, 0, 0). 'what' names the stage (today "aerial
+     * indirect layer", in rows of the light map: the bulk of a bake).
+     * Added after file_unmap so port tables written before keep their
+     * layout. */
+    void (*progress)(void *ctx, const char *what, uint64_t n, uint64_t total);
 } plx_port;
 
 /* Most workers the core asks a parallel-for for. */

@@ -34,6 +34,7 @@ static void port(void)
     FIELD(plx_port, cores);
     FIELD(plx_port, file_map);
     FIELD(plx_port, file_unmap);
+    FIELD(plx_port, progress);
 }
 
 static void config(void)

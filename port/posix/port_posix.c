@@ -192,6 +192,7 @@ static void posix_unlock(void *ctx)
 static const plx_port posix_port = {
     NULL, posix_clock, posix_log, posix_file_size, posix_file_read, posix_lock, posix_unlock,
     port_parallel_for, port_cores, posix_file_map, posix_file_unmap,
+    NULL, /* progress: the command sets its own (src/cli/common.c, cli_config) */
 };
 
 const plx_port *plx_port_posix(void)

@@ -32,7 +32,8 @@ class Port(ctypes.Structure):
                 ("file_size", ctypes.c_void_p), ("file_read", ctypes.c_void_p),
                 ("lock", ctypes.c_void_p), ("unlock", ctypes.c_void_p),
                 ("parallel_for", ctypes.c_void_p), ("cores", ctypes.c_void_p),
-                ("file_map", ctypes.c_void_p), ("file_unmap", ctypes.c_void_p)]
+                ("file_map", ctypes.c_void_p), ("file_unmap", ctypes.c_void_p),
+                ("progress", ctypes.c_void_p)]
 
 
 class Config(ctypes.Structure):

@@ -241,6 +241,7 @@ void eng_lightmap_layer(plx_engine *e)
 {
     layer_worker w[RENDER_MAX_WORKERS];
     void *users[RENDER_MAX_WORKERS];
+    render_progress pg;
     render_opts ro;
     arena_mark m;
     plx_status st;
@@ -264,7 +265,9 @@ void eng_lightmap_layer(plx_engine *e)
         icache_set_spacing(w[k].ic, ICACHE_AERIAL);
         users[k] = &w[k];
     }
-    st = render_lightmap_fill_ind(e->rd, lightmap_indirect, users, ro.par, ro.par_ctx, n);
+    pg.fn = e->port.progress;
+    pg.ctx = e->port.ctx;
+    st = render_lightmap_fill_ind(e->rd, lightmap_indirect, users, ro.par, ro.par_ctx, n, &pg);
     for (k = 1; k < n; k++) {
         e->ic->gathered += w[k].ic->gathered;
         e->ic->direct += w[k].ic->direct;

@@ -18,10 +18,10 @@ static const char help[] =
     "lamp light, photon buffers with K frames of N photons (levels for a viewer\n"
     "at the centre, all around), the renderer for frames up to --max-size and\n"
     "the aerial light map with its indirect layer (gathered after the photons\n"
-    "on --threads workers: most of the time on a large city); then writes it\n"
-    "all to one file. Every command that takes a SCENE also takes the bake file\n"
-    "and starts at once (README 'Bake files'). Prints the file size, the engine\n"
-    "memory in use and the times.\n"
+    "on --threads workers: most of the time on a large city, with a progress\n"
+    "line on a terminal); then writes it all to one file. Every command that\n"
+    "takes a SCENE also takes the bake file and starts at once (README 'Bake\n"
+    "files'). Prints the file size, the engine memory in use and the times.\n"
     "\n"
     "  -o FILE         the bake file (required)\n"
     "  --photons N     photons per frame (default 65536)\n"
@@ -104,6 +104,7 @@ static int load_engine(const bake_args *a, int twin, plx_engine **e)
         static plx_port silent;
         silent = *cfg.port;
         silent.log = NULL; /* the twin's warnings were printed once already */
+        silent.progress = NULL;
         cfg.port = &silent;
     }
     st = plx_engine_create(block, mem, &cfg, e);

@@ -1,5 +1,6 @@
 #include <errno.h>
 #include <math.h>
+#include <pthread.h>
 #include <stdarg.h>
 #include <stdlib.h>
 #include <string.h>
@@ -322,16 +323,45 @@ const char *cli_dark_reason(plx_engine *e)
     return "no lamp's light reaches it (each lamp lights only within its radius, and buildings cast shadows)";
 }
 
+/* The command's progress line for the core's long stages (plx_port.progress):
+ * the workers' units summed under a lock, shown as cli_progress shows a
+ * loop of the command's own (a terminal only, after a second). */
+static struct {
+    pthread_mutex_t lock;
+    cli_progress pr;
+    uint64_t done;
+    int on;
+} stage = { PTHREAD_MUTEX_INITIALIZER, { 0, 0, 0, 0 }, 0, 0 };
+
+static void stage_progress(void *ctx, const char *what, uint64_t n, uint64_t total)
+{
+    (void)ctx;
+    pthread_mutex_lock(&stage.lock);
+    if (total == 0) {
+        if (stage.on)
+            cli_progress_end(&stage.pr);
+        stage.on = 0;
+    } else if (n == 0) {
+        cli_progress_start(&stage.pr);
+        stage.done = 0;
+        stage.on = 1;
+    } else if (stage.on) {
+        stage.done += n;
+        cli_progress_step(&stage.pr, what, (size_t)stage.done, (size_t)total);
+    }
+    pthread_mutex_unlock(&stage.lock);
+}
+
 void cli_config(const cli_common *c, plx_config *cfg)
 {
-    static plx_port quiet_port;
+    static plx_port port;
     plx_config_default(cfg);
-    cfg->port = plx_port_posix();
-    if (c->quiet) {
-        quiet_port = *cfg->port;
-        quiet_port.log = quiet_log;
-        cfg->port = &quiet_port;
-    }
+    port = *plx_port_posix();
+    if (c->quiet)
+        port.log = quiet_log;
+    else
+        port.progress = stage_progress;
+    cfg->port = &port;
     cfg->strict = c->strict;
     cfg->render_max_width = c->render_w;
     cfg->render_max_height = c->render_h;

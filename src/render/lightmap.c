@@ -144,21 +144,32 @@ typedef struct ind_job {
     lightmap_ind_fn fn;
     void *const *users;
     uint32_t rows;       /* per band */
+    const lightmap_par *par;
 } ind_job;
+
+/* Row j for the user of the worker, reported done. */
+static void ind_row_told(const ind_job *jb, uint32_t j, void *user)
+{
+    const lightmap_par *p = jb->par;
+    ind_row(jb->m, j, jb->fn, user);
+    if (p && p->progress)
+        p->progress(p->progress_ctx, LIGHTMAP_LAYER_STAGE, 1, jb->m->ny);
+}
 
 static void ind_band(void *arg, int worker, uint32_t k)
 {
     ind_job *jb = arg;
     uint32_t j, j1 = (k + 1) * jb->rows < jb->m->ny ? (k + 1) * jb->rows : jb->m->ny;
     for (j = k * jb->rows; j < j1; j++)
-        ind_row(jb->m, j, jb->fn, jb->users[worker]);
+        ind_row_told(jb, j, jb->users[worker]);
 }
 
 plx_status lightmap_fill_ind(lightmap *m, lightmap_ind_fn ind_fn, void *const *users, int workers,
                              const lightmap_par *par)
 {
     ind_job jb;
-    uint32_t bands;
+    uint32_t bands, j;
+    int told = par && par->progress;
     if (!m->built || !m->ind || !ind_fn || !users || workers < 1 ||
         (size_t)m->nx * m->ny * 4 > m->ind_cap)
         return PLX_E_INVALID;
@@ -168,10 +179,16 @@ plx_status lightmap_fill_ind(lightmap *m, lightmap_ind_fn ind_fn, void *const *u
     jb.fn = ind_fn;
     jb.users = users;
     jb.rows = (m->ny + bands - 1) / bands;
+    jb.par = par;
     bands = jb.rows ? (m->ny + jb.rows - 1) / jb.rows : 0;
+    if (told)
+        par->progress(par->progress_ctx, LIGHTMAP_LAYER_STAGE, 0, m->ny);
     if (workers < 2 || !par || !par->par || !users[0] ||
         par->par(par->ctx, workers, bands, ind_band, &jb) != 0)
-        ind_fill(m, ind_fn, users[0]);
+        for (j = 0; j < m->ny; j++)
+            ind_row_told(&jb, j, users[0]);
+    if (told)
+        par->progress(par->progress_ctx, LIGHTMAP_LAYER_STAGE, 0, 0);
     m->has_ind = users[0] != NULL;
     return PLX_OK;
 }

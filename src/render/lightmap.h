@@ -39,6 +39,10 @@ typedef struct lightmap_par {
     void *ctx;
     int workers;
     struct light *lt;
+    /* plx_port.progress and its ctx (NULL: none): lightmap_fill_ind
+     * reports its rows */
+    void (*progress)(void *ctx, const char *what, uint64_t n, uint64_t total);
+    void *progress_ctx;
 } lightmap_par;
 
 /* Builds the map of scene s with texels of cell metres (grown by 5% steps
@@ -71,8 +75,10 @@ plx_status lightmap_build_ind(lightmap *m, arena *mem, const scene *s, double ce
  * workers >= 2 and par, bands of rows run on the workers, worker w
  * calling ind_fn with users[w] (each its own state: ind_fn must give a
  * texel the same value whoever asks, and the layer is then the same for
- * any number of workers); otherwise users[0] on this thread. Returns
+ * any number of workers); otherwise users[0] on this thread. Each row
+ * done is reported to par->progress (LIGHTMAP_LAYER_STAGE). Returns
  * PLX_E_INVALID when the map was built without a layer. */
+#define LIGHTMAP_LAYER_STAGE "aerial indirect layer"
 plx_status lightmap_fill_ind(lightmap *m, lightmap_ind_fn ind_fn, void *const *users, int workers,
                              const lightmap_par *par /* may be NULL */);
 

@@ -2158,6 +2158,7 @@ plx_status render_lightmap_build_par(render *r, double cell, size_t max_bytes, r
     lightmap_par lp;
     if (!r)
         return PLX_E_INVALID;
+    memset(&lp, 0, sizeof lp);
     r->im.built = 0;   /* over the old map's box */
     lp.par = par;
     lp.ctx = ctx;
@@ -2172,6 +2173,7 @@ plx_status render_lightmap_build_ind(render *r, double cell, size_t max_bytes, l
     lightmap_par lp;
     if (!r || !ind)
         return PLX_E_INVALID;
+    memset(&lp, 0, sizeof lp);
     r->im.built = 0;   /* over the old map's box */
     lp.par = par;
     lp.ctx = ctx;
@@ -2181,11 +2183,16 @@ plx_status render_lightmap_build_ind(render *r, double cell, size_t max_bytes, l
 }
 
 plx_status render_lightmap_fill_ind(render *r, lightmap_ind_fn ind, void *const *users, render_par_fn par,
-                                    void *ctx, int workers)
+                                    void *ctx, int workers, const render_progress *pg)
 {
     lightmap_par lp;
     if (!r)
         return PLX_E_INVALID;
+    memset(&lp, 0, sizeof lp);
+    if (pg) {
+        lp.progress = pg->fn;
+        lp.progress_ctx = pg->ctx;
+    }
     lp.par = par;
     lp.ctx = ctx;
     lp.workers = workers > RENDER_MAX_WORKERS ? RENDER_MAX_WORKERS : workers;

@@ -10,12 +10,15 @@
  *    small: the exact status and message, no engine.
  *  - The corpus tests/corpus/bake-*.plxb with exact outcomes.
  *  - A twin that is not laid out alike is refused.
+ *  - The aerial layer's rows are reported to plx_port.progress: one start
+ *    with the map's rows, the workers' units summing to them, one end.
  */
 #include <stdarg.h>
 #include <stddef.h>
 #include <setjmp.h>
 #include <stdint.h>
 #include <math.h>
+#include <pthread.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -39,15 +42,42 @@ typedef struct baked {
     size_t len;
 } baked;
 
+/* plx_port.progress counted (the workers call it: under a lock). */
+static struct {
+    pthread_mutex_t lock;
+    uint64_t starts, ends, units, total, calls, bad;
+} told = { PTHREAD_MUTEX_INITIALIZER, 0, 0, 0, 0, 0, 0 };
+
+static void count_progress(void *ctx, const char *what, uint64_t n, uint64_t total)
+{
+    (void)ctx;
+    pthread_mutex_lock(&told.lock);
+    told.calls++;
+    told.bad += strcmp(what, "aerial indirect layer") != 0;
+    if (total == 0) {
+        told.ends++;
+    } else if (n == 0) {
+        told.starts++;
+        told.total = total;
+    } else {
+        told.units += n;
+        told.bad += total != told.total;
+    }
+    pthread_mutex_unlock(&told.lock);
+}
+
 static plx_engine *make(void **mem, int twin, int aerial)
 {
+    static plx_port counting;
     plx_config cfg;
     plx_bake_opts o;
     plx_engine *e = NULL;
     assert_int_equal(posix_memalign(mem, 64, MEM), 0);
     memset(*mem, 0, MEM); /* the bake saves every byte of the used arena, padding included */
     plx_config_default(&cfg);
-    cfg.port = plx_port_posix();
+    counting = *plx_port_posix();
+    counting.progress = count_progress;
+    cfg.port = &counting;
     cfg.threads = 2; /* the aerial layer gathered on two workers (test_aerial_layer_in_bake) */
     cfg.render_max_width = 320;
     cfg.render_max_height = 240;
@@ -245,6 +275,13 @@ static void test_aerial_layer_in_bake(void **state)
     assert_true(li.built && li.has_ind);
     assert_true(k.a->ic->gathered > 0);
     assert_int_equal(k.a->layer_workers, 2);
+    /* the bake's layer, reported row by row (the twin gathers none) */
+    assert_int_equal(told.starts, 1);
+    assert_int_equal(told.ends, 1);
+    assert_int_equal(told.total, li.ny);
+    assert_int_equal(told.units, li.ny);
+    assert_int_equal(told.bad, 0);
+    assert_true(told.calls == li.ny + 2);
     c = load(k.file, k.len, &mc);
     render_lightmap_get(c->rd, &li);
     assert_true(li.built && li.has_ind);
