@@ -241,7 +241,7 @@ void eng_lightmap_layer(plx_engine *e)
 {
     layer_worker w[RENDER_MAX_WORKERS];
     void *users[RENDER_MAX_WORKERS];
-    render_progress pg;
+    lightmap_progress pg;
     render_opts ro;
     arena_mark m;
     plx_status st;

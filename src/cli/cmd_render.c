@@ -412,10 +412,10 @@ int cmd_render(int argc, char **argv)
                a.aerial ? "aerial" : "street", a.cam.width, a.cam.height, prec, a.cam.eye[0], prec, a.cam.eye[1],
                a.cam.eye[2], prec, a.cam.target[0], prec, a.cam.target[1], a.cam.target[2], info.drawn, info.buildings,
                100.0 * info.drawn_fraction, (port_now_ns() - t0) / 1e6, a.out);
-    if (rc == EXIT_OK)
+    if (rc == EXIT_OK) {
         cli_aa_warn("render", &a.c, &a.opts, &info);
-    if (rc == EXIT_OK)
         cli_aa_print(&a.opts, info.aa_later, (double)a.cam.width * a.cam.height, info.aa_adaptive);
+    }
     if (rc == EXIT_OK && a.opts.auto_exposure)
         printf("exposure: %.4g (automatic: a high percentile of the lit surfaces' luminance near white, "
                "tone curve; --exposure 1 for SPEC §5's linear image)\n", info.exposure);

@@ -152,8 +152,8 @@ static void ind_row_told(const ind_job *jb, uint32_t j, void *user)
 {
     const lightmap_par *p = jb->par;
     ind_row(jb->m, j, jb->fn, user);
-    if (p && p->progress)
-        p->progress(p->progress_ctx, LIGHTMAP_LAYER_STAGE, 1, jb->m->ny);
+    if (p && p->progress.fn)
+        p->progress.fn(p->progress.ctx, LIGHTMAP_LAYER_STAGE, 1, jb->m->ny);
 }
 
 static void ind_band(void *arg, int worker, uint32_t k)
@@ -169,7 +169,7 @@ plx_status lightmap_fill_ind(lightmap *m, lightmap_ind_fn ind_fn, void *const *u
 {
     ind_job jb;
     uint32_t bands, j;
-    int told = par && par->progress;
+    int told = par && par->progress.fn;
     if (!m->built || !m->ind || !ind_fn || !users || workers < 1 ||
         (size_t)m->nx * m->ny * 4 > m->ind_cap)
         return PLX_E_INVALID;
@@ -182,13 +182,13 @@ plx_status lightmap_fill_ind(lightmap *m, lightmap_ind_fn ind_fn, void *const *u
     jb.par = par;
     bands = jb.rows ? (m->ny + jb.rows - 1) / jb.rows : 0;
     if (told)
-        par->progress(par->progress_ctx, LIGHTMAP_LAYER_STAGE, 0, m->ny);
+        par->progress.fn(par->progress.ctx, LIGHTMAP_LAYER_STAGE, 0, m->ny);
     if (workers < 2 || !par || !par->par || !users[0] ||
         par->par(par->ctx, workers, bands, ind_band, &jb) != 0)
         for (j = 0; j < m->ny; j++)
             ind_row_told(&jb, j, users[0]);
     if (told)
-        par->progress(par->progress_ctx, LIGHTMAP_LAYER_STAGE, 0, 0);
+        par->progress.fn(par->progress.ctx, LIGHTMAP_LAYER_STAGE, 0, 0);
     m->has_ind = users[0] != NULL;
     return PLX_OK;
 }

@@ -33,16 +33,20 @@ typedef int (*lightmap_ind_fn)(void *user, double x, double y, double rgb[3] /* 
 /* Building on several threads: par runs jobs (render.h's parallel-for),
  * lt is the light object when the shader is the light module's (else
  * NULL: one thread). */
+/* A progress hook (plx_port.progress) and its ctx: lightmap_fill_ind
+ * reports its rows (fn NULL: none). */
+typedef struct lightmap_progress {
+    void (*fn)(void *ctx, const char *what, uint64_t n, uint64_t total);
+    void *ctx;
+} lightmap_progress;
+
 typedef struct lightmap_par {
     int (*par)(void *ctx, int workers, uint32_t njobs, void (*job)(void *arg, int worker, uint32_t k),
                void *arg);
     void *ctx;
     int workers;
     struct light *lt;
-    /* plx_port.progress and its ctx (NULL: none): lightmap_fill_ind
-     * reports its rows */
-    void (*progress)(void *ctx, const char *what, uint64_t n, uint64_t total);
-    void *progress_ctx;
+    lightmap_progress progress;
 } lightmap_par;
 
 /* Builds the map of scene s with texels of cell metres (grown by 5% steps

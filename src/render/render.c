@@ -1341,6 +1341,16 @@ static int par_workers(const render_opts *o)
     return o->workers > RENDER_MAX_WORKERS ? RENDER_MAX_WORKERS : o->workers;
 }
 
+/* fn(arg, worker, k) for k = 0 .. jobs - 1 on the workers, or on this
+ * thread without them (or when the port could not run them). */
+static void run_jobs(const render_opts *o, uint32_t jobs, render_job_fn fn, void *arg)
+{
+    uint32_t k;
+    if (par_workers(o) < 2 || jobs < 2 || o->par(o->par_ctx, par_workers(o), jobs, fn, arg) != 0)
+        for (k = 0; k < jobs; k++)
+            fn(arg, 0, k);
+}
+
 /* How many workers may try the hook (0: none, the hook on this thread). */
 static int try_workers(const render_opts *o)
 {
@@ -1893,19 +1903,13 @@ void render_tonemap_par(const render *r, const float *lin, size_t px, double ex,
                         const render_opts *o)
 {
     tonemap_job jb;
-    uint32_t jobs = (uint32_t)((3 * px + TONEMAP_CHUNK - 1) / TONEMAP_CHUNK);
-    if (par_workers(o) < 2 || jobs < 2) {
-        render_tonemap(r, lin, px, ex, curve, rgb8);
-        return;
-    }
     jb.r = r;
     jb.lin = lin;
     jb.n = 3 * px;
     jb.ex = ex;
     jb.curve = curve;
     jb.rgb8 = rgb8;
-    if (o->par(o->par_ctx, par_workers(o), jobs, tonemap_chunk, &jb) != 0)
-        render_tonemap(r, lin, px, ex, curve, rgb8);
+    run_jobs(o, (uint32_t)((3 * px + TONEMAP_CHUNK - 1) / TONEMAP_CHUNK), tonemap_chunk, &jb);
 }
 
 /* Part k of RENDER_MAX_WORKERS of the exposure's pixels counted into
@@ -1924,10 +1928,7 @@ static void exposure_part(void *arg, int worker, uint32_t k)
 static double exposure_par(render *r, const render_opts *o)
 {
     uint32_t k, b;
-    int nw = par_workers(o);
-    if (nw < 2 || o->par(o->par_ctx, nw, RENDER_MAX_WORKERS, exposure_part, r) != 0)
-        for (k = 0; k < RENDER_MAX_WORKERS; k++)
-            exposure_part(r, 0, k);
+    run_jobs(o, RENDER_MAX_WORKERS, exposure_part, r);
     for (k = 1; k < RENDER_MAX_WORKERS; k++)
         for (b = 0; b < EXPOSURE_BINS; b++)
             r->hist[0][b] += r->hist[k][b];
@@ -2033,15 +2034,6 @@ static void mask_or_rows(void *arg, int worker, uint32_t k)
         }
 }
 
-/* Runs fn over every job of rows on the workers, or here. */
-static void mask_pass(const render_opts *o, render_job_fn fn, mask_job *jb, uint32_t jobs)
-{
-    uint32_t k;
-    if (par_workers(o) < 2 || jobs < 2 || o->par(o->par_ctx, par_workers(o), jobs, fn, jb) != 0)
-        for (k = 0; k < jobs; k++)
-            fn(jb, 0, k);
-}
-
 size_t render_aa_mask(render *r, const render_opts *o, double ex, int curve, int level, uint8_t *rgb, uint32_t *id0,
                       uint8_t *mask)
 {
@@ -2059,8 +2051,8 @@ size_t render_aa_mask(render *r, const render_opts *o, double ex, int curve, int
      * first pass is its last reader), copied back to mask */
     jb.bits = mask;
     jb.out = rgb;
-    mask_pass(o, mask_bits_rows, &jb, jobs);
-    mask_pass(o, mask_or_rows, &jb, jobs);
+    run_jobs(o, jobs, mask_bits_rows, &jb);
+    run_jobs(o, jobs, mask_or_rows, &jb);
     memcpy(mask, rgb, px);
     if (!o->no_glow)
         glow_mark(r, mask); /* a glow the first sample sees: every sample adds its own */
@@ -2183,16 +2175,14 @@ plx_status render_lightmap_build_ind(render *r, double cell, size_t max_bytes, l
 }
 
 plx_status render_lightmap_fill_ind(render *r, lightmap_ind_fn ind, void *const *users, render_par_fn par,
-                                    void *ctx, int workers, const render_progress *pg)
+                                    void *ctx, int workers, const lightmap_progress *pg)
 {
     lightmap_par lp;
     if (!r)
         return PLX_E_INVALID;
     memset(&lp, 0, sizeof lp);
-    if (pg) {
-        lp.progress = pg->fn;
-        lp.progress_ctx = pg->ctx;
-    }
+    if (pg)
+        lp.progress = *pg;
     lp.par = par;
     lp.ctx = ctx;
     lp.workers = workers > RENDER_MAX_WORKERS ? RENDER_MAX_WORKERS : workers;

@@ -404,17 +404,11 @@ plx_status render_lightmap_build_par(render *r, double m_per_texel, size_t max_b
 plx_status render_lightmap_build_ind(render *r, double m_per_texel, size_t max_bytes, lightmap_ind_fn ind,
                                      void *user, render_par_fn par, void *ctx, int workers);
 
-/* A progress hook (plx_port.progress) and its ctx. */
-typedef struct render_progress {
-    void (*fn)(void *ctx, const char *what, uint64_t n, uint64_t total);
-    void *ctx;
-} render_progress;
-
 /* The built map's indirect layer filled again by ind (lightmap_fill_ind:
  * users[w] for worker w of par), its direct part kept: PLX_E_INVALID
  * without a layer. Its rows are reported to pg (may be NULL). */
 plx_status render_lightmap_fill_ind(render *r, lightmap_ind_fn ind, void *const *users, render_par_fn par,
-                                    void *ctx, int workers, const render_progress *pg);
+                                    void *ctx, int workers, const lightmap_progress *pg);
 
 typedef struct render_lightmap_info {
     int built;
