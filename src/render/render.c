@@ -6,6 +6,7 @@
 #include "base/plx_assert.h"
 #include "render/render.h"
 #include "render/exposure.h"
+#include "render/tonemap.h"
 #include "render/raster.h"
 #include "light/light.h"
 #include "scene/photometry.h"
@@ -93,8 +94,8 @@ struct render {
     int sparse;                 /* this frame's indirect is sparse */
     lightmap lm;                /* the aerial light map (lightmap.c) */
     indmap im;                  /* its indirect twin (indmap.c) */
-    double thr[255];
-    uint8_t *lut;               /* 65536: byte for the float bits >> 16 (a hint) */
+    double thr[TONEMAP_LEVELS];
+    tonemap_table *tm;          /* the last exposure's table (tonemap.h) */
     const char *err;
 };
 
@@ -117,11 +118,6 @@ void render_opts_default(render_opts *o)
 
 /* ---- creation --------------------------------------------------------------- */
 
-static double srgb_decode(double e)
-{
-    return e <= 0.04045 ? e / 12.92 : pow((e + 0.055) / 1.055, 2.4);
-}
-
 uint32_t render_surf_slots(const scene *s, int32_t max_w, int32_t max_h)
 {
     size_t px = (size_t)max_w * (size_t)max_h, nsurf = 2 + (size_t)s->npts + 2 * (size_t)s->nbld;
@@ -142,7 +138,7 @@ size_t render_bytes(const scene *s, int32_t max_w, int32_t max_h)
     size_t px = (size_t)max_w * (size_t)max_h;
     size_t tiles = (size_t)((max_w + RENDER_TILE - 1) / RENDER_TILE) * (size_t)((max_h + RENDER_TILE - 1) / RENDER_TILE);
     size_t corners = (size_t)(max_w / IND_STEP + 2) * (size_t)(max_h / IND_STEP + 2);
-    return px * 20 + tiles + (size_t)s->nbld * (2 * sizeof(cull_item) + 17) + RENDER_BINS * 8 + 65536 +
+    return px * 20 + tiles + (size_t)s->nbld * (2 * sizeof(cull_item) + 17) + RENDER_BINS * 8 + sizeof(tonemap_table) + 8 +
            corners * (1 + 3 * sizeof(float)) + 2 * (size_t)(max_w / IND_STEP + 2) * sizeof(corner_hit) + render_surf_slots(s, max_w, max_h) * (sizeof(uint32_t) + sizeof(mesh_surf)) +
            stop_rows(max_h) * sizeof(int32_t) +
            sizeof(render) + 4096;
@@ -165,16 +161,7 @@ const char *render_error(const render *r)
 
 uint8_t render_srgb8(const render *r, double v)
 {
-    int lo = 0, hi = 255;
-    /* the number of thresholds <= v (NaN gives 0) */
-    while (lo < hi) {
-        int mid = (lo + hi) / 2;
-        if (v >= r->thr[mid])
-            lo = mid + 1;
-        else
-            hi = mid;
-    }
-    return (uint8_t)lo;
+    return tonemap_srgb8(r->thr, v);
 }
 
 /* ---- the software backend (raster.h) ------------------------------------------ */
@@ -241,7 +228,6 @@ plx_status render_create(arena *a, const scene *s, int32_t max_w, int32_t max_h,
     render *r;
     size_t px;
     plx_status st;
-    int k;
     if (!a || !s || !shade || !out)
         return PLX_E_INVALID;
     *out = NULL;
@@ -285,7 +271,7 @@ plx_status render_create(arena *a, const scene *s, int32_t max_w, int32_t max_h,
         arena_release(a, &m0);
         return PLX_E_NOMEM;
     }
-    r->lut = arena_alloc(a, PLX_PART_FRAME, 65536, R_ALIGN);
+    r->tm = arena_alloc(a, PLX_PART_FRAME, sizeof(tonemap_table), R_ALIGN);
     r->defer = arena_alloc(a, PLX_PART_FRAME,
                            (size_t)((max_w + RENDER_TILE - 1) / RENDER_TILE) *
                                (size_t)((max_h + RENDER_TILE - 1) / RENDER_TILE), R_ALIGN);
@@ -298,17 +284,12 @@ plx_status render_create(arena *a, const scene *s, int32_t max_w, int32_t max_h,
     r->stop = arena_alloc(a, PLX_PART_FRAME, stop_rows(max_h) * sizeof(int32_t), R_ALIGN);
     if (shade == render_shade_light && user)
         r->lt = user;
-    if (!r->lut || !r->defer || !r->blk || !r->ind || !r->crow || !r->stop) {
+    if (!r->tm || !r->defer || !r->blk || !r->ind || !r->crow || !r->stop) {
         arena_release(a, &m0);
         return PLX_E_NOMEM;
     }
-    for (k = 0; k < 255; k++)
-        r->thr[k] = srgb_decode((k + 0.5) / 255.0);
-    for (k = 0; k < 65536; k++) {
-        union { uint32_t u; float f; } cv;
-        cv.u = (uint32_t)k << 16;
-        r->lut[k] = render_srgb8(r, (double)cv.f);
-    }
+    tonemap_thresholds(r->thr);
+    r->tm->usable = 0;
     render_code_bind(r, shade);
     *out = r;
     return PLX_OK;
@@ -1850,34 +1831,11 @@ static void glow_mark(const render *r, uint8_t *mask)
     }
 }
 
-static void tonemap_range(const render *r, const float *lin, size_t p0, size_t p1, double ex, int curve,
-                          uint8_t *rgb8)
-{
-    size_t p;
-    for (p = p0; p < p1; p++) {
-        double v = (double)lin[p] * ex;
-        union { uint32_t u; float f; } cv;
-        int b;
-        if (curve)
-            v = exposure_curve(v);
-        cv.f = (float)v;
-        if (!(v > 0.0)) {
-            rgb8[p] = 0;
-            continue;
-        }
-        /* a hint from the table, then exact against the thresholds */
-        b = r->lut[cv.u >> 16];
-        while (b > 0 && v < r->thr[b - 1])
-            b--;
-        while (b < 255 && v >= r->thr[b])
-            b++;
-        rgb8[p] = (uint8_t)b;
-    }
-}
-
 void render_tonemap(const render *r, const float *lin, size_t px, double ex, int curve, uint8_t *rgb8)
 {
-    tonemap_range(r, lin, 0, 3 * px, ex, curve, rgb8);
+    size_t p;
+    for (p = 0; p < 3 * px; p++)
+        rgb8[p] = tonemap_value(r->thr, lin[p], ex, curve);
 }
 
 #define TONEMAP_CHUNK 65536     /* values a job */
@@ -1886,8 +1844,6 @@ typedef struct tonemap_job {
     const render *r;
     const float *lin;
     size_t n;
-    double ex;
-    int curve;
     uint8_t *rgb8;
 } tonemap_job;
 
@@ -1896,18 +1852,17 @@ static void tonemap_chunk(void *arg, int worker, uint32_t k)
     const tonemap_job *jb = arg;
     size_t p0 = (size_t)k * TONEMAP_CHUNK, p1 = p0 + TONEMAP_CHUNK < jb->n ? p0 + TONEMAP_CHUNK : jb->n;
     (void)worker;
-    tonemap_range(jb->r, jb->lin, p0, p1, jb->ex, jb->curve, jb->rgb8);
+    tonemap_apply(jb->r->tm, jb->r->thr, jb->lin, p0, p1, jb->rgb8);
 }
 
-void render_tonemap_par(const render *r, const float *lin, size_t px, double ex, int curve, uint8_t *rgb8,
+void render_tonemap_par(render *r, const float *lin, size_t px, double ex, int curve, uint8_t *rgb8,
                         const render_opts *o)
 {
     tonemap_job jb;
+    tonemap_table_set(r->tm, r->thr, ex, curve);
     jb.r = r;
     jb.lin = lin;
     jb.n = 3 * px;
-    jb.ex = ex;
-    jb.curve = curve;
     jb.rgb8 = rgb8;
     run_jobs(o, (uint32_t)((3 * px + TONEMAP_CHUNK - 1) / TONEMAP_CHUNK), tonemap_chunk, &jb);
 }

@@ -361,8 +361,9 @@ plx_status render_frame(render *r, const render_camera *cam, const render_opts *
  * thresholds). What render_frame does to its own image. */
 void render_tonemap(const render *r, const float *lin, size_t px, double ex, int curve,
                     uint8_t *rgb8 /* OUT */);
-/* The same on o's parallel-for (each value on its own: the same bytes). */
-void render_tonemap_par(const render *r, const float *lin, size_t px, double ex, int curve,
+/* The same on o's parallel-for, from a table of the exposure's float
+ * thresholds (tonemap.h; each value on its own: the same bytes). */
+void render_tonemap_par(render *r, const float *lin, size_t px, double ex, int curve,
                         uint8_t *rgb8 /* OUT */, const render_opts *o);
 
 /* Adaptive anti-aliasing, after the frame of the first sample (its exposure

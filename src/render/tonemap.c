@@ -1,0 +1,175 @@
+/* tonemap: linear RGB to sRGB bytes (tonemap.h, README "How SPEC §5
+ * (images) is read").
+ *
+ * A frame's 921,600 values (640x480) each go through the exposure, the
+ * tone curve's division and a search of the 255 thresholds. For one
+ * exposure and curve the byte depends on the float alone and grows with
+ * it, so the table holds, for each byte, the smallest float that reaches
+ * it: found from the curve's inverse and checked float by float against
+ * tonemap_value, so the bytes are the same by construction. A value then
+ * costs a table read and a compare or two of its bits.
+ */
+#include <float.h>
+#include <math.h>
+#include <string.h>
+
+#include "render/exposure.h"
+#include "render/tonemap.h"
+
+#define FLOAT_INF_BITS 0x7f800000u
+
+static double srgb_decode(double e)
+{
+    return e <= 0.04045 ? e / 12.92 : pow((e + 0.055) / 1.055, 2.4);
+}
+
+void tonemap_thresholds(double thr[TONEMAP_LEVELS])
+{
+    int k;
+    for (k = 0; k < TONEMAP_LEVELS; k++)
+        thr[k] = srgb_decode((k + 0.5) / 255.0);
+}
+
+uint8_t tonemap_srgb8(const double thr[TONEMAP_LEVELS], double v)
+{
+    int lo = 0, hi = TONEMAP_LEVELS;
+    while (lo < hi) {
+        int mid = (lo + hi) / 2;
+        if (v >= thr[mid])
+            lo = mid + 1;
+        else
+            hi = mid;
+    }
+    return (uint8_t)lo;
+}
+
+uint8_t tonemap_value(const double thr[TONEMAP_LEVELS], float x, double ex, int curve)
+{
+    double v = (double)x * ex;
+    if (curve)
+        v = exposure_curve(v);
+    if (!(v > 0.0))
+        return 0;
+    return tonemap_srgb8(thr, v);
+}
+
+static float from_bits(uint32_t u)
+{
+    float f;
+    memcpy(&f, &u, sizeof f);
+    return f;
+}
+
+static uint32_t to_bits(float f)
+{
+    uint32_t u;
+    memcpy(&u, &f, sizeof u);
+    return u;
+}
+
+/* Whether the positive float of bits u has a byte above k. */
+static int above(const double thr[TONEMAP_LEVELS], double ex, int curve, uint32_t u, int k)
+{
+    return tonemap_value(thr, from_bits(u), ex, curve) > k;
+}
+
+/* The linear value whose curve is y (y < 1: the stable root of
+ * v^2 / W^2 + (1 - y) v - y = 0). */
+static double curve_inverse(double y)
+{
+    const double w2 = EXPOSURE_WHITE * EXPOSURE_WHITE;
+    return 2.0 * y / ((1.0 - y) + sqrt((1.0 - y) * (1.0 - y) + 4.0 * y / w2));
+}
+
+/* The smallest bits in 1 .. FLOAT_INF_BITS (that: no finite float) whose
+ * byte is above k, from a guess: steps doubling from it until they
+ * bracket the change, then bisection. */
+static uint32_t first_above(const double thr[TONEMAP_LEVELS], double ex, int curve, int k, uint32_t guess)
+{
+    uint32_t lo, hi, step = 1; /* lo: not above (or 0), hi: above (or FLOAT_INF_BITS) */
+    guess = guess < 1 ? 1 : guess >= FLOAT_INF_BITS ? FLOAT_INF_BITS - 1 : guess;
+    if (above(thr, ex, curve, guess, k)) {
+        hi = guess;
+        for (;;) {
+            lo = hi > step ? hi - step : 0;
+            if (lo == 0 || !above(thr, ex, curve, lo, k))
+                break;
+            hi = lo;
+            step *= 2;
+        }
+    } else {
+        lo = guess;
+        for (;;) {
+            hi = FLOAT_INF_BITS - lo > step ? lo + step : FLOAT_INF_BITS;
+            if (hi == FLOAT_INF_BITS || above(thr, ex, curve, hi, k))
+                break;
+            lo = hi;
+            step *= 2;
+        }
+    }
+    while (hi - lo > 1) {
+        uint32_t mid = lo + (hi - lo) / 2;
+        if (above(thr, ex, curve, mid, k))
+            hi = mid;
+        else
+            lo = mid;
+    }
+    return hi;
+}
+
+/* The float whose value times ex reaches threshold y after the curve. */
+static uint32_t guess_bits(double y, double ex, int curve)
+{
+    double x = (curve ? curve_inverse(y) : y) / ex;
+    if (!(x > 0.0))
+        return 1;
+    if (!(x < (double)FLT_MAX))
+        return FLOAT_INF_BITS - 1;
+    return to_bits((float)x);
+}
+
+void tonemap_table_set(tonemap_table *t, const double thr[TONEMAP_LEVELS], double ex, int curve)
+{
+    uint32_t h;
+    int k;
+    curve = curve != 0;
+    if (t->usable && t->ex == ex && t->curve == curve)
+        return;
+    t->ex = ex;
+    t->curve = curve;
+    /* an exposure so large that the curve's square overflows for some
+     * float (or none at all) is left to tonemap_value */
+    t->usable = ex > 0.0 && ex * (double)FLT_MAX < 1e150;
+    if (!t->usable)
+        return;
+    for (k = 0; k < TONEMAP_LEVELS; k++)
+        t->f[k] = first_above(thr, ex, curve, k, guess_bits(thr[k], ex, curve));
+    for (h = 0, k = 0; h < TONEMAP_HINTS; h++) {
+        while (k < TONEMAP_LEVELS && t->f[k] <= h << 16)
+            k++;
+        t->hint[h] = (uint8_t)k;
+    }
+}
+
+void tonemap_apply(const tonemap_table *t, const double thr[TONEMAP_LEVELS], const float *lin, size_t p0,
+                   size_t p1, uint8_t *rgb8)
+{
+    size_t p;
+    if (!t->usable) {
+        for (p = p0; p < p1; p++)
+            rgb8[p] = tonemap_value(thr, lin[p], t->ex, t->curve);
+        return;
+    }
+    for (p = p0; p < p1; p++) {
+        uint32_t u = to_bits(lin[p]);
+        int b;
+        if (u - 1u >= FLOAT_INF_BITS - 1u) { /* zero, negative, infinite, NaN */
+            rgb8[p] = u == 0 ? 0 : tonemap_value(thr, lin[p], t->ex, t->curve);
+            continue;
+        }
+        b = t->hint[u >> 16];
+        while (b < TONEMAP_LEVELS && u >= t->f[b])
+            b++;
+        rgb8[p] = (uint8_t)b;
+    }
+}

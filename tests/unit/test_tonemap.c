@@ -1,0 +1,153 @@
+/* test_tonemap: the tone map's table of float thresholds (src/render/
+ * tonemap.c) gives the same byte as the direct computation (exposure, tone
+ * curve, search of SPEC §5's thresholds: tonemap_value) for every value
+ * tried: floats spread over the whole positive range, 300 floats each side
+ * of every threshold the table found, and zero, negatives, subnormals,
+ * the largest float, infinities and NaN; at exposures from 1e-30 to 1e120
+ * (the last too large for the table: its values go the direct way), with
+ * and without the curve. */
+#include <stdarg.h>
+#include <stddef.h>
+#include <setjmp.h>
+#include <stdint.h>
+#include <float.h>
+#include <math.h>
+#include <string.h>
+#include <cmocka.h>
+
+#include "render/tonemap.h"
+
+#define SPREAD 4099u   /* a stride through the positive float bits */
+#define NEAR 300u      /* floats each side of a threshold */
+#define BUF 4096
+
+static float from_bits(uint32_t u)
+{
+    float f;
+    memcpy(&f, &u, sizeof f);
+    return f;
+}
+
+static unsigned bits_of(float f)
+{
+    uint32_t u;
+    memcpy(&u, &f, sizeof u);
+    return (unsigned)u;
+}
+
+typedef struct batch {
+    float x[BUF];
+    uint8_t got[BUF];
+    size_t n;
+    size_t checked, lit;
+} batch;
+
+/* The batch's bytes from the table against tonemap_value, one by one. */
+static void flush(batch *b, const tonemap_table *t, const double *thr, double ex, int curve)
+{
+    size_t i;
+    tonemap_apply(t, thr, b->x, 0, b->n, b->got);
+    for (i = 0; i < b->n; i++) {
+        uint8_t want = tonemap_value(thr, b->x[i], ex, curve);
+        if (b->got[i] != want)
+            fail_msg("ex %g curve %d: %.9g (bits %08x) gives %u, not %u", ex, curve, (double)b->x[i],
+                     bits_of(b->x[i]), b->got[i], want);
+        b->lit += want > 0 && want < 255;
+    }
+    b->checked += b->n;
+    b->n = 0;
+}
+
+static void add(batch *b, const tonemap_table *t, const double *thr, double ex, int curve, float x)
+{
+    b->x[b->n++] = x;
+    if (b->n == BUF)
+        flush(b, t, thr, ex, curve);
+}
+
+static void check_exposure(const double *thr, double ex, int curve, int usable)
+{
+    static tonemap_table t;
+    static batch b;
+    static const float special[] = { 0.0f, -0.0f, -1.0f, -FLT_MIN, FLT_MIN, 1e-45f, 1e-40f, FLT_MAX,
+                                     1.0f, 0.5f, 1e-3f };
+    uint64_t u;
+    uint32_t k, d;
+    size_t i;
+    memset(&t, 0, sizeof t);
+    b.n = b.checked = b.lit = 0;
+    tonemap_table_set(&t, thr, ex, curve);
+    assert_int_equal(t.usable, usable);
+    for (u = 1; u < 0x7f800000u; u += SPREAD)
+        add(&b, &t, thr, ex, curve, from_bits((uint32_t)u));
+    if (usable)
+        for (k = 0; k < TONEMAP_LEVELS; k++)
+            for (d = 0; d < 2 * NEAR; d++) {
+                int64_t v = (int64_t)t.f[k] - NEAR + d;
+                if (v >= 1 && v < 0x7f800000)
+                    add(&b, &t, thr, ex, curve, from_bits((uint32_t)v));
+            }
+    for (i = 0; i < sizeof special / sizeof special[0]; i++)
+        add(&b, &t, thr, ex, curve, special[i]);
+    add(&b, &t, thr, ex, curve, INFINITY);
+    add(&b, &t, thr, ex, curve, -INFINITY);
+    add(&b, &t, thr, ex, curve, NAN);
+    flush(&b, &t, thr, ex, curve);
+    assert_true(b.checked > 500000);
+    /* the exposure's range of floats is crossed: bytes between 0 and 255
+     * (1e120 takes every float but the smallest to 255) */
+    if (usable)
+        assert_true(b.lit > 1000);
+}
+
+static void test_same_bytes(void **state)
+{
+    static const double ex[] = { 1.0, 0.15, 3.7e-3, 250.0, 1e-30, 7.3e20, 0.999999, 1e6 };
+    double thr[TONEMAP_LEVELS];
+    size_t i;
+    int curve;
+    (void)state;
+    tonemap_thresholds(thr);
+    for (i = 0; i < sizeof ex / sizeof ex[0]; i++)
+        for (curve = 0; curve < 2; curve++)
+            check_exposure(thr, ex[i], curve, 1);
+    check_exposure(thr, 1e120, 1, 0);
+    check_exposure(thr, 1e120, 0, 0);
+}
+
+/* The thresholds themselves: between each float below f[k] and f[k] the
+ * byte steps past k (so the table is the exact boundary, not near it). */
+static void test_boundaries(void **state)
+{
+    static tonemap_table t;
+    double thr[TONEMAP_LEVELS];
+    int k;
+    (void)state;
+    tonemap_thresholds(thr);
+    memset(&t, 0, sizeof t);
+    tonemap_table_set(&t, thr, 0.37, 1);
+    assert_true(t.usable);
+    for (k = 0; k < TONEMAP_LEVELS; k++) {
+        assert_true(tonemap_value(thr, from_bits(t.f[k]), 0.37, 1) > k);
+        assert_true(tonemap_value(thr, from_bits(t.f[k] - 1), 0.37, 1) <= k);
+        if (k > 0)
+            assert_true(t.f[k] >= t.f[k - 1]);
+    }
+    /* the same exposure again keeps the table; another makes a new one */
+    t.f[0] ^= 1;
+    tonemap_table_set(&t, thr, 0.37, 1);
+    assert_true(tonemap_value(thr, from_bits(t.f[0]), 0.37, 1) == 0 ||
+                tonemap_value(thr, from_bits(t.f[0] - 1), 0.37, 1) > 0);
+    tonemap_table_set(&t, thr, 0.38, 1);
+    assert_true(tonemap_value(thr, from_bits(t.f[0]), 0.38, 1) > 0);
+    assert_true(tonemap_value(thr, from_bits(t.f[0] - 1), 0.38, 1) == 0);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_same_bytes),
+        cmocka_unit_test(test_boundaries),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
