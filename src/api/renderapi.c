@@ -45,11 +45,11 @@ static void shade_indirect(void *user, const double P[3], const double n[3], dou
 /* shade_indirect's value when it needs no gather (the cache's records
  * all there): changes nothing, so the workers may ask it at once; 0 when
  * only shade_indirect can say. */
-static int shade_indirect_try(void *user, const double P[3], const double n[3], double rgb[3])
+static int shade_indirect_try(void *user, int worker, const double P[3], const double n[3], double rgb[3])
 {
     plx_engine *e = user;
     if (icache_on(e))
-        return icache_peek(e->ic, e->ph, P, n, rgb);
+        return icache_peek(e->ic, e->ph, worker, P, n, rgb);
     eng_indirect_photons_rgb(e, P, n, rgb);
     return 1;
 }

@@ -15,12 +15,6 @@
 #define COORD_BIAS ((int64_t)1 << 28)
 #define COORD_MASK (((uint64_t)1 << 29) - 1)
 
-struct icache_rec {
-    uint64_t k1, k2;      /* surface; level and vertex */
-    float e[3];           /* RGB E_indirect at the vertex */
-    uint32_t flags;       /* REC_USED, REC_VALID */
-};
-
 enum { REC_USED = 1, REC_VALID = 2 };
 
 /* The surface a pixel's point lies on: its key and its grid frame. */
@@ -101,6 +95,8 @@ static void flush(icache *c)
 void icache_clear(icache *c)
 {
     flush(c);
+    /* the peeks' cells too: a bake holds none of the workers' history */
+    memset(c->peek_last, 0, sizeof c->peek_last);
     c->stamp = 0;
     c->gathered = c->direct = c->flushes = 0;
 }
@@ -225,12 +221,18 @@ static uint32_t later_of(const icache *c)
     return c->fixed > 0.0 ? ICACHE_AERIAL_LATER : 1;
 }
 
+/* The second key of vertex (i, j) at level l (the first: the surface). */
+static uint64_t key2(const icache *c, int l, int64_t i, int64_t j)
+{
+    return ((uint64_t)(c->side != ICACHE_SIDE) << 62) | ((uint64_t)l << 58) |
+           (((uint64_t)(i + COORD_BIAS) & COORD_MASK) << 29) | ((uint64_t)(j + COORD_BIAS) & COORD_MASK);
+}
+
 /* Vertex (i, j) at level l's slot: the one holding its record, or the
  * free slot where it goes. */
 static icache_rec *slot(const icache *c, const plane *pl, int l, int64_t i, int64_t j, uint64_t *k2_out)
 {
-    uint64_t k2 = ((uint64_t)(c->side != ICACHE_SIDE) << 62) | ((uint64_t)l << 58) |
-                  (((uint64_t)(i + COORD_BIAS) & COORD_MASK) << 29) | ((uint64_t)(j + COORD_BIAS) & COORD_MASK);
+    uint64_t k2 = key2(c, l, i, j);
     uint32_t mask = c->nrec - 1, at;
     icache_rec *r;
     at = (uint32_t)mix64(pl->code ^ mix64(k2)) & mask;
@@ -300,6 +302,38 @@ static const icache_rec *cell_record(icache *c, photon_sys *ps, light *L, const 
     return r;
 }
 
+/* A peek's vertex v of cell (i, j) at level l (as cell_record): from
+ * the worker's last cell at the level while its slot holds the vertex,
+ * else the table; NULL when the record is not there (nothing remembered
+ * then). */
+static const icache_rec *peek_record(const icache *c, icache_cell *last, const plane *pl, int l, int64_t i,
+                                     int64_t j, int v)
+{
+    icache_cell *lc = &last[l];
+    int64_t vi = i + (v & 1), vj = j + (v >> 1);
+    icache_rec *r;
+    uint64_t k2;
+    if (!lc->set || lc->code != pl->code || lc->i != i || lc->j != j) {
+        memset(lc, 0, sizeof *lc);
+        lc->set = ICACHE_CELL_SET;
+        lc->code = pl->code;
+        lc->i = i;
+        lc->j = j;
+    }
+    if (lc->r[v]) {
+        r = &c->tab[lc->r[v] - 1];
+        if ((r->flags & REC_USED) && r->k1 == pl->code && r->k2 == key2(c, l, vi, vj))
+            return r;
+    }
+    r = slot(c, pl, l, vi, vj, &k2);
+    if (!(r->flags & REC_USED)) {
+        lc->r[v] = 0;
+        return NULL;
+    }
+    lc->r[v] = (uint32_t)(r - c->tab) + 1;
+    return r;
+}
+
 /* Whether the horizontal segment from P (5 cm above its surface) to the
  * vertex Q meets a wall: on coarse grids a ground cell may span a small
  * building, and the street beyond it is the same height of ground. */
@@ -327,10 +361,10 @@ static int blocked(tracer *T, const double P[3], const double Q[3])
  * set it to this cell). The surface's points lie within 1 mm of one
  * height (its code holds it in mm), so walls within 1 mm of the segments'
  * height z count. */
-static int cell_clear(icache *c, tracer *T, const plane *pl, int l, int64_t i, int64_t j, double sp,
+static int cell_clear(icache_cell *last, tracer *T, const plane *pl, int l, int64_t i, int64_t j, double sp,
                       double z)
 {
-    icache_cell *lc = &c->last[l];
+    icache_cell *lc = &last[l];
     if (!lc->set || lc->code != pl->code || lc->i != i || lc->j != j)
         return 0;
     if (lc->set == ICACHE_CELL_SET)
@@ -340,11 +374,18 @@ static int cell_clear(icache *c, tracer *T, const plane *pl, int l, int64_t i, i
     return lc->set == ICACHE_CELL_CLEAR;
 }
 
+/* A peek's state: set when a record is not there, and the worker's
+ * last cells. */
+typedef struct peek_state {
+    int miss;
+    icache_cell *last;
+} peek_state;
+
 /* Bilinear over the valid vertices of P's cell at level l; 0 when none
- * of them is valid (with weight). With miss (a peek): the records are
- * only looked for, and *miss set (0 returned) when one is not there. */
+ * of them is valid (with weight). With pk (a peek): the records are only
+ * looked for, and pk->miss set (0 returned) when one is not there. */
 static int level_value(icache *c, photon_sys *ps, light *L, const plane *pl, const double P[3],
-                       int l, double rgb[3], int *miss)
+                       int l, double rgb[3], peek_state *pk)
 {
     double sp = ICACHE_S0 * ldexp(1.0, l), d[3], fu, fv, wu, wv, ws = 0.0, acc[3] = {0, 0, 0};
     int64_t i, j;
@@ -363,11 +404,10 @@ static int level_value(icache *c, photon_sys *ps, light *L, const plane *pl, con
             const icache_rec *r;
             if (!(w > 0.0))
                 continue;
-            if (miss) {
-                uint64_t k2;
-                r = slot(c, pl, l, i + a, j + b, &k2);
-                if (!(r->flags & REC_USED)) {
-                    *miss = 1;
+            if (pk) {
+                r = peek_record(c, pk->last, pl, l, i, j, 2 * b + a);
+                if (!r) {
+                    pk->miss = 1;
                     return 0;
                 }
             } else
@@ -375,7 +415,7 @@ static int level_value(icache *c, photon_sys *ps, light *L, const plane *pl, con
             if (!(r->flags & REC_VALID))
                 continue;
             if (!pl->wall && l >= ICACHE_LEVEL_SEG &&
-                (miss || !cell_clear(c, ps->T, pl, l, i, j, sp, P[2] + BLOCK_DZ))) {
+                !cell_clear(pk ? pk->last : c->last, ps->T, pl, l, i, j, sp, P[2] + BLOCK_DZ)) {
                 double Q[3];
                 vertex_point(pl, sp, i + a, j + b, Q);
                 if (blocked(ps->T, P, Q))
@@ -393,15 +433,15 @@ static int level_value(icache *c, photon_sys *ps, light *L, const plane *pl, con
 }
 
 /* Level l, or the finest level below it with a valid vertex, or P itself
- * (a peek: *miss set instead of gathering). */
+ * (a peek: pk->miss set instead of gathering). */
 static void level_or_finer(icache *c, photon_sys *ps, light *L, const plane *pl,
-                           const double P[3], int l, double rgb[3], int *miss)
+                           const double P[3], int l, double rgb[3], peek_state *pk)
 {
     for (; l >= 0; l--)
-        if (level_value(c, ps, L, pl, P, l, rgb, miss) || (miss && *miss))
+        if (level_value(c, ps, L, pl, P, l, rgb, pk) || (pk && pk->miss))
             return;
-    if (miss) {
-        *miss = 1;
+    if (pk) {
+        pk->miss = 1;
         return;
     }
     c->direct++;
@@ -444,16 +484,17 @@ double icache_lookup_top(icache *c, photon_sys *ps, light *L, double x, double y
     return P[2];
 }
 
-/* icache_lookup, or with miss its peek (nothing changed). */
+/* icache_lookup, or with pk its peek (nothing changed but the worker's
+ * last cells). */
 static void lookup(icache *c, photon_sys *ps, light *L, const double P[3], const double n[3], double rgb[3],
-                   int *miss)
+                   peek_state *pk)
 {
     double dx = P[0] - c->eye[0], dy = P[1] - c->eye[1], dz = P[2] - c->eye[2], lf, t, r1[3];
     plane pl;
     int l0, k;
-    if (miss) {
+    if (pk) {
         if (photon_stamp(ps) != c->stamp) {
-            *miss = 1;
+            pk->miss = 1;
             return;
         }
     } else
@@ -463,7 +504,7 @@ static void lookup(icache *c, photon_sys *ps, light *L, const double P[3], const
         return;
     }
     if (c->fixed > 0.0) {
-        level_or_finer(c, ps, L, &pl, P, fixed_level(c), rgb, miss);
+        level_or_finer(c, ps, L, &pl, P, fixed_level(c), rgb, pk);
         return;
     }
     lf = log2(fmax(c->kappa * sqrt(dx * dx + dy * dy + dz * dz), fmax(c->smin, ICACHE_S0)) / ICACHE_S0);
@@ -473,10 +514,10 @@ static void lookup(icache *c, photon_sys *ps, light *L, const double P[3], const
     }
     l0 = (int)floor(lf);
     t = lf - l0;
-    level_or_finer(c, ps, L, &pl, P, l0, rgb, miss);
-    if (t > 0.0 && !(miss && *miss)) {
+    level_or_finer(c, ps, L, &pl, P, l0, rgb, pk);
+    if (t > 0.0 && !(pk && pk->miss)) {
         if (l0 < ICACHE_LEVEL_MAX)
-            level_or_finer(c, ps, L, &pl, P, l0 + 1, r1, miss);
+            level_or_finer(c, ps, L, &pl, P, l0 + 1, r1, pk);
         else
             photon_indirect_rgb(ps, P, n, r1);
         for (k = 0; k < 3; k++)
@@ -490,9 +531,13 @@ void icache_lookup(icache *c, photon_sys *ps, light *L, const double P[3], const
     lookup(c, ps, L, P, n, rgb, NULL);
 }
 
-int icache_peek(icache *c, photon_sys *ps, const double P[3], const double n[3], double rgb[3])
+int icache_peek(icache *c, photon_sys *ps, int worker, const double P[3], const double n[3], double rgb[3])
 {
-    int miss = 0;
-    lookup(c, ps, NULL, P, n, rgb, &miss);
-    return !miss;
+    peek_state pk;
+    if (worker < 0 || worker >= ICACHE_PEEK_WORKERS)
+        return 0;
+    pk.miss = 0;
+    pk.last = c->peek_last[worker];
+    lookup(c, ps, NULL, P, n, rgb, &pk);
+    return !pk.miss;
 }

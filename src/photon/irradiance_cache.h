@@ -91,7 +91,12 @@
                                  (final_gather_rgb_later; README "Aerial views'
                                  indirect light") */
 
-typedef struct icache_rec icache_rec;
+/* A record: one vertex's final gather (tests read the keys). */
+typedef struct icache_rec {
+    uint64_t k1, k2;      /* surface; level and vertex */
+    float e[3];           /* RGB E_indirect at the vertex */
+    uint32_t flags;       /* REC_USED, REC_VALID */
+} icache_rec;
 
 /* The last cell looked up at one level, and the records of its four
  * vertices fetched so far (0: not yet): neighbouring pixels share
@@ -109,6 +114,8 @@ typedef struct icache_cell {
 
 enum { ICACHE_CELL_SET = 1, ICACHE_CELL_CLEAR = 2, ICACHE_CELL_WALLS = 3 };
 
+#define ICACHE_PEEK_WORKERS 16 /* PLX_MAX_THREADS */
+
 typedef struct icache {
     icache_rec *tab;          /* nrec slots */
     uint32_t nrec;            /* a power of two, ICACHE_RECORDS_MIN..ICACHE_RECORDS */
@@ -123,6 +130,10 @@ typedef struct icache {
     uint64_t direct;          /* points gathered themselves (no valid vertex) */
     uint64_t flushes;         /* times the table was emptied */
     icache_cell last[ICACHE_LEVEL_MAX + 1]; /* per level: the last cell looked up */
+    /* the peeks' own last cells, one set per worker (icache_peek): a slot
+     * they remember is used again only while it holds the same vertex's
+     * record (the table may have been emptied and filled since) */
+    icache_cell peek_last[ICACHE_PEEK_WORKERS][ICACHE_LEVEL_MAX + 1];
 } icache;
 
 /* The table's slots for a budget of 'budget' bytes (the photon buffers'
@@ -138,8 +149,9 @@ size_t icache_bytes(uint32_t nrec);
  * arena; PLX_E_NOMEM when it does not fit. */
 plx_status icache_create(arena *a, uint32_t nrec, icache **out /* OUT */);
 
-/* Empty, as created (records, counters): what a bake saves, so that the
- * file does not depend on which worker gathered what. */
+/* Empty, as created (records, counters, the peeks' cells): what a bake
+ * saves, so that the file does not depend on which worker gathered or
+ * peeked at what. */
 void icache_clear(icache *c);
 
 /* The viewer for the lookups that follow: the grid spacing asked for at
@@ -169,8 +181,10 @@ double icache_lookup_top(icache *c, photon_sys *ps, light *L, double x, double y
 /* icache_lookup's value when every record it reads is in the table (and
  * the photons are those the table was gathered from): 1 with rgb, the
  * same bits icache_lookup gives; else 0 (it would gather). Changes
- * nothing (not even the last-cell memo), so several threads may peek at
- * once while nothing looks up. */
-int icache_peek(icache *c, photon_sys *ps, const double P[3], const double n[3], double rgb[3] /* OUT */);
+ * nothing but worker's own last cells (peek_last[worker]), so several
+ * threads may peek at once, each with its own worker (0 ..
+ * ICACHE_PEEK_WORKERS - 1), while nothing looks up. */
+int icache_peek(icache *c, photon_sys *ps, int worker, const double P[3], const double n[3],
+                double rgb[3] /* OUT */);
 
 #endif

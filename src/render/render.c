@@ -1255,13 +1255,14 @@ static int corner_used(const render *r, int32_t a, int32_t b)
 
 /* Corner (a, b)'s value from the hook (try: from indirect_try; returns 0
  * when it cannot say), stored in r->ind. */
-static int corner_value(render *r, const render_opts *o, int32_t a, int32_t b, const corner_hit *h, int try)
+static int corner_value(render *r, const render_opts *o, int32_t a, int32_t b, const corner_hit *h, int try,
+                        int worker)
 {
     float *c = &r->ind[3 * ((size_t)b * (size_t)(r->nbx + 1) + (size_t)a)];
     double Ei[3] = { 0.0, 0.0, 0.0 };
     int k;
     if (try) {
-        if (!o->indirect_try(o->indirect_user, h->P, h->n, Ei))
+        if (!o->indirect_try(o->indirect_user, worker, h->P, h->n, Ei))
             return 0;
     } else
         o->indirect(o->indirect_user, h->P, h->n, Ei);
@@ -1278,7 +1279,7 @@ static void corner_gather(render *r, const render_opts *o, render_stats *st, int
     int32_t a;
     for (a = a0; a <= r->nbx; a++)
         if (row[a].hit && corner_used(r, a, b)) {
-            (void)corner_value(r, o, a, b, &row[a], 0);
+            (void)corner_value(r, o, a, b, &row[a], 0, 0);
             st->indirect_calls++;
         }
 }
@@ -1306,7 +1307,7 @@ static void corner_try_row(void *arg, int worker, uint32_t b)
         h.hit = pixel_hit(r, corner_x(r, a), corner_y(r, (int32_t)b), &sid, h.P, h.n);
         if (!h.hit)
             continue;
-        if (!corner_value(r, jb->o, a, (int32_t)b, &h, 1))
+        if (!corner_value(r, jb->o, a, (int32_t)b, &h, 1, worker))
             break;
         jb->calls[worker]++;
     }
@@ -1365,7 +1366,7 @@ static void corners_rest(render *r, const render_opts *o, render_stats *st)
             if (corner_used(r, a, b)) {
                 h.hit = pixel_hit(r, corner_x(r, a), corner_y(r, b), &sid, h.P, h.n);
                 if (h.hit) {
-                    (void)corner_value(r, o, a, b, &h, 0);
+                    (void)corner_value(r, o, a, b, &h, 0, 0);
                     st->indirect_calls++;
                 }
             }
@@ -1479,7 +1480,8 @@ static void sparse_at(const render *r, int32_t i, int32_t j, double E[3])
 /* Pixel row j's pixels the blocks leave, from pixel i0 on: the hook's
  * term added (try: stops at the first the try cannot answer); returns
  * where it stopped (r->w: the row is done) and counts the calls. */
-static int32_t rest_row(render *r, const render_opts *o, int32_t j, int32_t i0, int try, uint64_t *calls)
+static int32_t rest_row(render *r, const render_opts *o, int32_t j, int32_t i0, int try, int worker,
+                        uint64_t *calls)
 {
     int32_t i;
     for (i = i0; i < r->w; i++) {
@@ -1493,7 +1495,7 @@ static int32_t rest_row(render *r, const render_opts *o, int32_t j, int32_t i0, 
             continue;
         if (!try)
             o->indirect(o->indirect_user, P, n, Ei);
-        else if (!o->indirect_try(o->indirect_user, P, n, Ei))
+        else if (!o->indirect_try(o->indirect_user, worker, P, n, Ei))
             break;
         (*calls)++;
         if (sid == MESH_SURF_GROUND)
@@ -1511,7 +1513,7 @@ static void rest_try_row(void *arg, int worker, uint32_t j)
 {
     try_job *jb = arg;
     render *r = jb->r;
-    r->stop[r->nby + 1 + (int32_t)j] = rest_row(r, jb->o, (int32_t)j, 0, 1, &jb->calls[worker]);
+    r->stop[r->nby + 1 + (int32_t)j] = rest_row(r, jb->o, (int32_t)j, 0, 1, worker, &jb->calls[worker]);
 }
 
 static void sparse_rest(render *r, const render_opts *o, render_stats *st)
@@ -1521,7 +1523,7 @@ static void sparse_rest(render *r, const render_opts *o, render_stats *st)
         for (j = 0; j < r->h; j++)
             stop[j] = 0;
     for (j = 0; j < r->h; j++)
-        (void)rest_row(r, o, j, stop[j], 0, &st->indirect_calls);
+        (void)rest_row(r, o, j, stop[j], 0, 0, &st->indirect_calls);
 }
 
 /* Step 3: shade every pixel of the tile. Returns -1 (ro only) when a pixel

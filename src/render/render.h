@@ -290,11 +290,12 @@ typedef struct render_opts {
                                   The shading pass may then use workers whatever
                                   indirect_mt says */
     double indirect_span;      /* see indirect_sparse (> 0, else no sparse indirect) */
-    int (*indirect_try)(void *user, const double P[3], const double n[3], double rgb[3]);
+    int (*indirect_try)(void *user, int worker, const double P[3], const double n[3], double rgb[3]);
                                /* sparse, with workers: indirect's value (the same bits) when
-                                  it can be had without changing anything, so on several
-                                  workers at once, else 0 (NULL: indirect alone, on this
-                                  thread); user is indirect_user */
+                                  it can be had without changing anything but the state of
+                                  this worker (0 .. workers - 1 of the parallel-for), so on
+                                  several workers at once, else 0 (NULL: indirect alone, on
+                                  this thread); user is indirect_user */
     void (*indirect_surf)(void *user, uint32_t sid, uint32_t bld, const double P[3], const double n[3],
                           double rgb[3]);
                                /* not sparse: called instead of indirect for each pixel, with
