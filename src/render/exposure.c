@@ -24,16 +24,78 @@ static double luminance(const float *c)
     return 0.2126 * c[0] + 0.7152 * c[1] + 0.0722 * c[2];
 }
 
+int exposure_bin(double y)
+{
+    double l = (log2(y) - LOG_MIN) * PER_STOP;
+    return l < 0 ? 0 : l >= BINS ? BINS - 1 : (int)l;
+}
+
 void exposure_count(const float *lin, const uint32_t *id, size_t p0, size_t p1, uint32_t hist[EXPOSURE_BINS])
 {
     size_t p;
     for (p = p0; p < p1; p++) {
-        double y = luminance(lin + 3 * p), l;
+        double y = luminance(lin + 3 * p);
+        if (id[p] == EXPOSURE_SKY || !(y > 0.0) || !isfinite(y))
+            continue;
+        hist[exposure_bin(y)]++;
+    }
+}
+
+static uint64_t dbits(double x)
+{
+    uint64_t u;
+    memcpy(&u, &x, sizeof u);
+    return u;
+}
+
+static double from_dbits(uint64_t u)
+{
+    double x;
+    memcpy(&x, &u, sizeof x);
+    return x;
+}
+
+/* The smallest positive double whose bin is at least k (1 .. BINS - 1),
+ * by bisection of the bits between 2^-40 (bin 0) and 2^40 (the last). */
+static double first_of_bin(int k)
+{
+    uint64_t lo = dbits(0x1p-40), hi = dbits(0x1p40);
+    while (hi - lo > 1) {
+        uint64_t mid = lo + (hi - lo) / 2;
+        if (exposure_bin(from_dbits(mid)) >= k)
+            hi = mid;
+        else
+            lo = mid;
+    }
+    return from_dbits(hi);
+}
+
+void exposure_table_init(exposure_table *et)
+{
+    uint32_t h;
+    int k;
+    et->t[0] = 0.0;
+    for (k = 1; k < BINS; k++)
+        et->t[k] = first_of_bin(k);
+    for (h = 0, k = 1; h < EXPOSURE_HINTS; h++) {
+        while (k < BINS && dbits(et->t[k]) <= (uint64_t)h << 49)
+            k++;
+        et->hint[h] = (uint16_t)(k - 1);
+    }
+}
+
+void exposure_count_table(const exposure_table *et, const float *lin, const uint32_t *id, size_t p0, size_t p1,
+                          uint32_t hist[EXPOSURE_BINS])
+{
+    size_t p;
+    for (p = p0; p < p1; p++) {
+        double y = luminance(lin + 3 * p);
         int b;
         if (id[p] == EXPOSURE_SKY || !(y > 0.0) || !isfinite(y))
             continue;
-        l = (log2(y) - LOG_MIN) * PER_STOP;
-        b = l < 0 ? 0 : l >= BINS ? BINS - 1 : (int)l;
+        b = et->hint[dbits(y) >> 49];
+        while (b + 1 < BINS && y >= et->t[b + 1])
+            b++;
         hist[b]++;
     }
 }

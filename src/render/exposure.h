@@ -21,4 +21,24 @@ double exposure_from(const uint32_t hist[EXPOSURE_BINS]);
 /* The tone curve: v (1 + v / W^2) / (1 + v), 0 for v <= 0 or NaN. */
 double exposure_curve(double v);
 
+/* The bin of a luminance y > 0: floor of 8 (log2 y + 32), within
+ * 0 .. EXPOSURE_BINS - 1 (what exposure_count counts). */
+int exposure_bin(double y);
+
+#define EXPOSURE_HINTS 16384     /* positive double bits >> 49 */
+
+/* exposure_bin without the logarithm: t[k] (k >= 1) is the smallest
+ * double whose bin is k or more, hint[h] the number of them at or below
+ * the bits h << 49; a luminance's bin is the number of t[k] at or below
+ * it (exposure_bin grows with y). Made once (exposure_table_init). */
+typedef struct exposure_table {
+    double t[EXPOSURE_BINS];     /* t[0] unused */
+    uint16_t hint[EXPOSURE_HINTS];
+} exposure_table;
+
+void exposure_table_init(exposure_table *et);
+/* exposure_count with the table: the same counts. */
+void exposure_count_table(const exposure_table *et, const float *lin, const uint32_t *id, size_t p0, size_t p1,
+                          uint32_t hist[EXPOSURE_BINS]);
+
 #endif

@@ -96,6 +96,7 @@ struct render {
     indmap im;                  /* its indirect twin (indmap.c) */
     double thr[TONEMAP_LEVELS];
     tonemap_table *tm;          /* the last exposure's table (tonemap.h) */
+    exposure_table *et;         /* the exposure's bins without the logarithm (exposure.h) */
     const char *err;
 };
 
@@ -138,7 +139,7 @@ size_t render_bytes(const scene *s, int32_t max_w, int32_t max_h)
     size_t px = (size_t)max_w * (size_t)max_h;
     size_t tiles = (size_t)((max_w + RENDER_TILE - 1) / RENDER_TILE) * (size_t)((max_h + RENDER_TILE - 1) / RENDER_TILE);
     size_t corners = (size_t)(max_w / IND_STEP + 2) * (size_t)(max_h / IND_STEP + 2);
-    return px * 20 + tiles + (size_t)s->nbld * (2 * sizeof(cull_item) + 17) + RENDER_BINS * 8 + sizeof(tonemap_table) + 8 +
+    return px * 20 + tiles + (size_t)s->nbld * (2 * sizeof(cull_item) + 17) + RENDER_BINS * 8 + sizeof(tonemap_table) + 8 + sizeof(exposure_table) + 8 +
            corners * (1 + 3 * sizeof(float)) + 2 * (size_t)(max_w / IND_STEP + 2) * sizeof(corner_hit) + render_surf_slots(s, max_w, max_h) * (sizeof(uint32_t) + sizeof(mesh_surf)) +
            stop_rows(max_h) * sizeof(int32_t) +
            sizeof(render) + 4096;
@@ -272,6 +273,7 @@ plx_status render_create(arena *a, const scene *s, int32_t max_w, int32_t max_h,
         return PLX_E_NOMEM;
     }
     r->tm = arena_alloc(a, PLX_PART_FRAME, sizeof(tonemap_table), R_ALIGN);
+    r->et = arena_alloc(a, PLX_PART_FRAME, sizeof(exposure_table), R_ALIGN);
     r->defer = arena_alloc(a, PLX_PART_FRAME,
                            (size_t)((max_w + RENDER_TILE - 1) / RENDER_TILE) *
                                (size_t)((max_h + RENDER_TILE - 1) / RENDER_TILE), R_ALIGN);
@@ -284,12 +286,13 @@ plx_status render_create(arena *a, const scene *s, int32_t max_w, int32_t max_h,
     r->stop = arena_alloc(a, PLX_PART_FRAME, stop_rows(max_h) * sizeof(int32_t), R_ALIGN);
     if (shade == render_shade_light && user)
         r->lt = user;
-    if (!r->tm || !r->defer || !r->blk || !r->ind || !r->crow || !r->stop) {
+    if (!r->tm || !r->et || !r->defer || !r->blk || !r->ind || !r->crow || !r->stop) {
         arena_release(a, &m0);
         return PLX_E_NOMEM;
     }
     tonemap_thresholds(r->thr);
     r->tm->usable = 0;
+    exposure_table_init(r->et);
     render_code_bind(r, shade);
     *out = r;
     return PLX_OK;
@@ -1374,31 +1377,42 @@ static void corners_rest(render *r, const render_opts *o, render_stats *st)
 }
 
 /* Pixel row j's ground pixels get the ground's id (pixel_hit writes it;
- * each pixel on its own: render_job_fn). */
-static void ground_row(void *arg, int worker, uint32_t j)
+ * each pixel on its own). The camera's right vector is horizontal
+ * (setup_camera: rt[2] = 0), so a pixel's direction has the same height
+ * along a row, bit for bit: one pixel_dir a row decides it. */
+static void ground_row(render *r, int32_t j)
 {
-    render *r = arg;
+    uint32_t *id = &r->id[(size_t)j * (size_t)r->w];
     double d[3];
     int32_t i;
-    (void)worker;
-    for (i = 0; i < r->w; i++) {
-        uint32_t *id = &r->id[(size_t)j * (size_t)r->w + (size_t)i];
-        if (*id != MESH_SURF_NONE)
-            continue;
-        pixel_dir(r, i, (int32_t)j, d);   /* as pixel_hit decides */
-        if (d[2] < 0.0)
-            *id = MESH_SURF_GROUND;
+    if (r->rt[2] != 0.0) { /* (not made by setup_camera) each pixel as pixel_hit decides */
+        for (i = 0; i < r->w; i++) {
+            pixel_dir(r, i, j, d);
+            if (id[i] == MESH_SURF_NONE && d[2] < 0.0)
+                id[i] = MESH_SURF_GROUND;
+        }
+        return;
     }
+    pixel_dir(r, 0, j, d); /* as pixel_hit decides, for every pixel of the row */
+#ifdef PLX_DEBUG
+    for (i = 0; i < r->w; i++) {
+        double di[3];
+        pixel_dir(r, i, j, di);
+        PLX_ASSERT((di[2] < 0.0) == (d[2] < 0.0));
+    }
+#endif
+    if (!(d[2] < 0.0))
+        return;
+    for (i = 0; i < r->w; i++)
+        if (id[i] == MESH_SURF_NONE)
+            id[i] = MESH_SURF_GROUND;
 }
 
-static void ground_ids(render *r, const render_opts *o)
+static void ground_ids(render *r)
 {
-    uint32_t j;
-    int nw = par_workers(o);
-    if (nw > 1 && o->par(o->par_ctx, nw, (uint32_t)r->h, ground_row, r) == 0)
-        return;
-    for (j = 0; j < (uint32_t)r->h; j++)
-        ground_row(r, 0, j);
+    int32_t j;
+    for (j = 0; j < r->h; j++)
+        ground_row(r, j);
 }
 
 /* Whether a pixel of block (a, b), its far corners included, is shaded
@@ -1428,7 +1442,7 @@ static void sparse_corners(render *r, const render_opts *o, render_stats *st)
     row[0] = r->crow;
     row[1] = r->crow + r->nbx + 1;
     int tries = try_workers(o) > 0;
-    ground_ids(r, o);
+    ground_ids(r);
     corner_row(r, 0, row[0]);
     for (b = 0; b < r->nby; b++) {
         corner_row(r, b + 1, row[(b + 1) & 1]);
@@ -1877,7 +1891,7 @@ static void exposure_part(void *arg, int worker, uint32_t k)
     size_t px = (size_t)r->w * (size_t)r->h, p0 = px * k / RENDER_MAX_WORKERS, p1 = px * (k + 1) / RENDER_MAX_WORKERS;
     (void)worker;
     memset(r->hist[k], 0, sizeof r->hist[k]);
-    exposure_count(r->lin, r->id, p0, p1, r->hist[k]);
+    exposure_count_table(r->et, r->lin, r->id, p0, p1, r->hist[k]);
 }
 
 /* exposure_auto over the frame, its parts counted on the workers (the

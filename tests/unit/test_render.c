@@ -1432,12 +1432,14 @@ static void test_exposure_parts(void **state)
 {
     enum { N = 20000 };
     float *lin = malloc(sizeof *lin * 3 * N);
-    uint32_t *id = malloc(sizeof *id * N), hist[EXPOSURE_BINS];
+    uint32_t *id = malloc(sizeof *id * N), hist[EXPOSURE_BINS], hist2[EXPOSURE_BINS];
     double *y = malloc(sizeof *y * N);
+    exposure_table *et = malloc(sizeof *et);
     uint64_t seed = 7;
     int round;
     (void)state;
-    assert_true(lin && id && y);
+    assert_true(lin && id && y && et);
+    exposure_table_init(et);
     for (round = 0; round < 40; round++) {
         size_t p, n = 0, cut[8];
         double e, yp;
@@ -1473,10 +1475,73 @@ static void test_exposure_parts(void **state)
         for (k = 0; k < 7; k++)
             exposure_count(lin, id, cut[k], cut[k + 1], hist);
         assert_true(exposure_from(hist) == e);
+        /* the table's counts (what frames use) are the same */
+        memset(hist2, 0, sizeof hist2);
+        for (k = 0; k < 7; k++)
+            exposure_count_table(et, lin, id, cut[k], cut[k + 1], hist2);
+        assert_memory_equal(hist, hist2, sizeof hist);
     }
     free(lin);
     free(id);
     free(y);
+    free(et);
+}
+
+static double from_dbits(uint64_t u)
+{
+    double x;
+    memcpy(&x, &u, sizeof x);
+    return x;
+}
+
+/* The exposure's table of bin thresholds gives exposure_bin's bin for
+ * every luminance tried: 2,000 doubles each side of every threshold, a
+ * million spread log-uniformly over 2^-45 .. 2^45, and the extremes. */
+static void test_exposure_table(void **state)
+{
+    exposure_table *et = malloc(sizeof *et);
+    static const double extreme[] = { 4.9406564584124654e-324, 2.2250738585072014e-308, 1e-300, 1e-20,
+                                      0x1p-32, 0x1p32, 1e20, 1e300, 1.7976931348623157e308 };
+    uint64_t seed = 77;
+    uint32_t h1[EXPOSURE_BINS], h2[EXPOSURE_BINS];
+    float lin[3];
+    uint32_t id = 1;
+    size_t i;
+    int k, d;
+    (void)state;
+    assert_non_null(et);
+    exposure_table_init(et);
+    for (k = 1; k < EXPOSURE_BINS; k++) {
+        uint64_t t;
+        memcpy(&t, &et->t[k], sizeof t);
+        assert_true(exposure_bin(et->t[k]) >= k);
+        assert_true(exposure_bin(from_dbits(t - 1)) < k);
+        for (d = -2000; d <= 2000; d++) {
+            double y = from_dbits(t + (uint64_t)(int64_t)d);
+            int b = et->hint[(t + (uint64_t)(int64_t)d) >> 49];
+            while (b + 1 < EXPOSURE_BINS && y >= et->t[b + 1])
+                b++;
+            if (b != exposure_bin(y))
+                fail_msg("y %.17g: table bin %d, exposure_bin %d", y, b, exposure_bin(y));
+        }
+    }
+    /* through exposure_count_table itself: luminances of grey pixels */
+    for (i = 0; i < 1000000 + sizeof extreme / sizeof extreme[0]; i++) {
+        double y;
+        if (i < 1000000) {
+            seed = seed * 6364136223846793005ull + 1442695040888963407ull;
+            lin[0] = lin[1] = lin[2] = (float)exp2(((double)(seed >> 11) / 9007199254740992.0) * 90.0 - 45.0);
+        } else
+            lin[0] = lin[1] = lin[2] = (float)extreme[i - 1000000];
+        y = 0.2126 * lin[0] + 0.7152 * lin[1] + 0.0722 * lin[2];
+        memset(h1, 0, sizeof h1);
+        memset(h2, 0, sizeof h2);
+        exposure_count(lin, &id, 0, 1, h1);
+        exposure_count_table(et, lin, &id, 0, 1, h2);
+        if (memcmp(h1, h2, sizeof h1) != 0)
+            fail_msg("luminance %.17g: the table counts another bin", y);
+    }
+    free(et);
 }
 
 int main(void)
@@ -1488,6 +1553,7 @@ int main(void)
         cmocka_unit_test(test_backends_agree),
         cmocka_unit_test(test_tiled_light_same),
         cmocka_unit_test(test_sparse_indirect),
+        cmocka_unit_test(test_exposure_table),
         cmocka_unit_test(test_cull_equal_street),
         cmocka_unit_test(test_cull_equal_above_roofs),
         cmocka_unit_test(test_cull_over_low_roof),
