@@ -139,7 +139,8 @@ size_t render_bytes(const scene *s, int32_t max_w, int32_t max_h)
     size_t px = (size_t)max_w * (size_t)max_h;
     size_t tiles = (size_t)((max_w + RENDER_TILE - 1) / RENDER_TILE) * (size_t)((max_h + RENDER_TILE - 1) / RENDER_TILE);
     size_t corners = (size_t)(max_w / IND_STEP + 2) * (size_t)(max_h / IND_STEP + 2);
-    return px * 20 + tiles + (size_t)s->nbld * (2 * sizeof(cull_item) + 17) + RENDER_BINS * 8 + sizeof(tonemap_table) + 8 + sizeof(exposure_table) + 8 +
+    return px * 20 + tiles + (size_t)s->nbld * (2 * sizeof(cull_item) + 17) + RENDER_BINS * 8 +
+           sizeof(tonemap_table) + 8 + sizeof(exposure_table) + 8 +
            corners * (1 + 3 * sizeof(float)) + 2 * (size_t)(max_w / IND_STEP + 2) * sizeof(corner_hit) + render_surf_slots(s, max_w, max_h) * (sizeof(uint32_t) + sizeof(mesh_surf)) +
            stop_rows(max_h) * sizeof(int32_t) +
            sizeof(render) + 4096;
