@@ -3,6 +3,7 @@
 #include <math.h>
 #include <string.h>
 
+#include "base/bits.h"
 #include "photon/irradiance_cache.h"
 #include "photon/final_gather.h"
 #include "photon/indirect.h"
@@ -101,13 +102,6 @@ void icache_clear(icache *c)
     c->gathered = c->direct = c->flushes = 0;
 }
 
-static uint64_t dbits(double x)
-{
-    uint64_t b;
-    memcpy(&b, &x, sizeof b);
-    return b;
-}
-
 /* What the records were gathered from: any new photon frame, reset or
  * refined lamp changes these sums and counts. */
 static uint64_t photon_stamp(const photon_sys *ps)
@@ -115,13 +109,13 @@ static uint64_t photon_stamp(const photon_sys *ps)
     const photon_stats *st = &ps->st;
     uint64_t h = mix64(st->frames ^ 0x5eedull);
     h = mix64(h ^ st->photons);
-    h = mix64(h ^ dbits(st->emitted));
-    h = mix64(h ^ dbits(st->arrived));
-    h = mix64(h ^ dbits(st->stored_chart));
-    h = mix64(h ^ dbits(st->stored_aerial));
+    h = mix64(h ^ bits_of_double(st->emitted));
+    h = mix64(h ^ bits_of_double(st->arrived));
+    h = mix64(h ^ bits_of_double(st->stored_chart));
+    h = mix64(h ^ bits_of_double(st->stored_aerial));
     h = mix64(h ^ st->lamp_refined);
     h = mix64(h ^ st->aerial_restarts);
-    return mix64(h ^ dbits(ps->flux_total));
+    return mix64(h ^ bits_of_double(ps->flux_total));
 }
 
 /* A wall probe: the edge whose wall is within 2 cm behind P along -n. */
@@ -277,27 +271,29 @@ static const icache_rec *record(icache *c, photon_sys *ps, light *L, const plane
 
 /* Vertex v (0..3: +a, +2b) of cell (i, j) at level l: from the level's
  * last cell when it is this one, else from the table (record). */
+/* lc made cell (i, j) of pl's surface, emptied when it was another
+ * (or none: the table was emptied). */
+static void cell_at(icache_cell *lc, const plane *pl, int64_t i, int64_t j)
+{
+    if (lc->set && lc->code == pl->code && lc->i == i && lc->j == j)
+        return;
+    memset(lc, 0, sizeof *lc);
+    lc->set = ICACHE_CELL_SET;
+    lc->code = pl->code;
+    lc->i = i;
+    lc->j = j;
+}
+
 static const icache_rec *cell_record(icache *c, photon_sys *ps, light *L, const plane *pl, int l,
                                      int64_t i, int64_t j, int v)
 {
     icache_cell *lc = &c->last[l];
     const icache_rec *r;
-    if (!lc->set || lc->code != pl->code || lc->i != i || lc->j != j) {
-        memset(lc, 0, sizeof *lc);
-        lc->set = ICACHE_CELL_SET;
-        lc->code = pl->code;
-        lc->i = i;
-        lc->j = j;
-    }
+    cell_at(lc, pl, i, j);
     if (lc->r[v])
         return &c->tab[lc->r[v] - 1];
     r = record(c, ps, L, pl, l, i + (v & 1), j + (v >> 1));
-    if (!lc->set) { /* the table was emptied to make room: this cell again */
-        lc->set = ICACHE_CELL_SET;
-        lc->code = pl->code;
-        lc->i = i;
-        lc->j = j;
-    }
+    cell_at(lc, pl, i, j); /* the table was emptied to make room: this cell again */
     lc->r[v] = (uint32_t)(r - c->tab) + 1;
     return r;
 }
@@ -313,13 +309,7 @@ static const icache_rec *peek_record(const icache *c, icache_cell *last, const p
     int64_t vi = i + (v & 1), vj = j + (v >> 1);
     icache_rec *r;
     uint64_t k2;
-    if (!lc->set || lc->code != pl->code || lc->i != i || lc->j != j) {
-        memset(lc, 0, sizeof *lc);
-        lc->set = ICACHE_CELL_SET;
-        lc->code = pl->code;
-        lc->i = i;
-        lc->j = j;
-    }
+    cell_at(lc, pl, i, j);
     if (lc->r[v]) {
         r = &c->tab[lc->r[v] - 1];
         if ((r->flags & REC_USED) && r->k1 == pl->code && r->k2 == key2(c, l, vi, vj))

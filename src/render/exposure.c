@@ -13,6 +13,7 @@
 #include <math.h>
 #include <string.h>
 
+#include "base/bits.h"
 #include "render/exposure.h"
 
 #define BINS EXPOSURE_BINS
@@ -41,33 +42,19 @@ void exposure_count(const float *lin, const uint32_t *id, size_t p0, size_t p1, 
     }
 }
 
-static uint64_t dbits(double x)
-{
-    uint64_t u;
-    memcpy(&u, &x, sizeof u);
-    return u;
-}
-
-static double from_dbits(uint64_t u)
-{
-    double x;
-    memcpy(&x, &u, sizeof x);
-    return x;
-}
-
 /* The smallest positive double whose bin is at least k (1 .. BINS - 1),
  * by bisection of the bits between 2^-40 (bin 0) and 2^40 (the last). */
 static double first_of_bin(int k)
 {
-    uint64_t lo = dbits(0x1p-40), hi = dbits(0x1p40);
+    uint64_t lo = bits_of_double(0x1p-40), hi = bits_of_double(0x1p40);
     while (hi - lo > 1) {
         uint64_t mid = lo + (hi - lo) / 2;
-        if (exposure_bin(from_dbits(mid)) >= k)
+        if (exposure_bin(double_of_bits(mid)) >= k)
             hi = mid;
         else
             lo = mid;
     }
-    return from_dbits(hi);
+    return double_of_bits(hi);
 }
 
 void exposure_table_init(exposure_table *et)
@@ -78,7 +65,7 @@ void exposure_table_init(exposure_table *et)
     for (k = 1; k < BINS; k++)
         et->t[k] = first_of_bin(k);
     for (h = 0, k = 1; h < EXPOSURE_HINTS; h++) {
-        while (k < BINS && dbits(et->t[k]) <= (uint64_t)h << 49)
+        while (k < BINS && bits_of_double(et->t[k]) <= (uint64_t)h << 49)
             k++;
         et->hint[h] = (uint16_t)(k - 1);
     }
@@ -93,7 +80,7 @@ void exposure_count_table(const exposure_table *et, const float *lin, const uint
         int b;
         if (id[p] == EXPOSURE_SKY || !(y > 0.0) || !isfinite(y))
             continue;
-        b = et->hint[dbits(y) >> 49];
+        b = et->hint[bits_of_double(y) >> 49];
         while (b + 1 < BINS && y >= et->t[b + 1])
             b++;
         hist[b]++;

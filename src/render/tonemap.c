@@ -13,6 +13,7 @@
 #include <math.h>
 #include <string.h>
 
+#include "base/bits.h"
 #include "render/exposure.h"
 #include "render/tonemap.h"
 
@@ -53,24 +54,10 @@ uint8_t tonemap_value(const double thr[TONEMAP_LEVELS], float x, double ex, int 
     return tonemap_srgb8(thr, v);
 }
 
-static float from_bits(uint32_t u)
-{
-    float f;
-    memcpy(&f, &u, sizeof f);
-    return f;
-}
-
-static uint32_t to_bits(float f)
-{
-    uint32_t u;
-    memcpy(&u, &f, sizeof u);
-    return u;
-}
-
 /* Whether the positive float of bits u has a byte above k. */
 static int above(const double thr[TONEMAP_LEVELS], double ex, int curve, uint32_t u, int k)
 {
-    return tonemap_value(thr, from_bits(u), ex, curve) > k;
+    return tonemap_value(thr, float_of_bits(u), ex, curve) > k;
 }
 
 /* The linear value whose curve is y (y < 1: the stable root of
@@ -125,7 +112,7 @@ static uint32_t guess_bits(double y, double ex, int curve)
         return 1;
     if (!(x < (double)FLT_MAX))
         return FLOAT_INF_BITS - 1;
-    return to_bits((float)x);
+    return bits_of_float((float)x);
 }
 
 void tonemap_table_set(tonemap_table *t, const double thr[TONEMAP_LEVELS], double ex, int curve)
@@ -161,7 +148,7 @@ void tonemap_apply(const tonemap_table *t, const double thr[TONEMAP_LEVELS], con
         return;
     }
     for (p = p0; p < p1; p++) {
-        uint32_t u = to_bits(lin[p]);
+        uint32_t u = bits_of_float(lin[p]);
         int b;
         if (u - 1u >= FLOAT_INF_BITS - 1u) { /* zero, negative, infinite, NaN */
             rgb8[p] = u == 0 ? 0 : tonemap_value(thr, lin[p], t->ex, t->curve);

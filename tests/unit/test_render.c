@@ -43,6 +43,7 @@
 #include "render/render.h"
 #include "render/mesh.h"
 #include "render/exposure.h"
+#include "base/bits.h"
 #include "light/illuminance.h"
 #include "light/litregion.h"
 #include "base/geom.h"
@@ -1487,12 +1488,6 @@ static void test_exposure_parts(void **state)
     free(et);
 }
 
-static double from_dbits(uint64_t u)
-{
-    double x;
-    memcpy(&x, &u, sizeof x);
-    return x;
-}
 
 /* The exposure's table of bin thresholds gives exposure_bin's bin for
  * every luminance tried: 2,000 doubles each side of every threshold, a
@@ -1515,9 +1510,9 @@ static void test_exposure_table(void **state)
         uint64_t t;
         memcpy(&t, &et->t[k], sizeof t);
         assert_true(exposure_bin(et->t[k]) >= k);
-        assert_true(exposure_bin(from_dbits(t - 1)) < k);
+        assert_true(exposure_bin(double_of_bits(t - 1)) < k);
         for (d = -2000; d <= 2000; d++) {
-            double y = from_dbits(t + (uint64_t)(int64_t)d);
+            double y = double_of_bits(t + (uint64_t)(int64_t)d);
             int b = et->hint[(t + (uint64_t)(int64_t)d) >> 49];
             while (b + 1 < EXPOSURE_BINS && y >= et->t[b + 1])
                 b++;

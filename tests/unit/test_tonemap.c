@@ -15,25 +15,13 @@
 #include <string.h>
 #include <cmocka.h>
 
+#include "base/bits.h"
 #include "render/tonemap.h"
 
 #define SPREAD 4099u   /* a stride through the positive float bits */
 #define NEAR 300u      /* floats each side of a threshold */
 #define BUF 4096
 
-static float from_bits(uint32_t u)
-{
-    float f;
-    memcpy(&f, &u, sizeof f);
-    return f;
-}
-
-static unsigned bits_of(float f)
-{
-    uint32_t u;
-    memcpy(&u, &f, sizeof u);
-    return (unsigned)u;
-}
 
 typedef struct batch {
     float x[BUF];
@@ -51,7 +39,7 @@ static void flush(batch *b, const tonemap_table *t, const double *thr, double ex
         uint8_t want = tonemap_value(thr, b->x[i], ex, curve);
         if (b->got[i] != want)
             fail_msg("ex %g curve %d: %.9g (bits %08x) gives %u, not %u", ex, curve, (double)b->x[i],
-                     bits_of(b->x[i]), b->got[i], want);
+                     (unsigned)bits_of_float(b->x[i]), b->got[i], want);
         b->lit += want > 0 && want < 255;
     }
     b->checked += b->n;
@@ -79,13 +67,13 @@ static void check_exposure(const double *thr, double ex, int curve, int usable)
     tonemap_table_set(&t, thr, ex, curve);
     assert_int_equal(t.usable, usable);
     for (u = 1; u < 0x7f800000u; u += SPREAD)
-        add(&b, &t, thr, ex, curve, from_bits((uint32_t)u));
+        add(&b, &t, thr, ex, curve, float_of_bits((uint32_t)u));
     if (usable)
         for (k = 0; k < TONEMAP_LEVELS; k++)
             for (d = 0; d < 2 * NEAR; d++) {
                 int64_t v = (int64_t)t.f[k] - NEAR + d;
                 if (v >= 1 && v < 0x7f800000)
-                    add(&b, &t, thr, ex, curve, from_bits((uint32_t)v));
+                    add(&b, &t, thr, ex, curve, float_of_bits((uint32_t)v));
             }
     for (i = 0; i < sizeof special / sizeof special[0]; i++)
         add(&b, &t, thr, ex, curve, special[i]);
@@ -128,19 +116,19 @@ static void test_boundaries(void **state)
     tonemap_table_set(&t, thr, 0.37, 1);
     assert_true(t.usable);
     for (k = 0; k < TONEMAP_LEVELS; k++) {
-        assert_true(tonemap_value(thr, from_bits(t.f[k]), 0.37, 1) > k);
-        assert_true(tonemap_value(thr, from_bits(t.f[k] - 1), 0.37, 1) <= k);
+        assert_true(tonemap_value(thr, float_of_bits(t.f[k]), 0.37, 1) > k);
+        assert_true(tonemap_value(thr, float_of_bits(t.f[k] - 1), 0.37, 1) <= k);
         if (k > 0)
             assert_true(t.f[k] >= t.f[k - 1]);
     }
     /* the same exposure again keeps the table; another makes a new one */
     t.f[0] ^= 1;
     tonemap_table_set(&t, thr, 0.37, 1);
-    assert_true(tonemap_value(thr, from_bits(t.f[0]), 0.37, 1) == 0 ||
-                tonemap_value(thr, from_bits(t.f[0] - 1), 0.37, 1) > 0);
+    assert_true(tonemap_value(thr, float_of_bits(t.f[0]), 0.37, 1) == 0 ||
+                tonemap_value(thr, float_of_bits(t.f[0] - 1), 0.37, 1) > 0);
     tonemap_table_set(&t, thr, 0.38, 1);
-    assert_true(tonemap_value(thr, from_bits(t.f[0]), 0.38, 1) > 0);
-    assert_true(tonemap_value(thr, from_bits(t.f[0] - 1), 0.38, 1) == 0);
+    assert_true(tonemap_value(thr, float_of_bits(t.f[0]), 0.38, 1) > 0);
+    assert_true(tonemap_value(thr, float_of_bits(t.f[0] - 1), 0.38, 1) == 0);
 }
 
 int main(void)
