@@ -1386,14 +1386,7 @@ static void ground_row(render *r, int32_t j)
     uint32_t *id = &r->id[(size_t)j * (size_t)r->w];
     double d[3];
     int32_t i;
-    if (r->rt[2] != 0.0) { /* (not made by setup_camera) each pixel as pixel_hit decides */
-        for (i = 0; i < r->w; i++) {
-            pixel_dir(r, i, j, d);
-            if (id[i] == MESH_SURF_NONE && d[2] < 0.0)
-                id[i] = MESH_SURF_GROUND;
-        }
-        return;
-    }
+    PLX_ASSERT(r->rt[2] == 0.0);
     pixel_dir(r, 0, j, d); /* as pixel_hit decides, for every pixel of the row */
 #ifdef PLX_DEBUG
     for (i = 0; i < r->w; i++) {
@@ -1848,12 +1841,6 @@ static void glow_mark(const render *r, uint8_t *mask)
     }
 }
 
-void render_tonemap(const render *r, const float *lin, size_t px, double ex, int curve, uint8_t *rgb8)
-{
-    size_t p;
-    for (p = 0; p < 3 * px; p++)
-        rgb8[p] = tonemap_value(r->thr, lin[p], ex, curve);
-}
 
 #define TONEMAP_CHUNK 65536     /* values a job */
 

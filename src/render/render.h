@@ -359,11 +359,9 @@ plx_status render_frame(render *r, const render_camera *cam, const render_opts *
 
 /* Tone mapping of px pixels of linear RGB: times ex, through the tone
  * curve when curve (exposure.h), into sRGB bytes (SPEC §5's exact
- * thresholds). What render_frame does to its own image. */
-void render_tonemap(const render *r, const float *lin, size_t px, double ex, int curve,
-                    uint8_t *rgb8 /* OUT */);
-/* The same on o's parallel-for, from a table of the exposure's float
- * thresholds (tonemap.h; each value on its own: the same bytes). */
+ * thresholds), on o's parallel-for; what render_frame does to its own
+ * image. From a table of the exposure's float thresholds (tonemap.h:
+ * tonemap_value's bytes, each value on its own). */
 void render_tonemap_par(render *r, const float *lin, size_t px, double ex, int curve,
                         uint8_t *rgb8 /* OUT */, const render_opts *o);
 
