@@ -113,6 +113,11 @@ static int load_engine(const bake_args *a, int twin, plx_engine **e)
         free(block);
         return cli_exit_code(st);
     }
+    if (twin) { /* the command's own notes too (no lamps, ...) */
+        cli_common quiet = a->c;
+        quiet.quiet = 1;
+        return cli_load_scene("bake", a->scene, &quiet, e);
+    }
     return cli_load_scene("bake", a->scene, &a->c, e);
 }
 

@@ -23,7 +23,7 @@ static const char help[] =
     "PNG, 1/F s each, looping) and DIR/contact.png (a contact sheet\n"
     "of up to 16 frames). Everything is built once (or loaded from a bake) and\n"
     "reused by every frame. Prints the render time per frame (median, p95)\n"
-    "and frames per second.\n"
+    "and frames per second; says on stderr how many frames are entirely black, if any.\n"
     "\n"
     "  --path FILE      a GeoJSON LineString of eye positions [x, y] or [x, y, z]\n"
     "                   (z default 1.7 m); the eye looks 10 m ahead along the path,\n"
@@ -240,6 +240,7 @@ typedef struct walk_run {
     uint8_t *buf[2];           /* with the writer: frame k is rendered into buf[k & 1] */
     frame_writer fw;
     int writer;                /* 1: frames written on the writer's thread */
+    long black, first_black;   /* frames entirely black: how many, the first (1-based) */
 } walk_run;
 
 /* After the first frame (the engine at its peak): the frames are written
@@ -300,6 +301,14 @@ static int writer_end(walk_run *wr, int rc)
     return rc;
 }
 
+static int all_black(const uint8_t *px, size_t n)
+{
+    size_t k;
+    for (k = 0; k < n && px[k] == 0; k++)
+        ;
+    return k == n;
+}
+
 static int frame(const walk_args *a, plx_engine *e, const walk_path *wp, walk_run *wr, long k, double step)
 {
     plx_camera cam;
@@ -335,6 +344,8 @@ static int frame(const walk_args *a, plx_engine *e, const walk_path *wp, walk_ru
                 cam.eye[2], plx_last_error(e));
         return cli_exit_code(st);
     }
+    if (all_black(wr->rgb8, (size_t)a->w * a->h * 3) && wr->black++ == 0)
+        wr->first_black = k + 1;
     fprintf(wr->cams, "%ld %.17g %.17g %.17g %.17g %.17g %.17g %.6g\n", k + 1, cam.eye[0], cam.eye[1], cam.eye[2],
             cam.target[0], cam.target[1], cam.target[2], info.exposure);
     if (k == 0)
@@ -435,6 +446,11 @@ static int run(const walk_args *a, plx_engine *e, const walk_path *wp)
                    "%.1f ms in all (floor maps and refill frames)\n", (unsigned long long)wr.rs.hits,
                    (unsigned long long)wr.rs.misses, (unsigned long long)wr.rs.evictions,
                    (unsigned long long)wr.rs.refined, wr.rs.slots, wr.rs.near_radius, wr.refine_ms);
+        if (wr.black == wr.n)
+            cli_warn("walk", &a->c, "every frame is entirely black: %s", cli_dark_reason(e));
+        else if (wr.black)
+            cli_warn("walk", &a->c, "%ld of %ld frames are entirely black (the first: frame %ld): %s", wr.black,
+                     wr.n, wr.first_black, cli_dark_reason(e));
     }
     if (wr.cams)
         fclose(wr.cams);

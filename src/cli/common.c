@@ -297,7 +297,8 @@ void cli_warn(const char *cmd, const cli_common *c, const char *fmt, ...)
 /* Commands whose results are light: they say so when the scene has none. */
 static int computes_light(const char *cmd)
 {
-    static const char *const names[] = { "illum", "lit", "heatmap", "render", "route", "dark-spots", "meter" };
+    static const char *const names[] = { "illum", "lit", "heatmap", "render", "route", "dark-spots", "meter",
+                                         "walk", "tiles", "annotate", "bake" };
     size_t i;
     for (i = 0; i < sizeof names / sizeof names[0]; i++)
         if (strcmp(cmd, names[i]) == 0)
@@ -305,14 +306,19 @@ static int computes_light(const char *cmd)
     return 0;
 }
 
-static void note_no_lamps(const char *cmd, const char *path, const cli_common *c, plx_engine *e)
+/* A bake (baked 1) takes no --lamps: its lamps come from 'polarlux bake'. */
+static void note_no_lamps(const char *cmd, const char *path, const cli_common *c, plx_engine *e, int baked)
 {
     plx_scene_info si;
     if (!computes_light(cmd) || plx_scene_info_get(e, &si) != PLX_OK || si.lamps > 0)
         return;
-    cli_warn(cmd, c, "%s has no lamps%s, so every result is dark (0 lx); add lamps as Point features "
-             "with \"lamp\": true, or from another file with --lamps FILE", path,
-             si.skipped_lamps ? " (all were left out, see the warnings above)" : "");
+    if (baked)
+        cli_warn(cmd, c, "%s has no lamps, so every result is dark (0 lx); bake a scene with lamps "
+                 "(Point features with \"lamp\": true, or 'polarlux bake SCENE --lamps FILE')", path);
+    else
+        cli_warn(cmd, c, "%s has no lamps%s, so every result is dark (0 lx); add lamps as Point features "
+                 "with \"lamp\": true, or from another file with --lamps FILE", path,
+                 si.skipped_lamps ? " (all were left out, see the warnings above)" : "");
 }
 
 const char *cli_dark_reason(plx_engine *e)
@@ -449,6 +455,7 @@ static int open_bake(const char *cmd, const char *path, const cli_common *c, plx
     cli_bake_last.loaded = 1;
     cli_bake_last.bytes = len;
     cli_bake_last.load_ns = port_now_ns() - t0;
+    note_no_lamps(cmd, path, c, *e, 1);
     return EXIT_OK;
 }
 
@@ -504,7 +511,7 @@ int cli_load_scene(const char *cmd, const char *path, const cli_common *c, plx_e
             return rc;
         }
     }
-    note_no_lamps(cmd, path, c, *e);
+    note_no_lamps(cmd, path, c, *e, 0);
     return rc;
 }
 

@@ -15,6 +15,16 @@ expect dark-spots-no-lamps 0 "no street point is within a lamp's reach \(the sce
 expect dark-render-street 1 "the scene has no lamps, so the default street view" -- "$bin" render "$tmp/nolamp.geojson" --frames 1 -o "$tmp/dark.png"
 expect dark-render-black 0 "the image is entirely black: the scene has no lamps" -- "$bin" render "$tmp/nolamp.geojson" --view aerial --size 32x24 --frames 1 -o "$tmp/dark.png"
 expect dark-illum 0 "every point is dark \(0 lx\): the scene has no lamps" -- sh -c "echo '30 30' | '$bin' illum --frames 1 '$tmp/nolamp.geojson' --points -"
+echo '{"type":"Feature","properties":{},"geometry":{"type":"LineString","coordinates":[[30,12,1.7],[-400,12,1.7]]}}' >"$tmp/away.geojson"
+expect dark-walk-no-lamps 0 "nolamp\.geojson has no lamps, so every result is dark" -- "$bin" walk "$tmp/nolamp.geojson" --path "$tmp/away.geojson" --speed 100 --fps 1 --size 16x12 --no-indirect -o "$tmp/dwalk"
+expect dark-walk-every-frame 0 "warning: every frame is entirely black: the scene has no lamps" -- "$bin" walk "$tmp/nolamp.geojson" --path "$tmp/away.geojson" --speed 100 --fps 1 --size 16x12 --no-indirect -o "$tmp/dwalk"
+# walking away from tiny's lamps, looking ahead: the first frame lit, the four after it black
+expect dark-walk-some-frames 0 "warning: 4 of 5 frames are entirely black \(the first: frame 2\): no lamp's light reaches it" -- "$bin" walk fixtures/tiny.geojson --path "$tmp/away.geojson" --speed 100 --fps 1 --size 32x24 --no-indirect --no-glow -o "$tmp/dwalk2"
+expect dark-walk-lit-silent 0 "" -- "$bin" walk fixtures/tiny.geojson --path "$tmp/away.geojson" --speed 100 --fps 1 --size 32x24 --no-indirect --no-glow --max-frames 1 -o "$tmp/dwalk3"
+if grep -q "black" "$tmp/out"; then echo "FAIL dark-walk-lit-silent: a lit frame was called black"; fail=$((fail + 1)); fi
+expect dark-bake-no-lamps 0 "nolamp\.geojson has no lamps, so every result is dark" -- "$bin" bake "$tmp/nolamp.geojson" --frames 1 -o "$tmp/nolamp.plxb"
+if [ "$(grep -c "has no lamps" "$tmp/out")" != 1 ]; then echo "FAIL dark-bake-once: the note is not printed once (the twin's load is quiet)"; fail=$((fail + 1)); fi
+expect dark-bake-walk 0 "nolamp\.plxb has no lamps, so every result is dark \(0 lx\); bake a scene with lamps" -- "$bin" walk "$tmp/nolamp.plxb" --path "$tmp/away.geojson" --speed 100 --fps 1 --size 16x12 --no-indirect -o "$tmp/dwalk4"
 expect dark-vis-silent 0 "" -- "$bin" vis fixtures/tiny.geojson --at 30,30
 if grep -q "no lamps" "$tmp/out"; then echo "FAIL dark-vis-silent: vis warned about lamps"; fail=$((fail + 1)); fi
 expect dark-quiet 0 "" -- "$bin" heatmap -q "$tmp/nolamp.geojson" --res 1 -o "$tmp/dark.png"
