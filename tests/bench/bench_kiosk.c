@@ -12,7 +12,12 @@
  *  - loading the bake into a block touched beforehand (median of 5);
  *  - a street walk (640x480, indirect, one sample per pixel) and an aerial
  *    walk (1024x768) from the loaded engine: median and p95 per frame,
- *    with one thread and then with two (the POSIX port's parallel-for).
+ *    with one thread and then with two (the POSIX port's parallel-for);
+ *  - the floor: the same cameras over the same city without its lamps and
+ *    with no indirect light, a new engine from the GeoJSON, on 1 and 2
+ *    threads: what a frame costs with no light to compute (culling,
+ *    rasterising, hit points, exposure, tone mapping). PLX_BENCH_FLOOR_ONLY
+ *    set: that alone.
  * Wall-clock and CPU times (the baseline's of its thread, the bakes' and
  * the walks' of the process, every thread): the build machine is shared,
  * CPU time is the steadier figure. PLX_BENCH_FRAMES photon frames of 65,536
@@ -50,6 +55,38 @@ static double proc_ms(void)
 static double wall_ms(void)
 {
     return port_now_ns() / 1e6;
+}
+
+/* Whether line p (n bytes) holds the string k. */
+static int line_has(const char *p, size_t n, const char *k)
+{
+    size_t i, m = strlen(k);
+    for (i = 0; i + m <= n; i++)
+        if (memcmp(p + i, k, m) == 0)
+            return 1;
+    return 0;
+}
+
+/* The generated city without its lamps: plx_gen_city writes the header, a
+ * feature a line (a lamp's holds "lamp":true) and the closing line. */
+static int without_lamps(const text *in, text *out)
+{
+    const char *p = in->buf, *end = in->buf + in->len;
+    size_t kept = 0;
+    while (p < end) {
+        const char *nl = memchr(p, '\n', (size_t)(end - p));
+        size_t n = nl ? (size_t)(nl - p) : (size_t)(end - p);
+        if (n >= 17 && strncmp(p, "{\"type\":\"Feature\"", 17) == 0) {
+            if (!line_has(p, n, "\"lamp\":true")) {
+                if ((kept++ > 0 && append(out, ",\n", 2) != 0) || append(out, p, p[n - 1] == ',' ? n - 1 : n) != 0)
+                    return -1;
+            }
+        } else if ((kept > 0 && append(out, "\n", 1) != 0) || append(out, p, n) != 0 || append(out, "\n", 1) != 0) {
+            return -1;
+        }
+        p += n + (nl ? 1 : 0);
+    }
+    return 0;
 }
 
 static int cmp_double(const void *x, const void *y)
@@ -121,7 +158,7 @@ static void aerial_cam(plx_camera *c, double s)
  * process CPU per frame, and the first frame's wall-clock time before
  * them; aa x aa samples (full: every pixel all of them). */
 static void walk(plx_engine *e, int aerial, int aa, int full, int n, uint8_t *rgb8, double *med, double *p95,
-                 double *cpu, double *first)
+                 double *cpu, double *first, int indirect)
 {
     double *t = malloc(sizeof *t * (size_t)n), c0, f0 = wall_ms();
     plx_render_opts o;
@@ -132,6 +169,7 @@ static void walk(plx_engine *e, int aerial, int aa, int full, int n, uint8_t *rg
     o.auto_exposure = 1;
     o.aa = aa;
     o.aa_full = full;
+    o.no_indirect = !indirect;
     if (aerial)
         aerial_cam(&cam0, -4.0);
     else
@@ -227,6 +265,39 @@ static int same_bake(const unsigned char *f, size_t n, const unsigned char *g, s
     return n == m && n > 128 && memcmp(f, g, n) == 0;
 }
 
+/* The floor: the same cameras over the same city without its lamps, no
+ * indirect light: what a frame costs with no light to compute (culling,
+ * rasterising, hit points, exposure, tone mapping), on 1 and 2 threads. */
+static int floor_walks(const text *city, uint8_t *rgb8)
+{
+    text dark = { NULL, 0, 0 };
+    plx_scene_info si;
+    plx_engine *d;
+    void *md;
+    double sm, sp, sc, sf, am, ap, ac, af;
+    int k;
+    if (without_lamps(city, &dark) != 0)
+        return -1;
+    for (k = 1; k <= 2; k++) {
+        if (!(d = engine(&md, 1024, 768, 1, k)) || plx_load_geojson(d, dark.buf, dark.len, "dark") != PLX_OK)
+            return -1;
+        plx_scene_info_get(d, &si);
+        if (si.lamps != 0) {
+            printf("floor: the city still has %u lamps\n", si.lamps);
+            return -1;
+        }
+        walk(d, 0, 1, 0, 20, rgb8, &sm, &sp, &sc, &sf, 0);
+        walk(d, 1, 1, 0, 10, rgb8, &am, &ap, &ac, &af, 0);
+        printf("floor, %d thread%s (the city's %u buildings, no lamps, no indirect light): street 640x480 "
+               "median %.1f ms, CPU %.1f ms/frame; aerial 1024x768 median %.1f ms, CPU %.1f ms/frame\n",
+               k, k > 1 ? "s" : "", si.buildings, sm, sc, am, ac);
+        plx_engine_destroy(d);
+        free(md);
+    }
+    free(dark.buf);
+    return 0;
+}
+
 int main(void)
 {
     text city = { NULL, 0, 0 };
@@ -246,6 +317,8 @@ int main(void)
     if (plx_gen_city("eixample", 30, 30, 1, append, &city) != PLX_OK || !rgb8)
         return 1;
     printf("city: gen eixample 30 30 (%.1f MB of GeoJSON); photons: %d frames x 65,536\n", city.len / 1e6, frames);
+    if (getenv("PLX_BENCH_FLOOR_ONLY")) /* the floor alone (a minute, not several) */
+        return floor_walks(&city, rgb8) != 0;
 
     /* baseline: today's render path from the GeoJSON */
     d = engine(&md, 1024, 768, 1, 1);
@@ -324,8 +397,8 @@ int main(void)
                 return 1;
             }
         }
-        walk(c, 0, 1, 0, 20, rgb8, &sm, &sp, &sc, &sf);
-        walk(c, 1, 1, 0, 10, rgb8, &am, &ap, &ac, &af);
+        walk(c, 0, 1, 0, 20, rgb8, &sm, &sp, &sc, &sf, 1);
+        walk(c, 1, 1, 0, 10, rgb8, &am, &ap, &ac, &af, 1);
         printf("%d thread%s:\n", k + 1, k ? "s" : "");
         printf("  street walk 640x480 with indirect, 20 frames: median %.1f ms, p95 %.1f ms, CPU %.1f ms/frame "
                "(target 10 ms); %.1fx the baseline's first frame (%.0f ms), %.0fx its load + photons + frame; "
@@ -339,8 +412,8 @@ int main(void)
     {
         /* walk's default: 2 x 2 samples, adaptive, against every sample */
         double dm, dp, dc, df, fm, fp, fc, ff;
-        walk(c, 0, 2, 0, 20, rgb8, &dm, &dp, &dc, &df);
-        walk(c, 0, 2, 1, 20, rgb8, &fm, &fp, &fc, &ff);
+        walk(c, 0, 2, 0, 20, rgb8, &dm, &dp, &dc, &df, 1);
+        walk(c, 0, 2, 1, 20, rgb8, &fm, &fp, &fc, &ff, 1);
         printf("2 threads, street walk 640x480 with --aa 2 (walk's default), 20 frames: adaptive median %.1f ms, "
                "CPU %.1f ms/frame; every sample (--aa-full) median %.1f ms, CPU %.1f ms/frame; %.2fx\n",
                dm, dc, fm, fc, fc / dc);
@@ -348,6 +421,9 @@ int main(void)
     plx_engine_destroy(c);
     free(mc);
     free(file);
+
+    if (floor_walks(&city, rgb8) != 0)
+        return 1;
     free(rgb8);
     free(city.buf);
     return 0;
