@@ -100,6 +100,8 @@ int cli_refine(const char *cmd, plx_engine *e, const double eye[3], long frames,
 void cli_warn(const char *cmd, const cli_common *c, const char *fmt, ...);
 /* Why a result is dark: "the scene has no lamps", or that no light reaches it. */
 const char *cli_dark_reason(plx_engine *e);
+/* Whether an 8-bit image of n bytes is entirely black (every byte 0). */
+int cli_all_black(const uint8_t *px, size_t n);
 
 /* After a frame: a warning when the anti-aliasing (o->aa > 1) was to be
  * adaptive but the block had no room for it (every sample taken), or when

@@ -399,13 +399,8 @@ int cmd_render(int argc, char **argv)
     }
     cli_from_local(e, &a.cam.eye[0], &a.cam.eye[1]);
     cli_from_local(e, &a.cam.target[0], &a.cam.target[1]);
-    if (rc == EXIT_OK) {
-        size_t k, npx = (size_t)a.cam.width * a.cam.height * 3;
-        for (k = 0; k < npx && rgb8[k] == 0; k++)
-            ;
-        if (k == npx)
-            cli_warn("render", &a.c, "the image is entirely black: %s", cli_dark_reason(e));
-    }
+    if (rc == EXIT_OK && cli_all_black(rgb8, (size_t)a.cam.width * a.cam.height * 3))
+        cli_warn("render", &a.c, "the image is entirely black: %s", cli_dark_reason(e));
     if (rc == EXIT_OK)
         printf("%s view %dx%d from (%.*f, %.*f, %.1f) to (%.*f, %.*f, %.1f): drew %u of %u buildings "
                "(%.2f%% of the geometry) in %.1f ms, written to %s\n",

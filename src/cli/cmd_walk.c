@@ -301,14 +301,6 @@ static int writer_end(walk_run *wr, int rc)
     return rc;
 }
 
-static int all_black(const uint8_t *px, size_t n)
-{
-    size_t k;
-    for (k = 0; k < n && px[k] == 0; k++)
-        ;
-    return k == n;
-}
-
 static int frame(const walk_args *a, plx_engine *e, const walk_path *wp, walk_run *wr, long k, double step)
 {
     plx_camera cam;
@@ -344,7 +336,7 @@ static int frame(const walk_args *a, plx_engine *e, const walk_path *wp, walk_ru
                 cam.eye[2], plx_last_error(e));
         return cli_exit_code(st);
     }
-    if (all_black(wr->rgb8, (size_t)a->w * a->h * 3) && wr->black++ == 0)
+    if (cli_all_black(wr->rgb8, (size_t)a->w * a->h * 3) && wr->black++ == 0)
         wr->first_black = k + 1;
     fprintf(wr->cams, "%ld %.17g %.17g %.17g %.17g %.17g %.17g %.6g\n", k + 1, cam.eye[0], cam.eye[1], cam.eye[2],
             cam.target[0], cam.target[1], cam.target[2], info.exposure);

@@ -321,6 +321,14 @@ static void note_no_lamps(const char *cmd, const char *path, const cli_common *c
                  si.skipped_lamps ? " (all were left out, see the warnings above)" : "");
 }
 
+int cli_all_black(const uint8_t *px, size_t n)
+{
+    size_t k;
+    for (k = 0; k < n && px[k] == 0; k++)
+        ;
+    return k == n;
+}
+
 const char *cli_dark_reason(plx_engine *e)
 {
     plx_scene_info si;
