@@ -685,6 +685,10 @@ typedef struct plx_render_opts {
                                    aa_full: the later samples only where the first sample's
                                    image has an edge (README "Anti-aliasing") */
     int aa_full;                /* 1: every pixel takes all aa x aa samples */
+    int per_pixel;              /* 1: with indirect light, every pixel's light computed at the
+                                   pixel (exact direct light, the irradiance cache's indirect
+                                   light), not read from the radiance atlas (README "The
+                                   radiance atlas"): slower, shadow edges exact */
 } plx_render_opts;
 
 #define PLX_RENDER_MAX_AA 16

@@ -123,6 +123,7 @@ static void render_opts(void)
     FIELD(plx_render_opts, auto_exposure);
     FIELD(plx_render_opts, aa);
     FIELD(plx_render_opts, aa_full);
+    FIELD(plx_render_opts, per_pixel);
 }
 
 static void render_info(void)

@@ -32,6 +32,8 @@
 #include "photon/irradiance_cache.h"
 #include "polar/polar.h"
 #include "render/render.h"
+#include "render/atlas.h"
+#include "render/atlas_frame.h"
 
 #define BAKE_MAGIC "PLXBAKE\0"
 #define BAKE_VERSION 1u
@@ -122,9 +124,11 @@ static uint32_t layout_print(void)
                           sizeof(plx_config), sizeof(render_opts), render_struct_bytes(),
                           sizeof(render_stats), sizeof(icache), sizeof(polar), sizeof(polar_trap),
                           PLX_PART_COUNT, sizeof(mesh), sizeof(mesh_bld),
-                          sizeof(mesh_surf), RENDER_SURF_CACHE,
-                          3 /* format changes that keep the sizes (bump on such changes): 2 the polar
-                               DAG's wide nodes bit-packed, 3 aerial records keyed apart, 8 m */ };
+                          sizeof(mesh_surf), RENDER_SURF_CACHE, sizeof(atlas), sizeof(atlas_chart),
+                          sizeof(atlas_cache),
+                          4 /* format changes that keep the sizes (bump on such changes): 2 the polar
+                               DAG's wide nodes bit-packed, 3 aerial records keyed apart, 8 m, 4 the
+                               radiance atlas */ };
     uint64_t h = FNV_BASIS;
     size_t i;
     for (i = 0; i < sizeof sz / sizeof sz[0]; i++)
@@ -163,9 +167,16 @@ plx_status plx_bake_prepare(plx_engine *e, const plx_bake_opts *o)
         return st;
     if ((st = eng_need_render(e)) != PLX_OK)
         return st;
-    if (o->aerial && e->lightmap_cell == 0.0 &&
-        (st = eng_need_lightmap(e, o->aerial_m_per_texel, o->twin)) != PLX_OK)
+    if (o->aerial && !o->no_indirect) {
+        /* frames with indirect light read the radiance atlas: laid out
+         * now (the twin alike), filled when saved, after the photons */
+        e->atlas_fine = o->aerial_m_per_texel;
+        if ((st = eng_need_atlas(e, o->aerial_m_per_texel)) != PLX_OK)
+            return st;
+    } else if (o->aerial && e->lightmap_cell == 0.0 &&
+               (st = eng_need_lightmap(e, o->aerial_m_per_texel, o->twin)) != PLX_OK) {
         return st;
+    }
     eng_clear_error(e);
     return PLX_OK;
 }
@@ -214,6 +225,8 @@ static void make_savable(plx_engine *e, savable_keep *keep)
     }
     if (e->rd)
         render_code_unbind(e->rd);
+    if (e->atlas_cache) /* which worker met which surface: not saved */
+        memset(e->atlas_cache, 0, PLX_MAX_THREADS * sizeof(atlas_cache));
     e->lit_last = NULL;
     keep->port = e->port;
     memset(&e->port, 0, sizeof e->port);
@@ -362,8 +375,11 @@ static plx_status measure(plx_engine *e, plx_engine *twin, const char *fn, bake_
         return st;
     if ((st = check_twin(e, twin, fn)) != PLX_OK)
         return st;
-    /* photon frames came after plx_bake_prepare: the aerial map's indirect
-     * layer is gathered now, so aerial frames of the bake start at once */
+    /* photon frames came after plx_bake_prepare: the radiance atlas is
+     * filled now (and an aerial light map's indirect layer gathered), so
+     * the bake's frames start at once */
+    if (e->atlas && (st = eng_atlas_fill_all(e)) != PLX_OK)
+        return st;
     eng_lightmap_layer(e);
     return scan_savable(e, twin, NULL, L);
 }

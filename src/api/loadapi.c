@@ -18,6 +18,9 @@ static void drop_scene(plx_engine *e)
     e->lit_last = NULL;
     e->rd = NULL;
     e->ph = NULL;
+    e->atlas = NULL;
+    e->atlas_cache = NULL;
+    e->atlas_list = NULL;
     e->lightmap_cell = 0.0;
     e->warnings = 0;
     eng_clear_error(e);

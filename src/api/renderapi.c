@@ -10,9 +10,13 @@
 #include "photon/trace.h"
 #include "photon/photon.h"
 #include "photon/irradiance_cache.h"
+#include "render/atlas.h"
+#include "render/atlas_fill.h"
+#include "render/atlas_frame.h"
 
 #define AA_LEVEL 2  /* adaptive anti-aliasing: a step of more than this in the 8-bit image is an edge */
 #define LIGHTMAP_MAX_BYTES ((size_t)48 << 20) /* plx_config.lightmap_bytes 0: at most this */
+#define ATLAS_MAX_BYTES ((size_t)64 << 20)    /* the radiance atlas's, likewise */
 
 void plx_render_opts_default(plx_render_opts *o)
 {
@@ -278,6 +282,154 @@ void eng_lightmap_layer(plx_engine *e)
         e->lightmap_cell = 0.0; /* no layer memory: the next aerial frame builds the map whole */
 }
 
+/* ---- the radiance atlas (render/atlas.h): frames with indirect light ---------- */
+
+/* Whether a frame reads the atlas: indirect light asked for and traced. */
+static int atlas_frames(const plx_engine *e, const plx_render_opts *o)
+{
+    return !o->no_indirect && !o->per_pixel && e->ph && plx_indirect_frames(e) > 0;
+}
+
+/* The atlas's indirect light at a vertex: the photon buffers (a wall's
+ * own facade chart), read only, so on any worker. */
+static void atlas_ind(void *user, const atlas_chart *c, uint32_t sid, const double P[3], const double n[3],
+                      double rgb[3])
+{
+    if (c->kind == ATLAS_WALL)
+        shade_photons_surf(user, sid, c->bld, P, n, rgb);
+    else
+        shade_photons(user, P, n, rgb);
+}
+
+/* The atlas's budget: plx_config.lightmap_bytes, else half the free
+ * bytes, at most ATLAS_MAX_BYTES. */
+static size_t atlas_budget(const plx_engine *e)
+{
+    size_t half = arena_free_bytes(&e->mem) / 2;
+    if (e->cfg.lightmap_bytes)
+        return e->cfg.lightmap_bytes;
+    return half < ATLAS_MAX_BYTES ? half : ATLAS_MAX_BYTES;
+}
+
+plx_status eng_need_atlas(plx_engine *e, double fine)
+{
+    arena_mark m;
+    double f;
+    plx_status st;
+    if (e->atlas)
+        return PLX_OK;
+    if ((st = eng_need_render(e)) != PLX_OK)
+        return st;
+    f = atlas_spacing_for(&e->mem, e->sc, render_mesh(e->rd), fine, atlas_budget(e));
+    if (f == 0.0)
+        return eng_nomem(e, "laying out the radiance atlas (even 64 m between its points does not fit)");
+    m = arena_get_mark(&e->mem);
+    st = atlas_create(&e->mem, e->sc, render_mesh(e->rd), f, &e->atlas);
+    e->atlas_cache = st == PLX_OK ? arena_calloc(&e->mem, PLX_PART_FRAME, PLX_MAX_THREADS, sizeof(atlas_cache), 64)
+                                  : NULL;
+    e->atlas_list = e->atlas_cache ? arena_alloc(&e->mem, PLX_PART_FRAME, ENG_ATLAS_LIST * sizeof(uint32_t), 64) : NULL;
+    if (!e->atlas_list) {
+        arena_release(&e->mem, &m);
+        e->atlas = NULL;
+        e->atlas_cache = NULL;
+        return eng_nomem(e, "making the radiance atlas");
+    }
+    atlas_clear(e->atlas, e->indirect_gen);
+    return PLX_OK;
+}
+
+/* Worker 0 of a fill: the engine's light object, records in scratch. */
+static int atlas_worker0(plx_engine *e, atlas_worker *w)
+{
+    w->lt = e->lt;
+    w->ind = e->ph && plx_indirect_frames(e) > 0 ? atlas_ind : NULL;
+    w->ind_user = e;
+    w->rec = arena_scratch(&e->mem, arena_mul(atlas_fill_records(e->atlas), sizeof(double)), 8);
+    return w->rec ? 0 : -1;
+}
+
+/* A further worker: a light object of its own (it fills its region cache
+ * as it reads) in an arena taken from the block for the while. */
+static int atlas_worker_new(plx_engine *e, atlas_worker *w, arena *mem)
+{
+    size_t bytes = light_base_bytes(e->sc) + 2 * e->lt->pool_cap + ((size_t)8 << 20) +
+                   atlas_fill_records(e->atlas) * sizeof(double) + 64;
+    void *blk = arena_alloc(&e->mem, PLX_PART_LIT, bytes, 64);
+    if (!blk)
+        return -1;
+    arena_init(mem, blk, bytes);
+    memset(w, 0, sizeof *w);
+    if (light_create(mem, e->sc, e->lt->pool_cap, &w->lt) != PLX_OK)
+        return -1;
+    w->ind = e->ph && plx_indirect_frames(e) > 0 ? atlas_ind : NULL;
+    w->ind_user = e;
+    w->rec = arena_alloc(mem, PLX_PART_LIT, arena_mul(atlas_fill_records(e->atlas), sizeof(double)), 8);
+    return w->rec ? 0 : -1;
+}
+
+/* The atlas made current: cleared when the light changed since it was
+ * filled (a new key). */
+static void atlas_current(plx_engine *e)
+{
+    if (e->atlas->key != e->indirect_gen)
+        atlas_clear(e->atlas, e->indirect_gen);
+}
+
+plx_status eng_atlas_fill_all(plx_engine *e)
+{
+    atlas_worker w[PLX_MAX_THREADS];
+    arena wm[PLX_MAX_THREADS];
+    atlas_par par;
+    render_opts ro;
+    arena_mark m;
+    plx_status st;
+    int n, k;
+    if ((st = eng_need(e, ENG_LIGHT, "plx_bake_save")) != PLX_OK || (st = eng_need_atlas(e, e->atlas_fine)) != PLX_OK)
+        return st;
+    atlas_current(e);
+    if (e->atlas->todo == 0)
+        return PLX_OK;
+    render_opts_default(&ro);
+    ro.workers = 1;
+    set_workers(e, &ro);
+    m = arena_get_mark(&e->mem);
+    if (atlas_worker0(e, &w[0]) != 0) {
+        arena_release(&e->mem, &m);
+        return eng_nomem(e, "filling the radiance atlas");
+    }
+    for (n = 1; n < ro.workers && n < PLX_MAX_THREADS; n++)
+        if (atlas_worker_new(e, &w[n], &wm[n]) != 0)
+            break;
+    par.par = ro.par;
+    par.ctx = ro.par_ctx;
+    par.progress.fn = e->port.progress;
+    par.progress.ctx = e->port.ctx;
+    st = atlas_fill(e->atlas, w, n, &par);
+    for (k = 1; k < n; k++)
+        e->lt->st.computed += w[k].lt->st.computed;
+    arena_release(&e->mem, &m);
+    return st;
+}
+
+/* render_opts.atlas_need: what the frame reads and is not filled yet,
+ * filled on this thread (the engine's light object), round after round
+ * of at most ENG_ATLAS_LIST items. */
+static void atlas_need(void *user, const atlas_view *v, const uint32_t *ids)
+{
+    plx_engine *e = user;
+    arena_mark m;
+    atlas_worker w;
+    uint32_t n;
+    atlas_current(e);
+    if (e->atlas->todo == 0)
+        return;
+    m = arena_get_mark(&e->mem);
+    if (atlas_worker0(e, &w) == 0)
+        while ((n = atlas_frame_missing(e->atlas, v, ids, e->atlas_list, ENG_ATLAS_LIST)) > 0)
+            (void)atlas_fill_items(e->atlas, &w, 1, NULL, e->atlas_list, n);
+    arena_release(&e->mem, &m);
+}
+
 /* The adaptive anti-aliasing's buffers (PLX_PART_FRAME, on first need,
  * all three or none): whether they are there. Taken after the first
  * sample's frame, so that what that frame builds (the indirect ground map)
@@ -423,14 +575,18 @@ plx_status plx_render(plx_engine *e, const plx_camera *cam, const plx_render_opt
         return st;
     if ((st = frame_fits(e, cam)) != PLX_OK)
         return st;
-    if (o->aerial && e->lightmap_cell != 0.0 && !o->no_indirect && e->ic && e->ph && plx_indirect_frames(e) > 0) {
+    if (atlas_frames(e, o) && (st = eng_need_atlas(e, e->atlas_fine > 0.0 ? e->atlas_fine : o->aerial_m_per_texel)) != PLX_OK)
+        return st;
+    if (atlas_frames(e, o)) {
+        /* from the atlas: no light map, no indirect hook */
+    } else if (o->aerial && e->lightmap_cell != 0.0 && !o->no_indirect && e->ic && e->ph && plx_indirect_frames(e) > 0) {
         /* built before the photons: its indirect layer gathered now;
          * gathering switched off since: the map again, without the layer */
         eng_lightmap_layer(e);
         if (aerial_layer(e) && !layer_on(e))
             e->lightmap_cell = 0.0;
     }
-    if (o->aerial && e->lightmap_cell == 0.0) {
+    if (o->aerial && e->lightmap_cell == 0.0 && !atlas_frames(e, o)) {
         st = eng_need_lightmap(e, o->aerial_m_per_texel, 0);
         if (st != PLX_OK)
             return st;
@@ -447,7 +603,13 @@ plx_status plx_render(plx_engine *e, const plx_camera *cam, const plx_render_opt
     ro.cull = o->no_cull ? RENDER_CULL_NONE : RENDER_CULL_ALL;
     ro.backend = o->backend;
     ro.auto_exposure = o->auto_exposure;
-    if (!o->no_indirect && e->ph && plx_indirect_frames(e) > 0) {
+    if (atlas_frames(e, o)) {
+        ro.lightmap = 0;
+        ro.atlas = e->atlas;
+        ro.atlas_cache = e->atlas_cache;
+        ro.atlas_need = atlas_need;
+        ro.atlas_user = e;
+    } else if (!o->no_indirect && e->ph && plx_indirect_frames(e) > 0) {
         ro.indirect = shade_indirect;
         ro.indirect_user = e;
         if (e->ic) {

@@ -38,6 +38,10 @@ struct plx_engine {
     uint32_t *aa_id;        /* adaptive anti-aliasing: the first sample's surface ids, */
     uint8_t *aa_mask;       /* the pixels the later samples shade (1 byte each) and */
     uint8_t *aa_rgb;        /* the first sample's 8-bit image (PLX_PART_FRAME, on first need) */
+    struct atlas *atlas;    /* the radiance atlas of frames with indirect light (on first need) */
+    struct atlas_cache *atlas_cache; /* its per-worker map caches (PLX_MAX_THREADS) */
+    uint32_t *atlas_list;   /* what a frame lists to fill (ENG_ATLAS_LIST items) */
+    double atlas_fine;      /* the spacing asked for (0: the default) */
     uint32_t gather_side;   /* final gathering at points: side^2 directions
                                (0 = photon buffers only); set by
                                plx_indirect_set_gather, else FINAL_GATHER_SIDE */
@@ -70,6 +74,13 @@ void eng_render_max(const plx_engine *e, int32_t *w, int32_t *h);
 /* Builds the aerial light map at m_per_texel metres (0: 1 m) unless built;
  * dark: with a shader giving no light (the bake's twin, bake.c). */
 plx_status eng_need_lightmap(plx_engine *e, double m_per_texel, int dark);
+/* The radiance atlas (render/atlas.h) made on first need at spacing fine
+ * (0: the default), not filled (renderapi.c). */
+#define ENG_ATLAS_LIST 16384
+plx_status eng_need_atlas(plx_engine *e, double fine);
+/* Every chart of the atlas filled (a bake), on the port's workers, with
+ * progress: PLX_OK or PLX_E_NOMEM. */
+plx_status eng_atlas_fill_all(plx_engine *e);
 /* The aerial map's indirect layer gathered when photons came after the map
  * (renderapi.c). */
 void eng_lightmap_layer(plx_engine *e);

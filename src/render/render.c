@@ -5,6 +5,7 @@
 
 #include "base/plx_assert.h"
 #include "render/render.h"
+#include "render/atlas_frame.h"
 #include "render/exposure.h"
 #include "render/tonemap.h"
 #include "render/raster.h"
@@ -96,6 +97,7 @@ struct render {
     indmap im;                  /* its indirect twin (indmap.c) */
     double thr[TONEMAP_LEVELS];
     tonemap_table *tm;          /* the last exposure's table (tonemap.h) */
+    uint32_t frames;            /* frames drawn: the atlas maps' stamp (atlas_frame.h) */
     exposure_table *et;         /* the exposure's bins without the logarithm (exposure.h) */
     const char *err;
 };
@@ -2025,6 +2027,62 @@ const float *render_linear(const render *r)
     return r->lin;
 }
 
+/* ---- frames from the radiance atlas (atlas_frame.h) ------------------------------ */
+
+typedef struct atlas_job {
+    render *r;
+    const render_opts *o;
+    atlas_view v;
+} atlas_job;
+
+static void atlas_rows(void *arg, int worker, uint32_t k)
+{
+    atlas_job *jb = arg;
+    render *r = jb->r;
+    int32_t j, j0 = (int32_t)k * RENDER_TILE, j1 = j0 + RENDER_TILE < r->h ? j0 + RENDER_TILE : r->h;
+    for (j = j0; j < j1; j++)
+        atlas_frame_row(jb->o->atlas, &jb->v, &jb->o->atlas_cache[worker], &r->id[(size_t)j * (size_t)r->w], j,
+                        &r->lin[3 * (size_t)j * (size_t)r->w]);
+}
+
+/* Every pixel from the atlas: the ground's ids set, then rows of pixels
+ * (RENDER_TILE a job) on the workers, each with its own map cache. */
+static void atlas_pass(render *r, const render_opts *o, render_stats *st)
+{
+    atlas_job jb;
+    double ta = r->tanh_ * r->aspect, tb = r->tanh_, a0, b0;
+    size_t p, px = (size_t)r->w * (size_t)r->h;
+    int k;
+    ground_ids(r);
+    a0 = (2.0 * (0.5 + r->shift[0]) / r->w - 1.0) * ta;
+    b0 = (1.0 - 2.0 * (0.5 + r->shift[1]) / r->h) * tb;
+    for (k = 0; k < 3; k++) {
+        jb.v.eye[k] = r->eye[k];
+        jb.v.D0[k] = r->f[k] + a0 * r->rt[k] + b0 * r->up[k];
+        jb.v.Dx[k] = 2.0 * ta / r->w * r->rt[k];
+        jb.v.Dy[k] = -2.0 * tb / r->h * r->up[k];
+    }
+    jb.v.w = r->w;
+    jb.v.h = r->h;
+    jb.v.stamp = ++r->frames;
+    if (jb.v.stamp == 0) /* 2^32 frames: a stale map could carry stamp 0 */
+        jb.v.stamp = ++r->frames;
+    jb.r = r;
+    jb.o = o;
+    if (o->atlas_need)
+        o->atlas_need(o->atlas_user, &jb.v, r->id);
+    run_jobs(o, (uint32_t)((r->h + RENDER_TILE - 1) / RENDER_TILE), atlas_rows, &jb);
+    for (p = 0; p < px; p++) {
+        uint32_t id = r->id[p];
+        if (id == MESH_SURF_NONE)
+            st->sky_pixels++;
+        else if (id == MESH_SURF_GROUND)
+            st->ground_pixels++;
+        else
+            st->building_pixels++;
+    }
+}
+
 plx_status render_frame(render *r, const render_camera *cam, const render_opts *o,
                         uint8_t *rgb8, float *rgbf, render_stats *stats)
 {
@@ -2066,10 +2124,14 @@ plx_status render_frame(render *r, const render_camera *cam, const render_opts *
         r->err = "render_frame: the backend could not read the frame back";
         return PLX_E_UNSUPPORTED;
     }
+    st.drawn_fraction = st.triangles ? (double)st.triangles_drawn / (double)st.triangles : 1.0;
+    if (o->atlas) {
+        atlas_pass(r, o, &st);
+        goto finish;
+    }
     surf_cache_fill(r);
     if (o->mask)
         mask_update(r, o);
-    st.drawn_fraction = st.triangles ? (double)st.triangles_drawn / (double)st.triangles : 1.0;
     if (o->lightmap && r->lm.built && !r->lm.has_ind && o->indirect && o->indirect_map &&
         (!r->im.built || r->im.key != o->indirect_key))
         /* out of memory: the frame takes the hook per pixel (indmap_usable) */
@@ -2082,6 +2144,7 @@ plx_status render_frame(render *r, const render_camera *cam, const render_opts *
     shade_pass(r, o, &st);
     if (r->sparse)
         sparse_rest(r, o, &st);
+finish:
     /* the exposure from the lit surfaces, before the glows */
     st.exposure = o->auto_exposure ? exposure_par(r, o) : o->exposure;
     if (!o->no_glow)

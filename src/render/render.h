@@ -201,6 +201,10 @@
 
 #define RENDER_BINS 4096
 
+struct atlas;
+struct atlas_cache;
+struct atlas_view;
+
 /* The shader: colour-weighted illuminance E_rgb (lux, per channel) at
  * surface point P with unit normal n. Must not fail; must be deterministic
  * (the culling guarantee compares images). */
@@ -308,6 +312,15 @@ typedef struct render_opts {
                                   building's surface id; the ground and the sky count as one)
                                   gets its byte set to 1. NULL: every pixel */
     const uint32_t *mask_id;   /* with mask: the first sample's surface ids */
+    const struct atlas *atlas; /* not NULL: every pixel read from this radiance atlas (atlas.h,
+                                  atlas_frame.h) instead of shaded; the indirect hooks, the
+                                  light map and the mask are then not used */
+    struct atlas_cache *atlas_cache; /* with atlas: one per worker (workers of them, at least 1) */
+    void (*atlas_need)(void *user, const struct atlas_view *v, const uint32_t *ids);
+                               /* with atlas (may be NULL): called once the frame's surface ids
+                                  are known (the ground's set), before any pixel is read: fills
+                                  what the frame reads of the atlas (atlas_frame_missing) */
+    void *atlas_user;
 } render_opts;
 
 void render_opts_default(render_opts *o /* OUT */);

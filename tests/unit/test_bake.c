@@ -10,8 +10,10 @@
  *    small: the exact status and message, no engine.
  *  - The corpus tests/corpus/bake-*.plxb with exact outcomes.
  *  - A twin that is not laid out alike is refused.
- *  - The aerial layer's rows are reported to plx_port.progress: one start
- *    with the map's rows, the workers' units summing to them, one end.
+ *  - The radiance atlas is filled while saving, its jobs reported to
+ *    plx_port.progress: one start with the jobs, the workers' units
+ *    summing to them, one end; frames of the loaded bake equal those of
+ *    an engine that fills the atlas as its frames need it.
  */
 #include <stdarg.h>
 #include <stddef.h>
@@ -28,6 +30,7 @@
 #include "../ref/ref_bake_sum.h"
 #include "base/engine.h"
 #include "render/render.h"
+#include "render/atlas.h"
 #include "photon/irradiance_cache.h"
 #include "polarlux_port.h"
 #include "ref_bake_sum.h"
@@ -53,7 +56,7 @@ static void count_progress(void *ctx, const char *what, uint64_t n, uint64_t tot
     (void)ctx;
     pthread_mutex_lock(&told.lock);
     told.calls++;
-    told.bad += strcmp(what, "aerial indirect layer") != 0;
+    told.bad += strcmp(what, "radiance atlas") != 0;
     if (total == 0) {
         told.ends++;
     } else if (n == 0) {
@@ -78,7 +81,7 @@ static plx_engine *make(void **mem, int twin, int aerial)
     counting = *plx_port_posix();
     counting.progress = count_progress;
     cfg.port = &counting;
-    cfg.threads = 2; /* the aerial layer gathered on two workers (test_aerial_layer_in_bake) */
+    cfg.threads = 2; /* the atlas filled on two workers (test_atlas_in_bake) */
     cfg.render_max_width = 320;
     cfg.render_max_height = 240;
     cfg.lit_cache_bytes = 4u << 20;
@@ -259,38 +262,42 @@ static void test_round_trip(void **state)
     free(mc);
 }
 
-/* The aerial map's indirect layer: a bake made before its photons gathers
- * it while saving, so the loaded engine's aerial frames gather nothing,
- * and they equal those of an engine that never saw a bake (its map built
- * whole, layer and all, at its first aerial frame). */
-static void test_aerial_layer_in_bake(void **state)
+/* The radiance atlas: a bake made before its photons fills it whole while
+ * saving (on two workers, its jobs reported to plx_port.progress), so the
+ * loaded engine's frames fill nothing, and they equal, byte for byte,
+ * those of an engine that never saw a bake and fills the charts each
+ * frame reads as it draws it (atlas_frame_missing): a chart's values do
+ * not depend on when, or by which worker, it was filled. */
+static void test_atlas_in_bake(void **state)
 {
     baked k = shared;
     void *mc, *md;
     plx_engine *c, *d;
-    render_lightmap_info li;
-    uint64_t f, g0;
+    uint64_t f;
+    int aerial;
     (void)state;
-    render_lightmap_get(k.a->rd, &li);
-    assert_true(li.built && li.has_ind);
-    assert_true(k.a->ic->gathered > 0);
-    assert_int_equal(k.a->layer_workers, 2);
-    /* the bake's layer, reported row by row (the twin gathers none) */
+    assert_non_null(k.a->atlas);
+    assert_true(k.a->atlas->todo == 0 && k.a->atlas->with_ind);
+    assert_true(k.b->atlas->todo > 0); /* the twin: laid out alike, never filled */
+    assert_true(k.a->atlas->fine == 2.0 && k.b->atlas->fine == 2.0);
+    /* the fill, reported job by job (the twin reports none) */
     assert_int_equal(told.starts, 1);
     assert_int_equal(told.ends, 1);
-    assert_int_equal(told.total, li.ny);
-    assert_int_equal(told.units, li.ny);
+    assert_int_equal(told.units, told.total);
     assert_int_equal(told.bad, 0);
-    assert_true(told.calls == li.ny + 2);
+    assert_true(told.calls == told.total + 2);
     c = load(k.file, k.len, &mc);
-    render_lightmap_get(c->rd, &li);
-    assert_true(li.built && li.has_ind);
-    g0 = c->ic->gathered;
+    assert_true(c->atlas->todo == 0);
     d = make(&md, 0, 0);
     for (f = 1; f <= 3; f++)
         assert_int_equal(plx_indirect_step(d, 20000, f), PLX_OK);
-    same_render(d, c, 1, 0);
-    assert_true(c->ic->gathered == g0);
+    for (aerial = 0; aerial <= 1; aerial++) {
+        uint64_t before = d->atlas ? d->atlas->todo : 0;
+        same_render(d, c, aerial, 0);
+        assert_true(c->atlas->todo == 0);
+        assert_true(d->atlas->fine == 2.0);
+        assert_true(d->atlas->todo > 0 && (aerial == 0 || d->atlas->todo < before)); /* filled on demand */
+    }
     plx_engine_destroy(d);
     free(md);
     plx_engine_destroy(c);
@@ -441,7 +448,7 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_round_trip),
-        cmocka_unit_test(test_aerial_layer_in_bake),
+        cmocka_unit_test(test_atlas_in_bake),
         cmocka_unit_test(test_damaged),
         cmocka_unit_test(test_corpus),
         cmocka_unit_test(test_twin_mismatch),

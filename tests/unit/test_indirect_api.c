@@ -105,6 +105,7 @@ static void test_render_hook(void **state)
     (void)state;
     plx_render_opts_default(&o);
     o.no_glow = 1;
+    o.per_pixel = 1; /* the same exact direct light in both: shaded at every pixel */
     assert_int_equal(plx_indirect_step(e, 20000, 1), PLX_OK);
     assert_int_equal(plx_render(e, &cam, &o, NULL, with, NULL), PLX_OK);
     o.no_indirect = 1;

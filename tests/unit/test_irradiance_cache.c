@@ -105,6 +105,7 @@ static void render_pair(plx_engine *e, const plx_camera *c, float *with, float *
 {
     plx_render_opts o;
     plx_render_opts_default(&o);
+    o.per_pixel = 1; /* every pixel shaded: the irradiance cache, not the radiance atlas */
     o.no_glow = 1;
     o.no_indirect = 1;
     assert_int_equal(plx_render(e, c, &o, NULL, without, NULL), PLX_OK);
@@ -225,6 +226,7 @@ static void test_image_same_bytes(void **state)
     assert_true(a && b);
     two_views(&c, &other);
     plx_render_opts_default(&o);
+    o.per_pixel = 1; /* every pixel shaded: the irradiance cache, not the radiance atlas */
     assert_int_equal(plx_indirect_step(e1, 16384, 3), PLX_OK);
     assert_int_equal(plx_indirect_step(e2, 16384, 3), PLX_OK);
     assert_int_equal(e1->ic->nrec, ICACHE_RECORDS);
@@ -283,6 +285,7 @@ static void test_image_after_aerial_same_bytes(void **state)
     top.target[1] = top.eye[1] + 1.0;
     top.target[2] = 0.0;
     plx_render_opts_default(&o);
+    o.per_pixel = 1; /* every pixel shaded: the irradiance cache, not the radiance atlas */
     oa = o;
     oa.aerial = 1;
     assert_int_equal(plx_indirect_step(e1, 16384, 3), PLX_OK);
@@ -322,6 +325,7 @@ static void test_peek_same_bits(void **state)
     assert_non_null(before);
     two_views(&c, &other);
     plx_render_opts_default(&o);
+    o.per_pixel = 1; /* every pixel shaded: the irradiance cache, not the radiance atlas */
     assert_int_equal(plx_indirect_step(e, 16384, 3), PLX_OK);
     assert_int_equal(plx_render(e, &c, &o, NULL, NULL, NULL), PLX_OK);
     assert_int_equal(e->ic->nrec, ICACHE_RECORDS);
@@ -389,6 +393,7 @@ static void test_peek_cells_follow_table(void **state)
     (void)state;
     two_views(&c, &other);
     plx_render_opts_default(&o);
+    o.per_pixel = 1; /* every pixel shaded: the irradiance cache, not the radiance atlas */
     assert_int_equal(plx_indirect_step(e, 16384, 3), PLX_OK);
     assert_int_equal(plx_render(e, &c, &o, NULL, NULL, NULL), PLX_OK);
     icache_set_view(e->ic, c.eye);
@@ -493,6 +498,7 @@ static void test_aerial_accuracy(void **state)
     for (k = 0; k < 4; k++) /* the command's default: 4 x 65536 photons */
         assert_int_equal(plx_indirect_step(e, 65536, (uint64_t)k + 1), PLX_OK);
     plx_render_opts_default(&o);
+    o.per_pixel = 1; /* every pixel shaded: the irradiance cache, not the radiance atlas */
     o.no_glow = 1;
     o.aerial = 1;
     o.no_indirect = 1;

@@ -46,9 +46,10 @@ typedef struct frame {
 } frame;
 
 /* Renders the street and the aerial view with the given threads and port;
- * small_cache: a lamp-region cache of 64 KiB; gather: images gather with
- * the irradiance cache (else they read the photon buffers), and only the
- * street view is drawn (out[1] zeroed). */
+ * small_cache: a lamp-region cache of 64 KiB; gather: 0 frames read the
+ * radiance atlas (the default), 1 every pixel is shaded and gathers with
+ * the irradiance cache, and only the street view is drawn (out[1]
+ * zeroed), 2 every pixel is shaded and reads the photon buffers. */
 static void render_pair_g(int threads, const plx_port *port, int small_cache, int gather, frame *out)
 {
     plx_config cfg;
@@ -69,10 +70,10 @@ static void render_pair_g(int threads, const plx_port *port, int small_cache, in
     assert_int_equal(plx_load_file(e, "fixtures/eixample-4x4.geojson"), PLX_OK);
     for (k = 0; k < 2; k++)
         assert_int_equal(plx_indirect_step(e, 20000, 7), PLX_OK);
-    if (!gather)
+    if (gather != 1)
         assert_int_equal(plx_indirect_set_gather(e, 0), PLX_OK);
     memset(&out[1], 0, sizeof out[1]);
-    for (v = 0; v < (gather ? 1 : 2); v++) { /* gathering: the street view */
+    for (v = 0; v < (gather == 1 ? 1 : 2); v++) { /* gathering: the street view */
         memset(&cam, 0, sizeof cam);
         if (v == 0) {
             cam.eye[0] = 298.6; cam.eye[1] = 265.5; cam.eye[2] = 1.7;
@@ -87,6 +88,7 @@ static void render_pair_g(int threads, const plx_port *port, int small_cache, in
         plx_render_opts_default(&o);
         o.aerial = v;
         o.auto_exposure = 1;
+        o.per_pixel = gather != 0;
         assert_int_equal(plx_render(e, &cam, &o, out[v].rgb8, out[v].rgbf, &out[v].info), PLX_OK);
     }
     plx_engine_destroy(e);
@@ -128,8 +130,13 @@ static void test_same_bytes(void **state)
         render_pair(3, &back, 0, other);
         check_same(one, other);
     }
-    render_pair(1, plx_port_posix(), 1, one);
-    render_pair(2, &back, 1, other);
+    /* every pixel shaded: the lamp regions the workers need, left to the
+     * calling thread with the small cache */
+    render_pair_g(1, plx_port_posix(), 0, 2, one);
+    render_pair_g(2, plx_port_posix(), 0, 2, other);
+    check_same(one, other);
+    render_pair_g(1, plx_port_posix(), 1, 2, one);
+    render_pair_g(2, &back, 1, 2, other);
     check_same(one, other);
 }
 
@@ -184,6 +191,7 @@ static void render_aerial_gathered(int threads, const plx_port *port, int photon
     o.aerial = 1;
     o.aerial_m_per_texel = 2.0;
     o.no_glow = 1;
+    o.per_pixel = 1; /* the light map's layer, not the radiance atlas */
     assert_int_equal(plx_render(e, &cam, &o, out->rgb8, out->rgbf, &out->info), PLX_OK);
     plx_engine_destroy(e);
     free(mem);

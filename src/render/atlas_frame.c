@@ -1,0 +1,237 @@
+/* atlas_frame: a frame's pixels from the radiance atlas (atlas_frame.h). */
+#include <math.h>
+#include <string.h>
+
+#include "render/atlas_frame.h"
+#include "render/texel.h"
+
+static double dot3(const double *a, const double *b)
+{
+    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+}
+
+/* The map of chart c: u, v and the denominator as affine functions of
+ * (i, j), in double, stored as floats. */
+static void make_map(const atlas_view *v, const atlas_chart *c, atlas_map *m)
+{
+    double n[3], gu[3] = { 0.0, 0.0, 0.0 }, gv[3] = { 0.0, 0.0, 0.0 }, eo[3], N, cu, cv;
+    const double *D[3];
+    int k;
+    atlas_chart_normal(c, n);
+    if (c->kind == ATLAS_WALL) {
+        gu[0] = c->e[0] / c->tu;
+        gu[1] = c->e[1] / c->tu;
+        gv[2] = 1.0 / c->tv;
+    } else {
+        gu[0] = 1.0 / c->tu;
+        gv[1] = 1.0 / c->tv;
+    }
+    for (k = 0; k < 3; k++)
+        eo[k] = v->eye[k] - c->o[k];
+    N = -dot3(n, eo);           /* n.(o - eye): the plane passes through o */
+    cu = dot3(eo, gu);
+    cv = dot3(eo, gv);
+    D[0] = v->D0;
+    D[1] = v->Dx;
+    D[2] = v->Dy;
+    for (k = 0; k < 3; k++) {
+        double nd = dot3(n, D[k]);
+        m->a[k] = (float)(cu * nd + N * dot3(D[k], gu));
+        m->a[3 + k] = (float)(cv * nd + N * dot3(D[k], gv));
+        m->a[6 + k] = (float)nd;
+    }
+    m->c = c;
+}
+
+static const atlas_map *map_of(const atlas *A, const atlas_view *v, atlas_cache *k, uint32_t sid)
+{
+    atlas_map *m = &k->slot[sid & (ATLAS_CACHE_SLOTS - 1)];
+    const atlas_chart *c;
+    if (m->sid == sid && m->stamp == v->stamp)
+        return m;
+    c = atlas_surface_chart(A, sid);
+    m->sid = sid;
+    m->stamp = v->stamp;
+    if (c)
+        make_map(v, c, m);
+    else
+        m->c = NULL;
+    return m;
+}
+
+/* The four vertices around the last cell read, unpacked: pixels in the
+ * same cell (a surface seen up close) reuse them. */
+typedef struct cell4 {
+    const uint32_t *t;        /* vertex (i, j) of the cell; NULL: none */
+    float a[3], b[3], c[3], d[3];
+} cell4;
+
+/* Cell index and weight along one axis: u clamped to [0, n - 1], the
+ * cell's index in 0 .. n - 2 (truncation is floor for u >= 0). */
+static inline uint32_t cell_of(float u, uint32_t n, float *f)
+{
+    uint32_t i;
+    if (!(u > 0.0f))
+        u = 0.0f;
+    if (u > (float)(n - 1))
+        u = (float)(n - 1);
+    i = (uint32_t)u;
+    if (i > n - 2)
+        i = n - 2;
+    *f = u - (float)i;
+    return i;
+}
+
+/* Bilinear over the vertices of a chart whose vertex (0, 0) is t0 and
+ * rows nu long, at (u, w) in vertex steps. */
+static inline void bilerp(cell4 *q, const uint32_t *t0, uint32_t nu, uint32_t nv, float u, float w, float out[3])
+{
+    float fu, fv;
+    uint32_t i = cell_of(u, nu, &fu), j = cell_of(w, nv, &fv);
+    const uint32_t *t = t0 + (size_t)j * nu + i;
+    int k;
+    if (t != q->t) {
+        q->t = t;
+        texel_unpack(t[0], q->a);
+        texel_unpack(t[1], q->b);
+        texel_unpack(t[nu], q->c);
+        texel_unpack(t[nu + 1], q->d);
+    }
+    for (k = 0; k < 3; k++) {
+        float lo = q->a[k] + fu * (q->b[k] - q->a[k]), hi = q->c[k] + fu * (q->d[k] - q->c[k]);
+        out[k] = lo + fv * (hi - lo);
+    }
+}
+
+/* A row's ground: the hit point (x, y) relative to the tiles' corner at
+ * pixel 0 and its step per pixel (the ray's height does not change
+ * along a row: the camera's right vector is horizontal). */
+typedef struct ground_row {
+    int on;                   /* the row's rays go down */
+    double x0, y0, dx, dy;
+} ground_row;
+
+static void ground_setup(const atlas *A, const atlas_view *v, int32_t j, ground_row *g)
+{
+    double dz = v->D0[2] + j * v->Dy[2], t;
+    g->on = dz < 0.0;
+    if (!g->on)
+        return;
+    t = -v->eye[2] / dz;
+    g->x0 = v->eye[0] - A->g0[0] + t * (v->D0[0] + j * v->Dy[0]);
+    g->y0 = v->eye[1] - A->g0[1] + t * (v->D0[1] + j * v->Dy[1]);
+    g->dx = t * v->Dx[0];
+    g->dy = t * v->Dx[1];
+}
+
+/* The ground block item (atlas.h) under (x, y) from the tiles' corner,
+ * and (x, y) in steps within it; UINT32_MAX off the tiles. */
+static uint32_t ground_block(const atlas *A, double x, double y, double *u, double *w)
+{
+    double fx = x * A->inv_tile, fy = y * A->inv_tile, step_inv, bx, by;
+    uint32_t tx, ty, tile;
+    if (!(fx >= 0.0 && fx < A->gx && fy >= 0.0 && fy < A->gy))
+        return UINT32_MAX;
+    tx = (uint32_t)fx;
+    ty = (uint32_t)fy;
+    tile = ty * A->gx + tx;
+    step_inv = A->gfine[tile] ? A->inv_fine : A->inv_coarse;
+    x = (x - tx * A->tile) * step_inv; /* in steps within the tile */
+    y = (y - ty * A->tile) * step_inv;
+    bx = x < 0.0 ? 0.0 : x * (1.0 / ATLAS_BLOCK);
+    by = y < 0.0 ? 0.0 : y * (1.0 / ATLAS_BLOCK);
+    tx = bx < ATLAS_TB - 1 ? (uint32_t)bx : ATLAS_TB - 1;
+    ty = by < ATLAS_TB - 1 ? (uint32_t)by : ATLAS_TB - 1;
+    *u = x - tx * ATLAS_BLOCK;
+    *w = y - ty * ATLAS_BLOCK;
+    return tile * ATLAS_TB * ATLAS_TB + ty * ATLAS_TB + tx;
+}
+
+/* The ground at (x, y) from the tiles' corner: its block, bilinear. */
+static void ground_px(const atlas *A, cell4 *q, double x, double y, float out[3])
+{
+    double u, w;
+    uint32_t b = ground_block(A, x, y, &u, &w), first = b == UINT32_MAX ? ATLAS_NOVERT : A->gfirst[b];
+    if (first == ATLAS_NOVERT) {
+        out[0] = out[1] = out[2] = 0.0f;
+        return;
+    }
+    bilerp(q, &A->tex[first], ATLAS_BLOCK + 1, ATLAS_BLOCK + 1, (float)u, (float)w, out);
+}
+
+/* Lists item it unless filled or listed (done byte 2: listed this round). */
+static void want(atlas *A, uint32_t it, uint32_t *list, uint32_t cap, uint32_t *n)
+{
+    uint8_t *d = it < A->nsurf ? &A->cdone[it] : &A->gdone[it - A->nsurf];
+    if (*d || *n >= cap)
+        return;
+    *d = 2;
+    list[(*n)++] = it;
+}
+
+uint32_t atlas_frame_missing(atlas *A, const atlas_view *v, const uint32_t *ids, uint32_t *list, uint32_t cap)
+{
+    uint32_t n = 0, last = MESH_SURF_NONE;
+    int32_t i, j;
+    if (A->todo == 0)
+        return 0;
+    for (j = 0; j < v->h && n < cap; j++) {
+        ground_row g;
+        ground_setup(A, v, j, &g);
+        for (i = 0; i < v->w; i++) {
+            uint32_t sid = ids[(size_t)j * v->w + i];
+            if (sid == MESH_SURF_GROUND && g.on) {
+                double u, w;
+                uint32_t b = ground_block(A, g.x0 + i * g.dx, g.y0 + i * g.dy, &u, &w);
+                if (b != UINT32_MAX && A->gfirst[b] != ATLAS_NOVERT)
+                    want(A, atlas_block_item(A, 0, 0) + b, list, cap, &n);
+            } else if (sid != last && sid != MESH_SURF_NONE && sid != MESH_SURF_GROUND) {
+                last = sid;
+                if (atlas_surface_chart(A, sid))
+                    want(A, sid - 2u, list, cap, &n);
+            }
+        }
+    }
+    return n;
+}
+
+void atlas_frame_row(const atlas *A, const atlas_view *v, atlas_cache *k, const uint32_t *ids, int32_t j, float *lin)
+{
+    const atlas_map *m = NULL;
+    uint32_t last = MESH_SURF_NONE;
+    ground_row g;
+    cell4 q;
+    float fj = (float)j, bu = 0, bv = 0, bw = 0;
+    int32_t i;
+    q.t = NULL;
+    ground_setup(A, v, j, &g);
+    for (i = 0; i < v->w; i++) {
+        uint32_t sid = ids[i];
+        float *o = &lin[3 * (size_t)i];
+        if (sid == MESH_SURF_NONE || (sid == MESH_SURF_GROUND && !g.on)) {
+            o[0] = o[1] = o[2] = 0.0f;
+            continue;
+        }
+        if (sid == MESH_SURF_GROUND) {
+            ground_px(A, &q, g.x0 + i * g.dx, g.y0 + i * g.dy, o);
+            continue;
+        }
+        if (sid != last) {
+            m = map_of(A, v, k, sid);
+            last = sid;
+            if (m->c) {
+                bu = m->a[0] + m->a[2] * fj;
+                bv = m->a[3] + m->a[5] * fj;
+                bw = m->a[6] + m->a[8] * fj;
+            }
+        }
+        if (!m->c) {
+            o[0] = o[1] = o[2] = 0.0f;
+            continue;
+        }
+        {
+            float fi = (float)i, r = 1.0f / (bw + m->a[7] * fi);
+            bilerp(&q, &A->tex[m->c->first], m->c->nu, m->c->nv, (bu + m->a[1] * fi) * r, (bv + m->a[4] * fi) * r, o);
+        }
+    }
+}
