@@ -59,13 +59,6 @@ static const atlas_map *map_of(const atlas *A, const atlas_view *v, atlas_cache 
     return m;
 }
 
-/* The four vertices around the last cell read, unpacked: pixels in the
- * same cell (a surface seen up close) reuse them. */
-typedef struct cell4 {
-    const uint32_t *t;        /* vertex (i, j) of the cell; NULL: none */
-    float a[3], b[3], c[3], d[3];
-} cell4;
-
 /* Cell index and weight along one axis: u clamped to [0, n - 1], the
  * cell's index in 0 .. n - 2 (truncation is floor for u >= 0). */
 static inline uint32_t cell_of(float u, uint32_t n, float *f)
@@ -82,25 +75,33 @@ static inline uint32_t cell_of(float u, uint32_t n, float *f)
     return i;
 }
 
-/* Bilinear over the vertices of a chart whose vertex (0, 0) is t0 and
- * rows nu long, at (u, w) in vertex steps. */
-static inline void bilerp(cell4 *q, const uint32_t *t0, uint32_t nu, uint32_t nv, float u, float w, float out[3])
+/* A packed value's scale times a weight (texel.h). */
+static inline float wscale(uint32_t t, float w)
 {
-    float fu, fv;
-    uint32_t i = cell_of(u, nu, &fu), j = cell_of(w, nv, &fv);
+    return texel_scale(t) * w;
+}
+
+/* Bilinear over the vertices of a chart whose vertex (0, 0) is t0 and
+ * rows nu long, at (u, w) in vertex steps: each vertex's weight folded
+ * into its scale, then the mantissas summed channel by channel. */
+static inline void bilerp(const uint32_t *t0, uint32_t nu, uint32_t nv, float u, float w, float out[3])
+{
+    float fu, fv, sa, sb, sc, sd;
+    uint32_t i = cell_of(u, nu, &fu), j = cell_of(w, nv, &fv), a, b, c, d;
     const uint32_t *t = t0 + (size_t)j * nu + i;
-    int k;
-    if (t != q->t) {
-        q->t = t;
-        texel_unpack(t[0], q->a);
-        texel_unpack(t[1], q->b);
-        texel_unpack(t[nu], q->c);
-        texel_unpack(t[nu + 1], q->d);
-    }
-    for (k = 0; k < 3; k++) {
-        float lo = q->a[k] + fu * (q->b[k] - q->a[k]), hi = q->c[k] + fu * (q->d[k] - q->c[k]);
-        out[k] = lo + fv * (hi - lo);
-    }
+    a = t[0];
+    b = t[1];
+    c = t[nu];
+    d = t[nu + 1];
+    sa = wscale(a, (1.0f - fu) * (1.0f - fv));
+    sb = wscale(b, fu * (1.0f - fv));
+    sc = wscale(c, (1.0f - fu) * fv);
+    sd = wscale(d, fu * fv);
+    out[0] = (float)(a & 511u) * sa + (float)(b & 511u) * sb + (float)(c & 511u) * sc + (float)(d & 511u) * sd;
+    out[1] = (float)((a >> 9) & 511u) * sa + (float)((b >> 9) & 511u) * sb + (float)((c >> 9) & 511u) * sc +
+             (float)((d >> 9) & 511u) * sd;
+    out[2] = (float)((a >> 18) & 511u) * sa + (float)((b >> 18) & 511u) * sb + (float)((c >> 18) & 511u) * sc +
+             (float)((d >> 18) & 511u) * sd;
 }
 
 /* A row's ground: the hit point (x, y) relative to the tiles' corner at
@@ -148,7 +149,7 @@ static uint32_t ground_block(const atlas *A, double x, double y, double *u, doub
 }
 
 /* The ground at (x, y) from the tiles' corner: its block, bilinear. */
-static void ground_px(const atlas *A, cell4 *q, double x, double y, float out[3])
+static void ground_px(const atlas *A, double x, double y, float out[3])
 {
     double u, w;
     uint32_t b = ground_block(A, x, y, &u, &w), first = b == UINT32_MAX ? ATLAS_NOVERT : A->gfirst[b];
@@ -156,7 +157,7 @@ static void ground_px(const atlas *A, cell4 *q, double x, double y, float out[3]
         out[0] = out[1] = out[2] = 0.0f;
         return;
     }
-    bilerp(q, &A->tex[first], ATLAS_BLOCK + 1, ATLAS_BLOCK + 1, (float)u, (float)w, out);
+    bilerp(&A->tex[first], ATLAS_BLOCK + 1, ATLAS_BLOCK + 1, (float)u, (float)w, out);
 }
 
 /* Lists item it unless filled or listed (done byte 2: listed this round). */
@@ -195,27 +196,29 @@ uint32_t atlas_frame_missing(atlas *A, const atlas_view *v, const uint32_t *ids,
     return n;
 }
 
-void atlas_frame_row(const atlas *A, const atlas_view *v, atlas_cache *k, const uint32_t *ids, int32_t j, float *lin)
+void atlas_frame_row(const atlas *A, const atlas_view *v, atlas_cache *k, const uint32_t *ids, int32_t j, float *lin,
+                     uint64_t count[3])
 {
     const atlas_map *m = NULL;
     uint32_t last = MESH_SURF_NONE;
     ground_row g;
-    cell4 q;
     float fj = (float)j, bu = 0, bv = 0, bw = 0;
     int32_t i;
-    q.t = NULL;
     ground_setup(A, v, j, &g);
     for (i = 0; i < v->w; i++) {
         uint32_t sid = ids[i];
         float *o = &lin[3 * (size_t)i];
         if (sid == MESH_SURF_NONE || (sid == MESH_SURF_GROUND && !g.on)) {
             o[0] = o[1] = o[2] = 0.0f;
+            count[0]++;
             continue;
         }
         if (sid == MESH_SURF_GROUND) {
-            ground_px(A, &q, g.x0 + i * g.dx, g.y0 + i * g.dy, o);
+            ground_px(A, g.x0 + i * g.dx, g.y0 + i * g.dy, o);
+            count[1]++;
             continue;
         }
+        count[2]++;
         if (sid != last) {
             m = map_of(A, v, k, sid);
             last = sid;
@@ -231,7 +234,7 @@ void atlas_frame_row(const atlas *A, const atlas_view *v, atlas_cache *k, const 
         }
         {
             float fi = (float)i, r = 1.0f / (bw + m->a[7] * fi);
-            bilerp(&q, &A->tex[m->c->first], m->c->nu, m->c->nv, (bu + m->a[1] * fi) * r, (bv + m->a[4] * fi) * r, o);
+            bilerp(&A->tex[m->c->first], m->c->nu, m->c->nv, (bu + m->a[1] * fi) * r, (bv + m->a[4] * fi) * r, o);
         }
     }
 }

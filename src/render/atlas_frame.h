@@ -43,9 +43,10 @@ typedef struct atlas_cache {
 } atlas_cache;
 
 /* Row j of the frame: lin (3 floats a pixel) from ids (mesh.h's ids, the
- * ground's set), through worker cache k. */
+ * ground's set), through worker cache k; count[0..2] += the row's sky,
+ * ground and building pixels. */
 void atlas_frame_row(const atlas *A, const atlas_view *v, atlas_cache *k, const uint32_t *ids, int32_t j,
-                     float *lin /* OUT */);
+                     float *lin /* OUT */, uint64_t count[3]);
 
 /* The charts and blocks (atlas.h's items) the frame's pixels read that
  * are not filled yet, listed into list (at most cap), each once: their

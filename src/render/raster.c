@@ -576,3 +576,115 @@ size_t raster_triangles(raster_ctx *r, const raster_vertex *verts, size_t nvert,
     }
     return written;
 }
+
+/* ---- surface ids without fragment calls ------------------------------- */
+
+void raster_prepare(const raster_ctx *r, const float *pos, raster_pvert *out)
+{
+    raster_vertex v;
+    svert sv;
+    if (!valid_position(pos)) {
+        out->code = ~0u;
+        return;
+    }
+    out->code = outcode(r, pos);
+    if (out->code != 0)
+        return;
+    memcpy(v.pos, pos, sizeof v.pos);
+    project(r, &v, &sv); /* nattr is 0 for id drawing: no attributes read */
+    out->x = sv.x;
+    out->y = sv.y;
+    out->z = sv.z;
+}
+
+/* draw_triangle with no attributes, depth test and write, and the id
+ * stored: the same spans and the same depth expression per pixel. */
+static size_t draw_triangle_id(raster_ctx *r, const svert *v0, const svert *v1, const svert *v2, int64_t area,
+                               uint32_t id, uint32_t *ids)
+{
+    const raster_target *t = &r->t;
+    edge e[3];
+    int64_t xmin, xmax, ymin, ymax, i0, i1, j0, j1, j;
+    double inv_area = 1.0 / (double)area;
+    double z0 = v0->z, dz1 = v1->z - v0->z, dz2 = v2->z - v0->z;
+    size_t written = 0;
+    int k;
+    edge_setup(&e[0], v1, v2);
+    edge_setup(&e[1], v2, v0);
+    edge_setup(&e[2], v0, v1);
+    xmin = min64(v0->x, min64(v1->x, v2->x));
+    xmax = max64(v0->x, max64(v1->x, v2->x));
+    ymin = min64(v0->y, min64(v1->y, v2->y));
+    ymax = max64(v0->y, max64(v1->y, v2->y));
+    i0 = max64(ceil_div(xmin - FIX_HALF, FIX_ONE), r->sx0);
+    i1 = min64(floor_div(xmax - FIX_HALF, FIX_ONE), (int64_t)r->sx1 - 1);
+    j0 = max64(ceil_div(ymin - FIX_HALF, FIX_ONE), r->sy0);
+    j1 = min64(floor_div(ymax - FIX_HALF, FIX_ONE), (int64_t)r->sy1 - 1);
+    if (i0 > i1 || j0 > j1)
+        return 0;
+    for (j = j0; j <= j1; j++) {
+        int64_t py = j * FIX_ONE + FIX_HALF, px = i0 * FIX_ONE + FIX_HALF;
+        int64_t ev[3], lo = i0, hi = i1, e1, e2, x, s1 = e[1].step_x, s2 = e[2].step_x;
+        float *drow = t->depth + (size_t)j * t->depth_stride;
+        uint32_t *irow = ids + (size_t)j * (size_t)t->width;
+        for (k = 0; k < 3; k++) {
+            int64_t eb, s = e[k].step_x;
+            ev[k] = edge_eval(&e[k], px, py);
+            eb = ev[k] + e[k].bias;
+            if (s > 0) {
+                if (eb < 0)
+                    lo = max64(lo, i0 + ceil_div(-eb, s));
+            } else if (s < 0) {
+                if (eb < 0)
+                    hi = i0 - 1;
+                else
+                    hi = min64(hi, i0 + eb / -s);
+            } else if (eb < 0) {
+                hi = i0 - 1;
+            }
+        }
+        if (lo > hi)
+            continue;
+        e1 = ev[1] + (lo - i0) * s1;
+        e2 = ev[2] + (lo - i0) * s2;
+        for (x = lo; x <= hi; x++, e1 += s1, e2 += s2) {
+            double l1 = (double)e1 * inv_area, l2 = (double)e2 * inv_area;
+            float z = (float)(z0 + l1 * dz1 + l2 * dz2);
+            if (!(z < drow[x]))
+                continue;
+            drow[x] = z;
+            irow[x] = id;
+            written++;
+        }
+    }
+    return written;
+}
+
+long raster_triangle_id(raster_ctx *r, const raster_pvert *p0, const raster_pvert *p1, const raster_pvert *p2,
+                        uint32_t id, uint32_t *ids)
+{
+    svert s[3];
+    int64_t a;
+    size_t n;
+    if ((p0->code | p1->code | p2->code) != 0 || !r->depth_test || !r->depth_write || !r->t.depth ||
+        r->nattr != 0)
+        return -1;
+    r->stats.triangles_in++;
+    s[0].x = p0->x; s[0].y = p0->y; s[0].z = p0->z;
+    s[1].x = p1->x; s[1].y = p1->y; s[1].z = p1->z;
+    s[2].x = p2->x; s[2].y = p2->y; s[2].z = p2->z;
+    a = area2(&s[0], &s[1], &s[2]);
+    if (a == 0) {
+        r->stats.triangles_rejected++;
+        return 0;
+    }
+    if ((r->cull == RASTER_CULL_BACK && a > 0) || (r->cull == RASTER_CULL_FRONT && a < 0)) {
+        r->stats.triangles_culled++;
+        return 0;
+    }
+    n = a > 0 ? draw_triangle_id(r, &s[0], &s[1], &s[2], a, id, ids)
+              : draw_triangle_id(r, &s[0], &s[2], &s[1], -a, id, ids);
+    r->stats.pixels_written += n;
+    r->stats.fragments_shaded += n;
+    return (long)n;
+}

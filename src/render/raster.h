@@ -182,4 +182,24 @@ size_t raster_triangle(raster_ctx *r, const raster_vertex *v0,
 size_t raster_triangles(raster_ctx *r, const raster_vertex *verts, size_t nvert,
                         const uint32_t *idx, size_t ntri);
 
+/*
+ * Surface ids without fragment calls: the same coverage, depths and
+ * depth test (less, written) as raster_triangle with no attributes, the
+ * id written instead of a colour. For a mesh whose triangles share
+ * vertices: raster_prepare projects each vertex once (clip-space x, y, z,
+ * w); raster_triangle_id then draws a triangle whose three prepared
+ * vertices lie inside every clip plane straight from them, and returns -1
+ * for any other triangle (the caller draws it with raster_triangle, whose
+ * fragment function writes the id: the same pixels either way).
+ */
+typedef struct raster_pvert {
+    int64_t x, y;          /* snapped window position */
+    double z;              /* window depth */
+    unsigned code;         /* outcode (clip planes outside); ~0u: invalid input */
+} raster_pvert;
+
+void raster_prepare(const raster_ctx *r, const float *pos, raster_pvert *out /* OUT */);
+long raster_triangle_id(raster_ctx *r, const raster_pvert *v0, const raster_pvert *v1, const raster_pvert *v2,
+                        uint32_t id, uint32_t *ids /* width x height, row 0 at the top */);
+
 #endif

@@ -57,6 +57,7 @@ struct render {
     uint32_t *id;
     float *lin;
     raster_vertex *vbuf;
+    raster_pvert *pv;           /* vbuf's vertices prepared (raster_prepare) */
     float *clip;                /* 4 per vertex of one building */
     render_backend soft;        /* the built-in backend (user = this) */
     raster_ctx rc;              /* its rasteriser state during a frame */
@@ -204,13 +205,17 @@ static void soft_draw(void *user, const float *clip, uint32_t nv, const mesh_tri
 {
     render *r = user;
     uint32_t k;
-    for (k = 0; k < nv; k++)
+    for (k = 0; k < nv; k++) {
         memcpy(r->vbuf[k].pos, clip + 4 * (size_t)k, 4 * sizeof(float));
+        raster_prepare(&r->rc, r->vbuf[k].pos, &r->pv[k]);
+    }
     for (k = 0; k < ntri; k++) {
         const mesh_tri *t = &tri[k];
+        uint32_t a = t->v[0] - v_base, b = t->v[1] - v_base, c = t->v[2] - v_base;
+        if (raster_triangle_id(&r->rc, &r->pv[a], &r->pv[b], &r->pv[c], t->surf, r->id) >= 0)
+            continue; /* inside every clip plane: drawn from the prepared vertices */
         r->cur_id = t->surf;
-        raster_triangle(&r->rc, &r->vbuf[t->v[0] - v_base], &r->vbuf[t->v[1] - v_base],
-                        &r->vbuf[t->v[2] - v_base]);
+        raster_triangle(&r->rc, &r->vbuf[a], &r->vbuf[b], &r->vbuf[c]);
     }
 }
 
@@ -257,6 +262,7 @@ plx_status render_create(arena *a, const scene *s, int32_t max_w, int32_t max_h,
     r->id = arena_alloc(a, PLX_PART_FRAME, arena_mul(px, sizeof(uint32_t)), 64);
     r->lin = arena_alloc(a, PLX_PART_FRAME, arena_mul(px, 3 * sizeof(float)), 64);
     r->vbuf = arena_alloc(a, PLX_PART_FRAME, arena_mul(r->m->max_bld_verts + 1, sizeof(raster_vertex)), 64);
+    r->pv = arena_alloc(a, PLX_PART_FRAME, arena_mul(r->m->max_bld_verts + 1, sizeof(raster_pvert)), 64);
     r->clip = arena_alloc(a, PLX_PART_FRAME, arena_mul(r->m->max_bld_verts + 1, 4 * sizeof(float)), 64);
     r->gxyz = arena_alloc(a, PLX_PART_FRAME, arena_mul(r->m->max_bld_verts + 1, 3 * sizeof(double)), 64);
     r->gtri = arena_alloc(a, PLX_PART_FRAME, arena_mul(r->m->max_bld_tris + 1, sizeof(mesh_tri)), 64);
@@ -269,7 +275,7 @@ plx_status render_create(arena *a, const scene *s, int32_t max_w, int32_t max_h,
     r->wmax = arena_alloc(a, PLX_PART_FRAME, arena_mul(s->nbld + 1, sizeof(double)), R_ALIGN);
     r->draw = arena_alloc(a, PLX_PART_FRAME, s->nbld + 1, R_ALIGN);
     r->bins = arena_alloc(a, PLX_PART_FRAME, RENDER_BINS * sizeof(double), R_ALIGN);
-    if (!r->depth || !r->id || !r->lin || !r->vbuf || !r->clip || !r->gxyz || !r->gtri || !r->sc_id || !r->sc ||
+    if (!r->depth || !r->id || !r->lin || !r->vbuf || !r->pv || !r->clip || !r->gxyz || !r->gtri || !r->sc_id || !r->sc ||
         !r->order || !r->heap || !r->wmin ||
         !r->wmax || !r->draw || !r->bins) {
         arena_release(a, &m0);
@@ -1884,16 +1890,23 @@ static void exposure_part(void *arg, int worker, uint32_t k)
     exposure_count_table(r->et, r->lin, r->id, p0, p1, r->hist[k]);
 }
 
-/* exposure_auto over the frame, its parts counted on the workers (the
- * counts are summed: the same exposure for any number of them). */
-static double exposure_par(render *r, const render_opts *o)
+/* The exposure from the parts' counts (hist[0 .. RENDER_MAX_WORKERS-1]),
+ * summed into hist[0]. */
+static double exposure_sum(render *r)
 {
     uint32_t k, b;
-    run_jobs(o, RENDER_MAX_WORKERS, exposure_part, r);
     for (k = 1; k < RENDER_MAX_WORKERS; k++)
         for (b = 0; b < EXPOSURE_BINS; b++)
             r->hist[0][b] += r->hist[k][b];
     return exposure_from(r->hist[0]);
+}
+
+/* exposure_auto over the frame, its parts counted on the workers (the
+ * counts are summed: the same exposure for any number of them). */
+static double exposure_par(render *r, const render_opts *o)
+{
+    run_jobs(o, RENDER_MAX_WORKERS, exposure_part, r);
+    return exposure_sum(r);
 }
 
 /* ---- adaptive anti-aliasing (render_aa_mask, render_opts.mask) ------------------- */
@@ -2033,16 +2046,25 @@ typedef struct atlas_job {
     render *r;
     const render_opts *o;
     atlas_view v;
+    int count;      /* count the exposure's histogram (automatic exposure) */
+    uint64_t px[RENDER_MAX_WORKERS][3]; /* sky, ground and building pixels, by worker */
 } atlas_job;
 
+/* Rows k RENDER_TILE .. of the frame from the atlas, each counted into
+ * the worker's exposure histogram while it is in the cache (the sums do
+ * not depend on which worker counted what). */
 static void atlas_rows(void *arg, int worker, uint32_t k)
 {
     atlas_job *jb = arg;
     render *r = jb->r;
     int32_t j, j0 = (int32_t)k * RENDER_TILE, j1 = j0 + RENDER_TILE < r->h ? j0 + RENDER_TILE : r->h;
-    for (j = j0; j < j1; j++)
-        atlas_frame_row(jb->o->atlas, &jb->v, &jb->o->atlas_cache[worker], &r->id[(size_t)j * (size_t)r->w], j,
-                        &r->lin[3 * (size_t)j * (size_t)r->w]);
+    for (j = j0; j < j1; j++) {
+        const uint32_t *ids = &r->id[(size_t)j * (size_t)r->w];
+        float *lin = &r->lin[3 * (size_t)j * (size_t)r->w];
+        atlas_frame_row(jb->o->atlas, &jb->v, &jb->o->atlas_cache[worker], ids, j, lin, jb->px[worker]);
+        if (jb->count)
+            exposure_count_table(r->et, lin, ids, 0, (size_t)r->w, r->hist[worker]);
+    }
 }
 
 /* Every pixel from the atlas: the ground's ids set, then rows of pixels
@@ -2051,7 +2073,6 @@ static void atlas_pass(render *r, const render_opts *o, render_stats *st)
 {
     atlas_job jb;
     double ta = r->tanh_ * r->aspect, tb = r->tanh_, a0, b0;
-    size_t p, px = (size_t)r->w * (size_t)r->h;
     int k;
     ground_ids(r);
     a0 = (2.0 * (0.5 + r->shift[0]) / r->w - 1.0) * ta;
@@ -2069,17 +2090,17 @@ static void atlas_pass(render *r, const render_opts *o, render_stats *st)
         jb.v.stamp = ++r->frames;
     jb.r = r;
     jb.o = o;
+    jb.count = o->auto_exposure;
     if (o->atlas_need)
         o->atlas_need(o->atlas_user, &jb.v, r->id);
+    if (jb.count)
+        memset(r->hist, 0, sizeof r->hist);
+    memset(jb.px, 0, sizeof jb.px);
     run_jobs(o, (uint32_t)((r->h + RENDER_TILE - 1) / RENDER_TILE), atlas_rows, &jb);
-    for (p = 0; p < px; p++) {
-        uint32_t id = r->id[p];
-        if (id == MESH_SURF_NONE)
-            st->sky_pixels++;
-        else if (id == MESH_SURF_GROUND)
-            st->ground_pixels++;
-        else
-            st->building_pixels++;
+    for (k = 0; k < RENDER_MAX_WORKERS; k++) {
+        st->sky_pixels += jb.px[k][0];
+        st->ground_pixels += jb.px[k][1];
+        st->building_pixels += jb.px[k][2];
     }
 }
 
@@ -2145,8 +2166,12 @@ plx_status render_frame(render *r, const render_camera *cam, const render_opts *
     if (r->sparse)
         sparse_rest(r, o, &st);
 finish:
-    /* the exposure from the lit surfaces, before the glows */
-    st.exposure = o->auto_exposure ? exposure_par(r, o) : o->exposure;
+    /* the exposure from the lit surfaces, before the glows (counted by
+     * the atlas's rows as they were read) */
+    if (o->atlas && o->auto_exposure)
+        st.exposure = exposure_sum(r);
+    else
+        st.exposure = o->auto_exposure ? exposure_par(r, o) : o->exposure;
     if (!o->no_glow)
         glows(r, o, &st);
     if (rgbf)
