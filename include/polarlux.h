@@ -693,6 +693,23 @@ typedef struct plx_render_opts {
 
 #define PLX_RENDER_MAX_AA 16
 
+/* The radiance atlas frames with indirect light read (README "The radiance
+ * atlas"): made at the first such frame (or by plx_bake_prepare), filled
+ * as frames need it (or whole by plx_bake_save). */
+typedef struct plx_atlas_info {
+    int made;                   /* 0: no atlas yet (the rest is 0) */
+    double spacing;             /* m between sample points on surfaces a lamp may light */
+    double coarse;              /* and on the others (indirect light only) */
+    uint64_t points;            /* sample points, 4 bytes each */
+    uint64_t points_fine;       /* of which at the fine spacing */
+    size_t bytes;               /* the atlas's memory (part PLX_PART_FRAME) */
+    uint64_t unfilled;          /* charts and ground blocks not filled yet (0: complete) */
+    int indirect;               /* its values hold indirect light */
+} plx_atlas_info;
+
+/* Fills out. Errors: PLX_E_INVALID (out NULL). Threads: engine (reads). */
+plx_status plx_atlas_info_get(plx_engine *e, plx_atlas_info *out /* OUT */);
+
 /* Exposure 1, everything else off (NULL: nothing). Threads: any. */
 void plx_render_opts_default(plx_render_opts *o /* OUT */);
 

@@ -338,6 +338,25 @@ plx_status eng_need_atlas(plx_engine *e, double fine)
     return PLX_OK;
 }
 
+plx_status plx_atlas_info_get(plx_engine *e, plx_atlas_info *out)
+{
+    const atlas *A;
+    if (!eng_ok(e) || !out)
+        return PLX_E_INVALID;
+    memset(out, 0, sizeof *out);
+    if (!(A = e->atlas))
+        return PLX_OK;
+    out->made = 1;
+    out->spacing = A->fine;
+    out->coarse = A->coarse;
+    out->points = A->ntex;
+    out->points_fine = A->ntex_fine;
+    out->bytes = A->bytes;
+    out->unfilled = A->todo;
+    out->indirect = A->with_ind;
+    return PLX_OK;
+}
+
 /* Worker 0 of a fill: the engine's light object, records in scratch. */
 static int atlas_worker0(plx_engine *e, atlas_worker *w)
 {

@@ -112,6 +112,8 @@ void cli_aa_warn(const char *cmd, const cli_common *c, const plx_render_opts *o,
  * together) the later anti-aliasing samples shaded, later of them, and
  * whether they were adaptive. */
 void cli_aa_print(const plx_render_opts *o, uint64_t later, double px, int adaptive);
+/* One line on the engine's radiance atlas (nothing when it has none). */
+void cli_atlas_print(plx_engine *e);
 /* Coordinates of options (--at, --eye, --box, ...) are the scene's own:
  * lon/lat degrees on a lon/lat scene, metres on a metre scene. These turn
  * them into the engine's local metres and back; to_local returns -1 when a

@@ -17,9 +17,11 @@ static const char help[] =
     "Loads SCENE and builds everything queries and frames need: polar diagrams,\n"
     "lamp light, photon buffers with K frames of N photons (levels for a viewer\n"
     "at the centre, all around), the renderer for frames up to --max-size and\n"
-    "the aerial light map with its indirect layer (gathered after the photons\n"
-    "on --threads workers: most of the time on a large city, with a progress\n"
-    "line on a terminal); then writes it all to one file. Every command that\n"
+    "the radiance atlas: every surface's light (exact direct light, indirect\n"
+    "light from the photons) at sample points --texel metres apart, which\n"
+    "street and aerial frames read (filled after the photons on --threads\n"
+    "workers, with a progress line on a terminal; with --no-indirect the aerial\n"
+    "light map of direct light instead); then writes it all to one file. Every command that\n"
     "takes a SCENE also takes the bake file and starts at once (README 'Bake\n"
     "files'). Prints the file size, the engine memory in use and the times.\n"
     "\n"
@@ -28,13 +30,15 @@ static const char help[] =
     "  --frames K      photon frames (default 16: the points' final gathering\n"
     "                  reads them too)\n"
     "  --no-indirect   no photon buffers\n"
-    "  --no-aerial     no aerial light map\n"
+    "  --no-aerial     no radiance atlas (frames then fill it as they need it)\n"
     "  --no-polar      no polar diagrams: frames do not need them (a bake for a\n"
     "                  walk in a small --mem); queries build them when asked\n"
-    "  --texel M       aerial light map resolution (default 1 m, coarser if the budget needs)\n"
+    "  --texel M       the atlas's spacing between sample points (default 0.5 m,\n"
+    "                  coarser until it fits its budget: half the free --mem, at\n"
+    "                  most 64 MiB; printed)\n"
     "  --max-size WxH  the largest frame the loaded engine renders (default 1024x768)\n"
-    "  --threads N     threads for the aerial light map and its indirect layer\n"
-    "                  (default: the number of processors); the same map for any N\n"
+    "  --threads N     threads for filling the atlas (default: the number of\n"
+    "                  processors); the same file for any N\n"
     "  --mem SIZE, --strict, --quiet   as for 'polarlux info'\n"
     "\n"
     "Exit codes: 0 written, 1 the scene or the file failed, 2 usage, 3 --mem too small.\n";
@@ -223,7 +227,8 @@ int cmd_bake(int argc, char **argv)
         plx_memory_get(e, &m);
         printf("baked %s into %s: %zu bytes (%.1f MB); engine memory in use %zu bytes (%.1f MB)\n", a.scene,
                a.out, bytes, bytes / 1048576.0, m.used_total, m.used_total / 1048576.0);
-        printf("times: load and build %.0f ms, photons %.0f ms (%ld x %ld), aerial indirect layer, twin and save %.0f ms, "
+        cli_atlas_print(e);
+        printf("times: load and build %.0f ms, photons %.0f ms (%ld x %ld), radiance atlas, twin and save %.0f ms, "
                "total %.2f s\n", (t1 - t0) / 1e6, (t2 - t1) / 1e6, a.ind.off ? 0L : a.ind.frames,
                a.ind.photons, (port_now_ns() - t2) / 1e6, (port_now_ns() - t0) / 1e9);
     }

@@ -15,14 +15,16 @@
 static const char help[] =
     "usage: polarlux walk SCENE|BAKE --path CAMERA.geojson -o DIR [--size WxH] [--fps F]\n"
     "                     [--speed M/S] [--fov DEG] [--aa N [--aa-full]] [--exposure E]\n"
-    "                     [--no-glow] [--no-indirect] [--view street|aerial] [--max-frames N]\n"
-    "                     [--threads N]\n"
+    "                     [--no-glow] [--no-indirect] [--per-pixel] [--view street|aerial]\n"
+    "                     [--max-frames N] [--texel M] [--threads N]\n"
     "\n"
     "Renders frames along a camera path and writes DIR/frame-0001.png ...,\n"
     "DIR/cameras.txt (frame, eye, target), DIR/walk.png (the frames as an animated\n"
     "PNG, 1/F s each, looping) and DIR/contact.png (a contact sheet\n"
     "of up to 16 frames). Everything is built once (or loaded from a bake) and\n"
-    "reused by every frame. Prints the render time per frame (median, p95)\n"
+    "reused by every frame: with indirect light each frame reads the radiance\n"
+    "atlas (see render), filled as the frames need it or held by the bake.\n"
+    "Prints the render time per frame (median, p95)\n"
     "and frames per second; says on stderr how many frames are entirely black, if any.\n"
     "\n"
     "  --path FILE      a GeoJSON LineString of eye positions [x, y] or [x, y, z]\n"
@@ -35,7 +37,8 @@ static const char help[] =
     "  --aa N           N x N samples per pixel (default 2; 1: pixel centres, SPEC §5),\n"
     "                   the later ones only at edges, as for render (--aa-full: all)\n"
     "  --exposure E     fixed exposure, no tone curve (default: automatic per frame)\n"
-    "  --no-glow, --no-indirect, --view V, --photons N, --frames K   as for render\n"
+    "  --no-glow, --no-indirect, --per-pixel, --view V, --texel M, --photons N,\n"
+    "  --frames K       as for render\n"
     "  --max-frames N   at most N frames (default 1000)\n"
     "  --refine         near-viewer refinement (munoz2013 §3.3-3.4): before each frame\n"
     "                   the lamps near the eye get floor photon maps in an LRU cache,\n"
@@ -69,6 +72,11 @@ static int parse_exposure(const char *val, void *dst)
     return cli_parse_double(val, v) != 0 || !(*v >= 0) ? -1 : 0;
 }
 
+static int parse_texel(const char *val, void *dst)
+{
+    return cli_parse_real(val, 0.01, 1e4, dst);
+}
+
 static int parse_refine_frames(const char *val, void *dst)
 {
     return cli_parse_int(val, 0, 100000, dst);
@@ -93,6 +101,8 @@ static int parse_args(int argc, char **argv, walk_args *a)
         CLI_OPT_VAL("--refine-frames", &a->refine_frames, parse_refine_frames,
                     "--refine-frames '%s' is not a whole number >= 0"),
         CLI_OPT_VAL("--max-frames", &a->max_frames, parse_max_frames, "--max-frames '%s' is not a whole number >= 1"),
+        CLI_OPT_VAL("--texel", &a->opts.aerial_m_per_texel, parse_texel,
+                    "--texel '%s' is not a number of metres from 0.01 to 1e4"),
         CLI_OPT_MORE(v.frag),
         CLI_OPT_END
     };

@@ -799,3 +799,15 @@ void cli_aa_print(const plx_render_opts *o, uint64_t later, double px, int adapt
                all > 0.0 ? 100.0 * (double)later / all : 0.0,
                adaptive ? "adaptive: edges and glows; --aa-full for all" : "every sample");
 }
+
+void cli_atlas_print(plx_engine *e)
+{
+    plx_atlas_info ai;
+    if (plx_atlas_info_get(e, &ai) != PLX_OK || !ai.made)
+        return;
+    printf("radiance atlas: %llu sample points %.2f m apart (%.2f m where only indirect light reaches), "
+           "%zu bytes (%.1f MB), %s%s\n",
+           (unsigned long long)ai.points, ai.spacing, ai.coarse, ai.bytes, ai.bytes / 1048576.0,
+           ai.unfilled ? "filled as frames need it" : "filled",
+           ai.indirect ? ", indirect light included" : ", direct light only");
+}

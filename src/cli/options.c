@@ -155,6 +155,7 @@ static void view_opts(cli_view *v)
         CLI_OPT_FLAG("--aa-full", &v->aa_full),
         CLI_OPT_FLAG("--no-glow", &v->no_glow),
         CLI_OPT_FLAG("--refine", &v->refine),
+        CLI_OPT_FLAG("--per-pixel", &v->per_pixel),
         CLI_OPT_END
     };
     memcpy(v->frag, f, sizeof f);
@@ -180,6 +181,7 @@ void cli_view_apply(const cli_view *v, const cli_indirect *ind, plx_render_opts 
     o->aa_full = v->aa_full;
     o->no_glow = v->no_glow;
     o->aerial = v->aerial;
+    o->per_pixel = v->per_pixel;
     if (v->exposure)
         o->auto_exposure = 0;
     o->no_indirect = ind->off;

@@ -70,7 +70,7 @@ int cli_opt_size(const char *value, void *dst);
 
 /* ---- the view options of render and walk ---------------------------------- */
 
-#define CLI_VIEW_NOPTS 8
+#define CLI_VIEW_NOPTS 9
 
 typedef struct cli_view {
     long size[2];           /* --size WxH (1..8192 each) */
@@ -79,6 +79,7 @@ typedef struct cli_view {
     int aerial;             /* --view street|aerial */
     int no_glow, refine;    /* --no-glow, --refine */
     int aa_full;            /* --aa-full */
+    int per_pixel;          /* --per-pixel: light computed at every pixel, not read from the atlas */
     int exposure;           /* --exposure was given (the command's own table
                              * entry sets it): no automatic exposure */
     cli_opt frag[CLI_VIEW_NOPTS]; /* the options above (the last entry
@@ -91,8 +92,8 @@ typedef struct cli_view {
  * no refinement, and its options in v->frag. */
 void cli_view_init(cli_view *v, long w, long h, double fov, plx_render_opts *o, cli_indirect *ind);
 
-/* After parsing: the anti-aliasing, glow, view, exposure and --no-indirect
- * into o. */
+/* After parsing: the anti-aliasing, glow, view, exposure, --per-pixel and
+ * --no-indirect into o. */
 void cli_view_apply(const cli_view *v, const cli_indirect *ind, plx_render_opts *o);
 
 #endif

@@ -196,8 +196,8 @@ uint32_t atlas_frame_missing(atlas *A, const atlas_view *v, const uint32_t *ids,
     return n;
 }
 
-void atlas_frame_row(const atlas *A, const atlas_view *v, atlas_cache *k, const uint32_t *ids, int32_t j, float *lin,
-                     uint64_t count[3])
+void atlas_frame_row(const atlas *A, const atlas_view *v, atlas_cache *k, const uint32_t *ids, const uint8_t *mask,
+                     int32_t j, float *lin, uint64_t count[3])
 {
     const atlas_map *m = NULL;
     uint32_t last = MESH_SURF_NONE;
@@ -208,6 +208,8 @@ void atlas_frame_row(const atlas *A, const atlas_view *v, atlas_cache *k, const 
     for (i = 0; i < v->w; i++) {
         uint32_t sid = ids[i];
         float *o = &lin[3 * (size_t)i];
+        if (mask && !mask[i])
+            continue;
         if (sid == MESH_SURF_NONE || (sid == MESH_SURF_GROUND && !g.on)) {
             o[0] = o[1] = o[2] = 0.0f;
             count[0]++;

@@ -2061,7 +2061,8 @@ static void atlas_rows(void *arg, int worker, uint32_t k)
     for (j = j0; j < j1; j++) {
         const uint32_t *ids = &r->id[(size_t)j * (size_t)r->w];
         float *lin = &r->lin[3 * (size_t)j * (size_t)r->w];
-        atlas_frame_row(jb->o->atlas, &jb->v, &jb->o->atlas_cache[worker], ids, j, lin, jb->px[worker]);
+        const uint8_t *mask = jb->o->mask ? &jb->o->mask[(size_t)j * (size_t)r->w] : NULL;
+        atlas_frame_row(jb->o->atlas, &jb->v, &jb->o->atlas_cache[worker], ids, mask, j, lin, jb->px[worker]);
         if (jb->count)
             exposure_count_table(r->et, lin, ids, 0, (size_t)r->w, r->hist[worker]);
     }
@@ -2075,6 +2076,8 @@ static void atlas_pass(render *r, const render_opts *o, render_stats *st)
     double ta = r->tanh_ * r->aspect, tb = r->tanh_, a0, b0;
     int k;
     ground_ids(r);
+    if (o->mask) /* adaptive anti-aliasing's later samples: only the marked pixels */
+        mask_update(r, o);
     a0 = (2.0 * (0.5 + r->shift[0]) / r->w - 1.0) * ta;
     b0 = (1.0 - 2.0 * (0.5 + r->shift[1]) / r->h) * tb;
     for (k = 0; k < 3; k++) {

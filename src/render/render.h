@@ -313,8 +313,9 @@ typedef struct render_opts {
                                   gets its byte set to 1. NULL: every pixel */
     const uint32_t *mask_id;   /* with mask: the first sample's surface ids */
     const struct atlas *atlas; /* not NULL: every pixel read from this radiance atlas (atlas.h,
-                                  atlas_frame.h) instead of shaded; the indirect hooks, the
-                                  light map and the mask are then not used */
+                                  atlas_frame.h) instead of shaded (the mask's pixels only,
+                                  when there is one); the indirect hooks and the light map
+                                  are then not used */
     struct atlas_cache *atlas_cache; /* with atlas: one per worker (workers of them, at least 1) */
     void (*atlas_need)(void *user, const struct atlas_view *v, const uint32_t *ids);
                                /* with atlas (may be NULL): called once the frame's surface ids
