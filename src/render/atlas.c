@@ -158,6 +158,23 @@ static void cut_wall(const scene *s, uint32_t o, double *zlo, double *zhi)
         *zhi = lo;
 }
 
+/* Wall x of keys i .. j-1 (one edge) cut by every building on the other
+ * side of the edge, again until no cut changes it: solids stacked against
+ * it (one over another) reach its end one after the other, in any order. */
+static void cut_by_all(const scene *s, const wall_key *k, uint32_t i, uint32_t j, uint32_t x, double *zlo,
+                       double *zhi)
+{
+    int changed = 1;
+    while (changed && *zhi > *zlo) {
+        double lo = *zlo, hi = *zhi;
+        uint32_t y;
+        for (y = i; y < j; y++)
+            if (k[x].flip != k[y].flip && k[x].bld != k[y].bld)
+                cut_wall(s, k[y].bld, zlo, zhi);
+        changed = *zlo != lo || *zhi != hi;
+    }
+}
+
 /* Each wall's visible heights [zlo[pt], zhi[pt]] (zlo == zhi: hidden):
  * its building's, less those of a building whose footprint has the same
  * edge the other way round. Scratch from a; -1 when short. */
@@ -184,15 +201,13 @@ static int wall_heights(arena *a, const scene *s, double *zlo, double *zhi)
             }
     sort_keys(k, tmp, n, NULL);
     for (i = 0; i < n; i = j) {
-        uint32_t x, y;
+        uint32_t x;
         for (j = i + 1; j < n && k[j].a.x == k[i].a.x && k[j].a.y == k[i].a.y && k[j].b.x == k[i].b.x &&
                         k[j].b.y == k[i].b.y;
              j++)
             ;
         for (x = i; x < j; x++)
-            for (y = i; y < j; y++)
-                if (k[x].flip != k[y].flip && k[x].bld != k[y].bld)
-                    cut_wall(s, k[y].bld, &zlo[k[x].pt], &zhi[k[x].pt]);
+            cut_by_all(s, k, i, j, x, &zlo[k[x].pt], &zhi[k[x].pt]);
     }
     return 0;
 }
@@ -527,31 +542,39 @@ size_t atlas_plan(arena *a, const scene *s, const mesh *m, double fine, uint64_t
 double atlas_spacing_for(arena *a, const scene *s, const mesh *m, double fine, size_t max_bytes)
 {
     const double step = 1.189207115002721; /* 2^(1/4) */
-    double f = fine > 0.0 && isfinite(fine) ? fine : ATLAS_FINE_DEFAULT, c;
+    double f0 = fine > 0.0 && isfinite(fine) ? fine : ATLAS_FINE_DEFAULT, c;
     size_t bc;
-    /* a cheap first guess from a plan at four times the spacing (its bytes
-     * grow about as 1 / spacing^2), one step finer to be safe */
-    bc = atlas_plan(a, s, m, 4.0 * f, NULL);
+    int k = 0, n;
+    /* a first guess k steps up from a plan at four times the spacing (its
+     * bytes grow about as 1 / spacing^2), then the finest step that fits:
+     * down while the next finer one fits, else up until one does */
+    bc = atlas_plan(a, s, m, 4.0 * f0, NULL);
     if (bc != SIZE_MAX && bc > 0 && max_bytes > 0) {
-        c = 4.0 * f * sqrt((double)bc / (double)max_bytes) / step;
-        while (f * step <= c && f < 64.0)
-            f *= step;
+        c = 4.0 * f0 * sqrt((double)bc / (double)max_bytes);
+        while (f0 * pow(step, k + 1) <= c && k < 64)
+            k++;
     }
-    for (; f <= 64.0; f *= step)
-        if (atlas_plan(a, s, m, f, NULL) <= max_bytes)
-            return f;
+    for (n = 0; n < 64 && f0 * pow(step, k) <= 64.0; n++) {
+        if (atlas_plan(a, s, m, f0 * pow(step, k), NULL) <= max_bytes) {
+            while (k > 0 && atlas_plan(a, s, m, f0 * pow(step, k - 1), NULL) <= max_bytes)
+                k--;
+            return f0 * pow(step, k);
+        }
+        k++;
+    }
     return 0.0;
 }
 
 plx_status atlas_create(arena *a, const scene *s, const mesh *m, double fine, atlas **out)
 {
     atlas F, *A;
-    arena_mark mk = arena_get_mark(a);
+    arena_mark mk;
     lay_scratch ls;
     uint64_t n;
     size_t nt;
     if (!a || !s || !m || !out || !(fine > 0.0) || !isfinite(fine))
         return PLX_E_INVALID;
+    mk = arena_get_mark(a);
     if (frame(&F, s, m, fine) != 0)
         return PLX_E_NOMEM;
     if (lay_scratch_get(a, &F, &ls) != 0) {

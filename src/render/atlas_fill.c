@@ -80,6 +80,52 @@ static uint32_t solid_at(const light *L, vec2 p)
     return UINT32_MAX;
 }
 
+/* The nearest point to p on an edge of a building within radius rad of p
+ * (the light's building grid), moved GROUND_OUT out of it along the
+ * edge's outward normal, that lies strictly inside no solid standing on
+ * the ground: visible ground. 1 with *q set, 0 when there is none. */
+static int open_ground_near(const light *L, vec2 p, double rad, vec2 *q)
+{
+    const scene *s = L->s;
+    const bucketgrid *g = &L->bgrid;
+    double box[4], best = INFINITY;
+    uint32_t r0[4], x, y, k, r, e;
+    int found = 0;
+    box[0] = p.x - rad;
+    box[1] = p.y - rad;
+    box[2] = p.x + rad;
+    box[3] = p.y + rad;
+    bucketgrid_range(g, box, r0);
+    for (y = r0[1]; y <= r0[3]; y++)
+        for (x = r0[0]; x <= r0[2]; x++)
+            for (k = g->start[y * g->nx + x]; k < g->start[y * g->nx + x + 1]; k++) {
+                const scene_building *bd = &s->bld[g->item[k]];
+                if (bd->box[0] > box[2] || bd->box[2] < box[0] || bd->box[1] > box[3] || bd->box[3] < box[1])
+                    continue;
+                for (r = bd->ring_first; r < bd->ring_first + bd->ring_count; r++)
+                    for (e = 0; e < s->rings[r].count; e++) {
+                        vec2 a = s->pts[s->rings[r].first + e];
+                        vec2 b = s->pts[s->rings[r].first + (e + 1) % s->rings[r].count];
+                        double ex = b.x - a.x, ey = b.y - a.y, l2 = ex * ex + ey * ey, t, l, d2;
+                        vec2 c;
+                        if (!(l2 > 0.0))
+                            continue;
+                        t = ((p.x - a.x) * ex + (p.y - a.y) * ey) / l2;
+                        t = t < 0.0 ? 0.0 : t > 1.0 ? 1.0 : t;
+                        l = sqrt(l2);
+                        c.x = a.x + t * ex + GROUND_OUT * ey / l;
+                        c.y = a.y + t * ey - GROUND_OUT * ex / l;
+                        d2 = (c.x - p.x) * (c.x - p.x) + (c.y - p.y) * (c.y - p.y);
+                        if (d2 < best && d2 <= rad * rad && solid_at(L, c) == UINT32_MAX) {
+                            best = d2;
+                            *q = c;
+                            found = 1;
+                        }
+                    }
+            }
+    return found; /* within rad: no building outside the box has a point nearer */
+}
+
 void atlas_vertex_site(const atlas *A, const light *L, const atlas_chart *c, uint32_t i, uint32_t j, double P[3],
                        double n[3])
 {
@@ -95,9 +141,21 @@ void atlas_vertex_site(const atlas *A, const light *L, const atlas_chart *c, uin
     } else if (c->kind == ATLAS_GROUND) {
         uint32_t b = solid_at(L, p);
         if (b != UINT32_MAX) {
+            double rad;
             nearest_boundary(A->s, b, p, &q, &o);
-            P[0] = q.x + GROUND_OUT * o.x;
-            P[1] = q.y + GROUND_OUT * o.y;
+            q.x += GROUND_OUT * o.x;
+            q.y += GROUND_OUT * o.y;
+            /* that point may lie in another solid (a wall shared by two
+             * buildings, a narrow reflex corner): then the nearest open
+             * ground around, searched ever farther */
+            rad = 2.0 * sqrt((q.x - p.x) * (q.x - p.x) + (q.y - p.y) * (q.y - p.y)) + 1.0;
+            while (solid_at(L, q) != UINT32_MAX && rad <= 256.0) {
+                if (open_ground_near(L, p, rad, &q))
+                    break;
+                rad *= 2.0;
+            }
+            P[0] = q.x;
+            P[1] = q.y;
         }
     }
 }

@@ -597,6 +597,45 @@ void raster_prepare(const raster_ctx *r, const float *pos, raster_pvert *out)
     out->z = sv.z;
 }
 
+/* One edge's bound along the rows of draw_triangle_id: with s = |step_x|
+ * and eb the edge function plus bias at the row's first pixel, q =
+ * floor(eb / s) and the remainder r (0 <= r < s), carried from row to row
+ * by the change of eb per row (dq, dr: its quotient and remainder,
+ * taken on the second row): the same bounds as the divisions of
+ * draw_triangle at every row, without them. */
+typedef struct edge_walk {
+    int64_t s, q, r, d, dq, dr;
+    int have_step;
+} edge_walk;
+
+static void walk_start(edge_walk *w, const edge *e, int64_t eb)
+{
+    w->s = e->step_x < 0 ? -e->step_x : e->step_x;
+    w->d = e->dx * FIX_ONE;
+    w->have_step = 0;
+    if (w->s == 0)
+        return;
+    w->q = floor_div(eb, w->s);
+    w->r = eb - w->q * w->s;
+}
+
+static void walk_row(edge_walk *w)
+{
+    if (w->s == 0)
+        return;
+    if (!w->have_step) {
+        w->dq = floor_div(w->d, w->s);
+        w->dr = w->d - w->dq * w->s;
+        w->have_step = 1;
+    }
+    w->q += w->dq;
+    w->r += w->dr;
+    if (w->r >= w->s) {
+        w->r -= w->s;
+        w->q++;
+    }
+}
+
 /* draw_triangle with no attributes, depth test and write, and the id
  * stored: the same spans and the same depth expression per pixel. */
 static size_t draw_triangle_id(raster_ctx *r, const svert *v0, const svert *v1, const svert *v2, int64_t area,
@@ -604,7 +643,8 @@ static size_t draw_triangle_id(raster_ctx *r, const svert *v0, const svert *v1, 
 {
     const raster_target *t = &r->t;
     edge e[3];
-    int64_t xmin, xmax, ymin, ymax, i0, i1, j0, j1, j;
+    edge_walk wk[3];
+    int64_t xmin, xmax, ymin, ymax, i0, i1, j0, j1, j, eb0[3], ev1, ev2;
     double inv_area = 1.0 / (double)area;
     double z0 = v0->z, dz1 = v1->z - v0->z, dz2 = v2->z - v0->z;
     size_t written = 0;
@@ -622,31 +662,41 @@ static size_t draw_triangle_id(raster_ctx *r, const svert *v0, const svert *v1, 
     j1 = min64(floor_div(ymax - FIX_HALF, FIX_ONE), (int64_t)r->sy1 - 1);
     if (i0 > i1 || j0 > j1)
         return 0;
+    for (k = 0; k < 3; k++) {
+        eb0[k] = edge_eval(&e[k], i0 * FIX_ONE + FIX_HALF, j0 * FIX_ONE + FIX_HALF) + e[k].bias;
+        walk_start(&wk[k], &e[k], eb0[k]);
+    }
+    ev1 = eb0[1] - e[1].bias;
+    ev2 = eb0[2] - e[2].bias;
     for (j = j0; j <= j1; j++) {
-        int64_t py = j * FIX_ONE + FIX_HALF, px = i0 * FIX_ONE + FIX_HALF;
-        int64_t ev[3], lo = i0, hi = i1, e1, e2, x, s1 = e[1].step_x, s2 = e[2].step_x;
+        int64_t lo = i0, hi = i1, e1, e2, x, s1 = e[1].step_x, s2 = e[2].step_x;
         float *drow = t->depth + (size_t)j * t->depth_stride;
         uint32_t *irow = ids + (size_t)j * (size_t)t->width;
+        if (j > j0) {
+            for (k = 0; k < 3; k++)
+                walk_row(&wk[k]);
+            ev1 += e[1].dx * FIX_ONE;
+            ev2 += e[2].dx * FIX_ONE;
+            eb0[0] += e[0].dx * FIX_ONE;
+        }
         for (k = 0; k < 3; k++) {
-            int64_t eb, s = e[k].step_x;
-            ev[k] = edge_eval(&e[k], px, py);
-            eb = ev[k] + e[k].bias;
-            if (s > 0) {
-                if (eb < 0)
-                    lo = max64(lo, i0 + ceil_div(-eb, s));
-            } else if (s < 0) {
-                if (eb < 0)
+            int64_t sx = e[k].step_x;
+            if (sx > 0) {
+                if (wk[k].q < 0) /* eb < 0: from ceil(-eb / s) = -floor(eb / s) */
+                    lo = max64(lo, i0 - wk[k].q);
+            } else if (sx < 0) {
+                if (wk[k].q < 0)
                     hi = i0 - 1;
                 else
-                    hi = min64(hi, i0 + eb / -s);
-            } else if (eb < 0) {
+                    hi = min64(hi, i0 + wk[k].q);
+            } else if ((k == 0 ? eb0[0] : k == 1 ? ev1 + e[1].bias : ev2 + e[2].bias) < 0) {
                 hi = i0 - 1;
             }
         }
         if (lo > hi)
             continue;
-        e1 = ev[1] + (lo - i0) * s1;
-        e2 = ev[2] + (lo - i0) * s2;
+        e1 = ev1 + (lo - i0) * s1;
+        e2 = ev2 + (lo - i0) * s2;
         for (x = lo; x <= hi; x++, e1 += s1, e2 += s2) {
             double l1 = (double)e1 * inv_area, l2 = (double)e2 * inv_area;
             float z = (float)(z0 + l1 * dz1 + l2 * dz2);

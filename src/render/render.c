@@ -6,6 +6,7 @@
 #include "base/plx_assert.h"
 #include "render/render.h"
 #include "render/atlas_frame.h"
+#include "base/bucketgrid.h"
 #include "render/exposure.h"
 #include "render/tonemap.h"
 #include "render/raster.h"
@@ -72,6 +73,13 @@ struct render {
     uint32_t nheap;
     double *wmin, *wmax;        /* nbld */
     uint8_t *draw;              /* nbld */
+    /* the buildings by cells of a grid (each in the cell of its box's
+     * centre), each cell with the box of its buildings' boxes: a cell
+     * wholly outside the frustum culls its buildings at once */
+    uint32_t ncell;
+    uint32_t *cell_start;       /* ncell + 1 offsets into cell_bld */
+    uint32_t *cell_bld;         /* nbld building indices, cell by cell, ascending */
+    double *cell_box;           /* 6 a cell: minx, miny, minz, maxx, maxy, maxz */
     double *bins;               /* RENDER_BINS */
     /* frame state */
     int32_t w, h;
@@ -230,6 +238,60 @@ static int soft_finish(void *user, uint32_t *id, float *depth)
     return 0;
 }
 
+#define CULL_CELL 64.0  /* m, the culling grid's cells */
+
+/* The culling grid's side in cells (at most 256) over the buildings' boxes. */
+static uint32_t cull_side(const scene *s, double *x0, double *y0, double *cell)
+{
+    double w = s->bounds[2] - s->bounds[0], h = s->bounds[3] - s->bounds[1], side = fmax(w, h);
+    uint32_t n = (uint32_t)fmin(256.0, fmax(1.0, ceil(side / CULL_CELL)));
+    *x0 = s->bounds[0];
+    *y0 = s->bounds[1];
+    *cell = side > 0.0 ? side / n : 1.0;
+    return n;
+}
+
+static uint32_t cull_cell_of(const scene_building *bd, double x0, double y0, double cell, uint32_t n)
+{
+    double cx = 0.5 * (bd->box[0] + bd->box[2]), cy = 0.5 * (bd->box[1] + bd->box[3]);
+    return bucketgrid_index(cy, y0, 1.0 / cell, n) * n + bucketgrid_index(cx, x0, 1.0 / cell, n);
+}
+
+/* Fills the culling grid (its arrays taken already): counts, offsets,
+ * the buildings in index order within each cell, the cells' boxes. */
+static void cull_grid_fill(render *r)
+{
+    const scene *s = r->s;
+    double x0, y0, cell;
+    uint32_t n = cull_side(s, &x0, &y0, &cell), b, c, k;
+    memset(r->cell_start, 0, (r->ncell + 1) * sizeof *r->cell_start);
+    for (b = 0; b < s->nbld; b++)
+        r->cell_start[cull_cell_of(&s->bld[b], x0, y0, cell, n) + 1]++;
+    for (c = 0; c < r->ncell; c++)
+        r->cell_start[c + 1] += r->cell_start[c];
+    for (b = 0; b < s->nbld; b++) { /* placed after the cell's earlier ones, then shifted back */
+        c = cull_cell_of(&s->bld[b], x0, y0, cell, n);
+        r->cell_bld[r->cell_start[c]++] = b;
+    }
+    for (c = r->ncell; c > 0; c--)
+        r->cell_start[c] = r->cell_start[c - 1];
+    r->cell_start[0] = 0;
+    for (c = 0; c < r->ncell; c++) {
+        double *bx = &r->cell_box[6 * (size_t)c];
+        bx[0] = bx[1] = bx[2] = HUGE_VAL;
+        bx[3] = bx[4] = bx[5] = -HUGE_VAL;
+        for (k = r->cell_start[c]; k < r->cell_start[c + 1]; k++) {
+            double bb[6];
+            int q;
+            mesh_box(r->m, r->cell_bld[k], bb);
+            for (q = 0; q < 3; q++) {
+                bx[q] = fmin(bx[q], bb[q]);
+                bx[3 + q] = fmax(bx[3 + q], bb[3 + q]);
+            }
+        }
+    }
+}
+
 plx_status render_create(arena *a, const scene *s, int32_t max_w, int32_t max_h,
                          render_shade_fn shade, void *user, render **out)
 {
@@ -275,12 +337,21 @@ plx_status render_create(arena *a, const scene *s, int32_t max_w, int32_t max_h,
     r->wmax = arena_alloc(a, PLX_PART_FRAME, arena_mul(s->nbld + 1, sizeof(double)), R_ALIGN);
     r->draw = arena_alloc(a, PLX_PART_FRAME, s->nbld + 1, R_ALIGN);
     r->bins = arena_alloc(a, PLX_PART_FRAME, RENDER_BINS * sizeof(double), R_ALIGN);
+    {
+        double x0, y0, cell;
+        uint32_t n = cull_side(s, &x0, &y0, &cell);
+        r->ncell = n * n;
+        r->cell_start = arena_alloc(a, PLX_PART_FRAME, arena_mul(r->ncell + 1, sizeof(uint32_t)), R_ALIGN);
+        r->cell_bld = arena_alloc(a, PLX_PART_FRAME, arena_mul(s->nbld + 1, sizeof(uint32_t)), R_ALIGN);
+        r->cell_box = arena_alloc(a, PLX_PART_FRAME, arena_mul(r->ncell, 6 * sizeof(double)), R_ALIGN);
+    }
     if (!r->depth || !r->id || !r->lin || !r->vbuf || !r->pv || !r->clip || !r->gxyz || !r->gtri || !r->sc_id || !r->sc ||
         !r->order || !r->heap || !r->wmin ||
-        !r->wmax || !r->draw || !r->bins) {
+        !r->wmax || !r->draw || !r->bins || !r->cell_start || !r->cell_bld || !r->cell_box) {
         arena_release(a, &m0);
         return PLX_E_NOMEM;
     }
+    cull_grid_fill(r);
     r->tm = arena_alloc(a, PLX_PART_FRAME, sizeof(tonemap_table), R_ALIGN);
     r->et = arena_alloc(a, PLX_PART_FRAME, sizeof(exposure_table), R_ALIGN);
     r->defer = arena_alloc(a, PLX_PART_FRAME,
@@ -617,46 +688,82 @@ static int eye_inside_solid(const render *r)
     return 0;
 }
 
+/* Whether every corner of box bx (minx, miny, minz, maxx, maxy, maxz)
+ * lies beyond one side plane of the frustum (by a tolerance of 1e-6 |w|
+ * + 1e-9) or before the near plane: no pixel centre sees it; its
+ * corners' smallest and largest w. whole: the tolerance from the largest
+ * |w| of the corners for every corner, so that what holds for the box
+ * holds for every box inside it (clip coordinates are affine in the
+ * point: inside, x - w is at least its least value at a corner, and |w|
+ * at most its largest). */
+static int box_out(const render *r, const double *bx, double *wmn, double *wmx, int whole)
+{
+    int out_l = 1, out_r = 1, out_b = 1, out_t = 1, out_n = 1, k;
+    double c[8][4], big = 0.0;
+    *wmn = HUGE_VAL;
+    *wmx = -HUGE_VAL;
+    for (k = 0; k < 8; k++) {
+        double X[3];
+        X[0] = bx[(k & 1) ? 3 : 0];
+        X[1] = bx[(k & 2) ? 4 : 1];
+        X[2] = bx[(k & 4) ? 5 : 2];
+        to_clip(r, X, c[k]);
+        *wmn = fmin(*wmn, c[k][3]);
+        *wmx = fmax(*wmx, c[k][3]);
+        big = fmax(big, fabs(c[k][3]));
+    }
+    for (k = 0; k < 8; k++) {
+        double tol = 1e-6 * (whole ? big : fabs(c[k][3])) + 1e-9;
+        if (!(c[k][0] > c[k][3] + tol)) out_r = 0;
+        if (!(c[k][0] < -c[k][3] - tol)) out_l = 0;
+        if (!(c[k][1] > c[k][3] + tol)) out_t = 0;
+        if (!(c[k][1] < -c[k][3] - tol)) out_b = 0;
+        if (!(c[k][3] < r->near_ * (1.0 - 1e-6))) out_n = 0;
+    }
+    return out_l || out_r || out_t || out_b || out_n;
+}
+
+/* Building b's frustum test: drawn, or culled (counted); a drawn one with
+ * triangles is listed for the occlusion pass. */
+static void cull_building(render *r, int mode, uint32_t b, render_stats *st, uint32_t *n)
+{
+    double bx[6], wmn, wmx;
+    int out;
+    mesh_box(r->m, b, bx);
+    out = box_out(r, bx, &wmn, &wmx, 0);
+    r->wmin[b] = wmn;
+    r->wmax[b] = wmx;
+    r->draw[b] = 1;
+    if ((mode & RENDER_CULL_FRUSTUM) && out) {
+        r->draw[b] = 0;
+        st->frustum_culled++;
+        return;
+    }
+    if (r->m->bld[b].t_count == 0)
+        return;
+    r->order[*n].key = fmax(wmn, r->near_);
+    r->order[*n].b = b;
+    (*n)++;
+}
+
 static void cull(render *r, int mode, int inside, render_stats *st)
 {
     const mesh *m = r->m;
-    uint32_t b, n = 0, i;
+    uint32_t c, k, n = 0, i;
     double mu = 2.0 * r->tanh_ / r->h;
     double gap_a = 1e-3, gap_b = mu / (8.0 * r->eye[2]) + 4e-6 / r->near_;
-    for (b = 0; b < m->nbld; b++) {
-        double bx[6], c[4], wmn = HUGE_VAL, wmx = -HUGE_VAL;
-        int out_l = 1, out_r = 1, out_b = 1, out_t = 1, out_n = 1, k;
-        mesh_box(m, b, bx);
-        for (k = 0; k < 8; k++) {
-            double X[3];
-            X[0] = bx[(k & 1) ? 3 : 0];
-            X[1] = bx[(k & 2) ? 4 : 1];
-            X[2] = bx[(k & 4) ? 5 : 2];
-            to_clip(r, X, c);
-            wmn = fmin(wmn, c[3]);
-            wmx = fmax(wmx, c[3]);
-            {
-                double tol = 1e-6 * fabs(c[3]) + 1e-9;
-                if (!(c[0] > c[3] + tol)) out_r = 0;
-                if (!(c[0] < -c[3] - tol)) out_l = 0;
-                if (!(c[1] > c[3] + tol)) out_t = 0;
-                if (!(c[1] < -c[3] - tol)) out_b = 0;
-                if (!(c[3] < r->near_ * (1.0 - 1e-6))) out_n = 0;
-            }
-        }
-        r->wmin[b] = wmn;
-        r->wmax[b] = wmx;
-        r->draw[b] = 1;
-        if ((mode & RENDER_CULL_FRUSTUM) && (out_l || out_r || out_t || out_b || out_n)) {
-            r->draw[b] = 0;
-            st->frustum_culled++;
+    for (c = 0; c < r->ncell; c++) {
+        double wmn, wmx;
+        if ((mode & RENDER_CULL_FRUSTUM) && r->cell_start[c + 1] > r->cell_start[c] &&
+            box_out(r, &r->cell_box[6 * (size_t)c], &wmn, &wmx, 1)) {
+            /* the cell's box holds its buildings' boxes: each of them is out too */
+            for (k = r->cell_start[c]; k < r->cell_start[c + 1]; k++)
+                r->draw[r->cell_bld[k]] = 0;
+            st->frustum_culled += r->cell_start[c + 1] - r->cell_start[c];
             continue;
         }
-        if (m->bld[b].t_count == 0)
-            continue;
-        r->order[n].key = fmax(wmn, r->near_);
-        r->order[n].b = b;
-        n++;
+        for (k = r->cell_start[c]; k < r->cell_start[c + 1]; k++)
+            cull_building(r, mode, r->cell_bld[k], st, &n);
     }
     if (!(mode & RENDER_CULL_OCCLUSION) || inside)
         return;

@@ -39,6 +39,15 @@ static inline void texel_unpack(uint32_t t, float out[3])
     out[2] = (float)((t >> 18) & 511u) * s;
 }
 
+/* x >= 0 rounded to the nearest whole number, ties up: the fraction is
+ * compared with one half exactly (floor(x + 0.5) would round the double
+ * just below 0.5 up, the sum rounding to 1). */
+static inline double texel_round(double x)
+{
+    double f = floor(x);
+    return x - f >= 0.5 ? f + 1.0 : f;
+}
+
 /* The nearest packed value to (r, g, b) (negative and NaN channels as 0,
  * the largest clamped to TEXEL_MAX). */
 static inline uint32_t texel_pack(double r, double g, double b)
@@ -62,12 +71,12 @@ static inline uint32_t texel_pack(double r, double g, double b)
     if (e < 0)
         e = 0;
     step = ldexp(1.0, e - TEXEL_BIAS - 9);
-    if (floor(mx / step + 0.5) > 511.0 && e < 31) { /* rounding carried into a new bit */
+    if (texel_round(mx / step) > 511.0 && e < 31) { /* rounding carried into a new bit */
         e++;
         step *= 2.0;
     }
     for (k = 0; k < 3; k++) {
-        double q = floor(c[k] / step + 0.5);
+        double q = texel_round(c[k] / step);
         m[k] = q > 511.0 ? 511u : (uint32_t)q;
     }
     return m[0] | (m[1] << 9) | (m[2] << 18) | ((uint32_t)e << 27);

@@ -4,6 +4,7 @@
 #include <stddef.h>
 #include <setjmp.h>
 #include <stdint.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <math.h>
@@ -137,6 +138,112 @@ static int poly_classify(const double *x, const double *y, int n, double px, dou
 }
 
 /* ---- set-up -------------------------------------------------------------- */
+
+/* ---- surface ids without fragment calls (raster_prepare, raster_triangle_id) ---- */
+
+typedef struct id_target {
+    uint32_t *id;
+    uint32_t cur;
+    int w;
+} id_target;
+
+static int id_frag(void *user, int32_t x, int32_t y, float depth, const float *attr, float rgba[4])
+{
+    id_target *t = user;
+    (void)depth;
+    (void)attr;
+    (void)rgba;
+    t->id[(size_t)y * (size_t)t->w + (size_t)x] = t->cur;
+    return 1;
+}
+
+/* A random clip-space position: mostly on screen, some far off it, behind
+ * the eye, beyond the far plane, on the guard band, or exactly repeated
+ * (shared and degenerate triangles). */
+static void rnd_clip(float *p, const float *pool, int npool)
+{
+    double w = 0.2 + 20.0 * rnd(), k = rnd();
+    if (npool > 0 && k < 0.3) {
+        memcpy(p, pool + 4 * (int)(rnd() * npool), 4 * sizeof(float));
+        return;
+    }
+    p[3] = (float)(k < 0.35 ? -w * 0.1 : w);
+    p[0] = (float)((k < 0.9 ? 2.4 : 5000.0) * (rnd() - 0.5) * w);
+    p[1] = (float)((k < 0.9 ? 2.4 : 5000.0) * (rnd() - 0.5) * w);
+    p[2] = (float)((2.4 * rnd() - 1.2) * w);
+}
+
+/* Thousands of random triangles drawn both ways into a depth buffer and an
+ * id buffer (triangles in order, depth test less): the same ids and the
+ * same depth bits at every pixel, with back faces culled and not, on small
+ * odd frames so that many triangles touch the borders. */
+static void test_triangle_id_same(void **state)
+{
+    int round, rounds = getenv("PLX_TEST_QUICK") ? 60 : 400;
+    long direct = 0, fallback = 0;
+    (void)state;
+    rng_state = 0x5eed1d5ull;
+    for (round = 0; round < rounds; round++) {
+        int w = 13 + (int)(rnd() * 90), h = 7 + (int)(rnd() * 70), n = 40 + (int)(rnd() * 200), k;
+        float *pool = malloc(sizeof(float) * 4 * 3 * (size_t)n);
+        float *da = malloc(sizeof(float) * (size_t)w * h), *db = malloc(sizeof(float) * (size_t)w * h);
+        uint32_t *ia = calloc((size_t)w * h, sizeof(uint32_t)), *ib = calloc((size_t)w * h, sizeof(uint32_t));
+        raster_target ta, tb;
+        raster_ctx ra, rb;
+        id_target it;
+        raster_cull cull = round % 3 == 0 ? RASTER_CULL_NONE : RASTER_CULL_BACK;
+        assert_true(pool && da && db && ia && ib);
+        memset(&ta, 0, sizeof ta);
+        ta.format = RASTER_RGBA8;
+        ta.width = w;
+        ta.height = h;
+        ta.depth = da;
+        tb = ta;
+        tb.depth = db;
+        assert_int_equal(raster_init(&ra, &ta, NULL), PLX_OK);
+        assert_int_equal(raster_init(&rb, &tb, NULL), PLX_OK);
+        raster_clear_depth(&ra, 1.0f);
+        raster_clear_depth(&rb, 1.0f);
+        it.id = ia;
+        it.w = w;
+        raster_set_fragment(&ra, id_frag, &it, 0);
+        raster_set_cull(&ra, cull);
+        raster_set_cull(&rb, cull);
+        for (k = 0; k < 3 * n; k++)
+            rnd_clip(&pool[4 * k], pool, k);
+        for (k = 0; k < n; k++) {
+            raster_vertex v[3];
+            raster_pvert p[3];
+            int q;
+            memset(v, 0, sizeof v);
+            for (q = 0; q < 3; q++) {
+                memcpy(v[q].pos, &pool[4 * (3 * k + q)], 4 * sizeof(float));
+                raster_prepare(&rb, v[q].pos, &p[q]);
+            }
+            it.cur = (uint32_t)k + 1;
+            raster_triangle(&ra, &v[0], &v[1], &v[2]);
+            if (raster_triangle_id(&rb, &p[0], &p[1], &p[2], (uint32_t)k + 1, ib) >= 0) {
+                direct++;
+                continue;
+            }
+            fallback++;
+            it.id = ib; /* the fallback writes through the fragment function, as render.c's */
+            raster_set_fragment(&rb, id_frag, &it, 0);
+            raster_triangle(&rb, &v[0], &v[1], &v[2]);
+            it.id = ia;
+        }
+        assert_memory_equal(ia, ib, sizeof(uint32_t) * (size_t)w * h);
+        assert_memory_equal(da, db, sizeof(float) * (size_t)w * h);
+        free(pool);
+        free(da);
+        free(db);
+        free(ia);
+        free(ib);
+    }
+    printf("raster_triangle_id: %ld triangles drawn from prepared vertices, %ld through raster_triangle, "
+           "the same ids and depths as raster_triangle alone\n", direct, fallback);
+    assert_true(direct > 1000 && fallback > 100);
+}
 
 static void test_init_rejects_bad_targets(void **state)
 {
@@ -979,6 +1086,7 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_init_rejects_bad_targets),
+        cmocka_unit_test(test_triangle_id_same),
         cmocka_unit_test(test_square_two_triangles),
         cmocka_unit_test(test_single_triangle_top_left),
         cmocka_unit_test(test_fan_shared_edges),
