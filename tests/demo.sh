@@ -22,7 +22,7 @@ echo "== visibility from a pedestrian at (24.944296, 60.167723) looking east"
 "$bin" vis --quiet "$scene" --at 24.944296,60.167723 --dir 0 --fov 90 | tail -2
 echo
 echo "== kiosk: bake the district once, then walk along a street from the bake"
-"$bin" bake --quiet "$scene" --frames 64 --texel 2 --max-size 640x480 -o "$out/helsinki.plxb"
+"$bin" bake --quiet "$scene" --frames 64 --max-size 640x480 -o "$out/helsinki.plxb"
 "$bin" walk --quiet "$out/helsinki.plxb" --path fixtures/helsinki-walk.geojson --size 480x360 --speed 10 --fps 1 \
     -o "$out/walk"
 echo

@@ -18,10 +18,11 @@
  *    the scene's Bounds and every lamp's ground reach, each cut into
  *    blocks of ATLAS_BLOCK steps (ATLAS_BLOCK + 1 vertices a side; blocks
  *    side by side share their border vertices, with the same values: no
- *    seam). A block wholly under the footprints of buildings standing on
- *    the ground (none of it can be seen) holds nothing. A ground vertex
- *    inside such a footprint holds the light at the nearest point of that
- *    footprint's boundary, 1 mm out. Beyond the tiles the ground is black
+ *    seam, but for rounding: one step of the packed values at most). A
+ *    block wholly under the footprints of buildings standing on the
+ *    ground (none of it can be seen) holds nothing. A ground vertex inside
+ *    such a footprint holds the light of the nearest open ground
+ *    (atlas_fill.h). Beyond the tiles the ground is black
  *    (no lamp reaches it; the light bounced there is left out).
  *  - A wall shared with another building (the same edge, the other way
  *    round) is hidden where the other building's solid stands against it:

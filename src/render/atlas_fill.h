@@ -7,8 +7,13 @@
  * nearest point of the footprint's boundary. The ground: the vertex,
  * unless it lies strictly inside the footprint of a building standing on
  * the ground (its solid): then the nearest point of that footprint's
- * boundary, moved 1 mm out along the edge's outward normal. The light at
- * a vertex is SPEC §2's at that point with the surface's outward normal.
+ * boundary, moved 1 mm out along the edge's outward normal, or, when
+ * that point lies strictly inside a solid too (a wall two buildings
+ * share, a narrow reflex corner), the nearest such point (an edge's
+ * nearest point 1 mm out) of any building around that lies in none: open
+ * ground, searched within a radius doubled until one is found (256 m at
+ * most). The light at a vertex is SPEC §2's at that point with the
+ * surface's outward normal.
  * So every vertex holds the light of a point on (or 1 mm off) its own
  * surface, and a pixel near a wall foot or a roof edge mixes only values
  * of its surface.

@@ -74,8 +74,14 @@ void exposure_table_init(exposure_table *et)
 void exposure_count_table(const exposure_table *et, const float *lin, const uint32_t *id, size_t p0, size_t p1,
                           uint32_t hist[EXPOSURE_BINS])
 {
+    exposure_count_every(et, lin, id, p0, p1, 1, hist);
+}
+
+void exposure_count_every(const exposure_table *et, const float *lin, const uint32_t *id, size_t p0, size_t p1,
+                          size_t step, uint32_t hist[EXPOSURE_BINS])
+{
     size_t p;
-    for (p = p0; p < p1; p++) {
+    for (p = p0; p < p1; p += step) {
         double y = luminance(lin + 3 * p);
         int b;
         if (id[p] == EXPOSURE_SKY || !(y > 0.0) || !isfinite(y))

@@ -40,5 +40,8 @@ void exposure_table_init(exposure_table *et);
 /* exposure_count with the table: the same counts. */
 void exposure_count_table(const exposure_table *et, const float *lin, const uint32_t *id, size_t p0, size_t p1,
                           uint32_t hist[EXPOSURE_BINS]);
+/* The same counting only pixels p0, p0 + step, ... below p1. */
+void exposure_count_every(const exposure_table *et, const float *lin, const uint32_t *id, size_t p0, size_t p1,
+                          size_t step, uint32_t hist[EXPOSURE_BINS]);
 
 #endif

@@ -2157,9 +2157,11 @@ typedef struct atlas_job {
     uint64_t px[RENDER_MAX_WORKERS][3]; /* sky, ground and building pixels, by worker */
 } atlas_job;
 
-/* Rows k RENDER_TILE .. of the frame from the atlas, each counted into
- * the worker's exposure histogram while it is in the cache (the sums do
- * not depend on which worker counted what). */
+/* Rows k RENDER_TILE .. of the frame from the atlas, counted into the
+ * worker's exposure histogram while they are in the cache: every other
+ * pixel of every other row (all of them in frames under 64 pixels a
+ * side), enough for the percentile; the sums do not depend on which
+ * worker counted what. */
 static void atlas_rows(void *arg, int worker, uint32_t k)
 {
     atlas_job *jb = arg;
@@ -2170,8 +2172,8 @@ static void atlas_rows(void *arg, int worker, uint32_t k)
         float *lin = &r->lin[3 * (size_t)j * (size_t)r->w];
         const uint8_t *mask = jb->o->mask ? &jb->o->mask[(size_t)j * (size_t)r->w] : NULL;
         atlas_frame_row(jb->o->atlas, &jb->v, &jb->o->atlas_cache[worker], ids, mask, j, lin, jb->px[worker]);
-        if (jb->count)
-            exposure_count_table(r->et, lin, ids, 0, (size_t)r->w, r->hist[worker]);
+        if (jb->count && (j % 2 == 0 || r->h < 64)) /* every other pixel of every other row */
+            exposure_count_every(r->et, lin, ids, 0, (size_t)r->w, r->w < 64 ? 1 : 2, r->hist[worker]);
     }
 }
 

@@ -131,16 +131,24 @@ void tonemap_table_set(tonemap_table *t, const double thr[TONEMAP_LEVELS], doubl
         return;
     for (k = 0; k < TONEMAP_LEVELS; k++)
         t->f[k] = first_above(thr, ex, curve, k, guess_bits(thr[k], ex, curve));
+    t->f[TONEMAP_LEVELS] = UINT32_MAX; /* no float reaches it */
     for (h = 0, k = 0; h < TONEMAP_HINTS; h++) {
-        while (k < TONEMAP_LEVELS && t->f[k] <= h << 16)
+        while (k < TONEMAP_LEVELS && t->f[k] <= h << TONEMAP_HINT_SHIFT)
             k++;
         t->hint[h] = (uint8_t)k;
     }
+    t->single = 1;
+    for (k = 0; k + 1 < TONEMAP_LEVELS; k++)
+        if ((t->f[k] >> TONEMAP_HINT_SHIFT) == (t->f[k + 1] >> TONEMAP_HINT_SHIFT))
+            t->single = 0;
 }
 
 void tonemap_apply(const tonemap_table *t, const double thr[TONEMAP_LEVELS], const float *lin, size_t p0,
                    size_t p1, uint8_t *rgb8)
 {
+    const uint32_t *f = t->f;
+    const uint8_t *hint = t->hint;
+    int single = t->single;
     size_t p;
     if (!t->usable) {
         for (p = p0; p < p1; p++)
@@ -154,9 +162,12 @@ void tonemap_apply(const tonemap_table *t, const double thr[TONEMAP_LEVELS], con
             rgb8[p] = u == 0 ? 0 : tonemap_value(thr, lin[p], t->ex, t->curve);
             continue;
         }
-        b = t->hint[u >> 16];
-        while (b < TONEMAP_LEVELS && u >= t->f[b])
-            b++;
+        b = hint[u >> TONEMAP_HINT_SHIFT];
+        if (single)
+            b += u >= f[b];
+        else
+            while (b < TONEMAP_LEVELS && u >= f[b])
+                b++;
         rgb8[p] = (uint8_t)b;
     }
 }

@@ -8,7 +8,8 @@
 #include <stdint.h>
 
 #define TONEMAP_LEVELS 255          /* thresholds between the 256 bytes */
-#define TONEMAP_HINTS 32768         /* positive float bits >> 16 */
+#define TONEMAP_HINT_SHIFT 15       /* a hint for every 2^15 positive float bit patterns */
+#define TONEMAP_HINTS (1u << (31 - TONEMAP_HINT_SHIFT))
 
 /* The thresholds: thr[k] is the linear value from which a pixel's byte
  * is above k (the middle between the sRGB codes k and k + 1). */
@@ -21,7 +22,12 @@ uint8_t tonemap_value(const double thr[TONEMAP_LEVELS], float x, double ex, int 
 
 /* For one exposure and curve, the same bytes as tonemap_value from the
  * float's bits alone: f[k] is the smallest float (its bits) whose byte is
- * above k, hint[h] the number of them at or below the bits h << 16.
+ * above k (f[255]: beyond every float), hint[h] the number of them at or
+ * below the bits h << TONEMAP_HINT_SHIFT. single: no two thresholds fall
+ * in one hint's range (a relative width of at most 2^-8, where SPEC §5's
+ * thresholds are at least 0.9% apart, and the tone curve only widens the
+ * gaps: checked when the table is made), so a value's byte is its hint
+ * plus one compare.
  * tonemap_value is monotone in a positive float (the curve's slope keeps
  * one float step above its rounding), so the byte of a float is the
  * number of f[k] at or below it. */
@@ -29,7 +35,8 @@ typedef struct tonemap_table {
     double ex;
     int curve;
     int usable;                     /* 0: tonemap_apply takes tonemap_value */
-    uint32_t f[TONEMAP_LEVELS];
+    int single;                     /* at most one threshold in a hint's range */
+    uint32_t f[TONEMAP_LEVELS + 1];
     uint8_t hint[TONEMAP_HINTS];
 } tonemap_table;
 

@@ -11,8 +11,11 @@
  *    bytes;
  *  - loading the bake into a block touched beforehand (median of 5);
  *  - a street walk (640x480, indirect, one sample per pixel) and an aerial
- *    walk (1024x768) from the loaded engine: median and p95 per frame,
- *    with one thread and then with two (the POSIX port's parallel-for);
+ *    walk (1024x768) from the loaded engine, its frames read from the
+ *    radiance atlas: median and p95 per frame, with one thread and then
+ *    with two (the POSIX port's parallel-for); beside them the same walks
+ *    with every pixel shaded (plx_render_opts.per_pixel: the frames of
+ *    before the atlas), the ratio of the medians;
  *  - the floor: the same cameras over the same city without its lamps and
  *    with no indirect light, a new engine from the GeoJSON, on 1 and 2
  *    threads: what a frame costs with no light to compute (culling,
@@ -157,6 +160,9 @@ static void aerial_cam(plx_camera *c, double s)
 /* n frames along the street or aerial path: wall-clock median and p95,
  * process CPU per frame, and the first frame's wall-clock time before
  * them; aa x aa samples (full: every pixel all of them). */
+static int per_pixel_walks; /* walk(): every pixel shaded, not read from the atlas */
+static double atlas_mb;     /* the last bake's radiance atlas */
+
 static void walk(plx_engine *e, int aerial, int aa, int full, int n, uint8_t *rgb8, double *med, double *p95,
                  double *cpu, double *first, int indirect)
 {
@@ -170,6 +176,7 @@ static void walk(plx_engine *e, int aerial, int aa, int full, int n, uint8_t *rg
     o.aa = aa;
     o.aa_full = full;
     o.no_indirect = !indirect;
+    o.per_pixel = per_pixel_walks;
     if (aerial)
         aerial_cam(&cam0, -4.0);
     else
@@ -252,6 +259,11 @@ static int bake(text city, int frames, int threads, unsigned char **file, size_t
     *wall = wall_ms() - w0;
     *cpu = proc_ms() - c0;
     plx_memory_get(a, m);
+    {
+        plx_atlas_info ai;
+        if (plx_atlas_info_get(a, &ai) == PLX_OK)
+            atlas_mb = ai.bytes / 1048576.0;
+    }
     plx_engine_destroy(a);
     plx_engine_destroy(tj.b);
     free(ma);
@@ -331,6 +343,7 @@ int main(void)
     trace(d, frames);
     base_ph = wall_ms() - w0;
     plx_render_opts_default(&o);
+    o.per_pixel = 1; /* the render path of before the radiance atlas */
     street_cam(&cam, 0);
     w0 = wall_ms();
     plx_render(d, &cam, &o, rgb8, NULL, NULL);
@@ -342,8 +355,9 @@ int main(void)
     base_aerial = wall_ms() - w0;
     cb = cpu_ms() - cb;
     plx_memory_get(d, &m);
-    printf("baseline (render from the GeoJSON): load %.0f ms, photons %.0f ms, first street frame %.0f ms, "
-           "first aerial frame %.0f ms (light map included), wall; %.2f s CPU in all; engine memory %.1f MB\n",
+    printf("baseline (render from the GeoJSON, every pixel shaded): load %.0f ms, photons %.0f ms, first street "
+           "frame %.0f ms, first aerial frame %.0f ms (light map and its layer included), wall; %.2f s CPU in all; "
+           "engine memory %.1f MB\n",
            base_load, base_ph, base_street, base_aerial, cb / 1e3, m.used_total / 1048576.0);
     plx_engine_destroy(d);
     free(md);
@@ -351,8 +365,9 @@ int main(void)
     /* the bake, on one thread, then on two (the POSIX port's parallel-for) */
     if (bake(city, frames, 1, &file, &len, &bake_w, &bake_c, &m) != 0)
         return 1;
-    printf("bake, 1 thread: %.2f s wall, %.2f s CPU (target 10 s); file %.1f MB; engine memory %.1f MB\n",
-           bake_w / 1e3, bake_c / 1e3, len / 1048576.0, m.used_total / 1048576.0);
+    printf("bake, 1 thread: %.2f s wall, %.2f s CPU (target 10 s); file %.1f MB; engine memory %.1f MB, of it "
+           "the radiance atlas %.1f MB\n",
+           bake_w / 1e3, bake_c / 1e3, len / 1048576.0, m.used_total / 1048576.0, atlas_mb);
     if (bake(city, frames, 2, &file2, &len2, &bake2_w, &bake2_c, &m) != 0)
         return 1;
     printf("bake, 2 threads: %.2f s wall, %.2f s CPU of the process; %.2fx the 1-thread wall time; "
@@ -397,9 +412,17 @@ int main(void)
                 return 1;
             }
         }
+        double pm, pp, pc, pf, qm, qp, qc, qf;
         walk(c, 0, 1, 0, 20, rgb8, &sm, &sp, &sc, &sf, 1);
         walk(c, 1, 1, 0, 10, rgb8, &am, &ap, &ac, &af, 1);
+        per_pixel_walks = 1;
+        walk(c, 0, 1, 0, 20, rgb8, &pm, &pp, &pc, &pf, 1);
+        walk(c, 1, 1, 0, 10, rgb8, &qm, &qp, &qc, &qf, 1);
+        per_pixel_walks = 0;
         printf("%d thread%s:\n", k + 1, k ? "s" : "");
+        printf("  every pixel shaded (per_pixel, the frames of before the atlas): street median %.1f ms, aerial "
+               "median %.1f ms; the atlas's frames %.1fx and %.1fx faster\n",
+               pm, qm, pm / sm, qm / am);
         printf("  street walk 640x480 with indirect, 20 frames: median %.1f ms, p95 %.1f ms, CPU %.1f ms/frame "
                "(target 10 ms); %.1fx the baseline's first frame (%.0f ms), %.0fx its load + photons + frame; "
                "first frame %.0f ms\n",
