@@ -203,6 +203,8 @@ void atlas_frame_row(const atlas *A, const atlas_view *v, atlas_cache *k, const 
     uint32_t last = MESH_SURF_NONE;
     ground_row g;
     float fj = (float)j, bu = 0, bv = 0, bw = 0;
+    uint64_t nsky = 0, nground = 0, nbld = 0; /* counted here: count[] may share a cache line with
+                                                 another worker's */
     int32_t i;
     ground_setup(A, v, j, &g);
     for (i = 0; i < v->w; i++) {
@@ -212,15 +214,15 @@ void atlas_frame_row(const atlas *A, const atlas_view *v, atlas_cache *k, const 
             continue;
         if (sid == MESH_SURF_NONE || (sid == MESH_SURF_GROUND && !g.on)) {
             o[0] = o[1] = o[2] = 0.0f;
-            count[0]++;
+            nsky++;
             continue;
         }
         if (sid == MESH_SURF_GROUND) {
             ground_px(A, g.x0 + i * g.dx, g.y0 + i * g.dy, o);
-            count[1]++;
+            nground++;
             continue;
         }
-        count[2]++;
+        nbld++;
         if (sid != last) {
             m = map_of(A, v, k, sid);
             last = sid;
@@ -239,4 +241,7 @@ void atlas_frame_row(const atlas *A, const atlas_view *v, atlas_cache *k, const 
             bilerp(&A->tex[m->c->first], m->c->nu, m->c->nv, (bu + m->a[1] * fi) * r, (bv + m->a[4] * fi) * r, o);
         }
     }
+    count[0] += nsky;
+    count[1] += nground;
+    count[2] += nbld;
 }
