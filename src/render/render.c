@@ -81,6 +81,8 @@ struct render {
     uint32_t *cell_bld;         /* nbld building indices, cell by cell, ascending */
     double *cell_box;           /* 6 a cell: minx, miny, minz, maxx, maxy, maxz */
     double *bins;               /* RENDER_BINS */
+    int32_t *yr;                /* nbld x 2: a drawn building's rows on screen (cull) */
+    struct band *band;          /* RENDER_BANDS of them, or NULL: the rows drawn by bands */
     /* frame state */
     int32_t w, h;
     uint32_t cur_id;
@@ -179,6 +181,32 @@ uint8_t render_srgb8(const render *r, double v)
 
 /* ---- the software backend (raster.h) ------------------------------------------ */
 
+/* A worker drawing a band of rows with the built-in rasteriser (render
+ * frames on several workers): its own rasteriser state, scissored to the
+ * band, and its own buffers for one building at a time. */
+#define RENDER_BANDS 4                /* band workers at most */
+#define RENDER_BAND_BYTES ((size_t)8 << 20) /* their buffers together at most */
+typedef struct band {
+    render *r;
+    raster_ctx rc;
+    uint32_t cur_id;
+    double *gxyz;
+    mesh_tri *gtri;
+    float *clip;
+    raster_vertex *vbuf;
+    raster_pvert *pv;
+} band;
+
+static int band_frag(void *user, int32_t x, int32_t y, float depth, const float *attr, float rgba[4])
+{
+    band *bd = user;
+    (void)depth;
+    (void)attr;
+    (void)rgba;
+    bd->r->id[(size_t)y * (size_t)bd->r->w + (size_t)x] = bd->cur_id;
+    return 1;
+}
+
 static int frag_id(void *user, int32_t x, int32_t y, float depth, const float *attr, float rgba[4])
 {
     render *r = user;
@@ -236,6 +264,40 @@ static int soft_finish(void *user, uint32_t *id, float *depth)
     if (depth != r->depth)
         memcpy(depth, r->depth, px * sizeof *depth);
     return 0;
+}
+
+/* The band workers' buffers (RENDER_BANDS of each), when they take at
+ * most RENDER_BAND_BYTES; r->band stays NULL otherwise. */
+static size_t band_bytes(const mesh *m)
+{
+    size_t v = (size_t)m->max_bld_verts + 1, t = (size_t)m->max_bld_tris + 1;
+    return sizeof(band) + v * (3 * sizeof(double) + 4 * sizeof(float) + sizeof(raster_vertex) + sizeof(raster_pvert)) +
+           t * sizeof(mesh_tri) + 5 * 64;
+}
+
+static void bands_create(render *r, arena *a)
+{
+    size_t v = (size_t)r->m->max_bld_verts + 1, t = (size_t)r->m->max_bld_tris + 1;
+    arena_mark m = arena_get_mark(a);
+    int k;
+    r->band = NULL;
+    if (band_bytes(r->m) > RENDER_BAND_BYTES / RENDER_BANDS)
+        return;
+    r->band = arena_calloc(a, PLX_PART_FRAME, RENDER_BANDS, sizeof(band), 64);
+    for (k = 0; r->band && k < RENDER_BANDS; k++) {
+        band *bd = &r->band[k];
+        bd->r = r;
+        bd->gxyz = arena_alloc(a, PLX_PART_FRAME, v * 3 * sizeof(double), 64);
+        bd->gtri = arena_alloc(a, PLX_PART_FRAME, t * sizeof(mesh_tri), 64);
+        bd->clip = arena_alloc(a, PLX_PART_FRAME, v * 4 * sizeof(float), 64);
+        bd->vbuf = arena_alloc(a, PLX_PART_FRAME, v * sizeof(raster_vertex), 64);
+        bd->pv = arena_alloc(a, PLX_PART_FRAME, v * sizeof(raster_pvert), 64);
+        if (!bd->gxyz || !bd->gtri || !bd->clip || !bd->vbuf || !bd->pv) {
+            arena_release(a, &m);
+            r->band = NULL;
+            return;
+        }
+    }
 }
 
 #define CULL_CELL 64.0  /* m, the culling grid's cells */
@@ -370,6 +432,12 @@ plx_status render_create(arena *a, const scene *s, int32_t max_w, int32_t max_h,
         arena_release(a, &m0);
         return PLX_E_NOMEM;
     }
+    r->yr = arena_alloc(a, PLX_PART_FRAME, arena_mul(s->nbld + 1, 2 * sizeof(int32_t)), R_ALIGN);
+    if (!r->yr) {
+        arena_release(a, &m0);
+        return PLX_E_NOMEM;
+    }
+    bands_create(r, a); /* none when their buffers would be too large: one thread draws */
     tonemap_thresholds(r->thr);
     r->tm->usable = 0;
     exposure_table_init(r->et);
@@ -723,6 +791,33 @@ static int box_out(const render *r, const double *bx, double *wmn, double *wmx, 
     return out_l || out_r || out_t || out_b || out_n;
 }
 
+/* The rows a box's projection may cover (its corners' rows, a pixel more
+ * each way for snapping), every row when a corner is not in front of the
+ * near plane: what a band of rows needs to draw (draw_bands). */
+static void box_rows(const render *r, const double *bx, int32_t rows[2])
+{
+    double lo = HUGE_VAL, hi = -HUGE_VAL;
+    int k;
+    rows[0] = 0;
+    rows[1] = r->h - 1;
+    for (k = 0; k < 8; k++) {
+        double X[3], c[4], y;
+        X[0] = bx[(k & 1) ? 3 : 0];
+        X[1] = bx[(k & 2) ? 4 : 1];
+        X[2] = bx[(k & 4) ? 5 : 2];
+        to_clip(r, X, c);
+        if (!(c[3] >= r->near_))
+            return;
+        y = (1.0 - c[1] / c[3]) * 0.5 * r->h;
+        lo = fmin(lo, y);
+        hi = fmax(hi, y);
+    }
+    if (!(hi - lo < 4.0 * RASTER_MAX_DIM))
+        return;
+    rows[0] = lo - 2.0 > 0.0 ? (int32_t)(lo - 2.0) : 0;
+    rows[1] = hi + 2.0 < r->h - 1 ? (int32_t)(hi + 2.0) : r->h - 1;
+}
+
 /* Building b's frustum test: drawn, or culled (counted); a drawn one with
  * triangles is listed for the occlusion pass. */
 static void cull_building(render *r, int mode, uint32_t b, render_stats *st, uint32_t *n)
@@ -731,6 +826,7 @@ static void cull_building(render *r, int mode, uint32_t b, render_stats *st, uin
     int out;
     mesh_box(r->m, b, bx);
     out = box_out(r, bx, &wmn, &wmx, 0);
+    box_rows(r, bx, &r->yr[2 * (size_t)b]);
     r->wmin[b] = wmn;
     r->wmax[b] = wmx;
     r->draw[b] = 1;
@@ -794,6 +890,98 @@ static void cull(render *r, int mode, int inside, render_stats *st)
 }
 
 /* ---- drawing ------------------------------------------------------------------ */
+
+static int par_workers(const render_opts *o);
+
+/* One building through band bd: its triangles made, projected and drawn
+ * (ids written through raster_triangle_id, or the fragment function). */
+static void band_building(band *bd, uint32_t b)
+{
+    render *r = bd->r;
+    const mesh *m = r->m;
+    const mesh_bld *mb = &m->bld[b];
+    uint32_t k;
+    mesh_building(m, b, bd->gxyz, bd->gtri);
+    for (k = 0; k < mb->v_count; k++) {
+        double c[4];
+        float *v = bd->vbuf[k].pos;
+        to_clip(r, &bd->gxyz[3 * (size_t)k], c);
+        v[0] = (float)c[0];
+        v[1] = (float)c[1];
+        v[2] = (float)c[2];
+        v[3] = (float)c[3];
+        raster_prepare(&bd->rc, v, &bd->pv[k]);
+    }
+    for (k = 0; k < mb->t_count; k++) {
+        const mesh_tri *t = &bd->gtri[k];
+        if (raster_triangle_id(&bd->rc, &bd->pv[t->v[0]], &bd->pv[t->v[1]], &bd->pv[t->v[2]], t->surf, r->id) >= 0)
+            continue;
+        bd->cur_id = t->surf;
+        raster_triangle(&bd->rc, &bd->vbuf[t->v[0]], &bd->vbuf[t->v[1]], &bd->vbuf[t->v[2]]);
+    }
+}
+
+typedef struct bands_job {
+    render *r;
+    int32_t nb;          /* bands of rows */
+    int cull_back;
+} bands_job;
+
+/* Band k of rows: cleared, then every drawn building whose rows meet it,
+ * in index order (a pixel's triangles in the same order as one thread
+ * draws them: the same ids and depths). */
+static void band_rows(void *arg, int worker, uint32_t k)
+{
+    bands_job *jb = arg;
+    render *r = jb->r;
+    band *bd = &r->band[worker];
+    raster_target tg;
+    int32_t y0 = (int32_t)((int64_t)r->h * k / jb->nb), y1 = (int32_t)((int64_t)r->h * (k + 1) / jb->nb), y;
+    uint32_t b;
+    memset(&tg, 0, sizeof tg);
+    tg.format = RASTER_RGBA8;
+    tg.width = r->w;
+    tg.height = r->h;
+    tg.depth = r->depth;
+    if (y1 <= y0 || raster_init(&bd->rc, &tg, NULL) != PLX_OK)
+        return;
+    raster_set_fragment(&bd->rc, band_frag, bd, 0);
+    raster_set_cull(&bd->rc, jb->cull_back ? RASTER_CULL_BACK : RASTER_CULL_NONE);
+    raster_set_scissor(&bd->rc, 0, y0, r->w, y1);
+    for (y = y0; y < y1; y++) {
+        size_t p0 = (size_t)y * (size_t)r->w, i;
+        memset(&r->id[p0], 0, (size_t)r->w * sizeof *r->id);
+        for (i = 0; i < (size_t)r->w; i++)
+            r->depth[p0 + i] = 1.0f;
+    }
+    for (b = 0; b < r->m->nbld; b++)
+        if (r->draw[b] && r->yr[2 * (size_t)b] < y1 && r->yr[2 * (size_t)b + 1] >= y0)
+            band_building(bd, b);
+}
+
+/* The visibility pass on the workers: the frame cut into bands of rows,
+ * RENDER_BANDS_PER_WORKER a worker (rows of sky cost little), each drawn
+ * by one worker from the drawn buildings that reach it. */
+#define RENDER_BANDS_PER_WORKER 4
+static void draw_bands(render *r, const render_opts *o, int cull_back, render_stats *st)
+{
+    bands_job jb;
+    uint32_t b;
+    int nw = par_workers(o) < RENDER_BANDS ? par_workers(o) : RENDER_BANDS;
+    for (b = 0; b < r->m->nbld; b++)
+        if (r->draw[b]) {
+            st->drawn++;
+            st->triangles_drawn += r->m->bld[b].t_count;
+        }
+    jb.r = r;
+    jb.nb = nw * RENDER_BANDS_PER_WORKER < r->h ? nw * RENDER_BANDS_PER_WORKER : r->h;
+    jb.cull_back = cull_back;
+    if (o->par(o->par_ctx, nw, (uint32_t)jb.nb, band_rows, &jb) != 0) {
+        uint32_t k;
+        for (k = 0; k < (uint32_t)jb.nb; k++)
+            band_rows(&jb, 0, k);
+    }
+}
 
 static void draw_buildings(render *r, const render_backend *be, render_stats *st)
 {
@@ -2247,15 +2435,21 @@ plx_status render_frame(render *r, const render_camera *cam, const render_opts *
     }
     inside = eye_inside_solid(r);
     st.eye_inside = inside;
-    if (be->begin(be->user, r->w, r->h, !inside) != 0) {
-        r->err = "render_frame: the backend could not start the frame";
-        return PLX_E_UNSUPPORTED;
-    }
-    cull(r, o->cull, inside, &st);
-    draw_buildings(r, be, &st);
-    if (be->finish(be->user, r->id, r->depth) != 0) {
-        r->err = "render_frame: the backend could not read the frame back";
-        return PLX_E_UNSUPPORTED;
+    if (be == &r->soft && r->band && par_workers(o) >= 2) {
+        /* the built-in rasteriser on the workers, by bands of rows */
+        cull(r, o->cull, inside, &st);
+        draw_bands(r, o, !inside, &st);
+    } else {
+        if (be->begin(be->user, r->w, r->h, !inside) != 0) {
+            r->err = "render_frame: the backend could not start the frame";
+            return PLX_E_UNSUPPORTED;
+        }
+        cull(r, o->cull, inside, &st);
+        draw_buildings(r, be, &st);
+        if (be->finish(be->user, r->id, r->depth) != 0) {
+            r->err = "render_frame: the backend could not read the frame back";
+            return PLX_E_UNSUPPORTED;
+        }
     }
     st.drawn_fraction = st.triangles ? (double)st.triangles_drawn / (double)st.triangles : 1.0;
     if (o->atlas) {
