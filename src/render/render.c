@@ -25,6 +25,8 @@
 typedef struct cull_item { double key; uint32_t b; } cull_item;
 
 #define RENDER_TILE 8           /* shading tiles, pixels a side */
+#define CULL_CELL 64.0          /* m, the culling grid's cells, */
+#define CULL_SIDE 128.0         /* at most this many a side (larger cells over larger scenes) */
 #define RENDER_TILE_LAMPS 64    /* longest lamp list of a tile */
 #define TILE_PX (RENDER_TILE * RENDER_TILE)
 #define IND_STEP 4              /* sparse indirect: corners every IND_STEP pixels */
@@ -63,7 +65,6 @@ struct render {
     render_backend soft;        /* the built-in backend (user = this) */
     raster_ctx rc;              /* its rasteriser state during a frame */
     /* culling */
-    cull_item *order;           /* nbld */
     cull_item *heap;            /* nbld, min-heap by w_max */
     double *gxyz;               /* one building's vertices (mesh_building) */
     mesh_tri *gtri;             /* and its triangles */
@@ -80,6 +81,8 @@ struct render {
     uint32_t *cell_start;       /* ncell + 1 offsets into cell_bld */
     uint32_t *cell_bld;         /* nbld building indices, cell by cell, ascending */
     double *cell_box;           /* 6 a cell: minx, miny, minz, maxx, maxy, maxz */
+    cull_item *trav;            /* nbld + ncell: the occlusion pass's heap */
+    uint32_t ntrav;
     double *bins;               /* RENDER_BINS */
     int32_t *yr;                /* nbld x 2: a drawn building's rows on screen (cull) */
     struct band *band;          /* RENDER_BANDS of them, or NULL: the rows drawn by bands */
@@ -152,7 +155,8 @@ size_t render_bytes(const scene *s, int32_t max_w, int32_t max_h)
     size_t px = (size_t)max_w * (size_t)max_h;
     size_t tiles = (size_t)((max_w + RENDER_TILE - 1) / RENDER_TILE) * (size_t)((max_h + RENDER_TILE - 1) / RENDER_TILE);
     size_t corners = (size_t)(max_w / IND_STEP + 2) * (size_t)(max_h / IND_STEP + 2);
-    return px * 20 + tiles + (size_t)s->nbld * (2 * sizeof(cull_item) + 17) + RENDER_BINS * 8 +
+    return px * 20 + tiles + (size_t)s->nbld * (2 * sizeof(cull_item) + 29) +
+           (size_t)CULL_SIDE * CULL_SIDE * (6 * sizeof(double) + 4 + sizeof(cull_item)) + RENDER_BINS * 8 +
            sizeof(tonemap_table) + 8 + sizeof(exposure_table) + 8 +
            corners * (1 + 3 * sizeof(float)) + 2 * (size_t)(max_w / IND_STEP + 2) * sizeof(corner_hit) + render_surf_slots(s, max_w, max_h) * (sizeof(uint32_t) + sizeof(mesh_surf)) +
            stop_rows(max_h) * sizeof(int32_t) +
@@ -300,13 +304,12 @@ static void bands_create(render *r, arena *a)
     }
 }
 
-#define CULL_CELL 64.0  /* m, the culling grid's cells */
 
-/* The culling grid's side in cells (at most 256) over the buildings' boxes. */
+/* The culling grid's side in cells (at most CULL_SIDE) over the buildings' boxes. */
 static uint32_t cull_side(const scene *s, double *x0, double *y0, double *cell)
 {
     double w = s->bounds[2] - s->bounds[0], h = s->bounds[3] - s->bounds[1], side = fmax(w, h);
-    uint32_t n = (uint32_t)fmin(256.0, fmax(1.0, ceil(side / CULL_CELL)));
+    uint32_t n = (uint32_t)fmin(CULL_SIDE, fmax(1.0, ceil(side / CULL_CELL)));
     *x0 = s->bounds[0];
     *y0 = s->bounds[1];
     *cell = side > 0.0 ? side / n : 1.0;
@@ -393,7 +396,6 @@ plx_status render_create(arena *a, const scene *s, int32_t max_w, int32_t max_h,
     r->sc_mask = render_surf_slots(s, max_w, max_h) - 1u;
     r->sc_id = arena_calloc(a, PLX_PART_FRAME, r->sc_mask + 1u, sizeof(uint32_t), 64);
     r->sc = arena_calloc(a, PLX_PART_FRAME, r->sc_mask + 1u, sizeof(mesh_surf), 64);
-    r->order = arena_alloc(a, PLX_PART_FRAME, arena_mul(s->nbld + 1, sizeof(cull_item)), R_ALIGN);
     r->heap = arena_alloc(a, PLX_PART_FRAME, arena_mul(s->nbld + 1, sizeof(cull_item)), R_ALIGN);
     r->wmin = arena_alloc(a, PLX_PART_FRAME, arena_mul(s->nbld + 1, sizeof(double)), R_ALIGN);
     r->wmax = arena_alloc(a, PLX_PART_FRAME, arena_mul(s->nbld + 1, sizeof(double)), R_ALIGN);
@@ -406,10 +408,13 @@ plx_status render_create(arena *a, const scene *s, int32_t max_w, int32_t max_h,
         r->cell_start = arena_alloc(a, PLX_PART_FRAME, arena_mul(r->ncell + 1, sizeof(uint32_t)), R_ALIGN);
         r->cell_bld = arena_alloc(a, PLX_PART_FRAME, arena_mul(s->nbld + 1, sizeof(uint32_t)), R_ALIGN);
         r->cell_box = arena_alloc(a, PLX_PART_FRAME, arena_mul(r->ncell, 6 * sizeof(double)), R_ALIGN);
+        r->trav = arena_alloc(a, PLX_PART_FRAME, arena_mul((size_t)s->nbld + r->ncell + 1, sizeof(cull_item)),
+                              R_ALIGN);
     }
     if (!r->depth || !r->id || !r->lin || !r->vbuf || !r->pv || !r->clip || !r->gxyz || !r->gtri || !r->sc_id || !r->sc ||
-        !r->order || !r->heap || !r->wmin ||
-        !r->wmax || !r->draw || !r->bins || !r->cell_start || !r->cell_bld || !r->cell_box) {
+        !r->heap || !r->wmin ||
+        !r->wmax || !r->draw || !r->bins || !r->cell_start || !r->cell_bld || !r->cell_box ||
+        !r->trav) {
         arena_release(a, &m0);
         return PLX_E_NOMEM;
     }
@@ -561,14 +566,6 @@ static void to_clip(const render *r, const double *X, double out[4])
 
 /* ---- culling ----------------------------------------------------------------- */
 
-static int cmp_item(const void *pa, const void *pb)
-{
-    const cull_item *a = pa, *b = pb;
-    if (a->key != b->key)
-        return a->key < b->key ? -1 : 1;
-    return (a->b > b->b) - (a->b < b->b);
-}
-
 static void heap_push(render *r, double key, uint32_t b)
 {
     uint32_t i = r->nheap++;
@@ -685,13 +682,16 @@ static void occluder_insert(render *r, uint32_t b, double mu)
 }
 
 /* Is building b hidden by the horizon? */
-static int hidden(render *r, uint32_t b, double mu)
+/* Whether every ray that can reach box (minx, miny, minz, maxx, maxy,
+ * maxz) is stopped by the horizon's bins (render.h); *slope_out gets the
+ * steepest slope from the eye to its top (sB) when it is computed. */
+static int hidden_box(render *r, const double *box, double mu, double *slope_out)
 {
-    double box[6], cx, cy, cl, c0, lo = HUGE_VAL, hi = -HUGE_VAL, rnear, rfar = 0;
+    double cx, cy, cl, c0, lo = HUGE_VAL, hi = -HUGE_VAL, rnear, rfar = 0;
     double dz, sB, slope, ma, ms;
     int64_t k0, k1, k;
     int i;
-    mesh_box(r->m, b, box);
+    *slope_out = HUGE_VAL;
     cx = 0.5 * (box[0] + box[3]) - r->eye[0];
     cy = 0.5 * (box[1] + box[4]) - r->eye[1];
     cl = sqrt(cx * cx + cy * cy);
@@ -712,6 +712,7 @@ static int hidden(render *r, uint32_t b, double mu)
         return 0;
     dz = box[5] - r->eye[2];
     sB = dz >= 0 ? dz / (rnear * (1.0 - 1e-12)) : dz / (rfar * (1.0 + 1e-12));
+    *slope_out = sB;
     slope = fmax(fabs(dz), fabs(box[2] - r->eye[2])) / rnear;
     ma = 2.0 * mu * sqrt(1.0 + slope * slope) + 1e-9;
     ms = 2.0 * 2.0 * mu * (1.0 + sB * sB) + 1e-12;
@@ -726,6 +727,130 @@ static int hidden(render *r, uint32_t b, double mu)
         if (!(r->bins[bin_wrap(k)] > sB))
             return 0;
     return 1;
+}
+
+static int hidden(render *r, uint32_t b, double mu)
+{
+    double box[6], sB;
+    mesh_box(r->m, b, box);
+    return hidden_box(r, box, mu, &sB);
+}
+
+/* The traversal of the occlusion pass: a min-heap of cells and buildings
+ * by (key, index), a cell's index nbld + its number. */
+static int trav_before(const cull_item *a, const cull_item *b)
+{
+    return a->key < b->key || (a->key == b->key && a->b < b->b);
+}
+
+static void trav_push(render *r, double key, uint32_t b)
+{
+    uint32_t i = r->ntrav++;
+    cull_item it;
+    it.key = key;
+    it.b = b;
+    while (i > 0) {
+        uint32_t p = (i - 1) / 2;
+        if (trav_before(&r->trav[p], &it))
+            break;
+        r->trav[i] = r->trav[p];
+        i = p;
+    }
+    r->trav[i] = it;
+}
+
+static cull_item trav_pop(render *r)
+{
+    cull_item top = r->trav[0], last = r->trav[--r->ntrav];
+    uint32_t i = 0, n = r->ntrav;
+    for (;;) {
+        uint32_t c = 2 * i + 1;
+        if (c >= n)
+            break;
+        if (c + 1 < n && trav_before(&r->trav[c + 1], &r->trav[c]))
+            c++;
+        if (!trav_before(&r->trav[c], &last))
+            break;
+        r->trav[i] = r->trav[c];
+        i = c;
+    }
+    if (n > 0)
+        r->trav[i] = last;
+    return top;
+}
+
+/* The occluders whose w_max, with the depth gap, lies before w: into the
+ * horizon's bins (valid for whatever is tested at w or beyond). */
+static void occluders_before(render *r, double w, double mu, double gap_a, double gap_b)
+{
+    while (r->nheap > 0) {
+        double wo = r->heap[0].key;
+        if (!(wo * (1.0 + gap_a + gap_b * wo) < w))
+            break;
+        occluder_insert(r, heap_pop(r).b, mu);
+    }
+}
+
+/* The occlusion pass (render.h's occlusion horizon) over the cells cull
+ * pushed: cells and buildings taken by increasing key (the smallest w of
+ * a box's corners, at least near; a cell's is at most its buildings',
+ * its box holding theirs) from one heap. A cell whose box the horizon
+ * hides hides every building in it (their boxes lie in its box: their
+ * azimuths within its azimuths, their top slopes at most its own, for
+ * slopes above -64 where the margins grow too little with the slope to
+ * matter), and they are culled at once, untested; otherwise each of its
+ * buildings gets its frustum test and, when drawn, joins the heap. A
+ * building is tested as before, after the occluders due before its key,
+ * so with the horizon the one-by-one pass would give it (buildings of
+ * equal key cannot occlude one another: an occluder waits for its w_max,
+ * at least its own key). The buildings a hidden cell takes away are
+ * hidden too; they no longer occlude for others, which only culls less. */
+static int cull_building(render *r, int mode, uint32_t b, render_stats *st, double *key);
+
+static void occlusion_start(render *r)
+{
+    uint32_t k;
+    for (k = 0; k < RENDER_BINS; k++)
+        r->bins[k] = -HUGE_VAL;
+    r->nheap = 0;
+    r->ntrav = 0;
+}
+
+static void occlusion(render *r, int mode, render_stats *st)
+{
+    const mesh *m = r->m;
+    double mu = 2.0 * r->tanh_ / r->h;
+    double gap_a = 1e-3, gap_b = mu / (8.0 * r->eye[2]) + 4e-6 / r->near_;
+    while (r->ntrav > 0) {
+        cull_item it = trav_pop(r);
+        occluders_before(r, it.key, mu, gap_a, gap_b);
+        if (it.b >= m->nbld) {
+            uint32_t c = it.b - m->nbld, q;
+            const double *cb = &r->cell_box[6 * (size_t)c];
+            double sB, key;
+            int h = !eye_in_box(r, cb) && hidden_box(r, cb, mu, &sB) && sB > -64.0;
+            for (q = r->cell_start[c]; q < r->cell_start[c + 1]; q++) {
+                uint32_t b = r->cell_bld[q];
+                if (h) {
+                    r->draw[b] = 0;
+                    st->occlusion_culled++;
+                } else if (cull_building(r, mode, b, st, &key) == 2) {
+                    trav_push(r, key, b);
+                }
+            }
+        } else {
+            double box[6];
+            mesh_box(m, it.b, box);
+            if (!eye_in_box(r, box)) {
+                if (hidden(r, it.b, mu)) {
+                    r->draw[it.b] = 0;
+                    st->occlusion_culled++;
+                }
+                if (mesh_occluder(m, it.b))
+                    heap_push(r, r->wmax[it.b], it.b);
+            }
+        }
+    }
 }
 
 static int eye_inside_solid(const render *r)
@@ -756,137 +881,135 @@ static int eye_inside_solid(const render *r)
     return 0;
 }
 
-/* Whether every corner of box bx (minx, miny, minz, maxx, maxy, maxz)
- * lies beyond one side plane of the frustum (by a tolerance of 1e-6 |w|
- * + 1e-9) or before the near plane: no pixel centre sees it; its
+/* The clip coordinates of box bx's 8 corners (minx, miny, minz, maxx,
+ * maxy, maxz; corner k takes max x when k & 1, max y when k & 2, max z
+ * when k & 4): clip coordinates are affine in the point, so the corner
+ * (min, min, min) and the box's three edges make all eight. */
+static void box_clip(const render *r, const double *bx, double c[8][4])
+{
+    double o[3], e[3][4], X[3];
+    int k, q, a;
+    o[0] = bx[0];
+    o[1] = bx[1];
+    o[2] = bx[2];
+    to_clip(r, o, c[0]);
+    for (a = 0; a < 3; a++) {
+        double t[4];
+        memcpy(X, o, sizeof X);
+        X[a] = bx[3 + a];
+        to_clip(r, X, t);
+        for (q = 0; q < 4; q++)
+            e[a][q] = t[q] - c[0][q];
+    }
+    for (k = 1; k < 8; k++)
+        for (q = 0; q < 4; q++)
+            c[k][q] = c[0][q] + ((k & 1) ? e[0][q] : 0.0) + ((k & 2) ? e[1][q] : 0.0) + ((k & 4) ? e[2][q] : 0.0);
+}
+
+/* Whether every corner of box bx lies beyond one side plane of the
+ * frustum (by a tolerance of 1e-6 |w| + 1e-9, far above the corners'
+ * rounding) or before the near plane: no pixel centre sees it; its
  * corners' smallest and largest w. whole: the tolerance from the largest
  * |w| of the corners for every corner, so that what holds for the box
  * holds for every box inside it (clip coordinates are affine in the
  * point: inside, x - w is at least its least value at a corner, and |w|
- * at most its largest). */
-static int box_out(const render *r, const double *bx, double *wmn, double *wmx, int whole)
+ * at most its largest). rows (may be NULL): the rows its projection may
+ * cover (its corners' rows, two pixels more each way for snapping), every
+ * row when a corner is not in front of the near plane: what a band of
+ * rows needs to draw (draw_bands). */
+static int box_out(const render *r, const double *bx, double *wmn, double *wmx, int whole, int32_t *rows)
 {
-    int out_l = 1, out_r = 1, out_b = 1, out_t = 1, out_n = 1, k;
-    double c[8][4], big = 0.0;
+    int out_l = 1, out_r = 1, out_b = 1, out_t = 1, out_n = 1, k, all_front = 1;
+    double c[8][4], big = 0.0, lo = HUGE_VAL, hi = -HUGE_VAL;
+    box_clip(r, bx, c);
     *wmn = HUGE_VAL;
     *wmx = -HUGE_VAL;
     for (k = 0; k < 8; k++) {
-        double X[3];
-        X[0] = bx[(k & 1) ? 3 : 0];
-        X[1] = bx[(k & 2) ? 4 : 1];
-        X[2] = bx[(k & 4) ? 5 : 2];
-        to_clip(r, X, c[k]);
-        *wmn = fmin(*wmn, c[k][3]);
-        *wmx = fmax(*wmx, c[k][3]);
-        big = fmax(big, fabs(c[k][3]));
+        double w = c[k][3], aw = w < 0.0 ? -w : w;
+        *wmn = w < *wmn ? w : *wmn;
+        *wmx = w > *wmx ? w : *wmx;
+        big = aw > big ? aw : big;
     }
     for (k = 0; k < 8; k++) {
-        double tol = 1e-6 * (whole ? big : fabs(c[k][3])) + 1e-9;
-        if (!(c[k][0] > c[k][3] + tol)) out_r = 0;
-        if (!(c[k][0] < -c[k][3] - tol)) out_l = 0;
-        if (!(c[k][1] > c[k][3] + tol)) out_t = 0;
-        if (!(c[k][1] < -c[k][3] - tol)) out_b = 0;
-        if (!(c[k][3] < r->near_ * (1.0 - 1e-6))) out_n = 0;
+        double w = c[k][3], tol = 1e-6 * (whole ? big : (w < 0.0 ? -w : w)) + 1e-9;
+        if (!(c[k][0] > w + tol)) out_r = 0;
+        if (!(c[k][0] < -w - tol)) out_l = 0;
+        if (!(c[k][1] > w + tol)) out_t = 0;
+        if (!(c[k][1] < -w - tol)) out_b = 0;
+        if (!(w < r->near_ * (1.0 - 1e-6))) out_n = 0;
+        if (!(w >= r->near_)) {
+            all_front = 0;
+        } else if (rows) {
+            double y = (1.0 - c[k][1] / w) * 0.5 * r->h;
+            lo = y < lo ? y : lo;
+            hi = y > hi ? y : hi;
+        }
+    }
+    if (rows) {
+        rows[0] = 0;
+        rows[1] = r->h - 1;
+        if (all_front && hi - lo < 4.0 * RASTER_MAX_DIM) {
+            rows[0] = lo - 2.0 > 0.0 ? (int32_t)(lo - 2.0) : 0;
+            rows[1] = hi + 2.0 < r->h - 1 ? (int32_t)(hi + 2.0) : r->h - 1;
+        }
     }
     return out_l || out_r || out_t || out_b || out_n;
 }
 
-/* The rows a box's projection may cover (its corners' rows, a pixel more
- * each way for snapping), every row when a corner is not in front of the
- * near plane: what a band of rows needs to draw (draw_bands). */
-static void box_rows(const render *r, const double *bx, int32_t rows[2])
-{
-    double lo = HUGE_VAL, hi = -HUGE_VAL;
-    int k;
-    rows[0] = 0;
-    rows[1] = r->h - 1;
-    for (k = 0; k < 8; k++) {
-        double X[3], c[4], y;
-        X[0] = bx[(k & 1) ? 3 : 0];
-        X[1] = bx[(k & 2) ? 4 : 1];
-        X[2] = bx[(k & 4) ? 5 : 2];
-        to_clip(r, X, c);
-        if (!(c[3] >= r->near_))
-            return;
-        y = (1.0 - c[1] / c[3]) * 0.5 * r->h;
-        lo = fmin(lo, y);
-        hi = fmax(hi, y);
-    }
-    if (!(hi - lo < 4.0 * RASTER_MAX_DIM))
-        return;
-    rows[0] = lo - 2.0 > 0.0 ? (int32_t)(lo - 2.0) : 0;
-    rows[1] = hi + 2.0 < r->h - 1 ? (int32_t)(hi + 2.0) : r->h - 1;
-}
-
 /* Building b's frustum test: drawn, or culled (counted); a drawn one with
  * triangles is listed for the occlusion pass. */
-static void cull_building(render *r, int mode, uint32_t b, render_stats *st, uint32_t *n)
+/* Building b's frustum test: culled (counted, 0), or drawn (1; 2 when
+ * it has triangles: a candidate for the occlusion pass, its key the
+ * smallest w of its box's corners, at least near). */
+static int cull_building(render *r, int mode, uint32_t b, render_stats *st, double *key)
 {
     double bx[6], wmn, wmx;
     int out;
     mesh_box(r->m, b, bx);
-    out = box_out(r, bx, &wmn, &wmx, 0);
-    box_rows(r, bx, &r->yr[2 * (size_t)b]);
+    out = box_out(r, bx, &wmn, &wmx, 0, &r->yr[2 * (size_t)b]);
     r->wmin[b] = wmn;
     r->wmax[b] = wmx;
     r->draw[b] = 1;
     if ((mode & RENDER_CULL_FRUSTUM) && out) {
         r->draw[b] = 0;
         st->frustum_culled++;
-        return;
+        return 0;
     }
-    if (r->m->bld[b].t_count == 0)
-        return;
-    r->order[*n].key = fmax(wmn, r->near_);
-    r->order[*n].b = b;
-    (*n)++;
+    *key = fmax(wmn, r->near_);
+    return r->m->bld[b].t_count == 0 ? 1 : 2;
 }
 
+/* Culling (render.h): cells of buildings first. A cell whose box lies
+ * out of the frustum culls its buildings (their boxes lie in it); with
+ * occlusion culling the others go to the occlusion pass as a whole (their
+ * buildings are tested when the cell is reached and not hidden), without
+ * it their buildings are tested at once. */
 static void cull(render *r, int mode, int inside, render_stats *st)
 {
-    const mesh *m = r->m;
-    uint32_t c, k, n = 0, i;
-    double mu = 2.0 * r->tanh_ / r->h;
-    double gap_a = 1e-3, gap_b = mu / (8.0 * r->eye[2]) + 4e-6 / r->near_;
+    uint32_t c, k;
+    int occl = (mode & RENDER_CULL_OCCLUSION) && !inside;
+    occlusion_start(r);
     for (c = 0; c < r->ncell; c++) {
-        double wmn, wmx;
-        if ((mode & RENDER_CULL_FRUSTUM) && r->cell_start[c + 1] > r->cell_start[c] &&
-            box_out(r, &r->cell_box[6 * (size_t)c], &wmn, &wmx, 1)) {
-            /* the cell's box holds its buildings' boxes: each of them is out too */
+        double wmn, wmx, key;
+        int out;
+        if (r->cell_start[c + 1] == r->cell_start[c])
+            continue;
+        out = box_out(r, &r->cell_box[6 * (size_t)c], &wmn, &wmx, 1, NULL);
+        if ((mode & RENDER_CULL_FRUSTUM) && out) {
             for (k = r->cell_start[c]; k < r->cell_start[c + 1]; k++)
                 r->draw[r->cell_bld[k]] = 0;
             st->frustum_culled += r->cell_start[c + 1] - r->cell_start[c];
             continue;
         }
+        if (occl) {
+            trav_push(r, fmax(wmn, r->near_), r->m->nbld + c);
+            continue;
+        }
         for (k = r->cell_start[c]; k < r->cell_start[c + 1]; k++)
-            cull_building(r, mode, r->cell_bld[k], st, &n);
+            (void)cull_building(r, mode, r->cell_bld[k], st, &key);
     }
-    if (!(mode & RENDER_CULL_OCCLUSION) || inside)
-        return;
-    qsort(r->order, n, sizeof *r->order, cmp_item);
-    for (i = 0; i < RENDER_BINS; i++)
-        r->bins[i] = -HUGE_VAL;
-    r->nheap = 0;
-    for (i = 0; i < n; i++) {
-        uint32_t bb = r->order[i].b;
-        double wb = r->order[i].key;
-        double box[6];
-        mesh_box(m, bb, box);
-        while (r->nheap > 0) {
-            double wo = r->heap[0].key;
-            if (!(wo * (1.0 + gap_a + gap_b * wo) < wb))
-                break;
-            occluder_insert(r, heap_pop(r).b, mu);
-        }
-        if (!eye_in_box(r, box)) {
-            if (hidden(r, bb, mu)) {
-                r->draw[bb] = 0;
-                st->occlusion_culled++;
-            }
-            if (mesh_occluder(m, bb))
-                heap_push(r, r->wmax[bb], bb);
-        }
-    }
+    if (occl)
+        occlusion(r, mode, st);
 }
 
 /* ---- drawing ------------------------------------------------------------------ */
