@@ -152,11 +152,12 @@ typedef struct plx_config {
                                          the free bytes at first use, 256 KiB to 16 MiB) */
     int32_t render_max_width;         /* largest frame plx_render draws (0: 1920) */
     int32_t render_max_height;        /* (0: 1080) */
-    size_t lightmap_bytes;            /* the aerial light map's budget (12 bytes a texel, 28 with its
-                                         indirect layer (README "Aerial views' indirect light"); the
-                                         texel grows from the one asked for until the map fits; 0:
-                                         from the budget, half the free bytes when the map is built,
-                                         at most 48 MiB) */
+    size_t lightmap_bytes;            /* the light maps' budget: the radiance atlas's (4 bytes a
+                                         sample point, its spacing grows from the one asked for until
+                                         it fits; 0: a quarter of the block, at most 64 MiB) and the
+                                         aerial light map's of frames without the atlas (12 bytes a
+                                         texel, 28 with its indirect layer; 0: half the free bytes
+                                         when the map is built, at most 48 MiB) */
     size_t photon_bytes;              /* the photon buffers' budget (0: from the budget, half the free
                                          bytes when they are first needed); their quality is lowered
                                          step by step until they fit (plx_indirect_info_get) */
@@ -667,10 +668,14 @@ typedef struct plx_backend plx_backend;
 typedef struct plx_render_opts {
     double exposure;            /* radiance multiplier before sRGB (SPEC default 1) */
     int no_glow;                /* 1: no lamp glows: every pixel is SPEC §5's radiance */
-    int aerial;                 /* 1: ground from the aerial light map (built once; with photons
-                                   traced, its indirect layer lights ground and roofs; a reset
-                                   of the photons rebuilds it on the next aerial frame) */
-    double aerial_m_per_texel;  /* light map resolution (0: 1 m, coarser if the budget needs) */
+    int aerial;                 /* 1: a view from above. Frames that read the radiance atlas
+                                   (indirect light traced, not per_pixel) draw it as any other;
+                                   the others take the ground from the aerial light map (built
+                                   once; with photons traced, its indirect layer lights ground
+                                   and roofs; a reset of the photons rebuilds it) */
+    double aerial_m_per_texel;  /* the radiance atlas's spacing when the frame makes it (0: 0.5 m),
+                                   and the light map's resolution (0: 1 m); both coarser if the
+                                   budget needs */
     int no_cull;                /* 1: draw every building (the culled image is identical) */
     int no_indirect;            /* 1: direct light only even when photons were traced */
     const plx_backend *backend; /* visibility pass: NULL = the built-in software rasteriser;
@@ -695,7 +700,7 @@ typedef struct plx_render_opts {
 
 /* The radiance atlas frames with indirect light read (README "The radiance
  * atlas"): made at the first such frame (or by plx_bake_prepare), filled
- * as frames need it (or whole by plx_bake_save). */
+ * as frames need it (or whole by plx_bake_size or plx_bake_save). */
 typedef struct plx_atlas_info {
     int made;                   /* 0: no atlas yet (the rest is 0) */
     double spacing;             /* m between sample points on surfaces a lamp may light */
@@ -716,7 +721,8 @@ void plx_render_opts_default(plx_render_opts *o /* OUT */);
 typedef struct plx_render_info {
     uint32_t buildings, drawn;  /* buildings in the scene, drawn after culling */
     double drawn_fraction;      /* triangles drawn / triangles of the scene */
-    uint64_t shaded_pixels;     /* the direct-light shader's calls, all --aa passes together */
+    uint64_t shaded_pixels;     /* the direct-light shader's calls, all --aa passes together (0 for
+                                   frames read from the radiance atlas) */
     double exposure;            /* the exposure applied (the chosen one with auto_exposure) */
     uint64_t indirect_lookups;  /* points whose indirect light was looked up (the irradiance
                                    cache or the photon buffers), all --aa passes together;
@@ -733,11 +739,15 @@ typedef struct plx_render_info {
  * Renders one frame into caller-owned buffers: rgb8 (width*height*3 bytes,
  * sRGB after exposure, row 0 at the top) and/or rgbf (width*height*3 floats,
  * linear radiance); either may be NULL. Indirect light is added when photon
- * frames were traced (plx_indirect_step) unless o->no_indirect. The
+ * frames were traced (plx_indirect_step) unless o->no_indirect; such frames
+ * read the radiance atlas (plx_atlas_info_get; made on first need, the
+ * charts a frame shows filled as it draws them) unless o->per_pixel, the
+ * eye is inside a building, or the atlas does not fit the block (said once
+ * in a warning): then every pixel's light is computed there. The
  * renderer's own buffers come from the engine (PLX_PART_FRAME) on first use.
  * Lamp light, the renderer's frame buffers and mesh (sized for the
- * config's largest frame) and, with o->aerial, the aerial light map are
- * built on first need and kept until the next load.
+ * config's largest frame) and, with o->aerial and no atlas, the aerial light
+ * map are built on first need and kept until the next load.
  * Errors: PLX_E_INVALID (cam NULL; bad camera: eye below the ground, eye ==
  * target, size above the maximum), PLX_E_NOSCENE, PLX_E_NOMEM,
  * PLX_E_UNSUPPORTED (o->backend could not draw the frame). Lifetime: the
@@ -871,11 +881,14 @@ plx_status plx_gen_city(const char *style, int nx, int ny, uint64_t seed,
 /* ---- Bake files: build once, load without rebuilding (README "Bake files") */
 
 typedef struct plx_bake_opts {
-    int aerial;                 /* 1: build the aerial light map too */
-    double aerial_m_per_texel;  /* its resolution (0: 1 m) */
+    int aerial;                 /* 1: make the radiance atlas (filled by plx_bake_size or
+                                   plx_bake_save, after the photons); with no_indirect the
+                                   aerial light map of direct light instead */
+    double aerial_m_per_texel;  /* the atlas's spacing (0: 0.5 m), or the light map's
+                                   resolution (0: 1 m); coarser if the budget needs */
     int no_indirect;            /* 1: no photon buffers */
     int twin;                   /* 1: the twin engine (see plx_bake_save): the same memory
-                                   layout without the light map's shading */
+                                   layout without the atlas's or light map's values */
     int no_polar;               /* 1: no polar diagrams (frames do not read them; a
                                    query on the loaded bake builds them on need) */
 } plx_bake_opts;
@@ -883,8 +896,9 @@ typedef struct plx_bake_opts {
 /*
  * Builds everything queries and frames need for the loaded scene: polar
  * diagrams (unless o->no_polar), lamp light, photon buffers (levels for a viewer at the centre
- * of Bounds, all around), the renderer and, with o->aerial, the aerial light
- * map. Photon frames are then added with plx_indirect_step.
+ * of Bounds, all around), the renderer and, with o->aerial, the radiance
+ * atlas laid out (or, with o->no_indirect, the aerial light map). Photon
+ * frames are then added with plx_indirect_step.
  */
 plx_status plx_bake_prepare(plx_engine *e, const plx_bake_opts *o);
 
@@ -896,12 +910,13 @@ plx_status plx_bake_prepare(plx_engine *e, const plx_bake_opts *o);
  * frames; the words that differ between the two by exactly the distance of
  * their blocks are the pointers, saved as offsets. Both blocks must have
  * the same address modulo 64, and be zero-filled when the engines were
- * created (padding and never-written bytes are saved too). With an aerial
- * map and photon frames, the first of these calls gathers the map's
- * indirect layer (on plx_config.threads workers; the bulk of a large
- * city's bake), so the loaded engine's aerial frames gather nothing.
+ * created (padding and never-written bytes are saved too). With the
+ * radiance atlas, the first of these calls fills it (on
+ * plx_config.threads workers, the bulk of a large city's bake; progress
+ * through plx_port.progress), so the loaded engine's frames fill nothing;
+ * what frames drawn before left in the engine is not saved.
  * Errors: PLX_E_INVALID (no twin of the same layout, buffer too small),
- * PLX_E_NOSCENE.
+ * PLX_E_NOSCENE, PLX_E_NOMEM (no room to fill the atlas).
  */
 plx_status plx_bake_size(plx_engine *e, plx_engine *twin, size_t *bytes /* OUT */);
 plx_status plx_bake_save(plx_engine *e, plx_engine *twin, void *buf, size_t cap,

@@ -34,6 +34,7 @@
 #include "render/render.h"
 #include "render/atlas.h"
 #include "render/atlas_frame.h"
+#include "render/atlas_fill.h"
 
 #define BAKE_MAGIC "PLXBAKE\0"
 #define BAKE_VERSION 1u
@@ -223,10 +224,27 @@ static void make_savable(plx_engine *e, savable_keep *keep)
         if (e->lt->pool)
             memset(e->lt->pool, 0, e->lt->pool_cap);
     }
-    if (e->rd)
+    if (e->rd) {
+        int32_t w, h;
+        size_t px;
+        render_frame_clear(e->rd); /* what frames drawn before left: not saved */
         render_code_unbind(e->rd);
+        eng_render_max(e, &w, &h);
+        px = (size_t)w * (size_t)h;
+        if (e->aa_sum)
+            memset(e->aa_sum, 0, px * 3 * sizeof *e->aa_sum);
+        if (e->aa_mask) {
+            memset(e->aa_id, 0, px * sizeof *e->aa_id);
+            memset(e->aa_rgb, 0, px * 3);
+            memset(e->aa_mask, 0, px);
+        }
+    }
     if (e->atlas_cache) /* which worker met which surface: not saved */
         memset(e->atlas_cache, 0, PLX_MAX_THREADS * sizeof(atlas_cache));
+    if (e->atlas_rec) /* the last chart's indirect records (whichever chart worker 0 filled last) */
+        memset(e->atlas_rec, 0, atlas_fill_records(e->atlas) * sizeof *e->atlas_rec);
+    if (e->atlas_list)
+        memset(e->atlas_list, 0, ENG_ATLAS_LIST * sizeof *e->atlas_list);
     e->lit_last = NULL;
     keep->port = e->port;
     memset(&e->port, 0, sizeof e->port);

@@ -21,6 +21,9 @@ static void drop_scene(plx_engine *e)
     e->atlas = NULL;
     e->atlas_cache = NULL;
     e->atlas_list = NULL;
+    e->atlas_rec = NULL;
+    e->atlas_fine = 0.0;
+    e->atlas_off = 0;
     e->lightmap_cell = 0.0;
     e->warnings = 0;
     eng_clear_error(e);

@@ -301,14 +301,16 @@ static void atlas_ind(void *user, const atlas_chart *c, uint32_t sid, const doub
         shade_photons(user, P, n, rgb);
 }
 
-/* The atlas's budget: plx_config.lightmap_bytes, else half the free
- * bytes, at most ATLAS_MAX_BYTES. */
+/* The atlas's budget: plx_config.lightmap_bytes, else a quarter of the
+ * block, at most ATLAS_MAX_BYTES: from the block, not from what is free
+ * when it is made, so that a bake (which makes it before the photons)
+ * and an engine that makes it at its first frame lay it out alike. */
 static size_t atlas_budget(const plx_engine *e)
 {
-    size_t half = arena_free_bytes(&e->mem) / 2;
+    size_t quarter = e->mem.cap / 4;
     if (e->cfg.lightmap_bytes)
         return e->cfg.lightmap_bytes;
-    return half < ATLAS_MAX_BYTES ? half : ATLAS_MAX_BYTES;
+    return quarter < ATLAS_MAX_BYTES ? quarter : ATLAS_MAX_BYTES;
 }
 
 plx_status eng_need_atlas(plx_engine *e, double fine)
@@ -327,11 +329,14 @@ plx_status eng_need_atlas(plx_engine *e, double fine)
     st = atlas_create(&e->mem, e->sc, render_mesh(e->rd), f, &e->atlas);
     e->atlas_cache = st == PLX_OK ? arena_calloc(&e->mem, PLX_PART_FRAME, PLX_MAX_THREADS, sizeof(atlas_cache), 64)
                                   : NULL;
-    e->atlas_list = e->atlas_cache ? arena_alloc(&e->mem, PLX_PART_FRAME, ENG_ATLAS_LIST * sizeof(uint32_t), 64) : NULL;
-    if (!e->atlas_list) {
+    e->atlas_list = e->atlas_cache ? arena_calloc(&e->mem, PLX_PART_FRAME, ENG_ATLAS_LIST, sizeof(uint32_t), 64) : NULL;
+    e->atlas_rec = e->atlas_list ? arena_calloc(&e->mem, PLX_PART_FRAME, atlas_fill_records(e->atlas), sizeof(double), 64)
+                                 : NULL;
+    if (!e->atlas_rec) {
         arena_release(&e->mem, &m);
         e->atlas = NULL;
         e->atlas_cache = NULL;
+        e->atlas_list = NULL;
         return eng_nomem(e, "making the radiance atlas");
     }
     atlas_clear(e->atlas, e->indirect_gen);
@@ -357,14 +362,14 @@ plx_status plx_atlas_info_get(plx_engine *e, plx_atlas_info *out)
     return PLX_OK;
 }
 
-/* Worker 0 of a fill: the engine's light object, records in scratch. */
-static int atlas_worker0(plx_engine *e, atlas_worker *w)
+/* Worker 0 of a fill: the engine's light object, the records buffer
+ * taken with the atlas (a frame's fill needs no memory). */
+static void atlas_worker0(plx_engine *e, atlas_worker *w)
 {
     w->lt = e->lt;
     w->ind = e->ph && plx_indirect_frames(e) > 0 ? atlas_ind : NULL;
     w->ind_user = e;
-    w->rec = arena_scratch(&e->mem, arena_mul(atlas_fill_records(e->atlas), sizeof(double)), 8);
-    return w->rec ? 0 : -1;
+    w->rec = e->atlas_rec;
 }
 
 /* A further worker: a light object of its own (it fills its region cache
@@ -403,7 +408,8 @@ plx_status eng_atlas_fill_all(plx_engine *e)
     arena_mark m;
     plx_status st;
     int n, k;
-    if ((st = eng_need(e, ENG_LIGHT, "plx_bake_save")) != PLX_OK || (st = eng_need_atlas(e, e->atlas_fine)) != PLX_OK)
+    if ((st = eng_need(e, ENG_LIGHT, "filling the radiance atlas")) != PLX_OK ||
+        (st = eng_need_atlas(e, e->atlas_fine)) != PLX_OK)
         return st;
     atlas_current(e);
     if (e->atlas->todo == 0)
@@ -412,10 +418,7 @@ plx_status eng_atlas_fill_all(plx_engine *e)
     ro.workers = 1;
     set_workers(e, &ro);
     m = arena_get_mark(&e->mem);
-    if (atlas_worker0(e, &w[0]) != 0) {
-        arena_release(&e->mem, &m);
-        return eng_nomem(e, "filling the radiance atlas");
-    }
+    atlas_worker0(e, &w[0]);
     for (n = 1; n < ro.workers && n < PLX_MAX_THREADS; n++)
         if (atlas_worker_new(e, &w[n], &wm[n]) != 0)
             break;
@@ -433,20 +436,19 @@ plx_status eng_atlas_fill_all(plx_engine *e)
 /* render_opts.atlas_need: what the frame reads and is not filled yet,
  * filled on this thread (the engine's light object), round after round
  * of at most ENG_ATLAS_LIST items. */
-static void atlas_need(void *user, const atlas_view *v, const uint32_t *ids)
+static int atlas_need(void *user, const atlas_view *v, const uint32_t *ids)
 {
     plx_engine *e = user;
-    arena_mark m;
     atlas_worker w;
     uint32_t n;
     atlas_current(e);
     if (e->atlas->todo == 0)
-        return;
-    m = arena_get_mark(&e->mem);
-    if (atlas_worker0(e, &w) == 0)
-        while ((n = atlas_frame_missing(e->atlas, v, ids, e->atlas_list, ENG_ATLAS_LIST)) > 0)
-            (void)atlas_fill_items(e->atlas, &w, 1, NULL, e->atlas_list, n);
-    arena_release(&e->mem, &m);
+        return 0;
+    atlas_worker0(e, &w);
+    while ((n = atlas_frame_missing(e->atlas, v, ids, e->atlas_list, ENG_ATLAS_LIST)) > 0)
+        if (atlas_fill_items(e->atlas, &w, 1, NULL, e->atlas_list, n) != PLX_OK)
+            return -1;
+    return 0;
 }
 
 /* The adaptive anti-aliasing's buffers (PLX_PART_FRAME, on first need,
@@ -577,6 +579,7 @@ plx_status plx_render(plx_engine *e, const plx_camera *cam, const plx_render_opt
     render_stats rs;
     plx_render_opts def;
     plx_status st;
+    int use_atlas;
     if (!eng_ok(e))
         return PLX_E_INVALID;
     if (!e->sc)
@@ -594,9 +597,18 @@ plx_status plx_render(plx_engine *e, const plx_camera *cam, const plx_render_opt
         return st;
     if ((st = frame_fits(e, cam)) != PLX_OK)
         return st;
-    if (atlas_frames(e, o) && (st = eng_need_atlas(e, e->atlas_fine > 0.0 ? e->atlas_fine : o->aerial_m_per_texel)) != PLX_OK)
-        return st;
-    if (atlas_frames(e, o)) {
+    use_atlas = atlas_frames(e, o) && !e->atlas_off && !render_eye_inside(e->rd, cam->eye);
+    if (use_atlas && (st = eng_need_atlas(e, e->atlas_fine > 0.0 ? e->atlas_fine : o->aerial_m_per_texel)) != PLX_OK) {
+        if (st != PLX_E_NOMEM)
+            return st;
+        /* too large for the block: every pixel shaded instead, said once */
+        eng_warn(e, "the radiance atlas does not fit in the block (plx_config.lightmap_bytes, --mem, --texel): "
+                    "frames with indirect light shade every pixel instead (slower)");
+        e->atlas_off = 1;
+        use_atlas = 0;
+        eng_clear_error(e);
+    }
+    if (use_atlas) {
         /* from the atlas: no light map, no indirect hook */
     } else if (o->aerial && e->lightmap_cell != 0.0 && !o->no_indirect && e->ic && e->ph && plx_indirect_frames(e) > 0) {
         /* built before the photons: its indirect layer gathered now;
@@ -605,7 +617,7 @@ plx_status plx_render(plx_engine *e, const plx_camera *cam, const plx_render_opt
         if (aerial_layer(e) && !layer_on(e))
             e->lightmap_cell = 0.0;
     }
-    if (o->aerial && e->lightmap_cell == 0.0 && !atlas_frames(e, o)) {
+    if (o->aerial && e->lightmap_cell == 0.0 && !use_atlas) {
         st = eng_need_lightmap(e, o->aerial_m_per_texel, 0);
         if (st != PLX_OK)
             return st;
@@ -622,7 +634,7 @@ plx_status plx_render(plx_engine *e, const plx_camera *cam, const plx_render_opt
     ro.cull = o->no_cull ? RENDER_CULL_NONE : RENDER_CULL_ALL;
     ro.backend = o->backend;
     ro.auto_exposure = o->auto_exposure;
-    if (atlas_frames(e, o)) {
+    if (use_atlas) {
         ro.lightmap = 0;
         ro.atlas = e->atlas;
         ro.atlas_cache = e->atlas_cache;

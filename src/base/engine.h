@@ -41,7 +41,9 @@ struct plx_engine {
     struct atlas *atlas;    /* the radiance atlas of frames with indirect light (on first need) */
     struct atlas_cache *atlas_cache; /* its per-worker map caches (PLX_MAX_THREADS) */
     uint32_t *atlas_list;   /* what a frame lists to fill (ENG_ATLAS_LIST items) */
+    double *atlas_rec;      /* its fills' indirect records (atlas_fill_records) */
     double atlas_fine;      /* the spacing asked for (0: the default) */
+    int atlas_off;          /* the atlas did not fit: frames shade every pixel */
     uint32_t gather_side;   /* final gathering at points: side^2 directions
                                (0 = photon buffers only); set by
                                plx_indirect_set_gather, else FINAL_GATHER_SIDE */

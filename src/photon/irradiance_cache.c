@@ -100,6 +100,9 @@ void icache_clear(icache *c)
     memset(c->peek_last, 0, sizeof c->peek_last);
     c->stamp = 0;
     c->gathered = c->direct = c->flushes = 0;
+    /* and the last frame's viewer and spacing: every frame sets them */
+    c->eye[0] = c->eye[1] = c->eye[2] = 0.0;
+    c->fixed = 0.0;
 }
 
 /* What the records were gathered from: any new photon frame, reset or

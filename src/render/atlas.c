@@ -19,6 +19,14 @@ static uint32_t side_vertices(double len, double step)
     return (uint32_t)n + 1u;
 }
 
+/* Whether lamp l may light the ground: a photometric lamp counts even
+ * before its table is given (its intensity is 0 until then, and the
+ * atlas's layout does not change when it comes). */
+static int lights_ground(const scene_lamp *l)
+{
+    return (l->intensity > 0.0 || l->photometry) && l->z < l->radius;
+}
+
 /* The box the ground tiles cover: Bounds and every lamp's ground reach. */
 static void ground_box(const scene *s, double b[4])
 {
@@ -27,7 +35,7 @@ static void ground_box(const scene *s, double b[4])
     for (i = 0; i < s->nlamps; i++) {
         const scene_lamp *l = &s->lamps[i];
         double rg;
-        if (!(l->intensity > 0.0) || !(l->z < l->radius))
+        if (!lights_ground(l))
             continue;
         rg = sqrt(l->radius * l->radius - l->z * l->z);
         b[0] = fmin(b[0], l->x - rg);
@@ -61,7 +69,7 @@ static void mark_fine_tiles(const scene *s, const double g0[2], double tile, uin
     for (i = 0; i < s->nlamps; i++) {
         const scene_lamp *l = &s->lamps[i];
         double rg, x0, x1, y0, y1;
-        if (!(l->intensity > 0.0) || !(l->z < l->radius))
+        if (!lights_ground(l))
             continue;
         rg = sqrt(l->radius * l->radius - l->z * l->z);
         x0 = floor((l->x - rg - g0[0]) / tile);
@@ -253,7 +261,9 @@ static double clipped_area2(const vec2 *p, uint32_t n, const double q[4], vec2 *
 }
 
 /* What finding covered blocks needs: the buildings standing on the
- * ground by box, and clip buffers. */
+ * ground by box (cells of 32 m, larger over a large Bounds: at most 1024
+ * a side, so the grid's scratch follows the scene's extent no further),
+ * and clip buffers. */
 typedef struct cover_ctx {
     const scene *s;
     bucketgrid g;
@@ -264,7 +274,7 @@ static int cover_init(cover_ctx *cc, arena *a, const scene *s)
 {
     double *box = arena_scratch(a, arena_mul(s->nbld ? s->nbld : 1, 4 * sizeof(double)), 8);
     uint32_t b, most = 0, r;
-    double cell = 32.0;
+    double cell = fmax(32.0, fmax(s->bounds[2] - s->bounds[0], s->bounds[3] - s->bounds[1]) / 1024.0);
     cc->s = s;
     if (!box)
         return -1;
@@ -309,32 +319,97 @@ static int under_solid(const cover_ctx *cc, vec2 p)
     return 0;
 }
 
+/* Whether point p lies strictly inside building b's footprint (outer
+ * ring in, holes out, boundaries out). */
+static int strictly_in(const scene *s, uint32_t b, vec2 p)
+{
+    const scene_building *bd = &s->bld[b];
+    uint32_t r;
+    if (geom_point_in_ring(p, &s->pts[s->rings[bd->ring_first].first], s->rings[bd->ring_first].count) != GEOM_INSIDE)
+        return 0;
+    for (r = bd->ring_first + 1; r < bd->ring_first + bd->ring_count; r++)
+        if (geom_point_in_ring(p, &s->pts[s->rings[r].first], s->rings[r].count) != GEOM_OUTSIDE)
+            return 0;
+    return 1;
+}
+
+/* Whether footprint a's edges enter footprint b's interior: an edge of a
+ * crosses one of b, or a vertex of a, or a point just inside a next to an
+ * edge's middle (a copy of b, or a lying within b), lies strictly inside
+ * b. Footprints that only share walls do not. */
+static int enters(const scene *s, uint32_t a, uint32_t b)
+{
+    const scene_building *ba = &s->bld[a], *bb = &s->bld[b];
+    uint32_t ra, rb, i, j;
+    if (ba->box[2] < bb->box[0] || ba->box[0] > bb->box[2] || ba->box[3] < bb->box[1] || ba->box[1] > bb->box[3])
+        return 0;
+    for (ra = ba->ring_first; ra < ba->ring_first + ba->ring_count; ra++) {
+        const scene_ring *g = &s->rings[ra];
+        for (i = 0; i < g->count; i++) {
+            vec2 u = s->pts[g->first + i], v = s->pts[g->first + (i + 1) % g->count], m;
+            double ex = v.x - u.x, ey = v.y - u.y, l = sqrt(ex * ex + ey * ey);
+            if (strictly_in(s, b, u))
+                return 1;
+            /* inward is left of the edge (outer rings counter-clockwise, holes clockwise) */
+            m.x = 0.5 * (u.x + v.x) - 1e-6 * ey / (l > 0.0 ? l : 1.0);
+            m.y = 0.5 * (u.y + v.y) + 1e-6 * ex / (l > 0.0 ? l : 1.0);
+            if (strictly_in(s, b, m))
+                return 1;
+            for (rb = bb->ring_first; rb < bb->ring_first + bb->ring_count; rb++)
+                for (j = 0; j < s->rings[rb].count; j++) {
+                    const scene_ring *h = &s->rings[rb];
+                    if (geom_seg_meet(u, v, s->pts[h->first + j], s->pts[h->first + (j + 1) % h->count]) ==
+                        GEOM_SEG_CROSS)
+                        return 1;
+                }
+        }
+    }
+    return 0;
+}
+
 /* Whether the ground block q (x0, y0, x1, y1, its vertices 'step' apart)
- * is wholly under footprints: the footprints' areas within it add up to
- * its area (footprints overlap little) and every vertex lies strictly
+ * is wholly under footprints: one footprint's area within it is its
+ * area, or the footprints' areas add up to it and no two of them overlap
+ * (else overlaps could make up for a gap); and every vertex lies strictly
  * inside one. */
+#define COVER_MAX 16 /* footprints meeting a block that the overlap check takes */
 static int block_covered(const cover_ctx *cc, const double q[4], double step)
 {
     const scene *s = cc->s;
-    uint32_t r0[4], x, y, k, i, j;
+    uint32_t r0[4], x, y, k, i, j, got[COVER_MAX], ngot = 0;
     double area = 0.0, full = (q[2] - q[0]) * (q[3] - q[1]);
+    int one = 0;
     bucketgrid_range(&cc->g, q, r0);
     for (y = r0[1]; y <= r0[3]; y++)
         for (x = r0[0]; x <= r0[2]; x++)
             for (k = cc->g.start[y * cc->g.nx + x]; k < cc->g.start[y * cc->g.nx + x + 1]; k++) {
-                const scene_building *bd = &s->bld[cc->g.item[k]];
-                uint32_t c = cc->g.item[k], r;
+                uint32_t b = cc->g.item[k], r;
+                const scene_building *bd = &s->bld[b];
+                double a = 0.0;
                 /* count each building once: in the first cell of the range its box meets */
                 if (bd->min_height != 0.0 || bd->box[2] <= q[0] || bd->box[0] >= q[2] || bd->box[3] <= q[1] ||
                     bd->box[1] >= q[3] || bucketgrid_index(fmax(bd->box[0], q[0]), cc->g.x0, cc->g.sx, cc->g.nx) != x ||
                     bucketgrid_index(fmax(bd->box[1], q[1]), cc->g.y0, cc->g.sy, cc->g.ny) != y)
                     continue;
-                (void)c;
                 for (r = bd->ring_first; r < bd->ring_first + bd->ring_count; r++)
-                    area += 0.5 * clipped_area2(&s->pts[s->rings[r].first], s->rings[r].count, q, cc->buf0, cc->buf1);
+                    a += 0.5 * clipped_area2(&s->pts[s->rings[r].first], s->rings[r].count, q, cc->buf0, cc->buf1);
+                if (!(a > 0.0))
+                    continue;
+                if (a >= full * (1.0 - 1e-9))
+                    one = 1; /* one footprint covers it: no overlap can matter */
+                if (ngot < COVER_MAX)
+                    got[ngot] = b;
+                ngot++;
+                area += a;
             }
     if (area < full * (1.0 - 1e-9))
         return 0;
+    if (!one && ngot > COVER_MAX)
+        return 0; /* too many to check for overlaps: kept */
+    for (i = 0; !one && i < ngot; i++)
+        for (j = 0; j < ngot; j++)
+            if (i != j && enters(s, got[i], got[j]))
+                return 0;
     for (j = 0; j <= ATLAS_BLOCK; j++)
         for (i = 0; i <= ATLAS_BLOCK; i++) {
             vec2 p;
@@ -554,7 +629,7 @@ double atlas_spacing_for(arena *a, const scene *s, const mesh *m, double fine, s
         while (f0 * pow(step, k + 1) <= c && k < 64)
             k++;
     }
-    for (n = 0; n < 64 && f0 * pow(step, k) <= 64.0; n++) {
+    for (n = 0; n < 64 && f0 * pow(step, k) <= fmax(64.0, f0); n++) {
         if (atlas_plan(a, s, m, f0 * pow(step, k), NULL) <= max_bytes) {
             while (k > 0 && atlas_plan(a, s, m, f0 * pow(step, k - 1), NULL) <= max_bytes)
                 k--;

@@ -42,8 +42,8 @@
  * shadow edges are as sharp as the spacing); frames that must be exact
  * (no indirect light, render.h) do not read the atlas.
  *
- * MEMORY. The charts (ATLAS_CHART_BYTES each: one per footprint edge,
- * two per building), the ground tiles (65 bytes each) and the packed
+ * MEMORY. The charts (ATLAS_CHART_BYTES + 1 each: one per footprint edge,
+ * two per building), the ground tiles (81 bytes each) and the packed
  * values (4 bytes a vertex), from the arena (part PLX_PART_FRAME), sized before anything is
  * taken (atlas_plan): the fine spacing grows from the one asked for until
  * the whole fits the budget. A bake saves it with the engine's other
@@ -120,8 +120,8 @@ typedef struct atlas {
 size_t atlas_plan(arena *a, const scene *s, const mesh *m, double fine, uint64_t *ntex /* OUT */);
 
 /* The fine spacing to use: 'fine' (ATLAS_FINE_DEFAULT when <= 0) grown by
- * steps of 2^(1/4) until atlas_plan fits max_bytes; 0 when even 64 m does
- * not. */
+ * steps of 2^(1/4) until atlas_plan fits max_bytes (the finest such step);
+ * 0 when even 64 m (or 'fine', if coarser) does not. */
 double atlas_spacing_for(arena *a, const scene *s, const mesh *m, double fine, size_t max_bytes);
 
 /* Lays out the charts at fine spacing 'fine' and takes their memory (the

@@ -130,7 +130,7 @@ static void ground_setup(const atlas *A, const atlas_view *v, int32_t j, ground_
 static uint32_t ground_block(const atlas *A, double x, double y, double *u, double *w)
 {
     double fx = x * A->inv_tile, fy = y * A->inv_tile, step_inv, bx, by;
-    uint32_t tx, ty, tile;
+    uint32_t tx, ty, tile, nb;
     if (!(fx >= 0.0 && fx < A->gx && fy >= 0.0 && fy < A->gy))
         return UINT32_MAX;
     tx = (uint32_t)fx;
@@ -141,8 +141,9 @@ static uint32_t ground_block(const atlas *A, double x, double y, double *u, doub
     y = (y - ty * A->tile) * step_inv;
     bx = x < 0.0 ? 0.0 : x * (1.0 / ATLAS_BLOCK);
     by = y < 0.0 ? 0.0 : y * (1.0 / ATLAS_BLOCK);
-    tx = bx < ATLAS_TB - 1 ? (uint32_t)bx : ATLAS_TB - 1;
-    ty = by < ATLAS_TB - 1 ? (uint32_t)by : ATLAS_TB - 1;
+    nb = A->gfine[tile] ? ATLAS_TB - 1 : 0; /* a coarse tile is one block */
+    tx = bx < nb ? (uint32_t)bx : nb;
+    ty = by < nb ? (uint32_t)by : nb;
     *u = x - tx * ATLAS_BLOCK;
     *w = y - ty * ATLAS_BLOCK;
     return tile * ATLAS_TB * ATLAS_TB + ty * ATLAS_TB + tx;

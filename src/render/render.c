@@ -451,6 +451,63 @@ plx_status render_create(arena *a, const scene *s, int32_t max_w, int32_t max_h,
     return PLX_OK;
 }
 
+void render_frame_clear(render *r)
+{
+    const scene *s = r->s;
+    size_t px = (size_t)r->max_w * (size_t)r->max_h, v = (size_t)r->m->max_bld_verts + 1, nb = (size_t)s->nbld + 1;
+    size_t tiles = (size_t)((r->max_w + RENDER_TILE - 1) / RENDER_TILE) * (size_t)((r->max_h + RENDER_TILE - 1) / RENDER_TILE);
+    size_t corners = (size_t)(r->max_w / IND_STEP + 2) * (size_t)(r->max_h / IND_STEP + 2);
+    int k;
+    memset(r->depth, 0, px * sizeof *r->depth);
+    memset(r->id, 0, px * sizeof *r->id);
+    memset(r->lin, 0, px * 3 * sizeof *r->lin);
+    memset(r->vbuf, 0, v * sizeof *r->vbuf);
+    memset(r->pv, 0, v * sizeof *r->pv);
+    memset(r->clip, 0, v * 4 * sizeof *r->clip);
+    memset(r->gxyz, 0, v * 3 * sizeof *r->gxyz);
+    memset(r->gtri, 0, ((size_t)r->m->max_bld_tris + 1) * sizeof *r->gtri);
+    memset(r->sc_id, 0, ((size_t)r->sc_mask + 1) * sizeof *r->sc_id);
+    memset(r->sc, 0, ((size_t)r->sc_mask + 1) * sizeof *r->sc);
+    memset(r->heap, 0, nb * sizeof *r->heap);
+    memset(r->wmin, 0, nb * sizeof *r->wmin);
+    memset(r->wmax, 0, nb * sizeof *r->wmax);
+    memset(r->draw, 0, nb);
+    memset(r->yr, 0, nb * 2 * sizeof *r->yr);
+    memset(r->bins, 0, RENDER_BINS * sizeof *r->bins);
+    memset(r->trav, 0, (nb + r->ncell) * sizeof *r->trav);
+    memset(r->defer, 0, tiles);
+    memset(r->blk, 0, corners);
+    memset(r->ind, 0, corners * 3 * sizeof *r->ind);
+    memset(r->crow, 0, 2 * (size_t)(r->max_w / IND_STEP + 2) * sizeof *r->crow);
+    memset(r->stop, 0, stop_rows(r->max_h) * sizeof *r->stop);
+    memset(r->tm, 0, sizeof *r->tm);
+    memset(r->ws, 0, sizeof r->ws);
+    memset(r->hist, 0, sizeof r->hist);
+    memset(&r->rc, 0, sizeof r->rc);
+    for (k = 0; r->band && k < RENDER_BANDS; k++) {
+        band *bd = &r->band[k];
+        memset(&bd->rc, 0, sizeof bd->rc);
+        bd->cur_id = 0;
+        memset(bd->gxyz, 0, v * 3 * sizeof *bd->gxyz);
+        memset(bd->gtri, 0, ((size_t)r->m->max_bld_tris + 1) * sizeof *bd->gtri);
+        memset(bd->clip, 0, v * 4 * sizeof *bd->clip);
+        memset(bd->vbuf, 0, v * sizeof *bd->vbuf);
+        memset(bd->pv, 0, v * sizeof *bd->pv);
+    }
+    r->w = r->h = 0;
+    r->cur_id = 0;
+    r->frames = 0;
+    r->nheap = r->ntrav = 0;
+    memset(r->eye, 0, sizeof r->eye);
+    memset(r->f, 0, sizeof r->f);
+    memset(r->rt, 0, sizeof r->rt);
+    memset(r->up, 0, sizeof r->up);
+    r->sx = r->sy = r->za = r->zb = r->tanh_ = r->aspect = r->near_ = r->far_ = 0.0;
+    r->shift[0] = r->shift[1] = r->shx = r->shy = 0.0;
+    r->nbx = r->nby = 0;
+    r->sparse = 0;
+}
+
 size_t render_struct_bytes(void)
 {
     return sizeof(render);
@@ -853,20 +910,20 @@ static void occlusion(render *r, int mode, render_stats *st)
     }
 }
 
-static int eye_inside_solid(const render *r)
+int render_eye_inside(const render *r, const double eye[3])
 {
     const scene *s = r->s;
     uint32_t b, k;
     vec2 p;
-    p.x = r->eye[0];
-    p.y = r->eye[1];
+    p.x = eye[0];
+    p.y = eye[1];
     for (b = 0; b < s->nbld; b++) {
         const scene_building *bd = &s->bld[b];
         const scene_ring *rg;
         int in;
         if (p.x < bd->box[0] || p.x > bd->box[2] || p.y < bd->box[1] || p.y > bd->box[3])
             continue;
-        if (!(r->eye[2] >= bd->min_height && r->eye[2] <= bd->height))
+        if (!(eye[2] >= bd->min_height && eye[2] <= bd->height))
             continue;
         rg = &s->rings[bd->ring_first];
         in = geom_point_in_ring(p, s->pts + rg->first, rg->count) != GEOM_OUTSIDE;
@@ -948,9 +1005,10 @@ static int box_out(const render *r, const double *bx, double *wmn, double *wmx, 
     if (rows) {
         rows[0] = 0;
         rows[1] = r->h - 1;
-        if (all_front && hi - lo < 4.0 * RASTER_MAX_DIM) {
-            rows[0] = lo - 2.0 > 0.0 ? (int32_t)(lo - 2.0) : 0;
-            rows[1] = hi + 2.0 < r->h - 1 ? (int32_t)(hi + 2.0) : r->h - 1;
+        if (all_front) { /* clamped before the conversion: far-off boxes give huge rows */
+            double a = fmin(fmax(lo - 2.0, 0.0), r->h - 1.0), b = fmin(fmax(hi + 2.0, 0.0), r->h - 1.0);
+            rows[0] = (int32_t)a;
+            rows[1] = (int32_t)b;
         }
     }
     return out_l || out_r || out_t || out_b || out_n;
@@ -2490,7 +2548,7 @@ static void atlas_rows(void *arg, int worker, uint32_t k)
 
 /* Every pixel from the atlas: the ground's ids set, then rows of pixels
  * (RENDER_TILE a job) on the workers, each with its own map cache. */
-static void atlas_pass(render *r, const render_opts *o, render_stats *st)
+static int atlas_pass(render *r, const render_opts *o, render_stats *st)
 {
     atlas_job jb;
     double ta = r->tanh_ * r->aspect, tb = r->tanh_, a0, b0;
@@ -2514,8 +2572,8 @@ static void atlas_pass(render *r, const render_opts *o, render_stats *st)
     jb.r = r;
     jb.o = o;
     jb.count = o->auto_exposure;
-    if (o->atlas_need)
-        o->atlas_need(o->atlas_user, &jb.v, r->id);
+    if (o->atlas_need && o->atlas_need(o->atlas_user, &jb.v, r->id) != 0)
+        return -1;
     if (jb.count)
         memset(r->hist, 0, sizeof r->hist);
     memset(jb.px, 0, sizeof jb.px);
@@ -2525,6 +2583,7 @@ static void atlas_pass(render *r, const render_opts *o, render_stats *st)
         st->ground_pixels += jb.px[k][1];
         st->building_pixels += jb.px[k][2];
     }
+    return 0;
 }
 
 plx_status render_frame(render *r, const render_camera *cam, const render_opts *o,
@@ -2556,7 +2615,7 @@ plx_status render_frame(render *r, const render_camera *cam, const render_opts *
         r->err = "render_frame: the backend lacks a function";
         return PLX_E_INVALID;
     }
-    inside = eye_inside_solid(r);
+    inside = render_eye_inside(r, r->eye);
     st.eye_inside = inside;
     if (be == &r->soft && r->band && par_workers(o) >= 2) {
         /* the built-in rasteriser on the workers, by bands of rows */
@@ -2576,7 +2635,10 @@ plx_status render_frame(render *r, const render_camera *cam, const render_opts *
     }
     st.drawn_fraction = st.triangles ? (double)st.triangles_drawn / (double)st.triangles : 1.0;
     if (o->atlas) {
-        atlas_pass(r, o, &st);
+        if (atlas_pass(r, o, &st) != 0) {
+            r->err = "render_frame: the radiance atlas could not be filled for this frame";
+            return PLX_E_NOMEM;
+        }
         goto finish;
     }
     surf_cache_fill(r);

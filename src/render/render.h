@@ -317,10 +317,12 @@ typedef struct render_opts {
                                   when there is one); the indirect hooks and the light map
                                   are then not used */
     struct atlas_cache *atlas_cache; /* with atlas: one per worker (workers of them, at least 1) */
-    void (*atlas_need)(void *user, const struct atlas_view *v, const uint32_t *ids);
+    int (*atlas_need)(void *user, const struct atlas_view *v, const uint32_t *ids);
                                /* with atlas (may be NULL): called once the frame's surface ids
                                   are known (the ground's set), before any pixel is read: fills
-                                  what the frame reads of the atlas (atlas_frame_missing) */
+                                  what the frame reads of the atlas (atlas_frame_missing);
+                                  returns 0, or -1 when it could not (the frame then fails with
+                                  PLX_E_NOMEM) */
     void *atlas_user;
 } render_opts;
 
@@ -452,6 +454,16 @@ void render_code_unbind(render *r);
  * RENDER_SURF_CACHE, at least 64. A record not cached is made again when
  * read (the same values), so the number changes no byte of a frame. */
 uint32_t render_surf_slots(const scene *s, int32_t max_w, int32_t max_h);
+
+/* Every buffer and value a frame leaves behind set to zero, so that what
+ * the object holds does not depend on the frames drawn (a bake saves it):
+ * the next frame starts as the first one did. */
+void render_frame_clear(render *r);
+
+/* Whether the point eye lies in some building's solid (its footprint,
+ * holes out, boundaries in, between its heights): frames from there see
+ * the inner faces of walls, which the radiance atlas does not hold. */
+int render_eye_inside(const render *r, const double eye[3]);
 
 /* sizeof the render object (opaque elsewhere). */
 size_t render_struct_bytes(void);

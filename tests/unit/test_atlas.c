@@ -1771,7 +1771,7 @@ typedef struct lazy {
     long rounds, listed;
 } lazy;
 
-static void lazy_need(void *user, const atlas_view *v, const uint32_t *ids)
+static int lazy_need(void *user, const atlas_view *v, const uint32_t *ids)
 {
     lazy *z = user;
     uint32_t n;
@@ -1784,6 +1784,7 @@ static void lazy_need(void *user, const atlas_view *v, const uint32_t *ids)
         z->rounds++;
         z->listed += n;
     }
+    return 0;
 }
 
 static int eye_in_solid(const scene *s, const double eye[3])
@@ -2107,6 +2108,108 @@ static void determinism_check(world *w, double fine, rng *r)
     free(wk[1].rec);
     free(blk);
     arena_release(&w->e->mem, &mk);
+}
+
+/* ---- frames through the engine: memory faults, the eye in a building --------------- */
+
+#define FW 120
+#define FH 90
+
+static plx_engine *fault_engine(void **mem)
+{
+    plx_config cfg;
+    plx_engine *e = NULL;
+    *mem = calloc(1, (size_t)64 << 20);
+    assert_non_null(*mem);
+    plx_config_default(&cfg);
+    cfg.port = fixture_quiet_port();
+    cfg.threads = 1;
+    cfg.render_max_width = FW;
+    cfg.render_max_height = FH;
+    assert_int_equal(plx_engine_create(*mem, (size_t)64 << 20, &cfg, &e), PLX_OK);
+    assert_int_equal(plx_load_file(e, "fixtures/eixample-4x4.geojson"), PLX_OK);
+    assert_int_equal(plx_indirect_step(e, 20000, 1), PLX_OK);
+    return e;
+}
+
+static plx_status fault_shot(plx_engine *e, int per_pixel, const double eye[3], float *out)
+{
+    plx_camera c;
+    plx_render_opts o;
+    memset(&c, 0, sizeof c);
+    memcpy(c.eye, eye, sizeof c.eye);
+    c.target[0] = 100;
+    c.target[1] = 80;
+    c.fov_deg = 60;
+    c.width = FW;
+    c.height = FH;
+    plx_render_opts_default(&o);
+    o.no_glow = 1;
+    o.per_pixel = per_pixel;
+    return plx_render(e, &c, &o, NULL, out, NULL);
+}
+
+/* An allocation refused at every point of a first atlas frame (the
+ * atlas made and filled for it): the frame fails with an error, or gives
+ * the image of an engine without faults, or (the atlas did not fit, said
+ * in a warning) the image of every pixel shaded; never another image
+ * with PLX_OK. */
+static void test_frame_faults(void **state)
+{
+    static float ref[FW * FH * 3], pp[FW * FH * 3], img[FW * FH * 3];
+    const double eye[3] = { 200, 250, 60 };
+    void *m;
+    plx_engine *e = fault_engine(&m);
+    int k, n = quick() ? 60 : 200, failed = 0, same = 0, shaded = 0;
+    (void)state;
+    assert_int_equal(fault_shot(e, 0, eye, ref), PLX_OK);
+    assert_int_equal(fault_shot(e, 1, eye, pp), PLX_OK);
+    fixture_done(e, m);
+    for (k = 1; k <= n; k++) {
+        uint32_t warned;
+        plx_status st;
+        e = fault_engine(&m);
+        /* the renderer and the lamps' light made by a first frame without the atlas */
+        assert_int_equal(fault_shot(e, 1, eye, img), PLX_OK);
+        warned = plx_warning_count(e);
+        (void)plx_debug_fail_alloc(e, (uint64_t)k);
+        memset(img, 0, sizeof img);
+        st = fault_shot(e, 0, eye, img);
+        (void)plx_debug_fail_alloc(e, 0);
+        if (st != PLX_OK) {
+            failed++;
+        } else if (memcmp(img, ref, sizeof img) == 0) {
+            same++;
+        } else {
+            assert_true(plx_warning_count(e) > warned);
+            assert_memory_equal(img, pp, sizeof img);
+            shaded++;
+        }
+        fixture_done(e, m);
+    }
+    printf("  first atlas frame with allocation %d..%d refused: %d errors, %d the same image, %d every pixel "
+           "shaded (warned)\n", 1, n, failed, same, shaded);
+    assert_true(same > 0);
+}
+
+/* The eye inside a building: frames shade every pixel (the atlas holds
+ * no inner faces), so they equal per_pixel frames. */
+static void test_eye_inside(void **state)
+{
+    static float a[FW * FH * 3], b[FW * FH * 3];
+    double eye[3];
+    void *m;
+    plx_engine *e = fault_engine(&m);
+    const scene_building *bd = &e->sc->bld[5];
+    (void)state;
+    eye[0] = 0.5 * (bd->box[0] + bd->box[2]); /* the middle of a (convex) footprint, half way up */
+    eye[1] = 0.5 * (bd->box[1] + bd->box[3]);
+    eye[2] = 0.5 * (bd->min_height + bd->height);
+    assert_int_equal(fault_shot(e, 0, eye, a), PLX_OK);
+    assert_true(render_eye_inside(e->rd, eye));
+    assert_int_equal(fault_shot(e, 1, eye, b), PLX_OK);
+    assert_memory_equal(a, b, sizeof a);
+    fixture_done(e, m);
 }
 
 static void test_determinism(void **state)
@@ -2459,7 +2562,8 @@ int main(void)
         cmocka_unit_test(test_texel_codec),     cmocka_unit_test(test_layout),
         cmocka_unit_test(test_create_errors),   cmocka_unit_test(test_values),
         cmocka_unit_test(test_frames),          cmocka_unit_test(test_sample),
-        cmocka_unit_test(test_determinism),     cmocka_unit_test(test_spacing),
+        cmocka_unit_test(test_determinism),     cmocka_unit_test(test_frame_faults),
+        cmocka_unit_test(test_eye_inside),     cmocka_unit_test(test_spacing),
         cmocka_unit_test(test_bug_stacked_neighbours), cmocka_unit_test(test_bug_ground_site_in_solid),
         cmocka_unit_test(test_bug_spacing_too_coarse), cmocka_unit_test(test_bug_texel_below_half),
         cmocka_unit_test(test_bug_create_null_arena),

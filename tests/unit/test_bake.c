@@ -304,6 +304,48 @@ static void test_atlas_in_bake(void **state)
     free(mc);
 }
 
+/* A bake made after frames were drawn (street and aerial from the atlas,
+ * a street view shading every pixel, on two workers) is the same bytes as
+ * one made without them: what frames leave behind (frame buffers, the
+ * bands' rasteriser state, the surfaces' maps, the cache's records) is
+ * not saved. (Frames that take memory, anti-aliased ones or an aerial
+ * view's light map, would need the twin to draw them too.) */
+static void test_bake_after_frames(void **state)
+{
+    baked k;
+    size_t size = 0;
+    uint64_t f;
+    int v;
+    (void)state;
+    k.a = make(&k.ma, 0, 1);
+    for (f = 1; f <= 3; f++)
+        assert_int_equal(plx_indirect_step(k.a, 20000, f), PLX_OK);
+    for (v = 0; v < 3; v++) {
+        plx_camera cam;
+        plx_render_opts o;
+        static uint8_t rgb[320 * 240 * 3];
+        memset(&cam, 0, sizeof cam);
+        cam.width = 320;
+        cam.height = 240;
+        cam.fov_deg = 60;
+        cam.eye[0] = 298.6; cam.eye[1] = 265.5; cam.eye[2] = v == 2 ? 300.0 : 1.7;
+        cam.target[0] = 261.8; cam.target[1] = 302.3; cam.target[2] = 3.0;
+        plx_render_opts_default(&o);
+        o.aerial = v == 2;
+        o.per_pixel = v == 1;
+        o.auto_exposure = 1;
+        assert_int_equal(plx_render(k.a, &cam, &o, rgb, NULL, NULL), PLX_OK);
+    }
+    k.b = make(&k.mb, 1, 1);
+    assert_int_equal(plx_bake_size(k.a, k.b, &size), PLX_OK);
+    k.file = malloc(size);
+    assert_non_null(k.file);
+    assert_int_equal(plx_bake_save(k.a, k.b, k.file, size, &k.len), PLX_OK);
+    assert_int_equal(k.len, shared.len);
+    assert_memory_equal(k.file, shared.file, k.len);
+    bake_free(&k);
+}
+
 /* ---- damaged files ----------------------------------------------------------- */
 
 static void expect_fail(const unsigned char *f, size_t len, plx_status want, const char *msg)
@@ -449,6 +491,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_round_trip),
         cmocka_unit_test(test_atlas_in_bake),
+        cmocka_unit_test(test_bake_after_frames),
         cmocka_unit_test(test_damaged),
         cmocka_unit_test(test_corpus),
         cmocka_unit_test(test_twin_mismatch),
