@@ -149,18 +149,6 @@ static uint32_t ground_block(const atlas *A, double x, double y, double *u, doub
     return tile * ATLAS_TB * ATLAS_TB + ty * ATLAS_TB + tx;
 }
 
-/* The ground at (x, y) from the tiles' corner: its block, bilinear. */
-static void ground_px(const atlas *A, double x, double y, float out[3])
-{
-    double u, w;
-    uint32_t b = ground_block(A, x, y, &u, &w), first = b == UINT32_MAX ? ATLAS_NOVERT : A->gfirst[b];
-    if (first == ATLAS_NOVERT) {
-        out[0] = out[1] = out[2] = 0.0f;
-        return;
-    }
-    bilerp(&A->tex[first], ATLAS_BLOCK + 1, ATLAS_BLOCK + 1, (float)u, (float)w, out);
-}
-
 /* Lists item it unless filled or listed (done byte 2: listed this round). */
 static void want(atlas *A, uint32_t it, uint32_t *list, uint32_t cap, uint32_t *n)
 {
@@ -197,52 +185,107 @@ uint32_t atlas_frame_missing(atlas *A, const atlas_view *v, const uint32_t *ids,
     return n;
 }
 
-void atlas_frame_row(const atlas *A, const atlas_view *v, atlas_cache *k, const uint32_t *ids, const uint8_t *mask,
-                     int32_t j, float *lin, uint64_t count[3])
+/* A run of ground pixels i0 .. i1 - 1 of a row: the block under each hit
+ * point, kept while the points stay in it (a row's points move by a
+ * fixed step: runs of them share a block). */
+static void ground_run(const atlas *A, const ground_row *g, int32_t i0, int32_t i1, const uint8_t *mask, float *lin)
 {
-    const atlas_map *m = NULL;
-    uint32_t last = MESH_SURF_NONE;
-    ground_row g;
-    float fj = (float)j, bu = 0, bv = 0, bw = 0;
-    uint64_t nsky = 0, nground = 0, nbld = 0; /* counted here: count[] may share a cache line with
-                                                 another worker's */
+    double bx0 = 0.0, by0 = 0.0, inv = 0.0, lim = -1.0;
+    const uint32_t *t0 = NULL;
+    uint32_t cur = UINT32_MAX;
     int32_t i;
-    ground_setup(A, v, j, &g);
-    for (i = 0; i < v->w; i++) {
-        uint32_t sid = ids[i];
+    for (i = i0; i < i1; i++) {
+        double x = g->x0 + i * g->dx, y = g->y0 + i * g->dy, u = (x - bx0) * inv, w = (y - by0) * inv;
         float *o = &lin[3 * (size_t)i];
         if (mask && !mask[i])
             continue;
-        if (sid == MESH_SURF_NONE || (sid == MESH_SURF_GROUND && !g.on)) {
-            o[0] = o[1] = o[2] = 0.0f;
-            nsky++;
-            continue;
-        }
-        if (sid == MESH_SURF_GROUND) {
-            ground_px(A, g.x0 + i * g.dx, g.y0 + i * g.dy, o);
-            nground++;
-            continue;
-        }
-        nbld++;
-        if (sid != last) {
-            m = map_of(A, v, k, sid);
-            last = sid;
-            if (m->c) {
-                bu = m->a[0] + m->a[2] * fj;
-                bv = m->a[3] + m->a[5] * fj;
-                bw = m->a[6] + m->a[8] * fj;
+        if (!(u >= 0.0 && u <= lim && w >= 0.0 && w <= lim)) { /* another block */
+            cur = ground_block(A, x, y, &u, &w);
+            t0 = NULL;
+            lim = -1.0;
+            if (cur != UINT32_MAX && A->gfirst[cur] != ATLAS_NOVERT) {
+                uint32_t tile = cur / (ATLAS_TB * ATLAS_TB), b = cur % (ATLAS_TB * ATLAS_TB);
+                double step = A->gfine[tile] ? A->fine : A->coarse;
+                t0 = &A->tex[A->gfirst[cur]];
+                inv = 1.0 / step;
+                bx0 = (tile % A->gx) * A->tile + (b % ATLAS_TB) * ATLAS_BLOCK * step;
+                by0 = (tile / A->gx) * A->tile + (b / ATLAS_TB) * ATLAS_BLOCK * step;
+                lim = ATLAS_BLOCK;
             }
         }
-        if (!m->c) {
+        if (!t0) {
             o[0] = o[1] = o[2] = 0.0f;
             continue;
         }
-        {
-            float fi = (float)i, r = 1.0f / (bw + m->a[7] * fi);
-            bilerp(&A->tex[m->c->first], m->c->nu, m->c->nv, (bu + m->a[1] * fi) * r, (bv + m->a[4] * fi) * r, o);
-        }
+        bilerp(t0, ATLAS_BLOCK + 1, ATLAS_BLOCK + 1, (float)u, (float)w, o);
     }
-    count[0] += nsky;
-    count[1] += nground;
-    count[2] += nbld;
+}
+
+/* A run of pixels i0 .. i1 - 1 of row j on surface sid: its chart's map,
+ * then each pixel's (u, v) and the bilinear read. */
+static void surface_run(const atlas *A, const atlas_view *v, atlas_cache *k, uint32_t sid, int32_t j, int32_t i0,
+                        int32_t i1, const uint8_t *mask, float *lin)
+{
+    const atlas_map *m = map_of(A, v, k, sid);
+    const atlas_chart *c = m->c;
+    float fj = (float)j, bu, bv, bw, au, av, aw;
+    const uint32_t *t0;
+    uint32_t nu, nv;
+    int32_t i;
+    if (!c) {
+        for (i = i0; i < i1; i++)
+            if (!mask || mask[i])
+                lin[3 * (size_t)i] = lin[3 * (size_t)i + 1] = lin[3 * (size_t)i + 2] = 0.0f;
+        return;
+    }
+    bu = m->a[0] + m->a[2] * fj;
+    bv = m->a[3] + m->a[5] * fj;
+    bw = m->a[6] + m->a[8] * fj;
+    au = m->a[1];
+    av = m->a[4];
+    aw = m->a[7];
+    t0 = &A->tex[c->first];
+    nu = c->nu;
+    nv = c->nv;
+    for (i = i0; i < i1; i++) {
+        float fi = (float)i, r = 1.0f / (bw + aw * fi);
+        if (mask && !mask[i])
+            continue;
+        bilerp(t0, nu, nv, (bu + au * fi) * r, (bv + av * fi) * r, &lin[3 * (size_t)i]);
+    }
+}
+
+void atlas_frame_row(const atlas *A, const atlas_view *v, atlas_cache *k, const uint32_t *ids, const uint8_t *mask,
+                     int32_t j, float *lin, uint64_t count[3])
+{
+    ground_row g;
+    int32_t i = 0, e;
+    ground_setup(A, v, j, &g);
+    while (i < v->w) {
+        uint32_t sid = ids[i];
+        uint64_t n;
+        for (e = i + 1; e < v->w && ids[e] == sid; e++)
+            ;
+        if (mask) { /* only the marked pixels are written, and counted */
+            int32_t q;
+            for (n = 0, q = i; q < e; q++)
+                n += mask[q] != 0;
+        } else {
+            n = (uint64_t)(e - i);
+        }
+        if (sid == MESH_SURF_NONE || (sid == MESH_SURF_GROUND && !g.on)) {
+            int32_t q;
+            for (q = i; q < e; q++)
+                if (!mask || mask[q])
+                    lin[3 * (size_t)q] = lin[3 * (size_t)q + 1] = lin[3 * (size_t)q + 2] = 0.0f;
+            count[0] += n;
+        } else if (sid == MESH_SURF_GROUND) {
+            ground_run(A, &g, i, e, mask, lin);
+            count[1] += n;
+        } else {
+            surface_run(A, v, k, sid, j, i, e, mask, lin);
+            count[2] += n;
+        }
+        i = e;
+    }
 }
