@@ -35,7 +35,7 @@
 #include "polarlux_port.h"
 #include "ref_bake_sum.h"
 
-#define MEM ((size_t)160 << 20)
+#define MEM ((size_t)64 << 20)
 #define SCENE "fixtures/eixample-4x4.geojson"
 
 typedef struct baked {
