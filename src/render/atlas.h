@@ -73,6 +73,16 @@
 
 enum { ATLAS_NONE = 0, ATLAS_WALL, ATLAS_ROOF, ATLAS_UNDER, ATLAS_GROUND };
 
+/* A chart's or block's state (atlas.cdone, atlas.gdone): not filled;
+ * filled; listed by atlas_frame_missing this round; filled and every
+ * value 0 (a frame writes its pixels black without reading them). */
+enum { ATLAS_TODO = 0, ATLAS_FILLED = 1, ATLAS_LISTED = 2, ATLAS_DARK = 3 };
+
+static inline int atlas_filled(uint8_t state)
+{
+    return state == ATLAS_FILLED || state == ATLAS_DARK;
+}
+
 typedef struct atlas_chart {
     double o[3];          /* the world point of vertex (0, 0) */
     float e[2];           /* walls: the edge's unit direction (x, y); else (1, 0) */
@@ -102,8 +112,8 @@ typedef struct atlas {
                              vertex (i, j) j (ATLAS_BLOCK + 1) + i after; ATLAS_NOVERT: none.
                              A coarse tile has its one block at bx = by = 0 */
     uint8_t *gfine;       /* per tile: 1 fine, 0 coarse */
-    uint8_t *cdone;       /* per surface chart: 1 when its values are filled */
-    uint8_t *gdone;       /* per ground block (as gfirst): 1 when filled */
+    uint8_t *cdone;       /* per surface chart: its state (ATLAS_FILLED ...) */
+    uint8_t *gdone;       /* per ground block (as gfirst): its state */
     uint64_t todo;        /* charts and blocks with vertices not filled yet */
     uint64_t key;         /* the light the values belong to (the engine's; atlas_clear) */
     uint32_t *tex;        /* packed radiance (texel.h), ntex */

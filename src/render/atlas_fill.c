@@ -303,13 +303,13 @@ static void fill_item(const atlas *A, atlas_worker *w, uint32_t it)
     atlas_chart c;
     uint32_t b, tile;
     if (it < A->nsurf) {
-        if (A->cdone[it] != 1 && A->chart[it].kind != ATLAS_NONE)
+        if (!atlas_filled(A->cdone[it]) && A->chart[it].kind != ATLAS_NONE)
             fill_chart(A, w, &A->chart[it]);
         return;
     }
     b = it - A->nsurf;
     tile = b / (ATLAS_TB * ATLAS_TB);
-    if (A->gdone[b] == 1 || A->gfirst[b] == ATLAS_NOVERT)
+    if (atlas_filled(A->gdone[b]) || A->gfirst[b] == ATLAS_NOVERT)
         return;
     b %= ATLAS_TB * ATLAS_TB;
     atlas_ground_block(A, tile % A->gx, tile / A->gx, b % ATLAS_TB, b / ATLAS_TB, &c);
@@ -339,22 +339,38 @@ static void fill_run(void *arg, int worker, uint32_t k)
         jb->par->progress.fn(jb->par->progress.ctx, ATLAS_STAGE, 1, jb->njobs);
 }
 
-/* Marks item it filled (this thread, after the workers). */
+/* Whether the n values from first are all 0. */
+static int all_zero(const atlas *A, uint32_t first, size_t n)
+{
+    uint32_t any = 0;
+    size_t k;
+    for (k = 0; k < n; k++)
+        any |= A->tex[first + k];
+    return any == 0;
+}
+
+/* Marks item it filled, ATLAS_DARK when its values are all 0 (this
+ * thread, after the workers). */
 static void mark_done(atlas *A, uint32_t it)
 {
     uint8_t *d;
+    int dark;
     if (it < A->nsurf) {
-        if (A->chart[it].kind == ATLAS_NONE)
+        const atlas_chart *c = &A->chart[it];
+        if (c->kind == ATLAS_NONE)
             return;
         d = &A->cdone[it];
+        dark = all_zero(A, c->first, (size_t)c->nu * c->nv);
     } else {
-        if (A->gfirst[it - A->nsurf] == ATLAS_NOVERT)
+        uint32_t first = A->gfirst[it - A->nsurf];
+        if (first == ATLAS_NOVERT)
             return;
         d = &A->gdone[it - A->nsurf];
+        dark = all_zero(A, first, (ATLAS_BLOCK + 1) * (ATLAS_BLOCK + 1));
     }
-    if (*d != 1 && A->todo > 0)
+    if (!atlas_filled(*d) && A->todo > 0)
         A->todo--;
-    *d = 1;
+    *d = dark ? ATLAS_DARK : ATLAS_FILLED;
 }
 
 static plx_status run_fill(atlas *A, atlas_worker *w, int nw, const atlas_par *par, const uint32_t *items, uint32_t n)

@@ -93,6 +93,10 @@ static inline void bilerp(const uint32_t *t0, uint32_t nu, uint32_t nv, float u,
     b = t[1];
     c = t[nu];
     d = t[nu + 1];
+    if ((a | b | c | d) == 0u) { /* black: +0, as the sums below would give */
+        out[0] = out[1] = out[2] = 0.0f;
+        return;
+    }
     sa = wscale(a, (1.0f - fu) * (1.0f - fv));
     sb = wscale(b, fu * (1.0f - fv));
     sc = wscale(c, (1.0f - fu) * fv);
@@ -149,13 +153,13 @@ static uint32_t ground_block(const atlas *A, double x, double y, double *u, doub
     return tile * ATLAS_TB * ATLAS_TB + ty * ATLAS_TB + tx;
 }
 
-/* Lists item it unless filled or listed (done byte 2: listed this round). */
+/* Lists item it unless filled or listed this round (atlas.h's states). */
 static void want(atlas *A, uint32_t it, uint32_t *list, uint32_t cap, uint32_t *n)
 {
     uint8_t *d = it < A->nsurf ? &A->cdone[it] : &A->gdone[it - A->nsurf];
     if (*d || *n >= cap)
         return;
-    *d = 2;
+    *d = ATLAS_LISTED;
     list[(*n)++] = it;
 }
 
@@ -187,7 +191,7 @@ uint32_t atlas_frame_missing(atlas *A, const atlas_view *v, const uint32_t *ids,
 
 /* A run of ground pixels i0 .. i1 - 1 of a row: the block under each hit
  * point, kept while the points stay in it (a row's points move by a
- * fixed step: runs of them share a block). */
+ * fixed step: runs of them share a block); black in a dark block. */
 static void ground_run(const atlas *A, const ground_row *g, int32_t i0, int32_t i1, const uint8_t *mask, float *lin)
 {
     double bx0 = 0.0, by0 = 0.0, inv = 0.0, lim = -1.0;
@@ -206,7 +210,7 @@ static void ground_run(const atlas *A, const ground_row *g, int32_t i0, int32_t 
             if (cur != UINT32_MAX && A->gfirst[cur] != ATLAS_NOVERT) {
                 uint32_t tile = cur / (ATLAS_TB * ATLAS_TB), b = cur % (ATLAS_TB * ATLAS_TB);
                 double step = A->gfine[tile] ? A->fine : A->coarse;
-                t0 = &A->tex[A->gfirst[cur]];
+                t0 = A->gdone[cur] == ATLAS_DARK ? NULL : &A->tex[A->gfirst[cur]];
                 inv = 1.0 / step;
                 bx0 = (tile % A->gx) * A->tile + (b % ATLAS_TB) * ATLAS_BLOCK * step;
                 by0 = (tile / A->gx) * A->tile + (b / ATLAS_TB) * ATLAS_BLOCK * step;
@@ -222,12 +226,13 @@ static void ground_run(const atlas *A, const ground_row *g, int32_t i0, int32_t 
 }
 
 /* A run of pixels i0 .. i1 - 1 of row j on surface sid: its chart's map,
- * then each pixel's (u, v) and the bilinear read. */
+ * then each pixel's (u, v) and the bilinear read; black on a dark chart
+ * (the same bits: a bilinear read of four 0 values is +0). */
 static void surface_run(const atlas *A, const atlas_view *v, atlas_cache *k, uint32_t sid, int32_t j, int32_t i0,
                         int32_t i1, const uint8_t *mask, float *lin)
 {
     const atlas_map *m = map_of(A, v, k, sid);
-    const atlas_chart *c = m->c;
+    const atlas_chart *c = m->c && A->cdone[sid - 2u] != ATLAS_DARK ? m->c : NULL;
     float fj = (float)j, bu, bv, bw, au, av, aw;
     const uint32_t *t0;
     uint32_t nu, nv;

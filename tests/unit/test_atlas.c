@@ -347,6 +347,36 @@ static uint32_t tex_at(const atlas *A, const atlas_chart *c, uint32_t i, uint32_
     return A->tex[c->first + (size_t)j * c->nu + i];
 }
 
+/* The state item it (of L) must have once filled: ATLAS_DARK when every
+ * one of its values is 0, else ATLAS_FILLED. */
+static int filled_state(const atlas *A, const atlas_chart *c)
+{
+    uint32_t i, j;
+    for (j = 0; j < c->nv; j++)
+        for (i = 0; i < c->nu; i++)
+            if (tex_at(A, c, i, j) != 0)
+                return ATLAS_FILLED;
+    return ATLAS_DARK;
+}
+
+static uint8_t item_state(const atlas *A, uint32_t it)
+{
+    return it < A->nsurf ? A->cdone[it] : A->gdone[it - A->nsurf];
+}
+
+/* Every item of L in the state its values give; the dark ones counted. */
+static long states_check(const atlas *A, const clist *L)
+{
+    long dark = 0;
+    uint32_t k;
+    for (k = 0; k < L->n; k++) {
+        int want = filled_state(A, &L->it[k].c);
+        assert_int_equal(item_state(A, L->it[k].item), want);
+        dark += want == ATLAS_DARK;
+    }
+    return dark;
+}
+
 /* ---- 1. the texel codec --------------------------------------------------------- */
 
 static double round_half_up(double x) /* x >= 0, below 2^52 */
@@ -1225,6 +1255,7 @@ typedef struct vtally {
 typedef struct hook_ctx {
     const atlas *A;
     double c0[3], a[3], b[3][3], q[3];
+    int dark_roofs;           /* no indirect light on roofs (dark charts where no lamp reaches) */
     long calls, bad;
 } hook_ctx;
 
@@ -1255,6 +1286,8 @@ static void hook_fn(void *user, const atlas_chart *c, uint32_t sid, const double
     }
     h->bad += n[0] != cn[0] || n[1] != cn[1] || n[2] != cn[2];
     hook_value(h, P, rgb);
+    if (h->dark_roofs && c->kind == ATLAS_ROOF)
+        rgb[0] = rgb[1] = rgb[2] = 0.0;
 }
 
 static void hook_init(hook_ctx *h, const atlas *A, const scene *s, rng *r)
@@ -1324,7 +1357,7 @@ static void values_check(world *w, double fine, long nsamp, rng *r)
     clist L;
     vtally t;
     hook_ctx h;
-    long k, nitems;
+    long k, nitems, dark;
     int pass;
     uint32_t *items, q;
     uint64_t todo0;
@@ -1337,8 +1370,8 @@ static void values_check(world *w, double fine, long nsamp, rng *r)
     assert_int_equal(atlas_fill(A, &wk, 1, NULL), PLX_OK);
     assert_true(A->todo == 0 && A->with_ind == 0);
     clist_make(A, &L);
-    for (k = 0; k < (long)L.n; k++)
-        assert_int_equal(L.it[k].item < A->nsurf ? A->cdone[L.it[k].item] : A->gdone[L.it[k].item - A->nsurf], 1);
+    dark = states_check(A, &L); /* roofs no lamp reaches are dark */
+    assert_true(dark > 0 && dark < (long)L.n);
     /* direct light: the stored value against the reference at the site */
     for (k = 0; k < nsamp; k++) {
         uint32_t i, j, got, want;
@@ -1424,7 +1457,7 @@ static void values_check(world *w, double fine, long nsamp, rng *r)
         atlas_clear(A, 77 + (uint64_t)pass);
         assert_true(A->key == 77u + (uint64_t)pass && A->todo == L.n && A->with_ind == 0);
         for (k = 0; k < (long)L.n; k++)
-            assert_int_equal(L.it[k].item < A->nsurf ? A->cdone[L.it[k].item] : A->gdone[L.it[k].item - A->nsurf], 0);
+            assert_int_equal(item_state(A, L.it[k].item), ATLAS_TODO);
         hook_init(&h, A, s, r);
         if (pass == 0)
             h.q[0] = h.q[1] = h.q[2] = 0.0; /* affine */
@@ -1437,12 +1470,14 @@ static void values_check(world *w, double fine, long nsamp, rng *r)
         {
             uint64_t distinct = 0;
             for (k = 0; k < (long)L.n; k++) {
-                uint32_t it = L.it[k].item, d = it < A->nsurf ? A->cdone[it] : A->gdone[it - A->nsurf];
+                uint32_t it = L.it[k].item, d = item_state(A, it);
                 long z;
                 int listed = 0;
                 for (z = 0; z < nitems && !listed; z++)
                     listed = items[z] == it;
-                assert_int_equal(d, listed);
+                assert_int_equal(atlas_filled((uint8_t)d), listed);
+                if (listed)
+                    assert_int_equal(d, filled_state(A, &L.it[k].c));
                 distinct += listed;
             }
             assert_true(A->todo == todo0 - distinct);
@@ -1782,8 +1817,7 @@ static int lazy_need(void *user, const atlas_view *v, const uint32_t *ids)
     while ((n = atlas_frame_missing(z->A, v, ids, z->list, 7)) > 0) {
         uint32_t k;
         for (k = 0; k < n; k++) /* listed once, marked listed */
-            assert_int_equal(z->list[k] < z->A->nsurf ? z->A->cdone[z->list[k]] : z->A->gdone[z->list[k] - z->A->nsurf],
-                             2);
+            assert_int_equal(item_state(z->A, z->list[k]), ATLAS_LISTED);
         assert_int_equal(atlas_fill_items(z->A, z->w, 1, NULL, z->list, n), PLX_OK);
         z->rounds++;
         z->listed += n;
@@ -1845,6 +1879,9 @@ static void frames_check(world *w, double fine, int nframes, rng *r)
     ftally t;
     lazy z;
     float *lin1 = malloc(3 * 200 * 200 * sizeof(float));
+    size_t nst = A->nsurf + (size_t)A->gx * A->gy * ATLAS_TB * ATLAS_TB, q;
+    uint8_t *st0 = malloc(nst);
+    long dark = 0;
     int f, partial = 0;
     double t0 = now_s();
     assert_true(cache && cache2 && lin1);
@@ -1854,9 +1891,14 @@ static void frames_check(world *w, double fine, int nframes, rng *r)
     wk.rec = malloc((atlas_fill_records(A) + 1) * sizeof(double));
     assert_non_null(wk.rec);
     hook_init(&h, A, w->s, r);
+    h.dark_roofs = 1;
     wk.ind = hook_fn;
     wk.ind_user = &h;
     assert_int_equal(atlas_fill(A, &wk, 1, NULL), PLX_OK);
+    assert_non_null(st0);
+    for (q = 0; q < nst; q++)
+        dark += (q < A->nsurf ? A->cdone[q] : A->gdone[q - A->nsurf]) == ATLAS_DARK;
+    assert_true(dark > 0);
     memset(&z, 0, sizeof z);
     hb = h;
     hb.A = B;
@@ -1878,6 +1920,17 @@ static void frames_check(world *w, double fine, int nframes, rng *r)
         assert_int_equal(render_frame(w->e->rd, &cam, &o, NULL, NULL, &st), PLX_OK);
         frame_check(A, &cam, render_linear(w->e->rd), render_ids(w->e->rd), &t);
         memcpy(lin1, render_linear(w->e->rd), 3 * px * sizeof(float));
+        /* no chart or block marked dark (each read): the same bytes */
+        memcpy(st0, A->cdone, A->nsurf);
+        memcpy(st0 + A->nsurf, A->gdone, nst - A->nsurf);
+        for (q = 0; q < nst; q++) {
+            uint8_t *d = q < A->nsurf ? &A->cdone[q] : &A->gdone[q - A->nsurf];
+            *d = *d == ATLAS_DARK ? ATLAS_FILLED : *d;
+        }
+        assert_int_equal(render_frame(w->e->rd, &cam, &o, NULL, NULL, &st), PLX_OK);
+        assert_memory_equal(lin1, render_linear(w->e->rd), 3 * px * sizeof(float));
+        memcpy(A->cdone, st0, A->nsurf);
+        memcpy(A->gdone, st0 + A->nsurf, nst - A->nsurf);
         /* on two workers: the same bytes */
         o.par = port->parallel_for;
         o.par_ctx = port->ctx;
@@ -1896,14 +1949,16 @@ static void frames_check(world *w, double fine, int nframes, rng *r)
         partial += B->todo > 0;
     }
     printf("  %s at %.2f m: %d frames, %ld pixels (sky %ld, ground %ld, buildings %ld, %ld on no chart): %ld compared, "
-           "%ld skipped at block sides; worst error %.3g of its tolerance; on demand %ld items in %ld rounds; %.2f s\n",
+           "%ld skipped at block sides; worst error %.3g of its tolerance; on demand %ld items in %ld rounds; %ld dark "
+           "items; %.2f s\n",
            w->name, fine, nframes, t.px, t.sky, t.ground, t.surf, t.nochart, t.compared, t.skipped, t.worst, z.listed,
-           z.rounds, now_s() - t0);
+           z.rounds, dark, now_s() - t0);
     assert_true(t.compared >= t.px * 99 / 100);
     assert_true(t.ground > t.px / 20 && t.surf > t.px / 20);
     assert_true(partial > 0 && z.rounds > nframes);
     assert_true(h.bad == 0 && hb.bad == 0);
     free(lin1);
+    free(st0);
     free(cache);
     free(cache2);
     free(wk.rec);
