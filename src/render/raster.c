@@ -13,6 +13,12 @@
  * input within +-(RASTER_MAX_DIM + RASTER_GUARD_PX) pixels, about 2^22.6
  * units, so the clamp only guards against rounding at the guard planes. */
 #define FIX_LIMIT ((int64_t)1 << 24)
+/* draw_triangle_id tests every pixel of a box at most this many columns
+ * wide (walls seen from afar are slivers a pixel or two wide, where the
+ * spans' setup per row costs more than the pixels). */
+#ifndef RASTER_NARROW
+#define RASTER_NARROW 8
+#endif
 
 /* Clip planes, applied in this order. */
 enum { PLANE_W = 0, PLANE_NEAR, PLANE_FAR, PLANE_LEFT, PLANE_RIGHT,
@@ -351,13 +357,27 @@ static int64_t edge_eval(const edge *e, int64_t px, int64_t py)
     return e->dx * (py - e->ay) - e->dy * (px - e->ax);
 }
 
+/* The pixels whose centre lies in the triangle's bounding box, within
+ * the scissor: columns i0 .. i1, rows j0 .. j1; 0 when there are none. */
+static int pixel_box(const raster_ctx *r, const svert *v0, const svert *v1, const svert *v2, int64_t *i0,
+                     int64_t *i1, int64_t *j0, int64_t *j1)
+{
+    int64_t xmin = min64(v0->x, min64(v1->x, v2->x)), xmax = max64(v0->x, max64(v1->x, v2->x));
+    int64_t ymin = min64(v0->y, min64(v1->y, v2->y)), ymax = max64(v0->y, max64(v1->y, v2->y));
+    *i0 = max64(ceil_div(xmin - FIX_HALF, FIX_ONE), r->sx0);
+    *i1 = min64(floor_div(xmax - FIX_HALF, FIX_ONE), (int64_t)r->sx1 - 1);
+    *j0 = max64(ceil_div(ymin - FIX_HALF, FIX_ONE), r->sy0);
+    *j1 = min64(floor_div(ymax - FIX_HALF, FIX_ONE), (int64_t)r->sy1 - 1);
+    return *i0 <= *i1 && *j0 <= *j1;
+}
+
 /* Draws triangle v0 v1 v2 with area2 == area > 0. */
 static size_t draw_triangle(raster_ctx *r, const svert *v0, const svert *v1,
                             const svert *v2, int64_t area)
 {
     const raster_target *t = &r->t;
     edge e[3];
-    int64_t xmin, xmax, ymin, ymax, i0, i1, j0, j1, j;
+    int64_t i0, i1, j0, j1, j;
     double inv_area = 1.0 / (double)area;
     double z0 = v0->z, dz1 = v1->z - v0->z, dz2 = v2->z - v0->z;
     float iw0 = v0->iw, diw1 = v1->iw - v0->iw, diw2 = v2->iw - v0->iw;
@@ -378,16 +398,7 @@ static size_t draw_triangle(raster_ctx *r, const svert *v0, const svert *v1,
     edge_setup(&e[1], v2, v0);  /* opposite v1: gives the weight of v1 */
     edge_setup(&e[2], v0, v1);  /* opposite v2: gives the weight of v2 */
 
-    /* Pixels whose centre lies in the bounding box, within the scissor. */
-    xmin = min64(v0->x, min64(v1->x, v2->x));
-    xmax = max64(v0->x, max64(v1->x, v2->x));
-    ymin = min64(v0->y, min64(v1->y, v2->y));
-    ymax = max64(v0->y, max64(v1->y, v2->y));
-    i0 = max64(ceil_div(xmin - FIX_HALF, FIX_ONE), r->sx0);
-    i1 = min64(floor_div(xmax - FIX_HALF, FIX_ONE), (int64_t)r->sx1 - 1);
-    j0 = max64(ceil_div(ymin - FIX_HALF, FIX_ONE), r->sy0);
-    j1 = min64(floor_div(ymax - FIX_HALF, FIX_ONE), (int64_t)r->sy1 - 1);
-    if (i0 > i1 || j0 > j1)
+    if (!pixel_box(r, v0, v1, v2, &i0, &i1, &j0, &j1))
         return 0;
 
     for (j = j0; j <= j1; j++) {
@@ -636,15 +647,53 @@ static void walk_row(edge_walk *w)
     }
 }
 
+/* A narrow triangle's pixels (draw_triangle_id): every centre of its box
+ * tested against the three edges, E + bias >= 0 each, the test the spans
+ * of draw_triangle solve row by row, so the same pixels, with the same
+ * edge values for the depth. eb0: E + bias at (i0, j0); zc: z0, dz1,
+ * dz2, 1 / area. */
+static size_t draw_narrow_id(raster_ctx *r, const edge e[3], const int64_t eb0[3], int64_t i0, int64_t i1,
+                             int64_t j0, int64_t j1, const double zc[4], uint32_t id, uint32_t *ids)
+{
+    const raster_target *t = &r->t;
+    int64_t b0 = eb0[0], b1 = eb0[1], b2 = eb0[2], j, x;
+    int64_t s0 = e[0].step_x, s1 = e[1].step_x, s2 = e[2].step_x;
+    size_t written = 0;
+    for (j = j0; j <= j1; j++) {
+        float *drow = t->depth + (size_t)j * t->depth_stride;
+        uint32_t *irow = ids + (size_t)j * (size_t)t->width;
+        int64_t c0 = b0, c1 = b1, c2 = b2;
+        for (x = i0; x <= i1; x++, c0 += s0, c1 += s1, c2 += s2) {
+            double l1, l2;
+            float z;
+            if ((c0 | c1 | c2) < 0) /* one of them negative */
+                continue;
+            l1 = (double)(c1 - e[1].bias) * zc[3];
+            l2 = (double)(c2 - e[2].bias) * zc[3];
+            z = (float)(zc[0] + l1 * zc[1] + l2 * zc[2]);
+            if (!(z < drow[x]))
+                continue;
+            drow[x] = z;
+            irow[x] = id;
+            written++;
+        }
+        b0 += e[0].dx * FIX_ONE;
+        b1 += e[1].dx * FIX_ONE;
+        b2 += e[2].dx * FIX_ONE;
+    }
+    return written;
+}
+
 /* draw_triangle with no attributes, depth test and write, and the id
- * stored: the same spans and the same depth expression per pixel. */
+ * stored: the same spans and the same depth expression per pixel (a
+ * triangle at most RASTER_NARROW columns wide by its box). */
 static size_t draw_triangle_id(raster_ctx *r, const svert *v0, const svert *v1, const svert *v2, int64_t area,
                                uint32_t id, uint32_t *ids)
 {
     const raster_target *t = &r->t;
     edge e[3];
     edge_walk wk[3];
-    int64_t xmin, xmax, ymin, ymax, i0, i1, j0, j1, j, eb0[3], ev1, ev2;
+    int64_t i0, i1, j0, j1, j, eb0[3], ev1, ev2;
     double inv_area = 1.0 / (double)area;
     double z0 = v0->z, dz1 = v1->z - v0->z, dz2 = v2->z - v0->z;
     size_t written = 0;
@@ -652,20 +701,20 @@ static size_t draw_triangle_id(raster_ctx *r, const svert *v0, const svert *v1, 
     edge_setup(&e[0], v1, v2);
     edge_setup(&e[1], v2, v0);
     edge_setup(&e[2], v0, v1);
-    xmin = min64(v0->x, min64(v1->x, v2->x));
-    xmax = max64(v0->x, max64(v1->x, v2->x));
-    ymin = min64(v0->y, min64(v1->y, v2->y));
-    ymax = max64(v0->y, max64(v1->y, v2->y));
-    i0 = max64(ceil_div(xmin - FIX_HALF, FIX_ONE), r->sx0);
-    i1 = min64(floor_div(xmax - FIX_HALF, FIX_ONE), (int64_t)r->sx1 - 1);
-    j0 = max64(ceil_div(ymin - FIX_HALF, FIX_ONE), r->sy0);
-    j1 = min64(floor_div(ymax - FIX_HALF, FIX_ONE), (int64_t)r->sy1 - 1);
-    if (i0 > i1 || j0 > j1)
+    if (!pixel_box(r, v0, v1, v2, &i0, &i1, &j0, &j1))
         return 0;
-    for (k = 0; k < 3; k++) {
+    for (k = 0; k < 3; k++)
         eb0[k] = edge_eval(&e[k], i0 * FIX_ONE + FIX_HALF, j0 * FIX_ONE + FIX_HALF) + e[k].bias;
-        walk_start(&wk[k], &e[k], eb0[k]);
+    if (i1 - i0 < RASTER_NARROW) {
+        double zc[4];
+        zc[0] = z0;
+        zc[1] = dz1;
+        zc[2] = dz2;
+        zc[3] = inv_area;
+        return draw_narrow_id(r, e, eb0, i0, i1, j0, j1, zc, id, ids);
     }
+    for (k = 0; k < 3; k++)
+        walk_start(&wk[k], &e[k], eb0[k]);
     ev1 = eb0[1] - e[1].bias;
     ev2 = eb0[2] - e[2].bias;
     for (j = j0; j <= j1; j++) {

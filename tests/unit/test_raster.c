@@ -173,6 +173,58 @@ static void rnd_clip(float *p, const float *pool, int npool)
     p[2] = (float)((2.4 * rnd() - 1.2) * w);
 }
 
+/* Triangle k of the pool (3 clip points at p) made small: a box a few
+ * pixels across or a sliver one or two pixels wide and up to 30 tall, as
+ * walls seen from afar (raster_triangle_id tests every pixel of a box at
+ * most 8 columns wide), half of them sharing an edge with the one
+ * before. */
+static void rnd_small(float *p, int k, int w, int h)
+{
+    double cw = 0.5 + 10.0 * rnd(), cx = 2.4 * rnd() - 1.2, cy = 2.4 * rnd() - 1.2, z = 1.8 * rnd() - 0.9;
+    double ax = 2.0 / w * (rnd() < 0.5 ? 0.3 + 2.5 * rnd() : 1.0 + 12.0 * rnd());
+    double ay = 2.0 / h * (rnd() < 0.5 ? 0.3 + 3.0 * rnd() : 2.0 + 28.0 * rnd());
+    int q, first = 0;
+    if (k > 0 && rnd() < 0.5) { /* the edge (1, 2) of the triangle before, reversed */
+        memcpy(&p[0], &p[-4], 4 * sizeof(float));
+        memcpy(&p[4], &p[-8], 4 * sizeof(float));
+        cw = p[3];
+        cx = p[0] / cw;
+        cy = p[1] / cw;
+        first = 2;
+    }
+    for (q = first; q < 3; q++) {
+        double x = cx + ax * (rnd() - 0.5), y = cy + ay * (rnd() - 0.5);
+        p[4 * q + 0] = (float)(x * cw);
+        p[4 * q + 1] = (float)(y * cw);
+        p[4 * q + 2] = (float)((z + 0.05 * (rnd() - 0.5)) * cw);
+        p[4 * q + 3] = (float)cw;
+    }
+}
+
+/* Triangle k made small with its corners on pixel centres of a frame
+ * whose sides are powers of two (w = 1: exact window coordinates), so
+ * that edges pass through centres and the tie rule decides them; half
+ * of them share an edge with the one before. */
+static void rnd_grid_small(float *p, int k, int w, int h)
+{
+    double z = 1.8 * rnd() - 0.9;
+    int q, first = 0, x0 = (int)(rnd() * w), y0 = (int)(rnd() * h);
+    if (k > 0 && rnd() < 0.5) {
+        memcpy(&p[0], &p[-4], 4 * sizeof(float));
+        memcpy(&p[4], &p[-8], 4 * sizeof(float));
+        first = 2;
+        x0 = (int)floor((p[0] + 1.0) * 0.5 * w);
+        y0 = (int)floor((1.0 - p[1]) * 0.5 * h);
+    }
+    for (q = first; q < 3; q++) {
+        double x = x0 + (int)(rnd() * 9.0) - 4 + 0.5, y = y0 + (int)(rnd() * 17.0) - 8 + 0.5;
+        p[4 * q + 0] = (float)(2.0 * x / w - 1.0);
+        p[4 * q + 1] = (float)(1.0 - 2.0 * y / h);
+        p[4 * q + 2] = (float)(z + 0.05 * (rnd() - 0.5));
+        p[4 * q + 3] = 1.0f;
+    }
+}
+
 /* Thousands of random triangles drawn both ways into a depth buffer and an
  * id buffer (triangles in order, depth test less): the same ids and the
  * same depth bits at every pixel, with back faces culled and not, on small
@@ -180,11 +232,12 @@ static void rnd_clip(float *p, const float *pool, int npool)
 static void test_triangle_id_same(void **state)
 {
     int round, rounds = getenv("PLX_TEST_QUICK") ? 60 : 400;
-    long direct = 0, fallback = 0;
+    long direct = 0, fallback = 0, small = 0;
     (void)state;
     rng_state = 0x5eed1d5ull;
     for (round = 0; round < rounds; round++) {
-        int w = 13 + (int)(rnd() * 90), h = 7 + (int)(rnd() * 70), n = 40 + (int)(rnd() * 200), k;
+        int grid = round % 4 == 3, w = grid ? 64 : 13 + (int)(rnd() * 90), h = grid ? 32 : 7 + (int)(rnd() * 70);
+        int n = 40 + (int)(rnd() * 200), k;
         float *pool = malloc(sizeof(float) * 4 * 3 * (size_t)n);
         float *da = malloc(sizeof(float) * (size_t)w * h), *db = malloc(sizeof(float) * (size_t)w * h);
         uint32_t *ia = calloc((size_t)w * h, sizeof(uint32_t)), *ib = calloc((size_t)w * h, sizeof(uint32_t));
@@ -211,6 +264,15 @@ static void test_triangle_id_same(void **state)
         raster_set_cull(&rb, cull);
         for (k = 0; k < 3 * n; k++)
             rnd_clip(&pool[4 * k], pool, k);
+        if (round % 2 == 1) /* most of them small; every other time on the pixel grid */
+            for (k = 0; k < n; k++)
+                if (rnd() < 0.8) {
+                    if (grid)
+                        rnd_grid_small(&pool[12 * k], k, w, h);
+                    else
+                        rnd_small(&pool[12 * k], k, w, h);
+                    small++;
+                }
         for (k = 0; k < n; k++) {
             raster_vertex v[3];
             raster_pvert p[3];
@@ -240,9 +302,9 @@ static void test_triangle_id_same(void **state)
         free(ia);
         free(ib);
     }
-    printf("raster_triangle_id: %ld triangles drawn from prepared vertices, %ld through raster_triangle, "
-           "the same ids and depths as raster_triangle alone\n", direct, fallback);
-    assert_true(direct > 1000 && fallback > 100);
+    printf("raster_triangle_id: %ld triangles drawn from prepared vertices (%ld of them small), %ld through "
+           "raster_triangle, the same ids and depths as raster_triangle alone\n", direct, small, fallback);
+    assert_true(direct > 1000 && fallback > 100 && small > 1000);
 }
 
 static void test_init_rejects_bad_targets(void **state)
