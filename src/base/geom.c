@@ -763,3 +763,24 @@ int geom_ring_is_simple(arena *a, const vec2 *p, uint32_t n, uint32_t *ei, uint3
         return ring_bad(s.bad_a, s.bad_b, ei, ej);
     return 1;
 }
+
+void geom_basis3(const double n[3], double t[3], double b[3])
+{
+    double l;
+    if (fabs(n[2]) < 0.9) {
+        t[0] = -n[1];
+        t[1] = n[0];
+        t[2] = 0.0;
+    } else {
+        t[0] = 0.0;
+        t[1] = -n[2];
+        t[2] = n[1];
+    }
+    l = sqrt(t[0] * t[0] + t[1] * t[1] + t[2] * t[2]);
+    t[0] /= l;
+    t[1] /= l;
+    t[2] /= l;
+    b[0] = n[1] * t[2] - n[2] * t[1];
+    b[1] = n[2] * t[0] - n[0] * t[2];
+    b[2] = n[0] * t[1] - n[1] * t[0];
+}

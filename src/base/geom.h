@@ -90,6 +90,10 @@ int geom_ring_is_simple(arena *a, const vec2 *p, uint32_t n, uint32_t *ei, uint3
  *   two vertices at one point      -> 0, the edges starting at them.
  * A triangle with three distinct, non-collinear vertices is simple. */
 
+/* Two unit vectors t, b completing the unit vector n to a right-handed
+ * orthonormal basis (t horizontal unless n is nearly vertical). */
+void geom_basis3(const double n[3], double t[3], double b[3]);
+
 /* Squared distance between closed segments ab and cd. */
 double geom_seg_dist2(vec2 a, vec2 b, vec2 c, vec2 d);
 /* Details: exactly 0 when geom_seg_meet says they meet; otherwise the

@@ -5,6 +5,7 @@
 
 #include "photon/final_gather.h"
 #include "photon/indirect.h"
+#include "base/geom.h"
 
 static uint64_t mix64(uint64_t z)
 {
@@ -26,28 +27,6 @@ static uint64_t point_seed(uint64_t seed, const double P[3], const double n[3])
         h = mix64(h ^ b);
     }
     return h;
-}
-
-/* Two unit vectors t, b completing n to an orthonormal basis. */
-static void basis(const double n[3], double t[3], double b[3])
-{
-    double l;
-    if (fabs(n[2]) < 0.9) {
-        t[0] = -n[1];
-        t[1] = n[0];
-        t[2] = 0.0;
-    } else {
-        t[0] = 0.0;
-        t[1] = -n[2];
-        t[2] = n[1];
-    }
-    l = sqrt(t[0] * t[0] + t[1] * t[1] + t[2] * t[2]);
-    t[0] /= l;
-    t[1] /= l;
-    t[2] /= l;
-    b[0] = n[1] * t[2] - n[2] * t[1];
-    b[1] = n[2] * t[0] - n[0] * t[2];
-    b[2] = n[0] * t[1] - n[1] * t[0];
 }
 
 /* RGB albedo of the surface a ray hit. */
@@ -116,7 +95,7 @@ static void gather(photon_sys *ps, tracer *T, light *L, const double P[3], const
     uint64_t lseed = mix64(rs ^ 0x3c6ef372fe94f82bull);
     uint32_t i, j;
     int c;
-    basis(n, t, b);
+    geom_basis3(n, t, b);
     for (c = 0; c < 3; c++)
         o[c] = P[c] + 1e-6 * n[c];
     if (o[2] < 0.0)

@@ -203,22 +203,7 @@ static void cosine_dir(uint64_t *st, const double n[3], double d[3])
     sincos_turn(u2, &cp, &sp);
     a = r * cp;
     b = r * sp;
-    if (fabs(n[2]) < 0.9) {
-        t[0] = -n[1];
-        t[1] = n[0];
-        t[2] = 0.0;
-    } else {
-        t[0] = 0.0;
-        t[1] = -n[2];
-        t[2] = n[1];
-    }
-    l = sqrt(t[0] * t[0] + t[1] * t[1] + t[2] * t[2]);
-    t[0] /= l;
-    t[1] /= l;
-    t[2] /= l;
-    bt[0] = n[1] * t[2] - n[2] * t[1];
-    bt[1] = n[2] * t[0] - n[0] * t[2];
-    bt[2] = n[0] * t[1] - n[1] * t[0];
+    geom_basis3(n, t, bt);
     d[0] = a * t[0] + b * bt[0] + c * n[0];
     d[1] = a * t[1] + b * bt[1] + c * n[1];
     d[2] = a * t[2] + b * bt[2] + c * n[2];
