@@ -75,37 +75,72 @@ static inline uint32_t cell_of(float u, uint32_t n, float *f)
     return i;
 }
 
-/* A packed value's scale times a weight (texel.h). */
-static inline float wscale(uint32_t t, float w)
+/* The four values around the last cell read (a run's pixels mostly stay
+ * in a cell or step to the next one: decoded once, reused): vertex (0, 0)
+ * of the cell in the atlas (NULL: none yet), and the values of its
+ * vertices (i, j), (i + 1, j), (i, j + 1), (i + 1, j + 1), each channel
+ * its mantissa times its scale (exact: a 9-bit whole number times a
+ * power of two). A run starts with t NULL: the cell's rows are nu apart
+ * only within one chart. */
+typedef struct cell_vals {
+    const uint32_t *t;
+    float v[4][3];
+    int zero;                 /* all four packed values 0 */
+} cell_vals;
+
+static void cell_load(cell_vals *cv, const uint32_t *t, uint32_t nu)
 {
-    return texel_scale(t) * w;
+    if (cv->t && t == cv->t + 1) { /* the next cell along the row: its left side is the old right side */
+        memcpy(cv->v[0], cv->v[1], sizeof cv->v[0]);
+        memcpy(cv->v[2], cv->v[3], sizeof cv->v[2]);
+        texel_unpack(t[1], cv->v[1]);
+        texel_unpack(t[nu + 1], cv->v[3]);
+    } else if (cv->t && t + 1 == cv->t) {
+        memcpy(cv->v[1], cv->v[0], sizeof cv->v[1]);
+        memcpy(cv->v[3], cv->v[2], sizeof cv->v[3]);
+        texel_unpack(t[0], cv->v[0]);
+        texel_unpack(t[nu], cv->v[2]);
+    } else {
+        texel_unpack(t[0], cv->v[0]);
+        texel_unpack(t[1], cv->v[1]);
+        texel_unpack(t[nu], cv->v[2]);
+        texel_unpack(t[nu + 1], cv->v[3]);
+    }
+    cv->t = t;
+    cv->zero = (t[0] | t[1] | t[nu] | t[nu + 1]) == 0u;
 }
 
 /* Bilinear over the vertices of a chart whose vertex (0, 0) is t0 and
- * rows nu long, at (u, w) in vertex steps: each vertex's weight folded
- * into its scale, then the mantissas summed channel by channel. */
-static inline void bilerp(const uint32_t *t0, uint32_t nu, uint32_t nv, float u, float w, float out[3])
+ * rows nu long, at (u, w) in vertex steps, summed vertex by vertex
+ * (value times weight: the same bits as mantissa times scale times
+ * weight, the scale a power of two); black (+0) where all four are 0. */
+static inline void bilerp(cell_vals *cv, const uint32_t *t0, uint32_t nu, uint32_t nv, float u, float w,
+                          float out[3])
 {
-    float fu, fv, sa, sb, sc, sd;
-    uint32_t i = cell_of(u, nu, &fu), j = cell_of(w, nv, &fv), a, b, c, d;
+    float fu, fv, wa, wb, wc, wd, o0, o1, o2;
+    uint32_t i = cell_of(u, nu, &fu), j = cell_of(w, nv, &fv);
     const uint32_t *t = t0 + (size_t)j * nu + i;
-    a = t[0];
-    b = t[1];
-    c = t[nu];
-    d = t[nu + 1];
-    if ((a | b | c | d) == 0u) { /* black: +0, as the sums below would give */
+    const float *a, *b, *c, *d;
+    if (t != cv->t)
+        cell_load(cv, t, nu);
+    if (cv->zero) {
         out[0] = out[1] = out[2] = 0.0f;
         return;
     }
-    sa = wscale(a, (1.0f - fu) * (1.0f - fv));
-    sb = wscale(b, fu * (1.0f - fv));
-    sc = wscale(c, (1.0f - fu) * fv);
-    sd = wscale(d, fu * fv);
-    out[0] = (float)(a & 511u) * sa + (float)(b & 511u) * sb + (float)(c & 511u) * sc + (float)(d & 511u) * sd;
-    out[1] = (float)((a >> 9) & 511u) * sa + (float)((b >> 9) & 511u) * sb + (float)((c >> 9) & 511u) * sc +
-             (float)((d >> 9) & 511u) * sd;
-    out[2] = (float)((a >> 18) & 511u) * sa + (float)((b >> 18) & 511u) * sb + (float)((c >> 18) & 511u) * sc +
-             (float)((d >> 18) & 511u) * sd;
+    wa = (1.0f - fu) * (1.0f - fv);
+    wb = fu * (1.0f - fv);
+    wc = (1.0f - fu) * fv;
+    wd = fu * fv;
+    a = cv->v[0];
+    b = cv->v[1];
+    c = cv->v[2];
+    d = cv->v[3];
+    o0 = a[0] * wa + b[0] * wb + c[0] * wc + d[0] * wd; /* all read before out is written */
+    o1 = a[1] * wa + b[1] * wb + c[1] * wc + d[1] * wd;
+    o2 = a[2] * wa + b[2] * wb + c[2] * wc + d[2] * wd;
+    out[0] = o0;
+    out[1] = o1;
+    out[2] = o2;
 }
 
 /* A row's ground: the hit point (x, y) relative to the tiles' corner at
@@ -198,6 +233,8 @@ static void ground_run(const atlas *A, const ground_row *g, int32_t i0, int32_t 
     const uint32_t *t0 = NULL;
     uint32_t cur = UINT32_MAX;
     int32_t i;
+    cell_vals cv;
+    cv.t = NULL;
     for (i = i0; i < i1; i++) {
         double x = g->x0 + i * g->dx, y = g->y0 + i * g->dy, u = (x - bx0) * inv, w = (y - by0) * inv;
         float *o = &lin[3 * (size_t)i];
@@ -207,6 +244,7 @@ static void ground_run(const atlas *A, const ground_row *g, int32_t i0, int32_t 
             cur = ground_block(A, x, y, &u, &w);
             t0 = NULL;
             lim = -1.0;
+            cv.t = NULL;
             if (cur != UINT32_MAX && A->gfirst[cur] != ATLAS_NOVERT) {
                 uint32_t tile = cur / (ATLAS_TB * ATLAS_TB), b = cur % (ATLAS_TB * ATLAS_TB);
                 double step = A->gfine[tile] ? A->fine : A->coarse;
@@ -221,7 +259,7 @@ static void ground_run(const atlas *A, const ground_row *g, int32_t i0, int32_t 
             o[0] = o[1] = o[2] = 0.0f;
             continue;
         }
-        bilerp(t0, ATLAS_BLOCK + 1, ATLAS_BLOCK + 1, (float)u, (float)w, o);
+        bilerp(&cv, t0, ATLAS_BLOCK + 1, ATLAS_BLOCK + 1, (float)u, (float)w, o);
     }
 }
 
@@ -237,6 +275,8 @@ static void surface_run(const atlas *A, const atlas_view *v, atlas_cache *k, uin
     const uint32_t *t0;
     uint32_t nu, nv;
     int32_t i;
+    cell_vals cv;
+    cv.t = NULL;
     if (!c) {
         for (i = i0; i < i1; i++)
             if (!mask || mask[i])
@@ -256,7 +296,7 @@ static void surface_run(const atlas *A, const atlas_view *v, atlas_cache *k, uin
         float fi = (float)i, r = 1.0f / (bw + aw * fi);
         if (mask && !mask[i])
             continue;
-        bilerp(t0, nu, nv, (bu + au * fi) * r, (bv + av * fi) * r, &lin[3 * (size_t)i]);
+        bilerp(&cv, t0, nu, nv, (bu + au * fi) * r, (bv + av * fi) * r, &lin[3 * (size_t)i]);
     }
 }
 
