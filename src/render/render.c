@@ -2407,14 +2407,36 @@ static void mask_update(render *r, const render_opts *o)
         glow_mark(r, o->mask);
 }
 
-/* Whether pixels p and q differ: surface id, or a channel more than level
- * steps apart in rgb. */
-static inline int px_differ(const uint8_t *rgb, const uint32_t *id, size_t p, size_t q, int level)
+/* A pixel's three bytes in 16-bit lanes of a 64-bit word, so that a
+ * pair's three channels are tested at once (px_far). */
+static inline uint64_t px_lanes(const uint8_t *a)
 {
-    const uint8_t *a = rgb + 3 * p, *b = rgb + 3 * q;
-    int d0 = (int)a[0] - (int)b[0], d1 = (int)a[1] - (int)b[1], d2 = (int)a[2] - (int)b[2];
-    return (id[p] != id[q]) | (d0 > level) | (d0 < -level) | (d1 > level) | (d1 < -level) | (d2 > level) |
-           (d2 < -level);
+    return (uint64_t)a[0] | (uint64_t)a[1] << 16 | (uint64_t)a[2] << 32;
+}
+
+#define LANES3(x) ((uint64_t)(x) * 0x0000000100010001ull) /* x in each of the three lanes */
+
+/* The constants of px_far for a level L in 0 .. 255. */
+typedef struct far_k {
+    uint64_t bias, hi, lo, top;
+} far_k;
+
+static void far_setup(far_k *k, unsigned level)
+{
+    k->bias = LANES3(256u + level);
+    k->hi = LANES3(32768u - 257u - 2u * level);
+    k->lo = LANES3(32768u - 256u);
+    k->top = LANES3(32768u);
+}
+
+/* Whether a channel of lanes a and b is more than L apart: each lane of
+ * a + bias - b is d + 256 + L, in 1 + L .. 511 + L (no lane borrows or
+ * carries, here or below); adding hi sets its bit 15 when d > L, adding
+ * lo when d >= -L. */
+static inline int px_far(uint64_t a, uint64_t b, const far_k *k)
+{
+    uint64_t d = a + k->bias - b;
+    return (((d + k->hi) | ~(d + k->lo)) & k->top) != 0;
 }
 
 /* The pairs of 8-neighbours a pixel starts (each pair once, from its
@@ -2430,32 +2452,48 @@ typedef struct mask_job {
     const uint8_t *rgb;
     const uint32_t *id;
     uint8_t *bits, *out;
-    int level;
+    unsigned level;
 } mask_job;
 
 /* Rows of job k: for each pixel, which of the pairs it starts (right,
- * down, down-right, down-left) differ. */
+ * down, down-right, down-left) differ: surface id, or a channel more than
+ * level steps apart. Along a row the lanes of the pixel, its right
+ * neighbour and the three below are carried from pixel to pixel. */
 static void mask_bits_rows(void *arg, int worker, uint32_t k)
 {
     const mask_job *jb = arg;
     int32_t w = jb->r->w, h = jb->r->h, i, j, j1 = (int32_t)(k + 1) * MASK_ROWS;
+    far_k fk;
     (void)worker;
-    for (j = (int32_t)k * MASK_ROWS; j < j1 && j < h; j++)
+    far_setup(&fk, jb->level);
+    for (j = (int32_t)k * MASK_ROWS; j < j1 && j < h; j++) {
+        const uint8_t *c = jb->rgb + 3 * (size_t)j * (size_t)w, *n = c + 3 * (size_t)w;
+        const uint32_t *ic = jb->id + (size_t)j * (size_t)w, *in = ic + w;
+        uint8_t *bt = jb->bits + (size_t)j * (size_t)w;
+        int down = j + 1 < h;
+        uint64_t pc = px_lanes(c), pn = down ? px_lanes(n) : 0, pnl = 0;
         for (i = 0; i < w; i++) {
-            size_t p = (size_t)j * (size_t)w + (size_t)i, ws = (size_t)w;
+            uint64_t pr = 0, pnr = 0;
             unsigned b = 0;
-            if (i + 1 < w && px_differ(jb->rgb, jb->id, p, p + 1, jb->level))
-                b |= MASK_RIGHT;
-            if (j + 1 < h) {
-                if (px_differ(jb->rgb, jb->id, p, p + ws, jb->level))
-                    b |= MASK_DOWN;
-                if (i + 1 < w && px_differ(jb->rgb, jb->id, p, p + ws + 1, jb->level))
-                    b |= MASK_DOWN_RIGHT;
-                if (i > 0 && px_differ(jb->rgb, jb->id, p, p + ws - 1, jb->level))
-                    b |= MASK_DOWN_LEFT;
+            if (i + 1 < w) {
+                pr = px_lanes(c + 3 * (size_t)(i + 1));
+                b |= (ic[i] != ic[i + 1] || px_far(pc, pr, &fk)) ? MASK_RIGHT : 0u;
             }
-            jb->bits[p] = (uint8_t)b;
+            if (down) {
+                if (i + 1 < w) {
+                    pnr = px_lanes(n + 3 * (size_t)(i + 1));
+                    b |= (ic[i] != in[i + 1] || px_far(pc, pnr, &fk)) ? MASK_DOWN_RIGHT : 0u;
+                }
+                b |= (ic[i] != in[i] || px_far(pc, pn, &fk)) ? MASK_DOWN : 0u;
+                if (i > 0)
+                    b |= (ic[i] != in[i - 1] || px_far(pc, pnl, &fk)) ? MASK_DOWN_LEFT : 0u;
+            }
+            bt[i] = (uint8_t)b;
+            pnl = pn;
+            pn = pnr;
+            pc = pr;
         }
+    }
 }
 
 /* Rows of job k: a pixel is marked when a pair it starts differs, or a
@@ -2495,7 +2533,7 @@ size_t render_aa_mask(render *r, const render_opts *o, double ex, int curve, int
     jb.r = r;
     jb.rgb = rgb;
     jb.id = id0;
-    jb.level = level;
+    jb.level = level < 0 ? 0u : level > 255 ? 255u : (unsigned)level; /* 255: no channel step is an edge */
     /* two passes on the workers, each pixel writing only its own byte: the
      * pairs' bits into mask, then the marks into rgb (free by then: the
      * first pass is its last reader), copied back to mask */

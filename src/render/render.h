@@ -386,7 +386,8 @@ void render_tonemap_par(render *r, const float *lin, size_t px, double ex, int c
  * rgb (3 bytes a pixel, scratch), copies the surface ids into id0 and
  * marks in mask (1 byte a pixel) every pixel that differs from one of its
  * 8 neighbours: another surface id, or a channel more than level steps
- * apart in the 8-bit image. Returns the pixels marked. */
+ * apart in the 8-bit image (level taken into 0 .. 255: below 0 as 0).
+ * Returns the pixels marked. */
 size_t render_aa_mask(render *r, const render_opts *o, double ex, int curve, int level, uint8_t *rgb, uint32_t *id0,
                       uint8_t *mask);
 

@@ -294,7 +294,7 @@ static void mask_against_brute(plx_engine *e, int w, int h, int workers)
     ro.par = e->port.parallel_for;
     ro.par_ctx = e->port.ctx;
     ro.workers = workers;
-    for (level = 0; level <= 2; level += 2) {
+    for (level = 0; level <= 7; level += level < 2 ? 1 : 5) { /* 0, 1, 2 (AA_LEVEL), 7 */
         n = render_aa_mask(e->rd, &ro, info.exposure, 1, level, scratch, id0, mask);
         marked = 0;
         for (j = 0; j < h; j++)
