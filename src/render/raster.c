@@ -248,14 +248,15 @@ static float plane_dist(const raster_ctx *r, int k, const float *p)
     }
 }
 
+/* The planes point p is outside of, a bit each: plane_dist's expressions
+ * written out (the loop over its switch cost 75 instructions a vertex). */
 static unsigned outcode(const raster_ctx *r, const float *p)
 {
-    unsigned m = 0;
-    int k;
-    for (k = 0; k < PLANE_COUNT; k++)
-        if (plane_dist(r, k, p) < 0.0f)
-            m |= 1u << k;
-    return m;
+    float gxw = r->gx * p[3], gyw = r->gy * p[3];
+    return (unsigned)(p[3] - RASTER_W_EPSILON < 0.0f) << PLANE_W | (unsigned)(p[2] + p[3] < 0.0f) << PLANE_NEAR |
+           (unsigned)(p[3] - p[2] < 0.0f) << PLANE_FAR | (unsigned)(p[0] + gxw < 0.0f) << PLANE_LEFT |
+           (unsigned)(gxw - p[0] < 0.0f) << PLANE_RIGHT | (unsigned)(p[1] + gyw < 0.0f) << PLANE_BOTTOM |
+           (unsigned)(gyw - p[1] < 0.0f) << PLANE_TOP;
 }
 
 /* The point where edge (in, out) crosses a plane, computed from the inside
