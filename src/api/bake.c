@@ -129,7 +129,10 @@ static uint32_t layout_print(void)
                           sizeof(atlas_cache),
                           4 /* format changes that keep the sizes (bump on such changes): 2 the polar
                                DAG's wide nodes bit-packed, 3 aerial records keyed apart, 8 m, 4 the
-                               radiance atlas */ };
+                               radiance atlas. The atlas's dark state (ATLAS_DARK, 2026-11-29) needs
+                               none: an older bake's charts read as filled (no shortcut, the same
+                               image), an older reader takes the state as done (a saved bake has
+                               nothing left to fill) */ };
     uint64_t h = FNV_BASIS;
     size_t i;
     for (i = 0; i < sizeof sz / sizeof sz[0]; i++)

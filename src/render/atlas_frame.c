@@ -112,8 +112,10 @@ static void cell_load(cell_vals *cv, const uint32_t *t, uint32_t nu)
 
 /* Bilinear over the vertices of a chart whose vertex (0, 0) is t0 and
  * rows nu long, at (u, w) in vertex steps, summed vertex by vertex
- * (value times weight: the same bits as mantissa times scale times
- * weight, the scale a power of two); black (+0) where all four are 0. */
+ * (value times weight: the same bits as mantissa times scale-and-weight,
+ * the scale a power of two, unless scale times weight falls below 2^-126:
+ * weights under 2^-99, a point within 1e-15 m of the ground tiles'
+ * corner); black (+0) where all four are 0. */
 static inline void bilerp(cell_vals *cv, const uint32_t *t0, uint32_t nu, uint32_t nv, float u, float w,
                           float out[3])
 {

@@ -249,14 +249,25 @@ static float plane_dist(const raster_ctx *r, int k, const float *p)
 }
 
 /* The planes point p is outside of, a bit each: plane_dist's expressions
- * written out (the loop over its switch cost 75 instructions a vertex). */
+ * written out (the loop over its switch cost 75 instructions a vertex),
+ * each distance stored in a float first as plane_dist's return rounds it
+ * (the same bits where floats are evaluated wider, FLT_EVAL_METHOD 2). */
 static unsigned outcode(const raster_ctx *r, const float *p)
 {
     float gxw = r->gx * p[3], gyw = r->gy * p[3];
-    return (unsigned)(p[3] - RASTER_W_EPSILON < 0.0f) << PLANE_W | (unsigned)(p[2] + p[3] < 0.0f) << PLANE_NEAR |
-           (unsigned)(p[3] - p[2] < 0.0f) << PLANE_FAR | (unsigned)(p[0] + gxw < 0.0f) << PLANE_LEFT |
-           (unsigned)(gxw - p[0] < 0.0f) << PLANE_RIGHT | (unsigned)(p[1] + gyw < 0.0f) << PLANE_BOTTOM |
-           (unsigned)(gyw - p[1] < 0.0f) << PLANE_TOP;
+    float d[PLANE_COUNT];
+    unsigned m = 0;
+    int k;
+    d[PLANE_W] = p[3] - RASTER_W_EPSILON;
+    d[PLANE_NEAR] = p[2] + p[3];
+    d[PLANE_FAR] = p[3] - p[2];
+    d[PLANE_LEFT] = p[0] + gxw;
+    d[PLANE_RIGHT] = gxw - p[0];
+    d[PLANE_BOTTOM] = p[1] + gyw;
+    d[PLANE_TOP] = gyw - p[1];
+    for (k = 0; k < PLANE_COUNT; k++)
+        m |= (unsigned)(d[k] < 0.0f) << k;
+    return m;
 }
 
 /* The point where edge (in, out) crosses a plane, computed from the inside

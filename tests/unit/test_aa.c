@@ -307,8 +307,8 @@ static void mask_against_brute(plx_engine *e, int w, int h, int workers)
         assert_int_equal(n, marked);
         assert_true(marked > 0 && marked < px); /* edges, and flat parts */
     }
-    print_message("mask %dx%d on %d workers: %zu of %zu pixels marked (level 2), as the brute force\n", w, h,
-                  workers, marked, px);
+    print_message("mask %dx%d on %d workers: %zu of %zu pixels marked (level 7), as the brute force at levels 0, 1, "
+                  "2 and 7\n", w, h, workers, marked, px);
     free(rgb8); free(scratch); free(mask); free(id); free(id0);
 }
 

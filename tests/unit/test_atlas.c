@@ -1255,7 +1255,9 @@ typedef struct vtally {
 typedef struct hook_ctx {
     const atlas *A;
     double c0[3], a[3], b[3][3], q[3];
-    int dark_roofs;           /* no indirect light on roofs (dark charts where no lamp reaches) */
+    int dark;                 /* no indirect light on roofs and on the ground west of c0: dark
+                                 charts and blocks where no lamp reaches, and cells between
+                                 dark and lit points at the edges of the lamps' pools */
     long calls, bad;
 } hook_ctx;
 
@@ -1286,7 +1288,7 @@ static void hook_fn(void *user, const atlas_chart *c, uint32_t sid, const double
     }
     h->bad += n[0] != cn[0] || n[1] != cn[1] || n[2] != cn[2];
     hook_value(h, P, rgb);
-    if (h->dark_roofs && c->kind == ATLAS_ROOF)
+    if (h->dark && (c->kind == ATLAS_ROOF || (c->kind == ATLAS_GROUND && P[0] < h->c0[0])))
         rgb[0] = rgb[1] = rgb[2] = 0.0;
 }
 
@@ -1881,7 +1883,7 @@ static void frames_check(world *w, double fine, int nframes, rng *r)
     float *lin1 = malloc(3 * 200 * 200 * sizeof(float));
     size_t nst = A->nsurf + (size_t)A->gx * A->gy * ATLAS_TB * ATLAS_TB, q;
     uint8_t *st0 = malloc(nst);
-    long dark = 0;
+    long dark = 0, dark_ground = 0;
     int f, partial = 0;
     double t0 = now_s();
     assert_true(cache && cache2 && lin1);
@@ -1891,14 +1893,17 @@ static void frames_check(world *w, double fine, int nframes, rng *r)
     wk.rec = malloc((atlas_fill_records(A) + 1) * sizeof(double));
     assert_non_null(wk.rec);
     hook_init(&h, A, w->s, r);
-    h.dark_roofs = 1;
+    h.dark = 1;
     wk.ind = hook_fn;
     wk.ind_user = &h;
     assert_int_equal(atlas_fill(A, &wk, 1, NULL), PLX_OK);
     assert_non_null(st0);
-    for (q = 0; q < nst; q++)
-        dark += (q < A->nsurf ? A->cdone[q] : A->gdone[q - A->nsurf]) == ATLAS_DARK;
-    assert_true(dark > 0);
+    for (q = 0; q < nst; q++) {
+        int d = (q < A->nsurf ? A->cdone[q] : A->gdone[q - A->nsurf]) == ATLAS_DARK;
+        dark += d;
+        dark_ground += d && q >= A->nsurf;
+    }
+    assert_true(dark > dark_ground && dark_ground > 0);
     memset(&z, 0, sizeof z);
     hb = h;
     hb.A = B;
@@ -1950,9 +1955,9 @@ static void frames_check(world *w, double fine, int nframes, rng *r)
     }
     printf("  %s at %.2f m: %d frames, %ld pixels (sky %ld, ground %ld, buildings %ld, %ld on no chart): %ld compared, "
            "%ld skipped at block sides; worst error %.3g of its tolerance; on demand %ld items in %ld rounds; %ld dark "
-           "items; %.2f s\n",
+           "items (%ld ground blocks); %.2f s\n",
            w->name, fine, nframes, t.px, t.sky, t.ground, t.surf, t.nochart, t.compared, t.skipped, t.worst, z.listed,
-           z.rounds, dark, now_s() - t0);
+           z.rounds, dark, dark_ground, now_s() - t0);
     assert_true(t.compared >= t.px * 99 / 100);
     assert_true(t.ground > t.px / 20 && t.surf > t.px / 20);
     assert_true(partial > 0 && z.rounds > nframes);
