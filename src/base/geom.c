@@ -1,4 +1,4 @@
-/* geom: robust 2D predicates and ring utilities (contracts in geom.h).
+/* geom: robust 2D predicates and ring utilities, and a 3D orthonormal basis (contracts in geom.h).
  *
  * Arithmetic requirements. The exact predicates below need IEEE 754 binary64
  * arithmetic with round-to-nearest-even, every operation rounded to double on

@@ -76,7 +76,7 @@ enum { ATLAS_NONE = 0, ATLAS_WALL, ATLAS_ROOF, ATLAS_UNDER, ATLAS_GROUND };
 /* A chart's or block's state (atlas.cdone, atlas.gdone): not filled;
  * filled; listed by atlas_frame_missing this round; filled and every
  * value 0 (a frame writes its pixels black without reading them). */
-enum { ATLAS_TODO = 0, ATLAS_FILLED = 1, ATLAS_LISTED = 2, ATLAS_DARK = 3 };
+enum { ATLAS_UNFILLED = 0, ATLAS_FILLED = 1, ATLAS_LISTED = 2, ATLAS_DARK = 3 };
 
 static inline int atlas_filled(uint8_t state)
 {
