@@ -730,10 +730,17 @@ typedef struct plx_render_info {
                                    blocks on one surface and the pixels the blocks leave */
     uint64_t aa_later;          /* aa > 1: pixels the later samples shaded, all passes together
                                    ((aa * aa - 1) * width * height when every sample is taken) */
-    int aa_adaptive;            /* aa > 1: 1 when the later samples were adaptive; 0 with
-                                   aa_full, or when the block had no room for the adaptive
-                                   buffers (8 bytes a pixel of the largest frame) */
+    int aa_adaptive;            /* aa > 1: PLX_AA_ADAPTIVE when the later samples were adaptive;
+                                   PLX_AA_DENSE when a frame read from the radiance atlas had
+                                   edges at more than half its pixels, so every sample was
+                                   taken (faster there: the image is aa_full's); PLX_AA_EVERY
+                                   (0) with aa_full, or when the block had no room for the
+                                   adaptive buffers (8 bytes a pixel of the largest frame) */
 } plx_render_info;
+
+#define PLX_AA_EVERY 0
+#define PLX_AA_ADAPTIVE 1
+#define PLX_AA_DENSE 2
 
 /*
  * Renders one frame into caller-owned buffers: rgb8 (width*height*3 bytes,

@@ -482,7 +482,11 @@ static int aa_adaptive_buffers(plx_engine *e, size_t maxpx)
  * first sample's 3 x 3 neighbourhood) and those where they meet another
  * surface; every other pixel keeps the first sample's value for them. The
  * pixels shaded are the same values a full pass gives them (README
- * "Anti-aliasing"). */
+ * "Anti-aliasing"). A frame read from the radiance atlas whose mask marks
+ * more than half its pixels takes every sample instead (PLX_AA_DENSE):
+ * there a pixel costs about its rasterising, which the later samples pay
+ * for every pixel anyway, and the mask's bookkeeping costs more than the
+ * reads it saves (README "Anti-aliasing"). */
 static plx_status render_aa(plx_engine *e, const render_camera *rc, render_opts *ro, int n, int full,
                             uint8_t *rgb8, float *rgbf, render_stats *rs, plx_render_info *info)
 {
@@ -516,11 +520,15 @@ static plx_status render_aa(plx_engine *e, const render_camera *rc, render_opts 
                 memcpy(e->aa_sum, lin, px * 3 * sizeof(float));
                 /* the later samples: the first one's exposure */
                 ro->auto_exposure = 0;
-                adaptive = !full && aa_adaptive_buffers(e, maxpx);
+                adaptive = !full && aa_adaptive_buffers(e, maxpx) ? PLX_AA_ADAPTIVE : PLX_AA_EVERY;
                 if (adaptive && px > 0) {
-                    (void)render_aa_mask(e->rd, ro, ex, curve, AA_LEVEL, e->aa_rgb, e->aa_id, e->aa_mask);
-                    ro->mask = e->aa_mask;
-                    ro->mask_id = e->aa_id;
+                    size_t marked = render_aa_mask(e->rd, ro, ex, curve, AA_LEVEL, e->aa_rgb, e->aa_id, e->aa_mask);
+                    if (ro->atlas && marked > px / 2) {
+                        adaptive = PLX_AA_DENSE;
+                    } else {
+                        ro->mask = e->aa_mask;
+                        ro->mask_id = e->aa_id;
+                    }
                 }
             } else {
                 for (p = 0; p < 3 * px; p++)

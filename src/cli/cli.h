@@ -110,8 +110,10 @@ void cli_aa_warn(const char *cmd, const cli_common *c, const plx_render_opts *o,
 
 /* With o->aa > 1, the line saying which share of px pixels (all frames
  * together) the later anti-aliasing samples shaded, later of them, and
- * whether they were adaptive. */
-void cli_aa_print(const plx_render_opts *o, uint64_t later, double px, int adaptive);
+ * how: of the frames, adaptive were adaptive and dense took every sample
+ * for their edges (plx_render_info.aa_adaptive PLX_AA_DENSE); the others
+ * took every sample (aa_full, or no room). */
+void cli_aa_print(const plx_render_opts *o, uint64_t later, double px, long frames, long adaptive, long dense);
 /* One line on the engine's radiance atlas (nothing when it has none). */
 void cli_atlas_print(plx_engine *e);
 /* Coordinates of options (--at, --eye, --box, ...) are the scene's own:

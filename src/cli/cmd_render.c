@@ -58,7 +58,9 @@ static const char help[] =
     "  --aa N           anti-aliasing: N x N samples per pixel, averaged in linear\n"
     "                   radiance (default 1: one sample at each pixel centre, SPEC §5);\n"
     "                   the later samples only where the first one's image has an edge\n"
-    "                   (another surface, or a step of more than 2 in 8 bits)\n"
+    "                   (another surface, or a step of more than 2 in 8 bits); every\n"
+    "                   sample where such edges cover more than half of a frame read\n"
+    "                   from the radiance atlas (faster there)\n"
     "  --aa-full        every pixel takes all N x N samples\n"
     "  --no-indirect    direct light only, exact at every pixel (SPEC §5's pixels\n"
     "                   with --no-glow --exposure 1)\n"
@@ -415,7 +417,8 @@ int cmd_render(int argc, char **argv)
                100.0 * info.drawn_fraction, (port_now_ns() - t0) / 1e6, a.out);
     if (rc == EXIT_OK) {
         cli_aa_warn("render", &a.c, &a.opts, &info);
-        cli_aa_print(&a.opts, info.aa_later, (double)a.cam.width * a.cam.height, info.aa_adaptive);
+        cli_aa_print(&a.opts, info.aa_later, (double)a.cam.width * a.cam.height, 1,
+                     info.aa_adaptive == PLX_AA_ADAPTIVE, info.aa_adaptive == PLX_AA_DENSE);
     }
     if (rc == EXIT_OK && a.opts.auto_exposure)
         printf("exposure: %.4g (automatic: a high percentile of the lit surfaces' luminance near white, "

@@ -247,7 +247,7 @@ typedef struct walk_run {
     double refine_ms;
     uint64_t lookups;          /* indirect lookups, all frames */
     uint64_t aa_later;         /* pixels the later anti-aliasing samples shaded, all frames */
-    int aa_adaptive;           /* the first frame's anti-aliasing was adaptive */
+    long aa_adaptive, aa_dense; /* frames whose anti-aliasing was adaptive, took every sample for its edges */
     uint8_t *buf[2];           /* with the writer: frame k is rendered into buf[k & 1] */
     frame_writer fw;
     int writer;                /* 1: frames written on the writer's thread */
@@ -338,10 +338,12 @@ static int frame(const walk_args *a, plx_engine *e, const walk_path *wp, walk_ru
     wr->ms[k] = (port_now_ns() - t0) / 1e6;
     wr->lookups += info.indirect_lookups;
     wr->aa_later += info.aa_later;
-    if (st == PLX_OK && k == 0) {
-        wr->aa_adaptive = info.aa_adaptive;
-        cli_aa_warn("walk", &a->c, &a->opts, &info);
+    if (st == PLX_OK) {
+        wr->aa_adaptive += info.aa_adaptive == PLX_AA_ADAPTIVE;
+        wr->aa_dense += info.aa_adaptive == PLX_AA_DENSE;
     }
+    if (st == PLX_OK && k == 0)
+        cli_aa_warn("walk", &a->c, &a->opts, &info);
     if (st != PLX_OK) {
         fprintf(stderr, "polarlux walk: frame %ld at (%.2f, %.2f, %.2f): %s\n", k + 1, cam.eye[0], cam.eye[1],
                 cam.eye[2], plx_last_error(e));
@@ -443,7 +445,7 @@ static int run(const walk_args *a, plx_engine *e, const walk_path *wp)
         if (wr.lookups)
             printf("indirect light: %.0f lookups a frame on average, for %.0f samples\n",
                    (double)wr.lookups / wr.n, (double)a->w * a->h * (a->opts.aa > 1 ? a->opts.aa * a->opts.aa : 1));
-        cli_aa_print(&a->opts, wr.aa_later, (double)a->w * a->h * wr.n, wr.aa_adaptive);
+        cli_aa_print(&a->opts, wr.aa_later, (double)a->w * a->h * wr.n, wr.n, wr.aa_adaptive, wr.aa_dense);
         if (a->refine && !a->ind.off)
             printf("refinement: %llu hits, %llu misses, %llu evictions, %llu lamps refined (%u slots, %.0f m); "
                    "%.1f ms in all (floor maps and refill frames)\n", (unsigned long long)wr.rs.hits,

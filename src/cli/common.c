@@ -784,20 +784,31 @@ void cli_aa_warn(const char *cmd, const cli_common *c, const plx_render_opts *o,
 {
     if (o->aa_full && o->aa <= 1)
         cli_warn(cmd, c, "--aa-full has no effect without --aa 2 or more (one sample a pixel)");
-    if (o->aa > 1 && !o->aa_full && !info->aa_adaptive)
+    if (o->aa > 1 && !o->aa_full && info->aa_adaptive == PLX_AA_EVERY)
         cli_warn(cmd, c, "the engine's memory block (--mem; for a bake without --mem, the bake's own room) "
                  "leaves no room for adaptive anti-aliasing (8 bytes a pixel of the largest frame): every "
                  "pixel takes all %dx%d samples (slower; the image differs from the adaptive one by about 1 "
                  "in 255)", o->aa, o->aa);
 }
 
-void cli_aa_print(const plx_render_opts *o, uint64_t later, double px, int adaptive)
+void cli_aa_print(const plx_render_opts *o, uint64_t later, double px, long frames, long adaptive, long dense)
 {
     double all = ((double)o->aa * o->aa - 1.0) * px;
-    if (o->aa > 1)
-        printf("anti-aliasing %dx%d: the later samples shaded %.1f%% of the pixels (%s)\n", o->aa, o->aa,
-               all > 0.0 ? 100.0 * (double)later / all : 0.0,
-               adaptive ? "adaptive: edges and glows; --aa-full for all" : "every sample");
+    char how[160];
+    if (o->aa <= 1)
+        return;
+    if (adaptive == 0 && dense == 0)
+        snprintf(how, sizeof how, "every sample");
+    else if (dense > 0 && dense == frames)
+        snprintf(how, sizeof how, "every sample: edges at more than half the pixels%s; --aa 1 is faster",
+                 frames > 1 ? " of every frame" : "");
+    else if (dense > 0)
+        snprintf(how, sizeof how, "adaptive: edges and glows; every sample in %ld of %ld frames, with edges at "
+                 "more than half the pixels", dense, frames);
+    else
+        snprintf(how, sizeof how, "adaptive: edges and glows; --aa-full for all");
+    printf("anti-aliasing %dx%d: the later samples shaded %.1f%% of the pixels (%s)\n", o->aa, o->aa,
+           all > 0.0 ? 100.0 * (double)later / all : 0.0, how);
 }
 
 void cli_atlas_print(plx_engine *e)

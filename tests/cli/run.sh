@@ -206,6 +206,8 @@ expect render-aa-adaptive 0 "^anti-aliasing 2x2: the later samples shaded [0-9.]
     "$bin" render -q "$tmp/e.plxb" --size 160x120 --aa 2 -o "$tmp/aa2.png"
 expect render-aa-full 0 "^anti-aliasing 2x2: the later samples shaded 100\.0% of the pixels \(every sample\)" -- \
     "$bin" render -q "$tmp/e.plxb" --size 160x120 --aa 2 --aa-full -o "$tmp/aa2f.png"
+expect render-aa-dense 0 "^anti-aliasing 2x2: the later samples shaded 100\.0% of the pixels \(every sample: edges at more than half the pixels; --aa 1 is faster\)" -- \
+    "$bin" render -q "$tmp/e.plxb" --view aerial --size 160x120 --aa 2 -o "$tmp/aa2d.png"
 expect render-aa-full-alone 0 "^polarlux render: warning: --aa-full has no effect without --aa 2 or more" -- \
     "$bin" render "$tmp/e.plxb" --size 32x24 --aa-full -o "$tmp/aa1f.png"
 if /usr/bin/python3 tests/cli/png_same.py --within 2 "$tmp/aa2.png" "$tmp/aa2f.png" >/dev/null; then echo "ok   render-aa-adaptive-near-full"; pass=$((pass + 1)); else echo "FAIL render-aa-adaptive-near-full"; fail=$((fail + 1)); fi

@@ -346,6 +346,79 @@ static void test_bake_after_frames(void **state)
     bake_free(&k);
 }
 
+/* Anti-aliasing of frames read from the radiance atlas (a loaded bake):
+ * an aerial frame whose first sample has edges at more than half its
+ * pixels takes every sample (PLX_AA_DENSE), and its bytes are aa_full's;
+ * a street frame with fewer edges stays adaptive, and only the marked
+ * pixels took the later samples. */
+static void aa_frame(plx_engine *e, int aerial, double height, int full, uint8_t *rgb8, float *rgbf,
+                     plx_render_info *info)
+{
+    plx_camera cam;
+    plx_render_opts o;
+    memset(&cam, 0, sizeof cam);
+    cam.width = 160;
+    cam.height = 120;
+    cam.fov_deg = 60;
+    if (aerial) {
+        cam.eye[0] = cam.target[0] = 266.0;
+        cam.eye[1] = 200.0;
+        cam.target[1] = 267.0;
+        cam.eye[2] = height;
+    } else {
+        cam.eye[0] = 298.6; cam.eye[1] = 265.5; cam.eye[2] = 1.7;
+        cam.target[0] = 261.8; cam.target[1] = 302.3; cam.target[2] = 3.0;
+    }
+    plx_render_opts_default(&o);
+    o.auto_exposure = 1;
+    o.aa = 2;
+    o.aa_full = full;
+    assert_int_equal(plx_render(e, &cam, &o, rgb8, rgbf, info), PLX_OK);
+}
+
+static size_t marked(const plx_engine *e, size_t px)
+{
+    size_t p, n = 0;
+    for (p = 0; p < px; p++)
+        n += e->aa_mask[p] != 0;
+    return n;
+}
+
+static void test_aa_dense(void **state)
+{
+    baked k = shared;
+    void *mc;
+    plx_engine *c;
+    plx_render_info ia, iff;
+    size_t px = 160 * 120;
+    uint8_t *a8 = malloc(px * 3), *f8 = malloc(px * 3);
+    float *af = malloc(sizeof(float) * px * 3), *ff = malloc(sizeof(float) * px * 3);
+    (void)state;
+    c = load(k.file, k.len, &mc);
+    /* aerial, from high enough that the blocks' edges fill the frame */
+    aa_frame(c, 1, 400.0, 0, a8, af, &ia);
+    print_message("aerial: %zu of %zu pixels marked\n", marked(c, px), px);
+    assert_int_equal(ia.aa_adaptive, PLX_AA_DENSE);
+    assert_true(marked(c, px) > px / 2);
+    assert_true(ia.aa_later == 3 * px);
+    aa_frame(c, 1, 400.0, 1, f8, ff, &iff);
+    assert_int_equal(iff.aa_adaptive, PLX_AA_EVERY);
+    assert_memory_equal(a8, f8, px * 3);
+    assert_memory_equal(af, ff, sizeof(float) * px * 3);
+    assert_true(ia.exposure == iff.exposure);
+    /* a street frame: adaptive, the later samples at the marked pixels only */
+    aa_frame(c, 0, 0.0, 0, a8, af, &ia);
+    print_message("street: %zu of %zu pixels marked\n", marked(c, px), px);
+    assert_int_equal(ia.aa_adaptive, PLX_AA_ADAPTIVE);
+    assert_true(marked(c, px) <= px / 2 && marked(c, px) > 0);
+    assert_true(ia.aa_later >= 3 * marked(c, px)); /* and the slivers the later samples found */
+    aa_frame(c, 0, 0.0, 1, f8, ff, &iff);
+    assert_true(memcmp(af, ff, sizeof(float) * px * 3) != 0); /* not the full pass: some pixels kept their first sample */
+    plx_engine_destroy(c);
+    free(mc);
+    free(a8); free(f8); free(af); free(ff);
+}
+
 /* ---- damaged files ----------------------------------------------------------- */
 
 static void expect_fail(const unsigned char *f, size_t len, plx_status want, const char *msg)
@@ -492,6 +565,7 @@ int main(void)
         cmocka_unit_test(test_round_trip),
         cmocka_unit_test(test_atlas_in_bake),
         cmocka_unit_test(test_bake_after_frames),
+        cmocka_unit_test(test_aa_dense),
         cmocka_unit_test(test_damaged),
         cmocka_unit_test(test_corpus),
         cmocka_unit_test(test_twin_mismatch),
