@@ -143,31 +143,41 @@ void tonemap_table_set(tonemap_table *t, const double thr[TONEMAP_LEVELS], doubl
             t->single = 0;
 }
 
+/* The bytes of values whose bits u are at least FLOAT_INF_BITS
+ * (negative, infinite, NaN) come from tonemap_value; +0 needs no case:
+ * its hint is byte 0 and f[0] >= 1. */
 void tonemap_apply(const tonemap_table *t, const double thr[TONEMAP_LEVELS], const float *lin, size_t p0,
                    size_t p1, uint8_t *rgb8)
 {
     const uint32_t *f = t->f;
     const uint8_t *hint = t->hint;
-    int single = t->single;
     size_t p;
     if (!t->usable) {
         for (p = p0; p < p1; p++)
             rgb8[p] = tonemap_value(thr, lin[p], t->ex, t->curve);
         return;
     }
+    if (t->single) { /* one threshold at most above the hint */
+        for (p = p0; p < p1; p++) {
+            uint32_t u = bits_of_float(lin[p]), b;
+            if (u >= FLOAT_INF_BITS) {
+                rgb8[p] = tonemap_value(thr, lin[p], t->ex, t->curve);
+                continue;
+            }
+            b = hint[u >> TONEMAP_HINT_SHIFT];
+            rgb8[p] = (uint8_t)(b + (u >= f[b]));
+        }
+        return;
+    }
     for (p = p0; p < p1; p++) {
-        uint32_t u = bits_of_float(lin[p]);
-        int b;
-        if (u - 1u >= FLOAT_INF_BITS - 1u) { /* zero, negative, infinite, NaN */
-            rgb8[p] = u == 0 ? 0 : tonemap_value(thr, lin[p], t->ex, t->curve);
+        uint32_t u = bits_of_float(lin[p]), b;
+        if (u >= FLOAT_INF_BITS) {
+            rgb8[p] = tonemap_value(thr, lin[p], t->ex, t->curve);
             continue;
         }
         b = hint[u >> TONEMAP_HINT_SHIFT];
-        if (single)
-            b += u >= f[b];
-        else
-            while (b < TONEMAP_LEVELS && u >= f[b])
-                b++;
+        while (b < TONEMAP_LEVELS && u >= f[b])
+            b++;
         rgb8[p] = (uint8_t)b;
     }
 }
