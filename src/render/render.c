@@ -1042,10 +1042,26 @@ static int cull_building(render *r, int mode, uint32_t b, render_stats *st, doub
  * occlusion culling the others go to the occlusion pass as a whole (their
  * buildings are tested when the cell is reached and not hidden), without
  * it their buildings are tested at once. */
+/* Whether the occlusion test may pay: not when the eye is higher than
+ * twice the tallest top. From there a building hides a whole other one
+ * only just behind a taller one, and the front-to-back traversal cost
+ * more than it saved (the aerial bench's frames: 11 million instructions
+ * a frame, nothing culled). Either way the image is the same: culling
+ * only skips what the depth test would hide. */
+static int occlusion_pays(const render *r)
+{
+    double top = -HUGE_VAL;
+    uint32_t c;
+    for (c = 0; c < r->ncell; c++)
+        if (r->cell_start[c + 1] > r->cell_start[c])
+            top = fmax(top, r->cell_box[6 * (size_t)c + 5]);
+    return !(r->eye[2] > 2.0 * fmax(top, 0.0));
+}
+
 static void cull(render *r, int mode, int inside, render_stats *st)
 {
     uint32_t c, k;
-    int occl = (mode & RENDER_CULL_OCCLUSION) && !inside;
+    int occl = (mode & RENDER_CULL_OCCLUSION) && !inside && occlusion_pays(r);
     occlusion_start(r);
     for (c = 0; c < r->ncell; c++) {
         double wmn, wmx, key;
