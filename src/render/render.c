@@ -1014,8 +1014,6 @@ static int box_out(const render *r, const double *bx, double *wmn, double *wmx, 
     return out_l || out_r || out_t || out_b || out_n;
 }
 
-/* Building b's frustum test: drawn, or culled (counted); a drawn one with
- * triangles is listed for the occlusion pass. */
 /* Building b's frustum test: culled (counted, 0), or drawn (1; 2 when
  * it has triangles: a candidate for the occlusion pass, its key the
  * smallest w of its box's corners, at least near). */
@@ -1037,11 +1035,6 @@ static int cull_building(render *r, int mode, uint32_t b, render_stats *st, doub
     return r->m->bld[b].t_count == 0 ? 1 : 2;
 }
 
-/* Culling (render.h): cells of buildings first. A cell whose box lies
- * out of the frustum culls its buildings (their boxes lie in it); with
- * occlusion culling the others go to the occlusion pass as a whole (their
- * buildings are tested when the cell is reached and not hidden), without
- * it their buildings are tested at once. */
 /* Whether the occlusion test may pay: not when the eye is higher than
  * twice the tallest top. From there a building hides a whole other one
  * only just behind a taller one, and the front-to-back traversal cost
@@ -1058,6 +1051,11 @@ static int occlusion_pays(const render *r)
     return !(r->eye[2] > 2.0 * fmax(top, 0.0));
 }
 
+/* Culling (render.h): cells of buildings first. A cell whose box lies
+ * out of the frustum culls its buildings (their boxes lie in it); with
+ * occlusion culling the others go to the occlusion pass as a whole (their
+ * buildings are tested when the cell is reached and not hidden), without
+ * it their buildings are tested at once. */
 static void cull(render *r, int mode, int inside, render_stats *st)
 {
     uint32_t c, k;

@@ -134,7 +134,8 @@
  *     Raised buildings, buildings with courtyards and buildings whose box
  *     contains the eye never occlude; the last are always drawn. The eye
  *     inside a solid, or at or below the ground, switches occlusion culling
- *     off. Touching buildings are separate occluders, so a bin that holds
+ *     off, and so does an eye higher than twice the tallest top (from
+ *     there the test hardly ever culls and costs more than it saves). Touching buildings are separate occluders, so a bin that holds
  *     the azimuth of a shared wall is not closed by either: the culling
  *     leaks there (conservative, costs drawn geometry).
  *     Why not the polar-diagram visible set (visibility.h): it treats every
