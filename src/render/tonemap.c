@@ -7,10 +7,12 @@
  * it, so the table holds, for each byte, the smallest float that reaches
  * it: found from the curve's inverse and checked float by float against
  * tonemap_value, so the bytes are the same by construction. A value then
- * costs a table read and a compare or two of its bits.
+ * costs a table read and a compare or two of its bits, and a run of +0
+ * (the dark half of an aerial frame) four values a test.
  */
 #include <float.h>
 #include <math.h>
+#include <stdint.h>
 #include <string.h>
 
 #include "base/bits.h"
@@ -160,6 +162,15 @@ void tonemap_apply(const tonemap_table *t, const double thr[TONEMAP_LEVELS], con
     if (t->single) { /* one threshold at most above the hint */
         for (p = p0; p < p1; p++) {
             uint32_t u = bits_of_float(lin[p]), b;
+            if (u == 0) { /* a dark run (half an aerial frame): its next values four at a time */
+                uint64_t q[2];
+                rgb8[p] = 0;
+                while (p + 5 <= p1 && (memcpy(q, lin + p + 1, sizeof q), (q[0] | q[1]) == 0)) {
+                    memset(rgb8 + p + 1, 0, 4);
+                    p += 4;
+                }
+                continue;
+            }
             if (u >= FLOAT_INF_BITS) {
                 rgb8[p] = tonemap_value(thr, lin[p], t->ex, t->curve);
                 continue;
