@@ -57,8 +57,12 @@ static const cJSON *first_line(const cJSON *root, const cJSON **props)
 {
     const cJSON *type = cJSON_GetObjectItemCaseSensitive(root, "type"), *ft;
     *props = NULL;
-    if (cJSON_IsString(type) && strcmp(type->valuestring, "LineString") == 0)
+    if (cJSON_IsString(type) && strcmp(type->valuestring, "LineString") == 0) {
+        /* a bare LineString's own "properties" (a foreign member in
+         * GeoJSON) count as a Feature's would: units already did */
+        *props = cJSON_GetObjectItemCaseSensitive(root, "properties");
         return root;
+    }
     if (cJSON_IsString(type) && strcmp(type->valuestring, "Feature") == 0) {
         const cJSON *g = cJSON_GetObjectItemCaseSensitive(root, "geometry");
         *props = cJSON_GetObjectItemCaseSensitive(root, "properties");

@@ -208,6 +208,15 @@ expect render-aa-full 0 "^anti-aliasing 2x2: the later samples shaded 100\.0% of
     "$bin" render -q "$tmp/e.plxb" --size 160x120 --aa 2 --aa-full -o "$tmp/aa2f.png"
 expect render-aa-dense 0 "^anti-aliasing 2x2: the later samples shaded 100\.0% of the pixels \(every sample: edges at more than half the pixels; --aa 1 is faster\)" -- \
     "$bin" render -q "$tmp/e.plxb" --view aerial --size 160x120 --aa 2 -o "$tmp/aa2d.png"
+# a walk from high up (dense: every sample) down to the street (adaptive), the
+# targets in a bare LineString's own properties
+printf '{"type":"LineString","coordinates":[[266,200,400],[298.6,265.5,1.7]],"properties":{"targets":[[266,267,0],[261.8,302.3,3.0]]}}' >"$tmp/mix.geojson"
+expect walk-aa-mixed 0 "^anti-aliasing 2x2: .*\(adaptive: edges and glows; every sample in 1 of 2 frames, with edges at more than half the pixels\)" -- \
+    "$bin" walk -q "$tmp/e.plxb" --path "$tmp/mix.geojson" --size 160x120 --speed 400 --fps 1 -o "$tmp/wmix"
+expect walk-bare-targets 0 "^1 266 200 400 266 267 0 " -- cat "$tmp/wmix/cameras.txt"
+printf '{"type":"LineString","coordinates":[[266,200,400],[266,201,400]],"properties":{"targets":[[266,267,0],[266,267,0]]}}' >"$tmp/high2.geojson"
+expect walk-aa-dense 0 "^anti-aliasing 2x2: the later samples shaded 100\.0% of the pixels \(every sample: edges at more than half the pixels of every frame; --aa 1 is faster\)" -- \
+    "$bin" walk -q "$tmp/e.plxb" --path "$tmp/high2.geojson" --size 160x120 --speed 1 --fps 1 -o "$tmp/wdense"
 expect render-aa-full-alone 0 "^polarlux render: warning: --aa-full has no effect without --aa 2 or more" -- \
     "$bin" render "$tmp/e.plxb" --size 32x24 --aa-full -o "$tmp/aa1f.png"
 if /usr/bin/python3 tests/cli/png_same.py --within 2 "$tmp/aa2.png" "$tmp/aa2f.png" >/dev/null; then echo "ok   render-aa-adaptive-near-full"; pass=$((pass + 1)); else echo "FAIL render-aa-adaptive-near-full"; fail=$((fail + 1)); fi
