@@ -688,7 +688,7 @@ plx_status plx_render(plx_engine *e, const plx_camera *cam, const plx_render_opt
     set_workers(e, &ro);
     if (info) {
         info->aa_later = 0;
-        info->aa_adaptive = 0;
+        info->aa_adaptive = PLX_AA_EVERY;
     }
     if (o->aa > 1)
         st = render_aa(e, &rc, &ro, o->aa, o->aa_full, rgb8, rgbf, &rs, info);

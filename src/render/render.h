@@ -135,9 +135,10 @@
  *     contains the eye never occlude; the last are always drawn. The eye
  *     inside a solid, or at or below the ground, switches occlusion culling
  *     off, and so does an eye higher than twice the tallest top (from
- *     there the test hardly ever culls and costs more than it saves). Touching buildings are separate occluders, so a bin that holds
- *     the azimuth of a shared wall is not closed by either: the culling
- *     leaks there (conservative, costs drawn geometry).
+ *     there the test hardly ever culls and costs more than it saves).
+ *     Touching buildings are separate occluders, so a bin that holds the
+ *     azimuth of a shared wall is not closed by either: the culling leaks
+ *     there (conservative, costs drawn geometry).
  *     Why not the polar-diagram visible set (visibility.h): it treats every
  *     building as infinitely tall, which is only valid with occluders nothing
  *     behind can rise above; the horizon gives the same shadows for tall

@@ -146,8 +146,9 @@ void tonemap_table_set(tonemap_table *t, const double thr[TONEMAP_LEVELS], doubl
 }
 
 /* The bytes of values whose bits u are at least FLOAT_INF_BITS
- * (negative, infinite, NaN) come from tonemap_value; +0 needs no case:
- * its hint is byte 0 and f[0] >= 1. */
+ * (negative, infinite, NaN) come from tonemap_value. +0 needs no case of
+ * its own (its hint is byte 0 and f[0] >= 1); the single-threshold loop
+ * tests for it only to take the run it starts four values at a time. */
 void tonemap_apply(const tonemap_table *t, const double thr[TONEMAP_LEVELS], const float *lin, size_t p0,
                    size_t p1, uint8_t *rgb8)
 {

@@ -200,7 +200,7 @@ static void aa_adaptive(plx_engine *e, int n, int sparse)
     o.aa = n;
     street(&cam, W, H);
     assert_int_equal(plx_render(e, &cam, &o, ad8, ad, &ia), PLX_OK);
-    assert_true(ia.aa_adaptive && e->aa_mask);
+    assert_true(ia.aa_adaptive == PLX_AA_ADAPTIVE && e->aa_mask);
     memcpy(mask, e->aa_mask, px);  /* the pixels the later samples shaded */
     o.aa_full = 1;
     assert_int_equal(plx_render(e, &cam, &o, fu8, fu, &iff), PLX_OK);
@@ -253,6 +253,43 @@ static void test_aa_adaptive(void **state)
     aa_adaptive(e, 2, 1);
     plx_engine_destroy(e);
     free(mem);
+}
+
+/* A frame shaded pixel by pixel (not read from the radiance atlas) stays
+ * adaptive however many pixels its mask marks: the dense rule
+ * (PLX_AA_DENSE, test_bake's test_aa_dense) is for atlas frames only,
+ * where a pixel costs little more than its rasterising. */
+static void test_aa_dense_atlas_only(void **state)
+{
+    void *mem;
+    plx_engine *e = open_eixample(&mem);
+    plx_camera cam;
+    plx_render_opts o;
+    plx_render_info info;
+    size_t px = 160 * 120, p, marked = 0;
+    uint8_t *rgb8 = malloc(px * 3);
+    (void)state;
+    memset(&cam, 0, sizeof cam);
+    cam.eye[0] = cam.target[0] = 266.0;
+    cam.eye[1] = 200.0;
+    cam.target[1] = 267.0;
+    cam.eye[2] = 400.0;
+    cam.fov_deg = 60;
+    cam.width = 160;
+    cam.height = 120;
+    plx_render_opts_default(&o);
+    o.auto_exposure = 1;
+    o.aa = 2;
+    o.aerial = 1;
+    assert_int_equal(plx_render(e, &cam, &o, rgb8, NULL, &info), PLX_OK);
+    for (p = 0; p < px; p++)
+        marked += e->aa_mask[p] != 0;
+    print_message("aerial, shaded per pixel: %zu of %zu pixels marked\n", marked, px);
+    assert_true(marked > px / 2);
+    assert_int_equal(info.aa_adaptive, PLX_AA_ADAPTIVE);
+    plx_engine_destroy(e);
+    free(mem);
+    free(rgb8);
 }
 
 /* Brute force: pixel (i, j) against each of its 8 neighbours. */
@@ -332,6 +369,7 @@ int main(void)
         cmocka_unit_test(test_auto_exposure),
         cmocka_unit_test(test_aa),
         cmocka_unit_test(test_aa_adaptive),
+        cmocka_unit_test(test_aa_dense_atlas_only),
         cmocka_unit_test(test_aa_mask),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

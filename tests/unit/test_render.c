@@ -819,7 +819,10 @@ static double rng_unit(uint64_t *s)
 /* Renders ncam cameras culled and unculled; returns buildings culled by
  * occlusion in all. Eyes: near lamps (streets), at height z (z < 0: the
  * eye height drawn from 1.5 .. -z). */
-static uint64_t cull_equal(const char *path, int ncam, double zmax, uint64_t seed)
+/* zmin 0: street-level eyes from 1.5 m to zmax looking about level;
+ * else eyes from zmin to zmax looking down at the ground 50 to 300 m
+ * away. */
+static uint64_t cull_equal_from(const char *path, int ncam, double zmin, double zmax, uint64_t seed)
 {
     void *mem;
     plx_engine *e = open_scene(path, &mem);
@@ -840,11 +843,18 @@ static uint64_t cull_equal(const char *path, int ncam, double zmax, uint64_t see
         render_stats sa, sb;
         cam.eye[0] = l->x + 1.3 * cos(ang);
         cam.eye[1] = l->y + 1.3 * sin(ang);
-        cam.eye[2] = 1.5 + (zmax - 1.5) * rng_unit(&seed);
+        cam.eye[2] = zmin > 0.0 ? zmin + (zmax - zmin) * rng_unit(&seed) : 1.5 + (zmax - 1.5) * rng_unit(&seed);
         ang = TWO_PI_T * rng_unit(&seed);
-        cam.target[0] = cam.eye[0] + 100 * cos(ang);
-        cam.target[1] = cam.eye[1] + 100 * sin(ang);
-        cam.target[2] = cam.eye[2] + 30 * (rng_unit(&seed) - 0.6);
+        if (zmin > 0.0) {
+            double d = 50 + 250 * rng_unit(&seed);
+            cam.target[0] = cam.eye[0] + d * cos(ang);
+            cam.target[1] = cam.eye[1] + d * sin(ang);
+            cam.target[2] = 0.0;
+        } else {
+            cam.target[0] = cam.eye[0] + 100 * cos(ang);
+            cam.target[1] = cam.eye[1] + 100 * sin(ang);
+            cam.target[2] = cam.eye[2] + 30 * (rng_unit(&seed) - 0.6);
+        }
         cam.fov_deg = 30 + 60 * rng_unit(&seed);
         cam.width = w;
         cam.height = h;
@@ -882,6 +892,11 @@ static uint64_t cull_equal(const char *path, int ncam, double zmax, uint64_t see
     return culled;
 }
 
+static uint64_t cull_equal(const char *path, int ncam, double zmax, uint64_t seed)
+{
+    return cull_equal_from(path, ncam, 0.0, zmax, seed);
+}
+
 static void test_cull_equal_street(void **state)
 {
     (void)state;
@@ -905,6 +920,16 @@ static void test_cull_equal_above_roofs(void **state)
     }
     cull_equal("fixtures/tiny.geojson", 10, 14, 23);
     cull_equal("fixtures/oldtown-8x8.geojson", quick() ? 6 : 16, 25, 24);
+}
+
+/* Eyes above twice the tallest top, where the occlusion test is skipped
+ * (render.c occlusion_pays): the image is still the unculled one. */
+static void test_cull_equal_high(void **state)
+{
+    (void)state;
+    cull_equal_from("fixtures/eixample-4x4.geojson", quick() ? 4 : 16, 57, 400, 25);
+    cull_equal_from("fixtures/helsinki-centre.geojson", quick() ? 4 : 16, 141, 500, 26);
+    cull_equal_from("fixtures/oldtown-8x8.geojson", quick() ? 4 : 12, 60, 300, 27);
 }
 
 /* An eye just above a low roof, looking over it at taller buildings behind:
@@ -1551,6 +1576,7 @@ int main(void)
         cmocka_unit_test(test_exposure_table),
         cmocka_unit_test(test_cull_equal_street),
         cmocka_unit_test(test_cull_equal_above_roofs),
+        cmocka_unit_test(test_cull_equal_high),
         cmocka_unit_test(test_cull_over_low_roof),
         cmocka_unit_test(test_mesh_fixtures),
         cmocka_unit_test(test_mesh_awkward),

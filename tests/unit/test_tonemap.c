@@ -93,15 +93,23 @@ static void check_exposure(const double *thr, double ex, int curve, int usable)
 
 static void test_same_bytes(void **state)
 {
-    static const double ex[] = { 1.0, 0.15, 3.7e-3, 250.0, 1e-30, 7.3e20, 0.999999, 1e6 };
+    /* the last two: tables with more than one threshold in a hint's range
+     * (the loop that steps past several) */
+    static const double ex[] = { 1.0, 0.15, 3.7e-3, 250.0, 1e-30, 7.3e20, 0.999999, 1e6, 1e-40, 1e38 };
+    static tonemap_table t;
     double thr[TONEMAP_LEVELS];
     size_t i;
-    int curve;
+    int curve, several = 0;
     (void)state;
     tonemap_thresholds(thr);
     for (i = 0; i < sizeof ex / sizeof ex[0]; i++)
-        for (curve = 0; curve < 2; curve++)
+        for (curve = 0; curve < 2; curve++) {
             check_exposure(thr, ex[i], curve, 1);
+            memset(&t, 0, sizeof t);
+            tonemap_table_set(&t, thr, ex[i], curve);
+            several += !t.single;
+        }
+    assert_true(several >= 2);
     check_exposure(thr, 1e120, 1, 0);
     check_exposure(thr, 1e120, 0, 0);
 }
