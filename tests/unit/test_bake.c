@@ -207,6 +207,25 @@ static void same_illum(plx_engine *x, plx_engine *y, int indirect)
         assert_memory_equal(i1, i2, sizeof i1);
 }
 
+/* The tests' 160x120 cameras: aerial from (266, eye_y, eye_z) looking at
+ * (266, 267, 0) (a view from above), or a street view by a lamp. */
+static void fixed_camera(plx_camera *cam, int aerial, double eye_y, double eye_z)
+{
+    memset(cam, 0, sizeof *cam);
+    cam->width = 160;
+    cam->height = 120;
+    cam->fov_deg = 60;
+    if (aerial) {
+        cam->eye[0] = cam->target[0] = 266.0;
+        cam->eye[1] = eye_y;
+        cam->target[1] = 267.0;
+        cam->eye[2] = eye_z;
+    } else {
+        cam->eye[0] = 298.6; cam->eye[1] = 265.5; cam->eye[2] = 1.7;
+        cam->target[0] = 261.8; cam->target[1] = 302.3; cam->target[2] = 3.0;
+    }
+}
+
 static void same_render(plx_engine *x, plx_engine *y, int aerial, int no_indirect)
 {
     plx_camera cam;
@@ -214,19 +233,7 @@ static void same_render(plx_engine *x, plx_engine *y, int aerial, int no_indirec
     size_t px = 160 * 120;
     uint8_t *a8 = malloc(px * 3), *b8 = malloc(px * 3);
     float *af = malloc(sizeof(float) * px * 3), *bf = malloc(sizeof(float) * px * 3);
-    memset(&cam, 0, sizeof cam);
-    cam.width = 160;
-    cam.height = 120;
-    cam.fov_deg = 60;
-    if (aerial) {
-        cam.eye[0] = cam.target[0] = 266.0;
-        cam.eye[1] = 266.0;
-        cam.target[1] = 267.0;
-        cam.eye[2] = 500.0;
-    } else {
-        cam.eye[0] = 298.6; cam.eye[1] = 265.5; cam.eye[2] = 1.7;
-        cam.target[0] = 261.8; cam.target[1] = 302.3; cam.target[2] = 3.0;
-    }
+    fixed_camera(&cam, aerial, 266.0, 500.0);
     plx_render_opts_default(&o);
     o.aerial = aerial;
     o.aerial_m_per_texel = 2.0;
@@ -356,19 +363,7 @@ static void aa_frame(plx_engine *e, int aerial, double height, int full, uint8_t
 {
     plx_camera cam;
     plx_render_opts o;
-    memset(&cam, 0, sizeof cam);
-    cam.width = 160;
-    cam.height = 120;
-    cam.fov_deg = 60;
-    if (aerial) {
-        cam.eye[0] = cam.target[0] = 266.0;
-        cam.eye[1] = 200.0;
-        cam.target[1] = 267.0;
-        cam.eye[2] = height;
-    } else {
-        cam.eye[0] = 298.6; cam.eye[1] = 265.5; cam.eye[2] = 1.7;
-        cam.target[0] = 261.8; cam.target[1] = 302.3; cam.target[2] = 3.0;
-    }
+    fixed_camera(&cam, aerial, 200.0, height);
     plx_render_opts_default(&o);
     o.auto_exposure = 1;
     o.aa = 2;
