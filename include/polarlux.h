@@ -635,7 +635,10 @@ typedef struct plx_refine_stats {
  * first, up to the cache capacity, get their own floor photon maps, kept
  * in an LRU cache; a lamp's map is pushed into the improved aerial map the
  * first time, and the progressive aerial chart then restarts without that
- * lamp (further plx_indirect_step frames fill it again). out (may be NULL)
+ * lamp (further plx_indirect_step frames fill it again). Only a miss
+ * changes the indirect light (the cached maps are summed in slot order,
+ * which hits do not change): after a call of hits alone the frames'
+ * radiance atlas and indirect map stay filled. out (may be NULL)
  * gets the cache's counters. Errors: PLX_E_NOSCENE (no photon buffers yet),
  * PLX_E_INVALID, PLX_E_NOMEM (scratch).
  */

@@ -54,9 +54,15 @@ plx_status plx_indirect_refine(plx_engine *e, const double eye[3], plx_refine_st
     if (!e->ph)
         return eng_fail(e, PLX_E_NOSCENE, "plx_indirect_refine: no photon buffers (trace indirect light first)");
     misses = photon_lamps_update(e->ph, eye);
-    e->indirect_gen++;   /* floor maps, and the order they are summed in */
-    if (misses < 0)
+    if (misses < 0) /* before any request: nothing changed */
         return eng_nomem(e, "choosing the lamps near the viewer");
+    /* Only a miss changes the indirect light: a floor map computed (and,
+     * the first time, pushed, restarting the progressive chart) or one
+     * evicted. Hits reorder the LRU list alone, which the sum does not
+     * follow (photon_night_horizontal sums in slot order), so the atlas
+     * and the indirect map of the last frame stay valid. */
+    if (misses > 0)
+        e->indirect_gen++;
     if (out) {
         memset(out, 0, sizeof *out);
         out->misses_now = (uint32_t)misses;

@@ -253,7 +253,10 @@ void photon_night_horizontal(const photon_sys *ps, double x, double y, double z,
     }
     photon_gather(ps->gimp, ps->garea, ps->gheight, z, ps->gw, ps->gh, 0, gx, gy, e);
     F = ps->cfg.lamp_res;
-    for (s = ps->lru_head; s != PHOTON_NONE; s = ps->slots[s].next) {
+    /* in slot order, not LRU order: a hit reorders the LRU list but moves
+     * no slot, so the sum keeps its bits until a miss changes the cached
+     * lamps (plx_indirect_refine keys the frames' caches on that) */
+    for (s = 0; s < ps->nslots; s++) {
         const photon_lamp_slot *sl = &ps->slots[s];
         double fx, fy;
         if (sl->lamp == PHOTON_NONE)

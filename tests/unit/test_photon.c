@@ -1665,6 +1665,62 @@ static void test_lamp_lru(void **state)
     fx_close(&f);
 }
 
+/* The night lighting sums the cached floor maps in slot order, so a hit,
+ * which reorders the LRU list but moves no slot, leaves every bit of it
+ * unchanged (plx_indirect_refine keeps the frames' atlas on hits alone);
+ * a miss changes it. Points on a 1 m grid along the row of lamps, where
+ * the floor maps of neighbouring lamps overlap. */
+static void night_grid(const photon_sys *ps, double *e, int n)
+{
+    int i;
+    for (i = 0; i < n; i++)
+        photon_night_horizontal(ps, 10.0 + 0.37 * i, 1.0 + (i % 7), 0.0, 0, &e[PHOTON_CH * (size_t)i]);
+}
+
+static void test_lamp_hits_keep_bits(void **state)
+{
+    enum { N = 160 };
+    fixture f;
+    photon_sys *ps;
+    photon_config c;
+    uint32_t order[8];
+    static double before[N * PHOTON_CH], after[N * PHOTON_CH];
+    int i, overlap = 0;
+    (void)state;
+    lamp_row(&f, 6);
+    photon_config_default(&c);
+    c.aerial_res = 128;
+    c.lamp_slots = 3;
+    c.lamp_res = 16;
+    c.lamp_photons = 2000;
+    assert_int_equal(photon_create(&f.a, &f.s, &c, &ps), PLX_OK);
+    photon_step(ps, 5000, 1);
+    assert_int_equal(photon_lamp_request(ps, 0), 0);
+    assert_int_equal(photon_lamp_request(ps, 1), 0);
+    assert_int_equal(photon_lamp_request(ps, 2), 0);
+    night_grid(ps, before, N);
+    for (i = 0; i < N; i++) { /* points in more than one floor map: the order could matter */
+        double x = 10.0 + 0.37 * i;
+        int k, in = 0;
+        for (k = 0; k < 3; k++)
+            in += fabs(x - (10.0 + 20.0 * k)) < 20.0;
+        overlap += in > 1 && before[PHOTON_CH * (size_t)i] > 0.0;
+    }
+    assert_true(overlap > 20);
+    assert_int_equal(photon_lamp_request(ps, 0), 1); /* hits: LRU 2 1 0 becomes 1 0 2 */
+    assert_int_equal(photon_lamp_request(ps, 1), 1);
+    assert_int_equal(photon_lamp_lru(ps, order, 8), 3);
+    assert_int_equal(order[0], 1);
+    assert_int_equal(order[1], 0);
+    assert_int_equal(order[2], 2);
+    night_grid(ps, after, N);
+    assert_memory_equal(before, after, sizeof before);
+    assert_int_equal(photon_lamp_request(ps, 3), 0); /* a miss: lamp 2 evicted, 3 pushed */
+    night_grid(ps, after, N);
+    assert_memory_not_equal(before, after, sizeof before);
+    fx_close(&f);
+}
+
 /* Push-pull: a lamp's ground indirect is the same whether it comes from the
  * progressive aerial chart (never refined), from its cached floor map, or
  * from the improved map after eviction; eviction and recomputation leave
@@ -1940,6 +1996,7 @@ int main(void)
         cmocka_unit_test(test_two_colour_street),
         cmocka_unit_test(test_covered_canopy),
         cmocka_unit_test(test_lamp_lru),
+        cmocka_unit_test(test_lamp_hits_keep_bits),
         cmocka_unit_test(test_lamp_push_pull),
         cmocka_unit_test(test_levels_moving_viewer),
         cmocka_unit_test(test_hist_match),
