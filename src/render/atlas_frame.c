@@ -200,6 +200,47 @@ static void want(atlas *A, uint32_t it, uint32_t *list, uint32_t cap, uint32_t *
     list[(*n)++] = it;
 }
 
+/* Ground block item cur's corner (x, y) from the tiles' corner, and the
+ * inverse of its steps' length. */
+static void block_frame(const atlas *A, uint32_t cur, double *bx0, double *by0, double *inv)
+{
+    uint32_t tile = cur / (ATLAS_TB * ATLAS_TB), b = cur % (ATLAS_TB * ATLAS_TB);
+    double step = A->gfine[tile] ? A->fine : A->coarse;
+    *inv = 1.0 / step;
+    *bx0 = (tile % A->gx) * A->tile + (b % ATLAS_TB) * ATLAS_BLOCK * step;
+    *by0 = (tile / A->gx) * A->tile + (b / ATLAS_TB) * ATLAS_BLOCK * step;
+}
+
+/* The last ground block found along a row (atlas_frame_missing): its
+ * corner, inverse step, and the open range of steps (lo, hi) taken as
+ * inside it (empty: none). A point farther than ATLAS_EDGE steps inside a
+ * block is in no other block (blocks meet only at their edges), so
+ * ground_block's answer there is that block whatever run ground_run reads
+ * it in: the same list, in the same order, as ground_block at every pixel. */
+#define ATLAS_EDGE 1e-6
+typedef struct block_memo {
+    double bx0, by0, inv, lo, hi;
+} block_memo;
+
+static void missing_ground(atlas *A, const ground_row *g, int32_t i, block_memo *bm, uint32_t *list, uint32_t cap,
+                           uint32_t *n)
+{
+    double x = g->x0 + i * g->dx, y = g->y0 + i * g->dy, u = (x - bm->bx0) * bm->inv, v = (y - bm->by0) * bm->inv;
+    uint32_t b;
+    if (u > bm->lo && u < bm->hi && v > bm->lo && v < bm->hi)
+        return;
+    b = ground_block(A, x, y, &u, &v);
+    bm->lo = 1.0;
+    bm->hi = -1.0;
+    if (b == UINT32_MAX)
+        return;
+    block_frame(A, b, &bm->bx0, &bm->by0, &bm->inv);
+    bm->lo = ATLAS_EDGE;
+    bm->hi = ATLAS_BLOCK - ATLAS_EDGE;
+    if (A->gfirst[b] != ATLAS_NOVERT)
+        want(A, atlas_block_item(A, 0, 0) + b, list, cap, n);
+}
+
 uint32_t atlas_frame_missing(atlas *A, const atlas_view *v, const uint32_t *ids, uint32_t *list, uint32_t cap)
 {
     uint32_t n = 0, last = MESH_SURF_NONE;
@@ -207,15 +248,13 @@ uint32_t atlas_frame_missing(atlas *A, const atlas_view *v, const uint32_t *ids,
     if (A->todo == 0)
         return 0;
     for (j = 0; j < v->h && n < cap; j++) {
+        block_memo bm = { 0.0, 0.0, 0.0, 1.0, -1.0 };
         ground_row g;
         ground_setup(A, v, j, &g);
         for (i = 0; i < v->w; i++) {
             uint32_t sid = ids[(size_t)j * v->w + i];
             if (sid == MESH_SURF_GROUND && g.on) {
-                double u, w;
-                uint32_t b = ground_block(A, g.x0 + i * g.dx, g.y0 + i * g.dy, &u, &w);
-                if (b != UINT32_MAX && A->gfirst[b] != ATLAS_NOVERT)
-                    want(A, atlas_block_item(A, 0, 0) + b, list, cap, &n);
+                missing_ground(A, &g, i, &bm, list, cap, &n);
             } else if (sid != last && sid != MESH_SURF_NONE && sid != MESH_SURF_GROUND) {
                 last = sid;
                 if (atlas_surface_chart(A, sid))
@@ -248,12 +287,8 @@ static void ground_run(const atlas *A, const ground_row *g, int32_t i0, int32_t 
             lim = -1.0;
             cv.t = NULL;
             if (cur != UINT32_MAX && A->gfirst[cur] != ATLAS_NOVERT) {
-                uint32_t tile = cur / (ATLAS_TB * ATLAS_TB), b = cur % (ATLAS_TB * ATLAS_TB);
-                double step = A->gfine[tile] ? A->fine : A->coarse;
                 t0 = A->gdone[cur] == ATLAS_DARK ? NULL : &A->tex[A->gfirst[cur]];
-                inv = 1.0 / step;
-                bx0 = (tile % A->gx) * A->tile + (b % ATLAS_TB) * ATLAS_BLOCK * step;
-                by0 = (tile / A->gx) * A->tile + (b / ATLAS_TB) * ATLAS_BLOCK * step;
+                block_frame(A, cur, &bx0, &by0, &inv);
                 lim = ATLAS_BLOCK;
             }
         }

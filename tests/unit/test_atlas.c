@@ -1809,21 +1809,95 @@ typedef struct lazy {
     atlas *A;
     atlas_worker *w;
     uint32_t list[7];
-    long rounds, listed;
+    long rounds, listed, checked;
 } lazy;
+
+/* The list atlas_frame_missing must give, from the block under every
+ * ground pixel found afresh (the frame's ground point as ground_run's row
+ * setup computes it, then the tile and block it falls in), on copies of
+ * the items' states: a per-pixel reference for its remembered block. */
+static uint32_t ref_block(const atlas *A, double x, double y)
+{
+    double fx = x * A->inv_tile, fy = y * A->inv_tile, inv, bx, by;
+    uint32_t tx, ty, tile, nb;
+    if (!(fx >= 0.0 && fx < A->gx && fy >= 0.0 && fy < A->gy))
+        return UINT32_MAX;
+    tx = (uint32_t)fx;
+    ty = (uint32_t)fy;
+    tile = ty * A->gx + tx;
+    inv = A->gfine[tile] ? A->inv_fine : A->inv_coarse;
+    x = (x - tx * A->tile) * inv;
+    y = (y - ty * A->tile) * inv;
+    bx = x < 0.0 ? 0.0 : x * (1.0 / ATLAS_BLOCK);
+    by = y < 0.0 ? 0.0 : y * (1.0 / ATLAS_BLOCK);
+    nb = A->gfine[tile] ? ATLAS_TB - 1 : 0;
+    tx = bx < nb ? (uint32_t)bx : nb;
+    ty = by < nb ? (uint32_t)by : nb;
+    return tile * ATLAS_TB * ATLAS_TB + ty * ATLAS_TB + tx;
+}
+
+static void ref_want(uint8_t *st, uint32_t it, uint32_t *list, uint32_t cap, uint32_t *n)
+{
+    if (st[it] || *n >= cap)
+        return;
+    st[it] = ATLAS_LISTED;
+    list[(*n)++] = it;
+}
+
+static uint32_t ref_missing(const atlas *A, const atlas_view *v, const uint32_t *ids, uint8_t *st, uint32_t *list,
+                            uint32_t cap)
+{
+    uint32_t n = 0, last = MESH_SURF_NONE;
+    int32_t i, j;
+    if (A->todo == 0)
+        return 0;
+    for (j = 0; j < v->h && n < cap; j++) {
+        double dz = v->D0[2] + j * v->Dy[2], t = -v->eye[2] / dz, x0, y0, dx, dy;
+        x0 = v->eye[0] - A->g0[0] + t * (v->D0[0] + j * v->Dy[0]);
+        y0 = v->eye[1] - A->g0[1] + t * (v->D0[1] + j * v->Dy[1]);
+        dx = t * v->Dx[0];
+        dy = t * v->Dx[1];
+        for (i = 0; i < v->w; i++) {
+            uint32_t sid = ids[(size_t)j * v->w + i];
+            if (sid == MESH_SURF_GROUND && dz < 0.0) {
+                uint32_t b = ref_block(A, x0 + i * dx, y0 + i * dy);
+                if (b != UINT32_MAX && A->gfirst[b] != ATLAS_NOVERT)
+                    ref_want(st, (uint32_t)A->nsurf + b, list, cap, &n);
+            } else if (sid != last && sid != MESH_SURF_NONE && sid != MESH_SURF_GROUND) {
+                last = sid;
+                if (atlas_surface_chart(A, sid))
+                    ref_want(st, sid - 2u, list, cap, &n);
+            }
+        }
+    }
+    return n;
+}
 
 static int lazy_need(void *user, const atlas_view *v, const uint32_t *ids)
 {
     lazy *z = user;
-    uint32_t n;
-    while ((n = atlas_frame_missing(z->A, v, ids, z->list, 7)) > 0) {
+    size_t nst = z->A->nsurf + (size_t)z->A->gx * z->A->gy * ATLAS_TB * ATLAS_TB;
+    uint8_t *st = malloc(nst);
+    uint32_t n, ref[7];
+    assert_non_null(st);
+    for (;;) {
         uint32_t k;
+        memcpy(st, z->A->cdone, z->A->nsurf);
+        memcpy(st + z->A->nsurf, z->A->gdone, nst - z->A->nsurf);
+        k = ref_missing(z->A, v, ids, st, ref, 7);
+        n = atlas_frame_missing(z->A, v, ids, z->list, 7);
+        assert_int_equal(n, k);
+        assert_memory_equal(z->list, ref, n * sizeof ref[0]);
+        z->checked += n;
+        if (n == 0)
+            break;
         for (k = 0; k < n; k++) /* listed once, marked listed */
             assert_int_equal(item_state(z->A, z->list[k]), ATLAS_LISTED);
         assert_int_equal(atlas_fill_items(z->A, z->w, 1, NULL, z->list, n), PLX_OK);
         z->rounds++;
         z->listed += n;
     }
+    free(st);
     return 0;
 }
 
@@ -1954,7 +2028,8 @@ static void frames_check(world *w, double fine, int nframes, rng *r)
         partial += B->todo > 0;
     }
     printf("  %s at %.2f m: %d frames, %ld pixels (sky %ld, ground %ld, buildings %ld, %ld on no chart): %ld compared, "
-           "%ld skipped at block sides; worst error %.3g of its tolerance; on demand %ld items in %ld rounds; %ld dark "
+           "%ld skipped at block sides; worst error %.3g of its tolerance; on demand %ld items in %ld rounds (each "
+           "list the per-pixel reference's); %ld dark "
            "items (%ld ground blocks); %.2f s\n",
            w->name, fine, nframes, t.px, t.sky, t.ground, t.surf, t.nochart, t.compared, t.skipped, t.worst, z.listed,
            z.rounds, dark, dark_ground, now_s() - t0);
