@@ -91,11 +91,13 @@ int cli_indirect_option(const char *cmd, int argc, char **argv, int *i, cli_indi
 void cli_indirect_note(const char *cmd, plx_engine *e);
 int cli_indirect_run(const char *cmd, plx_engine *e, const cli_indirect *ind, const double *eye,
                      const double *dir, double fov_deg);
-/* Near-viewer refinement at eye (plx_indirect_refine); when lamps were
- * newly refined, 'frames' photon frames of 'photons' refill the aerial
- * chart. Prints the error and returns an exit code. */
-int cli_refine(const char *cmd, plx_engine *e, const double eye[3], long frames, long photons,
-               plx_refine_stats *rs /* OUT */);
+/* Near-viewer refinement at eye (plx_indirect_refine) when the eye is at
+ * most height metres above the ground (munoz2013 §3.3: only low views are
+ * refined; *done 0 and nothing changed above it); when lamps were newly
+ * refined, 'frames' photon frames of 'photons' refill the aerial chart.
+ * Prints the error and returns an exit code. */
+int cli_refine(const char *cmd, plx_engine *e, const double eye[3], double height, long frames, long photons,
+               plx_refine_stats *rs /* OUT */, int *done /* OUT */);
 /* "polarlux CMD: warning: ..." on stderr unless --quiet (c may be NULL). */
 void cli_warn(const char *cmd, const cli_common *c, const char *fmt, ...);
 /* Why a result is dark: "the scene has no lamps", or that no light reaches it. */

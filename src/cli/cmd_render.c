@@ -55,6 +55,8 @@ static const char help[] =
     "  --refine         near-viewer refinement (munoz2013 §3.3-3.4): the lamps near\n"
     "                   the eye get their own floor photon maps (LRU cache, pushed\n"
     "                   into the aerial map); 16 more photon frames refill the chart\n"
+    "  --refine-height M  refine only with the eye at most M m above the ground\n"
+    "                   (default 60; munoz2013 §3.3 refines low views only)\n"
     "  --aa N           anti-aliasing: N x N samples per pixel, averaged in linear\n"
     "                   radiance (default 1: one sample at each pixel centre, SPEC §5);\n"
     "                   the later samples only where the first one's image has an edge\n"
@@ -80,6 +82,7 @@ static const char help[] =
 typedef struct render_args {
     const char *scene, *out, *pfm;
     int have_eye, have_target, aerial, osmesa, refine;
+    double refine_height;
     plx_camera cam;
     plx_render_opts opts;
     cli_common c;
@@ -142,6 +145,9 @@ static int parse_args(int argc, char **argv, render_args *a)
     cli_view_apply(&v, &a->ind, &a->opts);
     a->aerial = v.aerial;
     a->refine = v.refine;
+    a->refine_height = v.refine_height;
+    if (v.refine_height_set && !v.refine)
+        cli_warn("render", &a->c, "--refine-height has no effect without --refine");
     if (!a->scene)
         return cli_usage_error("render", "missing SCENE");
     if (!a->out)
@@ -359,10 +365,15 @@ int cmd_render(int argc, char **argv)
                               a.cam.fov_deg * a.cam.width / a.cam.height);
         if (rc == EXIT_OK && a.refine && !a.ind.off) {
             plx_refine_stats rs;
-            rc = cli_refine("render", e, a.cam.eye, 16, a.ind.photons, &rs);
-            if (rc == EXIT_OK)
+            int done;
+            rc = cli_refine("render", e, a.cam.eye, a.refine_height, 16, a.ind.photons, &rs, &done);
+            if (rc == EXIT_OK && done)
                 printf("refinement: %u lamps near the eye got floor maps (%u cached of %u slots)\n", rs.misses_now,
                        rs.cached, rs.slots);
+            else if (rc == EXIT_OK)
+                cli_warn("render", &a.c, "--refine: the eye is %g m high, above --refine-height %g m, so no lamp "
+                         "was refined (munoz2013 refines only low views; a larger --refine-height refines from "
+                         "higher up)", a.cam.eye[2], a.refine_height);
         }
         if (rc != EXIT_OK) {
             plx_engine_free(e);

@@ -46,6 +46,10 @@ static const char help[] =
     "                   frames (default 2) refill the aerial chart and the atlas is\n"
     "                   filled again as frames show it (a slower frame); hits keep\n"
     "                   it. Prints the cache's hits, misses and evictions\n"
+    "  --refine-height M  refine only the frames whose eye is at most M m above\n"
+    "                   the ground (default 60; munoz2013 §3.3 refines low views\n"
+    "                   only: from higher up a miss costs a slow frame for lamps\n"
+    "                   the view hardly shows)\n"
     "  --threads N      threads for each frame (default: the number of processors);\n"
     "                   the same bytes for any N\n"
     "  --mem SIZE, --strict, --quiet   as for 'polarlux info'\n";
@@ -53,6 +57,7 @@ static const char help[] =
 typedef struct walk_args {
     const char *scene, *path, *dir;
     int w, h, aerial, refine;
+    double refine_height;
     long refine_frames;
     long max_frames;
     double fps, speed, fov;
@@ -125,6 +130,9 @@ static int parse_args(int argc, char **argv, walk_args *a)
     cli_view_apply(&v, &a->ind, &a->opts);
     a->aerial = v.aerial;
     a->refine = v.refine;
+    a->refine_height = v.refine_height;
+    if (v.refine_height_set && !v.refine)
+        cli_warn("walk", &a->c, "--refine-height has no effect without --refine");
     if (!a->scene)
         return cli_usage_error("walk", "missing SCENE");
     if (!a->path)
@@ -237,7 +245,10 @@ static int animation(const walk_args *a, long n, char *err, size_t errlen)
     return rc;
 }
 
-typedef struct walk_run {
+typedef struct walk_run walk_run;
+static void walk_refine_print(const walk_args *a, const walk_run *wr);
+
+struct walk_run {
     long n;
     double *ms;
     uint8_t *rgb8;
@@ -245,6 +256,7 @@ typedef struct walk_run {
     FILE *cams;
     plx_refine_stats rs;
     double refine_ms;
+    long refine_high;          /* frames whose eye was above --refine-height: not refined */
     uint64_t lookups;          /* indirect lookups, all frames */
     uint64_t aa_later;         /* pixels the later anti-aliasing samples shaded, all frames */
     long aa_adaptive, aa_dense; /* frames whose anti-aliasing was adaptive, took every sample for its edges */
@@ -252,7 +264,7 @@ typedef struct walk_run {
     frame_writer fw;
     int writer;                /* 1: frames written on the writer's thread */
     long black, first_black;   /* frames entirely black: how many, the first (1-based) */
-} walk_run;
+};
 
 /* After the first frame (the engine at its peak): the frames are written
  * on a thread of their own, beside the next frame's rendering, when --mem
@@ -324,10 +336,11 @@ static int frame(const walk_args *a, plx_engine *e, const walk_path *wp, walk_ru
     cam.width = a->w;
     cam.height = a->h;
     if (a->refine && !a->ind.off) {
-        int rc;
+        int rc, done;
         t0 = port_now_ns();
-        rc = cli_refine("walk", e, cam.eye, a->refine_frames, a->ind.photons, &wr->rs);
+        rc = cli_refine("walk", e, cam.eye, a->refine_height, a->refine_frames, a->ind.photons, &wr->rs, &done);
         wr->refine_ms += (port_now_ns() - t0) / 1e6;
+        wr->refine_high += !done;
         if (rc != EXIT_OK)
             return rc;
     }
@@ -395,6 +408,25 @@ static void view_hint(const walk_args *a, const walk_path *wp)
                  "from above faster (the ground and roofs from the aerial light map)", zmin);
 }
 
+/* The refinement's line, and a word when the eye was too high for it. */
+static void walk_refine_print(const walk_args *a, const walk_run *wr)
+{
+    if (wr->refine_high == wr->n) {
+        cli_warn("walk", &a->c, "--refine: the eye was above --refine-height %g m at every frame, so no lamp was "
+                 "refined (munoz2013 refines only low views; a larger --refine-height refines from higher up)",
+                 a->refine_height);
+        return;
+    }
+    printf("refinement: %llu hits, %llu misses, %llu evictions, %llu lamps refined (%u slots, %.0f m); "
+           "%.1f ms in all (floor maps and refill frames)", (unsigned long long)wr->rs.hits,
+           (unsigned long long)wr->rs.misses, (unsigned long long)wr->rs.evictions,
+           (unsigned long long)wr->rs.refined, wr->rs.slots, wr->rs.near_radius, wr->refine_ms);
+    if (wr->refine_high)
+        printf("; %ld of %ld frames above --refine-height %g m not refined", wr->refine_high, wr->n,
+               a->refine_height);
+    printf("\n");
+}
+
 static int run(const walk_args *a, plx_engine *e, const walk_path *wp)
 {
     walk_run wr;
@@ -447,10 +479,7 @@ static int run(const walk_args *a, plx_engine *e, const walk_path *wp)
                    (double)wr.lookups / wr.n, (double)a->w * a->h * (a->opts.aa > 1 ? a->opts.aa * a->opts.aa : 1));
         cli_aa_print(&a->opts, wr.aa_later, (double)a->w * a->h * wr.n, wr.n, wr.aa_adaptive, wr.aa_dense);
         if (a->refine && !a->ind.off)
-            printf("refinement: %llu hits, %llu misses, %llu evictions, %llu lamps refined (%u slots, %.0f m); "
-                   "%.1f ms in all (floor maps and refill frames)\n", (unsigned long long)wr.rs.hits,
-                   (unsigned long long)wr.rs.misses, (unsigned long long)wr.rs.evictions,
-                   (unsigned long long)wr.rs.refined, wr.rs.slots, wr.rs.near_radius, wr.refine_ms);
+            walk_refine_print(a, &wr);
         if (wr.black == wr.n)
             cli_warn("walk", &a->c, "every frame is entirely black: %s", cli_dark_reason(e));
         else if (wr.black)

@@ -760,11 +760,16 @@ size_t cli_buffer_budget(const plx_engine *e, const cli_common *c)
     return m.peak_total < mem ? mem - m.peak_total : 0;
 }
 
-int cli_refine(const char *cmd, plx_engine *e, const double eye[3], long frames, long photons,
-               plx_refine_stats *rs)
+int cli_refine(const char *cmd, plx_engine *e, const double eye[3], double height, long frames, long photons,
+               plx_refine_stats *rs, int *done)
 {
-    plx_status st = plx_indirect_refine(e, eye, rs);
+    plx_status st;
     long k;
+    *done = 0;
+    if (eye[2] > height)
+        return EXIT_OK;
+    *done = 1;
+    st = plx_indirect_refine(e, eye, rs);
     if (st != PLX_OK) {
         fprintf(stderr, "polarlux %s: %s\n", cmd, plx_last_error(e));
         return cli_exit_code(st);

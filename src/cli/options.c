@@ -144,6 +144,15 @@ static int parse_view(const char *v, void *dst)
     return 0;
 }
 
+static int parse_refine_height(const char *v, void *dst)
+{
+    cli_view *cv = dst;
+    if (cli_parse_real(v, 0.0, 1e6, &cv->refine_height) != 0)
+        return -1;
+    cv->refine_height_set = 1;
+    return 0;
+}
+
 static void view_opts(cli_view *v)
 {
     const cli_opt f[CLI_VIEW_NOPTS] = {
@@ -155,6 +164,8 @@ static void view_opts(cli_view *v)
         CLI_OPT_FLAG("--aa-full", &v->aa_full),
         CLI_OPT_FLAG("--no-glow", &v->no_glow),
         CLI_OPT_FLAG("--refine", &v->refine),
+        CLI_OPT_VAL("--refine-height", v, parse_refine_height,
+                    "--refine-height '%s' is not a number of metres from 0 to 1e6"),
         CLI_OPT_FLAG("--per-pixel", &v->per_pixel),
         CLI_OPT_END
     };
@@ -172,6 +183,7 @@ void cli_view_init(cli_view *v, long w, long h, double fov, plx_render_opts *o, 
     v->fov = fov;
     v->aa = o->aa;
     v->no_glow = o->no_glow;
+    v->refine_height = CLI_REFINE_HEIGHT;
     view_opts(v);
 }
 

@@ -70,7 +70,10 @@ int cli_opt_size(const char *value, void *dst);
 
 /* ---- the view options of render and walk ---------------------------------- */
 
-#define CLI_VIEW_NOPTS 9
+#define CLI_VIEW_NOPTS 10
+/* --refine-height's default, m: munoz2013 §3.3 refines only when the
+ * camera is below a height; the near radius of the refinement. */
+#define CLI_REFINE_HEIGHT 60.0
 
 typedef struct cli_view {
     long size[2];           /* --size WxH (1..8192 each) */
@@ -78,6 +81,8 @@ typedef struct cli_view {
     long aa;                /* --aa (1..PLX_RENDER_MAX_AA) */
     int aerial;             /* --view street|aerial */
     int no_glow, refine;    /* --no-glow, --refine */
+    double refine_height;   /* --refine-height: refine only with the eye at most this high, m */
+    int refine_height_set;  /* --refine-height was given */
     int aa_full;            /* --aa-full */
     int per_pixel;          /* --per-pixel: light computed at every pixel, not read from the atlas */
     int exposure;           /* --exposure was given (the command's own table

@@ -217,6 +217,19 @@ expect walk-bare-targets 0 "^1 266 200 400 266 267 0 " -- cat "$tmp/wmix/cameras
 printf '{"type":"LineString","coordinates":[[266,200,400],[266,201,400]],"properties":{"targets":[[266,267,0],[266,267,0]]}}' >"$tmp/high2.geojson"
 expect walk-aa-dense 0 "^anti-aliasing 2x2: the later samples shaded 100\.0% of the pixels \(every sample: edges at more than half the pixels of every frame; --aa 1 is faster\)" -- \
     "$bin" walk -q "$tmp/e.plxb" --path "$tmp/high2.geojson" --size 160x120 --speed 1 --fps 1 -o "$tmp/wdense"
+expect walk-refine-high 0 "^polarlux walk: warning: --refine: the eye was above --refine-height 60 m at every frame, so no lamp was refined" -- \
+    "$bin" walk "$tmp/e.plxb" --path "$tmp/high2.geojson" --size 32x24 --speed 1 --fps 1 --aa 1 --refine -o "$tmp/wrh"
+printf '{"type":"LineString","coordinates":[[266,200,100],[266,260,2]],"properties":{"targets":[[266,267,0],[266,300,2]]}}' >"$tmp/desc.geojson"
+expect walk-refine-mixed 0 "^refinement: 0 hits, [1-9][0-9]* misses, .*; 2 of 3 frames above --refine-height 60 m not refined$" -- \
+    "$bin" walk "$tmp/e.plxb" --path "$tmp/desc.geojson" --size 32x24 --speed 40 --fps 1 --aa 1 --refine -o "$tmp/wrm"
+expect walk-refine-height-all 0 "^refinement: [1-9][0-9]* hits, [1-9][0-9]* misses, [0-9]+ evictions, [0-9]+ lamps refined \([0-9]+ slots, 60 m\); [0-9.]+ ms in all \(floor maps and refill frames\)$" -- \
+    "$bin" walk "$tmp/e.plxb" --path "$tmp/desc.geojson" --size 32x24 --speed 40 --fps 1 --aa 1 --refine --refine-height 100 -o "$tmp/wra"
+expect render-refine-high 0 "^polarlux render: warning: --refine: the eye is 400 m high, above --refine-height 60 m, so no lamp was refined" -- \
+    "$bin" render "$tmp/e.plxb" --eye 266,200,400 --target 266,267,0 --size 32x24 --refine -o "$tmp/rrh.png"
+expect render-refine-height-alone 0 "^polarlux render: warning: --refine-height has no effect without --refine" -- \
+    "$bin" render "$tmp/e.plxb" --size 32x24 --refine-height 5 -o "$tmp/rrh2.png"
+expect render-refine-height-bad 2 "--refine-height '-3' is not a number of metres from 0 to 1e6" -- \
+    "$bin" render "$tmp/e.plxb" --size 32x24 --refine --refine-height -3 -o "$tmp/rrh3.png"
 expect render-aa-full-alone 0 "^polarlux render: warning: --aa-full has no effect without --aa 2 or more" -- \
     "$bin" render "$tmp/e.plxb" --size 32x24 --aa-full -o "$tmp/aa1f.png"
 if /usr/bin/python3 tests/cli/png_same.py --within 2 "$tmp/aa2.png" "$tmp/aa2f.png" >/dev/null; then echo "ok   render-aa-adaptive-near-full"; pass=$((pass + 1)); else echo "FAIL render-aa-adaptive-near-full"; fail=$((fail + 1)); fi
