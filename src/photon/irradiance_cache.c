@@ -105,8 +105,9 @@ void icache_clear(icache *c)
     c->fixed = 0.0;
 }
 
-/* What the records were gathered from: any new photon frame, reset or
- * refined lamp changes these sums and counts. */
+/* What the records were gathered from: any new photon frame, reset,
+ * refined lamp or floor map computed again (a miss: an evicted lamp's
+ * map back in the cache) changes these sums and counts. */
 static uint64_t photon_stamp(const photon_sys *ps)
 {
     const photon_stats *st = &ps->st;
@@ -117,6 +118,7 @@ static uint64_t photon_stamp(const photon_sys *ps)
     h = mix64(h ^ bits_of_double(st->stored_chart));
     h = mix64(h ^ bits_of_double(st->stored_aerial));
     h = mix64(h ^ st->lamp_refined);
+    h = mix64(h ^ st->lamp_misses);
     h = mix64(h ^ st->aerial_restarts);
     return mix64(h ^ bits_of_double(ps->flux_total));
 }

@@ -141,7 +141,10 @@ static void test_lru_along_path(void **state)
  * indirect light and empties it. Either way a frame equals, byte for byte,
  * the same camera on a fresh engine given the same refinements with no
  * frame between them (its atlas filled for that frame alone). A narrow
- * view fills charts and blocks that the wide one's pixel centres miss. */
+ * view fills charts and blocks that the wide one's pixel centres miss.
+ * The order of the floor maps' sum is guarded in test_photon
+ * (test_lamp_hits_keep_bits): the atlas's 9-bit values hide its last
+ * bits, so these frames are the same under either order. */
 #define RW 160
 #define RH 120
 
@@ -227,11 +230,79 @@ static void test_hits_keep_atlas(void **state)
     fixture_done(e, m1);
 }
 
+/* A miss that computes an evicted lamp's floor map again (no new lamp
+ * refined, no progressive chart restarted) changes the light near it:
+ * frames that shade every pixel through the irradiance cache must see
+ * it. Along y = 266 the cache evicts the lamps of the walk's start; back
+ * at the start they miss again, and a per-pixel frame there equals the
+ * same camera on a fresh engine given the same refinements. */
+static void street_frame(plx_engine *e, float *rgbf)
+{
+    plx_camera cam;
+    plx_render_opts o;
+    memset(&cam, 0, sizeof cam);
+    cam.width = 80;
+    cam.height = 60;
+    cam.fov_deg = 60;
+    cam.eye[0] = 200.0; cam.eye[1] = 266.0; cam.eye[2] = 1.7;
+    cam.target[0] = 240.0; cam.target[1] = 270.0; cam.target[2] = 3.0;
+    plx_render_opts_default(&o);
+    o.per_pixel = 1;
+    assert_int_equal(plx_render(e, &cam, &o, NULL, rgbf, NULL), PLX_OK);
+}
+
+static void refine_along(plx_engine *e, plx_refine_stats *rs)
+{
+    double eye[3] = { 0.0, 266.0, 1.7 };
+    int k;
+    for (k = 0; k <= 18; k++) {
+        eye[0] = 200.0 + 20.0 * k;
+        assert_int_equal(plx_indirect_refine(e, eye, rs), PLX_OK);
+    }
+}
+
+static void test_recompute_refreshes_cache(void **state)
+{
+    double A[3] = { 200.0, 266.0, 1.7 };
+    size_t n = 80 * 60 * 3;
+    float *before = malloc(n * sizeof(float)), *after = malloc(n * sizeof(float)), *fresh = malloc(n * sizeof(float));
+    void *m1, *m2;
+    plx_engine *e = walk_engine(&m1), *f;
+    plx_refine_stats rs;
+    uint64_t refined, evictions;
+    (void)state;
+    assert_int_equal(plx_indirect_refine(e, A, &rs), PLX_OK);
+    refine_along(e, &rs);
+    street_frame(e, before);
+    refined = rs.refined;
+    evictions = rs.evictions;
+    assert_true(evictions > 0);
+    assert_int_equal(plx_indirect_refine(e, A, &rs), PLX_OK);
+    assert_true(rs.misses_now > 0);
+    assert_int_equal(rs.refined, refined); /* computed again, none new */
+    street_frame(e, after);
+    f = walk_engine(&m2);
+    assert_int_equal(plx_indirect_refine(f, A, &rs), PLX_OK);
+    refine_along(f, &rs);
+    assert_int_equal(plx_indirect_refine(f, A, &rs), PLX_OK);
+    street_frame(f, fresh);
+    assert_memory_equal(after, fresh, n * sizeof(float));
+    assert_memory_not_equal(before, after, n * sizeof(float));
+    printf("back at the start: %u floor maps computed again (%llu evictions before), the per-pixel frame as a "
+           "fresh engine's\n", rs.misses_now, (unsigned long long)evictions);
+    free(before);
+    free(after);
+    free(fresh);
+    fixture_done(f, m2);
+    fixture_done(e, m1);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_lru_along_path),
         cmocka_unit_test(test_hits_keep_atlas),
+        cmocka_unit_test(test_recompute_refreshes_cache),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
