@@ -94,10 +94,12 @@ int cli_indirect_run(const char *cmd, plx_engine *e, const cli_indirect *ind, co
 /* Near-viewer refinement at eye (plx_indirect_refine) when the eye is at
  * most height metres above the ground (munoz2013 §3.3: only low views are
  * refined; *done 0 and nothing changed above it); when lamps were newly
- * refined, 'frames' photon frames of 'photons' refill the aerial chart.
+ * refined (rs->refined grew: rs holds the last call's counters, zeroed
+ * before the first), 'frames' photon frames of 'photons' refill the aerial
+ * chart, added to *refills.
  * Prints the error and returns an exit code. */
 int cli_refine(const char *cmd, plx_engine *e, const double eye[3], double height, long frames, long photons,
-               plx_refine_stats *rs /* OUT */, int *done /* OUT */);
+               plx_refine_stats *rs /* OUT */, int *done /* OUT */, long *refills /* OUT, adds */);
 /* "polarlux CMD: warning: ..." on stderr unless --quiet (c may be NULL). */
 void cli_warn(const char *cmd, const cli_common *c, const char *fmt, ...);
 /* Why a result is dark: "the scene has no lamps", or that no light reaches it. */

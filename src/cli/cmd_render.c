@@ -148,6 +148,8 @@ static int parse_args(int argc, char **argv, render_args *a)
     a->refine_height = v.refine_height;
     if (v.refine_height_set && !v.refine)
         cli_warn("render", &a->c, "--refine-height has no effect without --refine");
+    if (v.refine && a->ind.off)
+        cli_warn("render", &a->c, "--refine has no effect with --no-indirect (it refines the indirect light)");
     if (!a->scene)
         return cli_usage_error("render", "missing SCENE");
     if (!a->out)
@@ -366,7 +368,9 @@ int cmd_render(int argc, char **argv)
         if (rc == EXIT_OK && a.refine && !a.ind.off) {
             plx_refine_stats rs;
             int done;
-            rc = cli_refine("render", e, a.cam.eye, a.refine_height, 16, a.ind.photons, &rs, &done);
+            long refills = 0;
+            memset(&rs, 0, sizeof rs);
+            rc = cli_refine("render", e, a.cam.eye, a.refine_height, 16, a.ind.photons, &rs, &done, &refills);
             if (rc == EXIT_OK && done)
                 printf("refinement: %u lamps near the eye got floor maps (%u cached of %u slots)\n", rs.misses_now,
                        rs.cached, rs.slots);

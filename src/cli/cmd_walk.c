@@ -42,10 +42,11 @@ static const char help[] =
     "  --max-frames N   at most N frames (default 1000)\n"
     "  --refine         near-viewer refinement (munoz2013 §3.3-3.4): before each frame\n"
     "                   the lamps near the eye get floor photon maps in an LRU cache.\n"
-    "                   A miss changes the indirect light: --refine-frames K photon\n"
-    "                   frames (default 2) refill the aerial chart and the atlas is\n"
-    "                   filled again as frames show it (a slower frame); hits keep\n"
-    "                   it. Prints the cache's hits, misses and evictions\n"
+    "                   A miss changes the indirect light: the atlas is filled again\n"
+    "                   as frames show it (a slower frame); hits keep it. A lamp\n"
+    "                   refined for the first time restarts the aerial chart, and\n"
+    "                   --refine-frames K photon frames (default 2) refill it.\n"
+    "                   Prints the cache's hits, misses and evictions\n"
     "  --refine-height M  refine only the frames whose eye is at most M m above\n"
     "                   the ground (default 60; munoz2013 §3.3 refines low views\n"
     "                   only: from higher up a miss costs a slow frame for lamps\n"
@@ -133,6 +134,8 @@ static int parse_args(int argc, char **argv, walk_args *a)
     a->refine_height = v.refine_height;
     if (v.refine_height_set && !v.refine)
         cli_warn("walk", &a->c, "--refine-height has no effect without --refine");
+    if (v.refine && a->ind.off)
+        cli_warn("walk", &a->c, "--refine has no effect with --no-indirect (it refines the indirect light)");
     if (!a->scene)
         return cli_usage_error("walk", "missing SCENE");
     if (!a->path)
@@ -257,6 +260,7 @@ struct walk_run {
     plx_refine_stats rs;
     double refine_ms;
     long refine_high;          /* frames whose eye was above --refine-height: not refined */
+    long refills;              /* photon frames traced after lamps newly refined */
     uint64_t lookups;          /* indirect lookups, all frames */
     uint64_t aa_later;         /* pixels the later anti-aliasing samples shaded, all frames */
     long aa_adaptive, aa_dense; /* frames whose anti-aliasing was adaptive, took every sample for its edges */
@@ -338,7 +342,8 @@ static int frame(const walk_args *a, plx_engine *e, const walk_path *wp, walk_ru
     if (a->refine && !a->ind.off) {
         int rc, done;
         t0 = port_now_ns();
-        rc = cli_refine("walk", e, cam.eye, a->refine_height, a->refine_frames, a->ind.photons, &wr->rs, &done);
+        rc = cli_refine("walk", e, cam.eye, a->refine_height, a->refine_frames, a->ind.photons, &wr->rs, &done,
+                        &wr->refills);
         wr->refine_ms += (port_now_ns() - t0) / 1e6;
         wr->refine_high += !done;
         if (rc != EXIT_OK)
@@ -418,9 +423,9 @@ static void walk_refine_print(const walk_args *a, const walk_run *wr)
         return;
     }
     printf("refinement: %llu hits, %llu misses, %llu evictions, %llu lamps refined (%u slots, %.0f m); "
-           "%.1f ms in all (floor maps and refill frames)", (unsigned long long)wr->rs.hits,
+           "%ld refill photon frames; %.1f ms in all (floor maps and refill frames)", (unsigned long long)wr->rs.hits,
            (unsigned long long)wr->rs.misses, (unsigned long long)wr->rs.evictions,
-           (unsigned long long)wr->rs.refined, wr->rs.slots, wr->rs.near_radius, wr->refine_ms);
+           (unsigned long long)wr->rs.refined, wr->rs.slots, wr->rs.near_radius, wr->refills, wr->refine_ms);
     if (wr->refine_high)
         printf("; %ld of %ld frames above --refine-height %g m not refined", wr->refine_high, wr->n,
                a->refine_height);

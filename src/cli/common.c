@@ -761,9 +761,10 @@ size_t cli_buffer_budget(const plx_engine *e, const cli_common *c)
 }
 
 int cli_refine(const char *cmd, plx_engine *e, const double eye[3], double height, long frames, long photons,
-               plx_refine_stats *rs, int *done)
+               plx_refine_stats *rs, int *done, long *refills)
 {
     plx_status st;
+    uint64_t before = rs->refined;
     long k;
     *done = 0;
     if (eye[2] > height)
@@ -774,13 +775,15 @@ int cli_refine(const char *cmd, plx_engine *e, const double eye[3], double heigh
         fprintf(stderr, "polarlux %s: %s\n", cmd, plx_last_error(e));
         return cli_exit_code(st);
     }
-    /* a newly refined lamp restarts the progressive aerial chart: refill it */
-    for (k = 0; rs->misses_now > 0 && k < frames; k++) {
+    /* a newly refined lamp restarts the progressive aerial chart: refill it
+     * (an evicted lamp's map computed again restarts nothing) */
+    for (k = 0; rs->refined > before && k < frames; k++) {
         st = plx_indirect_step(e, (uint32_t)photons, plx_indirect_frames(e) + 1);
         if (st != PLX_OK) {
             fprintf(stderr, "polarlux %s: %s\n", cmd, plx_last_error(e));
             return cli_exit_code(st);
         }
+        (*refills)++;
     }
     return EXIT_OK;
 }

@@ -222,12 +222,19 @@ expect walk-refine-high 0 "^polarlux walk: warning: --refine: the eye was above 
 printf '{"type":"LineString","coordinates":[[266,200,100],[266,260,2]],"properties":{"targets":[[266,267,0],[266,300,2]]}}' >"$tmp/desc.geojson"
 expect walk-refine-mixed 0 "^refinement: 0 hits, [1-9][0-9]* misses, .*; 2 of 3 frames above --refine-height 60 m not refined$" -- \
     "$bin" walk "$tmp/e.plxb" --path "$tmp/desc.geojson" --size 32x24 --speed 40 --fps 1 --aa 1 --refine -o "$tmp/wrm"
-expect walk-refine-height-all 0 "^refinement: [1-9][0-9]* hits, [1-9][0-9]* misses, [0-9]+ evictions, [0-9]+ lamps refined \([0-9]+ slots, 60 m\); [0-9.]+ ms in all \(floor maps and refill frames\)$" -- \
+expect walk-refine-height-all 0 "^refinement: [1-9][0-9]* hits, [1-9][0-9]* misses, [0-9]+ evictions, [0-9]+ lamps refined \([0-9]+ slots, 60 m\); [0-9]+ refill photon frames; [0-9.]+ ms in all \(floor maps and refill frames\)$" -- \
     "$bin" walk "$tmp/e.plxb" --path "$tmp/desc.geojson" --size 32x24 --speed 40 --fps 1 --aa 1 --refine --refine-height 100 -o "$tmp/wra"
+# out and back: the lamps of the start, evicted on the way, come back computed again but not new, so
+# only the first two frames (new lamps) trace refill photon frames (2 each)
+printf '{"type":"LineString","coordinates":[[100,266,1.7],[400,266,1.7],[100,266,1.7]],"properties":{"targets":[[110,266,1.7],[410,266,1.7],[110,266,1.7]]}}' >"$tmp/aba.geojson"
+expect walk-refine-recompute 0 "^refinement: 0 hits, [0-9]+ misses, [1-9][0-9]* evictions, .*; 4 refill photon frames;" -- \
+    "$bin" walk "$tmp/e.plxb" --path "$tmp/aba.geojson" --size 32x24 --speed 300 --fps 1 --aa 1 --refine -o "$tmp/waba"
 expect render-refine-high 0 "^polarlux render: warning: --refine: the eye is 400 m high, above --refine-height 60 m, so no lamp was refined" -- \
     "$bin" render "$tmp/e.plxb" --eye 266,200,400 --target 266,267,0 --size 32x24 --refine -o "$tmp/rrh.png"
 expect render-refine-height-alone 0 "^polarlux render: warning: --refine-height has no effect without --refine" -- \
     "$bin" render "$tmp/e.plxb" --size 32x24 --refine-height 5 -o "$tmp/rrh2.png"
+expect render-refine-no-indirect 0 "^polarlux render: warning: --refine has no effect with --no-indirect" -- \
+    "$bin" render "$tmp/e.plxb" --size 32x24 --refine --no-indirect -o "$tmp/rrn.png"
 expect render-refine-height-bad 2 "--refine-height '-3' is not a number of metres from 0 to 1e6" -- \
     "$bin" render "$tmp/e.plxb" --size 32x24 --refine --refine-height -3 -o "$tmp/rrh3.png"
 expect render-aa-full-alone 0 "^polarlux render: warning: --aa-full has no effect without --aa 2 or more" -- \
