@@ -2062,6 +2062,110 @@ static void test_frames(void **state)
     world_close(&w);
 }
 
+/* atlas_frame_missing at block edges: rows of two ground points, the
+ * first well inside one block and the second d steps across its edge
+ * into the next (d from 1e-9 to 0.3 steps, on either side, along x and
+ * along y, at an edge inside a fine tile and at the side of a coarse
+ * tile), each against ref_missing: a point just across the edge must
+ * list the next block however close it lies. */
+static void edge_row(atlas *A, double x0, double y0, double sx, double sy, uint8_t *st, size_t nst, long *rows)
+{
+    atlas_view v;
+    uint32_t ids[2] = { MESH_SURF_GROUND, MESH_SURF_GROUND }, list[8], ref[8], n, k;
+    memset(&v, 0, sizeof v);
+    v.w = 2;
+    v.h = 1;
+    v.eye[2] = 1.0;                      /* t = 1: a point is eye + D0 + i Dx */
+    v.D0[0] = A->g0[0] + x0;
+    v.D0[1] = A->g0[1] + y0;
+    v.D0[2] = -1.0;
+    v.Dx[0] = sx;
+    v.Dx[1] = sy;
+    memcpy(st, A->cdone, A->nsurf);
+    memcpy(st + A->nsurf, A->gdone, nst - A->nsurf);
+    k = ref_missing(A, &v, ids, st, ref, 8);
+    n = atlas_frame_missing(A, &v, ids, list, 8);
+    assert_int_equal(n, k);
+    assert_int_equal(n, 2);              /* two blocks, both unfilled */
+    assert_memory_equal(list, ref, n * sizeof ref[0]);
+    for (k = 0; k < n; k++)              /* unlisted again for the next row */
+        A->gdone[list[k] - A->nsurf] = ATLAS_UNFILLED;
+    (*rows)++;
+}
+
+/* The rows of test_missing_edges over world w's atlas at spacing fine;
+ * seen[0], seen[1]: a fine, a coarse tile was found and crossed. */
+static void edges_in(world *w, double fine, int seen[2], long *rows)
+{
+    const double d[] = { 1e-9, 1e-7, 1e-6, 2e-6, 1e-5, 1e-4, 1e-3, 1e-2, 0.3 };
+    arena_mark mk = arena_get_mark(&w->e->mem);
+    atlas *A = make_atlas(w, fine);
+    size_t nst = A->nsurf + (size_t)A->gx * A->gy * ATLAS_TB * ATLAS_TB, q;
+    uint8_t *st = malloc(nst);
+    uint32_t t, tf = UINT32_MAX, tc = UINT32_MAX;
+    int kind, axis, side;
+    assert_non_null(st);
+    /* a fine tile whose blocks (0, 0), (1, 0) and (0, 1) have vertices, and a
+     * coarse tile whose neighbours along x and y are coarse, all with vertices */
+    for (t = 0; t < A->gx * A->gy; t++) {
+        const uint32_t *g = &A->gfirst[(size_t)t * ATLAS_TB * ATLAS_TB];
+        uint32_t tx = t % A->gx, ty = t / A->gx;
+        if (tx + 1 >= A->gx || ty + 1 >= A->gy)
+            continue;
+        if (A->gfine[t] && tf == UINT32_MAX && g[0] != ATLAS_NOVERT && g[1] != ATLAS_NOVERT &&
+            g[ATLAS_TB] != ATLAS_NOVERT)
+            tf = t;
+        if (!A->gfine[t] && !A->gfine[t + 1] && !A->gfine[t + A->gx] && tc == UINT32_MAX && g[0] != ATLAS_NOVERT &&
+            A->gfirst[(size_t)(t + 1) * ATLAS_TB * ATLAS_TB] != ATLAS_NOVERT &&
+            A->gfirst[(size_t)(t + A->gx) * ATLAS_TB * ATLAS_TB] != ATLAS_NOVERT)
+            tc = t;
+    }
+    for (q = 0; q < nst - A->nsurf; q++)
+        assert_int_equal(A->gdone[q], ATLAS_UNFILLED);
+    for (kind = 0; kind < 2; kind++) {
+        uint32_t tile = kind ? tc : tf;
+        double step = kind ? A->coarse : A->fine, e, ox, oy, mid;
+        size_t k;
+        if (tile == UINT32_MAX)
+            continue;
+        seen[kind] = 1;
+        /* the edge: between the tile's first two blocks (fine), or the tile's far side (coarse) */
+        e = kind ? A->tile : ATLAS_BLOCK * A->fine;
+        ox = (tile % A->gx) * A->tile;
+        oy = (tile / A->gx) * A->tile;
+        mid = 0.5 * ATLAS_BLOCK * step;
+        for (axis = 0; axis < 2; axis++)
+            for (side = 0; side < 2; side++)
+                for (k = 0; k < sizeof d / sizeof d[0]; k++) {
+                    /* from 2 steps before the edge to d steps after it, or back from 2 steps after it */
+                    double a = side ? e + 2.0 * step : e - 2.0 * step;
+                    double b = side ? e - d[k] * step : e + d[k] * step;
+                    if (axis == 0)
+                        edge_row(A, ox + a, oy + mid, b - a, 0.0, st, nst, rows);
+                    else
+                        edge_row(A, ox + mid, oy + a, 0.0, b - a, st, nst, rows);
+                }
+    }
+    free(st);
+    arena_release(&w->e->mem, &mk);
+}
+
+static void test_missing_edges(void **state)
+{
+    world w;
+    int seen[2] = { 0, 0 };
+    long rows = 0;
+    (void)state;
+    world_open(&w, "eixample", EIXAMPLE, NULL);
+    edges_in(&w, 1.3, seen, &rows);
+    world_close(&w);
+    world_open(&w, "helsinki", HELSINKI, NULL);
+    edges_in(&w, 2.0, seen, &rows);
+    world_close(&w);
+    printf("  %ld rows across block edges, in fine and coarse tiles: the lists of the per-pixel reference\n", rows);
+    assert_true(seen[0] && seen[1]);
+}
+
 /* atlas_sample (the public read) against the bilinear in double. */
 static void test_sample(void **state)
 {
@@ -2852,7 +2956,8 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_texel_codec),     cmocka_unit_test(test_layout),
         cmocka_unit_test(test_create_errors),   cmocka_unit_test(test_values),
-        cmocka_unit_test(test_frames),          cmocka_unit_test(test_sample),
+        cmocka_unit_test(test_frames),          cmocka_unit_test(test_missing_edges),
+        cmocka_unit_test(test_sample),
         cmocka_unit_test(test_determinism),     cmocka_unit_test(test_frame_faults),
         cmocka_unit_test(test_eye_inside),      cmocka_unit_test(test_indirect_accuracy),     cmocka_unit_test(test_spacing),
         cmocka_unit_test(test_bug_stacked_neighbours), cmocka_unit_test(test_bug_ground_site_in_solid),
