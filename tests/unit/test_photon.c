@@ -1604,6 +1604,21 @@ static void lamp_row(fixture *f, int nl)
     fx_finish(f);
 }
 
+/* The photon buffers of a row of 6 lamps 20 m apart (lamp_row) with a
+ * cache of 3 floor maps of 16 x 16 texels, photons photons a lamp. */
+static photon_sys *lamp_cache(fixture *f, photon_config *c, uint32_t photons)
+{
+    photon_sys *ps = NULL;
+    lamp_row(f, 6);
+    photon_config_default(c);
+    c->aerial_res = 128;
+    c->lamp_slots = 3;
+    c->lamp_res = 16;
+    c->lamp_photons = photons;
+    assert_int_equal(photon_create(&f->a, &f->s, c, &ps), PLX_OK);
+    return ps;
+}
+
 static void test_lamp_lru(void **state)
 {
     fixture f;
@@ -1611,13 +1626,7 @@ static void test_lamp_lru(void **state)
     photon_config c;
     uint32_t order[8], n;
     (void)state;
-    lamp_row(&f, 6);
-    photon_config_default(&c);
-    c.aerial_res = 128;
-    c.lamp_slots = 3;
-    c.lamp_res = 16;
-    c.lamp_photons = 500;
-    assert_int_equal(photon_create(&f.a, &f.s, &c, &ps), PLX_OK);
+    ps = lamp_cache(&f, &c, 500);
     assert_int_equal(ps->nslots, 3);
     assert_int_equal(photon_lamp_request(ps, 0), 0);
     assert_int_equal(photon_lamp_request(ps, 1), 0);
@@ -1687,13 +1696,7 @@ static void test_lamp_hits_keep_bits(void **state)
     static double before[N * PHOTON_CH], after[N * PHOTON_CH];
     int i, overlap = 0;
     (void)state;
-    lamp_row(&f, 6);
-    photon_config_default(&c);
-    c.aerial_res = 128;
-    c.lamp_slots = 3;
-    c.lamp_res = 16;
-    c.lamp_photons = 2000;
-    assert_int_equal(photon_create(&f.a, &f.s, &c, &ps), PLX_OK);
+    ps = lamp_cache(&f, &c, 2000);
     photon_step(ps, 5000, 1);
     assert_int_equal(photon_lamp_request(ps, 0), 0);
     assert_int_equal(photon_lamp_request(ps, 1), 0);
