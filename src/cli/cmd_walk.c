@@ -248,10 +248,7 @@ static int animation(const walk_args *a, long n, char *err, size_t errlen)
     return rc;
 }
 
-typedef struct walk_run walk_run;
-static void walk_refine_print(const walk_args *a, const walk_run *wr);
-
-struct walk_run {
+typedef struct walk_run {
     long n;
     double *ms;
     uint8_t *rgb8;
@@ -268,7 +265,7 @@ struct walk_run {
     frame_writer fw;
     int writer;                /* 1: frames written on the writer's thread */
     long black, first_black;   /* frames entirely black: how many, the first (1-based) */
-};
+} walk_run;
 
 /* After the first frame (the engine at its peak): the frames are written
  * on a thread of their own, beside the next frame's rendering, when --mem
