@@ -91,15 +91,26 @@ int cli_indirect_option(const char *cmd, int argc, char **argv, int *i, cli_indi
 void cli_indirect_note(const char *cmd, plx_engine *e);
 int cli_indirect_run(const char *cmd, plx_engine *e, const cli_indirect *ind, const double *eye,
                      const double *dir, double fov_deg);
+/* A command's near-viewer refinement (cli_refine): its settings and
+ * what its calls did. */
+typedef struct cli_refiner {
+    double height;          /* refine only with the eye at most this high above the ground, m */
+    long frames, photons;   /* refill photon frames after a newly refined lamp, and their photons */
+    plx_refine_stats rs;    /* the last refinement's counters */
+    long refills;           /* refill photon frames traced, all calls */
+    long high;              /* calls with the eye above height: nothing refined */
+} cli_refiner;
+
+/* The settings, and no call yet. */
+void cli_refiner_init(cli_refiner *r, double height, long frames, long photons);
+
 /* Near-viewer refinement at eye (plx_indirect_refine) when the eye is at
- * most height metres above the ground (munoz2013 §3.3: only low views are
- * refined; *done 0 and nothing changed above it); when lamps were newly
- * refined (rs->refined grew: rs holds the last call's counters, zeroed
- * before the first), 'frames' photon frames of 'photons' refill the aerial
- * chart, added to *refills.
- * Prints the error and returns an exit code. */
-int cli_refine(const char *cmd, plx_engine *e, const double eye[3], double height, long frames, long photons,
-               plx_refine_stats *rs /* OUT */, int *done /* OUT */, long *refills /* OUT, adds */);
+ * most r->height above the ground (munoz2013 §3.3: only low views are
+ * refined; above it nothing changes and r->high counts the call); when
+ * lamps were refined for the first time (r->rs.refined grew), r->frames
+ * photon frames refill the aerial chart. Prints the error and returns an
+ * exit code. */
+int cli_refine(const char *cmd, plx_engine *e, const double eye[3], cli_refiner *r);
 /* "polarlux CMD: warning: ..." on stderr unless --quiet (c may be NULL). */
 void cli_warn(const char *cmd, const cli_common *c, const char *fmt, ...);
 /* Why a result is dark: "the scene has no lamps", or that no light reaches it. */

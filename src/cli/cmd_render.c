@@ -366,14 +366,12 @@ int cmd_render(int argc, char **argv)
         rc = cli_indirect_run("render", e, &a.ind, a.cam.eye, a.aerial || !(len > 0) ? NULL : dir,
                               a.cam.fov_deg * a.cam.width / a.cam.height);
         if (rc == EXIT_OK && a.refine && !a.ind.off) {
-            plx_refine_stats rs;
-            int done;
-            long refills = 0;
-            memset(&rs, 0, sizeof rs);
-            rc = cli_refine("render", e, a.cam.eye, a.refine_height, 16, a.ind.photons, &rs, &done, &refills);
-            if (rc == EXIT_OK && done)
-                printf("refinement: %u lamps near the eye got floor maps (%u cached of %u slots)\n", rs.misses_now,
-                       rs.cached, rs.slots);
+            cli_refiner rf;
+            cli_refiner_init(&rf, a.refine_height, 16, a.ind.photons);
+            rc = cli_refine("render", e, a.cam.eye, &rf);
+            if (rc == EXIT_OK && !rf.high)
+                printf("refinement: %u lamps near the eye got floor maps (%u cached of %u slots)\n",
+                       rf.rs.misses_now, rf.rs.cached, rf.rs.slots);
             else if (rc == EXIT_OK)
                 cli_warn("render", &a.c, "--refine: the eye is %g m high, above --refine-height %g m, so no lamp "
                          "was refined (munoz2013 refines only low views; a larger --refine-height refines from "

@@ -254,10 +254,8 @@ typedef struct walk_run {
     uint8_t *rgb8;
     sheet sh;
     FILE *cams;
-    plx_refine_stats rs;
+    cli_refiner ref;           /* --refine */
     double refine_ms;
-    long refine_high;          /* frames whose eye was above --refine-height: not refined */
-    long refills;              /* photon frames traced after lamps newly refined */
     uint64_t lookups;          /* indirect lookups, all frames */
     uint64_t aa_later;         /* pixels the later anti-aliasing samples shaded, all frames */
     long aa_adaptive, aa_dense; /* frames whose anti-aliasing was adaptive, took every sample for its edges */
@@ -337,12 +335,10 @@ static int frame(const walk_args *a, plx_engine *e, const walk_path *wp, walk_ru
     cam.width = a->w;
     cam.height = a->h;
     if (a->refine && !a->ind.off) {
-        int rc, done;
+        int rc;
         t0 = port_now_ns();
-        rc = cli_refine("walk", e, cam.eye, a->refine_height, a->refine_frames, a->ind.photons, &wr->rs, &done,
-                        &wr->refills);
+        rc = cli_refine("walk", e, cam.eye, &wr->ref);
         wr->refine_ms += (port_now_ns() - t0) / 1e6;
-        wr->refine_high += !done;
         if (rc != EXIT_OK)
             return rc;
     }
@@ -413,18 +409,19 @@ static void view_hint(const walk_args *a, const walk_path *wp)
 /* The refinement's line, and a word when the eye was too high for it. */
 static void walk_refine_print(const walk_args *a, const walk_run *wr)
 {
-    if (wr->refine_high == wr->n) {
+    const plx_refine_stats *rs = &wr->ref.rs;
+    if (wr->ref.high == wr->n) {
         cli_warn("walk", &a->c, "--refine: the eye was above --refine-height %g m at every frame, so no lamp was "
                  "refined (munoz2013 refines only low views; a larger --refine-height refines from higher up)",
                  a->refine_height);
         return;
     }
     printf("refinement: %llu hits, %llu misses, %llu evictions, %llu lamps refined (%u slots, %.0f m); "
-           "%ld refill photon frames; %.1f ms in all (floor maps and refill frames)", (unsigned long long)wr->rs.hits,
-           (unsigned long long)wr->rs.misses, (unsigned long long)wr->rs.evictions,
-           (unsigned long long)wr->rs.refined, wr->rs.slots, wr->rs.near_radius, wr->refills, wr->refine_ms);
-    if (wr->refine_high)
-        printf("; %ld of %ld frames above --refine-height %g m not refined", wr->refine_high, wr->n,
+           "%ld refill photon frames; %.1f ms in all (floor maps and refill frames)", (unsigned long long)rs->hits,
+           (unsigned long long)rs->misses, (unsigned long long)rs->evictions, (unsigned long long)rs->refined,
+           rs->slots, rs->near_radius, wr->ref.refills, wr->refine_ms);
+    if (wr->ref.high)
+        printf("; %ld of %ld frames above --refine-height %g m not refined", wr->ref.high, wr->n,
                a->refine_height);
     printf("\n");
 }
@@ -437,6 +434,7 @@ static int run(const walk_args *a, plx_engine *e, const walk_path *wp)
     int rc = EXIT_OK;
     long k;
     memset(&wr, 0, sizeof wr);
+    cli_refiner_init(&wr.ref, a->refine_height, a->refine_frames, a->ind.photons);
     view_hint(a, wp);
     wr.n = (long)floor(L / step) + 1;
     if (wr.n > a->max_frames)

@@ -760,30 +760,37 @@ size_t cli_buffer_budget(const plx_engine *e, const cli_common *c)
     return m.peak_total < mem ? mem - m.peak_total : 0;
 }
 
-int cli_refine(const char *cmd, plx_engine *e, const double eye[3], double height, long frames, long photons,
-               plx_refine_stats *rs, int *done, long *refills)
+void cli_refiner_init(cli_refiner *r, double height, long frames, long photons)
 {
+    memset(r, 0, sizeof *r);
+    r->height = height;
+    r->frames = frames;
+    r->photons = photons;
+}
+
+int cli_refine(const char *cmd, plx_engine *e, const double eye[3], cli_refiner *r)
+{
+    uint64_t before = r->rs.refined;
     plx_status st;
-    uint64_t before = rs->refined;
     long k;
-    *done = 0;
-    if (eye[2] > height)
+    if (eye[2] > r->height) {
+        r->high++;
         return EXIT_OK;
-    *done = 1;
-    st = plx_indirect_refine(e, eye, rs);
+    }
+    st = plx_indirect_refine(e, eye, &r->rs);
     if (st != PLX_OK) {
         fprintf(stderr, "polarlux %s: %s\n", cmd, plx_last_error(e));
         return cli_exit_code(st);
     }
     /* a newly refined lamp restarts the progressive aerial chart: refill it
      * (an evicted lamp's map computed again restarts nothing) */
-    for (k = 0; rs->refined > before && k < frames; k++) {
-        st = plx_indirect_step(e, (uint32_t)photons, plx_indirect_frames(e) + 1);
+    for (k = 0; r->rs.refined > before && k < r->frames; k++) {
+        st = plx_indirect_step(e, (uint32_t)r->photons, plx_indirect_frames(e) + 1);
         if (st != PLX_OK) {
             fprintf(stderr, "polarlux %s: %s\n", cmd, plx_last_error(e));
             return cli_exit_code(st);
         }
-        (*refills)++;
+        r->refills++;
     }
     return EXIT_OK;
 }
