@@ -256,8 +256,6 @@ static unsigned outcode(const raster_ctx *r, const float *p)
 {
     float gxw = r->gx * p[3], gyw = r->gy * p[3];
     float d[PLANE_COUNT];
-    unsigned m = 0;
-    int k;
     d[PLANE_W] = p[3] - RASTER_W_EPSILON;
     d[PLANE_NEAR] = p[2] + p[3];
     d[PLANE_FAR] = p[3] - p[2];
@@ -265,9 +263,10 @@ static unsigned outcode(const raster_ctx *r, const float *p)
     d[PLANE_RIGHT] = gxw - p[0];
     d[PLANE_BOTTOM] = p[1] + gyw;
     d[PLANE_TOP] = gyw - p[1];
-    for (k = 0; k < PLANE_COUNT; k++)
-        m |= (unsigned)(d[k] < 0.0f) << k;
-    return m;
+    return (unsigned)(d[PLANE_W] < 0.0f) << PLANE_W | (unsigned)(d[PLANE_NEAR] < 0.0f) << PLANE_NEAR |
+           (unsigned)(d[PLANE_FAR] < 0.0f) << PLANE_FAR | (unsigned)(d[PLANE_LEFT] < 0.0f) << PLANE_LEFT |
+           (unsigned)(d[PLANE_RIGHT] < 0.0f) << PLANE_RIGHT | (unsigned)(d[PLANE_BOTTOM] < 0.0f) << PLANE_BOTTOM |
+           (unsigned)(d[PLANE_TOP] < 0.0f) << PLANE_TOP; /* written out: the loop cost 58 instructions a vertex */
 }
 
 /* The point where edge (in, out) crosses a plane, computed from the inside
@@ -324,18 +323,23 @@ static int64_t snap(double v)
     return (int64_t)f;
 }
 
+/* Clip-space pos to the snapped window position and the depth in [0, 1]. */
+static void window_xyz(const raster_ctx *r, const float *pos, int64_t *x, int64_t *y, double *z)
+{
+    double w = (double)pos[3];
+    double d = ((double)pos[2] / w + 1.0) * 0.5;
+    *x = snap(((double)pos[0] / w + 1.0) * 0.5 * (double)r->t.width);
+    *y = snap((1.0 - (double)pos[1] / w) * 0.5 * (double)r->t.height);
+    if (!(d > 0.0)) d = 0.0;
+    if (d > 1.0) d = 1.0;
+    *z = d;
+}
+
 static void project(const raster_ctx *r, const raster_vertex *v, svert *s)
 {
-    double w = (double)v->pos[3];
-    double z = ((double)v->pos[2] / w + 1.0) * 0.5;
     int k;
-
-    s->x = snap(((double)v->pos[0] / w + 1.0) * 0.5 * (double)r->t.width);
-    s->y = snap((1.0 - (double)v->pos[1] / w) * 0.5 * (double)r->t.height);
-    if (!(z > 0.0)) z = 0.0;
-    if (z > 1.0) z = 1.0;
-    s->z = z;
-    s->iw = (float)(1.0 / w);
+    window_xyz(r, v->pos, &s->x, &s->y, &s->z);
+    s->iw = (float)(1.0 / (double)v->pos[3]);
     for (k = 0; k < r->nattr; k++)
         s->a[k] = v->attr[k] * s->iw;
 }
@@ -520,11 +524,8 @@ static size_t draw_polygon(raster_ctx *r, const raster_vertex *const *p, int n)
 
 static int valid_position(const float *p)
 {
-    int c;
-    for (c = 0; c < 4; c++)
-        if (!(fabsf(p[c]) <= RASTER_MAX_COORD))   /* also NaN */
-            return 0;
-    return 1;
+    return fabsf(p[0]) <= RASTER_MAX_COORD && fabsf(p[1]) <= RASTER_MAX_COORD && /* false for NaN */
+           fabsf(p[2]) <= RASTER_MAX_COORD && fabsf(p[3]) <= RASTER_MAX_COORD;
 }
 
 size_t raster_triangle(raster_ctx *r, const raster_vertex *v0,
@@ -604,8 +605,6 @@ size_t raster_triangles(raster_ctx *r, const raster_vertex *verts, size_t nvert,
 
 void raster_prepare(const raster_ctx *r, const float *pos, raster_pvert *out)
 {
-    raster_vertex v;
-    svert sv;
     if (!valid_position(pos)) {
         out->code = ~0u;
         return;
@@ -613,11 +612,7 @@ void raster_prepare(const raster_ctx *r, const float *pos, raster_pvert *out)
     out->code = outcode(r, pos);
     if (out->code != 0)
         return;
-    memcpy(v.pos, pos, sizeof v.pos);
-    project(r, &v, &sv); /* nattr is 0 for id drawing: no attributes read */
-    out->x = sv.x;
-    out->y = sv.y;
-    out->z = sv.z;
+    window_xyz(r, pos, &out->x, &out->y, &out->z); /* as project: the same bits */
 }
 
 /* One edge's bound along the rows of draw_triangle_id: with s = |step_x|
