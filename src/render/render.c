@@ -1051,37 +1051,81 @@ static int occlusion_pays(const render *r)
     return !(r->eye[2] > 2.0 * fmax(top, 0.0));
 }
 
-/* Culling (render.h): cells of buildings first. A cell whose box lies
- * out of the frustum culls its buildings (their boxes lie in it); with
- * occlusion culling the others go to the occlusion pass as a whole (their
- * buildings are tested when the cell is reached and not hidden), without
- * it their buildings are tested at once. */
-static void cull(render *r, int mode, int inside, render_stats *st)
+static void run_jobs(const render_opts *o, uint32_t jobs, render_job_fn fn, void *arg);
+
+/* Cells c0 .. c1 - 1 without the occlusion pass: a cell out of the frustum
+ * culls its buildings, the others' buildings are tested one by one. */
+static void cull_cells(render *r, int mode, uint32_t c0, uint32_t c1, render_stats *st)
 {
     uint32_t c, k;
-    int occl = (mode & RENDER_CULL_OCCLUSION) && !inside && occlusion_pays(r);
-    occlusion_start(r);
-    for (c = 0; c < r->ncell; c++) {
+    for (c = c0; c < c1; c++) {
         double wmn, wmx, key;
-        int out;
         if (r->cell_start[c + 1] == r->cell_start[c])
             continue;
-        out = box_out(r, &r->cell_box[6 * (size_t)c], &wmn, &wmx, 1, NULL);
-        if ((mode & RENDER_CULL_FRUSTUM) && out) {
+        if ((mode & RENDER_CULL_FRUSTUM) && box_out(r, &r->cell_box[6 * (size_t)c], &wmn, &wmx, 1, NULL)) {
             for (k = r->cell_start[c]; k < r->cell_start[c + 1]; k++)
                 r->draw[r->cell_bld[k]] = 0;
             st->frustum_culled += r->cell_start[c + 1] - r->cell_start[c];
             continue;
         }
-        if (occl) {
-            trav_push(r, fmax(wmn, r->near_), r->m->nbld + c);
-            continue;
-        }
         for (k = r->cell_start[c]; k < r->cell_start[c + 1]; k++)
             (void)cull_building(r, mode, r->cell_bld[k], st, &key);
     }
-    if (occl)
-        occlusion(r, mode, st);
+}
+
+#define CULL_JOB_CELLS 256
+typedef struct cull_job {
+    render *r;
+    int mode;
+    uint64_t culled[RENDER_MAX_WORKERS];
+} cull_job;
+
+static void cull_part(void *arg, int worker, uint32_t k)
+{
+    cull_job *jb = arg;
+    render_stats st;
+    uint32_t c1 = (k + 1) * CULL_JOB_CELLS < jb->r->ncell ? (k + 1) * CULL_JOB_CELLS : jb->r->ncell;
+    memset(&st, 0, sizeof st);
+    cull_cells(jb->r, jb->mode, k * CULL_JOB_CELLS, c1, &st);
+    jb->culled[worker] += st.frustum_culled;
+}
+
+/* Culling (render.h): cells of buildings first. A cell whose box lies
+ * out of the frustum culls its buildings (their boxes lie in it); with
+ * occlusion culling the others go to the occlusion pass as a whole (their
+ * buildings are tested when the cell is reached and not hidden), without
+ * it their buildings are tested at once, cells on the workers (each
+ * building's results its own: the same for any split). */
+static void cull(render *r, const render_opts *o, int inside, render_stats *st)
+{
+    uint32_t c;
+    int mode = o->cull, occl = (mode & RENDER_CULL_OCCLUSION) && !inside && occlusion_pays(r);
+    occlusion_start(r);
+    if (!occl) {
+        cull_job jb;
+        int k;
+        memset(&jb, 0, sizeof jb);
+        jb.r = r;
+        jb.mode = mode;
+        run_jobs(o, (r->ncell + CULL_JOB_CELLS - 1) / CULL_JOB_CELLS, cull_part, &jb);
+        for (k = 0; k < RENDER_MAX_WORKERS; k++)
+            st->frustum_culled += jb.culled[k];
+        return;
+    }
+    for (c = 0; c < r->ncell; c++) {
+        double wmn, wmx;
+        if (r->cell_start[c + 1] == r->cell_start[c])
+            continue;
+        if (box_out(r, &r->cell_box[6 * (size_t)c], &wmn, &wmx, 1, NULL) && (mode & RENDER_CULL_FRUSTUM)) {
+            uint32_t k;
+            for (k = r->cell_start[c]; k < r->cell_start[c + 1]; k++)
+                r->draw[r->cell_bld[k]] = 0;
+            st->frustum_culled += r->cell_start[c + 1] - r->cell_start[c];
+            continue;
+        }
+        trav_push(r, fmax(wmn, r->near_), r->m->nbld + c);
+    }
+    occlusion(r, mode, st);
 }
 
 /* ---- drawing ------------------------------------------------------------------ */
@@ -1900,11 +1944,20 @@ static void ground_row(render *r, int32_t j)
             id[i] = MESH_SURF_GROUND;
 }
 
-static void ground_ids(render *r)
+/* Rows k RENDER_TILE .. of the frame (render_job_fn; arg the render). */
+static void ground_rows(void *arg, int worker, uint32_t k)
 {
-    int32_t j;
-    for (j = 0; j < r->h; j++)
+    render *r = arg;
+    int32_t j, j1 = ((int32_t)k + 1) * RENDER_TILE < r->h ? ((int32_t)k + 1) * RENDER_TILE : r->h;
+    (void)worker;
+    for (j = (int32_t)k * RENDER_TILE; j < j1; j++)
         ground_row(r, j);
+}
+
+/* Every row's ground pixels, rows on the workers (each row on its own). */
+static void ground_ids(render *r, const render_opts *o)
+{
+    run_jobs(o, (uint32_t)((r->h + RENDER_TILE - 1) / RENDER_TILE), ground_rows, r);
 }
 
 /* Whether a pixel of block (a, b), its far corners included, is shaded
@@ -1934,7 +1987,7 @@ static void sparse_corners(render *r, const render_opts *o, render_stats *st)
     row[0] = r->crow;
     row[1] = r->crow + r->nbx + 1;
     int tries = try_workers(o) > 0;
-    ground_ids(r);
+    ground_ids(r, o);
     corner_row(r, 0, row[0]);
     for (b = 0; b < r->nby; b++) {
         corner_row(r, b + 1, row[(b + 1) & 1]);
@@ -2605,7 +2658,7 @@ static int atlas_pass(render *r, const render_opts *o, render_stats *st)
     atlas_job jb;
     double ta = r->tanh_ * r->aspect, tb = r->tanh_, a0, b0;
     int k;
-    ground_ids(r);
+    ground_ids(r, o);
     if (o->mask) /* adaptive anti-aliasing's later samples: only the marked pixels */
         mask_update(r, o);
     a0 = (2.0 * (0.5 + r->shift[0]) / r->w - 1.0) * ta;
@@ -2671,14 +2724,14 @@ plx_status render_frame(render *r, const render_camera *cam, const render_opts *
     st.eye_inside = inside;
     if (be == &r->soft && r->band && par_workers(o) >= 2) {
         /* the built-in rasteriser on the workers, by bands of rows */
-        cull(r, o->cull, inside, &st);
+        cull(r, o, inside, &st);
         draw_bands(r, o, !inside, &st);
     } else {
         if (be->begin(be->user, r->w, r->h, !inside) != 0) {
             r->err = "render_frame: the backend could not start the frame";
             return PLX_E_UNSUPPORTED;
         }
-        cull(r, o->cull, inside, &st);
+        cull(r, o, inside, &st);
         draw_buildings(r, be, &st);
         if (be->finish(be->user, r->id, r->depth) != 0) {
             r->err = "render_frame: the backend could not read the frame back";
