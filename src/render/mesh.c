@@ -4,6 +4,7 @@
 #include <string.h>
 
 #include "render/mesh.h"
+#include "render/party_walls.h"
 #include "base/geom.h"
 #include "base/bucketgrid.h"
 
@@ -625,6 +626,12 @@ static uint32_t split_find(const mesh *m, uint32_t lo, uint32_t hi, uint32_t v)
     return lo;
 }
 
+/* Footprint vertex pt's wall is hidden whole (mesh.hidden). */
+static int wall_hidden(const mesh *m, uint32_t pt)
+{
+    return (m->hidden[pt >> 3] >> (pt & 7)) & 1;
+}
+
 /* The vertices of local vertex v's wall column (mesh_building's order:
  * the ring vertices at the top, then at the bottom, then the splits):
  * bottom, len - 2 splits from 'split' on, top. */
@@ -700,6 +707,8 @@ static void put_walls(const mesh *m, uint32_t b, uint32_t ntot, const double *xy
                 col_of(m, b, off + i + 1, ntot, &R);
             else
                 R = first;
+            if (wall_hidden(m, rg->first + i))
+                continue;
             /* zip the columns; (L_i, R_j, R_j+1) and (L_i, R_j, L_i+1)
              * are counter-clockwise seen from outside (right of a->b) */
             while (li + 1 < L.len || ri + 1 < R.len) {
@@ -789,6 +798,23 @@ static colpt *columns(arena *a, const scene *s, uint32_t *ncol)
     return col;
 }
 
+/* mesh.hidden from the walls' open heights (scratch released). */
+static int mark_hidden(arena *a, mesh *m)
+{
+    const scene *s = m->s;
+    arena_mark mk = arena_get_mark(a);
+    double *zlo = arena_scratch(a, arena_mul((size_t)s->npts + 1, sizeof *zlo), 8);
+    double *zhi = zlo ? arena_scratch(a, arena_mul((size_t)s->npts + 1, sizeof *zhi), 8) : NULL;
+    uint32_t p;
+    if (!zhi || party_wall_heights(a, s, zlo, zhi) != 0)
+        return -1;
+    for (p = 0; p < s->npts; p++)
+        if (!(zhi[p] > zlo[p]))
+            m->hidden[p >> 3] |= (uint8_t)(1u << (p & 7));
+    release_scratch(a, &mk);
+    return 0;
+}
+
 /* Count pass: each building's vertices and wall triangles, the splits,
  * the footprint vertices' buildings; *roof_cap: roof indices at most;
  * *maxring: most ring vertices (+ 2 a hole) of one building. */
@@ -811,7 +837,8 @@ static void count(mesh *m, const colpt *col, uint32_t ncol, uint32_t *nsplit, ui
                 uint32_t ca = column(col, ncol, s->pts[rg->first + i], bd->min_height, bd->height, &f);
                 uint32_t cb = column(col, ncol, s->pts[rg->first + j], bd->min_height, bd->height, &f);
                 nvb += ca; /* its column once: bottom, splits, top (mesh_building) */
-                ntb += ca + cb - 2;
+                if (!wall_hidden(m, rg->first + i))
+                    ntb += ca + cb - 2;
                 *nsplit += ca - 2;
                 if (m->pt_bld)
                     m->pt_bld[rg->first + i] = b;
@@ -921,8 +948,11 @@ plx_status mesh_build(arena *a, const scene *s, mesh **out)
                                        MESH_ALIGN)) != NULL)
         make_hints(m);
     m->lit = arena_calloc(a, PLX_PART_FRAME, m->nsurf / 8 + 1, 1, MESH_ALIGN);
+    m->hidden = arena_calloc(a, PLX_PART_FRAME, s->npts / 8 + 1, 1, MESH_ALIGN);
+    if (!m->bld || (!m->pt_bld && !m->pt_hint) || !m->lit || !m->hidden || mark_hidden(a, m) != 0)
+        goto nomem;
     col = columns(a, s, &ncol);
-    if (!m->bld || (!m->pt_bld && !m->pt_hint) || !m->lit || !col)
+    if (!col)
         goto nomem;
     count(m, col, ncol, &nsplit, &roof_cap, &maxring);
     if (maxring <= 65535u)

@@ -122,6 +122,8 @@ typedef struct mesh {
     uint32_t *pt_hint;    /* then per MESH_HINT_PTS vertices from 0: the last building
                            * starting at or before it (npts / MESH_HINT_PTS + 2) */
     uint8_t *lit;         /* a bit per surface id: mesh_surf.lit */
+    uint8_t *hidden;      /* a bit per footprint vertex: its wall is hidden whole by the
+                           * solids against it (party_walls.h) and not drawn */
     uint32_t max_bld_verts;  /* most vertices of one building */
     uint32_t max_bld_tris;   /* most triangles of one building */
     uint32_t split_verts;    /* vertices added on wall columns (T-junctions) */

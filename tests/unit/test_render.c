@@ -985,7 +985,7 @@ static void test_cull_over_low_roof(void **state)
 
 /* ---- the mesh ---------------------------------------------------------------- */
 
-typedef struct dedge { double a[3], b[3]; } dedge;
+typedef struct dedge { double a[3], b[3]; int ground; } dedge; /* ground: a bottom edge at z = 0 */
 
 static int cmp_dedge(const void *pa, const void *pb)
 {
@@ -1000,7 +1000,8 @@ static int cmp_dedge(const void *pa, const void *pb)
 static void check_mesh_scene(plx_engine *e, const scene *s, const char *path, int want_search)
 {
     mesh *m;
-    uint32_t b, k, open_edges = 0, nv = 0, ntri = 0;
+    uint32_t b, k, open_edges = 0, nv = 0, ntri = 0, hidden = 0, *wall_tris;
+    size_t ne = 0, i;
     dedge *ed;
     double *xyz;
     mesh_tri *tri;
@@ -1008,14 +1009,15 @@ static void check_mesh_scene(plx_engine *e, const scene *s, const char *path, in
     assert_int_equal(m->bad_holes, 0);
     /* walls find their building by a search, or by the kept table */
     assert_int_equal(m->pt_bld == NULL, want_search);
-    ed = malloc((3 * (size_t)m->max_bld_tris + 1) * sizeof *ed);
+    ed = malloc((3 * (size_t)m->ntri + 1) * sizeof *ed);
+    wall_tris = calloc((size_t)s->npts + 1, sizeof *wall_tris);
     xyz = malloc((3 * (size_t)m->max_bld_verts + 1) * sizeof *xyz);
     tri = malloc(((size_t)m->max_bld_tris + 1) * sizeof *tri);
     for (b = 0; b < s->nbld; b++) {
         const scene_building *bd = &s->bld[b];
         const mesh_bld *mb = &m->bld[b];
         double want = 0, got = 0;
-        uint32_t r, ne = 0, i;
+        uint32_t r;
         assert_true(mb->v_count <= m->max_bld_verts && mb->t_count <= m->max_bld_tris);
         mesh_building(m, b, xyz, tri);
         nv += mb->v_count;
@@ -1048,33 +1050,50 @@ static void check_mesh_scene(plx_engine *e, const scene *s, const char *path, in
                                       : t->surf == mesh_under_id(s, b) ? MESH_KIND_UNDER : MESH_KIND_WALL);
             if (t->surf == mesh_roof_id(s, b))
                 got += 0.5 * nz;
+            if (t->surf >= 2 && t->surf < 2 + s->npts)
+                wall_tris[t->surf - 2]++;
             for (j = 0; j < 3; j++) {
                 memcpy(ed[ne].a, &xyz[3 * t->v[j]], 3 * sizeof(double));
                 memcpy(ed[ne].b, &xyz[3 * t->v[(j + 1) % 3]], 3 * sizeof(double));
+                ed[ne].ground = bd->min_height == 0 && ed[ne].a[2] == 0 && ed[ne].b[2] == 0;
                 ne++;
             }
         }
         if (fabs(got - want) > 1e-9 * fabs(want) + 1e-9)
             fail_msg("%s building %u: roof area %.17g, footprint area %.17g", path, b, got, want);
-        /* watertight: every directed edge has its reverse (the bottom of a
-         * building on the ground aside) */
-        qsort(ed, ne, sizeof *ed, cmp_dedge);
-        for (i = 0; i < ne; i++) {
-            dedge rev;
-            memcpy(rev.a, ed[i].b, sizeof rev.a);
-            memcpy(rev.b, ed[i].a, sizeof rev.b);
-            if (!bsearch(&rev, ed, ne, sizeof *ed, cmp_dedge)) {
-                if (bd->min_height == 0 && ed[i].a[2] == 0 && ed[i].b[2] == 0)
-                    continue;
-                open_edges++;
-            }
+    }
+    /* watertight as a whole: every directed edge has its reverse in some
+     * building (the bottoms of buildings on the ground aside): a wall
+     * hidden whole is left out, and the solids against it close the mesh
+     * there with the same points */
+    qsort(ed, ne, sizeof *ed, cmp_dedge);
+    for (i = 0; i < ne; i++) {
+        dedge rev;
+        memcpy(rev.a, ed[i].b, sizeof rev.a);
+        memcpy(rev.b, ed[i].a, sizeof rev.b);
+        if (!ed[i].ground && !bsearch(&rev, ed, ne, sizeof *ed, cmp_dedge))
+            open_edges++;
+    }
+    /* exactly the walls hidden whole have no triangles */
+    for (k = 0; k < s->npts; k++) {
+        int hid = (m->hidden[k >> 3] >> (k & 7)) & 1;
+        hidden += (uint32_t)hid;
+        if (hid) {
+            assert_int_equal(wall_tris[k], 0);
+        } else {
+            mesh_surf sf;
+            mesh_surface(m, mesh_wall_id(s, k), &sf);
+            if (s->bld[sf.bld].height > s->bld[sf.bld].min_height && wall_tris[k] == 0)
+                fail_msg("%s: wall %u has no triangles and is not hidden", path, k);
         }
     }
     assert_int_equal(nv, m->nv);
     assert_int_equal(ntri, m->ntri);
-    print_message("%s: %u vertices, %u triangles, %u column split vertices, %u ear fallbacks, %zu bytes\n",
-                  path, m->nv, m->ntri, m->split_verts, m->fallbacks, m->bytes);
+    print_message("%s: %u vertices, %u triangles, %u column split vertices, %u walls hidden whole, %u ear "
+                  "fallbacks, %zu bytes\n",
+                  path, m->nv, m->ntri, m->split_verts, hidden, m->fallbacks, m->bytes);
     assert_int_equal(open_edges, 0);
+    free(wall_tris);
     free(ed);
     free(xyz);
     free(tri);
