@@ -1014,6 +1014,23 @@ static int box_out(const render *r, const double *bx, double *wmn, double *wmx, 
     return out_l || out_r || out_t || out_b || out_n;
 }
 
+/* Whether box bx lies inside the frustum's four sides and in front of
+ * the near plane, every corner by a margin (1e-6 |w| + 1e-9, far
+ * above the corners' rounding): no box inside it is out (box_out). */
+static int box_inside(const render *r, const double *bx)
+{
+    double c[8][4];
+    int k;
+    box_clip(r, bx, c);
+    for (k = 0; k < 8; k++) {
+        double w = c[k][3], tol = 1e-6 * (w < 0.0 ? -w : w) + 1e-9;
+        if (!(w >= r->near_ * (1.0 + 1e-6) && c[k][0] <= w - tol && c[k][0] >= -w + tol && c[k][1] <= w - tol &&
+              c[k][1] >= -w + tol))
+            return 0;
+    }
+    return 1;
+}
+
 /* Building b's frustum test: culled (counted, 0), or drawn (1; 2 when
  * it has triangles: a candidate for the occlusion pass, its key the
  * smallest w of its box's corners, at least near). */
@@ -1054,8 +1071,10 @@ static int occlusion_pays(const render *r)
 static void run_jobs(const render_opts *o, uint32_t jobs, render_job_fn fn, void *arg);
 
 /* Cells c0 .. c1 - 1 without the occlusion pass: a cell out of the frustum
- * culls its buildings, the others' buildings are tested one by one. */
-static void cull_cells(render *r, int mode, uint32_t c0, uint32_t c1, render_stats *st)
+ * culls its buildings, the others' buildings are tested one by one, but
+ * for a cell wholly inside when no band needs its buildings' rows (their
+ * boxes lie in it: none is out). */
+static void cull_cells(render *r, int mode, int rows, uint32_t c0, uint32_t c1, render_stats *st)
 {
     uint32_t c, k;
     for (c = c0; c < c1; c++) {
@@ -1068,6 +1087,11 @@ static void cull_cells(render *r, int mode, uint32_t c0, uint32_t c1, render_sta
             st->frustum_culled += r->cell_start[c + 1] - r->cell_start[c];
             continue;
         }
+        if (!rows && box_inside(r, &r->cell_box[6 * (size_t)c])) {
+            for (k = r->cell_start[c]; k < r->cell_start[c + 1]; k++)
+                r->draw[r->cell_bld[k]] = 1;
+            continue;
+        }
         for (k = r->cell_start[c]; k < r->cell_start[c + 1]; k++)
             (void)cull_building(r, mode, r->cell_bld[k], st, &key);
     }
@@ -1076,7 +1100,7 @@ static void cull_cells(render *r, int mode, uint32_t c0, uint32_t c1, render_sta
 #define CULL_JOB_CELLS 256
 typedef struct cull_job {
     render *r;
-    int mode;
+    int mode, rows;
     uint64_t culled[RENDER_MAX_WORKERS];
 } cull_job;
 
@@ -1086,7 +1110,7 @@ static void cull_part(void *arg, int worker, uint32_t k)
     render_stats st;
     uint32_t c1 = (k + 1) * CULL_JOB_CELLS < jb->r->ncell ? (k + 1) * CULL_JOB_CELLS : jb->r->ncell;
     memset(&st, 0, sizeof st);
-    cull_cells(jb->r, jb->mode, k * CULL_JOB_CELLS, c1, &st);
+    cull_cells(jb->r, jb->mode, jb->rows, k * CULL_JOB_CELLS, c1, &st);
     jb->culled[worker] += st.frustum_culled;
 }
 
@@ -1096,7 +1120,7 @@ static void cull_part(void *arg, int worker, uint32_t k)
  * buildings are tested when the cell is reached and not hidden), without
  * it their buildings are tested at once, cells on the workers (each
  * building's results its own: the same for any split). */
-static void cull(render *r, const render_opts *o, int inside, render_stats *st)
+static void cull(render *r, const render_opts *o, int inside, int rows, render_stats *st)
 {
     uint32_t c;
     int mode = o->cull, occl = (mode & RENDER_CULL_OCCLUSION) && !inside && occlusion_pays(r);
@@ -1107,6 +1131,7 @@ static void cull(render *r, const render_opts *o, int inside, render_stats *st)
         memset(&jb, 0, sizeof jb);
         jb.r = r;
         jb.mode = mode;
+        jb.rows = rows;
         run_jobs(o, (r->ncell + CULL_JOB_CELLS - 1) / CULL_JOB_CELLS, cull_part, &jb);
         for (k = 0; k < RENDER_MAX_WORKERS; k++)
             st->frustum_culled += jb.culled[k];
@@ -2724,14 +2749,14 @@ plx_status render_frame(render *r, const render_camera *cam, const render_opts *
     st.eye_inside = inside;
     if (be == &r->soft && r->band && par_workers(o) >= 2) {
         /* the built-in rasteriser on the workers, by bands of rows */
-        cull(r, o, inside, &st);
+        cull(r, o, inside, 1, &st);
         draw_bands(r, o, !inside, &st);
     } else {
         if (be->begin(be->user, r->w, r->h, !inside) != 0) {
             r->err = "render_frame: the backend could not start the frame";
             return PLX_E_UNSUPPORTED;
         }
-        cull(r, o, inside, &st);
+        cull(r, o, inside, 0, &st);
         draw_buildings(r, be, &st);
         if (be->finish(be->user, r->id, r->depth) != 0) {
             r->err = "render_frame: the backend could not read the frame back";
