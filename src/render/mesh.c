@@ -712,8 +712,8 @@ static void put_walls(const mesh *m, uint32_t b, uint32_t ntot, const double *xy
             /* zip the columns; (L_i, R_j, R_j+1) and (L_i, R_j, L_i+1)
              * are counter-clockwise seen from outside (right of a->b) */
             while (li + 1 < L.len || ri + 1 < R.len) {
-                if (ri + 1 < R.len &&
-                    (li + 1 >= L.len || xyz[3 * (size_t)col_at(&R, ri + 1) + 2] <= xyz[3 * (size_t)col_at(&L, li + 1) + 2])) {
+                if (ri + 1 < R.len && (li + 1 >= L.len || xyz[3 * (size_t)col_at(&R, ri + 1) + 2] <=
+                                                              xyz[3 * (size_t)col_at(&L, li + 1) + 2])) {
                     put_t(tri, nt, col_at(&L, li), col_at(&R, ri), col_at(&R, ri + 1), wid);
                     ri++;
                 } else {
