@@ -963,7 +963,7 @@ static void box_clip(const render *r, const double *bx, double c[8][4])
             c[k][q] = c[0][q] + ((k & 1) ? e[0][q] : 0.0) + ((k & 2) ? e[1][q] : 0.0) + ((k & 4) ? e[2][q] : 0.0);
 }
 
-/* Whether every corner of box bx lies beyond one side plane of the
+/* Whether every corner c of a box (box_clip) lies beyond one side plane of the
  * frustum (by a tolerance of 1e-6 |w| + 1e-9, far above the corners'
  * rounding) or before the near plane: no pixel centre sees it; its
  * corners' smallest and largest w. whole: the tolerance from the largest
@@ -973,12 +973,11 @@ static void box_clip(const render *r, const double *bx, double c[8][4])
  * at most its largest). rows (may be NULL): the rows its projection may
  * cover (its corners' rows, two pixels more each way for snapping), every
  * row when a corner is not in front of the near plane: what a band of
- * rows needs to draw (draw_bands). */
-static int box_out(const render *r, const double *bx, double *wmn, double *wmx, int whole, int32_t *rows)
+ * rows needs to draw (draw_bands). box_out: the same from the box. */
+static int corners_out(const render *r, double c[8][4], double *wmn, double *wmx, int whole, int32_t *rows)
 {
     int out_l = 1, out_r = 1, out_b = 1, out_t = 1, out_n = 1, k, all_front = 1;
-    double c[8][4], big = 0.0, lo = HUGE_VAL, hi = -HUGE_VAL;
-    box_clip(r, bx, c);
+    double big = 0.0, lo = HUGE_VAL, hi = -HUGE_VAL;
     *wmn = HUGE_VAL;
     *wmx = -HUGE_VAL;
     for (k = 0; k < 8; k++) {
@@ -1014,14 +1013,20 @@ static int box_out(const render *r, const double *bx, double *wmn, double *wmx, 
     return out_l || out_r || out_t || out_b || out_n;
 }
 
-/* Whether box bx lies inside the frustum's four sides and in front of
- * the near plane, every corner by a margin (1e-6 |w| + 1e-9, far
- * above the corners' rounding): no box inside it is out (box_out). */
-static int box_inside(const render *r, const double *bx)
+static int box_out(const render *r, const double *bx, double *wmn, double *wmx, int whole, int32_t *rows)
 {
     double c[8][4];
-    int k;
     box_clip(r, bx, c);
+    return corners_out(r, c, wmn, wmx, whole, rows);
+}
+
+/* Whether a box whose corners are c (box_clip) lies inside the frustum's
+ * four sides and in front of the near plane, every corner by a margin
+ * (1e-6 |w| + 1e-9, far above the corners' rounding): no box inside it is
+ * out (box_out). */
+static int corners_inside(const render *r, double c[8][4])
+{
+    int k;
     for (k = 0; k < 8; k++) {
         double w = c[k][3], tol = 1e-6 * (w < 0.0 ? -w : w) + 1e-9;
         if (!(w >= r->near_ * (1.0 + 1e-6) && c[k][0] <= w - tol && c[k][0] >= -w + tol && c[k][1] <= w - tol &&
@@ -1070,6 +1075,16 @@ static int occlusion_pays(const render *r)
 
 static void run_jobs(const render_opts *o, uint32_t jobs, render_job_fn fn, void *arg);
 
+/* Cell c's buildings all drawn (1) or all culled by the frustum (0, counted). */
+static void cell_draw(render *r, uint32_t c, uint8_t draw, render_stats *st)
+{
+    uint32_t k;
+    for (k = r->cell_start[c]; k < r->cell_start[c + 1]; k++)
+        r->draw[r->cell_bld[k]] = draw;
+    if (!draw)
+        st->frustum_culled += r->cell_start[c + 1] - r->cell_start[c];
+}
+
 /* Cells c0 .. c1 - 1 without the occlusion pass: a cell out of the frustum
  * culls its buildings, the others' buildings are tested one by one, but
  * for a cell wholly inside when no band needs its buildings' rows (their
@@ -1078,22 +1093,17 @@ static void cull_cells(render *r, int mode, int rows, uint32_t c0, uint32_t c1, 
 {
     uint32_t c, k;
     for (c = c0; c < c1; c++) {
-        double wmn, wmx, key;
+        double corner[8][4], wmn, wmx, key;
         if (r->cell_start[c + 1] == r->cell_start[c])
             continue;
-        if ((mode & RENDER_CULL_FRUSTUM) && box_out(r, &r->cell_box[6 * (size_t)c], &wmn, &wmx, 1, NULL)) {
+        box_clip(r, &r->cell_box[6 * (size_t)c], corner);
+        if ((mode & RENDER_CULL_FRUSTUM) && corners_out(r, corner, &wmn, &wmx, 1, NULL))
+            cell_draw(r, c, 0, st);
+        else if (!rows && corners_inside(r, corner))
+            cell_draw(r, c, 1, st);
+        else
             for (k = r->cell_start[c]; k < r->cell_start[c + 1]; k++)
-                r->draw[r->cell_bld[k]] = 0;
-            st->frustum_culled += r->cell_start[c + 1] - r->cell_start[c];
-            continue;
-        }
-        if (!rows && box_inside(r, &r->cell_box[6 * (size_t)c])) {
-            for (k = r->cell_start[c]; k < r->cell_start[c + 1]; k++)
-                r->draw[r->cell_bld[k]] = 1;
-            continue;
-        }
-        for (k = r->cell_start[c]; k < r->cell_start[c + 1]; k++)
-            (void)cull_building(r, mode, r->cell_bld[k], st, &key);
+                (void)cull_building(r, mode, r->cell_bld[k], st, &key);
     }
 }
 
@@ -1141,14 +1151,10 @@ static void cull(render *r, const render_opts *o, int inside, int rows, render_s
         double wmn, wmx;
         if (r->cell_start[c + 1] == r->cell_start[c])
             continue;
-        if (box_out(r, &r->cell_box[6 * (size_t)c], &wmn, &wmx, 1, NULL) && (mode & RENDER_CULL_FRUSTUM)) {
-            uint32_t k;
-            for (k = r->cell_start[c]; k < r->cell_start[c + 1]; k++)
-                r->draw[r->cell_bld[k]] = 0;
-            st->frustum_culled += r->cell_start[c + 1] - r->cell_start[c];
-            continue;
-        }
-        trav_push(r, fmax(wmn, r->near_), r->m->nbld + c);
+        if (box_out(r, &r->cell_box[6 * (size_t)c], &wmn, &wmx, 1, NULL) && (mode & RENDER_CULL_FRUSTUM))
+            cell_draw(r, c, 0, st);
+        else
+            trav_push(r, fmax(wmn, r->near_), r->m->nbld + c);
     }
     occlusion(r, mode, st);
 }
