@@ -130,8 +130,9 @@ static uint32_t layout_print(void)
                           5 /* format changes that keep the sizes (bump on such changes): 2 the polar
                                DAG's wide nodes bit-packed, 3 aerial records keyed apart, 8 m, 4 the
                                radiance atlas, 5 a wall column's vertices shared by its two walls, the
-                               roof and the underside (mesh_bld.v_count). The atlas's dark state (ATLAS_DARK, 2026-11-29) needs
-                               none: an older bake's charts read as filled (no shortcut, the same
+                               roof and the underside (mesh_bld.v_count). The atlas's dark state
+                               (ATLAS_DARK, 2026-11-29) needs none: an older bake's charts read as
+                               filled (no shortcut, the same
                                image), an older reader takes the state as done (a saved bake has
                                nothing left to fill) */ };
     uint64_t h = FNV_BASIS;
