@@ -627,6 +627,7 @@ typedef struct plx_refine_stats {
     double near_radius;         /* lamps within this horizontal distance are refined, m */
     uint32_t cached;            /* lamps in the cache now ... */
     uint32_t lru[PLX_REFINE_LRU_MAX]; /* ... the first of them, most recently used first */
+    double centre[3];           /* the point the lamps were chosen around (x, y; z 0) */
 } plx_refine_stats;
 
 /*
@@ -663,6 +664,20 @@ typedef struct plx_camera {
     double fov_deg;             /* vertical field of view, 0 < fov < 180 */
     int32_t width, height;      /* pixels, at most the config's render maximum */
 } plx_camera;
+
+/*
+ * plx_indirect_refine around the ground point a camera looks at rather
+ * than its eye (README "Walking through a city"): the eye's ground point
+ * moved along the view's horizontal direction to where the view's centre
+ * ray meets the ground (z = 0), but at most near_radius / 2 ahead. A view
+ * from 30 to 60 m looking ahead refines the lamps it shows instead of
+ * those under the eye, below the frame; a level view (no ground met) is
+ * centred near_radius / 2 ahead, so the lamps beside the viewer stay
+ * within reach. A view straight down keeps the eye's ground point.
+ * out->centre gets the centre. Errors: those of plx_indirect_refine;
+ * PLX_E_INVALID for a NULL or non-finite camera.
+ */
+plx_status plx_indirect_refine_view(plx_engine *e, const plx_camera *cam, plx_refine_stats *out /* OUT */);
 
 /* A raster backend for the visibility pass (depth and surface id per
  * pixel); opaque here, made by a port (see plx_render_opts.backend). */

@@ -73,8 +73,46 @@ plx_status plx_indirect_refine(plx_engine *e, const double eye[3], plx_refine_st
         out->slots = e->ph->nslots;
         out->near_radius = e->ph->cfg.near_radius;
         out->cached = photon_lamp_lru(e->ph, out->lru, PLX_REFINE_LRU_MAX);
+        out->centre[0] = eye[0];
+        out->centre[1] = eye[1];
     }
     return PLX_OK;
+}
+
+/* How far ahead of the eye, horizontally, a view's refinement is centred:
+ * where the centre ray (direction d, horizontal length h > 0) meets the
+ * ground, at most limit. */
+static double refine_ahead(const double eye[3], const double d[3], double h, double limit)
+{
+    double s;
+    if (!(d[2] < 0.0))
+        return limit;           /* level or upward: the ground is never met */
+    s = eye[2] > 0.0 ? eye[2] * h / -d[2] : 0.0;
+    return s < limit ? s : limit;
+}
+
+plx_status plx_indirect_refine_view(plx_engine *e, const plx_camera *cam, plx_refine_stats *out)
+{
+    double c[3], d[3], h, a = 0.0;
+    int k;
+    if (!eng_ok(e))
+        return PLX_E_INVALID;
+    if (!cam)
+        return eng_fail(e, PLX_E_INVALID, "plx_indirect_refine_view: camera is NULL");
+    for (k = 0; k < 3; k++) {
+        if (!isfinite(cam->eye[k]) || !isfinite(cam->target[k]))
+            return eng_fail(e, PLX_E_INVALID, "plx_indirect_refine_view: the camera's eye or target is not finite");
+        d[k] = cam->target[k] - cam->eye[k];
+    }
+    if (!e->ph)
+        return eng_fail(e, PLX_E_NOSCENE, "plx_indirect_refine_view: no photon buffers (trace indirect light first)");
+    h = sqrt(d[0] * d[0] + d[1] * d[1]);
+    if (h > 0.0 && isfinite(h))
+        a = refine_ahead(cam->eye, d, h, 0.5 * e->ph->cfg.near_radius);
+    c[0] = a > 0.0 ? cam->eye[0] + d[0] / h * a : cam->eye[0];
+    c[1] = a > 0.0 ? cam->eye[1] + d[1] / h * a : cam->eye[1];
+    c[2] = 0.0;
+    return plx_indirect_refine(e, c, out);
 }
 
 plx_status plx_indirect_info_get(plx_engine *e, plx_indirect_info *out)

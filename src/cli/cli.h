@@ -104,13 +104,14 @@ typedef struct cli_refiner {
 /* The settings, and no call yet. */
 void cli_refiner_init(cli_refiner *r, double height, long frames, long photons);
 
-/* Near-viewer refinement at eye (plx_indirect_refine) when the eye is at
- * most r->height above the ground (munoz2013 §3.3: only low views are
+/* Near-viewer refinement for camera cam (plx_indirect_refine_view: around
+ * the ground point the view looks at) when the eye is at most r->height
+ * above the ground (munoz2013 §3.3: only low views are
  * refined; above it nothing changes and r->high counts the call); when
  * lamps were refined for the first time (r->rs.refined grew), r->frames
  * photon frames refill the aerial chart. Prints the error and returns an
  * exit code. */
-int cli_refine(const char *cmd, plx_engine *e, const double eye[3], cli_refiner *r);
+int cli_refine(const char *cmd, plx_engine *e, const plx_camera *cam, cli_refiner *r);
 /* "polarlux CMD: warning: ..." on stderr unless --quiet (c may be NULL). */
 void cli_warn(const char *cmd, const cli_common *c, const char *fmt, ...);
 /* Why a result is dark: "the scene has no lamps", or that no light reaches it. */

@@ -53,8 +53,9 @@ static const char help[] =
     "                   a tone curve keeping highlights near lamps; printed\n"
     "  --no-glow        no lamp glows: every pixel is exactly SPEC §5's radiance\n"
     "  --refine         near-viewer refinement (munoz2013 §3.3-3.4): the lamps near\n"
-    "                   the eye get their own floor photon maps (LRU cache, pushed\n"
-    "                   into the aerial map); 16 more photon frames refill the chart\n"
+    "                   where the view meets the ground (up to 30 m ahead) get floor\n"
+    "                   photon maps (LRU cache, pushed into the aerial map); 16\n"
+    "                   more photon frames refill the chart\n"
     "  --refine-height M  refine only with the eye at most M m above the ground\n"
     "                   (default 60; munoz2013 §3.3 refines low views only)\n"
     "  --aa N           anti-aliasing: N x N samples per pixel, averaged in linear\n"
@@ -368,10 +369,12 @@ int cmd_render(int argc, char **argv)
         if (rc == EXIT_OK && a.refine && !a.ind.off) {
             cli_refiner rf;
             cli_refiner_init(&rf, a.refine_height, 16, a.ind.photons);
-            rc = cli_refine("render", e, a.cam.eye, &rf);
+            rc = cli_refine("render", e, &a.cam, &rf);
             if (rc == EXIT_OK && !rf.high)
-                printf("refinement: %u lamps near the eye got floor maps (%u cached of %u slots)\n",
-                       rf.rs.misses_now, rf.rs.cached, rf.rs.slots);
+                printf("refinement: %u lamps near (%.1f, %.1f), %.1f m ahead of the eye, got floor maps (%u "
+                       "cached of %u slots)\n", rf.rs.misses_now, rf.rs.centre[0], rf.rs.centre[1],
+                       hypot(rf.rs.centre[0] - a.cam.eye[0], rf.rs.centre[1] - a.cam.eye[1]), rf.rs.cached,
+                       rf.rs.slots);
             else if (rc == EXIT_OK)
                 cli_warn("render", &a.c, "--refine: the eye is %g m high, above --refine-height %g m, so no lamp "
                          "was refined (munoz2013 refines only low views; a larger --refine-height refines from "

@@ -41,7 +41,9 @@ static const char help[] =
     "  --frames K       as for render\n"
     "  --max-frames N   at most N frames (default 1000)\n"
     "  --refine         near-viewer refinement (munoz2013 §3.3-3.4): before each frame\n"
-    "                   the lamps near the eye get floor photon maps in an LRU cache.\n"
+    "                   the lamps near the ground point the view looks at (at most\n"
+    "                   half the refinement radius ahead of the eye) get floor\n"
+    "                   photon maps in an LRU cache.\n"
     "                   A miss changes the indirect light: the atlas is filled again\n"
     "                   as frames show it (a slower frame); hits keep it. A lamp\n"
     "                   refined for the first time restarts the aerial chart, and\n"
@@ -337,7 +339,7 @@ static int frame(const walk_args *a, plx_engine *e, const walk_path *wp, walk_ru
     if (a->refine && !a->ind.off) {
         int rc;
         t0 = port_now_ns();
-        rc = cli_refine("walk", e, cam.eye, &wr->ref);
+        rc = cli_refine("walk", e, &cam, &wr->ref);
         wr->refine_ms += (port_now_ns() - t0) / 1e6;
         if (rc != EXIT_OK)
             return rc;

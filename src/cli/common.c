@@ -768,16 +768,16 @@ void cli_refiner_init(cli_refiner *r, double height, long frames, long photons)
     r->photons = photons;
 }
 
-int cli_refine(const char *cmd, plx_engine *e, const double eye[3], cli_refiner *r)
+int cli_refine(const char *cmd, plx_engine *e, const plx_camera *cam, cli_refiner *r)
 {
     uint64_t before = r->rs.refined;
     plx_status st;
     long k;
-    if (eye[2] > r->height) {
+    if (cam->eye[2] > r->height) {
         r->high++;
         return EXIT_OK;
     }
-    st = plx_indirect_refine(e, eye, &r->rs);
+    st = plx_indirect_refine_view(e, cam, &r->rs);
     if (st != PLX_OK) {
         fprintf(stderr, "polarlux %s: %s\n", cmd, plx_last_error(e));
         return cli_exit_code(st);

@@ -4,7 +4,8 @@
  * cache capacity, are requested farthest first. An LRU cache written here
  * follows the same requests; after every step the engine's hits, misses,
  * evictions and LRU order must equal the model's, and along the whole path
- * there must be hits, misses and evictions. */
+ * there must be hits, misses and evictions. plx_indirect_refine_view
+ * centres the same on the ground point a camera looks at. */
 #include <stdarg.h>
 #include <stddef.h>
 #include <setjmp.h>
@@ -297,12 +298,180 @@ static void test_recompute_refreshes_cache(void **state)
     fixture_done(e, m1);
 }
 
+/* plx_indirect_refine_view: the centre, computed here another way (the
+ * point eye + t d at height 0, if any, and its horizontal distance from
+ * the eye, else half the radius along the view), and the lamps requested
+ * around it, nearest first, as the LRU model has them. */
+static void view_centre(const plx_camera *c, double radius, double out[2])
+{
+    double d[3], h, t, ahead = 0.5 * radius;
+    int k;
+    for (k = 0; k < 3; k++)
+        d[k] = c->target[k] - c->eye[k];
+    h = hypot(d[0], d[1]);
+    out[0] = c->eye[0];
+    out[1] = c->eye[1];
+    if (h == 0.0)
+        return;
+    if (d[2] < 0.0) {
+        t = c->eye[2] / -d[2];  /* eye + t d is on the ground */
+        if (t * h < ahead)
+            ahead = t * h;
+    }
+    out[0] += d[0] / h * ahead;
+    out[1] += d[1] / h * ahead;
+}
+
+static void set_camera(plx_camera *c, double ex, double ey, double ez, double tx, double ty, double tz)
+{
+    memset(c, 0, sizeof *c);
+    c->eye[0] = ex; c->eye[1] = ey; c->eye[2] = ez;
+    c->target[0] = tx; c->target[1] = ty; c->target[2] = tz;
+    c->fov_deg = 60.0;
+    c->width = 640;
+    c->height = 480;
+}
+
+static void test_view_centre(void **state)
+{
+    static const double cams[][6] = {
+        { 100, 266, 1.7, 110, 266, 1.7 },   /* level: half the radius ahead */
+        { 100, 266, 40, 180, 266, 0 },      /* meets the ground 80 m ahead: clamped */
+        { 100, 266, 40, 110, 266, 0 },      /* meets it 10 m ahead */
+        { 100, 266, 40, 100, 266, 0 },      /* straight down */
+        { 300, 200, 20, 303, 204, -20 },    /* 2.5 m ahead, on a diagonal */
+        { 266, 100, 1.7, 266, 110, 50 },    /* looking up */
+        { 266, 400, 0, 276, 400, -5 },      /* the eye on the ground */
+    };
+    void *mem;
+    plx_engine *e = fixture_load_file(fixture_engine(MEM, 0, plx_port_posix(), &mem), "fixtures/eixample-4x4.geojson");
+    plx_refine_stats rs;
+    plx_camera c;
+    static model m;
+    size_t k;
+    (void)state;
+    set_camera(&c, 100, 266, 40, 180, 266, 0);
+    assert_int_equal(plx_indirect_refine_view(e, &c, &rs), PLX_E_NOSCENE);
+    assert_int_equal(plx_indirect_step(e, 5000, 1), PLX_OK);
+    assert_int_equal(plx_indirect_refine_view(e, NULL, &rs), PLX_E_INVALID);
+    assert_int_equal(plx_indirect_refine_view(NULL, &c, &rs), PLX_E_INVALID);
+    c.eye[1] = NAN;
+    assert_int_equal(plx_indirect_refine_view(e, &c, &rs), PLX_E_INVALID);
+    c.target[1] = INFINITY;
+    c.eye[1] = 266;
+    assert_int_equal(plx_indirect_refine_view(e, &c, &rs), PLX_E_INVALID);
+    memset(&m, 0, sizeof m);
+    for (k = 0; k < sizeof cams / sizeof cams[0]; k++) {
+        double want[2], centre[3];
+        uint32_t i;
+        set_camera(&c, cams[k][0], cams[k][1], cams[k][2], cams[k][3], cams[k][4], cams[k][5]);
+        assert_int_equal(plx_indirect_refine_view(e, &c, &rs), PLX_OK);
+        if (!m.lru) {
+            m.cap = rs.slots;
+            m.lru = malloc(sizeof *m.lru * m.cap);
+        }
+        view_centre(&c, rs.near_radius, want);
+        assert_true(fabs(rs.centre[0] - want[0]) < 1e-9 && fabs(rs.centre[1] - want[1]) < 1e-9);
+        assert_true(rs.centre[2] == 0.0);
+        centre[0] = want[0];
+        centre[1] = want[1];
+        centre[2] = 0.0;
+        model_update(&m, e, centre, rs.near_radius);
+        assert_int_equal(rs.hits, m.hits);
+        assert_int_equal(rs.misses, m.misses);
+        assert_int_equal(rs.cached, m.n);
+        for (i = 0; i < m.n && i < PLX_REFINE_LRU_MAX; i++)
+            assert_int_equal(rs.lru[i], m.lru[i]);
+    }
+    free(m.lru);
+    fixture_done(e, mem);
+}
+
+/* Whether lamp l's foot is inside camera c's frame (up is +z). */
+static int in_frame(const plx_camera *c, const plx_lamp *l)
+{
+    double f[3], r[3], u[3], q[3], n, z, x, y, t = tan(c->fov_deg * 3.14159265358979323846 / 360.0);
+    int k;
+    for (k = 0; k < 3; k++)
+        f[k] = c->target[k] - c->eye[k];
+    n = sqrt(f[0] * f[0] + f[1] * f[1] + f[2] * f[2]);
+    for (k = 0; k < 3; k++)
+        f[k] /= n;
+    n = hypot(f[0], f[1]);
+    r[0] = f[1] / n; r[1] = -f[0] / n; r[2] = 0.0;
+    u[0] = r[1] * f[2] - r[2] * f[1];
+    u[1] = r[2] * f[0] - r[0] * f[2];
+    u[2] = r[0] * f[1] - r[1] * f[0];
+    q[0] = l->x - c->eye[0];
+    q[1] = l->y - c->eye[1];
+    q[2] = -c->eye[2];
+    z = q[0] * f[0] + q[1] * f[1] + q[2] * f[2];
+    if (!(z > 0.0))
+        return 0;
+    x = (q[0] * r[0] + q[1] * r[1] + q[2] * r[2]) / (z * t * c->width / c->height);
+    y = (q[0] * u[0] + q[1] * u[1] + q[2] * u[2]) / (z * t);
+    return fabs(x) <= 1.0 && fabs(y) <= 1.0;
+}
+
+/* The lamps chosen around centre (nearest first, up to cap, within the
+ * radius) whose feet the camera shows. */
+static uint32_t chosen_in_frame(plx_engine *e, const plx_camera *c, const double centre[3], const model *m,
+                                double radius, uint32_t *chosen)
+{
+    model one;
+    uint32_t i, shown = 0;
+    memset(&one, 0, sizeof one);
+    one.cap = m->cap;
+    one.lru = malloc(sizeof *one.lru * one.cap);
+    model_update(&one, e, centre, radius);
+    for (i = 0; i < one.n; i++) {
+        plx_lamp l;
+        assert_int_equal(plx_lamp_get(e, one.lru[i], &l), PLX_OK);
+        shown += (uint32_t)in_frame(c, &l);
+    }
+    *chosen += one.n;
+    free(one.lru);
+    return shown;
+}
+
+/* A flight at 40 m along y = 266 looking 120 m ahead at the ground: the
+ * lamps refined around the view's centre are more often in the frame
+ * than those around the eye, most of them under or behind it. */
+static void test_view_refines_what_it_shows(void **state)
+{
+    void *mem;
+    plx_engine *e = fixture_load_file(fixture_engine(MEM, 0, plx_port_posix(), &mem), "fixtures/eixample-4x4.geojson");
+    plx_refine_stats rs;
+    plx_camera c;
+    model m;
+    uint32_t by_view = 0, by_eye = 0, n_view = 0, n_eye = 0;
+    int k;
+    (void)state;
+    assert_int_equal(plx_indirect_step(e, 5000, 1), PLX_OK);
+    memset(&m, 0, sizeof m);
+    for (k = 0; k < 20; k++) {
+        double x = 20.0 * k;
+        set_camera(&c, x, 266, 40, x + 120, 266, 0);
+        assert_int_equal(plx_indirect_refine_view(e, &c, &rs), PLX_OK);
+        m.cap = rs.slots;
+        by_view += chosen_in_frame(e, &c, rs.centre, &m, rs.near_radius, &n_view);
+        by_eye += chosen_in_frame(e, &c, c.eye, &m, rs.near_radius, &n_eye);
+    }
+    printf("along 20 views from 40 m: %u of %u lamps refined around the view's centre in the frame, %u of %u "
+           "around the eye\n", by_view, n_view, by_eye, n_eye);
+    assert_true(by_view > 0);
+    assert_true((double)by_view / n_view > 1.5 * (double)by_eye / n_eye);
+    fixture_done(e, mem);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_lru_along_path),
         cmocka_unit_test(test_hits_keep_atlas),
         cmocka_unit_test(test_recompute_refreshes_cache),
+        cmocka_unit_test(test_view_centre),
+        cmocka_unit_test(test_view_refines_what_it_shows),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
