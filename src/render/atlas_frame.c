@@ -59,90 +59,103 @@ static const atlas_map *map_of(const atlas *A, const atlas_view *v, atlas_cache 
     return m;
 }
 
-/* Cell index and weight along one axis: u clamped to [0, n - 1], the
- * cell's index in 0 .. n - 2 (truncation is floor for u >= 0). */
-static inline uint32_t cell_of(float u, uint32_t n, float *f)
+/* Bilinear reads in lanes: a row's points are gathered ATLAS_LANES at a
+ * time, each with its chart, and read together, each step a loop of fixed
+ * length over the lanes (which compilers turn into vector instructions;
+ * only the reads of the vertices are one lane at a time). A point (u, w)
+ * in vertex steps is clamped to the chart per axis, [0, n - 1], its cell
+ * is (i, j) with i in 0 .. n - 2, and its value is the four vertices'
+ * values (texel_unpack's: each channel its mantissa times its scale)
+ * times their weights, summed in the order (i, j), (i + 1, j), (i, j + 1),
+ * (i + 1, j + 1): the bits of the read one point at a time it replaced
+ * (a cell of four 0 values sums to +0, black). */
+#define ATLAS_LANES 8
+
+typedef struct lanes {
+    uint32_t n;                 /* points in use */
+    int32_t pix[ATLAS_LANES];   /* their pixels in the row */
+    const uint32_t *t0[ATLAS_LANES]; /* their chart's vertex (0, 0) */
+    float u[ATLAS_LANES], w[ATLAS_LANES], nu[ATLAS_LANES], nv[ATLAS_LANES]; /* sides in vertices */
+    uint32_t row[ATLAS_LANES];  /* the chart's row length */
+} lanes;
+
+/* Cell index and weight along one axis for every lane, n vertices along
+ * it (n >= 2, exact as a float): u clamped to [0, n - 1] (NaN to 0), the
+ * cell's index at most n - 2 (truncation is floor for u >= 0). */
+static void cells_of(const float *restrict u, const float *restrict n, int32_t *restrict cell, float *restrict f)
 {
-    uint32_t i;
-    if (!(u > 0.0f))
-        u = 0.0f;
-    if (u > (float)(n - 1))
-        u = (float)(n - 1);
-    i = (uint32_t)u;
-    if (i > n - 2)
-        i = n - 2;
-    *f = u - (float)i;
-    return i;
+    int32_t k;
+    for (k = 0; k < ATLAS_LANES; k++) {
+        float x = u[k], top = n[k] - 1.0f;
+        int32_t i, last = (int32_t)n[k] - 2;
+        x = x > 0.0f ? x : 0.0f; /* NaN compares false: 0 */
+        x = x > top ? top : x;
+        i = (int32_t)x;
+        i = i > last ? last : i;
+        cell[k] = i;
+        f[k] = x - (float)i;
+    }
 }
 
-/* The four values around the last cell read (a run's pixels mostly stay
- * in a cell or step to the next one: decoded once, reused): vertex (0, 0)
- * of the cell in the atlas (NULL: none yet), and the values of its
- * vertices (i, j), (i + 1, j), (i, j + 1), (i + 1, j + 1), each channel
- * its mantissa times its scale (exact: a 9-bit whole number times a
- * power of two). A run starts with t NULL: the cell's rows are nu apart
- * only within one chart. */
-typedef struct cell_vals {
-    const uint32_t *t;
-    float v[4][3];
-    int zero;                 /* all four packed values 0 */
-} cell_vals;
-
-static void cell_load(cell_vals *cv, const uint32_t *t, uint32_t nu)
+/* The lanes' bilinear reads, written to their pixels of lin; none left. */
+static void lanes_read(lanes *L, float *lin)
 {
-    if (cv->t && t == cv->t + 1) { /* the next cell along the row: its left side is the old right side */
-        memcpy(cv->v[0], cv->v[1], sizeof cv->v[0]);
-        memcpy(cv->v[2], cv->v[3], sizeof cv->v[2]);
-        texel_unpack(t[1], cv->v[1]);
-        texel_unpack(t[nu + 1], cv->v[3]);
-    } else if (cv->t && t + 1 == cv->t) {
-        memcpy(cv->v[1], cv->v[0], sizeof cv->v[1]);
-        memcpy(cv->v[3], cv->v[2], sizeof cv->v[3]);
-        texel_unpack(t[0], cv->v[0]);
-        texel_unpack(t[nu], cv->v[2]);
-    } else {
-        texel_unpack(t[0], cv->v[0]);
-        texel_unpack(t[1], cv->v[1]);
-        texel_unpack(t[nu], cv->v[2]);
-        texel_unpack(t[nu + 1], cv->v[3]);
+    uint32_t qa[ATLAS_LANES], qb[ATLAS_LANES], qc[ATLAS_LANES], qd[ATLAS_LANES];
+    int32_t ci[ATLAS_LANES], cj[ATLAS_LANES], k;
+    float fu[ATLAS_LANES], fv[ATLAS_LANES], o[3][ATLAS_LANES];
+    for (k = (int32_t)L->n; k < ATLAS_LANES; k++) { /* idle lanes read the first point */
+        L->t0[k] = L->t0[0];
+        L->u[k] = L->u[0];
+        L->w[k] = L->w[0];
+        L->nu[k] = L->nu[0];
+        L->nv[k] = L->nv[0];
+        L->row[k] = L->row[0];
     }
-    cv->t = t;
-    cv->zero = (t[0] | t[1] | t[nu] | t[nu + 1]) == 0u;
+    cells_of(L->u, L->nu, ci, fu);
+    cells_of(L->w, L->nv, cj, fv);
+    for (k = 0; k < ATLAS_LANES; k++) {
+        const uint32_t *t = L->t0[k] + (size_t)cj[k] * L->row[k] + (size_t)ci[k];
+        qa[k] = t[0];
+        qb[k] = t[1];
+        qc[k] = t[L->row[k]];
+        qd[k] = t[L->row[k] + 1];
+    }
+    for (k = 0; k < ATLAS_LANES; k++) {
+        float wa = (1.0f - fu[k]) * (1.0f - fv[k]), wb = fu[k] * (1.0f - fv[k]);
+        float wc = (1.0f - fu[k]) * fv[k], wd = fu[k] * fv[k];
+        float sa = texel_scale(qa[k]), sb = texel_scale(qb[k]), sc = texel_scale(qc[k]), sd = texel_scale(qd[k]);
+        o[0][k] = (float)(int32_t)(qa[k] & 511u) * sa * wa + (float)(int32_t)(qb[k] & 511u) * sb * wb +
+                  (float)(int32_t)(qc[k] & 511u) * sc * wc + (float)(int32_t)(qd[k] & 511u) * sd * wd;
+        o[1][k] = (float)(int32_t)((qa[k] >> 9) & 511u) * sa * wa + (float)(int32_t)((qb[k] >> 9) & 511u) * sb * wb +
+                  (float)(int32_t)((qc[k] >> 9) & 511u) * sc * wc + (float)(int32_t)((qd[k] >> 9) & 511u) * sd * wd;
+        o[2][k] = (float)(int32_t)((qa[k] >> 18) & 511u) * sa * wa +
+                  (float)(int32_t)((qb[k] >> 18) & 511u) * sb * wb +
+                  (float)(int32_t)((qc[k] >> 18) & 511u) * sc * wc + (float)(int32_t)((qd[k] >> 18) & 511u) * sd * wd;
+    }
+    for (k = 0; k < (int32_t)L->n; k++) {
+        float *p = &lin[3 * (size_t)L->pix[k]];
+        p[0] = o[0][k];
+        p[1] = o[1][k];
+        p[2] = o[2][k];
+    }
+    L->n = 0;
 }
 
-/* Bilinear over the vertices of a chart whose vertex (0, 0) is t0 and
- * rows nu long, at (u, w) in vertex steps, summed vertex by vertex
- * (value times weight: the same bits as mantissa times scale-and-weight,
- * the scale a power of two, unless scale times weight falls below 2^-126:
- * weights under 2^-99, a point within 1e-15 m of the ground tiles'
- * corner); black (+0) where all four are 0. */
-static inline void bilerp(cell_vals *cv, const uint32_t *t0, uint32_t nu, uint32_t nv, float u, float w,
-                          float out[3])
+/* Pixel i's read at (u, w) of the chart at t0 (nu by nv vertices), read
+ * when the lanes are full. */
+static inline void lanes_add(lanes *L, int32_t i, const uint32_t *t0, uint32_t nu, uint32_t nv, float u, float w,
+                             float *lin)
 {
-    float fu, fv, wa, wb, wc, wd, o0, o1, o2;
-    uint32_t i = cell_of(u, nu, &fu), j = cell_of(w, nv, &fv);
-    const uint32_t *t = t0 + (size_t)j * nu + i;
-    const float *a, *b, *c, *d;
-    if (t != cv->t)
-        cell_load(cv, t, nu);
-    if (cv->zero) {
-        out[0] = out[1] = out[2] = 0.0f;
-        return;
-    }
-    wa = (1.0f - fu) * (1.0f - fv);
-    wb = fu * (1.0f - fv);
-    wc = (1.0f - fu) * fv;
-    wd = fu * fv;
-    a = cv->v[0];
-    b = cv->v[1];
-    c = cv->v[2];
-    d = cv->v[3];
-    o0 = a[0] * wa + b[0] * wb + c[0] * wc + d[0] * wd; /* all read before out is written */
-    o1 = a[1] * wa + b[1] * wb + c[1] * wc + d[1] * wd;
-    o2 = a[2] * wa + b[2] * wb + c[2] * wc + d[2] * wd;
-    out[0] = o0;
-    out[1] = o1;
-    out[2] = o2;
+    uint32_t k = L->n;
+    L->pix[k] = i;
+    L->t0[k] = t0;
+    L->u[k] = u;
+    L->w[k] = w;
+    L->nu[k] = (float)nu;
+    L->nv[k] = (float)nv;
+    L->row[k] = nu;
+    if (++L->n == ATLAS_LANES)
+        lanes_read(L, lin);
 }
 
 /* A row's ground: the hit point (x, y) relative to the tiles' corner at
@@ -268,14 +281,13 @@ uint32_t atlas_frame_missing(atlas *A, const atlas_view *v, const uint32_t *ids,
 /* A run of ground pixels i0 .. i1 - 1 of a row: the block under each hit
  * point, kept while the points stay in it (a row's points move by a
  * fixed step: runs of them share a block); black in a dark block. */
-static void ground_run(const atlas *A, const ground_row *g, int32_t i0, int32_t i1, const uint8_t *mask, float *lin)
+static void ground_run(const atlas *A, const ground_row *g, int32_t i0, int32_t i1, const uint8_t *mask, lanes *L,
+                       float *lin)
 {
     double bx0 = 0.0, by0 = 0.0, inv = 0.0, lim = -1.0;
     const uint32_t *t0 = NULL;
     uint32_t cur = UINT32_MAX;
     int32_t i;
-    cell_vals cv;
-    cv.t = NULL;
     for (i = i0; i < i1; i++) {
         double x = g->x0 + i * g->dx, y = g->y0 + i * g->dy, u = (x - bx0) * inv, w = (y - by0) * inv;
         float *o = &lin[3 * (size_t)i];
@@ -285,7 +297,6 @@ static void ground_run(const atlas *A, const ground_row *g, int32_t i0, int32_t 
             cur = ground_block(A, x, y, &u, &w);
             t0 = NULL;
             lim = -1.0;
-            cv.t = NULL;
             if (cur != UINT32_MAX && A->gfirst[cur] != ATLAS_NOVERT) {
                 t0 = A->gdone[cur] == ATLAS_DARK ? NULL : &A->tex[A->gfirst[cur]];
                 block_frame(A, cur, &bx0, &by0, &inv);
@@ -296,7 +307,7 @@ static void ground_run(const atlas *A, const ground_row *g, int32_t i0, int32_t 
             o[0] = o[1] = o[2] = 0.0f;
             continue;
         }
-        bilerp(&cv, t0, ATLAS_BLOCK + 1, ATLAS_BLOCK + 1, (float)u, (float)w, o);
+        lanes_add(L, i, t0, ATLAS_BLOCK + 1, ATLAS_BLOCK + 1, (float)u, (float)w, lin);
     }
 }
 
@@ -304,7 +315,7 @@ static void ground_run(const atlas *A, const ground_row *g, int32_t i0, int32_t 
  * then each pixel's (u, v) and the bilinear read; black on a dark chart
  * (the same bits: a bilinear read of four 0 values is +0). */
 static void surface_run(const atlas *A, const atlas_view *v, atlas_cache *k, uint32_t sid, int32_t j, int32_t i0,
-                        int32_t i1, const uint8_t *mask, float *lin)
+                        int32_t i1, const uint8_t *mask, lanes *L, float *lin)
 {
     const atlas_map *m = map_of(A, v, k, sid);
     const atlas_chart *c = m->c && A->cdone[sid - 2u] != ATLAS_DARK ? m->c : NULL;
@@ -312,8 +323,6 @@ static void surface_run(const atlas *A, const atlas_view *v, atlas_cache *k, uin
     const uint32_t *t0;
     uint32_t nu, nv;
     int32_t i;
-    cell_vals cv;
-    cv.t = NULL;
     if (!c) {
         for (i = i0; i < i1; i++)
             if (!mask || mask[i])
@@ -333,7 +342,7 @@ static void surface_run(const atlas *A, const atlas_view *v, atlas_cache *k, uin
         float fi = (float)i, r = 1.0f / (bw + aw * fi);
         if (mask && !mask[i])
             continue;
-        bilerp(&cv, t0, nu, nv, (bu + au * fi) * r, (bv + av * fi) * r, &lin[3 * (size_t)i]);
+        lanes_add(L, i, t0, nu, nv, (bu + au * fi) * r, (bv + av * fi) * r, lin);
     }
 }
 
@@ -341,7 +350,9 @@ void atlas_frame_row(const atlas *A, const atlas_view *v, atlas_cache *k, const 
                      int32_t j, float *lin, uint64_t count[3])
 {
     ground_row g;
+    lanes L;
     int32_t i = 0, e;
+    L.n = 0;
     ground_setup(A, v, j, &g);
     while (i < v->w) {
         uint32_t sid = ids[i];
@@ -362,12 +373,14 @@ void atlas_frame_row(const atlas *A, const atlas_view *v, atlas_cache *k, const 
                     lin[3 * (size_t)q] = lin[3 * (size_t)q + 1] = lin[3 * (size_t)q + 2] = 0.0f;
             count[0] += n;
         } else if (sid == MESH_SURF_GROUND) {
-            ground_run(A, &g, i, e, mask, lin);
+            ground_run(A, &g, i, e, mask, &L, lin);
             count[1] += n;
         } else {
-            surface_run(A, v, k, sid, j, i, e, mask, lin);
+            surface_run(A, v, k, sid, j, i, e, mask, &L, lin);
             count[2] += n;
         }
         i = e;
     }
+    if (L.n)
+        lanes_read(&L, lin);
 }
