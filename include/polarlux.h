@@ -627,7 +627,7 @@ typedef struct plx_refine_stats {
     double near_radius;         /* lamps within this horizontal distance are refined, m */
     uint32_t cached;            /* lamps in the cache now ... */
     uint32_t lru[PLX_REFINE_LRU_MAX]; /* ... the first of them, most recently used first */
-    double centre[3];           /* the point the lamps were chosen around (x, y; z 0) */
+    double centre[3];           /* the point the lamps were chosen around: local metres (x, y; z 0) */
 } plx_refine_stats;
 
 /*

@@ -370,11 +370,15 @@ int cmd_render(int argc, char **argv)
             cli_refiner rf;
             cli_refiner_init(&rf, a.refine_height, 16, a.ind.photons);
             rc = cli_refine("render", e, &a.cam, &rf);
-            if (rc == EXIT_OK && !rf.high)
-                printf("refinement: %u lamps near (%.1f, %.1f), %.1f m ahead of the eye, got floor maps (%u "
-                       "cached of %u slots)\n", rf.rs.misses_now, rf.rs.centre[0], rf.rs.centre[1],
-                       hypot(rf.rs.centre[0] - a.cam.eye[0], rf.rs.centre[1] - a.cam.eye[1]), rf.rs.cached,
-                       rf.rs.slots);
+            if (rc == EXIT_OK && !rf.high) {
+                double cx = rf.rs.centre[0], cy = rf.rs.centre[1], ahead = hypot(cx - a.cam.eye[0], cy - a.cam.eye[1]);
+                plx_scene_info si;
+                plx_scene_info_get(e, &si);
+                cli_from_local(e, &cx, &cy); /* in the scene's coordinates, as the view below */
+                printf("refinement: %u lamps near (%.*f, %.*f), %.1f m ahead of the eye, got floor maps (%u "
+                       "cached of %u slots)\n", rf.rs.misses_now, si.lonlat ? 7 : 1, cx, si.lonlat ? 7 : 1, cy,
+                       ahead, rf.rs.cached, rf.rs.slots);
+            }
             else if (rc == EXIT_OK)
                 cli_warn("render", &a.c, "--refine: the eye is %g m high, above --refine-height %g m, so no lamp "
                          "was refined (munoz2013 refines only low views; a larger --refine-height refines from "
