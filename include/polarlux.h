@@ -673,7 +673,8 @@ typedef struct plx_camera {
  * from 30 to 60 m looking ahead refines the lamps it shows instead of
  * those under the eye, below the frame; a level view (no ground met) is
  * centred near_radius / 2 ahead, so the lamps beside the viewer stay
- * within reach. A view straight down keeps the eye's ground point.
+ * within reach. A view straight down, and an eye at or below the ground,
+ * keep the eye's ground point.
  * out->centre gets the centre. Errors: those of plx_indirect_refine;
  * PLX_E_INVALID for a NULL or non-finite camera.
  */

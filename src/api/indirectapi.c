@@ -81,13 +81,15 @@ plx_status plx_indirect_refine(plx_engine *e, const double eye[3], plx_refine_st
 
 /* How far ahead of the eye, horizontally, a view's refinement is centred:
  * where the centre ray (direction d, horizontal length h > 0) meets the
- * ground, at most limit. */
+ * ground, at most limit; 0 for an eye at or below the ground. */
 static double refine_ahead(const double eye[3], const double d[3], double h, double limit)
 {
     double s;
+    if (!(eye[2] > 0.0))
+        return 0.0;             /* at or below the ground: its own ground point */
     if (!(d[2] < 0.0))
-        return limit;           /* level or upward: the ground is never met */
-    s = eye[2] > 0.0 ? eye[2] * h / -d[2] : 0.0;
+        return limit;           /* level or upward from above: the ground is never met */
+    s = eye[2] * h / -d[2];
     return s < limit ? s : limit;
 }
 
@@ -106,7 +108,7 @@ plx_status plx_indirect_refine_view(plx_engine *e, const plx_camera *cam, plx_re
     }
     if (!e->ph)
         return eng_fail(e, PLX_E_NOSCENE, "plx_indirect_refine_view: no photon buffers (trace indirect light first)");
-    h = sqrt(d[0] * d[0] + d[1] * d[1]);
+    h = hypot(d[0], d[1]); /* no underflow or overflow of the squares */
     if (h > 0.0 && isfinite(h))
         a = refine_ahead(cam->eye, d, h, 0.5 * e->ph->cfg.near_radius);
     c[0] = a > 0.0 ? cam->eye[0] + d[0] / h * a : cam->eye[0];

@@ -103,6 +103,8 @@ static void lanes_read(lanes *L, float *lin)
     uint32_t qa[ATLAS_LANES], qb[ATLAS_LANES], qc[ATLAS_LANES], qd[ATLAS_LANES];
     int32_t ci[ATLAS_LANES], cj[ATLAS_LANES], k;
     float fu[ATLAS_LANES], fv[ATLAS_LANES], o[3][ATLAS_LANES];
+    if (L->n == 0)
+        return;
     for (k = (int32_t)L->n; k < ATLAS_LANES; k++) { /* idle lanes read the first point */
         L->t0[k] = L->t0[0];
         L->u[k] = L->u[0];

