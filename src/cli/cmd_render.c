@@ -302,6 +302,25 @@ static int write_outputs(const render_args *a, const uint8_t *rgb8, const float 
     return EXIT_OK;
 }
 
+/* Digits after the point for the scene's coordinates: lon/lat or metres. */
+static int coord_digits(plx_engine *e)
+{
+    plx_scene_info si;
+    plx_scene_info_get(e, &si);
+    return si.lonlat ? 7 : 1;
+}
+
+/* The refinement's centre, in the scene's coordinates as the view line,
+ * and what it cached. */
+static void print_refinement(plx_engine *e, const plx_camera *cam, const plx_refine_stats *rs)
+{
+    double cx = rs->centre[0], cy = rs->centre[1], ahead = hypot(cx - cam->eye[0], cy - cam->eye[1]);
+    int d = coord_digits(e);
+    cli_from_local(e, &cx, &cy);
+    printf("refinement: %u lamps near (%.*f, %.*f), %.1f m ahead of the eye, got floor maps (%u cached of %u "
+           "slots)\n", rs->misses_now, d, cx, d, cy, ahead, rs->cached, rs->slots);
+}
+
 int cmd_render(int argc, char **argv)
 {
     render_args a;
@@ -370,15 +389,8 @@ int cmd_render(int argc, char **argv)
             cli_refiner rf;
             cli_refiner_init(&rf, a.refine_height, 16, a.ind.photons);
             rc = cli_refine("render", e, &a.cam, &rf);
-            if (rc == EXIT_OK && !rf.high) {
-                double cx = rf.rs.centre[0], cy = rf.rs.centre[1], ahead = hypot(cx - a.cam.eye[0], cy - a.cam.eye[1]);
-                plx_scene_info si;
-                plx_scene_info_get(e, &si);
-                cli_from_local(e, &cx, &cy); /* in the scene's coordinates, as the view below */
-                printf("refinement: %u lamps near (%.*f, %.*f), %.1f m ahead of the eye, got floor maps (%u "
-                       "cached of %u slots)\n", rf.rs.misses_now, si.lonlat ? 7 : 1, cx, si.lonlat ? 7 : 1, cy,
-                       ahead, rf.rs.cached, rf.rs.slots);
-            }
+            if (rc == EXIT_OK && !rf.high)
+                print_refinement(e, &a.cam, &rf.rs);
             else if (rc == EXIT_OK)
                 cli_warn("render", &a.c, "--refine: the eye is %g m high, above --refine-height %g m, so no lamp "
                          "was refined (munoz2013 refines only low views; a larger --refine-height refines from "
@@ -420,11 +432,7 @@ int cmd_render(int argc, char **argv)
         goto done;
     }
     rc = write_outputs(&a, rgb8, rgbf);
-    {
-        plx_scene_info si;
-        plx_scene_info_get(e, &si);
-        prec = si.lonlat ? 7 : 1;
-    }
+    prec = coord_digits(e);
     cli_from_local(e, &a.cam.eye[0], &a.cam.eye[1]);
     cli_from_local(e, &a.cam.target[0], &a.cam.target[1]);
     if (rc == EXIT_OK && cli_all_black(rgb8, (size_t)a.cam.width * a.cam.height * 3))
