@@ -291,10 +291,14 @@ static void ground_run(const atlas *A, const ground_row *g, int32_t i0, int32_t 
     uint32_t cur = UINT32_MAX;
     int32_t i;
     for (i = i0; i < i1; i++) {
-        double x = g->x0 + i * g->dx, y = g->y0 + i * g->dy, u = (x - bx0) * inv, w = (y - by0) * inv;
+        double x, y, u, w;
         float *o = &lin[3 * (size_t)i];
         if (mask && !mask[i])
             continue;
+        x = g->x0 + i * g->dx;
+        y = g->y0 + i * g->dy;
+        u = (x - bx0) * inv;
+        w = (y - by0) * inv;
         if (!(u >= 0.0 && u <= lim && w >= 0.0 && w <= lim)) { /* another block */
             cur = ground_block(A, x, y, &u, &w);
             t0 = NULL;
@@ -341,11 +345,24 @@ static void surface_run(const atlas *A, const atlas_view *v, atlas_cache *k, uin
     nu = c->nu;
     nv = c->nv;
     for (i = i0; i < i1; i++) {
-        float fi = (float)i, r = 1.0f / (bw + aw * fi);
+        float fi = (float)i, r;
         if (mask && !mask[i])
             continue;
+        r = 1.0f / (bw + aw * fi);
         lanes_add(L, i, t0, nu, nv, (bu + au * fi) * r, (bv + av * fi) * r, lin);
     }
+}
+
+/* The first marked pixel of i .. e - 1 (e: none), eight unmarked bytes a
+ * test where it can. */
+static int32_t next_marked(const uint8_t *mask, int32_t i, int32_t e)
+{
+    uint64_t q;
+    while (i + 8 <= e && (memcpy(&q, mask + i, sizeof q), q == 0))
+        i += 8;
+    while (i < e && !mask[i])
+        i++;
+    return i;
 }
 
 void atlas_frame_row(const atlas *A, const atlas_view *v, atlas_cache *k, const uint32_t *ids, const uint8_t *mask,
@@ -363,6 +380,9 @@ void atlas_frame_row(const atlas *A, const atlas_view *v, atlas_cache *k, const 
             ;
         if (mask) { /* only the marked pixels are written, and counted */
             int32_t q;
+            i = next_marked(mask, i, e);
+            if (i == e)
+                continue;
             for (n = 0, q = i; q < e; q++)
                 n += mask[q] != 0;
         } else {

@@ -2492,15 +2492,27 @@ static uint32_t mask_class(uint32_t id)
     return id == MESH_SURF_GROUND ? MESH_SURF_NONE : id;
 }
 
+/* Marks (sets to 1) the n pixels whose surface in id is not the one in
+ * id0, sixteen at a time in a loop of fixed length (vectorised by GCC
+ * at -O2); the marks are 0 or 1, so or-ing the test gives the same. */
+#define MASK_LANES 16
+static void mask_ids(uint8_t *restrict mask, const uint32_t *restrict id, const uint32_t *restrict id0, size_t n)
+{
+    size_t p;
+    int k;
+    for (p = 0; p + MASK_LANES <= n; p += MASK_LANES)
+        for (k = 0; k < MASK_LANES; k++)
+            mask[p + k] |= (uint8_t)(mask_class(id[p + k]) != mask_class(id0[p + k]));
+    for (; p < n; p++)
+        mask[p] |= (uint8_t)(mask_class(id[p]) != mask_class(id0[p]));
+}
+
 /* Marks the pixels whose surface is not the first sample's, and those of
  * the glows this sample sees. */
 static void mask_update(render *r, const render_opts *o)
 {
-    size_t p, px = (size_t)r->w * (size_t)r->h;
     if (o->mask_id)
-        for (p = 0; p < px; p++)
-            if (mask_class(r->id[p]) != mask_class(o->mask_id[p]))
-                o->mask[p] = 1;
+        mask_ids(o->mask, r->id, o->mask_id, (size_t)r->w * (size_t)r->h);
     if (!o->no_glow)
         glow_mark(r, o->mask);
 }
@@ -2553,10 +2565,60 @@ typedef struct mask_job {
     unsigned level;
 } mask_job;
 
+/* The pairs pixel i of a row starts (c: its bytes, ic: its ids; n, in:
+ * the row below, when down) that differ: surface id, or a channel more
+ * than the level apart (px_far). */
+static unsigned pair_bits(const uint8_t *c, const uint8_t *n, const uint32_t *ic, const uint32_t *in, int32_t i,
+                          int32_t w, int down, const far_k *fk)
+{
+    uint64_t pc = px_lanes(c + 3 * (size_t)i);
+    unsigned b = 0;
+    if (i + 1 < w)
+        b |= (ic[i] != ic[i + 1] || px_far(pc, px_lanes(c + 3 * (size_t)(i + 1)), fk)) ? MASK_RIGHT : 0u;
+    if (down) {
+        if (i + 1 < w)
+            b |= (ic[i] != in[i + 1] || px_far(pc, px_lanes(n + 3 * (size_t)(i + 1)), fk)) ? MASK_DOWN_RIGHT : 0u;
+        b |= (ic[i] != in[i] || px_far(pc, px_lanes(n + 3 * (size_t)i), fk)) ? MASK_DOWN : 0u;
+        if (i > 0)
+            b |= (ic[i] != in[i - 1] || px_far(pc, px_lanes(n + 3 * (size_t)(i - 1)), fk)) ? MASK_DOWN_LEFT : 0u;
+    }
+    return b;
+}
+
+/* Whether bytes a and b are more than level L apart. */
+static inline uint8_t far8(uint8_t a, uint8_t b, uint8_t L)
+{
+    uint8_t d = a > b ? (uint8_t)(a - b) : (uint8_t)(b - a);
+    return d > L;
+}
+
+/* pair_bits for MASK_CHUNK pixels of a row with a row below, none on the
+ * frame's left or right edge (c, n, ic, in and bt at the first of them):
+ * the channels' tests byte by byte and the ids' pixel by pixel, in loops
+ * of fixed length that GCC vectorises at -O2, then each pixel's three
+ * channels or-ed together. */
+#define MASK_CHUNK 64
+static void pair_bits_chunk(const uint8_t *restrict c, const uint8_t *restrict n, const uint32_t *restrict ic,
+                            const uint32_t *restrict in, uint8_t level, uint8_t *restrict bt)
+{
+    uint8_t f[3 * MASK_CHUNK];
+    int k;
+    for (k = 0; k < 3 * MASK_CHUNK; k++) {
+        uint8_t a = c[k];
+        f[k] = (uint8_t)(far8(a, c[k + 3], level) | far8(a, n[k], level) << 1 | far8(a, n[k + 3], level) << 2 |
+                         far8(a, n[k - 3], level) << 3);
+    }
+    for (k = 0; k < MASK_CHUNK; k++) {
+        uint32_t x = ic[k];
+        bt[k] = (uint8_t)((x != ic[k + 1]) | (x != in[k]) << 1 | (x != in[k + 1]) << 2 | (x != in[k - 1]) << 3);
+    }
+    for (k = 0; k < MASK_CHUNK; k++)
+        bt[k] |= (uint8_t)(f[3 * k] | f[3 * k + 1] | f[3 * k + 2]);
+}
+
 /* Rows of job k: for each pixel, which of the pairs it starts (right,
- * down, down-right, down-left) differ: surface id, or a channel more than
- * level steps apart. Along a row the lanes of the pixel, its right
- * neighbour and the three below are carried from pixel to pixel. */
+ * down, down-right, down-left) differ (pair_bits): chunks of MASK_CHUNK
+ * pixels inside the frame with a row below, the rest one by one. */
 static void mask_bits_rows(void *arg, int worker, uint32_t k)
 {
     const mask_job *jb = arg;
@@ -2569,55 +2631,70 @@ static void mask_bits_rows(void *arg, int worker, uint32_t k)
         const uint32_t *ic = jb->id + (size_t)j * (size_t)w, *in = ic + w;
         uint8_t *bt = jb->bits + (size_t)j * (size_t)w;
         int down = j + 1 < h;
-        uint64_t pc = px_lanes(c), pn = down ? px_lanes(n) : 0, pnl = 0;
-        for (i = 0; i < w; i++) {
-            uint64_t pr = 0, pnr = 0;
-            unsigned b = 0;
-            if (i + 1 < w) {
-                pr = px_lanes(c + 3 * (size_t)(i + 1));
-                b |= (ic[i] != ic[i + 1] || px_far(pc, pr, &fk)) ? MASK_RIGHT : 0u;
+        i = 0;
+        if (down && w >= MASK_CHUNK + 2) {
+            bt[0] = (uint8_t)pair_bits(c, n, ic, in, 0, w, down, &fk);
+            for (i = 1; i < w - 1; i += MASK_CHUNK) {
+                i = i + MASK_CHUNK <= w - 1 ? i : w - 1 - MASK_CHUNK; /* the last overlaps the one before */
+                pair_bits_chunk(c + 3 * (size_t)i, n + 3 * (size_t)i, ic + i, in + i, (uint8_t)jb->level, bt + i);
             }
-            if (down) {
-                if (i + 1 < w) {
-                    pnr = px_lanes(n + 3 * (size_t)(i + 1));
-                    b |= (ic[i] != in[i + 1] || px_far(pc, pnr, &fk)) ? MASK_DOWN_RIGHT : 0u;
-                }
-                b |= (ic[i] != in[i] || px_far(pc, pn, &fk)) ? MASK_DOWN : 0u;
-                if (i > 0)
-                    b |= (ic[i] != in[i - 1] || px_far(pc, pnl, &fk)) ? MASK_DOWN_LEFT : 0u;
-            }
-            bt[i] = (uint8_t)b;
-            pnl = pn;
-            pn = pnr;
-            pc = pr;
         }
+        for (; i < w; i++)
+            bt[i] = (uint8_t)pair_bits(c, n, ic, in, i, w, down, &fk);
     }
 }
 
-/* Rows of job k: a pixel is marked when a pair it starts differs, or a
- * pair that ends at it (from its left, upper, upper-left or upper-right
- * neighbour). */
+/* A pixel's mark from the pairs' bits bt (at it, its row's stride w): a
+ * pair it starts differs, or one that ends at it (from its left, upper,
+ * upper-left or upper-right neighbour). */
+static uint8_t mark_at(const uint8_t *bt, int32_t i, int32_t j, int32_t w)
+{
+    size_t ws = (size_t)w;
+    unsigned m = bt[0] != 0;
+    if (i > 0)
+        m |= (bt[-1] & MASK_RIGHT) != 0;
+    if (j > 0) {
+        m |= (bt[-(ptrdiff_t)ws] & MASK_DOWN) != 0;
+        if (i > 0)
+            m |= (bt[-(ptrdiff_t)ws - 1] & MASK_DOWN_RIGHT) != 0;
+        if (i + 1 < w)
+            m |= (bt[-(ptrdiff_t)ws + 1] & MASK_DOWN_LEFT) != 0;
+    }
+    return (uint8_t)m;
+}
+
+/* mark_at for MASK_CHUNK pixels of a row with a row above, none on the
+ * frame's left or right edge (bt, up: the row's bits and the row above's,
+ * and out at the first of them), in a loop of fixed length. */
+static void marks_chunk(const uint8_t *restrict bt, const uint8_t *restrict up, uint8_t *restrict out)
+{
+    int k;
+    for (k = 0; k < MASK_CHUNK; k++)
+        out[k] = (uint8_t)((bt[k] != 0) | ((bt[k - 1] & MASK_RIGHT) != 0) | ((up[k] & MASK_DOWN) != 0) |
+                           ((up[k - 1] & MASK_DOWN_RIGHT) != 0) | ((up[k + 1] & MASK_DOWN_LEFT) != 0));
+}
+
+/* Rows of job k: each pixel's mark (mark_at), chunks inside the frame
+ * below its first row, the rest one by one. */
 static void mask_or_rows(void *arg, int worker, uint32_t k)
 {
     const mask_job *jb = arg;
-    const uint8_t *bt = jb->bits;
     int32_t w = jb->r->w, h = jb->r->h, i, j, j1 = (int32_t)(k + 1) * MASK_ROWS;
     (void)worker;
-    for (j = (int32_t)k * MASK_ROWS; j < j1 && j < h; j++)
-        for (i = 0; i < w; i++) {
-            size_t p = (size_t)j * (size_t)w + (size_t)i, ws = (size_t)w;
-            unsigned m = bt[p] != 0;
-            if (i > 0)
-                m |= (bt[p - 1] & MASK_RIGHT) != 0;
-            if (j > 0) {
-                m |= (bt[p - ws] & MASK_DOWN) != 0;
-                if (i > 0)
-                    m |= (bt[p - ws - 1] & MASK_DOWN_RIGHT) != 0;
-                if (i + 1 < w)
-                    m |= (bt[p - ws + 1] & MASK_DOWN_LEFT) != 0;
+    for (j = (int32_t)k * MASK_ROWS; j < j1 && j < h; j++) {
+        const uint8_t *bt = jb->bits + (size_t)j * (size_t)w;
+        uint8_t *out = jb->out + (size_t)j * (size_t)w;
+        i = 0;
+        if (j > 0 && w >= MASK_CHUNK + 2) {
+            out[0] = mark_at(bt, 0, j, w);
+            for (i = 1; i < w - 1; i += MASK_CHUNK) {
+                i = i + MASK_CHUNK <= w - 1 ? i : w - 1 - MASK_CHUNK; /* the last overlaps the one before */
+                marks_chunk(bt + i, bt + i - w, out + i);
             }
-            jb->out[p] = (uint8_t)m;
         }
+        for (; i < w; i++)
+            out[i] = mark_at(bt + i, i, j, w);
+    }
 }
 
 size_t render_aa_mask(render *r, const render_opts *o, double ex, int curve, int level, uint8_t *rgb, uint32_t *id0,

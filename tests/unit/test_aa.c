@@ -359,6 +359,13 @@ static void test_aa_mask(void **state)
     mask_against_brute(e, 160, 120, 2);
     mask_against_brute(e, 97, 45, 2);
     mask_against_brute(e, 31, 9, 2);
+    /* the vector chunks of 64 pixels inside a row: exactly two (130), the
+     * smallest row that takes one (66), one too short (65), and a last
+     * chunk overlapping the one before (200) */
+    mask_against_brute(e, 130, 20, 1);
+    mask_against_brute(e, 66, 17, 2);
+    mask_against_brute(e, 65, 17, 1);
+    mask_against_brute(e, 200, 33, 2);
     plx_engine_destroy(e);
     free(mem);
 }
