@@ -536,6 +536,8 @@ static plx_status render_aa(plx_engine *e, const render_camera *rc, render_opts 
             const float *lin;
             ro->shift[0] = (a + 0.5) / n - 0.5;
             ro->shift[1] = (b + 0.5) / n - 0.5;
+            /* one culling for all the sample points: made by the first */
+            ro->cull_samples = n < 2 ? 0 : a == 0 && b == 0 ? RENDER_SAMPLE_FIRST : RENDER_SAMPLE_LATER;
             st = render_frame(e->rd, rc, ro, NULL, NULL, rs);
             if (st != PLX_OK)
                 break;
@@ -565,6 +567,7 @@ static plx_status render_aa(plx_engine *e, const render_camera *rc, render_opts 
     ro->auto_exposure = curve;
     ro->mask = NULL;
     ro->mask_id = NULL;
+    ro->cull_samples = 0;
     if (st != PLX_OK)
         return st;
     aa_scale(e->aa_sum, 3 * px, inv);

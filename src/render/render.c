@@ -92,6 +92,14 @@ struct render {
     double eye[3], f[3], rt[3], up[3];
     double sx, sy, za, zb, tanh_, aspect, near_, far_;
     double shift[2], shx, shy;  /* sample point offset in pixels, and in NDC */
+    double cpad[3];             /* the frustum culling's widening: x and y in NDC a unit of w,
+                                   and rows (render_opts.cull_samples) */
+    /* the culling kept for the later sample points of a frame (cull_samples):
+     * what it was made for, and its counts */
+    int kept;
+    double kept_key[16];
+    int kept_inside;
+    uint32_t kept_frustum, kept_occlusion;
     /* shading by tiles */
     light *lt;                  /* the light module when shade is render_shade_light */
     shade_ws ws[RENDER_MAX_WORKERS];  /* one per worker of the shading pass */
@@ -504,6 +512,10 @@ void render_frame_clear(render *r)
     memset(r->up, 0, sizeof r->up);
     r->sx = r->sy = r->za = r->zb = r->tanh_ = r->aspect = r->near_ = r->far_ = 0.0;
     r->shift[0] = r->shift[1] = r->shx = r->shy = 0.0;
+    memset(r->cpad, 0, sizeof r->cpad);
+    r->kept = r->kept_inside = 0;
+    memset(r->kept_key, 0, sizeof r->kept_key);
+    r->kept_frustum = r->kept_occlusion = 0;
     r->nbx = r->nby = 0;
     r->sparse = 0;
 }
@@ -591,6 +603,12 @@ static int setup_camera(render *r, const render_camera *c, const render_opts *o)
     r->shift[1] = isfinite(o->shift[1]) ? o->shift[1] : 0.0;
     r->shx = 2.0 * r->shift[0] / c->width;
     r->shy = 2.0 * r->shift[1] / c->height;
+    /* culling for every sample point within the pixel: a sample point
+     * moves a point's clip x by less than 2 / width times w from this
+     * one's, y by 2 / height, its row by less than one */
+    r->cpad[0] = o->cull_samples ? 2.0 / c->width : 0.0;
+    r->cpad[1] = o->cull_samples ? 2.0 / c->height : 0.0;
+    r->cpad[2] = o->cull_samples ? 1.0 : 0.0;
     /* far: beyond every corner of the scene box (buildings, lamps' reach) */
     {
         double hx = fmax(fabs(b[0] - c->eye[0]), fabs(b[2] - c->eye[0]));
@@ -987,11 +1005,12 @@ static int corners_out(const render *r, double c[8][4], double *wmn, double *wmx
         big = aw > big ? aw : big;
     }
     for (k = 0; k < 8; k++) {
-        double w = c[k][3], tol = 1e-6 * (whole ? big : (w < 0.0 ? -w : w)) + 1e-9;
-        if (!(c[k][0] > w + tol)) out_r = 0;
-        if (!(c[k][0] < -w - tol)) out_l = 0;
-        if (!(c[k][1] > w + tol)) out_t = 0;
-        if (!(c[k][1] < -w - tol)) out_b = 0;
+        double w = c[k][3], aw = whole ? big : (w < 0.0 ? -w : w), tol = 1e-6 * aw + 1e-9;
+        double tx = tol + r->cpad[0] * aw, ty = tol + r->cpad[1] * aw; /* tol when not widened */
+        if (!(c[k][0] > w + tx)) out_r = 0;
+        if (!(c[k][0] < -w - tx)) out_l = 0;
+        if (!(c[k][1] > w + ty)) out_t = 0;
+        if (!(c[k][1] < -w - ty)) out_b = 0;
         if (!(w < r->near_ * (1.0 - 1e-6))) out_n = 0;
         if (!(w >= r->near_)) {
             all_front = 0;
@@ -1005,7 +1024,8 @@ static int corners_out(const render *r, double c[8][4], double *wmn, double *wmx
         rows[0] = 0;
         rows[1] = r->h - 1;
         if (all_front) { /* clamped before the conversion: far-off boxes give huge rows */
-            double a = fmin(fmax(lo - 2.0, 0.0), r->h - 1.0), b = fmin(fmax(hi + 2.0, 0.0), r->h - 1.0);
+            double a = fmin(fmax(lo - 2.0 - r->cpad[2], 0.0), r->h - 1.0);
+            double b = fmin(fmax(hi + 2.0 + r->cpad[2], 0.0), r->h - 1.0);
             rows[0] = (int32_t)a;
             rows[1] = (int32_t)b;
         }
@@ -2799,6 +2819,64 @@ static int atlas_pass(render *r, const render_opts *o, render_stats *st)
     return 0;
 }
 
+/* What a frame's culling depends on besides the sample point: the
+ * camera, the near and far planes, the culling mode and the drawing path
+ * (bands take the buildings' rows). */
+static void culling_key(const render *r, const render_opts *o, int bands, double key[16])
+{
+    int k;
+    for (k = 0; k < 3; k++) {
+        key[k] = r->eye[k];
+        key[3 + k] = r->f[k];
+        key[6 + k] = r->up[k];
+    }
+    key[9] = r->tanh_;
+    key[10] = r->aspect;
+    key[11] = r->near_;
+    key[12] = r->far_;
+    key[13] = (double)r->w * 65536.0 + r->h;
+    key[14] = o->cull;
+    key[15] = bands;
+}
+
+/* Whether this sample reuses the culling kept by the frame's first
+ * (render_opts.cull_samples), with the eye's inside test it made;
+ * otherwise the test is made here. */
+static int kept_culling(render *r, const render_opts *o, int bands, int *inside)
+{
+    double key[16];
+    culling_key(r, o, bands, key);
+    if (o->cull_samples == RENDER_SAMPLE_LATER && r->kept && memcmp(key, r->kept_key, sizeof key) == 0) {
+        *inside = r->kept_inside;
+        return 1;
+    }
+    r->kept = 0;
+    *inside = render_eye_inside(r, r->eye);
+    if (o->cull_samples) {
+        memcpy(r->kept_key, key, sizeof key);
+        r->kept_inside = *inside;
+    }
+    return 0;
+}
+
+/* The frame's culling (cull), or the one kept for its sample points, its
+ * counts with it. */
+static void frame_cull(render *r, const render_opts *o, int inside, int rows, int kept, render_stats *st)
+{
+    if (kept) {
+        st->cull_kept = 1;
+        st->frustum_culled = r->kept_frustum;
+        st->occlusion_culled = r->kept_occlusion;
+        return;
+    }
+    cull(r, o, inside, rows, st);
+    if (o->cull_samples) {
+        r->kept = 1;
+        r->kept_frustum = st->frustum_culled;
+        r->kept_occlusion = st->occlusion_culled;
+    }
+}
+
 plx_status render_frame(render *r, const render_camera *cam, const render_opts *o,
                         uint8_t *rgb8, float *rgbf, render_stats *stats)
 {
@@ -2806,7 +2884,7 @@ plx_status render_frame(render *r, const render_camera *cam, const render_opts *
     render_opts def;
     const render_backend *be;
     size_t px;
-    int inside;
+    int inside, bands, kept;
     if (!r)
         return PLX_E_INVALID;
     if (!cam) {
@@ -2828,18 +2906,19 @@ plx_status render_frame(render *r, const render_camera *cam, const render_opts *
         r->err = "render_frame: the backend lacks a function";
         return PLX_E_INVALID;
     }
-    inside = render_eye_inside(r, r->eye);
+    bands = be == &r->soft && r->band && par_workers(o) >= 2;
+    kept = kept_culling(r, o, bands, &inside);
     st.eye_inside = inside;
-    if (be == &r->soft && r->band && par_workers(o) >= 2) {
+    if (bands) {
         /* the built-in rasteriser on the workers, by bands of rows */
-        cull(r, o, inside, 1, &st);
+        frame_cull(r, o, inside, 1, kept, &st);
         draw_bands(r, o, !inside, &st);
     } else {
         if (be->begin(be->user, r->w, r->h, !inside) != 0) {
             r->err = "render_frame: the backend could not start the frame";
             return PLX_E_UNSUPPORTED;
         }
-        cull(r, o, inside, 0, &st);
+        frame_cull(r, o, inside, 0, kept, &st);
         draw_buildings(r, be, &st);
         if (be->finish(be->user, r->id, r->depth) != 0) {
             r->err = "render_frame: the backend could not read the frame back";

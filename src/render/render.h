@@ -262,6 +262,9 @@ typedef void (*render_job_fn)(void *arg, int worker, uint32_t k);
 typedef int (*render_par_fn)(void *ctx, int workers, uint32_t njobs, render_job_fn job, void *arg);
 #define RENDER_MAX_WORKERS 16
 
+#define RENDER_SAMPLE_FIRST 1     /* render_opts.cull_samples */
+#define RENDER_SAMPLE_LATER 2
+
 typedef struct render_opts {
     double exposure;           /* radiance multiplier before sRGB, default 1 */
     int no_glow;               /* 1: no lamp discs (exact SPEC §5 pixels) */
@@ -274,6 +277,12 @@ typedef struct render_opts {
     int auto_exposure;         /* 1: exposure from the image and the tone curve (exposure.h) */
     double shift[2];           /* the sample point of each pixel: its centre + shift (pixels,
                                   x right, y down; |shift| < 0.5); 0 0 is SPEC §5's centre */
+    int cull_samples;          /* a frame of several sample points (anti-aliasing): RENDER_SAMPLE_FIRST
+                                  culls for any sample point within the pixel (the frustum
+                                  widened by a pixel each way, its rows by one more) and keeps
+                                  the culling; RENDER_SAMPLE_LATER reuses it when the camera,
+                                  the near plane, the culling mode and the drawing path are the
+                                  same (else culls as FIRST does); 0: culls for this sample point */
     render_par_fn par;         /* the shading pass's parallel-for (NULL: one thread) */
     void *par_ctx;
     int workers;               /* workers it may use (1 .. RENDER_MAX_WORKERS; more are cut) */
@@ -345,6 +354,8 @@ typedef struct render_stats {
     uint64_t indirect_nblocks; /* the frame's blocks */
     uint32_t glows;            /* lamp discs drawn */
     int eye_inside;            /* the eye is inside a solid */
+    int cull_kept;             /* the culling kept by the frame's first sample point was reused
+                                  (render_opts.cull_samples) */
     double exposure;           /* the exposure applied (chosen when auto_exposure) */
 } render_stats;
 

@@ -816,6 +816,41 @@ static double rng_unit(uint64_t *s)
     return (rng_next(s) >> 11) * (1.0 / 9007199254740992.0);
 }
 
+/* The culling an anti-aliased frame's first sample point keeps for the
+ * later ones (render_opts.cull_samples): camera c's frame with n x n
+ * sample points (n = 2 or 3 by turns), one later sample point drawn at
+ * random, is the same (ids, bytes and floats) with the first one's
+ * culling kept as unculled. a, fa, b, fb, ids: scratch of the frame's size. */
+static void kept_equal(render *r, const render_camera *cam, int c, uint8_t *a, float *fa, uint8_t *b, float *fb,
+                       uint32_t *ids)
+{
+    size_t px = (size_t)cam->width * cam->height;
+    uint64_t seed = 0x5eed0000u + (uint64_t)c; /* the cameras' own sequence untouched */
+    int n = 2 + c % 2, k = 1 + (int)(rng_next(&seed) % (uint64_t)(n * n - 1));
+    render_opts o;
+    render_stats st;
+    render_opts_default(&o);
+    o.cull = RENDER_CULL_NONE;
+    o.shift[0] = (k % n + 0.5) / n - 0.5;
+    o.shift[1] = (k / n + 0.5) / n - 0.5;
+    assert_int_equal(render_frame(r, cam, &o, a, fa, &st), PLX_OK);
+    memcpy(ids, render_ids(r), px * sizeof *ids);
+    o.cull = RENDER_CULL_ALL;
+    o.cull_samples = RENDER_SAMPLE_FIRST;
+    o.shift[0] = o.shift[1] = 0.5 / n - 0.5;
+    assert_int_equal(render_frame(r, cam, &o, b, fb, &st), PLX_OK);
+    o.cull_samples = RENDER_SAMPLE_LATER;
+    o.shift[0] = (k % n + 0.5) / n - 0.5;
+    o.shift[1] = (k / n + 0.5) / n - 0.5;
+    assert_int_equal(render_frame(r, cam, &o, b, fb, &st), PLX_OK);
+    assert_int_equal(st.cull_kept, 1);
+    if (memcmp(ids, render_ids(r), px * sizeof *ids) != 0 || memcmp(a, b, 3 * px) != 0 ||
+        memcmp(fa, fb, 3 * px * sizeof(float)) != 0)
+        fail_msg("camera %d: eye (%.3f, %.3f, %.3f) target (%.3f, %.3f, %.3f) fov %.2f, sample %d of %dx%d: "
+                 "the first sample's culling kept gives another frame than no culling", c, cam->eye[0],
+                 cam->eye[1], cam->eye[2], cam->target[0], cam->target[1], cam->target[2], cam->fov_deg, k, n, n);
+}
+
 /* Renders ncam cameras culled and unculled; returns buildings culled by
  * occlusion in all. Eyes: near lamps (streets), at height z (z < 0: the
  * eye height drawn from 1.5 .. -z). */
@@ -876,6 +911,7 @@ static uint64_t cull_equal_from(const char *path, int ncam, double zmin, double 
                      cam.target[0], cam.target[1], cam.target[2], cam.fov_deg, nd);
         }
         assert_int_equal(sa.occlusion_culled, 0);
+        kept_equal(r, &cam, c, a, fa, b, fb, ids);
         culled += sb.occlusion_culled;
         drawn += sb.triangles_drawn;
         total += sb.triangles;
@@ -930,6 +966,82 @@ static void test_cull_equal_high(void **state)
     cull_equal_from("fixtures/eixample-4x4.geojson", quick() ? 4 : 16, 57, 400, 25);
     cull_equal_from("fixtures/helsinki-centre.geojson", quick() ? 4 : 16, 141, 500, 26);
     cull_equal_from("fixtures/oldtown-8x8.geojson", quick() ? 4 : 12, 60, 300, 27);
+}
+
+/* The kept culling at the frame's edge (render_opts.cull_samples): a box
+ * building seen from a level eye, the camera turned so that the box's
+ * leftmost vertical edge falls at 81 places across the last two pixels
+ * of the right-hand edge. With 3 x 3 sample points the first (a third of
+ * a pixel left and up of the centre) and a later one lie 2/3 of a pixel
+ * apart, more than the half pixel by which the frame's edge lies beyond
+ * its outermost sample points: a culling made for the first sample alone
+ * would cull the building where a later sample sees it. Every later
+ * sample with the first one's culling kept equals no culling (ids and
+ * floats), and some of them see the building where the first does not. */
+static void test_cull_kept_edge(void **state)
+{
+    static const char *text =
+        "{\"type\":\"FeatureCollection\",\"properties\":{\"units\":\"m\"},\"features\":["
+        "{\"type\":\"Feature\",\"properties\":{\"height\":20},\"geometry\":{\"type\":\"Polygon\","
+        "\"coordinates\":[[[-5,40],[5,40],[5,50],[-5,50],[-5,40]]]}},"
+        "{\"type\":\"Feature\",\"properties\":{\"lamp\":true,\"z\":8,\"radius\":80},"
+        "\"geometry\":{\"type\":\"Point\",\"coordinates\":[0,20]}}]}";
+    const int w = 96, h = 72, n = 3;
+    size_t px = (size_t)w * h, p;
+    void *mem;
+    plx_engine *e = fixture_load_text(fixture_engine(MEM, 0, NULL, &mem), text, "edge");
+    render *r;
+    render_camera cam = { { 0, 0, 6 }, { 0, 0, 6 }, 60, 96, 72 };
+    render_opts o;
+    render_stats st;
+    uint32_t *ids = malloc(px * sizeof *ids);
+    float *fa = malloc(3 * px * sizeof *fa);
+    int step, k, first_sees, only_later = 0, compared = 0;
+    /* the footprint's most anticlockwise corner from the eye: (-5, 40) */
+    double phi = atan2(40.0, -5.0), sx = 1.0 / (tan(PI / 6.0) * (double)w / h);
+    (void)state;
+    assert_int_equal(render_create(&e->mem, e->sc, w, h, pos_shade, NULL, &r), PLX_OK);
+    for (step = 0; step <= 80; step++) {
+        double xb = 1.0 - 4.0 / w + step * (4.0 / w) / 80.0, th = phi + atan(xb / sx);
+        cam.target[0] = 100.0 * cos(th);
+        cam.target[1] = 100.0 * sin(th);
+        for (k = 1; k < n * n; k++) {
+            int later_sees = 0;
+            /* the later sample unculled; then the first sample's culling,
+             * kept for the later one (a frame between would drop it) */
+            render_opts_default(&o);
+            o.shift[0] = (k % n + 0.5) / n - 0.5;
+            o.shift[1] = (k / n + 0.5) / n - 0.5;
+            o.cull = RENDER_CULL_NONE;
+            assert_int_equal(render_frame(r, &cam, &o, NULL, fa, &st), PLX_OK);
+            memcpy(ids, render_ids(r), px * sizeof *ids);
+            o.cull = RENDER_CULL_ALL;
+            o.cull_samples = RENDER_SAMPLE_FIRST;
+            o.shift[0] = o.shift[1] = 0.5 / n - 0.5;
+            assert_int_equal(render_frame(r, &cam, &o, NULL, NULL, &st), PLX_OK);
+            assert_int_equal(st.cull_kept, 0);
+            for (p = 0, first_sees = 0; p < px; p++)
+                first_sees |= render_ids(r)[p] >= 2;
+            o.cull_samples = RENDER_SAMPLE_LATER;
+            o.shift[0] = (k % n + 0.5) / n - 0.5;
+            o.shift[1] = (k / n + 0.5) / n - 0.5;
+            assert_int_equal(render_frame(r, &cam, &o, NULL, NULL, &st), PLX_OK);
+            assert_int_equal(st.cull_kept, 1);
+            assert_memory_equal(ids, render_ids(r), px * sizeof *ids);
+            assert_memory_equal(fa, render_linear(r), 3 * px * sizeof *fa);
+            for (p = 0; p < px; p++)
+                later_sees |= ids[p] >= 2;
+            only_later += later_sees && !first_sees;
+            compared++;
+        }
+    }
+    print_message("kept culling at the frame's edge: %d later samples equal to no culling, %d of them see the "
+                  "building where the first sample does not\n", compared, only_later);
+    assert_true(only_later > 0);
+    free(ids);
+    free(fa);
+    plx_engine_destroy(e);
+    free(mem);
 }
 
 /* An eye just above a low roof, looking over it at taller buildings behind:
@@ -1597,6 +1709,7 @@ int main(void)
         cmocka_unit_test(test_cull_equal_above_roofs),
         cmocka_unit_test(test_cull_equal_high),
         cmocka_unit_test(test_cull_over_low_roof),
+        cmocka_unit_test(test_cull_kept_edge),
         cmocka_unit_test(test_mesh_fixtures),
         cmocka_unit_test(test_mesh_awkward),
         cmocka_unit_test(test_golden),
