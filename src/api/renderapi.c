@@ -472,33 +472,6 @@ static int aa_adaptive_buffers(plx_engine *e, size_t maxpx)
     return 0;
 }
 
-/* sum[p] += lin[p] for the n values, eight at a time in a loop of fixed
- * length (GCC vectorises those at -O2, not loops of unknown length); each
- * sum the same float operation as one at a time. */
-#define AA_LANES 8
-static void aa_add(float *restrict sum, const float *restrict lin, size_t n)
-{
-    size_t p;
-    int k;
-    for (p = 0; p + AA_LANES <= n; p += AA_LANES)
-        for (k = 0; k < AA_LANES; k++)
-            sum[p + k] += lin[p + k];
-    for (; p < n; p++)
-        sum[p] += lin[p];
-}
-
-/* sum[p] times inv, rounded to float, as aa_add. */
-static void aa_scale(float *restrict sum, size_t n, double inv)
-{
-    size_t p;
-    int k;
-    for (p = 0; p + AA_LANES <= n; p += AA_LANES)
-        for (k = 0; k < AA_LANES; k++)
-            sum[p + k] = (float)(sum[p + k] * inv);
-    for (; p < n; p++)
-        sum[p] = (float)(sum[p] * inv);
-}
-
 /* Anti-aliasing: n x n frames with the sample point moved within the
  * pixel on a regular grid, their linear images averaged (summed in sample
  * order, so the bytes are the same every time), then tone mapped with the
@@ -560,7 +533,7 @@ static plx_status render_aa(plx_engine *e, const render_camera *rc, render_opts 
                     }
                 }
             } else {
-                aa_add(e->aa_sum, lin, 3 * px);
+                render_aa_add(ro, e->aa_sum, lin, 3 * px);
                 later += rs->sky_pixels + rs->ground_pixels + rs->building_pixels;
             }
         }
@@ -570,7 +543,7 @@ static plx_status render_aa(plx_engine *e, const render_camera *rc, render_opts 
     ro->cull_samples = 0;
     if (st != PLX_OK)
         return st;
-    aa_scale(e->aa_sum, 3 * px, inv);
+    render_aa_scale(ro, e->aa_sum, 3 * px, inv);
     if (rgbf)
         memcpy(rgbf, e->aa_sum, px * 3 * sizeof(float));
     if (rgb8)

@@ -100,6 +100,10 @@ struct render {
     double kept_key[16];
     int kept_inside;
     uint32_t kept_frustum, kept_occlusion;
+    uint32_t *glamp;            /* nlamps + 1: with the kept culling, the lamps whose glow a
+                                   sample point within the pixel may draw (glow_candidates) */
+    uint32_t nglamp;
+    int glamp_ok;               /* glamp holds them for this frame's camera */
     /* shading by tiles */
     light *lt;                  /* the light module when shade is render_shade_light */
     shade_ws ws[RENDER_MAX_WORKERS];  /* one per worker of the shading pass */
@@ -167,7 +171,7 @@ size_t render_bytes(const scene *s, int32_t max_w, int32_t max_h)
            (size_t)CULL_SIDE * CULL_SIDE * (6 * sizeof(double) + 4 + sizeof(cull_item)) + RENDER_BINS * 8 +
            sizeof(tonemap_table) + 8 + sizeof(exposure_table) + 8 +
            corners * (1 + 3 * sizeof(float)) + 2 * (size_t)(max_w / IND_STEP + 2) * sizeof(corner_hit) + render_surf_slots(s, max_w, max_h) * (sizeof(uint32_t) + sizeof(mesh_surf)) +
-           stop_rows(max_h) * sizeof(int32_t) +
+           stop_rows(max_h) * sizeof(int32_t) + ((size_t)s->nlamps + 1) * sizeof(uint32_t) + 64 +
            sizeof(render) + 4096;
 }
 
@@ -408,6 +412,7 @@ plx_status render_create(arena *a, const scene *s, int32_t max_w, int32_t max_h,
     r->wmin = arena_alloc(a, PLX_PART_FRAME, arena_mul(s->nbld + 1, sizeof(double)), R_ALIGN);
     r->wmax = arena_alloc(a, PLX_PART_FRAME, arena_mul(s->nbld + 1, sizeof(double)), R_ALIGN);
     r->draw = arena_alloc(a, PLX_PART_FRAME, s->nbld + 1, R_ALIGN);
+    r->glamp = arena_alloc(a, PLX_PART_FRAME, arena_mul((size_t)s->nlamps + 1, sizeof(uint32_t)), R_ALIGN);
     r->bins = arena_alloc(a, PLX_PART_FRAME, RENDER_BINS * sizeof(double), R_ALIGN);
     {
         double x0, y0, cell;
@@ -421,7 +426,7 @@ plx_status render_create(arena *a, const scene *s, int32_t max_w, int32_t max_h,
     }
     if (!r->depth || !r->id || !r->lin || !r->vbuf || !r->pv || !r->clip || !r->gxyz || !r->gtri || !r->sc_id || !r->sc ||
         !r->heap || !r->wmin ||
-        !r->wmax || !r->draw || !r->bins || !r->cell_start || !r->cell_bld || !r->cell_box ||
+        !r->wmax || !r->draw || !r->glamp || !r->bins || !r->cell_start || !r->cell_bld || !r->cell_box ||
         !r->trav) {
         arena_release(a, &m0);
         return PLX_E_NOMEM;
@@ -516,6 +521,9 @@ void render_frame_clear(render *r)
     r->kept = r->kept_inside = 0;
     memset(r->kept_key, 0, sizeof r->kept_key);
     r->kept_frustum = r->kept_occlusion = 0;
+    memset(r->glamp, 0, ((size_t)s->nlamps + 1) * sizeof *r->glamp);
+    r->nglamp = 0;
+    r->glamp_ok = 0;
     r->nbx = r->nby = 0;
     r->sparse = 0;
 }
@@ -2399,12 +2407,51 @@ static double glow_q(const double g[3], int32_t x, int32_t y)
     return (dx * dx + dy * dy) / (g[2] * g[2]);
 }
 
+/* The lamps whose glow a sample point within the pixel may draw, for the
+ * frame's later sample points (render_opts.cull_samples): lit, in front
+ * of the near plane, their centre within two pixels of the frame at this
+ * sample point (a later one moves it by less than one); in index order,
+ * so that the glows add up in the same order. glow_disc gives every other
+ * lamp no disc at any of them. */
+static void glow_candidates(render *r)
+{
+    uint32_t l;
+    r->nglamp = 0;
+    for (l = 0; l < r->s->nlamps; l++) {
+        const scene_lamp *lp = &r->s->lamps[l];
+        double X[3], c[4], px, py;
+        X[0] = lp->x;
+        X[1] = lp->y;
+        X[2] = lp->z;
+        to_clip(r, X, c);
+        if (!(c[3] > r->near_) || !(lp->intensity > 0))
+            continue;
+        px = (c[0] / c[3] + 1.0) * 0.5 * r->w;
+        py = (1.0 - c[1] / c[3]) * 0.5 * r->h;
+        if (px >= -2.0 && py >= -2.0 && px < r->w + 2.0 && py < r->h + 2.0)
+            r->glamp[r->nglamp++] = l;
+    }
+    r->glamp_ok = 1;
+}
+
+/* The lamps glows and glow_mark go through: the candidates when there are
+ * some for this frame, else every lamp. */
+static uint32_t glow_count(const render *r)
+{
+    return r->glamp_ok ? r->nglamp : r->s->nlamps;
+}
+
+static uint32_t glow_lamp(const render *r, uint32_t k)
+{
+    return r->glamp_ok ? r->glamp[k] : k;
+}
+
 static void glows(render *r, const render_opts *o, render_stats *st)
 {
     const scene *s = r->s;
-    uint32_t l;
-    for (l = 0; l < s->nlamps; l++) {
-        const scene_lamp *lp = &s->lamps[l];
+    uint32_t q0, n = glow_count(r);
+    for (q0 = 0; q0 < n; q0++) {
+        const scene_lamp *lp = &s->lamps[glow_lamp(r, q0)];
         double g[3], peak;
         int32_t b[4], x, y;
         if (!glow_disc(r, lp, g, b))
@@ -2430,11 +2477,11 @@ static void glows(render *r, const render_opts *o, render_stats *st)
 /* Marks in mask the pixels of every glow disc seen in this frame. */
 static void glow_mark(const render *r, uint8_t *mask)
 {
-    uint32_t l;
-    for (l = 0; l < r->s->nlamps; l++) {
+    uint32_t k, n = glow_count(r);
+    for (k = 0; k < n; k++) {
         double g[3];
         int32_t b[4], x, y;
-        if (!glow_disc(r, &r->s->lamps[l], g, b))
+        if (!glow_disc(r, &r->s->lamps[glow_lamp(r, k)], g, b))
             continue;
         for (y = b[1]; y <= b[3]; y++)
             for (x = b[0]; x <= b[2]; x++)
@@ -2512,6 +2559,73 @@ static uint32_t mask_class(uint32_t id)
     return id == MESH_SURF_GROUND ? MESH_SURF_NONE : id;
 }
 
+/* sum[p] += lin[p] for the n values, eight at a time in a loop of fixed
+ * length (GCC vectorises those at -O2, not loops of unknown length); each
+ * sum the same float operation as one at a time. */
+#define AA_LANES 8
+static void aa_add(float *restrict sum, const float *restrict lin, size_t n)
+{
+    size_t p;
+    int k;
+    for (p = 0; p + AA_LANES <= n; p += AA_LANES)
+        for (k = 0; k < AA_LANES; k++)
+            sum[p + k] += lin[p + k];
+    for (; p < n; p++)
+        sum[p] += lin[p];
+}
+
+/* sum[p] times inv, rounded to float, as aa_add. */
+static void aa_scale(float *restrict sum, size_t n, double inv)
+{
+    size_t p;
+    int k;
+    for (p = 0; p + AA_LANES <= n; p += AA_LANES)
+        for (k = 0; k < AA_LANES; k++)
+            sum[p + k] = (float)(sum[p + k] * inv);
+    for (; p < n; p++)
+        sum[p] = (float)(sum[p] * inv);
+}
+
+#define AA_CHUNK 65536          /* values a job of the sums and the mask's ids */
+
+typedef struct aa_job {
+    float *sum;
+    const float *lin;           /* NULL: scale by inv */
+    size_t n;
+    double inv;
+} aa_job;
+
+static void aa_chunk(void *arg, int worker, uint32_t k)
+{
+    const aa_job *jb = arg;
+    size_t p0 = (size_t)k * AA_CHUNK, m = jb->n - p0 < AA_CHUNK ? jb->n - p0 : AA_CHUNK;
+    (void)worker;
+    if (jb->lin)
+        aa_add(jb->sum + p0, jb->lin + p0, m);
+    else
+        aa_scale(jb->sum + p0, m, jb->inv);
+}
+
+void render_aa_add(const render_opts *o, float *sum, const float *lin, size_t n)
+{
+    aa_job jb;
+    jb.sum = sum;
+    jb.lin = lin;
+    jb.n = n;
+    jb.inv = 1.0;
+    run_jobs(o, (uint32_t)((n + AA_CHUNK - 1) / AA_CHUNK), aa_chunk, &jb);
+}
+
+void render_aa_scale(const render_opts *o, float *sum, size_t n, double inv)
+{
+    aa_job jb;
+    jb.sum = sum;
+    jb.lin = NULL;
+    jb.n = n;
+    jb.inv = inv;
+    run_jobs(o, (uint32_t)((n + AA_CHUNK - 1) / AA_CHUNK), aa_chunk, &jb);
+}
+
 /* Marks (sets to 1) the n pixels whose surface in id is not the one in
  * id0, sixteen at a time in a loop of fixed length (vectorised by GCC
  * at -O2); the marks are 0 or 1, so or-ing the test gives the same. */
@@ -2529,10 +2643,28 @@ static void mask_ids(uint8_t *restrict mask, const uint32_t *restrict id, const 
 
 /* Marks the pixels whose surface is not the first sample's, and those of
  * the glows this sample sees. */
+typedef struct ids_job {
+    const render *r;
+    const render_opts *o;
+} ids_job;
+
+static void mask_ids_chunk(void *arg, int worker, uint32_t k)
+{
+    const ids_job *jb = arg;
+    size_t px = (size_t)jb->r->w * (size_t)jb->r->h, p0 = (size_t)k * AA_CHUNK;
+    (void)worker;
+    mask_ids(jb->o->mask + p0, jb->r->id + p0, jb->o->mask_id + p0, px - p0 < AA_CHUNK ? px - p0 : AA_CHUNK);
+}
+
 static void mask_update(render *r, const render_opts *o)
 {
-    if (o->mask_id)
-        mask_ids(o->mask, r->id, o->mask_id, (size_t)r->w * (size_t)r->h);
+    size_t px = (size_t)r->w * (size_t)r->h;
+    if (o->mask_id) {
+        ids_job jb;
+        jb.r = r;
+        jb.o = o;
+        run_jobs(o, (uint32_t)((px + AA_CHUNK - 1) / AA_CHUNK), mask_ids_chunk, &jb);
+    }
     if (!o->no_glow)
         glow_mark(r, o->mask);
 }
@@ -2870,7 +3002,9 @@ static void frame_cull(render *r, const render_opts *o, int inside, int rows, in
         return;
     }
     cull(r, o, inside, rows, st);
+    r->glamp_ok = 0;
     if (o->cull_samples) {
+        glow_candidates(r);
         r->kept = 1;
         r->kept_frustum = st->frustum_culled;
         r->kept_occlusion = st->occlusion_culled;

@@ -401,6 +401,12 @@ void render_tonemap_par(render *r, const float *lin, size_t px, double ex, int c
  * 8 neighbours: another surface id, or a channel more than level steps
  * apart in the 8-bit image (level taken into 0 .. 255: below 0 as 0).
  * Returns the pixels marked. */
+/* Anti-aliasing's sums on o's workers: sum[p] += lin[p] for p < n, and
+ * sum[p] = (float)(sum[p] * inv); each value the same float operations
+ * as one at a time. */
+void render_aa_add(const render_opts *o, float *sum, const float *lin, size_t n);
+void render_aa_scale(const render_opts *o, float *sum, size_t n, double inv);
+
 size_t render_aa_mask(render *r, const render_opts *o, double ex, int curve, int level, uint8_t *rgb, uint32_t *id0,
                       uint8_t *mask);
 
