@@ -374,15 +374,18 @@ void atlas_frame_row(const atlas *A, const atlas_view *v, atlas_cache *k, const 
     L.n = 0;
     ground_setup(A, v, j, &g);
     while (i < v->w) {
-        uint32_t sid = ids[i];
+        uint32_t sid;
         uint64_t n;
+        /* with a mask, from the next marked pixel to the end of its run
+         * of one surface: the part of that run a full partition of the row
+         * by surface would read (the pixels before it are not marked) */
+        if (mask && (i = next_marked(mask, i, v->w)) == v->w)
+            break;
+        sid = ids[i];
         for (e = i + 1; e < v->w && ids[e] == sid; e++)
             ;
         if (mask) { /* only the marked pixels are written, and counted */
             int32_t q;
-            i = next_marked(mask, i, e);
-            if (i == e)
-                continue;
             for (n = 0, q = i; q < e; q++)
                 n += mask[q] != 0;
         } else {

@@ -91,6 +91,7 @@ struct render {
     uint32_t cur_id;
     double eye[3], f[3], rt[3], up[3];
     double sx, sy, za, zb, tanh_, aspect, near_, far_;
+    double far_eye[3], far_near; /* what far_ was found for (setup_camera) */
     double shift[2], shx, shy;  /* sample point offset in pixels, and in NDC */
     double cpad[3];             /* the frustum culling's widening: x and y in NDC a unit of w,
                                    and rows (render_opts.cull_samples) */
@@ -516,6 +517,8 @@ void render_frame_clear(render *r)
     memset(r->rt, 0, sizeof r->rt);
     memset(r->up, 0, sizeof r->up);
     r->sx = r->sy = r->za = r->zb = r->tanh_ = r->aspect = r->near_ = r->far_ = 0.0;
+    memset(r->far_eye, 0, sizeof r->far_eye);
+    r->far_near = 0.0;
     r->shift[0] = r->shift[1] = r->shx = r->shy = 0.0;
     memset(r->cpad, 0, sizeof r->cpad);
     r->kept = r->kept_inside = 0;
@@ -617,8 +620,10 @@ static int setup_camera(render *r, const render_camera *c, const render_opts *o)
     r->cpad[0] = o->cull_samples ? 2.0 / c->width : 0.0;
     r->cpad[1] = o->cull_samples ? 2.0 / c->height : 0.0;
     r->cpad[2] = o->cull_samples ? 1.0 : 0.0;
-    /* far: beyond every corner of the scene box (buildings, lamps' reach) */
-    {
+    /* far: beyond every corner of the scene box (buildings, lamps' reach);
+     * the same eye and near plane as the last frame's (its later sample
+     * points): the last far */
+    if (!(r->far_ > 0.0 && memcmp(r->far_eye, c->eye, sizeof r->far_eye) == 0 && r->far_near == o->near)) {
         double hx = fmax(fabs(b[0] - c->eye[0]), fabs(b[2] - c->eye[0]));
         double hy = fmax(fabs(b[1] - c->eye[1]), fabs(b[3] - c->eye[1]));
         double hz = fmax(fabs(c->eye[2]), fabs(r->s->height_max - c->eye[2]));
@@ -631,6 +636,8 @@ static int setup_camera(render *r, const render_camera *c, const render_opts *o)
         }
         t = sqrt(hx * hx + hy * hy + hz * hz);
         r->far_ = 2.0 * t + 10.0 * o->near + 1.0;
+        memcpy(r->far_eye, c->eye, sizeof r->far_eye);
+        r->far_near = o->near;
     }
     r->za = (r->far_ + r->near_) / (r->far_ - r->near_);
     r->zb = -2.0 * r->far_ * r->near_ / (r->far_ - r->near_);
