@@ -519,7 +519,7 @@ static plx_status render_aa(plx_engine *e, const render_camera *rc, render_opts 
             lin = render_linear(e->rd);
             if (a == 0 && b == 0) {
                 ex = rs->exposure;
-                memcpy(e->aa_sum, lin, px * 3 * sizeof(float));
+                render_aa_copy(ro, e->aa_sum, lin, 3 * px);
                 /* the later samples: the first one's exposure */
                 ro->auto_exposure = 0;
                 adaptive = !full && aa_adaptive_buffers(e, maxpx) ? PLX_AA_ADAPTIVE : PLX_AA_EVERY;

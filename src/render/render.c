@@ -2481,10 +2481,12 @@ static void glows(render *r, const render_opts *o, render_stats *st)
     }
 }
 
-/* Marks in mask the pixels of every glow disc seen in this frame. */
-static void glow_mark(const render *r, uint8_t *mask)
+/* Marks in mask the pixels of every glow disc seen in this frame; returns
+ * how many were not marked before. */
+static size_t glow_mark(const render *r, uint8_t *mask)
 {
     uint32_t k, n = glow_count(r);
+    size_t added = 0;
     for (k = 0; k < n; k++) {
         double g[3];
         int32_t b[4], x, y;
@@ -2492,9 +2494,13 @@ static void glow_mark(const render *r, uint8_t *mask)
             continue;
         for (y = b[1]; y <= b[3]; y++)
             for (x = b[0]; x <= b[2]; x++)
-                if (glow_q(g, x, y) < 1.0)
-                    mask[(size_t)y * (size_t)r->w + (size_t)x] = 1;
+                if (glow_q(g, x, y) < 1.0) {
+                    uint8_t *m = &mask[(size_t)y * (size_t)r->w + (size_t)x];
+                    added += *m == 0;
+                    *m = 1;
+                }
     }
+    return added;
 }
 
 
@@ -2600,6 +2606,7 @@ typedef struct aa_job {
     const float *lin;           /* NULL: scale by inv */
     size_t n;
     double inv;
+    int copy;                   /* with lin: sum = lin */
 } aa_job;
 
 static void aa_chunk(void *arg, int worker, uint32_t k)
@@ -2607,10 +2614,23 @@ static void aa_chunk(void *arg, int worker, uint32_t k)
     const aa_job *jb = arg;
     size_t p0 = (size_t)k * AA_CHUNK, m = jb->n - p0 < AA_CHUNK ? jb->n - p0 : AA_CHUNK;
     (void)worker;
-    if (jb->lin)
+    if (jb->lin && jb->copy)
+        memcpy(jb->sum + p0, jb->lin + p0, m * sizeof *jb->sum);
+    else if (jb->lin)
         aa_add(jb->sum + p0, jb->lin + p0, m);
     else
         aa_scale(jb->sum + p0, m, jb->inv);
+}
+
+void render_aa_copy(const render_opts *o, float *sum, const float *lin, size_t n)
+{
+    aa_job jb;
+    jb.sum = sum;
+    jb.lin = lin;
+    jb.n = n;
+    jb.inv = 1.0;
+    jb.copy = 1;
+    run_jobs(o, (uint32_t)((n + AA_CHUNK - 1) / AA_CHUNK), aa_chunk, &jb);
 }
 
 void render_aa_add(const render_opts *o, float *sum, const float *lin, size_t n)
@@ -2620,6 +2640,7 @@ void render_aa_add(const render_opts *o, float *sum, const float *lin, size_t n)
     jb.lin = lin;
     jb.n = n;
     jb.inv = 1.0;
+    jb.copy = 0;
     run_jobs(o, (uint32_t)((n + AA_CHUNK - 1) / AA_CHUNK), aa_chunk, &jb);
 }
 
@@ -2630,6 +2651,7 @@ void render_aa_scale(const render_opts *o, float *sum, size_t n, double inv)
     jb.lin = NULL;
     jb.n = n;
     jb.inv = inv;
+    jb.copy = 0;
     run_jobs(o, (uint32_t)((n + AA_CHUNK - 1) / AA_CHUNK), aa_chunk, &jb);
 }
 
@@ -2673,7 +2695,7 @@ static void mask_update(render *r, const render_opts *o)
         run_jobs(o, (uint32_t)((px + AA_CHUNK - 1) / AA_CHUNK), mask_ids_chunk, &jb);
     }
     if (!o->no_glow)
-        glow_mark(r, o->mask);
+        (void)glow_mark(r, o->mask);
 }
 
 /* A pixel's three bytes in 16-bit lanes of a 64-bit word, so that a
@@ -2719,9 +2741,11 @@ static inline int px_far(uint64_t a, uint64_t b, const far_k *k)
 typedef struct mask_job {
     const render *r;
     const uint8_t *rgb;
-    const uint32_t *id;
+    const uint32_t *id;         /* the frame's ids (render.id) */
+    uint32_t *id0;              /* their copy, row by row */
     uint8_t *bits, *out;
     unsigned level;
+    size_t marked[RENDER_MAX_WORKERS]; /* marks, by worker */
 } mask_job;
 
 /* The pairs pixel i of a row starts (c: its bytes, ic: its ids; n, in:
@@ -2790,6 +2814,7 @@ static void mask_bits_rows(void *arg, int worker, uint32_t k)
         const uint32_t *ic = jb->id + (size_t)j * (size_t)w, *in = ic + w;
         uint8_t *bt = jb->bits + (size_t)j * (size_t)w;
         int down = j + 1 < h;
+        memcpy(jb->id0 + (size_t)j * (size_t)w, ic, (size_t)w * sizeof *ic);
         i = 0;
         if (down && w >= MASK_CHUNK + 2) {
             bt[0] = (uint8_t)pair_bits(c, n, ic, in, 0, w, down, &fk);
@@ -2837,9 +2862,9 @@ static void marks_chunk(const uint8_t *restrict bt, const uint8_t *restrict up, 
  * below its first row, the rest one by one. */
 static void mask_or_rows(void *arg, int worker, uint32_t k)
 {
-    const mask_job *jb = arg;
+    mask_job *jb = arg;
     int32_t w = jb->r->w, h = jb->r->h, i, j, j1 = (int32_t)(k + 1) * MASK_ROWS;
-    (void)worker;
+    size_t n = 0;
     for (j = (int32_t)k * MASK_ROWS; j < j1 && j < h; j++) {
         const uint8_t *bt = jb->bits + (size_t)j * (size_t)w;
         uint8_t *out = jb->out + (size_t)j * (size_t)w;
@@ -2853,20 +2878,25 @@ static void mask_or_rows(void *arg, int worker, uint32_t k)
         }
         for (; i < w; i++)
             out[i] = mark_at(bt + i, i, j, w);
+        for (i = 0; i < w; i++)
+            n += out[i];
     }
+    jb->marked[worker] += n;
 }
 
 size_t render_aa_mask(render *r, const render_opts *o, double ex, int curve, int level, uint8_t *rgb, uint32_t *id0,
                       uint8_t *mask)
 {
-    size_t px = (size_t)r->w * (size_t)r->h, n = 0, p;
+    size_t px = (size_t)r->w * (size_t)r->h, n = 0;
     uint32_t jobs = (uint32_t)((r->h + MASK_ROWS - 1) / MASK_ROWS);
     mask_job jb;
+    int k;
     render_tonemap_par(r, r->lin, px, ex, curve, rgb, o);
-    memcpy(id0, r->id, px * sizeof *id0);
+    memset(&jb, 0, sizeof jb);
     jb.r = r;
     jb.rgb = rgb;
-    jb.id = id0;
+    jb.id = r->id;
+    jb.id0 = id0;
     jb.level = level < 0 ? 0u : level > 255 ? 255u : (unsigned)level; /* 255: no channel step is an edge */
     /* two passes on the workers, each pixel writing only its own byte: the
      * pairs' bits into mask, then the marks into rgb (free by then: the
@@ -2876,10 +2906,10 @@ size_t render_aa_mask(render *r, const render_opts *o, double ex, int curve, int
     run_jobs(o, jobs, mask_bits_rows, &jb);
     run_jobs(o, jobs, mask_or_rows, &jb);
     memcpy(mask, rgb, px);
+    for (k = 0; k < RENDER_MAX_WORKERS; k++)
+        n += jb.marked[k];
     if (!o->no_glow)
-        glow_mark(r, mask); /* a glow the first sample sees: every sample adds its own */
-    for (p = 0; p < px; p++)
-        n += mask[p];
+        n += glow_mark(r, mask); /* a glow the first sample sees: every sample adds its own */
     return n;
 }
 

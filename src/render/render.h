@@ -404,6 +404,7 @@ void render_tonemap_par(render *r, const float *lin, size_t px, double ex, int c
 /* Anti-aliasing's sums on o's workers: sum[p] += lin[p] for p < n, and
  * sum[p] = (float)(sum[p] * inv); each value the same float operations
  * as one at a time. */
+void render_aa_copy(const render_opts *o, float *sum, const float *lin, size_t n); /* sum = lin */
 void render_aa_add(const render_opts *o, float *sum, const float *lin, size_t n);
 void render_aa_scale(const render_opts *o, float *sum, size_t n, double inv);
 
