@@ -172,6 +172,7 @@ static void ground_setup(const atlas *A, const atlas_view *v, int32_t j, ground_
 {
     double dz = v->D0[2] + j * v->Dy[2], t;
     g->on = dz < 0.0;
+    g->x0 = g->y0 = g->dx = g->dy = 0.0; /* unread when off; set for the compiler's flow analysis */
     if (!g->on)
         return;
     t = -v->eye[2] / dz;
