@@ -172,7 +172,7 @@ size_t render_bytes(const scene *s, int32_t max_w, int32_t max_h)
            (size_t)CULL_SIDE * CULL_SIDE * (6 * sizeof(double) + 4 + sizeof(cull_item)) + RENDER_BINS * 8 +
            sizeof(tonemap_table) + 8 + sizeof(exposure_table) + 8 +
            corners * (1 + 3 * sizeof(float)) + 2 * (size_t)(max_w / IND_STEP + 2) * sizeof(corner_hit) + render_surf_slots(s, max_w, max_h) * (sizeof(uint32_t) + sizeof(mesh_surf)) +
-           stop_rows(max_h) * sizeof(int32_t) + ((size_t)s->nlamps + 1) * sizeof(uint32_t) + 64 +
+           stop_rows(max_h) * sizeof(int32_t) + arena_mul((size_t)s->nlamps + 1, sizeof(uint32_t)) + 64 +
            sizeof(render) + 4096;
 }
 
@@ -2670,8 +2670,6 @@ static void mask_ids(uint8_t *restrict mask, const uint32_t *restrict id, const 
         mask[p] |= (uint8_t)(mask_class(id[p]) != mask_class(id0[p]));
 }
 
-/* Marks the pixels whose surface is not the first sample's, and those of
- * the glows this sample sees. */
 typedef struct ids_job {
     const render *r;
     const render_opts *o;
@@ -2685,6 +2683,8 @@ static void mask_ids_chunk(void *arg, int worker, uint32_t k)
     mask_ids(jb->o->mask + p0, jb->r->id + p0, jb->o->mask_id + p0, px - p0 < AA_CHUNK ? px - p0 : AA_CHUNK);
 }
 
+/* Marks the pixels whose surface is not the first sample's (by chunks on
+ * the workers), and those of the glows this sample sees. */
 static void mask_update(render *r, const render_opts *o)
 {
     size_t px = (size_t)r->w * (size_t)r->h;
@@ -3041,7 +3041,8 @@ static void frame_cull(render *r, const render_opts *o, int inside, int rows, in
     cull(r, o, inside, rows, st);
     r->glamp_ok = 0;
     if (o->cull_samples) {
-        glow_candidates(r);
+        if (!o->no_glow)
+            glow_candidates(r);
         r->kept = 1;
         r->kept_frustum = st->frustum_culled;
         r->kept_occlusion = st->occlusion_culled;

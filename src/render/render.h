@@ -394,20 +394,21 @@ plx_status render_frame(render *r, const render_camera *cam, const render_opts *
 void render_tonemap_par(render *r, const float *lin, size_t px, double ex, int curve,
                         uint8_t *rgb8 /* OUT */, const render_opts *o);
 
+/* Anti-aliasing's sums on o's workers: sum[p] = lin[p] (copy), sum[p] +=
+ * lin[p] (add) for p < n, and sum[p] = (float)(sum[p] * inv) (scale);
+ * each value the same float operations as one at a time. */
+void render_aa_copy(const render_opts *o, float *sum, const float *lin, size_t n);
+void render_aa_add(const render_opts *o, float *sum, const float *lin, size_t n);
+void render_aa_scale(const render_opts *o, float *sum, size_t n, double inv);
+
 /* Adaptive anti-aliasing, after the frame of the first sample (its exposure
  * ex, curve as render_opts.auto_exposure): tone maps the linear image into
  * rgb (3 bytes a pixel, scratch), copies the surface ids into id0 and
  * marks in mask (1 byte a pixel) every pixel that differs from one of its
  * 8 neighbours: another surface id, or a channel more than level steps
- * apart in the 8-bit image (level taken into 0 .. 255: below 0 as 0).
+ * apart in the 8-bit image (level taken into 0 .. 255: below 0 as 0), and
+ * (without render_opts.no_glow) the pixels of the glows it sees.
  * Returns the pixels marked. */
-/* Anti-aliasing's sums on o's workers: sum[p] += lin[p] for p < n, and
- * sum[p] = (float)(sum[p] * inv); each value the same float operations
- * as one at a time. */
-void render_aa_copy(const render_opts *o, float *sum, const float *lin, size_t n); /* sum = lin */
-void render_aa_add(const render_opts *o, float *sum, const float *lin, size_t n);
-void render_aa_scale(const render_opts *o, float *sum, size_t n, double inv);
-
 size_t render_aa_mask(render *r, const render_opts *o, double ex, int curve, int level, uint8_t *rgb, uint32_t *id0,
                       uint8_t *mask);
 

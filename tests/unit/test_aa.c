@@ -17,7 +17,14 @@
  *  - The adaptive mask (render_aa_mask, without glows) on 1 and on 2
  *    workers equals a brute force: a pixel is marked when one of its 8
  *    neighbours has another surface id or a channel more than 2 steps
- *    apart in the 8-bit first sample.
+ *    apart in the 8-bit first sample; at sizes around its chunks of 64
+ *    pixels, and rows of 1 and 2. Its count with the glows it marks is
+ *    the marked bytes.
+ *  - A later sample's mask update marks exactly the pixels whose surface
+ *    is not the first sample's (and keeps the marks there), for ids
+ *    sixteen at a time and jobs of 65,536 pixels.
+ *  - The sums of the samples on the workers give the bits of one value at
+ *    a time, for lengths around the lanes and the jobs.
  */
 #include <stdarg.h>
 #include <stddef.h>
@@ -109,10 +116,9 @@ static void test_auto_exposure(void **state)
     free(mem);
 }
 
-/* aa = n at w x h against one sample per pixel at n w x n h, averaged. */
-static void aa_against_supersampling(plx_engine *e, int n)
+/* aa = n at W x H against one sample per pixel at n W x n H, averaged. */
+static void aa_against_supersampling(plx_engine *e, int n, int W, int H)
 {
-    enum { W = 160, H = 120 };
     plx_camera cam;
     plx_render_opts o;
     float *small = malloc(sizeof(float) * W * H * 3), *big = malloc(sizeof(float) * W * H * 3 * n * n);
@@ -157,8 +163,12 @@ static void test_aa(void **state)
     plx_render_opts o;
     uint8_t *a8 = malloc(160 * 120 * 3), *b8 = malloc(160 * 120 * 3);
     (void)state;
-    aa_against_supersampling(e, 2);
-    aa_against_supersampling(e, 3);
+    aa_against_supersampling(e, 2, 160, 120);
+    aa_against_supersampling(e, 3, 160, 120);
+    /* the sums by jobs of 65,536 values on the workers, and eight at a
+     * time: two jobs, the second's last lanes short (203 x 111 x 3 =
+     * 67,599 values) */
+    aa_against_supersampling(e, 2, 203, 111);
     /* aa 1 is the plain image */
     street(&cam, 160, 120);
     plx_render_opts_default(&o);
@@ -342,11 +352,139 @@ static void mask_against_brute(plx_engine *e, int w, int h, int workers)
                 marked += mask[p];
             }
         assert_int_equal(n, marked);
-        assert_true(marked > 0 && marked < px); /* edges, and flat parts */
+        if (h > 2) /* a row or two of a street view may be all edges */
+            assert_true(marked > 0 && marked < px); /* edges, and flat parts */
     }
     print_message("mask %dx%d on %d workers: %zu of %zu pixels marked (level 7), as the brute force at levels 0, 1, "
                   "2 and 7\n", w, h, workers, marked, px);
     free(rgb8); free(scratch); free(mask); free(id); free(id0);
+}
+
+/* mask_update (a later sample with render_opts.mask): every pixel whose
+ * surface (the ground and the sky as one) is not mask_id's gets marked,
+ * the marks already there stay, and no other pixel is marked (no glows);
+ * on the given workers, at w x h (ids sixteen at a time, jobs of 65,536
+ * pixels). */
+static void mask_update_against_brute(plx_engine *e, int w, int h, int workers)
+{
+    plx_camera pc;
+    render_camera cam;
+    render_opts ro;
+    render_stats st;
+    size_t px = (size_t)w * h, p, marked = 0, changed = 0;
+    uint32_t *id0 = malloc(px * sizeof *id0);
+    uint8_t *mask = malloc(px), *before = malloc(px);
+    street(&pc, w, h);
+    memcpy(cam.eye, pc.eye, sizeof cam.eye);
+    memcpy(cam.target, pc.target, sizeof cam.target);
+    cam.fov_deg = pc.fov_deg;
+    cam.width = w;
+    cam.height = h;
+    render_opts_default(&ro);
+    ro.no_glow = 1;
+    ro.par = e->port.parallel_for;
+    ro.par_ctx = e->port.ctx;
+    ro.workers = workers;
+    ro.shift[0] = ro.shift[1] = -0.25;
+    assert_int_equal(render_frame(e->rd, &cam, &ro, NULL, NULL, &st), PLX_OK);
+    memcpy(id0, render_ids(e->rd), px * sizeof *id0);
+    for (p = 0; p < px; p++) {
+        before[p] = mask[p] = p % 7 == 0;
+        if (p % 5 == 0 || p + 3 >= px) /* surfaces of no frame, the last pixels among them */
+            id0[p] = 0xfffff000u + (uint32_t)(p % 3);
+    }
+    ro.mask = mask;
+    ro.mask_id = id0;
+    ro.shift[0] = 0.25;
+    ro.shift[1] = 0.25;
+    assert_int_equal(render_frame(e->rd, &cam, &ro, NULL, NULL, &st), PLX_OK);
+    for (p = 0; p < px; p++) {
+        uint32_t a = render_ids(e->rd)[p], b = id0[p];
+        int other = (a == 1 ? 0 : a) != (b == 1 ? 0 : b);
+        assert_int_equal(mask[p], before[p] | other);
+        marked += mask[p];
+        changed += other;
+    }
+    print_message("mask update %dx%d on %d workers: %zu pixels meet another surface at the later sample, as the "
+                  "brute force\n", w, h, workers, changed);
+    assert_true(changed > 0 && marked < px);
+    free(id0); free(mask); free(before);
+}
+
+/* render_aa_mask's count with the glows it marks: the marked bytes. */
+static void mask_count_with_glows(plx_engine *e, int w, int h)
+{
+    plx_camera cam;
+    plx_render_opts o;
+    plx_render_info info;
+    render_opts ro;
+    size_t px = (size_t)w * h, p, marked = 0, n, plain;
+    uint8_t *scratch = malloc(px * 3), *mask = malloc(px);
+    uint32_t *id0 = malloc(px * sizeof *id0);
+    plx_render_opts_default(&o);
+    o.auto_exposure = 1;
+    street(&cam, w, h);
+    assert_int_equal(plx_render(e, &cam, &o, NULL, NULL, &info), PLX_OK);
+    render_opts_default(&ro);
+    ro.no_glow = 1;
+    ro.par = e->port.parallel_for;
+    ro.par_ctx = e->port.ctx;
+    ro.workers = 2;
+    /* level 255: surface edges only, so that the glows mark pixels of their own */
+    plain = render_aa_mask(e->rd, &ro, info.exposure, 1, 255, scratch, id0, mask);
+    ro.no_glow = 0;
+    n = render_aa_mask(e->rd, &ro, info.exposure, 1, 255, scratch, id0, mask);
+    for (p = 0; p < px; p++)
+        marked += mask[p];
+    print_message("mask %dx%d with glows: %zu pixels marked, %zu without the glows\n", w, h, n, plain);
+    assert_int_equal(n, marked);
+    assert_true(n > plain); /* the street view sees glows */
+    free(scratch); free(mask); free(id0);
+}
+
+/* The sums of the samples (render_aa_copy, render_aa_add,
+ * render_aa_scale), eight values at a time in jobs of 65,536 on the
+ * workers, against one value at a time: the same bits, for lengths around
+ * the lanes and the jobs. */
+static void test_aa_sums(void **state)
+{
+    static const size_t lens[] = { 0, 1, 7, 8, 9, 65535, 65536, 65537, 131079, 200003 };
+    const plx_port *port = plx_port_posix();
+    size_t i, p, n = 200003;
+    float *lin = malloc(n * sizeof *lin), *sum = malloc(n * sizeof *sum), *ref = malloc(n * sizeof *ref);
+    uint64_t seed = 7;
+    int workers;
+    (void)state;
+    for (p = 0; p < n; p++) {
+        seed = seed * 6364136223846793005ull + 1442695040888963407ull;
+        lin[p] = (float)((double)(seed >> 11) / 9007199254740992.0 * 1000.0);
+    }
+    for (workers = 1; workers <= 2; workers++)
+        for (i = 0; i < sizeof lens / sizeof *lens; i++) {
+            size_t m = lens[i];
+            render_opts ro;
+            render_opts_default(&ro);
+            ro.par = port->parallel_for;
+            ro.par_ctx = port->ctx;
+            ro.workers = workers;
+            for (p = 0; p < n; p++)
+                sum[p] = ref[p] = -1.0f;
+            render_aa_copy(&ro, sum, lin, m);
+            render_aa_add(&ro, sum, lin + 1, m > 0 ? m - 1 : 0);
+            render_aa_add(&ro, sum, lin, m);
+            render_aa_scale(&ro, sum, m, 1.0 / 3.0);
+            for (p = 0; p < m; p++) {
+                ref[p] = lin[p];
+                if (p + 1 < m)
+                    ref[p] += lin[p + 1];
+                ref[p] += lin[p];
+                ref[p] = (float)(ref[p] * (1.0 / 3.0));
+            }
+            assert_memory_equal(sum, ref, n * sizeof *sum); /* and nothing past m written */
+        }
+    print_message("anti-aliasing sums: the same bits as one value at a time for 10 lengths from 0 to 200,003 "
+                  "on 1 and 2 workers\n");
+    free(lin); free(sum); free(ref);
 }
 
 static void test_aa_mask(void **state)
@@ -366,6 +504,12 @@ static void test_aa_mask(void **state)
     mask_against_brute(e, 66, 17, 2);
     mask_against_brute(e, 65, 17, 1);
     mask_against_brute(e, 200, 33, 2);
+    mask_against_brute(e, 66, 1, 2);
+    mask_against_brute(e, 130, 2, 1);
+    mask_update_against_brute(e, 160, 120, 1);
+    mask_update_against_brute(e, 203, 111, 2);
+    mask_update_against_brute(e, 300, 230, 2); /* two jobs of ids */
+    mask_count_with_glows(e, 160, 120);
     plx_engine_destroy(e);
     free(mem);
 }
@@ -377,6 +521,7 @@ int main(void)
         cmocka_unit_test(test_aa),
         cmocka_unit_test(test_aa_adaptive),
         cmocka_unit_test(test_aa_dense_atlas_only),
+        cmocka_unit_test(test_aa_sums),
         cmocka_unit_test(test_aa_mask),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

@@ -820,7 +820,9 @@ static double rng_unit(uint64_t *s)
  * later ones (render_opts.cull_samples): camera c's frame with n x n
  * sample points (n = 2 or 3 by turns), one later sample point drawn at
  * random, is the same (ids, bytes and floats) with the first one's
- * culling kept as unculled. a, fa, b, fb, ids: scratch of the frame's size. */
+ * culling kept as unculled, on one worker or (every other pair of
+ * cameras) by bands of rows on two. a, fa, b, fb, ids: scratch of the
+ * frame's size. */
 static void kept_equal(render *r, const render_camera *cam, int c, uint8_t *a, float *fa, uint8_t *b, float *fb,
                        uint32_t *ids)
 {
@@ -830,6 +832,9 @@ static void kept_equal(render *r, const render_camera *cam, int c, uint8_t *a, f
     render_opts o;
     render_stats st;
     render_opts_default(&o);
+    o.par = plx_port_posix()->parallel_for; /* every other camera by bands of rows on two workers */
+    o.par_ctx = plx_port_posix()->ctx;
+    o.workers = 1 + (c / 2) % 2;
     o.cull = RENDER_CULL_NONE;
     o.shift[0] = (k % n + 0.5) / n - 0.5;
     o.shift[1] = (k / n + 0.5) / n - 0.5;
@@ -978,38 +983,48 @@ static void test_cull_equal_high(void **state)
  * would cull the building where a later sample sees it. Every later
  * sample with the first one's culling kept equals no culling (ids and
  * floats), and some of them see the building where the first does not. */
-static void test_cull_kept_edge(void **state)
+/* One sweep of test_cull_kept_edge: the camera turned (vertical: pitched)
+ * so that the box's leftmost vertical edge (vertical: its top edge) falls
+ * at 81 places across the last two pixels of the frame's right (bottom)
+ * edge, drawn on the given workers (2: by bands of rows). Returns the
+ * later samples that see the box where the first does not. */
+static int kept_edge_sweep(render *r, int w, int h, int vertical, int workers)
 {
-    static const char *text =
-        "{\"type\":\"FeatureCollection\",\"properties\":{\"units\":\"m\"},\"features\":["
-        "{\"type\":\"Feature\",\"properties\":{\"height\":20},\"geometry\":{\"type\":\"Polygon\","
-        "\"coordinates\":[[[-5,40],[5,40],[5,50],[-5,50],[-5,40]]]}},"
-        "{\"type\":\"Feature\",\"properties\":{\"lamp\":true,\"z\":8,\"radius\":80},"
-        "\"geometry\":{\"type\":\"Point\",\"coordinates\":[0,20]}}]}";
-    const int w = 96, h = 72, n = 3;
+    const int n = 3;
     size_t px = (size_t)w * h, p;
-    void *mem;
-    plx_engine *e = fixture_load_text(fixture_engine(MEM, 0, NULL, &mem), text, "edge");
-    render *r;
-    render_camera cam = { { 0, 0, 6 }, { 0, 0, 6 }, 60, 96, 72 };
+    render_camera cam = { { 0, 0, 6 }, { 0, 0, 6 }, 60, 0, 0 };
     render_opts o;
     render_stats st;
     uint32_t *ids = malloc(px * sizeof *ids);
     float *fa = malloc(3 * px * sizeof *fa);
-    int step, k, first_sees, only_later = 0, compared = 0;
-    /* the footprint's most anticlockwise corner from the eye: (-5, 40) */
-    double phi = atan2(40.0, -5.0), sx = 1.0 / (tan(PI / 6.0) * (double)w / h);
-    (void)state;
-    assert_int_equal(render_create(&e->mem, e->sc, w, h, pos_shade, NULL, &r), PLX_OK);
+    int step, k, first_sees, only_later = 0;
+    /* the footprint's most anticlockwise corner from the eye, (-5, 40), and
+     * the elevation of the box's front top edge (20 m high, 40 m away) */
+    double phi = atan2(40.0, -5.0), sx = 1.0 / (tan(PI / 6.0) * (double)w / h), alpha = atan2(14.0, 40.0);
+    cam.width = w;
+    cam.height = h;
     for (step = 0; step <= 80; step++) {
-        double xb = 1.0 - 4.0 / w + step * (4.0 / w) / 80.0, th = phi + atan(xb / sx);
-        cam.target[0] = 100.0 * cos(th);
-        cam.target[1] = 100.0 * sin(th);
+        double xb = 1.0 - 4.0 / w + step * (4.0 / w) / 80.0, yb = -1.0 + step * (4.0 / h) / 80.0;
+        if (vertical) {
+            double th = alpha - atan(yb * tan(PI / 6.0));
+            cam.target[0] = 0.0;
+            cam.target[1] = 100.0 * cos(th);
+            cam.target[2] = 6.0 + 100.0 * sin(th);
+        } else {
+            double th = phi + atan(xb / sx);
+            cam.target[0] = 100.0 * cos(th);
+            cam.target[1] = 100.0 * sin(th);
+            cam.target[2] = 6.0;
+        }
         for (k = 1; k < n * n; k++) {
             int later_sees = 0;
+            render_camera moved = cam;
             /* the later sample unculled; then the first sample's culling,
              * kept for the later one (a frame between would drop it) */
             render_opts_default(&o);
+            o.par = plx_port_posix()->parallel_for;
+            o.par_ctx = plx_port_posix()->ctx;
+            o.workers = workers;
             o.shift[0] = (k % n + 0.5) / n - 0.5;
             o.shift[1] = (k / n + 0.5) / n - 0.5;
             o.cull = RENDER_CULL_NONE;
@@ -1032,14 +1047,52 @@ static void test_cull_kept_edge(void **state)
             for (p = 0; p < px; p++)
                 later_sees |= ids[p] >= 2;
             only_later += later_sees && !first_sees;
-            compared++;
+            /* a later sample of another camera culls for itself */
+            moved.eye[0] += 0.5;
+            assert_int_equal(render_frame(r, &moved, &o, NULL, NULL, &st), PLX_OK);
+            assert_int_equal(st.cull_kept, 0);
         }
     }
-    print_message("kept culling at the frame's edge: %d later samples equal to no culling, %d of them see the "
-                  "building where the first sample does not\n", compared, only_later);
-    assert_true(only_later > 0);
     free(ids);
     free(fa);
+    return only_later;
+}
+
+/* The kept culling at the frame's edge (render_opts.cull_samples): a box
+ * building seen from an eye 6 m up, the camera turned so that the box's
+ * edge falls at 81 places across the last two pixels of the frame's
+ * right-hand edge, then pitched so that its top edge falls across the
+ * bottom edge, on one worker and by bands of rows on two. With 3 x 3
+ * sample points the first (a third of a pixel left and up of the centre)
+ * and a later one lie 2/3 of a pixel apart, more than the half pixel by
+ * which the frame's edge lies beyond its outermost sample points: a
+ * culling made for the first sample alone would cull the box where a
+ * later sample sees it. Every later sample with the first one's culling
+ * kept equals no culling (ids and floats), some of them see the box where
+ * the first does not, and a later sample of another camera does not take
+ * the kept culling. */
+static void test_cull_kept_edge(void **state)
+{
+    static const char *text =
+        "{\"type\":\"FeatureCollection\",\"properties\":{\"units\":\"m\"},\"features\":["
+        "{\"type\":\"Feature\",\"properties\":{\"height\":20},\"geometry\":{\"type\":\"Polygon\","
+        "\"coordinates\":[[[-5,40],[5,40],[5,50],[-5,50],[-5,40]]]}},"
+        "{\"type\":\"Feature\",\"properties\":{\"lamp\":true,\"z\":8,\"radius\":80},"
+        "\"geometry\":{\"type\":\"Point\",\"coordinates\":[0,20]}}]}";
+    void *mem;
+    plx_engine *e = fixture_load_text(fixture_engine(MEM, 0, NULL, &mem), text, "edge");
+    render *r;
+    int vertical, workers, only;
+    (void)state;
+    assert_int_equal(render_create(&e->mem, e->sc, 96, 72, pos_shade, NULL, &r), PLX_OK);
+    for (vertical = 0; vertical < 2; vertical++)
+        for (workers = 1; workers <= 2; workers++) {
+            only = kept_edge_sweep(r, 96, 72, vertical, workers);
+            print_message("kept culling at the frame's %s edge, %d worker%s: 648 later samples equal to no "
+                          "culling, %d of them see the building where the first sample does not\n",
+                          vertical ? "bottom" : "right", workers, workers > 1 ? "s" : "", only);
+            assert_true(only > 0);
+        }
     plx_engine_destroy(e);
     free(mem);
 }
