@@ -7,14 +7,25 @@
  * second engine on another thread, or a job that itself asks for a
  * parallel-for) starts threads of its own for the call, as before the
  * pool. Which worker runs which job varies from run to run; the core
- * makes its results depend on the job alone. */
+ * makes its results depend on the job alone.
+ *
+ * A frame makes a few dozen parallel-fors with short serial parts between
+ * them. A thread about to sleep on the condition variable (a pool thread
+ * between calls, the caller waiting for the last jobs) first looks again
+ * PAR_SPIN times, yielding the core between looks (about 75 us in all
+ * here): waking a sleeping thread costs more than that. Measured on a
+ * 640x480 street frame with 2 x 2 samples on two threads: about 5 to 10%
+ * less wall time (README "Threads"). */
 #include <pthread.h>
 #include <stdint.h>
 #include <stdlib.h>
+#include <sched.h>
 #include <unistd.h>
 
 #include "polarlux.h"
 #include "port.h"
+
+#define PAR_SPIN 300 /* looks before sleeping */
 
 typedef struct par_run {
     pthread_mutex_t mu;
@@ -72,6 +83,12 @@ static void *pool_loop(void *p)
     int id = (int)(intptr_t)p;
     pthread_mutex_lock(&pool.mu);
     for (;;) {
+        int spin;
+        for (spin = 0; spin < PAR_SPIN && !pool.quit && pool.seen[id] == pool.gen; spin++) {
+            pthread_mutex_unlock(&pool.mu);
+            sched_yield();
+            pthread_mutex_lock(&pool.mu);
+        }
         while (!pool.quit && pool.seen[id] == pool.gen)
             pthread_cond_wait(&pool.wake, &pool.mu);
         if (pool.quit)
@@ -160,7 +177,7 @@ static void spawn_for(par_run *run, int n)
 /* The call on the pool's threads; 0 when another call holds the pool. */
 static int pool_for(par_run *run, int n)
 {
-    int m;
+    int m, spin;
     pthread_mutex_lock(&pool.mu);
     if (pool.busy) {
         pthread_mutex_unlock(&pool.mu);
@@ -178,6 +195,11 @@ static int pool_for(par_run *run, int n)
     pthread_mutex_unlock(&pool.mu);
     par_loop(run, 0);
     pthread_mutex_lock(&pool.mu);
+    for (spin = 0; spin < PAR_SPIN && pool.left > 0; spin++) {
+        pthread_mutex_unlock(&pool.mu);
+        sched_yield();
+        pthread_mutex_lock(&pool.mu);
+    }
     while (pool.left > 0)
         pthread_cond_wait(&pool.idle, &pool.mu);
     pool.run = NULL;
