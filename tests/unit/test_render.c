@@ -1097,6 +1097,51 @@ static void test_cull_kept_edge(void **state)
     free(mem);
 }
 
+/* The far plane kept between frames of one eye (setup_camera): a frame
+ * from an eye far outside the scene after one from inside it needs a far
+ * plane of its own; its ids equal those of a new render object's first
+ * frame from there (with the first eye's far plane the farther buildings
+ * would be cut off). */
+static void test_far_plane_follows_eye(void **state)
+{
+    void *mem;
+    plx_engine *e = fixture_file("fixtures/eixample-4x4.geojson", MEM, &mem);
+    const scene *s = e->sc;
+    render *r, *fresh;
+    double cx = 0.5 * (s->bounds[0] + s->bounds[2]), cy = 0.5 * (s->bounds[1] + s->bounds[3]);
+    render_camera near_cam = { { 0, 0, 1.7 }, { 0, 0, 3 }, 60, 96, 72 };
+    render_camera far_cam = { { 0, 0, 40 }, { 0, 0, 0 }, 20, 96, 72 };
+    render_opts o;
+    render_stats st;
+    uint32_t *ids = malloc(96 * 72 * sizeof *ids);
+    size_t p, seen = 0;
+    (void)state;
+    near_cam.eye[0] = cx;
+    near_cam.eye[1] = cy;
+    near_cam.target[0] = cx + 50.0;
+    near_cam.target[1] = cy;
+    far_cam.eye[0] = cx - 3000.0;
+    far_cam.eye[1] = cy;
+    far_cam.target[0] = cx;
+    far_cam.target[1] = cy;
+    assert_int_equal(render_create(&e->mem, s, 96, 72, pos_shade, NULL, &r), PLX_OK);
+    assert_int_equal(render_create(&e->mem, s, 96, 72, pos_shade, NULL, &fresh), PLX_OK);
+    render_opts_default(&o);
+    assert_int_equal(render_frame(fresh, &far_cam, &o, NULL, NULL, &st), PLX_OK);
+    memcpy(ids, render_ids(fresh), 96 * 72 * sizeof *ids);
+    assert_int_equal(render_frame(r, &near_cam, &o, NULL, NULL, &st), PLX_OK);
+    assert_int_equal(render_frame(r, &far_cam, &o, NULL, NULL, &st), PLX_OK);
+    assert_memory_equal(ids, render_ids(r), 96 * 72 * sizeof *ids);
+    for (p = 0; p < 96 * 72; p++)
+        seen += ids[p] >= 2;
+    print_message("far plane from 3 km after a frame from inside the scene: %zu building pixels, as a new "
+                  "render object's\n", seen);
+    assert_true(seen > 0);
+    free(ids);
+    plx_engine_destroy(e);
+    free(mem);
+}
+
 /* An eye just above a low roof, looking over it at taller buildings behind:
  * the low building must not hide them. */
 static void test_cull_over_low_roof(void **state)
@@ -1763,6 +1808,7 @@ int main(void)
         cmocka_unit_test(test_cull_equal_high),
         cmocka_unit_test(test_cull_over_low_roof),
         cmocka_unit_test(test_cull_kept_edge),
+        cmocka_unit_test(test_far_plane_follows_eye),
         cmocka_unit_test(test_mesh_fixtures),
         cmocka_unit_test(test_mesh_awkward),
         cmocka_unit_test(test_golden),
