@@ -2622,37 +2622,31 @@ static void aa_chunk(void *arg, int worker, uint32_t k)
         aa_scale(jb->sum + p0, m, jb->inv);
 }
 
-void render_aa_copy(const render_opts *o, float *sum, const float *lin, size_t n)
+/* One of the sums over n values on the workers (aa_chunk). */
+static void aa_run(const render_opts *o, float *sum, const float *lin, size_t n, double inv, int copy)
 {
     aa_job jb;
     jb.sum = sum;
     jb.lin = lin;
     jb.n = n;
-    jb.inv = 1.0;
-    jb.copy = 1;
+    jb.inv = inv;
+    jb.copy = copy;
     run_jobs(o, (uint32_t)((n + AA_CHUNK - 1) / AA_CHUNK), aa_chunk, &jb);
+}
+
+void render_aa_copy(const render_opts *o, float *sum, const float *lin, size_t n)
+{
+    aa_run(o, sum, lin, n, 1.0, 1);
 }
 
 void render_aa_add(const render_opts *o, float *sum, const float *lin, size_t n)
 {
-    aa_job jb;
-    jb.sum = sum;
-    jb.lin = lin;
-    jb.n = n;
-    jb.inv = 1.0;
-    jb.copy = 0;
-    run_jobs(o, (uint32_t)((n + AA_CHUNK - 1) / AA_CHUNK), aa_chunk, &jb);
+    aa_run(o, sum, lin, n, 1.0, 0);
 }
 
 void render_aa_scale(const render_opts *o, float *sum, size_t n, double inv)
 {
-    aa_job jb;
-    jb.sum = sum;
-    jb.lin = NULL;
-    jb.n = n;
-    jb.inv = inv;
-    jb.copy = 0;
-    run_jobs(o, (uint32_t)((n + AA_CHUNK - 1) / AA_CHUNK), aa_chunk, &jb);
+    aa_run(o, sum, NULL, n, inv, 0);
 }
 
 /* Marks (sets to 1) the n pixels whose surface in id is not the one in
