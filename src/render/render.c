@@ -2372,19 +2372,29 @@ static void shade_pass(render *r, const render_opts *o, render_stats *st)
  * pixels box[4] (x0, y0, x1, y1) it may touch, when the lamp is in front of
  * the eye, inside the frame and not hidden at its own pixel (the depth
  * buffer); else 0. */
-static int glow_disc(const render *r, const scene_lamp *lp, double g[3], int32_t box[4])
+/* A lit lamp's centre in front of the near plane: its clip coordinates c
+ * and its place (px, py) in pixels of this sample point; 0 otherwise. */
+static int lamp_centre(const render *r, const scene_lamp *lp, double c[4], double *px, double *py)
 {
-    double X[3], c[4], px, py, rad;
-    size_t p;
-    float dz;
+    double X[3];
     X[0] = lp->x;
     X[1] = lp->y;
     X[2] = lp->z;
     to_clip(r, X, c);
     if (!(c[3] > r->near_) || !(lp->intensity > 0))
         return 0;
-    px = (c[0] / c[3] + 1.0) * 0.5 * r->w;
-    py = (1.0 - c[1] / c[3]) * 0.5 * r->h;
+    *px = (c[0] / c[3] + 1.0) * 0.5 * r->w;
+    *py = (1.0 - c[1] / c[3]) * 0.5 * r->h;
+    return 1;
+}
+
+static int glow_disc(const render *r, const scene_lamp *lp, double g[3], int32_t box[4])
+{
+    double c[4], px, py, rad;
+    size_t p;
+    float dz;
+    if (!lamp_centre(r, lp, c, &px, &py))
+        return 0;
     rad = 0.3 * r->sy * 0.5 * r->h / c[3];
     rad = fmin(fmax(rad, 1.5), 48.0);
     if (!(px >= 0 && py >= 0 && px < r->w && py < r->h))
@@ -2425,16 +2435,9 @@ static void glow_candidates(render *r)
     uint32_t l;
     r->nglamp = 0;
     for (l = 0; l < r->s->nlamps; l++) {
-        const scene_lamp *lp = &r->s->lamps[l];
-        double X[3], c[4], px, py;
-        X[0] = lp->x;
-        X[1] = lp->y;
-        X[2] = lp->z;
-        to_clip(r, X, c);
-        if (!(c[3] > r->near_) || !(lp->intensity > 0))
+        double c[4], px, py;
+        if (!lamp_centre(r, &r->s->lamps[l], c, &px, &py))
             continue;
-        px = (c[0] / c[3] + 1.0) * 0.5 * r->w;
-        py = (1.0 - c[1] / c[3]) * 0.5 * r->h;
         if (px >= -2.0 && py >= -2.0 && px < r->w + 2.0 && py < r->h + 2.0)
             r->glamp[r->nglamp++] = l;
     }
@@ -2692,38 +2695,6 @@ static void mask_update(render *r, const render_opts *o)
         (void)glow_mark(r, o->mask);
 }
 
-/* A pixel's three bytes in 16-bit lanes of a 64-bit word, so that a
- * pair's three channels are tested at once (px_far). */
-static inline uint64_t px_lanes(const uint8_t *a)
-{
-    return (uint64_t)a[0] | (uint64_t)a[1] << 16 | (uint64_t)a[2] << 32;
-}
-
-#define LANES3(x) ((uint64_t)(x) * 0x0000000100010001ull) /* x in each of the three lanes */
-
-/* The constants of px_far for a level L in 0 .. 255. */
-typedef struct far_k {
-    uint64_t bias, hi, lo, top;
-} far_k;
-
-static void far_setup(far_k *k, unsigned level)
-{
-    k->bias = LANES3(256u + level);
-    k->hi = LANES3(32768u - 257u - 2u * level);
-    k->lo = LANES3(32768u - 256u);
-    k->top = LANES3(32768u);
-}
-
-/* Whether a channel of lanes a and b is more than L apart: each lane of
- * a + bias - b is d + 256 + L, in 1 + L .. 511 + L (no lane borrows or
- * carries, here or below); adding hi sets its bit 15 when d > L, adding
- * lo when d >= -L. */
-static inline int px_far(uint64_t a, uint64_t b, const far_k *k)
-{
-    uint64_t d = a + k->bias - b;
-    return (((d + k->hi) | ~(d + k->lo)) & k->top) != 0;
-}
-
 /* The pairs of 8-neighbours a pixel starts (each pair once, from its
  * upper or left pixel), as bits of the first pass. */
 #define MASK_RIGHT 1u
@@ -2742,31 +2713,38 @@ typedef struct mask_job {
     size_t marked[RENDER_MAX_WORKERS]; /* marks, by worker */
 } mask_job;
 
-/* The pairs pixel i of a row starts (c: its bytes, ic: its ids; n, in:
- * the row below, when down) that differ: surface id, or a channel more
- * than the level apart (px_far). */
-static unsigned pair_bits(const uint8_t *c, const uint8_t *n, const uint32_t *ic, const uint32_t *in, int32_t i,
-                          int32_t w, int down, const far_k *fk)
-{
-    uint64_t pc = px_lanes(c + 3 * (size_t)i);
-    unsigned b = 0;
-    if (i + 1 < w)
-        b |= (ic[i] != ic[i + 1] || px_far(pc, px_lanes(c + 3 * (size_t)(i + 1)), fk)) ? MASK_RIGHT : 0u;
-    if (down) {
-        if (i + 1 < w)
-            b |= (ic[i] != in[i + 1] || px_far(pc, px_lanes(n + 3 * (size_t)(i + 1)), fk)) ? MASK_DOWN_RIGHT : 0u;
-        b |= (ic[i] != in[i] || px_far(pc, px_lanes(n + 3 * (size_t)i), fk)) ? MASK_DOWN : 0u;
-        if (i > 0)
-            b |= (ic[i] != in[i - 1] || px_far(pc, px_lanes(n + 3 * (size_t)(i - 1)), fk)) ? MASK_DOWN_LEFT : 0u;
-    }
-    return b;
-}
-
 /* Whether bytes a and b are more than level L apart. */
 static inline uint8_t far8(uint8_t a, uint8_t b, uint8_t L)
 {
     uint8_t d = a > b ? (uint8_t)(a - b) : (uint8_t)(b - a);
     return d > L;
+}
+
+/* Whether the pixels at bytes a and b differ: surface ids ia and ib, or a
+ * channel more than level apart. */
+static int px_differ(const uint8_t *a, const uint8_t *b, uint32_t ia, uint32_t ib, uint8_t level)
+{
+    return ia != ib || far8(a[0], b[0], level) || far8(a[1], b[1], level) || far8(a[2], b[2], level);
+}
+
+/* The pairs pixel i of a row starts (c: the row's bytes, ic: its ids; n,
+ * in: the row below, when down) that differ (px_differ). */
+static unsigned pair_bits(const uint8_t *c, const uint8_t *n, const uint32_t *ic, const uint32_t *in, int32_t i,
+                          int32_t w, int down, uint8_t level)
+{
+    const uint8_t *pc = c + 3 * (size_t)i, *pn = down ? n + 3 * (size_t)i : pc;
+    unsigned b = 0;
+    if (i + 1 < w && px_differ(pc, pc + 3, ic[i], ic[i + 1], level))
+        b |= MASK_RIGHT;
+    if (down) {
+        if (i + 1 < w && px_differ(pc, pn + 3, ic[i], in[i + 1], level))
+            b |= MASK_DOWN_RIGHT;
+        if (px_differ(pc, pn, ic[i], in[i], level))
+            b |= MASK_DOWN;
+        if (i > 0 && px_differ(pc, pn - 3, ic[i], in[i - 1], level))
+            b |= MASK_DOWN_LEFT;
+    }
+    return b;
 }
 
 /* pair_bits for MASK_CHUNK pixels of a row with a row below, none on the
@@ -2800,9 +2778,8 @@ static void mask_bits_rows(void *arg, int worker, uint32_t k)
 {
     const mask_job *jb = arg;
     int32_t w = jb->r->w, h = jb->r->h, i, j, j1 = (int32_t)(k + 1) * MASK_ROWS;
-    far_k fk;
+    uint8_t level = (uint8_t)jb->level;
     (void)worker;
-    far_setup(&fk, jb->level);
     for (j = (int32_t)k * MASK_ROWS; j < j1 && j < h; j++) {
         const uint8_t *c = jb->rgb + 3 * (size_t)j * (size_t)w, *n = c + 3 * (size_t)w;
         const uint32_t *ic = jb->id + (size_t)j * (size_t)w, *in = ic + w;
@@ -2811,14 +2788,14 @@ static void mask_bits_rows(void *arg, int worker, uint32_t k)
         memcpy(jb->id0 + (size_t)j * (size_t)w, ic, (size_t)w * sizeof *ic);
         i = 0;
         if (down && w >= MASK_CHUNK + 2) {
-            bt[0] = (uint8_t)pair_bits(c, n, ic, in, 0, w, down, &fk);
+            bt[0] = (uint8_t)pair_bits(c, n, ic, in, 0, w, down, level);
             for (i = 1; i < w - 1; i += MASK_CHUNK) {
                 i = i + MASK_CHUNK <= w - 1 ? i : w - 1 - MASK_CHUNK; /* the last overlaps the one before */
-                pair_bits_chunk(c + 3 * (size_t)i, n + 3 * (size_t)i, ic + i, in + i, (uint8_t)jb->level, bt + i);
+                pair_bits_chunk(c + 3 * (size_t)i, n + 3 * (size_t)i, ic + i, in + i, level, bt + i);
             }
         }
         for (; i < w; i++)
-            bt[i] = (uint8_t)pair_bits(c, n, ic, in, i, w, down, &fk);
+            bt[i] = (uint8_t)pair_bits(c, n, ic, in, i, w, down, level);
     }
 }
 
