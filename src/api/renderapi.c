@@ -524,7 +524,11 @@ static plx_status render_aa(plx_engine *e, const render_camera *rc, render_opts 
                 ro->auto_exposure = 0;
                 adaptive = !full && aa_adaptive_buffers(e, maxpx) ? PLX_AA_ADAPTIVE : PLX_AA_EVERY;
                 if (adaptive && px > 0) {
-                    size_t marked = render_aa_mask(e->rd, ro, ex, curve, AA_LEVEL, e->aa_rgb, e->aa_id, e->aa_mask);
+                    /* the first sample's bytes into the caller's image, where
+                     * the pixels that keep them stay (render_tonemap_kept) */
+                    uint8_t *first = rgb8 ? rgb8 : e->aa_rgb;
+                    size_t marked = render_aa_mask(e->rd, ro, ex, curve, AA_LEVEL, first, e->aa_rgb, e->aa_id,
+                                                   e->aa_mask);
                     if (ro->atlas && marked > px / 2) {
                         adaptive = PLX_AA_DENSE;
                     } else {
@@ -546,7 +550,14 @@ static plx_status render_aa(plx_engine *e, const render_camera *rc, render_opts 
     render_aa_scale(ro, e->aa_sum, 3 * px, inv);
     if (rgbf)
         memcpy(rgbf, e->aa_sum, px * 3 * sizeof(float));
-    if (rgb8)
+    /* 2 x 2: a pixel no later sample shaded sums its first value four
+     * times, and ((v + v) + v) + v rounds to exactly 4v (3v rounds by a
+     * tie at most, which 4v's even neighbour cannot win), so its bytes
+     * are the first sample's; 3 x 3 and up return v for only about half
+     * of the values or less, and the test would cost more than it saves */
+    if (rgb8 && adaptive == PLX_AA_ADAPTIVE && n == 2 && px > 0)
+        render_tonemap_kept(e->rd, e->aa_sum, e->aa_mask, px, ex, curve, rgb8, ro);
+    else if (rgb8)
         render_tonemap_par(e->rd, e->aa_sum, px, ex, curve, rgb8, ro);
     rs->exposure = ex;
     rs->indirect_calls = lookups;

@@ -2524,6 +2524,82 @@ static void tonemap_chunk(void *arg, int worker, uint32_t k)
     tonemap_apply(jb->r->tm, jb->r->thr, jb->lin, p0, p1, jb->rgb8);
 }
 
+/* Pixels a job of render_tonemap_kept: a multiple of KEPT_LANES. */
+#define KEPT_PIXELS 16384
+#define KEPT_LANES 64
+
+typedef struct kept_job {
+    const render *r;
+    const float *sum;
+    const uint8_t *mask;
+    size_t px;
+    uint8_t *rgb8;
+} kept_job;
+
+/* d[k]: whether value k of sum is not lin's, for the KEPT_LANES pixels'
+ * 3 * KEPT_LANES values in a loop of fixed length. Equal floats have
+ * equal bytes (+0 and -0 both give 0; NaN is never equal). */
+static void kept_diff(const float *restrict sum, const float *restrict lin, uint8_t *restrict d)
+{
+    int k;
+    for (k = 0; k < 3 * KEPT_LANES; k++)
+        d[k] = (uint8_t)(sum[k] != lin[k]);
+}
+
+/* The first of i .. e - 1 whose byte is (not) 0 when want is 1 (0); e:
+ * none. Eight bytes a test where they all differ from want (each byte 0
+ * or 1). */
+static size_t kept_next(const uint8_t *b, size_t i, size_t e, int want)
+{
+    const uint64_t all = want ? 0 : UINT64_C(0x0101010101010101);
+    uint64_t q;
+    while (i + 8 <= e && (memcpy(&q, b + i, sizeof q), q == all))
+        i += 8;
+    while (i < e && (b[i] != 0) != want)
+        i++;
+    return i;
+}
+
+/* Job k of render_tonemap_kept, KEPT_LANES pixels at a time: which values
+ * differ from the linear image (kept_diff), all three of each marked
+ * pixel, then each run of them through tonemap_apply. */
+static void kept_chunk(void *arg, int worker, uint32_t k)
+{
+    const kept_job *jb = arg;
+    const float *lin = jb->r->lin;
+    size_t p0 = (size_t)k * KEPT_PIXELS, p1 = p0 + KEPT_PIXELS < jb->px ? p0 + KEPT_PIXELS : jb->px, p;
+    uint8_t d[3 * KEPT_LANES];
+    (void)worker;
+    for (p = p0; p < p1; p += KEPT_LANES) {
+        size_t n = p1 - p < KEPT_LANES ? p1 - p : KEPT_LANES, i, e;
+        const uint8_t *m = jb->mask + p;
+        if (n == KEPT_LANES)
+            kept_diff(jb->sum + 3 * p, lin + 3 * p, d);
+        else
+            for (i = 0; i < 3 * n; i++)
+                d[i] = (uint8_t)(jb->sum[3 * p + i] != lin[3 * p + i]);
+        for (i = kept_next(m, 0, n, 1); i < n; i = kept_next(m, i + 1, n, 1))
+            d[3 * i] = d[3 * i + 1] = d[3 * i + 2] = 1;
+        for (i = kept_next(d, 0, 3 * n, 1); i < 3 * n; i = kept_next(d, e, 3 * n, 1)) {
+            e = kept_next(d, i, 3 * n, 0);
+            tonemap_apply(jb->r->tm, jb->r->thr, jb->sum, 3 * p + i, 3 * p + e, jb->rgb8);
+        }
+    }
+}
+
+void render_tonemap_kept(render *r, const float *sum, const uint8_t *mask, size_t px, double ex, int curve,
+                         uint8_t *rgb8, const render_opts *o)
+{
+    kept_job jb;
+    tonemap_table_set(r->tm, r->thr, ex, curve);
+    jb.r = r;
+    jb.sum = sum;
+    jb.mask = mask;
+    jb.px = px;
+    jb.rgb8 = rgb8;
+    run_jobs(o, (uint32_t)((px + KEPT_PIXELS - 1) / KEPT_PIXELS), kept_chunk, &jb);
+}
+
 void render_tonemap_par(render *r, const float *lin, size_t px, double ex, int curve, uint8_t *rgb8,
                         const render_opts *o)
 {
@@ -2855,8 +2931,8 @@ static void mask_or_rows(void *arg, int worker, uint32_t k)
     jb->marked[worker] += n;
 }
 
-size_t render_aa_mask(render *r, const render_opts *o, double ex, int curve, int level, uint8_t *rgb, uint32_t *id0,
-                      uint8_t *mask)
+size_t render_aa_mask(render *r, const render_opts *o, double ex, int curve, int level, uint8_t *rgb,
+                      uint8_t *marks, uint32_t *id0, uint8_t *mask)
 {
     size_t px = (size_t)r->w * (size_t)r->h, n = 0;
     uint32_t jobs = (uint32_t)((r->h + MASK_ROWS - 1) / MASK_ROWS);
@@ -2870,13 +2946,13 @@ size_t render_aa_mask(render *r, const render_opts *o, double ex, int curve, int
     jb.id0 = id0;
     jb.level = level < 0 ? 0u : level > 255 ? 255u : (unsigned)level; /* 255: no channel step is an edge */
     /* two passes on the workers, each pixel writing only its own byte: the
-     * pairs' bits into mask, then the marks into rgb (free by then: the
-     * first pass is its last reader), copied back to mask */
+     * pairs' bits into mask, then the marks into marks (which may be rgb:
+     * the first pass is its last reader), copied back to mask */
     jb.bits = mask;
-    jb.out = rgb;
+    jb.out = marks;
     run_jobs(o, jobs, mask_bits_rows, &jb);
     run_jobs(o, jobs, mask_or_rows, &jb);
-    memcpy(mask, rgb, px);
+    memcpy(mask, marks, px);
     for (k = 0; k < RENDER_MAX_WORKERS; k++)
         n += jb.marked[k];
     if (!o->no_glow)

@@ -394,6 +394,17 @@ plx_status render_frame(render *r, const render_camera *cam, const render_opts *
 void render_tonemap_par(render *r, const float *lin, size_t px, double ex, int curve,
                         uint8_t *rgb8 /* OUT */, const render_opts *o);
 
+/* render_tonemap_par for the end of an adaptive anti-aliased frame whose
+ * first sample render_aa_mask tone mapped into rgb8 (the same ex and
+ * curve): only the values of the pixels marked in mask, and those of sum
+ * not equal (as floats) to the renderer's linear image's (its first
+ * sample's, which the later samples keep at the pixels they do not
+ * shade), are tone mapped again; every other value's byte is already
+ * that of sum (equal floats give equal bytes: +0 and -0 both 0, and NaN
+ * is never equal). */
+void render_tonemap_kept(render *r, const float *sum, const uint8_t *mask, size_t px, double ex, int curve,
+                         uint8_t *rgb8 /* IN/OUT */, const render_opts *o);
+
 /* Anti-aliasing's sums on o's workers: sum[p] = lin[p] (copy), sum[p] +=
  * lin[p] (add) for p < n, and sum[p] = (float)(sum[p] * inv) (scale);
  * each value the same float operations as one at a time. */
@@ -403,14 +414,15 @@ void render_aa_scale(const render_opts *o, float *sum, size_t n, double inv);
 
 /* Adaptive anti-aliasing, after the frame of the first sample (its exposure
  * ex, curve as render_opts.auto_exposure): tone maps the linear image into
- * rgb (3 bytes a pixel, scratch), copies the surface ids into id0 and
+ * rgb (3 bytes a pixel; kept unless marks is rgb), uses marks (1 byte a
+ * pixel, scratch; may be rgb) for the marks, copies the surface ids into id0 and
  * marks in mask (1 byte a pixel) every pixel that differs from one of its
  * 8 neighbours: another surface id, or a channel more than level steps
  * apart in the 8-bit image (level taken into 0 .. 255: below 0 as 0), and
  * (without render_opts.no_glow) the pixels of the glows it sees.
  * Returns the pixels marked. */
-size_t render_aa_mask(render *r, const render_opts *o, double ex, int curve, int level, uint8_t *rgb, uint32_t *id0,
-                      uint8_t *mask);
+size_t render_aa_mask(render *r, const render_opts *o, double ex, int curve, int level, uint8_t *rgb,
+                      uint8_t *marks, uint32_t *id0, uint8_t *mask);
 
 /* The linear image of the last frame (width*height*3). Valid until the next frame. */
 const float *render_linear(const render *r);

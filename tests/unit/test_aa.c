@@ -25,6 +25,11 @@
  *    sixteen at a time and jobs of 65,536 pixels.
  *  - The sums of the samples on the workers give the bits of one value at
  *    a time, for lengths around the lanes and the jobs.
+ *  - The last tone map of a 2 x 2 adaptive frame (render_tonemap_kept)
+ *    maps again exactly the values whose pixel is marked or which are
+ *    not the first sample's value, and leaves the others' bytes.
+ *  - render_aa_mask with its marks elsewhere leaves the first sample's
+ *    bytes in rgb: those of the plain frame.
  */
 #include <stdarg.h>
 #include <stddef.h>
@@ -328,7 +333,7 @@ static void mask_against_brute(plx_engine *e, int w, int h, int workers)
     plx_render_info info;
     render_opts ro;
     size_t px = (size_t)w * h, p, marked = 0, n;
-    uint8_t *rgb8 = malloc(px * 3), *scratch = malloc(px * 3), *mask = malloc(px);
+    uint8_t *rgb8 = malloc(px * 3), *scratch = malloc(px * 3), *keep = malloc(px), *mask = malloc(px);
     uint32_t *id = malloc(px * sizeof *id), *id0 = malloc(px * sizeof *id0);
     int i, j, level;
     plx_render_opts_default(&o);
@@ -342,7 +347,8 @@ static void mask_against_brute(plx_engine *e, int w, int h, int workers)
     ro.par_ctx = e->port.ctx;
     ro.workers = workers;
     for (level = 0; level <= 7; level += level < 2 ? 1 : 5) { /* 0, 1, 2 (AA_LEVEL), 7 */
-        n = render_aa_mask(e->rd, &ro, info.exposure, 1, level, scratch, id0, mask);
+        n = render_aa_mask(e->rd, &ro, info.exposure, 1, level, scratch, keep, id0, mask);
+        assert_memory_equal(scratch, rgb8, px * 3); /* the first sample's bytes, kept */
         marked = 0;
         for (j = 0; j < h; j++)
             for (i = 0; i < w; i++) {
@@ -357,7 +363,7 @@ static void mask_against_brute(plx_engine *e, int w, int h, int workers)
     }
     print_message("mask %dx%d on %d workers: %zu of %zu pixels marked (level 7), as the brute force at levels 0, 1, "
                   "2 and 7\n", w, h, workers, marked, px);
-    free(rgb8); free(scratch); free(mask); free(id); free(id0);
+    free(rgb8); free(scratch); free(keep); free(mask); free(id); free(id0);
 }
 
 /* mask_update (a later sample with render_opts.mask): every pixel whose
@@ -431,9 +437,9 @@ static void mask_count_with_glows(plx_engine *e, int w, int h)
     ro.par_ctx = e->port.ctx;
     ro.workers = 2;
     /* level 255: surface edges only, so that the glows mark pixels of their own */
-    plain = render_aa_mask(e->rd, &ro, info.exposure, 1, 255, scratch, id0, mask);
+    plain = render_aa_mask(e->rd, &ro, info.exposure, 1, 255, scratch, scratch, id0, mask);
     ro.no_glow = 0;
-    n = render_aa_mask(e->rd, &ro, info.exposure, 1, 255, scratch, id0, mask);
+    n = render_aa_mask(e->rd, &ro, info.exposure, 1, 255, scratch, scratch, id0, mask);
     for (p = 0; p < px; p++)
         marked += mask[p];
     print_message("mask %dx%d with glows: %zu pixels marked, %zu without the glows\n", w, h, n, plain);
@@ -487,6 +493,80 @@ static void test_aa_sums(void **state)
     free(lin); free(sum); free(ref);
 }
 
+/* render_tonemap_kept against its rule, one value at a time: a value is
+ * tone mapped again (render_tonemap_par's byte of sum) when its pixel is
+ * marked or it is not the renderer's linear image's value (as floats);
+ * every other value keeps the byte it had. The frame's own linear image, with
+ * pixels of sum changed by one step, set to NaN or -0, and marked, at
+ * 150x111 (two jobs of 16,384 pixels, the last 64 short by 54), on 1 and 2
+ * workers. */
+static void kept_against_rule(plx_engine *e, int workers)
+{
+    const int w = 150, h = 111;
+    plx_camera cam;
+    plx_render_opts o;
+    plx_render_info info;
+    render_opts ro;
+    size_t px = (size_t)w * h, p, v, kept = 0, again = 0;
+    float *sum = malloc(px * 3 * sizeof *sum);
+    uint8_t *rgb8 = malloc(px * 3), *ref = malloc(px * 3), *was = malloc(px * 3), *mask = calloc(px, 1);
+    const float *lin;
+    uint64_t seed = 11;
+    plx_render_opts_default(&o);
+    o.auto_exposure = 1;
+    street(&cam, w, h);
+    assert_int_equal(plx_render(e, &cam, &o, rgb8, NULL, &info), PLX_OK);
+    lin = render_linear(e->rd);
+    memcpy(sum, lin, px * 3 * sizeof *sum);
+    for (p = 0; p < px; p++) {
+        unsigned pick;
+        seed = seed * 6364136223846793005ull + 1442695040888963407ull;
+        pick = (unsigned)(seed >> 61); /* 0 .. 7 */
+        if (pick == 0)
+            mask[p] = 1;                      /* marked, values equal */
+        else if (pick == 1)
+            sum[3 * p + (seed >> 40) % 3] = nextafterf(sum[3 * p + (seed >> 40) % 3], 1e30f);
+        else if (pick == 2)
+            sum[3 * p + 1] = NAN;
+        else if (pick == 3 && lin[3 * p] == 0.0f)
+            sum[3 * p] = -0.0f;               /* equal as floats: kept */
+        else if (pick == 4) {
+            mask[p] = 1;
+            sum[3 * p + 2] *= 2.0f;
+        }
+    }
+    for (v = 0; v < px * 3; v++)
+        was[v] = (uint8_t)(v * 37u + 5u);
+    render_opts_default(&ro);
+    ro.par = e->port.parallel_for;
+    ro.par_ctx = e->port.ctx;
+    ro.workers = workers;
+    render_tonemap_par(e->rd, sum, px, info.exposure, 1, ref, &ro);
+    memcpy(rgb8, was, px * 3);
+    render_tonemap_kept(e->rd, sum, mask, px, info.exposure, 1, rgb8, &ro);
+    for (v = 0; v < px * 3; v++) {
+        int need = mask[v / 3] || sum[v] != lin[v];
+        assert_int_equal(rgb8[v], need ? ref[v] : was[v]);
+        again += (size_t)need;
+        kept += (size_t)!need;
+    }
+    assert_true(again > px * 3 / 10 && kept > px * 3 / 2);
+    print_message("kept tone map 150x111 on %d workers: %zu values mapped again, %zu kept, as the rule says\n",
+                  workers, again, kept);
+    free(sum); free(rgb8); free(ref); free(was); free(mask);
+}
+
+static void test_tonemap_kept(void **state)
+{
+    void *mem;
+    plx_engine *e = open_eixample(&mem);
+    (void)state;
+    kept_against_rule(e, 1);
+    kept_against_rule(e, 2);
+    plx_engine_destroy(e);
+    free(mem);
+}
+
 static void test_aa_mask(void **state)
 {
     void *mem;
@@ -523,6 +603,7 @@ int main(void)
         cmocka_unit_test(test_aa_dense_atlas_only),
         cmocka_unit_test(test_aa_sums),
         cmocka_unit_test(test_aa_mask),
+        cmocka_unit_test(test_tonemap_kept),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
