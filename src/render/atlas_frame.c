@@ -378,20 +378,18 @@ void atlas_frame_row(const atlas *A, const atlas_view *v, atlas_cache *k, const 
         uint32_t sid;
         uint64_t n;
         /* with a mask, from the next marked pixel to the end of its run
-         * of one surface: the part of that run a full partition of the row
-         * by surface would read (the pixels before it are not marked) */
+         * of marked pixels of one surface (each pixel's read depends only
+         * on the pixel, not on where its run starts) */
         if (mask && (i = next_marked(mask, i, v->w)) == v->w)
             break;
         sid = ids[i];
-        for (e = i + 1; e < v->w && ids[e] == sid; e++)
-            ;
-        if (mask) { /* only the marked pixels are written, and counted */
-            int32_t q;
-            for (n = 0, q = i; q < e; q++)
-                n += mask[q] != 0;
-        } else {
-            n = (uint64_t)(e - i);
-        }
+        if (mask)
+            for (e = i + 1; e < v->w && ids[e] == sid && mask[e]; e++)
+                ;
+        else
+            for (e = i + 1; e < v->w && ids[e] == sid; e++)
+                ;
+        n = (uint64_t)(e - i);
         if (sid == MESH_SURF_NONE || (sid == MESH_SURF_GROUND && !g.on)) {
             int32_t q;
             for (q = i; q < e; q++)
