@@ -494,7 +494,7 @@ static plx_status render_aa(plx_engine *e, const render_camera *rc, render_opts 
     double ex = 1.0, inv = 1.0 / ((double)n * n);
     plx_status st = PLX_OK;
     uint64_t lookups = 0, later = 0, calls = 0;
-    int a, b, curve = ro->auto_exposure, adaptive = 0;
+    int a, b, curve = ro->auto_exposure, adaptive = 0, marked_sums = 0;
     int32_t mw, mh;
     if (rc->width < 1 || rc->height < 1)
         px = 0;
@@ -534,31 +534,38 @@ static plx_status render_aa(plx_engine *e, const render_camera *rc, render_opts 
                     } else {
                         ro->mask = e->aa_mask;
                         ro->mask_id = e->aa_id;
+                        /* 2 x 2 into bytes: the sums at the marked pixels only */
+                        marked_sums = n == 2 && rgb8 != NULL;
+                        ro->mask_new = marked_sums ? 2 : 1;
                     }
                 }
             } else {
-                render_aa_add(ro, e->aa_sum, lin, 3 * px);
+                if (marked_sums)
+                    render_aa_add_marked(ro, e->aa_sum, lin, e->aa_mask, px, b * n + a - 1);
+                else
+                    render_aa_add(ro, e->aa_sum, lin, 3 * px);
                 later += rs->sky_pixels + rs->ground_pixels + rs->building_pixels;
             }
         }
     ro->auto_exposure = curve;
     ro->mask = NULL;
     ro->mask_id = NULL;
+    ro->mask_new = 0;
     ro->cull_samples = 0;
     if (st != PLX_OK)
         return st;
-    render_aa_scale(ro, e->aa_sum, 3 * px, inv);
-    if (rgbf)
-        memcpy(rgbf, e->aa_sum, px * 3 * sizeof(float));
-    /* 2 x 2: a pixel no later sample shaded sums its first value four
-     * times, and ((v + v) + v) + v rounds to exactly 4v (3v rounds by a
-     * tie at most, which 4v's even neighbour cannot win), so its bytes
-     * are the first sample's; 3 x 3 and up return v for only about half
-     * of the values or less, and the test would cost more than it saves */
-    if (rgb8 && adaptive == PLX_AA_ADAPTIVE && n == 2 && px > 0)
+    if (marked_sums) {
+        /* the first sample's bytes stay where no later sample shaded */
         render_tonemap_kept(e->rd, e->aa_sum, e->aa_mask, px, ex, curve, rgb8, ro);
-    else if (rgb8)
-        render_tonemap_par(e->rd, e->aa_sum, px, ex, curve, rgb8, ro);
+        if (rgbf)
+            memcpy(rgbf, e->aa_sum, px * 3 * sizeof(float));
+    } else {
+        render_aa_scale(ro, e->aa_sum, 3 * px, inv);
+        if (rgbf)
+            memcpy(rgbf, e->aa_sum, px * 3 * sizeof(float));
+        if (rgb8)
+            render_tonemap_par(e->rd, e->aa_sum, px, ex, curve, rgb8, ro);
+    }
     rs->exposure = ex;
     rs->indirect_calls = lookups;
     rs->shader_calls = calls;

@@ -1,4 +1,5 @@
 /* render: night images on the CPU (see render.h). */
+#include <float.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -2484,9 +2485,10 @@ static void glows(render *r, const render_opts *o, render_stats *st)
     }
 }
 
-/* Marks in mask the pixels of every glow disc seen in this frame; returns
- * how many were not marked before. */
-static size_t glow_mark(const render *r, uint8_t *mask)
+/* Marks in mask the pixels of every glow disc seen in this frame (an
+ * unmarked pixel's byte set to nw, a marked one's kept); returns how many
+ * were not marked before. */
+static size_t glow_mark(const render *r, uint8_t *mask, uint8_t nw)
 {
     uint32_t k, n = glow_count(r);
     size_t added = 0;
@@ -2500,7 +2502,7 @@ static size_t glow_mark(const render *r, uint8_t *mask)
                 if (glow_q(g, x, y) < 1.0) {
                     uint8_t *m = &mask[(size_t)y * (size_t)r->w + (size_t)x];
                     added += *m == 0;
-                    *m = 1;
+                    *m = *m ? *m : nw;
                 }
     }
     return added;
@@ -2522,82 +2524,6 @@ static void tonemap_chunk(void *arg, int worker, uint32_t k)
     size_t p0 = (size_t)k * TONEMAP_CHUNK, p1 = p0 + TONEMAP_CHUNK < jb->n ? p0 + TONEMAP_CHUNK : jb->n;
     (void)worker;
     tonemap_apply(jb->r->tm, jb->r->thr, jb->lin, p0, p1, jb->rgb8);
-}
-
-/* Pixels a job of render_tonemap_kept: a multiple of KEPT_LANES. */
-#define KEPT_PIXELS 16384
-#define KEPT_LANES 64
-
-typedef struct kept_job {
-    const render *r;
-    const float *sum;
-    const uint8_t *mask;
-    size_t px;
-    uint8_t *rgb8;
-} kept_job;
-
-/* d[k]: whether value k of sum is not lin's, for the KEPT_LANES pixels'
- * 3 * KEPT_LANES values in a loop of fixed length. Equal floats have
- * equal bytes (+0 and -0 both give 0; NaN is never equal). */
-static void kept_diff(const float *restrict sum, const float *restrict lin, uint8_t *restrict d)
-{
-    int k;
-    for (k = 0; k < 3 * KEPT_LANES; k++)
-        d[k] = (uint8_t)(sum[k] != lin[k]);
-}
-
-/* The first of i .. e - 1 whose byte is (not) 0 when want is 1 (0); e:
- * none. Eight bytes a test where they all differ from want (each byte 0
- * or 1). */
-static size_t kept_next(const uint8_t *b, size_t i, size_t e, int want)
-{
-    const uint64_t all = want ? 0 : UINT64_C(0x0101010101010101);
-    uint64_t q;
-    while (i + 8 <= e && (memcpy(&q, b + i, sizeof q), q == all))
-        i += 8;
-    while (i < e && (b[i] != 0) != want)
-        i++;
-    return i;
-}
-
-/* Job k of render_tonemap_kept, KEPT_LANES pixels at a time: which values
- * differ from the linear image (kept_diff), all three of each marked
- * pixel, then each run of them through tonemap_apply. */
-static void kept_chunk(void *arg, int worker, uint32_t k)
-{
-    const kept_job *jb = arg;
-    const float *lin = jb->r->lin;
-    size_t p0 = (size_t)k * KEPT_PIXELS, p1 = p0 + KEPT_PIXELS < jb->px ? p0 + KEPT_PIXELS : jb->px, p;
-    uint8_t d[3 * KEPT_LANES];
-    (void)worker;
-    for (p = p0; p < p1; p += KEPT_LANES) {
-        size_t n = p1 - p < KEPT_LANES ? p1 - p : KEPT_LANES, i, e;
-        const uint8_t *m = jb->mask + p;
-        if (n == KEPT_LANES)
-            kept_diff(jb->sum + 3 * p, lin + 3 * p, d);
-        else
-            for (i = 0; i < 3 * n; i++)
-                d[i] = (uint8_t)(jb->sum[3 * p + i] != lin[3 * p + i]);
-        for (i = kept_next(m, 0, n, 1); i < n; i = kept_next(m, i + 1, n, 1))
-            d[3 * i] = d[3 * i + 1] = d[3 * i + 2] = 1;
-        for (i = kept_next(d, 0, 3 * n, 1); i < 3 * n; i = kept_next(d, e, 3 * n, 1)) {
-            e = kept_next(d, i, 3 * n, 0);
-            tonemap_apply(jb->r->tm, jb->r->thr, jb->sum, 3 * p + i, 3 * p + e, jb->rgb8);
-        }
-    }
-}
-
-void render_tonemap_kept(render *r, const float *sum, const uint8_t *mask, size_t px, double ex, int curve,
-                         uint8_t *rgb8, const render_opts *o)
-{
-    kept_job jb;
-    tonemap_table_set(r->tm, r->thr, ex, curve);
-    jb.r = r;
-    jb.sum = sum;
-    jb.mask = mask;
-    jb.px = px;
-    jb.rgb8 = rgb8;
-    run_jobs(o, (uint32_t)((px + KEPT_PIXELS - 1) / KEPT_PIXELS), kept_chunk, &jb);
 }
 
 void render_tonemap_par(render *r, const float *lin, size_t px, double ex, int curve, uint8_t *rgb8,
@@ -2728,19 +2654,170 @@ void render_aa_scale(const render_opts *o, float *sum, size_t n, double inv)
     aa_run(o, sum, NULL, n, inv, 0);
 }
 
-/* Marks (sets to 1) the n pixels whose surface in id is not the one in
- * id0, sixteen at a time in a loop of fixed length (vectorised by GCC
- * at -O2); the marks are 0 or 1, so or-ing the test gives the same. */
+/* ---- 2 x 2 sums at the marked pixels (render_aa_add_marked, render_tonemap_kept) ---- */
+
+#define KEPT_PIXELS 16384       /* pixels a job: a multiple of KEPT_LANES */
+#define KEPT_LANES 64
+#define KEPT_LIMIT (FLT_MAX / 4.0f) /* 4v finite up to here */
+
+/* The first of i .. e - 1 whose byte is (not) 0 when want is 1 (0); e:
+ * none. Eight bytes a test where they are all 0 (want 1), or all 1 (want
+ * 0; bytes 0 or 1 then). */
+static size_t byte_next(const uint8_t *b, size_t i, size_t e, int want)
+{
+    const uint64_t all = want ? 0 : UINT64_C(0x0101010101010101);
+    uint64_t q;
+    while (i + 8 <= e && (memcpy(&q, b + i, sizeof q), q == all))
+        i += 8;
+    while (i < e && (b[i] != 0) != want)
+        i++;
+    return i;
+}
+
+typedef struct marked_job {
+    const render *r;
+    float *sum;
+    const float *lin;
+    uint8_t *mask;
+    const uint8_t *cmask;
+    size_t px;
+    int before;
+    uint8_t *rgb8;
+} marked_job;
+
+static size_t job_end(size_t k, size_t px)
+{
+    return (k + 1) * KEPT_PIXELS < px ? (k + 1) * KEPT_PIXELS : px;
+}
+
+/* Job k of render_aa_add_marked: each run of marked pixels, its new
+ * marks caught up, then its values' adds. */
+static void add_marked_chunk(void *arg, int worker, uint32_t k)
+{
+    const marked_job *jb = arg;
+    size_t p1 = job_end(k, jb->px), i, e, q;
+    (void)worker;
+    for (i = byte_next(jb->mask, (size_t)k * KEPT_PIXELS, p1, 1); i < p1; i = byte_next(jb->mask, e, p1, 1)) {
+        float *s = jb->sum;
+        e = byte_next(jb->mask, i, p1, 0);
+        for (q = i; q < e; q++)
+            if (jb->mask[q] == 2) { /* newly marked: the samples before added its first value */
+                int c, t;
+                for (c = 0; c < 3; c++) {
+                    float v = s[3 * q + (size_t)c];
+                    for (t = 0; t < jb->before; t++)
+                        s[3 * q + (size_t)c] += v;
+                }
+                jb->mask[q] = 1;
+            }
+        for (q = 3 * i; q < 3 * e; q++)
+            s[q] += jb->lin[q];
+    }
+}
+
+void render_aa_add_marked(const render_opts *o, float *sum, const float *lin, uint8_t *mask, size_t px,
+                          int before)
+{
+    marked_job jb;
+    memset(&jb, 0, sizeof jb);
+    jb.sum = sum;
+    jb.lin = lin;
+    jb.mask = mask;
+    jb.px = px;
+    jb.before = before;
+    run_jobs(o, (uint32_t)((px + KEPT_PIXELS - 1) / KEPT_PIXELS), add_marked_chunk, &jb);
+}
+
+/* d[k]: whether value k of the KEPT_LANES pixels' sums is outside
+ * [-KEPT_LIMIT, KEPT_LIMIT] (or NaN), in a loop of fixed length. */
+static void kept_far(const float *restrict sum, uint8_t *restrict d)
+{
+    int k;
+    for (k = 0; k < 3 * KEPT_LANES; k++)
+        d[k] = (uint8_t)!(fabsf(sum[k]) <= KEPT_LIMIT);
+}
+
+/* An unmarked value v's dense sums: ((v + v) + v) + v times 1/4. */
+static float dense_2x2(float v)
+{
+    float s = v;
+    s += v;
+    s += v;
+    s += v;
+    return (float)(s * 0.25);
+}
+
+/* Job k of render_tonemap_kept, KEPT_LANES pixels at a time: the values
+ * to map again (marked pixels' scaled sums, unmarked values summed when
+ * outside the limit), then each run of them through tonemap_apply. */
+static void kept_chunk(void *arg, int worker, uint32_t k)
+{
+    const marked_job *jb = arg;
+    size_t p1 = job_end(k, jb->px), p;
+    uint8_t d[3 * KEPT_LANES];
+    (void)worker;
+    for (p = (size_t)k * KEPT_PIXELS; p < p1; p += KEPT_LANES) {
+        size_t n = p1 - p < KEPT_LANES ? p1 - p : KEPT_LANES, i, e;
+        float *s = jb->sum + 3 * p;
+        const uint8_t *m = jb->cmask + p;
+        if (n == KEPT_LANES)
+            kept_far(s, d);
+        else
+            for (i = 0; i < 3 * n; i++)
+                d[i] = (uint8_t)!(fabsf(s[i]) <= KEPT_LIMIT);
+        for (i = byte_next(d, 0, 3 * n, 1); i < 3 * n; i = byte_next(d, i + 1, 3 * n, 1))
+            if (!m[i / 3])
+                s[i] = dense_2x2(s[i]);
+        for (i = byte_next(m, 0, n, 1); i < n; i = byte_next(m, e, n, 1)) { /* runs of marked pixels */
+            size_t q;
+            e = byte_next(m, i, n, 0);
+            for (q = 3 * i; q < 3 * e; q++)
+                s[q] = (float)(s[q] * 0.25);
+            memset(d + 3 * i, 1, 3 * (e - i));
+        }
+        for (i = byte_next(d, 0, 3 * n, 1); i < 3 * n; i = byte_next(d, e, 3 * n, 1)) {
+            e = byte_next(d, i, 3 * n, 0);
+            tonemap_apply(jb->r->tm, jb->r->thr, jb->sum, 3 * p + i, 3 * p + e, jb->rgb8);
+        }
+    }
+}
+
+void render_tonemap_kept(render *r, float *sum, const uint8_t *mask, size_t px, double ex, int curve,
+                         uint8_t *rgb8, const render_opts *o)
+{
+    marked_job jb;
+    memset(&jb, 0, sizeof jb);
+    tonemap_table_set(r->tm, r->thr, ex, curve);
+    jb.r = r;
+    jb.sum = sum;
+    jb.cmask = mask;
+    jb.px = px;
+    jb.rgb8 = rgb8;
+    run_jobs(o, (uint32_t)((px + KEPT_PIXELS - 1) / KEPT_PIXELS), kept_chunk, &jb);
+}
+
+/* The mark a pixel's byte m takes when its surface is (d = 1) or is not
+ * (d = 0) another than the first sample's: a marked pixel keeps its
+ * byte, an unmarked one takes nw when d. */
+static inline uint8_t mark_new(uint8_t m, uint8_t d, uint8_t nw)
+{
+    return (uint8_t)(m | (uint8_t)((m == 0) & d) * nw);
+}
+
+/* Marks (mark_new, byte nw) the n pixels whose surface in id is not the
+ * one in id0, sixteen at a time in a loop of fixed length (vectorised by
+ * GCC at -O2). */
 #define MASK_LANES 16
-static void mask_ids(uint8_t *restrict mask, const uint32_t *restrict id, const uint32_t *restrict id0, size_t n)
+static void mask_ids(uint8_t *restrict mask, const uint32_t *restrict id, const uint32_t *restrict id0, size_t n,
+                     uint8_t nw)
 {
     size_t p;
     int k;
     for (p = 0; p + MASK_LANES <= n; p += MASK_LANES)
         for (k = 0; k < MASK_LANES; k++)
-            mask[p + k] |= (uint8_t)(mask_class(id[p + k]) != mask_class(id0[p + k]));
+            mask[p + k] = mark_new(mask[p + k], (uint8_t)(mask_class(id[p + k]) != mask_class(id0[p + k])), nw);
     for (; p < n; p++)
-        mask[p] |= (uint8_t)(mask_class(id[p]) != mask_class(id0[p]));
+        mask[p] = mark_new(mask[p], (uint8_t)(mask_class(id[p]) != mask_class(id0[p])), nw);
 }
 
 typedef struct ids_job {
@@ -2753,7 +2830,8 @@ static void mask_ids_chunk(void *arg, int worker, uint32_t k)
     const ids_job *jb = arg;
     size_t px = (size_t)jb->r->w * (size_t)jb->r->h, p0 = (size_t)k * AA_CHUNK;
     (void)worker;
-    mask_ids(jb->o->mask + p0, jb->r->id + p0, jb->o->mask_id + p0, px - p0 < AA_CHUNK ? px - p0 : AA_CHUNK);
+    mask_ids(jb->o->mask + p0, jb->r->id + p0, jb->o->mask_id + p0, px - p0 < AA_CHUNK ? px - p0 : AA_CHUNK,
+             jb->o->mask_new ? jb->o->mask_new : 1);
 }
 
 /* Marks the pixels whose surface is not the first sample's (by chunks on
@@ -2768,7 +2846,7 @@ static void mask_update(render *r, const render_opts *o)
         run_jobs(o, (uint32_t)((px + AA_CHUNK - 1) / AA_CHUNK), mask_ids_chunk, &jb);
     }
     if (!o->no_glow)
-        (void)glow_mark(r, o->mask);
+        (void)glow_mark(r, o->mask, o->mask_new ? o->mask_new : 1);
 }
 
 /* The pairs of 8-neighbours a pixel starts (each pair once, from its
@@ -2956,7 +3034,7 @@ size_t render_aa_mask(render *r, const render_opts *o, double ex, int curve, int
     for (k = 0; k < RENDER_MAX_WORKERS; k++)
         n += jb.marked[k];
     if (!o->no_glow)
-        n += glow_mark(r, mask); /* a glow the first sample sees: every sample adds its own */
+        n += glow_mark(r, mask, 1); /* a glow the first sample sees: every sample adds its own */
     return n;
 }
 

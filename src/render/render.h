@@ -283,6 +283,9 @@ typedef struct render_opts {
                                   the culling; RENDER_SAMPLE_LATER reuses it when the camera,
                                   the near plane, the culling mode and the drawing path are the
                                   same (else culls as FIRST does); 0: culls for this sample point */
+    uint8_t mask_new;          /* with mask: the byte a pixel newly marked by this sample
+                                  gets (0 taken as 1); render_aa's 2 x 2 sums take 2, to
+                                  find the pixels they catch up (render_aa_add_marked) */
     render_par_fn par;         /* the shading pass's parallel-for (NULL: one thread) */
     void *par_ctx;
     int workers;               /* workers it may use (1 .. RENDER_MAX_WORKERS; more are cut) */
@@ -394,15 +397,27 @@ plx_status render_frame(render *r, const render_camera *cam, const render_opts *
 void render_tonemap_par(render *r, const float *lin, size_t px, double ex, int curve,
                         uint8_t *rgb8 /* OUT */, const render_opts *o);
 
-/* render_tonemap_par for the end of an adaptive anti-aliased frame whose
+/* 2 x 2 adaptive anti-aliasing's sums at the marked pixels only, for a
+ * frame whose every pixel sum already holds the first sample's value
+ * (render_aa_copy) and whose later samples have been added this way:
+ * after later sample s (1 .. 3; before = s - 1), each pixel marked 2
+ * (newly, render_opts.mask_new) first adds its first value before times,
+ * as the samples that left it did, and becomes 1; then every marked
+ * pixel adds lin. The same float operations, in the same order, as the
+ * dense sums give those pixels. */
+void render_aa_add_marked(const render_opts *o, float *sum, const float *lin, uint8_t *mask, size_t px,
+                          int before);
+
+/* The end of a 2 x 2 adaptive frame summed by render_aa_add_marked, whose
  * first sample render_aa_mask tone mapped into rgb8 (the same ex and
- * curve): only the values of the pixels marked in mask, and those of sum
- * not equal (as floats) to the renderer's linear image's (its first
- * sample's, which the later samples keep at the pixels they do not
- * shade), are tone mapped again; every other value's byte is already
- * that of sum (equal floats give equal bytes: +0 and -0 both 0, and NaN
- * is never equal). */
-void render_tonemap_kept(render *r, const float *sum, const uint8_t *mask, size_t px, double ex, int curve,
+ * curve): each marked pixel's sums scaled by 1/4 and tone mapped again;
+ * an unmarked pixel holds its first value v, which is already the dense
+ * sums' ((v + v) + v) + v times 1/4 (v + v is exact; the rounded 3v is
+ * within a quarter of a unit in 4v's last place of 3v, so adding v
+ * rounds to exactly 4v), so its bytes stay, except where 4v would
+ * overflow or v is not finite: those values are summed as the dense sums
+ * do and mapped again. Afterwards sum holds the frame's linear values. */
+void render_tonemap_kept(render *r, float *sum, const uint8_t *mask, size_t px, double ex, int curve,
                          uint8_t *rgb8 /* IN/OUT */, const render_opts *o);
 
 /* Anti-aliasing's sums on o's workers: sum[p] = lin[p] (copy), sum[p] +=

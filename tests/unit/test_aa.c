@@ -22,12 +22,16 @@
  *    the marked bytes.
  *  - A later sample's mask update marks exactly the pixels whose surface
  *    is not the first sample's (and keeps the marks there), for ids
- *    sixteen at a time and jobs of 65,536 pixels.
+ *    sixteen at a time and jobs of 65,536 pixels, with the byte asked for
+ *    new marks (1 or 2); and the pixels of the glows it sees, with that
+ *    byte too.
  *  - The sums of the samples on the workers give the bits of one value at
  *    a time, for lengths around the lanes and the jobs.
- *  - The last tone map of a 2 x 2 adaptive frame (render_tonemap_kept)
- *    maps again exactly the values whose pixel is marked or which are
- *    not the first sample's value, and leaves the others' bytes.
+ *  - A 2 x 2 frame's sums at the marked pixels only (render_aa_add_marked,
+ *    render_tonemap_kept) give the dense sums' bits and bytes, for values
+ *    of every kind (any bits, near FLT_MAX / 4 and beyond, 0, -0,
+ *    infinite, NaN) and marks added at every sample; and a 2 x 2 frame
+ *    into bytes gives the floats of the same frame into floats alone.
  *  - render_aa_mask with its marks elsewhere leaves the first sample's
  *    bytes in rgb: those of the plain frame.
  */
@@ -35,6 +39,7 @@
 #include <stddef.h>
 #include <setjmp.h>
 #include <stdint.h>
+#include <float.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -371,7 +376,7 @@ static void mask_against_brute(plx_engine *e, int w, int h, int workers)
  * the marks already there stay, and no other pixel is marked (no glows);
  * on the given workers, at w x h (ids sixteen at a time, jobs of 65,536
  * pixels). */
-static void mask_update_against_brute(plx_engine *e, int w, int h, int workers)
+static void mask_update_against_brute(plx_engine *e, int w, int h, int workers, uint8_t nw)
 {
     plx_camera pc;
     render_camera cam;
@@ -401,14 +406,15 @@ static void mask_update_against_brute(plx_engine *e, int w, int h, int workers)
     }
     ro.mask = mask;
     ro.mask_id = id0;
+    ro.mask_new = nw;
     ro.shift[0] = 0.25;
     ro.shift[1] = 0.25;
     assert_int_equal(render_frame(e->rd, &cam, &ro, NULL, NULL, &st), PLX_OK);
     for (p = 0; p < px; p++) {
         uint32_t a = render_ids(e->rd)[p], b = id0[p];
         int other = (a == 1 ? 0 : a) != (b == 1 ? 0 : b);
-        assert_int_equal(mask[p], before[p] | other);
-        marked += mask[p];
+        assert_int_equal(mask[p], before[p] ? before[p] : other * (nw ? nw : 1));
+        marked += mask[p] != 0;
         changed += other;
     }
     print_message("mask update %dx%d on %d workers: %zu pixels meet another surface at the later sample, as the "
@@ -418,6 +424,45 @@ static void mask_update_against_brute(plx_engine *e, int w, int h, int workers)
 }
 
 /* render_aa_mask's count with the glows it marks: the marked bytes. */
+/* mask_update's glows: a later sample whose surfaces are all the first's
+ * (mask_id: its own ids) marks the pixels of the glows it sees, with byte
+ * render_opts.mask_new (2), and keeps the marks already there (1). */
+static void mask_update_glows(plx_engine *e, int w, int h)
+{
+    plx_camera pc;
+    render_camera cam;
+    render_opts ro;
+    render_stats st;
+    size_t px = (size_t)w * h, p, news = 0, kept = 0;
+    uint32_t *id0 = malloc(px * sizeof *id0);
+    uint8_t *mask = malloc(px);
+    street(&pc, w, h);
+    memcpy(cam.eye, pc.eye, sizeof cam.eye);
+    memcpy(cam.target, pc.target, sizeof cam.target);
+    cam.fov_deg = pc.fov_deg;
+    cam.width = w;
+    cam.height = h;
+    render_opts_default(&ro);
+    ro.shift[0] = ro.shift[1] = 0.25;
+    assert_int_equal(render_frame(e->rd, &cam, &ro, NULL, NULL, &st), PLX_OK);
+    memcpy(id0, render_ids(e->rd), px * sizeof *id0);
+    for (p = 0; p < px; p++)
+        mask[p] = p % 3 == 0;
+    ro.mask = mask;
+    ro.mask_id = id0;
+    ro.mask_new = 2;
+    assert_int_equal(render_frame(e->rd, &cam, &ro, NULL, NULL, &st), PLX_OK);
+    for (p = 0; p < px; p++) {
+        assert_true(p % 3 == 0 ? mask[p] == 1 : mask[p] == 0 || mask[p] == 2);
+        news += mask[p] == 2;
+        kept += mask[p] == 1;
+    }
+    assert_true(st.glows > 0 && news > 0);
+    print_message("mask update %dx%d, glows only: %zu pixels newly marked 2 (%u glows), %zu marks kept\n", w, h, news,
+                  (unsigned)st.glows, kept);
+    free(id0); free(mask);
+}
+
 static void mask_count_with_glows(plx_engine *e, int w, int h)
 {
     plx_camera cam;
@@ -493,14 +538,37 @@ static void test_aa_sums(void **state)
     free(lin); free(sum); free(ref);
 }
 
-/* render_tonemap_kept against its rule, one value at a time: a value is
- * tone mapped again (render_tonemap_par's byte of sum) when its pixel is
- * marked or it is not the renderer's linear image's value (as floats);
- * every other value keeps the byte it had. The frame's own linear image, with
- * pixels of sum changed by one step, set to NaN or -0, and marked, at
- * 150x111 (two jobs of 16,384 pixels, the last 64 short by 54), on 1 and 2
- * workers. */
-static void kept_against_rule(plx_engine *e, int workers)
+/* A random float for the 2 x 2 sums: mostly any finite bits (of either
+ * sign, every exponent), some near FLT_MAX / 4 and beyond, some 0, -0,
+ * infinite or NaN. */
+static float any_float(uint64_t *seed)
+{
+    uint32_t u;
+    float v;
+    *seed = *seed * 6364136223846793005ull + 1442695040888963407ull;
+    u = (uint32_t)(*seed >> 32);
+    switch ((*seed >> 24) & 15) {
+    case 0: return 0.0f;
+    case 1: return -0.0f;
+    case 2: return (u & 1) ? INFINITY : NAN;
+    case 3: return FLT_MAX / 4.0f * (1.0f + (float)(u & 1023) / 4096.0f); /* about the limit */
+    default: break;
+    }
+    memcpy(&v, &u, sizeof v);
+    return isnan(v) ? 1.0f : v;
+}
+
+/* The 2 x 2 sums at the marked pixels (render_aa_add_marked, then
+ * render_tonemap_kept) against the dense sums, at 150x111 (two jobs of
+ * 16,384 pixels, the last 64 short by 54) on 1 and 2 workers: random
+ * values of every kind (any_float), a quarter of the pixels marked after
+ * the first sample and more at each later one (as a sliver or a glow
+ * marks them: byte 2); a later sample's value is its own at the pixels
+ * marked by then and the first sample's elsewhere, as the renderer leaves
+ * them. The sums end with the dense sums' bits, scaled, at every pixel,
+ * and the bytes are the dense sums' tone map where the first sample's
+ * bytes (the mask's) were in place. */
+static void marked_sums_against_dense(plx_engine *e, int workers)
 {
     const int w = 150, h = 111;
     plx_camera cam;
@@ -508,61 +576,108 @@ static void kept_against_rule(plx_engine *e, int workers)
     plx_render_info info;
     render_opts ro;
     size_t px = (size_t)w * h, p, v, kept = 0, again = 0;
-    float *sum = malloc(px * 3 * sizeof *sum);
-    uint8_t *rgb8 = malloc(px * 3), *ref = malloc(px * 3), *was = malloc(px * 3), *mask = calloc(px, 1);
-    const float *lin;
-    uint64_t seed = 11;
+    float *smp = malloc(px * 3 * 4 * sizeof *smp), *lin = malloc(px * 3 * sizeof *lin);
+    float *dense = malloc(px * 3 * sizeof *dense), *sum = malloc(px * 3 * sizeof *sum);
+    uint8_t *rgb8 = malloc(px * 3), *ref = malloc(px * 3), *first = malloc(px * 3);
+    uint8_t *mask = calloc(px, 1), *when = malloc(px);
+    uint64_t seed = 5;
+    int s;
     plx_render_opts_default(&o);
     o.auto_exposure = 1;
     street(&cam, w, h);
-    assert_int_equal(plx_render(e, &cam, &o, rgb8, NULL, &info), PLX_OK);
-    lin = render_linear(e->rd);
-    memcpy(sum, lin, px * 3 * sizeof *sum);
-    for (p = 0; p < px; p++) {
-        unsigned pick;
+    assert_int_equal(plx_render(e, &cam, &o, rgb8, NULL, &info), PLX_OK); /* the tone map's tables */
+    for (v = 0; v < px * 3 * 4; v++)
+        smp[v] = any_float(&seed);
+    for (p = 0; p < px; p++) { /* the sample that marks it: 0 .. 3, or 4: never */
         seed = seed * 6364136223846793005ull + 1442695040888963407ull;
-        pick = (unsigned)(seed >> 61); /* 0 .. 7 */
-        if (pick == 0)
-            mask[p] = 1;                      /* marked, values equal */
-        else if (pick == 1)
-            sum[3 * p + (seed >> 40) % 3] = nextafterf(sum[3 * p + (seed >> 40) % 3], 1e30f);
-        else if (pick == 2)
-            sum[3 * p + 1] = NAN;
-        else if (pick == 3 && lin[3 * p] == 0.0f)
-            sum[3 * p] = -0.0f;               /* equal as floats: kept */
-        else if (pick == 4) {
-            mask[p] = 1;
-            sum[3 * p + 2] *= 2.0f;
-        }
+        when[p] = (uint8_t)((seed >> 60) < 4 ? 0 : (seed >> 60) < 7 ? 1 + (seed >> 60) % 3 : 4);
     }
-    for (v = 0; v < px * 3; v++)
-        was[v] = (uint8_t)(v * 37u + 5u);
     render_opts_default(&ro);
     ro.par = e->port.parallel_for;
     ro.par_ctx = e->port.ctx;
     ro.workers = workers;
-    render_tonemap_par(e->rd, sum, px, info.exposure, 1, ref, &ro);
-    memcpy(rgb8, was, px * 3);
-    render_tonemap_kept(e->rd, sum, mask, px, info.exposure, 1, rgb8, &ro);
-    for (v = 0; v < px * 3; v++) {
-        int need = mask[v / 3] || sum[v] != lin[v];
-        assert_int_equal(rgb8[v], need ? ref[v] : was[v]);
-        again += (size_t)need;
-        kept += (size_t)!need;
+    /* dense: every value of every sample added, then scaled */
+    memcpy(dense, smp, px * 3 * sizeof *dense);
+    for (s = 1; s < 4; s++) {
+        for (v = 0; v < px * 3; v++)
+            lin[v] = when[v / 3] <= s ? smp[(size_t)s * px * 3 + v] : smp[v];
+        render_aa_add(&ro, dense, lin, px * 3);
     }
-    assert_true(again > px * 3 / 10 && kept > px * 3 / 2);
-    print_message("kept tone map 150x111 on %d workers: %zu values mapped again, %zu kept, as the rule says\n",
-                  workers, again, kept);
-    free(sum); free(rgb8); free(ref); free(was); free(mask);
+    render_aa_scale(&ro, dense, px * 3, 0.25);
+    render_tonemap_par(e->rd, dense, px, info.exposure, 1, ref, &ro);
+    /* marked: the first sample's bytes in place, then the marked sums */
+    render_tonemap_par(e->rd, smp, px, info.exposure, 1, first, &ro);
+    memcpy(rgb8, first, px * 3);
+    memcpy(sum, smp, px * 3 * sizeof *sum);
+    for (p = 0; p < px; p++)
+        mask[p] = when[p] == 0;
+    for (s = 1; s < 4; s++) {
+        for (p = 0; p < px; p++)
+            if (when[p] == s)
+                mask[p] = 2;
+        for (v = 0; v < px * 3; v++)
+            lin[v] = when[v / 3] <= s ? smp[(size_t)s * px * 3 + v] : smp[v];
+        render_aa_add_marked(&ro, sum, lin, mask, px, s - 1);
+    }
+    for (p = 0; p < px; p++)
+        assert_int_equal(mask[p], when[p] < 4);
+    render_tonemap_kept(e->rd, sum, mask, px, info.exposure, 1, rgb8, &ro);
+    assert_memory_equal(sum, dense, px * 3 * sizeof *sum);
+    assert_memory_equal(rgb8, ref, px * 3);
+    for (v = 0; v < px * 3; v++) {
+        kept += when[v / 3] == 4;
+        again += when[v / 3] < 4;
+    }
+    assert_true(kept > px && again > px);
+    print_message("2x2 sums at the marked pixels 150x111 on %d workers: the dense sums' bits and bytes (%zu values "
+                  "marked, %zu kept)\n", workers, again, kept);
+    free(smp); free(lin); free(dense); free(sum); free(rgb8); free(ref); free(first); free(mask); free(when);
 }
 
-static void test_tonemap_kept(void **state)
+/* plx_render at 2 x 2 into bytes (the sums at the marked pixels) against
+ * the same frame into floats alone (the dense sums), 24 street cameras
+ * along the 4 x 4 Eixample with glows: the same floats, and the bytes are
+ * their tone map. */
+static void marked_frames_against_dense(plx_engine *e)
+{
+    const int w = 160, h = 120;
+    plx_camera cam;
+    plx_render_opts o;
+    plx_render_info ia, ib;
+    render_opts ro;
+    size_t px = (size_t)w * h;
+    float *fa = malloc(px * 3 * sizeof *fa), *fb = malloc(px * 3 * sizeof *fb);
+    uint8_t *a8 = malloc(px * 3), *b8 = malloc(px * 3);
+    int k;
+    plx_render_opts_default(&o);
+    o.auto_exposure = 1;
+    o.aa = 2;
+    render_opts_default(&ro);
+    for (k = 0; k < 24; k++) {
+        street(&cam, w, h);
+        cam.eye[0] -= 3.0 * k;
+        cam.eye[1] += 1.5 * k;
+        cam.target[0] -= 3.0 * k;
+        cam.target[1] += 1.5 * k;
+        assert_int_equal(plx_render(e, &cam, &o, a8, fa, &ia), PLX_OK);
+        assert_int_equal(ia.aa_adaptive, PLX_AA_ADAPTIVE);
+        assert_int_equal(plx_render(e, &cam, &o, NULL, fb, &ib), PLX_OK);
+        assert_memory_equal(fa, fb, px * 3 * sizeof *fa);
+        render_tonemap_par(e->rd, fb, px, ib.exposure, 1, b8, &ro);
+        assert_memory_equal(a8, b8, px * 3);
+    }
+    print_message("2x2 frames into bytes: the floats of the frames into floats alone, and their bytes (24 cameras)\n");
+    free(fa); free(fb); free(a8); free(b8);
+}
+
+static void test_marked_sums(void **state)
 {
     void *mem;
     plx_engine *e = open_eixample(&mem);
     (void)state;
-    kept_against_rule(e, 1);
-    kept_against_rule(e, 2);
+    marked_sums_against_dense(e, 1);
+    marked_sums_against_dense(e, 2);
+    marked_frames_against_dense(e);
     plx_engine_destroy(e);
     free(mem);
 }
@@ -586,9 +701,10 @@ static void test_aa_mask(void **state)
     mask_against_brute(e, 200, 33, 2);
     mask_against_brute(e, 66, 1, 2);
     mask_against_brute(e, 130, 2, 1);
-    mask_update_against_brute(e, 160, 120, 1);
-    mask_update_against_brute(e, 203, 111, 2);
-    mask_update_against_brute(e, 300, 230, 2); /* two jobs of ids */
+    mask_update_against_brute(e, 160, 120, 1, 0);
+    mask_update_against_brute(e, 203, 111, 2, 2); /* new marks 2 (2 x 2 sums at the marked pixels) */
+    mask_update_against_brute(e, 300, 230, 2, 1); /* two jobs of ids */
+    mask_update_glows(e, 160, 120);
     mask_count_with_glows(e, 160, 120);
     plx_engine_destroy(e);
     free(mem);
@@ -603,7 +719,7 @@ int main(void)
         cmocka_unit_test(test_aa_dense_atlas_only),
         cmocka_unit_test(test_aa_sums),
         cmocka_unit_test(test_aa_mask),
-        cmocka_unit_test(test_tonemap_kept),
+        cmocka_unit_test(test_marked_sums),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
