@@ -232,7 +232,7 @@ static void rnd_grid_small(float *p, int k, int w, int h)
 static void test_triangle_id_same(void **state)
 {
     int round, rounds = getenv("PLX_TEST_QUICK") ? 60 : 400;
-    long direct = 0, fallback = 0, small = 0;
+    long direct = 0, fallback = 0, small = 0, counted = 0;
     (void)state;
     rng_state = 0x5eed1d5ull;
     for (round = 0; round < rounds; round++) {
@@ -276,6 +276,7 @@ static void test_triangle_id_same(void **state)
         for (k = 0; k < n; k++) {
             raster_vertex v[3];
             raster_pvert p[3];
+            long got;
             int q;
             memset(v, 0, sizeof v);
             for (q = 0; q < 3; q++) {
@@ -284,7 +285,15 @@ static void test_triangle_id_same(void **state)
             }
             it.cur = (uint32_t)k + 1;
             raster_triangle(&ra, &v[0], &v[1], &v[2]);
-            if (raster_triangle_id(&rb, &p[0], &p[1], &p[2], (uint32_t)k + 1, ib) >= 0) {
+            if ((got = raster_triangle_id(&rb, &p[0], &p[1], &p[2], (uint32_t)k + 1, ib)) >= 0) {
+                if (k % 4 == 0) { /* the pixels it says it wrote: those that now carry its id */
+                    long have = 0;
+                    size_t q2;
+                    for (q2 = 0; q2 < (size_t)w * h; q2++)
+                        have += ib[q2] == (uint32_t)k + 1;
+                    assert_int_equal(got, have);
+                    counted += have;
+                }
                 direct++;
                 continue;
             }
@@ -303,8 +312,9 @@ static void test_triangle_id_same(void **state)
         free(ib);
     }
     printf("raster_triangle_id: %ld triangles drawn from prepared vertices (%ld of them small), %ld through "
-           "raster_triangle, the same ids and depths as raster_triangle alone\n", direct, small, fallback);
-    assert_true(direct > 1000 && fallback > 100 && small > 1000);
+           "raster_triangle, the same ids and depths as raster_triangle alone; every fourth one's count of pixels "
+           "written is the pixels carrying its id (%ld)\n", direct, small, fallback, counted);
+    assert_true(direct > 1000 && fallback > 100 && small > 1000 && counted > 10000);
 }
 
 static void test_init_rejects_bad_targets(void **state)
