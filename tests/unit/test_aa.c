@@ -74,6 +74,18 @@ static void street(plx_camera *cam, int w, int h)
     cam->height = h;
 }
 
+/* street() as the renderer's camera. */
+static void street_render(render_camera *cam, int w, int h)
+{
+    plx_camera pc;
+    street(&pc, w, h);
+    memcpy(cam->eye, pc.eye, sizeof cam->eye);
+    memcpy(cam->target, pc.target, sizeof cam->target);
+    cam->fov_deg = pc.fov_deg;
+    cam->width = w;
+    cam->height = h;
+}
+
 static int cmp_double(const void *x, const void *y)
 {
     double a = *(const double *)x, b = *(const double *)y;
@@ -378,19 +390,13 @@ static void mask_against_brute(plx_engine *e, int w, int h, int workers)
  * pixels). */
 static void mask_update_against_brute(plx_engine *e, int w, int h, int workers, uint8_t nw)
 {
-    plx_camera pc;
     render_camera cam;
     render_opts ro;
     render_stats st;
     size_t px = (size_t)w * h, p, marked = 0, changed = 0;
     uint32_t *id0 = malloc(px * sizeof *id0);
     uint8_t *mask = malloc(px), *before = malloc(px);
-    street(&pc, w, h);
-    memcpy(cam.eye, pc.eye, sizeof cam.eye);
-    memcpy(cam.target, pc.target, sizeof cam.target);
-    cam.fov_deg = pc.fov_deg;
-    cam.width = w;
-    cam.height = h;
+    street_render(&cam, w, h);
     render_opts_default(&ro);
     ro.no_glow = 1;
     ro.par = e->port.parallel_for;
@@ -429,19 +435,13 @@ static void mask_update_against_brute(plx_engine *e, int w, int h, int workers, 
  * render_opts.mask_new (2), and keeps the marks already there (1). */
 static void mask_update_glows(plx_engine *e, int w, int h)
 {
-    plx_camera pc;
     render_camera cam;
     render_opts ro;
     render_stats st;
     size_t px = (size_t)w * h, p, news = 0, kept = 0;
     uint32_t *id0 = malloc(px * sizeof *id0);
     uint8_t *mask = malloc(px);
-    street(&pc, w, h);
-    memcpy(cam.eye, pc.eye, sizeof cam.eye);
-    memcpy(cam.target, pc.target, sizeof cam.target);
-    cam.fov_deg = pc.fov_deg;
-    cam.width = w;
-    cam.height = h;
+    street_render(&cam, w, h);
     render_opts_default(&ro);
     ro.shift[0] = ro.shift[1] = 0.25;
     assert_int_equal(render_frame(e->rd, &cam, &ro, NULL, NULL, &st), PLX_OK);
