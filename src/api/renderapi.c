@@ -494,7 +494,7 @@ static plx_status render_aa(plx_engine *e, const render_camera *rc, render_opts 
     double ex = 1.0, inv = 1.0 / ((double)n * n);
     plx_status st = PLX_OK;
     uint64_t lookups = 0, later = 0, calls = 0;
-    int a, b, curve = ro->auto_exposure, adaptive = 0, marked_sums = 0;
+    int a, b, curve = ro->auto_exposure, adaptive = 0, marked_sums = 0, far = 1;
     int32_t mw, mh;
     if (rc->width < 1 || rc->height < 1)
         px = 0;
@@ -519,7 +519,7 @@ static plx_status render_aa(plx_engine *e, const render_camera *rc, render_opts 
             lin = render_linear(e->rd);
             if (a == 0 && b == 0) {
                 ex = rs->exposure;
-                render_aa_copy(ro, e->aa_sum, lin, 3 * px);
+                far = render_aa_copy(ro, e->aa_sum, lin, 3 * px);
                 /* the later samples: the first one's exposure */
                 ro->auto_exposure = 0;
                 adaptive = !full && aa_adaptive_buffers(e, maxpx) ? PLX_AA_ADAPTIVE : PLX_AA_EVERY;
@@ -556,7 +556,7 @@ static plx_status render_aa(plx_engine *e, const render_camera *rc, render_opts 
         return st;
     if (marked_sums) {
         /* the first sample's bytes stay where no later sample shaded */
-        render_tonemap_kept(e->rd, e->aa_sum, e->aa_mask, px, ex, curve, rgb8, ro);
+        render_tonemap_kept(e->rd, e->aa_sum, e->aa_mask, px, far, ex, curve, rgb8, ro);
         if (rgbf)
             memcpy(rgbf, e->aa_sum, px * 3 * sizeof(float));
     } else {

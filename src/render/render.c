@@ -2612,53 +2612,78 @@ typedef struct aa_job {
     size_t n;
     double inv;
     int copy;                   /* with lin: sum = lin */
+    int far[RENDER_MAX_WORKERS]; /* copy: a value beyond AA_FAR (or not finite), by worker */
 } aa_job;
+
+#define AA_FAR (FLT_MAX / 4.0f) /* 4v finite up to here */
+
+/* sum[p] = lin[p] for the n values, eight at a time in a loop of fixed
+ * length; returns whether one of them is beyond +-AA_FAR or NaN. */
+static int aa_copy(float *restrict sum, const float *restrict lin, size_t n)
+{
+    size_t p;
+    int k, far = 0;
+    for (p = 0; p + AA_LANES <= n; p += AA_LANES)
+        for (k = 0; k < AA_LANES; k++) {
+            sum[p + k] = lin[p + k];
+            far |= !(fabsf(lin[p + k]) <= AA_FAR);
+        }
+    for (; p < n; p++) {
+        sum[p] = lin[p];
+        far |= !(fabsf(lin[p]) <= AA_FAR);
+    }
+    return far;
+}
 
 static void aa_chunk(void *arg, int worker, uint32_t k)
 {
-    const aa_job *jb = arg;
+    aa_job *jb = arg;
     size_t p0 = (size_t)k * AA_CHUNK, m = jb->n - p0 < AA_CHUNK ? jb->n - p0 : AA_CHUNK;
-    (void)worker;
     if (jb->lin && jb->copy)
-        memcpy(jb->sum + p0, jb->lin + p0, m * sizeof *jb->sum);
+        jb->far[worker] |= aa_copy(jb->sum + p0, jb->lin + p0, m);
     else if (jb->lin)
         aa_add(jb->sum + p0, jb->lin + p0, m);
     else
         aa_scale(jb->sum + p0, m, jb->inv);
 }
 
-/* One of the sums over n values on the workers (aa_chunk). */
-static void aa_run(const render_opts *o, float *sum, const float *lin, size_t n, double inv, int copy)
+/* One of the sums over n values on the workers (aa_chunk); a copy
+ * returns whether a value is beyond +-AA_FAR or NaN. */
+static int aa_run(const render_opts *o, float *sum, const float *lin, size_t n, double inv, int copy)
 {
     aa_job jb;
+    int k, far = 0;
+    memset(&jb, 0, sizeof jb);
     jb.sum = sum;
     jb.lin = lin;
     jb.n = n;
     jb.inv = inv;
     jb.copy = copy;
     run_jobs(o, (uint32_t)((n + AA_CHUNK - 1) / AA_CHUNK), aa_chunk, &jb);
+    for (k = 0; k < RENDER_MAX_WORKERS; k++)
+        far |= jb.far[k];
+    return far;
 }
 
-void render_aa_copy(const render_opts *o, float *sum, const float *lin, size_t n)
+int render_aa_copy(const render_opts *o, float *sum, const float *lin, size_t n)
 {
-    aa_run(o, sum, lin, n, 1.0, 1);
+    return aa_run(o, sum, lin, n, 1.0, 1);
 }
 
 void render_aa_add(const render_opts *o, float *sum, const float *lin, size_t n)
 {
-    aa_run(o, sum, lin, n, 1.0, 0);
+    (void)aa_run(o, sum, lin, n, 1.0, 0);
 }
 
 void render_aa_scale(const render_opts *o, float *sum, size_t n, double inv)
 {
-    aa_run(o, sum, NULL, n, inv, 0);
+    (void)aa_run(o, sum, NULL, n, inv, 0);
 }
 
 /* ---- 2 x 2 sums at the marked pixels (render_aa_add_marked, render_tonemap_kept) ---- */
 
 #define KEPT_PIXELS 16384       /* pixels a job: a multiple of KEPT_LANES */
 #define KEPT_LANES 64
-#define KEPT_LIMIT (FLT_MAX / 4.0f) /* 4v finite up to here */
 
 /* The first of i .. e - 1 whose byte is (not) 0 when want is 1 (0); e:
  * none. Eight bytes a test where they are all 0 (want 1), or all 1 (want
@@ -2682,6 +2707,7 @@ typedef struct marked_job {
     const uint8_t *cmask;
     size_t px;
     int before;
+    int far;                    /* render_tonemap_kept: a value beyond +-AA_FAR or NaN somewhere */
     uint8_t *rgb8;
 } marked_job;
 
@@ -2729,12 +2755,12 @@ void render_aa_add_marked(const render_opts *o, float *sum, const float *lin, ui
 }
 
 /* d[k]: whether value k of the KEPT_LANES pixels' sums is outside
- * [-KEPT_LIMIT, KEPT_LIMIT] (or NaN), in a loop of fixed length. */
+ * [-AA_FAR, AA_FAR] (or NaN), in a loop of fixed length. */
 static void kept_far(const float *restrict sum, uint8_t *restrict d)
 {
     int k;
     for (k = 0; k < 3 * KEPT_LANES; k++)
-        d[k] = (uint8_t)!(fabsf(sum[k]) <= KEPT_LIMIT);
+        d[k] = (uint8_t)!(fabsf(sum[k]) <= AA_FAR);
 }
 
 /* An unmarked value v's dense sums: ((v + v) + v) + v times 1/4. */
@@ -2747,6 +2773,19 @@ static float dense_2x2(float v)
     return (float)(s * 0.25);
 }
 
+/* Job k of render_tonemap_kept with no value beyond the limit: each run
+ * of marked pixels scaled and mapped again. */
+static void kept_marked_chunk(const marked_job *jb, uint32_t k)
+{
+    size_t p1 = job_end(k, jb->px), i, e, q;
+    for (i = byte_next(jb->cmask, (size_t)k * KEPT_PIXELS, p1, 1); i < p1; i = byte_next(jb->cmask, e, p1, 1)) {
+        e = byte_next(jb->cmask, i, p1, 0);
+        for (q = 3 * i; q < 3 * e; q++)
+            jb->sum[q] = (float)(jb->sum[q] * 0.25);
+        tonemap_apply(jb->r->tm, jb->r->thr, jb->sum, 3 * i, 3 * e, jb->rgb8);
+    }
+}
+
 /* Job k of render_tonemap_kept, KEPT_LANES pixels at a time: the values
  * to map again (marked pixels' scaled sums, unmarked values summed when
  * outside the limit), then each run of them through tonemap_apply. */
@@ -2756,6 +2795,10 @@ static void kept_chunk(void *arg, int worker, uint32_t k)
     size_t p1 = job_end(k, jb->px), p;
     uint8_t d[3 * KEPT_LANES];
     (void)worker;
+    if (!jb->far) {
+        kept_marked_chunk(jb, k);
+        return;
+    }
     for (p = (size_t)k * KEPT_PIXELS; p < p1; p += KEPT_LANES) {
         size_t n = p1 - p < KEPT_LANES ? p1 - p : KEPT_LANES, i, e;
         float *s = jb->sum + 3 * p;
@@ -2764,7 +2807,7 @@ static void kept_chunk(void *arg, int worker, uint32_t k)
             kept_far(s, d);
         else
             for (i = 0; i < 3 * n; i++)
-                d[i] = (uint8_t)!(fabsf(s[i]) <= KEPT_LIMIT);
+                d[i] = (uint8_t)!(fabsf(s[i]) <= AA_FAR);
         for (i = byte_next(d, 0, 3 * n, 1); i < 3 * n; i = byte_next(d, i + 1, 3 * n, 1))
             if (!m[i / 3])
                 s[i] = dense_2x2(s[i]);
@@ -2782,12 +2825,13 @@ static void kept_chunk(void *arg, int worker, uint32_t k)
     }
 }
 
-void render_tonemap_kept(render *r, float *sum, const uint8_t *mask, size_t px, double ex, int curve,
+void render_tonemap_kept(render *r, float *sum, const uint8_t *mask, size_t px, int far, double ex, int curve,
                          uint8_t *rgb8, const render_opts *o)
 {
     marked_job jb;
     memset(&jb, 0, sizeof jb);
     tonemap_table_set(r->tm, r->thr, ex, curve);
+    jb.far = far;
     jb.r = r;
     jb.sum = sum;
     jb.cmask = mask;

@@ -416,14 +416,18 @@ void render_aa_add_marked(const render_opts *o, float *sum, const float *lin, ui
  * within a quarter of a unit in 4v's last place of 3v, so adding v
  * rounds to exactly 4v), so its bytes stay, except where 4v would
  * overflow or v is not finite: those values are summed as the dense sums
- * do and mapped again. Afterwards sum holds the frame's linear values. */
-void render_tonemap_kept(render *r, float *sum, const uint8_t *mask, size_t px, double ex, int curve,
+ * do and mapped again (looked for only when far, render_aa_copy's
+ * answer for the first sample: else only the marked pixels are read).
+ * Afterwards sum holds the frame's linear values. */
+void render_tonemap_kept(render *r, float *sum, const uint8_t *mask, size_t px, int far, double ex, int curve,
                          uint8_t *rgb8 /* IN/OUT */, const render_opts *o);
 
 /* Anti-aliasing's sums on o's workers: sum[p] = lin[p] (copy), sum[p] +=
  * lin[p] (add) for p < n, and sum[p] = (float)(sum[p] * inv) (scale);
- * each value the same float operations as one at a time. */
-void render_aa_copy(const render_opts *o, float *sum, const float *lin, size_t n);
+ * each value the same float operations as one at a time. The copy
+ * returns whether a value is beyond +-FLT_MAX / 4 or NaN (for
+ * render_tonemap_kept). */
+int render_aa_copy(const render_opts *o, float *sum, const float *lin, size_t n);
 void render_aa_add(const render_opts *o, float *sum, const float *lin, size_t n);
 void render_aa_scale(const render_opts *o, float *sum, size_t n, double inv);
 

@@ -533,8 +533,25 @@ static void test_aa_sums(void **state)
             }
             assert_memory_equal(sum, ref, n * sizeof *sum); /* and nothing past m written */
         }
+    for (workers = 1; workers <= 2; workers++) { /* the copy's answer: one value past FLT_MAX / 4, or NaN */
+        static const size_t at[] = { 0, 7, 8, 65535, 65539, 200002 };
+        render_opts ro;
+        render_opts_default(&ro);
+        ro.par = port->parallel_for;
+        ro.par_ctx = port->ctx;
+        ro.workers = workers;
+        assert_int_equal(render_aa_copy(&ro, sum, lin, n), 0);
+        for (i = 0; i < sizeof at / sizeof *at; i++) {
+            float keep = lin[at[i]];
+            lin[at[i]] = i % 2 ? NAN : -FLT_MAX / 3.0f;
+            assert_int_equal(render_aa_copy(&ro, sum, lin, n), 1);
+            lin[at[i]] = FLT_MAX / 4.0f; /* the limit itself: 4v is finite */
+            assert_int_equal(render_aa_copy(&ro, sum, lin, n), 0);
+            lin[at[i]] = keep;
+        }
+    }
     print_message("anti-aliasing sums: the same bits as one value at a time for 10 lengths from 0 to 200,003 "
-                  "on 1 and 2 workers\n");
+                  "on 1 and 2 workers; the copy finds a value past FLT_MAX / 4 or NaN at 6 places\n");
     free(lin); free(sum); free(ref);
 }
 
@@ -561,14 +578,16 @@ static float any_float(uint64_t *seed)
 /* The 2 x 2 sums at the marked pixels (render_aa_add_marked, then
  * render_tonemap_kept) against the dense sums, at 150x111 (two jobs of
  * 16,384 pixels, the last 64 short by 54) on 1 and 2 workers: random
- * values of every kind (any_float), a quarter of the pixels marked after
+ * values of every kind (any_float; tame: all finite and within FLT_MAX
+ * / 4, where render_aa_copy says so and the end reads only the marked
+ * pixels), a quarter of the pixels marked after
  * the first sample and more at each later one (as a sliver or a glow
  * marks them: byte 2); a later sample's value is its own at the pixels
  * marked by then and the first sample's elsewhere, as the renderer leaves
  * them. The sums end with the dense sums' bits, scaled, at every pixel,
  * and the bytes are the dense sums' tone map where the first sample's
  * bytes (the mask's) were in place. */
-static void marked_sums_against_dense(plx_engine *e, int workers)
+static void marked_sums_against_dense(plx_engine *e, int workers, int tame)
 {
     const int w = 150, h = 111;
     plx_camera cam;
@@ -581,13 +600,16 @@ static void marked_sums_against_dense(plx_engine *e, int workers)
     uint8_t *rgb8 = malloc(px * 3), *ref = malloc(px * 3), *first = malloc(px * 3);
     uint8_t *mask = calloc(px, 1), *when = malloc(px);
     uint64_t seed = 5;
-    int s;
+    int s, far;
     plx_render_opts_default(&o);
     o.auto_exposure = 1;
     street(&cam, w, h);
     assert_int_equal(plx_render(e, &cam, &o, rgb8, NULL, &info), PLX_OK); /* the tone map's tables */
-    for (v = 0; v < px * 3 * 4; v++)
+    for (v = 0; v < px * 3 * 4; v++) {
         smp[v] = any_float(&seed);
+        if (tame && !(fabsf(smp[v]) <= 1e30f)) /* tame: all finite, within the limit */
+            smp[v] = (float)v;
+    }
     for (p = 0; p < px; p++) { /* the sample that marks it: 0 .. 3, or 4: never */
         seed = seed * 6364136223846793005ull + 1442695040888963407ull;
         when[p] = (uint8_t)((seed >> 60) < 4 ? 0 : (seed >> 60) < 7 ? 1 + (seed >> 60) % 3 : 4);
@@ -608,7 +630,8 @@ static void marked_sums_against_dense(plx_engine *e, int workers)
     /* marked: the first sample's bytes in place, then the marked sums */
     render_tonemap_par(e->rd, smp, px, info.exposure, 1, first, &ro);
     memcpy(rgb8, first, px * 3);
-    memcpy(sum, smp, px * 3 * sizeof *sum);
+    far = render_aa_copy(&ro, sum, smp, px * 3);
+    assert_int_equal(far, !tame);
     for (p = 0; p < px; p++)
         mask[p] = when[p] == 0;
     for (s = 1; s < 4; s++) {
@@ -621,7 +644,7 @@ static void marked_sums_against_dense(plx_engine *e, int workers)
     }
     for (p = 0; p < px; p++)
         assert_int_equal(mask[p], when[p] < 4);
-    render_tonemap_kept(e->rd, sum, mask, px, info.exposure, 1, rgb8, &ro);
+    render_tonemap_kept(e->rd, sum, mask, px, far, info.exposure, 1, rgb8, &ro);
     assert_memory_equal(sum, dense, px * 3 * sizeof *sum);
     assert_memory_equal(rgb8, ref, px * 3);
     for (v = 0; v < px * 3; v++) {
@@ -629,8 +652,8 @@ static void marked_sums_against_dense(plx_engine *e, int workers)
         again += when[v / 3] < 4;
     }
     assert_true(kept > px && again > px);
-    print_message("2x2 sums at the marked pixels 150x111 on %d workers: the dense sums' bits and bytes (%zu values "
-                  "marked, %zu kept)\n", workers, again, kept);
+    print_message("2x2 sums at the marked pixels 150x111 on %d workers%s: the dense sums' bits and bytes (%zu "
+                  "values marked, %zu kept)\n", workers, tame ? ", all values within the limit" : "", again, kept);
     free(smp); free(lin); free(dense); free(sum); free(rgb8); free(ref); free(first); free(mask); free(when);
 }
 
@@ -675,8 +698,9 @@ static void test_marked_sums(void **state)
     void *mem;
     plx_engine *e = open_eixample(&mem);
     (void)state;
-    marked_sums_against_dense(e, 1);
-    marked_sums_against_dense(e, 2);
+    marked_sums_against_dense(e, 1, 0);
+    marked_sums_against_dense(e, 2, 0);
+    marked_sums_against_dense(e, 2, 1); /* no value past the limit: only the marked pixels read */
     marked_frames_against_dense(e);
     plx_engine_destroy(e);
     free(mem);
