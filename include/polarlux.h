@@ -776,8 +776,10 @@ typedef struct plx_render_info {
  * map are built on first need and kept until the next load.
  * Errors: PLX_E_INVALID (cam NULL; bad camera: eye below the ground, eye ==
  * target, size above the maximum), PLX_E_NOSCENE, PLX_E_NOMEM,
- * PLX_E_UNSUPPORTED (o->backend could not draw the frame). Lifetime: the
- * caller's buffers are written, not kept. Threads: engine.
+ * PLX_E_UNSUPPORTED (o->backend could not draw the frame); after an error
+ * the buffers' contents are unspecified (an anti-aliased frame may have
+ * written its first sample). Lifetime: the caller's buffers are written,
+ * not kept. Threads: engine.
  */
 plx_status plx_render(plx_engine *e, const plx_camera *cam, const plx_render_opts *o, uint8_t *rgb8 /* OUT */,
                       float *rgbf /* OUT */, plx_render_info *info /* OUT */);

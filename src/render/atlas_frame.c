@@ -377,19 +377,29 @@ void atlas_frame_row(const atlas *A, const atlas_view *v, atlas_cache *k, const 
     while (i < v->w) {
         uint32_t sid;
         uint64_t n;
-        /* with a mask, from the next marked pixel to the end of its run
-         * of marked pixels of one surface (each pixel's read depends only
-         * on the pixel, not on where its run starts) */
+        /* with a mask, from the next marked pixel: on a building or the
+         * sky to the end of its run of marked pixels (a building pixel's
+         * read depends only on the pixel), on the ground to the end of its
+         * run of ground, the marked pixels only (the ground's block cache
+         * carries on over the unmarked ones as in a full row, whose
+         * reads at a block's edge or at a spacing not a power of two can
+         * differ in the last bits from a fresh lookup's) */
         if (mask && (i = next_marked(mask, i, v->w)) == v->w)
             break;
         sid = ids[i];
-        if (mask)
+        if (mask && sid != MESH_SURF_GROUND)
             for (e = i + 1; e < v->w && ids[e] == sid && mask[e]; e++)
                 ;
         else
             for (e = i + 1; e < v->w && ids[e] == sid; e++)
                 ;
-        n = (uint64_t)(e - i);
+        if (mask && sid == MESH_SURF_GROUND) { /* only the marked pixels are written, and counted */
+            int32_t q;
+            for (n = 0, q = i; q < e; q++)
+                n += mask[q] != 0;
+        } else {
+            n = (uint64_t)(e - i);
+        }
         if (sid == MESH_SURF_NONE || (sid == MESH_SURF_GROUND && !g.on)) {
             int32_t q;
             for (q = i; q < e; q++)

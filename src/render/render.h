@@ -320,11 +320,12 @@ typedef struct render_opts {
                                   the pixel's surface id and its building (mesh.h); the same
                                   rules (indirect_mt) and user */
     uint8_t *mask;             /* adaptive anti-aliasing's later samples (render_aa_mask): only
-                                  the pixels whose byte is 1 are shaded, lit by indirect light
-                                  and glows, and written; the others keep what the linear image
-                                  held. First, a pixel whose surface is not mask_id's (a
-                                  building's surface id; the ground and the sky count as one)
-                                  gets its byte set to 1. NULL: every pixel */
+                                  the pixels whose byte is not 0 are shaded, lit by indirect
+                                  light and glows, and written; the others keep what the linear
+                                  image held. First, an unmarked pixel whose surface is not
+                                  mask_id's (a building's surface id; the ground and the sky
+                                  count as one), or that a glow of this sample covers, gets its
+                                  byte set to mask_new. NULL: every pixel */
     const uint32_t *mask_id;   /* with mask: the first sample's surface ids */
     const struct atlas *atlas; /* not NULL: every pixel read from this radiance atlas (atlas.h,
                                   atlas_frame.h) instead of shaded (the mask's pixels only,
@@ -413,8 +414,11 @@ void render_aa_add_marked(const render_opts *o, float *sum, const float *lin, ui
  * curve): each marked pixel's sums scaled by 1/4 and tone mapped again;
  * an unmarked pixel holds its first value v, which is already the dense
  * sums' ((v + v) + v) + v times 1/4 (v + v is exact; the rounded 3v is
- * within a quarter of a unit in 4v's last place of 3v, so adding v
- * rounds to exactly 4v), so its bytes stay, except where 4v would
+ * within half a unit in 4v's last place of 3v, and when exactly half, v
+ * is an odd multiple of that half unit, so 4v's last digit is even and
+ * the tie in 3v + v rounds to 4v; under round to nearest even without
+ * flushing subnormals to zero, C's default; all 2^32 floats checked), so
+ * its bytes stay, except where 4v would
  * overflow or v is not finite: those values are summed as the dense sums
  * do and mapped again (looked for only when far, render_aa_copy's
  * answer for the first sample: else only the marked pixels are read).

@@ -317,6 +317,44 @@ static void test_triangle_id_same(void **state)
     assert_true(direct > 1000 && fallback > 100 && small > 1000 && counted > 10000);
 }
 
+/* A wide triangle drawn twice at the same depth with two ids (spans of
+ * more than 16 pixels: the lanes): the second is not nearer, so every
+ * pixel keeps the first id, and it says it wrote none. */
+static void test_triangle_id_tie(void **state)
+{
+    enum { W = 96, H = 40 };
+    float depth[W * H];
+    uint32_t ids[W * H];
+    raster_target t;
+    raster_ctx r;
+    raster_pvert p[3];
+    float pos[3][4] = { { -0.9f, -0.8f, 0.2f, 1.0f }, { 0.95f, -0.7f, 0.3f, 1.0f }, { 0.1f, 0.9f, 0.1f, 1.0f } };
+    long first, second;
+    size_t q, n1 = 0;
+    int k;
+    (void)state;
+    memset(&t, 0, sizeof t);
+    t.format = RASTER_RGBA8;
+    t.width = W;
+    t.height = H;
+    t.depth = depth;
+    assert_int_equal(raster_init(&r, &t, NULL), PLX_OK);
+    raster_clear_depth(&r, 1.0f);
+    raster_set_cull(&r, RASTER_CULL_NONE);
+    memset(ids, 0, sizeof ids);
+    for (k = 0; k < 3; k++)
+        raster_prepare(&r, pos[k], &p[k]);
+    first = raster_triangle_id(&r, &p[0], &p[1], &p[2], 1, ids);
+    second = raster_triangle_id(&r, &p[0], &p[1], &p[2], 2, ids);
+    for (q = 0; q < (size_t)W * H; q++) {
+        assert_true(ids[q] == 0 || ids[q] == 1);
+        n1 += ids[q] == 1;
+    }
+    assert_true(first > 1000);
+    assert_int_equal(first, (long)n1);
+    assert_int_equal(second, 0);
+}
+
 static void test_init_rejects_bad_targets(void **state)
 {
     raster_ctx r;
@@ -1159,6 +1197,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_init_rejects_bad_targets),
         cmocka_unit_test(test_triangle_id_same),
+        cmocka_unit_test(test_triangle_id_tie),
         cmocka_unit_test(test_square_two_triangles),
         cmocka_unit_test(test_single_triangle_top_left),
         cmocka_unit_test(test_fan_shared_edges),
