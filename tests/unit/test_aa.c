@@ -32,6 +32,9 @@
  *    of every kind (any bits, near FLT_MAX / 4 and beyond, 0, -0,
  *    infinite, NaN) and marks added at every sample; and a 2 x 2 frame
  *    into bytes gives the floats of the same frame into floats alone.
+ *  - The rule behind it: four equal floats summed and scaled by 1/4 give
+ *    the value's bits back up to FLT_MAX / 4, for all 2^32 floats (a
+ *    sample and the edges in make check).
  *  - render_aa_mask with its marks elsewhere leaves the first sample's
  *    bytes in rgb: those of the plain frame.
  */
@@ -723,6 +726,52 @@ static void test_marked_sums(void **state)
     free(mem);
 }
 
+/* The rule the 2 x 2 sums at the marked pixels rest on: the dense sums
+ * of four equal values v, ((v + v) + v) + v scaled by 1/4 as aa_add and
+ * aa_scale do, give v's bits back for every float with |v| <= FLT_MAX /
+ * 4: all 2^32 bit patterns (PLX_TEST_QUICK: every 4,099th, and every
+ * pattern near 0, near FLT_MAX / 4 and among the subnormals' top). */
+static int four_equal_back(uint32_t u)
+{
+    float v, s;
+    uint32_t b;
+    memcpy(&v, &u, sizeof v);
+    if (!(fabsf(v) <= FLT_MAX / 4.0f))
+        return 1;
+    s = v;
+    s += v;
+    s += v;
+    s += v;
+    s = (float)(s * 0.25);
+    memcpy(&b, &s, sizeof b);
+    return b == u;
+}
+
+static void test_four_equal_values(void **state)
+{
+    const int quick = getenv("PLX_TEST_QUICK") != NULL;
+    const uint32_t lim = 0x7e800000u; /* FLT_MAX / 4's bits, rounded up to its binade's end */
+    uint64_t n = 0, bad = 0, u;
+    uint32_t sign, k;
+    (void)state;
+    for (u = 0; u <= UINT32_MAX; u += quick ? 4099u : 1u) {
+        n++;
+        bad += !four_equal_back((uint32_t)u);
+    }
+    for (sign = 0; sign < 2; sign++) /* the edges, every pattern */
+        for (k = 0; k < 65536; k++) {
+            uint32_t s = sign << 31;
+            bad += !four_equal_back(s | k);                     /* 0 and the smallest subnormals */
+            bad += !four_equal_back(s | (0x00800000u - 1u - k)); /* the largest subnormals */
+            bad += !four_equal_back(s | (0x00800000u + k));      /* the smallest normals */
+            bad += !four_equal_back(s | (lim - 1u - k));         /* up to FLT_MAX / 4 */
+            n += 4;
+        }
+    print_message("four equal values summed and scaled by 1/4: %llu bit patterns, %llu not given back (%s)\n",
+                  (unsigned long long)n, (unsigned long long)bad, quick ? "a sample and the edges" : "all 2^32");
+    assert_true(bad == 0);
+}
+
 static void test_aa_mask(void **state)
 {
     void *mem;
@@ -761,6 +810,7 @@ int main(void)
         cmocka_unit_test(test_aa_sums),
         cmocka_unit_test(test_aa_mask),
         cmocka_unit_test(test_marked_sums),
+        cmocka_unit_test(test_four_equal_values),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
