@@ -709,9 +709,7 @@ static size_t draw_narrow_id(raster_ctx *r, const edge e[3], const int64_t eb0[3
  * too: all exact in a double, so the sum is the same double as the int64
  * value converted, and the depth the same expression as one at a time. */
 #define SPAN_LANES 8
-#ifndef SPAN_MIN
 #define SPAN_MIN 16     /* the shortest span taken in lanes: shorter ones cost more so */
-#endif
 
 static void span_offsets(int64_t s1, int64_t s2, double off1[SPAN_LANES], double off2[SPAN_LANES])
 {
@@ -771,19 +769,14 @@ static size_t draw_triangle_id(raster_ctx *r, const svert *v0, const svert *v1, 
         return 0;
     for (k = 0; k < 3; k++)
         eb0[k] = edge_eval(&e[k], i0 * FIX_ONE + FIX_HALF, j0 * FIX_ONE + FIX_HALF) + e[k].bias;
-    if (i1 - i0 < RASTER_NARROW) {
-        zc[0] = z0;
-        zc[1] = dz1;
-        zc[2] = dz2;
-        zc[3] = inv_area;
-        return draw_narrow_id(r, e, eb0, i0, i1, j0, j1, zc, id, ids);
-    }
-    for (k = 0; k < 3; k++)
-        walk_start(&wk[k], &e[k], eb0[k]);
     zc[0] = z0;
     zc[1] = dz1;
     zc[2] = dz2;
     zc[3] = inv_area;
+    if (i1 - i0 < RASTER_NARROW)
+        return draw_narrow_id(r, e, eb0, i0, i1, j0, j1, zc, id, ids);
+    for (k = 0; k < 3; k++)
+        walk_start(&wk[k], &e[k], eb0[k]);
     ev1 = eb0[1] - e[1].bias;
     ev2 = eb0[2] - e[2].bias;
     for (j = j0; j <= j1; j++) {

@@ -2617,6 +2617,13 @@ typedef struct aa_job {
 
 #define AA_FAR (FLT_MAX / 4.0f) /* 4v finite up to here */
 
+/* Whether v is beyond +-AA_FAR or NaN: a value whose four-fold sum need
+ * not give it back (render_tonemap_kept). */
+static inline int aa_far(float v)
+{
+    return !(fabsf(v) <= AA_FAR);
+}
+
 /* sum[p] = lin[p] for the n values, eight at a time in a loop of fixed
  * length; returns whether one of them is beyond +-AA_FAR or NaN. */
 static int aa_copy(float *restrict sum, const float *restrict lin, size_t n)
@@ -2626,11 +2633,11 @@ static int aa_copy(float *restrict sum, const float *restrict lin, size_t n)
     for (p = 0; p + AA_LANES <= n; p += AA_LANES)
         for (k = 0; k < AA_LANES; k++) {
             sum[p + k] = lin[p + k];
-            far |= !(fabsf(lin[p + k]) <= AA_FAR);
+            far |= aa_far(lin[p + k]);
         }
     for (; p < n; p++) {
         sum[p] = lin[p];
-        far |= !(fabsf(lin[p]) <= AA_FAR);
+        far |= aa_far(lin[p]);
     }
     return far;
 }
@@ -2682,8 +2689,7 @@ void render_aa_scale(const render_opts *o, float *sum, size_t n, double inv)
 
 /* ---- 2 x 2 sums at the marked pixels (render_aa_add_marked, render_tonemap_kept) ---- */
 
-#define KEPT_PIXELS 16384       /* pixels a job: a multiple of KEPT_LANES */
-#define KEPT_LANES 64
+#define KEPT_PIXELS 16384       /* pixels a job */
 
 /* The first of i .. e - 1 whose byte is (not) 0 when want is 1 (0); e:
  * none. Eight bytes a test where they are all 0 (want 1), or all 1 (want
@@ -2754,15 +2760,6 @@ void render_aa_add_marked(const render_opts *o, float *sum, const float *lin, ui
     run_jobs(o, (uint32_t)((px + KEPT_PIXELS - 1) / KEPT_PIXELS), add_marked_chunk, &jb);
 }
 
-/* d[k]: whether value k of the KEPT_LANES pixels' sums is outside
- * [-AA_FAR, AA_FAR] (or NaN), in a loop of fixed length. */
-static void kept_far(const float *restrict sum, uint8_t *restrict d)
-{
-    int k;
-    for (k = 0; k < 3 * KEPT_LANES; k++)
-        d[k] = (uint8_t)!(fabsf(sum[k]) <= AA_FAR);
-}
-
 /* An unmarked value v's dense sums: ((v + v) + v) + v times 1/4. */
 static float dense_2x2(float v)
 {
@@ -2773,55 +2770,25 @@ static float dense_2x2(float v)
     return (float)(s * 0.25);
 }
 
-/* Job k of render_tonemap_kept with no value beyond the limit: each run
- * of marked pixels scaled and mapped again. */
-static void kept_marked_chunk(const marked_job *jb, uint32_t k)
+/* Job k of render_tonemap_kept: each run of marked pixels scaled and
+ * mapped again; with far, first each unmarked value beyond the limit
+ * summed the dense way and mapped again (no real frame has one). */
+static void kept_chunk(void *arg, int worker, uint32_t k)
 {
-    size_t p1 = job_end(k, jb->px), i, e, q;
-    for (i = byte_next(jb->cmask, (size_t)k * KEPT_PIXELS, p1, 1); i < p1; i = byte_next(jb->cmask, e, p1, 1)) {
+    const marked_job *jb = arg;
+    size_t p0 = (size_t)k * KEPT_PIXELS, p1 = job_end(k, jb->px), i, e, q;
+    (void)worker;
+    if (jb->far)
+        for (q = 3 * p0; q < 3 * p1; q++)
+            if (!jb->cmask[q / 3] && aa_far(jb->sum[q])) {
+                jb->sum[q] = dense_2x2(jb->sum[q]);
+                tonemap_apply(jb->r->tm, jb->r->thr, jb->sum, q, q + 1, jb->rgb8);
+            }
+    for (i = byte_next(jb->cmask, p0, p1, 1); i < p1; i = byte_next(jb->cmask, e, p1, 1)) {
         e = byte_next(jb->cmask, i, p1, 0);
         for (q = 3 * i; q < 3 * e; q++)
             jb->sum[q] = (float)(jb->sum[q] * 0.25);
         tonemap_apply(jb->r->tm, jb->r->thr, jb->sum, 3 * i, 3 * e, jb->rgb8);
-    }
-}
-
-/* Job k of render_tonemap_kept, KEPT_LANES pixels at a time: the values
- * to map again (marked pixels' scaled sums, unmarked values summed when
- * outside the limit), then each run of them through tonemap_apply. */
-static void kept_chunk(void *arg, int worker, uint32_t k)
-{
-    const marked_job *jb = arg;
-    size_t p1 = job_end(k, jb->px), p;
-    uint8_t d[3 * KEPT_LANES];
-    (void)worker;
-    if (!jb->far) {
-        kept_marked_chunk(jb, k);
-        return;
-    }
-    for (p = (size_t)k * KEPT_PIXELS; p < p1; p += KEPT_LANES) {
-        size_t n = p1 - p < KEPT_LANES ? p1 - p : KEPT_LANES, i, e;
-        float *s = jb->sum + 3 * p;
-        const uint8_t *m = jb->cmask + p;
-        if (n == KEPT_LANES)
-            kept_far(s, d);
-        else
-            for (i = 0; i < 3 * n; i++)
-                d[i] = (uint8_t)!(fabsf(s[i]) <= AA_FAR);
-        for (i = byte_next(d, 0, 3 * n, 1); i < 3 * n; i = byte_next(d, i + 1, 3 * n, 1))
-            if (!m[i / 3])
-                s[i] = dense_2x2(s[i]);
-        for (i = byte_next(m, 0, n, 1); i < n; i = byte_next(m, e, n, 1)) { /* runs of marked pixels */
-            size_t q;
-            e = byte_next(m, i, n, 0);
-            for (q = 3 * i; q < 3 * e; q++)
-                s[q] = (float)(s[q] * 0.25);
-            memset(d + 3 * i, 1, 3 * (e - i));
-        }
-        for (i = byte_next(d, 0, 3 * n, 1); i < 3 * n; i = byte_next(d, e, 3 * n, 1)) {
-            e = byte_next(d, i, 3 * n, 0);
-            tonemap_apply(jb->r->tm, jb->r->thr, jb->sum, 3 * p + i, 3 * p + e, jb->rgb8);
-        }
     }
 }
 

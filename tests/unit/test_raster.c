@@ -139,6 +139,19 @@ static int poly_classify(const double *x, const double *y, int n, double px, dou
 
 /* ---- set-up -------------------------------------------------------------- */
 
+/* A w x h target of depths only (cleared to 1), for r. */
+static void depth_only(raster_ctx *r, float *depth, int w, int h)
+{
+    raster_target t;
+    memset(&t, 0, sizeof t);
+    t.format = RASTER_RGBA8;
+    t.width = w;
+    t.height = h;
+    t.depth = depth;
+    assert_int_equal(raster_init(r, &t, NULL), PLX_OK);
+    raster_clear_depth(r, 1.0f);
+}
+
 /* ---- surface ids without fragment calls (raster_prepare, raster_triangle_id) ---- */
 
 typedef struct id_target {
@@ -325,7 +338,6 @@ static void test_triangle_id_tie(void **state)
     enum { W = 96, H = 40 };
     float depth[W * H];
     uint32_t ids[W * H];
-    raster_target t;
     raster_ctx r;
     raster_pvert p[3];
     float pos[3][4] = { { -0.9f, -0.8f, 0.2f, 1.0f }, { 0.95f, -0.7f, 0.3f, 1.0f }, { 0.1f, 0.9f, 0.1f, 1.0f } };
@@ -333,13 +345,7 @@ static void test_triangle_id_tie(void **state)
     size_t q, n1 = 0;
     int k;
     (void)state;
-    memset(&t, 0, sizeof t);
-    t.format = RASTER_RGBA8;
-    t.width = W;
-    t.height = H;
-    t.depth = depth;
-    assert_int_equal(raster_init(&r, &t, NULL), PLX_OK);
-    raster_clear_depth(&r, 1.0f);
+    depth_only(&r, depth, W, H);
     raster_set_cull(&r, RASTER_CULL_NONE);
     memset(ids, 0, sizeof ids);
     for (k = 0; k < 3; k++)
@@ -799,7 +805,6 @@ static void test_perspective_correct_attributes(void **state)
         float depth[W * H];
         float *a = calloc(W * H * 2, sizeof(float));
         raster_ctx r;
-        raster_target t;
         attr_probe probe;
         int k, x, y, checked = 0;
         double z2 = clipped ? 5.0 : -2.5;
@@ -807,13 +812,7 @@ static void test_perspective_correct_attributes(void **state)
         assert_non_null(a);
         for (k = 0; k < W * H * 2; k++)
             a[k] = NAN;
-        memset(&t, 0, sizeof t);
-        t.format = RASTER_RGBA8;
-        t.width = W;
-        t.height = H;
-        t.depth = depth;
-        assert_int_equal(raster_init(&r, &t, NULL), PLX_OK);
-        raster_clear_depth(&r, 1.0f);
+        depth_only(&r, depth, W, H);
         probe.w = W;
         probe.a = a;
         raster_set_fragment(&r, probe_frag, &probe, 2);
@@ -1157,20 +1156,13 @@ static void test_depth_only_and_switches(void **state)
 {
     float depth[16 * 16];
     raster_ctx r;
-    raster_target t;
     fb geom;
     raster_vertex a, b, c;
     int k;
     (void)state;
 
     fb_open(&geom, 16, 16);          /* only for pv() */
-    memset(&t, 0, sizeof t);
-    t.format = RASTER_RGBA8;
-    t.width = 16;
-    t.height = 16;
-    t.depth = depth;
-    assert_int_equal(raster_init(&r, &t, NULL), PLX_OK);
-    raster_clear_depth(&r, 1.0f);
+    depth_only(&r, depth, 16, 16);
     a = pv(&geom, -1.0, -1.0, 0.0, 1.0);
     b = pv(&geom, 40.0, -1.0, 0.0, 1.0);
     c = pv(&geom, -1.0, 40.0, 0.0, 1.0);
