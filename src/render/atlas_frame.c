@@ -97,6 +97,27 @@ static void cells_of(const float *restrict u, const float *restrict n, int32_t *
     }
 }
 
+/* The lanes' bilinear sums o[channel][lane] of their four vertices qa ..
+ * qd with weights from (fu, fv). */
+static void bilinear(const uint32_t *restrict qa, const uint32_t *restrict qb, const uint32_t *restrict qc,
+                     const uint32_t *restrict qd, const float *restrict fu, const float *restrict fv,
+                     float o[3][ATLAS_LANES])
+{
+    int32_t k;
+    for (k = 0; k < ATLAS_LANES; k++) {
+        float wa = (1.0f - fu[k]) * (1.0f - fv[k]), wb = fu[k] * (1.0f - fv[k]);
+        float wc = (1.0f - fu[k]) * fv[k], wd = fu[k] * fv[k];
+        float sa = texel_scale(qa[k]), sb = texel_scale(qb[k]), sc = texel_scale(qc[k]), sd = texel_scale(qd[k]);
+        o[0][k] = (float)(int32_t)(qa[k] & 511u) * sa * wa + (float)(int32_t)(qb[k] & 511u) * sb * wb +
+                  (float)(int32_t)(qc[k] & 511u) * sc * wc + (float)(int32_t)(qd[k] & 511u) * sd * wd;
+        o[1][k] = (float)(int32_t)((qa[k] >> 9) & 511u) * sa * wa + (float)(int32_t)((qb[k] >> 9) & 511u) * sb * wb +
+                  (float)(int32_t)((qc[k] >> 9) & 511u) * sc * wc + (float)(int32_t)((qd[k] >> 9) & 511u) * sd * wd;
+        o[2][k] = (float)(int32_t)((qa[k] >> 18) & 511u) * sa * wa +
+                  (float)(int32_t)((qb[k] >> 18) & 511u) * sb * wb +
+                  (float)(int32_t)((qc[k] >> 18) & 511u) * sc * wc + (float)(int32_t)((qd[k] >> 18) & 511u) * sd * wd;
+    }
+}
+
 /* The lanes' bilinear reads, written to their pixels of lin; none left. */
 static void lanes_read(lanes *L, float *lin)
 {
@@ -122,18 +143,7 @@ static void lanes_read(lanes *L, float *lin)
         qc[k] = t[L->row[k]];
         qd[k] = t[L->row[k] + 1];
     }
-    for (k = 0; k < ATLAS_LANES; k++) {
-        float wa = (1.0f - fu[k]) * (1.0f - fv[k]), wb = fu[k] * (1.0f - fv[k]);
-        float wc = (1.0f - fu[k]) * fv[k], wd = fu[k] * fv[k];
-        float sa = texel_scale(qa[k]), sb = texel_scale(qb[k]), sc = texel_scale(qc[k]), sd = texel_scale(qd[k]);
-        o[0][k] = (float)(int32_t)(qa[k] & 511u) * sa * wa + (float)(int32_t)(qb[k] & 511u) * sb * wb +
-                  (float)(int32_t)(qc[k] & 511u) * sc * wc + (float)(int32_t)(qd[k] & 511u) * sd * wd;
-        o[1][k] = (float)(int32_t)((qa[k] >> 9) & 511u) * sa * wa + (float)(int32_t)((qb[k] >> 9) & 511u) * sb * wb +
-                  (float)(int32_t)((qc[k] >> 9) & 511u) * sc * wc + (float)(int32_t)((qd[k] >> 9) & 511u) * sd * wd;
-        o[2][k] = (float)(int32_t)((qa[k] >> 18) & 511u) * sa * wa +
-                  (float)(int32_t)((qb[k] >> 18) & 511u) * sb * wb +
-                  (float)(int32_t)((qc[k] >> 18) & 511u) * sc * wc + (float)(int32_t)((qd[k] >> 18) & 511u) * sd * wd;
-    }
+    bilinear(qa, qb, qc, qd, fu, fv, o);
     for (k = 0; k < (int32_t)L->n; k++) {
         float *p = &lin[3 * (size_t)L->pix[k]];
         p[0] = o[0][k];
@@ -141,6 +151,37 @@ static void lanes_read(lanes *L, float *lin)
         p[2] = o[2][k];
     }
     L->n = 0;
+}
+
+/* Eight neighbouring pixels i .. i + 7 at (u[k], w[k]) of one chart at t0
+ * (nu by nv vertices): the bits of lanes_read's, without gathering them
+ * lane by lane. */
+static void run_read(const uint32_t *t0, uint32_t nu, uint32_t nv, const float *u, const float *w, int32_t i,
+                     float *lin)
+{
+    uint32_t qa[ATLAS_LANES], qb[ATLAS_LANES], qc[ATLAS_LANES], qd[ATLAS_LANES];
+    int32_t ci[ATLAS_LANES], cj[ATLAS_LANES], k;
+    float fu[ATLAS_LANES], fv[ATLAS_LANES], o[3][ATLAS_LANES];
+    float *p = &lin[3 * (size_t)i], su[ATLAS_LANES], sv[ATLAS_LANES];
+    for (k = 0; k < ATLAS_LANES; k++) {
+        su[k] = (float)nu;
+        sv[k] = (float)nv;
+    }
+    cells_of(u, su, ci, fu);
+    cells_of(w, sv, cj, fv);
+    for (k = 0; k < ATLAS_LANES; k++) {
+        const uint32_t *t = t0 + (size_t)cj[k] * nu + (size_t)ci[k];
+        qa[k] = t[0];
+        qb[k] = t[1];
+        qc[k] = t[nu];
+        qd[k] = t[nu + 1];
+    }
+    bilinear(qa, qb, qc, qd, fu, fv, o);
+    for (k = 0; k < ATLAS_LANES; k++) {
+        p[3 * k] = o[0][k];
+        p[3 * k + 1] = o[1][k];
+        p[3 * k + 2] = o[2][k];
+    }
 }
 
 /* Pixel i's read at (u, w) of the chart at t0 (nu by nv vertices), read
@@ -281,46 +322,95 @@ uint32_t atlas_frame_missing(atlas *A, const atlas_view *v, const uint32_t *ids,
     return n;
 }
 
+/* Whether the 8 pixels from i are all marked (all are without a mask). */
+static int all_marked(const uint8_t *mask, int32_t i)
+{
+    int32_t k, all = 1;
+    if (!mask)
+        return 1;
+    for (k = 0; k < ATLAS_LANES; k++)
+        all &= mask[i + k] != 0;
+    return all;
+}
+
+/* The 8 ground pixels from i when all their hit points lie in the block
+ * at (bx0, by0) (u and w in [0, lim], as ground_run's test), read at once:
+ * ground_run's reads, with the same doubles. 0 and nothing read when not. */
+static int ground_eight(const ground_row *g, int32_t i, double bx0, double by0, double inv, double lim,
+                        const uint32_t *t0, float *lin)
+{
+    double u[ATLAS_LANES], w[ATLAS_LANES];
+    float uf[ATLAS_LANES], wf[ATLAS_LANES];
+    int32_t k, in = 1;
+    for (k = 0; k < ATLAS_LANES; k++) {
+        double x = g->x0 + (i + k) * g->dx, y = g->y0 + (i + k) * g->dy;
+        u[k] = (x - bx0) * inv;
+        w[k] = (y - by0) * inv;
+    }
+    for (k = 0; k < ATLAS_LANES; k++)
+        in &= u[k] >= 0.0 && u[k] <= lim && w[k] >= 0.0 && w[k] <= lim;
+    if (!in)
+        return 0;
+    for (k = 0; k < ATLAS_LANES; k++) {
+        uf[k] = (float)u[k];
+        wf[k] = (float)w[k];
+    }
+    run_read(t0, ATLAS_BLOCK + 1, ATLAS_BLOCK + 1, uf, wf, i, lin);
+    return 1;
+}
+
 /* A run of ground pixels i0 .. i1 - 1 of a row: the block under each hit
  * point, kept while the points stay in it (a row's points move by a
- * fixed step: runs of them share a block); black in a dark block. */
+ * fixed step: runs of them share a block); black in a dark block. Eight
+ * marked pixels in the block are read at once; eight that are not, one
+ * by one. */
 static void ground_run(const atlas *A, const ground_row *g, int32_t i0, int32_t i1, const uint8_t *mask, lanes *L,
                        float *lin)
 {
     double bx0 = 0.0, by0 = 0.0, inv = 0.0, lim = -1.0;
     const uint32_t *t0 = NULL;
     uint32_t cur = UINT32_MAX;
-    int32_t i;
-    for (i = i0; i < i1; i++) {
-        double x, y, u, w;
-        float *o = &lin[3 * (size_t)i];
-        if (mask && !mask[i])
+    int32_t i, e;
+    for (i = i0; i < i1; ) {
+        if (i + ATLAS_LANES <= i1 && t0 && all_marked(mask, i) &&
+            ground_eight(g, i, bx0, by0, inv, lim, t0, lin)) {
+            i += ATLAS_LANES;
             continue;
-        x = g->x0 + i * g->dx;
-        y = g->y0 + i * g->dy;
-        u = (x - bx0) * inv;
-        w = (y - by0) * inv;
-        if (!(u >= 0.0 && u <= lim && w >= 0.0 && w <= lim)) { /* another block */
-            cur = ground_block(A, x, y, &u, &w);
-            t0 = NULL;
-            lim = -1.0;
-            if (cur != UINT32_MAX && A->gfirst[cur] != ATLAS_NOVERT) {
-                t0 = A->gdone[cur] == ATLAS_DARK ? NULL : &A->tex[A->gfirst[cur]];
-                block_frame(A, cur, &bx0, &by0, &inv);
-                lim = ATLAS_BLOCK;
+        }
+        for (e = i + ATLAS_LANES < i1 ? i + ATLAS_LANES : i1; i < e; i++) {
+            double x, y, u, w;
+            float *o = &lin[3 * (size_t)i];
+            if (mask && !mask[i])
+                continue;
+            x = g->x0 + i * g->dx;
+            y = g->y0 + i * g->dy;
+            u = (x - bx0) * inv;
+            w = (y - by0) * inv;
+            if (!(u >= 0.0 && u <= lim && w >= 0.0 && w <= lim)) { /* another block */
+                cur = ground_block(A, x, y, &u, &w);
+                t0 = NULL;
+                lim = -1.0;
+                if (cur != UINT32_MAX && A->gfirst[cur] != ATLAS_NOVERT) {
+                    t0 = A->gdone[cur] == ATLAS_DARK ? NULL : &A->tex[A->gfirst[cur]];
+                    block_frame(A, cur, &bx0, &by0, &inv);
+                    lim = ATLAS_BLOCK;
+                }
             }
+            if (!t0) {
+                o[0] = o[1] = o[2] = 0.0f;
+                continue;
+            }
+            lanes_add(L, i, t0, ATLAS_BLOCK + 1, ATLAS_BLOCK + 1, (float)u, (float)w, lin);
         }
-        if (!t0) {
-            o[0] = o[1] = o[2] = 0.0f;
-            continue;
-        }
-        lanes_add(L, i, t0, ATLAS_BLOCK + 1, ATLAS_BLOCK + 1, (float)u, (float)w, lin);
     }
 }
 
-/* A run of pixels i0 .. i1 - 1 of row j on surface sid: its chart's map,
- * then each pixel's (u, v) and the bilinear read; black on a dark chart
- * (the same bits: a bilinear read of four 0 values is +0). */
+/* A run of pixels i0 .. i1 - 1 of row j on surface sid, all marked when
+ * there is a mask (atlas_frame_row ends a building's run at its first
+ * unmarked pixel): its chart's map, then each pixel's (u, v) and the
+ * bilinear read, eight neighbours at once and the rest through the
+ * lanes; black on a dark chart (the same bits: a bilinear read of four 0
+ * values is +0). */
 static void surface_run(const atlas *A, const atlas_view *v, atlas_cache *k, uint32_t sid, int32_t j, int32_t i0,
                         int32_t i1, const uint8_t *mask, lanes *L, float *lin)
 {
@@ -345,11 +435,18 @@ static void surface_run(const atlas *A, const atlas_view *v, atlas_cache *k, uin
     t0 = &A->tex[c->first];
     nu = c->nu;
     nv = c->nv;
-    for (i = i0; i < i1; i++) {
-        float fi = (float)i, r;
-        if (mask && !mask[i])
-            continue;
-        r = 1.0f / (bw + aw * fi);
+    for (i = i0; i + ATLAS_LANES <= i1; i += ATLAS_LANES) { /* all marked (atlas_frame_row's runs) */
+        float u[ATLAS_LANES], w[ATLAS_LANES];
+        int32_t q;
+        for (q = 0; q < ATLAS_LANES; q++) {
+            float fi = (float)(i + q), r = 1.0f / (bw + aw * fi);
+            u[q] = (bu + au * fi) * r;
+            w[q] = (bv + av * fi) * r;
+        }
+        run_read(t0, nu, nv, u, w, i, lin);
+    }
+    for (; i < i1; i++) {
+        float fi = (float)i, r = 1.0f / (bw + aw * fi);
         lanes_add(L, i, t0, nu, nv, (bu + au * fi) * r, (bv + av * fi) * r, lin);
     }
 }

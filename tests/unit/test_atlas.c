@@ -2062,6 +2062,106 @@ static void test_frames(void **state)
     world_close(&w);
 }
 
+/* atlas_frame_row reads a run of eight or more pixels on one surface,
+ * or in one ground block, eight at a time (run_read); scattered marked
+ * pixels go through the lanes one by one. The two must give the same
+ * bits: every row of random frames read whole (mask NULL), then again
+ * as the union of two rows with every other pixel marked (runs of one:
+ * the lanes), and once with every pixel marked. The ground's block
+ * cache restarts at a skipped pixel, and a fresh lookup agrees with it
+ * only at power-of-two spacings (atlas_frame.c), hence 1 and 0.5 m. */
+static int grab_view(void *user, const atlas_view *v, const uint32_t *ids)
+{
+    (void)ids;
+    *(atlas_view *)user = *v;
+    return 0;
+}
+
+static void runs_check(world *w, double fine, int nframes, rng *r, long *runs)
+{
+    arena_mark mk = arena_get_mark(&w->e->mem);
+    atlas *A = make_atlas(w, fine);
+    atlas_worker wk;
+    hook_ctx h;
+    atlas_cache *cache = calloc(1, sizeof *cache);
+    float *row = malloc(3 * 200 * sizeof(float));
+    uint8_t mask[3][200];
+    int f, m;
+    assert_true(cache && row);
+    memset(&wk, 0, sizeof wk);
+    wk.lt = w->e->lt;
+    wk.rec = malloc((atlas_fill_records(A) + 1) * sizeof(double));
+    assert_non_null(wk.rec);
+    hook_init(&h, A, w->s, r);
+    wk.ind = hook_fn;
+    wk.ind_user = &h;
+    assert_int_equal(atlas_fill(A, &wk, 1, NULL), PLX_OK);
+    for (m = 0; m < 200; m++) {
+        mask[0][m] = (uint8_t)(m % 2);
+        mask[1][m] = (uint8_t)(2 * (1 - m % 2)); /* any nonzero byte marks */
+        mask[2][m] = 1;
+    }
+    for (f = 0; f < nframes; f++) {
+        render_camera cam;
+        render_opts o;
+        render_stats st;
+        atlas_view v;
+        const float *lin;
+        const uint32_t *ids;
+        int32_t j, i;
+        random_camera(w->s, r, f, &cam);
+        render_opts_default(&o);
+        o.no_glow = 1;
+        o.atlas = A;
+        o.atlas_cache = cache;
+        o.atlas_need = grab_view;
+        o.atlas_user = &v;
+        assert_int_equal(render_frame(w->e->rd, &cam, &o, NULL, NULL, &st), PLX_OK);
+        lin = render_linear(w->e->rd);
+        ids = render_ids(w->e->rd);
+        for (j = 0; j < cam.height; j++) {
+            const uint32_t *rid = &ids[(size_t)j * cam.width];
+            const float *want = &lin[3 * (size_t)j * cam.width];
+            uint64_t c0[3] = { 0, 0, 0 }, c1[3] = { 0, 0, 0 };
+            for (i = 0; i + 8 <= cam.width; i++) /* runs the eight-at-a-time path can take */
+                if (rid[i] != MESH_SURF_NONE && rid[i + 7] == rid[i])
+                    (*runs)++;
+            atlas_frame_row(A, &v, cache, rid, NULL, j, row, c0);
+            assert_memory_equal(row, want, 3 * (size_t)cam.width * sizeof(float));
+            memset(row, 0xff, 3 * (size_t)cam.width * sizeof(float)); /* NaN: every pixel must be written */
+            atlas_frame_row(A, &v, cache, rid, mask[0], j, row, c1);
+            atlas_frame_row(A, &v, cache, rid, mask[1], j, row, c1);
+            assert_memory_equal(row, want, 3 * (size_t)cam.width * sizeof(float));
+            assert_memory_equal(c0, c1, sizeof c0);
+            memset(row, 0xff, 3 * (size_t)cam.width * sizeof(float));
+            atlas_frame_row(A, &v, cache, rid, mask[2], j, row, c1);
+            assert_memory_equal(row, want, 3 * (size_t)cam.width * sizeof(float));
+        }
+    }
+    free(row);
+    free(cache);
+    free(wk.rec);
+    arena_release(&w->e->mem, &mk);
+}
+
+static void test_runs_equal_lanes(void **state)
+{
+    rng r = { 0x5eed81u };
+    world w;
+    long runs = 0;
+    int q = quick();
+    (void)state;
+    world_open(&w, "eixample", EIXAMPLE, NULL);
+    runs_check(&w, 1.0, q ? 12 : 60, &r, &runs);
+    world_close(&w);
+    world_open(&w, "helsinki", HELSINKI, NULL);
+    runs_check(&w, 0.5, q ? 6 : 30, &r, &runs);
+    world_close(&w);
+    printf("  %ld places a run of eight pixels starts: whole rows, every other pixel, and every pixel marked give the "
+           "same bits\n", runs);
+    assert_true(runs > 1000);
+}
+
 /* atlas_frame_missing at block edges: rows of two ground points, the
  * first well inside one block and the second d steps across its edge
  * into the next (d from 1e-9 to 0.3 steps, on either side, along x and
@@ -2957,7 +3057,7 @@ int main(void)
         cmocka_unit_test(test_texel_codec),     cmocka_unit_test(test_layout),
         cmocka_unit_test(test_create_errors),   cmocka_unit_test(test_values),
         cmocka_unit_test(test_frames),          cmocka_unit_test(test_missing_edges),
-        cmocka_unit_test(test_sample),
+        cmocka_unit_test(test_sample),          cmocka_unit_test(test_runs_equal_lanes),
         cmocka_unit_test(test_determinism),     cmocka_unit_test(test_frame_faults),
         cmocka_unit_test(test_eye_inside),      cmocka_unit_test(test_indirect_accuracy),     cmocka_unit_test(test_spacing),
         cmocka_unit_test(test_bug_stacked_neighbours), cmocka_unit_test(test_bug_ground_site_in_solid),
