@@ -496,6 +496,7 @@ static plx_status render_aa(plx_engine *e, const render_camera *rc, render_opts 
     uint64_t lookups = 0, later = 0, calls = 0;
     int a, b, curve = ro->auto_exposure, adaptive = 0, marked_sums = 0, far = 1;
     int32_t mw, mh;
+    float *sum;
     if (rc->width < 1 || rc->height < 1)
         px = 0;
     eng_render_max(e, &mw, &mh);
@@ -504,6 +505,7 @@ static plx_status render_aa(plx_engine *e, const render_camera *rc, render_opts 
         e->aa_sum = arena_alloc(&e->mem, PLX_PART_FRAME, arena_mul(maxpx, 3 * sizeof(float)), 64);
     if (!e->aa_sum)
         return PLX_E_NOMEM;
+    sum = e->aa_sum;
     for (b = 0; b < n && st == PLX_OK; b++)
         for (a = 0; a < n && st == PLX_OK; a++) {
             const float *lin;
@@ -519,7 +521,6 @@ static plx_status render_aa(plx_engine *e, const render_camera *rc, render_opts 
             lin = render_linear(e->rd);
             if (a == 0 && b == 0) {
                 ex = rs->exposure;
-                far = render_aa_copy(ro, e->aa_sum, lin, 3 * px);
                 /* the later samples: the first one's exposure */
                 ro->auto_exposure = 0;
                 adaptive = !full && aa_adaptive_buffers(e, maxpx) ? PLX_AA_ADAPTIVE : PLX_AA_EVERY;
@@ -528,7 +529,7 @@ static plx_status render_aa(plx_engine *e, const render_camera *rc, render_opts 
                      * the pixels that keep them stay (render_tonemap_kept) */
                     uint8_t *first = rgb8 ? rgb8 : e->aa_rgb;
                     size_t marked = render_aa_mask(e->rd, ro, ex, curve, AA_LEVEL, first, e->aa_rgb, e->aa_id,
-                                                   e->aa_mask);
+                                                   e->aa_mask, &far);
                     if (ro->atlas && marked > px / 2) {
                         adaptive = PLX_AA_DENSE;
                     } else {
@@ -539,11 +540,16 @@ static plx_status render_aa(plx_engine *e, const render_camera *rc, render_opts 
                         ro->mask_new = marked_sums ? 2 : 1;
                     }
                 }
+                if (marked_sums) /* the first sample stays where it was drawn, as the sums' start; the later
+                                  * ones write only the marked pixels, into the sums' buffer lent */
+                    sum = render_swap_linear(e->rd, e->aa_sum);
+                else
+                    far = render_aa_copy(ro, sum, lin, 3 * px);
             } else {
                 if (marked_sums)
-                    render_aa_add_marked(ro, e->aa_sum, lin, e->aa_mask, px, b * n + a - 1);
+                    render_aa_add_marked(ro, sum, lin, e->aa_mask, px, b * n + a - 1);
                 else
-                    render_aa_add(ro, e->aa_sum, lin, 3 * px);
+                    render_aa_add(ro, sum, lin, 3 * px);
                 later += rs->sky_pixels + rs->ground_pixels + rs->building_pixels;
             }
         }
@@ -552,19 +558,21 @@ static plx_status render_aa(plx_engine *e, const render_camera *rc, render_opts 
     ro->mask_id = NULL;
     ro->mask_new = 0;
     ro->cull_samples = 0;
+    if (sum != e->aa_sum) /* the renderer's own buffer back, holding the sums */
+        (void)render_swap_linear(e->rd, sum);
     if (st != PLX_OK)
         return st;
     if (marked_sums) {
         /* the first sample's bytes stay where no later sample shaded */
-        render_tonemap_kept(e->rd, e->aa_sum, e->aa_mask, px, far, ex, curve, rgb8, ro);
+        render_tonemap_kept(e->rd, sum, e->aa_mask, px, far, ex, curve, rgb8, ro);
         if (rgbf)
-            memcpy(rgbf, e->aa_sum, px * 3 * sizeof(float));
+            memcpy(rgbf, sum, px * 3 * sizeof(float));
     } else {
-        render_aa_scale(ro, e->aa_sum, 3 * px, inv);
+        render_aa_scale(ro, sum, 3 * px, inv);
         if (rgbf)
-            memcpy(rgbf, e->aa_sum, px * 3 * sizeof(float));
+            memcpy(rgbf, sum, px * 3 * sizeof(float));
         if (rgb8)
-            render_tonemap_par(e->rd, e->aa_sum, px, ex, curve, rgb8, ro);
+            (void)render_tonemap_par(e->rd, sum, px, ex, curve, rgb8, ro);
     }
     rs->exposure = ex;
     rs->indirect_calls = lookups;

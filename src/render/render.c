@@ -2516,26 +2516,31 @@ typedef struct tonemap_job {
     const float *lin;
     size_t n;
     uint8_t *rgb8;
+    int far[RENDER_MAX_WORKERS]; /* tonemap_apply's answers, by worker */
 } tonemap_job;
 
 static void tonemap_chunk(void *arg, int worker, uint32_t k)
 {
-    const tonemap_job *jb = arg;
+    tonemap_job *jb = arg;
     size_t p0 = (size_t)k * TONEMAP_CHUNK, p1 = p0 + TONEMAP_CHUNK < jb->n ? p0 + TONEMAP_CHUNK : jb->n;
-    (void)worker;
-    tonemap_apply(jb->r->tm, jb->r->thr, jb->lin, p0, p1, jb->rgb8);
+    jb->far[worker] |= tonemap_apply(jb->r->tm, jb->r->thr, jb->lin, p0, p1, jb->rgb8);
 }
 
-void render_tonemap_par(render *r, const float *lin, size_t px, double ex, int curve, uint8_t *rgb8,
-                        const render_opts *o)
+int render_tonemap_par(render *r, const float *lin, size_t px, double ex, int curve, uint8_t *rgb8,
+                       const render_opts *o)
 {
     tonemap_job jb;
+    int k, far = 0;
     tonemap_table_set(r->tm, r->thr, ex, curve);
+    memset(&jb, 0, sizeof jb);
     jb.r = r;
     jb.lin = lin;
     jb.n = 3 * px;
     jb.rgb8 = rgb8;
     run_jobs(o, (uint32_t)((3 * px + TONEMAP_CHUNK - 1) / TONEMAP_CHUNK), tonemap_chunk, &jb);
+    for (k = 0; k < RENDER_MAX_WORKERS; k++)
+        far |= jb.far[k];
+    return far;
 }
 
 /* Part k of RENDER_MAX_WORKERS of the exposure's pixels counted into
@@ -3021,13 +3026,14 @@ static void mask_or_rows(void *arg, int worker, uint32_t k)
 }
 
 size_t render_aa_mask(render *r, const render_opts *o, double ex, int curve, int level, uint8_t *rgb,
-                      uint8_t *marks, uint32_t *id0, uint8_t *mask)
+                      uint8_t *marks, uint32_t *id0, uint8_t *mask, int *far)
 {
     size_t px = (size_t)r->w * (size_t)r->h, n = 0;
     uint32_t jobs = (uint32_t)((r->h + MASK_ROWS - 1) / MASK_ROWS);
     mask_job jb;
-    int k;
-    render_tonemap_par(r, r->lin, px, ex, curve, rgb, o);
+    int k, f = render_tonemap_par(r, r->lin, px, ex, curve, rgb, o);
+    if (far)
+        *far = f;
     memset(&jb, 0, sizeof jb);
     jb.r = r;
     jb.rgb = rgb;
@@ -3052,6 +3058,13 @@ size_t render_aa_mask(render *r, const render_opts *o, double ex, int curve, int
 const float *render_linear(const render *r)
 {
     return r->lin;
+}
+
+float *render_swap_linear(render *r, float *lin)
+{
+    float *old = r->lin;
+    r->lin = lin;
+    return old;
 }
 
 /* ---- frames from the radiance atlas (atlas_frame.h) ------------------------------ */

@@ -394,9 +394,10 @@ plx_status render_frame(render *r, const render_camera *cam, const render_opts *
  * curve when curve (exposure.h), into sRGB bytes (SPEC §5's exact
  * thresholds), on o's parallel-for; what render_frame does to its own
  * image. From a table of the exposure's float thresholds (tonemap.h:
- * tonemap_value's bytes, each value on its own). */
-void render_tonemap_par(render *r, const float *lin, size_t px, double ex, int curve,
-                        uint8_t *rgb8 /* OUT */, const render_opts *o);
+ * tonemap_value's bytes, each value on its own). Returns whether a value
+ * is beyond +-FLT_MAX / 4 or NaN (tonemap_apply). */
+int render_tonemap_par(render *r, const float *lin, size_t px, double ex, int curve,
+                       uint8_t *rgb8 /* OUT */, const render_opts *o);
 
 /* 2 x 2 adaptive anti-aliasing's sums at the marked pixels only, for a
  * frame whose every pixel sum already holds the first sample's value
@@ -443,12 +444,20 @@ void render_aa_scale(const render_opts *o, float *sum, size_t n, double inv);
  * 8 neighbours: another surface id, or a channel more than level steps
  * apart in the 8-bit image (level taken into 0 .. 255: below 0 as 0), and
  * (without render_opts.no_glow) the pixels of the glows it sees.
- * Returns the pixels marked. */
+ * Returns the pixels marked, and in *far (when not NULL) whether a
+ * value of the linear image is beyond +-FLT_MAX / 4 or NaN (as
+ * render_aa_copy's answer). */
 size_t render_aa_mask(render *r, const render_opts *o, double ex, int curve, int level, uint8_t *rgb,
-                      uint8_t *marks, uint32_t *id0, uint8_t *mask);
+                      uint8_t *marks, uint32_t *id0, uint8_t *mask, int *far /* OUT */);
 
 /* The linear image of the last frame (width*height*3). Valid until the next frame. */
 const float *render_linear(const render *r);
+
+/* Gives the renderer lin (room for its largest frame's 3 floats a pixel)
+ * as its linear image from now on, and returns the one it had. 2 x 2
+ * adaptive frames lend it the sums' buffer after the first sample, and
+ * keep the first sample where it was drawn as the start of the sums. */
+float *render_swap_linear(render *r, float *lin);
 
 /* The surface id buffer of the last frame (width*height, row 0 on top;
  * MESH_SURF_NONE for sky, MESH_SURF_GROUND for ground) -- for tests and

@@ -145,20 +145,32 @@ void tonemap_table_set(tonemap_table *t, const double thr[TONEMAP_LEVELS], doubl
             t->single = 0;
 }
 
-/* The bytes of values whose bits u are at least FLOAT_INF_BITS
- * (negative, infinite, NaN) come from tonemap_value. +0 needs no case of
- * its own (its hint is byte 0 and f[0] >= 1); the single-threshold loop
- * tests for it only to take the run it starts four values at a time. */
-void tonemap_apply(const tonemap_table *t, const double thr[TONEMAP_LEVELS], const float *lin, size_t p0,
-                   size_t p1, uint8_t *rgb8)
+/* Whether x is beyond +-TONEMAP_FAR or NaN. */
+static int far_value(float x)
+{
+    return !(fabsf(x) <= TONEMAP_FAR);
+}
+
+/* The bytes of values whose bits u are above FAR_BITS (beyond
+ * TONEMAP_FAR, negative, infinite, NaN) come from tonemap_value, and
+ * there the far values are noticed at no cost to the others. +0 needs no
+ * case of its own (its hint is byte 0 and f[0] >= 1); the
+ * single-threshold loop tests for it only to take the run it starts four
+ * values at a time. */
+#define FAR_BITS 0x7e7fffffu /* TONEMAP_FAR */
+int tonemap_apply(const tonemap_table *t, const double thr[TONEMAP_LEVELS], const float *lin, size_t p0,
+                  size_t p1, uint8_t *rgb8)
 {
     const uint32_t *f = t->f;
     const uint8_t *hint = t->hint;
     size_t p;
+    int far = 0;
     if (!t->usable) {
-        for (p = p0; p < p1; p++)
+        for (p = p0; p < p1; p++) {
             rgb8[p] = tonemap_value(thr, lin[p], t->ex, t->curve);
-        return;
+            far |= far_value(lin[p]);
+        }
+        return far;
     }
     if (t->single) { /* one threshold at most above the hint */
         for (p = p0; p < p1; p++) {
@@ -172,19 +184,21 @@ void tonemap_apply(const tonemap_table *t, const double thr[TONEMAP_LEVELS], con
                 }
                 continue;
             }
-            if (u >= FLOAT_INF_BITS) {
+            if (u > FAR_BITS) {
                 rgb8[p] = tonemap_value(thr, lin[p], t->ex, t->curve);
+                far |= far_value(lin[p]);
                 continue;
             }
             b = hint[u >> TONEMAP_HINT_SHIFT];
             rgb8[p] = (uint8_t)(b + (u >= f[b]));
         }
-        return;
+        return far;
     }
     for (p = p0; p < p1; p++) {
         uint32_t u = bits_of_float(lin[p]), b;
-        if (u >= FLOAT_INF_BITS) {
+        if (u > FAR_BITS) {
             rgb8[p] = tonemap_value(thr, lin[p], t->ex, t->curve);
+            far |= far_value(lin[p]);
             continue;
         }
         b = hint[u >> TONEMAP_HINT_SHIFT];
@@ -192,4 +206,5 @@ void tonemap_apply(const tonemap_table *t, const double thr[TONEMAP_LEVELS], con
             b++;
         rgb8[p] = (uint8_t)b;
     }
+    return far;
 }

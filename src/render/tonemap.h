@@ -4,6 +4,7 @@
 #ifndef PLX_TONEMAP_H
 #define PLX_TONEMAP_H
 
+#include <float.h>
 #include <stddef.h>
 #include <stdint.h>
 
@@ -42,8 +43,11 @@ typedef struct tonemap_table {
 
 /* The table of ex and curve (kept when t already has them). */
 void tonemap_table_set(tonemap_table *t, const double thr[TONEMAP_LEVELS], double ex, int curve);
-/* Values p0 .. p1 - 1 of lin into bytes: the same as tonemap_value. */
-void tonemap_apply(const tonemap_table *t, const double thr[TONEMAP_LEVELS], const float *lin, size_t p0,
-                   size_t p1, uint8_t *rgb8);
+/* Values p0 .. p1 - 1 of lin into bytes: the same as tonemap_value.
+ * Returns whether one of them is beyond +-TONEMAP_FAR or NaN (where four
+ * equal values no longer sum to four times one: render_tonemap_kept). */
+#define TONEMAP_FAR (FLT_MAX / 4.0f)
+int tonemap_apply(const tonemap_table *t, const double thr[TONEMAP_LEVELS], const float *lin, size_t p0,
+                  size_t p1, uint8_t *rgb8);
 
 #endif

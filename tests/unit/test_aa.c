@@ -367,7 +367,7 @@ static void mask_against_brute(plx_engine *e, int w, int h, int workers)
     ro.par_ctx = e->port.ctx;
     ro.workers = workers;
     for (level = 0; level <= 7; level += level < 2 ? 1 : 5) { /* 0, 1, 2 (AA_LEVEL), 7 */
-        n = render_aa_mask(e->rd, &ro, info.exposure, 1, level, scratch, keep, id0, mask);
+        n = render_aa_mask(e->rd, &ro, info.exposure, 1, level, scratch, keep, id0, mask, NULL);
         assert_memory_equal(scratch, rgb8, px * 3); /* the first sample's bytes, kept */
         marked = 0;
         for (j = 0; j < h; j++)
@@ -485,9 +485,9 @@ static void mask_count_with_glows(plx_engine *e, int w, int h)
     ro.par_ctx = e->port.ctx;
     ro.workers = 2;
     /* level 255: surface edges only, so that the glows mark pixels of their own */
-    plain = render_aa_mask(e->rd, &ro, info.exposure, 1, 255, scratch, scratch, id0, mask);
+    plain = render_aa_mask(e->rd, &ro, info.exposure, 1, 255, scratch, scratch, id0, mask, NULL);
     ro.no_glow = 0;
-    n = render_aa_mask(e->rd, &ro, info.exposure, 1, 255, scratch, scratch, id0, mask);
+    n = render_aa_mask(e->rd, &ro, info.exposure, 1, 255, scratch, scratch, id0, mask, NULL);
     for (p = 0; p < px; p++)
         marked += mask[p];
     print_message("mask %dx%d with glows: %zu pixels marked, %zu without the glows\n", w, h, n, plain);
@@ -637,9 +637,9 @@ static void marked_sums_against_dense(plx_engine *e, int workers, int tame)
     render_aa_scale(&ro, dense, px * 3, 0.25);
     render_tonemap_par(e->rd, dense, px, info.exposure, 1, ref, &ro);
     /* marked: the first sample's bytes in place, then the marked sums */
-    render_tonemap_par(e->rd, smp, px, info.exposure, 1, first, &ro);
+    far = render_tonemap_par(e->rd, smp, px, info.exposure, 1, first, &ro);
     memcpy(rgb8, first, px * 3);
-    far = render_aa_copy(&ro, sum, smp, px * 3);
+    assert_int_equal(render_aa_copy(&ro, sum, smp, px * 3), far); /* the tone map's answer is the copy's */
     assert_int_equal(far, !tame);
     for (p = 0; p < px; p++)
         mask[p] = when[p] == 0;

@@ -8,7 +8,8 @@
  * and without the curve. Runs of +0 (taken four at a time) of every length
  * up to the window's end, beside -0, the smallest floats and NaN, in
  * random windows p0 .. p1 of a buffer: the same bytes, and none written
- * outside the window. */
+ * outside the window. Each batch's answer whether a value lies beyond
+ * +-FLT_MAX / 4 or is NaN (the 2 x 2 sums' limit) against a scan. */
 #include <stdarg.h>
 #include <stddef.h>
 #include <setjmp.h>
@@ -30,14 +31,19 @@ typedef struct batch {
     float x[BUF];
     uint8_t got[BUF];
     size_t n;
-    size_t checked, lit;
+    size_t checked, lit, far;
 } batch;
 
 /* The batch's bytes from the table against tonemap_value, one by one. */
 static void flush(batch *b, const tonemap_table *t, const double *thr, double ex, int curve)
 {
     size_t i;
-    tonemap_apply(t, thr, b->x, 0, b->n, b->got);
+    int far = tonemap_apply(t, thr, b->x, 0, b->n, b->got), want_far = 0;
+    for (i = 0; i < b->n; i++)
+        want_far |= !(fabsf(b->x[i]) <= FLT_MAX / 4.0f);
+    if (far != want_far)
+        fail_msg("ex %g curve %d: a batch of %zu values says far %d, not %d", ex, curve, b->n, far, want_far);
+    b->far += far;
     for (i = 0; i < b->n; i++) {
         uint8_t want = tonemap_value(thr, b->x[i], ex, curve);
         if (b->got[i] != want)
@@ -66,7 +72,7 @@ static void check_exposure(const double *thr, double ex, int curve, int usable)
     uint32_t k, d;
     size_t i;
     memset(&t, 0, sizeof t);
-    b.n = b.checked = b.lit = 0;
+    b.n = b.checked = b.lit = b.far = 0;
     tonemap_table_set(&t, thr, ex, curve);
     assert_int_equal(t.usable, usable);
     for (u = 1; u < 0x7f800000u; u += SPREAD)
@@ -85,6 +91,9 @@ static void check_exposure(const double *thr, double ex, int curve, int usable)
     add(&b, &t, thr, ex, curve, NAN);
     flush(&b, &t, thr, ex, curve);
     assert_true(b.checked > 500000);
+    /* far answered both ways: the batches past FLT_MAX / 4 and the last
+     * (infinities, NaN), not the others */
+    assert_true(b.far >= 2 && b.far * 4 < b.checked / BUF);
     /* the exposure's range of floats is crossed: bytes between 0 and 255
      * (1e120 takes every float but the smallest to 255) */
     if (usable)
@@ -176,7 +185,7 @@ static void test_zero_runs(void **state)
         p0 = (size_t)(seed >> 58) % 20;
         p1 = p0 + (size_t)(seed >> 40) % (41 - p0);
         memset(got, 0xAB, sizeof got);
-        tonemap_apply(&t, thr, x, p0, p1, got);
+        assert_int_equal(tonemap_apply(&t, thr, x, p0, p1, got), 0); /* none beyond FLT_MAX / 4 */
         for (i = 0; i < 40; i++) {
             if (i < p0 || i >= p1) {
                 if (got[i] != 0xAB)
