@@ -544,7 +544,7 @@ static plx_status render_aa(plx_engine *e, const render_camera *rc, render_opts 
                                   * ones write only the marked pixels, into the sums' buffer lent */
                     sum = render_swap_linear(e->rd, e->aa_sum);
                 else
-                    far = render_aa_copy(ro, sum, lin, 3 * px);
+                    render_aa_copy(ro, sum, lin, 3 * px);
             } else {
                 if (marked_sums)
                     render_aa_add_marked(ro, sum, lin, e->aa_mask, px, b * n + a - 1);

@@ -2617,79 +2617,66 @@ typedef struct aa_job {
     size_t n;
     double inv;
     int copy;                   /* with lin: sum = lin */
-    int far[RENDER_MAX_WORKERS]; /* copy: a value beyond AA_FAR (or not finite), by worker */
 } aa_job;
 
-#define AA_FAR (FLT_MAX / 4.0f) /* 4v finite up to here */
-
-/* Whether v is beyond +-AA_FAR or NaN: a value whose four-fold sum need
- * not give it back (render_tonemap_kept). */
+/* Whether v is beyond +-TONEMAP_FAR or NaN: a value whose four-fold sum
+ * need not give it back (render_tonemap_kept). */
 static inline int aa_far(float v)
 {
-    return !(fabsf(v) <= AA_FAR);
+    return !(fabsf(v) <= TONEMAP_FAR);
 }
 
 /* sum[p] = lin[p] for the n values, eight at a time in a loop of fixed
- * length; returns whether one of them is beyond +-AA_FAR or NaN. */
-static int aa_copy(float *restrict sum, const float *restrict lin, size_t n)
+ * length. */
+static void aa_copy(float *restrict sum, const float *restrict lin, size_t n)
 {
     size_t p;
-    int k, far = 0;
+    int k;
     for (p = 0; p + AA_LANES <= n; p += AA_LANES)
-        for (k = 0; k < AA_LANES; k++) {
+        for (k = 0; k < AA_LANES; k++)
             sum[p + k] = lin[p + k];
-            far |= aa_far(lin[p + k]);
-        }
-    for (; p < n; p++) {
+    for (; p < n; p++)
         sum[p] = lin[p];
-        far |= aa_far(lin[p]);
-    }
-    return far;
 }
 
 static void aa_chunk(void *arg, int worker, uint32_t k)
 {
     aa_job *jb = arg;
     size_t p0 = (size_t)k * AA_CHUNK, m = jb->n - p0 < AA_CHUNK ? jb->n - p0 : AA_CHUNK;
+    (void)worker;
     if (jb->lin && jb->copy)
-        jb->far[worker] |= aa_copy(jb->sum + p0, jb->lin + p0, m);
+        aa_copy(jb->sum + p0, jb->lin + p0, m);
     else if (jb->lin)
         aa_add(jb->sum + p0, jb->lin + p0, m);
     else
         aa_scale(jb->sum + p0, m, jb->inv);
 }
 
-/* One of the sums over n values on the workers (aa_chunk); a copy
- * returns whether a value is beyond +-AA_FAR or NaN. */
-static int aa_run(const render_opts *o, float *sum, const float *lin, size_t n, double inv, int copy)
+/* One of the sums over n values on the workers (aa_chunk). */
+static void aa_run(const render_opts *o, float *sum, const float *lin, size_t n, double inv, int copy)
 {
     aa_job jb;
-    int k, far = 0;
-    memset(&jb, 0, sizeof jb);
     jb.sum = sum;
     jb.lin = lin;
     jb.n = n;
     jb.inv = inv;
     jb.copy = copy;
     run_jobs(o, (uint32_t)((n + AA_CHUNK - 1) / AA_CHUNK), aa_chunk, &jb);
-    for (k = 0; k < RENDER_MAX_WORKERS; k++)
-        far |= jb.far[k];
-    return far;
 }
 
-int render_aa_copy(const render_opts *o, float *sum, const float *lin, size_t n)
+void render_aa_copy(const render_opts *o, float *sum, const float *lin, size_t n)
 {
-    return aa_run(o, sum, lin, n, 1.0, 1);
+    aa_run(o, sum, lin, n, 1.0, 1);
 }
 
 void render_aa_add(const render_opts *o, float *sum, const float *lin, size_t n)
 {
-    (void)aa_run(o, sum, lin, n, 1.0, 0);
+    aa_run(o, sum, lin, n, 1.0, 0);
 }
 
 void render_aa_scale(const render_opts *o, float *sum, size_t n, double inv)
 {
-    (void)aa_run(o, sum, NULL, n, inv, 0);
+    aa_run(o, sum, NULL, n, inv, 0);
 }
 
 /* ---- 2 x 2 sums at the marked pixels (render_aa_add_marked, render_tonemap_kept) ---- */
@@ -2718,7 +2705,7 @@ typedef struct marked_job {
     const uint8_t *cmask;
     size_t px;
     int before;
-    int far;                    /* render_tonemap_kept: a value beyond +-AA_FAR or NaN somewhere */
+    int far;                    /* render_tonemap_kept: a value beyond +-TONEMAP_FAR or NaN somewhere */
     uint8_t *rgb8;
 } marked_job;
 

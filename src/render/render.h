@@ -401,7 +401,7 @@ int render_tonemap_par(render *r, const float *lin, size_t px, double ex, int cu
 
 /* 2 x 2 adaptive anti-aliasing's sums at the marked pixels only, for a
  * frame whose every pixel sum already holds the first sample's value
- * (render_aa_copy) and whose later samples have been added this way:
+ * (the first sample's own image, render_swap_linear) and whose later samples have been added this way:
  * after later sample s (1 .. 3; before = s - 1), each pixel marked 2
  * (newly, render_opts.mask_new) first adds its first value before times,
  * as the samples that left it did, and becomes 1; then every marked
@@ -421,18 +421,16 @@ void render_aa_add_marked(const render_opts *o, float *sum, const float *lin, ui
  * flushing subnormals to zero, C's default; all 2^32 floats checked), so
  * its bytes stay, except where 4v would
  * overflow or v is not finite: those values are summed as the dense sums
- * do and mapped again (looked for only when far, render_aa_copy's
- * answer for the first sample: else only the marked pixels are read).
+ * do and mapped again (looked for only when far, the first sample's
+ * tone map's answer, render_aa_mask: else only the marked pixels are read).
  * Afterwards sum holds the frame's linear values. */
 void render_tonemap_kept(render *r, float *sum, const uint8_t *mask, size_t px, int far, double ex, int curve,
                          uint8_t *rgb8 /* IN/OUT */, const render_opts *o);
 
 /* Anti-aliasing's sums on o's workers: sum[p] = lin[p] (copy), sum[p] +=
  * lin[p] (add) for p < n, and sum[p] = (float)(sum[p] * inv) (scale);
- * each value the same float operations as one at a time. The copy
- * returns whether a value is beyond +-FLT_MAX / 4 or NaN (for
- * render_tonemap_kept). */
-int render_aa_copy(const render_opts *o, float *sum, const float *lin, size_t n);
+ * each value the same float operations as one at a time. */
+void render_aa_copy(const render_opts *o, float *sum, const float *lin, size_t n);
 void render_aa_add(const render_opts *o, float *sum, const float *lin, size_t n);
 void render_aa_scale(const render_opts *o, float *sum, size_t n, double inv);
 
@@ -445,8 +443,8 @@ void render_aa_scale(const render_opts *o, float *sum, size_t n, double inv);
  * apart in the 8-bit image (level taken into 0 .. 255: below 0 as 0), and
  * (without render_opts.no_glow) the pixels of the glows it sees.
  * Returns the pixels marked, and in *far (when not NULL) whether a
- * value of the linear image is beyond +-FLT_MAX / 4 or NaN (as
- * render_aa_copy's answer). */
+ * value of the linear image is beyond +-FLT_MAX / 4 or NaN (for
+ * render_tonemap_kept). */
 size_t render_aa_mask(render *r, const render_opts *o, double ex, int curve, int level, uint8_t *rgb,
                       uint8_t *marks, uint32_t *id0, uint8_t *mask, int *far /* OUT */);
 
