@@ -7,8 +7,9 @@
  * it, so the table holds, for each byte, the smallest float that reaches
  * it: found from the curve's inverse and checked float by float against
  * tonemap_value, so the bytes are the same by construction. A value then
- * costs a table read and a compare or two of its bits, and a run of +0
- * (the dark half of an aerial frame) four values a test.
+ * costs a table read and a compare or two of its bits (with one threshold
+ * at most per hint, runs of 32 values with no branch), and 32 values of
+ * +0 (the dark half of an aerial frame) one test.
  */
 #include <float.h>
 #include <math.h>
@@ -154,10 +155,46 @@ static int far_value(float x)
 /* The bytes of values whose bits u are above FAR_BITS (beyond
  * TONEMAP_FAR, negative, infinite, NaN) come from tonemap_value, and
  * there the far values are noticed at no cost to the others. +0 needs no
- * case of its own (its hint is byte 0 and f[0] >= 1); the
- * single-threshold loop tests for it only to take the run it starts four
- * values at a time. */
+ * case of its own (its hint is byte 0 and f[0] >= 1). */
 #define FAR_BITS 0x7e7fffffu /* TONEMAP_FAR */
+
+/* The byte of the bits u (at most FAR_BITS) in the single-threshold
+ * case: the hint, plus one when u reaches the threshold above it. */
+static inline uint8_t single_byte(const tonemap_table *t, uint32_t u)
+{
+    uint32_t b = t->hint[u >> TONEMAP_HINT_SHIFT];
+    return (uint8_t)(b + (u >= t->f[b]));
+}
+
+/* Values p .. p + TONEMAP_RUN - 1 in the single-threshold case, when
+ * none is above FAR_BITS (else 0, nothing written): all +0 (the dark
+ * half of an aerial frame) at once, else a hint and a compare each, four
+ * to a step, with no branch. */
+#define TONEMAP_RUN 32
+static int single_run(const tonemap_table *t, const float *lin, size_t p, uint8_t *rgb8)
+{
+    uint32_t u[TONEMAP_RUN], any = 0, far = 0;
+    int k;
+    memcpy(u, lin + p, sizeof u);
+    for (k = 0; k < TONEMAP_RUN; k++) {
+        any |= u[k];
+        far |= u[k] > FAR_BITS;
+    }
+    if (far)
+        return 0;
+    if (!any) {
+        memset(rgb8 + p, 0, TONEMAP_RUN);
+        return 1;
+    }
+    for (k = 0; k < TONEMAP_RUN; k += 4) {
+        rgb8[p + k] = single_byte(t, u[k]);
+        rgb8[p + k + 1] = single_byte(t, u[k + 1]);
+        rgb8[p + k + 2] = single_byte(t, u[k + 2]);
+        rgb8[p + k + 3] = single_byte(t, u[k + 3]);
+    }
+    return 1;
+}
+
 int tonemap_apply(const tonemap_table *t, const double thr[TONEMAP_LEVELS], const float *lin, size_t p0,
                   size_t p1, uint8_t *rgb8)
 {
@@ -172,25 +209,22 @@ int tonemap_apply(const tonemap_table *t, const double thr[TONEMAP_LEVELS], cons
         }
         return far;
     }
-    if (t->single) { /* one threshold at most above the hint */
-        for (p = p0; p < p1; p++) {
-            uint32_t u = bits_of_float(lin[p]), b;
-            if (u == 0) { /* a dark run (half an aerial frame): its next values four at a time */
-                uint64_t q[2];
-                rgb8[p] = 0;
-                while (p + 5 <= p1 && (memcpy(q, lin + p + 1, sizeof q), (q[0] | q[1]) == 0)) {
-                    memset(rgb8 + p + 1, 0, 4);
-                    p += 4;
+    if (t->single) { /* one threshold at most above the hint: runs of TONEMAP_RUN, else one by one */
+        for (p = p0; p < p1;) {
+            size_t e;
+            if (p + TONEMAP_RUN <= p1 && single_run(t, lin, p, rgb8)) {
+                p += TONEMAP_RUN;
+                continue;
+            }
+            for (e = p + TONEMAP_RUN < p1 ? p + TONEMAP_RUN : p1; p < e; p++) {
+                uint32_t u = bits_of_float(lin[p]);
+                if (u > FAR_BITS) {
+                    rgb8[p] = tonemap_value(thr, lin[p], t->ex, t->curve);
+                    far |= far_value(lin[p]);
+                    continue;
                 }
-                continue;
+                rgb8[p] = single_byte(t, u);
             }
-            if (u > FAR_BITS) {
-                rgb8[p] = tonemap_value(thr, lin[p], t->ex, t->curve);
-                far |= far_value(lin[p]);
-                continue;
-            }
-            b = hint[u >> TONEMAP_HINT_SHIFT];
-            rgb8[p] = (uint8_t)(b + (u >= f[b]));
         }
         return far;
     }

@@ -5,7 +5,7 @@
  * of every threshold the table found, and zero, negatives, subnormals,
  * the largest float, infinities and NaN; at exposures from 1e-30 to 1e120
  * (the last too large for the table: its values go the direct way), with
- * and without the curve. Runs of +0 (taken four at a time) of every length
+ * and without the curve. Runs of +0 (32 at once when all are) of every length
  * up to the window's end, beside -0, the smallest floats and NaN, in
  * random windows p0 .. p1 of a buffer: the same bytes, and none written
  * outside the window. Each batch's answer whether a value lies beyond
@@ -151,42 +151,47 @@ static void test_boundaries(void **state)
     assert_true(tonemap_value(thr, float_of_bits(t.f[0] - 1), 0.38, 1) == 0);
 }
 
-/* Runs of +0 among other values: 20,000 random buffers of up to 40
- * values, each run of +0 1 to 12 long, tone mapped through a random
- * window (sentinels around it must stay). */
+/* Runs of +0 among other values: 20,000 random buffers of ZN values,
+ * each run of +0 1 to 48 long, tone mapped through a random window
+ * (sentinels around it must stay); many windows hold 32 zeros in a row,
+ * the all-dark runs the tone map writes at once. */
+#define ZN 100 /* values a trial */
 static void test_zero_runs(void **state)
 {
     static const float other[] = { -0.0f, 1e-45f, 2e-45f, FLT_MIN, 0.02f, 1.0f, 400.0f, -3.0f };
     static tonemap_table t;
     double thr[TONEMAP_LEVELS];
     uint64_t seed = 12345;
-    long trial, zeros = 0;
+    long trial, zeros = 0, dark = 0;
     (void)state;
     tonemap_thresholds(thr);
     memset(&t, 0, sizeof t);
     tonemap_table_set(&t, thr, 0.05, 1);
     assert_true(t.usable && t.single);
     for (trial = 0; trial < 20000; trial++) {
-        float x[40];
-        uint8_t got[40];
+        float x[ZN];
+        uint8_t got[ZN];
         size_t n = 0, p0, p1, i;
-        while (n < 40) {
+        while (n < ZN) {
             size_t run, k;
             seed = seed * 6364136223846793005ull + 1442695040888963407ull;
-            run = 1 + (size_t)(seed >> 60) % 12;
+            run = 1 + (size_t)(seed >> 58) % 48;
             if ((seed >> 40) & 1) {
-                for (k = 0; k < run && n < 40; k++)
+                for (k = 0; k < run && n < ZN; k++)
                     x[n++] = 0.0f;
             } else {
                 x[n++] = other[(seed >> 33) % (sizeof other / sizeof other[0])];
             }
         }
         seed = seed * 6364136223846793005ull + 1442695040888963407ull;
-        p0 = (size_t)(seed >> 58) % 20;
-        p1 = p0 + (size_t)(seed >> 40) % (41 - p0);
+        p0 = (size_t)(seed >> 58) % 40;
+        p1 = p0 + (size_t)(seed >> 40) % (ZN + 1 - p0);
         memset(got, 0xAB, sizeof got);
         assert_int_equal(tonemap_apply(&t, thr, x, p0, p1, got), 0); /* none beyond FLT_MAX / 4 */
-        for (i = 0; i < 40; i++) {
+        for (i = p0, n = 0; i < p1 && n < 32; i++)
+            n = bits_of_float(x[i]) == 0 ? n + 1 : 0;
+        dark += n == 32;
+        for (i = 0; i < ZN; i++) {
             if (i < p0 || i >= p1) {
                 if (got[i] != 0xAB)
                     fail_msg("trial %ld: byte %zu outside %zu .. %zu written", trial, i, p0, p1);
@@ -198,7 +203,7 @@ static void test_zero_runs(void **state)
             }
         }
     }
-    assert_true(zeros > 100000);
+    assert_true(zeros > 100000 && dark > 1000);
 }
 
 int main(void)
