@@ -333,27 +333,35 @@ static int all_marked(const uint8_t *mask, int32_t i)
     return all;
 }
 
+/* Pixel i's ground point in steps of the block at (bx0, by0), as
+ * ground_run computes it. Along a row it is monotone in i (each step a
+ * rounding of a monotone function, and inv > 0). */
+static void ground_uw(const ground_row *g, int32_t i, double bx0, double by0, double inv, double *u, double *w)
+{
+    double x = g->x0 + i * g->dx, y = g->y0 + i * g->dy;
+    *u = (x - bx0) * inv;
+    *w = (y - by0) * inv;
+}
+
 /* The 8 ground pixels from i when all their hit points lie in the block
- * at (bx0, by0) (u and w in [0, lim], as ground_run's test), read at once:
- * ground_run's reads, with the same doubles. 0 and nothing read when not. */
+ * at (bx0, by0) (u and w in [0, lim], as ground_run's test: by the
+ * monotony, when the first and the last do), read at once: ground_run's
+ * reads, with the same doubles. 0 and nothing read when not. */
 static int ground_eight(const ground_row *g, int32_t i, double bx0, double by0, double inv, double lim,
                         const uint32_t *t0, float *lin)
 {
-    double u[ATLAS_LANES], w[ATLAS_LANES];
+    double ua, wa, ub, wb;
     float uf[ATLAS_LANES], wf[ATLAS_LANES];
-    int32_t k, in = 1;
-    for (k = 0; k < ATLAS_LANES; k++) {
-        double x = g->x0 + (i + k) * g->dx, y = g->y0 + (i + k) * g->dy;
-        u[k] = (x - bx0) * inv;
-        w[k] = (y - by0) * inv;
-    }
-    for (k = 0; k < ATLAS_LANES; k++)
-        in &= u[k] >= 0.0 && u[k] <= lim && w[k] >= 0.0 && w[k] <= lim;
-    if (!in)
+    int32_t k;
+    ground_uw(g, i, bx0, by0, inv, &ua, &wa);
+    ground_uw(g, i + ATLAS_LANES - 1, bx0, by0, inv, &ub, &wb);
+    if (!(ua >= 0.0 && ua <= lim && wa >= 0.0 && wa <= lim && ub >= 0.0 && ub <= lim && wb >= 0.0 && wb <= lim))
         return 0;
     for (k = 0; k < ATLAS_LANES; k++) {
-        uf[k] = (float)u[k];
-        wf[k] = (float)w[k];
+        double u, w;
+        ground_uw(g, i + k, bx0, by0, inv, &u, &w);
+        uf[k] = (float)u;
+        wf[k] = (float)w;
     }
     run_read(t0, ATLAS_BLOCK + 1, ATLAS_BLOCK + 1, uf, wf, i, lin);
     return 1;
@@ -382,11 +390,10 @@ static void ground_run(const atlas *A, const ground_row *g, int32_t i0, int32_t 
             float *o = &lin[3 * (size_t)i];
             if (mask && !mask[i])
                 continue;
-            x = g->x0 + i * g->dx;
-            y = g->y0 + i * g->dy;
-            u = (x - bx0) * inv;
-            w = (y - by0) * inv;
+            ground_uw(g, i, bx0, by0, inv, &u, &w);
             if (!(u >= 0.0 && u <= lim && w >= 0.0 && w <= lim)) { /* another block */
+                x = g->x0 + i * g->dx;
+                y = g->y0 + i * g->dy;
                 cur = ground_block(A, x, y, &u, &w);
                 t0 = NULL;
                 lim = -1.0;
