@@ -1986,6 +1986,15 @@ static void corners_rest(render *r, const render_opts *o, render_stats *st)
     }
 }
 
+/* The ids of GROUND_LANES pixels: the ground's where none (sky). */
+#define GROUND_LANES 16
+static void ground_lanes(uint32_t *restrict id)
+{
+    int k;
+    for (k = 0; k < GROUND_LANES; k++)
+        id[k] = id[k] == MESH_SURF_NONE ? MESH_SURF_GROUND : id[k];
+}
+
 /* Pixel row j's ground pixels get the ground's id (pixel_hit writes it;
  * each pixel on its own). The camera's right vector is horizontal
  * (setup_camera: rt[2] = 0), so a pixel's direction has the same height
@@ -2006,9 +2015,10 @@ static void ground_row(render *r, int32_t j)
 #endif
     if (!(d[2] < 0.0))
         return;
-    for (i = 0; i < r->w; i++)
-        if (id[i] == MESH_SURF_NONE)
-            id[i] = MESH_SURF_GROUND;
+    for (i = 0; i + GROUND_LANES <= r->w; i += GROUND_LANES) /* a loop of fixed length: GCC vectorises it */
+        ground_lanes(id + i);
+    for (; i < r->w; i++)
+        id[i] = id[i] == MESH_SURF_NONE ? MESH_SURF_GROUND : id[i];
 }
 
 /* Rows k RENDER_TILE .. of the frame (render_job_fn; arg the render). */
