@@ -6,7 +6,9 @@
 # Builds revision BASE (default 73d3a0e, the flat layout before the move to
 # src/<stage>/) in a temporary git worktree, and the current tree, then runs
 # every command (info, gen, vis, draw, illum, lit, heatmap, render street /
-# aerial / --pfm, route, dark-spots, nightify) with both binaries on every
+# aerial / --pfm / --aa 2, 3 and --aa-full, route, dark-spots, nightify;
+# bake, renders from the bake and a walk on the Helsinki district) with
+# both binaries on every
 # fixture in fixtures/ and on two generated cities (gen eixample 6 6, gen
 # oldtown 8 8), and compares standard output, standard error, the exit code
 # and every file written, byte for byte. Timing figures ("12.34 ms",
@@ -113,10 +115,24 @@ all_commands() {
         run "$n/street" render "$s" --size 160x120 $ph -o "$d/street.png" --pfm "$d/street.pfm"
         run "$n/street-direct" render "$s" --size 160x120 --no-indirect --no-glow -o "$d/street-direct.png"
         run "$n/aerial" render "$s" --view aerial --size 160x160 --texel 2 $ph -o "$d/aerial.png" --pfm "$d/aerial.pfm"
+        # anti-aliased: 2 x 2 adaptive into bytes (the marked sums), 3 x 3, every sample
+        run "$n/street-aa2" render "$s" --size 161x119 --aa 2 $ph -o "$d/street-aa2.png" --pfm "$d/street-aa2.pfm"
+        run "$n/aerial-aa3" render "$s" --view aerial --size 120x120 --texel 2 --aa 3 $ph -o "$d/aerial-aa3.png"
+        run "$n/street-aafull" render "$s" --size 160x120 --aa 2 --aa-full --threads 2 $ph -o "$d/street-aafull.png"
         run "$n/route" route "$s" --path "$r" --step 2 --geojson "$d/route.geojson"
         run "$n/dark-spots" dark-spots "$s" --res "$res" --count 10 -o "$d/dark.geojson"
         run "$n/nightify" nightify fixtures/ground-day.png "$d/street.png" -o "$d/nightify.png"
     done
+    # a bake of the real district, frames read from its radiance atlas and a walk
+    mkdir -p "$DIR/bake"
+    run "bake/bake" bake fixtures/helsinki-centre.geojson --photons 4096 --frames 2 -o "$DIR/bake/city.plxb"
+    for th in 1 2; do
+        run "bake/street-aa2-$th" render "$DIR/bake/city.plxb" --size 240x180 --aa 2 --threads $th \
+            -o "$DIR/bake/street-aa2-$th.png" --pfm "$DIR/bake/street-aa2-$th.pfm"
+    done
+    run "bake/aerial-aa2" render "$DIR/bake/city.plxb" --view aerial --size 200x150 --aa 2 -o "$DIR/bake/aerial-aa2.png"
+    run "bake/walk" walk "$DIR/bake/city.plxb" --path fixtures/helsinki-walk.geojson --size 200x150 \
+        --max-frames 6 --refine -o "$DIR/bake/walk"
     mkdir -p "$DIR/gen"
     for style in grid eixample oldtown; do
         run "gen/$style" gen $style 6 6 --seed 3 -o "$DIR/gen/$style.geojson"
@@ -136,6 +152,7 @@ for f in $(cd "$OUT/base" && find . -name '*.out' -o -name '*.err'); do
         sed -E -e 's/[0-9]+(\.[0-9]+)?( ?)(ms|us|ns|s)\b/#\2\3/g' \
             -e "s#$OUT/$side/#OUT/#g" \
             -e 's/[0-9]+(\.[0-9]+)? ?(Mphotons|photons|Mrays|rays|pixels|px)\/s\b/# \2\/s/g' \
+            -e 's/[0-9]+(\.[0-9]+)? frames per second/# frames per second/g' \
             "$OUT/$side/$f" >"$OUT/$side/$f.t" && mv "$OUT/$side/$f.t" "$OUT/$side/$f"
     done
 done

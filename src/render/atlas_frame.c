@@ -2,6 +2,7 @@
 #include <math.h>
 #include <string.h>
 
+#include "base/plx_assert.h"
 #include "render/atlas_frame.h"
 #include "render/texel.h"
 
@@ -442,7 +443,11 @@ static void surface_run(const atlas *A, const atlas_view *v, atlas_cache *k, uin
     t0 = &A->tex[c->first];
     nu = c->nu;
     nv = c->nv;
-    for (i = i0; i + ATLAS_LANES <= i1; i += ATLAS_LANES) { /* all marked (atlas_frame_row's runs) */
+#ifdef PLX_DEBUG
+    for (i = i0; i < i1; i++) /* every pixel marked: atlas_frame_row's building runs end at an unmarked one */
+        PLX_ASSERT(!mask || mask[i]);
+#endif
+    for (i = i0; i + ATLAS_LANES <= i1; i += ATLAS_LANES) {
         float u[ATLAS_LANES], w[ATLAS_LANES];
         int32_t q;
         for (q = 0; q < ATLAS_LANES; q++) {

@@ -448,11 +448,16 @@ void render_aa_scale(const render_opts *o, float *sum, size_t n, double inv);
 size_t render_aa_mask(render *r, const render_opts *o, double ex, int curve, int level, uint8_t *rgb,
                       uint8_t *marks, uint32_t *id0, uint8_t *mask, int *far /* OUT */);
 
-/* The linear image of the last frame (width*height*3). Valid until the next frame. */
+/* The linear image of the last frame (width*height*3). Valid until the next frame.
+ * After plx_render's anti-aliased frames it is not the frame's image:
+ * after a 2 x 2 adaptive frame into bytes it holds the frame's sums
+ * (scaled), after the others the last sample point's image; plx_render
+ * returns the frame's own floats. */
 const float *render_linear(const render *r);
 
-/* Gives the renderer lin (room for its largest frame's 3 floats a pixel)
- * as its linear image from now on, and returns the one it had. 2 x 2
+/* Gives the renderer lin (room for its largest frame's 3 floats a pixel:
+ * not checked, the caller sizes it as render_create does) as its linear
+ * image from now on, and returns the one it had. 2 x 2
  * adaptive frames lend it the sums' buffer after the first sample, and
  * keep the first sample where it was drawn as the start of the sums. */
 float *render_swap_linear(render *r, float *lin);
