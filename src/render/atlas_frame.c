@@ -334,12 +334,19 @@ static int all_marked(const uint8_t *mask, int32_t i)
     return all;
 }
 
-/* Pixel i's ground point in steps of the block at (bx0, by0), as
- * ground_run computes it. Along a row it is monotone in i (each step a
+/* Pixel i's ground point (x, y) from the tiles' corner, and in steps of
+ * the block at (bx0, by0), as ground_run computes them. Along a row it is monotone in i (each step a
  * rounding of a monotone function, and inv > 0). */
+static void ground_xy(const ground_row *g, int32_t i, double *x, double *y)
+{
+    *x = g->x0 + i * g->dx;
+    *y = g->y0 + i * g->dy;
+}
+
 static void ground_uw(const ground_row *g, int32_t i, double bx0, double by0, double inv, double *u, double *w)
 {
-    double x = g->x0 + i * g->dx, y = g->y0 + i * g->dy;
+    double x, y;
+    ground_xy(g, i, &x, &y);
     *u = (x - bx0) * inv;
     *w = (y - by0) * inv;
 }
@@ -393,8 +400,7 @@ static void ground_run(const atlas *A, const ground_row *g, int32_t i0, int32_t 
                 continue;
             ground_uw(g, i, bx0, by0, inv, &u, &w);
             if (!(u >= 0.0 && u <= lim && w >= 0.0 && w <= lim)) { /* another block */
-                x = g->x0 + i * g->dx;
-                y = g->y0 + i * g->dy;
+                ground_xy(g, i, &x, &y);
                 cur = ground_block(A, x, y, &u, &w);
                 t0 = NULL;
                 lim = -1.0;

@@ -2629,13 +2629,6 @@ typedef struct aa_job {
     int copy;                   /* with lin: sum = lin */
 } aa_job;
 
-/* Whether v is beyond +-TONEMAP_FAR or NaN: a value whose four-fold sum
- * need not give it back (render_tonemap_kept). */
-static inline int aa_far(float v)
-{
-    return !(fabsf(v) <= TONEMAP_FAR);
-}
-
 /* sum[p] = lin[p] for the n values, eight at a time in a loop of fixed
  * length. */
 static void aa_copy(float *restrict sum, const float *restrict lin, size_t n)
@@ -2782,7 +2775,7 @@ static void kept_chunk(void *arg, int worker, uint32_t k)
     (void)worker;
     if (jb->far)
         for (q = 3 * p0; q < 3 * p1; q++)
-            if (!jb->cmask[q / 3] && aa_far(jb->sum[q])) {
+            if (!jb->cmask[q / 3] && tonemap_far(jb->sum[q]) /* its four-fold sum need not give it back */) {
                 jb->sum[q] = dense_2x2(jb->sum[q]);
                 tonemap_apply(jb->r->tm, jb->r->thr, jb->sum, q, q + 1, jb->rgb8);
             }

@@ -146,12 +146,6 @@ void tonemap_table_set(tonemap_table *t, const double thr[TONEMAP_LEVELS], doubl
             t->single = 0;
 }
 
-/* Whether x is beyond +-TONEMAP_FAR or NaN. */
-static int far_value(float x)
-{
-    return !(fabsf(x) <= TONEMAP_FAR);
-}
-
 /* The bytes of values whose bits u are above FAR_BITS (beyond
  * TONEMAP_FAR, negative, infinite, NaN) come from tonemap_value, and
  * there the far values are noticed at no cost to the others. +0 needs no
@@ -205,7 +199,7 @@ int tonemap_apply(const tonemap_table *t, const double thr[TONEMAP_LEVELS], cons
     if (!t->usable) {
         for (p = p0; p < p1; p++) {
             rgb8[p] = tonemap_value(thr, lin[p], t->ex, t->curve);
-            far |= far_value(lin[p]);
+            far |= tonemap_far(lin[p]);
         }
         return far;
     }
@@ -220,7 +214,7 @@ int tonemap_apply(const tonemap_table *t, const double thr[TONEMAP_LEVELS], cons
                 uint32_t u = bits_of_float(lin[p]);
                 if (u > FAR_BITS) {
                     rgb8[p] = tonemap_value(thr, lin[p], t->ex, t->curve);
-                    far |= far_value(lin[p]);
+                    far |= tonemap_far(lin[p]);
                     continue;
                 }
                 rgb8[p] = single_byte(t, u);
@@ -232,7 +226,7 @@ int tonemap_apply(const tonemap_table *t, const double thr[TONEMAP_LEVELS], cons
         uint32_t u = bits_of_float(lin[p]), b;
         if (u > FAR_BITS) {
             rgb8[p] = tonemap_value(thr, lin[p], t->ex, t->curve);
-            far |= far_value(lin[p]);
+            far |= tonemap_far(lin[p]);
             continue;
         }
         b = hint[u >> TONEMAP_HINT_SHIFT];

@@ -5,6 +5,7 @@
 #define PLX_TONEMAP_H
 
 #include <float.h>
+#include <math.h>
 #include <stddef.h>
 #include <stdint.h>
 
@@ -47,6 +48,11 @@ void tonemap_table_set(tonemap_table *t, const double thr[TONEMAP_LEVELS], doubl
  * Returns whether one of them is beyond +-TONEMAP_FAR or NaN (where four
  * equal values no longer sum to four times one: render_tonemap_kept). */
 #define TONEMAP_FAR (FLT_MAX / 4.0f)
+/* Whether x is beyond +-TONEMAP_FAR or NaN. */
+static inline int tonemap_far(float x)
+{
+    return !(fabsf(x) <= TONEMAP_FAR);
+}
 int tonemap_apply(const tonemap_table *t, const double thr[TONEMAP_LEVELS], const float *lin, size_t p0,
                   size_t p1, uint8_t *rgb8);
 
