@@ -28,6 +28,7 @@ typedef struct cull_item { double key; uint32_t b; } cull_item;
 #define RENDER_TILE 8           /* shading tiles, pixels a side */
 #define CULL_CELL 64.0          /* m, the culling grid's cells, */
 #define CULL_SIDE 128.0         /* at most this many a side (larger cells over larger scenes) */
+#define CULL_GROUP 8u           /* cells a side of a group of cells, tested first (cull) */
 #define RENDER_TILE_LAMPS 64    /* longest lamp list of a tile */
 #define TILE_PX (RENDER_TILE * RENDER_TILE)
 #define IND_STEP 4              /* sparse indirect: corners every IND_STEP pixels */
@@ -82,6 +83,12 @@ struct render {
     uint32_t *cell_start;       /* ncell + 1 offsets into cell_bld */
     uint32_t *cell_bld;         /* nbld building indices, cell by cell, ascending */
     double *cell_box;           /* 6 a cell: minx, miny, minz, maxx, maxy, maxz */
+    /* the cells by groups of CULL_GROUP x CULL_GROUP, each with the box of
+     * its cells' boxes: a group wholly outside the frustum culls its cells
+     * without testing them */
+    uint32_t cside, gside;      /* cells and groups a side */
+    double *group_box;          /* 6 a group, as cell_box */
+    uint8_t *group_out;         /* gside^2: this frame's groups out of the frustum (cull) */
     cull_item *trav;            /* nbld + ncell: the occlusion pass's heap */
     uint32_t ntrav;
     double *bins;               /* RENDER_BINS */
@@ -171,6 +178,7 @@ size_t render_bytes(const scene *s, int32_t max_w, int32_t max_h)
     size_t corners = (size_t)(max_w / IND_STEP + 2) * (size_t)(max_h / IND_STEP + 2);
     return px * 20 + tiles + (size_t)s->nbld * (2 * sizeof(cull_item) + 29) +
            (size_t)CULL_SIDE * CULL_SIDE * (6 * sizeof(double) + 4 + sizeof(cull_item)) + RENDER_BINS * 8 +
+           (size_t)(CULL_SIDE / CULL_GROUP + 1) * (CULL_SIDE / CULL_GROUP + 1) * (6 * sizeof(double) + 1) + 16 +
            sizeof(tonemap_table) + 8 + sizeof(exposure_table) + 8 +
            corners * (1 + 3 * sizeof(float)) + 2 * (size_t)(max_w / IND_STEP + 2) * sizeof(corner_hit) + render_surf_slots(s, max_w, max_h) * (sizeof(uint32_t) + sizeof(mesh_surf)) +
            stop_rows(max_h) * sizeof(int32_t) + arena_mul((size_t)s->nlamps + 1, sizeof(uint32_t)) + 64 +
@@ -336,8 +344,25 @@ static uint32_t cull_cell_of(const scene_building *bd, double x0, double y0, dou
     return bucketgrid_index(cy, y0, 1.0 / cell, n) * n + bucketgrid_index(cx, x0, 1.0 / cell, n);
 }
 
+/* Box bx (minx, miny, minz, maxx, maxy, maxz) grown to hold box bb. */
+static void box_grow(double *bx, const double *bb)
+{
+    int q;
+    for (q = 0; q < 3; q++) {
+        bx[q] = fmin(bx[q], bb[q]);
+        bx[3 + q] = fmax(bx[3 + q], bb[3 + q]);
+    }
+}
+
+/* The group of cells cell c lies in. */
+static uint32_t cell_group(const render *r, uint32_t c)
+{
+    return (c / r->cside / CULL_GROUP) * r->gside + (c % r->cside) / CULL_GROUP;
+}
+
 /* Fills the culling grid (its arrays taken already): counts, offsets,
- * the buildings in index order within each cell, the cells' boxes. */
+ * the buildings in index order within each cell, the cells' boxes and
+ * the groups'. */
 static void cull_grid_fill(render *r)
 {
     const scene *s = r->s;
@@ -361,14 +386,18 @@ static void cull_grid_fill(render *r)
         bx[3] = bx[4] = bx[5] = -HUGE_VAL;
         for (k = r->cell_start[c]; k < r->cell_start[c + 1]; k++) {
             double bb[6];
-            int q;
             mesh_box(r->m, r->cell_bld[k], bb);
-            for (q = 0; q < 3; q++) {
-                bx[q] = fmin(bx[q], bb[q]);
-                bx[3 + q] = fmax(bx[3 + q], bb[3 + q]);
-            }
+            box_grow(bx, bb);
         }
     }
+    for (c = 0; c < (size_t)r->gside * r->gside; c++) {
+        double *gb = &r->group_box[6 * (size_t)c];
+        gb[0] = gb[1] = gb[2] = HUGE_VAL;
+        gb[3] = gb[4] = gb[5] = -HUGE_VAL;
+    }
+    for (c = 0; c < r->ncell; c++)
+        if (r->cell_start[c + 1] > r->cell_start[c])
+            box_grow(&r->group_box[6 * (size_t)cell_group(r, c)], &r->cell_box[6 * (size_t)c]);
 }
 
 plx_status render_create(arena *a, const scene *s, int32_t max_w, int32_t max_h,
@@ -420,6 +449,11 @@ plx_status render_create(arena *a, const scene *s, int32_t max_w, int32_t max_h,
         double x0, y0, cell;
         uint32_t n = cull_side(s, &x0, &y0, &cell);
         r->ncell = n * n;
+        r->cside = n;
+        r->gside = (n + CULL_GROUP - 1) / CULL_GROUP;
+        r->group_box = arena_alloc(a, PLX_PART_FRAME, arena_mul((size_t)r->gside * r->gside, 6 * sizeof(double)),
+                                   R_ALIGN);
+        r->group_out = arena_alloc(a, PLX_PART_FRAME, (size_t)r->gside * r->gside, R_ALIGN);
         r->cell_start = arena_alloc(a, PLX_PART_FRAME, arena_mul(r->ncell + 1, sizeof(uint32_t)), R_ALIGN);
         r->cell_bld = arena_alloc(a, PLX_PART_FRAME, arena_mul(s->nbld + 1, sizeof(uint32_t)), R_ALIGN);
         r->cell_box = arena_alloc(a, PLX_PART_FRAME, arena_mul(r->ncell, 6 * sizeof(double)), R_ALIGN);
@@ -429,7 +463,7 @@ plx_status render_create(arena *a, const scene *s, int32_t max_w, int32_t max_h,
     if (!r->depth || !r->id || !r->lin || !r->vbuf || !r->pv || !r->clip || !r->gxyz || !r->gtri || !r->sc_id || !r->sc ||
         !r->heap || !r->wmin ||
         !r->wmax || !r->draw || !r->glamp || !r->bins || !r->cell_start || !r->cell_bld || !r->cell_box ||
-        !r->trav) {
+        !r->trav || !r->group_box || !r->group_out) {
         arena_release(a, &m0);
         return PLX_E_NOMEM;
     }
@@ -490,6 +524,7 @@ void render_frame_clear(render *r)
     memset(r->yr, 0, nb * 2 * sizeof *r->yr);
     memset(r->bins, 0, RENDER_BINS * sizeof *r->bins);
     memset(r->trav, 0, (nb + r->ncell) * sizeof *r->trav);
+    memset(r->group_out, 0, (size_t)r->gside * r->gside);
     memset(r->defer, 0, tiles);
     memset(r->blk, 0, corners);
     memset(r->ind, 0, corners * 3 * sizeof *r->ind);
@@ -992,9 +1027,18 @@ static void box_clip(const render *r, const double *bx, double c[8][4])
         for (q = 0; q < 4; q++)
             e[a][q] = t[q] - c[0][q];
     }
-    for (k = 1; k < 8; k++)
+    /* corner k is corner k & ~4 (or k & ~2) plus one edge: the sums
+     * c[0] + e[0] + e[1] + e[2] in that order, the absent edges left out
+     * (adding +0.0 would change only a -0.0; corners are compared, and
+     * divided by a w of at least near, where -0.0 acts as +0.0) */
+    for (q = 0; q < 4; q++) {
+        c[1][q] = c[0][q] + e[0][q];
+        c[2][q] = c[0][q] + e[1][q];
+        c[3][q] = c[1][q] + e[1][q];
+    }
+    for (k = 0; k < 4; k++)
         for (q = 0; q < 4; q++)
-            c[k][q] = c[0][q] + ((k & 1) ? e[0][q] : 0.0) + ((k & 2) ? e[1][q] : 0.0) + ((k & 4) ? e[2][q] : 0.0);
+            c[4 + k][q] = c[k][q] + e[2][q];
 }
 
 /* Whether every corner c of a box (box_clip) lies beyond one side plane of the
@@ -1132,6 +1176,10 @@ static void cull_cells(render *r, int mode, int rows, uint32_t c0, uint32_t c1, 
         double corner[8][4], wmn, wmx, key;
         if (r->cell_start[c + 1] == r->cell_start[c])
             continue;
+        if (r->group_out[cell_group(r, c)]) {
+            cell_draw(r, c, 0, st);
+            continue;
+        }
         box_clip(r, &r->cell_box[6 * (size_t)c], corner);
         if ((mode & RENDER_CULL_FRUSTUM) && corners_out(r, corner, &wmn, &wmx, 1, NULL))
             cell_draw(r, c, 0, st);
@@ -1140,6 +1188,20 @@ static void cull_cells(render *r, int mode, int rows, uint32_t c0, uint32_t c1, 
         else
             for (k = r->cell_start[c]; k < r->cell_start[c + 1]; k++)
                 (void)cull_building(r, mode, r->cell_bld[k], st, &key);
+    }
+}
+
+/* This frame's groups of cells wholly out of the frustum (group_out), by
+ * box_out with the tolerance of the whole box: each cell's box lies in
+ * its group's, so its own test would cull it too. An empty group (no
+ * box) is not out: its cells are empty and skipped. */
+static void groups_out(render *r, int mode)
+{
+    uint32_t g, n = r->gside * r->gside;
+    for (g = 0; g < n; g++) {
+        const double *gb = &r->group_box[6 * (size_t)g];
+        double wmn, wmx;
+        r->group_out[g] = (mode & RENDER_CULL_FRUSTUM) && gb[0] <= gb[3] && box_out(r, gb, &wmn, &wmx, 1, NULL);
     }
 }
 
@@ -1171,6 +1233,7 @@ static void cull(render *r, const render_opts *o, int inside, int rows, render_s
     uint32_t c;
     int mode = o->cull, occl = (mode & RENDER_CULL_OCCLUSION) && !inside && occlusion_pays(r);
     occlusion_start(r);
+    groups_out(r, mode);
     if (!occl) {
         cull_job jb;
         int k;
@@ -1187,7 +1250,8 @@ static void cull(render *r, const render_opts *o, int inside, int rows, render_s
         double wmn, wmx;
         if (r->cell_start[c + 1] == r->cell_start[c])
             continue;
-        if (box_out(r, &r->cell_box[6 * (size_t)c], &wmn, &wmx, 1, NULL) && (mode & RENDER_CULL_FRUSTUM))
+        if (r->group_out[cell_group(r, c)] ||
+            (box_out(r, &r->cell_box[6 * (size_t)c], &wmn, &wmx, 1, NULL) && (mode & RENDER_CULL_FRUSTUM)))
             cell_draw(r, c, 0, st);
         else
             trav_push(r, fmax(wmn, r->near_), r->m->nbld + c);

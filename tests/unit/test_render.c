@@ -963,6 +963,71 @@ static void test_cull_equal_above_roofs(void **state)
     cull_equal("fixtures/oldtown-8x8.geojson", quick() ? 6 : 16, 25, 24);
 }
 
+/* The groups of culling cells (render.c groups_out: a group out of the
+ * frustum culls its cells untested), over scenes of several groups a
+ * side: eyes anywhere over the scene, at street level looking level to
+ * up (the frame's lower edge cuts walls: a group's tops decide) or above
+ * the roofs looking down, any way round, small frames; the culled ids
+ * must equal the unculled ones. Returns the buildings the frustum culled in all. */
+static uint64_t cull_groups_equal(plx_engine *e, int ncam, uint64_t seed)
+{
+    const scene *s = e->sc;
+    const double *bd = s->bounds;
+    render *r;
+    int w = 40, h = 30, c;
+    size_t px = (size_t)w * h;
+    uint32_t *ids = malloc(px * sizeof *ids);
+    uint64_t culled = 0;
+    assert_int_equal(render_create(&e->mem, s, w, h, pos_shade, NULL, &r), PLX_OK);
+    for (c = 0; c < ncam; c++) {
+        double ang = TWO_PI_T * rng_unit(&seed), pitch = c % 2 ? -0.6 * rng_unit(&seed) : 0.6 * rng_unit(&seed) - 0.1;
+        render_camera cam;
+        render_opts o;
+        render_stats st;
+        cam.eye[0] = bd[0] + (bd[2] - bd[0]) * rng_unit(&seed);
+        cam.eye[1] = bd[1] + (bd[3] - bd[1]) * rng_unit(&seed);
+        cam.eye[2] = c % 2 ? 20.0 + 200.0 * rng_unit(&seed) : 1.5 + 0.5 * rng_unit(&seed);
+        cam.target[0] = cam.eye[0] + 100 * cos(ang);
+        cam.target[1] = cam.eye[1] + 100 * sin(ang);
+        cam.target[2] = cam.eye[2] + 100 * pitch;
+        cam.fov_deg = 10 + 100 * rng_unit(&seed);
+        cam.width = w;
+        cam.height = h;
+        render_opts_default(&o);
+        o.cull = RENDER_CULL_NONE;
+        assert_int_equal(render_frame(r, &cam, &o, NULL, NULL, NULL), PLX_OK);
+        memcpy(ids, render_ids(r), px * sizeof *ids);
+        o.cull = RENDER_CULL_ALL;
+        assert_int_equal(render_frame(r, &cam, &o, NULL, NULL, &st), PLX_OK);
+        if (memcmp(ids, render_ids(r), px * sizeof *ids) != 0)
+            fail_msg("camera %d: eye (%.3f, %.3f, %.3f) target (%.3f, %.3f, %.3f) fov %.2f: culled ids differ",
+                     c, cam.eye[0], cam.eye[1], cam.eye[2], cam.target[0], cam.target[1], cam.target[2],
+                     cam.fov_deg);
+        culled += st.frustum_culled;
+    }
+    free(ids);
+    return culled;
+}
+
+static void test_cull_groups(void **state)
+{
+    fixture_city t;
+    void *mem;
+    plx_engine *e;
+    int n = quick() ? 60 : 400;
+    (void)state;
+    fixture_gen("eixample", 12, 12, 7, &t); /* about 1.6 km a side: 4 groups a side */
+    e = fixture_text(t.buf, MEM, 0, &mem);
+    assert_true(cull_groups_equal(e, n, 31) > 0);
+    plx_engine_destroy(e);
+    free(mem);
+    free(t.buf);
+    e = open_scene("fixtures/helsinki-centre.geojson", &mem); /* 28 cells, 4 groups a side */
+    assert_true(cull_groups_equal(e, n, 32) > 0);
+    plx_engine_destroy(e);
+    free(mem);
+}
+
 /* Eyes above twice the tallest top, where the occlusion test is skipped
  * (render.c occlusion_pays): the image is still the unculled one. */
 static void test_cull_equal_high(void **state)
@@ -1806,6 +1871,7 @@ int main(void)
         cmocka_unit_test(test_cull_equal_street),
         cmocka_unit_test(test_cull_equal_above_roofs),
         cmocka_unit_test(test_cull_equal_high),
+        cmocka_unit_test(test_cull_groups),
         cmocka_unit_test(test_cull_over_low_roof),
         cmocka_unit_test(test_cull_kept_edge),
         cmocka_unit_test(test_far_plane_follows_eye),
