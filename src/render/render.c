@@ -51,6 +51,13 @@ typedef struct corner_hit {
     int hit;
 } corner_hit;
 
+/* A glow disc seen in a frame (glow_disc): centre x, y and radius in
+ * pixels, and its lamp. */
+typedef struct glow_seen {
+    double g[3];
+    uint32_t lamp;
+} glow_seen;
+
 struct render {
     arena *a;
     const scene *s;
@@ -113,6 +120,9 @@ struct render {
                                    sample point within the pixel may draw (glow_candidates) */
     uint32_t nglamp;
     int glamp_ok;               /* glamp holds them for this frame's camera */
+    glow_seen *gseen;          /* nlamps + 1: the glow discs of the last frame drawn (glow_discs) */
+    uint32_t ngseen;
+    int gseen_ok;               /* gseen holds them */
     /* shading by tiles */
     light *lt;                  /* the light module when shade is render_shade_light */
     shade_ws ws[RENDER_MAX_WORKERS];  /* one per worker of the shading pass */
@@ -182,6 +192,7 @@ size_t render_bytes(const scene *s, int32_t max_w, int32_t max_h)
            sizeof(tonemap_table) + 8 + sizeof(exposure_table) + 8 +
            corners * (1 + 3 * sizeof(float)) + 2 * (size_t)(max_w / IND_STEP + 2) * sizeof(corner_hit) + render_surf_slots(s, max_w, max_h) * (sizeof(uint32_t) + sizeof(mesh_surf)) +
            stop_rows(max_h) * sizeof(int32_t) + arena_mul((size_t)s->nlamps + 1, sizeof(uint32_t)) + 64 +
+           arena_mul((size_t)s->nlamps + 1, sizeof(glow_seen)) + 16 +
            sizeof(render) + 4096;
 }
 
@@ -444,6 +455,7 @@ plx_status render_create(arena *a, const scene *s, int32_t max_w, int32_t max_h,
     r->wmax = arena_alloc(a, PLX_PART_FRAME, arena_mul(s->nbld + 1, sizeof(double)), R_ALIGN);
     r->draw = arena_alloc(a, PLX_PART_FRAME, s->nbld + 1, R_ALIGN);
     r->glamp = arena_alloc(a, PLX_PART_FRAME, arena_mul((size_t)s->nlamps + 1, sizeof(uint32_t)), R_ALIGN);
+    r->gseen = arena_alloc(a, PLX_PART_FRAME, arena_mul((size_t)s->nlamps + 1, sizeof(glow_seen)), R_ALIGN);
     r->bins = arena_alloc(a, PLX_PART_FRAME, RENDER_BINS * sizeof(double), R_ALIGN);
     {
         double x0, y0, cell;
@@ -463,7 +475,7 @@ plx_status render_create(arena *a, const scene *s, int32_t max_w, int32_t max_h,
     if (!r->depth || !r->id || !r->lin || !r->vbuf || !r->pv || !r->clip || !r->gxyz || !r->gtri || !r->sc_id || !r->sc ||
         !r->heap || !r->wmin ||
         !r->wmax || !r->draw || !r->glamp || !r->bins || !r->cell_start || !r->cell_bld || !r->cell_box ||
-        !r->trav || !r->group_box || !r->group_out) {
+        !r->trav || !r->group_box || !r->group_out || !r->gseen) {
         arena_release(a, &m0);
         return PLX_E_NOMEM;
     }
@@ -563,6 +575,9 @@ void render_frame_clear(render *r)
     memset(r->glamp, 0, ((size_t)s->nlamps + 1) * sizeof *r->glamp);
     r->nglamp = 0;
     r->glamp_ok = 0;
+    memset(r->gseen, 0, ((size_t)s->nlamps + 1) * sizeof *r->gseen);
+    r->ngseen = 0;
+    r->gseen_ok = 0;
     r->nbx = r->nby = 0;
     r->sparse = 0;
 }
@@ -2443,10 +2458,9 @@ static void shade_pass(render *r, const render_opts *o, render_stats *st)
     }
 }
 
-/* Lamp lp's glow disc: centre (px, py), radius rad in pixels and the
- * pixels box[4] (x0, y0, x1, y1) it may touch, when the lamp is in front of
- * the eye, inside the frame and not hidden at its own pixel (the depth
- * buffer); else 0. */
+/* Lamp lp's glow disc g: centre (px, py) and radius rad in pixels, when
+ * the lamp is in front of the eye, inside the frame and not hidden at its
+ * own pixel (the depth buffer); else 0. */
 /* A lit lamp's centre in front of the near plane: its clip coordinates c
  * and its place (px, py) in pixels of this sample point; 0 otherwise. */
 static int lamp_centre(const render *r, const scene_lamp *lp, double c[4], double *px, double *py)
@@ -2463,7 +2477,7 @@ static int lamp_centre(const render *r, const scene_lamp *lp, double c[4], doubl
     return 1;
 }
 
-static int glow_disc(const render *r, const scene_lamp *lp, double g[3], int32_t box[4])
+static int glow_disc(const render *r, const scene_lamp *lp, double g[3])
 {
     double c[4], px, py, rad;
     size_t p;
@@ -2481,15 +2495,20 @@ static int glow_disc(const render *r, const scene_lamp *lp, double g[3], int32_t
     g[0] = px;
     g[1] = py;
     g[2] = rad;
-    box[0] = (int32_t)floor(px - rad);
-    box[2] = (int32_t)ceil(px + rad);
-    box[1] = (int32_t)floor(py - rad);
-    box[3] = (int32_t)ceil(py + rad);
+    return 1;
+}
+
+/* The pixels box[4] (x0, y0, x1, y1) glow disc g may touch. */
+static void glow_box(const render *r, const double g[3], int32_t box[4])
+{
+    box[0] = (int32_t)floor(g[0] - g[2]);
+    box[2] = (int32_t)ceil(g[0] + g[2]);
+    box[1] = (int32_t)floor(g[1] - g[2]);
+    box[3] = (int32_t)ceil(g[1] + g[2]);
     if (box[0] < 0) box[0] = 0;
     if (box[1] < 0) box[1] = 0;
     if (box[2] > r->w - 1) box[2] = r->w - 1;
     if (box[3] > r->h - 1) box[3] = r->h - 1;
-    return 1;
 }
 
 /* Pixel (x, y)'s place in glow disc g: (d / rad)^2, 1 or more outside. */
@@ -2531,16 +2550,34 @@ static uint32_t glow_lamp(const render *r, uint32_t k)
     return r->glamp_ok ? r->glamp[k] : k;
 }
 
+/* The glow discs of the last frame drawn (its camera and depth buffer),
+ * of the lamps glow_count and glow_lamp give, in their order: found once
+ * for glows and glow_mark, which both go through them. */
+static void glow_discs(render *r)
+{
+    uint32_t k, n = glow_count(r);
+    if (r->gseen_ok)
+        return;
+    r->ngseen = 0;
+    for (k = 0; k < n; k++) {
+        glow_seen *v = &r->gseen[r->ngseen];
+        v->lamp = glow_lamp(r, k);
+        r->ngseen += (uint32_t)glow_disc(r, &r->s->lamps[v->lamp], v->g);
+    }
+    r->gseen_ok = 1;
+}
+
 static void glows(render *r, const render_opts *o, render_stats *st)
 {
     const scene *s = r->s;
-    uint32_t q0, n = glow_count(r);
-    for (q0 = 0; q0 < n; q0++) {
-        const scene_lamp *lp = &s->lamps[glow_lamp(r, q0)];
-        double g[3], peak;
+    uint32_t q0;
+    glow_discs(r);
+    for (q0 = 0; q0 < r->ngseen; q0++) {
+        const scene_lamp *lp = &s->lamps[r->gseen[q0].lamp];
+        const double *g = r->gseen[q0].g;
+        double peak;
         int32_t b[4], x, y;
-        if (!glow_disc(r, lp, g, b))
-            continue;
+        glow_box(r, g, b);
         st->glows++;
         peak = lp->intensity / 250.0;
         for (y = b[1]; y <= b[3]; y++)
@@ -2562,15 +2599,15 @@ static void glows(render *r, const render_opts *o, render_stats *st)
 /* Marks in mask the pixels of every glow disc seen in this frame (an
  * unmarked pixel's byte set to nw, a marked one's kept); returns how many
  * were not marked before. */
-static size_t glow_mark(const render *r, uint8_t *mask, uint8_t nw)
+static size_t glow_mark(render *r, uint8_t *mask, uint8_t nw)
 {
-    uint32_t k, n = glow_count(r);
+    uint32_t k;
     size_t added = 0;
-    for (k = 0; k < n; k++) {
-        double g[3];
+    glow_discs(r);
+    for (k = 0; k < r->ngseen; k++) {
+        const double *g = r->gseen[k].g;
         int32_t b[4], x, y;
-        if (!glow_disc(r, &r->s->lamps[glow_lamp(r, k)], g, b))
-            continue;
+        glow_box(r, g, b);
         for (y = b[1]; y <= b[3]; y++)
             for (x = b[0]; x <= b[2]; x++)
                 if (glow_q(g, x, y) < 1.0) {
@@ -3270,6 +3307,7 @@ plx_status render_frame(render *r, const render_camera *cam, const render_opts *
         render_opts_default(&def);
         o = &def;
     }
+    r->gseen_ok = 0; /* the glow discs are the frame's (glow_discs) */
     if (!setup_camera(r, cam, o))
         return PLX_E_INVALID;
     memset(&st, 0, sizeof st);
