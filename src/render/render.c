@@ -3017,7 +3017,7 @@ static unsigned pair_bits(const uint8_t *c, const uint8_t *n, const uint32_t *ic
 static void pair_bits_chunk(const uint8_t *restrict c, const uint8_t *restrict n, const uint32_t *restrict ic,
                             const uint32_t *restrict in, uint8_t level, uint8_t *restrict bt)
 {
-    uint8_t f[3 * MASK_CHUNK];
+    uint8_t f[3 * MASK_CHUNK + 2], g[3 * MASK_CHUNK];
     int k;
     for (k = 0; k < 3 * MASK_CHUNK; k++) {
         uint8_t a = c[k];
@@ -3028,8 +3028,11 @@ static void pair_bits_chunk(const uint8_t *restrict c, const uint8_t *restrict n
         uint32_t x = ic[k];
         bt[k] = (uint8_t)((x != ic[k + 1]) | (x != in[k]) << 1 | (x != in[k + 1]) << 2 | (x != in[k - 1]) << 3);
     }
+    f[3 * MASK_CHUNK] = f[3 * MASK_CHUNK + 1] = 0;
+    for (k = 0; k < 3 * MASK_CHUNK; k++) /* each byte's with the next two: one read a pixel below */
+        g[k] = (uint8_t)(f[k] | f[k + 1] | f[k + 2]);
     for (k = 0; k < MASK_CHUNK; k++)
-        bt[k] |= (uint8_t)(f[3 * k] | f[3 * k + 1] | f[3 * k + 2]);
+        bt[k] |= g[3 * k];
 }
 
 /* Rows of job k: for each pixel, which of the pairs it starts (right,
