@@ -116,6 +116,8 @@ struct render {
     double kept_key[16];
     int kept_inside;
     uint32_t kept_frustum, kept_occlusion;
+    int bg_fill;                /* this frame's built-in rasteriser starts each row of ids at its
+                                   background (row_background), for ground_ids to skip */
     uint32_t *glamp;            /* nlamps + 1: with the kept culling, the lamps whose glow a
                                    sample point within the pixel may draw (glow_candidates) */
     uint32_t nglamp;
@@ -254,6 +256,52 @@ static int frag_id(void *user, int32_t x, int32_t y, float depth, const float *a
     return 1;
 }
 
+#define GROUND_LANES 16
+static void pixel_dir(const render *r, int32_t i, int32_t j, double d[3]);
+
+/* Row j's id where nothing is drawn: the ground's when the row looks
+ * below the horizon, else none (sky). The camera's right vector is
+ * horizontal (setup_camera: rt[2] = 0), so a pixel's direction has the
+ * same height along a row, bit for bit: one pixel_dir a row decides it,
+ * as pixel_hit decides it for each pixel. */
+static uint32_t row_background(const render *r, int32_t j)
+{
+    double d[3];
+    PLX_ASSERT(r->rt[2] == 0.0);
+    pixel_dir(r, 0, j, d);
+#ifdef PLX_DEBUG
+    {
+        int32_t i;
+        for (i = 0; i < r->w; i++) {
+            double di[3];
+            pixel_dir(r, i, j, di);
+            PLX_ASSERT((di[2] < 0.0) == (d[2] < 0.0));
+        }
+    }
+#endif
+    return d[2] < 0.0 ? MESH_SURF_GROUND : MESH_SURF_NONE;
+}
+
+/* Rows y0 .. y1 - 1 of the ids before drawing: none, or with bg_fill
+ * each row's background (the ids ground_ids would give the pixels left
+ * undrawn). */
+static void ids_start(render *r, int32_t y0, int32_t y1)
+{
+    int32_t y, i, k, w = r->w;
+    for (y = y0; y < y1; y++) {
+        uint32_t *id = &r->id[(size_t)y * (size_t)w], v = r->bg_fill ? row_background(r, y) : MESH_SURF_NONE;
+        if (v == MESH_SURF_NONE) {
+            memset(id, 0, (size_t)w * sizeof *id);
+            continue;
+        }
+        for (i = 0; i + GROUND_LANES <= w; i += GROUND_LANES) /* loops of fixed length: GCC vectorises them */
+            for (k = 0; k < GROUND_LANES; k++)
+                id[i + k] = v;
+        for (; i < w; i++)
+            id[i] = v;
+    }
+}
+
 static int soft_begin(void *user, int32_t w, int32_t h, int cull_back)
 {
     render *r = user;
@@ -266,7 +314,7 @@ static int soft_begin(void *user, int32_t w, int32_t h, int cull_back)
     tg.depth = r->depth;
     if (raster_init(&r->rc, &tg, NULL) != PLX_OK)
         return -1;
-    memset(r->id, 0, (size_t)w * (size_t)h * sizeof *r->id);
+    ids_start(r, 0, h);
     raster_clear_depth(&r->rc, 1.0f);
     raster_set_fragment(&r->rc, frag_id, r, 0);
     raster_set_cull(&r->rc, cull_back ? RASTER_CULL_BACK : RASTER_CULL_NONE);
@@ -573,6 +621,7 @@ void render_frame_clear(render *r)
     memset(r->kept_key, 0, sizeof r->kept_key);
     r->kept_frustum = r->kept_occlusion = 0;
     memset(r->glamp, 0, ((size_t)s->nlamps + 1) * sizeof *r->glamp);
+    r->bg_fill = 0;
     r->nglamp = 0;
     r->glamp_ok = 0;
     memset(r->gseen, 0, ((size_t)s->nlamps + 1) * sizeof *r->gseen);
@@ -1333,9 +1382,9 @@ static void band_rows(void *arg, int worker, uint32_t k)
     raster_set_fragment(&bd->rc, band_frag, bd, 0);
     raster_set_cull(&bd->rc, jb->cull_back ? RASTER_CULL_BACK : RASTER_CULL_NONE);
     raster_set_scissor(&bd->rc, 0, y0, r->w, y1);
+    ids_start(r, y0, y1);
     for (y = y0; y < y1; y++) {
         size_t p0 = (size_t)y * (size_t)r->w, i;
-        memset(&r->id[p0], 0, (size_t)r->w * sizeof *r->id);
         for (i = 0; i < (size_t)r->w; i++)
             r->depth[p0 + i] = 1.0f;
     }
@@ -2066,7 +2115,6 @@ static void corners_rest(render *r, const render_opts *o, render_stats *st)
 }
 
 /* The ids of GROUND_LANES pixels: the ground's where none (sky). */
-#define GROUND_LANES 16
 static void ground_lanes(uint32_t *restrict id)
 {
     int k;
@@ -2075,24 +2123,13 @@ static void ground_lanes(uint32_t *restrict id)
 }
 
 /* Pixel row j's ground pixels get the ground's id (pixel_hit writes it;
- * each pixel on its own). The camera's right vector is horizontal
- * (setup_camera: rt[2] = 0), so a pixel's direction has the same height
- * along a row, bit for bit: one pixel_dir a row decides it. */
+ * each pixel on its own), when the row looks below the horizon
+ * (row_background). */
 static void ground_row(render *r, int32_t j)
 {
     uint32_t *id = &r->id[(size_t)j * (size_t)r->w];
-    double d[3];
     int32_t i;
-    PLX_ASSERT(r->rt[2] == 0.0);
-    pixel_dir(r, 0, j, d); /* as pixel_hit decides, for every pixel of the row */
-#ifdef PLX_DEBUG
-    for (i = 0; i < r->w; i++) {
-        double di[3];
-        pixel_dir(r, i, j, di);
-        PLX_ASSERT((di[2] < 0.0) == (d[2] < 0.0));
-    }
-#endif
-    if (!(d[2] < 0.0))
+    if (row_background(r, j) != MESH_SURF_GROUND)
         return;
     for (i = 0; i + GROUND_LANES <= r->w; i += GROUND_LANES) /* a loop of fixed length: GCC vectorises it */
         ground_lanes(id + i);
@@ -2110,9 +2147,12 @@ static void ground_rows(void *arg, int worker, uint32_t k)
         ground_row(r, j);
 }
 
-/* Every row's ground pixels, rows on the workers (each row on its own). */
+/* Every row's ground pixels, rows on the workers (each row on its own);
+ * nothing to do when the rows started at their background (bg_fill). */
 static void ground_ids(render *r, const render_opts *o)
 {
+    if (r->bg_fill)
+        return;
     run_jobs(o, (uint32_t)((r->h + RENDER_TILE - 1) / RENDER_TILE), ground_rows, r);
 }
 
@@ -3323,6 +3363,8 @@ plx_status render_frame(render *r, const render_camera *cam, const render_opts *
         return PLX_E_INVALID;
     }
     bands = be == &r->soft && r->band && par_workers(o) >= 2;
+    /* atlas frames from the built-in rasteriser: the ground's ids as the rows start */
+    r->bg_fill = be == &r->soft && o->atlas != NULL;
     kept = kept_culling(r, o, bands, &inside);
     st.eye_inside = inside;
     if (bands) {

@@ -1660,6 +1660,12 @@ static int expect_px(const atlas *A, const cam3 *cm, int32_t i, int32_t j, uint3
         out[k] = 0.0;
         tol[k] = 0.0;
     }
+    /* nothing drawn: sky where the ray does not go down, ground where it
+     * does (beyond rounding at the horizon) */
+    if ((sid == MESH_SURF_NONE && d[2] < -1e-9) || (sid == MESH_SURF_GROUND && d[2] > 1e-9)) {
+        printf("  pixel (%d, %d): %s, its ray's height %.9g\n", i, j, sid ? "ground" : "sky", d[2]);
+        fail();
+    }
     if (sid == MESH_SURF_NONE) {
         t->sky++;
         return 1;
