@@ -728,11 +728,13 @@ static int setup_camera(render *r, const render_camera *c, const render_opts *o)
         double hy = fmax(fabs(b[1] - c->eye[1]), fabs(b[3] - c->eye[1]));
         double hz = fmax(fabs(c->eye[2]), fabs(r->s->height_max - c->eye[2]));
         uint32_t i;
-        for (i = 0; i < r->s->nlamps; i++) {
+        for (i = 0; i < r->s->nlamps; i++) { /* fmax's values, without a call a lamp (none is NaN) */
             const scene_lamp *l = &r->s->lamps[i];
-            hx = fmax(hx, fabs(l->x - c->eye[0]) + l->radius);
-            hy = fmax(hy, fabs(l->y - c->eye[1]) + l->radius);
-            hz = fmax(hz, fabs(l->z - c->eye[2]) + l->radius);
+            double ax = fabs(l->x - c->eye[0]) + l->radius, ay = fabs(l->y - c->eye[1]) + l->radius;
+            double az = fabs(l->z - c->eye[2]) + l->radius;
+            hx = ax > hx ? ax : hx;
+            hy = ay > hy ? ay : hy;
+            hz = az > hz ? az : hz;
         }
         t = sqrt(hx * hx + hy * hy + hz * hz);
         r->far_ = 2.0 * t + 10.0 * o->near + 1.0;
@@ -2863,23 +2865,25 @@ static size_t job_end(size_t k, size_t px)
 static void add_marked_chunk(void *arg, int worker, uint32_t k)
 {
     const marked_job *jb = arg;
+    float *restrict s = jb->sum;
+    const float *restrict lin = jb->lin;
+    uint8_t *mask = jb->mask;
     size_t p1 = job_end(k, jb->px), i, e, q;
     (void)worker;
-    for (i = byte_next(jb->mask, (size_t)k * KEPT_PIXELS, p1, 1); i < p1; i = byte_next(jb->mask, e, p1, 1)) {
-        float *s = jb->sum;
-        e = byte_next(jb->mask, i, p1, 0);
+    for (i = byte_next(mask, (size_t)k * KEPT_PIXELS, p1, 1); i < p1; i = byte_next(mask, e, p1, 1)) {
+        e = byte_next(mask, i, p1, 0);
         for (q = i; q < e; q++)
-            if (jb->mask[q] == 2) { /* newly marked: the samples before added its first value */
+            if (mask[q] == 2) { /* newly marked: the samples before added its first value */
                 int c, t;
                 for (c = 0; c < 3; c++) {
                     float v = s[3 * q + (size_t)c];
                     for (t = 0; t < jb->before; t++)
                         s[3 * q + (size_t)c] += v;
                 }
-                jb->mask[q] = 1;
+                mask[q] = 1;
             }
         for (q = 3 * i; q < 3 * e; q++)
-            s[q] += jb->lin[q];
+            s[q] += lin[q];
     }
 }
 
@@ -3058,21 +3062,23 @@ static void pair_bits_chunk(const uint8_t *restrict c, const uint8_t *restrict n
                             const uint32_t *restrict in, uint8_t level, uint8_t *restrict bt)
 {
     uint8_t f[3 * MASK_CHUNK + 2], g[3 * MASK_CHUNK];
+    uint32_t t[MASK_CHUNK];
     int k;
     for (k = 0; k < 3 * MASK_CHUNK; k++) {
         uint8_t a = c[k];
         f[k] = (uint8_t)(far8(a, c[k + 3], level) | far8(a, n[k], level) << 1 | far8(a, n[k + 3], level) << 2 |
                          far8(a, n[k - 3], level) << 3);
     }
-    for (k = 0; k < MASK_CHUNK; k++) {
+    for (k = 0; k < MASK_CHUNK; k++) { /* in 32-bit lanes, narrowed once below */
         uint32_t x = ic[k];
-        bt[k] = (uint8_t)((x != ic[k + 1]) | (x != in[k]) << 1 | (x != in[k + 1]) << 2 | (x != in[k - 1]) << 3);
+        t[k] = (uint32_t)(x != ic[k + 1]) | (uint32_t)(x != in[k]) << 1 | (uint32_t)(x != in[k + 1]) << 2 |
+               (uint32_t)(x != in[k - 1]) << 3;
     }
     f[3 * MASK_CHUNK] = f[3 * MASK_CHUNK + 1] = 0;
     for (k = 0; k < 3 * MASK_CHUNK; k++) /* each byte's with the next two: one read a pixel below */
         g[k] = (uint8_t)(f[k] | f[k + 1] | f[k + 2]);
     for (k = 0; k < MASK_CHUNK; k++)
-        bt[k] |= g[3 * k];
+        bt[k] = (uint8_t)(t[k] | g[3 * k]);
 }
 
 /* Rows of job k: for each pixel, which of the pairs it starts (right,
