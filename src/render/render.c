@@ -728,7 +728,9 @@ static int setup_camera(render *r, const render_camera *c, const render_opts *o)
         double hy = fmax(fabs(b[1] - c->eye[1]), fabs(b[3] - c->eye[1]));
         double hz = fmax(fabs(c->eye[2]), fabs(r->s->height_max - c->eye[2]));
         uint32_t i;
-        for (i = 0; i < r->s->nlamps; i++) { /* fmax's values, without a call a lamp (none is NaN) */
+        /* fmax's values without a call a lamp: a NaN is not above, and
+         * leaves the maximum as fmax does */
+        for (i = 0; i < r->s->nlamps; i++) {
             const scene_lamp *l = &r->s->lamps[i];
             double ax = fabs(l->x - c->eye[0]) + l->radius, ay = fabs(l->y - c->eye[1]) + l->radius;
             double az = fabs(l->z - c->eye[2]) + l->radius;
