@@ -151,6 +151,9 @@ void tonemap_table_set(tonemap_table *t, const double thr[TONEMAP_LEVELS], doubl
  * there the far values are noticed at no cost to the others. +0 needs no
  * case of its own (its hint is byte 0 and f[0] >= 1). */
 #define FAR_BITS 0x7e7fffffu /* TONEMAP_FAR */
+/* Bits u are above FAR_BITS when negative (bit 31) or when u's other 31
+ * bits plus FAR_GAP reach bit 31 (no carry out: at most 2^31 - 1 + FAR_GAP). */
+#define FAR_GAP (0x7fffffffu - FAR_BITS)
 
 /* The byte of the bits u (at most FAR_BITS) in the single-threshold
  * case: the hint, plus one when u reaches the threshold above it. */
@@ -167,24 +170,24 @@ static inline uint8_t single_byte(const tonemap_table *t, uint32_t u)
 #define TONEMAP_RUN 32
 static int single_run(const tonemap_table *t, const float *lin, size_t p, uint8_t *rgb8)
 {
-    uint32_t u[TONEMAP_RUN], any = 0, far = 0;
+    uint32_t any = 0, far = 0;
     int k;
-    memcpy(u, lin + p, sizeof u);
-    for (k = 0; k < TONEMAP_RUN; k++) {
-        any |= u[k];
-        far |= u[k] > FAR_BITS;
+    for (k = 0; k < TONEMAP_RUN; k++) { /* adds, ors and shifts only: vectorised */
+        uint32_t u = bits_of_float(lin[p + k]);
+        any |= u;
+        far |= ((u & 0x7fffffffu) + FAR_GAP) | u; /* bit 31: above FAR_BITS */
     }
-    if (far)
+    if (far >> 31)
         return 0;
     if (!any) {
         memset(rgb8 + p, 0, TONEMAP_RUN);
         return 1;
     }
     for (k = 0; k < TONEMAP_RUN; k += 4) {
-        rgb8[p + k] = single_byte(t, u[k]);
-        rgb8[p + k + 1] = single_byte(t, u[k + 1]);
-        rgb8[p + k + 2] = single_byte(t, u[k + 2]);
-        rgb8[p + k + 3] = single_byte(t, u[k + 3]);
+        rgb8[p + k] = single_byte(t, bits_of_float(lin[p + k]));
+        rgb8[p + k + 1] = single_byte(t, bits_of_float(lin[p + k + 1]));
+        rgb8[p + k + 2] = single_byte(t, bits_of_float(lin[p + k + 2]));
+        rgb8[p + k + 3] = single_byte(t, bits_of_float(lin[p + k + 3]));
     }
     return 1;
 }

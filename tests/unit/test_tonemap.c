@@ -90,6 +90,16 @@ static void check_exposure(const double *thr, double ex, int curve, int usable)
     add(&b, &t, thr, ex, curve, -INFINITY);
     add(&b, &t, thr, ex, curve, NAN);
     flush(&b, &t, thr, ex, curve);
+    /* the far limit's two sides (FLT_MAX / 4 and the float above it), each
+     * inside a run of 32 ordinary values, alone in its batch */
+    for (d = 0; d < 2; d++) {
+        for (k = 0; k < 40; k++)
+            add(&b, &t, thr, ex, curve, 1.0f);
+        add(&b, &t, thr, ex, curve, float_of_bits(bits_of_float(FLT_MAX / 4.0f) + d));
+        for (k = 0; k < 40; k++)
+            add(&b, &t, thr, ex, curve, 0.5f);
+        flush(&b, &t, thr, ex, curve);
+    }
     assert_true(b.checked > 500000);
     /* far answered both ways: the batches past FLT_MAX / 4 and the last
      * (infinities, NaN), not the others */
