@@ -122,7 +122,7 @@ struct render {
                                    sample point within the pixel may draw (glow_candidates) */
     uint32_t nglamp;
     int glamp_ok;               /* glamp holds them for this frame's camera */
-    glow_seen *gseen;          /* nlamps + 1: the glow discs of the last frame drawn (glow_discs) */
+    glow_seen *gseen;           /* nlamps + 1: the glow discs of the last frame drawn (glow_discs) */
     uint32_t ngseen;
     int gseen_ok;               /* gseen holds them */
     /* shading by tiles */
@@ -2502,9 +2502,6 @@ static void shade_pass(render *r, const render_opts *o, render_stats *st)
     }
 }
 
-/* Lamp lp's glow disc g: centre (px, py) and radius rad in pixels, when
- * the lamp is in front of the eye, inside the frame and not hidden at its
- * own pixel (the depth buffer); else 0. */
 /* A lit lamp's centre in front of the near plane: its clip coordinates c
  * and its place (px, py) in pixels of this sample point; 0 otherwise. */
 static int lamp_centre(const render *r, const scene_lamp *lp, double c[4], double *px, double *py)
@@ -2521,6 +2518,9 @@ static int lamp_centre(const render *r, const scene_lamp *lp, double c[4], doubl
     return 1;
 }
 
+/* Lamp lp's glow disc g: centre (px, py) and radius rad in pixels, when
+ * the lamp is in front of the eye, inside the frame and not hidden at its
+ * own pixel (the depth buffer); else 0. */
 static int glow_disc(const render *r, const scene_lamp *lp, double g[3])
 {
     double c[4], px, py, rad;
