@@ -728,8 +728,9 @@ static int setup_camera(render *r, const render_camera *c, const render_opts *o)
         double hy = fmax(fabs(b[1] - c->eye[1]), fabs(b[3] - c->eye[1]));
         double hz = fmax(fabs(c->eye[2]), fabs(r->s->height_max - c->eye[2]));
         uint32_t i;
-        /* fmax's values without a call a lamp: a NaN is not above, and
-         * leaves the maximum as fmax does */
+        /* fmax's values without a call a lamp: the maximum so far is
+         * finite (the bounds and the eye are), and a NaN, not above it,
+         * leaves it as fmax does */
         for (i = 0; i < r->s->nlamps; i++) {
             const scene_lamp *l = &r->s->lamps[i];
             double ax = fabs(l->x - c->eye[0]) + l->radius, ay = fabs(l->y - c->eye[1]) + l->radius;
@@ -1261,8 +1262,11 @@ static void cull_cells(render *r, int mode, int rows, uint32_t c0, uint32_t c1, 
 
 /* This frame's groups of cells wholly out of the frustum (group_out), by
  * box_out with the tolerance of the whole box: each cell's box lies in
- * its group's, so its own test would cull it too. An empty group (no
- * box) is not out: its cells are empty and skipped. */
+ * its group's, so its own test would cull it too (in real numbers; the
+ * cell's corners, rounded on their own, could fall the other way only
+ * at the margin, where the image is the same and only the counts of
+ * culled buildings could differ). An empty group (no box) is not out:
+ * its cells are empty and skipped. */
 static void groups_out(render *r, int mode)
 {
     uint32_t g, n = r->gside * r->gside;

@@ -406,7 +406,8 @@ int render_tonemap_par(render *r, const float *lin, size_t px, double ex, int cu
  * (newly, render_opts.mask_new) first adds its first value before times,
  * as the samples that left it did, and becomes 1; then every marked
  * pixel adds lin. The same float operations, in the same order, as the
- * dense sums give those pixels. */
+ * dense sums give those pixels. sum and lin must not overlap (they are
+ * restrict-qualified inside). */
 void render_aa_add_marked(const render_opts *o, float *sum, const float *lin, uint8_t *mask, size_t px,
                           int before);
 
