@@ -2508,18 +2508,29 @@ static void shade_pass(render *r, const render_opts *o, render_stats *st)
 
 /* A lit lamp's centre in front of the near plane: its clip coordinates c
  * and its place (px, py) in pixels of this sample point; 0 otherwise. */
-static int lamp_centre(const render *r, const scene_lamp *lp, double c[4], double *px, double *py)
+static void lamp_clip(const render *r, const scene_lamp *lp, double c[4])
 {
     double X[3];
     X[0] = lp->x;
     X[1] = lp->y;
     X[2] = lp->z;
     to_clip(r, X, c);
+}
+
+/* lamp_centre from the lamp's clip coordinates c (lamp_clip). */
+static int centre_of(const render *r, const scene_lamp *lp, const double c[4], double *px, double *py)
+{
     if (!(c[3] > r->near_) || !(lp->intensity > 0))
         return 0;
     *px = (c[0] / c[3] + 1.0) * 0.5 * r->w;
     *py = (1.0 - c[1] / c[3]) * 0.5 * r->h;
     return 1;
+}
+
+static int lamp_centre(const render *r, const scene_lamp *lp, double c[4], double *px, double *py)
+{
+    lamp_clip(r, lp, c);
+    return centre_of(r, lp, c, px, py);
 }
 
 /* Lamp lp's glow disc g: centre (px, py) and radius rad in pixels, when
@@ -2532,14 +2543,14 @@ static int glow_disc(const render *r, const scene_lamp *lp, double g[3])
     float dz;
     if (!lamp_centre(r, lp, c, &px, &py))
         return 0;
-    rad = 0.3 * r->sy * 0.5 * r->h / c[3];
-    rad = fmin(fmax(rad, 1.5), 48.0);
     if (!(px >= 0 && py >= 0 && px < r->w && py < r->h))
         return 0;
     p = (size_t)(int32_t)py * (size_t)r->w + (size_t)(int32_t)px;
     dz = (float)((r->za * c[3] + r->zb) / c[3] * 0.5 + 0.5);
     if (!(dz < r->depth[p]))
         return 0;
+    rad = 0.3 * r->sy * 0.5 * r->h / c[3]; /* a division only for the discs seen */
+    rad = fmin(fmax(rad, 1.5), 48.0);
     g[0] = px;
     g[1] = py;
     g[2] = rad;
@@ -2575,10 +2586,18 @@ static double glow_q(const double g[3], int32_t x, int32_t y)
 static void glow_candidates(render *r)
 {
     uint32_t l;
+    double mx = 1.0 + 8.0 / r->w, my = 1.0 + 8.0 / r->h;
     r->nglamp = 0;
     for (l = 0; l < r->s->nlamps; l++) {
+        const scene_lamp *lp = &r->s->lamps[l];
         double c[4], px, py;
-        if (!lamp_centre(r, &r->s->lamps[l], c, &px, &py))
+        lamp_clip(r, lp, c);
+        /* in front and more than four pixels out of the frame (|x / w| >
+         * 1 + 8 / width: far beyond any rounding): out, without the
+         * divisions */
+        if (c[3] > r->near_ && (fabs(c[0]) > c[3] * mx || fabs(c[1]) > c[3] * my))
+            continue;
+        if (!centre_of(r, lp, c, &px, &py))
             continue;
         if (px >= -2.0 && py >= -2.0 && px < r->w + 2.0 && py < r->h + 2.0)
             r->glamp[r->nglamp++] = l;
