@@ -334,15 +334,17 @@ static int all_marked(const uint8_t *mask, int32_t i)
     return all;
 }
 
-/* Pixel i's ground point (x, y) from the tiles' corner, and in steps of
- * the block at (bx0, by0), as ground_run computes them. Along a row it is monotone in i (each step a
- * rounding of a monotone function, and inv > 0). */
+/* Pixel i's ground point (x, y) from the tiles' corner, as ground_run
+ * computes it. */
 static void ground_xy(const ground_row *g, int32_t i, double *x, double *y)
 {
     *x = g->x0 + i * g->dx;
     *y = g->y0 + i * g->dy;
 }
 
+/* Pixel i's ground point in steps of the block at (bx0, by0). Along a row
+ * it is monotone in i (each step a rounding of a monotone function, and
+ * inv > 0). */
 static void ground_uw(const ground_row *g, int32_t i, double bx0, double by0, double inv, double *u, double *w)
 {
     double x, y;
