@@ -670,7 +670,7 @@ static void walk_row(edge_walk *w)
  * edge values for the depth. eb0: E + bias at (i0, j0); zc: z0, dz1,
  * dz2, 1 / area. */
 static size_t draw_narrow_id(raster_ctx *r, const edge e[3], const int64_t eb0[3], int64_t i0, int64_t i1,
-                             int64_t j0, int64_t j1, const double zc[4], uint32_t id, uint32_t *ids)
+                             int64_t j0, int64_t j1, const double zc[4], float zlo, uint32_t id, uint32_t *ids)
 {
     const raster_target *t = &r->t;
     int64_t b0 = eb0[0], b1 = eb0[1], b2 = eb0[2], j, x;
@@ -683,7 +683,7 @@ static size_t draw_narrow_id(raster_ctx *r, const edge e[3], const int64_t eb0[3
         for (x = i0; x <= i1; x++, c0 += s0, c1 += s1, c2 += s2) {
             double l1, l2;
             float z;
-            if ((c0 | c1 | c2) < 0) /* one of them negative */
+            if ((c0 | c1 | c2) < 0 || drow[x] <= zlo) /* outside, or hidden (depth_floor) */
                 continue;
             l1 = (double)(c1 - e[1].bias) * zc[3];
             l2 = (double)(c2 - e[2].bias) * zc[3];
@@ -725,12 +725,16 @@ static void span_offsets(int64_t s1, int64_t s2, double off1[SPAN_LANES], double
  * nearer, written with the id, and counted in c[k]; in loops of fixed
  * length (vectorised by GCC at -O2). */
 static void span_lanes_id(float *restrict drow, uint32_t *restrict irow, double e1, double e2,
-                          const double *restrict off1, const double *restrict off2, const double zc[4], uint32_t id,
-                          uint32_t *restrict c)
+                          const double *restrict off1, const double *restrict off2, const double zc[4], float zlo,
+                          uint32_t id, uint32_t *restrict c)
 {
     float z[SPAN_LANES];
-    uint32_t zb[SPAN_LANES], db[SPAN_LANES];
+    uint32_t zb[SPAN_LANES], db[SPAN_LANES], hidden = 1;
     int k;
+    for (k = 0; k < SPAN_LANES; k++)
+        hidden &= drow[k] <= zlo;
+    if (hidden) /* no lane can be nearer (depth_floor) */
+        return;
     for (k = 0; k < SPAN_LANES; k++) {
         double l1 = (e1 + off1[k]) * zc[3], l2 = (e2 + off2[k]) * zc[3];
         z[k] = (float)(zc[0] + l1 * zc[1] + l2 * zc[2]);
@@ -747,6 +751,25 @@ static void span_lanes_id(float *restrict drow, uint32_t *restrict irow, double 
     memcpy(drow, db, sizeof db);
 }
 
+/* A float at or below every depth draw_triangle_id computes inside the
+ * triangle of vertex depths z0, z1, z2 (doubles in [0, 1]): inside, the
+ * edge values are >= 0 and sum to the area, so the exact depth is a
+ * convex combination, at least their minimum m; the computed one (l1, l2
+ * each a product with 1 / area, then two products and two sums, all in
+ * double) is within 1e-14 of it, and rounding to float is monotone. So a
+ * pixel whose stored depth is at most this float fails the depth test,
+ * and skipping it changes nothing. */
+static float depth_floor(double z0, double z1, double z2)
+{
+    double m = z0 < z1 ? z0 : z1;
+    float f;
+    m = (m < z2 ? m : z2) - 1e-9;
+    f = (float)m;
+    if ((double)f > m)
+        f = nextafterf(f, -1.0f);
+    return f;
+}
+
 /* draw_triangle with no attributes, depth test and write, and the id
  * stored: the same spans and the same depth expression per pixel (a
  * triangle at most RASTER_NARROW columns wide by its box). */
@@ -760,6 +783,7 @@ static size_t draw_triangle_id(raster_ctx *r, const svert *v0, const svert *v1, 
     double inv_area = 1.0 / (double)area;
     double z0 = v0->z, dz1 = v1->z - v0->z, dz2 = v2->z - v0->z, zc[4], off1[SPAN_LANES], off2[SPAN_LANES];
     uint32_t cnt[SPAN_LANES]; /* pixels the lanes wrote */
+    float zlo;
     size_t written = 0;
     int k, offs = 0;
     edge_setup(&e[0], v1, v2);
@@ -773,8 +797,9 @@ static size_t draw_triangle_id(raster_ctx *r, const svert *v0, const svert *v1, 
     zc[1] = dz1;
     zc[2] = dz2;
     zc[3] = inv_area;
+    zlo = depth_floor(z0, v1->z, v2->z);
     if (i1 - i0 < RASTER_NARROW)
-        return draw_narrow_id(r, e, eb0, i0, i1, j0, j1, zc, id, ids);
+        return draw_narrow_id(r, e, eb0, i0, i1, j0, j1, zc, zlo, id, ids);
     for (k = 0; k < 3; k++)
         walk_start(&wk[k], &e[k], eb0[k]);
     ev1 = eb0[1] - e[1].bias;
@@ -816,11 +841,16 @@ static size_t draw_triangle_id(raster_ctx *r, const svert *v0, const svert *v1, 
                 offs = 1;
             }
             for (; x + SPAN_LANES - 1 <= hi; x += SPAN_LANES, e1 += SPAN_LANES * s1, e2 += SPAN_LANES * s2)
-                span_lanes_id(drow + x, irow + x, (double)e1, (double)e2, off1, off2, zc, id, cnt);
+                span_lanes_id(drow + x, irow + x, (double)e1, (double)e2, off1, off2, zc, zlo, id, cnt);
         }
         for (; x <= hi; x++, e1 += s1, e2 += s2) {
-            double l1 = (double)e1 * inv_area, l2 = (double)e2 * inv_area;
-            float z = (float)(z0 + l1 * dz1 + l2 * dz2);
+            double l1, l2;
+            float z;
+            if (drow[x] <= zlo)
+                continue;
+            l1 = (double)e1 * inv_area;
+            l2 = (double)e2 * inv_area;
+            z = (float)(z0 + l1 * dz1 + l2 * dz2);
             if (!(z < drow[x]))
                 continue;
             drow[x] = z;

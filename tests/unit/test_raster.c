@@ -361,6 +361,78 @@ static void test_triangle_id_tie(void **state)
     assert_int_equal(second, 0);
 }
 
+/* Triangles sloped in depth whose nearest corner lies just in front of
+ * or just behind the depth stored at every pixel, from 1e-7 to 0.05 away
+ * (the far corners from 1e-6 to 0.3 farther still):
+ * raster_triangle_id skips the pixels it can tell are hidden from the
+ * triangle's nearest depth alone (depth_floor in raster.c), and must
+ * still write every pixel nearer than the stored depth. Wide triangles
+ * (spans in lanes), narrow ones (every pixel of the box) and short
+ * spans, the same ids and depth bits as raster_triangle. */
+static void test_triangle_id_near_depth(void **state)
+{
+    enum { W = 97, H = 41 };
+    static const double gap[] = { 1e-7, 1e-6, 1e-5, 1e-3, 0.05 }, slope[] = { 0.3, 1e-3, 1e-5, 1e-6 };
+    int round, rounds = getenv("PLX_TEST_QUICK") ? 300 : 3000;
+    long front = 0, behind = 0;
+    (void)state;
+    rng_state = 0xdee9f100ull;
+    for (round = 0; round < rounds; round++) {
+        float da[W * H], db[W * H], dc[W * H], pos[3][4];
+        uint32_t ia[W * H], ib[W * H];
+        double d = 0.1 + 0.5 * rnd(), z0 = d + (rnd() < 0.5 ? -1.0 : 1.0) * gap[round % 5], wide;
+        raster_ctx ra, rb, rc;
+        raster_vertex v[3];
+        raster_pvert p[3];
+        id_target it;
+        int q, shape = round % 3; /* wide, narrow, a few columns */
+        long got, inside;
+        size_t k;
+        depth_only(&ra, da, W, H);
+        depth_only(&rb, db, W, H);
+        depth_only(&rc, dc, W, H); /* nothing stored: every pixel inside is written */
+        raster_set_cull(&rc, RASTER_CULL_NONE);
+        raster_clear_depth(&ra, (float)d);
+        raster_clear_depth(&rb, (float)d);
+        memset(ia, 0, sizeof ia);
+        memset(ib, 0, sizeof ib);
+        it.id = ia;
+        it.w = W;
+        it.cur = 1;
+        raster_set_fragment(&ra, id_frag, &it, 0);
+        raster_set_cull(&ra, RASTER_CULL_NONE);
+        raster_set_cull(&rb, RASTER_CULL_NONE);
+        wide = shape == 0 ? 1.9 : shape == 1 ? 10.0 / W : 30.0 / W;
+        for (q = 0; q < 3; q++) {
+            double x = -0.95 + (q == 1 ? wide : rnd() * 0.3 * wide), y = -0.95 + 1.9 * (q == 2 ? 1.0 : rnd() * 0.4);
+            double z = q == 0 ? z0 : z0 + slope[(round / 15) % 4] * rnd(); /* corner 0 the nearest */
+            pos[q][0] = (float)(x + (shape ? 1.9 * rnd() * (1.0 - wide) : 0.0));
+            pos[q][1] = (float)y;
+            pos[q][2] = (float)(2.0 * z - 1.0);
+            pos[q][3] = 1.0f;
+        }
+        for (q = 0; q < 3; q++) {
+            memset(&v[q], 0, sizeof v[q]);
+            memcpy(v[q].pos, pos[q], sizeof pos[q]);
+            raster_prepare(&rb, pos[q], &p[q]);
+        }
+        raster_triangle(&ra, &v[0], &v[1], &v[2]);
+        inside = (long)raster_triangle(&rc, &v[0], &v[1], &v[2]);
+        got = raster_triangle_id(&rb, &p[0], &p[1], &p[2], 1, ib);
+        assert_true(got >= 0);
+        front += got;
+        behind += inside - got;
+        assert_memory_equal(ia, ib, sizeof ia);
+        assert_memory_equal(da, db, sizeof da);
+        for (k = 0; k < (size_t)W * H; k++)
+            got -= ib[k] == 1;
+        assert_int_equal(got, 0);
+    }
+    printf("raster_triangle_id near a stored depth: of the triangles' pixels %ld written in front of it, %ld "
+           "behind it left; the same ids and depths as raster_triangle\n", front, behind);
+    assert_true(front > 2000 && behind > 20000);
+}
+
 static void test_init_rejects_bad_targets(void **state)
 {
     raster_ctx r;
@@ -1190,6 +1262,7 @@ int main(void)
         cmocka_unit_test(test_init_rejects_bad_targets),
         cmocka_unit_test(test_triangle_id_same),
         cmocka_unit_test(test_triangle_id_tie),
+        cmocka_unit_test(test_triangle_id_near_depth),
         cmocka_unit_test(test_square_two_triangles),
         cmocka_unit_test(test_single_triangle_top_left),
         cmocka_unit_test(test_fan_shared_edges),
