@@ -421,6 +421,20 @@ static void ground_run(const atlas *A, const ground_row *g, int32_t i0, int32_t 
     }
 }
 
+/* Pixels i0 .. i1 - 1 black (+0, all bits zero), or only the marked ones
+ * with a mask. */
+static void black_run(float *lin, int32_t i0, int32_t i1, const uint8_t *mask)
+{
+    int32_t i;
+    if (!mask) {
+        memset(&lin[3 * (size_t)i0], 0, 3 * sizeof *lin * (size_t)(i1 - i0));
+        return;
+    }
+    for (i = i0; i < i1; i++)
+        if (mask[i])
+            lin[3 * (size_t)i] = lin[3 * (size_t)i + 1] = lin[3 * (size_t)i + 2] = 0.0f;
+}
+
 /* A run of pixels i0 .. i1 - 1 of row j on surface sid, all marked when
  * there is a mask (atlas_frame_row ends a building's run at its first
  * unmarked pixel): its chart's map, then each pixel's (u, v) and the
@@ -437,9 +451,7 @@ static void surface_run(const atlas *A, const atlas_view *v, atlas_cache *k, uin
     uint32_t nu, nv;
     int32_t i;
     if (!c) {
-        for (i = i0; i < i1; i++)
-            if (!mask || mask[i])
-                lin[3 * (size_t)i] = lin[3 * (size_t)i + 1] = lin[3 * (size_t)i + 2] = 0.0f;
+        black_run(lin, i0, i1, mask);
         return;
     }
     bu = m->a[0] + m->a[2] * fj;
@@ -518,10 +530,7 @@ void atlas_frame_row(const atlas *A, const atlas_view *v, atlas_cache *k, const 
             n = (uint64_t)(e - i);
         }
         if (sid == MESH_SURF_NONE || (sid == MESH_SURF_GROUND && !g.on)) {
-            int32_t q;
-            for (q = i; q < e; q++)
-                if (!mask || mask[q])
-                    lin[3 * (size_t)q] = lin[3 * (size_t)q + 1] = lin[3 * (size_t)q + 2] = 0.0f;
+            black_run(lin, i, e, mask);
             count[0] += n;
         } else if (sid == MESH_SURF_GROUND) {
             ground_run(A, &g, i, e, mask, &L, lin);
