@@ -26,6 +26,8 @@ double exposure_curve(double v);
 int exposure_bin(double y);
 
 #define EXPOSURE_HINTS 16384     /* positive double bits >> 49 */
+#define EXPOSURE_HINT_STEPS 1    /* thresholds at most in a hint's cell past its first double
+                                    (exposure_table_bin takes one step) */
 
 /* exposure_bin without the logarithm: t[k] (k >= 1) is the smallest
  * double whose bin is k or more, hint[h] the number of them at or below
@@ -37,6 +39,8 @@ typedef struct exposure_table {
 } exposure_table;
 
 void exposure_table_init(exposure_table *et);
+/* exposure_bin(y) from the table, for a positive finite y. */
+int exposure_table_bin(const exposure_table *et, double y);
 /* exposure_count with the table: the same counts. */
 void exposure_count_table(const exposure_table *et, const float *lin, const uint32_t *id, size_t p0, size_t p1,
                           uint32_t hist[EXPOSURE_BINS]);

@@ -1809,8 +1809,10 @@ static void test_exposure_parts(void **state)
 
 
 /* The exposure's table of bin thresholds gives exposure_bin's bin for
- * every luminance tried: 2,000 doubles each side of every threshold, a
- * million spread log-uniformly over 2^-45 .. 2^45, and the extremes. */
+ * every luminance tried (exposure_table_bin): 2,000 doubles each side of
+ * every threshold, a million spread log-uniformly over 2^-45 .. 2^45
+ * through exposure_count_table, and the extremes; and no hint's cell
+ * holds more thresholds than exposure_table_bin's one step can pass. */
 static void test_exposure_table(void **state)
 {
     exposure_table *et = malloc(sizeof *et);
@@ -1832,12 +1834,30 @@ static void test_exposure_table(void **state)
         assert_true(exposure_bin(double_of_bits(t - 1)) < k);
         for (d = -2000; d <= 2000; d++) {
             double y = double_of_bits(t + (uint64_t)(int64_t)d);
-            int b = et->hint[(t + (uint64_t)(int64_t)d) >> 49];
-            while (b + 1 < EXPOSURE_BINS && y >= et->t[b + 1])
-                b++;
+            int b = exposure_table_bin(et, y);
             if (b != exposure_bin(y))
                 fail_msg("y %.17g: table bin %d, exposure_bin %d", y, b, exposure_bin(y));
         }
+    }
+    /* the counting's one step from the hint reaches every bin: a hint's
+     * cell of doubles holds at most EXPOSURE_HINT_STEPS thresholds past
+     * its first double */
+    {
+        int most = 0, in_cell = 0;
+        uint64_t cell = UINT64_MAX;
+        for (k = 1; k < EXPOSURE_BINS; k++) {
+            uint64_t t;
+            memcpy(&t, &et->t[k], sizeof t);
+            if (t >> 49 != cell) {
+                cell = t >> 49;
+                in_cell = 0;
+            }
+            in_cell += (t & ((1ull << 49) - 1)) != 0;
+            most = in_cell > most ? in_cell : most;
+        }
+        printf("exposure table: at most %d threshold(s) in a hint's cell (the counting takes %d step(s))\n", most,
+               EXPOSURE_HINT_STEPS);
+        assert_true(most <= EXPOSURE_HINT_STEPS);
     }
     /* through exposure_count_table itself: luminances of grey pixels */
     for (i = 0; i < 1000000 + sizeof extreme / sizeof extreme[0]; i++) {
