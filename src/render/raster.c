@@ -658,9 +658,10 @@ static void walk_row(edge_walk *w)
     }
     w->q += w->dq;
     w->r += w->dr;
-    if (w->r >= w->s) {
-        w->r -= w->s;
-        w->q++;
+    {
+        int64_t carry = -(int64_t)(w->r >= w->s); /* all ones or 0: no branch (it mispredicted) */
+        w->r -= w->s & carry;
+        w->q -= carry;
     }
 }
 
