@@ -363,7 +363,9 @@ static void test_triangle_id_tie(void **state)
 
 /* Triangles sloped in depth whose nearest corner lies just in front of
  * or just behind the depth stored at every pixel, from 1e-7 to 0.05 away
- * (the far corners from 1e-6 to 0.3 farther still):
+ * (the far corners up to 1e-6 .. 0.3 farther still; the stored depth
+ * flat, or rising by 1e-6 or 1e-3 across the frame, so that a span or
+ * a lane can be partly hidden):
  * raster_triangle_id skips the pixels it can tell are hidden from the
  * triangle's nearest depth alone (depth_floor in raster.c), and must
  * still write every pixel nearer than the stored depth. Wide triangles
@@ -373,6 +375,7 @@ static void test_triangle_id_near_depth(void **state)
 {
     enum { W = 97, H = 41 };
     static const double gap[] = { 1e-7, 1e-6, 1e-5, 1e-3, 0.05 }, slope[] = { 0.3, 1e-3, 1e-5, 1e-6 };
+    static const double ramp[] = { 0.0, 1e-6, 1e-3 };
     int round, rounds = getenv("PLX_TEST_QUICK") ? 300 : 3000;
     long front = 0, behind = 0;
     (void)state;
@@ -380,7 +383,7 @@ static void test_triangle_id_near_depth(void **state)
     for (round = 0; round < rounds; round++) {
         float da[W * H], db[W * H], dc[W * H], pos[3][4];
         uint32_t ia[W * H], ib[W * H];
-        double d = 0.1 + 0.5 * rnd(), z0 = d + (rnd() < 0.5 ? -1.0 : 1.0) * gap[round % 5], wide;
+        double d = 0.1 + 0.5 * rnd(), z0 = d + (rnd() < 0.5 ? -1.0 : 1.0) * gap[round % 5], wide, shift;
         raster_ctx ra, rb, rc;
         raster_vertex v[3];
         raster_pvert p[3];
@@ -392,8 +395,6 @@ static void test_triangle_id_near_depth(void **state)
         depth_only(&rb, db, W, H);
         depth_only(&rc, dc, W, H); /* nothing stored: every pixel inside is written */
         raster_set_cull(&rc, RASTER_CULL_NONE);
-        raster_clear_depth(&ra, (float)d);
-        raster_clear_depth(&rb, (float)d);
         memset(ia, 0, sizeof ia);
         memset(ib, 0, sizeof ib);
         it.id = ia;
@@ -403,10 +404,13 @@ static void test_triangle_id_near_depth(void **state)
         raster_set_cull(&ra, RASTER_CULL_NONE);
         raster_set_cull(&rb, RASTER_CULL_NONE);
         wide = shape == 0 ? 1.9 : shape == 1 ? 10.0 / W : 30.0 / W;
+        shift = shape ? 1.9 * rnd() * (1.0 - wide) : 0.0; /* one for the whole triangle */
+        for (k = 0; k < (size_t)W * H; k++) /* the stored depth: flat, or rising across the frame */
+            da[k] = db[k] = (float)(d + ramp[(round / 60) % 3] * ((double)(k % W) - 0.5 * W) / W);
         for (q = 0; q < 3; q++) {
             double x = -0.95 + (q == 1 ? wide : rnd() * 0.3 * wide), y = -0.95 + 1.9 * (q == 2 ? 1.0 : rnd() * 0.4);
             double z = q == 0 ? z0 : z0 + slope[(round / 15) % 4] * rnd(); /* corner 0 the nearest */
-            pos[q][0] = (float)(x + (shape ? 1.9 * rnd() * (1.0 - wide) : 0.0));
+            pos[q][0] = (float)(x + shift);
             pos[q][1] = (float)y;
             pos[q][2] = (float)(2.0 * z - 1.0);
             pos[q][3] = 1.0f;
