@@ -757,18 +757,14 @@ static void span_lanes_id(float *restrict drow, uint32_t *restrict irow, double 
  * edge values are >= 0 and sum to the area, so the exact depth is a
  * convex combination, at least their minimum m; the computed one (l1, l2
  * each a product with 1 / area, then two products and two sums, all in
- * double) is within 1e-14 of it, and rounding to float is monotone. So a
- * pixel whose stored depth is at most this float fails the depth test,
- * and skipping it changes nothing. */
+ * double) is within 1e-14 of it, so at least m - 1e-9, and rounding to
+ * float is monotone: the depth's float is at least this one. So a pixel
+ * whose stored depth is at most this float fails the depth test, and
+ * skipping it changes nothing. */
 static float depth_floor(double z0, double z1, double z2)
 {
     double m = z0 < z1 ? z0 : z1;
-    float f;
-    m = (m < z2 ? m : z2) - 1e-9;
-    f = (float)m;
-    if ((double)f > m)
-        f = nextafterf(f, -1.0f);
-    return f;
+    return (float)((m < z2 ? m : z2) - 1e-9);
 }
 
 /* draw_triangle with no attributes, depth test and write, and the id
