@@ -444,12 +444,18 @@ static void black_run(float *lin, int32_t i0, int32_t i1, const uint8_t *mask)
 static void surface_run(const atlas *A, const atlas_view *v, atlas_cache *k, uint32_t sid, int32_t j, int32_t i0,
                         int32_t i1, const uint8_t *mask, lanes *L, float *lin)
 {
-    const atlas_map *m = map_of(A, v, k, sid);
-    const atlas_chart *c = m->c && A->cdone[sid - 2u] != ATLAS_DARK ? m->c : NULL;
+    const atlas_map *m;
+    const atlas_chart *c;
     float fj = (float)j, bu, bv, bw, au, av, aw;
     const uint32_t *t0;
     uint32_t nu, nv;
     int32_t i;
+    if (sid - 2u < A->nsurf && A->cdone[sid - 2u] == ATLAS_DARK) { /* no map: one byte decides */
+        black_run(lin, i0, i1, mask);
+        return;
+    }
+    m = map_of(A, v, k, sid);
+    c = m->c;
     if (!c) {
         black_run(lin, i0, i1, mask);
         return;
