@@ -749,7 +749,7 @@ static int setup_camera(render *r, const render_camera *c, const render_opts *o)
     return 1;
 }
 
-static void to_clip(const render *r, const double *X, double out[4])
+static inline void to_clip(const render *r, const double *X, double out[4])
 {
     double v0 = X[0] - r->eye[0], v1 = X[1] - r->eye[1], v2 = X[2] - r->eye[2];
     double w = v0 * r->f[0] + v1 * r->f[1] + v2 * r->f[2];
@@ -757,6 +757,17 @@ static void to_clip(const render *r, const double *X, double out[4])
     out[1] = (v0 * r->up[0] + v1 * r->up[1] + v2 * r->up[2]) * r->sy + r->shy * w;
     out[2] = r->za * w + r->zb;
     out[3] = w;
+}
+
+/* to_clip rounded to floats, the rasteriser's vertex positions. */
+static void clip_floats(const render *r, const double *X, float v[4])
+{
+    double c[4];
+    to_clip(r, X, c);
+    v[0] = (float)c[0];
+    v[1] = (float)c[1];
+    v[2] = (float)c[2];
+    v[3] = (float)c[3];
 }
 
 /* ---- culling ----------------------------------------------------------------- */
@@ -1345,14 +1356,8 @@ static void band_building(band *bd, uint32_t b)
     uint32_t k;
     mesh_building(m, b, bd->gxyz, bd->gtri);
     for (k = 0; k < mb->v_count; k++) {
-        double c[4];
-        float *v = bd->vbuf[k].pos;
-        to_clip(r, &bd->gxyz[3 * (size_t)k], c);
-        v[0] = (float)c[0];
-        v[1] = (float)c[1];
-        v[2] = (float)c[2];
-        v[3] = (float)c[3];
-        raster_prepare(&bd->rc, v, &bd->pv[k]);
+        clip_floats(r, &bd->gxyz[3 * (size_t)k], bd->vbuf[k].pos);
+        raster_prepare(&bd->rc, bd->vbuf[k].pos, &bd->pv[k]);
     }
     for (k = 0; k < mb->t_count; k++) {
         const mesh_tri *t = &bd->gtri[k];
@@ -1436,15 +1441,8 @@ static void draw_buildings(render *r, const render_backend *be, render_stats *st
         st->drawn++;
         st->triangles_drawn += mb->t_count;
         mesh_building(m, b, r->gxyz, r->gtri);
-        for (k = 0; k < mb->v_count; k++) {
-            double c[4];
-            float *v = &r->clip[4 * (size_t)k];
-            to_clip(r, &r->gxyz[3 * (size_t)k], c);
-            v[0] = (float)c[0];
-            v[1] = (float)c[1];
-            v[2] = (float)c[2];
-            v[3] = (float)c[3];
-        }
+        for (k = 0; k < mb->v_count; k++)
+            clip_floats(r, &r->gxyz[3 * (size_t)k], &r->clip[4 * (size_t)k]);
         be->draw(be->user, r->clip, mb->v_count, r->gtri, mb->t_count, 0);
     }
 }
