@@ -299,18 +299,40 @@ static void missing_ground(atlas *A, const ground_row *g, int32_t i, block_memo 
         want(A, atlas_block_item(A, 0, 0) + b, list, cap, n);
 }
 
-uint32_t atlas_frame_missing(atlas *A, const atlas_view *v, const uint32_t *ids, uint32_t *list, uint32_t cap)
+/* The first marked pixel of i .. e - 1 (e: none), eight unmarked bytes a
+ * test where it can. */
+static int32_t next_marked(const uint8_t *mask, int32_t i, int32_t e)
+{
+    uint64_t q;
+    while (i + 8 <= e && (memcpy(&q, mask + i, sizeof q), q == 0))
+        i += 8;
+    while (i < e && !mask[i])
+        i++;
+    return i;
+}
+
+/* With a mask, the pixels atlas_frame_row reads with it: a building
+ * pixel reads its own chart; a ground pixel the block under it, or the
+ * block an earlier marked pixel of its run read (ground_run's carried
+ * block), listed there. */
+uint32_t atlas_frame_missing(atlas *A, const atlas_view *v, const uint32_t *ids, const uint8_t *mask, uint32_t *list,
+                             uint32_t cap)
 {
     uint32_t n = 0, last = MESH_SURF_NONE;
     int32_t i, j;
     if (A->todo == 0)
         return 0;
     for (j = 0; j < v->h && n < cap; j++) {
+        const uint32_t *row = &ids[(size_t)j * v->w];
+        const uint8_t *mrow = mask ? &mask[(size_t)j * v->w] : NULL;
         block_memo bm = { 0.0, 0.0, 0.0, 1.0, -1.0 };
         ground_row g;
         ground_setup(A, v, j, &g);
         for (i = 0; i < v->w; i++) {
-            uint32_t sid = ids[(size_t)j * v->w + i];
+            uint32_t sid;
+            if (mrow && (i = next_marked(mrow, i, v->w)) == v->w)
+                break;
+            sid = row[i];
             if (sid == MESH_SURF_GROUND && g.on) {
                 missing_ground(A, &g, i, &bm, list, cap, &n);
             } else if (sid != last && sid != MESH_SURF_NONE && sid != MESH_SURF_GROUND) {
@@ -487,18 +509,6 @@ static void surface_run(const atlas *A, const atlas_view *v, atlas_cache *k, uin
         float fi = (float)i, r = 1.0f / (bw + aw * fi);
         lanes_add(L, i, t0, nu, nv, (bu + au * fi) * r, (bv + av * fi) * r, lin);
     }
-}
-
-/* The first marked pixel of i .. e - 1 (e: none), eight unmarked bytes a
- * test where it can. */
-static int32_t next_marked(const uint8_t *mask, int32_t i, int32_t e)
-{
-    uint64_t q;
-    while (i + 8 <= e && (memcpy(&q, mask + i, sizeof q), q == 0))
-        i += 8;
-    while (i < e && !mask[i])
-        i++;
-    return i;
 }
 
 void atlas_frame_row(const atlas *A, const atlas_view *v, atlas_cache *k, const uint32_t *ids, const uint8_t *mask,

@@ -52,7 +52,10 @@ void atlas_frame_row(const atlas *A, const atlas_view *v, atlas_cache *k, const 
 /* The charts and blocks (atlas.h's items) the frame's pixels read that
  * are not filled yet, listed into list (at most cap), each once: their
  * done bytes are set to 2 (listed) until atlas_fill_items fills them.
+ * With a mask (not NULL), only the pixels whose byte is set, the ones
+ * atlas_frame_row reads with that mask: anti-aliasing's later samples.
  * Returns how many were listed; 0 at once when the atlas is complete. */
-uint32_t atlas_frame_missing(atlas *A, const atlas_view *v, const uint32_t *ids, uint32_t *list, uint32_t cap);
+uint32_t atlas_frame_missing(atlas *A, const atlas_view *v, const uint32_t *ids, const uint8_t *mask, uint32_t *list,
+                             uint32_t cap);
 
 #endif

@@ -3286,7 +3286,7 @@ static int atlas_pass(render *r, const render_opts *o, render_stats *st)
     jb.r = r;
     jb.o = o;
     jb.count = o->auto_exposure;
-    if (o->atlas_need && o->atlas_need(o->atlas_user, &jb.v, r->id) != 0)
+    if (o->atlas_need && o->atlas_need(o->atlas_user, &jb.v, r->id, o->mask) != 0)
         return -1;
     if (jb.count)
         memset(r->hist, 0, sizeof r->hist);

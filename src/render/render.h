@@ -332,10 +332,11 @@ typedef struct render_opts {
                                   when there is one); the indirect hooks and the light map
                                   are then not used */
     struct atlas_cache *atlas_cache; /* with atlas: one per worker (workers of them, at least 1) */
-    int (*atlas_need)(void *user, const struct atlas_view *v, const uint32_t *ids);
+    int (*atlas_need)(void *user, const struct atlas_view *v, const uint32_t *ids, const uint8_t *mask);
                                /* with atlas (may be NULL): called once the frame's surface ids
                                   are known (the ground's set), before any pixel is read: fills
-                                  what the frame reads of the atlas (atlas_frame_missing);
+                                  what the frame reads of the atlas (atlas_frame_missing; with
+                                  mask, the marked pixels' reads only);
                                   returns 0, or -1 when it could not (the frame then fails with
                                   PLX_E_NOMEM) */
     void *atlas_user;
