@@ -670,6 +670,7 @@ plx_status plx_render(plx_engine *e, const plx_camera *cam, const plx_render_opt
     ro.backend = o->backend;
     ro.auto_exposure = o->auto_exposure;
     if (use_atlas) {
+        atlas_current(e); /* cleared when the light changed: the frames read what is filled */
         ro.lightmap = 0;
         ro.atlas = e->atlas;
         ro.atlas_cache = e->atlas_cache;

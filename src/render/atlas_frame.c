@@ -404,13 +404,14 @@ static int ground_eight(const ground_row *g, int32_t i, double bx0, double by0, 
  * fixed step: runs of them share a block); black in a dark block. Eight
  * marked pixels in the block are read at once; eight that are not, one
  * by one. */
-static void ground_run(const atlas *A, const ground_row *g, int32_t i0, int32_t i1, const uint8_t *mask, lanes *L,
-                       float *lin)
+static int ground_run(const atlas *A, const ground_row *g, int32_t i0, int32_t i1, const uint8_t *mask, lanes *L,
+                      float *lin)
 {
     double bx0 = 0.0, by0 = 0.0, inv = 0.0, lim = -1.0;
     const uint32_t *t0 = NULL;
     uint32_t cur = UINT32_MAX;
     int32_t i, e;
+    int unfilled = 0;
     for (i = i0; i < i1; ) {
         if (i + ATLAS_LANES <= i1 && t0 && all_marked(mask, i) &&
             ground_eight(g, i, bx0, by0, inv, lim, t0, lin)) {
@@ -429,6 +430,7 @@ static void ground_run(const atlas *A, const ground_row *g, int32_t i0, int32_t 
                 t0 = NULL;
                 lim = -1.0;
                 if (cur != UINT32_MAX && A->gfirst[cur] != ATLAS_NOVERT) {
+                    unfilled |= !atlas_filled(A->gdone[cur]);
                     t0 = A->gdone[cur] == ATLAS_DARK ? NULL : &A->tex[A->gfirst[cur]];
                     block_frame(A, cur, &bx0, &by0, &inv);
                     lim = ATLAS_BLOCK;
@@ -441,6 +443,7 @@ static void ground_run(const atlas *A, const ground_row *g, int32_t i0, int32_t 
             lanes_add(L, i, t0, ATLAS_BLOCK + 1, ATLAS_BLOCK + 1, (float)u, (float)w, lin);
         }
     }
+    return unfilled;
 }
 
 /* Pixels i0 .. i1 - 1 black (+0, all bits zero), or only the marked ones
@@ -463,8 +466,8 @@ static void black_run(float *lin, int32_t i0, int32_t i1, const uint8_t *mask)
  * bilinear read, eight neighbours at once and the rest through the
  * lanes; black on a dark chart (the same bits: a bilinear read of four 0
  * values is +0). */
-static void surface_run(const atlas *A, const atlas_view *v, atlas_cache *k, uint32_t sid, int32_t j, int32_t i0,
-                        int32_t i1, const uint8_t *mask, lanes *L, float *lin)
+static int surface_run(const atlas *A, const atlas_view *v, atlas_cache *k, uint32_t sid, int32_t j, int32_t i0,
+                       int32_t i1, const uint8_t *mask, lanes *L, float *lin)
 {
     const atlas_map *m;
     const atlas_chart *c;
@@ -474,13 +477,13 @@ static void surface_run(const atlas *A, const atlas_view *v, atlas_cache *k, uin
     int32_t i;
     if (sid - 2u < A->nsurf && A->cdone[sid - 2u] == ATLAS_DARK) { /* no map: one byte decides */
         black_run(lin, i0, i1, mask);
-        return;
+        return 0;
     }
     m = map_of(A, v, k, sid);
     c = m->c;
     if (!c) {
         black_run(lin, i0, i1, mask);
-        return;
+        return 0;
     }
     bu = m->a[0] + m->a[2] * fj;
     bv = m->a[3] + m->a[5] * fj;
@@ -509,14 +512,16 @@ static void surface_run(const atlas *A, const atlas_view *v, atlas_cache *k, uin
         float fi = (float)i, r = 1.0f / (bw + aw * fi);
         lanes_add(L, i, t0, nu, nv, (bu + au * fi) * r, (bv + av * fi) * r, lin);
     }
+    return !atlas_filled(A->cdone[sid - 2u]);
 }
 
-void atlas_frame_row(const atlas *A, const atlas_view *v, atlas_cache *k, const uint32_t *ids, const uint8_t *mask,
-                     int32_t j, float *lin, uint64_t count[3])
+int atlas_frame_row(const atlas *A, const atlas_view *v, atlas_cache *k, const uint32_t *ids, const uint8_t *mask,
+                    int32_t j, float *lin, uint64_t count[3])
 {
     ground_row g;
     lanes L;
     int32_t i = 0, e;
+    int unfilled = 0;
     L.n = 0;
     ground_setup(A, v, j, &g);
     while (i < v->w) {
@@ -549,14 +554,15 @@ void atlas_frame_row(const atlas *A, const atlas_view *v, atlas_cache *k, const 
             black_run(lin, i, e, mask);
             count[0] += n;
         } else if (sid == MESH_SURF_GROUND) {
-            ground_run(A, &g, i, e, mask, &L, lin);
+            unfilled |= ground_run(A, &g, i, e, mask, &L, lin);
             count[1] += n;
         } else {
-            surface_run(A, v, k, sid, j, i, e, mask, &L, lin);
+            unfilled |= surface_run(A, v, k, sid, j, i, e, mask, &L, lin);
             count[2] += n;
         }
         i = e;
     }
     if (L.n)
         lanes_read(&L, lin);
+    return unfilled;
 }

@@ -45,9 +45,13 @@ typedef struct atlas_cache {
 /* Row j of the frame: lin (3 floats a pixel) from ids (mesh.h's ids, the
  * ground's set), through worker cache k; only the pixels whose mask byte
  * is set when mask is not NULL (the others keep what lin held);
- * count[0..2] += the sky, ground and building pixels written. */
-void atlas_frame_row(const atlas *A, const atlas_view *v, atlas_cache *k, const uint32_t *ids, const uint8_t *mask,
-                     int32_t j, float *lin /* OUT */, uint64_t count[3]);
+ * count[0..2] += the sky, ground and building pixels written. Returns
+ * nonzero when a pixel read a chart or block not filled (atlas_filled
+ * false): the row's values are then not the atlas's light, and it must be
+ * read again once atlas_frame_missing's items are filled (the same row
+ * and mask list every item the row read). */
+int atlas_frame_row(const atlas *A, const atlas_view *v, atlas_cache *k, const uint32_t *ids, const uint8_t *mask,
+                    int32_t j, float *lin /* OUT */, uint64_t count[3]);
 
 /* The charts and blocks (atlas.h's items) the frame's pixels read that
  * are not filled yet, listed into list (at most cap), each once: their

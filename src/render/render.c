@@ -128,7 +128,9 @@ struct render {
     /* shading by tiles */
     light *lt;                  /* the light module when shade is render_shade_light */
     shade_ws ws[RENDER_MAX_WORKERS];  /* one per worker of the shading pass */
-    uint8_t *defer;             /* per tile of the largest frame: left to the serial pass */
+    uint8_t *defer;             /* per tile of the largest frame: left to the serial pass; in
+                                   frames from the radiance atlas, per job of RENDER_TILE rows:
+                                   read again (atlas_rows) */
     /* sparse indirect (render_opts.indirect_sparse): per block of IND_STEP
      * pixels a side, whether one surface covers it with its corners; the
      * hook's value at each corner of the grid (RGB) */
@@ -3237,27 +3239,77 @@ typedef struct atlas_job {
     const render_opts *o;
     atlas_view v;
     int count;      /* count the exposure's histogram (automatic exposure) */
+    int again;      /* read only the jobs that met an item not filled, filled since */
     uint64_t px[RENDER_MAX_WORKERS][3]; /* sky, ground and building pixels, by worker */
 } atlas_job;
 
-/* Rows k RENDER_TILE .. of the frame from the atlas, counted into the
- * worker's exposure histogram while they are in the cache: every other
- * pixel of every other row (all of them in frames under 64 pixels a
- * side), enough for the percentile; the sums do not depend on which
- * worker counted what. */
+/* Rows k RENDER_TILE .. of the frame from the atlas, then counted into
+ * the worker's exposure histogram while they are in the cache: every
+ * other pixel of every other row (all of them in frames under 64 pixels
+ * a side), enough for the percentile; the sums do not depend on which
+ * worker counted what. Rows that read a chart or block not filled yet
+ * (with an atlas_need to fill it) are not counted: r->defer[k] says
+ * they are read again, and counted then (a frame's tiles outnumber its
+ * jobs of rows). */
 static void atlas_rows(void *arg, int worker, uint32_t k)
 {
     atlas_job *jb = arg;
     render *r = jb->r;
     int32_t j, j0 = (int32_t)k * RENDER_TILE, j1 = j0 + RENDER_TILE < r->h ? j0 + RENDER_TILE : r->h;
+    uint64_t px[3] = { 0, 0, 0 };
+    int unfilled = 0, c;
+    if (jb->again && !r->defer[k])
+        return;
     for (j = j0; j < j1; j++) {
         const uint32_t *ids = &r->id[(size_t)j * (size_t)r->w];
         float *lin = &r->lin[3 * (size_t)j * (size_t)r->w];
         const uint8_t *mask = jb->o->mask ? &jb->o->mask[(size_t)j * (size_t)r->w] : NULL;
-        atlas_frame_row(jb->o->atlas, &jb->v, &jb->o->atlas_cache[worker], ids, mask, j, lin, jb->px[worker]);
-        if (jb->count && (j % 2 == 0 || r->h < 64)) /* every other pixel of every other row */
-            exposure_count_every(r->et, lin, ids, 0, (size_t)r->w, r->w < 64 ? 1 : 2, r->hist[worker]);
+        unfilled |= atlas_frame_row(jb->o->atlas, &jb->v, &jb->o->atlas_cache[worker], ids, mask, j, lin, px);
     }
+    r->defer[k] = (uint8_t)(unfilled && jb->o->atlas_need);
+    if (r->defer[k])
+        return;
+    for (c = 0; c < 3; c++)
+        jb->px[worker][c] += px[c];
+    if (jb->count)
+        for (j = j0; j < j1; j++)
+            if (j % 2 == 0 || r->h < 64) /* every other pixel of every other row */
+                exposure_count_every(r->et, &r->lin[3 * (size_t)j * (size_t)r->w], &r->id[(size_t)j * (size_t)r->w],
+                                     0, (size_t)r->w, r->w < 64 ? 1 : 2, r->hist[worker]);
+}
+
+/* Whether a job of the pass met an item not filled. */
+static int atlas_unfilled(const render *r, uint32_t jobs)
+{
+    uint32_t k;
+    for (k = 0; k < jobs; k++)
+        if (r->defer[k])
+            return 1;
+    return 0;
+}
+
+/* The atlas's view of the frame set up (its camera and sample shift),
+ * stamped with the frame's number. */
+static void atlas_view_make(const render *r, atlas_view *v)
+{
+    double ta = r->tanh_ * r->aspect, tb = r->tanh_, a0, b0;
+    int k;
+    a0 = (2.0 * (0.5 + r->shift[0]) / r->w - 1.0) * ta;
+    b0 = (1.0 - 2.0 * (0.5 + r->shift[1]) / r->h) * tb;
+    for (k = 0; k < 3; k++) {
+        v->eye[k] = r->eye[k];
+        v->D0[k] = r->f[k] + a0 * r->rt[k] + b0 * r->up[k];
+        v->Dx[k] = 2.0 * ta / r->w * r->rt[k];
+        v->Dy[k] = -2.0 * tb / r->h * r->up[k];
+    }
+    v->w = r->w;
+    v->h = r->h;
+    v->stamp = r->frames;
+}
+
+void render_atlas_view(const render *r, atlas_view *v)
+{
+    atlas_view_make(r, v);
 }
 
 /* Every pixel from the atlas: the ground's ids set, then rows of pixels
@@ -3265,33 +3317,33 @@ static void atlas_rows(void *arg, int worker, uint32_t k)
 static int atlas_pass(render *r, const render_opts *o, render_stats *st)
 {
     atlas_job jb;
-    double ta = r->tanh_ * r->aspect, tb = r->tanh_, a0, b0;
+    uint32_t jobs = (uint32_t)((r->h + RENDER_TILE - 1) / RENDER_TILE);
     int k;
     ground_ids(r, o);
     if (o->mask) /* adaptive anti-aliasing's later samples: only the marked pixels */
         mask_update(r, o);
-    a0 = (2.0 * (0.5 + r->shift[0]) / r->w - 1.0) * ta;
-    b0 = (1.0 - 2.0 * (0.5 + r->shift[1]) / r->h) * tb;
-    for (k = 0; k < 3; k++) {
-        jb.v.eye[k] = r->eye[k];
-        jb.v.D0[k] = r->f[k] + a0 * r->rt[k] + b0 * r->up[k];
-        jb.v.Dx[k] = 2.0 * ta / r->w * r->rt[k];
-        jb.v.Dy[k] = -2.0 * tb / r->h * r->up[k];
-    }
-    jb.v.w = r->w;
-    jb.v.h = r->h;
-    jb.v.stamp = ++r->frames;
-    if (jb.v.stamp == 0) /* 2^32 frames: a stale map could carry stamp 0 */
-        jb.v.stamp = ++r->frames;
+    if (++r->frames == 0) /* 2^32 frames: a stale map could carry stamp 0 */
+        ++r->frames;
+    atlas_view_make(r, &jb.v);
     jb.r = r;
     jb.o = o;
     jb.count = o->auto_exposure;
-    if (o->atlas_need && o->atlas_need(o->atlas_user, &jb.v, r->id, o->mask) != 0)
-        return -1;
+    jb.again = 0;
     if (jb.count)
         memset(r->hist, 0, sizeof r->hist);
     memset(jb.px, 0, sizeof jb.px);
-    run_jobs(o, (uint32_t)((r->h + RENDER_TILE - 1) / RENDER_TILE), atlas_rows, &jb);
+    /* the rows read first; only a frame that met a chart or block not
+     * filled yet lists what it reads (atlas_need, atlas_frame_missing),
+     * fills it, and reads those rows again: the same bytes as filling
+     * first, a chart's values being its own whenever it is filled */
+    run_jobs(o, jobs, atlas_rows, &jb);
+    if (atlas_unfilled(r, jobs)) {
+        if (o->atlas_need(o->atlas_user, &jb.v, r->id, o->mask) != 0)
+            return -1;
+        jb.again = 1;
+        run_jobs(o, jobs, atlas_rows, &jb);
+        PLX_ASSERT(!atlas_unfilled(r, jobs)); /* the list holds every item a row reads */
+    }
     for (k = 0; k < RENDER_MAX_WORKERS; k++) {
         st->sky_pixels += jb.px[k][0];
         st->ground_pixels += jb.px[k][1];

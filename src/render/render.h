@@ -333,10 +333,14 @@ typedef struct render_opts {
                                   are then not used */
     struct atlas_cache *atlas_cache; /* with atlas: one per worker (workers of them, at least 1) */
     int (*atlas_need)(void *user, const struct atlas_view *v, const uint32_t *ids, const uint8_t *mask);
-                               /* with atlas (may be NULL): called once the frame's surface ids
-                                  are known (the ground's set), before any pixel is read: fills
-                                  what the frame reads of the atlas (atlas_frame_missing; with
-                                  mask, the marked pixels' reads only);
+                               /* with atlas (may be NULL: the atlas is complete): called when
+                                  the frame's rows read a chart or block not filled yet
+                                  (atlas_frame_row), with the frame's surface ids (the ground's
+                                  set): fills what the frame reads of the atlas
+                                  (atlas_frame_missing; with mask, the marked pixels' reads
+                                  only), after which those rows are read again. The caller
+                                  makes the atlas current for the light before the frame (its
+                                  filled items are read as they are);
                                   returns 0, or -1 when it could not (the frame then fails with
                                   PLX_E_NOMEM) */
     void *atlas_user;
@@ -456,6 +460,10 @@ size_t render_aa_mask(render *r, const render_opts *o, double ex, int curve, int
  * (scaled), after the others the last sample point's image; plx_render
  * returns the frame's own floats. */
 const float *render_linear(const render *r);
+
+/* The view of the last frame read from the radiance atlas (atlas_frame.h):
+ * its camera, sample shift and stamp. */
+void render_atlas_view(const render *r, struct atlas_view *v /* OUT */);
 
 /* Gives the renderer lin (room for its largest frame's 3 floats a pixel:
  * not checked, the caller sizes it as render_create does) as its linear

@@ -2106,14 +2106,6 @@ static void test_frames(void **state)
  * the lanes), and once with every pixel marked. The ground's block
  * cache restarts at a skipped pixel, and a fresh lookup agrees with it
  * only at power-of-two spacings (atlas_frame.c), hence 1 and 0.5 m. */
-static int grab_view(void *user, const atlas_view *v, const uint32_t *ids, const uint8_t *mask)
-{
-    (void)ids;
-    (void)mask;
-    *(atlas_view *)user = *v;
-    return 0;
-}
-
 static void runs_check(world *w, double fine, int nframes, rng *r, long *runs)
 {
     arena_mark mk = arena_get_mark(&w->e->mem);
@@ -2151,9 +2143,8 @@ static void runs_check(world *w, double fine, int nframes, rng *r, long *runs)
         o.no_glow = 1;
         o.atlas = A;
         o.atlas_cache = cache;
-        o.atlas_need = grab_view;
-        o.atlas_user = &v;
         assert_int_equal(render_frame(w->e->rd, &cam, &o, NULL, NULL, &st), PLX_OK);
+        render_atlas_view(w->e->rd, &v);
         lin = render_linear(w->e->rd);
         ids = render_ids(w->e->rd);
         for (j = 0; j < cam.height; j++) {
