@@ -433,10 +433,11 @@ plx_status eng_atlas_fill_all(plx_engine *e)
     return st;
 }
 
-/* render_opts.atlas_need: what the frame reads and is not filled yet,
+/* render_opts.atlas_need: what rows j0 .. j1 - 1 read and is not filled yet,
  * filled on this thread (the engine's light object), round after round
  * of at most ENG_ATLAS_LIST items. */
-static int atlas_need(void *user, const atlas_view *v, const uint32_t *ids, const uint8_t *mask)
+static int atlas_need(void *user, const atlas_view *v, const uint32_t *ids, const uint8_t *mask, int32_t j0,
+                      int32_t j1)
 {
     plx_engine *e = user;
     atlas_worker w;
@@ -445,7 +446,7 @@ static int atlas_need(void *user, const atlas_view *v, const uint32_t *ids, cons
     if (e->atlas->todo == 0)
         return 0;
     atlas_worker0(e, &w);
-    while ((n = atlas_frame_missing(e->atlas, v, ids, mask, e->atlas_list, ENG_ATLAS_LIST)) > 0)
+    while ((n = atlas_frame_missing(e->atlas, v, ids, mask, j0, j1, e->atlas_list, ENG_ATLAS_LIST)) > 0)
         if (atlas_fill_items(e->atlas, &w, 1, NULL, e->atlas_list, n) != PLX_OK)
             return -1;
     return 0;

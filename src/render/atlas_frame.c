@@ -315,14 +315,14 @@ static int32_t next_marked(const uint8_t *mask, int32_t i, int32_t e)
  * pixel reads its own chart; a ground pixel the block under it, or the
  * block an earlier marked pixel of its run read (ground_run's carried
  * block), listed there. */
-uint32_t atlas_frame_missing(atlas *A, const atlas_view *v, const uint32_t *ids, const uint8_t *mask, uint32_t *list,
-                             uint32_t cap)
+uint32_t atlas_frame_missing(atlas *A, const atlas_view *v, const uint32_t *ids, const uint8_t *mask, int32_t j0,
+                             int32_t j1, uint32_t *list, uint32_t cap)
 {
     uint32_t n = 0, last = MESH_SURF_NONE;
     int32_t i, j;
     if (A->todo == 0)
         return 0;
-    for (j = 0; j < v->h && n < cap; j++) {
+    for (j = j0 > 0 ? j0 : 0; j < j1 && j < v->h && n < cap; j++) {
         const uint32_t *row = &ids[(size_t)j * v->w];
         const uint8_t *mrow = mask ? &mask[(size_t)j * v->w] : NULL;
         block_memo bm = { 0.0, 0.0, 0.0, 1.0, -1.0 };

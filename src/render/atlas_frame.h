@@ -53,13 +53,14 @@ typedef struct atlas_cache {
 int atlas_frame_row(const atlas *A, const atlas_view *v, atlas_cache *k, const uint32_t *ids, const uint8_t *mask,
                     int32_t j, float *lin /* OUT */, uint64_t count[3]);
 
-/* The charts and blocks (atlas.h's items) the frame's pixels read that
- * are not filled yet, listed into list (at most cap), each once: their
- * done bytes are set to 2 (listed) until atlas_fill_items fills them.
- * With a mask (not NULL), only the pixels whose byte is set, the ones
- * atlas_frame_row reads with that mask: anti-aliasing's later samples.
- * Returns how many were listed; 0 at once when the atlas is complete. */
-uint32_t atlas_frame_missing(atlas *A, const atlas_view *v, const uint32_t *ids, const uint8_t *mask, uint32_t *list,
-                             uint32_t cap);
+/* The charts and blocks (atlas.h's items) the pixels of rows j0 .. j1 - 1
+ * of the frame read that are not filled yet, listed into list (at most
+ * cap), each once: their done bytes are set to 2 (listed) until
+ * atlas_fill_items fills them. With a mask (not NULL), only the pixels
+ * whose byte is set, the ones atlas_frame_row reads with that mask:
+ * anti-aliasing's later samples. Returns how many were listed; 0 at once
+ * when the atlas is complete. */
+uint32_t atlas_frame_missing(atlas *A, const atlas_view *v, const uint32_t *ids, const uint8_t *mask, int32_t j0,
+                             int32_t j1, uint32_t *list, uint32_t cap);
 
 #endif

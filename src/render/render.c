@@ -3278,6 +3278,25 @@ static void atlas_rows(void *arg, int worker, uint32_t k)
                                      0, (size_t)r->w, r->w < 64 ? 1 : 2, r->hist[worker]);
 }
 
+/* atlas_need for each run of jobs that met an item not filled: what
+ * their rows read, filled. */
+static int atlas_fill_rows(render *r, const render_opts *o, const atlas_view *v, uint32_t jobs)
+{
+    uint32_t k = 0, e;
+    while (k < jobs) {
+        if (!r->defer[k]) {
+            k++;
+            continue;
+        }
+        for (e = k + 1; e < jobs && r->defer[e]; e++)
+            ;
+        if (o->atlas_need(o->atlas_user, v, r->id, o->mask, (int32_t)k * RENDER_TILE, (int32_t)e * RENDER_TILE) != 0)
+            return -1;
+        k = e;
+    }
+    return 0;
+}
+
 /* Whether a job of the pass met an item not filled. */
 static int atlas_unfilled(const render *r, uint32_t jobs)
 {
@@ -3338,7 +3357,7 @@ static int atlas_pass(render *r, const render_opts *o, render_stats *st)
      * first, a chart's values being its own whenever it is filled */
     run_jobs(o, jobs, atlas_rows, &jb);
     if (atlas_unfilled(r, jobs)) {
-        if (o->atlas_need(o->atlas_user, &jb.v, r->id, o->mask) != 0)
+        if (atlas_fill_rows(r, o, &jb.v, jobs) != 0)
             return -1;
         jb.again = 1;
         run_jobs(o, jobs, atlas_rows, &jb);

@@ -332,13 +332,14 @@ typedef struct render_opts {
                                   when there is one); the indirect hooks and the light map
                                   are then not used */
     struct atlas_cache *atlas_cache; /* with atlas: one per worker (workers of them, at least 1) */
-    int (*atlas_need)(void *user, const struct atlas_view *v, const uint32_t *ids, const uint8_t *mask);
-                               /* with atlas (may be NULL: the atlas is complete): called when
-                                  the frame's rows read a chart or block not filled yet
-                                  (atlas_frame_row), with the frame's surface ids (the ground's
-                                  set): fills what the frame reads of the atlas
+    int (*atlas_need)(void *user, const struct atlas_view *v, const uint32_t *ids, const uint8_t *mask,
+                      int32_t j0, int32_t j1);
+                               /* with atlas (may be NULL: the atlas is complete): called for
+                                  each run of rows j0 .. j1 - 1 that read a chart or block not
+                                  filled yet (atlas_frame_row), with the frame's surface ids
+                                  (the ground's set): fills what those rows read of the atlas
                                   (atlas_frame_missing; with mask, the marked pixels' reads
-                                  only), after which those rows are read again. The caller
+                                  only), after which they are read again. The caller
                                   makes the atlas current for the light before the frame (its
                                   filled items are read as they are);
                                   returns 0, or -1 when it could not (the frame then fails with
