@@ -3247,10 +3247,10 @@ typedef struct atlas_job {
  * the worker's exposure histogram while they are in the cache: every
  * other pixel of every other row (all of them in frames under 64 pixels
  * a side), enough for the percentile; the sums do not depend on which
- * worker counted what. Rows that read a chart or block not filled yet
- * (with an atlas_need to fill it) are not counted: r->defer[k] says
- * they are read again, and counted then (a frame's tiles outnumber its
- * jobs of rows). */
+ * worker counted what. A first read that met a chart or block not filled
+ * yet (with an atlas_need to fill it) is not counted: r->defer[k] says
+ * the job is read again, and counted then (a frame's tiles outnumber its
+ * jobs of rows); the second read always counts. */
 static void atlas_rows(void *arg, int worker, uint32_t k)
 {
     atlas_job *jb = arg;
@@ -3266,9 +3266,13 @@ static void atlas_rows(void *arg, int worker, uint32_t k)
         const uint8_t *mask = jb->o->mask ? &jb->o->mask[(size_t)j * (size_t)r->w] : NULL;
         unfilled |= atlas_frame_row(jb->o->atlas, &jb->v, &jb->o->atlas_cache[worker], ids, mask, j, lin, px);
     }
-    r->defer[k] = (uint8_t)(unfilled && jb->o->atlas_need);
-    if (r->defer[k])
-        return;
+    if (jb->again) {
+        PLX_ASSERT(!unfilled); /* the list held every item the rows read */
+    } else {
+        r->defer[k] = (uint8_t)(unfilled && jb->o->atlas_need);
+        if (r->defer[k])
+            return;
+    }
     for (c = 0; c < 3; c++)
         jb->px[worker][c] += px[c];
     if (jb->count)
@@ -3361,7 +3365,6 @@ static int atlas_pass(render *r, const render_opts *o, render_stats *st)
             return -1;
         jb.again = 1;
         run_jobs(o, jobs, atlas_rows, &jb);
-        PLX_ASSERT(!atlas_unfilled(r, jobs)); /* the list holds every item a row reads */
     }
     for (k = 0; k < RENDER_MAX_WORKERS; k++) {
         st->sky_pixels += jb.px[k][0];

@@ -335,8 +335,9 @@ typedef struct render_opts {
     int (*atlas_need)(void *user, const struct atlas_view *v, const uint32_t *ids, const uint8_t *mask,
                       int32_t j0, int32_t j1);
                                /* with atlas (may be NULL: the atlas is complete): called for
-                                  each run of rows j0 .. j1 - 1 that read a chart or block not
-                                  filled yet (atlas_frame_row), with the frame's surface ids
+                                  each run of rows j0 .. j1 - 1 (whole jobs of the frame's rows,
+                                  j1 may pass its height) of which a row read a chart or block
+                                  not filled yet (atlas_frame_row), with the frame's surface ids
                                   (the ground's set): fills what those rows read of the atlas
                                   (atlas_frame_missing; with mask, the marked pixels' reads
                                   only), after which they are read again. The caller
@@ -462,8 +463,9 @@ size_t render_aa_mask(render *r, const render_opts *o, double ex, int curve, int
  * returns the frame's own floats. */
 const float *render_linear(const render *r);
 
-/* The view of the last frame read from the radiance atlas (atlas_frame.h):
- * its camera, sample shift and stamp. */
+/* The atlas's view (atlas_frame.h) of the camera and sample shift of the
+ * last frame set up, with the stamp of the last frame read from the atlas:
+ * right after a frame read from the atlas, that frame's view. */
 void render_atlas_view(const render *r, struct atlas_view *v /* OUT */);
 
 /* Gives the renderer lin (room for its largest frame's 3 floats a pixel:

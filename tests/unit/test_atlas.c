@@ -1815,7 +1815,7 @@ typedef struct lazy {
     atlas *A;
     atlas_worker *w;
     uint32_t list[7];
-    long rounds, listed, checked, masked, some_rows;
+    long rounds, listed, checked, masked, some_rows, masked_fills, masked_frames;
 } lazy;
 
 /* The list atlas_frame_missing must give, from the block under every
@@ -1936,6 +1936,7 @@ static int lazy_need(void *user, const atlas_view *v, const uint32_t *ids, const
         assert_int_equal(atlas_fill_items(z->A, z->w, 1, NULL, z->list, n), PLX_OK);
         z->rounds++;
         z->listed += n;
+        z->masked_fills += mask ? (long)n : 0;
     }
     free(st);
     return 0;
@@ -1984,6 +1985,49 @@ static void random_camera(const scene *s, rng *r, int k, render_camera *cam)
     cam->height = k == 0 ? 61 : (int32_t)(12 + rpick(r, 110));
 }
 
+/* An anti-aliasing later sample (shifted sample points, a mask of about
+ * half the pixels): from the complete atlas A, then from B filled as the
+ * frames need it (z: lazy_need, which lists through the mask), the same
+ * marked pixels and counts; the others keep what the buffer held. */
+static void masked_frame(world *w, const render_camera *cam, atlas *A, atlas *B, atlas_cache *ca, atlas_cache *cb,
+                         lazy *z, rng *r)
+{
+    size_t px = (size_t)cam->width * cam->height, p;
+    uint8_t *mask = malloc(px);
+    float *want = malloc(3 * px * sizeof(float));
+    render_opts o;
+    render_stats sa, sb;
+    long before = z->masked_fills;
+    int k;
+    assert_true(mask && want);
+    for (p = 0; p < px; p++)
+        mask[p] = (uint8_t)rpick(r, 2);
+    for (k = 0; k < 2; k++) {
+        render_opts_default(&o);
+        o.no_glow = 1;
+        o.shift[0] = 0.25 - 0.5 * k;
+        o.shift[1] = -0.25;
+        o.mask = mask;
+        o.atlas = A;
+        o.atlas_cache = ca;
+        assert_int_equal(render_frame(w->e->rd, cam, &o, NULL, NULL, &sa), PLX_OK);
+        memcpy(want, render_linear(w->e->rd), 3 * px * sizeof(float));
+        o.atlas = B;
+        o.atlas_cache = cb;
+        o.atlas_need = lazy_need;
+        o.atlas_user = z;
+        assert_int_equal(render_frame(w->e->rd, cam, &o, NULL, NULL, &sb), PLX_OK);
+        for (p = 0; p < px; p++)
+            if (mask[p])
+                assert_memory_equal(&want[3 * p], &render_linear(w->e->rd)[3 * p], 3 * sizeof(float));
+        assert_true(sa.sky_pixels == sb.sky_pixels && sa.ground_pixels == sb.ground_pixels &&
+                    sa.building_pixels == sb.building_pixels);
+    }
+    z->masked_frames += z->masked_fills > before;
+    free(mask);
+    free(want);
+}
+
 static void frames_check(world *w, double fine, int nframes, rng *r)
 {
     arena_mark mk = arena_get_mark(&w->e->mem);
@@ -2028,7 +2072,7 @@ static void frames_check(world *w, double fine, int nframes, rng *r)
     for (f = 0; f < nframes; f++) {
         render_camera cam;
         render_opts o;
-        render_stats st;
+        render_stats st, st1;
         size_t px;
         random_camera(w->s, r, f, &cam);
         px = (size_t)cam.width * cam.height;
@@ -2037,6 +2081,7 @@ static void frames_check(world *w, double fine, int nframes, rng *r)
         o.atlas = A;
         o.atlas_cache = cache;
         assert_int_equal(render_frame(w->e->rd, &cam, &o, NULL, NULL, &st), PLX_OK);
+        st1 = st;
         frame_check(A, &cam, render_linear(w->e->rd), render_ids(w->e->rd), &t);
         memcpy(lin1, render_linear(w->e->rd), 3 * px * sizeof(float));
         /* no chart or block marked dark (each read): the same bytes */
@@ -2065,17 +2110,21 @@ static void frames_check(world *w, double fine, int nframes, rng *r)
         o.atlas_user = &z;
         assert_int_equal(render_frame(w->e->rd, &cam, &o, NULL, NULL, &st), PLX_OK);
         assert_memory_equal(lin1, render_linear(w->e->rd), 3 * px * sizeof(float));
+        assert_true(st.sky_pixels == st1.sky_pixels && st.ground_pixels == st1.ground_pixels &&
+                    st.building_pixels == st1.building_pixels); /* each row counted once */
         partial += B->todo > 0;
+        masked_frame(w, &cam, A, B, cache, cache2, &z, r);
     }
     printf("  %s at %.2f m: %d frames, %ld pixels (sky %ld, ground %ld, buildings %ld, %ld on no chart): %ld compared, "
            "%ld skipped at block sides; worst error %.3g of its tolerance; on demand %ld items in %ld rounds (each "
-           "list the per-pixel reference's; %ld listed through masks; %ld calls for some rows only); %ld dark "
+           "list the per-pixel reference's; %ld listed through masks; %ld calls for some rows only; %ld filled "
+           "for masked later samples, in %ld frames); %ld dark "
            "items (%ld ground blocks); %.2f s\n",
            w->name, fine, nframes, t.px, t.sky, t.ground, t.surf, t.nochart, t.compared, t.skipped, t.worst, z.listed,
-           z.rounds, z.masked, z.some_rows, dark, dark_ground, now_s() - t0);
+           z.rounds, z.masked, z.some_rows, z.masked_fills, z.masked_frames, dark, dark_ground, now_s() - t0);
     assert_true(t.compared >= t.px * 99 / 100);
     assert_true(t.ground > t.px / 20 && t.surf > t.px / 20);
-    assert_true(partial > 0 && z.rounds > nframes && z.masked > 0 && z.some_rows > 0);
+    assert_true(partial > 0 && z.rounds > nframes && z.masked > 0 && z.some_rows > 0 && z.masked_fills > 0);
     assert_true(h.bad == 0 && hb.bad == 0);
     free(lin1);
     free(st0);
