@@ -442,8 +442,7 @@ static int atlas_need(void *user, const atlas_view *v, const uint32_t *ids, cons
     plx_engine *e = user;
     atlas_worker w;
     uint32_t n;
-    atlas_current(e);
-    if (e->atlas->todo == 0)
+    if (e->atlas->todo == 0) /* made current by plx_render before the frame */
         return 0;
     atlas_worker0(e, &w);
     while ((n = atlas_frame_missing(e->atlas, v, ids, mask, j0, j1, e->atlas_list, ENG_ATLAS_LIST)) > 0)

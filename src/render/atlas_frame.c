@@ -475,7 +475,8 @@ static int surface_run(const atlas *A, const atlas_view *v, atlas_cache *k, uint
     const uint32_t *t0;
     uint32_t nu, nv;
     int32_t i;
-    if (sid - 2u < A->nsurf && A->cdone[sid - 2u] == ATLAS_DARK) { /* no map: one byte decides */
+    uint8_t state = sid - 2u < A->nsurf ? A->cdone[sid - 2u] : ATLAS_UNFILLED; /* no chart past nsurf */
+    if (state == ATLAS_DARK) { /* no map: one byte decides */
         black_run(lin, i0, i1, mask);
         return 0;
     }
@@ -512,7 +513,7 @@ static int surface_run(const atlas *A, const atlas_view *v, atlas_cache *k, uint
         float fi = (float)i, r = 1.0f / (bw + aw * fi);
         lanes_add(L, i, t0, nu, nv, (bu + au * fi) * r, (bv + av * fi) * r, lin);
     }
-    return !atlas_filled(A->cdone[sid - 2u]);
+    return !atlas_filled(state);
 }
 
 int atlas_frame_row(const atlas *A, const atlas_view *v, atlas_cache *k, const uint32_t *ids, const uint8_t *mask,

@@ -3283,10 +3283,12 @@ static void atlas_rows(void *arg, int worker, uint32_t k)
 }
 
 /* atlas_need for each run of jobs that met an item not filled: what
- * their rows read, filled. */
+ * their rows read, filled. Returns the runs filled, or -1 when one could
+ * not be. */
 static int atlas_fill_rows(render *r, const render_opts *o, const atlas_view *v, uint32_t jobs)
 {
     uint32_t k = 0, e;
+    int runs = 0;
     while (k < jobs) {
         if (!r->defer[k]) {
             k++;
@@ -3296,24 +3298,13 @@ static int atlas_fill_rows(render *r, const render_opts *o, const atlas_view *v,
             ;
         if (o->atlas_need(o->atlas_user, v, r->id, o->mask, (int32_t)k * RENDER_TILE, (int32_t)e * RENDER_TILE) != 0)
             return -1;
+        runs++;
         k = e;
     }
-    return 0;
+    return runs;
 }
 
-/* Whether a job of the pass met an item not filled. */
-static int atlas_unfilled(const render *r, uint32_t jobs)
-{
-    uint32_t k;
-    for (k = 0; k < jobs; k++)
-        if (r->defer[k])
-            return 1;
-    return 0;
-}
-
-/* The atlas's view of the frame set up (its camera and sample shift),
- * stamped with the frame's number. */
-static void atlas_view_make(const render *r, atlas_view *v)
+void render_atlas_view(const render *r, atlas_view *v)
 {
     double ta = r->tanh_ * r->aspect, tb = r->tanh_, a0, b0;
     int k;
@@ -3330,24 +3321,19 @@ static void atlas_view_make(const render *r, atlas_view *v)
     v->stamp = r->frames;
 }
 
-void render_atlas_view(const render *r, atlas_view *v)
-{
-    atlas_view_make(r, v);
-}
-
 /* Every pixel from the atlas: the ground's ids set, then rows of pixels
  * (RENDER_TILE a job) on the workers, each with its own map cache. */
 static int atlas_pass(render *r, const render_opts *o, render_stats *st)
 {
     atlas_job jb;
     uint32_t jobs = (uint32_t)((r->h + RENDER_TILE - 1) / RENDER_TILE);
-    int k;
+    int k, runs;
     ground_ids(r, o);
     if (o->mask) /* adaptive anti-aliasing's later samples: only the marked pixels */
         mask_update(r, o);
     if (++r->frames == 0) /* 2^32 frames: a stale map could carry stamp 0 */
         ++r->frames;
-    atlas_view_make(r, &jb.v);
+    render_atlas_view(r, &jb.v);
     jb.r = r;
     jb.o = o;
     jb.count = o->auto_exposure;
@@ -3360,9 +3346,9 @@ static int atlas_pass(render *r, const render_opts *o, render_stats *st)
      * fills it, and reads those rows again: the same bytes as filling
      * first, a chart's values being its own whenever it is filled */
     run_jobs(o, jobs, atlas_rows, &jb);
-    if (atlas_unfilled(r, jobs)) {
-        if (atlas_fill_rows(r, o, &jb.v, jobs) != 0)
-            return -1;
+    if ((runs = atlas_fill_rows(r, o, &jb.v, jobs)) < 0)
+        return -1;
+    if (runs > 0) {
         jb.again = 1;
         run_jobs(o, jobs, atlas_rows, &jb);
     }
