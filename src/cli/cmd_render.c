@@ -422,6 +422,7 @@ int cmd_render(int argc, char **argv)
 #endif
     t0 = port_now_ns();
     st = plx_render(e, &a.cam, &a.opts, rgb8, rgbf, &info);
+    t0 = port_now_ns() - t0; /* the frame alone, not the PNG written after it */
     if (st != PLX_OK) {
         fprintf(stderr, "polarlux render: %s\n", plx_last_error(e));
 #ifdef PLX_HAVE_OSMESA
@@ -442,7 +443,7 @@ int cmd_render(int argc, char **argv)
                "(%.2f%% of the geometry) in %.1f ms, written to %s\n",
                a.aerial ? "aerial" : "street", a.cam.width, a.cam.height, prec, a.cam.eye[0], prec, a.cam.eye[1],
                a.cam.eye[2], prec, a.cam.target[0], prec, a.cam.target[1], a.cam.target[2], info.drawn, info.buildings,
-               100.0 * info.drawn_fraction, (port_now_ns() - t0) / 1e6, a.out);
+               100.0 * info.drawn_fraction, t0 / 1e6, a.out);
     if (rc == EXIT_OK) {
         cli_aa_warn("render", &a.c, &a.opts, &info);
         cli_aa_print(&a.opts, info.aa_later, (double)a.cam.width * a.cam.height, 1,
