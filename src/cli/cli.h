@@ -52,6 +52,9 @@ int cli_common_option(const char *cmd, int argc, char **argv, int *i, cli_common
 /* Creates an engine and loads the scene; prints the error and returns an
  * exit code on failure (engine freed), EXIT_OK on success. */
 int cli_open_scene(const char *cmd, const char *path, const cli_common *c, plx_engine **e);
+/* Whether path is a regular file starting with the bake magic (README
+ * "Bake files"); 0 for anything else, unreadable files included. */
+int cli_is_bake(const char *path);
 /* A large block (2 MiB aligned, huge pages where offered); free() it. */
 void *cli_big_alloc(size_t size);
 

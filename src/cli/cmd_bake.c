@@ -14,16 +14,17 @@ static const char help[] =
     "                     [--no-aerial] [--no-polar] [--texel M] [--max-size WxH]\n"
     "                     [--threads N] [--mem SIZE] [--strict] [--quiet]\n"
     "\n"
-    "Loads SCENE and builds everything queries and frames need: polar diagrams,\n"
-    "lamp light, photon buffers with K frames of N photons (levels for a viewer\n"
-    "at the centre, all around), the renderer for frames up to --max-size and\n"
-    "the radiance atlas: every surface's light (exact direct light, indirect\n"
-    "light from the photons) at sample points --texel metres apart, which\n"
-    "street and aerial frames read (filled after the photons on --threads\n"
-    "workers, with a progress line on a terminal; with --no-indirect the aerial\n"
-    "light map of direct light instead); then writes it all to one file. Every command that\n"
-    "takes a SCENE also takes the bake file and starts at once (README 'Bake\n"
-    "files'). Prints the file size, the engine memory in use and the times.\n"
+    "Loads SCENE (a GeoJSON file; a bake file cannot be baked again) and builds\n"
+    "everything queries and frames need: polar diagrams, lamp light, photon\n"
+    "buffers with K frames of N photons (levels for a viewer at the centre, all\n"
+    "around), the renderer for frames up to --max-size and the radiance atlas:\n"
+    "every surface's light (exact direct light, indirect light from the photons)\n"
+    "at sample points --texel metres apart, which street and aerial frames read\n"
+    "(filled after the photons on --threads workers, with a progress line on a\n"
+    "terminal; with --no-indirect the aerial light map of direct light instead);\n"
+    "then writes it all to one file. Every other command that takes a SCENE also\n"
+    "takes the bake file and starts at once (README 'Bake files'). Prints the\n"
+    "file size, the engine memory in use and the times.\n"
     "\n"
     "  -o FILE         the bake file (required)\n"
     "  --photons N     photons per frame (default 65536)\n"
@@ -84,6 +85,13 @@ static int parse_args(int argc, char **argv, bake_args *a)
         return cli_usage_error("bake", "missing SCENE");
     if (!a->out)
         return cli_usage_error("bake", "missing -o CITY.plxb");
+    if (cli_is_bake(a->scene)) { /* its scene is the loader's result, not the file it came from */
+        fprintf(stderr,
+                "polarlux bake: %s is a bake file, not a GeoJSON scene: bake the scene it was made from "
+                "again with the options you want\n",
+                a->scene);
+        return EXIT_USAGE;
+    }
     a->o.no_indirect = a->ind.off;
     return EXIT_OK;
 }

@@ -384,8 +384,7 @@ void cli_config(const cli_common *c, plx_config *cfg)
 
 cli_bake_state cli_bake_last;
 
-/* Whether path starts with the bake magic (README "Bake files"). */
-static int is_bake(const char *path)
+int cli_is_bake(const char *path)
 {
     char head[8];
     struct stat sb;
@@ -471,7 +470,7 @@ int cli_open_scene(const char *cmd, const char *path, const cli_common *c, plx_e
 {
     plx_config cfg;
     plx_status st;
-    if (is_bake(path)) {
+    if (cli_is_bake(path)) {
         if (c->nlamp_files > 0) {
             fprintf(stderr, "polarlux %s: %s: --lamps cannot be added to a bake file; give them to 'polarlux bake'\n",
                     cmd, path);

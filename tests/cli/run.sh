@@ -133,6 +133,9 @@ expect bake-unknown-option 2 "polarlux bake: unknown option '--bogus'" -- "$bin"
 expect bake-missing-out 2 "missing -o CITY.plxb" -- "$bin" bake fixtures/tiny.geojson
 expect bake-tiny 0 "^baked fixtures/eixample-4x4\.geojson into .*: [0-9]+ bytes .*engine memory in use [0-9]+ bytes" -- \
     "$bin" bake -q fixtures/eixample-4x4.geojson --frames 2 --photons 4000 --texel 2 --max-size 160x120 -o "$tmp/e.plxb"
+# a bake given as bake's SCENE: one line saying so (it read as malformed JSON)
+expect bake-of-bake 2 "polarlux bake: .*e\.plxb is a bake file, not a GeoJSON scene" -- "$bin" bake "$tmp/e.plxb" -o "$tmp/ee.plxb"
+if [ ! -e "$tmp/ee.plxb" ]; then echo "ok   bake-of-bake-no-file"; pass=$((pass + 1)); else echo "FAIL bake-of-bake-no-file"; fail=$((fail + 1)); fi
 expect bake-info 0 "^bake: [0-9]+ bytes \([0-9.]+ MB\) loaded in [0-9.]+ ms" -- "$bin" info "$tmp/e.plxb"
 expect bake-info-memory 0 "^memory: [0-9]+ bytes in use" -- "$bin" info "$tmp/e.plxb"
 printf '0.5 0.5\n10 -3\n61 61\n' >"$tmp/bp.txt"
