@@ -438,17 +438,20 @@ static int run(const walk_args *a, plx_engine *e, const walk_path *wp)
     memset(&wr, 0, sizeof wr);
     cli_refiner_init(&wr.ref, a->refine_height, a->refine_frames, a->ind.photons);
     view_hint(a, wp);
-    wr.n = (long)floor(L / step) + 1;
-    if (wr.n > a->max_frames)
-        wr.n = a->max_frames;
+    /* compared as a double: a long path at a slow pace has more steps
+     * than a long holds, and converting such a double is undefined */
+    wr.n = floor(L / step) + 1.0 < (double)a->max_frames ? (long)floor(L / step) + 1 : a->max_frames;
     sheet_plan(&wr.sh, a, wr.n);
     wr.ms = malloc(sizeof *wr.ms * (size_t)wr.n);
     sorted = malloc(sizeof *sorted * (size_t)wr.n);
     wr.rgb8 = malloc((size_t)a->w * a->h * 3);
     snprintf(path, sizeof path, "%s/cameras.txt", a->dir);
     wr.cams = fopen(path, "w");
-    if (!wr.ms || !sorted || !wr.rgb8 || !wr.cams) {
-        fprintf(stderr, "polarlux walk: %s\n", wr.cams ? "out of memory" : path);
+    if (!wr.cams) {
+        fprintf(stderr, "polarlux walk: %s: cannot write: %s\n", path, strerror(errno));
+        rc = EXIT_FAIL;
+    } else if (!wr.ms || !sorted || !wr.rgb8) {
+        fprintf(stderr, "polarlux walk: out of memory for %ld frames of %dx%d\n", wr.n, a->w, a->h);
         rc = EXIT_FAIL;
     } else {
         fprintf(wr.cams, "# frame eye_x eye_y eye_z target_x target_y target_z exposure\n");
@@ -497,6 +500,12 @@ static int run(const walk_args *a, plx_engine *e, const walk_path *wp)
     return rc;
 }
 
+static int is_folder(const char *path)
+{
+    struct stat sb;
+    return stat(path, &sb) == 0 && S_ISDIR(sb.st_mode);
+}
+
 int cmd_walk(int argc, char **argv)
 {
     walk_args a;
@@ -508,6 +517,10 @@ int cmd_walk(int argc, char **argv)
         return rc < 0 ? EXIT_OK : rc;
     if (mkdir(a.dir, 0755) != 0 && errno != EEXIST) {
         fprintf(stderr, "polarlux walk: %s: cannot create the folder: %s\n", a.dir, strerror(errno));
+        return EXIT_FAIL;
+    }
+    if (!is_folder(a.dir)) {
+        fprintf(stderr, "polarlux walk: %s: not a folder (-o names the folder the frames go to)\n", a.dir);
         return EXIT_FAIL;
     }
     a.c.render_w = a.w;

@@ -5,6 +5,7 @@
 #include <string.h>
 #include <cjson/cJSON.h>
 
+#include "cli.h"
 #include "port.h"
 #include "walk_path.h"
 
@@ -44,6 +45,12 @@ static int read_positions(const cJSON *coords, int project, const plx_scene_info
         if (project) {
             out[3 * k] = (out[3 * k] - si->lon0) * 111320.0 * coslat;
             out[3 * k + 1] = (out[3 * k + 1] - si->lat0) * 110540.0;
+        }
+        if (fabs(out[3 * k]) > CLI_MAX_COORD || fabs(out[3 * k + 1]) > CLI_MAX_COORD ||
+            fabs(out[3 * k + 2]) > CLI_MAX_COORD) {
+            snprintf(why, whylen, "position %d (%g, %g, %g) is more than 1e7 m from the origin", k, out[3 * k],
+                     out[3 * k + 1], out[3 * k + 2]);
+            return -1;
         }
         if (eyes && !(out[3 * k + 2] > 0)) {
             snprintf(why, whylen, "position %d: the eye must be above the ground (z > 0)", k);

@@ -203,6 +203,14 @@ expect walk-high-street-hint 0 "^polarlux walk: warning: the eye stays 200 m or 
     "$bin" walk "$tmp/e.plxb" --path "$tmp/high.geojson" --size 32x24 --fps 0.5 --aa 1 --no-indirect -o "$tmp/wh"
 printf '{"type":"LineString","coordinates":[[1,2]]}' >"$tmp/short.geojson"
 expect walk-short-path 1 "^polarlux walk: $tmp/short\.geojson: the LineString needs at least 2 positions$" -- "$bin" walk -q "$tmp/e.plxb" --path "$tmp/short.geojson" -o "$tmp/w3"
+# a coordinate beyond 1e7 m (it made the frame count overflow, then "out of
+# memory for the animation"), and -o naming a file (it said only the path)
+printf '{"type":"LineString","coordinates":[[1,2,1e300],[1,9,2]]}' >"$tmp/huge.geojson"
+expect walk-huge-coordinate 1 "^polarlux walk: $tmp/huge\.geojson: position 0 \(1, 2, 1e\+300\) is more than 1e7 m from the origin$" -- \
+    "$bin" walk -q "$tmp/e.plxb" --path "$tmp/huge.geojson" -o "$tmp/w3"
+printf 'x' >"$tmp/wfile"
+expect walk-out-is-file 1 "^polarlux walk: $tmp/wfile: not a folder" -- \
+    "$bin" walk -q "$tmp/e.plxb" --path "$tmp/path.geojson" --size 32x24 -o "$tmp/wfile"
 expect render-aa-bad 2 "--aa '0' is not a whole number from 1 to 16" -- "$bin" render fixtures/tiny.geojson --aa 0 -o "$tmp/x.png"
 # adaptive anti-aliasing (README "Anti-aliasing") against every sample
 expect render-aa-adaptive 0 "^anti-aliasing 2x2: the later samples shaded [0-9.]+% of the pixels \(adaptive" -- \
