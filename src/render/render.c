@@ -18,138 +18,10 @@
 #include "light/illuminance.h"
 #include "light/litregion.h"
 #include "base/geom.h"
+#include "render/render_int.h"
 
 #define R_ALIGN 16
-#define PI 3.14159265358979323846
 #define TWO_PI (2.0 * PI)
-
-typedef struct cull_item { double key; uint32_t b; } cull_item;
-
-#define RENDER_TILE 8           /* shading tiles, pixels a side */
-#define CULL_CELL 64.0          /* m, the culling grid's cells, */
-#define CULL_SIDE 128.0         /* at most this many a side (larger cells over larger scenes) */
-#define CULL_GROUP 8u           /* cells a side of a group of cells, tested first (cull) */
-#define RENDER_TILE_LAMPS 64    /* longest lamp list of a tile */
-#define TILE_PX (RENDER_TILE * RENDER_TILE)
-#define IND_STEP 4              /* sparse indirect: corners every IND_STEP pixels */
-
-/* What one worker of the shading pass works in: a tile's hit points,
- * normals and E, its lamp list, and its counters. */
-typedef struct shade_ws {
-    uint32_t tl[RENDER_TILE_LAMPS];
-    double tP[TILE_PX][3], tN[TILE_PX][3], tE[TILE_PX][3];
-    uint8_t tcall[TILE_PX];     /* 0 sky, 1 no shader, 2 shader */
-    double tI[TILE_PX][3];      /* indirect from the indirect ground map ... */
-    uint8_t tind[TILE_PX];      /* ... when 1 (else the hook's) */
-    render_stats st;            /* the shading pass's counters of this worker */
-} shade_ws;
-
-/* A grid corner's sample: whether its ray meets a surface, the point and
- * the normal (pixel_hit). */
-typedef struct corner_hit {
-    double P[3], n[3];
-    int hit;
-} corner_hit;
-
-/* A glow disc seen in a frame (glow_disc): centre x, y and radius in
- * pixels, and its lamp. */
-typedef struct glow_seen {
-    double g[3];
-    uint32_t lamp;
-} glow_seen;
-
-struct render {
-    arena *a;
-    const scene *s;
-    mesh *m;
-    render_shade_fn shade;
-    void *user;
-    int32_t max_w, max_h;
-    float *depth;
-    uint32_t *id;
-    float *lin;
-    raster_vertex *vbuf;
-    raster_pvert *pv;           /* vbuf's vertices prepared (raster_prepare) */
-    float *clip;                /* 4 per vertex of one building */
-    render_backend soft;        /* the built-in backend (user = this) */
-    raster_ctx rc;              /* its rasteriser state during a frame */
-    /* culling */
-    cull_item *heap;            /* nbld, min-heap by w_max */
-    double *gxyz;               /* one building's vertices (mesh_building) */
-    mesh_tri *gtri;             /* and its triangles */
-    uint32_t *sc_id;            /* sc_mask + 1 slots: surfaces seen (surf_get), by id */
-    mesh_surf *sc;
-    uint32_t sc_mask;           /* render_surf_slots - 1 */
-    uint32_t nheap;
-    double *wmin, *wmax;        /* nbld */
-    uint8_t *draw;              /* nbld */
-    /* the buildings by cells of a grid (each in the cell of its box's
-     * centre), each cell with the box of its buildings' boxes: a cell
-     * wholly outside the frustum culls its buildings at once */
-    uint32_t ncell;
-    uint32_t *cell_start;       /* ncell + 1 offsets into cell_bld */
-    uint32_t *cell_bld;         /* nbld building indices, cell by cell, ascending */
-    double *cell_box;           /* 6 a cell: minx, miny, minz, maxx, maxy, maxz */
-    /* the cells by groups of CULL_GROUP x CULL_GROUP, each with the box of
-     * its cells' boxes: a group wholly outside the frustum culls its cells
-     * without testing them */
-    uint32_t cside, gside;      /* cells and groups a side */
-    double *group_box;          /* 6 a group, as cell_box */
-    uint8_t *group_out;         /* gside^2: this frame's groups out of the frustum (cull) */
-    cull_item *trav;            /* nbld + ncell: the occlusion pass's heap */
-    uint32_t ntrav;
-    double *bins;               /* RENDER_BINS */
-    int32_t *yr;                /* nbld x 2: a drawn building's rows on screen (cull) */
-    struct band *band;          /* RENDER_BANDS of them, or NULL: the rows drawn by bands */
-    /* frame state */
-    int32_t w, h;
-    uint32_t cur_id;
-    double eye[3], f[3], rt[3], up[3];
-    double sx, sy, za, zb, tanh_, aspect, near_, far_;
-    double far_eye[3], far_near; /* what far_ was found for (setup_camera) */
-    double shift[2], shx, shy;  /* sample point offset in pixels, and in NDC */
-    double cpad[3];             /* the frustum culling's widening: x and y in NDC a unit of w,
-                                   and rows (render_opts.cull_samples) */
-    /* the culling kept for the later sample points of a frame (cull_samples):
-     * what it was made for, and its counts */
-    int kept;
-    double kept_key[16];
-    int kept_inside;
-    uint32_t kept_frustum, kept_occlusion;
-    int bg_fill;                /* this frame's built-in rasteriser starts each row of ids at its
-                                   background (row_background), for ground_ids to skip */
-    uint32_t *glamp;            /* nlamps + 1: with the kept culling, the lamps whose glow a
-                                   sample point within the pixel may draw (glow_candidates) */
-    uint32_t nglamp;
-    int glamp_ok;               /* glamp holds them for this frame's camera */
-    glow_seen *gseen;           /* nlamps + 1: the glow discs of the last frame drawn (glow_discs) */
-    uint32_t ngseen;
-    int gseen_ok;               /* gseen holds them */
-    /* shading by tiles */
-    light *lt;                  /* the light module when shade is render_shade_light */
-    shade_ws ws[RENDER_MAX_WORKERS];  /* one per worker of the shading pass */
-    uint8_t *defer;             /* per tile of the largest frame: left to the serial pass; in
-                                   frames from the radiance atlas, per job of RENDER_TILE rows:
-                                   read again (atlas_rows) */
-    /* sparse indirect (render_opts.indirect_sparse): per block of IND_STEP
-     * pixels a side, whether one surface covers it with its corners; the
-     * hook's value at each corner of the grid (RGB) */
-    uint8_t *blk;
-    float *ind;
-    corner_hit *crow;           /* two rows of corners' hit points (max_w / IND_STEP + 2 each) */
-    uint32_t hist[RENDER_MAX_WORKERS][EXPOSURE_BINS]; /* automatic exposure's counts, by part */
-    int32_t *stop;              /* per row of corners, then per pixel row: where the workers'
-                                   tries stopped (render_opts.indirect_try) */
-    int32_t nbx, nby;           /* blocks a row, rows of blocks */
-    int sparse;                 /* this frame's indirect is sparse */
-    lightmap lm;                /* the aerial light map (lightmap.c) */
-    indmap im;                  /* its indirect twin (indmap.c) */
-    double thr[TONEMAP_LEVELS];
-    tonemap_table *tm;          /* the last exposure's table (tonemap.h) */
-    uint32_t frames;            /* frames drawn: the atlas maps' stamp (atlas_frame.h) */
-    exposure_table *et;         /* the exposure's bins without the logarithm (exposure.h) */
-    const char *err;
-};
 
 /* ---- shaders ---------------------------------------------------------------- */
 
@@ -222,22 +94,7 @@ uint8_t render_srgb8(const render *r, double v)
 
 /* ---- the software backend (raster.h) ------------------------------------------ */
 
-/* A worker drawing a band of rows with the built-in rasteriser (render
- * frames on several workers): its own rasteriser state, scissored to the
- * band, and its own buffers for one building at a time. */
-#define RENDER_BANDS 4                /* band workers at most */
 #define RENDER_BAND_BYTES ((size_t)8 << 20) /* their buffers together at most */
-typedef struct band {
-    render *r;
-    raster_ctx rc;
-    uint32_t cur_id;
-    double *gxyz;
-    mesh_tri *gtri;
-    float *clip;
-    raster_vertex *vbuf;
-    raster_pvert *pv;
-} band;
-
 static int band_frag(void *user, int32_t x, int32_t y, float depth, const float *attr, float rgba[4])
 {
     band *bd = user;
@@ -386,7 +243,6 @@ static void bands_create(render *r, arena *a)
         }
     }
 }
-
 
 /* The culling grid's side in cells (at most CULL_SIDE) over the buildings' boxes. */
 static uint32_t cull_side(const scene *s, double *x0, double *y0, double *cell)
@@ -749,16 +605,6 @@ static int setup_camera(render *r, const render_camera *c, const render_opts *o)
     r->za = (r->far_ + r->near_) / (r->far_ - r->near_);
     r->zb = -2.0 * r->far_ * r->near_ / (r->far_ - r->near_);
     return 1;
-}
-
-static inline void to_clip(const render *r, const double *X, double out[4])
-{
-    double v0 = X[0] - r->eye[0], v1 = X[1] - r->eye[1], v2 = X[2] - r->eye[2];
-    double w = v0 * r->f[0] + v1 * r->f[1] + v2 * r->f[2];
-    out[0] = (v0 * r->rt[0] + v1 * r->rt[1] + v2 * r->rt[2]) * r->sx - r->shx * w;
-    out[1] = (v0 * r->up[0] + v1 * r->up[1] + v2 * r->up[2]) * r->sy + r->shy * w;
-    out[2] = r->za * w + r->zb;
-    out[3] = w;
 }
 
 /* to_clip rounded to floats, the rasteriser's vertex positions. */
@@ -1235,8 +1081,6 @@ static int occlusion_pays(const render *r)
     return !(r->eye[2] > 2.0 * fmax(top, 0.0));
 }
 
-static void run_jobs(const render_opts *o, uint32_t jobs, render_job_fn fn, void *arg);
-
 /* Cell c's buildings all drawn (1) or all culled by the frustum (0, counted). */
 static void cell_draw(render *r, uint32_t c, uint8_t draw, render_stats *st)
 {
@@ -1345,8 +1189,6 @@ static void cull(render *r, const render_opts *o, int inside, int rows, render_s
 }
 
 /* ---- drawing ------------------------------------------------------------------ */
-
-static int par_workers(const render_opts *o);
 
 /* One building through band bd: its triangles made, projected and drawn
  * (ids written through raster_triangle_id, or the fragment function). */
@@ -1737,13 +1579,6 @@ static const mesh_surf *surf_get(const render *r, uint32_t sid, mesh_surf *tmp)
     return tmp;
 }
 
-/* Surface sid's albedo (cached, or mesh_albedo). */
-static double surf_albedo(const render *r, uint32_t sid)
-{
-    uint32_t k = sid & r->sc_mask;
-    return r->sc_id[k] == sid ? r->sc[k].albedo : mesh_albedo(r->m, sid);
-}
-
 /* Puts the surfaces of the frame's pixels (and the ground) in the cache,
  * before the shading pass (whose workers only read it): a surface's slot
  * is its id modulo the cache's slots, the last one seen keeps it. */
@@ -2061,25 +1896,6 @@ static void corner_try_row(void *arg, int worker, uint32_t b)
         jb->calls[worker]++;
     }
     r->stop[b] = a;
-}
-
-/* The workers a parallel-for of this frame may use: 1 without one, at
- * most RENDER_MAX_WORKERS. */
-static int par_workers(const render_opts *o)
-{
-    if (!o || !o->par || o->workers < 2)
-        return 1;
-    return o->workers > RENDER_MAX_WORKERS ? RENDER_MAX_WORKERS : o->workers;
-}
-
-/* fn(arg, worker, k) for k = 0 .. jobs - 1 on the workers, or on this
- * thread without them (or when the port could not run them). */
-static void run_jobs(const render_opts *o, uint32_t jobs, render_job_fn fn, void *arg)
-{
-    uint32_t k;
-    if (par_workers(o) < 2 || jobs < 2 || o->par(o->par_ctx, par_workers(o), jobs, fn, arg) != 0)
-        for (k = 0; k < jobs; k++)
-            fn(arg, 0, k);
 }
 
 /* How many workers may try the hook (0: none, the hook on this thread). */
@@ -2685,7 +2501,6 @@ static size_t glow_mark(render *r, uint8_t *mask, uint8_t nw)
     }
     return added;
 }
-
 
 #define TONEMAP_CHUNK 65536     /* values a job */
 
