@@ -2,6 +2,7 @@
  * src/render/; see render.h for the renderer itself).
  *
  *   render.c           the render object and the passes not in a file of their own
+ *   camera.c           a frame's camera
  *
  * The small helpers are inline: they run in the hot loops of several files.
  */
@@ -103,7 +104,7 @@ struct render {
     uint32_t cur_id;
     double eye[3], f[3], rt[3], up[3];
     double sx, sy, za, zb, tanh_, aspect, near_, far_;
-    double far_eye[3], far_near; /* what far_ was found for (setup_camera) */
+    double far_eye[3], far_near; /* what far_ was found for (camera_setup) */
     double shift[2], shx, shy;  /* sample point offset in pixels, and in NDC */
     double cpad[3];             /* the frustum culling's widening: x and y in NDC a unit of w,
                                    and rows (render_opts.cull_samples) */
@@ -198,5 +199,10 @@ static inline void run_jobs(const render_opts *o, uint32_t jobs, render_job_fn f
         for (k = 0; k < jobs; k++)
             fn(arg, 0, k);
 }
+
+/* camera.c: a frame's camera from render_camera and render_opts (0 and
+ * r->err on a bad one); a pixel's sample ray direction. */
+int camera_setup(render *r, const render_camera *c, const render_opts *o);
+void camera_pixel_dir(const render *r, int32_t i, int32_t j, double d[3]);
 
 #endif
