@@ -3,6 +3,8 @@
  *
  *   render.c           the render object and the passes not in a file of their own
  *   camera.c           a frame's camera
+ *   cull.c             culling: the grid of cells, the frustum, the occlusion
+ *                      horizon and its front-to-back traversal
  *
  * The small helpers are inline: they run in the hot loops of several files.
  */
@@ -26,7 +28,7 @@ typedef struct cull_item { double key; uint32_t b; } cull_item;
 #define RENDER_TILE 8           /* shading tiles, pixels a side */
 #define CULL_CELL 64.0          /* m, the culling grid's cells, */
 #define CULL_SIDE 128.0         /* at most this many a side (larger cells over larger scenes) */
-#define CULL_GROUP 8u           /* cells a side of a group of cells, tested first (cull) */
+#define CULL_GROUP 8u           /* cells a side of a group of cells, tested first (cull_buildings) */
 #define RENDER_TILE_LAMPS 64    /* longest lamp list of a tile */
 #define TILE_PX (RENDER_TILE * RENDER_TILE)
 #define IND_STEP 4              /* sparse indirect: corners every IND_STEP pixels */
@@ -93,11 +95,11 @@ struct render {
      * without testing them */
     uint32_t cside, gside;      /* cells and groups a side */
     double *group_box;          /* 6 a group, as cell_box */
-    uint8_t *group_out;         /* gside^2: this frame's groups out of the frustum (cull) */
+    uint8_t *group_out;         /* gside^2: this frame's groups out of the frustum (cull_buildings) */
     cull_item *trav;            /* nbld + ncell: the occlusion pass's heap */
     uint32_t ntrav;
     double *bins;               /* RENDER_BINS */
-    int32_t *yr;                /* nbld x 2: a drawn building's rows on screen (cull) */
+    int32_t *yr;                /* nbld x 2: a drawn building's rows on screen (cull_buildings) */
     struct band *band;          /* RENDER_BANDS of them, or NULL: the rows drawn by bands */
     /* frame state */
     int32_t w, h;
@@ -204,5 +206,11 @@ static inline void run_jobs(const render_opts *o, uint32_t jobs, render_job_fn f
  * r->err on a bad one); a pixel's sample ray direction. */
 int camera_setup(render *r, const render_camera *c, const render_opts *o);
 void camera_pixel_dir(const render *r, int32_t i, int32_t j, double d[3]);
+
+/* cull.c: the culling grid's side and its fill (render_create); the
+ * frame's culling (r->draw, by frustum and occlusion). */
+uint32_t cull_side(const scene *s, double *x0, double *y0, double *cell);
+void cull_grid_fill(render *r);
+void cull_buildings(render *r, const render_opts *o, int inside, int rows, render_stats *st);
 
 #endif
