@@ -412,7 +412,7 @@ static void box_clip(const render *r, const double *bx, double c[8][4])
  * at most its largest). rows (may be NULL): the rows its projection may
  * cover (its corners' rows, two pixels more each way for snapping), every
  * row when a corner is not in front of the near plane: what a band of
- * rows needs to draw (draw_bands). box_out: the same from the box. */
+ * rows needs to draw (soft_draw_bands). box_out: the same from the box. */
 static int corners_out(const render *r, double c[8][4], double *wmn, double *wmx, int whole, int32_t *rows)
 {
     int out_l = 1, out_r = 1, out_b = 1, out_t = 1, out_n = 1, k, all_front = 1;

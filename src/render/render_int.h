@@ -5,6 +5,8 @@
  *   camera.c           a frame's camera
  *   cull.c             culling: the grid of cells, the frustum, the occlusion
  *                      horizon and its front-to-back traversal
+ *   soft_backend.c     the visibility pass: the built-in backend over raster.h,
+ *                      bands of rows on the workers, the ground's ids
  *
  * The small helpers are inline: they run in the hot loops of several files.
  */
@@ -117,7 +119,7 @@ struct render {
     int kept_inside;
     uint32_t kept_frustum, kept_occlusion;
     int bg_fill;                /* this frame's built-in rasteriser starts each row of ids at its
-                                   background (row_background), for ground_ids to skip */
+                                   background (row_background), for soft_ground_ids to skip */
     uint32_t *glamp;            /* nlamps + 1: with the kept culling, the lamps whose glow a
                                    sample point within the pixel may draw (glow_candidates) */
     uint32_t nglamp;
@@ -212,5 +214,17 @@ void camera_pixel_dir(const render *r, int32_t i, int32_t j, double d[3]);
 uint32_t cull_side(const scene *s, double *x0, double *y0, double *cell);
 void cull_grid_fill(render *r);
 void cull_buildings(render *r, const render_opts *o, int inside, int rows, render_stats *st);
+
+/* soft_backend.c: the built-in backend "soft" over raster.h; its band
+ * workers' buffers (render_create); the visibility pass by bands of rows
+ * or through a backend; the ground's ids where nothing was drawn. */
+int soft_begin(void *user, int32_t w, int32_t h, int cull_back);
+void soft_draw(void *user, const float *clip, uint32_t nv, const mesh_tri *tri, uint32_t ntri,
+               uint32_t v_base);
+int soft_finish(void *user, uint32_t *id, float *depth);
+void soft_bands_create(render *r, arena *a);
+void soft_draw_bands(render *r, const render_opts *o, int cull_back, render_stats *st);
+void soft_draw_buildings(render *r, const render_backend *be, render_stats *st);
+void soft_ground_ids(render *r, const render_opts *o);
 
 #endif
