@@ -7,6 +7,7 @@
  *                      horizon and its front-to-back traversal
  *   soft_backend.c     the visibility pass: the built-in backend over raster.h,
  *                      bands of rows on the workers, the ground's ids
+ *   glow.c             the lamps' glow discs
  *
  * The small helpers are inline: they run in the hot loops of several files.
  */
@@ -226,5 +227,11 @@ void soft_bands_create(render *r, arena *a);
 void soft_draw_bands(render *r, const render_opts *o, int cull_back, render_stats *st);
 void soft_draw_buildings(render *r, const render_backend *be, render_stats *st);
 void soft_ground_ids(render *r, const render_opts *o);
+
+/* glow.c: the lamps whose glow a frame's sample points may draw; the
+ * glows added to the linear image; their pixels marked in a mask. */
+void glow_candidates(render *r);
+void glow_draw(render *r, const render_opts *o, render_stats *st);
+size_t glow_mark(render *r, uint8_t *mask, uint8_t nw);
 
 #endif
