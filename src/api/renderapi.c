@@ -5,6 +5,7 @@
 #include "light/illuminance.h"
 #include "light/litregion.h"
 #include "render/render.h"
+#include "render/render_aa.h"
 #include "render/mesh.h"
 #include "photon/indirect.h"
 #include "photon/trace.h"

@@ -8,6 +8,8 @@
  *   soft_backend.c     the visibility pass: the built-in backend over raster.h,
  *                      bands of rows on the workers, the ground's ids
  *   glow.c             the lamps' glow discs
+ *   render_aa.c        adaptive anti-aliasing: the samples' sums, the marks, the
+ *                      2 x 2 sums at the marked pixels (render_aa.h)
  *
  * The small helpers are inline: they run in the hot loops of several files.
  */
@@ -233,5 +235,8 @@ void soft_ground_ids(render *r, const render_opts *o);
 void glow_candidates(render *r);
 void glow_draw(render *r, const render_opts *o, render_stats *st);
 size_t glow_mark(render *r, uint8_t *mask, uint8_t nw);
+
+/* render_aa.c: a later anti-aliasing sample's mask updated (render_opts.mask). */
+void render_aa_mask_update(render *r, const render_opts *o);
 
 #endif

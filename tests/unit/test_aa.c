@@ -54,6 +54,7 @@
 #include "fixture.h"
 #include "base/engine.h"
 #include "render/render.h"
+#include "render/render_aa.h"
 
 #define MEM ((size_t)256 << 20)
 
