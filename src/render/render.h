@@ -413,11 +413,6 @@ int render_tonemap_par(render *r, const float *lin, size_t px, double ex, int cu
  * returns the frame's own floats. */
 const float *render_linear(const render *r);
 
-/* The atlas's view (atlas_frame.h) of the camera and sample shift of the
- * last frame set up, with the stamp of the last frame read from the atlas:
- * right after a frame read from the atlas, that frame's view. */
-void render_atlas_view(const render *r, struct atlas_view *v /* OUT */);
-
 /* Gives the renderer lin (room for its largest frame's 3 floats a pixel:
  * not checked, the caller sizes it as render_create does) as its linear
  * image from now on, and returns the one it had. 2 x 2

@@ -10,6 +10,7 @@
  *   glow.c             the lamps' glow discs
  *   render_aa.c        adaptive anti-aliasing: the samples' sums, the marks, the
  *                      2 x 2 sums at the marked pixels (render_aa.h)
+ *   render_atlas.c     frames from the radiance atlas (render_atlas.h)
  *
  * The small helpers are inline: they run in the hot loops of several files.
  */
@@ -238,5 +239,9 @@ size_t glow_mark(render *r, uint8_t *mask, uint8_t nw);
 
 /* render_aa.c: a later anti-aliasing sample's mask updated (render_opts.mask). */
 void render_aa_mask_update(render *r, const render_opts *o);
+
+/* render_atlas.c: every pixel of a frame from the radiance atlas (-1 when
+ * what it shows could not be filled). */
+int render_atlas_pass(render *r, const render_opts *o, render_stats *st);
 
 #endif

@@ -55,6 +55,7 @@
 #include "light/light.h"
 #include "light/illuminance.h"
 #include "render/render.h"
+#include "render/render_atlas.h"
 #include "render/mesh.h"
 #include "render/texel.h"
 #include "render/atlas.h"
