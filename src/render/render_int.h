@@ -7,6 +7,7 @@
  *                      horizon and its front-to-back traversal
  *   soft_backend.c     the visibility pass: the built-in backend over raster.h,
  *                      bands of rows on the workers, the ground's ids
+ *   shade_tiles.c      the shading pass by tiles of pixels
  *   glow.c             the lamps' glow discs
  *   render_aa.c        adaptive anti-aliasing: the samples' sums, the marks, the
  *                      2 x 2 sums at the marked pixels (render_aa.h)
@@ -51,7 +52,7 @@ typedef struct shade_ws {
 } shade_ws;
 
 /* A grid corner's sample: whether its ray meets a surface, the point and
- * the normal (pixel_hit). */
+ * the normal (shade_pixel_hit). */
 typedef struct corner_hit {
     double P[3], n[3];
     int hit;
@@ -243,5 +244,14 @@ void render_aa_mask_update(render *r, const render_opts *o);
 /* render_atlas.c: every pixel of a frame from the radiance atlas (-1 when
  * what it shows could not be filled). */
 int render_atlas_pass(render *r, const render_opts *o, render_stats *st);
+
+/* shade_tiles.c: the surface cache filled before the shading pass; a
+ * pixel's hit point; the shading pass by tiles. */
+void shade_surf_cache_fill(render *r);
+int shade_pixel_hit(render *r, int32_t i, int32_t j, uint32_t *sid_out, double P[3], double n[3]);
+void shade_pass(render *r, const render_opts *o, render_stats *st);
+
+/* render.c, sparse_indirect.c's part not yet in a file of its own: */
+void sparse_at(const render *r, int32_t i, int32_t j, double E[3]);
 
 #endif
