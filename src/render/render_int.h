@@ -1,13 +1,15 @@
 /* render_int.h: what the files of the renderer share (private to
  * src/render/; see render.h for the renderer itself).
  *
- *   render.c           the render object and the passes not in a file of their own
+ *   render.c           the render object: creation, the frame driver, exposure
+ *                      and tone mapping on the workers, the light map's builds
  *   camera.c           a frame's camera
  *   cull.c             culling: the grid of cells, the frustum, the occlusion
  *                      horizon and its front-to-back traversal
  *   soft_backend.c     the visibility pass: the built-in backend over raster.h,
  *                      bands of rows on the workers, the ground's ids
  *   shade_tiles.c      the shading pass by tiles of pixels
+ *   sparse_indirect.c  the indirect hook at the corners of blocks of pixels
  *   glow.c             the lamps' glow discs
  *   render_aa.c        adaptive anti-aliasing: the samples' sums, the marks, the
  *                      2 x 2 sums at the marked pixels (render_aa.h)
@@ -251,7 +253,10 @@ void shade_surf_cache_fill(render *r);
 int shade_pixel_hit(render *r, int32_t i, int32_t j, uint32_t *sid_out, double P[3], double n[3]);
 void shade_pass(render *r, const render_opts *o, render_stats *st);
 
-/* render.c, sparse_indirect.c's part not yet in a file of its own: */
+/* sparse_indirect.c: the hook at the corners of one-surface blocks before
+ * the shading pass, a pixel's term from them, the other pixels after it. */
+void sparse_corners(render *r, const render_opts *o, render_stats *st);
 void sparse_at(const render *r, int32_t i, int32_t j, double E[3]);
+void sparse_rest(render *r, const render_opts *o, render_stats *st);
 
 #endif
