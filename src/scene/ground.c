@@ -29,7 +29,7 @@
  *
  * Who reads it: the photon tracer (Russian roulette at a ground hit uses the
  * luminance of the albedo there, photon.c) and the renderer (ground pixels
- * are albedo_c / pi * E_c per channel, render.c). Nothing else reads the
+ * are albedo_c / pi * E_c per channel, shade_tiles.c). Nothing else reads the
  * ground's albedo; the photon buffers hold what was traced with the image
  * of the time, so setting an image drops them (plx_set_ground_image in
  * src/api/groundapi.c).

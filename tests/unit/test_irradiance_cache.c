@@ -61,7 +61,7 @@ static void camera(plx_camera *c)
     c->height = H;
 }
 
-/* The ray through the centre of pixel (i, j), as render.c projects. */
+/* The ray through the centre of pixel (i, j), as camera.c projects. */
 static void pixel_ray(const plx_camera *c, int i, int j, double d[3])
 {
     double f[3], rt[3], up[3], l, x, y, th = tan(c->fov_deg * PI / 360.0);

@@ -311,7 +311,7 @@ static void test_triangle_id_same(void **state)
                 continue;
             }
             fallback++;
-            it.id = ib; /* the fallback writes through the fragment function, as render.c's */
+            it.id = ib; /* the fallback writes through the fragment function, as soft_backend.c's */
             raster_set_fragment(&rb, id_frag, &it, 0);
             raster_triangle(&rb, &v[0], &v[1], &v[2]);
             it.id = ia;

@@ -963,7 +963,7 @@ static void test_cull_equal_above_roofs(void **state)
     cull_equal("fixtures/oldtown-8x8.geojson", quick() ? 6 : 16, 25, 24);
 }
 
-/* The groups of culling cells (render.c groups_out: a group out of the
+/* The groups of culling cells (cull.c groups_out: a group out of the
  * frustum culls its cells untested), over scenes of several groups a
  * side: eyes anywhere over the scene, at street level looking level to
  * up (the frame's lower edge cuts walls: a group's tops decide) or above
@@ -1029,7 +1029,7 @@ static void test_cull_groups(void **state)
 }
 
 /* Eyes above twice the tallest top, where the occlusion test is skipped
- * (render.c occlusion_pays): the image is still the unculled one. */
+ * (cull.c occlusion_pays): the image is still the unculled one. */
 static void test_cull_equal_high(void **state)
 {
     (void)state;

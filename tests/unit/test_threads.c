@@ -1,5 +1,5 @@
 /* test_threads: a frame is the same bytes for any number of threads
- * (plx_config.threads, plx_port.parallel_for; src/render/render.c's
+ * (plx_config.threads, plx_port.parallel_for; src/render/shade_tiles.c's
  * shading pass).
  *
  * The eixample fixture with photon frames (indirect light from the photon
