@@ -196,7 +196,6 @@ static void occluder_insert(render *r, uint32_t b, double mu)
     }
 }
 
-/* Is building b hidden by the horizon? */
 /* Whether every ray that can reach box (minx, miny, minz, maxx, maxy,
  * maxz) is stopped by the horizon's bins (render.h); *slope_out gets the
  * steepest slope from the eye to its top (sB) when it is computed. */

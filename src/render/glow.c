@@ -4,8 +4,7 @@
 
 #include "render/render_int.h"
 
-/* A lit lamp's centre in front of the near plane: its clip coordinates c
- * and its place (px, py) in pixels of this sample point; 0 otherwise. */
+/* The clip coordinates c of lamp lp's centre. */
 static void lamp_clip(const render *r, const scene_lamp *lp, double c[4])
 {
     double X[3];
@@ -25,6 +24,8 @@ static int centre_of(const render *r, const scene_lamp *lp, const double c[4], d
     return 1;
 }
 
+/* A lit lamp's centre in front of the near plane: its clip coordinates c
+ * and its place (px, py) in pixels of this sample point; 0 otherwise. */
 static int lamp_centre(const render *r, const scene_lamp *lp, double c[4], double *px, double *py)
 {
     lamp_clip(r, lp, c);

@@ -387,7 +387,7 @@ static void mask_against_brute(plx_engine *e, int w, int h, int workers)
     free(rgb8); free(scratch); free(keep); free(mask); free(id); free(id0);
 }
 
-/* mask_update (a later sample with render_opts.mask): every pixel whose
+/* render_aa_mask_update (a later sample with render_opts.mask): every pixel whose
  * surface (the ground and the sky as one) is not mask_id's gets marked,
  * the marks already there stay, and no other pixel is marked (no glows);
  * on the given workers, at w x h (ids sixteen at a time, jobs of 65,536

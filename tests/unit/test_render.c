@@ -1162,7 +1162,7 @@ static void test_cull_kept_edge(void **state)
     free(mem);
 }
 
-/* The far plane kept between frames of one eye (setup_camera): a frame
+/* The far plane kept between frames of one eye (camera_setup): a frame
  * from an eye far outside the scene after one from inside it needs a far
  * plane of its own; its ids equal those of a new render object's first
  * frame from there (with the first eye's far plane the farther buildings
