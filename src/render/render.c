@@ -504,7 +504,7 @@ plx_status render_frame(render *r, const render_camera *cam, const render_opts *
         }
         goto finish;
     }
-    shade_surf_cache_fill(r);
+    pixel_surf_cache_fill(r);
     if (o->mask)
         render_aa_mask_update(r, o);
     if (o->lightmap && r->lm.built && !r->lm.has_ind && o->indirect && o->indirect_map &&

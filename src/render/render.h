@@ -474,7 +474,7 @@ void render_lightmap_get(const render *r, render_lightmap_info *out /* OUT */);
  * pointer is kept. */
 void render_code_unbind(render *r);
 /* Surface records the renderer keeps, by id modulo their number (a power
- * of 2; shade_tiles.c's surf_get): at most this many. */
+ * of 2; render_int.h's pixel_surf): at most this many. */
 #define RENDER_SURF_CACHE 16384
 /* Their number for a scene and the largest frame: one per surface of the
  * scene (every one cached), at most one per 64 pixels and

@@ -8,6 +8,7 @@
  *                      horizon and its front-to-back traversal
  *   soft_backend.c     the visibility pass: the built-in backend over raster.h,
  *                      bands of rows on the workers, the ground's ids
+ *   pixel_hit.c        a pixel's surface, hit point and normal; the surface cache
  *   shade_tiles.c      the shading pass by tiles of pixels
  *   sparse_indirect.c  the indirect hook at the corners of blocks of pixels
  *   glow.c             the lamps' glow discs
@@ -54,7 +55,7 @@ typedef struct shade_ws {
 } shade_ws;
 
 /* A grid corner's sample: whether its ray meets a surface, the point and
- * the normal (shade_pixel_hit). */
+ * the normal (pixel_hit). */
 typedef struct corner_hit {
     double P[3], n[3];
     int hit;
@@ -86,7 +87,7 @@ struct render {
     cull_item *heap;            /* nbld, min-heap by w_max */
     double *gxyz;               /* one building's vertices (mesh_building) */
     mesh_tri *gtri;             /* and its triangles */
-    uint32_t *sc_id;            /* sc_mask + 1 slots: surfaces seen (surf_get), by id */
+    uint32_t *sc_id;            /* sc_mask + 1 slots: surfaces seen (pixel_surf), by id */
     mesh_surf *sc;
     uint32_t sc_mask;           /* render_surf_slots - 1 */
     uint32_t nheap;
@@ -211,6 +212,17 @@ static inline void run_jobs(const render_opts *o, uint32_t jobs, render_job_fn f
             fn(arg, 0, k);
 }
 
+/* Surface sid's record: from the cache when it holds it, else made in
+ * tmp (the same values: mesh_surface). */
+static inline const mesh_surf *pixel_surf(const render *r, uint32_t sid, mesh_surf *tmp)
+{
+    uint32_t k = sid & r->sc_mask;
+    if (r->sc_id[k] == sid)
+        return &r->sc[k];
+    mesh_surface(r->m, sid, tmp);
+    return tmp;
+}
+
 /* camera.c: a frame's camera from render_camera and render_opts (0 and
  * r->err on a bad one); a pixel's sample ray direction. */
 int camera_setup(render *r, const render_camera *c, const render_opts *o);
@@ -247,10 +259,12 @@ void render_aa_mask_update(render *r, const render_opts *o);
  * what it shows could not be filled). */
 int render_atlas_pass(render *r, const render_opts *o, render_stats *st);
 
-/* shade_tiles.c: the surface cache filled before the shading pass; a
- * pixel's hit point; the shading pass by tiles. */
-void shade_surf_cache_fill(render *r);
-int shade_pixel_hit(render *r, int32_t i, int32_t j, uint32_t *sid_out, double P[3], double n[3]);
+/* pixel_hit.c: the surface cache filled before the shading pass; a
+ * pixel's surface, hit point and normal. */
+void pixel_surf_cache_fill(render *r);
+int pixel_hit(render *r, int32_t i, int32_t j, uint32_t *sid_out, double P[3], double n[3]);
+
+/* shade_tiles.c: the shading pass by tiles. */
 void shade_pass(render *r, const render_opts *o, render_stats *st);
 
 /* sparse_indirect.c: the hook at the corners of one-surface blocks before

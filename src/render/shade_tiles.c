@@ -288,73 +288,6 @@ static int indmap_usable(const render *r, const render_opts *o)
     return o->indirect && o->indirect_map && r->im.built && r->im.key == o->indirect_key;
 }
 
-/* Surface sid's record: from the cache when it holds it, else made in
- * tmp (the same values: mesh_surface). */
-static const mesh_surf *surf_get(const render *r, uint32_t sid, mesh_surf *tmp)
-{
-    uint32_t k = sid & r->sc_mask;
-    if (r->sc_id[k] == sid)
-        return &r->sc[k];
-    mesh_surface(r->m, sid, tmp);
-    return tmp;
-}
-
-/* Puts the surfaces of the frame's pixels (and the ground) in the cache,
- * before the shading pass (whose workers only read it): a surface's slot
- * is its id modulo the cache's slots, the last one seen keeps it. */
-void shade_surf_cache_fill(render *r)
-{
-    size_t p, px = (size_t)r->w * (size_t)r->h;
-    uint32_t last = MESH_SURF_NONE, sid, k;
-    for (p = 0; p <= px; p++) {
-        sid = p < px ? r->id[p] : MESH_SURF_GROUND;
-        if (sid == last)
-            continue;
-        last = sid;
-        k = sid & r->sc_mask;
-        if (r->sc_id[k] != sid) {
-            mesh_surface(r->m, sid, &r->sc[k]);
-            r->sc_id[k] = sid;
-        }
-    }
-}
-
-/* Pixel (i, j)'s sample ray and what it meets: the surface (a pixel no
- * building covers that looks down is the ground, and its id is set so),
- * the hit point and the normal facing the eye. Returns 0 for the sky. */
-int shade_pixel_hit(render *r, int32_t i, int32_t j, uint32_t *sid_out, double P[3], double n[3])
-{
-    size_t p = (size_t)j * (size_t)r->w + (size_t)i;
-    double d[3], tt, nd;
-    uint32_t sid = r->id[p];
-    mesh_surf sfv;
-    const mesh_surf *sf;
-    int k;
-    camera_pixel_dir(r, i, j, d);
-    if (sid == MESH_SURF_NONE) {
-        if (!(d[2] < 0.0))
-            return 0;
-        sid = MESH_SURF_GROUND;
-        r->id[p] = sid;
-    }
-    sf = surf_get(r, sid, &sfv);
-    nd = sf->n[0] * d[0] + sf->n[1] * d[1] + sf->n[2] * d[2];
-    if (sid == MESH_SURF_GROUND)
-        tt = -r->eye[2] / d[2];
-    else
-        tt = (sf->d - (sf->n[0] * r->eye[0] + sf->n[1] * r->eye[1] + sf->n[2] * r->eye[2])) / nd;
-    if (!isfinite(tt) || tt < 0.0)
-        tt = 0.0;
-    for (k = 0; k < 3; k++) {
-        P[k] = r->eye[k] + tt * d[k];
-        n[k] = nd > 0.0 ? -sf->n[k] : sf->n[k];
-    }
-    if (sid == MESH_SURF_GROUND)
-        P[2] = 0.0;
-    *sid_out = sid;
-    return 1;
-}
-
 /* Step 1 of a tile: every pixel's hit point and normal; E = 0 (or the
  * light map's, when sample) for now; sky pixels written. */
 static void tile_points(render *r, shade_ws *w, const render_opts *o, tile_state *t, int sample)
@@ -389,12 +322,12 @@ static void tile_points(render *r, shade_ws *w, const render_opts *o, tile_state
             w->tcall[q] = 0;
             if (o->mask && !o->mask[p])
                 continue;
-            if (!shade_pixel_hit(r, i, j, &sid, P, n)) {
+            if (!pixel_hit(r, i, j, &sid, P, n)) {
                 t->sky++;
                 out[0] = out[1] = out[2] = 0.0f;
                 continue;
             }
-            sf = surf_get(r, sid, &sfv);
+            sf = pixel_surf(r, sid, &sfv);
             if (sid == MESH_SURF_GROUND)
                 t->ground++;
             else
@@ -492,7 +425,7 @@ static int tile_shade(render *r, shade_ws *w, const render_opts *o, tile_state *
                 double Ei[3] = { 0, 0, 0 };
                 if (o->indirect_surf) {
                     mesh_surf sfv;
-                    const mesh_surf *sf = surf_get(r, r->id[p], &sfv);
+                    const mesh_surf *sf = pixel_surf(r, r->id[p], &sfv);
                     o->indirect_surf(o->indirect_user, r->id[p], sf->bld, w->tP[q], w->tN[q], Ei);
                 } else
                     o->indirect(o->indirect_user, w->tP[q], w->tN[q], Ei);

@@ -34,7 +34,7 @@ static int frag_id(void *user, int32_t x, int32_t y, float depth, const float *a
  * below the horizon, else none (sky). The camera's right vector is
  * horizontal (camera_setup: rt[2] = 0), so a pixel's direction has the
  * same height along a row, bit for bit: one camera_pixel_dir a row decides it,
- * as shade_pixel_hit decides it for each pixel. */
+ * as pixel_hit decides it for each pixel. */
 static uint32_t row_background(const render *r, int32_t j)
 {
     double d[3];
@@ -276,7 +276,7 @@ static void ground_lanes(uint32_t *restrict id)
         id[k] = id[k] == MESH_SURF_NONE ? MESH_SURF_GROUND : id[k];
 }
 
-/* Pixel row j's ground pixels get the ground's id (shade_pixel_hit writes it;
+/* Pixel row j's ground pixels get the ground's id (pixel_hit writes it;
  * each pixel on its own), when the row looks below the horizon
  * (row_background). */
 static void ground_row(render *r, int32_t j)

@@ -41,7 +41,7 @@ static void corner_row(render *r, int32_t b, corner_hit *row)
     int32_t a;
     uint32_t sid;
     for (a = 0; a <= r->nbx; a++)
-        row[a].hit = shade_pixel_hit(r, corner_x(r, a), corner_y(r, b), &sid, row[a].P, row[a].n);
+        row[a].hit = pixel_hit(r, corner_x(r, a), corner_y(r, b), &sid, row[a].P, row[a].n);
 }
 
 /* Whether block (a, b), its far corners included, lies on one surface,
@@ -141,8 +141,8 @@ static void corner_try_row(void *arg, int worker, uint32_t b)
         uint32_t sid;
         if (!corner_used(r, a, (int32_t)b))
             continue;
-        /* the ground ids are in place: this shade_pixel_hit writes nothing */
-        h.hit = shade_pixel_hit(r, corner_x(r, a), corner_y(r, (int32_t)b), &sid, h.P, h.n);
+        /* the ground ids are in place: this pixel_hit writes nothing */
+        h.hit = pixel_hit(r, corner_x(r, a), corner_y(r, (int32_t)b), &sid, h.P, h.n);
         if (!h.hit)
             continue;
         if (!corner_value(r, jb->o, a, (int32_t)b, &h, 1, worker))
@@ -183,7 +183,7 @@ static void corners_rest(render *r, const render_opts *o, render_stats *st)
         uint32_t sid;
         for (a = r->stop[b]; a <= r->nbx; a++)
             if (corner_used(r, a, b)) {
-                h.hit = shade_pixel_hit(r, corner_x(r, a), corner_y(r, b), &sid, h.P, h.n);
+                h.hit = pixel_hit(r, corner_x(r, a), corner_y(r, b), &sid, h.P, h.n);
                 if (h.hit) {
                     (void)corner_value(r, o, a, b, &h, 0, 0);
                     st->indirect_calls++;
@@ -282,7 +282,7 @@ static int32_t rest_row(render *r, const render_opts *o, int32_t j, int32_t i0, 
         uint32_t sid;
         int k;
         if (r->blk[(size_t)block_of(j, r->nby) * (size_t)r->nbx + (size_t)block_of(i, r->nbx)] ||
-            (o->mask && !o->mask[p]) || !shade_pixel_hit(r, i, j, &sid, P, n))
+            (o->mask && !o->mask[p]) || !pixel_hit(r, i, j, &sid, P, n))
             continue;
         if (!try)
             o->indirect(o->indirect_user, P, n, Ei);
