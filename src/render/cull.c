@@ -243,6 +243,7 @@ static int hidden_box(render *r, const double *box, double mu, double *slope_out
     return 1;
 }
 
+/* Is building b hidden by the horizon? */
 static int hidden(render *r, uint32_t b, double mu)
 {
     double box[6], sB;

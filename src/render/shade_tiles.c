@@ -1,6 +1,5 @@
 /* shade_tiles: the shading pass, by tiles of RENDER_TILE x RENDER_TILE pixels
- * (each pixel's hit point, the tile's lamps, the illuminance), and the
- * cache of the surfaces a frame sees. */
+ * (each pixel's hit point, the tile's lamps, the illuminance). */
 #include <math.h>
 #include <string.h>
 

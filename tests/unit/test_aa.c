@@ -433,8 +433,7 @@ static void mask_update_against_brute(plx_engine *e, int w, int h, int workers, 
     free(id0); free(mask); free(before);
 }
 
-/* render_aa_mask's count with the glows it marks: the marked bytes. */
-/* mask_update's glows: a later sample whose surfaces are all the first's
+/* render_aa_mask_update's glows: a later sample whose surfaces are all the first's
  * (mask_id: its own ids) marks the pixels of the glows it sees, with byte
  * render_opts.mask_new (2), and keeps the marks already there (1). */
 static void mask_update_glows(plx_engine *e, int w, int h)
@@ -467,6 +466,7 @@ static void mask_update_glows(plx_engine *e, int w, int h)
     free(id0); free(mask);
 }
 
+/* render_aa_mask's count with the glows it marks: the marked bytes. */
 static void mask_count_with_glows(plx_engine *e, int w, int h)
 {
     plx_camera cam;
