@@ -24,8 +24,9 @@ static const char help[] =
     "of up to 16 frames). Everything is built once (or loaded from a bake) and\n"
     "reused by every frame: with indirect light each frame reads the radiance\n"
     "atlas (see render), filled as the frames need it or held by the bake.\n"
-    "Prints the render time per frame (median, p95)\n"
-    "and frames per second; says on stderr how many frames are entirely black, if any.\n"
+    "Prints the render time per frame (median, p95) and frames per second, and on\n"
+    "stderr how many frames are entirely black, if any; on a terminal, a walk of\n"
+    "more than a second shows the share of its frames done as it goes.\n"
     "\n"
     "  --path FILE      a GeoJSON LineString of eye positions [x, y] or [x, y, z]\n"
     "                   (z default 1.7 m); the eye looks 10 m ahead along the path,\n"
@@ -431,6 +432,7 @@ static void walk_refine_print(const walk_args *a, const walk_run *wr)
 static int run(const walk_args *a, plx_engine *e, const walk_path *wp)
 {
     walk_run wr;
+    cli_progress pr;
     double L = walk_path_length(wp), step = a->speed / a->fps, *sorted;
     char path[4096], err[512];
     int rc = EXIT_OK;
@@ -456,8 +458,12 @@ static int run(const walk_args *a, plx_engine *e, const walk_path *wp)
     } else {
         fprintf(wr.cams, "# frame eye_x eye_y eye_z target_x target_y target_z exposure\n");
     }
-    for (k = 0; rc == EXIT_OK && k < wr.n; k++)
+    cli_progress_start(&pr); /* a line on a terminal, after a second */
+    for (k = 0; rc == EXIT_OK && k < wr.n; k++) {
         rc = frame(a, e, wp, &wr, k, step);
+        cli_progress_step(&pr, "walk", (size_t)k + 1, (size_t)wr.n);
+    }
+    cli_progress_end(&pr);
     rc = writer_end(&wr, rc);
     if (rc == EXIT_OK && contact_sheet(a, &wr.sh, err, sizeof err) != 0) {
         fprintf(stderr, "polarlux walk: %s\n", err);
