@@ -24,6 +24,9 @@ __all__ = ["Scene", "PolarluxError", "MemoryBudgetError", "memory_estimate", "sc
 USE_VISIBILITY, USE_LIGHT, USE_RENDER = _lib.USE_VISIBILITY, _lib.USE_LIGHT, _lib.USE_RENDER
 
 
+BAKE_MAGIC = b"PLXBAKE\0"  # a bake file's first 8 bytes (README "Bake files")
+
+
 class PolarluxError(Exception):
     """A call failed: .status is the plx_status name, str() the engine's one-line message."""
 
@@ -100,11 +103,7 @@ class Scene:
 
     def __init__(self, text, name="scene", mem=None, strict=False, lit_cache_bytes=0, render_max=(0, 0)):
         data = _as_bytes(text)
-        self.warnings = []
-        self._log = _lib.LOG_FN(self._on_log)
-        self._port = _lib.Port()
-        self._port.log = self._log
-        self._cfg = _config(lit_cache_bytes, render_max, strict, self._port)
+        self._start(strict, lit_cache_bytes, render_max)
         if mem is None:
             mem = memory_estimate(data, USE_VISIBILITY | USE_LIGHT | USE_RENDER, lit_cache_bytes, render_max)
         # np.empty: the pages are taken by the OS only when the engine touches them
@@ -115,6 +114,17 @@ class Scene:
         if st != _lib.OK:
             _raise(st, "plx_engine_create failed (mem too small?)")
         self._check(lib.plx_load_geojson(self._e, data, len(data), name.encode("utf-8")))
+        self._read_info()
+
+    def _start(self, strict, lit_cache_bytes=0, render_max=(0, 0)):
+        self.warnings = []
+        self._e = ctypes.c_void_p()
+        self._log = _lib.LOG_FN(self._on_log)
+        self._port = _lib.Port()
+        self._port.log = self._log
+        self._cfg = _config(lit_cache_bytes, render_max, strict, self._port)
+
+    def _read_info(self):
         info = _lib.padded(_lib.SceneInfo)
         self._check(lib.plx_scene_info_get(self._e, ctypes.byref(info)))
         self.info = {name: (list(getattr(info, name)) if name == "bounds" else getattr(info, name))
@@ -122,11 +132,49 @@ class Scene:
 
     @classmethod
     def from_file(cls, path, **kw):
-        """Loads a GeoJSON file (read here; the core reads no files)."""
+        """Loads a GeoJSON file, or a bake file (polarlux bake: see
+        from_bake, which takes mem= and strict= only); read here, the core
+        reads no files."""
         with open(path, "rb") as f:
             data = f.read()
+        if data[:len(BAKE_MAGIC)] == BAKE_MAGIC:
+            return cls._from_bake_bytes(data, str(path), **kw)
         kw.setdefault("name", str(path))
         return cls(data, **kw)
+
+    @classmethod
+    def from_bake(cls, path, mem=None, strict=False):
+        """An engine from a bake file (polarlux bake SCENE -o CITY.plxb):
+        one copy of its image into a block of its own, no parsing and no
+        rebuilding; frames read the bake's radiance atlas. mem: the block
+        in bytes (None: the size the bake asks, plx_bake_block_size). A
+        bake keeps its render maximum and lit cache (polarlux bake
+        --max-size)."""
+        with open(path, "rb") as f:
+            data = f.read()
+        return cls._from_bake_bytes(data, str(path), mem=mem, strict=strict)
+
+    @classmethod
+    def _from_bake_bytes(cls, data, name, mem=None, strict=False, **rest):
+        if set(rest) - {"name"}:
+            raise ValueError(f"{name}: a bake file takes mem= and strict= only (it keeps its own "
+                             f"{', '.join(sorted(set(rest) - {'name'}))}: set them with polarlux bake)")
+        self = cls.__new__(cls)
+        self._start(strict)
+        err = ctypes.create_string_buffer(512)
+        need = ctypes.c_size_t()
+        st = lib.plx_bake_block_size(data, len(data), ctypes.byref(need), err, len(err))
+        if st != _lib.OK:
+            _raise(st, f"{name}: {err.value.decode('utf-8', 'replace')}")
+        self._block = np.empty(int(need.value) if mem is None else int(mem), dtype=np.uint8)
+        st = lib.plx_bake_load(self._block.ctypes.data_as(ctypes.c_void_p), self._block.size,
+                               ctypes.byref(self._cfg), data, len(data), ctypes.byref(self._e), err, len(err))
+        if st != _lib.OK:
+            self._e = ctypes.c_void_p()
+            self._block = None
+            _raise(st, f"{name}: {err.value.decode('utf-8', 'replace')}")
+        self._read_info()
+        return self
 
     def _on_log(self, ctx, level, msg):
         self.warnings.append(msg.decode("utf-8", "replace"))

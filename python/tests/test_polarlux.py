@@ -143,6 +143,60 @@ def test_render_matches_the_command(tmp_path):
     assert np.array_equal(read_pfm(tmp_path / "r.pfm"), lin)
 
 
+def bake_fixture(tmp_path, *extra):
+    out = tmp_path / "e.plxb"
+    rc, _, err = run_cli("bake", "-q", EIXAMPLE, "--frames", "2", "--photons", "4000", "--texel", "2",
+                         "--max-size", "160x120", *extra, "-o", str(out))
+    assert rc == 0, err
+    return out
+
+
+def test_bake_loads_and_renders_as_the_command(tmp_path):
+    bake = bake_fixture(tmp_path)
+    s = polarlux.Scene.from_bake(bake)
+    geo = polarlux.Scene.from_file(EIXAMPLE)
+    for k in ("buildings", "lamps", "blocks", "courtyards", "vertices"):
+        assert s.info[k] == geo.info[k]
+    assert s.info["bounds"] == geo.info["bounds"]
+    b = polarlux.Scene.from_file(bake)  # the magic is recognised
+    assert b.info == s.info
+    # a frame from the bake's radiance atlas (indirect light included) is
+    # the command's frame from the same bake, float for float
+    eye, target = (10.0, -30.0, 40.0), (60.0, 60.0, 0.0)
+    img, lin = s.render(eye, target, fov_deg=50, size=(96, 64), linear=True)
+    assert 0 < (img.sum(axis=2) > 0).mean() < 1
+    rc, _, err = run_cli("render", "-q", str(bake), "--eye", "10,-30,40", "--target", "60,60,0", "--fov", "50",
+                         "--size", "96x64", "--exposure", "1", "-o", str(tmp_path / "r.png"),
+                         "--pfm", str(tmp_path / "r.pfm"))
+    assert rc == 0, err
+    assert np.array_equal(read_pfm(tmp_path / "r.pfm"), lin)
+    # and differs from the GeoJSON scene's direct light alone (the bake's photons are read)
+    assert not np.array_equal(geo.render(eye, target, fov_deg=50, size=(96, 64), linear=True)[1], lin)
+    # a frame beyond the bake's --max-size: the engine's message
+    with pytest.raises(polarlux.PolarluxError) as e:
+        s.render(eye, target, size=(320, 240))
+    assert "160x120" in str(e.value)
+
+
+def test_bake_errors(tmp_path):
+    bake = bake_fixture(tmp_path)
+    data = bake.read_bytes()
+    cut = tmp_path / "cut.plxb"
+    cut.write_bytes(data[:len(data) // 2])
+    with pytest.raises(polarlux.PolarluxError) as e:
+        polarlux.Scene.from_bake(cut)
+    assert e.value.status == "PLX_E_PARSE" and "truncated bake file" in str(e.value) and "cut.plxb" in str(e.value)
+    bad = tmp_path / "bad.plxb"
+    bad.write_bytes(data[:200] + bytes([data[200] ^ 1]) + data[201:])
+    with pytest.raises(polarlux.PolarluxError):
+        polarlux.Scene.from_file(bad)
+    with pytest.raises(polarlux.MemoryBudgetError):
+        polarlux.Scene.from_bake(bake, mem=1 << 20)
+    with pytest.raises(ValueError) as v:
+        polarlux.Scene.from_file(bake, render_max=(640, 480))
+    assert "render_max" in str(v.value)
+
+
 def test_projection_round_trip_and_formula():
     s = polarlux.Scene.from_file(HELSINKI)
     assert s.info["lonlat"] == 1
