@@ -297,17 +297,29 @@ class Scene:
 
     # ---- images ---------------------------------------------------------------------
     def render(self, eye, target, fov_deg=60.0, size=(640, 480), exposure=1.0, aerial=False, glow=True,
-               linear=False):
+               linear=False, aa=1):
         """A night image (SPEC §5) as an (H, W, 3) uint8 sRGB array; with
-        linear=True also the (H, W, 3) float32 linear radiance: (rgb8, rgbf)."""
+        linear=True also the (H, W, 3) float32 linear radiance: (rgb8, rgbf).
+        exposure="auto": chosen from the image, with the tone curve (the
+        command's default; README "Automatic exposure"); aa=N: N x N samples
+        a pixel, adaptive (1: the pixel centre, SPEC §5). What plx_render
+        reported (the exposure applied, ...) is in .last_render."""
         w, h = int(size[0]), int(size[1])
+        if not (isinstance(aa, int) and 1 <= aa <= 16):
+            raise ValueError(f"aa must be a whole number from 1 to 16, not {aa!r}")
+        if isinstance(exposure, str) and exposure != "auto":
+            raise ValueError(f"exposure must be a number or 'auto', not {exposure!r}")
         cam = _lib.Camera()
         cam.eye[:] = [float(v) for v in eye]
         cam.target[:] = [float(v) for v in target]
         cam.fov_deg, cam.width, cam.height = float(fov_deg), w, h
         opts = _lib.padded(_lib.RenderOpts)
         lib.plx_render_opts_default(ctypes.byref(opts))
-        opts.exposure, opts.aerial, opts.no_glow = float(exposure), int(bool(aerial)), int(not glow)
+        if exposure == "auto":
+            opts.auto_exposure = 1
+        else:
+            opts.exposure = float(exposure)
+        opts.aerial, opts.no_glow, opts.aa = int(bool(aerial)), int(not glow), aa
         rgb8 = np.zeros((h, w, 3), dtype=np.uint8)
         rgbf = np.zeros((h, w, 3), dtype=np.float32) if linear else None
         info = _lib.padded(_lib.RenderInfo)
@@ -315,4 +327,5 @@ class Scene:
                                    rgb8.ctypes.data_as(_lib.c_uint8_p),
                                    rgbf.ctypes.data_as(ctypes.POINTER(ctypes.c_float)) if linear else None,
                                    ctypes.byref(info)))
+        self.last_render = {name: getattr(info, name) for name, _ in _lib.RenderInfo._fields_}
         return (rgb8, rgbf) if linear else rgb8

@@ -4,11 +4,15 @@ $POLARLUX_BIN, default build/polarlux), with SPEC formulas written out here,
 and with numpy sums over the package's own point queries."""
 import os
 import subprocess
+import sys
 
 import numpy as np
 import pytest
 
 import polarlux
+
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "tests", "web"))
+from png_pixels import decode as decode_png  # noqa: E402
 
 ROOT = os.path.abspath(os.path.join(os.path.dirname(__file__), "..", ".."))
 BIN = os.environ.get("POLARLUX_BIN", os.path.join(ROOT, "build", "polarlux"))
@@ -172,6 +176,22 @@ def test_bake_loads_and_renders_as_the_command(tmp_path):
     assert np.array_equal(read_pfm(tmp_path / "r.pfm"), lin)
     # and differs from the GeoJSON scene's direct light alone (the bake's photons are read)
     assert not np.array_equal(geo.render(eye, target, fov_deg=50, size=(96, 64), linear=True)[1], lin)
+    # the command's defaults for a frame: automatic exposure, 2 x 2 samples
+    img2, lin2 = s.render(eye, target, fov_deg=50, size=(96, 64), linear=True, exposure="auto", aa=2)
+    rc, out, err = run_cli("render", str(bake), "--eye", "10,-30,40", "--target", "60,60,0", "--fov", "50",
+                           "--size", "96x64", "--aa", "2", "-o", str(tmp_path / "a.png"), "--pfm",
+                           str(tmp_path / "a.pfm"))
+    assert rc == 0, err
+    assert np.array_equal(read_pfm(tmp_path / "a.pfm"), lin2)
+    w8, h8, bpp, rows = decode_png(tmp_path / "a.png")  # tests/web/png_pixels.py: zlib alone
+    assert (w8, h8, bpp) == (96, 64, 3) and b"".join(bytes(r) for r in rows) == img2.tobytes()
+    chosen = float(out.split("exposure: ")[1].split()[0])
+    assert s.last_render["exposure"] == pytest.approx(chosen, rel=1e-3) and chosen != 1.0
+    assert s.last_render["aa_later"] > 0 and not np.array_equal(lin2, lin)
+    with pytest.raises(ValueError):
+        s.render(eye, target, aa=0)
+    with pytest.raises(ValueError):
+        s.render(eye, target, exposure="bright")
     # a frame beyond the bake's --max-size: the engine's message
     with pytest.raises(polarlux.PolarluxError) as e:
         s.render(eye, target, size=(320, 240))
