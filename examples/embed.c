@@ -38,7 +38,7 @@ static const char scene_json[] =
 #define FRAME_H 120
 
 /* The application's memory: the engine lives in it and never asks for more. */
-static unsigned char engine_block[2u << 20];
+static unsigned char engine_block[3u << 20];
 /* The application's frame buffer. */
 static uint8_t frame[FRAME_W * FRAME_H * 3];
 

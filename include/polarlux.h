@@ -1010,7 +1010,7 @@ plx_status plx_scene_size_scan(const char *text, size_t len, plx_scene_size *out
 #define PLX_USE_VISIBILITY 1u  /* polar diagrams: plx_visibility_get, plx_polar_* */
 #define PLX_USE_LIGHT      2u  /* plx_illuminance, plx_lamps_at, lit regions, routes */
 #define PLX_USE_RENDER     4u  /* plx_render at the config's largest frame (direct light,
-                                  aerial light map not included) */
+                                  anti-aliased or not; aerial light map not included) */
 
 /*
  * The block size (bytes, for plx_engine_create) that a scene of these

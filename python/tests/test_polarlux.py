@@ -244,9 +244,20 @@ def test_memory_estimate_sizes_the_block():
     s.visibility_areas(street_points(s, 5, 3))
     s.illuminance(street_points(s, 100, 4))
     s.render((0, -300, 200), (0, 0, 0), size=(320, 240))
+    s.render((0, -300, 200), (0, 0, 0), size=(320, 240), exposure="auto", aa=2)  # its own buffers
     assert s.memory()["peak_total"] <= need
     with pytest.raises(polarlux.MemoryBudgetError):
         polarlux.Scene(text, mem=64 * 1024)
+
+
+def test_estimate_holds_anti_aliased_frames():
+    # a small scene in its estimated block (frames up to the default
+    # 1920x1080): anti-aliasing's buffers, sized by the largest frame, fit
+    # (they were left out of plx_memory_estimate: PLX_E_NOMEM here)
+    s = polarlux.Scene.from_file(EIXAMPLE)
+    s.render((10.0, -30.0, 40.0), (60.0, 60.0, 0.0), size=(32, 24), aa=2)
+    assert s.last_render["aa_later"] > 0
+    assert s.memory()["peak_total"] <= s.memory()["capacity"]
 
 
 def test_errors_name_the_place():

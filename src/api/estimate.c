@@ -192,7 +192,8 @@ static phase est_light(const est *c, const plx_config *cfg)
     return p;
 }
 
-/* Images: 20 bytes a pixel of the largest frame (depth, id, linear RGB),
+/* Images: 40 bytes a pixel of the largest frame (depth, id, linear RGB;
+ * anti-aliasing's sums, the first sample's ids and bytes, the marks),
  * the mesh's compact records (mesh.h: about 12 bytes a footprint vertex
  * and 20 a building) and culling tables, a 64 KB tone-mapping table and the
  * surface cache; the mesh's construction in scratch (its roof
@@ -203,7 +204,7 @@ static phase est_render(const est *c, const plx_config *cfg)
     phase p;
     double w = cfg && cfg->render_max_width ? cfg->render_max_width : EST_MAX_W;
     double h = cfg && cfg->render_max_height ? cfg->render_max_height : EST_MAX_H;
-    p.kept = 262144.0 + 20.5 * w * h + 64.0 * c->positions + 128.0 * c->rings;
+    p.kept = 262144.0 + 40.5 * w * h + 64.0 * c->positions + 128.0 * c->rings;
     p.scratch = 65536.0 + 320.0 * c->positions;
     return p;
 }

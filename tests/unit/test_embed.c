@@ -177,6 +177,9 @@ static plx_status workflow(const char *text, size_t len, const plx_config *cfg, 
         uint8_t *px = malloc((size_t)FRAME_W * FRAME_H * 3);
         plx_render_opts_default(&o);
         st = plx_render(e, &cam, &o, px, NULL, NULL);
+        o.aa = 2; /* anti-aliasing takes buffers of its own (walk's default) */
+        if (st == PLX_OK)
+            st = plx_render(e, &cam, &o, px, NULL, NULL);
         free(px);
     }
     if (e) {
@@ -216,7 +219,7 @@ static void check_estimate(const char *text, size_t len, const char *name)
         if (ratio > worst_ratio)
             worst_ratio = ratio;
         assert_true(ratio >= 1.0);
-        /* the loosest: 4.01x for a render on gen eixample 20 20 (full run) */
+        /* the loosest: 3.82x for visibility on gen eixample 20 20 (full run) */
         assert_true(ratio <= 4.5);
     }
 }
