@@ -12,6 +12,7 @@ with Scene.lonlat_to_local / local_to_lonlat. Arrays go in and come out as
 numpy arrays of float64 (images uint8 or float32). See README "Python".
 """
 import ctypes
+import numbers
 
 import numpy as np
 
@@ -305,7 +306,7 @@ class Scene:
         a pixel, adaptive (1: the pixel centre, SPEC §5). What plx_render
         reported (the exposure applied, ...) is in .last_render."""
         w, h = int(size[0]), int(size[1])
-        if not (isinstance(aa, int) and 1 <= aa <= 16):
+        if not (isinstance(aa, numbers.Integral) and 1 <= aa <= 16):
             raise ValueError(f"aa must be a whole number from 1 to 16, not {aa!r}")
         if isinstance(exposure, str) and exposure != "auto":
             raise ValueError(f"exposure must be a number or 'auto', not {exposure!r}")
@@ -319,7 +320,7 @@ class Scene:
             opts.auto_exposure = 1
         else:
             opts.exposure = float(exposure)
-        opts.aerial, opts.no_glow, opts.aa = int(bool(aerial)), int(not glow), aa
+        opts.aerial, opts.no_glow, opts.aa = int(bool(aerial)), int(not glow), int(aa)
         rgb8 = np.zeros((h, w, 3), dtype=np.uint8)
         rgbf = np.zeros((h, w, 3), dtype=np.float32) if linear else None
         info = _lib.padded(_lib.RenderInfo)

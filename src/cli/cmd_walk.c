@@ -433,7 +433,7 @@ static int run(const walk_args *a, plx_engine *e, const walk_path *wp)
 {
     walk_run wr;
     cli_progress pr;
-    double L = walk_path_length(wp), step = a->speed / a->fps, *sorted;
+    double L = walk_path_length(wp), step = a->speed / a->fps, steps, *sorted;
     char path[4096], err[512];
     int rc = EXIT_OK;
     long k;
@@ -442,7 +442,8 @@ static int run(const walk_args *a, plx_engine *e, const walk_path *wp)
     view_hint(a, wp);
     /* compared as a double: a long path at a slow pace has more steps
      * than a long holds, and converting such a double is undefined */
-    wr.n = floor(L / step) + 1.0 < (double)a->max_frames ? (long)floor(L / step) + 1 : a->max_frames;
+    steps = floor(L / step) + 1.0;
+    wr.n = steps < (double)a->max_frames ? (long)steps : a->max_frames;
     sheet_plan(&wr.sh, a, wr.n);
     wr.ms = malloc(sizeof *wr.ms * (size_t)wr.n);
     sorted = malloc(sizeof *sorted * (size_t)wr.n);

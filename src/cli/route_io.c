@@ -4,11 +4,11 @@
 #include <string.h>
 #include <cjson/cJSON.h>
 
+#include "cli.h"
 #include "port.h"
 #include "route_io.h"
 
 /* The bound of scene coordinates (README, "Scene format"). */
-#define ROUTE_MAX_COORD 1e7
 
 typedef struct frame {
     int lonlat;           /* the path file is in lon/lat */
@@ -62,7 +62,7 @@ static int add_line(route_set *rs, size_t *cap, const char *name, const cJSON *c
             vx = xy[0];
             vy = xy[1];
         }
-        if (fabs(vx) > ROUTE_MAX_COORD || fabs(vy) > ROUTE_MAX_COORD) {
+        if (fabs(vx) > CLI_MAX_COORD || fabs(vy) > CLI_MAX_COORD) {
             snprintf(why, whylen, "position %u (%g, %g) is more than 1e7 m from the origin", k, vx, vy);
             free(l->xy);
             return -1;
