@@ -12,7 +12,9 @@ with Scene.lonlat_to_local / local_to_lonlat. Arrays go in and come out as
 numpy arrays of float64 (images uint8 or float32). See README "Python".
 """
 import ctypes
+import mmap
 import numbers
+import os
 
 import numpy as np
 
@@ -44,6 +46,16 @@ class MemoryBudgetError(PolarluxError):
 def _raise(status, message):
     cls = MemoryBudgetError if status == _lib.E_NOMEM else PolarluxError
     raise cls(status, message)
+
+
+def _big_block(n):
+    """n zeroed bytes of anonymous pages as a numpy array, asked to be huge
+    pages where the system offers them (a bake's hundreds of megabytes then
+    cost a few hundred page faults, not tens of thousands)."""
+    m = mmap.mmap(-1, max(int(n), 1))
+    if hasattr(m, "madvise") and hasattr(mmap, "MADV_HUGEPAGE"):
+        m.madvise(mmap.MADV_HUGEPAGE)
+    return np.frombuffer(m, dtype=np.uint8)
 
 
 def _as_bytes(text):
@@ -137,9 +149,10 @@ class Scene:
         from_bake, which takes mem= and strict= only); read here, the core
         reads no files."""
         with open(path, "rb") as f:
+            if f.read(len(BAKE_MAGIC)) == BAKE_MAGIC:
+                return cls._from_bake_file(f, str(path), **kw)
+            f.seek(0)
             data = f.read()
-        if data[:len(BAKE_MAGIC)] == BAKE_MAGIC:
-            return cls._from_bake_bytes(data, str(path), **kw)
         kw.setdefault("name", str(path))
         return cls(data, **kw)
 
@@ -152,24 +165,30 @@ class Scene:
         bake keeps its render maximum and lit cache (polarlux bake
         --max-size)."""
         with open(path, "rb") as f:
-            data = f.read()
-        return cls._from_bake_bytes(data, str(path), mem=mem, strict=strict)
+            return cls._from_bake_file(f, str(path), mem=mem, strict=strict)
 
     @classmethod
-    def _from_bake_bytes(cls, data, name, mem=None, strict=False, **rest):
+    def _from_bake_file(cls, f, name, mem=None, strict=False, **rest):
+        """The bake read through a mapping of the file (no copy of it in
+        Python's memory) into a block of anonymous pages, huge pages where
+        the system offers them: the load copies the image once, as the
+        command's does."""
         if set(rest) - {"name"}:
             raise ValueError(f"{name}: a bake file takes mem= and strict= only (it keeps its own "
                              f"{', '.join(sorted(set(rest) - {'name'}))}: set them with polarlux bake)")
+        size = os.fstat(f.fileno()).st_size
+        fmap = mmap.mmap(f.fileno(), 0, access=mmap.ACCESS_READ) if size else None
+        data = np.frombuffer(fmap, dtype=np.uint8) if fmap is not None else np.zeros(1, dtype=np.uint8)
         self = cls.__new__(cls)
         self._start(strict)
         err = ctypes.create_string_buffer(512)
         need = ctypes.c_size_t()
-        st = lib.plx_bake_block_size(data, len(data), ctypes.byref(need), err, len(err))
+        st = lib.plx_bake_block_size(data.ctypes.data, size, ctypes.byref(need), err, len(err))
         if st != _lib.OK:
             _raise(st, f"{name}: {err.value.decode('utf-8', 'replace')}")
-        self._block = np.empty(int(need.value) if mem is None else int(mem), dtype=np.uint8)
-        st = lib.plx_bake_load(self._block.ctypes.data_as(ctypes.c_void_p), self._block.size,
-                               ctypes.byref(self._cfg), data, len(data), ctypes.byref(self._e), err, len(err))
+        self._block = _big_block(int(need.value) if mem is None else int(mem))
+        st = lib.plx_bake_load(self._block.ctypes.data, self._block.size, ctypes.byref(self._cfg), data.ctypes.data,
+                               size, ctypes.byref(self._e), err, len(err))
         if st != _lib.OK:
             self._e = ctypes.c_void_p()
             self._block = None

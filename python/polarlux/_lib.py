@@ -156,9 +156,9 @@ def _declare(lib):
         "plx_local_to_lonlat": (st, [E, ctypes.c_size_t, c_double_p, c_double_p]),
         "plx_scene_size_scan": (st, [ctypes.c_char_p, ctypes.c_size_t, ctypes.c_void_p]),
         "plx_memory_estimate": (ctypes.c_size_t, [ctypes.c_void_p, ctypes.POINTER(Config), ctypes.c_uint]),
-        "plx_bake_block_size": (st, [ctypes.c_char_p, ctypes.c_size_t, ctypes.POINTER(ctypes.c_size_t),
+        "plx_bake_block_size": (st, [ctypes.c_void_p, ctypes.c_size_t, ctypes.POINTER(ctypes.c_size_t),
                                      ctypes.c_char_p, ctypes.c_size_t]),
-        "plx_bake_load": (st, [ctypes.c_void_p, ctypes.c_size_t, ctypes.POINTER(Config), ctypes.c_char_p,
+        "plx_bake_load": (st, [ctypes.c_void_p, ctypes.c_size_t, ctypes.POINTER(Config), ctypes.c_void_p,
                                ctypes.c_size_t, ctypes.POINTER(ctypes.c_void_p), ctypes.c_char_p,
                                ctypes.c_size_t]),
     }
