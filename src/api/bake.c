@@ -179,9 +179,11 @@ plx_status plx_bake_prepare(plx_engine *e, const plx_bake_opts *o)
         e->atlas_fine = o->aerial_m_per_texel;
         if ((st = eng_need_atlas(e, o->aerial_m_per_texel)) != PLX_OK)
             return st;
-    } else if (o->aerial && e->lightmap_cell == 0.0 &&
-               (st = eng_need_lightmap(e, o->aerial_m_per_texel, o->twin)) != PLX_OK) {
-        return st;
+    } else if (o->aerial && e->lightmap_cell == 0.0) {
+        if ((st = eng_need_lightmap(e, o->aerial_m_per_texel, o->twin)) != PLX_OK)
+            return st;
+        if (!o->twin) /* its values when images gather over traced photons */
+            eng_lightmap_layer(e);
     }
     eng_clear_error(e);
     return PLX_OK;

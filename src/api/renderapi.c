@@ -231,8 +231,6 @@ plx_status eng_need_lightmap(plx_engine *e, double m_per_texel, int dark)
     if (st != PLX_OK)
         return eng_fail(e, st, render_error(e->rd));
     e->lightmap_cell = cell;
-    if (!dark) /* its values when images gather over traced photons */
-        eng_lightmap_layer(e);
     return PLX_OK;
 }
 
@@ -657,6 +655,12 @@ plx_status plx_render(plx_engine *e, const plx_camera *cam, const plx_render_opt
         st = eng_need_lightmap(e, o->aerial_m_per_texel, 0);
         if (st != PLX_OK)
             return st;
+        /* the indirect layer only for a frame that reads it: a frame
+         * without indirect light does not (shade_tiles.c), and the first
+         * one with it gathers the layer above (16 s before a 1024x768
+         * frame without indirect light from a gen eixample 30 30 bake) */
+        if (!o->no_indirect)
+            eng_lightmap_layer(e);
     }
     memcpy(rc.eye, cam->eye, sizeof rc.eye);
     memcpy(rc.target, cam->target, sizeof rc.target);

@@ -74,7 +74,9 @@ plx_status eng_need_render(plx_engine *e);
  * their defaults for 0; a bake's as it was made). */
 void eng_render_max(const plx_engine *e, int32_t *w, int32_t *h);
 /* Builds the aerial light map at m_per_texel metres (0: 1 m) unless built;
- * dark: with a shader giving no light (the bake's twin, bake.c). */
+ * dark: with a shader giving no light (the bake's twin, bake.c). Its
+ * indirect layer is left to eng_lightmap_layer: only frames with indirect
+ * light read it. */
 plx_status eng_need_lightmap(plx_engine *e, double m_per_texel, int dark);
 /* The radiance atlas (render/atlas.h) made on first need at spacing fine
  * (0: the default), not filled (renderapi.c). */

@@ -399,7 +399,7 @@ static int frame(const walk_args *a, plx_engine *e, const walk_path *wp, walk_ru
  * --view aerial), so they get no word. Without it, the street view's
  * ground takes the per-pixel path (93 ms a 1024x768 frame of that flight)
  * and --view aerial reads the aerial light map (73 ms), which the first
- * frame builds unless the bake holds it (16 s for that city). */
+ * frame builds unless the bake holds it (about 0.25 s for that city). */
 #define WALK_HIGH 100.0
 
 static void view_hint(const walk_args *a, const walk_path *wp)
@@ -412,8 +412,7 @@ static void view_hint(const walk_args *a, const walk_path *wp)
         zmin = fmin(zmin, wp->eye[3 * k + 2]);
     if (zmin >= WALK_HIGH)
         cli_warn("walk", &a->c, "the eye stays %.0f m or more above the ground: --view aerial draws views "
-                 "from above faster (the ground and roofs from the aerial light map, built at the first "
-                 "frame unless the bake holds it: bake --no-indirect)", zmin);
+                 "from above faster (the ground and roofs from the aerial light map)", zmin);
 }
 
 /* The refinement's line, and a word when the eye was too high for it. */

@@ -263,6 +263,48 @@ static void test_image_same_bytes(void **state)
     plx_engine_free(e3);
 }
 
+/* An aerial frame without indirect light gathers nothing (it does not
+ * read the light map's indirect layer, so the map is built without it: a
+ * 1024x768 frame from a gen eixample 30 30 bake waited 16 s for it), and
+ * changes no byte of the aerial frame with indirect light that follows
+ * (which gathers the layer then), nor does a gathered layer change a
+ * frame without indirect light. */
+static void test_aerial_without_indirect_gathers_nothing(void **state)
+{
+    plx_engine *e1 = fixture_new((size_t)1 << 30, "fixtures/eixample-4x4.geojson", NULL, 0);
+    plx_engine *e2 = fixture_new((size_t)1 << 30, "fixtures/eixample-4x4.geojson", NULL, 0);
+    uint8_t *a = malloc(3 * W * H), *b = malloc(3 * W * H);
+    plx_render_opts oa, od;
+    plx_camera top;
+    (void)state;
+    assert_true(a && b);
+    camera(&top);
+    top.eye[2] = 150.0;
+    top.target[0] = top.eye[0];
+    top.target[1] = top.eye[1] + 1.0;
+    top.target[2] = 0.0;
+    plx_render_opts_default(&oa);
+    oa.per_pixel = 1; /* the light map, not the radiance atlas */
+    oa.aerial = 1;
+    od = oa;
+    od.no_indirect = 1;
+    assert_int_equal(plx_indirect_step(e1, 16384, 3), PLX_OK);
+    assert_int_equal(plx_indirect_step(e2, 16384, 3), PLX_OK);
+    assert_int_equal(plx_render(e2, &top, &od, b, NULL, NULL), PLX_OK);
+    assert_int_equal(e2->ic->gathered, 0);
+    assert_int_equal(plx_render(e1, &top, &oa, a, NULL, NULL), PLX_OK);
+    assert_true(e1->ic->gathered > 0);
+    assert_int_equal(plx_render(e2, &top, &oa, b, NULL, NULL), PLX_OK);
+    assert_memory_equal(a, b, 3 * W * H);
+    assert_int_equal(plx_render(e1, &top, &od, a, NULL, NULL), PLX_OK);
+    assert_int_equal(plx_render(e2, &top, &od, b, NULL, NULL), PLX_OK);
+    assert_memory_equal(a, b, 3 * W * H);
+    free(a);
+    free(b);
+    plx_engine_free(e1);
+    plx_engine_free(e2);
+}
+
 /* An aerial frame first (its light map's layer gathers 8 m records of
  * 24 x 24 directions into the engine's cache) changes no byte of a street
  * frame: the two kinds of records never share a slot, though the street
@@ -572,6 +614,7 @@ int main(void)
         cmocka_unit_test(test_image_accuracy),
         cmocka_unit_test(test_image_same_bytes),
         cmocka_unit_test(test_image_after_aerial_same_bytes),
+        cmocka_unit_test(test_aerial_without_indirect_gathers_nothing),
         cmocka_unit_test(test_peek_same_bits),
         cmocka_unit_test(test_peek_cells_follow_table),
         cmocka_unit_test(test_aerial_accuracy),
