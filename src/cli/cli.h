@@ -90,6 +90,12 @@ void cli_indirect_default(cli_indirect *ind);
 int cli_indirect_option(const char *cmd, int argc, char **argv, int *i, cli_indirect *ind);
 /* Traces the frames (progress on a terminal), viewer at eye looking along
  * dir (either may be NULL). Returns an exit code. */
+/* A bake without photon frames (bake --no-indirect or --frames 0) gives
+ * images of the direct light, as it was made (README "Bake files"):
+ * render and walk do not trace photons into its block, which has no room
+ * for them beside a frame. Sets ind->off with a warning and returns 1
+ * then; 0 otherwise (not a bake, photons traced, or indirect light off). */
+int cli_bake_direct(const char *cmd, const char *path, const cli_common *c, plx_engine *e, cli_indirect *ind);
 /* A line on stderr when the photon buffers were fitted below the default quality. */
 void cli_indirect_note(const char *cmd, plx_engine *e);
 int cli_indirect_run(const char *cmd, plx_engine *e, const cli_indirect *ind, const double *eye,

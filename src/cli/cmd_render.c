@@ -349,6 +349,8 @@ int cmd_render(int argc, char **argv)
     rc = cli_open_scene("render", a.scene, &a.c, &e);
     if (rc != EXIT_OK)
         return rc;
+    if (cli_bake_direct("render", a.scene, &a.c, e, &a.ind))
+        a.opts.no_indirect = 1;
     if (a.have_eye && (cli_option_local("render", "--eye", e, &a.cam.eye[0], &a.cam.eye[1]) != 0 ||
                        cli_option_local("render", "--target", e, &a.cam.target[0], &a.cam.target[1]) != 0)) {
         plx_engine_free(e);

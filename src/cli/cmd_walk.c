@@ -546,6 +546,8 @@ int cmd_walk(int argc, char **argv)
         plx_engine_free(e);
         return EXIT_FAIL;
     }
+    if (cli_bake_direct("walk", a.scene, &a.c, e, &a.ind))
+        a.opts.no_indirect = 1;
     rc = cli_indirect_run("walk", e, &a.ind, NULL, NULL, a.fov);
     if (rc == EXIT_OK)
         rc = run(&a, e, &wp);

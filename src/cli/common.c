@@ -562,6 +562,16 @@ int cli_indirect_option(const char *cmd, int argc, char **argv, int *i, cli_indi
     return 1;
 }
 
+int cli_bake_direct(const char *cmd, const char *path, const cli_common *c, plx_engine *e, cli_indirect *ind)
+{
+    if (ind->off || plx_indirect_frames(e) > 0 || !cli_is_bake(path))
+        return 0;
+    ind->off = 1;
+    cli_warn(cmd, c, "%s holds no indirect light (baked with --no-indirect or --frames 0): its images show the "
+             "direct light; bake the scene without those options for indirect light", path);
+    return 1;
+}
+
 /* A word on stderr when the photon buffers were made smaller than the
  * default quality to fit --mem (README "Memory budgets"). */
 void cli_indirect_note(const char *cmd, plx_engine *e)

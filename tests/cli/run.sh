@@ -136,6 +136,17 @@ expect bake-tiny 0 "^baked fixtures/eixample-4x4\.geojson into .*: [0-9]+ bytes 
 # a bake given as bake's SCENE: one line saying so (it read as malformed JSON)
 expect bake-of-bake 2 "polarlux bake: .*e\.plxb is a bake file, not a GeoJSON scene" -- "$bin" bake "$tmp/e.plxb" -o "$tmp/ee.plxb"
 if [ ! -e "$tmp/ee.plxb" ]; then echo "ok   bake-of-bake-no-file"; pass=$((pass + 1)); else echo "FAIL bake-of-bake-no-file"; fail=$((fail + 1)); fi
+# a bake without indirect light gives images of the direct light, as
+# README "Bake files" says (render and walk traced photons into its block:
+# a Helsinki walk then ran out of memory at frame 1)
+"$bin" bake -q fixtures/eixample-4x4.geojson --no-indirect --max-size 160x120 -o "$tmp/end.plxb" >/dev/null 2>&1
+expect bake-no-indirect-render 0 "warning: .*end\.plxb holds no indirect light \(baked with --no-indirect or --frames 0\)" -- \
+    "$bin" render "$tmp/end.plxb" --size 160x120 -o "$tmp/end1.png"
+"$bin" render -q "$tmp/end.plxb" --size 160x120 --no-indirect -o "$tmp/end2.png" >/dev/null 2>&1
+if cmp -s "$tmp/end1.png" "$tmp/end2.png"; then echo "ok   bake-no-indirect-direct-light"; pass=$((pass + 1)); else echo "FAIL bake-no-indirect-direct-light"; fail=$((fail + 1)); fi
+printf '{"type":"LineString","coordinates":[[20,5,1.7],[20,60,1.7]],"properties":{"units":"m"}}' >"$tmp/endpath.geojson"
+expect bake-no-indirect-walk 0 "holds no indirect light" -- \
+    "$bin" walk "$tmp/end.plxb" --path "$tmp/endpath.geojson" --size 160x120 --max-frames 3 -o "$tmp/endw"
 expect bake-info 0 "^bake: [0-9]+ bytes \([0-9.]+ MB\) loaded in [0-9.]+ ms" -- "$bin" info "$tmp/e.plxb"
 expect bake-info-memory 0 "^memory: [0-9]+ bytes in use" -- "$bin" info "$tmp/e.plxb"
 printf '0.5 0.5\n10 -3\n61 61\n' >"$tmp/bp.txt"
