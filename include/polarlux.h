@@ -755,6 +755,9 @@ typedef struct plx_render_info {
                                    taken (faster there: the image is aa_full's); PLX_AA_EVERY
                                    (0) with aa_full, or when the block had no room for the
                                    adaptive buffers (8 bytes a pixel of the largest frame) */
+    int eye_inside;             /* 1: the eye was inside a building's solid: the frame shows the
+                                   inside of its walls, every pixel computed (not read from the
+                                   radiance atlas: slower) */
 } plx_render_info;
 
 #define PLX_AA_EVERY 0

@@ -137,6 +137,7 @@ static void render_info(void)
     FIELD(plx_render_info, indirect_lookups);
     FIELD(plx_render_info, aa_later);
     FIELD(plx_render_info, aa_adaptive);
+    FIELD(plx_render_info, eye_inside);
 }
 
 static void scene_size(void)

@@ -90,7 +90,7 @@ class RenderInfo(ctypes.Structure):
     _fields_ = [("buildings", ctypes.c_uint32), ("drawn", ctypes.c_uint32),
                 ("drawn_fraction", ctypes.c_double), ("shaded_pixels", ctypes.c_uint64),
                 ("exposure", ctypes.c_double), ("indirect_lookups", ctypes.c_uint64),
-                ("aa_later", ctypes.c_uint64), ("aa_adaptive", ctypes.c_int)]
+                ("aa_later", ctypes.c_uint64), ("aa_adaptive", ctypes.c_int), ("eye_inside", ctypes.c_int)]
 
 
 class SceneSize(ctypes.Structure):

@@ -613,7 +613,7 @@ plx_status plx_render(plx_engine *e, const plx_camera *cam, const plx_render_opt
     render_stats rs;
     plx_render_opts def;
     plx_status st;
-    int use_atlas;
+    int use_atlas, inside;
     if (!eng_ok(e))
         return PLX_E_INVALID;
     if (!e->sc)
@@ -631,7 +631,8 @@ plx_status plx_render(plx_engine *e, const plx_camera *cam, const plx_render_opt
         return st;
     if ((st = frame_fits(e, cam)) != PLX_OK)
         return st;
-    use_atlas = atlas_frames(e, o) && !e->atlas_off && !render_eye_inside(e->rd, cam->eye);
+    inside = render_eye_inside(e->rd, cam->eye);
+    use_atlas = atlas_frames(e, o) && !e->atlas_off && !inside;
     if (use_atlas && (st = eng_need_atlas(e, e->atlas_fine > 0.0 ? e->atlas_fine : o->aerial_m_per_texel)) != PLX_OK) {
         if (st != PLX_E_NOMEM)
             return st;
@@ -722,6 +723,7 @@ plx_status plx_render(plx_engine *e, const plx_camera *cam, const plx_render_opt
     if (info) {
         info->aa_later = 0;
         info->aa_adaptive = PLX_AA_EVERY;
+        info->eye_inside = inside;
     }
     if (o->aa > 1)
         st = render_aa(e, &rc, &ro, o->aa, o->aa_full, rgb8, rgbf, &rs, info);

@@ -265,7 +265,10 @@ typedef struct walk_run {
     uint8_t *buf[2];           /* with the writer: frame k is rendered into buf[k & 1] */
     frame_writer fw;
     int writer;                /* 1: frames written on the writer's thread */
-    long black, first_black;   /* frames entirely black: how many, the first (1-based) */
+    long black, first_black;   /* frames entirely black, the eye outside buildings: how many,
+                                  the first (1-based) */
+    long inside, first_inside; /* frames with the eye inside a building: how many, the first */
+    double inside_eye[3];      /* the first one's eye */
 } walk_run;
 
 /* After the first frame (the engine at its peak): the frames are written
@@ -363,8 +366,13 @@ static int frame(const walk_args *a, plx_engine *e, const walk_path *wp, walk_ru
                 cam.eye[2], plx_last_error(e));
         return cli_exit_code(st);
     }
-    if (cli_all_black(wr->rgb8, (size_t)a->w * a->h * 3) && wr->black++ == 0)
+    /* black with the eye inside a building: its own warning says why */
+    if (!info.eye_inside && cli_all_black(wr->rgb8, (size_t)a->w * a->h * 3) && wr->black++ == 0)
         wr->first_black = k + 1;
+    if (info.eye_inside && wr->inside++ == 0) {
+        wr->first_inside = k + 1;
+        memcpy(wr->inside_eye, cam.eye, sizeof wr->inside_eye);
+    }
     fprintf(wr->cams, "%ld %.17g %.17g %.17g %.17g %.17g %.17g %.6g\n", k + 1, cam.eye[0], cam.eye[1], cam.eye[2],
             cam.target[0], cam.target[1], cam.target[2], info.exposure);
     if (k == 0)
@@ -498,6 +506,11 @@ static int run(const walk_args *a, plx_engine *e, const walk_path *wp)
         cli_aa_print(&a->opts, wr.aa_later, (double)a->w * a->h * wr.n, wr.n, wr.aa_adaptive, wr.aa_dense);
         if (a->refine && !a->ind.off)
             walk_refine_print(a, &wr);
+        if (wr.inside)
+            cli_warn("walk", &a->c, "%ld of %ld frames have the eye inside a building (the first: frame %ld at "
+                     "(%.2f, %.2f, %.2f)): they show the inside of its walls, every pixel computed (slower); "
+                     "move the path out of the footprints or raise it above the roofs", wr.inside, wr.n,
+                     wr.first_inside, wr.inside_eye[0], wr.inside_eye[1], wr.inside_eye[2]);
         if (wr.black == wr.n)
             cli_warn("walk", &a->c, "every frame is entirely black: %s", cli_dark_reason(e));
         else if (wr.black)

@@ -216,6 +216,12 @@ expect walk-high-street-hint 0 "^polarlux walk: warning: the eye stays 200 m or 
 # views: no word (it said "faster" there too, where it was not)
 "$bin" walk "$tmp/e.plxb" --path "$tmp/high.geojson" --size 32x24 --fps 0.5 --aa 1 -o "$tmp/wh2" >"$tmp/out" 2>&1
 if [ $? -eq 0 ] && ! grep -q -- "--view aerial" "$tmp/out"; then echo "ok   walk-high-atlas-no-hint"; pass=$((pass + 1)); else echo "FAIL walk-high-atlas-no-hint"; sed 's/^/    /' "$tmp/out" | head; fail=$((fail + 1)); fi
+# an eye inside a building: its frames show the inside of its walls, 3.7 s
+# each on gen eixample 30 30 (every pixel computed), and walk said nothing
+printf '{"type":"LineString","coordinates":[[5,5,1.7],[5,6,1.7]]}' >"$tmp/inside.geojson"
+expect walk-eye-inside 0 "^polarlux walk: warning: 2 of 2 frames have the eye inside a building \(the first: frame 1 at \(5\.00, 5\.00, 1\.70\)\)" -- \
+    "$bin" walk fixtures/tiny.geojson --path "$tmp/inside.geojson" --size 32x24 --fps 1 --speed 1 --no-indirect -o "$tmp/wi"
+if ! grep -q "entirely black" "$tmp/out"; then echo "ok   walk-eye-inside-not-dark"; pass=$((pass + 1)); else echo "FAIL walk-eye-inside-not-dark"; fail=$((fail + 1)); fi
 printf '{"type":"LineString","coordinates":[[1,2]]}' >"$tmp/short.geojson"
 expect walk-short-path 1 "^polarlux walk: $tmp/short\.geojson: the LineString needs at least 2 positions$" -- "$bin" walk -q "$tmp/e.plxb" --path "$tmp/short.geojson" -o "$tmp/w3"
 # a coordinate beyond 1e7 m (it made the frame count overflow, then "out of
