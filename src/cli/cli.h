@@ -42,6 +42,9 @@ int cli_parse_int(const char *s, long lo, long hi, long *out);
 #define CLI_MAX_COORD 1e7
 /* A finite number in [lo, hi]; 0 on success. */
 int cli_parse_real(const char *s, double lo, double hi, double *out);
+/* --exposure of render and walk: a number above 0, at most 1e9 (0 drew
+ * a black image, called dark for want of lamps); 0 on success. */
+int cli_parse_exposure(const char *s, void *out);
 /* n comma-separated coordinates "X,Y[,Z...]", each finite and within
  * +-CLI_MAX_COORD; 0 on success. */
 int cli_parse_coords(const char *s, double *v, int n);

@@ -104,11 +104,6 @@ static int parse_backend(const char *s, void *dst)
     return 0;
 }
 
-static int parse_exposure(const char *s, void *dst)
-{
-    return cli_parse_real(s, 0, 1e9, dst);
-}
-
 static int parse_texel(const char *s, void *dst)
 {
     return cli_parse_real(s, 0.01, 1e4, dst);
@@ -124,7 +119,7 @@ static int parse_args(int argc, char **argv, render_args *a)
         { "--target", NULL, a->cam.target, parse_vec3,
           "--target '%s' is not X,Y,Z (finite, x and y within 1e7 m, z within 1e5 m)", 0, NULL, &a->have_target, NULL },
         CLI_OPT_VAL("--backend", &a->osmesa, parse_backend, "--backend '%s' is not soft or osmesa"),
-        { "--exposure", NULL, &a->opts.exposure, parse_exposure, "--exposure '%s' is not a number from 0 to 1e9", 0,
+        { "--exposure", NULL, &a->opts.exposure, cli_parse_exposure, "--exposure '%s' is not a number above 0, up to 1e9", 0,
           NULL, &v.exposure, NULL },
         CLI_OPT_VAL("--texel", &a->opts.aerial_m_per_texel, parse_texel,
                     "--texel '%s' is not a number of metres from 0.01 to 1e4"),

@@ -76,12 +76,6 @@ static int parse_rate(const char *val, void *dst)
     return cli_parse_double(val, v) != 0 || !(*v > 0) || *v > 1e4 ? -1 : 0;
 }
 
-static int parse_exposure(const char *val, void *dst)
-{
-    double *v = dst;
-    return cli_parse_double(val, v) != 0 || !(*v >= 0) ? -1 : 0;
-}
-
 static int parse_texel(const char *val, void *dst)
 {
     return cli_parse_real(val, 0.01, 1e4, dst);
@@ -106,7 +100,7 @@ static int parse_args(int argc, char **argv, walk_args *a)
         CLI_OPT_STR("-o", &a->dir),
         CLI_OPT_VAL("--fps", &a->fps, parse_rate, "--fps '%s' is not a positive number"),
         CLI_OPT_VAL("--speed", &a->speed, parse_rate, "--speed '%s' is not a positive number"),
-        { "--exposure", NULL, &a->opts.exposure, parse_exposure, "--exposure '%s' is not a number >= 0", 0, NULL,
+        { "--exposure", NULL, &a->opts.exposure, cli_parse_exposure, "--exposure '%s' is not a number above 0, up to 1e9", 0, NULL,
           &v.exposure, NULL },
         CLI_OPT_VAL("--refine-frames", &a->refine_frames, parse_refine_frames,
                     "--refine-frames '%s' is not a whole number >= 0"),
@@ -458,6 +452,9 @@ static int run(const walk_args *a, plx_engine *e, const walk_path *wp)
      * than a long holds, and converting such a double is undefined */
     steps = floor(L / step) + 1.0;
     wr.n = steps < (double)a->max_frames ? (long)steps : a->max_frames;
+    if (steps > (double)a->max_frames)
+        cli_warn("walk", &a->c, "--max-frames %ld stops the walk at %.1f m of the path's %.1f m (%.0f frames "
+                 "would walk it all)", a->max_frames, (wr.n - 1) * step, L, steps);
     sheet_plan(&wr.sh, a, wr.n);
     wr.ms = malloc(sizeof *wr.ms * (size_t)wr.n);
     sorted = malloc(sizeof *sorted * (size_t)wr.n);
@@ -496,8 +493,8 @@ static int run(const walk_args *a, plx_engine *e, const walk_path *wp)
             sum += sorted[k];
         med = sorted[wr.n / 2];
         p95 = sorted[(size_t)ceil(0.95 * wr.n) - 1];
-        printf("walk: %ld frames %dx%d (%.1f m at %.2f m/s, %g fps, aa %d), written to %s/\n", wr.n, a->w, a->h,
-               L, a->speed, a->fps, a->opts.aa > 1 ? a->opts.aa : 1, a->dir);
+        printf("walk: %ld frames %dx%d (%.1f m of %.1f m at %.2f m/s, %g fps, aa %d), written to %s/\n", wr.n, a->w,
+               a->h, (wr.n - 1) * step, L, a->speed, a->fps, a->opts.aa > 1 ? a->opts.aa : 1, a->dir);
         printf("frame time: median %.2f ms, p95 %.2f ms, mean %.2f ms: %.1f frames per second (rendering only)\n",
                med, p95, sum / wr.n, 1000.0 * wr.n / sum);
         if (wr.lookups)

@@ -59,6 +59,12 @@ int cli_parse_real(const char *s, double lo, double hi, double *out)
     return cli_parse_double(s, out) != 0 || !(*out >= lo && *out <= hi) ? -1 : 0;
 }
 
+int cli_parse_exposure(const char *s, void *out)
+{
+    double *v = out;
+    return cli_parse_real(s, 0.0, 1e9, v) != 0 || !(*v > 0.0) ? -1 : 0;
+}
+
 int cli_parse_coords(const char *s, double *v, int n)
 {
     const char *p = s;

@@ -222,6 +222,12 @@ printf '{"type":"LineString","coordinates":[[5,5,1.7],[5,6,1.7]]}' >"$tmp/inside
 expect walk-eye-inside 0 "^polarlux walk: warning: 2 of 2 frames have the eye inside a building \(the first: frame 1 at \(5\.00, 5\.00, 1\.70\)\)" -- \
     "$bin" walk fixtures/tiny.geojson --path "$tmp/inside.geojson" --size 32x24 --fps 1 --speed 1 --no-indirect -o "$tmp/wi"
 if ! grep -q "entirely black" "$tmp/out"; then echo "ok   walk-eye-inside-not-dark"; pass=$((pass + 1)); else echo "FAIL walk-eye-inside-not-dark"; fail=$((fail + 1)); fi
+# --max-frames cutting the path short is said, and the summary gives the
+# metres walked (it gave the path's length: 1000 frames "165.2 m" walked 56 m)
+printf '{"type":"LineString","coordinates":[[0,0,1.7],[0,10,1.7]]}' >"$tmp/ten.geojson"
+expect walk-max-frames-cut 0 "^polarlux walk: warning: --max-frames 3 stops the walk at 2\.0 m of the path's 10\.0 m \(11 frames would walk it all\)" -- \
+    "$bin" walk fixtures/tiny.geojson --path "$tmp/ten.geojson" --size 32x24 --fps 1 --speed 1 --max-frames 3 --no-indirect -o "$tmp/wmf"
+if grep -q "^walk: 3 frames 32x24 (2\.0 m of 10\.0 m at 1\.00 m/s" "$tmp/out"; then echo "ok   walk-max-frames-summary"; pass=$((pass + 1)); else echo "FAIL walk-max-frames-summary"; sed 's/^/    /' "$tmp/out"; fail=$((fail + 1)); fi
 printf '{"type":"LineString","coordinates":[[1,2]]}' >"$tmp/short.geojson"
 expect walk-short-path 1 "^polarlux walk: $tmp/short\.geojson: the LineString needs at least 2 positions$" -- "$bin" walk -q "$tmp/e.plxb" --path "$tmp/short.geojson" -o "$tmp/w3"
 # a coordinate beyond 1e7 m (it made the frame count overflow, then "out of
@@ -232,6 +238,9 @@ expect walk-huge-coordinate 1 "^polarlux walk: $tmp/huge\.geojson: position 0 \(
 printf 'x' >"$tmp/wfile"
 expect walk-out-is-file 1 "^polarlux walk: $tmp/wfile: not a folder" -- \
     "$bin" walk -q "$tmp/e.plxb" --path "$tmp/path.geojson" --size 32x24 -o "$tmp/wfile"
+# exposure 0 drew a black image, called dark for want of lamps
+expect render-exposure-zero 2 "--exposure '0' is not a number above 0, up to 1e9" -- "$bin" render fixtures/tiny.geojson --exposure 0 -o "$tmp/x.png"
+expect walk-exposure-zero 2 "--exposure '0' is not a number above 0, up to 1e9" -- "$bin" walk fixtures/tiny.geojson --path "$tmp/ten.geojson" --exposure 0 -o "$tmp/wmf"
 expect render-aa-bad 2 "--aa '0' is not a whole number from 1 to 16" -- "$bin" render fixtures/tiny.geojson --aa 0 -o "$tmp/x.png"
 # adaptive anti-aliasing (README "Anti-aliasing") against every sample
 expect render-aa-adaptive 0 "^anti-aliasing 2x2: the later samples shaded [0-9.]+% of the pixels \(adaptive" -- \
