@@ -151,7 +151,7 @@ for v in $values; do
     expect "route-step-$v" 2 "^polarlux route: --step '$v' $U a number of metres from 0.01 to 1e7" -- route $T --path fixtures/helsinki-route.geojson --step $v
     expect "route-dark-$v" 2 "^polarlux route: --dark-lux '$v' $U a number of lux" -- route $T --path fixtures/helsinki-route.geojson --dark-lux $v
     expect "render-fov-$v" 2 "^polarlux render: --fov '$v' $U between 0 and 180" -- render $T --fov $v -o "$tmp/r.png"
-    expect "render-exposure-$v" 2 "^polarlux render: --exposure '$v' $U a number from 0 to 1e9" -- render $T --exposure $v -o "$tmp/r.png"
+    expect "render-exposure-$v" 2 "^polarlux render: --exposure '$v' $U a number above 0, up to 1e9" -- render $T --exposure $v -o "$tmp/r.png"
     expect "render-texel-$v" 2 "^polarlux render: --texel '$v' $U a number of metres from 0.01 to 1e4" -- render $T --texel $v -o "$tmp/r.png"
     expect "vis-dir-$v" 2 "^polarlux vis: --dir '$v' $U a number of degrees" -- vis $T --at 30,30 --dir $v
     expect "vis-fov-$v" 2 "^polarlux vis: --fov '$v' $U a positive number of degrees" -- vis $T --at 30,30 --fov $v
