@@ -210,6 +210,8 @@ typedef struct savable_keep {
     size_t peak_total, peak[PLX_PART_COUNT]; /* the build's peaks: saved as the image's use, so that
                                                 bakes made with any number of workers are the same bytes */
     uint64_t requests;
+    plx_part failed_part;         /* the build's last refused request: not saved (its free */
+    size_t failed_size, failed_free; /* figure depends on the workers' scratch) */
     int threads, layer_workers;
 } savable_keep;
 
@@ -266,6 +268,11 @@ static void make_savable(plx_engine *e, savable_keep *keep)
     memcpy(e->mem.peak, e->mem.used, sizeof e->mem.peak);
     keep->requests = e->mem.requests; /* the workers' arenas are requests too; plx_bake_load counts anew */
     e->mem.requests = 0;
+    keep->failed_part = e->mem.failed_part;
+    keep->failed_size = e->mem.failed_size;
+    keep->failed_free = e->mem.failed_free;
+    e->mem.failed_part = PLX_PART_ENGINE;
+    e->mem.failed_size = e->mem.failed_free = 0;
     keep->threads = e->cfg.threads;
     e->cfg.threads = 0;   /* plx_bake_load sets the loaded engine's */
     keep->layer_workers = e->layer_workers;
@@ -291,6 +298,9 @@ static void restore_code(plx_engine *e, const savable_keep *keep)
         e->mem.peak_total = keep->peak_total;
         memcpy(e->mem.peak, keep->peak, sizeof e->mem.peak);
         e->mem.requests = keep->requests;
+        e->mem.failed_part = keep->failed_part;
+        e->mem.failed_size = keep->failed_size;
+        e->mem.failed_free = keep->failed_free;
         e->cfg.threads = keep->threads;
         e->layer_workers = keep->layer_workers;
     }

@@ -27,6 +27,7 @@ void arena_init(arena *a, void *mem, size_t size)
     a->fail_at = 0;
     a->failed_part = PLX_PART_ENGINE;
     a->failed_size = 0;
+    a->failed_free = 0;
     PLX_ASSERT(((uintptr_t)a->base & (PLX_ENGINE_ALIGN - 1)) == 0 || a->cap == 0);
 }
 
@@ -37,22 +38,26 @@ size_t arena_mul(size_t n, size_t size)
     return n * size;
 }
 
-static int refuse(arena *a, plx_part part, size_t size)
+/* Records a refused request with the free bytes at this moment (read
+ * later, the figure would count what the failed step released since). */
+static int refuse(arena *a, plx_part part, size_t size, size_t align)
 {
+    size_t start = align_up(a->lo, align), top = a->cap - a->hi;
     a->failed_part = part;
     a->failed_size = size;
+    a->failed_free = start < a->lo || start > top ? 0 : top - start;
     return 0;
 }
 
 /* Counts the request and checks fault injection and the part budget. */
-static int admit(arena *a, plx_part part, size_t size)
+static int admit(arena *a, plx_part part, size_t size, size_t align)
 {
     a->requests++;
     if (a->fail_at != 0 && a->requests == a->fail_at)
-        return refuse(a, part, size);
+        return refuse(a, part, size, align);
     if (a->budget[part] != 0 &&
         (size > a->budget[part] || a->used[part] > a->budget[part] - size))
-        return refuse(a, part, size);
+        return refuse(a, part, size, align);
     return 1;
 }
 
@@ -71,13 +76,13 @@ static void account(arena *a, plx_part part, size_t bytes)
 void *arena_alloc(arena *a, plx_part part, size_t size, size_t align)
 {
     size_t start, end;
-    if (!admit(a, part, size))
+    if (!admit(a, part, size, align))
         return NULL;
     if (size == 0)
         size = 1;
     start = align_up(a->lo, align);
     if (start < a->lo || start > a->cap - a->hi || size > a->cap - a->hi - start)
-        return refuse(a, part, size), NULL;
+        return refuse(a, part, size, align), NULL;
     end = start + size;
     PLX_ASSERT(part != PLX_PART_SCRATCH && start % align == 0);
     {
@@ -94,7 +99,7 @@ void *arena_calloc(arena *a, plx_part part, size_t n, size_t size, size_t align)
     unsigned char *p;
     size_t i;
     if (bytes == SIZE_MAX)
-        return (void)admit(a, part, bytes), refuse(a, part, bytes), NULL;
+        return (void)admit(a, part, bytes, align), refuse(a, part, bytes, align), NULL;
     p = arena_alloc(a, part, bytes, align);
     if (p)
         for (i = 0; i < bytes; i++)
@@ -105,17 +110,17 @@ void *arena_calloc(arena *a, plx_part part, size_t n, size_t size, size_t align)
 void *arena_scratch(arena *a, size_t size, size_t align)
 {
     size_t top, start, avail;
-    if (!admit(a, PLX_PART_SCRATCH, size))
+    if (!admit(a, PLX_PART_SCRATCH, size, align))
         return NULL;
     if (size == 0)
         size = 1;
     avail = a->cap - a->hi - a->lo;
     if (size > avail)
-        return refuse(a, PLX_PART_SCRATCH, size), NULL;
+        return refuse(a, PLX_PART_SCRATCH, size, align), NULL;
     top = a->cap - a->hi;
     start = (top - size) & ~(align - 1);
     if (start < a->lo)
-        return refuse(a, PLX_PART_SCRATCH, size), NULL;
+        return refuse(a, PLX_PART_SCRATCH, size, align), NULL;
     PLX_ASSERT((align & (align - 1)) == 0 && start % align == 0 && start >= a->lo);
     a->hi = a->cap - start;
     account(a, PLX_PART_SCRATCH, top - start);

@@ -24,7 +24,10 @@ typedef struct arena {
     uint64_t requests;              /* requests served or refused */
     uint64_t fail_at;               /* 0 = off, else the request number that fails */
     plx_part failed_part;           /* part of the last refused request */
-    size_t failed_size;
+    size_t failed_size;             /* bytes it asked for */
+    size_t failed_free;             /* bytes it could have had when refused: the free
+                                     * middle less its alignment padding (for a request
+                                     * the block refused, less than failed_size) */
 } arena;
 
 /* A position to roll back to; taken and released in stack order. */

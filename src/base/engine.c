@@ -103,7 +103,7 @@ plx_status eng_nomem(plx_engine *e, const char *during)
         sb_str(&b, " bytes)");
     }
     sb_str(&b, "; ");
-    sb_uint(&b, arena_free_bytes(&e->mem));
+    sb_uint(&b, e->mem.failed_free); /* at the refusal: the step has released its memory since */
     sb_str(&b, " of ");
     sb_uint(&b, e->mem.cap);
     sb_str(&b, " bytes free");

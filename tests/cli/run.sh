@@ -108,6 +108,14 @@ expect render-osmesa 1 "built without OSMesa" -- "$bin" render -q --frames 2 fix
 else
 expect render-osmesa 0 "^street view 64x48 " -- "$bin" render -q --frames 2 fixtures/tiny.geojson --backend osmesa --size 64x48 -o "$tmp/u.png"
 fi
+# out of memory: the free bytes when the request was refused, less than it
+# asked for (read after the failed step had let go of its memory, it said
+# "asked for 805306368 bytes; 1042579456 of 1073741824 bytes free")
+expect render-nomem-free 3 "out of memory while creating the renderer .*: part 'frame' asked for [0-9]+ bytes; [0-9]+ of [0-9]+ bytes free$" -- \
+    "$bin" render -q fixtures/tiny.geojson --size 8192x8192 -o "$tmp/u.png"
+set -- $(sed -n 's/.* asked for \([0-9]*\) bytes; \([0-9]*\) of [0-9]* bytes free$/\1 \2/p' "$tmp/out")
+if [ $# -eq 2 ] && [ "$2" -lt "$1" ]; then echo "ok   render-nomem-free-less"; pass=$((pass + 1))
+else echo "FAIL render-nomem-free-less: free not below asked: $*"; fail=$((fail + 1)); fi
 expect render-bad-size 2 "--size '12' is not WxH" -- "$bin" render -q fixtures/tiny.geojson --size 12 -o "$tmp/u.png"
 expect nightify-ok 0 "^nightify: 160x120 day image matched to 120x80 night reference" -- "$bin" nightify "$tmp/s.png" "$tmp/a.png" -o "$tmp/n.png"
 expect nightify-missing 1 "nope.png" -- "$bin" nightify "$tmp/nope.png" "$tmp/a.png" -o "$tmp/n2.png"

@@ -55,6 +55,45 @@ static void test_arena_exhaustion(void **state)
     assert_null(arena_calloc(&a, PLX_PART_SCENE, SIZE_MAX / 2, 4, 8)); /* overflow */
 }
 
+/* A refused request records the bytes it could have had at that moment:
+ * less than it asked for (the message "asked for N bytes; F of C bytes
+ * free" read the free bytes after the failed step had released its memory,
+ * so F came out larger than N), and the alignment's padding is not free to
+ * it. */
+static void test_arena_refusal_free(void **state)
+{
+    static unsigned char block[4096];
+    arena a;
+    arena_mark m;
+    size_t f;
+    (void)state;
+    arena_init(&a, block, sizeof block);
+    assert_non_null(arena_alloc(&a, PLX_PART_SCENE, 100, 8)); /* lo 100: 4 bytes to the next 8 */
+    m = arena_get_mark(&a);
+    assert_non_null(arena_scratch(&a, 1000, 16));
+    f = arena_free_bytes(&a);
+    assert_null(arena_alloc(&a, PLX_PART_POLAR, 3500, 8));
+    assert_int_equal(a.failed_size, 3500);
+    assert_int_equal(a.failed_free, f - 4);
+    assert_true(a.failed_free < a.failed_size);
+    arena_release(&a, &m); /* the failed step lets go of its scratch */
+    assert_true(arena_free_bytes(&a) > a.failed_size);
+    assert_int_equal(a.failed_free, f - 4); /* still the figure at the refusal */
+    /* the padding to a 64-byte start (28 bytes) is not free to the request */
+    f = arena_free_bytes(&a);
+    assert_null(arena_alloc(&a, PLX_PART_POLAR, f - 10, 64));
+    assert_int_equal(a.failed_free, f - 28);
+    assert_non_null(arena_alloc(&a, PLX_PART_POLAR, a.failed_free, 64)); /* and that much fits */
+    arena_release(&a, &m);
+    /* scratch from the high end: the same figure, and that much fits */
+    assert_null(arena_scratch(&a, f + 1, 16));
+    assert_int_equal(a.failed_part, PLX_PART_SCRATCH);
+    assert_true(a.failed_free < a.failed_size);
+    assert_non_null(arena_scratch(&a, a.failed_free, 16));
+    assert_null(arena_scratch(&a, 1, 16));
+    assert_int_equal(a.failed_free, 0);
+}
+
 static void test_arena_budget_and_faults(void **state)
 {
     static unsigned char block[4096];
@@ -121,6 +160,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_arena_parts_and_marks),
         cmocka_unit_test(test_arena_exhaustion),
+        cmocka_unit_test(test_arena_refusal_free),
         cmocka_unit_test(test_arena_budget_and_faults),
         cmocka_unit_test(test_strbuf),
     };
