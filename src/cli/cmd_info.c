@@ -1,8 +1,10 @@
 /* polarlux info SCENE: counts, bounds, heights, skipped features, load time
  * and memory per part. */
+#include <stdlib.h>
 #include <string.h>
 #include "cli.h"
 #include "options.h"
+#include "port.h"
 
 static const char help[] =
     "usage: polarlux info SCENE [--mem SIZE] [--strict] [--quiet] [--lamps FILE]... [--min-mem]\n"
@@ -31,7 +33,9 @@ static const char help[] =
     "  --min-mem    also find the smallest --mem that loads SCENE (the file alone)\n"
     "               and builds its\n"
     "               polar diagrams, by bisection over loads (to 4 KiB; about 18\n"
-    "               loads), and print it\n"
+    "               loads), and print it; for a bake file, the smallest block its\n"
+    "               image loads in (polar diagrams built there if it has none),\n"
+    "               beside the block it takes without --mem (room for queries)\n"
     "  --photons    also create the photon buffers (no photons traced) and print\n"
     "               the sizes chosen at this --mem: bytes, the default quality's\n"
     "               bytes, the budget, the quality steps taken to fit it, chart\n"
@@ -79,6 +83,67 @@ static void print_min_mem(const char *path, const cli_common *c, size_t hi)
     }
     printf("smallest --mem: %zu bytes (%.2f MiB) loads the scene and builds its polar diagrams "
            "(bisection, %d loads; a ground image needs its pixels on top)\n", hi, hi / 1048576.0, loads);
+}
+
+/* 1 when the block 'mem', given as 'bytes' long, loads the bake and has
+ * its polar diagrams (built here for a --no-polar bake). The block is
+ * aligned as the command's (cli_big_alloc), which the bake's offset in it
+ * depends on. */
+static int bake_fits(void *mem, size_t bytes, const void *data, size_t len)
+{
+    static plx_port port;
+    plx_config cfg;
+    plx_engine *e;
+    plx_polar_info pi;
+    int ok;
+    plx_config_default(&cfg);
+    port = *plx_port_posix();
+    port.log = silent_log;
+    cfg.port = &port;
+    if (plx_bake_load(mem, bytes, &cfg, data, len, &e, NULL, 0) != PLX_OK)
+        return 0;
+    ok = plx_polar_info_get(e, &pi) == PLX_OK;
+    plx_engine_destroy(e);
+    return ok;
+}
+
+/* For a bake, the smallest --mem is the block its image loads in (the
+ * bake's block size adds room for queries and frames): the same bisection,
+ * over bake loads into one block of 'hi' bytes (0: the bake's own size). */
+static int print_min_mem_bake(const char *path, size_t hi)
+{
+    char err[512];
+    size_t len, own, lo = PLX_ENGINE_MIN_BYTES;
+    char *data = port_read_text(path, &len, err, sizeof err);
+    void *mem = NULL;
+    int loads = 0, rc = EXIT_FAIL;
+    if (data && plx_bake_block_size(data, len, &own, err, sizeof err) == PLX_OK) {
+        if (!hi)
+            hi = own;
+        if (!(mem = cli_big_alloc(hi))) {
+            snprintf(err, sizeof err, "cannot take a block of %zu bytes", hi);
+            rc = EXIT_NOMEM;
+        }
+    }
+    if (!mem) {
+        fprintf(stderr, "polarlux info: %s: --min-mem: %s\n", path, err);
+        free(data);
+        return rc;
+    }
+    while (hi - lo > 4096) {
+        size_t mid = lo + (hi - lo) / 2;
+        loads++;
+        if (bake_fits(mem, mid, data, len))
+            hi = mid;
+        else
+            lo = mid;
+    }
+    free(mem);
+    free(data);
+    printf("smallest --mem: %zu bytes (%.2f MiB) loads the bake and has its polar diagrams (bisection, %d loads; "
+           "without --mem a bake takes %zu bytes (%.2f MiB), room for queries and frames)\n", hi, hi / 1048576.0,
+           loads, own, own / 1048576.0);
+    return EXIT_OK;
 }
 
 /* The photon buffers at this budget (created when missing). */
@@ -212,7 +277,9 @@ int cmd_info(int argc, char **argv)
         rc = print_photons(e, path, &si);
     print_memory(e);
     plx_engine_free(e);
-    if (min_mem && rc == EXIT_OK)
+    if (min_mem && rc == EXIT_OK && cli_bake_last.loaded)
+        rc = print_min_mem_bake(path, c.mem);
+    else if (min_mem && rc == EXIT_OK)
         print_min_mem(path, &c, c.mem ? c.mem : CLI_DEFAULT_MEM);
     return rc;
 }

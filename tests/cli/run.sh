@@ -195,6 +195,19 @@ expect bake-version 1 "^polarlux render: tests/corpus/bake-version-99\.plxb: bak
     "$bin" render tests/corpus/bake-version-99.plxb -o "$tmp/x.png"
 expect bake-arch 1 "bake made on another architecture" -- "$bin" vis tests/corpus/bake-big-endian.plxb --at 0,0
 expect bake-nomem 3 "the block is too small for the bake" -- "$bin" info --mem 64K "$tmp/e.plxb"
+# info --min-mem on a bake: the block its image loads in (it echoed --mem:
+# 1073741824 by default, 2147483648 with --mem 2G); the printed budget
+# loads, 4 KiB (the bisection's step) less does not, whatever --mem says
+for f in e np; do
+    n=$("$bin" info -q --min-mem "$tmp/$f.plxb" | sed -n 's/^smallest --mem: \([0-9]*\) bytes (.*) loads the bake .*/\1/p')
+    n2=$("$bin" info -q --min-mem --mem 2G "$tmp/$f.plxb" | sed -n 's/^smallest --mem: \([0-9]*\) bytes (.*) loads the bake .*/\1/p')
+    if [ -n "$n" ] && [ -n "$n2" ] && [ $((n - n2)) -lt 4096 ] && [ $((n2 - n)) -lt 4096 ]; then
+        echo "ok   bake-min-mem-$f"; pass=$((pass + 1))
+    else echo "FAIL bake-min-mem-$f: --min-mem printed '$n', with --mem 2G '$n2'"; fail=$((fail + 1)); n=1073741824; fi
+    expect bake-min-mem-$f-fits 0 "^memory: [0-9]+ bytes in use" -- "$bin" info -q --mem "$n" "$tmp/$f.plxb"
+    expect bake-min-mem-$f-less 3 "the block is too small for the bake|out of memory while building the polar diagrams" -- \
+        "$bin" info -q --mem $((n - 4096)) "$tmp/$f.plxb"
+done
 # ---- walk (README "Walking through a city") ----
 expect walk-help 0 "^usage: polarlux walk" -- "$bin" walk --help
 expect walk-unknown-option 2 "polarlux walk: unknown option '--bogus'" -- "$bin" walk --bogus x
