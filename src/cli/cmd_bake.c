@@ -144,7 +144,9 @@ static int prepare_engine(const bake_args *a, int twin, plx_engine **e, char *er
     st = plx_bake_prepare(*e, &o);
     if (st == PLX_OK)
         return EXIT_OK;
-    snprintf(err, errlen, "polarlux bake: %s\n", plx_last_error(*e));
+    snprintf(err, errlen, "polarlux bake: %s%s\n", plx_last_error(*e),
+             st == PLX_E_NOMEM ? " (--no-aerial, --no-polar, a smaller --max-size or a coarser --texel need less; "
+                                 "or give a larger --mem)" : "");
     plx_engine_free(*e);
     *e = NULL;
     return st == PLX_E_NOMEM ? EXIT_NOMEM : EXIT_FAIL;

@@ -421,7 +421,7 @@ int cmd_render(int argc, char **argv)
     st = plx_render(e, &a.cam, &a.opts, rgb8, rgbf, &info);
     t0 = port_now_ns() - t0; /* the frame alone, not the PNG written after it */
     if (st != PLX_OK) {
-        fprintf(stderr, "polarlux render: %s\n", plx_last_error(e));
+        fprintf(stderr, "polarlux render: %s%s\n", plx_last_error(e), cli_aa_nomem_hint(st, &a.opts));
 #ifdef PLX_HAVE_OSMESA
         if (om && *plx_osmesa_error(om))
             fprintf(stderr, "polarlux render: osmesa: %s\n", plx_osmesa_error(om));

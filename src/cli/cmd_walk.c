@@ -356,8 +356,8 @@ static int frame(const walk_args *a, plx_engine *e, const walk_path *wp, walk_ru
     if (st == PLX_OK && k == 0)
         cli_aa_warn("walk", &a->c, &a->opts, &info);
     if (st != PLX_OK) {
-        fprintf(stderr, "polarlux walk: frame %ld at (%.2f, %.2f, %.2f): %s\n", k + 1, cam.eye[0], cam.eye[1],
-                cam.eye[2], plx_last_error(e));
+        fprintf(stderr, "polarlux walk: frame %ld at (%.2f, %.2f, %.2f): %s%s\n", k + 1, cam.eye[0], cam.eye[1],
+                cam.eye[2], plx_last_error(e), cli_aa_nomem_hint(st, &a->opts));
         return cli_exit_code(st);
     }
     /* black with the eye inside a building: its own warning says why */

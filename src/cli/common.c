@@ -59,6 +59,13 @@ int cli_parse_real(const char *s, double lo, double hi, double *out)
     return cli_parse_double(s, out) != 0 || !(*out >= lo && *out <= hi) ? -1 : 0;
 }
 
+const char *cli_aa_nomem_hint(plx_status st, const plx_render_opts *o)
+{
+    if (st != PLX_E_NOMEM || o->aa <= 1)
+        return "";
+    return " (anti-aliasing takes 20 bytes a pixel of the largest frame, a bake's --max-size; --aa 1 needs none)";
+}
+
 int cli_parse_exposure(const char *s, void *out)
 {
     double *v = out;

@@ -155,6 +155,18 @@ if cmp -s "$tmp/end1.png" "$tmp/end2.png"; then echo "ok   bake-no-indirect-dire
 printf '{"type":"LineString","coordinates":[[20,5,1.7],[20,60,1.7]],"properties":{"units":"m"}}' >"$tmp/endpath.geojson"
 expect bake-no-indirect-walk 0 "holds no indirect light" -- \
     "$bin" walk "$tmp/end.plxb" --path "$tmp/endpath.geojson" --size 160x120 --max-frames 3 -o "$tmp/endw"
+# out of memory: what takes less (bake), and that --aa 1 needs no
+# anti-aliasing buffers (a walk at the bake's own --mem failed at frame 1
+# with no word of it)
+expect bake-nomem-hint 3 "out of memory .*\(--no-aerial, --no-polar, a smaller --max-size or a coarser --texel need less; or give a larger --mem\)$" -- \
+    "$bin" bake -q fixtures/eixample-4x4.geojson --mem 3M -o "$tmp/nomem.plxb"
+# 28 KB above the smallest --mem that loads the bake: room for a frame without anti-aliasing only
+amem=$("$bin" info "$tmp/e.plxb" --min-mem 2>/dev/null | sed -n 's/^smallest --mem: \([0-9]*\) bytes.*/\1/p')
+amem=$((amem + 28000))
+expect walk-nomem-aa-hint 3 "^polarlux walk: frame 1 at .*out of memory .*\(anti-aliasing takes 20 bytes a pixel of the largest frame, a bake's --max-size; --aa 1 needs none\)$" -- \
+    "$bin" walk -q "$tmp/e.plxb" --mem "$amem" --path "$tmp/endpath.geojson" --size 160x120 --max-frames 2 -o "$tmp/endw"
+expect walk-nomem-aa1 0 "^walk: 2 frames" -- \
+    "$bin" walk -q "$tmp/e.plxb" --mem "$amem" --aa 1 --path "$tmp/endpath.geojson" --size 160x120 --max-frames 2 -o "$tmp/endw"
 expect bake-info 0 "^bake: [0-9]+ bytes \([0-9.]+ MB\) loaded in [0-9.]+ ms" -- "$bin" info "$tmp/e.plxb"
 expect bake-info-memory 0 "^memory: [0-9]+ bytes in use" -- "$bin" info "$tmp/e.plxb"
 printf '0.5 0.5\n10 -3\n61 61\n' >"$tmp/bp.txt"
