@@ -21,7 +21,7 @@ static const char help[] =
     "usage: polarlux render SCENE [--eye X,Y,Z --target X,Y,Z] [--fov DEG] [--size WxH]\n"
     "                       [--view street|aerial] [--backend soft|osmesa] [--exposure E]\n"
     "                       [--no-indirect] [--no-glow] [--aa N [--aa-full]] [--texel M]\n"
-    "                       [--per-pixel] [--threads N]\n"
+    "                       [--per-pixel] [--threads N] [--refine] [--mem SIZE]\n"
     "                       -o OUT.png [--pfm OUT.pfm]\n"
     "\n"
     "Renders the scene at night through a pinhole camera (SPEC §5: up is +z,\n"
