@@ -100,8 +100,8 @@ static int parse_args(int argc, char **argv, walk_args *a)
     const cli_opt opts[] = {
         CLI_OPT_STR("--path", &a->path),
         CLI_OPT_STR("-o", &a->dir),
-        CLI_OPT_VAL("--fps", &a->fps, parse_rate, "--fps '%s' is not a positive number"),
-        CLI_OPT_VAL("--speed", &a->speed, parse_rate, "--speed '%s' is not a positive number"),
+        CLI_OPT_VAL("--fps", &a->fps, parse_rate, "--fps '%s' is not a number above 0, up to 1e4"),
+        CLI_OPT_VAL("--speed", &a->speed, parse_rate, "--speed '%s' is not a number above 0, up to 1e4 (m/s)"),
         { "--exposure", NULL, &a->opts.exposure, cli_parse_exposure, "--exposure '%s' is not a number above 0, up to 1e9", 0, NULL,
           &v.exposure, NULL },
         CLI_OPT_VAL("--refine-frames", &a->refine_frames, parse_refine_frames,
@@ -439,6 +439,20 @@ static void walk_refine_print(const walk_args *a, const walk_run *wr)
     printf("\n");
 }
 
+/* A word when DIR already holds the frame after this walk's last (an
+ * earlier, longer walk's): the folder would mix the two walks' frames. */
+static void stale_hint(const walk_args *a, long n)
+{
+    char path[4096];
+    FILE *f;
+    snprintf(path, sizeof path, "%s/frame-%04ld.png", a->dir, n + 1);
+    if (!(f = fopen(path, "rb")))
+        return;
+    fclose(f);
+    cli_warn("walk", &a->c, "%s holds %s and maybe later frames from an earlier walk: this walk writes frames 1 "
+             "to %ld and leaves them", a->dir, path + strlen(a->dir) + 1, n);
+}
+
 static int run(const walk_args *a, plx_engine *e, const walk_path *wp)
 {
     walk_run wr;
@@ -457,6 +471,7 @@ static int run(const walk_args *a, plx_engine *e, const walk_path *wp)
     if (steps > (double)a->max_frames)
         cli_warn("walk", &a->c, "--max-frames %ld stops the walk at %.1f m of the path's %.1f m (%.0f frames "
                  "would walk it all)", a->max_frames, (wr.n - 1) * step, L, steps);
+    stale_hint(a, wr.n);
     sheet_plan(&wr.sh, a, wr.n);
     wr.ms = malloc(sizeof *wr.ms * (size_t)wr.n);
     sorted = malloc(sizeof *sorted * (size_t)wr.n);
@@ -493,7 +508,8 @@ static int run(const walk_args *a, plx_engine *e, const walk_path *wp)
         qsort(sorted, (size_t)wr.n, sizeof *sorted, cmp_double);
         for (k = 0; k < wr.n; k++)
             sum += sorted[k];
-        med = sorted[wr.n / 2];
+        /* the middle frame, or the mean of the two middle ones */
+        med = wr.n % 2 ? sorted[wr.n / 2] : 0.5 * (sorted[wr.n / 2 - 1] + sorted[wr.n / 2]);
         p95 = sorted[(size_t)ceil(0.95 * wr.n) - 1];
         printf("walk: %ld frames %dx%d (%.1f m of %.1f m at %.2f m/s, %g fps, aa %d), written to %s/\n", wr.n, a->w,
                a->h, (wr.n - 1) * step, L, a->speed, a->fps, a->opts.aa > 1 ? a->opts.aa : 1, a->dir);

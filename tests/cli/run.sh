@@ -261,6 +261,14 @@ printf '{"type":"LineString","coordinates":[[0,0,1.7],[0,10,1.7]]}' >"$tmp/ten.g
 expect walk-max-frames-cut 0 "^polarlux walk: warning: --max-frames 3 stops the walk at 2\.0 m of the path's 10\.0 m \(11 frames would walk it all\)" -- \
     "$bin" walk fixtures/tiny.geojson --path "$tmp/ten.geojson" --size 32x24 --fps 1 --speed 1 --max-frames 3 --no-indirect -o "$tmp/wmf"
 if grep -q "^walk: 3 frames 32x24 (2\.0 m of 10\.0 m at 1\.00 m/s" "$tmp/out"; then echo "ok   walk-max-frames-summary"; pass=$((pass + 1)); else echo "FAIL walk-max-frames-summary"; sed 's/^/    /' "$tmp/out"; fail=$((fail + 1)); fi
+# an earlier, longer walk's frames left in the folder are pointed out
+expect walk-stale-frames 0 "^polarlux walk: warning: .*/wmf holds frame-0003\.png and maybe later frames from an earlier walk: this walk writes frames 1 to 2 and leaves them" -- \
+    "$bin" walk fixtures/tiny.geojson --path "$tmp/ten.geojson" --size 32x24 --fps 1 --speed 1 --max-frames 2 --no-indirect -o "$tmp/wmf"
+# the median of an even count is the mean of the two middle frames (it was
+# the slower one): with two frames, the mean of both
+"$bin" walk -q fixtures/tiny.geojson --path "$tmp/ten.geojson" --size 32x24 --fps 1 --speed 1 --max-frames 2 --no-indirect -o "$tmp/wmf" >"$tmp/out" 2>&1
+set -- $(sed -n 's/^frame time: median \([0-9.]*\) ms, p95 [0-9.]* ms, mean \([0-9.]*\) ms.*/\1 \2/p' "$tmp/out")
+if [ -n "${2:-}" ] && [ "$1" = "$2" ]; then echo "ok   walk-even-median"; pass=$((pass + 1)); else echo "FAIL walk-even-median: $*"; fail=$((fail + 1)); fi
 printf '{"type":"LineString","coordinates":[[1,2]]}' >"$tmp/short.geojson"
 expect walk-short-path 1 "^polarlux walk: $tmp/short\.geojson: the LineString needs at least 2 positions$" -- "$bin" walk -q "$tmp/e.plxb" --path "$tmp/short.geojson" -o "$tmp/w3"
 # a coordinate beyond 1e7 m (it made the frame count overflow, then "out of
