@@ -97,6 +97,22 @@ static int metres(const cJSON *root)
     return root && metres_props(cJSON_GetObjectItemCaseSensitive(root, "properties"));
 }
 
+/* No keyframe looks at its own eye (the camera would have no direction:
+ * render refuses such a camera; walk looked 1 m east). */
+static int check_targets(const walk_path *wp, int n, char *why, size_t whylen)
+{
+    int k;
+    for (k = 0; k < n; k++) {
+        const double *p = &wp->eye[3 * k], *t = &wp->target[3 * k];
+        if (p[0] == t[0] && p[1] == t[1] && p[2] == t[2]) {
+            snprintf(why, whylen, "properties.targets: position %d's target is its eye (%g, %g, %g): the camera "
+                     "would look nowhere", k, p[0], p[1], p[2]);
+            return -1;
+        }
+    }
+    return 0;
+}
+
 static int parse(const cJSON *root, plx_engine *e, walk_path *wp, char *why, size_t whylen)
 {
     const cJSON *props, *line = first_line(root, &props), *coords, *targets;
@@ -137,7 +153,7 @@ static int parse(const cJSON *root, plx_engine *e, walk_path *wp, char *why, siz
         snprintf(why, whylen, "properties.targets: %.200s", inner);
         return -1;
     }
-    return 0;
+    return targets ? check_targets(wp, n, why, whylen) : 0;
 }
 
 int walk_path_read(const char *path, plx_engine *e, walk_path *wp, char *err, size_t errlen)

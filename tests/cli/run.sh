@@ -269,6 +269,10 @@ expect walk-stale-frames 0 "^polarlux walk: warning: .*/wmf holds frame-0003\.pn
 "$bin" walk -q fixtures/tiny.geojson --path "$tmp/ten.geojson" --size 32x24 --fps 1 --speed 1 --max-frames 2 --no-indirect -o "$tmp/wmf" >"$tmp/out" 2>&1
 set -- $(sed -n 's/^frame time: median \([0-9.]*\) ms, p95 [0-9.]* ms, mean \([0-9.]*\) ms.*/\1 \2/p' "$tmp/out")
 if [ -n "${2:-}" ] && [ "$1" = "$2" ]; then echo "ok   walk-even-median"; pass=$((pass + 1)); else echo "FAIL walk-even-median: $*"; fail=$((fail + 1)); fi
+# a keyframe whose target is its eye (render refuses that camera; walk looked 1 m east)
+printf '{"type":"LineString","coordinates":[[0,0,50],[10,0,50]],"properties":{"targets":[[0,0,50],[10,5,0]]}}' >"$tmp/kt.geojson"
+expect walk-target-is-eye 1 "^polarlux walk: .*kt\.geojson: properties\.targets: position 0's target is its eye \(0, 0, 50\): the camera would look nowhere$" -- \
+    "$bin" walk -q fixtures/tiny.geojson --path "$tmp/kt.geojson" --no-indirect -o "$tmp/wmf"
 printf '{"type":"LineString","coordinates":[[1,2]]}' >"$tmp/short.geojson"
 expect walk-short-path 1 "^polarlux walk: $tmp/short\.geojson: the LineString needs at least 2 positions$" -- "$bin" walk -q "$tmp/e.plxb" --path "$tmp/short.geojson" -o "$tmp/w3"
 # a coordinate beyond 1e7 m (it made the frame count overflow, then "out of
