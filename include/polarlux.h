@@ -150,7 +150,8 @@ typedef struct plx_config {
     size_t part_budget[PLX_PART_COUNT]; /* per-part byte limits, 0 = only the block limits */
     size_t lit_cache_bytes;           /* pool for lamp lit regions (0: from the budget, an eighth of
                                          the free bytes at first use, 256 KiB to 16 MiB) */
-    int32_t render_max_width;         /* largest frame plx_render draws (0: 1920) */
+    int32_t render_max_width;         /* largest frame plx_render draws (0: 1920; at most
+                                         PLX_RENDER_MAX_DIM, plx_engine_create refuses more) */
     int32_t render_max_height;        /* (0: 1080) */
     size_t lightmap_bytes;            /* the light maps' budget: the radiance atlas's (4 bytes a
                                          sample point, its spacing grows from the one asked for until
@@ -183,7 +184,8 @@ typedef struct plx_engine plx_engine;
  * frees it after plx_engine_destroy. cfg (may be NULL: the defaults) and
  * its port table are copied; the port's ctx must outlive the engine.
  * plx_memory_estimate says what size a scene needs.
- * Errors: PLX_E_INVALID (mem or engine NULL, size < PLX_ENGINE_MIN_BYTES),
+ * Errors: PLX_E_INVALID (mem or engine NULL, size < PLX_ENGINE_MIN_BYTES,
+ * cfg's render_max_width or _height outside 0..PLX_RENDER_MAX_DIM),
  * PLX_E_NOMEM (the block cannot hold the engine object after alignment).
  * Lifetime: *engine is valid until plx_engine_destroy. Threads: any (it
  * touches only the block).
@@ -716,6 +718,7 @@ typedef struct plx_render_opts {
 } plx_render_opts;
 
 #define PLX_RENDER_MAX_AA 16
+#define PLX_RENDER_MAX_DIM 16384   /* the largest frame width or height */
 
 /* The radiance atlas frames with indirect light read (README "The radiance
  * atlas"): made at the first such frame (or by plx_bake_prepare), filled
@@ -966,7 +969,9 @@ plx_status plx_bake_block_size(const void *bake, size_t len, size_t *block_bytes
  * Creates an engine in the caller's block from a bake: one copy of the
  * image and the relocation of its pointers, no parsing, no rebuilding.
  * cfg gives the port, strictness and part budgets (the lit cache and the
- * render maximum stay the bake's). The bake buffer may be freed after.
+ * render maximum stay the bake's). The bake buffer may be freed after; it
+ * must not overlap the block (PLX_E_INVALID: the image is written over the
+ * block from its start).
  * Errors as plx_bake_block_size, plus PLX_E_NOMEM (block too small) and
  * PLX_E_INVALID; err gets one line.
  */

@@ -613,6 +613,12 @@ plx_status plx_bake_load(void *mem, size_t size, const plx_config *cfg, const vo
         *out = NULL;
     if (!mem || !out)
         return say(err, errlen, PLX_E_INVALID, "plx_bake_load: mem and out must not be NULL", 0, NULL, 0, NULL);
+    /* the image is written over the block from its start: a file read
+     * into the block would be overwritten before it is read (and memcpy
+     * of overlapping bytes is undefined) */
+    if ((uintptr_t)f < (uintptr_t)mem + size && (uintptr_t)mem < (uintptr_t)f + len)
+        return say(err, errlen, PLX_E_INVALID, "plx_bake_load: the bake's bytes lie inside the block; read the "
+                   "file into memory outside it (the load writes the block from its start)", 0, NULL, 0, NULL);
     st = check_file(f, len, &L, err, errlen);
     if (st != PLX_OK)
         return st;

@@ -51,6 +51,9 @@ plx_status plx_indirect_refine(plx_engine *e, const double eye[3], plx_refine_st
         return PLX_E_INVALID;
     if (!eye)
         return eng_fail(e, PLX_E_INVALID, "plx_indirect_refine: eye is NULL");
+    /* as plx_indirect_refine_view's camera (a NaN eye refined lamps) */
+    if (!isfinite(eye[0]) || !isfinite(eye[1]) || !isfinite(eye[2]))
+        return eng_fail(e, PLX_E_INVALID, "plx_indirect_refine: the eye must be finite");
     if (!e->ph)
         return eng_fail(e, PLX_E_NOSCENE, "plx_indirect_refine: no photon buffers (trace indirect light first)");
     misses = photon_lamps_update(e->ph, eye);

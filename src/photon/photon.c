@@ -559,12 +559,17 @@ double photon_gather_wide(const float *flux, const float *area, const float *hei
                           double e[PHOTON_CH])
 {
     double sf[PHOTON_CH] = {0.0, 0.0, 0.0, 0.0}, sa = 0.0, r2 = r * r, dx2[2 * PHOTON_LOOKUP_MAXI + 1];
-    int ri = (int)ceil(r), ci = (int)floor(fx), cj = (int)floor(fy), a, b, c;
+    int ri, ci, cj, a, b, c;
     if (r <= 0.0 || r > PHOTON_LOOKUP_MAX ||
         !(fx > -2.0 && fy > -2.0 && fx < (double)w + 2.0 && fy < (double)h + 2.0)) {
         grid g = grid_full(area, height, NULL, z, w, h, wrap);
         return gather_any(flux, &g, fx, fy, e);
     }
+    /* converted once in range (a point far off the grid: a float-to-int
+     * overflow, undefined, before the test moved above them) */
+    ri = (int)ceil(r);
+    ci = (int)floor(fx);
+    cj = (int)floor(fy);
     /* each column's dx^2 once, for every row */
     for (a = ci - ri; a <= ci + ri; a++) {
         double dx = a + 0.5 - fx;

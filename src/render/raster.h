@@ -61,7 +61,7 @@
 /* Fraction bits of snapped window coordinates: 1 pixel = 256 units. */
 #define RASTER_SUBPIXEL_BITS 8
 /* Largest target width or height accepted. */
-#define RASTER_MAX_DIM 16384
+#define RASTER_MAX_DIM PLX_RENDER_MAX_DIM
 /* The guard band reaches this many pixels beyond each edge of the target. */
 #define RASTER_GUARD_PX 8192
 /* Clip-space w below which geometry is clipped away. */

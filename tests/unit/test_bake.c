@@ -620,6 +620,34 @@ static void test_twin_mismatch(void **state)
     free(mb);
 }
 
+/* The bake's bytes inside the block the engine is loaded into: refused
+ * before a byte of the block is written (the load copies the image over
+ * the block from its start: it read the file after overwriting it, and
+ * reported a corrupt bake), the file's bytes as they were. */
+static void test_file_inside_block(void **state)
+{
+    size_t need = 0;
+    char err[256];
+    unsigned char *blk;
+    plx_engine *e = NULL;
+    (void)state;
+    assert_int_equal(plx_bake_block_size(shared.file, shared.len, &need, err, sizeof err), PLX_OK);
+    blk = malloc(need + shared.len);
+    assert_non_null(blk);
+    memcpy(blk, shared.file, shared.len); /* at the block's start */
+    assert_int_equal(plx_bake_load(blk, need, NULL, blk, shared.len, &e, err, sizeof err), PLX_E_INVALID);
+    assert_null(e);
+    assert_non_null(strstr(err, "the bake's bytes lie inside the block"));
+    assert_memory_equal(blk, shared.file, shared.len);
+    memcpy(blk + need - 8, shared.file, shared.len); /* straddling its end */
+    assert_int_equal(plx_bake_load(blk, need, NULL, blk + need - 8, shared.len, &e, err, sizeof err),
+                     PLX_E_INVALID);
+    memcpy(blk + need, shared.file, shared.len); /* just past it: loads */
+    assert_int_equal(plx_bake_load(blk, need, NULL, blk + need, shared.len, &e, err, sizeof err), PLX_OK);
+    plx_engine_destroy(e);
+    free(blk);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -631,6 +659,7 @@ int main(void)
         cmocka_unit_test(test_damaged),
         cmocka_unit_test(test_corpus),
         cmocka_unit_test(test_twin_mismatch),
+        cmocka_unit_test(test_file_inside_block),
     };
     return cmocka_run_group_tests(tests, shared_make, shared_free);
 }

@@ -158,6 +158,60 @@ static void test_nomem(void **state)
     free(mem);
 }
 
+/* Arguments the API used to take and go wrong with later or silently:
+ * a render maximum beyond the rasteriser's (refused at the first frame
+ * with no reason), a fixed exposure of 0 or less (a black frame), a NaN
+ * eye for the refinement (lamps refined around NaN); and the frame's
+ * report of an eye inside a building. */
+static void test_refusals(void **state)
+{
+    static unsigned char blk[1 << 16];
+    plx_config cfg;
+    plx_engine *e;
+    plx_render_opts o;
+    plx_render_info info;
+    plx_refine_stats rs;
+    plx_camera in = { { 5, 5, 3 }, { 15, 6, 3 }, 60, 32, 24 }, out = { { -5, -5, 1.7 }, { 5, 5, 1 }, 60, 32, 24 };
+    double nan_eye[3] = { 0.0, 0.0, 1.7 };
+    uint8_t rgb[32 * 24 * 3];
+    void *mem;
+    (void)state;
+    plx_config_default(&cfg);
+    cfg.render_max_width = -1;
+    assert_int_equal(plx_engine_create(blk, sizeof blk, &cfg, &e), PLX_E_INVALID);
+    cfg.render_max_width = PLX_RENDER_MAX_DIM + 1;
+    assert_int_equal(plx_engine_create(blk, sizeof blk, &cfg, &e), PLX_E_INVALID);
+    cfg.render_max_width = PLX_RENDER_MAX_DIM;
+    cfg.render_max_height = PLX_RENDER_MAX_DIM + 1;
+    assert_int_equal(plx_engine_create(blk, sizeof blk, &cfg, &e), PLX_E_INVALID);
+    cfg.render_max_height = PLX_RENDER_MAX_DIM;
+    assert_int_equal(plx_engine_create(blk, sizeof blk, &cfg, &e), PLX_OK);
+    plx_engine_destroy(e);
+
+    e = open_tiny(&mem);
+    plx_render_opts_default(&o);
+    o.no_indirect = 1;
+    o.exposure = 0.0;
+    assert_int_equal(plx_render(e, &out, &o, rgb, NULL, NULL), PLX_E_INVALID);
+    assert_non_null(strstr(plx_last_error(e), "exposure must be a finite number above 0"));
+    o.exposure = -1.0;
+    assert_int_equal(plx_render(e, &out, &o, rgb, NULL, NULL), PLX_E_INVALID);
+    o.auto_exposure = 1; /* the fixed exposure is not read */
+    assert_int_equal(plx_render(e, &out, &o, rgb, NULL, &info), PLX_OK);
+    assert_int_equal(info.eye_inside, 0);
+    assert_int_equal(plx_render(e, &in, &o, rgb, NULL, &info), PLX_OK);
+    assert_int_equal(info.eye_inside, 1);
+
+    assert_int_equal(plx_indirect_step(e, 2000, 1), PLX_OK);
+    nan_eye[0] = nan("");
+    assert_int_equal(plx_indirect_refine(e, nan_eye, &rs), PLX_E_INVALID);
+    assert_non_null(strstr(plx_last_error(e), "the eye must be finite"));
+    nan_eye[0] = 0.0;
+    nan_eye[2] = INFINITY;
+    assert_int_equal(plx_indirect_refine(e, nan_eye, &rs), PLX_E_INVALID);
+    fixture_done(e, mem);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -166,6 +220,7 @@ int main(void)
         cmocka_unit_test(test_render_hook),
         cmocka_unit_test(test_nightify),
         cmocka_unit_test(test_nomem),
+        cmocka_unit_test(test_refusals),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
