@@ -638,7 +638,11 @@ typedef struct plx_refine_stats {
  * first, up to the cache capacity, get their own floor photon maps, kept
  * in an LRU cache; a lamp's map is pushed into the improved aerial map the
  * first time, and the progressive aerial chart then restarts without that
- * lamp (further plx_indirect_step frames fill it again). Only a miss
+ * lamp: it holds nothing (every lamp's share of it is gone) until further
+ * plx_indirect_step frames fill it again, so trace some before the next
+ * frame (polarlux walk traces --refine-frames, 2 by default; a frame drawn
+ * straight after a miss lacked about a third of its indirect light on the
+ * 4x4 Eixample). Only a miss
  * changes the indirect light (the cached maps are summed in slot order,
  * which hits do not change): after a call of hits alone the frames'
  * radiance atlas and indirect map stay filled. out (may be NULL)
