@@ -605,6 +605,39 @@ static plx_status frame_fits(plx_engine *e, const plx_camera *cam)
     return PLX_E_INVALID;
 }
 
+/* PLX_E_INVALID, saying what and the values, for a camera the renderer
+ * cannot take (it said "render_frame: ..." without them). */
+static plx_status camera_ok(plx_engine *e, const plx_camera *cam)
+{
+    strbuf b;
+    int k;
+    for (k = 0; k < 3; k++)
+        if (!isfinite(cam->eye[k]) || !isfinite(cam->target[k]))
+            return eng_fail(e, PLX_E_INVALID, "plx_render: the camera's eye or target is not finite");
+    sb_init(&b, e->err, sizeof e->err);
+    if (!(cam->fov_deg > 0.0 && cam->fov_deg < 180.0)) {
+        sb_str(&b, "plx_render: fov_deg ");
+        sb_num(&b, cam->fov_deg, 6);
+        sb_str(&b, " is outside (0, 180) degrees");
+        return PLX_E_INVALID;
+    }
+    if (!(cam->eye[2] > 0.0)) {
+        sb_str(&b, "plx_render: the eye is at z = ");
+        sb_num(&b, cam->eye[2], 6);
+        sb_str(&b, " m, not above the ground (z > 0)");
+        return PLX_E_INVALID;
+    }
+    if (cam->eye[0] == cam->target[0] && cam->eye[1] == cam->target[1] && cam->eye[2] == cam->target[2]) {
+        sb_str(&b, "plx_render: the eye and the target are the same point (");
+        for (k = 0; k < 3; k++) {
+            sb_num(&b, cam->eye[k], 9);
+            sb_str(&b, k < 2 ? ", " : "): the camera looks nowhere");
+        }
+        return PLX_E_INVALID;
+    }
+    return PLX_OK;
+}
+
 plx_status plx_render(plx_engine *e, const plx_camera *cam, const plx_render_opts *o, uint8_t *rgb8,
                       float *rgbf, plx_render_info *info)
 {
@@ -633,7 +666,7 @@ plx_status plx_render(plx_engine *e, const plx_camera *cam, const plx_render_opt
     st = eng_need(e, ENG_RENDER, "plx_render");
     if (st != PLX_OK)
         return st;
-    if ((st = frame_fits(e, cam)) != PLX_OK)
+    if ((st = frame_fits(e, cam)) != PLX_OK || (st = camera_ok(e, cam)) != PLX_OK)
         return st;
     inside = render_eye_inside(e->rd, cam->eye);
     use_atlas = atlas_frames(e, o) && !e->atlas_off && !inside;

@@ -171,7 +171,7 @@ static void test_refusals(void **state)
     plx_render_opts o;
     plx_render_info info;
     plx_refine_stats rs;
-    plx_camera in = { { 5, 5, 3 }, { 15, 6, 3 }, 60, 32, 24 }, out = { { -5, -5, 1.7 }, { 5, 5, 1 }, 60, 32, 24 };
+    plx_camera in = { { 5, 5, 3 }, { 15, 6, 3 }, 60, 32, 24 }, out = { { -5, -5, 1.7 }, { 5, 5, 1 }, 60, 32, 24 }, bad;
     double nan_eye[3] = { 0.0, 0.0, 1.7 };
     uint8_t rgb[32 * 24 * 3];
     void *mem;
@@ -201,6 +201,25 @@ static void test_refusals(void **state)
     assert_int_equal(info.eye_inside, 0);
     assert_int_equal(plx_render(e, &in, &o, rgb, NULL, &info), PLX_OK);
     assert_int_equal(info.eye_inside, 1);
+
+    /* bad cameras: what is wrong, with the values (it said "render_frame: ..." without them) */
+    bad = out;
+    bad.fov_deg = 0.0;
+    assert_int_equal(plx_render(e, &bad, &o, rgb, NULL, NULL), PLX_E_INVALID);
+    assert_string_equal(plx_last_error(e), "plx_render: fov_deg 0 is outside (0, 180) degrees");
+    bad = out;
+    bad.eye[2] = -2.5;
+    assert_int_equal(plx_render(e, &bad, &o, rgb, NULL, NULL), PLX_E_INVALID);
+    assert_string_equal(plx_last_error(e), "plx_render: the eye is at z = -2.5 m, not above the ground (z > 0)");
+    bad = out;
+    memcpy(bad.target, bad.eye, sizeof bad.eye);
+    assert_int_equal(plx_render(e, &bad, &o, rgb, NULL, NULL), PLX_E_INVALID);
+    assert_string_equal(plx_last_error(e),
+                        "plx_render: the eye and the target are the same point (-5, -5, 1.7): the camera looks nowhere");
+    bad = out;
+    bad.target[1] = nan("");
+    assert_int_equal(plx_render(e, &bad, &o, rgb, NULL, NULL), PLX_E_INVALID);
+    assert_string_equal(plx_last_error(e), "plx_render: the camera's eye or target is not finite");
 
     assert_int_equal(plx_indirect_step(e, 2000, 1), PLX_OK);
     nan_eye[0] = nan("");
