@@ -374,7 +374,7 @@ static plx_status scan(plx_engine *e, plx_engine *t, unsigned char *out, bake_la
 
 static plx_status check_twin(plx_engine *e, plx_engine *t, const char *fn)
 {
-    char msg[200];
+    char msg[400]; /* the whole sentence: 200 cut it mid-word */
     strbuf b;
     size_t k;
     int same = t && eng_ok(t) && t != e && t->mem.lo == e->mem.lo &&
