@@ -28,9 +28,10 @@ FPFLAGS  = -ffp-contract=off
 CPPFLAGS = -Iinclude -Isrc -Iport
 CFLAGS_ALL = $(WARN) $(FPFLAGS) $(OPT) -fPIC -MMD -MP $(EXTRA_CFLAGS)
 POSIX    = -D_POSIX_C_SOURCE=200809L
-# The core needs cJSON and libm only; the port (port/posix, port/png) adds
-# libpng and pthreads. Programs link both: $(PORT_A) $(LIB_A) $(LIBS).
-CORE_LIBS = -lcjson -lm
+# The core needs libm only (it reads JSON itself, without cJSON); the port
+# (port/posix, port/png) adds libpng and pthreads. The command and the tests
+# link both with $(LIBS), which adds cJSON: they still parse JSON with it.
+CORE_LIBS = -lm
 PORT_LIBS = -lpng -lpthread
 LIBS     = -lcjson -lpng -lm -lpthread
 # The command alone also links SQLite (polarlux tiles to MBTiles).
@@ -218,8 +219,8 @@ check-layers:
 	@sh tests/check_layers.sh
 
 # examples/: programs that embed the engine as an application would. Each
-# links the core library alone (no port, no libpng, no pthreads) and checks
-# its own results: make check runs them.
+# links the core library alone (no port, no libpng, no pthreads, no cJSON)
+# and checks its own results: make check runs them.
 EXAMPLES = $(patsubst examples/%.c,$(BUILD)/examples/%,$(wildcard examples/*.c))
 $(BUILD)/examples/%: examples/%.c $(LIB_A)
 	@mkdir -p $(@D)
@@ -280,11 +281,11 @@ check-hostile-valgrind: all $(BUILD)/tests/failwrite.so
 unit: $(TESTS)
 	@for t in $(TESTS); do $$t || exit 1; done
 
-# The core library stands alone: libpolarlux.a asks only for cJSON, libm and
-# the C functions a bare-metal libc has (the list of check-freestanding) and
-# never for libpng, pthreads or stdio; libpolarlux.so needs only libcjson,
-# libm and libc, and carries its SONAME.
-LIB_ALLOWED_RE = ^(cJSON_[A-Za-z]+|sincos|_GLOBAL_OFFSET_TABLE_|__stack_chk_fail|__[a-z_]+_chk|__(asan|ubsan|sanitizer|sancov|lsan)_[A-Za-z0-9_]+|__sanitizer_cov_.*)$$
+# The core library stands alone: libpolarlux.a asks only for libm and the C
+# functions a bare-metal libc has (the list of check-freestanding) and never
+# for cJSON, libpng, pthreads or stdio; libpolarlux.so needs only libm and
+# libc, and carries its SONAME.
+LIB_ALLOWED_RE = ^(sincos|_GLOBAL_OFFSET_TABLE_|__stack_chk_fail|__[a-z_]+_chk|__(asan|ubsan|sanitizer|sancov|lsan)_[A-Za-z0-9_]+|__sanitizer_cov_.*)$$
 check-lib-split: $(LIB_A) $(LIB_SO)
 	@t=$$(mktemp -d); \
 	nm -u $(LIB_A) | awk 'NF==2{print $$2}' | sort -u >$$t/u; \
@@ -293,7 +294,7 @@ check-lib-split: $(LIB_A) $(LIB_SO)
 	rm -rf $$t; \
 	if [ -n "$$bad" ]; then echo "check-lib-split: libpolarlux.a needs symbols outside the core's allowance:" $$bad; exit 1; fi; \
 	needed=$$(readelf -d $(LIB_SO_REAL) | sed -n 's/.*(NEEDED).*\[\(.*\)\]/\1/p' | tr '\n' ' '); \
-	for n in $$needed; do case $$n in libcjson.so.*|libm.so.*|libc.so.*) ;; \
+	for n in $$needed; do case $$n in libm.so.*|libc.so.*) ;; \
 	  *) echo "check-lib-split: libpolarlux.so needs $$n"; exit 1;; esac; done; \
 	soname=$$(readelf -d $(LIB_SO_REAL) | sed -n 's/.*(SONAME).*\[\(.*\)\]/\1/p'); \
 	[ "$$soname" = "$(SONAME)" ] || { echo "check-lib-split: SONAME '$$soname', want $(SONAME)"; exit 1; }; \
@@ -303,7 +304,7 @@ check-lib-split: $(LIB_A) $(LIB_SO)
 # The core may include only these C headers: no I/O, no OS.
 check-core-headers:
 	@bad=$$(grep -nE '^[[:space:]]*#[[:space:]]*include[[:space:]]*<' $(CORE_SRC) $(foreach d,$(CORE_DIRS),$(wildcard src/$(d)/*.h)) | \
-	  grep -vE '<(stddef|stdint|string|math|float|limits|stdarg|stdlib|cjson/cJSON)\.h>' || true); \
+	  grep -vE '<(stddef|stdint|string|math|float|limits|stdarg|stdlib)\.h>' || true); \
 	if [ -n "$$bad" ]; then echo "core includes a platform header:"; echo "$$bad"; exit 1; fi; \
 	if grep -nE '\b(malloc|calloc|realloc|free)[[:space:]]*\(' $(CORE_SRC) | grep -v '^src/scene/geojson.c:.*json_' ; then \
 	  echo "core calls the C heap (see above)"; exit 1; fi
@@ -329,7 +330,7 @@ bench: all $(BENCHES)
 	@for b in $(BENCHES); do echo "== $$b"; $$b || exit 1; done
 
 # ---- install ------------------------------------------------------------------
-# Two pkg-config files: polarlux (the core: cJSON and libm) and
+# Two pkg-config files: polarlux (the core: libm) and
 # polarlux-port (the POSIX port and PNG files, which add libpng and pthreads).
 install: all
 	install -d $(DESTDIR)$(PREFIX)/lib $(DESTDIR)$(PREFIX)/include $(DESTDIR)$(PREFIX)/bin \
@@ -345,7 +346,7 @@ install: all
 	printf '%s\n' 'prefix=$(PREFIX)' 'libdir=$${prefix}/lib' 'includedir=$${prefix}/include' '' \
 	  'Name: polarlux' 'Description: exact night lighting of 2.5D cities (portable core)' \
 	  'Version: $(VERSION)' 'Libs: -L$${libdir} -lpolarlux' 'Libs.private: $(CORE_LIBS)' \
-	  'Requires.private: libcjson' 'Cflags: -I$${includedir}' \
+	  'Cflags: -I$${includedir}' \
 	  > $(DESTDIR)$(PREFIX)/lib/pkgconfig/polarlux.pc
 	printf '%s\n' 'prefix=$(PREFIX)' 'libdir=$${prefix}/lib' 'includedir=$${prefix}/include' '' \
 	  'Name: polarlux-port' 'Description: polarlux POSIX port and PNG/PFM files' \

@@ -5,11 +5,11 @@
  *   - a scene loaded from memory (a GeoJSON string compiled in);
  *   - a route scored (how well lit is a walk along the street);
  *   - a frame rendered into the caller's own pixel buffer.
- * It links libpolarlux.a alone (+ cJSON and libm): no port, no files, no
- * threads, no libpng. It checks its own results and exits non-zero when
+ * It links libpolarlux.a alone (+ libm): no port, no files, no threads, no
+ * libpng, no cJSON. It checks its own results and exits non-zero when
  * something is off, so `make check` runs it as a test.
  *
- *   cc embed.c -Iinclude build/libpolarlux.a -lcjson -lm
+ *   cc embed.c -Iinclude build/libpolarlux.a -lm
  */
 #include <math.h>
 #include <stdio.h>

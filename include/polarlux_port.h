@@ -3,17 +3,18 @@
  * portable core (library libpolarlux-port: port/posix, port/png).
  *
  * libpolarlux (include/polarlux.h) is the portable core alone: it needs
- * libc's string/math functions, libm and cJSON, and reaches the platform only
- * through the plx_port table the caller puts in plx_config. A board or an
- * application with its own platform layer links libpolarlux alone. This
- * library adds what a POSIX program wants: a plx_port over clock_gettime,
- * stderr and stdio, engines in a malloc'd block, and image files. It needs
- * libpng and pthreads:
+ * libc's string/math functions and libm (no cJSON: it reads JSON itself),
+ * and reaches the platform only through the plx_port table the caller puts
+ * in plx_config. A board or an application with its own platform layer
+ * links libpolarlux alone. This library adds what a POSIX program wants: a
+ * plx_port over clock_gettime, stderr and stdio, engines in a malloc'd
+ * block, and image files. It needs libpng and pthreads:
  *
- *   cc app.c -lpolarlux-port -lpolarlux -lcjson -lpng -lpthread -lm
+ *   cc app.c -lpolarlux-port -lpolarlux -lpng -lpthread -lm
  *
- * Thread-safety: every call here may be made from any thread; the port's
- * JSON lock is one process-wide pthread mutex.
+ * Thread-safety: every call here may be made from any thread. The port's
+ * lock/unlock are one process-wide pthread mutex, which the core no longer
+ * takes (loading touches no process-wide state).
  */
 #ifndef POLARLUX_PORT_H
 #define POLARLUX_PORT_H
@@ -27,8 +28,10 @@ extern "C" {
 #endif
 
 /* The POSIX services: clock_gettime (CLOCK_MONOTONIC), one line a message on
- * stderr, stdio files, a pthread mutex around JSON parsing. The table is
- * static: valid for the life of the process. Never fails. */
+ * stderr, files read whole or mapped read-only (mmap), a parallel_for on a
+ * pthread pool, the processor count, and a process-wide pthread mutex as
+ * lock/unlock (not taken by the core). The table is static: valid for the
+ * life of the process. Never fails. */
 const plx_port *plx_port_posix(void);
 
 /* Creates an engine in a block of 'budget' bytes taken from the C heap
