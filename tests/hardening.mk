@@ -144,13 +144,11 @@ check-arm64: check-arm64-build all
 	done; echo "arm64 same output as host: $$n passed, 0 failed"
 
 # ---- freestanding Cortex-M4 --------------------------------------------------------
-# The core is compiled with -ffreestanding for arm-none-eabi. cJSON has no
-# arm-none-eabi build here, so the core is compiled against the host's
-# cJSON.h alone (copied into a folder of its own, so no other host header is
-# visible; cJSON.h includes only <stddef.h>) and linked into one relocatable
-# object: the size is the core's own code, cJSON not included. Every symbol
-# left undefined must be cJSON's, the compiler runtime's (__aeabi_*) or one of
-# the C library functions the core may use (string.h, math.h, qsort).
+# The core is compiled with -ffreestanding for arm-none-eabi against the
+# toolchain's own headers (no cJSON.h: the core reads JSON itself) and linked
+# into one relocatable object: the size is the core's own code. Every symbol
+# left undefined must be the compiler runtime's (__aeabi_*) or one of the C
+# library functions the core may use (string.h, math.h, qsort, strtod).
 FS_CC     ?= arm-none-eabi-gcc
 FS_BUILD   = build/freestanding
 FS_FLAGS   = -ffreestanding -mthumb -mcpu=cortex-m4 -Os -ffunction-sections -fdata-sections
@@ -170,20 +168,16 @@ FS_ALLOWED = memcpy memmove memset memcmp memchr strlen strcmp strncmp strchr st
              fdimf fmaxf fminf fmaf \
              strtod
 
-$(FS_BUILD)/include/cjson/cJSON.h: /usr/include/cjson/cJSON.h
+$(FS_BUILD)/%.o: src/%.c
 	@mkdir -p $(@D)
-	cp $< $@
-
-$(FS_BUILD)/%.o: src/%.c $(FS_BUILD)/include/cjson/cJSON.h
-	@mkdir -p $(@D)
-	$(FS_CC) -Iinclude -Isrc -I$(FS_BUILD)/include $(WARN) $(FPFLAGS) $(FS_FLAGS) -c $< -o $@
+	$(FS_CC) -Iinclude -Isrc $(WARN) $(FPFLAGS) $(FS_FLAGS) -c $< -o $@
 
 check-freestanding:
 	@command -v $(FS_CC) >/dev/null || { echo "check-freestanding: needs $(FS_CC) (make hardening-deps)" >&2; exit 1; }
 	@$(MAKE) --no-print-directory $(FS_OBJ)
 	$(FS_CC:gcc=ld) -r -o $(FS_BUILD)/polarlux-core.o $(FS_OBJ)
 	@bad=$$($(FS_CC:gcc=nm) -u $(FS_BUILD)/polarlux-core.o | awk '{print $$2}' | \
-	  grep -vE '^(__aeabi_[a-z0-9_]+|cJSON_[A-Za-z]+)$$' | \
+	  grep -vE '^__aeabi_[a-z0-9_]+$$' | \
 	  grep -vxF "$$(printf '%s\n' $(FS_ALLOWED))" || true); \
 	if [ -n "$$bad" ]; then echo "check-freestanding: the core needs symbols a bare-metal target may lack:"; \
 	  echo "$$bad"; exit 1; fi
