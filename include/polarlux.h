@@ -784,12 +784,15 @@ typedef struct plx_render_info {
  * Lamp light, the renderer's frame buffers and mesh (sized for the
  * config's largest frame) and, with o->aerial and no atlas, the aerial light
  * map are built on first need and kept until the next load.
- * Errors: PLX_E_INVALID (cam NULL; bad camera: eye below the ground, eye ==
- * target, size above the maximum), PLX_E_NOSCENE, PLX_E_NOMEM,
- * PLX_E_UNSUPPORTED (o->backend could not draw the frame); after an error
- * the buffers' contents are unspecified (an anti-aliased frame may have
- * written its first sample). Lifetime: the caller's buffers are written,
- * not kept. Threads: engine.
+ * Errors: PLX_E_INVALID (cam NULL; eye or target not finite; eye not above
+ * the ground, z <= 0; eye == target; fov_deg outside (0, 180); width or
+ * height outside 1 .. the engine's largest frame, render_max_width/height
+ * or the bake's; o->exposure not a finite number above 0, or with
+ * auto_exposure not finite; o->aa outside 0 .. PLX_RENDER_MAX_AA),
+ * PLX_E_NOSCENE, PLX_E_NOMEM, PLX_E_UNSUPPORTED (o->backend could not draw
+ * the frame); after an error the buffers' contents are unspecified (an
+ * anti-aliased frame may have written its first sample). Lifetime: the
+ * caller's buffers are written, not kept. Threads: engine.
  */
 plx_status plx_render(plx_engine *e, const plx_camera *cam, const plx_render_opts *o, uint8_t *rgb8 /* OUT */,
                       float *rgbf /* OUT */, plx_render_info *info /* OUT */);
