@@ -166,10 +166,11 @@ static int print_photons(plx_engine *e, const char *path, const plx_scene_info *
         fprintf(stderr, "polarlux info: %s: photon buffers not created: %s\n", path, plx_last_error(e));
         return cli_exit_code(st);
     }
-    printf("photon buffers: %zu bytes (default quality %zu, budget %zu): %u quality steps; facade charts %ux%u, "
+    /* a bake's buffers were sized in the block it was baked in, not this one */
+    printf("photon buffers: %zu bytes (default quality %zu, budget %zu%s): %u quality steps; facade charts %ux%u, "
            "aerial chart %ux%u texels of %.2f m, %u lamp floor maps, lamp ray tables %s\n",
-           pi.bytes, pi.full_bytes, pi.budget, pi.reductions, pi.chart_w, pi.chart_h, pi.aerial_w, pi.aerial_h,
-           pi.aerial_texel, pi.lamp_slots, pi.lamp_tables ? "on" : "off");
+           pi.bytes, pi.full_bytes, pi.budget, cli_bake_last.loaded ? " when baked" : "", pi.reductions, pi.chart_w,
+           pi.chart_h, pi.aerial_w, pi.aerial_h, pi.aerial_texel, pi.lamp_slots, pi.lamp_tables ? "on" : "off");
     return EXIT_OK;
 }
 

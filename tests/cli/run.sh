@@ -167,6 +167,8 @@ expect walk-nomem-aa-hint 3 "^polarlux walk: frame 1 at .*out of memory .*\(anti
     "$bin" walk -q "$tmp/e.plxb" --mem "$amem" --path "$tmp/endpath.geojson" --size 160x120 --max-frames 2 -o "$tmp/endw"
 expect walk-nomem-aa1 0 "^walk: 2 frames" -- \
     "$bin" walk -q "$tmp/e.plxb" --mem "$amem" --aa 1 --path "$tmp/endpath.geojson" --size 160x120 --max-frames 2 -o "$tmp/endw"
+# a bake's photon budget is the one of the block it was baked in
+expect bake-info-photons 0 "^photon buffers: [0-9]+ bytes \(default quality [0-9]+, budget [0-9]+ when baked\)" -- "$bin" info "$tmp/e.plxb" --photons
 expect bake-info 0 "^bake: [0-9]+ bytes \([0-9.]+ MB\) loaded in [0-9.]+ ms" -- "$bin" info "$tmp/e.plxb"
 expect bake-info-memory 0 "^memory: [0-9]+ bytes in use" -- "$bin" info "$tmp/e.plxb"
 printf '0.5 0.5\n10 -3\n61 61\n' >"$tmp/bp.txt"
