@@ -24,6 +24,33 @@ static int lonlat_range(const cJSON *coords)
     return 1;
 }
 
+/* The first position within lon/lat range (-180..180, -90..90), and the
+ * first one outside it; -1 for none. */
+static int lonlat_at(const cJSON *coords, int want)
+{
+    const cJSON *pos;
+    int k = 0;
+    cJSON_ArrayForEach(pos, coords) {
+        const cJSON *x = cJSON_GetArrayItem(pos, 0), *y = cJSON_GetArrayItem(pos, 1);
+        int in = cJSON_IsNumber(x) && cJSON_IsNumber(y) && x->valuedouble >= -180 && x->valuedouble <= 180 &&
+                 y->valuedouble >= -90 && y->valuedouble <= 90;
+        if (in == want)
+            return k;
+        k++;
+    }
+    return -1;
+}
+
+static int first_lonlat(const cJSON *coords)
+{
+    return lonlat_at(coords, 1);
+}
+
+static int first_not_lonlat(const cJSON *coords)
+{
+    return lonlat_at(coords, 0);
+}
+
 /* Reads n positions [x, y(, z)] into out (3 per position); eyes must be
  * above the ground, targets may lie on it (an aerial camera looking down). */
 static int read_positions(const cJSON *coords, int project, const plx_scene_info *si, double *out, int n,
@@ -117,7 +144,7 @@ static int parse(const cJSON *root, plx_engine *e, walk_path *wp, char *why, siz
 {
     const cJSON *props, *line = first_line(root, &props), *coords, *targets;
     plx_scene_info si;
-    int n, project;
+    int n, project, k;
     if (!line) {
         snprintf(why, whylen, "no LineString (a Feature, a FeatureCollection or a bare geometry)");
         return -1;
@@ -132,6 +159,15 @@ static int parse(const cJSON *root, plx_engine *e, walk_path *wp, char *why, siz
     project = si.lonlat && lonlat_range(coords) && !metres(root) && !metres(props ? root : NULL);
     if (props && metres_props(props))
         project = 0;
+    /* a lon/lat scene, a path not declared in metres, some positions lon/lat
+     * and some not: a typo, not a path in metres (it was read as metres) */
+    if (si.lonlat && !project && !metres(root) && !(props && metres_props(props)) &&
+        (k = first_lonlat(coords)) >= 0) {
+        snprintf(why, whylen, "position %d is lon/lat (the scene's coordinates) but position %d is not: give "
+                 "every position in lon/lat, or all in local metres with properties.units \"m\"", k,
+                 first_not_lonlat(coords));
+        return -1;
+    }
     wp->n = (uint32_t)n;
     wp->eye = malloc(sizeof(double) * 3 * (size_t)n);
     targets = cJSON_GetObjectItemCaseSensitive(props, "targets");

@@ -275,6 +275,11 @@ if [ -n "${2:-}" ] && [ "$1" = "$2" ]; then echo "ok   walk-even-median"; pass=$
 printf '{"type":"LineString","coordinates":[[0,0,50],[10,0,50]],"properties":{"targets":[[0,0,50],[10,5,0]]}}' >"$tmp/kt.geojson"
 expect walk-target-is-eye 1 "^polarlux walk: .*kt\.geojson: properties\.targets: position 0's target is its eye \(0, 0, 50\): the camera would look nowhere$" -- \
     "$bin" walk -q fixtures/tiny.geojson --path "$tmp/kt.geojson" --no-indirect -o "$tmp/wmf"
+# a lon/lat scene and a path with one position out of lon/lat range: a
+# typo, refused (the whole path was read as metres, far from the city)
+printf '{"type":"LineString","coordinates":[[24.944,60.168],[24.946,95.0]]}' >"$tmp/ll.geojson"
+expect walk-lonlat-mixed 1 "position 0 is lon/lat \(the scene's coordinates\) but position 1 is not: give every position in lon/lat, or all in local metres with properties\.units \"m\"$" -- \
+    "$bin" walk -q fixtures/helsinki-centre.geojson --path "$tmp/ll.geojson" --no-indirect -o "$tmp/wmf"
 printf '{"type":"LineString","coordinates":[[1,2]]}' >"$tmp/short.geojson"
 expect walk-short-path 1 "^polarlux walk: $tmp/short\.geojson: the LineString needs at least 2 positions$" -- "$bin" walk -q "$tmp/e.plxb" --path "$tmp/short.geojson" -o "$tmp/w3"
 # a coordinate beyond 1e7 m (it made the frame count overflow, then "out of
