@@ -46,6 +46,16 @@ static void silent_log(void *ctx, plx_log_level level, const char *msg)
     (void)ctx, (void)level, (void)msg;
 }
 
+/* The bisection's engines: the default config through the POSIX port
+ * without its log (port must outlive the engine). */
+static void silent_config(plx_config *cfg, plx_port *port)
+{
+    plx_config_default(cfg);
+    *port = *plx_port_posix();
+    port->log = silent_log;
+    cfg->port = port;
+}
+
 /* 1 when an engine of 'bytes' loads the scene and builds its polar diagrams. */
 static int fits(const char *path, const cli_common *c, size_t bytes)
 {
@@ -54,10 +64,7 @@ static int fits(const char *path, const cli_common *c, size_t bytes)
     plx_engine *e;
     plx_polar_info pi;
     int ok;
-    plx_config_default(&cfg);
-    port = *plx_port_posix();
-    port.log = silent_log;
-    cfg.port = &port;
+    silent_config(&cfg, &port);
     cfg.strict = c->strict;
     if (plx_engine_new(bytes, &cfg, &e) != PLX_OK)
         return 0;
@@ -96,10 +103,7 @@ static int bake_fits(void *mem, size_t bytes, const void *data, size_t len)
     plx_engine *e;
     plx_polar_info pi;
     int ok;
-    plx_config_default(&cfg);
-    port = *plx_port_posix();
-    port.log = silent_log;
-    cfg.port = &port;
+    silent_config(&cfg, &port);
     if (plx_bake_load(mem, bytes, &cfg, data, len, &e, NULL, 0) != PLX_OK)
         return 0;
     ok = plx_polar_info_get(e, &pi) == PLX_OK;
