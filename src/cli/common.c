@@ -577,7 +577,8 @@ int cli_indirect_option(const char *cmd, int argc, char **argv, int *i, cli_indi
 
 int cli_bake_direct(const char *cmd, const char *path, const cli_common *c, plx_engine *e, cli_indirect *ind)
 {
-    if (ind->off || plx_indirect_frames(e) > 0 || !cli_is_bake(path))
+    /* cli_open_scene says whether it loaded a bake: the file is not read again */
+    if (ind->off || plx_indirect_frames(e) > 0 || !cli_bake_last.loaded)
         return 0;
     ind->off = 1;
     cli_warn(cmd, c, "%s holds no indirect light (baked with --no-indirect or --frames 0): its images show the "
