@@ -924,7 +924,7 @@ static void walls_classify(photon_sys *ps)
                 const vec2 *p = &s->pts[e], *q = &s->pts[T->enext[e]];
                 double ex = q->x - p->x, ey = q->y - p->y, l = sqrt(ex * ex + ey * ey);
                 double qx, qy, z0 = B->min_height, z1 = B->height, fx, fy;
-                int cls = PHOTON_EDGE_OUTER;
+                int cls = PHOTON_EDGE_OUTER, faced = 0;
                 if (!(l > 0.0)) {
                     ps->eclass[e] = PHOTON_EDGE_INTERNAL;
                     continue;
@@ -951,14 +951,16 @@ static void walls_classify(photon_sys *ps)
                                 z1 = O->min_height;
                             else
                                 z0 = O->height;
-                        }
+                        } else
+                            continue;
+                        faced = 1;
                     }
                 }
                 if (!(z1 > z0)) {
                     cls = PHOTON_EDGE_INTERNAL;
                     z0 = z1 = 0.0;
-                } else if (r > 0) {
-                    cls = PHOTON_EDGE_INNER; /* a hole of the building: a courtyard */
+                } else if (r > 0 || faced) {
+                    cls = PHOTON_EDGE_INNER; /* a courtyard, or a strip over a neighbour */
                 } else if (B->block < s->nblocks) {
                     const scene_block *K = &s->blocks[B->block];
                     uint32_t rr;
