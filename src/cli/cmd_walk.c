@@ -403,7 +403,8 @@ static int frame(const walk_args *a, plx_engine *e, const walk_path *wp, walk_ru
  * --view aerial), so they get no word. Without it, the street view's
  * ground takes the per-pixel path (93 ms a 1024x768 frame of that flight)
  * and --view aerial reads the aerial light map (73 ms), which the first
- * frame builds unless the bake holds it (0.32 to 0.34 s for that city, measured with walk --max-frames 1). */
+ * frame builds unless the bake holds it (0.32 to 0.34 s for that city,
+ * measured with walk --max-frames 1). */
 #define WALK_HIGH 100.0
 
 static void view_hint(const walk_args *a, const walk_path *wp)
