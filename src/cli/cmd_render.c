@@ -356,7 +356,9 @@ int cmd_render(int argc, char **argv)
         if (a.aerial) {
             default_aerial(e, &a.cam);
         } else if ((rc = default_street(e, &a.cam)) == -2) {
-            fprintf(stderr, "polarlux render: %s\n", plx_last_error(e));
+            fprintf(stderr, "polarlux render: %s: the default street view needs the polar diagrams to find a "
+                            "street%s; give --eye and --target, --view aerial, or a larger --mem\n",
+                    plx_last_error(e), cli_bake_last.loaded ? ", and this bake was made without them (--no-polar)" : "");
             plx_engine_free(e);
             return EXIT_NOMEM;
         } else if (rc != 0) {

@@ -203,6 +203,11 @@ if [ "$(wc -c <"$tmp/np.plxb")" -lt "$(wc -c <"$tmp/e.plxb")" ]; then echo "ok  
 else echo "FAIL bake-no-polar-smaller"; fail=$((fail + 1)); fi
 expect bake-no-polar-vis 0 "" -- "$bin" vis -q "$tmp/np.plxb" --points "$tmp/bp.txt"
 if cmp -s "$tmp/out" "$tmp/v1"; then echo "ok   bake-no-polar-vis-same"; pass=$((pass + 1)); else echo "FAIL bake-no-polar-vis-same"; fail=$((fail + 1)); fi
+# in a block that holds the bake but not the polar diagrams, the default
+# street view (which needs them to find a street) says what to give instead
+npm=$("$bin" info "$tmp/np.plxb" --min-mem 2>/dev/null | sed -n 's/^smallest --mem: \([0-9]*\) bytes.*/\1/p')
+expect bake-no-polar-default-view 3 "the default street view needs the polar diagrams to find a street, and this bake was made without them \(--no-polar\); give --eye and --target, --view aerial, or a larger --mem$" -- \
+    "$bin" render -q "$tmp/np.plxb" --mem $((npm - 150000)) --size 16x12 -o "$tmp/npv.png"
 head -c 5000 "$tmp/e.plxb" >"$tmp/cut.plxb"
 expect bake-truncated 1 "^polarlux info: $tmp/cut\.plxb: truncated bake file: 5000 bytes, the header says [0-9]+$" -- "$bin" info "$tmp/cut.plxb"
 expect bake-version 1 "^polarlux render: tests/corpus/bake-version-99\.plxb: bake format version 99, this polarlux reads version 1; bake the scene again$" -- \
