@@ -44,9 +44,10 @@
  *    a courtyard fills it in the outline, hence the first rule), or when
  *    another building touches its front (the exposed strip of a party wall
  *    above a lower neighbour, or below a raised one): such a strip faces a
- *    roof, not the street, and reading the street facade's light at its
- *    place around the block made it 2 to 9 times too bright against the
- *    path tracer (test_photon's test_party_wall_strips).
+ *    neighbour's roof (or its underside), not the street, and reading the
+ *    street facade's light at its place around the block made it 1.7 to 9
+ *    times too bright against the path tracer (test_photon's
+ *    test_party_wall_strips).
  *    Only the exposed part of a wall is charted: the part not covered by
  *    another building touching its front (a shared wall is exposed only
  *    above the lower neighbour); this is decided at the wall's middle.
