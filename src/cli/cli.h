@@ -78,6 +78,7 @@ typedef struct cli_indirect {
     long photons;    /* per frame (default 65536) */
     long frames;     /* progressive frames (default 4; illum and bake 16) */
     int frames_given; /* --frames was given */
+    int photons_given; /* --photons was given */
     int off;         /* --no-indirect */
     long gather;     /* --gather N: final gathering side at points (0 = photon
                         buffers only); -1 = the engine's default */

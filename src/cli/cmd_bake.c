@@ -27,7 +27,8 @@ static const char help[] =
     "file size, the engine memory in use and the times.\n"
     "\n"
     "  -o FILE         the bake file (required)\n"
-    "  --photons N     photons per frame (default 65536)\n"
+    "  --photons N     photons per frame (default 16 a lamp, from 65536 to\n"
+    "                  1048576: a large city's facades need more)\n"
     "  --frames K      photon frames (default 16: the points' final gathering\n"
     "                  reads them too)\n"
     "  --no-indirect   no photon buffers\n"
@@ -134,6 +135,24 @@ static int load_engine(const bake_args *a, int twin, plx_engine **e)
     return cli_load_scene("bake", a->scene, &a->c, e);
 }
 
+/* Photons per frame without --photons: 16 a lamp, from 65,536 to 1,048,576.
+ * The default 65,536 leaves each street-facade point of gen eixample 30 30
+ * (18,480 lamps) 27% off the path tracer on average; 16 a lamp (295,680)
+ * about 15%, for 0.6 s more of a 6 s bake (README "Bake files"). */
+#define BAKE_PHOTONS_PER_LAMP 16
+#define BAKE_PHOTONS_MIN 65536L
+#define BAKE_PHOTONS_MAX 1048576L
+
+static void default_photons(plx_engine *e, cli_indirect *ind)
+{
+    plx_scene_info si;
+    long n;
+    if (ind->photons_given || plx_scene_info_get(e, &si) != PLX_OK)
+        return;
+    n = (long)si.lamps * BAKE_PHOTONS_PER_LAMP;
+    ind->photons = n < BAKE_PHOTONS_MIN ? BAKE_PHOTONS_MIN : n > BAKE_PHOTONS_MAX ? BAKE_PHOTONS_MAX : n;
+}
+
 /* Whether the bake holds a radiance atlas (not with --no-aerial or
  * --no-indirect): the times line names it only then. */
 static int atlas_made(plx_engine *e)
@@ -228,8 +247,10 @@ int cmd_bake(int argc, char **argv)
     if (rc == EXIT_OK && (rc = prepare_engine(&a, 0, &e, err, sizeof err)) != EXIT_OK)
         fputs(err, stderr);
     t1 = port_now_ns();
-    if (rc == EXIT_OK)
+    if (rc == EXIT_OK) {
+        default_photons(e, &a.ind);
         rc = cli_indirect_run("bake", e, &a.ind, NULL, NULL, 60.0);
+    }
     t2 = port_now_ns();
     if (alongside)
         pthread_join(th, NULL);

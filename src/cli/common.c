@@ -542,6 +542,7 @@ void cli_indirect_default(cli_indirect *ind)
                         the irradiance cache gathers the first from the exact direct light
                         (README, "Indirect light"); illum sets CLI_GATHER_FRAMES */
     ind->frames_given = 0;
+    ind->photons_given = 0;
     ind->off = 0;
     ind->gather = -1;
 }
@@ -572,6 +573,7 @@ int cli_indirect_option(const char *cmd, int argc, char **argv, int *i, cli_indi
         return -1;
     }
     ind->frames_given |= strcmp(a, "--frames") == 0;
+    ind->photons_given |= strcmp(a, "--photons") == 0;
     return 1;
 }
 

@@ -28,8 +28,9 @@
  *    set: that alone.
  * Wall-clock and CPU times (the baseline's of its thread, the bakes' and
  * the walks' of the process, every thread): the build machine is shared,
- * CPU time is the steadier figure. PLX_BENCH_FRAMES photon frames of 65,536
- * (default 64; the command's default is 256).
+ * CPU time is the steadier figure. PLX_BENCH_FRAMES photon frames (default
+ * 64; bake's default is 16) of 65,536 for the baseline (render's per frame)
+ * and of 16 a lamp for the bakes (bake's default, 295,680 here).
  */
 #include <math.h>
 #include <pthread.h>
@@ -123,13 +124,26 @@ static plx_engine *engine(void **mem, int max_w, int max_h, int quiet, int threa
     return e;
 }
 
-static int trace(plx_engine *e, int frames)
+/* frames photon frames of n photons */
+static int trace(plx_engine *e, int frames, uint32_t n)
 {
     int k;
     for (k = 0; k < frames; k++)
-        if (plx_indirect_step(e, 65536, (uint64_t)k + 1) != PLX_OK)
+        if (plx_indirect_step(e, n, (uint64_t)k + 1) != PLX_OK)
             return -1;
     return 0;
+}
+
+/* The bake command's photons per frame (cmd_bake.c's default_photons): 16 a
+ * lamp, from 65,536 to 1,048,576; 295,680 on this city. */
+static uint32_t bake_photons(plx_engine *e)
+{
+    plx_scene_info si;
+    uint32_t n;
+    if (plx_scene_info_get(e, &si) != PLX_OK)
+        return 65536;
+    n = si.lamps * 16u;
+    return n < 65536u ? 65536u : n > 1048576u ? 1048576u : n;
 }
 
 static void street_cam(plx_camera *c, double s)
@@ -253,7 +267,7 @@ static int bake(text city, int frames, int threads, unsigned char **file, size_t
     tj.b = engine(&mb, 1024, 768, 1, threads);
     alongside = threads > 1 && pthread_create(&th, NULL, twin_prepare, &tj) == 0;
     ok = a && plx_load_geojson(a, city.buf, city.len, "eixample") == PLX_OK && plx_bake_prepare(a, &bo) == PLX_OK &&
-         trace(a, frames) == 0;
+         trace(a, frames, bake_photons(a)) == 0;
     if (alongside)
         pthread_join(th, NULL);
     else
@@ -335,7 +349,8 @@ int main(void)
     char err[256];
     if (plx_gen_city("eixample", 30, 30, 1, append, &city) != PLX_OK || !rgb8)
         return 1;
-    printf("city: gen eixample 30 30 (%.1f MB of GeoJSON); photons: %d frames x 65,536\n", city.len / 1e6, frames);
+    printf("city: gen eixample 30 30 (%.1f MB of GeoJSON); photons: %d frames of 65,536 for the baseline (render's "
+           "default), of 16 a lamp for the bakes (bake's)\n", city.len / 1e6, frames);
     if (getenv("PLX_BENCH_FLOOR_ONLY")) /* the floor alone (a minute, not several) */
         return floor_walks(&city, rgb8) != 0;
 
@@ -347,7 +362,7 @@ int main(void)
         return 1;
     base_load = wall_ms() - w0;
     w0 = wall_ms();
-    trace(d, frames);
+    trace(d, frames, 65536); /* render's photons per frame */
     base_ph = wall_ms() - w0;
     plx_render_opts_default(&o);
     o.per_pixel = 1; /* the render path of before the radiance atlas */

@@ -203,6 +203,12 @@ if [ "$(wc -c <"$tmp/np.plxb")" -lt "$(wc -c <"$tmp/e.plxb")" ]; then echo "ok  
 else echo "FAIL bake-no-polar-smaller"; fail=$((fail + 1)); fi
 expect bake-no-polar-vis 0 "" -- "$bin" vis -q "$tmp/np.plxb" --points "$tmp/bp.txt"
 if cmp -s "$tmp/out" "$tmp/v1"; then echo "ok   bake-no-polar-vis-same"; pass=$((pass + 1)); else echo "FAIL bake-no-polar-vis-same"; fail=$((fail + 1)); fi
+# bake's photons per frame: 16 a lamp (4,740 lamps: 75,840) unless --photons
+"$bin" gen eixample 15 15 -o "$tmp/e15.geojson"
+expect bake-photons-per-lamp 0 "photons [0-9]+ ms \(16 x 75840\)" -- \
+    "$bin" bake "$tmp/e15.geojson" --no-aerial --no-polar --max-size 32x24 -o "$tmp/e15.plxb"
+expect bake-photons-given 0 "photons [0-9]+ ms \(2 x 4000\)" -- \
+    "$bin" bake "$tmp/e15.geojson" --no-aerial --no-polar --max-size 32x24 --photons 4000 --frames 2 -o "$tmp/e15.plxb"
 # in a block that holds the bake but not the polar diagrams, the default
 # street view (which needs them to find a street) says what to give instead
 npm=$("$bin" info "$tmp/np.plxb" --min-mem 2>/dev/null | sed -n 's/^smallest --mem: \([0-9]*\) bytes.*/\1/p')
