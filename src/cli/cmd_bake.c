@@ -138,7 +138,7 @@ static int load_engine(const bake_args *a, int twin, plx_engine **e)
 /* Photons per frame without --photons: 16 a lamp, from 65,536 to 1,048,576.
  * The default 65,536 leaves each street-facade point of gen eixample 30 30
  * (18,480 lamps) 27% off the path tracer on average; 16 a lamp (295,680)
- * about 15%, for 0.6 s more of a 6 s bake (README "Bake files"). */
+ * about 15%, for 0.8 s more of a 6 s bake (README "Bake files"). */
 #define BAKE_PHOTONS_PER_LAMP 16
 #define BAKE_PHOTONS_MIN 65536L
 #define BAKE_PHOTONS_MAX 1048576L
