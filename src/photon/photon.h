@@ -45,8 +45,8 @@
  *    another building touches its front (the exposed strip of a party wall
  *    above a lower neighbour, or below a raised one): such a strip faces a
  *    neighbour's roof (or its underside), not the street, and reading the
- *    street facade's light at its place around the block made it 1.7 to 9
- *    times too bright against the path tracer (test_photon's
+ *    street facade's light at its place around the block made it 1.7 to
+ *    9.5 times too bright against the path tracer (test_photon's
  *    test_party_wall_strips).
  *    Only the exposed part of a wall is charted: the part not covered by
  *    another building touching its front (a shared wall is exposed only
