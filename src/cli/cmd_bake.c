@@ -74,6 +74,7 @@ static int parse_args(int argc, char **argv, bake_args *a)
     cli_args pa;
     memset(a, 0, sizeof *a);
     cli_indirect_default(&a->ind);
+    a->ind.per_lamp = 1;
     a->ind.frames = CLI_GATHER_FRAMES; /* illum on the bake gathers over them */
     rc = cli_options_n("bake", help, argc, argv, opts, &a->c, &a->ind, 1, NULL, &pa);
     if (rc != EXIT_OK)
@@ -133,24 +134,6 @@ static int load_engine(const bake_args *a, int twin, plx_engine **e)
         return cli_load_scene("bake", a->scene, &quiet, e);
     }
     return cli_load_scene("bake", a->scene, &a->c, e);
-}
-
-/* Photons per frame without --photons: 16 a lamp, from 65,536 to 1,048,576.
- * The default 65,536 leaves each street-facade point of gen eixample 30 30
- * (18,480 lamps) 27% off the path tracer on average; 16 a lamp (295,680)
- * about 15%, for 0.8 s more of a 6 s bake (README "Bake files"). */
-#define BAKE_PHOTONS_PER_LAMP 16
-#define BAKE_PHOTONS_MIN 65536L
-#define BAKE_PHOTONS_MAX 1048576L
-
-static void default_photons(plx_engine *e, cli_indirect *ind)
-{
-    plx_scene_info si;
-    long n;
-    if (ind->photons_given || plx_scene_info_get(e, &si) != PLX_OK)
-        return;
-    n = (long)si.lamps * BAKE_PHOTONS_PER_LAMP;
-    ind->photons = n < BAKE_PHOTONS_MIN ? BAKE_PHOTONS_MIN : n > BAKE_PHOTONS_MAX ? BAKE_PHOTONS_MAX : n;
 }
 
 /* Whether the bake holds a radiance atlas (not with --no-aerial or
@@ -248,7 +231,6 @@ int cmd_bake(int argc, char **argv)
         fputs(err, stderr);
     t1 = port_now_ns();
     if (rc == EXIT_OK) {
-        default_photons(e, &a.ind);
         rc = cli_indirect_run("bake", e, &a.ind, NULL, NULL, 60.0);
     }
     t2 = port_now_ns();
@@ -269,7 +251,7 @@ int cmd_bake(int argc, char **argv)
                a.out, bytes, bytes / 1048576.0, m.used_total, m.used_total / 1048576.0);
         cli_atlas_print(e);
         printf("times: load and build %.0f ms, photons %.0f ms (%ld x %ld), %s %.0f ms, total %.2f s\n",
-               (t1 - t0) / 1e6, (t2 - t1) / 1e6, a.ind.off ? 0L : a.ind.frames, a.ind.photons,
+               (t1 - t0) / 1e6, (t2 - t1) / 1e6, a.ind.off ? 0L : a.ind.frames, cli_photons(e, &a.ind),
                atlas_made(e) ? "radiance atlas, twin and save" : "twin and save", (port_now_ns() - t2) / 1e6,
                (port_now_ns() - t0) / 1e9);
     }

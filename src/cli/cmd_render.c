@@ -68,7 +68,7 @@ static const char help[] =
     "                   with --no-glow --exposure 1)\n"
     "  --per-pixel      with indirect light, each pixel's light computed there (exact\n"
     "                   direct; indirect by final gathers at sparse points): slower\n"
-    "  --photons N      photons per frame (default 65536)\n"
+    "  --photons N      photons per frame (default 16 a lamp, 65536..1048576)\n"
     "  --frames K       progressive photon frames for the still image (default 4;\n"
     "                   aerial views too: their light map gathers like street views)\n"
     "  --backend B      raster pass: soft (default, built in) or osmesa (OpenGL into\n"

@@ -543,6 +543,7 @@ void cli_indirect_default(cli_indirect *ind)
                         (README, "Indirect light"); illum sets CLI_GATHER_FRAMES */
     ind->frames_given = 0;
     ind->photons_given = 0;
+    ind->per_lamp = 0;
     ind->off = 0;
     ind->gather = -1;
 }
@@ -603,16 +604,26 @@ void cli_indirect_note(const char *cmd, plx_engine *e)
             pi.aerial_w, pi.aerial_h, pi.aerial_texel, pi.lamp_slots, pi.lamp_tables ? "on" : "off");
 }
 
+long cli_photons(plx_engine *e, const cli_indirect *ind)
+{
+    plx_scene_info si;
+    long n;
+    if (ind->photons_given || !ind->per_lamp || plx_scene_info_get(e, &si) != PLX_OK)
+        return ind->photons;
+    n = (long)si.lamps * CLI_PHOTONS_PER_LAMP;
+    return n < CLI_PHOTONS_MIN ? CLI_PHOTONS_MIN : n > CLI_PHOTONS_MAX ? CLI_PHOTONS_MAX : n;
+}
+
 int cli_indirect_run(const char *cmd, plx_engine *e, const cli_indirect *ind, const double *eye,
                      const double *dir, double fov_deg)
 {
-    long k;
+    long k, photons = cli_photons(e, ind);
     int tty = isatty(2);
     unsigned long long t0 = port_now_ns();
     if (ind->off || ind->frames == 0 || plx_indirect_frames(e) > 0)
         return EXIT_OK; /* off, or traced already (a bake) */
-    if ((double)ind->photons * (double)ind->frames > CLI_MAX_PHOTONS)
-        return cli_usage_error(cmd, "--photons %ld x --frames %ld is more than %.0f photons", ind->photons,
+    if ((double)photons * (double)ind->frames > CLI_MAX_PHOTONS)
+        return cli_usage_error(cmd, "--photons %ld x --frames %ld is more than %.0f photons", photons,
                                ind->frames, CLI_MAX_PHOTONS);
     if (ind->gather >= 0 && plx_indirect_set_gather(e, (uint32_t)ind->gather) != PLX_OK) {
         fprintf(stderr, "polarlux %s: %s\n", cmd, plx_last_error(e));
@@ -626,7 +637,7 @@ int cli_indirect_run(const char *cmd, plx_engine *e, const cli_indirect *ind, co
         }
     }
     for (k = 0; k < ind->frames; k++) {
-        plx_status st = plx_indirect_step(e, (uint32_t)ind->photons, (uint64_t)k + 1);
+        plx_status st = plx_indirect_step(e, (uint32_t)photons, (uint64_t)k + 1);
         if (st != PLX_OK) {
             fprintf(stderr, "%spolarlux %s: %s\n", tty ? "\n" : "", cmd, plx_last_error(e));
             return cli_exit_code(st);
@@ -635,7 +646,7 @@ int cli_indirect_run(const char *cmd, plx_engine *e, const cli_indirect *ind, co
             cli_indirect_note(cmd, e);
         if (tty)
             fprintf(stderr, "\rindirect light: frame %ld/%ld (%ld photons each), %.1f s", k + 1, ind->frames,
-                    ind->photons, (port_now_ns() - t0) / 1e9);
+                    photons, (port_now_ns() - t0) / 1e9);
     }
     if (tty)
         fprintf(stderr, "\n");

@@ -177,6 +177,7 @@ void cli_view_init(cli_view *v, long w, long h, double fov, plx_render_opts *o, 
     plx_render_opts_default(o);
     o->auto_exposure = 1; /* until --exposure */
     cli_indirect_default(ind);
+    ind->per_lamp = 1; /* render and walk: 16 photons a lamp without --photons (cli_photons) */
     memset(v, 0, sizeof *v);
     v->size[0] = w;
     v->size[1] = h;

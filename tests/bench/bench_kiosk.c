@@ -134,7 +134,7 @@ static int trace(plx_engine *e, int frames, uint32_t n)
     return 0;
 }
 
-/* The bake command's photons per frame (cmd_bake.c's default_photons): 16 a
+/* The bake command's photons per frame (src/cli/common.c's cli_photons): 16 a
  * lamp, from 65,536 to 1,048,576; 295,680 on this city. */
 static uint32_t bake_photons(plx_engine *e)
 {

@@ -209,6 +209,18 @@ expect bake-photons-per-lamp 0 "photons [0-9]+ ms \(16 x 75840\)" -- \
     "$bin" bake "$tmp/e15.geojson" --no-aerial --no-polar --max-size 32x24 -o "$tmp/e15.plxb"
 expect bake-photons-given 0 "photons [0-9]+ ms \(2 x 4000\)" -- \
     "$bin" bake "$tmp/e15.geojson" --no-aerial --no-polar --max-size 32x24 --photons 4000 --frames 2 -o "$tmp/e15.plxb"
+# render from a GeoJSON traces 16 photons a lamp too (4,740 lamps: 75,840 a
+# frame): the same image as --photons 75840, another than the old 65,536
+"$bin" render -q "$tmp/e15.geojson" --size 64x48 -o "$tmp/pd.png"
+"$bin" render -q "$tmp/e15.geojson" --size 64x48 --photons 75840 -o "$tmp/p75.png"
+"$bin" render -q "$tmp/e15.geojson" --size 64x48 --photons 65536 -o "$tmp/p65.png"
+if cmp -s "$tmp/pd.png" "$tmp/p75.png" && ! cmp -s "$tmp/pd.png" "$tmp/p65.png"; then echo "ok   render-photons-per-lamp"; pass=$((pass + 1))
+else echo "FAIL render-photons-per-lamp: the default image is not --photons 75840's, or is --photons 65536's"; fail=$((fail + 1)); fi
+# a scene of fewer than 4,096 lamps keeps 65,536 a frame
+"$bin" render -q fixtures/eixample-4x4.geojson --size 64x48 -o "$tmp/pd.png"
+"$bin" render -q fixtures/eixample-4x4.geojson --size 64x48 --photons 65536 -o "$tmp/p65.png"
+if cmp -s "$tmp/pd.png" "$tmp/p65.png"; then echo "ok   render-photons-floor"; pass=$((pass + 1))
+else echo "FAIL render-photons-floor: eixample-4x4's default image is not --photons 65536's"; fail=$((fail + 1)); fi
 # in a block that holds the bake but not the polar diagrams, the default
 # street view (which needs them to find a street) says what to give instead
 npm=$("$bin" info "$tmp/np.plxb" --min-mem 2>/dev/null | sed -n 's/^smallest --mem: \([0-9]*\) bytes.*/\1/p')
