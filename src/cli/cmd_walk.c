@@ -522,6 +522,12 @@ static int run(const walk_args *a, plx_engine *e, const walk_path *wp)
         cli_aa_print(&a->opts, wr.aa_later, (double)a->w * a->h * wr.n, wr.n, wr.aa_adaptive, wr.aa_dense);
         if (a->refine && !a->ind.off)
             walk_refine_print(a, &wr);
+        if (med > 1000.0 / a->fps) /* shown as they are made, the frames would fall behind */
+            cli_warn("walk", &a->c, "the frames took %.1f ms (median) to render, longer than a frame lasts at "
+                     "%g fps (%.1f ms): shown as they are made, they fall behind on this machine; %s",
+                     med, a->fps, 1000.0 / a->fps,
+                     a->opts.aa > 1 ? "--aa 1 (one sample a pixel), a smaller --size or a lower --fps keep up"
+                                    : "a smaller --size or a lower --fps keep up");
         if (wr.inside)
             cli_warn("walk", &a->c, "%ld of %ld frames have the eye inside a building (the first: frame %ld at "
                      "(%.2f, %.2f, %.2f)): they show the inside of its walls, every pixel computed (slower); "

@@ -167,6 +167,12 @@ expect walk-nomem-aa-hint 3 "^polarlux walk: frame 1 at .*out of memory .*\(anti
     "$bin" walk -q "$tmp/e.plxb" --mem "$amem" --path "$tmp/endpath.geojson" --size 160x120 --max-frames 2 -o "$tmp/endw"
 expect walk-nomem-aa1 0 "^walk: 2 frames" -- \
     "$bin" walk -q "$tmp/e.plxb" --mem "$amem" --aa 1 --path "$tmp/endpath.geojson" --size 160x120 --max-frames 2 -o "$tmp/endw"
+# frames slower than --fps say so (1e4 fps: 0.1 ms a frame), with what is faster
+expect walk-slower-than-fps 0 "^polarlux walk: warning: the frames took [0-9.]+ ms \(median\) to render, longer than a frame lasts at 10000 fps \(0\.1 ms\): shown as they are made, they fall behind on this machine; --aa 1 \(one sample a pixel\), a smaller --size or a lower --fps keep up$" -- \
+    "$bin" walk "$tmp/e.plxb" --fps 10000 --path "$tmp/endpath.geojson" --size 160x120 --max-frames 2 -o "$tmp/endw"
+"$bin" walk "$tmp/e.plxb" --fps 1 --path "$tmp/endpath.geojson" --size 160x120 --max-frames 2 -o "$tmp/endw" >"$tmp/out" 2>&1
+if grep -q "fall behind" "$tmp/out"; then echo "FAIL walk-fps-kept: a walk at 1 fps says its frames fall behind"; fail=$((fail + 1))
+else echo "ok   walk-fps-kept"; pass=$((pass + 1)); fi
 # a bake's photon budget is the one of the block it was baked in
 expect bake-info-photons 0 "^photon buffers: [0-9]+ bytes \(default quality [0-9]+, budget [0-9]+ when baked\)" -- "$bin" info "$tmp/e.plxb" --photons
 expect bake-info 0 "^bake: [0-9]+ bytes \([0-9.]+ MB\) loaded in [0-9.]+ ms" -- "$bin" info "$tmp/e.plxb"
