@@ -27,8 +27,9 @@ static const char help[] =
     "reused by every frame: with indirect light each frame reads the radiance\n"
     "atlas (see render), filled as the frames need it or held by the bake.\n"
     "Prints the render time per frame (median, p95) and frames per second, and on\n"
-    "stderr how many frames are entirely black, if any; on a terminal, a walk of\n"
-    "more than a second shows the share of its frames done as it goes.\n"
+    "stderr how many frames are entirely black, if any, and whether the frames\n"
+    "render slower than --fps; on a terminal, a walk of more than a second shows\n"
+    "the share of its frames done as it goes.\n"
     "\n"
     "  --path FILE      a GeoJSON LineString of eye positions [x, y] or [x, y, z]\n"
     "                   (z default 1.7 m); the eye looks 10 m ahead along the path,\n"
@@ -522,7 +523,9 @@ static int run(const walk_args *a, plx_engine *e, const walk_path *wp)
         cli_aa_print(&a->opts, wr.aa_later, (double)a->w * a->h * wr.n, wr.n, wr.aa_adaptive, wr.aa_dense);
         if (a->refine && !a->ind.off)
             walk_refine_print(a, &wr);
-        if (med > 1000.0 / a->fps) /* shown as they are made, the frames would fall behind */
+        if (wr.n >= 3 && med > 1000.0 / a->fps) /* shown as they are made, the frames would fall behind (3
+                                                   * frames at least: a walk from a scene fills the atlas in
+                                                   * its first) */
             cli_warn("walk", &a->c, "the frames took %.1f ms (median) to render, longer than a frame lasts at "
                      "%g fps (%.1f ms): shown as they are made, they fall behind on this machine; %s",
                      med, a->fps, 1000.0 / a->fps,

@@ -610,8 +610,10 @@ long cli_photons(plx_engine *e, const cli_indirect *ind)
     long n;
     if (ind->photons_given || !ind->per_lamp || plx_scene_info_get(e, &si) != PLX_OK)
         return ind->photons;
+    if (si.lamps > CLI_PHOTONS_MAX / CLI_PHOTONS_PER_LAMP) /* clamped before the product: no overflow */
+        return CLI_PHOTONS_MAX;
     n = (long)si.lamps * CLI_PHOTONS_PER_LAMP;
-    return n < CLI_PHOTONS_MIN ? CLI_PHOTONS_MIN : n > CLI_PHOTONS_MAX ? CLI_PHOTONS_MAX : n;
+    return n < CLI_PHOTONS_MIN ? CLI_PHOTONS_MIN : n;
 }
 
 int cli_indirect_run(const char *cmd, plx_engine *e, const cli_indirect *ind, const double *eye,
@@ -623,8 +625,11 @@ int cli_indirect_run(const char *cmd, plx_engine *e, const cli_indirect *ind, co
     if (ind->off || ind->frames == 0 || plx_indirect_frames(e) > 0)
         return EXIT_OK; /* off, or traced already (a bake) */
     if ((double)photons * (double)ind->frames > CLI_MAX_PHOTONS)
-        return cli_usage_error(cmd, "--photons %ld x --frames %ld is more than %.0f photons", photons,
-                               ind->frames, CLI_MAX_PHOTONS);
+        return ind->photons_given
+                   ? cli_usage_error(cmd, "--photons %ld x --frames %ld is more than %.0f photons", photons,
+                                     ind->frames, CLI_MAX_PHOTONS)
+                   : cli_usage_error(cmd, "%ld photons a frame (16 a lamp; --photons sets it) x --frames %ld is "
+                                     "more than %.0f photons", photons, ind->frames, CLI_MAX_PHOTONS);
     if (ind->gather >= 0 && plx_indirect_set_gather(e, (uint32_t)ind->gather) != PLX_OK) {
         fprintf(stderr, "polarlux %s: %s\n", cmd, plx_last_error(e));
         return EXIT_USAGE;

@@ -362,7 +362,8 @@ int main(void)
         return 1;
     base_load = wall_ms() - w0;
     w0 = wall_ms();
-    trace(d, frames, 65536); /* render's photons per frame */
+    trace(d, frames, 65536); /* render's photons per frame when the issue was filed (since 2026-11-30
+                                  render traces 16 a lamp from a scene, 295,680 a frame here) */
     base_ph = wall_ms() - w0;
     plx_render_opts_default(&o);
     o.per_pixel = 1; /* the render path of before the radiance atlas */
