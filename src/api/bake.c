@@ -37,7 +37,7 @@
 #include "render/atlas_fill.h"
 
 #define BAKE_MAGIC "PLXBAKE\0"
-#define BAKE_VERSION 1u
+#define BAKE_VERSION 2u
 #define BAKE_HEADER 128u
 #define BAKE_ENDIAN 0x01020304u
 #define BAKE_ALIGN 64u

@@ -126,12 +126,59 @@ static int open_ground_near(const light *L, vec2 p, double rad, vec2 *q)
     return found; /* within rad: no building outside the box has a point nearer */
 }
 
-void atlas_vertex_site(const atlas *A, const light *L, const atlas_chart *c, uint32_t i, uint32_t j, double P[3],
-                       double n[3])
+/* The footprint edge of wall chart c: the edge of building c->bld's
+ * rings that starts at the chart's origin and runs along its direction
+ * (atlas.c's wall_chart: o is the edge's first point, e its unit
+ * direction rounded to float). 0 when there is none. */
+static int wall_line(const scene *s, const atlas_chart *c, vec2 ends[2])
+{
+    const scene_building *bd = &s->bld[c->bld];
+    uint32_t r, k;
+    for (r = bd->ring_first; r < bd->ring_first + bd->ring_count; r++) {
+        const scene_ring *rg = &s->rings[r];
+        for (k = 0; k < rg->count; k++) {
+            vec2 a = s->pts[rg->first + k], q = s->pts[rg->first + (k + 1) % rg->count];
+            double dx = q.x - a.x, dy = q.y - a.y, len = sqrt(dx * dx + dy * dy);
+            if (a.x == c->o[0] && a.y == c->o[1] && len > 0.0 && fabs(dx / len - c->e[0]) <= 1e-6 &&
+                fabs(dy / len - c->e[1]) <= 1e-6) {
+                ends[0] = a;
+                ends[1] = q;
+                return 1;
+            }
+        }
+    }
+    return 0;
+}
+
+/* A wall vertex's point P moved onto its footprint edge's line (ends),
+ * and the edge's outward normal, both in double: the chart's direction
+ * is a float (atlas.h), so o + u e drifts off the wall by up to its length
+ * times 2^-24 (2.4 um on a 40 m wall at 10 degrees), and a point that far
+ * inside the building is in its own wall's shadow (the visibility's
+ * tolerance is 1e-9 m): most vertices of such a wall were dark. Only the
+ * distance along the edge is kept from P. */
+static void wall_site(const vec2 ends[2], double P[3], double n[3])
+{
+    double dx = ends[1].x - ends[0].x, dy = ends[1].y - ends[0].y, l2 = dx * dx + dy * dy, t, len;
+    t = ((P[0] - ends[0].x) * dx + (P[1] - ends[0].y) * dy) / l2;
+    P[0] = ends[0].x + t * dx;
+    P[1] = ends[0].y + t * dy;
+    len = sqrt(l2);
+    n[0] = dy / len; /* outer rings counter-clockwise, holes clockwise: out is right */
+    n[1] = -dx / len;
+    n[2] = 0.0;
+}
+
+/* atlas_vertex_site with the wall's edge found already (NULL: not a wall,
+ * or none found). */
+static void vertex_site(const atlas *A, const light *L, const atlas_chart *c, const vec2 *ends, uint32_t i,
+                        uint32_t j, double P[3], double n[3])
 {
     vec2 p, q, o;
     atlas_vertex_point(c, i, j, P);
     atlas_chart_normal(c, n);
+    if (ends)
+        wall_site(ends, P, n);
     p.x = P[0];
     p.y = P[1];
     if ((c->kind == ATLAS_ROOF || c->kind == ATLAS_UNDER) && !in_footprint(A->s, c->bld, p, 0)) {
@@ -158,6 +205,14 @@ void atlas_vertex_site(const atlas *A, const light *L, const atlas_chart *c, uin
             P[1] = q.y;
         }
     }
+}
+
+void atlas_vertex_site(const atlas *A, const light *L, const atlas_chart *c, uint32_t i, uint32_t j, double P[3],
+                       double n[3])
+{
+    vec2 ends[2];
+    int wall = c->kind == ATLAS_WALL && wall_line(A->s, c, ends);
+    vertex_site(A, L, c, wall ? ends : NULL, i, j, P, n);
 }
 
 /* ---- values ------------------------------------------------------------------------ */
@@ -216,10 +271,12 @@ static void chart_records(const atlas *A, atlas_worker *w, const atlas_chart *c)
 {
     uint32_t k = rec_every(c), nru = rec_count(c->nu, k), nrv = rec_count(c->nv, k), a, b;
     uint32_t sid = chart_sid(A, c);
+    vec2 ends[2];
+    int wall = c->kind == ATLAS_WALL && wall_line(A->s, c, ends);
     for (b = 0; b < nrv; b++)
         for (a = 0; a < nru; a++) {
             double P[3], n[3], *e = &w->rec[3 * ((size_t)b * nru + a)];
-            atlas_vertex_site(A, w->lt, c, rec_vertex(a, c->nu, k), rec_vertex(b, c->nv, k), P, n);
+            vertex_site(A, w->lt, c, wall ? ends : NULL, rec_vertex(a, c->nu, k), rec_vertex(b, c->nv, k), P, n);
             w->ind(w->ind_user, c, sid, P, n, e);
         }
 }
@@ -268,13 +325,15 @@ static void fill_chart(const atlas *A, atlas_worker *w, const atlas_chart *c)
 {
     uint32_t i, j, q;
     int direct = !(c->kind == ATLAS_GROUND && !c->fine);
+    vec2 ends[2];
+    int wall = c->kind == ATLAS_WALL && wall_line(A->s, c, ends);
     if (w->ind)
         chart_records(A, w, c);
     for (j = 0; j < c->nv; j++) {
         uint32_t *t = &A->tex[c->first + (size_t)j * c->nu];
         for (i = 0; i < c->nu; i++) {
             double P[3], n[3], E = 0.0, rgb[3] = { 0.0, 0.0, 0.0 }, ind[3] = { 0.0, 0.0, 0.0 }, a[3];
-            atlas_vertex_site(A, w->lt, c, i, j, P, n);
+            vertex_site(A, w->lt, c, wall ? ends : NULL, i, j, P, n);
             if (direct && light_illuminance(w->lt, P, n, &E, rgb) != PLX_OK)
                 rgb[0] = rgb[1] = rgb[2] = 0.0;
             if (w->ind)

@@ -1,8 +1,11 @@
 /* atlas_fill: the radiance atlas's values (atlas.h), direct light exact at
  * every vertex plus indirect light from a hook on a coarser grid.
  *
- * A VERTEX'S POINT. Walls: the vertex itself (on the wall's plane,
- * between its corners). Roofs and undersides: the vertex when it lies in
+ * A VERTEX'S POINT. Walls: the vertex moved onto its footprint edge's
+ * line (computed in double from the edge's two points, with the edge's
+ * normal: the chart's float direction leaves o + u e up to the wall's
+ * length times 2^-24 off the wall, in its own shadow when inside),
+ * between its corners. Roofs and undersides: the vertex when it lies in
  * the footprint (outer ring in, holes out, boundaries in), else the
  * nearest point of the footprint's boundary. The ground: the vertex,
  * unless it lies strictly inside the footprint of a building standing on
