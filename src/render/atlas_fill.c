@@ -126,16 +126,32 @@ static int open_ground_near(const light *L, vec2 p, double rad, vec2 *q)
     return found; /* within rad: no building outside the box has a point nearer */
 }
 
-/* The footprint edge of wall chart c: the edge of building c->bld's
- * rings that starts at the chart's origin and runs along its direction
- * (atlas.c's wall_chart: o is the edge's first point, e its unit
- * direction rounded to float). 0 when there is none. */
-static int wall_line(const scene *s, const atlas_chart *c, vec2 ends[2])
+/* The footprint edge of wall chart c (its first point and the next of
+ * its ring): wall chart k of the atlas is the wall over footprint point
+ * k (mesh_wall_id), found through its building's rings; a copy of a
+ * chart (the tests') is matched instead by the edge of its building that
+ * starts at the chart's origin and runs along its direction (atlas.c's
+ * wall_chart: o is the edge's first point, e its unit direction rounded
+ * to float). 0 when there is none. */
+static int wall_line(const atlas *A, const atlas_chart *c, vec2 ends[2])
 {
+    const scene *s = A->s;
     const scene_building *bd = &s->bld[c->bld];
+    uintptr_t base = (uintptr_t)A->chart, at = (uintptr_t)c;
     uint32_t r, k;
+    int own = at >= base && at - base < (uintptr_t)A->nsurf * sizeof *A->chart &&
+              (at - base) % sizeof *A->chart == 0;
+    uint32_t pt = own ? (uint32_t)((at - base) / sizeof *A->chart) : 0u;
     for (r = bd->ring_first; r < bd->ring_first + bd->ring_count; r++) {
         const scene_ring *rg = &s->rings[r];
+        if (own) {
+            if (pt < rg->first || pt - rg->first >= rg->count)
+                continue;
+            ends[0] = s->pts[pt];
+            ends[1] = s->pts[rg->first + (pt - rg->first + 1) % rg->count];
+            return ends[0].x == c->o[0] && ends[0].y == c->o[1] &&
+                   (ends[1].x != ends[0].x || ends[1].y != ends[0].y);
+        }
         for (k = 0; k < rg->count; k++) {
             vec2 a = s->pts[rg->first + k], q = s->pts[rg->first + (k + 1) % rg->count];
             double dx = q.x - a.x, dy = q.y - a.y, len = sqrt(dx * dx + dy * dy);
@@ -211,7 +227,7 @@ void atlas_vertex_site(const atlas *A, const light *L, const atlas_chart *c, uin
                        double n[3])
 {
     vec2 ends[2];
-    int wall = c->kind == ATLAS_WALL && wall_line(A->s, c, ends);
+    int wall = c->kind == ATLAS_WALL && wall_line(A, c, ends);
     vertex_site(A, L, c, wall ? ends : NULL, i, j, P, n);
 }
 
@@ -272,7 +288,7 @@ static void chart_records(const atlas *A, atlas_worker *w, const atlas_chart *c)
     uint32_t k = rec_every(c), nru = rec_count(c->nu, k), nrv = rec_count(c->nv, k), a, b;
     uint32_t sid = chart_sid(A, c);
     vec2 ends[2];
-    int wall = c->kind == ATLAS_WALL && wall_line(A->s, c, ends);
+    int wall = c->kind == ATLAS_WALL && wall_line(A, c, ends);
     for (b = 0; b < nrv; b++)
         for (a = 0; a < nru; a++) {
             double P[3], n[3], *e = &w->rec[3 * ((size_t)b * nru + a)];
@@ -326,7 +342,7 @@ static void fill_chart(const atlas *A, atlas_worker *w, const atlas_chart *c)
     uint32_t i, j, q;
     int direct = !(c->kind == ATLAS_GROUND && !c->fine);
     vec2 ends[2];
-    int wall = c->kind == ATLAS_WALL && wall_line(A->s, c, ends);
+    int wall = c->kind == ATLAS_WALL && wall_line(A, c, ends);
     if (w->ind)
         chart_records(A, w, c);
     for (j = 0; j < c->nv; j++) {
