@@ -4,10 +4,12 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 
 #include "cli.h"
 #include "options.h"
 #include "port.h"
+#include "posix/safe_out.h"
 
 static const char help[] =
     "usage: polarlux bake SCENE -o CITY.plxb [--photons N] [--frames K] [--no-indirect]\n"
@@ -205,6 +207,28 @@ static int save(const bake_args *a, plx_engine *e, plx_engine *t, size_t *bytes)
     return EXIT_OK;
 }
 
+/* Whether -o can be written, tried before any work (a bake of a large
+ * city takes seconds): a temporary file is made beside it and removed
+ * (safe_out, as the write at the end does), so a folder given as -o, a
+ * missing folder or one without write permission is said at once. A
+ * target that exists and is not a regular file (a device) is left to
+ * the write. */
+static int out_writable(const char *path)
+{
+    struct stat st;
+    char err[512];
+    safe_out *o;
+    if (stat(path, &st) == 0 && !S_ISREG(st.st_mode) && !S_ISDIR(st.st_mode))
+        return 1;
+    o = safe_out_open(path, err, sizeof err);
+    if (!o) {
+        fprintf(stderr, "polarlux bake: %s\n", err);
+        return 0;
+    }
+    safe_out_abort(o);
+    return 1;
+}
+
 int cmd_bake(int argc, char **argv)
 {
     bake_args a;
@@ -219,6 +243,8 @@ int cmd_bake(int argc, char **argv)
     int rc = parse_args(argc, argv, &a);
     if (rc != EXIT_OK)
         return rc < 0 ? EXIT_OK : rc;
+    if (!out_writable(a.out))
+        return EXIT_FAIL;
     tj.a = &a;
     tj.t = NULL;
     tj.rc = EXIT_FAIL;
@@ -247,7 +273,7 @@ int cmd_bake(int argc, char **argv)
         rc = save(&a, e, t, &bytes);
     if (rc == EXIT_OK) {
         plx_memory_get(e, &m);
-        printf("baked %s into %s: %zu bytes (%.1f MB); engine memory in use %zu bytes (%.1f MB)\n", a.scene,
+        printf("baked %s into %s: %zu bytes (%.1f MiB); engine memory in use %zu bytes (%.1f MiB)\n", a.scene,
                a.out, bytes, bytes / 1048576.0, m.used_total, m.used_total / 1048576.0);
         cli_atlas_print(e);
         printf("times: load and build %.0f ms, photons %.0f ms (%ld x %ld), %s %.0f ms, total %.2f s\n",

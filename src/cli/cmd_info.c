@@ -260,7 +260,7 @@ int cmd_info(int argc, char **argv)
     if (!cli_bake_last.loaded) /* a bake's line below says how long it took */
         printf("load time: %.2f ms\n", si.load_ns / 1e6);
     if (cli_bake_last.loaded)
-        printf("bake: %zu bytes (%.1f MB) loaded in %.2f ms (read, check, copy, relocate)\n", cli_bake_last.bytes,
+        printf("bake: %zu bytes (%.1f MiB) loaded in %.2f ms (read, check, copy, relocate)\n", cli_bake_last.bytes,
                cli_bake_last.bytes / 1048576.0, cli_bake_last.load_ns / 1e6);
     cli_atlas_print(e);
     if (plx_polar_info_get(e, &pi) == PLX_OK) {

@@ -873,7 +873,7 @@ void cli_atlas_print(plx_engine *e)
     if (plx_atlas_info_get(e, &ai) != PLX_OK || !ai.made)
         return;
     printf("radiance atlas: %llu sample points %.2f m apart (%.2f m where only indirect light reaches), "
-           "%zu bytes (%.1f MB), %s%s\n",
+           "%zu bytes (%.1f MiB), %s%s\n",
            (unsigned long long)ai.points, ai.spacing, ai.coarse, ai.bytes, ai.bytes / 1048576.0,
            ai.unfilled ? "filled as frames need it" : "filled",
            ai.indirect ? ", indirect light included" : ", direct light only");

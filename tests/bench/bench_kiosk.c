@@ -380,7 +380,7 @@ int main(void)
     plx_memory_get(d, &m);
     printf("baseline (render from the GeoJSON, every pixel shaded): load %.0f ms, photons %.0f ms, first street "
            "frame %.0f ms, first aerial frame %.0f ms (light map and its layer included), wall; %.2f s CPU in all; "
-           "engine memory %.1f MB\n",
+           "engine memory %.1f MiB\n",
            base_load, base_ph, base_street, base_aerial, cb / 1e3, m.used_total / 1048576.0);
     plx_engine_destroy(d);
     free(md);
@@ -388,8 +388,8 @@ int main(void)
     /* the bake, on one thread, then on two (the POSIX port's parallel-for) */
     if (bake(city, frames, 1, &file, &len, &bake_w, &bake_c, &m) != 0)
         return 1;
-    printf("bake, 1 thread: %.2f s wall, %.2f s CPU (target 10 s); file %.1f MB; engine memory %.1f MB, of it "
-           "the radiance atlas %.1f MB\n",
+    printf("bake, 1 thread: %.2f s wall, %.2f s CPU (target 10 s); file %.1f MiB; engine memory %.1f MiB, of it "
+           "the radiance atlas %.1f MiB\n",
            bake_w / 1e3, bake_c / 1e3, len / 1048576.0, m.used_total / 1048576.0, atlas_mb);
     if (bake(city, frames, 2, &file2, &len2, &bake2_w, &bake2_c, &m) != 0)
         return 1;

@@ -180,7 +180,7 @@ if grep -q "fall behind" "$tmp/out"; then echo "FAIL walk-fps-short: a walk of 2
 else echo "ok   walk-fps-short"; pass=$((pass + 1)); fi
 # a bake's photon budget is the one of the block it was baked in
 expect bake-info-photons 0 "^photon buffers: [0-9]+ bytes \(default quality [0-9]+, budget [0-9]+ when baked\)" -- "$bin" info "$tmp/e.plxb" --photons
-expect bake-info 0 "^bake: [0-9]+ bytes \([0-9.]+ MB\) loaded in [0-9.]+ ms" -- "$bin" info "$tmp/e.plxb"
+expect bake-info 0 "^bake: [0-9]+ bytes \([0-9.]+ MiB\) loaded in [0-9.]+ ms" -- "$bin" info "$tmp/e.plxb"
 expect bake-info-memory 0 "^memory: [0-9]+ bytes in use" -- "$bin" info "$tmp/e.plxb"
 printf '0.5 0.5\n10 -3\n61 61\n' >"$tmp/bp.txt"
 "$bin" vis -q fixtures/eixample-4x4.geojson --points "$tmp/bp.txt" >"$tmp/v1" 2>&1
@@ -220,6 +220,11 @@ expect bake-photons-per-lamp 0 "photons [0-9]+ ms \(16 x 75840\)" -- \
     "$bin" bake "$tmp/e15.geojson" --no-aerial --no-polar --max-size 32x24 -o "$tmp/e15.plxb"
 expect bake-photons-given 0 "photons [0-9]+ ms \(2 x 4000\)" -- \
     "$bin" bake "$tmp/e15.geojson" --no-aerial --no-polar --max-size 32x24 --photons 4000 --frames 2 -o "$tmp/e15.plxb"
+# an -o bake cannot write is refused before the scene is read (it was
+# refused after the whole bake: 5 s on gen eixample 15 15)
+expect bake-out-is-folder 1 "^polarlux bake: '$tmp' is a directory$" -- "$bin" bake "$tmp/nope.geojson" -o "$tmp"
+expect bake-out-no-folder 1 "^polarlux bake: cannot create a temporary file for '$tmp/no/such/x\.plxb'.*No such file or directory$" -- \
+    "$bin" bake "$tmp/nope.geojson" -o "$tmp/no/such/x.plxb"
 # render from a GeoJSON traces 16 photons a lamp too (4,740 lamps: 75,840 a
 # frame): the same image as --photons 75840, another than the old 65,536
 "$bin" render -q "$tmp/e15.geojson" --size 64x48 -o "$tmp/pd.png" >/dev/null
