@@ -73,6 +73,11 @@ typedef struct cli_bake_state {
     unsigned long long load_ns;
 } cli_bake_state;
 extern cli_bake_state cli_bake_last;
+/* "NAME: malformed JSON at byte B (line L, column C)" into err (as the
+ * scene loader says it), where
+ * cJSON stopped in text (len bytes; cJSON_GetErrorPtr, read right after
+ * the failed parse); "NAME: malformed JSON" when it does not say. */
+void cli_json_error(const char *name, const char *text, size_t len, char *err, size_t errlen);
 /* Photon frames for indirect light (--photons, --frames, --no-indirect). */
 typedef struct cli_indirect {
     long photons;    /* per frame with --photons (else 65536, or cli_photons's with per_lamp) */

@@ -5,6 +5,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
+#include <cjson/cJSON.h>
 
 #include "cli.h"
 #include "lamp_layer.h"
@@ -602,6 +603,25 @@ void cli_indirect_note(const char *cmd, plx_engine *e)
             "%u lamp floor maps, lamp ray tables %s)\n",
             cmd, pi.bytes / 1048576.0, pi.full_bytes / 1048576.0, pi.reductions, pi.chart_w, pi.chart_h,
             pi.aerial_w, pi.aerial_h, pi.aerial_texel, pi.lamp_slots, pi.lamp_tables ? "on" : "off");
+}
+
+void cli_json_error(const char *name, const char *text, size_t len, char *err, size_t errlen)
+{
+    const char *at = cJSON_GetErrorPtr(), *p;
+    long line = 1, col = 1;
+    if (!at || at < text || at > text + len) {
+        snprintf(err, errlen, "%s: malformed JSON", name);
+        return;
+    }
+    for (p = text; p < at; p++) {
+        col++;
+        if (*p == '\n') {
+            line++;
+            col = 1;
+        }
+    }
+    snprintf(err, errlen, "%s: malformed JSON at byte %ld (line %ld, column %ld)", name, (long)(at - text), line,
+             col);
 }
 
 long cli_photons(plx_engine *e, const cli_indirect *ind)

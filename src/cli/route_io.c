@@ -165,9 +165,7 @@ int route_parse(const char *name, const char *text, size_t len, plx_engine *e, r
     char why[256];
     memset(out, 0, sizeof *out);
     if (!root) {
-        const char *at = cJSON_GetErrorPtr();
-        long off = at && at >= text && at <= text + len ? (long)(at - text) : -1;
-        snprintf(err, errlen, "%s: malformed JSON near byte %ld", name, off);
+        cli_json_error(name, text, len, err, errlen);
         return -1;
     }
     type = cJSON_GetObjectItemCaseSensitive(root, "type");

@@ -206,11 +206,11 @@ int walk_path_read(const char *path, plx_engine *e, walk_path *wp, char *err, si
         return -1;
     }
     root = cJSON_ParseWithLength(text, len);
+    if (!root)
+        cli_json_error(path, text, len, err, errlen);
     free(text);
-    if (!root) {
-        snprintf(err, errlen, "%s: malformed JSON", path);
+    if (!root)
         return -1;
-    }
     rc = parse(root, e, wp, why, sizeof why);
     cJSON_Delete(root);
     if (rc != 0) {

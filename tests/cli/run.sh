@@ -265,6 +265,10 @@ for f in e np; do
         "$bin" info -q --mem $((n - 4096)) "$tmp/$f.plxb"
 done
 # ---- walk (README "Walking through a city") ----
+# a damaged camera path says where (it said only "malformed JSON")
+printf '{"type":"LineString",\n "coordinates":[[0,0],[1,' >"$tmp/pbad.geojson"
+expect walk-path-malformed 1 "^polarlux walk: $tmp/pbad\.geojson: malformed JSON at byte 46 \(line 2, column 25\)$" -- \
+    "$bin" walk -q fixtures/tiny.geojson --path "$tmp/pbad.geojson" -o "$tmp/wpb"
 expect walk-help 0 "^usage: polarlux walk" -- "$bin" walk --help
 expect walk-unknown-option 2 "polarlux walk: unknown option '--bogus'" -- "$bin" walk --bogus x
 expect walk-missing-path 2 "missing --path CAMERA.geojson" -- "$bin" walk "$tmp/e.plxb" -o "$tmp/w"
