@@ -266,7 +266,16 @@ typedef struct walk_run {
                                   the first (1-based) */
     long inside, first_inside; /* frames with the eye inside a building: how many, the first */
     double inside_eye[3];      /* the first one's eye */
+    double near_scene;         /* the least distance of an eye or target from the scene's bounds, m (0: inside) */
 } walk_run;
+
+/* How far (x, y) lies from the box b (minx, miny, maxx, maxy), m; 0 inside. */
+static double box_distance(const double b[4], double x, double y)
+{
+    double dx = x < b[0] ? b[0] - x : x > b[2] ? x - b[2] : 0.0;
+    double dy = y < b[1] ? b[1] - y : y > b[3] ? y - b[3] : 0.0;
+    return sqrt(dx * dx + dy * dy);
+}
 
 /* After the first frame (the engine at its peak): the frames are written
  * on a thread of their own, beside the next frame's rendering, when --mem
@@ -334,6 +343,14 @@ static int frame(const walk_args *a, plx_engine *e, const walk_path *wp, walk_ru
     plx_status st;
     memset(&cam, 0, sizeof cam);
     walk_path_camera(wp, k * step, cam.eye, cam.target);
+    {
+        plx_scene_info si;
+        if (plx_scene_info_get(e, &si) == PLX_OK) {
+            double d = fmin(box_distance(si.bounds, cam.eye[0], cam.eye[1]),
+                            box_distance(si.bounds, cam.target[0], cam.target[1]));
+            wr->near_scene = k == 0 || d < wr->near_scene ? d : wr->near_scene;
+        }
+    }
     cam.fov_deg = a->fov;
     cam.width = a->w;
     cam.height = a->h;
@@ -536,7 +553,11 @@ static int run(const walk_args *a, plx_engine *e, const walk_path *wp)
                      "(%.2f, %.2f, %.2f)): they show the inside of its walls, every pixel computed (slower); "
                      "move the path out of the footprints or raise it above the roofs", wr.inside, wr.n,
                      wr.first_inside, wr.inside_eye[0], wr.inside_eye[1], wr.inside_eye[2]);
-        if (wr.black == wr.n)
+        if (wr.black == wr.n && wr.near_scene > 0.0)
+            cli_warn("walk", &a->c, "every frame is entirely black: the camera path stays outside the scene, its "
+                     "eyes and targets %.0f m or more from the scene's bounds (its buildings' box and 50 m); is the "
+                     "path in the scene's coordinates?", wr.near_scene);
+        else if (wr.black == wr.n)
             cli_warn("walk", &a->c, "every frame is entirely black: %s", cli_dark_reason(e));
         else if (wr.black)
             cli_warn("walk", &a->c, "%ld of %ld frames are entirely black (the first: frame %ld): %s", wr.black,

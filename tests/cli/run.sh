@@ -265,6 +265,10 @@ for f in e np; do
         "$bin" info -q --mem $((n - 4096)) "$tmp/$f.plxb"
 done
 # ---- walk (README "Walking through a city") ----
+# a path far outside the scene says so (it blamed the lamps' reach)
+printf '{"type":"LineString","coordinates":[[5000,5000,1.7],[5010,5000,1.7]],"properties":{"units":"m"}}' >"$tmp/far.geojson"
+expect walk-path-outside 0 "^polarlux walk: warning: every frame is entirely black: the camera path stays outside the scene, its eyes and targets [0-9]+ m or more from the scene's bounds" -- \
+    "$bin" walk fixtures/tiny.geojson --path "$tmp/far.geojson" --size 32x24 --max-frames 2 --no-indirect -o "$tmp/wfar"
 # a damaged camera path says where (it said only "malformed JSON")
 printf '{"type":"LineString",\n "coordinates":[[0,0],[1,' >"$tmp/pbad.geojson"
 expect walk-path-malformed 1 "^polarlux walk: $tmp/pbad\.geojson: malformed JSON at byte 46 \(line 2, column 25\)$" -- \
