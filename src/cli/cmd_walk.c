@@ -269,6 +269,19 @@ typedef struct walk_run {
     double near_scene;         /* the least distance of an eye or target from the scene's bounds, m (0: inside) */
 } walk_run;
 
+/* An eye position as the user gave it: "(x, y, z)" in the scene's own
+ * coordinates (lon/lat degrees to 7 places on a lon/lat scene, else
+ * metres to 2), z in metres. */
+static const char *eye_text(plx_engine *e, const double P[3], char *buf, size_t len)
+{
+    plx_scene_info si;
+    double x = P[0], y = P[1];
+    int ll = plx_scene_info_get(e, &si) == PLX_OK && si.lonlat;
+    cli_from_local(e, &x, &y);
+    snprintf(buf, len, ll ? "(%.7f, %.7f, %.2f)" : "(%.2f, %.2f, %.2f)", x, y, P[2]);
+    return buf;
+}
+
 /* How far (x, y) lies from the box b (minx, miny, maxx, maxy), m; 0 inside. */
 static double box_distance(const double b[4], double x, double y)
 {
@@ -376,8 +389,9 @@ static int frame(const walk_args *a, plx_engine *e, const walk_path *wp, walk_ru
     if (st == PLX_OK && k == 0)
         cli_aa_warn("walk", &a->c, &a->opts, &info);
     if (st != PLX_OK) {
-        fprintf(stderr, "polarlux walk: frame %ld at (%.2f, %.2f, %.2f): %s%s\n", k + 1, cam.eye[0], cam.eye[1],
-                cam.eye[2], plx_last_error(e), cli_aa_nomem_hint(st, &a->opts));
+        char at[96];
+        fprintf(stderr, "polarlux walk: frame %ld at %s: %s%s\n", k + 1, eye_text(e, cam.eye, at, sizeof at),
+                plx_last_error(e), cli_aa_nomem_hint(st, &a->opts));
         return cli_exit_code(st);
     }
     /* black with the eye inside a building: its own warning says why */
@@ -387,8 +401,15 @@ static int frame(const walk_args *a, plx_engine *e, const walk_path *wp, walk_ru
         wr->first_inside = k + 1;
         memcpy(wr->inside_eye, cam.eye, sizeof wr->inside_eye);
     }
-    fprintf(wr->cams, "%ld %.17g %.17g %.17g %.17g %.17g %.17g %.6g\n", k + 1, cam.eye[0], cam.eye[1], cam.eye[2],
-            cam.target[0], cam.target[1], cam.target[2], info.exposure);
+    {
+        /* in the scene's own coordinates (lon/lat on a lon/lat scene), as
+         * render --eye and --target take them */
+        double ex = cam.eye[0], ey = cam.eye[1], tx = cam.target[0], ty = cam.target[1];
+        cli_from_local(e, &ex, &ey);
+        cli_from_local(e, &tx, &ty);
+        fprintf(wr->cams, "%ld %.17g %.17g %.17g %.17g %.17g %.17g %.6g\n", k + 1, ex, ey, cam.eye[2], tx, ty,
+                cam.target[2], info.exposure);
+    }
     if (k == 0)
         writer_plan(a, e, wr);
     if (wr->sh.n < 16 && k == (wr->n >= 16 ? (wr->sh.n * (wr->n - 1)) / 15 : wr->sh.n)) {
@@ -504,7 +525,11 @@ static int run(const walk_args *a, plx_engine *e, const walk_path *wp)
         fprintf(stderr, "polarlux walk: out of memory for %ld frames of %dx%d\n", wr.n, a->w, a->h);
         rc = EXIT_FAIL;
     } else {
-        fprintf(wr.cams, "# frame eye_x eye_y eye_z target_x target_y target_z exposure\n");
+        plx_scene_info si;
+        if (plx_scene_info_get(e, &si) == PLX_OK && si.lonlat)
+            fprintf(wr.cams, "# frame eye_lon eye_lat eye_z target_lon target_lat target_z exposure (degrees; z in m)\n");
+        else
+            fprintf(wr.cams, "# frame eye_x eye_y eye_z target_x target_y target_z exposure\n");
     }
     cli_progress_start(&pr); /* a line on a terminal, after a second */
     for (k = 0; rc == EXIT_OK && k < wr.n; k++) {
@@ -548,11 +573,13 @@ static int run(const walk_args *a, plx_engine *e, const walk_path *wp)
                      med, a->fps, 1000.0 / a->fps,
                      a->opts.aa > 1 ? "--aa 1 (one sample a pixel), a smaller --size or a lower --fps keep up"
                                     : "a smaller --size or a lower --fps keep up");
-        if (wr.inside)
+        if (wr.inside) {
+            char at[96];
             cli_warn("walk", &a->c, "%ld of %ld frames have the eye inside a building (the first: frame %ld at "
-                     "(%.2f, %.2f, %.2f)): they show the inside of its walls, every pixel computed (slower); "
+                     "%s): they show the inside of its walls, every pixel computed (slower); "
                      "move the path out of the footprints or raise it above the roofs", wr.inside, wr.n,
-                     wr.first_inside, wr.inside_eye[0], wr.inside_eye[1], wr.inside_eye[2]);
+                     wr.first_inside, eye_text(e, wr.inside_eye, at, sizeof at));
+        }
         if (wr.black == wr.n && wr.near_scene > 0.0)
             cli_warn("walk", &a->c, "every frame is entirely black: the camera path stays outside the scene, its "
                      "eyes and targets %.0f m or more from the scene's bounds (its buildings' box and 50 m); is the "

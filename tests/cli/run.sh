@@ -282,6 +282,13 @@ expect walk-exact 0 "^frame time: median [0-9.]+ ms, p95 [0-9.]+ ms, mean [0-9.]
 set -- $(sed -n '3p' "$tmp/w1/cameras.txt")
 "$bin" render -q "$tmp/e.plxb" --size 160x120 --no-indirect --no-glow --exposure 1 --eye "$2,$3,$4" --target "$5,$6,$7" -o "$tmp/w1r.png" >/dev/null 2>&1
 if /usr/bin/python3 tests/cli/png_same.py "$tmp/w1/frame-0002.png" "$tmp/w1r.png"; then echo "ok   walk-exact-equals-render"; pass=$((pass + 1)); else echo "FAIL walk-exact-equals-render"; fail=$((fail + 1)); fi
+# on a lon/lat scene cameras.txt is in lon/lat (it was local metres, which
+# render refuses there): a frame's camera fed back to render gives the frame
+expect walk-lonlat-cameras 0 "^# frame eye_lon eye_lat eye_z target_lon target_lat target_z exposure" -- \
+    sh -c "'$bin' walk -q fixtures/helsinki-centre.geojson --path fixtures/helsinki-walk.geojson --size 80x60 --max-frames 2 --aa 1 --no-indirect --no-glow --exposure 1 -o '$tmp/wll' >/dev/null && cat '$tmp/wll/cameras.txt'"
+set -- $(sed -n '3p' "$tmp/wll/cameras.txt")
+"$bin" render -q fixtures/helsinki-centre.geojson --size 80x60 --no-indirect --no-glow --exposure 1 --eye "$2,$3,$4" --target "$5,$6,$7" -o "$tmp/wllr.png" >/dev/null 2>&1
+if /usr/bin/python3 tests/cli/png_same.py "$tmp/wll/frame-0002.png" "$tmp/wllr.png"; then echo "ok   walk-lonlat-cameras-render"; pass=$((pass + 1)); else echo "FAIL walk-lonlat-cameras-render"; fail=$((fail + 1)); fi
 expect walk-default 0 "^walk: [0-9]+ frames 160x120 .*aa 2" -- "$bin" walk -q "$tmp/e.plxb" --path "$tmp/path.geojson" --size 160x120 --fps 0.1 -o "$tmp/w2"
 set -- $(sed -n '2p' "$tmp/w2/cameras.txt")
 "$bin" render -q "$tmp/e.plxb" --size 160x120 --aa 2 --eye "$2,$3,$4" --target "$5,$6,$7" -o "$tmp/w2r.png" >/dev/null 2>&1
