@@ -73,10 +73,10 @@ typedef struct cli_bake_state {
     unsigned long long load_ns;
 } cli_bake_state;
 extern cli_bake_state cli_bake_last;
-/* "NAME: malformed JSON at byte B (line L, column C)" into err (as the
- * scene loader says it), where
+/* "NAME: malformed JSON at byte B (line L, column C)" into err, where
  * cJSON stopped in text (len bytes; cJSON_GetErrorPtr, read right after
- * the failed parse); "NAME: malformed JSON" when it does not say. */
+ * the failed parse), with ": the text ends early" for a text cut short:
+ * the scene loader's words (src/scene/geojson.c's parse_error). */
 void cli_json_error(const char *name, const char *text, size_t len, char *err, size_t errlen);
 /* Photon frames for indirect light (--photons, --frames, --no-indirect). */
 typedef struct cli_indirect {

@@ -21,9 +21,9 @@ static const char help[] =
     "                     [--mem SIZE] [--strict] [--quiet]\n"
     "\n"
     "Renders frames along a camera path and writes DIR/frame-0001.png ...,\n"
-    "DIR/cameras.txt (frame, eye, target), DIR/walk.png (the frames as an animated\n"
-    "PNG, 1/F s each, looping) and DIR/contact.png (a contact sheet\n"
-    "of up to 16 frames). Everything is built once (or loaded from a bake) and\n"
+    "DIR/cameras.txt (frame, eye, target in the scene's coordinates), DIR/walk.png\n"
+    "(the frames as an animated PNG, 1/F s each, looping) and DIR/contact.png (a\n"
+    "contact sheet of up to 16 frames). Everything is built once (or loaded from a bake) and\n"
     "reused by every frame: with indirect light each frame reads the radiance\n"
     "atlas (see render), filled as the frames need it or held by the bake.\n"
     "Prints the render time per frame (median, p95) and frames per second, and on\n"
@@ -280,6 +280,17 @@ static const char *eye_text(plx_engine *e, const double P[3], char *buf, size_t 
     cli_from_local(e, &x, &y);
     snprintf(buf, len, ll ? "(%.7f, %.7f, %.2f)" : "(%.2f, %.2f, %.2f)", x, y, P[2]);
     return buf;
+}
+
+/* A black walk whose eyes and targets all stay farther than this from
+ * the scene's bounds (the buildings' box and 50 m) is said to be outside
+ * the scene, m. */
+#define WALK_FAR_OUTSIDE 100.0
+
+static int has_lamps(plx_engine *e)
+{
+    plx_scene_info si;
+    return plx_scene_info_get(e, &si) == PLX_OK && si.lamps > 0;
 }
 
 /* How far (x, y) lies from the box b (minx, miny, maxx, maxy), m; 0 inside. */
@@ -580,7 +591,7 @@ static int run(const walk_args *a, plx_engine *e, const walk_path *wp)
                      "move the path out of the footprints or raise it above the roofs", wr.inside, wr.n,
                      wr.first_inside, eye_text(e, wr.inside_eye, at, sizeof at));
         }
-        if (wr.black == wr.n && wr.near_scene > 0.0)
+        if (wr.black == wr.n && wr.near_scene > WALK_FAR_OUTSIDE && has_lamps(e))
             cli_warn("walk", &a->c, "every frame is entirely black: the camera path stays outside the scene, its "
                      "eyes and targets %.0f m or more from the scene's bounds (its buildings' box and 50 m); is the "
                      "path in the scene's coordinates?", wr.near_scene);

@@ -172,11 +172,13 @@ static int wall_line(const atlas *A, const atlas_chart *c, vec2 ends[2])
  * times 2^-24 (2.4 um on a 40 m wall at 10 degrees), and a point that far
  * inside the building is in its own wall's shadow (the visibility's
  * tolerance is 1e-9 m): most vertices of such a wall were dark. Only the
- * distance along the edge is kept from P. */
+ * distance along the edge is kept from P, within the edge. */
 static void wall_site(const vec2 ends[2], double P[3], double n[3])
 {
     double dx = ends[1].x - ends[0].x, dy = ends[1].y - ends[0].y, l2 = dx * dx + dy * dy, t, len;
     t = ((P[0] - ends[0].x) * dx + (P[1] - ends[0].y) * dy) / l2;
+    t = t < 0.0 ? 0.0 : t > 1.0 ? 1.0 : t; /* the last vertex, (nu - 1) tu with a float tu, can pass the corner:
+                                              inside the building at a reflex corner */
     P[0] = ends[0].x + t * dx;
     P[1] = ends[0].y + t * dy;
     len = sqrt(l2);

@@ -271,7 +271,7 @@ expect walk-path-outside 0 "^polarlux walk: warning: every frame is entirely bla
     "$bin" walk fixtures/tiny.geojson --path "$tmp/far.geojson" --size 32x24 --max-frames 2 --no-indirect -o "$tmp/wfar"
 # a damaged camera path says where (it said only "malformed JSON")
 printf '{"type":"LineString",\n "coordinates":[[0,0],[1,' >"$tmp/pbad.geojson"
-expect walk-path-malformed 1 "^polarlux walk: $tmp/pbad\.geojson: malformed JSON at byte 46 \(line 2, column 25\)$" -- \
+expect walk-path-malformed 1 "^polarlux walk: $tmp/pbad\.geojson: malformed JSON at byte 47 \(line 2, column 26\): the text ends early$" -- \
     "$bin" walk -q fixtures/tiny.geojson --path "$tmp/pbad.geojson" -o "$tmp/wpb"
 expect walk-help 0 "^usage: polarlux walk" -- "$bin" walk --help
 expect walk-unknown-option 2 "polarlux walk: unknown option '--bogus'" -- "$bin" walk --bogus x
