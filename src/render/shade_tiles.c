@@ -135,9 +135,9 @@ static int hull_visible(render *r, uint32_t l, const double (*c)[2], int nc, int
 {
     light *L = r->lt;
     const lit_region *rg = NULL;
-    double wx[4], wy[4], base = 0.0, lo = 0.0, hi = 0.0, qmax;
-    uint32_t i0, i1, i, k;
-    int j;
+    double wx[4], wy[4], base = 0.0, lo = 0.0, hi = 0.0, qmax, span;
+    uint32_t i0, i1, i, k, seen;
+    int j, all = 0;
     if (L->pool_cap == 0 || !(r->s->lamps[l].radius > 0.0))
         return 0;
     if (ro)
@@ -173,11 +173,22 @@ static int hull_visible(render *r, uint32_t l, const double (*c)[2], int nc, int
         return 0;
     lo += base - 1e-9;
     hi += base + 1e-9;
+    span = hi - lo;
     lo = lo < 0.0 ? lo + 4.0 : lo >= 4.0 ? lo - 4.0 : lo;
     hi = hi < 0.0 ? hi + 4.0 : hi >= 4.0 ? hi - 4.0 : hi;
     i0 = tile_find_sector(rg->sec_ang, rg->nsec, lo);
     i1 = tile_find_sector(rg->sec_ang, rg->nsec, hi);
-    for (i = i0;; i = (i + 1) % rg->nsec) {
+    /* both ends in one sector: the range lies in it, or it runs from that
+     * sector all the way round back into it (the last sector wraps past 4
+     * to sec_ang[0]: a range from before sec_ang[0] to after
+     * sec_ang[nsec - 1] meets every sector), and then every sector is looked at */
+    if (i0 == i1) {
+        double s0 = rg->sec_ang[i0], e0 = i0 + 1 < rg->nsec ? rg->sec_ang[i0 + 1] : rg->sec_ang[0] + 4.0;
+        double d = lo - s0;
+        d = d < 0.0 ? d + 4.0 : d;
+        all = !(d + span <= e0 - s0);
+    }
+    for (i = i0, seen = 1;; i = (i + 1) % rg->nsec, seen++) {
         for (k = rg->sec_first[i]; k < rg->sec_first[i + 1]; k++) {
             const lit_band *b = &rg->band[k];
             const lit_line *ln;
@@ -192,7 +203,7 @@ static int hull_visible(render *r, uint32_t l, const double (*c)[2], int nc, int
                     return 0;
             }
         }
-        if (i == i1)
+        if ((i == i1 && !all) || seen == rg->nsec)
             break;
     }
     return 1;

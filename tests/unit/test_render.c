@@ -688,6 +688,54 @@ static void test_tiled_light_same(void **state)
     }
 }
 
+/* A tile whose corners, seen from the lamp, span a range of angles that
+ * starts before the lamp's first sector and ends after its last: both ends
+ * fall in the last sector, which wraps past 4 (shade_tiles.c's
+ * hull_visible). The range meets every sector; only the last was looked
+ * at, so the tile was "surely lit" and its pixels behind the L's far arm
+ * took the lamp's light (8 x 8 tiles lit in shadow, a random sweep's
+ * scene, minimised: one L, one lamp). The tiled image must be the
+ * per-pixel one. */
+static void test_tiled_light_wrapping_sector(void **state)
+{
+    static const char *text =
+        "{\"type\": \"FeatureCollection\", \"properties\": {\"units\": \"m\"}, \"features\": ["
+        "{\"type\": \"Feature\", \"properties\": {\"height\": 14.17}, \"geometry\": {\"type\": \"Polygon\", "
+        "\"coordinates\": [[[-21.82289277228733, 5.336292667928892], [-16.406078437873774, 8.894474622181901], "
+        "[-18.035904743373212, 11.37564804381684], [-20.971545656151825, 9.447292395063268], "
+        "[-23.321351165505426, 13.024529402557082], [-25.80252458714037, 11.394703097057645], "
+        "[-21.82289277228733, 5.336292667928892]]]}}, "
+        "{\"type\": \"Feature\", \"properties\": {\"lamp\": true, \"z\": 3.01, \"intensity\": 1771.5, "
+        "\"radius\": 25.7}, \"geometry\": {\"type\": \"Point\", \"coordinates\": [-31.102, -0.088]}}]}";
+    ref_cam c = { { 16.532226, 16.238432, 1.7 }, { -21.104302, 9.180411, 2.4 }, 60, 160, 120 };
+    void *mem;
+    plx_engine *e = fixture_text(text, (size_t)64 << 20, 1, &mem);
+    light *L;
+    render *ra, *rb;
+    render_camera cam = to_cam(&c);
+    size_t px = (size_t)c.w * c.h, p, differ = 0;
+    float *fa = malloc(3 * px * sizeof *fa), *fb = malloc(3 * px * sizeof *fb);
+    render_opts o;
+    render_stats st;
+    (void)state;
+    assert_non_null(e);
+    assert_int_equal(light_create(&e->mem, e->sc, (size_t)32 << 20, &L), PLX_OK);
+    assert_int_equal(render_create(&e->mem, e->sc, c.w, c.h, render_shade_light, L, &ra), PLX_OK);
+    assert_int_equal(render_create(&e->mem, e->sc, c.w, c.h, light_generic, L, &rb), PLX_OK);
+    render_opts_default(&o);
+    o.no_glow = 1;
+    assert_int_equal(render_frame(ra, &cam, &o, NULL, fa, &st), PLX_OK);
+    assert_int_equal(render_frame(rb, &cam, &o, NULL, fb, NULL), PLX_OK);
+    for (p = 0; p < 3 * px; p++)
+        differ += fabs((double)fa[p] - fb[p]) > 1e-12 * fmax(1e-30, fmax(fabs((double)fa[p]), fabs((double)fb[p])));
+    print_message("wrapping sector: %zu of %zu values differ between the tiled and the per-pixel light; %llu "
+                  "lamp visibilities known from the tile\n", differ, 3 * px, (unsigned long long)st.visibility_skipped);
+    assert_int_equal(differ, 0); /* 117 before the fix */
+    free(fa);
+    free(fb);
+    fixture_done(e, mem);
+}
+
 /* ---- sparse indirect (render_opts.indirect_sparse) ------------------------- */
 
 typedef struct ind_count {
@@ -1885,7 +1933,7 @@ int main(void)
         cmocka_unit_test(test_eixample_vs_ref),
         cmocka_unit_test(test_helsinki_vs_ref),
         cmocka_unit_test(test_backends_agree),
-        cmocka_unit_test(test_tiled_light_same),
+        cmocka_unit_test(test_tiled_light_same), cmocka_unit_test(test_tiled_light_wrapping_sector),
         cmocka_unit_test(test_sparse_indirect),
         cmocka_unit_test(test_exposure_table),
         cmocka_unit_test(test_cull_equal_street),
