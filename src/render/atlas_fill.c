@@ -185,6 +185,13 @@ static void wall_site(const vec2 ends[2], double P[3], double n[3])
     n[0] = dy / len; /* outer rings counter-clockwise, holes clockwise: out is right */
     n[1] = -dx / len;
     n[2] = 0.0;
+    /* out by a few units in the last place of the coordinates: a + t d
+     * rounds to about 1e-9 m far from the origin (a projected CRS), the
+     * visibility's tolerance (pixel_hit.c does the same for a frame's
+     * wall points); near the origin under 1e-11 m */
+    t = fmax(fabs(P[0]), fabs(P[1])) * (1.0 / 281474976710656.0);
+    P[0] += t * n[0];
+    P[1] += t * n[1];
 }
 
 /* atlas_vertex_site with the wall's edge found already (NULL: not a wall,
