@@ -4,6 +4,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
+#include <unistd.h>
 
 #include "cli.h"
 #include "options.h"
@@ -622,10 +623,13 @@ int cmd_walk(int argc, char **argv)
     walk_path wp;
     plx_engine *e;
     char err[600];
+    int made = 0;
     int rc = parse_args(argc, argv, &a);
     if (rc != EXIT_OK)
         return rc < 0 ? EXIT_OK : rc;
-    if (mkdir(a.dir, 0755) != 0 && errno != EEXIST) {
+    if (mkdir(a.dir, 0755) == 0) {
+        made = 1; /* removed again if the walk fails before its first frame (rmdir: only when empty) */
+    } else if (errno != EEXIST) {
         fprintf(stderr, "polarlux walk: %s: cannot create the folder: %s\n", a.dir, strerror(errno));
         return EXIT_FAIL;
     }
@@ -636,11 +640,16 @@ int cmd_walk(int argc, char **argv)
     a.c.render_w = a.w;
     a.c.render_h = a.h;
     rc = cli_open_scene("walk", a.scene, &a.c, &e);
-    if (rc != EXIT_OK)
+    if (rc != EXIT_OK) {
+        if (made)
+            (void)rmdir(a.dir);
         return rc;
+    }
     if (walk_path_read(a.path, e, &wp, err, sizeof err) != 0) {
         fprintf(stderr, "polarlux walk: %s\n", err);
         plx_engine_free(e);
+        if (made)
+            (void)rmdir(a.dir);
         return EXIT_FAIL;
     }
     if (cli_bake_direct("walk", a.scene, &a.c, e, &a.ind))

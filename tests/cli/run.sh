@@ -274,6 +274,13 @@ else echo "FAIL render-far-from-origin"; sed 's/^/    /' "$tmp/out"; fail=$((fai
 printf '{"type":"LineString","coordinates":[[5000,5000,1.7],[5010,5000,1.7]],"properties":{"units":"m"}}' >"$tmp/far.geojson"
 expect walk-path-outside 0 "^polarlux walk: warning: every frame is entirely black: the camera path stays outside the scene, its eyes and targets [0-9]+ m or more from the scene's bounds" -- \
     "$bin" walk fixtures/tiny.geojson --path "$tmp/far.geojson" --size 32x24 --max-frames 2 --no-indirect -o "$tmp/wfar"
+# a walk that fails before its first frame leaves no folder it made (it
+# left an empty one), and keeps one that was there
+"$bin" walk -q fixtures/tiny.geojson --path "$tmp/no-such-path.geojson" -o "$tmp/wgone" >/dev/null 2>&1
+mkdir -p "$tmp/wkept"
+"$bin" walk -q fixtures/tiny.geojson --path "$tmp/no-such-path.geojson" -o "$tmp/wkept" >/dev/null 2>&1
+if [ ! -e "$tmp/wgone" ] && [ -d "$tmp/wkept" ]; then echo "ok   walk-fail-no-folder"; pass=$((pass + 1))
+else echo "FAIL walk-fail-no-folder: a failed walk left its new -o folder, or removed an existing one"; fail=$((fail + 1)); fi
 # a damaged camera path says where (it said only "malformed JSON")
 printf '{"type":"LineString",\n "coordinates":[[0,0],[1,' >"$tmp/pbad.geojson"
 expect walk-path-malformed 1 "^polarlux walk: $tmp/pbad\.geojson: malformed JSON at byte 47 \(line 2, column 26\): the text ends early$" -- \
