@@ -100,4 +100,16 @@ double geom_seg_dist2(vec2 a, vec2 b, vec2 c, vec2 d);
  * smallest endpoint-to-segment distance in plain double arithmetic (it may
  * underflow to 0 for segments closer than about 1e-154). */
 
+/* The margin by which a point computed at (x, y) in double moves off
+ * the surface it was computed on, so that it lies on the side it faces:
+ * 2^-48 times its largest coordinate (4 units in the last place), m.
+ * Near the origin under 1e-11 m; far from it (a projected CRS, y near
+ * 6.7e6 m) 2.4e-8 m, where the point's rounding (about 1e-9 m) reaches
+ * the visibility's 1e-9 m tolerance and could put a wall point in its
+ * own building's shadow (pixel_hit.c, atlas_fill.c). */
+static inline double geom_round_margin(double x, double y)
+{
+    return fmax(fabs(x), fabs(y)) * (1.0 / 281474976710656.0);
+}
+
 #endif

@@ -374,3 +374,15 @@ int jsonscan_truncated(const char *text, size_t len)
     }
     return in_string || depth > 0;
 }
+
+size_t jsonscan_error_at(const char *text, size_t len, size_t at, const char **tail)
+{
+    int truncated = jsonscan_truncated(text, len), empty = 1;
+    size_t k;
+    for (k = 0; k < len && empty; k++)
+        empty = text[k] == ' ' || text[k] == '\t' || text[k] == '\r' || text[k] == '\n';
+    if (at > len || (truncated && at + 1 >= len) || empty)
+        at = len;
+    *tail = at < len ? "" : truncated || empty ? ": the text ends early" : ": unexpected end";
+    return at;
+}

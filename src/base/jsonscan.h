@@ -74,4 +74,11 @@ void jsonscan_line_col(const char *text, size_t len, size_t off, uint32_t *line,
 /* 1 when the text ends inside a string or with brackets still open. */
 int jsonscan_truncated(const char *text, size_t len);
 
+/* Where to report a parse that stopped at byte 'at' (cJSON's error
+ * pointer as an offset; past len or unknown: len): the end of the text
+ * when cJSON ran off it (it reports the last byte of a text cut short)
+ * or the text is empty or white space, else 'at'; *tail gets the words
+ * for the end (": the text ends early", ": unexpected end") or "". */
+size_t jsonscan_error_at(const char *text, size_t len, size_t at, const char **tail /* OUT */);
+
 #endif

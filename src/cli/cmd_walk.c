@@ -267,7 +267,8 @@ typedef struct walk_run {
                                   the first (1-based) */
     long inside, first_inside; /* frames with the eye inside a building: how many, the first */
     double inside_eye[3];      /* the first one's eye */
-    double near_scene;         /* the least distance of an eye or target from the scene's bounds, m (0: inside) */
+    double bounds[4];          /* the scene's (plx_scene_info), taken once */
+    double near_scene;         /* the least distance of an eye or target from bounds, m (0: inside) */
 } walk_run;
 
 /* An eye position as the user gave it: "(x, y, z)" in the scene's own
@@ -369,12 +370,9 @@ static int frame(const walk_args *a, plx_engine *e, const walk_path *wp, walk_ru
     memset(&cam, 0, sizeof cam);
     walk_path_camera(wp, k * step, cam.eye, cam.target);
     {
-        plx_scene_info si;
-        if (plx_scene_info_get(e, &si) == PLX_OK) {
-            double d = fmin(box_distance(si.bounds, cam.eye[0], cam.eye[1]),
-                            box_distance(si.bounds, cam.target[0], cam.target[1]));
-            wr->near_scene = k == 0 || d < wr->near_scene ? d : wr->near_scene;
-        }
+        double d = fmin(box_distance(wr->bounds, cam.eye[0], cam.eye[1]),
+                        box_distance(wr->bounds, cam.target[0], cam.target[1]));
+        wr->near_scene = k == 0 || d < wr->near_scene ? d : wr->near_scene;
     }
     cam.fov_deg = a->fov;
     cam.width = a->w;
@@ -538,7 +536,12 @@ static int run(const walk_args *a, plx_engine *e, const walk_path *wp)
         rc = EXIT_FAIL;
     } else {
         plx_scene_info si;
-        if (plx_scene_info_get(e, &si) == PLX_OK && si.lonlat)
+        int ok = plx_scene_info_get(e, &si) == PLX_OK;
+        wr.bounds[0] = wr.bounds[1] = -HUGE_VAL; /* unknown: every eye inside, no outside warning */
+        wr.bounds[2] = wr.bounds[3] = HUGE_VAL;
+        if (ok)
+            memcpy(wr.bounds, si.bounds, sizeof wr.bounds);
+        if (ok && si.lonlat)
             fprintf(wr.cams, "# frame eye_lon eye_lat eye_z target_lon target_lat target_z exposure (degrees; z in m)\n");
         else
             fprintf(wr.cams, "# frame eye_x eye_y eye_z target_x target_y target_z exposure\n");

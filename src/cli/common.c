@@ -608,19 +608,12 @@ void cli_indirect_note(const char *cmd, plx_engine *e)
 
 void cli_json_error(const char *name, const char *text, size_t len, char *err, size_t errlen)
 {
-    const char *at = cJSON_GetErrorPtr();
-    size_t off, k;
+    const char *at = cJSON_GetErrorPtr(), *tail;
+    size_t off = jsonscan_error_at(text, len, at && at >= text ? (size_t)(at - text) : len, &tail);
     uint32_t line, col;
-    int truncated = jsonscan_truncated(text, len), empty = 1;
-    for (k = 0; k < len && empty; k++)
-        empty = text[k] == ' ' || text[k] == '\t' || text[k] == '\n' || text[k] == '\r';
-    off = at && at >= text && at <= text + len ? (size_t)(at - text) : len;
-    if (off > len || (truncated && off + 1 >= len) || empty) /* cJSON reports the last byte when it runs off the end */
-        off = len;
     jsonscan_line_col(text, len, off, &line, &col);
     snprintf(err, errlen, "%s: malformed JSON at byte %zu (line %lu, column %lu)%s", name, off, (unsigned long)line,
-             (unsigned long)col,
-             off < len ? "" : truncated || empty ? ": the text ends early" : ": unexpected end");
+             (unsigned long)col, tail);
 }
 
 long cli_photons(plx_engine *e, const cli_indirect *ind)

@@ -185,11 +185,10 @@ static void wall_site(const vec2 ends[2], double P[3], double n[3])
     n[0] = dy / len; /* outer rings counter-clockwise, holes clockwise: out is right */
     n[1] = -dx / len;
     n[2] = 0.0;
-    /* out by a few units in the last place of the coordinates: a + t d
-     * rounds to about 1e-9 m far from the origin (a projected CRS), the
-     * visibility's tolerance (pixel_hit.c does the same for a frame's
-     * wall points); near the origin under 1e-11 m */
-    t = fmax(fabs(P[0]), fabs(P[1])) * (1.0 / 281474976710656.0);
+    /* out by geom_round_margin: a + t d rounds to about 1e-9 m far from
+     * the origin, the visibility's tolerance (pixel_hit.c moves a frame's
+     * wall points alike) */
+    t = geom_round_margin(P[0], P[1]);
     P[0] += t * n[0];
     P[1] += t * n[1];
 }

@@ -3,11 +3,8 @@
  * term ask it), and the cache of the surfaces a frame shows. */
 #include <math.h>
 
+#include "base/geom.h"
 #include "render/render_int.h"
-
-/* A wall's hit point moves this many times its largest coordinate
- * towards the eye (2^-48: 4 units in the last place of a double). */
-#define WALL_NUDGE (1.0 / 281474976710656.0)
 
 /* Puts the surfaces of the frame's pixels (and the ground) in the cache,
  * before the shading pass (whose workers only read it): a surface's slot
@@ -62,13 +59,10 @@ int pixel_hit(render *r, int32_t i, int32_t j, uint32_t *sid_out, double P[3], d
     if (sid == MESH_SURF_GROUND)
         P[2] = 0.0;
     else if (sf->n[2] == 0.0) {
-        /* a wall: the point moved towards the eye by a few units in the
-         * last place of its coordinates. Far from the origin (a projected
-         * CRS: y near 6.7e6 m) the hit's rounding, about 1e-9 m there, put
-         * a third of a wall's points inside its building, below the
-         * visibility's 1e-9 m tolerance, so in its own shadow; near the
-         * origin the move is under 1e-11 m */
-        double m = fmax(fabs(P[0]), fabs(P[1])) * WALL_NUDGE;
+        /* a wall: the point moved towards the eye by geom_round_margin
+         * (far from the origin a third of a slanted wall's points were
+         * rounded inside their building, in its own shadow) */
+        double m = geom_round_margin(P[0], P[1]);
         P[0] += m * n[0];
         P[1] += m * n[1];
     }

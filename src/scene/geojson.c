@@ -77,17 +77,6 @@ static plx_status bad_top_property(loader *ld, const char *why)
 
 /* ---- parsing ------------------------------------------------------------ */
 
-static int is_space(char c);
-
-/* 1 when the text from off to the end holds only white space. */
-static int only_space(const loader *ld, size_t off)
-{
-    for (; off < ld->len; off++)
-        if (!is_space(ld->text[off]))
-            return 0;
-    return 1;
-}
-
 /* Arrays and objects open before byte off (outside strings). */
 static long depth_at(const loader *ld, size_t off)
 {
@@ -116,12 +105,9 @@ static plx_status parse_error(loader *ld, const char *at)
 {
     char msg[ENGINE_ERR_BYTES];
     strbuf b;
-    size_t off = at && at >= ld->text ? (size_t)(at - ld->text) : 0;
+    const char *tail;
+    size_t off = jsonscan_error_at(ld->text, ld->len, at && at >= ld->text ? (size_t)(at - ld->text) : 0, &tail);
     uint32_t line, col;
-    int truncated = jsonscan_truncated(ld->text, ld->len), empty = only_space(ld, 0);
-    /* cJSON reports the last byte when it runs off the end */
-    if (off > ld->len || (truncated && off + 1 >= ld->len) || empty)
-        off = ld->len;
     jsonscan_line_col(ld->text, ld->len, off, &line, &col);
     sb_init(&b, msg, sizeof msg);
     if (ld->name) {
@@ -149,8 +135,7 @@ static plx_status parse_error(loader *ld, const char *at)
     sb_str(&b, ", column ");
     sb_uint(&b, col);
     sb_str(&b, ")");
-    if (off >= ld->len)
-        sb_str(&b, truncated || empty ? ": the text ends early" : ": unexpected end");
+    sb_str(&b, tail);
     return eng_fail(ld->e, PLX_E_PARSE, msg);
 }
 
