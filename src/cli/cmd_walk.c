@@ -399,9 +399,11 @@ static int frame(const walk_args *a, plx_engine *e, const walk_path *wp, walk_ru
     if (st == PLX_OK && k == 0)
         cli_aa_warn("walk", &a->c, &a->opts, &info);
     if (st != PLX_OK) {
-        char at[96];
-        fprintf(stderr, "polarlux walk: frame %ld at %s: %s%s\n", k + 1, eye_text(e, cam.eye, at, sizeof at),
-                plx_last_error(e), cli_aa_nomem_hint(st, &a->opts));
+        char at[96], why[512];
+        /* the error first: eye_text asks the engine again, which clears it */
+        snprintf(why, sizeof why, "%s", plx_last_error(e));
+        fprintf(stderr, "polarlux walk: frame %ld at %s: %s%s\n", k + 1, eye_text(e, cam.eye, at, sizeof at), why,
+                cli_aa_nomem_hint(st, &a->opts));
         return cli_exit_code(st);
     }
     /* black with the eye inside a building: its own warning says why */
@@ -503,7 +505,8 @@ static void stale_hint(const walk_args *a, long n)
              "to %ld and leaves them", a->dir, path + strlen(a->dir) + 1, n);
 }
 
-static int run(const walk_args *a, plx_engine *e, const walk_path *wp)
+/* The walk's frames; *done: how many were written. */
+static int run(const walk_args *a, plx_engine *e, const walk_path *wp, long *done)
 {
     walk_run wr;
     cli_progress pr;
@@ -551,6 +554,7 @@ static int run(const walk_args *a, plx_engine *e, const walk_path *wp)
         rc = frame(a, e, wp, &wr, k, step);
         cli_progress_step(&pr, "walk", (size_t)k + 1, (size_t)wr.n);
     }
+    *done = rc == EXIT_OK ? k : k - 1;
     cli_progress_end(&pr);
     rc = writer_end(&wr, rc);
     if (rc == EXIT_OK && contact_sheet(a, &wr.sh, err, sizeof err) != 0) {
@@ -627,6 +631,7 @@ int cmd_walk(int argc, char **argv)
     plx_engine *e;
     char err[600];
     int made = 0;
+    long done = 0;
     int rc = parse_args(argc, argv, &a);
     if (rc != EXIT_OK)
         return rc < 0 ? EXIT_OK : rc;
@@ -659,8 +664,15 @@ int cmd_walk(int argc, char **argv)
         a.opts.no_indirect = 1;
     rc = cli_indirect_run("walk", e, &a.ind, NULL, NULL, a.fov);
     if (rc == EXIT_OK)
-        rc = run(&a, e, &wp);
+        rc = run(&a, e, &wp, &done);
     walk_path_free(&wp);
     plx_engine_free(e);
+    if (rc != EXIT_OK && done == 0) { /* nothing to keep: not even cameras.txt's header */
+        char path[4096];
+        snprintf(path, sizeof path, "%s/cameras.txt", a.dir);
+        (void)remove(path);
+        if (made)
+            (void)rmdir(a.dir);
+    }
     return rc;
 }
