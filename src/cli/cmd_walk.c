@@ -268,6 +268,7 @@ typedef struct walk_run {
     long inside, first_inside; /* frames with the eye inside a building: how many, the first */
     double inside_eye[3];      /* the first one's eye */
     double bounds[4];          /* the scene's (plx_scene_info), taken once */
+    int lonlat;                /* a lon/lat scene: cameras.txt in degrees */
     double near_scene;         /* the least distance of an eye or target from bounds, m (0: inside) */
 } walk_run;
 
@@ -361,6 +362,24 @@ static int writer_end(walk_run *wr, int rc)
     return rc;
 }
 
+/* DIR/cameras.txt opened and its header written, once the first frame
+ * rendered: a walk whose first frame fails leaves an earlier walk's file
+ * as it was. */
+static int cams_open(const walk_args *a, walk_run *wr)
+{
+    char path[4096];
+    snprintf(path, sizeof path, "%s/cameras.txt", a->dir);
+    if (!(wr->cams = fopen(path, "w"))) {
+        fprintf(stderr, "polarlux walk: %s: cannot write: %s\n", path, strerror(errno));
+        return -1;
+    }
+    if (wr->lonlat)
+        fprintf(wr->cams, "# frame eye_lon eye_lat eye_z target_lon target_lat target_z exposure (degrees; z in m)\n");
+    else
+        fprintf(wr->cams, "# frame eye_x eye_y eye_z target_x target_y target_z exposure\n");
+    return 0;
+}
+
 static int frame(const walk_args *a, plx_engine *e, const walk_path *wp, walk_run *wr, long k, double step)
 {
     plx_camera cam;
@@ -396,8 +415,11 @@ static int frame(const walk_args *a, plx_engine *e, const walk_path *wp, walk_ru
         wr->aa_adaptive += info.aa_adaptive == PLX_AA_ADAPTIVE;
         wr->aa_dense += info.aa_adaptive == PLX_AA_DENSE;
     }
-    if (st == PLX_OK && k == 0)
+    if (st == PLX_OK && k == 0) {
         cli_aa_warn("walk", &a->c, &a->opts, &info);
+        if (cams_open(a, wr) != 0)
+            return EXIT_FAIL;
+    }
     if (st != PLX_OK) {
         char at[96], why[512];
         /* the error first: eye_text asks the engine again, which clears it */
@@ -511,7 +533,7 @@ static int run(const walk_args *a, plx_engine *e, const walk_path *wp, long *don
     walk_run wr;
     cli_progress pr;
     double L = walk_path_length(wp), step = a->speed / a->fps, steps, *sorted;
-    char path[4096], err[512];
+    char err[512];
     int rc = EXIT_OK;
     long k;
     memset(&wr, 0, sizeof wr);
@@ -529,12 +551,7 @@ static int run(const walk_args *a, plx_engine *e, const walk_path *wp, long *don
     wr.ms = malloc(sizeof *wr.ms * (size_t)wr.n);
     sorted = malloc(sizeof *sorted * (size_t)wr.n);
     wr.rgb8 = malloc((size_t)a->w * a->h * 3);
-    snprintf(path, sizeof path, "%s/cameras.txt", a->dir);
-    wr.cams = fopen(path, "w");
-    if (!wr.cams) {
-        fprintf(stderr, "polarlux walk: %s: cannot write: %s\n", path, strerror(errno));
-        rc = EXIT_FAIL;
-    } else if (!wr.ms || !sorted || !wr.rgb8) {
+    if (!wr.ms || !sorted || !wr.rgb8) {
         fprintf(stderr, "polarlux walk: out of memory for %ld frames of %dx%d\n", wr.n, a->w, a->h);
         rc = EXIT_FAIL;
     } else {
@@ -544,10 +561,7 @@ static int run(const walk_args *a, plx_engine *e, const walk_path *wp, long *don
         wr.bounds[2] = wr.bounds[3] = HUGE_VAL;
         if (ok)
             memcpy(wr.bounds, si.bounds, sizeof wr.bounds);
-        if (ok && si.lonlat)
-            fprintf(wr.cams, "# frame eye_lon eye_lat eye_z target_lon target_lat target_z exposure (degrees; z in m)\n");
-        else
-            fprintf(wr.cams, "# frame eye_x eye_y eye_z target_x target_y target_z exposure\n");
+        wr.lonlat = ok && si.lonlat;
     }
     cli_progress_start(&pr); /* a line on a terminal, after a second */
     for (k = 0; rc == EXIT_OK && k < wr.n; k++) {
@@ -667,12 +681,7 @@ int cmd_walk(int argc, char **argv)
         rc = run(&a, e, &wp, &done);
     walk_path_free(&wp);
     plx_engine_free(e);
-    if (rc != EXIT_OK && done == 0) { /* nothing to keep: not even cameras.txt's header */
-        char path[4096];
-        snprintf(path, sizeof path, "%s/cameras.txt", a.dir);
-        (void)remove(path);
-        if (made)
-            (void)rmdir(a.dir);
-    }
+    if (rc != EXIT_OK && done == 0 && made) /* nothing written in it */
+        (void)rmdir(a.dir);
     return rc;
 }

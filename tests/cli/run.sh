@@ -322,6 +322,10 @@ expect walk-default 0 "^walk: [0-9]+ frames 160x120 .*aa 2" -- "$bin" walk -q "$
 set -- $(sed -n '2p' "$tmp/w2/cameras.txt")
 "$bin" render -q "$tmp/e.plxb" --size 160x120 --aa 2 --eye "$2,$3,$4" --target "$5,$6,$7" -o "$tmp/w2r.png" >/dev/null 2>&1
 if /usr/bin/python3 tests/cli/png_same.py "$tmp/w2/frame-0001.png" "$tmp/w2r.png"; then echo "ok   walk-default-equals-render"; pass=$((pass + 1)); else echo "FAIL walk-default-equals-render"; fail=$((fail + 1)); fi
+cp "$tmp/w2/cameras.txt" "$tmp/w2cams.txt"
+"$bin" walk -q "$tmp/e.plxb" --path "$tmp/path.geojson" --size 320x240 -o "$tmp/w2" >/dev/null 2>&1
+if cmp -s "$tmp/w2/cameras.txt" "$tmp/w2cams.txt"; then echo "ok   walk-fail-keeps-cameras"; pass=$((pass + 1))
+else echo "FAIL walk-fail-keeps-cameras: a walk whose first frame failed changed the folder's cameras.txt"; fail=$((fail + 1)); fi
 if [ -s "$tmp/w2/contact.png" ]; then echo "ok   walk-contact-sheet"; pass=$((pass + 1)); else echo "FAIL walk-contact-sheet"; fail=$((fail + 1)); fi
 # the animated PNG against the frame files (an independent reader: tests/cli/apng_check.py)
 if /usr/bin/python3 tests/cli/apng_check.py "$tmp/w2/walk.png" "$tmp/w2"/frame-*.png >/dev/null; then echo "ok   walk-apng"; pass=$((pass + 1)); else echo "FAIL walk-apng"; fail=$((fail + 1)); fi
