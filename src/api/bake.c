@@ -37,7 +37,7 @@
 #include "render/atlas_fill.h"
 
 #define BAKE_MAGIC "PLXBAKE\0"
-#define BAKE_VERSION 2u
+#define BAKE_VERSION 3u
 #define BAKE_HEADER 128u
 #define BAKE_ENDIAN 0x01020304u
 #define BAKE_ALIGN 64u
@@ -49,20 +49,38 @@ enum {
     H_SUM = 32, H_IMAGE = 40, H_NREL = 48, H_BASEMOD = 56, H_SLACK = 64, H_RESERVED = 72, H_PAGES = 80
 };
 
-/* ---- checksum: FNV-1a over 64-bit words, four interleaved lanes ---------- */
+/* ---- checksum: a multiply-rotate round over 64-bit words, four lanes ------ */
 
-#define FNV_BASIS 0xcbf29ce484222325ull
-#define FNV_PRIME 0x00000100000001b3ull
+/* Each word enters its lane as acc = rotl(acc + w K2, 31) K1: for a fixed
+ * word a bijection of acc, for a fixed acc a bijection of w (K1 and K2
+ * odd), and the rotation carries every bit of the product into the low
+ * bits of the next one. Format 2's FNV-1a step, (acc ^ w) P, carried a
+ * word's bit 63 only into the sum's bit 63: two flipped top bits in one
+ * lane cancelled, and one in a field nothing reads went unseen, so a
+ * damaged file passed and crashed the frames (a hostile-input pass). */
+#define SUM_K1 0x9e3779b97f4a7c15ull /* 2^64 / the golden ratio, odd */
+#define SUM_K2 0xd6e8feb86659fd93ull
+#define SUM_K3 0xff51afd7ed558ccdull
 
 typedef struct bake_sum {
     uint64_t h[4];
 } bake_sum;
 
+static uint64_t rotl64(uint64_t x, unsigned r)
+{
+    return (x << r) | (x >> (64u - r));
+}
+
+static uint64_t sum_round(uint64_t acc, uint64_t w)
+{
+    return rotl64(acc + w * SUM_K2, 31) * SUM_K1;
+}
+
 static void sum_init(bake_sum *s)
 {
     int k;
     for (k = 0; k < 4; k++)
-        s->h[k] = FNV_BASIS ^ (uint64_t)k;
+        s->h[k] = SUM_K3 + (uint64_t)k;
 }
 
 /* Adds n bytes (n a multiple of 32 except for the last call). */
@@ -72,25 +90,32 @@ static void sum_add(bake_sum *s, const unsigned char *p, size_t n)
     uint64_t h0 = s->h[0], h1 = s->h[1], h2 = s->h[2], h3 = s->h[3], w[4];
     for (; i + 32 <= n; i += 32) {
         memcpy(w, p + i, 32);
-        h0 = (h0 ^ w[0]) * FNV_PRIME;
-        h1 = (h1 ^ w[1]) * FNV_PRIME;
-        h2 = (h2 ^ w[2]) * FNV_PRIME;
-        h3 = (h3 ^ w[3]) * FNV_PRIME;
+        h0 = sum_round(h0, w[0]);
+        h1 = sum_round(h1, w[1]);
+        h2 = sum_round(h2, w[2]);
+        h3 = sum_round(h3, w[3]);
     }
     for (; i < n; i++)
-        h0 = (h0 ^ p[i]) * FNV_PRIME;
+        h0 = sum_round(h0, p[i]);
     s->h[0] = h0;
     s->h[1] = h1;
     s->h[2] = h2;
     s->h[3] = h3;
 }
 
+/* The lanes folded in order through the same round, then mixed so that
+ * every bit of the result depends on every bit of each lane. */
 static uint64_t sum_end(const bake_sum *s)
 {
     uint64_t h = s->h[0];
     int k;
     for (k = 1; k < 4; k++)
-        h = (h ^ s->h[k]) * FNV_PRIME;
+        h = sum_round(h, s->h[k]);
+    h ^= h >> 33;
+    h *= SUM_K3;
+    h ^= h >> 29;
+    h *= SUM_K2;
+    h ^= h >> 32;
     return h;
 }
 
@@ -135,10 +160,10 @@ static uint32_t layout_print(void)
                                filled (no shortcut, the same
                                image), an older reader takes the state as done (a saved bake has
                                nothing left to fill) */ };
-    uint64_t h = FNV_BASIS;
+    uint64_t h = 0xcbf29ce484222325ull; /* FNV-1a's basis and prime: the sizes are small */
     size_t i;
     for (i = 0; i < sizeof sz / sizeof sz[0]; i++)
-        h = (h ^ (uint64_t)sz[i]) * FNV_PRIME;
+        h = (h ^ (uint64_t)sz[i]) * 0x00000100000001b3ull;
     return (uint32_t)(h ^ (h >> 32));
 }
 

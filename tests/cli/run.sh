@@ -255,7 +255,7 @@ expect bake-no-polar-default-view 3 "the default street view needs the polar dia
     "$bin" render -q "$tmp/np.plxb" --mem $((npm - 150000)) --size 16x12 -o "$tmp/npv.png"
 head -c 5000 "$tmp/e.plxb" >"$tmp/cut.plxb"
 expect bake-truncated 1 "^polarlux info: $tmp/cut\.plxb: truncated bake file: 5000 bytes, the header says [0-9]+$" -- "$bin" info "$tmp/cut.plxb"
-expect bake-version 1 "^polarlux render: tests/corpus/bake-version-99\.plxb: bake format version 99, this polarlux reads version 2; bake the scene again$" -- \
+expect bake-version 1 "^polarlux render: tests/corpus/bake-version-99\.plxb: bake format version 99, this polarlux reads version 3; bake the scene again$" -- \
     "$bin" render tests/corpus/bake-version-99.plxb -o "$tmp/x.png"
 expect bake-arch 1 "bake made on another architecture" -- "$bin" vis tests/corpus/bake-big-endian.plxb --at 0,0
 expect bake-nomem 3 "the block is too small for the bake" -- "$bin" info --mem 64K "$tmp/e.plxb"

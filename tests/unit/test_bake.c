@@ -498,6 +498,39 @@ static void expect_fail(const unsigned char *f, size_t len, plx_status want, con
     free(mem);
 }
 
+/* Two flipped bits pass no longer: format 2's checksum carried a word's
+ * top bit only into its own top bit, so the top bits of two words of one
+ * lane (32 bytes apart), or one of them in the unread bytes 72..79,
+ * cancelled and the damaged file loaded (and crashed the frames: a
+ * hostile-input pass). Those cases through the loader, then 300 random
+ * pairs of bits through the README's checksum (ref_bake_sum). */
+static void two_bit_flips(const baked *k, unsigned char *f)
+{
+    size_t body = k->len - 128, i, a, b;
+    uint64_t seed = 0x2545f4914f6cdd1dull, sum = ref_bake_sum(k->file, k->len);
+    for (i = 0; i < 2; i++) {
+        a = i == 0 ? 79 : 128 + (body / 64) * 32 + 7; /* the reserved field, or a word of the body */
+        b = a + 32;                                   /* the same lane's next word */
+        memcpy(f, k->file, k->len);
+        f[a] ^= 0x80;
+        f[b] ^= 0x80;
+        expect_fail(f, k->len, PLX_E_PARSE, "corrupt bake file: checksum mismatch");
+    }
+    for (i = 0; i < 300; i++) {
+        seed ^= seed << 13;
+        seed ^= seed >> 7;
+        seed ^= seed << 17;
+        a = (size_t)(seed % (k->len * 8));
+        b = (size_t)((seed >> 21) % (k->len * 8));
+        if (a == b || (a / 8 >= 32 && a / 8 < 40) || (b / 8 >= 32 && b / 8 < 40)) /* the checksum's own field */
+            continue;
+        memcpy(f, k->file, k->len);
+        f[a / 8] ^= (unsigned char)(1u << (a % 8));
+        f[b / 8] ^= (unsigned char)(1u << (b % 8));
+        assert_true(ref_bake_sum(f, k->len) != sum);
+    }
+}
+
 static void test_damaged(void **state)
 {
     baked k = shared;
@@ -526,10 +559,11 @@ static void test_damaged(void **state)
     memcpy(f, k.file, k.len);
     f[k.len - 1] ^= 0x01;
     expect_fail(f, k.len, PLX_E_PARSE, "corrupt bake file: checksum mismatch");
+    two_bit_flips(&k, f);
     /* header fields */
     memcpy(f, k.file, k.len);
-    f[8] = 3;
-    expect_fail(f, k.len, PLX_E_UNSUPPORTED, "bake format version 3, this polarlux reads version 2; bake the scene again");
+    f[8] = 4;
+    expect_fail(f, k.len, PLX_E_UNSUPPORTED, "bake format version 4, this polarlux reads version 3; bake the scene again");
     memcpy(f, k.file, k.len);
     f[12] ^= 0xff;
     expect_fail(f, k.len, PLX_E_UNSUPPORTED, "bake made on another architecture (byte order or pointer, size_t, "
@@ -574,10 +608,13 @@ static const corpus_row corpus[] = {
     { "bake-geojson.plxb", PLX_E_PARSE, "not a polarlux bake file (no PLXBAKE magic)" },
     { "bake-magic-only.plxb", PLX_E_PARSE, "truncated bake file: 8 bytes, shorter than its 128-byte header" },
     { "bake-version-99.plxb", PLX_E_UNSUPPORTED,
-      "bake format version 99, this polarlux reads version 2; bake the scene again" },
+      "bake format version 99, this polarlux reads version 3; bake the scene again" },
     /* a bake of before 2026-11-30 evening (its slanted walls too dark: atlas_fill.c's wall_site) */
     { "bake-version-1.plxb", PLX_E_UNSUPPORTED,
-      "bake format version 1, this polarlux reads version 2; bake the scene again" },
+      "bake format version 1, this polarlux reads version 3; bake the scene again" },
+    /* a bake of before the checksum's rotation (2026-11-30 night) */
+    { "bake-version-2.plxb", PLX_E_UNSUPPORTED,
+      "bake format version 2, this polarlux reads version 3; bake the scene again" },
     { "bake-big-endian.plxb", PLX_E_UNSUPPORTED,
       "bake made on another architecture (byte order or pointer, size_t, double, long sizes differ); "
       "bake the scene again on this machine" },
