@@ -539,6 +539,9 @@ static int run(const walk_args *a, plx_engine *e, const walk_path *wp, long *don
     memset(&wr, 0, sizeof wr);
     cli_refiner_init(&wr.ref, a->refine_height, a->refine_frames, a->ind.photons);
     view_hint(a, wp);
+    if (!walk_path_moves(wp))
+        cli_warn("walk", &a->c, "the path never moves horizontally and has no properties.targets: the camera "
+                 "looks east (+x); give targets to aim it");
     /* compared as a double: a long path at a slow pace has more steps
      * than a long holds, and converting such a double is undefined */
     steps = floor(L / step) + 1.0;

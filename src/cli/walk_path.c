@@ -264,15 +264,76 @@ static void at(const walk_path *wp, const double *pts, double s, double out[3])
     }
 }
 
+/* A segment's horizontal length under this moves the eye too little to
+ * look along (m). */
+#define WALK_FLAT 1e-6
+
+/* Segment k's (1 .. n - 1) horizontal direction, unit; 0 when it hardly
+ * moves horizontally. */
+static int seg_dir(const walk_path *wp, uint32_t k, double d[2])
+{
+    const double *a = wp->eye + 3 * (k - 1), *b = wp->eye + 3 * k;
+    double dx = b[0] - a[0], dy = b[1] - a[1], h = hypot(dx, dy);
+    if (!(h > WALK_FLAT))
+        return 0;
+    d[0] = dx / h;
+    d[1] = dy / h;
+    return 1;
+}
+
+/* The horizontal direction the eye walks at arc length s: its segment's,
+ * else the next segment's that moves horizontally, else the last one's
+ * before it; 0 when none does. */
+static int walk_dir(const walk_path *wp, double s, double d[2])
+{
+    uint32_t k, here = 1;
+    double acc = 0;
+    for (k = 1; k < wp->n; k++) {
+        const double *a = wp->eye + 3 * (k - 1), *b = wp->eye + 3 * k;
+        double seg = hypot(hypot(b[0] - a[0], b[1] - a[1]), b[2] - a[2]);
+        here = k;
+        if (!(s > acc + seg))
+            break;
+        acc += seg;
+    }
+    for (k = here; k < wp->n; k++)
+        if (seg_dir(wp, k, d))
+            return 1;
+    for (k = here; k-- > 1;)
+        if (seg_dir(wp, k, d))
+            return 1;
+    return 0;
+}
+
+int walk_path_moves(const walk_path *wp)
+{
+    double d[2];
+    return wp->target != NULL || walk_dir(wp, 0.0, d);
+}
+
 void walk_path_camera(const walk_path *wp, double s, double eye[3], double target[3])
 {
+    double d[2];
     at(wp, wp->eye, s, eye);
     if (wp->target) {
         at(wp, wp->target, s, target);
+        if (hypot(hypot(target[0] - eye[0], target[1] - eye[1]), target[2] - eye[2]) > WALK_FLAT)
+            return;
     } else {
         at(wp, wp->eye, s + LOOK_AHEAD, target);
         target[2] = eye[2];
+        if (hypot(target[0] - eye[0], target[1] - eye[1]) > WALK_FLAT)
+            return;
     }
-    if (target[0] == eye[0] && target[1] == eye[1] && target[2] == eye[2])
-        target[0] += 1.0;
+    /* no direction there (a vertical or repeated stretch, the point ahead
+     * back at the eye, a keyframe's target crossing its eye): along the
+     * walk, or east when the path never moves horizontally (said once) */
+    target[2] = eye[2];
+    if (walk_dir(wp, s, d)) {
+        target[0] = eye[0] + LOOK_AHEAD * d[0];
+        target[1] = eye[1] + LOOK_AHEAD * d[1];
+    } else {
+        target[0] = eye[0] + LOOK_AHEAD;
+        target[1] = eye[1];
+    }
 }

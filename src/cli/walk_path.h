@@ -22,7 +22,13 @@ int walk_path_read(const char *path, plx_engine *e, walk_path *wp, char *err, si
 void walk_path_free(walk_path *wp);
 /* Length of the eye polyline, m. */
 double walk_path_length(const walk_path *wp);
-/* The camera at arc length s along the eye polyline. */
+/* Whether the path gives the camera a direction: targets, or a stretch
+ * that moves horizontally. */
+int walk_path_moves(const walk_path *wp);
+/* The camera at arc length s along the eye polyline. Where the targets
+ * or the point ahead give no direction (the target at the eye, the point
+ * ahead above or at it), the eye looks 10 m along its walk (the nearest
+ * stretch that moves horizontally), or east without one. */
 void walk_path_camera(const walk_path *wp, double s, double eye[3] /* OUT */, double target[3] /* OUT */);
 
 #endif

@@ -296,6 +296,15 @@ expect walk-too-large 2 "^polarlux walk: frame 1 at \(.*\): plx_render: a 320x24
     "$bin" walk -q "$tmp/e.plxb" --path "$tmp/path.geojson" --size 320x240 -o "$tmp/wbig"
 if [ ! -e "$tmp/wbig" ]; then echo "ok   walk-too-large-no-folder"; pass=$((pass + 1))
 else echo "FAIL walk-too-large-no-folder: a walk whose first frame failed left its folder"; fail=$((fail + 1)); fi
+# a vertical stretch gives no point ahead: the eye looks along the next
+# stretch that moves (it looked 1 m east), and a path that never moves
+# says where it looks
+printf '{"type":"Feature","properties":{"units":"m"},"geometry":{"type":"LineString","coordinates":[[300,265,1.7],[300,265,30],[300,300,30]]}}' >"$tmp/pvert.geojson"
+expect walk-vertical-looks-along 0 "^2 300 265 15.85 300 275 15.85 " -- \
+    sh -c "'$bin' walk -q '$tmp/e.plxb' --path '$tmp/pvert.geojson' --size 32x24 --speed 14.15 --fps 1 --aa 1 --no-indirect -o '$tmp/wvert' >/dev/null && cat '$tmp/wvert/cameras.txt'"
+printf '{"type":"Feature","properties":{"units":"m"},"geometry":{"type":"LineString","coordinates":[[300,265,1.7],[300,265,30]]}}' >"$tmp/pup.geojson"
+expect walk-never-moves 0 "the path never moves horizontally and has no properties.targets: the camera looks east" -- \
+    "$bin" walk "$tmp/e.plxb" --path "$tmp/pup.geojson" --size 32x24 --speed 14.15 --fps 1 --aa 1 --no-indirect -o "$tmp/wup"
 expect walk-exact 0 "^frame time: median [0-9.]+ ms, p95 [0-9.]+ ms, mean [0-9.]+ ms: [0-9.]+ frames per second" -- \
     "$bin" walk -q "$tmp/e.plxb" --path "$tmp/path.geojson" --size 160x120 --fps 0.2 --aa 1 --no-indirect --no-glow --exposure 1 -o "$tmp/w1"
 set -- $(sed -n '3p' "$tmp/w1/cameras.txt")
