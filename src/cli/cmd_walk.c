@@ -222,16 +222,51 @@ static int contact_sheet(const walk_args *a, const sheet *sh, char *err, size_t 
     return image_write_png_rgb8_fast(path, sh->W, sh->H, sh->px, 0, err, errlen);
 }
 
+/* APNG's frame delay num / den s (each 1 .. 65535) nearest x s: the last
+ * convergent of x's continued fraction whose terms fit (1/30 for 30 fps,
+ * 100/2997 for 29.97; it was rounded to whole ms, 33/1000), clamped to
+ * 1/65535 .. 65535/1 s. */
+static void delay_fraction(double x, unsigned *num, unsigned *den)
+{
+    double h1 = 1.0, h2 = 0.0, k1 = 0.0, k2 = 1.0, r = x;
+    int i;
+    *num = 1;
+    *den = 65535;
+    if (!(x > 1.0 / 65535.0)) /* also NaN */
+        return;
+    if (x >= 65535.0) {
+        *num = 65535;
+        *den = 1;
+        return;
+    }
+    for (i = 0; i < 64; i++) {
+        double a = floor(r), h = a * h1 + h2, k = a * k1 + k2;
+        if (h > 65535.0 || k > 65535.0)
+            break;
+        if (h >= 1.0) {
+            *num = (unsigned)h;
+            *den = (unsigned)k;
+        }
+        h2 = h1;
+        h1 = h;
+        k2 = k1;
+        k1 = k;
+        if (!(r - a > 1e-12))
+            break;
+        r = 1.0 / (r - a);
+    }
+}
+
 /* The animated PNG DIR/walk.png from the n frame files, 1/fps s each. */
 static int animation(const walk_args *a, long n, char *err, size_t errlen)
 {
     char path[4096], **names = calloc((size_t)n, sizeof *names);
-    double d = 1000.0 / a->fps;
-    unsigned num = d < 1.0 ? 1u : d > 65535.0 ? 65535u : (unsigned)(d + 0.5);
+    unsigned num, den;
     long k;
     int rc = -1;
     if (!names)
         return snprintf(err, errlen, "out of memory for the animation"), -1;
+    delay_fraction(1.0 / a->fps, &num, &den);
     for (k = 0; k < n; k++) {
         names[k] = malloc(strlen(a->dir) + 32);
         if (!names[k])
@@ -240,7 +275,7 @@ static int animation(const walk_args *a, long n, char *err, size_t errlen)
     }
     snprintf(path, sizeof path, "%s/walk.png", a->dir);
     if (k == n)
-        rc = image_write_apng(path, (const char *const *)names, (int)n, num, 1000, err, errlen);
+        rc = image_write_apng(path, (const char *const *)names, (int)n, num, den, err, errlen);
     else
         snprintf(err, errlen, "out of memory for the animation");
     for (k = 0; k < n; k++)

@@ -336,6 +336,13 @@ cp "$tmp/w2/cameras.txt" "$tmp/w2cams.txt"
 if cmp -s "$tmp/w2/cameras.txt" "$tmp/w2cams.txt"; then echo "ok   walk-fail-keeps-cameras"; pass=$((pass + 1))
 else echo "FAIL walk-fail-keeps-cameras: a walk whose first frame failed changed the folder's cameras.txt"; fail=$((fail + 1)); fi
 if [ -s "$tmp/w2/contact.png" ]; then echo "ok   walk-contact-sheet"; pass=$((pass + 1)); else echo "FAIL walk-contact-sheet"; fail=$((fail + 1)); fi
+# a frame's delay is 1/fps exactly where 16-bit terms allow (it was
+# whole milliseconds: 33/1000 at 30 and at 29.97 fps)
+"$bin" walk -q "$tmp/e.plxb" --path "$tmp/path.geojson" --size 32x24 --fps 29.97 --max-frames 2 --aa 1 --no-indirect -o "$tmp/wfps" >/dev/null 2>&1
+expect walk-apng-delay 0 "^100/2997$" -- /usr/bin/python3 -c "
+import struct,sys
+d=open(sys.argv[1],'rb').read(); i=d.index(b'fcTL')
+n,m=struct.unpack('>HH',d[i+24:i+28]); print('%d/%d'%(n,m))" "$tmp/wfps/walk.png"
 # the animated PNG against the frame files (an independent reader: tests/cli/apng_check.py)
 if /usr/bin/python3 tests/cli/apng_check.py "$tmp/w2/walk.png" "$tmp/w2"/frame-*.png >/dev/null; then echo "ok   walk-apng"; pass=$((pass + 1)); else echo "FAIL walk-apng"; fail=$((fail + 1)); fi
 # threads (README "Threads"): the same bytes with 1 and 2
