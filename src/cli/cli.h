@@ -5,6 +5,7 @@
 #include <stdio.h>
 #include "polarlux.h"
 #include "polarlux_port.h"
+#include <cjson/cJSON.h>
 
 /* Exit codes (README, "Exit codes"). */
 enum {
@@ -78,6 +79,10 @@ extern cli_bake_state cli_bake_last;
  * the failed parse), with ": the text ends early" for a text cut short:
  * the scene loader's words (src/scene/geojson.c's parse_error). */
 void cli_json_error(const char *name, const char *text, size_t len, char *err, size_t errlen);
+/* text (len bytes) parsed, or NULL with cli_json_error's words in err;
+ * anything but white space after the JSON value is refused at its byte,
+ * as the scene loader does (walk and route paths took it). */
+cJSON *cli_json_parse(const char *name, const char *text, size_t len, char *err, size_t errlen);
 /* Photon frames for indirect light (--photons, --frames, --no-indirect). */
 typedef struct cli_indirect {
     long photons;    /* per frame with --photons (else 65536, or cli_photons's with per_lamp) */

@@ -616,6 +616,28 @@ void cli_json_error(const char *name, const char *text, size_t len, char *err, s
              (unsigned long)col, tail);
 }
 
+cJSON *cli_json_parse(const char *name, const char *text, size_t len, char *err, size_t errlen)
+{
+    const char *end = NULL;
+    cJSON *root = cJSON_ParseWithLengthOpts(text, len, &end, 0);
+    size_t off;
+    uint32_t line, col;
+    if (!root) {
+        cli_json_error(name, text, len, err, errlen);
+        return NULL;
+    }
+    off = end && end >= text ? (size_t)(end - text) : len;
+    while (off < len && (text[off] == ' ' || text[off] == '\t' || text[off] == '\r' || text[off] == '\n'))
+        off++;
+    if (off == len)
+        return root;
+    cJSON_Delete(root); /* more after the value: the scene loader refuses it too */
+    jsonscan_line_col(text, len, off, &line, &col);
+    snprintf(err, errlen, "%s: malformed JSON at byte %zu (line %lu, column %lu)", name, off, (unsigned long)line,
+             (unsigned long)col);
+    return NULL;
+}
+
 long cli_photons(plx_engine *e, const cli_indirect *ind)
 {
     plx_scene_info si;

@@ -158,16 +158,14 @@ static void line_id(const cJSON *ft, char *out, size_t len)
 int route_parse(const char *name, const char *text, size_t len, plx_engine *e, route_set *out,
                 char *err, size_t errlen)
 {
-    cJSON *root = cJSON_ParseWithLength(text, len);
+    cJSON *root = cli_json_parse(name, text, len, err, errlen);
     const cJSON *features, *ft, *type;
     frame f;
     size_t cap = 0, k = 0, first = 0;
     char why[256];
     memset(out, 0, sizeof *out);
-    if (!root) {
-        cli_json_error(name, text, len, err, errlen);
+    if (!root)
         return -1;
-    }
     type = cJSON_GetObjectItemCaseSensitive(root, "type");
     features = cJSON_GetObjectItemCaseSensitive(root, "features");
     if (!cJSON_IsString(type) || strcmp(type->valuestring, "FeatureCollection") != 0 || !cJSON_IsArray(features)) {

@@ -124,6 +124,14 @@ static int metres(const cJSON *root)
     return root && metres_props(cJSON_GetObjectItemCaseSensitive(root, "properties"));
 }
 
+/* properties.units given and not "m" (route and the scene loader refuse
+ * it; walk read such a path as metres, or projected it, without a word). */
+static int other_units(const cJSON *props)
+{
+    const cJSON *u = cJSON_GetObjectItemCaseSensitive(props, "units");
+    return u && !metres_props(props);
+}
+
 /* No keyframe looks at its own eye (the camera would have no direction:
  * render refuses such a camera; walk looked 1 m east). */
 static int check_targets(const walk_path *wp, int n, char *why, size_t whylen)
@@ -147,6 +155,11 @@ static int parse(const cJSON *root, plx_engine *e, walk_path *wp, char *why, siz
     int n, project, k;
     if (!line) {
         snprintf(why, whylen, "no LineString (a Feature, a FeatureCollection or a bare geometry)");
+        return -1;
+    }
+    if (other_units(cJSON_GetObjectItemCaseSensitive(root, "properties")) || other_units(props)) {
+        snprintf(why, whylen, "properties.units must be \"m\" when given (positions in local metres; without "
+                 "it, lon/lat on a lon/lat scene)");
         return -1;
     }
     coords = cJSON_GetObjectItemCaseSensitive(line, "coordinates");
@@ -205,9 +218,7 @@ int walk_path_read(const char *path, plx_engine *e, walk_path *wp, char *err, si
         snprintf(err, errlen, "%s: %s", path, why);
         return -1;
     }
-    root = cJSON_ParseWithLength(text, len);
-    if (!root)
-        cli_json_error(path, text, len, err, errlen);
+    root = cli_json_parse(path, text, len, err, errlen);
     free(text);
     if (!root)
         return -1;

@@ -207,6 +207,14 @@ expect bake-info-polar 0 "^polar diagrams: from the bake; [0-9]+ bytes" -- "$bin
 printf '{"type":"LineString",\n "coordinates":[[0,0],[1,' >"$tmp/pbad.geojson"
 expect walk-path-malformed 1 "^polarlux walk: $tmp/pbad\.geojson: malformed JSON at byte 47 \(line 2, column 26\): the text ends early$" -- \
     "$bin" walk -q fixtures/tiny.geojson --path "$tmp/pbad.geojson" -o "$tmp/wpb"
+# a path's units other than "m", and text after its JSON, are refused as
+# route and the scene loader refuse them (walk read "ft" as metres)
+printf '{"type":"Feature","properties":{"units":"ft"},"geometry":{"type":"LineString","coordinates":[[0,0],[10,0]]}}' >"$tmp/pft.geojson"
+expect walk-path-units 1 "^polarlux walk: $tmp/pft\.geojson: properties\.units must be \"m\" when given" -- \
+    "$bin" walk -q fixtures/tiny.geojson --path "$tmp/pft.geojson" -o "$tmp/wft"
+printf '{"type":"LineString","coordinates":[[0,0],[10,0]]} x' >"$tmp/ptrail.geojson"
+expect walk-path-trailing 1 "^polarlux walk: $tmp/ptrail\.geojson: malformed JSON at byte 51 \(line 1, column 52\)$" -- \
+    "$bin" walk -q fixtures/tiny.geojson --path "$tmp/ptrail.geojson" -o "$tmp/wtr"
 expect walk-help 0 "^usage: polarlux walk" -- "$bin" walk --help
 expect walk-unknown-option 2 "polarlux walk: unknown option '--bogus'" -- "$bin" walk --bogus x
 expect walk-missing-path 2 "missing --path CAMERA.geojson" -- "$bin" walk "$tmp/e.plxb" -o "$tmp/w"
