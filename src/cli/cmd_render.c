@@ -427,11 +427,14 @@ int cmd_render(int argc, char **argv)
         goto done;
     }
     rc = write_outputs(&a, rgb8, rgbf);
+    if (rc == EXIT_OK && cli_all_black(rgb8, (size_t)a.cam.width * a.cam.height * 3)) {
+        char why[200]; /* rgb8 is written out: cli_black_reason may draw into it */
+        cli_warn("render", &a.c, "the image is entirely black: %s",
+                 cli_black_reason(e, &a.cam, &a.opts, rgb8, why, sizeof why));
+    }
     prec = coord_digits(e);
     cli_from_local(e, &a.cam.eye[0], &a.cam.eye[1]);
     cli_from_local(e, &a.cam.target[0], &a.cam.target[1]);
-    if (rc == EXIT_OK && cli_all_black(rgb8, (size_t)a.cam.width * a.cam.height * 3))
-        cli_warn("render", &a.c, "the image is entirely black: %s", cli_dark_reason(e));
     if (rc == EXIT_OK)
         printf("%s view %dx%d from (%.*f, %.*f, %.1f) to (%.*f, %.*f, %.1f): drew %u of %u buildings "
                "(%.2f%% of the geometry) in %.1f ms, written to %s\n",

@@ -300,6 +300,7 @@ typedef struct walk_run {
     int writer;                /* 1: frames written on the writer's thread */
     long black, first_black;   /* frames entirely black, the eye outside buildings: how many,
                                   the first (1-based) */
+    plx_camera black_cam;      /* the first one's camera */
     long inside, first_inside; /* frames with the eye inside a building: how many, the first */
     double inside_eye[3];      /* the first one's eye */
     double bounds[4];          /* the scene's (plx_scene_info), taken once */
@@ -464,8 +465,10 @@ static int frame(const walk_args *a, plx_engine *e, const walk_path *wp, walk_ru
         return cli_exit_code(st);
     }
     /* black with the eye inside a building: its own warning says why */
-    if (!info.eye_inside && cli_all_black(wr->rgb8, (size_t)a->w * a->h * 3) && wr->black++ == 0)
+    if (!info.eye_inside && cli_all_black(wr->rgb8, (size_t)a->w * a->h * 3) && wr->black++ == 0) {
         wr->first_black = k + 1;
+        wr->black_cam = cam;
+    }
     if (info.eye_inside && wr->inside++ == 0) {
         wr->first_inside = k + 1;
         memcpy(wr->inside_eye, cam.eye, sizeof wr->inside_eye);
@@ -619,6 +622,7 @@ static int run(const walk_args *a, plx_engine *e, const walk_path *wp, long *don
     }
     if (rc == EXIT_OK) {
         double med, p95, sum = 0;
+        char why[200]; /* the frames are written (writer_end): cli_black_reason may draw into wr.rgb8 */
         memcpy(sorted, wr.ms, sizeof *sorted * (size_t)wr.n);
         qsort(sorted, (size_t)wr.n, sizeof *sorted, cmp_double);
         for (k = 0; k < wr.n; k++)
@@ -656,10 +660,11 @@ static int run(const walk_args *a, plx_engine *e, const walk_path *wp, long *don
                      "eyes and targets %.0f m or more from the scene's bounds (its buildings' box and 50 m); is the "
                      "path in the scene's coordinates?", wr.near_scene);
         else if (wr.black == wr.n)
-            cli_warn("walk", &a->c, "every frame is entirely black: %s", cli_dark_reason(e));
+            cli_warn("walk", &a->c, "every frame is entirely black: %s",
+                     cli_black_reason(e, &wr.black_cam, &a->opts, wr.rgb8, why, sizeof why));
         else if (wr.black)
             cli_warn("walk", &a->c, "%ld of %ld frames are entirely black (the first: frame %ld): %s", wr.black,
-                     wr.n, wr.first_black, cli_dark_reason(e));
+                     wr.n, wr.first_black, cli_black_reason(e, &wr.black_cam, &a->opts, wr.rgb8, why, sizeof why));
     }
     if (wr.cams)
         fclose(wr.cams);

@@ -352,6 +352,22 @@ const char *cli_dark_reason(plx_engine *e)
     return "no lamp's light reaches it (each lamp lights only within its radius, and buildings cast shadows)";
 }
 
+const char *cli_black_reason(plx_engine *e, const plx_camera *cam, const plx_render_opts *o, unsigned char *rgb8,
+                             char *buf, size_t len)
+{
+    plx_render_opts ao = *o;
+    plx_render_info info;
+    if (o->auto_exposure || !rgb8)
+        return cli_dark_reason(e);
+    ao.auto_exposure = 1;
+    if (plx_render(e, cam, &ao, rgb8, NULL, &info) != PLX_OK ||
+        cli_all_black(rgb8, (size_t)cam->width * cam->height * 3))
+        return cli_dark_reason(e);
+    snprintf(buf, len, "--exposure %g maps the light there to black (automatic exposure, without --exposure, "
+             "chooses %.4g)", o->exposure, info.exposure);
+    return buf;
+}
+
 /* The command's progress line for the core's long stages (plx_port.progress):
  * the workers' units summed under a lock, shown as cli_progress shows a
  * loop of the command's own (a terminal only, after a second). */

@@ -215,6 +215,10 @@ expect walk-path-units 1 "^polarlux walk: $tmp/pft\.geojson: properties\.units m
 printf '{"type":"LineString","coordinates":[[0,0],[10,0]]} x' >"$tmp/ptrail.geojson"
 expect walk-path-trailing 1 "^polarlux walk: $tmp/ptrail\.geojson: malformed JSON at byte 51 \(line 1, column 52\)$" -- \
     "$bin" walk -q fixtures/tiny.geojson --path "$tmp/ptrail.geojson" -o "$tmp/wtr"
+# a tiny --exposure is named when the image comes out black (the lamps
+# were blamed)
+expect render-black-exposure 0 "warning: the image is entirely black: --exposure 1e-06 maps the light there to black \(automatic exposure, without --exposure, chooses [0-9.]+\)" -- \
+    "$bin" render "$tmp/e.plxb" --size 64x48 --exposure 1e-6 -o "$tmp/xblack.png"
 expect walk-help 0 "^usage: polarlux walk" -- "$bin" walk --help
 expect walk-unknown-option 2 "polarlux walk: unknown option '--bogus'" -- "$bin" walk --bogus x
 expect walk-missing-path 2 "missing --path CAMERA.geojson" -- "$bin" walk "$tmp/e.plxb" -o "$tmp/w"
@@ -313,6 +317,8 @@ expect walk-vertical-looks-along 0 "^2 300 265 15.85 300 275 15.85 " -- \
 printf '{"type":"Feature","properties":{"units":"m"},"geometry":{"type":"LineString","coordinates":[[300,265,1.7],[300,265,30]]}}' >"$tmp/pup.geojson"
 expect walk-never-moves 0 "the path never moves horizontally and has no properties.targets: the camera looks east" -- \
     "$bin" walk "$tmp/e.plxb" --path "$tmp/pup.geojson" --size 32x24 --speed 14.15 --fps 1 --aa 1 --no-indirect -o "$tmp/wup"
+expect walk-black-exposure 0 "warning: every frame is entirely black: --exposure 1e-06 maps the light there to black" -- \
+    "$bin" walk "$tmp/e.plxb" --path "$tmp/path.geojson" --size 32x24 --max-frames 2 --exposure 1e-6 -o "$tmp/wblack"
 expect walk-exact 0 "^frame time: median [0-9.]+ ms, p95 [0-9.]+ ms, mean [0-9.]+ ms: [0-9.]+ frames per second" -- \
     "$bin" walk -q "$tmp/e.plxb" --path "$tmp/path.geojson" --size 160x120 --fps 0.2 --aa 1 --no-indirect --no-glow --exposure 1 -o "$tmp/w1"
 set -- $(sed -n '3p' "$tmp/w1/cameras.txt")
