@@ -705,10 +705,16 @@ typedef struct plx_render_opts {
     int no_indirect;            /* 1: direct light only even when photons were traced */
     const plx_backend *backend; /* visibility pass: NULL = the built-in software rasteriser;
                                    or a port's, e.g. port/osmesa/plx_osmesa.h */
-    int auto_exposure;          /* 1: the exposure is chosen from the image (a high percentile of
-                                   the lit pixels' luminance near white) and a tone curve keeps
-                                   the highlights near lamps; exposure is then ignored. rgbf
-                                   stays linear radiance. README "Automatic exposure" */
+    int auto_exposure;          /* PLX_EXPOSURE_AUTO (1): the exposure is chosen from the image (a
+                                   high percentile of the lit pixels' luminance near white) and a
+                                   tone curve keeps the highlights near lamps; exposure is then
+                                   ignored. PLX_EXPOSURE_ADAPT: chosen so, but held at exposure
+                                   (the last frame's) while the image's own choice stays within
+                                   half a stop of it, else moved to half a stop from that choice
+                                   (frames of a walk without flicker). PLX_EXPOSURE_TONE: exposure
+                                   with the tone curve. PLX_EXPOSURE_FIXED (0): exposure, linear
+                                   (SPEC §5). rgbf stays linear radiance. README "Automatic
+                                   exposure" */
     int aa;                     /* anti-aliasing: aa x aa samples per pixel on a regular grid,
                                    averaged in linear radiance (0 or 1: one sample at the pixel
                                    centre, SPEC §5); at most PLX_RENDER_MAX_AA. Adaptive unless
@@ -720,6 +726,11 @@ typedef struct plx_render_opts {
                                    light), not read from the radiance atlas (README "The
                                    radiance atlas"): slower, shadow edges exact */
 } plx_render_opts;
+
+#define PLX_EXPOSURE_FIXED 0
+#define PLX_EXPOSURE_AUTO 1
+#define PLX_EXPOSURE_ADAPT 2
+#define PLX_EXPOSURE_TONE 3
 
 #define PLX_RENDER_MAX_AA 16
 #define PLX_RENDER_MAX_DIM 16384   /* the largest frame width or height */

@@ -657,7 +657,9 @@ plx_status plx_render(plx_engine *e, const plx_camera *cam, const plx_render_opt
         return eng_fail(e, PLX_E_INVALID, "plx_render: aa must be 0..16 (samples per pixel side)");
     /* a fixed exposure of 0 or less gave a black (or negative) frame; NaN
      * and inf were refused deeper, as "near must be > 0" */
-    if (o && !o->auto_exposure && !(o->exposure > 0.0 && isfinite(o->exposure)))
+    if (o && (o->auto_exposure < PLX_EXPOSURE_FIXED || o->auto_exposure > PLX_EXPOSURE_TONE))
+        return eng_fail(e, PLX_E_INVALID, "plx_render: auto_exposure must be PLX_EXPOSURE_FIXED, _AUTO, _ADAPT or _TONE");
+    if (o && o->auto_exposure != PLX_EXPOSURE_AUTO && !(o->exposure > 0.0 && isfinite(o->exposure)))
         return eng_fail(e, PLX_E_INVALID, "plx_render: exposure must be a finite number above 0 (or auto_exposure)");
     if (!o) {
         plx_render_opts_default(&def);

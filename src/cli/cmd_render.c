@@ -19,9 +19,11 @@
 
 static const char help[] =
     "usage: polarlux render SCENE [--eye X,Y,Z --target X,Y,Z] [--fov DEG] [--size WxH]\n"
-    "                       [--view street|aerial] [--backend soft|osmesa] [--exposure E]\n"
-    "                       [--no-indirect] [--no-glow] [--aa N [--aa-full]] [--texel M]\n"
-    "                       [--per-pixel] [--threads N] [--refine] [--mem SIZE]\n"
+    "                       [--view street|aerial] [--backend soft|osmesa]\n"
+    "                       [--exposure E [--tone-curve]] [--no-indirect] [--no-glow]\n"
+    "                       [--aa N [--aa-full]] [--texel M] [--per-pixel] [--threads N]\n"
+    "                       [--refine [--refine-height M]] [--photons N] [--frames K]\n"
+    "                       [--lamps FILE] [--mem SIZE] [--strict] [--quiet]\n"
     "                       -o OUT.png [--pfm OUT.pfm]\n"
     "\n"
     "Renders the scene at night through a pinhole camera (SPEC §5: up is +z,\n"
@@ -51,26 +53,24 @@ static const char help[] =
     "                   --exposure 1 is the reference image). Default: automatic:\n"
     "                   a high percentile of the lit pixels' luminance near white,\n"
     "                   a tone curve keeping highlights near lamps; printed\n"
+    "  --tone-curve     with --exposure E: E with the tone curve (a walk frame\n"
+    "                   again from its cameras.txt exposure)\n"
     "  --no-glow        no lamp glows: every pixel is exactly SPEC §5's radiance\n"
     "  --refine         near-viewer refinement (munoz2013 §3.3-3.4): the lamps near\n"
     "                   where the view meets the ground (up to 30 m ahead) get floor\n"
-    "                   photon maps (LRU cache, pushed into the aerial map); 16\n"
-    "                   more photon frames refill the chart\n"
+    "                   photon maps; 16 more photon frames refill the chart\n"
     "  --refine-height M  refine only with the eye at most M m above the ground\n"
     "                   (default 60; munoz2013 §3.3 refines low views only)\n"
     "  --aa N           anti-aliasing: N x N samples per pixel, averaged in linear\n"
     "                   radiance (default 1: one sample at each pixel centre, SPEC §5);\n"
     "                   the later samples only where the first one's image has an edge\n"
-    "                   (another surface, or a step of more than 2 in 8 bits); every\n"
-    "                   sample when edges cover over half of an atlas frame\n"
+    "                   (every sample when edges cover over half of an atlas frame)\n"
     "  --aa-full        every pixel takes all N x N samples\n"
     "  --no-indirect    direct light only, exact at every pixel (SPEC §5's pixels\n"
     "                   with --no-glow --exposure 1)\n"
-    "  --per-pixel      with indirect light, each pixel's light computed there (exact\n"
-    "                   direct; indirect by final gathers at sparse points): slower\n"
+    "  --per-pixel      with indirect light, each pixel's light computed there: slower\n"
     "  --photons N      photons per frame (default 16 a lamp, 65536..1048576)\n"
-    "  --frames K       progressive photon frames for the still image (default 4;\n"
-    "                   aerial views too: their light map gathers like street views)\n"
+    "  --frames K       progressive photon frames for the still image (default 4)\n"
     "  --backend B      raster pass: soft (default, built in) or osmesa (OpenGL into\n"
     "                   an OSMesa buffer; " OSMESA_STATE "); the same image\n"
     "  -o FILE          output PNG (required)\n"
@@ -137,7 +137,8 @@ static int parse_args(int argc, char **argv, render_args *a)
     a->cam.fov_deg = v.fov;
     a->cam.width = (int32_t)v.size[0];
     a->cam.height = (int32_t)v.size[1];
-    cli_view_apply(&v, &a->ind, &a->opts);
+    if ((rc = cli_view_apply("render", &v, &a->ind, &a->opts)) != EXIT_OK)
+        return rc;
     a->aerial = v.aerial;
     a->refine = v.refine;
     a->refine_height = v.refine_height;
@@ -446,7 +447,7 @@ int cmd_render(int argc, char **argv)
         cli_aa_print(&a.opts, info.aa_later, (double)a.cam.width * a.cam.height, 1,
                      info.aa_adaptive == PLX_AA_ADAPTIVE, info.aa_adaptive == PLX_AA_DENSE);
     }
-    if (rc == EXIT_OK && a.opts.auto_exposure)
+    if (rc == EXIT_OK && a.opts.auto_exposure == PLX_EXPOSURE_AUTO)
         printf("exposure: %.4g (automatic: a high percentile of the lit surfaces' luminance near white, "
                "tone curve; --exposure 1 for SPEC §5's linear image)\n", info.exposure);
 done:

@@ -15,8 +15,9 @@
 
 static const char help[] =
     "usage: polarlux walk SCENE|BAKE --path CAMERA.geojson -o DIR [--size WxH] [--fps F]\n"
-    "                     [--speed M/S] [--fov DEG] [--aa N [--aa-full]] [--exposure E]\n"
-    "                     [--no-glow] [--no-indirect] [--per-pixel] [--view street|aerial]\n"
+    "                     [--speed M/S] [--fov DEG] [--aa N [--aa-full]]\n"
+    "                     [--exposure E [--tone-curve]] [--no-adapt] [--no-glow]\n"
+    "                     [--no-indirect] [--per-pixel] [--view street|aerial]\n"
     "                     [--max-frames N] [--texel M] [--threads N] [--photons N] [--frames K]\n"
     "                     [--refine [--refine-height M] [--refine-frames K]]\n"
     "                     [--mem SIZE] [--strict] [--quiet]\n"
@@ -41,7 +42,10 @@ static const char help[] =
     "  --fov DEG        vertical field of view (default 60)\n"
     "  --aa N           N x N samples per pixel (default 2; 1: pixel centres, SPEC §5),\n"
     "                   the later ones only at edges, as for render (--aa-full: all)\n"
-    "  --exposure E     fixed exposure, no tone curve (default: automatic per frame)\n"
+    "  --exposure E     fixed exposure, no tone curve (--tone-curve: with it). Default:\n"
+    "                   automatic, held while a frame's own choice stays within half\n"
+    "                   a stop (no flicker); in cameras.txt, for render --tone-curve\n"
+    "  --no-adapt       each frame's automatic exposure from its own image alone\n"
     "  --no-glow, --no-indirect, --per-pixel, --view V, --texel M, --photons N,\n"
     "  --frames K       as for render\n"
     "  --max-frames N   at most N frames (default 1000)\n"
@@ -65,6 +69,7 @@ static const char help[] =
 typedef struct walk_args {
     const char *scene, *path, *dir;
     int w, h, aerial, refine;
+    int no_adapt;              /* --no-adapt: each frame's exposure from its own image alone */
     double refine_height;
     long refine_frames;
     long max_frames;
@@ -109,6 +114,7 @@ static int parse_args(int argc, char **argv, walk_args *a)
         CLI_OPT_VAL("--refine-frames", &a->refine_frames, parse_refine_frames,
                     "--refine-frames '%s' is not a whole number >= 0"),
         CLI_OPT_VAL("--max-frames", &a->max_frames, parse_max_frames, "--max-frames '%s' is not a whole number >= 1"),
+        CLI_OPT_FLAG("--no-adapt", &a->no_adapt),
         CLI_OPT_VAL("--texel", &a->opts.aerial_m_per_texel, parse_texel,
                     "--texel '%s' is not a number of metres from 0.01 to 1e4"),
         CLI_OPT_MORE(v.frag),
@@ -129,7 +135,8 @@ static int parse_args(int argc, char **argv, walk_args *a)
     a->w = (int)v.size[0];
     a->h = (int)v.size[1];
     a->fov = v.fov;
-    cli_view_apply(&v, &a->ind, &a->opts);
+    if ((rc = cli_view_apply("walk", &v, &a->ind, &a->opts)) != EXIT_OK)
+        return rc;
     a->aerial = v.aerial;
     a->refine = v.refine;
     a->refine_height = v.refine_height;
@@ -305,6 +312,7 @@ typedef struct walk_run {
     double inside_eye[3];      /* the first one's eye */
     double bounds[4];          /* the scene's (plx_scene_info), taken once */
     int lonlat;                /* a lon/lat scene: cameras.txt in degrees */
+    double held;               /* the last frame's exposure (automatic exposure, held near it) */
     double near_scene;         /* the least distance of an eye or target from bounds, m (0: inside) */
 } walk_run;
 
@@ -420,6 +428,7 @@ static int frame(const walk_args *a, plx_engine *e, const walk_path *wp, walk_ru
 {
     plx_camera cam;
     plx_render_info info;
+    plx_render_opts o;
     unsigned long long t0;
     plx_status st;
     memset(&cam, 0, sizeof cam);
@@ -442,8 +451,13 @@ static int frame(const walk_args *a, plx_engine *e, const walk_path *wp, walk_ru
     }
     if (wr->writer) /* the other buffer: the writer may still read the last frame */
         wr->rgb8 = wr->buf[k & 1];
+    o = a->opts;
+    if (o.auto_exposure == PLX_EXPOSURE_AUTO && !a->no_adapt && k > 0) { /* held from the last frame */
+        o.auto_exposure = PLX_EXPOSURE_ADAPT;
+        o.exposure = wr->held;
+    }
     t0 = port_now_ns();
-    st = plx_render(e, &cam, &a->opts, wr->rgb8, NULL, &info);
+    st = plx_render(e, &cam, &o, wr->rgb8, NULL, &info);
     wr->ms[k] = (port_now_ns() - t0) / 1e6;
     wr->lookups += info.indirect_lookups;
     wr->aa_later += info.aa_later;
@@ -451,6 +465,7 @@ static int frame(const walk_args *a, plx_engine *e, const walk_path *wp, walk_ru
         wr->aa_adaptive += info.aa_adaptive == PLX_AA_ADAPTIVE;
         wr->aa_dense += info.aa_adaptive == PLX_AA_DENSE;
     }
+    wr->held = info.exposure;
     if (st == PLX_OK && k == 0) {
         cli_aa_warn("walk", &a->c, &a->opts, &info);
         if (cams_open(a, wr) != 0)
@@ -479,7 +494,7 @@ static int frame(const walk_args *a, plx_engine *e, const walk_path *wp, walk_ru
         double ex = cam.eye[0], ey = cam.eye[1], tx = cam.target[0], ty = cam.target[1];
         cli_from_local(e, &ex, &ey);
         cli_from_local(e, &tx, &ty);
-        fprintf(wr->cams, "%ld %.17g %.17g %.17g %.17g %.17g %.17g %.6g\n", k + 1, ex, ey, cam.eye[2], tx, ty,
+        fprintf(wr->cams, "%ld %.17g %.17g %.17g %.17g %.17g %.17g %.17g\n", k + 1, ex, ey, cam.eye[2], tx, ty,
                 cam.target[2], info.exposure);
     }
     if (k == 0)

@@ -357,9 +357,9 @@ const char *cli_black_reason(plx_engine *e, const plx_camera *cam, const plx_ren
 {
     plx_render_opts ao = *o;
     plx_render_info info;
-    if (o->auto_exposure || !rgb8)
+    if (o->auto_exposure == PLX_EXPOSURE_AUTO || o->auto_exposure == PLX_EXPOSURE_ADAPT || !rgb8)
         return cli_dark_reason(e);
-    ao.auto_exposure = 1;
+    ao.auto_exposure = PLX_EXPOSURE_AUTO;
     if (plx_render(e, cam, &ao, rgb8, NULL, &info) != PLX_OK ||
         cli_all_black(rgb8, (size_t)cam->width * cam->height * 3))
         return cli_dark_reason(e);

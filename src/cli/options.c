@@ -167,6 +167,7 @@ static void view_opts(cli_view *v)
         CLI_OPT_VAL("--refine-height", v, parse_refine_height,
                     "--refine-height '%s' is not a number of metres from 0 to 1e6"),
         CLI_OPT_FLAG("--per-pixel", &v->per_pixel),
+        CLI_OPT_FLAG("--tone-curve", &v->tone_curve),
         CLI_OPT_END
     };
     memcpy(v->frag, f, sizeof f);
@@ -188,7 +189,7 @@ void cli_view_init(cli_view *v, long w, long h, double fov, plx_render_opts *o, 
     view_opts(v);
 }
 
-void cli_view_apply(const cli_view *v, const cli_indirect *ind, plx_render_opts *o)
+int cli_view_apply(const char *cmd, const cli_view *v, const cli_indirect *ind, plx_render_opts *o)
 {
     o->aa = (int)v->aa;
     o->aa_full = v->aa_full;
@@ -196,6 +197,9 @@ void cli_view_apply(const cli_view *v, const cli_indirect *ind, plx_render_opts 
     o->aerial = v->aerial;
     o->per_pixel = v->per_pixel;
     if (v->exposure)
-        o->auto_exposure = 0;
+        o->auto_exposure = v->tone_curve ? PLX_EXPOSURE_TONE : PLX_EXPOSURE_FIXED;
     o->no_indirect = ind->off;
+    if (v->tone_curve && !v->exposure)
+        return cli_usage_error(cmd, "--tone-curve needs --exposure E (automatic exposure has the curve already)");
+    return EXIT_OK;
 }

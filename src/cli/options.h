@@ -70,7 +70,7 @@ int cli_opt_size(const char *value, void *dst);
 
 /* ---- the view options of render and walk ---------------------------------- */
 
-#define CLI_VIEW_NOPTS 10
+#define CLI_VIEW_NOPTS 11
 /* --refine-height's default, m: munoz2013 §3.3 refines only when the
  * camera is below a height; the near radius of the refinement. */
 #define CLI_REFINE_HEIGHT 60.0
@@ -87,6 +87,7 @@ typedef struct cli_view {
     int per_pixel;          /* --per-pixel: light computed at every pixel, not read from the atlas */
     int exposure;           /* --exposure was given (the command's own table
                              * entry sets it): no automatic exposure */
+    int tone_curve;         /* --tone-curve: the fixed exposure with the tone curve */
     cli_opt frag[CLI_VIEW_NOPTS]; /* the options above (the last entry
                              * CLI_OPT_END), for CLI_OPT_MORE(v.frag) */
 } cli_view;
@@ -98,7 +99,8 @@ typedef struct cli_view {
 void cli_view_init(cli_view *v, long w, long h, double fov, plx_render_opts *o, cli_indirect *ind);
 
 /* After parsing: the anti-aliasing, glow, view, exposure, --per-pixel and
- * --no-indirect into o. */
-void cli_view_apply(const cli_view *v, const cli_indirect *ind, plx_render_opts *o);
+ * --no-indirect into o; EXIT_USAGE, said, for --tone-curve without
+ * --exposure. */
+int cli_view_apply(const char *cmd, const cli_view *v, const cli_indirect *ind, plx_render_opts *o);
 
 #endif

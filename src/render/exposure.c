@@ -109,6 +109,18 @@ void exposure_count_every(const exposure_table *et, const float *lin, const uint
     }
 }
 
+/* exposure_from's exposure of bin b, and the bin of an exposure e > 0
+ * (the nearest: e need not be one of them). */
+static double exposure_of_bin(int b)
+{
+    return EXPOSURE_KEY / exp2(LOG_MIN + (b + 1) / PER_STOP);
+}
+
+static double bin_of_exposure(double e)
+{
+    return floor((log2(EXPOSURE_KEY / e) - LOG_MIN) * PER_STOP - 1.0 + 0.5);
+}
+
 double exposure_from(const uint32_t hist[EXPOSURE_BINS])
 {
     size_t n = 0, want, acc = 0;
@@ -126,7 +138,19 @@ double exposure_from(const uint32_t hist[EXPOSURE_BINS])
     if (b >= BINS)
         b = BINS - 1;
     /* the bin's upper edge, so the chosen pixel is at most the key */
-    return EXPOSURE_KEY / exp2(LOG_MIN + (b + 1) / PER_STOP);
+    return exposure_of_bin(b);
+}
+
+double exposure_hold(double held, double chosen)
+{
+    double bh, bc;
+    if (!(held > 0.0) || !isfinite(held))
+        return chosen;
+    bh = bin_of_exposure(held);
+    bc = bin_of_exposure(chosen);
+    if (fabs(bc - bh) <= EXPOSURE_HOLD)
+        return held;
+    return exposure_of_bin((int)(bc > bh ? bc - EXPOSURE_HOLD : bc + EXPOSURE_HOLD));
 }
 
 double exposure_auto(const float *lin, const uint32_t *id, size_t px)

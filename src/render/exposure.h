@@ -18,6 +18,14 @@ double exposure_auto(const float *lin, const uint32_t *id, size_t px);
  * it), and the exposure from the sum of the parts' counts. */
 void exposure_count(const float *lin, const uint32_t *id, size_t p0, size_t p1, uint32_t hist[EXPOSURE_BINS]);
 double exposure_from(const uint32_t hist[EXPOSURE_BINS]);
+/* A walk's exposure without flicker: the exposure chosen from the image,
+ * exposure_from's, held at the last frame's, held, while they are at
+ * most EXPOSURE_HOLD eighths of a stop apart (in exposure_from's steps,
+ * held read to the nearest step); else the step EXPOSURE_HOLD from chosen
+ * towards held. A frame drawn again with its own exposure as held keeps
+ * it (it is within the band), so the frame can be drawn again. */
+#define EXPOSURE_HOLD 4
+double exposure_hold(double held, double chosen);
 /* The tone curve: v (1 + v / W^2) / (1 + v), 0 for v <= 0 or NaN. */
 double exposure_curve(double v);
 

@@ -522,10 +522,12 @@ plx_status render_frame(render *r, const render_camera *cam, const render_opts *
 finish:
     /* the exposure from the lit surfaces, before the glows (counted by
      * the atlas's rows as they were read) */
-    if (o->atlas && o->auto_exposure)
-        st.exposure = exposure_sum(r);
+    if (o->auto_exposure == RENDER_EXPOSURE_FIXED || o->auto_exposure == RENDER_EXPOSURE_TONE)
+        st.exposure = o->exposure;
     else
-        st.exposure = o->auto_exposure ? exposure_par(r, o) : o->exposure;
+        st.exposure = o->atlas ? exposure_sum(r) : exposure_par(r, o);
+    if (o->auto_exposure == RENDER_EXPOSURE_ADAPT)
+        st.exposure = exposure_hold(o->exposure, st.exposure);
     if (!o->no_glow)
         glow_draw(r, o, &st);
     if (rgbf)

@@ -262,6 +262,10 @@ typedef void (*render_job_fn)(void *arg, int worker, uint32_t k);
 typedef int (*render_par_fn)(void *ctx, int workers, uint32_t njobs, render_job_fn job, void *arg);
 #define RENDER_MAX_WORKERS 16
 
+#define RENDER_EXPOSURE_FIXED 0   /* render_opts.auto_exposure (PLX_EXPOSURE_*) */
+#define RENDER_EXPOSURE_AUTO 1
+#define RENDER_EXPOSURE_ADAPT 2
+#define RENDER_EXPOSURE_TONE 3
 #define RENDER_SAMPLE_FIRST 1     /* render_opts.cull_samples */
 #define RENDER_SAMPLE_LATER 2
 
@@ -274,7 +278,9 @@ typedef struct render_opts {
     render_shade_fn indirect;  /* added to E_rgb when not NULL (photon hook) */
     void *indirect_user;
     const render_backend *backend;  /* pass 1; NULL: the built-in software rasteriser */
-    int auto_exposure;         /* 1: exposure from the image and the tone curve (exposure.h) */
+    int auto_exposure;         /* RENDER_EXPOSURE_*: 0 exposure, linear; 1 from the image, 2 from the
+                                  image held near exposure (exposure_hold), 3 exposure; 1 to 3
+                                  with the tone curve (exposure.h) */
     double shift[2];           /* the sample point of each pixel: its centre + shift (pixels,
                                   x right, y down; |shift| < 0.5); 0 0 is SPEC §5's centre */
     int cull_samples;          /* a frame of several sample points (anti-aliasing): RENDER_SAMPLE_FIRST

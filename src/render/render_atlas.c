@@ -108,7 +108,7 @@ int render_atlas_pass(render *r, const render_opts *o, render_stats *st)
     render_atlas_view(r, &jb.v);
     jb.r = r;
     jb.o = o;
-    jb.count = o->auto_exposure;
+    jb.count = o->auto_exposure == RENDER_EXPOSURE_AUTO || o->auto_exposure == RENDER_EXPOSURE_ADAPT;
     jb.again = 0;
     if (jb.count)
         memset(r->hist, 0, sizeof r->hist);

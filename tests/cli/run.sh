@@ -332,8 +332,22 @@ if /usr/bin/python3 tests/cli/png_same.py "$tmp/w1/frame-0002.png" "$tmp/w1r.png
 printf '{"type":"LineString","coordinates":[[133,300],[133,700]]}' >"$tmp/e8path.geojson"
 "$bin" walk -q "$tmp/e8.geojson" --path "$tmp/e8path.geojson" --size 160x120 --fps 0.05 --max-frames 2 -o "$tmp/we8" >/dev/null 2>&1
 set -- $(sed -n '3p' "$tmp/we8/cameras.txt")
-"$bin" render -q "$tmp/e8.geojson" --size 160x120 --aa 2 --eye "$2,$3,$4" --target "$5,$6,$7" -o "$tmp/we8r.png" >/dev/null 2>&1
+"$bin" render -q "$tmp/e8.geojson" --size 160x120 --aa 2 --eye "$2,$3,$4" --target "$5,$6,$7" --exposure "$8" --tone-curve -o "$tmp/we8r.png" >/dev/null 2>&1
 if /usr/bin/python3 tests/cli/png_same.py "$tmp/we8/frame-0002.png" "$tmp/we8r.png"; then echo "ok   walk-scene-equals-render"; pass=$((pass + 1)); else echo "FAIL walk-scene-equals-render"; fail=$((fail + 1)); fi
+# a walk's automatic exposure holds while each frame's own choice stays
+# within half a stop: frame to frame it flipped by an eighth of a stop and
+# back (17 changes in these 120 frames; --no-adapt keeps that)
+changes() { awk 'NR>2 && $8!=p{c++} NR>1{p=$8} END{print c+0}' "$1"; }
+"$bin" walk -q "$tmp/e8.geojson" --path "$tmp/e8path.geojson" --size 80x60 --max-frames 120 --aa 1 -o "$tmp/wad" >/dev/null 2>&1
+"$bin" walk -q "$tmp/e8.geojson" --path "$tmp/e8path.geojson" --size 80x60 --max-frames 120 --aa 1 --no-adapt -o "$tmp/wnad" >/dev/null 2>&1
+ca=$(changes "$tmp/wad/cameras.txt"); cn=$(changes "$tmp/wnad/cameras.txt")
+if [ "$ca" -le 2 ] && [ "$cn" -ge 10 ]; then echo "ok   walk-exposure-holds ($ca changes, $cn without)"; pass=$((pass + 1))
+else echo "FAIL walk-exposure-holds: $ca exposure changes held, $cn with --no-adapt"; fail=$((fail + 1)); fi
+# a held frame drawn again: render --exposure E --tone-curve at its camera
+set -- $(sed -n '101p' "$tmp/wad/cameras.txt")
+"$bin" render -q "$tmp/e8.geojson" --size 80x60 --eye "$2,$3,$4" --target "$5,$6,$7" --exposure "$8" --tone-curve -o "$tmp/wadr.png" >/dev/null 2>&1
+if /usr/bin/python3 tests/cli/png_same.py "$tmp/wad/frame-0100.png" "$tmp/wadr.png"; then echo "ok   walk-held-equals-render-tone-curve"; pass=$((pass + 1)); else echo "FAIL walk-held-equals-render-tone-curve"; fail=$((fail + 1)); fi
+expect render-tone-curve-needs-exposure 2 "^polarlux render: --tone-curve needs --exposure E" -- "$bin" render "$tmp/e.plxb" --tone-curve -o "$tmp/x.png"
 # on a lon/lat scene cameras.txt is in lon/lat (it was local metres, which
 # render refuses there): a frame's camera fed back to render gives the frame
 expect walk-lonlat-cameras 0 "^# frame eye_lon eye_lat eye_z target_lon target_lat target_z exposure" -- \

@@ -196,6 +196,18 @@ static void test_refusals(void **state)
     assert_non_null(strstr(plx_last_error(e), "exposure must be a finite number above 0"));
     o.exposure = -1.0;
     assert_int_equal(plx_render(e, &out, &o, rgb, NULL, NULL), PLX_E_INVALID);
+    o.auto_exposure = PLX_EXPOSURE_ADAPT; /* held from exposure: it must be one */
+    assert_int_equal(plx_render(e, &out, &o, rgb, NULL, NULL), PLX_E_INVALID);
+    o.auto_exposure = PLX_EXPOSURE_TONE;
+    assert_int_equal(plx_render(e, &out, &o, rgb, NULL, NULL), PLX_E_INVALID);
+    o.auto_exposure = 7;
+    o.exposure = 1.0;
+    assert_int_equal(plx_render(e, &out, &o, rgb, NULL, NULL), PLX_E_INVALID);
+    assert_non_null(strstr(plx_last_error(e), "auto_exposure must be PLX_EXPOSURE_FIXED, _AUTO, _ADAPT or _TONE"));
+    o.auto_exposure = PLX_EXPOSURE_TONE; /* applied as given */
+    assert_int_equal(plx_render(e, &out, &o, rgb, NULL, &info), PLX_OK);
+    assert_true(info.exposure == 1.0);
+    o.exposure = -1.0;
     o.auto_exposure = 1; /* the fixed exposure is not read */
     assert_int_equal(plx_render(e, &out, &o, rgb, NULL, &info), PLX_OK);
     assert_int_equal(info.eye_inside, 0);

@@ -1856,6 +1856,34 @@ static void test_exposure_parts(void **state)
 }
 
 
+/* A walk's held exposure (exposure_hold), on every pair of exposure_from's
+ * exposures 2^(32 - (b + 1) / 8), b in 0 .. 511, written here from the
+ * formula: within half a stop (4 eighths) of the image's own choice the
+ * held one stays, bit for bit; farther, it moves to half a stop from the
+ * choice, on the held one's side; and a frame drawn again with its own
+ * exposure as the held one keeps it (walk frames drawn again by render).
+ * A held exposure off the steps counts as its nearest step. */
+static void test_exposure_hold(void **state)
+{
+    int bh, bc;
+    (void)state;
+    for (bh = 0; bh < EXPOSURE_BINS; bh += 3)
+        for (bc = 0; bc < EXPOSURE_BINS; bc++) {
+            double h = exp2(32.0 - (bh + 1) / 8.0), c = exp2(32.0 - (bc + 1) / 8.0), a = exposure_hold(h, c);
+            if (abs(bc - bh) <= EXPOSURE_HOLD) {
+                assert_true(a == h);
+            } else {
+                double stops = log2(a / c);
+                assert_true(fabs(fabs(stops) - 0.5) < 1e-9);
+                assert_true((a - c) * (h - c) > 0.0); /* on the held one's side */
+            }
+            assert_true(exposure_hold(a, c) == a);
+            assert_true(exposure_hold(h * 1.01, c) == (abs(bc - bh) <= EXPOSURE_HOLD ? h * 1.01 : a));
+        }
+    assert_true(exposure_hold(0.0, 0.25) == 0.25); /* nothing held: the choice */
+    assert_true(exposure_hold(NAN, 0.25) == 0.25);
+}
+
 /* The exposure's table of bin thresholds gives exposure_bin's bin for
  * every luminance tried (exposure_table_bin): 2,000 doubles each side of
  * every threshold, a million spread log-uniformly over 2^-45 .. 2^45
@@ -1951,6 +1979,7 @@ int main(void)
         cmocka_unit_test(test_eye_inside_solid),
         cmocka_unit_test(test_fault_injection),
         cmocka_unit_test(test_exposure_parts),
+        cmocka_unit_test(test_exposure_hold),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
