@@ -731,6 +731,9 @@ typedef struct plx_render_opts {
 #define PLX_EXPOSURE_AUTO 1
 #define PLX_EXPOSURE_ADAPT 2
 #define PLX_EXPOSURE_TONE 3
+/* The largest exposure automatic exposure chooses: a frame whose lit
+ * surfaces are all darker than about 0.001 cd/m^2 stays dark */
+#define PLX_EXPOSURE_MAX 1024.0
 
 #define PLX_RENDER_MAX_AA 16
 #define PLX_RENDER_MAX_DIM 16384   /* the largest frame width or height */

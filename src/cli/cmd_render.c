@@ -431,7 +431,7 @@ int cmd_render(int argc, char **argv)
     if (rc == EXIT_OK && cli_all_black(rgb8, (size_t)a.cam.width * a.cam.height * 3)) {
         char why[200]; /* rgb8 is written out: cli_black_reason may draw into it */
         cli_warn("render", &a.c, "the image is entirely black: %s",
-                 cli_black_reason(e, &a.cam, &a.opts, rgb8, why, sizeof why));
+                 cli_black_reason(e, &a.cam, &a.opts, info.exposure, rgb8, why, sizeof why));
     }
     prec = coord_digits(e);
     cli_from_local(e, &a.cam.eye[0], &a.cam.eye[1]);
@@ -447,6 +447,10 @@ int cmd_render(int argc, char **argv)
         cli_aa_print(&a.opts, info.aa_later, (double)a.cam.width * a.cam.height, 1,
                      info.aa_adaptive == PLX_AA_ADAPTIVE, info.aa_adaptive == PLX_AA_DENSE);
     }
+    if (rc == EXIT_OK && a.opts.auto_exposure == PLX_EXPOSURE_AUTO && info.exposure == PLX_EXPOSURE_MAX &&
+        !cli_all_black(rgb8, (size_t)a.cam.width * a.cam.height * 3))
+        cli_warn("render", &a.c, "the view is dark: its lit surfaces are under about 0.001 cd/m^2, where automatic "
+                 "exposure stops (at %g; --exposure E brightens it)", PLX_EXPOSURE_MAX);
     if (rc == EXIT_OK && a.opts.auto_exposure == PLX_EXPOSURE_AUTO)
         printf("exposure: %.4g (automatic: a high percentile of the lit surfaces' luminance near white, "
                "tone curve; --exposure 1 for SPEC §5's linear image)\n", info.exposure);

@@ -307,7 +307,8 @@ typedef struct walk_run {
     int writer;                /* 1: frames written on the writer's thread */
     long black, first_black;   /* frames entirely black, the eye outside buildings: how many,
                                   the first (1-based) */
-    plx_camera black_cam;      /* the first one's camera */
+    plx_camera black_cam;      /* the first one's camera and exposure */
+    double black_exposure;
     long inside, first_inside; /* frames with the eye inside a building: how many, the first */
     double inside_eye[3];      /* the first one's eye */
     double bounds[4];          /* the scene's (plx_scene_info), taken once */
@@ -483,6 +484,7 @@ static int frame(const walk_args *a, plx_engine *e, const walk_path *wp, walk_ru
     if (!info.eye_inside && cli_all_black(wr->rgb8, (size_t)a->w * a->h * 3) && wr->black++ == 0) {
         wr->first_black = k + 1;
         wr->black_cam = cam;
+        wr->black_exposure = info.exposure;
     }
     if (info.eye_inside && wr->inside++ == 0) {
         wr->first_inside = k + 1;
@@ -676,10 +678,11 @@ static int run(const walk_args *a, plx_engine *e, const walk_path *wp, long *don
                      "path in the scene's coordinates?", wr.near_scene);
         else if (wr.black == wr.n)
             cli_warn("walk", &a->c, "every frame is entirely black: %s",
-                     cli_black_reason(e, &wr.black_cam, &a->opts, wr.rgb8, why, sizeof why));
+                     cli_black_reason(e, &wr.black_cam, &a->opts, wr.black_exposure, wr.rgb8, why, sizeof why));
         else if (wr.black)
             cli_warn("walk", &a->c, "%ld of %ld frames are entirely black (the first: frame %ld): %s", wr.black,
-                     wr.n, wr.first_black, cli_black_reason(e, &wr.black_cam, &a->opts, wr.rgb8, why, sizeof why));
+                     wr.n, wr.first_black,
+                     cli_black_reason(e, &wr.black_cam, &a->opts, wr.black_exposure, wr.rgb8, why, sizeof why));
     }
     if (wr.cams)
         fclose(wr.cams);

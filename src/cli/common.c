@@ -352,12 +352,18 @@ const char *cli_dark_reason(plx_engine *e)
     return "no lamp's light reaches it (each lamp lights only within its radius, and buildings cast shadows)";
 }
 
-const char *cli_black_reason(plx_engine *e, const plx_camera *cam, const plx_render_opts *o, unsigned char *rgb8,
-                             char *buf, size_t len)
+const char *cli_black_reason(plx_engine *e, const plx_camera *cam, const plx_render_opts *o, double applied,
+                             unsigned char *rgb8, char *buf, size_t len)
 {
     plx_render_opts ao = *o;
     plx_render_info info;
-    if (o->auto_exposure == PLX_EXPOSURE_AUTO || o->auto_exposure == PLX_EXPOSURE_ADAPT || !rgb8)
+    int chosen = o->auto_exposure == PLX_EXPOSURE_AUTO || o->auto_exposure == PLX_EXPOSURE_ADAPT;
+    if (chosen && applied == PLX_EXPOSURE_MAX) { /* only lit surfaces make the cap */
+        snprintf(buf, len, "its light is under about 0.001 cd/m^2, where automatic exposure stops (at %g; "
+                 "--exposure E brightens it)", PLX_EXPOSURE_MAX);
+        return buf;
+    }
+    if (chosen || !rgb8)
         return cli_dark_reason(e);
     ao.auto_exposure = PLX_EXPOSURE_AUTO;
     if (plx_render(e, cam, &ao, rgb8, NULL, &info) != PLX_OK ||

@@ -137,6 +137,8 @@ double exposure_from(const uint32_t hist[EXPOSURE_BINS])
     }
     if (b >= BINS)
         b = BINS - 1;
+    if (b < EXPOSURE_MAX_BIN) /* at most EXPOSURE_MAX */
+        b = EXPOSURE_MAX_BIN;
     /* the bin's upper edge, so the chosen pixel is at most the key */
     return exposure_of_bin(b);
 }

@@ -11,6 +11,12 @@
 #define EXPOSURE_SKY 0u          /* the id of sky pixels (MESH_SURF_NONE) */
 
 #define EXPOSURE_BINS 512        /* log2 Y from -32 to +32 in eighth stops */
+/* The largest automatic exposure, 1024: a frame whose lit surfaces are
+ * all darker than about 0.001 cd/m^2 is shown dark, as it is (the
+ * percentile of such a frame is photon noise: a courtyard's 1e-7 cd/m^2
+ * was exposed 7e6 times to white). The bin whose upper edge is 2^-10. */
+#define EXPOSURE_MAX 1024.0
+#define EXPOSURE_MAX_BIN 175
 
 /* The exposure for px pixels of linear RGB lin with surface ids id. */
 double exposure_auto(const float *lin, const uint32_t *id, size_t px);

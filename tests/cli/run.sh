@@ -347,6 +347,15 @@ else echo "FAIL walk-exposure-holds: $ca exposure changes held, $cn with --no-ad
 set -- $(sed -n '101p' "$tmp/wad/cameras.txt")
 "$bin" render -q "$tmp/e8.geojson" --size 80x60 --eye "$2,$3,$4" --target "$5,$6,$7" --exposure "$8" --tone-curve -o "$tmp/wadr.png" >/dev/null 2>&1
 if /usr/bin/python3 tests/cli/png_same.py "$tmp/wad/frame-0100.png" "$tmp/wadr.png"; then echo "ok   walk-held-equals-render-tone-curve"; pass=$((pass + 1)); else echo "FAIL walk-held-equals-render-tone-curve"; fail=$((fail + 1)); fi
+# a view darker than about 0.001 cd/m^2 at its percentile stays dark: the
+# exposure stops at 1024 and render says so (a courtyard's photon noise
+# was exposed 7e6 times to white); here a view of a wall far from any lamp
+printf '{"type":"FeatureCollection","properties":{"units":"m"},"features":[{"type":"Feature","properties":{"height":10},"geometry":{"type":"Polygon","coordinates":[[[0,0],[10,0],[10,10],[0,10],[0,0]]]}},{"type":"Feature","properties":{"lamp":true,"z":5,"intensity":1e-5,"radius":30},"geometry":{"type":"Point","coordinates":[5,-5]}}]}' >"$tmp/faint.geojson"
+expect render-black-capped 0 "the image is entirely black: its light is under about 0.001 cd/m\^2, where automatic exposure stops \(at 1024" -- \
+    "$bin" render "$tmp/faint.geojson" --no-indirect --size 64x48 --eye 5,-20,1.7 --target 5,0,3 -o "$tmp/xdark.png"
+sed 's/"intensity":1e-5/"intensity":0.01/' "$tmp/faint.geojson" >"$tmp/faint2.geojson"
+expect render-dark-capped 0 "the view is dark: its lit surfaces are under about 0.001 cd/m\^2, where automatic exposure stops \(at 1024" -- \
+    "$bin" render "$tmp/faint2.geojson" --no-indirect --size 64x48 --eye 5,-20,1.7 --target 5,0,3 -o "$tmp/xdark2.png"
 expect render-tone-curve-needs-exposure 2 "^polarlux render: --tone-curve needs --exposure E" -- "$bin" render "$tmp/e.plxb" --tone-curve -o "$tmp/x.png"
 # on a lon/lat scene cameras.txt is in lon/lat (it was local metres, which
 # render refuses there): a frame's camera fed back to render gives the frame

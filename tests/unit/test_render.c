@@ -1880,6 +1880,21 @@ static void test_exposure_hold(void **state)
             assert_true(exposure_hold(a, c) == a);
             assert_true(exposure_hold(h * 1.01, c) == (abs(bc - bh) <= EXPOSURE_HOLD ? h * 1.01 : a));
         }
+    {
+        /* the cap: a frame darker than 2^-10 (about 0.001 cd/m^2) at its
+         * percentile is exposed at most EXPOSURE_MAX; just above, less */
+        uint32_t hist[EXPOSURE_BINS];
+        memset(hist, 0, sizeof hist);
+        hist[0] = 10;
+        assert_true(exposure_from(hist) == EXPOSURE_MAX && EXPOSURE_MAX == PLX_EXPOSURE_MAX);
+        hist[0] = 0;
+        hist[EXPOSURE_MAX_BIN] = 10;
+        assert_true(exposure_from(hist) == EXPOSURE_MAX);
+        hist[EXPOSURE_MAX_BIN] = 0;
+        hist[EXPOSURE_MAX_BIN + 1] = 10;
+        assert_true(exposure_from(hist) == EXPOSURE_MAX * exp2(-0.125));
+        assert_true(exposure_bin(1.0 / EXPOSURE_MAX) == EXPOSURE_MAX_BIN + 1);
+    }
     assert_true(exposure_hold(0.0, 0.25) == 0.25); /* nothing held: the choice */
     assert_true(exposure_hold(NAN, 0.25) == 0.25);
 }
