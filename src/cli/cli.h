@@ -124,6 +124,11 @@ int cli_indirect_option(const char *cmd, int argc, char **argv, int *i, cli_indi
  * for them beside a frame. Sets ind->off with a warning and returns 1
  * then; 0 otherwise (not a bake, photons traced, or indirect light off). */
 int cli_bake_direct(const char *cmd, const char *path, const cli_common *c, plx_engine *e, cli_indirect *ind);
+/* A word on stderr for options a loaded bake makes moot: --photons and
+ * --frames (its photon buffers are used), --texel (texel > 0) when it
+ * holds the radiance atlas. Nothing for a scene. */
+void cli_bake_kept(const char *cmd, const char *path, const cli_common *c, plx_engine *e, const cli_indirect *ind,
+                   double texel);
 /* A line on stderr when the photon buffers were fitted below the default quality. */
 void cli_indirect_note(const char *cmd, plx_engine *e);
 int cli_indirect_run(const char *cmd, plx_engine *e, const cli_indirect *ind, const double *eye,

@@ -46,7 +46,7 @@ static const char help[] =
     "  --max-size WxH  the largest frame the loaded engine renders (default 1024x768)\n"
     "  --threads N     threads for filling the atlas (default: the number of\n"
     "                  processors); the same file for any N\n"
-    "  --mem SIZE, --strict, --quiet   as for 'polarlux info'\n"
+    "  --mem SIZE, --strict, --quiet, --lamps FILE   as for 'polarlux info'\n"
     "\n"
     "Exit codes: 0 written, 1 the scene or the file failed, 2 usage, 3 --mem too small.\n";
 
@@ -278,8 +278,13 @@ int cmd_bake(int argc, char **argv)
         printf("baked %s into %s: %zu bytes (%.1f MiB); engine memory in use %zu bytes (%.1f MiB)\n", a.scene,
                a.out, bytes, bytes / 1048576.0, m.used_total, m.used_total / 1048576.0);
         cli_atlas_print(e);
-        printf("times: load and build %.0f ms, photons %.0f ms (%ld x %ld), %s %.0f ms, total %.2f s\n",
-               (t1 - t0) / 1e6, (t2 - t1) / 1e6, a.ind.off ? 0L : a.ind.frames, cli_photons(e, &a.ind),
+        char ph[96];
+        if (a.ind.off || a.ind.frames == 0)
+            snprintf(ph, sizeof ph, "no photons (%s)", a.ind.off ? "--no-indirect" : "--frames 0");
+        else
+            snprintf(ph, sizeof ph, "photons %.0f ms (%ld x %ld)", (t2 - t1) / 1e6, a.ind.frames,
+                     cli_photons(e, &a.ind));
+        printf("times: load and build %.0f ms, %s, %s %.0f ms, total %.2f s\n", (t1 - t0) / 1e6, ph,
                atlas_made(e) ? "radiance atlas, twin and save" : "twin and save", (port_now_ns() - t2) / 1e6,
                (port_now_ns() - t0) / 1e9);
     }

@@ -46,7 +46,7 @@ static const char route_help[] =
     "  --geojson OUT    write both routes as LineStrings (properties route,\n"
     "                   length_m, dark_m, min_lux, mean_lux, min_ev_lux,\n"
     "                   min_sc_lux, class, class_h, ...)\n"
-    "  --mem SIZE, --strict, --quiet   as for 'polarlux info'\n";
+    "  --mem SIZE, --strict, --quiet, --lamps FILE   as for 'polarlux info'\n";
 
 static const char annotate_help[] =
     "usage: polarlux annotate SCENE --network STREETS -o OUT.geojson [--csv OUT.csv]\n"
@@ -71,7 +71,7 @@ static const char annotate_help[] =
     "  --csv OUT        the per-way CSV\n"
     "  --dark-lux LX, --dark-weight W, --step M, --height M   as for 'polarlux\n"
     "                   route --network'\n"
-    "  --mem SIZE, --strict, --quiet   as for 'polarlux info'\n";
+    "  --mem SIZE, --strict, --quiet, --lamps FILE   as for 'polarlux info'\n";
 
 typedef struct net_opts {
     const char *cmd, *scene, *network, *geojson, *out, *csv, *from_s, *to_s;

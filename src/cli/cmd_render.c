@@ -346,6 +346,7 @@ int cmd_render(int argc, char **argv)
         return rc;
     if (cli_bake_direct("render", a.scene, &a.c, e, &a.ind))
         a.opts.no_indirect = 1;
+    cli_bake_kept("render", a.scene, &a.c, e, &a.ind, a.opts.aerial_m_per_texel);
     if (a.have_eye && (cli_option_local("render", "--eye", e, &a.cam.eye[0], &a.cam.eye[1]) != 0 ||
                        cli_option_local("render", "--target", e, &a.cam.target[0], &a.cam.target[1]) != 0)) {
         plx_engine_free(e);

@@ -38,7 +38,7 @@ static const char help[] =
     "                 the quantity with its default resolution, the next power of\n"
     "                 ten above the brightest pixel)\n"
     "  -o OUT         folder or .mbtiles file (required)\n"
-    "  --mem SIZE, --strict, --quiet   as for 'polarlux info'\n";
+    "  --mem SIZE, --strict, --quiet, --lamps FILE   as for 'polarlux info'\n";
 
 typedef struct tiles_opts {
     const char *scene, *out;

@@ -64,7 +64,7 @@ static const char help[] =
     "                   the view hardly shows)\n"
     "  --threads N      threads for each frame (default: the number of processors);\n"
     "                   the same bytes for any N\n"
-    "  --mem SIZE, --strict, --quiet   as for 'polarlux info'\n";
+    "  --mem SIZE, --strict, --quiet, --lamps FILE   as for 'polarlux info'\n";
 
 typedef struct walk_args {
     const char *scene, *path, *dir;
@@ -602,8 +602,11 @@ static int run(const walk_args *a, plx_engine *e, const walk_path *wp, long *don
     steps = floor(L / step) + 1.0;
     wr.n = steps < (double)a->max_frames ? (long)steps : a->max_frames;
     if (steps > (double)a->max_frames)
-        cli_warn("walk", &a->c, "--max-frames %ld stops the walk at %.1f m of the path's %.1f m (%.0f frames "
+        cli_warn("walk", &a->c, "--max-frames %ld stops the walk at %.1f m of the path's %.1f m (%.4g frames "
                  "would walk it all)", a->max_frames, (wr.n - 1) * step, L, steps);
+    if (steps < 2.0 && L > 0.0)
+        cli_warn("walk", &a->c, "one step (--speed / --fps: %g m) is longer than the path (%.1f m): one frame, at "
+                 "its start", step, L);
     stale_hint(a, wr.n);
     sheet_plan(&wr.sh, a, wr.n);
     wr.ms = malloc(sizeof *wr.ms * (size_t)wr.n);
@@ -647,13 +650,15 @@ static int run(const walk_args *a, plx_engine *e, const walk_path *wp, long *don
         /* the middle frame, or the mean of the two middle ones */
         med = wr.n % 2 ? sorted[wr.n / 2] : 0.5 * (sorted[wr.n / 2 - 1] + sorted[wr.n / 2]);
         p95 = sorted[(size_t)ceil(0.95 * wr.n) - 1];
-        printf("walk: %ld frames %dx%d (%.1f m of %.1f m at %.2f m/s, %g fps, aa %d), written to %s/\n", wr.n, a->w,
-               a->h, (wr.n - 1) * step, L, a->speed, a->fps, a->opts.aa > 1 ? a->opts.aa : 1, a->dir);
+        printf("walk: %ld frame%s %dx%d (%.1f m of %.1f m at %g m/s, %g fps, aa %d), written to %s/\n", wr.n,
+               wr.n == 1 ? "" : "s", a->w, a->h, (wr.n - 1) * step, L, a->speed, a->fps,
+               a->opts.aa > 1 ? a->opts.aa : 1, a->dir);
         printf("frame time: median %.2f ms, p95 %.2f ms, mean %.2f ms: %.1f frames per second (rendering only)\n",
                med, p95, sum / wr.n, 1000.0 * wr.n / sum);
         if (wr.lookups)
-            printf("indirect light: %.0f lookups a frame on average, for %.0f samples\n",
-                   (double)wr.lookups / wr.n, (double)a->w * a->h * (a->opts.aa > 1 ? a->opts.aa * a->opts.aa : 1));
+            printf("indirect light: %.0f lookups a frame on average, for %.0f samples (the pixels' first and "
+                   "the later ones taken)\n", (double)wr.lookups / wr.n,
+                   (double)a->w * a->h + (double)wr.aa_later / wr.n);
         cli_aa_print(&a->opts, wr.aa_later, (double)a->w * a->h * wr.n, wr.n, wr.aa_adaptive, wr.aa_dense);
         if (a->refine && !a->ind.off)
             walk_refine_print(a, &wr);
@@ -737,6 +742,7 @@ int cmd_walk(int argc, char **argv)
     }
     if (cli_bake_direct("walk", a.scene, &a.c, e, &a.ind))
         a.opts.no_indirect = 1;
+    cli_bake_kept("walk", a.scene, &a.c, e, &a.ind, a.opts.aerial_m_per_texel);
     rc = cli_indirect_run("walk", e, &a.ind, NULL, NULL, a.fov);
     if (rc == EXIT_OK)
         rc = run(&a, e, &wp, &done);

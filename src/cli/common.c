@@ -39,6 +39,7 @@ size_t cli_parse_size(const char *s)
     case 'k': case 'K': v *= 1024.0; end++; break;
     case 'm': case 'M': v *= 1024.0 * 1024.0; end++; break;
     case 'g': case 'G': v *= 1024.0 * 1024.0 * 1024.0; end++; break;
+    case 't': case 'T': v *= 1024.0 * 1024.0 * 1024.0 * 1024.0; end++; break;
     default: break;
     }
     if (*end == 'B' || *end == 'b')
@@ -150,8 +151,8 @@ int cli_common_option(const char *cmd, int argc, char **argv, int *i, cli_common
         }
         c->mem = cli_parse_size(argv[++*i]);
         if (c->mem < PLX_ENGINE_MIN_BYTES) {
-            cli_usage_error(cmd, "--mem '%s' is not a size of at least %d bytes (e.g. 512M, 2G)",
-                            argv[*i], PLX_ENGINE_MIN_BYTES);
+            cli_usage_error(cmd, "--mem '%s' is not a size from %d bytes to 1e15 (a number with K, M, G or T, "
+                            "e.g. 512M, 2G)", argv[*i], PLX_ENGINE_MIN_BYTES);
             return -1;
         }
         return 1;
@@ -594,7 +595,8 @@ int cli_indirect_option(const char *cmd, int argc, char **argv, int *i, cli_indi
     }
     if (strcmp(a, "--photons") == 0 ? cli_parse_int(argv[++*i], 1, 100000000, &ind->photons)
                                     : cli_parse_int(argv[++*i], 0, 100000, &ind->frames)) {
-        cli_usage_error(cmd, "%s '%s' is not a whole number in range", a, argv[*i]);
+        cli_usage_error(cmd, "%s '%s' is not a whole number from %s", a, argv[*i],
+                        strcmp(a, "--photons") == 0 ? "1 to 100000000" : "0 to 100000");
         return -1;
     }
     ind->frames_given |= strcmp(a, "--frames") == 0;
@@ -611,6 +613,22 @@ int cli_bake_direct(const char *cmd, const char *path, const cli_common *c, plx_
     cli_warn(cmd, c, "%s holds no indirect light (baked with --no-indirect or --frames 0): its images show the "
              "direct light; bake the scene without those options for indirect light", path);
     return 1;
+}
+
+void cli_bake_kept(const char *cmd, const char *path, const cli_common *c, plx_engine *e, const cli_indirect *ind,
+                   double texel)
+{
+    plx_atlas_info ai;
+    if (!cli_bake_last.loaded)
+        return;
+    if (!ind->off && plx_indirect_frames(e) > 0 && (ind->photons_given || ind->frames_given))
+        cli_warn(cmd, c, "%s%s%s%s not used: %s holds its photon buffers (bake again to change them)",
+                 ind->photons_given ? "--photons" : "", ind->photons_given && ind->frames_given ? " and " : "",
+                 ind->frames_given ? "--frames" : "", ind->photons_given && ind->frames_given ? " are" : " is",
+                 path);
+    if (texel > 0.0 && plx_atlas_info_get(e, &ai) == PLX_OK && ai.made)
+        cli_warn(cmd, c, "--texel is not used: %s holds its radiance atlas, %.2f m between its points (bake again "
+                 "with --texel to change it)", path, ai.spacing);
 }
 
 /* A word on stderr when the photon buffers were made smaller than the

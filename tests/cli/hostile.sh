@@ -178,7 +178,7 @@ expect render-size-huge 2 "^polarlux render: --size '100000x100000' $U WxH \(1..
 expect render-size-overflow 2 "^polarlux render: --size '99999999999999999999x2' $U WxH" -- render $T --size 99999999999999999999x2 -o "$tmp/r.png"
 expect render-photons-frames 2 "^polarlux render: --photons 100000000 x --frames 100000 is more than 4294967296 photons" -- render -q $T --photons 100000000 --frames 100000 -o "$tmp/r.png"
 expect illum-photons-frames 2 "^polarlux illum: --photons 70000 x --frames 100000 is more than 4294967296 photons" -- illum -q $T --points "$tmp/p.txt" --photons 70000 --frames 100000
-expect illum-photons-huge 2 "^polarlux illum: --photons '1e9' $U a whole number in range" -- illum $T --points - --photons 1e9
+expect illum-photons-huge 2 "^polarlux illum: --photons '1e9' $U a whole number from 1 to 100000000" -- illum $T --points - --photons 1e9
 for at in 1e9,0 0,1e308 nan,0 0,inf 1,2,3 1; do
     expect "vis-at-$at" 2 "^polarlux vis: --at '$at' $U X,Y \(finite, within 1e7 m\)" -- vis $T --at $at
 done
