@@ -59,8 +59,7 @@ typedef struct bake_args {
 
 static int parse_texel(const char *v, void *dst)
 {
-    double *t = dst;
-    return cli_parse_double(v, t) != 0 || !(*t > 0) ? -1 : 0;
+    return cli_parse_real(v, 0.01, 1e4, dst); /* render's and walk's range */
 }
 
 static int parse_args(int argc, char **argv, bake_args *a)
@@ -71,7 +70,7 @@ static int parse_args(int argc, char **argv, bake_args *a)
         CLI_OPT_FLAG("--no-aerial", &no_aerial),
         CLI_OPT_FLAG("--no-polar", &a->o.no_polar),
         CLI_OPT_STR("-o", &a->out),
-        CLI_OPT_VAL("--texel", &a->o.aerial_m_per_texel, parse_texel, "--texel '%s' is not a positive number of metres"),
+        CLI_OPT_VAL("--texel", &a->o.aerial_m_per_texel, parse_texel, "--texel '%s' is not a number of metres from 0.01 to 1e4"),
         CLI_OPT_VAL("--max-size", size, cli_opt_size, "--max-size '%s' is not WxH (1..8192 each)"),
         CLI_OPT_END
     };

@@ -715,6 +715,8 @@ int cmd_walk(int argc, char **argv)
     int rc = parse_args(argc, argv, &a);
     if (rc != EXIT_OK)
         return rc < 0 ? EXIT_OK : rc;
+    if (strlen(a.dir) > 4000) /* its files' names are made in 4096 bytes */
+        return cli_usage_error("walk", "-o: the folder's path is longer than 4000 bytes");
     if (mkdir(a.dir, 0755) == 0) {
         made = 1; /* removed again if the walk fails before its first frame (rmdir: only when empty) */
     } else if (errno != EEXIST) {
