@@ -25,6 +25,8 @@ __all__ = ["Scene", "PolarluxError", "MemoryBudgetError", "memory_estimate", "sc
            "USE_VISIBILITY", "USE_LIGHT", "USE_RENDER"]
 
 USE_VISIBILITY, USE_LIGHT, USE_RENDER = _lib.USE_VISIBILITY, _lib.USE_LIGHT, _lib.USE_RENDER
+EXPOSURE_FIXED, EXPOSURE_AUTO, EXPOSURE_ADAPT, EXPOSURE_TONE = (_lib.EXPOSURE_FIXED, _lib.EXPOSURE_AUTO,
+                                                                 _lib.EXPOSURE_ADAPT, _lib.EXPOSURE_TONE)
 
 
 BAKE_MAGIC = b"PLXBAKE\0"  # a bake file's first 8 bytes (README "Bake files")
@@ -317,28 +319,39 @@ class Scene:
 
     # ---- images ---------------------------------------------------------------------
     def render(self, eye, target, fov_deg=60.0, size=(640, 480), exposure=1.0, aerial=False, glow=True,
-               linear=False, aa=1):
+               linear=False, aa=1, held=None, tone_curve=False):
         """A night image (SPEC §5) as an (H, W, 3) uint8 sRGB array; with
         linear=True also the (H, W, 3) float32 linear radiance: (rgb8, rgbf).
         exposure="auto": chosen from the image, with the tone curve (the
-        command's default; README "Automatic exposure"); aa=N: N x N samples
-        a pixel, adaptive (1: the pixel centre, SPEC §5). What plx_render
-        reported (the exposure applied, ...) is in .last_render."""
+        command's default; README "Automatic exposure"), and with held=E (the
+        last frame's exposure) held at E while the image's own choice stays
+        within half a stop, as walk's frames are; a number with
+        tone_curve=True: that exposure with the tone curve (a walk frame
+        again); aa=N: N x N samples a pixel, adaptive (1: the pixel centre,
+        SPEC §5). What plx_render reported (the exposure applied, ...) is in
+        .last_render."""
         w, h = int(size[0]), int(size[1])
         if not (isinstance(aa, numbers.Integral) and 1 <= aa <= 16):
             raise ValueError(f"aa must be a whole number from 1 to 16, not {aa!r}")
         if isinstance(exposure, str) and exposure != "auto":
             raise ValueError(f"exposure must be a number or 'auto', not {exposure!r}")
+        if held is not None and exposure != "auto":
+            raise ValueError("held needs exposure='auto' (it holds the automatic exposure)")
+        if tone_curve and exposure == "auto":
+            raise ValueError("tone_curve needs a number for exposure (automatic exposure has the curve)")
         cam = _lib.Camera()
         cam.eye[:] = [float(v) for v in eye]
         cam.target[:] = [float(v) for v in target]
         cam.fov_deg, cam.width, cam.height = float(fov_deg), w, h
         opts = _lib.padded(_lib.RenderOpts)
         lib.plx_render_opts_default(ctypes.byref(opts))
-        if exposure == "auto":
-            opts.auto_exposure = 1
+        if exposure == "auto" and held is not None:
+            opts.auto_exposure, opts.exposure = EXPOSURE_ADAPT, float(held)
+        elif exposure == "auto":
+            opts.auto_exposure = EXPOSURE_AUTO
         else:
             opts.exposure = float(exposure)
+            opts.auto_exposure = EXPOSURE_TONE if tone_curve else EXPOSURE_FIXED
         opts.aerial, opts.no_glow, opts.aa = int(bool(aerial)), int(not glow), int(aa)
         rgb8 = np.zeros((h, w, 3), dtype=np.uint8)
         rgbf = np.zeros((h, w, 3), dtype=np.float32) if linear else None

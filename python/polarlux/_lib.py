@@ -22,6 +22,8 @@ STATUS_NAMES = ["PLX_OK", "PLX_E_INVALID", "PLX_E_NOMEM", "PLX_E_IO", "PLX_E_PAR
                 "PLX_E_NOSCENE", "PLX_E_RANGE", "PLX_E_UNSUPPORTED"]
 
 USE_VISIBILITY, USE_LIGHT, USE_RENDER = 1, 2, 4
+# plx_render_opts.auto_exposure (PLX_EXPOSURE_* in polarlux.h; test_polarlux checks them)
+EXPOSURE_FIXED, EXPOSURE_AUTO, EXPOSURE_ADAPT, EXPOSURE_TONE = 0, 1, 2, 3
 
 LOG_FN = ctypes.CFUNCTYPE(None, ctypes.c_void_p, ctypes.c_int, ctypes.c_char_p)
 

@@ -147,6 +147,41 @@ def test_render_matches_the_command(tmp_path):
     assert np.array_equal(read_pfm(tmp_path / "r.pfm"), lin)
 
 
+def test_walk_frames_from_python(tmp_path):
+    """A walk's frames drawn again: each frame's automatic exposure held at
+    the last one's (held=, what walk does), and a frame at its cameras.txt
+    exposure with the tone curve (tone_curve=True), byte for byte; the
+    constants are the header's."""
+    header = open(os.path.join(ROOT, "include", "polarlux.h")).read()
+    for name in ("FIXED", "AUTO", "ADAPT", "TONE"):
+        value = int(header.split(f"#define PLX_EXPOSURE_{name} ")[1].split()[0])
+        assert getattr(polarlux._lib, f"EXPOSURE_{name}") == value
+    bake = bake_fixture(tmp_path)
+    path = tmp_path / "p.geojson"
+    path.write_text('{"type":"Feature","properties":{"units":"m"},"geometry":{"type":"LineString",'
+                    '"coordinates":[[298.6,265.5,1.7],[270,294,1.7],[262,330]]}}')
+    rc, _, err = run_cli("walk", "-q", str(bake), "--path", str(path), "--size", "96x64", "--fps", "0.1",
+                         "-o", str(tmp_path / "w"))
+    assert rc == 0, err
+    cams = [ln.split() for ln in open(tmp_path / "w" / "cameras.txt") if not ln.startswith("#")]
+    assert len(cams) >= 3
+    s = polarlux.Scene.from_bake(bake)
+    held = None
+    for k, c in enumerate(cams):
+        eye, target, ex = [float(v) for v in c[1:4]], [float(v) for v in c[4:7]], float(c[7])
+        img = s.render(eye, target, size=(96, 64), exposure="auto", aa=2, held=held)
+        assert s.last_render["exposure"] == ex
+        w8, h8, bpp, rows = decode_png(tmp_path / "w" / f"frame-{k + 1:04d}.png")
+        assert b"".join(bytes(r) for r in rows) == img.tobytes()
+        again = s.render(eye, target, size=(96, 64), exposure=ex, tone_curve=True, aa=2)
+        assert np.array_equal(again, img)
+        held = ex
+    with pytest.raises(ValueError):
+        s.render(cams[0][1:4], cams[0][4:7], exposure=0.5, held=0.5)
+    with pytest.raises(ValueError):
+        s.render(cams[0][1:4], cams[0][4:7], exposure="auto", tone_curve=True)
+
+
 def bake_fixture(tmp_path, *extra):
     out = tmp_path / "e.plxb"
     rc, _, err = run_cli("bake", "-q", EIXAMPLE, "--frames", "2", "--photons", "4000", "--texel", "2",
