@@ -711,7 +711,8 @@ typedef struct plx_render_opts {
                                    ignored. PLX_EXPOSURE_ADAPT: chosen so, but held at exposure
                                    (the last frame's) while the image's own choice stays within
                                    half a stop of it, else moved to half a stop from that choice
-                                   (frames of a walk without flicker). PLX_EXPOSURE_TONE: exposure
+                                   (frames of a walk without flicker; kept when no lit surface
+                                   is counted; at most PLX_EXPOSURE_MAX). PLX_EXPOSURE_TONE: exposure
                                    with the tone curve. PLX_EXPOSURE_FIXED (0): exposure, linear
                                    (SPEC §5). rgbf stays linear radiance. README "Automatic
                                    exposure" */
@@ -801,8 +802,11 @@ typedef struct plx_render_info {
  * Errors: PLX_E_INVALID (cam NULL; eye or target not finite; eye not above
  * the ground, z <= 0; eye == target; fov_deg outside (0, 180); width or
  * height outside 1 .. the engine's largest frame, render_max_width/height
- * or the bake's; o->exposure not a finite number above 0, or with
- * auto_exposure not finite; o->aa outside 0 .. PLX_RENDER_MAX_AA),
+ * or the bake's; o->auto_exposure not one of PLX_EXPOSURE_FIXED, _AUTO,
+ * _ADAPT, _TONE (before 2026-11-30 any nonzero value meant _AUTO; 2 and 3
+ * now hold or fix the exposure); o->exposure not a finite number above 0
+ * unless auto_exposure is PLX_EXPOSURE_AUTO; o->aa outside 0 ..
+ * PLX_RENDER_MAX_AA),
  * PLX_E_NOSCENE, PLX_E_NOMEM, PLX_E_UNSUPPORTED (o->backend could not draw
  * the frame); after an error the buffers' contents are unspecified (an
  * anti-aliased frame may have written its first sample). Lifetime: the

@@ -137,6 +137,8 @@ static int parse_args(int argc, char **argv, walk_args *a)
     a->fov = v.fov;
     if ((rc = cli_view_apply("walk", &v, &a->ind, &a->opts)) != EXIT_OK)
         return rc;
+    if (a->no_adapt && v.exposure)
+        cli_warn("walk", &a->c, "--no-adapt has no effect with --exposure (a fixed exposure does not adapt)");
     a->aerial = v.aerial;
     a->refine = v.refine;
     a->refine_height = v.refine_height;
@@ -750,7 +752,11 @@ int cmd_walk(int argc, char **argv)
         rc = run(&a, e, &wp, &done);
     walk_path_free(&wp);
     plx_engine_free(e);
-    if (rc != EXIT_OK && done == 0 && made) /* nothing written in it */
+    if (rc != EXIT_OK && done <= 0 && made) { /* no frame written in the folder it made: removed */
+        char path[4096];
+        snprintf(path, sizeof path, "%s/cameras.txt", a.dir);
+        (void)remove(path);
         (void)rmdir(a.dir);
+    }
     return rc;
 }

@@ -359,7 +359,9 @@ const char *cli_black_reason(plx_engine *e, const plx_camera *cam, const plx_ren
     plx_render_opts ao = *o;
     plx_render_info info;
     int chosen = o->auto_exposure == PLX_EXPOSURE_AUTO || o->auto_exposure == PLX_EXPOSURE_ADAPT;
-    if (chosen && applied == PLX_EXPOSURE_MAX) { /* only lit surfaces make the cap */
+    /* only lit surfaces make the cap; a held exposure stops half a stop
+     * short of it (exposure_hold: 724) */
+    if (chosen && applied > PLX_EXPOSURE_MAX * 0.7) {
         snprintf(buf, len, "its light is under about 0.001 cd/m^2, where automatic exposure stops (at %g; "
                  "--exposure E brightens it)", PLX_EXPOSURE_MAX);
         return buf;
@@ -667,7 +669,8 @@ cJSON *cli_json_parse(const char *name, const char *text, size_t len, char *err,
         return NULL;
     }
     off = end && end >= text ? (size_t)(end - text) : len;
-    while (off < len && (text[off] == ' ' || text[off] == '\t' || text[off] == '\r' || text[off] == '\n'))
+    while (off < len && (text[off] == ' ' || text[off] == '\t' || text[off] == '\r' || text[off] == '\n' ||
+                         text[off] == '\0')) /* a NUL at the end, as the scene loader takes it */
         off++;
     if (off == len)
         return root;

@@ -121,6 +121,15 @@ static double bin_of_exposure(double e)
     return floor((log2(EXPOSURE_KEY / e) - LOG_MIN) * PER_STOP - 1.0 + 0.5);
 }
 
+int exposure_counted(const uint32_t hist[EXPOSURE_BINS])
+{
+    int b;
+    for (b = 0; b < BINS; b++)
+        if (hist[b])
+            return 1;
+    return 0;
+}
+
 double exposure_from(const uint32_t hist[EXPOSURE_BINS])
 {
     size_t n = 0, want, acc = 0;

@@ -24,6 +24,8 @@ double exposure_auto(const float *lin, const uint32_t *id, size_t px);
  * it), and the exposure from the sum of the parts' counts. */
 void exposure_count(const float *lin, const uint32_t *id, size_t p0, size_t p1, uint32_t hist[EXPOSURE_BINS]);
 double exposure_from(const uint32_t hist[EXPOSURE_BINS]);
+/* Whether hist counted any pixel (exposure_from is 1 for none). */
+int exposure_counted(const uint32_t hist[EXPOSURE_BINS]);
 /* A walk's exposure without flicker: the exposure chosen from the image,
  * exposure_from's, held at the last frame's, held, while they are at
  * most EXPOSURE_HOLD eighths of a stop apart (in exposure_from's steps,

@@ -526,8 +526,9 @@ finish:
         st.exposure = o->exposure;
     else
         st.exposure = o->atlas ? exposure_sum(r) : exposure_par(r, o);
-    if (o->auto_exposure == RENDER_EXPOSURE_ADAPT)
-        st.exposure = exposure_hold(o->exposure, st.exposure);
+    if (o->auto_exposure == RENDER_EXPOSURE_ADAPT) /* no lit surface counted: nothing to move to */
+        st.exposure = fmin(exposure_counted(r->hist[0]) ? exposure_hold(o->exposure, st.exposure) : o->exposure,
+                           EXPOSURE_MAX);
     if (!o->no_glow)
         glow_draw(r, o, &st);
     if (rgbf)

@@ -365,6 +365,35 @@ expect render-black-capped 0 "the image is entirely black: its light is under ab
 sed 's/"intensity":1e-5/"intensity":0.01/' "$tmp/faint.geojson" >"$tmp/faint2.geojson"
 expect render-dark-capped 0 "the view is dark: its lit surfaces are under about 0.001 cd/m\^2, where automatic exposure stops \(at 1024" -- \
     "$bin" render "$tmp/faint2.geojson" --no-indirect --size 64x48 --eye 5,-20,1.7 --target 5,0,3 -o "$tmp/xdark2.png"
+# a held walk: a frame with no lit surface keeps the held exposure (it
+# took automatic exposure's 1 for an empty image, then jumped back), and
+# a frame black at the held cap (724: half a stop short of 1024) says its
+# light is too faint (it blamed the lamps)
+printf '{"type":"FeatureCollection","properties":{"units":"m"},"features":[{"type":"Feature","properties":{"height":10},"geometry":{"type":"Polygon","coordinates":[[[0,0],[10,0],[10,10],[0,10],[0,0]]]}},{"type":"Feature","properties":{"height":10},"geometry":{"type":"Polygon","coordinates":[[[100,0],[110,0],[110,10],[100,10],[100,0]]]}},{"type":"Feature","properties":{"lamp":true,"z":5,"intensity":1000,"radius":30},"geometry":{"type":"Point","coordinates":[5,-5]}},{"type":"Feature","properties":{"lamp":true,"z":5,"intensity":1e-5,"radius":30},"geometry":{"type":"Point","coordinates":[105,-5]}}]}' >"$tmp/two.geojson"
+printf '{"type":"Feature","properties":{"units":"m","targets":[[5,0,3],[5,-120,300]]},"geometry":{"type":"LineString","coordinates":[[5,-20,1.7],[5,-120,1.7]]}}' >"$tmp/twosky.geojson"
+"$bin" walk -q "$tmp/two.geojson" --path "$tmp/twosky.geojson" --no-indirect --size 64x48 --speed 100 --fps 1 -o "$tmp/wsky" >/dev/null 2>&1
+if [ "$(awk 'NR>1{print $8}' "$tmp/wsky/cameras.txt" | sort -u | wc -l)" -eq 1 ]; then echo "ok   walk-held-empty-frame"; pass=$((pass + 1))
+else echo "FAIL walk-held-empty-frame: the exposure moved at a frame with no lit surface"; fail=$((fail + 1)); fi
+printf '{"type":"Feature","properties":{"units":"m","targets":[[5,0,3],[105,0,3]]},"geometry":{"type":"LineString","coordinates":[[5,-20,1.7],[105,-20,1.7]]}}' >"$tmp/twofaint.geojson"
+expect walk-black-capped 0 "1 of 2 frames are entirely black \(the first: frame 2\): its light is under about 0.001 cd/m\^2, where automatic exposure stops" -- \
+    "$bin" walk "$tmp/two.geojson" --path "$tmp/twofaint.geojson" --no-indirect --size 64x48 --speed 100 --fps 1 -o "$tmp/wfaint"
+# walk --tone-curve: the fixed exposure with the curve, as render's
+"$bin" walk -q "$tmp/two.geojson" --path "$tmp/twofaint.geojson" --no-indirect --size 64x48 --speed 100 --fps 1 --exposure 0.3 --tone-curve -o "$tmp/wtc" >/dev/null 2>&1
+"$bin" render -q "$tmp/two.geojson" --no-indirect --size 64x48 --aa 2 --eye 5,-20,1.7 --target 5,0,3 --exposure 0.3 --tone-curve -o "$tmp/wtcr.png" >/dev/null 2>&1
+"$bin" render -q "$tmp/two.geojson" --no-indirect --size 64x48 --aa 2 --eye 5,-20,1.7 --target 5,0,3 --exposure 0.3 -o "$tmp/wtcl.png" >/dev/null 2>&1
+if /usr/bin/python3 tests/cli/png_same.py "$tmp/wtc/frame-0001.png" "$tmp/wtcr.png" && ! /usr/bin/python3 tests/cli/png_same.py "$tmp/wtcr.png" "$tmp/wtcl.png"; then
+    echo "ok   walk-tone-curve"; pass=$((pass + 1)); else echo "FAIL walk-tone-curve"; fail=$((fail + 1)); fi
+expect walk-no-adapt-fixed 0 "warning: --no-adapt has no effect with --exposure" -- \
+    "$bin" walk "$tmp/two.geojson" --path "$tmp/twofaint.geojson" --no-indirect --size 32x24 --speed 100 --fps 1 --exposure 0.3 --no-adapt -o "$tmp/wna"
+expect mem-terabytes 0 "^buildings:" -- "$bin" info fixtures/tiny.geojson --mem 0.0001T
+expect bake-texel-range 2 "^polarlux bake: --texel '0.001' is not a number of metres from 0.01 to 1e4" -- \
+    "$bin" bake fixtures/tiny.geojson --texel 0.001 -o "$tmp/xt.plxb"
+long=$(printf '%04000d' 0)
+expect walk-out-too-long 2 "^polarlux walk: -o: the folder's path is longer than 4000 bytes" -- \
+    "$bin" walk fixtures/tiny.geojson --path "$tmp/twofaint.geojson" -o "$tmp/$long"
+printf '{"type":"FeatureCollection","properties":{"units":"m"},"features":[{"type":"Feature","properties":{},"geometry":{"type":"LineString","coordinates":[[0,-5],[20,-5]]}}]} x' >"$tmp/rtrail.geojson"
+expect route-path-trailing 1 "^polarlux route: .*rtrail\.geojson: malformed JSON at byte 168 \(line 1, column 169\)$" -- \
+    "$bin" route fixtures/tiny.geojson --path "$tmp/rtrail.geojson"
 expect render-tone-curve-needs-exposure 2 "^polarlux render: --tone-curve needs --exposure E" -- "$bin" render "$tmp/e.plxb" --tone-curve -o "$tmp/x.png"
 # on a lon/lat scene cameras.txt is in lon/lat (it was local metres, which
 # render refuses there): a frame's camera fed back to render gives the frame
