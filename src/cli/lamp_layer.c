@@ -230,11 +230,12 @@ static int geojson_lonlat(const cJSON *root, const cJSON *features)
 
 static int parse_geojson(const char *name, const char *text, lamp_file *out, char *err, size_t errlen)
 {
-    cJSON *root = cJSON_Parse(text), *features, *f;
+    cJSON *root = cli_json_parse(name, text, strlen(text), err, errlen), *features, *f;
     int tagged = 0, rc;
     const char *crs;
-    if (!root) {
-        snprintf(err, errlen, "%s: not valid JSON (a lamp file is GeoJSON or CSV)", name);
+    if (!root) { /* where, as for scenes and paths (text after the value too: it was taken) */
+        size_t n = strlen(err);
+        snprintf(err + n, errlen > n ? errlen - n : 0, " (a lamp file is GeoJSON or CSV)");
         return -1;
     }
     features = cJSON_GetObjectItemCaseSensitive(root, "features");

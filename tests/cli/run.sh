@@ -394,6 +394,9 @@ expect walk-out-too-long 2 "^polarlux walk: -o: the folder's path is longer than
 printf '{"type":"FeatureCollection","properties":{"units":"m"},"features":[{"type":"Feature","properties":{},"geometry":{"type":"LineString","coordinates":[[0,-5],[20,-5]]}}]} x' >"$tmp/rtrail.geojson"
 expect route-path-trailing 1 "^polarlux route: .*rtrail\.geojson: malformed JSON at byte 168 \(line 1, column 169\)$" -- \
     "$bin" route fixtures/tiny.geojson --path "$tmp/rtrail.geojson"
+printf '{"type":"FeatureCollection","features":[]} junk' >"$tmp/ltrail.geojson"
+expect lamps-trailing 1 "^polarlux info: --lamps .*ltrail\.geojson: malformed JSON at byte 43 \(line 1, column 44\) \(a lamp file is GeoJSON or CSV\)$" -- \
+    "$bin" info fixtures/tiny.geojson --lamps "$tmp/ltrail.geojson"
 expect render-tone-curve-needs-exposure 2 "^polarlux render: --tone-curve needs --exposure E" -- "$bin" render "$tmp/e.plxb" --tone-curve -o "$tmp/x.png"
 # on a lon/lat scene cameras.txt is in lon/lat (it was local metres, which
 # render refuses there): a frame's camera fed back to render gives the frame
