@@ -53,7 +53,8 @@ typedef enum plx_status {
     PLX_E_INVALID,   /* bad argument or misuse of the API */
     PLX_E_NOMEM,     /* the engine's memory block (or a part's budget) is exhausted */
     PLX_E_IO,        /* a file could not be read or written */
-    PLX_E_PARSE,     /* malformed JSON (message gives byte offset, line, column) */
+    PLX_E_PARSE,     /* malformed JSON (message gives byte offset, line, column), or a damaged
+                        or foreign bake file (the message says which) */
     PLX_E_SCENE,     /* the scene is not a valid polarlux GeoJSON profile */
     PLX_E_NOSCENE,   /* the call needs a loaded scene */
     PLX_E_RANGE,     /* a query point is outside Bounds, inside a building, ... */
@@ -700,7 +701,8 @@ typedef struct plx_render_opts {
                                    and roofs; a reset of the photons rebuilds it) */
     double aerial_m_per_texel;  /* the radiance atlas's spacing when the frame makes it (0: 0.5 m),
                                    and the light map's resolution (0: 1 m); both coarser if the
-                                   budget needs */
+                                   budget needs; 0 or PLX_TEXEL_MIN .. _MAX. Not read once the
+                                   atlas is made (a bake's, or an earlier frame's) */
     int no_cull;                /* 1: draw every building (the culled image is identical) */
     int no_indirect;            /* 1: direct light only even when photons were traced */
     const plx_backend *backend; /* visibility pass: NULL = the built-in software rasteriser;
@@ -712,7 +714,9 @@ typedef struct plx_render_opts {
                                    (the last frame's) while the image's own choice stays within
                                    half a stop of it, else moved to half a stop from that choice
                                    (frames of a walk without flicker; kept when no lit surface
-                                   is counted; at most PLX_EXPOSURE_MAX). PLX_EXPOSURE_TONE: exposure
+                                   is counted; at most PLX_EXPOSURE_MAX): a walk's first frame
+                                   takes PLX_EXPOSURE_AUTO, each later one _ADAPT with exposure
+                                   the last frame's plx_render_info.exposure. PLX_EXPOSURE_TONE: exposure
                                    with the tone curve. PLX_EXPOSURE_FIXED (0): exposure, linear
                                    (SPEC §5). rgbf stays linear radiance. README "Automatic
                                    exposure" */
@@ -735,6 +739,11 @@ typedef struct plx_render_opts {
 /* The largest exposure automatic exposure chooses: a frame whose lit
  * surfaces are all darker than about 0.001 cd/m^2 stays dark */
 #define PLX_EXPOSURE_MAX 1024.0
+
+/* plx_render_opts.aerial_m_per_texel and plx_bake_opts': 0 (the default)
+ * or within these, m (a finer atlas laid out for minutes) */
+#define PLX_TEXEL_MIN 0.01
+#define PLX_TEXEL_MAX 1e4
 
 #define PLX_RENDER_MAX_AA 16
 #define PLX_RENDER_MAX_DIM 16384   /* the largest frame width or height */
@@ -944,7 +953,8 @@ typedef struct plx_bake_opts {
                                    plx_bake_save, after the photons); with no_indirect the
                                    aerial light map of direct light instead */
     double aerial_m_per_texel;  /* the atlas's spacing (0: 0.5 m), or the light map's
-                                   resolution (0: 1 m); coarser if the budget needs */
+                                   resolution (0: 1 m); coarser if the budget needs; 0 or
+                                   PLX_TEXEL_MIN .. _MAX */
     int no_indirect;            /* 1: no photon buffers */
     int twin;                   /* 1: the twin engine (see plx_bake_save): the same memory
                                    layout without the atlas's or light map's values */
@@ -983,9 +993,14 @@ plx_status plx_bake_save(plx_engine *e, plx_engine *twin, void *buf, size_t cap,
 
 /*
  * Size first: checks the bake's header and checksum and gives the block
- * size to pass to plx_bake_load (the image plus room for queries).
- * Errors (one line in err): PLX_E_PARSE (not a bake, truncated, corrupt),
- * PLX_E_UNSUPPORTED (another format version, architecture or build).
+ * size to pass to plx_bake_load: the image, plus 32 MiB for queries, plus
+ * 20 bytes a pixel of the largest frame with a renderer. Frames need less
+ * than that: the image and the 20 bytes a pixel (anti-aliasing's buffers;
+ * with less, plx_render takes every sample, PLX_AA_EVERY, or, below 8
+ * bytes a pixel, a frame of aa > 1 fails with PLX_E_NOMEM).
+ * Errors (one line in err, emptied on success): PLX_E_PARSE (not a bake,
+ * truncated, corrupt; bake NULL), PLX_E_UNSUPPORTED (another format
+ * version, architecture or build). Threads: none (reads bake only).
  */
 plx_status plx_bake_block_size(const void *bake, size_t len, size_t *block_bytes /* OUT */, char *err,
                                size_t errlen);
@@ -997,8 +1012,10 @@ plx_status plx_bake_block_size(const void *bake, size_t len, size_t *block_bytes
  * render maximum stay the bake's). The bake buffer may be freed after; it
  * must not overlap the block (PLX_E_INVALID: the image is written over the
  * block from its start).
+ * cfg->threads is taken as for plx_engine_create.
  * Errors as plx_bake_block_size, plus PLX_E_NOMEM (block too small) and
- * PLX_E_INVALID; err gets one line.
+ * PLX_E_INVALID; err gets one line, emptied on success. Lifetime: the
+ * engine lives in mem until plx_engine_destroy. Threads: none.
  */
 plx_status plx_bake_load(void *mem, size_t size, const plx_config *cfg, const void *bake, size_t len,
                          plx_engine **engine /* OUT */, char *err, size_t errlen);

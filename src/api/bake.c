@@ -188,6 +188,10 @@ plx_status plx_bake_prepare(plx_engine *e, const plx_bake_opts *o)
         return st;
     if (!o)
         return eng_fail(e, PLX_E_INVALID, "plx_bake_prepare: options are NULL");
+    if (!(o->aerial_m_per_texel == 0.0 ||
+          (o->aerial_m_per_texel >= PLX_TEXEL_MIN && o->aerial_m_per_texel <= PLX_TEXEL_MAX)))
+        return eng_fail(e, PLX_E_INVALID, "plx_bake_prepare: aerial_m_per_texel must be 0 (the default) or 0.01 .. "
+                        "1e4 m");
     if ((!o->no_polar && (st = plx_polar_build(e)) != PLX_OK) ||
         (st = eng_need(e, ENG_LIGHT, "plx_bake_prepare")) != PLX_OK)
         return st;
@@ -571,6 +575,8 @@ plx_status plx_bake_block_size(const void *bake, size_t len, size_t *block_bytes
     if (st != PLX_OK)
         return st;
     *block_bytes = L.image + (size_t)get64(f + H_SLACK) + 2 * BAKE_ALIGN;
+    if (err && errlen) /* no stale line from an earlier call */
+        err[0] = '\0';
     return PLX_OK;
 }
 
@@ -681,5 +687,7 @@ plx_status plx_bake_load(void *mem, size_t size, const plx_config *cfg, const vo
                    0, NULL);
     rebase_engine(e, mem, base, cap, (size_t)img, cfg);
     *out = e;
+    if (err && errlen)
+        err[0] = '\0';
     return PLX_OK;
 }

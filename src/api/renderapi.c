@@ -657,6 +657,9 @@ plx_status plx_render(plx_engine *e, const plx_camera *cam, const plx_render_opt
         return eng_fail(e, PLX_E_INVALID, "plx_render: aa must be 0..16 (samples per pixel side)");
     /* a fixed exposure of 0 or less gave a black (or negative) frame; NaN
      * and inf were refused deeper, as "near must be > 0" */
+    if (o && !(o->aerial_m_per_texel == 0.0 || (o->aerial_m_per_texel >= PLX_TEXEL_MIN &&
+                                                  o->aerial_m_per_texel <= PLX_TEXEL_MAX)))
+        return eng_fail(e, PLX_E_INVALID, "plx_render: aerial_m_per_texel must be 0 (the default) or 0.01 .. 1e4 m");
     if (o && (o->auto_exposure < PLX_EXPOSURE_FIXED || o->auto_exposure > PLX_EXPOSURE_TONE))
         return eng_fail(e, PLX_E_INVALID, "plx_render: auto_exposure must be PLX_EXPOSURE_FIXED, _AUTO, _ADAPT or _TONE");
     if (o && o->auto_exposure != PLX_EXPOSURE_AUTO && !(o->exposure > 0.0 && isfinite(o->exposure)))
@@ -708,7 +711,7 @@ plx_status plx_render(plx_engine *e, const plx_camera *cam, const plx_render_opt
     rc.width = cam->width;
     rc.height = cam->height;
     render_opts_default(&ro);
-    ro.exposure = o->exposure;
+    ro.exposure = o->auto_exposure == PLX_EXPOSURE_AUTO ? 1.0 : o->exposure; /* not read with _AUTO */
     ro.no_glow = o->no_glow;
     ro.lightmap = o->aerial;
     ro.cull = o->no_cull ? RENDER_CULL_NONE : RENDER_CULL_ALL;

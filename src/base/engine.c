@@ -8,7 +8,7 @@ static const char *const status_text[PLX_STATUS_COUNT] = {
     "invalid argument",
     "out of memory",
     "input/output error",
-    "malformed JSON",
+    "malformed input (JSON, or a damaged bake file)",
     "invalid scene",
     "no scene loaded",
     "out of range",

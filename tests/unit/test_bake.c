@@ -547,6 +547,10 @@ static void test_damaged(void **state)
     memcpy(&sum, k.file + 32, 8);
     assert_true(sum == ref_bake_sum(k.file, k.len));
     expect_fail(k.file, 0, PLX_E_PARSE, "not a polarlux bake file (no PLXBAKE magic)");
+    /* a success empties err (an earlier call's line stayed) */
+    strcpy(err, "stale");
+    assert_int_equal(plx_bake_block_size(k.file, k.len, &need, err, sizeof err), PLX_OK);
+    assert_string_equal(err, "");
     expect_fail(k.file, 100, PLX_E_PARSE, "truncated bake file: 100 bytes, shorter than its 128-byte header");
     snprintf(msg, sizeof msg, "truncated bake file: %zu bytes, the header says %zu", k.len / 2, k.len);
     expect_fail(k.file, k.len / 2, PLX_E_PARSE, msg);

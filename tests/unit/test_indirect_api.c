@@ -207,10 +207,26 @@ static void test_refusals(void **state)
     o.auto_exposure = PLX_EXPOSURE_TONE; /* applied as given */
     assert_int_equal(plx_render(e, &out, &o, rgb, NULL, &info), PLX_OK);
     assert_true(info.exposure == 1.0);
+    o.exposure = NAN;
+    o.auto_exposure = 1; /* the fixed exposure is not read (NaN was refused deeper, as "near must be > 0") */
+    assert_int_equal(plx_render(e, &out, &o, rgb, NULL, &info), PLX_OK);
     o.exposure = -1.0;
-    o.auto_exposure = 1; /* the fixed exposure is not read */
     assert_int_equal(plx_render(e, &out, &o, rgb, NULL, &info), PLX_OK);
     assert_int_equal(info.eye_inside, 0);
+    /* an atlas spacing far below a centimetre laid out for minutes (0.001 m:
+     * 133 s), NaN and negatives were taken as the default: refused */
+    {
+        const double spacing[] = { 0.001, 0.0099, -1.0, NAN, INFINITY, 2e4 };
+        size_t k;
+        for (k = 0; k < sizeof spacing / sizeof spacing[0]; k++) {
+            o.aerial_m_per_texel = spacing[k];
+            assert_int_equal(plx_render(e, &out, &o, rgb, NULL, NULL), PLX_E_INVALID);
+            assert_non_null(strstr(plx_last_error(e), "aerial_m_per_texel must be 0 (the default) or 0.01 .. 1e4 m"));
+        }
+        o.aerial_m_per_texel = PLX_TEXEL_MIN;
+        assert_int_equal(plx_render(e, &out, &o, rgb, NULL, NULL), PLX_OK);
+        o.aerial_m_per_texel = 0.0;
+    }
     assert_int_equal(plx_render(e, &in, &o, rgb, NULL, &info), PLX_OK);
     assert_int_equal(info.eye_inside, 1);
 
