@@ -712,7 +712,8 @@ typedef struct plx_render_opts {
                                    tone curve keeps the highlights near lamps; exposure is then
                                    ignored. PLX_EXPOSURE_ADAPT: chosen so, but held at exposure
                                    (the last frame's) while the image's own choice stays within
-                                   half a stop of it, else moved to half a stop from that choice
+                                   half a stop of it, else moved towards half a stop from that
+                                   choice, at most exposure_step eighths of a stop a frame
                                    (frames of a walk without flicker; kept when no lit surface
                                    is counted; at most PLX_EXPOSURE_MAX): a walk's first frame
                                    takes PLX_EXPOSURE_AUTO, each later one _ADAPT with exposure
@@ -730,6 +731,9 @@ typedef struct plx_render_opts {
                                    pixel (exact direct light, the irradiance cache's indirect
                                    light), not read from the radiance atlas (README "The
                                    radiance atlas"): slower, shadow edges exact */
+    int exposure_step;          /* PLX_EXPOSURE_ADAPT: the most the exposure moves in a frame,
+                                   in eighths of a stop (0: to the band around the image's own
+                                   choice at once); walk gives 4 stops a second at its --fps */
 } plx_render_opts;
 
 #define PLX_EXPOSURE_FIXED 0

@@ -124,6 +124,7 @@ static void render_opts(void)
     FIELD(plx_render_opts, aa);
     FIELD(plx_render_opts, aa_full);
     FIELD(plx_render_opts, per_pixel);
+    FIELD(plx_render_opts, exposure_step);
 }
 
 static void render_info(void)

@@ -319,13 +319,14 @@ class Scene:
 
     # ---- images ---------------------------------------------------------------------
     def render(self, eye, target, fov_deg=60.0, size=(640, 480), exposure=1.0, aerial=False, glow=True,
-               linear=False, aa=1, held=None, tone_curve=False):
+               linear=False, aa=1, held=None, tone_curve=False, exposure_step=0):
         """A night image (SPEC §5) as an (H, W, 3) uint8 sRGB array; with
         linear=True also the (H, W, 3) float32 linear radiance: (rgb8, rgbf).
         exposure="auto": chosen from the image, with the tone curve (the
         command's default; README "Automatic exposure"), and with held=E (the
         last frame's exposure) held at E while the image's own choice stays
-        within half a stop, as walk's frames are; a number with
+        within half a stop, as walk's frames are (exposure_step=N: moving at
+        most N eighths of a stop a frame, walk's 32 / fps); a number with
         tone_curve=True: that exposure with the tone curve (a walk frame
         again); aa=N: N x N samples a pixel, adaptive (1: the pixel centre,
         SPEC §5). What plx_render reported (the exposure applied, ...) is in
@@ -347,6 +348,7 @@ class Scene:
         lib.plx_render_opts_default(ctypes.byref(opts))
         if exposure == "auto" and held is not None:
             opts.auto_exposure, opts.exposure = EXPOSURE_ADAPT, float(held)
+            opts.exposure_step = int(exposure_step)
         elif exposure == "auto":
             opts.auto_exposure = EXPOSURE_AUTO
         else:

@@ -84,7 +84,7 @@ class RenderOpts(ctypes.Structure):
                 ("aerial_m_per_texel", ctypes.c_double), ("no_cull", ctypes.c_int),
                 ("no_indirect", ctypes.c_int), ("backend", ctypes.c_void_p),
                 ("auto_exposure", ctypes.c_int), ("aa", ctypes.c_int),
-                ("aa_full", ctypes.c_int), ("per_pixel", ctypes.c_int)]
+                ("aa_full", ctypes.c_int), ("per_pixel", ctypes.c_int), ("exposure_step", ctypes.c_int)]
 
 
 class RenderInfo(ctypes.Structure):

@@ -169,7 +169,8 @@ def test_walk_frames_from_python(tmp_path):
     held = None
     for k, c in enumerate(cams):
         eye, target, ex = [float(v) for v in c[1:4]], [float(v) for v in c[4:7]], float(c[7])
-        img = s.render(eye, target, size=(96, 64), exposure="auto", aa=2, held=held)
+        img = s.render(eye, target, size=(96, 64), exposure="auto", aa=2, held=held,
+                       exposure_step=320)  # walk's 8 x 4 stops a second / --fps 0.1
         assert s.last_render["exposure"] == ex
         w8, h8, bpp, rows = decode_png(tmp_path / "w" / f"frame-{k + 1:04d}.png")
         assert b"".join(bytes(r) for r in rows) == img.tobytes()

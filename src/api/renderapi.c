@@ -660,6 +660,8 @@ plx_status plx_render(plx_engine *e, const plx_camera *cam, const plx_render_opt
     if (o && !(o->aerial_m_per_texel == 0.0 || (o->aerial_m_per_texel >= PLX_TEXEL_MIN &&
                                                   o->aerial_m_per_texel <= PLX_TEXEL_MAX)))
         return eng_fail(e, PLX_E_INVALID, "plx_render: aerial_m_per_texel must be 0 (the default) or 0.01 .. 1e4 m");
+    if (o && (o->exposure_step < 0 || o->exposure_step > 4096))
+        return eng_fail(e, PLX_E_INVALID, "plx_render: exposure_step must be 0 .. 4096 (eighths of a stop)");
     if (o && (o->auto_exposure < PLX_EXPOSURE_FIXED || o->auto_exposure > PLX_EXPOSURE_TONE))
         return eng_fail(e, PLX_E_INVALID, "plx_render: auto_exposure must be PLX_EXPOSURE_FIXED, _AUTO, _ADAPT or _TONE");
     if (o && o->auto_exposure != PLX_EXPOSURE_AUTO && !(o->exposure > 0.0 && isfinite(o->exposure)))
@@ -717,6 +719,7 @@ plx_status plx_render(plx_engine *e, const plx_camera *cam, const plx_render_opt
     ro.cull = o->no_cull ? RENDER_CULL_NONE : RENDER_CULL_ALL;
     ro.backend = o->backend;
     ro.auto_exposure = o->auto_exposure;
+    ro.exposure_step = o->exposure_step;
     if (use_atlas) {
         atlas_current(e); /* cleared when the light changed: the frames read what is filled */
         ro.lightmap = 0;

@@ -162,11 +162,12 @@ const char *cli_aa_nomem_hint(plx_status st, const plx_render_opts *o);
 void cli_warn(const char *cmd, const cli_common *c, const char *fmt, ...);
 /* Why a result is dark: "the scene has no lamps", or that no light reaches it. */
 const char *cli_dark_reason(plx_engine *e);
-/* Why a frame at cam came out entirely black (applied: its exposure): at
- * automatic exposure's cap, too faint to show; with a fixed exposure, the
- * frame is drawn again into rgb8 (its buffer, written out already) with
- * automatic exposure, and when that shows light the exposure is named
- * (a tiny --exposure was blamed on the lamps); else cli_dark_reason. */
+/* Why a frame at cam came out entirely black (applied: its exposure): the
+ * frame is drawn again into rgb8 (its buffer, written out already) at its
+ * own automatic exposure; when that shows light, the fixed or held
+ * exposure is named (a tiny --exposure was blamed on the lamps); when it
+ * is black at automatic exposure's cap, the light is too faint; with no
+ * building drawn, the camera looks away; else cli_dark_reason. */
 const char *cli_black_reason(plx_engine *e, const plx_camera *cam, const plx_render_opts *o, double applied,
                              unsigned char *rgb8, char *buf, size_t len);
 /* Whether an 8-bit image of n bytes is entirely black (every byte 0). */

@@ -44,7 +44,8 @@ static const char help[] =
     "                   the later ones only at edges, as for render (--aa-full: all)\n"
     "  --exposure E     fixed exposure, no tone curve (--tone-curve: with it). Default:\n"
     "                   automatic, held while a frame's own choice stays within half\n"
-    "                   a stop (no flicker); in cameras.txt, for render --tone-curve\n"
+    "                   a stop, else following it at 4 stops a second (no flicker);\n"
+    "                   in cameras.txt, for render --tone-curve\n"
     "  --no-adapt       each frame's automatic exposure from its own image alone\n"
     "  --no-glow, --no-indirect, --per-pixel, --view V, --texel M, --photons N,\n"
     "  --frames K       as for render\n"
@@ -112,8 +113,9 @@ static int parse_args(int argc, char **argv, walk_args *a)
         { "--exposure", NULL, &a->opts.exposure, cli_parse_exposure, "--exposure '%s' is not a number above 0, up to 1e9", 0, NULL,
           &v.exposure, NULL },
         CLI_OPT_VAL("--refine-frames", &a->refine_frames, parse_refine_frames,
-                    "--refine-frames '%s' is not a whole number >= 0"),
-        CLI_OPT_VAL("--max-frames", &a->max_frames, parse_max_frames, "--max-frames '%s' is not a whole number >= 1"),
+                    "--refine-frames '%s' is not a whole number from 0 to 100000"),
+        CLI_OPT_VAL("--max-frames", &a->max_frames, parse_max_frames,
+                    "--max-frames '%s' is not a whole number from 1 to 1000000"),
         CLI_OPT_FLAG("--no-adapt", &a->no_adapt),
         CLI_OPT_VAL("--texel", &a->opts.aerial_m_per_texel, parse_texel,
                     "--texel '%s' is not a number of metres from 0.01 to 1e4"),
@@ -427,6 +429,11 @@ static int cams_open(const walk_args *a, walk_run *wr)
     return 0;
 }
 
+/* How fast a walk's held exposure follows the view, stops a second (of
+ * the walk's time, --fps frames a second): a few dozen bright pixels at a
+ * frame's edge moved it 3.5 stops for one frame and back at 25 fps. */
+#define WALK_ADAPT_STOPS 4.0
+
 static int frame(const walk_args *a, plx_engine *e, const walk_path *wp, walk_run *wr, long k, double step)
 {
     plx_camera cam;
@@ -456,8 +463,10 @@ static int frame(const walk_args *a, plx_engine *e, const walk_path *wp, walk_ru
         wr->rgb8 = wr->buf[k & 1];
     o = a->opts;
     if (o.auto_exposure == PLX_EXPOSURE_AUTO && !a->no_adapt && k > 0) { /* held from the last frame */
+        double eighths = floor(8.0 * WALK_ADAPT_STOPS / a->fps + 0.5); /* the most a frame */
         o.auto_exposure = PLX_EXPOSURE_ADAPT;
         o.exposure = wr->held;
+        o.exposure_step = eighths < 1.0 ? 1 : eighths > 4096.0 ? 4096 : (int)eighths;
     }
     t0 = port_now_ns();
     st = plx_render(e, &cam, &o, wr->rgb8, NULL, &info);
@@ -539,8 +548,14 @@ static int frame(const walk_args *a, plx_engine *e, const walk_path *wp, walk_ru
 
 static void view_hint(const walk_args *a, const walk_path *wp)
 {
-    double zmin = HUGE_VAL;
+    double zmin = HUGE_VAL, zmax = 0.0;
     uint32_t k;
+    for (k = 0; k < wp->n; k++)
+        zmax = fmax(zmax, wp->eye[3 * k + 2]);
+    if (!wp->target && zmax >= WALK_HIGH) /* a flight's frames of sky: said whatever the view */
+        cli_warn("walk", &a->c, "the eye rises to %.0f m and looks level, 10 m ahead along the path at its own "
+                 "height: the city is below those frames; properties.targets (one [x, y, z] a position) aim "
+                 "the camera down", zmax);
     if (a->aerial || (!a->ind.off && !a->opts.per_pixel))
         return;
     for (k = 0; k < wp->n; k++)

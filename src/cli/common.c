@@ -358,23 +358,32 @@ const char *cli_black_reason(plx_engine *e, const plx_camera *cam, const plx_ren
 {
     plx_render_opts ao = *o;
     plx_render_info info;
-    int chosen = o->auto_exposure == PLX_EXPOSURE_AUTO || o->auto_exposure == PLX_EXPOSURE_ADAPT;
-    /* only lit surfaces make the cap; a held exposure stops half a stop
-     * short of it (exposure_hold: 724) */
-    if (chosen && applied > PLX_EXPOSURE_MAX * 0.7) {
+    if (!rgb8)
+        return cli_dark_reason(e);
+    ao.auto_exposure = PLX_EXPOSURE_AUTO; /* the frame's own exposure: what is there to see */
+    if (plx_render(e, cam, &ao, rgb8, NULL, &info) != PLX_OK)
+        return cli_dark_reason(e);
+    if (!cli_all_black(rgb8, (size_t)cam->width * cam->height * 3)) {
+        if (o->auto_exposure == PLX_EXPOSURE_ADAPT)
+            snprintf(buf, len, "its exposure %.4g, held from the frames before and following the view at a few "
+                     "stops a second, is too low for it (its own: %.4g; --no-adapt takes each frame's own)",
+                     applied, info.exposure);
+        else
+            snprintf(buf, len, "--exposure %g maps the light there to black (automatic exposure, without "
+                     "--exposure, chooses %.4g)", o->exposure, info.exposure);
+        return buf;
+    }
+    if (info.exposure == PLX_EXPOSURE_MAX) { /* only lit surfaces make the cap */
         snprintf(buf, len, "its light is under about 0.001 cd/m^2, where automatic exposure stops (at %g; "
                  "--exposure E brightens it)", PLX_EXPOSURE_MAX);
         return buf;
     }
-    if (chosen || !rgb8)
-        return cli_dark_reason(e);
-    ao.auto_exposure = PLX_EXPOSURE_AUTO;
-    if (plx_render(e, cam, &ao, rgb8, NULL, &info) != PLX_OK ||
-        cli_all_black(rgb8, (size_t)cam->width * cam->height * 3))
-        return cli_dark_reason(e);
-    snprintf(buf, len, "--exposure %g maps the light there to black (automatic exposure, without --exposure, "
-             "chooses %.4g)", o->exposure, info.exposure);
-    return buf;
+    if (info.drawn == 0) {
+        snprintf(buf, len, "the camera sees no building and no lit ground: it looks away from the city, or "
+                 "level from high up (a walk path's properties.targets aim it down)");
+        return buf;
+    }
+    return cli_dark_reason(e);
 }
 
 /* The command's progress line for the core's long stages (plx_port.progress):

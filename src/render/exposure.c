@@ -152,16 +152,19 @@ double exposure_from(const uint32_t hist[EXPOSURE_BINS])
     return exposure_of_bin(b);
 }
 
-double exposure_hold(double held, double chosen)
+double exposure_hold(double held, double chosen, int step)
 {
-    double bh, bc;
+    double bh, bc, d;
     if (!(held > 0.0) || !isfinite(held))
         return chosen;
     bh = bin_of_exposure(held);
     bc = bin_of_exposure(chosen);
-    if (fabs(bc - bh) <= EXPOSURE_HOLD)
+    d = fabs(bc - bh) - EXPOSURE_HOLD; /* how far outside the band */
+    if (d <= 0.0)
         return held;
-    return exposure_of_bin((int)(bc > bh ? bc - EXPOSURE_HOLD : bc + EXPOSURE_HOLD));
+    if (step > 0 && d > step)
+        d = step;
+    return exposure_of_bin((int)(bc > bh ? bh + d : bh - d));
 }
 
 double exposure_auto(const float *lin, const uint32_t *id, size_t px)

@@ -29,11 +29,13 @@ int exposure_counted(const uint32_t hist[EXPOSURE_BINS]);
 /* A walk's exposure without flicker: the exposure chosen from the image,
  * exposure_from's, held at the last frame's, held, while they are at
  * most EXPOSURE_HOLD eighths of a stop apart (in exposure_from's steps,
- * held read to the nearest step); else the step EXPOSURE_HOLD from chosen
- * towards held. A frame drawn again with its own exposure as held keeps
- * it (it is within the band), so the frame can be drawn again. */
+ * held read to the nearest step); else moved from held to the edge of
+ * the band around chosen, or by step eighths of a stop when step > 0 and
+ * the edge is farther (a view where a few dozen pixels set the
+ * percentile jumped by 3.5 stops for one frame and back). A frame that
+ * reached the band, drawn again with its own exposure as held, keeps it. */
 #define EXPOSURE_HOLD 4
-double exposure_hold(double held, double chosen);
+double exposure_hold(double held, double chosen, int step);
 /* The tone curve: v (1 + v / W^2) / (1 + v), 0 for v <= 0 or NaN. */
 double exposure_curve(double v);
 

@@ -527,7 +527,8 @@ finish:
     else
         st.exposure = o->atlas ? exposure_sum(r) : exposure_par(r, o);
     if (o->auto_exposure == RENDER_EXPOSURE_ADAPT) /* no lit surface counted: nothing to move to */
-        st.exposure = fmin(exposure_counted(r->hist[0]) ? exposure_hold(o->exposure, st.exposure) : o->exposure,
+        st.exposure = fmin(exposure_counted(r->hist[0]) ? exposure_hold(o->exposure, st.exposure, o->exposure_step)
+                                                        : o->exposure,
                            EXPOSURE_MAX);
     if (!o->no_glow)
         glow_draw(r, o, &st);

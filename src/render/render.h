@@ -281,6 +281,8 @@ typedef struct render_opts {
     int auto_exposure;         /* RENDER_EXPOSURE_*: 0 exposure, linear; 1 from the image, 2 from the
                                   image held near exposure (exposure_hold), 3 exposure; 1 to 3
                                   with the tone curve (exposure.h) */
+    int exposure_step;         /* RENDER_EXPOSURE_ADAPT: at most this many eighths of a stop a
+                                  frame (0: no limit; exposure_hold) */
     double shift[2];           /* the sample point of each pixel: its centre + shift (pixels,
                                   x right, y down; |shift| < 0.5); 0 0 is SPEC §5's centre */
     int cull_samples;          /* a frame of several sample points (anti-aliasing): RENDER_SAMPLE_FIRST

@@ -397,6 +397,23 @@ expect route-path-trailing 1 "^polarlux route: .*rtrail\.geojson: malformed JSON
 printf '{"type":"FeatureCollection","features":[]} junk' >"$tmp/ltrail.geojson"
 expect lamps-trailing 1 "^polarlux info: --lamps .*ltrail\.geojson: malformed JSON at byte 43 \(line 1, column 44\) \(a lamp file is GeoJSON or CSV\)$" -- \
     "$bin" info fixtures/tiny.geojson --lamps "$tmp/ltrail.geojson"
+# a path that climbs high without targets looks level into the sky: said
+printf '{"type":"Feature","properties":{"units":"m"},"geometry":{"type":"LineString","coordinates":[[5,-20,1.7],[5,-120,300]]}}' >"$tmp/climb.geojson"
+expect walk-high-level-hint 0 "warning: the eye rises to 300 m and looks level, 10 m ahead along the path at its own height: the city is below those frames; properties.targets" -- \
+    "$bin" walk "$tmp/two.geojson" --path "$tmp/climb.geojson" --no-indirect --size 32x24 --speed 100 --fps 1 -o "$tmp/wclimb"
+# a held walk follows a change at 4 stops a second (at 25 fps an eighth
+# of a stop a frame): from a bright wall to one lit a thousand times less,
+# no frame's exposure is more than an eighth of a stop from the last
+# (without holding, one frame jumps 10 stops)
+sed 's/"intensity":1e-5/"intensity":1/' "$tmp/two.geojson" >"$tmp/two2.geojson"
+maxjump() { awk 'NR>2{d=log($8/p)/log(2); if(d<0)d=-d; if(d>m)m=d} NR>1{p=$8} END{printf "%.4f", m}' "$1"; }
+"$bin" walk -q "$tmp/two2.geojson" --path "$tmp/twofaint.geojson" --no-indirect --size 64x48 --speed 100 --fps 25 -o "$tmp/wab" >/dev/null 2>&1
+"$bin" walk -q "$tmp/two2.geojson" --path "$tmp/twofaint.geojson" --no-indirect --size 64x48 --speed 100 --fps 25 --no-adapt -o "$tmp/wabn" >/dev/null 2>&1
+ja=$(maxjump "$tmp/wab/cameras.txt"); jn=$(maxjump "$tmp/wabn/cameras.txt")
+if [ "$ja" = "0.1250" ] && [ "$(awk -v j="$jn" 'BEGIN { print (j > 2) }')" = 1 ]; then echo "ok   walk-exposure-rate ($ja stops a frame at most, $jn without holding)"; pass=$((pass + 1))
+else echo "FAIL walk-exposure-rate: $ja stops a frame held, $jn without"; fail=$((fail + 1)); fi
+expect walk-max-frames-range 2 "--max-frames '1000001' is not a whole number from 1 to 1000000" -- \
+    "$bin" walk "$tmp/two.geojson" --path "$tmp/climb.geojson" --max-frames 1000001 -o "$tmp/wmr"
 expect render-tone-curve-needs-exposure 2 "^polarlux render: --tone-curve needs --exposure E" -- "$bin" render "$tmp/e.plxb" --tone-curve -o "$tmp/x.png"
 # on a lon/lat scene cameras.txt is in lon/lat (it was local metres, which
 # render refuses there): a frame's camera fed back to render gives the frame

@@ -1859,27 +1859,33 @@ static void test_exposure_parts(void **state)
 /* A walk's held exposure (exposure_hold), on every pair of exposure_from's
  * exposures 2^(32 - (b + 1) / 8), b in 0 .. 511, written here from the
  * formula: within half a stop (4 eighths) of the image's own choice the
- * held one stays, bit for bit; farther, it moves to half a stop from the
- * choice, on the held one's side; and a frame drawn again with its own
- * exposure as the held one keeps it (walk frames drawn again by render).
+ * held one stays, bit for bit; farther, it moves to the band's edge, or
+ * by the step when one is given and the edge is farther, on the held
+ * one's side; and a frame that reached the band, drawn again with its own
+ * exposure as the held one, keeps it.
  * A held exposure off the steps counts as its nearest step. */
 static void test_exposure_hold(void **state)
 {
-    int bh, bc;
+    int bh, bc, step;
     (void)state;
-    for (bh = 0; bh < EXPOSURE_BINS; bh += 3)
-        for (bc = 0; bc < EXPOSURE_BINS; bc++) {
-            double h = exp2(32.0 - (bh + 1) / 8.0), c = exp2(32.0 - (bc + 1) / 8.0), a = exposure_hold(h, c);
-            if (abs(bc - bh) <= EXPOSURE_HOLD) {
-                assert_true(a == h);
-            } else {
-                double stops = log2(a / c);
-                assert_true(fabs(fabs(stops) - 0.5) < 1e-9);
-                assert_true((a - c) * (h - c) > 0.0); /* on the held one's side */
+    for (step = 0; step <= 4; step += 4) /* no limit, and half a stop a frame */
+        for (bh = 0; bh < EXPOSURE_BINS; bh += 3)
+            for (bc = 0; bc < EXPOSURE_BINS; bc++) {
+                double h = exp2(32.0 - (bh + 1) / 8.0), c = exp2(32.0 - (bc + 1) / 8.0);
+                double a = exposure_hold(h, c, step);
+                int out = abs(bc - bh) - EXPOSURE_HOLD, moved = step > 0 && out > step ? step : out;
+                if (out <= 0) {
+                    assert_true(a == h);
+                } else {
+                    double eighths = log2(h / a) * 8.0; /* + when the bin grew */
+                    assert_true(fabs(eighths - (bc > bh ? moved : -moved)) < 1e-9);
+                    assert_true((a - c) * (h - c) > 0.0);                     /* on the held one's side */
+                    assert_true(fabs(log2(a / c)) * 8.0 > EXPOSURE_HOLD - 1e-9); /* not past the band */
+                }
+                if (moved == out) /* reached the band: drawn again, kept */
+                    assert_true(exposure_hold(a, c, step) == a);
+                assert_true(exposure_hold(h * 1.01, c, step) == (out <= 0 ? h * 1.01 : a));
             }
-            assert_true(exposure_hold(a, c) == a);
-            assert_true(exposure_hold(h * 1.01, c) == (abs(bc - bh) <= EXPOSURE_HOLD ? h * 1.01 : a));
-        }
     {
         /* the cap: a frame darker than 2^-10 (about 0.001 cd/m^2) at its
          * percentile is exposed at most EXPOSURE_MAX; just above, less */
@@ -1895,8 +1901,8 @@ static void test_exposure_hold(void **state)
         assert_true(exposure_from(hist) == EXPOSURE_MAX * exp2(-0.125));
         assert_true(exposure_bin(1.0 / EXPOSURE_MAX) == EXPOSURE_MAX_BIN + 1);
     }
-    assert_true(exposure_hold(0.0, 0.25) == 0.25); /* nothing held: the choice */
-    assert_true(exposure_hold(NAN, 0.25) == 0.25);
+    assert_true(exposure_hold(0.0, 0.25, 0) == 0.25); /* nothing held: the choice */
+    assert_true(exposure_hold(NAN, 0.25, 4) == 0.25);
 }
 
 /* The exposure's table of bin thresholds gives exposure_bin's bin for
