@@ -731,9 +731,11 @@ typedef struct plx_render_opts {
                                    pixel (exact direct light, the irradiance cache's indirect
                                    light), not read from the radiance atlas (README "The
                                    radiance atlas"): slower, shadow edges exact */
-    int exposure_step;          /* PLX_EXPOSURE_ADAPT: the most the exposure moves in a frame,
-                                   in eighths of a stop (0: to the band around the image's own
-                                   choice at once); walk gives 4 stops a second at its --fps */
+    int exposure_step;          /* PLX_EXPOSURE_ADAPT: the most the exposure rises in a frame,
+                                   in eighths of a stop; it falls up to 4 times that (0: to the
+                                   band around the image's own choice at once; 0 .. 4096 in
+                                   every mode, else PLX_E_INVALID); walk gives round(32 / fps),
+                                   at least 1: about 4 stops a second rising */
 } plx_render_opts;
 
 #define PLX_EXPOSURE_FIXED 0

@@ -177,6 +177,9 @@ def test_walk_frames_from_python(tmp_path):
         again = s.render(eye, target, size=(96, 64), exposure=ex, tone_curve=True, aa=2)
         assert np.array_equal(again, img)
         held = ex
+    with pytest.raises(polarlux.PolarluxError) as err:  # the step reaches the library
+        s.render(cams[0][1:4], cams[0][4:7], size=(96, 64), exposure="auto", held=0.5, exposure_step=-1)
+    assert "exposure_step must be 0 .. 4096" in str(err.value)
     with pytest.raises(ValueError):
         s.render(cams[0][1:4], cams[0][4:7], exposure=0.5, held=0.5)
     with pytest.raises(ValueError):

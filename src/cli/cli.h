@@ -162,6 +162,8 @@ const char *cli_aa_nomem_hint(plx_status st, const plx_render_opts *o);
 void cli_warn(const char *cmd, const cli_common *c, const char *fmt, ...);
 /* Why a result is dark: "the scene has no lamps", or that no light reaches it. */
 const char *cli_dark_reason(plx_engine *e);
+/* Whether the loaded scene has lamps. */
+int cli_has_lamps(plx_engine *e);
 /* Why a frame at cam came out entirely black (applied: its exposure): the
  * frame is drawn again into rgb8 (its buffer, written out already) at its
  * own automatic exposure; when that shows light, the fixed or held

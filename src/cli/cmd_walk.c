@@ -44,7 +44,8 @@ static const char help[] =
     "                   the later ones only at edges, as for render (--aa-full: all)\n"
     "  --exposure E     fixed exposure, no tone curve (--tone-curve: with it). Default:\n"
     "                   automatic, held while a frame's own choice stays within half\n"
-    "                   a stop, else following it at 4 stops a second (no flicker);\n"
+    "                   a stop, else following it at about 4 stops a second (16 as\n"
+    "                   it falls: no flicker);\n"
     "                   in cameras.txt, for render --tone-curve\n"
     "  --no-adapt       each frame's automatic exposure from its own image alone\n"
     "  --no-glow, --no-indirect, --per-pixel, --view V, --texel M, --photons N,\n"
@@ -311,7 +312,8 @@ typedef struct walk_run {
     int writer;                /* 1: frames written on the writer's thread */
     long black, first_black;   /* frames entirely black, the eye outside buildings: how many,
                                   the first (1-based) */
-    plx_camera black_cam;      /* the first one's camera and exposure */
+    plx_camera black_cam;      /* the first one's camera, options and exposure */
+    plx_render_opts black_opts;
     double black_exposure;
     long inside, first_inside; /* frames with the eye inside a building: how many, the first */
     double inside_eye[3];      /* the first one's eye */
@@ -338,12 +340,6 @@ static const char *eye_text(plx_engine *e, const double P[3], char *buf, size_t 
  * the scene's bounds (the buildings' box and 50 m) is said to be outside
  * the scene, m. */
 #define WALK_FAR_OUTSIDE 100.0
-
-static int has_lamps(plx_engine *e)
-{
-    plx_scene_info si;
-    return plx_scene_info_get(e, &si) == PLX_OK && si.lamps > 0;
-}
 
 /* How far (x, y) lies from the box b (minx, miny, maxx, maxy), m; 0 inside. */
 static double box_distance(const double b[4], double x, double y)
@@ -432,7 +428,7 @@ static int cams_open(const walk_args *a, walk_run *wr)
 /* How fast a walk's held exposure follows the view, stops a second (of
  * the walk's time, --fps frames a second): a few dozen bright pixels at a
  * frame's edge moved it 3.5 stops for one frame and back at 25 fps. */
-#define WALK_ADAPT_STOPS 4.0
+#define WALK_ADAPT_STOPS 4.0 /* rising; falling 4 times as fast (EXPOSURE_FALL) */
 
 static int frame(const walk_args *a, plx_engine *e, const walk_path *wp, walk_run *wr, long k, double step)
 {
@@ -495,6 +491,7 @@ static int frame(const walk_args *a, plx_engine *e, const walk_path *wp, walk_ru
     if (!info.eye_inside && cli_all_black(wr->rgb8, (size_t)a->w * a->h * 3) && wr->black++ == 0) {
         wr->first_black = k + 1;
         wr->black_cam = cam;
+        wr->black_opts = o; /* the frame's own: held (_ADAPT) after the first */
         wr->black_exposure = info.exposure;
     }
     if (info.eye_inside && wr->inside++ == 0) {
@@ -697,17 +694,17 @@ static int run(const walk_args *a, plx_engine *e, const walk_path *wp, long *don
                      "move the path out of the footprints or raise it above the roofs", wr.inside, wr.n,
                      wr.first_inside, eye_text(e, wr.inside_eye, at, sizeof at));
         }
-        if (wr.black == wr.n && wr.near_scene > WALK_FAR_OUTSIDE && has_lamps(e))
+        if (wr.black == wr.n && wr.near_scene > WALK_FAR_OUTSIDE && cli_has_lamps(e))
             cli_warn("walk", &a->c, "every frame is entirely black: the camera path stays outside the scene, its "
                      "eyes and targets %.0f m or more from the scene's bounds (its buildings' box and 50 m); is the "
                      "path in the scene's coordinates?", wr.near_scene);
         else if (wr.black == wr.n)
             cli_warn("walk", &a->c, "every frame is entirely black: %s",
-                     cli_black_reason(e, &wr.black_cam, &a->opts, wr.black_exposure, wr.rgb8, why, sizeof why));
+                     cli_black_reason(e, &wr.black_cam, &wr.black_opts, wr.black_exposure, wr.rgb8, why, sizeof why));
         else if (wr.black)
             cli_warn("walk", &a->c, "%ld of %ld frames are entirely black (the first: frame %ld): %s", wr.black,
                      wr.n, wr.first_black,
-                     cli_black_reason(e, &wr.black_cam, &a->opts, wr.black_exposure, wr.rgb8, why, sizeof why));
+                     cli_black_reason(e, &wr.black_cam, &wr.black_opts, wr.black_exposure, wr.rgb8, why, sizeof why));
     }
     if (wr.cams)
         fclose(wr.cams);

@@ -353,6 +353,19 @@ const char *cli_dark_reason(plx_engine *e)
     return "no lamp's light reaches it (each lamp lights only within its radius, and buildings cast shadows)";
 }
 
+int cli_has_lamps(plx_engine *e)
+{
+    plx_scene_info si;
+    return plx_scene_info_get(e, &si) == PLX_OK && si.lamps > 0;
+}
+
+/* Whether the camera looks up, level or less than about 11 degrees down. */
+static int looks_up(const plx_camera *cam)
+{
+    double dz = cam->target[2] - cam->eye[2];
+    return dz > -0.2 * hypot(cam->target[0] - cam->eye[0], cam->target[1] - cam->eye[1]);
+}
+
 const char *cli_black_reason(plx_engine *e, const plx_camera *cam, const plx_render_opts *o, double applied,
                              unsigned char *rgb8, char *buf, size_t len)
 {
@@ -363,7 +376,7 @@ const char *cli_black_reason(plx_engine *e, const plx_camera *cam, const plx_ren
     ao.auto_exposure = PLX_EXPOSURE_AUTO; /* the frame's own exposure: what is there to see */
     if (plx_render(e, cam, &ao, rgb8, NULL, &info) != PLX_OK)
         return cli_dark_reason(e);
-    if (!cli_all_black(rgb8, (size_t)cam->width * cam->height * 3)) {
+    if (!cli_all_black(rgb8, (size_t)cam->width * cam->height * 3) && o->auto_exposure != PLX_EXPOSURE_AUTO) {
         if (o->auto_exposure == PLX_EXPOSURE_ADAPT)
             snprintf(buf, len, "its exposure %.4g, held from the frames before and following the view at a few "
                      "stops a second, is too low for it (its own: %.4g; --no-adapt takes each frame's own)",
@@ -373,14 +386,16 @@ const char *cli_black_reason(plx_engine *e, const plx_camera *cam, const plx_ren
                      "--exposure, chooses %.4g)", o->exposure, info.exposure);
         return buf;
     }
+    if (!cli_has_lamps(e))
+        return cli_dark_reason(e);
     if (info.exposure == PLX_EXPOSURE_MAX) { /* only lit surfaces make the cap */
         snprintf(buf, len, "its light is under about 0.001 cd/m^2, where automatic exposure stops (at %g; "
                  "--exposure E brightens it)", PLX_EXPOSURE_MAX);
         return buf;
     }
-    if (info.drawn == 0) {
+    if (info.drawn == 0 && looks_up(cam)) {
         snprintf(buf, len, "the camera sees no building and no lit ground: it looks away from the city, or "
-                 "level from high up (a walk path's properties.targets aim it down)");
+                 "level from high up (--target, or a walk path's properties.targets, aims it)");
         return buf;
     }
     return cli_dark_reason(e);

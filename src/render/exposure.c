@@ -162,6 +162,8 @@ double exposure_hold(double held, double chosen, int step)
     d = fabs(bc - bh) - EXPOSURE_HOLD; /* how far outside the band */
     if (d <= 0.0)
         return held;
+    if (step > 0 && bc > bh) /* a brighter view: the exposure falls EXPOSURE_FALL times as fast */
+        step *= EXPOSURE_FALL;
     if (step > 0 && d > step)
         d = step;
     return exposure_of_bin((int)(bc > bh ? bh + d : bh - d));

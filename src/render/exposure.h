@@ -30,11 +30,15 @@ int exposure_counted(const uint32_t hist[EXPOSURE_BINS]);
  * exposure_from's, held at the last frame's, held, while they are at
  * most EXPOSURE_HOLD eighths of a stop apart (in exposure_from's steps,
  * held read to the nearest step); else moved from held to the edge of
- * the band around chosen, or by step eighths of a stop when step > 0 and
- * the edge is farther (a view where a few dozen pixels set the
- * percentile jumped by 3.5 stops for one frame and back). A frame that
- * reached the band, drawn again with its own exposure as held, keeps it. */
+ * the band around chosen, or, when step > 0 and the edge is farther, by
+ * step eighths of a stop as the exposure rises (a darker view) and
+ * EXPOSURE_FALL times that as it falls (a brighter view, which would
+ * otherwise stay blown out: ten stops took 3 s at 25 fps). A view where
+ * a few dozen pixels set the percentile jumped 3.5 stops for one frame and
+ * back. A frame that reached the band, drawn again with its own exposure
+ * as held, keeps it. */
 #define EXPOSURE_HOLD 4
+#define EXPOSURE_FALL 4
 double exposure_hold(double held, double chosen, int step);
 /* The tone curve: v (1 + v / W^2) / (1 + v), 0 for v <= 0 or NaN. */
 double exposure_curve(double v);

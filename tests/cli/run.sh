@@ -397,6 +397,16 @@ expect route-path-trailing 1 "^polarlux route: .*rtrail\.geojson: malformed JSON
 printf '{"type":"FeatureCollection","features":[]} junk' >"$tmp/ltrail.geojson"
 expect lamps-trailing 1 "^polarlux info: --lamps .*ltrail\.geojson: malformed JSON at byte 43 \(line 1, column 44\) \(a lamp file is GeoJSON or CSV\)$" -- \
     "$bin" info fixtures/tiny.geojson --lamps "$tmp/ltrail.geojson"
+# a frame black because the held exposure has not caught up says so (the
+# walk's own options were read: it blamed --exposure 1)
+sed 's/"intensity":1e-5/"intensity":0.0005/' "$tmp/two.geojson" >"$tmp/two4.geojson"
+expect walk-black-held 0 "1 of 2 frames are entirely black \(the first: frame 2\): its exposure 5.187, held from the frames before and following the view at a few stops a second, is too low for it" -- \
+    "$bin" walk "$tmp/two4.geojson" --path "$tmp/twofaint.geojson" --no-indirect --size 64x48 --speed 100 --fps 1 -o "$tmp/wheld"
+# no lamps comes first among the reasons (a view of no building said the
+# camera looked away)
+printf '{"type":"FeatureCollection","properties":{"units":"m"},"features":[{"type":"Feature","properties":{"height":10},"geometry":{"type":"Polygon","coordinates":[[[0,0],[10,0],[10,10],[0,10],[0,0]]]}}]}' >"$tmp/nolamps.geojson"
+expect render-black-no-lamps 0 "the image is entirely black: the scene has no lamps" -- \
+    "$bin" render "$tmp/nolamps.geojson" --size 32x24 --eye 5,-20,1.7 --target 5,-40,1.7 -o "$tmp/xnl.png"
 # a path that climbs high without targets looks level into the sky: said
 printf '{"type":"Feature","properties":{"units":"m"},"geometry":{"type":"LineString","coordinates":[[5,-20,1.7],[5,-120,300]]}}' >"$tmp/climb.geojson"
 expect walk-high-level-hint 0 "warning: the eye rises to 300 m and looks level, 10 m ahead along the path at its own height: the city is below those frames; properties.targets" -- \
@@ -412,6 +422,14 @@ maxjump() { awk 'NR>2{d=log($8/p)/log(2); if(d<0)d=-d; if(d>m)m=d} NR>1{p=$8} EN
 ja=$(maxjump "$tmp/wab/cameras.txt"); jn=$(maxjump "$tmp/wabn/cameras.txt")
 if [ "$ja" = "0.1250" ] && [ "$(awk -v j="$jn" 'BEGIN { print (j > 2) }')" = 1 ]; then echo "ok   walk-exposure-rate ($ja stops a frame at most, $jn without holding)"; pass=$((pass + 1))
 else echo "FAIL walk-exposure-rate: $ja stops a frame held, $jn without"; fail=$((fail + 1)); fi
+# the exposure falls four times as fast as it rises: from the faint wall
+# to the bright one at 25 fps, half a stop a frame at most (it stayed
+# blown out for seconds at an eighth)
+printf '{"type":"Feature","properties":{"units":"m","targets":[[105,0,3],[5,0,3]]},"geometry":{"type":"LineString","coordinates":[[105,-20,1.7],[5,-20,1.7]]}}' >"$tmp/twoback.geojson"
+"$bin" walk -q "$tmp/two2.geojson" --path "$tmp/twoback.geojson" --no-indirect --size 64x48 --speed 100 --fps 25 -o "$tmp/wba" >/dev/null 2>&1
+jb=$(maxjump "$tmp/wba/cameras.txt")
+if [ "$jb" = "0.5000" ]; then echo "ok   walk-exposure-falls-faster ($jb stops a frame at most)"; pass=$((pass + 1))
+else echo "FAIL walk-exposure-falls-faster: $jb stops a frame at most"; fail=$((fail + 1)); fi
 expect walk-max-frames-range 2 "--max-frames '1000001' is not a whole number from 1 to 1000000" -- \
     "$bin" walk "$tmp/two.geojson" --path "$tmp/climb.geojson" --max-frames 1000001 -o "$tmp/wmr"
 expect render-tone-curve-needs-exposure 2 "^polarlux render: --tone-curve needs --exposure E" -- "$bin" render "$tmp/e.plxb" --tone-curve -o "$tmp/x.png"
