@@ -22,8 +22,9 @@ static const char help[] =
     "                     [--refine [--refine-height M] [--refine-frames K]]\n"
     "                     [--mem SIZE] [--strict] [--quiet]\n"
     "\n"
-    "Renders frames along a camera path and writes DIR/frame-0001.png ...,\n"
-    "DIR/cameras.txt (frame, eye, target in the scene's coordinates), DIR/walk.png\n"
+    "Renders frames along a camera path, --speed / --fps metres apart and the last\n"
+    "at the path's end, and writes DIR/frame-0001.png ..., DIR/cameras.txt (frame,\n"
+    "eye, target in the scene's coordinates, exposure), DIR/walk.png\n"
     "(the frames as an animated PNG, 1/F s each, looping) and DIR/contact.png (a\n"
     "contact sheet of up to 16 frames). Everything is built once (or loaded from a bake) and\n"
     "reused by every frame: with indirect light each frame reads the radiance\n"
@@ -430,7 +431,15 @@ static int cams_open(const walk_args *a, walk_run *wr)
  * frame's edge moved it 3.5 stops for one frame and back at 25 fps. */
 #define WALK_ADAPT_STOPS 4.0 /* rising; falling 4 times as fast (EXPOSURE_FALL) */
 
-static int frame(const walk_args *a, plx_engine *e, const walk_path *wp, walk_run *wr, long k, double step)
+/* Frame k's place along the path: k steps, the last frame at the path's
+ * end when the steps do not reach it (a flight's landing ended a step
+ * short, in the air). */
+static double frame_at(long k, double step, double L)
+{
+    return fmin((double)k * step, L);
+}
+
+static int frame(const walk_args *a, plx_engine *e, const walk_path *wp, walk_run *wr, long k, double s)
 {
     plx_camera cam;
     plx_render_info info;
@@ -438,7 +447,7 @@ static int frame(const walk_args *a, plx_engine *e, const walk_path *wp, walk_ru
     unsigned long long t0;
     plx_status st;
     memset(&cam, 0, sizeof cam);
-    walk_path_camera(wp, k * step, cam.eye, cam.target);
+    walk_path_camera(wp, s, cam.eye, cam.target);
     {
         double d = fmin(box_distance(wr->bounds, cam.eye[0], cam.eye[1]),
                         box_distance(wr->bounds, cam.target[0], cam.target[1]));
@@ -614,13 +623,12 @@ static int run(const walk_args *a, plx_engine *e, const walk_path *wp, long *don
     /* compared as a double: a long path at a slow pace has more steps
      * than a long holds, and converting such a double is undefined */
     steps = floor(L / step) + 1.0;
+    if (L - (steps - 1.0) * step > 1e-9 * fmax(L, 1.0)) /* and one at the end */
+        steps += 1.0;
     wr.n = steps < (double)a->max_frames ? (long)steps : a->max_frames;
     if (steps > (double)a->max_frames)
         cli_warn("walk", &a->c, "--max-frames %ld stops the walk at %.1f m of the path's %.1f m (%.4g frames "
-                 "would walk it all)", a->max_frames, (wr.n - 1) * step, L, steps);
-    if (steps < 2.0 && L > 0.0)
-        cli_warn("walk", &a->c, "one step (--speed / --fps: %g m) is longer than the path (%.1f m): one frame, at "
-                 "its start", step, L);
+                 "would walk it all)", a->max_frames, frame_at(wr.n - 1, step, L), L, steps);
     stale_hint(a, wr.n);
     sheet_plan(&wr.sh, a, wr.n);
     wr.ms = malloc(sizeof *wr.ms * (size_t)wr.n);
@@ -640,7 +648,7 @@ static int run(const walk_args *a, plx_engine *e, const walk_path *wp, long *don
     }
     cli_progress_start(&pr); /* a line on a terminal, after a second */
     for (k = 0; rc == EXIT_OK && k < wr.n; k++) {
-        rc = frame(a, e, wp, &wr, k, step);
+        rc = frame(a, e, wp, &wr, k, frame_at(k, step, L));
         cli_progress_step(&pr, "walk", (size_t)k + 1, (size_t)wr.n);
     }
     *done = rc == EXIT_OK ? k : k - 1;
@@ -665,7 +673,7 @@ static int run(const walk_args *a, plx_engine *e, const walk_path *wp, long *don
         med = wr.n % 2 ? sorted[wr.n / 2] : 0.5 * (sorted[wr.n / 2 - 1] + sorted[wr.n / 2]);
         p95 = sorted[(size_t)ceil(0.95 * wr.n) - 1];
         printf("walk: %ld frame%s %dx%d (%.1f m of %.1f m at %g m/s, %g fps, aa %d), written to %s/\n", wr.n,
-               wr.n == 1 ? "" : "s", a->w, a->h, (wr.n - 1) * step, L, a->speed, a->fps,
+               wr.n == 1 ? "" : "s", a->w, a->h, frame_at(wr.n - 1, step, L), L, a->speed, a->fps,
                a->opts.aa > 1 ? a->opts.aa : 1, a->dir);
         printf("frame time: median %.2f ms, p95 %.2f ms, mean %.2f ms: %.1f frames per second (rendering only)\n",
                med, p95, sum / wr.n, 1000.0 * wr.n / sum);
