@@ -742,6 +742,7 @@ typedef struct plx_render_opts {
 #define PLX_EXPOSURE_AUTO 1
 #define PLX_EXPOSURE_ADAPT 2
 #define PLX_EXPOSURE_TONE 3
+#define PLX_EXPOSURE_STEP_MAX 4096 /* plx_render_opts.exposure_step at most */
 /* The largest exposure automatic exposure chooses: a frame whose lit
  * surfaces are all darker than about 0.001 cd/m^2 stays dark */
 #define PLX_EXPOSURE_MAX 1024.0

@@ -188,10 +188,8 @@ plx_status plx_bake_prepare(plx_engine *e, const plx_bake_opts *o)
         return st;
     if (!o)
         return eng_fail(e, PLX_E_INVALID, "plx_bake_prepare: options are NULL");
-    if (!(o->aerial_m_per_texel == 0.0 ||
-          (o->aerial_m_per_texel >= PLX_TEXEL_MIN && o->aerial_m_per_texel <= PLX_TEXEL_MAX)))
-        return eng_fail(e, PLX_E_INVALID, "plx_bake_prepare: aerial_m_per_texel must be 0 (the default) or 0.01 .. "
-                        "1e4 m");
+    if ((st = eng_texel_check(e, "plx_bake_prepare", o->aerial_m_per_texel)) != PLX_OK)
+        return st;
     if ((!o->no_polar && (st = plx_polar_build(e)) != PLX_OK) ||
         (st = eng_need(e, ENG_LIGHT, "plx_bake_prepare")) != PLX_OK)
         return st;

@@ -177,6 +177,18 @@ void eng_render_max(const plx_engine *e, int32_t *w, int32_t *h)
     *h = e->cfg.render_max_height ? e->cfg.render_max_height : DEFAULT_MAX_H;
 }
 
+plx_status eng_texel_check(plx_engine *e, const char *fn, double t)
+{
+    strbuf b;
+    char msg[160];
+    if (t == 0.0 || (t >= PLX_TEXEL_MIN && t <= PLX_TEXEL_MAX))
+        return PLX_OK;
+    sb_init(&b, msg, sizeof msg);
+    sb_str(&b, fn);
+    sb_str(&b, ": aerial_m_per_texel must be 0 (the default) or 0.01 .. 1e4 m");
+    return eng_fail(e, PLX_E_INVALID, msg);
+}
+
 static plx_status need_render(plx_engine *e)
 {
     int32_t w, h;

@@ -657,10 +657,9 @@ plx_status plx_render(plx_engine *e, const plx_camera *cam, const plx_render_opt
         return eng_fail(e, PLX_E_INVALID, "plx_render: aa must be 0..16 (samples per pixel side)");
     /* a fixed exposure of 0 or less gave a black (or negative) frame; NaN
      * and inf were refused deeper, as "near must be > 0" */
-    if (o && !(o->aerial_m_per_texel == 0.0 || (o->aerial_m_per_texel >= PLX_TEXEL_MIN &&
-                                                  o->aerial_m_per_texel <= PLX_TEXEL_MAX)))
-        return eng_fail(e, PLX_E_INVALID, "plx_render: aerial_m_per_texel must be 0 (the default) or 0.01 .. 1e4 m");
-    if (o && (o->exposure_step < 0 || o->exposure_step > 4096))
+    if (o && eng_texel_check(e, "plx_render", o->aerial_m_per_texel) != PLX_OK)
+        return PLX_E_INVALID;
+    if (o && (o->exposure_step < 0 || o->exposure_step > PLX_EXPOSURE_STEP_MAX))
         return eng_fail(e, PLX_E_INVALID, "plx_render: exposure_step must be 0 .. 4096 (eighths of a stop)");
     if (o && (o->auto_exposure < PLX_EXPOSURE_FIXED || o->auto_exposure > PLX_EXPOSURE_TONE))
         return eng_fail(e, PLX_E_INVALID, "plx_render: auto_exposure must be PLX_EXPOSURE_FIXED, _AUTO, _ADAPT or _TONE");

@@ -73,6 +73,9 @@ plx_status eng_need_render(plx_engine *e);
 /* The largest frame the engine's renderer draws (plx_config.render_max_*,
  * their defaults for 0; a bake's as it was made). */
 void eng_render_max(const plx_engine *e, int32_t *w, int32_t *h);
+/* PLX_E_INVALID, said by the call fn, unless the atlas spacing t is 0
+ * (the default) or PLX_TEXEL_MIN .. PLX_TEXEL_MAX; PLX_OK otherwise. */
+plx_status eng_texel_check(plx_engine *e, const char *fn, double t);
 /* Builds the aerial light map at m_per_texel metres (0: 1 m) unless built;
  * dark: with a shader giving no light (the bake's twin, bake.c). Its
  * indirect layer is left to eng_lightmap_layer: only frames with indirect

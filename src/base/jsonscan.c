@@ -13,6 +13,13 @@ size_t jsonscan_ws(const char *text, size_t len, size_t off)
     return off;
 }
 
+size_t jsonscan_trailing(const char *text, size_t len, size_t end)
+{
+    while (end < len && (text[end] == ' ' || text[end] == '\t' || text[end] == '\r' || text[end] == '\n'))
+        end++;
+    return end < len && text[end] != '\0' ? end : len;
+}
+
 js_kind jsonscan_kind(const char *text, size_t off)
 {
     if (off == JSONSCAN_NONE)

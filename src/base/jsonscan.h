@@ -29,6 +29,12 @@ int jsonscan_check(const char *text, size_t len, size_t *at /* OUT */);
  * (bytes 0..32); len when none. */
 size_t jsonscan_ws(const char *text, size_t len, size_t off);
 
+/* After a document's value ending at end: the offset of the first byte
+ * that is not JSON white space (space, tab, CR, LF), or len when there is
+ * none or it is a NUL (the text ends there). Text after the value is
+ * malformed: the scene loader and the command's paths refuse it alike. */
+size_t jsonscan_trailing(const char *text, size_t len, size_t end);
+
 /* The kind of the value at off (JS_NONE for JSONSCAN_NONE). */
 js_kind jsonscan_kind(const char *text, size_t off);
 

@@ -471,7 +471,7 @@ static int frame(const walk_args *a, plx_engine *e, const walk_path *wp, walk_ru
         double eighths = floor(8.0 * WALK_ADAPT_STOPS / a->fps + 0.5); /* the most a frame */
         o.auto_exposure = PLX_EXPOSURE_ADAPT;
         o.exposure = wr->held;
-        o.exposure_step = eighths < 1.0 ? 1 : eighths > 4096.0 ? 4096 : (int)eighths;
+        o.exposure_step = eighths < 1.0 ? 1 : eighths > PLX_EXPOSURE_STEP_MAX ? PLX_EXPOSURE_STEP_MAX : (int)eighths;
     }
     t0 = port_now_ns();
     st = plx_render(e, &cam, &o, wr->rgb8, NULL, &info);

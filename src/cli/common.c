@@ -345,18 +345,17 @@ int cli_all_black(const uint8_t *px, size_t n)
     return k == n;
 }
 
-const char *cli_dark_reason(plx_engine *e)
-{
-    plx_scene_info si;
-    if (plx_scene_info_get(e, &si) != PLX_OK || si.lamps == 0)
-        return "the scene has no lamps";
-    return "no lamp's light reaches it (each lamp lights only within its radius, and buildings cast shadows)";
-}
-
 int cli_has_lamps(plx_engine *e)
 {
     plx_scene_info si;
     return plx_scene_info_get(e, &si) == PLX_OK && si.lamps > 0;
+}
+
+const char *cli_dark_reason(plx_engine *e)
+{
+    if (!cli_has_lamps(e))
+        return "the scene has no lamps";
+    return "no lamp's light reaches it (each lamp lights only within its radius, and buildings cast shadows)";
 }
 
 /* Whether the camera looks up, level or less than about 11 degrees down. */
@@ -692,13 +691,10 @@ cJSON *cli_json_parse(const char *name, const char *text, size_t len, char *err,
         cli_json_error(name, text, len, err, errlen);
         return NULL;
     }
-    off = end && end >= text ? (size_t)(end - text) : len;
-    while (off < len && (text[off] == ' ' || text[off] == '\t' || text[off] == '\r' || text[off] == '\n' ||
-                         text[off] == '\0')) /* a NUL at the end, as the scene loader takes it */
-        off++;
+    off = jsonscan_trailing(text, len, end && end >= text ? (size_t)(end - text) : len);
     if (off == len)
         return root;
-    cJSON_Delete(root); /* more after the value: the scene loader refuses it too */
+    cJSON_Delete(root); /* more after the value: the scene loader's rule */
     jsonscan_line_col(text, len, off, &line, &col);
     snprintf(err, errlen, "%s: malformed JSON at byte %zu (line %lu, column %lu)", name, off, (unsigned long)line,
              (unsigned long)col);

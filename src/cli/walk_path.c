@@ -252,27 +252,34 @@ double walk_path_length(const walk_path *wp)
 /* The point at arc length s (clamped to the path; beyond its end it goes on
  * along the last segment), of the eye polyline or, with the same
  * parameter, of the targets. */
-static void at(const walk_path *wp, const double *pts, double s, double out[3])
+/* The segment k (1 .. n - 1, from position k - 1 to k) of the eye
+ * polyline holding arc length s, the last one beyond the end; *acc the
+ * length before it, *seg its own. */
+static uint32_t segment_at(const walk_path *wp, double s, double *acc, double *seg)
 {
     uint32_t k;
-    double acc = 0;
-    for (k = 1; k < wp->n; k++) {
+    *acc = 0.0;
+    for (k = 1;; k++) {
         const double *a = wp->eye + 3 * (k - 1), *b = wp->eye + 3 * k;
-        double seg = hypot(hypot(b[0] - a[0], b[1] - a[1]), b[2] - a[2]), t;
-        int c;
-        if (s > acc + seg && k + 1 < wp->n) {
-            acc += seg;
-            continue;
-        }
-        t = seg > 0 ? (s - acc) / seg : 0;
-        if (t < 0)
-            t = 0;
-        if (pts != wp->eye && t > 1)
-            t = 1;
-        for (c = 0; c < 3; c++)
-            out[c] = pts[3 * (k - 1) + c] + t * (pts[3 * k + c] - pts[3 * (k - 1) + c]);
-        return;
+        *seg = hypot(hypot(b[0] - a[0], b[1] - a[1]), b[2] - a[2]);
+        if (!(s > *acc + *seg) || k + 1 >= wp->n)
+            return k;
+        *acc += *seg;
     }
+}
+
+static void at(const walk_path *wp, const double *pts, double s, double out[3])
+{
+    double acc, seg, t;
+    uint32_t k = segment_at(wp, s, &acc, &seg);
+    int c;
+    t = seg > 0 ? (s - acc) / seg : 0;
+    if (t < 0)
+        t = 0;
+    if (pts != wp->eye && t > 1)
+        t = 1;
+    for (c = 0; c < 3; c++)
+        out[c] = pts[3 * (k - 1) + c] + t * (pts[3 * k + c] - pts[3 * (k - 1) + c]);
 }
 
 /* A segment's horizontal length under this moves the eye too little to
@@ -297,16 +304,8 @@ static int seg_dir(const walk_path *wp, uint32_t k, double d[2])
  * before it; 0 when none does. */
 static int walk_dir(const walk_path *wp, double s, double d[2])
 {
-    uint32_t k, here = 1;
-    double acc = 0;
-    for (k = 1; k < wp->n; k++) {
-        const double *a = wp->eye + 3 * (k - 1), *b = wp->eye + 3 * k;
-        double seg = hypot(hypot(b[0] - a[0], b[1] - a[1]), b[2] - a[2]);
-        here = k;
-        if (!(s > acc + seg))
-            break;
-        acc += seg;
-    }
+    double acc, seg;
+    uint32_t k, here = segment_at(wp, s, &acc, &seg);
     for (k = here; k < wp->n; k++)
         if (seg_dir(wp, k, d))
             return 1;

@@ -139,11 +139,6 @@ static plx_status parse_error(loader *ld, const char *at)
     return eng_fail(ld->e, PLX_E_PARSE, msg);
 }
 
-static int is_space(char c)
-{
-    return c == ' ' || c == '\t' || c == '\r' || c == '\n';
-}
-
 /* Checks the whole text; a value followed by anything but white space (up
  * to a NUL byte) is malformed. */
 static plx_status check_json(loader *ld)
@@ -151,9 +146,7 @@ static plx_status check_json(loader *ld)
     size_t end, p = 0;
     if (!jsonscan_check(ld->text, ld->len, &end))
         return parse_error(ld, ld->text + end);
-    while (end < ld->len && is_space(ld->text[end]))
-        end++;
-    if (end < ld->len && ld->text[end] != '\0')
+    if ((end = jsonscan_trailing(ld->text, ld->len, end)) < ld->len)
         return parse_error(ld, ld->text + end);
     if (ld->len >= 5 && memcmp(ld->text, "\xEF\xBB\xBF", 3) == 0)
         p = 3; /* a UTF-8 byte order mark */
