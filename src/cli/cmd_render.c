@@ -160,11 +160,13 @@ static int parse_args(int argc, char **argv, render_args *a)
     return EXIT_OK;
 }
 
-/* A free ground point at (x, y): not inside any footprint (visibility test). */
+/* Whether (x, y) is a free ground point, not inside any footprint
+ * (visibility test): 1 free, 0 not, -1 out of memory for the query. */
 static int free_point(plx_engine *e, double x, double y)
 {
     plx_visibility v;
-    return plx_visibility_get(e, x, y, 0, 1, &v) == PLX_OK;
+    plx_status st = plx_visibility_get(e, x, y, 0, 1, &v);
+    return st == PLX_OK ? 1 : st == PLX_E_NOMEM ? -1 : 0;
 }
 
 /* A warning when the eye is inside a building's solid (over its footprint,
@@ -192,7 +194,8 @@ static void warn_eye_inside(plx_engine *e, const double *eye, int quiet)
  * 8 directions each, an eye 1.7 m high 12 m before the lamp with 40 m of free
  * ground past it, choosing the most enclosed view (the smallest visible area
  * in a 60-degree field of view, at least 300 m^2): a street rather than a
- * square. */
+ * square. 0 found, -1 none, -2 no memory for the polar diagrams, -3 no
+ * memory for the search's visibility queries. */
 typedef struct lamp_rank {
     double dist;
     uint32_t i;
@@ -235,11 +238,17 @@ static int default_street(plx_engine *e, plx_camera *cam)
             double a = d * 0.7853981633974483, ux = cos(a), uy = sin(a);
             double ex = l.x - 12 * ux, ey = l.y - 12 * uy, tx = l.x + 40 * ux, ty = l.y + 40 * uy;
             plx_visibility v;
+            plx_status vs = PLX_OK;
             int k, ok = free_point(e, ex, ey);
-            for (k = 1; ok && k <= 10; k++)
+            for (k = 1; ok == 1 && k <= 10; k++)
                 ok = free_point(e, ex + (tx - ex) * k / 10, ey + (ty - ey) * k / 10);
-            if (!ok || plx_visibility_get(e, ex, ey, a * 57.29577951308232, 60, &v) != PLX_OK ||
-                v.area < 300 || v.area >= best)
+            if (ok == 1)
+                vs = plx_visibility_get(e, ex, ey, a * 57.29577951308232, 60, &v);
+            if (ok < 0 || vs == PLX_E_NOMEM) {
+                free(r);
+                return -3;
+            }
+            if (ok == 0 || vs != PLX_OK || v.area < 300 || v.area >= best)
                 continue;
             best = v.area;
             cam->eye[0] = ex;
@@ -361,6 +370,11 @@ int cmd_render(int argc, char **argv)
             fprintf(stderr, "polarlux render: %s: the default street view needs the polar diagrams to find a "
                             "street%s; give --eye and --target, --view aerial, or a larger --mem\n",
                     plx_last_error(e), cli_bake_last.loaded ? ", and this bake was made without them (--no-polar)" : "");
+            plx_engine_free(e);
+            return EXIT_NOMEM;
+        } else if (rc == -3) {
+            fprintf(stderr, "polarlux render: %s: the default street view's search for a street ran out of "
+                            "memory; give --eye and --target, --view aerial, or a larger --mem\n", plx_last_error(e));
             plx_engine_free(e);
             return EXIT_NOMEM;
         } else if (rc != 0) {

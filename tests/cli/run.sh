@@ -265,6 +265,11 @@ else echo "FAIL render-photons-floor: eixample-4x4's default image is not --phot
 npm=$("$bin" info "$tmp/np.plxb" --min-mem 2>/dev/null | sed -n 's/^smallest --mem: \([0-9]*\) bytes.*/\1/p')
 expect bake-no-polar-default-view 3 "the default street view needs the polar diagrams to find a street, and this bake was made without them \(--no-polar\); give --eye and --target, --view aerial, or a larger --mem$" -- \
     "$bin" render -q "$tmp/np.plxb" --mem $((npm - 150000)) --size 16x12 -o "$tmp/npv.png"
+# in the smallest block that loads a bake with its polar diagrams, the
+# default street view's visibility queries run out of memory: it says so
+# (it said "found no free street spot beside a lamp", exit 1)
+expect render-nomem-street-search 3 "ran out of memory; give --eye and --target, --view aerial, or a larger --mem$" -- \
+    "$bin" render -q "$tmp/e.plxb" --mem "$amem" --size 16x12 -o "$tmp/nss.png"
 head -c 5000 "$tmp/e.plxb" >"$tmp/cut.plxb"
 expect bake-truncated 1 "^polarlux info: $tmp/cut\.plxb: truncated bake file: 5000 bytes, the header says [0-9]+$" -- "$bin" info "$tmp/cut.plxb"
 expect bake-version 1 "^polarlux render: tests/corpus/bake-version-99\.plxb: bake format version 99, this polarlux reads version 3; bake the scene again$" -- \
