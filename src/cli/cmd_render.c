@@ -263,6 +263,12 @@ static int default_street(plx_engine *e, plx_camera *cam)
     return best < INFINITY ? 0 : -1;
 }
 
+/* The default aerial view: straight down over the scene's box (its
+ * buildings plus 50 m), the box's limiting side 1 / AERIAL_MARGIN of the
+ * frame's (a margin of 5% of the frame each side: with none, glow discs
+ * and lit ground at the box's edge touched the frame's). */
+#define AERIAL_MARGIN (1.0 / 0.9)
+
 static void default_aerial(plx_engine *e, plx_camera *cam)
 {
     plx_scene_info si;
@@ -270,7 +276,7 @@ static void default_aerial(plx_engine *e, plx_camera *cam)
     plx_scene_info_get(e, &si);
     w = si.bounds[2] - si.bounds[0];
     h = si.bounds[3] - si.bounds[1];
-    half = 0.5 * fmax(h, w * cam->height / cam->width);
+    half = 0.5 * fmax(h, w * cam->height / cam->width) * AERIAL_MARGIN;
     cam->target[0] = cam->eye[0] = 0.5 * (si.bounds[0] + si.bounds[2]);
     cam->target[1] = cam->eye[1] = 0.5 * (si.bounds[1] + si.bounds[3]);
     cam->target[2] = 0.0;
