@@ -152,7 +152,8 @@ typedef struct plx_config {
     size_t lit_cache_bytes;           /* pool for lamp lit regions (0: from the budget, an eighth of
                                          the free bytes at first use, 256 KiB to 16 MiB) */
     int32_t render_max_width;         /* largest frame plx_render draws (0: 1920; at most
-                                         PLX_RENDER_MAX_DIM, plx_engine_create refuses more) */
+                                         PLX_RENDER_MAX_DIM, plx_engine_create refuses more),
+                                         either way round: it draws height x width frames too */
     int32_t render_max_height;        /* (0: 1080) */
     size_t lightmap_bytes;            /* the light maps' budget: the radiance atlas's (4 bytes a
                                          sample point, its spacing grows from the one asked for until
@@ -818,7 +819,7 @@ typedef struct plx_render_info {
  * Errors: PLX_E_INVALID (cam NULL; eye or target not finite; eye not above
  * the ground, z <= 0; eye == target; fov_deg outside (0, 180); width or
  * height outside 1 .. the engine's largest frame, render_max_width/height
- * or the bake's; o->auto_exposure not one of PLX_EXPOSURE_FIXED, _AUTO,
+ * or the bake's, either way round; o->auto_exposure not one of PLX_EXPOSURE_FIXED, _AUTO,
  * _ADAPT, _TONE (before 2026-11-30 any nonzero value meant _AUTO; 2 and 3
  * now hold or fix the exposure); o->exposure not a finite number above 0
  * unless auto_exposure is PLX_EXPOSURE_AUTO; o->aa outside 0 ..

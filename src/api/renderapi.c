@@ -590,7 +590,7 @@ static plx_status frame_fits(plx_engine *e, const plx_camera *cam)
     int32_t w, h;
     strbuf b;
     eng_render_max(e, &w, &h);
-    if (cam->width >= 1 && cam->height >= 1 && cam->width <= w && cam->height <= h)
+    if (render_frame_fits(cam->width, cam->height, w, h))
         return PLX_OK;
     sb_init(&b, e->err, sizeof e->err);
     sb_str(&b, "plx_render: a ");
@@ -601,7 +601,11 @@ static plx_status frame_fits(plx_engine *e, const plx_camera *cam)
     sb_int(&b, w);
     sb_str(&b, "x");
     sb_int(&b, h);
-    sb_str(&b, ", the largest this engine draws (plx_config.render_max_width/height; a bake's --max-size)");
+    sb_str(&b, " (or ");
+    sb_int(&b, h);
+    sb_str(&b, "x");
+    sb_int(&b, w);
+    sb_str(&b, "), the largest this engine draws (plx_config.render_max_width/height; a bake's --max-size)");
     return PLX_E_INVALID;
 }
 

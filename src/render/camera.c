@@ -15,7 +15,7 @@ int camera_setup(render *r, const render_camera *c, const render_opts *o)
             return r->err = "render_frame: eye and target must be finite", 0;
     if (!(c->fov_deg > 0.0 && c->fov_deg < 180.0))
         return r->err = "render_frame: fov must be in (0, 180) degrees", 0;
-    if (c->width < 1 || c->height < 1 || c->width > r->max_w || c->height > r->max_h)
+    if (!render_frame_fits(c->width, c->height, r->max_w, r->max_h))
         return r->err = "render_frame: image size outside 1 .. the render object's maximum", 0;
     if (!(c->eye[2] > 0.0))
         return r->err = "render_frame: the eye must be above the ground (z > 0)", 0;

@@ -44,6 +44,20 @@ static size_t stop_rows(int32_t max_h)
     return (size_t)(max_h / IND_STEP + 2) + (size_t)max_h;
 }
 
+/* The longer side of max_w x max_h: a frame of either orientation is
+ * drawn (render_frame_fits), so the buffers of a row or a column of the
+ * frame take this many. The buffers of the whole frame (pixels, tiles,
+ * corners) are the same for both. */
+static int32_t long_side(int32_t max_w, int32_t max_h)
+{
+    return max_w > max_h ? max_w : max_h;
+}
+
+int render_frame_fits(int32_t w, int32_t h, int32_t max_w, int32_t max_h)
+{
+    return w >= 1 && h >= 1 && ((w <= max_w && h <= max_h) || (w <= max_h && h <= max_w));
+}
+
 size_t render_bytes(const scene *s, int32_t max_w, int32_t max_h)
 {
     size_t px = (size_t)max_w * (size_t)max_h;
@@ -53,8 +67,8 @@ size_t render_bytes(const scene *s, int32_t max_w, int32_t max_h)
            (size_t)CULL_SIDE * CULL_SIDE * (6 * sizeof(double) + 4 + sizeof(cull_item)) + RENDER_BINS * 8 +
            (size_t)(CULL_SIDE / CULL_GROUP + 1) * (CULL_SIDE / CULL_GROUP + 1) * (6 * sizeof(double) + 1) + 16 +
            sizeof(tonemap_table) + 8 + sizeof(exposure_table) + 8 +
-           corners * (1 + 3 * sizeof(float)) + 2 * (size_t)(max_w / IND_STEP + 2) * sizeof(corner_hit) + render_surf_slots(s, max_w, max_h) * (sizeof(uint32_t) + sizeof(mesh_surf)) +
-           stop_rows(max_h) * sizeof(int32_t) + arena_mul((size_t)s->nlamps + 1, sizeof(uint32_t)) + 64 +
+           corners * (1 + 3 * sizeof(float)) + 2 * (size_t)(long_side(max_w, max_h) / IND_STEP + 2) * sizeof(corner_hit) + render_surf_slots(s, max_w, max_h) * (sizeof(uint32_t) + sizeof(mesh_surf)) +
+           stop_rows(long_side(max_w, max_h)) * sizeof(int32_t) + arena_mul((size_t)s->nlamps + 1, sizeof(uint32_t)) + 64 +
            arena_mul((size_t)s->nlamps + 1, sizeof(glow_seen)) + 16 +
            sizeof(render) + 4096;
 }
@@ -158,8 +172,9 @@ plx_status render_create(arena *a, const scene *s, int32_t max_w, int32_t max_h,
     r->ind = arena_alloc(a, PLX_PART_FRAME,
                          arena_mul((size_t)(max_w / IND_STEP + 2) * (size_t)(max_h / IND_STEP + 2),
                                    3 * sizeof(float)), R_ALIGN);
-    r->crow = arena_alloc(a, PLX_PART_FRAME, 2 * (size_t)(max_w / IND_STEP + 2) * sizeof(corner_hit), R_ALIGN);
-    r->stop = arena_alloc(a, PLX_PART_FRAME, stop_rows(max_h) * sizeof(int32_t), R_ALIGN);
+    r->crow = arena_alloc(a, PLX_PART_FRAME, 2 * (size_t)(long_side(max_w, max_h) / IND_STEP + 2) * sizeof(corner_hit),
+                          R_ALIGN);
+    r->stop = arena_alloc(a, PLX_PART_FRAME, stop_rows(long_side(max_w, max_h)) * sizeof(int32_t), R_ALIGN);
     if (shade == render_shade_light && user)
         r->lt = user;
     if (!r->tm || !r->et || !r->defer || !r->blk || !r->ind || !r->crow || !r->stop) {
@@ -208,8 +223,8 @@ void render_frame_clear(render *r)
     memset(r->defer, 0, tiles);
     memset(r->blk, 0, corners);
     memset(r->ind, 0, corners * 3 * sizeof *r->ind);
-    memset(r->crow, 0, 2 * (size_t)(r->max_w / IND_STEP + 2) * sizeof *r->crow);
-    memset(r->stop, 0, stop_rows(r->max_h) * sizeof *r->stop);
+    memset(r->crow, 0, 2 * (size_t)(long_side(r->max_w, r->max_h) / IND_STEP + 2) * sizeof *r->crow);
+    memset(r->stop, 0, stop_rows(long_side(r->max_w, r->max_h)) * sizeof *r->stop);
     memset(r->tm, 0, sizeof *r->tm);
     memset(r->ws, 0, sizeof r->ws);
     memset(r->hist, 0, sizeof r->hist);

@@ -392,6 +392,11 @@ plx_status render_create(arena *a, const scene *s, int32_t max_w, int32_t max_h,
  * kilobytes of alignment; the mesh's bytes are render_mesh(r)->bytes. */
 size_t render_bytes(const scene *s, int32_t max_w, int32_t max_h);
 
+/* Whether a w x h frame is one a render object for max_w x max_h draws:
+ * at most max_w x max_h, or max_h x max_w (turned a quarter: a portrait
+ * screen's frames from a bake for a landscape one). */
+int render_frame_fits(int32_t w, int32_t h, int32_t max_w, int32_t max_h);
+
 /* The mesh (read-only). */
 const mesh *render_mesh(const render *r);
 

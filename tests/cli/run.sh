@@ -224,8 +224,13 @@ expect walk-unknown-option 2 "polarlux walk: unknown option '--bogus'" -- "$bin"
 expect walk-missing-path 2 "missing --path CAMERA.geojson" -- "$bin" walk "$tmp/e.plxb" -o "$tmp/w"
 printf '{"type":"Feature","properties":{"units":"m"},"geometry":{"type":"LineString","coordinates":[[298.6,265.5,1.7],[270,294,1.7],[262,330]]}}' >"$tmp/path.geojson"
 # a frame larger than the bake's --max-size: the sizes, not a crash
-expect bake-frame-too-large 2 "a 320x240 frame is outside 1x1 \.\. 160x120, the largest this engine draws" -- \
+expect bake-frame-too-large 2 "a 320x240 frame is outside 1x1 \.\. 160x120 \(or 120x160\), the largest this engine draws" -- \
     "$bin" render -q "$tmp/e.plxb" --no-indirect --size 320x240 -o "$tmp/big.png"
+# the same frame turned a quarter is drawn (a portrait screen from a bake
+# for a landscape one; it was refused)
+expect bake-frame-turned 0 "^street view 120x160 " -- "$bin" render -q "$tmp/e.plxb" --size 120x160 -o "$tmp/turn.png"
+expect bake-frame-turned-walk 0 "^walk: 3 frames 120x160 " -- \
+    "$bin" walk -q "$tmp/e.plxb" --path "$tmp/path.geojson" --size 120x160 --max-frames 3 -o "$tmp/turnw"
 # a bake without polar diagrams (for frames in a small block): smaller, and a
 # visibility query on it builds them on need, with the same answers
 expect bake-no-polar 0 "^baked " -- \
