@@ -75,8 +75,8 @@ static int read_positions(const cJSON *coords, int project, const plx_scene_info
         }
         if (fabs(out[3 * k]) > CLI_MAX_COORD || fabs(out[3 * k + 1]) > CLI_MAX_COORD ||
             fabs(out[3 * k + 2]) > CLI_MAX_COORD) {
-            snprintf(why, whylen, "position %d (%g, %g, %g) is more than 1e7 m from the origin", k, out[3 * k],
-                     out[3 * k + 1], out[3 * k + 2]);
+            snprintf(why, whylen, "position %d (%g, %g, %g) is more than 1e7 m from the %s", k, x->valuedouble,
+                     y->valuedouble, out[3 * k + 2], project ? "scene's origin" : "origin");
             return -1;
         }
         if (eyes && !(out[3 * k + 2] > 0)) {
@@ -196,6 +196,13 @@ static int parse(const cJSON *root, plx_engine *e, walk_path *wp, char *why, siz
     }
     if (read_positions(coords, project, &si, wp->eye, n, 1, why, whylen) != 0)
         return -1;
+    /* positions in lon/lat: so are the targets (a latitude of 95 was
+     * projected far north, and render refused the camera walk wrote) */
+    if (targets && project && (k = first_not_lonlat(targets)) >= 0) {
+        snprintf(why, whylen, "properties.targets: position %d is not lon/lat (-180..180, -90..90) and the "
+                 "path's positions are: give the targets in the positions' coordinates", k);
+        return -1;
+    }
     if (targets && read_positions(targets, project, &si, wp->target, n, 0, why, whylen) != 0) {
         char inner[320];
         snprintf(inner, sizeof inner, "%s", why);

@@ -512,6 +512,15 @@ expect walk-target-is-eye 1 "^polarlux walk: .*kt\.geojson: properties\.targets:
 printf '{"type":"LineString","coordinates":[[24.944,60.168],[24.946,95.0]]}' >"$tmp/ll.geojson"
 expect walk-lonlat-mixed 1 "position 0 is lon/lat \(the scene's coordinates\) but position 1 is not: give every position in lon/lat, or all in local metres with properties\.units \"m\"$" -- \
     "$bin" walk -q fixtures/helsinki-centre.geojson --path "$tmp/ll.geojson" --no-indirect -o "$tmp/wmf"
+# lon/lat positions and a target out of lon/lat range, or in metres: refused
+# (a latitude of 95 was projected far north without a word, and render
+# refused the camera cameras.txt held)
+printf '{"type":"Feature","properties":{"targets":[[24.945,95,0],[24.947,60.1679,0]]},"geometry":{"type":"LineString","coordinates":[[24.9436,60.1677,10],[24.9465,60.1678,20]]}}' >"$tmp/llt.geojson"
+expect walk-lonlat-targets 1 "properties\.targets: position 0 is not lon/lat \(-180\.\.180, -90\.\.90\) and the path's positions are: give the targets in the positions' coordinates$" -- \
+    "$bin" walk -q fixtures/helsinki-centre.geojson --path "$tmp/llt.geojson" --no-indirect -o "$tmp/wlt"
+printf '{"type":"Feature","properties":{"targets":[[24.945,60.1679,0],[200,-430,0]]},"geometry":{"type":"LineString","coordinates":[[24.9436,60.1677,10],[24.9465,60.1678,20]]}}' >"$tmp/llm.geojson"
+expect walk-lonlat-targets-metres 1 "properties\.targets: position 1 is not lon/lat" -- \
+    "$bin" walk -q fixtures/helsinki-centre.geojson --path "$tmp/llm.geojson" --no-indirect -o "$tmp/wlt"
 printf '{"type":"LineString","coordinates":[[1,2]]}' >"$tmp/short.geojson"
 expect walk-short-path 1 "^polarlux walk: $tmp/short\.geojson: the LineString needs at least 2 positions$" -- "$bin" walk -q "$tmp/e.plxb" --path "$tmp/short.geojson" -o "$tmp/w3"
 # a coordinate beyond 1e7 m (it made the frame count overflow, then "out of
