@@ -32,7 +32,7 @@ static const char help[] =
     "  --photons N     photons per frame (default 16 a lamp, from 65536 to\n"
     "                  1048576: a large city's facades need more)\n"
     "  --frames K      photon frames (default 16: the points' final gathering\n"
-    "                  reads them too)\n"
+    "                  reads them too; 0 bakes as --no-indirect)\n"
     "  --no-indirect   no photon buffers\n"
     "  --no-aerial     no radiance atlas: frames lay it out in the loaded block and\n"
     "                  fill it as they need it (coarser than a full bake's when it\n"
@@ -56,6 +56,7 @@ typedef struct bake_args {
     cli_common c;
     cli_indirect ind;
     plx_bake_opts o;
+    int frames0;    /* --frames 0: baked as with --no-indirect */
 } bake_args;
 
 static int parse_texel(const char *v, void *dst)
@@ -98,6 +99,11 @@ static int parse_args(int argc, char **argv, bake_args *a)
                 a->scene);
         return EXIT_USAGE;
     }
+    /* no photon frames: a bake as with --no-indirect (the photon buffers
+     * and a radiance atlas of direct light were built and saved, and
+     * frames, having no indirect light, shaded every pixel instead) */
+    a->frames0 = !a->ind.off && a->ind.frames == 0;
+    a->ind.off |= a->frames0;
     a->o.no_indirect = a->ind.off;
     return EXIT_OK;
 }
@@ -279,8 +285,8 @@ int cmd_bake(int argc, char **argv)
                a.out, bytes, bytes / 1048576.0, m.used_total, m.used_total / 1048576.0);
         cli_atlas_print(e);
         char ph[96];
-        if (a.ind.off || a.ind.frames == 0)
-            snprintf(ph, sizeof ph, "no photons (%s)", a.ind.off ? "--no-indirect" : "--frames 0");
+        if (a.ind.off)
+            snprintf(ph, sizeof ph, "no photons (%s)", a.frames0 ? "--frames 0: as --no-indirect" : "--no-indirect");
         else
             snprintf(ph, sizeof ph, "photons %.0f ms (%ld x %ld)", (t2 - t1) / 1e6, a.ind.frames,
                      cli_photons(e, &a.ind));

@@ -152,6 +152,12 @@ expect bake-no-indirect-render 0 "warning: .*end\.plxb holds no indirect light \
     "$bin" render "$tmp/end.plxb" --size 160x120 -o "$tmp/end1.png"
 "$bin" render -q "$tmp/end.plxb" --size 160x120 --no-indirect -o "$tmp/end2.png" >/dev/null 2>&1
 if cmp -s "$tmp/end1.png" "$tmp/end2.png"; then echo "ok   bake-no-indirect-direct-light"; pass=$((pass + 1)); else echo "FAIL bake-no-indirect-direct-light"; fail=$((fail + 1)); fi
+# --frames 0 bakes as --no-indirect, the same file (it kept photon buffers
+# and an atlas of direct light that frames never read: 5 MB more on the
+# Helsinki district, and its frames shaded every pixel all the same)
+expect bake-frames-zero 0 "no photons \(--frames 0: as --no-indirect\)" -- \
+    "$bin" bake fixtures/eixample-4x4.geojson --frames 0 --max-size 160x120 -o "$tmp/f0.plxb"
+if cmp -s "$tmp/f0.plxb" "$tmp/end.plxb"; then echo "ok   bake-frames-zero-file"; pass=$((pass + 1)); else echo "FAIL bake-frames-zero-file: not the --no-indirect bake"; fail=$((fail + 1)); fi
 printf '{"type":"LineString","coordinates":[[20,5,1.7],[20,60,1.7]],"properties":{"units":"m"}}' >"$tmp/endpath.geojson"
 expect bake-no-indirect-walk 0 "holds no indirect light" -- \
     "$bin" walk "$tmp/end.plxb" --path "$tmp/endpath.geojson" --size 160x120 --max-frames 3 -o "$tmp/endw"
