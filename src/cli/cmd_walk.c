@@ -168,7 +168,8 @@ static int cmp_double(const void *x, const void *y)
 
 /* The contact sheet: up to 16 frames spread over the walk, 4 to a row,
  * each shrunk by an integer factor f (box filter) to at most 400 pixels
- * wide, drawn into the sheet as each is rendered (the frames themselves
+ * on its longer side (a portrait frame's height: a sheet of 768x1024
+ * frames was 2.25 times the bytes of one of 1024x768 frames), drawn into the sheet as each is rendered (the frames themselves
  * are not kept). */
 typedef struct sheet {
     uint8_t *px;               /* W x H x 3, NULL: none */
@@ -187,23 +188,29 @@ static void sheet_size(sheet *sh, const walk_args *a, long frames, int f)
     sh->H = (cells + 3) / 4 * sh->th;
 }
 
+/* The frame's longer side. */
+static int long_side(const walk_args *a)
+{
+    return a->w > a->h ? a->w : a->h;
+}
+
 static void sheet_plan(sheet *sh, const walk_args *a, long frames)
 {
     int f;
     memset(sh, 0, sizeof *sh);
-    for (f = 1; a->w / f > 400; f++)
+    for (f = 1; long_side(a) / f > 400; f++)
         ;
     sheet_size(sh, a, frames, f);
 }
 
 /* A smaller sheet when the budget leaves too little room for the planned
- * one: frames shrunk further, down to 80 pixels wide; 0 when even that
- * does not fit. */
+ * one: frames shrunk further, down to 80 pixels on the longer side; 0
+ * when even that does not fit. */
 static int sheet_fit(sheet *sh, const walk_args *a, long frames, size_t room)
 {
     int f = sh->f;
     while ((size_t)sh->W * sh->H * 3 > room) {
-        if (a->w / (f + 1) < 80)
+        if (long_side(a) / (f + 1) < 80)
             return 0;
         sheet_size(sh, a, frames, ++f);
     }

@@ -468,6 +468,13 @@ cp "$tmp/w2/cameras.txt" "$tmp/w2cams.txt"
 if cmp -s "$tmp/w2/cameras.txt" "$tmp/w2cams.txt"; then echo "ok   walk-fail-keeps-cameras"; pass=$((pass + 1))
 else echo "FAIL walk-fail-keeps-cameras: a walk whose first frame failed changed the folder's cameras.txt"; fail=$((fail + 1)); fi
 if [ -s "$tmp/w2/contact.png" ]; then echo "ok   walk-contact-sheet"; pass=$((pass + 1)); else echo "FAIL walk-contact-sheet"; fail=$((fail + 1)); fi
+# portrait frames are shrunk into the sheet by their longer side, as
+# landscape ones by theirs (360x640 frames were not shrunk: a 1440x640
+# sheet where 640x360 frames give 640x180)
+"$bin" walk -q fixtures/eixample-4x4.geojson --path "$tmp/path.geojson" --size 360x640 --max-frames 4 --aa 1 --no-indirect -o "$tmp/wport" >/dev/null 2>&1
+set -- $(od -An -tu1 -j16 -N8 "$tmp/wport/contact.png")
+if [ $# -eq 8 ] && [ $(($3 * 256 + $4)) -eq 720 ] && [ $(($7 * 256 + $8)) -eq 320 ]; then echo "ok   walk-contact-portrait"; pass=$((pass + 1))
+else echo "FAIL walk-contact-portrait: sheet header bytes $*, want 720x320"; fail=$((fail + 1)); fi
 # a frame's delay is 1/fps exactly where 16-bit terms allow (it was
 # whole milliseconds: 33/1000 at 30 and at 29.97 fps)
 "$bin" walk -q "$tmp/e.plxb" --path "$tmp/path.geojson" --size 32x24 --fps 29.97 --max-frames 2 --aa 1 --no-indirect -o "$tmp/wfps" >/dev/null 2>&1
