@@ -685,7 +685,8 @@ plx_status plx_render(plx_engine *e, const plx_camera *cam, const plx_render_opt
             return st;
         /* too large for the block: every pixel shaded instead, said once */
         eng_warn(e, "the radiance atlas does not fit in the block (plx_config.lightmap_bytes, --mem, --texel): "
-                    "frames with indirect light shade every pixel instead (slower)");
+                    "frames with indirect light shade every pixel instead (much slower: seconds a frame "
+                    "for an aerial view; no_indirect, --no-indirect, for direct light alone)");
         e->atlas_off = 1;
         use_atlas = 0;
         eng_clear_error(e);
