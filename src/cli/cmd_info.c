@@ -31,11 +31,12 @@ static const char help[] =
     "               are left out and lamps at an earlier lamp's position merged,\n"
     "               each with a warning.\n"
     "  --min-mem    also find the smallest --mem that loads SCENE (the file alone)\n"
-    "               and builds its\n"
-    "               polar diagrams, by bisection over loads (to 4 KiB; about 18\n"
-    "               loads), and print it; for a bake file, the smallest block its\n"
-    "               image loads in (polar diagrams built there if it has none),\n"
-    "               beside the block it takes without --mem (room for queries)\n"
+    "               and builds its polar diagrams, by bisection over loads (to\n"
+    "               4 KiB; about 18 loads), and print it; for a bake file, the\n"
+    "               smallest block its image loads in (polar diagrams built\n"
+    "               there if it has none, and then also the smallest for frames\n"
+    "               without them), beside the block it takes without --mem\n"
+    "               (room for queries)\n"
     "  --photons    also create the photon buffers (no photons traced) and print\n"
     "               the sizes chosen at this --mem: bytes, the default quality's\n"
     "               bytes, the budget, the quality steps taken to fit it, chart\n"
@@ -92,23 +93,45 @@ static void print_min_mem(const char *path, const cli_common *c, size_t hi)
            "(bisection, %d loads; a ground image needs its pixels on top)\n", hi, hi / 1048576.0, loads);
 }
 
-/* 1 when the block 'mem', given as 'bytes' long, loads the bake and has
- * its polar diagrams (built here for a --no-polar bake). The block is
- * aligned as the command's (cli_big_alloc), which the bake's offset in it
- * depends on. */
-static int bake_fits(void *mem, size_t bytes, const void *data, size_t len)
+/* 1 when the block 'mem', given as 'bytes' long, loads the bake, and with
+ * 'polar' has its polar diagrams (a bake made with them; a --no-polar
+ * bake's walk does not need them, and a query builds them: 'polar' 0).
+ * With has_polar, whether the bake holds them. The block is aligned as
+ * the command's (cli_big_alloc), which the bake's offset in it depends on. */
+static int bake_fits(void *mem, size_t bytes, const void *data, size_t len, int polar, int *has_polar)
 {
     static plx_port port;
     plx_config cfg;
     plx_engine *e;
     plx_polar_info pi;
-    int ok;
+    plx_memory_report m;
+    int ok = 1;
     silent_config(&cfg, &port);
     if (plx_bake_load(mem, bytes, &cfg, data, len, &e, NULL, 0) != PLX_OK)
         return 0;
-    ok = plx_polar_info_get(e, &pi) == PLX_OK;
+    if (has_polar) {
+        plx_memory_get(e, &m);
+        *has_polar = m.used[PLX_PART_POLAR] > 0;
+    }
+    if (polar)
+        ok = plx_polar_info_get(e, &pi) == PLX_OK;
     plx_engine_destroy(e);
     return ok;
+}
+
+/* The smallest block from lo to hi, to 4 KiB, that bake_fits (its polar
+ * diagrams too with 'polar'), by bisection; loads counted. */
+static size_t bisect_bake(void *mem, size_t lo, size_t hi, const void *data, size_t len, int polar, int *loads)
+{
+    while (hi - lo > 4096) {
+        size_t mid = lo + (hi - lo) / 2;
+        ++*loads;
+        if (bake_fits(mem, mid, data, len, polar, NULL))
+            hi = mid;
+        else
+            lo = mid;
+    }
+    return hi;
 }
 
 /* For a bake, the smallest --mem is the block its image loads in (the
@@ -120,7 +143,8 @@ static int print_min_mem_bake(const char *path, size_t hi)
     size_t len, own, lo = PLX_ENGINE_MIN_BYTES;
     char *data = port_read_text(path, &len, err, sizeof err);
     void *mem = NULL;
-    int loads = 0, rc = EXIT_FAIL;
+    int loads = 0, rc = EXIT_FAIL, polar = 1;
+    size_t alone = 0;
     if (data && plx_bake_block_size(data, len, &own, err, sizeof err) == PLX_OK) {
         if (!hi)
             hi = own;
@@ -134,19 +158,20 @@ static int print_min_mem_bake(const char *path, size_t hi)
         free(data);
         return rc;
     }
-    while (hi - lo > 4096) {
-        size_t mid = lo + (hi - lo) / 2;
-        loads++;
-        if (bake_fits(mem, mid, data, len))
-            hi = mid;
-        else
-            lo = mid;
-    }
+    if (!bake_fits(mem, hi, data, len, 0, &polar)) /* the block the info above loaded it in */
+        polar = 1;
+    hi = bisect_bake(mem, lo, hi, data, len, 1, &loads);
+    if (!polar)
+        alone = bisect_bake(mem, lo, hi, data, len, 0, &loads);
     free(mem);
     free(data);
-    printf("smallest --mem: %zu bytes (%.2f MiB) loads the bake and has its polar diagrams (bisection, %d loads; "
+    printf("smallest --mem: %zu bytes (%.2f MiB) loads the bake and has its polar diagrams%s (bisection, %d loads; "
            "without --mem a bake takes %zu bytes (%.2f MiB), room for queries and frames)\n", hi, hi / 1048576.0,
-           loads, own, own / 1048576.0);
+           polar ? "" : " (built, as info does)", loads, own, own / 1048576.0);
+    if (!polar)
+        printf("smallest --mem for frames: %zu bytes (%.2f MiB) loads the bake, made with --no-polar, without them "
+               "(walk and render with --eye, --aa 1; anti-aliasing adds 20 bytes a pixel)\n", alone,
+               alone / 1048576.0);
     return EXIT_OK;
 }
 

@@ -300,6 +300,15 @@ for f in e np; do
     expect bake-min-mem-$f-less 3 "the block is too small for the bake|out of memory while building the polar diagrams" -- \
         "$bin" info -q --mem $((n - 4096)) "$tmp/$f.plxb"
 done
+# a --no-polar bake's smallest block for frames (without the polar
+# diagrams info builds): a walk at --aa 1 runs in it, 4 KiB less does not
+# load the bake (--min-mem printed only the block with them, 42.7 MiB
+# where a walk of the e30 city's 32M bake runs in 29.9)
+nf=$("$bin" info -q --min-mem "$tmp/np.plxb" | sed -n 's/^smallest --mem for frames: \([0-9]*\) bytes .*made with --no-polar.*/\1/p')
+expect bake-min-mem-frames 0 "^walk: 2 frames" -- \
+    "$bin" walk -q "$tmp/np.plxb" --mem "${nf:-1}" --aa 1 --path "$tmp/endpath.geojson" --size 160x120 --max-frames 2 -o "$tmp/nfw"
+expect bake-min-mem-frames-less 3 "the block is too small for the bake" -- \
+    "$bin" walk -q "$tmp/np.plxb" --mem $((${nf:-1} - 4096)) --aa 1 --path "$tmp/endpath.geojson" --size 160x120 --max-frames 2 -o "$tmp/nfw"
 # a metre scene far from the origin (a projected CRS) gives the images of
 # the same scene at the origin, exact and atlas (135 and 29 lit pixels went
 # dark before 2026-11-30: wall points rounded into their buildings)
