@@ -136,7 +136,7 @@ int image_write_apng(const char *path, const char *const *frames, int n, unsigne
     safe_out *o;
     int k;
     if (n < 1 || delay_num > 65535 || delay_den > 65535) {
-        snprintf(err, errlen, "write_apng: '%s': needs 1 or more frames and delays below 65536", path);
+        snprintf(err, errlen, "animated PNG: '%s': needs 1 or more frames and delays below 65536", path);
         return -1;
     }
     o = safe_out_open(path, err, errlen);
@@ -144,7 +144,7 @@ int image_write_apng(const char *path, const char *const *frames, int n, unsigne
         return -1;
     if (safe_out_write(o, sig, 8) != 0) {
         safe_out_abort(o);
-        snprintf(err, errlen, "write_apng: '%s': write failed", path);
+        snprintf(err, errlen, "animated PNG: '%s': write failed", path);
         return -1;
     }
     for (k = 0; k < n; k++) {
@@ -156,13 +156,13 @@ int image_write_apng(const char *path, const char *const *frames, int n, unsigne
         free(b);
         if (rc != 0) {
             safe_out_abort(o);
-            snprintf(err, errlen, "write_apng: '%s': frame '%s': %s", path, frames[k], why);
+            snprintf(err, errlen, "animated PNG: '%s': frame '%s': %s", path, frames[k], why);
             return -1;
         }
     }
     if (put_chunk(o, "IEND", NULL, 0, NULL, 0) != 0) {
         safe_out_abort(o);
-        snprintf(err, errlen, "write_apng: '%s': write failed", path);
+        snprintf(err, errlen, "animated PNG: '%s': write failed", path);
         return -1;
     }
     return safe_out_commit(&o, 1, err, errlen);

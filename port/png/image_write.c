@@ -121,7 +121,7 @@ int image_encode_png(safe_out *out, const char *path, int width, int height, con
 int image_encode_png_level(safe_out *out, const char *path, int width, int height, const uint8_t *rgb,
                            int stride, int level, char *err, size_t errlen)
 {
-    const char *op = "write_png";
+    const char *op = "PNG";
     png_io io;
 
     if (check_size(op, path, width, height, rgb, err, errlen) != 0)
@@ -170,13 +170,13 @@ static int write_one(const char *op, const char *path, int width, int height, co
 int image_write_png_rgb8(const char *path, int width, int height, const uint8_t *rgb,
                          int stride, char *err, size_t errlen)
 {
-    return write_one("write_png", path, width, height, rgb, stride, 0, -1, err, errlen);
+    return write_one("PNG", path, width, height, rgb, stride, 0, -1, err, errlen);
 }
 
 int image_write_png_rgb8_fast(const char *path, int width, int height, const uint8_t *rgb,
                               int stride, char *err, size_t errlen)
 {
-    return write_one("write_png", path, width, height, rgb, stride, 0, 1, err, errlen);
+    return write_one("PNG", path, width, height, rgb, stride, 0, 1, err, errlen);
 }
 
 /* ---- PFM writer ------------------------------------------------------------ */
@@ -184,7 +184,7 @@ int image_write_png_rgb8_fast(const char *path, int width, int height, const uin
 int image_encode_pfm(safe_out *out, const char *path, int width, int height, const float *rgb,
                      char *err, size_t errlen)
 {
-    const char *op = "write_pfm";
+    const char *op = "PFM";
     size_t row_floats, i;
     unsigned char *row;
     char head[64];
@@ -226,7 +226,7 @@ int image_encode_pfm(safe_out *out, const char *path, int width, int height, con
 int image_write_pfm(const char *path, int width, int height, const float *rgb,
                     char *err, size_t errlen)
 {
-    return write_one("write_pfm", path, width, height, rgb, 0, 1, -1, err, errlen);
+    return write_one("PFM", path, width, height, rgb, 0, 1, -1, err, errlen);
 }
 
 /* ---- PNG reader ------------------------------------------------------------ */

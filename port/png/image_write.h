@@ -14,7 +14,7 @@
  * All functions return 0 on success, -1 on failure. On failure, when err is
  * not NULL and errlen > 0, err receives one line (NUL-terminated, truncated
  * to errlen) naming the operation, the file and the reason, e.g.
- *   "write_png: cannot create a temporary file for '/no/dir/a.png'
+ *   "PNG: cannot create a temporary file for '/no/dir/a.png'
  *    ('/no/dir/a.png.tmp.42.0'): No such file or directory"
  * They never print and keep no state between calls.
  */

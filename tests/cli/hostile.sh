@@ -112,7 +112,7 @@ if [ -f "$shim" ]; then
     # walk writes its frames on a thread of their own: a failed frame still stops it with exit 1
     printf '{"type":"LineString","coordinates":[[0,0,1.7],[10,0,1.7]]}' >"$tmp/walk.geojson"
     pre="LD_PRELOAD=$shim ASAN_OPTIONS=verify_asan_link_order=0 PLX_FAILWRITE_MATCH=frame-0003.png.tmp"
-    expect walk-frame-fails 1 "^polarlux walk: write_png: cannot write '$tmp/w/frame-0003.png': No space left on device$" -- \
+    expect walk-frame-fails 1 "^polarlux walk: PNG: cannot write '$tmp/w/frame-0003.png': No space left on device$" -- \
         walk -q $T --path "$tmp/walk.geojson" --size 32x24 --fps 1 --no-indirect -o "$tmp/w"
     pre=
     if [ -s "$tmp/w/frame-0002.png" ] && [ ! -e "$tmp/w/frame-0003.png" ] && [ ! -e "$tmp/w/walk.png" ] &&

@@ -254,7 +254,7 @@ static void test_missing_directory(void **state)
     snprintf(p, sizeof p, "%s/no/such/dir/out.png", t->dir);
     strcpy(err, "");
     assert_int_equal(image_write_png_rgb8(p, 6, 5, img, 0, err, sizeof err), -1);
-    assert_non_null(strstr(err, "write_png"));
+    assert_non_null(strstr(err, "PNG: "));
     assert_non_null(strstr(err, "/no/such/dir/out.png"));
     assert_non_null(strstr(err, strerror(ENOENT)));
     assert_false(file_exists(p));
@@ -262,7 +262,7 @@ static void test_missing_directory(void **state)
     snprintf(p, sizeof p, "%s/no/such/dir/out.pfm", t->dir);
     strcpy(err, "");
     assert_int_equal(image_write_pfm(p, 6, 5, fimg, err, sizeof err), -1);
-    assert_non_null(strstr(err, "write_pfm"));
+    assert_non_null(strstr(err, "PFM: "));
     assert_non_null(strstr(err, "out.pfm"));
     assert_non_null(strstr(err, strerror(ENOENT)));
     assert_false(file_exists(p));
