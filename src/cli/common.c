@@ -462,6 +462,25 @@ int cli_is_bake(const char *path)
     return yes;
 }
 
+/* A regular file named *.plxb whose first byte cannot start a JSON text
+ * (after white space, '{' or '['): a bake whose magic is damaged, which
+ * the bake reader refuses as such (the scene reader said "malformed JSON
+ * at byte 0"). */
+static int damaged_bake(const char *path)
+{
+    size_t n = strlen(path);
+    struct stat sb;
+    FILE *f;
+    int ch;
+    if (n < 5 || strcmp(path + n - 5, ".plxb") != 0 || stat(path, &sb) != 0 || !S_ISREG(sb.st_mode) ||
+        !(f = fopen(path, "rb")))
+        return 0;
+    while ((ch = fgetc(f)) == ' ' || ch == '\t' || ch == '\n' || ch == '\r')
+        ;
+    fclose(f);
+    return ch != EOF && ch != '{' && ch != '[';
+}
+
 /* A whole file in a block of cli_big_alloc; NULL and a reason on failure. */
 static char *read_big(const char *path, size_t *len, char *err, size_t errlen)
 {
@@ -533,7 +552,7 @@ int cli_open_scene(const char *cmd, const char *path, const cli_common *c, plx_e
 {
     plx_config cfg;
     plx_status st;
-    if (cli_is_bake(path)) {
+    if (cli_is_bake(path) || damaged_bake(path)) {
         if (c->nlamp_files > 0) {
             fprintf(stderr, "polarlux %s: %s: --lamps cannot be added to a bake file; give them to 'polarlux bake'\n",
                     cmd, path);

@@ -281,6 +281,10 @@ expect bake-no-polar-default-view 3 "the default street view needs the polar dia
 # (it said "found no free street spot beside a lamp", exit 1)
 expect render-nomem-street-search 3 "ran out of memory; give --eye and --target, --view aerial, or a larger --mem$" -- \
     "$bin" render -q "$tmp/e.plxb" --mem "$amem" --size 16x12 -o "$tmp/nss.png"
+# a bake whose first byte is damaged is refused as a bake, not as JSON
+# ("malformed JSON at byte 0")
+{ printf 'Q'; tail -c +2 "$tmp/e.plxb"; } >"$tmp/dmg.plxb"
+expect bake-damaged-magic 1 "^polarlux info: $tmp/dmg\.plxb: not a polarlux bake file \(no PLXBAKE magic\)$" -- "$bin" info "$tmp/dmg.plxb"
 head -c 5000 "$tmp/e.plxb" >"$tmp/cut.plxb"
 expect bake-truncated 1 "^polarlux info: $tmp/cut\.plxb: truncated bake file: 5000 bytes, the header says [0-9]+$" -- "$bin" info "$tmp/cut.plxb"
 expect bake-version 1 "^polarlux render: tests/corpus/bake-version-99\.plxb: bake format version 99, this polarlux reads version 3; bake the scene again$" -- \
