@@ -580,14 +580,20 @@ plx_status plx_bake_block_size(const void *bake, size_t len, size_t *block_bytes
     return PLX_OK;
 }
 
+/* p is NULL, or lies in the image with 'bytes' after it and on an 8-byte
+ * boundary (the load places the image as the baking engine's block lay,
+ * modulo BAKE_ALIGN, so its structures keep their alignment; they hold
+ * doubles and pointers: a misaligned renderer made the load itself fault,
+ * found by a survey of forged bakes). */
 static int inside(const void *p, size_t bytes, const unsigned char *base, size_t len)
 {
     const unsigned char *q = p;
-    return !q || (q >= base && (size_t)(q - base) <= len && bytes <= len - (size_t)(q - base));
+    return !q || (q >= base && (size_t)(q - base) <= len && bytes <= len - (size_t)(q - base) &&
+                  (uintptr_t)q % 8 == 0);
 }
 
-/* The engine's own pointers lie in the image, with room for what they
- * point at where loading touches it (the renderer). */
+/* The engine's own pointers lie in the image, aligned, with room for what
+ * they point at where loading touches it (the renderer). */
 static int roots_inside(const plx_engine *e, const unsigned char *base, size_t len)
 {
     return inside(e->sc, sizeof(scene), base, len) && inside(e->pd, 1, base, len) &&

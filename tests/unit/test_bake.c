@@ -589,6 +589,31 @@ static void test_damaged(void **state)
     f[56] = (unsigned char)(f[56] + 7) & 63;
     ref_bake_reseal(f, k.len);
     expect_fail(f, k.len, PLX_E_PARSE, "corrupt bake file: inconsistent header");
+    /* the renderer's root pointer moved off its alignment, resealed (a
+     * forged file: the load itself then bound the renderer's code at a
+     * misaligned address, a fault under UBSan and on strict machines) */
+    {
+        uint64_t img, w;
+        size_t npages, pages_at, at;
+        memcpy(f, k.file, k.len);
+        memcpy(&img, f + 40, 8);
+        npages = (size_t)((img + 4095) / 4096);
+        pages_at = 128 + (((npages + 7) / 8 + 7) & ~(size_t)7);
+        assert_true(f[128] & 1); /* page 0, the engine's, is stored */
+        at = pages_at + offsetof(struct plx_engine, rd);
+        memcpy(&w, f + at, 8);
+        assert_true(w != 0 && w % 8 == 0); /* an offset into the image */
+        w += 4;
+        memcpy(f + at, &w, 8);
+        ref_bake_reseal(f, k.len);
+        assert_int_equal(plx_bake_block_size(f, k.len, &need, err, sizeof err), PLX_OK); /* the header is sound */
+        mem = malloc(need);
+        e = (plx_engine *)&need;
+        assert_int_equal(plx_bake_load(mem, need, NULL, f, k.len, &e, err, sizeof err), PLX_E_PARSE);
+        assert_null(e);
+        assert_string_equal(err, "corrupt bake file: no engine at the start of the image");
+        free(mem);
+    }
     /* a block too small */
     assert_int_equal(plx_bake_block_size(k.file, k.len, &need, err, sizeof err), PLX_OK);
     mem = malloc(1 << 20);
