@@ -153,7 +153,8 @@ typedef struct plx_config {
                                          the free bytes at first use, 256 KiB to 16 MiB) */
     int32_t render_max_width;         /* largest frame plx_render draws (0: 1920; at most
                                          PLX_RENDER_MAX_DIM, plx_engine_create refuses more),
-                                         either way round: it draws height x width frames too */
+                                         either way round: it draws height x width frames too
+                                         (an OSMesa context, plx_osmesa_open, only its own way) */
     int32_t render_max_height;        /* (0: 1080) */
     size_t lightmap_bytes;            /* the light maps' budget: the radiance atlas's (4 bytes a
                                          sample point, its spacing grows from the one asked for until

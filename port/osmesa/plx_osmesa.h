@@ -36,8 +36,11 @@
 
 typedef struct plx_osmesa plx_osmesa;
 
-/* Opens a context for frames up to max_w x max_h (1..16384). Returns NULL
- * on failure with a one-line reason in err (errlen bytes, may be 0). */
+/* Opens a context for frames up to max_w x max_h (1..16384), this way
+ * round only: an engine draws frames either way round
+ * (plx_config.render_max_width), the context does not, so to draw both
+ * open it at the frames' own size or at the longer side squared. Returns
+ * NULL on failure with a one-line reason in err (errlen bytes, may be 0). */
 plx_osmesa *plx_osmesa_open(int32_t max_w, int32_t max_h, char *err, size_t errlen);
 
 /* The backend to put in plx_render_opts.backend (or render_opts.backend);

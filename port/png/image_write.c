@@ -259,7 +259,7 @@ static FILE *open_input(const char *op, const char *path, char *err, size_t errl
 static int read_png(const char *path, uint8_t *buf, size_t cap, uint8_t **out, int *width,
                     int *height, png_uint_32 max_dim, size_t max_bytes, char *err, size_t errlen)
 {
-    const char *op = "read_png";
+    const char *op = "PNG";
     png_structp png;
     png_infop info;
     png_io io;
@@ -383,7 +383,7 @@ int image_read_png_max(const char *path, int max_dim, uint8_t **out, int *width,
     if (max_dim < 1 || max_dim > IMAGE_MAX_DIM) {
         if (out != NULL)
             *out = NULL;
-        port_set_err(err, errlen, "read_png: max_dim %d is not 1..%d", max_dim, IMAGE_MAX_DIM);
+        port_set_err(err, errlen, "PNG: max_dim %d is not 1..%d", max_dim, IMAGE_MAX_DIM);
         return -1;
     }
     return read_png(path, NULL, 0, out, width, height, (png_uint_32)max_dim, (size_t)-1, err, errlen);
@@ -395,7 +395,7 @@ int image_read_png_budget(const char *path, int max_dim, size_t max_bytes, uint8
     if (max_dim < 1 || max_dim > IMAGE_MAX_DIM) {
         if (out != NULL)
             *out = NULL;
-        port_set_err(err, errlen, "read_png: max_dim %d is not 1..%d", max_dim, IMAGE_MAX_DIM);
+        port_set_err(err, errlen, "PNG: max_dim %d is not 1..%d", max_dim, IMAGE_MAX_DIM);
         return -1;
     }
     return read_png(path, NULL, 0, out, width, height, (png_uint_32)max_dim, max_bytes, err, errlen);

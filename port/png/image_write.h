@@ -86,10 +86,10 @@ int image_read_png_rgb8(const char *path, uint8_t *buf, size_t cap, uint8_t **ou
 /*
  * The same into a new malloc() buffer (*out, freed by the caller), refusing
  * an image wider or taller than max_dim (1..1000000) before any pixel
- * memory is taken: "read_png: 'big.png' is 20000x300 pixels, larger than
- * the 16384x16384 allowed". Other messages as above: "read_png: cannot
- * open 'x.png': No such file or directory", "read_png: 'x.png' is not a
- * PNG file (bad signature)", "read_png: cannot decode 'x.png': ...".
+ * memory is taken: "PNG: 'big.png' is 20000x300 pixels, larger than
+ * the 16384x16384 allowed". Other messages as above: "PNG: cannot
+ * open 'x.png': No such file or directory", "PNG: 'x.png' is not a
+ * PNG file (bad signature)", "PNG: cannot decode 'x.png': ...".
  */
 int image_read_png_max(const char *path, int max_dim, uint8_t **out, int *width, int *height,
                        char *err, size_t errlen);
@@ -97,7 +97,7 @@ int image_read_png_max(const char *path, int max_dim, uint8_t **out, int *width,
 /*
  * The same limited also by bytes: an image whose decoded pixels
  * (width*height*3) exceed max_bytes is refused after reading the header,
- * before any pixel memory is taken: "read_png: 'big.png' is 1000000x1000000
+ * before any pixel memory is taken: "PNG: 'big.png' is 1000000x1000000
  * pixels: decoding needs 3000000000000 bytes, more than the 1073741824 the
  * memory budget allows"; that refusal returns -2 (other failures -1). Every reader refuses a file that is not a regular
  * file (a FIFO, a device, a directory) without waiting on it.

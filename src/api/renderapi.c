@@ -601,11 +601,14 @@ static plx_status frame_fits(plx_engine *e, const plx_camera *cam)
     sb_int(&b, w);
     sb_str(&b, "x");
     sb_int(&b, h);
-    sb_str(&b, " (or ");
-    sb_int(&b, h);
-    sb_str(&b, "x");
-    sb_int(&b, w);
-    sb_str(&b, "), the largest this engine draws (plx_config.render_max_width/height; a bake's --max-size)");
+    if (w != h) {
+        sb_str(&b, " (or ");
+        sb_int(&b, h);
+        sb_str(&b, "x");
+        sb_int(&b, w);
+        sb_str(&b, ")");
+    }
+    sb_str(&b, ", the largest this engine draws (plx_config.render_max_width/height; a bake's --max-size)");
     return PLX_E_INVALID;
 }
 

@@ -188,17 +188,24 @@ static void sheet_size(sheet *sh, const walk_args *a, long frames, int f)
     sh->H = (cells + 3) / 4 * sh->th;
 }
 
-/* The frame's longer side. */
+/* The frame's longer and shorter sides. */
 static int long_side(const walk_args *a)
 {
     return a->w > a->h ? a->w : a->h;
 }
 
+static int short_side(const walk_args *a)
+{
+    return a->w < a->h ? a->w : a->h;
+}
+
+/* The factor f shrinks the longer side to 400 pixels or less, and keeps
+ * the shorter one at least a pixel (a 3x1600 frame: 3 pixels wide). */
 static void sheet_plan(sheet *sh, const walk_args *a, long frames)
 {
     int f;
     memset(sh, 0, sizeof *sh);
-    for (f = 1; long_side(a) / f > 400; f++)
+    for (f = 1; long_side(a) / f > 400 && f < short_side(a); f++)
         ;
     sheet_size(sh, a, frames, f);
 }
@@ -210,7 +217,7 @@ static int sheet_fit(sheet *sh, const walk_args *a, long frames, size_t room)
 {
     int f = sh->f;
     while ((size_t)sh->W * sh->H * 3 > room) {
-        if (long_side(a) / (f + 1) < 80)
+        if (long_side(a) / (f + 1) < 80 || f + 1 > short_side(a))
             return 0;
         sheet_size(sh, a, frames, ++f);
     }

@@ -463,7 +463,8 @@ int cli_is_bake(const char *path)
 }
 
 /* A regular file named *.plxb whose first byte cannot start a JSON text
- * (after white space, '{' or '['): a bake whose magic is damaged, which
+ * (after a byte-order mark and white space, '{' or '['): a bake whose
+ * magic is damaged, which
  * the bake reader refuses as such (the scene reader said "malformed JSON
  * at byte 0"). */
 static int damaged_bake(const char *path)
@@ -475,8 +476,11 @@ static int damaged_bake(const char *path)
     if (n < 5 || strcmp(path + n - 5, ".plxb") != 0 || stat(path, &sb) != 0 || !S_ISREG(sb.st_mode) ||
         !(f = fopen(path, "rb")))
         return 0;
-    while ((ch = fgetc(f)) == ' ' || ch == '\t' || ch == '\n' || ch == '\r')
-        ;
+    ch = fgetc(f);
+    if (ch == 0xEF && fgetc(f) == 0xBB && fgetc(f) == 0xBF) /* a UTF-8 byte-order mark, as the reader skips */
+        ch = fgetc(f);
+    while (ch == ' ' || ch == '\t' || ch == '\n' || ch == '\r')
+        ch = fgetc(f);
     fclose(f);
     return ch != EOF && ch != '{' && ch != '[';
 }

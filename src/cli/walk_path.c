@@ -41,6 +41,13 @@ static int lonlat_at(const cJSON *coords, int want)
     return -1;
 }
 
+/* Whether a position's first two members are numbers (else read_positions
+ * says what is wrong with it). */
+static int two_numbers(const cJSON *pos)
+{
+    return cJSON_IsNumber(cJSON_GetArrayItem(pos, 0)) && cJSON_IsNumber(cJSON_GetArrayItem(pos, 1));
+}
+
 static int first_lonlat(const cJSON *coords)
 {
     return lonlat_at(coords, 1);
@@ -185,7 +192,7 @@ static int parse(const cJSON *root, plx_engine *e, walk_path *wp, char *why, siz
     wp->eye = malloc(sizeof(double) * 3 * (size_t)n);
     targets = cJSON_GetObjectItemCaseSensitive(props, "targets");
     if (targets && (!cJSON_IsArray(targets) || cJSON_GetArraySize(targets) != n)) {
-        snprintf(why, whylen, "properties.targets must hold one [x, y, z] per position (%d)", n);
+        snprintf(why, whylen, "properties.targets must hold one [x, y] or [x, y, z] per position (%d)", n);
         return -1;
     }
     if (targets)
@@ -198,7 +205,7 @@ static int parse(const cJSON *root, plx_engine *e, walk_path *wp, char *why, siz
         return -1;
     /* positions in lon/lat: so are the targets (a latitude of 95 was
      * projected far north, and render refused the camera walk wrote) */
-    if (targets && project && (k = first_not_lonlat(targets)) >= 0) {
+    if (targets && project && (k = first_not_lonlat(targets)) >= 0 && two_numbers(cJSON_GetArrayItem(targets, k))) {
         snprintf(why, whylen, "properties.targets: position %d is not lon/lat (-180..180, -90..90) and the "
                  "path's positions are: give the targets in the positions' coordinates", k);
         return -1;

@@ -175,6 +175,9 @@ plx_status render_create(arena *a, const scene *s, int32_t max_w, int32_t max_h,
     r->crow = arena_alloc(a, PLX_PART_FRAME, 2 * (size_t)(long_side(max_w, max_h) / IND_STEP + 2) * sizeof(corner_hit),
                           R_ALIGN);
     r->stop = arena_alloc(a, PLX_PART_FRAME, stop_rows(long_side(max_w, max_h)) * sizeof(int32_t), R_ALIGN);
+    r->corner_cap = (size_t)(max_w / IND_STEP + 2) * (size_t)(max_h / IND_STEP + 2);
+    r->crow_cap = 2 * (size_t)(long_side(max_w, max_h) / IND_STEP + 2);
+    r->stop_cap = stop_rows(long_side(max_w, max_h));
     if (shade == render_shade_light && user)
         r->lt = user;
     if (!r->tm || !r->et || !r->defer || !r->blk || !r->ind || !r->crow || !r->stop) {

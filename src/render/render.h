@@ -381,7 +381,7 @@ typedef struct render_stats {
 typedef struct render render;
 
 /* Builds the mesh and takes the frame memory for images up to max_w x
- * max_h. shade (required) and user are kept. Returns PLX_OK, PLX_E_INVALID
+ * max_h, or max_h x max_w (render_frame_fits). shade (required) and user are kept. Returns PLX_OK, PLX_E_INVALID
  * (NULL argument, sizes outside 1..16384), PLX_E_NOMEM (arena back where it
  * was). */
 plx_status render_create(arena *a, const scene *s, int32_t max_w, int32_t max_h,

@@ -146,10 +146,12 @@ struct render {
      * hook's value at each corner of the grid (RGB) */
     uint8_t *blk;
     float *ind;
-    corner_hit *crow;           /* two rows of corners' hit points (max_w / IND_STEP + 2 each) */
+    corner_hit *crow;           /* two rows of corners' hit points (the longer side of the
+                                   largest frame / IND_STEP + 2 each: frames either way round) */
     uint32_t hist[RENDER_MAX_WORKERS][EXPOSURE_BINS]; /* automatic exposure's counts, by part */
     int32_t *stop;              /* per row of corners, then per pixel row: where the workers'
                                    tries stopped (render_opts.indirect_try) */
+    size_t corner_cap, crow_cap, stop_cap; /* entries of blk (ind: 3 floats each), crow, stop */
     int32_t nbx, nby;           /* blocks a row, rows of blocks */
     int sparse;                 /* this frame's indirect is sparse */
     lightmap lm;                /* the aerial light map (lightmap.c) */

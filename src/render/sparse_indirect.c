@@ -14,6 +14,7 @@
 #include <math.h>
 #include <string.h>
 
+#include "base/plx_assert.h"
 #include "render/render_int.h"
 
 static int32_t corner_x(const render *r, int32_t a)
@@ -216,6 +217,11 @@ void sparse_corners(render *r, const render_opts *o, render_stats *st)
     corner_hit *row[2];
     r->nbx = r->w > 1 ? (r->w - 1 + IND_STEP - 1) / IND_STEP : 1;
     r->nby = r->h > 1 ? (r->h - 1 + IND_STEP - 1) / IND_STEP : 1;
+    /* the buffers sized for the largest frame hold this one's, either way
+     * round (render_frame_fits) */
+    PLX_ASSERT((size_t)(r->nbx + 1) * (size_t)(r->nby + 1) <= r->corner_cap);
+    PLX_ASSERT(2 * (size_t)(r->nbx + 1) <= r->crow_cap);
+    PLX_ASSERT((size_t)(r->nby + 1) + (size_t)r->h <= r->stop_cap);
     row[0] = r->crow;
     row[1] = r->crow + r->nbx + 1;
     int tries = try_workers(o) > 0;

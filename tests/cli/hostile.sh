@@ -210,10 +210,10 @@ for f in "$tmp/in.fifo" /dev/zero "$tmp"; do
     expect "illum-points-$n" 1 "^polarlux illum: $f: not a regular file \($kind\)$" -- illum -q $T --points "$f"
     expect "route-path-$n" 1 "^polarlux route: $f: not a regular file \($kind\)$" -- route -q $T --path "$f"
     expect "heatmap-path-$n" 1 "^polarlux heatmap: $f: not a regular file \($kind\)$" -- heatmap -q $T --path "$f" -o "$tmp/h.png"
-    expect "nightify-day-$n" 1 "^polarlux nightify: read_png: '$f' is not a regular file$" -- nightify "$f" "$f" -o "$tmp/n.png"
+    expect "nightify-day-$n" 1 "^polarlux nightify: PNG: '$f' is not a regular file$" -- nightify "$f" "$f" -o "$tmp/n.png"
 done
 mkdir -p "$tmp/gi"; cp fixtures/ground-image.geojson "$tmp/gi/s.geojson"; mkfifo "$tmp/gi/ground-day.png"
-expect ground-image-fifo 1 "^polarlux info: $tmp/gi/s.geojson: ground image 'ground-day.png': read_png: '$tmp/gi/ground-day.png' is not a regular file$" -- info "$tmp/gi/s.geojson"
+expect ground-image-fifo 1 "^polarlux info: $tmp/gi/s.geojson: ground image 'ground-day.png': PNG: '$tmp/gi/ground-day.png' is not a regular file$" -- info "$tmp/gi/s.geojson"
 # text inputs read whole or refused
 printf '50 10\n50 12\0\n50 14\n' >"$tmp/nul.txt"
 expect points-nul 1 "^polarlux vis: $tmp/nul.txt:2: a NUL byte at byte 11 \(not a text file\?\)$" -- vis -q $T --points "$tmp/nul.txt"
@@ -236,10 +236,10 @@ def png(path, w, h):
 png(sys.argv[1] + "/huge.png", 1000000, 1000000)
 png(sys.argv[1] + "/mid.png", 1000, 1000)
 PY
-expect nightify-huge-header 3 "^polarlux nightify: read_png: '$tmp/huge.png' is 1000000x1000000 pixels: decoding needs 3000000000000 bytes, more than the 1073741824 the memory budget allows; give it more with --mem$" -- nightify "$tmp/huge.png" "$tmp/huge.png" -o "$tmp/n.png"
-expect nightify-mid-small-mem 3 "^polarlux nightify: read_png: '$tmp/mid.png' is 1000x1000 pixels: decoding needs 3000000 bytes, more than the 1048576 the memory budget allows" -- nightify --mem 1M "$tmp/mid.png" "$tmp/mid.png" -o "$tmp/n.png"
+expect nightify-huge-header 3 "^polarlux nightify: PNG: '$tmp/huge.png' is 1000000x1000000 pixels: decoding needs 3000000000000 bytes, more than the 1073741824 the memory budget allows; give it more with --mem$" -- nightify "$tmp/huge.png" "$tmp/huge.png" -o "$tmp/n.png"
+expect nightify-mid-small-mem 3 "^polarlux nightify: PNG: '$tmp/mid.png' is 1000x1000 pixels: decoding needs 3000000 bytes, more than the 1048576 the memory budget allows" -- nightify --mem 1M "$tmp/mid.png" "$tmp/mid.png" -o "$tmp/n.png"
 cp "$tmp/mid.png" "$tmp/gi/ground-day.png.new"; rm "$tmp/gi/ground-day.png"; mv "$tmp/gi/ground-day.png.new" "$tmp/gi/ground-day.png"
-expect ground-image-over-mem 3 "^polarlux info: $tmp/gi/s.geojson: ground image 'ground-day.png': read_png: '$tmp/gi/ground-day.png' is 1000x1000 pixels: decoding needs 3000000 bytes, more than the 2097152 the memory budget allows; give it more with --mem$" -- info --mem 2M "$tmp/gi/s.geojson"
+expect ground-image-over-mem 3 "^polarlux info: $tmp/gi/s.geojson: ground image 'ground-day.png': PNG: '$tmp/gi/ground-day.png' is 1000x1000 pixels: decoding needs 3000000 bytes, more than the 2097152 the memory budget allows; give it more with --mem$" -- info --mem 2M "$tmp/gi/s.geojson"
 # the eye inside a building: a warning
 expect render-eye-inside 0 "^polarlux render: warning: --eye \(5, 5, 3\) is inside building 0 \(A\) \(0 to 10 m high\): the image shows the inside of its walls$" -- render --no-indirect $T --eye 5,5,3 --target 50,10,2 --size 16x12 -o "$tmp/r.png"
 # 1,000 lamps at one spot: merged into one with a warning (tests/unit/test_lampmerge.c checks the light)

@@ -100,6 +100,11 @@ expect render-street 0 "^street view 160x120 from \(30\.0, 30\.0, 1\.7\) to \(50
 if [ "$(head -c 12 "$tmp/s.pfm" | tr '\n' ' ')" = "PF 160 120 -" ]; then echo "ok   render-pfm-header"; pass=$((pass + 1)); else echo "FAIL render-pfm-header"; fail=$((fail + 1)); fi
 if [ "$(wc -c < "$tmp/s.pfm")" -gt $((160 * 120 * 12)) ]; then echo "ok   render-pfm-size"; pass=$((pass + 1)); else echo "FAIL render-pfm-size"; fail=$((fail + 1)); fi
 expect render-aerial 0 "^aerial view 120x80 " -- "$bin" render -q --frames 4 fixtures/tiny.geojson --view aerial --size 120x80 -o "$tmp/a.png"
+# the default aerial view keeps 5% of the frame each side around the
+# scene's box (612 m: half of it over 0.9, over tan 30 degrees; 530.0 m up
+# without the margin)
+expect render-aerial-margin 0 "^aerial view 100x100 from \(266\.0, 266\.0, 588\.9\) to \(266\.0, 266\.0, 0\.0\)" -- \
+    "$bin" render -q --no-indirect fixtures/eixample-4x4.geojson --view aerial --size 100x100 -o "$tmp/am.png"
 expect render-default-street 0 "^street view 64x48 " -- "$bin" render -q --frames 4 fixtures/eixample-4x4.geojson --size 64x48 -o "$tmp/d.png"
 expect render-eye-underground 2 "the eye must be above the ground" -- "$bin" render -q fixtures/tiny.geojson --eye 30,30,-1 --target 50,10,2 --size 16x16 -o "$tmp/u.png"
 expect render-eye-only 2 "give both --eye and --target" -- "$bin" render -q fixtures/tiny.geojson --eye 30,30,2 -o "$tmp/u.png"
@@ -125,10 +130,10 @@ expect render-ground-image 0 "^aerial view 120x80 " -- "$bin" render -q --no-ind
 expect illum-ground-image 0 "^0 0 0 [0-9.]+ [0-9.]+" -- sh -c "echo '0 0' | '$bin' illum -q --frames 2 --photons 5000 fixtures/ground-image.geojson --points -"
 mkdir -p "$tmp/gi"
 cp fixtures/ground-image.geojson "$tmp/gi/s.geojson"
-expect ground-image-missing 1 "^polarlux info: $tmp/gi/s\.geojson: ground image 'ground-day\.png': read_png: cannot open '$tmp/gi/ground-day\.png': No such file or directory$" -- "$bin" info "$tmp/gi/s.geojson"
+expect ground-image-missing 1 "^polarlux info: $tmp/gi/s\.geojson: ground image 'ground-day\.png': PNG: cannot open '$tmp/gi/ground-day\.png': No such file or directory$" -- "$bin" info "$tmp/gi/s.geojson"
 expect ground-image-missing-heatmap 1 "polarlux heatmap: $tmp/gi/s\.geojson: ground image 'ground-day\.png'" -- "$bin" heatmap "$tmp/gi/s.geojson" -o "$tmp/gi/h.png"
 echo "not a png" >"$tmp/gi/ground-day.png"
-expect ground-image-not-png 1 "ground image 'ground-day\.png': read_png: '$tmp/gi/ground-day\.png' is not a PNG file \(bad signature\)$" -- "$bin" render -q "$tmp/gi/s.geojson" -o "$tmp/gi/r.png"
+expect ground-image-not-png 1 "ground image 'ground-day\.png': PNG: '$tmp/gi/ground-day\.png' is not a PNG file \(bad signature\)$" -- "$bin" render -q "$tmp/gi/s.geojson" -o "$tmp/gi/r.png"
 sed "s|\"ground-day.png\"|\"$(pwd)/fixtures/ground-day.png\"|" fixtures/ground-image.geojson >"$tmp/gi/abs.geojson"
 expect ground-image-absolute 0 "^ground image: /.*fixtures/ground-day\.png \(64x64 pixels\)" -- "$bin" info "$tmp/gi/abs.geojson"
 printf '{"type": "FeatureCollection", "properties": {"units": "m", "ground_image": 5}, "features": []}' >"$tmp/gi/bad.geojson"
@@ -235,6 +240,7 @@ expect bake-frame-too-large 2 "a 320x240 frame is outside 1x1 \.\. 160x120 \(or 
 # the same frame turned a quarter is drawn (a portrait screen from a bake
 # for a landscape one; it was refused)
 expect bake-frame-turned 0 "^street view 120x160 " -- "$bin" render -q "$tmp/e.plxb" --size 120x160 -o "$tmp/turn.png"
+expect bake-frame-turned-per-pixel 0 "^street view 120x160 " -- "$bin" render -q "$tmp/e.plxb" --per-pixel --size 120x160 -o "$tmp/turnp.png"
 expect bake-frame-turned-walk 0 "^walk: 3 frames 120x160 " -- \
     "$bin" walk -q "$tmp/e.plxb" --path "$tmp/path.geojson" --size 120x160 --max-frames 3 -o "$tmp/turnw"
 # a bake without polar diagrams (for frames in a small block): smaller, and a
@@ -285,6 +291,9 @@ expect render-nomem-street-search 3 "ran out of memory; give --eye and --target,
 # ("malformed JSON at byte 0")
 { printf 'Q'; tail -c +2 "$tmp/e.plxb"; } >"$tmp/dmg.plxb"
 expect bake-damaged-magic 1 "^polarlux info: $tmp/dmg\.plxb: not a polarlux bake file \(no PLXBAKE magic\)$" -- "$bin" info "$tmp/dmg.plxb"
+# a GeoJSON scene with a byte-order mark named *.plxb is still a scene
+{ printf '\357\273\277'; cat fixtures/tiny.geojson; } >"$tmp/bom.plxb"
+expect scene-named-plxb-bom 0 "^buildings: 4 " -- "$bin" info -q "$tmp/bom.plxb"
 head -c 5000 "$tmp/e.plxb" >"$tmp/cut.plxb"
 expect bake-truncated 1 "^polarlux info: $tmp/cut\.plxb: truncated bake file: 5000 bytes, the header says [0-9]+$" -- "$bin" info "$tmp/cut.plxb"
 expect bake-version 1 "^polarlux render: tests/corpus/bake-version-99\.plxb: bake format version 99, this polarlux reads version 3; bake the scene again$" -- \
@@ -483,11 +492,15 @@ else echo "FAIL walk-fail-keeps-cameras: a walk whose first frame failed changed
 if [ -s "$tmp/w2/contact.png" ]; then echo "ok   walk-contact-sheet"; pass=$((pass + 1)); else echo "FAIL walk-contact-sheet"; fail=$((fail + 1)); fi
 # portrait frames are shrunk into the sheet by their longer side, as
 # landscape ones by theirs (360x640 frames were not shrunk: a 1440x640
-# sheet where 640x360 frames give 640x180)
+# sheet where four 640x360 frames give 1280x180)
 "$bin" walk -q fixtures/eixample-4x4.geojson --path "$tmp/path.geojson" --size 360x640 --max-frames 4 --aa 1 --no-indirect -o "$tmp/wport" >/dev/null 2>&1
 set -- $(od -An -tu1 -j16 -N8 "$tmp/wport/contact.png")
 if [ $# -eq 8 ] && [ $(($3 * 256 + $4)) -eq 720 ] && [ $(($7 * 256 + $8)) -eq 320 ]; then echo "ok   walk-contact-portrait"; pass=$((pass + 1))
 else echo "FAIL walk-contact-portrait: sheet header bytes $*, want 720x320"; fail=$((fail + 1)); fi
+# a frame narrower than the shrink factor keeps a pixel in the sheet (3x1600
+# frames failed the walk: "size 0x400")
+expect walk-contact-narrow 0 "^walk: 4 frames 3x1600 " -- \
+    "$bin" walk -q fixtures/eixample-4x4.geojson --path "$tmp/path.geojson" --size 3x1600 --max-frames 4 --aa 1 --no-indirect -o "$tmp/wnar"
 # a frame's delay is 1/fps exactly where 16-bit terms allow (it was
 # whole milliseconds: 33/1000 at 30 and at 29.97 fps)
 "$bin" walk -q "$tmp/e.plxb" --path "$tmp/path.geojson" --size 32x24 --fps 29.97 --max-frames 2 --aa 1 --no-indirect -o "$tmp/wfps" >/dev/null 2>&1
@@ -547,6 +560,10 @@ expect walk-lonlat-targets 1 "properties\.targets: position 0 is not lon/lat \(-
 printf '{"type":"Feature","properties":{"targets":[[24.945,60.1679,0],[200,-430,0]]},"geometry":{"type":"LineString","coordinates":[[24.9436,60.1677,10],[24.9465,60.1678,20]]}}' >"$tmp/llm.geojson"
 expect walk-lonlat-targets-metres 1 "properties\.targets: position 1 is not lon/lat" -- \
     "$bin" walk -q fixtures/helsinki-centre.geojson --path "$tmp/llm.geojson" --no-indirect -o "$tmp/wlt"
+# a target that is not numbers is told so, not that it is not lon/lat
+printf '{"type":"Feature","properties":{"targets":[[24.945,60.1679,0],["x",60.17]]},"geometry":{"type":"LineString","coordinates":[[24.9436,60.1677,10],[24.9465,60.1678,20]]}}' >"$tmp/llx.geojson"
+expect walk-lonlat-targets-shape 1 "properties\.targets: position 1 is not \[x, y\] or \[x, y, z\] of finite numbers$" -- \
+    "$bin" walk -q fixtures/helsinki-centre.geojson --path "$tmp/llx.geojson" --no-indirect -o "$tmp/wlt"
 printf '{"type":"LineString","coordinates":[[1,2]]}' >"$tmp/short.geojson"
 expect walk-short-path 1 "^polarlux walk: $tmp/short\.geojson: the LineString needs at least 2 positions$" -- "$bin" walk -q "$tmp/e.plxb" --path "$tmp/short.geojson" -o "$tmp/w3"
 # a coordinate beyond 1e7 m (it made the frame count overflow, then "out of

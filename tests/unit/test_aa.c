@@ -210,13 +210,15 @@ static void test_aa(void **state)
 }
 
 /* An engine for 480x360 frames draws 360x480 ones (a portrait screen's
- * from a landscape bake): the same bytes as an engine for 360x480, with
- * indirect light looked up sparsely (rows of corners as long as the
- * frame's width, stop rows as many as its height) and anti-aliased, and
- * straight down; 361x480 and 480x361 are refused. */
+ * from a landscape bake), and one for 360x480 draws 480x360 ones: the
+ * same bytes as the engine for the frame's own size, read from the
+ * radiance atlas or shaded pixel by pixel with indirect light looked up
+ * sparsely (rows of corners as long as the frame's width, stop rows as
+ * many as its height: buffers taken for the longer side; the debug
+ * build asserts they hold the frame's), anti-aliased, and straight down;
+ * 361x480 and 480x361 are refused. */
 static void test_frame_turned(void **state)
 {
-    enum { W = 360, H = 480 };
     void *mem[2];
     plx_engine *e[2];
     plx_config cfg;
@@ -224,45 +226,42 @@ static void test_frame_turned(void **state)
     plx_render_opts o;
     float *f[2];
     uint8_t *b[2];
-    int k, view;
+    int k, view, turn, per_pixel;
     (void)state;
-    e[0] = open_eixample(&mem[0]);
     plx_config_default(&cfg);
     cfg.port = plx_port_posix();
-    cfg.render_max_width = H;   /* the other way round */
-    cfg.render_max_height = W;
-    assert_true(cfg.render_max_width == 480 && cfg.render_max_height == 360);
-    plx_engine_destroy(e[0]);
-    free(mem[0]);
-    e[0] = fixture_load_file(fixture_engine_cfg(MEM, &cfg, &mem[0]), "fixtures/eixample-4x4.geojson");
-    cfg.render_max_width = W;
-    cfg.render_max_height = H;
-    e[1] = fixture_load_file(fixture_engine_cfg(MEM, &cfg, &mem[1]), "fixtures/eixample-4x4.geojson");
-    for (k = 0; k < 2; k++) {
+    for (k = 0; k < 2; k++) { /* e[0] for 480x360, e[1] for 360x480 */
+        cfg.render_max_width = k ? 360 : 480;
+        cfg.render_max_height = k ? 480 : 360;
+        e[k] = fixture_load_file(fixture_engine_cfg(MEM, &cfg, &mem[k]), "fixtures/eixample-4x4.geojson");
         assert_int_equal(plx_indirect_step(e[k], 16384, 1), PLX_OK);
-        f[k] = malloc(sizeof(float) * W * H * 3);
-        b[k] = malloc((size_t)W * H * 3);
+        f[k] = malloc(sizeof(float) * 480 * 360 * 3);
+        b[k] = malloc((size_t)480 * 360 * 3);
     }
-    for (view = 0; view < 2; view++) {
-        plx_render_opts_default(&o);
-        o.aa = 2;
-        street(&cam, W, H);
-        if (view == 1) {
-            o.aerial = 1;
-            cam.eye[0] = cam.target[0] = 266.0;
-            cam.eye[1] = cam.target[1] = 266.0;
-            cam.eye[2] = 800.0;
-            cam.target[2] = 0.0;
-        }
-        for (k = 0; k < 2; k++)
-            assert_int_equal(plx_render(e[k], &cam, &o, b[k], f[k], NULL), PLX_OK);
-        assert_memory_equal(b[0], b[1], (size_t)W * H * 3);
-        assert_memory_equal(f[0], f[1], sizeof(float) * W * H * 3);
-    }
-    street(&cam, W + 1, H);
+    for (turn = 0; turn < 2; turn++) /* frames 360x480, then 480x360 */
+        for (per_pixel = 0; per_pixel < 2; per_pixel++)
+            for (view = 0; view < 2; view++) {
+                int w = turn ? 480 : 360, h = turn ? 360 : 480;
+                plx_render_opts_default(&o);
+                o.aa = 2;
+                o.per_pixel = per_pixel;
+                street(&cam, w, h);
+                if (view == 1) {
+                    o.aerial = 1;
+                    cam.eye[0] = cam.target[0] = 266.0;
+                    cam.eye[1] = cam.target[1] = 266.0;
+                    cam.eye[2] = 800.0;
+                    cam.target[2] = 0.0;
+                }
+                for (k = 0; k < 2; k++)
+                    assert_int_equal(plx_render(e[k], &cam, &o, b[k], f[k], NULL), PLX_OK);
+                assert_memory_equal(b[0], b[1], (size_t)w * h * 3);
+                assert_memory_equal(f[0], f[1], sizeof(float) * w * h * 3);
+            }
+    street(&cam, 361, 480);
     assert_int_equal(plx_render(e[0], &cam, &o, b[0], NULL, NULL), PLX_E_INVALID);
     assert_non_null(strstr(plx_last_error(e[0]), "a 361x480 frame is outside 1x1 .. 480x360 (or 360x480)"));
-    street(&cam, H, W + 1);
+    street(&cam, 480, 361);
     assert_int_equal(plx_render(e[0], &cam, &o, b[0], NULL, NULL), PLX_E_INVALID);
     for (k = 0; k < 2; k++) {
         free(f[k]);

@@ -798,7 +798,7 @@ static void test_png_cap(void **state)
     assert_true(w == 16385 && h == 1);
     {
         char want[300];
-        snprintf(want, sizeof want, "read_png: '%s' is 16385x1 pixels, larger than the 16384x16384 allowed", path);
+        snprintf(want, sizeof want, "PNG: '%s' is 16385x1 pixels, larger than the 16384x16384 allowed", path);
         assert_string_equal(err, want);
     }
     assert_int_equal(image_read_png_max(path, 16385, &out, &w, &h, err, sizeof err), 0);

@@ -561,7 +561,7 @@ static void test_read_errors(void **state)
     assert_int_equal(image_read_png_rgb8(p, NULL, 0, &back, NULL, NULL, err, sizeof err), -1);
     assert_null(back);
     assert_non_null(strstr(err, "cut.png"));
-    assert_true(strlen(err) > strlen("read_png: cannot decode ''") + 7);
+    assert_true(strlen(err) > strlen("PNG: cannot decode ''") + 7);
     /* and into a caller buffer */
     back = (uint8_t *)1;
     assert_int_equal(image_read_png_rgb8(p, img, sizeof img, &back, NULL, NULL, err, sizeof err), -1);
