@@ -164,9 +164,13 @@ static int prepare_engine(const bake_args *a, int twin, plx_engine **e, char *er
     st = plx_bake_prepare(*e, &o);
     if (st == PLX_OK)
         return EXIT_OK;
-    snprintf(err, errlen, "polarlux bake: %s%s\n", plx_last_error(*e),
-             st == PLX_E_NOMEM ? " (--no-aerial, --no-polar, a smaller --max-size or a coarser --texel need less; "
-                                 "or give a larger --mem)" : "");
+    if (st == PLX_E_NOMEM) { /* what would need less, of the options not given yet */
+        int more = a->o.aerial || !a->o.no_polar;
+        snprintf(err, errlen, "polarlux bake: %s (%s%sa smaller --max-size%s need%s less; or give a larger --mem)\n",
+                 plx_last_error(*e), a->o.aerial ? "--no-aerial, " : "", a->o.no_polar ? "" : "--no-polar, ",
+                 a->o.aerial ? " or a coarser --texel" : "", more ? "" : "s");
+    } else
+        snprintf(err, errlen, "polarlux bake: %s\n", plx_last_error(*e));
     plx_engine_free(*e);
     *e = NULL;
     return st == PLX_E_NOMEM ? EXIT_NOMEM : EXIT_FAIL;

@@ -171,6 +171,10 @@ expect bake-no-indirect-walk 0 "holds no indirect light" -- \
 # with no word of it)
 expect bake-nomem-hint 3 "out of memory .*\(--no-aerial, --no-polar, a smaller --max-size or a coarser --texel need less; or give a larger --mem\)$" -- \
     "$bin" bake -q fixtures/eixample-4x4.geojson --mem 3M -o "$tmp/nomem.plxb"
+# the hint names only the options not given (a kiosk pass's bake with
+# --no-aerial --no-polar was told to give them)
+expect bake-nomem-hint-given 3 "out of memory .*\(a smaller --max-size needs less; or give a larger --mem\)$" -- \
+    "$bin" bake -q fixtures/eixample-4x4.geojson --no-aerial --no-polar --mem 2M -o "$tmp/nomem.plxb"
 # 28 KB above the smallest --mem that loads the bake: room for a frame without anti-aliasing only
 amem=$("$bin" info "$tmp/e.plxb" --min-mem 2>/dev/null | sed -n 's/^smallest --mem: \([0-9]*\) bytes.*/\1/p')
 amem=$((amem + 28000))
