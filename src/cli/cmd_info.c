@@ -95,25 +95,20 @@ static void print_min_mem(const char *path, const cli_common *c, size_t hi)
 }
 
 /* 1 when the block 'mem', given as 'bytes' long, loads the bake, and with
- * 'polar' has its polar diagrams (a bake made with them; a --no-polar
- * bake's walk does not need them, and a query builds them: 'polar' 0).
- * With has_polar, whether the bake holds them. The block is aligned as
- * the command's (cli_big_alloc), which the bake's offset in it depends on. */
-static int bake_fits(void *mem, size_t bytes, const void *data, size_t len, int polar, int *has_polar)
+ * 'polar' has its polar diagrams (built for a --no-polar bake, as info
+ * does; a --no-polar bake's walk does not need them: 'polar' 0). The
+ * block is aligned as the command's (cli_big_alloc), which the bake's
+ * offset in it depends on. */
+static int bake_fits(void *mem, size_t bytes, const void *data, size_t len, int polar)
 {
     static plx_port port;
     plx_config cfg;
     plx_engine *e;
     plx_polar_info pi;
-    plx_memory_report m;
     int ok = 1;
     silent_config(&cfg, &port);
     if (plx_bake_load(mem, bytes, &cfg, data, len, &e, NULL, 0) != PLX_OK)
         return 0;
-    if (has_polar) {
-        plx_memory_get(e, &m);
-        *has_polar = m.used[PLX_PART_POLAR] > 0;
-    }
     if (polar)
         ok = plx_polar_info_get(e, &pi) == PLX_OK;
     plx_engine_destroy(e);
@@ -127,7 +122,7 @@ static size_t bisect_bake(void *mem, size_t lo, size_t hi, const void *data, siz
     while (hi - lo > 4096) {
         size_t mid = lo + (hi - lo) / 2;
         ++*loads;
-        if (bake_fits(mem, mid, data, len, polar, NULL))
+        if (bake_fits(mem, mid, data, len, polar))
             hi = mid;
         else
             lo = mid;
@@ -137,14 +132,16 @@ static size_t bisect_bake(void *mem, size_t lo, size_t hi, const void *data, siz
 
 /* For a bake, the smallest --mem is the block its image loads in (the
  * bake's block size adds room for queries and frames): the same bisection,
- * over bake loads into one block of 'hi' bytes (0: the bake's own size). */
-static int print_min_mem_bake(const char *path, size_t hi)
+ * over bake loads into one block of 'hi' bytes (0: the bake's own size);
+ * for a bake without polar diagrams (has_polar 0) also the smallest
+ * without building them. */
+static int print_min_mem_bake(const char *path, size_t hi, int has_polar)
 {
     char err[512];
     size_t len, own, lo = PLX_ENGINE_MIN_BYTES;
     char *data = port_read_text(path, &len, err, sizeof err);
     void *mem = NULL;
-    int loads = 0, rc = EXIT_FAIL, polar = 1;
+    int loads = 0, rc = EXIT_FAIL, polar = has_polar;
     size_t alone = 0;
     if (data && plx_bake_block_size(data, len, &own, err, sizeof err) == PLX_OK) {
         if (!hi)
@@ -159,8 +156,6 @@ static int print_min_mem_bake(const char *path, size_t hi)
         free(data);
         return rc;
     }
-    if (!bake_fits(mem, hi, data, len, 0, &polar)) /* the block the info above loaded it in */
-        polar = 1;
     hi = bisect_bake(mem, lo, hi, data, len, 1, &loads);
     if (!polar)
         alone = bisect_bake(mem, lo, hi, data, len, 0, &loads);
@@ -242,7 +237,7 @@ int cmd_info(int argc, char **argv)
     plx_scene_info si;
     plx_polar_info pi;
     plx_ground_image_info gi;
-    int rc, min_mem = 0, photons = 0;
+    int rc, min_mem = 0, photons = 0, polar_baked = 0;
     const cli_opt opts[] = { CLI_OPT_FLAG("--min-mem", &min_mem), CLI_OPT_FLAG("--photons", &photons), CLI_OPT_END };
     cli_args pa;
     memset(&c, 0, sizeof c);
@@ -290,7 +285,8 @@ int cmd_info(int argc, char **argv)
                cli_bake_last.bytes / 1048576.0, cli_bake_last.load_ns / 1e6);
     cli_atlas_print(e);
     if (plx_polar_info_get(e, &pi) == PLX_OK) {
-        if (pi.build_ns == 0 && cli_bake_last.loaded)
+        polar_baked = pi.build_ns == 0 && cli_bake_last.loaded;
+        if (polar_baked)
             printf("polar diagrams: from the bake; ");
         else
             printf("polar diagrams: built in %.2f ms; ", pi.build_ns / 1e6);
@@ -309,7 +305,7 @@ int cmd_info(int argc, char **argv)
     print_memory(e);
     plx_engine_free(e);
     if (min_mem && rc == EXIT_OK && cli_bake_last.loaded)
-        rc = print_min_mem_bake(path, c.mem);
+        rc = print_min_mem_bake(path, c.mem, polar_baked);
     else if (min_mem && rc == EXIT_OK)
         print_min_mem(path, &c, c.mem ? c.mem : CLI_DEFAULT_MEM);
     return rc;

@@ -169,8 +169,8 @@ static int cmp_double(const void *x, const void *y)
 /* The contact sheet: up to 16 frames spread over the walk, 4 to a row,
  * each shrunk by an integer factor f (box filter) to at most 400 pixels
  * on its longer side (a portrait frame's height: a sheet of 768x1024
- * frames was 2.25 times the bytes of one of 1024x768 frames), drawn into the sheet as each is rendered (the frames themselves
- * are not kept). */
+ * frames was 2.25 times the bytes of one of 1024x768 frames), drawn into
+ * the sheet as each is rendered (the frames themselves are not kept). */
 typedef struct sheet {
     uint8_t *px;               /* W x H x 3, NULL: none */
     int f, tw, th, W, H, n;    /* n: cells filled */

@@ -24,6 +24,13 @@ static int lonlat_range(const cJSON *coords)
     return 1;
 }
 
+/* Whether a position's first two members are numbers (else read_positions
+ * says what is wrong with it). */
+static int two_numbers(const cJSON *pos)
+{
+    return cJSON_IsNumber(cJSON_GetArrayItem(pos, 0)) && cJSON_IsNumber(cJSON_GetArrayItem(pos, 1));
+}
+
 /* The first position within lon/lat range (-180..180, -90..90), and the
  * first one outside it; -1 for none. */
 static int lonlat_at(const cJSON *coords, int want)
@@ -32,20 +39,13 @@ static int lonlat_at(const cJSON *coords, int want)
     int k = 0;
     cJSON_ArrayForEach(pos, coords) {
         const cJSON *x = cJSON_GetArrayItem(pos, 0), *y = cJSON_GetArrayItem(pos, 1);
-        int in = cJSON_IsNumber(x) && cJSON_IsNumber(y) && x->valuedouble >= -180 && x->valuedouble <= 180 &&
-                 y->valuedouble >= -90 && y->valuedouble <= 90;
+        int in = two_numbers(pos) && x->valuedouble >= -180 && x->valuedouble <= 180 && y->valuedouble >= -90 &&
+                 y->valuedouble <= 90;
         if (in == want)
             return k;
         k++;
     }
     return -1;
-}
-
-/* Whether a position's first two members are numbers (else read_positions
- * says what is wrong with it). */
-static int two_numbers(const cJSON *pos)
-{
-    return cJSON_IsNumber(cJSON_GetArrayItem(pos, 0)) && cJSON_IsNumber(cJSON_GetArrayItem(pos, 1));
 }
 
 static int first_lonlat(const cJSON *coords)
@@ -263,9 +263,6 @@ double walk_path_length(const walk_path *wp)
     return L;
 }
 
-/* The point at arc length s (clamped to the path; beyond its end it goes on
- * along the last segment), of the eye polyline or, with the same
- * parameter, of the targets. */
 /* The segment k (1 .. n - 1, from position k - 1 to k) of the eye
  * polyline holding arc length s, the last one beyond the end; *acc the
  * length before it, *seg its own. */
@@ -282,6 +279,9 @@ static uint32_t segment_at(const walk_path *wp, double s, double *acc, double *s
     }
 }
 
+/* The point at arc length s (clamped to the path; beyond its end it goes on
+ * along the last segment), of the eye polyline or, with the same
+ * parameter, of the targets. */
 static void at(const walk_path *wp, const double *pts, double s, double out[3])
 {
     double acc, seg, t;

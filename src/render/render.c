@@ -53,6 +53,23 @@ static int32_t long_side(int32_t max_w, int32_t max_h)
     return max_w > max_h ? max_w : max_h;
 }
 
+/* Entries of the sparse indirect light's buffers (render.corner_cap,
+ * crow_cap, stop_cap) for frames up to max_w x max_h either way round. */
+static size_t corner_entries(int32_t max_w, int32_t max_h)
+{
+    return (size_t)(max_w / IND_STEP + 2) * (size_t)(max_h / IND_STEP + 2);
+}
+
+static size_t crow_entries(int32_t max_w, int32_t max_h)
+{
+    return 2 * (size_t)(long_side(max_w, max_h) / IND_STEP + 2);
+}
+
+static size_t stop_entries(int32_t max_w, int32_t max_h)
+{
+    return stop_rows(long_side(max_w, max_h));
+}
+
 int render_frame_fits(int32_t w, int32_t h, int32_t max_w, int32_t max_h)
 {
     return w >= 1 && h >= 1 && ((w <= max_w && h <= max_h) || (w <= max_h && h <= max_w));
@@ -62,13 +79,13 @@ size_t render_bytes(const scene *s, int32_t max_w, int32_t max_h)
 {
     size_t px = (size_t)max_w * (size_t)max_h;
     size_t tiles = (size_t)((max_w + RENDER_TILE - 1) / RENDER_TILE) * (size_t)((max_h + RENDER_TILE - 1) / RENDER_TILE);
-    size_t corners = (size_t)(max_w / IND_STEP + 2) * (size_t)(max_h / IND_STEP + 2);
+    size_t corners = corner_entries(max_w, max_h);
     return px * 20 + tiles + (size_t)s->nbld * (2 * sizeof(cull_item) + 29) +
            (size_t)CULL_SIDE * CULL_SIDE * (6 * sizeof(double) + 4 + sizeof(cull_item)) + RENDER_BINS * 8 +
            (size_t)(CULL_SIDE / CULL_GROUP + 1) * (CULL_SIDE / CULL_GROUP + 1) * (6 * sizeof(double) + 1) + 16 +
            sizeof(tonemap_table) + 8 + sizeof(exposure_table) + 8 +
-           corners * (1 + 3 * sizeof(float)) + 2 * (size_t)(long_side(max_w, max_h) / IND_STEP + 2) * sizeof(corner_hit) + render_surf_slots(s, max_w, max_h) * (sizeof(uint32_t) + sizeof(mesh_surf)) +
-           stop_rows(long_side(max_w, max_h)) * sizeof(int32_t) + arena_mul((size_t)s->nlamps + 1, sizeof(uint32_t)) + 64 +
+           corners * (1 + 3 * sizeof(float)) + crow_entries(max_w, max_h) * sizeof(corner_hit) + render_surf_slots(s, max_w, max_h) * (sizeof(uint32_t) + sizeof(mesh_surf)) +
+           stop_entries(max_w, max_h) * sizeof(int32_t) + arena_mul((size_t)s->nlamps + 1, sizeof(uint32_t)) + 64 +
            arena_mul((size_t)s->nlamps + 1, sizeof(glow_seen)) + 16 +
            sizeof(render) + 4096;
 }
@@ -167,17 +184,13 @@ plx_status render_create(arena *a, const scene *s, int32_t max_w, int32_t max_h,
     r->defer = arena_alloc(a, PLX_PART_FRAME,
                            (size_t)((max_w + RENDER_TILE - 1) / RENDER_TILE) *
                                (size_t)((max_h + RENDER_TILE - 1) / RENDER_TILE), R_ALIGN);
-    r->blk = arena_alloc(a, PLX_PART_FRAME, (size_t)(max_w / IND_STEP + 2) * (size_t)(max_h / IND_STEP + 2),
-                         R_ALIGN);
-    r->ind = arena_alloc(a, PLX_PART_FRAME,
-                         arena_mul((size_t)(max_w / IND_STEP + 2) * (size_t)(max_h / IND_STEP + 2),
-                                   3 * sizeof(float)), R_ALIGN);
-    r->crow = arena_alloc(a, PLX_PART_FRAME, 2 * (size_t)(long_side(max_w, max_h) / IND_STEP + 2) * sizeof(corner_hit),
-                          R_ALIGN);
-    r->stop = arena_alloc(a, PLX_PART_FRAME, stop_rows(long_side(max_w, max_h)) * sizeof(int32_t), R_ALIGN);
-    r->corner_cap = (size_t)(max_w / IND_STEP + 2) * (size_t)(max_h / IND_STEP + 2);
-    r->crow_cap = 2 * (size_t)(long_side(max_w, max_h) / IND_STEP + 2);
-    r->stop_cap = stop_rows(long_side(max_w, max_h));
+    r->corner_cap = corner_entries(max_w, max_h);
+    r->crow_cap = crow_entries(max_w, max_h);
+    r->stop_cap = stop_entries(max_w, max_h);
+    r->blk = arena_alloc(a, PLX_PART_FRAME, r->corner_cap, R_ALIGN);
+    r->ind = arena_alloc(a, PLX_PART_FRAME, arena_mul(r->corner_cap, 3 * sizeof(float)), R_ALIGN);
+    r->crow = arena_alloc(a, PLX_PART_FRAME, arena_mul(r->crow_cap, sizeof(corner_hit)), R_ALIGN);
+    r->stop = arena_alloc(a, PLX_PART_FRAME, arena_mul(r->stop_cap, sizeof(int32_t)), R_ALIGN);
     if (shade == render_shade_light && user)
         r->lt = user;
     if (!r->tm || !r->et || !r->defer || !r->blk || !r->ind || !r->crow || !r->stop) {
@@ -203,7 +216,6 @@ void render_frame_clear(render *r)
     const scene *s = r->s;
     size_t px = (size_t)r->max_w * (size_t)r->max_h, v = (size_t)r->m->max_bld_verts + 1, nb = (size_t)s->nbld + 1;
     size_t tiles = (size_t)((r->max_w + RENDER_TILE - 1) / RENDER_TILE) * (size_t)((r->max_h + RENDER_TILE - 1) / RENDER_TILE);
-    size_t corners = (size_t)(r->max_w / IND_STEP + 2) * (size_t)(r->max_h / IND_STEP + 2);
     int k;
     memset(r->depth, 0, px * sizeof *r->depth);
     memset(r->id, 0, px * sizeof *r->id);
@@ -224,10 +236,10 @@ void render_frame_clear(render *r)
     memset(r->trav, 0, (nb + r->ncell) * sizeof *r->trav);
     memset(r->group_out, 0, (size_t)r->gside * r->gside);
     memset(r->defer, 0, tiles);
-    memset(r->blk, 0, corners);
-    memset(r->ind, 0, corners * 3 * sizeof *r->ind);
-    memset(r->crow, 0, 2 * (size_t)(long_side(r->max_w, r->max_h) / IND_STEP + 2) * sizeof *r->crow);
-    memset(r->stop, 0, stop_rows(long_side(r->max_w, r->max_h)) * sizeof *r->stop);
+    memset(r->blk, 0, r->corner_cap);
+    memset(r->ind, 0, r->corner_cap * 3 * sizeof *r->ind);
+    memset(r->crow, 0, r->crow_cap * sizeof *r->crow);
+    memset(r->stop, 0, r->stop_cap * sizeof *r->stop);
     memset(r->tm, 0, sizeof *r->tm);
     memset(r->ws, 0, sizeof r->ws);
     memset(r->hist, 0, sizeof r->hist);
