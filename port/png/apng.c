@@ -139,7 +139,7 @@ int image_write_apng(const char *path, const char *const *frames, int n, unsigne
         snprintf(err, errlen, "animated PNG: '%s': needs 1 or more frames and delays below 65536", path);
         return -1;
     }
-    o = safe_out_open(path, err, errlen);
+    o = safe_out_open_batch(path, err, errlen);
     if (!o)
         return -1;
     if (safe_out_write(o, sig, 8) != 0) {

@@ -150,7 +150,8 @@ static int write_one(const char *op, const char *path, int width, int height, co
     safe_out *o;
     if (check_size(op, path, width, height, pixels, err, errlen) != 0)
         return -1;
-    o = safe_out_open(path, why, sizeof why);
+    /* fast: a frame of a batch, synced with the others (safe_out_batch_end) */
+    o = level == 1 ? safe_out_open_batch(path, why, sizeof why) : safe_out_open(path, why, sizeof why);
     if (!o) {
         port_set_err(err, errlen, "%s: %s", op, why);
         return -1;

@@ -6,7 +6,8 @@
  * Every writer goes through safe_out (port/posix/safe_out.h): a regular
  * file is written to a temporary file beside the output
  * ("<path>.tmp.<pid>.<n>", created exclusively with mode 0666 & ~umask),
- * flushed to disk (fsync), closed, and only then renamed over <path>; a
+ * flushed to disk (fsync; a batch of frames together, below), closed, and
+ * only then renamed over <path>; a
  * device, FIFO or "-" is written directly. A crash, a full disk or any error therefore never leaves a partial
  * output: <path> is either the complete new image or whatever was there
  * before. On failure the temporary file is removed.
@@ -37,7 +38,8 @@ int image_write_png_rgb8(const char *path, int width, int height, const uint8_t 
 /* The same at zlib's fastest level (1) and with the "up" row filter only
  * (libpng tries all five filters on every row by default): for frames
  * written one after another (walk), where the default costs as much as the
- * frame. */
+ * frame. A frame of a batch (safe_out.h): renamed into place unsynced, the
+ * caller syncs the batch at its end (safe_out_batch_begin, _end). */
 int image_write_png_rgb8_fast(const char *path, int width, int height, const uint8_t *rgb,
                               int stride, char *err, size_t errlen);
 
@@ -46,7 +48,8 @@ int image_write_png_rgb8_fast(const char *path, int width, int height, const uin
  * files frames[0..n-1], all of one size and format (as image_write_png_rgb8
  * writes them), each shown delay_num / delay_den seconds (each below
  * 65536). The frames' compressed data is copied, not encoded again; a
- * viewer without APNG shows the first frame (port/png/apng.c).
+ * viewer without APNG shows the first frame (port/png/apng.c). Written as
+ * one of the frames' batch, unsynced, as image_write_png_rgb8_fast.
  */
 int image_write_apng(const char *path, const char *const *frames, int n, unsigned delay_num, unsigned delay_den,
                      char *err, size_t errlen);

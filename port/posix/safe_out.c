@@ -1,5 +1,10 @@
-/* realpath() is an XSI function of POSIX.1-2008. */
+/* realpath() is an XSI function of POSIX.1-2008; syncfs() (a batch's one
+ * sync) is Linux's. */
+#ifdef __linux__
+#define _GNU_SOURCE
+#else
 #define _XOPEN_SOURCE 700
+#endif
 /* safe_out: outputs written through an exclusive temporary file and a
  * rename, or directly when the target is not a regular file. See
  * safe_out.h for the rules. */
@@ -25,6 +30,7 @@ struct safe_out {
     int err;           /* first write errno, sticky */
     mode_t mode;       /* permission bits of an existing target */
     int keep_mode;
+    int batch;         /* committed without a sync (safe_out_open_batch) */
     size_t used;
     unsigned char buf[SAFE_OUT_BUF];
 };
@@ -213,7 +219,7 @@ static int finish_one(safe_out *o)
     if (o->tmp) {
         if (o->keep_mode && fchmod(o->fd, o->mode) != 0)
             return errno;
-        if (fsync(o->fd) != 0)
+        if (!o->batch && fsync(o->fd) != 0)
             return errno;
     }
     if (o->close_fd) {
@@ -264,12 +270,58 @@ int safe_out_commit(safe_out **outs, size_t n, char *err, size_t errlen)
             break;
         }
         if (outs[i]->tmp) {
-            sync_folder(outs[i]->target);
+            if (!outs[i]->batch)
+                sync_folder(outs[i]->target);
             free(outs[i]->tmp);
             outs[i]->tmp = NULL;
         }
     }
     for (i = 0; i < n; i++)
         safe_out_abort(outs[i]);
+    return rc;
+}
+
+safe_out *safe_out_open_batch(const char *path, char *err, size_t errlen)
+{
+    safe_out *o = safe_out_open(path, err, errlen);
+    if (o)
+        o->batch = 1;
+    return o;
+}
+
+int safe_out_batch_begin(const char *dir, char *err, size_t errlen)
+{
+    int fd = open(dir, O_RDONLY);
+    if (fd < 0)
+        port_set_err(err, errlen, "cannot open the folder '%s': %s", dir, strerror(errno));
+    return fd;
+}
+
+/* The file system's data written back: Linux's syncfs, which reports a
+ * write-back error met since fd was opened; elsewhere sync(), which
+ * reports none (the outputs' own write and close errors still are). */
+static int sync_all(int fd)
+{
+#ifdef __linux__
+    return syncfs(fd);
+#else
+    (void)fd;
+    sync();
+    return 0;
+#endif
+}
+
+int safe_out_batch_end(int fd, const char *dir, int commit, char *err, size_t errlen)
+{
+    int rc = 0;
+    if (fd < 0)
+        return 0;
+    if (commit && sync_all(fd) != 0) {
+        port_set_err(err, errlen, "cannot write the files in '%s' to disk: %s", dir, strerror(errno));
+        rc = -1;
+    }
+    if (commit && rc == 0)
+        (void)fsync(fd); /* the renames (best effort, as one output's commit: not every file system syncs folders) */
+    close(fd);
     return rc;
 }

@@ -35,6 +35,22 @@ int safe_out_errno(const safe_out *o);
  * temporary files into place, only if all of them succeeded. Frees them
  * all. 0, or -1 with a message naming the first failure. */
 int safe_out_commit(safe_out **outs, size_t n, char *err, size_t errlen);
+/* A batch: many outputs in one folder (walk's frames), each opened with
+ * safe_out_open_batch, written and committed as any other (checked,
+ * renamed into place, its temporary file removed on an error) but
+ * without a sync, then all made durable together by safe_out_batch_end:
+ * one sync of the folder's file system instead of two a file (a file's
+ * fsync and its folder's cost milliseconds on an SD card). Until then a
+ * crash may lose committed files of the batch.
+ * safe_out_batch_begin opens dir before the batch's first output (so a
+ * write-back error met during the batch is reported at its end): a
+ * handle, or -1 with a message. safe_out_batch_end syncs (when commit is
+ * non-zero) and closes it: 0, or -1 with a message when the file system
+ * reports a failed write-back (Linux's syncfs; elsewhere sync(), which
+ * reports none). A handle of -1 is ignored. */
+safe_out *safe_out_open_batch(const char *path, char *err, size_t errlen);
+int safe_out_batch_begin(const char *dir, char *err, size_t errlen);
+int safe_out_batch_end(int fd, const char *dir, int commit, char *err, size_t errlen);
 /* Gives up: closes, removes the temporary file, frees. NULL is ignored. */
 void safe_out_abort(safe_out *o);
 /* "-" as an output: the data goes to the original standard output and

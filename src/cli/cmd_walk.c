@@ -26,7 +26,8 @@ static const char help[] =
     "at the path's end, and writes DIR/frame-0001.png ..., DIR/cameras.txt (frame,\n"
     "eye, target in the scene's coordinates, exposure), DIR/walk.png\n"
     "(the frames as an animated PNG, 1/F s each, looping) and DIR/contact.png (a\n"
-    "contact sheet of up to 16 frames). Everything is built once (or loaded from a bake) and\n"
+    "contact sheet of up to 16 frames), synced to disk together at the end.\n"
+    "Everything is built once (or loaded from a bake) and\n"
     "reused by every frame: with indirect light each frame reads the radiance\n"
     "atlas (see render), filled as the frames need it or held by the bake.\n"
     "Prints the render time per frame (median, p95) and frames per second, and on\n"
@@ -441,6 +442,27 @@ static int cams_open(const walk_args *a, walk_run *wr)
     return 0;
 }
 
+/* DIR/cameras.txt closed, its writes checked (rc kept unless they
+ * failed). */
+static int cams_close(const walk_args *a, walk_run *wr, int rc)
+{
+    int e = 0, earlier;
+    if (!wr->cams)
+        return rc;
+    if (fflush(wr->cams) != 0)
+        e = errno;
+    earlier = ferror(wr->cams); /* a write before: its errno is gone */
+    if (fclose(wr->cams) != 0 && !e)
+        e = errno;
+    wr->cams = NULL;
+    if ((e || earlier) && rc == EXIT_OK) {
+        fprintf(stderr, "polarlux walk: %s/cameras.txt: cannot write: %s\n", a->dir,
+                e ? strerror(e) : "a write failed");
+        return EXIT_FAIL;
+    }
+    return rc;
+}
+
 /* How fast a walk's held exposure follows the view, stops a second (of
  * the walk's time, --fps frames a second): a few dozen bright pixels at a
  * frame's edge moved it 3.5 stops for one frame and back at 25 fps. */
@@ -627,9 +649,15 @@ static int run(const walk_args *a, plx_engine *e, const walk_path *wp, long *don
     cli_progress pr;
     double L = walk_path_length(wp), step = a->speed / a->fps, steps, *sorted;
     char err[512];
-    int rc = EXIT_OK;
+    int rc = EXIT_OK, batch;
     long k;
     memset(&wr, 0, sizeof wr);
+    /* the frames, sheet and cameras.txt synced together at the end */
+    if ((batch = safe_out_batch_begin(a->dir, err, sizeof err)) < 0) {
+        fprintf(stderr, "polarlux walk: %s\n", err);
+        *done = 0;
+        return EXIT_FAIL;
+    }
     cli_refiner_init(&wr.ref, a->refine_height, a->refine_frames, a->ind.photons);
     view_hint(a, wp);
     if (!walk_path_moves(wp))
@@ -674,6 +702,11 @@ static int run(const walk_args *a, plx_engine *e, const walk_path *wp, long *don
         rc = EXIT_FAIL;
     }
     if (rc == EXIT_OK && animation(a, wr.n, err, sizeof err) != 0) {
+        fprintf(stderr, "polarlux walk: %s\n", err);
+        rc = EXIT_FAIL;
+    }
+    rc = cams_close(a, &wr, rc);
+    if (safe_out_batch_end(batch, a->dir, *done > 0, err, sizeof err) != 0 && rc == EXIT_OK) {
         fprintf(stderr, "polarlux walk: %s\n", err);
         rc = EXIT_FAIL;
     }
@@ -729,8 +762,6 @@ static int run(const walk_args *a, plx_engine *e, const walk_path *wp, long *don
                      wr.n, wr.first_black,
                      cli_black_reason(e, &wr.black_cam, &wr.black_opts, wr.black_exposure, wr.rgb8, why, sizeof why));
     }
-    if (wr.cams)
-        fclose(wr.cams);
     free(wr.sh.px);
     free(wr.ms);
     free(sorted);

@@ -4,7 +4,8 @@
  * $PLX_FAILWRITE_MATCH fail once $PLX_FAILWRITE_AFTER bytes (default 0)
  * have gone to such files: with ENOSPC, or the errno named by
  * $PLX_FAILWRITE_ERRNO (EIO, EFBIG), or, with "SHORT", by writing 0 bytes
- * (a short write). fsync fails with EIO when $PLX_FAILWRITE_FSYNC is set.
+ * (a short write). fsync and syncfs fail with EIO when $PLX_FAILWRITE_FSYNC
+ * is set.
  * Everything else goes to the C library. */
 #define _GNU_SOURCE
 #include <dlfcn.h>
@@ -53,6 +54,17 @@ int fsync(int fd)
 {
     int (*real)(int);
     *(void **)&real = dlsym(RTLD_NEXT, "fsync");
+    if (getenv("PLX_FAILWRITE_FSYNC") && matches(fd)) {
+        errno = EIO;
+        return -1;
+    }
+    return real(fd);
+}
+
+int syncfs(int fd)
+{
+    int (*real)(int);
+    *(void **)&real = dlsym(RTLD_NEXT, "syncfs");
     if (getenv("PLX_FAILWRITE_FSYNC") && matches(fd)) {
         errno = EIO;
         return -1;

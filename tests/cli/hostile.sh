@@ -117,12 +117,30 @@ if [ -f "$shim" ]; then
     pre=
     if [ -s "$tmp/w/frame-0002.png" ] && [ ! -e "$tmp/w/frame-0003.png" ] && [ ! -e "$tmp/w/walk.png" ] &&
        [ -z "$(ls "$tmp/w" | grep '\.tmp')" ]; then ok walk-frame-fails-clean; else bad walk-frame-fails-clean; fi
+    # walk's outputs are synced together at its end (one syncfs of the folder's file system), not
+    # one by one: a failing fsync of the frames is never met; a failing sync of the folder is
+    pre="LD_PRELOAD=$shim ASAN_OPTIONS=verify_asan_link_order=0 PLX_FAILWRITE_MATCH=wsync/ PLX_FAILWRITE_AFTER=100000000 PLX_FAILWRITE_FSYNC=1"
+    expect walk-frames-unsynced 0 "^walk: 9 frames" -- \
+        walk -q $T --path "$tmp/walk.geojson" --size 32x24 --fps 1 --no-indirect -o "$tmp/wsync"
+    pre="LD_PRELOAD=$shim ASAN_OPTIONS=verify_asan_link_order=0 PLX_FAILWRITE_MATCH=wsync2 PLX_FAILWRITE_AFTER=100000000 PLX_FAILWRITE_FSYNC=1"
+    expect walk-sync-fails 1 "^polarlux walk: cannot write the files in '$tmp/wsync2' to disk: Input/output error$" -- \
+        walk -q $T --path "$tmp/walk.geojson" --size 32x24 --fps 1 --no-indirect -o "$tmp/wsync2"
+    pre=
+    if [ -s "$tmp/wsync2/frame-0009.png" ] && [ -s "$tmp/wsync2/walk.png" ] && [ -s "$tmp/wsync2/cameras.txt" ] &&
+       [ -z "$(ls "$tmp/wsync2" | grep '\.tmp')" ]; then ok walk-sync-fails-files; else bad walk-sync-fails-files; fi
 elif [ -n "${PLX_NO_SHIM:-}" ]; then
     # a cross build run under qemu-user: a host LD_PRELOAD shim cannot reach
     # the emulated program's writes (check-arm64 sets PLX_NO_SHIM)
     echo "skip failing-disk shim cases: $PLX_NO_SHIM"
 else
     bad "no $shim (make check builds it)"
+fi
+# cameras.txt's writes are checked: a full disk is told, not a short file left
+if [ -c /dev/full ]; then
+    printf '{"type":"LineString","coordinates":[[0,0,1.7],[10,0,1.7]]}' >"$tmp/walkc.geojson"
+    mkdir "$tmp/wcam"; ln -s /dev/full "$tmp/wcam/cameras.txt"
+    expect walk-cameras-full 1 "^polarlux walk: $tmp/wcam/cameras.txt: cannot write: No space left on device$" -- \
+        walk -q $T --path "$tmp/walkc.geojson" --size 32x24 --fps 1 --no-indirect -o "$tmp/wcam"
 fi
 # a full small filesystem: a 64 KiB tmpfs in a mount namespace of its own, where permitted
 if [ "$(id -u)" = 0 ] && unshare -m true 2>/dev/null; then
