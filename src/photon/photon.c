@@ -376,6 +376,26 @@ static void prefetch_rows(const float *out, const grid *g, int i0, int i1, int j
     }
 }
 
+/* Whether a photon at (fx, fy) lands on a surface its chart holds: on a
+ * chart of heights (the aerial chart, the lamps' floor maps), the texel
+ * under it charted at the photon's height (off the grid: yes). A texel
+ * holds one height, that of its centre, and its area counts the part of
+ * it at that height; a photon on another surface (a roof of another
+ * height, the ground beside a roof) is not represented, and splatted onto
+ * the nearest texels of its height it would add to their flux light from
+ * an area they do not count: with coarse texels (a small --mem) roofs took
+ * the light of the roofs around them, several times what the fine chart
+ * gives. So it is not stored (counted lost). */
+static int own_texel(const grid *g, double fx, double fy)
+{
+    int i, j;
+    if (!g->height || !(fx >= 0.0 && fy >= 0.0 && fx < (double)g->w && fy < (double)g->h))
+        return 1;
+    i = (int)floor(fx);
+    j = (int)floor(fy);
+    return gvalid(g, i, j);
+}
+
 /* The cone kernel over the texels within r of (fx, fy), weights normalised
  * over the valid ones. The square's columns (wrapped) and their dx^2 are
  * found once; a texel is looked at only when d^2 says it may be inside
@@ -392,7 +412,8 @@ static int splat_any(float *out, const grid *g, double fx, double fy, double r,
     if (r > PHOTON_KERNEL_MAX)
         r = PHOTON_KERNEL_MAX;
     if (!(fx > -r - 2.0 && fy > -r - 2.0 && fx < (double)g->w + r + 2.0 &&
-          fy < (double)g->h + r + 2.0))
+          fy < (double)g->h + r + 2.0) ||
+        !own_texel(g, fx, fy))
         return 0;
     i0 = (int)floor(fx - r);
     i1 = (int)floor(fx + r);
