@@ -60,7 +60,7 @@ static void facade_lookup(const photon_sys *ps, const trace_hit *h, double e[PHO
  * A_cov / M + I_cov. */
 static void horizontal_lookup(const photon_sys *ps, const double P[3], double e[PHOTON_CH])
 {
-    double fx, fy, night[PHOTON_CH];
+    double fx, fy, night[PHOTON_CH], key = surface_key(&ps->keys, ps->s, P[0], P[1], P[2]);
     int c, covered = P[2] <= HEIGHT_TOL && photon_covered_at(ps, P[0], P[1]);
     for (c = 0; c < PHOTON_CH; c++)
         e[c] = 0.0;
@@ -69,12 +69,12 @@ static void horizontal_lookup(const photon_sys *ps, const double P[3], double e[
         if (covered)
             photon_gather_sparse(ps->cov_flux, ps->cov_area, ps->gcov, ps->gw, ps->gh, fx, fy, e);
         else
-            photon_gather_wide(ps->gflux, ps->garea, ps->gheight, P[2], ps->gw, ps->gh, 0, fx, fy,
+            photon_gather_wide(ps->gflux, ps->garea, ps->gheight, key, ps->gw, ps->gh, 0, fx, fy,
                                ps->cfg.lookup_radius, e);
         for (c = 0; c < PHOTON_CH; c++)
             e[c] /= ps->gframes;
     }
-    photon_night_horizontal(ps, P[0], P[1], P[2], covered, night);
+    photon_night_horizontal(ps, P[0], P[1], key, covered, night);
     for (c = 0; c < PHOTON_CH; c++)
         e[c] += night[c];
 }

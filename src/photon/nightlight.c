@@ -24,7 +24,7 @@ static void store_lamp(photon_sys *ps, void *vctx, uint32_t lamp, const trace_hi
     lamp_ctx *c = vctx;
     photon_lamp_slot *sl = c->sl;
     uint32_t F = ps->cfg.lamp_res;
-    double fx, fy, gx, gy;
+    double fx, fy, gx, gy, key;
     (void)lamp;
     if (h->kind != TRACE_GROUND && h->kind != TRACE_ROOF)
         return;
@@ -36,17 +36,18 @@ static void store_lamp(photon_sys *ps, void *vctx, uint32_t lamp, const trace_hi
                                 ps->cfg.kernel_min, f);
         return;
     }
+    key = surface_key(&ps->keys, ps->s, h->p[0], h->p[1], h->p[2]);
     fx = (h->p[0] - sl->x0) / sl->texel;
     fy = (h->p[1] - sl->y0) / sl->texel;
     if (fx >= 0.0 && fy >= 0.0 && fx < (double)F && fy < (double)F &&
-        photon_splat(sl->flux, sl->area, sl->height, h->p[2], F, F, 0, fx, fy,
+        photon_splat(sl->flux, sl->area, sl->height, key, F, F, 0, fx, fy,
                      ps->cfg.lamp_kernel, f)) {
         /* in C: also its aerial-resolution copy D (same kernel as I) */
         photon_splat_win(sl->dwin, ps->dwin_n, ps->dwin_n, sl->dx0, sl->dy0, ps->garea,
-                         ps->gheight, h->p[2], ps->gw, ps->gh, gx, gy, ps->cfg.kernel_min, f);
+                         ps->gheight, key, ps->gw, ps->gh, gx, gy, ps->cfg.kernel_min, f);
     }
     if (c->push)
-        photon_splat(ps->gimp, ps->garea, ps->gheight, h->p[2], ps->gw, ps->gh, 0, gx, gy,
+        photon_splat(ps->gimp, ps->garea, ps->gheight, key, ps->gw, ps->gh, 0, gx, gy,
                      ps->cfg.kernel_min, f);
 }
 
@@ -71,13 +72,13 @@ static void lamp_compute(photon_sys *ps, uint32_t i, photon_lamp_slot *sl)
     for (y = 0; y < F; y++)
         for (x = 0; x < F; x++) {
             double cx = sl->x0 + (x + 0.5) * t, cy = sl->y0 + (y + 0.5) * t;
-            double hc = trace_top(ps->T, cx, cy, NULL);
+            double hc = surface_key(&ps->keys, ps->s, cx, cy, trace_top(ps->T, cx, cy, NULL));
             uint32_t match = 0;
             for (b = 0; b < k; b++)
                 for (a = 0; a < k; a++) {
                     double px = sl->x0 + (x + (a + 0.5) / k) * t;
                     double py = sl->y0 + (y + (b + 0.5) / k) * t;
-                    if (fabs(trace_top(ps->T, px, py, NULL) - hc) <= HEIGHT_TOL)
+                    if (fabs(surface_key(&ps->keys, ps->s, px, py, trace_top(ps->T, px, py, NULL)) - hc) <= HEIGHT_TOL)
                         match++;
                 }
             if (match == 0)

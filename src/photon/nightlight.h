@@ -27,7 +27,8 @@ int photon_lamp_cached(const photon_sys *ps, uint32_t lamp);
  * lamp indices, returns how many are cached. */
 uint32_t photon_lamp_lru(const photon_sys *ps, uint32_t *lamps /* OUT */, uint32_t cap);
 
-/* The floor-map share of E_indirect at (x, y, z) on the ground or a roof,
+/* The floor-map share of E_indirect at (x, y) on the ground or a roof of
+ * surface key z (surface_key.h),
  * PHOTON_CH channels: I - sum D_i + sum C_i (lux), 0 when nothing is
  * refined. On covered ground (covered != 0) it is I_cov. */
 void photon_night_horizontal(const photon_sys *ps, double x, double y, double z, int covered,

@@ -832,6 +832,11 @@ static void layout(photon_sys *ps, taker *t, const scene *s, const photon_config
     }
     aerial_dims(s, c, &ps->gw, &ps->gh, &ps->gtex);
     g = (size_t)ps->gw * ps->gh;
+    surface_keys_dims(s, &ps->keys);
+    ps->keys.ring = take(t, ps->keys.ncy, sizeof(uint32_t));
+    ps->keys.box = take(t, arena_mul(ps->keys.ncy, 4), sizeof(double));
+    ps->keys.first = take(t, (size_t)ps->keys.cyw * ps->keys.cyh + 1, sizeof(uint32_t));
+    ps->keys.item = take(t, surface_keys_pairs(s, &ps->keys), sizeof(uint32_t));
     ps->gheight = take(t, g, sizeof(float));
     ps->garea = take(t, g, sizeof(float));
     ps->gflux = take(t, arena_mul(g, PHOTON_CH), sizeof(float));
@@ -1250,13 +1255,13 @@ static void aerial_build(photon_sys *ps)
     for (j = 0; j < ps->gh; j++)
         for (i = 0; i < ps->gw; i++) {
             double cx = ps->gx0 + (i + 0.5) * t, cy = ps->gy0 + (j + 0.5) * t;
-            double hc = trace_top(ps->T, cx, cy, NULL);
+            double hc = surface_key(&ps->keys, ps->s, cx, cy, trace_top(ps->T, cx, cy, NULL));
             uint32_t match = 0;
             for (b = 0; b < k; b++)
                 for (a = 0; a < k; a++) {
                     double x = ps->gx0 + (i + (a + 0.5) / k) * t;
                     double y = ps->gy0 + (j + (b + 0.5) / k) * t;
-                    if (fabs(trace_top(ps->T, x, y, NULL) - hc) <= HEIGHT_TOL)
+                    if (fabs(surface_key(&ps->keys, ps->s, x, y, trace_top(ps->T, x, y, NULL)) - hc) <= HEIGHT_TOL)
                         match++;
                 }
             if (match == 0)
@@ -1340,6 +1345,7 @@ plx_status photon_create(arena *a, const scene *s, const photon_config *cfg, pho
         }
         lv->nfree = lv->nslots;
     }
+    surface_keys_build(s, &ps->keys);
     aerial_build(ps);
     lamp_fluxes(ps);
     for (i = 0; i < s->nlamps; i++)
@@ -1649,13 +1655,14 @@ static void prepare_progressive(photon_sys *ps, uint32_t lamp, const trace_hit *
         return;
     }
     aerial_xy(ps, h->p[0], h->p[1], &fx, &fy);
-    if (h->kind == TRACE_GROUND && covered_at(ps, h->p[0], h->p[1]))
+    if (h->kind == TRACE_GROUND && covered_at(ps, h->p[0], h->p[1])) {
         prepare_splat(op, &ps->st.stored_covered, ps->cov_flux,
                       grid_full(ps->cov_area, NULL, ps->gcov, 0.0, ps->gw, ps->gh, 0), fx, fy, r);
-    else
+    } else {
+        double key = surface_key(&ps->keys, ps->s, h->p[0], h->p[1], h->p[2]);
         prepare_splat(op, &ps->st.stored_aerial, ps->gflux,
-                      grid_full(ps->garea, ps->gheight, NULL, h->p[2], ps->gw, ps->gh, 0), fx,
-                      fy, r);
+                      grid_full(ps->garea, ps->gheight, NULL, key, ps->gw, ps->gh, 0), fx, fy, r);
+    }
 }
 
 /* Splats a prepared photon and counts it. */

@@ -166,6 +166,7 @@
 #include "base/arena.h"
 #include "base/scene.h"
 #include "photon/trace.h"
+#include "photon/surface_key.h"
 
 #define PHOTON_LEVELS 4        /* charted levels 0..3; level 4 = ambient */
 #define PHOTON_NONE 0xffffffffu
@@ -277,7 +278,8 @@ typedef struct photon_sys {
     /* aerial chart */
     uint32_t gw, gh;
     double gx0, gy0, gtex;
-    float *gheight, *garea;
+    float *gheight, *garea;         /* a texel's surface key (surface_key.h) and area */
+    surface_keys keys;              /* the courtyards (surface_key.h) */
     float *gflux;                   /* A: progressive, unrefined lamps; PHOTON_CH per texel */
     float *gimp;                    /* I: refined lamps, one computation each; same */
     uint32_t gframes;
@@ -443,5 +445,6 @@ void photon_sphere_dir(uint64_t *st, double d[3] /* OUT */);
 void photon_cosine_dir(uint64_t *st, const double n[3], double d[3] /* OUT */);
 /* Aerial texel coordinates of (x, y). */
 void photon_aerial_xy(const photon_sys *ps, double x, double y, double *fx, double *fy);
+
 
 #endif
