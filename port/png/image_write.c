@@ -144,14 +144,13 @@ int image_encode_png_level(safe_out *out, const char *path, int width, int heigh
 
 /* Opens path, runs one encoder, commits; the message prefixed with op. */
 static int write_one(const char *op, const char *path, int width, int height, const void *pixels,
-                     int stride, int pfm, int level, char *err, size_t errlen)
+                     int stride, int pfm, int level, int batch, char *err, size_t errlen)
 {
     char why[600];
     safe_out *o;
     if (check_size(op, path, width, height, pixels, err, errlen) != 0)
         return -1;
-    /* fast: a frame of a batch, synced with the others (safe_out_batch_end) */
-    o = level == 1 ? safe_out_open_batch(path, why, sizeof why) : safe_out_open(path, why, sizeof why);
+    o = batch ? safe_out_open_batch(path, why, sizeof why) : safe_out_open(path, why, sizeof why);
     if (!o) {
         port_set_err(err, errlen, "%s: %s", op, why);
         return -1;
@@ -171,13 +170,13 @@ static int write_one(const char *op, const char *path, int width, int height, co
 int image_write_png_rgb8(const char *path, int width, int height, const uint8_t *rgb,
                          int stride, char *err, size_t errlen)
 {
-    return write_one("PNG", path, width, height, rgb, stride, 0, -1, err, errlen);
+    return write_one("PNG", path, width, height, rgb, stride, 0, -1, 0, err, errlen);
 }
 
-int image_write_png_rgb8_fast(const char *path, int width, int height, const uint8_t *rgb,
+int image_write_png_frame(const char *path, int width, int height, const uint8_t *rgb,
                               int stride, char *err, size_t errlen)
 {
-    return write_one("PNG", path, width, height, rgb, stride, 0, 1, err, errlen);
+    return write_one("PNG", path, width, height, rgb, stride, 0, 1, 1, err, errlen);
 }
 
 /* ---- PFM writer ------------------------------------------------------------ */
@@ -227,7 +226,7 @@ int image_encode_pfm(safe_out *out, const char *path, int width, int height, con
 int image_write_pfm(const char *path, int width, int height, const float *rgb,
                     char *err, size_t errlen)
 {
-    return write_one("PFM", path, width, height, rgb, 0, 1, -1, err, errlen);
+    return write_one("PFM", path, width, height, rgb, 0, 1, -1, 0, err, errlen);
 }
 
 /* ---- PNG reader ------------------------------------------------------------ */

@@ -6,11 +6,15 @@
  * Every writer goes through safe_out (port/posix/safe_out.h): a regular
  * file is written to a temporary file beside the output
  * ("<path>.tmp.<pid>.<n>", created exclusively with mode 0666 & ~umask),
- * flushed to disk (fsync; a batch of frames together, below), closed, and
- * only then renamed over <path>; a
- * device, FIFO or "-" is written directly. A crash, a full disk or any error therefore never leaves a partial
- * output: <path> is either the complete new image or whatever was there
- * before. On failure the temporary file is removed.
+ * flushed to disk (fsync), closed, and only then renamed over <path>; a
+ * device, FIFO or "-" is written directly. A crash, a full disk or any
+ * error therefore never leaves a partial output: <path> is either the
+ * complete new image or whatever was there before. On failure the
+ * temporary file is removed. The frame writers (image_write_png_frame,
+ * image_write_apng) are the exception to the crash rule: outputs of a
+ * batch, renamed unsynced and synced together by the caller at its end
+ * (safe_out_batch_begin, _end), so a crash before then may leave a frame
+ * empty or cut short.
  *
  * All functions return 0 on success, -1 on failure. On failure, when err is
  * not NULL and errlen > 0, err receives one line (NUL-terminated, truncated
@@ -35,12 +39,13 @@
 int image_write_png_rgb8(const char *path, int width, int height, const uint8_t *rgb,
                          int stride, char *err, size_t errlen);
 
-/* The same at zlib's fastest level (1) and with the "up" row filter only
- * (libpng tries all five filters on every row by default): for frames
- * written one after another (walk), where the default costs as much as the
- * frame. A frame of a batch (safe_out.h): renamed into place unsynced, the
- * caller syncs the batch at its end (safe_out_batch_begin, _end). */
-int image_write_png_rgb8_fast(const char *path, int width, int height, const uint8_t *rgb,
+/* A frame of a batch (safe_out.h): the same at zlib's fastest level (1)
+ * and with the "up" row filter only (libpng tries all five filters on
+ * every row by default), for frames written one after another (walk),
+ * where the default costs as much as the frame; renamed into place
+ * unsynced, the caller syncs the batch at its end (safe_out_batch_begin,
+ * _end). */
+int image_write_png_frame(const char *path, int width, int height, const uint8_t *rgb,
                               int stride, char *err, size_t errlen);
 
 /*
@@ -49,7 +54,7 @@ int image_write_png_rgb8_fast(const char *path, int width, int height, const uin
  * writes them), each shown delay_num / delay_den seconds (each below
  * 65536). The frames' compressed data is copied, not encoded again; a
  * viewer without APNG shows the first frame (port/png/apng.c). Written as
- * one of the frames' batch, unsynced, as image_write_png_rgb8_fast.
+ * one of the frames' batch, unsynced, as image_write_png_frame.
  */
 int image_write_apng(const char *path, const char *const *frames, int n, unsigned delay_num, unsigned delay_den,
                      char *err, size_t errlen);

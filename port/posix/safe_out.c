@@ -291,10 +291,25 @@ safe_out *safe_out_open_batch(const char *path, char *err, size_t errlen)
 
 int safe_out_batch_begin(const char *dir, char *err, size_t errlen)
 {
-    int fd = open(dir, O_RDONLY);
-    if (fd < 0)
-        port_set_err(err, errlen, "cannot open the folder '%s': %s", dir, strerror(errno));
-    return fd;
+    char tmp[PATH_MAX];
+    int fd = open(dir, O_RDONLY), e = errno, k;
+    if (fd >= 0)
+        return fd;
+    /* a folder one may write but not read (mode 0300): a file of its
+     * own there, removed at once, names the file system to sync */
+    for (k = 0; k < 1000 && fd < 0; k++) {
+        if (snprintf(tmp, sizeof tmp, "%s/.sync.%ld.%d", dir, (long)getpid(), k) >= (int)sizeof tmp)
+            break;
+        fd = open(tmp, O_WRONLY | O_CREAT | O_EXCL | O_NOFOLLOW, 0600);
+        if (fd < 0 && errno != EEXIST)
+            break;
+    }
+    if (fd >= 0) {
+        unlink(tmp);
+        return fd;
+    }
+    port_set_err(err, errlen, "cannot open the folder '%s': %s", dir, strerror(e));
+    return -1;
 }
 
 /* The file system's data written back: Linux's syncfs, which reports a
@@ -321,7 +336,8 @@ int safe_out_batch_end(int fd, const char *dir, int commit, char *err, size_t er
         rc = -1;
     }
     if (commit && rc == 0)
-        (void)fsync(fd); /* the renames (best effort, as one output's commit: not every file system syncs folders) */
+        (void)fsync(fd); /* the renames (best effort, as one output's commit: not every file system syncs
+                            folders; on the stand-in file of an unreadable folder, nothing) */
     close(fd);
     return rc;
 }

@@ -41,13 +41,21 @@ int safe_out_commit(safe_out **outs, size_t n, char *err, size_t errlen);
  * without a sync, then all made durable together by safe_out_batch_end:
  * one sync of the folder's file system instead of two a file (a file's
  * fsync and its folder's cost milliseconds on an SD card). Until then a
- * crash may lose committed files of the batch.
+ * crash may leave a committed file of the batch empty or cut short, also
+ * one that replaced an earlier file (the rename may reach the disk before
+ * the data).
  * safe_out_batch_begin opens dir before the batch's first output (so a
- * write-back error met during the batch is reported at its end): a
- * handle, or -1 with a message. safe_out_batch_end syncs (when commit is
+ * write-back error met during the batch is reported at its end; a folder
+ * that cannot be read, a stand-in file made and removed in it): a handle,
+ * or -1 with a message. safe_out_batch_end syncs (when commit is
  * non-zero) and closes it: 0, or -1 with a message when the file system
- * reports a failed write-back (Linux's syncfs; elsewhere sync(), which
- * reports none). A handle of -1 is ignored. */
+ * reports a failed write-back. On Linux that is syncfs(), which reports
+ * write-back errors since kernel 5.8 (before, it returns 0), for the
+ * whole file system: a failure of another program's file there is
+ * reported too, and an output that is a symbolic link to another file
+ * system is neither synced nor checked. Elsewhere it is sync(), which
+ * reports nothing and may return before the data is written. A handle of
+ * -1 is ignored. */
 safe_out *safe_out_open_batch(const char *path, char *err, size_t errlen);
 int safe_out_batch_begin(const char *dir, char *err, size_t errlen);
 int safe_out_batch_end(int fd, const char *dir, int commit, char *err, size_t errlen);

@@ -248,7 +248,7 @@ static int contact_sheet(const walk_args *a, const sheet *sh, char *err, size_t 
     if (!sh->px)
         return 0;
     snprintf(path, sizeof path, "%s/contact.png", a->dir);
-    return image_write_png_rgb8_fast(path, sh->W, sh->H, sh->px, 0, err, errlen);
+    return image_write_png_frame(path, sh->W, sh->H, sh->px, 0, err, errlen);
 }
 
 /* APNG's frame delay num / den s (each 1 .. 65535) nearest x s: the last
@@ -398,7 +398,7 @@ static int write_frame(const walk_args *a, walk_run *wr, long k)
         fprintf(stderr, "polarlux walk: %s\n", wr->fw.err);
         return EXIT_FAIL;
     }
-    if (image_write_png_rgb8_fast(path, a->w, a->h, wr->rgb8, 0, err, sizeof err) != 0) {
+    if (image_write_png_frame(path, a->w, a->h, wr->rgb8, 0, err, sizeof err) != 0) {
         fprintf(stderr, "polarlux walk: %s\n", err);
         return EXIT_FAIL;
     }

@@ -16,7 +16,7 @@ static void *writer_loop(void *arg)
         if (!fw->busy)
             break;
         pthread_mutex_unlock(&fw->mu);
-        rc = image_write_png_rgb8_fast(fw->path, fw->w, fw->h, fw->rgb, 0, fw->err, sizeof fw->err);
+        rc = image_write_png_frame(fw->path, fw->w, fw->h, fw->rgb, 0, fw->err, sizeof fw->err);
         pthread_mutex_lock(&fw->mu);
         if (rc != 0)
             fw->failed = 1;

@@ -20,7 +20,8 @@ typedef struct surface_keys {
     double x0, y0, cell;
     uint32_t *ring;     /* ncy: each courtyard's ring (scene.block_rings) */
     double *box;        /* ncy x 4: x0 y0 x1 y1 */
-    uint32_t *first;    /* cyw cyh + 1: each cell's first item */
+    uint32_t *first;    /* cyw cyh + 1: each cell's first item (32 bits:
+                           a scene with 4G items could not take them) */
     uint32_t *item;     /* courtyards, cell by cell */
 } surface_keys;
 

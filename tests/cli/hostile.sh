@@ -135,6 +135,22 @@ elif [ -n "${PLX_NO_SHIM:-}" ]; then
 else
     bad "no $shim (make check builds it)"
 fi
+# a folder one may write but not read (mode 0300): the walk's sync goes through a file of its own there
+if [ "$(id -u)" = 0 ] && command -v setpriv >/dev/null 2>&1; then
+    printf '{"type":"LineString","coordinates":[[0,0,1.7],[10,0,1.7]]}' >"$tmp/walkw.geojson"
+    mkdir "$tmp/wonly"; chown 65534:65534 "$tmp/wonly"; chmod 0300 "$tmp/wonly"; chmod 0755 "$tmp"
+    chmod 0644 "$tmp/walkw.geojson"
+    pre="setpriv --reuid=65534 --regid=65534 --clear-groups"
+    timeout ${PLX_HOSTILE_TIMEOUT:-60} $pre $PLX_HOSTILE_WRAP "$bin" walk -q $T --path "$tmp/walkw.geojson" --size 32x24 --fps 1 --no-indirect \
+        -o "$tmp/wonly" >"$tmp/out" 2>"$tmp/err" </dev/null; rc=$?
+    pre=
+    chmod 0700 "$tmp/wonly"
+    if [ "$rc" -eq 0 ] && [ -s "$tmp/wonly/frame-0009.png" ] && [ -z "$(ls -A "$tmp/wonly" | grep '^\.sync')" ]; then
+        ok walk-write-only-folder
+    else
+        bad "walk-write-only-folder: exit $rc"; sed 's/^/    /' "$tmp/err" | head -5
+    fi
+fi
 # cameras.txt's writes are checked: a full disk is told, not a short file left
 if [ -c /dev/full ]; then
     printf '{"type":"LineString","coordinates":[[0,0,1.7],[10,0,1.7]]}' >"$tmp/walkc.geojson"

@@ -1240,50 +1240,61 @@ static int in_any_courtyard(const scene *s, double x, double y)
     return 0;
 }
 
+/* The courtyard ring holding (x, y), found block by block and ring by
+ * ring with its own even-odd and shoelace code: the index in
+ * scene.block_rings, UINT32_MAX when none. */
+static uint32_t courtyard_ring_at(const scene *s, double x, double y)
+{
+    uint32_t k, r, i, j;
+    for (k = 0; k < s->nblocks; k++)
+        for (r = 1; r < s->blocks[k].ring_count; r++) {
+            const scene_ring *R = &s->block_rings[s->blocks[k].ring_first + r];
+            const vec2 *p = &s->block_pts[R->first];
+            double a2 = 0.0;
+            int in = 0;
+            for (i = 0, j = R->count - 1; i < R->count; j = i++) {
+                a2 += p[j].x * p[i].y - p[i].x * p[j].y;
+                if ((p[i].y > y) != (p[j].y > y) &&
+                    x < p[j].x + (p[i].x - p[j].x) * (y - p[j].y) / (p[i].y - p[j].y))
+                    in = !in;
+            }
+            if (a2 < 0.0 && in)
+                return s->blocks[k].ring_first + r;
+        }
+    return UINT32_MAX;
+}
+
 /* surface_key against the courtyards found ring by ring
- * (in_courtyard, its own even-odd and shoelace code) at random points of
- * two cities, eixample-4x4 and the Helsinki district: on the ground a
- * courtyard's key (< 0) exactly when some block's courtyard holds the
- * point, one key a courtyard (the same block for every point with that
- * key), 0 elsewhere; a roof's height passes through. */
+ * (courtyard_ring_at) at random points of two cities, eixample-4x4 and
+ * the Helsinki district: on the ground a courtyard's key -1 - c exactly
+ * when a courtyard holds the point, c naming that ring (keys.ring[c]), 0
+ * elsewhere; a roof's height passes through. */
 static void surface_key_city(const char *path, int n, int *in_out)
 {
     void *mem;
     plx_engine *e = open_fixture(path, &mem, 512u << 20);
     const scene *s = e->sc;
     photon_sys *ps;
-    uint32_t *owner;
     uint64_t rs = 0x5eedu;
     int k, inside = 0;
     assert_int_equal(photon_create(&e->mem, s, NULL, &ps), PLX_OK);
-    owner = malloc(sizeof *owner * (ps->keys.ncy + 1));
-    assert_non_null(owner);
-    for (k = 0; k <= (int)ps->keys.ncy; k++)
-        owner[k] = UINT32_MAX;
     for (k = 0; k < n; k++) {
         double x = s->bounds[0] + (s->bounds[2] - s->bounds[0]) * urand(&rs);
         double y = s->bounds[1] + (s->bounds[3] - s->bounds[1]) * urand(&rs), key;
-        uint32_t b, blk = UINT32_MAX, q;
-        for (b = 0; b < s->nblocks && blk == UINT32_MAX; b++)
-            if (in_courtyard(s, b, x, y))
-                blk = b;
+        uint32_t ring = courtyard_ring_at(s, x, y);
         key = surface_key(&ps->keys, ps->s, x, y, 0.0);
         assert_true(surface_key(&ps->keys, ps->s, x, y, 12.5) == 12.5);
-        if (blk == UINT32_MAX) {
+        if (ring == UINT32_MAX) {
             assert_true(key == 0.0);
             continue;
         }
         inside++;
         assert_true(key <= -1.0 && key == floor(key) && -1.0 - key < (double)ps->keys.ncy);
-        q = (uint32_t)(-1.0 - key);
-        if (owner[q] == UINT32_MAX)
-            owner[q] = blk;
-        assert_int_equal(owner[q], blk);
+        assert_int_equal(ps->keys.ring[(uint32_t)(-1.0 - key)], ring);
     }
     printf("  %s: %u courtyards, %d of %d random points in one, every key as the ring-by-ring test\n", path,
            ps->keys.ncy, inside, n);
     *in_out = inside;
-    free(owner);
     plx_engine_destroy(e);
     free(mem);
 }
@@ -1355,11 +1366,11 @@ static void test_coarse_charts(void **state)
     void *mem;
     plx_engine *e = open_fixture("fixtures/eixample-4x4.geojson", &mem, 512u << 20);
     int want = quick_mode() ? 48 : 96, paths = quick_mode() ? 1000 : 4000, kind, k;
-    uint32_t res[3] = { 16, 32, 512 };
+    uint32_t res[4] = { 16, 32, 512, 8 };
     const char *name[3] = { "roofs", "courtyards", "open ground" };
-    double est[3][3], ref[3][3];
+    double est[4][3], ref[4][3];
     (void)state;
-    for (k = 0; k < 3; k++) {
+    for (k = 0; k < 4; k++) {
         kinds_vs_paths(e, res[k], want, paths, est[k], ref[k]);
         for (kind = 0; kind < 3; kind++)
             printf("  aerial chart %u texels a side, %s: mean E_indirect %.4f lx from the chart, %.4f lx by "
@@ -1369,12 +1380,20 @@ static void test_coarse_charts(void **state)
     for (k = 0; k < 3; k++) {
         /* roofs: a hundredth of a lux here, read low or about right */
         assert_true(est[k][0] >= 0.25 * ref[k][0] && est[k][0] <= 1.5 * ref[k][0]);
-        /* courtyards, nearly dark here: within 5% of the open ground's
-         * light of the truth */
-        assert_true(fabs(est[k][1] - ref[k][1]) <= 0.05 * ref[k][2]);
+        /* courtyards, nearly dark here (under a thousandth of a lux):
+         * within 0.5% of the open ground's light of the truth */
+        assert_true(fabs(est[k][1] - ref[k][1]) <= 0.005 * ref[k][2]);
         /* the open ground (streets and the border) */
         assert_true(est[k][2] >= 0.8 * ref[k][2] && est[k][2] <= 1.25 * ref[k][2]);
     }
+    /* 8 texels a side (59 m each, the whole city under a splat of 2 to 4
+     * texels): the open ground reads low, 0.34 to 0.45 of the truth (1.11 before
+     * the own-texel rule, which then dropped most street photons: they
+     * land in texels centred on roofs and courtyards, while the splats
+     * spread the rest over the empty border); photon.h says so. Held
+     * from falling further; the courtyards stay dark. */
+    assert_true(est[3][2] >= 0.25 * ref[3][2] && est[3][2] <= 1.25 * ref[3][2]);
+    assert_true(fabs(est[3][1] - ref[3][1]) <= 0.005 * ref[3][2]);
     plx_engine_destroy(e);
     free(mem);
 }
