@@ -127,6 +127,16 @@ static int put_frame(safe_out *o, const unsigned char *b, size_t len, int k, int
     return 0;
 }
 
+/* A write to the animation failed: given up, the reason said as every
+ * output's ("cannot write 'PATH': REASON"). */
+static int write_failed(safe_out *o, const char *path, char *err, size_t errlen)
+{
+    int e = safe_out_errno(o);
+    safe_out_abort(o);
+    snprintf(err, errlen, "animated PNG: cannot write '%s': %s", path, e ? strerror(e) : "a write failed");
+    return -1;
+}
+
 int image_write_apng(const char *path, const char *const *frames, int n, unsigned delay_num, unsigned delay_den,
                      char *err, size_t errlen)
 {
@@ -142,11 +152,8 @@ int image_write_apng(const char *path, const char *const *frames, int n, unsigne
     o = safe_out_open_batch(path, err, errlen);
     if (!o)
         return -1;
-    if (safe_out_write(o, sig, 8) != 0) {
-        safe_out_abort(o);
-        snprintf(err, errlen, "animated PNG: '%s': write failed", path);
-        return -1;
-    }
+    if (safe_out_write(o, sig, 8) != 0)
+        return write_failed(o, path, err, errlen);
     for (k = 0; k < n; k++) {
         size_t len;
         char *b = port_read_text(frames[k], &len, why, sizeof why);
@@ -154,16 +161,19 @@ int image_write_apng(const char *path, const char *const *frames, int n, unsigne
                                sizeof why)
                    : -1;
         free(b);
+        if (rc != 0 && safe_out_errno(o))
+            return write_failed(o, path, err, errlen);
         if (rc != 0) {
             safe_out_abort(o);
             snprintf(err, errlen, "animated PNG: '%s': frame '%s': %s", path, frames[k], why);
             return -1;
         }
     }
-    if (put_chunk(o, "IEND", NULL, 0, NULL, 0) != 0) {
-        safe_out_abort(o);
-        snprintf(err, errlen, "animated PNG: '%s': write failed", path);
+    if (put_chunk(o, "IEND", NULL, 0, NULL, 0) != 0)
+        return write_failed(o, path, err, errlen);
+    if (safe_out_commit(&o, 1, why, sizeof why) != 0) {
+        snprintf(err, errlen, "animated PNG: %s", why);
         return -1;
     }
-    return safe_out_commit(&o, 1, err, errlen);
+    return 0;
 }

@@ -129,7 +129,9 @@ int cli_bake_direct(const char *cmd, const char *path, const cli_common *c, plx_
  * holds the radiance atlas. Nothing for a scene. */
 void cli_bake_kept(const char *cmd, const char *path, const cli_common *c, plx_engine *e, const cli_indirect *ind,
                    double texel);
-/* A line on stderr when the photon buffers were fitted below the default quality. */
+/* A line on stderr when the photon buffers were fitted below the default
+ * quality: to fit --mem, or (a loaded bake's, photons traced again for
+ * illum's lamps) when the bake was made. Not a warning: --quiet keeps it. */
 void cli_indirect_note(const char *cmd, plx_engine *e);
 int cli_indirect_run(const char *cmd, plx_engine *e, const cli_indirect *ind, const double *eye,
                      const double *dir, double fov_deg);

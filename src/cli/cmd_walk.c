@@ -562,9 +562,14 @@ static int frame(const walk_args *a, plx_engine *e, const walk_path *wp, walk_ru
             size_t budget = cli_buffer_budget(e, &a->c), room = budget > frame_bytes ? budget - frame_bytes : 0;
             int f = wr->sh.f;
             if (!sheet_fit(&wr->sh, a, wr->n, room) || !(wr->sh.px = calloc((size_t)wr->sh.W * wr->sh.H * 3, 1))) {
+                char old[4096];
+                struct stat sb;
+                snprintf(old, sizeof old, "%s/contact.png", a->dir);
                 fprintf(stderr, "polarlux walk: no contact sheet: it needs %.1f MB beside the engine and the "
-                        "frame (%.1f MB with frames %d pixels wide), and --mem leaves %.1f MB\n", need / 1e6,
-                        (double)wr->sh.W * wr->sh.H * 3 / 1e6, wr->sh.tw, room / 1e6);
+                        "frame (%.1f MB with frames %d pixels wide), and --mem leaves %.1f MB%s%s%s\n", need / 1e6,
+                        (double)wr->sh.W * wr->sh.H * 3 / 1e6, wr->sh.tw, room / 1e6,
+                        stat(old, &sb) == 0 ? "; " : "", stat(old, &sb) == 0 ? old : "",
+                        stat(old, &sb) == 0 ? " is an earlier walk's, left as it was" : "");
                 wr->sh.skipped = 1;
             } else if (wr->sh.f != f) {
                 fprintf(stderr, "polarlux walk: contact sheet with frames %d pixels wide (not %d) to fit --mem: "

@@ -687,10 +687,11 @@ void cli_indirect_note(const char *cmd, plx_engine *e)
     if (plx_indirect_info_get(e, &pi) != PLX_OK || pi.reductions == 0)
         return;
     fprintf(stderr,
-            "polarlux %s: indirect light at reduced quality to fit --mem: photon buffers %.1f MiB "
+            "polarlux %s: indirect light at reduced quality %s: photon buffers %.1f MiB "
             "instead of %.1f (%u steps: facade charts %ux%u, aerial chart %ux%u texels of %.1f m, "
             "%u lamp floor maps, lamp ray tables %s)\n",
-            cmd, pi.bytes / 1048576.0, pi.full_bytes / 1048576.0, pi.reductions, pi.chart_w, pi.chart_h,
+            cmd, cli_bake_last.loaded ? "as the bake was made (to fit its --mem when baked)" : "to fit --mem",
+            pi.bytes / 1048576.0, pi.full_bytes / 1048576.0, pi.reductions, pi.chart_w, pi.chart_h,
             pi.aerial_w, pi.aerial_h, pi.aerial_texel, pi.lamp_slots, pi.lamp_tables ? "on" : "off");
 }
 

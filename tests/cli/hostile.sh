@@ -117,6 +117,11 @@ if [ -f "$shim" ]; then
     pre=
     if [ -s "$tmp/w/frame-0002.png" ] && [ ! -e "$tmp/w/frame-0003.png" ] && [ ! -e "$tmp/w/walk.png" ] &&
        [ -z "$(ls "$tmp/w" | grep '\.tmp')" ]; then ok walk-frame-fails-clean; else bad walk-frame-fails-clean; fi
+    # the animated PNG on a full disk says why, as every output does
+    pre="LD_PRELOAD=$shim ASAN_OPTIONS=verify_asan_link_order=0 PLX_FAILWRITE_MATCH=walk.png.tmp"
+    expect walk-apng-fails 1 "^polarlux walk: animated PNG: cannot write '$tmp/wapng/walk.png': No space left on device$" -- \
+        walk -q $T --path "$tmp/walk.geojson" --size 32x24 --fps 1 --no-indirect -o "$tmp/wapng"
+    pre=
     # walk's outputs are synced together at its end (one syncfs of the folder's file system), not
     # one by one: a failing fsync of the frames is never met; a failing sync of the folder is
     pre="LD_PRELOAD=$shim ASAN_OPTIONS=verify_asan_link_order=0 PLX_FAILWRITE_MATCH=wsync/ PLX_FAILWRITE_AFTER=100000000 PLX_FAILWRITE_FSYNC=1"

@@ -505,6 +505,15 @@ else echo "FAIL walk-contact-portrait: sheet header bytes $*, want 720x320"; fai
 # frames failed the walk: "size 0x400")
 expect walk-contact-narrow 0 "^walk: 4 frames 3x1600 " -- \
     "$bin" walk -q fixtures/eixample-4x4.geojson --path "$tmp/path.geojson" --size 3x1600 --max-frames 4 --aa 1 --no-indirect -o "$tmp/wnar"
+# illum traces photons again for its lamps in a bake's reduced buffers: the note says the bake made them so
+"$bin" bake -q fixtures/helsinki-centre.geojson --mem 16M --no-aerial --no-polar --max-size 320x240 --frames 2 -o "$tmp/hs.plxb" >/dev/null 2>&1
+echo "0 0 1.5" >"$tmp/hs.txt"
+expect illum-bake-reduced 0 "^polarlux illum: indirect light at reduced quality as the bake was made \(to fit its --mem when baked\): photon buffers" -- \
+    "$bin" illum -q "$tmp/hs.plxb" --points "$tmp/hs.txt" --frames 2
+# a walk that cannot make its contact sheet says an earlier walk's is left in the folder
+mkdir -p "$tmp/wold"; echo old >"$tmp/wold/contact.png"
+expect walk-contact-stale 0 "no contact sheet: .*; $tmp/wold/contact.png is an earlier walk's, left as it was" -- \
+    "$bin" walk fixtures/tiny.geojson --path "$tmp/path.geojson" --size 640x480 --max-frames 2 --aa 1 --no-indirect --mem 8M -o "$tmp/wold"
 # a frame's delay is 1/fps exactly where 16-bit terms allow (it was
 # whole milliseconds: 33/1000 at 30 and at 29.97 fps)
 "$bin" walk -q "$tmp/e.plxb" --path "$tmp/path.geojson" --size 32x24 --fps 29.97 --max-frames 2 --aa 1 --no-indirect -o "$tmp/wfps" >/dev/null 2>&1
