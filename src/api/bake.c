@@ -151,13 +151,14 @@ static uint32_t layout_print(void)
                           sizeof(render_stats), sizeof(icache), sizeof(polar), sizeof(polar_trap),
                           PLX_PART_COUNT, sizeof(mesh), sizeof(mesh_bld),
                           sizeof(mesh_surf), RENDER_SURF_CACHE, sizeof(atlas), sizeof(atlas_chart),
-                          sizeof(atlas_cache),
-                          6 /* format changes that keep the sizes (bump on such changes): 2 the polar
+                          sizeof(atlas_cache), sizeof(light_entry),
+                          7 /* format changes that keep the sizes (bump on such changes): 2 the polar
                                DAG's wide nodes bit-packed, 3 aerial records keyed apart, 8 m, 4 the
                                radiance atlas, 5 a wall column's vertices shared by its two walls, the
                                roof and the underside (mesh_bld.v_count), 6 the renderer's buffers of
                                a row or a column for the longer side (it draws frames either way
-                               round: an older bake's are too short for a turned frame). The atlas's dark state
+                               round: an older bake's are too short for a turned frame), 7 the photon
+                               charts' surface keys (courtyards apart) and own-texel rule. The atlas's dark state
                                (ATLAS_DARK, 2026-11-29) needs none: an older bake's charts read as
                                filled (no shortcut, the same
                                image), an older reader takes the state as done (a saved bake has

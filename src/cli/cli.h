@@ -19,6 +19,7 @@ enum {
 
 typedef struct cli_common {
     size_t mem;      /* engine budget in bytes (--mem) */
+    int mem_given;   /* --mem was given */
     int strict;      /* --strict */
     int quiet;       /* --quiet: no warnings on stderr */
     int render_w, render_h; /* largest frame the engine will render (0: default) */

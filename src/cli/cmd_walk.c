@@ -744,10 +744,12 @@ static int run(const walk_args *a, plx_engine *e, const walk_path *wp, long *don
         if (wr.n >= 3 && (med > 1000.0 / a->fps || (sum - wr.ms[0]) / (wr.n - 1) > 1000.0 / a->fps))
             cli_warn("walk", &a->c, "the frames took %.1f ms (median; mean after the first %.1f ms) to render, "
                      "longer than a frame lasts at %g fps (%.1f ms): shown as they are made, they fall behind on "
-                     "this machine; %s",
+                     "this machine; %s%s",
                      med, (sum - wr.ms[0]) / (wr.n - 1), a->fps, 1000.0 / a->fps,
                      a->opts.aa > 1 ? "--aa 1 (one sample a pixel), a smaller --size or a lower --fps keep up"
-                                    : "a smaller --size or a lower --fps keep up");
+                                    : "a smaller --size or a lower --fps keep up",
+                     a->c.mem_given ? "; a larger --mem may too (near the smallest block, the lamps' "
+                                                   "lit regions and the radiance atlas find no room)" : "");
         if (wr.inside) {
             char at[96];
             cli_warn("walk", &a->c, "%ld of %ld frames have the eye inside a building (the first: frame %ld at "

@@ -150,6 +150,7 @@ int cli_common_option(const char *cmd, int argc, char **argv, int *i, cli_common
             return -1;
         }
         c->mem = cli_parse_size(argv[++*i]);
+        c->mem_given = 1;
         if (c->mem < PLX_ENGINE_MIN_BYTES) {
             cli_usage_error(cmd, "--mem '%s' is not a size from %d bytes to 1e15 (a number with K, M, G or T, "
                             "e.g. 512M, 2G)", argv[*i], PLX_ENGINE_MIN_BYTES);

@@ -144,6 +144,7 @@ static plx_status create_parts(light *L, arena *a, size_t cache_bytes)
         L->ent[i].reg = NULL;
         L->ent[i].prev = L->ent[i].next = LIT_NONE;
         L->ent[i].aprev = L->ent[i].anext = LIT_NONE;
+        L->ent[i].fail_free = 0;
     }
     L->lru_head = L->lru_tail = L->addr_head = L->addr_tail = LIT_NONE;
     L->pool_cap = cache_bytes & ~(size_t)(LIGHT_ALIGN - 1);

@@ -116,12 +116,18 @@ typedef struct light_entry {
     struct lit_region *reg;   /* NULL when not cached */
     uint32_t prev, next;      /* LRU list, most recent first */
     uint32_t aprev, anext;    /* address order in the pool */
+    size_t fail_free;         /* the arena's free bytes when computing its
+                                 region last ran out of memory (0: it did
+                                 not): not tried again until more is free */
 } light_entry;
 
 typedef struct light_stats {
     uint64_t hits, misses, evictions, compactions, computed;
     uint64_t fallbacks;       /* queries answered by the segment path because
                                  a region could not be computed */
+    uint64_t failed;          /* region computations that ran out of memory
+                                 (a lamp's is not tried again until more
+                                 memory is free: light_entry.fail_free) */
 } light_stats;
 
 typedef struct light {

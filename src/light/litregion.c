@@ -1550,9 +1550,22 @@ static plx_status region_get(light *L, uint32_t lamp, int polygons, const lit_re
     L->st.misses++;
     if (L->pool_cap == 0)
         return PLX_E_NOMEM;
+    /* it ran out of memory with this much free or more: the same again
+     * (a frame near the block's smallest --mem asked every lamp in view
+     * at every pixel, each failing late: 100 times slower than with 30
+     * KB more) */
+    if (L->ent[lamp].fail_free && arena_free_bytes(L->a) <= L->ent[lamp].fail_free)
+        return PLX_E_NOMEM;
     if (L->ent[lamp].reg)
         evict(L, lamp);             /* index only: replaced by the full region */
     st = region_compute(L, lamp, polygons);
+    if (st == PLX_E_NOMEM) {
+        size_t f = arena_free_bytes(L->a);
+        L->ent[lamp].fail_free = f ? f : 1;
+        L->st.failed++;
+    } else {
+        L->ent[lamp].fail_free = 0;
+    }
     if (st == PLX_OK)
         *out = L->ent[lamp].reg;
     /* the cache stays inside its pool; a region got is at the LRU head */
@@ -1573,9 +1586,12 @@ plx_status light_region_index(light *L, uint32_t lamp, const lit_region **out)
 
 void light_cache_clear(light *L)
 {
+    uint32_t i;
     while (L->lru_tail != LIT_NONE)
         evict(L, L->lru_tail);
     L->pool_end = 0;
+    for (i = 0; i < L->s->nlamps; i++)
+        L->ent[i].fail_free = 0;
 }
 
 void light_cache_reset(light *L)

@@ -510,6 +510,9 @@ expect walk-contact-narrow 0 "^walk: 4 frames 3x1600 " -- \
 echo "0 0 1.5" >"$tmp/hs.txt"
 expect illum-bake-reduced 0 "^polarlux illum: indirect light at reduced quality as the bake was made \(to fit its --mem when baked\): photon buffers" -- \
     "$bin" illum -q "$tmp/hs.plxb" --points "$tmp/hs.txt" --frames 2
+# slow frames in a block given with --mem: a larger --mem is named too
+expect walk-slower-mem 0 "fall behind on this machine; --aa 1 \(one sample a pixel\), a smaller --size or a lower --fps keep up; a larger --mem may too" -- \
+    "$bin" walk "$tmp/e.plxb" --fps 10000 --mem 1G --path "$tmp/endpath.geojson" --size 160x120 --max-frames 3 -o "$tmp/endw"
 # a walk that cannot make its contact sheet says an earlier walk's is left in the folder
 mkdir -p "$tmp/wold"; echo old >"$tmp/wold/contact.png"
 expect walk-contact-stale 0 "no contact sheet: .*; $tmp/wold/contact.png is an earlier walk's, left as it was" -- \

@@ -1234,6 +1234,14 @@ static void test_cache_nomem(void **state)
     }
     assert_int_equal(t.bad, 0);
     assert_true(b.L->st.fallbacks > 0);
+    /* each lamp's region tried once: with no more memory free, not again
+     * (every query used to compute it until it ran out) */
+    printf("  pool of 64 bytes: %llu queries by the segment path, %llu computations out of memory (%u lamps)\n",
+           (unsigned long long)b.L->st.fallbacks, (unsigned long long)b.L->st.failed, s.nlamps);
+    assert_true(b.L->st.failed >= 1 && b.L->st.failed <= s.nlamps && b.L->st.fallbacks > 2 * b.L->st.failed);
+    light_cache_clear(b.L); /* a fresh start tries again */
+    assert_int_equal(light_region(b.L, 0, &r), PLX_E_NOMEM);
+    assert_true(b.L->st.failed <= s.nlamps + 1);
     lab_close(&b);
     /* no cache at all */
     lab_open(&b, &s, 0);
@@ -1282,6 +1290,10 @@ static void test_fault_injection(void **state)
         assert_int_equal(a.lo, m.lo);
         assert_int_equal(a.hi, m.hi);
         assert_int_equal(L->ncached, 0);
+        /* with no more memory free the lamp is not tried again (a failure
+         * is taken to repeat): the injected one does not, so start afresh */
+        assert_int_equal(light_region(L, 1, &r), PLX_E_NOMEM);
+        light_cache_clear(L);
     }
     a.fail_at = 0;
     printf("  light_region: %llu requests\n", (unsigned long long)k);
