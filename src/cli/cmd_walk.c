@@ -564,12 +564,13 @@ static int frame(const walk_args *a, plx_engine *e, const walk_path *wp, walk_ru
             if (!sheet_fit(&wr->sh, a, wr->n, room) || !(wr->sh.px = calloc((size_t)wr->sh.W * wr->sh.H * 3, 1))) {
                 char old[4096];
                 struct stat sb;
+                int left;
                 snprintf(old, sizeof old, "%s/contact.png", a->dir);
+                left = stat(old, &sb) == 0; /* an earlier walk's */
                 fprintf(stderr, "polarlux walk: no contact sheet: it needs %.1f MB beside the engine and the "
                         "frame (%.1f MB with frames %d pixels wide), and --mem leaves %.1f MB%s%s%s\n", need / 1e6,
-                        (double)wr->sh.W * wr->sh.H * 3 / 1e6, wr->sh.tw, room / 1e6,
-                        stat(old, &sb) == 0 ? "; " : "", stat(old, &sb) == 0 ? old : "",
-                        stat(old, &sb) == 0 ? " is an earlier walk's, left as it was" : "");
+                        (double)wr->sh.W * wr->sh.H * 3 / 1e6, wr->sh.tw, room / 1e6, left ? "; " : "",
+                        left ? old : "", left ? " is an earlier walk's, left as it was" : "");
                 wr->sh.skipped = 1;
             } else if (wr->sh.f != f) {
                 fprintf(stderr, "polarlux walk: contact sheet with frames %d pixels wide (not %d) to fit --mem: "
@@ -748,8 +749,9 @@ static int run(const walk_args *a, plx_engine *e, const walk_path *wp, long *don
                      med, (sum - wr.ms[0]) / (wr.n - 1), a->fps, 1000.0 / a->fps,
                      a->opts.aa > 1 ? "--aa 1 (one sample a pixel), a smaller --size or a lower --fps keep up"
                                     : "a smaller --size or a lower --fps keep up",
-                     a->c.mem_given ? "; a larger --mem may too (near the smallest block, the lamps' "
-                                                   "lit regions and the radiance atlas find no room)" : "");
+                     a->c.mem_given ? "; a larger --mem may too (near the smallest block, the lamps' lit "
+                                      "regions and the radiance atlas find no room)"
+                                    : "");
         if (wr.inside) {
             char at[96];
             cli_warn("walk", &a->c, "%ld of %ld frames have the eye inside a building (the first: frame %ld at "
