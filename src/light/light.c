@@ -138,13 +138,14 @@ static plx_status create_parts(light *L, arena *a, size_t cache_bytes)
     L->cross_d = arena_alloc(a, PLX_PART_LIT, arena_mul(v, sizeof(int)), LIGHT_ALIGN);
     L->col = arena_alloc(a, PLX_PART_LIT, arena_mul(2 * (size_t)v, sizeof(double)), LIGHT_ALIGN);
     L->ent = arena_alloc(a, PLX_PART_LIT, arena_mul(s->nlamps + 1, sizeof *L->ent), LIGHT_ALIGN);
-    if (!L->stamp || !L->cross_t || !L->cross_d || !L->col || !L->ent)
+    L->failed = arena_calloc(a, PLX_PART_LIT, (size_t)s->nlamps / 8 + 1, 1, LIGHT_ALIGN);
+    L->fail_free = 0;
+    if (!L->stamp || !L->cross_t || !L->cross_d || !L->col || !L->ent || !L->failed)
         return PLX_E_NOMEM;
     for (i = 0; i < s->nlamps; i++) {
         L->ent[i].reg = NULL;
         L->ent[i].prev = L->ent[i].next = LIT_NONE;
         L->ent[i].aprev = L->ent[i].anext = LIT_NONE;
-        L->ent[i].fail_free = 0;
     }
     L->lru_head = L->lru_tail = L->addr_head = L->addr_tail = LIT_NONE;
     L->pool_cap = cache_bytes & ~(size_t)(LIGHT_ALIGN - 1);
@@ -195,7 +196,7 @@ size_t light_base_bytes(const scene *s)
 {
     size_t v = max_vertices(s) + 1;
     return sizeof(light) + 4 * (s->nbld + 1) + v * (8 + 4 + 16) +
-           (s->nlamps + 1) * sizeof(light_entry);
+           (s->nlamps + 1) * sizeof(light_entry) + s->nlamps / 8 + 1;
 }
 
 /* ---- the exact segment test ---------------------------------------------- */

@@ -116,9 +116,6 @@ typedef struct light_entry {
     struct lit_region *reg;   /* NULL when not cached */
     uint32_t prev, next;      /* LRU list, most recent first */
     uint32_t aprev, anext;    /* address order in the pool */
-    size_t fail_free;         /* the arena's free bytes when computing its
-                                 region last ran out of memory (0: it did
-                                 not): not tried again until more is free */
 } light_entry;
 
 typedef struct light_stats {
@@ -127,7 +124,7 @@ typedef struct light_stats {
                                  a region could not be computed */
     uint64_t failed;          /* region computations that ran out of memory
                                  (a lamp's is not tried again until more
-                                 memory is free: light_entry.fail_free) */
+                                 memory is free: light.failed) */
 } light_stats;
 
 typedef struct light {
@@ -146,6 +143,11 @@ typedef struct light {
     unsigned char *pool;
     size_t pool_cap, pool_end, pool_live;
     light_entry *ent;         /* one per lamp */
+    unsigned char *failed;    /* a bit per lamp: its region ran out of
+                                 memory, with at most fail_free bytes free
+                                 in the arena; not tried again until more
+                                 is free (then every bit is cleared) */
+    size_t fail_free;
     uint32_t lru_head, lru_tail, addr_head, addr_tail;
     uint32_t ncached;
     light_stats st;

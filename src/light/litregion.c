@@ -1532,6 +1532,13 @@ static plx_status region_compute(light *L, uint32_t lamp, int polygons)
     return st;
 }
 
+/* Forgets which lamps' regions ran out of memory. */
+static void fail_clear(light *L)
+{
+    memset(L->failed, 0, (size_t)L->s->nlamps / 8 + 1);
+    L->fail_free = 0;
+}
+
 static plx_status region_get(light *L, uint32_t lamp, int polygons, const lit_region **out)
 {
     plx_status st;
@@ -1554,17 +1561,19 @@ static plx_status region_get(light *L, uint32_t lamp, int polygons, const lit_re
      * (a frame near the block's smallest --mem asked every lamp in view
      * at every pixel, each failing late: 100 times slower than with 30
      * KB more) */
-    if (L->ent[lamp].fail_free && arena_free_bytes(L->a) <= L->ent[lamp].fail_free)
-        return PLX_E_NOMEM;
+    if (L->failed[lamp >> 3] & (1u << (lamp & 7))) {
+        if (arena_free_bytes(L->a) <= L->fail_free)
+            return PLX_E_NOMEM;
+        fail_clear(L); /* more memory now: every lamp may be tried again */
+    }
     if (L->ent[lamp].reg)
         evict(L, lamp);             /* index only: replaced by the full region */
     st = region_compute(L, lamp, polygons);
     if (st == PLX_E_NOMEM) {
         size_t f = arena_free_bytes(L->a);
-        L->ent[lamp].fail_free = f ? f : 1;
+        L->failed[lamp >> 3] |= (unsigned char)(1u << (lamp & 7));
+        L->fail_free = f > L->fail_free ? f : L->fail_free;
         L->st.failed++;
-    } else {
-        L->ent[lamp].fail_free = 0;
     }
     if (st == PLX_OK)
         *out = L->ent[lamp].reg;
@@ -1586,12 +1595,10 @@ plx_status light_region_index(light *L, uint32_t lamp, const lit_region **out)
 
 void light_cache_clear(light *L)
 {
-    uint32_t i;
     while (L->lru_tail != LIT_NONE)
         evict(L, L->lru_tail);
     L->pool_end = 0;
-    for (i = 0; i < L->s->nlamps; i++)
-        L->ent[i].fail_free = 0;
+    fail_clear(L);
 }
 
 void light_cache_reset(light *L)
