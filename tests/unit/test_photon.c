@@ -1112,10 +1112,11 @@ static void test_accuracy_eixample(void **state)
     free(mem);
 }
 
-/* 1 when (x, y) lies in a courtyard of block k: inside one of its
- * outline's clockwise rings after the first (blocks.h), by the even-odd
- * rule and the shoelace sign here, not geom.c's. */
-static int in_courtyard(const scene *s, uint32_t k, double x, double y)
+/* The courtyard ring of block k holding (x, y): one of its outline's
+ * clockwise rings after the first (blocks.h), by the even-odd rule and
+ * the shoelace sign here, not geom.c's (nor surface_key.c's); its index
+ * in scene.block_rings, UINT32_MAX when none. */
+static uint32_t courtyard_ring_of(const scene *s, uint32_t k, double x, double y)
 {
     const scene_block *K = &s->blocks[k];
     uint32_t r, i, j;
@@ -1131,9 +1132,15 @@ static int in_courtyard(const scene *s, uint32_t k, double x, double y)
                 in = !in;
         }
         if (a2 < 0.0 && in)
-            return 1;
+            return K->ring_first + r;
     }
-    return 0;
+    return UINT32_MAX;
+}
+
+/* 1 when (x, y) lies in a courtyard of block k. */
+static int in_courtyard(const scene *s, uint32_t k, double x, double y)
+{
+    return courtyard_ring_of(s, k, x, y) != UINT32_MAX;
 }
 
 /* A random point on an outer wall of eixample-4x4 (z in the building's
@@ -1176,6 +1183,24 @@ static trace_hit strip_point(photon_sys *ps, const scene *s, uint64_t *rs, int *
     return h;
 }
 
+/* Photon buffers of e's scene (cfg NULL: the defaults) with the viewer at
+ * its centre, 16 frames of 65536 photons (the command's default). */
+static photon_sys *traced_from_centre(plx_engine *e, const photon_config *cfg)
+{
+    const scene *s = e->sc;
+    photon_sys *ps;
+    double eye[3];
+    int k;
+    assert_int_equal(photon_create(&e->mem, s, cfg, &ps), PLX_OK);
+    eye[0] = 0.5 * (s->bounds[0] + s->bounds[2]);
+    eye[1] = 0.5 * (s->bounds[1] + s->bounds[3]);
+    eye[2] = 1.7;
+    assert_int_equal(photon_set_viewer(ps, eye, NULL, 0.0), PLX_OK);
+    for (k = 0; k < 16; k++)
+        photon_step(ps, 65536, (uint64_t)k + 1);
+    return ps;
+}
+
 /* The exposed upper strip of a party wall (above a lower neighbour's roof)
  * sees roofs and sky, not the street. Its E_indirect from the block's
  * charts against the independent path tracer, beside street facades at
@@ -1195,17 +1220,11 @@ static void test_party_wall_strips(void **state)
     const scene *s = e->sc;
     photon_sys *ps;
     int want = quick_mode() ? 48 : 96, paths = quick_mode() ? 1000 : 4000, n[2] = { 0, 0 }, k, tries = 0;
-    double est[2] = { 0.0, 0.0 }, ref[2] = { 0.0, 0.0 }, eye[3];
+    double est[2] = { 0.0, 0.0 }, ref[2] = { 0.0, 0.0 };
     uint64_t rs = 0x57219u;
     const char *name[2] = { "street facades", "party-wall strips" };
     (void)state;
-    assert_int_equal(photon_create(&e->mem, s, NULL, &ps), PLX_OK);
-    eye[0] = 0.5 * (s->bounds[0] + s->bounds[2]);
-    eye[1] = 0.5 * (s->bounds[1] + s->bounds[3]);
-    eye[2] = 1.7;
-    assert_int_equal(photon_set_viewer(ps, eye, NULL, 0.0), PLX_OK);
-    for (k = 0; k < 16; k++)
-        photon_step(ps, 65536, (uint64_t)k + 1);
+    ps = traced_from_centre(e, NULL);
     while ((n[0] < want || n[1] < want) && tries++ < 200000) {
         int kind;
         trace_hit h = strip_point(ps, s, &rs, &kind);
@@ -1240,27 +1259,14 @@ static int in_any_courtyard(const scene *s, double x, double y)
     return 0;
 }
 
-/* The courtyard ring holding (x, y), found block by block and ring by
- * ring with its own even-odd and shoelace code: the index in
- * scene.block_rings, UINT32_MAX when none. */
+/* The courtyard ring holding (x, y), block by block (courtyard_ring_of):
+ * its index in scene.block_rings, UINT32_MAX when none. */
 static uint32_t courtyard_ring_at(const scene *s, double x, double y)
 {
-    uint32_t k, r, i, j;
+    uint32_t k, r;
     for (k = 0; k < s->nblocks; k++)
-        for (r = 1; r < s->blocks[k].ring_count; r++) {
-            const scene_ring *R = &s->block_rings[s->blocks[k].ring_first + r];
-            const vec2 *p = &s->block_pts[R->first];
-            double a2 = 0.0;
-            int in = 0;
-            for (i = 0, j = R->count - 1; i < R->count; j = i++) {
-                a2 += p[j].x * p[i].y - p[i].x * p[j].y;
-                if ((p[i].y > y) != (p[j].y > y) &&
-                    x < p[j].x + (p[i].x - p[j].x) * (y - p[j].y) / (p[i].y - p[j].y))
-                    in = !in;
-            }
-            if (a2 < 0.0 && in)
-                return s->blocks[k].ring_first + r;
-        }
+        if ((r = courtyard_ring_of(s, k, x, y)) != UINT32_MAX)
+            return r;
     return UINT32_MAX;
 }
 
@@ -1326,18 +1332,11 @@ static void kinds_vs_paths(plx_engine *e, uint32_t res, int want, int paths, dou
     photon_config c;
     photon_sys *ps;
     arena_mark m = arena_get_mark(&e->mem);
-    double eye[3];
     uint64_t rs = 0x600fu;
     int n[3] = { 0, 0, 0 }, k, tries = 0;
     photon_config_default(&c);
     c.aerial_res = res;
-    assert_int_equal(photon_create(&e->mem, s, &c, &ps), PLX_OK);
-    eye[0] = 0.5 * (s->bounds[0] + s->bounds[2]);
-    eye[1] = 0.5 * (s->bounds[1] + s->bounds[3]);
-    eye[2] = 1.7;
-    assert_int_equal(photon_set_viewer(ps, eye, NULL, 0.0), PLX_OK);
-    for (k = 0; k < 16; k++)
-        photon_step(ps, 65536, (uint64_t)k + 1);
+    ps = traced_from_centre(e, &c);
     for (k = 0; k < 3; k++)
         est[k] = ref[k] = 0.0;
     while ((n[0] < want || n[1] < want || n[2] < want) && tries++ < 400000) {
