@@ -2,6 +2,7 @@
 #include <math.h>
 #include <string.h>
 
+#include "base/geom.h"
 #include "photon/surface_key.h"
 
 #define HEIGHT_TOL 1e-3     /* m: as in photon.c */
@@ -9,17 +10,6 @@
 #define CY_CELL_MIN 64.0    /* m: the courtyard grid's cells at least */
 #define CY_CELLS_MAX 128u   /* and at most this many a side */
 #define CY_MAX (1u << 24)   /* courtyards kept apart (their keys exact in a float) */
-
-/* Whether ring R of the blocks' outlines is clockwise (a courtyard). */
-static int ring_clockwise(const scene *s, const scene_ring *R)
-{
-    const vec2 *p = &s->block_pts[R->first];
-    double a2 = 0.0;
-    uint32_t i, j;
-    for (i = 0, j = R->count - 1; i < R->count; j = i++)
-        a2 += p[j].x * p[i].y - p[i].x * p[j].y;
-    return a2 < 0.0;
-}
 
 /* Calls fn for every courtyard ring (the rings after the first of each
  * block, clockwise), at most CY_MAX. */
@@ -29,7 +19,7 @@ static uint32_t each_courtyard(const scene *s, void (*fn)(void *, const scene *,
     for (k = 0; k < s->nblocks; k++)
         for (r = 1; r < s->blocks[k].ring_count && n < CY_MAX; r++) {
             uint32_t ri = s->blocks[k].ring_first + r;
-            if (!ring_clockwise(s, &s->block_rings[ri]))
+            if (!(geom_ring_area2(&s->block_pts[s->block_rings[ri].first], s->block_rings[ri].count) < 0.0))
                 continue;
             if (fn)
                 fn(arg, s, ri, n);
@@ -140,23 +130,11 @@ void surface_keys_build(const scene *s, surface_keys *K)
     K->first[0] = 0;
 }
 
-/* Whether (x, y) lies in ring ri (even-odd). */
-static int in_ring(const scene *s, uint32_t ri, double x, double y)
-{
-    const scene_ring *R = &s->block_rings[ri];
-    const vec2 *p = &s->block_pts[R->first];
-    uint32_t i, j;
-    int in = 0;
-    for (i = 0, j = R->count - 1; i < R->count; j = i++)
-        if ((p[i].y > y) != (p[j].y > y) && x < p[j].x + (p[i].x - p[j].x) * (y - p[j].y) / (p[i].y - p[j].y))
-            in = !in;
-    return in;
-}
-
 double surface_key(const surface_keys *K, const scene *s, double x, double y, double z)
 {
     double fi, fj;
     uint32_t k, q;
+    vec2 p;
     if (z > HEIGHT_TOL || K->ncy == 0)
         return z;
     fi = floor((x - K->x0) / K->cell);
@@ -167,7 +145,11 @@ double surface_key(const surface_keys *K, const scene *s, double x, double y, do
     for (q = K->first[k]; q < K->first[k + 1]; q++) {
         uint32_t c = K->item[q];
         const double *b = &K->box[4 * (size_t)c];
-        if (x >= b[0] && x <= b[2] && y >= b[1] && y <= b[3] && in_ring(s, K->ring[c], x, y))
+        const scene_ring *R = &s->block_rings[K->ring[c]];
+        p.x = x;
+        p.y = y;
+        if (x >= b[0] && x <= b[2] && y >= b[1] && y <= b[3] &&
+            geom_point_in_ring(p, &s->block_pts[R->first], R->count) == GEOM_INSIDE)
             return -1.0 - (double)c;
     }
     return z;
