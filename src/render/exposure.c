@@ -4,7 +4,8 @@
  * A night street is mostly black with small, very bright patches under the
  * lamps, so the mean says little. The exposure maps a high percentile of
  * the luminance of the lit surface pixels (EXPOSURE_PERCENTILE of the
- * pixels with Y > 0 that show a surface, not the sky) to EXPOSURE_KEY; the
+ * pixels with Y > 0 that show a surface, not the sky, and are at most
+ * EXPOSURE_RANGE stops below the EXPOSURE_ANCHOR percentile) to EXPOSURE_KEY; the
  * tone curve (extended Reinhard, white point EXPOSURE_WHITE) then rolls
  * off the highlights near lamps instead of clipping them. The percentile
  * comes from a histogram of log2 Y in eighth stops: O(pixels), no sort,
@@ -130,22 +131,36 @@ int exposure_counted(const uint32_t hist[EXPOSURE_BINS])
     return 0;
 }
 
+/* The bin of the want-th pixel (1 ..) counted in bins lo .. in ascending
+ * order; the last bin when fewer. */
+static int bin_at(const uint32_t hist[EXPOSURE_BINS], int lo, size_t want)
+{
+    size_t acc = 0;
+    int b;
+    for (b = lo; b < BINS; b++) {
+        acc += hist[b];
+        if (acc >= want)
+            return b;
+    }
+    return BINS - 1;
+}
+
 double exposure_from(const uint32_t hist[EXPOSURE_BINS])
 {
-    size_t n = 0, want, acc = 0;
-    int b;
+    size_t n = 0, m = 0;
+    int b, lo;
     for (b = 0; b < BINS; b++)
         n += hist[b];
     if (n == 0)
         return 1.0;
-    want = (size_t)ceil(EXPOSURE_PERCENTILE * (double)n);
-    for (b = 0; b < BINS; b++) {
-        acc += hist[b];
-        if (acc >= want)
-            break;
-    }
-    if (b >= BINS)
-        b = BINS - 1;
+    /* the pixels more than EXPOSURE_RANGE stops below the anchor are left
+     * out: black at any exposure the rule picks, and how many there are
+     * says how the dark was computed, not what the view shows */
+    lo = bin_at(hist, 0, (size_t)ceil(EXPOSURE_ANCHOR * (double)n)) - EXPOSURE_RANGE * (int)PER_STOP;
+    lo = lo > 0 ? lo : 0;
+    for (b = lo; b < BINS; b++)
+        m += hist[b];
+    b = bin_at(hist, lo, (size_t)ceil(EXPOSURE_PERCENTILE * (double)m));
     if (b < EXPOSURE_MAX_BIN) /* at most EXPOSURE_MAX */
         b = EXPOSURE_MAX_BIN;
     /* the bin's upper edge, so the chosen pixel is at most the key */
