@@ -30,6 +30,10 @@ typedef struct cli_common {
 } cli_common;
 
 #define CLI_DEFAULT_MEM ((size_t)1 << 30)
+/* The radiance atlas's spacing when none is asked (plx_render_opts.aerial_m_per_texel 0). */
+#define CLI_ATLAS_SPACING 0.5
+/* Its most when plx_config.lightmap_bytes is 0, a quarter of the block up to this (renderapi.c). */
+#define CLI_ATLAS_MAX_BYTES ((size_t)64 << 20)
 
 /* Prints "polarlux CMD: msg" on stderr and returns EXIT_USAGE. */
 int cli_usage_error(const char *cmd, const char *fmt, ...);
@@ -134,6 +138,12 @@ void cli_bake_kept(const char *cmd, const char *path, const cli_common *c, plx_e
  * quality: to fit --mem, or (a loaded bake's, photons traced again for
  * illum's lamps) when the bake was made. Not a warning: --quiet keeps it. */
 void cli_indirect_note(const char *cmd, plx_engine *e);
+/* A line on stderr when this run's first frame laid out the radiance
+ * atlas (had: whether it was made before the frame, a bake's) with its
+ * points farther apart than asked (texel, or the default 0.5 m when 0)
+ * because the block is small (its quarter under CLI_ATLAS_MAX_BYTES: a
+ * larger --mem gives finer points). Not a warning: --quiet keeps it. */
+void cli_atlas_note(const char *cmd, plx_engine *e, int had, double texel);
 int cli_indirect_run(const char *cmd, plx_engine *e, const cli_indirect *ind, const double *eye,
                      const double *dir, double fov_deg);
 /* A command's near-viewer refinement (cli_refine): its settings and

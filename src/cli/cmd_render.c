@@ -340,7 +340,7 @@ int cmd_render(int argc, char **argv)
     float *rgbf = NULL;
     unsigned long long t0;
     plx_status st;
-    int prec;
+    int prec, had_atlas;
 #ifdef PLX_HAVE_OSMESA
     plx_osmesa *om = NULL;
 #endif
@@ -436,9 +436,15 @@ int cmd_render(int argc, char **argv)
         a.opts.backend = plx_osmesa_backend(om);
     }
 #endif
+    {
+        plx_atlas_info ai;
+        had_atlas = plx_atlas_info_get(e, &ai) == PLX_OK && ai.made;
+    }
     t0 = port_now_ns();
     st = plx_render(e, &a.cam, &a.opts, rgb8, rgbf, &info);
     t0 = port_now_ns() - t0; /* the frame alone, not the PNG written after it */
+    if (st == PLX_OK)
+        cli_atlas_note("render", e, had_atlas, a.opts.aerial_m_per_texel);
     if (st != PLX_OK) {
         fprintf(stderr, "polarlux render: %s%s\n", plx_last_error(e), cli_aa_nomem_hint(st, &a.opts));
 #ifdef PLX_HAVE_OSMESA

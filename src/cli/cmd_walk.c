@@ -483,6 +483,7 @@ static int frame(const walk_args *a, plx_engine *e, const walk_path *wp, walk_ru
     plx_render_opts o;
     unsigned long long t0;
     plx_status st;
+    int had_atlas = 0;
     memset(&cam, 0, sizeof cam);
     walk_path_camera(wp, s, cam.eye, cam.target);
     {
@@ -510,9 +511,15 @@ static int frame(const walk_args *a, plx_engine *e, const walk_path *wp, walk_ru
         o.exposure = wr->held;
         o.exposure_step = eighths < 1.0 ? 1 : eighths > PLX_EXPOSURE_STEP_MAX ? PLX_EXPOSURE_STEP_MAX : (int)eighths;
     }
+    if (k == 0) {
+        plx_atlas_info ai;
+        had_atlas = plx_atlas_info_get(e, &ai) == PLX_OK && ai.made;
+    }
     t0 = port_now_ns();
     st = plx_render(e, &cam, &o, wr->rgb8, NULL, &info);
     wr->ms[k] = (port_now_ns() - t0) / 1e6;
+    if (st == PLX_OK && k == 0)
+        cli_atlas_note("walk", e, had_atlas, a->opts.aerial_m_per_texel);
     wr->lookups += info.indirect_lookups;
     wr->aa_later += info.aa_later;
     if (st == PLX_OK) {

@@ -696,6 +696,26 @@ void cli_indirect_note(const char *cmd, plx_engine *e)
             pi.aerial_w, pi.aerial_h, pi.aerial_texel, pi.lamp_slots, pi.lamp_tables ? "on" : "off");
 }
 
+void cli_atlas_note(const char *cmd, plx_engine *e, int had, double texel)
+{
+    plx_atlas_info ai;
+    plx_memory_report mr;
+    double asked = texel > 0.0 ? texel : CLI_ATLAS_SPACING;
+    if (had || plx_atlas_info_get(e, &ai) != PLX_OK || !ai.made || !(ai.spacing > asked * 1.001))
+        return;
+    plx_memory_get(e, &mr);
+    if (mr.capacity / 4 >= CLI_ATLAS_MAX_BYTES / 100 * 99) /* the atlas's own ceiling set it (the block's
+                                                              usable bytes are a little under --mem) */
+        return;
+    fprintf(stderr,
+            "polarlux %s: radiance atlas at reduced quality to fit %s: points %.2f m apart instead of %.2f "
+            "(%.2f m where only indirect light reaches), in a quarter of the block (%.1f MiB); lamp pools and "
+            "shadow edges are blurred at that scale: a larger --mem for finer points (the atlas takes at most "
+            "%d MiB, from a block of %d MiB)\n",
+            cmd, cli_bake_last.loaded ? "the block beside the bake" : "the block", ai.spacing, asked, ai.coarse,
+            mr.capacity / 4 / 1048576.0, (int)(CLI_ATLAS_MAX_BYTES >> 20), (int)(4 * (CLI_ATLAS_MAX_BYTES >> 20)));
+}
+
 void cli_json_error(const char *name, const char *text, size_t len, char *err, size_t errlen)
 {
     const char *at = cJSON_GetErrorPtr(), *tail;

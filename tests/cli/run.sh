@@ -420,6 +420,15 @@ ep=$("$bin" render fixtures/eixample-4x4.geojson --view aerial --size 320x240 --
 if [ -n "$ea" ] && [ -n "$ep" ] && awk -v a="$ea" -v b="$ep" 'BEGIN { d = log(a / b) / log(2); exit !(d < 0.13 && d > -0.13) }'; then
     echo "ok   render-exposure-atlas-per-pixel ($ea, $ep)"; pass=$((pass + 1))
 else echo "FAIL render-exposure-atlas-per-pixel: atlas $ea, per pixel $ep"; fail=$((fail + 1)); fi
+# a radiance atlas laid out coarser than asked because the block is small
+# says so, with the remedy (a kiosk pass found a bake's frames at 4 m
+# between points without a word); none when the atlas has its spacing
+expect render-atlas-reduced-note 0 "radiance atlas at reduced quality to fit the block: points 0.71 m apart instead of 0.50 .*a larger --mem for finer points" -- \
+    "$bin" render fixtures/eixample-4x4.geojson --mem 24M --size 160x120 -o "$tmp/xatl.png"
+expect render-atlas-no-note 0 "" -- "$bin" render fixtures/eixample-4x4.geojson --size 160x120 -o "$tmp/xatl.png"
+if grep -q "radiance atlas" "$tmp/out"; then echo "FAIL render-atlas-no-note: a note at the default block"; fail=$((fail + 1)); fi
+expect walk-atlas-reduced-note 0 "^polarlux walk: radiance atlas at reduced quality to fit the block: points 0.71 m apart" -- \
+    "$bin" walk fixtures/eixample-4x4.geojson --mem 24M --path "$tmp/endpath.geojson" --size 160x120 --max-frames 2 -o "$tmp/atlw"
 # a held walk: a frame with no lit surface keeps the held exposure (it
 # took automatic exposure's 1 for an empty image, then jumped back), and
 # a frame black at the held cap (724: half a stop short of 1024) says its
