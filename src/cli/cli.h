@@ -27,6 +27,8 @@ typedef struct cli_common {
     int nlamp_files;
     const char *points_crs; /* --points-crs: lonlat, local, or a CRS name (NULL: the file says, or the scene's) */
     int threads;     /* --threads N: workers of a frame (0: the number of processors) */
+    int atlas_room;  /* frames will read the radiance atlas: a bake without one, loaded without
+                        --mem, gets a block with room for it (CLI_ATLAS_BLOCK) */
 } cli_common;
 
 #define CLI_DEFAULT_MEM ((size_t)1 << 30)
@@ -34,6 +36,8 @@ typedef struct cli_common {
 #define CLI_ATLAS_SPACING 0.5
 /* Its most when plx_config.lightmap_bytes is 0, a quarter of the block up to this (renderapi.c). */
 #define CLI_ATLAS_MAX_BYTES ((size_t)64 << 20)
+/* The block a bake without its atlas is loaded in when no --mem is given: room for the atlas at its most. */
+#define CLI_ATLAS_BLOCK (4 * CLI_ATLAS_MAX_BYTES + ((size_t)1 << 20))
 
 /* Prints "polarlux CMD: msg" on stderr and returns EXIT_USAGE. */
 int cli_usage_error(const char *cmd, const char *fmt, ...);

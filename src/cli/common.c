@@ -508,6 +508,34 @@ static char *read_big(const char *path, size_t *len, char *err, size_t errlen)
     return buf;
 }
 
+/* The bake's image loaded into a new block of need bytes, the reason
+ * said on stderr when it cannot be. */
+static plx_status load_bake_in(const char *cmd, const char *path, size_t need, const plx_config *cfg,
+                               const char *data, size_t len, plx_engine **e)
+{
+    char err[512];
+    plx_status st;
+    void *mem = cli_big_alloc(need);
+    if (!mem) {
+        fprintf(stderr, "polarlux %s: %s: cannot take a block of %zu bytes for the bake\n", cmd, path, need);
+        return PLX_E_NOMEM;
+    }
+    st = plx_bake_load(mem, need, cfg, data, len, e, err, sizeof err);
+    if (st != PLX_OK) {
+        fprintf(stderr, "polarlux %s: %s: %s\n", cmd, path, err);
+        free(mem);
+    }
+    return st;
+}
+
+/* Whether a loaded bake holds its radiance atlas, or holds no indirect
+ * light (its frames shade every pixel anyway). */
+static int bake_has_atlas(plx_engine *e)
+{
+    plx_atlas_info ai;
+    return plx_indirect_frames(e) == 0 || (plx_atlas_info_get(e, &ai) == PLX_OK && ai.made);
+}
+
 /* An engine from a bake file: the file read once, the block sized by the
  * bake (or --mem), the image copied and relocated. */
 static int open_bake(const char *cmd, const char *path, const cli_common *c, plx_engine **e)
@@ -515,7 +543,6 @@ static int open_bake(const char *cmd, const char *path, const cli_common *c, plx
     char err[512];
     size_t len, need;
     char *data;
-    void *mem;
     plx_config cfg;
     plx_status st;
     unsigned long long t0 = port_now_ns();
@@ -532,20 +559,20 @@ static int open_bake(const char *cmd, const char *path, const cli_common *c, plx
     }
     if (c->mem)
         need = c->mem;
-    mem = cli_big_alloc(need);
-    if (!mem) {
-        fprintf(stderr, "polarlux %s: %s: cannot take a block of %zu bytes for the bake\n", cmd, path, need);
-        free(data);
-        return EXIT_NOMEM;
-    }
     cli_config(c, &cfg);
-    st = plx_bake_load(mem, need, &cfg, data, len, e, err, sizeof err);
-    free(data);
-    if (st != PLX_OK) {
-        fprintf(stderr, "polarlux %s: %s: %s\n", cmd, path, err);
-        free(mem);
-        return st == PLX_E_NOMEM ? EXIT_NOMEM : EXIT_FAIL;
+    st = load_bake_in(cmd, path, need, &cfg, data, len, e);
+    if (st == PLX_OK && c->atlas_room && !c->mem && need < CLI_ATLAS_BLOCK && !bake_has_atlas(*e)) {
+        /* no --mem, and the bake holds no radiance atlas (--no-aerial):
+         * again in a block whose quarter holds the atlas at its finest,
+         * as a scene's default block does, not at the 4 m the bake's own
+         * size left (its pages are taken as the atlas fills them) */
+        plx_engine_free(*e);
+        *e = NULL;
+        st = load_bake_in(cmd, path, CLI_ATLAS_BLOCK, &cfg, data, len, e);
     }
+    free(data);
+    if (st != PLX_OK)
+        return st == PLX_E_NOMEM ? EXIT_NOMEM : EXIT_FAIL;
     cli_bake_last.loaded = 1;
     cli_bake_last.bytes = len;
     cli_bake_last.load_ns = port_now_ns() - t0;

@@ -427,6 +427,19 @@ expect render-atlas-reduced-note 0 "radiance atlas at reduced quality to fit the
     "$bin" render fixtures/eixample-4x4.geojson --mem 24M --size 160x120 -o "$tmp/xatl.png"
 expect render-atlas-no-note 0 "" -- "$bin" render fixtures/eixample-4x4.geojson --size 160x120 -o "$tmp/xatl.png"
 if grep -q "radiance atlas" "$tmp/out"; then echo "FAIL render-atlas-no-note: a note at the default block"; fail=$((fail + 1)); fi
+# a --no-aerial bake (made small) drawn without --mem gets a block with
+# room for its atlas at the spacing asked, as a scene's default block has
+# (it drew from points 4 m apart on gen eixample 30 30: blocky lamp pools);
+# with --mem, the block given, and the note
+# (gen eixample 12 12 in 32M: its own block, 50 MB, left points 1.41 m apart)
+"$bin" gen eixample 12 12 >"$tmp/e12.geojson"
+"$bin" bake -q "$tmp/e12.geojson" --no-aerial --mem 32M --frames 2 --photons 4000 --max-size 160x120 -o "$tmp/na.plxb" >/dev/null 2>&1
+expect render-bake-atlas-room 0 "" -- "$bin" render "$tmp/na.plxb" --size 160x120 -o "$tmp/xna.png"
+if grep -q "radiance atlas" "$tmp/out"; then echo "FAIL render-bake-atlas-room: the atlas was reduced"; sed 's/^/    /' "$tmp/out"; fail=$((fail + 1)); fi
+expect render-bake-atlas-mem 0 "radiance atlas at reduced quality to fit the block beside the bake: points 1.41 m apart instead of 0.50" -- \
+    "$bin" render "$tmp/na.plxb" --mem 50M --size 160x120 -o "$tmp/xna.png"
+expect walk-bake-atlas-room 0 "" -- "$bin" walk "$tmp/na.plxb" --path "$tmp/endpath.geojson" --size 160x120 --max-frames 2 -o "$tmp/naw"
+if grep -q "radiance atlas" "$tmp/out"; then echo "FAIL walk-bake-atlas-room: the atlas was reduced"; sed 's/^/    /' "$tmp/out"; fail=$((fail + 1)); fi
 expect walk-atlas-reduced-note 0 "^polarlux walk: radiance atlas at reduced quality to fit the block: points 0.71 m apart" -- \
     "$bin" walk fixtures/eixample-4x4.geojson --mem 24M --path "$tmp/endpath.geojson" --size 160x120 --max-frames 2 -o "$tmp/atlw"
 # a held walk: a frame with no lit surface keeps the held exposure (it
