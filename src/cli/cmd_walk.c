@@ -319,6 +319,7 @@ typedef struct walk_run {
     uint8_t *rgb8;
     sheet sh;
     FILE *cams;
+    char cams_name[4096];       /* its path, for messages */
     cli_refiner ref;           /* --refine */
     double refine_ms;
     uint64_t lookups;          /* indirect lookups, all frames */
@@ -379,7 +380,7 @@ static void writer_plan(const walk_args *a, plx_engine *e, walk_run *wr)
     wr->buf[1] = malloc(frame_bytes);
     if (!wr->buf[1])
         return;
-    if (frame_writer_start(&wr->fw) != 0) {
+    if (frame_writer_start(&wr->fw, wr->cams, wr->cams_name) != 0) {
         free(wr->buf[1]);
         wr->buf[1] = NULL;
         return;
@@ -387,18 +388,20 @@ static void writer_plan(const walk_args *a, plx_engine *e, walk_run *wr)
     wr->writer = 1;
 }
 
-/* Frame k's PNG: handed to the writer, or written now. */
-static int write_frame(const walk_args *a, walk_run *wr, long k)
+/* Frame k's PNG, then its line of cameras.txt: handed to the writer, or
+ * written now. */
+static int write_frame(const walk_args *a, walk_run *wr, long k, const char *line)
 {
     char path[4096], err[512];
     snprintf(path, sizeof path, "%s/frame-%04ld.png", a->dir, k + 1);
     if (wr->writer) {
-        if (frame_writer_put(&wr->fw, path, wr->rgb8, a->w, a->h) == 0)
+        if (frame_writer_put(&wr->fw, path, wr->rgb8, a->w, a->h, line) == 0)
             return EXIT_OK;
         fprintf(stderr, "polarlux walk: %s\n", wr->fw.err);
         return EXIT_FAIL;
     }
-    if (image_write_png_frame(path, a->w, a->h, wr->rgb8, 0, err, sizeof err) != 0) {
+    if (image_write_png_frame(path, a->w, a->h, wr->rgb8, 0, err, sizeof err) != 0 ||
+        frame_log_line(wr->cams, wr->cams_name, line, err, sizeof err) != 0) {
         fprintf(stderr, "polarlux walk: %s\n", err);
         return EXIT_FAIL;
     }
@@ -429,10 +432,9 @@ static int writer_end(walk_run *wr, int rc)
  * as it was. */
 static int cams_open(const walk_args *a, walk_run *wr)
 {
-    char path[4096];
-    snprintf(path, sizeof path, "%s/cameras.txt", a->dir);
-    if (!(wr->cams = fopen(path, "w"))) {
-        fprintf(stderr, "polarlux walk: %s: cannot write: %s\n", path, strerror(errno));
+    snprintf(wr->cams_name, sizeof wr->cams_name, "%s/cameras.txt", a->dir);
+    if (!(wr->cams = fopen(wr->cams_name, "w"))) {
+        fprintf(stderr, "polarlux walk: %s: cannot write: %s\n", wr->cams_name, strerror(errno));
         return -1;
     }
     if (wr->lonlat)
@@ -484,6 +486,7 @@ static int frame(const walk_args *a, plx_engine *e, const walk_path *wp, walk_ru
     unsigned long long t0;
     plx_status st;
     int had_atlas = 0;
+    char line[320];
     memset(&cam, 0, sizeof cam);
     walk_path_camera(wp, s, cam.eye, cam.target);
     {
@@ -553,12 +556,12 @@ static int frame(const walk_args *a, plx_engine *e, const walk_path *wp, walk_ru
     }
     {
         /* in the scene's own coordinates (lon/lat on a lon/lat scene), as
-         * render --eye and --target take them */
+         * render --eye and --target take them; written once the frame is */
         double ex = cam.eye[0], ey = cam.eye[1], tx = cam.target[0], ty = cam.target[1];
         cli_from_local(e, &ex, &ey);
         cli_from_local(e, &tx, &ty);
-        fprintf(wr->cams, "%ld %.17g %.17g %.17g %.17g %.17g %.17g %.17g\n", k + 1, ex, ey, cam.eye[2], tx, ty,
-                cam.target[2], info.exposure);
+        snprintf(line, sizeof line, "%ld %.17g %.17g %.17g %.17g %.17g %.17g %.17g\n", k + 1, ex, ey, cam.eye[2], tx,
+                 ty, cam.target[2], info.exposure);
     }
     if (k == 0)
         writer_plan(a, e, wr);
@@ -588,7 +591,7 @@ static int frame(const walk_args *a, plx_engine *e, const walk_path *wp, walk_ru
             sheet_put(&wr->sh, a, wr->rgb8, wr->sh.n);
         wr->sh.n++;
     }
-    return write_frame(a, wr, k);
+    return write_frame(a, wr, k, line);
 }
 
 /* A path whose eye stays this high, drawn as street views without the

@@ -117,6 +117,10 @@ if [ -f "$shim" ]; then
     pre=
     if [ -s "$tmp/w/frame-0002.png" ] && [ ! -e "$tmp/w/frame-0003.png" ] && [ ! -e "$tmp/w/walk.png" ] &&
        [ -z "$(ls "$tmp/w" | grep '\.tmp')" ]; then ok walk-frame-fails-clean; else bad walk-frame-fails-clean; fi
+    # cameras.txt lists the frames on disk: each line is written once its frame is (it listed
+    # frame 3, which a full disk stopped)
+    if [ "$(grep -vc '^#' "$tmp/w/cameras.txt")" = 2 ] && [ "$(awk '!/^#/ { n = $1 } END { print n }' "$tmp/w/cameras.txt")" = 2 ]; then
+        ok walk-frame-fails-cameras; else bad "walk-frame-fails-cameras: $(grep -vc '^#' "$tmp/w/cameras.txt") lines"; fi
     # the animated PNG on a full disk says why, as every output does
     pre="LD_PRELOAD=$shim ASAN_OPTIONS=verify_asan_link_order=0 PLX_FAILWRITE_MATCH=walk.png.tmp"
     expect walk-apng-fails 1 "^polarlux walk: animated PNG: cannot write '$tmp/wapng/walk.png': No space left on device$" -- \
@@ -162,6 +166,28 @@ if [ -c /dev/full ]; then
     mkdir "$tmp/wcam"; ln -s /dev/full "$tmp/wcam/cameras.txt"
     expect walk-cameras-full 1 "^polarlux walk: $tmp/wcam/cameras.txt: cannot write: No space left on device$" -- \
         walk -q $T --path "$tmp/walkc.geojson" --size 32x24 --fps 1 --no-indirect -o "$tmp/wcam"
+fi
+# a walk killed half way: cameras.txt lists frames 1 .. n, each on disk, and at most the one
+# after them is on disk beside (a killed walk left it shorter than the frames: its lines were
+# buffered; they are flushed as each frame is written)
+printf '{"type":"LineString","coordinates":[[0,0,1.7],[4000,0,1.7]]}' >"$tmp/walkk.geojson"
+$PLX_HOSTILE_WRAP "$bin" walk -q $T --path "$tmp/walkk.geojson" --size 64x48 --speed 1 --fps 1 --no-indirect \
+    -o "$tmp/wkill" >/dev/null 2>&1 &
+kpid=$!
+k=0
+while [ $k -lt 600 ] && [ ! -e "$tmp/wkill/frame-0005.png" ]; do sleep 0.1; k=$((k + 1)); done
+kill -9 $kpid 2>/dev/null; wait $kpid 2>/dev/null
+lines=$(grep -vc '^#' "$tmp/wkill/cameras.txt" 2>/dev/null || echo 0)
+frames=$(ls "$tmp/wkill" | grep -c '^frame-[0-9]*\.png$')
+listed=1
+for n in $(awk '!/^#/ { print $1 }' "$tmp/wkill/cameras.txt" 2>/dev/null); do
+    [ -s "$tmp/wkill/$(printf 'frame-%04d.png' "$n")" ] || listed=0
+done
+if [ "$lines" -ge 1 ] && [ "$listed" = 1 ] && [ "$frames" -ge "$lines" ] && [ "$frames" -le $((lines + 1)) ] &&
+   [ "$(awk '!/^#/ { if ($1 != NR - 1) bad = 1 } END { print bad + 0 }' "$tmp/wkill/cameras.txt")" = 0 ]; then
+    ok "walk-killed-cameras ($lines lines, $frames frames)"
+else
+    bad "walk-killed-cameras: $lines lines, $frames frames, every listed one on disk: $listed"
 fi
 # a full small filesystem: a 64 KiB tmpfs in a mount namespace of its own, where permitted
 if [ "$(id -u)" = 0 ] && unshare -m true 2>/dev/null; then
