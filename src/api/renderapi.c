@@ -2,6 +2,7 @@
 #include <string.h>
 
 #include "base/engine.h"
+#include "base/strbuf.h"
 #include "light/illuminance.h"
 #include "light/litregion.h"
 #include "render/render.h"
@@ -322,8 +323,15 @@ plx_status eng_need_atlas(plx_engine *e, double fine)
     if ((st = eng_need_render(e)) != PLX_OK)
         return st;
     f = atlas_spacing_for(&e->mem, e->sc, render_mesh(e->rd), fine, atlas_budget(e));
-    if (f == 0.0)
-        return eng_nomem(e, "laying out the radiance atlas (even 64 m between its points does not fit)");
+    if (f == 0.0) {
+        char why[120]; /* the coarsest tried: 64 m, or the spacing asked when coarser */
+        strbuf b;
+        sb_init(&b, why, sizeof why);
+        sb_str(&b, "laying out the radiance atlas (even ");
+        sb_num(&b, fine > 64.0 ? fine : 64.0, 6);
+        sb_str(&b, " m between its points does not fit)");
+        return eng_nomem(e, why);
+    }
     m = arena_get_mark(&e->mem);
     st = atlas_create(&e->mem, e->sc, render_mesh(e->rd), f, &e->atlas);
     e->atlas_cache = st == PLX_OK ? arena_calloc(&e->mem, PLX_PART_FRAME, PLX_MAX_THREADS, sizeof(atlas_cache), 64)

@@ -164,11 +164,19 @@ static int prepare_engine(const bake_args *a, int twin, plx_engine **e, char *er
     st = plx_bake_prepare(*e, &o);
     if (st == PLX_OK)
         return EXIT_OK;
-    if (st == PLX_E_NOMEM) { /* what would need less, of the options not given yet */
-        int more = a->o.aerial || !a->o.no_polar;
-        snprintf(err, errlen, "polarlux bake: %s (%s%sa smaller --max-size%s need%s less; or give a larger --mem)\n",
-                 plx_last_error(*e), a->o.aerial ? "--no-aerial, " : "", a->o.no_polar ? "" : "--no-polar, ",
-                 a->o.aerial ? " or a coarser --texel" : "", more ? "" : "s");
+    if (st == PLX_E_NOMEM) { /* what would need less, of the options not given yet, at the stage that failed */
+        const char *why = plx_last_error(*e);
+        /* the stages in order: polar diagrams, lamp light, photons, renderer, radiance atlas; an option
+         * helps at its own stage and the later ones */
+        int atlas = strstr(why, "radiance atlas") != NULL, polar = strstr(why, "polar diagrams") != NULL;
+        int aerial = atlas && a->o.aerial, size = !polar;
+        int more = aerial + !a->o.no_polar + size;
+        if (more == 0)
+            snprintf(err, errlen, "polarlux bake: %s (give a larger --mem)\n", why);
+        else
+            snprintf(err, errlen, "polarlux bake: %s (%s%s%s%s%s need%s less; or give a larger --mem)\n", why,
+                     aerial ? "--no-aerial, " : "", a->o.no_polar ? "" : "--no-polar", size && !a->o.no_polar ? ", " : "",
+                     size ? "a smaller --max-size" : "", aerial ? " or a coarser --texel" : "", more > 1 ? "" : "s");
     } else
         snprintf(err, errlen, "polarlux bake: %s\n", plx_last_error(*e));
     plx_engine_free(*e);

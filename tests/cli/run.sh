@@ -169,8 +169,14 @@ expect bake-no-indirect-walk 0 "holds no indirect light" -- \
 # out of memory: what takes less (bake), and that --aa 1 needs no
 # anti-aliasing buffers (a walk at the bake's own --mem failed at frame 1
 # with no word of it)
-expect bake-nomem-hint 3 "out of memory .*\(--no-aerial, --no-polar, a smaller --max-size or a coarser --texel need less; or give a larger --mem\)$" -- \
-    "$bin" bake -q fixtures/eixample-4x4.geojson --mem 3M -o "$tmp/nomem.plxb"
+expect bake-nomem-hint 3 "out of memory while making the radiance atlas.*\(--no-aerial, --no-polar, a smaller --max-size or a coarser --texel need less; or give a larger --mem\)$" -- \
+    "$bin" bake -q fixtures/eixample-4x4.geojson --max-size 160x120 --mem 3M -o "$tmp/nomem.plxb"
+# ... and only the options that act at the stage that ran out or before it (the
+# renderer's frame buffers were told of --no-aerial and --texel, which act after)
+expect bake-nomem-hint-renderer 3 "out of memory while creating the renderer.*\(--no-polar, a smaller --max-size need less; or give a larger --mem\)$" -- \
+    "$bin" bake -q fixtures/eixample-4x4.geojson --mem 8M -o "$tmp/nomem.plxb"
+expect bake-nomem-hint-polar 3 "out of memory while building the polar diagrams.*\(--no-polar needs less; or give a larger --mem\)$" -- \
+    "$bin" bake -q fixtures/helsinki-centre.geojson --mem 1500K -o "$tmp/nomem.plxb"
 # the hint names only the options not given (a kiosk pass's bake with
 # --no-aerial --no-polar was told to give them)
 expect bake-nomem-hint-given 3 "out of memory .*\(a smaller --max-size needs less; or give a larger --mem\)$" -- \
