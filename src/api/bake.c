@@ -25,6 +25,7 @@
  */
 #include <string.h>
 
+#include "api/bake_file.h"
 #include "base/engine.h"
 #include "light/light.h"
 #include "light/litregion.h"
@@ -35,151 +36,6 @@
 #include "render/atlas.h"
 #include "render/atlas_frame.h"
 #include "render/atlas_fill.h"
-
-#define BAKE_MAGIC "PLXBAKE\0"
-#define BAKE_VERSION 3u
-#define BAKE_HEADER 128u
-#define BAKE_ENDIAN 0x01020304u
-#define BAKE_ALIGN 64u
-#define BAKE_PAGE 4096u
-#define BAKE_SLACK ((uint64_t)32 << 20) /* room for queries' scratch */
-
-enum {
-    H_MAGIC = 0, H_VERSION = 8, H_ENDIAN = 12, H_SIZES = 16, H_LAYOUT = 20, H_LENGTH = 24,
-    H_SUM = 32, H_IMAGE = 40, H_NREL = 48, H_BASEMOD = 56, H_SLACK = 64, H_RESERVED = 72, H_PAGES = 80
-};
-
-/* ---- checksum: a multiply-rotate round over 64-bit words, four lanes ------ */
-
-/* Each word enters its lane as acc = rotl(acc + w K2, 31) K1: for a fixed
- * word a bijection of acc, for a fixed acc a bijection of w (K1 and K2
- * odd), and the rotation carries every bit of the product into the low
- * bits of the next one. Format 2's FNV-1a step, (acc ^ w) P, carried a
- * word's bit 63 only into the sum's bit 63: two flipped top bits in one
- * lane cancelled, and one in a field nothing reads went unseen, so a
- * damaged file passed and crashed the frames (a hostile-input pass). */
-#define SUM_K1 0x9e3779b97f4a7c15ull /* 2^64 / the golden ratio, odd */
-#define SUM_K2 0xd6e8feb86659fd93ull
-#define SUM_K3 0xff51afd7ed558ccdull
-
-typedef struct bake_sum {
-    uint64_t h[4];
-} bake_sum;
-
-static uint64_t rotl64(uint64_t x, unsigned r)
-{
-    return (x << r) | (x >> (64u - r));
-}
-
-static uint64_t sum_round(uint64_t acc, uint64_t w)
-{
-    return rotl64(acc + w * SUM_K2, 31) * SUM_K1;
-}
-
-static void sum_init(bake_sum *s)
-{
-    int k;
-    for (k = 0; k < 4; k++)
-        s->h[k] = SUM_K3 + (uint64_t)k;
-}
-
-/* Adds n bytes (n a multiple of 32 except for the last call). */
-static void sum_add(bake_sum *s, const unsigned char *p, size_t n)
-{
-    size_t i = 0;
-    uint64_t h0 = s->h[0], h1 = s->h[1], h2 = s->h[2], h3 = s->h[3], w[4];
-    for (; i + 32 <= n; i += 32) {
-        memcpy(w, p + i, 32);
-        h0 = sum_round(h0, w[0]);
-        h1 = sum_round(h1, w[1]);
-        h2 = sum_round(h2, w[2]);
-        h3 = sum_round(h3, w[3]);
-    }
-    for (; i < n; i++)
-        h0 = sum_round(h0, p[i]);
-    s->h[0] = h0;
-    s->h[1] = h1;
-    s->h[2] = h2;
-    s->h[3] = h3;
-}
-
-/* The lanes folded in order through the same round, then mixed so that
- * every bit of the result depends on every bit of each lane. */
-static uint64_t sum_end(const bake_sum *s)
-{
-    uint64_t h = s->h[0];
-    int k;
-    for (k = 1; k < 4; k++)
-        h = sum_round(h, s->h[k]);
-    h ^= h >> 33;
-    h *= SUM_K3;
-    h ^= h >> 29;
-    h *= SUM_K2;
-    h ^= h >> 32;
-    return h;
-}
-
-/* The checksum of a whole file: the header with its checksum field as 0,
- * then everything after the header. */
-static uint64_t file_sum(const unsigned char *f, size_t len)
-{
-    unsigned char h[BAKE_HEADER];
-    bake_sum s;
-    memcpy(h, f, BAKE_HEADER);
-    memset(h + H_SUM, 0, 8);
-    sum_init(&s);
-    sum_add(&s, h, BAKE_HEADER);
-    sum_add(&s, f + BAKE_HEADER, len - BAKE_HEADER);
-    return sum_end(&s);
-}
-
-/* ---- header fields ------------------------------------------------------- */
-
-static void put32(unsigned char *p, uint32_t v) { memcpy(p, &v, 4); }
-static void put64(unsigned char *p, uint64_t v) { memcpy(p, &v, 8); }
-static uint32_t get32(const unsigned char *p) { uint32_t v; memcpy(&v, p, 4); return v; }
-static uint64_t get64(const unsigned char *p) { uint64_t v; memcpy(&v, p, 8); return v; }
-
-/* Sizes of the saved structures: a bake from a build whose structures
- * differ is refused (a cheap guard; BAKE_VERSION is the real contract). */
-static uint32_t layout_print(void)
-{
-    const size_t sz[] = { sizeof(struct plx_engine), sizeof(scene), sizeof(scene_building),
-                          sizeof(scene_lamp), sizeof(light), sizeof(lit_region), sizeof(photon_sys),
-                          sizeof(photon_config), sizeof(photon_lamp_slot), sizeof(arena),
-                          sizeof(plx_config), sizeof(render_opts), render_struct_bytes(),
-                          sizeof(render_stats), sizeof(icache), sizeof(polar), sizeof(polar_trap),
-                          PLX_PART_COUNT, sizeof(mesh), sizeof(mesh_bld),
-                          sizeof(mesh_surf), RENDER_SURF_CACHE, sizeof(atlas), sizeof(atlas_chart),
-                          sizeof(atlas_cache), sizeof(light_entry),
-                          7 /* format changes that keep the sizes (bump on such changes): 2 the polar
-                               DAG's wide nodes bit-packed, 3 aerial records keyed apart, 8 m, 4 the
-                               radiance atlas, 5 a wall column's vertices shared by its two walls, the
-                               roof and the underside (mesh_bld.v_count), 6 the renderer's buffers of
-                               a row or a column for the longer side (it draws frames either way
-                               round: an older bake's are too short for a turned frame), 7 the photon
-                               charts' surface keys (courtyards apart) and own-texel rule. The atlas's dark state
-                               (ATLAS_DARK, 2026-11-29) needs none: an older bake's charts read as
-                               filled (no shortcut, the same
-                               image), an older reader takes the state as done (a saved bake has
-                               nothing left to fill) */ };
-    uint64_t h = 0xcbf29ce484222325ull; /* FNV-1a's basis and prime: the sizes are small */
-    size_t i;
-    for (i = 0; i < sizeof sz / sizeof sz[0]; i++)
-        h = (h ^ (uint64_t)sz[i]) * 0x00000100000001b3ull;
-    return (uint32_t)(h ^ (h >> 32));
-}
-
-static uint32_t arch_sizes(void)
-{
-    return (uint32_t)sizeof(void *) | (uint32_t)sizeof(size_t) << 8 | (uint32_t)sizeof(double) << 16 |
-           (uint32_t)sizeof(long) << 24;
-}
-
-static size_t pad8(size_t n)
-{
-    return (n + 7) & ~(size_t)7;
-}
 
 /* ---- preparing an engine --------------------------------------------------- */
 
@@ -220,13 +76,6 @@ plx_status plx_bake_prepare(plx_engine *e, const plx_bake_opts *o)
 }
 
 /* ---- saving ---------------------------------------------------------------- */
-
-/* Where a file's parts are: the page bitmap, the stored pages, the
- * relocations. */
-typedef struct bake_layout {
-    size_t image, npages, pages_present, nrel;
-    size_t bitmap_at, pages_at, rel_at, total;
-} bake_layout;
 
 static plx_status scan(plx_engine *e, plx_engine *t, unsigned char *out, bake_layout *L);
 
@@ -311,8 +160,7 @@ static void make_savable(plx_engine *e, savable_keep *keep)
 
 static void restore_code(plx_engine *e, const savable_keep *keep)
 {
-    if (e->rd)
-        render_code_bind(e->rd, render_shade_light);
+    bake_bind_code(e);
     if (keep) {
         if (e->ic) {
             e->ic->gathered = keep->ic_gathered;
@@ -350,15 +198,6 @@ static plx_status scan_savable(plx_engine *e, plx_engine *t, unsigned char *out,
 }
 
 
-static void layout_fill(bake_layout *L)
-{
-    L->npages = (L->image + BAKE_PAGE - 1) / BAKE_PAGE;
-    L->bitmap_at = BAKE_HEADER;
-    L->pages_at = L->bitmap_at + pad8((L->npages + 7) / 8);
-    L->rel_at = L->pages_at + L->pages_present * BAKE_PAGE;
-    L->total = L->rel_at + 4 * L->nrel;
-}
-
 /* Walks the image page by page: pointers become offsets (and relocations),
  * all-zero pages are left out. Counts into L; writes the file's bitmap,
  * pages and relocations when out is given (L then holds the counts of a
@@ -380,7 +219,7 @@ static plx_status scan(plx_engine *e, plx_engine *t, unsigned char *out, bake_la
             if (wa - base_a <= len && wb == wa + delta) {
                 page[i] = wa - base_a;
                 if (out)
-                    put32(out + L->rel_at + 4 * n, (uint32_t)(start / 8 + i));
+                    bake_put32(out + L->rel_at + 4 * n, (uint32_t)(start / 8 + i));
                 n++;
                 any = 1;
             }
@@ -398,7 +237,7 @@ static plx_status scan(plx_engine *e, plx_engine *t, unsigned char *out, bake_la
     L->image = len;
     L->nrel = n;
     L->pages_present = present;
-    layout_fill(L);
+    bake_layout_fill(L);
     return PLX_OK;
 }
 
@@ -475,226 +314,24 @@ plx_status plx_bake_save(plx_engine *e, plx_engine *twin, void *buf, size_t cap,
     if (st != PLX_OK)
         return st;
     memcpy(f + H_MAGIC, BAKE_MAGIC, 8);
-    put32(f + H_VERSION, BAKE_VERSION);
-    put32(f + H_ENDIAN, BAKE_ENDIAN);
-    put32(f + H_SIZES, arch_sizes());
-    put32(f + H_LAYOUT, layout_print());
-    put64(f + H_LENGTH, L.total);
-    put64(f + H_IMAGE, L.image);
-    put64(f + H_NREL, L.nrel);
-    put64(f + H_BASEMOD, (uintptr_t)e->mem.base & (BAKE_ALIGN - 1));
-    put64(f + H_SLACK, bake_slack(e));
+    bake_put32(f + H_VERSION, BAKE_VERSION);
+    bake_put32(f + H_ENDIAN, BAKE_ENDIAN);
+    bake_put32(f + H_SIZES, bake_arch_sizes());
+    bake_put32(f + H_LAYOUT, bake_layout_print());
+    bake_put64(f + H_LENGTH, L.total);
+    bake_put64(f + H_IMAGE, L.image);
+    bake_put64(f + H_NREL, L.nrel);
+    bake_put64(f + H_BASEMOD, (uintptr_t)e->mem.base & (BAKE_ALIGN - 1));
+    bake_put64(f + H_SLACK, bake_slack(e));
     /* 0: files of before 2026-11-25 hold the build's peak memory here, which
      * the layer's workers raised, so that bakes on 1 and N threads differed;
      * nothing reads it */
-    put64(f + H_RESERVED, 0);
-    put64(f + H_PAGES, L.pages_present);
-    put64(f + H_SUM, file_sum(f, L.total));
+    bake_put64(f + H_RESERVED, 0);
+    bake_put64(f + H_PAGES, L.pages_present);
+    bake_put64(f + H_SUM, bake_file_sum(f, L.total));
     if (written)
         *written = L.total;
     eng_clear_error(e);
     return PLX_OK;
 }
 
-/* ---- loading ----------------------------------------------------------------- */
-
-static plx_status say(char *err, size_t errlen, plx_status s, const char *a, uint64_t x, const char *b,
-                      uint64_t y, const char *c)
-{
-    strbuf sb;
-    if (err && errlen) {
-        sb_init(&sb, err, errlen);
-        sb_str(&sb, a);
-        if (b) {
-            sb_uint(&sb, x);
-            sb_str(&sb, b);
-            if (c) {
-                sb_uint(&sb, y);
-                sb_str(&sb, c);
-            }
-        }
-    }
-    return s;
-}
-
-/* Checks the header and the checksum; fills the image length. */
-static size_t popcount(const unsigned char *bits, size_t n)
-{
-    size_t i, c = 0;
-    for (i = 0; i < n; i++)
-        c += (bits[i / 8] >> (i % 8)) & 1u;
-    return c;
-}
-
-static plx_status check_file(const unsigned char *f, size_t len, bake_layout *L, char *err, size_t errlen)
-{
-    uint64_t flen, img;
-    if (!f || len < 8 || memcmp(f, BAKE_MAGIC, 8) != 0)
-        return say(err, errlen, PLX_E_PARSE, "not a polarlux bake file (no PLXBAKE magic)", 0, NULL, 0, NULL);
-    if (len < BAKE_HEADER)
-        return say(err, errlen, PLX_E_PARSE, "truncated bake file: ", len, " bytes, shorter than its ",
-                   BAKE_HEADER, "-byte header");
-    if (get32(f + H_VERSION) != BAKE_VERSION)
-        return say(err, errlen, PLX_E_UNSUPPORTED, "bake format version ", get32(f + H_VERSION),
-                   ", this polarlux reads version ", BAKE_VERSION, "; bake the scene again");
-    if (get32(f + H_ENDIAN) != BAKE_ENDIAN || get32(f + H_SIZES) != arch_sizes())
-        return say(err, errlen, PLX_E_UNSUPPORTED,
-                   "bake made on another architecture (byte order or pointer, size_t, double, long sizes "
-                   "differ); bake the scene again on this machine", 0, NULL, 0, NULL);
-    if (get32(f + H_LAYOUT) != layout_print())
-        return say(err, errlen, PLX_E_UNSUPPORTED,
-                   "bake made by a different build of polarlux (its structures differ); bake the scene again",
-                   0, NULL, 0, NULL);
-    flen = get64(f + H_LENGTH);
-    if (flen != len)
-        return say(err, errlen, PLX_E_PARSE, flen > len ? "truncated bake file: " : "bake file too long: ",
-                   len, " bytes, the header says ", flen, "");
-    img = get64(f + H_IMAGE);
-    L->image = (size_t)img;
-    L->nrel = (size_t)get64(f + H_NREL);
-    L->pages_present = (size_t)get64(f + H_PAGES);
-    if (img < sizeof(struct plx_engine) || img > ((uint64_t)1 << 34) || get64(f + H_NREL) > len / 4 ||
-        get64(f + H_PAGES) > len / BAKE_PAGE || get64(f + H_BASEMOD) >= BAKE_ALIGN ||
-        get64(f + H_BASEMOD) % PLX_ENGINE_ALIGN != 0)
-        return say(err, errlen, PLX_E_PARSE, "corrupt bake file: inconsistent header", 0, NULL, 0, NULL);
-    layout_fill(L);
-    if (L->total != len || L->pages_present > L->npages || popcount(f + L->bitmap_at, L->npages) != L->pages_present)
-        return say(err, errlen, PLX_E_PARSE, "corrupt bake file: inconsistent header", 0, NULL, 0, NULL);
-    if (file_sum(f, len) != get64(f + H_SUM))
-        return say(err, errlen, PLX_E_PARSE, "corrupt bake file: checksum mismatch", 0, NULL, 0, NULL);
-    return PLX_OK;
-}
-
-plx_status plx_bake_block_size(const void *bake, size_t len, size_t *block_bytes, char *err, size_t errlen)
-{
-    const unsigned char *f = bake;
-    bake_layout L;
-    plx_status st;
-    if (!block_bytes)
-        return say(err, errlen, PLX_E_INVALID, "plx_bake_block_size: block_bytes is NULL", 0, NULL, 0, NULL);
-    st = check_file(f, len, &L, err, errlen);
-    if (st != PLX_OK)
-        return st;
-    *block_bytes = L.image + (size_t)get64(f + H_SLACK) + 2 * BAKE_ALIGN;
-    if (err && errlen) /* no stale line from an earlier call */
-        err[0] = '\0';
-    return PLX_OK;
-}
-
-/* p is NULL, or lies in the image with 'bytes' after it and on an 8-byte
- * boundary (the load places the image as the baking engine's block lay,
- * modulo BAKE_ALIGN, so its structures keep their alignment; they hold
- * doubles and pointers: a misaligned renderer made the load itself fault,
- * found by a survey of forged bakes). */
-static int inside(const void *p, size_t bytes, const unsigned char *base, size_t len)
-{
-    const unsigned char *q = p;
-    return !q || (q >= base && (size_t)(q - base) <= len && bytes <= len - (size_t)(q - base) &&
-                  (uintptr_t)q % 8 == 0);
-}
-
-/* The engine's own pointers lie in the image, aligned, with room for what
- * they point at where loading touches it (the renderer). */
-static int roots_inside(const plx_engine *e, const unsigned char *base, size_t len)
-{
-    return inside(e->sc, sizeof(scene), base, len) && inside(e->pd, 1, base, len) &&
-           inside(e->lt, sizeof(light), base, len) && inside(e->rd, render_struct_bytes(), base, len) &&
-           inside(e->ph, sizeof(photon_sys), base, len) && inside(e->vis_poly, 1, base, len) &&
-           inside(e->vis_ids, 1, base, len);
-}
-
-/* The engine object of a loaded image, made to fit its new block. */
-static void rebase_engine(plx_engine *e, void *mem, unsigned char *base, size_t cap, size_t lo,
-                          const plx_config *cfg)
-{
-    plx_config saved = e->cfg;
-    size_t k;
-    e->block = mem;
-    e->mem.base = base;
-    e->mem.cap = cap;
-    e->mem.lo = lo;
-    e->mem.hi = 0;
-    e->mem.peak_total = lo;
-    e->mem.requests = 0;
-    e->mem.fail_at = 0;
-    e->mem.used[PLX_PART_SCRATCH] = 0;
-    if (cfg)
-        e->cfg = *cfg;
-    else
-        plx_config_default(&e->cfg);
-    /* what the saved structures were sized by stays */
-    e->cfg.lit_cache_bytes = saved.lit_cache_bytes;
-    e->cfg.render_max_width = saved.render_max_width;
-    e->cfg.render_max_height = saved.render_max_height;
-    memset(&e->port, 0, sizeof e->port);
-    if (e->cfg.port)
-        e->port = *e->cfg.port;
-    e->cfg.port = &e->port;
-    for (k = 0; k < PLX_PART_COUNT; k++)
-        e->mem.budget[k] = e->cfg.part_budget[k];
-    e->lit_last = NULL;
-    eng_clear_error(e);
-    restore_code(e, NULL);
-}
-
-plx_status plx_bake_load(void *mem, size_t size, const plx_config *cfg, const void *bake, size_t len,
-                         plx_engine **out, char *err, size_t errlen)
-{
-    const unsigned char *f = bake, *rel;
-    unsigned char *base;
-    uint64_t img, k;
-    size_t off, cap, p, present = 0;
-    bake_layout L;
-    plx_engine *e;
-    plx_status st;
-    if (out)
-        *out = NULL;
-    if (!mem || !out)
-        return say(err, errlen, PLX_E_INVALID, "plx_bake_load: mem and out must not be NULL", 0, NULL, 0, NULL);
-    /* the image is written over the block from its start: a file read
-     * into the block would be overwritten before it is read (and memcpy
-     * of overlapping bytes is undefined) */
-    if ((uintptr_t)f < (uintptr_t)mem + size && (uintptr_t)mem < (uintptr_t)f + len)
-        return say(err, errlen, PLX_E_INVALID, "plx_bake_load: the bake's bytes lie inside the block; read the "
-                   "file into memory outside it (the load writes the block from its start)", 0, NULL, 0, NULL);
-    st = check_file(f, len, &L, err, errlen);
-    if (st != PLX_OK)
-        return st;
-    img = L.image;
-    /* the same alignment modulo 64 as where it was saved */
-    off = (size_t)((get64(f + H_BASEMOD) - (uint64_t)(uintptr_t)mem) & (BAKE_ALIGN - 1));
-    if (size < off || size - off < img || size - off < PLX_ENGINE_MIN_BYTES)
-        return say(err, errlen, PLX_E_NOMEM, "the block is too small for the bake: it needs ",
-                   img + off, " bytes, the block has ", size, "");
-    base = (unsigned char *)mem + off;
-    cap = size - off;
-    for (p = 0; p < L.npages; p++) {
-        size_t start = p * BAKE_PAGE, bytes = img - start < BAKE_PAGE ? (size_t)img - start : BAKE_PAGE;
-        if ((f[L.bitmap_at + p / 8] >> (p % 8)) & 1u)
-            memcpy(base + start, f + L.pages_at + BAKE_PAGE * present++, bytes);
-        else
-            memset(base + start, 0, bytes);
-    }
-    rel = f + L.rel_at;
-    for (k = 0; k < L.nrel; k++) {
-        uint64_t at = (uint64_t)get32(rel + 4 * k) * 8, w;
-        if (at + 8 > img)
-            return say(err, errlen, PLX_E_PARSE, "corrupt bake file: relocation ", k, " points outside the image",
-                       0, NULL);
-        memcpy(&w, base + at, 8);
-        if (w > img)
-            return say(err, errlen, PLX_E_PARSE, "corrupt bake file: relocated word ", k,
-                       " points outside the image", 0, NULL);
-        w += (uint64_t)(uintptr_t)base;
-        memcpy(base + at, &w, 8);
-    }
-    e = (plx_engine *)(void *)base;
-    if (e->magic != ENGINE_MAGIC || e->mem.lo != img || !roots_inside(e, base, (size_t)img))
-        return say(err, errlen, PLX_E_PARSE, "corrupt bake file: no engine at the start of the image", 0, NULL,
-                   0, NULL);
-    rebase_engine(e, mem, base, cap, (size_t)img, cfg);
-    *out = e;
-    if (err && errlen)
-        err[0] = '\0';
-    return PLX_OK;
-}
