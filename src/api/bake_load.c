@@ -29,7 +29,7 @@ static plx_status say(char *err, size_t errlen, plx_status s, const char *a, uin
     return s;
 }
 
-/* Checks the header and the checksum; fills the image length. */
+/* The set bits among the first n of bits. */
 static size_t popcount(const unsigned char *bits, size_t n)
 {
     size_t i, c = 0;
@@ -38,43 +38,72 @@ static size_t popcount(const unsigned char *bits, size_t n)
     return c;
 }
 
-static plx_status check_file(const unsigned char *f, size_t len, bake_layout *L, char *err, size_t errlen)
+/* Checks the header h (its first min(len, BAKE_HEADER) bytes read) of a
+ * file of len bytes and fills L from it. */
+static plx_status check_header(const unsigned char *h, uint64_t len, bake_layout *L, char *err, size_t errlen)
 {
     uint64_t flen, img;
-    if (!f || len < 8 || memcmp(f, BAKE_MAGIC, 8) != 0)
+    if (!h || len < 8 || memcmp(h, BAKE_MAGIC, 8) != 0)
         return say(err, errlen, PLX_E_PARSE, "not a polarlux bake file (no PLXBAKE magic)", 0, NULL, 0, NULL);
     if (len < BAKE_HEADER)
         return say(err, errlen, PLX_E_PARSE, "truncated bake file: ", len, " bytes, shorter than its ",
                    BAKE_HEADER, "-byte header");
-    if (bake_get32(f + H_VERSION) != BAKE_VERSION)
-        return say(err, errlen, PLX_E_UNSUPPORTED, "bake format version ", bake_get32(f + H_VERSION),
+    if (bake_get32(h + H_VERSION) != BAKE_VERSION)
+        return say(err, errlen, PLX_E_UNSUPPORTED, "bake format version ", bake_get32(h + H_VERSION),
                    ", this polarlux reads version ", BAKE_VERSION, "; bake the scene again");
-    if (bake_get32(f + H_ENDIAN) != BAKE_ENDIAN || bake_get32(f + H_SIZES) != bake_arch_sizes())
+    if (bake_get32(h + H_ENDIAN) != BAKE_ENDIAN || bake_get32(h + H_SIZES) != bake_arch_sizes())
         return say(err, errlen, PLX_E_UNSUPPORTED,
                    "bake made on another architecture (byte order or pointer, size_t, double, long sizes "
                    "differ); bake the scene again on this machine", 0, NULL, 0, NULL);
-    if (bake_get32(f + H_LAYOUT) != bake_layout_print())
+    if (bake_get32(h + H_LAYOUT) != bake_layout_print())
         return say(err, errlen, PLX_E_UNSUPPORTED,
                    "bake made by a different build of polarlux (its structures differ); bake the scene again",
                    0, NULL, 0, NULL);
-    flen = bake_get64(f + H_LENGTH);
+    flen = bake_get64(h + H_LENGTH);
     if (flen != len)
         return say(err, errlen, PLX_E_PARSE, flen > len ? "truncated bake file: " : "bake file too long: ",
                    len, " bytes, the header says ", flen, "");
-    img = bake_get64(f + H_IMAGE);
+    img = bake_get64(h + H_IMAGE);
     L->image = (size_t)img;
-    L->nrel = (size_t)bake_get64(f + H_NREL);
-    L->pages_present = (size_t)bake_get64(f + H_PAGES);
-    if (img < sizeof(struct plx_engine) || img > ((uint64_t)1 << 34) || bake_get64(f + H_NREL) > len / 4 ||
-        bake_get64(f + H_PAGES) > len / BAKE_PAGE || bake_get64(f + H_BASEMOD) >= BAKE_ALIGN ||
-        bake_get64(f + H_BASEMOD) % PLX_ENGINE_ALIGN != 0)
+    L->nrel = (size_t)bake_get64(h + H_NREL);
+    L->pages_present = (size_t)bake_get64(h + H_PAGES);
+    if (img < sizeof(struct plx_engine) || img > ((uint64_t)1 << 34) || bake_get64(h + H_NREL) > len / 4 ||
+        bake_get64(h + H_PAGES) > len / BAKE_PAGE || bake_get64(h + H_BASEMOD) >= BAKE_ALIGN ||
+        bake_get64(h + H_BASEMOD) % PLX_ENGINE_ALIGN != 0)
         return say(err, errlen, PLX_E_PARSE, "corrupt bake file: inconsistent header", 0, NULL, 0, NULL);
     bake_layout_fill(L);
-    if (L->total != len || L->pages_present > L->npages || popcount(f + L->bitmap_at, L->npages) != L->pages_present)
+    if (L->total != len || L->pages_present > L->npages)
         return say(err, errlen, PLX_E_PARSE, "corrupt bake file: inconsistent header", 0, NULL, 0, NULL);
-    if (bake_file_sum(f, len) != bake_get64(f + H_SUM))
+    return PLX_OK;
+}
+
+/* The checks after the header's: the bitmap's count of stored pages
+ * (present of them), then the checksum (sum, the file's). */
+static plx_status check_body(const bake_layout *L, size_t present, uint64_t sum, uint64_t want, char *err,
+                             size_t errlen)
+{
+    if (present != L->pages_present)
+        return say(err, errlen, PLX_E_PARSE, "corrupt bake file: inconsistent header", 0, NULL, 0, NULL);
+    if (sum != want)
         return say(err, errlen, PLX_E_PARSE, "corrupt bake file: checksum mismatch", 0, NULL, 0, NULL);
     return PLX_OK;
+}
+
+/* Checks the header and the checksum; fills L. */
+static plx_status check_file(const unsigned char *f, size_t len, bake_layout *L, char *err, size_t errlen)
+{
+    plx_status st = check_header(f, len, L, err, errlen);
+    if (st != PLX_OK)
+        return st;
+    return check_body(L, popcount(f + L->bitmap_at, L->npages), bake_file_sum(f, len), bake_get64(f + H_SUM), err,
+                      errlen);
+}
+
+/* The block plx_bake_block_size gives for a file of layout L, header h:
+ * the image, the room the bake keeps beside it, and the alignment. */
+static size_t block_for(const bake_layout *L, const unsigned char *h)
+{
+    return L->image + (size_t)bake_get64(h + H_SLACK) + 2 * BAKE_ALIGN;
 }
 
 plx_status plx_bake_block_size(const void *bake, size_t len, size_t *block_bytes, char *err, size_t errlen)
@@ -87,7 +116,7 @@ plx_status plx_bake_block_size(const void *bake, size_t len, size_t *block_bytes
     st = check_file(f, len, &L, err, errlen);
     if (st != PLX_OK)
         return st;
-    *block_bytes = L.image + (size_t)bake_get64(f + H_SLACK) + 2 * BAKE_ALIGN;
+    *block_bytes = block_for(&L, f);
     if (err && errlen) /* no stale line from an earlier call */
         err[0] = '\0';
     return PLX_OK;
@@ -149,15 +178,60 @@ static void rebase_engine(plx_engine *e, void *mem, unsigned char *base, size_t 
     bake_bind_code(e);
 }
 
+/* Where the image goes in the block mem of size bytes: the same
+ * alignment modulo 64 as where it was saved (the header h's); *base and
+ * *cap, or PLX_E_NOMEM when it does not fit. */
+static plx_status place(void *mem, size_t size, const unsigned char *h, const bake_layout *L, unsigned char **base,
+                        size_t *cap, char *err, size_t errlen)
+{
+    size_t off = (size_t)((bake_get64(h + H_BASEMOD) - (uint64_t)(uintptr_t)mem) & (BAKE_ALIGN - 1));
+    if (size < off || size - off < L->image || size - off < PLX_ENGINE_MIN_BYTES)
+        return say(err, errlen, PLX_E_NOMEM, "the block is too small for the bake: it needs ",
+                   (uint64_t)L->image + off, " bytes, the block has ", size, "");
+    *base = (unsigned char *)mem + off;
+    *cap = size - off;
+    return PLX_OK;
+}
+
+/* Relocation k, the image's word index w: its offset becomes an address. */
+static plx_status relocate(unsigned char *base, size_t img, uint64_t k, uint32_t w, char *err, size_t errlen)
+{
+    uint64_t at = (uint64_t)w * 8, v;
+    if (at + 8 > img)
+        return say(err, errlen, PLX_E_PARSE, "corrupt bake file: relocation ", k, " points outside the image", 0,
+                   NULL);
+    memcpy(&v, base + at, 8);
+    if (v > img)
+        return say(err, errlen, PLX_E_PARSE, "corrupt bake file: relocated word ", k, " points outside the image",
+                   0, NULL);
+    v += (uint64_t)(uintptr_t)base;
+    memcpy(base + at, &v, 8);
+    return PLX_OK;
+}
+
+/* The engine at base, checked and made to fit the block. */
+static plx_status finish(void *mem, unsigned char *base, size_t cap, size_t img, const plx_config *cfg,
+                         plx_engine **out, char *err, size_t errlen)
+{
+    plx_engine *e = (plx_engine *)(void *)base;
+    if (e->magic != ENGINE_MAGIC || e->mem.lo != img || !roots_inside(e, base, img))
+        return say(err, errlen, PLX_E_PARSE, "corrupt bake file: no engine at the start of the image", 0, NULL,
+                   0, NULL);
+    rebase_engine(e, mem, base, cap, img, cfg);
+    *out = e;
+    if (err && errlen)
+        err[0] = '\0';
+    return PLX_OK;
+}
+
 plx_status plx_bake_load(void *mem, size_t size, const plx_config *cfg, const void *bake, size_t len,
                          plx_engine **out, char *err, size_t errlen)
 {
-    const unsigned char *f = bake, *rel;
+    const unsigned char *f = bake;
     unsigned char *base;
-    uint64_t img, k;
-    size_t off, cap, p, present = 0;
+    uint64_t k;
+    size_t cap, p, present = 0;
     bake_layout L;
-    plx_engine *e;
     plx_status st;
     if (out)
         *out = NULL;
@@ -169,44 +243,278 @@ plx_status plx_bake_load(void *mem, size_t size, const plx_config *cfg, const vo
     if ((uintptr_t)f < (uintptr_t)mem + size && (uintptr_t)mem < (uintptr_t)f + len)
         return say(err, errlen, PLX_E_INVALID, "plx_bake_load: the bake's bytes lie inside the block; read the "
                    "file into memory outside it (the load writes the block from its start)", 0, NULL, 0, NULL);
-    st = check_file(f, len, &L, err, errlen);
-    if (st != PLX_OK)
+    if ((st = check_file(f, len, &L, err, errlen)) != PLX_OK ||
+        (st = place(mem, size, f, &L, &base, &cap, err, errlen)) != PLX_OK)
         return st;
-    img = L.image;
-    /* the same alignment modulo 64 as where it was saved */
-    off = (size_t)((bake_get64(f + H_BASEMOD) - (uint64_t)(uintptr_t)mem) & (BAKE_ALIGN - 1));
-    if (size < off || size - off < img || size - off < PLX_ENGINE_MIN_BYTES)
-        return say(err, errlen, PLX_E_NOMEM, "the block is too small for the bake: it needs ",
-                   img + off, " bytes, the block has ", size, "");
-    base = (unsigned char *)mem + off;
-    cap = size - off;
     for (p = 0; p < L.npages; p++) {
-        size_t start = p * BAKE_PAGE, bytes = img - start < BAKE_PAGE ? (size_t)img - start : BAKE_PAGE;
+        size_t start = p * BAKE_PAGE, bytes = L.image - start < BAKE_PAGE ? L.image - start : BAKE_PAGE;
         if ((f[L.bitmap_at + p / 8] >> (p % 8)) & 1u)
             memcpy(base + start, f + L.pages_at + BAKE_PAGE * present++, bytes);
         else
             memset(base + start, 0, bytes);
     }
-    rel = f + L.rel_at;
-    for (k = 0; k < L.nrel; k++) {
-        uint64_t at = (uint64_t)bake_get32(rel + 4 * k) * 8, w;
-        if (at + 8 > img)
-            return say(err, errlen, PLX_E_PARSE, "corrupt bake file: relocation ", k, " points outside the image",
-                       0, NULL);
-        memcpy(&w, base + at, 8);
-        if (w > img)
-            return say(err, errlen, PLX_E_PARSE, "corrupt bake file: relocated word ", k,
-                       " points outside the image", 0, NULL);
-        w += (uint64_t)(uintptr_t)base;
-        memcpy(base + at, &w, 8);
+    for (k = 0; k < L.nrel; k++)
+        if ((st = relocate(base, L.image, k, bake_get32(f + L.rel_at + 4 * k), err, errlen)) != PLX_OK)
+            return st;
+    return finish(mem, base, cap, L.image, cfg, out, err, errlen);
+}
+
+/* ---- through the caller's reads -------------------------------------------- */
+
+#define READ_SMALL 512u              /* bytes a read into the stack (a multiple of 32) */
+#define READ_BIG ((size_t)1 << 20)   /* at most a read into the block */
+
+typedef struct bake_src {
+    plx_bake_read_fn read;
+    void *user;
+    uint64_t len;
+    char *err;
+    size_t errlen;
+} bake_src;
+
+static plx_status src_read(const bake_src *s, uint64_t off, void *buf, size_t n)
+{
+    if (n == 0 || s->read(s->user, off, buf, n) == 0)
+        return PLX_OK;
+    return say(s->err, s->errlen, PLX_E_IO, "cannot read the bake file: ", n, " bytes at byte ", off, "");
+}
+
+/* The header read into h and checked (check_header), L filled. */
+static plx_status src_header(const bake_src *s, unsigned char h[BAKE_HEADER], bake_layout *L)
+{
+    plx_status st = src_read(s, 0, h, s->len < BAKE_HEADER ? (size_t)s->len : BAKE_HEADER);
+    if (st != PLX_OK)
+        return st;
+    return check_header(h, s->len, L, s->err, s->errlen);
+}
+
+/* The checksum over the file's bytes given in order in pieces of any
+ * length: in groups of 32 from the header's end, as bake_file_sum takes
+ * them in one piece. */
+typedef struct sum_stream {
+    bake_sum s;
+    unsigned char tail[32];
+    size_t nt;
+} sum_stream;
+
+static void ss_start(sum_stream *ss, const unsigned char *h)
+{
+    bake_sum_init(&ss->s);
+    bake_sum_header(&ss->s, h);
+    ss->nt = 0;
+}
+
+static void ss_add(sum_stream *ss, const unsigned char *p, size_t n)
+{
+    size_t whole;
+    if (ss->nt) {
+        size_t take = 32 - ss->nt < n ? 32 - ss->nt : n;
+        memcpy(ss->tail + ss->nt, p, take);
+        ss->nt += take;
+        p += take;
+        n -= take;
+        if (ss->nt < 32)
+            return;
+        bake_sum_add(&ss->s, ss->tail, 32);
+        ss->nt = 0;
     }
-    e = (plx_engine *)(void *)base;
-    if (e->magic != ENGINE_MAGIC || e->mem.lo != img || !roots_inside(e, base, (size_t)img))
-        return say(err, errlen, PLX_E_PARSE, "corrupt bake file: no engine at the start of the image", 0, NULL,
-                   0, NULL);
-    rebase_engine(e, mem, base, cap, (size_t)img, cfg);
-    *out = e;
+    whole = n & ~(size_t)31;
+    bake_sum_add(&ss->s, p, whole);
+    memcpy(ss->tail, p + whole, n - whole);
+    ss->nt = n - whole;
+}
+
+static uint64_t ss_end(sum_stream *ss)
+{
+    bake_sum_add(&ss->s, ss->tail, ss->nt);
+    return bake_sum_end(&ss->s);
+}
+
+/* The stored pages' bits among the file's n bytes from off in buf. */
+static size_t bitmap_bits(const bake_layout *L, uint64_t off, const unsigned char *buf, size_t n)
+{
+    uint64_t lo = off > L->bitmap_at ? off : L->bitmap_at, hi = off + n < L->pages_at ? off + n : L->pages_at, o;
+    size_t c = 0;
+    unsigned b;
+    for (o = lo; o < hi; o++)
+        for (b = 0; b < 8; b++)
+            c += (o - L->bitmap_at) * 8 + b < L->npages && ((buf[o - off] >> b) & 1u);
+    return c;
+}
+
+/* The first reading: the whole file through buf (n bytes), checked as
+ * check_file checks a file in memory. */
+static plx_status check_read(const bake_src *s, const unsigned char *h, const bake_layout *L, unsigned char *buf,
+                             size_t n)
+{
+    sum_stream ss;
+    size_t present = 0;
+    uint64_t off;
+    plx_status st;
+    ss_start(&ss, h);
+    for (off = BAKE_HEADER; off < s->len; off += n) {
+        n = s->len - off < n ? (size_t)(s->len - off) : n;
+        if ((st = src_read(s, off, buf, n)) != PLX_OK)
+            return st;
+        ss_add(&ss, buf, n);
+        present += bitmap_bits(L, off, buf, n);
+    }
+    return check_body(L, present, ss_end(&ss), bake_get64(h + H_SUM), s->err, s->errlen);
+}
+
+/* The bitmap's bytes from first, READ_SMALL of them at most, read when a
+ * page's bit lies outside them. */
+typedef struct bit_window {
+    unsigned char b[READ_SMALL];
+    size_t first;
+    int have;
+} bit_window;
+
+static plx_status page_stored(const bake_src *s, const bake_layout *L, bit_window *w, size_t p, int *stored)
+{
+    size_t byte = p / 8, nb = (L->npages + 7) / 8;
+    if (!w->have || byte < w->first || byte >= w->first + READ_SMALL) {
+        plx_status st;
+        w->first = byte - byte % READ_SMALL;
+        if ((st = src_read(s, L->bitmap_at + w->first, w->b, nb - w->first < READ_SMALL ? nb - w->first : READ_SMALL)) !=
+            PLX_OK)
+            return st;
+        w->have = 1;
+    }
+    *stored = (w->b[byte - w->first] >> (p % 8)) & 1u;
+    return PLX_OK;
+}
+
+/* n bytes at off read and summed, READ_SMALL at a time through the stack
+ * (the bitmap, a last page's bytes past the image). */
+static plx_status sum_read(const bake_src *s, sum_stream *ss, uint64_t off, uint64_t n)
+{
+    unsigned char buf[READ_SMALL];
+    while (n > 0) {
+        size_t k = n < READ_SMALL ? (size_t)n : READ_SMALL;
+        plx_status st = src_read(s, off, buf, k);
+        if (st != PLX_OK)
+            return st;
+        ss_add(ss, buf, k);
+        off += k;
+        n -= k;
+    }
+    return PLX_OK;
+}
+
+/* The stored pages p .. q - 1 (the present-th stored page first) read
+ * into the image at base (img bytes) and summed; a last page's bytes past
+ * the image only summed. */
+static plx_status read_pages(const bake_src *s, const bake_layout *L, sum_stream *ss, unsigned char *base, size_t p,
+                             size_t q, size_t present)
+{
+    uint64_t at = L->pages_at + (uint64_t)BAKE_PAGE * present;
+    size_t start = p * BAKE_PAGE, end = q * BAKE_PAGE < L->image ? q * BAKE_PAGE : L->image;
+    plx_status st = src_read(s, at, base + start, end - start);
+    if (st != PLX_OK)
+        return st;
+    ss_add(ss, base + start, end - start);
+    return sum_read(s, ss, at + (end - start), (uint64_t)(q - p) * BAKE_PAGE - (end - start));
+}
+
+/* The second reading: the pages into the image at base, the relocations
+ * applied, the checksum taken again. */
+static plx_status copy_read(const bake_src *s, const unsigned char *h, const bake_layout *L, unsigned char *base)
+{
+    sum_stream ss;
+    bit_window w;
+    unsigned char buf[READ_SMALL];
+    size_t p = 0, q, present = 0;
+    uint64_t k;
+    int stored;
+    plx_status st;
+    w.have = 0;
+    ss_start(&ss, h);
+    if ((st = sum_read(s, &ss, L->bitmap_at, L->pages_at - L->bitmap_at)) != PLX_OK)
+        return st;
+    while (p < L->npages) {
+        if ((st = page_stored(s, L, &w, p, &stored)) != PLX_OK)
+            return st;
+        if (!stored) {
+            memset(base + p * BAKE_PAGE, 0, L->image - p * BAKE_PAGE < BAKE_PAGE ? L->image - p * BAKE_PAGE : BAKE_PAGE);
+            p++;
+            continue;
+        }
+        for (q = p + 1; q < L->npages; q++)
+            if ((st = page_stored(s, L, &w, q, &stored)) != PLX_OK || !stored)
+                break;
+        if (st != PLX_OK || (st = read_pages(s, L, &ss, base, p, q, present)) != PLX_OK)
+            return st;
+        present += q - p;
+        p = q;
+    }
+    for (k = 0; k < L->nrel; k += READ_SMALL / 4) {
+        size_t m = L->nrel - k < READ_SMALL / 4 ? (size_t)(L->nrel - k) : READ_SMALL / 4, i;
+        if ((st = src_read(s, L->rel_at + 4 * k, buf, 4 * m)) != PLX_OK)
+            return st;
+        ss_add(&ss, buf, 4 * m);
+        for (i = 0; i < m; i++)
+            if ((st = relocate(base, L->image, k + i, bake_get32(buf + 4 * i), s->err, s->errlen)) != PLX_OK)
+                return st;
+    }
+    if (ss_end(&ss) != bake_get64(h + H_SUM))
+        return say(s->err, s->errlen, PLX_E_PARSE, "corrupt bake file: it changed while it was read", 0, NULL, 0,
+                   NULL);
+    return PLX_OK;
+}
+
+plx_status plx_bake_block_size_read(plx_bake_read_fn read, void *user, uint64_t len, size_t *block_bytes, char *err,
+                                    size_t errlen)
+{
+    unsigned char h[BAKE_HEADER];
+    bake_layout L;
+    bake_src s;
+    plx_status st;
+    if (!read || !block_bytes)
+        return say(err, errlen, PLX_E_INVALID, "plx_bake_block_size_read: read and block_bytes must not be NULL", 0,
+                   NULL, 0, NULL);
+    s.read = read;
+    s.user = user;
+    s.len = len;
+    s.err = err;
+    s.errlen = errlen;
+    if ((st = src_header(&s, h, &L)) != PLX_OK)
+        return st;
+    *block_bytes = block_for(&L, h);
     if (err && errlen)
         err[0] = '\0';
     return PLX_OK;
+}
+
+plx_status plx_bake_load_read(void *mem, size_t size, const plx_config *cfg, plx_bake_read_fn read, void *user,
+                              uint64_t len, plx_engine **out, char *err, size_t errlen)
+{
+    unsigned char h[BAKE_HEADER], small[READ_SMALL], *base = NULL;
+    size_t cap = 0;
+    bake_layout L;
+    bake_src s;
+    plx_status st, fits;
+    if (out)
+        *out = NULL;
+    if (!mem || !out || !read)
+        return say(err, errlen, PLX_E_INVALID, "plx_bake_load_read: mem, read and out must not be NULL", 0, NULL, 0,
+                   NULL);
+    s.read = read;
+    s.user = user;
+    s.len = len;
+    s.err = err;
+    s.errlen = errlen;
+    if ((st = src_header(&s, h, &L)) != PLX_OK)
+        return st;
+    /* checked first, with the block as the buffer when the image fits
+     * (else the stack's, and then the block's error, as plx_bake_load) */
+    fits = place(mem, size, h, &L, &base, &cap, NULL, 0);
+    if (fits == PLX_OK)
+        st = check_read(&s, h, &L, base, cap < READ_BIG ? cap : READ_BIG);
+    else
+        st = check_read(&s, h, &L, small, sizeof small);
+    if (st != PLX_OK || (st = place(mem, size, h, &L, &base, &cap, err, errlen)) != PLX_OK ||
+        (st = copy_read(&s, h, &L, base)) != PLX_OK)
+        return st;
+    return finish(mem, base, cap, L.image, cfg, out, err, errlen);
 }

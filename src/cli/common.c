@@ -486,32 +486,45 @@ static int damaged_bake(const char *path)
     return ch != EOF && ch != '{' && ch != '[';
 }
 
-/* A whole file in a block of cli_big_alloc; NULL and a reason on failure. */
-static char *read_big(const char *path, size_t *len, char *err, size_t errlen)
+/* A bake file read through plx_bake_load_read (the command's memory
+ * stays the block: the file is not held beside it): its descriptor, and
+ * why the last read failed. */
+typedef struct bake_in {
+    int fd;
+    char why[160];
+} bake_in;
+
+static int bake_read(void *user, uint64_t off, void *buf, size_t n)
 {
-    FILE *f = fopen(path, "rb");
-    char *buf = NULL;
-    long n;
-    if (!f || fseek(f, 0, SEEK_END) != 0 || (n = ftell(f)) < 0 || fseek(f, 0, SEEK_SET) != 0) {
-        snprintf(err, errlen, "cannot read: %s", strerror(errno));
-    } else if (!(buf = cli_big_alloc((size_t)n + 1))) {
-        snprintf(err, errlen, "out of memory reading %ld bytes", n);
-    } else if (fread(buf, 1, (size_t)n, f) != (size_t)n) {
-        snprintf(err, errlen, "read failed: %s", ferror(f) ? strerror(errno) : "the file shrank");
-        free(buf);
-        buf = NULL;
-    } else {
-        *len = (size_t)n;
+    bake_in *b = user;
+    unsigned char *p = buf;
+    while (n > 0) {
+        ssize_t r = pread(b->fd, p, n, (off_t)off);
+        if (r < 0 && errno == EINTR)
+            continue;
+        if (r <= 0) {
+            snprintf(b->why, sizeof b->why, "%s", r < 0 ? strerror(errno) : "the file shrank");
+            return -1;
+        }
+        p += r;
+        off += (uint64_t)r;
+        n -= (size_t)r;
     }
-    if (f)
-        fclose(f);
-    return buf;
+    return 0;
 }
 
-/* The bake's image loaded into a new block of need bytes, the reason
- * said on stderr when it cannot be. */
-static plx_status load_bake_in(const char *cmd, const char *path, size_t need, const plx_config *cfg,
-                               const char *data, size_t len, plx_engine **e)
+/* A bake's error line: the library's, with the read's reason after a
+ * failed read. */
+static void bake_say(const char *cmd, const char *path, plx_status st, const char *err, const bake_in *in)
+{
+    fprintf(stderr, "polarlux %s: %s: %s%s%s\n", cmd, path, err, st == PLX_E_IO && in->why[0] ? ": " : "",
+            st == PLX_E_IO ? in->why : "");
+}
+
+/* The bake read into a new block of need bytes, the reason said on
+ * stderr when it cannot be. */
+static plx_status load_bake_in(const char *cmd, const char *path, size_t need, const plx_config *cfg, bake_in *in,
+                               uint64_t len, plx_engine **e)
 {
     char err[512];
     plx_status st;
@@ -520,9 +533,10 @@ static plx_status load_bake_in(const char *cmd, const char *path, size_t need, c
         fprintf(stderr, "polarlux %s: %s: cannot take a block of %zu bytes for the bake\n", cmd, path, need);
         return PLX_E_NOMEM;
     }
-    st = plx_bake_load(mem, need, cfg, data, len, e, err, sizeof err);
+    in->why[0] = '\0';
+    st = plx_bake_load_read(mem, need, cfg, bake_read, in, len, e, err, sizeof err);
     if (st != PLX_OK) {
-        fprintf(stderr, "polarlux %s: %s: %s\n", cmd, path, err);
+        bake_say(cmd, path, st, err, in);
         free(mem);
     }
     return st;
@@ -536,31 +550,33 @@ static int bake_has_atlas(plx_engine *e)
     return plx_indirect_frames(e) == 0 || (plx_atlas_info_get(e, &ai) == PLX_OK && ai.made);
 }
 
-/* An engine from a bake file: the file read once, the block sized by the
- * bake (or --mem), the image copied and relocated. */
+/* An engine from a bake file: the file read through the library's
+ * reads into the block sized by the bake (or --mem), its pointers
+ * relocated. */
 static int open_bake(const char *cmd, const char *path, const cli_common *c, plx_engine **e)
 {
     char err[512];
     size_t len, need;
-    char *data;
+    bake_in in;
     plx_config cfg;
     plx_status st;
     unsigned long long t0 = port_now_ns();
-    data = read_big(path, &len, err, sizeof err);
-    if (!data) {
+    in.why[0] = '\0';
+    in.fd = port_open_input(path, &len, err, sizeof err);
+    if (in.fd < 0) {
         fprintf(stderr, "polarlux %s: %s: %s\n", cmd, path, err);
         return EXIT_FAIL;
     }
-    st = plx_bake_block_size(data, len, &need, err, sizeof err);
+    st = plx_bake_block_size_read(bake_read, &in, len, &need, err, sizeof err);
     if (st != PLX_OK) {
-        fprintf(stderr, "polarlux %s: %s: %s\n", cmd, path, err);
-        free(data);
+        bake_say(cmd, path, st, err, &in);
+        close(in.fd);
         return EXIT_FAIL;
     }
     if (c->mem)
         need = c->mem;
     cli_config(c, &cfg);
-    st = load_bake_in(cmd, path, need, &cfg, data, len, e);
+    st = load_bake_in(cmd, path, need, &cfg, &in, len, e);
     if (st == PLX_OK && c->atlas_room && !c->mem && need < CLI_ATLAS_BLOCK && !bake_has_atlas(*e)) {
         /* no --mem, and the bake holds no radiance atlas (--no-aerial):
          * again in a block whose quarter holds the atlas at its finest,
@@ -568,9 +584,9 @@ static int open_bake(const char *cmd, const char *path, const cli_common *c, plx
          * size left (its pages are taken as the atlas fills them) */
         plx_engine_free(*e);
         *e = NULL;
-        st = load_bake_in(cmd, path, CLI_ATLAS_BLOCK, &cfg, data, len, e);
+        st = load_bake_in(cmd, path, CLI_ATLAS_BLOCK, &cfg, &in, len, e);
     }
-    free(data);
+    close(in.fd);
     if (st != PLX_OK)
         return st == PLX_E_NOMEM ? EXIT_NOMEM : EXIT_FAIL;
     cli_bake_last.loaded = 1;

@@ -1,4 +1,6 @@
-/* libFuzzer target: the bake reader (plx_bake_block_size, plx_bake_load).
+/* libFuzzer target: the bake reader (plx_bake_block_size, plx_bake_load,
+ * and through reads plx_bake_block_size_read, plx_bake_load_read, which
+ * must give the load's status).
  * Every input is read as it comes (nearly all fail at the header or the
  * checksum, with one line and no engine). Inputs starting with the magic
  * are also read with their length field and checksum made right, so the
@@ -17,6 +19,44 @@
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size);
 
 #define BLOCK ((size_t)8 << 20)
+
+typedef struct bytes_in {
+    const uint8_t *f;
+    size_t len;
+} bytes_in;
+
+static int bytes_read(void *user, uint64_t off, void *buf, size_t n)
+{
+    const bytes_in *b = user;
+    if (off > b->len || n > b->len - off)
+        return -1;
+    memcpy(buf, b->f + off, n);
+    return 0;
+}
+
+/* The same file through reads: the same status as plx_bake_load's (want). */
+static void one_read(const uint8_t *f, size_t len, void *mem, plx_status want)
+{
+    char err[512];
+    size_t need = 0;
+    plx_engine *e = NULL;
+    bytes_in in;
+    plx_status st;
+    in.f = f;
+    in.len = len;
+    st = plx_bake_block_size_read(bytes_read, &in, len, &need, err, sizeof err);
+    CHECK(st == PLX_OK || st == want);
+    err[0] = '\0';
+    st = plx_bake_load_read(mem, BLOCK, NULL, bytes_read, &in, len, &e, err, sizeof err);
+    CHECK(st == want);
+    if (st != PLX_OK) {
+        CHECK(e == NULL);
+        CHECK(err[0] != '\0' && strchr(err, '\n') == NULL);
+    } else {
+        CHECK(e != NULL && plx_engine_block(e) == mem);
+        plx_engine_destroy(e);
+    }
+}
 
 static void one(const uint8_t *f, size_t len, void *mem)
 {
@@ -39,6 +79,7 @@ static void one(const uint8_t *f, size_t len, void *mem)
         CHECK(e != NULL && plx_engine_block(e) == mem);
         plx_engine_destroy(e);
     }
+    one_read(f, len, mem, st);
 }
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)

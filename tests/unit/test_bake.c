@@ -269,6 +269,95 @@ static void test_round_trip(void **state)
     free(mc);
 }
 
+/* A bake file read through plx_bake_read_fn: bytes in memory, a read
+ * that fails at call fail_at (0: none), and with flip set, byte flip
+ * changed (bit 4) when a read reaches it the second time (the file
+ * changed between the loader's two readings). */
+typedef struct mem_file {
+    unsigned char *f;
+    size_t len;
+    int calls, fail_at, flip_on, seen;
+    size_t flip;
+} mem_file;
+
+static int mem_read(void *user, uint64_t off, void *buf, size_t n)
+{
+    mem_file *m = user;
+    if (++m->calls == m->fail_at || off > m->len || n > m->len - off)
+        return -1;
+    if (m->flip_on && off <= m->flip && m->flip < off + n && ++m->seen == 2)
+        m->f[m->flip] ^= 0x10;
+    memcpy(buf, m->f + off, n);
+    return 0;
+}
+
+/* The bake read through the caller's reads (plx_bake_load_read), at an
+ * address 16 bytes past 64-byte alignment: the same answers and frames
+ * as the loaded buffer's; its size-first call gives plx_bake_block_size's.
+ * A read that fails says which bytes (PLX_E_IO), at every call of the
+ * load's; a file changed between the two readings is refused. */
+static void test_load_read(void **state)
+{
+    baked k = shared;
+    void *mc, *mem;
+    plx_engine *c, *d = NULL;
+    size_t need = 0, need2 = 0;
+    char err[256];
+    mem_file mf;
+    int calls, at;
+    (void)state;
+    memset(&mf, 0, sizeof mf);
+    mf.f = malloc(k.len);
+    memcpy(mf.f, k.file, k.len);
+    mf.len = k.len;
+    assert_int_equal(plx_bake_block_size(k.file, k.len, &need, err, sizeof err), PLX_OK);
+    assert_int_equal(plx_bake_block_size_read(mem_read, &mf, k.len, &need2, err, sizeof err), PLX_OK);
+    assert_true(need2 == need);
+    mem = malloc(need + 64);
+    mf.calls = 0;
+    assert_int_equal(plx_bake_load_read((char *)mem + 16, need + 48, NULL, mem_read, &mf, k.len, &d, err, sizeof err),
+                     PLX_OK);
+    assert_string_equal(err, "");
+    calls = mf.calls;
+    assert_true(calls > 3);
+    c = load(k.file, k.len, &mc);
+    assert_int_equal(plx_indirect_frames(d), 3);
+    same_vis(c, d);
+    same_illum(c, d, 1);
+    same_render(c, d, 0, 0);
+    same_render(c, d, 1, 0);
+    plx_engine_destroy(d);
+    for (at = 1; at <= calls; at++) {
+        mf.calls = 0;
+        mf.fail_at = at;
+        d = (plx_engine *)&need;
+        assert_int_equal(plx_bake_load_read(mem, need + 64, NULL, mem_read, &mf, k.len, &d, err, sizeof err), PLX_E_IO);
+        assert_null(d);
+        assert_non_null(strstr(err, "cannot read the bake file: "));
+    }
+    mf.fail_at = 0;
+    /* the first byte of the second stored page (a word's lowest: 16 more
+     * or less, inside the image if it is a pointer) changed after the
+     * first reading */
+    {
+        uint64_t img;
+        size_t npages;
+        memcpy(&img, k.file + 40, 8);
+        npages = (size_t)((img + 4095) / 4096);
+        mf.flip = 128 + (((npages + 7) / 8 + 7) & ~(size_t)7) + 4096;
+    }
+    mf.calls = 0;
+    mf.flip_on = 1;
+    assert_int_equal(plx_bake_load_read(mem, need + 64, NULL, mem_read, &mf, k.len, &d, err, sizeof err), PLX_E_PARSE);
+    assert_null(d);
+    assert_string_equal(err, "corrupt bake file: it changed while it was read");
+    assert_int_equal(mf.seen, 2);
+    plx_engine_destroy(c);
+    free(mc);
+    free(mem);
+    free(mf.f);
+}
+
 /* The radiance atlas: a bake made before its photons fills it whole while
  * saving (on two workers, its jobs reported to plx_port.progress), so the
  * loaded engine's frames fill nothing, and they equal, byte for byte,
@@ -482,12 +571,16 @@ static void test_aa_on_demand(void **state)
 
 /* ---- damaged files ----------------------------------------------------------- */
 
+/* Every way of reading f: the same error and line (plx_bake_block_size_read
+ * checks the header only: past it, it passes). */
 static void expect_fail(const unsigned char *f, size_t len, plx_status want, const char *msg)
 {
     char err[256];
     size_t need = 12345;
     void *mem = malloc(1 << 20);
     plx_engine *e = (plx_engine *)&need;
+    mem_file mf;
+    plx_status st;
     err[0] = '\0';
     assert_int_equal(plx_bake_block_size(f, len, &need, err, sizeof err), want);
     assert_string_equal(err, msg);
@@ -495,6 +588,22 @@ static void expect_fail(const unsigned char *f, size_t len, plx_status want, con
     assert_int_equal(plx_bake_load(mem, 1 << 20, NULL, f, len, &e, err, sizeof err), want);
     assert_null(e);
     assert_string_equal(err, msg);
+    memset(&mf, 0, sizeof mf);
+    mf.f = malloc(len ? len : 1);
+    memcpy(mf.f, f, len);
+    mf.len = len;
+    err[0] = '\0';
+    e = (plx_engine *)&need;
+    assert_int_equal(plx_bake_load_read(mem, 1 << 20, NULL, mem_read, &mf, len, &e, err, sizeof err), want);
+    assert_null(e);
+    assert_string_equal(err, msg);
+    err[0] = '\0';
+    st = plx_bake_block_size_read(mem_read, &mf, len, &need, err, sizeof err);
+    if (st != PLX_OK) {
+        assert_int_equal(st, want);
+        assert_string_equal(err, msg);
+    }
+    free(mf.f);
     free(mem);
 }
 
@@ -723,6 +832,7 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_round_trip),
+        cmocka_unit_test(test_load_read),
         cmocka_unit_test(test_atlas_in_bake),
         cmocka_unit_test(test_bake_after_frames),
         cmocka_unit_test(test_aa_dense),
