@@ -665,43 +665,6 @@ static void walk_row(edge_walk *w)
     }
 }
 
-/* A narrow triangle's pixels (draw_triangle_id): every centre of its box
- * tested against the three edges, E + bias >= 0 each, the test the spans
- * of draw_triangle solve row by row, so the same pixels, with the same
- * edge values for the depth. eb0: E + bias at (i0, j0); zc: z0, dz1,
- * dz2, 1 / area. */
-static size_t draw_narrow_id(raster_ctx *r, const edge e[3], const int64_t eb0[3], int64_t i0, int64_t i1,
-                             int64_t j0, int64_t j1, const double zc[4], float zlo, uint32_t id, uint32_t *ids)
-{
-    const raster_target *t = &r->t;
-    int64_t b0 = eb0[0], b1 = eb0[1], b2 = eb0[2], j, x;
-    int64_t s0 = e[0].step_x, s1 = e[1].step_x, s2 = e[2].step_x;
-    size_t written = 0;
-    for (j = j0; j <= j1; j++) {
-        float *drow = t->depth + (size_t)j * t->depth_stride;
-        uint32_t *irow = ids + (size_t)j * (size_t)t->width;
-        int64_t c0 = b0, c1 = b1, c2 = b2;
-        for (x = i0; x <= i1; x++, c0 += s0, c1 += s1, c2 += s2) {
-            double l1, l2;
-            float z;
-            if ((c0 | c1 | c2) < 0 || drow[x] <= zlo) /* outside, or hidden (depth_floor) */
-                continue;
-            l1 = (double)(c1 - e[1].bias) * zc[3];
-            l2 = (double)(c2 - e[2].bias) * zc[3];
-            z = (float)(zc[0] + l1 * zc[1] + l2 * zc[2]);
-            if (!(z < drow[x]))
-                continue;
-            drow[x] = z;
-            irow[x] = id;
-            written++;
-        }
-        b0 += e[0].dx * FIX_ONE;
-        b1 += e[1].dx * FIX_ONE;
-        b2 += e[2].dx * FIX_ONE;
-    }
-    return written;
-}
-
 /* A span's pixels SPAN_LANES at a time (draw_triangle_id): the edge
  * values as doubles, the one at the span's first pixel plus k steps. An
  * edge value is an integer within 2^51 in magnitude (snapped coordinates
@@ -710,7 +673,9 @@ static size_t draw_narrow_id(raster_ctx *r, const edge e[3], const int64_t eb0[3
  * too: all exact in a double, so the sum is the same double as the int64
  * value converted, and the depth the same expression as one at a time. */
 #define SPAN_LANES 8
-#define SPAN_MIN 16     /* the shortest span taken in lanes: shorter ones cost more so */
+#if RASTER_NARROW > SPAN_LANES
+#error "draw_narrow_id takes a box's columns as one group of SPAN_LANES lanes"
+#endif
 
 static void span_offsets(int64_t s1, int64_t s2, double off1[SPAN_LANES], double off2[SPAN_LANES])
 {
@@ -752,6 +717,191 @@ static void span_lanes_id(float *restrict drow, uint32_t *restrict irow, double 
     memcpy(drow, db, sizeof db);
 }
 
+/* Lanes klo .. khi of SPAN_LANES pixels from drow, irow, as
+ * span_lanes_id draws them (the other lanes written back unchanged): a
+ * span's part shorter than SPAN_LANES, in lanes too, as one at a time
+ * its variable end and the branches per pixel cost more. */
+static void span_part_id(float *restrict drow, uint32_t *restrict irow, double e1, double e2,
+                         const double *restrict off1, const double *restrict off2, const double zc[4], int32_t klo,
+                         int32_t khi, uint32_t id, uint32_t *restrict c)
+{
+    float z[SPAN_LANES];
+    uint32_t zb[SPAN_LANES], db[SPAN_LANES];
+    int32_t k;
+    for (k = 0; k < SPAN_LANES; k++) {
+        double l1 = (e1 + off1[k]) * zc[3], l2 = (e2 + off2[k]) * zc[3];
+        z[k] = (float)(zc[0] + l1 * zc[1] + l2 * zc[2]);
+    }
+    memcpy(zb, z, sizeof zb);
+    memcpy(db, drow, sizeof db);
+    for (k = 0; k < SPAN_LANES; k++) {
+        uint32_t m = 0u - ((uint32_t)(z[k] < drow[k]) & (uint32_t)(k >= klo) & (uint32_t)(k <= khi));
+        db[k] = (zb[k] & m) | (db[k] & ~m);
+        irow[k] = (id & m) | (irow[k] & ~m);
+        c[k] -= m;
+    }
+    memcpy(drow, db, sizeof db);
+}
+
+/* A narrow triangle's pixels (draw_triangle_id) one at a time, where the
+ * scissor is narrower than SPAN_LANES columns: every centre of its box
+ * tested against the three edges, E + bias >= 0 each, the test the spans
+ * of draw_triangle solve row by row, so the same pixels, with the same
+ * edge values for the depth. eb0: E + bias at (i0, j0); zc: z0, dz1,
+ * dz2, 1 / area. */
+static size_t draw_narrow_scalar(raster_ctx *r, const edge e[3], const int64_t eb0[3], int64_t i0, int64_t i1,
+                                 int64_t j0, int64_t j1, const double zc[4], float zlo, uint32_t id, uint32_t *ids)
+{
+    const raster_target *t = &r->t;
+    int64_t b0 = eb0[0], b1 = eb0[1], b2 = eb0[2], j, x;
+    int64_t s0 = e[0].step_x, s1 = e[1].step_x, s2 = e[2].step_x;
+    size_t written = 0;
+    for (j = j0; j <= j1; j++) {
+        float *drow = t->depth + (size_t)j * t->depth_stride;
+        uint32_t *irow = ids + (size_t)j * (size_t)t->width;
+        int64_t c0 = b0, c1 = b1, c2 = b2;
+        for (x = i0; x <= i1; x++, c0 += s0, c1 += s1, c2 += s2) {
+            double l1, l2;
+            float z;
+            if ((c0 | c1 | c2) < 0 || drow[x] <= zlo) /* outside, or hidden (depth_floor) */
+                continue;
+            l1 = (double)(c1 - e[1].bias) * zc[3];
+            l2 = (double)(c2 - e[2].bias) * zc[3];
+            z = (float)(zc[0] + l1 * zc[1] + l2 * zc[2]);
+            if (!(z < drow[x]))
+                continue;
+            drow[x] = z;
+            irow[x] = id;
+            written++;
+        }
+        b0 += e[0].dx * FIX_ONE;
+        b1 += e[1].dx * FIX_ONE;
+        b2 += e[2].dx * FIX_ONE;
+    }
+    return written;
+}
+
+/* SPAN_LANES pixels of a narrow triangle's row from drow, irow: the
+ * edge values v = ev[i] + off[i SPAN_LANES + k] (exact doubles, see
+ * span_offsets), a lane inside when every v + bias >= 0, i.e. v >=
+ * lim[i] = -bias (the values are integers), tested on v rounded to
+ * float (rounding is monotone and lim is a float: the same answer, in
+ * lanes of the depths' width); inside and nearer, written with the id
+ * and counted in c[k]; in loops of fixed length (vectorised by GCC). */
+static void narrow_lanes_id(float *restrict drow, uint32_t *restrict irow, const double ev[3],
+                            const double *restrict off, const float lim[3], const double zc[4], uint32_t id,
+                            uint32_t *restrict c)
+{
+    float z[SPAN_LANES], f0[SPAN_LANES], f1[SPAN_LANES], f2[SPAN_LANES];
+    uint32_t zb[SPAN_LANES], db[SPAN_LANES];
+    int k;
+    for (k = 0; k < SPAN_LANES; k++) {
+        double v0 = ev[0] + off[k], v1 = ev[1] + off[SPAN_LANES + k], v2 = ev[2] + off[2 * SPAN_LANES + k];
+        double l1 = v1 * zc[3], l2 = v2 * zc[3];
+        z[k] = (float)(zc[0] + l1 * zc[1] + l2 * zc[2]);
+        f0[k] = (float)v0;
+        f1[k] = (float)v1;
+        f2[k] = (float)v2;
+    }
+    memcpy(zb, z, sizeof zb);
+    memcpy(db, drow, sizeof db);
+    for (k = 0; k < SPAN_LANES; k++) {
+        uint32_t m = 0u - ((uint32_t)(f0[k] >= lim[0]) & (uint32_t)(f1[k] >= lim[1]) &
+                           (uint32_t)(f2[k] >= lim[2]) & (uint32_t)(z[k] < drow[k]));
+        db[k] = (zb[k] & m) | (db[k] & ~m);
+        irow[k] = (id & m) | (irow[k] & ~m);
+        c[k] -= m;
+    }
+    memcpy(drow, db, sizeof db);
+}
+
+/* A narrow triangle's pixels (draw_triangle_id): its box (at most
+ * SPAN_LANES columns) a row at a time in lanes, from column xs, the box's
+ * first or further left so that the lanes stay within the scissor; every
+ * centre tested against the three edges, E + bias >= 0 each, the test the
+ * spans of draw_triangle solve row by row, so the same pixels (a centre
+ * outside the box is outside the triangle: the lanes beyond it draw
+ * nothing), with the same edge values for the depth. eb0: E + bias at
+ * (i0, j0); zc: z0, dz1, dz2, 1 / area. */
+static size_t draw_narrow_id(raster_ctx *r, const edge e[3], const int64_t eb0[3], int64_t i0, int64_t i1,
+                             int64_t j0, int64_t j1, const double zc[4], float zlo, uint32_t id, uint32_t *ids)
+{
+    const raster_target *t = &r->t;
+    int64_t xs = i0 + SPAN_LANES <= r->sx1 ? i0 : (int64_t)r->sx1 - SPAN_LANES, j;
+    double ev[3], dv[3], off[3 * SPAN_LANES];
+    float lim[3];
+    uint32_t cnt[SPAN_LANES];
+    size_t written = 0;
+    int i, k;
+    if (r->sx1 - r->sx0 < SPAN_LANES)
+        return draw_narrow_scalar(r, e, eb0, i0, i1, j0, j1, zc, zlo, id, ids);
+    for (i = 0; i < 3; i++) {
+        ev[i] = (double)(eb0[i] - e[i].bias + (xs - i0) * e[i].step_x);
+        lim[i] = (float)-e[i].bias;
+        dv[i] = (double)(e[i].dx * FIX_ONE);
+        for (k = 0; k < SPAN_LANES; k++)
+            off[i * SPAN_LANES + k] = (double)k * (double)e[i].step_x;
+    }
+    memset(cnt, 0, sizeof cnt);
+    for (j = j0; j <= j1; j++) {
+        float *drow = t->depth + (size_t)j * t->depth_stride + xs;
+        uint32_t hidden = 1;
+        for (k = 0; k < SPAN_LANES; k++)
+            hidden &= drow[k] <= zlo;
+        if (!hidden) /* else no lane can be nearer (depth_floor) */
+            narrow_lanes_id(drow, ids + (size_t)j * (size_t)t->width + xs, ev, off, lim, zc, id, cnt);
+        for (i = 0; i < 3; i++)
+            ev[i] += dv[i]; /* an edge value again: exact */
+    }
+    for (k = 0; k < SPAN_LANES; k++)
+        written += cnt[k];
+    return written;
+}
+
+/* Row span lo .. hi of draw_triangle_id in lanes (e1, e2: the edge
+ * values at lo; s1, s2 their steps): whole groups of SPAN_LANES, then the
+ * rest as a part, its lanes moved left where they would pass the
+ * scissor's right end sx1 (at least SPAN_LANES columns wide), so no lane
+ * leaves it. */
+static void span_id(float *drow, uint32_t *irow, int64_t lo, int64_t hi, int64_t e1, int64_t e2, int64_t s1,
+                    int64_t s2, int64_t sx1, const double *off1, const double *off2, const double zc[4], float zlo,
+                    uint32_t id, uint32_t *c)
+{
+    int64_t x = lo, xs;
+    for (; x + SPAN_LANES - 1 <= hi; x += SPAN_LANES, e1 += SPAN_LANES * s1, e2 += SPAN_LANES * s2)
+        span_lanes_id(drow + x, irow + x, (double)e1, (double)e2, off1, off2, zc, zlo, id, c);
+    if (x > hi)
+        return;
+    xs = x + SPAN_LANES <= sx1 ? x : sx1 - SPAN_LANES;
+    span_part_id(drow + xs, irow + xs, (double)(e1 + (xs - x) * s1), (double)(e2 + (xs - x) * s2), off1, off2, zc,
+                 (int32_t)(x - xs), (int32_t)(hi - xs), id, c);
+}
+
+/* Row span lo .. hi of draw_triangle_id one pixel at a time, where the
+ * scissor is narrower than SPAN_LANES columns. Returns the pixels
+ * written. */
+static size_t span_scalar_id(float *drow, uint32_t *irow, int64_t lo, int64_t hi, int64_t e1, int64_t e2, int64_t s1,
+                             int64_t s2, const double zc[4], float zlo, uint32_t id)
+{
+    int64_t x;
+    size_t written = 0;
+    for (x = lo; x <= hi; x++, e1 += s1, e2 += s2) {
+        double l1, l2;
+        float z;
+        if (drow[x] <= zlo)
+            continue;
+        l1 = (double)e1 * zc[3];
+        l2 = (double)e2 * zc[3];
+        z = (float)(zc[0] + l1 * zc[1] + l2 * zc[2]);
+        if (!(z < drow[x]))
+            continue;
+        drow[x] = z;
+        irow[x] = id;
+        written++;
+    }
+    return written;
+}
+
 /* A float at or below every depth draw_triangle_id computes inside the
  * triangle of vertex depths z0, z1, z2 (doubles in [0, 1]): inside, the
  * edge values are >= 0 and sum to the area, so the exact depth is a
@@ -782,7 +932,7 @@ static size_t draw_triangle_id(raster_ctx *r, const svert *v0, const svert *v1, 
     uint32_t cnt[SPAN_LANES]; /* pixels the lanes wrote */
     float zlo;
     size_t written = 0;
-    int k, offs = 0;
+    int k, lanes = r->sx1 - r->sx0 >= SPAN_LANES;
     edge_setup(&e[0], v1, v2);
     edge_setup(&e[1], v2, v0);
     edge_setup(&e[2], v0, v1);
@@ -799,10 +949,12 @@ static size_t draw_triangle_id(raster_ctx *r, const svert *v0, const svert *v1, 
         return draw_narrow_id(r, e, eb0, i0, i1, j0, j1, zc, zlo, id, ids);
     for (k = 0; k < 3; k++)
         walk_start(&wk[k], &e[k], eb0[k]);
+    span_offsets(e[1].step_x, e[2].step_x, off1, off2);
+    memset(cnt, 0, sizeof cnt);
     ev1 = eb0[1] - e[1].bias;
     ev2 = eb0[2] - e[2].bias;
     for (j = j0; j <= j1; j++) {
-        int64_t lo = i0, hi = i1, e1, e2, x, s1 = e[1].step_x, s2 = e[2].step_x;
+        int64_t lo = i0, hi = i1, e1, e2, s1 = e[1].step_x, s2 = e[2].step_x;
         float *drow = t->depth + (size_t)j * t->depth_stride;
         uint32_t *irow = ids + (size_t)j * (size_t)t->width;
         if (j > j0) {
@@ -830,34 +982,13 @@ static size_t draw_triangle_id(raster_ctx *r, const svert *v0, const svert *v1, 
             continue;
         e1 = ev1 + (lo - i0) * s1;
         e2 = ev2 + (lo - i0) * s2;
-        x = lo;
-        if (hi - lo + 1 >= SPAN_MIN) {
-            if (!offs) {
-                span_offsets(s1, s2, off1, off2);
-                memset(cnt, 0, sizeof cnt);
-                offs = 1;
-            }
-            for (; x + SPAN_LANES - 1 <= hi; x += SPAN_LANES, e1 += SPAN_LANES * s1, e2 += SPAN_LANES * s2)
-                span_lanes_id(drow + x, irow + x, (double)e1, (double)e2, off1, off2, zc, zlo, id, cnt);
-        }
-        for (; x <= hi; x++, e1 += s1, e2 += s2) {
-            double l1, l2;
-            float z;
-            if (drow[x] <= zlo)
-                continue;
-            l1 = (double)e1 * inv_area;
-            l2 = (double)e2 * inv_area;
-            z = (float)(z0 + l1 * dz1 + l2 * dz2);
-            if (!(z < drow[x]))
-                continue;
-            drow[x] = z;
-            irow[x] = id;
-            written++;
-        }
+        if (lanes)
+            span_id(drow, irow, lo, hi, e1, e2, s1, s2, r->sx1, off1, off2, zc, zlo, id, cnt);
+        else
+            written += span_scalar_id(drow, irow, lo, hi, e1, e2, s1, s2, zc, zlo, id);
     }
-    if (offs)
-        for (k = 0; k < SPAN_LANES; k++)
-            written += cnt[k];
+    for (k = 0; k < SPAN_LANES; k++)
+        written += cnt[k];
     return written;
 }
 
