@@ -632,37 +632,35 @@ void raster_prepare(const raster_ctx *r, const float *pos, raster_pvert *out)
  * taken on the second row): the same bounds as the divisions of
  * draw_triangle at every row, without them. */
 typedef struct edge_walk {
-    int64_t s, q, r, d, dq, dr;
-    int have_step;
+    int64_t s, q, r, dq, dr;
 } edge_walk;
 
-static void walk_start(edge_walk *w, const edge *e, int64_t eb)
+/* rows: the triangle has more than one row (only then the step per row,
+ * a division, is taken). */
+static void walk_start(edge_walk *w, const edge *e, int64_t eb, int rows)
 {
+    int64_t d = e->dx * FIX_ONE;
     w->s = e->step_x < 0 ? -e->step_x : e->step_x;
-    w->d = e->dx * FIX_ONE;
-    w->have_step = 0;
     if (w->s == 0)
         return;
     w->q = floor_div(eb, w->s);
     w->r = eb - w->q * w->s;
+    if (rows) {
+        w->dq = floor_div(d, w->s);
+        w->dr = d - w->dq * w->s;
+    }
 }
 
 static void walk_row(edge_walk *w)
 {
+    int64_t carry;
     if (w->s == 0)
         return;
-    if (!w->have_step) {
-        w->dq = floor_div(w->d, w->s);
-        w->dr = w->d - w->dq * w->s;
-        w->have_step = 1;
-    }
     w->q += w->dq;
     w->r += w->dr;
-    {
-        int64_t carry = -(int64_t)(w->r >= w->s); /* all ones or 0: no branch (it mispredicted) */
-        w->r -= w->s & carry;
-        w->q -= carry;
-    }
+    carry = -(int64_t)(w->r >= w->s); /* all ones or 0: no branch (it mispredicted) */
+    w->r -= w->s & carry;
+    w->q -= carry;
 }
 
 /* A span's pixels SPAN_LANES at a time (draw_triangle_id): the edge
@@ -948,7 +946,7 @@ static size_t draw_triangle_id(raster_ctx *r, const svert *v0, const svert *v1, 
     if (i1 - i0 < RASTER_NARROW)
         return draw_narrow_id(r, e, eb0, i0, i1, j0, j1, zc, zlo, id, ids);
     for (k = 0; k < 3; k++)
-        walk_start(&wk[k], &e[k], eb0[k]);
+        walk_start(&wk[k], &e[k], eb0[k], j1 > j0);
     span_offsets(e[1].step_x, e[2].step_x, off1, off2);
     memset(cnt, 0, sizeof cnt);
     ev1 = eb0[1] - e[1].bias;
@@ -966,17 +964,12 @@ static size_t draw_triangle_id(raster_ctx *r, const svert *v0, const svert *v1, 
         }
         for (k = 0; k < 3; k++) {
             int64_t sx = e[k].step_x;
-            if (sx > 0) {
-                if (wk[k].q < 0) /* eb < 0: from ceil(-eb / s) = -floor(eb / s) */
-                    lo = max64(lo, i0 - wk[k].q);
-            } else if (sx < 0) {
-                if (wk[k].q < 0)
-                    hi = i0 - 1;
-                else
-                    hi = min64(hi, i0 + wk[k].q);
-            } else if ((k == 0 ? eb0[0] : k == 1 ? ev1 + e[1].bias : ev2 + e[2].bias) < 0) {
+            if (sx > 0) /* from ceil(-eb / s) = -floor(eb / s); no bound while eb >= 0 */
+                lo = max64(lo, i0 - wk[k].q);
+            else if (sx < 0) /* eb < 0 leaves hi < i0: no pixel */
+                hi = min64(hi, i0 + wk[k].q);
+            else if ((k == 0 ? eb0[0] : k == 1 ? ev1 + e[1].bias : ev2 + e[2].bias) < 0)
                 hi = i0 - 1;
-            }
         }
         if (lo > hi)
             continue;
