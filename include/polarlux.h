@@ -1035,8 +1035,11 @@ plx_status plx_bake_load(void *mem, size_t size, const plx_config *cfg, const vo
  * block doubles the memory a load takes). read(user, off, buf, n) puts
  * the n bytes at offset off of the file (len bytes long) into buf and
  * returns 0, or -1 when it cannot (an error, or the file ended).
- * plx_bake_block_size_read checks the header only and gives
- * plx_bake_block_size's size; plx_bake_load_read checks the whole file
+ * plx_bake_block_size_read gives plx_bake_block_size's size, with its
+ * checks when given scratch (scratch_len >= 512 bytes of the caller's to
+ * read the file through; the more, the fewer reads), else the header's
+ * only (its size field unchecked: a damaged one can ask for a block far
+ * too big); plx_bake_load_read checks the whole file
  * as plx_bake_load does, reading it once with the block as its buffer,
  * then loads it reading it again: the same engine as plx_bake_load's,
  * the same errors and messages, plus PLX_E_IO (a read failed: which
@@ -1045,8 +1048,8 @@ plx_status plx_bake_load(void *mem, size_t size, const plx_config *cfg, const vo
  * error the block's contents are unspecified. Threads: none.
  */
 typedef int (*plx_bake_read_fn)(void *user, uint64_t off, void *buf, size_t n);
-plx_status plx_bake_block_size_read(plx_bake_read_fn read, void *user, uint64_t len, size_t *block_bytes /* OUT */,
-                                    char *err, size_t errlen);
+plx_status plx_bake_block_size_read(plx_bake_read_fn read, void *user, uint64_t len, void *scratch, size_t scratch_len,
+                                    size_t *block_bytes /* OUT */, char *err, size_t errlen);
 plx_status plx_bake_load_read(void *mem, size_t size, const plx_config *cfg, plx_bake_read_fn read, void *user,
                               uint64_t len, plx_engine **engine /* OUT */, char *err, size_t errlen);
 

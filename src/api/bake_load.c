@@ -368,6 +368,7 @@ typedef struct bit_window {
     unsigned char b[READ_SMALL];
     size_t first;
     int have;
+    bake_sum used;              /* the windows' bytes as read, in order (each once: p only grows) */
 } bit_window;
 
 static plx_status page_stored(const bake_src *s, const bake_layout *L, bit_window *w, size_t p, int *stored)
@@ -376,9 +377,10 @@ static plx_status page_stored(const bake_src *s, const bake_layout *L, bit_windo
     if (!w->have || byte < w->first || byte >= w->first + READ_SMALL) {
         plx_status st;
         w->first = byte - byte % READ_SMALL;
-        if ((st = src_read(s, L->bitmap_at + w->first, w->b, nb - w->first < READ_SMALL ? nb - w->first : READ_SMALL)) !=
-            PLX_OK)
+        size_t n = nb - w->first < READ_SMALL ? nb - w->first : READ_SMALL;
+        if ((st = src_read(s, L->bitmap_at + w->first, w->b, n)) != PLX_OK)
             return st;
+        bake_sum_add(&w->used, w->b, n);
         w->have = 1;
     }
     *stored = (w->b[byte - w->first] >> (p % 8)) & 1u;
@@ -386,18 +388,24 @@ static plx_status page_stored(const bake_src *s, const bake_layout *L, bit_windo
 }
 
 /* n bytes at off read and summed, READ_SMALL at a time through the stack
- * (the bitmap, a last page's bytes past the image). */
-static plx_status sum_read(const bake_src *s, sum_stream *ss, uint64_t off, uint64_t n)
+ * (the bitmap, a last page's bytes past the image); with mine, its first
+ * upto bytes summed into it too, READ_SMALL at a time as page_stored
+ * reads them. */
+static plx_status sum_read(const bake_src *s, sum_stream *ss, uint64_t off, uint64_t n, bake_sum *mine, uint64_t upto)
 {
     unsigned char buf[READ_SMALL];
+    uint64_t done = 0;
     while (n > 0) {
         size_t k = n < READ_SMALL ? (size_t)n : READ_SMALL;
         plx_status st = src_read(s, off, buf, k);
         if (st != PLX_OK)
             return st;
         ss_add(ss, buf, k);
+        if (mine && done < upto)
+            bake_sum_add(mine, buf, upto - done < k ? (size_t)(upto - done) : k);
         off += k;
         n -= k;
+        done += k;
     }
     return PLX_OK;
 }
@@ -414,23 +422,28 @@ static plx_status read_pages(const bake_src *s, const bake_layout *L, sum_stream
     if (st != PLX_OK)
         return st;
     ss_add(ss, base + start, end - start);
-    return sum_read(s, ss, at + (end - start), (uint64_t)(q - p) * BAKE_PAGE - (end - start));
+    return sum_read(s, ss, at + (end - start), (uint64_t)(q - p) * BAKE_PAGE - (end - start), NULL, 0);
 }
 
 /* The second reading: the pages into the image at base, the relocations
- * applied, the checksum taken again. */
+ * applied, the checksum taken again; the bitmap that placed the pages
+ * (read again in windows as they pass) must be the one summed (a file
+ * that moved a stored page's bit between them kept its checksum). */
 static plx_status copy_read(const bake_src *s, const unsigned char *h, const bake_layout *L, unsigned char *base)
 {
     sum_stream ss;
     bit_window w;
+    bake_sum summed;
     unsigned char buf[READ_SMALL];
     size_t p = 0, q, present = 0;
     uint64_t k;
     int stored;
     plx_status st;
     w.have = 0;
+    bake_sum_init(&w.used);
+    bake_sum_init(&summed);
     ss_start(&ss, h);
-    if ((st = sum_read(s, &ss, L->bitmap_at, L->pages_at - L->bitmap_at)) != PLX_OK)
+    if ((st = sum_read(s, &ss, L->bitmap_at, L->pages_at - L->bitmap_at, &summed, (L->npages + 7) / 8)) != PLX_OK)
         return st;
     while (p < L->npages) {
         if ((st = page_stored(s, L, &w, p, &stored)) != PLX_OK)
@@ -457,14 +470,14 @@ static plx_status copy_read(const bake_src *s, const unsigned char *h, const bak
             if ((st = relocate(base, L->image, k + i, bake_get32(buf + 4 * i), s->err, s->errlen)) != PLX_OK)
                 return st;
     }
-    if (ss_end(&ss) != bake_get64(h + H_SUM))
+    if (ss_end(&ss) != bake_get64(h + H_SUM) || bake_sum_end(&w.used) != bake_sum_end(&summed))
         return say(s->err, s->errlen, PLX_E_PARSE, "corrupt bake file: it changed while it was read", 0, NULL, 0,
                    NULL);
     return PLX_OK;
 }
 
-plx_status plx_bake_block_size_read(plx_bake_read_fn read, void *user, uint64_t len, size_t *block_bytes, char *err,
-                                    size_t errlen)
+plx_status plx_bake_block_size_read(plx_bake_read_fn read, void *user, uint64_t len, void *scratch, size_t scratch_len,
+                                    size_t *block_bytes, char *err, size_t errlen)
 {
     unsigned char h[BAKE_HEADER];
     bake_layout L;
@@ -479,6 +492,9 @@ plx_status plx_bake_block_size_read(plx_bake_read_fn read, void *user, uint64_t 
     s.err = err;
     s.errlen = errlen;
     if ((st = src_header(&s, h, &L)) != PLX_OK)
+        return st;
+    if (scratch && scratch_len >= READ_SMALL &&
+        (st = check_read(&s, h, &L, scratch, scratch_len & ~(size_t)31)) != PLX_OK)
         return st;
     *block_bytes = block_for(&L, h);
     if (err && errlen)

@@ -38,6 +38,8 @@ typedef struct cli_common {
 #define CLI_ATLAS_MAX_BYTES ((size_t)64 << 20)
 /* The block a bake without its atlas is loaded in when no --mem is given: room for the atlas at its most. */
 #define CLI_ATLAS_BLOCK (4 * CLI_ATLAS_MAX_BYTES + ((size_t)1 << 20))
+/* The buffer a bake file is checked through before its block is taken. */
+#define CLI_BAKE_SCRATCH ((size_t)1 << 20)
 
 /* Prints "polarlux CMD: msg" on stderr and returns EXIT_USAGE. */
 int cli_usage_error(const char *cmd, const char *fmt, ...);

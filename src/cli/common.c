@@ -521,18 +521,13 @@ static void bake_say(const char *cmd, const char *path, plx_status st, const cha
             st == PLX_E_IO ? in->why : "");
 }
 
-/* The bake read into a new block of need bytes, the reason said on
- * stderr when it cannot be. */
-static plx_status load_bake_in(const char *cmd, const char *path, size_t need, const plx_config *cfg, bake_in *in,
-                               uint64_t len, plx_engine **e)
+/* The bake read into the block mem of need bytes (freed when the load
+ * fails), the reason said on stderr when it cannot be. */
+static plx_status load_bake_in(const char *cmd, const char *path, void *mem, size_t need, const plx_config *cfg,
+                               bake_in *in, uint64_t len, plx_engine **e)
 {
     char err[512];
     plx_status st;
-    void *mem = cli_big_alloc(need);
-    if (!mem) {
-        fprintf(stderr, "polarlux %s: %s: cannot take a block of %zu bytes for the bake\n", cmd, path, need);
-        return PLX_E_NOMEM;
-    }
     in->why[0] = '\0';
     st = plx_bake_load_read(mem, need, cfg, bake_read, in, len, e, err, sizeof err);
     if (st != PLX_OK) {
@@ -540,6 +535,14 @@ static plx_status load_bake_in(const char *cmd, const char *path, size_t need, c
         free(mem);
     }
     return st;
+}
+
+/* The block a bake without its atlas is loaded in again (no --mem): a
+ * quarter of it for the atlas at its most, and that much free beside the
+ * image of need bytes. */
+static size_t atlas_block(size_t need)
+{
+    return need + CLI_ATLAS_MAX_BYTES > CLI_ATLAS_BLOCK ? need + CLI_ATLAS_MAX_BYTES : CLI_ATLAS_BLOCK;
 }
 
 /* Whether a loaded bake holds its radiance atlas, or holds no indirect
@@ -557,6 +560,7 @@ static int open_bake(const char *cmd, const char *path, const cli_common *c, plx
 {
     char err[512];
     size_t len, need;
+    void *mem, *big = NULL;
     bake_in in;
     plx_config cfg;
     plx_status st;
@@ -567,7 +571,15 @@ static int open_bake(const char *cmd, const char *path, const cli_common *c, plx
         fprintf(stderr, "polarlux %s: %s: %s\n", cmd, path, err);
         return EXIT_FAIL;
     }
-    st = plx_bake_block_size_read(bake_read, &in, len, &need, err, sizeof err);
+    {
+        /* the whole file checked before a block is taken for it (a
+         * damaged size field asked for 4.6e18 bytes), through a buffer of
+         * the command's own, freed before the block is taken */
+        void *scratch = malloc(CLI_BAKE_SCRATCH);
+        st = plx_bake_block_size_read(bake_read, &in, len, scratch, scratch ? CLI_BAKE_SCRATCH : 0, &need, err,
+                                      sizeof err);
+        free(scratch);
+    }
     if (st != PLX_OK) {
         bake_say(cmd, path, st, err, &in);
         close(in.fd);
@@ -576,15 +588,21 @@ static int open_bake(const char *cmd, const char *path, const cli_common *c, plx
     if (c->mem)
         need = c->mem;
     cli_config(c, &cfg);
-    st = load_bake_in(cmd, path, need, &cfg, &in, len, e);
-    if (st == PLX_OK && c->atlas_room && !c->mem && need < CLI_ATLAS_BLOCK && !bake_has_atlas(*e)) {
+    if (!(mem = cli_big_alloc(need))) {
+        fprintf(stderr, "polarlux %s: %s: cannot take a block of %zu bytes for the bake\n", cmd, path, need);
+        close(in.fd);
+        return EXIT_NOMEM;
+    }
+    st = load_bake_in(cmd, path, mem, need, &cfg, &in, len, e);
+    if (st == PLX_OK && c->atlas_room && !c->mem && !bake_has_atlas(*e) && (big = cli_big_alloc(atlas_block(need)))) {
         /* no --mem, and the bake holds no radiance atlas (--no-aerial):
          * again in a block whose quarter holds the atlas at its finest,
          * as a scene's default block does, not at the 4 m the bake's own
-         * size left (its pages are taken as the atlas fills them) */
+         * size left (its pages are taken as the atlas fills them); kept
+         * as loaded when that block cannot be had */
         plx_engine_free(*e);
         *e = NULL;
-        st = load_bake_in(cmd, path, CLI_ATLAS_BLOCK, &cfg, &in, len, e);
+        st = load_bake_in(cmd, path, big, atlas_block(need), &cfg, &in, len, e);
     }
     close(in.fd);
     if (st != PLX_OK)

@@ -154,7 +154,7 @@ double exposure_from(const uint32_t hist[EXPOSURE_BINS])
     if (n == 0)
         return 1.0;
     /* the pixels more than EXPOSURE_RANGE stops below the anchor are left
-     * out: black at any exposure the rule picks, and how many there are
+     * out: near black at any exposure the rule picks, and how many there are
      * says how the dark was computed, not what the view shows */
     lo = bin_at(hist, 0, (size_t)ceil(EXPOSURE_ANCHOR * (double)n)) - EXPOSURE_RANGE * (int)PER_STOP;
     lo = lo > 0 ? lo : 0;

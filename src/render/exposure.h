@@ -8,7 +8,7 @@
 #define EXPOSURE_PERCENTILE 0.995 /* of the lit surface pixels' luminance ... */
 /* (the lit pixels: Y > 0 and Y's bin at most EXPOSURE_RANGE stops below
  * the bin of the EXPOSURE_ANCHOR percentile of all with Y > 0. Light far
- * below the view's brightest is black at any exposure the rule picks, and
+ * below the view's brightest is near black at any exposure the rule picks, and
  * the number of such pixels depends on how the dark was computed: the
  * per-pixel gather gives 1e-4 cd/m^2 where the atlas's photon charts give
  * 0, and counting them moved the percentile a stop.) */

@@ -446,6 +446,12 @@ expect render-bake-atlas-mem 0 "radiance atlas at reduced quality to fit the blo
     "$bin" render "$tmp/na.plxb" --mem 50M --size 160x120 -o "$tmp/xna.png"
 expect walk-bake-atlas-room 0 "" -- "$bin" walk "$tmp/na.plxb" --path "$tmp/endpath.geojson" --size 160x120 --max-frames 2 -o "$tmp/naw"
 if grep -q "radiance atlas" "$tmp/out"; then echo "FAIL walk-bake-atlas-room: the atlas was reduced"; sed 's/^/    /' "$tmp/out"; fail=$((fail + 1)); fi
+# a walk of one frame writes it without the writer thread: its line of
+# cameras.txt too
+"$bin" walk -q fixtures/eixample-4x4.geojson --path "$tmp/endpath.geojson" --size 32x24 --max-frames 1 --no-indirect -o "$tmp/w1cam" >/dev/null 2>&1
+if [ "$(grep -vc '^#' "$tmp/w1cam/cameras.txt" 2>/dev/null)" = 1 ] && [ -s "$tmp/w1cam/frame-0001.png" ]; then
+    echo "ok   walk-one-frame-cameras"; pass=$((pass + 1))
+else echo "FAIL walk-one-frame-cameras: $(cat "$tmp/w1cam/cameras.txt" 2>/dev/null | wc -l) lines"; fail=$((fail + 1)); fi
 expect walk-atlas-reduced-note 0 "^polarlux walk: radiance atlas at reduced quality to fit the block: points 0.71 m apart" -- \
     "$bin" walk fixtures/eixample-4x4.geojson --mem 24M --path "$tmp/endpath.geojson" --size 160x120 --max-frames 2 -o "$tmp/atlw"
 # a held walk: a frame with no lit surface keeps the held exposure (it

@@ -34,21 +34,27 @@ static int bytes_read(void *user, uint64_t off, void *buf, size_t n)
     return 0;
 }
 
-/* The same file through reads: the same status as plx_bake_load's (want). */
-static void one_read(const uint8_t *f, size_t len, void *mem, plx_status want)
+/* The same file through reads: the size-first call gives
+ * plx_bake_block_size's status (size_st; without scratch the header's
+ * checks only, so PLX_OK where the body is damaged), the load
+ * plx_bake_load's (load_st). */
+static void one_read(const uint8_t *f, size_t len, void *mem, plx_status size_st, plx_status load_st)
 {
     char err[512];
     size_t need = 0;
     plx_engine *e = NULL;
+    unsigned char scratch[1024];
     bytes_in in;
     plx_status st;
     in.f = f;
     in.len = len;
-    st = plx_bake_block_size_read(bytes_read, &in, len, &need, err, sizeof err);
-    CHECK(st == PLX_OK || st == want);
+    st = plx_bake_block_size_read(bytes_read, &in, len, NULL, 0, &need, err, sizeof err);
+    CHECK(st == PLX_OK || st == size_st);
+    st = plx_bake_block_size_read(bytes_read, &in, len, scratch, sizeof scratch, &need, err, sizeof err);
+    CHECK(st == size_st);
     err[0] = '\0';
     st = plx_bake_load_read(mem, BLOCK, NULL, bytes_read, &in, len, &e, err, sizeof err);
-    CHECK(st == want);
+    CHECK(st == load_st);
     if (st != PLX_OK) {
         CHECK(e == NULL);
         CHECK(err[0] != '\0' && strchr(err, '\n') == NULL);
@@ -63,9 +69,9 @@ static void one(const uint8_t *f, size_t len, void *mem)
     char err[512];
     size_t need = 0;
     plx_engine *e = NULL;
-    plx_status st;
+    plx_status st, size_st;
     err[0] = '\0';
-    st = plx_bake_block_size(f, len, &need, err, sizeof err);
+    st = size_st = plx_bake_block_size(f, len, &need, err, sizeof err);
     CHECK(st == PLX_OK || st == PLX_E_PARSE || st == PLX_E_UNSUPPORTED);
     if (st != PLX_OK)
         CHECK(err[0] != '\0' && strchr(err, '\n') == NULL);
@@ -79,7 +85,7 @@ static void one(const uint8_t *f, size_t len, void *mem)
         CHECK(e != NULL && plx_engine_block(e) == mem);
         plx_engine_destroy(e);
     }
-    one_read(f, len, mem, st);
+    one_read(f, len, mem, size_st, st);
 }
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)

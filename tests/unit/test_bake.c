@@ -270,14 +270,15 @@ static void test_round_trip(void **state)
 }
 
 /* A bake file read through plx_bake_read_fn: bytes in memory, a read
- * that fails at call fail_at (0: none), and with flip set, byte flip
- * changed (bit 4) when a read reaches it the second time (the file
- * changed between the loader's two readings). */
+ * that fails at call fail_at (0: none), and with flip_nth set, byte flip
+ * changed (xor flip_mask) when a read reaches it the flip_nth time (the
+ * file changed between the loader's readings). */
 typedef struct mem_file {
     unsigned char *f;
     size_t len;
-    int calls, fail_at, flip_on, seen;
+    int calls, fail_at, flip_nth, seen;
     size_t flip;
+    unsigned char flip_mask;
 } mem_file;
 
 static int mem_read(void *user, uint64_t off, void *buf, size_t n)
@@ -285,10 +286,20 @@ static int mem_read(void *user, uint64_t off, void *buf, size_t n)
     mem_file *m = user;
     if (++m->calls == m->fail_at || off > m->len || n > m->len - off)
         return -1;
-    if (m->flip_on && off <= m->flip && m->flip < off + n && ++m->seen == 2)
-        m->f[m->flip] ^= 0x10;
+    if (m->flip_nth && off <= m->flip && m->flip < off + n && ++m->seen == m->flip_nth)
+        m->f[m->flip] ^= m->flip_mask;
     memcpy(buf, m->f + off, n);
     return 0;
+}
+
+/* A bake's first stored page's offset in the file (after the bitmap). */
+static size_t pages_at(const unsigned char *f)
+{
+    uint64_t img;
+    size_t npages;
+    memcpy(&img, f + 40, 8);
+    npages = (size_t)((img + 4095) / 4096);
+    return 128 + (((npages + 7) / 8 + 7) & ~(size_t)7);
 }
 
 /* The bake read through the caller's reads (plx_bake_load_read), at an
@@ -311,7 +322,14 @@ static void test_load_read(void **state)
     memcpy(mf.f, k.file, k.len);
     mf.len = k.len;
     assert_int_equal(plx_bake_block_size(k.file, k.len, &need, err, sizeof err), PLX_OK);
-    assert_int_equal(plx_bake_block_size_read(mem_read, &mf, k.len, &need2, err, sizeof err), PLX_OK);
+    assert_int_equal(plx_bake_block_size_read(mem_read, &mf, k.len, NULL, 0, &need2, err, sizeof err), PLX_OK);
+    assert_true(need2 == need);
+    need2 = 0;
+    {
+        char scratch[1000]; /* not a multiple of 32: the reads' pieces need not be */
+        assert_int_equal(plx_bake_block_size_read(mem_read, &mf, k.len, scratch, sizeof scratch, &need2, err, sizeof err),
+                         PLX_OK);
+    }
     assert_true(need2 == need);
     mem = malloc(need + 64);
     mf.calls = 0;
@@ -339,23 +357,98 @@ static void test_load_read(void **state)
     /* the first byte of the second stored page (a word's lowest: 16 more
      * or less, inside the image if it is a pointer) changed after the
      * first reading */
-    {
-        uint64_t img;
-        size_t npages;
-        memcpy(&img, k.file + 40, 8);
-        npages = (size_t)((img + 4095) / 4096);
-        mf.flip = 128 + (((npages + 7) / 8 + 7) & ~(size_t)7) + 4096;
-    }
-    mf.calls = 0;
-    mf.flip_on = 1;
+    mf.flip = pages_at(k.file) + 4096;
+    mf.flip_mask = 0x10;
+    mf.flip_nth = 2;
+    mf.calls = mf.seen = 0;
     assert_int_equal(plx_bake_load_read(mem, need + 64, NULL, mem_read, &mf, k.len, &d, err, sizeof err), PLX_E_PARSE);
     assert_null(d);
     assert_string_equal(err, "corrupt bake file: it changed while it was read");
     assert_int_equal(mf.seen, 2);
+    /* a stored page's bit moved to a page not stored, in the bitmap the
+     * pages are placed by (its third reading, after the first's checksum
+     * and the second's), the pages' bytes the same: it loaded as sound,
+     * the page's data one page on */
+    memcpy(mf.f, k.file, k.len);
+    {
+        size_t b;
+        for (b = 0; b < (size_t)(pages_at(k.file) - 128) && (k.file[128 + b] == 0 || k.file[128 + b] == 0xff); b++)
+            ;
+        assert_true(b < (size_t)(pages_at(k.file) - 128)); /* a byte with stored and empty pages */
+        mf.flip = 128 + b;
+        mf.flip_mask = 0;
+        for (at = 0; at < 7; at++) /* a stored page followed by one not stored: both bits flip */
+            if (((k.file[128 + b] >> at) & 3u) == 1u)
+                mf.flip_mask = (unsigned char)(3u << at);
+        assert_true(mf.flip_mask != 0);
+    }
+    mf.flip_nth = 3;
+    mf.calls = mf.seen = 0;
+    assert_int_equal(plx_bake_load_read(mem, need + 64, NULL, mem_read, &mf, k.len, &d, err, sizeof err), PLX_E_PARSE);
+    assert_null(d);
+    assert_string_equal(err, "corrupt bake file: it changed while it was read");
+    assert_int_equal(mf.seen, 3);
     plx_engine_destroy(c);
     free(mc);
     free(mem);
     free(mf.f);
+}
+
+/* A bake whose last page, a part page, is stored (the saver leaves an
+ * all-zero page out; a file may hold it): its bytes in the file past the
+ * image are summed but not copied. Both loads read it as the file
+ * without the page, and a byte changed there between the readings is
+ * seen. */
+static void test_last_page_stored(void **state)
+{
+    baked k = shared;
+    uint64_t img, pages, total;
+    size_t npages, pa, present = 0, p, nlen, need;
+    unsigned char *g;
+    void *mc, *mem;
+    plx_engine *c, *d = NULL;
+    char err[256];
+    mem_file mf;
+    (void)state;
+    memcpy(&img, k.file + 40, 8);
+    memcpy(&pages, k.file + 80, 8);
+    npages = (size_t)((img + 4095) / 4096);
+    pa = pages_at(k.file);
+    assert_true(img % 4096 != 0);                                  /* a part page */
+    assert_false((k.file[128 + (npages - 1) / 8] >> ((npages - 1) % 8)) & 1); /* left out by the saver */
+    for (p = 0; p + 1 < npages; p++)
+        present += (k.file[128 + p / 8] >> (p % 8)) & 1u;
+    nlen = k.len + 4096;
+    g = calloc(1, nlen);
+    memcpy(g, k.file, pa + present * 4096);
+    memset(g + pa + present * 4096 + (size_t)(img % 4096), 0x5a, 4096 - (size_t)(img % 4096)); /* past the image */
+    memcpy(g + pa + (present + 1) * 4096, k.file + pa + present * 4096, k.len - pa - present * 4096);
+    g[128 + (npages - 1) / 8] |= (unsigned char)(1u << ((npages - 1) % 8));
+    pages++;
+    total = nlen;
+    memcpy(g + 80, &pages, 8);
+    memcpy(g + 24, &total, 8);
+    ref_bake_reseal(g, nlen);
+    assert_int_equal(plx_bake_block_size(g, nlen, &need, err, sizeof err), PLX_OK);
+    c = load(g, nlen, &mc);
+    memset(&mf, 0, sizeof mf);
+    mf.f = g;
+    mf.len = nlen;
+    mem = malloc(need);
+    assert_int_equal(plx_bake_load_read(mem, need, NULL, mem_read, &mf, nlen, &d, err, sizeof err), PLX_OK);
+    same_render(c, d, 1, 0);
+    same_render(k.a, d, 0, 0);
+    plx_engine_destroy(d);
+    /* a byte past the image changed after the first reading */
+    mf.flip = pa + present * 4096 + 4095;
+    mf.flip_mask = 0x01;
+    mf.flip_nth = 2;
+    assert_int_equal(plx_bake_load_read(mem, need, NULL, mem_read, &mf, nlen, &d, err, sizeof err), PLX_E_PARSE);
+    assert_string_equal(err, "corrupt bake file: it changed while it was read");
+    plx_engine_destroy(c);
+    free(mc);
+    free(mem);
+    free(g);
 }
 
 /* The radiance atlas: a bake made before its photons fills it whole while
@@ -571,8 +664,28 @@ static void test_aa_on_demand(void **state)
 
 /* ---- damaged files ----------------------------------------------------------- */
 
+/* plx_bake_load_read of f (len bytes) into mem (size bytes): status want,
+ * line msg, no engine. */
+static void expect_read(void *mem, size_t size, const unsigned char *f, size_t len, plx_status want, const char *msg)
+{
+    char err[256];
+    char want_msg[256];
+    plx_engine *e = (plx_engine *)&want_msg;
+    mem_file mf;
+    snprintf(want_msg, sizeof want_msg, "%s", msg); /* msg may be the caller's err */
+    memset(&mf, 0, sizeof mf);
+    mf.f = malloc(len ? len : 1);
+    memcpy(mf.f, f, len);
+    mf.len = len;
+    err[0] = '\0';
+    assert_int_equal(plx_bake_load_read(mem, size, NULL, mem_read, &mf, len, &e, err, sizeof err), want);
+    assert_null(e);
+    assert_string_equal(err, want_msg);
+    free(mf.f);
+}
+
 /* Every way of reading f: the same error and line (plx_bake_block_size_read
- * checks the header only: past it, it passes). */
+ * without scratch checks the header only: past it, it passes). */
 static void expect_fail(const unsigned char *f, size_t len, plx_status want, const char *msg)
 {
     char err[256];
@@ -588,19 +701,22 @@ static void expect_fail(const unsigned char *f, size_t len, plx_status want, con
     assert_int_equal(plx_bake_load(mem, 1 << 20, NULL, f, len, &e, err, sizeof err), want);
     assert_null(e);
     assert_string_equal(err, msg);
+    expect_read(mem, 1 << 20, f, len, want, msg);
     memset(&mf, 0, sizeof mf);
     mf.f = malloc(len ? len : 1);
     memcpy(mf.f, f, len);
     mf.len = len;
     err[0] = '\0';
-    e = (plx_engine *)&need;
-    assert_int_equal(plx_bake_load_read(mem, 1 << 20, NULL, mem_read, &mf, len, &e, err, sizeof err), want);
-    assert_null(e);
-    assert_string_equal(err, msg);
-    err[0] = '\0';
-    st = plx_bake_block_size_read(mem_read, &mf, len, &need, err, sizeof err);
+    st = plx_bake_block_size_read(mem_read, &mf, len, NULL, 0, &need, err, sizeof err);
     if (st != PLX_OK) {
         assert_int_equal(st, want);
+        assert_string_equal(err, msg);
+    }
+    err[0] = '\0';
+    {
+        unsigned char scratch[4096];
+        assert_int_equal(plx_bake_block_size_read(mem_read, &mf, len, scratch, sizeof scratch, &need, err, sizeof err),
+                         want);
         assert_string_equal(err, msg);
     }
     free(mf.f);
@@ -721,6 +837,7 @@ static void test_damaged(void **state)
         assert_int_equal(plx_bake_load(mem, need, NULL, f, k.len, &e, err, sizeof err), PLX_E_PARSE);
         assert_null(e);
         assert_string_equal(err, "corrupt bake file: no engine at the start of the image");
+        expect_read(mem, need, f, k.len, PLX_E_PARSE, "corrupt bake file: no engine at the start of the image");
         free(mem);
     }
     /* a block too small */
@@ -729,6 +846,7 @@ static void test_damaged(void **state)
     assert_int_equal(plx_bake_load(mem, 1 << 20, NULL, k.file, k.len, &e, err, sizeof err), PLX_E_NOMEM);
     assert_null(e);
     assert_non_null(strstr(err, "the block is too small for the bake: it needs "));
+    expect_read(mem, 1 << 20, k.file, k.len, PLX_E_NOMEM, err);
     free(mem);
     free(f);
 }
@@ -833,6 +951,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_round_trip),
         cmocka_unit_test(test_load_read),
+        cmocka_unit_test(test_last_page_stored),
         cmocka_unit_test(test_atlas_in_bake),
         cmocka_unit_test(test_bake_after_frames),
         cmocka_unit_test(test_aa_dense),
