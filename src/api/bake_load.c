@@ -279,13 +279,21 @@ static plx_status src_read(const bake_src *s, uint64_t off, void *buf, size_t n)
     return say(s->err, s->errlen, PLX_E_IO, "cannot read the bake file: ", n, " bytes at byte ", off, "");
 }
 
-/* The header read into h and checked (check_header), L filled. */
-static plx_status src_header(const bake_src *s, unsigned char h[BAKE_HEADER], bake_layout *L)
+/* s set up for the file of len bytes read through read(user, ...), its
+ * header read into h and checked (check_header), L filled. */
+static plx_status src_open(bake_src *s, plx_bake_read_fn read, void *user, uint64_t len, char *err, size_t errlen,
+                           unsigned char h[BAKE_HEADER], bake_layout *L)
 {
-    plx_status st = src_read(s, 0, h, s->len < BAKE_HEADER ? (size_t)s->len : BAKE_HEADER);
+    plx_status st;
+    s->read = read;
+    s->user = user;
+    s->len = len;
+    s->err = err;
+    s->errlen = errlen;
+    st = src_read(s, 0, h, len < BAKE_HEADER ? (size_t)len : BAKE_HEADER);
     if (st != PLX_OK)
         return st;
-    return check_header(h, s->len, L, s->err, s->errlen);
+    return check_header(h, len, L, err, errlen);
 }
 
 /* The checksum over the file's bytes given in order in pieces of any
@@ -486,12 +494,7 @@ plx_status plx_bake_block_size_read(plx_bake_read_fn read, void *user, uint64_t 
     if (!read || !block_bytes)
         return say(err, errlen, PLX_E_INVALID, "plx_bake_block_size_read: read and block_bytes must not be NULL", 0,
                    NULL, 0, NULL);
-    s.read = read;
-    s.user = user;
-    s.len = len;
-    s.err = err;
-    s.errlen = errlen;
-    if ((st = src_header(&s, h, &L)) != PLX_OK)
+    if ((st = src_open(&s, read, user, len, err, errlen, h, &L)) != PLX_OK)
         return st;
     if (scratch && scratch_len >= READ_SMALL &&
         (st = check_read(&s, h, &L, scratch, scratch_len & ~(size_t)31)) != PLX_OK)
@@ -515,12 +518,7 @@ plx_status plx_bake_load_read(void *mem, size_t size, const plx_config *cfg, plx
     if (!mem || !out || !read)
         return say(err, errlen, PLX_E_INVALID, "plx_bake_load_read: mem, read and out must not be NULL", 0, NULL, 0,
                    NULL);
-    s.read = read;
-    s.user = user;
-    s.len = len;
-    s.err = err;
-    s.errlen = errlen;
-    if ((st = src_header(&s, h, &L)) != PLX_OK)
+    if ((st = src_open(&s, read, user, len, err, errlen, h, &L)) != PLX_OK)
         return st;
     /* checked first, with the block as the buffer when the image fits
      * (else the stack's, and then the block's error, as plx_bake_load) */

@@ -684,6 +684,36 @@ static void span_offsets(int64_t s1, int64_t s2, double off1[SPAN_LANES], double
     }
 }
 
+/* The depths of SPAN_LANES pixels (zc: z0, dz1, dz2, 1 / area) from the
+ * edge values e1 + off1[k], e2 + off2[k]. */
+static inline void lanes_depth(double e1, double e2, const double *restrict off1, const double *restrict off2,
+                        const double zc[4], float *restrict z)
+{
+    int k;
+    for (k = 0; k < SPAN_LANES; k++) {
+        double l1 = (e1 + off1[k]) * zc[3], l2 = (e2 + off2[k]) * zc[3];
+        z[k] = (float)(zc[0] + l1 * zc[1] + l2 * zc[2]);
+    }
+}
+
+/* The lanes whose mask m[k] is all ones written with depth z[k] and the
+ * id, and counted in c[k]; the others written back unchanged. The
+ * selects as bit masks: written as conditions, GCC branches. */
+static inline void lanes_store(float *restrict drow, uint32_t *restrict irow, const float *restrict z,
+                        const uint32_t *restrict m, uint32_t id, uint32_t *restrict c)
+{
+    uint32_t zb[SPAN_LANES], db[SPAN_LANES];
+    int k;
+    memcpy(zb, z, sizeof zb);
+    memcpy(db, drow, sizeof db);
+    for (k = 0; k < SPAN_LANES; k++) {
+        db[k] = (zb[k] & m[k]) | (db[k] & ~m[k]);
+        irow[k] = (id & m[k]) | (irow[k] & ~m[k]);
+        c[k] -= m[k]; /* one more in lane k */
+    }
+    memcpy(drow, db, sizeof db);
+}
+
 /* SPAN_LANES pixels from drow, irow: depth z (zc: z0, dz1, dz2, 1 /
  * area) from the edge values e1 + off1[k], e2 + off2[k]; where it is
  * nearer, written with the id, and counted in c[k]; in loops of fixed
@@ -693,26 +723,16 @@ static void span_lanes_id(float *restrict drow, uint32_t *restrict irow, double 
                           uint32_t id, uint32_t *restrict c)
 {
     float z[SPAN_LANES];
-    uint32_t zb[SPAN_LANES], db[SPAN_LANES], hidden = 1;
+    uint32_t m[SPAN_LANES], hidden = 1;
     int k;
     for (k = 0; k < SPAN_LANES; k++)
         hidden &= drow[k] <= zlo;
     if (hidden) /* no lane can be nearer (depth_floor) */
         return;
-    for (k = 0; k < SPAN_LANES; k++) {
-        double l1 = (e1 + off1[k]) * zc[3], l2 = (e2 + off2[k]) * zc[3];
-        z[k] = (float)(zc[0] + l1 * zc[1] + l2 * zc[2]);
-    }
-    /* the selects as bit masks: written as conditions, GCC branches */
-    memcpy(zb, z, sizeof zb);
-    memcpy(db, drow, sizeof db);
-    for (k = 0; k < SPAN_LANES; k++) {
-        uint32_t m = 0u - (uint32_t)(z[k] < drow[k]); /* NaN: not nearer */
-        db[k] = (zb[k] & m) | (db[k] & ~m);
-        irow[k] = (id & m) | (irow[k] & ~m);
-        c[k] -= m; /* one more in lane k */
-    }
-    memcpy(drow, db, sizeof db);
+    lanes_depth(e1, e2, off1, off2, zc, z);
+    for (k = 0; k < SPAN_LANES; k++)
+        m[k] = 0u - (uint32_t)(z[k] < drow[k]); /* NaN: not nearer */
+    lanes_store(drow, irow, z, m, id, c);
 }
 
 /* Lanes klo .. khi of SPAN_LANES pixels from drow, irow, as
@@ -724,21 +744,12 @@ static void span_part_id(float *restrict drow, uint32_t *restrict irow, double e
                          int32_t khi, uint32_t id, uint32_t *restrict c)
 {
     float z[SPAN_LANES];
-    uint32_t zb[SPAN_LANES], db[SPAN_LANES];
+    uint32_t m[SPAN_LANES];
     int32_t k;
-    for (k = 0; k < SPAN_LANES; k++) {
-        double l1 = (e1 + off1[k]) * zc[3], l2 = (e2 + off2[k]) * zc[3];
-        z[k] = (float)(zc[0] + l1 * zc[1] + l2 * zc[2]);
-    }
-    memcpy(zb, z, sizeof zb);
-    memcpy(db, drow, sizeof db);
-    for (k = 0; k < SPAN_LANES; k++) {
-        uint32_t m = 0u - ((uint32_t)(z[k] < drow[k]) & (uint32_t)(k >= klo) & (uint32_t)(k <= khi));
-        db[k] = (zb[k] & m) | (db[k] & ~m);
-        irow[k] = (id & m) | (irow[k] & ~m);
-        c[k] -= m;
-    }
-    memcpy(drow, db, sizeof db);
+    lanes_depth(e1, e2, off1, off2, zc, z);
+    for (k = 0; k < SPAN_LANES; k++)
+        m[k] = 0u - ((uint32_t)(z[k] < drow[k]) & (uint32_t)(k >= klo) & (uint32_t)(k <= khi));
+    lanes_store(drow, irow, z, m, id, c);
 }
 
 /* A narrow triangle's pixels (draw_triangle_id) one at a time, where the
@@ -791,7 +802,7 @@ static void narrow_lanes_id(float *restrict drow, uint32_t *restrict irow, const
                             uint32_t *restrict c)
 {
     float z[SPAN_LANES], f0[SPAN_LANES], f1[SPAN_LANES], f2[SPAN_LANES];
-    uint32_t zb[SPAN_LANES], db[SPAN_LANES];
+    uint32_t m[SPAN_LANES];
     int k;
     for (k = 0; k < SPAN_LANES; k++) {
         double v0 = ev[0] + off[k], v1 = ev[1] + off[SPAN_LANES + k], v2 = ev[2] + off[2 * SPAN_LANES + k];
@@ -801,16 +812,10 @@ static void narrow_lanes_id(float *restrict drow, uint32_t *restrict irow, const
         f1[k] = (float)v1;
         f2[k] = (float)v2;
     }
-    memcpy(zb, z, sizeof zb);
-    memcpy(db, drow, sizeof db);
-    for (k = 0; k < SPAN_LANES; k++) {
-        uint32_t m = 0u - ((uint32_t)(f0[k] >= lim[0]) & (uint32_t)(f1[k] >= lim[1]) &
-                           (uint32_t)(f2[k] >= lim[2]) & (uint32_t)(z[k] < drow[k]));
-        db[k] = (zb[k] & m) | (db[k] & ~m);
-        irow[k] = (id & m) | (irow[k] & ~m);
-        c[k] -= m;
-    }
-    memcpy(drow, db, sizeof db);
+    for (k = 0; k < SPAN_LANES; k++)
+        m[k] = 0u - ((uint32_t)(f0[k] >= lim[0]) & (uint32_t)(f1[k] >= lim[1]) & (uint32_t)(f2[k] >= lim[2]) &
+                     (uint32_t)(z[k] < drow[k]));
+    lanes_store(drow, irow, z, m, id, c);
 }
 
 /* A narrow triangle's pixels (draw_triangle_id): its box (at most

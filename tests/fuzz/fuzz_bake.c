@@ -34,6 +34,19 @@ static int bytes_read(void *user, uint64_t off, void *buf, size_t n)
     return 0;
 }
 
+/* A load's result: on failure no engine and a line; on success an
+ * engine in mem, destroyed. */
+static void loaded(plx_status st, plx_engine *e, const char *err, void *mem)
+{
+    if (st != PLX_OK) {
+        CHECK(e == NULL);
+        CHECK(err[0] != '\0' && strchr(err, '\n') == NULL);
+    } else {
+        CHECK(e != NULL && plx_engine_block(e) == mem);
+        plx_engine_destroy(e);
+    }
+}
+
 /* The same file through reads: the size-first call gives
  * plx_bake_block_size's status (size_st; without scratch the header's
  * checks only, so PLX_OK where the body is damaged), the load
@@ -55,13 +68,7 @@ static void one_read(const uint8_t *f, size_t len, void *mem, plx_status size_st
     err[0] = '\0';
     st = plx_bake_load_read(mem, BLOCK, NULL, bytes_read, &in, len, &e, err, sizeof err);
     CHECK(st == load_st);
-    if (st != PLX_OK) {
-        CHECK(e == NULL);
-        CHECK(err[0] != '\0' && strchr(err, '\n') == NULL);
-    } else {
-        CHECK(e != NULL && plx_engine_block(e) == mem);
-        plx_engine_destroy(e);
-    }
+    loaded(st, e, err, mem);
 }
 
 static void one(const uint8_t *f, size_t len, void *mem)
@@ -78,13 +85,7 @@ static void one(const uint8_t *f, size_t len, void *mem)
     err[0] = '\0';
     st = plx_bake_load(mem, BLOCK, NULL, f, len, &e, err, sizeof err);
     CHECK(st == PLX_OK || st == PLX_E_PARSE || st == PLX_E_UNSUPPORTED || st == PLX_E_NOMEM);
-    if (st != PLX_OK) {
-        CHECK(e == NULL);
-        CHECK(err[0] != '\0' && strchr(err, '\n') == NULL);
-    } else {
-        CHECK(e != NULL && plx_engine_block(e) == mem);
-        plx_engine_destroy(e);
-    }
+    loaded(st, e, err, mem);
     one_read(f, len, mem, size_st, st);
 }
 

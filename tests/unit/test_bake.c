@@ -302,6 +302,21 @@ static size_t pages_at(const unsigned char *f)
     return 128 + (((npages + 7) / 8 + 7) & ~(size_t)7);
 }
 
+/* mf's file loaded through reads into mem (size bytes) with its byte
+ * mf->flip changed at the nth reading that reaches it: refused as changed
+ * while it was read, at that reading. */
+static void expect_changed(void *mem, size_t size, mem_file *mf, int nth)
+{
+    char err[256];
+    plx_engine *e = NULL;
+    mf->flip_nth = nth;
+    mf->calls = mf->seen = 0;
+    assert_int_equal(plx_bake_load_read(mem, size, NULL, mem_read, mf, mf->len, &e, err, sizeof err), PLX_E_PARSE);
+    assert_null(e);
+    assert_string_equal(err, "corrupt bake file: it changed while it was read");
+    assert_int_equal(mf->seen, nth);
+}
+
 /* The bake read through the caller's reads (plx_bake_load_read), at an
  * address 16 bytes past 64-byte alignment: the same answers and frames
  * as the loaded buffer's; its size-first call gives plx_bake_block_size's.
@@ -359,12 +374,7 @@ static void test_load_read(void **state)
      * first reading */
     mf.flip = pages_at(k.file) + 4096;
     mf.flip_mask = 0x10;
-    mf.flip_nth = 2;
-    mf.calls = mf.seen = 0;
-    assert_int_equal(plx_bake_load_read(mem, need + 64, NULL, mem_read, &mf, k.len, &d, err, sizeof err), PLX_E_PARSE);
-    assert_null(d);
-    assert_string_equal(err, "corrupt bake file: it changed while it was read");
-    assert_int_equal(mf.seen, 2);
+    expect_changed(mem, need + 64, &mf, 2);
     /* a stored page's bit moved to a page not stored, in the bitmap the
      * pages are placed by (its third reading, after the first's checksum
      * and the second's), the pages' bytes the same: it loaded as sound,
@@ -382,12 +392,7 @@ static void test_load_read(void **state)
                 mf.flip_mask = (unsigned char)(3u << at);
         assert_true(mf.flip_mask != 0);
     }
-    mf.flip_nth = 3;
-    mf.calls = mf.seen = 0;
-    assert_int_equal(plx_bake_load_read(mem, need + 64, NULL, mem_read, &mf, k.len, &d, err, sizeof err), PLX_E_PARSE);
-    assert_null(d);
-    assert_string_equal(err, "corrupt bake file: it changed while it was read");
-    assert_int_equal(mf.seen, 3);
+    expect_changed(mem, need + 64, &mf, 3);
     plx_engine_destroy(c);
     free(mc);
     free(mem);
@@ -442,9 +447,7 @@ static void test_last_page_stored(void **state)
     /* a byte past the image changed after the first reading */
     mf.flip = pa + present * 4096 + 4095;
     mf.flip_mask = 0x01;
-    mf.flip_nth = 2;
-    assert_int_equal(plx_bake_load_read(mem, need, NULL, mem_read, &mf, nlen, &d, err, sizeof err), PLX_E_PARSE);
-    assert_string_equal(err, "corrupt bake file: it changed while it was read");
+    expect_changed(mem, need, &mf, 2);
     plx_engine_destroy(c);
     free(mc);
     free(mem);
