@@ -752,6 +752,25 @@ static void span_part_id(float *restrict drow, uint32_t *restrict irow, double e
     lanes_store(drow, irow, z, m, id, c);
 }
 
+/* One pixel inside a triangle, its edge values e1, e2: the depth from
+ * them (zc: z0, dz1, dz2, 1 / area) and, where nearer, written with the
+ * id. Returns 1 when written. */
+static int pixel_id(float *drow, uint32_t *irow, double e1, double e2, const double zc[4], float zlo, uint32_t id)
+{
+    double l1, l2;
+    float z;
+    if (*drow <= zlo) /* hidden (depth_floor) */
+        return 0;
+    l1 = e1 * zc[3];
+    l2 = e2 * zc[3];
+    z = (float)(zc[0] + l1 * zc[1] + l2 * zc[2]);
+    if (!(z < *drow))
+        return 0;
+    *drow = z;
+    *irow = id;
+    return 1;
+}
+
 /* A narrow triangle's pixels (draw_triangle_id) one at a time, where the
  * scissor is narrower than SPAN_LANES columns: every centre of its box
  * tested against the three edges, E + bias >= 0 each, the test the spans
@@ -769,20 +788,9 @@ static size_t draw_narrow_scalar(raster_ctx *r, const edge e[3], const int64_t e
         float *drow = t->depth + (size_t)j * t->depth_stride;
         uint32_t *irow = ids + (size_t)j * (size_t)t->width;
         int64_t c0 = b0, c1 = b1, c2 = b2;
-        for (x = i0; x <= i1; x++, c0 += s0, c1 += s1, c2 += s2) {
-            double l1, l2;
-            float z;
-            if ((c0 | c1 | c2) < 0 || drow[x] <= zlo) /* outside, or hidden (depth_floor) */
-                continue;
-            l1 = (double)(c1 - e[1].bias) * zc[3];
-            l2 = (double)(c2 - e[2].bias) * zc[3];
-            z = (float)(zc[0] + l1 * zc[1] + l2 * zc[2]);
-            if (!(z < drow[x]))
-                continue;
-            drow[x] = z;
-            irow[x] = id;
-            written++;
-        }
+        for (x = i0; x <= i1; x++, c0 += s0, c1 += s1, c2 += s2)
+            if ((c0 | c1 | c2) >= 0) /* inside */
+                written += pixel_id(drow + x, irow + x, (double)(c1 - e[1].bias), (double)(c2 - e[2].bias), zc, zlo, id);
         b0 += e[0].dx * FIX_ONE;
         b1 += e[1].dx * FIX_ONE;
         b2 += e[2].dx * FIX_ONE;
@@ -888,20 +896,8 @@ static size_t span_scalar_id(float *drow, uint32_t *irow, int64_t lo, int64_t hi
 {
     int64_t x;
     size_t written = 0;
-    for (x = lo; x <= hi; x++, e1 += s1, e2 += s2) {
-        double l1, l2;
-        float z;
-        if (drow[x] <= zlo)
-            continue;
-        l1 = (double)e1 * zc[3];
-        l2 = (double)e2 * zc[3];
-        z = (float)(zc[0] + l1 * zc[1] + l2 * zc[2]);
-        if (!(z < drow[x]))
-            continue;
-        drow[x] = z;
-        irow[x] = id;
-        written++;
-    }
+    for (x = lo; x <= hi; x++, e1 += s1, e2 += s2)
+        written += pixel_id(drow + x, irow + x, (double)e1, (double)e2, zc, zlo, id);
     return written;
 }
 
