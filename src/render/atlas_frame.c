@@ -345,6 +345,21 @@ uint32_t atlas_frame_missing(atlas *A, const atlas_view *v, const uint32_t *ids,
     return n;
 }
 
+/* The end of the run of pixels from i with pixel i's id (the first pixel
+ * after it, or w): two ids a test, read as one 64-bit word (memcpy: no
+ * alignment or aliasing assumed), where it can. */
+static int32_t run_end(const uint32_t *ids, int32_t i, int32_t w)
+{
+    uint32_t sid = ids[i];
+    uint64_t two = (uint64_t)sid << 32 | sid, q;
+    int32_t e = i + 1;
+    while (e + 2 <= w && (memcpy(&q, &ids[e], sizeof q), q == two))
+        e += 2;
+    if (e < w && ids[e] == sid)
+        e++;
+    return e;
+}
+
 /* Whether the 8 pixels from i are all marked (all are without a mask). */
 static int all_marked(const uint8_t *mask, int32_t i)
 {
@@ -542,8 +557,7 @@ int atlas_frame_row(const atlas *A, const atlas_view *v, atlas_cache *k, const u
             for (e = i + 1; e < v->w && ids[e] == sid && mask[e]; e++)
                 ;
         else
-            for (e = i + 1; e < v->w && ids[e] == sid; e++)
-                ;
+            e = run_end(ids, i, v->w);
         if (mask && sid == MESH_SURF_GROUND) { /* only the marked pixels are written, and counted */
             int32_t q;
             for (n = 0, q = i; q < e; q++)
