@@ -224,28 +224,41 @@ static void ground_setup(const atlas *A, const atlas_view *v, int32_t j, ground_
     g->dy = t * v->Dx[1];
 }
 
+/* A ground block's frame: its corner (x, y) from the tiles' corner, and
+ * the inverse of its steps' length. */
+typedef struct block_frame {
+    double x0, y0, inv;
+} block_frame;
+
 /* The ground block item (atlas.h) under (x, y) from the tiles' corner,
- * and (x, y) in steps within it; UINT32_MAX off the tiles. */
-static uint32_t ground_block(const atlas *A, double x, double y, double *u, double *w)
+ * (x, y) in steps within it, and its frame (*f, from the tile's and the
+ * block's indices at hand, without dividing: tx A->tile + ix ATLAS_BLOCK
+ * step is the same double as from the item's indices); UINT32_MAX off the
+ * tiles (*f not written). */
+static uint32_t ground_block(const atlas *A, double x, double y, double *u, double *w, block_frame *f)
 {
-    double fx = x * A->inv_tile, fy = y * A->inv_tile, step_inv, bx, by;
-    uint32_t tx, ty, tile, nb;
+    double fx = x * A->inv_tile, fy = y * A->inv_tile, step_inv, step, bx, by;
+    uint32_t tx, ty, tile, nb, ix, iy;
     if (!(fx >= 0.0 && fx < A->gx && fy >= 0.0 && fy < A->gy))
         return UINT32_MAX;
     tx = (uint32_t)fx;
     ty = (uint32_t)fy;
     tile = ty * A->gx + tx;
-    step_inv = A->gfine[tile] ? A->inv_fine : A->inv_coarse;
+    step_inv = A->gfine[tile] ? A->inv_fine : A->inv_coarse; /* 1.0 / step (atlas.c) */
+    step = A->gfine[tile] ? A->fine : A->coarse;
     x = (x - tx * A->tile) * step_inv; /* in steps within the tile */
     y = (y - ty * A->tile) * step_inv;
     bx = x < 0.0 ? 0.0 : x * (1.0 / ATLAS_BLOCK);
     by = y < 0.0 ? 0.0 : y * (1.0 / ATLAS_BLOCK);
     nb = A->gfine[tile] ? ATLAS_TB - 1 : 0; /* a coarse tile is one block */
-    tx = bx < nb ? (uint32_t)bx : nb;
-    ty = by < nb ? (uint32_t)by : nb;
-    *u = x - tx * ATLAS_BLOCK;
-    *w = y - ty * ATLAS_BLOCK;
-    return tile * ATLAS_TB * ATLAS_TB + ty * ATLAS_TB + tx;
+    ix = bx < nb ? (uint32_t)bx : nb;
+    iy = by < nb ? (uint32_t)by : nb;
+    *u = x - ix * ATLAS_BLOCK;
+    *w = y - iy * ATLAS_BLOCK;
+    f->inv = step_inv;
+    f->x0 = tx * A->tile + ix * ATLAS_BLOCK * step;
+    f->y0 = ty * A->tile + iy * ATLAS_BLOCK * step;
+    return tile * ATLAS_TB * ATLAS_TB + iy * ATLAS_TB + ix;
 }
 
 /* Lists item it unless filled or listed this round (atlas.h's states). */
@@ -256,17 +269,6 @@ static void want(atlas *A, uint32_t it, uint32_t *list, uint32_t cap, uint32_t *
         return;
     *d = ATLAS_LISTED;
     list[(*n)++] = it;
-}
-
-/* Ground block item cur's corner (x, y) from the tiles' corner, and the
- * inverse of its steps' length. */
-static void block_frame(const atlas *A, uint32_t cur, double *bx0, double *by0, double *inv)
-{
-    uint32_t tile = cur / (ATLAS_TB * ATLAS_TB), b = cur % (ATLAS_TB * ATLAS_TB);
-    double step = A->gfine[tile] ? A->fine : A->coarse;
-    *inv = 1.0 / step;
-    *bx0 = (tile % A->gx) * A->tile + (b % ATLAS_TB) * ATLAS_BLOCK * step;
-    *by0 = (tile / A->gx) * A->tile + (b / ATLAS_TB) * ATLAS_BLOCK * step;
 }
 
 /* The last ground block found along a row (atlas_frame_missing): its
@@ -284,15 +286,18 @@ static void missing_ground(atlas *A, const ground_row *g, int32_t i, block_memo 
                            uint32_t *n)
 {
     double x = g->x0 + i * g->dx, y = g->y0 + i * g->dy, u = (x - bm->bx0) * bm->inv, v = (y - bm->by0) * bm->inv;
+    block_frame f;
     uint32_t b;
     if (u > bm->lo && u < bm->hi && v > bm->lo && v < bm->hi)
         return;
-    b = ground_block(A, x, y, &u, &v);
+    b = ground_block(A, x, y, &u, &v, &f);
     bm->lo = 1.0;
     bm->hi = -1.0;
     if (b == UINT32_MAX)
         return;
-    block_frame(A, b, &bm->bx0, &bm->by0, &bm->inv);
+    bm->bx0 = f.x0;
+    bm->by0 = f.y0;
+    bm->inv = f.inv;
     bm->lo = ATLAS_EDGE;
     bm->hi = ATLAS_BLOCK - ATLAS_EDGE;
     if (A->gfirst[b] != ATLAS_NOVERT)
@@ -435,19 +440,22 @@ static int ground_run(const atlas *A, const ground_row *g, int32_t i0, int32_t i
         }
         for (e = i + ATLAS_LANES < i1 ? i + ATLAS_LANES : i1; i < e; i++) {
             double x, y, u, w;
+            block_frame f;
             float *o = &lin[3 * (size_t)i];
             if (mask && !mask[i])
                 continue;
             ground_uw(g, i, bx0, by0, inv, &u, &w);
             if (!(u >= 0.0 && u <= lim && w >= 0.0 && w <= lim)) { /* another block */
                 ground_xy(g, i, &x, &y);
-                cur = ground_block(A, x, y, &u, &w);
+                cur = ground_block(A, x, y, &u, &w, &f);
                 t0 = NULL;
                 lim = -1.0;
                 if (cur != UINT32_MAX && A->gfirst[cur] != ATLAS_NOVERT) {
                     unfilled |= !atlas_filled(A->gdone[cur]);
                     t0 = A->gdone[cur] == ATLAS_DARK ? NULL : &A->tex[A->gfirst[cur]];
-                    block_frame(A, cur, &bx0, &by0, &inv);
+                    bx0 = f.x0;
+                    by0 = f.y0;
+                    inv = f.inv;
                     lim = ATLAS_BLOCK;
                 }
             }
