@@ -72,12 +72,29 @@ static const atlas_map *map_of(const atlas *A, const atlas_view *v, atlas_cache 
  * (a cell of four 0 values sums to +0, black). */
 #define ATLAS_LANES 8
 
+/* A batch of ATLAS_LANES reads whose vertices were read (gathered), to be
+ * summed and written one batch later. The vertices of walls and roofs
+ * often miss the caches: summed at once, the sums wait for them and fill
+ * the processor's window of instructions in flight, so that nothing else
+ * is done while they come, batch after batch; summing the batch before
+ * instead gives that window work that needs nothing from memory. The sums and the pixels they go to are the same; only when
+ * they are written changes (each pixel of a row is written once, and
+ * atlas_frame_row writes every batch before it returns). */
+typedef struct batch {
+    uint32_t qa[ATLAS_LANES], qb[ATLAS_LANES], qc[ATLAS_LANES], qd[ATLAS_LANES]; /* the four vertices */
+    float fu[ATLAS_LANES], fv[ATLAS_LANES]; /* the weights' fractions */
+    int32_t pix[ATLAS_LANES];   /* the pixels in the row */
+    int32_t n;                  /* lanes to write (0: none) */
+} batch;
+
 typedef struct lanes {
     uint32_t n;                 /* points in use */
     int32_t pix[ATLAS_LANES];   /* their pixels in the row */
     const uint32_t *t0[ATLAS_LANES]; /* their chart's vertex (0, 0) */
     float u[ATLAS_LANES], w[ATLAS_LANES], nu[ATLAS_LANES], nv[ATLAS_LANES]; /* sides in vertices */
     uint32_t row[ATLAS_LANES];  /* the chart's row length */
+    batch b[2];                 /* the batch gathered last (b[next ^ 1]) and the one gathered next */
+    int32_t next;
 } lanes;
 
 /* Cell index and weight along one axis for every lane, n vertices along
@@ -119,12 +136,37 @@ static void bilinear(const uint32_t *restrict qa, const uint32_t *restrict qb, c
     }
 }
 
-/* The lanes' bilinear reads, written to their pixels of lin; none left. */
+/* Batch b summed and written to its pixels of lin; empty after. */
+static void batch_write(batch *b, float *lin)
+{
+    float o[3][ATLAS_LANES];
+    int32_t k;
+    if (b->n == 0)
+        return;
+    bilinear(b->qa, b->qb, b->qc, b->qd, b->fu, b->fv, o);
+    for (k = 0; k < b->n; k++) {
+        float *p = &lin[3 * (size_t)b->pix[k]];
+        p[0] = o[0][k];
+        p[1] = o[1][k];
+        p[2] = o[2][k];
+    }
+    b->n = 0;
+}
+
+/* The batch just gathered (L->b[L->next]) in flight, and the one gathered
+ * before it summed and written. */
+static void batch_turn(lanes *L, float *lin)
+{
+    L->next ^= 1;
+    batch_write(&L->b[L->next], lin);
+}
+
+/* The lanes' vertices gathered into the next batch (their pixels written
+ * one batch later, batch_turn); none left. */
 static void lanes_read(lanes *L, float *lin)
 {
-    uint32_t qa[ATLAS_LANES], qb[ATLAS_LANES], qc[ATLAS_LANES], qd[ATLAS_LANES];
+    batch *b = &L->b[L->next];
     int32_t ci[ATLAS_LANES], cj[ATLAS_LANES], k;
-    float fu[ATLAS_LANES], fv[ATLAS_LANES], o[3][ATLAS_LANES];
     if (L->n == 0)
         return;
     for (k = (int32_t)L->n; k < ATLAS_LANES; k++) { /* idle lanes read the first point */
@@ -135,54 +177,54 @@ static void lanes_read(lanes *L, float *lin)
         L->nv[k] = L->nv[0];
         L->row[k] = L->row[0];
     }
-    cells_of(L->u, L->nu, ci, fu);
-    cells_of(L->w, L->nv, cj, fv);
+    cells_of(L->u, L->nu, ci, b->fu);
+    cells_of(L->w, L->nv, cj, b->fv);
     for (k = 0; k < ATLAS_LANES; k++) {
         const uint32_t *t = L->t0[k] + (size_t)cj[k] * L->row[k] + (size_t)ci[k];
-        qa[k] = t[0];
-        qb[k] = t[1];
-        qc[k] = t[L->row[k]];
-        qd[k] = t[L->row[k] + 1];
+        b->qa[k] = t[0];
+        b->qb[k] = t[1];
+        b->qc[k] = t[L->row[k]];
+        b->qd[k] = t[L->row[k] + 1];
+        b->pix[k] = L->pix[k];
     }
-    bilinear(qa, qb, qc, qd, fu, fv, o);
-    for (k = 0; k < (int32_t)L->n; k++) {
-        float *p = &lin[3 * (size_t)L->pix[k]];
-        p[0] = o[0][k];
-        p[1] = o[1][k];
-        p[2] = o[2][k];
-    }
+    b->n = (int32_t)L->n;
     L->n = 0;
+    batch_turn(L, lin);
 }
 
 /* Eight neighbouring pixels i .. i + 7 at (u[k], w[k]) of one chart at t0
- * (nu by nv vertices): the bits of lanes_read's, without gathering them
- * lane by lane. */
-static void run_read(const uint32_t *t0, uint32_t nu, uint32_t nv, const float *u, const float *w, int32_t i,
-                     float *lin)
+ * (nu by nv vertices): the bits of lanes_read's, gathered into the next
+ * batch without going through the lanes one by one. */
+static void run_read(lanes *L, const uint32_t *t0, uint32_t nu, uint32_t nv, const float *u, const float *w,
+                     int32_t i, float *lin)
 {
-    uint32_t qa[ATLAS_LANES], qb[ATLAS_LANES], qc[ATLAS_LANES], qd[ATLAS_LANES];
+    batch *b = &L->b[L->next];
     int32_t ci[ATLAS_LANES], cj[ATLAS_LANES], k;
-    float fu[ATLAS_LANES], fv[ATLAS_LANES], o[3][ATLAS_LANES];
-    float *p = &lin[3 * (size_t)i], su[ATLAS_LANES], sv[ATLAS_LANES];
+    float su[ATLAS_LANES], sv[ATLAS_LANES];
     for (k = 0; k < ATLAS_LANES; k++) {
         su[k] = (float)nu;
         sv[k] = (float)nv;
     }
-    cells_of(u, su, ci, fu);
-    cells_of(w, sv, cj, fv);
+    cells_of(u, su, ci, b->fu);
+    cells_of(w, sv, cj, b->fv);
     for (k = 0; k < ATLAS_LANES; k++) {
         const uint32_t *t = t0 + (size_t)cj[k] * nu + (size_t)ci[k];
-        qa[k] = t[0];
-        qb[k] = t[1];
-        qc[k] = t[nu];
-        qd[k] = t[nu + 1];
+        b->qa[k] = t[0];
+        b->qb[k] = t[1];
+        b->qc[k] = t[nu];
+        b->qd[k] = t[nu + 1];
+        b->pix[k] = i + k;
     }
-    bilinear(qa, qb, qc, qd, fu, fv, o);
-    for (k = 0; k < ATLAS_LANES; k++) {
-        p[3 * k] = o[0][k];
-        p[3 * k + 1] = o[1][k];
-        p[3 * k + 2] = o[2][k];
-    }
+    b->n = ATLAS_LANES;
+    batch_turn(L, lin);
+}
+
+/* Every read of the lanes and batches written. */
+static void lanes_finish(lanes *L, float *lin)
+{
+    lanes_read(L, lin);
+    batch_write(&L->b[0], lin);
+    batch_write(&L->b[1], lin);
 }
 
 /* Pixel i's read at (u, w) of the chart at t0 (nu by nv vertices), read
@@ -400,7 +442,7 @@ static void ground_uw(const ground_row *g, int32_t i, double bx0, double by0, do
  * monotony, when the first and the last do), read at once: ground_run's
  * reads, with the same doubles. 0 and nothing read when not. */
 static int ground_eight(const ground_row *g, int32_t i, double bx0, double by0, double inv, double lim,
-                        const uint32_t *t0, float *lin)
+                        const uint32_t *t0, lanes *L, float *lin)
 {
     double ua, wa, ub, wb;
     float uf[ATLAS_LANES], wf[ATLAS_LANES];
@@ -415,7 +457,7 @@ static int ground_eight(const ground_row *g, int32_t i, double bx0, double by0, 
         uf[k] = (float)u;
         wf[k] = (float)w;
     }
-    run_read(t0, ATLAS_BLOCK + 1, ATLAS_BLOCK + 1, uf, wf, i, lin);
+    run_read(L, t0, ATLAS_BLOCK + 1, ATLAS_BLOCK + 1, uf, wf, i, lin);
     return 1;
 }
 
@@ -434,7 +476,7 @@ static int ground_run(const atlas *A, const ground_row *g, int32_t i0, int32_t i
     int unfilled = 0;
     for (i = i0; i < i1; ) {
         if (i + ATLAS_LANES <= i1 && t0 && all_marked(mask, i) &&
-            ground_eight(g, i, bx0, by0, inv, lim, t0, lin)) {
+            ground_eight(g, i, bx0, by0, inv, lim, t0, L, lin)) {
             i += ATLAS_LANES;
             continue;
         }
@@ -530,7 +572,7 @@ static int surface_run(const atlas *A, const atlas_view *v, atlas_cache *k, uint
             u[q] = (bu + au * fi) * r;
             w[q] = (bv + av * fi) * r;
         }
-        run_read(t0, nu, nv, u, w, i, lin);
+        run_read(L, t0, nu, nv, u, w, i, lin);
     }
     for (; i < i1; i++) {
         float fi = (float)i, r = 1.0f / (bw + aw * fi);
@@ -547,6 +589,8 @@ int atlas_frame_row(const atlas *A, const atlas_view *v, atlas_cache *k, const u
     int32_t i = 0, e;
     int unfilled = 0;
     L.n = 0;
+    L.next = 0;
+    L.b[0].n = L.b[1].n = 0;
     ground_setup(A, v, j, &g);
     while (i < v->w) {
         uint32_t sid;
@@ -585,7 +629,6 @@ int atlas_frame_row(const atlas *A, const atlas_view *v, atlas_cache *k, const u
         }
         i = e;
     }
-    if (L.n)
-        lanes_read(&L, lin);
+    lanes_finish(&L, lin);
     return unfilled;
 }
