@@ -145,6 +145,12 @@ typedef struct plx_port {
 /* Most workers the core asks a parallel-for for. */
 #define PLX_MAX_THREADS 16
 
+/* The radiance atlas (plx_atlas_info_get): its spacing when none is asked
+ * (aerial_m_per_texel 0), in m, and its most bytes when
+ * plx_config.lightmap_bytes is 0 (a quarter of the block, at most this). */
+#define PLX_ATLAS_SPACING_DEFAULT 0.5
+#define PLX_ATLAS_MAX_BYTES ((size_t)64 << 20)
+
 typedef struct plx_config {
     const plx_port *port;             /* NULL: no platform services */
     int strict;                       /* 1: the first bad feature fails the load */

@@ -18,7 +18,6 @@
 
 #define AA_LEVEL 2  /* adaptive anti-aliasing: a step of more than this in the 8-bit image is an edge */
 #define LIGHTMAP_MAX_BYTES ((size_t)48 << 20) /* plx_config.lightmap_bytes 0: at most this */
-#define ATLAS_MAX_BYTES ((size_t)64 << 20)    /* the radiance atlas's, likewise */
 
 void plx_render_opts_default(plx_render_opts *o)
 {
@@ -302,7 +301,7 @@ static void atlas_ind(void *user, const atlas_chart *c, uint32_t sid, const doub
 }
 
 /* The atlas's budget: plx_config.lightmap_bytes, else a quarter of the
- * block, at most ATLAS_MAX_BYTES: from the block, not from what is free
+ * block, at most PLX_ATLAS_MAX_BYTES: from the block, not from what is free
  * when it is made, so that a bake (which makes it before the photons)
  * and an engine that makes it at its first frame lay it out alike. */
 static size_t atlas_budget(const plx_engine *e)
@@ -310,7 +309,7 @@ static size_t atlas_budget(const plx_engine *e)
     size_t quarter = e->mem.cap / 4;
     if (e->cfg.lightmap_bytes)
         return e->cfg.lightmap_bytes;
-    return quarter < ATLAS_MAX_BYTES ? quarter : ATLAS_MAX_BYTES;
+    return quarter < PLX_ATLAS_MAX_BYTES ? quarter : PLX_ATLAS_MAX_BYTES;
 }
 
 plx_status eng_need_atlas(plx_engine *e, double fine)

@@ -32,12 +32,8 @@ typedef struct cli_common {
 } cli_common;
 
 #define CLI_DEFAULT_MEM ((size_t)1 << 30)
-/* The radiance atlas's spacing when none is asked (plx_render_opts.aerial_m_per_texel 0). */
-#define CLI_ATLAS_SPACING 0.5
-/* Its most when plx_config.lightmap_bytes is 0, a quarter of the block up to this (renderapi.c). */
-#define CLI_ATLAS_MAX_BYTES ((size_t)64 << 20)
 /* The block a bake without its atlas is loaded in when no --mem is given: room for the atlas at its most. */
-#define CLI_ATLAS_BLOCK (4 * CLI_ATLAS_MAX_BYTES + ((size_t)1 << 20))
+#define CLI_ATLAS_BLOCK (4 * PLX_ATLAS_MAX_BYTES + ((size_t)1 << 20))
 /* The buffer a bake file is checked through before its block is taken. */
 #define CLI_BAKE_SCRATCH ((size_t)1 << 20)
 
@@ -147,7 +143,7 @@ void cli_indirect_note(const char *cmd, plx_engine *e);
 /* A line on stderr when this run's first frame laid out the radiance
  * atlas (had: whether it was made before the frame, a bake's) with its
  * points farther apart than asked (texel, or the default 0.5 m when 0)
- * because the block is small (its quarter under CLI_ATLAS_MAX_BYTES: a
+ * because the block is small (its quarter under PLX_ATLAS_MAX_BYTES: a
  * larger --mem gives finer points). Not a warning: --quiet keeps it. */
 void cli_atlas_note(const char *cmd, plx_engine *e, int had, double texel);
 int cli_indirect_run(const char *cmd, plx_engine *e, const cli_indirect *ind, const double *eye,

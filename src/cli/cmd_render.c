@@ -348,8 +348,8 @@ int cmd_render(int argc, char **argv)
     if (rc != EXIT_OK)
         return rc < 0 ? EXIT_OK : rc;
     a.c.render_w = a.cam.width;
-    a.c.atlas_room = !a.opts.no_indirect && !a.opts.per_pixel;
     a.c.render_h = a.cam.height;
+    a.c.atlas_room = !a.opts.no_indirect && !a.opts.per_pixel;
 #ifndef PLX_HAVE_OSMESA
     if (a.osmesa) {
         fprintf(stderr, "polarlux render: this polarlux was built without OSMesa (libosmesa6-dev); "

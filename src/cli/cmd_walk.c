@@ -818,8 +818,8 @@ int cmd_walk(int argc, char **argv)
         return EXIT_FAIL;
     }
     a.c.render_w = a.w;
-    a.c.atlas_room = !a.opts.no_indirect && !a.opts.per_pixel;
     a.c.render_h = a.h;
+    a.c.atlas_room = !a.opts.no_indirect && !a.opts.per_pixel;
     rc = cli_open_scene("walk", a.scene, &a.c, &e);
     if (rc != EXIT_OK) {
         if (made)

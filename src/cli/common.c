@@ -542,7 +542,7 @@ static plx_status load_bake_in(const char *cmd, const char *path, void *mem, siz
  * image of need bytes. */
 static size_t atlas_block(size_t need)
 {
-    return need + CLI_ATLAS_MAX_BYTES > CLI_ATLAS_BLOCK ? need + CLI_ATLAS_MAX_BYTES : CLI_ATLAS_BLOCK;
+    return need + PLX_ATLAS_MAX_BYTES > CLI_ATLAS_BLOCK ? need + PLX_ATLAS_MAX_BYTES : CLI_ATLAS_BLOCK;
 }
 
 /* Whether a loaded bake holds its radiance atlas, or holds no indirect
@@ -571,7 +571,9 @@ static int open_bake(const char *cmd, const char *path, const cli_common *c, plx
         fprintf(stderr, "polarlux %s: %s: %s\n", cmd, path, err);
         return EXIT_FAIL;
     }
-    {
+    if (c->mem) { /* the block given: the load checks the file as it reads it */
+        need = c->mem;
+    } else {
         /* the whole file checked before a block is taken for it (a
          * damaged size field asked for 4.6e18 bytes), through a buffer of
          * the command's own, freed before the block is taken */
@@ -579,14 +581,12 @@ static int open_bake(const char *cmd, const char *path, const cli_common *c, plx
         st = plx_bake_block_size_read(bake_read, &in, len, scratch, scratch ? CLI_BAKE_SCRATCH : 0, &need, err,
                                       sizeof err);
         free(scratch);
+        if (st != PLX_OK) {
+            bake_say(cmd, path, st, err, &in);
+            close(in.fd);
+            return EXIT_FAIL;
+        }
     }
-    if (st != PLX_OK) {
-        bake_say(cmd, path, st, err, &in);
-        close(in.fd);
-        return EXIT_FAIL;
-    }
-    if (c->mem)
-        need = c->mem;
     cli_config(c, &cfg);
     if (!(mem = cli_big_alloc(need))) {
         fprintf(stderr, "polarlux %s: %s: cannot take a block of %zu bytes for the bake\n", cmd, path, need);
@@ -761,11 +761,11 @@ void cli_atlas_note(const char *cmd, plx_engine *e, int had, double texel)
 {
     plx_atlas_info ai;
     plx_memory_report mr;
-    double asked = texel > 0.0 ? texel : CLI_ATLAS_SPACING;
+    double asked = texel > 0.0 ? texel : PLX_ATLAS_SPACING_DEFAULT;
     if (had || plx_atlas_info_get(e, &ai) != PLX_OK || !ai.made || !(ai.spacing > asked * 1.001))
         return;
     plx_memory_get(e, &mr);
-    if (mr.capacity / 4 >= CLI_ATLAS_MAX_BYTES / 100 * 99) /* the atlas's own ceiling set it (the block's
+    if (mr.capacity / 4 >= PLX_ATLAS_MAX_BYTES / 100 * 99) /* the atlas's own ceiling set it (the block's
                                                               usable bytes are a little under --mem) */
         return;
     fprintf(stderr,
@@ -774,7 +774,7 @@ void cli_atlas_note(const char *cmd, plx_engine *e, int had, double texel)
             "shadow edges are blurred at that scale: a larger --mem for finer points (the atlas takes at most "
             "%d MiB, from a block of %d MiB)\n",
             cmd, cli_bake_last.loaded ? "the block beside the bake" : "the block", ai.spacing, asked, ai.coarse,
-            mr.capacity / 4 / 1048576.0, (int)(CLI_ATLAS_MAX_BYTES >> 20), (int)(4 * (CLI_ATLAS_MAX_BYTES >> 20)));
+            mr.capacity / 4 / 1048576.0, (int)(PLX_ATLAS_MAX_BYTES >> 20), (int)(4 * (PLX_ATLAS_MAX_BYTES >> 20)));
 }
 
 void cli_json_error(const char *name, const char *text, size_t len, char *err, size_t errlen)

@@ -69,7 +69,7 @@
 #define ATLAS_TB (ATLAS_TILE / ATLAS_BLOCK) /* fine blocks a tile side */
 #define ATLAS_COARSE 4        /* coarse spacing: this many fine steps (a coarse tile is one block) */
 #define ATLAS_NOVERT 0xffffffffu /* a block with no vertices */
-#define ATLAS_FINE_DEFAULT 0.5 /* m, the spacing asked for when none is */
+#define ATLAS_FINE_DEFAULT PLX_ATLAS_SPACING_DEFAULT /* m, the spacing asked for when none is */
 
 enum { ATLAS_NONE = 0, ATLAS_WALL, ATLAS_ROOF, ATLAS_UNDER, ATLAS_GROUND };
 
