@@ -77,8 +77,9 @@ static const atlas_map *map_of(const atlas *A, const atlas_view *v, atlas_cache 
  * often miss the caches: summed at once, the sums wait for them and fill
  * the processor's window of instructions in flight, so that nothing else
  * is done while they come, batch after batch; summing the batch before
- * instead gives that window work that needs nothing from memory. The sums and the pixels they go to are the same; only when
- * they are written changes (each pixel of a row is written once, and
+ * instead gives that window work that needs nothing from memory. The
+ * sums and the pixels they go to are the same; only when they are
+ * written changes (each pixel of a row is written once, and
  * atlas_frame_row writes every batch before it returns). */
 typedef struct batch {
     uint32_t qa[ATLAS_LANES], qb[ATLAS_LANES], qc[ATLAS_LANES], qd[ATLAS_LANES]; /* the four vertices */
