@@ -323,11 +323,11 @@ plx_status eng_need_atlas(plx_engine *e, double fine)
         return st;
     f = atlas_spacing_for(&e->mem, e->sc, render_mesh(e->rd), fine, atlas_budget(e));
     if (f == 0.0) {
-        char why[120]; /* the coarsest tried: 64 m, or the spacing asked when coarser */
+        char why[120]; /* the coarsest tried: ATLAS_COARSEST, or the spacing asked when coarser */
         strbuf b;
         sb_init(&b, why, sizeof why);
         sb_str(&b, "laying out the radiance atlas (even ");
-        sb_num(&b, fine > 64.0 ? fine : 64.0, 6);
+        sb_num(&b, fine > ATLAS_COARSEST ? fine : ATLAS_COARSEST, 6);
         sb_str(&b, " m between its points does not fit)");
         return eng_nomem(e, why);
     }

@@ -532,7 +532,7 @@ double atlas_spacing_for(arena *a, const scene *s, const mesh *m, double fine, s
         while (f0 * pow(step, k + 1) <= c && k < 64)
             k++;
     }
-    for (n = 0; n < 64 && f0 * pow(step, k) <= fmax(64.0, f0); n++) {
+    for (n = 0; n < 64 && f0 * pow(step, k) <= fmax(ATLAS_COARSEST, f0); n++) {
         if (atlas_plan(a, s, m, f0 * pow(step, k), NULL) <= max_bytes) {
             while (k > 0 && atlas_plan(a, s, m, f0 * pow(step, k - 1), NULL) <= max_bytes)
                 k--;

@@ -70,6 +70,7 @@
 #define ATLAS_COARSE 4        /* coarse spacing: this many fine steps (a coarse tile is one block) */
 #define ATLAS_NOVERT 0xffffffffu /* a block with no vertices */
 #define ATLAS_FINE_DEFAULT PLX_ATLAS_SPACING_DEFAULT /* m, the spacing asked for when none is */
+#define ATLAS_COARSEST 64.0  /* m: atlas_spacing_for grows the spacing no further (unless asked for more) */
 
 enum { ATLAS_NONE = 0, ATLAS_WALL, ATLAS_ROOF, ATLAS_UNDER, ATLAS_GROUND };
 
@@ -131,7 +132,7 @@ size_t atlas_plan(arena *a, const scene *s, const mesh *m, double fine, uint64_t
 
 /* The fine spacing to use: 'fine' (ATLAS_FINE_DEFAULT when <= 0) grown by
  * steps of 2^(1/4) until atlas_plan fits max_bytes (the finest such step);
- * 0 when even 64 m (or 'fine', if coarser) does not. */
+ * 0 when even ATLAS_COARSEST (or 'fine', if coarser) does not. */
 double atlas_spacing_for(arena *a, const scene *s, const mesh *m, double fine, size_t max_bytes);
 
 /* Lays out the charts at fine spacing 'fine' and takes their memory (the
