@@ -2,6 +2,7 @@
 #include <math.h>
 #include <stdio.h>
 #include <string.h>
+#include <sys/stat.h>
 
 #include "options.h"
 
@@ -66,10 +67,81 @@ static int take_opt(const char *cmd, int argc, char **argv, int *i, const cli_op
     return EXIT_OK;
 }
 
+/* ---- outputs that would replace an input -------------------------------- */
+
+/* Whether option name n names an output file (the others that keep a
+ * string name input files, or points). */
+static int output_opt(const char *n)
+{
+    return strcmp(n, "-o") == 0 || strcmp(n, "--pfm") == 0 || strcmp(n, "--geojson") == 0 || strcmp(n, "--csv") == 0;
+}
+
+/* Whether paths a and b are one existing regular file (the same device
+ * and inode: also through a link or another spelling of the path). */
+static int same_file(const char *a, const char *b)
+{
+    struct stat sa, sb;
+    return stat(a, &sa) == 0 && stat(b, &sb) == 0 && S_ISREG(sa.st_mode) && S_ISREG(sb.st_mode) &&
+           sa.st_dev == sb.st_dev && sa.st_ino == sb.st_ino;
+}
+
+#define CLI_MAX_FILES 32
+
+/* The file names of a command line: its outputs and its inputs, each
+ * with the option (or word) that gave it. */
+typedef struct cli_files {
+    const char *on[CLI_MAX_FILES], *ov[CLI_MAX_FILES], *in[CLI_MAX_FILES], *iv[CLI_MAX_FILES];
+    int no, ni;
+} cli_files;
+
+/* A string option's value (o: its table entry, as typed: name) kept
+ * among the outputs or the inputs ("-": standard output or input, no
+ * file). */
+static void file_opt(cli_files *f, const char *name, const char *v)
+{
+    if (strcmp(v, "-") == 0)
+        return;
+    if (output_opt(name) && f->no < CLI_MAX_FILES) {
+        f->on[f->no] = name;
+        f->ov[f->no++] = v;
+    } else if (!output_opt(name) && f->ni < CLI_MAX_FILES) {
+        f->in[f->ni] = name;
+        f->iv[f->ni++] = v;
+    }
+}
+
+/* Refuses (usage error) an output file that is one of the command's
+ * inputs (its positional arguments but for gen's, the string options
+ * that are not outputs, the --lamps files): writing it would replace the
+ * input; and two outputs that name one file (the second would replace
+ * the first). A name not there yet can be no input. */
+static int outputs_clash(const char *cmd, cli_files *f, const cli_common *c, const cli_args *a)
+{
+    int i, k;
+    if (strcmp(cmd, "gen") != 0) /* gen's positionals are a kind and numbers, not files */
+        for (i = 0; i < a->npos; i++)
+            file_opt(f, "the input", a->pos[i]);
+    for (i = 0; c && i < c->nlamp_files; i++)
+        file_opt(f, "--lamps", c->lamp_files[i]);
+    for (k = 0; k < f->no; k++) {
+        for (i = 0; i < f->ni; i++)
+            if (same_file(f->ov[k], f->iv[i]))
+                return cli_usage_error(cmd, "%s '%s' is %s '%s': writing it would replace it; choose another name",
+                                       f->on[k], f->ov[k], f->in[i], f->iv[i]);
+        for (i = 0; i < k; i++)
+            if (strcmp(f->ov[k], f->ov[i]) == 0 || same_file(f->ov[k], f->ov[i]))
+                return cli_usage_error(cmd, "%s '%s' and %s '%s' name the same file; give each its own", f->on[i],
+                                       f->ov[i], f->on[k], f->ov[k]);
+    }
+    return EXIT_OK;
+}
+
 int cli_options_n(const char *cmd, const char *help, int argc, char **argv, const cli_opt *opts,
                   cli_common *c, cli_indirect *ind, int maxpos, const char *toomany, cli_args *out)
 {
     int i;
+    cli_files files;
+    files.no = files.ni = 0;
     memset(out, 0, sizeof *out);
     if (maxpos > CLI_MAX_POS)
         maxpos = CLI_MAX_POS;
@@ -94,6 +166,8 @@ int cli_options_n(const char *cmd, const char *help, int argc, char **argv, cons
         if (o) {
             if (take_opt(cmd, argc, argv, &i, o) != EXIT_OK)
                 return EXIT_USAGE;
+            if (!o->flag && !o->parse)
+                file_opt(&files, o->name, argv[i]);
         } else if (a[0] == '-' && a[1] != '\0') {
             return cli_usage_error(cmd, "unknown option '%s'", a);
         } else if (out->npos < maxpos) {
@@ -103,7 +177,7 @@ int cli_options_n(const char *cmd, const char *help, int argc, char **argv, cons
                                    out->npos ? out->pos[out->npos - 1] : "");
         }
     }
-    return EXIT_OK;
+    return outputs_clash(cmd, &files, c, out);
 }
 
 int cli_options(const char *cmd, const char *help, int argc, char **argv, const cli_opt *opts,

@@ -99,6 +99,14 @@ expect dark-spots 0 "\"rank\":1" -- "$bin" dark-spots -q fixtures/tiny.geojson -
 expect render-street 0 "^street view 160x120 from \(30\.0, 30\.0, 1\.7\) to \(50\.0, 10\.0, 2\.0\): drew [0-9]+ of 4 buildings" -- "$bin" render -q --frames 4 fixtures/tiny.geojson --eye 30,30,1.7 --target 50,10,2 --size 160x120 -o "$tmp/s.png" --pfm "$tmp/s.pfm"
 if [ "$(head -c 12 "$tmp/s.pfm" | tr '\n' ' ')" = "PF 160 120 -" ]; then echo "ok   render-pfm-header"; pass=$((pass + 1)); else echo "FAIL render-pfm-header"; fail=$((fail + 1)); fi
 if [ "$(wc -c < "$tmp/s.pfm")" -gt $((160 * 120 * 12)) ]; then echo "ok   render-pfm-size"; pass=$((pass + 1)); else echo "FAIL render-pfm-size"; fail=$((fail + 1)); fi
+# an output that names an input (or the other output) is refused before any
+# work, and the input is left as it was
+cp fixtures/tiny.geojson "$tmp/in.geojson"; ln -s in.geojson "$tmp/in-link.png"
+expect bake-out-is-scene 2 "-o '$tmp/in.geojson' is the input '$tmp/in.geojson': writing it would replace it" -- "$bin" bake "$tmp/in.geojson" -o "$tmp/in.geojson"
+expect render-out-is-scene-link 2 "-o '$tmp/in-link.png' is the input" -- "$bin" render -q "$tmp/in.geojson" -o "$tmp/in-link.png"
+expect route-geojson-is-path 2 "writing it would replace it" -- "$bin" route -q fixtures/tiny.geojson --path "$tmp/in.geojson" --geojson "$tmp/in.geojson"
+if cmp -s fixtures/tiny.geojson "$tmp/in.geojson"; then echo "ok   out-is-input-kept"; pass=$((pass + 1)); else echo "FAIL out-is-input-kept"; fail=$((fail + 1)); fi
+expect render-png-is-pfm 2 "-o '$tmp/same' and --pfm '$tmp/same' name the same file" -- "$bin" render -q fixtures/tiny.geojson -o "$tmp/same" --pfm "$tmp/same"
 expect render-aerial 0 "^aerial view 120x80 " -- "$bin" render -q --frames 4 fixtures/tiny.geojson --view aerial --size 120x80 -o "$tmp/a.png"
 # the default aerial view keeps 5% of the frame each side around the
 # scene's box (612 m: half of it over 0.9, over tan 30 degrees; 530.0 m up
