@@ -59,14 +59,16 @@ static int first_not_lonlat(const cJSON *coords)
 }
 
 /* Reads n positions [x, y(, z)] into out (3 per position); eyes must be
- * above the ground, targets may lie on it (an aerial camera looking down). */
+ * above the ground, targets may lie on it (an aerial camera looking down).
+ * The positions in their list's order (cJSON_GetArrayItem walks the list
+ * from its start: a path of 160,000 positions took 48 s). */
 static int read_positions(const cJSON *coords, int project, const plx_scene_info *si, double *out, int n,
                           int eyes, char *why, size_t whylen)
 {
     double coslat = cos(si->lat0 * 3.14159265358979323846 / 180.0);
-    int k;
-    for (k = 0; k < n; k++) {
-        const cJSON *pos = cJSON_GetArrayItem(coords, k);
+    const cJSON *pos;
+    int k = 0;
+    cJSON_ArrayForEach(pos, coords) {
         const cJSON *x = cJSON_GetArrayItem(pos, 0), *y = cJSON_GetArrayItem(pos, 1), *z = cJSON_GetArrayItem(pos, 2);
         if (!cJSON_IsNumber(x) || !cJSON_IsNumber(y) || (z && !cJSON_IsNumber(z)) || !isfinite(x->valuedouble) ||
             !isfinite(y->valuedouble) || (z && !isfinite(z->valuedouble))) {
@@ -90,6 +92,8 @@ static int read_positions(const cJSON *coords, int project, const plx_scene_info
             snprintf(why, whylen, "position %d: the eye must be above the ground (z > 0)", k);
             return -1;
         }
+        if (++k == n)
+            break;
     }
     return 0;
 }
