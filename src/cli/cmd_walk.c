@@ -658,6 +658,21 @@ static void stale_hint(const walk_args *a, long n)
              "to %ld and leaves them", a->dir, path + strlen(a->dir) + 1, n);
 }
 
+/* A word at the first frame with the eye inside a building, as it comes
+ * (the walk's end counts them all): such frames are computed pixel by
+ * pixel, seconds each on a large city, and a walk of hundreds of them
+ * ran for minutes without a word. Below the progress line, if shown. */
+static void inside_now(const walk_args *a, plx_engine *e, const walk_run *wr, cli_progress *pr)
+{
+    char at[96];
+    if (a->c.quiet)
+        return;
+    cli_progress_end(pr);
+    cli_warn("walk", &a->c, "frame %ld at %s: the eye is inside a building: such frames show the inside of its "
+             "walls, every pixel computed (%.0f ms this one); move the path out of the footprints or raise it above "
+             "the roofs", wr->first_inside, eye_text(e, wr->inside_eye, at, sizeof at), wr->ms[wr->first_inside - 1]);
+}
+
 /* The walk's frames; *done: how many were written. */
 static int run(const walk_args *a, plx_engine *e, const walk_path *wp, long *done)
 {
@@ -707,7 +722,10 @@ static int run(const walk_args *a, plx_engine *e, const walk_path *wp, long *don
     }
     cli_progress_start(&pr); /* a line on a terminal, after a second */
     for (k = 0; rc == EXIT_OK && k < wr.n; k++) {
+        long inside = wr.inside;
         rc = frame(a, e, wp, &wr, k, frame_at(k, step, L));
+        if (wr.inside == 1 && inside == 0)
+            inside_now(a, e, &wr, &pr);
         cli_progress_step(&pr, "walk", (size_t)k + 1, (size_t)wr.n);
     }
     *done = rc == EXIT_OK ? k : k - 1;
@@ -757,8 +775,10 @@ static int run(const walk_args *a, plx_engine *e, const walk_path *wp, long *don
                      "longer than a frame lasts at %g fps (%.1f ms): shown as they are made, they fall behind on "
                      "this machine; %s%s",
                      med, (sum - wr.ms[0]) / (wr.n - 1), a->fps, 1000.0 / a->fps,
-                     a->opts.aa > 1 ? "--aa 1 (one sample a pixel), a smaller --size or a lower --fps keep up"
-                                    : "a smaller --size or a lower --fps keep up",
+                     2 * wr.inside >= wr.n ? "most of them have the eye inside a building (below), computed pixel "
+                                             "by pixel"
+                     : a->opts.aa > 1      ? "--aa 1 (one sample a pixel), a smaller --size or a lower --fps keep up"
+                                           : "a smaller --size or a lower --fps keep up",
                      a->c.mem_given ? "; a larger --mem may too (near the smallest block, the lamps' lit "
                                       "regions and the radiance atlas find no room)"
                                     : "");

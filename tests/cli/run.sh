@@ -596,6 +596,12 @@ printf '{"type":"LineString","coordinates":[[5,5,1.7],[5,6,1.7]]}' >"$tmp/inside
 expect walk-eye-inside 0 "^polarlux walk: warning: 2 of 2 frames have the eye inside a building \(the first: frame 1 at \(5\.00, 5\.00, 1\.70\)\)" -- \
     "$bin" walk fixtures/tiny.geojson --path "$tmp/inside.geojson" --size 32x24 --fps 1 --speed 1 --no-indirect -o "$tmp/wi"
 if ! grep -q "entirely black" "$tmp/out"; then echo "ok   walk-eye-inside-not-dark"; pass=$((pass + 1)); else echo "FAIL walk-eye-inside-not-dark"; fail=$((fail + 1)); fi
+# ... said at the first such frame too, before the frames after it (a
+# walk of hundreds of them ran for minutes first): the line comes before
+# the summary's
+if grep -q "^polarlux walk: warning: frame 1 at (5.00, 5.00, 1.70): the eye is inside a building" "$tmp/out" &&
+   [ "$(grep -n 'frame 1 at (5.00, 5.00, 1.70): the eye is inside' "$tmp/out" | cut -d: -f1)" -lt "$(grep -n '2 of 2 frames have the eye inside' "$tmp/out" | cut -d: -f1)" ]; then
+    echo "ok   walk-eye-inside-at-once"; pass=$((pass + 1)); else echo "FAIL walk-eye-inside-at-once"; sed 's/^/    /' "$tmp/out" | head; fail=$((fail + 1)); fi
 # --max-frames cutting the path short is said, and the summary gives the
 # metres walked (it gave the path's length: 1000 frames "165.2 m" walked 56 m)
 printf '{"type":"LineString","coordinates":[[0,0,1.7],[0,10,1.7]]}' >"$tmp/ten.geojson"
