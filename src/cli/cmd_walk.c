@@ -52,7 +52,9 @@ static const char help[] =
     "                   in cameras.txt, for render --tone-curve\n"
     "  --no-adapt       each frame's automatic exposure from its own image alone\n"
     "  --no-glow, --no-indirect, --per-pixel, --view V, --texel M, --photons N,\n"
-    "  --frames K       as for render\n"
+    "  --frames K       as for render; the camera comes from the path, so --view\n"
+    "                   aerial changes only the ground of frames shaded pixel by\n"
+    "                   pixel (--per-pixel, --no-indirect), not those of the atlas\n"
     "  --max-frames N   at most N frames (default 1000)\n"
     "  --refine         near-viewer refinement (munoz2013 §3.3-3.4): before each frame\n"
     "                   the lamps near the ground point the view looks at (at most\n"
@@ -334,6 +336,7 @@ typedef struct walk_run {
     plx_render_opts black_opts;
     double black_exposure;
     long inside, first_inside; /* frames with the eye inside a building: how many, the first */
+    long from_atlas;           /* frames read from the radiance atlas (no pixel shaded) */
     double inside_eye[3];      /* the first one's eye */
     double bounds[4];          /* the scene's (plx_scene_info), taken once */
     int lonlat;                /* a lon/lat scene: cameras.txt in degrees */
@@ -550,6 +553,7 @@ static int frame(const walk_args *a, plx_engine *e, const walk_path *wp, walk_ru
         wr->black_opts = o; /* the frame's own: held (_ADAPT) after the first */
         wr->black_exposure = info.exposure;
     }
+    wr->from_atlas += info.shaded_pixels == 0 && !info.eye_inside;
     if (info.eye_inside && wr->inside++ == 0) {
         wr->first_inside = k + 1;
         memcpy(wr->inside_eye, cam.eye, sizeof wr->inside_eye);
@@ -789,6 +793,10 @@ static int run(const walk_args *a, plx_engine *e, const walk_path *wp, long *don
                      "move the path out of the footprints or raise it above the roofs", wr.inside, wr.n,
                      wr.first_inside, eye_text(e, wr.inside_eye, at, sizeof at));
         }
+        if (a->aerial && wr.from_atlas == wr.n)
+            cli_warn("walk", &a->c, "--view aerial changed nothing: the camera comes from the path, and every frame "
+                     "was read from the radiance atlas, the same for any view (--view aerial picks the aerial light "
+                     "map for the ground of frames shaded pixel by pixel: --per-pixel, --no-indirect)");
         if (wr.black == wr.n && wr.near_scene > WALK_FAR_OUTSIDE && cli_has_lamps(e))
             cli_warn("walk", &a->c, "every frame is entirely black: the camera path stays outside the scene, its "
                      "eyes and targets %.0f m or more from the scene's bounds (its buildings' box and 50 m); is the "

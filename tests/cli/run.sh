@@ -590,6 +590,10 @@ expect walk-high-street-hint 0 "^polarlux walk: warning: the eye stays 200 m or 
 # views: no word (it said "faster" there too, where it was not)
 "$bin" walk "$tmp/e.plxb" --path "$tmp/high.geojson" --size 32x24 --fps 0.5 --aa 1 -o "$tmp/wh2" >"$tmp/out" 2>&1
 if [ $? -eq 0 ] && ! grep -q -- "--view aerial" "$tmp/out"; then echo "ok   walk-high-atlas-no-hint"; pass=$((pass + 1)); else echo "FAIL walk-high-atlas-no-hint"; sed 's/^/    /' "$tmp/out" | head; fail=$((fail + 1)); fi
+# --view aerial on a walk whose frames all read the radiance atlas changes
+# no byte: said (it was taken silently)
+expect walk-view-aerial-atlas 0 "--view aerial changed nothing: the camera comes from the path" -- \
+    "$bin" walk "$tmp/e.plxb" --path "$tmp/high.geojson" --size 32x24 --fps 0.5 --aa 1 --view aerial -o "$tmp/wh3"
 # an eye inside a building: its frames show the inside of its walls, 3.7 s
 # each on gen eixample 30 30 (every pixel computed), and walk said nothing
 printf '{"type":"LineString","coordinates":[[5,5,1.7],[5,6,1.7]]}' >"$tmp/inside.geojson"
