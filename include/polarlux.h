@@ -780,6 +780,12 @@ typedef struct plx_atlas_info {
 /* Fills out. Errors: PLX_E_INVALID (out NULL). Threads: engine (reads). */
 plx_status plx_atlas_info_get(plx_engine *e, plx_atlas_info *out /* OUT */);
 
+/* The largest frame plx_render draws: plx_config.render_max_width and
+ * _height, or their defaults (1920 x 1080), or a bake's (its --max-size);
+ * frames of either orientation fit. Errors: PLX_E_INVALID (e, w or h
+ * NULL). Threads: engine (reads). */
+plx_status plx_render_max_get(plx_engine *e, int32_t *w /* OUT */, int32_t *h /* OUT */);
+
 /* Exposure 1, everything else off (NULL: nothing). Threads: any. */
 void plx_render_opts_default(plx_render_opts *o /* OUT */);
 

@@ -349,6 +349,14 @@ plx_status eng_need_atlas(plx_engine *e, double fine)
     return PLX_OK;
 }
 
+plx_status plx_render_max_get(plx_engine *e, int32_t *w, int32_t *h)
+{
+    if (!eng_ok(e) || !w || !h)
+        return PLX_E_INVALID;
+    eng_render_max(e, w, h);
+    return PLX_OK;
+}
+
 plx_status plx_atlas_info_get(plx_engine *e, plx_atlas_info *out)
 {
     const atlas *A;

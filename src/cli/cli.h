@@ -220,6 +220,9 @@ int cli_option_local(const char *cmd, const char *opt, plx_engine *e, double *x,
 struct points;
 int cli_points_local(const char *cmd, plx_engine *e, const cli_common *c, const char *path, struct points *p,
                      double **orig);
+/* render's default aerial view into cam (its size and fov kept): straight
+ * down over the scene's box, with a margin of 5% of the frame each side. */
+void cli_default_aerial(plx_engine *e, plx_camera *cam);
 /* Progress of long work on a terminal: a line "WHAT: N% (T s)" on stderr,
  * only when stderr is a terminal and the work has run over a second. */
 typedef struct cli_progress {

@@ -37,7 +37,9 @@ static const char help[] =
     "               smallest block its image loads in (polar diagrams built\n"
     "               there if it has none, and then also the smallest for frames\n"
     "               without them), beside the block it takes without --mem\n"
-    "               (room for queries)\n"
+    "               (room for queries), and the smallest that draws the whole\n"
+    "               scene from above at its largest frame with walk's default\n"
+    "               2 x 2 adaptive samples (a frame drawn at each step)\n"
     "  --photons    also create the photon buffers (no photons traced) and print\n"
     "               the sizes chosen at this --mem: bytes, the default quality's\n"
     "               bytes, the budget, the quality steps taken to fit it, chart\n"
@@ -94,12 +96,37 @@ static void print_min_mem(const char *path, const cli_common *c, size_t hi)
            "(bisection, %d loads; a ground image needs its pixels on top)\n", hi, hi / 1048576.0, loads);
 }
 
-/* 1 when the block 'mem', given as 'bytes' long, loads the bake, and with
- * 'polar' has its polar diagrams (built for a --no-polar bake, as info
- * does; a --no-polar bake's walk does not need them: 'polar' 0). The
- * block is aligned as the command's (cli_big_alloc), which the bake's
- * offset in it depends on. */
-static int bake_fits(void *mem, size_t bytes, const void *data, size_t len, int polar)
+/* What a bisection over bake loads asks of each block: the load alone,
+ * the polar diagrams too (built for a --no-polar bake, as info does), or
+ * a frame as walk draws it by default. */
+enum { BAKE_LOADS = 0, BAKE_POLAR, BAKE_FRAME };
+
+/* One frame as walk draws them by default (2 x 2 samples, adaptive, its
+ * buffers in the block; automatic exposure; fov 60) at the engine's largest size, the whole
+ * scene from above (render --view aerial's camera: every chart or the
+ * most of them read), into rgb8 (3 bytes a pixel of that size). */
+static int frame_fits(plx_engine *e, uint8_t *rgb8)
+{
+    plx_camera cam;
+    plx_render_opts o;
+    plx_render_info ri;
+    memset(&cam, 0, sizeof cam);
+    if (!rgb8 || plx_render_max_get(e, &cam.width, &cam.height) != PLX_OK)
+        return 0;
+    cam.fov_deg = 60.0;
+    cli_default_aerial(e, &cam);
+    plx_render_opts_default(&o);
+    o.auto_exposure = PLX_EXPOSURE_AUTO;
+    o.aa = 2;
+    /* with room for the adaptive buffers (without, every sample is
+     * taken: PLX_AA_EVERY, slower) */
+    return plx_render(e, &cam, &o, rgb8, NULL, &ri) == PLX_OK && ri.aa_adaptive != PLX_AA_EVERY;
+}
+
+/* 1 when the block 'mem', given as 'bytes' long, loads the bake and does
+ * 'what' (BAKE_*; a frame into rgb8). The block is aligned as the
+ * command's (cli_big_alloc), which the bake's offset in it depends on. */
+static int bake_fits(void *mem, size_t bytes, const void *data, size_t len, int what, uint8_t *rgb8)
 {
     static plx_port port;
     plx_config cfg;
@@ -109,25 +136,52 @@ static int bake_fits(void *mem, size_t bytes, const void *data, size_t len, int 
     silent_config(&cfg, &port);
     if (plx_bake_load(mem, bytes, &cfg, data, len, &e, NULL, 0) != PLX_OK)
         return 0;
-    if (polar)
+    if (what == BAKE_POLAR)
         ok = plx_polar_info_get(e, &pi) == PLX_OK;
+    else if (what == BAKE_FRAME)
+        ok = frame_fits(e, rgb8);
     plx_engine_destroy(e);
     return ok;
 }
 
-/* The smallest block from lo to hi, to 4 KiB, that bake_fits (its polar
- * diagrams too with 'polar'), by bisection; loads counted. */
-static size_t bisect_bake(void *mem, size_t lo, size_t hi, const void *data, size_t len, int polar, int *loads)
+/* The smallest block from lo to hi, to 4 KiB, that bake_fits 'what', by
+ * bisection; loads counted. */
+static size_t bisect_bake(void *mem, size_t lo, size_t hi, const void *data, size_t len, int what, uint8_t *rgb8,
+                          int *loads)
 {
     while (hi - lo > 4096) {
         size_t mid = lo + (hi - lo) / 2;
         ++*loads;
-        if (bake_fits(mem, mid, data, len, polar))
+        if (bake_fits(mem, mid, data, len, what, rgb8))
             hi = mid;
         else
             lo = mid;
     }
     return hi;
+}
+
+/* The smallest block for walk's frames (frame_fits) from lo (the load's
+ * smallest) up to hi, and the frame's size (*w, *h, the bake's largest);
+ * 0 when hi holds none. */
+static size_t frames_min(void *mem, size_t lo, size_t hi, const void *data, size_t len, int *loads, int32_t *w,
+                         int32_t *h)
+{
+    static plx_port port;
+    plx_config cfg;
+    plx_engine *e;
+    uint8_t *rgb8 = NULL;
+    size_t f = 0;
+    silent_config(&cfg, &port);
+    if (plx_bake_load(mem, hi, &cfg, data, len, &e, NULL, 0) != PLX_OK)
+        return 0;
+    if (plx_render_max_get(e, w, h) == PLX_OK)
+        rgb8 = malloc((size_t)*w * (size_t)*h * 3);
+    plx_engine_destroy(e);
+    ++*loads;
+    if (rgb8 && bake_fits(mem, hi, data, len, BAKE_FRAME, rgb8))
+        f = bisect_bake(mem, lo, hi, data, len, BAKE_FRAME, rgb8, loads);
+    free(rgb8);
+    return f;
 }
 
 /* For a bake, the smallest --mem is the block its image loads in (the
@@ -142,7 +196,8 @@ static int print_min_mem_bake(const char *path, size_t hi, int has_polar)
     char *data = port_read_text(path, &len, err, sizeof err);
     void *mem = NULL;
     int loads = 0, rc = EXIT_FAIL, polar = has_polar;
-    size_t alone = 0;
+    int32_t fw = 0, fh = 0;
+    size_t alone = 0, top, frames;
     if (data && plx_bake_block_size(data, len, &own, err, sizeof err) == PLX_OK) {
         if (!hi)
             hi = own;
@@ -156,9 +211,11 @@ static int print_min_mem_bake(const char *path, size_t hi, int has_polar)
         free(data);
         return rc;
     }
-    hi = bisect_bake(mem, lo, hi, data, len, 1, &loads);
+    top = hi;
+    hi = bisect_bake(mem, lo, hi, data, len, BAKE_POLAR, NULL, &loads);
     if (!polar)
-        alone = bisect_bake(mem, lo, hi, data, len, 0, &loads);
+        alone = bisect_bake(mem, lo, hi, data, len, BAKE_LOADS, NULL, &loads);
+    frames = frames_min(mem, polar ? hi : alone, top, data, len, &loads, &fw, &fh);
     free(mem);
     free(data);
     printf("smallest --mem: %zu bytes (%.2f MiB) loads the bake and has its polar diagrams%s (bisection, %d loads; "
@@ -169,6 +226,15 @@ static int print_min_mem_bake(const char *path, size_t hi, int has_polar)
                "(walk and render with --eye, --aa 1; anti-aliasing adds 20 bytes a pixel; at the smallest, frames "
                "can be several times slower: the lamps' lit regions, the irradiance cache and the radiance atlas "
                "take what is free beyond it)\n", alone, alone / 1048576.0);
+    if (frames)
+        printf("smallest --mem for frames from above: %zu bytes (%.2f MiB) loads the bake and draws the whole "
+               "scene from above in a %dx%d frame (its largest) with walk's default 2 x 2 samples, adaptive "
+               "(bisection, as above; street views and --aa 1 may need less; walk's own frame buffers, 3 bytes a "
+               "pixel of its --size, and its contact sheet take what --mem leaves beside)\n",
+               frames, frames / 1048576.0, fw, fh);
+    else
+        printf("smallest --mem for frames from above: not found: a %dx%d frame of the whole scene with 2 x 2 "
+               "samples does not fit in %zu bytes\n", fw, fh, top);
     return EXIT_OK;
 }
 
@@ -284,6 +350,11 @@ int cmd_info(int argc, char **argv)
     if (cli_bake_last.loaded)
         printf("bake: %zu bytes (%.1f MiB) loaded in %.2f ms (read, check, copy, relocate)\n", cli_bake_last.bytes,
                cli_bake_last.bytes / 1048576.0, cli_bake_last.load_ns / 1e6);
+    if (cli_bake_last.loaded) {
+        int32_t w = 0, h = 0;
+        plx_render_max_get(e, &w, &h);
+        printf("largest frame: %dx%d (either way round; bake --max-size), render and walk draw up to it\n", w, h);
+    }
     cli_atlas_print(e);
     if (plx_polar_info_get(e, &pi) == PLX_OK) {
         polar_baked = pi.build_ns == 0 && cli_bake_last.loaded;
@@ -301,7 +372,8 @@ int cmd_info(int argc, char **argv)
         fprintf(stderr, "polarlux info: %s: polar diagrams not built: %s\n", path, plx_last_error(e));
         rc = plx_last_error(e)[0] && strstr(plx_last_error(e), "out of memory") ? EXIT_NOMEM : EXIT_FAIL;
     }
-    if (photons && rc == EXIT_OK && si.lamps > 0)
+    /* a bake's photon buffers are its own (no budget to try): said always */
+    if ((photons || (cli_bake_last.loaded && plx_indirect_frames(e) > 0)) && rc == EXIT_OK && si.lamps > 0)
         rc = print_photons(e, path, &si);
     print_memory(e);
     plx_engine_free(e);

@@ -263,26 +263,6 @@ static int default_street(plx_engine *e, plx_camera *cam)
     return best < INFINITY ? 0 : -1;
 }
 
-/* The default aerial view: straight down over the scene's box (its
- * buildings plus 50 m), the box's limiting side 1 / AERIAL_MARGIN of the
- * frame's (a margin of 5% of the frame each side: with none, glow discs
- * and lit ground at the box's edge touched the frame's). */
-#define AERIAL_MARGIN (1.0 / 0.9)
-
-static void default_aerial(plx_engine *e, plx_camera *cam)
-{
-    plx_scene_info si;
-    double w, h, half;
-    plx_scene_info_get(e, &si);
-    w = si.bounds[2] - si.bounds[0];
-    h = si.bounds[3] - si.bounds[1];
-    half = 0.5 * fmax(h, w * cam->height / cam->width) * AERIAL_MARGIN;
-    cam->target[0] = cam->eye[0] = 0.5 * (si.bounds[0] + si.bounds[2]);
-    cam->target[1] = cam->eye[1] = 0.5 * (si.bounds[1] + si.bounds[3]);
-    cam->target[2] = 0.0;
-    cam->eye[2] = half / tan(cam->fov_deg * 0.008726646259971648);
-}
-
 /* The PNG and the PFM belong together: both are written, then both are
  * renamed into place (safe_out_commit), or neither. */
 static int write_outputs(const render_args *a, const uint8_t *rgb8, const float *rgbf)
@@ -372,7 +352,7 @@ int cmd_render(int argc, char **argv)
         warn_eye_inside(e, a.cam.eye, a.c.quiet);
     if (!a.have_eye) {
         if (a.aerial) {
-            default_aerial(e, &a.cam);
+            cli_default_aerial(e, &a.cam);
         } else if ((rc = default_street(e, &a.cam)) == -2) {
             fprintf(stderr, "polarlux render: %s: the default street view needs the polar diagrams to find a "
                             "street%s; give --eye and --target, --view aerial, or a larger --mem\n",

@@ -967,6 +967,26 @@ int cli_points_local(const char *cmd, plx_engine *e, const cli_common *c, const 
     return EXIT_OK;
 }
 
+/* The default aerial view: straight down over the scene's box (its
+ * buildings plus 50 m), the box's limiting side 1 / AERIAL_MARGIN of the
+ * frame's (a margin of 5% of the frame each side: with none, glow discs
+ * and lit ground at the box's edge touched the frame's). */
+#define AERIAL_MARGIN (1.0 / 0.9)
+
+void cli_default_aerial(plx_engine *e, plx_camera *cam)
+{
+    plx_scene_info si;
+    double w, h, half;
+    plx_scene_info_get(e, &si);
+    w = si.bounds[2] - si.bounds[0];
+    h = si.bounds[3] - si.bounds[1];
+    half = 0.5 * fmax(h, w * cam->height / cam->width) * AERIAL_MARGIN;
+    cam->target[0] = cam->eye[0] = 0.5 * (si.bounds[0] + si.bounds[2]);
+    cam->target[1] = cam->eye[1] = 0.5 * (si.bounds[1] + si.bounds[3]);
+    cam->target[2] = 0.0;
+    cam->eye[2] = half / tan(cam->fov_deg * 0.008726646259971648);
+}
+
 /* ---- progress and the command's buffers ------------------------------------ */
 
 void cli_progress_start(cli_progress *p)

@@ -340,6 +340,16 @@ expect bake-min-mem-frames 0 "^walk: 2 frames" -- \
     "$bin" walk -q "$tmp/np.plxb" --mem "${nf:-1}" --aa 1 --path "$tmp/endpath.geojson" --size 160x120 --max-frames 2 -o "$tmp/nfw"
 expect bake-min-mem-frames-less 3 "the block is too small for the bake" -- \
     "$bin" walk -q "$tmp/np.plxb" --mem $((${nf:-1} - 4096)) --aa 1 --path "$tmp/endpath.geojson" --size 160x120 --max-frames 2 -o "$tmp/nfw"
+# info --min-mem's block for frames from above: the whole scene from above
+# at the bake's largest size with 2 x 2 adaptive samples (walk's default)
+# fits in it; 4 KiB less leaves no room for the adaptive buffers (the
+# bisection's test), said by the warning (the full bake's line was only
+# the load's, and walk failed there)
+na=$("$bin" info -q --min-mem "$tmp/e.plxb" | sed -n 's/^smallest --mem for frames from above: \([0-9]*\) bytes .* a 160x120 frame .*/\1/p')
+"$bin" render "$tmp/e.plxb" --view aerial --size 160x120 --aa 2 --mem "${na:-1}" -o "$tmp/na.png" >"$tmp/out" 2>&1
+if [ $? -eq 0 ] && ! grep -q "no room for adaptive" "$tmp/out"; then echo "ok   bake-min-mem-from-above"; pass=$((pass + 1)); else echo "FAIL bake-min-mem-from-above ('$na')"; sed 's/^/    /' "$tmp/out" | head -5; fail=$((fail + 1)); fi
+expect bake-min-mem-from-above-less 0 "leaves no room for adaptive anti-aliasing" -- \
+    "$bin" render "$tmp/e.plxb" --view aerial --size 160x120 --aa 2 --mem $((${na:-1} - 4096)) -o "$tmp/na.png"
 # a metre scene far from the origin (a projected CRS) gives the images of
 # the same scene at the origin, exact and atlas (135 and 29 lit pixels went
 # dark before 2026-11-30: wall points rounded into their buildings)

@@ -251,8 +251,15 @@ static void test_round_trip(void **state)
     void *mc, *md;
     plx_engine *c, *d;
     (void)state;
+    int32_t w = 0, h = 0;
     c = load(k.file, k.len, &mc);
     assert_int_equal(plx_indirect_frames(c), 3);
+    /* the largest frame is the bake's (its config's), not the default */
+    assert_int_equal(plx_render_max_get(c, &w, &h), PLX_OK);
+    assert_int_equal(w, 320);
+    assert_int_equal(h, 240);
+    assert_int_equal(plx_render_max_get(c, NULL, &h), PLX_E_INVALID);
+    assert_int_equal(plx_render_max_get(NULL, &w, &h), PLX_E_INVALID);
     same_vis(k.a, c);
     same_illum(k.a, c, 1);
     same_render(k.a, c, 0, 0);
