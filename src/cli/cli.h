@@ -189,6 +189,16 @@ const char *cli_black_reason(plx_engine *e, const plx_camera *cam, const plx_ren
                              unsigned char *rgb8, char *buf, size_t len);
 /* Whether an 8-bit image of n bytes is entirely black (every byte 0). */
 int cli_all_black(const uint8_t *px, size_t n);
+/* The share of an RGB image's npx pixels that are black (all three bytes
+ * 0). */
+double cli_black_share(const uint8_t *rgb, size_t npx);
+/* At or above this share of black pixels (and not all), render and walk
+ * call a frame nearly black: a normal night view from above is 70 to 90%
+ * black (its roofs), a street view 10 to 15%. */
+#define CLI_NEARLY_BLACK 0.99
+/* Why a nearly black frame is so, for its warning. */
+#define CLI_NEARLY_BLACK_WHY "little that is lit is in view (each lamp lights only within its radius, and " \
+                             "buildings cast shadows): move the camera toward the lamps, or aim it at them"
 
 /* After a frame: a warning when the anti-aliasing (o->aa > 1) was to be
  * adaptive but the block had no room for it (every sample taken), or when

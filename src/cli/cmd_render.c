@@ -440,6 +440,11 @@ int cmd_render(int argc, char **argv)
         char why[200]; /* rgb8 is written out: cli_black_reason may draw into it */
         cli_warn("render", &a.c, "the image is entirely black: %s",
                  cli_black_reason(e, &a.cam, &a.opts, info.exposure, rgb8, why, sizeof why));
+    } else if (rc == EXIT_OK) {
+        double share = cli_black_share(rgb8, (size_t)a.cam.width * a.cam.height);
+        if (share >= CLI_NEARLY_BLACK)
+            cli_warn("render", &a.c, "the image is nearly black: %.2f%% of its pixels are black: %s", 100.0 * share,
+                     CLI_NEARLY_BLACK_WHY);
     }
     prec = coord_digits(e);
     cli_from_local(e, &a.cam.eye[0], &a.cam.eye[1]);

@@ -337,6 +337,7 @@ typedef struct walk_run {
     double black_exposure;
     long inside, first_inside; /* frames with the eye inside a building: how many, the first */
     long from_atlas;           /* frames read from the radiance atlas (no pixel shaded) */
+    long nearly, first_nearly; /* frames nearly black (CLI_NEARLY_BLACK), not all: how many, the first */
     double inside_eye[3];      /* the first one's eye */
     double bounds[4];          /* the scene's (plx_scene_info), taken once */
     int lonlat;                /* a lon/lat scene: cameras.txt in degrees */
@@ -488,7 +489,7 @@ static int frame(const walk_args *a, plx_engine *e, const walk_path *wp, walk_ru
     plx_render_opts o;
     unsigned long long t0;
     plx_status st;
-    int had_atlas = 0;
+    int had_atlas = 0, black;
     char line[320];
     memset(&cam, 0, sizeof cam);
     walk_path_camera(wp, s, cam.eye, cam.target);
@@ -547,12 +548,16 @@ static int frame(const walk_args *a, plx_engine *e, const walk_path *wp, walk_ru
         return cli_exit_code(st);
     }
     /* black with the eye inside a building: its own warning says why */
-    if (!info.eye_inside && cli_all_black(wr->rgb8, (size_t)a->w * a->h * 3) && wr->black++ == 0) {
+    black = !info.eye_inside && cli_all_black(wr->rgb8, (size_t)a->w * a->h * 3);
+    if (black && wr->black++ == 0) {
         wr->first_black = k + 1;
         wr->black_cam = cam;
         wr->black_opts = o; /* the frame's own: held (_ADAPT) after the first */
         wr->black_exposure = info.exposure;
     }
+    if (!info.eye_inside && !black && cli_black_share(wr->rgb8, (size_t)a->w * a->h) >= CLI_NEARLY_BLACK &&
+        wr->nearly++ == 0)
+        wr->first_nearly = k + 1;
     wr->from_atlas += info.shaded_pixels == 0 && !info.eye_inside;
     if (info.eye_inside && wr->inside++ == 0) {
         wr->first_inside = k + 1;
@@ -808,6 +813,10 @@ static int run(const walk_args *a, plx_engine *e, const walk_path *wp, long *don
             cli_warn("walk", &a->c, "%ld of %ld frames are entirely black (the first: frame %ld): %s", wr.black,
                      wr.n, wr.first_black,
                      cli_black_reason(e, &wr.black_cam, &wr.black_opts, wr.black_exposure, wr.rgb8, why, sizeof why));
+        if (wr.nearly)
+            cli_warn("walk", &a->c, "%ld of %ld frames are nearly black, %.0f%% of their pixels or more (the first: "
+                     "frame %ld): %s", wr.nearly, wr.n, 100.0 * CLI_NEARLY_BLACK, wr.first_nearly,
+                     CLI_NEARLY_BLACK_WHY);
     }
     free(wr.sh.px);
     free(wr.ms);

@@ -346,6 +346,14 @@ int cli_all_black(const uint8_t *px, size_t n)
     return k == n;
 }
 
+double cli_black_share(const uint8_t *rgb, size_t npx)
+{
+    size_t k, black = 0;
+    for (k = 0; k < npx; k++)
+        black += (rgb[3 * k] | rgb[3 * k + 1] | rgb[3 * k + 2]) == 0;
+    return npx ? (double)black / (double)npx : 1.0;
+}
+
 int cli_has_lamps(plx_engine *e)
 {
     plx_scene_info si;

@@ -350,6 +350,16 @@ na=$("$bin" info -q --min-mem "$tmp/e.plxb" | sed -n 's/^smallest --mem for fram
 if [ $? -eq 0 ] && ! grep -q "no room for adaptive" "$tmp/out"; then echo "ok   bake-min-mem-from-above"; pass=$((pass + 1)); else echo "FAIL bake-min-mem-from-above ('$na')"; sed 's/^/    /' "$tmp/out" | head -5; fail=$((fail + 1)); fi
 expect bake-min-mem-from-above-less 0 "leaves no room for adaptive anti-aliasing" -- \
     "$bin" render "$tmp/e.plxb" --view aerial --size 160x120 --aa 2 --mem $((${na:-1} - 4096)) -o "$tmp/na.png"
+# a view with a few lit pixels (the city 3 km off) is nearly black: said
+# (only an entirely black one was), by render and by walk; a normal view
+# from above (about 70% black: its roofs) is not
+expect render-nearly-black 0 "warning: the image is nearly black: 99\.[0-9]+% of its pixels are black: little that is lit is in view" -- \
+    "$bin" render "$tmp/e.plxb" --eye -3000,266,60 --target 266,266,0 --size 160x120 -o "$tmp/nb.png"
+printf '{"type":"LineString","coordinates":[[-3000,266,60],[-2999,266,60]],"properties":{"targets":[[266,266,0],[266,266,0]]}}' >"$tmp/nb.geojson"
+expect walk-nearly-black 0 "warning: 2 of 2 frames are nearly black, 99% of their pixels or more \(the first: frame 1\)" -- \
+    "$bin" walk "$tmp/e.plxb" --path "$tmp/nb.geojson" --size 160x120 --fps 1 --speed 1 -o "$tmp/nbw"
+"$bin" render "$tmp/e.plxb" --view aerial --size 160x120 -o "$tmp/nb.png" >"$tmp/out" 2>&1
+if [ $? -eq 0 ] && ! grep -q "nearly black" "$tmp/out"; then echo "ok   render-aerial-not-nearly-black"; pass=$((pass + 1)); else echo "FAIL render-aerial-not-nearly-black"; sed 's/^/    /' "$tmp/out" | head -5; fail=$((fail + 1)); fi
 # a metre scene far from the origin (a projected CRS) gives the images of
 # the same scene at the origin, exact and atlas (135 and 29 lit pixels went
 # dark before 2026-11-30: wall points rounded into their buildings)
