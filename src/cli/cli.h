@@ -189,6 +189,14 @@ const char *cli_black_reason(plx_engine *e, const plx_camera *cam, const plx_ren
                              unsigned char *rgb8, char *buf, size_t len);
 /* Whether an 8-bit image of n bytes is entirely black (every byte 0). */
 int cli_all_black(const uint8_t *px, size_t n);
+/* Whether output path can be written, tried before any work (a bake or
+ * a frame of a large city takes seconds): a temporary file is made beside
+ * it and removed (safe_out, as the write at the end does), so a folder
+ * given as the file, a missing folder or one without write permission is
+ * said at once (on stderr, as "polarlux CMD: ..."). "-", NULL and a
+ * target that exists and is not a regular file (a device) are left to
+ * the write. */
+int cli_out_writable(const char *cmd, const char *path);
 /* The share of an RGB image's npx pixels that are black (all three bytes
  * 0). */
 double cli_black_share(const uint8_t *rgb, size_t npx);

@@ -227,28 +227,6 @@ static int save(const bake_args *a, plx_engine *e, plx_engine *t, size_t *bytes)
     return EXIT_OK;
 }
 
-/* Whether -o can be written, tried before any work (a bake of a large
- * city takes seconds): a temporary file is made beside it and removed
- * (safe_out, as the write at the end does), so a folder given as -o, a
- * missing folder or one without write permission is said at once. A
- * target that exists and is not a regular file (a device) is left to
- * the write. */
-static int out_writable(const char *path)
-{
-    struct stat st;
-    char err[512];
-    safe_out *o;
-    if (stat(path, &st) == 0 && !S_ISREG(st.st_mode) && !S_ISDIR(st.st_mode))
-        return 1;
-    o = safe_out_open(path, err, sizeof err);
-    if (!o) {
-        fprintf(stderr, "polarlux bake: %s\n", err);
-        return 0;
-    }
-    safe_out_abort(o);
-    return 1;
-}
-
 int cmd_bake(int argc, char **argv)
 {
     bake_args a;
@@ -263,7 +241,7 @@ int cmd_bake(int argc, char **argv)
     int rc = parse_args(argc, argv, &a);
     if (rc != EXIT_OK)
         return rc < 0 ? EXIT_OK : rc;
-    if (!out_writable(a.out))
+    if (!cli_out_writable("bake", a.out))
         return EXIT_FAIL;
     tj.a = &a;
     tj.t = NULL;

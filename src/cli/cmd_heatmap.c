@@ -568,6 +568,8 @@ int cmd_heatmap(int argc, char **argv)
         return cli_usage_error("heatmap", "missing -o MAP.png");
     if (o.q.facing_min && o.q.quantity != PLX_METER_SC)
         return cli_usage_error("heatmap", "--facing min needs --quantity sc (the least E_sc over every direction)");
+    if (!cli_out_writable("heatmap", o.out))
+        return EXIT_FAIL;
     rc = cli_open_scene("heatmap", scene, &c, &e);
     if (rc != EXIT_OK)
         return rc;

@@ -365,6 +365,8 @@ int cmd_route_network(int argc, char **argv)
         return cli_usage_error("route", "--network needs --from X,Y and --to X,Y");
     if (o.out || o.csv)
         return cli_usage_error("route", "-o and --csv belong to 'polarlux annotate'");
+    if (!cli_out_writable("route", o.geojson))
+        return EXIT_FAIL;
     rc = cli_open_scene("route", o.scene, &o.c, &e);
     if (rc != EXIT_OK)
         return rc;
@@ -564,6 +566,8 @@ int cmd_annotate(int argc, char **argv)
         return cli_usage_error("annotate", "missing -o OUT.geojson");
     if (o.from_s || o.to_s || o.geojson || o.have_detour)
         return cli_usage_error("annotate", "--from, --to, --geojson and --max-detour belong to 'polarlux route'");
+    if (!cli_out_writable("annotate", o.out) || !cli_out_writable("annotate", o.csv))
+        return EXIT_FAIL;
     rc = cli_open_scene("annotate", o.scene, &o.c, &e);
     if (rc != EXIT_OK)
         return rc;

@@ -337,6 +337,10 @@ int cmd_render(int argc, char **argv)
         return EXIT_FAIL;
     }
 #endif
+    /* the outputs tried before the work (a frame of a large city takes
+     * seconds; a missing folder was said after them) */
+    if (!cli_out_writable("render", a.out) || !cli_out_writable("render", a.pfm))
+        return EXIT_FAIL;
     rc = cli_open_scene("render", a.scene, &a.c, &e);
     if (rc != EXIT_OK)
         return rc;

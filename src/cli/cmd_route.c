@@ -269,6 +269,8 @@ int cmd_route(int argc, char **argv)
         return cli_usage_error("route", "missing SCENE");
     if (!o.path)
         return cli_usage_error("route", "missing --path FILE");
+    if (!cli_out_writable("route", o.geojson))
+        return EXIT_FAIL;
     rc = cli_open_scene("route", o.scene, &o.c, &e);
     if (rc != EXIT_OK)
         return rc;

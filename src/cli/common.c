@@ -8,6 +8,7 @@
 #include <cjson/cJSON.h>
 
 #include "cli.h"
+#include "posix/safe_out.h"
 #include "base/jsonscan.h"
 #include "lamp_layer.h"
 #include "points.h"
@@ -344,6 +345,22 @@ int cli_all_black(const uint8_t *px, size_t n)
     for (k = 0; k < n && px[k] == 0; k++)
         ;
     return k == n;
+}
+
+int cli_out_writable(const char *cmd, const char *path)
+{
+    struct stat st;
+    char err[512];
+    safe_out *o;
+    if (!path || strcmp(path, "-") == 0 || (stat(path, &st) == 0 && !S_ISREG(st.st_mode) && !S_ISDIR(st.st_mode)))
+        return 1;
+    o = safe_out_open(path, err, sizeof err);
+    if (!o) {
+        fprintf(stderr, "polarlux %s: %s\n", cmd, err);
+        return 0;
+    }
+    safe_out_abort(o);
+    return 1;
 }
 
 double cli_black_share(const uint8_t *rgb, size_t npx)

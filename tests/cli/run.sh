@@ -99,6 +99,13 @@ expect dark-spots 0 "\"rank\":1" -- "$bin" dark-spots -q fixtures/tiny.geojson -
 expect render-street 0 "^street view 160x120 from \(30\.0, 30\.0, 1\.7\) to \(50\.0, 10\.0, 2\.0\): drew [0-9]+ of 4 buildings" -- "$bin" render -q --frames 4 fixtures/tiny.geojson --eye 30,30,1.7 --target 50,10,2 --size 160x120 -o "$tmp/s.png" --pfm "$tmp/s.pfm"
 if [ "$(head -c 12 "$tmp/s.pfm" | tr '\n' ' ')" = "PF 160 120 -" ]; then echo "ok   render-pfm-header"; pass=$((pass + 1)); else echo "FAIL render-pfm-header"; fail=$((fail + 1)); fi
 if [ "$(wc -c < "$tmp/s.pfm")" -gt $((160 * 120 * 12)) ]; then echo "ok   render-pfm-size"; pass=$((pass + 1)); else echo "FAIL render-pfm-size"; fail=$((fail + 1)); fi
+# an output in a missing folder is said before the work (render drew the
+# frame first: 3.5 s for an aerial view of gen eixample 30 30)
+expect render-out-missing-folder 1 "polarlux render: cannot create a temporary file for '$tmp/nodir/x.png'" -- \
+    "$bin" render fixtures/tiny.geojson -o "$tmp/nodir/x.png"
+if ! grep -q "view 160x120\|view [0-9]*x[0-9]* from" "$tmp/out"; then echo "ok   render-out-missing-folder-first"; pass=$((pass + 1)); else echo "FAIL render-out-missing-folder-first"; fail=$((fail + 1)); fi
+expect heatmap-out-missing-folder 1 "polarlux heatmap: cannot create a temporary file" -- \
+    "$bin" heatmap fixtures/tiny.geojson -o "$tmp/nodir/h.png"
 # an output that names an input (or the other output) is refused before any
 # work, and the input is left as it was
 cp fixtures/tiny.geojson "$tmp/in.geojson"; ln -s in.geojson "$tmp/in-link.png"
