@@ -110,7 +110,7 @@ static int parse_max_frames(const char *val, void *dst)
 static int parse_args(int argc, char **argv, walk_args *a)
 {
     cli_view v;
-    int rc;
+    int rc, refine_frames_set = 0;
     const cli_opt opts[] = {
         CLI_OPT_STR("--path", &a->path),
         CLI_OPT_STR("-o", &a->dir),
@@ -118,8 +118,8 @@ static int parse_args(int argc, char **argv, walk_args *a)
         CLI_OPT_VAL("--speed", &a->speed, parse_rate, "--speed '%s' is not a number above 0, up to 1e4 (m/s)"),
         { "--exposure", NULL, &a->opts.exposure, cli_parse_exposure, "--exposure '%s' is not a number above 0, up to 1e9", 0, NULL,
           &v.exposure, NULL },
-        CLI_OPT_VAL("--refine-frames", &a->refine_frames, parse_refine_frames,
-                    "--refine-frames '%s' is not a whole number from 0 to 100000"),
+        { "--refine-frames", NULL, &a->refine_frames, parse_refine_frames,
+          "--refine-frames '%s' is not a whole number from 0 to 100000", 0, NULL, &refine_frames_set, NULL },
         CLI_OPT_VAL("--max-frames", &a->max_frames, parse_max_frames,
                     "--max-frames '%s' is not a whole number from 1 to 1000000"),
         CLI_OPT_FLAG("--no-adapt", &a->no_adapt),
@@ -152,6 +152,8 @@ static int parse_args(int argc, char **argv, walk_args *a)
     a->refine_height = v.refine_height;
     if (v.refine_height_set && !v.refine)
         cli_warn("walk", &a->c, "--refine-height has no effect without --refine");
+    if (refine_frames_set && !v.refine)
+        cli_warn("walk", &a->c, "--refine-frames has no effect without --refine");
     if (v.refine && a->ind.off)
         cli_warn("walk", &a->c, "--refine has no effect with --no-indirect (it refines the indirect light)");
     if (!a->scene)

@@ -719,6 +719,8 @@ expect render-refine-centre-lonlat 0 "^refinement: [1-9][0-9]* lamps near \\(24\
     "$bin" render fixtures/helsinki-centre.geojson --photons 4000 --frames 2 --size 32x24 --refine -o "$tmp/rrl.png"
 expect render-refine-height-alone 0 "^polarlux render: warning: --refine-height has no effect without --refine" -- \
     "$bin" render "$tmp/e.plxb" --size 32x24 --refine-height 5 -o "$tmp/rrh2.png"
+expect walk-refine-frames-alone 0 "^polarlux walk: warning: --refine-frames has no effect without --refine" -- \
+    "$bin" walk "$tmp/e.plxb" --path "$tmp/nb.geojson" --size 32x24 --max-frames 1 --refine-frames 3 -o "$tmp/wrf"
 expect render-refine-no-indirect 0 "^polarlux render: warning: --refine has no effect with --no-indirect" -- \
     "$bin" render "$tmp/e.plxb" --size 32x24 --refine --no-indirect -o "$tmp/rrn.png"
 expect render-refine-height-bad 2 "--refine-height '-3' is not a number of metres from 0 to 1e6" -- \
