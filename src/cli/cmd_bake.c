@@ -154,6 +154,48 @@ static int atlas_made(plx_engine *e)
     return plx_atlas_info_get(e, &ai) == PLX_OK && ai.made;
 }
 
+/* Whether the renderer's frame buffers (20 bytes a pixel of --max-size)
+ * take an eighth of the block or more: only then does a smaller
+ * --max-size free much (at 16x16 it was still offered). */
+static int frame_share(const bake_args *a)
+{
+    size_t mem = a->c.mem ? a->c.mem : CLI_DEFAULT_MEM;
+    return 20.0 * a->c.render_w * a->c.render_h >= mem / 8.0;
+}
+
+/* The options not given yet that need less memory at the stage that ran
+ * out (why: the engine's message), into buf as "--a, --b or --c"; returns
+ * how many (0: buf empty). The stages in order: polar diagrams, lamp light, photon
+ * buffers, renderer, radiance atlas; an option helps at its own stage and
+ * the later ones: --no-polar after the polar diagrams' own, --no-indirect
+ * (no photon buffers) from theirs on, a smaller --max-size where the
+ * renderer's frame buffers count (the photon buffers' budget is what the
+ * renderer leaves; not the renderer's scratch, which the city sizes;
+ * only when the frame buffers are a large share, frame_share), and
+ * --no-aerial or a coarser --texel at the atlas. */
+static int nomem_options(const bake_args *a, const char *why, char *buf, size_t len)
+{
+    const char *o[5];
+    int n = 0, k, atlas = strstr(why, "radiance atlas") != NULL;
+    int photons = strstr(why, "photon buffers") != NULL, renderer = strstr(why, "renderer") != NULL;
+    if (atlas && a->o.aerial)
+        o[n++] = "--no-aerial";
+    if (!a->o.no_polar)
+        o[n++] = "--no-polar";
+    if ((photons || renderer || atlas) && !a->o.no_indirect)
+        o[n++] = "--no-indirect";
+    if ((photons || atlas || (renderer && !strstr(why, "part 'scratch'"))) && frame_share(a))
+        o[n++] = "a smaller --max-size";
+    if (atlas && a->o.aerial)
+        o[n++] = "a coarser --texel";
+    buf[0] = '\0';
+    for (k = 0; k < n; k++) {
+        size_t u = strlen(buf);
+        snprintf(buf + u, len - u, "%s%s", k == 0 ? "" : k == n - 1 ? " or " : ", ", o[k]);
+    }
+    return n;
+}
+
 /* Everything prepared (plx_bake_prepare); a failure's line goes to err
  * (the twin's is printed only when the engine itself did not fail). */
 static int prepare_engine(const bake_args *a, int twin, plx_engine **e, char *err, size_t errlen)
@@ -166,17 +208,13 @@ static int prepare_engine(const bake_args *a, int twin, plx_engine **e, char *er
         return EXIT_OK;
     if (st == PLX_E_NOMEM) { /* what would need less, of the options not given yet, at the stage that failed */
         const char *why = plx_last_error(*e);
-        /* the stages in order: polar diagrams, lamp light, photons, renderer, radiance atlas; an option
-         * helps at its own stage and the later ones */
-        int atlas = strstr(why, "radiance atlas") != NULL, polar = strstr(why, "polar diagrams") != NULL;
-        int aerial = atlas && a->o.aerial, size = !polar;
-        int more = aerial + !a->o.no_polar + size;
-        if (more == 0)
+        char opts[160];
+        int n = nomem_options(a, why, opts, sizeof opts);
+        if (n == 0)
             snprintf(err, errlen, "polarlux bake: %s (give a larger --mem)\n", why);
         else
-            snprintf(err, errlen, "polarlux bake: %s (%s%s%s%s%s need%s less; or give a larger --mem)\n", why,
-                     aerial ? "--no-aerial, " : "", a->o.no_polar ? "" : "--no-polar", size && !a->o.no_polar ? ", " : "",
-                     size ? "a smaller --max-size" : "", aerial ? " or a coarser --texel" : "", more > 1 ? "" : "s");
+            snprintf(err, errlen, "polarlux bake: %s (%s need%s less; or give a larger --mem)\n", why, opts,
+                     n > 1 ? "" : "s");
     } else
         snprintf(err, errlen, "polarlux bake: %s\n", plx_last_error(*e));
     plx_engine_free(*e);

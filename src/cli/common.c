@@ -844,6 +844,14 @@ long cli_photons(plx_engine *e, const cli_indirect *ind)
     return n < CLI_PHOTONS_MIN ? CLI_PHOTONS_MIN : n;
 }
 
+/* What takes less when the photon buffers ran out of memory (a walk in
+ * --mem 1M said only that they did). */
+static const char *photons_hint(plx_status st)
+{
+    return st == PLX_E_NOMEM ? " (--no-indirect needs no photon buffers: direct light alone; or give a larger --mem)"
+                             : "";
+}
+
 int cli_indirect_run(const char *cmd, plx_engine *e, const cli_indirect *ind, const double *eye,
                      const double *dir, double fov_deg)
 {
@@ -865,14 +873,14 @@ int cli_indirect_run(const char *cmd, plx_engine *e, const cli_indirect *ind, co
     if (eye) {
         plx_status st = plx_indirect_set_viewer(e, eye, dir, fov_deg);
         if (st != PLX_OK) {
-            fprintf(stderr, "polarlux %s: %s\n", cmd, plx_last_error(e));
+            fprintf(stderr, "polarlux %s: %s%s\n", cmd, plx_last_error(e), photons_hint(st));
             return cli_exit_code(st);
         }
     }
     for (k = 0; k < ind->frames; k++) {
         plx_status st = plx_indirect_step(e, (uint32_t)photons, (uint64_t)k + 1);
         if (st != PLX_OK) {
-            fprintf(stderr, "%spolarlux %s: %s\n", tty ? "\n" : "", cmd, plx_last_error(e));
+            fprintf(stderr, "%spolarlux %s: %s%s\n", tty ? "\n" : "", cmd, plx_last_error(e), photons_hint(st));
             return cli_exit_code(st);
         }
         if (k == 0)

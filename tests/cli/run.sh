@@ -184,18 +184,30 @@ expect bake-no-indirect-walk 0 "holds no indirect light" -- \
 # out of memory: what takes less (bake), and that --aa 1 needs no
 # anti-aliasing buffers (a walk at the bake's own --mem failed at frame 1
 # with no word of it)
-expect bake-nomem-hint 3 "out of memory while making the radiance atlas.*\(--no-aerial, --no-polar, a smaller --max-size or a coarser --texel need less; or give a larger --mem\)$" -- \
+expect bake-nomem-hint 3 "out of memory while making the radiance atlas.*\(--no-aerial, --no-polar, --no-indirect or a coarser --texel need less; or give a larger --mem\)$" -- \
     "$bin" bake -q fixtures/eixample-4x4.geojson --max-size 160x120 --mem 3M -o "$tmp/nomem.plxb"
 # ... and only the options that act at the stage that ran out or before it (the
 # renderer's frame buffers were told of --no-aerial and --texel, which act after)
-expect bake-nomem-hint-renderer 3 "out of memory while creating the renderer.*\(--no-polar, a smaller --max-size need less; or give a larger --mem\)$" -- \
+expect bake-nomem-hint-renderer 3 "out of memory while creating the renderer.*\(--no-polar, --no-indirect or a smaller --max-size need less; or give a larger --mem\)$" -- \
     "$bin" bake -q fixtures/eixample-4x4.geojson --mem 8M -o "$tmp/nomem.plxb"
 expect bake-nomem-hint-polar 3 "out of memory while building the polar diagrams.*\(--no-polar needs less; or give a larger --mem\)$" -- \
     "$bin" bake -q fixtures/helsinki-centre.geojson --mem 1500K -o "$tmp/nomem.plxb"
 # the hint names only the options not given (a kiosk pass's bake with
-# --no-aerial --no-polar was told to give them)
-expect bake-nomem-hint-given 3 "out of memory .*\(a smaller --max-size needs less; or give a larger --mem\)$" -- \
+# --no-aerial --no-polar was told to give them); --no-indirect (no photon
+# buffers) at the photon buffers' stage and after, which was never named
+# and is what fits (a kiosk pass); a smaller --max-size only while the
+# frame buffers are an eighth of the block or more (at 16x16 it was
+# still offered)
+expect bake-nomem-hint-given 3 "out of memory while creating the photon buffers.*\(--no-indirect or a smaller --max-size need less; or give a larger --mem\)$" -- \
     "$bin" bake -q fixtures/eixample-4x4.geojson --no-aerial --no-polar --mem 2M -o "$tmp/nomem.plxb"
+expect bake-nomem-hint-small-frames 3 "out of memory while creating the photon buffers.*\(--no-indirect needs less; or give a larger --mem\)$" -- \
+    "$bin" bake -q fixtures/eixample-4x4.geojson --no-aerial --no-polar --max-size 16x16 --mem 2M -o "$tmp/nomem.plxb"
+expect bake-nomem-hint-fits 0 "^baked " -- \
+    "$bin" bake -q fixtures/eixample-4x4.geojson --no-aerial --no-polar --no-indirect --max-size 16x16 --mem 2M -o "$tmp/nomem.plxb"
+# walk and render (and illum) out of memory for the photon buffers name
+# --no-indirect (a walk in --mem 1M said only that they did not fit)
+expect walk-nomem-photons-hint 3 "out of memory while creating the photon buffers.*\(--no-indirect needs no photon buffers: direct light alone; or give a larger --mem\)$" -- \
+    "$bin" walk -q fixtures/helsinki-centre.geojson --path fixtures/helsinki-walk.geojson --mem 1M -o "$tmp/wnm"
 # 28 KB above the smallest --mem that loads the bake: room for a frame without anti-aliasing only
 amem=$("$bin" info "$tmp/e.plxb" --min-mem 2>/dev/null | sed -n 's/^smallest --mem: \([0-9]*\) bytes.*/\1/p')
 amem=$((amem + 28000))
