@@ -49,6 +49,15 @@ static int64_t ceil_div(int64_t a, int64_t b) /* b > 0 */
     return -floor_div(-a, b);
 }
 
+/* floor(a / FIX_ONE) for |a| < FIX_OFFSET, by a shift of a + FIX_OFFSET
+ * (>= 0, so the shift is a plain division by the power of two): the
+ * same value as floor_div(a, FIX_ONE) without the division's branches. */
+#define FIX_OFFSET ((int64_t)1 << 40)
+static int64_t fix_floor(int64_t a)
+{
+    return ((a + FIX_OFFSET) >> RASTER_SUBPIXEL_BITS) - (FIX_OFFSET >> RASTER_SUBPIXEL_BITS);
+}
+
 static int64_t min64(int64_t a, int64_t b) { return a < b ? a : b; }
 static int64_t max64(int64_t a, int64_t b) { return a > b ? a : b; }
 
@@ -390,10 +399,10 @@ static int pixel_box(const raster_ctx *r, const svert *v0, const svert *v1, cons
 {
     int64_t xmin = min64(v0->x, min64(v1->x, v2->x)), xmax = max64(v0->x, max64(v1->x, v2->x));
     int64_t ymin = min64(v0->y, min64(v1->y, v2->y)), ymax = max64(v0->y, max64(v1->y, v2->y));
-    *i0 = max64(ceil_div(xmin - FIX_HALF, FIX_ONE), r->sx0);
-    *i1 = min64(floor_div(xmax - FIX_HALF, FIX_ONE), (int64_t)r->sx1 - 1);
-    *j0 = max64(ceil_div(ymin - FIX_HALF, FIX_ONE), r->sy0);
-    *j1 = min64(floor_div(ymax - FIX_HALF, FIX_ONE), (int64_t)r->sy1 - 1);
+    *i0 = max64(fix_floor(xmin + (FIX_HALF - 1)), r->sx0); /* ceil((xmin - FIX_HALF) / FIX_ONE) */
+    *i1 = min64(fix_floor(xmax - FIX_HALF), (int64_t)r->sx1 - 1);
+    *j0 = max64(fix_floor(ymin + (FIX_HALF - 1)), r->sy0);
+    *j1 = min64(fix_floor(ymax - FIX_HALF), (int64_t)r->sy1 - 1);
     return *i0 <= *i1 && *j0 <= *j1;
 }
 
