@@ -613,23 +613,19 @@ static uint32_t split_v(const mesh *m, uint32_t k)
     return m->split16 ? m->split16[k] : m->split32[k];
 }
 
-/* First split of local vertex v among splits [lo, hi) of a building. */
-static uint32_t split_find(const mesh *m, uint32_t lo, uint32_t hi, uint32_t v)
-{
-    while (lo < hi) {
-        uint32_t mid = lo + (hi - lo) / 2;
-        if (split_v(m, mid) < v)
-            lo = mid + 1;
-        else
-            hi = mid;
-    }
-    return lo;
-}
-
 /* Footprint vertex pt's wall is hidden whole (mesh.hidden). */
 static int wall_hidden(const mesh *m, uint32_t pt)
 {
     return (m->hidden[pt >> 3] >> (pt & 7)) & 1;
+}
+
+static void put_t(mesh_tri *tri, uint32_t *nt, uint32_t a, uint32_t b, uint32_t c, uint32_t surf)
+{
+    mesh_tri *t = &tri[(*nt)++];
+    t->v[0] = a;
+    t->v[1] = b;
+    t->v[2] = c;
+    t->surf = surf;
 }
 
 /* The vertices of local vertex v's wall column (mesh_building's order:
@@ -639,15 +635,34 @@ typedef struct wall_col {
     uint32_t bot, top, split, len;
 } wall_col;
 
-static void col_of(const mesh *m, uint32_t b, uint32_t v, uint32_t ntot, wall_col *c)
+/* The column of local vertex v, vertices taken in increasing order: *k,
+ * the first split at or after the last vertex's (from the building's
+ * first), moved on to v's first (the splits are in order of vertex). */
+static void col_next(const mesh *m, uint32_t b, uint32_t v, uint32_t ntot, uint32_t *k, wall_col *c)
 {
-    uint32_t f = m->bld[b].split_first, e = m->bld[b + 1].split_first, k = split_find(m, f, e, v), n = 0;
-    while (k + n < e && split_v(m, k + n) == v)
+    uint32_t f = m->bld[b].split_first, e = m->bld[b + 1].split_first, n = 0;
+    while (*k < e && split_v(m, *k) < v)
+        (*k)++;
+    while (*k + n < e && split_v(m, *k + n) == v)
         n++;
     c->bot = ntot + v;
     c->top = v;
-    c->split = 2 * ntot + (k - f);
+    c->split = 2 * ntot + (*k - f);
     c->len = n + 2;
+}
+
+/* Two triangles zipping columns L and R of two vertices each (no
+ * splits), in put_walls' order. */
+static void put_plain_wall(const wall_col *L, const wall_col *R, const double *xyz, mesh_tri *tri, uint32_t *nt,
+                           uint32_t wid)
+{
+    if (xyz[3 * (size_t)R->top + 2] <= xyz[3 * (size_t)L->top + 2]) {
+        put_t(tri, nt, L->bot, R->bot, R->top, wid);
+        put_t(tri, nt, L->bot, R->top, L->top, wid);
+    } else {
+        put_t(tri, nt, L->bot, R->bot, L->top, wid);
+        put_t(tri, nt, L->top, R->bot, R->top, wid);
+    }
 }
 
 /* Vertex t (0: the bottom) of column c. */
@@ -677,38 +692,33 @@ static uint32_t put_splits(const mesh *m, uint32_t b, double *xyz, uint32_t nv)
     return nv;
 }
 
-static void put_t(mesh_tri *tri, uint32_t *nt, uint32_t a, uint32_t b, uint32_t c, uint32_t surf)
-{
-    mesh_tri *t = &tri[(*nt)++];
-    t->v[0] = a;
-    t->v[1] = b;
-    t->v[2] = c;
-    t->surf = surf;
-}
-
 /* Building b's walls (ntot ring vertices; its vertices written): each
  * footprint edge's two columns zipped (*nt triangles). */
 static void put_walls(const mesh *m, uint32_t b, uint32_t ntot, const double *xyz, mesh_tri *tri, uint32_t *nt)
 {
     const scene *s = m->s;
     const scene_building *bd = &s->bld[b];
-    uint32_t r, i, off = 0;
+    uint32_t r, i, off = 0, k = m->bld[b].split_first;
     for (r = 0; r < bd->ring_count; r++) {
         const scene_ring *rg = &s->rings[bd->ring_first + r];
         wall_col first, L, R;
         if (rg->count == 0)
             continue;
-        col_of(m, b, off, ntot, &first);
+        col_next(m, b, off, ntot, &k, &first);
         R = first;
         for (i = 0; i < rg->count; i++) {
             uint32_t li = 0, ri = 0, wid = mesh_wall_id(s, rg->first + i);
             L = R; /* the last wall's right column */
             if (i + 1 < rg->count)
-                col_of(m, b, off + i + 1, ntot, &R);
+                col_next(m, b, off + i + 1, ntot, &k, &R);
             else
                 R = first;
             if (wall_hidden(m, rg->first + i))
                 continue;
+            if (L.len == 2 && R.len == 2) {
+                put_plain_wall(&L, &R, xyz, tri, nt, wid);
+                continue;
+            }
             /* zip the columns; (L_i, R_j, R_j+1) and (L_i, R_j, L_i+1)
              * are counter-clockwise seen from outside (right of a->b) */
             while (li + 1 < L.len || ri + 1 < R.len) {
