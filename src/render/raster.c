@@ -681,7 +681,7 @@ static void walk_row(edge_walk *w)
  * value converted, and the depth the same expression as one at a time. */
 #define SPAN_LANES 8
 #if RASTER_NARROW > SPAN_LANES
-#error "draw_narrow_id takes a box's columns as one group of SPAN_LANES lanes"
+#error "draw_narrow_id takes a box's columns as at most SPAN_LANES lanes"
 #endif
 
 static void span_offsets(int64_t s1, int64_t s2, double off1[SPAN_LANES], double off2[SPAN_LANES])
@@ -807,48 +807,73 @@ static size_t draw_narrow_scalar(raster_ctx *r, const edge e[3], const int64_t e
     return written;
 }
 
-/* SPAN_LANES pixels of a narrow triangle's row from drow, irow: the
- * edge values v = ev[i] + off[i SPAN_LANES + k] (exact doubles, see
+/* A narrow triangle's row (draw_narrow_id) QUAD_LANES pixels at a time:
+ * a box at most QUAD_LANES columns wide is one quad, a wider one two. */
+#define QUAD_LANES 4
+
+/* QUAD_LANES pixels of a narrow triangle's row from drow, irow: the
+ * edge values v = ev[i] + off[i QUAD_LANES + k] (exact doubles, see
  * span_offsets), a lane inside when every v + bias >= 0, i.e. v >=
  * lim[i] = -bias (the values are integers), tested on v rounded to
  * float (rounding is monotone and lim is a float: the same answer, in
  * lanes of the depths' width); inside and nearer, written with the id
- * and counted in c[k]; in loops of fixed length (vectorised by GCC). */
-static void narrow_lanes_id(float *restrict drow, uint32_t *restrict irow, const double ev[3],
-                            const double *restrict off, const float lim[3], const double zc[4], uint32_t id,
-                            uint32_t *restrict c)
+ * and counted in c[k]; in loops of fixed length (vectorised by GCC). The
+ * selects as bit masks, as lanes_store. */
+static void narrow_quad_id(float *restrict drow, uint32_t *restrict irow, const double ev[3],
+                           const double *restrict off, const float lim[3], const double zc[4], uint32_t id,
+                           uint32_t *restrict c)
 {
-    float z[SPAN_LANES], f0[SPAN_LANES], f1[SPAN_LANES], f2[SPAN_LANES];
-    uint32_t m[SPAN_LANES];
+    float z[QUAD_LANES], f0[QUAD_LANES], f1[QUAD_LANES], f2[QUAD_LANES];
+    uint32_t m[QUAD_LANES], zb[QUAD_LANES], db[QUAD_LANES];
     int k;
-    for (k = 0; k < SPAN_LANES; k++) {
-        double v0 = ev[0] + off[k], v1 = ev[1] + off[SPAN_LANES + k], v2 = ev[2] + off[2 * SPAN_LANES + k];
+    for (k = 0; k < QUAD_LANES; k++) {
+        double v0 = ev[0] + off[k], v1 = ev[1] + off[QUAD_LANES + k], v2 = ev[2] + off[2 * QUAD_LANES + k];
         double l1 = v1 * zc[3], l2 = v2 * zc[3];
         z[k] = (float)(zc[0] + l1 * zc[1] + l2 * zc[2]);
         f0[k] = (float)v0;
         f1[k] = (float)v1;
         f2[k] = (float)v2;
     }
-    for (k = 0; k < SPAN_LANES; k++)
+    for (k = 0; k < QUAD_LANES; k++)
         m[k] = 0u - ((uint32_t)(f0[k] >= lim[0]) & (uint32_t)(f1[k] >= lim[1]) & (uint32_t)(f2[k] >= lim[2]) &
                      (uint32_t)(z[k] < drow[k]));
-    lanes_store(drow, irow, z, m, id, c);
+    memcpy(zb, z, sizeof zb);
+    memcpy(db, drow, sizeof db);
+    for (k = 0; k < QUAD_LANES; k++) {
+        db[k] = (zb[k] & m[k]) | (db[k] & ~m[k]);
+        irow[k] = (id & m[k]) | (irow[k] & ~m[k]);
+        c[k] -= m[k]; /* one more in lane k */
+    }
+    memcpy(drow, db, sizeof db);
+}
+
+/* Whether the QUAD_LANES depths from drow are all at or below zlo (no
+ * lane can be nearer: depth_floor). */
+static int quad_hidden(const float *drow, float zlo)
+{
+    uint32_t hidden = 1;
+    int k;
+    for (k = 0; k < QUAD_LANES; k++)
+        hidden &= drow[k] <= zlo;
+    return (int)hidden;
 }
 
 /* A narrow triangle's pixels (draw_triangle_id): its box (at most
- * SPAN_LANES columns) a row at a time in lanes, from column xs, the box's
- * first or further left so that the lanes stay within the scissor; every
- * centre tested against the three edges, E + bias >= 0 each, the test the
- * spans of draw_triangle solve row by row, so the same pixels (a centre
- * outside the box is outside the triangle: the lanes beyond it draw
- * nothing), with the same edge values for the depth. eb0: E + bias at
- * (i0, j0); zc: z0, dz1, dz2, 1 / area. */
+ * SPAN_LANES columns) a row at a time in nq quads of QUAD_LANES lanes,
+ * from column xs, the box's first or further left so that the lanes stay
+ * within the scissor; every centre tested against the three edges, E +
+ * bias >= 0 each, the test the spans of draw_triangle solve row by row,
+ * so the same pixels (a centre outside the box is outside the triangle:
+ * the lanes beyond it draw nothing), with the same edge values for the
+ * depth (the second quad's from ev + QUAD_LANES steps: exact, as every
+ * edge value). eb0: E + bias at (i0, j0); zc: z0, dz1, dz2, 1 / area. */
 static size_t draw_narrow_id(raster_ctx *r, const edge e[3], const int64_t eb0[3], int64_t i0, int64_t i1,
                              int64_t j0, int64_t j1, const double zc[4], float zlo, uint32_t id, uint32_t *ids)
 {
     const raster_target *t = &r->t;
-    int64_t xs = i0 + SPAN_LANES <= r->sx1 ? i0 : (int64_t)r->sx1 - SPAN_LANES, j;
-    double ev[3], dv[3], off[3 * SPAN_LANES];
+    int nq = i1 - i0 < QUAD_LANES ? 1 : 2, q;
+    int64_t nl = (int64_t)nq * QUAD_LANES, xs = i0 + nl <= r->sx1 ? i0 : (int64_t)r->sx1 - nl, j;
+    double ev[2][3], dv[3], off[3 * QUAD_LANES];
     float lim[3];
     uint32_t cnt[SPAN_LANES];
     size_t written = 0;
@@ -856,22 +881,25 @@ static size_t draw_narrow_id(raster_ctx *r, const edge e[3], const int64_t eb0[3
     if (r->sx1 - r->sx0 < SPAN_LANES)
         return draw_narrow_scalar(r, e, eb0, i0, i1, j0, j1, zc, zlo, id, ids);
     for (i = 0; i < 3; i++) {
-        ev[i] = (double)(eb0[i] - e[i].bias + (xs - i0) * e[i].step_x);
+        int64_t e0 = eb0[i] - e[i].bias + (xs - i0) * e[i].step_x;
+        ev[0][i] = (double)e0;
+        ev[1][i] = (double)(e0 + QUAD_LANES * e[i].step_x);
         lim[i] = (float)-e[i].bias;
         dv[i] = (double)(e[i].dx * FIX_ONE);
-        for (k = 0; k < SPAN_LANES; k++)
-            off[i * SPAN_LANES + k] = (double)k * (double)e[i].step_x;
+        for (k = 0; k < QUAD_LANES; k++)
+            off[i * QUAD_LANES + k] = (double)k * (double)e[i].step_x;
     }
     memset(cnt, 0, sizeof cnt);
     for (j = j0; j <= j1; j++) {
         float *drow = t->depth + (size_t)j * t->depth_stride + xs;
-        uint32_t hidden = 1;
-        for (k = 0; k < SPAN_LANES; k++)
-            hidden &= drow[k] <= zlo;
-        if (!hidden) /* else no lane can be nearer (depth_floor) */
-            narrow_lanes_id(drow, ids + (size_t)j * (size_t)t->width + xs, ev, off, lim, zc, id, cnt);
-        for (i = 0; i < 3; i++)
-            ev[i] += dv[i]; /* an edge value again: exact */
+        uint32_t *irow = ids + (size_t)j * (size_t)t->width + xs;
+        for (q = 0; q < nq; q++)
+            if (!quad_hidden(drow + q * QUAD_LANES, zlo))
+                narrow_quad_id(drow + q * QUAD_LANES, irow + q * QUAD_LANES, ev[q], off, lim, zc, id,
+                               cnt + q * QUAD_LANES);
+        for (q = 0; q < nq; q++)
+            for (i = 0; i < 3; i++)
+                ev[q][i] += dv[i]; /* an edge value again: exact */
     }
     for (k = 0; k < SPAN_LANES; k++)
         written += cnt[k];
