@@ -334,12 +334,20 @@ static int clip_plane(const raster_ctx *r, int k, const raster_vertex *in, int n
 
 /* ---- window space -------------------------------------------------------- */
 
+/* floor(v FIX_ONE + 0.5) clamped to +-FIX_LIMIT: past a limit, the
+ * limit (floor's value there is at or past it too); within them, the
+ * truncation less one where it rounded up (a negative fraction), which
+ * is floor's value without floor's test of the magnitude. */
 static int64_t snap(double v)
 {
-    double f = floor(v * (double)FIX_ONE + 0.5);
-    if (f > (double)FIX_LIMIT) f = (double)FIX_LIMIT;
-    if (f < -(double)FIX_LIMIT) f = -(double)FIX_LIMIT;
-    return (int64_t)f;
+    double f = v * (double)FIX_ONE + 0.5;
+    int64_t t;
+    if (f > (double)FIX_LIMIT)
+        return FIX_LIMIT;
+    if (f < -(double)FIX_LIMIT)
+        return -FIX_LIMIT;
+    t = (int64_t)f;
+    return t - ((double)t > f);
 }
 
 /* Clip-space pos to the snapped window position and the depth in [0, 1]. */
