@@ -977,11 +977,11 @@ static size_t draw_triangle_id(raster_ctx *r, const svert *v0, const svert *v1, 
     float zlo;
     size_t written = 0;
     int k, lanes = r->sx1 - r->sx0 >= SPAN_LANES;
+    if (!pixel_box(r, v0, v1, v2, &i0, &i1, &j0, &j1)) /* no centre: no edges to set up */
+        return 0;
     edge_setup(&e[0], v1, v2);
     edge_setup(&e[1], v2, v0);
     edge_setup(&e[2], v0, v1);
-    if (!pixel_box(r, v0, v1, v2, &i0, &i1, &j0, &j1))
-        return 0;
     for (k = 0; k < 3; k++)
         eb0[k] = edge_eval(&e[k], i0 * FIX_ONE + FIX_HALF, j0 * FIX_ONE + FIX_HALF) + e[k].bias;
     zc[0] = z0;
