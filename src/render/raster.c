@@ -402,7 +402,7 @@ static int64_t edge_eval(const edge *e, int64_t px, int64_t py)
 
 /* The pixels whose centre lies in the triangle's bounding box, within
  * the scissor: columns i0 .. i1, rows j0 .. j1; 0 when there are none. */
-static int pixel_box(const raster_ctx *r, const svert *v0, const svert *v1, const svert *v2, int64_t *i0,
+static inline int pixel_box(const raster_ctx *r, const svert *v0, const svert *v1, const svert *v2, int64_t *i0,
                      int64_t *i1, int64_t *j0, int64_t *j1)
 {
     int64_t xmin = min64(v0->x, min64(v1->x, v2->x)), xmax = max64(v0->x, max64(v1->x, v2->x));
