@@ -271,7 +271,7 @@ static float plane_dist(const raster_ctx *r, int k, const float *p)
  * written out (the loop over its switch cost 75 instructions a vertex),
  * each distance stored in a float first as plane_dist's return rounds it
  * (the same bits where floats are evaluated wider, FLT_EVAL_METHOD 2). */
-static unsigned outcode(const raster_ctx *r, const float *p)
+static inline unsigned outcode(const raster_ctx *r, const float *p)
 {
     float gxw = r->gx * p[3], gyw = r->gy * p[3];
     float d[PLANE_COUNT];
@@ -351,7 +351,7 @@ static int64_t snap(double v)
 }
 
 /* Clip-space pos to the snapped window position and the depth in [0, 1]. */
-static void window_xyz(const raster_ctx *r, const float *pos, int64_t *x, int64_t *y, double *z)
+static inline void window_xyz(const raster_ctx *r, const float *pos, int64_t *x, int64_t *y, double *z)
 {
     double w = (double)pos[3];
     double d = ((double)pos[2] / w + 1.0) * 0.5;
