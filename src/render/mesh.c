@@ -671,6 +671,27 @@ static uint32_t col_at(const wall_col *c, uint32_t t)
     return t == 0 ? c->bot : t + 1 == c->len ? c->top : c->split + t - 1;
 }
 
+/* Columns L and R zipped: (L_i, R_j, R_j+1) and (L_i, R_j, L_i+1) are
+ * counter-clockwise seen from outside (right of a->b); the lower next
+ * vertex first, R's on a tie. Each column's vertex at hand (la, ra) and
+ * next one (ln, rn; read only while there is one) carried. */
+static void zip_columns(const wall_col *L, const wall_col *R, const double *xyz, mesh_tri *tri, uint32_t *nt,
+                        uint32_t wid)
+{
+    uint32_t li = 0, ri = 0, la = L->bot, ra = R->bot, ln = col_at(L, 1), rn = col_at(R, 1);
+    while (li + 1 < L->len || ri + 1 < R->len) {
+        if (ri + 1 < R->len && (li + 1 >= L->len || xyz[3 * (size_t)rn + 2] <= xyz[3 * (size_t)ln + 2])) {
+            put_t(tri, nt, la, ra, rn, wid);
+            ra = rn;
+            rn = col_at(R, ++ri + 1);
+        } else {
+            put_t(tri, nt, la, ra, ln, wid);
+            la = ln;
+            ln = col_at(L, ++li + 1);
+        }
+    }
+}
+
 /* Building b's splits (its columns' vertices between bottom and top), in
  * the order of the building's split list (by local vertex, then height),
  * from xyz vertex nv on. */
@@ -707,7 +728,7 @@ static void put_walls(const mesh *m, uint32_t b, uint32_t ntot, const double *xy
         col_next(m, b, off, ntot, &k, &first);
         R = first;
         for (i = 0; i < rg->count; i++) {
-            uint32_t li = 0, ri = 0, wid = mesh_wall_id(s, rg->first + i);
+            uint32_t wid = mesh_wall_id(s, rg->first + i);
             L = R; /* the last wall's right column */
             if (i + 1 < rg->count)
                 col_next(m, b, off + i + 1, ntot, &k, &R);
@@ -715,22 +736,10 @@ static void put_walls(const mesh *m, uint32_t b, uint32_t ntot, const double *xy
                 R = first;
             if (wall_hidden(m, rg->first + i))
                 continue;
-            if (L.len == 2 && R.len == 2) {
+            if (L.len == 2 && R.len == 2)
                 put_plain_wall(&L, &R, xyz, tri, nt, wid);
-                continue;
-            }
-            /* zip the columns; (L_i, R_j, R_j+1) and (L_i, R_j, L_i+1)
-             * are counter-clockwise seen from outside (right of a->b) */
-            while (li + 1 < L.len || ri + 1 < R.len) {
-                if (ri + 1 < R.len && (li + 1 >= L.len || xyz[3 * (size_t)col_at(&R, ri + 1) + 2] <=
-                                                              xyz[3 * (size_t)col_at(&L, li + 1) + 2])) {
-                    put_t(tri, nt, col_at(&L, li), col_at(&R, ri), col_at(&R, ri + 1), wid);
-                    ri++;
-                } else {
-                    put_t(tri, nt, col_at(&L, li), col_at(&R, ri), col_at(&L, li + 1), wid);
-                    li++;
-                }
-            }
+            else
+                zip_columns(&L, &R, xyz, tri, nt, wid);
         }
         off += rg->count;
     }
