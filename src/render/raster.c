@@ -1041,10 +1041,7 @@ long raster_triangle_id(raster_ctx *r, const raster_pvert *p0, const raster_pver
         r->nattr != 0)
         return -1;
     r->stats.triangles_in++;
-    s[0].x = p0->x; s[0].y = p0->y; s[0].z = p0->z;
-    s[1].x = p1->x; s[1].y = p1->y; s[1].z = p1->z;
-    s[2].x = p2->x; s[2].y = p2->y; s[2].z = p2->z;
-    a = area2(&s[0], &s[1], &s[2]);
+    a = (p1->x - p0->x) * (p2->y - p0->y) - (p1->y - p0->y) * (p2->x - p0->x); /* area2, before any copy */
     if (a == 0) {
         r->stats.triangles_rejected++;
         return 0;
@@ -1053,6 +1050,9 @@ long raster_triangle_id(raster_ctx *r, const raster_pvert *p0, const raster_pver
         r->stats.triangles_culled++;
         return 0;
     }
+    s[0].x = p0->x; s[0].y = p0->y; s[0].z = p0->z;
+    s[1].x = p1->x; s[1].y = p1->y; s[1].z = p1->z;
+    s[2].x = p2->x; s[2].y = p2->y; s[2].z = p2->z;
     n = a > 0 ? draw_triangle_id(r, &s[0], &s[1], &s[2], a, id, ids)
               : draw_triangle_id(r, &s[0], &s[2], &s[1], -a, id, ids);
     r->stats.pixels_written += n;

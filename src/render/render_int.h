@@ -78,8 +78,8 @@ struct render {
     float *depth;
     uint32_t *id;
     float *lin;
-    raster_vertex *vbuf;
-    raster_pvert *pv;           /* vbuf's vertices prepared (raster_prepare) */
+    raster_vertex *vbuf;        /* soft_draw: the vertices of the triangles it clips */
+    raster_pvert *pv;           /* soft_draw's vertices prepared (raster_prepare) */
     float *clip;                /* 4 per vertex of one building */
     render_backend soft;        /* the built-in backend (user = this) */
     raster_ctx rc;              /* its rasteriser state during a frame */

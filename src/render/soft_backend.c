@@ -97,16 +97,17 @@ void soft_draw(void *user, const float *clip, uint32_t nv, const mesh_tri *tri, 
 {
     render *r = user;
     uint32_t k;
-    for (k = 0; k < nv; k++) {
-        memcpy(r->vbuf[k].pos, clip + 4 * (size_t)k, 4 * sizeof(float));
-        raster_prepare(&r->rc, r->vbuf[k].pos, &r->pv[k]);
-    }
+    for (k = 0; k < nv; k++)
+        raster_prepare(&r->rc, clip + 4 * (size_t)k, &r->pv[k]);
     for (k = 0; k < ntri; k++) {
         const mesh_tri *t = &tri[k];
         uint32_t a = t->v[0] - v_base, b = t->v[1] - v_base, c = t->v[2] - v_base;
         if (raster_triangle_id(&r->rc, &r->pv[a], &r->pv[b], &r->pv[c], t->surf, r->id) >= 0)
             continue; /* inside every clip plane: drawn from the prepared vertices */
-        r->cur_id = t->surf;
+        r->cur_id = t->surf; /* clipped: the rasteriser's vertices made for it */
+        memcpy(r->vbuf[a].pos, clip + 4 * (size_t)a, 4 * sizeof(float));
+        memcpy(r->vbuf[b].pos, clip + 4 * (size_t)b, 4 * sizeof(float));
+        memcpy(r->vbuf[c].pos, clip + 4 * (size_t)c, 4 * sizeof(float));
         raster_triangle(&r->rc, &r->vbuf[a], &r->vbuf[b], &r->vbuf[c]);
     }
 }
