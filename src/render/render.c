@@ -315,6 +315,8 @@ int render_eye_inside(const render *r, const double eye[3])
     const scene *s = r->s;
     uint32_t b, k;
     vec2 p;
+    if (eye[2] > s->height_max) /* above every building (the loader's maximum): in none */
+        return 0;
     p.x = eye[0];
     p.y = eye[1];
     for (b = 0; b < s->nbld; b++) {
