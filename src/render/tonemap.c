@@ -118,9 +118,29 @@ static uint32_t guess_bits(double y, double ex, int curve)
     return bits_of_float((float)x);
 }
 
+/* Each hint h the first level k whose bits pass h << TONEMAP_HINT_SHIFT
+ * (the levels from the last hint's on; TONEMAP_LEVELS past them all):
+ * level k's run of hints, those below it, ends at the first h with h <<
+ * TONEMAP_HINT_SHIFT at or above f[k], ceil(f[k] / 2^TONEMAP_HINT_SHIFT),
+ * and is set at once. */
+static void hints_fill(tonemap_table *t)
+{
+    uint32_t h = 0;
+    int k;
+    for (k = 0; k < TONEMAP_LEVELS && h < TONEMAP_HINTS; k++) {
+        uint64_t end = ((uint64_t)t->f[k] + ((uint64_t)1 << TONEMAP_HINT_SHIFT) - 1) >> TONEMAP_HINT_SHIFT;
+        end = end < TONEMAP_HINTS ? end : TONEMAP_HINTS;
+        if (end > h) {
+            memset(&t->hint[h], k, (size_t)(end - h));
+            h = (uint32_t)end;
+        }
+    }
+    if (h < TONEMAP_HINTS)
+        memset(&t->hint[h], TONEMAP_LEVELS, TONEMAP_HINTS - h);
+}
+
 void tonemap_table_set(tonemap_table *t, const double thr[TONEMAP_LEVELS], double ex, int curve)
 {
-    uint32_t h;
     int k;
     curve = curve != 0;
     if (t->usable && t->ex == ex && t->curve == curve)
@@ -135,11 +155,7 @@ void tonemap_table_set(tonemap_table *t, const double thr[TONEMAP_LEVELS], doubl
     for (k = 0; k < TONEMAP_LEVELS; k++)
         t->f[k] = first_above(thr, ex, curve, k, guess_bits(thr[k], ex, curve));
     t->f[TONEMAP_LEVELS] = UINT32_MAX; /* no float reaches it */
-    for (h = 0, k = 0; h < TONEMAP_HINTS; h++) {
-        while (k < TONEMAP_LEVELS && t->f[k] <= h << TONEMAP_HINT_SHIFT)
-            k++;
-        t->hint[h] = (uint8_t)k;
-    }
+    hints_fill(t);
     t->single = 1;
     for (k = 0; k + 1 < TONEMAP_LEVELS; k++)
         if ((t->f[k] >> TONEMAP_HINT_SHIFT) == (t->f[k + 1] >> TONEMAP_HINT_SHIFT))
