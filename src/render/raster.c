@@ -883,7 +883,7 @@ static size_t draw_narrow_id(raster_ctx *r, const edge e[3], const int64_t eb0[3
     int64_t nl = (int64_t)nq * QUAD_LANES, xs = i0 + nl <= r->sx1 ? i0 : (int64_t)r->sx1 - nl, j;
     double ev[2][3], dv[3], off[3 * QUAD_LANES];
     float lim[3];
-    uint32_t cnt[SPAN_LANES];
+    uint32_t cnt[QUAD_LANES]; /* pixels written in lane k of either quad */
     size_t written = 0;
     int i, k;
     if (r->sx1 - r->sx0 < SPAN_LANES)
@@ -903,13 +903,12 @@ static size_t draw_narrow_id(raster_ctx *r, const edge e[3], const int64_t eb0[3
         uint32_t *irow = ids + (size_t)j * (size_t)t->width + xs;
         for (q = 0; q < nq; q++)
             if (!quad_hidden(drow + q * QUAD_LANES, zlo))
-                narrow_quad_id(drow + q * QUAD_LANES, irow + q * QUAD_LANES, ev[q], off, lim, zc, id,
-                               cnt + q * QUAD_LANES);
+                narrow_quad_id(drow + q * QUAD_LANES, irow + q * QUAD_LANES, ev[q], off, lim, zc, id, cnt);
         for (q = 0; q < nq; q++)
             for (i = 0; i < 3; i++)
                 ev[q][i] += dv[i]; /* an edge value again: exact */
     }
-    for (k = 0; k < SPAN_LANES; k++)
+    for (k = 0; k < QUAD_LANES; k++)
         written += cnt[k];
     return written;
 }
