@@ -792,13 +792,14 @@ static int pixel_id(float *drow, uint32_t *irow, double e1, double e2, const dou
  * scissor is narrower than SPAN_LANES columns: every centre of its box
  * tested against the three edges, E + bias >= 0 each, the test the spans
  * of draw_triangle solve row by row, so the same pixels, with the same
- * edge values for the depth. eb0: E + bias at (i0, j0); zc: z0, dz1,
- * dz2, 1 / area. */
-static size_t draw_narrow_scalar(raster_ctx *r, const edge e[3], const int64_t eb0[3], int64_t i0, int64_t i1,
-                                 int64_t j0, int64_t j1, const double zc[4], float zlo, uint32_t id, uint32_t *ids)
+ * edge values for the depth. zc: z0, dz1, dz2, 1 / area. */
+static size_t draw_narrow_scalar(raster_ctx *r, const edge e[3], int64_t i0, int64_t i1, int64_t j0, int64_t j1,
+                                 const double zc[4], float zlo, uint32_t id, uint32_t *ids)
 {
     const raster_target *t = &r->t;
-    int64_t b0 = eb0[0], b1 = eb0[1], b2 = eb0[2], j, x;
+    int64_t px = i0 * FIX_ONE + FIX_HALF, py = j0 * FIX_ONE + FIX_HALF;
+    int64_t b0 = edge_eval(&e[0], px, py) + e[0].bias, b1 = edge_eval(&e[1], px, py) + e[1].bias;
+    int64_t b2 = edge_eval(&e[2], px, py) + e[2].bias, j, x;
     int64_t s0 = e[0].step_x, s1 = e[1].step_x, s2 = e[2].step_x;
     size_t written = 0;
     for (j = j0; j <= j1; j++) {
@@ -874,9 +875,10 @@ static int quad_hidden(const float *drow, float zlo)
  * so the same pixels (a centre outside the box is outside the triangle:
  * the lanes beyond it draw nothing), with the same edge values for the
  * depth (the second quad's from ev + QUAD_LANES steps: exact, as every
- * edge value). eb0: E + bias at (i0, j0); zc: z0, dz1, dz2, 1 / area. */
-static size_t draw_narrow_id(raster_ctx *r, const edge e[3], const int64_t eb0[3], int64_t i0, int64_t i1,
-                             int64_t j0, int64_t j1, const double zc[4], float zlo, uint32_t id, uint32_t *ids)
+ * edge value; the first, E at (xs, j0), evaluated there). zc: z0, dz1,
+ * dz2, 1 / area. */
+static size_t draw_narrow_id(raster_ctx *r, const edge e[3], int64_t i0, int64_t i1, int64_t j0, int64_t j1,
+                             const double zc[4], float zlo, uint32_t id, uint32_t *ids)
 {
     const raster_target *t = &r->t;
     int nq = i1 - i0 < QUAD_LANES ? 1 : 2, q;
@@ -887,9 +889,9 @@ static size_t draw_narrow_id(raster_ctx *r, const edge e[3], const int64_t eb0[3
     size_t written = 0;
     int i, k;
     if (r->sx1 - r->sx0 < SPAN_LANES)
-        return draw_narrow_scalar(r, e, eb0, i0, i1, j0, j1, zc, zlo, id, ids);
+        return draw_narrow_scalar(r, e, i0, i1, j0, j1, zc, zlo, id, ids);
     for (i = 0; i < 3; i++) {
-        int64_t e0 = eb0[i] - e[i].bias + (xs - i0) * e[i].step_x;
+        int64_t e0 = edge_eval(&e[i], xs * FIX_ONE + FIX_HALF, j0 * FIX_ONE + FIX_HALF);
         ev[0][i] = (double)e0;
         ev[1][i] = (double)(e0 + QUAD_LANES * e[i].step_x);
         lim[i] = (float)-e[i].bias;
@@ -981,15 +983,15 @@ static size_t draw_triangle_id(raster_ctx *r, const svert *v0, const svert *v1, 
     edge_setup(&e[0], v1, v2);
     edge_setup(&e[1], v2, v0);
     edge_setup(&e[2], v0, v1);
-    for (k = 0; k < 3; k++)
-        eb0[k] = edge_eval(&e[k], i0 * FIX_ONE + FIX_HALF, j0 * FIX_ONE + FIX_HALF) + e[k].bias;
     zc[0] = z0;
     zc[1] = dz1;
     zc[2] = dz2;
     zc[3] = inv_area;
     zlo = depth_floor(z0, v1->z, v2->z);
     if (i1 - i0 < RASTER_NARROW)
-        return draw_narrow_id(r, e, eb0, i0, i1, j0, j1, zc, zlo, id, ids);
+        return draw_narrow_id(r, e, i0, i1, j0, j1, zc, zlo, id, ids);
+    for (k = 0; k < 3; k++)
+        eb0[k] = edge_eval(&e[k], i0 * FIX_ONE + FIX_HALF, j0 * FIX_ONE + FIX_HALF) + e[k].bias;
     for (k = 0; k < 3; k++)
         walk_start(&wk[k], &e[k], eb0[k], j1 > j0);
     span_offsets(e[1].step_x, e[2].step_x, off1, off2);
