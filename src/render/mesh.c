@@ -745,30 +745,41 @@ static void put_walls(const mesh *m, uint32_t b, uint32_t ntot, const double *xy
     }
 }
 
-/* The ring vertices of building bd at height z from xyz vertex nv on. */
-static uint32_t put_ring_verts(const scene *s, const scene_building *bd, double z, double *xyz, uint32_t nv)
+/* The ring vertices of building bd (ntot of them) at its height from xyz
+ * vertex 0 on, and at its min_height from vertex ntot on. */
+static void put_ring_verts(const scene *s, const scene_building *bd, uint32_t ntot, double *xyz)
 {
+    double *top = xyz, *bot = xyz + 3 * (size_t)ntot;
     uint32_t r, k;
     for (r = 0; r < bd->ring_count; r++) {
         const scene_ring *rg = &s->rings[bd->ring_first + r];
-        for (k = 0; k < rg->count; k++, nv++) {
-            xyz[3 * (size_t)nv] = s->pts[rg->first + k].x;
-            xyz[3 * (size_t)nv + 1] = s->pts[rg->first + k].y;
-            xyz[3 * (size_t)nv + 2] = z;
+        for (k = 0; k < rg->count; k++, top += 3, bot += 3) {
+            top[0] = bot[0] = s->pts[rg->first + k].x;
+            top[1] = bot[1] = s->pts[rg->first + k].y;
+            top[2] = bd->height;
+            bot[2] = bd->min_height;
         }
     }
-    return nv;
+}
+
+/* Building bd's ring vertices. */
+static uint32_t ring_total(const scene *s, const scene_building *bd)
+{
+    uint32_t r, n = 0;
+    for (r = 0; r < bd->ring_count; r++)
+        n += s->rings[bd->ring_first + r].count;
+    return n;
 }
 
 void mesh_building(const mesh *m, uint32_t b, double *xyz, mesh_tri *tri)
 {
     const scene *s = m->s;
     const scene_building *bd = &s->bld[b];
-    uint32_t nt = 0, ntot, nv, q, q0 = m->bld[b].roof_first, q1 = m->bld[b + 1].roof_first;
+    uint32_t nt = 0, ntot, q, q0 = m->bld[b].roof_first, q1 = m->bld[b + 1].roof_first;
     uint32_t rid = mesh_roof_id(s, b), uid = mesh_under_id(s, b);
-    ntot = put_ring_verts(s, bd, bd->height, xyz, 0);
-    nv = put_ring_verts(s, bd, bd->min_height, xyz, ntot);
-    (void)put_splits(m, b, xyz, nv);
+    ntot = ring_total(s, bd);
+    put_ring_verts(s, bd, ntot, xyz);
+    (void)put_splits(m, b, xyz, 2 * ntot);
     put_walls(m, b, ntot, xyz, tri, &nt);
     for (q = q0; q < q1; q += 3)
         put_t(tri, &nt, roof_at(m, q), roof_at(m, q + 1), roof_at(m, q + 2), rid);
