@@ -524,19 +524,26 @@ static void cell_draw(render *r, uint32_t c, uint8_t draw, render_stats *st)
         st->frustum_culled += r->cell_start[c + 1] - r->cell_start[c];
 }
 
+/* group_out's values: a group of cells wholly out of the frustum, or
+ * wholly inside it (groups_out). */
+#define GROUP_OUT 1u
+#define GROUP_IN 2u
+
 /* Cells c0 .. c1 - 1 without the occlusion pass: a cell out of the frustum
  * culls its buildings, the others' buildings are tested one by one, but
- * for a cell wholly inside when no band needs its buildings' rows (their
- * boxes lie in it: none is out). */
+ * for a cell wholly inside, or in a group wholly inside, when no band
+ * needs its buildings' rows (their boxes lie in it: none is out). */
 static void cull_cells(render *r, int mode, int rows, uint32_t c0, uint32_t c1, render_stats *st)
 {
     uint32_t c, k;
     for (c = c0; c < c1; c++) {
         double corner[8][4], wmn, wmx, key;
+        uint8_t g;
         if (r->cell_start[c + 1] == r->cell_start[c])
             continue;
-        if (r->group_out[cell_group(r, c)]) {
-            cell_draw(r, c, 0, st);
+        g = r->group_out[cell_group(r, c)];
+        if (g == GROUP_OUT || (g == GROUP_IN && !rows)) {
+            cell_draw(r, c, g == GROUP_IN, st);
             continue;
         }
         box_clip(r, &r->cell_box[6 * (size_t)c], corner);
@@ -550,20 +557,30 @@ static void cull_cells(render *r, int mode, int rows, uint32_t c0, uint32_t c1, 
     }
 }
 
-/* This frame's groups of cells wholly out of the frustum (group_out), by
- * box_out with the tolerance of the whole box: each cell's box lies in
- * its group's, so its own test would cull it too (in real numbers; the
- * cell's corners, rounded on their own, could fall the other way only
- * at the margin, where the image is the same and only the counts of
- * culled buildings could differ). An empty group (no box) is not out:
- * its cells are empty and skipped. */
+/* This frame's groups of cells wholly out of the frustum (group_out
+ * GROUP_OUT), by box_out with the tolerance of the whole box: each cell's
+ * box lies in its group's, so its own test would cull it too (in real
+ * numbers; the cell's corners, rounded on their own, could fall the other
+ * way only at the margin, where the image is the same and only the counts
+ * of culled buildings could differ). The others wholly inside (GROUP_IN)
+ * by corners_inside: then so is each cell's box in it (the margin's test
+ * is convex in the point: what holds at the group's corners holds in its
+ * box; and a cell's buildings tested one by one would all be drawn too).
+ * An empty group (no box) is neither: its cells are empty and skipped. */
 static void groups_out(render *r, int mode)
 {
     uint32_t g, n = r->gside * r->gside;
     for (g = 0; g < n; g++) {
         const double *gb = &r->group_box[6 * (size_t)g];
-        double wmn, wmx;
-        r->group_out[g] = (mode & RENDER_CULL_FRUSTUM) && gb[0] <= gb[3] && box_out(r, gb, &wmn, &wmx, 1, NULL);
+        double c[8][4], wmn, wmx;
+        r->group_out[g] = 0;
+        if (!(gb[0] <= gb[3]))
+            continue;
+        box_clip(r, gb, c);
+        if ((mode & RENDER_CULL_FRUSTUM) && corners_out(r, c, &wmn, &wmx, 1, NULL))
+            r->group_out[g] = GROUP_OUT;
+        else if (corners_inside(r, c))
+            r->group_out[g] = GROUP_IN;
     }
 }
 
@@ -612,7 +629,7 @@ void cull_buildings(render *r, const render_opts *o, int inside, int rows, rende
         double wmn, wmx;
         if (r->cell_start[c + 1] == r->cell_start[c])
             continue;
-        if (r->group_out[cell_group(r, c)] ||
+        if (r->group_out[cell_group(r, c)] == GROUP_OUT ||
             (box_out(r, &r->cell_box[6 * (size_t)c], &wmn, &wmx, 1, NULL) && (mode & RENDER_CULL_FRUSTUM)))
             cell_draw(r, c, 0, st);
         else

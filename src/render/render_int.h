@@ -105,7 +105,7 @@ struct render {
      * without testing them */
     uint32_t cside, gside;      /* cells and groups a side */
     double *group_box;          /* 6 a group, as cell_box */
-    uint8_t *group_out;         /* gside^2: this frame's groups out of the frustum (cull_buildings) */
+    uint8_t *group_out;         /* gside^2: this frame's groups out of the frustum or wholly inside (cull_buildings) */
     cull_item *trav;            /* nbld + ncell: the occlusion pass's heap */
     uint32_t ntrav;
     double *bins;               /* RENDER_BINS */
