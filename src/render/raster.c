@@ -630,7 +630,7 @@ size_t raster_triangles(raster_ctx *r, const raster_vertex *verts, size_t nvert,
 
 /* ---- surface ids without fragment calls ------------------------------- */
 
-void raster_prepare(const raster_ctx *r, const float *pos, raster_pvert *out)
+static inline void prepare_one(const raster_ctx *r, const float *pos, raster_pvert *out)
 {
     if (!valid_position(pos)) {
         out->code = ~0u;
@@ -640,6 +640,18 @@ void raster_prepare(const raster_ctx *r, const float *pos, raster_pvert *out)
     if (out->code != 0)
         return;
     window_xyz(r, pos, &out->x, &out->y, &out->z); /* as project: the same bits */
+}
+
+void raster_prepare(const raster_ctx *r, const float *pos, raster_pvert *out)
+{
+    prepare_one(r, pos, out);
+}
+
+void raster_prepare_n(const raster_ctx *r, const float *pos, size_t n, raster_pvert *out)
+{
+    size_t k;
+    for (k = 0; k < n; k++)
+        prepare_one(r, pos + 4 * k, &out[k]);
 }
 
 /* One edge's bound along the rows of draw_triangle_id: with s = |step_x|

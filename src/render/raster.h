@@ -199,6 +199,8 @@ typedef struct raster_pvert {
 } raster_pvert;
 
 void raster_prepare(const raster_ctx *r, const float *pos, raster_pvert *out /* OUT */);
+/* raster_prepare for n vertices, x, y, z, w each, one after another. */
+void raster_prepare_n(const raster_ctx *r, const float *pos, size_t n, raster_pvert *out /* OUT: n */);
 long raster_triangle_id(raster_ctx *r, const raster_pvert *v0, const raster_pvert *v1, const raster_pvert *v2,
                         uint32_t id, uint32_t *ids /* width x height, row 0 at the top */);
 

@@ -97,8 +97,7 @@ void soft_draw(void *user, const float *clip, uint32_t nv, const mesh_tri *tri, 
 {
     render *r = user;
     uint32_t k;
-    for (k = 0; k < nv; k++)
-        raster_prepare(&r->rc, clip + 4 * (size_t)k, &r->pv[k]);
+    raster_prepare_n(&r->rc, clip, nv, r->pv);
     for (k = 0; k < ntri; k++) {
         const mesh_tri *t = &tri[k];
         uint32_t a = t->v[0] - v_base, b = t->v[1] - v_base, c = t->v[2] - v_base;
