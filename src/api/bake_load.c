@@ -39,10 +39,16 @@ static size_t popcount(const unsigned char *bits, size_t n)
 }
 
 /* Checks the header h (its first min(len, BAKE_HEADER) bytes read) of a
- * file of len bytes and fills L from it. */
-static plx_status check_header(const unsigned char *h, uint64_t len, bake_layout *L, char *err, size_t errlen)
+ * file of len bytes and fills L from it. *foreign is set when the file
+ * is of this format version and byte order but names other sizes or
+ * another build: such a file is from another build only when its
+ * checksum holds (the caller's to check, header_verdict); a damaged
+ * header byte there was blamed on the build. */
+static plx_status check_header(const unsigned char *h, uint64_t len, bake_layout *L, int *foreign, char *err,
+                               size_t errlen)
 {
     uint64_t flen, img;
+    *foreign = 0;
     if (!h || len < 8 || memcmp(h, BAKE_MAGIC, 8) != 0)
         return say(err, errlen, PLX_E_PARSE, "not a polarlux bake file (no PLXBAKE magic)", 0, NULL, 0, NULL);
     if (len < BAKE_HEADER)
@@ -51,6 +57,10 @@ static plx_status check_header(const unsigned char *h, uint64_t len, bake_layout
     if (bake_get32(h + H_VERSION) != BAKE_VERSION)
         return say(err, errlen, PLX_E_UNSUPPORTED, "bake format version ", bake_get32(h + H_VERSION),
                    ", this polarlux reads version ", BAKE_VERSION, "; bake the scene again");
+    /* (not for another byte order: its checksum, summed in that order,
+     * cannot be checked here) */
+    *foreign = bake_get32(h + H_ENDIAN) == BAKE_ENDIAN &&
+               (bake_get32(h + H_SIZES) != bake_arch_sizes() || bake_get32(h + H_LAYOUT) != bake_layout_print());
     if (bake_get32(h + H_ENDIAN) != BAKE_ENDIAN || bake_get32(h + H_SIZES) != bake_arch_sizes())
         return say(err, errlen, PLX_E_UNSUPPORTED,
                    "bake made on another architecture (byte order or pointer, size_t, double, long sizes "
@@ -89,10 +99,24 @@ static plx_status check_body(const bake_layout *L, size_t present, uint64_t sum,
     return PLX_OK;
 }
 
+/* A foreign header's verdict (check_header): another architecture or
+ * build (st, its message kept) when the checksum over the file (sum)
+ * holds, else a corrupt file. */
+static plx_status header_verdict(plx_status st, const unsigned char *h, uint64_t sum, char *err, size_t errlen)
+{
+    if (sum != bake_get64(h + H_SUM))
+        return say(err, errlen, PLX_E_PARSE, "corrupt bake file: checksum mismatch (in its header)", 0, NULL, 0,
+                   NULL);
+    return st;
+}
+
 /* Checks the header and the checksum; fills L. */
 static plx_status check_file(const unsigned char *f, size_t len, bake_layout *L, char *err, size_t errlen)
 {
-    plx_status st = check_header(f, len, L, err, errlen);
+    int foreign;
+    plx_status st = check_header(f, len, L, &foreign, err, errlen);
+    if (st != PLX_OK && foreign)
+        return header_verdict(st, f, bake_file_sum(f, len), err, errlen);
     if (st != PLX_OK)
         return st;
     return check_body(L, popcount(f + L->bitmap_at, L->npages), bake_file_sum(f, len), bake_get64(f + H_SUM), err,
@@ -279,23 +303,6 @@ static plx_status src_read(const bake_src *s, uint64_t off, void *buf, size_t n)
     return say(s->err, s->errlen, PLX_E_IO, "cannot read the bake file: ", n, " bytes at byte ", off, "");
 }
 
-/* s set up for the file of len bytes read through read(user, ...), its
- * header read into h and checked (check_header), L filled. */
-static plx_status src_open(bake_src *s, plx_bake_read_fn read, void *user, uint64_t len, char *err, size_t errlen,
-                           unsigned char h[BAKE_HEADER], bake_layout *L)
-{
-    plx_status st;
-    s->read = read;
-    s->user = user;
-    s->len = len;
-    s->err = err;
-    s->errlen = errlen;
-    st = src_read(s, 0, h, len < BAKE_HEADER ? (size_t)len : BAKE_HEADER);
-    if (st != PLX_OK)
-        return st;
-    return check_header(h, len, L, err, errlen);
-}
-
 /* The checksum over the file's bytes given in order in pieces of any
  * length: in groups of 32 from the header's end, as bake_file_sum takes
  * them in one piece. */
@@ -416,6 +423,32 @@ static plx_status sum_read(const bake_src *s, sum_stream *ss, uint64_t off, uint
         done += k;
     }
     return PLX_OK;
+}
+
+/* s set up for the file of len bytes read through read(user, ...), its
+ * header read into h and checked (check_header), L filled. */
+static plx_status src_open(bake_src *s, plx_bake_read_fn read, void *user, uint64_t len, char *err, size_t errlen,
+                           unsigned char h[BAKE_HEADER], bake_layout *L)
+{
+    plx_status st;
+    s->read = read;
+    s->user = user;
+    s->len = len;
+    s->err = err;
+    s->errlen = errlen;
+    int foreign;
+    sum_stream ss;
+    plx_status sr;
+    st = src_read(s, 0, h, len < BAKE_HEADER ? (size_t)len : BAKE_HEADER);
+    if (st != PLX_OK)
+        return st;
+    st = check_header(h, len, L, &foreign, err, errlen);
+    if (st == PLX_OK || !foreign)
+        return st;
+    ss_start(&ss, h); /* the whole file summed: another build's, or damaged */
+    if ((sr = sum_read(s, &ss, BAKE_HEADER, len - BAKE_HEADER, NULL, 0)) != PLX_OK)
+        return sr;
+    return header_verdict(st, h, ss_end(&ss), err, errlen);
 }
 
 /* The stored pages p .. q - 1 (the present-th stored page first) read

@@ -390,6 +390,7 @@ size_t jsonscan_error_at(const char *text, size_t len, size_t at, const char **t
         empty = text[k] == ' ' || text[k] == '\t' || text[k] == '\r' || text[k] == '\n';
     if (at > len || (truncated && at + 1 >= len) || empty)
         at = len;
-    *tail = at < len ? "" : truncated || empty ? ": the text ends early" : ": unexpected end";
+    *tail = at < len ? "" : empty ? (len == 0 ? ": the file is empty" : ": the text holds only white space")
+            : truncated ? ": the text ends early" : ": unexpected end";
     return at;
 }

@@ -84,7 +84,8 @@ int jsonscan_truncated(const char *text, size_t len);
  * pointer as an offset; past len or unknown: len): the end of the text
  * when cJSON ran off it (it reports the last byte of a text cut short)
  * or the text is empty or white space, else 'at'; *tail gets the words
- * for the end (": the text ends early", ": unexpected end") or "". */
+ * for the end (": the file is empty", ": the text holds only white
+ * space", ": the text ends early", ": unexpected end") or "". */
 size_t jsonscan_error_at(const char *text, size_t len, size_t at, const char **tail /* OUT */);
 
 #endif

@@ -336,6 +336,12 @@ expect bake-truncated 1 "^polarlux info: $tmp/cut\.plxb: truncated bake file: 50
 expect bake-version 1 "^polarlux render: tests/corpus/bake-version-99\.plxb: bake format version 99, this polarlux reads version 3; bake the scene again$" -- \
     "$bin" render tests/corpus/bake-version-99.plxb -o "$tmp/x.png"
 expect bake-arch 1 "bake made on another architecture" -- "$bin" vis tests/corpus/bake-big-endian.plxb --at 0,0
+# a damaged byte in the header's build print is a damaged file, not a bake
+# of another build (its checksum does not hold: it was blamed on the build)
+cp "$tmp/e.plxb" "$tmp/flip.plxb"; printf '\001' | dd of="$tmp/flip.plxb" bs=1 seek=20 conv=notrunc 2>/dev/null
+expect bake-header-flip 1 "flip\.plxb: corrupt bake file: checksum mismatch \(in its header\)" -- "$bin" info "$tmp/flip.plxb"
+printf '' >"$tmp/empty.geojson"
+expect info-empty-file 1 "malformed JSON at byte 0 \(line 1, column 1\): the file is empty" -- "$bin" info "$tmp/empty.geojson"
 expect bake-nomem 3 "the block is too small for the bake" -- "$bin" info --mem 64K "$tmp/e.plxb"
 # info --min-mem on a bake: the block its image loads in (it echoed --mem:
 # 1073741824 by default, 2147483648 with --mem 2G); the printed budget
