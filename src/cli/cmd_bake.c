@@ -265,6 +265,20 @@ static int save(const bake_args *a, plx_engine *e, plx_engine *t, size_t *bytes)
     return EXIT_OK;
 }
 
+/* A word on stderr when --texel asked for finer points than the atlas
+ * has (its budget, a quarter of --mem at most 64 MiB, took coarser ones;
+ * said on stdout only, among the bake's figures). */
+static void coarser_note(const bake_args *a, plx_engine *e)
+{
+    plx_atlas_info ai;
+    double asked = a->o.aerial_m_per_texel;
+    if (asked <= 0.0 || plx_atlas_info_get(e, &ai) != PLX_OK || !ai.made || !(ai.spacing > asked * 1.0001))
+        return;
+    cli_warn("bake", &a->c, "--texel %g: the radiance atlas's points are %.2f m apart, the finest that fits its "
+             "budget (a quarter of --mem, at most 64 MiB)%s", asked, ai.spacing,
+             a->c.mem ? "; a larger --mem fits finer ones" : "");
+}
+
 int cmd_bake(int argc, char **argv)
 {
     bake_args a;
@@ -312,6 +326,7 @@ int cmd_bake(int argc, char **argv)
         printf("baked %s into %s: %zu bytes (%.1f MiB); engine memory in use %zu bytes (%.1f MiB)\n", a.scene,
                a.out, bytes, bytes / 1048576.0, m.used_total, m.used_total / 1048576.0);
         cli_atlas_print(e);
+        coarser_note(&a, e);
         char ph[96];
         if (a.ind.off)
             snprintf(ph, sizeof ph, "no photons (%s)", a.frames0 ? "--frames 0: as --no-indirect" : "--no-indirect");

@@ -204,6 +204,10 @@ expect bake-nomem-hint-small-frames 3 "out of memory while creating the photon b
     "$bin" bake -q fixtures/eixample-4x4.geojson --no-aerial --no-polar --max-size 16x16 --mem 2M -o "$tmp/nomem.plxb"
 expect bake-nomem-hint-fits 0 "^baked " -- \
     "$bin" bake -q fixtures/eixample-4x4.geojson --no-aerial --no-polar --no-indirect --max-size 16x16 --mem 2M -o "$tmp/nomem.plxb"
+# --texel finer than the atlas's budget takes is said on stderr (it was a
+# figure on stdout only: 0.25 asked, 0.30 m made)
+expect bake-texel-coarser 0 "warning: --texel 0\.5: the radiance atlas's points are 0\.71 m apart, the finest that fits its budget" -- \
+    "$bin" bake fixtures/eixample-4x4.geojson --texel 0.5 --mem 24M --frames 2 --photons 4000 --max-size 160x120 -o "$tmp/tc.plxb"
 # walk and render (and illum) out of memory for the photon buffers name
 # --no-indirect (a walk in --mem 1M said only that they did not fit)
 expect walk-nomem-photons-hint 3 "out of memory while creating the photon buffers.*\(--no-indirect needs no photon buffers: direct light alone; or give a larger --mem\)$" -- \
