@@ -765,9 +765,10 @@ static int run(const walk_args *a, plx_engine *e, const walk_path *wp, long *don
         /* the middle frame, or the mean of the two middle ones */
         med = wr.n % 2 ? sorted[wr.n / 2] : 0.5 * (sorted[wr.n / 2 - 1] + sorted[wr.n / 2]);
         p95 = sorted[(size_t)ceil(0.95 * wr.n) - 1];
-        printf("walk: %ld frame%s %dx%d (%.1f m of %.1f m at %g m/s, %g fps, aa %d), written to %s/\n", wr.n,
+        printf("walk: %ld frame%s %dx%d (%.1f m of %.1f m at %g m/s, %g fps, aa %d), written to %s%s\n", wr.n,
                wr.n == 1 ? "" : "s", a->w, a->h, frame_at(wr.n - 1, step, L), L, a->speed, a->fps,
-               a->opts.aa > 1 ? a->opts.aa : 1, a->dir);
+               a->opts.aa > 1 ? a->opts.aa : 1, a->dir,
+               a->dir[0] && a->dir[strlen(a->dir) - 1] == '/' ? "" : "/"); /* "DIR/" as given, one slash */
         printf("frame time: median %.2f ms, p95 %.2f ms, mean %.2f ms: %.1f frames per second (rendering only)\n",
                med, p95, sum / wr.n, 1000.0 * wr.n / sum);
         if (wr.lookups)
