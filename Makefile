@@ -29,11 +29,12 @@ CPPFLAGS = -Iinclude -Isrc -Iport
 CFLAGS_ALL = $(WARN) $(FPFLAGS) $(OPT) -fPIC -MMD -MP $(EXTRA_CFLAGS)
 POSIX    = -D_POSIX_C_SOURCE=200809L
 # The core needs libm only (it reads JSON itself, without cJSON); the port
-# (port/posix, port/png) adds libpng and pthreads. The command and the tests
-# link both with $(LIBS), which adds cJSON: they still parse JSON with it.
+# (port/posix, port/png) adds libpng, zlib (the animated PNG's CRCs, with
+# libpng's own zlib) and pthreads. The command and the tests link both with
+# $(LIBS), which adds cJSON: they still parse JSON with it.
 CORE_LIBS = -lm
-PORT_LIBS = -lpng -lpthread
-LIBS     = -lcjson -lpng -lm -lpthread
+PORT_LIBS = -lpng -lz -lpthread
+LIBS     = -lcjson -lpng -lz -lm -lpthread
 # The command alone also links SQLite (polarlux tiles to MBTiles).
 CLI_LIBS = -lsqlite3
 
@@ -77,7 +78,7 @@ all: $(LIB_A) $(LIB_SO) $(PORT_A) $(BIN)
 # packages are there (when dpkg is) and stops naming the missing ones.
 # `make deps` installs every package of DEB_PACKAGES (with apt-get, as root)
 # and says which. The Python packages are needed by `make check` only.
-BUILD_PACKAGES = libcjson-dev libcmocka-dev libpng-dev pkg-config libsqlite3-dev
+BUILD_PACKAGES = libcjson-dev libcmocka-dev libpng-dev zlib1g-dev pkg-config libsqlite3-dev
 missing_packages = for p in $(1); do \
 	  dpkg-query -W -f='$${Status}' $$p 2>/dev/null | grep -q "ok installed" || missing="$$missing $$p"; \
 	done
@@ -351,7 +352,7 @@ install: all
 	printf '%s\n' 'prefix=$(PREFIX)' 'libdir=$${prefix}/lib' 'includedir=$${prefix}/include' '' \
 	  'Name: polarlux-port' 'Description: polarlux POSIX port and PNG/PFM files' \
 	  'Version: $(VERSION)' 'Requires: polarlux' 'Libs: -L$${libdir} -lpolarlux-port' \
-	  'Libs.private: $(PORT_LIBS)' 'Requires.private: libpng' 'Cflags: -I$${includedir}' \
+	  'Libs.private: $(PORT_LIBS)' 'Requires.private: libpng zlib' 'Cflags: -I$${includedir}' \
 	  > $(DESTDIR)$(PREFIX)/lib/pkgconfig/polarlux-port.pc
 
 clean:

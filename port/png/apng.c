@@ -7,23 +7,26 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <zlib.h>
 
 #include "png/image_write.h"
 #include "port.h"
 
 static const unsigned char sig[8] = { 0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n' };
 
-/* CRC-32 of the PNG specification (polynomial 0xedb88320, reflected). */
+/* CRC-32 of the PNG specification, zlib's (the same polynomial, the
+ * chunks' CRC as libpng computes it), over n bytes in steps zlib's uInt
+ * can count. */
 static uint32_t crc_update(uint32_t c, const unsigned char *p, size_t n)
 {
-    size_t i;
-    int k;
-    for (i = 0; i < n; i++) {
-        c ^= p[i];
-        for (k = 0; k < 8; k++)
-            c = (c >> 1) ^ (0xedb88320u & (0u - (c & 1u)));
+    uLong z = c ^ 0xffffffffu; /* zlib's crc32 takes and gives the CRC complemented */
+    while (n > 0) {
+        uInt k = n > 0x40000000u ? 0x40000000u : (uInt)n;
+        z = crc32(z, p, k);
+        p += k;
+        n -= k;
     }
-    return c;
+    return (uint32_t)z ^ 0xffffffffu;
 }
 
 static void be32(unsigned char *p, uint32_t v)
