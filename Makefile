@@ -63,7 +63,7 @@ LIB_SO_REAL = $(BUILD)/libpolarlux.so.$(VERSION)
 LIB_SO = $(BUILD)/libpolarlux.so
 PORT_A = $(BUILD)/libpolarlux-port.a
 BIN    = $(BUILD)/polarlux
-DEB_PACKAGES = libcjson-dev libcmocka-dev libpng-dev pkg-config python3-numpy python3-pytest libsqlite3-dev \
+DEB_PACKAGES = libcjson-dev libcmocka-dev libpng-dev zlib1g-dev pkg-config python3-numpy python3-pytest libsqlite3-dev \
                libosmesa6-dev
 
 .SECONDARY:

@@ -1051,13 +1051,17 @@ plx_status plx_bake_load(void *mem, size_t size, const plx_config *cfg, const vo
  * checks when given scratch (scratch_len >= 512 bytes of the caller's to
  * read the file through; the more, the fewer reads), else the header's
  * only (its size field unchecked: a damaged one can ask for a block far
- * too big); plx_bake_load_read checks the whole file
- * as plx_bake_load does, reading it once with the block as its buffer,
- * then loads it reading it again: the same engine as plx_bake_load's,
- * the same errors and messages, plus PLX_E_IO (a read failed: which
- * bytes) and PLX_E_PARSE "corrupt bake file: it changed while it was
- * read" (the second reading's checksum is not the first's). After an
- * error the block's contents are unspecified. Threads: none.
+ * too big); plx_bake_load_read reads the file once, straight into the
+ * block, checking it as it reads as plx_bake_load does (only a reading
+ * that fails is followed by a second, checking the whole file through
+ * the block for the damaged file's own message): the same engine as
+ * plx_bake_load's, the same errors and messages, plus PLX_E_IO (a read
+ * failed: which bytes) and PLX_E_PARSE "corrupt bake file: it changed
+ * while it was read" (the first reading failed its checks, the second
+ * passed them). When the image does not fit the block, the file is
+ * checked first through 512 bytes of the stack, so that a damaged file
+ * gets its own error before the block's. After an error the block's
+ * contents are unspecified. Threads: none.
  */
 typedef int (*plx_bake_read_fn)(void *user, uint64_t off, void *buf, size_t n);
 plx_status plx_bake_block_size_read(plx_bake_read_fn read, void *user, uint64_t len, void *scratch, size_t scratch_len,

@@ -357,8 +357,9 @@ static size_t bitmap_bits(const bake_layout *L, uint64_t off, const unsigned cha
     return c;
 }
 
-/* The first reading: the whole file through buf (n bytes), checked as
- * check_file checks a file in memory. */
+/* The whole file read through buf (n bytes) and checked as check_file
+ * checks a file in memory: a block too small's first reading, and the
+ * verdict on a file whose loading failed (load_once). */
 static plx_status check_read(const bake_src *s, const unsigned char *h, const bake_layout *L, unsigned char *buf,
                              size_t n)
 {
@@ -466,10 +467,11 @@ static plx_status read_pages(const bake_src *s, const bake_layout *L, sum_stream
     return sum_read(s, ss, at + (end - start), (uint64_t)(q - p) * BAKE_PAGE - (end - start), NULL, 0);
 }
 
-/* The second reading: the pages into the image at base, the relocations
- * applied, the checksum taken again; the bitmap that placed the pages
- * (read again in windows as they pass) must be the one summed (a file
- * that moved a stored page's bit between them kept its checksum). */
+/* The loading reading: the pages into the image at base, the relocations
+ * applied, the checksum and the stored pages' count taken; the bitmap
+ * that placed the pages (read again in windows as they pass) must be the
+ * one summed (a file that moved a stored page's bit between them kept its
+ * checksum). */
 static plx_status copy_read(const bake_src *s, const unsigned char *h, const bake_layout *L, unsigned char *base)
 {
     sum_stream ss;
@@ -511,10 +513,30 @@ static plx_status copy_read(const bake_src *s, const unsigned char *h, const bak
             if ((st = relocate(base, L->image, k + i, bake_get32(buf + 4 * i), s->err, s->errlen)) != PLX_OK)
                 return st;
     }
-    if (ss_end(&ss) != bake_get64(h + H_SUM) || bake_sum_end(&w.used) != bake_sum_end(&summed))
+    if (present != L->pages_present || ss_end(&ss) != bake_get64(h + H_SUM) ||
+        bake_sum_end(&w.used) != bake_sum_end(&summed))
         return say(s->err, s->errlen, PLX_E_PARSE, "corrupt bake file: it changed while it was read", 0, NULL, 0,
                    NULL);
     return PLX_OK;
+}
+
+/* The file read once into the image at base (cap bytes), checked as it
+ * is read (copy_read); when that fails, read again through the block
+ * (check_read) for check_file's verdict on a damaged file, the first
+ * reading's error kept when the file passes (a failed read, or a file
+ * that changed). */
+static plx_status load_once(const bake_src *s, const unsigned char *h, const bake_layout *L, unsigned char *base,
+                            size_t cap)
+{
+    char first[256];
+    plx_status st = copy_read(s, h, L, base), st2;
+    if (st == PLX_OK)
+        return st;
+    say(first, sizeof first, st, s->err && s->errlen ? s->err : "", 0, NULL, 0, NULL);
+    st2 = check_read(s, h, L, base, cap < READ_BIG ? cap : READ_BIG);
+    if (st2 != PLX_OK)
+        return st2;
+    return say(s->err, s->errlen, st, first, 0, NULL, 0, NULL);
 }
 
 plx_status plx_bake_block_size_read(plx_bake_read_fn read, void *user, uint64_t len, void *scratch, size_t scratch_len,
@@ -553,15 +575,15 @@ plx_status plx_bake_load_read(void *mem, size_t size, const plx_config *cfg, plx
                    NULL);
     if ((st = src_open(&s, read, user, len, err, errlen, h, &L)) != PLX_OK)
         return st;
-    /* checked first, with the block as the buffer when the image fits
-     * (else the stack's, and then the block's error, as plx_bake_load) */
+    /* when the image fits, read once into it and checked as it is read;
+     * else checked through the stack first, then the block's error, as
+     * plx_bake_load */
     fits = place(mem, size, h, &L, &base, &cap, NULL, 0);
     if (fits == PLX_OK)
-        st = check_read(&s, h, &L, base, cap < READ_BIG ? cap : READ_BIG);
-    else
-        st = check_read(&s, h, &L, small, sizeof small);
-    if (st != PLX_OK || (st = place(mem, size, h, &L, &base, &cap, err, errlen)) != PLX_OK ||
-        (st = copy_read(&s, h, &L, base)) != PLX_OK)
+        st = load_once(&s, h, &L, base, cap);
+    else if ((st = check_read(&s, h, &L, small, sizeof small)) == PLX_OK)
+        st = place(mem, size, h, &L, &base, &cap, err, errlen);
+    if (st != PLX_OK)
         return st;
     return finish(mem, base, cap, L.image, cfg, out, err, errlen);
 }

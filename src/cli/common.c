@@ -578,6 +578,18 @@ static int bake_has_atlas(plx_engine *e)
     return plx_indirect_frames(e) == 0 || (plx_atlas_info_get(e, &ai) == PLX_OK && ai.made);
 }
 
+/* The block size of the bake read through in, after the whole file is
+ * checked (through a buffer of the command's own, freed before any block
+ * is taken): a damaged file's verdict. */
+static plx_status block_size_checked(bake_in *in, uint64_t len, size_t *need, char *err, size_t errlen)
+{
+    void *scratch = malloc(CLI_BAKE_SCRATCH);
+    plx_status st = plx_bake_block_size_read(bake_read, in, len, scratch, scratch ? CLI_BAKE_SCRATCH : 0, need, err,
+                                             errlen);
+    free(scratch);
+    return st;
+}
+
 /* An engine from a bake file: the file read through the library's
  * reads into the block sized by the bake (or --mem), its pointers
  * relocated. */
@@ -585,7 +597,7 @@ static int open_bake(const char *cmd, const char *path, const cli_common *c, plx
 {
     char err[512];
     size_t len, need;
-    void *mem, *big = NULL;
+    void *mem = NULL, *big = NULL;
     bake_in in;
     plx_config cfg;
     plx_status st;
@@ -599,13 +611,12 @@ static int open_bake(const char *cmd, const char *path, const cli_common *c, plx
     if (c->mem) { /* the block given: the load checks the file as it reads it */
         need = c->mem;
     } else {
-        /* the whole file checked before a block is taken for it (a
-         * damaged size field asked for 4.6e18 bytes), through a buffer of
-         * the command's own, freed before the block is taken */
-        void *scratch = malloc(CLI_BAKE_SCRATCH);
-        st = plx_bake_block_size_read(bake_read, &in, len, scratch, scratch ? CLI_BAKE_SCRATCH : 0, &need, err,
-                                      sizeof err);
-        free(scratch);
+        /* the block the header asks for, the load checking the file as it
+         * reads it; the whole file checked first only when that block
+         * cannot be had (a damaged size field asked for 4.6e18 bytes) */
+        st = plx_bake_block_size_read(bake_read, &in, len, NULL, 0, &need, err, sizeof err);
+        if (st == PLX_OK && !(mem = cli_big_alloc(need)))
+            st = block_size_checked(&in, len, &need, err, sizeof err);
         if (st != PLX_OK) {
             bake_say(cmd, path, st, err, &in);
             close(in.fd);
@@ -613,7 +624,7 @@ static int open_bake(const char *cmd, const char *path, const cli_common *c, plx
         }
     }
     cli_config(c, &cfg);
-    if (!(mem = cli_big_alloc(need))) {
+    if (!mem && !(mem = cli_big_alloc(need))) {
         fprintf(stderr, "polarlux %s: %s: cannot take a block of %zu bytes for the bake\n", cmd, path, need);
         close(in.fd);
         return EXIT_NOMEM;
