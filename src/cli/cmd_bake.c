@@ -276,7 +276,7 @@ static void coarser_note(const bake_args *a, plx_engine *e)
         return;
     cli_warn("bake", &a->c, "--texel %g: the radiance atlas's points are %.2f m apart, the finest that fits its "
              "budget (a quarter of --mem, at most 64 MiB)%s", asked, ai.spacing,
-             a->c.mem ? "; a larger --mem fits finer ones" : "");
+             a->c.mem && a->c.mem / 4 < PLX_ATLAS_MAX_BYTES ? "; a larger --mem fits finer ones" : "");
 }
 
 int cmd_bake(int argc, char **argv)

@@ -445,10 +445,12 @@ int cmd_render(int argc, char **argv)
         cli_warn("render", &a.c, "the image is entirely black: %s",
                  cli_black_reason(e, &a.cam, &a.opts, info.exposure, rgb8, why, sizeof why));
     } else if (rc == EXIT_OK) {
-        double share = cli_black_share(rgb8, (size_t)a.cam.width * a.cam.height);
+        size_t npx = (size_t)a.cam.width * a.cam.height;
+        double share = cli_black_share(rgb8, npx);
+        /* the share rounded down: 100.00% would say all */
         if (share >= CLI_NEARLY_BLACK)
-            cli_warn("render", &a.c, "the image is nearly black: %.2f%% of its pixels are black: %s", 100.0 * share,
-                     CLI_NEARLY_BLACK_WHY);
+            cli_warn("render", &a.c, "the image is nearly black: %.2f%% of its pixels are black (%.0f lit): %s",
+                     floor(share * 10000.0) / 100.0, (1.0 - share) * (double)npx, CLI_NEARLY_BLACK_WHY);
     }
     prec = coord_digits(e);
     cli_from_local(e, &a.cam.eye[0], &a.cam.eye[1]);

@@ -560,7 +560,9 @@ static int frame(const walk_args *a, plx_engine *e, const walk_path *wp, walk_ru
     if (!info.eye_inside && !black && cli_black_share(wr->rgb8, (size_t)a->w * a->h) >= CLI_NEARLY_BLACK &&
         wr->nearly++ == 0)
         wr->first_nearly = k + 1;
-    wr->from_atlas += info.shaded_pixels == 0 && !info.eye_inside;
+    /* no pixel shaded, and something drawn: read from the radiance atlas
+     * (a black frame, of sky alone, shades nothing either) */
+    wr->from_atlas += info.shaded_pixels == 0 && !info.eye_inside && !black;
     if (info.eye_inside && wr->inside++ == 0) {
         wr->first_inside = k + 1;
         memcpy(wr->inside_eye, cam.eye, sizeof wr->inside_eye);

@@ -69,11 +69,18 @@ static int take_opt(const char *cmd, int argc, char **argv, int *i, const cli_op
 
 /* ---- outputs that would replace an input -------------------------------- */
 
-/* Whether option name n names an output file (the others that keep a
- * string name input files, or points). */
+/* Whether option name n names an output file. */
 static int output_opt(const char *n)
 {
     return strcmp(n, "-o") == 0 || strcmp(n, "--pfm") == 0 || strcmp(n, "--geojson") == 0 || strcmp(n, "--csv") == 0;
+}
+
+/* Whether option name n names an input file (the other string options
+ * keep points or ids: network's --from and --to, lit's --lamp). */
+static int input_opt(const char *n)
+{
+    return strcmp(n, "--path") == 0 || strcmp(n, "--points") == 0 || strcmp(n, "--network") == 0 ||
+           strcmp(n, "--lamps") == 0 || strcmp(n, "the input") == 0;
 }
 
 /* Whether paths a and b are one existing regular file (the same device
@@ -85,26 +92,66 @@ static int same_file(const char *a, const char *b)
            sa.st_dev == sb.st_dev && sa.st_ino == sb.st_ino;
 }
 
+/* Path p's folder, as stat takes it, in buf (n bytes), and its last
+ * part; 0 when the path is too long for buf. */
+static int split_path(const char *p, char *buf, size_t n, const char **base)
+{
+    const char *slash = strrchr(p, '/');
+    size_t d;
+    if (!slash) {
+        *base = p;
+        return snprintf(buf, n, ".") > 0;
+    }
+    *base = slash + 1;
+    d = slash == p ? 1 : (size_t)(slash - p);
+    if (d + 1 > n)
+        return 0;
+    memcpy(buf, p, d);
+    buf[d] = '\0';
+    return 1;
+}
+
+/* Whether outputs a and b are one file: the same existing file, or, not
+ * there yet, the same name in the same folder (another spelling of the
+ * folder too: './a.png' and 'a.png'). */
+static int same_output(const char *a, const char *b)
+{
+    char da[4096], db[4096];
+    const char *ba, *bb;
+    struct stat sa, sb;
+    if (strcmp(a, b) == 0 || same_file(a, b))
+        return 1;
+    if (stat(a, &sa) == 0 || stat(b, &sb) == 0) /* one is there: same_file said no */
+        return 0;
+    return split_path(a, da, sizeof da, &ba) && split_path(b, db, sizeof db, &bb) && strcmp(ba, bb) == 0 &&
+           ba[0] != '\0' && stat(da, &sa) == 0 && stat(db, &sb) == 0 && sa.st_dev == sb.st_dev &&
+           sa.st_ino == sb.st_ino;
+}
+
 #define CLI_MAX_FILES 32
 
 /* The file names of a command line: its outputs and its inputs, each
  * with the option (or word) that gave it. */
 typedef struct cli_files {
     const char *on[CLI_MAX_FILES], *ov[CLI_MAX_FILES], *in[CLI_MAX_FILES], *iv[CLI_MAX_FILES];
-    int no, ni;
+    const char *out_std;        /* the first output given as '-' (standard output) */
+    int no, ni, nstd;
 } cli_files;
 
 /* A string option's value (o: its table entry, as typed: name) kept
  * among the outputs or the inputs ("-": standard output or input, no
- * file). */
+ * file; outputs there counted); options of points or ids left out. */
 static void file_opt(cli_files *f, const char *name, const char *v)
 {
-    if (strcmp(v, "-") == 0)
+    if (strcmp(v, "-") == 0) {
+        if (output_opt(name) && f->nstd++ == 0)
+            f->out_std = name;
         return;
+    }
     if (output_opt(name) && f->no < CLI_MAX_FILES) {
         f->on[f->no] = name;
         f->ov[f->no++] = v;
-    } else if (!output_opt(name) && f->ni < CLI_MAX_FILES) {
+    } else if (input_opt(name) && f->ni < CLI_MAX_FILES) {
         f->in[f->ni] = name;
         f->iv[f->ni++] = v;
     }
@@ -129,10 +176,13 @@ static int outputs_clash(const char *cmd, cli_files *f, const cli_common *c, con
                 return cli_usage_error(cmd, "%s '%s' is %s '%s': writing it would replace it; choose another name",
                                        f->on[k], f->ov[k], f->in[i], f->iv[i]);
         for (i = 0; i < k; i++)
-            if (strcmp(f->ov[k], f->ov[i]) == 0 || same_file(f->ov[k], f->ov[i]))
+            if (same_output(f->ov[k], f->ov[i]))
                 return cli_usage_error(cmd, "%s '%s' and %s '%s' name the same file; give each its own", f->on[i],
                                        f->ov[i], f->on[k], f->ov[k]);
     }
+    if (f->nstd > 1)
+        return cli_usage_error(cmd, "%s and another output are both '-': only one can go to standard output",
+                               f->out_std);
     return EXIT_OK;
 }
 

@@ -103,9 +103,13 @@ if [ "$(wc -c < "$tmp/s.pfm")" -gt $((160 * 120 * 12)) ]; then echo "ok   render
 # frame first: 3.5 s for an aerial view of gen eixample 30 30)
 expect render-out-missing-folder 1 "polarlux render: cannot create a temporary file for '$tmp/nodir/x.png'" -- \
     "$bin" render fixtures/tiny.geojson -o "$tmp/nodir/x.png"
-if ! grep -q "view 160x120\|view [0-9]*x[0-9]* from" "$tmp/out"; then echo "ok   render-out-missing-folder-first"; pass=$((pass + 1)); else echo "FAIL render-out-missing-folder-first"; fail=$((fail + 1)); fi
+# before the work: before the scene is even read (tiny.geojson's loading
+# warns of a lamp inside a building; the check of before wrote no image
+# either, but loaded the scene and drew the frame first)
+if ! grep -q "view [0-9]*x[0-9]* from\|lamp is inside building" "$tmp/out"; then echo "ok   render-out-missing-folder-first"; pass=$((pass + 1)); else echo "FAIL render-out-missing-folder-first"; fail=$((fail + 1)); fi
 expect heatmap-out-missing-folder 1 "polarlux heatmap: cannot create a temporary file" -- \
     "$bin" heatmap fixtures/tiny.geojson -o "$tmp/nodir/h.png"
+if ! grep -q "lamp is inside building" "$tmp/out"; then echo "ok   heatmap-out-missing-folder-first"; pass=$((pass + 1)); else echo "FAIL heatmap-out-missing-folder-first"; fail=$((fail + 1)); fi
 # an output that names an input (or the other output) is refused before any
 # work, and the input is left as it was
 cp fixtures/tiny.geojson "$tmp/in.geojson"; ln -s in.geojson "$tmp/in-link.png"
@@ -206,8 +210,22 @@ expect bake-nomem-hint-fits 0 "^baked " -- \
     "$bin" bake -q fixtures/eixample-4x4.geojson --no-aerial --no-polar --no-indirect --max-size 16x16 --mem 2M -o "$tmp/nomem.plxb"
 # --texel finer than the atlas's budget takes is said on stderr (it was a
 # figure on stdout only: 0.25 asked, 0.30 m made)
-expect bake-texel-coarser 0 "warning: --texel 0\.5: the radiance atlas's points are 0\.71 m apart, the finest that fits its budget" -- \
+# (a larger --mem named only where a quarter of it is below the atlas's 64 MiB)
+expect bake-texel-coarser 0 "warning: --texel 0\.5: the radiance atlas's points are 0\.71 m apart, the finest that fits its budget \(a quarter of --mem, at most 64 MiB\); a larger --mem fits finer ones$" -- \
     "$bin" bake fixtures/eixample-4x4.geojson --texel 0.5 --mem 24M --frames 2 --photons 4000 --max-size 160x120 -o "$tmp/tc.plxb"
+# outputs: a new file named twice (another spelling of its folder), two
+# outputs to standard output; string options of points and ids are no files
+mkdir -p "$tmp/sub"
+expect render-new-output-twice 2 "-o '$tmp/nf.png' and --pfm '$tmp/sub/../nf.png' name the same file" -- \
+    "$bin" render fixtures/tiny.geojson --size 8x6 --no-indirect -o "$tmp/nf.png" --pfm "$tmp/sub/../nf.png"
+if [ ! -e "$tmp/nf.png" ]; then echo "ok   render-new-output-twice-nothing"; pass=$((pass + 1)); else echo "FAIL render-new-output-twice-nothing"; fail=$((fail + 1)); fi
+expect render-two-stdout 2 "-o and another output are both '-': only one can go to standard output" -- \
+    "$bin" render fixtures/tiny.geojson --size 8x6 --no-indirect -o - --pfm -
+# (lit --lamp 0 -o 0 twice in one folder: the second was refused, '0' taken for an input file)
+here=$(pwd); abin=$(cd "$(dirname "$bin")" && pwd)/$(basename "$bin")
+(cd "$tmp" && "$abin" lit -q "$here/fixtures/tiny.geojson" --lamp 0 -o 0 >/dev/null 2>&1)
+(cd "$tmp" && "$abin" lit -q "$here/fixtures/tiny.geojson" --lamp 0 -o 0 >"$tmp/out" 2>&1); rc=$?
+if [ "$rc" -eq 0 ]; then echo "ok   lit-lamp-id-same-as-output"; pass=$((pass + 1)); else echo "FAIL lit-lamp-id-same-as-output: exit $rc"; sed 's/^/    /' "$tmp/out" | head -3; fail=$((fail + 1)); fi
 # walk and render (and illum) out of memory for the photon buffers name
 # --no-indirect (a walk in --mem 1M said only that they did not fit)
 expect walk-nomem-photons-hint 3 "out of memory while creating the photon buffers.*\(--no-indirect needs no photon buffers: direct light alone; or give a larger --mem\)$" -- \
@@ -382,7 +400,7 @@ expect bake-min-mem-from-above-less 0 "leaves no room for adaptive anti-aliasing
 # a view with a few lit pixels (the city 3 km off) is nearly black: said
 # (only an entirely black one was), by render and by walk; a normal view
 # from above (about 70% black: its roofs) is not
-expect render-nearly-black 0 "warning: the image is nearly black: 99\.[0-9]+% of its pixels are black: little that is lit is in view" -- \
+expect render-nearly-black 0 "warning: the image is nearly black: 99\.[0-9]+% of its pixels are black \([0-9]+ lit\): little that is lit is in view" -- \
     "$bin" render "$tmp/e.plxb" --eye -3000,266,60 --target 266,266,0 --size 160x120 -o "$tmp/nb.png"
 printf '{"type":"LineString","coordinates":[[-3000,266,60],[-2999,266,60]],"properties":{"targets":[[266,266,0],[266,266,0]]}}' >"$tmp/nb.geojson"
 expect walk-nearly-black 0 "warning: 2 of 2 frames are nearly black, 99% of their pixels or more \(the first: frame 1\)" -- \
@@ -643,6 +661,11 @@ if [ $? -eq 0 ] && ! grep -q -- "--view aerial" "$tmp/out"; then echo "ok   walk
 # no byte: said (it was taken silently)
 expect walk-view-aerial-atlas 0 "--view aerial changed nothing: the camera comes from the path" -- \
     "$bin" walk "$tmp/e.plxb" --path "$tmp/high.geojson" --size 32x24 --fps 0.5 --aa 1 --view aerial -o "$tmp/wh3"
+# ... but not when the frames show sky alone (they shade nothing either;
+# it blamed the atlas with --per-pixel given)
+printf '{"type":"Feature","properties":{"targets":[[30,30.5,500],[31,30.5,500]]},"geometry":{"type":"LineString","coordinates":[[30,30,2],[31,30,2]]}}' >"$tmp/sky.geojson"
+"$bin" walk fixtures/tiny.geojson --path "$tmp/sky.geojson" --size 32x24 --fps 1 --speed 1 --per-pixel --view aerial -o "$tmp/wsky2" >"$tmp/out" 2>&1
+if [ $? -eq 0 ] && ! grep -q -- "changed nothing" "$tmp/out"; then echo "ok   walk-view-aerial-sky-no-blame"; pass=$((pass + 1)); else echo "FAIL walk-view-aerial-sky-no-blame"; sed 's/^/    /' "$tmp/out" | head; fail=$((fail + 1)); fi
 # an eye inside a building: its frames show the inside of its walls, 3.7 s
 # each on gen eixample 30 30 (every pixel computed), and walk said nothing
 printf '{"type":"LineString","coordinates":[[5,5,1.7],[5,6,1.7]]}' >"$tmp/inside.geojson"
