@@ -385,12 +385,16 @@ int jsonscan_truncated(const char *text, size_t len)
 size_t jsonscan_error_at(const char *text, size_t len, size_t at, const char **tail)
 {
     int truncated = jsonscan_truncated(text, len), empty = 1;
-    size_t k;
-    for (k = 0; k < len && empty; k++)
+    size_t bom = len >= 3 && memcmp(text, "\xEF\xBB\xBF", 3) == 0 ? 3 : 0, k; /* a UTF-8 byte-order mark */
+    for (k = bom; k < len && empty; k++)
         empty = text[k] == ' ' || text[k] == '\t' || text[k] == '\r' || text[k] == '\n';
     if (at > len || (truncated && at + 1 >= len) || empty)
         at = len;
-    *tail = at < len ? "" : empty ? (len == 0 ? ": the file is empty" : ": the text holds only white space")
+    *tail = at < len ? ""
+            : empty ? (len == 0      ? ": the file is empty"
+                       : len == bom  ? ": the text holds only a UTF-8 byte-order mark"
+                       : bom         ? ": the text holds only a UTF-8 byte-order mark and white space"
+                                     : ": the text holds only white space")
             : truncated ? ": the text ends early" : ": unexpected end";
     return at;
 }

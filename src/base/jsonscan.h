@@ -83,9 +83,11 @@ int jsonscan_truncated(const char *text, size_t len);
 /* Where to report a parse that stopped at byte 'at' (cJSON's error
  * pointer as an offset; past len or unknown: len): the end of the text
  * when cJSON ran off it (it reports the last byte of a text cut short)
- * or the text is empty or white space, else 'at'; *tail gets the words
- * for the end (": the file is empty", ": the text holds only white
- * space", ": the text ends early", ": unexpected end") or "". */
+ * or the text is empty or white space (after a UTF-8 byte-order mark,
+ * which the readers skip), else 'at'; *tail gets the words for the end
+ * (": the file is empty", ": the text holds only white space", ": the
+ * text holds only a UTF-8 byte-order mark" [" and white space"], ": the
+ * text ends early", ": unexpected end") or "". */
 size_t jsonscan_error_at(const char *text, size_t len, size_t at, const char **tail /* OUT */);
 
 #endif

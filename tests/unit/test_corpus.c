@@ -122,6 +122,18 @@ typedef struct corpus_case {
 
 /* Messages carry no file name: the corpus is loaded with name NULL. */
 static const corpus_case corpus[] = {
+    { "bom-only.geojson", PLX_E_PARSE,
+      "malformed JSON at byte 3 (line 1, column 4): the text holds only a UTF-8 byte-order mark",
+      "malformed JSON at byte 3 (line 1, column 4): the text holds only a UTF-8 byte-order mark",
+      "",
+      0, 0, 0, 0,
+      NULL },
+    { "bom-whitespace.geojson", PLX_E_PARSE,
+      "malformed JSON at byte 8 (line 3, column 1): the text holds only a UTF-8 byte-order mark and white space",
+      "malformed JSON at byte 8 (line 3, column 1): the text holds only a UTF-8 byte-order mark and white space",
+      "",
+      0, 0, 0, 0,
+      NULL },
     { "bowtie-rings.geojson", PLX_OK,
       NULL,
       "feature 0 (bowtie, line 2, column 1): outer ring intersects itself (edges 0 and 2 meet)",
