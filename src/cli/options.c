@@ -191,7 +191,7 @@ int cli_options_n(const char *cmd, const char *help, int argc, char **argv, cons
 {
     int i;
     cli_files files;
-    files.no = files.ni = 0;
+    memset(&files, 0, sizeof files);
     memset(out, 0, sizeof *out);
     if (maxpos > CLI_MAX_POS)
         maxpos = CLI_MAX_POS;
