@@ -232,9 +232,12 @@ static int print_min_mem_bake(const char *path, size_t hi, int has_polar)
                "(bisection, as above; street views and --aa 1 may need less; walk's own frame buffers, 3 bytes a "
                "pixel of its --size, and its contact sheet take what --mem leaves beside)\n",
                frames, frames / 1048576.0, fw, fh);
-    else
+    else if (fw > 0 && fh > 0)
         printf("smallest --mem for frames from above: not found: a %dx%d frame of the whole scene with 2 x 2 "
                "samples does not fit in %zu bytes\n", fw, fh, top);
+    else
+        printf("smallest --mem for frames from above: not found: the bake did not load in %zu bytes to ask its "
+               "largest frame\n", top);
     return EXIT_OK;
 }
 
