@@ -362,6 +362,14 @@ expect bake-arch 1 "bake made on another architecture" -- "$bin" vis tests/corpu
 # of another build (its checksum does not hold: it was blamed on the build)
 cp "$tmp/e.plxb" "$tmp/flip.plxb"; printf '\001' | dd of="$tmp/flip.plxb" bs=1 seek=20 conv=notrunc 2>/dev/null
 expect bake-header-flip 1 "flip\.plxb: corrupt bake file: checksum mismatch \(in its header\)" -- "$bin" info "$tmp/flip.plxb"
+# the size fields the block is taken by, damaged (the command asks the
+# header's size and checks the whole file only when that block cannot be
+# had): a size far too big (byte 71, the slack's top: 9e18 bytes) and one
+# that can be had (byte 67: 2 GB more) are both a damaged file
+for at in 71 67; do
+    cp "$tmp/e.plxb" "$tmp/slack.plxb"; printf '\177' | dd of="$tmp/slack.plxb" bs=1 seek=$at conv=notrunc 2>/dev/null
+    expect bake-size-flip-$at 1 "^polarlux info: $tmp/slack\.plxb: corrupt bake file: checksum mismatch$" -- "$bin" info "$tmp/slack.plxb"
+done
 printf '' >"$tmp/empty.geojson"
 expect info-empty-file 1 "malformed JSON at byte 0 \(line 1, column 1\): the file is empty" -- "$bin" info "$tmp/empty.geojson"
 expect bake-nomem 3 "the block is too small for the bake" -- "$bin" info --mem 64K "$tmp/e.plxb"
