@@ -1058,10 +1058,13 @@ plx_status plx_bake_load(void *mem, size_t size, const plx_config *cfg, const vo
  * plx_bake_load's, the same errors and messages, plus PLX_E_IO (a read
  * failed: which bytes) and PLX_E_PARSE "corrupt bake file: it changed
  * while it was read" (the first reading failed its checks, the second
- * passed them). When the image does not fit the block, the file is
- * checked first through 512 bytes of the stack, so that a damaged file
- * gets its own error before the block's. After an error the block's
- * contents are unspecified. Threads: none.
+ * passed them). The file is checked first, through the block, when the
+ * image is over four times the file (the pages it leaves out are zeroed
+ * as the reading passes them) and, through 512 bytes of the stack, when
+ * the image does not fit the block, so that a damaged file gets its own
+ * error before the block's. No read reaches past the stored pages the
+ * bitmap counts. After an error the block's contents are unspecified.
+ * Threads: none.
  */
 typedef int (*plx_bake_read_fn)(void *user, uint64_t off, void *buf, size_t n);
 plx_status plx_bake_block_size_read(plx_bake_read_fn read, void *user, uint64_t len, void *scratch, size_t scratch_len,

@@ -406,8 +406,10 @@ static plx_status page_stored(const bake_src *s, const bake_layout *L, bit_windo
 /* n bytes at off read and summed, READ_SMALL at a time through the stack
  * (the bitmap, a last page's bytes past the image); with mine, its first
  * upto bytes summed into it too, READ_SMALL at a time as page_stored
- * reads them. */
-static plx_status sum_read(const bake_src *s, sum_stream *ss, uint64_t off, uint64_t n, bake_sum *mine, uint64_t upto)
+ * reads them; with bits, the stored pages' bits among them (L's bitmap)
+ * counted into it. */
+static plx_status sum_read_bits(const bake_src *s, sum_stream *ss, uint64_t off, uint64_t n, bake_sum *mine,
+                                uint64_t upto, const bake_layout *L, size_t *bits)
 {
     unsigned char buf[READ_SMALL];
     uint64_t done = 0;
@@ -419,11 +421,18 @@ static plx_status sum_read(const bake_src *s, sum_stream *ss, uint64_t off, uint
         ss_add(ss, buf, k);
         if (mine && done < upto)
             bake_sum_add(mine, buf, upto - done < k ? (size_t)(upto - done) : k);
+        if (bits)
+            *bits += bitmap_bits(L, off, buf, k);
         off += k;
         n -= k;
         done += k;
     }
     return PLX_OK;
+}
+
+static plx_status sum_read(const bake_src *s, sum_stream *ss, uint64_t off, uint64_t n, bake_sum *mine, uint64_t upto)
+{
+    return sum_read_bits(s, ss, off, n, mine, upto, NULL, NULL);
 }
 
 /* s set up for the file of len bytes read through read(user, ...), its
@@ -478,7 +487,7 @@ static plx_status copy_read(const bake_src *s, const unsigned char *h, const bak
     bit_window w;
     bake_sum summed;
     unsigned char buf[READ_SMALL];
-    size_t p = 0, q, present = 0;
+    size_t p = 0, q, present = 0, bits = 0;
     uint64_t k;
     int stored;
     plx_status st;
@@ -486,8 +495,11 @@ static plx_status copy_read(const bake_src *s, const unsigned char *h, const bak
     bake_sum_init(&w.used);
     bake_sum_init(&summed);
     ss_start(&ss, h);
-    if ((st = sum_read(s, &ss, L->bitmap_at, L->pages_at - L->bitmap_at, &summed, (L->npages + 7) / 8)) != PLX_OK)
+    if ((st = sum_read_bits(s, &ss, L->bitmap_at, L->pages_at - L->bitmap_at, &summed, (L->npages + 7) / 8, L,
+                            &bits)) != PLX_OK)
         return st;
+    if (bits != L->pages_present) /* before any page: no read past the stored pages */
+        return say(s->err, s->errlen, PLX_E_PARSE, "corrupt bake file: inconsistent header", 0, NULL, 0, NULL);
     while (p < L->npages) {
         if ((st = page_stored(s, L, &w, p, &stored)) != PLX_OK)
             return st;
@@ -575,14 +587,21 @@ plx_status plx_bake_load_read(void *mem, size_t size, const plx_config *cfg, plx
                    NULL);
     if ((st = src_open(&s, read, user, len, err, errlen, h, &L)) != PLX_OK)
         return st;
-    /* when the image fits, read once into it and checked as it is read;
-     * else checked through the stack first, then the block's error, as
-     * plx_bake_load */
+    /* when the image fits, read once into it and checked as it is read
+     * (checked first, through the block, when the image is over four
+     * times the file: its pages left out are zeroed as they pass, and a
+     * damaged header of a small file asked to zero gigabytes before its
+     * checksum was found wrong); else checked through the stack first,
+     * then the block's error, as plx_bake_load */
     fits = place(mem, size, h, &L, &base, &cap, NULL, 0);
-    if (fits == PLX_OK)
-        st = load_once(&s, h, &L, base, cap);
-    else if ((st = check_read(&s, h, &L, small, sizeof small)) == PLX_OK)
+    if (fits == PLX_OK) {
+        if (L.image / 4 > len)
+            st = check_read(&s, h, &L, base, cap < READ_BIG ? cap : READ_BIG);
+        if (st == PLX_OK)
+            st = load_once(&s, h, &L, base, cap);
+    } else if ((st = check_read(&s, h, &L, small, sizeof small)) == PLX_OK) {
         st = place(mem, size, h, &L, &base, &cap, err, errlen);
+    }
     if (st != PLX_OK)
         return st;
     return finish(mem, base, cap, L.image, cfg, out, err, errlen);

@@ -286,13 +286,15 @@ typedef struct mem_file {
     unsigned char *f;
     size_t len;
     int calls, fail_at, flip_nth, flip_back, seen;
-    size_t flip;
+    size_t flip, maxend; /* maxend: the furthest byte asked for, plus one */
     unsigned char flip_mask;
 } mem_file;
 
 static int mem_read(void *user, uint64_t off, void *buf, size_t n)
 {
     mem_file *m = user;
+    if (off + n > m->maxend)
+        m->maxend = (size_t)(off + n);
     if (++m->calls == m->fail_at || off > m->len || n > m->len - off)
         return -1;
     if (m->flip_nth && off <= m->flip && m->flip < off + n) {
@@ -418,6 +420,83 @@ static void test_load_read(void **state)
     expect_changed(mem, need + 64, &mf, 2);
     plx_engine_destroy(c);
     free(mc);
+    free(mem);
+    free(mf.f);
+}
+
+/* A small file whose header names a large image, none of its pages
+ * stored and a wrong checksum (a reviewer's: 64 KiB that named 2 GiB):
+ * refused as damaged before the block is written (its pages left out
+ * were zeroed first, 2 GiB touched in 8.6 s, before the checksum was
+ * found wrong); resealed, the same image loads no further than its first
+ * page ("no engine"). */
+static void test_sparse_header(void **state)
+{
+    baked k = shared;
+    const uint64_t img = (uint64_t)16 << 20;
+    size_t npages = (size_t)(img / 4096), len = 128 + (((npages + 7) / 8 + 7) & ~(size_t)7), need, i, touched = 0;
+    uint64_t zero = 0, len64 = len;
+    unsigned char *f = calloc(1, len), *mem;
+    char err[256];
+    plx_engine *e = NULL;
+    mem_file mf;
+    (void)state;
+    memcpy(f, k.file, 128);
+    memcpy(f + 24, &len64, 8);
+    memcpy(f + 40, &img, 8);
+    memcpy(f + 48, &zero, 8); /* no relocations */
+    memcpy(f + 80, &zero, 8); /* no stored pages */
+    assert_int_equal(plx_bake_block_size_read(mem_read, &(mem_file){ .f = f, .len = len }, len, NULL, 0, &need, err,
+                                              sizeof err), PLX_OK);
+    assert_true(need > img);
+    mem = malloc(need);
+    memset(mem, 0xab, need);
+    memset(&mf, 0, sizeof mf);
+    mf.f = f;
+    mf.len = len;
+    assert_int_equal(plx_bake_load_read(mem, need, NULL, mem_read, &mf, len, &e, err, sizeof err), PLX_E_PARSE);
+    assert_null(e);
+    assert_string_equal(err, "corrupt bake file: checksum mismatch");
+    for (i = 0; i < need; i++)
+        touched += mem[i] != 0xab;
+    assert_true(touched <= ((size_t)1 << 20)); /* the check's reads go through the block: 1 MiB at most */
+    ref_bake_reseal(f, len);
+    assert_int_equal(plx_bake_load_read(mem, need, NULL, mem_read, &mf, len, &e, err, sizeof err), PLX_E_PARSE);
+    assert_string_equal(err, "corrupt bake file: no engine at the start of the image");
+    free(mem);
+    free(f);
+}
+
+/* A bitmap that names one stored page more than the file holds: refused
+ * from the bitmap's count before any page is read (the pages were read
+ * on, and the last read asked for bytes past the file's end, which a
+ * caller's read need not guard against). */
+static void test_bitmap_extra_bit(void **state)
+{
+    baked k = shared;
+    size_t b, need;
+    int bit;
+    char err[256];
+    plx_engine *e = NULL;
+    mem_file mf;
+    void *mem;
+    (void)state;
+    memset(&mf, 0, sizeof mf);
+    mf.f = malloc(k.len);
+    memcpy(mf.f, k.file, k.len);
+    mf.len = k.len;
+    for (b = 128; b < pages_at(k.file) && mf.f[b] == 0xff; b++)
+        ;
+    assert_true(b < pages_at(k.file) && mf.f[b] != 0xff);
+    for (bit = 0; (mf.f[b] >> bit) & 1; bit++)
+        ;
+    mf.f[b] |= (unsigned char)(1u << bit);
+    assert_int_equal(plx_bake_block_size(k.file, k.len, &need, err, sizeof err), PLX_OK);
+    mem = malloc(need);
+    assert_int_equal(plx_bake_load_read(mem, need, NULL, mem_read, &mf, k.len, &e, err, sizeof err), PLX_E_PARSE);
+    assert_null(e);
+    assert_string_equal(err, "corrupt bake file: inconsistent header");
+    assert_true(mf.maxend <= k.len);
     free(mem);
     free(mf.f);
 }
@@ -986,6 +1065,8 @@ int main(void)
         cmocka_unit_test(test_round_trip),
         cmocka_unit_test(test_load_read),
         cmocka_unit_test(test_last_page_stored),
+        cmocka_unit_test(test_sparse_header),
+        cmocka_unit_test(test_bitmap_extra_bit),
         cmocka_unit_test(test_atlas_in_bake),
         cmocka_unit_test(test_bake_after_frames),
         cmocka_unit_test(test_aa_dense),
