@@ -338,7 +338,8 @@ typedef struct walk_run {
     plx_render_opts black_opts;
     double black_exposure;
     long inside, first_inside; /* frames with the eye inside a building: how many, the first */
-    long from_atlas;           /* frames read from the radiance atlas (no pixel shaded) */
+    long from_atlas;           /* frames that shaded no pixel: read from the radiance atlas, or of sky alone */
+    long atlas_lit;            /* of which not black: some pixel read from the atlas */
     long nearly, first_nearly; /* frames nearly black (CLI_NEARLY_BLACK), not all: how many, the first */
     double inside_eye[3];      /* the first one's eye */
     double bounds[4];          /* the scene's (plx_scene_info), taken once */
@@ -560,9 +561,12 @@ static int frame(const walk_args *a, plx_engine *e, const walk_path *wp, walk_ru
     if (!info.eye_inside && !black && cli_black_share(wr->rgb8, (size_t)a->w * a->h) >= CLI_NEARLY_BLACK &&
         wr->nearly++ == 0)
         wr->first_nearly = k + 1;
-    /* no pixel shaded, and something drawn: read from the radiance atlas
-     * (a black frame, of sky alone, shades nothing either) */
-    wr->from_atlas += info.shaded_pixels == 0 && !info.eye_inside && !black;
+    /* no pixel shaded: read from the radiance atlas, or sky alone (a
+     * black frame: it shades nothing either) */
+    if (info.shaded_pixels == 0 && !info.eye_inside) {
+        wr->from_atlas++;
+        wr->atlas_lit += !black;
+    }
     if (info.eye_inside && wr->inside++ == 0) {
         wr->first_inside = k + 1;
         memcpy(wr->inside_eye, cam.eye, sizeof wr->inside_eye);
@@ -803,7 +807,7 @@ static int run(const walk_args *a, plx_engine *e, const walk_path *wp, long *don
                      "move the path out of the footprints or raise it above the roofs", wr.inside, wr.n,
                      wr.first_inside, eye_text(e, wr.inside_eye, at, sizeof at));
         }
-        if (a->aerial && wr.from_atlas == wr.n)
+        if (a->aerial && wr.from_atlas == wr.n && wr.atlas_lit > 0)
             cli_warn("walk", &a->c, "--view aerial changed nothing: the camera comes from the path, and every frame "
                      "was read from the radiance atlas, the same for any view (--view aerial picks the aerial light "
                      "map for the ground of frames shaded pixel by pixel: --per-pixel, --no-indirect)");

@@ -669,6 +669,11 @@ if [ $? -eq 0 ] && ! grep -q -- "--view aerial" "$tmp/out"; then echo "ok   walk
 # no byte: said (it was taken silently)
 expect walk-view-aerial-atlas 0 "--view aerial changed nothing: the camera comes from the path" -- \
     "$bin" walk "$tmp/e.plxb" --path "$tmp/high.geojson" --size 32x24 --fps 0.5 --aa 1 --view aerial -o "$tmp/wh3"
+# ... and when some of them are black (a reviewer's path from the city up
+# to the sky: the warning was lost when black frames stopped counting)
+printf '{"type":"Feature","properties":{"targets":[[266,266,0],[10,0,5000]]},"geometry":{"type":"LineString","coordinates":[[0,0,200],[10,0,250]]}}' >"$tmp/mix.geojson"
+expect walk-view-aerial-atlas-some-black 0 "--view aerial changed nothing: the camera comes from the path" -- \
+    "$bin" walk "$tmp/e.plxb" --path "$tmp/mix.geojson" --size 32x24 --fps 0.5 --aa 1 --view aerial -o "$tmp/wmix"
 # ... but not when the frames show sky alone (they shade nothing either;
 # it blamed the atlas with --per-pixel given)
 printf '{"type":"Feature","properties":{"targets":[[30,30.5,500],[31,30.5,500]]},"geometry":{"type":"LineString","coordinates":[[30,30,2],[31,30,2]]}}' >"$tmp/sky.geojson"
