@@ -612,10 +612,14 @@ static int open_bake(const char *cmd, const char *path, const cli_common *c, plx
         need = c->mem;
     } else {
         /* the block the header asks for, the load checking the file as it
-         * reads it; the whole file checked first only when that block
-         * cannot be had (a damaged size field asked for 4.6e18 bytes) */
+         * reads it; the whole file checked first when that block is far
+         * beyond the file (more than 64 times it and a GiB: a damaged size
+         * field asked for 4.6e18 bytes, which a sanitizer build does not
+         * even try to take) or cannot be had */
         st = plx_bake_block_size_read(bake_read, &in, len, NULL, 0, &need, err, sizeof err);
-        if (st == PLX_OK && !(mem = cli_big_alloc(need)))
+        if (st == PLX_OK && need / 64 <= len + ((size_t)1 << 24))
+            mem = cli_big_alloc(need);
+        if (st == PLX_OK && !mem)
             st = block_size_checked(&in, len, &need, err, sizeof err);
         if (st != PLX_OK) {
             bake_say(cmd, path, st, err, &in);
