@@ -144,14 +144,37 @@ static int bake_fits(void *mem, size_t bytes, const void *data, size_t len, int 
     return ok;
 }
 
+/* A bake's --min-mem search: its loads counted against the most it can
+ * take, on a progress line (a terminal's, after a second: a city's search
+ * takes 7 to 11 s). */
+typedef struct min_search {
+    int loads, most;
+    cli_progress pg;
+} min_search;
+
+static void search_load(min_search *ms)
+{
+    ms->loads++;
+    cli_progress_step(&ms->pg, "info --min-mem: bisection over loads", (size_t)ms->loads, (size_t)ms->most);
+}
+
+/* Bisection steps over hi - lo bytes to 4 KiB. */
+static int steps_over(size_t lo, size_t hi)
+{
+    int n = 0;
+    for (; hi - lo > 4096; hi = lo + (hi - lo) / 2)
+        n++;
+    return n;
+}
+
 /* The smallest block from lo to hi, to 4 KiB, that bake_fits 'what', by
  * bisection; loads counted. */
 static size_t bisect_bake(void *mem, size_t lo, size_t hi, const void *data, size_t len, int what, uint8_t *rgb8,
-                          int *loads)
+                          min_search *ms)
 {
     while (hi - lo > 4096) {
         size_t mid = lo + (hi - lo) / 2;
-        ++*loads;
+        search_load(ms);
         if (bake_fits(mem, mid, data, len, what, rgb8))
             hi = mid;
         else
@@ -163,7 +186,7 @@ static size_t bisect_bake(void *mem, size_t lo, size_t hi, const void *data, siz
 /* The smallest block for walk's frames (frame_fits) from lo (the load's
  * smallest) up to hi, and the frame's size (*w, *h, the bake's largest);
  * 0 when hi holds none. */
-static size_t frames_min(void *mem, size_t lo, size_t hi, const void *data, size_t len, int *loads, int32_t *w,
+static size_t frames_min(void *mem, size_t lo, size_t hi, const void *data, size_t len, min_search *ms, int32_t *w,
                          int32_t *h)
 {
     static plx_port port;
@@ -177,9 +200,9 @@ static size_t frames_min(void *mem, size_t lo, size_t hi, const void *data, size
     if (plx_render_max_get(e, w, h) == PLX_OK)
         rgb8 = malloc((size_t)*w * (size_t)*h * 3);
     plx_engine_destroy(e);
-    ++*loads;
+    search_load(ms);
     if (rgb8 && bake_fits(mem, hi, data, len, BAKE_FRAME, rgb8))
-        f = bisect_bake(mem, lo, hi, data, len, BAKE_FRAME, rgb8, loads);
+        f = bisect_bake(mem, lo, hi, data, len, BAKE_FRAME, rgb8, ms);
     free(rgb8);
     return f;
 }
@@ -195,7 +218,8 @@ static int print_min_mem_bake(const char *path, size_t hi, int has_polar)
     size_t len, own, lo = PLX_ENGINE_MIN_BYTES;
     char *data = port_read_text(path, &len, err, sizeof err);
     void *mem = NULL;
-    int loads = 0, rc = EXIT_FAIL, polar = has_polar;
+    int rc = EXIT_FAIL, polar = has_polar;
+    min_search ms;
     int32_t fw = 0, fh = 0;
     size_t alone = 0, top, frames;
     if (data && plx_bake_block_size(data, len, &own, err, sizeof err) == PLX_OK) {
@@ -212,15 +236,20 @@ static int print_min_mem_bake(const char *path, size_t hi, int has_polar)
         return rc;
     }
     top = hi;
-    hi = bisect_bake(mem, lo, hi, data, len, BAKE_POLAR, NULL, &loads);
+    ms.loads = 0;
+    ms.most = steps_over(lo, top) * (polar ? 2 : 3) + 1;
+    cli_progress_start(&ms.pg);
+    hi = bisect_bake(mem, lo, hi, data, len, BAKE_POLAR, NULL, &ms);
     if (!polar)
-        alone = bisect_bake(mem, lo, hi, data, len, BAKE_LOADS, NULL, &loads);
-    frames = frames_min(mem, polar ? hi : alone, top, data, len, &loads, &fw, &fh);
+        alone = bisect_bake(mem, lo, hi, data, len, BAKE_LOADS, NULL, &ms);
+    frames = frames_min(mem, polar ? hi : alone, top, data, len, &ms, &fw, &fh);
+    cli_progress_step(&ms.pg, "info --min-mem: bisection over loads", 1, 1);
+    cli_progress_end(&ms.pg);
     free(mem);
     free(data);
     printf("smallest --mem: %zu bytes (%.2f MiB) loads the bake and has its polar diagrams%s (bisection, %d loads; "
            "without --mem a bake takes %zu bytes (%.2f MiB), room for queries and frames)\n", hi, hi / 1048576.0,
-           polar ? "" : " (built, as info does)", loads, own, own / 1048576.0);
+           polar ? "" : " (built, as info does)", ms.loads, own, own / 1048576.0);
     if (!polar)
         printf("smallest --mem for frames: %zu bytes (%.2f MiB) loads the bake, made with --no-polar, without them "
                "(walk and render with --eye, --aa 1; anti-aliasing adds 20 bytes a pixel; at the smallest, frames "
