@@ -477,8 +477,8 @@ static plx_status read_pages(const bake_src *s, const bake_layout *L, sum_stream
 }
 
 /* The loading reading: the pages into the image at base, the relocations
- * applied, the checksum and the stored pages' count taken; the bitmap
- * that placed the pages (read again in windows as they pass) must be the
+ * applied, the checksum taken (the stored pages counted before any is
+ * read); the bitmap that placed the pages (read again in windows as they pass) must be the
  * one summed (a file that moved a stored page's bit between them kept its
  * checksum). */
 static plx_status copy_read(const bake_src *s, const unsigned char *h, const bake_layout *L, unsigned char *base)
@@ -525,8 +525,7 @@ static plx_status copy_read(const bake_src *s, const unsigned char *h, const bak
             if ((st = relocate(base, L->image, k + i, bake_get32(buf + 4 * i), s->err, s->errlen)) != PLX_OK)
                 return st;
     }
-    if (present != L->pages_present || ss_end(&ss) != bake_get64(h + H_SUM) ||
-        bake_sum_end(&w.used) != bake_sum_end(&summed))
+    if (ss_end(&ss) != bake_get64(h + H_SUM) || bake_sum_end(&w.used) != bake_sum_end(&summed))
         return say(s->err, s->errlen, PLX_E_PARSE, "corrupt bake file: it changed while it was read", 0, NULL, 0,
                    NULL);
     return PLX_OK;
