@@ -517,18 +517,25 @@ size_t atlas_plan(arena *a, const scene *s, const mesh *m, double fine, uint64_t
     return bytes_for(&F, n);
 }
 
+/* m: the coarsest first plan atlas_spacing_for makes (the default
+ * spacing's four times) */
+#define ATLAS_GUESS (4.0 * ATLAS_FINE_DEFAULT)
+
 double atlas_spacing_for(arena *a, const scene *s, const mesh *m, double fine, size_t max_bytes)
 {
     const double step = 1.189207115002721; /* 2^(1/4) */
-    double f0 = fine > 0.0 && isfinite(fine) ? fine : ATLAS_FINE_DEFAULT, c;
+    double f0 = fine > 0.0 && isfinite(fine) ? fine : ATLAS_FINE_DEFAULT, c, g;
     size_t bc;
     int k = 0, n;
-    /* a first guess k steps up from a plan at four times the spacing (its
-     * bytes grow about as 1 / spacing^2), then the finest step that fits:
-     * down while the next finer one fits, else up until one does */
-    bc = atlas_plan(a, s, m, 4.0 * f0, NULL);
+    /* a first guess k steps up from a plan at four times the spacing, or
+     * at ATLAS_GUESS when that is finer (a plan's time grows with its
+     * points: one at 4 cm took seconds), its bytes growing about as 1 /
+     * spacing^2; then the finest step that fits: down while the next
+     * finer one fits, else up until one does */
+    g = fmax(4.0 * f0, ATLAS_GUESS);
+    bc = atlas_plan(a, s, m, g, NULL);
     if (bc != SIZE_MAX && bc > 0 && max_bytes > 0) {
-        c = 4.0 * f0 * sqrt((double)bc / (double)max_bytes);
+        c = g * sqrt((double)bc / (double)max_bytes);
         while (f0 * pow(step, k + 1) <= c && k < 64)
             k++;
     }

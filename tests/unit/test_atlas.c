@@ -2841,9 +2841,11 @@ static void test_spacing(void **state)
         world_open(&w, f ? "helsinki" : "eixample", f ? HELSINKI : EIXAMPLE, NULL);
         lo = atlas_plan(&w.e->mem, w.s, w.m, 16.0, NULL);
         hi = atlas_plan(&w.e->mem, w.s, w.m, 0.5, NULL);
-        for (k = 0; k < n; k++) {
-            double fine = runi(&r, 0.3, 2.0), e;
-            size_t budget = (size_t)exp(runi(&r, log((double)lo), log((double)hi)));
+        for (k = 0; k <= n; k++) {
+            /* the last: a spacing far finer than the budget allows (--texel
+             * 0.01), whose first plan is made at ATLAS_GUESS, not at 4 cm */
+            double fine = k < n ? runi(&r, 0.3, 2.0) : 0.01, e;
+            size_t budget = k < n ? (size_t)exp(runi(&r, log((double)lo), log((double)hi))) : hi;
             double got = atlas_spacing_for(&w.e->mem, w.s, w.m, fine, budget), prev;
             assert_true(got > 0.0);
             e = log(got / fine) / log(step);
@@ -2851,6 +2853,8 @@ static void test_spacing(void **state)
             assert_true(atlas_plan(&w.e->mem, w.s, w.m, got, NULL) <= budget);
             total++;
             prev = got / step;
+            if (k == n) /* the step finer does not fit */
+                assert_true(atlas_plan(&w.e->mem, w.s, w.m, prev, NULL) > budget);
             if (prev >= fine * (1.0 - 1e-9) && atlas_plan(&w.e->mem, w.s, w.m, prev, NULL) <= budget) {
                 coarser++;
                 if (coarser <= 2)
