@@ -175,6 +175,11 @@ int cli_refine(const char *cmd, plx_engine *e, const plx_camera *cam, cli_refine
 const char *cli_aa_nomem_hint(plx_status st, const plx_render_opts *o);
 /* "polarlux CMD: warning: ..." on stderr unless --quiet (c may be NULL). */
 void cli_warn(const char *cmd, const cli_common *c, const char *fmt, ...);
+/* A note on stderr (unless --quiet): whether the horizontal illuminance
+ * printed is direct light only or direct + indirect (the photon buffers,
+ * a bake's). route and annotate gave different numbers for a scene and
+ * its bake, the table saying nothing. */
+void cli_light_note(const char *cmd, const cli_common *c, plx_engine *e);
 /* Why a result is dark: "the scene has no lamps", or that no light reaches it. */
 const char *cli_dark_reason(plx_engine *e);
 /* Whether the loaded scene has lamps. */

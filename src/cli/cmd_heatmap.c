@@ -1,4 +1,5 @@
 /* polarlux heatmap SCENE --res M -o map.png: top-down ground illuminance. */
+#include <ctype.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -24,8 +25,9 @@ static const char help[] =
     "MAP.tif (or .tiff): a float32 GeoTIFF, band 1 the lux at pixel centres,\n"
     "NaN under buildings, georeferenced in the scene's CRS: WGS84 (EPSG:4326)\n"
     "for a lon/lat scene, the EPSG code of the scene's crs, else local metres.\n"
-    "The map is computed in strips so the command's buffers and the engine\n"
-    "together stay within --mem (exit 3 when even one row does not fit).\n"
+    "The map's lux (4 bytes a pixel) and the PNG's image are held whole, the\n"
+    "lux computed in strips, so that the command's buffers and the engine\n"
+    "together stay within --mem (exit 3 when the map and one row do not fit).\n"
     "\n"
     "  --res M    metres per pixel (default: the longer side of Bounds / 1200)\n"
     "  -o FILE    output .png or .tif (required)\n"
@@ -45,6 +47,19 @@ static const char help[] =
     "             from east (default 0); for sc also 'min': the least E_sc over\n"
     "             every horizontal facing direction (as 'polarlux tiles')\n"
     "  --mem SIZE, --strict, --quiet, --lamps FILE   as for 'polarlux info'\n";
+
+/* Whether the file name names another format: an extension (a dot in
+ * its last part) other than .png (any case). Names without one (a
+ * device, a FIFO, "-") take the PNG. */
+static int other_ext(const char *path)
+{
+    const char *base = strrchr(path, '/'), *dot;
+    base = base ? base + 1 : path;
+    dot = strrchr(base, '.');
+    return dot && dot != base &&
+           !(tolower((unsigned char)dot[1]) == 'p' && tolower((unsigned char)dot[2]) == 'n' &&
+             tolower((unsigned char)dot[3]) == 'g' && dot[4] == '\0');
+}
 
 /* A night palette on t in [0, 1]: black, deep blue, purple, orange, yellow, white. */
 static void palette(double t, uint8_t rgb[3])
@@ -101,7 +116,7 @@ static void legend(canvas *c, int x0, double lo, double top)
 
 typedef struct heat_opts {
     double res, top, box[4];
-    int have_box;
+    int have_box, have_height, have_facing;
     heat_quantity q;          /* q.quantity PLX_METER_*; H maps the ground */
     const char *out, *path;
     const cli_common *c;
@@ -146,6 +161,8 @@ static int draw_routes(plx_engine *e, canvas *c, const heat_opts *o, double lo, 
         fprintf(stderr, "polarlux heatmap: %s\n", err);
         return EXIT_FAIL;
     }
+    if (rs.note[0])
+        cli_warn("heatmap", o->c, "%s: %s", o->path, rs.note);
     for (pass = 0; pass < 2; pass++) {
         for (i = 0; i < rs.n; i++) {
             uint32_t k;
@@ -492,9 +509,11 @@ static int run(plx_engine *e, const heat_opts *o)
         printf("heatmap: %zux%zu pixels at %g m, float32 GeoTIFF of lux (%zu lit), written to %s\n", m.w, m.h,
                m.res, lit, o->out);
     else if (rc == EXIT_OK)
-        printf("heatmap: %zux%zu pixels at %g m, scale %g..%g lx (2nd-98th percentile of the %zu lit pixels), "
-               "written to %s%s\n", m.w, m.h, m.res, lo, top, lit, o->out,
-               world_file_wanted(o->out) ? " (world file .pgw beside it)" : "");
+        printf(o->top > 0 ? "heatmap: %zux%zu pixels at %g m, scale %g..%g lx (fixed by --max; %zu lit pixels), "
+                            "written to %s%s\n"
+                          : "heatmap: %zux%zu pixels at %g m, scale %g..%g lx (2nd-98th percentile of the %zu lit "
+                            "pixels), written to %s%s\n",
+               m.w, m.h, m.res, lo, top, lit, o->out, world_file_wanted(o->out) ? " (world file .pgw beside it)" : "");
     if (rc == EXIT_OK && o->q.quantity != PLX_METER_H && o->q.facing_min)
         printf("heatmap: semi-cylindrical illuminance at %g m, the least over every facing direction\n",
                o->q.height);
@@ -545,8 +564,10 @@ int cmd_heatmap(int argc, char **argv)
         CLI_OPT_VAL("--res", &o.res, parse_res, "--res '%s' is not a positive number of metres (at most 1e7)"),
         CLI_OPT_VAL("--max", &o.top, parse_max, "--max '%s' is not a number of lux above 0.1 (at most 1e9)"),
         CLI_OPT_VAL("--quantity", &o.q.quantity, parse_quantity, "--quantity '%s' is not h, v, sc or hs"),
-        CLI_OPT_VAL("--height", &o.q.height, cli_opt_height, "--height '%s' is not a number of metres from 0 to 1000"),
-        CLI_OPT_VAL("--facing", &o.q, cli_opt_facing, "--facing '%s' is not a number of degrees or min"),
+        { "--height", NULL, &o.q.height, cli_opt_height, "--height '%s' is not a number of metres from 0 to 1000", 0,
+          NULL, &o.have_height, NULL },
+        { "--facing", NULL, &o.q, cli_opt_facing, "--facing '%s' is not a number of degrees or min", 0, NULL,
+          &o.have_facing, NULL },
         CLI_OPT_STR("-o", &o.out),
         CLI_OPT_STR("--path", &o.path),
         { "--box", NULL, o.box, parse_box,
@@ -568,6 +589,15 @@ int cmd_heatmap(int argc, char **argv)
         return cli_usage_error("heatmap", "missing -o MAP.png");
     if (o.q.facing_min && o.q.quantity != PLX_METER_SC)
         return cli_usage_error("heatmap", "--facing min needs --quantity sc (the least E_sc over every direction)");
+    if (!is_tiff_path(o.out) && other_ext(o.out))
+        return cli_usage_error("heatmap", "-o '%s': the map is written as PNG (.png) or GeoTIFF (.tif, .tiff); "
+                               "name the file so", o.out);
+    if (o.have_height && o.q.quantity == PLX_METER_H)
+        cli_warn("heatmap", &c, "--height is for --quantity v, sc and hs: the ground illuminance (h) is mapped on "
+                 "the ground");
+    if (o.have_facing && !o.q.facing_min && o.q.quantity != PLX_METER_V && o.q.quantity != PLX_METER_SC)
+        cli_warn("heatmap", &c, "--facing is for --quantity v and sc: %s illuminance faces no direction",
+                 o.q.quantity == PLX_METER_H ? "ground" : "hemispherical");
     if (!cli_out_writable("heatmap", o.out))
         return EXIT_FAIL;
     rc = cli_open_scene("heatmap", scene, &c, &e);

@@ -351,7 +351,7 @@ int cmd_info(int argc, char **argv)
         return rc;
     plx_scene_info_get(e, &si);
     printf("scene: %s\n", path);
-    printf("buildings: %u (%u raised above the ground, %u with inner rings)\n", si.buildings,
+    printf("buildings: %u (%u raised above the ground; %u inner rings of their own)\n", si.buildings,
            si.raised, si.holes);
     printf("blocks: %u with %u courtyards\n", si.blocks, si.courtyards);
     printf("lamps: %u\n", si.lamps);

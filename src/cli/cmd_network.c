@@ -163,6 +163,8 @@ static int load_network(const net_opts *o, plx_engine *e, network *net)
         fprintf(stderr, "polarlux %s: %s\n", o->cmd, err);
         return EXIT_FAIL;
     }
+    if (rs.note[0])
+        cli_warn(o->cmd, &o->c, "%s: %s", o->network, rs.note);
     if (net_build(net, &rs, err, sizeof err) != 0) {
         fprintf(stderr, "polarlux %s: %s: %s\n", o->cmd, o->network, err);
         return EXIT_FAIL;
@@ -322,6 +324,11 @@ static int find_routes(const net_opts *o, plx_engine *e, network *net)
         fprintf(stderr, "polarlux %s: %s\n", o->cmd, err);
         rc = EXIT_FAIL;
     }
+    if (rc == EXIT_OK && !(shortest.length > 0.0)) {
+        fprintf(stderr, "polarlux %s: --from %s and --to %s meet the streets of %s at the same point: the route has "
+                        "no length, so there is nothing to score\n", o->cmd, o->from_s, o->to_s, o->network);
+        rc = EXIT_FAIL;
+    }
     if (rc == EXIT_OK && o->have_detour && best.length > (1.0 + o->detour) * shortest.length &&
         cap_detour(net, e, &a, &b, o, &shortest, &best, &weight) != 0) {
         fprintf(stderr, "polarlux %s: out of memory while capping the detour\n", o->cmd);
@@ -332,6 +339,7 @@ static int find_routes(const net_opts *o, plx_engine *e, network *net)
                "min_Ev", "min_Esc", "class_h", "class", "detour");
         print_route("best-lit", &best, shortest.length);
         print_route("shortest", &shortest, shortest.length);
+        cli_light_note(o->cmd, &o->c, e);
         printf("cost = length + %g x dark metres (below %g lx or inside footprints)", weight, o->dark);
         if (weight != o->weight)
             printf("; weight lowered from %g by --max-detour %g", o->weight, o->detour);
@@ -582,9 +590,11 @@ int cmd_annotate(int argc, char **argv)
             dark += net.edges[i].dark + net.edges[i].s.blocked_length;
             len += net.edges[i].length;
         }
-        if (rc == EXIT_OK)
+        if (rc == EXIT_OK) {
             printf("annotate: %u edges, %u nodes, %.0f m of street, %.0f m dark (below %g lx), written to %s%s%s\n",
                    net.nedges, net.nnodes, len, dark, o.dark, o.out, o.csv ? " and " : "", o.csv ? o.csv : "");
+            cli_light_note("annotate", &o.c, e);
+        }
         net_free(&net);
     }
     plx_engine_free(e);

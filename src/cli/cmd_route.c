@@ -12,8 +12,9 @@
 static const char route_help[] =
     "usage: polarlux route SCENE --path FILE [--step M] [--dark-lux LX] [--geojson OUT] [options]\n"
     "\n"
-    "Scores routes by their horizontal ground illuminance (direct + indirect when\n"
-    "available). FILE is GeoJSON with LineString or MultiLineString features, in\n"
+    "Scores routes by their horizontal ground illuminance: direct light, plus\n"
+    "indirect light from a bake's photon buffers (a note on stderr says which).\n"
+    "FILE is GeoJSON with LineString or MultiLineString features, in\n"
     "the scene's coordinate rules (properties.units = \"m\", else WGS84 lon/lat\n"
     "projected with the scene's own centre). Each line is sampled every --step\n"
     "metres; for each line and each segment between its vertices the table gives\n"
@@ -75,12 +76,12 @@ static int facial_class(const plx_route_stats *s, const double fac[4])
     return plx_p_class_facial(s->mean, s->min, ev, esc);
 }
 
-static void print_row(const char *line, const char *seg, const plx_route_stats *s, const double fac[4])
+static void print_row(int width, const char *line, const char *seg, const plx_route_stats *s, const double fac[4])
 {
     char cls[4], fr[4];
     class_text(s->p_class, cls);
     class_text(facial_class(s, fac), fr);
-    printf("%-8s %-5s %9.1f %9.3f %9.3f %9.3f %6.3f %6.3f %-5s %8.3f %8.3f %8.3f %8.3f %-3s", line, seg,
+    printf("%-*s %-5s %9.1f %9.3f %9.3f %9.3f %6.3f %6.3f %-5s %8.3f %8.3f %8.3f %8.3f %-3s", width, line, seg,
            s->length, s->mean, s->min, s->max, s->uniformity, s->dark_share, cls, fac[0], fac[1], fac[2], fac[3],
            fr);
     if (s->blocked_length > 0)
@@ -152,6 +153,16 @@ typedef struct route_opts {
 /* The path's samples at --step, counted before any work: at most
  * ROUTE_MAX_SAMPLES in all (and 1e7 a segment, the engine's limit). */
 #define ROUTE_MAX_SAMPLES 1e8
+/* The line's length in metres (the scene's frame). */
+static double line_length(const route_line *l)
+{
+    double len = 0.0;
+    uint32_t k;
+    for (k = 0; k + 1 < l->n; k++)
+        len += hypot(l->xy[2 * k + 2] - l->xy[2 * k], l->xy[2 * k + 3] - l->xy[2 * k + 1]);
+    return len;
+}
+
 static int check_samples(const route_opts *o, const route_set *rs)
 {
     double total = 0, longest = 0, len = 0;
@@ -165,6 +176,12 @@ static int check_samples(const route_opts *o, const route_set *rs)
             total += ceil(d / o->step) + 1;
             longest = fmax(longest, ceil(d / o->step));
         }
+    for (i = 0; i < rs->n; i++)
+        if (!(line_length(&rs->lines[i]) > 0.0)) { /* a mean over no length: 0 lx would read as dark */
+            fprintf(stderr, "polarlux route: %s: line %s has no length (its %u positions are one point): give it two "
+                            "distinct positions\n", o->path, rs->lines[i].name, rs->lines[i].n);
+            return EXIT_FAIL;
+        }
     if (total > ROUTE_MAX_SAMPLES || longest > 1e7)
         return cli_usage_error("route", "--step %g gives %.0f samples over the path's %.0f m (at most 1e8, "
                                "1e7 a segment)", o->step, total, len);
@@ -176,20 +193,23 @@ static int score_all(plx_engine *e, const route_opts *o, route_set *rs)
     geo_out g;
     size_t i;
     cli_progress pr;
-    int rc = EXIT_OK;
+    int rc = EXIT_OK, width = 8;
     memset(&g, 0, sizeof g);
     if (o->geojson && geo_begin(&g, e) != 0)
         return EXIT_FAIL;
-    printf("%-8s %-5s %9s %9s %9s %9s %6s %6s %-5s %8s %8s %8s %8s %s\n", "line", "seg", "length_m", "mean_lx",
+    for (i = 0; i < rs->n; i++) /* the names' column as wide as the longest */
+        width = (int)strlen(rs->lines[i].name) > width ? (int)strlen(rs->lines[i].name) : width;
+    printf("%-*s %-5s %9s %9s %9s %9s %6s %6s %-5s %8s %8s %8s %8s %s\n", width, "line", "seg", "length_m", "mean_lx",
            "min_lx", "max_lx", "U0", "dark", "class", "Ev_fw", "Ev_bw", "Esc_fw", "Esc_bw", "class_fr");
     cli_progress_start(&pr);
     for (i = 0; i < rs->n; i++) {
         const route_line *l = &rs->lines[i];
-        plx_route_stats tot, *seg = malloc(sizeof *seg * l->n);
+        plx_route_stats tot, *seg;
         double *fac = malloc(sizeof(double) * 4 * l->n), ftot[4];
         char name[32], sname[16];
         uint32_t k;
         plx_status st;
+        seg = malloc(sizeof *seg * l->n);
         if (!seg || !fac) {
             free(seg);
             free(fac);
@@ -210,10 +230,10 @@ static int score_all(plx_engine *e, const route_opts *o, route_set *rs)
         if (tot.samples > 0 && !(tot.max > 0))
             cli_warn("route", &o->c, "%s: line %s is entirely dark (0 lx): %s", o->path, l->name,
                      cli_dark_reason(e));
-        print_row(name, "all", &tot, ftot);
+        print_row(width, name, "all", &tot, ftot);
         for (k = 0; k + 1 < l->n; k++) {
             snprintf(sname, sizeof sname, "%u", k);
-            print_row("", sname, &seg[k], fac + 4 * k);
+            print_row(width, "", sname, &seg[k], fac + 4 * k);
         }
         if (g.root)
             add_segments(&g, l, i, &tot, seg, ftot, fac);
@@ -222,6 +242,8 @@ static int score_all(plx_engine *e, const route_opts *o, route_set *rs)
         free(fac);
     }
     cli_progress_end(&pr);
+    if (rc == EXIT_OK)
+        cli_light_note("route", &o->c, e);
     if (g.root && rc == EXIT_OK && geo_write(&g, "route", o->geojson) != 0)
         rc = EXIT_FAIL;
     geo_free(&g);
@@ -279,6 +301,8 @@ int cmd_route(int argc, char **argv)
         plx_engine_free(e);
         return EXIT_FAIL;
     }
+    if (rs.note[0])
+        cli_warn("route", &o.c, "%s: %s", o.path, rs.note);
     rc = check_samples(&o, &rs);
     if (rc == EXIT_OK)
         rc = score_all(e, &o, &rs);

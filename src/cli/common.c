@@ -312,6 +312,19 @@ void cli_warn(const char *cmd, const cli_common *c, const char *fmt, ...)
     fprintf(stderr, "\n");
 }
 
+void cli_light_note(const char *cmd, const cli_common *c, plx_engine *e)
+{
+    uint64_t frames = plx_indirect_frames(e);
+    if (c && c->quiet)
+        return;
+    if (frames > 0)
+        fprintf(stderr, "polarlux %s: note: the lux are direct + indirect light (%llu photon frames)\n", cmd,
+                (unsigned long long)frames);
+    else
+        fprintf(stderr, "polarlux %s: note: the lux are direct light only (no photon buffers: a bake of the scene "
+                        "adds indirect light)\n", cmd);
+}
+
 /* Commands whose results are light: they say so when the scene has none. */
 static int computes_light(const char *cmd)
 {

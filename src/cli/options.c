@@ -216,6 +216,8 @@ int cli_options_n(const char *cmd, const char *help, int argc, char **argv, cons
         if (o) {
             if (take_opt(cmd, argc, argv, &i, o) != EXIT_OK)
                 return EXIT_USAGE;
+            if (!o->flag && !o->parse && argv[i][0] == '\0' && (output_opt(o->name) || input_opt(o->name)))
+                return cli_usage_error(cmd, "%s needs a file name, not an empty string", o->name);
             if (!o->flag && !o->parse)
                 file_opt(&files, o->name, argv[i]);
         } else if (a[0] == '-' && a[1] != '\0') {

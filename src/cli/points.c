@@ -100,6 +100,12 @@ int points_parse(const char *name, const char *text, int need, int cols, const d
         }
         row = out->v + out->n * (size_t)cols;
         k = parse_row(t, end, row, cols, &bad);
+        if (cols == 6 && fill && k > 3 && k < 6) { /* a normal is given whole (illum's rows) */
+            snprintf(err, errlen, "%s:%zu: expected 2, 3 or 6 numbers ('x y', 'x y z' or 'x y z nx ny nz'), found %d",
+                     name, lineno, k);
+            points_free(out);
+            return -1;
+        }
         if (k < 0 || k < need || (k < cols && !fill)) {
             int len = 0;
             if (bad)

@@ -15,7 +15,8 @@ typedef struct points {
 
 /* Parses text (NUL-terminated). Each row needs at least 'need' numbers;
  * numbers past 'cols' are ignored, missing ones up to 'cols' are an error
- * unless fill is given (then they take fill[k]). Returns 0, or -1 with
+ * unless fill is given (then they take fill[k]; with cols 6, a row of 4 or
+ * 5 numbers is an error: a normal is given whole). Returns 0, or -1 with
  * "NAME:LINE: why" in err. */
 int points_parse(const char *name, const char *text, int need, int cols, const double *fill,
                  points *out, char *err, size_t errlen);

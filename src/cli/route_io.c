@@ -92,13 +92,20 @@ static int all_lonlat(const cJSON *c)
     return 1;
 }
 
-static int set_frame(const cJSON *root, const cJSON *features, plx_engine *e, frame *f, char *why, size_t whylen)
+/* The path's frame. properties.units "m": metres. Otherwise lon/lat when
+ * every coordinate is in that range (refused on a metre scene, naming
+ * units "m" for a metre path that happens to be in range), else metres:
+ * on a lon/lat scene with a note (the scene file's own rule; a metre path
+ * there was read with no word). */
+static int set_frame(const cJSON *root, const cJSON *features, plx_engine *e, frame *f, char *note, size_t notelen,
+                     char *why, size_t whylen)
 {
     const cJSON *props = cJSON_GetObjectItemCaseSensitive(root, "properties");
     const cJSON *units = cJSON_GetObjectItemCaseSensitive(props, "units"), *ft;
     plx_scene_info si;
     int ll = 1;
     memset(f, 0, sizeof f[0]);
+    note[0] = '\0';
     plx_scene_info_get(e, &si);
     if (cJSON_IsString(units) && strcmp(units->valuestring, "m") == 0)
         return 0;
@@ -111,11 +118,20 @@ static int set_frame(const cJSON *root, const cJSON *features, plx_engine *e, fr
         if (!all_lonlat(cJSON_GetObjectItemCaseSensitive(g, "coordinates")))
             ll = 0;
     }
-    if (!ll)
-        return 0; /* metres, as for scenes (with no warning: the path file follows the scene) */
     if (!si.lonlat) {
-        snprintf(why, whylen, "the path is in lon/lat but the scene is in local metres");
-        return -1;
+        if (ll) {
+            snprintf(why, whylen,
+                     "the path is in lon/lat but the scene is in local metres (properties.units \"m\" reads "
+                     "it as metres)");
+            return -1;
+        }
+        return 0;
+    }
+    if (!ll) {
+        snprintf(note, notelen,
+                 "coordinates exceed the lon/lat range: read as metres of the scene's frame, where the scene is in "
+                 "lon/lat (properties.units \"m\" says so and silences this)");
+        return 0;
     }
     f->lonlat = 1;
     f->e = e;
@@ -173,7 +189,7 @@ int route_parse(const char *name, const char *text, size_t len, plx_engine *e, r
         cJSON_Delete(root);
         return -1;
     }
-    if (set_frame(root, features, e, &f, why, sizeof why) != 0) {
+    if (set_frame(root, features, e, &f, out->note, sizeof out->note, why, sizeof why) != 0) {
         snprintf(err, errlen, "%s: %s", name, why);
         cJSON_Delete(root);
         return -1;

@@ -223,6 +223,18 @@ static int parse(const cJSON *root, plx_engine *e, walk_path *wp, char *why, siz
     return targets ? check_targets(wp, n, why, whylen) : 0;
 }
 
+/* The LineStrings of root: 1 for a bare one or a Feature's, a collection's
+ * features with one. */
+static uint32_t count_lines(const cJSON *root)
+{
+    const cJSON *ft, *props;
+    uint32_t n = 0;
+    if (!cJSON_GetObjectItemCaseSensitive(root, "features"))
+        return first_line(root, &props) ? 1 : 0;
+    cJSON_ArrayForEach(ft, cJSON_GetObjectItemCaseSensitive(root, "features")) n += first_line(ft, &props) != NULL;
+    return n;
+}
+
 int walk_path_read(const char *path, plx_engine *e, walk_path *wp, char *err, size_t errlen)
 {
     size_t len;
@@ -241,6 +253,7 @@ int walk_path_read(const char *path, plx_engine *e, walk_path *wp, char *err, si
     if (!root)
         return -1;
     rc = parse(root, e, wp, why, sizeof why);
+    wp->lines = count_lines(root);
     cJSON_Delete(root);
     if (rc != 0) {
         snprintf(err, errlen, "%s: %s", path, why);

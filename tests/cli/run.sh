@@ -810,6 +810,32 @@ printf 'IESNA:LM-63-2002\nTILT=NONE\n1 -1 1 2 1 1 2 0 0 0\n1 1 0\n0 90\n0\n100\n
 expect photometry-short 1 "l\\.ies: line 7: table too short" -- "$bin" info "$tmp/ph/s.geojson"
 printf 'IESNA:LM-63-2002\nTILT=NONE\n1 -1 1 2 1 1 2 0 0 0\n1 1 0\n0 90\n0\n100 0\n' >"$tmp/ph/l.ies"
 expect photometry-nadir 0 "^0 0 0 2\\.768895999" -- sh -c "echo '0 0' | '$bin' illum -q --no-indirect '$tmp/ph/s.geojson' --points -"
+# a user's pass on the real district (2026-12-02): coordinates, empty routes, output names, notes
+H=fixtures/helsinki-centre.geojson
+printf '{"type":"FeatureCollection","features":[{"type":"Feature","properties":{},"geometry":{"type":"LineString","coordinates":[[100,200],[300,200]]}}]}' >"$tmp/metres-route.json"
+expect route-metres-on-lonlat-warns 0 "warning: .*metres-route.json: coordinates exceed the lon/lat range: read as metres" -- "$bin" route $H --path "$tmp/metres-route.json"
+printf '{"type":"FeatureCollection","properties":{"units":"m"},"features":[{"type":"Feature","properties":{},"geometry":{"type":"LineString","coordinates":[[100,200],[300,200]]}}]}' >"$tmp/metres-route-m.json"
+"$bin" route $H --path "$tmp/metres-route-m.json" >/dev/null 2>"$tmp/err"
+if ! grep -q "exceed the lon/lat range" "$tmp/err" && grep -q "note: the lux are direct light only" "$tmp/err"; then echo "ok   route-units-m-no-warning"; pass=$((pass + 1)); else echo "FAIL route-units-m-no-warning"; fail=$((fail + 1)); fi
+printf '{"type":"FeatureCollection","features":[{"type":"Feature","properties":{},"geometry":{"type":"LineString","coordinates":[[10,20],[50,20]]}}]}' >"$tmp/small-route.json"
+expect route-small-metres-hint 1 'in local metres \(properties.units "m" reads it as metres\)' -- "$bin" route -q fixtures/tiny.geojson --path "$tmp/small-route.json"
+printf '{"type":"FeatureCollection","properties":{"units":"m"},"features":[{"type":"Feature","properties":{},"geometry":{"type":"LineString","coordinates":[[10,20],[50,20]]}}]}' >"$tmp/small-route-m.json"
+expect route-small-metres-m 0 "^#0 +all +40\.0 " -- "$bin" route -q fixtures/tiny.geojson --path "$tmp/small-route-m.json"
+printf '{"type":"FeatureCollection","features":[{"type":"Feature","properties":{},"geometry":{"type":"LineString","coordinates":[[24.9432847,60.1676957],[24.9432847,60.1676957]]}}]}' >"$tmp/point-route.json"
+expect route-no-length 1 "line #0 has no length \(its 2 positions are one point\)" -- "$bin" route -q $H --path "$tmp/point-route.json"
+expect route-network-same-point 1 "meet the streets of .* at the same point: the route has no length" -- "$bin" route -q $H --network fixtures/helsinki-streets.geojson --from 24.9432847,60.1676957 --to 24.9432847,60.1676957
+expect route-light-note-direct 0 "note: the lux are direct light only" -- "$bin" route fixtures/tiny.geojson --path "$tmp/small-route-m.json"
+expect route-names-aligned 0 "^line        seg " -- "$bin" route -q $H --path fixtures/helsinki-route.geojson --step 4
+expect heatmap-o-jpg 2 "-o '.*j\.jpg': the map is written as PNG \(\.png\) or GeoTIFF" -- "$bin" heatmap -q fixtures/tiny.geojson --res 4 -o "$tmp/j.jpg"
+[ ! -e "$tmp/j.jpg" ] && [ ! -e "$tmp/j.pgw" ] && { echo "ok   heatmap-o-jpg-nothing"; pass=$((pass + 1)); } || { echo "FAIL heatmap-o-jpg-nothing"; fail=$((fail + 1)); }
+expect heatmap-height-for-h 0 "warning: --height is for --quantity v, sc and hs" -- "$bin" heatmap fixtures/tiny.geojson --res 4 --height 3 -o "$tmp/hm.png"
+expect heatmap-facing-for-hs 0 "warning: --facing is for --quantity v and sc: hemispherical" -- "$bin" heatmap fixtures/tiny.geojson --res 4 --quantity hs --facing 30 -o "$tmp/hm.png"
+expect heatmap-max-says-fixed 0 "scale 0\.1\.\.100 lx \(fixed by --max; " -- "$bin" heatmap -q fixtures/tiny.geojson --res 4 --max 100 -o "$tmp/hm.png"
+expect illum-five-numbers 1 "<stdin>:1: expected 2, 3 or 6 numbers \('x y', 'x y z' or 'x y z nx ny nz'\), found 5" -- sh -c "echo '50 10 1.5 1 0' | '$bin' illum -q --no-indirect fixtures/tiny.geojson --points -"
+expect illum-empty-points 2 "--points needs a file name, not an empty string" -- "$bin" illum -q fixtures/tiny.geojson --points ''
+expect tiles-empty-out 2 "-o needs a file name, not an empty string" -- "$bin" tiles -q fixtures/tiny.geojson --zoom 14 -o ''
+expect walk-collection-first-line 0 "holds 2 LineStrings: the walk follows the first \(318\.4 m\)" -- "$bin" walk $H --path fixtures/helsinki-route.geojson -o "$tmp/wcol" --size 32x24 --max-frames 2 --no-indirect --aa 1
+expect info-inner-rings 0 "^buildings: 442 \(4 raised above the ground; 71 inner rings of their own\)$" -- "$bin" info -q $H
 . tests/cli/gis.sh
 . tests/cli/network.sh
 ls "$tmp"/*.tmp* >/dev/null 2>&1 && { echo "FAIL temporary files left"; fail=$((fail + 1)); }
