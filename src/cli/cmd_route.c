@@ -76,12 +76,32 @@ static int facial_class(const plx_route_stats *s, const double fac[4])
     return plx_p_class_facial(s->mean, s->min, ev, esc);
 }
 
+/* The characters of UTF-8 text s (its bytes but the continuation bytes):
+ * the columns a name takes (street names hold ä and ö). */
+static int text_width(const char *s)
+{
+    int n = 0;
+    for (; *s; s++)
+        n += ((unsigned char)*s & 0xc0u) != 0x80u;
+    return n;
+}
+
+/* s, then spaces to width characters. */
+static void print_padded(const char *s, int width)
+{
+    int k;
+    fputs(s, stdout);
+    for (k = text_width(s); k < width; k++)
+        putchar(' ');
+}
+
 static void print_row(int width, const char *line, const char *seg, const plx_route_stats *s, const double fac[4])
 {
     char cls[4], fr[4];
     class_text(s->p_class, cls);
     class_text(facial_class(s, fac), fr);
-    printf("%-*s %-5s %9.1f %9.3f %9.3f %9.3f %6.3f %6.3f %-5s %8.3f %8.3f %8.3f %8.3f %-3s", width, line, seg,
+    print_padded(line, width);
+    printf(" %-5s %9.1f %9.3f %9.3f %9.3f %6.3f %6.3f %-5s %8.3f %8.3f %8.3f %8.3f %-3s", seg,
            s->length, s->mean, s->min, s->max, s->uniformity, s->dark_share, cls, fac[0], fac[1], fac[2], fac[3],
            fr);
     if (s->blocked_length > 0)
@@ -178,8 +198,9 @@ static int check_samples(const route_opts *o, const route_set *rs)
         }
     for (i = 0; i < rs->n; i++)
         if (!(line_length(&rs->lines[i]) > 0.0)) { /* a mean over no length: 0 lx would read as dark */
-            fprintf(stderr, "polarlux route: %s: line %s has no length (its %u positions are one point): give it two "
-                            "distinct positions\n", o->path, rs->lines[i].name, rs->lines[i].n);
+            fprintf(stderr, "polarlux route: %s: line %s (feature %u) has no length (its %u positions are one "
+                            "point): give it two distinct positions\n", o->path, rs->lines[i].name,
+                    rs->lines[i].feature, rs->lines[i].n);
             return EXIT_FAIL;
         }
     if (total > ROUTE_MAX_SAMPLES || longest > 1e7)
@@ -198,8 +219,9 @@ static int score_all(plx_engine *e, const route_opts *o, route_set *rs)
     if (o->geojson && geo_begin(&g, e) != 0)
         return EXIT_FAIL;
     for (i = 0; i < rs->n; i++) /* the names' column as wide as the longest */
-        width = (int)strlen(rs->lines[i].name) > width ? (int)strlen(rs->lines[i].name) : width;
-    printf("%-*s %-5s %9s %9s %9s %9s %6s %6s %-5s %8s %8s %8s %8s %s\n", width, "line", "seg", "length_m", "mean_lx",
+        width = text_width(rs->lines[i].name) > width ? text_width(rs->lines[i].name) : width;
+    print_padded("line", width);
+    printf(" %-5s %9s %9s %9s %9s %6s %6s %-5s %8s %8s %8s %8s %s\n", "seg", "length_m", "mean_lx",
            "min_lx", "max_lx", "U0", "dark", "class", "Ev_fw", "Ev_bw", "Esc_fw", "Esc_bw", "class_fr");
     cli_progress_start(&pr);
     for (i = 0; i < rs->n; i++) {

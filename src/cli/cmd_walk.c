@@ -880,8 +880,8 @@ int cmd_walk(int argc, char **argv)
         return EXIT_FAIL;
     }
     if (wp.lines > 1)
-        cli_warn("walk", &a.c, "%s holds %u LineStrings: the walk follows the first (%.1f m), the others are "
-                 "left out", a.path, wp.lines, walk_path_length(&wp));
+        cli_warn("walk", &a.c, "%s holds %u line features: the walk follows the first LineString (%.1f m), the "
+                 "others are left out", a.path, wp.lines, walk_path_length(&wp));
     if (cli_bake_direct("walk", a.scene, &a.c, e, &a.ind))
         a.opts.no_indirect = 1;
     cli_bake_kept("walk", a.scene, &a.c, e, &a.ind, a.opts.aerial_m_per_texel);

@@ -127,6 +127,10 @@ int cli_common_option(const char *cmd, int argc, char **argv, int *i, cli_common
             cli_usage_error(cmd, "--lamps needs a GeoJSON or CSV file of lamps");
             return -1;
         }
+        if (argv[*i + 1][0] == '\0') {
+            cli_usage_error(cmd, "--lamps needs a file name, not an empty string");
+            return -1;
+        }
         if (c->nlamp_files == CLI_MAX_LAMP_FILES) {
             cli_usage_error(cmd, "at most %d --lamps files", CLI_MAX_LAMP_FILES);
             return -1;
@@ -318,11 +322,14 @@ void cli_light_note(const char *cmd, const cli_common *c, plx_engine *e)
     if (c && c->quiet)
         return;
     if (frames > 0)
-        fprintf(stderr, "polarlux %s: note: the lux are direct + indirect light (%llu photon frames)\n", cmd,
-                (unsigned long long)frames);
+        fprintf(stderr, "polarlux %s: note: the ground's lux (E_h) are direct + indirect light (%llu photon "
+                        "frames); Ev and Esc are direct light\n", cmd, (unsigned long long)frames);
+    else if (cli_bake_last.loaded)
+        fprintf(stderr, "polarlux %s: note: the lux are direct light only (the bake holds no photon buffers: "
+                        "baked with --no-indirect or --frames 0)\n", cmd);
     else
         fprintf(stderr, "polarlux %s: note: the lux are direct light only (no photon buffers: a bake of the scene "
-                        "adds indirect light)\n", cmd);
+                        "adds indirect light to E_h)\n", cmd);
 }
 
 /* Commands whose results are light: they say so when the scene has none. */
@@ -671,6 +678,7 @@ int cli_open_scene(const char *cmd, const char *path, const cli_common *c, plx_e
 {
     plx_config cfg;
     plx_status st;
+    memset(&cli_bake_last, 0, sizeof cli_bake_last); /* this scene's (commands run in one process: test_tiles) */
     if (cli_is_bake(path) || damaged_bake(path)) {
         if (c->nlamp_files > 0) {
             fprintf(stderr, "polarlux %s: %s: --lamps cannot be added to a bake file; give them to 'polarlux bake'\n",

@@ -171,6 +171,27 @@ static void line_id(const cJSON *ft, char *out, size_t len)
         snprintf(out, len, "%.0f", v->valuedouble);
 }
 
+/* A note when no position of the lines lies within the scene's bounds
+ * (nothing of the scene lights them: a file of another place, or metres
+ * read as lon/lat), unless a note on the frame was made already. */
+static void outside_note(route_set *rs, plx_engine *e, int lonlat)
+{
+    plx_scene_info si;
+    size_t i;
+    uint32_t k;
+    if (rs->note[0])
+        return;
+    plx_scene_info_get(e, &si);
+    for (i = 0; i < rs->n; i++)
+        for (k = 0; k < rs->lines[i].n; k++) {
+            const double *p = &rs->lines[i].xy[2 * k];
+            if (p[0] >= si.bounds[0] && p[0] <= si.bounds[2] && p[1] >= si.bounds[1] && p[1] <= si.bounds[3])
+                return;
+        }
+    snprintf(rs->note, sizeof rs->note, "no position lies within the scene's bounds, so no lamp of it lights the "
+             "lines%s", lonlat ? " (read as lon/lat: properties.units \"m\" if they are metres)" : "");
+}
+
 int route_parse(const char *name, const char *text, size_t len, plx_engine *e, route_set *out,
                 char *err, size_t errlen)
 {
@@ -226,6 +247,7 @@ int route_parse(const char *name, const char *text, size_t len, plx_engine *e, r
         snprintf(err, errlen, "%s: no LineString features", name);
         return -1;
     }
+    outside_note(out, e, f.lonlat);
     return 0;
 }
 

@@ -223,15 +223,24 @@ static int parse(const cJSON *root, plx_engine *e, walk_path *wp, char *why, siz
     return targets ? check_targets(wp, n, why, whylen) : 0;
 }
 
-/* The LineStrings of root: 1 for a bare one or a Feature's, a collection's
- * features with one. */
+/* Whether feature ft's geometry is a LineString or a MultiLineString. */
+static int has_lines(const cJSON *ft)
+{
+    const cJSON *t = cJSON_GetObjectItemCaseSensitive(cJSON_GetObjectItemCaseSensitive(ft, "geometry"), "type");
+    return cJSON_IsString(t) && (strcmp(t->valuestring, "LineString") == 0 ||
+                                 strcmp(t->valuestring, "MultiLineString") == 0);
+}
+
+/* The line features of root: 1 for a bare LineString or a Feature's, a
+ * collection's features with a LineString or a MultiLineString (the walk
+ * follows the first LineString). */
 static uint32_t count_lines(const cJSON *root)
 {
     const cJSON *ft, *props;
     uint32_t n = 0;
     if (!cJSON_GetObjectItemCaseSensitive(root, "features"))
         return first_line(root, &props) ? 1 : 0;
-    cJSON_ArrayForEach(ft, cJSON_GetObjectItemCaseSensitive(root, "features")) n += first_line(ft, &props) != NULL;
+    cJSON_ArrayForEach(ft, cJSON_GetObjectItemCaseSensitive(root, "features")) n += has_lines(ft);
     return n;
 }
 

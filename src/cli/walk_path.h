@@ -15,7 +15,7 @@ typedef struct walk_path {
     uint32_t n;
     double *eye;      /* 3 n, local metres */
     double *target;   /* 3 n or NULL */
-    uint32_t lines;   /* LineStrings in the file (a collection's: the walk follows the first) */
+    uint32_t lines;   /* line features in the file (LineString, MultiLineString): the walk follows the first LineString */
 } walk_path;
 
 /* 0 on success; -1 with "FILE: why" in err. */

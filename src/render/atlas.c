@@ -517,9 +517,13 @@ size_t atlas_plan(arena *a, const scene *s, const mesh *m, double fine, uint64_t
     return bytes_for(&F, n);
 }
 
-/* m: the coarsest first plan atlas_spacing_for makes (the default
- * spacing's four times) */
-#define ATLAS_GUESS (4.0 * ATLAS_FINE_DEFAULT)
+/* m: the finest first plan atlas_spacing_for makes. Coarser than 4 cm,
+ * whose plan took seconds; fine enough that every spacing asked from
+ * ATLAS_GUESS / 4 up gets the first plan, and so the answer, it got
+ * before: atlas_plan's bytes do not always fall as the spacing grows
+ * (tiny.geojson: 0.67 m 110,960 bytes, 0.80 m 117,587), so a guess from
+ * elsewhere can stop at another step. */
+#define ATLAS_GUESS 0.25
 
 double atlas_spacing_for(arena *a, const scene *s, const mesh *m, double fine, size_t max_bytes)
 {
@@ -528,10 +532,10 @@ double atlas_spacing_for(arena *a, const scene *s, const mesh *m, double fine, s
     size_t bc;
     int k = 0, n;
     /* a first guess k steps up from a plan at four times the spacing, or
-     * at ATLAS_GUESS when that is finer (a plan's time grows with its
-     * points: one at 4 cm took seconds), its bytes growing about as 1 /
-     * spacing^2; then the finest step that fits: down while the next
-     * finer one fits, else up until one does */
+     * at ATLAS_GUESS when that is coarser (a plan's time grows with its
+     * points), its bytes growing about as 1 / spacing^2; then the finest
+     * step that fits: down while the next finer one fits, else up until
+     * one does */
     g = fmax(4.0 * f0, ATLAS_GUESS);
     bc = atlas_plan(a, s, m, g, NULL);
     if (bc != SIZE_MAX && bc > 0 && max_bytes > 0) {

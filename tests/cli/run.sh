@@ -822,10 +822,22 @@ expect route-small-metres-hint 1 'in local metres \(properties.units "m" reads i
 printf '{"type":"FeatureCollection","properties":{"units":"m"},"features":[{"type":"Feature","properties":{},"geometry":{"type":"LineString","coordinates":[[10,20],[50,20]]}}]}' >"$tmp/small-route-m.json"
 expect route-small-metres-m 0 "^#0 +all +40\.0 " -- "$bin" route -q fixtures/tiny.geojson --path "$tmp/small-route-m.json"
 printf '{"type":"FeatureCollection","features":[{"type":"Feature","properties":{},"geometry":{"type":"LineString","coordinates":[[24.9432847,60.1676957],[24.9432847,60.1676957]]}}]}' >"$tmp/point-route.json"
-expect route-no-length 1 "line #0 has no length \(its 2 positions are one point\)" -- "$bin" route -q $H --path "$tmp/point-route.json"
+expect route-no-length 1 "line #0 \(feature 0\) has no length \(its 2 positions are one point\)" -- "$bin" route -q $H --path "$tmp/point-route.json"
 expect route-network-same-point 1 "meet the streets of .* at the same point: the route has no length" -- "$bin" route -q $H --network fixtures/helsinki-streets.geojson --from 24.9432847,60.1676957 --to 24.9432847,60.1676957
-expect route-light-note-direct 0 "note: the lux are direct light only" -- "$bin" route fixtures/tiny.geojson --path "$tmp/small-route-m.json"
-expect route-names-aligned 0 "^line        seg " -- "$bin" route -q $H --path fixtures/helsinki-route.geojson --step 4
+expect route-light-note-direct 0 "note: the lux are direct light only \(no photon buffers: a bake of the scene adds" -- "$bin" route fixtures/tiny.geojson --path "$tmp/small-route-m.json"
+expect route-light-note-bake 0 "note: the ground's lux \(E_h\) are direct \+ indirect light \(2 photon frames\); Ev and Esc are direct light" -- "$bin" route "$tmp/e.plxb" --path "$tmp/small-route-m.json"
+expect route-light-note-bake-direct 0 "note: the lux are direct light only \(the bake holds no photon buffers" -- "$bin" route "$tmp/end.plxb" --path "$tmp/small-route-m.json"
+"$bin" route -q $H --path fixtures/helsinki-route.geojson --step 4 >"$tmp/rt.txt" 2>&1
+if grep -q "^line        seg " "$tmp/rt.txt" && grep -q "^lamp-street all " "$tmp/rt.txt" && grep -q "^            0  " "$tmp/rt.txt" &&
+   grep -q "^park-walk   all " "$tmp/rt.txt"; then echo "ok   route-names-aligned"; pass=$((pass + 1)); else echo "FAIL route-names-aligned"; sed 's/^/    /' "$tmp/rt.txt"; fail=$((fail + 1)); fi
+printf '{"type":"FeatureCollection","properties":{"units":"m"},"features":[{"type":"Feature","properties":{"name":"Etel\303\244esplanadi"},"geometry":{"type":"LineString","coordinates":[[10,20],[50,20]]}},{"type":"Feature","properties":{"name":"Keskuskatu-1"},"geometry":{"type":"LineString","coordinates":[[10,25],[50,25]]}}]}' >"$tmp/utf8-route.json"
+"$bin" route -q fixtures/tiny.geojson --path "$tmp/utf8-route.json" >"$tmp/rt.txt" 2>&1
+if grep -q "^Eteläesplanadi all " "$tmp/rt.txt" && grep -q "^Keskuskatu-1   all " "$tmp/rt.txt"; then echo "ok   route-names-utf8-aligned"; pass=$((pass + 1)); else echo "FAIL route-names-utf8-aligned"; sed 's/^/    /' "$tmp/rt.txt"; fail=$((fail + 1)); fi
+expect route-outside-scene 0 "warning: .*small-route.json: no position lies within the scene's bounds.*\(read as lon/lat: properties.units \"m\" if they are metres\)" -- "$bin" route $H --path "$tmp/small-route.json"
+expect annotate-metres-on-lonlat-warns 0 "warning: .*metres-route.json: coordinates exceed the lon/lat range" -- "$bin" annotate $H --network "$tmp/metres-route.json" -o "$tmp/ann.geojson"
+expect heatmap-path-metres-on-lonlat-warns 0 "warning: .*metres-route.json: coordinates exceed the lon/lat range" -- "$bin" heatmap $H --res 20 --path "$tmp/metres-route.json" -o "$tmp/hmp.png"
+printf '{"type":"FeatureCollection","properties":{"units":"m"},"features":[{"type":"Feature","properties":{},"geometry":{"type":"LineString","coordinates":[[30,20],[70,20]]}},{"type":"Feature","properties":{"name":"ml"},"geometry":{"type":"MultiLineString","coordinates":[[[30,20],[60,20]],[[40,20],[40,20]]]}}]}' >"$tmp/part-route.json"
+expect route-no-length-part 1 "line ml \(feature 1\) has no length" -- "$bin" route -q fixtures/tiny.geojson --path "$tmp/part-route.json"
 expect heatmap-o-jpg 2 "-o '.*j\.jpg': the map is written as PNG \(\.png\) or GeoTIFF" -- "$bin" heatmap -q fixtures/tiny.geojson --res 4 -o "$tmp/j.jpg"
 [ ! -e "$tmp/j.jpg" ] && [ ! -e "$tmp/j.pgw" ] && { echo "ok   heatmap-o-jpg-nothing"; pass=$((pass + 1)); } || { echo "FAIL heatmap-o-jpg-nothing"; fail=$((fail + 1)); }
 expect heatmap-height-for-h 0 "warning: --height is for --quantity v, sc and hs" -- "$bin" heatmap fixtures/tiny.geojson --res 4 --height 3 -o "$tmp/hm.png"
@@ -834,7 +846,10 @@ expect heatmap-max-says-fixed 0 "scale 0\.1\.\.100 lx \(fixed by --max; " -- "$b
 expect illum-five-numbers 1 "<stdin>:1: expected 2, 3 or 6 numbers \('x y', 'x y z' or 'x y z nx ny nz'\), found 5" -- sh -c "echo '50 10 1.5 1 0' | '$bin' illum -q --no-indirect fixtures/tiny.geojson --points -"
 expect illum-empty-points 2 "--points needs a file name, not an empty string" -- "$bin" illum -q fixtures/tiny.geojson --points ''
 expect tiles-empty-out 2 "-o needs a file name, not an empty string" -- "$bin" tiles -q fixtures/tiny.geojson --zoom 14 -o ''
-expect walk-collection-first-line 0 "holds 2 LineStrings: the walk follows the first \(318\.4 m\)" -- "$bin" walk $H --path fixtures/helsinki-route.geojson -o "$tmp/wcol" --size 32x24 --max-frames 2 --no-indirect --aa 1
+expect walk-collection-first-line 0 "holds 2 line features: the walk follows the first LineString \(318\.4 m\)" -- "$bin" walk $H --path fixtures/helsinki-route.geojson -o "$tmp/wcol" --size 32x24 --max-frames 2 --no-indirect --aa 1
+printf '{"type":"FeatureCollection","properties":{"units":"m"},"features":[{"type":"Feature","properties":{},"geometry":{"type":"LineString","coordinates":[[30,20,1.7],[60,20,1.7]]}},{"type":"Feature","properties":{},"geometry":{"type":"MultiLineString","coordinates":[[[30,25],[60,25]]]}}]}' >"$tmp/walk-multi.json"
+expect walk-multilinestring-counted 0 "holds 2 line features: the walk follows the first LineString \(30\.0 m\)" -- "$bin" walk fixtures/tiny.geojson --path "$tmp/walk-multi.json" -o "$tmp/wmul" --size 32x24 --max-frames 2 --no-indirect --aa 1
+expect lamps-empty-name 2 "--lamps needs a file name, not an empty string" -- "$bin" info -q fixtures/tiny.geojson --lamps ''
 expect info-inner-rings 0 "^buildings: 442 \(4 raised above the ground; 71 inner rings of their own\)$" -- "$bin" info -q $H
 . tests/cli/gis.sh
 . tests/cli/network.sh
