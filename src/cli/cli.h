@@ -175,6 +175,13 @@ int cli_refine(const char *cmd, plx_engine *e, const plx_camera *cam, cli_refine
 const char *cli_aa_nomem_hint(plx_status st, const plx_render_opts *o);
 /* "polarlux CMD: warning: ..." on stderr unless --quiet (c may be NULL). */
 void cli_warn(const char *cmd, const cli_common *c, const char *fmt, ...);
+/* Whether the file name's extension (a dot in its last part) is another
+ * than ext (lower case; any case matches). Names without one (a device,
+ * a FIFO, "-") are not. */
+int cli_other_ext(const char *path, const char *ext);
+/* 1 when path (NULL: none) may take the format what (.ext), else 0 after
+ * a usage message: render -o x.jpg wrote a PNG under that name. */
+int cli_out_ext(const char *cmd, const char *opt, const char *path, const char *ext, const char *what);
 /* A note on stderr (unless --quiet): whether the horizontal illuminance
  * printed is direct light only or direct + indirect (the photon buffers,
  * a bake's). route and annotate gave different numbers for a scene and

@@ -118,6 +118,8 @@ int cmd_draw(int argc, char **argv)
         return cli_usage_error("draw", "missing --polar Q (0..3)");
     if (!out)
         return cli_usage_error("draw", "missing -o OUT.png");
+    if (!cli_out_ext("draw", "-o", out, "png", "PNG"))
+        return EXIT_USAGE;
     rc = cli_open_scene("draw", scene, &c, &e);
     if (rc != EXIT_OK)
         return rc;

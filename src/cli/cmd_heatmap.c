@@ -1,5 +1,4 @@
 /* polarlux heatmap SCENE --res M -o map.png: top-down ground illuminance. */
-#include <ctype.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -47,19 +46,6 @@ static const char help[] =
     "             from east (default 0); for sc also 'min': the least E_sc over\n"
     "             every horizontal facing direction (as 'polarlux tiles')\n"
     "  --mem SIZE, --strict, --quiet, --lamps FILE   as for 'polarlux info'\n";
-
-/* Whether the file name names another format: an extension (a dot in
- * its last part) other than .png (any case). Names without one (a
- * device, a FIFO, "-") take the PNG. */
-static int other_ext(const char *path)
-{
-    const char *base = strrchr(path, '/'), *dot;
-    base = base ? base + 1 : path;
-    dot = strrchr(base, '.');
-    return dot && dot != base &&
-           !(tolower((unsigned char)dot[1]) == 'p' && tolower((unsigned char)dot[2]) == 'n' &&
-             tolower((unsigned char)dot[3]) == 'g' && dot[4] == '\0');
-}
 
 /* A night palette on t in [0, 1]: black, deep blue, purple, orange, yellow, white. */
 static void palette(double t, uint8_t rgb[3])
@@ -502,7 +488,11 @@ static int run(plx_engine *e, const heat_opts *o)
     for (k = 0; k < m.w * m.h; k++)
         lit += m.E[k] > 0;
     if (lit == 0)
-        cli_warn("heatmap", o->c, "every pixel of the map is dark (0 lx): %s", cli_dark_reason(e));
+        cli_warn("heatmap", o->c, "every pixel of the map is dark (0 lx): %s",
+                 o->have_box && (m.box[2] < si.bounds[0] || m.box[0] > si.bounds[2] || m.box[3] < si.bounds[1] ||
+                                 m.box[1] > si.bounds[3])
+                     ? "--box lies wholly outside the scene's bounds (see 'polarlux info')"
+                     : cli_dark_reason(e));
     heat_scale(&m, o->top, &lo, &top);
     rc = tiff ? write_tiff(e, o, &m) : write_png(e, o, &m, lo, top);
     if (rc == EXIT_OK && tiff)
@@ -511,8 +501,10 @@ static int run(plx_engine *e, const heat_opts *o)
     else if (rc == EXIT_OK)
         printf(o->top > 0 ? "heatmap: %zux%zu pixels at %g m, scale %g..%g lx (fixed by --max; %zu lit pixels), "
                             "written to %s%s\n"
-                          : "heatmap: %zux%zu pixels at %g m, scale %g..%g lx (2nd-98th percentile of the %zu lit "
-                            "pixels), written to %s%s\n",
+                 : lit == 0 ? "heatmap: %zux%zu pixels at %g m, scale %g..%g lx (%zu lit pixels: the default scale), "
+                              "written to %s%s\n"
+                            : "heatmap: %zux%zu pixels at %g m, scale %g..%g lx (2nd-98th percentile of the %zu lit "
+                              "pixels), written to %s%s\n",
                m.w, m.h, m.res, lo, top, lit, o->out, world_file_wanted(o->out) ? " (world file .pgw beside it)" : "");
     if (rc == EXIT_OK && o->q.quantity != PLX_METER_H && o->q.facing_min)
         printf("heatmap: semi-cylindrical illuminance at %g m, the least over every facing direction\n",
@@ -589,7 +581,7 @@ int cmd_heatmap(int argc, char **argv)
         return cli_usage_error("heatmap", "missing -o MAP.png");
     if (o.q.facing_min && o.q.quantity != PLX_METER_SC)
         return cli_usage_error("heatmap", "--facing min needs --quantity sc (the least E_sc over every direction)");
-    if (!is_tiff_path(o.out) && other_ext(o.out))
+    if (!is_tiff_path(o.out) && cli_other_ext(o.out, "png"))
         return cli_usage_error("heatmap", "-o '%s': the map is written as PNG (.png) or GeoTIFF (.tif, .tiff); "
                                "name the file so", o.out);
     if (o.have_height && o.q.quantity == PLX_METER_H)

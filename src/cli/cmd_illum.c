@@ -143,10 +143,15 @@ int cmd_illum(int argc, char **argv)
     }
     cli_progress_end(&pr);
     rc = failed ? EXIT_FAIL : EXIT_OK;
-    for (k = 0; k < pts.n && !(ed[k] + ei[k] > 0); k++)
-        ;
-    if (pts.n > 0 && k == pts.n)
-        cli_warn("illum", &c, "every point is dark (0 lx): %s", cli_dark_reason(e));
+    {   /* dark: every point that got numbers (not those inside a building: nan) got 0 lx */
+        size_t got = 0, lit = 0;
+        for (k = 0; k < pts.n; k++) {
+            got += ed[k] == ed[k];
+            lit += ed[k] + ei[k] > 0;
+        }
+        if (got > 0 && lit == 0)
+            cli_warn("illum", &c, "every point is dark (0 lx): %s", cli_dark_reason(e));
+    }
 done:
     free(given);
     free(ed);

@@ -53,6 +53,8 @@ int cmd_nightify(int argc, char **argv)
         return cli_usage_error("nightify", "needs DAY.png and NIGHT.png");
     if (!out)
         return cli_usage_error("nightify", "missing -o OUT.png");
+    if (!cli_out_ext("nightify", "-o", out, "png", "PNG"))
+        return EXIT_USAGE;
     mem = c.mem ? c.mem : CLI_DEFAULT_MEM;
     if ((r = image_read_png_budget(pos[0], 1000000, mem, &day, &dw, &dh, err, sizeof err)) != 0 ||
         (r = image_read_png_budget(pos[1], 1000000, mem - (size_t)dw * dh * 3, &night, &nw, &nh, err,

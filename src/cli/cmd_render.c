@@ -150,6 +150,8 @@ static int parse_args(int argc, char **argv, render_args *a)
         return cli_usage_error("render", "missing SCENE");
     if (!a->out)
         return cli_usage_error("render", "missing -o OUT.png");
+    if (!cli_out_ext("render", "-o", a->out, "png", "PNG") || !cli_out_ext("render", "--pfm", a->pfm, "pfm", "PFM"))
+        return EXIT_USAGE;
     if (a->have_eye != a->have_target)
         return cli_usage_error("render", "give both --eye and --target, or neither");
     if (a->have_eye && !(a->cam.eye[2] > 0.0))

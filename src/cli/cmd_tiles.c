@@ -231,6 +231,7 @@ static int parse_max(const char *s, void *dst)
 static int parse(int argc, char **argv, tiles_opts *o)
 {
     int have_zoom = 0, sc_option = 0, rc;
+    struct stat st;
     const cli_opt opts[] = {
         { "--zoom", NULL, o, parse_zoom, "--zoom '%s' is not Z or Z0-Z1 with 0 <= Z0 <= Z1 <= 22", 0, NULL, &have_zoom,
           NULL },
@@ -257,6 +258,9 @@ static int parse(int argc, char **argv, tiles_opts *o)
         return cli_usage_error("tiles", "missing --zoom Z0-Z1");
     if (!o->out)
         return cli_usage_error("tiles", "missing -o OUT (a folder or a .mbtiles file)");
+    if (!ends_with(o->out, ".mbtiles") && stat(o->out, &st) == 0 && !S_ISDIR(st.st_mode))
+        return cli_usage_error("tiles", "-o '%s' is a file, not a folder: name a folder for z/x/y.png tiles, or a "
+                               ".mbtiles file", o->out);
     if (sc_option && o->q.quantity != PLX_METER_SC)
         return cli_usage_error("tiles", "--height and --facing need --quantity sc (E_h is on the ground)");
     return EXIT_OK;

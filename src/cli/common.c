@@ -1,3 +1,4 @@
+#include <ctype.h>
 #include <errno.h>
 #include <math.h>
 #include <pthread.h>
@@ -367,6 +368,53 @@ int cli_all_black(const uint8_t *px, size_t n)
     return k == n;
 }
 
+int cli_other_ext(const char *path, const char *ext)
+{
+    const char *base = strrchr(path, '/'), *dot;
+    size_t k;
+    base = base ? base + 1 : path;
+    dot = strrchr(base, '.');
+    if (!dot || dot == base)
+        return 0;
+    for (k = 0; ext[k] && dot[1 + k]; k++)
+        if (tolower((unsigned char)dot[1 + k]) != ext[k])
+            return 1;
+    return ext[k] != '\0' || dot[1 + k] != '\0';
+}
+
+int cli_out_ext(const char *cmd, const char *opt, const char *path, const char *ext, const char *what)
+{
+    if (!path || !cli_other_ext(path, ext))
+        return 1;
+    cli_usage_error(cmd, "%s '%s': the file is written as %s (.%s); name it so", opt, path, what, ext);
+    return 0;
+}
+
+/* Whether the folder that would hold path exists (a message if not). */
+static int folder_exists(const char *cmd, const char *path)
+{
+    char dir[4096];
+    const char *slash = strrchr(path, '/');
+    struct stat st;
+    size_t n;
+    if (!slash)
+        return 1; /* the working folder */
+    n = (size_t)(slash - path);
+    if (n == 0 || n >= sizeof dir)
+        return 1;
+    memcpy(dir, path, n);
+    dir[n] = '\0';
+    if (stat(dir, &st) != 0) {
+        fprintf(stderr, "polarlux %s: cannot write '%s': the folder '%s' does not exist\n", cmd, path, dir);
+        return 0;
+    }
+    if (!S_ISDIR(st.st_mode)) {
+        fprintf(stderr, "polarlux %s: cannot write '%s': '%s' is not a folder\n", cmd, path, dir);
+        return 0;
+    }
+    return 1;
+}
+
 int cli_out_writable(const char *cmd, const char *path)
 {
     struct stat st;
@@ -374,6 +422,8 @@ int cli_out_writable(const char *cmd, const char *path)
     safe_out *o;
     if (!path || strcmp(path, "-") == 0 || (stat(path, &st) == 0 && !S_ISREG(st.st_mode) && !S_ISDIR(st.st_mode)))
         return 1;
+    if (!folder_exists(cmd, path))
+        return 0;
     o = safe_out_open(path, err, sizeof err);
     if (!o) {
         fprintf(stderr, "polarlux %s: %s\n", cmd, err);

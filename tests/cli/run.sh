@@ -101,13 +101,13 @@ if [ "$(head -c 12 "$tmp/s.pfm" | tr '\n' ' ')" = "PF 160 120 -" ]; then echo "o
 if [ "$(wc -c < "$tmp/s.pfm")" -gt $((160 * 120 * 12)) ]; then echo "ok   render-pfm-size"; pass=$((pass + 1)); else echo "FAIL render-pfm-size"; fail=$((fail + 1)); fi
 # an output in a missing folder is said before the work (render drew the
 # frame first: 3.5 s for an aerial view of gen eixample 30 30)
-expect render-out-missing-folder 1 "polarlux render: cannot create a temporary file for '$tmp/nodir/x.png'" -- \
+expect render-out-missing-folder 1 "polarlux render: cannot write '$tmp/nodir/x.png': the folder '$tmp/nodir' does not exist" -- \
     "$bin" render fixtures/tiny.geojson -o "$tmp/nodir/x.png"
 # before the work: before the scene is even read (tiny.geojson's loading
 # warns of a lamp inside a building; the check of before wrote no image
 # either, but loaded the scene and drew the frame first)
 if ! grep -q "view [0-9]*x[0-9]* from\|lamp is inside building" "$tmp/out"; then echo "ok   render-out-missing-folder-first"; pass=$((pass + 1)); else echo "FAIL render-out-missing-folder-first"; fail=$((fail + 1)); fi
-expect heatmap-out-missing-folder 1 "polarlux heatmap: cannot create a temporary file" -- \
+expect heatmap-out-missing-folder 1 "polarlux heatmap: cannot write '.*': the folder '.*' does not exist" -- \
     "$bin" heatmap fixtures/tiny.geojson -o "$tmp/nodir/h.png"
 if ! grep -q "lamp is inside building" "$tmp/out"; then echo "ok   heatmap-out-missing-folder-first"; pass=$((pass + 1)); else echo "FAIL heatmap-out-missing-folder-first"; fail=$((fail + 1)); fi
 # an output that names an input (or the other output) is refused before any
@@ -319,7 +319,7 @@ expect bake-photons-given 0 "photons [0-9]+ ms \(2 x 4000\)" -- \
 # an -o bake cannot write is refused before the scene is read (it was
 # refused after the whole bake: 5 s on gen eixample 15 15)
 expect bake-out-is-folder 1 "^polarlux bake: '$tmp' is a directory$" -- "$bin" bake "$tmp/nope.geojson" -o "$tmp"
-expect bake-out-no-folder 1 "^polarlux bake: cannot create a temporary file for '$tmp/no/such/x\.plxb'.*No such file or directory$" -- \
+expect bake-out-no-folder 1 "^polarlux bake: cannot write '$tmp/no/such/x\.plxb': the folder '$tmp/no/such' does not exist$" -- \
     "$bin" bake "$tmp/nope.geojson" -o "$tmp/no/such/x.plxb"
 # render from a GeoJSON traces 16 photons a lamp too (4,740 lamps: 75,840 a
 # frame): the same image as --photons 75840, another than the old 65,536
@@ -850,6 +850,19 @@ expect walk-collection-first-line 0 "holds 2 line features: the walk follows the
 printf '{"type":"FeatureCollection","properties":{"units":"m"},"features":[{"type":"Feature","properties":{},"geometry":{"type":"LineString","coordinates":[[30,20,1.7],[60,20,1.7]]}},{"type":"Feature","properties":{},"geometry":{"type":"MultiLineString","coordinates":[[[30,25],[60,25]]]}}]}' >"$tmp/walk-multi.json"
 expect walk-multilinestring-counted 0 "holds 2 line features: the walk follows the first LineString \(30\.0 m\)" -- "$bin" walk fixtures/tiny.geojson --path "$tmp/walk-multi.json" -o "$tmp/wmul" --size 32x24 --max-frames 2 --no-indirect --aa 1
 expect lamps-empty-name 2 "--lamps needs a file name, not an empty string" -- "$bin" info -q fixtures/tiny.geojson --lamps ''
+expect render-o-jpg 2 "-o '.*x\.jpg': the file is written as PNG \(\.png\); name it so" -- "$bin" render -q fixtures/tiny.geojson -o "$tmp/x.jpg"
+expect render-pfm-exr 2 "--pfm '.*x\.exr': the file is written as PFM \(\.pfm\)" -- "$bin" render -q fixtures/tiny.geojson -o "$tmp/x.png" --pfm "$tmp/x.exr"
+expect draw-o-jpg 2 "-o '.*d\.jpg': the file is written as PNG" -- "$bin" draw -q fixtures/tiny.geojson --polar 0 -o "$tmp/d.jpg"
+[ ! -e "$tmp/x.jpg" ] && [ ! -e "$tmp/d.jpg" ] && { echo "ok   o-jpg-nothing-written"; pass=$((pass + 1)); } || { echo "FAIL o-jpg-nothing-written"; fail=$((fail + 1)); }
+: >"$tmp/afile.png"
+expect tiles-o-is-a-file 2 "-o '.*afile\.png' is a file, not a folder" -- "$bin" tiles -q $H --zoom 14 -o "$tmp/afile.png"
+expect heatmap-box-outside 0 "every pixel of the map is dark \(0 lx\): --box lies wholly outside the scene's bounds" -- "$bin" heatmap fixtures/tiny.geojson --box 5000,5000,5100,5100 --res 10 -o "$tmp/hbo.png"
+expect heatmap-no-lit-scale 0 "\(0 lit pixels: the default scale\)" -- "$bin" heatmap -q fixtures/tiny.geojson --box 5000,5000,5100,5100 --res 10 -o "$tmp/hbo.png"
+"$bin" illum fixtures/tiny.geojson --no-indirect --points - <<EOF >/dev/null 2>"$tmp/err"
+5 5 3
+EOF
+if grep -q "inside a building's solid" "$tmp/err" && ! grep -q "every point is dark" "$tmp/err"; then echo "ok   illum-inside-not-dark"; pass=$((pass + 1)); else echo "FAIL illum-inside-not-dark"; sed 's/^/    /' "$tmp/err"; fail=$((fail + 1)); fi
+expect info-usable-bytes 0 "^memory: [0-9]+ bytes in use, peak [0-9]+, of the block's [0-9]+ usable bytes" -- "$bin" info -q fixtures/tiny.geojson
 expect info-inner-rings 0 "^buildings: 442 \(4 raised above the ground; 71 inner rings of their own\)$" -- "$bin" info -q $H
 . tests/cli/gis.sh
 . tests/cli/network.sh
