@@ -517,9 +517,29 @@ static int spot_buffers(plx_engine *e, const cli_common *c, spot_grid *g, long c
     return EXIT_OK;
 }
 
+/* Whether (x, y) lies between two footprints: on a wall two buildings
+ * share, where the grid of a city drawn on whole metres falls (the
+ * ground there is no street: nothing lights it). Both neighbours a hair
+ * away along x, or both along y, are inside a building (nan). */
+static int spot_between(plx_engine *e, double x, double y, double res)
+{
+    double d = 1e-4 * res, P[12], N[12], E[4], Ei[4];
+    int k;
+    for (k = 0; k < 4; k++) {
+        P[3 * k] = x + (k == 0 ? d : k == 1 ? -d : 0.0);
+        P[3 * k + 1] = y + (k == 2 ? d : k == 3 ? -d : 0.0);
+        P[3 * k + 2] = 0.0;
+        N[3 * k] = N[3 * k + 1] = 0.0;
+        N[3 * k + 2] = 1.0;
+    }
+    if (plx_illuminance(e, 4, P, N, E, Ei, NULL) == PLX_E_RANGE)
+        return (E[0] != E[0] && E[1] != E[1]) || (E[2] != E[2] && E[3] != E[3]);
+    return 0;
+}
+
 /* Takes this pass's candidates in order, each at least `spacing` from every
- * spot taken before. */
-static void spot_take(const spot_grid *g, double spacing, long count, spot *pick, long *npick)
+ * spot taken before, and none between two footprints (spot_between). */
+static void spot_take(plx_engine *e, const spot_grid *g, double spacing, long count, spot *pick, long *npick)
 {
     size_t k;
     for (k = 0; k < g->n && *npick < count; k++) {
@@ -532,7 +552,7 @@ static void spot_take(const spot_grid *g, double spacing, long count, spot *pick
             if (hypot(px - x, py - y) < spacing)
                 break;
         }
-        if (j == *npick)
+        if (j == *npick && !spot_between(e, x, y, g->res))
             pick[(*npick)++] = g->heap[k];
     }
 }
@@ -546,7 +566,7 @@ static int spot_search(plx_engine *e, spot_grid *g, int all, double spacing, lon
         rc = spot_pass(e, g, all, pass);
         if (rc != EXIT_OK)
             return rc;
-        spot_take(g, spacing, count, pick, npick);
+        spot_take(e, g, spacing, count, pick, npick);
         if (*npick == count || g->offered <= g->n)
             break;
         g->after = g->heap[g->n - 1];
@@ -599,6 +619,7 @@ static int find_spots(plx_engine *e, double res, long count, double spacing, int
                  "does not reach the ground" : "the scene has no lamps");
     if (g.street > 0 && !(g.max_lux > 0))
         cli_warn("dark-spots", c, "all %zu street points are dark (0 lx): %s", g.street, cli_dark_reason(e));
+    cli_light_note("dark-spots", c, e);
     if (geo_begin(&geo, e) != 0) {
         rc = EXIT_FAIL;
         goto done;

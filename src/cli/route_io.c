@@ -97,13 +97,22 @@ static int all_lonlat(const cJSON *c)
  * units "m" for a metre path that happens to be in range), else metres:
  * on a lon/lat scene with a note (the scene file's own rule; a metre path
  * there was read with no word). */
+/* A feature's own properties.units: 1 "m", -1 another value, 0 none. */
+static int feature_units(const cJSON *ft)
+{
+    const cJSON *u = cJSON_GetObjectItemCaseSensitive(cJSON_GetObjectItemCaseSensitive(ft, "properties"), "units");
+    if (!u)
+        return 0;
+    return cJSON_IsString(u) && strcmp(u->valuestring, "m") == 0 ? 1 : -1;
+}
+
 static int set_frame(const cJSON *root, const cJSON *features, plx_engine *e, frame *f, char *note, size_t notelen,
                      char *why, size_t whylen)
 {
     const cJSON *props = cJSON_GetObjectItemCaseSensitive(root, "properties");
     const cJSON *units = cJSON_GetObjectItemCaseSensitive(props, "units"), *ft;
     plx_scene_info si;
-    int ll = 1;
+    int ll = 1, plain = 0, k = 0;
     memset(f, 0, sizeof f[0]);
     note[0] = '\0';
     plx_scene_info_get(e, &si);
@@ -113,11 +122,22 @@ static int set_frame(const cJSON *root, const cJSON *features, plx_engine *e, fr
         snprintf(why, whylen, "properties.units must be \"m\" when given");
         return -1;
     }
-    cJSON_ArrayForEach(ft, features) {
+    cJSON_ArrayForEach(ft, features) { /* the features without units of their own decide */
         const cJSON *g = cJSON_GetObjectItemCaseSensitive(ft, "geometry");
+        int u = feature_units(ft);
+        if (u < 0) {
+            snprintf(why, whylen, "feature %d: properties.units must be \"m\" when given", k);
+            return -1;
+        }
+        k++;
+        if (u > 0)
+            continue;
+        plain = 1;
         if (!all_lonlat(cJSON_GetObjectItemCaseSensitive(g, "coordinates")))
             ll = 0;
     }
+    if (!plain)
+        return 0;
     if (!si.lonlat) {
         if (ll) {
             snprintf(why, whylen,
@@ -192,12 +212,46 @@ static void outside_note(route_set *rs, plx_engine *e, int lonlat)
              "lines%s", lonlat ? " (read as lon/lat: properties.units \"m\" if they are metres)" : "");
 }
 
+/* A collection of one made of root (a Feature, or a bare geometry given
+ * a Feature around it with its "properties" member), by reference: the
+ * result is deleted before root, and deletes nothing of root. NULL when
+ * out of memory. */
+static cJSON *wrap_one(cJSON *root)
+{
+    cJSON *list = cJSON_CreateArray(), *ft;
+    const cJSON *type = cJSON_GetObjectItemCaseSensitive(root, "type");
+    cJSON *props = cJSON_GetObjectItemCaseSensitive(root, "properties");
+    if (!list)
+        return NULL;
+    if (strcmp(type->valuestring, "Feature") == 0) {
+        if (!cJSON_AddItemReferenceToArray(list, root)) {
+            cJSON_Delete(list);
+            return NULL;
+        }
+        return list;
+    }
+    ft = cJSON_CreateObject();
+    if (!ft || !cJSON_AddItemToArray(list, ft)) {
+        cJSON_Delete(ft);
+        cJSON_Delete(list);
+        return NULL;
+    }
+    /* from here ft is the list's: deleting the list deletes it, and
+     * leaves what the references point to */
+    if (!cJSON_AddItemReferenceToObject(ft, "geometry", root) ||
+        (props && !cJSON_AddItemReferenceToObject(ft, "properties", props))) {
+        cJSON_Delete(list);
+        return NULL;
+    }
+    return list;
+}
+
 int route_parse(const char *name, const char *text, size_t len, plx_engine *e, route_set *out,
                 char *err, size_t errlen)
 {
-    cJSON *root = cli_json_parse(name, text, len, err, errlen);
+    cJSON *root = cli_json_parse(name, text, len, err, errlen), *wrap = NULL;
     const cJSON *features, *ft, *type;
-    frame f;
+    frame f, metres;
     size_t cap = 0, k = 0, first = 0;
     char why[256];
     memset(out, 0, sizeof *out);
@@ -205,27 +259,41 @@ int route_parse(const char *name, const char *text, size_t len, plx_engine *e, r
         return -1;
     type = cJSON_GetObjectItemCaseSensitive(root, "type");
     features = cJSON_GetObjectItemCaseSensitive(root, "features");
-    if (!cJSON_IsString(type) || strcmp(type->valuestring, "FeatureCollection") != 0 || !cJSON_IsArray(features)) {
-        snprintf(err, errlen, "%s: not a GeoJSON FeatureCollection with a features array", name);
+    if (cJSON_IsString(type) && (strcmp(type->valuestring, "Feature") == 0 ||
+                                 strcmp(type->valuestring, "LineString") == 0 ||
+                                 strcmp(type->valuestring, "MultiLineString") == 0)) {
+        /* one Feature (walk's path files) or a bare geometry: a collection of one */
+        if (!(wrap = wrap_one(root))) {
+            snprintf(err, errlen, "%s: out of memory", name);
+            cJSON_Delete(root);
+            return -1;
+        }
+        features = wrap;
+    } else if (!cJSON_IsString(type) || strcmp(type->valuestring, "FeatureCollection") != 0 ||
+               !cJSON_IsArray(features)) {
+        snprintf(err, errlen, "%s: not a GeoJSON FeatureCollection, Feature or LineString", name);
         cJSON_Delete(root);
         return -1;
     }
     if (set_frame(root, features, e, &f, out->note, sizeof out->note, why, sizeof why) != 0) {
         snprintf(err, errlen, "%s: %s", name, why);
+        cJSON_Delete(wrap);
         cJSON_Delete(root);
         return -1;
     }
+    memset(&metres, 0, sizeof metres);
     cJSON_ArrayForEach(ft, features) {
         const cJSON *g = cJSON_GetObjectItemCaseSensitive(ft, "geometry");
         const cJSON *gt = cJSON_GetObjectItemCaseSensitive(g, "type");
         const cJSON *co = cJSON_GetObjectItemCaseSensitive(g, "coordinates"), *part;
         char nm[32];
         int bad = 0;
+        const frame *ff = feature_units(ft) > 0 ? &metres : &f; /* a feature's own units "m" */
         line_name(ft, k, nm, sizeof nm);
         if (cJSON_IsString(gt) && strcmp(gt->valuestring, "LineString") == 0) {
-            bad = add_line(out, &cap, nm, co, &f, why, sizeof why);
+            bad = add_line(out, &cap, nm, co, ff, why, sizeof why);
         } else if (cJSON_IsString(gt) && strcmp(gt->valuestring, "MultiLineString") == 0 && cJSON_IsArray(co)) {
-            cJSON_ArrayForEach(part, co) if (!bad) bad = add_line(out, &cap, nm, part, &f, why, sizeof why);
+            cJSON_ArrayForEach(part, co) if (!bad) bad = add_line(out, &cap, nm, part, ff, why, sizeof why);
         } else {
             snprintf(why, sizeof why, "geometry is not a LineString or MultiLineString");
             bad = 1;
@@ -236,12 +304,14 @@ int route_parse(const char *name, const char *text, size_t len, plx_engine *e, r
         }
         if (bad) {
             snprintf(err, errlen, "%s: feature %zu: %s", name, k, why);
+            cJSON_Delete(wrap);
             cJSON_Delete(root);
             route_free(out);
             return -1;
         }
         k++;
     }
+    cJSON_Delete(wrap);
     cJSON_Delete(root);
     if (out->n == 0) {
         snprintf(err, errlen, "%s: no LineString features", name);

@@ -863,6 +863,20 @@ expect heatmap-no-lit-scale 0 "\(0 lit pixels: the default scale\)" -- "$bin" he
 EOF
 if grep -q "inside a building's solid" "$tmp/err" && ! grep -q "every point is dark" "$tmp/err"; then echo "ok   illum-inside-not-dark"; pass=$((pass + 1)); else echo "FAIL illum-inside-not-dark"; sed 's/^/    /' "$tmp/err"; fail=$((fail + 1)); fi
 expect info-usable-bytes 0 "^memory: [0-9]+ bytes in use, peak [0-9]+, of the block's [0-9]+ usable bytes" -- "$bin" info -q fixtures/tiny.geojson
+"$bin" dark-spots -q fixtures/eixample-4x4.geojson --count 6 >"$tmp/spots.json" 2>&1
+/usr/bin/python3 -c "import json,sys; [print('%g,%g' % (f['properties']['x'], f['properties']['y'])) for f in json.load(open(sys.argv[1]))['features']]" "$tmp/spots.json" >"$tmp/spots.txt"
+between=0; n=0
+while read -r pt; do n=$((n + 1)); "$bin" vis -q fixtures/eixample-4x4.geojson --at "$pt" 2>&1 | grep -q "shared by two buildings" && between=$((between + 1)); done <"$tmp/spots.txt"
+if [ "$n" -eq 6 ] && [ "$between" -eq 0 ]; then echo "ok   dark-spots-not-on-party-walls"; pass=$((pass + 1)); else echo "FAIL dark-spots-not-on-party-walls: $between of $n on shared walls"; fail=$((fail + 1)); fi
+expect dark-spots-light-note 0 "note: the lux are direct light only" -- "$bin" dark-spots fixtures/tiny.geojson --count 2
+expect route-walk-path-file 0 "^a walk east along the street of all " -- "$bin" route -q $H --path fixtures/helsinki-walk.geojson --step 4
+printf '{"type":"LineString","coordinates":[[10,20],[50,20]],"properties":{"units":"m"}}' >"$tmp/bare-route.json"
+expect route-bare-linestring 0 "^#0 +all +40\.0 " -- "$bin" route -q fixtures/tiny.geojson --path "$tmp/bare-route.json"
+printf '{"type":"FeatureCollection","features":[{"type":"Feature","properties":{"units":"m"},"geometry":{"type":"LineString","coordinates":[[100,200],[300,200]]}}]}' >"$tmp/feature-m.json"
+"$bin" route $H --path "$tmp/feature-m.json" >/dev/null 2>"$tmp/err"
+if ! grep -q "exceed the lon/lat range" "$tmp/err"; then echo "ok   route-feature-units-m"; pass=$((pass + 1)); else echo "FAIL route-feature-units-m"; fail=$((fail + 1)); fi
+printf '{"type":"FeatureCollection","features":[{"type":"Feature","properties":{"units":"ft"},"geometry":{"type":"LineString","coordinates":[[100,200],[300,200]]}}]}' >"$tmp/feature-ft.json"
+expect route-feature-units-ft 1 "feature-ft.json: feature 0: properties.units must be \"m\" when given" -- "$bin" route -q $H --path "$tmp/feature-ft.json"
 expect info-inner-rings 0 "^buildings: 442 \(4 raised above the ground; 71 inner rings of their own\)$" -- "$bin" info -q $H
 . tests/cli/gis.sh
 . tests/cli/network.sh
