@@ -159,7 +159,7 @@ class Scene:
         return cls(data, **kw)
 
     @classmethod
-    def from_bake(cls, path, mem=None, strict=False):
+    def from_bake(cls, path, mem=None, strict=False, **rest):
         """An engine from a bake file (polarlux bake SCENE -o CITY.plxb):
         one copy of its image into a block of its own, no parsing and no
         rebuilding; frames read the bake's radiance atlas. mem: the block
@@ -167,7 +167,7 @@ class Scene:
         bake keeps its render maximum and lit cache (polarlux bake
         --max-size)."""
         with open(path, "rb") as f:
-            return cls._from_bake_file(f, str(path), mem=mem, strict=strict)
+            return cls._from_bake_file(f, str(path), mem=mem, strict=strict, **rest)
 
     @classmethod
     def _from_bake_file(cls, f, name, mem=None, strict=False, **rest):
@@ -232,6 +232,26 @@ class Scene:
         return {"capacity": r.capacity, "used_total": r.used_total, "peak_total": r.peak_total}
 
     # ---- coordinates -------------------------------------------------------------
+    def _local(self, xy, what):
+        """Raises ValueError when the (N, >=2) local points of a lon/lat scene
+        all lie where the scene's own bounds would be in lon/lat degrees: they
+        are lon/lat given where the API takes metres (such a point as metres
+        lies in a box of centimetres next to the scene's centre; before
+        2026-12-02 a route of them scored 0 m, a render showed black)."""
+        if not self.info.get("lonlat"):
+            return
+        a = np.atleast_2d(np.asarray(xy, dtype=np.float64))
+        if a.ndim != 2 or a.shape[0] == 0 or a.shape[1] < 2:
+            return
+        b = self.info["bounds"]
+        corners = self.local_to_lonlat(np.array([[b[0], b[1]], [b[2], b[3]]]))
+        lo, hi = corners.min(axis=0), corners.max(axis=0)
+        x, y = a[:, 0], a[:, 1]
+        if np.all((x >= lo[0]) & (x <= hi[0]) & (y >= lo[1]) & (y <= hi[1])):
+            raise ValueError(f"{what} look like lon/lat degrees within the scene ({lo[0]:.5f}..{hi[0]:.5f}, "
+                             f"{lo[1]:.5f}..{hi[1]:.5f}); this API takes the scene's local metres: convert "
+                             f"with Scene.lonlat_to_local")
+
     def lonlat_to_local(self, lonlat):
         """(N, 2) lon/lat degrees -> (N, 2) local metres (SPEC §1); lon/lat scenes only."""
         a = _points(lonlat, 2, "lonlat")
@@ -253,9 +273,14 @@ class Scene:
         two (N,) arrays; NaN for a point on no surface or with its normal into a
         building (the others are computed)."""
         pts = np.ascontiguousarray(points, dtype=np.float64)
-        if pts.ndim == 2 and pts.shape[1] == 2:
+        if pts.ndim == 1 and pts.size in (2, 3):
+            pts = pts.reshape(1, pts.size)
+        if pts.ndim != 2 or pts.shape[1] not in (2, 3):
+            raise ValueError(f"points must have shape (N, 2) or (N, 3), not {pts.shape}")
+        if pts.shape[1] == 2:
             pts = np.column_stack([pts, np.zeros(pts.shape[0])])
         pts = _points(pts, 3, "points")
+        self._local(pts, "points")
         if normals is None:
             nrm = np.zeros_like(pts)
             nrm[:, 2] = 1.0
@@ -275,6 +300,7 @@ class Scene:
         """The exact visibility polygon from (x, y): {"area", "polygon" (M, 2),
         "visible" (K,) building indices}. Raises PolarluxError (PLX_E_RANGE)
         for a point that is not free."""
+        self._local([[float(x), float(y)]], "x, y")
         v = _lib.padded(_lib.Visibility)
         self._check(lib.plx_visibility_get(self._e, float(x), float(y), float(dir_deg), float(fov_deg),
                                            ctypes.byref(v)))
@@ -288,6 +314,7 @@ class Scene:
         """(N, 2) viewpoints -> (N,) visible areas in m^2 (SPEC §3); NaN where the
         point is not free (inside a building, on a wall, outside Bounds)."""
         pts = _points(points, 2, "points")
+        self._local(pts, "points")
         out = np.empty(pts.shape[0])
         v = _lib.padded(_lib.Visibility)
         for i, (x, y) in enumerate(pts):
@@ -308,6 +335,7 @@ class Scene:
         n = a.shape[0]
         if n < 2:
             raise ValueError("a route needs 2 or more vertices")
+        self._local(a, "xy")
         total = _lib.padded(_lib.RouteStats)
         segs = (_lib.RouteStats * (n - 1))()
         self._check(lib.plx_route_score(self._e, _dptr(a), n, float(step), float(dark_lux),
@@ -340,6 +368,10 @@ class Scene:
             raise ValueError("held needs exposure='auto' (it holds the automatic exposure)")
         if tone_curve and exposure == "auto":
             raise ValueError("tone_curve needs a number for exposure (automatic exposure has the curve)")
+        for name, v in (("eye", eye), ("target", target)):
+            if len(v) != 3:
+                raise ValueError(f"{name} must be (x, y, z) in the scene's local metres, not {tuple(v)!r}")
+        self._local([list(eye)[:2], list(target)[:2]], "eye and target")
         cam = _lib.Camera()
         cam.eye[:] = [float(v) for v in eye]
         cam.target[:] = [float(v) for v in target]

@@ -306,3 +306,32 @@ def test_errors_name_the_place():
     assert "bad.json: malformed JSON at byte 44 (line 2, column 15)" in str(err.value)
     with pytest.raises(ValueError):
         polarlux.Scene.from_file(TINY).illuminance(np.zeros((3, 4)))
+
+
+def test_lonlat_given_for_metres_is_refused(tmp_path):
+    """A lon/lat scene's API takes local metres: lon/lat degrees within the
+    scene are refused (a route of them scored 0 m, a render was black), and
+    the same points converted work."""
+    s = polarlux.Scene.from_file(HELSINKI)
+    ll = np.array([[24.9432847, 60.1676957], [24.9452847, 60.1676957]])
+    for call in (lambda: s.route_score(ll), lambda: s.illuminance(ll), lambda: s.visibility_areas(ll),
+                 lambda: s.visibility(*ll[0]),
+                 lambda: s.render(eye=(*ll[0], 1.7), target=(*ll[1], 1.0), size=(32, 24))):
+        with pytest.raises(ValueError) as v:
+            call()
+        assert "look like lon/lat" in str(v.value) and "lonlat_to_local" in str(v.value)
+    xy = s.lonlat_to_local(ll)
+    total, _ = s.route_score(xy, step=2.0)
+    assert 100.0 < total["length"] < 120.0 and total["mean"] > 0.0
+    with pytest.raises(ValueError) as v:
+        s.render(eye=(xy[0][0], xy[0][1]), target=(xy[1][0], xy[1][1], 1.0), size=(32, 24))
+    assert "eye must be (x, y, z)" in str(v.value)
+    ed, _ = s.illuminance([xy[0][0], xy[0][1]])
+    assert ed.shape == (1,)
+    with pytest.raises(ValueError) as v:
+        s.illuminance(np.zeros((2, 4)))
+    assert "(N, 2) or (N, 3)" in str(v.value)
+    bake = bake_fixture(tmp_path)
+    with pytest.raises(ValueError) as v:
+        polarlux.Scene.from_bake(bake, render_max=(640, 480))
+    assert "render_max" in str(v.value)
