@@ -187,6 +187,12 @@ int cli_out_ext(const char *cmd, const char *opt, const char *path, const char *
  * a bake's). route and annotate gave different numbers for a scene and
  * its bake, the table saying nothing. */
 void cli_light_note(const char *cmd, const cli_common *c, plx_engine *e);
+/* A point query's failure (plx_last_error) at FILE:LINE, the point as the
+ * file gave it (given: x y) when that differs from the local metres the
+ * library names (lon/lat points): "point 24.9379 60.1740 (local -353.5,
+ * 266.0 m) is inside building 368". */
+void cli_point_error(const char *cmd, const char *file, size_t line, const double *given, const double *local,
+                     plx_engine *e);
 /* Why a result is dark: "the scene has no lamps", or that no light reaches it. */
 const char *cli_dark_reason(plx_engine *e);
 /* Whether the loaded scene has lamps. */

@@ -131,7 +131,7 @@ int cmd_illum(int argc, char **argv)
         plx_status st = plx_illuminance(e, 1, p, p + 3, &ed[k], &ei[k], NULL);
         cli_progress_step(&pr, "illum", k + 1, pts.n);
         if (st == PLX_E_RANGE) {
-            fprintf(stderr, "polarlux illum: %s:%zu: %s\n", file, pts.line[k], plx_last_error(e));
+            cli_point_error("illum", file, pts.line[k], &given[2 * k], p, e);
             failed = 1;
         } else if (st != PLX_OK) {
             cli_progress_end(&pr);

@@ -59,7 +59,7 @@ static int run(plx_engine *e, const char *file, const points *pts, const double 
         double m[PLX_METER_COUNT];
         plx_status st = plx_meter(e, 1, p, p + 3, m);
         if (st == PLX_E_RANGE) {
-            fprintf(stderr, "polarlux meter: %s:%zu: %s\n", file, pts->line[k], plx_last_error(e));
+            cli_point_error("meter", file, pts->line[k], &given[2 * k], p, e);
             failed = 1;
         } else if (st == PLX_E_INVALID) {
             fprintf(stderr, "polarlux meter: %s:%zu: the facing direction (ux, uy) is zero or not finite\n", file,

@@ -113,7 +113,7 @@ static int run_points(plx_engine *e, const vis_opts *o, geo_out *g)
         plx_visibility v;
         plx_status st = plx_visibility_get(e, x, y, o->dir, o->fov, &v);
         if (st != PLX_OK) {
-            fprintf(stderr, "polarlux vis: %s:%zu: %s\n", o->points, pts.line[k], plx_last_error(e));
+            cli_point_error("vis", o->points, pts.line[k], &given[2 * k], &pts.v[2 * k], e);
             if (st != PLX_E_RANGE) {
                 points_free(&pts);
                 free(given);

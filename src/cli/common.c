@@ -333,6 +333,20 @@ void cli_light_note(const char *cmd, const cli_common *c, plx_engine *e)
                         "adds indirect light to E_h)\n", cmd);
 }
 
+void cli_point_error(const char *cmd, const char *file, size_t line, const double *given, const double *local,
+                     plx_engine *e)
+{
+    const char *msg = plx_last_error(e), *close = strstr(msg, ") ");
+    if ((given[0] == local[0] && given[1] == local[1]) || strncmp(msg, "point (", 7) != 0 || !close) {
+        fprintf(stderr, "polarlux %s: %s:%zu: %s\n", cmd, file, line, msg);
+        return;
+    }
+    /* the library's "point (x, y[, z]) why" in local metres: the point as
+     * the file gave it first */
+    fprintf(stderr, "polarlux %s: %s:%zu: point %.10g %.10g (local %.*s m) %s\n", cmd, file, line, given[0], given[1],
+            (int)(close - (msg + 7)), msg + 7, close + 2);
+}
+
 /* Commands whose results are light: they say so when the scene has none. */
 static int computes_light(const char *cmd)
 {

@@ -877,6 +877,9 @@ printf '{"type":"FeatureCollection","features":[{"type":"Feature","properties":{
 if ! grep -q "exceed the lon/lat range" "$tmp/err"; then echo "ok   route-feature-units-m"; pass=$((pass + 1)); else echo "FAIL route-feature-units-m"; fail=$((fail + 1)); fi
 printf '{"type":"FeatureCollection","features":[{"type":"Feature","properties":{"units":"ft"},"geometry":{"type":"LineString","coordinates":[[100,200],[300,200]]}}]}' >"$tmp/feature-ft.json"
 expect route-feature-units-ft 1 "feature-ft.json: feature 0: properties.units must be \"m\" when given" -- "$bin" route -q $H --path "$tmp/feature-ft.json"
+echo "24.937911661 60.174032879" >"$tmp/in-ll.txt"
+expect vis-lonlat-error-as-given 1 "in-ll\.txt:1: point 24\.93791166 60\.17403288 \(local -353\.5125927, 266\.0121887 m\) is inside building 368" -- "$bin" vis -q $H --points "$tmp/in-ll.txt"
+expect meter-lonlat-error-as-given 1 "in-ll\.txt:1: point 24\.93791166 60\.17403288 \(local -353\.5125927, 266\.0121887, 1\.5 m\) is inside a building's solid" -- "$bin" meter -q $H --points "$tmp/in-ll.txt"
 expect info-inner-rings 0 "^buildings: 442 \(4 raised above the ground; 71 inner rings of their own\)$" -- "$bin" info -q $H
 . tests/cli/gis.sh
 . tests/cli/network.sh
