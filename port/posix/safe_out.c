@@ -59,6 +59,32 @@ static char *dup_str(const char *s)
     return d;
 }
 
+/* Whether the folder that would hold target is missing or no folder: then
+ * says so in err (what a user can act on, rather than the temporary
+ * file's name and errno). */
+static int folder_missing(const char *target, char *err, size_t errlen)
+{
+    const char *slash = strrchr(target, '/');
+    char *dir;
+    struct stat st;
+    int missing;
+    if (!slash || slash == target)
+        return 0;
+    dir = malloc((size_t)(slash - target) + 1);
+    if (!dir)
+        return 0;
+    memcpy(dir, target, (size_t)(slash - target));
+    dir[slash - target] = '\0';
+    missing = stat(dir, &st) != 0;
+    if (missing)
+        port_set_err(err, errlen, "cannot write '%s': the folder '%s' does not exist", target, dir);
+    else if (!S_ISDIR(st.st_mode))
+        port_set_err(err, errlen, "cannot write '%s': '%s' is not a folder", target, dir);
+    missing = missing || !S_ISDIR(st.st_mode);
+    free(dir);
+    return missing;
+}
+
 /* The regular-file case: an exclusive temporary file beside target. */
 static int open_temp(safe_out *o, char *err, size_t errlen)
 {
@@ -75,6 +101,8 @@ static int open_temp(safe_out *o, char *err, size_t errlen)
         if (o->fd >= 0 || errno != EEXIST)
             break;
     }
+    if (o->fd < 0 && (errno == ENOENT || errno == ENOTDIR) && folder_missing(o->target, err, errlen))
+        return -1;
     if (o->fd < 0) {
         port_set_err(err, errlen, "cannot create a temporary file for '%s' ('%s'): %s", o->target, o->tmp,
                 strerror(errno));

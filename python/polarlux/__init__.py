@@ -175,6 +175,9 @@ class Scene:
         Python's memory) into a block of anonymous pages, huge pages where
         the system offers them: the load copies the image once, as the
         command's does."""
+        unknown = set(rest) - {"name", "render_max", "lit_cache_bytes"}
+        if unknown:
+            raise TypeError(f"unexpected keyword argument {sorted(unknown)[0]!r}")
         if set(rest) - {"name"}:
             raise ValueError(f"{name}: a bake file takes mem= and strict= only (it keeps its own "
                              f"{', '.join(sorted(set(rest) - {'name'}))}: set them with polarlux bake)")

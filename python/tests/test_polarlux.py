@@ -335,3 +335,5 @@ def test_lonlat_given_for_metres_is_refused(tmp_path):
     with pytest.raises(ValueError) as v:
         polarlux.Scene.from_bake(bake, render_max=(640, 480))
     assert "render_max" in str(v.value)
+    with pytest.raises(TypeError):
+        polarlux.Scene.from_bake(bake, bogus=1)

@@ -120,6 +120,8 @@ int cmd_draw(int argc, char **argv)
         return cli_usage_error("draw", "missing -o OUT.png");
     if (!cli_out_ext("draw", "-o", out, "png", "PNG"))
         return EXIT_USAGE;
+    if (!cli_out_writable("draw", out))
+        return EXIT_FAIL;
     rc = cli_open_scene("draw", scene, &c, &e);
     if (rc != EXIT_OK)
         return rc;

@@ -303,8 +303,8 @@ static void print_memory(const plx_engine *e)
     plx_memory_report m;
     int p;
     plx_memory_get(e, &m);
-    printf("memory: %zu bytes in use, peak %zu, of the block's %zu usable bytes (the engine's own record "
-           "takes the rest)\n", m.used_total, m.peak_total, m.capacity);
+    printf("memory: %zu bytes in use, peak %zu, of the block's %zu usable bytes\n", m.used_total, m.peak_total,
+           m.capacity);
     for (p = 0; p < PLX_PART_COUNT; p++)
         printf("  %-8s %12zu bytes  (peak %zu)\n", plx_part_name((plx_part)p), m.used[p], m.peak[p]);
 }

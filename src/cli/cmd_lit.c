@@ -192,6 +192,8 @@ int cmd_lit(int argc, char **argv)
         return cli_usage_error("lit", "missing --lamp ID");
     if (!out)
         return cli_usage_error("lit", "missing -o OUT.geojson");
+    if (!cli_out_writable("lit", out))
+        return EXIT_FAIL;
     rc = cli_open_scene("lit", scene, &c, &e);
     if (rc != EXIT_OK)
         return rc;

@@ -696,6 +696,8 @@ int cmd_dark_spots(int argc, char **argv)
     scene = pa.npos ? pa.pos[0] : NULL;
     if (!scene)
         return cli_usage_error("dark-spots", "missing SCENE");
+    if (!cli_out_writable("dark-spots", out)) /* before the search, not after it */
+        return EXIT_FAIL;
     rc = cli_open_scene("dark-spots", scene, &c, &e);
     if (rc != EXIT_OK)
         return rc;

@@ -198,6 +198,8 @@ int cmd_vis(int argc, char **argv)
     int rc = parse_args(argc, argv, &o);
     if (rc != EXIT_OK)
         return rc < 0 ? EXIT_OK : rc;
+    if (!cli_out_writable("vis", o.geojson))
+        return EXIT_FAIL;
     rc = cli_open_scene("vis", o.scene, &o.c, &e);
     if (rc != EXIT_OK)
         return rc;

@@ -333,17 +333,32 @@ void cli_light_note(const char *cmd, const cli_common *c, plx_engine *e)
                         "adds indirect light to E_h)\n", cmd);
 }
 
+/* v in the fewest significant digits that read back as v (24.937911661 as
+ * it was written, not 24.93791166 or 24.937911661000001). */
+static void shortest(double v, char *out, size_t len)
+{
+    int p;
+    for (p = 1; p <= 17; p++) {
+        snprintf(out, len, "%.*g", p, v);
+        if (strtod(out, NULL) == v)
+            return;
+    }
+}
+
 void cli_point_error(const char *cmd, const char *file, size_t line, const double *given, const double *local,
                      plx_engine *e)
 {
     const char *msg = plx_last_error(e), *close = strstr(msg, ") ");
+    char gx[32], gy[32];
     if ((given[0] == local[0] && given[1] == local[1]) || strncmp(msg, "point (", 7) != 0 || !close) {
         fprintf(stderr, "polarlux %s: %s:%zu: %s\n", cmd, file, line, msg);
         return;
     }
     /* the library's "point (x, y[, z]) why" in local metres: the point as
      * the file gave it first */
-    fprintf(stderr, "polarlux %s: %s:%zu: point %.10g %.10g (local %.*s m) %s\n", cmd, file, line, given[0], given[1],
+    shortest(given[0], gx, sizeof gx);
+    shortest(given[1], gy, sizeof gy);
+    fprintf(stderr, "polarlux %s: %s:%zu: point %s %s (local %.*s m) %s\n", cmd, file, line, gx, gy,
             (int)(close - (msg + 7)), msg + 7, close + 2);
 }
 
@@ -404,31 +419,6 @@ int cli_out_ext(const char *cmd, const char *opt, const char *path, const char *
     return 0;
 }
 
-/* Whether the folder that would hold path exists (a message if not). */
-static int folder_exists(const char *cmd, const char *path)
-{
-    char dir[4096];
-    const char *slash = strrchr(path, '/');
-    struct stat st;
-    size_t n;
-    if (!slash)
-        return 1; /* the working folder */
-    n = (size_t)(slash - path);
-    if (n == 0 || n >= sizeof dir)
-        return 1;
-    memcpy(dir, path, n);
-    dir[n] = '\0';
-    if (stat(dir, &st) != 0) {
-        fprintf(stderr, "polarlux %s: cannot write '%s': the folder '%s' does not exist\n", cmd, path, dir);
-        return 0;
-    }
-    if (!S_ISDIR(st.st_mode)) {
-        fprintf(stderr, "polarlux %s: cannot write '%s': '%s' is not a folder\n", cmd, path, dir);
-        return 0;
-    }
-    return 1;
-}
-
 int cli_out_writable(const char *cmd, const char *path)
 {
     struct stat st;
@@ -436,8 +426,6 @@ int cli_out_writable(const char *cmd, const char *path)
     safe_out *o;
     if (!path || strcmp(path, "-") == 0 || (stat(path, &st) == 0 && !S_ISREG(st.st_mode) && !S_ISDIR(st.st_mode)))
         return 1;
-    if (!folder_exists(cmd, path))
-        return 0;
     o = safe_out_open(path, err, sizeof err);
     if (!o) {
         fprintf(stderr, "polarlux %s: %s\n", cmd, err);

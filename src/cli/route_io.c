@@ -97,6 +97,17 @@ static int all_lonlat(const cJSON *c)
  * units "m" for a metre path that happens to be in range), else metres:
  * on a lon/lat scene with a note (the scene file's own rule; a metre path
  * there was read with no word). */
+/* The positions [x, y ...] in c (nested arrays). */
+static int count_positions(const cJSON *c)
+{
+    const cJSON *it;
+    int n = 0;
+    if (cJSON_IsArray(c) && cJSON_IsNumber(cJSON_GetArrayItem(c, 0)))
+        return 1;
+    cJSON_ArrayForEach(it, c) n += count_positions(it);
+    return n;
+}
+
 /* A feature's own properties.units: 1 "m", -1 another value, 0 none. */
 static int feature_units(const cJSON *ft)
 {
@@ -116,27 +127,29 @@ static int set_frame(const cJSON *root, const cJSON *features, plx_engine *e, fr
     memset(f, 0, sizeof f[0]);
     note[0] = '\0';
     plx_scene_info_get(e, &si);
-    if (cJSON_IsString(units) && strcmp(units->valuestring, "m") == 0)
-        return 0;
-    if (units) {
+    if (units && !(cJSON_IsString(units) && strcmp(units->valuestring, "m") == 0)) {
         snprintf(why, whylen, "properties.units must be \"m\" when given");
         return -1;
     }
-    cJSON_ArrayForEach(ft, features) { /* the features without units of their own decide */
-        const cJSON *g = cJSON_GetObjectItemCaseSensitive(ft, "geometry");
-        int u = feature_units(ft);
-        if (u < 0) {
+    cJSON_ArrayForEach(ft, features) { /* another unit refused, on any feature */
+        if (feature_units(ft) < 0) {
             snprintf(why, whylen, "feature %d: properties.units must be \"m\" when given", k);
             return -1;
         }
         k++;
-        if (u > 0)
+    }
+    if (units)
+        return 0;
+    cJSON_ArrayForEach(ft, features) { /* the features without units of their own decide */
+        const cJSON *g = cJSON_GetObjectItemCaseSensitive(ft, "geometry");
+        const cJSON *co = cJSON_GetObjectItemCaseSensitive(g, "coordinates");
+        if (feature_units(ft) > 0)
             continue;
-        plain = 1;
-        if (!all_lonlat(cJSON_GetObjectItemCaseSensitive(g, "coordinates")))
+        plain += count_positions(co);
+        if (!all_lonlat(co))
             ll = 0;
     }
-    if (!plain)
+    if (!plain) /* no position to judge by: the features' own errors come later */
         return 0;
     if (!si.lonlat) {
         if (ll) {

@@ -878,8 +878,16 @@ if ! grep -q "exceed the lon/lat range" "$tmp/err"; then echo "ok   route-featur
 printf '{"type":"FeatureCollection","features":[{"type":"Feature","properties":{"units":"ft"},"geometry":{"type":"LineString","coordinates":[[100,200],[300,200]]}}]}' >"$tmp/feature-ft.json"
 expect route-feature-units-ft 1 "feature-ft.json: feature 0: properties.units must be \"m\" when given" -- "$bin" route -q $H --path "$tmp/feature-ft.json"
 echo "24.937911661 60.174032879" >"$tmp/in-ll.txt"
-expect vis-lonlat-error-as-given 1 "in-ll\.txt:1: point 24\.93791166 60\.17403288 \(local -353\.5125927, 266\.0121887 m\) is inside building 368" -- "$bin" vis -q $H --points "$tmp/in-ll.txt"
-expect meter-lonlat-error-as-given 1 "in-ll\.txt:1: point 24\.93791166 60\.17403288 \(local -353\.5125927, 266\.0121887, 1\.5 m\) is inside a building's solid" -- "$bin" meter -q $H --points "$tmp/in-ll.txt"
+expect vis-lonlat-error-as-given 1 "in-ll\.txt:1: point 24\.937911661 60\.174032879 \(local -353\.5125927, 266\.0121887 m\) is inside building 368" -- "$bin" vis -q $H --points "$tmp/in-ll.txt"
+expect meter-lonlat-error-as-given 1 "in-ll\.txt:1: point 24\.937911661 60\.174032879 \(local -353\.5125927, 266\.0121887, 1\.5 m\) is inside a building's solid" -- "$bin" meter -q $H --points "$tmp/in-ll.txt"
+printf '{"type":"FeatureCollection","properties":{"units":"m"},"features":[{"type":"Feature","properties":{"units":"ft"},"geometry":{"type":"LineString","coordinates":[[10,20],[50,20]]}}]}' >"$tmp/coll-m-feat-ft.json"
+expect route-feature-ft-under-m 1 "feature 0: properties.units must be \"m\" when given" -- "$bin" route -q fixtures/tiny.geojson --path "$tmp/coll-m-feat-ft.json"
+printf '{"type":"Feature","properties":{},"geometry":null}' >"$tmp/no-geometry.json"
+expect route-no-geometry 1 "feature 0: geometry is not a LineString or MultiLineString" -- "$bin" route -q fixtures/tiny.geojson --path "$tmp/no-geometry.json"
+expect draw-out-missing-folder 1 "polarlux draw: cannot write '.*/nodir/x\.png': the folder '.*/nodir' does not exist" -- "$bin" draw -q fixtures/tiny.geojson --polar 0 -o "$tmp/nodir/x.png"
+expect dark-spots-out-missing-folder 1 "polarlux dark-spots: cannot write '.*/nodir/s\.json': the folder" -- "$bin" dark-spots -q fixtures/tiny.geojson -o "$tmp/nodir/s.json"
+: >"$tmp/plain"
+expect out-parent-is-a-file 1 "cannot write '.*/plain/x\.png': '.*/plain' is not a folder" -- "$bin" heatmap -q fixtures/tiny.geojson --res 10 -o "$tmp/plain/x.png"
 expect info-inner-rings 0 "^buildings: 442 \(4 raised above the ground; 71 inner rings of their own\)$" -- "$bin" info -q $H
 . tests/cli/gis.sh
 . tests/cli/network.sh

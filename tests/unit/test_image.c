@@ -256,7 +256,7 @@ static void test_missing_directory(void **state)
     assert_int_equal(image_write_png_rgb8(p, 6, 5, img, 0, err, sizeof err), -1);
     assert_non_null(strstr(err, "PNG: "));
     assert_non_null(strstr(err, "/no/such/dir/out.png"));
-    assert_non_null(strstr(err, strerror(ENOENT)));
+    assert_non_null(strstr(err, "/no/such/dir' does not exist")); /* the folder named, not errno */
     assert_false(file_exists(p));
 
     snprintf(p, sizeof p, "%s/no/such/dir/out.pfm", t->dir);
@@ -264,7 +264,7 @@ static void test_missing_directory(void **state)
     assert_int_equal(image_write_pfm(p, 6, 5, fimg, err, sizeof err), -1);
     assert_non_null(strstr(err, "PFM: "));
     assert_non_null(strstr(err, "out.pfm"));
-    assert_non_null(strstr(err, strerror(ENOENT)));
+    assert_non_null(strstr(err, "/no/such/dir' does not exist"));
     assert_false(file_exists(p));
 
     /* the output path is an existing directory: refused, nothing left */
