@@ -316,12 +316,13 @@ plx_status eng_need_atlas(plx_engine *e, double fine)
 {
     arena_mark m;
     double f;
+    uint64_t ntex = 0;
     plx_status st;
     if (e->atlas)
         return PLX_OK;
     if ((st = eng_need_render(e)) != PLX_OK)
         return st;
-    f = atlas_spacing_for(&e->mem, e->sc, render_mesh(e->rd), fine, atlas_budget(e));
+    f = atlas_spacing_for(&e->mem, e->sc, render_mesh(e->rd), fine, atlas_budget(e), &ntex);
     if (f == 0.0) {
         char why[120]; /* the coarsest tried: ATLAS_COARSEST, or the spacing asked when coarser */
         strbuf b;
@@ -332,7 +333,7 @@ plx_status eng_need_atlas(plx_engine *e, double fine)
         return eng_nomem(e, why);
     }
     m = arena_get_mark(&e->mem);
-    st = atlas_create(&e->mem, e->sc, render_mesh(e->rd), f, &e->atlas);
+    st = atlas_create_counted(&e->mem, e->sc, render_mesh(e->rd), f, ntex, &e->atlas);
     e->atlas_cache = st == PLX_OK ? arena_calloc(&e->mem, PLX_PART_FRAME, PLX_MAX_THREADS, sizeof(atlas_cache), 64)
                                   : NULL;
     e->atlas_list = e->atlas_cache ? arena_calloc(&e->mem, PLX_PART_FRAME, ENG_ATLAS_LIST, sizeof(uint32_t), 64) : NULL;

@@ -525,17 +525,29 @@ size_t atlas_plan(arena *a, const scene *s, const mesh *m, double fine, uint64_t
  * elsewhere can stop at another step. */
 #define ATLAS_GUESS 0.25
 
-double atlas_spacing_for(arena *a, const scene *s, const mesh *m, double fine, size_t max_bytes)
+/* Whether the plan at spacing f fits max_bytes (its vertex count in *n);
+ * *known: 1 when it was made (0: no scratch for it, or past 2^32 vertices,
+ * which a later plan at this spacing may not meet again). */
+static int plan_fits(arena *a, const scene *s, const mesh *m, double f, size_t max_bytes, uint64_t *n, int *known)
+{
+    size_t b = atlas_plan(a, s, m, f, n);
+    *known = b != SIZE_MAX;
+    return b <= max_bytes;
+}
+
+double atlas_spacing_for(arena *a, const scene *s, const mesh *m, double fine, size_t max_bytes, uint64_t *ntex)
 {
     const double step = 1.189207115002721; /* 2^(1/4) */
     double f0 = fine > 0.0 && isfinite(fine) ? fine : ATLAS_FINE_DEFAULT, c, g;
     size_t bc;
-    int k = 0, n;
+    uint64_t n_at, n_below;
+    int k = 0, n, known, bad = -1; /* bad: a step whose plan was made and did not fit */
     /* a first guess k steps up from a plan at four times the spacing, or
      * at ATLAS_GUESS when that is coarser (a plan's time grows with its
      * points), its bytes growing about as 1 / spacing^2; then the finest
      * step that fits: down while the next finer one fits, else up until
-     * one does */
+     * one does (the step below one that fits is not planned again when
+     * it was the one that did not) */
     g = fmax(4.0 * f0, ATLAS_GUESS);
     bc = atlas_plan(a, s, m, g, NULL);
     if (bc != SIZE_MAX && bc > 0 && max_bytes > 0) {
@@ -544,22 +556,27 @@ double atlas_spacing_for(arena *a, const scene *s, const mesh *m, double fine, s
             k++;
     }
     for (n = 0; n < 64 && f0 * pow(step, k) <= fmax(ATLAS_COARSEST, f0); n++) {
-        if (atlas_plan(a, s, m, f0 * pow(step, k), NULL) <= max_bytes) {
-            while (k > 0 && atlas_plan(a, s, m, f0 * pow(step, k - 1), NULL) <= max_bytes)
+        if (plan_fits(a, s, m, f0 * pow(step, k), max_bytes, &n_at, &known)) {
+            while (k > 0 && k - 1 != bad && plan_fits(a, s, m, f0 * pow(step, k - 1), max_bytes, &n_below, &known)) {
                 k--;
+                n_at = n_below;
+            }
+            if (ntex)
+                *ntex = n_at;
             return f0 * pow(step, k);
         }
+        bad = known ? k : -1;
         k++;
     }
     return 0.0;
 }
 
-plx_status atlas_create(arena *a, const scene *s, const mesh *m, double fine, atlas **out)
+/* atlas_create with the vertex count n when known (else n_known 0). */
+static plx_status create(arena *a, const scene *s, const mesh *m, double fine, int n_known, uint64_t n, atlas **out)
 {
     atlas F, *A;
     arena_mark mk;
     lay_scratch ls;
-    uint64_t n;
     size_t nt;
     if (!a || !s || !m || !out || !(fine > 0.0) || !isfinite(fine))
         return PLX_E_INVALID;
@@ -570,7 +587,8 @@ plx_status atlas_create(arena *a, const scene *s, const mesh *m, double fine, at
         arena_release(a, &mk);
         return PLX_E_NOMEM;
     }
-    n = lay(&F, ls.marks, ls.zlo, ls.zhi, &ls.cc); /* the count first: nothing lasting taken if it does not fit */
+    if (!n_known) /* the count first: nothing lasting taken if it does not fit */
+        n = lay(&F, ls.marks, ls.zlo, ls.zhi, &ls.cc);
     F.ntex = n;
     F.bytes = bytes_for(&F, n);
     nt = (size_t)F.gx * F.gy;
@@ -581,16 +599,25 @@ plx_status atlas_create(arena *a, const scene *s, const mesh *m, double fine, at
     F.cdone = F.gfine ? arena_calloc(a, PLX_PART_FRAME, F.nsurf ? F.nsurf : 1, 1, 64) : NULL;
     F.gdone = F.cdone ? arena_calloc(a, PLX_PART_FRAME, nt * ATLAS_TB * ATLAS_TB, 1, 64) : NULL;
     F.tex = F.gdone ? arena_calloc(a, PLX_PART_FRAME, n ? (size_t)n : 1, sizeof(uint32_t), 64) : NULL;
-    if (!F.tex) {
+    if (!F.tex || lay(&F, ls.marks, ls.zlo, ls.zhi, &ls.cc) != n) { /* a count not this layout's: refused */
         arena_release(a, &mk);
-        return PLX_E_NOMEM;
+        return F.tex ? PLX_E_INVALID : PLX_E_NOMEM;
     }
-    (void)lay(&F, ls.marks, ls.zlo, ls.zhi, &ls.cc);
     drop_scratch(a, &mk);
     *A = F;
     atlas_clear(A, 0);
     *out = A;
     return PLX_OK;
+}
+
+plx_status atlas_create(arena *a, const scene *s, const mesh *m, double fine, atlas **out)
+{
+    return create(a, s, m, fine, 0, 0, out);
+}
+
+plx_status atlas_create_counted(arena *a, const scene *s, const mesh *m, double fine, uint64_t ntex, atlas **out)
+{
+    return create(a, s, m, fine, 1, ntex, out);
 }
 
 void atlas_clear(atlas *A, uint64_t key)

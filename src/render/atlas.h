@@ -132,13 +132,21 @@ size_t atlas_plan(arena *a, const scene *s, const mesh *m, double fine, uint64_t
 
 /* The fine spacing to use: 'fine' (ATLAS_FINE_DEFAULT when <= 0) grown by
  * steps of 2^(1/4) until atlas_plan fits max_bytes (the finest such step);
- * 0 when even ATLAS_COARSEST (or 'fine', if coarser) does not. */
-double atlas_spacing_for(arena *a, const scene *s, const mesh *m, double fine, size_t max_bytes);
+ * 0 when even ATLAS_COARSEST (or 'fine', if coarser) does not. ntex (may
+ * be NULL): the vertex count of the plan at the spacing returned. */
+double atlas_spacing_for(arena *a, const scene *s, const mesh *m, double fine, size_t max_bytes,
+                         uint64_t *ntex /* OUT */);
 
 /* Lays out the charts at fine spacing 'fine' and takes their memory (the
  * values zero: black). Returns PLX_OK, PLX_E_INVALID, PLX_E_NOMEM (arena
  * back where it was). */
 plx_status atlas_create(arena *a, const scene *s, const mesh *m, double fine, atlas **out /* OUT */);
+
+/* atlas_create when the vertex count at 'fine' is known (atlas_plan's or
+ * atlas_spacing_for's ntex): the same atlas, without laying it out twice
+ * (once to count, once to store). */
+plx_status atlas_create_counted(arena *a, const scene *s, const mesh *m, double fine, uint64_t ntex,
+                                atlas **out /* OUT */);
 
 /* Marks every chart and block not filled (the light changed: the values
  * are stale), under a new key. */

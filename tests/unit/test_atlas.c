@@ -1022,6 +1022,37 @@ static void test_layout(void **state)
 }
 
 /* atlas_create: invalid arguments; out of memory leaves the arena as it was. */
+/* atlas_create_counted with atlas_plan's count lays out the atlas
+ * atlas_create does (charts, ground blocks, sizes), and a count that is
+ * not that layout's is refused with the arena where it was. */
+static void test_create_counted(void **state)
+{
+    world w;
+    atlas *A = NULL, *B = NULL;
+    uint64_t n = 0;
+    arena_mark m0, m1;
+    size_t nb;
+    int f;
+    (void)state;
+    for (f = 0; f < 2; f++) {
+        world_open(&w, f ? "helsinki" : "eixample", f ? HELSINKI : EIXAMPLE, NULL);
+        assert_true(atlas_plan(&w.e->mem, w.s, w.m, 1.5, &n) != SIZE_MAX && n > 0);
+        m0 = arena_get_mark(&w.e->mem);
+        assert_int_equal(atlas_create_counted(&w.e->mem, w.s, w.m, 1.5, n + 1, &B), PLX_E_INVALID);
+        m1 = arena_get_mark(&w.e->mem);
+        assert_true(m0.lo == m1.lo && m0.hi == m1.hi);
+        A = make_atlas(&w, 1.5);
+        assert_int_equal(atlas_create_counted(&w.e->mem, w.s, w.m, 1.5, n, &B), PLX_OK);
+        nb = (size_t)A->gx * A->gy;
+        assert_true(A->ntex == n && B->ntex == n && A->bytes == B->bytes && A->ntex_fine == B->ntex_fine);
+        assert_true(A->gx == B->gx && A->gy == B->gy && A->nsurf == B->nsurf);
+        assert_memory_equal(A->chart, B->chart, A->nsurf * sizeof(atlas_chart));
+        assert_memory_equal(A->gfirst, B->gfirst, nb * 4 * ATLAS_TB * ATLAS_TB);
+        assert_memory_equal(A->gfine, B->gfine, nb);
+        world_close(&w);
+    }
+}
+
 static void test_create_errors(void **state)
 {
     world w;
@@ -2846,11 +2877,13 @@ static void test_spacing(void **state)
              * 0.01), whose first plan is made at ATLAS_GUESS, not at 4 cm */
             double fine = k < n ? runi(&r, 0.3, 2.0) : 0.01, e;
             size_t budget = k < n ? (size_t)exp(runi(&r, log((double)lo), log((double)hi))) : hi;
-            double got = atlas_spacing_for(&w.e->mem, w.s, w.m, fine, budget), prev;
+            uint64_t nt = 0, nplan = 1;
+            double got = atlas_spacing_for(&w.e->mem, w.s, w.m, fine, budget, &nt), prev;
             assert_true(got > 0.0);
             e = log(got / fine) / log(step);
             assert_true(fabs(e - floor(e + 0.5)) < 1e-6 && e > -1e-6); /* fine 2^(k/4) */
-            assert_true(atlas_plan(&w.e->mem, w.s, w.m, got, NULL) <= budget);
+            assert_true(atlas_plan(&w.e->mem, w.s, w.m, got, &nplan) <= budget);
+            assert_true(nt == nplan); /* the count it gives is the plan's at that spacing */
             total++;
             prev = got / step;
             if (k == n) /* the step finer does not fit */
@@ -3233,7 +3266,7 @@ static void test_bug_spacing_too_coarse(void **state)
         skip();
     world_open(&w, "helsinki", HELSINKI, NULL);
     budget = atlas_plan(&w.e->mem, w.s, w.m, fine, NULL);
-    got = atlas_spacing_for(&w.e->mem, w.s, w.m, fine, budget);
+    got = atlas_spacing_for(&w.e->mem, w.s, w.m, fine, budget, NULL);
     printf("  helsinki: atlas_plan(%.2f m) = %zu bytes; atlas_spacing_for(%.2f m, %zu bytes) = %.4f m (plan %zu "
            "bytes)\n",
            fine, budget, fine, budget, got, atlas_plan(&w.e->mem, w.s, w.m, got, NULL));
@@ -3278,7 +3311,8 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_texel_codec),     cmocka_unit_test(test_layout),
-        cmocka_unit_test(test_create_errors),   cmocka_unit_test(test_values),
+        cmocka_unit_test(test_create_errors),   cmocka_unit_test(test_create_counted),
+        cmocka_unit_test(test_values),
         cmocka_unit_test(test_frames),          cmocka_unit_test(test_missing_edges),
         cmocka_unit_test(test_sample),          cmocka_unit_test(test_runs_equal_lanes),
         cmocka_unit_test(test_determinism),     cmocka_unit_test(test_frame_faults),
