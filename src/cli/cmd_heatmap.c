@@ -36,7 +36,7 @@ static const char help[] =
     "             a lon/lat scene) instead of Bounds\n"
     "  --path FILE  draw these routes (GeoJSON LineStrings, as for 'polarlux\n"
     "             route') on the map, sampled every pixel and coloured by lux\n"
-    "             on the same scale, outlined in cyan\n"
+    "             on the same scale, outlined in cyan ('-': standard input)\n"
     "  --quantity Q  what to map (SPEC §6): h ground illuminance (default),\n"
     "             sc semi-cylindrical, v vertical, hs hemispherical illuminance;\n"
     "             v and sc face --facing, all but h are taken --height above\n"

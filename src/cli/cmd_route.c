@@ -29,7 +29,7 @@ static const char route_help[] =
     "criterion too ('class_fr': also min Ev and min Esc over both ways,\n"
     "P1 5/5 ... P6 0.6/0.2 lx).\n"
     "\n"
-    "  --path FILE      the routes (required)\n"
+    "  --path FILE      the routes (required; '-': standard input)\n"
     "  --step M         sampling step in metres (default 1)\n"
     "  --dark-lux LX    the dark threshold (default 1)\n"
     "  --height M       height of the Ev/Esc meters above the path (default 1.5)\n"

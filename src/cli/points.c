@@ -158,7 +158,7 @@ static char *read_stdin(size_t *lenp, char *err, size_t errlen)
     while (buf && (got = fread(buf + len, 1, cap - len - 1, stdin)) > 0) {
         len += got;
         if (len + 1 == cap && cap >= POINTS_MAX_STDIN) {
-            snprintf(err, errlen, "standard input: more than %d MiB of points", POINTS_MAX_STDIN >> 20);
+            snprintf(err, errlen, "standard input: more than %d MiB", POINTS_MAX_STDIN >> 20);
             free(buf);
             return NULL;
         }
@@ -182,22 +182,34 @@ static char *read_stdin(size_t *lenp, char *err, size_t errlen)
     return buf;
 }
 
+char *cli_read_input(const char *path, size_t *lenp, char *err, size_t errlen)
+{
+    char why[256];
+    char *text;
+    size_t len = 0;
+    if (strcmp(path, "-") == 0)
+        text = read_stdin(&len, err, errlen);
+    else if ((text = port_read_text(path, &len, why, sizeof why)) == NULL)
+        snprintf(err, errlen, "%s: %s", path, why);
+    if (text && lenp)
+        *lenp = len;
+    return text;
+}
+
+const char *cli_input_name(const char *path)
+{
+    return strcmp(path, "-") == 0 ? "<stdin>" : path;
+}
+
 int points_read(const char *path, int need, int cols, const double *fill, points *out,
                 char *err, size_t errlen)
 {
     char *text;
     int rc;
     size_t len = 0;
-    char why[256];
-    const char *name = strcmp(path, "-") == 0 ? "<stdin>" : path;
+    const char *name = cli_input_name(path);
     memset(out, 0, sizeof *out);
-    if (strcmp(path, "-") == 0) {
-        text = read_stdin(&len, err, errlen);
-    } else {
-        text = port_read_text(path, &len, why, sizeof why);
-        if (!text)
-            snprintf(err, errlen, "%s: %s", path, why);
-    }
+    text = cli_read_input(path, &len, err, errlen);
     if (!text)
         return -1;
     if (points_check_text(name, text, len, err, errlen) != 0) {

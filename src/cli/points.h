@@ -33,4 +33,11 @@ int points_read(const char *path, int need, int cols, const double *fill, points
                 char *err, size_t errlen);
 void points_free(points *p);
 
+/* A text input read whole: "-" is standard input (up to POINTS_MAX_STDIN
+ * bytes), else the file (port_read_text: a FIFO, a device or a directory
+ * is refused). NULL with "NAME: why" in err. Free with free(). */
+char *cli_read_input(const char *path, size_t *len /* OUT, may be NULL */, char *err, size_t errlen);
+/* The name messages give an input: "<stdin>" for "-". */
+const char *cli_input_name(const char *path);
+
 #endif

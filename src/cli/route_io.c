@@ -5,6 +5,7 @@
 #include <cjson/cJSON.h>
 
 #include "cli.h"
+#include "points.h"
 #include "port.h"
 #include "route_io.h"
 
@@ -336,16 +337,13 @@ int route_parse(const char *name, const char *text, size_t len, plx_engine *e, r
 
 int route_read(const char *path, plx_engine *e, route_set *out, char *err, size_t errlen)
 {
-    char why[256];
     size_t len;
-    char *text = port_read_text(path, &len, why, sizeof why);
+    char *text = cli_read_input(path, &len, err, errlen);
     int rc;
     memset(out, 0, sizeof *out);
-    if (!text) {
-        snprintf(err, errlen, "%s: %s", path, why);
+    if (!text)
         return -1;
-    }
-    rc = route_parse(path, text, len, e, out, err, errlen);
+    rc = route_parse(cli_input_name(path), text, len, e, out, err, errlen);
     free(text);
     return rc;
 }

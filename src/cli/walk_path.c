@@ -6,6 +6,7 @@
 #include <cjson/cJSON.h>
 
 #include "cli.h"
+#include "points.h"
 #include "port.h"
 #include "walk_path.h"
 
@@ -252,11 +253,10 @@ int walk_path_read(const char *path, plx_engine *e, walk_path *wp, char *err, si
     cJSON *root;
     int rc;
     memset(wp, 0, sizeof *wp);
-    text = port_read_text(path, &len, why, sizeof why);
-    if (!text) {
-        snprintf(err, errlen, "%s: %s", path, why);
+    text = cli_read_input(path, &len, err, errlen);
+    if (!text)
         return -1;
-    }
+    path = cli_input_name(path);
     root = cli_json_parse(path, text, len, err, errlen);
     free(text);
     if (!root)

@@ -889,6 +889,14 @@ expect dark-spots-out-missing-folder 1 "polarlux dark-spots: cannot write '.*/no
 : >"$tmp/plain"
 expect out-parent-is-a-file 1 "cannot write '.*/plain/x\.png': '.*/plain' is not a folder" -- "$bin" heatmap -q fixtures/tiny.geojson --res 10 -o "$tmp/plain/x.png"
 expect info-inner-rings 0 "^buildings: 442 \(4 raised above the ground; 71 inner rings of their own\)$" -- "$bin" info -q $H
+# "-" reads a path or network from standard input, with the file's results
+"$bin" route -q $H --path fixtures/helsinki-route.geojson >"$tmp/route-file.txt" 2>/dev/null
+"$bin" route -q $H --path - <fixtures/helsinki-route.geojson >"$tmp/route-stdin.txt" 2>/dev/null
+if [ -s "$tmp/route-file.txt" ] && cmp -s "$tmp/route-file.txt" "$tmp/route-stdin.txt"; then echo "ok   route-path-stdin"; pass=$((pass + 1)); else echo "FAIL route-path-stdin"; fail=$((fail + 1)); fi
+expect route-path-stdin-empty 1 "polarlux route: <stdin>: malformed JSON at byte 0 .*the file is empty" -- sh -c "\"\$0\" route -q fixtures/tiny.geojson --path - </dev/null" "$bin"
+expect route-path-stdin-bad 1 "polarlux route: <stdin>: malformed JSON" -- sh -c "echo '{\"type\":' | \"\$0\" route -q fixtures/tiny.geojson --path -" "$bin"
+expect walk-path-stdin 0 "^walk: 2 frames 64x48" -- sh -c "\"\$0\" walk -q $H --path - --size 64x48 --max-frames 2 --no-indirect -o \"\$1/wks\" <fixtures/helsinki-walk.geojson" "$bin" "$tmp"
+expect heatmap-path-stdin 0 "written to" -- sh -c "\"\$0\" heatmap -q $H --res 20 --path - -o \"\$1/hps.png\" <fixtures/helsinki-route.geojson" "$bin" "$tmp"
 . tests/cli/gis.sh
 . tests/cli/network.sh
 ls "$tmp"/*.tmp* >/dev/null 2>&1 && { echo "FAIL temporary files left"; fail=$((fail + 1)); }
