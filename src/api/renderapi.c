@@ -333,7 +333,8 @@ plx_status eng_need_atlas(plx_engine *e, double fine)
         return eng_nomem(e, why);
     }
     m = arena_get_mark(&e->mem);
-    st = atlas_create_counted(&e->mem, e->sc, render_mesh(e->rd), f, ntex, &e->atlas);
+    st = ntex == UINT64_MAX ? atlas_create(&e->mem, e->sc, render_mesh(e->rd), f, &e->atlas)
+                            : atlas_create_counted(&e->mem, e->sc, render_mesh(e->rd), f, ntex, &e->atlas);
     e->atlas_cache = st == PLX_OK ? arena_calloc(&e->mem, PLX_PART_FRAME, PLX_MAX_THREADS, sizeof(atlas_cache), 64)
                                   : NULL;
     e->atlas_list = e->atlas_cache ? arena_calloc(&e->mem, PLX_PART_FRAME, ENG_ATLAS_LIST, sizeof(uint32_t), 64) : NULL;

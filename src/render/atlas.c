@@ -525,13 +525,15 @@ size_t atlas_plan(arena *a, const scene *s, const mesh *m, double fine, uint64_t
  * elsewhere can stop at another step. */
 #define ATLAS_GUESS 0.25
 
-/* Whether the plan at spacing f fits max_bytes (its vertex count in *n);
- * *known: 1 when it was made (0: no scratch for it, or past 2^32 vertices,
+/* Whether the plan at spacing f fits max_bytes (its vertex count in *n,
+ * UINT64_MAX when the plan was not made); *known: 1 when it was made (0: no scratch for it, or past 2^32 vertices,
  * which a later plan at this spacing may not meet again). */
 static int plan_fits(arena *a, const scene *s, const mesh *m, double f, size_t max_bytes, uint64_t *n, int *known)
 {
     size_t b = atlas_plan(a, s, m, f, n);
     *known = b != SIZE_MAX;
+    if (!*known)
+        *n = UINT64_MAX; /* not counted (it "fits" a budget of SIZE_MAX) */
     return b <= max_bytes;
 }
 

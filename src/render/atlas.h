@@ -133,7 +133,9 @@ size_t atlas_plan(arena *a, const scene *s, const mesh *m, double fine, uint64_t
 /* The fine spacing to use: 'fine' (ATLAS_FINE_DEFAULT when <= 0) grown by
  * steps of 2^(1/4) until atlas_plan fits max_bytes (the finest such step);
  * 0 when even ATLAS_COARSEST (or 'fine', if coarser) does not. ntex (may
- * be NULL): the vertex count of the plan at the spacing returned. */
+ * be NULL): the vertex count of the plan at the spacing returned, or
+ * UINT64_MAX when that plan could not be made (no scratch) and max_bytes
+ * is SIZE_MAX: then atlas_create counts it. */
 double atlas_spacing_for(arena *a, const scene *s, const mesh *m, double fine, size_t max_bytes,
                          uint64_t *ntex /* OUT */);
 

@@ -1021,7 +1021,6 @@ static void test_layout(void **state)
     }
 }
 
-/* atlas_create: invalid arguments; out of memory leaves the arena as it was. */
 /* atlas_create_counted with atlas_plan's count lays out the atlas
  * atlas_create does (charts, ground blocks, sizes), and a count that is
  * not that layout's is refused with the arena where it was. */
@@ -1053,6 +1052,7 @@ static void test_create_counted(void **state)
     }
 }
 
+/* atlas_create: invalid arguments; out of memory leaves the arena as it was. */
 static void test_create_errors(void **state)
 {
     world w;
@@ -2631,6 +2631,62 @@ static plx_status fault_shot(plx_engine *e, int per_pixel, const double eye[3], 
     return plx_render(e, &c, &o, NULL, out, NULL);
 }
 
+/* The radiance atlas made with an allocation refused at every point,
+ * under a budget of SIZE_MAX (plx_config.lightmap_bytes: no limit), where
+ * a spacing search's plan that found no scratch still "fits": the atlas
+ * is made at the spacing asked with the layout of an engine without
+ * faults, or the engine runs out of memory (helper-49 found the count of
+ * such a plan, never made, passed on uninitialised: PLX_E_NOMEM where
+ * the layout fitted). */
+static void test_atlas_faults_no_budget(void **state)
+{
+    uint64_t n0 = 0;
+    int k, n, ok = 0, nomem = 0, search = 0;
+    (void)state;
+    for (k = 0; k <= 200; k++) {
+        plx_config cfg;
+        plx_engine *e = NULL;
+        plx_status st;
+        void *mem = calloc(1, (size_t)64 << 20);
+        assert_non_null(mem);
+        plx_config_default(&cfg);
+        cfg.port = fixture_quiet_port();
+        cfg.threads = 1;
+        cfg.lightmap_bytes = SIZE_MAX;
+        assert_int_equal(plx_engine_create(mem, (size_t)64 << 20, &cfg, &e), PLX_OK);
+        assert_int_equal(plx_load_file(e, "fixtures/grid-4x4.geojson"), PLX_OK);
+        assert_int_equal(eng_need_render(e), PLX_OK);
+        if (k == 0) { /* the requests of the spacing search alone */
+            (void)plx_debug_fail_alloc(e, 0);
+            assert_true(atlas_spacing_for(&e->mem, e->sc, render_mesh(e->rd), 1.0, SIZE_MAX, NULL) == 1.0);
+            search = (int)plx_debug_fail_alloc(e, 0);
+        }
+        (void)plx_debug_fail_alloc(e, (uint64_t)k); /* k = 0: none refused */
+        st = eng_need_atlas(e, 1.0);
+        n = (int)plx_debug_fail_alloc(e, 0);
+        if (k == 0) {
+            assert_int_equal(st, PLX_OK);
+            n0 = e->atlas->ntex;
+        }
+        if (k <= search) /* a plan without scratch: counted again by atlas_create */
+            assert_int_equal(st, PLX_OK);
+        if (st == PLX_OK) {
+            assert_true(e->atlas->fine == 1.0 && e->atlas->ntex == n0);
+            ok++;
+        } else {
+            assert_int_equal(st, PLX_E_NOMEM);
+            nomem++;
+        }
+        plx_engine_destroy(e);
+        free(mem);
+        if (k > n)
+            break; /* past every request: this one made without a fault */
+    }
+    printf("  atlas with no budget, allocation k refused: %d made as without faults (the first %d in the spacing "
+           "search), %d out of memory\n", ok, search, nomem);
+    assert_true(search > 0 && nomem > 0);
+}
+
 /* An allocation refused at every point of a first atlas frame (the
  * atlas made and filled for it): the frame fails with an error, or gives
  * the image of an engine without faults, or (the atlas did not fit, said
@@ -3316,6 +3372,7 @@ int main(void)
         cmocka_unit_test(test_frames),          cmocka_unit_test(test_missing_edges),
         cmocka_unit_test(test_sample),          cmocka_unit_test(test_runs_equal_lanes),
         cmocka_unit_test(test_determinism),     cmocka_unit_test(test_frame_faults),
+        cmocka_unit_test(test_atlas_faults_no_budget),
         cmocka_unit_test(test_eye_inside),      cmocka_unit_test(test_indirect_accuracy),     cmocka_unit_test(test_spacing),
         cmocka_unit_test(test_bug_stacked_neighbours), cmocka_unit_test(test_bug_ground_site_in_solid),
         cmocka_unit_test(test_bug_spacing_too_coarse), cmocka_unit_test(test_bug_texel_below_half),
