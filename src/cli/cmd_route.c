@@ -55,8 +55,14 @@ static const char spots_help[] =
     "  --count N     how many spots (default 50)\n"
     "  --spacing M   minimum distance between reported spots (default 10)\n"
     "  --all         also points out of every lamp's reach\n"
+    "  --exhaustive  compute every point's indirect light (slow on a bake; the\n"
+    "                same spots: by default only points whose direct lux can\n"
+    "                still make them candidates get it)\n"
     "  -o OUT        write the GeoJSON to OUT instead of standard output\n"
-    "  --mem SIZE, --strict, --quiet, --lamps FILE   as for 'polarlux info'\n";
+    "  --mem SIZE, --strict, --quiet, --lamps FILE   as for 'polarlux info'\n"
+    "\n"
+    "A spot's lux is direct plus indirect light (a bake's photon buffers;\n"
+    "a scene file alone has direct light only).\n";
 
 static void class_text(int c, char out[4])
 {
@@ -335,9 +341,11 @@ int cmd_route(int argc, char **argv)
 
 /* ---- dark spots ------------------------------------------------------------ */
 
-/* A street point of the grid: its index j * w + i and its lux. */
+/* A street point of the grid: its index j * w + i and its lux (exact:
+ * direct + indirect; else direct only, a bound below the exact lux). */
 typedef struct spot {
     uint32_t k;
+    uint32_t exact;
     double lux;
 } spot;
 
@@ -356,26 +364,44 @@ static int cmp_spot(const void *a, const void *b)
 }
 
 #define SPOT_STRIP 65536 /* grid points per illuminance call, at most */
-#define SPOT_POINT_BYTES (3 * sizeof(double) * 2 + 2 * sizeof(double) + sizeof(uint32_t))
+#define SPOT_POINT_BYTES (3 * sizeof(double) * 2 + 2 * sizeof(double) + 2 * sizeof(uint32_t))
 #define SPOT_MIN_CANDIDATES 1024
+#define SPOT_PER_COUNT 64 /* candidates a pass keeps per spot asked (at least SPOT_MIN_CANDIDATES) */
 
 /* The street points are not all kept: a pass over the grid keeps the `cap`
  * darkest of those after `after` (in spot_before's order) in a max-heap,
  * so the command's buffers stay within --mem however fine --res is. The
  * spacing rule then takes them in order; when it runs out of candidates
  * before --count spots, the next pass continues after the last one. The
- * spots are those of one sort of every street point, pass or no pass. */
+ * spots are those of one sort of every street point, pass or no pass.
+ *
+ * Indirect light (a final gather a point, on a bake: a thousand times the
+ * direct light's cost) is computed only where it can change the answer:
+ * a point's direct lux is a bound below its lux, so a point whose bound
+ * is already after the cap-th darkest lux found cannot be a candidate
+ * (spot_pass). --exhaustive computes it everywhere: the reference. */
 typedef struct spot_grid {
     double x0, y0, res;
     size_t w, h, strip;
     spot *heap;          /* max-heap of the darkest candidates of this pass */
     size_t n, cap;
+    size_t cap_mem;      /* the most candidates --mem leaves room for (at most the grid points) */
+    int cap_by_mem;      /* cap is cap_mem (else SPOT_PER_COUNT's, grown by each pass) */
     spot after;          /* this pass takes spots after this one ... */
     int has_after;       /* ... when set */
+    int exhaustive;      /* every point's lux exact at once (--exhaustive, or no indirect light) */
+    int no_indirect;     /* the engine has no photon buffers: the direct lux is exact */
     size_t offered;      /* street points after `after` seen this pass */
     size_t street;       /* street points of the grid (first pass) */
-    double max_lux;      /* the brightest street point (first pass) */
+    double max_lux;      /* the brightest street point's lux, direct only unless exhaustive (first pass) */
+    size_t gathered;     /* points whose indirect light was computed */
 } spot_grid;
+
+/* One pass's buffers: a strip of grid points. */
+typedef struct spot_bufs {
+    double *P, *N, *E, *Ei;
+    uint32_t *reach, *mark;
+} spot_bufs;
 
 static void spot_xy(const spot_grid *g, uint32_t k, double *x, double *y)
 {
@@ -390,27 +416,13 @@ static void heap_swap(spot *h, size_t a, size_t b)
     h[b] = t;
 }
 
-/* Offers one street point to this pass's candidates. */
-static void spot_offer(spot_grid *g, spot s)
+static void heap_down(spot *h, size_t n, size_t i)
 {
-    spot *h = g->heap;
-    size_t i;
-    if (g->has_after && !spot_before(&g->after, &s))
-        return;
-    g->offered++;
-    if (g->n < g->cap) {
-        for (i = g->n++, h[i] = s; i > 0 && spot_before(&h[(i - 1) / 2], &h[i]); i = (i - 1) / 2)
-            heap_swap(h, i, (i - 1) / 2);
-        return;
-    }
-    if (!spot_before(&s, &h[0]))
-        return;
-    h[0] = s;
-    for (i = 0;;) {
+    for (;;) {
         size_t l = 2 * i + 1, r = l + 1, m = i;
-        if (l < g->n && spot_before(&h[m], &h[l]))
+        if (l < n && spot_before(&h[m], &h[l]))
             m = l;
-        if (r < g->n && spot_before(&h[m], &h[r]))
+        if (r < n && spot_before(&h[m], &h[r]))
             m = r;
         if (m == i)
             break;
@@ -419,84 +431,264 @@ static void spot_offer(spot_grid *g, spot s)
     }
 }
 
-/* Grid points [k0, k1): those in some lamp's reach (all with --all) get
- * their lux (direct + indirect); street points are offered. */
-static int spot_strip(plx_engine *e, spot_grid *g, size_t k0, size_t k1, int all, double *P, double *N,
-                      double *E, double *Ei, uint32_t *reach)
+/* Whether spot s (its lux exact or a bound below) can still be one of
+ * this pass's candidates: the heap has room, or s is before its last. */
+static int spot_may_enter(const spot_grid *g, const spot *s)
 {
-    size_t k, m = 0, n = k1 - k0;
-    plx_status st;
-    for (k = 0; k < n; k++) {
-        spot_xy(g, (uint32_t)(k0 + k), &P[3 * k], &P[3 * k + 1]);
-        P[3 * k + 2] = 0.0;
+    return g->n < g->cap || spot_before(s, &g->heap[0]);
+}
+
+/* Offers one street point (after `after`) to this pass's candidates. */
+static void spot_offer(spot_grid *g, spot s)
+{
+    spot *h = g->heap;
+    size_t i;
+    if (g->n < g->cap) {
+        for (i = g->n++, h[i] = s; i > 0 && spot_before(&h[(i - 1) / 2], &h[i]); i = (i - 1) / 2)
+            heap_swap(h, i, (i - 1) / 2);
+        return;
     }
-    if (!all && (st = plx_lamps_in_reach(e, n, P, reach)) != PLX_OK)
-        goto fail;
-    for (k = 0; k < n; k++) {
-        if (!all && reach[k] == 0)
-            continue;
-        memmove(&P[3 * m], &P[3 * k], 3 * sizeof *P);
-        N[3 * m] = N[3 * m + 1] = 0.0;
-        N[3 * m + 2] = 1.0;
-        reach[m++] = (uint32_t)(k0 + k);
-    }
-    st = plx_illuminance(e, m, P, N, E, Ei, NULL);
-    if (st != PLX_OK && st != PLX_E_RANGE)
-        goto fail;
-    for (k = 0; k < m; k++) {
-        spot s;
-        if (E[k] != E[k])
-            continue; /* under a building */
-        s.k = reach[k];
-        s.lux = E[k] + Ei[k];
-        if (!g->has_after) {
-            g->street++;
-            g->max_lux = g->street == 1 || s.lux > g->max_lux ? s.lux : g->max_lux;
-        }
-        spot_offer(g, s);
-    }
-    return EXIT_OK;
-fail:
+    if (!spot_before(&s, &h[0]))
+        return;
+    h[0] = s;
+    heap_down(h, g->n, 0);
+}
+
+/* Whether s is after this pass's start (`after`). */
+static int spot_after(const spot_grid *g, const spot *s)
+{
+    return !g->has_after || spot_before(&g->after, s);
+}
+
+static int spot_fail(plx_engine *e, plx_status st)
+{
     fprintf(stderr, "polarlux dark-spots: %s\n", plx_last_error(e));
     return cli_exit_code(st);
 }
 
+/* Grid points [k0, k1) in reach of some lamp (every one with --all): their
+ * positions and grid indices in b (P, reach), their direct lux (E, NaN
+ * under a building); *m: how many. */
+static int spot_direct(plx_engine *e, const spot_grid *g, size_t k0, size_t k1, int all, spot_bufs *b, size_t *m)
+{
+    size_t k, n = k1 - k0;
+    plx_status st;
+    *m = 0;
+    for (k = 0; k < n; k++) {
+        spot_xy(g, (uint32_t)(k0 + k), &b->P[3 * k], &b->P[3 * k + 1]);
+        b->P[3 * k + 2] = 0.0;
+    }
+    if (!all && (st = plx_lamps_in_reach(e, n, b->P, b->reach)) != PLX_OK)
+        return spot_fail(e, st);
+    for (k = 0; k < n; k++) {
+        if (!all && b->reach[k] == 0)
+            continue;
+        memmove(&b->P[3 * *m], &b->P[3 * k], 3 * sizeof *b->P);
+        b->N[3 * *m] = b->N[3 * *m + 1] = 0.0;
+        b->N[3 * *m + 2] = 1.0;
+        b->reach[(*m)++] = (uint32_t)(k0 + k);
+    }
+    st = plx_illuminance(e, *m, b->P, b->N, b->E, NULL, NULL);
+    return st != PLX_OK && st != PLX_E_RANGE ? spot_fail(e, st) : EXIT_OK;
+}
+
+/* The exact lux (direct + indirect) of the points b->mark[0 .. nm) of the
+ * strip, into b->E; their positions moved to the front of b->P. */
+static int spot_exact(plx_engine *e, spot_grid *g, spot_bufs *b, size_t nm)
+{
+    size_t j;
+    plx_status st;
+    for (j = 0; j < nm; j++)
+        memmove(&b->P[3 * j], &b->P[3 * b->mark[j]], 3 * sizeof *b->P);
+    st = plx_illuminance(e, nm, b->P, b->N, b->E, b->Ei, NULL);
+    if (st != PLX_OK && st != PLX_E_RANGE)
+        return spot_fail(e, st);
+    for (j = 0; j < nm; j++)
+        b->E[j] += b->Ei[j];
+    g->gathered += nm;
+    return EXIT_OK;
+}
+
+/* Step 1 of a pass on grid points [k0, k1): every street point after
+ * `after` offered with its direct lux as a bound (counted), or, where
+ * that bound is not after `after` (or --exhaustive), its exact lux. */
+static int spot_bound_strip(plx_engine *e, spot_grid *g, size_t k0, size_t k1, int all, spot_bufs *b)
+{
+    size_t k, m, nm = 0;
+    uint32_t *idx;
+    int rc = spot_direct(e, g, k0, k1, all, b, &m);
+    if (rc != EXIT_OK)
+        return rc;
+    for (k = 0; k < m; k++) {
+        spot s;
+        if (b->E[k] != b->E[k])
+            continue; /* under a building */
+        s.k = b->reach[k];
+        s.exact = 0;
+        s.lux = b->E[k];
+        if (!g->has_after) {
+            g->street++;
+            g->max_lux = g->street == 1 || s.lux > g->max_lux ? s.lux : g->max_lux;
+        }
+        if (g->no_indirect)
+            s.exact = 1;
+        else if (g->exhaustive || !spot_after(g, &s)) {
+            b->mark[nm++] = (uint32_t)k; /* the exact lux decides */
+            continue;
+        }
+        if (!spot_after(g, &s))
+            continue;
+        g->offered++;
+        spot_offer(g, s);
+    }
+    idx = b->reach; /* the marked points' grid indices, before spot_exact moves P */
+    for (k = 0; k < nm; k++)
+        idx[k] = b->reach[b->mark[k]];
+    if (nm == 0 || (rc = spot_exact(e, g, b, nm)) != EXIT_OK)
+        return rc;
+    for (k = 0; k < nm; k++) {
+        spot s;
+        s.k = idx[k];
+        s.exact = 1;
+        s.lux = b->E[k];
+        if (g->exhaustive && !g->has_after)
+            g->max_lux = s.lux > g->max_lux ? s.lux : g->max_lux;
+        if (!spot_after(g, &s))
+            continue;
+        g->offered++;
+        spot_offer(g, s);
+    }
+    return EXIT_OK;
+}
+
+/* Step 2: the candidates whose lux is a bound get their exact lux (in
+ * strips of b's size), and the heap is made again. */
+static int spot_exact_heap(plx_engine *e, spot_grid *g, spot_bufs *b)
+{
+    size_t i = 0, k;
+    while (i < g->n) {
+        size_t nm = 0, first = i;
+        int rc;
+        for (; i < g->n && nm < g->strip; i++)
+            if (!g->heap[i].exact) {
+                spot_xy(g, g->heap[i].k, &b->P[3 * nm], &b->P[3 * nm + 1]);
+                b->P[3 * nm + 2] = 0.0;
+                b->N[3 * nm] = b->N[3 * nm + 1] = 0.0;
+                b->N[3 * nm + 2] = 1.0;
+                b->mark[nm] = (uint32_t)nm;
+                nm++;
+            }
+        if (nm == 0)
+            continue;
+        if ((rc = spot_exact(e, g, b, nm)) != EXIT_OK)
+            return rc;
+        for (k = first, nm = 0; k < i; k++)
+            if (!g->heap[k].exact) {
+                g->heap[k].lux = b->E[nm++];
+                g->heap[k].exact = 1;
+            }
+    }
+    for (k = g->n / 2; k-- > 0;)
+        heap_down(g->heap, g->n, k);
+    return EXIT_OK;
+}
+
+/* Step 3 on grid points [k0, k1), when step 1 filled the heap: the points
+ * step 1 left out (bound after `last`, its last candidate then) whose
+ * bound is still before the heap's last get their exact lux and are
+ * offered. A point whose exact lux step 1 took is taken again. */
+static int spot_refine_strip(plx_engine *e, spot_grid *g, size_t k0, size_t k1, int all, const spot *last,
+                             spot_bufs *b)
+{
+    size_t k, m, nm = 0;
+    uint32_t *idx;
+    int rc = spot_direct(e, g, k0, k1, all, b, &m);
+    if (rc != EXIT_OK)
+        return rc;
+    for (k = 0; k < m; k++) {
+        spot s;
+        if (b->E[k] != b->E[k])
+            continue;
+        s.k = b->reach[k];
+        s.exact = 0;
+        s.lux = b->E[k];
+        if (spot_after(g, &s) && (!spot_before(last, &s) || !spot_may_enter(g, &s)))
+            continue; /* in the heap since step 1, or never a candidate */
+        b->mark[nm++] = (uint32_t)k;
+    }
+    idx = b->reach;
+    for (k = 0; k < nm; k++)
+        idx[k] = b->reach[b->mark[k]];
+    if (nm == 0 || (rc = spot_exact(e, g, b, nm)) != EXIT_OK)
+        return rc;
+    for (k = 0; k < nm; k++) {
+        spot s;
+        s.k = idx[k];
+        s.exact = 1;
+        s.lux = b->E[k];
+        if (spot_after(g, &s) && spot_before(last, &s)) /* else not after `after`, or in the heap since step 1 */
+            spot_offer(g, s);
+    }
+    return EXIT_OK;
+}
+
 /* One pass over every grid point, strip by strip (progress on a terminal);
- * leaves this pass's candidates sorted in g->heap[0 .. n). */
+ * leaves this pass's candidates, the `cap` darkest street points after
+ * `after` by their exact lux, sorted in g->heap[0 .. n). Step 1 keeps
+ * the darkest by bound, step 2 makes them exact, step 3 (when step 1's
+ * heap was full) brings in the points whose bound is before the last of
+ * them: a point left out has a bound, and so a lux, at or after it. */
 static int spot_pass(plx_engine *e, spot_grid *g, int all, int pass)
 {
     size_t total = g->w * g->h, k0;
-    double *P = malloc(sizeof *P * 3 * g->strip), *N = malloc(sizeof *N * 3 * g->strip);
-    double *E = malloc(sizeof *E * g->strip), *Ei = malloc(sizeof *Ei * g->strip);
-    uint32_t *reach = malloc(sizeof *reach * g->strip);
-    char what[48];
+    spot_bufs b;
+    spot last = { 0, 0, 0.0 };
+    char what[64];
     cli_progress pr;
-    int rc = EXIT_OK;
-    if (!P || !N || !E || !Ei || !reach) {
+    int rc = EXIT_OK, step;
+    b.P = malloc(sizeof *b.P * 3 * g->strip);
+    b.N = malloc(sizeof *b.N * 3 * g->strip);
+    b.E = malloc(sizeof *b.E * g->strip);
+    b.Ei = malloc(sizeof *b.Ei * g->strip);
+    b.reach = malloc(sizeof *b.reach * g->strip);
+    b.mark = malloc(sizeof *b.mark * g->strip);
+    if (!b.P || !b.N || !b.E || !b.Ei || !b.reach || !b.mark) {
         fprintf(stderr, "polarlux dark-spots: out of memory\n");
         rc = EXIT_FAIL;
     }
-    snprintf(what, sizeof what, pass > 1 ? "dark-spots (pass %d)" : "dark-spots", pass);
     g->n = g->offered = 0;
-    cli_progress_start(&pr);
-    for (k0 = 0; rc == EXIT_OK && k0 < total; k0 += g->strip) {
-        size_t k1 = k0 + g->strip < total ? k0 + g->strip : total;
-        rc = spot_strip(e, g, k0, k1, all, P, N, E, Ei, reach);
-        cli_progress_step(&pr, what, k1, total);
+    for (step = 1; step <= 3 && rc == EXIT_OK; step += 2) {
+        if (step == 3 && (g->exhaustive || g->n < g->cap))
+            break; /* every street point after `after` is a candidate: no step 3 */
+        if (step == 3) {
+            last = g->heap[0]; /* step 1's last candidate, by bound */
+            if ((rc = spot_exact_heap(e, g, &b)) != EXIT_OK)
+                break;
+        }
+        snprintf(what, sizeof what, "dark-spots%s%s", step == 3 ? " (exact lux)" : "", pass > 1 ? " (again)" : "");
+        cli_progress_start(&pr);
+        for (k0 = 0; rc == EXIT_OK && k0 < total; k0 += g->strip) {
+            size_t k1 = k0 + g->strip < total ? k0 + g->strip : total;
+            rc = step == 1 ? spot_bound_strip(e, g, k0, k1, all, &b) : spot_refine_strip(e, g, k0, k1, all, &last, &b);
+            cli_progress_step(&pr, what, k1, total);
+        }
+        cli_progress_end(&pr);
     }
-    cli_progress_end(&pr);
-    free(P), free(N), free(E), free(Ei), free(reach);
+    if (rc == EXIT_OK && !g->exhaustive && g->n < g->cap) /* no step 3: the candidates' bounds made exact */
+        rc = spot_exact_heap(e, g, &b);
+    free(b.P), free(b.N), free(b.E), free(b.Ei), free(b.reach), free(b.mark);
     if (g->n > 1) /* the heap is empty (maybe NULL) when there are no spots */
         qsort(g->heap, g->n, sizeof *g->heap, cmp_spot);
     return rc;
 }
 
 /* Sizes the strip and the candidate heap from what --mem leaves the
- * command; 0, or the exit code after a message. */
+ * command (at most SPOT_PER_COUNT a spot asked, when not --exhaustive);
+ * 0, or the exit code after a message. */
 static int spot_buffers(plx_engine *e, const cli_common *c, spot_grid *g, long count)
 {
     size_t budget = cli_buffer_budget(e, c), total = g->w * g->h;
-    size_t pick = sizeof(spot) * (size_t)count, fixed, need;
+    size_t pick = sizeof(spot) * (size_t)count, fixed, need, want;
     g->strip = budget / 4 / SPOT_POINT_BYTES;
     g->strip = g->strip > SPOT_STRIP ? SPOT_STRIP : g->strip < 64 ? 64 : g->strip;
     fixed = g->strip * SPOT_POINT_BYTES + pick;
@@ -507,8 +699,12 @@ static int spot_buffers(plx_engine *e, const cli_common *c, spot_grid *g, long c
                 SPOT_MIN_CANDIDATES);
         return EXIT_NOMEM;
     }
-    g->cap = (budget - fixed) / sizeof(spot);
-    g->cap = g->cap > total ? total : g->cap;
+    g->cap_mem = (budget - fixed) / sizeof(spot);
+    g->cap_mem = g->cap_mem > total ? total : g->cap_mem;
+    want = (size_t)count * SPOT_PER_COUNT;
+    want = want < SPOT_MIN_CANDIDATES ? SPOT_MIN_CANDIDATES : want;
+    g->cap_by_mem = g->exhaustive || g->cap_mem <= want;
+    g->cap = g->cap_by_mem ? g->cap_mem : want;
     g->heap = malloc(sizeof *g->heap * (g->cap ? g->cap : 1));
     if (!g->heap) {
         fprintf(stderr, "polarlux dark-spots: out of memory for %zu candidate points\n", g->cap);
@@ -571,15 +767,27 @@ static int spot_search(plx_engine *e, spot_grid *g, int all, double spacing, lon
             break;
         g->after = g->heap[g->n - 1];
         g->has_after = 1;
+        if (!g->cap_by_mem) { /* too few candidates: four times as many next pass, within --mem */
+            size_t cap = g->cap_mem / 4 > g->cap ? 4 * g->cap : g->cap_mem;
+            spot *h = realloc(g->heap, sizeof *h * cap);
+            if (h) {
+                g->heap = h;
+                g->cap = cap;
+                g->cap_by_mem = cap == g->cap_mem;
+            }
+        }
     }
-    if (pass > 1)
+    if (pass > 1 && g->cap_by_mem)
         fprintf(stderr, "dark-spots: %d passes over the grid: --mem leaves room for %zu of the %zu street "
                 "points at a time\n", pass, g->cap, g->street);
+    else if (pass > 1)
+        fprintf(stderr, "dark-spots: %d passes over the grid (--spacing left too few of the darkest points "
+                "each pass kept; the last kept %zu)\n", pass, g->cap);
     return EXIT_OK;
 }
 
-static int find_spots(plx_engine *e, double res, long count, double spacing, int all, const char *out,
-                      const cli_common *c)
+static int find_spots(plx_engine *e, double res, long count, double spacing, int all, int exhaustive,
+                      const char *out, const cli_common *c)
 {
     plx_scene_info si;
     spot_grid g;
@@ -592,6 +800,8 @@ static int find_spots(plx_engine *e, double res, long count, double spacing, int
     g.x0 = si.bounds[0];
     g.y0 = si.bounds[1];
     g.res = res;
+    g.no_indirect = plx_indirect_frames(e) == 0;
+    g.exhaustive = exhaustive || g.no_indirect;
     {   /* counted in doubles: no integer overflow for any finite --res */
         double wd = floor((si.bounds[2] - si.bounds[0]) / res), hd = floor((si.bounds[3] - si.bounds[1]) / res);
         if (!(wd * hd >= 1 && wd * hd <= 2e9)) {
@@ -617,9 +827,15 @@ static int find_spots(plx_engine *e, double res, long count, double spacing, int
         cli_warn("dark-spots", c, "no street point is within a lamp's reach (%s), so there are no spots; "
                  "--all takes every street point", si.lamps ? "the lamps are outside Bounds or their radius "
                  "does not reach the ground" : "the scene has no lamps");
-    if (g.street > 0 && !(g.max_lux > 0))
+    if (g.street > 0 && !(g.max_lux > 0) && g.exhaustive)
         cli_warn("dark-spots", c, "all %zu street points are dark (0 lx): %s", g.street, cli_dark_reason(e));
+    else if (g.street > 0 && !(g.max_lux > 0)) /* the direct lux's maximum; indirect light only where needed */
+        cli_warn("dark-spots", c, "no direct light reaches any of the %zu street points (0 lx direct): %s",
+                 g.street, cli_dark_reason(e));
     cli_light_note("dark-spots", c, e);
+    if (g.gathered > 0 && !g.exhaustive && !c->quiet)
+        fprintf(stderr, "dark-spots: indirect light gathered %zu times for the %zu street points (not where the "
+                "direct lux alone rules a point out; --exhaustive gathers at every one)\n", g.gathered, g.street);
     if (geo_begin(&geo, e) != 0) {
         rc = EXIT_FAIL;
         goto done;
@@ -678,13 +894,14 @@ int cmd_dark_spots(int argc, char **argv)
     const char *scene = NULL, *out = NULL;
     double res = 2.0, spacing = 10.0;
     long count = 50;
-    int all = 0, rc;
+    int all = 0, exhaustive = 0, rc;
     plx_engine *e;
     const cli_opt opts[] = {
         CLI_OPT_VAL("--res", &res, parse_res, "--res '%s' is not a positive number of metres"),
         CLI_OPT_VAL("--spacing", &spacing, parse_spacing, "--spacing '%s' is not a number of metres >= 0"),
         CLI_OPT_VAL("--count", &count, parse_count, "--count '%s' is not 1..1000000"),
         CLI_OPT_FLAG("--all", &all),
+        CLI_OPT_FLAG("--exhaustive", &exhaustive),
         CLI_OPT_STR("-o", &out),
         CLI_OPT_END
     };
@@ -701,7 +918,7 @@ int cmd_dark_spots(int argc, char **argv)
     rc = cli_open_scene("dark-spots", scene, &c, &e);
     if (rc != EXIT_OK)
         return rc;
-    rc = find_spots(e, res, count, spacing, all, out, &c);
+    rc = find_spots(e, res, count, spacing, all, exhaustive, out, &c);
     plx_engine_free(e);
     return rc;
 }

@@ -889,6 +889,19 @@ expect dark-spots-out-missing-folder 1 "polarlux dark-spots: cannot write '.*/no
 : >"$tmp/plain"
 expect out-parent-is-a-file 1 "cannot write '.*/plain/x\.png': '.*/plain' is not a folder" -- "$bin" heatmap -q fixtures/tiny.geojson --res 10 -o "$tmp/plain/x.png"
 expect info-inner-rings 0 "^buildings: 442 \(4 raised above the ground; 71 inner rings of their own\)$" -- "$bin" info -q $H
+# dark-spots on a bake gathers indirect light only where the direct lux
+# leaves a point a candidate: the same spots as --exhaustive (every point
+# gathered), in one pass and in two (--spacing leaves too few candidates)
+"$bin" bake -q fixtures/tiny.geojson -o "$tmp/ds.plxb" >/dev/null 2>&1
+for a in "--count 3 --res 1" "--count 40 --res 1 --spacing 12"; do
+    "$bin" dark-spots -q "$tmp/ds.plxb" $a >"$tmp/ds-lazy.json" 2>"$tmp/ds-lazy.err"
+    "$bin" dark-spots -q "$tmp/ds.plxb" $a --exhaustive >"$tmp/ds-all.json" 2>/dev/null
+    if grep -q '"rank":3' "$tmp/ds-lazy.json" && cmp -s "$tmp/ds-lazy.json" "$tmp/ds-all.json"; then
+        echo "ok   dark-spots-lazy-equals-exhaustive $a"; pass=$((pass + 1))
+    else echo "FAIL dark-spots-lazy-equals-exhaustive $a"; fail=$((fail + 1)); fi
+done
+expect dark-spots-gathered-note 0 "indirect light gathered [0-9]+ times for the 4034 street points" -- "$bin" dark-spots "$tmp/ds.plxb" --count 3 --res 1
+expect dark-spots-two-passes 0 "2 passes over the grid \(--spacing left too few" -- "$bin" dark-spots "$tmp/ds.plxb" --count 40 --res 1 --spacing 12
 # "-" reads a path or network from standard input, with the file's results
 "$bin" route -q $H --path fixtures/helsinki-route.geojson >"$tmp/route-file.txt" 2>/dev/null
 "$bin" route -q $H --path - <fixtures/helsinki-route.geojson >"$tmp/route-stdin.txt" 2>/dev/null
