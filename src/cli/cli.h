@@ -187,6 +187,13 @@ int cli_out_ext(const char *cmd, const char *opt, const char *path, const char *
  * a bake's). route and annotate gave different numbers for a scene and
  * its bake, the table saying nothing. */
 void cli_light_note(const char *cmd, const cli_common *c, plx_engine *e);
+
+/* The scene file's own top-level "attribution" string (a member some
+ * GeoJSON extracts carry: OpenStreetMap's licence line) into buf, read in
+ * place through the POSIX port's mapping; 1 when there is a non-empty
+ * one, else 0 and buf empty (a bake, no such member, a file that cannot
+ * be mapped). */
+int cli_scene_attribution(const char *path, char *buf, size_t cap);
 /* A point query's failure (plx_last_error) at FILE:LINE, the point as the
  * file gave it (given: x y) when that differs from the local metres the
  * library names (lon/lat points): "point 24.9379 60.1740 (local -353.5,

@@ -23,8 +23,9 @@ static const char help[] =
     "solid) are transparent. Each pixel is the ground point under its centre.\n"
     "The scene must be in lon/lat.\n"
     "OUT ending in .mbtiles is an MBTiles 1.3 file (SQLite; metadata name,\n"
-    "format, type, version, bounds, center, minzoom, maxzoom, description);\n"
-    "otherwise OUT is a folder receiving OUT/z/x/y.png.\n"
+    "format, type, version, bounds, center, minzoom, maxzoom, description, and\n"
+    "attribution when there is one); otherwise OUT is a folder receiving\n"
+    "OUT/z/x/y.png.\n"
     "\n"
     "  --zoom Z0-Z1   zoom levels (0..22; one level: --zoom Z)\n"
     "  --quantity Q   h: the horizontal illuminance E_h on the ground (default);\n"
@@ -38,10 +39,13 @@ static const char help[] =
     "                 the quantity with its default resolution, the next power of\n"
     "                 ten above the brightest pixel)\n"
     "  -o OUT         folder or .mbtiles file (required)\n"
+    "  --attribution TEXT  the MBTiles attribution (the data's credit line;\n"
+    "                 default: the scene file's own top-level \"attribution\"\n"
+    "                 member, as OpenStreetMap extracts carry; '' for none)\n"
     "  --mem SIZE, --strict, --quiet, --lamps FILE   as for 'polarlux info'\n";
 
 typedef struct tiles_opts {
-    const char *scene, *out;
+    const char *scene, *out, *attribution;
     long z0, z1;
     double top;
     heat_quantity q;
@@ -128,6 +132,20 @@ static void quantity_text(const heat_quantity *q, char *buf, size_t len)
         snprintf(buf, len, "direct semi-cylindrical illuminance E_sc at %g m facing %g deg", q->height, q->facing);
 }
 
+/* The MBTiles attribution: --attribution, else the scene file's own (none
+ * from a bake, which does not keep it: said on stderr). */
+static const char *tiles_attribution(const tiles_opts *o, char *buf, size_t cap)
+{
+    if (o->attribution)
+        return o->attribution;
+    if (cli_bake_last.loaded) {
+        cli_warn("tiles", &o->c, "%s: a bake keeps no attribution: the MBTiles file has none (give "
+                 "--attribution TEXT, the data's credit line)", o->scene);
+        return NULL;
+    }
+    return cli_scene_attribution(o->scene, buf, cap) ? buf : NULL;
+}
+
 /* Renders and stores every tile; returns an exit code. */
 static int run(plx_engine *e, const tiles_opts *o, double top)
 {
@@ -136,7 +154,7 @@ static int run(plx_engine *e, const tiles_opts *o, double top)
     int z, rc = EXIT_OK, tty = isatty(2);
     tile_work w;
     mbtiles *mb = NULL;
-    char err[512], name[256], what[160];
+    char err[512], name[256], what[160], credit[512];
     double b[4];
     memset(&w, 0, sizeof w);
     lonlat_bounds(e, b);
@@ -148,8 +166,8 @@ static int run(plx_engine *e, const tiles_opts *o, double top)
     w.q = o->q;
     quantity_text(&o->q, what, sizeof what);
     if (ends_with(o->out, ".mbtiles") &&
-        !(mb = mbtiles_open(o->out, scene_name(o->scene, name, sizeof name), b, (int)o->z0, (int)o->z1, what, top, err,
-                             sizeof err))) {
+        !(mb = mbtiles_open(o->out, scene_name(o->scene, name, sizeof name), b, (int)o->z0, (int)o->z1, what, top,
+                             tiles_attribution(o, credit, sizeof credit), err, sizeof err))) {
         fprintf(stderr, "polarlux tiles: %s\n", err);
         rc = EXIT_FAIL;
     }
@@ -242,6 +260,7 @@ static int parse(int argc, char **argv, tiles_opts *o)
           &sc_option, NULL },
         CLI_OPT_VAL("--max", &o->top, parse_max, "--max '%s' is not a number of lux above 0.1"),
         CLI_OPT_STR("-o", &o->out),
+        CLI_OPT_STR("--attribution", &o->attribution),
         CLI_OPT_END
     };
     cli_args pa;

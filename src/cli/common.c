@@ -1222,3 +1222,29 @@ void cli_atlas_print(plx_engine *e)
            ai.unfilled ? "filled as frames need it" : "filled",
            ai.indirect ? ", indirect light included" : ", direct light only");
 }
+
+int cli_scene_attribution(const char *path, char *buf, size_t cap)
+{
+    const plx_port *pt = plx_port_posix();
+    const void *data = NULL;
+    void *handle = NULL;
+    const char *text;
+    size_t len = 0, at, root, v;
+    char why[128];
+    int got = 0;
+    if (cap > 0)
+        buf[0] = '\0';
+    if (!pt->file_map || pt->file_map(pt->ctx, path, &data, &len, &handle, why, sizeof why) != 0)
+        return 0;
+    text = data;
+    root = len >= 3 && memcmp(text, "\xef\xbb\xbf", 3) == 0 ? 3 : 0; /* a UTF-8 byte order mark */
+    root = jsonscan_ws(text, len, root);
+    if (root < len && jsonscan_check(text + root, len - root, &at) && jsonscan_kind(text + root, 0) == JS_OBJECT &&
+        (v = jsonscan_get(text + root, len - root, 0, "attribution")) != JSONSCAN_NONE &&
+        jsonscan_kind(text + root, v) == JS_STRING) {
+        jsonscan_string(text + root, len - root, v, buf, cap);
+        got = buf[0] != '\0';
+    }
+    pt->file_unmap(pt->ctx, handle);
+    return got;
+}

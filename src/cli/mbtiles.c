@@ -34,7 +34,7 @@ static int add_meta(mbtiles *m, const char *name, const char *value)
 }
 
 static int write_metadata(mbtiles *m, const char *name, const double b[4], int z0, int z1, const char *what,
-                          double top)
+                          double top, const char *attribution)
 {
     char v[512];
     int rc = 0;
@@ -55,11 +55,13 @@ static int write_metadata(mbtiles *m, const char *name, const double b[4], int z
              "(the heat map's); transparent where there is no light",
              what, top);
     rc |= add_meta(m, "description", v);
+    if (attribution && attribution[0])
+        rc |= add_meta(m, "attribution", attribution);
     return rc;
 }
 
 mbtiles *mbtiles_open(const char *path, const char *name, const double bounds[4], int z0, int z1,
-                      const char *what, double top, char *err, size_t errlen)
+                      const char *what, double top, const char *attribution, char *err, size_t errlen)
 {
     static const char schema[] =
         "PRAGMA journal_mode = OFF; PRAGMA synchronous = OFF; BEGIN;"
@@ -79,7 +81,7 @@ mbtiles *mbtiles_open(const char *path, const char *name, const double bounds[4]
     snprintf(m->tmp, n, "%s.tmp.%ld", path, (long)getpid());
     unlink(m->tmp);
     if (sqlite3_open(m->tmp, &m->db) != SQLITE_OK || sqlite3_exec(m->db, schema, NULL, NULL, NULL) != SQLITE_OK ||
-        write_metadata(m, name, bounds, z0, z1, what, top) != 0 ||
+        write_metadata(m, name, bounds, z0, z1, what, top, attribution) != 0 ||
         sqlite3_prepare_v2(m->db, "INSERT INTO tiles VALUES (?, ?, ?, ?)", -1, &m->put, NULL) != SQLITE_OK) {
         sql_fail(m, "cannot create the MBTiles file", err, errlen);
         mbtiles_close(m, 0, NULL, 0);

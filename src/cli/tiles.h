@@ -55,9 +55,10 @@ int tile_png_decode(const uint8_t *png, size_t len, uint8_t *rgba);
 typedef struct mbtiles mbtiles;
 /* Creates path (through a temporary file renamed into place by
  * mbtiles_close) with the spec's metadata (the description names 'what' is
- * mapped); NULL and err on failure. */
+ * mapped; attribution, when not NULL or empty, the data's credit line);
+ * NULL and err on failure. */
 mbtiles *mbtiles_open(const char *path, const char *name, const double bounds[4], int z0, int z1,
-                      const char *what, double top, char *err, size_t errlen);
+                      const char *what, double top, const char *attribution, char *err, size_t errlen);
 /* Adds tile (z, x, y) in XYZ numbering (stored as TMS rows). 0 or -1. */
 int mbtiles_put(mbtiles *m, int z, long x, long y, const uint8_t *png, size_t len, char *err, size_t errlen);
 /* commit != 0: commits and renames into place; else discards. 0 or -1. */

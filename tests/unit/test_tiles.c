@@ -184,6 +184,24 @@ static uint8_t *read_file(const char *path, size_t *len)
     return (uint8_t *)port_read_text(path, len, err, sizeof err);
 }
 
+/* The scene file's top-level "attribution", read with cJSON (not the
+ * command's reader). */
+static const char *fixture_attribution(const char *path, char *buf, size_t len)
+{
+    size_t n;
+    char *text = (char *)read_file(path, &n);
+    cJSON *root, *a;
+    assert_non_null(text);
+    root = cJSON_ParseWithLength(text, n);
+    assert_non_null(root);
+    a = cJSON_GetObjectItemCaseSensitive(root, "attribution");
+    assert_true(cJSON_IsString(a) && strlen(a->valuestring) > 20);
+    snprintf(buf, len, "%s", a->valuestring);
+    cJSON_Delete(root);
+    free(text);
+    return buf;
+}
+
 static const char *meta(sqlite3 *db, const char *name, char *buf, size_t len)
 {
     sqlite3_stmt *s;
@@ -228,6 +246,7 @@ static void test_mbtiles_read_back(void **state)
     assert_int_equal(sscanf(meta(db, "bounds", buf, sizeof buf), "%lf,%lf,%lf,%lf", &b[0], &b[1], &b[2], &b[3]), 4);
     assert_true(b[0] > 24.93 && b[0] < 24.94 && b[2] > 24.95 && b[2] < 24.96 && b[1] > 60.16 && b[3] < 60.18);
     assert_int_equal(sscanf(meta(db, "center", buf, sizeof buf), "%lf,%lf,%d", &b[0], &b[1], &z), 3);
+    assert_string_equal(meta(db, "attribution", buf, sizeof buf), fixture_attribution(SCENE, path, sizeof path));
     assert_int_equal(sqlite3_prepare_v2(db, "SELECT zoom_level, tile_column, tile_row, tile_data FROM tiles", -1, &s,
                                         NULL), SQLITE_OK);
     while (sqlite3_step(s) == SQLITE_ROW) {
@@ -252,6 +271,29 @@ static void test_mbtiles_read_back(void **state)
     plx_engine_free(e);
 }
 
+/* --attribution gives the MBTiles attribution, '' none; a bake, which
+ * keeps no attribution, gives none unless given. */
+static void test_mbtiles_attribution(void **state)
+{
+    char mbt[64], buf[256];
+    const char *given[] = { "tiles", SCENE, "--quiet", "--zoom", "13", "--attribution", "Lights: the city's survey", "-o", mbt };
+    const char *none[] = { "tiles", SCENE, "--quiet", "--zoom", "13", "--attribution", "", "-o", mbt };
+    sqlite3 *db;
+    (void)state;
+    snprintf(mbt, sizeof mbt, "build/test_tiles_attr_%d.mbtiles", (int)getpid());
+    assert_int_equal(run(cmd_tiles, 9, given), 0);
+    assert_int_equal(sqlite3_open_v2(mbt, &db, SQLITE_OPEN_READONLY, NULL), SQLITE_OK);
+    assert_string_equal(meta(db, "attribution", buf, sizeof buf), "Lights: the city's survey");
+    sqlite3_close(db);
+    assert_int_equal(unlink(mbt), 0);
+    assert_int_equal(run(cmd_tiles, 9, none), 0);
+    assert_int_equal(sqlite3_open_v2(mbt, &db, SQLITE_OPEN_READONLY, NULL), SQLITE_OK);
+    assert_string_equal(meta(db, "attribution", buf, sizeof buf), "");
+    assert_string_equal(meta(db, "format", buf, sizeof buf), "png");
+    sqlite3_close(db);
+    assert_int_equal(unlink(mbt), 0);
+}
+
 static void test_errors(void **state)
 {
     const char *metres[] = { "tiles", "fixtures/tiny.geojson", "--quiet", "--zoom", "15", "-o", "build/never" };
@@ -272,6 +314,7 @@ int main(void)
         cmocka_unit_test(test_sc_tile_pixels_equal_heatmap),
         cmocka_unit_test(test_sc_least_over_directions),
         cmocka_unit_test(test_mbtiles_read_back),
+        cmocka_unit_test(test_mbtiles_attribution),
         cmocka_unit_test(test_errors),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
