@@ -366,7 +366,7 @@ static int cmp_spot(const void *a, const void *b)
 #define SPOT_STRIP 65536 /* grid points per illuminance call, at most */
 #define SPOT_POINT_BYTES (3 * sizeof(double) * 2 + 2 * sizeof(double) + 2 * sizeof(uint32_t))
 #define SPOT_MIN_CANDIDATES 1024
-#define SPOT_PER_COUNT 64 /* candidates a pass keeps per spot asked (at least SPOT_MIN_CANDIDATES) */
+#define SPOT_PER_COUNT 256 /* candidates the first pass keeps per spot asked (at least SPOT_MIN_CANDIDATES) */
 
 /* The street points are not all kept: a pass over the grid keeps the `cap`
  * darkest of those after `after` (in spot_before's order) in a max-heap,
@@ -379,19 +379,24 @@ static int cmp_spot(const void *a, const void *b)
  * direct light's cost) is computed only where it can change the answer:
  * a point's direct lux is a bound below its lux, so a point whose bound
  * is already after the cap-th darkest lux found cannot be a candidate
- * (spot_pass). --exhaustive computes it everywhere: the reference. */
+ * (spot_pass). That first pass keeps SPOT_PER_COUNT candidates a spot
+ * asked; a pass after it (the spacing rule left too few) computes it at
+ * every point, as --exhaustive does from the start (the reference): a
+ * later pass's points darker than its start would each be gathered twice
+ * by the bounds, which made it slower than gathering once everywhere. */
 typedef struct spot_grid {
     double x0, y0, res;
     size_t w, h, strip;
     spot *heap;          /* max-heap of the darkest candidates of this pass */
     size_t n, cap;
     size_t cap_mem;      /* the most candidates --mem leaves room for (at most the grid points) */
-    int cap_by_mem;      /* cap is cap_mem (else SPOT_PER_COUNT's, grown by each pass) */
+    int mem_limited;     /* cap_mem is below the grid points: --mem sets the passes */
     spot after;          /* this pass takes spots after this one ... */
     int has_after;       /* ... when set */
     int exhaustive;      /* every point's lux exact at once (--exhaustive, or no indirect light) */
     int no_indirect;     /* the engine has no photon buffers: the direct lux is exact */
     size_t offered;      /* street points after `after` seen this pass */
+    size_t unbounded;    /* of them, those step 1 gathered or bounded by 0 (no direct light) */
     size_t street;       /* street points of the grid (first pass) */
     double max_lux;      /* the brightest street point's lux, direct only unless exhaustive (first pass) */
     size_t gathered;     /* points whose indirect light was computed */
@@ -539,6 +544,7 @@ static int spot_bound_strip(plx_engine *e, spot_grid *g, size_t k0, size_t k1, i
         if (!spot_after(g, &s))
             continue;
         g->offered++;
+        g->unbounded += !s.exact && !(s.lux > 0.0);
         spot_offer(g, s);
     }
     idx = b->reach; /* the marked points' grid indices, before spot_exact moves P */
@@ -556,6 +562,7 @@ static int spot_bound_strip(plx_engine *e, spot_grid *g, size_t k0, size_t k1, i
         if (!spot_after(g, &s))
             continue;
         g->offered++;
+        g->unbounded++;
         spot_offer(g, s);
     }
     return EXIT_OK;
@@ -632,20 +639,62 @@ static int spot_refine_strip(plx_engine *e, spot_grid *g, size_t k0, size_t k1, 
     return EXIT_OK;
 }
 
+/* One sweep of a pass over every grid point, strip by strip (progress
+ * on a terminal): step 1 (spot_bound_strip, from an empty heap) or step
+ * 3 (spot_refine_strip, last: step 1's last candidate). */
+static int spot_sweep(plx_engine *e, spot_grid *g, int all, int pass, int step, const spot *last, spot_bufs *b)
+{
+    size_t total = g->w * g->h, k0;
+    char what[64];
+    cli_progress pr;
+    int rc = EXIT_OK;
+    if (step == 1) {
+        g->n = g->offered = g->unbounded = 0;
+        if (!g->has_after) {
+            g->street = 0;
+            g->max_lux = 0.0;
+        }
+    }
+    snprintf(what, sizeof what, "dark-spots%s%s", step == 3 ? " (exact lux)" : "", pass > 1 ? " (again)" : "");
+    cli_progress_start(&pr);
+    for (k0 = 0; rc == EXIT_OK && k0 < total; k0 += g->strip) {
+        size_t k1 = k0 + g->strip < total ? k0 + g->strip : total;
+        rc = step == 1 ? spot_bound_strip(e, g, k0, k1, all, b) : spot_refine_strip(e, g, k0, k1, all, last, b);
+        cli_progress_step(&pr, what, k1, total);
+    }
+    cli_progress_end(&pr);
+    return rc;
+}
+
+/* From here on every point's lux is exact at once, as --exhaustive: the
+ * heap as large as --mem leaves room for. */
+static int spot_all_exact(spot_grid *g)
+{
+    spot *h = realloc(g->heap, sizeof *h * (g->cap_mem ? g->cap_mem : 1));
+    if (!h) {
+        fprintf(stderr, "polarlux dark-spots: out of memory for %zu candidate points\n", g->cap_mem);
+        return EXIT_FAIL;
+    }
+    g->heap = h;
+    g->cap = g->cap_mem;
+    g->exhaustive = 1;
+    return EXIT_OK;
+}
+
 /* One pass over every grid point, strip by strip (progress on a terminal);
  * leaves this pass's candidates, the `cap` darkest street points after
  * `after` by their exact lux, sorted in g->heap[0 .. n). Step 1 keeps
  * the darkest by bound, step 2 makes them exact, step 3 (when step 1's
  * heap was full) brings in the points whose bound is before the last of
- * them: a point left out has a bound, and so a lux, at or after it. */
+ * them: a point left out has a bound, and so a lux, at or after it.
+ * When at least half the points step 1 saw were gathered or had a bound
+ * of 0 (no direct light: out of reach with --all, or in shadow), bounds
+ * would rule out too few: the pass starts again gathering everywhere. */
 static int spot_pass(plx_engine *e, spot_grid *g, int all, int pass)
 {
-    size_t total = g->w * g->h, k0;
     spot_bufs b;
     spot last = { 0, 0, 0.0 };
-    char what[64];
-    cli_progress pr;
-    int rc = EXIT_OK, step;
+    int rc = EXIT_OK;
     b.P = malloc(sizeof *b.P * 3 * g->strip);
     b.N = malloc(sizeof *b.N * 3 * g->strip);
     b.E = malloc(sizeof *b.E * g->strip);
@@ -656,26 +705,21 @@ static int spot_pass(plx_engine *e, spot_grid *g, int all, int pass)
         fprintf(stderr, "polarlux dark-spots: out of memory\n");
         rc = EXIT_FAIL;
     }
-    g->n = g->offered = 0;
-    for (step = 1; step <= 3 && rc == EXIT_OK; step += 2) {
-        if (step == 3 && (g->exhaustive || g->n < g->cap))
-            break; /* every street point after `after` is a candidate: no step 3 */
-        if (step == 3) {
-            last = g->heap[0]; /* step 1's last candidate, by bound */
-            if ((rc = spot_exact_heap(e, g, &b)) != EXIT_OK)
-                break;
-        }
-        snprintf(what, sizeof what, "dark-spots%s%s", step == 3 ? " (exact lux)" : "", pass > 1 ? " (again)" : "");
-        cli_progress_start(&pr);
-        for (k0 = 0; rc == EXIT_OK && k0 < total; k0 += g->strip) {
-            size_t k1 = k0 + g->strip < total ? k0 + g->strip : total;
-            rc = step == 1 ? spot_bound_strip(e, g, k0, k1, all, &b) : spot_refine_strip(e, g, k0, k1, all, &last, &b);
-            cli_progress_step(&pr, what, k1, total);
-        }
-        cli_progress_end(&pr);
+    if (rc == EXIT_OK)
+        rc = spot_sweep(e, g, all, pass, 1, NULL, &b);
+    if (rc == EXIT_OK && !g->exhaustive && 2 * (g->unbounded + g->cap) >= g->offered) {
+        /* most points have no direct light (a bound of 0) or are gathered
+         * anyway: the bounds would rule out too few; gather everywhere */
+        if ((rc = spot_all_exact(g)) == EXIT_OK)
+            rc = spot_sweep(e, g, all, pass, 1, NULL, &b);
     }
-    if (rc == EXIT_OK && !g->exhaustive && g->n < g->cap) /* no step 3: the candidates' bounds made exact */
+    if (rc == EXIT_OK && !g->exhaustive && g->n == g->cap) { /* full: steps 2 and 3 */
+        last = g->heap[0]; /* step 1's last candidate, by bound */
+        if ((rc = spot_exact_heap(e, g, &b)) == EXIT_OK)
+            rc = spot_sweep(e, g, all, pass, 3, &last, &b);
+    } else if (rc == EXIT_OK && !g->exhaustive) { /* every point after `after` a candidate: step 2 */
         rc = spot_exact_heap(e, g, &b);
+    }
     free(b.P), free(b.N), free(b.E), free(b.Ei), free(b.reach), free(b.mark);
     if (g->n > 1) /* the heap is empty (maybe NULL) when there are no spots */
         qsort(g->heap, g->n, sizeof *g->heap, cmp_spot);
@@ -700,11 +744,11 @@ static int spot_buffers(plx_engine *e, const cli_common *c, spot_grid *g, long c
         return EXIT_NOMEM;
     }
     g->cap_mem = (budget - fixed) / sizeof(spot);
+    g->mem_limited = g->cap_mem < total;
     g->cap_mem = g->cap_mem > total ? total : g->cap_mem;
     want = (size_t)count * SPOT_PER_COUNT;
     want = want < SPOT_MIN_CANDIDATES ? SPOT_MIN_CANDIDATES : want;
-    g->cap_by_mem = g->exhaustive || g->cap_mem <= want;
-    g->cap = g->cap_by_mem ? g->cap_mem : want;
+    g->cap = g->exhaustive || g->cap_mem <= want ? g->cap_mem : want;
     g->heap = malloc(sizeof *g->heap * (g->cap ? g->cap : 1));
     if (!g->heap) {
         fprintf(stderr, "polarlux dark-spots: out of memory for %zu candidate points\n", g->cap);
@@ -757,6 +801,7 @@ static void spot_take(plx_engine *e, const spot_grid *g, double spacing, long co
 static int spot_search(plx_engine *e, spot_grid *g, int all, double spacing, long count, spot *pick,
                        long *npick)
 {
+    size_t first = g->cap;
     int pass, rc;
     for (pass = 1;; pass++) {
         rc = spot_pass(e, g, all, pass);
@@ -767,22 +812,17 @@ static int spot_search(plx_engine *e, spot_grid *g, int all, double spacing, lon
             break;
         g->after = g->heap[g->n - 1];
         g->has_after = 1;
-        if (!g->cap_by_mem) { /* too few candidates: four times as many next pass, within --mem */
-            size_t cap = g->cap_mem / 4 > g->cap ? 4 * g->cap : g->cap_mem;
-            spot *h = realloc(g->heap, sizeof *h * cap);
-            if (h) {
-                g->heap = h;
-                g->cap = cap;
-                g->cap_by_mem = cap == g->cap_mem;
-            }
-        }
+        if (pass == 1)
+            first = g->cap;
+        if (!g->exhaustive && (rc = spot_all_exact(g)) != EXIT_OK) /* the next passes gather everywhere */
+            return rc;
     }
-    if (pass > 1 && g->cap_by_mem)
+    if (pass > 1 && g->mem_limited)
         fprintf(stderr, "dark-spots: %d passes over the grid: --mem leaves room for %zu of the %zu street "
                 "points at a time\n", pass, g->cap, g->street);
     else if (pass > 1)
-        fprintf(stderr, "dark-spots: %d passes over the grid (--spacing left too few of the darkest points "
-                "each pass kept; the last kept %zu)\n", pass, g->cap);
+        fprintf(stderr, "dark-spots: %d passes over the grid: --spacing left too few of the %zu darkest points "
+                "the first kept; the second gathered indirect light at every point after them\n", pass, first);
     return EXIT_OK;
 }
 
@@ -827,13 +867,13 @@ static int find_spots(plx_engine *e, double res, long count, double spacing, int
         cli_warn("dark-spots", c, "no street point is within a lamp's reach (%s), so there are no spots; "
                  "--all takes every street point", si.lamps ? "the lamps are outside Bounds or their radius "
                  "does not reach the ground" : "the scene has no lamps");
-    if (g.street > 0 && !(g.max_lux > 0) && g.exhaustive)
+    if (g.street > 0 && !(g.max_lux > 0) && (exhaustive || g.no_indirect))
         cli_warn("dark-spots", c, "all %zu street points are dark (0 lx): %s", g.street, cli_dark_reason(e));
     else if (g.street > 0 && !(g.max_lux > 0)) /* the direct lux's maximum; indirect light only where needed */
         cli_warn("dark-spots", c, "no direct light reaches any of the %zu street points (0 lx direct): %s",
                  g.street, cli_dark_reason(e));
     cli_light_note("dark-spots", c, e);
-    if (g.gathered > 0 && !g.exhaustive && !c->quiet)
+    if (g.gathered > 0 && !exhaustive && !g.no_indirect && !c->quiet)
         fprintf(stderr, "dark-spots: indirect light gathered %zu times for the %zu street points (not where the "
                 "direct lux alone rules a point out; --exhaustive gathers at every one)\n", g.gathered, g.street);
     if (geo_begin(&geo, e) != 0) {

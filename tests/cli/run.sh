@@ -891,17 +891,27 @@ expect out-parent-is-a-file 1 "cannot write '.*/plain/x\.png': '.*/plain' is not
 expect info-inner-rings 0 "^buildings: 442 \(4 raised above the ground; 71 inner rings of their own\)$" -- "$bin" info -q $H
 # dark-spots on a bake gathers indirect light only where the direct lux
 # leaves a point a candidate: the same spots as --exhaustive (every point
-# gathered), in one pass and in two (--spacing leaves too few candidates)
+# gathered). grid-4x4: bounds rule out most points (steps 1 to 3); tiny:
+# most points have no direct light, so the pass gathers everywhere.
+"$bin" bake -q fixtures/grid-4x4.geojson -o "$tmp/g4.plxb" >/dev/null 2>&1
 "$bin" bake -q fixtures/tiny.geojson -o "$tmp/ds.plxb" >/dev/null 2>&1
-for a in "--count 3 --res 1" "--count 40 --res 1 --spacing 12"; do
-    "$bin" dark-spots -q "$tmp/ds.plxb" $a >"$tmp/ds-lazy.json" 2>"$tmp/ds-lazy.err"
-    "$bin" dark-spots -q "$tmp/ds.plxb" $a --exhaustive >"$tmp/ds-all.json" 2>/dev/null
-    if grep -q '"rank":3' "$tmp/ds-lazy.json" && cmp -s "$tmp/ds-lazy.json" "$tmp/ds-all.json"; then
-        echo "ok   dark-spots-lazy-equals-exhaustive $a"; pass=$((pass + 1))
-    else echo "FAIL dark-spots-lazy-equals-exhaustive $a"; fail=$((fail + 1)); fi
-done
-expect dark-spots-gathered-note 0 "indirect light gathered [0-9]+ times for the 4034 street points" -- "$bin" dark-spots "$tmp/ds.plxb" --count 3 --res 1
-expect dark-spots-two-passes 0 "2 passes over the grid \(--spacing left too few" -- "$bin" dark-spots "$tmp/ds.plxb" --count 40 --res 1 --spacing 12
+spots_same() { # NAME BAKE ARGS...: the default's spots equal --exhaustive's
+    n=$1; b=$2; shift 2
+    "$bin" dark-spots -q "$b" "$@" >"$tmp/ds-lazy.json" 2>/dev/null
+    "$bin" dark-spots -q "$b" "$@" --exhaustive >"$tmp/ds-all.json" 2>/dev/null
+    if grep -q '"rank":2' "$tmp/ds-lazy.json" && cmp -s "$tmp/ds-lazy.json" "$tmp/ds-all.json"; then
+        echo "ok   $n"; pass=$((pass + 1))
+    else echo "FAIL $n"; fail=$((fail + 1)); fi
+}
+spots_same dark-spots-lazy-equals-exhaustive "$tmp/g4.plxb" --count 2 --res 4
+spots_same dark-spots-unbounded-equals-exhaustive "$tmp/ds.plxb" --count 3 --res 1
+expect dark-spots-gathered-note 0 "indirect light gathered 1[0-9]{3} times for the 8300 street points" -- "$bin" dark-spots "$tmp/g4.plxb" --count 2 --res 4
+expect dark-spots-gathers-everywhere 0 "indirect light gathered 4034 times for the 4034 street points" -- "$bin" dark-spots "$tmp/ds.plxb" --count 3 --res 1
+if [ -z "$PLX_TEST_QUICK" ]; then # check-full: a pass by bounds, then passes gathering everywhere (--mem)
+    need=$("$bin" dark-spots -q "$tmp/g4.plxb" --mem 1M 2>&1 | sed -n 's/.*it needs \([0-9]*\) bytes.*/\1/p')
+    spots_same dark-spots-passes-equal-exhaustive "$tmp/g4.plxb" --count 80 --res 3 --spacing 30 --mem $((need + 36312))
+    expect dark-spots-passes-note 0 "[3-9] passes over the grid: --mem leaves room for" -- "$bin" dark-spots -q "$tmp/g4.plxb" --count 80 --res 3 --spacing 30 --mem $((need + 36312))
+fi
 # "-" reads a path or network from standard input, with the file's results
 "$bin" route -q $H --path fixtures/helsinki-route.geojson >"$tmp/route-file.txt" 2>/dev/null
 "$bin" route -q $H --path - <fixtures/helsinki-route.geojson >"$tmp/route-stdin.txt" 2>/dev/null
