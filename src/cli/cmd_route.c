@@ -498,13 +498,17 @@ static int spot_direct(plx_engine *e, const spot_grid *g, size_t k0, size_t k1, 
 }
 
 /* The exact lux (direct + indirect) of the points b->mark[0 .. nm) of the
- * strip, into b->E; their positions moved to the front of b->P. */
+ * strip, into b->E; their positions and grid indices moved to the front
+ * of b->P and b->reach (marks rise: nothing is read after it is moved
+ * over). */
 static int spot_exact(plx_engine *e, spot_grid *g, spot_bufs *b, size_t nm)
 {
     size_t j;
     plx_status st;
-    for (j = 0; j < nm; j++)
+    for (j = 0; j < nm; j++) {
         memmove(&b->P[3 * j], &b->P[3 * b->mark[j]], 3 * sizeof *b->P);
+        b->reach[j] = b->reach[b->mark[j]];
+    }
     st = plx_illuminance(e, nm, b->P, b->N, b->E, b->Ei, NULL);
     if (st != PLX_OK && st != PLX_E_RANGE)
         return spot_fail(e, st);
@@ -520,7 +524,6 @@ static int spot_exact(plx_engine *e, spot_grid *g, spot_bufs *b, size_t nm)
 static int spot_bound_strip(plx_engine *e, spot_grid *g, size_t k0, size_t k1, int all, spot_bufs *b)
 {
     size_t k, m, nm = 0;
-    uint32_t *idx;
     int rc = spot_direct(e, g, k0, k1, all, b, &m);
     if (rc != EXIT_OK)
         return rc;
@@ -547,14 +550,11 @@ static int spot_bound_strip(plx_engine *e, spot_grid *g, size_t k0, size_t k1, i
         g->unbounded += !s.exact && !(s.lux > 0.0);
         spot_offer(g, s);
     }
-    idx = b->reach; /* the marked points' grid indices, before spot_exact moves P */
-    for (k = 0; k < nm; k++)
-        idx[k] = b->reach[b->mark[k]];
     if (nm == 0 || (rc = spot_exact(e, g, b, nm)) != EXIT_OK)
         return rc;
     for (k = 0; k < nm; k++) {
         spot s;
-        s.k = idx[k];
+        s.k = b->reach[k];
         s.exact = 1;
         s.lux = b->E[k];
         if (g->exhaustive && !g->has_after)
@@ -583,6 +583,7 @@ static int spot_exact_heap(plx_engine *e, spot_grid *g, spot_bufs *b)
                 b->N[3 * nm] = b->N[3 * nm + 1] = 0.0;
                 b->N[3 * nm + 2] = 1.0;
                 b->mark[nm] = (uint32_t)nm;
+                b->reach[nm] = g->heap[i].k;
                 nm++;
             }
         if (nm == 0)
@@ -608,7 +609,6 @@ static int spot_refine_strip(plx_engine *e, spot_grid *g, size_t k0, size_t k1, 
                              spot_bufs *b)
 {
     size_t k, m, nm = 0;
-    uint32_t *idx;
     int rc = spot_direct(e, g, k0, k1, all, b, &m);
     if (rc != EXIT_OK)
         return rc;
@@ -623,14 +623,11 @@ static int spot_refine_strip(plx_engine *e, spot_grid *g, size_t k0, size_t k1, 
             continue; /* in the heap since step 1, or never a candidate */
         b->mark[nm++] = (uint32_t)k;
     }
-    idx = b->reach;
-    for (k = 0; k < nm; k++)
-        idx[k] = b->reach[b->mark[k]];
     if (nm == 0 || (rc = spot_exact(e, g, b, nm)) != EXIT_OK)
         return rc;
     for (k = 0; k < nm; k++) {
         spot s;
-        s.k = idx[k];
+        s.k = b->reach[k];
         s.exact = 1;
         s.lux = b->E[k];
         if (spot_after(g, &s) && spot_before(last, &s)) /* else not after `after`, or in the heap since step 1 */

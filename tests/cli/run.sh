@@ -904,10 +904,10 @@ spots_same() { # NAME BAKE ARGS...: the default's spots equal --exhaustive's
     else echo "FAIL $n"; fail=$((fail + 1)); fi
 }
 spots_same dark-spots-lazy-equals-exhaustive "$tmp/g4.plxb" --count 2 --res 4
-spots_same dark-spots-unbounded-equals-exhaustive "$tmp/ds.plxb" --count 3 --res 1
 expect dark-spots-gathered-note 0 "indirect light gathered 1[0-9]{3} times for the 8300 street points" -- "$bin" dark-spots "$tmp/g4.plxb" --count 2 --res 4
 expect dark-spots-gathers-everywhere 0 "indirect light gathered 4034 times for the 4034 street points" -- "$bin" dark-spots "$tmp/ds.plxb" --count 3 --res 1
-if [ -z "$PLX_TEST_QUICK" ]; then # check-full: a pass by bounds, then passes gathering everywhere (--mem)
+if [ -z "$PLX_TEST_QUICK" ]; then # check-full: the pass that gathers everywhere; a pass by bounds, then passes gathering everywhere (--mem)
+    spots_same dark-spots-unbounded-equals-exhaustive "$tmp/ds.plxb" --count 3 --res 1
     need=$("$bin" dark-spots -q "$tmp/g4.plxb" --mem 1M 2>&1 | sed -n 's/.*it needs \([0-9]*\) bytes.*/\1/p')
     spots_same dark-spots-passes-equal-exhaustive "$tmp/g4.plxb" --count 80 --res 3 --spacing 30 --mem $((need + 36312))
     expect dark-spots-passes-note 0 "[3-9] passes over the grid: --mem leaves room for" -- "$bin" dark-spots -q "$tmp/g4.plxb" --count 80 --res 3 --spacing 30 --mem $((need + 36312))

@@ -214,6 +214,8 @@ static void test_aa(void **state)
  * 361x480 and 480x361 are refused. */
 static void test_frame_turned(void **state)
 {
+    if (getenv("PLX_TEST_QUICK")) /* seconds: check-full (CI) runs it, make check keeps its minute */
+        skip();
     void *mem[2];
     plx_engine *e[2];
     plx_config cfg;

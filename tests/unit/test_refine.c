@@ -189,6 +189,8 @@ static void frame(plx_engine *e, double fov, float *rgbf)
 
 static void test_hits_keep_atlas(void **state)
 {
+    if (getenv("PLX_TEST_QUICK")) /* seconds: check-full (CI) runs it, make check keeps its minute */
+        skip();
     double A[3] = { 200.0, 266.0, 1.7 }, A2[3] = { 198.0, 266.0, 1.7 }, B[3] = { 560.0, 266.0, 1.7 };
     size_t n = (size_t)RW * RH * 3;
     float *walk = malloc(n * sizeof(float)), *fresh = malloc(n * sizeof(float));
@@ -264,6 +266,8 @@ static void refine_along(plx_engine *e, plx_refine_stats *rs)
 
 static void test_recompute_refreshes_cache(void **state)
 {
+    if (getenv("PLX_TEST_QUICK")) /* seconds: check-full (CI) runs it, make check keeps its minute */
+        skip();
     double A[3] = { 200.0, 266.0, 1.7 };
     size_t n = 80 * 60 * 3;
     float *before = malloc(n * sizeof(float)), *after = malloc(n * sizeof(float)), *fresh = malloc(n * sizeof(float));

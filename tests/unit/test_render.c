@@ -1187,6 +1187,8 @@ static int kept_edge_sweep(render *r, int w, int h, int vertical, int workers)
  * the kept culling. */
 static void test_cull_kept_edge(void **state)
 {
+    if (getenv("PLX_TEST_QUICK")) /* seconds: check-full (CI) runs it, make check keeps its minute */
+        skip();
     static const char *text =
         "{\"type\":\"FeatureCollection\",\"properties\":{\"units\":\"m\"},\"features\":["
         "{\"type\":\"Feature\",\"properties\":{\"height\":20},\"geometry\":{\"type\":\"Polygon\","

@@ -114,6 +114,8 @@ static void check_same(const frame *a, const frame *b)
 
 static void test_same_bytes(void **state)
 {
+    if (getenv("PLX_TEST_QUICK")) /* seconds: check-full (CI) runs it, make check keeps its minute */
+        skip();
     static frame one[2], other[2];
     plx_port back = *plx_port_posix();
     size_t p, lit = 0;
@@ -199,6 +201,8 @@ static void render_aerial_gathered(int threads, const plx_port *port, int photon
 
 static void test_aerial_layer_same_bytes(void **state)
 {
+    if (getenv("PLX_TEST_QUICK")) /* seconds: check-full (CI) runs it, make check keeps its minute */
+        skip();
     static frame one, other;
     plx_port back = *plx_port_posix();
     size_t p, differ = 0;
