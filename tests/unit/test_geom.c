@@ -989,6 +989,8 @@ static vec2 *star(uint32_t n, int wild, rng *r)
 
 static void test_ring_simple_big(void **state)
 {
+    if (getenv("PLX_TEST_QUICK")) /* seconds: check-full (CI) runs it, make check keeps its minute */
+        skip();
     arena *a = &((arena_fx *)*state)->a;
     const uint32_t n = 1000000;
     rng r = { 5 };

@@ -275,6 +275,8 @@ static void test_mbtiles_read_back(void **state)
  * keeps no attribution, gives none unless given. */
 static void test_mbtiles_attribution(void **state)
 {
+    if (getenv("PLX_TEST_QUICK")) /* seconds: check-full (CI) runs it, make check keeps its minute */
+        skip();
     char mbt[64], buf[256];
     const char *given[] = { "tiles", SCENE, "--quiet", "--zoom", "13", "--attribution", "Lights: the city's survey", "-o", mbt };
     const char *none[] = { "tiles", SCENE, "--quiet", "--zoom", "13", "--attribution", "", "-o", mbt };
