@@ -8,6 +8,7 @@
 #include "geo_out.h"
 #include "port.h"
 #include "route_io.h"
+#include "twin_gather.h"
 
 static const char route_help[] =
     "usage: polarlux route SCENE --path FILE [--step M] [--dark-lux LX] [--geojson OUT] [options]\n"
@@ -43,7 +44,8 @@ static const char route_help[] =
     "network ('polarlux route --network x --help').\n";
 
 static const char spots_help[] =
-    "usage: polarlux dark-spots SCENE [--res M] [--count N] [--spacing M] [--all] [-o OUT] [options]\n"
+    "usage: polarlux dark-spots SCENE [--res M] [--count N] [--spacing M] [--all] [--exhaustive]\n"
+    "                           [--threads N] [-o OUT] [options]\n"
     "\n"
     "Lists the darkest points of the street area (ground outside building\n"
     "footprints, inside Bounds) as GeoJSON points with their lux, worst first.\n"
@@ -59,6 +61,10 @@ static const char spots_help[] =
     "                same spots: by default only points whose direct lux can\n"
     "                still make them candidates get it)\n"
     "  -o OUT        write the GeoJSON to OUT instead of standard output\n"
+    "  --threads N   threads gathering a bake's indirect light (default: the\n"
+    "                number of processors); each further thread loads the bake\n"
+    "                again (its own --mem block: N times the memory); the same\n"
+    "                spots for any N\n"
     "  --mem SIZE, --strict, --quiet, --lamps FILE   as for 'polarlux info'\n"
     "\n"
     "A spot's lux is direct plus indirect light (a bake's photon buffers;\n"
@@ -400,6 +406,7 @@ typedef struct spot_grid {
     size_t street;       /* street points of the grid (first pass) */
     double max_lux;      /* the brightest street point's lux, direct only unless exhaustive (first pass) */
     size_t gathered;     /* points whose indirect light was computed */
+    twin_gather tg;      /* the gathers shared with the bake's twins (--threads) */
 } spot_grid;
 
 /* One pass's buffers: a strip of grid points. */
@@ -505,13 +512,14 @@ static int spot_exact(plx_engine *e, spot_grid *g, spot_bufs *b, size_t nm)
 {
     size_t j;
     plx_status st;
+    plx_engine *failed;
     for (j = 0; j < nm; j++) {
         memmove(&b->P[3 * j], &b->P[3 * b->mark[j]], 3 * sizeof *b->P);
         b->reach[j] = b->reach[b->mark[j]];
     }
-    st = plx_illuminance(e, nm, b->P, b->N, b->E, b->Ei, NULL);
+    st = twin_illuminance(&g->tg, e, nm, b->P, b->N, b->E, b->Ei, &failed);
     if (st != PLX_OK && st != PLX_E_RANGE)
-        return spot_fail(e, st);
+        return spot_fail(failed, st);
     for (j = 0; j < nm; j++)
         b->E[j] += b->Ei[j];
     g->gathered += nm;
@@ -823,8 +831,8 @@ static int spot_search(plx_engine *e, spot_grid *g, int all, double spacing, lon
     return EXIT_OK;
 }
 
-static int find_spots(plx_engine *e, double res, long count, double spacing, int all, int exhaustive,
-                      const char *out, const cli_common *c)
+static int find_spots(plx_engine *e, const char *scene, double res, long count, double spacing, int all,
+                      int exhaustive, const char *out, const cli_common *c)
 {
     plx_scene_info si;
     spot_grid g;
@@ -839,6 +847,7 @@ static int find_spots(plx_engine *e, double res, long count, double spacing, int
     g.res = res;
     g.no_indirect = plx_indirect_frames(e) == 0;
     g.exhaustive = exhaustive || g.no_indirect;
+    twin_gather_init(&g.tg, "dark-spots", scene, c, e);
     {   /* counted in doubles: no integer overflow for any finite --res */
         double wd = floor((si.bounds[2] - si.bounds[0]) / res), hd = floor((si.bounds[3] - si.bounds[1]) / res);
         if (!(wd * hd >= 1 && wd * hd <= 2e9)) {
@@ -872,7 +881,8 @@ static int find_spots(plx_engine *e, double res, long count, double spacing, int
     cli_light_note("dark-spots", c, e);
     if (g.gathered > 0 && !exhaustive && !g.no_indirect && !c->quiet)
         fprintf(stderr, "dark-spots: indirect light gathered %zu times for the %zu street points (not where the "
-                "direct lux alone rules a point out; --exhaustive gathers at every one)\n", g.gathered, g.street);
+                "direct lux alone rules a point out; --exhaustive gathers at every one), on %d thread%s\n",
+                g.gathered, g.street, g.tg.n + 1, g.tg.n ? "s" : "");
     if (geo_begin(&geo, e) != 0) {
         rc = EXIT_FAIL;
         goto done;
@@ -904,6 +914,7 @@ static int find_spots(plx_engine *e, double res, long count, double spacing, int
     }
     geo_free(&geo);
 done:
+    twin_gather_free(&g.tg);
     free(g.heap);
     free(pick);
     return rc;
@@ -955,7 +966,7 @@ int cmd_dark_spots(int argc, char **argv)
     rc = cli_open_scene("dark-spots", scene, &c, &e);
     if (rc != EXIT_OK)
         return rc;
-    rc = find_spots(e, res, count, spacing, all, exhaustive, out, &c);
+    rc = find_spots(e, scene, res, count, spacing, all, exhaustive, out, &c);
     plx_engine_free(e);
     return rc;
 }

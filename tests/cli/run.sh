@@ -906,6 +906,15 @@ spots_same() { # NAME BAKE ARGS...: the default's spots equal --exhaustive's
 spots_same dark-spots-lazy-equals-exhaustive "$tmp/g4.plxb" --count 2 --res 4
 expect dark-spots-gathered-note 0 "indirect light gathered 1[0-9]{3} times for the 8300 street points" -- "$bin" dark-spots "$tmp/g4.plxb" --count 2 --res 4
 expect dark-spots-gathers-everywhere 0 "indirect light gathered 4034 times for the 4034 street points" -- "$bin" dark-spots "$tmp/ds.plxb" --count 3 --res 1
+# --threads: the gathers shared with twins of the bake, the same lux to the
+# last digit (every point gathered, 20 spots of lux 0.027 to 0.058)
+"$bin" dark-spots -q "$tmp/g4.plxb" --count 20 --res 4 --exhaustive --threads 1 >"$tmp/ds-t1.json" 2>/dev/null
+"$bin" dark-spots -q "$tmp/g4.plxb" --count 20 --res 4 --exhaustive --threads 3 >"$tmp/ds-t3.json" 2>/dev/null
+if grep -q '"rank":20,"lux":0\.0[1-9]' "$tmp/ds-t1.json" && cmp -s "$tmp/ds-t1.json" "$tmp/ds-t3.json"; then
+    echo "ok   dark-spots-threads-same"; pass=$((pass + 1))
+else echo "FAIL dark-spots-threads-same"; fail=$((fail + 1)); fi
+expect dark-spots-threads-note 0 "gathered 1[0-9]{3} times for the 8300 street points .*, on 3 threads$" -- "$bin" dark-spots "$tmp/g4.plxb" --count 2 --res 4 --threads 3
+expect dark-spots-one-thread-note 0 ", on 1 thread$" -- "$bin" dark-spots "$tmp/g4.plxb" --count 2 --res 4 --threads 1
 if [ -z "$PLX_TEST_QUICK" ]; then # check-full: the pass that gathers everywhere; a pass by bounds, then passes gathering everywhere (--mem)
     spots_same dark-spots-unbounded-equals-exhaustive "$tmp/ds.plxb" --count 3 --res 1
     need=$("$bin" dark-spots -q "$tmp/g4.plxb" --mem 1M 2>&1 | sed -n 's/.*it needs \([0-9]*\) bytes.*/\1/p')
