@@ -46,6 +46,10 @@ static const char route_help[] =
     "  --geojson OUT    write both routes as LineStrings (properties route,\n"
     "                   length_m, dark_m, min_lux, mean_lux, min_ev_lux,\n"
     "                   min_sc_lux, class, class_h, ...)\n"
+    "  --threads N      threads scoring the edges on a bake (default: the number\n"
+    "                   of processors); each further thread loads the bake again\n"
+    "                   (its own --mem block: N times the memory); the same\n"
+    "                   scores for any N\n"
     "  --mem SIZE, --strict, --quiet, --lamps FILE   as for 'polarlux info'\n";
 
 static const char annotate_help[] =
@@ -71,6 +75,7 @@ static const char annotate_help[] =
     "  --csv OUT        the per-way CSV\n"
     "  --dark-lux LX, --dark-weight W, --step M, --height M   as for 'polarlux\n"
     "                   route --network'\n"
+    "  --threads N      as for 'polarlux route --network'\n"
     "  --mem SIZE, --strict, --quiet, --lamps FILE   as for 'polarlux info'\n";
 
 typedef struct net_opts {
@@ -159,6 +164,8 @@ static int load_network(const net_opts *o, plx_engine *e, network *net)
     route_set rs;
     char err[512];
     plx_status st;
+    plx_engine *failed;
+    twin_gather tg;
     if (route_read(o->network, e, &rs, err, sizeof err) != 0) {
         fprintf(stderr, "polarlux %s: %s\n", o->cmd, err);
         return EXIT_FAIL;
@@ -169,12 +176,18 @@ static int load_network(const net_opts *o, plx_engine *e, network *net)
         fprintf(stderr, "polarlux %s: %s: %s\n", o->cmd, o->network, err);
         return EXIT_FAIL;
     }
-    st = net_score(net, e, o->step, o->dark, o->height, 1);
+    twin_gather_init(&tg, o->cmd, o->scene, &o->c, e);
+    st = net_score(net, e, &tg, o->step, o->dark, o->height, 1, &failed);
+    if (twin_threads(&tg) > 1 && !o->c.quiet)
+        fprintf(stderr, "%s: the %u edges scored on %d threads (the bake loaded %d more time%s)\n", o->cmd,
+                net->nedges, twin_threads(&tg), tg.n, tg.n == 1 ? "" : "s");
     if (st != PLX_OK) {
-        fprintf(stderr, "polarlux %s: %s: scoring the edges: %s\n", o->cmd, o->network, plx_last_error(e));
+        fprintf(stderr, "polarlux %s: %s: scoring the edges: %s\n", o->cmd, o->network, plx_last_error(failed));
+        twin_gather_free(&tg);
         net_free(net);
         return cli_exit_code(st);
     }
+    twin_gather_free(&tg);
     return EXIT_OK;
 }
 

@@ -182,30 +182,68 @@ int net_build(network *net, route_set *lines, char *err, size_t errlen)
     return 0;
 }
 
-plx_status net_score(network *net, plx_engine *e, double step, double dark_lux, double height, int progress)
+#define NET_CHUNK 4       /* edges a thread scores at a time */
+#define NET_MIN_EDGES 16  /* fewer edges: on the engine alone (a bake's edge costs about 4 ms, its twin some 30) */
+
+typedef struct score_job {
+    network *net;
+    int progress;          /* on a terminal: the share done, in steps of 5% */
+    uint32_t shown;
+} score_job;
+
+/* Edges [k0, k1) scored with engine e. */
+static plx_status score_edges(void *arg, plx_engine *e, size_t k0, size_t k1)
 {
-    uint32_t i, shown = 0;
-    net->step = step;
-    net->dark_lux = dark_lux;
-    net->height = height;
-    progress = progress && isatty(2);
-    for (i = 0; i < net->nedges; i++) {
+    score_job *j = arg;
+    network *net = j->net;
+    size_t i;
+    for (i = k0; i < k1; i++) {
         net_edge *ed = &net->edges[i];
         const route_line *l = &net->lines.lines[ed->line];
-        plx_status st = plx_route_score(e, l->xy + 2 * ed->v0, ed->v1 - ed->v0 + 1, step, dark_lux, &ed->s, NULL);
+        plx_status st = plx_route_score(e, l->xy + 2 * ed->v0, ed->v1 - ed->v0 + 1, net->step, net->dark_lux,
+                                        &ed->s, NULL);
         if (st == PLX_OK)
-            st = plx_route_facial(e, l->xy + 2 * ed->v0, ed->v1 - ed->v0 + 1, step, height, NULL, ed->fac);
+            st = plx_route_facial(e, l->xy + 2 * ed->v0, ed->v1 - ed->v0 + 1, net->step, net->height, NULL,
+                                  ed->fac);
         if (st != PLX_OK)
             return st;
         ed->dark = ed->s.dark_share * ed->s.length;
-        if (progress && (i + 1) * 20u / net->nedges > shown) {
-            shown = (i + 1) * 20u / net->nedges;
-            fprintf(stderr, "\rscoring edges: %3u%%", shown * 5);
-        }
     }
-    if (progress && shown)
-        fprintf(stderr, "\n");
     return PLX_OK;
+}
+
+static void score_progress(void *arg, size_t done, size_t n)
+{
+    score_job *j = arg;
+    if (j->progress && done * 20u / n > j->shown) {
+        j->shown = (uint32_t)(done * 20u / n);
+        fprintf(stderr, "\rscoring edges: %3u%%", j->shown * 5);
+    }
+}
+
+plx_status net_score(network *net, plx_engine *e, twin_gather *tg, double step, double dark_lux, double height,
+                     int progress, plx_engine **failed)
+{
+    score_job j;
+    twin_work w;
+    plx_status st;
+    net->step = step;
+    net->dark_lux = dark_lux;
+    net->height = height;
+    j.net = net;
+    j.progress = progress && isatty(2);
+    j.shown = 0;
+    memset(&w, 0, sizeof w);
+    w.n = net->nedges;
+    w.chunk = NET_CHUNK;
+    w.min_items = NET_MIN_EDGES;
+    w.fn = score_edges;
+    w.arg = &j;
+    w.progress = score_progress;
+    st = twin_for(tg, e, &w, failed);
+    if (j.progress && j.shown)
+        fprintf(stderr, "\n");
+    return st;
 }
 
 void net_free(network *net)

@@ -12,6 +12,7 @@
 #include <stdint.h>
 #include "polarlux.h"
 #include "route_io.h"
+#include "twin_gather.h"
 
 typedef struct net_edge {
     uint32_t a, b;          /* end nodes (a at vertex v0, b at v1) */
@@ -44,8 +45,12 @@ typedef struct network {
 int net_build(network *net, route_set *lines, char *err, size_t errlen);
 /* Scores every edge (plx_route_score over the piece, sampled every step
  * metres, and plx_route_facial with its meters 'height' above it);
- * progress on stderr when it is a terminal. A plx_status. */
-plx_status net_score(network *net, plx_engine *e, double step, double dark_lux, double height, int progress);
+ * progress on stderr when it is a terminal. The edges are shared out
+ * between e and tg's twins (NULL: e alone), the same scores on any number
+ * of threads. A plx_status; *failed the engine whose plx_last_error says
+ * why. */
+plx_status net_score(network *net, plx_engine *e, twin_gather *tg, double step, double dark_lux, double height,
+                     int progress, plx_engine **failed /* OUT */);
 void net_free(network *net);
 
 /* A route: its edges and the sums over them. min_ev and min_esc are the

@@ -1,4 +1,4 @@
-/* twin_gather: illuminance at many points on the engine and its twins
+/* twin_gather: work over many items on the engine and its twins
  * (twin_gather.h). */
 #include <pthread.h>
 #include <string.h>
@@ -34,15 +34,18 @@ static void twins_load(twin_gather *t)
                 t->n + 1, t->n ? "s" : "");
 }
 
-/* One call's points, taken TWIN_CHUNK at a time by every thread. */
+/* One call's items, taken `chunk` at a time by every thread. */
 typedef struct twin_job {
     pthread_mutex_t mu;
-    size_t n, next;
-    const double *P, *N;
-    double *E, *Ei;
-    plx_status st;      /* the first failure other than PLX_E_RANGE (PLX_OK: none) */
+    size_t n, chunk, next, done;
+    twin_fn fn;
+    void *arg;
+    int range_soft;     /* PLX_E_RANGE of a chunk is kept in `range`, not a failure */
+    void (*progress)(void *arg, size_t done, size_t n);
+    plx_status st;      /* the failure of the lowest chunk that failed (PLX_OK: none) */
+    size_t st_at;       /* that chunk's first item */
     plx_engine *failed; /* its engine */
-    int range;          /* some chunk had a point out of range */
+    int range;
 } twin_job;
 
 typedef struct twin_arg {
@@ -50,7 +53,8 @@ typedef struct twin_arg {
     plx_engine *e;
 } twin_arg;
 
-/* Takes chunks until none is left or a failure stops the job. */
+/* Takes chunks until none is left or a failure stops the handing out
+ * (chunks go out in order: every chunk before a failed one was taken). */
 static void *twin_run(void *p)
 {
     twin_arg *a = p;
@@ -60,54 +64,55 @@ static void *twin_run(void *p)
         plx_status st;
         pthread_mutex_lock(&j->mu);
         k = j->next;
-        m = j->st == PLX_OK && k < j->n ? (j->n - k < TWIN_CHUNK ? j->n - k : TWIN_CHUNK) : 0;
+        m = j->st == PLX_OK && k < j->n ? (j->n - k < j->chunk ? j->n - k : j->chunk) : 0;
         j->next += m;
         pthread_mutex_unlock(&j->mu);
         if (m == 0)
             return NULL;
-        st = plx_illuminance(a->e, m, j->P + 3 * k, j->N + 3 * k, j->E + k, j->Ei + k, NULL);
-        if (st == PLX_OK)
-            continue;
+        st = j->fn(j->arg, a->e, k, k + m);
         pthread_mutex_lock(&j->mu);
-        if (st == PLX_E_RANGE) {
+        if (st == PLX_E_RANGE && j->range_soft) {
             j->range = 1;
-        } else if (j->st == PLX_OK) {
+        } else if (st != PLX_OK && (j->st == PLX_OK || k < j->st_at)) {
             j->st = st;
+            j->st_at = k;
             j->failed = a->e;
         }
+        j->done += m;
+        if (j->progress)
+            j->progress(j->arg, j->done, j->n);
         pthread_mutex_unlock(&j->mu);
     }
 }
 
-plx_status twin_illuminance(twin_gather *t, plx_engine *e, size_t n, const double *P, const double *N,
-                            double *E_direct, double *E_indirect, plx_engine **failed)
+plx_status twin_for(twin_gather *t, plx_engine *e, const twin_work *w, plx_engine **failed)
 {
     pthread_t th[TWIN_MAX];
-    twin_arg arg[TWIN_MAX + 1];
-    int started[TWIN_MAX], k;
+    twin_arg a[TWIN_MAX + 1];
+    int started[TWIN_MAX], k, nt;
     twin_job j;
     *failed = e;
-    if (n >= TWIN_MIN_POINTS && t->want > 0 && !t->tried)
+    if (w->n >= w->min_items && t && t->want > 0 && !t->tried)
         twins_load(t);
-    if (n < TWIN_MIN_POINTS || t->n == 0)
-        return plx_illuminance(e, n, P, N, E_direct, E_indirect, NULL);
+    nt = w->n >= w->min_items && t ? t->n : 0;
     memset(&j, 0, sizeof j);
-    if (pthread_mutex_init(&j.mu, NULL) != 0)
-        return plx_illuminance(e, n, P, N, E_direct, E_indirect, NULL);
-    j.n = n;
-    j.P = P;
-    j.N = N;
-    j.E = E_direct;
-    j.Ei = E_indirect;
+    j.n = w->n;
+    j.chunk = w->chunk > 0 ? w->chunk : 1;
+    j.fn = w->fn;
+    j.arg = w->arg;
+    j.range_soft = w->range_soft;
+    j.progress = w->progress;
     j.st = PLX_OK;
-    for (k = 0; k <= t->n; k++) {
-        arg[k].j = &j;
-        arg[k].e = k == 0 ? e : t->tw[k - 1];
+    if (pthread_mutex_init(&j.mu, NULL) != 0) /* no lock: one call on the engine */
+        return w->n > 0 ? w->fn(w->arg, e, 0, w->n) : PLX_OK;
+    for (k = 0; k <= nt; k++) {
+        a[k].j = &j;
+        a[k].e = k == 0 ? e : t->tw[k - 1];
     }
-    for (k = 0; k < t->n; k++)
-        started[k] = pthread_create(&th[k], NULL, twin_run, &arg[k + 1]) == 0;
-    twin_run(&arg[0]);
-    for (k = 0; k < t->n; k++)
+    for (k = 0; k < nt; k++)
+        started[k] = pthread_create(&th[k], NULL, twin_run, &a[k + 1]) == 0;
+    twin_run(&a[0]);
+    for (k = 0; k < nt; k++)
         if (started[k])
             pthread_join(th[k], NULL);
     pthread_mutex_destroy(&j.mu);
@@ -116,6 +121,47 @@ plx_status twin_illuminance(twin_gather *t, plx_engine *e, size_t n, const doubl
         return j.st;
     }
     return j.range ? PLX_E_RANGE : PLX_OK;
+}
+
+typedef struct illum_arg {
+    const double *P, *N;
+    double *E, *Ei;
+} illum_arg;
+
+static plx_status illum_chunk(void *arg, plx_engine *e, size_t k0, size_t k1)
+{
+    illum_arg *a = arg;
+    return plx_illuminance(e, k1 - k0, a->P + 3 * k0, a->N + 3 * k0, a->E + k0, a->Ei + k0, NULL);
+}
+
+plx_status twin_illuminance(twin_gather *t, plx_engine *e, size_t n, const double *P, const double *N,
+                            double *E_direct, double *E_indirect, plx_engine **failed)
+{
+    illum_arg a;
+    twin_work w;
+    plx_status st;
+    a.P = P;
+    a.N = N;
+    a.E = E_direct;
+    a.Ei = E_indirect;
+    if (n < TWIN_MIN_POINTS || !t || t->want == 0) { /* one call: its message names the point by its place in P */
+        *failed = e;
+        return plx_illuminance(e, n, P, N, E_direct, E_indirect, NULL);
+    }
+    memset(&w, 0, sizeof w);
+    w.n = n;
+    w.chunk = TWIN_CHUNK;
+    w.min_items = TWIN_MIN_POINTS;
+    w.range_soft = 1;
+    w.fn = illum_chunk;
+    w.arg = &a;
+    st = twin_for(t, e, &w, failed);
+    return st;
+}
+
+int twin_threads(const twin_gather *t)
+{
+    return t ? t->n + 1 : 1;
 }
 
 void twin_gather_free(twin_gather *t)

@@ -1,6 +1,6 @@
-/* twin_gather: illuminance with indirect light at many points, shared
+/* twin_gather: work over many items (points, street edges) shared
  * between the engine and twins loaded from the same bake file, each on a
- * thread of its own (README "dark-spots").
+ * thread of its own (README: `dark-spots`, `annotate`, `route --network`).
  *
  * An engine answers one query at a time (its light and tracer keep
  * caches and counters), and a final gather costs about a thousand times
@@ -39,14 +39,38 @@ typedef struct twin_gather {
  * bake and e has photon frames. */
 void twin_gather_init(twin_gather *t, const char *cmd, const char *scene, const cli_common *c, plx_engine *e);
 
+/* Work on items [k0, k1) with engine e: a status (twin_work). */
+typedef plx_status (*twin_fn)(void *arg, plx_engine *e, size_t k0, size_t k1);
+
+typedef struct twin_work {
+    size_t n;          /* items */
+    size_t chunk;      /* items a thread takes at a time */
+    size_t min_items;  /* fewer items: on the engine alone (the twins not loaded for them) */
+    int range_soft;    /* a chunk's PLX_E_RANGE is no failure: the call returns it at the end */
+    twin_fn fn;        /* each chunk's work, on whichever engine takes it */
+    void *arg;
+    void (*progress)(void *arg, size_t done, size_t n); /* after each chunk (under a lock), or NULL */
+} twin_work;
+
+/* w->fn over items [0, w->n) in chunks taken by e's thread and a thread
+ * per twin (loaded on first need), each with its own engine; the items
+ * must not depend on one another. Returns PLX_OK, the status of the
+ * lowest failed chunk (no chunk is handed out after a failure; *failed:
+ * the engine whose plx_last_error says why), or PLX_E_RANGE with
+ * range_soft when a chunk returned it. t NULL: on e alone. */
+plx_status twin_for(twin_gather *t, plx_engine *e, const twin_work *w, plx_engine **failed /* OUT */);
+
 /* plx_illuminance(e, n, P, N, E_direct, E_indirect, NULL) (E_indirect
  * not NULL) with the points shared out in chunks between e and the
  * twins; the same values. Returns PLX_OK, PLX_E_RANGE (some point out of
- * range: its values NaN; the engines' messages then name a point by its
- * place in a chunk, not in P) or another status, with *failed the engine
- * whose plx_last_error says why. */
+ * range: its values NaN; with twins the engines' messages then name a
+ * point by its place in a chunk, not in P) or another status, with
+ * *failed the engine whose plx_last_error says why. */
 plx_status twin_illuminance(twin_gather *t, plx_engine *e, size_t n, const double *P, const double *N,
                             double *E_direct, double *E_indirect, plx_engine **failed /* OUT */);
+
+/* Threads the work runs on: the twins loaded and e's. */
+int twin_threads(const twin_gather *t);
 
 /* Frees the twins. */
 void twin_gather_free(twin_gather *t);

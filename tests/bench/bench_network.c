@@ -122,7 +122,7 @@ static int cmp_double(const void *a, const void *b)
 int main(void)
 {
     text txt = { NULL, 0, 0 };
-    plx_engine *e;
+    plx_engine *e, *failed;
     plx_config cfg;
     plx_port quiet = *plx_port_posix();
     route_set rs;
@@ -176,7 +176,7 @@ int main(void)
     t_build = (port_now_ns() - t0) / 1e9;
     t0 = port_now_ns();
     c0 = cpu_ms();
-    if (net_score(&net, e, 1.0, 1.0, 1.5, 0) != PLX_OK)
+    if (net_score(&net, e, NULL, 1.0, 1.0, 1.5, 0, &failed) != PLX_OK)
         return 1;
     t_score = (port_now_ns() - t0) / 1e9;
     cpu_score = cpu_ms() - c0;

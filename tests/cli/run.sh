@@ -915,6 +915,16 @@ if grep -q '"rank":20,"lux":0\.0[1-9]' "$tmp/ds-t1.json" && cmp -s "$tmp/ds-t1.j
 else echo "FAIL dark-spots-threads-same"; fail=$((fail + 1)); fi
 expect dark-spots-threads-note 0 "gathered 1[0-9]{3} times for the 8300 street points .*, on 3 threads$" -- "$bin" dark-spots "$tmp/g4.plxb" --count 2 --res 4 --threads 3
 expect dark-spots-one-thread-note 0 ", on 1 thread$" -- "$bin" dark-spots "$tmp/g4.plxb" --count 2 --res 4 --threads 1
+if [ -z "$PLX_TEST_QUICK" ]; then # check-full: annotate's edges scored on 1 and 3 threads (7 s), the same files
+    "$bin" bake -q fixtures/helsinki-centre.geojson --frames 2 --photons 4000 -o "$tmp/hq.plxb" >/dev/null 2>&1
+    "$bin" annotate -q "$tmp/hq.plxb" --network fixtures/helsinki-streets.geojson --threads 1 -o "$tmp/an1.geojson" --csv "$tmp/an1.csv" >/dev/null 2>&1
+    "$bin" annotate -q "$tmp/hq.plxb" --network fixtures/helsinki-streets.geojson --threads 3 -o "$tmp/an3.geojson" --csv "$tmp/an3.csv" >/dev/null 2>&1
+    if grep -q '^way/4243035,50.677,30.743,0.000,0.6067,1.5083,0.1939,' "$tmp/an1.csv" && cmp -s "$tmp/an1.csv" "$tmp/an3.csv" &&
+        cmp -s "$tmp/an1.geojson" "$tmp/an3.geojson"; then
+        echo "ok   annotate-threads-same"; pass=$((pass + 1))
+    else echo "FAIL annotate-threads-same"; fail=$((fail + 1)); fi
+    expect annotate-threads-note 0 "^annotate: the 4717 edges scored on 3 threads \(the bake loaded 2 more times\)$" -- "$bin" annotate "$tmp/hq.plxb" --network fixtures/helsinki-streets.geojson --threads 3 -o "$tmp/an3.geojson"
+fi
 if [ -z "$PLX_TEST_QUICK" ]; then # check-full: the pass that gathers everywhere; a pass by bounds, then passes gathering everywhere (--mem)
     spots_same dark-spots-unbounded-equals-exhaustive "$tmp/ds.plxb" --count 3 --res 1
     need=$("$bin" dark-spots -q "$tmp/g4.plxb" --mem 1M 2>&1 | sed -n 's/.*it needs \([0-9]*\) bytes.*/\1/p')

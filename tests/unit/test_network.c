@@ -31,11 +31,12 @@ static plx_engine *load_text(const char *json, void **mem)
 static void open_net(plx_engine *e, const char *path, network *net)
 {
     route_set rs;
+    plx_engine *failed;
     char err[512];
     if (route_read(path, e, &rs, err, sizeof err) != 0)
         fail_msg("%s", err);
     assert_int_equal(net_build(net, &rs, err, sizeof err), 0);
-    assert_int_equal(net_score(net, e, 1.0, 1.0, 1.5, 0), PLX_OK);
+    assert_int_equal(net_score(net, e, NULL, 1.0, 1.0, 1.5, 0, &failed), PLX_OK);
 }
 
 static void snap(const network *net, double x, double y, net_snap *s)
@@ -228,6 +229,7 @@ static int table_class(double mean, double min, double ev, double esc)
 static void test_class_depends_on_facial_criterion(void **state)
 {
     int sides;
+    plx_engine *failed;
     (void)state;
     for (sides = 0; sides < 2; sides++) {
         void *mem;
@@ -247,7 +249,7 @@ static void test_class_depends_on_facial_criterion(void **state)
         rs.lines[0].xy[2] = 20;
         rs.lines[0].xy[4] = 40;
         assert_int_equal(net_build(&net, &rs, err, sizeof err), 0);
-        assert_int_equal(net_score(&net, e, 1.0, 1.0, 1.5, 0), PLX_OK);
+        assert_int_equal(net_score(&net, e, NULL, 1.0, 1.0, 1.5, 0, &failed), PLX_OK);
         snap(&net, 0, 0, &a);
         snap(&net, 40, 0, &b);
         assert_int_equal(net_route_find(&net, e, &a, &b, 3.0, &r, err, sizeof err), 0);
@@ -382,6 +384,7 @@ static void test_random_grids_against_bellman_ford(void **state)
 {
     int seed, rounds = getenv("PLX_TEST_QUICK") ? 6 : 30, reached = 0, unreached = 0;
     static const double weights[3] = { 0.0, 0.7, 4.0 };
+    plx_engine *failed;
     (void)state;
     for (seed = 0; seed < rounds; seed++) {
         void *mem;
@@ -392,7 +395,7 @@ static void test_random_grids_against_bellman_ford(void **state)
         uint32_t q;
         grid_lines(seed, &rs);
         assert_int_equal(net_build(&net, &rs, err, sizeof err), 0);
-        assert_int_equal(net_score(&net, e, 1.0, 1.0, 1.5, 0), PLX_OK);
+        assert_int_equal(net_score(&net, e, NULL, 1.0, 1.0, 1.5, 0, &failed), PLX_OK);
         for (q = 0; q < 12; q++) {
             uint32_t s = (uint32_t)(rnd() * net.nnodes), t = q == 11 ? net.nnodes - 1 : (uint32_t)(rnd() * net.nnodes);
             double w = weights[q % 3], want = bellman_ford(&net, s, t, w);
