@@ -23,6 +23,8 @@ int port_write_atomic(const char *path, const void *data, size_t len, char *err,
 int port_parallel_for(void *ctx, int workers, uint32_t njobs, void (*job)(void *arg, int worker, uint32_t k),
                       void *arg);
 int port_cores(void *ctx);
+/* The machine's physical memory in bytes (sysconf), 0 when unknown. */
+unsigned long long port_memory_bytes(void);
 /* Monotonic clock in nanoseconds. */
 unsigned long long port_now_ns(void);
 /* The message fmt, ... into err (errlen bytes, cut to fit); nothing when

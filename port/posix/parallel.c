@@ -241,3 +241,13 @@ int port_cores(void *ctx)
     (void)ctx;
     return n < 1 ? 1 : n > PLX_MAX_THREADS ? PLX_MAX_THREADS : (int)n;
 }
+
+unsigned long long port_memory_bytes(void)
+{
+#if defined(_SC_PHYS_PAGES) && defined(_SC_PAGESIZE)
+    long pages = sysconf(_SC_PHYS_PAGES), size = sysconf(_SC_PAGESIZE);
+    return pages > 0 && size > 0 ? (unsigned long long)pages * (unsigned long long)size : 0;
+#else
+    return 0;
+#endif
+}

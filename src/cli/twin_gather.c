@@ -8,15 +8,37 @@
 
 #define TWIN_CHUNK 32 /* points a thread takes at a time: gathers vary a lot in cost */
 
+int twin_fit(int want, unsigned long long each, unsigned long long machine)
+{
+    unsigned long long fit;
+    if (machine == 0 || each == 0)
+        return want;
+    fit = machine / 2 / each;
+    return fit < 1 ? 0 : fit - 1 < (unsigned long long)want ? (int)(fit - 1) : want;
+}
+
 void twin_gather_init(twin_gather *t, const char *cmd, const char *scene, const cli_common *c, plx_engine *e)
 {
-    int threads = c->threads > 0 ? c->threads : port_cores(NULL);
+    int threads = c->threads > 0 ? c->threads : port_cores(NULL), allowed;
+    unsigned long long each, machine;
+    plx_memory_report m;
     memset(t, 0, sizeof *t);
     t->cmd = cmd;
     t->scene = scene;
     t->c = c;
     if (threads > 1 && cli_is_bake(scene) && plx_indirect_frames(e) > 0)
         t->want = threads - 1 < TWIN_MAX ? threads - 1 : TWIN_MAX;
+    if (t->want == 0 || c->threads > 0) /* --threads N: as asked */
+        return;
+    plx_memory_get(e, &m);
+    each = m.peak_total;
+    machine = port_memory_bytes();
+    allowed = twin_fit(t->want, each, machine);
+    if (allowed < t->want && !c->quiet)
+        fprintf(stderr, "polarlux %s: note: %d thread%s of the %d processors: each further thread loads the bake "
+                "again (%.0f MB), and more would pass half of the machine's %.0f MB (--threads N asks for N)\n",
+                cmd, allowed + 1, allowed ? "s" : "", threads, each / 1e6, machine / 1e6);
+    t->want = allowed;
 }
 
 /* The twins, loaded quietly (the engine's warnings were printed once);

@@ -34,9 +34,11 @@ typedef struct twin_gather {
 } twin_gather;
 
 /* Sets up t for engine e, loaded by cli_open_scene from scene (kept
- * referenced, as c): twins for c->threads - 1 further threads (the
- * processors' number - 1 when 0), loaded on first need, when scene is a
- * bake and e has photon frames. */
+ * referenced, as c): twins for c->threads - 1 further threads, loaded on
+ * first need, when scene is a bake and e has photon frames. Without
+ * --threads, one for each further processor while all the engines (each
+ * about e's bytes in use) stay within half of the machine's memory (a
+ * note on stderr when that leaves fewer). */
 void twin_gather_init(twin_gather *t, const char *cmd, const char *scene, const cli_common *c, plx_engine *e);
 
 /* Work on items [k0, k1) with engine e: a status (twin_work). */
@@ -68,6 +70,10 @@ plx_status twin_for(twin_gather *t, plx_engine *e, const twin_work *w, plx_engin
  * *failed the engine whose plx_last_error says why. */
 plx_status twin_illuminance(twin_gather *t, plx_engine *e, size_t n, const double *P, const double *N,
                             double *E_direct, double *E_indirect, plx_engine **failed /* OUT */);
+
+/* Of `want` twins, how many the default allows: all engines, each of
+ * `each` bytes, within half of `machine` bytes (0: unknown, all). */
+int twin_fit(int want, unsigned long long each, unsigned long long machine);
 
 /* Threads the work runs on: the twins loaded and e's. */
 int twin_threads(const twin_gather *t);

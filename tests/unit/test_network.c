@@ -1,6 +1,10 @@
 /* Street networks (src/cli/network.c): lines joined at shared vertices,
  * edges scored as plx_route_score scores lines, and Dijkstra's routes
- * against hand-computed answers and an independent Bellman-Ford. */
+ * against hand-computed answers and an independent Bellman-Ford. And
+ * twin_for (src/cli/twin_gather.c), which shares the edges' scoring out
+ * between threads: every item done once, a failure's status and engine
+ * with every chunk before it done, PLX_E_RANGE kept to the end, and the
+ * default's memory rule. */
 #include <stdarg.h>
 #include <stddef.h>
 #include <setjmp.h>
@@ -452,6 +456,115 @@ static void test_snap_and_empty(void **state)
     free(mem);
 }
 
+/* ---- twin_for (src/cli/twin_gather.c): the items shared out between an
+ * engine's thread and its twins' ---------------------------------------- */
+
+/* Stand-in engines: twin_for only hands their pointers to the work. */
+static char fake_engine[4];
+
+typedef struct fake_job {
+    int done[1000];         /* times each item was done */
+    int by[1000];           /* which engine did it (0 .. 3) */
+    long fail_at;           /* an item whose chunk fails (-1: none) */
+    long range_at;          /* an item whose chunk says PLX_E_RANGE (-1: none) */
+    size_t last_done;       /* progress: the last count seen */
+    int progress_calls, progress_back;
+} fake_job;
+
+static plx_status fake_work(void *arg, plx_engine *e, size_t k0, size_t k1)
+{
+    fake_job *j = arg;
+    size_t k;
+    int range = 0;
+    for (k = k0; k < k1; k++) { /* as plx_illuminance: a point out of range ends nothing */
+        j->done[k]++;
+        j->by[k] = (int)((char *)e - fake_engine);
+        if ((long)k == j->fail_at)
+            return PLX_E_NOMEM;
+        range |= (long)k == j->range_at;
+    }
+    return range ? PLX_E_RANGE : PLX_OK;
+}
+
+static void fake_progress(void *arg, size_t done, size_t n)
+{
+    fake_job *j = arg;
+    j->progress_back += done < j->last_done || done > n;
+    j->last_done = done;
+    j->progress_calls++;
+}
+
+/* n items in chunks of 7 on the engine and 3 twins. */
+static plx_status fake_run(fake_job *j, size_t n, int range_soft, plx_engine **failed)
+{
+    twin_gather t;
+    twin_work w;
+    int k;
+    memset(&t, 0, sizeof t);
+    t.tried = 1; /* the twins are "loaded": no bake is read */
+    t.n = 3;
+    for (k = 0; k < 3; k++)
+        t.tw[k] = (plx_engine *)(void *)&fake_engine[k + 1];
+    memset(&w, 0, sizeof w);
+    w.n = n;
+    w.chunk = 7;
+    w.min_items = 16;
+    w.range_soft = range_soft;
+    w.fn = fake_work;
+    w.arg = j;
+    w.progress = fake_progress;
+    return twin_for(&t, (plx_engine *)(void *)&fake_engine[0], &w, failed);
+}
+
+static void fake_init(fake_job *j)
+{
+    memset(j, 0, sizeof *j);
+    j->fail_at = j->range_at = -1;
+}
+
+static void test_twin_for(void **state)
+{
+    static fake_job j;
+    plx_engine *failed = NULL;
+    size_t k, n;
+    (void)state;
+    /* every item once, whatever the count (0, below min_items, around the chunks) */
+    for (n = 0; n <= 1000; n += n < 40 ? 1 : 137) {
+        fake_init(&j);
+        assert_int_equal(fake_run(&j, n, 0, &failed), PLX_OK);
+        for (k = 0; k < 1000; k++)
+            assert_int_equal(j.done[k], k < n);
+        assert_int_equal(j.progress_back, 0);
+        if (n > 0)
+            assert_true(j.last_done == n);
+        if (n > 0 && n < 16) /* below min_items: the engine alone */
+            for (k = 0; k < n; k++)
+                assert_int_equal(j.by[k], 0);
+    }
+    /* a failure: its status and engine, every chunk before it done, none
+     * handed out after it was seen; the lowest failed chunk wins */
+    for (k = 0; k < 1000; k += 97) {
+        fake_init(&j);
+        j.fail_at = (long)k;
+        assert_int_equal(fake_run(&j, 1000, 0, &failed), PLX_E_NOMEM);
+        assert_ptr_equal(failed, (plx_engine *)(void *)&fake_engine[j.by[k]]);
+        for (n = 0; n < k / 7 * 7; n++)
+            assert_int_equal(j.done[n], 1);
+    }
+    /* PLX_E_RANGE with range_soft: every item done, the status at the end */
+    fake_init(&j);
+    j.range_at = 500;
+    assert_int_equal(fake_run(&j, 1000, 1, &failed), PLX_E_RANGE);
+    for (k = 0; k < 1000; k++)
+        assert_int_equal(j.done[k], 1);
+    /* the default's memory rule: all engines within half the machine */
+    assert_int_equal(twin_fit(7, 100, 0), 7);          /* memory unknown: as many as asked */
+    assert_int_equal(twin_fit(7, 100, 1600), 7);       /* 8 x 100 <= 800 */
+    assert_int_equal(twin_fit(7, 100, 1599), 6);
+    assert_int_equal(twin_fit(3, 400, 1000), 0);       /* one engine already passes half */
+    assert_int_equal(twin_fit(3, 250, 1000), 1);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -461,6 +574,7 @@ int main(void)
         cmocka_unit_test(test_class_depends_on_facial_criterion),
         cmocka_unit_test(test_random_grids_against_bellman_ford),
         cmocka_unit_test(test_snap_and_empty),
+        cmocka_unit_test(test_twin_for),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
