@@ -79,8 +79,17 @@ typedef struct cli_bake_state {
     int loaded;
     size_t bytes;
     unsigned long long load_ns;
+    unsigned char head[16];  /* the header's file length and checksum (bytes 24-39), as loaded */
 } cli_bake_state;
 extern cli_bake_state cli_bake_last;
+/* A twin of the bake cli_open_scene loaded last from path: the same file
+ * read again into a block of its own (sized as that load sized it: the
+ * header's, or --mem), quietly (no warning of the engine's, no line on
+ * stderr: why says why it cannot be) and leaving cli_bake_last as it is.
+ * The file must still hold the bytes first loaded: its length and
+ * checksum are compared with the first load's, before and after. EXIT_OK
+ * or an exit code. */
+int cli_open_twin(const char *path, const cli_common *c, plx_engine **e, char *why, size_t whylen);
 /* "NAME: malformed JSON at byte B (line L, column C)" into err, where
  * cJSON stopped in text (len bytes; cJSON_GetErrorPtr, read right after
  * the failed parse), with ": the text ends early" for a text cut short:

@@ -12,7 +12,8 @@
 
 static const char route_help[] =
     "usage: polarlux route SCENE --network STREETS --from X,Y --to X,Y [--dark-lux LX]\n"
-    "                      [--dark-weight W] [--max-detour F] [--geojson OUT] [options]\n"
+    "                      [--dark-weight W] [--max-detour F] [--geojson OUT] [--threads N]\n"
+    "                      [options]\n"
     "\n"
     "Finds the best-lit walking route and the shortest route between two points\n"
     "of a street network and prints them side by side: metres, dark metres, min\n"
@@ -46,15 +47,17 @@ static const char route_help[] =
     "  --geojson OUT    write both routes as LineStrings (properties route,\n"
     "                   length_m, dark_m, min_lux, mean_lux, min_ev_lux,\n"
     "                   min_sc_lux, class, class_h, ...)\n"
-    "  --threads N      threads scoring the edges on a bake (default: the number\n"
-    "                   of processors); each further thread loads the bake again\n"
-    "                   (its own --mem block: N times the memory); the same\n"
-    "                   scores for any N\n"
+    "  --threads N      threads scoring the edges on a bake with indirect light\n"
+    "                   (default: the processors, at most 8, while the copies fit\n"
+    "                   in half the machine's memory); each further thread loads\n"
+    "                   the bake again (its own --mem block: N times the memory);\n"
+    "                   the same scores for any N\n"
     "  --mem SIZE, --strict, --quiet, --lamps FILE   as for 'polarlux info'\n";
 
 static const char annotate_help[] =
     "usage: polarlux annotate SCENE --network STREETS -o OUT.geojson [--csv OUT.csv]\n"
-    "                         [--dark-lux LX] [--dark-weight W] [--step M] [options]\n"
+    "                         [--dark-lux LX] [--dark-weight W] [--step M] [--threads N]\n"
+    "                         [options]\n"
     "\n"
     "Scores every edge of a street network (as 'polarlux route --network' does)\n"
     "and writes it as a GeoJSON LineString with its light: osm_id, name, from and\n"
@@ -179,8 +182,8 @@ static int load_network(const net_opts *o, plx_engine *e, network *net)
     twin_gather_init(&tg, o->cmd, o->scene, &o->c, e);
     st = net_score(net, e, &tg, o->step, o->dark, o->height, 1, &failed);
     if (twin_threads(&tg) > 1 && !o->c.quiet)
-        fprintf(stderr, "%s: the %u edges scored on %d threads (the bake loaded %d more time%s)\n", o->cmd,
-                net->nedges, twin_threads(&tg), tg.n, tg.n == 1 ? "" : "s");
+        fprintf(stderr, "polarlux %s: note: the %u edges scored on %d threads, each with its own copy of the bake\n",
+                o->cmd, net->nedges, twin_threads(&tg));
     if (st != PLX_OK) {
         fprintf(stderr, "polarlux %s: %s: scoring the edges: %s\n", o->cmd, o->network, plx_last_error(failed));
         twin_gather_free(&tg);

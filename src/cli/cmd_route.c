@@ -62,7 +62,8 @@ static const char spots_help[] =
     "                still make them candidates get it)\n"
     "  -o OUT        write the GeoJSON to OUT instead of standard output\n"
     "  --threads N   threads gathering a bake's indirect light (default: the\n"
-    "                number of processors); each further thread loads the bake\n"
+    "                processors, at most 8, while the copies fit in half the\n"
+    "                machine's memory); each further thread loads the bake\n"
     "                again (its own --mem block: N times the memory); the same\n"
     "                spots for any N\n"
     "  --mem SIZE, --strict, --quiet, --lamps FILE   as for 'polarlux info'\n"
@@ -882,7 +883,7 @@ static int find_spots(plx_engine *e, const char *scene, double res, long count, 
     if (g.gathered > 0 && !exhaustive && !g.no_indirect && !c->quiet)
         fprintf(stderr, "dark-spots: indirect light gathered %zu times for the %zu street points (not where the "
                 "direct lux alone rules a point out; --exhaustive gathers at every one), on %d thread%s\n",
-                g.gathered, g.street, g.tg.n + 1, g.tg.n ? "s" : "");
+                g.gathered, g.street, twin_threads(&g.tg), twin_threads(&g.tg) > 1 ? "s" : "");
     if (geo_begin(&geo, e) != 0) {
         rc = EXIT_FAIL;
         goto done;

@@ -673,6 +673,7 @@ static int open_bake(const char *cmd, const char *path, const cli_common *c, plx
     bake_in in;
     plx_config cfg;
     plx_status st;
+    unsigned char head[16];
     unsigned long long t0 = port_now_ns();
     in.why[0] = '\0';
     in.fd = port_open_input(path, &len, err, sizeof err);
@@ -680,6 +681,8 @@ static int open_bake(const char *cmd, const char *path, const cli_common *c, plx
         fprintf(stderr, "polarlux %s: %s: %s\n", cmd, path, err);
         return EXIT_FAIL;
     }
+    if (bake_read(&in, 24, head, sizeof head) != 0)
+        memset(head, 0, sizeof head); /* too short: the load says so */
     if (c->mem) { /* the block given: the load checks the file as it reads it */
         need = c->mem;
     } else {
@@ -722,8 +725,63 @@ static int open_bake(const char *cmd, const char *path, const cli_common *c, plx
     cli_bake_last.loaded = 1;
     cli_bake_last.bytes = len;
     cli_bake_last.load_ns = port_now_ns() - t0;
+    memcpy(cli_bake_last.head, head, sizeof head);
     note_no_lamps(cmd, path, c, *e, 1);
     return EXIT_OK;
+}
+
+/* Whether the bake at in still has the header bytes 24-39 of the first load. */
+static int twin_same_file(bake_in *in)
+{
+    unsigned char head[16];
+    return bake_read(in, 24, head, sizeof head) == 0 && memcmp(head, cli_bake_last.head, sizeof head) == 0;
+}
+
+int cli_open_twin(const char *path, const cli_common *c, plx_engine **e, char *why, size_t whylen)
+{
+    char err[512];
+    size_t len, need;
+    void *mem;
+    bake_in in;
+    plx_config cfg;
+    plx_status st;
+    cli_common quiet = *c;
+    *e = NULL;
+    if (!cli_bake_last.loaded) {
+        snprintf(why, whylen, "the scene was not loaded from a bake");
+        return EXIT_FAIL;
+    }
+    in.why[0] = '\0';
+    if ((in.fd = port_open_input(path, &len, err, sizeof err)) < 0) {
+        snprintf(why, whylen, "%s", err);
+        return EXIT_FAIL;
+    }
+    st = twin_same_file(&in) ? PLX_OK : PLX_E_INVALID;
+    if (st != PLX_OK)
+        snprintf(why, whylen, "the file changed since it was loaded");
+    need = c->mem;
+    if (st == PLX_OK && !need && (st = plx_bake_block_size_read(bake_read, &in, len, NULL, 0, &need, err,
+                                                                  sizeof err)) != PLX_OK)
+        snprintf(why, whylen, "%s", err);
+    mem = st == PLX_OK ? cli_big_alloc(need) : NULL;
+    if (st == PLX_OK && !mem) {
+        snprintf(why, whylen, "no memory for another block of %zu bytes", need);
+        st = PLX_E_NOMEM;
+    }
+    quiet.quiet = 1;
+    cli_config(&quiet, &cfg);
+    if (st == PLX_OK && (st = plx_bake_load_read(mem, need, &cfg, bake_read, &in, len, e, err, sizeof err)) != PLX_OK) {
+        snprintf(why, whylen, "%s", err);
+        free(mem);
+    }
+    if (st == PLX_OK && !twin_same_file(&in)) { /* changed as it was read: its checksum held, but another file's */
+        snprintf(why, whylen, "the file changed since it was loaded");
+        plx_engine_free(*e);
+        *e = NULL;
+        st = PLX_E_INVALID;
+    }
+    close(in.fd);
+    return st == PLX_OK ? EXIT_OK : cli_exit_code(st);
 }
 
 int cli_open_scene(const char *cmd, const char *path, const cli_common *c, plx_engine **e)

@@ -28,6 +28,9 @@ void twin_gather_init(twin_gather *t, const char *cmd, const char *scene, const 
     t->c = c;
     if (threads > 1 && cli_is_bake(scene) && plx_indirect_frames(e) > 0)
         t->want = threads - 1 < TWIN_MAX ? threads - 1 : TWIN_MAX;
+    if (t->want == TWIN_MAX && c->threads > TWIN_MAX + 1)
+        cli_warn(cmd, c, "--threads %d: this work runs on at most %d threads (a copy of the bake each)", c->threads,
+                 TWIN_MAX + 1);
     if (t->want == 0 || c->threads > 0) /* --threads N: as asked */
         return;
     plx_memory_get(e, &m);
@@ -41,19 +44,18 @@ void twin_gather_init(twin_gather *t, const char *cmd, const char *scene, const 
     t->want = allowed;
 }
 
-/* The twins, loaded quietly (the engine's warnings were printed once);
- * as many as load. */
+/* The twins, loaded quietly (cli_open_twin); as many as load, and a
+ * warning with the reason when fewer. */
 static void twins_load(twin_gather *t)
 {
-    cli_common quiet = *t->c;
+    char why[512];
+    why[0] = '\0';
     t->tried = 1;
-    quiet.quiet = 1;
-    while (t->n < t->want && cli_open_scene(t->cmd, t->scene, &quiet, &t->tw[t->n]) == EXIT_OK)
+    while (t->n < t->want && cli_open_twin(t->scene, t->c, &t->tw[t->n], why, sizeof why) == EXIT_OK)
         t->n++;
-    if (t->n < t->want && !t->c->quiet)
-        fprintf(stderr, "polarlux %s: warning: %s loaded %d time%s more of the %d asked for its threads; the "
-                "rest of the work runs on %d thread%s\n", t->cmd, t->scene, t->n, t->n == 1 ? "" : "s", t->want,
-                t->n + 1, t->n ? "s" : "");
+    if (t->n < t->want)
+        cli_warn(t->cmd, t->c, "%d of the %d further copies of %s for --threads could not be loaded (%s): "
+                 "working on %d thread%s", t->want - t->n, t->want, t->scene, why, t->n + 1, t->n ? "s" : "");
 }
 
 /* One call's items, taken `chunk` at a time by every thread. */
@@ -111,7 +113,7 @@ plx_status twin_for(twin_gather *t, plx_engine *e, const twin_work *w, plx_engin
 {
     pthread_t th[TWIN_MAX];
     twin_arg a[TWIN_MAX + 1];
-    int started[TWIN_MAX], k, nt;
+    int started[TWIN_MAX], k, nt, ran;
     twin_job j;
     *failed = e;
     if (w->n >= w->min_items && t && t->want > 0 && !t->tried)
@@ -131,12 +133,18 @@ plx_status twin_for(twin_gather *t, plx_engine *e, const twin_work *w, plx_engin
         a[k].j = &j;
         a[k].e = k == 0 ? e : t->tw[k - 1];
     }
-    for (k = 0; k < nt; k++)
-        started[k] = pthread_create(&th[k], NULL, twin_run, &a[k + 1]) == 0;
+    for (k = 0, ran = 1; k < nt; k++)
+        ran += started[k] = pthread_create(&th[k], NULL, twin_run, &a[k + 1]) == 0;
+    if (ran < nt + 1 && !t->thread_warned) {
+        t->thread_warned = 1;
+        cli_warn(t->cmd, t->c, "%d of %d threads could not be started: working on %d", nt + 1 - ran, nt + 1, ran);
+    }
     twin_run(&a[0]);
     for (k = 0; k < nt; k++)
         if (started[k])
             pthread_join(th[k], NULL);
+    if (t && ran > t->ran)
+        t->ran = ran;
     pthread_mutex_destroy(&j.mu);
     if (j.st != PLX_OK) {
         *failed = j.failed;
@@ -161,7 +169,6 @@ plx_status twin_illuminance(twin_gather *t, plx_engine *e, size_t n, const doubl
 {
     illum_arg a;
     twin_work w;
-    plx_status st;
     a.P = P;
     a.N = N;
     a.E = E_direct;
@@ -177,13 +184,12 @@ plx_status twin_illuminance(twin_gather *t, plx_engine *e, size_t n, const doubl
     w.range_soft = 1;
     w.fn = illum_chunk;
     w.arg = &a;
-    st = twin_for(t, e, &w, failed);
-    return st;
+    return twin_for(t, e, &w, failed);
 }
 
 int twin_threads(const twin_gather *t)
 {
-    return t ? t->n + 1 : 1;
+    return t && t->ran > 1 ? t->ran : 1;
 }
 
 void twin_gather_free(twin_gather *t)

@@ -31,6 +31,8 @@ typedef struct twin_gather {
     int n;          /* twins loaded */
     int want;       /* twins to load on first need (0: none) */
     int tried;      /* the load was tried */
+    int ran;        /* the most threads one call ran on (0: none yet) */
+    int thread_warned; /* a thread could not be started: said once */
 } twin_gather;
 
 /* Sets up t for engine e, loaded by cli_open_scene from scene (kept
@@ -75,7 +77,7 @@ plx_status twin_illuminance(twin_gather *t, plx_engine *e, size_t n, const doubl
  * `each` bytes, within half of `machine` bytes (0: unknown, all). */
 int twin_fit(int want, unsigned long long each, unsigned long long machine);
 
-/* Threads the work runs on: the twins loaded and e's. */
+/* The most threads a call of twin_for ran on (1 when none had twins). */
 int twin_threads(const twin_gather *t);
 
 /* Frees the twins. */

@@ -500,7 +500,10 @@ static plx_status fake_run(fake_job *j, size_t n, int range_soft, plx_engine **f
     twin_gather t;
     twin_work w;
     int k;
+    static cli_common c;
     memset(&t, 0, sizeof t);
+    t.cmd = "test_network";
+    t.c = &c;
     t.tried = 1; /* the twins are "loaded": no bake is read */
     t.n = 3;
     for (k = 0; k < 3; k++)
