@@ -168,7 +168,7 @@ static int load_network(const net_opts *o, plx_engine *e, network *net)
     char err[512];
     plx_status st;
     plx_engine *failed;
-    twin_gather tg;
+    twin_set tg;
     if (route_read(o->network, e, &rs, err, sizeof err) != 0) {
         fprintf(stderr, "polarlux %s: %s\n", o->cmd, err);
         return EXIT_FAIL;
@@ -179,18 +179,18 @@ static int load_network(const net_opts *o, plx_engine *e, network *net)
         fprintf(stderr, "polarlux %s: %s: %s\n", o->cmd, o->network, err);
         return EXIT_FAIL;
     }
-    twin_gather_init(&tg, o->cmd, o->scene, &o->c, e);
+    twin_set_init(&tg, o->cmd, o->scene, &o->c, e);
     st = net_score(net, e, &tg, o->step, o->dark, o->height, 1, &failed);
     if (twin_threads(&tg) > 1 && !o->c.quiet)
         fprintf(stderr, "polarlux %s: note: the %u edges scored on %d threads, each with its own copy of the bake\n",
                 o->cmd, net->nedges, twin_threads(&tg));
     if (st != PLX_OK) {
         fprintf(stderr, "polarlux %s: %s: scoring the edges: %s\n", o->cmd, o->network, plx_last_error(failed));
-        twin_gather_free(&tg);
+        twin_set_free(&tg);
         net_free(net);
         return cli_exit_code(st);
     }
-    twin_gather_free(&tg);
+    twin_set_free(&tg);
     return EXIT_OK;
 }
 

@@ -8,7 +8,7 @@
 #include "geo_out.h"
 #include "port.h"
 #include "route_io.h"
-#include "twin_gather.h"
+#include "twin_engines.h"
 
 static const char route_help[] =
     "usage: polarlux route SCENE --path FILE [--step M] [--dark-lux LX] [--geojson OUT] [options]\n"
@@ -407,7 +407,7 @@ typedef struct spot_grid {
     size_t street;       /* street points of the grid (first pass) */
     double max_lux;      /* the brightest street point's lux, direct only unless exhaustive (first pass) */
     size_t gathered;     /* points whose indirect light was computed */
-    twin_gather tg;      /* the gathers shared with the bake's twins (--threads) */
+    twin_set tg;      /* the gathers shared with the bake's twins (--threads) */
 } spot_grid;
 
 /* One pass's buffers: a strip of grid points. */
@@ -848,7 +848,7 @@ static int find_spots(plx_engine *e, const char *scene, double res, long count, 
     g.res = res;
     g.no_indirect = plx_indirect_frames(e) == 0;
     g.exhaustive = exhaustive || g.no_indirect;
-    twin_gather_init(&g.tg, "dark-spots", scene, c, e);
+    twin_set_init(&g.tg, "dark-spots", scene, c, e);
     {   /* counted in doubles: no integer overflow for any finite --res */
         double wd = floor((si.bounds[2] - si.bounds[0]) / res), hd = floor((si.bounds[3] - si.bounds[1]) / res);
         if (!(wd * hd >= 1 && wd * hd <= 2e9)) {
@@ -915,7 +915,7 @@ static int find_spots(plx_engine *e, const char *scene, double res, long count, 
     }
     geo_free(&geo);
 done:
-    twin_gather_free(&g.tg);
+    twin_set_free(&g.tg);
     free(g.heap);
     free(pick);
     return rc;

@@ -221,7 +221,7 @@ static void score_progress(void *arg, size_t done, size_t n)
     }
 }
 
-plx_status net_score(network *net, plx_engine *e, twin_gather *tg, double step, double dark_lux, double height,
+plx_status net_score(network *net, plx_engine *e, twin_set *tg, double step, double dark_lux, double height,
                      int progress, plx_engine **failed)
 {
     score_job j;

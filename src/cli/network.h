@@ -12,7 +12,7 @@
 #include <stdint.h>
 #include "polarlux.h"
 #include "route_io.h"
-#include "twin_gather.h"
+#include "twin_engines.h"
 
 typedef struct net_edge {
     uint32_t a, b;          /* end nodes (a at vertex v0, b at v1) */
@@ -49,7 +49,7 @@ int net_build(network *net, route_set *lines, char *err, size_t errlen);
  * between e and tg's twins (NULL: e alone), the same scores on any number
  * of threads. A plx_status; *failed the engine whose plx_last_error says
  * why. */
-plx_status net_score(network *net, plx_engine *e, twin_gather *tg, double step, double dark_lux, double height,
+plx_status net_score(network *net, plx_engine *e, twin_set *tg, double step, double dark_lux, double height,
                      int progress, plx_engine **failed /* OUT */);
 void net_free(network *net);
 

@@ -1,7 +1,7 @@
 /* Street networks (src/cli/network.c): lines joined at shared vertices,
  * edges scored as plx_route_score scores lines, and Dijkstra's routes
  * against hand-computed answers and an independent Bellman-Ford. And
- * twin_for (src/cli/twin_gather.c), which shares the edges' scoring out
+ * twin_for (src/cli/twin_engines.c), which shares the edges' scoring out
  * between threads: every item done once, a failure's status and engine
  * with every chunk before it done, PLX_E_RANGE kept to the end, and the
  * default's memory rule. */
@@ -456,7 +456,7 @@ static void test_snap_and_empty(void **state)
     free(mem);
 }
 
-/* ---- twin_for (src/cli/twin_gather.c): the items shared out between an
+/* ---- twin_for (src/cli/twin_engines.c): the items shared out between an
  * engine's thread and its twins' ---------------------------------------- */
 
 /* Stand-in engines: twin_for only hands their pointers to the work. */
@@ -497,7 +497,7 @@ static void fake_progress(void *arg, size_t done, size_t n)
 /* n items in chunks of 7 on the engine and 3 twins. */
 static plx_status fake_run(fake_job *j, size_t n, int range_soft, plx_engine **failed)
 {
-    twin_gather t;
+    twin_set t;
     twin_work w;
     int k;
     static cli_common c;

@@ -1,4 +1,4 @@
-/* twin_gather: work over many items (points, street edges) shared
+/* twin_engines: work over many items (points, street edges) shared
  * between the engine and twins loaded from the same bake file, each on a
  * thread of its own (README: `dark-spots`, `annotate`, `route --network`).
  *
@@ -15,8 +15,8 @@
  * photon frames get twins (a scene file has no indirect light to
  * gather, and tracing its photons again would cost more than it saves).
  */
-#ifndef PLX_TWIN_GATHER_H
-#define PLX_TWIN_GATHER_H
+#ifndef PLX_TWIN_ENGINES_H
+#define PLX_TWIN_ENGINES_H
 
 #include <stddef.h>
 #include "cli.h"
@@ -24,7 +24,7 @@
 #define TWIN_MAX 7          /* twins at most: 8 engines */
 #define TWIN_MIN_POINTS 256 /* fewer points a call: on the engine alone */
 
-typedef struct twin_gather {
+typedef struct twin_set {
     const char *cmd, *scene;
     const cli_common *c;
     plx_engine *tw[TWIN_MAX];
@@ -33,7 +33,7 @@ typedef struct twin_gather {
     int tried;      /* the load was tried */
     int ran;        /* the most threads one call ran on (0: none yet) */
     int thread_warned; /* a thread could not be started: said once */
-} twin_gather;
+} twin_set;
 
 /* Sets up t for engine e, loaded by cli_open_scene from scene (kept
  * referenced, as c): twins for c->threads - 1 further threads, loaded on
@@ -41,7 +41,7 @@ typedef struct twin_gather {
  * --threads, one for each further processor while all the engines (each
  * about e's bytes in use) stay within half of the machine's memory (a
  * note on stderr when that leaves fewer). */
-void twin_gather_init(twin_gather *t, const char *cmd, const char *scene, const cli_common *c, plx_engine *e);
+void twin_set_init(twin_set *t, const char *cmd, const char *scene, const cli_common *c, plx_engine *e);
 
 /* Work on items [k0, k1) with engine e: a status (twin_work). */
 typedef plx_status (*twin_fn)(void *arg, plx_engine *e, size_t k0, size_t k1);
@@ -62,7 +62,7 @@ typedef struct twin_work {
  * lowest failed chunk (no chunk is handed out after a failure; *failed:
  * the engine whose plx_last_error says why), or PLX_E_RANGE with
  * range_soft when a chunk returned it. t NULL: on e alone. */
-plx_status twin_for(twin_gather *t, plx_engine *e, const twin_work *w, plx_engine **failed /* OUT */);
+plx_status twin_for(twin_set *t, plx_engine *e, const twin_work *w, plx_engine **failed /* OUT */);
 
 /* plx_illuminance(e, n, P, N, E_direct, E_indirect, NULL) (E_indirect
  * not NULL) with the points shared out in chunks between e and the
@@ -70,7 +70,7 @@ plx_status twin_for(twin_gather *t, plx_engine *e, const twin_work *w, plx_engin
  * range: its values NaN; with twins the engines' messages then name a
  * point by its place in a chunk, not in P) or another status, with
  * *failed the engine whose plx_last_error says why. */
-plx_status twin_illuminance(twin_gather *t, plx_engine *e, size_t n, const double *P, const double *N,
+plx_status twin_illuminance(twin_set *t, plx_engine *e, size_t n, const double *P, const double *N,
                             double *E_direct, double *E_indirect, plx_engine **failed /* OUT */);
 
 /* Of `want` twins, how many the default allows: all engines, each of
@@ -78,9 +78,9 @@ plx_status twin_illuminance(twin_gather *t, plx_engine *e, size_t n, const doubl
 int twin_fit(int want, unsigned long long each, unsigned long long machine);
 
 /* The most threads a call of twin_for ran on (1 when none had twins). */
-int twin_threads(const twin_gather *t);
+int twin_threads(const twin_set *t);
 
 /* Frees the twins. */
-void twin_gather_free(twin_gather *t);
+void twin_set_free(twin_set *t);
 
 #endif

@@ -1,9 +1,9 @@
-/* twin_gather: work over many items on the engine and its twins
- * (twin_gather.h). */
+/* twin_engines: work over many items on the engine and its twins
+ * (twin_engines.h). */
 #include <pthread.h>
 #include <string.h>
 
-#include "twin_gather.h"
+#include "twin_engines.h"
 #include "port.h"
 
 #define TWIN_CHUNK 32 /* points a thread takes at a time: gathers vary a lot in cost */
@@ -17,7 +17,7 @@ int twin_fit(int want, unsigned long long each, unsigned long long machine)
     return fit < 1 ? 0 : fit - 1 < (unsigned long long)want ? (int)(fit - 1) : want;
 }
 
-void twin_gather_init(twin_gather *t, const char *cmd, const char *scene, const cli_common *c, plx_engine *e)
+void twin_set_init(twin_set *t, const char *cmd, const char *scene, const cli_common *c, plx_engine *e)
 {
     int threads = c->threads > 0 ? c->threads : port_cores(NULL), allowed;
     unsigned long long each, machine;
@@ -46,7 +46,7 @@ void twin_gather_init(twin_gather *t, const char *cmd, const char *scene, const 
 
 /* The twins, loaded quietly (cli_open_twin); as many as load, and a
  * warning with the reason when fewer. */
-static void twins_load(twin_gather *t)
+static void twins_load(twin_set *t)
 {
     char why[512];
     why[0] = '\0';
@@ -109,7 +109,7 @@ static void *twin_run(void *p)
     }
 }
 
-plx_status twin_for(twin_gather *t, plx_engine *e, const twin_work *w, plx_engine **failed)
+plx_status twin_for(twin_set *t, plx_engine *e, const twin_work *w, plx_engine **failed)
 {
     pthread_t th[TWIN_MAX];
     twin_arg a[TWIN_MAX + 1];
@@ -164,7 +164,7 @@ static plx_status illum_chunk(void *arg, plx_engine *e, size_t k0, size_t k1)
     return plx_illuminance(e, k1 - k0, a->P + 3 * k0, a->N + 3 * k0, a->E + k0, a->Ei + k0, NULL);
 }
 
-plx_status twin_illuminance(twin_gather *t, plx_engine *e, size_t n, const double *P, const double *N,
+plx_status twin_illuminance(twin_set *t, plx_engine *e, size_t n, const double *P, const double *N,
                             double *E_direct, double *E_indirect, plx_engine **failed)
 {
     illum_arg a;
@@ -187,12 +187,12 @@ plx_status twin_illuminance(twin_gather *t, plx_engine *e, size_t n, const doubl
     return twin_for(t, e, &w, failed);
 }
 
-int twin_threads(const twin_gather *t)
+int twin_threads(const twin_set *t)
 {
     return t && t->ran > 1 ? t->ran : 1;
 }
 
-void twin_gather_free(twin_gather *t)
+void twin_set_free(twin_set *t)
 {
     int k;
     for (k = 0; k < t->n; k++)
