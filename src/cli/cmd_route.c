@@ -407,7 +407,7 @@ typedef struct spot_grid {
     size_t street;       /* street points of the grid (first pass) */
     double max_lux;      /* the brightest street point's lux, direct only unless exhaustive (first pass) */
     size_t gathered;     /* points whose indirect light was computed */
-    twin_set tg;      /* the gathers shared with the bake's twins (--threads) */
+    twin_set tg;         /* the gathers shared with the bake's twins (--threads) */
 } spot_grid;
 
 /* One pass's buffers: a strip of grid points. */

@@ -1,6 +1,7 @@
 /* twin_engines: work over many items on the engine and its twins
  * (twin_engines.h). */
 #include <pthread.h>
+#include <stdint.h>
 #include <string.h>
 
 #include "twin_engines.h"
@@ -26,7 +27,7 @@ void twin_set_init(twin_set *t, const char *cmd, const char *scene, const cli_co
     t->cmd = cmd;
     t->scene = scene;
     t->c = c;
-    if (threads > 1 && cli_is_bake(scene) && plx_indirect_frames(e) > 0)
+    if (threads > 1 && cli_bake_last.loaded && plx_indirect_frames(e) > 0) /* e came from a bake */
         t->want = threads - 1 < TWIN_MAX ? threads - 1 : TWIN_MAX;
     if (t->want == TWIN_MAX && c->threads > TWIN_MAX + 1)
         cli_warn(cmd, c, "--threads %d: this work runs on at most %d threads (a copy of the bake each)", c->threads,
@@ -58,94 +59,80 @@ static void twins_load(twin_set *t)
                  "working on %d thread%s", t->want - t->n, t->want, t->scene, why, t->n + 1, t->n ? "s" : "");
 }
 
-/* One call's items, taken `chunk` at a time by every thread. */
+/* One call's items, `chunk` a job of the port's parallel-for (worker w
+ * works with engine e[w]). */
 typedef struct twin_job {
     pthread_mutex_t mu;
-    size_t n, chunk, next, done;
-    twin_fn fn;
-    void *arg;
-    int range_soft;     /* PLX_E_RANGE of a chunk is kept in `range`, not a failure */
-    void (*progress)(void *arg, size_t done, size_t n);
+    plx_engine *e[TWIN_MAX + 1];
+    const twin_work *w;
+    size_t done;
     plx_status st;      /* the failure of the lowest chunk that failed (PLX_OK: none) */
     size_t st_at;       /* that chunk's first item */
     plx_engine *failed; /* its engine */
-    int range;
+    int range;          /* a chunk said PLX_E_RANGE (range_soft) */
+    int ran;            /* the highest worker that took a chunk, plus one */
 } twin_job;
 
-typedef struct twin_arg {
-    twin_job *j;
-    plx_engine *e;
-} twin_arg;
-
-/* Takes chunks until none is left or a failure stops the handing out
- * (chunks go out in order: every chunk before a failed one was taken). */
-static void *twin_run(void *p)
+/* Chunk k on worker's engine; skipped when a chunk before it has
+ * failed (one after a failed chunk still runs: the port hands the jobs
+ * out in order, but a chunk taken earlier may start after a later one
+ * failed, and it may fail too, lower). */
+static void twin_chunk(void *arg, int worker, uint32_t k)
 {
-    twin_arg *a = p;
-    twin_job *j = a->j;
-    for (;;) {
-        size_t k, m;
-        plx_status st;
-        pthread_mutex_lock(&j->mu);
-        k = j->next;
-        m = j->st == PLX_OK && k < j->n ? (j->n - k < j->chunk ? j->n - k : j->chunk) : 0;
-        j->next += m;
-        pthread_mutex_unlock(&j->mu);
-        if (m == 0)
-            return NULL;
-        st = j->fn(j->arg, a->e, k, k + m);
-        pthread_mutex_lock(&j->mu);
-        if (st == PLX_E_RANGE && j->range_soft) {
-            j->range = 1;
-        } else if (st != PLX_OK && (j->st == PLX_OK || k < j->st_at)) {
-            j->st = st;
-            j->st_at = k;
-            j->failed = a->e;
-        }
-        j->done += m;
-        if (j->progress)
-            j->progress(j->arg, j->done, j->n);
-        pthread_mutex_unlock(&j->mu);
+    twin_job *j = arg;
+    const twin_work *w = j->w;
+    size_t k0 = (size_t)k * w->chunk, k1 = w->n - k0 < w->chunk ? w->n : k0 + w->chunk;
+    plx_status st;
+    int skip;
+    pthread_mutex_lock(&j->mu);
+    skip = j->st != PLX_OK && j->st_at < k0;
+    j->ran = worker + 1 > j->ran ? worker + 1 : j->ran;
+    pthread_mutex_unlock(&j->mu);
+    if (skip)
+        return;
+    st = w->fn(w->arg, j->e[worker], k0, k1);
+    pthread_mutex_lock(&j->mu);
+    if (st == PLX_E_RANGE && w->range_soft) {
+        j->range = 1;
+    } else if (st != PLX_OK && (j->st == PLX_OK || k0 < j->st_at)) {
+        j->st = st;
+        j->st_at = k0;
+        j->failed = j->e[worker];
     }
+    j->done += k1 - k0;
+    if (w->progress)
+        w->progress(w->arg, j->done, w->n);
+    pthread_mutex_unlock(&j->mu);
 }
 
 plx_status twin_for(twin_set *t, plx_engine *e, const twin_work *w, plx_engine **failed)
 {
-    pthread_t th[TWIN_MAX];
-    twin_arg a[TWIN_MAX + 1];
-    int started[TWIN_MAX], k, nt, ran;
     twin_job j;
+    size_t chunks, c;
+    int k, nt;
     *failed = e;
+    if (w->n == 0)
+        return PLX_OK;
+    if (w->chunk == 0)
+        return w->fn(w->arg, e, 0, w->n);
     if (w->n >= w->min_items && t && t->want > 0 && !t->tried)
         twins_load(t);
     nt = w->n >= w->min_items && t ? t->n : 0;
+    chunks = (w->n + w->chunk - 1) / w->chunk;
     memset(&j, 0, sizeof j);
-    j.n = w->n;
-    j.chunk = w->chunk > 0 ? w->chunk : 1;
-    j.fn = w->fn;
-    j.arg = w->arg;
-    j.range_soft = w->range_soft;
-    j.progress = w->progress;
+    j.w = w;
     j.st = PLX_OK;
-    if (pthread_mutex_init(&j.mu, NULL) != 0) /* no lock: one call on the engine */
-        return w->n > 0 ? w->fn(w->arg, e, 0, w->n) : PLX_OK;
-    for (k = 0; k <= nt; k++) {
-        a[k].j = &j;
-        a[k].e = k == 0 ? e : t->tw[k - 1];
-    }
-    for (k = 0, ran = 1; k < nt; k++)
-        ran += started[k] = pthread_create(&th[k], NULL, twin_run, &a[k + 1]) == 0;
-    if (ran < nt + 1 && !t->thread_warned) {
-        t->thread_warned = 1;
-        cli_warn(t->cmd, t->c, "%d of %d threads could not be started: working on %d", nt + 1 - ran, nt + 1, ran);
-    }
-    twin_run(&a[0]);
+    j.e[0] = e;
     for (k = 0; k < nt; k++)
-        if (started[k])
-            pthread_join(th[k], NULL);
-    if (t && ran > t->ran)
-        t->ran = ran;
+        j.e[k + 1] = t->tw[k];
+    if (chunks > UINT32_MAX || pthread_mutex_init(&j.mu, NULL) != 0)
+        return w->fn(w->arg, e, 0, w->n); /* one call on the engine */
+    if (port_parallel_for(NULL, nt + 1, (uint32_t)chunks, twin_chunk, &j) != 0)
+        for (c = 0; c < chunks; c++) /* the port could not run it: here, on e */
+            twin_chunk(&j, 0, (uint32_t)c);
     pthread_mutex_destroy(&j.mu);
+    if (t && j.ran > t->ran)
+        t->ran = j.ran;
     if (j.st != PLX_OK) {
         *failed = j.failed;
         return j.st;

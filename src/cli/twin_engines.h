@@ -32,12 +32,12 @@ typedef struct twin_set {
     int want;       /* twins to load on first need (0: none) */
     int tried;      /* the load was tried */
     int ran;        /* the most threads one call ran on (0: none yet) */
-    int thread_warned; /* a thread could not be started: said once */
 } twin_set;
 
-/* Sets up t for engine e, loaded by cli_open_scene from scene (kept
- * referenced, as c): twins for c->threads - 1 further threads, loaded on
- * first need, when scene is a bake and e has photon frames. Without
+/* Sets up t for engine e, loaded by the last cli_open_scene from scene
+ * (kept referenced, as c): twins for c->threads - 1 further threads,
+ * loaded on first need, when scene was a bake (cli_bake_last) and e has
+ * photon frames. Without
  * --threads, one for each further processor while all the engines (each
  * about e's bytes in use) stay within half of the machine's memory (a
  * note on stderr when that leaves fewer). */
@@ -56,10 +56,11 @@ typedef struct twin_work {
     void (*progress)(void *arg, size_t done, size_t n); /* after each chunk (under a lock), or NULL */
 } twin_work;
 
-/* w->fn over items [0, w->n) in chunks taken by e's thread and a thread
- * per twin (loaded on first need), each with its own engine; the items
+/* w->fn over items [0, w->n) in chunks, jobs of the port's parallel-for
+ * (port_parallel_for: e's thread and a worker per twin, the twins
+ * loaded on first need), each worker with its own engine; the items
  * must not depend on one another. Returns PLX_OK, the status of the
- * lowest failed chunk (no chunk is handed out after a failure; *failed:
+ * lowest failed chunk (chunks after it are skipped once it fails; *failed:
  * the engine whose plx_last_error says why), or PLX_E_RANGE with
  * range_soft when a chunk returned it. t NULL: on e alone. */
 plx_status twin_for(twin_set *t, plx_engine *e, const twin_work *w, plx_engine **failed /* OUT */);
