@@ -1026,7 +1026,7 @@ static void test_layout(void **state)
  * not that layout's is refused with the arena where it was. */
 static void test_create_counted(void **state)
 {
-    if (getenv("PLX_TEST_QUICK")) /* seconds: check-full (CI) runs it, make check keeps its minute */
+    if (quick()) /* seconds: check-full (CI) runs it, make check keeps its minute */
         skip();
     world w;
     atlas *A = NULL, *B = NULL;
@@ -2286,7 +2286,7 @@ static void runs_check(world *w, double fine, int nframes, rng *r, long *runs)
 
 static void test_runs_equal_lanes(void **state)
 {
-    if (getenv("PLX_TEST_QUICK")) /* seconds: check-full (CI) runs it, make check keeps its minute */
+    if (quick()) /* seconds: check-full (CI) runs it, make check keeps its minute */
         skip();
     rng r = { 0x5eed81u };
     world w;
@@ -2698,7 +2698,7 @@ static void test_atlas_faults_no_budget(void **state)
  * with PLX_OK. */
 static void test_frame_faults(void **state)
 {
-    if (getenv("PLX_TEST_QUICK")) /* seconds: check-full (CI) runs it, make check keeps its minute */
+    if (quick()) /* seconds: check-full (CI) runs it, make check keeps its minute */
         skip();
     static float ref[FW * FH * 3], pp[FW * FH * 3], img[FW * FH * 3];
     const double eye[3] = { 200, 250, 60 };
@@ -2839,7 +2839,7 @@ static void acc_hook(void *user, const atlas_chart *c, uint32_t sid, const doubl
  * atlas_ind: a wall's own facade chart, else the buffers' lookup). */
 static void test_indirect_accuracy(void **state)
 {
-    if (getenv("PLX_TEST_QUICK")) /* seconds: check-full (CI) runs it, make check keeps its minute */
+    if (quick()) /* seconds: check-full (CI) runs it, make check keeps its minute */
         skip();
     const double eye[3] = { 298.6, 265.5, 1.7 }, tg[3] = { 261.8, 302.3, 3.0 };
     int paths = quick() ? 4000 : 8000, maxn = quick() ? 20 : 60, n = 0, i, j, k, walls = 0;

@@ -355,7 +355,7 @@ static void test_image_after_aerial_same_bytes(void **state)
  * time). */
 static void test_peek_same_bits(void **state)
 {
-    if (getenv("PLX_TEST_QUICK")) /* seconds: check-full (CI) runs it, make check keeps its minute */
+    if (quick_mode()) /* seconds: check-full (CI) runs it, make check keeps its minute */
         skip();
     plx_engine *e = fixture_new((size_t)1 << 30, "fixtures/eixample-4x4.geojson", NULL, 0);
     size_t tab = (size_t)ICACHE_RECORDS * 32;

@@ -1362,7 +1362,7 @@ static void kinds_vs_paths(plx_engine *e, uint32_t res, int want, int paths, dou
 
 static void test_coarse_charts(void **state)
 {
-    if (getenv("PLX_TEST_QUICK")) /* seconds: check-full (CI) runs it, make check keeps its minute */
+    if (quick_mode()) /* seconds: check-full (CI) runs it, make check keeps its minute */
         skip();
     void *mem;
     plx_engine *e = open_fixture("fixtures/eixample-4x4.geojson", &mem, 512u << 20);
