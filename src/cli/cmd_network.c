@@ -160,9 +160,10 @@ static int parse_point(plx_engine *e, const char *s, double *x, double *y)
     return cli_to_local(e, x, y);
 }
 
-/* Loads the network and scores its edges; prints the error and returns an
- * exit code on failure. */
-static int load_network(const net_opts *o, plx_engine *e, network *net)
+/* Loads the network and scores its edges (all: every edge; else none yet,
+ * for net_score_route); prints the error and returns an exit code on
+ * failure. */
+static int load_network(const net_opts *o, plx_engine *e, network *net, int all)
 {
     route_set rs;
     char err[512];
@@ -178,6 +179,10 @@ static int load_network(const net_opts *o, plx_engine *e, network *net)
     if (net_build(net, &rs, err, sizeof err) != 0) {
         fprintf(stderr, "polarlux %s: %s: %s\n", o->cmd, o->network, err);
         return EXIT_FAIL;
+    }
+    if (!all) {
+        net_set_scoring(net, o->step, o->dark, o->height);
+        return EXIT_OK;
     }
     twin_set_init(&tg, o->cmd, o->scene, &o->c, e);
     st = net_score(net, e, &tg, o->step, o->dark, o->height, 1, &failed);
@@ -319,6 +324,29 @@ static int snap_end(const net_opts *o, plx_engine *e, const network *net, const 
     return EXIT_OK;
 }
 
+/* The edges the routes from a to b can take scored (net_score_route), on
+ * twins of a bake as annotate's; an exit code. */
+static int score_route_edges(const net_opts *o, plx_engine *e, network *net, const net_snap *a, const net_snap *b)
+{
+    twin_set tg;
+    plx_engine *failed;
+    size_t n;
+    plx_status st;
+    twin_set_init(&tg, o->cmd, o->scene, &o->c, e);
+    st = net_score_route(net, e, &tg, a, b, o->weight, 1, &n, &failed);
+    if (!o->c.quiet && n > 0) {
+        fprintf(stderr, "polarlux %s: note: %zu of the %u edges scored (those a walk from --from to --to no longer "
+                        "than the shortest route's cost can take)", o->cmd, n, net->nedges);
+        if (twin_threads(&tg) > 1)
+            fprintf(stderr, ", on %d threads, each with its own copy of the bake", twin_threads(&tg));
+        fputc('\n', stderr);
+    }
+    if (st != PLX_OK)
+        fprintf(stderr, "polarlux %s: %s: scoring the edges: %s\n", o->cmd, o->network, plx_last_error(failed));
+    twin_set_free(&tg);
+    return st == PLX_OK ? EXIT_OK : cli_exit_code(st);
+}
+
 static int find_routes(const net_opts *o, plx_engine *e, network *net)
 {
     net_snap a, b;
@@ -328,6 +356,8 @@ static int find_routes(const net_opts *o, plx_engine *e, network *net)
     int rc = snap_end(o, e, net, "--from", o->from_s, &a), r1, r2;
     if (rc == EXIT_OK)
         rc = snap_end(o, e, net, "--to", o->to_s, &b);
+    if (rc == EXIT_OK)
+        rc = score_route_edges(o, e, net, &a, &b);
     if (rc != EXIT_OK)
         return rc;
     r1 = net_route_find(net, e, &a, &b, 0.0, &shortest, err, sizeof err);
@@ -394,7 +424,7 @@ int cmd_route_network(int argc, char **argv)
     rc = cli_open_scene("route", o.scene, &o.c, &e);
     if (rc != EXIT_OK)
         return rc;
-    rc = load_network(&o, e, &net);
+    rc = load_network(&o, e, &net, 0);
     if (rc == EXIT_OK) {
         rc = find_routes(&o, e, &net);
         net_free(&net);
@@ -595,7 +625,7 @@ int cmd_annotate(int argc, char **argv)
     rc = cli_open_scene("annotate", o.scene, &o.c, &e);
     if (rc != EXIT_OK)
         return rc;
-    rc = load_network(&o, e, &net);
+    rc = load_network(&o, e, &net, 1);
     if (rc == EXIT_OK) {
         double dark = 0, len = 0;
         uint32_t i;

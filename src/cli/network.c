@@ -150,7 +150,8 @@ static int alloc_search(network *net)
     net->dist = malloc(sizeof *net->dist * n);
     net->prev = malloc(sizeof *net->prev * n);
     net->heap = malloc(2 * sizeof(double) * net->heap_cap);
-    return net->dist && net->prev && net->heap ? 0 : -1;
+    net->scored = calloc((size_t)net->nedges + 1, 1);
+    return net->dist && net->prev && net->heap && net->scored ? 0 : -1;
 }
 
 int net_build(network *net, route_set *lines, char *err, size_t errlen)
@@ -187,17 +188,19 @@ int net_build(network *net, route_set *lines, char *err, size_t errlen)
 
 typedef struct score_job {
     network *net;
+    const uint32_t *list;  /* the edges to score (NULL: every edge, in order) */
     int progress;          /* on a terminal: the share done, in steps of 5% */
     uint32_t shown;
 } score_job;
 
-/* Edges [k0, k1) scored with engine e. */
+/* Edges list[k0 .. k1) (or k0 .. k1) scored with engine e. */
 static plx_status score_edges(void *arg, plx_engine *e, size_t k0, size_t k1)
 {
     score_job *j = arg;
     network *net = j->net;
-    size_t i;
-    for (i = k0; i < k1; i++) {
+    size_t k;
+    for (k = k0; k < k1; k++) {
+        size_t i = j->list ? j->list[k] : k;
         net_edge *ed = &net->edges[i];
         const route_line *l = &net->lines.lines[ed->line];
         plx_status st = plx_route_score(e, l->xy + 2 * ed->v0, ed->v1 - ed->v0 + 1, net->step, net->dark_lux,
@@ -208,6 +211,7 @@ static plx_status score_edges(void *arg, plx_engine *e, size_t k0, size_t k1)
         if (st != PLX_OK)
             return st;
         ed->dark = ed->s.dark_share * ed->s.length;
+        net->scored[i] = 1;
     }
     return PLX_OK;
 }
@@ -221,29 +225,43 @@ static void score_progress(void *arg, size_t done, size_t n)
     }
 }
 
-plx_status net_score(network *net, plx_engine *e, twin_set *tg, double step, double dark_lux, double height,
-                     int progress, plx_engine **failed)
+/* The n edges of list (NULL: every edge) scored on e and tg's twins. */
+static plx_status score_list(network *net, plx_engine *e, twin_set *tg, const uint32_t *list, size_t n,
+                             int progress, plx_engine **failed)
 {
     score_job j;
     twin_work w;
     plx_status st;
-    net->step = step;
-    net->dark_lux = dark_lux;
-    net->height = height;
     j.net = net;
+    j.list = list;
     j.progress = progress && isatty(2);
     j.shown = 0;
     memset(&w, 0, sizeof w);
-    w.n = net->nedges;
+    w.n = n;
     w.chunk = NET_CHUNK;
     w.min_items = NET_MIN_EDGES;
     w.fn = score_edges;
     w.arg = &j;
     w.progress = score_progress;
-    st = twin_for(tg, e, &w, failed);
+    *failed = e;
+    st = n > 0 ? twin_for(tg, e, &w, failed) : PLX_OK;
     if (j.progress && j.shown)
         fprintf(stderr, "\n");
     return st;
+}
+
+void net_set_scoring(network *net, double step, double dark_lux, double height)
+{
+    net->step = step;
+    net->dark_lux = dark_lux;
+    net->height = height;
+}
+
+plx_status net_score(network *net, plx_engine *e, twin_set *tg, double step, double dark_lux, double height,
+                     int progress, plx_engine **failed)
+{
+    net_set_scoring(net, step, dark_lux, height);
+    return score_list(net, e, tg, NULL, net->nedges, progress, failed);
 }
 
 void net_free(network *net)
@@ -256,6 +274,7 @@ void net_free(network *net)
     free(net->dist);
     free(net->prev);
     free(net->heap);
+    free(net->scored);
     memset(net, 0, sizeof *net);
 }
 
@@ -396,16 +415,24 @@ static void free_pieces(query *q)
         free(q->piece[i].xy);
 }
 
-/* A binary min-heap of nodes keyed by net->dist at push time (lazy). */
+/* A binary min-heap of nodes keyed by net->dist at push time (lazy),
+ * equal keys by node number: the order nodes are settled in, and so the
+ * route among routes of equal cost, depends only on their distances, not
+ * on which other nodes the search pushed (net_score_route). */
 typedef struct hentry {
     double d;
     uint32_t node;
 } hentry;
 
+static int hless(double d, uint32_t node, const hentry *b)
+{
+    return d < b->d || (d == b->d && node < b->node);
+}
+
 static void heap_push(hentry *h, size_t *n, double d, uint32_t node)
 {
     size_t i = (*n)++;
-    while (i > 0 && h[(i - 1) / 2].d > d) {
+    while (i > 0 && hless(d, node, &h[(i - 1) / 2])) {
         h[i] = h[(i - 1) / 2];
         i = (i - 1) / 2;
     }
@@ -421,9 +448,9 @@ static hentry heap_pop(hentry *h, size_t *n)
         size_t c = 2 * i + 1;
         if (c >= *n)
             break;
-        if (c + 1 < *n && h[c + 1].d < h[c].d)
+        if (c + 1 < *n && hless(h[c + 1].d, h[c + 1].node, &h[c]))
             c++;
-        if (h[c].d >= last.d)
+        if (!hless(h[c].d, h[c].node, &last))
             break;
         h[i] = h[c];
         i = c;
@@ -444,7 +471,8 @@ static void relax(network *net, hentry *h, size_t *nh, uint32_t u, uint32_t x, d
     }
 }
 
-static void dijkstra(network *net, const query *q, double weight, hentry *h)
+/* From q->S until q->T is settled (every node with all: net->dist, net->prev). */
+static void dijkstra(network *net, const query *q, double weight, hentry *h, int all)
 {
     uint32_t i, n = net->nnodes + 2;
     size_t nh = 0;
@@ -459,13 +487,15 @@ static void dijkstra(network *net, const query *q, double weight, hentry *h)
         uint32_t u = top.node, j;
         if (top.d > net->dist[u])
             continue;
-        if (u == q->T)
+        if (u == q->T && !all)
             break;
         if (u < net->nnodes)
             for (j = net->adj_first[u]; j < net->adj_first[u + 1]; j++) {
                 const net_edge *ed = &net->edges[net->adj[j]];
-                relax(net, h, &nh, u, net->adj[j], edge_cost(ed->length, ed->dark, &ed->s, weight),
-                      ed->a == u ? ed->b : ed->a);
+                /* an edge left unscored (net_score_route) is one no route at this weight takes */
+                double c = net->scored[net->adj[j]] || weight == 0.0 ? edge_cost(ed->length, ed->dark, &ed->s, weight)
+                                                                     : INFINITY;
+                relax(net, h, &nh, u, net->adj[j], c, ed->a == u ? ed->b : ed->a);
             }
         for (j = 0; j < q->npiece; j++) {
             const walk_edge *w = &q->piece[j];
@@ -566,7 +596,7 @@ int net_route_find(network *net, plx_engine *e, const net_snap *a, const net_sna
         free_pieces(&q);
         return -1;
     }
-    dijkstra(net, &q, weight, (hentry *)net->heap);
+    dijkstra(net, &q, weight, (hentry *)net->heap, 0);
     if (net->dist[q.T] == INFINITY) {
         rc = 1;
     } else if (collect(net, &q, out) != 0) {
@@ -585,6 +615,112 @@ int net_route_find(network *net, plx_engine *e, const net_snap *a, const net_sna
     }
     free_pieces(&q);
     return rc;
+}
+
+/* The node at the other end of edge or piece x from v. */
+static uint32_t other_end(const network *net, const query *q, uint32_t x, uint32_t v)
+{
+    const walk_edge *w = x >= net->nedges ? &q->piece[x - net->nedges] : NULL;
+    if (w)
+        return w->u == v ? w->v : w->u;
+    return net->edges[x].a == v ? net->edges[x].b : net->edges[x].a;
+}
+
+/* The edges (not the pieces) of the route net->prev holds from q->T back to
+ * q->S into list; their number. */
+static size_t path_edges(const network *net, const query *q, uint32_t *list)
+{
+    uint32_t v = q->T;
+    size_t n = 0;
+    while (v != q->S) {
+        uint32_t x = net->prev[v];
+        if (x < net->nedges)
+            list[n++] = x;
+        v = other_end(net, q, x, v);
+    }
+    return n;
+}
+
+/* That route's cost at weight, its edges scored. */
+static double path_cost(const network *net, const query *q, double weight)
+{
+    uint32_t v = q->T;
+    double c = 0.0;
+    while (v != q->S) {
+        uint32_t x = net->prev[v];
+        if (x >= net->nedges) {
+            const walk_edge *w = &q->piece[x - net->nedges];
+            c += edge_cost(w->length, w->dark, &w->s, weight);
+        } else {
+            const net_edge *ed = &net->edges[x];
+            c += edge_cost(ed->length, ed->dark, &ed->s, weight);
+        }
+        v = other_end(net, q, x, v);
+    }
+    return c;
+}
+
+/* The unscored edges of list[0 .. n) kept, in order; their number. */
+static size_t unscored(const network *net, uint32_t *list, size_t n)
+{
+    size_t i, m = 0;
+    for (i = 0; i < n; i++)
+        if (!net->scored[list[i]])
+            list[m++] = list[i];
+    return m;
+}
+
+plx_status net_score_route(network *net, plx_engine *e, twin_set *tg, const net_snap *a, const net_snap *b,
+                           double weight, int progress, size_t *nscored, plx_engine **failed)
+{
+    query q, back;
+    uint32_t *list = malloc(sizeof *list * ((size_t)net->nedges + 1)), i;
+    double *ds = malloc(sizeof *ds * ((size_t)net->nnodes + 2)), bound;
+    size_t n = 0;
+    plx_status st = PLX_OK;
+    *failed = e;
+    *nscored = 0;
+    memset(&q, 0, sizeof q);
+    if (!list || !ds) {
+        st = PLX_E_NOMEM;
+        goto done;
+    }
+    /* the ends' pieces failing to score: net_route_find says so */
+    if (make_pieces(net, e, a, b, 0.0, &q) != 0)
+        goto done;
+    /* the shortest route (no score needed) and every node's length from --from */
+    dijkstra(net, &q, 0.0, (hentry *)net->heap, 1);
+    if (net->dist[q.T] == INFINITY) /* unconnected: net_route_find says so */
+        goto done;
+    memcpy(ds, net->dist, sizeof *ds * ((size_t)net->nnodes + 2));
+    n = unscored(net, list, path_edges(net, &q, list));
+    st = score_list(net, e, tg, list, n, 0, failed);
+    *nscored += n;
+    if (st != PLX_OK)
+        goto done;
+    /* no route of a lower weight costs more than the shortest does at this
+     * one, and none is longer than its cost: an edge on such a route lies
+     * within that length of walking from --from through it to --to (a
+     * margin for the sums' rounding) */
+    bound = path_cost(net, &q, weight);
+    bound += bound * 1e-9 + 1e-6;
+    back = q;
+    back.S = q.T;
+    back.T = q.S;
+    dijkstra(net, &back, 0.0, (hentry *)net->heap, 1); /* net->dist: every node's length to --to */
+    for (i = 0, n = 0; i < net->nedges; i++) {
+        const net_edge *ed = &net->edges[i];
+        double via = fmin(ds[ed->a] + ed->length + net->dist[ed->b], ds[ed->b] + ed->length + net->dist[ed->a]);
+        if (!net->scored[i] && via <= bound)
+            list[n++] = i;
+    }
+    st = score_list(net, e, tg, list, n, progress, failed);
+    *nscored += n;
+done:
+    free_pieces(&q);
+    free(list);
+    free(ds);
+    return st;
 }
 
 void net_route_free(net_route *r)

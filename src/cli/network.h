@@ -38,6 +38,7 @@ typedef struct network {
     uint32_t *prev;
     void *heap;             /* heap_cap entries of the search's priority queue */
     size_t heap_cap;
+    uint8_t *scored;        /* per edge: scored (net_score, net_score_route) */
 } network;
 
 /* Builds the graph from lines (taking them over: they are freed by
@@ -51,6 +52,9 @@ int net_build(network *net, route_set *lines, char *err, size_t errlen);
  * why. */
 plx_status net_score(network *net, plx_engine *e, twin_set *tg, double step, double dark_lux, double height,
                      int progress, plx_engine **failed /* OUT */);
+/* How edges are scored (net_score's step, dark_lux and height), for
+ * net_score_route. */
+void net_set_scoring(network *net, double step, double dark_lux, double height);
 void net_free(network *net);
 
 /* A route: its edges and the sums over them. min_ev and min_esc are the
@@ -82,6 +86,19 @@ int net_snap_point(const network *net, double x, double y, net_snap *out);
 int net_route_find(network *net, plx_engine *e, const net_snap *a, const net_snap *b, double weight,
                    net_route *out, char *err, size_t errlen);
 void net_route_free(net_route *r);
+
+/* Scores only the edges a route from a to b at any weight up to 'weight'
+ * can take (net_set_scoring's settings; e and tg's twins as net_score):
+ * the shortest route's, then every edge with a walk from a through it to
+ * b no longer than that route's cost at 'weight' (no cheaper route is
+ * longer than its cost). The searches after it leave the rest out at
+ * weights above 0 and find the routes, and their sums, that scoring every
+ * edge gives (equal costs settled by node number). *nscored: the edges
+ * scored. A plx_status, *failed as net_score's; unconnected ends, or ends
+ * whose pieces fail to score, score nothing and return PLX_OK
+ * (net_route_find then says why). */
+plx_status net_score_route(network *net, plx_engine *e, twin_set *tg, const net_snap *a, const net_snap *b,
+                           double weight, int progress, size_t *nscored /* OUT */, plx_engine **failed /* OUT */);
 
 /* The number of connected parts of the network (for messages). */
 uint32_t net_components(const network *net);

@@ -15,6 +15,11 @@ expect net-empty 1 "route: $tmp/empty-net\.json: no LineString features" -- "$bi
 expect net-missing-to 2 "--network needs --from X,Y and --to X,Y" -- "$bin" route -q $net --from 0,0
 expect net-help 0 "cost = length \+ W x dark metres" -- "$bin" route --network x --help
 expect net-helsinki 0 "^cost = length .*network [0-9]+ nodes, [0-9]+ edges" -- "$bin" route -q fixtures/helsinki-centre.geojson --network fixtures/helsinki-streets.geojson --from 24.9400,60.1660 --to 24.9480,60.1770
+# route scores only the edges a route can take: the lit Esplanadi's 506.5 m walk needs 30 of the 4,717
+# (the same routes and sums as scoring all: test_network's test_route_scoring_against_every_edge)
+esp="fixtures/helsinki-centre.geojson --network fixtures/helsinki-streets.geojson --from 24.9432847,60.1676957 --to 24.9524231,60.1678992"
+expect net-helsinki-edges-scored 0 "^polarlux route: note: 30 of the 4717 edges scored \(those a walk from --from to --to no longer than the shortest route's cost can take\)$" -- "$bin" route $esp
+expect net-helsinki-lit-route 0 "^best-lit +506\.5 +0\.0 +3\.402 +18\.758 +0\.022 +1\.358  P1 " -- "$bin" route -q $esp
 expect annotate 0 "^annotate: 6 edges, 6 nodes, 570 m of street" -- "$bin" annotate -q $net -o "$tmp/ann.geojson" --csv "$tmp/ann.csv"
 expect annotate-csv 0 "^way/2,300\.000,69\.000,0\.000,0\.2300,9\.4414,0\.0000,-,1\.6900,0\.0000,0\.0000,-$" -- cat "$tmp/ann.csv"
 expect annotate-csv-head 0 "^osm_id,length_m,dark_m,blocked_m,dark_share,mean_lux,min_lux,class,factor,min_ev_lux,min_sc_lux,class_h$" -- cat "$tmp/ann.csv"

@@ -430,6 +430,83 @@ static void test_random_grids_against_bellman_ford(void **state)
     assert_true(unreached > 0);
 }
 
+/* Two routes the same bytes: polyline and every sum. */
+static void assert_same_route(const net_route *x, const net_route *y)
+{
+    assert_int_equal(x->n, y->n);
+    assert_memory_equal(x->xy, y->xy, sizeof *x->xy * 2 * x->n);
+    assert_memory_equal(&x->length, &y->length, sizeof x->length);
+    assert_memory_equal(&x->dark, &y->dark, sizeof x->dark);
+    assert_memory_equal(&x->blocked, &y->blocked, sizeof x->blocked);
+    assert_memory_equal(&x->integral, &y->integral, sizeof x->integral);
+    assert_memory_equal(&x->min, &y->min, sizeof x->min);
+    assert_memory_equal(&x->cost, &y->cost, sizeof x->cost);
+    assert_memory_equal(&x->min_esc, &y->min_esc, sizeof x->min_esc);
+    assert_int_equal(x->p_class, y->p_class);
+}
+
+/* net_score_route against scoring every edge, on the random grids (20 m
+ * apart: many routes of exactly equal cost): for ends snapped anywhere on
+ * the streets and weights up to the one it was given, the same routes to
+ * the byte, its edges the same scores, and fewer edges scored where the
+ * shortest route is cheap. */
+static void test_route_scoring_against_every_edge(void **state)
+{
+    int seed, rounds = getenv("PLX_TEST_QUICK") ? 6 : 30, fewer = 0, compared = 0;
+    static const double weights[5] = { 0.0, 0.05, 0.3, 4.0, 1e6 };
+    plx_engine *failed;
+    (void)state;
+    for (seed = 0; seed < rounds; seed++) {
+        void *mem;
+        char *scene = grid_scene(seed), err[256];
+        plx_engine *e = load_text(scene, &mem);
+        network all, some;
+        route_set rs;
+        uint32_t q, i;
+        grid_lines(seed, &rs);
+        assert_int_equal(net_build(&all, &rs, err, sizeof err), 0);
+        assert_int_equal(net_score(&all, e, NULL, 1.0, 1.0, 1.5, 0, &failed), PLX_OK);
+        for (q = 0; q < 10; q++) {
+            double w = weights[q % 5];
+            net_snap a, b;
+            size_t n;
+            int k;
+            grid_lines(seed, &rs);
+            assert_int_equal(net_build(&some, &rs, err, sizeof err), 0);
+            net_set_scoring(&some, 1.0, 1.0, 1.5);
+            snap(&all, rnd() * 110 - 5, rnd() * 110 - 5, &a);
+            snap(&all, rnd() * 110 - 5, rnd() * 110 - 5, &b);
+            assert_int_equal(net_score_route(&some, e, NULL, &a, &b, w, 0, &n, &failed), PLX_OK);
+            fewer += w > 0 && n < some.nedges; /* weighted searches that leave edges out */
+            for (i = 0; i < some.nedges; i++)
+                if (some.scored[i]) {
+                    assert_memory_equal(&some.edges[i].s, &all.edges[i].s, sizeof all.edges[i].s);
+                    assert_memory_equal(some.edges[i].fac, all.edges[i].fac, sizeof all.edges[i].fac);
+                }
+            for (k = 0; k < 4; k++) { /* the weight asked for and below (route's --max-detour bisection) */
+                double wk = w * (k == 0 ? 1.0 : k == 1 ? 0.5 : k == 2 ? 0.123 : 0.0);
+                net_route x, y;
+                int rx = net_route_find(&all, e, &a, &b, wk, &x, err, sizeof err);
+                int ry = net_route_find(&some, e, &a, &b, wk, &y, err, sizeof err);
+                assert_int_equal(rx, ry);
+                if (rx != 0)
+                    continue;
+                assert_same_route(&x, &y);
+                compared++;
+                net_route_free(&x);
+                net_route_free(&y);
+            }
+            net_free(&some);
+        }
+        net_free(&all);
+        plx_engine_destroy(e);
+        free(mem);
+        free(scene);
+    }
+    assert_true(compared > 100);
+    assert_true(fewer > 5);
+}
+
 static void test_snap_and_empty(void **state)
 {
     void *mem;
@@ -576,6 +653,7 @@ int main(void)
         cmocka_unit_test(test_route_equals_its_polyline),
         cmocka_unit_test(test_class_depends_on_facial_criterion),
         cmocka_unit_test(test_random_grids_against_bellman_ford),
+        cmocka_unit_test(test_route_scoring_against_every_edge),
         cmocka_unit_test(test_snap_and_empty),
         cmocka_unit_test(test_twin_for),
     };
