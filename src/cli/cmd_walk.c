@@ -15,7 +15,7 @@
 
 static const char help[] =
     "usage: polarlux walk SCENE|BAKE --path CAMERA.geojson -o DIR [--size WxH] [--fps F]\n"
-    "                     [--speed M/S] [--fov DEG] [--aa N [--aa-full]]\n"
+    "                     [--speed M/S] [--fov DEG] [--pitch DEG] [--aa N [--aa-full]]\n"
     "                     [--exposure E [--tone-curve]] [--no-adapt] [--no-glow]\n"
     "                     [--no-indirect] [--per-pixel] [--view street|aerial]\n"
     "                     [--max-frames N] [--texel M] [--threads N] [--photons N] [--frames K]\n"
@@ -31,7 +31,7 @@ static const char help[] =
     "reused by every frame: with indirect light each frame reads the radiance\n"
     "atlas (see render), filled as the frames need it or held by the bake.\n"
     "Prints the render time per frame (median, p95) and frames per second, and on\n"
-    "stderr how many frames are entirely black, if any, and whether the frames\n"
+    "stderr how many frames are entirely black and whether the frames\n"
     "render slower than --fps; on a terminal, a walk of more than a second shows\n"
     "the share of its frames done as it goes.\n"
     "\n"
@@ -40,6 +40,7 @@ static const char help[] =
     "                   or at properties.targets (one [x, y] or [x, y, z] per\n"
     "                   position, z default 1.7 m, in the positions' coordinates);\n"
     "                   '-': standard input\n"
+    "  --pitch DEG      no targets: look DEG (0-89) degrees down the path (default 0)\n"
     "  --size WxH       frame size (default 640x480)\n"
     "  --fps F          frames per second of the walk (default 25)\n"
     "  --speed M/S      walking speed along the path (default 1.4)\n"
@@ -70,7 +71,7 @@ static const char help[] =
     "                   the ground (default 60; munoz2013 §3.3 refines low views\n"
     "                   only: from higher up a miss costs a slow frame for lamps\n"
     "                   the view hardly shows)\n"
-    "  --threads N      threads for each frame (default: the number of processors);\n"
+    "  --threads N      threads for each frame (default: the processors);\n"
     "                   the same bytes for any N\n"
     "  --mem SIZE, --strict, --quiet, --lamps FILE   as for 'polarlux info'\n";
 
@@ -82,6 +83,8 @@ typedef struct walk_args {
     long refine_frames;
     long max_frames;
     double fps, speed, fov;
+    double pitch;              /* --pitch, degrees below level (no targets) */
+    int pitch_set;
     plx_render_opts opts;
     cli_common c;
     cli_indirect ind;
@@ -91,6 +94,11 @@ static int parse_rate(const char *val, void *dst)
 {
     double *v = dst;
     return cli_parse_double(val, v) != 0 || !(*v > 0) || *v > 1e4 ? -1 : 0;
+}
+
+static int parse_pitch(const char *val, void *dst)
+{
+    return cli_parse_real(val, 0.0, 89.0, dst);
 }
 
 static int parse_texel(const char *val, void *dst)
@@ -124,6 +132,8 @@ static int parse_args(int argc, char **argv, walk_args *a)
         CLI_OPT_VAL("--max-frames", &a->max_frames, parse_max_frames,
                     "--max-frames '%s' is not a whole number from 1 to 1000000"),
         CLI_OPT_FLAG("--no-adapt", &a->no_adapt),
+        { "--pitch", NULL, &a->pitch, parse_pitch, "--pitch '%s' is not a number of degrees from 0 to 89", 0, NULL,
+          &a->pitch_set, NULL },
         CLI_OPT_VAL("--texel", &a->opts.aerial_m_per_texel, parse_texel,
                     "--texel '%s' is not a number of metres from 0.01 to 1e4"),
         CLI_OPT_MORE(v.frag),
@@ -629,10 +639,10 @@ static void view_hint(const walk_args *a, const walk_path *wp)
     uint32_t k;
     for (k = 0; k < wp->n; k++)
         zmax = fmax(zmax, wp->eye[3 * k + 2]);
-    if (!wp->target && zmax >= WALK_HIGH) /* a flight's frames of sky: said whatever the view */
+    if (!wp->target && !(a->pitch > 0.0) && zmax >= WALK_HIGH) /* a flight's frames of sky: said whatever the view */
         cli_warn("walk", &a->c, "the eye rises to %.0f m and looks level, 10 m ahead along the path at its own "
-                 "height: the city is below those frames; properties.targets (one [x, y, z] a position) aim "
-                 "the camera down", zmax);
+                 "height: the city is below those frames; --pitch DEG looks down along the path, "
+                 "properties.targets (one [x, y, z] a position) aim the camera", zmax);
     if (a->aerial || (!a->ind.off && !a->opts.per_pixel))
         return;
     for (k = 0; k < wp->n; k++)
@@ -883,6 +893,10 @@ int cmd_walk(int argc, char **argv)
     if (wp.lines > 1)
         cli_warn("walk", &a.c, "%s holds %u line features: the walk follows the first LineString (%.1f m), the "
                  "others are left out", a.path, wp.lines, walk_path_length(&wp));
+    if (a.pitch_set && wp.target)
+        cli_warn("walk", &a.c, "--pitch has no effect: %s has properties.targets, which aim the camera", a.path);
+    else
+        wp.pitch_tan = tan(a.pitch * (3.14159265358979323846 / 180.0));
     if (cli_bake_direct("walk", a.scene, &a.c, e, &a.ind))
         a.opts.no_indirect = 1;
     cli_bake_kept("walk", a.scene, &a.c, e, &a.ind, a.opts.aerial_m_per_texel);

@@ -363,7 +363,7 @@ int walk_path_moves(const walk_path *wp)
 
 void walk_path_camera(const walk_path *wp, double s, double eye[3], double target[3])
 {
-    double d[2];
+    double d[2], h;
     at(wp, wp->eye, s, eye);
     if (wp->target) {
         at(wp, wp->target, s, target);
@@ -371,14 +371,15 @@ void walk_path_camera(const walk_path *wp, double s, double eye[3], double targe
             return;
     } else {
         at(wp, wp->eye, s + LOOK_AHEAD, target);
-        target[2] = eye[2];
-        if (hypot(target[0] - eye[0], target[1] - eye[1]) > WALK_FLAT)
+        h = hypot(target[0] - eye[0], target[1] - eye[1]);
+        target[2] = eye[2] - wp->pitch_tan * h;
+        if (h > WALK_FLAT)
             return;
     }
     /* no direction there (a vertical or repeated stretch, the point ahead
      * back at the eye, a keyframe's target crossing its eye): along the
      * walk, or east when the path never moves horizontally (said once) */
-    target[2] = eye[2];
+    target[2] = eye[2] - wp->pitch_tan * LOOK_AHEAD;
     if (walk_dir(wp, s, d)) {
         target[0] = eye[0] + LOOK_AHEAD * d[0];
         target[1] = eye[1] + LOOK_AHEAD * d[1];

@@ -3,7 +3,7 @@
  * unless properties.units is "m" on the collection or the feature),
  * optionally with properties.targets, one [x, y, z] per position
  * (keyframes); without targets the eye looks 10 m ahead along the path at
- * its own height. */
+ * its own height, or pitch_tan x that distance below it. */
 #ifndef PLX_CLI_WALK_PATH_H
 #define PLX_CLI_WALK_PATH_H
 
@@ -16,6 +16,7 @@ typedef struct walk_path {
     double *eye;      /* 3 n, local metres */
     double *target;   /* 3 n or NULL */
     uint32_t lines;   /* line features in the file (LineString, MultiLineString): the walk follows the first LineString */
+    double pitch_tan; /* without targets: the view's drop per metre ahead (walk --pitch; 0: level) */
 } walk_path;
 
 /* 0 on success; -1 with "FILE: why" in err. */
@@ -29,7 +30,9 @@ int walk_path_moves(const walk_path *wp);
 /* The camera at arc length s along the eye polyline. Where the targets
  * or the point ahead give no direction (the target at the eye, the point
  * ahead above or at it), the eye looks 10 m along its walk (the nearest
- * stretch that moves horizontally), or east without one. */
+ * stretch that moves horizontally), or east without one. Without
+ * targets the target lies pitch_tan times its horizontal distance below
+ * the eye's height. */
 void walk_path_camera(const walk_path *wp, double s, double eye[3] /* OUT */, double target[3] /* OUT */);
 
 #endif

@@ -583,6 +583,20 @@ expect render-black-no-lamps 0 "the image is entirely black: the scene has no la
 printf '{"type":"Feature","properties":{"units":"m"},"geometry":{"type":"LineString","coordinates":[[5,-20,1.7],[5,-120,300]]}}' >"$tmp/climb.geojson"
 expect walk-high-level-hint 0 "warning: the eye rises to 300 m and looks level, 10 m ahead along the path at its own height: the city is below those frames; properties.targets" -- \
     "$bin" walk "$tmp/two.geojson" --path "$tmp/climb.geojson" --no-indirect --size 32x24 --speed 100 --fps 1 -o "$tmp/wclimb"
+# --pitch: a path without targets looked at DEG degrees below level (10 m
+# ahead, 10 tan(DEG) m down): a flight at 300 m toward the lit building
+# sees it, where the level view sees only sky; no level-view hint with
+# it; refused outside 0..89; said to do nothing on a path with targets
+printf '{"type":"Feature","properties":{"units":"m"},"geometry":{"type":"LineString","coordinates":[[5,-300,300],[5,-200,300]]}}' >"$tmp/fly300.geojson"
+expect walk-pitch-camera 0 "^1 5 -300 300 5 -290 290 " -- sh -c "'$bin' walk -q '$tmp/two.geojson' --path '$tmp/fly300.geojson' --pitch 45 --no-indirect --size 32x24 --speed 100 --fps 1 -o '$tmp/wpitch' >/dev/null && cat '$tmp/wpitch/cameras.txt'"
+expect walk-pitch-lit 0 "^0$" -- sh -c "'$bin' walk '$tmp/two.geojson' --path '$tmp/fly300.geojson' --pitch 45 --no-indirect --size 32x24 --speed 100 --fps 1 -o '$tmp/wpitch1' 2>&1 | grep -c 'black\\|looks level' || true"
+expect walk-level-black 0 "every frame is entirely black" -- \
+    "$bin" walk "$tmp/two.geojson" --path "$tmp/fly300.geojson" --no-indirect --size 32x24 --speed 100 --fps 1 -o "$tmp/wpitch2"
+expect walk-high-level-hint-pitch 0 "the city is below those frames; --pitch DEG looks down along the path" -- \
+    "$bin" walk "$tmp/two.geojson" --path "$tmp/fly300.geojson" --no-indirect --size 32x24 --speed 100 --fps 1 -o "$tmp/wpitch3"
+expect walk-pitch-range 2 "--pitch '90' is not a number of degrees from 0 to 89" -- "$bin" walk "$tmp/two.geojson" --path "$tmp/fly300.geojson" --pitch 90 -o "$tmp/wpitch4"
+expect walk-pitch-targets 0 "warning: --pitch has no effect: .*twofaint.geojson has properties.targets, which aim the camera" -- \
+    "$bin" walk "$tmp/two.geojson" --path "$tmp/twofaint.geojson" --pitch 20 --no-indirect --size 32x24 --speed 100 --fps 1 -o "$tmp/wpitch5"
 # a held walk follows a change at 4 stops a second (at 25 fps an eighth
 # of a stop a frame): from a bright wall to one lit a thousand times less,
 # no frame's exposure is more than an eighth of a stop from the last
