@@ -384,22 +384,32 @@ static double bellman_ford(const network *net, uint32_t s, uint32_t t, double w)
     return res;
 }
 
+/* Grid case seed: its scene's engine (freed with *mem and *scene) and its
+ * network built, every edge scored. */
+static plx_engine *grid_case(int seed, void **mem, char **scene, network *net)
+{
+    plx_engine *e, *failed;
+    route_set rs;
+    char err[256];
+    *scene = grid_scene(seed);
+    e = load_text(*scene, mem);
+    grid_lines(seed, &rs);
+    assert_int_equal(net_build(net, &rs, err, sizeof err), 0);
+    assert_int_equal(net_score(net, e, NULL, 1.0, 1.0, 1.5, 0, &failed), PLX_OK);
+    return e;
+}
+
 static void test_random_grids_against_bellman_ford(void **state)
 {
     int seed, rounds = getenv("PLX_TEST_QUICK") ? 6 : 30, reached = 0, unreached = 0;
     static const double weights[3] = { 0.0, 0.7, 4.0 };
-    plx_engine *failed;
     (void)state;
     for (seed = 0; seed < rounds; seed++) {
         void *mem;
-        char *scene = grid_scene(seed), err[256];
-        plx_engine *e = load_text(scene, &mem);
+        char *scene, err[256];
         network net;
-        route_set rs;
+        plx_engine *e = grid_case(seed, &mem, &scene, &net);
         uint32_t q;
-        grid_lines(seed, &rs);
-        assert_int_equal(net_build(&net, &rs, err, sizeof err), 0);
-        assert_int_equal(net_score(&net, e, NULL, 1.0, 1.0, 1.5, 0, &failed), PLX_OK);
         for (q = 0; q < 12; q++) {
             uint32_t s = (uint32_t)(rnd() * net.nnodes), t = q == 11 ? net.nnodes - 1 : (uint32_t)(rnd() * net.nnodes);
             double w = weights[q % 3], want = bellman_ford(&net, s, t, w);
@@ -458,14 +468,11 @@ static void test_route_scoring_against_every_edge(void **state)
     (void)state;
     for (seed = 0; seed < rounds; seed++) {
         void *mem;
-        char *scene = grid_scene(seed), err[256];
-        plx_engine *e = load_text(scene, &mem);
+        char *scene, err[256];
         network all, some;
+        plx_engine *e = grid_case(seed, &mem, &scene, &all);
         route_set rs;
         uint32_t q, i;
-        grid_lines(seed, &rs);
-        assert_int_equal(net_build(&all, &rs, err, sizeof err), 0);
-        assert_int_equal(net_score(&all, e, NULL, 1.0, 1.0, 1.5, 0, &failed), PLX_OK);
         for (q = 0; q < 10; q++) {
             double w = weights[q % 5];
             net_snap a, b;
