@@ -581,7 +581,7 @@ expect render-black-no-lamps 0 "the image is entirely black: the scene has no la
     "$bin" render "$tmp/nolamps.geojson" --size 32x24 --eye 5,-20,1.7 --target 5,-40,1.7 -o "$tmp/xnl.png"
 # a path that climbs high without targets looks level into the sky: said
 printf '{"type":"Feature","properties":{"units":"m"},"geometry":{"type":"LineString","coordinates":[[5,-20,1.7],[5,-120,300]]}}' >"$tmp/climb.geojson"
-expect walk-high-level-hint 0 "warning: the eye rises to 300 m and looks level, 10 m ahead along the path at its own height: the city is below those frames; properties.targets" -- \
+expect walk-high-level-hint 0 "warning: the eye rises to 300 m and looks level, 10 m ahead along the path at its own height: the city is below those frames; --pitch DEG looks down along the path, properties.targets" -- \
     "$bin" walk "$tmp/two.geojson" --path "$tmp/climb.geojson" --no-indirect --size 32x24 --speed 100 --fps 1 -o "$tmp/wclimb"
 # --pitch: a path without targets looked at DEG degrees below level (10 m
 # ahead, 10 tan(DEG) m down): a flight at 300 m toward the lit building
