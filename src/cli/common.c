@@ -662,53 +662,70 @@ static plx_status block_size_checked(bake_in *in, uint64_t len, size_t *need, ch
     return st;
 }
 
+/* The bake read through in (len bytes) into a block of its own: mem
+ * bytes (--mem), else the size the header asks for, the whole file
+ * checked first when that block is far beyond the file (more than 64
+ * times it and a GiB: a damaged size field asked for 4.6e18 bytes, which
+ * a sanitizer build does not even try to take) or cannot be had; the load
+ * checks the file as it reads it. *need: the block's size. On failure a
+ * status and its reason in msg (the library's line, with a failed read's
+ * cause after it). */
+static plx_status load_into_block(bake_in *in, size_t len, size_t mem, const plx_config *cfg, plx_engine **e,
+                                  size_t *need, char *msg, size_t msglen)
+{
+    char err[512];
+    void *block = NULL;
+    plx_status st = PLX_OK;
+    *need = mem;
+    if (!mem) {
+        st = plx_bake_block_size_read(bake_read, in, len, NULL, 0, need, err, sizeof err);
+        if (st == PLX_OK && *need / 64 <= len + ((size_t)1 << 24))
+            block = cli_big_alloc(*need);
+        if (st == PLX_OK && !block)
+            st = block_size_checked(in, len, need, err, sizeof err);
+        if (st != PLX_OK) {
+            snprintf(msg, msglen, "%s", err);
+            return st;
+        }
+    }
+    if (!block && !(block = cli_big_alloc(*need))) {
+        snprintf(msg, msglen, "cannot take a block of %zu bytes for the bake", *need);
+        return PLX_E_NOMEM;
+    }
+    in->why[0] = '\0';
+    st = plx_bake_load_read(block, *need, cfg, bake_read, in, len, e, err, sizeof err);
+    if (st != PLX_OK) {
+        snprintf(msg, msglen, "%s%s%s", err, st == PLX_E_IO && in->why[0] ? ": " : "", st == PLX_E_IO ? in->why : "");
+        free(block);
+    }
+    return st;
+}
+
 /* An engine from a bake file: the file read through the library's
  * reads into the block sized by the bake (or --mem), its pointers
  * relocated. */
 static int open_bake(const char *cmd, const char *path, const cli_common *c, plx_engine **e)
 {
-    char err[512];
+    char msg[1024];
     size_t len, need;
-    void *mem = NULL, *big = NULL;
+    void *big = NULL;
     bake_in in;
     plx_config cfg;
     plx_status st;
     unsigned char head[16];
     unsigned long long t0 = port_now_ns();
     in.why[0] = '\0';
-    in.fd = port_open_input(path, &len, err, sizeof err);
+    in.fd = port_open_input(path, &len, msg, sizeof msg);
     if (in.fd < 0) {
-        fprintf(stderr, "polarlux %s: %s: %s\n", cmd, path, err);
+        fprintf(stderr, "polarlux %s: %s: %s\n", cmd, path, msg);
         return EXIT_FAIL;
     }
     if (bake_read(&in, 24, head, sizeof head) != 0)
         memset(head, 0, sizeof head); /* too short: the load says so */
-    if (c->mem) { /* the block given: the load checks the file as it reads it */
-        need = c->mem;
-    } else {
-        /* the block the header asks for, the load checking the file as it
-         * reads it; the whole file checked first when that block is far
-         * beyond the file (more than 64 times it and a GiB: a damaged size
-         * field asked for 4.6e18 bytes, which a sanitizer build does not
-         * even try to take) or cannot be had */
-        st = plx_bake_block_size_read(bake_read, &in, len, NULL, 0, &need, err, sizeof err);
-        if (st == PLX_OK && need / 64 <= len + ((size_t)1 << 24))
-            mem = cli_big_alloc(need);
-        if (st == PLX_OK && !mem)
-            st = block_size_checked(&in, len, &need, err, sizeof err);
-        if (st != PLX_OK) {
-            bake_say(cmd, path, st, err, &in);
-            close(in.fd);
-            return EXIT_FAIL;
-        }
-    }
     cli_config(c, &cfg);
-    if (!mem && !(mem = cli_big_alloc(need))) {
-        fprintf(stderr, "polarlux %s: %s: cannot take a block of %zu bytes for the bake\n", cmd, path, need);
-        close(in.fd);
-        return EXIT_NOMEM;
-    }
-    st = load_bake_in(cmd, path, mem, need, &cfg, &in, len, e);
+    st = load_into_block(&in, len, c->mem, &cfg, e, &need, msg, sizeof msg);
+    if (st != PLX_OK)
+        fprintf(stderr, "polarlux %s: %s: %s\n", cmd, path, msg);
     if (st == PLX_OK && c->atlas_room && !c->mem && !bake_has_atlas(*e) && (big = cli_big_alloc(atlas_block(need)))) {
         /* no --mem, and the bake holds no radiance atlas (--no-aerial):
          * again in a block whose quarter holds the atlas at its finest,
@@ -741,11 +758,11 @@ int cli_open_twin(const char *path, const cli_common *c, plx_engine **e, char *w
 {
     char err[512];
     size_t len, need;
-    void *mem;
     bake_in in;
     plx_config cfg;
     plx_status st;
     cli_common quiet = *c;
+    int changed;
     *e = NULL;
     if (!cli_bake_last.loaded) {
         snprintf(why, whylen, "the scene was not loaded from a bake");
@@ -756,30 +773,18 @@ int cli_open_twin(const char *path, const cli_common *c, plx_engine **e, char *w
         snprintf(why, whylen, "%s", err);
         return EXIT_FAIL;
     }
-    st = twin_same_file(&in) ? PLX_OK : PLX_E_INVALID;
-    if (st != PLX_OK)
-        snprintf(why, whylen, "the file changed since it was loaded");
-    need = c->mem;
-    if (st == PLX_OK && !need && (st = plx_bake_block_size_read(bake_read, &in, len, NULL, 0, &need, err,
-                                                                  sizeof err)) != PLX_OK)
-        snprintf(why, whylen, "%s", err);
-    mem = st == PLX_OK ? cli_big_alloc(need) : NULL;
-    if (st == PLX_OK && !mem) {
-        snprintf(why, whylen, "no memory for another block of %zu bytes", need);
-        st = PLX_E_NOMEM;
-    }
     quiet.quiet = 1;
     cli_config(&quiet, &cfg);
-    if (st == PLX_OK && (st = plx_bake_load_read(mem, need, &cfg, bake_read, &in, len, e, err, sizeof err)) != PLX_OK) {
-        snprintf(why, whylen, "%s", err);
-        free(mem);
-    }
+    changed = !twin_same_file(&in);
+    st = changed ? PLX_E_INVALID : load_into_block(&in, len, c->mem, &cfg, e, &need, why, whylen);
     if (st == PLX_OK && !twin_same_file(&in)) { /* changed as it was read: its checksum held, but another file's */
-        snprintf(why, whylen, "the file changed since it was loaded");
         plx_engine_free(*e);
         *e = NULL;
+        changed = 1;
         st = PLX_E_INVALID;
     }
+    if (changed)
+        snprintf(why, whylen, "the file changed since it was loaded");
     close(in.fd);
     return st == PLX_OK ? EXIT_OK : cli_exit_code(st);
 }
