@@ -334,7 +334,7 @@ static int score_route_edges(const net_opts *o, plx_engine *e, network *net, con
     plx_status st;
     twin_set_init(&tg, o->cmd, o->scene, &o->c, e);
     st = net_score_route(net, e, &tg, a, b, o->weight, 1, &n, &failed);
-    if (!o->c.quiet && n > 0) {
+    if (st == PLX_OK && !o->c.quiet && n > 0) {
         fprintf(stderr, "polarlux %s: note: %zu of the %u edges scored (those a walk from --from to --to no longer "
                         "than the shortest route's cost can take)", o->cmd, n, net->nedges);
         if (twin_threads(&tg) > 1)
@@ -342,7 +342,8 @@ static int score_route_edges(const net_opts *o, plx_engine *e, network *net, con
         fputc('\n', stderr);
     }
     if (st != PLX_OK)
-        fprintf(stderr, "polarlux %s: %s: scoring the edges: %s\n", o->cmd, o->network, plx_last_error(failed));
+        fprintf(stderr, "polarlux %s: %s: scoring the edges: %s\n", o->cmd, o->network,
+                failed ? plx_last_error(failed) : "out of memory");
     twin_set_free(&tg);
     return st == PLX_OK ? EXIT_OK : cli_exit_code(st);
 }

@@ -261,6 +261,7 @@ plx_status net_score(network *net, plx_engine *e, twin_set *tg, double step, dou
                      int progress, plx_engine **failed)
 {
     net_set_scoring(net, step, dark_lux, height);
+    net->partial = 0;
     return score_list(net, e, tg, NULL, net->nedges, progress, failed);
 }
 
@@ -581,6 +582,22 @@ static int collect(network *net, const query *q, net_route *r)
     return 0;
 }
 
+static void snap_key(net_snap_key *k, const net_snap *s)
+{
+    memset(k, 0, sizeof *k);
+    k->edge = s->edge;
+    k->seg = s->seg;
+    k->x = s->x;
+    k->y = s->y;
+}
+
+static int same_ends(const net_snap_key *k, const net_snap *s)
+{
+    net_snap_key t;
+    snap_key(&t, s);
+    return memcmp(k, &t, sizeof t) == 0;
+}
+
 int net_route_find(network *net, plx_engine *e, const net_snap *a, const net_snap *b, double weight,
                    net_route *out, char *err, size_t errlen)
 {
@@ -591,6 +608,10 @@ int net_route_find(network *net, plx_engine *e, const net_snap *a, const net_sna
     out->min = INFINITY;
     out->max = -INFINITY;
     out->min_ev = out->min_esc = NAN;
+    if (net->partial && !(weight <= net->part_w && same_ends(&net->part_a, a) && same_ends(&net->part_b, b))) {
+        snprintf(err, errlen, "the network's edges were scored for other ends or a lower --dark-weight");
+        return -1;
+    }
     if (make_pieces(net, e, a, b, weight, &q) != 0) {
         snprintf(err, errlen, "scoring the ends of the route failed: %s", plx_last_error(e));
         free_pieces(&q);
@@ -681,7 +702,12 @@ plx_status net_score_route(network *net, plx_engine *e, twin_set *tg, const net_
     *failed = e;
     *nscored = 0;
     memset(&q, 0, sizeof q);
+    net->partial = 1;
+    net->part_w = weight;
+    snap_key(&net->part_a, a);
+    snap_key(&net->part_b, b);
     if (!list || !ds) {
+        *failed = NULL;
         st = PLX_E_NOMEM;
         goto done;
     }

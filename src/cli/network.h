@@ -24,6 +24,12 @@ typedef struct net_edge {
                                facing v0 to v1 (fw), back (bw), min E_sc fw, bw; NaN: no sample */
 } net_edge;
 
+/* The ends net_score_route scored a network for (edge, segment, point). */
+typedef struct net_snap_key {
+    uint32_t edge, seg;
+    double x, y;
+} net_snap_key;
+
 typedef struct network {
     route_set lines;        /* the source lines (owned) */
     double *node_xy;        /* 2 per node */
@@ -39,6 +45,9 @@ typedef struct network {
     void *heap;             /* heap_cap entries of the search's priority queue */
     size_t heap_cap;
     uint8_t *scored;        /* per edge: scored (net_score, net_score_route) */
+    int partial;            /* net_score_route scored only the edges for these ends and weights up to part_w */
+    net_snap_key part_a, part_b;
+    double part_w;
 } network;
 
 /* Builds the graph from lines (taking them over: they are freed by
@@ -96,7 +105,8 @@ void net_route_free(net_route *r);
  * edge gives (equal costs settled by node number). *nscored: the edges
  * scored. A plx_status, *failed as net_score's; unconnected ends, or ends
  * whose pieces fail to score, score nothing and return PLX_OK
- * (net_route_find then says why). */
+ * (net_route_find then says why). Out of memory: PLX_E_NOMEM, *failed
+ * NULL. net_route_find then refuses other ends or a higher weight. */
 plx_status net_score_route(network *net, plx_engine *e, twin_set *tg, const net_snap *a, const net_snap *b,
                            double weight, int progress, size_t *nscored /* OUT */, plx_engine **failed /* OUT */);
 

@@ -459,7 +459,7 @@ static void assert_same_route(const net_route *x, const net_route *y)
  * apart: many routes of exactly equal cost): for ends snapped anywhere on
  * the streets and weights up to the one it was given, the same routes to
  * the byte, its edges the same scores, and fewer edges scored where the
- * shortest route is cheap. */
+ * shortest route is cheap; other ends or a higher weight refused. */
 static void test_route_scoring_against_every_edge(void **state)
 {
     int seed, rounds = getenv("PLX_TEST_QUICK") ? 6 : 30, fewer = 0, compared = 0;
@@ -502,6 +502,14 @@ static void test_route_scoring_against_every_edge(void **state)
                 compared++;
                 net_route_free(&x);
                 net_route_free(&y);
+            }
+            { /* another weight above, or other ends: refused, not a route over unscored edges */
+                net_route r;
+                net_snap c = b;
+                c.x += 0.5;
+                assert_int_equal(net_route_find(&some, e, &a, &b, 2.0 * w + 1.0, &r, err, sizeof err), -1);
+                assert_string_equal(err, "the network's edges were scored for other ends or a lower --dark-weight");
+                assert_int_equal(net_route_find(&some, e, &a, &c, w, &r, err, sizeof err), -1);
             }
             net_free(&some);
         }
