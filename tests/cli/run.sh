@@ -310,17 +310,20 @@ if [ "$(wc -c <"$tmp/np.plxb")" -lt "$(wc -c <"$tmp/e.plxb")" ]; then echo "ok  
 else echo "FAIL bake-no-polar-smaller"; fail=$((fail + 1)); fi
 expect bake-no-polar-vis 0 "" -- "$bin" vis -q "$tmp/np.plxb" --points "$tmp/bp.txt"
 if cmp -s "$tmp/out" "$tmp/v1"; then echo "ok   bake-no-polar-vis-same"; pass=$((pass + 1)); else echo "FAIL bake-no-polar-vis-same"; fail=$((fail + 1)); fi
+if [ -z "$PLX_TEST_QUICK" ]; then # check-full: the photons a frame on a 4,740-lamp city (about 7 s)
 # bake's photons per frame: 16 a lamp (4,740 lamps: 75,840) unless --photons
 "$bin" gen eixample 15 15 -o "$tmp/e15.geojson"
 expect bake-photons-per-lamp 0 "photons [0-9]+ ms \(16 x 75840\)" -- \
     "$bin" bake "$tmp/e15.geojson" --no-aerial --no-polar --max-size 32x24 -o "$tmp/e15.plxb"
 expect bake-photons-given 0 "photons [0-9]+ ms \(2 x 4000\)" -- \
     "$bin" bake "$tmp/e15.geojson" --no-aerial --no-polar --max-size 32x24 --photons 4000 --frames 2 -o "$tmp/e15.plxb"
+fi
 # an -o bake cannot write is refused before the scene is read (it was
 # refused after the whole bake: 5 s on gen eixample 15 15)
 expect bake-out-is-folder 1 "^polarlux bake: '$tmp' is a directory$" -- "$bin" bake "$tmp/nope.geojson" -o "$tmp"
 expect bake-out-no-folder 1 "^polarlux bake: cannot write '$tmp/no/such/x\.plxb': the folder '$tmp/no/such' does not exist$" -- \
     "$bin" bake "$tmp/nope.geojson" -o "$tmp/no/such/x.plxb"
+if [ -z "$PLX_TEST_QUICK" ]; then # check-full (with the block above)
 # render from a GeoJSON traces 16 photons a lamp too (4,740 lamps: 75,840 a
 # frame): the same image as --photons 75840, another than the old 65,536
 "$bin" render -q "$tmp/e15.geojson" --size 64x48 -o "$tmp/pd.png" >/dev/null
@@ -336,6 +339,7 @@ expect render-photons-per-lamp-too-many 2 "75840 photons a frame \(16 a lamp; --
 "$bin" render -q fixtures/eixample-4x4.geojson --size 64x48 --photons 65536 -o "$tmp/p65.png" >/dev/null
 if cmp -s "$tmp/pd.png" "$tmp/p65.png"; then echo "ok   render-photons-floor"; pass=$((pass + 1))
 else echo "FAIL render-photons-floor: eixample-4x4's default image is not --photons 65536's"; fail=$((fail + 1)); fi
+fi
 # in a block that holds the bake but not the polar diagrams, the default
 # street view (which needs them to find a street) says what to give instead
 npm=$("$bin" info "$tmp/np.plxb" --min-mem 2>/dev/null | sed -n 's/^smallest --mem: \([0-9]*\) bytes.*/\1/p')
@@ -920,6 +924,7 @@ spots_same() { # NAME BAKE ARGS...: the default's spots equal --exhaustive's
 spots_same dark-spots-lazy-equals-exhaustive "$tmp/g4.plxb" --count 2 --res 4
 expect dark-spots-gathered-note 0 "indirect light gathered 1[0-9]{3} times for the 8300 street points" -- "$bin" dark-spots "$tmp/g4.plxb" --count 2 --res 4
 expect dark-spots-gathers-everywhere 0 "indirect light gathered 4034 times for the 4034 street points" -- "$bin" dark-spots "$tmp/ds.plxb" --count 3 --res 1
+if [ -z "$PLX_TEST_QUICK" ]; then # check-full: twins of the bake (about 3 s)
 # --threads: the gathers shared with twins of the bake, the same lux to the
 # last digit (every point gathered, 20 spots of lux 0.027 to 0.058)
 "$bin" dark-spots -q "$tmp/g4.plxb" --count 20 --res 4 --exhaustive --threads 1 >"$tmp/ds-t1.json" 2>/dev/null
@@ -929,6 +934,7 @@ if grep -q '"rank":20,"lux":0\.0[1-9]' "$tmp/ds-t1.json" && cmp -s "$tmp/ds-t1.j
 else echo "FAIL dark-spots-threads-same"; fail=$((fail + 1)); fi
 expect dark-spots-threads-note 0 "gathered 1[0-9]{3} times for the 8300 street points .*, on 3 threads$" -- "$bin" dark-spots "$tmp/g4.plxb" --count 2 --res 4 --threads 3
 expect dark-spots-one-thread-note 0 ", on 1 thread$" -- "$bin" dark-spots "$tmp/g4.plxb" --count 2 --res 4 --threads 1
+fi
 if [ -z "$PLX_TEST_QUICK" ]; then # check-full: annotate's edges scored on 1 and 3 threads (7 s), the same files
     "$bin" bake -q fixtures/helsinki-centre.geojson --frames 2 --photons 4000 -o "$tmp/hq.plxb" >/dev/null 2>&1
     "$bin" annotate -q "$tmp/hq.plxb" --network fixtures/helsinki-streets.geojson --threads 1 -o "$tmp/an1.geojson" --csv "$tmp/an1.csv" >/dev/null 2>&1

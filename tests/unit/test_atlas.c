@@ -987,6 +987,8 @@ static void layout_check(world *w, double fine, rng *r, layout_tally *t)
 
 static void test_layout(void **state)
 {
+    if (getenv("PLX_TEST_QUICK")) /* make check-full only: make check stays within a minute */
+        skip();
     static const struct {
         const char *name, *path;
         double fine[3];
@@ -1602,6 +1604,8 @@ static void values_check(world *w, double fine, long nsamp, rng *r)
 
 static void test_values(void **state)
 {
+    if (getenv("PLX_TEST_QUICK")) /* make check-full only: make check stays within a minute */
+        skip();
     rng r = { 0x5a1e5u };
     world w;
     int q = quick();
@@ -2195,6 +2199,8 @@ static void frames_check(world *w, double fine, int nframes, rng *r)
 
 static void test_frames(void **state)
 {
+    if (getenv("PLX_TEST_QUICK")) /* make check-full only: make check stays within a minute */
+        skip();
     rng r = { 0xf4a3e5u };
     world w;
     int q = quick();
@@ -2926,6 +2932,8 @@ static void test_determinism(void **state)
 
 static void test_spacing(void **state)
 {
+    if (getenv("PLX_TEST_QUICK")) /* make check-full only: make check stays within a minute */
+        skip();
     rng r = { 0x59ac1u };
     world w;
     int f, k, n = quick() ? 6 : 25, coarser = 0, total = 0;

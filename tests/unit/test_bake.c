@@ -606,6 +606,8 @@ static void test_atlas_in_bake(void **state)
  * view's light map, would need the twin to draw them too.) */
 static void test_bake_after_frames(void **state)
 {
+    if (getenv("PLX_TEST_QUICK")) /* make check-full only: make check stays within a minute */
+        skip();
     baked k;
     size_t size = 0;
     uint64_t f;
@@ -863,6 +865,8 @@ static void two_bit_flips(const baked *k, unsigned char *f)
 
 static void test_damaged(void **state)
 {
+    if (getenv("PLX_TEST_QUICK")) /* make check-full only: make check stays within a minute */
+        skip();
     baked k = shared;
     unsigned char *f;
     char msg[200];
@@ -1013,6 +1017,8 @@ static void test_corpus(void **state)
 
 static void test_twin_mismatch(void **state)
 {
+    if (getenv("PLX_TEST_QUICK")) /* make check-full only: make check stays within a minute */
+        skip();
     void *ma, *mb;
     plx_engine *a, *b;
     size_t size;

@@ -413,6 +413,8 @@ static const corpus_case corpus[] = {
 
 static void test_corpus_files(void **state)
 {
+    if (getenv("PLX_TEST_QUICK")) /* make check-full only: make check stays within a minute */
+        skip();
     size_t i;
     (void)state;
     for (i = 0; i < NCORPUS; i++) {

@@ -226,6 +226,8 @@ static void check_estimate(const char *text, size_t len, const char *name)
 
 static void test_scan_and_estimate_fixtures(void **state)
 {
+    if (getenv("PLX_TEST_QUICK")) /* make check-full only: make check stays within a minute */
+        skip();
     static const char *const files[] = { "fixtures/tiny.geojson", "fixtures/grid-4x4.geojson",
                                          "fixtures/eixample-4x4.geojson", "fixtures/oldtown-8x8.geojson",
                                          "fixtures/ground-image.geojson", "fixtures/helsinki-centre.geojson" };
@@ -245,6 +247,8 @@ static void test_scan_and_estimate_fixtures(void **state)
 
 static void test_scan_and_estimate_generated(void **state)
 {
+    if (getenv("PLX_TEST_QUICK")) /* make check-full only: make check stays within a minute */
+        skip();
     static const char *const styles[] = { "grid", "eixample", "oldtown" };
     int quick = getenv("PLX_TEST_QUICK") != NULL;
     const int n[] = { quick ? 12 : 30, quick ? 8 : 20, quick ? 16 : 40 };

@@ -215,6 +215,8 @@ static void two_views(plx_camera *c, plx_camera *other)
  * render_surf_slots) gives the 64x48 frame of the default one. */
 static void test_image_same_bytes(void **state)
 {
+    if (getenv("PLX_TEST_QUICK")) /* make check-full only: make check stays within a minute */
+        skip();
     plx_engine *e1 = fixture_new((size_t)1 << 30, "fixtures/eixample-4x4.geojson", NULL, 0);
     plx_engine *e2 = fixture_new((size_t)1 << 30, "fixtures/eixample-4x4.geojson", NULL, 0);
     plx_engine *e3;
@@ -271,6 +273,8 @@ static void test_image_same_bytes(void **state)
  * frame without indirect light. */
 static void test_aerial_without_indirect_gathers_nothing(void **state)
 {
+    if (getenv("PLX_TEST_QUICK")) /* make check-full only: make check stays within a minute */
+        skip();
     plx_engine *e1 = fixture_new((size_t)1 << 30, "fixtures/eixample-4x4.geojson", NULL, 0);
     plx_engine *e2 = fixture_new((size_t)1 << 30, "fixtures/eixample-4x4.geojson", NULL, 0);
     uint8_t *a = malloc(3 * W * H), *b = malloc(3 * W * H);
@@ -311,6 +315,8 @@ static void test_aerial_without_indirect_gathers_nothing(void **state)
  * frame's far pixels use the same 8 m level. */
 static void test_image_after_aerial_same_bytes(void **state)
 {
+    if (getenv("PLX_TEST_QUICK")) /* make check-full only: make check stays within a minute */
+        skip();
     plx_engine *e1 = fixture_new((size_t)1 << 30, "fixtures/eixample-4x4.geojson", NULL, 0);
     plx_engine *e2 = fixture_new((size_t)1 << 30, "fixtures/eixample-4x4.geojson", NULL, 0);
     uint8_t *a = malloc(3 * W * H), *b = malloc(3 * W * H);

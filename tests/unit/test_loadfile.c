@@ -347,6 +347,8 @@ static void guarded_file(const char *src, int prefixes)
 
 static void test_guarded_views(void **state)
 {
+    if (getenv("PLX_TEST_QUICK")) /* make check-full only: make check stays within a minute */
+        skip();
     static const char *const fixtures[] = {
         "fixtures/tiny.geojson", "fixtures/grid-4x4.geojson", "fixtures/ground-image.geojson",
         "fixtures/net-detour.geojson", "fixtures/oldtown-8x8.geojson", "fixtures/helsinki-centre.geojson",

@@ -1035,6 +1035,8 @@ static double reference_indirect(tracer *T, const scene *s, const double P[3],
 
 static void test_accuracy_eixample(void **state)
 {
+    if (getenv("PLX_TEST_QUICK")) /* make check-full only: make check stays within a minute */
+        skip();
     void *mem;
     plx_engine *e = open_fixture("fixtures/eixample-4x4.geojson", &mem, 512u << 20);
     const scene *s = e->sc;

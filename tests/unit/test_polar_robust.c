@@ -478,6 +478,8 @@ static int quick(int n)
 
 static void test_crossing_scenes(void **state)
 {
+    if (getenv("PLX_TEST_QUICK")) /* make check-full only: make check stays within a minute */
+        skip();
     counts c;
     int k, kind, nsc = quick(100);
     static const char *name[5] = { "lattice + rotated", "near one point", "tiny overlaps",

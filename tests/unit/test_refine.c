@@ -90,6 +90,8 @@ static void model_update(model *m, plx_engine *e, const double eye[3], double ra
 
 static void test_lru_along_path(void **state)
 {
+    if (getenv("PLX_TEST_QUICK")) /* make check-full only: make check stays within a minute */
+        skip();
     void *mem;
     plx_engine *e = fixture_load_file(fixture_engine(MEM, 0, plx_port_posix(), &mem), "fixtures/eixample-4x4.geojson");
     plx_refine_stats rs;
@@ -338,6 +340,8 @@ static void set_camera(plx_camera *c, double ex, double ey, double ez, double tx
 
 static void test_view_centre(void **state)
 {
+    if (getenv("PLX_TEST_QUICK")) /* make check-full only: make check stays within a minute */
+        skip();
     static const double cams[][6] = {
         { 100, 266, 1.7, 110, 266, 1.7 },   /* level: half the radius ahead */
         { 100, 266, 40, 180, 266, 0 },      /* meets the ground 80 m ahead: clamped */
@@ -445,6 +449,8 @@ static uint32_t chosen_in_frame(plx_engine *e, const plx_camera *c, const double
  * than those around the eye, most of them under or behind it. */
 static void test_view_refines_what_it_shows(void **state)
 {
+    if (getenv("PLX_TEST_QUICK")) /* make check-full only: make check stays within a minute */
+        skip();
     void *mem;
     plx_engine *e = fixture_load_file(fixture_engine(MEM, 0, plx_port_posix(), &mem), "fixtures/eixample-4x4.geojson");
     plx_refine_stats rs;

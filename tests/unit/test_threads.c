@@ -147,6 +147,8 @@ static void test_same_bytes(void **state)
  * pixels they leave), the direct light on the workers: the same bytes. */
 static void test_gather_same_bytes(void **state)
 {
+    if (getenv("PLX_TEST_QUICK")) /* make check-full only: make check stays within a minute */
+        skip();
     static frame one[2], other[2];
     plx_port back = *plx_port_posix();
     (void)state;

@@ -95,6 +95,8 @@ static void test_grid(void **state)
 
 static void test_eixample(void **state)
 {
+    if (getenv("PLX_TEST_QUICK")) /* make check-full only: make check stays within a minute */
+        skip();
     (void)state;
     compare_fixture("fixtures/eixample-4x4.geojson", 40, 3);
 }
