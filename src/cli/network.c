@@ -540,14 +540,21 @@ static void add_stats(net_route *r, double length, double dark, const plx_route_
     }
 }
 
+/* The node at the other end of edge or piece x from v. */
+static uint32_t other_end(const network *net, const query *q, uint32_t x, uint32_t v)
+{
+    const walk_edge *w = x >= net->nedges ? &q->piece[x - net->nedges] : NULL;
+    if (w)
+        return w->u == v ? w->v : w->u;
+    return net->edges[x].a == v ? net->edges[x].b : net->edges[x].a;
+}
+
 /* Walks prev back from T, then the edges forward from S. */
 static int collect(network *net, const query *q, net_route *r)
 {
     uint32_t count = 0, v = q->T, *path, i;
     while (v != q->S) {
-        uint32_t x = net->prev[v];
-        const walk_edge *w = x >= net->nedges ? &q->piece[x - net->nedges] : NULL;
-        v = w ? (w->u == v ? w->v : w->u) : (net->edges[x].a == v ? net->edges[x].b : net->edges[x].a);
+        v = other_end(net, q, net->prev[v], v);
         count++;
     }
     path = malloc(sizeof *path * (count + 1));
@@ -555,9 +562,8 @@ static int collect(network *net, const query *q, net_route *r)
         return -1;
     for (v = q->T, i = count; v != q->S;) {
         uint32_t x = net->prev[v];
-        const walk_edge *w = x >= net->nedges ? &q->piece[x - net->nedges] : NULL;
         path[--i] = x;
-        v = w ? (w->u == v ? w->v : w->u) : (net->edges[x].a == v ? net->edges[x].b : net->edges[x].a);
+        v = other_end(net, q, x, v);
     }
     for (i = 0, v = q->S; i < count; i++) {
         uint32_t x = path[i];
@@ -566,13 +572,12 @@ static int collect(network *net, const query *q, net_route *r)
             const walk_edge *w = &q->piece[x - net->nedges];
             rc = append_xy(r, w->xy, w->n, w->u != v);
             add_stats(r, w->length, w->dark, &w->s, w->fac);
-            v = w->u == v ? w->v : w->u;
         } else {
             const net_edge *ed = &net->edges[x];
             rc = append_xy(r, net->lines.lines[ed->line].xy + 2 * ed->v0, ed->v1 - ed->v0 + 1, ed->a != v);
             add_stats(r, ed->length, ed->dark, &ed->s, ed->fac);
-            v = ed->a == v ? ed->b : ed->a;
         }
+        v = other_end(net, q, x, v);
         if (rc != 0) {
             free(path);
             return -1;
@@ -636,15 +641,6 @@ int net_route_find(network *net, plx_engine *e, const net_snap *a, const net_sna
     }
     free_pieces(&q);
     return rc;
-}
-
-/* The node at the other end of edge or piece x from v. */
-static uint32_t other_end(const network *net, const query *q, uint32_t x, uint32_t v)
-{
-    const walk_edge *w = x >= net->nedges ? &q->piece[x - net->nedges] : NULL;
-    if (w)
-        return w->u == v ? w->v : w->u;
-    return net->edges[x].a == v ? net->edges[x].b : net->edges[x].a;
 }
 
 /* The edges (not the pieces) of the route net->prev holds from q->T back to
