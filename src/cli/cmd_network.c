@@ -37,7 +37,7 @@ static const char route_help[] =
     "  --from X,Y       start (required)\n"
     "  --to X,Y         end (required)\n"
     "  --dark-lux LX    the dark threshold (default 1)\n"
-    "  --dark-weight W  extra cost of a dark metre in metres (default 3)\n"
+    "  --dark-weight W  extra cost of a dark metre in metres, 0 to 1e6 (default 3)\n"
     "  --max-detour F   the best-lit route may be at most (1 + F) times as long\n"
     "                   as the shortest: W is lowered to the largest weight whose\n"
     "                   route keeps within it (bisection to W/1000)\n"
@@ -113,6 +113,21 @@ static int parse_height(const char *v, void *dst)
     return 0;
 }
 
+/* A number >= 0, then at most 1e6 (its own message; dst: the net_opts):
+ * far larger weights only overflow the route's costs to infinity, which
+ * the search would take for unconnected ends. */
+static int parse_weight(const char *v, void *dst)
+{
+    net_opts *o = dst;
+    if (parse_number(v, &o->weight) != 0)
+        return -1;
+    if (o->weight > 1e6) {
+        cli_usage_error(o->cmd, "--dark-weight '%s' is more than 1000000 (a dark metre's cost in lit metres)", v);
+        return -2;
+    }
+    return 0;
+}
+
 /* Parses the options shared by route --network and annotate; -1 for --help
  * (printed), else an exit code. */
 static int parse(net_opts *o, int argc, char **argv, const char *help)
@@ -126,7 +141,7 @@ static int parse(net_opts *o, int argc, char **argv, const char *help)
         CLI_OPT_STR("-o", &o->out),
         CLI_OPT_STR("--csv", &o->csv),
         CLI_OPT_VAL("--dark-lux", &o->dark, parse_number, "--dark-lux '%s' is not a number >= 0"),
-        CLI_OPT_VAL("--dark-weight", &o->weight, parse_number, "--dark-weight '%s' is not a number >= 0"),
+        CLI_OPT_VAL("--dark-weight", o, parse_weight, "--dark-weight '%s' is not a number >= 0"),
         CLI_OPT_VAL("--snap", &o->snap, parse_number, "--snap '%s' is not a number >= 0"),
         { "--max-detour", NULL, &o->detour, parse_number, "--max-detour '%s' is not a number >= 0", 0, NULL,
           &o->have_detour, NULL },
@@ -277,21 +292,25 @@ static int write_routes(const net_opts *o, plx_engine *e, const net_route *best,
  * 0 (the shortest route, always within) and W. Route length does not fall
  * as the weight grows, so the largest feasible weight is found. */
 static int cap_detour(network *net, plx_engine *e, const net_snap *a, const net_snap *b, const net_opts *o,
-                      const net_route *shortest, net_route *best, double *weight)
+                      const net_route *shortest, net_route *best, double *weight, char *err, size_t errlen)
 {
     double lo = 0, hi = o->weight, cap = (1.0 + o->detour) * shortest->length;
-    char err[256];
     net_route_free(best);
     *best = *shortest;
     best->xy = malloc(sizeof *best->xy * 2 * (shortest->n + 1));
-    if (!best->xy)
+    if (!best->xy) {
+        snprintf(err, errlen, "out of memory while capping the detour");
         return -1;
+    }
     memcpy(best->xy, shortest->xy, sizeof *best->xy * 2 * shortest->n);
     *weight = 0;
     while (hi - lo > o->weight * 1e-3) {
         double mid = 0.5 * (lo + hi);
         net_route r;
-        if (net_route_find(net, e, a, b, mid, &r, err, sizeof err) != 0)
+        int rc = net_route_find(net, e, a, b, mid, &r, err, errlen);
+        if (rc == 1) /* no route at a lower weight than one that found it: the costs overflowed */
+            snprintf(err, errlen, "no route at --dark-weight %g while capping the detour", mid);
+        if (rc != 0)
             return -1;
         if (r.length <= cap) {
             lo = mid;
@@ -377,8 +396,8 @@ static int find_routes(const net_opts *o, plx_engine *e, network *net)
         rc = EXIT_FAIL;
     }
     if (rc == EXIT_OK && o->have_detour && best.length > (1.0 + o->detour) * shortest.length &&
-        cap_detour(net, e, &a, &b, o, &shortest, &best, &weight) != 0) {
-        fprintf(stderr, "polarlux %s: out of memory while capping the detour\n", o->cmd);
+        cap_detour(net, e, &a, &b, o, &shortest, &best, &weight, err, sizeof err) != 0) {
+        fprintf(stderr, "polarlux %s: %s\n", o->cmd, err);
         rc = EXIT_FAIL;
     }
     if (rc == EXIT_OK) {

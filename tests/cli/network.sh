@@ -5,6 +5,9 @@ expect net-best-lit 0 "^best-lit +300\.0 +69\.0 .*\+50\.0%$" -- "$bin" route -q 
 expect net-shortest 0 "^shortest +200\.0 +200\.0 +0\.000 +0\.000 +0\.000 +0\.000  - +- +\+0\.0%$" -- "$bin" route -q $net --from 0,0 --to 200,0
 expect net-geojson 0 "" -- sh -c "grep -q '\"route\":\"best-lit\"' '$tmp/net.geojson' && grep -q '\"route\":\"shortest\"' '$tmp/net.geojson' && grep -q '\"mean_lux\"' '$tmp/net.geojson'"
 expect net-light-weight 0 "^best-lit +200\.0 +200\.0 " -- "$bin" route -q $net --from 0,0 --to 200,0 --dark-weight 0.5
+# a weight that would overflow the costs to infinity (and read as unconnected ends) is refused
+expect net-weight-too-large 2 "route: --dark-weight '1e308' is more than 1000000" -- "$bin" route -q $net --from 0,0 --to 200,0 --dark-weight 1e308
+expect net-weight-largest 0 "^best-lit +300\.0 +69\.0 " -- "$bin" route -q $net --from 0,0 --to 200,0 --dark-weight 1e6
 expect net-max-detour 0 "^best-lit +200\.0 " -- "$bin" route -q $net --from 0,0 --to 200,0 --max-detour 0.2
 expect net-max-detour-says 0 "weight lowered from 3 by --max-detour 0\.2" -- "$bin" route -q $net --from 0,0 --to 200,0 --max-detour 0.2
 expect net-max-detour-loose 0 "^best-lit +300\.0 " -- "$bin" route -q $net --from 0,0 --to 200,0 --max-detour 0.6
