@@ -30,6 +30,11 @@ for c in $commands; do
     printf '.SS %s\n.nf\n' "$c"
     "$bin" "$c" --help | esc
     printf '.fi\n'
+    if [ "$c" = route ]; then # route over a street network has its own help
+        printf '.SS route \\-\\-network\n.nf\n'
+        "$bin" route --network STREETS --help | esc
+        printf '.fi\n'
+    fi
 done
 printf '.SH EXIT STATUS\n.TP\n0\nsuccess\n.TP\n1\nthe work failed (bad scene, I/O, query out of range)\n'
 printf '.TP\n2\nusage error\n.TP\n3\nthe memory budget (\\-\\-mem) is too small\n'
