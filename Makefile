@@ -198,8 +198,12 @@ demo:
 # visibility points against the brute force, photon accuracy at the default
 # photon count, the 10^6-vertex ring built in 256 MiB, ...); a few minutes.
 # CI runs both.
+# SKIP_SLOW=1 (plain make check) also leaves out the hostile corpus, the
+# slowest unit tests (tests/unit/slow.h) and two command-line blocks, so it
+# stays within a minute; make asan runs them under the sanitizers.
+SKIP_SLOW ?= 1
 check: check-build
-	@PLX_TEST_QUICK=1 sh tests/run_tests.sh $(BUILD) $(TESTS)
+	@PLX_TEST_QUICK=1 PLX_TEST_SKIP_SLOW=$(SKIP_SLOW) sh tests/run_tests.sh $(BUILD) $(TESTS)
 	@$(MAKE) --no-print-directory check-examples check-python
 
 # check-full also builds every benchmark (not run), so one that falls behind
@@ -312,7 +316,7 @@ check-core-headers:
 	  echo "core calls the C heap (see above)"; exit 1; fi
 
 asan:
-	$(MAKE) BUILD=build/asan OPT="-O1 -g -fno-omit-frame-pointer" \
+	$(MAKE) BUILD=build/asan OPT="-O1 -g -fno-omit-frame-pointer" SKIP_SLOW= \
 	  EXTRA_CFLAGS="-fsanitize=address,undefined -fno-sanitize-recover=all -DPLX_DEBUG" check
 
 valgrind: all $(TESTS)

@@ -310,7 +310,7 @@ if [ "$(wc -c <"$tmp/np.plxb")" -lt "$(wc -c <"$tmp/e.plxb")" ]; then echo "ok  
 else echo "FAIL bake-no-polar-smaller"; fail=$((fail + 1)); fi
 expect bake-no-polar-vis 0 "" -- "$bin" vis -q "$tmp/np.plxb" --points "$tmp/bp.txt"
 if cmp -s "$tmp/out" "$tmp/v1"; then echo "ok   bake-no-polar-vis-same"; pass=$((pass + 1)); else echo "FAIL bake-no-polar-vis-same"; fail=$((fail + 1)); fi
-if [ -z "$PLX_TEST_QUICK" ]; then # check-full: the photons a frame on a 4,740-lamp city (about 7 s)
+if [ -z "$PLX_TEST_SKIP_SLOW" ]; then # not in plain make check: the photons a frame on a 4,740-lamp city (about 7 s)
 # bake's photons per frame: 16 a lamp (4,740 lamps: 75,840) unless --photons
 "$bin" gen eixample 15 15 -o "$tmp/e15.geojson"
 expect bake-photons-per-lamp 0 "photons [0-9]+ ms \(16 x 75840\)" -- \
@@ -323,7 +323,7 @@ fi
 expect bake-out-is-folder 1 "^polarlux bake: '$tmp' is a directory$" -- "$bin" bake "$tmp/nope.geojson" -o "$tmp"
 expect bake-out-no-folder 1 "^polarlux bake: cannot write '$tmp/no/such/x\.plxb': the folder '$tmp/no/such' does not exist$" -- \
     "$bin" bake "$tmp/nope.geojson" -o "$tmp/no/such/x.plxb"
-if [ -z "$PLX_TEST_QUICK" ]; then # check-full (with the block above)
+if [ -z "$PLX_TEST_SKIP_SLOW" ]; then # (with the block above)
 # render from a GeoJSON traces 16 photons a lamp too (4,740 lamps: 75,840 a
 # frame): the same image as --photons 75840, another than the old 65,536
 "$bin" render -q "$tmp/e15.geojson" --size 64x48 -o "$tmp/pd.png" >/dev/null
@@ -924,7 +924,7 @@ spots_same() { # NAME BAKE ARGS...: the default's spots equal --exhaustive's
 spots_same dark-spots-lazy-equals-exhaustive "$tmp/g4.plxb" --count 2 --res 4
 expect dark-spots-gathered-note 0 "indirect light gathered 1[0-9]{3} times for the 8300 street points" -- "$bin" dark-spots "$tmp/g4.plxb" --count 2 --res 4
 expect dark-spots-gathers-everywhere 0 "indirect light gathered 4034 times for the 4034 street points" -- "$bin" dark-spots "$tmp/ds.plxb" --count 3 --res 1
-if [ -z "$PLX_TEST_QUICK" ]; then # check-full: twins of the bake (about 3 s)
+if [ -z "$PLX_TEST_SKIP_SLOW" ]; then # not in plain make check: twins of the bake (about 3 s)
 # --threads: the gathers shared with twins of the bake, the same lux to the
 # last digit (every point gathered, 20 spots of lux 0.027 to 0.058)
 "$bin" dark-spots -q "$tmp/g4.plxb" --count 20 --res 4 --exhaustive --threads 1 >"$tmp/ds-t1.json" 2>/dev/null

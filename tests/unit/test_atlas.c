@@ -67,6 +67,7 @@
 #include "photon/trace.h"
 #include "photon/photon.h"
 #include "photon/indirect.h"
+#include "slow.h"
 
 #define PI 3.14159265358979323846
 #define MEM ((size_t)256 << 20)
@@ -987,7 +988,7 @@ static void layout_check(world *w, double fine, rng *r, layout_tally *t)
 
 static void test_layout(void **state)
 {
-    if (getenv("PLX_TEST_QUICK")) /* make check-full only: make check stays within a minute */
+    if (slow_test_skipped()) /* not in plain make check: it stays within a minute */
         skip();
     static const struct {
         const char *name, *path;
@@ -1604,7 +1605,7 @@ static void values_check(world *w, double fine, long nsamp, rng *r)
 
 static void test_values(void **state)
 {
-    if (getenv("PLX_TEST_QUICK")) /* make check-full only: make check stays within a minute */
+    if (slow_test_skipped()) /* not in plain make check: it stays within a minute */
         skip();
     rng r = { 0x5a1e5u };
     world w;
@@ -2199,7 +2200,7 @@ static void frames_check(world *w, double fine, int nframes, rng *r)
 
 static void test_frames(void **state)
 {
-    if (getenv("PLX_TEST_QUICK")) /* make check-full only: make check stays within a minute */
+    if (slow_test_skipped()) /* not in plain make check: it stays within a minute */
         skip();
     rng r = { 0xf4a3e5u };
     world w;
@@ -2932,7 +2933,7 @@ static void test_determinism(void **state)
 
 static void test_spacing(void **state)
 {
-    if (getenv("PLX_TEST_QUICK")) /* make check-full only: make check stays within a minute */
+    if (slow_test_skipped()) /* not in plain make check: it stays within a minute */
         skip();
     rng r = { 0x59ac1u };
     world w;

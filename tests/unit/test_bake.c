@@ -34,6 +34,7 @@
 #include "photon/irradiance_cache.h"
 #include "polarlux_port.h"
 #include "ref_bake_sum.h"
+#include "slow.h"
 
 #define MEM ((size_t)64 << 20)
 #define SCENE "fixtures/eixample-4x4.geojson"
@@ -606,7 +607,7 @@ static void test_atlas_in_bake(void **state)
  * view's light map, would need the twin to draw them too.) */
 static void test_bake_after_frames(void **state)
 {
-    if (getenv("PLX_TEST_QUICK")) /* make check-full only: make check stays within a minute */
+    if (slow_test_skipped()) /* not in plain make check: it stays within a minute */
         skip();
     baked k;
     size_t size = 0;
@@ -865,7 +866,7 @@ static void two_bit_flips(const baked *k, unsigned char *f)
 
 static void test_damaged(void **state)
 {
-    if (getenv("PLX_TEST_QUICK")) /* make check-full only: make check stays within a minute */
+    if (slow_test_skipped()) /* not in plain make check: it stays within a minute */
         skip();
     baked k = shared;
     unsigned char *f;
@@ -1017,7 +1018,7 @@ static void test_corpus(void **state)
 
 static void test_twin_mismatch(void **state)
 {
-    if (getenv("PLX_TEST_QUICK")) /* make check-full only: make check stays within a minute */
+    if (slow_test_skipped()) /* not in plain make check: it stays within a minute */
         skip();
     void *ma, *mb;
     plx_engine *a, *b;

@@ -17,6 +17,7 @@
 
 #include "polarlux.h"
 #include "port.h"
+#include "slow.h"
 
 #define MEM (64u << 20)
 #define CORPUS "tests/corpus/"
@@ -413,7 +414,7 @@ static const corpus_case corpus[] = {
 
 static void test_corpus_files(void **state)
 {
-    if (getenv("PLX_TEST_QUICK")) /* make check-full only: make check stays within a minute */
+    if (slow_test_skipped()) /* not in plain make check: it stays within a minute */
         skip();
     size_t i;
     (void)state;

@@ -19,6 +19,7 @@
 #include "polarlux_port.h"
 #include "port.h"
 #include "fixture.h"
+#include "slow.h"
 
 #define BIG ((size_t)256 << 20)
 
@@ -226,7 +227,7 @@ static void check_estimate(const char *text, size_t len, const char *name)
 
 static void test_scan_and_estimate_fixtures(void **state)
 {
-    if (getenv("PLX_TEST_QUICK")) /* make check-full only: make check stays within a minute */
+    if (slow_test_skipped()) /* not in plain make check: it stays within a minute */
         skip();
     static const char *const files[] = { "fixtures/tiny.geojson", "fixtures/grid-4x4.geojson",
                                          "fixtures/eixample-4x4.geojson", "fixtures/oldtown-8x8.geojson",
@@ -247,7 +248,7 @@ static void test_scan_and_estimate_fixtures(void **state)
 
 static void test_scan_and_estimate_generated(void **state)
 {
-    if (getenv("PLX_TEST_QUICK")) /* make check-full only: make check stays within a minute */
+    if (slow_test_skipped()) /* not in plain make check: it stays within a minute */
         skip();
     static const char *const styles[] = { "grid", "eixample", "oldtown" };
     int quick = getenv("PLX_TEST_QUICK") != NULL;

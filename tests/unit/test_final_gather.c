@@ -39,6 +39,7 @@
 #include "ref_scene.h"
 #include "ref_indirect.h"
 #include "fixture.h"
+#include "slow.h"
 
 #define PI 3.14159265358979323846
 
@@ -118,7 +119,7 @@ static double one_bounce_integral(double xl, double zl, double I, double R, doub
 
 static void test_one_bounce_wall(void **state)
 {
-    if (getenv("PLX_TEST_QUICK")) /* make check-full only: make check stays within a minute */
+    if (slow_test_skipped()) /* not in plain make check: it stays within a minute */
         skip();
     fixture f;
     double xl = 4.0, zl = 5.0, I = 1000.0, R = 30.0, ag = 0.5, worst = 0.0, mean = 0.0;
@@ -184,7 +185,7 @@ static void room_point(int face, int i, int j, double P[3], double n[3])
 
 static void test_energy_closed_room(void **state)
 {
-    if (getenv("PLX_TEST_QUICK")) /* make check-full only: make check stays within a minute */
+    if (slow_test_skipped()) /* not in plain make check: it stays within a minute */
         skip();
     fixture f;
     double xy[16] = {0, 0, 20, 0, 20, 20, 0, 20, 5, 5, 5, 15, 15, 15, 15, 5};
@@ -304,7 +305,7 @@ static void accuracy(const char *name, plx_engine *e, int npts, int paths, int s
 
 static void test_accuracy(void **state)
 {
-    if (getenv("PLX_TEST_QUICK")) /* make check-full only: make check stays within a minute */
+    if (slow_test_skipped()) /* not in plain make check: it stays within a minute */
         skip();
     plx_engine *e;
     double eg, ep, bound = quick_mode() ? 0.08 : 0.05;
@@ -339,7 +340,7 @@ static void test_accuracy(void **state)
  * left out reach the point only over more than 100 m). */
 static void test_select_lamps(void **state)
 {
-    if (getenv("PLX_TEST_QUICK")) /* make check-full only: make check stays within a minute */
+    if (slow_test_skipped()) /* not in plain make check: it stays within a minute */
         skip();
     plx_engine *e = engine_on("fixtures/eixample-4x4.geojson", NULL, 0);
     int npts = quick_mode() ? 2 : 8, paths = quick_mode() ? 6000 : 40000, np, i, k;
@@ -395,7 +396,7 @@ static void answers(double *E, const double *P, const double *N, int n, int reve
 
 static void test_same_bytes(void **state)
 {
-    if (getenv("PLX_TEST_QUICK")) /* make check-full only: make check stays within a minute */
+    if (slow_test_skipped()) /* not in plain make check: it stays within a minute */
         skip();
     plx_engine *e = engine_on("fixtures/eixample-4x4.geojson", NULL, 0);
     double P[3 * 16], N[3 * 16], a[16], b[16], c[16];

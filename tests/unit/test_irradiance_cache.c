@@ -36,6 +36,7 @@
 #include "render/render.h"
 #include "ref_indirect.h"
 #include "fixture.h"
+#include "slow.h"
 
 #define PI 3.14159265358979323846
 #define W 320
@@ -215,7 +216,7 @@ static void two_views(plx_camera *c, plx_camera *other)
  * render_surf_slots) gives the 64x48 frame of the default one. */
 static void test_image_same_bytes(void **state)
 {
-    if (getenv("PLX_TEST_QUICK")) /* make check-full only: make check stays within a minute */
+    if (slow_test_skipped()) /* not in plain make check: it stays within a minute */
         skip();
     plx_engine *e1 = fixture_new((size_t)1 << 30, "fixtures/eixample-4x4.geojson", NULL, 0);
     plx_engine *e2 = fixture_new((size_t)1 << 30, "fixtures/eixample-4x4.geojson", NULL, 0);
@@ -273,7 +274,7 @@ static void test_image_same_bytes(void **state)
  * frame without indirect light. */
 static void test_aerial_without_indirect_gathers_nothing(void **state)
 {
-    if (getenv("PLX_TEST_QUICK")) /* make check-full only: make check stays within a minute */
+    if (slow_test_skipped()) /* not in plain make check: it stays within a minute */
         skip();
     plx_engine *e1 = fixture_new((size_t)1 << 30, "fixtures/eixample-4x4.geojson", NULL, 0);
     plx_engine *e2 = fixture_new((size_t)1 << 30, "fixtures/eixample-4x4.geojson", NULL, 0);
@@ -315,7 +316,7 @@ static void test_aerial_without_indirect_gathers_nothing(void **state)
  * frame's far pixels use the same 8 m level. */
 static void test_image_after_aerial_same_bytes(void **state)
 {
-    if (getenv("PLX_TEST_QUICK")) /* make check-full only: make check stays within a minute */
+    if (slow_test_skipped()) /* not in plain make check: it stays within a minute */
         skip();
     plx_engine *e1 = fixture_new((size_t)1 << 30, "fixtures/eixample-4x4.geojson", NULL, 0);
     plx_engine *e2 = fixture_new((size_t)1 << 30, "fixtures/eixample-4x4.geojson", NULL, 0);

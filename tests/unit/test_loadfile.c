@@ -35,6 +35,7 @@
 #include "polarlux_port.h"
 #include "port.h"
 #include "fixture.h"
+#include "slow.h"
 
 static char tmpdir[512];
 
@@ -347,7 +348,7 @@ static void guarded_file(const char *src, int prefixes)
 
 static void test_guarded_views(void **state)
 {
-    if (getenv("PLX_TEST_QUICK")) /* make check-full only: make check stays within a minute */
+    if (slow_test_skipped()) /* not in plain make check: it stays within a minute */
         skip();
     static const char *const fixtures[] = {
         "fixtures/tiny.geojson", "fixtures/grid-4x4.geojson", "fixtures/ground-image.geojson",

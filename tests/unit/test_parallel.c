@@ -23,6 +23,7 @@
 
 #include "polarlux.h"
 #include "port.h"
+#include "slow.h"
 
 #define MAXJOBS 4096
 
@@ -64,7 +65,7 @@ static void check_call(tally *t, int workers, uint32_t njobs)
 
 static void test_every_job_once(void **state)
 {
-    if (getenv("PLX_TEST_QUICK")) /* make check-full only: make check stays within a minute */
+    if (slow_test_skipped()) /* not in plain make check: it stays within a minute */
         skip();
     static tally t;
     int c;

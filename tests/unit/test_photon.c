@@ -30,6 +30,7 @@
 #include "render/nightify.h"
 #include "ref_scene.h"
 #include "ref_indirect.h"
+#include "slow.h"
 
 #define PI 3.14159265358979323846
 
@@ -1035,7 +1036,7 @@ static double reference_indirect(tracer *T, const scene *s, const double P[3],
 
 static void test_accuracy_eixample(void **state)
 {
-    if (getenv("PLX_TEST_QUICK")) /* make check-full only: make check stays within a minute */
+    if (slow_test_skipped()) /* not in plain make check: it stays within a minute */
         skip();
     void *mem;
     plx_engine *e = open_fixture("fixtures/eixample-4x4.geojson", &mem, 512u << 20);

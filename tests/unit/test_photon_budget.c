@@ -19,6 +19,7 @@
 #include "polarlux.h"
 #include "polarlux_port.h"
 #include "photon/irradiance_cache.h"
+#include "slow.h"
 
 #define MEM ((size_t)256 << 20)
 #define SCENE "fixtures/eixample-4x4.geojson"
@@ -91,7 +92,7 @@ static void done(run *r)
 
 static void test_budgets_kept(void **state)
 {
-    if (getenv("PLX_TEST_QUICK")) /* make check-full only: make check stays within a minute */
+    if (slow_test_skipped()) /* not in plain make check: it stays within a minute */
         skip();
     run full, r;
     size_t budget;

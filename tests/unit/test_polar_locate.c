@@ -34,6 +34,7 @@
 #include "polar_faults.h"
 #include "ref_polar_scan.h"
 #include "ref_scene.h"
+#include "slow.h"
 
 #define ARENA_BYTES ((size_t)64 << 20)
 
@@ -714,7 +715,7 @@ static void test_construction_work(void **state)
  * then a build in an arena too small by a little fails the same way. */
 static void test_fault_injection(void **state)
 {
-    if (getenv("PLX_TEST_QUICK")) /* make check-full only: make check stays within a minute */
+    if (slow_test_skipped()) /* not in plain make check: it stays within a minute */
         skip();
     fix *f = fix_new();
     uint64_t k;

@@ -42,6 +42,7 @@
 #include "polar/visibility.h"
 #include "ref_scene.h"
 #include "ref_vis.h"
+#include "slow.h"
 
 #define PI 3.14159265358979323846
 #define ARENA_BYTES ((size_t)32 << 20)
@@ -478,7 +479,7 @@ static int quick(int n)
 
 static void test_crossing_scenes(void **state)
 {
-    if (getenv("PLX_TEST_QUICK")) /* make check-full only: make check stays within a minute */
+    if (slow_test_skipped()) /* not in plain make check: it stays within a minute */
         skip();
     counts c;
     int k, kind, nsc = quick(100);

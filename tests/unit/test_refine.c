@@ -19,6 +19,7 @@
 #include "polarlux.h"
 #include "polarlux_port.h"
 #include "fixture.h"
+#include "slow.h"
 
 #define MEM ((size_t)256 << 20)
 
@@ -90,7 +91,7 @@ static void model_update(model *m, plx_engine *e, const double eye[3], double ra
 
 static void test_lru_along_path(void **state)
 {
-    if (getenv("PLX_TEST_QUICK")) /* make check-full only: make check stays within a minute */
+    if (slow_test_skipped()) /* not in plain make check: it stays within a minute */
         skip();
     void *mem;
     plx_engine *e = fixture_load_file(fixture_engine(MEM, 0, plx_port_posix(), &mem), "fixtures/eixample-4x4.geojson");
@@ -340,7 +341,7 @@ static void set_camera(plx_camera *c, double ex, double ey, double ez, double tx
 
 static void test_view_centre(void **state)
 {
-    if (getenv("PLX_TEST_QUICK")) /* make check-full only: make check stays within a minute */
+    if (slow_test_skipped()) /* not in plain make check: it stays within a minute */
         skip();
     static const double cams[][6] = {
         { 100, 266, 1.7, 110, 266, 1.7 },   /* level: half the radius ahead */
@@ -449,7 +450,7 @@ static uint32_t chosen_in_frame(plx_engine *e, const plx_camera *c, const double
  * than those around the eye, most of them under or behind it. */
 static void test_view_refines_what_it_shows(void **state)
 {
-    if (getenv("PLX_TEST_QUICK")) /* make check-full only: make check stays within a minute */
+    if (slow_test_skipped()) /* not in plain make check: it stays within a minute */
         skip();
     void *mem;
     plx_engine *e = fixture_load_file(fixture_engine(MEM, 0, plx_port_posix(), &mem), "fixtures/eixample-4x4.geojson");

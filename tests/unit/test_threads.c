@@ -22,6 +22,7 @@
 
 #include "polarlux.h"
 #include "polarlux_port.h"
+#include "slow.h"
 
 #define MEM ((size_t)192 << 20)
 #define W 200
@@ -147,7 +148,7 @@ static void test_same_bytes(void **state)
  * pixels they leave), the direct light on the workers: the same bytes. */
 static void test_gather_same_bytes(void **state)
 {
-    if (getenv("PLX_TEST_QUICK")) /* make check-full only: make check stays within a minute */
+    if (slow_test_skipped()) /* not in plain make check: it stays within a minute */
         skip();
     static frame one[2], other[2];
     plx_port back = *plx_port_posix();

@@ -19,6 +19,7 @@
 #include "cli/cli.h"
 #include "cli/tiles.h"
 #include "png/image_write.h"
+#include "slow.h"
 
 #define SCENE "fixtures/helsinki-centre.geojson"
 
@@ -219,7 +220,7 @@ static const char *meta(sqlite3 *db, const char *name, char *buf, size_t len)
  * and the metadata says what the spec asks. */
 static void test_mbtiles_read_back(void **state)
 {
-    if (getenv("PLX_TEST_QUICK")) /* make check-full only: make check stays within a minute */
+    if (slow_test_skipped()) /* not in plain make check: it stays within a minute */
         skip();
     char dir[64], mbt[64], buf[256], path[256];
     const char *to_dir[] = { "tiles", SCENE, "--quiet", "--zoom", "14-15", "--max", "100", "-o", dir };

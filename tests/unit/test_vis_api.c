@@ -17,6 +17,7 @@
 #include "fixture.h"
 #include "base/engine.h"
 #include "ref_vis.h"
+#include "slow.h"
 
 #define MEM (256u << 20)
 
@@ -95,7 +96,7 @@ static void test_grid(void **state)
 
 static void test_eixample(void **state)
 {
-    if (getenv("PLX_TEST_QUICK")) /* make check-full only: make check stays within a minute */
+    if (slow_test_skipped()) /* not in plain make check: it stays within a minute */
         skip();
     (void)state;
     compare_fixture("fixtures/eixample-4x4.geojson", 40, 3);
