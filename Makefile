@@ -209,7 +209,7 @@ check: check-build
 # check-full also builds every benchmark (not run), so one that falls behind
 # the code fails here rather than in make bench
 check-full: check-build $(BENCHES)
-	@PLX_POLAR_RING_BIG=1 sh tests/run_tests.sh $(BUILD) $(TESTS)
+	@PLX_POLAR_RING_BIG=1 PLX_TEST_SKIP_SLOW= sh tests/run_tests.sh $(BUILD) $(TESTS)
 	@sh tests/cli/memory_city.sh $(BUILD)/polarlux
 	@$(MAKE) --no-print-directory check-examples check-python
 
@@ -322,7 +322,7 @@ asan:
 valgrind: all $(TESTS)
 	@for t in $(TESTS); do \
 	  echo "valgrind $$t"; \
-	  PLX_TEST_QUICK=1 valgrind -q --error-exitcode=9 --leak-check=full --errors-for-leak-kinds=definite --suppressions=tests/valgrind.supp $$t >/dev/null || exit 1; \
+	  PLX_TEST_QUICK=1 PLX_TEST_SKIP_SLOW= valgrind -q --error-exitcode=9 --leak-check=full --errors-for-leak-kinds=definite --suppressions=tests/valgrind.supp $$t >/dev/null || exit 1; \
 	done; echo "valgrind: clean"
 
 # The refactor check (not part of make check: it builds another revision):

@@ -128,7 +128,7 @@ check-arm64: check-arm64-build all
 	@file $(ARM64_BUILD)/polarlux | grep -q 'ARM aarch64' || { echo "check-arm64: not an aarch64 binary"; exit 1; }
 	@# every test runs, with the shorter random loops of the quick mode (qemu is
 	@# about 10x slower than the host; the host runs the full loops)
-	@PLX_TEST_QUICK=1 PLX_NO_SHIM='an x86 shim cannot reach a program under qemu' \
+	@PLX_TEST_QUICK=1 PLX_TEST_SKIP_SLOW= PLX_NO_SHIM='an x86 shim cannot reach a program under qemu' \
 	  PLX_NO_FORK_THREADS='qemu-user aborts when a child of a threaded process starts threads' \
 	  sh tests/run_tests.sh $(ARM64_RUN) $(ARM64_TESTS:$(ARM64_BUILD)/%=$(ARM64_RUN)/%)
 	@set -e; t=$$(mktemp -d); trap 'rm -rf "$$t"' EXIT; n=0; \

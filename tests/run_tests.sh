@@ -5,12 +5,13 @@
 # usage: tests/run_tests.sh BUILD_DIR TEST_BINARY...
 build=$1; shift
 jobs=${PLX_TEST_JOBS:-$(getconf _NPROCESSORS_ONLN 2>/dev/null || echo 2)}
-passed=0; failed=0; broken=""
+passed=0; failed=0; skipped=0; broken=""
 logs=$(mktemp -d)
 # the command-line tests and the hostile corpus (many short runs of the
 # command, mostly one core each) alongside the unit tests
 # (the hostile corpus not in plain make check, PLX_TEST_SKIP_SLOW, which
-# stays within a minute on two cores: check-full, asan and valgrind run it)
+# stays within a minute on two cores: check-full, asan, check-arm64 and
+# check-hostile-valgrind run it)
 if [ -z "$PLX_TEST_SKIP_SLOW" ]; then
     (sh tests/cli/hostile.sh "$build/polarlux" >"$logs/hostile.log" 2>&1; echo $? >"$logs/hostile.rc") &
 else
@@ -27,14 +28,15 @@ for t in "$@"; do
     name=$(basename "$t"); log="$logs/$name.log"; rc=$(cat "$logs/$name.rc" 2>/dev/null || echo 1)
     p=$(sed -n 's/^\[  PASSED  \] \([0-9]*\) test.*/\1/p' "$log" | tail -1)
     f=$(sed -n 's/^\[  FAILED  \] \([0-9]*\) test.*/\1/p' "$log" | tail -1)
-    p=${p:-0}; f=${f:-0}
+    s=$(sed -n 's/^\[  SKIPPED \] \([0-9][0-9]*\) test.*/\1/p' "$log" | tail -1)
+    p=${p:-0}; f=${f:-0}; skipped=$((skipped + ${s:-0}))
     if [ "$rc" -ne 0 ] && [ "$f" -eq 0 ]; then f=1; fi
     passed=$((passed + p)); failed=$((failed + f))
     if [ "$f" -ne 0 ]; then
         broken="$broken $name"
         echo "---- $name (exit $rc)"; cat "$log"
     else
-        echo "ok   $name: $p tests"
+        echo "ok   $name: $p tests${s:+, $s skipped}"
     fi
 done
 log="$logs/cli.log"; rc=$(cat "$logs/cli.rc")
@@ -55,11 +57,12 @@ passed=$((passed + p)); failed=$((failed + f))
 if [ "$f" -ne 0 ] || [ "$rc" -ne 0 ]; then
     broken="$broken hostile"; echo "---- hostile"; cat "$log"
 elif [ -n "$PLX_TEST_SKIP_SLOW" ]; then
-    echo "--   hostile: in make check-full, make asan and make check-hostile-valgrind"
+    echo "--   hostile: in make check-full, make asan, make check-arm64 and make check-hostile-valgrind"
 else
     echo "ok   hostile: $p tests"
 fi
 rm -rf "$logs"
 [ -n "$broken" ] && echo "failing:$broken"
+[ "$skipped" -gt 0 ] && echo "skipped: $skipped unit tests (each says why in its source)"
 echo "$passed passed, $failed failed"
 [ "$failed" -eq 0 ]

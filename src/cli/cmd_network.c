@@ -308,7 +308,8 @@ static int cap_detour(network *net, plx_engine *e, const net_snap *a, const net_
         double mid = 0.5 * (lo + hi);
         net_route r;
         int rc = net_route_find(net, e, a, b, mid, &r, err, errlen);
-        if (rc == 1) /* no route at a lower weight than one that found it: the costs overflowed */
+        if (rc == 1) /* no route at a lower weight than one that found it: not expected (the weights are
+                      * bounded and the shortest route's edges scored), but named if it happens */
             snprintf(err, errlen, "no route at --dark-weight %g while capping the detour", mid);
         if (rc != 0)
             return -1;

@@ -626,6 +626,7 @@ int net_route_find(network *net, plx_engine *e, const net_snap *a, const net_sna
     if (net->dist[q.T] == INFINITY) {
         rc = 1;
     } else if (collect(net, &q, out) != 0) {
+        net_route_free(out); /* the polyline as far as it got */
         snprintf(err, errlen, "out of memory for the route");
         rc = -1;
     } else {
