@@ -100,32 +100,33 @@ static int parse_step(const char *v, void *dst)
     return cli_parse_double(v, d) != 0 || !(*d >= 0.01) || !isfinite(*d) ? -1 : 0;
 }
 
-/* A number >= 0, then at most 1000 (its own message; dst: the net_opts). */
-static int parse_height(const char *v, void *dst)
+/* A number >= 0 into *d, then at most max: -1 (the option's own "not a
+ * number" message), or -2 with too_big (its '%s': the value) printed. */
+static int number_at_most(const net_opts *o, const char *v, double *d, double max, const char *too_big)
 {
-    net_opts *o = dst;
-    if (parse_number(v, &o->height) != 0)
+    if (parse_number(v, d) != 0)
         return -1;
-    if (o->height > 1000) {
-        cli_usage_error(o->cmd, "--height '%s' is not a number of metres from 0 to 1000", v);
+    if (*d > max) {
+        cli_usage_error(o->cmd, too_big, v);
         return -2;
     }
     return 0;
 }
 
-/* A number >= 0, then at most 1e6 (its own message; dst: the net_opts):
- * far larger weights only overflow the route's costs to infinity, which
- * the search would take for unconnected ends. */
+/* dst: the net_opts. */
+static int parse_height(const char *v, void *dst)
+{
+    net_opts *o = dst;
+    return number_at_most(o, v, &o->height, 1000, "--height '%s' is not a number of metres from 0 to 1000");
+}
+
+/* Far larger weights only overflow the route's costs to infinity, which
+ * the search would take for unconnected ends. dst: the net_opts. */
 static int parse_weight(const char *v, void *dst)
 {
     net_opts *o = dst;
-    if (parse_number(v, &o->weight) != 0)
-        return -1;
-    if (o->weight > 1e6) {
-        cli_usage_error(o->cmd, "--dark-weight '%s' is more than 1000000 (a dark metre's cost in lit metres)", v);
-        return -2;
-    }
-    return 0;
+    return number_at_most(o, v, &o->weight, 1e6,
+                          "--dark-weight '%s' is more than 1000000 (a dark metre's cost in lit metres)");
 }
 
 /* Parses the options shared by route --network and annotate; -1 for --help
