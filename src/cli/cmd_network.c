@@ -40,7 +40,8 @@ static const char route_help[] =
     "  --dark-weight W  extra cost of a dark metre in metres, 0 to 1e6 (default 3)\n"
     "  --max-detour F   the best-lit route may be at most (1 + F) times as long\n"
     "                   as the shortest: W is lowered to the largest weight whose\n"
-    "                   route keeps within it (bisection to W/1000)\n"
+    "                   route keeps within it (halving W until a route keeps\n"
+    "                   within, then bisection to a thousandth of the weight)\n"
     "  --snap M         the ends may lie at most M metres from a street (default 50)\n"
     "  --step M         sampling step in metres (default 1)\n"
     "  --height M       height of the Ev/Esc meters above the street (default 1.5)\n"
@@ -289,41 +290,17 @@ static int write_routes(const net_opts *o, plx_engine *e, const net_route *best,
     return rc;
 }
 
-/* The best-lit route within --max-detour: bisection on the weight between
- * 0 (the shortest route, always within) and W. Route length does not fall
- * as the weight grows, so the largest feasible weight is found. */
+/* The best-lit route within --max-detour (net_route_capped), in place of
+ * the route at W in *best. */
 static int cap_detour(network *net, plx_engine *e, const net_snap *a, const net_snap *b, const net_opts *o,
                       const net_route *shortest, net_route *best, double *weight, char *err, size_t errlen)
 {
-    double lo = 0, hi = o->weight, cap = (1.0 + o->detour) * shortest->length;
-    net_route_free(best);
-    *best = *shortest;
-    best->xy = malloc(sizeof *best->xy * 2 * (shortest->n + 1));
-    if (!best->xy) {
-        snprintf(err, errlen, "out of memory while capping the detour");
+    net_route capped;
+    if (net_route_capped(net, e, a, b, o->weight, (1.0 + o->detour) * shortest->length, shortest, &capped, weight,
+                         err, errlen) != 0)
         return -1;
-    }
-    memcpy(best->xy, shortest->xy, sizeof *best->xy * 2 * shortest->n);
-    *weight = 0;
-    while (hi - lo > o->weight * 1e-3) {
-        double mid = 0.5 * (lo + hi);
-        net_route r;
-        int rc = net_route_find(net, e, a, b, mid, &r, err, errlen);
-        if (rc == 1) /* no route at a lower weight than one that found it: not expected (the weights are
-                      * bounded and the shortest route's edges scored), but named if it happens */
-            snprintf(err, errlen, "no route at --dark-weight %g while capping the detour", mid);
-        if (rc != 0)
-            return -1;
-        if (r.length <= cap) {
-            lo = mid;
-            net_route_free(best);
-            *best = r;
-            *weight = mid;
-        } else {
-            hi = mid;
-            net_route_free(&r);
-        }
-    }
+    net_route_free(best);
+    *best = capped;
     return 0;
 }
 

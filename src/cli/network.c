@@ -746,6 +746,69 @@ done:
     return st;
 }
 
+/* One test of net_route_capped: the route at weight w, kept in *best (and
+ * w in *wbest) when it is within the cap. 1 within, 0 not, -1 failed. */
+static int capped_try(network *net, plx_engine *e, const net_snap *a, const net_snap *b, double w, double cap,
+                      net_route *best, double *wbest, char *err, size_t errlen)
+{
+    net_route r;
+    int rc = net_route_find(net, e, a, b, w, &r, err, errlen);
+    if (rc == 1) /* no route at a lower weight than one that found it: not expected (the weights are bounded
+                  * and the shortest route's edges scored), but named if it happens */
+        snprintf(err, errlen, "no route at --dark-weight %g while capping the detour", w);
+    if (rc != 0)
+        return -1;
+    if (!(r.length <= cap)) {
+        net_route_free(&r);
+        return 0;
+    }
+    net_route_free(best);
+    *best = r;
+    *wbest = w;
+    return 1;
+}
+
+int net_route_capped(network *net, plx_engine *e, const net_snap *a, const net_snap *b, double weight, double cap,
+                     const net_route *shortest, net_route *out, double *wout, char *err, size_t errlen)
+{
+    double lo = 0.0, hi = weight, w;
+    int k, rc = 0;
+    *out = *shortest;
+    out->xy = malloc(sizeof *out->xy * 2 * ((size_t)shortest->n + 1));
+    if (!out->xy) {
+        snprintf(err, errlen, "out of memory while capping the detour");
+        return -1;
+    }
+    memcpy(out->xy, shortest->xy, sizeof *out->xy * 2 * shortest->n);
+    *wout = 0.0;
+    /* halving from 'weight' down to the first weight within the cap (the
+     * feasible weights are an interval from 0, as a route's length never
+     * falls as the weight grows), then bisecting between it and the one
+     * above to a thousandth of it: the same relative precision at any
+     * 'weight' (a step of weight / 1000 from 0 left weights under it at
+     * 0, the shortest route, when 'weight' was large) */
+    for (k = 0, w = 0.5 * weight; k < NET_CAP_HALVINGS && rc == 0; k++, w *= 0.5) {
+        rc = capped_try(net, e, a, b, w, cap, out, wout, err, errlen);
+        if (rc == 0)
+            hi = w;
+        else if (rc == 1)
+            lo = w;
+    }
+    while (rc >= 0 && lo > 0.0 && hi - lo > lo * NET_CAP_PRECISION) {
+        w = 0.5 * (lo + hi);
+        rc = capped_try(net, e, a, b, w, cap, out, wout, err, errlen);
+        if (rc == 0)
+            hi = w;
+        else if (rc == 1)
+            lo = w;
+    }
+    if (rc < 0) {
+        net_route_free(out);
+        return -1;
+    }
+    return 0;
+}
+
 void net_route_free(net_route *r)
 {
     free(r->xy);

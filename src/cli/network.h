@@ -110,6 +110,21 @@ void net_route_free(net_route *r);
 plx_status net_score_route(network *net, plx_engine *e, twin_set *tg, const net_snap *a, const net_snap *b,
                            double weight, int progress, size_t *nscored /* OUT */, plx_engine **failed /* OUT */);
 
+/* The best-lit route from a to b no longer than 'cap' metres, when the
+ * route at 'weight' is longer: the route at the largest weight in
+ * [0, weight] whose route keeps within the cap (a route's length never
+ * falls as the weight grows, so those weights are an interval from 0),
+ * found by halving from 'weight' (at most NET_CAP_HALVINGS times, after
+ * which the shortest route, weight 0, is taken) and then bisecting to
+ * NET_CAP_PRECISION of the weight found. *out (net_route_free) and *wout
+ * the weight; 'shortest' is the route at weight 0 (copied when no weight
+ * above 0 keeps within the cap). 0, or -1 with a message in err. */
+#define NET_CAP_HALVINGS 60
+#define NET_CAP_PRECISION 1e-3
+int net_route_capped(network *net, plx_engine *e, const net_snap *a, const net_snap *b, double weight, double cap,
+                     const net_route *shortest, net_route *out /* OUT */, double *wout /* OUT */, char *err,
+                     size_t errlen);
+
 /* The number of connected parts of the network (for messages). */
 uint32_t net_components(const network *net);
 

@@ -10,6 +10,9 @@ expect net-weight-too-large 2 "route: --dark-weight '1e308' is more than 1000000
 expect net-weight-largest 0 "^best-lit +300\.0 +69\.0 " -- "$bin" route -q $net --from 0,0 --to 200,0 --dark-weight 1e6
 expect net-max-detour 0 "^best-lit +200\.0 " -- "$bin" route -q $net --from 0,0 --to 200,0 --max-detour 0.2
 expect net-max-detour-says 0 "weight lowered from 3 by --max-detour 0\.2" -- "$bin" route -q $net --from 0,0 --to 200,0 --max-detour 0.2
+# the weight lowered by --max-detour to a thousandth of itself at any W (a
+# step of W/1000 from 0 left W = 1e6 at 0 where W = 3 finds 0.763)
+expect net-capped-any-weight 0 "cost = length \+ 0\.763[0-9]* x dark metres.*weight lowered from 1e\+06" -- "$bin" route -q $net --from 0,0 --to 200,0 --max-detour 0.2 --dark-weight 1e6
 expect net-max-detour-loose 0 "^best-lit +300\.0 " -- "$bin" route -q $net --from 0,0 --to 200,0 --max-detour 0.6
 expect net-far-start 1 "route: --from 0,-80 is 80\.0 m from the nearest street of fixtures/net-detour-streets\.geojson \(more than --snap 50 m\)" -- "$bin" route -q $net --from 0,-80 --to 200,0
 expect net-unreachable 1 "no path from --from 0,0 to --to 410,400: they lie on unconnected parts of the network \(it has 2 parts\)" -- "$bin" route -q $net --from 0,0 --to 410,400

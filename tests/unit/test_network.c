@@ -440,6 +440,85 @@ static void test_random_grids_against_bellman_ford(void **state)
     assert_true(unreached > 0);
 }
 
+/* net_route_capped (route --max-detour) against a sweep of weights, on
+ * the random grids: for ends anywhere on the network, weights W of 3, 100
+ * and 10^6 and caps 5% and 20% over the shortest route, whenever the
+ * route at W is longer than the cap: the route found keeps within it, its
+ * weight is at least the largest of 131 weights from W down to 10^-13 W
+ * (ten a decade) whose route keeps within it, less the bisection's
+ * precision, and it has no more dark metres than that route; and the
+ * route at its weight plus twice the precision no longer keeps within
+ * the cap (the weight found is the largest, to the precision). A step of
+ * W / 1000 from 0, the bisection before, failed this at W = 10^6 (its
+ * weight stayed 0 below 1000, the shortest route). */
+static void test_capped_route_against_sweep(void **state)
+{
+    static const double weights[3] = { 3.0, 100.0, 1e6 }, detours[2] = { 0.05, 0.2 };
+    int seed, rounds = getenv("PLX_TEST_QUICK") ? 4 : 16, capped = 0, lowered = 0;
+    (void)state;
+    for (seed = 0; seed < rounds; seed++) {
+        void *mem;
+        char *scene, err[256];
+        network net;
+        plx_engine *e = grid_case(seed + 100, &mem, &scene, &net);
+        uint32_t q;
+        for (q = 0; q < 12; q++) {
+            uint32_t s = (uint32_t)(rnd() * net.nnodes), t = (uint32_t)(rnd() * net.nnodes);
+            double W = weights[q % 3], cap, wb = -1.0, ws = 0.0;
+            net_snap a, b;
+            net_route r0, rW, best, rs, over;
+            int k;
+            snap(&net, net.node_xy[2 * s], net.node_xy[2 * s + 1], &a);
+            snap(&net, net.node_xy[2 * t], net.node_xy[2 * t + 1], &b);
+            if (net_route_find(&net, e, &a, &b, 0.0, &r0, err, sizeof err) != 0)
+                continue; /* unconnected ends */
+            cap = (1.0 + detours[(q / 3) % 2]) * r0.length;
+            assert_int_equal(net_route_find(&net, e, &a, &b, W, &rW, err, sizeof err), 0);
+            if (rW.length <= cap) {
+                net_route_free(&r0);
+                net_route_free(&rW);
+                continue;
+            }
+            assert_int_equal(net_route_capped(&net, e, &a, &b, W, cap, &r0, &best, &wb, err, sizeof err), 0);
+            assert_true(best.length <= cap);
+            assert_true(wb >= 0.0 && wb < W);
+            memset(&rs, 0, sizeof rs);
+            for (k = 0; k <= 130; k++) { /* the sweep, from W down: its first route within the cap */
+                double w = W * pow(10.0, -0.1 * k);
+                assert_int_equal(net_route_find(&net, e, &a, &b, w, &rs, err, sizeof err), 0);
+                if (rs.length <= cap) {
+                    ws = w;
+                    break;
+                }
+                net_route_free(&rs);
+            }
+            assert_true(wb >= ws * (1.0 - 2.0 * NET_CAP_PRECISION));
+            if (ws > 0.0) {
+                assert_true(best.dark + best.blocked <= rs.dark + rs.blocked + 1e-9);
+                net_route_free(&rs);
+            }
+            if (wb > 0.0) {
+                assert_int_equal(net_route_find(&net, e, &a, &b, wb * (1.0 + 2.0 * NET_CAP_PRECISION), &over, err,
+                                                sizeof err), 0);
+                assert_true(over.length > cap);
+                net_route_free(&over);
+                lowered++;
+            }
+            capped++;
+            net_route_free(&best);
+            net_route_free(&r0);
+            net_route_free(&rW);
+        }
+        net_free(&net);
+        plx_engine_destroy(e);
+        free(mem);
+        free(scene);
+    }
+    print_message("capped routes: %d, %d with a weight above 0\n", capped, lowered);
+    assert_true(capped >= rounds);
+    assert_true(lowered > 0);
+}
+
 /* Two routes the same bytes: polyline and every sum. */
 static void assert_same_route(const net_route *x, const net_route *y)
 {
@@ -669,6 +748,7 @@ int main(void)
         cmocka_unit_test(test_class_depends_on_facial_criterion),
         cmocka_unit_test(test_random_grids_against_bellman_ford),
         cmocka_unit_test(test_route_scoring_against_every_edge),
+        cmocka_unit_test(test_capped_route_against_sweep),
         cmocka_unit_test(test_snap_and_empty),
         cmocka_unit_test(test_twin_for),
     };
