@@ -117,8 +117,10 @@ plx_status net_score_route(network *net, plx_engine *e, twin_set *tg, const net_
  * found by halving from 'weight' (at most NET_CAP_HALVINGS times, after
  * which the shortest route, weight 0, is taken) and then bisecting to
  * NET_CAP_PRECISION of the weight found. *out (net_route_free) and *wout
- * the weight; 'shortest' is the route at weight 0 (copied when no weight
- * above 0 keeps within the cap). 0, or -1 with a message in err. */
+ * the weight; 'shortest' is the route at weight 0, copied when no weight
+ * above 0 keeps within the cap (in practice never: at a weight small
+ * enough the route is a shortest one). 0, or -1 with a message in err
+ * (*wout then undefined). */
 #define NET_CAP_HALVINGS 60
 #define NET_CAP_PRECISION 1e-3
 int net_route_capped(network *net, plx_engine *e, const net_snap *a, const net_snap *b, double weight, double cap,
