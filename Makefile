@@ -146,7 +146,7 @@ $(BUILD)/tests/test_%: $(BUILD)/tests/unit/test_%.o $(REF_OBJ) $(PORT_A) $(LIB_A
 	$(CC) $(CFLAGS_ALL) -o $@ $< $(REF_OBJ) $(PORT_A) $(LIB_A) -lcmocka $(LIBS)
 
 # Tests and benches of the command's network and tile code link those objects.
-CLI_TEST_OBJ = $(addprefix $(BUILD)/src/cli/,network.o route_io.o geo_out.o tiles.o mbtiles.o cmd_heatmap.o \
+CLI_TEST_OBJ = $(addprefix $(BUILD)/src/cli/,network.o net_scores.o route_io.o geo_out.o tiles.o mbtiles.o cmd_heatmap.o \
                canvas.o common.o cmd_network.o cmd_tiles.o cmd_route.o lamp_layer.o bigmem.o options.o points.o \
                twin_engines.o)
 CLI_TESTS = $(BUILD)/tests/test_network $(BUILD)/tests/test_tiles $(BUILD)/bench/bench_network

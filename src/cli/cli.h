@@ -203,6 +203,10 @@ void cli_light_note(const char *cmd, const cli_common *c, plx_engine *e);
  * one, else 0 and buf empty (a bake, no such member, a file that cannot
  * be mapped). */
 int cli_scene_attribution(const char *path, char *buf, size_t cap);
+/* v (finite) in the fewest significant digits that read back as v
+ * (24.937911661 as it was written, not 24.93791166 or
+ * 24.937911661000001); len at least 32. */
+void cli_shortest(double v, char *out, size_t len);
 /* A point query's failure (plx_last_error) at FILE:LINE, the point as the
  * file gave it (given: x y) when that differs from the local metres the
  * library names (lon/lat points): "point 24.9379 60.1740 (local -353.5,

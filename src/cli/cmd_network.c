@@ -8,6 +8,7 @@
 #include "options.h"
 #include "geo_out.h"
 #include "network.h"
+#include "net_scores.h"
 #include "port.h"
 
 static const char route_help[] =
@@ -32,6 +33,10 @@ static const char route_help[] =
     "where dark metres are the metres below --dark-lux plus the metres inside\n"
     "building footprints (passages, whose light is unknown). W = 0 gives the\n"
     "shortest route.\n"
+    "STREETS may be 'polarlux annotate' output: its edges' light is then read,\n"
+    "not scored again (only the ends' pieces are), when it was made on this\n"
+    "scene (the same buildings, lamps and photon frames) with the same --step,\n"
+    "--dark-lux and --height; otherwise the command says what differs.\n"
     "\n"
     "  --network FILE   the street network (required; '-': standard input)\n"
     "  --from X,Y       start (required)\n"
@@ -72,7 +77,10 @@ static const char annotate_help[] =
     "the feature's id, else #FEATURE) summed over its edges:\n"
     "osm_id,length_m,dark_m,blocked_m,dark_share,mean_lux,min_lux,class,factor,\n"
     "min_ev_lux,min_sc_lux,class_h, for routing engines that take per-way\n"
-    "weights.\n"
+    "weights. The GeoJSON also holds below_m (dark_m less blocked_m) and, as\n"
+    "its member polarlux_scores, the settings and the scene it was scored for,\n"
+    "so that 'polarlux route --network OUT.geojson' reads the edges' light\n"
+    "instead of scoring them again.\n"
     "\n"
     "  --network FILE   the street network (required; '-': standard input)\n"
     "  -o OUT           the annotated GeoJSON (required)\n"
@@ -180,14 +188,17 @@ static int parse_point(plx_engine *e, const char *s, double *x, double *y)
 /* Loads the network and scores its edges (all: every edge; else none yet,
  * for net_score_route); prints the error and returns an exit code on
  * failure. */
-static int load_network(const net_opts *o, plx_engine *e, network *net, int all)
+static int load_network(const net_opts *o, plx_engine *e, network *net, int all, int *read_scores)
 {
     route_set rs;
     char err[512];
     plx_status st;
     plx_engine *failed;
     twin_set tg;
-    if (route_read(o->network, e, &rs, err, sizeof err) != 0) {
+    cJSON *doc = NULL;
+    int usage;
+    *read_scores = 0;
+    if (route_read_doc(o->network, e, &rs, all ? NULL : &doc, err, sizeof err) != 0) {
         fprintf(stderr, "polarlux %s: %s\n", o->cmd, err);
         return EXIT_FAIL;
     }
@@ -195,10 +206,19 @@ static int load_network(const net_opts *o, plx_engine *e, network *net, int all)
         cli_warn(o->cmd, &o->c, "%s: %s", o->network, rs.note);
     if (net_build(net, &rs, err, sizeof err) != 0) {
         fprintf(stderr, "polarlux %s: %s: %s\n", o->cmd, o->network, err);
+        cJSON_Delete(doc);
         return EXIT_FAIL;
     }
-    if (!all) {
+    if (!all) { /* route: annotate's scores when the file holds them, else none yet (net_score_route) */
         net_set_scoring(net, o->step, o->dark, o->height);
+        *read_scores = net_scores_read(net, doc, e, &usage, err, sizeof err);
+        cJSON_Delete(doc);
+        if (*read_scores < 0) {
+            fprintf(stderr, "polarlux %s: %s: annotate's scores: %s\n", o->cmd, o->network, err);
+            net_free(net);
+            return usage ? EXIT_USAGE : EXIT_FAIL;
+        }
+        *read_scores = *read_scores == 0;
         return EXIT_OK;
     }
     twin_set_init(&tg, o->cmd, o->scene, &o->c, e);
@@ -216,32 +236,19 @@ static int load_network(const net_opts *o, plx_engine *e, network *net, int all)
     return EXIT_OK;
 }
 
-static void class_text(int c, char out[4])
-{
-    if (c)
-        snprintf(out, 4, "P%d", c);
-    else
-        strcpy(out, "-");
-}
-
 static double route_mean(const net_route *r)
 {
     return r->scored > 0 ? r->integral / r->scored : 0.0;
 }
 
 /* A SPEC §6 minimum for output: -1 when there was no meter (NaN). */
-static double or_none(double v)
-{
-    return v == v ? v : -1.0;
-}
-
 static void print_route(const char *name, const net_route *r, double shortest)
 {
     char cls[4], clh[4];
-    class_text(r->p_class, cls);
-    class_text(r->p_class_h, clh);
+    net_class_text(r->p_class, cls);
+    net_class_text(r->p_class_h, clh);
     printf("%-9s %9.1f %9.1f %9.3f %9.3f %9.3f %9.3f  %-7s %-5s %+7.1f%%\n", name, r->length, r->dark + r->blocked,
-           r->min, route_mean(r), or_none(r->min_ev), or_none(r->min_esc), clh, cls,
+           r->min, route_mean(r), net_or_none(r->min_ev), net_or_none(r->min_esc), clh, cls,
            shortest > 0 ? 100.0 * (r->length / shortest - 1.0) : 0.0);
 }
 
@@ -249,16 +256,16 @@ static cJSON *route_props(const char *name, const net_route *r, double shortest,
 {
     cJSON *p = cJSON_CreateObject();
     char cls[4];
-    class_text(r->p_class, cls);
+    net_class_text(r->p_class, cls);
     cJSON_AddStringToObject(p, "route", name);
     cJSON_AddNumberToObject(p, "length_m", r->length);
     cJSON_AddNumberToObject(p, "dark_m", r->dark + r->blocked);
     cJSON_AddNumberToObject(p, "min_lux", r->min);
     cJSON_AddNumberToObject(p, "mean_lux", route_mean(r));
-    cJSON_AddNumberToObject(p, "min_ev_lux", or_none(r->min_ev));
-    cJSON_AddNumberToObject(p, "min_sc_lux", or_none(r->min_esc));
+    cJSON_AddNumberToObject(p, "min_ev_lux", net_or_none(r->min_ev));
+    cJSON_AddNumberToObject(p, "min_sc_lux", net_or_none(r->min_esc));
     cJSON_AddStringToObject(p, "class", cls);
-    class_text(r->p_class_h, cls);
+    net_class_text(r->p_class_h, cls);
     cJSON_AddStringToObject(p, "class_h", cls);
     cJSON_AddNumberToObject(p, "blocked_m", r->blocked);
     cJSON_AddNumberToObject(p, "detour_pct", shortest > 0 ? 100.0 * (r->length / shortest - 1.0) : 0.0);
@@ -346,7 +353,9 @@ static int score_route_edges(const net_opts *o, plx_engine *e, network *net, con
     return st == PLX_OK ? EXIT_OK : cli_exit_code(st);
 }
 
-static int find_routes(const net_opts *o, plx_engine *e, network *net)
+/* The routes; the edges scored first unless read from annotate's scores
+ * (read_scores). */
+static int find_routes(const net_opts *o, plx_engine *e, network *net, int read_scores)
 {
     net_snap a, b;
     net_route shortest, best;
@@ -355,10 +364,13 @@ static int find_routes(const net_opts *o, plx_engine *e, network *net)
     int rc = snap_end(o, e, net, "--from", o->from_s, &a), r1, r2;
     if (rc == EXIT_OK)
         rc = snap_end(o, e, net, "--to", o->to_s, &b);
-    if (rc == EXIT_OK)
+    if (rc == EXIT_OK && !read_scores)
         rc = score_route_edges(o, e, net, &a, &b);
     if (rc != EXIT_OK)
         return rc;
+    if (read_scores && !o->c.quiet)
+        fprintf(stderr, "polarlux %s: note: the %u edges' light read from annotate's scores in %s (the ends' "
+                        "pieces scored here)\n", o->cmd, net->nedges, o->network);
     r1 = net_route_find(net, e, &a, &b, 0.0, &shortest, err, sizeof err);
     r2 = r1 == 0 ? net_route_find(net, e, &a, &b, o->weight, &best, err, sizeof err) : r1;
     if (r1 == 1 || r2 == 1) {
@@ -408,10 +420,11 @@ int cmd_route_network(int argc, char **argv)
     net_opts o;
     plx_engine *e;
     network net;
-    int rc;
+    int rc, read_scores;
     memset(&o, 0, sizeof o);
     o.cmd = "route";
     rc = parse(&o, argc, argv, route_help);
+    read_scores = 0;
     if (rc != EXIT_OK)
         return rc < 0 ? EXIT_OK : rc;
     if (!o.from_s || !o.to_s)
@@ -423,9 +436,9 @@ int cmd_route_network(int argc, char **argv)
     rc = cli_open_scene("route", o.scene, &o.c, &e);
     if (rc != EXIT_OK)
         return rc;
-    rc = load_network(&o, e, &net, 0);
+    rc = load_network(&o, e, &net, 0, &read_scores);
     if (rc == EXIT_OK) {
-        rc = find_routes(&o, e, &net);
+        rc = find_routes(&o, e, &net, read_scores);
         net_free(&net);
     }
     plx_engine_free(e);
@@ -436,13 +449,6 @@ int cmd_route_network(int argc, char **argv)
 
 /* The SPEC §6 class of mean and min E_h and min E_v, E_sc over both ways
  * (0 with no E_h sample or no meter). */
-static int full_class(double scored, double mean, double min, double min_ev, double min_esc)
-{
-    if (!(scored > 0) || min_ev != min_ev || min_esc != min_esc)
-        return 0;
-    return plx_p_class_facial(mean, min, min_ev, min_esc);
-}
-
 static const char *edge_id(const network *net, const net_edge *ed, char buf[48])
 {
     const route_line *l = &net->lines.lines[ed->line];
@@ -457,41 +463,22 @@ static int write_edges(const net_opts *o, plx_engine *e, const network *net)
     geo_out g;
     uint32_t i, k;
     int rc = EXIT_OK;
+    cJSON *h;
     if (geo_begin(&g, e) != 0)
         return EXIT_FAIL;
+    h = net_scores_header(net, e);
+    if (!h || !cJSON_AddItemToObject(g.root, NET_SCORES_MEMBER, h)) {
+        cJSON_Delete(h);
+        geo_free(&g);
+        fprintf(stderr, "polarlux annotate: out of memory\n");
+        return EXIT_FAIL;
+    }
     for (i = 0; i < net->nedges; i++) {
         const net_edge *ed = &net->edges[i];
         const route_line *l = &net->lines.lines[ed->line];
-        cJSON *p = cJSON_CreateObject(), *coords = cJSON_CreateArray();
-        double dark = ed->dark + ed->s.blocked_length, cost = ed->length + o->weight * dark;
-        double ev = fmin(ed->fac[0], ed->fac[1]), esc = fmin(ed->fac[2], ed->fac[3]);
-        char cls[4], buf[48];
-        class_text(full_class(ed->s.length, ed->s.mean, ed->s.min, ev, esc), cls);
-        cJSON_AddStringToObject(p, "osm_id", edge_id(net, ed, buf));
-        cJSON_AddStringToObject(p, "name", l->name);
-        cJSON_AddNumberToObject(p, "edge", i);
-        cJSON_AddNumberToObject(p, "from", ed->a);
-        cJSON_AddNumberToObject(p, "to", ed->b);
-        cJSON_AddNumberToObject(p, "length_m", ed->length);
-        cJSON_AddNumberToObject(p, "scored_m", ed->s.length);
-        cJSON_AddNumberToObject(p, "blocked_m", ed->s.blocked_length);
-        cJSON_AddNumberToObject(p, "dark_m", dark);
-        cJSON_AddNumberToObject(p, "dark_share", ed->length > 0 ? dark / ed->length : 0.0);
-        cJSON_AddNumberToObject(p, "mean_lux", ed->s.mean);
-        cJSON_AddNumberToObject(p, "min_lux", ed->s.min);
-        cJSON_AddNumberToObject(p, "max_lux", ed->s.max);
-        cJSON_AddNumberToObject(p, "uniformity", ed->s.uniformity);
-        cJSON_AddNumberToObject(p, "min_ev_fw_lux", or_none(ed->fac[0]));
-        cJSON_AddNumberToObject(p, "min_ev_bw_lux", or_none(ed->fac[1]));
-        cJSON_AddNumberToObject(p, "min_sc_fw_lux", or_none(ed->fac[2]));
-        cJSON_AddNumberToObject(p, "min_sc_bw_lux", or_none(ed->fac[3]));
-        cJSON_AddNumberToObject(p, "min_ev_lux", or_none(ev));
-        cJSON_AddNumberToObject(p, "min_sc_lux", or_none(esc));
-        cJSON_AddStringToObject(p, "class", cls);
-        class_text(ed->s.p_class, cls);
-        cJSON_AddStringToObject(p, "class_h", cls);
-        cJSON_AddNumberToObject(p, "cost", cost);
-        cJSON_AddNumberToObject(p, "factor", ed->length > 0 ? cost / ed->length : 1.0);
+        char buf[48];
+        cJSON *p = net_scores_edge_props(net, i, edge_id(net, ed, buf), l->name, o->weight);
+        cJSON *coords = cJSON_CreateArray();
         for (k = ed->v0; k <= ed->v1; k++)
             cJSON_AddItemToArray(coords, geo_position(&g, l->xy[2 * k], l->xy[2 * k + 1], NULL));
         geo_add(&g, geo_geometry("LineString", coords), p);
@@ -528,8 +515,8 @@ static void csv_row(FILE *f, const way_sum *w, double weight)
     double dark = w->dark + w->blocked;
     char cls[4], clh[4];
     const char *c;
-    class_text(full_class(w->scored, mean, min, w->min_ev, w->min_esc), cls);
-    class_text(w->scored > 0 ? plx_p_class(mean, min) : 0, clh);
+    net_class_text(net_full_class(w->scored, mean, min, w->min_ev, w->min_esc), cls);
+    net_class_text(w->scored > 0 ? plx_p_class(mean, min) : 0, clh);
     if (strpbrk(w->id, ",\"\n")) {
         fputc('"', f);
         for (c = w->id; *c; c++) {
@@ -543,7 +530,7 @@ static void csv_row(FILE *f, const way_sum *w, double weight)
     }
     fprintf(f, ",%.3f,%.3f,%.3f,%.4f,%.4f,%.4f,%s,%.4f,%.4f,%.4f,%s\n", w->length, dark, w->blocked,
             w->length > 0 ? dark / w->length : 0.0, mean, min, cls,
-            w->length > 0 ? (w->length + weight * dark) / w->length : 1.0, or_none(w->min_ev), or_none(w->min_esc),
+            w->length > 0 ? (w->length + weight * dark) / w->length : 1.0, net_or_none(w->min_ev), net_or_none(w->min_esc),
             clh);
 }
 
@@ -609,7 +596,7 @@ int cmd_annotate(int argc, char **argv)
     net_opts o;
     plx_engine *e;
     network net;
-    int rc;
+    int rc, read_scores;
     memset(&o, 0, sizeof o);
     o.cmd = "annotate";
     rc = parse(&o, argc, argv, annotate_help);
@@ -624,7 +611,7 @@ int cmd_annotate(int argc, char **argv)
     rc = cli_open_scene("annotate", o.scene, &o.c, &e);
     if (rc != EXIT_OK)
         return rc;
-    rc = load_network(&o, e, &net, 1);
+    rc = load_network(&o, e, &net, 1, &read_scores);
     if (rc == EXIT_OK) {
         double dark = 0, len = 0;
         uint32_t i;

@@ -333,9 +333,7 @@ void cli_light_note(const char *cmd, const cli_common *c, plx_engine *e)
                         "adds indirect light to E_h)\n", cmd);
 }
 
-/* v in the fewest significant digits that read back as v (24.937911661 as
- * it was written, not 24.93791166 or 24.937911661000001). */
-static void shortest(double v, char *out, size_t len)
+void cli_shortest(double v, char *out, size_t len)
 {
     int p;
     for (p = 1; p <= 17; p++) {
@@ -356,8 +354,8 @@ void cli_point_error(const char *cmd, const char *file, size_t line, const doubl
     }
     /* the library's "point (x, y[, z]) why" in local metres: the point as
      * the file gave it first */
-    shortest(given[0], gx, sizeof gx);
-    shortest(given[1], gy, sizeof gy);
+    cli_shortest(given[0], gx, sizeof gx);
+    cli_shortest(given[1], gy, sizeof gy);
     fprintf(stderr, "polarlux %s: %s:%zu: point %s %s (local %.*s m) %s\n", cmd, file, line, gx, gy,
             (int)(close - (msg + 7)), msg + 7, close + 2);
 }

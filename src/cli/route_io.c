@@ -260,8 +260,10 @@ static cJSON *wrap_one(cJSON *root)
     return list;
 }
 
-int route_parse(const char *name, const char *text, size_t len, plx_engine *e, route_set *out,
-                char *err, size_t errlen)
+/* route_parse, the parsed document kept in *keep (when not NULL) on
+ * success. */
+static int parse_lines(const char *name, const char *text, size_t len, plx_engine *e, route_set *out, cJSON **keep,
+                       char *err, size_t errlen)
 {
     cJSON *root = cli_json_parse(name, text, len, err, errlen), *wrap = NULL;
     const cJSON *features, *ft, *type;
@@ -326,26 +328,50 @@ int route_parse(const char *name, const char *text, size_t len, plx_engine *e, r
         k++;
     }
     cJSON_Delete(wrap);
-    cJSON_Delete(root);
     if (out->n == 0) {
         snprintf(err, errlen, "%s: no LineString features", name);
+        cJSON_Delete(root);
         return -1;
     }
     outside_note(out, e, f.lonlat);
+    if (keep)
+        *keep = root;
+    else
+        cJSON_Delete(root);
     return 0;
 }
 
-int route_read(const char *path, plx_engine *e, route_set *out, char *err, size_t errlen)
+int route_parse(const char *name, const char *text, size_t len, plx_engine *e, route_set *out,
+                char *err, size_t errlen)
+{
+    return parse_lines(name, text, len, e, out, NULL, err, errlen);
+}
+
+int route_parse_doc(const char *name, const char *text, size_t len, plx_engine *e, route_set *out, cJSON **doc,
+                    char *err, size_t errlen)
+{
+    *doc = NULL;
+    return parse_lines(name, text, len, e, out, doc, err, errlen);
+}
+
+int route_read_doc(const char *path, plx_engine *e, route_set *out, cJSON **doc, char *err, size_t errlen)
 {
     size_t len;
     char *text = cli_read_input(path, &len, err, errlen);
     int rc;
     memset(out, 0, sizeof *out);
+    if (doc)
+        *doc = NULL;
     if (!text)
         return -1;
-    rc = route_parse(cli_input_name(path), text, len, e, out, err, errlen);
+    rc = parse_lines(cli_input_name(path), text, len, e, out, doc, err, errlen);
     free(text);
     return rc;
+}
+
+int route_read(const char *path, plx_engine *e, route_set *out, char *err, size_t errlen)
+{
+    return route_read_doc(path, e, out, NULL, err, errlen);
 }
 
 void route_free(route_set *rs)

@@ -23,6 +23,13 @@ typedef struct route_set {
 
 /* 0 on success; -1 with "FILE: feature k: why" in err. */
 int route_read(const char *path, plx_engine *e, route_set *out, char *err, size_t errlen);
+/* route_read, and the parsed GeoJSON in *doc (cJSON_Delete; NULL on
+ * failure) for what else it holds (annotate's scores, net_scores.h). */
+struct cJSON;
+int route_read_doc(const char *path, plx_engine *e, route_set *out, struct cJSON **doc, char *err, size_t errlen);
+/* route_read_doc from text. */
+int route_parse_doc(const char *name, const char *text, size_t len, plx_engine *e, route_set *out, struct cJSON **doc,
+                    char *err, size_t errlen);
 /* The same from text (for tests and fuzzing). */
 int route_parse(const char *name, const char *text, size_t len, plx_engine *e, route_set *out,
                 char *err, size_t errlen);

@@ -37,6 +37,18 @@ expect net-facial-geojson 0 "" -- sh -c "grep -q '\"min_sc_lux\":2\.07' '$tmp/fa
 expect net-facial-path 0 "^lit-street all .* P1 +1\.287 +1\.287 +2\.070 +2\.070 P5" -- "$bin" route -q fixtures/net-facial.geojson --path fixtures/net-facial-streets.geojson
 expect annotate-facial 0 "^way/10,40\.000,0\.000,0\.000,0\.0000,40\.6465,32\.0721,P5,1\.0000,1\.2870,2\.0701,P1$" -- sh -c "'$bin' annotate -q $fac -o '$tmp/fac-ann.geojson' --csv '$tmp/fac.csv' >/dev/null && cat '$tmp/fac.csv'"
 expect annotate-facial-geojson 0 "" -- grep -q '"min_sc_fw_lux":2\.07.*"min_sc_lux":2\.07.*"class":"P5","class_h":"P1"' "$tmp/fac-ann.geojson"
+# route over annotate's output reads the edges' light instead of scoring
+# them: the same tables as over the plain network; settings, scene or
+# properties that differ from what the scores were made with are refused
+for extra in "" "--max-detour 0.2" "--dark-weight 0.5"; do
+    "$bin" route -q $net --from 0,0 --to 200,0 $extra >"$tmp/plain-route.txt" 2>&1
+    expect "net-annotated-same${extra:+ $extra}" 0 "" -- sh -c "'$bin' route -q fixtures/net-detour.geojson --network '$tmp/ann.geojson' --from 0,0 --to 200,0 $extra | cmp - '$tmp/plain-route.txt'"
+done
+expect net-annotated-note 0 "note: the 6 edges' light read from annotate's scores in $tmp/ann\.geojson" -- "$bin" route fixtures/net-detour.geojson --network "$tmp/ann.geojson" --from 0,0 --to 200,0
+expect net-annotated-dark-lux 2 "route: $tmp/ann\.geojson: annotate's scores: its edges were scored with --dark-lux 1, not 2: pass --dark-lux 1, or run annotate again" -- "$bin" route -q fixtures/net-detour.geojson --network "$tmp/ann.geojson" --from 0,0 --to 200,0 --dark-lux 2
+expect net-annotated-other-scene 1 "annotate's scores: its edges were scored on another scene or light \(buildings, lamps, photon frames: 1, 9, 0 there; 1, 23, 0 here\)" -- "$bin" route -q fixtures/net-facial.geojson --network "$tmp/ann.geojson" --from 0,0 --to 40,0
+sed 's/"mean_lux":/"mean_luxx":/' "$tmp/ann.geojson" >"$tmp/ann-edited.geojson"
+expect net-annotated-edited 1 "annotate's scores: feature 0: no number 'mean_lux' \(not as annotate wrote it\)" -- "$bin" route -q fixtures/net-detour.geojson --network "$tmp/ann-edited.geojson" --from 0,0 --to 200,0
 expect annotate-missing-o 2 "missing -o OUT.geojson" -- "$bin" annotate -q $net
 expect tiles-metres 1 "the scene is in local metres, with no lon/lat" -- "$bin" tiles -q fixtures/tiny.geojson --zoom 15 -o "$tmp/t"
 expect tiles-quantity 2 "--quantity 'v' is not h \(ground E_h\) or sc \(E_sc\)" -- "$bin" tiles -q fixtures/helsinki-centre.geojson --zoom 15 --quantity v -o "$tmp/t"

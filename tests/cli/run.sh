@@ -944,6 +944,10 @@ if [ -z "$PLX_TEST_QUICK" ]; then # check-full: annotate's edges scored on 1 and
         echo "ok   annotate-threads-same"; pass=$((pass + 1))
     else echo "FAIL annotate-threads-same"; fail=$((fail + 1)); fi
     expect annotate-threads-note 0 "^polarlux annotate: note: the 4717 edges scored on 3 threads, each with its own copy of the bake$" -- "$bin" annotate "$tmp/hq.plxb" --network fixtures/helsinki-streets.geojson --threads 3 -o "$tmp/an3.geojson"
+    # route over the annotated network of a lon/lat bake: the table of the plain network's
+    esp="--from 24.9432847,60.1676957 --to 24.9524231,60.1678992 --dark-weight 0.5"
+    "$bin" route -q "$tmp/hq.plxb" --network fixtures/helsinki-streets.geojson $esp >"$tmp/esp-plain.txt" 2>&1
+    expect net-annotated-helsinki-same 0 "" -- sh -c "'$bin' route -q '$tmp/hq.plxb' --network '$tmp/an1.geojson' $esp | cmp - '$tmp/esp-plain.txt'"
 fi
 if [ -z "$PLX_TEST_QUICK" ]; then # check-full: the pass that gathers everywhere; a pass by bounds, then passes gathering everywhere (--mem)
     spots_same dark-spots-unbounded-equals-exhaustive "$tmp/ds.plxb" --count 3 --res 1

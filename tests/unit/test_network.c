@@ -19,6 +19,8 @@
 #include "polarlux_port.h"
 #include "fixture.h"
 #include "cli/network.h"
+#include "cli/net_scores.h"
+#include <cjson/cJSON.h>
 
 #define MEM ((size_t)256 << 20)
 
@@ -521,6 +523,156 @@ static void test_capped_route_against_sweep(void **state)
     assert_true(lowered > 0);
 }
 
+static void assert_same_route(const net_route *x, const net_route *y);
+
+/* The network as annotate writes it (net_scores_edge_props and the
+ * header; coordinates in metres), as text (free). */
+static char *scores_doc(const network *net, plx_engine *e)
+{
+    cJSON *root = cJSON_CreateObject(), *props, *fs;
+    char *text;
+    uint32_t i, k;
+    cJSON_AddStringToObject(root, "type", "FeatureCollection");
+    props = cJSON_AddObjectToObject(root, "properties");
+    cJSON_AddStringToObject(props, "units", "m");
+    fs = cJSON_AddArrayToObject(root, "features");
+    for (i = 0; i < net->nedges; i++) {
+        const net_edge *ed = &net->edges[i];
+        const double *xy = net->lines.lines[ed->line].xy;
+        cJSON *ft = cJSON_CreateObject(), *g, *co;
+        cJSON_AddStringToObject(ft, "type", "Feature");
+        cJSON_AddItemToObject(ft, "properties", net_scores_edge_props(net, i, "way", "street", 3.0));
+        g = cJSON_AddObjectToObject(ft, "geometry");
+        cJSON_AddStringToObject(g, "type", "LineString");
+        co = cJSON_AddArrayToObject(g, "coordinates");
+        for (k = ed->v0; k <= ed->v1; k++) { /* exact: cJSON's 15 digits may move a vertex by a bit */
+            cJSON *pos = cJSON_CreateArray();
+            char num[32];
+            int c;
+            for (c = 0; c < 2; c++) {
+                snprintf(num, sizeof num, "%.17g", xy[2 * k + c]);
+                cJSON_AddItemToArray(pos, cJSON_CreateRaw(num));
+            }
+            cJSON_AddItemToArray(co, pos);
+        }
+        cJSON_AddItemToArray(fs, ft);
+    }
+    cJSON_AddItemToObject(root, NET_SCORES_MEMBER, net_scores_header(net, e));
+    text = cJSON_PrintUnformatted(root);
+    assert_non_null(text);
+    cJSON_Delete(root);
+    return text;
+}
+
+/* text read back as route --network reads it (settings step 1, dark_lux,
+ * height 1.5); net_scores_read's result. */
+static int read_back(const char *text, plx_engine *e, double dark_lux, network *back, int *usage, char *err,
+                     size_t errlen)
+{
+    route_set rs;
+    cJSON *doc;
+    int rc;
+    assert_int_equal(route_parse_doc("scores", text, strlen(text), e, &rs, &doc, err, errlen), 0);
+    assert_int_equal(net_build(back, &rs, err, errlen), 0);
+    net_set_scoring(back, 1.0, dark_lux, 1.5);
+    rc = net_scores_read(back, doc, e, usage, err, errlen);
+    cJSON_Delete(doc);
+    return rc;
+}
+
+/* annotate's scores read back (route --network over annotate's output):
+ * on the random grids, every edge's light the same bytes as net_score
+ * gave it, and the routes over the network read back the same bytes as
+ * over the scored one, for ends anywhere on the streets and weights 0,
+ * 0.7 and 4; another --dark-lux, another scene, a property missing and a
+ * file with no scores answered as net_scores.h says. */
+static void test_scores_read_back(void **state)
+{
+    int seed, rounds = getenv("PLX_TEST_QUICK") ? 4 : 12, routes = 0;
+    static const double weights[3] = { 0.0, 0.7, 4.0 };
+    (void)state;
+    for (seed = 0; seed < rounds; seed++) {
+        void *mem;
+        char *scene, *text, err[256];
+        network net, back;
+        int usage;
+        uint32_t i, q;
+        plx_engine *e = grid_case(seed + 200, &mem, &scene, &net);
+        text = scores_doc(&net, e);
+        assert_int_equal(read_back(text, e, 1.0, &back, &usage, err, sizeof err), 0);
+        assert_int_equal(back.nedges, net.nedges);
+        assert_int_equal(back.nnodes, net.nnodes);
+        for (i = 0; i < net.nedges; i++) { /* one line a feature, in order: edge i is edge i */
+            const net_edge *x = &net.edges[i], *y = &back.edges[i];
+            assert_memory_equal(&x->length, &y->length, sizeof x->length);
+            assert_memory_equal(&x->dark, &y->dark, sizeof x->dark);
+            assert_memory_equal(&x->s.length, &y->s.length, sizeof x->s.length);
+            assert_memory_equal(&x->s.blocked_length, &y->s.blocked_length, sizeof x->s.blocked_length);
+            assert_memory_equal(&x->s.mean, &y->s.mean, sizeof x->s.mean);
+            assert_memory_equal(&x->s.min, &y->s.min, sizeof x->s.min);
+            assert_memory_equal(&x->s.max, &y->s.max, sizeof x->s.max);
+            assert_int_equal(x->s.p_class, y->s.p_class);
+            assert_memory_equal(x->fac, y->fac, sizeof x->fac); /* NaN read back as the same NaN */
+            assert_true(back.scored[i]);
+        }
+        for (q = 0; q < 9; q++) {
+            net_snap a, b, a2, b2;
+            net_route x, y;
+            int rx, ry;
+            double px = rnd() * 110 - 5, py = rnd() * 110 - 5, tx = rnd() * 110 - 5, ty = rnd() * 110 - 5;
+            snap(&net, px, py, &a);
+            snap(&net, tx, ty, &b);
+            snap(&back, px, py, &a2);
+            snap(&back, tx, ty, &b2);
+            rx = net_route_find(&net, e, &a, &b, weights[q % 3], &x, err, sizeof err);
+            ry = net_route_find(&back, e, &a2, &b2, weights[q % 3], &y, err, sizeof err);
+            assert_int_equal(rx, ry);
+            if (rx != 0)
+                continue;
+            assert_same_route(&x, &y);
+            routes++;
+            net_route_free(&x);
+            net_route_free(&y);
+        }
+        net_free(&back);
+        assert_int_equal(read_back(text, e, 2.0, &back, &usage, err, sizeof err), -1); /* another --dark-lux */
+        assert_int_equal(usage, 1);
+        assert_non_null(strstr(err, "--dark-lux 1, not 2"));
+        net_free(&back);
+        {
+            char *hole = strstr(text, "\"mean_lux\""); /* a property renamed */
+            assert_non_null(hole);
+            hole[1] = 'M';
+            assert_int_equal(read_back(text, e, 1.0, &back, &usage, err, sizeof err), -1);
+            assert_int_equal(usage, 0);
+            assert_non_null(strstr(err, "no number 'mean_lux'"));
+            net_free(&back);
+            hole[1] = 'm';
+        }
+        {
+            char *h = strstr(text, "\"" NET_SCORES_MEMBER "\""), *lamps; /* another scene */
+            assert_non_null(h);
+            lamps = strstr(h, "\"lamps\":");
+            assert_non_null(lamps);
+            lamps[8] = lamps[8] == '9' ? '8' : '9';
+            assert_int_equal(read_back(text, e, 1.0, &back, &usage, err, sizeof err), -1);
+            assert_non_null(strstr(err, "another scene or light"));
+            net_free(&back);
+            h[1] = 'q'; /* no scores: a plain network */
+            assert_int_equal(read_back(text, e, 1.0, &back, &usage, err, sizeof err), 1);
+            assert_false(back.scored[0]);
+            net_free(&back);
+        }
+        cJSON_free(text);
+        net_free(&net);
+        plx_engine_destroy(e);
+        free(mem);
+        free(scene);
+    }
+    print_message("routes compared: %d\n", routes);
+    assert_true(routes > 5 * rounds);
+}
+
 /* Two routes the same bytes: polyline and every sum. */
 static void assert_same_route(const net_route *x, const net_route *y)
 {
@@ -754,6 +906,7 @@ int main(void)
         cmocka_unit_test(test_random_grids_against_bellman_ford),
         cmocka_unit_test(test_route_scoring_against_every_edge),
         cmocka_unit_test(test_capped_route_against_sweep),
+        cmocka_unit_test(test_scores_read_back),
         cmocka_unit_test(test_snap_and_empty),
         cmocka_unit_test(test_twin_for),
     };

@@ -1,0 +1,248 @@
+/* net_scores: annotate's scores written with a network and read back
+ * (net_scores.h). */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "cli.h"
+#include "net_scores.h"
+
+/* v as a JSON number that reads back as the same double (cJSON's own
+ * printing keeps 15 digits when they come within a rounding of v, which
+ * may read back one bit away), null when not finite. */
+static void add_exact(cJSON *o, const char *k, double v)
+{
+    char buf[40];
+    if (!isfinite(v)) {
+        cJSON_AddNullToObject(o, k);
+        return;
+    }
+    cli_shortest(v, buf, sizeof buf);
+    cJSON_AddRawToObject(o, k, buf);
+}
+
+void net_class_text(int c, char out[4])
+{
+    if (c)
+        snprintf(out, 4, "P%d", c);
+    else
+        strcpy(out, "-");
+}
+
+int net_full_class(double scored, double mean, double min, double min_ev, double min_esc)
+{
+    if (!(scored > 0) || min_ev != min_ev || min_esc != min_esc)
+        return 0;
+    return plx_p_class_facial(mean, min, min_ev, min_esc);
+}
+
+double net_or_none(double v)
+{
+    return v == v ? v : -1.0;
+}
+
+cJSON *net_scores_edge_props(const network *net, uint32_t i, const char *osm_id, const char *name, double weight)
+{
+    const net_edge *ed = &net->edges[i];
+    cJSON *p = cJSON_CreateObject();
+    double dark = ed->dark + ed->s.blocked_length, cost = ed->length + weight * dark;
+    double ev = fmin(ed->fac[0], ed->fac[1]), esc = fmin(ed->fac[2], ed->fac[3]);
+    char cls[4];
+    if (!p)
+        return NULL;
+    net_class_text(net_full_class(ed->s.length, ed->s.mean, ed->s.min, ev, esc), cls);
+    cJSON_AddStringToObject(p, "osm_id", osm_id);
+    cJSON_AddStringToObject(p, "name", name);
+    cJSON_AddNumberToObject(p, "edge", i);
+    cJSON_AddNumberToObject(p, "from", ed->a);
+    cJSON_AddNumberToObject(p, "to", ed->b);
+    add_exact(p, "length_m", ed->length);
+    add_exact(p, "scored_m", ed->s.length);
+    add_exact(p, "blocked_m", ed->s.blocked_length);
+    add_exact(p, "below_m", ed->dark);
+    add_exact(p, "dark_m", dark);
+    add_exact(p, "dark_share", ed->length > 0 ? dark / ed->length : 0.0);
+    add_exact(p, "mean_lux", ed->s.mean);
+    add_exact(p, "min_lux", ed->s.min);
+    add_exact(p, "max_lux", ed->s.max);
+    add_exact(p, "uniformity", ed->s.uniformity);
+    add_exact(p, "min_ev_fw_lux", net_or_none(ed->fac[0]));
+    add_exact(p, "min_ev_bw_lux", net_or_none(ed->fac[1]));
+    add_exact(p, "min_sc_fw_lux", net_or_none(ed->fac[2]));
+    add_exact(p, "min_sc_bw_lux", net_or_none(ed->fac[3]));
+    add_exact(p, "min_ev_lux", net_or_none(ev));
+    add_exact(p, "min_sc_lux", net_or_none(esc));
+    cJSON_AddStringToObject(p, "class", cls);
+    net_class_text(ed->s.p_class, cls);
+    cJSON_AddStringToObject(p, "class_h", cls);
+    add_exact(p, "cost", cost);
+    add_exact(p, "factor", ed->length > 0 ? cost / ed->length : 1.0);
+    return p;
+}
+
+/* The scene as e holds it: buildings, lamps, photon frames. */
+static void scene_counts(plx_engine *e, double out[3])
+{
+    plx_scene_info si;
+    memset(&si, 0, sizeof si);
+    (void)plx_scene_info_get(e, &si);
+    out[0] = si.buildings;
+    out[1] = si.lamps;
+    out[2] = (double)plx_indirect_frames(e);
+}
+
+cJSON *net_scores_header(const network *net, plx_engine *e)
+{
+    cJSON *h = cJSON_CreateObject();
+    double sc[3];
+    if (!h)
+        return NULL;
+    scene_counts(e, sc);
+    add_exact(h, "version", NET_SCORES_VERSION);
+    add_exact(h, "step", net->step);
+    add_exact(h, "dark_lux", net->dark_lux);
+    add_exact(h, "height", net->height);
+    add_exact(h, "edges", net->nedges);
+    add_exact(h, "nodes", net->nnodes);
+    add_exact(h, "buildings", sc[0]);
+    add_exact(h, "lamps", sc[1]);
+    add_exact(h, "photon_frames", sc[2]);
+    return h;
+}
+
+/* Member k of object o as a number into *v; 0, or -1 when it is not one. */
+static int number(const cJSON *o, const char *k, double *v)
+{
+    const cJSON *n = cJSON_GetObjectItemCaseSensitive(o, k);
+    if (cJSON_IsNull(n)) { /* add_exact's value that was not finite */
+        *v = NAN;
+        return 0;
+    }
+    if (!cJSON_IsNumber(n))
+        return -1;
+    *v = n->valuedouble;
+    return 0;
+}
+
+/* The settings and the scene against the header; 0, or -1 with why. */
+static int check_header(const network *net, const cJSON *h, plx_engine *e, int *usage, char *err, size_t errlen)
+{
+    static const char *const opt[3] = { "--step", "--dark-lux", "--height" };
+    static const char *const key[3] = { "step", "dark_lux", "height" };
+    double have[3], sc[3], want[3], v;
+    int k;
+    have[0] = net->step;
+    have[1] = net->dark_lux;
+    have[2] = net->height;
+    if (number(h, "version", &v) != 0 || v != NET_SCORES_VERSION) {
+        snprintf(err, errlen, "%s member is not version %d (written by another polarlux)", NET_SCORES_MEMBER,
+                 NET_SCORES_VERSION);
+        return -1;
+    }
+    for (k = 0; k < 3; k++) {
+        if (number(h, key[k], &v) != 0) {
+            snprintf(err, errlen, "%s member has no number '%s'", NET_SCORES_MEMBER, key[k]);
+            return -1;
+        }
+        if (v != have[k]) {
+            *usage = 1;
+            snprintf(err, errlen, "its edges were scored with %s %g, not %g: pass %s %g, or run annotate again", opt[k],
+                     v, have[k], opt[k], v);
+            return -1;
+        }
+    }
+    scene_counts(e, sc);
+    if (number(h, "buildings", &want[0]) != 0 || number(h, "lamps", &want[1]) != 0 ||
+        number(h, "photon_frames", &want[2]) != 0) {
+        snprintf(err, errlen, "%s member has no scene counts (buildings, lamps, photon_frames)", NET_SCORES_MEMBER);
+        return -1;
+    }
+    if (want[0] != sc[0] || want[1] != sc[1] || want[2] != sc[2]) {
+        snprintf(err, errlen, "its edges were scored on another scene or light (buildings, lamps, photon frames: "
+                 "%.0f, %.0f, %.0f there; %.0f, %.0f, %.0f here): run annotate again on this scene, or route over "
+                 "the plain street network", want[0], want[1], want[2], sc[0], sc[1], sc[2]);
+        return -1;
+    }
+    if (number(h, "edges", &v) != 0 || v != net->nedges || number(h, "nodes", &want[0]) != 0 ||
+        want[0] != net->nnodes) {
+        snprintf(err, errlen, "its lines join into %u edges and %u nodes, not the ones annotate wrote (an edited "
+                 "file?): run annotate again", net->nedges, net->nnodes);
+        return -1;
+    }
+    return 0;
+}
+
+/* Edge i's scores from its feature's properties p; 0, or -1 with why. */
+static int read_edge(net_edge *ed, const cJSON *p, uint32_t feature, char *err, size_t errlen)
+{
+    static const char *const key[10] = { "scored_m", "blocked_m", "below_m", "mean_lux", "min_lux", "max_lux",
+                                          "uniformity", "min_ev_fw_lux", "min_ev_bw_lux", "min_sc_fw_lux" };
+    double v[11];
+    const cJSON *ch = cJSON_GetObjectItemCaseSensitive(p, "class_h");
+    int k;
+    for (k = 0; k < 11; k++)
+        if (number(p, k < 10 ? key[k] : "min_sc_bw_lux", &v[k]) != 0) {
+            snprintf(err, errlen, "feature %u: no number '%s' (not as annotate wrote it)", feature,
+                     k < 10 ? key[k] : "min_sc_bw_lux");
+            return -1;
+        }
+    if (!cJSON_IsString(ch) || !(strcmp(ch->valuestring, "-") == 0 ||
+                                 (ch->valuestring[0] == 'P' && ch->valuestring[1] >= '1' &&
+                                  ch->valuestring[1] <= '6' && ch->valuestring[2] == '\0'))) {
+        snprintf(err, errlen, "feature %u: class_h is not P1 .. P6 or '-'", feature);
+        return -1;
+    }
+    memset(&ed->s, 0, sizeof ed->s);
+    ed->s.length = v[0];
+    ed->s.blocked_length = v[1];
+    ed->dark = v[2];
+    ed->s.mean = v[3];
+    ed->s.min = v[4];
+    ed->s.max = v[5];
+    ed->s.uniformity = v[6];
+    ed->s.dark_share = v[0] > 0 ? v[2] / v[0] : 0.0;
+    ed->s.p_class = ch->valuestring[0] == 'P' ? ch->valuestring[1] - '0' : 0;
+    for (k = 0; k < 4; k++)
+        ed->fac[k] = v[7 + k] < 0 ? NAN : v[7 + k]; /* -1: no meter */
+    return 0;
+}
+
+int net_scores_read(network *net, const cJSON *doc, plx_engine *e, int *usage, char *err, size_t errlen)
+{
+    const cJSON *h = cJSON_GetObjectItemCaseSensitive(doc, NET_SCORES_MEMBER), *features, *ft;
+    const cJSON **byf;
+    size_t nf = 0;
+    uint32_t i;
+    int rc = 0;
+    *usage = 0;
+    if (!h)
+        return 1;
+    if (check_header(net, h, e, usage, err, errlen) != 0)
+        return -1;
+    features = cJSON_GetObjectItemCaseSensitive(doc, "features");
+    byf = malloc(sizeof *byf * ((size_t)cJSON_GetArraySize(features) + 1));
+    if (!byf) {
+        snprintf(err, errlen, "out of memory reading the scores");
+        return -1;
+    }
+    cJSON_ArrayForEach(ft, features) byf[nf++] = ft;
+    for (i = 0; i < net->nedges && rc == 0; i++) {
+        net_edge *ed = &net->edges[i];
+        const route_line *l = &net->lines.lines[ed->line];
+        if (ed->v0 != 0 || ed->v1 + 1 != l->n || l->feature >= nf || (ed->line > 0 && l[-1].feature == l->feature)) {
+            snprintf(err, errlen, "feature %u is not one edge of the network (not as annotate wrote it)", l->feature);
+            rc = -1;
+            break;
+        }
+        rc = read_edge(ed, cJSON_GetObjectItemCaseSensitive(byf[l->feature], "properties"), l->feature, err,
+                       errlen);
+    }
+    free(byf);
+    if (rc != 0)
+        return -1;
+    for (i = 0; i < net->nedges; i++)
+        net->scored[i] = 1;
+    net->partial = 0;
+    return 0;
+}
