@@ -1,6 +1,7 @@
 /* net_scores: annotate's scores written with a network and read back
  * (net_scores.h). */
 #include <math.h>
+#include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -92,13 +93,62 @@ static void scene_counts(plx_engine *e, double out[3])
     out[2] = (double)plx_indirect_frames(e);
 }
 
+/* n bytes into FNV-1a hash h. */
+static uint64_t fnv(uint64_t h, const void *p, size_t n)
+{
+    const unsigned char *b = p;
+    size_t i;
+    for (i = 0; i < n; i++)
+        h = (h ^ b[i]) * 1099511628211u;
+    return h;
+}
+
+/* A hash of what the light depends on in the scene: every building's
+ * rings, heights and albedo, every lamp's position, intensity, reach and
+ * colour, the ground's albedo (as 16 hex digits). */
+static void scene_hash(plx_engine *e, char out[17])
+{
+    plx_scene_info si;
+    uint64_t h = 14695981039346656037u;
+    uint32_t i, r, n;
+    memset(&si, 0, sizeof si);
+    (void)plx_scene_info_get(e, &si);
+    h = fnv(h, &si.ground_albedo, sizeof si.ground_albedo);
+    for (i = 0; i < si.buildings; i++) {
+        plx_building b;
+        const double *xy;
+        if (plx_building_get(e, i, &b) != PLX_OK)
+            continue;
+        h = fnv(h, &b.height, sizeof b.height);
+        h = fnv(h, &b.min_height, sizeof b.min_height);
+        h = fnv(h, &b.albedo, sizeof b.albedo);
+        for (r = 0; r < b.nrings; r++)
+            if (plx_building_ring(e, i, r, &xy, &n) == PLX_OK)
+                h = fnv(h, xy, sizeof *xy * 2 * (size_t)n);
+    }
+    for (i = 0; i < si.lamps; i++) {
+        plx_lamp l;
+        if (plx_lamp_get(e, i, &l) != PLX_OK)
+            continue;
+        h = fnv(h, &l.x, sizeof l.x);
+        h = fnv(h, &l.y, sizeof l.y);
+        h = fnv(h, &l.z, sizeof l.z);
+        h = fnv(h, &l.intensity, sizeof l.intensity);
+        h = fnv(h, &l.radius, sizeof l.radius);
+        h = fnv(h, l.color, sizeof l.color);
+    }
+    snprintf(out, 17, "%016llx", (unsigned long long)h);
+}
+
 cJSON *net_scores_header(const network *net, plx_engine *e)
 {
     cJSON *h = cJSON_CreateObject();
     double sc[3];
+    char hash[17];
     if (!h)
         return NULL;
     scene_counts(e, sc);
+    scene_hash(e, hash);
     add_exact(h, "version", NET_SCORES_VERSION);
     add_exact(h, "step", net->step);
     add_exact(h, "dark_lux", net->dark_lux);
@@ -108,6 +158,7 @@ cJSON *net_scores_header(const network *net, plx_engine *e)
     add_exact(h, "buildings", sc[0]);
     add_exact(h, "lamps", sc[1]);
     add_exact(h, "photon_frames", sc[2]);
+    cJSON_AddStringToObject(h, "scene_hash", hash);
     return h;
 }
 
@@ -131,6 +182,8 @@ static int check_header(const network *net, const cJSON *h, plx_engine *e, int *
     static const char *const opt[3] = { "--step", "--dark-lux", "--height" };
     static const char *const key[3] = { "step", "dark_lux", "height" };
     double have[3], sc[3], want[3], v;
+    const cJSON *sh;
+    char hash[17];
     int k;
     have[0] = net->step;
     have[1] = net->dark_lux;
@@ -162,6 +215,15 @@ static int check_header(const network *net, const cJSON *h, plx_engine *e, int *
         snprintf(err, errlen, "its edges were scored on another scene or light (buildings, lamps, photon frames: "
                  "%.0f, %.0f, %.0f there; %.0f, %.0f, %.0f here): run annotate again on this scene, or route over "
                  "the plain street network", want[0], want[1], want[2], sc[0], sc[1], sc[2]);
+        return -1;
+    }
+    sh = cJSON_GetObjectItemCaseSensitive(h, "scene_hash");
+    scene_hash(e, hash);
+    if (!cJSON_IsString(sh) || strcmp(sh->valuestring, hash) != 0) {
+        snprintf(err, errlen, "its edges were scored on another scene (the same counts, but the buildings' or "
+                 "lamps' positions, heights, intensities or colours differ: scene_hash %s there, %s here): run "
+                 "annotate again on this scene, or route over the plain street network",
+                 cJSON_IsString(sh) ? sh->valuestring : "none", hash);
         return -1;
     }
     if (number(h, "edges", &v) != 0 || v != net->nedges || number(h, "nodes", &want[0]) != 0 ||

@@ -47,6 +47,8 @@ done
 expect net-annotated-note 0 "note: the 6 edges' light read from annotate's scores in $tmp/ann\.geojson" -- "$bin" route fixtures/net-detour.geojson --network "$tmp/ann.geojson" --from 0,0 --to 200,0
 expect net-annotated-dark-lux 2 "route: $tmp/ann\.geojson: annotate's scores: its edges were scored with --dark-lux 1, not 2: pass --dark-lux 1, or run annotate again" -- "$bin" route -q fixtures/net-detour.geojson --network "$tmp/ann.geojson" --from 0,0 --to 200,0 --dark-lux 2
 expect net-annotated-other-scene 1 "annotate's scores: its edges were scored on another scene or light \(buildings, lamps, photon frames: 1, 9, 0 there; 1, 23, 0 here\)" -- "$bin" route -q fixtures/net-facial.geojson --network "$tmp/ann.geojson" --from 0,0 --to 40,0
+sed 's/"intensity": 1000/"intensity": 1001/' fixtures/net-detour.geojson >"$tmp/net-detour-brighter.geojson"
+expect net-annotated-other-light 1 "annotate's scores: its edges were scored on another scene \(the same counts, but the buildings' or lamps' positions, heights, intensities or colours differ: scene_hash [0-9a-f]{16} there, [0-9a-f]{16} here\)" -- "$bin" route -q "$tmp/net-detour-brighter.geojson" --network "$tmp/ann.geojson" --from 0,0 --to 200,0
 sed 's/"mean_lux":/"mean_luxx":/' "$tmp/ann.geojson" >"$tmp/ann-edited.geojson"
 expect net-annotated-edited 1 "annotate's scores: feature 0: no number 'mean_lux' \(not as annotate wrote it\)" -- "$bin" route -q fixtures/net-detour.geojson --network "$tmp/ann-edited.geojson" --from 0,0 --to 200,0
 expect annotate-missing-o 2 "missing -o OUT.geojson" -- "$bin" annotate -q $net
