@@ -9,6 +9,7 @@
 #include "geo_out.h"
 #include "network.h"
 #include "net_scores.h"
+#include "points.h"
 #include "port.h"
 
 static const char route_help[] =
@@ -370,7 +371,7 @@ static int find_routes(const net_opts *o, plx_engine *e, network *net, int read_
         return rc;
     if (read_scores && !o->c.quiet)
         fprintf(stderr, "polarlux %s: note: the %u edges' light read from annotate's scores in %s (the ends' "
-                        "pieces scored here)\n", o->cmd, net->nedges, o->network);
+                        "pieces scored here)\n", o->cmd, net->nedges, cli_input_name(o->network));
     r1 = net_route_find(net, e, &a, &b, 0.0, &shortest, err, sizeof err);
     r2 = r1 == 0 ? net_route_find(net, e, &a, &b, o->weight, &best, err, sizeof err) : r1;
     if (r1 == 1 || r2 == 1) {
@@ -480,7 +481,7 @@ static int write_edges(const net_opts *o, plx_engine *e, const network *net)
         cJSON *p = net_scores_edge_props(net, i, edge_id(net, ed, buf), l->name, o->weight);
         cJSON *coords = cJSON_CreateArray();
         for (k = ed->v0; k <= ed->v1; k++)
-            cJSON_AddItemToArray(coords, geo_position(&g, l->xy[2 * k], l->xy[2 * k + 1], NULL));
+            cJSON_AddItemToArray(coords, geo_position_exact(&g, l->xy[2 * k], l->xy[2 * k + 1]));
         geo_add(&g, geo_geometry("LineString", coords), p);
     }
     if (geo_write(&g, "annotate", o->out) != 0)

@@ -3,6 +3,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "cli.h"
 #include "geo_out.h"
 #include "port.h"
 
@@ -44,6 +45,27 @@ cJSON *geo_position(const geo_out *g, double x, double y, const double *z)
     cJSON_AddItemToArray(a, cJSON_CreateNumber(y));
     if (z)
         cJSON_AddItemToArray(a, cJSON_CreateNumber(*z));
+    return a;
+}
+
+cJSON *geo_position_exact(const geo_out *g, double x, double y)
+{
+    cJSON *a = cJSON_CreateArray();
+    double v[2];
+    char num[40];
+    int k;
+    v[0] = x;
+    v[1] = y;
+    if (g->lonlat) {
+        double xy[2];
+        xy[0] = x;
+        xy[1] = y;
+        plx_local_to_lonlat(g->e, 1, xy, v);
+    }
+    for (k = 0; k < 2; k++) {
+        cli_shortest(v[k], num, sizeof num);
+        cJSON_AddItemToArray(a, cJSON_CreateRaw(num));
+    }
     return a;
 }
 

@@ -17,6 +17,10 @@ typedef struct geo_out {
 int geo_begin(geo_out *g, plx_engine *e);
 /* A position [x, y] or [x, y, z] in the output frame. */
 cJSON *geo_position(const geo_out *g, double x, double y, const double *z);
+/* geo_position without z, each number in the fewest digits that read back
+ * as the same double (cJSON's 15 digits may move a vertex by a bit;
+ * annotate's networks are read back: net_scores.h). */
+cJSON *geo_position_exact(const geo_out *g, double x, double y);
 /* A closed linear ring from n x,y pairs (z per vertex may be NULL). */
 cJSON *geo_ring(const geo_out *g, const double *xy, uint32_t n, const double *z);
 /* Adds a feature with the geometry and properties (both owned by g after). */

@@ -140,6 +140,37 @@ static void scene_hash(plx_engine *e, char out[17])
     snprintf(out, 17, "%016llx", (unsigned long long)h);
 }
 
+/* A hash of the network as routes read it: every edge in order, its
+ * vertices (local metres, as projected) and its light (the -1 of no
+ * meter for NaN), as 16 hex digits. annotate writes it; route compares it
+ * with the network it read back, so a file whose coordinates or scores
+ * changed (edited, or numbers that did not read back to the same bits) is
+ * refused rather than routed over. */
+static void edges_hash(const network *net, char out[17])
+{
+    uint64_t h = 14695981039346656037u;
+    uint32_t i;
+    int k;
+    for (i = 0; i < net->nedges; i++) {
+        const net_edge *ed = &net->edges[i];
+        const double *xy = net->lines.lines[ed->line].xy + 2 * ed->v0;
+        double v[11];
+        h = fnv(h, xy, sizeof *xy * 2 * ((size_t)ed->v1 - ed->v0 + 1));
+        v[0] = ed->s.length;
+        v[1] = ed->s.blocked_length;
+        v[2] = ed->dark;
+        v[3] = ed->s.mean;
+        v[4] = ed->s.min;
+        v[5] = ed->s.max;
+        v[6] = ed->s.uniformity;
+        for (k = 0; k < 4; k++)
+            v[7 + k] = net_or_none(ed->fac[k]);
+        h = fnv(h, v, sizeof v);
+        h = fnv(h, &ed->s.p_class, sizeof ed->s.p_class);
+    }
+    snprintf(out, 17, "%016llx", (unsigned long long)h);
+}
+
 cJSON *net_scores_header(const network *net, plx_engine *e)
 {
     cJSON *h = cJSON_CreateObject();
@@ -159,6 +190,8 @@ cJSON *net_scores_header(const network *net, plx_engine *e)
     add_exact(h, "lamps", sc[1]);
     add_exact(h, "photon_frames", sc[2]);
     cJSON_AddStringToObject(h, "scene_hash", hash);
+    edges_hash(net, hash);
+    cJSON_AddStringToObject(h, "edges_hash", hash);
     return h;
 }
 
@@ -166,11 +199,7 @@ cJSON *net_scores_header(const network *net, plx_engine *e)
 static int number(const cJSON *o, const char *k, double *v)
 {
     const cJSON *n = cJSON_GetObjectItemCaseSensitive(o, k);
-    if (cJSON_IsNull(n)) { /* add_exact's value that was not finite */
-        *v = NAN;
-        return 0;
-    }
-    if (!cJSON_IsNumber(n))
+    if (!cJSON_IsNumber(n)) /* also null: add_exact's value that was not finite, which a route cannot use */
         return -1;
     *v = n->valuedouble;
     return 0;
@@ -272,8 +301,9 @@ static int read_edge(net_edge *ed, const cJSON *p, uint32_t feature, char *err, 
 
 int net_scores_read(network *net, const cJSON *doc, plx_engine *e, int *usage, char *err, size_t errlen)
 {
-    const cJSON *h = cJSON_GetObjectItemCaseSensitive(doc, NET_SCORES_MEMBER), *features, *ft;
+    const cJSON *h = cJSON_GetObjectItemCaseSensitive(doc, NET_SCORES_MEMBER), *features, *ft, *eh;
     const cJSON **byf;
+    char hash[17];
     size_t nf = 0;
     uint32_t i;
     int rc = 0;
@@ -303,6 +333,15 @@ int net_scores_read(network *net, const cJSON *doc, plx_engine *e, int *usage, c
     free(byf);
     if (rc != 0)
         return -1;
+    eh = cJSON_GetObjectItemCaseSensitive(h, "edges_hash");
+    edges_hash(net, hash);
+    if (!cJSON_IsString(eh) || strcmp(eh->valuestring, hash) != 0) {
+        snprintf(err, errlen, "its edges' coordinates or light are not those annotate wrote (edges_hash %s there, "
+                 "%s here: an edited file, or coordinates that did not read back to the same bits): run annotate "
+                 "again, or route over the plain street network", cJSON_IsString(eh) ? eh->valuestring : "none",
+                 hash);
+        return -1;
+    }
     for (i = 0; i < net->nedges; i++)
         net->scored[i] = 1;
     net->partial = 0;

@@ -8,8 +8,12 @@
  * blocked_m, below_m (scored metres below --dark-lux: dark_m less
  * blocked_m, which no subtraction gives back exactly), mean_lux,
  * min_lux, max_lux, uniformity, the four E_v and E_sc minima (-1: no
- * meter) and class_h. Read back, the edges hold what net_score gave them,
- * so the routes are those of the scored network. */
+ * meter) and class_h; annotate writes the coordinates so too
+ * (geo_position_exact). The header's edges_hash (every edge's vertices
+ * and light) is computed again over what was read: read back, the edges
+ * hold what net_score gave them, so the routes are those of the scored
+ * network, or the file is refused (edited, or numbers that did not read
+ * back to the same bits). */
 #ifndef PLX_CLI_NET_SCORES_H
 #define PLX_CLI_NET_SCORES_H
 

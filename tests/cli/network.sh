@@ -47,6 +47,15 @@ done
 expect net-annotated-note 0 "note: the 6 edges' light read from annotate's scores in $tmp/ann\.geojson" -- "$bin" route fixtures/net-detour.geojson --network "$tmp/ann.geojson" --from 0,0 --to 200,0
 expect net-annotated-dark-lux 2 "route: $tmp/ann\.geojson: annotate's scores: its edges were scored with --dark-lux 1, not 2: pass --dark-lux 1, or run annotate again" -- "$bin" route -q fixtures/net-detour.geojson --network "$tmp/ann.geojson" --from 0,0 --to 200,0 --dark-lux 2
 expect net-annotated-other-scene 1 "annotate's scores: its edges were scored on another scene or light \(buildings, lamps, photon frames: 1, 9, 0 there; 1, 23, 0 here\)" -- "$bin" route -q fixtures/net-facial.geojson --network "$tmp/ann.geojson" --from 0,0 --to 40,0
+# coordinates that need 17 digits come back to the same bits (cJSON's own
+# 15 digits wrote 100.00000000000001 as 100): the same tables and GeoJSON
+x=100.00000000000001
+printf '{"type":"FeatureCollection","properties":{"units":"m"},"features":[{"type":"Feature","properties":{"osm_id":"a"},"geometry":{"type":"LineString","coordinates":[[0,0],[%s,0],[200,0]]}},{"type":"Feature","properties":{"osm_id":"b"},"geometry":{"type":"LineString","coordinates":[[0,0],[0,50],[%s,50],[200,50],[200,0]]}},{"type":"Feature","properties":{"osm_id":"c"},"geometry":{"type":"LineString","coordinates":[[%s,0],[%s,50]]}}]}' $x $x $x $x >"$tmp/net17.geojson"
+"$bin" annotate -q fixtures/net-detour.geojson --network "$tmp/net17.geojson" -o "$tmp/ann17.geojson" >/dev/null 2>&1
+for w in 0 3; do
+    "$bin" route -q fixtures/net-detour.geojson --network "$tmp/net17.geojson" --from 0,0 --to 200,0 --dark-weight $w --geojson "$tmp/r17-plain.json" >"$tmp/r17-plain.txt" 2>&1
+    expect "net-annotated-17-digits-w$w" 0 "" -- sh -c "'$bin' route -q fixtures/net-detour.geojson --network '$tmp/ann17.geojson' --from 0,0 --to 200,0 --dark-weight $w --geojson '$tmp/r17-ann.json' | cmp - '$tmp/r17-plain.txt' && cmp '$tmp/r17-ann.json' '$tmp/r17-plain.json' && grep -q '$x' '$tmp/ann17.geojson'"
+done
 sed 's/"intensity": 1000/"intensity": 1001/' fixtures/net-detour.geojson >"$tmp/net-detour-brighter.geojson"
 expect net-annotated-other-light 1 "annotate's scores: its edges were scored on another scene \(the same counts, but the buildings' or lamps' positions, heights, intensities or colours differ: scene_hash [0-9a-f]{16} there, [0-9a-f]{16} here\)" -- "$bin" route -q "$tmp/net-detour-brighter.geojson" --network "$tmp/ann.geojson" --from 0,0 --to 200,0
 sed 's/"mean_lux":/"mean_luxx":/' "$tmp/ann.geojson" >"$tmp/ann-edited.geojson"

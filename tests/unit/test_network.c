@@ -584,8 +584,8 @@ static int read_back(const char *text, plx_engine *e, double dark_lux, network *
  * on the random grids, every edge's light the same bytes as net_score
  * gave it, and the routes over the network read back the same bytes as
  * over the scored one, for ends anywhere on the streets and weights 0,
- * 0.7 and 4; another --dark-lux, another scene, a property missing and a
- * file with no scores answered as net_scores.h says. */
+ * 0.7 and 4; another --dark-lux, another scene, a property missing, a
+ * value edited and a file with no scores answered as net_scores.h says. */
 static void test_scores_read_back(void **state)
 {
     int seed, rounds = getenv("PLX_TEST_QUICK") ? 4 : 12, routes = 0;
@@ -648,6 +648,14 @@ static void test_scores_read_back(void **state)
             assert_non_null(strstr(err, "no number 'mean_lux'"));
             net_free(&back);
             hole[1] = 'm';
+        }
+        {
+            char *v = strstr(text, "\"max_lux\":") + 10, was = *v; /* a value edited: the edges' hash */
+            *v = *v == '1' ? '2' : '1';
+            assert_int_equal(read_back(text, e, 1.0, &back, &usage, err, sizeof err), -1);
+            assert_non_null(strstr(err, "not those annotate wrote (edges_hash"));
+            net_free(&back);
+            *v = was;
         }
         {
             char *h = strstr(text, "\"" NET_SCORES_MEMBER "\""), *lamps; /* another scene */
