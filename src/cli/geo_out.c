@@ -30,17 +30,23 @@ int geo_begin(geo_out *g, plx_engine *e)
     return g->root && g->features ? 0 : -1;
 }
 
+/* (x, y) local into the output frame (lon/lat when the scene was). */
+static void out_frame(const geo_out *g, double *x, double *y)
+{
+    double xy[2], ll[2];
+    if (!g->lonlat)
+        return;
+    xy[0] = *x;
+    xy[1] = *y;
+    plx_local_to_lonlat(g->e, 1, xy, ll);
+    *x = ll[0];
+    *y = ll[1];
+}
+
 cJSON *geo_position(const geo_out *g, double x, double y, const double *z)
 {
     cJSON *a = cJSON_CreateArray();
-    if (g->lonlat) {
-        double xy[2], ll[2];
-        xy[0] = x;
-        xy[1] = y;
-        plx_local_to_lonlat(g->e, 1, xy, ll);
-        x = ll[0];
-        y = ll[1];
-    }
+    out_frame(g, &x, &y);
     cJSON_AddItemToArray(a, cJSON_CreateNumber(x));
     cJSON_AddItemToArray(a, cJSON_CreateNumber(y));
     if (z)
@@ -51,21 +57,12 @@ cJSON *geo_position(const geo_out *g, double x, double y, const double *z)
 cJSON *geo_position_exact(const geo_out *g, double x, double y)
 {
     cJSON *a = cJSON_CreateArray();
-    double v[2];
     char num[40];
-    int k;
-    v[0] = x;
-    v[1] = y;
-    if (g->lonlat) {
-        double xy[2];
-        xy[0] = x;
-        xy[1] = y;
-        plx_local_to_lonlat(g->e, 1, xy, v);
-    }
-    for (k = 0; k < 2; k++) {
-        cli_shortest(v[k], num, sizeof num);
-        cJSON_AddItemToArray(a, cJSON_CreateRaw(num));
-    }
+    out_frame(g, &x, &y);
+    cli_shortest(x, num, sizeof num);
+    cJSON_AddItemToArray(a, cJSON_CreateRaw(num));
+    cli_shortest(y, num, sizeof num);
+    cJSON_AddItemToArray(a, cJSON_CreateRaw(num));
     return a;
 }
 

@@ -205,13 +205,23 @@ static int number(const cJSON *o, const char *k, double *v)
     return 0;
 }
 
+/* The hash the header holds under key when it differs from 'have'
+ * ("none" when it holds none), NULL when they agree. */
+static const char *hash_differs(const cJSON *h, const char *key, const char *have)
+{
+    const cJSON *s = cJSON_GetObjectItemCaseSensitive(h, key);
+    if (!cJSON_IsString(s))
+        return "none";
+    return strcmp(s->valuestring, have) != 0 ? s->valuestring : NULL;
+}
+
 /* The settings and the scene against the header; 0, or -1 with why. */
 static int check_header(const network *net, const cJSON *h, plx_engine *e, int *usage, char *err, size_t errlen)
 {
     static const char *const opt[3] = { "--step", "--dark-lux", "--height" };
     static const char *const key[3] = { "step", "dark_lux", "height" };
     double have[3], sc[3], want[3], v;
-    const cJSON *sh;
+    const char *there;
     char hash[17];
     int k;
     have[0] = net->step;
@@ -246,13 +256,11 @@ static int check_header(const network *net, const cJSON *h, plx_engine *e, int *
                  "the plain street network", want[0], want[1], want[2], sc[0], sc[1], sc[2]);
         return -1;
     }
-    sh = cJSON_GetObjectItemCaseSensitive(h, "scene_hash");
     scene_hash(e, hash);
-    if (!cJSON_IsString(sh) || strcmp(sh->valuestring, hash) != 0) {
+    if ((there = hash_differs(h, "scene_hash", hash)) != NULL) {
         snprintf(err, errlen, "its edges were scored on another scene (the same counts, but the buildings' or "
                  "lamps' positions, heights, intensities or colours differ: scene_hash %s there, %s here): run "
-                 "annotate again on this scene, or route over the plain street network",
-                 cJSON_IsString(sh) ? sh->valuestring : "none", hash);
+                 "annotate again on this scene, or route over the plain street network", there, hash);
         return -1;
     }
     if (number(h, "edges", &v) != 0 || v != net->nedges || number(h, "nodes", &want[0]) != 0 ||
@@ -267,15 +275,15 @@ static int check_header(const network *net, const cJSON *h, plx_engine *e, int *
 /* Edge i's scores from its feature's properties p; 0, or -1 with why. */
 static int read_edge(net_edge *ed, const cJSON *p, uint32_t feature, char *err, size_t errlen)
 {
-    static const char *const key[10] = { "scored_m", "blocked_m", "below_m", "mean_lux", "min_lux", "max_lux",
-                                          "uniformity", "min_ev_fw_lux", "min_ev_bw_lux", "min_sc_fw_lux" };
+    static const char *const key[11] = { "scored_m", "blocked_m", "below_m", "mean_lux", "min_lux", "max_lux",
+                                          "uniformity", "min_ev_fw_lux", "min_ev_bw_lux", "min_sc_fw_lux",
+                                          "min_sc_bw_lux" };
     double v[11];
     const cJSON *ch = cJSON_GetObjectItemCaseSensitive(p, "class_h");
     int k;
     for (k = 0; k < 11; k++)
-        if (number(p, k < 10 ? key[k] : "min_sc_bw_lux", &v[k]) != 0) {
-            snprintf(err, errlen, "feature %u: no number '%s' (not as annotate wrote it)", feature,
-                     k < 10 ? key[k] : "min_sc_bw_lux");
+        if (number(p, key[k], &v[k]) != 0) {
+            snprintf(err, errlen, "feature %u: no number '%s' (not as annotate wrote it)", feature, key[k]);
             return -1;
         }
     if (!cJSON_IsString(ch) || !(strcmp(ch->valuestring, "-") == 0 ||
@@ -301,8 +309,9 @@ static int read_edge(net_edge *ed, const cJSON *p, uint32_t feature, char *err, 
 
 int net_scores_read(network *net, const cJSON *doc, plx_engine *e, int *usage, char *err, size_t errlen)
 {
-    const cJSON *h = cJSON_GetObjectItemCaseSensitive(doc, NET_SCORES_MEMBER), *features, *ft, *eh;
+    const cJSON *h = cJSON_GetObjectItemCaseSensitive(doc, NET_SCORES_MEMBER), *features, *ft;
     const cJSON **byf;
+    const char *there;
     char hash[17];
     size_t nf = 0;
     uint32_t i;
@@ -333,13 +342,11 @@ int net_scores_read(network *net, const cJSON *doc, plx_engine *e, int *usage, c
     free(byf);
     if (rc != 0)
         return -1;
-    eh = cJSON_GetObjectItemCaseSensitive(h, "edges_hash");
     edges_hash(net, hash);
-    if (!cJSON_IsString(eh) || strcmp(eh->valuestring, hash) != 0) {
+    if ((there = hash_differs(h, "edges_hash", hash)) != NULL) {
         snprintf(err, errlen, "its edges' coordinates or light are not those annotate wrote (edges_hash %s there, "
                  "%s here: an edited file, or coordinates that did not read back to the same bits): run annotate "
-                 "again, or route over the plain street network", cJSON_IsString(eh) ? eh->valuestring : "none",
-                 hash);
+                 "again, or route over the plain street network", there, hash);
         return -1;
     }
     for (i = 0; i < net->nedges; i++)
