@@ -231,39 +231,41 @@ static int load_ground_image(const char *cmd, const char *scene_path, plx_engine
     return EXIT_OK;
 }
 
-/* Reads a whole file into a malloc'd buffer; NULL with errno set. */
-static char *read_all(const char *path, size_t *len)
+/* Reads a whole photometry file into a malloc'd buffer, opened as every
+ * other input (port_open_input: a FIFO, device or directory is refused at
+ * once, never waited on), at most 64 MiB; NULL with why (a message). */
+static char *read_all(const char *path, size_t *len, char *why, size_t whylen)
 {
-    FILE *f = fopen(path, "rb");
-    char *buf = NULL, *nb;
-    size_t cap = 0, n = 0, got;
-    if (!f)
+    size_t size = 0, got = 0;
+    char *buf;
+    int fd = port_open_input(path, &size, why, whylen);
+    if (fd < 0)
         return NULL;
-    for (;;) {
-        if (n == cap) {
-            cap = cap ? 2 * cap : 65536;
-            nb = realloc(buf, cap);
-            if (!nb || cap > ((size_t)64 << 20)) {
-                free(nb ? nb : buf);
-                fclose(f);
-                errno = EFBIG;
-                return NULL;
-            }
-            buf = nb;
+    if (size > ((size_t)64 << 20)) {
+        snprintf(why, whylen, "%zu bytes, more than a photometry file's 64 MiB", size);
+        close(fd);
+        return NULL;
+    }
+    if (!(buf = malloc(size ? size : 1))) {
+        snprintf(why, whylen, "out of memory for its %zu bytes", size);
+        close(fd);
+        return NULL;
+    }
+    while (got < size) {
+        ssize_t r = read(fd, buf + got, size - got);
+        if (r < 0 && errno == EINTR)
+            continue;
+        if (r <= 0) {
+            snprintf(why, whylen, "read %zu of %zu bytes: %s", got, size,
+                     r < 0 ? strerror(errno) : "the file changed while reading");
+            free(buf);
+            close(fd);
+            return NULL;
         }
-        got = fread(buf + n, 1, cap - n, f);
-        n += got;
-        if (got == 0)
-            break;
+        got += (size_t)r;
     }
-    if (ferror(f)) {
-        free(buf);
-        fclose(f);
-        errno = EIO;
-        return NULL;
-    }
-    fclose(f);
-    *len = n;
+    close(fd);
+    *len = size;
     return buf;
 }
 
@@ -276,7 +278,7 @@ static int load_photometry(const char *cmd, const char *scene_path, plx_engine *
     const char *slash = strrchr(scene_path, '/');
     for (k = 0; k < n; k++) {
         const char *p;
-        char *full, *data;
+        char *full, *data, why[160];
         size_t dir, len = 0;
         plx_status st;
         if (plx_photometry_path(e, k, &p) != PLX_OK)
@@ -287,10 +289,9 @@ static int load_photometry(const char *cmd, const char *scene_path, plx_engine *
             return EXIT_NOMEM;
         memcpy(full, scene_path, dir);
         strcpy(full + dir, p);
-        data = read_all(full, &len);
+        data = read_all(full, &len, why, sizeof why);
         if (!data) {
-            fprintf(stderr, "polarlux %s: %s: photometry file %s: cannot read: %s\n", cmd, scene_path, full,
-                    strerror(errno));
+            fprintf(stderr, "polarlux %s: %s: photometry file %s: %s\n", cmd, scene_path, full, why);
             free(full);
             return EXIT_FAIL;
         }
@@ -339,8 +340,13 @@ void cli_shortest(double v, char *out, size_t len)
     for (p = 1; p <= 17; p++) {
         snprintf(out, len, "%.*g", p, v);
         if (strtod(out, NULL) == v)
-            return;
+            break;
     }
+    /* %g's exponent form of a whole number (100 as "1e+02": its digits fewer
+     * than its exponent, so v is that whole number): plain digits instead,
+     * the same double */
+    if (strstr(out, "e+") && fabs(v) < 1e17)
+        snprintf(out, len, "%.0f", v);
 }
 
 void cli_point_error(const char *cmd, const char *file, size_t line, const double *given, const double *local,

@@ -63,7 +63,7 @@ cJSON *net_scores_edge_props(const network *net, uint32_t i, const char *osm_id,
     add_exact(p, "blocked_m", ed->s.blocked_length);
     add_exact(p, "below_m", ed->dark);
     add_exact(p, "dark_m", dark);
-    add_exact(p, "dark_share", ed->length > 0 ? dark / ed->length : 0.0);
+    add_exact(p, "dark_share", ed->length > 0 ? fmin(dark / ed->length, 1.0) : 0.0); /* not 1 + 2^-52 */
     add_exact(p, "mean_lux", ed->s.mean);
     add_exact(p, "min_lux", ed->s.min);
     add_exact(p, "max_lux", ed->s.max);
@@ -103,9 +103,48 @@ static uint64_t fnv(uint64_t h, const void *p, size_t n)
     return h;
 }
 
+/* Lamp i's photometry into h: its file's format, azimuth, tilt, dimming,
+ * peak, flux and dark angle, and (a photometric lamp) its intensity in
+ * the scene's frame toward PHOT_GAMMAS x PHOT_CS fixed directions, so that
+ * a turned, tilted or rescaled table changes the hash where the lamp's
+ * position, intensity and reach do not. */
+#define PHOT_GAMMAS 19 /* 0, 10, .. 180 degrees from the nadir */
+#define PHOT_CS 24     /* 0, 15, .. 345 degrees from east */
+#define PHOT_PI 3.14159265358979323846
+static uint64_t photometry_hash(plx_engine *e, uint32_t i, uint64_t h)
+{
+    plx_lamp_photometry ph;
+    double v[7];
+    int g, c;
+    if (plx_lamp_photometry_get(e, i, &ph) != PLX_OK)
+        return h;
+    v[0] = ph.format;
+    v[1] = ph.azimuth;
+    v[2] = ph.tilt;
+    v[3] = ph.dimming;
+    v[4] = ph.peak_cd;
+    v[5] = ph.flux_lm;
+    v[6] = ph.gamma_lit;
+    h = fnv(h, v, sizeof v);
+    if (ph.format == 0)
+        return h;
+    for (g = 0; g < PHOT_GAMMAS; g++)
+        for (c = 0; c < PHOT_CS; c++) {
+            double gr = g * (PHOT_PI / (PHOT_GAMMAS - 1)), cr = c * (2.0 * PHOT_PI / PHOT_CS), cd = 0.0;
+            double dir[3];
+            dir[0] = sin(gr) * cos(cr);
+            dir[1] = sin(gr) * sin(cr);
+            dir[2] = -cos(gr);
+            if (plx_lamp_intensity(e, i, dir, &cd, NULL, NULL) != PLX_OK)
+                cd = -1.0;
+            h = fnv(h, &cd, sizeof cd);
+        }
+    return h;
+}
+
 /* A hash of what the light depends on in the scene: every building's
- * rings, heights and albedo, every lamp's position, intensity, reach and
- * colour, the ground's albedo (as 16 hex digits). */
+ * rings, heights and albedo, every lamp's position, intensity, reach,
+ * colour and photometry, the ground's albedo (as 16 hex digits). */
 static void scene_hash(plx_engine *e, char out[17])
 {
     plx_scene_info si;
@@ -136,6 +175,7 @@ static void scene_hash(plx_engine *e, char out[17])
         h = fnv(h, &l.intensity, sizeof l.intensity);
         h = fnv(h, &l.radius, sizeof l.radius);
         h = fnv(h, l.color, sizeof l.color);
+        h = photometry_hash(e, i, h);
     }
     snprintf(out, 17, "%016llx", (unsigned long long)h);
 }
@@ -259,7 +299,7 @@ static int check_header(const network *net, const cJSON *h, plx_engine *e, int *
     scene_hash(e, hash);
     if ((there = hash_differs(h, "scene_hash", hash)) != NULL) {
         snprintf(err, errlen, "its edges were scored on another scene (the same counts, but the buildings' or "
-                 "lamps' positions, heights, intensities or colours differ: scene_hash %s there, %s here): run "
+                 "lamps' positions, heights, intensities, colours or photometry differ: scene_hash %s there, %s here): run "
                  "annotate again on this scene, or route over the plain street network", there, hash);
         return -1;
     }

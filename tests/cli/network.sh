@@ -57,7 +57,16 @@ for w in 0 3; do
     expect "net-annotated-17-digits-w$w" 0 "" -- sh -c "'$bin' route -q fixtures/net-detour.geojson --network '$tmp/ann17.geojson' --from 0,0 --to 200,0 --dark-weight $w --geojson '$tmp/r17-ann.json' | cmp - '$tmp/r17-plain.txt' && cmp '$tmp/r17-ann.json' '$tmp/r17-plain.json' && grep -q '$x' '$tmp/ann17.geojson'"
 done
 sed 's/"intensity": 1000/"intensity": 1001/' fixtures/net-detour.geojson >"$tmp/net-detour-brighter.geojson"
-expect net-annotated-other-light 1 "annotate's scores: its edges were scored on another scene \(the same counts, but the buildings' or lamps' positions, heights, intensities or colours differ: scene_hash [0-9a-f]{16} there, [0-9a-f]{16} here\)" -- "$bin" route -q "$tmp/net-detour-brighter.geojson" --network "$tmp/ann.geojson" --from 0,0 --to 200,0
+expect net-annotated-other-light 1 "annotate's scores: its edges were scored on another scene \(the same counts, but the buildings' or lamps' positions, heights, intensities, colours or photometry differ: scene_hash [0-9a-f]{16} there, [0-9a-f]{16} here\)" -- "$bin" route -q "$tmp/net-detour-brighter.geojson" --network "$tmp/ann.geojson" --from 0,0 --to 200,0
+# luminaires turned: the same positions, intensities and reach, another light (helper-57's pass: version 1's
+# scene_hash left photometry out, and the route read the old scores with no word)
+sed "s|\"intensity\": 1000,|\"photometry\": \"$PWD/fixtures/photometry/street-type2.ies\",|" fixtures/net-detour.geojson >"$tmp/net-detour-ies.geojson"
+sed "s|\"intensity\": 1000,|\"photometry\": \"$PWD/fixtures/photometry/street-type2.ies\", \"azimuth\": 180,|" fixtures/net-detour.geojson >"$tmp/net-detour-ies-turned.geojson"
+"$bin" annotate -q "$tmp/net-detour-ies.geojson" --network fixtures/net-detour-streets.geojson -o "$tmp/ann-ies.geojson" >/dev/null 2>&1
+expect net-annotated-ies-same 0 "^best-lit" -- "$bin" route -q "$tmp/net-detour-ies.geojson" --network "$tmp/ann-ies.geojson" --from 0,0 --to 200,0
+expect net-annotated-ies-turned 1 "its edges were scored on another scene \\(the same counts, but .* photometry differ: scene_hash" -- "$bin" route -q "$tmp/net-detour-ies-turned.geojson" --network "$tmp/ann-ies.geojson" --from 0,0 --to 200,0
+sed 's/"version":2,/"version":1,/' "$tmp/ann-ies.geojson" >"$tmp/ann-v1.geojson"
+expect net-annotated-version-1 1 "polarlux_scores member is not version 2" -- "$bin" route -q "$tmp/net-detour-ies.geojson" --network "$tmp/ann-v1.geojson" --from 0,0 --to 200,0
 sed 's/"mean_lux":/"mean_luxx":/' "$tmp/ann.geojson" >"$tmp/ann-edited.geojson"
 expect net-annotated-edited 1 "annotate's scores: feature 0: no number 'mean_lux' \(not as annotate wrote it\)" -- "$bin" route -q fixtures/net-detour.geojson --network "$tmp/ann-edited.geojson" --from 0,0 --to 200,0
 expect annotate-missing-o 2 "missing -o OUT.geojson" -- "$bin" annotate -q $net
