@@ -114,9 +114,16 @@ class Scene:
     for visibility, light and rendering at render_max (default 1920x1080).
     Warnings of the load (skipped features, ignored properties) are in
     .warnings; strict=True makes the first one an error.
+
+    Lamps naming an IES or EULUMDAT file (properties.photometry, SPEC §2.1)
+    get it read here, relative to base_dir unless absolute: from_file's
+    default is the scene file's folder, as the polarlux command's; Scene's
+    is the current directory. A file that cannot be read or parsed raises
+    PolarluxError naming it (such a lamp would give no light).
     """
 
-    def __init__(self, text, name="scene", mem=None, strict=False, lit_cache_bytes=0, render_max=(0, 0)):
+    def __init__(self, text, name="scene", mem=None, strict=False, lit_cache_bytes=0, render_max=(0, 0),
+                 base_dir=None):
         data = _as_bytes(text)
         self._start(strict, lit_cache_bytes, render_max)
         if mem is None:
@@ -129,7 +136,26 @@ class Scene:
         if st != _lib.OK:
             _raise(st, "plx_engine_create failed (mem too small?)")
         self._check(lib.plx_load_geojson(self._e, data, len(data), name.encode("utf-8")))
+        self._load_photometry(name, base_dir)
         self._read_info()
+
+    def _load_photometry(self, name, base_dir):
+        """Every photometry file the lamps name, read and given to the
+        engine (the core reads no files)."""
+        for k in range(lib.plx_photometry_count(self._e)):
+            p = ctypes.c_char_p()
+            self._check(lib.plx_photometry_path(self._e, k, ctypes.byref(p)))
+            rel = p.value.decode("utf-8", "replace")
+            full = rel if os.path.isabs(rel) else os.path.join(base_dir or os.getcwd(), rel)
+            if not os.path.isfile(full):
+                why = "not a regular file" if os.path.exists(full) else "no such file"
+                _raise(_lib.E_IO, f"{name}: photometry file {full}: {why}")
+            try:
+                with open(full, "rb") as f:
+                    blob = f.read()
+            except OSError as ex:
+                _raise(_lib.E_IO, f"{name}: photometry file {full}: {ex.strerror}")
+            self._check(lib.plx_set_photometry(self._e, p.value, blob, len(blob), full.encode("utf-8")))
 
     def _start(self, strict, lit_cache_bytes=0, render_max=(0, 0)):
         self.warnings = []
@@ -156,6 +182,7 @@ class Scene:
             f.seek(0)
             data = f.read()
         kw.setdefault("name", str(path))
+        kw.setdefault("base_dir", os.path.dirname(os.path.abspath(path)))
         return cls(data, **kw)
 
     @classmethod
@@ -175,12 +202,12 @@ class Scene:
         Python's memory) into a block of anonymous pages, huge pages where
         the system offers them: the load copies the image once, as the
         command's does."""
-        unknown = set(rest) - {"name", "render_max", "lit_cache_bytes"}
+        unknown = set(rest) - {"name", "render_max", "lit_cache_bytes", "base_dir"}
         if unknown:
             raise TypeError(f"unexpected keyword argument {sorted(unknown)[0]!r}")
-        if set(rest) - {"name"}:
+        if set(rest) - {"name", "base_dir"}:  # a bake holds its photometry tables: base_dir has nothing to read
             raise ValueError(f"{name}: a bake file takes mem= and strict= only (it keeps its own "
-                             f"{', '.join(sorted(set(rest) - {'name'}))}: set them with polarlux bake)")
+                             f"{', '.join(sorted(set(rest) - {'name', 'base_dir'}))}: set them with polarlux bake)")
         size = os.fstat(f.fileno()).st_size
         fmap = mmap.mmap(f.fileno(), 0, access=mmap.ACCESS_READ) if size else None
         data = np.frombuffer(fmap, dtype=np.uint8) if fmap is not None else np.zeros(1, dtype=np.uint8)

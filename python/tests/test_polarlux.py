@@ -337,3 +337,51 @@ def test_lonlat_given_for_metres_is_refused(tmp_path):
     assert "render_max" in str(v.value)
     with pytest.raises(TypeError):
         polarlux.Scene.from_bake(bake, bogus=1)
+
+
+LUMINAIRES = os.path.join(ROOT, "fixtures", "helsinki-street-luminaires.geojson")
+ONE_IES = ("IESNA:LM-63-2002\nTILT=NONE\n1 -1 1 2 1 1 2 0 0 0\n1 1 0\n0 90\n0\n100 0\n")
+
+
+def ies_scene(phot):
+    """One lamp 8 m up naming the photometry file phot, a metre scene."""
+    return ('{"type":"FeatureCollection","properties":{"units":"m"},"features":[{"type":"Feature","properties":'
+            '{"lamp":true,"z":8,"radius":40,"photometry":"%s"},"geometry":{"type":"Point","coordinates":[0,0]}}]}'
+            % phot)
+
+
+def test_photometry_read_relative_to_the_scene_file(tmp_path):
+    # 100 cd toward the nadir from 8 m, reach 40 m: E_h = 100 / 64 W(8 / 40) lx under the lamp (SPEC §2,
+    # §2.1); the package once left such lamps dark (0 lx) with no word
+    (tmp_path / "l.ies").write_text(ONE_IES)
+    (tmp_path / "s.geojson").write_text(ies_scene("l.ies"))
+    s = polarlux.Scene.from_file(str(tmp_path / "s.geojson"))
+    ed, _ = s.illuminance(np.array([[0.0, 0.0]]))
+    assert ed[0] == pytest.approx(100.0 / 64.0 * (1.0 - 0.2 ** 4) ** 2, rel=1e-12)
+    t = polarlux.Scene(ies_scene("l.ies"), base_dir=str(tmp_path))
+    assert np.array_equal(t.illuminance(np.array([[0.0, 0.0]]))[0], ed)
+
+
+def test_photometry_matches_the_command():
+    s = polarlux.Scene.from_file(LUMINAIRES)
+    pts = street_points(s, 200, 5)
+    ed, _ = s.illuminance(pts)
+    text = "# crs: local\n" + "".join(f"{x!r} {y!r}\n" for x, y in pts)
+    rc, out, _ = run_cli("illum", LUMINAIRES, "--points", "-", "-q", "--no-indirect", stdin=text)
+    rows = np.array([[float(v) for v in line.split()] for line in out.splitlines()])
+    ok = ~np.isnan(ed)
+    assert (ed[ok] > 0).sum() > 20
+    np.testing.assert_allclose(ed[ok], rows[ok, 3], rtol=1e-12, atol=1e-12)
+
+
+def test_photometry_file_errors(tmp_path):
+    (tmp_path / "s.geojson").write_text(ies_scene("l.ies"))
+    with pytest.raises(polarlux.PolarluxError, match=r"photometry file .*l\.ies: no such file"):
+        polarlux.Scene.from_file(str(tmp_path / "s.geojson"))
+    os.mkfifo(tmp_path / "l.ies")  # refused, never waited on
+    with pytest.raises(polarlux.PolarluxError, match=r"photometry file .*l\.ies: not a regular file"):
+        polarlux.Scene.from_file(str(tmp_path / "s.geojson"))
+    os.remove(tmp_path / "l.ies")
+    (tmp_path / "l.ies").write_text("IESNA:LM-63-2002\nTILT=NONE\n1 -1 1 2 1 1 2 0 0 0\n1 1 0\n0 90\n0\n100 abc\n")
+    with pytest.raises(polarlux.PolarluxError, match=r"line 7: bad number 'abc'"):
+        polarlux.Scene.from_file(str(tmp_path / "s.geojson"))
