@@ -865,7 +865,9 @@ typedef struct plx_route_stats {
  * whole line, segments (may be NULL) n-1 entries, one per segment. The
  * P-class is the best class whose mean and minimum the line meets (P1 15/3,
  * P2 10/2, P3 7.5/1.5, P4 5/1, P5 3/0.6, P6 2/0.4 lx).
- * Samples inside a footprint are not scored (blocked_length).
+ * Samples inside a footprint are not scored (blocked_length). A segment
+ * of no length (a repeated vertex) is its one point: mean = min = max =
+ * that point's lux, dark_share 1 or 0, length 0.
  * Errors: PLX_E_INVALID (xy NULL, n < 2, step <= 0, dark_lux < 0,
  * non-finite input), PLX_E_NOSCENE, PLX_E_NOMEM (the samples of one segment
  * are held in scratch: 64 bytes a sample). Threads: engine.

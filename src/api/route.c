@@ -21,6 +21,7 @@ int plx_p_class(double mean, double min)
 typedef struct acc {
     double integral, length, min, max, dark, blocked;
     uint32_t samples;
+    int dark_at_point; /* a sample below dark_lux (a stretch of no length weighs none) */
 } acc;
 
 static void acc_init(acc *a)
@@ -37,6 +38,7 @@ static void acc_merge(acc *to, const acc *a)
     to->dark += a->dark;
     to->blocked += a->blocked;
     to->samples += a->samples;
+    to->dark_at_point |= a->dark_at_point;
     to->min = fmin(to->min, a->min);
     to->max = fmax(to->max, a->max);
 }
@@ -53,6 +55,15 @@ static void acc_stats(const acc *a, plx_route_stats *out)
         out->max = a->max;
         out->uniformity = out->mean > 0 ? out->min / out->mean : 0.0;
         out->dark_share = a->dark / a->length;
+        out->p_class = plx_p_class(out->mean, out->min);
+    } else if (a->samples > 0) {
+        /* a stretch of no length (a repeated vertex) that was scored: its
+         * samples are one point, so its mean is that point's light, the
+         * limit of a short stretch's (it read 0 lx: a false dark segment) */
+        out->mean = out->min = a->min;
+        out->max = a->max;
+        out->uniformity = out->mean > 0 ? 1.0 : 0.0;
+        out->dark_share = a->dark_at_point ? 1.0 : 0.0;
         out->p_class = plx_p_class(out->mean, out->min);
     }
 }
@@ -103,8 +114,10 @@ static plx_status score_segment(plx_engine *e, const double *a, const double *b,
         out->samples++;
         out->integral += wi * E;
         out->length += wi;
-        if (E < dark_lux)
+        if (E < dark_lux) {
             out->dark += wi;
+            out->dark_at_point = 1;
+        }
         out->min = fmin(out->min, E);
         out->max = fmax(out->max, E);
     }

@@ -143,6 +143,12 @@ static int lamp_props(const cJSON *props, plx_lamp *l, char *why, size_t whylen)
     double *dst[3];
     const cJSON *col = cJSON_GetObjectItemCaseSensitive(props, "color");
     int k;
+    const cJSON *phot = cJSON_GetObjectItemCaseSensitive(props, "photometry");
+    if (phot && !cJSON_IsNull(phot)) { /* taken as isotropic, it lit the sky: refused, not read wrong */
+        snprintf(why, whylen, "property \"photometry\": a lamp layer's lamps are isotropic (intensity in cd); "
+                 "a lamp with an IES or EULUMDAT file belongs in the scene file");
+        return -1;
+    }
     dst[0] = &l->z;
     dst[1] = &l->intensity;
     dst[2] = &l->radius;
@@ -180,7 +186,7 @@ static int geojson_lamps(const char *name, const cJSON *features, int tagged_onl
         const cJSON *type = cJSON_GetObjectItemCaseSensitive(geom, "type");
         const cJSON *pos = cJSON_GetObjectItemCaseSensitive(geom, "coordinates");
         const cJSON *x = cJSON_GetArrayItem(pos, 0), *y = cJSON_GetArrayItem(pos, 1);
-        char idbuf[32], why[128];
+        char idbuf[32], why[192];
         plx_lamp l;
         fi++;
         if (!cJSON_IsString(type) || strcmp(type->valuestring, "Point") != 0 ||

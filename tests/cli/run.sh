@@ -873,6 +873,8 @@ expect tiles-empty-out 2 "-o needs a file name, not an empty string" -- "$bin" t
 expect walk-collection-first-line 0 "holds 2 line features: the walk follows the first LineString \(318\.4 m\)" -- "$bin" walk $H --path fixtures/helsinki-route.geojson -o "$tmp/wcol" --size 32x24 --max-frames 2 --no-indirect --aa 1
 printf '{"type":"FeatureCollection","properties":{"units":"m"},"features":[{"type":"Feature","properties":{},"geometry":{"type":"LineString","coordinates":[[30,20,1.7],[60,20,1.7]]}},{"type":"Feature","properties":{},"geometry":{"type":"MultiLineString","coordinates":[[[30,25],[60,25]]]}}]}' >"$tmp/walk-multi.json"
 expect walk-multilinestring-counted 0 "holds 2 line features: the walk follows the first LineString \(30\.0 m\)" -- "$bin" walk fixtures/tiny.geojson --path "$tmp/walk-multi.json" -o "$tmp/wmul" --size 32x24 --max-frames 2 --no-indirect --aa 1
+printf '{"type":"FeatureCollection","properties":{"units":"m"},"features":[{"type":"Feature","properties":{"lamp":true,"photometry":"a.ies"},"geometry":{"type":"Point","coordinates":[30,12]}}]}' >"$tmp/lphot.geojson"
+expect lamps-photometry-refused 1 "^polarlux info: --lamps .*lphot\\.geojson: feature 0: property \"photometry\": a lamp layer's lamps are isotropic" -- "$bin" info -q fixtures/tiny.geojson --lamps "$tmp/lphot.geojson"
 expect lamps-empty-name 2 "--lamps needs a file name, not an empty string" -- "$bin" info -q fixtures/tiny.geojson --lamps ''
 expect render-o-jpg 2 "-o '.*x\.jpg': the file is written as PNG \(\.png\); name it so" -- "$bin" render -q fixtures/tiny.geojson -o "$tmp/x.jpg"
 expect render-pfm-exr 2 "--pfm '.*x\.exr': the file is written as PFM \(\.pfm\)" -- "$bin" render -q fixtures/tiny.geojson -o "$tmp/x.png" --pfm "$tmp/x.exr"

@@ -69,6 +69,36 @@ static void test_one_lamp_straight_street(void **state)
     free(mem);
 }
 
+/* A repeated vertex: the segment of no length is its one point, scored
+ * with that point's lux against the formula (it read 0 lx, a false dark
+ * segment), and changes nothing of the whole line's; a line of one
+ * repeated point is that point too. */
+static void test_segment_of_no_length(void **state)
+{
+    void *mem;
+    plx_engine *e = load("{\"type\":\"FeatureCollection\",\"properties\":{\"units\":\"m\"},\"features\":["
+                         "{\"type\":\"Feature\",\"properties\":{\"lamp\":true,\"z\":6,\"intensity\":1000,\"radius\":30},"
+                         "\"geometry\":{\"type\":\"Point\",\"coordinates\":[0,0]}}]}", &mem);
+    double xy[6] = { -10, 0, -10, 0, 10, 0 }, plain[4] = { -10, 0, 10, 0 }, far[4] = { 100, 0, 100, 0 };
+    double E = lamp_E(-10, 0, 0, 0, 6, 1000, 30);
+    plx_route_stats tot, ref, seg[2], one;
+    (void)state;
+    assert_int_equal(plx_route_score(e, xy, 3, 1.0, 5.0, &tot, seg), PLX_OK);
+    assert_true(seg[0].length == 0.0 && seg[0].samples == 2);
+    assert_true(fabs(seg[0].mean - E) < 1e-12 * E && seg[0].min == seg[0].mean && seg[0].max == seg[0].mean);
+    assert_true(seg[0].uniformity == 1.0 && seg[0].dark_share == (E < 5.0 ? 1.0 : 0.0));
+    assert_int_equal(seg[0].p_class, plx_p_class(E, E));
+    assert_int_equal(plx_route_score(e, plain, 2, 1.0, 5.0, &ref, NULL), PLX_OK);
+    assert_true(tot.length == ref.length && tot.mean == ref.mean && tot.min == ref.min && tot.max == ref.max);
+    assert_true(tot.dark_share == ref.dark_share && tot.p_class == ref.p_class);
+    assert_int_equal(plx_route_score(e, xy, 2, 1.0, 5.0, &one, NULL), PLX_OK);
+    assert_true(one.length == 0.0 && fabs(one.mean - E) < 1e-12 * E);
+    assert_int_equal(plx_route_score(e, far, 2, 1.0, 5.0, &one, NULL), PLX_OK); /* out of reach: dark */
+    assert_true(one.mean == 0.0 && one.dark_share == 1.0 && one.p_class == 0);
+    plx_engine_destroy(e);
+    free(mem);
+}
+
 static void test_shadow_across_street(void **state)
 {
     /* lamp at (0, 5, 6); a 20 m tall box x in [-2, 2], y in [2, 3]; the street
@@ -281,6 +311,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_one_lamp_straight_street),
         cmocka_unit_test(test_shadow_across_street),
+        cmocka_unit_test(test_segment_of_no_length),
         cmocka_unit_test(test_route_through_building),
         cmocka_unit_test(test_consistent_with_illuminance),
         cmocka_unit_test(test_p_class_boundaries),
