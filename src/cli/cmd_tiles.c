@@ -277,6 +277,9 @@ static int parse(int argc, char **argv, tiles_opts *o)
         return cli_usage_error("tiles", "missing --zoom Z0-Z1");
     if (!o->out)
         return cli_usage_error("tiles", "missing -o OUT (a folder or a .mbtiles file)");
+    if (strcmp(o->out, "-") == 0) /* elsewhere '-' is standard input or output: never a folder named '-' */
+        return cli_usage_error("tiles", "-o names a folder or a .mbtiles file: '-' (standard output) cannot hold "
+                               "tiles; name a folder, e.g. -o ./-");
     if (!ends_with(o->out, ".mbtiles") && stat(o->out, &st) == 0 && !S_ISDIR(st.st_mode))
         return cli_usage_error("tiles", "-o '%s' is a file, not a folder: name a folder for z/x/y.png tiles, or a "
                                ".mbtiles file", o->out);

@@ -820,6 +820,14 @@ int cli_load_scene(const char *cmd, const char *path, const cli_common *c, plx_e
 {
     int rc, k;
     plx_status st;
+    struct stat sb;
+    if (strcmp(path, "-") == 0 && stat(path, &sb) != 0) { /* '-' reads standard input for paths and points */
+        fprintf(stderr, "polarlux %s: SCENE '-': a scene is not read from standard input; give its file "
+                "(./- for a file named '-')\n", cmd);
+        plx_engine_free(*e);
+        *e = NULL;
+        return EXIT_USAGE;
+    }
     st = plx_load_file(*e, path);
     if (st != PLX_OK) {
         fprintf(stderr, "polarlux %s: %s\n", cmd, plx_last_error(*e));

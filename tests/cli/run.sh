@@ -873,6 +873,10 @@ expect tiles-empty-out 2 "-o needs a file name, not an empty string" -- "$bin" t
 expect walk-collection-first-line 0 "holds 2 line features: the walk follows the first LineString \(318\.4 m\)" -- "$bin" walk $H --path fixtures/helsinki-route.geojson -o "$tmp/wcol" --size 32x24 --max-frames 2 --no-indirect --aa 1
 printf '{"type":"FeatureCollection","properties":{"units":"m"},"features":[{"type":"Feature","properties":{},"geometry":{"type":"LineString","coordinates":[[30,20,1.7],[60,20,1.7]]}},{"type":"Feature","properties":{},"geometry":{"type":"MultiLineString","coordinates":[[[30,25],[60,25]]]}}]}' >"$tmp/walk-multi.json"
 expect walk-multilinestring-counted 0 "holds 2 line features: the walk follows the first LineString \(30\.0 m\)" -- "$bin" walk fixtures/tiny.geojson --path "$tmp/walk-multi.json" -o "$tmp/wmul" --size 32x24 --max-frames 2 --no-indirect --aa 1
+# '-' is standard input or output elsewhere: not a scene, and not a folder for frames or tiles (helper-56's pass)
+expect scene-dash 2 "^polarlux info: SCENE '-': a scene is not read from standard input" -- "$bin" info -
+expect walk-o-dash 2 "^polarlux walk: -o names the folder for the frames: '-' \\(standard output\\) cannot hold them" -- "$bin" walk fixtures/tiny.geojson --path "$tmp/nope.geojson" -o -
+expect tiles-o-dash 2 "^polarlux tiles: -o names a folder or a \\.mbtiles file: '-'" -- "$bin" tiles fixtures/helsinki-centre.geojson --zoom 12 -o -
 printf '{"type":"FeatureCollection","properties":{"units":"m"},"features":[{"type":"Feature","properties":{"lamp":true,"photometry":"a.ies"},"geometry":{"type":"Point","coordinates":[30,12]}}]}' >"$tmp/lphot.geojson"
 expect lamps-photometry-refused 1 "^polarlux info: --lamps .*lphot\\.geojson: feature 0: property \"photometry\": a lamp layer's lamps are isotropic" -- "$bin" info -q fixtures/tiny.geojson --lamps "$tmp/lphot.geojson"
 expect lamps-empty-name 2 "--lamps needs a file name, not an empty string" -- "$bin" info -q fixtures/tiny.geojson --lamps ''
