@@ -178,10 +178,12 @@ void cli_refiner_init(cli_refiner *r, double height, long frames, long photons);
  * photon frames refill the aerial chart. Prints the error and returns an
  * exit code. */
 int cli_refine(const char *cmd, plx_engine *e, const plx_camera *cam, cli_refiner *r);
-/* The end of a frame's out-of-memory line when it was anti-aliased: its
- * buffers take 20 bytes a pixel of the largest frame (a bake's --max-size)
- * and --aa 1 needs none; "" otherwise. */
-const char *cli_aa_nomem_hint(plx_status st, const plx_render_opts *o);
+/* The end of a frame's out-of-memory line (in buf): a larger --mem or a
+ * smaller --size, and when it was anti-aliased, that its buffers take 20
+ * bytes a pixel of the largest frame (a bake's --max-size) and --aa 1
+ * none; "" for another error. */
+const char *cli_render_nomem_hint(plx_status st, const plx_render_opts *o, const cli_common *c, char *buf,
+                                  size_t len);
 /* "polarlux CMD: warning: ..." on stderr unless --quiet (c may be NULL). */
 void cli_warn(const char *cmd, const cli_common *c, const char *fmt, ...);
 /* Whether the file name's extension (a dot in its last part) is another

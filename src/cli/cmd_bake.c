@@ -330,6 +330,8 @@ int cmd_bake(int argc, char **argv)
         char ph[96];
         if (a.ind.off)
             snprintf(ph, sizeof ph, "no photons (%s)", a.frames0 ? "--frames 0: as --no-indirect" : "--no-indirect");
+        else if (plx_indirect_frames(e) == 0 && !cli_has_lamps(e))
+            snprintf(ph, sizeof ph, "no photons (no lamps to trace from)");
         else
             snprintf(ph, sizeof ph, "photons %.0f ms (%ld x %ld)", (t2 - t1) / 1e6, a.ind.frames,
                      cli_photons(e, &a.ind));

@@ -118,6 +118,8 @@ int cmd_illum(int argc, char **argv)
             return rc;
         }
     }
+    if (!ind.off && ind.frames == 0 && plx_indirect_frames(e) == 0) /* the gather reads the photon buffers */
+        cli_warn("illum", &c, "--frames 0 traces no photons: E_indirect is 0, as with --no-indirect");
     ed = malloc(sizeof *ed * (pts.n + 1));
     ei = malloc(sizeof *ei * (pts.n + 1));
     if (!ed || !ei) {

@@ -433,7 +433,9 @@ int cmd_render(int argc, char **argv)
     if (st == PLX_OK)
         cli_atlas_note("render", e, had_atlas, a.opts.aerial_m_per_texel);
     if (st != PLX_OK) {
-        fprintf(stderr, "polarlux render: %s%s\n", plx_last_error(e), cli_aa_nomem_hint(st, &a.opts));
+        char hint[200];
+        fprintf(stderr, "polarlux render: %s%s\n", plx_last_error(e),
+                cli_render_nomem_hint(st, &a.opts, &a.c, hint, sizeof hint));
 #ifdef PLX_HAVE_OSMESA
         if (om && *plx_osmesa_error(om))
             fprintf(stderr, "polarlux render: osmesa: %s\n", plx_osmesa_error(om));

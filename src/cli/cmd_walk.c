@@ -558,11 +558,11 @@ static int frame(const walk_args *a, plx_engine *e, const walk_path *wp, walk_ru
             return EXIT_FAIL;
     }
     if (st != PLX_OK) {
-        char at[96], why[512];
+        char at[96], why[512], hint[200];
         /* the error first: eye_text asks the engine again, which clears it */
         snprintf(why, sizeof why, "%s", plx_last_error(e));
         fprintf(stderr, "polarlux walk: frame %ld at %s: %s%s\n", k + 1, eye_text(e, cam.eye, at, sizeof at), why,
-                cli_aa_nomem_hint(st, &a->opts));
+                cli_render_nomem_hint(st, &a->opts, &a->c, hint, sizeof hint));
         return cli_exit_code(st);
     }
     /* black with the eye inside a building: its own warning says why */
@@ -750,9 +750,15 @@ static int run(const walk_args *a, plx_engine *e, const walk_path *wp, long *don
     if (L - (steps - 1.0) * step > 1e-9 * fmax(L, 1.0)) /* and one at the end */
         steps += 1.0;
     wr.n = steps < (double)a->max_frames ? (long)steps : a->max_frames;
-    if (steps > (double)a->max_frames)
-        cli_warn("walk", &a->c, "--max-frames %ld stops the walk at %.1f m of the path's %.1f m (%.4g frames "
-                 "would walk it all)", a->max_frames, frame_at(wr.n - 1, step, L), L, steps);
+    if (steps > (double)a->max_frames) {
+        char all[40];
+        if (steps < 1e15) /* whole digits, not 1.786e+04 */
+            snprintf(all, sizeof all, "%.0f", steps);
+        else
+            snprintf(all, sizeof all, "more than 10^15");
+        cli_warn("walk", &a->c, "--max-frames %ld stops the walk at %.1f m of the path's %.1f m (%s frames "
+                 "would walk it all)", a->max_frames, frame_at(wr.n - 1, step, L), L, all);
+    }
     stale_hint(a, wr.n);
     sheet_plan(&wr.sh, a, wr.n);
     wr.ms = malloc(sizeof *wr.ms * (size_t)wr.n);

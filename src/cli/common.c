@@ -64,11 +64,15 @@ int cli_parse_real(const char *s, double lo, double hi, double *out)
     return cli_parse_double(s, out) != 0 || !(*out >= lo && *out <= hi) ? -1 : 0;
 }
 
-const char *cli_aa_nomem_hint(plx_status st, const plx_render_opts *o)
+const char *cli_render_nomem_hint(plx_status st, const plx_render_opts *o, const cli_common *c, char *buf,
+                                  size_t len)
 {
-    if (st != PLX_E_NOMEM || o->aa <= 1)
+    if (st != PLX_E_NOMEM)
         return "";
-    return " (anti-aliasing takes 20 bytes a pixel of the largest frame, a bake's --max-size; --aa 1 needs none)";
+    snprintf(buf, len, " (give a larger --mem, now %zu bytes, or a smaller --size%s)", c->mem ? c->mem
+             : CLI_DEFAULT_MEM, o->aa > 1 ? "; anti-aliasing takes 20 bytes a pixel more of the largest frame, a "
+             "bake's --max-size, and --aa 1 none" : "");
+    return buf;
 }
 
 int cli_parse_exposure(const char *s, void *out)
@@ -327,8 +331,8 @@ void cli_light_note(const char *cmd, const cli_common *c, plx_engine *e)
         fprintf(stderr, "polarlux %s: note: the ground's lux (E_h) are direct + indirect light (%llu photon "
                         "frames); Ev and Esc are direct light\n", cmd, (unsigned long long)frames);
     else if (cli_bake_last.loaded)
-        fprintf(stderr, "polarlux %s: note: the lux are direct light only (the bake holds no photon buffers: "
-                        "baked with --no-indirect or --frames 0)\n", cmd);
+        fprintf(stderr, "polarlux %s: note: the lux are direct light only (the bake holds no photon buffers: %s)\n",
+                cmd, cli_has_lamps(e) ? "baked with --no-indirect or --frames 0" : "its scene has no lamps");
     else
         fprintf(stderr, "polarlux %s: note: the lux are direct light only (no photon buffers: a bake of the scene "
                         "adds indirect light to E_h)\n", cmd);
@@ -453,10 +457,28 @@ int cli_has_lamps(plx_engine *e)
     return plx_scene_info_get(e, &si) == PLX_OK && si.lamps > 0;
 }
 
+/* Whether some lamp gives light: an intensity above 0 cd (a photometric
+ * lamp's is its dimming times its table's peak). */
+static int lamps_shine(plx_engine *e)
+{
+    plx_scene_info si;
+    plx_lamp l;
+    uint32_t i;
+    if (plx_scene_info_get(e, &si) != PLX_OK)
+        return 1;
+    for (i = 0; i < si.lamps; i++)
+        if (plx_lamp_get(e, i, &l) != PLX_OK || l.intensity > 0.0)
+            return 1;
+    return 0;
+}
+
 const char *cli_dark_reason(plx_engine *e)
 {
     if (!cli_has_lamps(e))
         return "the scene has no lamps";
+    if (!lamps_shine(e))
+        return "every lamp gives no light (0 cd: an intensity or dimming of 0, or a photometry file whose "
+               "candelas or multiplier are 0; 'polarlux info' lists their flux)";
     return "no lamp's light reaches it (each lamp lights only within its radius, and buildings cast shadows)";
 }
 
@@ -908,6 +930,8 @@ int cli_bake_direct(const char *cmd, const char *path, const cli_common *c, plx_
     if (ind->off || plx_indirect_frames(e) > 0 || !cli_bake_last.loaded)
         return 0;
     ind->off = 1;
+    if (!cli_has_lamps(e)) /* nothing to trace: the dark scene's own warnings say so */
+        return 1;
     cli_warn(cmd, c, "%s holds no indirect light (baked with --no-indirect or --frames 0): its images show the "
              "direct light; bake the scene without those options for indirect light", path);
     return 1;
