@@ -398,3 +398,26 @@ size_t jsonscan_error_at(const char *text, size_t len, size_t at, const char **t
             : truncated ? ": the text ends early" : ": unexpected end";
     return at;
 }
+
+long jsonscan_depth_at(const char *text, size_t len, size_t off)
+{
+    size_t i;
+    long depth = 0;
+    int in_string = 0;
+    for (i = 0; i < off && i < len; i++) {
+        char c = text[i];
+        if (in_string) {
+            if (c == '\\')
+                i++;
+            else if (c == '"')
+                in_string = 0;
+        } else if (c == '"') {
+            in_string = 1;
+        } else if (c == '[' || c == '{') {
+            depth++;
+        } else if (c == ']' || c == '}') {
+            depth--;
+        }
+    }
+    return depth;
+}

@@ -35,6 +35,11 @@ size_t jsonscan_ws(const char *text, size_t len, size_t off);
  * malformed: the scene loader and the command's paths refuse it alike. */
 size_t jsonscan_trailing(const char *text, size_t len, size_t end);
 
+/* The containers open just before offset off (strings skipped): at an
+ * error where a '[' or '{' opens the JSONSCAN_DEPTH-th, the text is nested
+ * deeper than cJSON parses, not malformed. */
+long jsonscan_depth_at(const char *text, size_t len, size_t off);
+
 /* The kind of the value at off (JS_NONE for JSONSCAN_NONE). */
 js_kind jsonscan_kind(const char *text, size_t off);
 

@@ -401,8 +401,9 @@ static int find_routes(const net_opts *o, plx_engine *e, network *net, int read_
         printf("cost = length + %g x dark metres (below %g lx or inside footprints)", weight, o->dark);
         if (weight != o->weight)
             printf("; weight lowered from %g by --max-detour %g", o->weight, o->detour);
-        printf("; Ev, Esc at %g m facing both ways; network %u nodes, %u edges; ends %.1f m and %.1f m from the "
-               "streets\n", o->height, net->nnodes, net->nedges, a.dist, b.dist);
+        printf("; Ev, Esc at %g m facing both ways; network %u node%s, %u edge%s; ends %.1f m and %.1f m from the "
+               "streets\n", o->height, net->nnodes, net->nnodes == 1 ? "" : "s", net->nedges,
+               net->nedges == 1 ? "" : "s", a.dist, b.dist);
         if (best.dark + best.blocked > 0 && !o->c.quiet)
             fprintf(stderr, "polarlux %s: note: the best-lit route still has %.1f dark metres\n", o->cmd,
                     best.dark + best.blocked);
@@ -422,8 +423,13 @@ int cmd_route_network(int argc, char **argv)
     plx_engine *e;
     network net;
     int rc, read_scores;
+    int i;
     memset(&o, 0, sizeof o);
     o.cmd = "route";
+    for (i = 1; i < argc; i++) /* route's other way: said as such, not as an unknown option */
+        if (strcmp(argv[i], "--path") == 0)
+            return cli_usage_error("route", "--path and --network do not combine: --path scores a given line; "
+                                   "--network finds the best-lit route from --from to --to");
     rc = parse(&o, argc, argv, route_help);
     read_scores = 0;
     if (rc != EXIT_OK)
@@ -624,8 +630,8 @@ int cmd_annotate(int argc, char **argv)
             len += net.edges[i].length;
         }
         if (rc == EXIT_OK) {
-            printf("annotate: %u edges, %u nodes, %.0f m of street, %.0f m dark (below %g lx), written to %s%s%s\n",
-                   net.nedges, net.nnodes, len, dark, o.dark, o.out, o.csv ? " and " : "", o.csv ? o.csv : "");
+            printf("annotate: %u edge%s, %u node%s, %.0f m of street, %.0f m dark (below %g lx), written to "
+                   "%s%s%s\n", net.nedges, net.nedges == 1 ? "" : "s", net.nnodes, net.nnodes == 1 ? "" : "s", len, dark, o.dark, o.out, o.csv ? " and " : "", o.csv ? o.csv : "");
             cli_light_note("annotate", &o.c, e);
         }
         net_free(&net);

@@ -114,7 +114,7 @@ static void print_row(int width, const char *line, const char *seg, const plx_ro
     class_text(s->p_class, cls);
     class_text(facial_class(s, fac), fr);
     print_padded(line, width);
-    printf(" %-5s %9.1f %9.3f %9.3f %9.3f %6.3f %6.3f %-5s %8.3f %8.3f %8.3f %8.3f %-3s", seg,
+    printf(" %-5s %9.1f %9.3f %9.3f %9.3f %6.3f %6.3f %-5s %8.3f %8.3f %8.3f %8.3f %s", seg,
            s->length, s->mean, s->min, s->max, s->uniformity, s->dark_share, cls, fac[0], fac[1], fac[2], fac[3],
            fr);
     if (s->blocked_length > 0)
@@ -311,9 +311,17 @@ int cmd_route(int argc, char **argv)
         CLI_OPT_END
     };
     cli_args pa;
+    static const char *const network_only[] = { "--from", "--to", "--dark-weight", "--max-detour", "--snap" };
+    size_t k;
     for (i = 1; i < argc; i++) /* the best-lit route over a street network: cmd_network.c */
         if (strcmp(argv[i], "--network") == 0)
             return cmd_route_network(argc, argv);
+    for (i = 1; i < argc; i++) /* its options, said as such rather than unknown */
+        for (k = 0; k < sizeof network_only / sizeof *network_only; k++)
+            if (strcmp(argv[i], network_only[k]) == 0)
+                return cli_usage_error("route", "%s needs --network STREETS.geojson (the best-lit route between "
+                                       "two points over a street network); without it route scores --path",
+                                       argv[i]);
     memset(&o, 0, sizeof o);
     o.step = 1.0;
     o.dark = 1.0;

@@ -280,6 +280,9 @@ static int parse(int argc, char **argv, tiles_opts *o)
     if (strcmp(o->out, "-") == 0) /* elsewhere '-' is standard input or output: never a folder named '-' */
         return cli_usage_error("tiles", "-o names a folder or a .mbtiles file: '-' (standard output) cannot hold "
                                "tiles; name a folder, e.g. -o ./-");
+    if (ends_with(o->out, ".mbtiles") && stat(o->out, &st) == 0 && S_ISDIR(st.st_mode))
+        return cli_usage_error("tiles", "-o '%s' is a folder: an .mbtiles file cannot replace it (remove it, or name "
+                               "another file)", o->out);
     if (!ends_with(o->out, ".mbtiles") && stat(o->out, &st) == 0 && !S_ISDIR(st.st_mode))
         return cli_usage_error("tiles", "-o '%s' is a file, not a folder: name a folder for z/x/y.png tiles, or a "
                                ".mbtiles file", o->out);

@@ -995,8 +995,12 @@ void cli_json_error(const char *name, const char *text, size_t len, char *err, s
     size_t off = jsonscan_error_at(text, len, at && at >= text ? (size_t)(at - text) : len, &tail);
     uint32_t line, col;
     jsonscan_line_col(text, len, off, &line, &col);
-    snprintf(err, errlen, "%s: malformed JSON at byte %zu (line %lu, column %lu)%s", name, off, (unsigned long)line,
-             (unsigned long)col, tail);
+    if (off < len && (text[off] == '[' || text[off] == '{') && jsonscan_depth_at(text, len, off) >= JSONSCAN_DEPTH)
+        snprintf(err, errlen, "%s: JSON nested deeper than %d levels at byte %zu (line %lu, column %lu)", name,
+                 JSONSCAN_DEPTH, off, (unsigned long)line, (unsigned long)col); /* the scene loader's words */
+    else
+        snprintf(err, errlen, "%s: malformed JSON at byte %zu (line %lu, column %lu)%s", name, off,
+                 (unsigned long)line, (unsigned long)col, tail);
 }
 
 cJSON *cli_json_parse(const char *name, const char *text, size_t len, char *err, size_t errlen)

@@ -97,13 +97,18 @@ void geo_add(geo_out *g, cJSON *geometry, cJSON *props)
 int geo_write(geo_out *g, const char *cmd, const char *path)
 {
     char err[512];
-    char *text = cJSON_PrintUnformatted(g->root);
+    char *text = cJSON_PrintUnformatted(g->root), *nl;
+    size_t n;
     int rc;
-    if (!text) {
+    if (!text || !(nl = realloc(text, (n = strlen(text)) + 2))) {
+        free(text);
         fprintf(stderr, "polarlux %s: %s: out of memory formatting GeoJSON\n", cmd, path);
         return -1;
     }
-    rc = port_write_atomic(path, text, strlen(text), err, sizeof err);
+    text = nl;
+    text[n] = '\n'; /* a text file's last line ends: on standard output the shell's prompt followed it */
+    text[n + 1] = '\0';
+    rc = port_write_atomic(path, text, n + 1, err, sizeof err);
     if (rc != 0)
         fprintf(stderr, "polarlux %s: %s\n", cmd, err);
     free(text);

@@ -1,5 +1,6 @@
 /* mbtiles: MBTiles 1.3 output (an SQLite file: metadata and tiles tables,
  * tile rows in TMS order), written to a temporary file renamed into place. */
+#include <errno.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -112,7 +113,7 @@ int mbtiles_close(mbtiles *m, int commit, char *err, size_t errlen)
         rc = sql_fail(m, "cannot close", err, errlen);
     m->db = NULL;
     if (commit && rc == 0 && rename(m->tmp, m->path) != 0) {
-        snprintf(err, errlen, "%s: cannot rename %s into place", m->path, m->tmp);
+        snprintf(err, errlen, "%s: cannot rename %s into place: %s", m->path, m->tmp, strerror(errno));
         rc = -1;
     }
     if (!commit || rc != 0)

@@ -77,30 +77,6 @@ static plx_status bad_top_property(loader *ld, const char *why)
 
 /* ---- parsing ------------------------------------------------------------ */
 
-/* Arrays and objects open before byte off (outside strings). */
-static long depth_at(const loader *ld, size_t off)
-{
-    size_t i;
-    long depth = 0;
-    int in_string = 0;
-    for (i = 0; i < off && i < ld->len; i++) {
-        char c = ld->text[i];
-        if (in_string) {
-            if (c == '\\')
-                i++;
-            else if (c == '"')
-                in_string = 0;
-        } else if (c == '"') {
-            in_string = 1;
-        } else if (c == '[' || c == '{') {
-            depth++;
-        } else if (c == ']' || c == '}') {
-            depth--;
-        }
-    }
-    return depth;
-}
-
 static plx_status parse_error(loader *ld, const char *at)
 {
     char msg[ENGINE_ERR_BYTES];
@@ -115,7 +91,7 @@ static plx_status parse_error(loader *ld, const char *at)
         sb_str(&b, ": ");
     }
     if (off < ld->len && (ld->text[off] == '[' || ld->text[off] == '{') &&
-        depth_at(ld, off) >= JSONSCAN_DEPTH) {
+        jsonscan_depth_at(ld->text, ld->len, off) >= JSONSCAN_DEPTH) {
         /* well-formed maybe, but deeper than cJSON parses */
         sb_str(&b, "JSON nested deeper than ");
         sb_uint(&b, JSONSCAN_DEPTH);

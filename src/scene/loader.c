@@ -53,6 +53,7 @@ plx_status ld_bad_feature(loader *ld, uint32_t fi, const char *id, const char *w
     if (eng_strict(ld->e))
         return eng_fail(ld->e, PLX_E_SCENE, msg);
     ld->s->skipped_features++;
+    sb_str(&b, "; left out"); /* a dropped lamp among hundreds went unnoticed without it */
     eng_warn(ld->e, msg);
     return PLX_OK;
 }

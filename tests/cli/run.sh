@@ -885,6 +885,18 @@ if grep -q "has no lamps" "$tmp/out" && ! grep -q "no-indirect or --frames 0" "$
 printf '{"type":"FeatureCollection","properties":{"units":"m"},"features":[{"type":"Feature","properties":{"lamp":true,"intensity":0},"geometry":{"type":"Point","coordinates":[0,0]}}]}' >"$tmp/zero-cd.geojson"
 expect dark-zero-cd 0 "every point is dark \\(0 lx\\): every lamp gives no light \\(0 cd" -- sh -c "echo '1 0' | '$bin' illum '$tmp/zero-cd.geojson' --points -"
 expect illum-frames-0 0 "^polarlux illum: warning: --frames 0 traces no photons: E_indirect is 0, as with --no-indirect$" -- sh -c "echo '4 0' | '$bin' illum fixtures/tiny.geojson --points - --frames 0"
+# route's two ways: their options said as such, not as unknown (helper-57's pass)
+expect route-from-without-network 2 "^polarlux route: --from needs --network STREETS.geojson" -- "$bin" route fixtures/helsinki-centre.geojson --from 1,2 --to 3,4
+expect route-path-with-network 2 "^polarlux route: --path and --network do not combine" -- "$bin" route fixtures/helsinki-centre.geojson --network fixtures/helsinki-streets.geojson --path fixtures/helsinki-route.geojson
+mkdir -p "$tmp/dir.mbtiles"
+expect tiles-mbtiles-folder 2 "^polarlux tiles: -o '.*dir\\.mbtiles' is a folder: an \\.mbtiles file cannot replace it" -- "$bin" tiles -q fixtures/helsinki-centre.geojson --zoom 12 -o "$tmp/dir.mbtiles"
+# a path nested past cJSON's depth: said as the scene loader says it, not "malformed" (helper-56's pass)
+python3 -c "print('{\"type\":\"LineString\",\"coordinates\":' + '[' * 1200)" >"$tmp/deep-path.geojson" 2>/dev/null || printf '%1200s' '' | tr ' ' '[' >"$tmp/deep-path.geojson"
+expect path-nested-deep 1 "deep-path\\.geojson: JSON nested deeper than 1000 levels at byte" -- "$bin" walk fixtures/tiny.geojson --path "$tmp/deep-path.geojson" -o "$tmp/deepw"
+# GeoJSON written to standard output ends its line; a dropped lamp says it is left out (helper-57's pass)
+expect geojson-stdout-newline 0 "" -- sh -c "'$bin' dark-spots -q fixtures/tiny.geojson -o - | tail -c 1 | od -An -c | grep -q '\\\\n'"
+printf '{"type":"FeatureCollection","properties":{"units":"m"},"features":[{"type":"Feature","properties":{"lamp":true,"radius":0},"geometry":{"type":"Point","coordinates":[0,0]}}]}' >"$tmp/radius0.geojson"
+expect lamp-bad-left-out 0 "feature 0 \\(line 1, column [0-9]+\\): lamp radius 0 m is out of range \\(> 0 and <= 100000 m\\); left out$" -- "$bin" info "$tmp/radius0.geojson"
 # '-' is standard input or output elsewhere: not a scene, and not a folder for frames or tiles (helper-56's pass)
 expect scene-dash 2 "^polarlux info: SCENE '-': a scene is not read from standard input" -- "$bin" info -
 expect walk-o-dash 2 "^polarlux walk: -o names the folder for the frames: '-' \\(standard output\\) cannot hold them" -- "$bin" walk fixtures/tiny.geojson --path "$tmp/nope.geojson" -o -
