@@ -6,6 +6,7 @@
 #include <string.h>
 #include <sys/stat.h>
 #include <unistd.h>
+#include <cjson/cJSON.h>
 
 #include "cli.h"
 #include "options.h"
@@ -25,7 +26,8 @@ static const char help[] =
     "OUT ending in .mbtiles is an MBTiles 1.3 file (SQLite; metadata name,\n"
     "format, type, version, bounds, center, minzoom, maxzoom, description, and\n"
     "attribution when there is one); otherwise OUT is a folder receiving\n"
-    "OUT/z/x/y.png.\n"
+    "OUT/z/x/y.png and OUT/metadata.json (TileJSON 3.0.0 with those fields and\n"
+    "polarlux_scale: min_lux, max_lux, for a legend).\n"
     "\n"
     "  --zoom Z0-Z1   zoom levels (0..22; one level: --zoom Z)\n"
     "  --quantity Q   h: the horizontal illuminance E_h on the ground (default);\n"
@@ -35,9 +37,11 @@ static const char help[] =
     "  --facing F     sc's facing direction: 'min' (default), the least E_sc over\n"
     "                 every horizontal direction (the face worst lit), or degrees\n"
     "                 counter-clockwise from east (as 'polarlux heatmap --facing')\n"
-    "  --max LUX      top of the colour scale (default: as 'polarlux heatmap' of\n"
-    "                 the quantity with its default resolution, the next power of\n"
-    "                 ten above the brightest pixel)\n"
+    "  --max LUX      top of the colour scale (default: the next power of ten\n"
+    "                 above the brightest pixel of the quantity on the grid of\n"
+    "                 'polarlux heatmap''s default resolution; heatmap's own\n"
+    "                 default scale spans its pixels' percentiles: give both\n"
+    "                 --max for one scale)\n"
     "  -o OUT         folder or .mbtiles file (required)\n"
     "  --attribution TEXT  the MBTiles attribution (the data's credit line;\n"
     "                 default: the scene file's own top-level \"attribution\"\n"
@@ -146,6 +150,51 @@ static const char *tiles_attribution(const tiles_opts *o, char *buf, size_t cap)
     return cli_scene_attribution(o->scene, buf, cap) ? buf : NULL;
 }
 
+/* A folder's OUT/metadata.json: TileJSON 3.0.0 (the MBTiles metadata's
+ * fields) and the colour scale, so a page can label its legend in lux. */
+static int write_tilejson(const tiles_opts *o, const char *name, const double b[4], const char *what, double top,
+                          const char *attribution)
+{
+    cJSON *j = cJSON_CreateObject(), *scale;
+    const char *tiles[1] = { "{z}/{x}/{y}.png" };
+    double centre[3];
+    char path[4096], err[512], *text, *line;
+    size_t n;
+    int rc;
+    centre[0] = 0.5 * (b[0] + b[2]);
+    centre[1] = 0.5 * (b[1] + b[3]);
+    centre[2] = (double)o->z1;
+    cJSON_AddStringToObject(j, "tilejson", "3.0.0");
+    cJSON_AddStringToObject(j, "name", name);
+    cJSON_AddStringToObject(j, "description", what);
+    if (attribution && attribution[0])
+        cJSON_AddStringToObject(j, "attribution", attribution);
+    cJSON_AddItemToObject(j, "tiles", cJSON_CreateStringArray(tiles, 1));
+    cJSON_AddItemToObject(j, "bounds", cJSON_CreateDoubleArray(b, 4));
+    cJSON_AddItemToObject(j, "center", cJSON_CreateDoubleArray(centre, 3));
+    cJSON_AddNumberToObject(j, "minzoom", (double)o->z0);
+    cJSON_AddNumberToObject(j, "maxzoom", (double)o->z1);
+    scale = cJSON_AddObjectToObject(j, "polarlux_scale");
+    cJSON_AddStringToObject(scale, "kind", "logarithmic, the heat map's colours; transparent at or below min_lux");
+    cJSON_AddNumberToObject(scale, "min_lux", 0.1);
+    cJSON_AddNumberToObject(scale, "max_lux", top);
+    text = cJSON_Print(j);
+    cJSON_Delete(j);
+    if (!text || !(line = realloc(text, (n = strlen(text)) + 2))) {
+        free(text);
+        fprintf(stderr, "polarlux tiles: out of memory for metadata.json\n");
+        return -1;
+    }
+    text = line;
+    memcpy(text + n, "\n", 2); /* the last line ends */
+    snprintf(path, sizeof path, "%s/metadata.json", o->out);
+    rc = port_write_atomic(path, text, n + 1, err, sizeof err);
+    if (rc != 0)
+        fprintf(stderr, "polarlux tiles: %s\n", err);
+    free(text);
+    return rc;
+}
+
 /* Renders and stores every tile; returns an exit code. */
 static int run(plx_engine *e, const tiles_opts *o, double top)
 {
@@ -205,6 +254,10 @@ static int run(plx_engine *e, const tiles_opts *o, double top)
         fprintf(stderr, "polarlux tiles: %s\n", err);
         rc = EXIT_FAIL;
     }
+    if (!mb && rc == EXIT_OK && (make_dir(o->out) != 0 ||
+                                 write_tilejson(o, scene_name(o->scene, name, sizeof name), b, what, top,
+                                                tiles_attribution(o, credit, sizeof credit)) != 0))
+        rc = EXIT_FAIL;
     if (rc == EXIT_OK) {
         printf("tiles: %ld tiles at zoom %ld-%ld (%ld with light) of %s, scale 0.1..%g lx, written to %s\n", total,
                o->z0, o->z1, lit_tiles, what, top, o->out);

@@ -897,6 +897,17 @@ expect path-nested-deep 1 "deep-path\\.geojson: JSON nested deeper than 1000 lev
 expect geojson-stdout-newline 0 "" -- sh -c "'$bin' dark-spots -q fixtures/tiny.geojson -o - | tail -c 1 | od -An -c | grep -q '\\\\n'"
 printf '{"type":"FeatureCollection","properties":{"units":"m"},"features":[{"type":"Feature","properties":{"lamp":true,"radius":0},"geometry":{"type":"Point","coordinates":[0,0]}}]}' >"$tmp/radius0.geojson"
 expect lamp-bad-left-out 0 "feature 0 \\(line 1, column [0-9]+\\): lamp radius 0 m is out of range \\(> 0 and <= 100000 m\\); left out$" -- "$bin" info "$tmp/radius0.geojson"
+# a tile folder's metadata.json: TileJSON with the colour scale the summary line prints
+"$bin" tiles -q fixtures/helsinki-centre.geojson --zoom 13 -o "$tmp/tj" >"$tmp/tj.txt" 2>&1
+expect tiles-folder-tilejson 0 "" -- /usr/bin/python3 -c "
+import json, re, sys
+m = json.load(open('$tmp/tj/metadata.json'))
+top = float(re.search(r'scale 0\\.1\\.\\.([0-9.e+]+) lx', open('$tmp/tj.txt').read()).group(1))
+assert m['tilejson'] == '3.0.0' and m['tiles'] == ['{z}/{x}/{y}.png'] and m['minzoom'] == m['maxzoom'] == 13, m
+assert m['polarlux_scale']['min_lux'] == 0.1 and m['polarlux_scale']['max_lux'] == top, (m, top)
+assert 24.9 < m['bounds'][0] < m['bounds'][2] < 25.0 and 60.1 < m['bounds'][1] < m['bounds'][3] < 60.2, m
+assert 'OpenStreetMap' in m['attribution'], m
+"
 # '-' is standard input or output elsewhere: not a scene, and not a folder for frames or tiles (helper-56's pass)
 expect scene-dash 2 "^polarlux info: SCENE '-': a scene is not read from standard input" -- "$bin" info -
 expect walk-o-dash 2 "^polarlux walk: -o names the folder for the frames: '-' \\(standard output\\) cannot hold them" -- "$bin" walk fixtures/tiny.geojson --path "$tmp/nope.geojson" -o -

@@ -21,8 +21,16 @@ timeout 120 "$browser" --headless --no-sandbox --disable-gpu --hide-scrollbars -
     >"$out/chromium.log" 2>&1
 [ -s "$out/web-demo.png" ] || { echo "check-web: no screenshot"; cat "$out/chromium.log"; exit 1; }
 echo "check-web: screenshot $out/web-demo.png"
-if python3 tests/web/png_pixels.py "$out/web-demo.png"; then
-    echo "web: 1 passed, 0 failed"
+pass=0; fail=0
+if python3 tests/web/png_pixels.py "$out/web-demo.png"; then pass=$((pass + 1)); else fail=$((fail + 1)); fi
+# the legend labels the scale with the lux of the tiles' metadata.json (it said "top of scale")
+timeout 120 "$browser" --headless --no-sandbox --disable-gpu --virtual-time-budget=15000 --dump-dom \
+    "http://127.0.0.1:$port/index.html" >"$out/web-demo.html" 2>>"$out/chromium.log"
+top=$(python3 -c "import json,sys; print('%g' % json.load(open(sys.argv[1]))['polarlux_scale']['max_lux'])" "$web/data/tiles/metadata.json")
+if [ -n "$top" ] && grep -q "<span id=\"scale-hi\">$top</span> lx" "$out/web-demo.html"; then
+    echo "ok   web-legend-lux ($top lx)"; pass=$((pass + 1))
 else
-    echo "web: 0 passed, 1 failed"; exit 1
+    echo "FAIL web-legend-lux: the page's legend lacks the tiles' top of scale '$top' lx"; fail=$((fail + 1))
 fi
+echo "web: $pass passed, $fail failed"
+[ $fail -eq 0 ]
