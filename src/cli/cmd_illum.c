@@ -141,7 +141,13 @@ int cmd_illum(int argc, char **argv)
             rc = cli_exit_code(st);
             goto done;
         }
-        printf("%.17g %.17g %.17g %.17g %.17g\n", given[2 * k], given[2 * k + 1], p[2], ed[k], ei[k]);
+        { /* the point as given (24.944, not 24.943999999999999: the same double), then the lux */
+            char gx[32], gy[32], gz[32];
+            cli_shortest(given[2 * k], gx, sizeof gx);
+            cli_shortest(given[2 * k + 1], gy, sizeof gy);
+            cli_shortest(p[2], gz, sizeof gz);
+            printf("%s %s %s %.17g %.17g\n", gx, gy, gz, ed[k], ei[k]);
+        }
     }
     cli_progress_end(&pr);
     rc = failed ? EXIT_FAIL : EXIT_OK;
@@ -153,6 +159,8 @@ int cmd_illum(int argc, char **argv)
         }
         if (got > 0 && lit == 0)
             cli_warn("illum", &c, "every point is dark (0 lx): %s", cli_dark_reason(e));
+        if (pts.n == 0) /* as meter: an empty answer says why */
+            fprintf(stderr, "polarlux illum: %s holds no points\n", file);
     }
 done:
     free(given);

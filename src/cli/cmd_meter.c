@@ -50,9 +50,10 @@ static int parse_quantities(const char *s, int q[16])
     return n;
 }
 
-static int run(plx_engine *e, const char *file, const points *pts, const double *given, const int *q, int nq)
+static int run(plx_engine *e, const cli_common *c, const char *file, const points *pts, const double *given,
+               const int *q, int nq)
 {
-    size_t k;
+    size_t k, got = 0, lit = 0;
     int failed = 0, i;
     for (k = 0; k < pts->n; k++) {
         const double *p = pts->v + 5 * k;
@@ -69,11 +70,22 @@ static int run(plx_engine *e, const char *file, const points *pts, const double 
             fprintf(stderr, "polarlux meter: %s\n", plx_last_error(e));
             return cli_exit_code(st);
         }
-        printf("%.17g %.17g %.17g", given[2 * k], given[2 * k + 1], p[2]);
-        for (i = 0; i < nq; i++)
+        { /* the point as given (24.944, not 24.943999999999999: the same double) */
+            char gx[32], gy[32], gz[32];
+            cli_shortest(given[2 * k], gx, sizeof gx);
+            cli_shortest(given[2 * k + 1], gy, sizeof gy);
+            cli_shortest(p[2], gz, sizeof gz);
+            printf("%s %s %s", gx, gy, gz);
+        }
+        for (i = 0; i < nq; i++) {
             printf(" %.17g", m[q[i]]);
+            lit += st == PLX_OK && m[q[i]] > 0.0;
+        }
         printf("\n");
+        got += st == PLX_OK;
     }
+    if (got > 0 && lit == 0) /* as illum: every meter that read reads 0 lx */
+        cli_warn("meter", c, "every point is dark (0 lx): %s", cli_dark_reason(e));
     return failed ? EXIT_FAIL : EXIT_OK;
 }
 
@@ -125,7 +137,7 @@ int cmd_meter(int argc, char **argv)
     }
     rc = cli_points_local("meter", e, &c, file, &pts, &given);
     if (rc == EXIT_OK)
-        rc = run(e, file, &pts, given, q, ql.n);
+        rc = run(e, &c, file, &pts, given, q, ql.n);
     free(given);
     if (rc == EXIT_OK && pts.n == 0)
         fprintf(stderr, "polarlux meter: %s holds no points\n", file);

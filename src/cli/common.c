@@ -1146,6 +1146,33 @@ static int frame_of(plx_engine *e, const char *name)
     return -1;
 }
 
+/* A word when points (local metres) lie more than CLI_FAR_POINT m outside
+ * the scene's bounds b: no lamp reaches them, and a point 30 km away said
+ * only that no lamp's light reached it. */
+#define CLI_FAR_POINT 1000.0
+static void far_points(const char *cmd, const cli_common *c, const char *path, const struct points *p,
+                       const double b[4])
+{
+    size_t k, n = 0, worst = 0;
+    double far = 0.0;
+    for (k = 0; k < p->n; k++) {
+        const double *row = p->v + k * (size_t)p->cols;
+        double dx = fmax(fmax(b[0] - row[0], row[0] - b[2]), 0.0), dy = fmax(fmax(b[1] - row[1], row[1] - b[3]), 0.0);
+        double d = hypot(dx, dy);
+        if (!(d > CLI_FAR_POINT))
+            continue;
+        if (d > far) {
+            far = d;
+            worst = k;
+        }
+        n++;
+    }
+    if (n > 0)
+        cli_warn(cmd, c, "%s: %zu of %zu points lie more than %.0f km outside the scene's bounds (the farthest %.1f "
+                 "km, line %zu), out of every lamp's reach: are they in the scene's coordinates?", path, n, p->n,
+                 CLI_FAR_POINT / 1000.0, far / 1000.0, p->line[worst]);
+}
+
 int cli_points_local(const char *cmd, plx_engine *e, const cli_common *c, const char *path, struct points *p,
                      double **orig)
 {
@@ -1188,6 +1215,7 @@ int cli_points_local(const char *cmd, plx_engine *e, const cli_common *c, const 
             return EXIT_FAIL;
         }
     }
+    far_points(cmd, c, path, p, si.bounds);
     return EXIT_OK;
 }
 

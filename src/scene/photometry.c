@@ -19,19 +19,35 @@ typedef struct pm_text {
     const char *name;
     char *err;
     size_t errlen;
+    int guessed_ldt;          /* read as EULUMDAT though not named *.ldt */
 } pm_text;
+
+static int pm_space(char c)
+{
+    return c == ' ' || c == '\t' || c == '\r' || c == '\f' || c == '\v';
+}
 
 static plx_status pm_fail(pm_text *t, uint32_t line, const char *why, const char *what)
 {
     strbuf b;
+    size_t i;
+    int blank = 1;
     sb_init(&b, t->err, t->errlen);
     sb_str(&b, t->name ? t->name : "photometry");
+    for (i = 0; i < t->len && blank; i++)
+        blank = pm_space(t->s[i]) || t->s[i] == '\n';
+    if (blank) { /* nothing to read: not "line 0: table too short" */
+        sb_str(&b, t->len ? ": the file holds only white space" : ": the file is empty");
+        return PLX_E_PARSE;
+    }
     sb_str(&b, ": line ");
     sb_uint(&b, line);
     sb_str(&b, ": ");
     sb_str(&b, why);
     if (what)
         sb_str(&b, what);
+    if (t->guessed_ldt) /* a file not named .ldt, with no TILT= line: say how it was read */
+        sb_str(&b, " (read as EULUMDAT: the file has no IES 'TILT=' line)");
     return PLX_E_PARSE;
 }
 
@@ -52,11 +68,6 @@ static int pm_line(pm_text *t, const char **l, size_t *n)
     t->pos = e < t->len ? e + 1 : e;
     t->line++;
     return 1;
-}
-
-static int pm_space(char c)
-{
-    return c == ' ' || c == '\t' || c == '\r' || c == '\f' || c == '\v';
 }
 
 /* A decimal number filling s[0..n) ("1", "-2.5", "3e-2"; comma as the
@@ -446,8 +457,16 @@ static plx_status ldt_number(pm_text *t, uint32_t k, const char *what, double *v
     plx_status st = ldt_line(t, k, what, &l, &n);
     if (st != PLX_OK)
         return st;
-    if (!pm_trim_number(l, n, 1, v))
-        return pm_fail(t, k, "bad number for ", what);
+    if (!pm_trim_number(l, n, 1, v)) { /* the line is in the message: not again from what's "(line k)" */
+        const char *paren = strstr(what, " (line ");
+        char bare[96];
+        size_t m = paren ? (size_t)(paren - what) : strlen(what);
+        if (m >= sizeof bare)
+            m = sizeof bare - 1;
+        memcpy(bare, what, m);
+        bare[m] = '\0';
+        return pm_fail(t, k, "bad number for ", bare);
+    }
     return PLX_OK;
 }
 
@@ -493,8 +512,10 @@ static plx_status parse_ldt(pm_text *t, pm_build *B)
         return pm_fail(t, 4, "Mc must be even for symmetry 2 or 3", NULL);
     if (isym == 4.0 && Mc % 4 != 0)
         return pm_fail(t, 4, "Mc must be a multiple of 4 for symmetry 4", NULL);
-    if (!(cf >= 0.0) || !(fabs(flux) > 0.0))
-        return pm_fail(t, 24, "the conversion factor or the lamp flux is not positive", NULL);
+    if (!(cf >= 0.0))
+        return pm_fail(t, 24, "the conversion factor is negative", NULL);
+    if (!(fabs(flux) > 0.0))
+        return pm_fail(t, 29, "the lamps' luminous flux is 0", NULL);
     sym = isym == 0.0 ? SYM_NONE : isym == 1.0 ? SYM_ROT : isym == 2.0 ? SYM_C0 : isym == 3.0 ? SYM_C90 : SYM_QUAD;
     first = sym == SYM_C90 ? Mc / 4 : 0;
     count = sym == SYM_NONE ? Mc : sym == SYM_ROT ? 1 : sym == SYM_QUAD ? Mc / 4 + 1 : Mc / 2 + 1;
@@ -534,6 +555,14 @@ static plx_status parse_ldt(pm_text *t, pm_build *B)
 }
 
 /* ---- entry points --------------------------------------------------------------- */
+
+/* Whether the name ends in .ldt (any case). */
+static int named_ldt(const char *name)
+{
+    size_t n = name ? strlen(name) : 0;
+    return n >= 4 && name[n - 4] == '.' && (name[n - 3] | 32) == 'l' && (name[n - 2] | 32) == 'd' &&
+           (name[n - 1] | 32) == 't';
+}
 
 static int looks_ies(const char *s, size_t len)
 {
@@ -575,6 +604,7 @@ plx_status photometry_parse(arena *a, plx_part part, const char *data, size_t le
     B.part = part;
     m = arena_get_mark(a);
     ies = looks_ies(data, len);
+    t.guessed_ldt = !ies && !named_ldt(name);
     st = ies ? parse_ies(&t, &B) : parse_ldt(&t, &B);
     if (st == PLX_OK) {
         arena_mark now = arena_get_mark(a);

@@ -196,6 +196,22 @@ static void test_parse_errors(void **state)
     expect_error(&b, ldt(buf, sizeof buf, 1, 4, 90, "0\n90\n", 2, "1\nabc\n", 1, 1000), "t.ies: line 50: bad number");
     expect_error(&b, ldt(buf, sizeof buf, 2, 4, 90, "0\n90\n", 2, "1\n2\n", 1, 1000), "table too short");
     expect_error(&b, "polarlux\n1\n7\n", "symmetry indicator Isym 7");
+    /* helper-57's pass: no "line 0" for an empty file, the line not said twice, the flux's own line, and how
+     * a file not named .ldt without a TILT= line was read */
+    expect_error(&b, "", "t.ies: the file is empty");
+    expect_error(&b, " \n\n", "t.ies: the file holds only white space");
+    expect_error(&b, "\x01\x02\n\x03\n\x7f\x10\n", "t.ies: line 3: bad number for the symmetry indicator (read as "
+                 "EULUMDAT: the file has no IES 'TILT=' line)");
+    expect_error(&b, ldt(buf, sizeof buf, 1, 4, 90, "0\n90\n", 2, "1\n2\n", 1, 0), "line 29: the lamps' luminous "
+                 "flux is 0");
+    expect_error(&b, ldt(buf, sizeof buf, 1, 4, 90, "0\n90\n", 2, "1\n2\n", -1, 1000), "line 24: the conversion "
+                 "factor is negative");
+    {
+        const photometry *p = NULL;
+        assert_int_equal(photometry_parse(&b.a, PLX_PART_SCENE, "x\n1\nabc\n", 10, "t.LDT", &p, b.err, sizeof b.err),
+                         PLX_E_PARSE);
+        assert_string_equal(b.err, "t.LDT: line 3: bad number for the symmetry indicator"); /* named so: no note */
+    }
     free(b.mem);
 }
 
