@@ -240,6 +240,11 @@ int cli_out_writable(const char *cmd, const char *path);
 /* The share of an RGB image's npx pixels that are black (all three bytes
  * 0). */
 double cli_black_share(const uint8_t *rgb, size_t npx);
+/* The share of the image's lit (not black) pixels that are full white
+ * (255, 255, 255 ); 0 when none is lit. At CLI_BLOWN_OUT or more, render
+ * calls a fixed --exposure's image blown out. */
+double cli_white_share(const uint8_t *rgb, size_t npx);
+#define CLI_BLOWN_OUT 0.5
 /* At or above this share of black pixels (and not all), render and walk
  * call a frame nearly black: a normal night view from above is 70 to 90%
  * black (its roofs), a street view 10 to 15%. */

@@ -455,6 +455,11 @@ int cmd_render(int argc, char **argv)
         if (share >= CLI_NEARLY_BLACK)
             cli_warn("render", &a.c, "the image is nearly black: %.2f%% of its pixels are black (%.0f lit): %s",
                      floor(share * 10000.0) / 100.0, (1.0 - share) * (double)npx, CLI_NEARLY_BLACK_WHY);
+        share = cli_white_share(rgb8, npx);
+        if (share >= CLI_BLOWN_OUT && (a.opts.auto_exposure == PLX_EXPOSURE_FIXED || a.opts.auto_exposure == PLX_EXPOSURE_TONE)) /* as a black image is said */
+            cli_warn("render", &a.c, "the image is blown out: %.0f%% of its lit pixels are full white: --exposure "
+                     "%g maps the light above white (without --exposure, automatic exposure chooses one from the "
+                     "image)", floor(share * 100.0), a.opts.exposure);
     }
     prec = coord_digits(e);
     cli_from_local(e, &a.cam.eye[0], &a.cam.eye[1]);

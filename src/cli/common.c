@@ -44,6 +44,8 @@ size_t cli_parse_size(const char *s)
     case 't': case 'T': v *= 1024.0 * 1024.0 * 1024.0 * 1024.0; end++; break;
     default: break;
     }
+    if ((*end == 'i' || *end == 'I') && strchr("kKmMgGtT", end[-1])) /* 1GiB: binary, as 1G */
+        end++;
     if (*end == 'B' || *end == 'b')
         end++;
     if (*end != '\0' || v > 1e15)
@@ -163,7 +165,7 @@ int cli_common_option(const char *cmd, int argc, char **argv, int *i, cli_common
         c->mem_given = 1;
         if (c->mem < PLX_ENGINE_MIN_BYTES) {
             cli_usage_error(cmd, "--mem '%s' is not a size from %d bytes to 1e15 (a number with K, M, G or T, "
-                            "e.g. 512M, 2G)", argv[*i], PLX_ENGINE_MIN_BYTES);
+                            "powers of 1024, e.g. 512M, 2G, 2GiB)", argv[*i], PLX_ENGINE_MIN_BYTES);
             return -1;
         }
         return 1;
@@ -449,6 +451,16 @@ double cli_black_share(const uint8_t *rgb, size_t npx)
     for (k = 0; k < npx; k++)
         black += (rgb[3 * k] | rgb[3 * k + 1] | rgb[3 * k + 2]) == 0;
     return npx ? (double)black / (double)npx : 1.0;
+}
+
+double cli_white_share(const uint8_t *rgb, size_t npx)
+{
+    size_t k, lit = 0, white = 0;
+    for (k = 0; k < npx; k++) {
+        lit += (rgb[3 * k] | rgb[3 * k + 1] | rgb[3 * k + 2]) != 0;
+        white += (rgb[3 * k] & rgb[3 * k + 1] & rgb[3 * k + 2]) == 255;
+    }
+    return lit ? (double)white / (double)lit : 0.0;
 }
 
 int cli_has_lamps(plx_engine *e)

@@ -196,6 +196,8 @@ static int parse(const cJSON *root, plx_engine *e, walk_path *wp, char *why, siz
     wp->n = (uint32_t)n;
     wp->eye = malloc(sizeof(double) * 3 * (size_t)n);
     targets = cJSON_GetObjectItemCaseSensitive(props, "targets");
+    if (cJSON_IsNull(targets)) /* null: none given, as GeoJSON writes an absent member (the eye looks ahead) */
+        targets = NULL;
     if (targets && (!cJSON_IsArray(targets) || cJSON_GetArraySize(targets) != n)) {
         snprintf(why, whylen, "properties.targets must hold one [x, y] or [x, y, z] per position (%d)", n);
         return -1;

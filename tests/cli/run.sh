@@ -913,6 +913,13 @@ expect meter-dark 0 "^polarlux meter: warning: every point is dark \\(0 lx\\): n
 expect points-far-outside 0 "^polarlux illum: warning: -: 1 of 2 points lie more than 1 km outside the scene's bounds \\(the farthest 95\\.6 km, line 1\\)" -- sh -c "printf '25.5 61\\n24.944 60.1677\\n' | '$bin' illum fixtures/helsinki-centre.geojson --points - --no-indirect"
 expect illum-as-given 0 "^24\\.944 60\\.1677 0 [0-9.]+ 0$" -- sh -c "echo '24.944 60.1677' | '$bin' illum -q fixtures/helsinki-centre.geojson --points - --no-indirect"
 expect illum-no-points 0 "^polarlux illum: - holds no points$" -- sh -c "printf '# nothing\\n' | '$bin' illum -q fixtures/tiny.geojson --points -"
+# a blown-out image is said as a black one is; --mem 1GiB; "targets": null as absent (helper-56's pass)
+expect render-blown-out 0 "^polarlux render: warning: the image is blown out: 100% of its lit pixels are full white: --exposure 1e\\+09" -- "$bin" render fixtures/tiny.geojson --exposure 1e9 --size 32x24 -o "$tmp/blown.png"
+"$bin" render fixtures/tiny.geojson --exposure 1 --size 32x24 -o "$tmp/notblown.png" >"$tmp/out" 2>&1
+if grep -q "blown out" "$tmp/out"; then echo "FAIL render-exposure-1-not-blown"; fail=$((fail + 1)); else echo "ok   render-exposure-1-not-blown"; pass=$((pass + 1)); fi
+expect mem-gib 0 "^buildings: 4" -- "$bin" info -q fixtures/tiny.geojson --mem 1GiB
+printf '{"type":"Feature","properties":{"targets":null},"geometry":{"type":"LineString","coordinates":[[30,12,1.7],[60,12,1.7]]}}' >"$tmp/tnull.geojson"
+expect walk-targets-null 0 "^walk: 2 frames" -- "$bin" walk -q fixtures/tiny.geojson --path "$tmp/tnull.geojson" --size 32x24 --max-frames 2 -o "$tmp/tnullw"
 # '-' is standard input or output elsewhere: not a scene, and not a folder for frames or tiles (helper-56's pass)
 expect scene-dash 2 "^polarlux info: SCENE '-': a scene is not read from standard input" -- "$bin" info -
 expect walk-o-dash 2 "^polarlux walk: -o names the folder for the frames: '-' \\(standard output\\) cannot hold them" -- "$bin" walk fixtures/tiny.geojson --path "$tmp/nope.geojson" -o -
