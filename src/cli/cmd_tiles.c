@@ -362,8 +362,14 @@ int cmd_tiles(int argc, char **argv)
         return rc;
     plx_scene_info_get(e, &si);
     if (!si.lonlat) {
-        fprintf(stderr, "polarlux tiles: %s: the scene is in local metres, with no lon/lat to place tiles on the "
-                        "map (web-map tiles need a scene in WGS84 lon/lat)\n", o.scene);
+        const char *crs = plx_scene_crs(e);
+        if (crs) /* a projected CRS: polarlux does not reproject (no projection library) */
+            fprintf(stderr, "polarlux tiles: %s: the scene is in %s metres, which polarlux does not turn into "
+                            "lon/lat: web-map tiles need a scene in WGS84 lon/lat (reproject it first, e.g. ogr2ogr "
+                            "-t_srs EPSG:4326)\n", o.scene, crs);
+        else
+            fprintf(stderr, "polarlux tiles: %s: the scene is in local metres, with no lon/lat to place tiles on "
+                            "the map (web-map tiles need a scene in WGS84 lon/lat)\n", o.scene);
         plx_engine_free(e);
         return EXIT_FAIL;
     }

@@ -613,6 +613,9 @@ static plx_status read_lamp_photometry(loader *ld, uint32_t fi, const char *id, 
         ld_str(ld, ph, dst, n + 1);
         l->photometry = dst;
         l->intensity = 0.0;   /* dark until the table is given */
+        if (ld_get(ld, props, "intensity") != JV_NONE) /* SPEC §2.1: I is dimming x the table */
+            ld_warn(ld, fi, id, "property \"intensity\" is ignored: the lamp's photometry file gives its "
+                    "candelas (\"dimming\" scales them)");
     } else if (ph != JV_NONE && ld_kind(ld, ph) != JS_NULL) {
         ld_warn(ld, fi, id, "property \"photometry\" is not a file path; ignored, the lamp is isotropic");
     }

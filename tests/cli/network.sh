@@ -71,6 +71,8 @@ sed 's/"mean_lux":/"mean_luxx":/' "$tmp/ann.geojson" >"$tmp/ann-edited.geojson"
 expect net-annotated-edited 1 "annotate's scores: feature 0: no number 'mean_lux' \(not as annotate wrote it\)" -- "$bin" route -q fixtures/net-detour.geojson --network "$tmp/ann-edited.geojson" --from 0,0 --to 200,0
 expect annotate-missing-o 2 "missing -o OUT.geojson" -- "$bin" annotate -q $net
 expect tiles-metres 1 "the scene is in local metres, with no lon/lat" -- "$bin" tiles -q fixtures/tiny.geojson --zoom 15 -o "$tmp/t"
+sed 's/"units": *"m"/"units": "m", "crs": "EPSG:3067"/' fixtures/tiny.geojson >"$tmp/tiny-3067.geojson"
+expect tiles-projected 1 "the scene is in EPSG:3067 metres, which polarlux does not turn into lon/lat" -- "$bin" tiles -q "$tmp/tiny-3067.geojson" --zoom 15 -o "$tmp/t"
 expect tiles-quantity 2 "--quantity 'v' is not h \(ground E_h\) or sc \(E_sc\)" -- "$bin" tiles -q fixtures/helsinki-centre.geojson --zoom 15 --quantity v -o "$tmp/t"
 expect tiles-facing 2 "--facing 'west' is not a number of degrees or min" -- "$bin" tiles -q fixtures/helsinki-centre.geojson --zoom 15 --quantity sc --facing west -o "$tmp/t"
 expect tiles-sc 0 "^tiles: [0-9]+ tiles at zoom 12-12 \([0-9]+ with light\) of direct semi-cylindrical illuminance E_sc at 1\.5 m, the least over every facing direction, scale 0\.1\.\.100 lx" -- "$bin" tiles -q fixtures/helsinki-centre.geojson --zoom 12 --quantity sc --max 100 -o "$tmp/sc.mbtiles"

@@ -836,6 +836,8 @@ expect photometry-tilt 1 "l\\.ies: line 2: unsupported tilt" -- "$bin" info "$tm
 printf 'IESNA:LM-63-2002\nTILT=NONE\n1 -1 1 2 1 1 2 0 0 0\n1 1 0\n0 90\n0\n100\n' >"$tmp/ph/l.ies"
 expect photometry-short 1 "l\\.ies: line 7: table too short" -- "$bin" info "$tmp/ph/s.geojson"
 printf 'IESNA:LM-63-2002\nTILT=NONE\n1 -1 1 2 1 1 2 0 0 0\n1 1 0\n0 90\n0\n100 0\n' >"$tmp/ph/l.ies"
+sed 's/"photometry":"l.ies"/"photometry":"l.ies","intensity":500/' "$tmp/ph/s.geojson" >"$tmp/ph/si.geojson"
+expect photometry-intensity-ignored 0 "feature 0 \\(line 1, column [0-9]+\\): property \"intensity\" is ignored: the lamp's photometry file gives its candelas" -- sh -c "echo '0 0' | '$bin' illum --no-indirect '$tmp/ph/si.geojson' --points -"
 expect photometry-nadir 0 "^0 0 0 2\\.768895999" -- sh -c "echo '0 0' | '$bin' illum -q --no-indirect '$tmp/ph/s.geojson' --points -"
 # a user's pass on the real district (2026-12-02): coordinates, empty routes, output names, notes
 H=fixtures/helsinki-centre.geojson
