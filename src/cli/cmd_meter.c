@@ -55,6 +55,14 @@ static int run(plx_engine *e, const cli_common *c, const char *file, const point
 {
     size_t k, got = 0, lit = 0;
     int failed = 0, i;
+    for (k = 0; k < pts->n; k++) { /* every facing direction first: no rows printed before a bad one */
+        const double *u = pts->v + 5 * k + 3;
+        if (!(isfinite(u[0]) && isfinite(u[1])) || (u[0] == 0.0 && u[1] == 0.0)) {
+            fprintf(stderr, "polarlux meter: %s:%zu: the facing direction (ux, uy) is zero or not finite\n", file,
+                    pts->line[k]);
+            return EXIT_FAIL;
+        }
+    }
     for (k = 0; k < pts->n; k++) {
         const double *p = pts->v + 5 * k;
         double m[PLX_METER_COUNT];

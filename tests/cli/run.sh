@@ -922,6 +922,10 @@ if grep -q "blown out" "$tmp/out"; then echo "FAIL render-exposure-1-not-blown";
 expect mem-gib 0 "^buildings: 4" -- "$bin" info -q fixtures/tiny.geojson --mem 1GiB
 printf '{"type":"Feature","properties":{"targets":null},"geometry":{"type":"LineString","coordinates":[[30,12,1.7],[60,12,1.7]]}}' >"$tmp/tnull.geojson"
 expect walk-targets-null 0 "^walk: 2 frames" -- "$bin" walk -q fixtures/tiny.geojson --path "$tmp/tnull.geojson" --size 32x24 --max-frames 2 -o "$tmp/tnullw"
+# a zero facing direction on line 3: refused before any row is printed (rows 1 and 2 were, then exit 1)
+printf '1 0\n2 0\n3 0 1.5 0 0\n' >"$tmp/facing0.txt"
+expect meter-facing-zero 1 "^polarlux meter: .*facing0\\.txt:3: the facing direction \\(ux, uy\\) is zero or not finite$" -- "$bin" meter -q fixtures/tiny.geojson --points "$tmp/facing0.txt"
+if [ -n "$("$bin" meter -q fixtures/tiny.geojson --points "$tmp/facing0.txt" 2>/dev/null)" ]; then echo "FAIL meter-facing-zero-no-rows"; fail=$((fail + 1)); else echo "ok   meter-facing-zero-no-rows"; pass=$((pass + 1)); fi
 # '-' is standard input or output elsewhere: not a scene, and not a folder for frames or tiles (helper-56's pass)
 expect scene-dash 2 "^polarlux info: SCENE '-': a scene is not read from standard input" -- "$bin" info -
 expect walk-o-dash 2 "^polarlux walk: -o names the folder for the frames: '-' \\(standard output\\) cannot hold them" -- "$bin" walk fixtures/tiny.geojson --path "$tmp/nope.geojson" -o -
