@@ -867,7 +867,8 @@ typedef struct plx_route_stats {
  * P2 10/2, P3 7.5/1.5, P4 5/1, P5 3/0.6, P6 2/0.4 lx).
  * Samples inside a footprint are not scored (blocked_length). A segment
  * of no length (a repeated vertex) is its one point: mean = min = max =
- * that point's lux, dark_share 1 or 0, length 0.
+ * that point's lux, dark_share 1 or 0, length 0 (inside a footprint it is
+ * scored as nothing, all 0, as a segment wholly inside one).
  * Errors: PLX_E_INVALID (xy NULL, n < 2, step <= 0, dark_lux < 0,
  * non-finite input), PLX_E_NOSCENE, PLX_E_NOMEM (the samples of one segment
  * are held in scratch: 64 bytes a sample). Threads: engine.
@@ -943,7 +944,9 @@ int plx_p_class_facial(double mean, double min, double min_ev, double min_esc);
  * min E_v and min E_sc at 'height' m above the polyline (xy, n vertices),
  * sampled like plx_route_score (each segment into ceil(length/step) equal
  * parts, ends included; samples inside a building's solid left out), facing
- * along the segment (dir 0: from vertex i to i+1) and back (dir 1).
+ * along the segment (dir 0: from vertex i to i+1) and back (dir 1); a
+ * segment of no length faces along the next segment with a length (else
+ * the previous one; east when none has).
  * seg (may be NULL): 4 values per segment, min_ev[0], min_ev[1], min_esc[0],
  * min_esc[1]; total (may be NULL) the same over the line (each direction's
  * minimum over all segments). A segment with no sample gets NaN.

@@ -145,7 +145,7 @@ class Scene:
         for k in range(lib.plx_photometry_count(self._e)):
             p = ctypes.c_char_p()
             self._check(lib.plx_photometry_path(self._e, k, ctypes.byref(p)))
-            rel = p.value.decode("utf-8", "replace")
+            rel = os.fsdecode(p.value)  # the bytes the scene names, as the file system reads them
             full = rel if os.path.isabs(rel) else os.path.join(base_dir or os.getcwd(), rel)
             if not os.path.isfile(full):
                 why = "not a regular file" if os.path.exists(full) else "no such file"

@@ -47,6 +47,8 @@ static plx_status layer_skip(plx_engine *e, const char *source, const plx_lamp *
     sb_str(&b, why);
     if (e->cfg.strict)
         return eng_fail(e, PLX_E_SCENE, msg);
+    if (!strstr(why, "left out")) /* as the scene's skipped features say */
+        sb_str(&b, "; left out");
     if (count)
         e->sc->skipped_lamps++;
     e->warnings++;

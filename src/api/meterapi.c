@@ -70,9 +70,21 @@ plx_status plx_meter(plx_engine *e, size_t n, const double *P, const double *U, 
     return PLX_OK;
 }
 
-/* min E_v and E_sc both ways over one segment's samples (NaN: none). */
-static void facial_segment(plx_engine *e, const double *a, const double *b, double step, double height,
-                           double out[4])
+/* The unit vector from a to b into u; 0 (u unchanged) when they are one point. */
+static int unit_along(const double *a, const double *b, double u[2])
+{
+    double len = hypot(b[0] - a[0], b[1] - a[1]);
+    if (!(len > 0.0))
+        return 0;
+    u[0] = (b[0] - a[0]) / len;
+    u[1] = (b[1] - a[1]) / len;
+    return 1;
+}
+
+/* min E_v and E_sc both ways over one segment's samples (NaN: none),
+ * facing along fw (a unit vector) and back. */
+static void facial_segment(plx_engine *e, const double *a, const double *b, const double fw[2], double step,
+                           double height, double out[4])
 {
     double len = hypot(b[0] - a[0], b[1] - a[1]), u[2][2];
     uint32_t k = (uint32_t)fmin(ceil(len / step), 1e7), i;
@@ -80,8 +92,8 @@ static void facial_segment(plx_engine *e, const double *a, const double *b, doub
     out[0] = out[1] = out[2] = out[3] = NAN;
     if (k < 1)
         k = 1;
-    u[0][0] = len > 0.0 ? (b[0] - a[0]) / len : 1.0;
-    u[0][1] = len > 0.0 ? (b[1] - a[1]) / len : 0.0;
+    u[0][0] = fw[0];
+    u[0][1] = fw[1];
     u[1][0] = -u[0][0];
     u[1][1] = -u[0][1];
     for (i = 0; i <= k; i++) {
@@ -99,6 +111,24 @@ static void facial_segment(plx_engine *e, const double *a, const double *b, doub
     }
 }
 
+/* The walker's direction along segment i of the polyline xy (n vertices):
+ * its own, or for a segment of no length (a repeated vertex) the next
+ * segment's with a length, else the previous one's (east when the line
+ * has none): such a segment's point is met walking that way, and facing
+ * east gave it an arbitrary E_v. */
+static void walking_direction(const double *xy, uint32_t n, uint32_t i, double fw[2])
+{
+    uint32_t j;
+    fw[0] = 1.0;
+    fw[1] = 0.0;
+    for (j = i; j + 1 < n; j++)
+        if (unit_along(xy + 2 * j, xy + 2 * j + 2, fw))
+            return;
+    for (j = i; j-- > 0;)
+        if (unit_along(xy + 2 * j, xy + 2 * j + 2, fw))
+            return;
+}
+
 plx_status plx_route_facial(plx_engine *e, const double *xy, uint32_t n, double step, double height,
                             double *seg, double total[4])
 {
@@ -114,8 +144,9 @@ plx_status plx_route_facial(plx_engine *e, const double *xy, uint32_t n, double 
         if (!isfinite(xy[i]))
             return eng_fail(e, PLX_E_INVALID, "plx_route_facial: a vertex is not finite");
     for (i = 0; i + 1 < n; i++) {
-        double s4[4];
-        facial_segment(e, xy + 2 * i, xy + 2 * i + 2, step, height, s4);
+        double s4[4], fw[2];
+        walking_direction(xy, n, i, fw);
+        facial_segment(e, xy + 2 * i, xy + 2 * i + 2, fw, step, height, s4);
         for (c = 0; c < 4; c++)
             if (s4[c] == s4[c])
                 all[c] = all[c] == all[c] ? fmin(all[c], s4[c]) : s4[c];

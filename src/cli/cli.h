@@ -155,7 +155,7 @@ void cli_indirect_note(const char *cmd, plx_engine *e);
  * because the block is small (its quarter under PLX_ATLAS_MAX_BYTES: a
  * larger --mem gives finer points). Not a warning: --quiet keeps it. */
 void cli_atlas_note(const char *cmd, plx_engine *e, int had, double texel);
-int cli_indirect_run(const char *cmd, plx_engine *e, const cli_indirect *ind, const double *eye,
+int cli_indirect_run(const char *cmd, const cli_common *c, plx_engine *e, const cli_indirect *ind, const double *eye,
                      const double *dir, double fov_deg);
 /* A command's near-viewer refinement (cli_refine): its settings and
  * what its calls did. */
@@ -182,8 +182,7 @@ int cli_refine(const char *cmd, plx_engine *e, const plx_camera *cam, cli_refine
  * smaller --size, and when it was anti-aliased, that its buffers take 20
  * bytes a pixel of the largest frame (a bake's --max-size) and --aa 1
  * none; "" for another error. */
-const char *cli_render_nomem_hint(plx_status st, const plx_render_opts *o, const cli_common *c, char *buf,
-                                  size_t len);
+const char *cli_render_nomem_hint(plx_status st, const plx_render_opts *o, plx_engine *e, char *buf, size_t len);
 /* "polarlux CMD: warning: ..." on stderr unless --quiet (c may be NULL). */
 void cli_warn(const char *cmd, const cli_common *c, const char *fmt, ...);
 /* Whether the file name's extension (a dot in its last part) is another
@@ -281,6 +280,9 @@ int cli_option_local(const char *cmd, const char *opt, plx_engine *e, double *x,
  * or the scene's CRS name. *orig (may be NULL) gets a malloc'd copy of the
  * given x,y pairs. Prints the error and returns an exit code. */
 struct points;
+/* A warning when points (local metres) lie more than 1 km outside the box
+ * of the scene's bounds and every lamp's reach (illum, meter). */
+void cli_points_far(const char *cmd, const cli_common *c, plx_engine *e, const char *path, const struct points *p);
 int cli_points_local(const char *cmd, plx_engine *e, const cli_common *c, const char *path, struct points *p,
                      double **orig);
 /* render's default aerial view into cam (its size and fov kept): straight

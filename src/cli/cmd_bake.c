@@ -307,7 +307,7 @@ int cmd_bake(int argc, char **argv)
         fputs(err, stderr);
     t1 = port_now_ns();
     if (rc == EXIT_OK) {
-        rc = cli_indirect_run("bake", e, &a.ind, NULL, NULL, 60.0);
+        rc = cli_indirect_run("bake", &a.c, e, &a.ind, NULL, NULL, 60.0);
     }
     t2 = port_now_ns();
     if (alongside)

@@ -86,6 +86,7 @@ int cmd_illum(int argc, char **argv)
         plx_engine_free(e);
         return rc;
     }
+    cli_points_far("illum", &c, e, file, &pts);
     if (!ind.off && pts.n > 0) {
         double eye[3] = { 0, 0, 1.7 }, box[4];
         box[0] = box[2] = pts.v[0];
@@ -110,7 +111,7 @@ int cmd_illum(int argc, char **argv)
             plx_engine_free(e);
             return sst == PLX_E_NOMEM ? EXIT_NOMEM : EXIT_FAIL;
         }
-        rc = cli_indirect_run("illum", e, &ind, eye, NULL, 360.0);
+        rc = cli_indirect_run("illum", &c, e, &ind, eye, NULL, 360.0);
         if (rc != EXIT_OK) {
             free(given);
             points_free(&pts);
@@ -118,8 +119,6 @@ int cmd_illum(int argc, char **argv)
             return rc;
         }
     }
-    if (!ind.off && ind.frames == 0 && plx_indirect_frames(e) == 0) /* the gather reads the photon buffers */
-        cli_warn("illum", &c, "--frames 0 traces no photons: E_indirect is 0, as with --no-indirect");
     ed = malloc(sizeof *ed * (pts.n + 1));
     ei = malloc(sizeof *ei * (pts.n + 1));
     if (!ed || !ei) {

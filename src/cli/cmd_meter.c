@@ -145,6 +145,8 @@ int cmd_meter(int argc, char **argv)
     }
     rc = cli_points_local("meter", e, &c, file, &pts, &given);
     if (rc == EXIT_OK)
+        cli_points_far("meter", &c, e, file, &pts);
+    if (rc == EXIT_OK)
         rc = run(e, &c, file, &pts, given, q, ql.n);
     free(given);
     if (rc == EXIT_OK && pts.n == 0)

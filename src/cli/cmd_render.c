@@ -387,7 +387,7 @@ int cmd_render(int argc, char **argv)
          * walk and bake lay them out: a walk frame and render at its camera
          * are the same image from a scene too (levels for this camera made
          * them differ by up to 30 of 255 on the Helsinki district) */
-        rc = cli_indirect_run("render", e, &a.ind, NULL, NULL, a.cam.fov_deg);
+        rc = cli_indirect_run("render", &a.c, e, &a.ind, NULL, NULL, a.cam.fov_deg);
         if (rc == EXIT_OK && a.refine && !a.ind.off) {
             cli_refiner rf;
             cli_refiner_init(&rf, a.refine_height, 16, a.ind.photons);
@@ -433,9 +433,9 @@ int cmd_render(int argc, char **argv)
     if (st == PLX_OK)
         cli_atlas_note("render", e, had_atlas, a.opts.aerial_m_per_texel);
     if (st != PLX_OK) {
-        char hint[200];
+        char hint[400];
         fprintf(stderr, "polarlux render: %s%s\n", plx_last_error(e),
-                cli_render_nomem_hint(st, &a.opts, &a.c, hint, sizeof hint));
+                cli_render_nomem_hint(st, &a.opts, e, hint, sizeof hint));
 #ifdef PLX_HAVE_OSMESA
         if (om && *plx_osmesa_error(om))
             fprintf(stderr, "polarlux render: osmesa: %s\n", plx_osmesa_error(om));

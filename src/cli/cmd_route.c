@@ -117,8 +117,8 @@ static void print_row(int width, const char *line, const char *seg, const plx_ro
     printf(" %-5s %9.1f %9.3f %9.3f %9.3f %6.3f %6.3f %-5s %8.3f %8.3f %8.3f %8.3f %s", seg,
            s->length, s->mean, s->min, s->max, s->uniformity, s->dark_share, cls, fac[0], fac[1], fac[2], fac[3],
            fr);
-    if (s->blocked_length > 0)
-        printf("  (%.1f m inside buildings)", s->blocked_length);
+    if (s->blocked_length > 0) /* in one column whatever the class's width (no trailing spaces without it) */
+        printf("%*s  (%.1f m inside buildings)", 3 - (int)strlen(fr), "", s->blocked_length);
     printf("\n");
 }
 

@@ -26,8 +26,9 @@ static const char help[] =
     "OUT ending in .mbtiles is an MBTiles 1.3 file (SQLite; metadata name,\n"
     "format, type, version, bounds, center, minzoom, maxzoom, description, and\n"
     "attribution when there is one); otherwise OUT is a folder receiving\n"
-    "OUT/z/x/y.png and OUT/metadata.json (TileJSON 3.0.0 with those fields and\n"
-    "polarlux_scale: min_lux, max_lux, for a legend).\n"
+    "OUT/z/x/y.png and OUT/metadata.json (TileJSON 3.0.0: name, description,\n"
+    "attribution, bounds, center, minzoom, maxzoom; and polarlux_scale: min_lux,\n"
+    "max_lux, for a legend).\n"
     "\n"
     "  --zoom Z0-Z1   zoom levels (0..22; one level: --zoom Z)\n"
     "  --quantity Q   h: the horizontal illuminance E_h on the ground (default);\n"
@@ -143,8 +144,8 @@ static const char *tiles_attribution(const tiles_opts *o, char *buf, size_t cap)
     if (o->attribution)
         return o->attribution;
     if (cli_bake_last.loaded) {
-        cli_warn("tiles", &o->c, "%s: a bake keeps no attribution: the MBTiles file has none (give "
-                 "--attribution TEXT, the data's credit line)", o->scene);
+        cli_warn("tiles", &o->c, "%s: a bake keeps no attribution: the %s has none (give --attribution TEXT, the "
+                 "data's credit line)", o->scene, ends_with(o->out, ".mbtiles") ? "MBTiles file" : "metadata.json");
         return NULL;
     }
     return cli_scene_attribution(o->scene, buf, cap) ? buf : NULL;

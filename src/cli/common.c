@@ -66,14 +66,18 @@ int cli_parse_real(const char *s, double lo, double hi, double *out)
     return cli_parse_double(s, out) != 0 || !(*out >= lo && *out <= hi) ? -1 : 0;
 }
 
-const char *cli_render_nomem_hint(plx_status st, const plx_render_opts *o, const cli_common *c, char *buf,
-                                  size_t len)
+const char *cli_render_nomem_hint(plx_status st, const plx_render_opts *o, plx_engine *e, char *buf, size_t len)
 {
+    plx_memory_report mr;
     if (st != PLX_E_NOMEM)
         return "";
-    snprintf(buf, len, " (give a larger --mem, now %zu bytes, or a smaller --size%s)", c->mem ? c->mem
-             : CLI_DEFAULT_MEM, o->aa > 1 ? "; anti-aliasing takes 20 bytes a pixel more of the largest frame, a "
-             "bake's --max-size, and --aa 1 none" : "");
+    plx_memory_get(e, &mr);
+    /* a bake's frame buffers are its --max-size's whatever --size asks */
+    snprintf(buf, len, " (give a larger --mem: the block holds %zu bytes; or %s%s)", mr.capacity,
+             cli_bake_last.loaded ? "bake with a smaller --max-size (a bake's frames take their buffers at it)"
+                                  : "a smaller --size",
+             o->aa > 1 ? "; anti-aliasing takes 20 bytes a pixel more of the largest frame, a bake's --max-size, "
+                         "and --aa 1 none" : "");
     return buf;
 }
 
@@ -1055,12 +1059,14 @@ static const char *photons_hint(plx_status st)
                              : "";
 }
 
-int cli_indirect_run(const char *cmd, plx_engine *e, const cli_indirect *ind, const double *eye,
-                     const double *dir, double fov_deg)
+int cli_indirect_run(const char *cmd, const cli_common *c, plx_engine *e, const cli_indirect *ind,
+                     const double *eye, const double *dir, double fov_deg)
 {
     long k, photons = cli_photons(e, ind);
     int tty = isatty(2);
     unsigned long long t0 = port_now_ns();
+    if (!ind->off && ind->frames == 0 && plx_indirect_frames(e) == 0 && strcmp(cmd, "bake") != 0)
+        cli_warn(cmd, c, "--frames 0 traces no photons: no indirect light, as with --no-indirect"); /* bake says */
     if (ind->off || ind->frames == 0 || plx_indirect_frames(e) > 0)
         return EXIT_OK; /* off, or traced already (a bake) */
     if ((double)photons * (double)ind->frames > CLI_MAX_PHOTONS)
@@ -1159,14 +1165,26 @@ static int frame_of(plx_engine *e, const char *name)
 }
 
 /* A word when points (local metres) lie more than CLI_FAR_POINT m outside
- * the scene's bounds b: no lamp reaches them, and a point 30 km away said
- * only that no lamp's light reached it. */
+ * the box of the scene's bounds and every lamp's reach: no lamp reaches
+ * them, and a point 30 km away said only that no lamp's light reached it. */
 #define CLI_FAR_POINT 1000.0
-static void far_points(const char *cmd, const cli_common *c, const char *path, const struct points *p,
-                       const double b[4])
+void cli_points_far(const char *cmd, const cli_common *c, plx_engine *e, const char *path, const struct points *p)
 {
+    plx_scene_info si;
+    plx_lamp l;
     size_t k, n = 0, worst = 0;
-    double far = 0.0;
+    double far = 0.0, b[4];
+    uint32_t i;
+    if (p->n == 0 || plx_scene_info_get(e, &si) != PLX_OK)
+        return;
+    memcpy(b, si.bounds, sizeof b);
+    for (i = 0; i < si.lamps; i++) /* lamps outside the buildings' box, a --lamps layer's */
+        if (plx_lamp_get(e, i, &l) == PLX_OK) {
+            b[0] = fmin(b[0], l.x - l.radius);
+            b[1] = fmin(b[1], l.y - l.radius);
+            b[2] = fmax(b[2], l.x + l.radius);
+            b[3] = fmax(b[3], l.y + l.radius);
+        }
     for (k = 0; k < p->n; k++) {
         const double *row = p->v + k * (size_t)p->cols;
         double dx = fmax(fmax(b[0] - row[0], row[0] - b[2]), 0.0), dy = fmax(fmax(b[1] - row[1], row[1] - b[3]), 0.0);
@@ -1180,8 +1198,8 @@ static void far_points(const char *cmd, const cli_common *c, const char *path, c
         n++;
     }
     if (n > 0)
-        cli_warn(cmd, c, "%s: %zu of %zu points lie more than %.0f km outside the scene's bounds (the farthest %.1f "
-                 "km, line %zu), out of every lamp's reach: are they in the scene's coordinates?", path, n, p->n,
+        cli_warn(cmd, c, "%s: %zu of %zu points lie more than %.0f km outside the scene's bounds and every lamp's "
+                 "reach (the farthest %.1f km, line %zu): are they in the scene's coordinates?", path, n, p->n,
                  CLI_FAR_POINT / 1000.0, far / 1000.0, p->line[worst]);
 }
 
@@ -1227,7 +1245,6 @@ int cli_points_local(const char *cmd, plx_engine *e, const cli_common *c, const 
             return EXIT_FAIL;
         }
     }
-    far_points(cmd, c, path, p, si.bounds);
     return EXIT_OK;
 }
 

@@ -328,6 +328,11 @@ static int csv_header(const char *name, const char *s, const char *end, int col[
         int kind = column_kind(buf);
         if (kind >= 0 && col[kind] < 0)
             col[kind] = k;
+        if (strcmp(buf, "photometry") == 0) { /* as a GeoJSON layer's: refused, not read as isotropic */
+            snprintf(err, errlen, "%s: column %d \"photometry\": a lamp layer's lamps are isotropic (intensity in "
+                     "cd); a lamp with an IES or EULUMDAT file belongs in the scene file", name, k + 1);
+            return -1;
+        }
     }
     if ((col[COL_X] < 0 || col[COL_Y] < 0) && (col[COL_LON] < 0 || col[COL_LAT] < 0)) {
         snprintf(err, errlen, "%s: the CSV header names no x,y or lon,lat columns (first line: '%.60s')", name, s);

@@ -135,7 +135,7 @@ fi
 # out of memory: the free bytes when the request was refused, less than it
 # asked for (read after the failed step had let go of its memory, it said
 # "asked for 805306368 bytes; 1042579456 of 1073741824 bytes free")
-expect render-nomem-free 3 "out of memory while creating the renderer .*: part 'frame' asked for [0-9]+ bytes; [0-9]+ of [0-9]+ bytes free \(give a larger --mem" -- \
+expect render-nomem-free 3 "out of memory while creating the renderer .*: part 'frame' asked for [0-9]+ bytes; [0-9]+ of [0-9]+ bytes free \(give a larger --mem: the block holds" -- \
     "$bin" render -q fixtures/tiny.geojson --size 8192x8192 -o "$tmp/u.png"
 set -- $(sed -n 's/.* asked for \([0-9]*\) bytes; \([0-9]*\) of [0-9]* bytes free (.*$/\1 \2/p' "$tmp/out")
 if [ $# -eq 2 ] && [ "$2" -lt "$1" ]; then echo "ok   render-nomem-free-less"; pass=$((pass + 1))
@@ -233,10 +233,10 @@ expect walk-nomem-photons-hint 3 "out of memory while creating the photon buffer
 # 28 KB above the smallest --mem that loads the bake: room for a frame without anti-aliasing only
 amem=$("$bin" info "$tmp/e.plxb" --min-mem 2>/dev/null | sed -n 's/^smallest --mem: \([0-9]*\) bytes.*/\1/p')
 amem=$((amem + 28000))
-expect walk-nomem-aa-hint 3 "^polarlux walk: frame 1 at .*out of memory .*\(give a larger --mem, now $amem bytes, or a smaller --size; anti-aliasing takes 20 bytes a pixel more of the largest frame, a bake's --max-size, and --aa 1 none\)$" -- \
+expect walk-nomem-aa-hint 3 "^polarlux walk: frame 1 at .*out of memory .*\(give a larger --mem: the block holds [0-9]+ bytes; or bake with a smaller --max-size \(a bake's frames take their buffers at it\); anti-aliasing takes 20 bytes a pixel more of the largest frame, a bake's --max-size, and --aa 1 none\)$" -- \
     "$bin" walk -q "$tmp/e.plxb" --mem "$amem" --path "$tmp/endpath.geojson" --size 160x120 --max-frames 2 -o "$tmp/endw"
 # a plain frame too large for the block: the hint names --mem and --size, not --aa 1 (which needed no less)
-expect render-nomem-size-hint 3 "^polarlux render: out of memory .*\(give a larger --mem, now 8388608 bytes, or a smaller --size\)$" -- \
+expect render-nomem-size-hint 3 "^polarlux render: out of memory .*\(give a larger --mem: the block holds [0-9]+ bytes; or a smaller --size\)$" -- \
     "$bin" render -q fixtures/tiny.geojson --mem 8M --size 2000x2000 -o "$tmp/big.png"
 expect walk-nomem-aa1 0 "^walk: 2 frames" -- \
     "$bin" walk -q "$tmp/e.plxb" --mem "$amem" --aa 1 --path "$tmp/endpath.geojson" --size 160x120 --max-frames 2 -o "$tmp/endw"
@@ -886,7 +886,7 @@ if grep -q "has no lamps" "$tmp/out" && ! grep -q "no-indirect or --frames 0" "$
 # lamps of 0 cd: the dark result names them, not their reach; --frames 0 says E_indirect is 0 (helper-57's pass)
 printf '{"type":"FeatureCollection","properties":{"units":"m"},"features":[{"type":"Feature","properties":{"lamp":true,"intensity":0},"geometry":{"type":"Point","coordinates":[0,0]}}]}' >"$tmp/zero-cd.geojson"
 expect dark-zero-cd 0 "every point is dark \\(0 lx\\): every lamp gives no light \\(0 cd" -- sh -c "echo '1 0' | '$bin' illum '$tmp/zero-cd.geojson' --points -"
-expect illum-frames-0 0 "^polarlux illum: warning: --frames 0 traces no photons: E_indirect is 0, as with --no-indirect$" -- sh -c "echo '4 0' | '$bin' illum fixtures/tiny.geojson --points - --frames 0"
+expect illum-frames-0 0 "^polarlux illum: warning: --frames 0 traces no photons: no indirect light, as with --no-indirect$" -- sh -c "echo '4 0' | '$bin' illum fixtures/tiny.geojson --points - --frames 0"
 # route's two ways: their options said as such, not as unknown (helper-57's pass)
 expect route-from-without-network 2 "^polarlux route: --from needs --network STREETS.geojson" -- "$bin" route fixtures/helsinki-centre.geojson --from 1,2 --to 3,4
 expect route-path-with-network 2 "^polarlux route: --path and --network do not combine" -- "$bin" route fixtures/helsinki-centre.geojson --network fixtures/helsinki-streets.geojson --path fixtures/helsinki-route.geojson
@@ -912,7 +912,10 @@ assert 'OpenStreetMap' in m['attribution'], m
 "
 # meters that all read 0 lx, points far outside the scene, an empty points file: a word each (helper-57's pass)
 expect meter-dark 0 "^polarlux meter: warning: every point is dark \\(0 lx\\): no lamp's light reaches it" -- sh -c "echo '1000 0' | '$bin' meter fixtures/tiny.geojson --points -"
-expect points-far-outside 0 "^polarlux illum: warning: -: 1 of 2 points lie more than 1 km outside the scene's bounds \\(the farthest 95\\.6 km, line 1\\)" -- sh -c "printf '25.5 61\\n24.944 60.1677\\n' | '$bin' illum fixtures/helsinki-centre.geojson --points - --no-indirect"
+expect points-far-outside 0 "^polarlux illum: warning: -: 1 of 2 points lie more than 1 km outside the scene's bounds and every lamp's reach \\(the farthest 95\\.[0-9] km, line 1\\)" -- sh -c "printf '25.5 61\\n24.944 60.1677\\n' | '$bin' illum fixtures/helsinki-centre.geojson --points - --no-indirect"
+printf '{"type":"FeatureCollection","properties":{"units":"m"},"features":[{"type":"Feature","properties":{"height":10},"geometry":{"type":"Polygon","coordinates":[[[0,0],[10,0],[10,10],[0,10],[0,0]]]}},{"type":"Feature","properties":{"lamp":true},"geometry":{"type":"Point","coordinates":[3000,0]}}]}' >"$tmp/far-lamp.geojson"
+echo '3000 5' | "$bin" illum "$tmp/far-lamp.geojson" --points - --no-indirect >"$tmp/out" 2>&1
+if grep -q "^3000 5 0 [1-9]" "$tmp/out" && ! grep -q "outside the scene's bounds" "$tmp/out"; then echo "ok   points-near-far-lamp"; pass=$((pass + 1)); else echo "FAIL points-near-far-lamp: a lit point by a lamp 3 km out was called out of reach"; sed 's/^/    /' "$tmp/out"; fail=$((fail + 1)); fi
 expect illum-as-given 0 "^24\\.944 60\\.1677 0 [0-9.]+ 0$" -- sh -c "echo '24.944 60.1677' | '$bin' illum -q fixtures/helsinki-centre.geojson --points - --no-indirect"
 expect illum-no-points 0 "^polarlux illum: - holds no points$" -- sh -c "printf '# nothing\\n' | '$bin' illum -q fixtures/tiny.geojson --points -"
 # a blown-out image is said as a black one is; --mem 1GiB; "targets": null as absent (helper-56's pass)
@@ -926,6 +929,12 @@ expect walk-targets-null 0 "^walk: 2 frames" -- "$bin" walk -q fixtures/tiny.geo
 printf '1 0\n2 0\n3 0 1.5 0 0\n' >"$tmp/facing0.txt"
 expect meter-facing-zero 1 "^polarlux meter: .*facing0\\.txt:3: the facing direction \\(ux, uy\\) is zero or not finite$" -- "$bin" meter -q fixtures/tiny.geojson --points "$tmp/facing0.txt"
 if [ -n "$("$bin" meter -q fixtures/tiny.geojson --points "$tmp/facing0.txt" 2>/dev/null)" ]; then echo "FAIL meter-facing-zero-no-rows"; fail=$((fail + 1)); else echo "ok   meter-facing-zero-no-rows"; pass=$((pass + 1)); fi
+# helper-58's review: --frames 0 on render, a CSV layer's photometry column, a layer's skipped lamp
+expect render-frames-0 0 "^polarlux render: warning: --frames 0 traces no photons: no indirect light, as with --no-indirect$" -- "$bin" render fixtures/tiny.geojson --frames 0 --size 32x24 -o "$tmp/f0.png"
+printf 'x,y,z,photometry\n30,12,6,a.ies\n' >"$tmp/lphot.csv"
+expect lamps-csv-photometry-refused 1 "lphot\\.csv: column 4 \"photometry\": a lamp layer's lamps are isotropic" -- "$bin" info -q fixtures/tiny.geojson --lamps "$tmp/lphot.csv"
+printf 'x,y,radius\n30,12,0\n' >"$tmp/lr0.csv"
+expect lamps-csv-left-out 0 "lr0\\.csv: feature 2: radius is out of range \\(> 0 and <= 100000 m\\); left out$" -- "$bin" info fixtures/tiny.geojson --lamps "$tmp/lr0.csv"
 # '-' is standard input or output elsewhere: not a scene, and not a folder for frames or tiles (helper-56's pass)
 expect scene-dash 2 "^polarlux info: SCENE '-': a scene is not read from standard input" -- "$bin" info -
 expect walk-o-dash 2 "^polarlux walk: -o names the folder for the frames: '-' \\(standard output\\) cannot hold them" -- "$bin" walk fixtures/tiny.geojson --path "$tmp/nope.geojson" -o -

@@ -95,6 +95,18 @@ static void test_segment_of_no_length(void **state)
     assert_true(one.length == 0.0 && fabs(one.mean - E) < 1e-12 * E);
     assert_int_equal(plx_route_score(e, far, 2, 1.0, 5.0, &one, NULL), PLX_OK); /* out of reach: dark */
     assert_true(one.mean == 0.0 && one.dark_share == 1.0 && one.p_class == 0);
+    { /* the facing meters of the repeated vertex look along the next segment (+x), not east by default: the
+       * line is walked west to east here, so build it east to west to tell the two apart */
+        double back[6] = { 10, 0, 10, 0, -10, 0 }, fac[8], tot4[4], P[3] = { 10, 0, 1.5 }, U[2], m[4];
+        assert_int_equal(plx_route_facial(e, back, 3, 1.0, 1.5, fac, tot4), PLX_OK);
+        U[0] = -1.0;
+        U[1] = 0.0;
+        assert_int_equal(plx_meter(e, 1, P, U, m), PLX_OK);
+        assert_true(fac[0] == m[PLX_METER_V] && fac[2] == m[PLX_METER_SC]);
+        U[0] = 1.0;
+        assert_int_equal(plx_meter(e, 1, P, U, m), PLX_OK);
+        assert_true(fac[1] == m[PLX_METER_V] && fac[3] == m[PLX_METER_SC]);
+    }
     plx_engine_destroy(e);
     free(mem);
 }
