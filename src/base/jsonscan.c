@@ -359,26 +359,35 @@ void jsonscan_line_col(const char *text, size_t len, size_t off, uint32_t *line,
     *col = c;
 }
 
-int jsonscan_truncated(const char *text, size_t len)
+/* The containers open before offset off (at most len), strings skipped;
+ * *in_string: whether off lies inside a string. */
+static long open_before(const char *text, size_t len, size_t off, int *in_string)
 {
     size_t i;
     long depth = 0;
-    int in_string = 0;
-    for (i = 0; i < len; i++) {
+    *in_string = 0;
+    for (i = 0; i < off && i < len; i++) {
         char c = text[i];
-        if (in_string) {
+        if (*in_string) {
             if (c == '\\')
                 i++;
             else if (c == '"')
-                in_string = 0;
+                *in_string = 0;
         } else if (c == '"') {
-            in_string = 1;
+            *in_string = 1;
         } else if (c == '{' || c == '[') {
             depth++;
         } else if (c == ']' || c == '}') {
             depth--;
         }
     }
+    return depth;
+}
+
+int jsonscan_truncated(const char *text, size_t len)
+{
+    int in_string;
+    long depth = open_before(text, len, len, &in_string);
     return in_string || depth > 0;
 }
 
@@ -401,23 +410,6 @@ size_t jsonscan_error_at(const char *text, size_t len, size_t at, const char **t
 
 long jsonscan_depth_at(const char *text, size_t len, size_t off)
 {
-    size_t i;
-    long depth = 0;
-    int in_string = 0;
-    for (i = 0; i < off && i < len; i++) {
-        char c = text[i];
-        if (in_string) {
-            if (c == '\\')
-                i++;
-            else if (c == '"')
-                in_string = 0;
-        } else if (c == '"') {
-            in_string = 1;
-        } else if (c == '[' || c == '{') {
-            depth++;
-        } else if (c == ']' || c == '}') {
-            depth--;
-        }
-    }
-    return depth;
+    int in_string;
+    return open_before(text, len, off, &in_string);
 }
