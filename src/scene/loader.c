@@ -53,7 +53,8 @@ plx_status ld_bad_feature(loader *ld, uint32_t fi, const char *id, const char *w
     if (eng_strict(ld->e))
         return eng_fail(ld->e, PLX_E_SCENE, msg);
     ld->s->skipped_features++;
-    sb_str(&b, "; left out"); /* a dropped lamp among hundreds went unnoticed without it */
+    if (!strstr(why, "left out") && !strstr(why, "dropped")) /* a dropped lamp among hundreds went unnoticed */
+        sb_str(&b, "; left out");
     eng_warn(ld->e, msg);
     return PLX_OK;
 }

@@ -138,17 +138,17 @@ static const corpus_case corpus[] = {
     { "bowtie-rings.geojson", PLX_OK,
       NULL,
       "feature 0 (bowtie, line 2, column 1): outer ring intersects itself (edges 0 and 2 meet)",
-      "feature 0 (bowtie, line 2, column 1): outer ring intersects itself (edges 0 and 2 meet)\n"
-      "feature 1 (bowtie-hole, line 3, column 1): inner ring 1 intersects itself (edges 0 and 2 meet)\n"
-      "feature 2 (figure-eight, line 4, column 1): outer ring intersects itself (edges 2 and 5 meet)\n"
-      "feature 3 (spike, line 5, column 1): outer ring intersects itself (edges 3 and 4 meet)\n"
-      "feature 4 (twice-round, line 6, column 1): outer ring intersects itself (edges 0 and 4 meet)\n",
+      "feature 0 (bowtie, line 2, column 1): outer ring intersects itself (edges 0 and 2 meet); left out\n"
+      "feature 1 (bowtie-hole, line 3, column 1): inner ring 1 intersects itself (edges 0 and 2 meet); left out\n"
+      "feature 2 (figure-eight, line 4, column 1): outer ring intersects itself (edges 2 and 5 meet); left out\n"
+      "feature 3 (spike, line 5, column 1): outer ring intersects itself (edges 3 and 4 meet); left out\n"
+      "feature 4 (twice-round, line 6, column 1): outer ring intersects itself (edges 0 and 4 meet); left out\n",
       0, 0, 5, 0,
       "|" },
     { "control-characters.geojson", PLX_OK,
       NULL,
       "feature 0 (pi?ch, line 2, column 1): outer ring intersects itself (edges 3 and 4 meet)",
-      "feature 0 (pi?ch, line 2, column 1): outer ring intersects itself (edges 3 and 4 meet)\n"
+      "feature 0 (pi?ch, line 2, column 1): outer ring intersects itself (edges 3 and 4 meet); left out\n"
       "feature 1 (tab?here, line 4, column 1): property \"height\" is not a number (\"3?4\"); ignored, the default applies\n",
       1, 0, 1, 0,
       "tab\there|" },
@@ -173,21 +173,21 @@ static const corpus_case corpus[] = {
     { "duplicate-points.geojson", PLX_OK,
       NULL,
       "feature 1 (all-same, line 3, column 1): outer ring has 1 distinct vertex (a ring needs at least 3)",
-      "feature 1 (all-same, line 3, column 1): outer ring has 1 distinct vertex (a ring needs at least 3)\n"
-      "feature 2 (pinch, line 4, column 1): outer ring intersects itself (edges 3 and 4 meet)\n",
+      "feature 1 (all-same, line 3, column 1): outer ring has 1 distinct vertex (a ring needs at least 3); left out\n"
+      "feature 2 (pinch, line 4, column 1): outer ring intersects itself (edges 3 and 4 meet); left out\n",
       1, 0, 2, 0,
       "dups|" },
     { "empty-and-one-point-rings.geojson", PLX_OK,
       NULL,
       "feature 0 (no-rings, line 2, column 1): a polygon has no rings",
-      "feature 0 (no-rings, line 2, column 1): a polygon has no rings\n"
-      "feature 1 (empty-ring, line 3, column 1): outer ring has 0 distinct vertices (a ring needs at least 3)\n"
-      "feature 2 (one-point, line 4, column 1): outer ring has 1 distinct vertex (a ring needs at least 3)\n"
-      "feature 3 (one-point-closed, line 5, column 1): outer ring has 1 distinct vertex (a ring needs at least 3)\n"
-      "feature 4 (empty-hole, line 6, column 1): inner ring 1 has 0 distinct vertices (a ring needs at least 3)\n"
-      "feature 5 (multi-empty, line 7, column 1): MultiPolygon has no polygons\n"
-      "feature 6 (multi-no-rings, line 8, column 1): polygon 0: a polygon has no rings\n"
-      "feature 7 (multi-one-point, line 9, column 1): polygon 1: outer ring has 1 distinct vertex (a ring needs at least 3)\n",
+      "feature 0 (no-rings, line 2, column 1): a polygon has no rings; left out\n"
+      "feature 1 (empty-ring, line 3, column 1): outer ring has 0 distinct vertices (a ring needs at least 3); left out\n"
+      "feature 2 (one-point, line 4, column 1): outer ring has 1 distinct vertex (a ring needs at least 3); left out\n"
+      "feature 3 (one-point-closed, line 5, column 1): outer ring has 1 distinct vertex (a ring needs at least 3); left out\n"
+      "feature 4 (empty-hole, line 6, column 1): inner ring 1 has 0 distinct vertices (a ring needs at least 3); left out\n"
+      "feature 5 (multi-empty, line 7, column 1): MultiPolygon has no polygons; left out\n"
+      "feature 6 (multi-no-rings, line 8, column 1): polygon 0: a polygon has no rings; left out\n"
+      "feature 7 (multi-one-point, line 9, column 1): polygon 1: outer ring has 1 distinct vertex (a ring needs at least 3); left out\n",
       0, 0, 8, 0,
       "|" },
     { "empty.geojson", PLX_E_PARSE,
@@ -199,22 +199,22 @@ static const corpus_case corpus[] = {
     { "holes-escaping.geojson", PLX_OK,
       NULL,
       "feature 0 (through-vertices, line 2, column 1): inner ring 1 is not inside the outer ring",
-      "feature 0 (through-vertices, line 2, column 1): inner ring 1 is not inside the outer ring\n"
-      "feature 1 (across-mouth, line 3, column 1): inner ring 1 is not inside the outer ring\n"
-      "feature 2 (hole-in-hole, line 4, column 1): inner rings 1 and 2 overlap\n",
+      "feature 0 (through-vertices, line 2, column 1): inner ring 1 is not inside the outer ring; left out\n"
+      "feature 1 (across-mouth, line 3, column 1): inner ring 1 is not inside the outer ring; left out\n"
+      "feature 2 (hole-in-hole, line 4, column 1): inner rings 1 and 2 overlap; left out\n",
       2, 0, 3, 0,
       "touching-corner holes-touching|" },
     { "huge-numbers.geojson", PLX_OK,
       NULL,
       "feature 0 (x1e308, line 2, column 1): position 1 of outer ring is out of range (|coordinate| > 1e7 m)",
-      "feature 0 (x1e308, line 2, column 1): position 1 of outer ring is out of range (|coordinate| > 1e7 m)\n"
-      "feature 1 (x1e309, line 3, column 1): position 1 of outer ring has a non-finite number\n"
-      "feature 2 (h1e308, line 4, column 1): height 1e308 m is out of range (must be > 0 and <= 1000 m)\n"
-      "feature 3 (h1e999, line 5, column 1): height inf m is out of range (must be > 0 and <= 1000 m)\n"
-      "feature 4 (h400digits, line 6, column 1): height inf m is out of range (must be > 0 and <= 1000 m)\n"
-      "feature 5 (h0e99999, line 7, column 1): height 0 m is out of range (must be > 0 and <= 1000 m)\n"
-      "feature 7 (htiny, line 9, column 1): height 0 m is out of range (must be > 0 and <= 1000 m)\n"
-      "feature 8 (r1e400, line 10, column 1): lamp radius inf m is out of range (> 0 and <= 100000 m)\n",
+      "feature 0 (x1e308, line 2, column 1): position 1 of outer ring is out of range (|coordinate| > 1e7 m); left out\n"
+      "feature 1 (x1e309, line 3, column 1): position 1 of outer ring has a non-finite number; left out\n"
+      "feature 2 (h1e308, line 4, column 1): height 1e308 m is out of range (must be > 0 and <= 1000 m); left out\n"
+      "feature 3 (h1e999, line 5, column 1): height inf m is out of range (must be > 0 and <= 1000 m); left out\n"
+      "feature 4 (h400digits, line 6, column 1): height inf m is out of range (must be > 0 and <= 1000 m); left out\n"
+      "feature 5 (h0e99999, line 7, column 1): height 0 m is out of range (must be > 0 and <= 1000 m); left out\n"
+      "feature 7 (htiny, line 9, column 1): height 0 m is out of range (must be > 0 and <= 1000 m); left out\n"
+      "feature 8 (r1e400, line 10, column 1): lamp radius inf m is out of range (> 0 and <= 100000 m); left out\n",
       1, 3, 8, 0,
       "hlongmantissa|i1e308 id-huge 1e308" },
     { "infinity-bare.geojson", PLX_E_PARSE,
@@ -226,7 +226,7 @@ static const corpus_case corpus[] = {
     { "lamps-at-height-zero.geojson", PLX_OK,
       NULL,
       "feature 4 (ztiny, line 6, column 1): lamp z -1e-300 m is out of range (0 to 1000 m)",
-      "feature 4 (ztiny, line 6, column 1): lamp z -1e-300 m is out of range (0 to 1000 m)\n",
+      "feature 4 (ztiny, line 6, column 1): lamp z -1e-300 m is out of range (0 to 1000 m); left out\n",
       1, 3, 1, 0,
       "A|z0 z0m zneg0" },
     { "lamps-inside-buildings.geojson", PLX_OK,
@@ -239,10 +239,10 @@ static const corpus_case corpus[] = {
     { "lamps-negative-radius.geojson", PLX_OK,
       NULL,
       "feature 0 (neg, line 2, column 1): lamp radius -3 m is out of range (> 0 and <= 100000 m)",
-      "feature 0 (neg, line 2, column 1): lamp radius -3 m is out of range (> 0 and <= 100000 m)\n"
-      "feature 1 (zero, line 3, column 1): lamp radius 0 m is out of range (> 0 and <= 100000 m)\n"
-      "feature 2 (negstr, line 4, column 1): lamp radius -5 m is out of range (> 0 and <= 100000 m)\n"
-      "feature 3 (huge, line 5, column 1): lamp radius 100001 m is out of range (> 0 and <= 100000 m)\n",
+      "feature 0 (neg, line 2, column 1): lamp radius -3 m is out of range (> 0 and <= 100000 m); left out\n"
+      "feature 1 (zero, line 3, column 1): lamp radius 0 m is out of range (> 0 and <= 100000 m); left out\n"
+      "feature 2 (negstr, line 4, column 1): lamp radius -5 m is out of range (> 0 and <= 100000 m); left out\n"
+      "feature 3 (huge, line 5, column 1): lamp radius 100001 m is out of range (> 0 and <= 100000 m); left out\n",
       0, 1, 4, 0,
       "|ok" },
     { "lamps-overflowing-sum.geojson", PLX_OK,
@@ -259,7 +259,7 @@ static const corpus_case corpus[] = {
       "feature 0 (zero, line 2, column 1): lamp intensity is 0 cd: it gives no light\n"
       "feature 1 (zero-str, line 3, column 1): lamp intensity is 0 cd: it gives no light\n"
       "feature 2 (neg-zero, line 4, column 1): lamp intensity is 0 cd: it gives no light\n"
-      "feature 3 (neg, line 5, column 1): lamp intensity -1e-9 cd is negative or not finite\n",
+      "feature 3 (neg, line 5, column 1): lamp intensity -1e-9 cd is negative or not finite; left out\n",
       0, 3, 1, 0,
       "|zero zero-str neg-zero" },
     { "minus-infinity-bare.geojson", PLX_E_PARSE,
@@ -282,16 +282,16 @@ static const corpus_case corpus[] = {
       "feature 2 (c, line 4, column 1): property \"height\" is not a number (\"Infinity\"); ignored, the default applies\n"
       "feature 3 (d, line 5, column 1): property \"height\" is not a number (\"-inf\"); ignored, the default applies\n"
       "feature 4 (e, line 6, column 1): property \"intensity\" is not a number (\"inf\"); ignored, the default applies\n"
-      "feature 5 (f, line 7, column 1): position 0 of outer ring is not a position [x, y] of numbers\n",
+      "feature 5 (f, line 7, column 1): position 0 of outer ring is not a position [x, y] of numbers; left out\n",
       4, 1, 1, 0,
       "a b c d|e" },
     { "rings-that-are-lines.geojson", PLX_OK,
       NULL,
       "feature 0 (line3, line 2, column 1): outer ring intersects itself (edges 0 and 2 meet)",
-      "feature 0 (line3, line 2, column 1): outer ring intersects itself (edges 0 and 2 meet)\n"
-      "feature 1 (back-and-forth, line 3, column 1): outer ring has 2 distinct vertices (a ring needs at least 3)\n"
-      "feature 2 (folded, line 4, column 1): outer ring intersects itself (edges 0 and 2 meet)\n"
-      "feature 3 (diagonal, line 5, column 1): outer ring intersects itself (edges 0 and 5 meet)\n",
+      "feature 0 (line3, line 2, column 1): outer ring intersects itself (edges 0 and 2 meet); left out\n"
+      "feature 1 (back-and-forth, line 3, column 1): outer ring has 2 distinct vertices (a ring needs at least 3); left out\n"
+      "feature 2 (folded, line 4, column 1): outer ring intersects itself (edges 0 and 2 meet); left out\n"
+      "feature 3 (diagonal, line 5, column 1): outer ring intersects itself (edges 0 and 5 meet); left out\n",
       0, 0, 4, 0,
       "|" },
     { "truncated-after-key.geojson", PLX_E_PARSE,
@@ -396,16 +396,16 @@ static const corpus_case corpus[] = {
     { "wrong-types-structure.geojson", PLX_OK,
       NULL,
       "feature 0 (line 2, column 1): is not a JSON object",
-      "feature 0 (line 2, column 1): is not a JSON object\n"
+      "feature 0 (line 2, column 1): is not a JSON object; left out\n"
       "feature 1 (line 3, column 1): \"properties\" is not an object; ignored\n"
-      "feature 2 (g-str, line 4, column 1): has no geometry object\n"
-      "feature 3 (t-num, line 5, column 1): geometry has no \"type\" string\n"
-      "feature 4 (c-str, line 6, column 1): geometry has no \"coordinates\" array\n"
-      "feature 5 (pos-short, line 7, column 1): position 1 of outer ring is not a position [x, y] of numbers\n"
-      "feature 6 (pos-str, line 8, column 1): position 0 of outer ring is not a position [x, y] of numbers\n"
-      "feature 7 (ring-num, line 9, column 1): outer ring is not an array of positions\n"
-      "feature 8 (pt-str, line 10, column 1): the point is not a position [x, y] of numbers\n"
-      "feature 10 (line 12, column 1): outer ring has 2 distinct vertices (a ring needs at least 3)\n",
+      "feature 2 (g-str, line 4, column 1): has no geometry object; left out\n"
+      "feature 3 (t-num, line 5, column 1): geometry has no \"type\" string; left out\n"
+      "feature 4 (c-str, line 6, column 1): geometry has no \"coordinates\" array; left out\n"
+      "feature 5 (pos-short, line 7, column 1): position 1 of outer ring is not a position [x, y] of numbers; left out\n"
+      "feature 6 (pos-str, line 8, column 1): position 0 of outer ring is not a position [x, y] of numbers; left out\n"
+      "feature 7 (ring-num, line 9, column 1): outer ring is not an array of positions; left out\n"
+      "feature 8 (pt-str, line 10, column 1): the point is not a position [x, y] of numbers; left out\n"
+      "feature 10 (line 12, column 1): outer ring has 2 distinct vertices (a ring needs at least 3); left out\n",
       2, 0, 9, 0,
       "- fid|" },
 };
