@@ -208,7 +208,7 @@ static void test_parse_errors(void **state)
                  "factor is negative");
     {
         const photometry *p = NULL;
-        assert_int_equal(photometry_parse(&b.a, PLX_PART_SCENE, "x\n1\nabc\n", 10, "t.LDT", &p, b.err, sizeof b.err),
+        assert_int_equal(photometry_parse(&b.a, PLX_PART_SCENE, "x\n1\nabc\n", 8, "t.LDT", &p, b.err, sizeof b.err),
                          PLX_E_PARSE);
         assert_string_equal(b.err, "t.LDT: line 3: bad number for the symmetry indicator"); /* named so: no note */
     }
