@@ -241,42 +241,17 @@ static int load_ground_image(const char *cmd, const char *scene_path, plx_engine
     return EXIT_OK;
 }
 
-/* Reads a whole photometry file into a malloc'd buffer, opened as every
- * other input (port_open_input: a FIFO, device or directory is refused at
- * once, never waited on), at most 64 MiB; NULL with why (a message). */
-static char *read_all(const char *path, size_t *len, char *why, size_t whylen)
+/* A whole photometry file (port_read_text: opened as every other input,
+ * a FIFO, device or folder refused at once), at most 64 MiB; NULL with
+ * why. */
+static char *read_photometry(const char *path, size_t *len, char *why, size_t whylen)
 {
-    size_t size = 0, got = 0;
-    char *buf;
-    int fd = port_open_input(path, &size, why, whylen);
-    if (fd < 0)
-        return NULL;
-    if (size > ((size_t)64 << 20)) {
-        snprintf(why, whylen, "%zu bytes, more than a photometry file's 64 MiB", size);
-        close(fd);
+    struct stat sb;
+    if (stat(path, &sb) == 0 && S_ISREG(sb.st_mode) && (unsigned long long)sb.st_size > (64ull << 20)) {
+        snprintf(why, whylen, "%llu bytes, more than a photometry file's 64 MiB", (unsigned long long)sb.st_size);
         return NULL;
     }
-    if (!(buf = malloc(size ? size : 1))) {
-        snprintf(why, whylen, "out of memory for its %zu bytes", size);
-        close(fd);
-        return NULL;
-    }
-    while (got < size) {
-        ssize_t r = read(fd, buf + got, size - got);
-        if (r < 0 && errno == EINTR)
-            continue;
-        if (r <= 0) {
-            snprintf(why, whylen, "read %zu of %zu bytes: %s", got, size,
-                     r < 0 ? strerror(errno) : "the file changed while reading");
-            free(buf);
-            close(fd);
-            return NULL;
-        }
-        got += (size_t)r;
-    }
-    close(fd);
-    *len = size;
-    return buf;
+    return port_read_text(path, len, why, whylen);
 }
 
 /* The photometry files the scene's lamps name (properties.photometry,
@@ -299,7 +274,7 @@ static int load_photometry(const char *cmd, const char *scene_path, plx_engine *
             return EXIT_NOMEM;
         memcpy(full, scene_path, dir);
         strcpy(full + dir, p);
-        data = read_all(full, &len, why, sizeof why);
+        data = read_photometry(full, &len, why, sizeof why);
         if (!data) {
             fprintf(stderr, "polarlux %s: %s: photometry file %s: %s\n", cmd, scene_path, full, why);
             free(full);
