@@ -898,6 +898,10 @@ int plx_p_class(double mean, double min);
  * photons) is dropped. Errors: PLX_E_PARSE "NAME: line L: why" (bad number,
  * table too short, unsupported tilt or photometric type, ...);
  * PLX_E_INVALID when no lamp names path; PLX_E_NOSCENE; PLX_E_NOMEM.
+ * A table whose own flux (the integral of its intensities) is more than
+ * 10% off what its header states (EULUMDAT: light output ratio x the
+ * lamps' flux; IES: only above lamps x lumens per lamp x ballast factor)
+ * is taken as given with a warning through the port's log.
  * Lifetime: *path lives until the next load; data is not kept (the table
  * is, until the next load). Threads: engine.
  */

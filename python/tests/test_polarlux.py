@@ -385,3 +385,15 @@ def test_photometry_file_errors(tmp_path):
     (tmp_path / "l.ies").write_text("IESNA:LM-63-2002\nTILT=NONE\n1 -1 1 2 1 1 2 0 0 0\n1 1 0\n0 90\n0\n100 abc\n")
     with pytest.raises(polarlux.PolarluxError, match=r"line 7: bad number 'abc'"):
         polarlux.Scene.from_file(str(tmp_path / "s.geojson"))
+
+
+def test_photometry_flux_warning(tmp_path):
+    """A table giving more light than its lamps (4 pi 100 = 1257 lm from one
+    1000 lm lamp) is used as given, with the loader's warning in warnings."""
+    (tmp_path / "s.geojson").write_text(ies_scene("l.ies"))
+    (tmp_path / "l.ies").write_text("IESNA:LM-63-2002\nTILT=NONE\n1 1000 1 2 1 1 2 0 0 0\n1 1 0\n0 180\n0\n100 100\n")
+    s = polarlux.Scene.from_file(str(tmp_path / "s.geojson"))
+    assert any("1257 lm, 126% of the lumens of its lamps" in w for w in s.warnings)
+    (tmp_path / "l.ies").write_text("IESNA:LM-63-2002\nTILT=NONE\n1 1000 1 2 1 1 2 0 0 0\n1 1 0\n0 180\n0\n70 70\n")
+    s = polarlux.Scene.from_file(str(tmp_path / "s.geojson"))
+    assert not any("lumens of its lamps" in w for w in s.warnings)

@@ -68,6 +68,8 @@ plx_status plx_set_photometry(plx_engine *e, const char *path, const char *data,
         return eng_nomem(e, "storing a photometry table");
     if (st != PLX_OK)
         return eng_fail(e, st, err);
+    if (err[0]) /* the header's flux and the table's disagree */
+        eng_warn(e, err);
     for (i = 0; i < e->sc->nlamps; i++) {
         scene_lamp *lp = &e->sc->lamps[i];
         if (lp->photometry && strcmp(lp->photometry, path) == 0) {

@@ -323,8 +323,8 @@ static void print_photometry(plx_engine *e, uint32_t nlamps)
             if (plx_lamp_photometry_get(e, l, &ph) == PLX_OK && ph.path && strcmp(ph.path, p) == 0 && !used++)
                 first = l;
         plx_lamp_photometry_get(e, first, &ph);
-        printf("photometry: %s (%s) for %u lamps; lamp %u: peak %.1f cd, flux %.1f lm, dark from gamma %.1f deg\n",
-               p, ph.format == 1 ? "IES" : "EULUMDAT", used, first, ph.peak_cd, ph.flux_lm, ph.gamma_lit);
+        printf("photometry: %s (%s) for %u lamp%s; lamp %u: peak %.1f cd, flux %.1f lm, dark from gamma %.1f deg\n",
+               p, ph.format == 1 ? "IES" : "EULUMDAT", used, used == 1 ? "" : "s", first, ph.peak_cd, ph.flux_lm, ph.gamma_lit);
     }
 }
 

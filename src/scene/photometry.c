@@ -179,6 +179,7 @@ typedef struct pm_build {
     double *g, *cd;           /* ng, nrows * ng */
     double *src_c;            /* nrows: the stored rows' C angles */
     uint32_t ng, nrows;
+    double rated;             /* lm the header states (0: none): EULUMDAT the luminaire's, IES its lamps' */
 } pm_build;
 
 static plx_status pm_alloc(pm_build *B, uint32_t ng, uint32_t nrows)
@@ -399,6 +400,8 @@ static plx_status parse_ies(pm_text *t, pm_build *B)
     mult = h[2] * h[10] * (v1995 ? h[11] : 1.0);
     if (!(mult >= 0.0) || !isfinite(mult))
         return pm_fail(t, t->line, "the multipliers give a negative or infinite factor", NULL);
+    if (h[0] > 0.0 && h[1] > 0.0) /* lumens -1: absolute photometry, no lamp flux stated */
+        B->rated = h[0] * h[1] * h[10] * (v1995 ? h[11] : 1.0);
     nv = (uint32_t)h[3];
     nh = (uint32_t)h[4];
     if ((st = pm_alloc(B, nv, nh)) != PLX_OK)
@@ -470,6 +473,18 @@ static plx_status ldt_number(pm_text *t, uint32_t k, const char *what, double *v
     return PLX_OK;
 }
 
+/* The light output ratio (line 23, %), read only to check the table's
+ * flux by: 0 when it is not a number. */
+static plx_status ldt_ratio(pm_text *t, double *lor)
+{
+    const char *l = NULL;
+    size_t n = 0;
+    plx_status st = ldt_line(t, 23, "the light output ratio (line 23)", &l, &n);
+    if (st == PLX_OK && !pm_trim_number(l, n, 1, lor))
+        *lor = 0.0;
+    return st;
+}
+
 /* A number on a line of its own (the C and gamma angles, the values):
  * EULUMDAT writes one per line, decimal commas allowed; blank lines skipped. */
 static plx_status ldt_value(pm_text *t, const char *what, double *v)
@@ -489,7 +504,7 @@ static plx_status ldt_value(pm_text *t, const char *what, double *v)
 
 static plx_status parse_ldt(pm_text *t, pm_build *B)
 {
-    double isym, mc, ng, cf, nsets, flux, v;
+    double isym, mc, ng, lor, cf, nsets, flux, v;
     uint32_t Mc, Ng, first, count, i, k, lsets;
     double *call;
     plx_status st;
@@ -500,6 +515,7 @@ static plx_status parse_ldt(pm_text *t, pm_build *B)
         (st = pm_count(t, "the number of C planes Mc", mc, 4, 1, PHOTOMETRY_MAX_ANGLES)) != PLX_OK ||
         (st = ldt_number(t, 6, "the number of intensities per plane (line 6)", &ng)) != PLX_OK ||
         (st = pm_count(t, "the number of intensities Ng", ng, 6, 1, PHOTOMETRY_MAX_ANGLES)) != PLX_OK ||
+        (st = ldt_ratio(t, &lor)) != PLX_OK ||
         (st = ldt_number(t, 24, "the conversion factor (line 24)", &cf)) != PLX_OK ||
         (st = ldt_number(t, 26, "the number of lamp sets (line 26)", &nsets)) != PLX_OK ||
         (st = pm_count(t, "the number of lamp sets", nsets, 26, 1, 20)) != PLX_OK ||
@@ -516,6 +532,8 @@ static plx_status parse_ldt(pm_text *t, pm_build *B)
         return pm_fail(t, 24, "the conversion factor is negative", NULL);
     if (!(fabs(flux) > 0.0))
         return pm_fail(t, 29, "the lamps' luminous flux is 0", NULL);
+    if (lor > 0.0) /* 0: not stated */
+        B->rated = lor / 100.0 * cf * fabs(flux);
     sym = isym == 0.0 ? SYM_NONE : isym == 1.0 ? SYM_ROT : isym == 2.0 ? SYM_C0 : isym == 3.0 ? SYM_C90 : SYM_QUAD;
     first = sym == SYM_C90 ? Mc / 4 : 0;
     count = sym == SYM_NONE ? Mc : sym == SYM_ROT ? 1 : sym == SYM_QUAD ? Mc / 4 + 1 : Mc / 2 + 1;
@@ -555,6 +573,31 @@ static plx_status parse_ldt(pm_text *t, pm_build *B)
 }
 
 /* ---- entry points --------------------------------------------------------------- */
+
+/* The header's stated flux against the table's own (the integral of its
+ * intensities): a warning in t's err when an EULUMDAT table gives more
+ * than 10% above or below its light output ratio x lamp flux, or an IES
+ * table more than 10% above its lamps' lumens (no luminaire gives more
+ * light than its lamps). The table is used as given either way. */
+static void pm_check_flux(pm_text *t, const pm_build *B, int ies)
+{
+    double f = B->p->flux, r = B->rated;
+    strbuf b;
+    if (!(r > 0.0) || !t->errlen || (f <= 1.1 * r && (ies || f >= 0.9 * r)))
+        return;
+    sb_init(&b, t->err, t->errlen);
+    sb_str(&b, t->name ? t->name : "photometry");
+    sb_str(&b, ": the table's intensities give ");
+    sb_fixed(&b, f, 0);
+    sb_str(&b, " lm, ");
+    sb_fixed(&b, 100.0 * f / r, 0);
+    sb_str(&b, ies ? "% of the lumens of its lamps (" : "% of the flux its header states (");
+    sb_fixed(&b, r, 0);
+    sb_str(&b, ies ? " lm: lamps x lumens per lamp x ballast factor)" :
+                     " lm: light output ratio x the lamps' flux x conversion factor)");
+    sb_str(&b, "; the table is used as given");
+}
+
 
 /* Whether the name ends in .ldt (any case). */
 static int named_ldt(const char *name)
@@ -609,6 +652,7 @@ plx_status photometry_parse(arena *a, plx_part part, const char *data, size_t le
     if (st == PLX_OK) {
         arena_mark now = arena_get_mark(a);
         pm_finish(&B, ies ? 1 : 2);
+        pm_check_flux(&t, &B, ies); /* a warning in err, or err stays empty */
         now.hi = m.hi;   /* drop the scratch, keep the table */
         now.used[PLX_PART_SCRATCH] = m.used[PLX_PART_SCRATCH];
         arena_release(a, &now);

@@ -49,7 +49,10 @@ typedef struct photometry {
 /* Parses data[0..len) (IES when a line starts with "TILT=", else
  * EULUMDAT) into memory of part 'part' of a. On failure returns
  * PLX_E_PARSE with "NAME: line L: why" in err (or PLX_E_NOMEM; the arena is
- * then back where it was). */
+ * then back where it was). On success err holds a warning, or is empty:
+ * the header's stated flux (EULUMDAT light output ratio x lamp flux, IES
+ * lamps x lumens) more than 10% off the table's own (an IES table only
+ * above it). */
 plx_status photometry_parse(arena *a, plx_part part, const char *data, size_t len, const char *name,
                             const photometry **out /* OUT */, char *err, size_t errlen);
 

@@ -838,6 +838,12 @@ expect photometry-short 1 "l\\.ies: line 7: table too short" -- "$bin" info "$tm
 printf 'IESNA:LM-63-2002\nTILT=NONE\n1 -1 1 2 1 1 2 0 0 0\n1 1 0\n0 90\n0\n100 0\n' >"$tmp/ph/l.ies"
 sed 's/"photometry":"l.ies"/"photometry":"l.ies","intensity":500/' "$tmp/ph/s.geojson" >"$tmp/ph/si.geojson"
 expect photometry-intensity-ignored 0 "feature 0 \\(line 1, column [0-9]+\\): property \"intensity\" is ignored: the lamp's photometry file gives its candelas" -- sh -c "echo '0 0' | '$bin' illum --no-indirect '$tmp/ph/si.geojson' --points -"
+printf 'IESNA:LM-63-2002\nTILT=NONE\n1 1000 1 2 1 1 2 0 0 0\n1 1 0\n0 180\n0\n100 100\n' >"$tmp/ph/l.ies"
+expect photometry-flux-above-lamps 0 "warning: $tmp/ph/l\\.ies: the table's intensities give 1257 lm, 126% of the lumens of its lamps \\(1000 lm: lamps x lumens per lamp x ballast factor\\); the table is used as given$" -- "$bin" info "$tmp/ph/s.geojson"
+expect photometry-flux-quiet 0 "" -- "$bin" info -q "$tmp/ph/s.geojson"
+if grep -q warning "$tmp/out"; then echo "FAIL photometry-flux-quiet printed a warning"; fail=$((fail + 1)); fi
+expect photometry-one-lamp 0 "^photometry: l\\.ies \\(IES\\) for 1 lamp; lamp 0: peak 100\\.0 cd, flux 1256\\.6 lm" -- "$bin" info -q "$tmp/ph/s.geojson"
+printf 'IESNA:LM-63-2002\nTILT=NONE\n1 -1 1 2 1 1 2 0 0 0\n1 1 0\n0 90\n0\n100 0\n' >"$tmp/ph/l.ies"
 expect photometry-nadir 0 "^0 0 0 2\\.768895999" -- sh -c "echo '0 0' | '$bin' illum -q --no-indirect '$tmp/ph/s.geojson' --points -"
 # a user's pass on the real district (2026-12-02): coordinates, empty routes, output names, notes
 H=fixtures/helsinki-centre.geojson

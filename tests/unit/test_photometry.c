@@ -215,6 +215,55 @@ static void test_parse_errors(void **state)
     free(b.mem);
 }
 
+/* The header's flux against the table's: a constant table of v over the
+ * whole sphere gives 4 pi v lm (times the EULUMDAT scale). */
+static void expect_flux_note(lab *b, const char *text, const char *note)
+{
+    parse(b, text, PLX_OK);
+    if (note ? !strstr(b->err, note) : b->err[0] != '\0') {
+        printf("note '%s', want '%s'\n", b->err, note ? note : "");
+        fail();
+    }
+}
+
+static void test_flux_check(void **state)
+{
+    lab b = { 0 };
+    char buf[4096], ies[256], *lor;
+    (void)state;
+    /* EULUMDAT: light output ratio 80% of 1000 lm = 800 lm; 4 pi 63.66 = 800 lm */
+    expect_flux_note(&b, ldt(buf, sizeof buf, 1, 4, 90, "0\n180\n", 2, "63.66\n63.66\n", 1, 1000), NULL);
+    expect_flux_note(&b, ldt(buf, sizeof buf, 1, 4, 90, "0\n180\n", 2, "80\n80\n", 1, 1000),
+                     "t.ies: the table's intensities give 1005 lm, 126% of the flux its header states (800 lm");
+    expect_flux_note(&b, ldt(buf, sizeof buf, 1, 4, 90, "0\n180\n", 2, "55\n55\n", 1, 1000), "691 lm, 86% of");
+    /* 10% either way is within: 4 pi 70 = 880 lm, 4 pi 57.3 = 720 lm */
+    expect_flux_note(&b, ldt(buf, sizeof buf, 1, 4, 90, "0\n180\n", 2, "70\n70\n", 1, 1000), NULL);
+    expect_flux_note(&b, ldt(buf, sizeof buf, 1, 4, 90, "0\n180\n", 2, "57.3\n57.3\n", 1, 1000), NULL);
+    /* the conversion factor scales both: 2 x 4 pi 63.66 against 2 x 800 */
+    expect_flux_note(&b, ldt(buf, sizeof buf, 1, 4, 90, "0\n180\n", 2, "63.66\n63.66\n", 2, 1000), NULL);
+    /* a light output ratio of 0 or not a number: not stated, no check */
+    ldt(buf, sizeof buf, 1, 4, 90, "0\n180\n", 2, "80\n80\n", 1, 1000);
+    lor = strstr(buf, "\n100\n80\n");
+    assert_non_null(lor);
+    memcpy(lor, "\n100\n 0\n", 8);
+    expect_flux_note(&b, buf, NULL);
+    memcpy(lor, "\n100\n x\n", 8);
+    expect_flux_note(&b, buf, NULL);
+    /* IES: 1 lamp of 1000 lm x ballast factor; only above is noted */
+    snprintf(ies, sizeof ies, "IESNA:LM-63-2002\nTILT=NONE\n1 1000 1 2 1 1 2 0 0 0\n%s 1 100\n0 180\n0\n%s %s\n",
+             "1", "90", "90");
+    expect_flux_note(&b, ies, "1131 lm, 113% of the lumens of its lamps (1000 lm");
+    snprintf(ies, sizeof ies, "IESNA:LM-63-2002\nTILT=NONE\n1 1000 1 2 1 1 2 0 0 0\n%s 1 100\n0 180\n0\n%s %s\n",
+             "0.5", "90", "90"); /* the ballast factor scales the table and the lamps alike */
+    expect_flux_note(&b, ies, "565 lm, 113% of the lumens of its lamps (500 lm");
+    snprintf(ies, sizeof ies, "IESNA:LM-63-2002\nTILT=NONE\n1 1000 1 2 1 1 2 0 0 0\n%s 1 100\n0 180\n0\n%s %s\n",
+             "1", "20", "20");
+    expect_flux_note(&b, ies, NULL);
+    /* lumens -1: absolute photometry, nothing stated */
+    expect_flux_note(&b, "IESNA:LM-63-2002\nTILT=NONE\n1 -1 1 2 1 1 2 0 0 0\n1 1 100\n0 180\n0\n900 900\n", NULL);
+    free(b.mem);
+}
+
 static const photometry *parse_file(lab *b, const char *path)
 {
     static char text[1 << 16];
@@ -239,9 +288,13 @@ static void test_fixture_files(void **state)
     assert_int_equal(p->format, 2);
     assert_int_equal(p->nc, 1);
     for (g = 0; g <= 180; g += 5) {
-        double r = g * PI / 180, want = 3 * (170 * sin(r) * sin(r) + 80 * fmax(0, cos(r)) + 15 * fmax(0, -cos(r)));
+        double r = g * PI / 180, want = 3 * (84 * sin(r) * sin(r) + 39.5 * fmax(0, cos(r)) + 7.5 * fmax(0, -cos(r)));
         assert_true(fabs(photometry_at(p, 33, g) - want) < 3 * 0.0005 + 1e-9);
     }
+    /* its table agrees with its header: 3 x 2 pi (84 4/3 + 39.5/2 + 7.5/2) =
+     * 2554 lm, 85% of 3000 lm (bilinear in 5 degree steps: within 1%) */
+    assert_string_equal(b.err, "");
+    assert_true(fabs(p->flux - 6 * PI * 135.5) < 0.01 * 6 * PI * 135.5);
     p = parse_file(&b, "fixtures/photometry/wall-down.ies");
     assert_int_equal(p->format, 1);
     for (c = 0; c <= 360; c += 15)
@@ -573,6 +626,7 @@ int main(void)
         cmocka_unit_test(test_ies_symmetries),
         cmocka_unit_test(test_ldt_symmetries),
         cmocka_unit_test(test_parse_errors),
+        cmocka_unit_test(test_flux_check),
         cmocka_unit_test(test_fixture_files),
         cmocka_unit_test(test_nadir_and_frame),
         cmocka_unit_test(test_semicylinder_hemisphere),
