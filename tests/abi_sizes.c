@@ -163,6 +163,18 @@ static void memory_report(void)
     FIELD(plx_memory_report, peak_total);
 }
 
+static void ground_image_info(void)
+{
+    STRUCT(plx_ground_image_info);
+    FIELD(plx_ground_image_info, path);
+    FIELD(plx_ground_image_info, bounds_given);
+    FIELD(plx_ground_image_info, bounds);
+    FIELD(plx_ground_image_info, width);
+    FIELD(plx_ground_image_info, height);
+    FIELD(plx_ground_image_info, mean_albedo);
+    FIELD(plx_ground_image_info, mean_luminance);
+}
+
 int main(void)
 {
     port();
@@ -175,5 +187,6 @@ int main(void)
     render_info();
     scene_size();
     memory_report();
+    ground_image_info();
     return fflush(stdout) == 0 ? 0 : 1;
 }

@@ -3,18 +3,24 @@
     import polarlux
     s = polarlux.Scene.from_file("fixtures/helsinki-centre.geojson")
     E_direct, E_indirect = s.illuminance(points_xy)          # (N,) lux
+    m = s.meter(points_xyz, facing=(0, 1))                   # SPEC §6: E_h, E_v, E_sc, E_hs (N,) lux
     areas = s.visibility_areas(points_xy)                     # (N,) m^2, NaN where not free
     total, segments = s.route_score(line_xy, step=1.0)
     img = s.render(eye=(x, y, 1.7), target=(x2, y2, 1.0), size=(640, 480))   # (480, 640, 3) uint8
 
 Coordinates are the scene's local metres (SPEC §1); lon/lat scenes convert
 with Scene.lonlat_to_local / local_to_lonlat. Arrays go in and come out as
-numpy arrays of float64 (images uint8 or float32). See README "Python".
+numpy arrays of float64 (images uint8 or float32). One Scene may be shared
+by threads (its calls take turns). See README "Python".
 """
 import ctypes
+import functools
+import json
 import mmap
 import numbers
 import os
+import threading
+import warnings as _warnings
 
 import numpy as np
 
@@ -61,7 +67,29 @@ def _big_block(n):
 
 
 def _as_bytes(text):
-    return text.encode("utf-8") if isinstance(text, str) else bytes(text)
+    """GeoJSON as bytes: str (UTF-8), bytes-like, or a dict (json.load's)."""
+    if isinstance(text, str):
+        return text.encode("utf-8")
+    if isinstance(text, (bytes, bytearray, memoryview)):
+        return bytes(text)
+    if isinstance(text, dict):
+        return json.dumps(text).encode("utf-8")
+    raise TypeError(f"a scene is GeoJSON text (str or bytes) or a dict, not {type(text).__name__}: "
+                    "use Scene.from_file for a path")
+
+
+def _engine_call(fn):
+    """Runs a method with the Scene's lock held, once the Scene is known to
+    be open: the engine's calls must not overlap (polarlux.h), and ctypes
+    lets other threads run during each call, so threads sharing one Scene
+    take turns (before 2026-12-03 four threads on one Scene crashed Python)."""
+    @functools.wraps(fn)
+    def call(self, *args, **kw):
+        with self._lock:
+            if not self._e:
+                raise ValueError("the Scene is closed")
+            return fn(self, *args, **kw)
+    return call
 
 
 def _dptr(a):
@@ -78,6 +106,11 @@ def _points(a, cols, what):
 
 
 def _config(lit_cache_bytes=0, render_max=(0, 0), strict=False, port=None):
+    if int(lit_cache_bytes) < 0:
+        raise ValueError(f"lit_cache_bytes must be 0 (the default) or more, not {lit_cache_bytes!r}")
+    if len(render_max) != 2 or int(render_max[0]) < 0 or int(render_max[1]) < 0:
+        raise ValueError(f"render_max must be (width, height), each 0 (the default, 1920x1080) or more, "
+                         f"not {tuple(render_max)!r}")
     cfg = _lib.Config()
     lib.plx_config_default(ctypes.byref(cfg))
     cfg.strict = 1 if strict else 0
@@ -101,8 +134,13 @@ def scene_size(text):
 def memory_estimate(text, uses=USE_VISIBILITY | USE_LIGHT | USE_RENDER, lit_cache_bytes=0, render_max=(0, 0)):
     """plx_memory_estimate: the block (bytes) a scene needs for these uses."""
     data = _as_bytes(text)
+    if not data.lstrip()[:1] == b"{":
+        raise ValueError("memory_estimate takes the scene's GeoJSON text, which starts with '{', not "
+                         f"{data[:40]!r}: read a file first")
     sz = _lib.padded(_lib.SceneSize)
-    lib.plx_scene_size_scan(data, len(data), ctypes.byref(sz))
+    st = lib.plx_scene_size_scan(data, len(data), ctypes.byref(sz))
+    if st != _lib.OK:
+        _raise(st, "plx_scene_size_scan failed")
     cfg = _config(lit_cache_bytes, render_max)
     return int(lib.plx_memory_estimate(ctypes.byref(sz), ctypes.byref(cfg), uses))
 
@@ -120,6 +158,12 @@ class Scene:
     default is the scene file's folder, as the polarlux command's; Scene's
     is the current directory. A file that cannot be read or parsed raises
     PolarluxError naming it (such a lamp would give no light).
+
+    text: GeoJSON as str or bytes, or a dict as json.load gives it.
+    Threads: one Scene may be shared; its calls take turns (a lock), since
+    one engine runs one call at a time. Separate Scenes run in parallel.
+    A Scene cannot be pickled or copied (it owns an engine in its own
+    block): load the text again.
     """
 
     def __init__(self, text, name="scene", mem=None, strict=False, lit_cache_bytes=0, render_max=(0, 0),
@@ -138,6 +182,17 @@ class Scene:
         self._check(lib.plx_load_geojson(self._e, data, len(data), name.encode("utf-8")))
         self._load_photometry(name, base_dir)
         self._read_info()
+        self._note_ground_image(name)
+
+    def _note_ground_image(self, name):
+        """A ground image the scene names is not read here (the package
+        decodes no PNG): said in .warnings, as renders differ from the
+        command's."""
+        g = _lib.padded(_lib.GroundImageInfo)
+        if lib.plx_ground_image_get(self._e, ctypes.byref(g)) == _lib.OK and g.path:
+            self.warnings.append(f"{name}: ground image {os.fsdecode(g.path)} is not loaded (the Python package "
+                                 "decodes no PNG): the ground keeps the scene's constant albedo in renders; "
+                                 "polarlux render reads it")
 
     def _load_photometry(self, name, base_dir):
         """Every photometry file the lamps name, read and given to the
@@ -158,9 +213,16 @@ class Scene:
             self._check(lib.plx_set_photometry(self._e, p.value, blob, len(blob), full.encode("utf-8")))
 
     def _start(self, strict, lit_cache_bytes=0, render_max=(0, 0)):
-        self.warnings = []
+        self._lock = threading.RLock()
+        self._baked = False
+        self._said_indirect = False
+        self.warnings = log = []
         self._e = ctypes.c_void_p()
-        self._log = _lib.LOG_FN(self._on_log)
+        # the callback holds the list, not the Scene: no reference cycle, so
+        # the engine's block goes with the Scene's last reference (with a
+        # bound method it waited for the cycle collector: 30 Scenes in a
+        # loop held 359 MB)
+        self._log = _lib.LOG_FN(lambda ctx, level, msg: log.append(msg.decode("utf-8", "replace")))
         self._port = _lib.Port()
         self._port.log = self._log
         self._cfg = _config(lit_cache_bytes, render_max, strict, self._port)
@@ -225,22 +287,39 @@ class Scene:
             self._e = ctypes.c_void_p()
             self._block = None
             _raise(st, f"{name}: {err.value.decode('utf-8', 'replace')}")
+        self._baked = True
         self._read_info()
         return self
-
-    def _on_log(self, ctx, level, msg):
-        self.warnings.append(msg.decode("utf-8", "replace"))
 
     def _check(self, st):
         if st != _lib.OK:
             _raise(st, lib.plx_last_error(self._e).decode("utf-8", "replace"))
 
     def close(self):
-        """Ends the engine and gives its block back."""
-        if self._e:
-            lib.plx_engine_destroy(self._e)
-            self._e = ctypes.c_void_p()
-            self._block = None
+        """Ends the engine and gives its block back; later calls raise
+        ValueError("the Scene is closed")."""
+        with self._lock:
+            if self._e:
+                lib.plx_engine_destroy(self._e)
+                self._e = ctypes.c_void_p()
+                self._block = None
+
+    def __repr__(self):
+        if not getattr(self, "_e", None):
+            return "<polarlux.Scene (closed)>"
+        i = self.info
+        return (f"<polarlux.Scene: {i['buildings']} buildings, {i['lamps']} lamps"
+                f"{', lon/lat' if i['lonlat'] else ''}{', baked' if self._baked else ''}>")
+
+    def __reduce__(self):
+        raise TypeError("a Scene owns an engine in its own memory block and cannot be pickled: "
+                        "pickle the scene's text (or keep a bake file) and load it again")
+
+    def __copy__(self):
+        raise TypeError("a Scene cannot be copied (two copies would share one engine): load the scene again")
+
+    def __deepcopy__(self, memo):
+        self.__copy__()
 
     def __enter__(self):
         return self
@@ -255,6 +334,7 @@ class Scene:
             pass
 
     # ---- memory ----------------------------------------------------------------
+    @_engine_call
     def memory(self):
         """plx_memory_get: capacity, used_total, peak_total (bytes)."""
         r = _lib.padded(_lib.MemoryReport)
@@ -264,7 +344,8 @@ class Scene:
     # ---- coordinates -------------------------------------------------------------
     def _local(self, xy, what):
         """Raises ValueError when the (N, >=2) local points of a lon/lat scene
-        all lie where the scene's own bounds would be in lon/lat degrees: they
+        all lie where the scene's own bounds would be in lon/lat degrees
+        (grown by their own size on every side): they
         are lon/lat given where the API takes metres (such a point as metres
         lies in a box of centimetres next to the scene's centre; before
         2026-12-02 a route of them scored 0 m, a render showed black)."""
@@ -276,12 +357,15 @@ class Scene:
         b = self.info["bounds"]
         corners = self.local_to_lonlat(np.array([[b[0], b[1]], [b[2], b[3]]]))
         lo, hi = corners.min(axis=0), corners.max(axis=0)
+        pad = np.maximum(hi - lo, 0.001)  # a route may leave the scene a little (300 m past its edge: 2026-12-03)
+        lo, hi = lo - pad, hi + pad
         x, y = a[:, 0], a[:, 1]
         if np.all((x >= lo[0]) & (x <= hi[0]) & (y >= lo[1]) & (y <= hi[1])):
             raise ValueError(f"{what} look like lon/lat degrees within the scene ({lo[0]:.5f}..{hi[0]:.5f}, "
                              f"{lo[1]:.5f}..{hi[1]:.5f}); this API takes the scene's local metres: convert "
                              f"with Scene.lonlat_to_local")
 
+    @_engine_call
     def lonlat_to_local(self, lonlat):
         """(N, 2) lon/lat degrees -> (N, 2) local metres (SPEC §1); lon/lat scenes only."""
         a = _points(lonlat, 2, "lonlat")
@@ -289,6 +373,7 @@ class Scene:
         self._check(lib.plx_lonlat_to_local(self._e, a.shape[0], _dptr(a), _dptr(out)))
         return out
 
+    @_engine_call
     def local_to_lonlat(self, xy):
         """(N, 2) local metres -> (N, 2) lon/lat degrees."""
         a = _points(xy, 2, "xy")
@@ -297,11 +382,18 @@ class Scene:
         return out
 
     # ---- light -------------------------------------------------------------------
+    @_engine_call
     def illuminance(self, points, normals=None):
-        """Illuminance (lux) at surface points: (N, 2) ground points facing up, or
-        (N, 3) points with (N, 3) unit normals. Returns (E_direct, E_indirect),
-        two (N,) arrays; NaN for a point on no surface or with its normal into a
-        building (the others are computed)."""
+        """Illuminance (lux, SPEC §2) at points: (N, 2) ground points facing
+        up, or (N, 3) points with (N, 3) unit normals (any point in free air,
+        on the ground or on a surface). Returns (E_direct, E_indirect), two
+        (N,) arrays. E_indirect comes from the scene's photon buffers: a
+        bake's (Scene.from_bake; polarlux bake traces them); a GeoJSON scene
+        has none here, so it is 0 (said once with a RuntimeWarning).
+        NaN, with a RuntimeWarning giving the engine's reason for the first
+        such point, where a point is strictly inside a building or below the
+        ground, not finite, or its normal is not of unit length within 1e-6
+        (the others are computed)."""
         pts = np.ascontiguousarray(points, dtype=np.float64)
         if pts.ndim == 1 and pts.size in (2, 3):
             pts = pts.reshape(1, pts.size)
@@ -323,9 +415,48 @@ class Scene:
         st = lib.plx_illuminance(self._e, n, _dptr(pts), _dptr(nrm), _dptr(ed), _dptr(ei), None)
         if st not in (_lib.OK, _lib.E_RANGE):
             self._check(st)
+        if st == _lib.E_RANGE:
+            _warnings.warn(f"{lib.plx_last_error(self._e).decode('utf-8', 'replace')}: "
+                           f"{int(np.isnan(ed).sum())} of {n} points are NaN", RuntimeWarning, stacklevel=3)
+        if not self._baked and not self._said_indirect and n and self.info["lamps"]:
+            self._said_indirect = True
+            _warnings.warn("E_indirect is 0: a GeoJSON scene has no photon buffers in the Python package; "
+                           "load a bake (polarlux bake SCENE -o CITY.plxb; Scene.from_bake) for indirect light",
+                           RuntimeWarning, stacklevel=3)
         return ed, ei
 
+    @_engine_call
+    def meter(self, points, facing=None):
+        """Light meter readings in free air (SPEC §6, EN 13201's pedestrian
+        criteria), direct light, lux: (N, 3) points (a meter 1.5 m above the
+        ground is z = 1.5) and the horizontal facing direction u, (N, 2) or
+        one (2,) for every point (normalised here; None: east, +x).
+        Returns a dict of (N,) arrays: E_h (horizontal, facing up), E_v
+        (vertical, facing u), E_sc (semi-cylindrical, facing u), E_hs
+        (hemispherical). NaN, with a RuntimeWarning, for a point strictly
+        inside a building or below the ground; a zero or non-finite u raises
+        PolarluxError (PLX_E_INVALID)."""
+        pts = _points(points, 3, "points")
+        self._local(pts, "points")
+        n = pts.shape[0]
+        u = None
+        if facing is not None:
+            u = np.ascontiguousarray(facing, dtype=np.float64)
+            if u.shape == (2,):
+                u = np.tile(u, (n, 1))
+            if u.shape != (n, 2):
+                raise ValueError(f"facing must have shape (2,) or ({n}, 2), not {u.shape}")
+        out = np.empty((n, 4))
+        st = lib.plx_meter(self._e, n, _dptr(pts), _dptr(u) if u is not None else None, _dptr(out))
+        if st not in (_lib.OK, _lib.E_RANGE):
+            self._check(st)
+        if st == _lib.E_RANGE:
+            _warnings.warn(f"{lib.plx_last_error(self._e).decode('utf-8', 'replace')}: "
+                           f"{int(np.isnan(out[:, 0]).sum())} of {n} points are NaN", RuntimeWarning, stacklevel=3)
+        return {"E_h": out[:, 0].copy(), "E_v": out[:, 1].copy(), "E_sc": out[:, 2].copy(), "E_hs": out[:, 3].copy()}
+
     # ---- visibility -----------------------------------------------------------------
+    @_engine_call
     def visibility(self, x, y, dir_deg=0.0, fov_deg=360.0):
         """The exact visibility polygon from (x, y): {"area", "polygon" (M, 2),
         "visible" (K,) building indices}. Raises PolarluxError (PLX_E_RANGE)
@@ -340,14 +471,19 @@ class Scene:
             np.empty(0, dtype=np.int64)
         return {"area": v.area, "polygon": poly, "visible": vis}
 
+    @_engine_call
     def visibility_areas(self, points, dir_deg=0.0, fov_deg=360.0):
         """(N, 2) viewpoints -> (N,) visible areas in m^2 (SPEC §3); NaN where the
-        point is not free (inside a building, on a wall, outside Bounds)."""
+        point is not free (inside a building, on a wall, outside Bounds) or
+        not finite."""
         pts = _points(points, 2, "points")
         self._local(pts, "points")
         out = np.empty(pts.shape[0])
         v = _lib.padded(_lib.Visibility)
         for i, (x, y) in enumerate(pts):
+            if not (np.isfinite(x) and np.isfinite(y)):
+                out[i] = np.nan
+                continue
             st = lib.plx_visibility_get(self._e, x, y, float(dir_deg), float(fov_deg), ctypes.byref(v))
             if st == _lib.E_RANGE:
                 out[i] = np.nan
@@ -357,10 +493,17 @@ class Scene:
         return out
 
     # ---- routes --------------------------------------------------------------------
+    @_engine_call
     def route_score(self, xy, step=1.0, dark_lux=1.0):
         """How well lit is the polyline xy (N, 2): returns (total, segments):
         total a dict (length, mean, min, max, uniformity, dark_share, p_class,
-        samples, blocked_length), segments a dict of (N-1,) arrays of the same."""
+        samples, blocked_length), segments a dict of (N-1,) arrays of the same.
+        Lux are direct light on the ground, sampled every step metres (the
+        trapezoid rule; README "Routes"); dark_share is the length below
+        dark_lux. p_class is EN 13201's P class the mean and minimum meet:
+        1 .. 6 for P1 .. P6, 0 for none. Length inside buildings is
+        blocked_length and is not sampled (a route wholly inside scores
+        mean = min = 0 with samples 0)."""
         a = _points(xy, 2, "xy")
         n = a.shape[0]
         if n < 2:
@@ -376,6 +519,7 @@ class Scene:
         return tot, seg
 
     # ---- images ---------------------------------------------------------------------
+    @_engine_call
     def render(self, eye, target, fov_deg=60.0, size=(640, 480), exposure=1.0, aerial=False, glow=True,
                linear=False, aa=1, held=None, tone_curve=False, exposure_step=0):
         """A night image (SPEC §5) as an (H, W, 3) uint8 sRGB array; with
@@ -396,6 +540,11 @@ class Scene:
             raise ValueError(f"exposure must be a number or 'auto', not {exposure!r}")
         if held is not None and exposure != "auto":
             raise ValueError("held needs exposure='auto' (it holds the automatic exposure)")
+        if held is not None and not (isinstance(held, numbers.Real) and np.isfinite(held) and held > 0):
+            raise ValueError(f"held must be the last frame's exposure, a positive number, not {held!r}")
+        for name, v in (("size", size),):
+            if len(v) != 2 or any(not isinstance(k, numbers.Integral) or k < 1 for k in v):
+                raise ValueError(f"size must be (width, height) in whole pixels, not {tuple(v)!r}")
         if tone_curve and exposure == "auto":
             raise ValueError("tone_curve needs a number for exposure (automatic exposure has the curve)")
         for name, v in (("eye", eye), ("target", target)):

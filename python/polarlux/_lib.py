@@ -108,6 +108,13 @@ class MemoryReport(ctypes.Structure):
                 ("peak_total", ctypes.c_size_t)]
 
 
+class GroundImageInfo(ctypes.Structure):
+    _c_name_ = "plx_ground_image_info"
+    _fields_ = [("path", ctypes.c_char_p), ("bounds_given", ctypes.c_int), ("bounds", ctypes.c_double * 4),
+                ("width", ctypes.c_uint32), ("height", ctypes.c_uint32), ("mean_albedo", ctypes.c_double * 3),
+                ("mean_luminance", ctypes.c_double)]
+
+
 def padded(struct_type):
     """An instance of struct_type inside a 1 KiB zeroed buffer."""
     buf = ctypes.create_string_buffer(max(1024, ctypes.sizeof(struct_type)))
@@ -152,6 +159,8 @@ def _declare(lib):
                                     ctypes.c_void_p]),
         "plx_illuminance": (st, [E, ctypes.c_size_t, c_double_p, c_double_p, c_double_p, c_double_p,
                                  c_double_p]),
+        "plx_meter": (st, [E, ctypes.c_size_t, c_double_p, c_double_p, c_double_p]),
+        "plx_ground_image_get": (st, [E, ctypes.c_void_p]),
         "plx_route_score": (st, [E, c_double_p, ctypes.c_uint32, ctypes.c_double, ctypes.c_double,
                                  ctypes.c_void_p, ctypes.c_void_p]),
         "plx_render_opts_default": (None, [ctypes.c_void_p]),

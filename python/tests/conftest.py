@@ -26,3 +26,10 @@ def pytest_runtest_setup(item):
 
 
 _ABI_FAILED = pytest.StashKey[list]()
+
+
+# the package beside the tests, also when pytest runs from the repository's root
+import os  # noqa: E402
+import sys  # noqa: E402
+
+sys.path.insert(0, os.path.abspath(os.path.join(os.path.dirname(__file__), "..")))

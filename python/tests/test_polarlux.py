@@ -397,3 +397,148 @@ def test_photometry_flux_warning(tmp_path):
     (tmp_path / "l.ies").write_text("IESNA:LM-63-2002\nTILT=NONE\n1 1000 1 2 1 1 2 0 0 0\n1 1 0\n0 180\n0\n70 70\n")
     s = polarlux.Scene.from_file(str(tmp_path / "s.geojson"))
     assert not any("lumens of its lamps" in w for w in s.warnings)
+
+
+# ---- a user's pass of 2026-12-03 (threads, lifetime, warnings, meters) ----------------------------------
+
+def test_one_scene_shared_by_threads():
+    """Four threads on one Scene take turns (the engine runs one call at a
+    time): the same numbers as one thread, where it crashed Python before."""
+    import threading
+    s = polarlux.Scene.from_file(HELSINKI)
+    pts = [street_points(s, 400, k) for k in range(4)]
+    out = [None] * 4
+
+    def work(k):
+        out[k] = (s.illuminance(pts[k])[0], s.visibility_areas(pts[k][:20]),
+                  s.route_score(pts[k][:5], step=4.0)[0]["mean"])
+    with pytest.warns(RuntimeWarning):
+        threads = [threading.Thread(target=work, args=(k,)) for k in range(4)]
+        for t in threads:
+            t.start()
+        for t in threads:
+            t.join()
+    fresh = polarlux.Scene.from_file(HELSINKI)
+    for k in range(4):
+        np.testing.assert_array_equal(out[k][0], fresh.illuminance(pts[k])[0])
+        np.testing.assert_array_equal(out[k][1], fresh.visibility_areas(pts[k][:20]))
+        assert out[k][2] == fresh.route_score(pts[k][:5], step=4.0)[0]["mean"]
+
+
+def test_scene_goes_with_its_last_reference():
+    """No reference cycle: the engine's block is freed at del, not when the
+    cycle collector runs."""
+    import gc
+    import weakref
+    gc.disable()
+    try:
+        s = polarlux.Scene.from_file(TINY)
+        r = weakref.ref(s)
+        del s
+        assert r() is None
+    finally:
+        gc.enable()
+
+
+def test_nan_points_say_why():
+    s = polarlux.Scene.from_file(TINY)
+    with pytest.warns(RuntimeWarning, match=r"not a unit vector.*: 2 of 3 points are NaN"):
+        ed, _ = s.illuminance([[30, 12, 1.5]] * 3, normals=[[.707, .707, 0], [.7071068, .7071068, 0], [1, 1, 0]])
+    assert np.isnan(ed[0]) and ed[1] > 0 and np.isnan(ed[2])
+    areas = s.visibility_areas([[30, 12], [np.nan, 12]])
+    assert areas[0] > 0 and np.isnan(areas[1])
+
+
+def test_indirect_zero_is_said_once():
+    s = polarlux.Scene.from_file(TINY)
+    with pytest.warns(RuntimeWarning, match="E_indirect is 0"):
+        s.illuminance([[30, 12]])
+    import warnings
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        s.illuminance([[30, 12]])  # said once a Scene
+
+
+def test_lonlat_route_leaving_the_scene_is_refused():
+    """One vertex 300 m past the district's east edge: still lon/lat, still
+    refused (it scored length 0 with no word)."""
+    s = polarlux.Scene.from_file(HELSINKI)
+    b = s.info["bounds"]
+    east = s.local_to_lonlat([[b[2] + 300.0, 0.0]])[0]
+    ll = np.array([[24.9432847, 60.1676957], [24.9452847, 60.1676957], east])
+    with pytest.raises(ValueError, match="look like lon/lat"):
+        s.route_score(ll)
+
+
+def test_meter_matches_the_command():
+    s = polarlux.Scene.from_file(HELSINKI)
+    xy = street_points(s, 60, 5)
+    pts = np.column_stack([xy, np.full(len(xy), 1.5)])
+    u = np.column_stack([np.cos(np.arange(len(xy))), np.sin(np.arange(len(xy)))])
+    with pytest.warns(RuntimeWarning, match="inside a building"):
+        m = s.meter(pts, facing=u)
+    text = "# crs: local\n" + "".join(f"{p[0]!r} {p[1]!r} 1.5 {a!r} {b!r}\n" for p, (a, b) in zip(pts, u))
+    rc, out, _ = run_cli("meter", HELSINKI, "--points", "-", "-q", stdin=text)
+    rows = np.array([[float(v) for v in line.split()] for line in out.splitlines()])
+    assert rows.shape == (len(pts), 7)
+    got = np.column_stack([m["E_h"], m["E_v"], m["E_sc"], m["E_hs"]])
+    assert np.array_equal(np.isnan(got), np.isnan(rows[:, 3:]))
+    ok = ~np.isnan(got)
+    assert ok.sum() > 100
+    np.testing.assert_allclose(got[ok], rows[:, 3:][ok], rtol=1e-12, atol=1e-12)
+    one = s.meter(pts[~np.isnan(got[:, 0])][:1], facing=(0.0, 2.0))  # one direction for all, normalised
+    assert one["E_v"].shape == (1,)
+    with pytest.raises(polarlux.PolarluxError):
+        s.meter(pts[:1], facing=(0.0, 0.0))
+    with pytest.raises(ValueError, match="facing must have shape"):
+        s.meter(pts[:2], facing=np.zeros((3, 2)))
+
+
+def test_meter_under_a_lamp_is_spec_formula():
+    """One isotropic lamp, no buildings (SPEC §2, §6): E_h = I h / d^3 W(d/R),
+    E_v = I (u.r) / d^3 W(d/R), W(x) = (1 - x^4)^2, R = 30 m."""
+    s = polarlux.Scene('{"type":"FeatureCollection","properties":{"units":"m"},"features":[{"type":"Feature",'
+                       '"properties":{"lamp":true,"intensity":1000,"height":6},'
+                       '"geometry":{"type":"Point","coordinates":[0,0]}}]}')
+    m = s.meter([[3.0, 4.0, 1.5]], facing=(-1.0, 0.0))
+    d = np.sqrt(9 + 16 + 4.5 ** 2)
+    w = (1 - (d / 30) ** 4) ** 2
+    assert abs(m["E_h"][0] - 1000 * 4.5 / d ** 3 * w) < 1e-12
+    assert abs(m["E_v"][0] - 1000 * 3 / d ** 3 * w) < 1e-12
+
+
+def test_scene_inputs_and_lifetime_errors(tmp_path):
+    import copy
+    import json
+    import pickle
+    with open(TINY) as f:
+        as_dict = json.load(f)
+    assert polarlux.Scene(as_dict).info["buildings"] == 4
+    with pytest.raises(TypeError, match="GeoJSON text"):
+        polarlux.Scene(5)
+    with pytest.raises(ValueError, match="render_max"):
+        polarlux.Scene(as_dict, render_max=(-1, -1))
+    with pytest.raises(ValueError, match="lit_cache_bytes"):
+        polarlux.Scene(as_dict, lit_cache_bytes=-1)
+    with pytest.raises(ValueError, match="GeoJSON text"):
+        polarlux.memory_estimate(TINY)
+    s = polarlux.Scene.from_file(TINY)
+    assert repr(s) == "<polarlux.Scene: 4 buildings, 3 lamps>"
+    with pytest.raises(TypeError, match="cannot be pickled"):
+        pickle.dumps(s)
+    with pytest.raises(TypeError, match="cannot be copied"):
+        copy.copy(s)
+    with pytest.raises(ValueError, match="held must be"):
+        s.render(eye=(30, 12, 1.7), target=(50, 10, 1), size=(8, 6), exposure="auto", held=-1)
+    with pytest.raises(ValueError, match="size must be"):
+        s.render(eye=(30, 12, 1.7), target=(50, 10, 1), size=(8.5, 6))
+    s.close()
+    assert repr(s) == "<polarlux.Scene (closed)>"
+    for call in (lambda: s.illuminance([[30, 12]]), lambda: s.memory(), lambda: s.meter([[30, 12, 1.5]])):
+        with pytest.raises(ValueError, match="the Scene is closed"):
+            call()
+
+
+def test_ground_image_not_loaded_is_said():
+    s = polarlux.Scene.from_file(os.path.join(ROOT, "fixtures", "ground-image.geojson"))
+    assert any("ground image" in w and "is not loaded" in w for w in s.warnings)
