@@ -367,8 +367,14 @@ class Scene:
 
     @_engine_call
     def lonlat_to_local(self, lonlat):
-        """(N, 2) lon/lat degrees -> (N, 2) local metres (SPEC §1); lon/lat scenes only."""
+        """(N, 2) lon/lat degrees -> (N, 2) local metres (SPEC §1); lon/lat scenes only.
+        Longitudes beyond +-180 or latitudes beyond +-90 raise ValueError."""
         a = _points(lonlat, 2, "lonlat")
+        bad = (np.abs(a[:, 0]) > 180.0) | (np.abs(a[:, 1]) > 90.0)
+        if bad.any():
+            k = int(np.argmax(bad))
+            raise ValueError(f"lonlat[{k}] = ({a[k, 0]!r}, {a[k, 1]!r}) is not lon/lat degrees "
+                             "(longitude -180..180, latitude -90..90)")
         out = np.empty_like(a)
         self._check(lib.plx_lonlat_to_local(self._e, a.shape[0], _dptr(a), _dptr(out)))
         return out

@@ -468,6 +468,8 @@ def test_lonlat_route_leaving_the_scene_is_refused():
     ll = np.array([[24.9432847, 60.1676957], [24.9452847, 60.1676957], east])
     with pytest.raises(ValueError, match="look like lon/lat"):
         s.route_score(ll)
+    with pytest.raises(ValueError, match=r"lonlat\[1\] = \(200.0, 95.0\) is not lon/lat degrees"):
+        s.lonlat_to_local([[24.9, 60.1], [200, 95]])
 
 
 def test_meter_matches_the_command():

@@ -15,9 +15,12 @@ size_t jsonscan_ws(const char *text, size_t len, size_t off)
 
 size_t jsonscan_trailing(const char *text, size_t len, size_t end)
 {
+    size_t k;
     while (end < len && (text[end] == ' ' || text[end] == '\t' || text[end] == '\r' || text[end] == '\n'))
         end++;
-    return end < len && text[end] != '\0' ? end : len;
+    for (k = end; k < len && text[k] == '\0'; k++) /* NULs to the end: a C string's terminator, padding */
+        ;
+    return k < len ? end : len;
 }
 
 js_kind jsonscan_kind(const char *text, size_t off)

@@ -31,8 +31,10 @@ size_t jsonscan_ws(const char *text, size_t len, size_t off);
 
 /* After a document's value ending at end: the offset of the first byte
  * that is not JSON white space (space, tab, CR, LF), or len when there is
- * none or it is a NUL (the text ends there). Text after the value is
- * malformed: the scene loader and the command's paths refuse it alike. */
+ * none or only NUL bytes follow (a C string's terminator; a NUL with text
+ * after it is that text's start: before 2026-12-03 a NUL ended the text and
+ * what followed was ignored). Text after the value is malformed: the scene
+ * loader and the command's paths refuse it alike. */
 size_t jsonscan_trailing(const char *text, size_t len, size_t end);
 
 /* The containers open just before offset off (strings skipped): at an

@@ -470,6 +470,11 @@ int cmd_render(int argc, char **argv)
                a.aerial ? "aerial" : "street", a.cam.width, a.cam.height, prec, a.cam.eye[0], prec, a.cam.eye[1],
                a.cam.eye[2], prec, a.cam.target[0], prec, a.cam.target[1], a.cam.target[2], info.drawn, info.buildings,
                100.0 * info.drawn_fraction, t0 / 1e6, a.out);
+    if (rc == EXIT_OK && a.aerial && a.have_eye && info.shaded_pixels == 0 && !info.eye_inside &&
+        !cli_all_black(rgb8, (size_t)a.cam.width * a.cam.height * 3))
+        cli_warn("render", &a.c, "--view aerial changed nothing: --eye and --target place the camera, and the "
+                 "frame was read from the radiance atlas, the same for any view (--view aerial picks the aerial "
+                 "light map for the ground of frames shaded pixel by pixel: --per-pixel, --no-indirect)");
     if (rc == EXIT_OK) {
         cli_aa_warn("render", &a.c, &a.opts, &info);
         cli_aa_print(&a.opts, info.aa_later, (double)a.cam.width * a.cam.height, 1,

@@ -115,8 +115,8 @@ static plx_status parse_error(loader *ld, const char *at)
     return eng_fail(ld->e, PLX_E_PARSE, msg);
 }
 
-/* Checks the whole text; a value followed by anything but white space (up
- * to a NUL byte) is malformed. */
+/* Checks the whole text; a value followed by anything but white space (and
+ * NUL bytes to the end) is malformed. */
 static plx_status check_json(loader *ld)
 {
     size_t end, p = 0;

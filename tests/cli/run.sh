@@ -33,6 +33,10 @@ expect info-missing-file 1 "polarlux info: $tmp/nope.geojson: cannot open: No su
 expect info-tiny 0 "^buildings: 4 \(1 raised" -- "$bin" info fixtures/tiny.geojson
 expect info-tiny-blocks 0 "^blocks: 3 with 1 courtyards" -- "$bin" info fixtures/tiny.geojson
 expect info-tiny-lamp-warning 0 "warning: fixtures/tiny.geojson: feature 6 \(L3, line 18, column 3\): lamp is inside building 0 \(A\); left out" -- "$bin" info fixtures/tiny.geojson
+(cat fixtures/tiny.geojson; printf '\000garbage') >"$tmp/nul-text.geojson"
+expect info-nul-then-text 1 "nul-text\\.geojson: malformed JSON at byte [0-9]+ \\(line 23, column 1\\)" -- "$bin" info "$tmp/nul-text.geojson"
+(cat fixtures/tiny.geojson; printf '\000\000') >"$tmp/nul-end.geojson"
+expect info-nul-at-end 0 "^buildings: 4 " -- "$bin" info "$tmp/nul-end.geojson"
 expect info-tiny-memory 0 "^  scene +[0-9]+ bytes" -- "$bin" info fixtures/tiny.geojson
 expect info-helsinki 0 "^skipped: 4 features, 2 lamps inside buildings" -- "$bin" info fixtures/helsinki-centre.geojson
 expect info-helsinki-lonlat 0 "^coordinates: WGS84 lon/lat" -- "$bin" info fixtures/helsinki-centre.geojson
@@ -166,6 +170,9 @@ expect bake-missing-out 2 "missing -o CITY.plxb" -- "$bin" bake fixtures/tiny.ge
 expect bake-tiny 0 "^baked fixtures/eixample-4x4\.geojson into .*: [0-9]+ bytes .*engine memory in use [0-9]+ bytes" -- \
     "$bin" bake -q fixtures/eixample-4x4.geojson --frames 2 --photons 4000 --texel 2 --max-size 160x120 -o "$tmp/e.plxb"
 # a bake given as bake's SCENE: one line saying so (it read as malformed JSON)
+expect render-aerial-own-camera 0 "warning: --view aerial changed nothing: --eye and --target place the camera" -- "$bin" render "$tmp/e.plxb" --view aerial --eye 0,0,1.7 --target 30,0,1.5 --size 160x120 -o "$tmp/ra.png"
+expect render-aerial-default-camera 0 "^aerial view 160x120" -- "$bin" render "$tmp/e.plxb" --view aerial --size 160x120 -o "$tmp/ra.png"
+if grep -q "changed nothing" "$tmp/out"; then echo "FAIL render-aerial-default-camera warned"; fail=$((fail + 1)); fi
 expect bake-of-bake 2 "polarlux bake: .*e\.plxb is a bake file, not a GeoJSON scene" -- "$bin" bake "$tmp/e.plxb" -o "$tmp/ee.plxb"
 if [ ! -e "$tmp/ee.plxb" ]; then echo "ok   bake-of-bake-no-file"; pass=$((pass + 1)); else echo "FAIL bake-of-bake-no-file"; fail=$((fail + 1)); fi
 # a bake without indirect light gives images of the direct light, as
