@@ -180,6 +180,54 @@ static void scene_hash(plx_engine *e, char out[17])
     snprintf(out, 17, "%016llx", (unsigned long long)h);
 }
 
+/* A hash of the indirect light the edges were scored with, beyond its
+ * photon frames (scene_counts): the photon buffers' sizes and spacing,
+ * and the direct and indirect lux on the ground at 4 x 4 points over the
+ * scene's box (a 0.2 ms gather each, the default directions, as annotate
+ * and route use), so that bakes differing only in --photons or --texel
+ * hash apart. "0" without photon frames (direct light only). */
+#define LIGHT_SIDE 4
+static void light_hash(plx_engine *e, char out[17])
+{
+    plx_scene_info si;
+    plx_indirect_info ii;
+    double P[3 * LIGHT_SIDE * LIGHT_SIDE], N[3 * LIGHT_SIDE * LIGHT_SIDE], E[2][LIGHT_SIDE * LIGHT_SIDE], v[6];
+    uint64_t h = 14695981039346656037u;
+    int i, j, k;
+    if (plx_indirect_frames(e) == 0 || plx_scene_info_get(e, &si) != PLX_OK) {
+        snprintf(out, 17, "0");
+        return;
+    }
+    memset(&ii, 0, sizeof ii);
+    (void)plx_indirect_info_get(e, &ii);
+    v[0] = (double)ii.bytes;
+    v[1] = ii.chart_w;
+    v[2] = ii.chart_h;
+    v[3] = ii.aerial_w;
+    v[4] = ii.aerial_h;
+    v[5] = ii.aerial_texel;
+    h = fnv(h, v, sizeof v);
+    for (j = 0; j < LIGHT_SIDE; j++)
+        for (i = 0; i < LIGHT_SIDE; i++) {
+            k = j * LIGHT_SIDE + i;
+            P[3 * k] = si.bounds[0] + (si.bounds[2] - si.bounds[0]) * (i + 0.5) / LIGHT_SIDE;
+            P[3 * k + 1] = si.bounds[1] + (si.bounds[3] - si.bounds[1]) * (j + 0.5) / LIGHT_SIDE;
+            P[3 * k + 2] = 0.0;
+            N[3 * k] = N[3 * k + 1] = 0.0;
+            N[3 * k + 2] = 1.0;
+        }
+    if (plx_illuminance(e, LIGHT_SIDE * LIGHT_SIDE, P, N, E[0], E[1], NULL) == PLX_E_NOMEM) {
+        snprintf(out, 17, "nomem");
+        return;
+    }
+    for (k = 0; k < LIGHT_SIDE * LIGHT_SIDE; k++) { /* inside a building: NaN, as the same bits every time */
+        E[0][k] = isnan(E[0][k]) ? -1.0 : E[0][k];
+        E[1][k] = isnan(E[1][k]) ? -1.0 : E[1][k];
+    }
+    h = fnv(h, E, sizeof E);
+    snprintf(out, 17, "%016llx", (unsigned long long)h);
+}
+
 /* A hash of the network as routes read it: every edge in order, its
  * vertices (local metres, as projected) and its light (the -1 of no
  * meter for NaN), as 16 hex digits. annotate writes it; route compares it
@@ -230,6 +278,8 @@ cJSON *net_scores_header(const network *net, plx_engine *e)
     add_exact(h, "lamps", sc[1]);
     add_exact(h, "photon_frames", sc[2]);
     cJSON_AddStringToObject(h, "scene_hash", hash);
+    light_hash(e, hash);
+    cJSON_AddStringToObject(h, "light_hash", hash);
     edges_hash(net, hash);
     cJSON_AddStringToObject(h, "edges_hash", hash);
     return h;
@@ -301,6 +351,13 @@ static int check_header(const network *net, const cJSON *h, plx_engine *e, int *
         snprintf(err, errlen, "its edges were scored on another scene (the same counts, but the buildings' or "
                  "lamps' positions, heights, intensities, colours or photometry differ: scene_hash %s there, %s here): run "
                  "annotate again on this scene, or route over the plain street network", there, hash);
+        return -1;
+    }
+    light_hash(e, hash);
+    if ((there = hash_differs(h, "light_hash", hash)) != NULL) {
+        snprintf(err, errlen, "its edges were scored with other indirect light (the same scene and photon frames, "
+                 "but other photons a frame or atlas spacing: light_hash %s there, %s here): run annotate again "
+                 "on this bake, or route over the plain street network", there, hash);
         return -1;
     }
     if (number(h, "edges", &v) != 0 || v != net->nedges || number(h, "nodes", &want[0]) != 0 ||

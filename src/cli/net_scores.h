@@ -29,7 +29,7 @@ int net_full_class(double scored, double mean, double min, double min_ev, double
 double net_or_none(double v);
 
 #define NET_SCORES_MEMBER "polarlux_scores"
-#define NET_SCORES_VERSION 2
+#define NET_SCORES_VERSION 3 /* 3: light_hash (2026-12-03) */
 
 /* Edge i's properties as annotate writes them (weight W for cost and
  * factor); NULL when out of memory. */

@@ -65,9 +65,16 @@ sed "s|\"intensity\": 1000,|\"photometry\": \"$PWD/fixtures/photometry/street-ty
 "$bin" annotate -q "$tmp/net-detour-ies.geojson" --network fixtures/net-detour-streets.geojson -o "$tmp/ann-ies.geojson" >/dev/null 2>&1
 expect net-annotated-ies-same 0 "^best-lit" -- "$bin" route -q "$tmp/net-detour-ies.geojson" --network "$tmp/ann-ies.geojson" --from 0,0 --to 200,0
 expect net-annotated-ies-turned 1 "its edges were scored on another scene \\(the same counts, but .* photometry differ: scene_hash" -- "$bin" route -q "$tmp/net-detour-ies-turned.geojson" --network "$tmp/ann-ies.geojson" --from 0,0 --to 200,0
-sed 's/"version":2,/"version":1,/' "$tmp/ann-ies.geojson" >"$tmp/ann-v1.geojson"
-expect net-annotated-version-1 1 "polarlux_scores member is not version 2" -- "$bin" route -q "$tmp/net-detour-ies.geojson" --network "$tmp/ann-v1.geojson" --from 0,0 --to 200,0
+sed 's/"version":3,/"version":2,/' "$tmp/ann-ies.geojson" >"$tmp/ann-v1.geojson"
+expect net-annotated-version-2 1 "polarlux_scores member is not version 3" -- "$bin" route -q "$tmp/net-detour-ies.geojson" --network "$tmp/ann-v1.geojson" --from 0,0 --to 200,0
 sed 's/"mean_lux":/"mean_luxx":/' "$tmp/ann.geojson" >"$tmp/ann-edited.geojson"
+# two bakes of one scene differing only in --photons: the same counts and scene_hash, other indirect light
+"$bin" bake -q fixtures/net-detour.geojson --frames 2 --photons 3000 --max-size 64x48 -o "$tmp/nd-a.plxb" >/dev/null 2>&1
+"$bin" bake -q fixtures/net-detour.geojson --frames 2 --photons 5000 --max-size 64x48 -o "$tmp/nd-b.plxb" >/dev/null 2>&1
+"$bin" annotate -q "$tmp/nd-a.plxb" --network fixtures/net-detour-streets.geojson -o "$tmp/ann-nd-a.geojson" >/dev/null 2>&1
+expect net-annotated-bake-same 0 "^best-lit" -- "$bin" route -q "$tmp/nd-a.plxb" --network "$tmp/ann-nd-a.geojson" --from 0,0 --to 200,0
+expect net-annotated-bake-other-photons 1 "its edges were scored with other indirect light \(the same scene and photon frames, but other photons a frame or atlas spacing: light_hash [0-9a-f]{16} there, [0-9a-f]{16} here\)" -- "$bin" route -q "$tmp/nd-b.plxb" --network "$tmp/ann-nd-a.geojson" --from 0,0 --to 200,0
+expect net-annotated-light-hash-plain 0 '"light_hash":"0"' -- cat "$tmp/ann-ies.geojson"
 expect net-annotated-edited 1 "annotate's scores: feature 0: no number 'mean_lux' \(not as annotate wrote it\)" -- "$bin" route -q fixtures/net-detour.geojson --network "$tmp/ann-edited.geojson" --from 0,0 --to 200,0
 expect annotate-missing-o 2 "missing -o OUT.geojson" -- "$bin" annotate -q $net
 expect tiles-metres 1 "the scene is in local metres, with no lon/lat" -- "$bin" tiles -q fixtures/tiny.geojson --zoom 15 -o "$tmp/t"
