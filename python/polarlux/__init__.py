@@ -500,7 +500,7 @@ class Scene:
 
     # ---- routes --------------------------------------------------------------------
     @_engine_call
-    def route_score(self, xy, step=1.0, dark_lux=1.0):
+    def route_score(self, xy, step=1.0, dark_lux=1.0, facial_height=None):
         """How well lit is the polyline xy (N, 2): returns (total, segments):
         total a dict (length, mean, min, max, uniformity, dark_share, p_class,
         samples, blocked_length), segments a dict of (N-1,) arrays of the same.
@@ -509,7 +509,13 @@ class Scene:
         dark_lux. p_class is EN 13201's P class the mean and minimum meet:
         1 .. 6 for P1 .. P6, 0 for none. Length inside buildings is
         blocked_length and is not sampled (a route wholly inside scores
-        mean = min = 0 with samples 0)."""
+        mean = min = 0 with samples 0).
+        facial_height=H (1.5 for EN 13201's pedestrians): also min_ev_fw,
+        min_ev_bw, min_esc_fw, min_esc_bw (the least vertical and
+        semi-cylindrical lux H m above the line, facing along it and back;
+        NaN where a segment has no sample) and class_fr (the P class meeting
+        the facial-recognition criterion too: min E_v and min E_sc over both
+        ways; 0 for none), as polarlux route's Ev_fw .. class_fr columns."""
         a = _points(xy, 2, "xy")
         n = a.shape[0]
         if n < 2:
@@ -522,7 +528,30 @@ class Scene:
         names = [f for f, _ in _lib.RouteStats._fields_]
         tot = {f: getattr(total, f) for f in names}
         seg = {f: np.array([getattr(s, f) for s in segs]) for f in names}
+        if facial_height is not None:
+            self._facial(a, float(step), float(facial_height), tot, seg)
         return tot, seg
+
+    def _facial(self, a, step, height, tot, seg):
+        """route_score's facial_height: plx_route_facial's minima and the
+        class with the facial-recognition criterion (polarlux route's rule)."""
+        n = a.shape[0]
+        fs = np.empty((n - 1, 4))
+        ft = np.empty(4)
+        self._check(lib.plx_route_facial(self._e, _dptr(a), n, step, height, _dptr(fs), _dptr(ft)))
+        keys = ("min_ev_fw", "min_ev_bw", "min_esc_fw", "min_esc_bw")
+
+        def cls(mean, mn, samples, f):
+            ev, esc = min(f[0], f[1]), min(f[2], f[3])
+            if samples == 0 or np.isnan(ev) or np.isnan(esc):
+                return 0
+            return int(lib.plx_p_class_facial(mean, mn, ev, esc))
+        for k, key in enumerate(keys):
+            tot[key] = float(ft[k])
+            seg[key] = fs[:, k].copy()
+        tot["class_fr"] = cls(tot["mean"], tot["min"], tot["samples"], ft)
+        seg["class_fr"] = np.array([cls(seg["mean"][i], seg["min"][i], seg["samples"][i], fs[i])
+                                    for i in range(n - 1)], dtype=np.int64)
 
     # ---- images ---------------------------------------------------------------------
     @_engine_call

@@ -544,3 +544,37 @@ def test_scene_inputs_and_lifetime_errors(tmp_path):
 def test_ground_image_not_loaded_is_said():
     s = polarlux.Scene.from_file(os.path.join(ROOT, "fixtures", "ground-image.geojson"))
     assert any("ground image" in w and "is not loaded" in w for w in s.warnings)
+
+
+def test_route_facial_matches_the_command():
+    """facial_height=1.5: the Ev/Esc minima and class_fr of polarlux route's table."""
+    import json
+    s = polarlux.Scene.from_file(HELSINKI)
+    path = os.path.join(ROOT, "fixtures", "helsinki-route.geojson")
+    with open(path) as f:
+        feats = json.load(f)["features"]
+    rc, out, _ = run_cli("route", "-q", HELSINKI, "--path", path)
+    assert rc == 0
+    rows = {}
+    name = None
+    for line in out.splitlines()[1:]:
+        w = line.split()
+        if not w or not (w[0] == "all" or w[0].isdigit() or w[1] == "all"):
+            continue
+        if w[1] == "all":
+            name = w[0]
+            w = w[1:]
+        rows[(name, w[0])] = w
+    checked = 0
+    for ft in feats:
+        nm = ft["properties"].get("name")
+        xy = s.lonlat_to_local(ft["geometry"]["coordinates"])
+        tot, seg = s.route_score(xy, facial_height=1.5)
+        for key, vals in [("all", tot)] + [(str(i), {k: v[i] for k, v in seg.items()}) for i in range(len(xy) - 1)]:
+            w = rows[(nm, key)]
+            assert abs(vals["mean"] - float(w[2])) < 6e-4
+            for col, k in zip(w[8:12], ("min_ev_fw", "min_ev_bw", "min_esc_fw", "min_esc_bw")):
+                assert abs(vals[k] - float(col)) < 6e-4, (nm, key, k)
+            assert (f"P{vals['class_fr']}" if vals["class_fr"] else "-") == w[12]
+            checked += 1
+    assert checked >= 4
