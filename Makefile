@@ -62,6 +62,13 @@ SONAME = libpolarlux.so.$(VERSION_MAJOR)
 LIB_SO_REAL = $(BUILD)/libpolarlux.so.$(VERSION)
 LIB_SO = $(BUILD)/libpolarlux.so
 PORT_A = $(BUILD)/libpolarlux-port.a
+# The archives our own programs link (the command, tests, benches, fuzz
+# targets): every object as compiled, internals reachable. LIB_A and PORT_A,
+# the ones embedders link, hold one object each whose only global symbols
+# are plx_* (an application's own arena_alloc or camera_setup clashed).
+LIB_INT  = $(BUILD)/libpolarlux-internal.a
+PORT_INT = $(BUILD)/libpolarlux-port-internal.a
+OBJCOPY ?= objcopy
 BIN    = $(BUILD)/polarlux
 DEB_PACKAGES = libcjson-dev libcmocka-dev libpng-dev zlib1g-dev pkg-config python3-numpy python3-pytest libsqlite3-dev \
                libosmesa6-dev
@@ -69,9 +76,9 @@ DEB_PACKAGES = libcjson-dev libcmocka-dev libpng-dev zlib1g-dev pkg-config pytho
 .SECONDARY:
 .PHONY: all deps deps-check check-no-install man check-man demo check check-full check-build unit cli-test asan \
         valgrind bench install clean check-core-headers check-identical check-lib-split check-examples check-python \
-        check-layers check-hostile-valgrind
+        check-layers check-hostile-valgrind check-install
 
-all: $(LIB_A) $(LIB_SO) $(PORT_A) $(BIN)
+all: $(LIB_A) $(LIB_SO) $(PORT_A) $(LIB_INT) $(PORT_INT) $(BIN)
 
 # ---- dependencies ------------------------------------------------------------
 # Plain `make` never installs anything: it checks that the build's Debian
@@ -124,26 +131,42 @@ $(BUILD)/tests/%.o: tests/%.c | deps-check
 	@mkdir -p $(@D)
 	$(CC) $(CPPFLAGS) -Itests/ref $(POSIX) $(CFLAGS_ALL) -c $< -o $@
 
-$(LIB_A): $(CORE_OBJ)
+$(LIB_INT): $(CORE_OBJ)
 	@rm -f $@
 	ar rcs $@ $^
+
+$(PORT_INT): $(PORT_OBJ)
+	@rm -f $@
+	ar rcs $@ $^
+
+# One relocatable object of all the archive's objects, every global symbol
+# but plx_* made local (references between the objects are resolved by then).
+$(LIB_A): $(CORE_OBJ)
+	@rm -f $@ $@.o
+	$(CC) -r -nostdlib -o $@.o $^
+	$(OBJCOPY) --wildcard --keep-global-symbol='plx_*' $@.o
+	ar rcs $@ $@.o
+	@rm -f $@.o
 
 $(PORT_A): $(PORT_OBJ)
-	@rm -f $@
-	ar rcs $@ $^
+	@rm -f $@ $@.o
+	$(CC) -r -nostdlib -o $@.o $^
+	$(OBJCOPY) --wildcard --keep-global-symbol='plx_*' $@.o
+	ar rcs $@ $@.o
+	@rm -f $@.o
 
-$(LIB_SO_REAL): $(CORE_OBJ)
-	$(CC) -shared -Wl,-soname,$(SONAME) -o $@ $^ $(CORE_LIBS)
+$(LIB_SO_REAL): $(CORE_OBJ) src/polarlux.map
+	$(CC) -shared -Wl,-soname,$(SONAME) -Wl,--version-script=src/polarlux.map -o $@ $(CORE_OBJ) $(CORE_LIBS)
 
 $(LIB_SO): $(LIB_SO_REAL)
 	ln -sf $(notdir $(LIB_SO_REAL)) $(BUILD)/$(SONAME)
 	ln -sf $(SONAME) $@
 
-$(BIN): $(CLI_OBJ) $(PORT_A) $(LIB_A)
-	$(CC) $(CFLAGS_ALL) -o $@ $(CLI_OBJ) $(PORT_A) $(LIB_A) $(LIBS) $(CLI_LIBS)
+$(BIN): $(CLI_OBJ) $(PORT_INT) $(LIB_INT)
+	$(CC) $(CFLAGS_ALL) -o $@ $(CLI_OBJ) $(PORT_INT) $(LIB_INT) $(LIBS) $(CLI_LIBS)
 
-$(BUILD)/tests/test_%: $(BUILD)/tests/unit/test_%.o $(REF_OBJ) $(PORT_A) $(LIB_A)
-	$(CC) $(CFLAGS_ALL) -o $@ $< $(REF_OBJ) $(PORT_A) $(LIB_A) -lcmocka $(LIBS)
+$(BUILD)/tests/test_%: $(BUILD)/tests/unit/test_%.o $(REF_OBJ) $(PORT_INT) $(LIB_INT)
+	$(CC) $(CFLAGS_ALL) -o $@ $< $(REF_OBJ) $(PORT_INT) $(LIB_INT) -lcmocka $(LIBS)
 
 # Tests and benches of the command's network and tile code link those objects.
 CLI_TEST_OBJ = $(addprefix $(BUILD)/src/cli/,network.o net_scores.o route_io.o geo_out.o tiles.o mbtiles.o cmd_heatmap.o \
@@ -151,15 +174,15 @@ CLI_TEST_OBJ = $(addprefix $(BUILD)/src/cli/,network.o net_scores.o route_io.o g
                twin_engines.o)
 CLI_TESTS = $(BUILD)/tests/test_network $(BUILD)/tests/test_tiles $(BUILD)/bench/bench_network
 $(CLI_TESTS): $(CLI_TEST_OBJ)
-$(BUILD)/tests/test_network $(BUILD)/tests/test_tiles: $(BUILD)/tests/test_%: $(BUILD)/tests/unit/test_%.o $(REF_OBJ) $(PORT_A) $(LIB_A)
-	$(CC) $(CFLAGS_ALL) -o $@ $< $(CLI_TEST_OBJ) $(REF_OBJ) $(PORT_A) $(LIB_A) -lcmocka $(LIBS) $(CLI_LIBS)
-$(BUILD)/bench/bench_network: $(BUILD)/tests/bench/bench_network.o $(REF_OBJ) $(PORT_A) $(LIB_A)
+$(BUILD)/tests/test_network $(BUILD)/tests/test_tiles: $(BUILD)/tests/test_%: $(BUILD)/tests/unit/test_%.o $(REF_OBJ) $(PORT_INT) $(LIB_INT)
+	$(CC) $(CFLAGS_ALL) -o $@ $< $(CLI_TEST_OBJ) $(REF_OBJ) $(PORT_INT) $(LIB_INT) -lcmocka $(LIBS) $(CLI_LIBS)
+$(BUILD)/bench/bench_network: $(BUILD)/tests/bench/bench_network.o $(REF_OBJ) $(PORT_INT) $(LIB_INT)
 	@mkdir -p $(@D)
-	$(CC) $(CFLAGS_ALL) -o $@ $< $(CLI_TEST_OBJ) $(REF_OBJ) $(PORT_A) $(LIB_A) $(LIBS) $(CLI_LIBS)
+	$(CC) $(CFLAGS_ALL) -o $@ $< $(CLI_TEST_OBJ) $(REF_OBJ) $(PORT_INT) $(LIB_INT) $(LIBS) $(CLI_LIBS)
 
-$(BUILD)/bench/bench_%: $(BUILD)/tests/bench/bench_%.o $(REF_OBJ) $(PORT_A) $(LIB_A)
+$(BUILD)/bench/bench_%: $(BUILD)/tests/bench/bench_%.o $(REF_OBJ) $(PORT_INT) $(LIB_INT)
 	@mkdir -p $(@D)
-	$(CC) $(CFLAGS_ALL) -o $@ $< $(REF_OBJ) $(PORT_A) $(LIB_A) $(LIBS)
+	$(CC) $(CFLAGS_ALL) -o $@ $< $(REF_OBJ) $(PORT_INT) $(LIB_INT) $(LIBS)
 
 -include port/osmesa/osmesa.mk
 
@@ -204,14 +227,14 @@ demo:
 SKIP_SLOW ?= 1
 check: check-build
 	@PLX_TEST_QUICK=1 PLX_TEST_SKIP_SLOW=$(SKIP_SLOW) sh tests/run_tests.sh $(BUILD) $(TESTS)
-	@$(MAKE) --no-print-directory check-examples check-python
+	@$(MAKE) --no-print-directory check-examples check-python check-install
 
 # check-full also builds every benchmark (not run), so one that falls behind
 # the code fails here rather than in make bench
 check-full: check-build $(BENCHES)
 	@PLX_POLAR_RING_BIG=1 PLX_TEST_SKIP_SLOW= sh tests/run_tests.sh $(BUILD) $(TESTS)
 	@sh tests/cli/memory_city.sh $(BUILD)/polarlux
-	@$(MAKE) --no-print-directory check-examples check-python
+	@$(MAKE) --no-print-directory check-examples check-python check-install
 
 check-build:
 	@$(MAKE) --no-print-directory deps
@@ -292,7 +315,18 @@ unit: $(TESTS)
 # for cJSON, libpng, pthreads or stdio; libpolarlux.so needs only libm and
 # libc, and carries its SONAME.
 LIB_ALLOWED_RE = ^(sincos|_GLOBAL_OFFSET_TABLE_|__stack_chk_fail|__[a-z_]+_chk|__(asan|ubsan|sanitizer|sancov|lsan)_[A-Za-z0-9_]+|__sanitizer_cov_.*)$$
-check-lib-split: $(LIB_A) $(LIB_SO)
+check-lib-split: $(LIB_A) $(LIB_SO) $(PORT_A)
+	@for l in $(LIB_A) $(PORT_A); do \
+	  bad=$$(nm -g --defined-only $$l | awk 'NF==3{print $$3}' | grep -v '^plx_' | head -5); \
+	  [ -z "$$bad" ] || { echo "check-lib-split: $$l exports names that are not plx_*:" $$bad; exit 1; }; done; \
+	bad=$$(nm -D --defined-only $(LIB_SO_REAL) | awk 'NF==3 && $$2 != "A"{print $$3}' | grep -v '^plx_' | head -5); \
+	[ -z "$$bad" ] || { echo "check-lib-split: libpolarlux.so exports names that are not plx_*:" $$bad; exit 1; }; \
+	mkdir -p $(BUILD)/tests && \
+	$(CC) -std=c99 -Wall -Wextra -Werror $(EXTRA_CFLAGS) -Iinclude -o $(BUILD)/tests/own_names tests/embed/own_names.c $(PORT_A) $(LIB_A) \
+	  -lpng -lz -lpthread -lm && $(BUILD)/tests/own_names >/dev/null && \
+	$(CC) -std=c99 $(EXTRA_CFLAGS) -Iinclude -o $(BUILD)/tests/own_names_so tests/embed/own_names.c $(PORT_A) -L$(BUILD) -lpolarlux \
+	  -lpng -lz -lpthread -lm && LD_LIBRARY_PATH=$(BUILD) $(BUILD)/tests/own_names_so >/dev/null || \
+	  { echo "check-lib-split: an application's own arena_alloc, camera_setup, port_now_ns clash with the library"; exit 1; }
 	@t=$$(mktemp -d); \
 	nm -u $(LIB_A) | awk 'NF==2{print $$2}' | sort -u >$$t/u; \
 	nm --defined-only $(LIB_A) | awk 'NF==3{print $$3}' | sort -u >$$t/d; \
@@ -356,9 +390,21 @@ install: all
 	  > $(DESTDIR)$(PREFIX)/lib/pkgconfig/polarlux.pc
 	printf '%s\n' 'prefix=$(PREFIX)' 'libdir=$${prefix}/lib' 'includedir=$${prefix}/include' '' \
 	  'Name: polarlux-port' 'Description: polarlux POSIX port and PNG/PFM files' \
-	  'Version: $(VERSION)' 'Requires: polarlux' 'Libs: -L$${libdir} -lpolarlux-port' \
-	  'Libs.private: $(PORT_LIBS)' 'Requires.private: libpng zlib' 'Cflags: -I$${includedir}' \
+	  'Version: $(VERSION)' 'Requires: polarlux' 'Libs: -L$${libdir} -lpolarlux-port $(PORT_LIBS)' \
+	  'Cflags: -I$${includedir}' \
 	  > $(DESTDIR)$(PREFIX)/lib/pkgconfig/polarlux-port.pc
+
+# The installed tree as an embedder uses it: pkg-config's flags build and
+# run tests/embed/own_names.c against the installed port (static: its
+# libraries are in Libs, not Libs.private, which only --static prints) and
+# core (the .so).
+check-install: all
+	@t=$$(mktemp -d); \
+	$(MAKE) --no-print-directory install PREFIX=$$t >/dev/null && \
+	$(CC) -std=c99 $(EXTRA_CFLAGS) -o $$t/own tests/embed/own_names.c \
+	  $$(PKG_CONFIG_PATH=$$t/lib/pkgconfig pkg-config --cflags --libs polarlux-port) && \
+	LD_LIBRARY_PATH=$$t/lib $$t/own >/dev/null && { echo "ok   install: pkg-config polarlux-port builds and runs an embedder"; rm -rf $$t; } || \
+	{ echo "check-install: pkg-config --cflags --libs polarlux-port does not build tests/embed/own_names.c"; rm -rf $$t; exit 1; }
 
 clean:
 	rm -rf build

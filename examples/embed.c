@@ -9,7 +9,7 @@
  * libpng, no cJSON. It checks its own results and exits non-zero when
  * something is off, so `make check` runs it as a test.
  *
- *   cc embed.c -Iinclude build/libpolarlux.a -lm
+ *   cc examples/embed.c -Iinclude build/libpolarlux.a -lm     (from the repository's root)
  */
 #include <math.h>
 #include <stdio.h>

@@ -194,7 +194,8 @@ typedef struct plx_engine plx_engine;
  * its port table are copied; the port's ctx must outlive the engine.
  * plx_memory_estimate says what size a scene needs.
  * Errors: PLX_E_INVALID (mem or engine NULL, size < PLX_ENGINE_MIN_BYTES,
- * cfg's render_max_width or _height outside 0..PLX_RENDER_MAX_DIM),
+ * cfg's render_max_width or _height outside 0..PLX_RENDER_MAX_DIM, or
+ * threads outside 0..PLX_MAX_THREADS),
  * PLX_E_NOMEM (the block cannot hold the engine object after alignment).
  * Lifetime: *engine is valid until plx_engine_destroy. Threads: any (it
  * touches only the block).
@@ -582,9 +583,10 @@ plx_status plx_indirect_step(plx_engine *e, uint32_t photons, uint64_t seed);
  * for an invalid handle). Threads: engine (reads). */
 uint64_t plx_indirect_frames(const plx_engine *e);
 /* Chart resolution levels for a viewer at eye looking along dir (unit, or
- * NULL for all around) with a full cone of fov_deg (argudo2012 §3.6); blocks
- * whose level changes start again. Errors: PLX_E_NOSCENE, PLX_E_INVALID
- * (eye NULL), PLX_E_NOMEM. Creates the photon buffers on first need.
+ * NULL for all around) with a full cone of fov_deg (argudo2012 §3.6; a
+ * fov_deg <= 0 or >= 360 is all around too); blocks whose level changes
+ * start again. Errors: PLX_E_NOSCENE, PLX_E_INVALID (eye NULL or not
+ * finite, dir not finite or zero, fov_deg not finite), PLX_E_NOMEM. Creates the photon buffers on first need.
  * Threads: engine. */
 plx_status plx_indirect_set_viewer(plx_engine *e, const double eye[3], const double dir[3], double fov_deg);
 /* The sizes the photon buffers were given (README "Memory budgets"). */
@@ -610,7 +612,7 @@ plx_status plx_indirect_reset(plx_engine *e);
 /*
  * How plx_illuminance and plx_indirect_rgb (and so routes) estimate
  * E_indirect at points: final gathering over side x side stratified
- * cosine-weighted directions (default 16: 256 directions), each gathering
+ * cosine-weighted directions (default 32: 1024 directions), each gathering
  * a (E_direct + E_photons) from the first surface it meets, E_direct exact,
  * the photon buffers only for light that bounced before (README,
  * "Indirect light"); side 0: the photon buffers' own estimate at the point
@@ -1030,7 +1032,7 @@ plx_status plx_bake_save(plx_engine *e, plx_engine *twin, void *buf, size_t cap,
  * bytes a pixel, a frame of aa > 1 fails with PLX_E_NOMEM).
  * Errors (one line in err, emptied on success): PLX_E_PARSE (not a bake,
  * truncated, corrupt; bake NULL), PLX_E_UNSUPPORTED (another format
- * version, architecture or build). Threads: none (reads bake only).
+ * version, architecture or build). Threads: any (reads only bake).
  */
 plx_status plx_bake_block_size(const void *bake, size_t len, size_t *block_bytes /* OUT */, char *err,
                                size_t errlen);
@@ -1045,7 +1047,7 @@ plx_status plx_bake_block_size(const void *bake, size_t len, size_t *block_bytes
  * cfg->threads is taken as for plx_engine_create.
  * Errors as plx_bake_block_size, plus PLX_E_NOMEM (block too small) and
  * PLX_E_INVALID; err gets one line, emptied on success. Lifetime: the
- * engine lives in mem until plx_engine_destroy. Threads: none.
+ * engine lives in mem until plx_engine_destroy. Threads: any (it touches only mem and the bake).
  */
 plx_status plx_bake_load(void *mem, size_t size, const plx_config *cfg, const void *bake, size_t len,
                          plx_engine **engine /* OUT */, char *err, size_t errlen);
@@ -1073,7 +1075,7 @@ plx_status plx_bake_load(void *mem, size_t size, const plx_config *cfg, const vo
  * the image does not fit the block, so that a damaged file gets its own
  * error before the block's. No read reaches past the stored pages the
  * bitmap counts. After an error the block's contents are unspecified.
- * Threads: none.
+ * Threads: any (it touches only mem and what read gives).
  */
 typedef int (*plx_bake_read_fn)(void *user, uint64_t off, void *buf, size_t n);
 plx_status plx_bake_block_size_read(plx_bake_read_fn read, void *user, uint64_t len, void *scratch, size_t scratch_len,

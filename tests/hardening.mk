@@ -45,11 +45,11 @@ FUZZ_OPTS ?= -timeout=20 -rss_limit_mb=4096 -max_len=65536 -print_final_stats=1
 
 fuzz-build:
 	$(MAKE) BUILD=$(FUZZ_BUILD) CC=$(FUZZ_CC) OPT="-O1 -g -fno-omit-frame-pointer" \
-	  EXTRA_CFLAGS="-fsanitize=fuzzer-no-link $(FUZZ_SAN) -DPLX_DEBUG" $(FUZZ_BUILD)/libpolarlux.a $(FUZZ_BUILD)/libpolarlux-port.a
+	  EXTRA_CFLAGS="-fsanitize=fuzzer-no-link $(FUZZ_SAN) -DPLX_DEBUG" $(FUZZ_BUILD)/libpolarlux-internal.a $(FUZZ_BUILD)/libpolarlux-port-internal.a
 	@for n in $(FUZZ_NAMES); do \
 	  echo "$(FUZZ_CC) ... tests/fuzz/$$n.c -o $(FUZZ_BUILD)/$$n"; \
 	  $(FUZZ_CC) $(CPPFLAGS) $(POSIX) $(WARN) $(FPFLAGS) -O1 -g -fsanitize=fuzzer $(FUZZ_SAN) \
-	    tests/fuzz/$$n.c -o $(FUZZ_BUILD)/$$n $(FUZZ_BUILD)/libpolarlux-port.a $(FUZZ_BUILD)/libpolarlux.a $(LIBS) || exit 1; \
+	    tests/fuzz/$$n.c -o $(FUZZ_BUILD)/$$n $(FUZZ_BUILD)/libpolarlux-port-internal.a $(FUZZ_BUILD)/libpolarlux-internal.a $(LIBS) || exit 1; \
 	done
 
 fuzz_seeds = $(or $(FUZZ_SEEDS_$(1)),fixtures)
@@ -64,10 +64,10 @@ fuzz: fuzz-build
 REPLAY_BUILD = build/fuzz-replay
 fuzz-replay:
 	$(MAKE) BUILD=$(REPLAY_BUILD) OPT="-O1 -g -fno-omit-frame-pointer" \
-	  EXTRA_CFLAGS="$(FUZZ_SAN) -DPLX_DEBUG" $(REPLAY_BUILD)/libpolarlux.a $(REPLAY_BUILD)/libpolarlux-port.a
+	  EXTRA_CFLAGS="$(FUZZ_SAN) -DPLX_DEBUG" $(REPLAY_BUILD)/libpolarlux-internal.a $(REPLAY_BUILD)/libpolarlux-port-internal.a
 	@for n in $(FUZZ_NAMES); do \
 	  $(CC) $(CPPFLAGS) $(POSIX) $(WARN) $(FPFLAGS) -O1 -g $(FUZZ_SAN) tests/fuzz/$$n.c \
-	    tests/fuzz/replay_main.c -o $(REPLAY_BUILD)/$$n $(REPLAY_BUILD)/libpolarlux-port.a $(REPLAY_BUILD)/libpolarlux.a $(LIBS) || exit 1; \
+	    tests/fuzz/replay_main.c -o $(REPLAY_BUILD)/$$n $(REPLAY_BUILD)/libpolarlux-port-internal.a $(REPLAY_BUILD)/libpolarlux-internal.a $(LIBS) || exit 1; \
 	done
 	@$(foreach n,$(FUZZ_NAMES),$(REPLAY_BUILD)/$(n) $(call fuzz_seeds,$(n)) && ) \
 	echo "fuzz-replay: $(words $(FUZZ_NAMES)) targets clean"

@@ -32,8 +32,10 @@ plx_status plx_scene_info_get(plx_engine *e, plx_scene_info *out)
     const scene *s;
     uint32_t i;
     plx_status st = eng_need(e, ENG_SCENE, "plx_scene_info_get");
-    if (st != PLX_OK || !out)
-        return st != PLX_OK ? st : PLX_E_INVALID;
+    if (st != PLX_OK)
+        return st;
+    if (!out)
+        return eng_fail(e, PLX_E_INVALID, "plx_scene_info_get: out is NULL");
     s = e->sc;
     memset(out, 0, sizeof *out);
     out->buildings = s->nbld;

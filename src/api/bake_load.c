@@ -261,6 +261,9 @@ plx_status plx_bake_load(void *mem, size_t size, const plx_config *cfg, const vo
         *out = NULL;
     if (!mem || !out)
         return say(err, errlen, PLX_E_INVALID, "plx_bake_load: mem and out must not be NULL", 0, NULL, 0, NULL);
+    if (cfg && (cfg->threads < 0 || cfg->threads > PLX_MAX_THREADS))
+        return say(err, errlen, PLX_E_INVALID, "plx_bake_load: cfg->threads must be from 0 to PLX_MAX_THREADS", 0,
+                   NULL, 0, NULL);
     /* the image is written over the block from its start: a file read
      * into the block would be overwritten before it is read (and memcpy
      * of overlapping bytes is undefined) */
@@ -584,6 +587,9 @@ plx_status plx_bake_load_read(void *mem, size_t size, const plx_config *cfg, plx
     if (!mem || !out || !read)
         return say(err, errlen, PLX_E_INVALID, "plx_bake_load_read: mem, read and out must not be NULL", 0, NULL, 0,
                    NULL);
+    if (cfg && (cfg->threads < 0 || cfg->threads > PLX_MAX_THREADS))
+        return say(err, errlen, PLX_E_INVALID, "plx_bake_load_read: cfg->threads must be from 0 to PLX_MAX_THREADS",
+                   0, NULL, 0, NULL);
     if ((st = src_open(&s, read, user, len, err, errlen, h, &L)) != PLX_OK)
         return st;
     /* when the image fits, read once into it and checked as it is read

@@ -37,6 +37,13 @@ plx_status plx_indirect_set_viewer(plx_engine *e, const double eye[3], const dou
         return st;
     if (!eye)
         return eng_fail(e, PLX_E_INVALID, "plx_indirect_set_viewer: eye is NULL");
+    if (!isfinite(eye[0]) || !isfinite(eye[1]) || !isfinite(eye[2]))
+        return eng_fail(e, PLX_E_INVALID, "plx_indirect_set_viewer: the eye must be finite");
+    if (dir && (!isfinite(dir[0]) || !isfinite(dir[1]) || !isfinite(dir[2]) ||
+                !(dir[0] * dir[0] + dir[1] * dir[1] + dir[2] * dir[2] > 0.0)))
+        return eng_fail(e, PLX_E_INVALID, "plx_indirect_set_viewer: dir must be finite and not zero (NULL: all around)");
+    if (!isfinite(fov_deg))
+        return eng_fail(e, PLX_E_INVALID, "plx_indirect_set_viewer: fov_deg must be finite");
     st = photon_set_viewer(e->ph, eye, dir, fov_deg);
     e->indirect_gen++;
     if (st == PLX_E_NOMEM)
@@ -123,8 +130,10 @@ plx_status plx_indirect_refine_view(plx_engine *e, const plx_camera *cam, plx_re
 plx_status plx_indirect_info_get(plx_engine *e, plx_indirect_info *out)
 {
     const photon_sys *ps;
-    if (!eng_ok(e) || !out)
+    if (!eng_ok(e))
         return PLX_E_INVALID;
+    if (!out)
+        return eng_fail(e, PLX_E_INVALID, "plx_indirect_info_get: out is NULL");
     memset(out, 0, sizeof *out);
     if (!e->ph)
         return eng_fail(e, PLX_E_NOSCENE, "plx_indirect_info_get: no photon buffers (trace indirect light first)");
@@ -214,7 +223,7 @@ plx_status plx_indirect_select_lamps(plx_engine *e, const double box[4], double 
     uint32_t n;
     if (st != PLX_OK)
         return st;
-    if (box && !(box[0] <= box[2] && box[1] <= box[3] && margin >= 0.0 && isfinite(margin)))
+    if ((box && !(box[0] <= box[2] && box[1] <= box[3])) || !(margin >= 0.0 && isfinite(margin)))
         return eng_fail(e, PLX_E_INVALID,
                         "plx_indirect_select_lamps: the box needs x0 <= x1, y0 <= y1 and a "
                         "finite margin >= 0");

@@ -43,6 +43,13 @@ static plx_status load_text(plx_engine *e, const char *text, size_t len, const c
     arena_mark m = arena_get_mark(&e->mem);
     plx_status st;
     uint64_t t0 = eng_clock(e);
+    if (len >= 8 && memcmp(text, "PLXBAKE", 8) == 0) { /* a bake's magic (bake_file.h), NUL included */
+        strbuf b;
+        sb_init(&b, e->err, sizeof e->err);
+        sb_str(&b, name ? name : "scene");
+        sb_str(&b, ": a bake file (polarlux bake), not GeoJSON: load it with plx_bake_load or plx_bake_load_read");
+        return PLX_E_PARSE;
+    }
     st = geojson_load(e, &e->mem, text, len, name, &e->sc);
     if (st != PLX_OK) {
         arena_release(&e->mem, &m);

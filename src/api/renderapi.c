@@ -353,8 +353,10 @@ plx_status eng_need_atlas(plx_engine *e, double fine)
 
 plx_status plx_render_max_get(plx_engine *e, int32_t *w, int32_t *h)
 {
-    if (!eng_ok(e) || !w || !h)
+    if (!eng_ok(e))
         return PLX_E_INVALID;
+    if (!w || !h)
+        return eng_fail(e, PLX_E_INVALID, "plx_render_max_get: w or h is NULL");
     eng_render_max(e, w, h);
     return PLX_OK;
 }
@@ -362,8 +364,10 @@ plx_status plx_render_max_get(plx_engine *e, int32_t *w, int32_t *h)
 plx_status plx_atlas_info_get(plx_engine *e, plx_atlas_info *out)
 {
     const atlas *A;
-    if (!eng_ok(e) || !out)
+    if (!eng_ok(e))
         return PLX_E_INVALID;
+    if (!out)
+        return eng_fail(e, PLX_E_INVALID, "plx_atlas_info_get: out is NULL");
     memset(out, 0, sizeof *out);
     if (!(A = e->atlas))
         return PLX_OK;

@@ -140,7 +140,8 @@ plx_status plx_engine_create(void *mem, size_t size, const plx_config *cfg,
     /* a frame larger than any the renderer draws (it failed at the first
      * frame, "creating the renderer failed", and the estimate took it) */
     if (cfg && (cfg->render_max_width < 0 || cfg->render_max_width > PLX_RENDER_MAX_DIM ||
-                cfg->render_max_height < 0 || cfg->render_max_height > PLX_RENDER_MAX_DIM))
+                cfg->render_max_height < 0 || cfg->render_max_height > PLX_RENDER_MAX_DIM ||
+                cfg->threads < 0 || cfg->threads > PLX_MAX_THREADS))
         return PLX_E_INVALID;
     memset(&a, 0, sizeof a); /* padding too: a bake saves the engine's bytes */
     arena_init(&a, mem, size);

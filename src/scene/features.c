@@ -908,11 +908,11 @@ plx_status ld_drop_buried_lamps_from(loader *ld, uint32_t first)
                 sb_str(&b, s->bld[host].id);
                 sb_char(&b, ')');
             }
-            sb_str(&b, "; left out");
-            if (eng_strict(ld->e)) {
+            if (eng_strict(ld->e)) { /* the load fails: nothing is left out */
                 arena_release(ld->mem, &m);
                 return ld_bad_feature(ld, s->lamps[i].feature, s->lamps[i].id, why);
             }
+            sb_str(&b, "; left out");
             ld_warn(ld, s->lamps[i].feature, s->lamps[i].id, why);
             s->skipped_lamps++;
             continue;

@@ -37,6 +37,7 @@ expect info-tiny-lamp-warning 0 "warning: fixtures/tiny.geojson: feature 6 \(L3,
 expect info-nul-then-text 1 "nul-text\\.geojson: malformed JSON at byte [0-9]+ \\(line 23, column 1\\)" -- "$bin" info "$tmp/nul-text.geojson"
 (cat fixtures/tiny.geojson; printf '\000\000') >"$tmp/nul-end.geojson"
 expect info-nul-at-end 0 "^buildings: 4 " -- "$bin" info "$tmp/nul-end.geojson"
+expect info-strict-lamp-inside 1 "feature 6 \\(L3, line 18, column 3\\): lamp is inside building 0 \\(A\\)$" -- "$bin" info --strict fixtures/tiny.geojson
 expect info-tiny-memory 0 "^  scene +[0-9]+ bytes" -- "$bin" info fixtures/tiny.geojson
 expect info-helsinki 0 "^skipped: 4 features, 2 lamps inside buildings" -- "$bin" info fixtures/helsinki-centre.geojson
 expect info-helsinki-lonlat 0 "^coordinates: WGS84 lon/lat" -- "$bin" info fixtures/helsinki-centre.geojson

@@ -185,6 +185,11 @@ static void test_refusals(void **state)
     cfg.render_max_height = PLX_RENDER_MAX_DIM + 1;
     assert_int_equal(plx_engine_create(blk, sizeof blk, &cfg, &e), PLX_E_INVALID);
     cfg.render_max_height = PLX_RENDER_MAX_DIM;
+    cfg.threads = -3; /* threads outside 0 .. PLX_MAX_THREADS were taken (2026-12-03, an embedder's pass) */
+    assert_int_equal(plx_engine_create(blk, sizeof blk, &cfg, &e), PLX_E_INVALID);
+    cfg.threads = PLX_MAX_THREADS + 1;
+    assert_int_equal(plx_engine_create(blk, sizeof blk, &cfg, &e), PLX_E_INVALID);
+    cfg.threads = PLX_MAX_THREADS;
     assert_int_equal(plx_engine_create(blk, sizeof blk, &cfg, &e), PLX_OK);
     plx_engine_destroy(e);
 
@@ -256,6 +261,37 @@ static void test_refusals(void **state)
     nan_eye[0] = 0.0;
     nan_eye[2] = INFINITY;
     assert_int_equal(plx_indirect_refine(e, nan_eye, &rs), PLX_E_INVALID);
+    /* the viewer's chart levels, the lamp choice and the getters: every
+     * refusal says why (a NaN eye was taken, and NULL outs left the last
+     * call's message) */
+    {
+        double eye[3] = { 5.0, 5.0, 1.7 }, dir[3] = { 1.0, 0.0, 0.0 }, zero[3] = { 0.0, 0.0, 0.0 };
+        double box[4] = { 0.0, 0.0, 10.0, 10.0 };
+        plx_lamp lamp;
+        assert_int_equal(plx_indirect_set_viewer(e, nan_eye, dir, 60.0), PLX_E_INVALID);
+        assert_string_equal(plx_last_error(e), "plx_indirect_set_viewer: the eye must be finite");
+        assert_int_equal(plx_indirect_set_viewer(e, eye, zero, 60.0), PLX_E_INVALID);
+        assert_non_null(strstr(plx_last_error(e), "dir must be finite and not zero"));
+        assert_int_equal(plx_indirect_set_viewer(e, eye, dir, NAN), PLX_E_INVALID);
+        assert_non_null(strstr(plx_last_error(e), "fov_deg must be finite"));
+        assert_int_equal(plx_indirect_set_viewer(e, eye, dir, 60.0), PLX_OK);
+        assert_int_equal(plx_indirect_set_viewer(e, eye, NULL, 0.0), PLX_OK); /* all around */
+        assert_int_equal(plx_indirect_select_lamps(e, NULL, -1.0, NULL), PLX_E_INVALID);
+        assert_int_equal(plx_indirect_select_lamps(e, box, NAN, NULL), PLX_E_INVALID);
+        assert_int_equal(plx_lamp_get(e, 999999, &lamp), PLX_E_RANGE); /* a message to be replaced */
+        assert_int_equal(plx_scene_info_get(e, NULL), PLX_E_INVALID);
+        assert_string_equal(plx_last_error(e), "plx_scene_info_get: out is NULL");
+        assert_int_equal(plx_indirect_info_get(e, NULL), PLX_E_INVALID);
+        assert_string_equal(plx_last_error(e), "plx_indirect_info_get: out is NULL");
+        assert_int_equal(plx_atlas_info_get(e, NULL), PLX_E_INVALID);
+        assert_string_equal(plx_last_error(e), "plx_atlas_info_get: out is NULL");
+        assert_int_equal(plx_render_max_get(e, NULL, NULL), PLX_E_INVALID);
+        assert_string_equal(plx_last_error(e), "plx_render_max_get: w or h is NULL");
+        /* a bake handed to the GeoJSON loader says what it is */
+        assert_int_equal(plx_load_geojson(e, "PLXBAKE\0\1\2\3\4", 12, "city.plxb"), PLX_E_PARSE);
+        assert_string_equal(plx_last_error(e), "city.plxb: a bake file (polarlux bake), not GeoJSON: load it with "
+                                               "plx_bake_load or plx_bake_load_read");
+    }
     fixture_done(e, mem);
 }
 
