@@ -12,6 +12,12 @@ Coordinates are the scene's local metres (SPEC §1); lon/lat scenes convert
 with Scene.lonlat_to_local / local_to_lonlat. Arrays go in and come out as
 numpy arrays of float64 (images uint8 or float32). One Scene may be shared
 by threads (its calls take turns). See README "Python".
+
+Constants: USE_VISIBILITY, USE_LIGHT, USE_RENDER (memory_estimate's uses=,
+or-ed: the polar diagrams; lamp light, lit regions and routes; frames at
+the largest render size), EXPOSURE_FIXED, EXPOSURE_AUTO, EXPOSURE_ADAPT,
+EXPOSURE_TONE (the header's plx_render_opts.auto_exposure, as
+Scene.last_render reports them), BAKE_MAGIC (a bake file's first 8 bytes).
 """
 import ctypes
 import functools
@@ -132,9 +138,12 @@ def scene_size(text):
 
 
 def memory_estimate(text, uses=USE_VISIBILITY | USE_LIGHT | USE_RENDER, lit_cache_bytes=0, render_max=(0, 0)):
-    """plx_memory_estimate: the block (bytes) a scene needs for these uses."""
+    """plx_memory_estimate: the block (bytes) a scene needs for these uses:
+    text is the scene's GeoJSON (str, bytes or dict), uses an or of
+    USE_VISIBILITY, USE_LIGHT and USE_RENDER (default all three: what
+    Scene sizes its block for), lit_cache_bytes and render_max as Scene's."""
     data = _as_bytes(text)
-    if not data.lstrip()[:1] == b"{":
+    if not data.lstrip().lstrip(b"\xef\xbb\xbf").lstrip()[:1] == b"{":  # a UTF-8 byte order mark allowed
         raise ValueError("memory_estimate takes the scene's GeoJSON text, which starts with '{', not "
                          f"{data[:40]!r}: read a file first")
     sz = _lib.padded(_lib.SceneSize)
@@ -160,6 +169,15 @@ class Scene:
     PolarluxError naming it (such a lamp would give no light).
 
     text: GeoJSON as str or bytes, or a dict as json.load gives it.
+    .info: plx_scene_info as a dict: buildings, raised, blocks, courtyards,
+    holes, lamps, vertices, skipped_features, skipped_lamps,
+    overlapping_pairs, lonlat (1 when the scene is WGS84 lon/lat), lon0 and
+    lat0 (the projection's centre), bounds [x0, y0, x1, y1] (local metres),
+    height_min, height_median, height_max, ground_albedo, load_ns,
+    merged_lamps. .last_render (after render): plx_render_info: buildings,
+    drawn, drawn_fraction, shaded_pixels (0: read from a bake's radiance
+    atlas), exposure (applied), indirect_lookups, aa_later, aa_adaptive,
+    eye_inside (1: the eye is inside a building, the frame shows its walls).
     Threads: one Scene may be shared; its calls take turns (a lock), since
     one engine runs one call at a time. Separate Scenes run in parallel.
     A Scene cannot be pickled or copied (it owns an engine in its own
