@@ -68,7 +68,9 @@ PORT_A = $(BUILD)/libpolarlux-port.a
 # are plx_* (an application's own arena_alloc or camera_setup clashed).
 LIB_INT  = $(BUILD)/libpolarlux-internal.a
 PORT_INT = $(BUILD)/libpolarlux-port-internal.a
-OBJCOPY ?= objcopy
+# the target's objcopy: aarch64-linux-gnu-gcc's is aarch64-linux-gnu-objcopy
+# (the host's cannot read its objects)
+OBJCOPY ?= $(if $(filter %gcc,$(CC)),$(patsubst %gcc,%objcopy,$(CC)),objcopy)
 BIN    = $(BUILD)/polarlux
 DEB_PACKAGES = libcjson-dev libcmocka-dev libpng-dev zlib1g-dev pkg-config python3-numpy python3-pytest libsqlite3-dev \
                libosmesa6-dev
@@ -404,7 +406,7 @@ check-install: all
 	$(CC) -std=c99 $(EXTRA_CFLAGS) -o $$t/own tests/embed/own_names.c \
 	  $$(PKG_CONFIG_PATH=$$t/lib/pkgconfig pkg-config --cflags --libs polarlux-port) && \
 	LD_LIBRARY_PATH=$$t/lib $$t/own >/dev/null && { echo "ok   install: pkg-config polarlux-port builds and runs an embedder"; rm -rf $$t; } || \
-	{ echo "check-install: pkg-config --cflags --libs polarlux-port does not build tests/embed/own_names.c"; rm -rf $$t; exit 1; }
+	{ echo "check-install: make install, building tests/embed/own_names.c with pkg-config --cflags --libs polarlux-port, or running it failed"; rm -rf $$t; exit 1; }
 
 clean:
 	rm -rf build

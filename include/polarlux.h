@@ -582,8 +582,11 @@ plx_status plx_indirect_step(plx_engine *e, uint32_t photons, uint64_t seed);
 /* Frames accumulated so far (0 before the first step or after a reset, or
  * for an invalid handle). Threads: engine (reads). */
 uint64_t plx_indirect_frames(const plx_engine *e);
-/* Chart resolution levels for a viewer at eye looking along dir (unit, or
- * NULL for all around) with a full cone of fov_deg (argudo2012 §3.6; a
+/* Photons emitted by those frames, all frames together (0 as above).
+ * Threads: engine (reads). */
+uint64_t plx_indirect_photons(const plx_engine *e);
+/* Chart resolution levels for a viewer at eye looking along dir (any
+ * length, made unit here, or NULL for all around) with a full cone of fov_deg (argudo2012 §3.6; a
  * fov_deg <= 0 or >= 360 is all around too); blocks whose level changes
  * start again. Errors: PLX_E_NOSCENE, PLX_E_INVALID (eye NULL or not
  * finite, dir not finite or zero, fov_deg not finite), PLX_E_NOMEM. Creates the photon buffers on first need.

@@ -137,6 +137,15 @@ def scene_size(text):
     return {name: getattr(sz, name) for name, _ in _lib.SceneSize._fields_}
 
 
+def _estimate(data, uses, lit_cache_bytes, render_max):
+    """plx_memory_estimate of GeoJSON bytes, unchecked (Scene's sizing: the
+    load itself says what is wrong with the text)."""
+    sz = _lib.padded(_lib.SceneSize)
+    lib.plx_scene_size_scan(data, len(data), ctypes.byref(sz))
+    cfg = _config(lit_cache_bytes, render_max)
+    return int(lib.plx_memory_estimate(ctypes.byref(sz), ctypes.byref(cfg), uses))
+
+
 def memory_estimate(text, uses=USE_VISIBILITY | USE_LIGHT | USE_RENDER, lit_cache_bytes=0, render_max=(0, 0)):
     """plx_memory_estimate: the block (bytes) a scene needs for these uses:
     text is the scene's GeoJSON (str, bytes or dict), uses an or of
@@ -187,9 +196,12 @@ class Scene:
     def __init__(self, text, name="scene", mem=None, strict=False, lit_cache_bytes=0, render_max=(0, 0),
                  base_dir=None):
         data = _as_bytes(text)
+        if data[:len(BAKE_MAGIC)] == BAKE_MAGIC:
+            raise ValueError(f"{name}: a bake file (polarlux bake), not GeoJSON: load it with Scene.from_bake "
+                             "or Scene.from_file")
         self._start(strict, lit_cache_bytes, render_max)
         if mem is None:
-            mem = memory_estimate(data, USE_VISIBILITY | USE_LIGHT | USE_RENDER, lit_cache_bytes, render_max)
+            mem = _estimate(data, USE_VISIBILITY | USE_LIGHT | USE_RENDER, lit_cache_bytes, render_max)
         # np.empty: the pages are taken by the OS only when the engine touches them
         self._block = np.empty(int(mem), dtype=np.uint8)
         self._e = ctypes.c_void_p()
@@ -442,10 +454,13 @@ class Scene:
         if st == _lib.E_RANGE:
             _warnings.warn(f"{lib.plx_last_error(self._e).decode('utf-8', 'replace')}: "
                            f"{int(np.isnan(ed).sum())} of {n} points are NaN", RuntimeWarning, stacklevel=3)
-        if not self._baked and not self._said_indirect and n and self.info["lamps"]:
+        if not self._said_indirect and n and self.info["lamps"] and lib.plx_indirect_frames(self._e) == 0:
             self._said_indirect = True
-            _warnings.warn("E_indirect is 0: a GeoJSON scene has no photon buffers in the Python package; "
-                           "load a bake (polarlux bake SCENE -o CITY.plxb; Scene.from_bake) for indirect light",
+            _warnings.warn("E_indirect is 0: " + ("the bake holds no photon buffers (baked with --no-indirect or "
+                                                  "--frames 0)" if self._baked else
+                                                  "a GeoJSON scene has no photon buffers in the Python package; "
+                                                  "load a bake (polarlux bake SCENE -o CITY.plxb; Scene.from_bake)"
+                                                  " for indirect light"),
                            RuntimeWarning, stacklevel=3)
         return ed, ei
 

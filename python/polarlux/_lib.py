@@ -162,6 +162,7 @@ def _declare(lib):
         "plx_route_facial": (st, [E, c_double_p, ctypes.c_uint32, ctypes.c_double, ctypes.c_double, c_double_p,
                                   c_double_p]),
         "plx_p_class_facial": (ctypes.c_int, [ctypes.c_double, ctypes.c_double, ctypes.c_double, ctypes.c_double]),
+        "plx_indirect_frames": (ctypes.c_uint64, [E]),
         "plx_meter": (st, [E, ctypes.c_size_t, c_double_p, c_double_p, c_double_p]),
         "plx_ground_image_get": (st, [E, ctypes.c_void_p]),
         "plx_route_score": (st, [E, c_double_p, ctypes.c_uint32, ctypes.c_double, ctypes.c_double,

@@ -524,6 +524,10 @@ def test_scene_inputs_and_lifetime_errors(tmp_path):
         polarlux.Scene(as_dict, lit_cache_bytes=-1)
     with pytest.raises(ValueError, match="GeoJSON text"):
         polarlux.memory_estimate(TINY)
+    with pytest.raises(polarlux.PolarluxError, match="malformed JSON"):
+        polarlux.Scene("not json")  # the load's own message, not memory_estimate's
+    with pytest.raises(ValueError, match="a bake file .* Scene.from_bake"):
+        polarlux.Scene(polarlux.BAKE_MAGIC + b"rest")
     s = polarlux.Scene.from_file(TINY)
     assert repr(s) == "<polarlux.Scene: 4 buildings, 3 lamps>"
     with pytest.raises(TypeError, match="cannot be pickled"):

@@ -30,8 +30,16 @@ uint64_t plx_indirect_frames(const plx_engine *e)
     return e->ph->st.frames;
 }
 
+uint64_t plx_indirect_photons(const plx_engine *e)
+{
+    if (!eng_ok(e) || !e->ph)
+        return 0;
+    return e->ph->st.photons;
+}
+
 plx_status plx_indirect_set_viewer(plx_engine *e, const double eye[3], const double dir[3], double fov_deg)
 {
+    double u[3];
     plx_status st = eng_need(e, ENG_PHOTON, "plx_indirect_set_viewer");
     if (st != PLX_OK)
         return st;
@@ -44,7 +52,13 @@ plx_status plx_indirect_set_viewer(plx_engine *e, const double eye[3], const dou
         return eng_fail(e, PLX_E_INVALID, "plx_indirect_set_viewer: dir must be finite and not zero (NULL: all around)");
     if (!isfinite(fov_deg))
         return eng_fail(e, PLX_E_INVALID, "plx_indirect_set_viewer: fov_deg must be finite");
-    st = photon_set_viewer(e->ph, eye, dir, fov_deg);
+    if (dir) { /* made unit: the cone test takes a cosine */
+        double l = sqrt(dir[0] * dir[0] + dir[1] * dir[1] + dir[2] * dir[2]);
+        u[0] = dir[0] / l;
+        u[1] = dir[1] / l;
+        u[2] = dir[2] / l;
+    }
+    st = photon_set_viewer(e->ph, eye, dir ? u : NULL, fov_deg);
     e->indirect_gen++;
     if (st == PLX_E_NOMEM)
         return eng_nomem(e, "assigning chart levels");

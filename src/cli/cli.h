@@ -218,6 +218,8 @@ void cli_point_error(const char *cmd, const char *file, size_t line, const doubl
 const char *cli_dark_reason(plx_engine *e);
 /* Whether the loaded scene has lamps. */
 int cli_has_lamps(plx_engine *e);
+/* Whether the engine holds a radiance atlas (frames may be read from it). */
+int cli_atlas_made(plx_engine *e);
 /* Why a frame at cam came out entirely black (applied: its exposure): the
  * frame is drawn again into rgb8 (its buffer, written out already) at its
  * own automatic exposure; when that shows light, the fixed or held

@@ -470,7 +470,11 @@ int cmd_render(int argc, char **argv)
                a.aerial ? "aerial" : "street", a.cam.width, a.cam.height, prec, a.cam.eye[0], prec, a.cam.eye[1],
                a.cam.eye[2], prec, a.cam.target[0], prec, a.cam.target[1], a.cam.target[2], info.drawn, info.buildings,
                100.0 * info.drawn_fraction, t0 / 1e6, a.out);
-    if (rc == EXIT_OK && a.aerial && a.have_eye && info.shaded_pixels == 0 && !info.eye_inside &&
+    /* read from the radiance atlas: no pixel shaded, indirect light not off
+     * or per pixel (aerial frames shaded pixel by pixel shade none either:
+     * their ground is the aerial light map's), an atlas made */
+    if (rc == EXIT_OK && a.aerial && a.have_eye && info.shaded_pixels == 0 && !info.eye_inside && !a.ind.off &&
+        !a.opts.no_indirect && !a.opts.per_pixel && cli_atlas_made(e) &&
         !cli_all_black(rgb8, (size_t)a.cam.width * a.cam.height * 3))
         cli_warn("render", &a.c, "--view aerial changed nothing: --eye and --target place the camera, and the "
                  "frame was read from the radiance atlas, the same for any view (--view aerial picks the aerial "

@@ -852,7 +852,8 @@ static int run(const walk_args *a, plx_engine *e, const walk_path *wp, long *don
                      "move the path out of the footprints or raise it above the roofs", wr.inside, wr.n,
                      wr.first_inside, eye_text(e, wr.inside_eye, at, sizeof at));
         }
-        if (a->aerial && wr.from_atlas == wr.n && wr.atlas_lit > 0)
+        if (a->aerial && wr.from_atlas == wr.n && wr.atlas_lit > 0 && !a->ind.off && !a->opts.no_indirect &&
+            !a->opts.per_pixel && cli_atlas_made(e))
             cli_warn("walk", &a->c, "--view aerial changed nothing: the camera comes from the path, and every frame "
                      "was read from the radiance atlas, the same for any view (--view aerial picks the aerial light "
                      "map for the ground of frames shaded pixel by pixel: --per-pixel, --no-indirect)");

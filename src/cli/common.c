@@ -442,6 +442,12 @@ double cli_white_share(const uint8_t *rgb, size_t npx)
     return lit ? (double)white / (double)lit : 0.0;
 }
 
+int cli_atlas_made(plx_engine *e)
+{
+    plx_atlas_info ai;
+    return plx_atlas_info_get(e, &ai) == PLX_OK && ai.made;
+}
+
 int cli_has_lamps(plx_engine *e)
 {
     plx_scene_info si;

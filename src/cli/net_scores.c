@@ -181,19 +181,25 @@ static void scene_hash(plx_engine *e, char out[17])
 }
 
 /* A hash of the indirect light the edges were scored with, beyond its
- * photon frames (scene_counts): the photon buffers' sizes and spacing,
- * and the direct and indirect lux on the ground at 4 x 4 points over the
- * scene's box (a 0.2 ms gather each, the default directions, as annotate
- * and route use), so that bakes differing only in --photons or --texel
- * hash apart. "0" without photon frames (direct light only). */
+ * photon frames (scene_counts): the photons those frames emitted (two
+ * bakes differing only in --photons), the photon buffers' sizes and chart
+ * texels, and the direct and indirect lux on the ground at up to
+ * LIGHT_EDGES points where the scores are (the first vertex of edges
+ * spread over the network), up to LIGHT_LAMPS points 1 m east of lamps
+ * spread over the scene, and 4 x 4 points over its box: a gather each
+ * (0.2 ms), with the default directions annotate and route use. "0"
+ * without photon frames. */
 #define LIGHT_SIDE 4
-static void light_hash(plx_engine *e, char out[17])
+#define LIGHT_EDGES 16
+#define LIGHT_LAMPS 16
+#define LIGHT_POINTS (LIGHT_SIDE * LIGHT_SIDE + LIGHT_EDGES + LIGHT_LAMPS)
+static void light_hash(const network *net, plx_engine *e, char out[17])
 {
     plx_scene_info si;
     plx_indirect_info ii;
-    double P[3 * LIGHT_SIDE * LIGHT_SIDE], N[3 * LIGHT_SIDE * LIGHT_SIDE], E[2][LIGHT_SIDE * LIGHT_SIDE], v[6];
+    double P[3 * LIGHT_POINTS], N[3 * LIGHT_POINTS], E[2][LIGHT_POINTS], v[7];
     uint64_t h = 14695981039346656037u;
-    int i, j, k;
+    uint32_t i, j, k, n = 0;
     if (plx_indirect_frames(e) == 0 || plx_scene_info_get(e, &si) != PLX_OK) {
         snprintf(out, 17, "0");
         return;
@@ -206,25 +212,44 @@ static void light_hash(plx_engine *e, char out[17])
     v[3] = ii.aerial_w;
     v[4] = ii.aerial_h;
     v[5] = ii.aerial_texel;
+    v[6] = (double)plx_indirect_photons(e);
     h = fnv(h, v, sizeof v);
     for (j = 0; j < LIGHT_SIDE; j++)
-        for (i = 0; i < LIGHT_SIDE; i++) {
-            k = j * LIGHT_SIDE + i;
-            P[3 * k] = si.bounds[0] + (si.bounds[2] - si.bounds[0]) * (i + 0.5) / LIGHT_SIDE;
-            P[3 * k + 1] = si.bounds[1] + (si.bounds[3] - si.bounds[1]) * (j + 0.5) / LIGHT_SIDE;
-            P[3 * k + 2] = 0.0;
-            N[3 * k] = N[3 * k + 1] = 0.0;
-            N[3 * k + 2] = 1.0;
+        for (i = 0; i < LIGHT_SIDE; i++, n++) {
+            P[3 * n] = si.bounds[0] + (si.bounds[2] - si.bounds[0]) * (i + 0.5) / LIGHT_SIDE;
+            P[3 * n + 1] = si.bounds[1] + (si.bounds[3] - si.bounds[1]) * (j + 0.5) / LIGHT_SIDE;
         }
-    if (plx_illuminance(e, LIGHT_SIDE * LIGHT_SIDE, P, N, E[0], E[1], NULL) == PLX_E_NOMEM) {
+    for (k = 0; k < LIGHT_EDGES && k < net->nedges; k++, n++) {
+        uint32_t m = LIGHT_EDGES < net->nedges ? LIGHT_EDGES : net->nedges;
+        const net_edge *ed = &net->edges[(uint64_t)k * net->nedges / m];
+        const double *xy = net->lines.lines[ed->line].xy + 2 * ed->v0;
+        P[3 * n] = xy[0];
+        P[3 * n + 1] = xy[1];
+    }
+    for (k = 0; k < LIGHT_LAMPS && k < si.lamps; k++) {
+        plx_lamp l;
+        uint32_t m = LIGHT_LAMPS < si.lamps ? LIGHT_LAMPS : si.lamps;
+        if (plx_lamp_get(e, (uint32_t)((uint64_t)k * si.lamps / m), &l) != PLX_OK)
+            continue;
+        P[3 * n] = l.x + 1.0;
+        P[3 * n + 1] = l.y;
+        n++;
+    }
+    for (k = 0; k < n; k++) {
+        P[3 * k + 2] = 0.0;
+        N[3 * k] = N[3 * k + 1] = 0.0;
+        N[3 * k + 2] = 1.0;
+    }
+    if (plx_illuminance(e, n, P, N, E[0], E[1], NULL) == PLX_E_NOMEM) {
         snprintf(out, 17, "nomem");
         return;
     }
-    for (k = 0; k < LIGHT_SIDE * LIGHT_SIDE; k++) { /* inside a building: NaN, as the same bits every time */
+    for (k = 0; k < n; k++) { /* inside a building: NaN, as the same bits every time */
         E[0][k] = isnan(E[0][k]) ? -1.0 : E[0][k];
         E[1][k] = isnan(E[1][k]) ? -1.0 : E[1][k];
     }
-    h = fnv(h, E, sizeof E);
+    h = fnv(h, E[0], sizeof E[0][0] * n);
+    h = fnv(h, E[1], sizeof E[1][0] * n);
     snprintf(out, 17, "%016llx", (unsigned long long)h);
 }
 
@@ -278,7 +303,7 @@ cJSON *net_scores_header(const network *net, plx_engine *e)
     add_exact(h, "lamps", sc[1]);
     add_exact(h, "photon_frames", sc[2]);
     cJSON_AddStringToObject(h, "scene_hash", hash);
-    light_hash(e, hash);
+    light_hash(net, e, hash);
     cJSON_AddStringToObject(h, "light_hash", hash);
     edges_hash(net, hash);
     cJSON_AddStringToObject(h, "edges_hash", hash);
@@ -353,17 +378,17 @@ static int check_header(const network *net, const cJSON *h, plx_engine *e, int *
                  "annotate again on this scene, or route over the plain street network", there, hash);
         return -1;
     }
-    light_hash(e, hash);
-    if ((there = hash_differs(h, "light_hash", hash)) != NULL) {
-        snprintf(err, errlen, "its edges were scored with other indirect light (the same scene and photon frames, "
-                 "but other photons a frame or atlas spacing: light_hash %s there, %s here): run annotate again "
-                 "on this bake, or route over the plain street network", there, hash);
-        return -1;
-    }
     if (number(h, "edges", &v) != 0 || v != net->nedges || number(h, "nodes", &want[0]) != 0 ||
         want[0] != net->nnodes) {
         snprintf(err, errlen, "its lines join into %u edges and %u nodes, not the ones annotate wrote (an edited "
                  "file?): run annotate again", net->nedges, net->nnodes);
+        return -1;
+    }
+    light_hash(net, e, hash); /* on the same edges as annotate's (checked just above) */
+    if ((there = hash_differs(h, "light_hash", hash)) != NULL) {
+        snprintf(err, errlen, "its edges were scored with other indirect light (the same scene and photon frames, "
+                 "but other photons a frame: light_hash %s there, %s here): run annotate again on this bake, or "
+                 "route over the plain street network", there, hash);
         return -1;
     }
     return 0;

@@ -20,6 +20,7 @@ typedef struct pm_text {
     char *err;
     size_t errlen;
     int guessed_ldt;          /* read as EULUMDAT though not named *.ldt */
+    char note[200];           /* a warning of the parse itself ("" none): TILT=INCLUDE not applied */
 } pm_text;
 
 static int pm_space(char c)
@@ -58,14 +59,14 @@ static int pm_line(pm_text *t, const char **l, size_t *n)
     if (t->pos >= t->len)
         return 0;
     e = t->pos;
-    while (e < t->len && t->s[e] != '\n')
+    while (e < t->len && t->s[e] != '\n' && t->s[e] != '\r') /* LF, CRLF or a lone CR (old Mac exports) */
         e++;
     *l = t->s + t->pos;
     *n = e - t->pos;
-    if (*n > 0 && (*l)[*n - 1] == '\r')
-        (*n)--;
     t->lline = t->line;
-    t->pos = e < t->len ? e + 1 : e;
+    if (e < t->len)
+        e += t->s[e] == '\r' && e + 1 < t->len && t->s[e + 1] == '\n' ? 2 : 1;
+    t->pos = e;
     t->line++;
     return 1;
 }
@@ -127,7 +128,7 @@ static plx_status pm_next(pm_text *t, const char *what, double *v)
     char tok[48];
     strbuf m;
     while (t->pos < t->len && (pm_space(t->s[t->pos]) || t->s[t->pos] == ',' || t->s[t->pos] == '\n')) {
-        if (t->s[t->pos] == '\n')
+        if (t->s[t->pos] == '\n' || (t->s[t->pos] == '\r' && (t->pos + 1 >= t->len || t->s[t->pos + 1] != '\n')))
             t->line++;
         t->pos++;
     }
@@ -180,6 +181,7 @@ typedef struct pm_build {
     double *src_c;            /* nrows: the stored rows' C angles */
     uint32_t ng, nrows;
     double rated;             /* lm the header states (0: none): EULUMDAT the luminaire's, IES its lamps' */
+    double multiplier;        /* IES: the candela multiplier (named when the flux check warns) */
 } pm_build;
 
 static plx_status pm_alloc(pm_build *B, uint32_t ng, uint32_t nrows)
@@ -348,11 +350,70 @@ static int pm_starts(const char *l, size_t n, const char *w)
     return n >= k && memcmp(l, w, k) == 0;
 }
 
+/* Whether s[0..n) holds w. */
+static int pm_has(const char *s, size_t n, const char *w)
+{
+    size_t k = strlen(w), i;
+    for (i = 0; i + k <= n; i++)
+        if (memcmp(s + i, w, k) == 0)
+            return 1;
+    return 0;
+}
+
+/* Whether s[0..n) is w, any case (w upper case). */
+static int pm_is_ci(const char *s, size_t n, const char *w)
+{
+    size_t i;
+    if (n != strlen(w))
+        return 0;
+    for (i = 0; i < n; i++)
+        if ((s[i] >= 'a' && s[i] <= 'z' ? s[i] - 'a' + 'A' : s[i]) != w[i])
+            return 0;
+    return 1;
+}
+
+/* TILT=INCLUDE's block after the TILT line: the lamp-to-luminaire
+ * geometry, the number of tilt angles, the angles and their multiplying
+ * factors, read and checked; the factors are not applied (a lamp's tilt
+ * is the scene's), which t->note says with their range. */
+static plx_status ies_tilt_block(pm_text *t)
+{
+    double geom, count, v, lo = 0.0, hi = 0.0;
+    uint32_t k, n;
+    plx_status st;
+    strbuf b;
+    if ((st = pm_next(t, "the tilt's lamp-to-luminaire geometry", &geom)) != PLX_OK ||
+        (st = pm_next(t, "the number of tilt angles", &count)) != PLX_OK ||
+        (st = pm_count(t, "the number of tilt angles", count, t->line, 1, PHOTOMETRY_MAX_ANGLES)) != PLX_OK)
+        return st;
+    n = (uint32_t)count;
+    for (k = 0; k < n; k++)
+        if ((st = pm_next(t, "the tilt angles", &v)) != PLX_OK)
+            return st;
+    for (k = 0; k < n; k++) {
+        if ((st = pm_next(t, "the tilt factors", &v)) != PLX_OK)
+            return st;
+        if (!(v >= 0.0) || !isfinite(v))
+            return pm_fail(t, t->line, "a tilt factor is negative or not finite", NULL);
+        lo = k == 0 || v < lo ? v : lo;
+        hi = k == 0 || v > hi ? v : hi;
+    }
+    sb_init(&b, t->note, sizeof t->note);
+    sb_str(&b, "TILT=INCLUDE: its ");
+    sb_uint(&b, n);
+    sb_str(&b, " lamp-tilt factors (");
+    sb_num(&b, lo, 4);
+    sb_str(&b, " .. ");
+    sb_num(&b, hi, 4);
+    sb_str(&b, ") are not applied: the table is used as photometered");
+    return PLX_OK;
+}
+
 static plx_status parse_ies(pm_text *t, pm_build *B)
 {
     const char *l = NULL;
     size_t n = 0;
-    int v1995 = 0, first = 1, sym;
+    int blpf = 0, first = 1, sym;
     double h[13], mult;
     double *hc;
     uint32_t nv, nh, k, hline;
@@ -365,12 +426,18 @@ static plx_status parse_ies(pm_text *t, pm_build *B)
     for (;;) {
         if (!pm_line(t, &l, &n))
             return pm_fail(t, t->lline, "no TILT= line: not an IES LM-63 file", NULL);
+        if (first && n >= 3 && memcmp(l, "\xEF\xBB\xBF", 3) == 0) { /* a UTF-8 byte order mark */
+            l += 3;
+            n -= 3;
+        }
         while (n > 0 && pm_space(*l)) {
             l++;
             n--;
         }
-        if (first && pm_starts(l, n, "IESNA:LM-63-1995"))
-            v1995 = 1;
+        /* the ballast-lamp photometric factor: LM-63-1986 (no version
+         * line), -1991 and -1995; 2002 and 2019 use the field otherwise */
+        if (first)
+            blpf = !(pm_has(l, n, "LM-63-2002") || pm_has(l, n, "LM-63-2019"));
         first = 0;
         if (pm_starts(l, n, "TILT="))
             break;
@@ -383,8 +450,13 @@ static plx_status parse_ies(pm_text *t, pm_build *B)
         l++;
         n--;
     }
-    if (!(n == 4 && memcmp(l, "NONE", 4) == 0))
-        return pm_fail(t, t->lline, "unsupported tilt (only TILT=NONE is read)", NULL);
+    if (pm_is_ci(l, n, "INCLUDE")) {
+        if ((st = ies_tilt_block(t)) != PLX_OK)
+            return st;
+    } else if (!pm_is_ci(l, n, "NONE")) {
+        return pm_fail(t, t->lline, "unsupported tilt: TILT=<file> names a separate tilt file, which is not read "
+                       "(TILT=NONE and TILT=INCLUDE are)", NULL);
+    }
     for (k = 0; k < 13; k++) {
         if ((st = pm_next(t, names[k], &h[k])) != PLX_OK)
             return st;
@@ -397,11 +469,12 @@ static plx_status parse_ies(pm_text *t, pm_build *B)
         if (k == 5 && h[5] != 1.0)
             return pm_fail(t, t->line, "photometric type is not C (1): types A and B are not read", NULL);
     }
-    mult = h[2] * h[10] * (v1995 ? h[11] : 1.0);
+    mult = h[2] * h[10] * (blpf ? h[11] : 1.0);
     if (!(mult >= 0.0) || !isfinite(mult))
         return pm_fail(t, t->line, "the multipliers give a negative or infinite factor", NULL);
+    B->multiplier = h[2];
     if (h[0] > 0.0 && h[1] > 0.0) /* lumens -1: absolute photometry, no lamp flux stated */
-        B->rated = h[0] * h[1] * h[10] * (v1995 ? h[11] : 1.0);
+        B->rated = h[0] * h[1] * h[10] * (blpf ? h[11] : 1.0);
     nv = (uint32_t)h[3];
     nh = (uint32_t)h[4];
     if ((st = pm_alloc(B, nv, nh)) != PLX_OK)
@@ -530,10 +603,12 @@ static plx_status parse_ldt(pm_text *t, pm_build *B)
         return pm_fail(t, 4, "Mc must be a multiple of 4 for symmetry 4", NULL);
     if (!(cf >= 0.0))
         return pm_fail(t, 24, "the conversion factor is negative", NULL);
+    if (cf == 0.0)
+        return pm_fail(t, 24, "the conversion factor is 0: every intensity would be 0", NULL);
     if (!(fabs(flux) > 0.0))
         return pm_fail(t, 29, "the lamps' luminous flux is 0", NULL);
-    if (lor > 0.0) /* 0: not stated */
-        B->rated = lor / 100.0 * cf * fabs(flux);
+    if (lor > 0.0) /* 0: not stated; the conversion factor scales the table only (a wrong one is caught) */
+        B->rated = lor / 100.0 * fabs(flux);
     sym = isym == 0.0 ? SYM_NONE : isym == 1.0 ? SYM_ROT : isym == 2.0 ? SYM_C0 : isym == 3.0 ? SYM_C90 : SYM_QUAD;
     first = sym == SYM_C90 ? Mc / 4 : 0;
     count = sym == SYM_NONE ? Mc : sym == SYM_ROT ? 1 : sym == SYM_QUAD ? Mc / 4 + 1 : Mc / 2 + 1;
@@ -578,24 +653,40 @@ static plx_status parse_ldt(pm_text *t, pm_build *B)
  * intensities): a warning in t's err when an EULUMDAT table gives more
  * than 10% above or below its light output ratio x lamp flux, or an IES
  * table more than 10% above its lamps' lumens (no luminaire gives more
- * light than its lamps). The table is used as given either way. */
+ * light than its lamps), or when every intensity is 0; then the parse's
+ * own note (t->note), "; " between. The table is used as given. */
 static void pm_check_flux(pm_text *t, const pm_build *B, int ies)
 {
     double f = B->p->flux, r = B->rated;
+    int off = r > 0.0 && !(f <= 1.1 * r && (ies || f >= 0.9 * r));
     strbuf b;
-    if (!(r > 0.0) || !t->errlen || (f <= 1.1 * r && (ies || f >= 0.9 * r)))
+    if (!t->errlen || (!off && B->p->peak > 0.0 && !t->note[0]))
         return;
     sb_init(&b, t->err, t->errlen);
     sb_str(&b, t->name ? t->name : "photometry");
-    sb_str(&b, ": the table's intensities give ");
-    sb_fixed(&b, f, 0);
-    sb_str(&b, " lm, ");
-    sb_fixed(&b, 100.0 * f / r, 0);
-    sb_str(&b, ies ? "% of the lumens of its lamps (" : "% of the flux its header states (");
-    sb_fixed(&b, r, 0);
-    sb_str(&b, ies ? " lm: lamps x lumens per lamp x ballast factor)" :
-                     " lm: light output ratio x the lamps' flux x conversion factor)");
-    sb_str(&b, "; the table is used as given");
+    sb_str(&b, ": ");
+    if (!(B->p->peak > 0.0)) {
+        sb_str(&b, "every intensity of the table is 0: its lamps give no light");
+    } else if (off) {
+        sb_str(&b, "the table's intensities give ");
+        sb_fixed(&b, f, 0);
+        sb_str(&b, " lm, ");
+        sb_fixed(&b, 100.0 * f / r, 0);
+        sb_str(&b, ies ? "% of the lumens of its lamps (" : "% of the flux its header states (");
+        sb_fixed(&b, r, 0);
+        sb_str(&b, ies ? " lm: lamps x lumens per lamp x ballast factor" : " lm: light output ratio x the lamps' flux");
+        if (ies && B->multiplier != 1.0) {
+            sb_str(&b, "; the candela multiplier ");
+            sb_num(&b, B->multiplier, 6);
+            sb_str(&b, " scales the table");
+        }
+        sb_str(&b, "); the table is used as given");
+    }
+    if (t->note[0]) {
+        if (off || !(B->p->peak > 0.0))
+            sb_str(&b, "; ");
+        sb_str(&b, t->note);
+    }
 }
 
 
@@ -615,7 +706,7 @@ static int looks_ies(const char *s, size_t len)
             i++;
         if (len - i >= 5 && memcmp(s + i, "TILT=", 5) == 0)
             return 1;
-        while (i < len && s[i] != '\n')
+        while (i < len && s[i] != '\n' && s[i] != '\r')
             i++;
         i++;
     }

@@ -73,7 +73,15 @@ sed 's/"mean_lux":/"mean_luxx":/' "$tmp/ann.geojson" >"$tmp/ann-edited.geojson"
 "$bin" bake -q fixtures/net-detour.geojson --frames 2 --photons 5000 --max-size 64x48 -o "$tmp/nd-b.plxb" >/dev/null 2>&1
 "$bin" annotate -q "$tmp/nd-a.plxb" --network fixtures/net-detour-streets.geojson -o "$tmp/ann-nd-a.geojson" >/dev/null 2>&1
 expect net-annotated-bake-same 0 "^best-lit" -- "$bin" route -q "$tmp/nd-a.plxb" --network "$tmp/ann-nd-a.geojson" --from 0,0 --to 200,0
-expect net-annotated-bake-other-photons 1 "its edges were scored with other indirect light \(the same scene and photon frames, but other photons a frame or atlas spacing: light_hash [0-9a-f]{16} there, [0-9a-f]{16} here\)" -- "$bin" route -q "$tmp/nd-b.plxb" --network "$tmp/ann-nd-a.geojson" --from 0,0 --to 200,0
+expect net-annotated-bake-other-photons 1 "its edges were scored with other indirect light \(the same scene and photon frames, but other photons a frame: light_hash [0-9a-f]{16} there, [0-9a-f]{16} here\)" -- "$bin" route -q "$tmp/nd-b.plxb" --network "$tmp/ann-nd-a.geojson" --from 0,0 --to 200,0
+# the same with a far building stretching the scene's box: its 4 x 4 grid meets no light; the edges' points do
+# (helper-61's review: one light_hash for both)
+sed 's/^ \]$/ ,{"type":"Feature","properties":{"height":10},"geometry":{"type":"Polygon","coordinates":[[[3000,3000],[3010,3000],[3010,3010],[3000,3010],[3000,3000]]]}}]/' fixtures/net-detour.geojson >"$tmp/nd-far.geojson"
+"$bin" bake -q "$tmp/nd-far.geojson" --frames 2 --photons 3000 --max-size 64x48 -o "$tmp/nd-far-a.plxb" >/dev/null 2>&1
+"$bin" bake -q "$tmp/nd-far.geojson" --frames 2 --photons 5000 --max-size 64x48 -o "$tmp/nd-far-b.plxb" >/dev/null 2>&1
+"$bin" annotate -q "$tmp/nd-far-a.plxb" --network fixtures/net-detour-streets.geojson -o "$tmp/ann-nd-far-a.geojson" >/dev/null 2>&1
+expect net-annotated-far-bake-same 0 "^best-lit" -- "$bin" route -q "$tmp/nd-far-a.plxb" --network "$tmp/ann-nd-far-a.geojson" --from 0,0 --to 200,0
+expect net-annotated-far-bake-other-photons 1 "its edges were scored with other indirect light" -- "$bin" route -q "$tmp/nd-far-b.plxb" --network "$tmp/ann-nd-far-a.geojson" --from 0,0 --to 200,0
 expect net-annotated-light-hash-plain 0 '"light_hash":"0"' -- cat "$tmp/ann-ies.geojson"
 expect net-annotated-edited 1 "annotate's scores: feature 0: no number 'mean_lux' \(not as annotate wrote it\)" -- "$bin" route -q fixtures/net-detour.geojson --network "$tmp/ann-edited.geojson" --from 0,0 --to 200,0
 expect annotate-missing-o 2 "missing -o OUT.geojson" -- "$bin" annotate -q $net

@@ -174,6 +174,10 @@ expect bake-tiny 0 "^baked fixtures/eixample-4x4\.geojson into .*: [0-9]+ bytes 
 expect render-aerial-own-camera 0 "warning: --view aerial changed nothing: --eye and --target place the camera" -- "$bin" render "$tmp/e.plxb" --view aerial --eye 0,0,1.7 --target 30,0,1.5 --size 160x120 -o "$tmp/ra.png"
 expect render-aerial-default-camera 0 "^aerial view 160x120" -- "$bin" render "$tmp/e.plxb" --view aerial --size 160x120 -o "$tmp/ra.png"
 if grep -q "changed nothing" "$tmp/out"; then echo "FAIL render-aerial-default-camera warned"; fail=$((fail + 1)); fi
+for o in --per-pixel --no-indirect; do # shaded pixel by pixel, the ground from the aerial light map: the view changes the frame
+    expect "render-aerial-own-camera$o" 0 "^aerial view 160x120" -- "$bin" render "$tmp/e.plxb" --view aerial $o --eye 0,0,1.7 --target 30,0,1.5 --size 160x120 -o "$tmp/ra.png"
+    if grep -q "changed nothing" "$tmp/out"; then echo "FAIL render-aerial-own-camera$o warned"; fail=$((fail + 1)); fi
+done
 expect bake-of-bake 2 "polarlux bake: .*e\.plxb is a bake file, not a GeoJSON scene" -- "$bin" bake "$tmp/e.plxb" -o "$tmp/ee.plxb"
 if [ ! -e "$tmp/ee.plxb" ]; then echo "ok   bake-of-bake-no-file"; pass=$((pass + 1)); else echo "FAIL bake-of-bake-no-file"; fail=$((fail + 1)); fi
 # a bake without indirect light gives images of the direct light, as

@@ -188,7 +188,12 @@ static void test_parse_errors(void **state)
     lab b = { 0 };
     char buf[4096];
     (void)state;
-    expect_error(&b, "IESNA:LM-63-2002\nTILT=INCLUDE\n1\n", "t.ies: line 2: unsupported tilt");
+    expect_error(&b, "IESNA:LM-63-2002\nTILT=lamp.tlt\n1\n", "t.ies: line 2: unsupported tilt: TILT=<file> names a "
+                 "separate tilt file");
+    expect_error(&b, "IESNA:LM-63-2002\nTILT=INCLUDE\n1\n", "t.ies: line 3: table too short: the file ends before the "
+                 "number of tilt angles");
+    expect_error(&b, ldt(buf, sizeof buf, 1, 4, 90, "0\n90\n", 2, "1\n2\n", 0, 1000), "line 24: the conversion factor "
+                 "is 0");
     expect_error(&b, "TILT=NONE\n1 -1 1 2 1 1 2 0 0 0 1 1 0\n0 90\n0\n100 x5\n", "t.ies: line 5: bad number 'x5'");
     expect_error(&b, "TILT=NONE\n1 -1 1 3 2 1 2 0 0 0 1 1 0\n0 45 90\n0 90\n1 2 3\n4\n", "table too short");
     expect_error(&b, "TILT=NONE\n1 -1 1 2 1 2 2 0 0 0 1 1 0\n0 90\n0\n1 2\n", "line 2: photometric type is not C");
@@ -226,6 +231,39 @@ static void expect_flux_note(lab *b, const char *text, const char *note)
     }
 }
 
+/* Real files' ways (helper-62's pass of 73 vendor files): TILT=INCLUDE read
+ * and not applied, with a note; TILT=None in any case; a lone CR ends a line;
+ * the ballast-lamp factor applies unless the file is LM-63-2002 or -2019,
+ * the version line found after a byte order mark and spaces. */
+static void test_real_file_ways(void **state)
+{
+    lab b = { 0 };
+    const photometry *p;
+    (void)state;
+    p = parse(&b, "IESNA:LM-63-2002\nTILT=INCLUDE\n1\n3\n0 45 90\n1.0 0.95 0.9\n1 -1 1 2 1 1 2 0 0 0\n1 1 0\n"
+                  "0 90\n0\n100 50\n", PLX_OK);
+    expect_cd(p, 0, 0, 100);
+    assert_string_equal(b.err, "t.ies: TILT=INCLUDE: its 3 lamp-tilt factors (0.9 .. 1) are not applied: the table "
+                               "is used as photometered");
+    p = parse(&b, "IESNA:LM-63-2002\nTILT=None\n1 -1 1 2 1 1 2 0 0 0\n1 1 0\n0 90\n0\n100 50\n", PLX_OK);
+    expect_cd(p, 0, 45, 75);
+    assert_string_equal(b.err, "");
+    p = parse(&b, "IESNA:LM-63-2002\r[TEST] cr\rTILT=NONE\r1 -1 1 2 1 1 2 0 0 0\r1 1 0\r0 90\r0\r100 50\r", PLX_OK);
+    expect_cd(p, 0, 90, 50);
+    /* the ballast-lamp factor (0.9): 1995 after a byte order mark, 1991, none (1986); not 2002, 2019 */
+    p = parse(&b, "\xEF\xBB\xBFIESNA:LM-63-1995\nTILT=NONE\n1 -1 1 2 1 1 2 0 0 0\n1 0.9 0\n0 90\n0\n100 50\n", PLX_OK);
+    expect_cd(p, 0, 0, 90);
+    p = parse(&b, "IESNA91\nTILT=NONE\n1 -1 1 2 1 1 2 0 0 0\n1 0.9 0\n0 90\n0\n100 50\n", PLX_OK);
+    expect_cd(p, 0, 0, 90);
+    p = parse(&b, "TILT=NONE\n1 -1 1 2 1 1 2 0 0 0\n1 0.9 0\n0 90\n0\n100 50\n", PLX_OK);
+    expect_cd(p, 0, 0, 90);
+    p = parse(&b, "IESNA: LM-63-2002\nTILT=NONE\n1 -1 1 2 1 1 2 0 0 0\n1 0.9 0\n0 90\n0\n100 50\n", PLX_OK);
+    expect_cd(p, 0, 0, 100);
+    p = parse(&b, "IES:LM-63-2019\nTILT=NONE\n1 -1 1 2 1 1 2 0 0 0\n1 1.10001 0\n0 90\n0\n100 50\n", PLX_OK);
+    expect_cd(p, 0, 0, 100);
+    free(b.mem);
+}
+
 static void test_flux_check(void **state)
 {
     lab b = { 0 };
@@ -239,8 +277,13 @@ static void test_flux_check(void **state)
     /* 10% either way is within: 4 pi 70 = 880 lm, 4 pi 57.3 = 720 lm */
     expect_flux_note(&b, ldt(buf, sizeof buf, 1, 4, 90, "0\n180\n", 2, "70\n70\n", 1, 1000), NULL);
     expect_flux_note(&b, ldt(buf, sizeof buf, 1, 4, 90, "0\n180\n", 2, "57.3\n57.3\n", 1, 1000), NULL);
-    /* the conversion factor scales both: 2 x 4 pi 63.66 against 2 x 800 */
-    expect_flux_note(&b, ldt(buf, sizeof buf, 1, 4, 90, "0\n180\n", 2, "63.66\n63.66\n", 2, 1000), NULL);
+    /* the conversion factor scales the table, not the header's flux: a wrong one is caught (a real file's
+     * factor of 1000 gave 5,136,133 lm with no word: helper-62's pass of 73 vendor files) */
+    expect_flux_note(&b, ldt(buf, sizeof buf, 1, 4, 90, "0\n180\n", 2, "63.66\n63.66\n", 2, 1000),
+                     "1600 lm, 200% of the flux its header states (800 lm: light output ratio x the lamps' flux)");
+    /* a table of zeros */
+    expect_flux_note(&b, ldt(buf, sizeof buf, 1, 4, 90, "0\n180\n", 2, "0\n0\n", 1, 1000),
+                     "every intensity of the table is 0: its lamps give no light");
     /* a light output ratio of 0 or not a number: not stated, no check */
     ldt(buf, sizeof buf, 1, 4, 90, "0\n180\n", 2, "80\n80\n", 1, 1000);
     lor = strstr(buf, "\n100\n80\n");
@@ -252,7 +295,12 @@ static void test_flux_check(void **state)
     /* IES: 1 lamp of 1000 lm x ballast factor; only above is noted */
     snprintf(ies, sizeof ies, "IESNA:LM-63-2002\nTILT=NONE\n1 1000 1 2 1 1 2 0 0 0\n%s 1 100\n0 180\n0\n%s %s\n",
              "1", "90", "90");
-    expect_flux_note(&b, ies, "1131 lm, 113% of the lumens of its lamps (1000 lm");
+    expect_flux_note(&b, ies, "1131 lm, 113% of the lumens of its lamps (1000 lm: lamps x lumens per lamp x ballast "
+                              "factor); the table");
+    /* a candela multiplier is named: relative photometry scaled twice is the usual cause */
+    expect_flux_note(&b, "IESNA:LM-63-2002\nTILT=NONE\n1 1000 5 2 1 1 2 0 0 0\n1 1 100\n0 180\n0\n80 80\n",
+                     "5027 lm, 503% of the lumens of its lamps (1000 lm: lamps x lumens per lamp x ballast factor; the "
+                     "candela multiplier 5 scales the table); the table is used as given");
     snprintf(ies, sizeof ies, "IESNA:LM-63-2002\nTILT=NONE\n1 1000 1 2 1 1 2 0 0 0\n%s 1 100\n0 180\n0\n%s %s\n",
              "0.5", "90", "90"); /* the ballast factor scales the table and the lamps alike */
     expect_flux_note(&b, ies, "565 lm, 113% of the lumens of its lamps (500 lm");
@@ -627,6 +675,7 @@ int main(void)
         cmocka_unit_test(test_ldt_symmetries),
         cmocka_unit_test(test_parse_errors),
         cmocka_unit_test(test_flux_check),
+        cmocka_unit_test(test_real_file_ways),
         cmocka_unit_test(test_fixture_files),
         cmocka_unit_test(test_nadir_and_frame),
         cmocka_unit_test(test_semicylinder_hemisphere),
