@@ -143,19 +143,19 @@ $(PORT_INT): $(PORT_OBJ)
 
 # One relocatable object of all the archive's objects, every global symbol
 # but plx_* made local (references between the objects are resolved by then).
-$(LIB_A): $(CORE_OBJ)
+define public_archive
 	@rm -f $@ $@.o
 	$(CC) -r -nostdlib -o $@.o $^
 	$(OBJCOPY) --wildcard --keep-global-symbol='plx_*' $@.o
 	ar rcs $@ $@.o
 	@rm -f $@.o
+endef
+
+$(LIB_A): $(CORE_OBJ)
+	$(public_archive)
 
 $(PORT_A): $(PORT_OBJ)
-	@rm -f $@ $@.o
-	$(CC) -r -nostdlib -o $@.o $^
-	$(OBJCOPY) --wildcard --keep-global-symbol='plx_*' $@.o
-	ar rcs $@ $@.o
-	@rm -f $@.o
+	$(public_archive)
 
 $(LIB_SO_REAL): $(CORE_OBJ) src/polarlux.map
 	$(CC) -shared -Wl,-soname,$(SONAME) -Wl,--version-script=src/polarlux.map -o $@ $(CORE_OBJ) $(CORE_LIBS)

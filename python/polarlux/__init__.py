@@ -137,11 +137,14 @@ def scene_size(text):
     return {name: getattr(sz, name) for name, _ in _lib.SceneSize._fields_}
 
 
-def _estimate(data, uses, lit_cache_bytes, render_max):
-    """plx_memory_estimate of GeoJSON bytes, unchecked (Scene's sizing: the
-    load itself says what is wrong with the text)."""
+def _estimate(data, uses, lit_cache_bytes, render_max, scan_checked=False):
+    """plx_memory_estimate of GeoJSON bytes; the scan's failure raises only
+    when scan_checked (Scene's sizing leaves it to the load, which says
+    what is wrong with the text)."""
     sz = _lib.padded(_lib.SceneSize)
-    lib.plx_scene_size_scan(data, len(data), ctypes.byref(sz))
+    st = lib.plx_scene_size_scan(data, len(data), ctypes.byref(sz))
+    if scan_checked and st != _lib.OK:
+        _raise(st, "plx_scene_size_scan failed")
     cfg = _config(lit_cache_bytes, render_max)
     return int(lib.plx_memory_estimate(ctypes.byref(sz), ctypes.byref(cfg), uses))
 
@@ -155,12 +158,7 @@ def memory_estimate(text, uses=USE_VISIBILITY | USE_LIGHT | USE_RENDER, lit_cach
     if not data.lstrip().lstrip(b"\xef\xbb\xbf").lstrip()[:1] == b"{":  # a UTF-8 byte order mark allowed
         raise ValueError("memory_estimate takes the scene's GeoJSON text, which starts with '{', not "
                          f"{data[:40]!r}: read a file first")
-    sz = _lib.padded(_lib.SceneSize)
-    st = lib.plx_scene_size_scan(data, len(data), ctypes.byref(sz))
-    if st != _lib.OK:
-        _raise(st, "plx_scene_size_scan failed")
-    cfg = _config(lit_cache_bytes, render_max)
-    return int(lib.plx_memory_estimate(ctypes.byref(sz), ctypes.byref(cfg), uses))
+    return _estimate(data, uses, lit_cache_bytes, render_max, scan_checked=True)
 
 
 class Scene:

@@ -146,14 +146,6 @@ static int load_engine(const bake_args *a, int twin, plx_engine **e)
     return cli_load_scene("bake", a->scene, &a->c, e);
 }
 
-/* Whether the bake holds a radiance atlas (not with --no-aerial or
- * --no-indirect): the times line names it only then. */
-static int atlas_made(plx_engine *e)
-{
-    plx_atlas_info ai;
-    return plx_atlas_info_get(e, &ai) == PLX_OK && ai.made;
-}
-
 /* Whether the renderer's frame buffers (20 bytes a pixel of --max-size)
  * take an eighth of the block or more: only then does a smaller
  * --max-size free much (at 16x16 it was still offered). */
@@ -336,7 +328,7 @@ int cmd_bake(int argc, char **argv)
             snprintf(ph, sizeof ph, "photons %.0f ms (%ld x %ld)", (t2 - t1) / 1e6, a.ind.frames,
                      cli_photons(e, &a.ind));
         printf("times: load and build %.0f ms, %s, %s %.0f ms, total %.2f s\n", (t1 - t0) / 1e6, ph,
-               atlas_made(e) ? "radiance atlas, twin and save" : "twin and save", (port_now_ns() - t2) / 1e6,
+               cli_atlas_made(e) ? "radiance atlas, twin and save" /* not with --no-aerial or --no-indirect */ : "twin and save", (port_now_ns() - t2) / 1e6,
                (port_now_ns() - t0) / 1e9);
     }
     plx_engine_free(t);

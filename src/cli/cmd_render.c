@@ -423,10 +423,7 @@ int cmd_render(int argc, char **argv)
         a.opts.backend = plx_osmesa_backend(om);
     }
 #endif
-    {
-        plx_atlas_info ai;
-        had_atlas = plx_atlas_info_get(e, &ai) == PLX_OK && ai.made;
-    }
+    had_atlas = cli_atlas_made(e);
     t0 = port_now_ns();
     st = plx_render(e, &a.cam, &a.opts, rgb8, rgbf, &info);
     t0 = port_now_ns() - t0; /* the frame alone, not the PNG written after it */

@@ -536,10 +536,8 @@ static int frame(const walk_args *a, plx_engine *e, const walk_path *wp, walk_ru
         o.exposure = wr->held;
         o.exposure_step = eighths < 1.0 ? 1 : eighths > PLX_EXPOSURE_STEP_MAX ? PLX_EXPOSURE_STEP_MAX : (int)eighths;
     }
-    if (k == 0) {
-        plx_atlas_info ai;
-        had_atlas = plx_atlas_info_get(e, &ai) == PLX_OK && ai.made;
-    }
+    if (k == 0)
+        had_atlas = cli_atlas_made(e);
     t0 = port_now_ns();
     st = plx_render(e, &cam, &o, wr->rgb8, NULL, &info);
     wr->ms[k] = (port_now_ns() - t0) / 1e6;

@@ -669,8 +669,7 @@ static size_t atlas_block(size_t need)
  * light (its frames shade every pixel anyway). */
 static int bake_has_atlas(plx_engine *e)
 {
-    plx_atlas_info ai;
-    return plx_indirect_frames(e) == 0 || (plx_atlas_info_get(e, &ai) == PLX_OK && ai.made);
+    return plx_indirect_frames(e) == 0 || cli_atlas_made(e);
 }
 
 /* The block size of the bake read through in, after the whole file is

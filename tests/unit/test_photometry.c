@@ -250,17 +250,22 @@ static void test_real_file_ways(void **state)
     assert_string_equal(b.err, "");
     p = parse(&b, "IESNA:LM-63-2002\r[TEST] cr\rTILT=NONE\r1 -1 1 2 1 1 2 0 0 0\r1 1 0\r0 90\r0\r100 50\r", PLX_OK);
     expect_cd(p, 0, 90, 50);
-    /* the ballast-lamp factor (0.9): 1995 after a byte order mark, 1991, none (1986); not 2002, 2019 */
-    p = parse(&b, "\xEF\xBB\xBFIESNA:LM-63-1995\nTILT=NONE\n1 -1 1 2 1 1 2 0 0 0\n1 0.9 0\n0 90\n0\n100 50\n", PLX_OK);
-    expect_cd(p, 0, 0, 90);
-    p = parse(&b, "IESNA91\nTILT=NONE\n1 -1 1 2 1 1 2 0 0 0\n1 0.9 0\n0 90\n0\n100 50\n", PLX_OK);
-    expect_cd(p, 0, 0, 90);
-    p = parse(&b, "TILT=NONE\n1 -1 1 2 1 1 2 0 0 0\n1 0.9 0\n0 90\n0\n100 50\n", PLX_OK);
-    expect_cd(p, 0, 0, 90);
-    p = parse(&b, "IESNA: LM-63-2002\nTILT=NONE\n1 -1 1 2 1 1 2 0 0 0\n1 0.9 0\n0 90\n0\n100 50\n", PLX_OK);
-    expect_cd(p, 0, 0, 100);
-    p = parse(&b, "IES:LM-63-2019\nTILT=NONE\n1 -1 1 2 1 1 2 0 0 0\n1 1.10001 0\n0 90\n0\n100 50\n", PLX_OK);
-    expect_cd(p, 0, 0, 100);
+    /* the ballast-lamp factor (0.9; 2019's file generation type 1.10001): 1995 after a byte order mark,
+     * 1991, none (1986) apply it; 2002 and 2019 do not */
+    {
+        static const struct {
+            const char *first, *factor;
+            double nadir;
+        } v[] = { { "\xEF\xBB\xBFIESNA:LM-63-1995\n", "0.9", 90 }, { "IESNA91\n", "0.9", 90 }, { "", "0.9", 90 },
+                  { "IESNA: LM-63-2002\n", "0.9", 100 }, { "IES:LM-63-2019\n", "1.10001", 100 } };
+        char text[256];
+        size_t k;
+        for (k = 0; k < sizeof v / sizeof v[0]; k++) {
+            snprintf(text, sizeof text, "%sTILT=NONE\n1 -1 1 2 1 1 2 0 0 0\n1 %s 0\n0 90\n0\n100 50\n", v[k].first,
+                     v[k].factor);
+            expect_cd(parse(&b, text, PLX_OK), 0, 0, v[k].nadir);
+        }
+    }
     free(b.mem);
 }
 
