@@ -328,6 +328,22 @@ static plx_status pm_angles(pm_text *t, const char *what, double *v, uint32_t n,
     return PLX_OK;
 }
 
+/* An intensity as used (its multipliers applied) above PHOTOMETRY_MAX_CD,
+ * or not finite, is refused: no luminaire gives it, and the table's flux
+ * and every lux from it must stay finite. */
+static plx_status pm_bounded(pm_text *t, uint32_t line, double cd, const char *by)
+{
+    strbuf m;
+    char why[160];
+    if (cd <= PHOTOMETRY_MAX_CD)
+        return PLX_OK;
+    sb_init(&m, why, sizeof why);
+    sb_str(&m, "an intensity times ");
+    sb_str(&m, by);
+    sb_str(&m, " is above 1e12 cd: not a luminaire's");
+    return pm_fail(t, line, why, NULL);
+}
+
 static plx_status pm_candela(pm_text *t, double *cd, size_t n, double mult)
 {
     size_t i;
@@ -338,6 +354,8 @@ static plx_status pm_candela(pm_text *t, double *cd, size_t n, double mult)
         if (cd[i] < 0.0)
             return pm_fail(t, t->line, "negative candela value", NULL);
         cd[i] *= mult;
+        if ((st = pm_bounded(t, t->line, cd[i], "the candela multiplier x the ballast factors")) != PLX_OK)
+            return st;
     }
     return PLX_OK;
 }
@@ -643,6 +661,8 @@ static plx_status parse_ldt(pm_text *t, pm_build *B)
         if (v < 0.0)
             return pm_fail(t, t->lline, "negative intensity", NULL);
         B->cd[k] = v * cf * fabs(flux) / 1000.0;
+        if ((st = pm_bounded(t, t->lline, B->cd[k], "the conversion factor x the lamps' flux / 1000")) != PLX_OK)
+            return st;
     }
     return pm_complete(B, sym);
 }

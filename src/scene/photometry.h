@@ -33,6 +33,8 @@
 #include "base/scene.h"
 
 #define PHOTOMETRY_MAX_ANGLES 10000   /* per axis; more is refused */
+#define PHOTOMETRY_MAX_CD 1e12        /* an intensity above this, multipliers applied, is refused
+                                       * (the brightest searchlights are near 1e10 cd) */
 
 typedef struct photometry {
     uint32_t ng, nc, nrows;
