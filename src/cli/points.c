@@ -100,9 +100,9 @@ int points_parse(const char *name, const char *text, int need, int cols, const d
         }
         row = out->v + out->n * (size_t)cols;
         k = parse_row(t, end, row, cols, &bad);
-        if (cols == 6 && fill && k > 3 && k < 6) { /* a normal is given whole (illum's rows) */
-            snprintf(err, errlen, "%s:%zu: expected 2, 3 or 6 numbers ('x y', 'x y z' or 'x y z nx ny nz'), found %d",
-                     name, lineno, k);
+        if (fill && (k > cols || (k > 3 && k < cols))) { /* a normal or a facing is given whole, nothing after */
+            snprintf(err, errlen, "%s:%zu: expected 2, 3 or %d numbers ('x y', 'x y z' or %s), found %d", name,
+                     lineno, cols, cols == 6 ? "'x y z nx ny nz'" : "'x y z ux uy'", k);
             points_free(out);
             return -1;
         }

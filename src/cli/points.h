@@ -13,10 +13,12 @@ typedef struct points {
     char crs[64];     /* a '# crs: NAME' line's NAME ("" if none) */
 } points;
 
-/* Parses text (NUL-terminated). Each row needs at least 'need' numbers;
- * numbers past 'cols' are ignored, missing ones up to 'cols' are an error
- * unless fill is given (then they take fill[k]; with cols 6, a row of 4 or
- * 5 numbers is an error: a normal is given whole). Returns 0, or -1 with
+/* Parses text (NUL-terminated). Each row needs at least 'need' numbers.
+ * Without fill (vis), numbers past 'cols' are ignored and missing ones up
+ * to 'cols' are an error. With fill (illum, meter), missing ones take
+ * fill[k], but the numbers after the third are given whole (a normal or a
+ * facing) and none past 'cols' (a row of 4 or 5 of 6, 4 or 7 of 5, is an
+ * error). Returns 0, or -1 with
  * "NAME:LINE: why" in err. */
 int points_parse(const char *name, const char *text, int need, int cols, const double *fill,
                  points *out, char *err, size_t errlen);
