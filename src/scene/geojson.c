@@ -338,6 +338,36 @@ static plx_status height_stats(plx_engine *e, arena *a, scene *s)
     return PLX_OK;
 }
 
+/* A key the loader read that its object holds twice (ld_get): cJSON and we
+ * read the first, other readers may read the last, so the scene may not be
+ * the one its author meant. Fatal when strict, else a warning. */
+static plx_status report_duplicate(loader *ld)
+{
+    char why[ENGINE_ERR_BYTES], key[64];
+    uint32_t line, col;
+    strbuf b;
+    if (!ld->cache || ld->cache->dup == JV_NONE)
+        return PLX_OK;
+    jsonscan_line_col(ld->text, ld->len, ld->cache->dup, &line, &col);
+    ld_str(ld, ld->cache->dup, key, sizeof key);
+    sb_init(&b, why, sizeof why);
+    if (ld->name) {
+        sb_str(&b, ld->name);
+        sb_str(&b, ": ");
+    }
+    sb_str(&b, "line ");
+    sb_uint(&b, line);
+    sb_str(&b, ", column ");
+    sb_uint(&b, col);
+    sb_str(&b, ": an object holds \"");
+    sb_str(&b, key);
+    sb_str(&b, "\" twice; the first is read (as cJSON reads), where other readers may take the last");
+    if (eng_strict(ld->e))
+        return eng_fail(ld->e, PLX_E_SCENE, why);
+    eng_warn(ld->e, why);
+    return PLX_OK;
+}
+
 static plx_status load(plx_engine *e, loader *ld, scene **out)
 {
     jv features = JV_NONE;
@@ -353,6 +383,9 @@ static plx_status load(plx_engine *e, loader *ld, scene **out)
     if (st != PLX_OK)
         return st;
     st = ld_features(ld, features);
+    if (st != PLX_OK)
+        return st;
+    st = report_duplicate(ld);
     if (st != PLX_OK)
         return st;
     finish_info(s);
@@ -387,6 +420,7 @@ plx_status geojson_load(plx_engine *e, arena *a, const char *text, size_t len, c
     memset(&cache, 0, sizeof cache);
     for (i = 0; i < LD_OBJECTS; i++)
         cache.obj[i].obj = JV_NONE;
+    cache.dup = JV_NONE;
     ld.cache = &cache;
     ld.e = e;
     ld.mem = a;

@@ -243,6 +243,23 @@ static int members_more(const loader *ld, ld_members *m)
     return 1;
 }
 
+/* A second member of the key found at m->key[i], looked for among the rest
+ * (each value skipped once; the members stay cached for later lookups):
+ * the first such in the text is kept in the cache's dup. */
+static void note_duplicate(const loader *ld, ld_members *m, uint32_t i, const char *key)
+{
+    uint32_t j;
+    for (j = i + 1;; j++) {
+        if (j == m->n && !members_more(ld, m))
+            return;
+        if (jsonscan_key_is(ld->text, ld->len, m->key[j], key)) {
+            if (ld->cache->dup == JV_NONE || m->key[j] < ld->cache->dup)
+                ld->cache->dup = m->key[j];
+            return;
+        }
+    }
+}
+
 jv ld_get(const loader *ld, jv obj, const char *key)
 {
     ld_members *m;
@@ -253,8 +270,10 @@ jv ld_get(const loader *ld, jv obj, const char *key)
     for (i = 0;; i++) {
         if (i == m->n && !members_more(ld, m))
             break;
-        if (jsonscan_key_is(ld->text, ld->len, m->key[i], key))
+        if (jsonscan_key_is(ld->text, ld->len, m->key[i], key)) {
+            note_duplicate(ld, m, i, key);
             return m->val[i];
+        }
     }
     return m->done < 0 ? jsonscan_get(ld->text, ld->len, obj, key) : JV_NONE;
 }

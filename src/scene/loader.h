@@ -28,6 +28,9 @@ typedef struct ld_members {
 typedef struct ld_cache {
     ld_members obj[LD_OBJECTS];
     uint32_t turn;         /* the entry replaced next */
+    size_t dup;            /* the first key found again later in its object (a lookup's
+                            * duplicate, which cJSON and we read the first of): the
+                            * offset of the second; JV_NONE when none */
 } ld_cache;
 
 typedef struct loader {
@@ -56,7 +59,9 @@ int ld_prop_number(loader *ld, uint32_t fi, const char *id, jv props, const char
 
 /* Reading values in place (loader.c; base/jsonscan.h for the rules). */
 js_kind ld_kind(const loader *ld, jv v);
-/* The member key of object obj (JV_NONE if none or obj is no object). */
+/* The member key of object obj (JV_NONE if none or obj is no object): the
+ * first, as cJSON; a later member of the same key (in an object of at most
+ * LD_MEMBERS members) is noted in the cache's dup. */
 jv ld_get(const loader *ld, jv obj, const char *key);
 /* Children of an array or object (an object's member values), as cJSON's
  * child list: the first (JV_NONE if none), the one after child. */

@@ -37,6 +37,11 @@ expect info-tiny-lamp-warning 0 "warning: fixtures/tiny.geojson: feature 6 \(L3,
 expect info-nul-then-text 1 "nul-text\\.geojson: malformed JSON at byte [0-9]+ \\(line 23, column 1\\)" -- "$bin" info "$tmp/nul-text.geojson"
 (cat fixtures/tiny.geojson; printf '\000\000') >"$tmp/nul-end.geojson"
 expect info-nul-at-end 0 "^buildings: 4 " -- "$bin" info "$tmp/nul-end.geojson"
+# a key read twice in one object: the first is read (cJSON's way), said on stderr; fatal when strict
+printf '{"type":"FeatureCollection","properties":{"units":"m"},"features":[\n{"type":"Feature","properties":{"height":10},"geometry":{"type":"Polygon","coordinates":[[[0,0],[10,0],[10,10],[0,10],[0,0]]],"coordinates":[[[50,0],[60,0],[60,10],[50,10],[50,0]]]}}]}\n' >"$tmp/dup-key.geojson"
+expect info-duplicate-key-warns 0 "warning: .*dup-key\.geojson: line 2, column 127: an object holds \"coordinates\" twice; the first is read" -- "$bin" info "$tmp/dup-key.geojson"
+expect info-duplicate-key-first 0 "^bounds: -50\.000 -50\.000 60\.000 60\.000 " -- "$bin" info -q "$tmp/dup-key.geojson"
+expect info-duplicate-key-strict 1 "polarlux info: .*dup-key\.geojson: line 2, column 127: an object holds \"coordinates\" twice" -- "$bin" info --strict "$tmp/dup-key.geojson"
 expect info-strict-lamp-inside 1 "feature 6 \\(L3, line 18, column 3\\): lamp is inside building 0 \\(A\\)$" -- "$bin" info --strict fixtures/tiny.geojson
 expect info-tiny-memory 0 "^  scene +[0-9]+ bytes" -- "$bin" info fixtures/tiny.geojson
 expect info-helsinki 0 "^skipped: 4 features, 2 lamps inside buildings" -- "$bin" info fixtures/helsinki-centre.geojson
@@ -891,6 +896,11 @@ expect heatmap-height-for-h 0 "warning: --height is for --quantity v, sc and hs"
 expect heatmap-facing-for-hs 0 "warning: --facing is for --quantity v and sc: hemispherical" -- "$bin" heatmap fixtures/tiny.geojson --res 4 --quantity hs --facing 30 -o "$tmp/hm.png"
 expect heatmap-max-says-fixed 0 "scale 0\.1\.\.100 lx \(fixed by --max; " -- "$bin" heatmap -q fixtures/tiny.geojson --res 4 --max 100 -o "$tmp/hm.png"
 expect illum-five-numbers 1 "<stdin>:1: expected 2, 3 or 6 numbers \('x y', 'x y z' or 'x y z nx ny nz'\), found 5" -- sh -c "echo '50 10 1.5 1 0' | '$bin' illum -q --no-indirect fixtures/tiny.geojson --points -"
+# nothing after the normal or the facing, and a facing given whole: a 7th number or a lone ux was read silently
+expect illum-seven-numbers 1 "<stdin>:1: expected 2, 3 or 6 numbers \('x y', 'x y z' or 'x y z nx ny nz'\), found 7" -- sh -c "echo '50 10 1.5 0 0 1 7' | '$bin' illum -q --no-indirect fixtures/tiny.geojson --points -"
+expect meter-four-numbers 1 "<stdin>:1: expected 2, 3 or 5 numbers \('x y', 'x y z' or 'x y z ux uy'\), found 4" -- sh -c "echo '50 10 1.5 1' | '$bin' meter -q fixtures/tiny.geojson --points -"
+expect meter-six-numbers 1 "<stdin>:1: expected 2, 3 or 5 numbers .*, found 6" -- sh -c "echo '50 10 1.5 0 1 9' | '$bin' meter -q fixtures/tiny.geojson --points -"
+expect vis-extra-columns-read 0 "^50 10 [0-9.]+ [0-9]+$" -- sh -c "echo '50 10 1.5 0 0 1 7' | '$bin' vis -q fixtures/tiny.geojson --points -"
 expect illum-empty-points 2 "--points needs a file name, not an empty string" -- "$bin" illum -q fixtures/tiny.geojson --points ''
 expect tiles-empty-out 2 "-o needs a file name, not an empty string" -- "$bin" tiles -q fixtures/tiny.geojson --zoom 14 -o ''
 expect walk-collection-first-line 0 "holds 2 line features: the walk follows the first LineString \(318\.4 m\)" -- "$bin" walk $H --path fixtures/helsinki-route.geojson -o "$tmp/wcol" --size 32x24 --max-frames 2 --no-indirect --aa 1
