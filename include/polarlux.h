@@ -47,6 +47,12 @@ extern "C" {
 #define PLX_VERSION_PATCH 0
 #define PLX_VERSION_STRING "0.1.0"
 
+/* The library's own PLX_VERSION_STRING, as it was built: an application
+ * (or a binding such as the Python package, which cannot read the macros)
+ * compares it with the header it was compiled against. Lifetime: static.
+ * Threads: any. */
+const char *plx_version(void);
+
 /* One error enum for the whole library. */
 typedef enum plx_status {
     PLX_OK = 0,

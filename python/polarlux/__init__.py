@@ -33,6 +33,8 @@ import numpy as np
 from . import _lib
 from ._lib import lib
 
+__version__ = lib.plx_version().decode()  # the loaded library's version (polarlux --version's)
+
 __all__ = ["Scene", "PolarluxError", "MemoryBudgetError", "memory_estimate", "scene_size",
            "USE_VISIBILITY", "USE_LIGHT", "USE_RENDER"]
 

@@ -142,6 +142,7 @@ def _declare(lib):
     st = ctypes.c_int
     sig = {
         "plx_strerror": (ctypes.c_char_p, [st]),
+        "plx_version": (ctypes.c_char_p, []),
         "plx_config_default": (None, [ctypes.POINTER(Config)]),
         "plx_engine_create": (st, [ctypes.c_void_p, ctypes.c_size_t, ctypes.POINTER(Config),
                                    ctypes.POINTER(ctypes.c_void_p)]),

@@ -14,6 +14,14 @@ import polarlux
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "tests", "web"))
 from png_pixels import decode as decode_png  # noqa: E402
 
+# Most tests draw random points over a scene without photon buffers: the
+# package's warnings for points inside buildings and for E_indirect 0 are
+# expected there and are checked where they are the subject
+# (test_nan_points_say_why and the E_indirect tests, whose pytest.warns sees
+# them whatever this filter says).
+pytestmark = [pytest.mark.filterwarnings("ignore:point .* is inside a building:RuntimeWarning"),
+              pytest.mark.filterwarnings("ignore:E_indirect is 0:RuntimeWarning")]
+
 ROOT = os.path.abspath(os.path.join(os.path.dirname(__file__), "..", ".."))
 BIN = os.environ.get("POLARLUX_BIN", os.path.join(ROOT, "build", "polarlux"))
 TINY = os.path.join(ROOT, "fixtures", "tiny.geojson")
@@ -31,6 +39,15 @@ def street_points(scene, n, seed):
     b = scene.info["bounds"]
     rng = np.random.default_rng(seed)
     return np.column_stack([rng.uniform(b[0] + 40, b[2] - 40, n), rng.uniform(b[1] + 40, b[3] - 40, n)])
+
+
+def test_version_is_the_library_and_the_command():
+    import re
+    rc, out, _ = run_cli("--version")
+    assert rc == 0 and out == f"polarlux {polarlux.__version__}\n"
+    with open(os.path.join(ROOT, "include", "polarlux.h")) as f:
+        header = re.search(r'#define PLX_VERSION_STRING "([^"]+)"', f.read()).group(1)
+    assert polarlux.__version__ == header
 
 
 def test_load_file_and_string_agree():

@@ -19,6 +19,11 @@ static const char *const part_text[PLX_PART_COUNT] = {
     "engine", "scene", "polar", "lit", "photon", "frame", "scratch",
 };
 
+const char *plx_version(void)
+{
+    return PLX_VERSION_STRING;
+}
+
 const char *plx_strerror(plx_status s)
 {
     if ((unsigned)s >= PLX_STATUS_COUNT)
