@@ -170,6 +170,14 @@ static const corpus_case corpus[] = {
       "feature 0 (deep, line 2, column 1): property \"height\" is not a number; ignored, the default applies\n",
       1, 0, 0, 0,
       "deep|" },
+    { "duplicate-keys.geojson", PLX_OK, /* the first of each read (cJSON's), the first such key said */
+      NULL,
+      "line 2, column 54: an object holds \"height\" twice; the first is read (as cJSON reads), where other "
+      "readers may take the last",
+      "line 2, column 54: an object holds \"height\" twice; the first is read (as cJSON reads), where other "
+      "readers may take the last\n",
+      2, 0, 0, 0,
+      "A B|" },
     { "duplicate-points.geojson", PLX_OK,
       NULL,
       "feature 1 (all-same, line 3, column 1): outer ring has 1 distinct vertex (a ring needs at least 3)",
