@@ -38,51 +38,88 @@ static size_t popcount(const unsigned char *bits, size_t n)
     return c;
 }
 
-/* Checks the header h (its first min(len, BAKE_HEADER) bytes read) of a
- * file of len bytes and fills L from it. *foreign is set when the file
- * is of this format version and byte order but names other sizes or
- * another build: such a file is from another build only when its
- * checksum holds (the caller's to check, header_verdict); a damaged
- * header byte there was blamed on the build. */
-static plx_status check_header(const unsigned char *h, uint64_t len, bake_layout *L, int *foreign, char *err,
-                               size_t errlen)
+#define BAKE_MAX_PLAUSIBLE_VERSION 255u /* a version field above this is damage, not another polarlux */
+
+static uint32_t swap32(uint32_t v)
 {
-    uint64_t flen, img;
-    *foreign = 0;
-    if (!h || len < 8 || memcmp(h, BAKE_MAGIC, 8) != 0)
-        return say(err, errlen, PLX_E_PARSE, "not a polarlux bake file (no PLXBAKE magic)", 0, NULL, 0, NULL);
-    if (len < BAKE_HEADER)
-        return say(err, errlen, PLX_E_PARSE, "truncated bake file: ", len, " bytes, shorter than its ",
-                   BAKE_HEADER, "-byte header");
-    if (bake_get32(h + H_VERSION) != BAKE_VERSION)
-        return say(err, errlen, PLX_E_UNSUPPORTED, "bake format version ", bake_get32(h + H_VERSION),
-                   ", this polarlux reads version ", BAKE_VERSION, "; bake the scene again");
-    /* (not for another byte order: its checksum, summed in that order,
-     * cannot be checked here) */
-    *foreign = bake_get32(h + H_ENDIAN) == BAKE_ENDIAN &&
-               (bake_get32(h + H_SIZES) != bake_arch_sizes() || bake_get32(h + H_LAYOUT) != bake_layout_print());
-    if (bake_get32(h + H_ENDIAN) != BAKE_ENDIAN || bake_get32(h + H_SIZES) != bake_arch_sizes())
-        return say(err, errlen, PLX_E_UNSUPPORTED,
-                   "bake made on another architecture (byte order or pointer, size_t, double, long sizes "
-                   "differ); bake the scene again on this machine", 0, NULL, 0, NULL);
-    if (bake_get32(h + H_LAYOUT) != bake_layout_print())
-        return say(err, errlen, PLX_E_UNSUPPORTED,
-                   "bake made by a different build of polarlux (its structures differ); bake the scene again",
-                   0, NULL, 0, NULL);
-    flen = bake_get64(h + H_LENGTH);
-    if (flen != len)
-        return say(err, errlen, PLX_E_PARSE, flen > len ? "truncated bake file: " : "bake file too long: ",
-                   len, " bytes, the header says ", flen, "");
-    img = bake_get64(h + H_IMAGE);
+    return (v >> 24) | ((v >> 8) & 0xff00u) | ((v << 8) & 0xff0000u) | (v << 24);
+}
+
+/* The layout the header's fields other than the length describe, checked
+ * against a file of len bytes; 0 when they are not consistent. */
+static int layout_of(const unsigned char *h, uint64_t len, bake_layout *L)
+{
+    uint64_t img = bake_get64(h + H_IMAGE);
     L->image = (size_t)img;
     L->nrel = (size_t)bake_get64(h + H_NREL);
     L->pages_present = (size_t)bake_get64(h + H_PAGES);
     if (img < sizeof(struct plx_engine) || img > ((uint64_t)1 << 34) || bake_get64(h + H_NREL) > len / 4 ||
         bake_get64(h + H_PAGES) > len / BAKE_PAGE || bake_get64(h + H_BASEMOD) >= BAKE_ALIGN ||
         bake_get64(h + H_BASEMOD) % PLX_ENGINE_ALIGN != 0)
-        return say(err, errlen, PLX_E_PARSE, "corrupt bake file: inconsistent header", 0, NULL, 0, NULL);
+        return 0;
     bake_layout_fill(L);
-    if (L->total != len || L->pages_present > L->npages)
+    return L->total == len && L->pages_present <= L->npages;
+}
+
+/* The version and byte-order fields: another polarlux's version or another
+ * byte order is said as such; values no polarlux writes are damage (a
+ * flipped bit there was blamed on the version or the architecture). */
+static plx_status check_version(const unsigned char *h, char *err, size_t errlen)
+{
+    uint32_t v = bake_get32(h + H_VERSION), e = bake_get32(h + H_ENDIAN);
+    if (e == swap32(BAKE_ENDIAN)) /* no single damaged bit makes it */
+        return say(err, errlen, PLX_E_UNSUPPORTED, "bake made on another architecture (its byte order differs); "
+                   "bake the scene again on this machine", 0, NULL, 0, NULL);
+    if (v != BAKE_VERSION && v >= 1 && v <= BAKE_MAX_PLAUSIBLE_VERSION)
+        return say(err, errlen, PLX_E_UNSUPPORTED, "bake format version ", v, ", this polarlux reads version ",
+                   BAKE_VERSION, "; bake the scene again");
+    if (v != BAKE_VERSION)
+        return say(err, errlen, PLX_E_PARSE, "corrupt bake file: damaged header (its version field reads ", v, ")",
+                   0, NULL);
+    if (e != BAKE_ENDIAN)
+        return say(err, errlen, PLX_E_PARSE, "corrupt bake file: damaged header (its byte-order field is neither "
+                   "this machine's nor the other)", 0, NULL, 0, NULL);
+    return PLX_OK;
+}
+
+/* Checks the header h (its first min(len, BAKE_HEADER) bytes read) of a
+ * file of len bytes and fills L from it. *foreign is set when the file
+ * is of this format version and byte order but names other sizes or
+ * another build: such a file is from another build only when its
+ * checksum holds (the caller's to check, header_verdict); a damaged
+ * header byte there was blamed on the build. A length field that
+ * disagrees with the file while the other fields describe exactly the
+ * file's bytes is damage too, not a truncated file. */
+static plx_status check_header(const unsigned char *h, uint64_t len, bake_layout *L, int *foreign, char *err,
+                               size_t errlen)
+{
+    uint64_t flen;
+    plx_status st;
+    *foreign = 0;
+    if (!h || len < 8 || memcmp(h, BAKE_MAGIC, 8) != 0)
+        return say(err, errlen, PLX_E_PARSE, "not a polarlux bake file (no PLXBAKE magic)", 0, NULL, 0, NULL);
+    if (len < BAKE_HEADER)
+        return say(err, errlen, PLX_E_PARSE, "truncated bake file: ", len, " bytes, shorter than its ",
+                   BAKE_HEADER, "-byte header");
+    if ((st = check_version(h, err, errlen)) != PLX_OK)
+        return st;
+    *foreign = bake_get32(h + H_SIZES) != bake_arch_sizes() || bake_get32(h + H_LAYOUT) != bake_layout_print();
+    if (bake_get32(h + H_SIZES) != bake_arch_sizes())
+        return say(err, errlen, PLX_E_UNSUPPORTED,
+                   "bake made on another architecture (its pointer, size_t, double or long "
+                   "sizes differ); bake the scene again on this machine", 0, NULL, 0, NULL);
+    if (bake_get32(h + H_LAYOUT) != bake_layout_print())
+        return say(err, errlen, PLX_E_UNSUPPORTED,
+                   "bake made by a different build of polarlux (its structures differ); bake the scene again",
+                   0, NULL, 0, NULL);
+    flen = bake_get64(h + H_LENGTH);
+    if (flen != len && layout_of(h, len, L))
+        return say(err, errlen, PLX_E_PARSE, "corrupt bake file: damaged header (its length field reads ", flen,
+                   " bytes, its layout the file's ", len, ")");
+    if (flen != len)
+        return say(err, errlen, PLX_E_PARSE, flen > len ? "truncated bake file: " : "bake file too long: ",
+                   len, " bytes, the header says ", flen, "");
+    if (!layout_of(h, len, L))
         return say(err, errlen, PLX_E_PARSE, "corrupt bake file: inconsistent header", 0, NULL, 0, NULL);
     return PLX_OK;
 }

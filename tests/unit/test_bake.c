@@ -903,10 +903,25 @@ static void test_damaged(void **state)
     memcpy(f, k.file, k.len);
     f[8] = 4;
     expect_fail(f, k.len, PLX_E_UNSUPPORTED, "bake format version 4, this polarlux reads version 3; bake the scene again");
+    /* a damaged version, byte-order or length field is a damaged file (a
+     * kiosk pass's flipped bits there read "version 16777219", "another
+     * architecture" and "truncated") */
+    memcpy(f, k.file, k.len);
+    f[11] ^= 0x01;
+    expect_fail(f, k.len, PLX_E_PARSE, "corrupt bake file: damaged header (its version field reads 16777219)");
     memcpy(f, k.file, k.len);
     f[12] ^= 0xff;
-    expect_fail(f, k.len, PLX_E_UNSUPPORTED, "bake made on another architecture (byte order or pointer, size_t, "
-                "double, long sizes differ); bake the scene again on this machine");
+    expect_fail(f, k.len, PLX_E_PARSE, "corrupt bake file: damaged header (its byte-order field is neither this "
+                "machine's nor the other)");
+    memcpy(f, k.file, k.len);
+    f[12] = 1, f[13] = 2, f[14] = 3, f[15] = 4; /* written in the other byte order */
+    expect_fail(f, k.len, PLX_E_UNSUPPORTED, "bake made on another architecture (its byte order differs); bake the "
+                "scene again on this machine");
+    memcpy(f, k.file, k.len);
+    f[26] ^= 0x40;
+    snprintf(msg, sizeof msg, "corrupt bake file: damaged header (its length field reads %zu bytes, its layout the "
+             "file's %zu)", k.len ^ ((size_t)0x40 << 16), k.len);
+    expect_fail(f, k.len, PLX_E_PARSE, msg);
     /* other sizes or another build: so only when the checksum holds
      * (the file resealed, as that build would have written it); a
      * damaged byte there is a damaged file (a kiosk pass's flipped byte
@@ -915,8 +930,8 @@ static void test_damaged(void **state)
     f[16] = 4;
     expect_fail(f, k.len, PLX_E_PARSE, "corrupt bake file: checksum mismatch (in its header)");
     ref_bake_reseal(f, k.len);
-    expect_fail(f, k.len, PLX_E_UNSUPPORTED, "bake made on another architecture (byte order or pointer, size_t, "
-                "double, long sizes differ); bake the scene again on this machine");
+    expect_fail(f, k.len, PLX_E_UNSUPPORTED, "bake made on another architecture (its pointer, size_t, double or "
+                "long sizes differ); bake the scene again on this machine");
     memcpy(f, k.file, k.len);
     f[20] ^= 1;
     expect_fail(f, k.len, PLX_E_PARSE, "corrupt bake file: checksum mismatch (in its header)");
@@ -990,10 +1005,9 @@ static const corpus_row corpus[] = {
     { "bake-version-2.plxb", PLX_E_UNSUPPORTED,
       "bake format version 2, this polarlux reads version 3; bake the scene again" },
     { "bake-big-endian.plxb", PLX_E_UNSUPPORTED,
-      "bake made on another architecture (byte order or pointer, size_t, double, long sizes differ); "
-      "bake the scene again on this machine" },
+      "bake made on another architecture (its byte order differs); bake the scene again on this machine" },
     { "bake-32bit.plxb", PLX_E_UNSUPPORTED,
-      "bake made on another architecture (byte order or pointer, size_t, double, long sizes differ); "
+      "bake made on another architecture (its pointer, size_t, double or long sizes differ); "
       "bake the scene again on this machine" },
 };
 
