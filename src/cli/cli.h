@@ -148,13 +148,13 @@ void cli_bake_kept(const char *cmd, const char *path, const cli_common *c, plx_e
 /* A line on stderr when the photon buffers were fitted below the default
  * quality: to fit --mem, or (a loaded bake's, photons traced again for
  * illum's lamps) when the bake was made. Not a warning: --quiet keeps it. */
-void cli_indirect_note(const char *cmd, plx_engine *e);
+void cli_indirect_note(const char *cmd, const cli_common *c, plx_engine *e);
 /* A line on stderr when this run's first frame laid out the radiance
  * atlas (had: whether it was made before the frame, a bake's) with its
  * points farther apart than asked (texel, or the default 0.5 m when 0)
  * because the block is small (its quarter under PLX_ATLAS_MAX_BYTES: a
  * larger --mem gives finer points). Not a warning: --quiet keeps it. */
-void cli_atlas_note(const char *cmd, plx_engine *e, int had, double texel);
+void cli_atlas_note(const char *cmd, const cli_common *c, plx_engine *e, int had, double texel);
 int cli_indirect_run(const char *cmd, const cli_common *c, plx_engine *e, const cli_indirect *ind, const double *eye,
                      const double *dir, double fov_deg);
 /* A command's near-viewer refinement (cli_refine): its settings and

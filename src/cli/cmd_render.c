@@ -428,7 +428,7 @@ int cmd_render(int argc, char **argv)
     st = plx_render(e, &a.cam, &a.opts, rgb8, rgbf, &info);
     t0 = port_now_ns() - t0; /* the frame alone, not the PNG written after it */
     if (st == PLX_OK)
-        cli_atlas_note("render", e, had_atlas, a.opts.aerial_m_per_texel);
+        cli_atlas_note("render", &a.c, e, had_atlas, a.opts.aerial_m_per_texel);
     if (st != PLX_OK) {
         char hint[400];
         fprintf(stderr, "polarlux render: %s%s\n", plx_last_error(e),

@@ -82,6 +82,7 @@ typedef struct walk_args {
     double refine_height;
     long refine_frames;
     long max_frames;
+    int max_frames_given;
     double fps, speed, fov;
     double pitch;              /* --pitch, degrees below level (no targets) */
     int pitch_set;
@@ -129,8 +130,8 @@ static int parse_args(int argc, char **argv, walk_args *a)
           &v.exposure, NULL },
         { "--refine-frames", NULL, &a->refine_frames, parse_refine_frames,
           "--refine-frames '%s' is not a whole number from 0 to 100000", 0, NULL, &refine_frames_set, NULL },
-        CLI_OPT_VAL("--max-frames", &a->max_frames, parse_max_frames,
-                    "--max-frames '%s' is not a whole number from 1 to 1000000"),
+        { "--max-frames", NULL, &a->max_frames, parse_max_frames,
+          "--max-frames '%s' is not a whole number from 1 to 1000000", 0, NULL, &a->max_frames_given, NULL },
         CLI_OPT_FLAG("--no-adapt", &a->no_adapt),
         { "--pitch", NULL, &a->pitch, parse_pitch, "--pitch '%s' is not a number of degrees from 0 to 89", 0, NULL,
           &a->pitch_set, NULL },
@@ -542,7 +543,7 @@ static int frame(const walk_args *a, plx_engine *e, const walk_path *wp, walk_ru
     st = plx_render(e, &cam, &o, wr->rgb8, NULL, &info);
     wr->ms[k] = (port_now_ns() - t0) / 1e6;
     if (st == PLX_OK && k == 0)
-        cli_atlas_note("walk", e, had_atlas, a->opts.aerial_m_per_texel);
+        cli_atlas_note("walk", &a->c, e, had_atlas, a->opts.aerial_m_per_texel);
     wr->lookups += info.indirect_lookups;
     wr->aa_later += info.aa_later;
     if (st == PLX_OK) {
@@ -607,12 +608,13 @@ static int frame(const walk_args *a, plx_engine *e, const walk_path *wp, walk_ru
                 int left;
                 snprintf(old, sizeof old, "%s/contact.png", a->dir);
                 left = stat(old, &sb) == 0; /* an earlier walk's */
-                fprintf(stderr, "polarlux walk: no contact sheet: it needs %.1f MB beside the engine and the "
-                        "frame (%.1f MB with frames %d pixels wide), and --mem leaves %.1f MB%s%s%s\n", need / 1e6,
-                        (double)wr->sh.W * wr->sh.H * 3 / 1e6, wr->sh.tw, room / 1e6, left ? "; " : "",
-                        left ? old : "", left ? " is an earlier walk's, left as it was" : "");
+                if (!a->c.quiet)
+                    fprintf(stderr, "polarlux walk: no contact sheet: it needs %.2f MB beside the engine and the "
+                            "frame (%.2f MB with frames %d pixels wide), and --mem leaves %.2f MB%s%s%s\n",
+                            need / 1e6, (double)wr->sh.W * wr->sh.H * 3 / 1e6, wr->sh.tw, room / 1e6,
+                            left ? "; " : "", left ? old : "", left ? " is an earlier walk's, left as it was" : "");
                 wr->sh.skipped = 1;
-            } else if (wr->sh.f != f) {
+            } else if (wr->sh.f != f && !a->c.quiet) {
                 fprintf(stderr, "polarlux walk: contact sheet with frames %d pixels wide (not %d) to fit --mem: "
                         "%.1f MB left beside the engine and the frame\n", wr->sh.tw, a->w / f, room / 1e6);
             }
@@ -758,8 +760,9 @@ static int run(const walk_args *a, plx_engine *e, const walk_path *wp, long *don
             snprintf(all, sizeof all, "%.0f", steps);
         else
             snprintf(all, sizeof all, "more than 10^15");
-        cli_warn("walk", &a->c, "--max-frames %ld stops the walk at %.1f m of the path's %.1f m (%s frames "
-                 "would walk it all)", a->max_frames, frame_at(wr.n - 1, step, L), L, all);
+        cli_warn("walk", &a->c, "--max-frames %ld%s stops the walk at %.1f m of the path's %.1f m (%s frames "
+                 "would walk it all)", a->max_frames, a->max_frames_given ? "" : " (the default)",
+                 frame_at(wr.n - 1, step, L), L, all);
     }
     stale_hint(a, wr.n);
     sheet_plan(&wr.sh, a, wr.n);

@@ -951,10 +951,10 @@ void cli_bake_kept(const char *cmd, const char *path, const cli_common *c, plx_e
 
 /* A word on stderr when the photon buffers were made smaller than the
  * default quality to fit --mem (README "Memory budgets"). */
-void cli_indirect_note(const char *cmd, plx_engine *e)
+void cli_indirect_note(const char *cmd, const cli_common *c, plx_engine *e)
 {
     plx_indirect_info pi;
-    if (plx_indirect_info_get(e, &pi) != PLX_OK || pi.reductions == 0)
+    if ((c && c->quiet) || plx_indirect_info_get(e, &pi) != PLX_OK || pi.reductions == 0)
         return;
     fprintf(stderr,
             "polarlux %s: indirect light at reduced quality %s: photon buffers %.1f MiB "
@@ -965,12 +965,12 @@ void cli_indirect_note(const char *cmd, plx_engine *e)
             pi.aerial_w, pi.aerial_h, pi.aerial_texel, pi.lamp_slots, pi.lamp_tables ? "on" : "off");
 }
 
-void cli_atlas_note(const char *cmd, plx_engine *e, int had, double texel)
+void cli_atlas_note(const char *cmd, const cli_common *c, plx_engine *e, int had, double texel)
 {
     plx_atlas_info ai;
     plx_memory_report mr;
     double asked = texel > 0.0 ? texel : PLX_ATLAS_SPACING_DEFAULT;
-    if (had || plx_atlas_info_get(e, &ai) != PLX_OK || !ai.made || !(ai.spacing > asked * 1.001))
+    if ((c && c->quiet) || had || plx_atlas_info_get(e, &ai) != PLX_OK || !ai.made || !(ai.spacing > asked * 1.001))
         return;
     plx_memory_get(e, &mr);
     if (mr.capacity / 4 >= PLX_ATLAS_MAX_BYTES / 100 * 99) /* the atlas's own ceiling set it (the block's
@@ -1073,7 +1073,7 @@ int cli_indirect_run(const char *cmd, const cli_common *c, plx_engine *e, const 
             return cli_exit_code(st);
         }
         if (k == 0)
-            cli_indirect_note(cmd, e);
+            cli_indirect_note(cmd, c, e);
         if (tty)
             fprintf(stderr, "\rindirect light: frame %ld/%ld (%ld photons each), %.1f s", k + 1, ind->frames,
                     photons, (port_now_ns() - t0) / 1e9);

@@ -72,7 +72,7 @@ static int read_positions(const cJSON *coords, int project, const plx_scene_info
     cJSON_ArrayForEach(pos, coords) {
         const cJSON *x = cJSON_GetArrayItem(pos, 0), *y = cJSON_GetArrayItem(pos, 1), *z = cJSON_GetArrayItem(pos, 2);
         if (!cJSON_IsNumber(x) || !cJSON_IsNumber(y) || (z && !cJSON_IsNumber(z)) || !isfinite(x->valuedouble) ||
-            !isfinite(y->valuedouble) || (z && !isfinite(z->valuedouble))) {
+            !isfinite(y->valuedouble) || (z && !isfinite(z->valuedouble)) || cJSON_GetArraySize(pos) > 3) {
             snprintf(why, whylen, "position %d is not [x, y] or [x, y, z] of finite numbers", k);
             return -1;
         }
@@ -86,7 +86,9 @@ static int read_positions(const cJSON *coords, int project, const plx_scene_info
         if (fabs(out[3 * k]) > CLI_MAX_COORD || fabs(out[3 * k + 1]) > CLI_MAX_COORD ||
             fabs(out[3 * k + 2]) > CLI_MAX_COORD) {
             snprintf(why, whylen, "position %d (%g, %g, %g) is more than 1e7 m from the %s", k, x->valuedouble,
-                     y->valuedouble, out[3 * k + 2], project ? "scene's origin" : "origin");
+                     y->valuedouble, out[3 * k + 2],
+                     project ? "scene's origin (read as lon/lat, as the scene is; a path in metres says "
+                               "properties.units \"m\")" : "origin");
             return -1;
         }
         if (eyes && !(out[3 * k + 2] > 0)) {

@@ -772,6 +772,13 @@ expect walk-short-path 1 "^polarlux walk: $tmp/short\.geojson: the LineString ne
 printf '{"type":"LineString","coordinates":[[1,2,1e300],[1,9,2]]}' >"$tmp/huge.geojson"
 expect walk-huge-coordinate 1 "^polarlux walk: $tmp/huge\.geojson: position 0 \(1, 2, 1e\+300\) is more than 1e7 m from the origin$" -- \
     "$bin" walk -q "$tmp/e.plxb" --path "$tmp/huge.geojson" -o "$tmp/w3"
+# a path in metres on a lon/lat scene says how it was read; a position of 4 numbers is refused (it was read silently)
+printf '{"type":"LineString","coordinates":[[-45,-43,1.7],[-40,-43,1.7]]}' >"$tmp/metres-path.geojson"
+expect walk-metres-on-lonlat-hint 1 "is more than 1e7 m from the scene's origin \(read as lon/lat, as the scene is; a path in metres says properties\.units \"m\"\)$" -- \
+    "$bin" walk -q fixtures/helsinki-centre.geojson --no-indirect --path "$tmp/metres-path.geojson" -o "$tmp/w3"
+printf '{"type":"LineString","properties":{"units":"m"},"coordinates":[[1,2,1.7,9],[1,9,2]]}' >"$tmp/four.geojson"
+expect walk-four-numbers 1 "position 0 is not \[x, y\] or \[x, y, z\] of finite numbers$" -- \
+    "$bin" walk -q "$tmp/e.plxb" --path "$tmp/four.geojson" -o "$tmp/w3"
 printf 'x' >"$tmp/wfile"
 expect walk-out-is-file 1 "^polarlux walk: $tmp/wfile: not a folder" -- \
     "$bin" walk -q "$tmp/e.plxb" --path "$tmp/path.geojson" --size 32x24 -o "$tmp/wfile"
