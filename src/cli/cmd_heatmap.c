@@ -438,14 +438,34 @@ static int write_png(plx_engine *e, const heat_opts *o, const heat_map *m, doubl
     return rc;
 }
 
+/* The GeoTIFF's description of its band: the quantity mapped (it named E_h
+ * for every --quantity). */
+static void band_description(const heat_quantity *q, char *buf, size_t cap)
+{
+    const char *name = q->quantity == PLX_METER_SC ? "semi-cylindrical illuminance E_sc"
+                       : q->quantity == PLX_METER_V ? "vertical illuminance E_v"
+                                                    : "hemispherical illuminance E_hs";
+    if (q->quantity == PLX_METER_H)
+        snprintf(buf, cap, "polarlux heatmap: band 1 = direct horizontal ground illuminance E_h in lux at pixel "
+                 "centres; NaN under buildings");
+    else if (q->facing_min)
+        snprintf(buf, cap, "polarlux heatmap: band 1 = direct %s in lux at %g m above pixel centres, the least over "
+                 "every facing direction; NaN under buildings", name, q->height);
+    else if (q->quantity == PLX_METER_HS)
+        snprintf(buf, cap, "polarlux heatmap: band 1 = direct %s in lux at %g m above pixel centres; NaN under "
+                 "buildings", name, q->height);
+    else
+        snprintf(buf, cap, "polarlux heatmap: band 1 = direct %s in lux at %g m above pixel centres, facing %g deg; "
+                 "NaN under buildings", name, q->height, q->facing);
+}
+
 static int write_tiff(plx_engine *e, const heat_opts *o, const heat_map *m)
 {
     raster_frame f;
-    char err[512];
+    char err[512], what[256];
     raster_frame_of(e, m->box, m->res, &f);
-    if (geotiff_write(o->out, m->E, (int)m->w, (int)m->h, 1, &f,
-                      "polarlux heatmap: band 1 = direct horizontal ground illuminance E_h in lux at pixel "
-                      "centres; NaN under buildings", err, sizeof err) != 0) {
+    band_description(&o->q, what, sizeof what);
+    if (geotiff_write(o->out, m->E, (int)m->w, (int)m->h, 1, &f, what, err, sizeof err) != 0) {
         fprintf(stderr, "polarlux heatmap: %s\n", err);
         return EXIT_FAIL;
     }

@@ -362,7 +362,10 @@ int cmd_info(int argc, char **argv)
     if (si.merged_lamps)
         printf("duplicate lamps: %u merged into lamps at the same spot\n", si.merged_lamps);
     printf("overlapping pairs: %u\n", si.overlapping_pairs);
-    if (si.lonlat)
+    if (si.lonlat && plx_scene_crs(e)) /* a geographic crs of its own (ETRS89, NAD83, ...) */
+        printf("coordinates: lon/lat (%s), projected about lon0 %.7f lat0 %.7f\n", plx_scene_crs(e), si.lon0,
+               si.lat0);
+    else if (si.lonlat)
         printf("coordinates: WGS84 lon/lat, projected about lon0 %.7f lat0 %.7f\n", si.lon0, si.lat0);
     else
         printf("coordinates: local metres\n");

@@ -112,6 +112,7 @@ void raster_frame_of(plx_engine *e, const double box[4], double res, raster_fram
         f->y0 = si.lat0 + box[3] / M_PER_DEG_LAT;
         f->sx = res / (M_PER_DEG_LON * cl);
         f->sy = res / M_PER_DEG_LAT;
+        f->epsg = f->name ? epsg_code(f->name) : 0; /* a geographic crs of its own (ETRS89, ...), else WGS 84 */
     } else if (f->name && (f->epsg = epsg_code(f->name)) != 0) {
         f->kind = RASTER_EPSG;
     }
@@ -132,8 +133,8 @@ static void set_keys(const gt_api *gt, GTIF *g, const raster_frame *f)
     gt->KeySet(g, GTRasterTypeGeoKey, TYPE_SHORT, 1, RasterPixelIsArea);
     if (f->kind == RASTER_LONLAT) {
         gt->KeySet(g, GTModelTypeGeoKey, TYPE_SHORT, 1, ModelTypeGeographic);
-        gt->KeySet(g, GeographicTypeGeoKey, TYPE_SHORT, 1, 4326);
-        gt->KeySet(g, GTCitationGeoKey, TYPE_ASCII, 0, "WGS 84");
+        gt->KeySet(g, GeographicTypeGeoKey, TYPE_SHORT, 1, f->epsg ? f->epsg : 4326);
+        gt->KeySet(g, GTCitationGeoKey, TYPE_ASCII, 0, f->epsg && f->name ? f->name : "WGS 84");
     } else if (f->kind == RASTER_EPSG) {
         gt->KeySet(g, GTModelTypeGeoKey, TYPE_SHORT, 1, ModelTypeProjected);
         gt->KeySet(g, ProjectedCSTypeGeoKey, TYPE_SHORT, 1, f->epsg);

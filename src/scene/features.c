@@ -31,6 +31,9 @@ typedef struct counts {
     double box[4];     /* of all coordinates */
     int any;
     int lonlat_ok;     /* every coordinate within lon/lat range */
+    int feat_out;      /* the feature being counted has a coordinate outside it */
+    uint32_t first_out; /* the first feature that has (when !lonlat_ok) */
+    uint32_t feats, feats_in; /* features with coordinates; those wholly within the range */
 } counts;
 
 /* The members of a feature that the passes look at, found once. */
@@ -79,7 +82,7 @@ static void count_position(const loader *ld, counts *c, jv pos)
     c->box[2] = fmax(c->box[2], vx);
     c->box[3] = fmax(c->box[3], vy);
     if (vx < -180.0 || vx > 180.0 || vy < -90.0 || vy > 90.0)
-        c->lonlat_ok = 0;
+        c->feat_out = 1;
 }
 
 static void count_polygon(const loader *ld, counts *c, jv poly)
@@ -138,6 +141,7 @@ static void count_features(loader *ld, jv features, counts *c)
         feat_find(ld, f, &m);
         if (m.type == JV_NONE || ld_kind(ld, m.coords) != JS_ARRAY)
             continue;
+        c->feat_out = 0;
         if (ld_str_is(ld, m.type, "Polygon")) {
             count_polygon(ld, c, m.coords);
         } else if (ld_str_is(ld, m.type, "MultiPolygon")) {
@@ -146,6 +150,15 @@ static void count_features(loader *ld, jv features, counts *c)
         } else if (ld_str_is(ld, m.type, "Point") && is_lamp(ld, m.props)) {
             c->lamps++;
             count_position(ld, c, m.coords);
+        } else {
+            continue;
+        }
+        c->feats++;
+        if (!c->feat_out)
+            c->feats_in++;
+        else if (c->lonlat_ok) {
+            c->lonlat_ok = 0;
+            c->first_out = fi - 1;
         }
     }
 }
@@ -721,11 +734,31 @@ static plx_status read_feature(loader *ld, jv f, uint32_t fi)
 
 static plx_status set_frame(loader *ld, const counts *c)
 {
+    char why[400];
+    strbuf b;
     if (ld->metres || !c->any)
         return PLX_OK;
+    if (!c->lonlat_ok && ld->crs_lonlat) {
+        /* read as metres, the file's geographic crs would place every output wrong */
+        sb_init(&b, why, sizeof why);
+        sb_str(&b, "coordinates exceed the lon/lat range (-180..180, -90..90), but the crs ");
+        sb_str(&b, ld->s->crs);
+        sb_str(&b, " names lon/lat degrees: give the crs the coordinates are in (or none, with properties.units "
+                   "= \"m\", for local metres)");
+        return ld_fail(ld, c->first_out, why);
+    }
     if (!c->lonlat_ok) {
-        ld_warn(ld, 0, NULL, "coordinates exceed the lon/lat range and properties.units is not given: "
-                             "reading them as metres (set properties.units = \"m\" to silence this)");
+        sb_init(&b, why, sizeof why);
+        sb_str(&b, "coordinates exceed the lon/lat range and properties.units is not given: reading them as metres "
+                   "(set properties.units = \"m\" to silence this)");
+        if (c->feats_in > 0) {
+            sb_str(&b, "; ");
+            sb_uint(&b, c->feats_in);
+            sb_str(&b, " of the ");
+            sb_uint(&b, c->feats);
+            sb_str(&b, " features lie wholly within it: if those are lon/lat, the file mixes coordinate systems");
+        }
+        ld_warn(ld, c->first_out, NULL, why);
         ld->metres = 1;
         return PLX_OK;
     }

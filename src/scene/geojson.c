@@ -212,14 +212,45 @@ static jv crs_name(const loader *ld, jv crs)
     return ld_kind(ld, name) == JS_STRING ? name : JV_NONE;
 }
 
-/* 1 when the CRS names WGS84 lon/lat (EPSG:4326, OGC CRS84). */
+/* Geographic CRSs (degrees of longitude and latitude) by EPSG code: WGS 84
+ * (2D and 3D), ETRS89 (2D and 3D, and its realisations' common code),
+ * NAD83 and its realisations, GDA94 and GDA2020, NZGD2000, JGD2000 and
+ * JGD2011, CGCS2000, SIRGAS 2000, SIRGAS-CON, WGS 72, ED50, OSGB36, DHDN,
+ * RT90's and SWEREF99's geographic bases, ETRF2000, ITRF2014's and the
+ * NAD27 datum. Their datums differ by metres at most from WGS 84 (ED50,
+ * OSGB36, NAD27 and WGS 72 by up to a few hundred), which a local frame of
+ * a district does not notice; the name is kept for the outputs. */
+static const long geographic_epsg[] = {
+    4326, 4979, 4258, 4937, 4269, 4617, 4759, 6318, 4283, 7844, 4167, 4612, 6668, 4490, 4674,
+    4322, 4230, 4277, 4314, 4124, 4619, 9067, 7912, 4267, 4171, 4170, 4275, 4312, 4258,
+};
+
+/* The EPSG code at the end of a name ("EPSG:4258", "urn:ogc:def:crs:EPSG::4258"), or 0. */
+static long crs_epsg(const char *name)
+{
+    size_t n = strlen(name), d = n;
+    long v = 0;
+    while (d > 0 && name[d - 1] >= '0' && name[d - 1] <= '9' && n - d < 7)
+        d--;
+    if (d == n || d == 0 || name[d - 1] != ':' || !strstr(name, "EPSG"))
+        return 0;
+    for (; d < n; d++)
+        v = v * 10 + (name[d] - '0');
+    return v;
+}
+
+/* 1 when the CRS names lon/lat degrees: OGC CRS84 (or CRS83, CRS27) or one
+ * of the geographic EPSG codes above. */
 static int crs_is_lonlat(const char *name)
 {
-    size_t n = strlen(name), k;
-    for (k = 0; k + 5 <= n; k++)
-        if (strncmp(name + k, "CRS84", 5) == 0)
+    long code = crs_epsg(name);
+    size_t i;
+    if (strstr(name, "CRS84") || strstr(name, "CRS83") || strstr(name, "CRS27"))
+        return 1;
+    for (i = 0; code && i < sizeof geographic_epsg / sizeof geographic_epsg[0]; i++)
+        if (code == geographic_epsg[i])
             return 1;
-    return n >= 5 && strcmp(name + n - 5, ":4326") == 0;
+    return 0;
 }
 
 /* Keeps the scene's CRS (copied into the scene) and reads a projected one
@@ -242,7 +273,8 @@ static plx_status read_crs(loader *ld, jv props)
         return eng_nomem(ld->e, "keeping the scene's crs");
     ld_str(ld, name, copy, n + 1);
     ld->s->crs = copy;
-    if (!crs_is_lonlat(copy))
+    ld->crs_lonlat = crs_is_lonlat(copy);
+    if (!ld->crs_lonlat)
         ld->metres = 1;
     return PLX_OK;
 }

@@ -59,6 +59,16 @@ plx_status ld_bad_feature(loader *ld, uint32_t fi, const char *id, const char *w
     return PLX_OK;
 }
 
+plx_status ld_fail(loader *ld, uint32_t fi, const char *why)
+{
+    char msg[ENGINE_ERR_BYTES];
+    strbuf b;
+    sb_init(&b, msg, sizeof msg);
+    msg_where(ld, &b, fi, NULL);
+    sb_str(&b, why);
+    return eng_fail(ld->e, PLX_E_SCENE, msg);
+}
+
 void ld_warn(loader *ld, uint32_t fi, const char *id, const char *why)
 {
     char msg[ENGINE_ERR_BYTES];

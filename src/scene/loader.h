@@ -45,6 +45,7 @@ typedef struct loader {
     uint32_t *feat_col;    /* its column */
     uint32_t nfeat;
     int metres;            /* properties.units == "m", or a projected crs */
+    int crs_lonlat;        /* the file names a geographic (lon/lat) crs */
     double lon0, lat0, coslat;
     int gi_bounds_given;   /* properties.ground_image_bounds read (scene coordinates) */
     double gi_bounds[4];
@@ -80,5 +81,7 @@ size_t ld_str(const loader *ld, jv v, char *buf, size_t cap);
 /* Reports a bad feature; PLX_OK means skip it and go on (not strict). */
 plx_status ld_bad_feature(loader *ld, uint32_t fi, const char *id, const char *why);
 void ld_warn(loader *ld, uint32_t fi, const char *id, const char *why);
+/* Fails the load (strict or not) with feature fi's place and why. */
+plx_status ld_fail(loader *ld, uint32_t fi, const char *why);
 
 #endif

@@ -145,6 +145,29 @@ expect tiff-tiny-tie 0 "^tie 0 0 -50 70$" -- "$probe" "$tmp/t.tif"
 tiff_check tiff-tiny-values fixtures/tiny.geojson "$tmp/t.tif" 35,25 38,26 40,27 41,28 44,30 45,22 50,30 30,20 52,25 10,50 0,0
 expect tiff-helsinki 0 "float32 GeoTIFF" -- "$bin" heatmap -q fixtures/helsinki-centre.geojson --res 8 -o "$tmp/h.tif"
 expect tiff-helsinki-wgs84 0 "^keys model 2 raster 1 geographic 4326 " -- "$probe" "$tmp/h.tif"
+expect tiff-description-eh 0 "^description polarlux heatmap: band 1 = direct horizontal ground illuminance E_h" -- "$probe" "$tmp/h.tif"
+# helper-64's GIS pass: the band said E_h for every --quantity
+expect tiff-v 0 "float32 GeoTIFF" -- "$bin" heatmap -q fixtures/tiny.geojson --res 4 --quantity v --facing 90 -o "$tmp/hv.tif"
+expect tiff-description-ev 0 "^description polarlux heatmap: band 1 = direct vertical illuminance E_v in lux at 1\.5 m above pixel centres, facing 90 deg" -- "$probe" "$tmp/hv.tif"
+# a geographic crs other than WGS 84 (ETRS89, EPSG:4258) is lon/lat: it was read as metres, every building within 2 cm
+/usr/bin/python3 -c "
+import json, sys
+d = json.load(open('fixtures/helsinki-centre.geojson'))
+d['crs'] = {'type': 'name', 'properties': {'name': 'urn:ogc:def:crs:EPSG::4258'}}
+json.dump(d, open(sys.argv[1], 'w'))
+g = json.load(open(sys.argv[3]))
+g['crs'] = {'type': 'name', 'properties': {'name': 'EPSG:4258'}}
+g.get('properties', {}).pop('units', None)
+json.dump(g, open(sys.argv[2], 'w'))" "$tmp/h4258.geojson" "$tmp/m4258.geojson" fixtures/eixample-4x4.geojson
+expect crs-etrs89-lonlat 0 "^coordinates: lon/lat \(urn:ogc:def:crs:EPSG::4258\), projected about lon0 24\.94" -- "$bin" info -q "$tmp/h4258.geojson"
+expect crs-etrs89-bounds 0 "^bounds: .* \(1108\.4 x 1742\.9 m\)" -- "$bin" info -q "$tmp/h4258.geojson"
+expect tiff-etrs89 0 "float32 GeoTIFF" -- "$bin" heatmap -q "$tmp/h4258.geojson" --res 20 -o "$tmp/h4258.tif"
+expect tiff-etrs89-key 0 "^keys model 2 raster 1 geographic 4258 " -- "$probe" "$tmp/h4258.tif"
+# metres under a geographic crs: refused (the outputs would carry degrees)
+expect crs-geographic-metres 1 "feature [0-9]+ .*: coordinates exceed the lon/lat range \(-180\.\.180, -90\.\.90\), but the crs EPSG:4258 names lon/lat degrees" -- "$bin" info -q "$tmp/m4258.geojson"
+# a scene mixing lon/lat and metres: the warning names the feature out of range (it named feature 0) and counts the rest
+printf '{"type":"FeatureCollection","features":[\n{"type":"Feature","properties":{"height":10},"geometry":{"type":"Polygon","coordinates":[[[24.94,60.17],[24.9401,60.17],[24.9401,60.1701],[24.94,60.1701],[24.94,60.17]]]}},\n{"type":"Feature","properties":{"highway":"street_lamp"},"geometry":{"type":"Point","coordinates":[385920,6672300]}}]}\n' >"$tmp/mixed.geojson"
+expect crs-mixed-names-feature 0 "warning: .*mixed\.geojson: feature 1 \(line 3, column 1\): coordinates exceed the lon/lat range .*; 1 of the 2 features lie wholly within it: if those are lon/lat, the file mixes coordinate systems" -- "$bin" info "$tmp/mixed.geojson"
 tiff_check tiff-helsinki-values fixtures/helsinki-centre.geojson "$tmp/h.tif" 30,60 35,70 40,80 45,90 50,100 55,110 60,120 65,130 70,140 75,150 80,160 85,170
 expect tiff-l93 0 "float32 GeoTIFF" -- "$bin" heatmap -q "$tmp/l93.geojson" --res 2 -o "$tmp/l93.tif"
 expect tiff-l93-epsg 0 "^keys model 1 raster 1 geographic -1 projected 2154 " -- "$probe" "$tmp/l93.tif"

@@ -48,6 +48,7 @@ int main(int argc, char **argv)
     uint32_t w = 0, h = 0;
     uint16_t nb = 0, bits = 0, fmt = 0, n = 0;
     double *scale = NULL, *tie = NULL;
+    const char *desc = NULL;
     float *row;
     int i, rc = 0;
     if (argc < 2 || !(t = XTIFFOpen(argv[1], "r"))) {
@@ -65,6 +66,8 @@ int main(int argc, char **argv)
         printf("scale %.17g %.17g\n", scale[0], scale[1]);
     if (TIFFGetField(t, TIFFTAG_GEOTIEPOINTS, &n, &tie) && n >= 6)
         printf("tie %.17g %.17g %.17g %.17g\n", tie[0], tie[1], tie[3], tie[4]);
+    if (TIFFGetField(t, TIFFTAG_IMAGEDESCRIPTION, &desc) && desc)
+        printf("description %s\n", desc);
     g = GTIFNew(t);
     if (g) {
         printf("keys model %d raster %d geographic %d projected %d units %d\n", key_short(g, GTModelTypeGeoKey),
