@@ -213,16 +213,16 @@ static jv crs_name(const loader *ld, jv crs)
 }
 
 /* Geographic CRSs (degrees of longitude and latitude) by EPSG code: WGS 84
- * (2D and 3D), ETRS89 (2D and 3D, and its realisations' common code),
- * NAD83 and its realisations, GDA94 and GDA2020, NZGD2000, JGD2000 and
- * JGD2011, CGCS2000, SIRGAS 2000, SIRGAS-CON, WGS 72, ED50, OSGB36, DHDN,
- * RT90's and SWEREF99's geographic bases, ETRF2000, ITRF2014's and the
- * NAD27 datum. Their datums differ by metres at most from WGS 84 (ED50,
- * OSGB36, NAD27 and WGS 72 by up to a few hundred), which a local frame of
- * a district does not notice; the name is kept for the outputs. */
+ * (2D and 3D), ETRS89 (2D and 3D), NAD83, NAD83(CSRS), NAD83(NSRS2007),
+ * NAD83(2011), GDA94, GDA2020, NZGD2000, JGD2000, JGD2011, CGCS2000,
+ * SIRGAS 2000, SIRGAS 1995, RGF93, WGS 72, ED50, OSGB36, DHDN, MGI, NTF,
+ * RT90, SWEREF99, ITRF2014 (3D) and NAD27. Their datums differ by metres at
+ * most from WGS 84 (ED50, OSGB36, NAD27 and WGS 72 by up to a few hundred),
+ * which a local frame of a district does not notice; the name is kept for
+ * the outputs. */
 static const long geographic_epsg[] = {
-    4326, 4979, 4258, 4937, 4269, 4617, 4759, 6318, 4283, 7844, 4167, 4612, 6668, 4490, 4674,
-    4322, 4230, 4277, 4314, 4124, 4619, 9067, 7912, 4267, 4171, 4170, 4275, 4312, 4258,
+    4326, 4979, 4258, 4937, 4269, 4617, 4759, 6318, 4283, 7844, 4167, 4612, 6668, 4490,
+    4674, 4170, 4171, 4322, 4230, 4277, 4314, 4312, 4275, 4124, 4619, 7912, 4267,
 };
 
 /* The EPSG code at the end of a name ("EPSG:4258", "urn:ogc:def:crs:EPSG::4258"), or 0. */
