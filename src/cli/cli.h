@@ -148,6 +148,11 @@ void cli_bake_kept(const char *cmd, const char *path, const cli_common *c, plx_e
 /* A line on stderr when the photon buffers were fitted below the default
  * quality: to fit --mem, or (a loaded bake's, photons traced again for
  * illum's lamps) when the bake was made. Not a warning: --quiet keeps it. */
+/* The EPSG code at the end of a CRS name ("EPSG:2154",
+ * "urn:ogc:def:crs:EPSG::2154"), or 0; two names of one CRS (the same
+ * string, or the same EPSG code written either way). */
+int cli_crs_epsg(const char *name);
+int cli_same_crs(const char *a, const char *b);
 void cli_indirect_note(const char *cmd, const cli_common *c, plx_engine *e);
 /* A line on stderr when this run's first frame laid out the radiance
  * atlas (had: whether it was made before the frame, a bake's) with its

@@ -1129,6 +1129,26 @@ int cli_option_local(const char *cmd, const char *opt, plx_engine *e, double *x,
     return -1;
 }
 
+int cli_crs_epsg(const char *name)
+{
+    const char *p = strstr(name, "EPSG"), *d = name + strlen(name);
+    long v;
+    if (!p)
+        return 0;
+    while (d > p && isdigit((unsigned char)d[-1]))
+        d--;
+    if (!*d || d[-1] != ':')
+        return 0;
+    v = strtol(d, NULL, 10);
+    return v > 0 && v < 1000000 ? (int)v : 0;
+}
+
+int cli_same_crs(const char *a, const char *b)
+{
+    int ca = cli_crs_epsg(a);
+    return strcmp(a, b) == 0 || (ca != 0 && ca == cli_crs_epsg(b));
+}
+
 /* 1: lon/lat, 0: local metres, -1: unknown name. */
 static int frame_of(plx_engine *e, const char *name)
 {
@@ -1139,7 +1159,7 @@ static int frame_of(plx_engine *e, const char *name)
         return 1;
     if (strcmp(name, "local") == 0)
         return 0;
-    if (crs && strcmp(name, crs) == 0)
+    if (crs && cli_same_crs(name, crs)) /* "EPSG:3067" names "urn:ogc:def:crs:EPSG::3067" too */
         return si.lonlat;
     return -1;
 }

@@ -21,6 +21,7 @@
 #include <xtiffio.h>
 #include <sys/stat.h>
 
+#include "cli.h"
 #include "geotiff.h"
 #include "posix/safe_out.h"
 
@@ -78,24 +79,6 @@ static int gt_load(gt_api *api, char *err, size_t errlen)
 #define M_PER_DEG_LON 111320.0
 #define M_PER_DEG_LAT 110540.0
 
-/* The EPSG code at the end of a CRS name ("EPSG:2154",
- * "urn:ogc:def:crs:EPSG::2154"), or 0. */
-static int epsg_code(const char *name)
-{
-    const char *p = strstr(name, "EPSG");
-    const char *d;
-    long v;
-    if (!p)
-        return 0;
-    d = name + strlen(name);
-    while (d > p && isdigit((unsigned char)d[-1]))
-        d--;
-    if (!*d || d[-1] != ':')
-        return 0;
-    v = strtol(d, NULL, 10);
-    return v > 0 && v < 1000000 ? (int)v : 0;
-}
-
 void raster_frame_of(plx_engine *e, const double box[4], double res, raster_frame *f)
 {
     plx_scene_info si;
@@ -112,8 +95,8 @@ void raster_frame_of(plx_engine *e, const double box[4], double res, raster_fram
         f->y0 = si.lat0 + box[3] / M_PER_DEG_LAT;
         f->sx = res / (M_PER_DEG_LON * cl);
         f->sy = res / M_PER_DEG_LAT;
-        f->epsg = f->name ? epsg_code(f->name) : 0; /* a geographic crs of its own (ETRS89, ...), else WGS 84 */
-    } else if (f->name && (f->epsg = epsg_code(f->name)) != 0) {
+        f->epsg = f->name ? cli_crs_epsg(f->name) : 0; /* a geographic crs of its own (ETRS89, ...), else WGS 84 */
+    } else if (f->name && (f->epsg = cli_crs_epsg(f->name)) != 0) {
         f->kind = RASTER_EPSG;
     }
 }

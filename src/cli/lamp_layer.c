@@ -464,7 +464,7 @@ static int same_frame(const char *cmd, const char *path, plx_engine *e, const la
     plx_scene_info si;
     const char *crs = plx_scene_crs(e);
     plx_scene_info_get(e, &si);
-    if (f->crs && crs && strcmp(f->crs, crs) != 0) {
+    if (f->crs && crs && !cli_same_crs(f->crs, crs)) {
         fprintf(stderr, "polarlux %s: %s: the lamps are in %s but the scene in %s; give them in the scene's CRS\n",
                 cmd, path, f->crs, crs);
         return -1;

@@ -165,6 +165,15 @@ expect tiff-etrs89 0 "float32 GeoTIFF" -- "$bin" heatmap -q "$tmp/h4258.geojson"
 expect tiff-etrs89-key 0 "^keys model 2 raster 1 geographic 4258 " -- "$probe" "$tmp/h4258.tif"
 # metres under a geographic crs: refused (the outputs would carry degrees)
 expect crs-geographic-metres 1 "feature [0-9]+ .*: coordinates exceed the lon/lat range \(-180\.\.180, -90\.\.90\), but the crs EPSG:4258 names lon/lat degrees" -- "$bin" info -q "$tmp/m4258.geojson"
+# one CRS written two ways ("EPSG:3067", "urn:ogc:def:crs:EPSG::3067") is the same CRS for points and lamp files
+/usr/bin/python3 -c "
+import json, sys
+g = json.load(open('fixtures/eixample-4x4.geojson'))
+g['crs'] = {'type': 'name', 'properties': {'name': 'urn:ogc:def:crs:EPSG::3067'}}
+g.get('properties', {}).pop('units', None)
+json.dump(g, open(sys.argv[1], 'w'))" "$tmp/e3067.geojson"
+expect crs-points-same-code 0 "^50 50 0 [0-9.e+-]+ 0$" -- sh -c "printf '# crs: EPSG:3067\n50 50\n' | '$bin' illum -q --no-indirect '$tmp/e3067.geojson' --points -"
+expect crs-points-other-code 1 "points crs 'EPSG:2154' is not lonlat, local or the scene's CRS" -- sh -c "printf '# crs: EPSG:2154\n50 50\n' | '$bin' illum -q --no-indirect '$tmp/e3067.geojson' --points -"
 # a scene mixing lon/lat and metres: the warning names the feature out of range (it named feature 0) and counts the rest
 printf '{"type":"FeatureCollection","features":[\n{"type":"Feature","properties":{"height":10},"geometry":{"type":"Polygon","coordinates":[[[24.94,60.17],[24.9401,60.17],[24.9401,60.1701],[24.94,60.1701],[24.94,60.17]]]}},\n{"type":"Feature","properties":{"highway":"street_lamp"},"geometry":{"type":"Point","coordinates":[385920,6672300]}}]}\n' >"$tmp/mixed.geojson"
 expect crs-mixed-names-feature 0 "warning: .*mixed\.geojson: feature 1 \(line 3, column 1\): coordinates exceed the lon/lat range .*; 1 of the 2 features lie wholly within it: if those are lon/lat, the file mixes coordinate systems" -- "$bin" info "$tmp/mixed.geojson"
