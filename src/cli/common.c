@@ -1149,15 +1149,23 @@ int cli_same_crs(const char *a, const char *b)
     return strcmp(a, b) == 0 || (ca != 0 && ca == cli_crs_epsg(b));
 }
 
-/* 1: lon/lat, 0: local metres, -1: unknown name. */
+/* a and b equal but for the case of ASCII letters */
+static int same_ci(const char *a, const char *b)
+{
+    for (; *a && tolower((unsigned char)*a) == tolower((unsigned char)*b); a++, b++)
+        ;
+    return *a == '\0' && *b == '\0';
+}
+
+/* 1: lon/lat, 0: local metres, -1: unknown name ("LonLat", "LOCAL" as well). */
 static int frame_of(plx_engine *e, const char *name)
 {
     plx_scene_info si;
     const char *crs = plx_scene_crs(e);
     plx_scene_info_get(e, &si);
-    if (strcmp(name, "lonlat") == 0 || strcmp(name, "EPSG:4326") == 0 || strcmp(name, "WGS84") == 0)
+    if (same_ci(name, "lonlat") || same_ci(name, "EPSG:4326") || same_ci(name, "WGS84"))
         return 1;
-    if (strcmp(name, "local") == 0)
+    if (same_ci(name, "local"))
         return 0;
     if (crs && cli_same_crs(name, crs)) /* "EPSG:3067" names "urn:ogc:def:crs:EPSG::3067" too */
         return si.lonlat;
@@ -1197,10 +1205,13 @@ void cli_points_far(const char *cmd, const cli_common *c, plx_engine *e, const c
         }
         n++;
     }
-    if (n > 0)
+    if (n > 0) {
+        char km[32]; /* not 300 digits for a point at 1e300 */
+        snprintf(km, sizeof km, far / 1000.0 < 1e7 ? "%.1f" : "%.3g", far / 1000.0);
         cli_warn(cmd, c, "%s: %zu of %zu points lie more than %.0f km outside the scene's bounds and every lamp's "
-                 "reach (the farthest %.1f km, line %zu): are they in the scene's coordinates?", path, n, p->n,
-                 CLI_FAR_POINT / 1000.0, far / 1000.0, p->line[worst]);
+                 "reach (the farthest %s km, line %zu): are they in the scene's coordinates?",
+                 strcmp(path, "-") == 0 ? "<stdin>" : path, n, p->n, CLI_FAR_POINT / 1000.0, km, p->line[worst]);
+    }
 }
 
 int cli_points_local(const char *cmd, plx_engine *e, const cli_common *c, const char *path, struct points *p,
@@ -1211,6 +1222,8 @@ int cli_points_local(const char *cmd, plx_engine *e, const cli_common *c, const 
     int lonlat;
     size_t k;
     plx_scene_info_get(e, &si);
+    if (strcmp(path, "-") == 0) /* named as the points' own messages name it */
+        path = "<stdin>";
     lonlat = name ? frame_of(e, name) : si.lonlat;
     if (lonlat < 0) {
         fprintf(stderr, "polarlux %s: %s: points crs '%s' is not lonlat, local or the scene's CRS (%s)\n", cmd,

@@ -1,3 +1,4 @@
+#include <ctype.h>
 #include <errno.h>
 #include <math.h>
 #include <stdio.h>
@@ -53,14 +54,16 @@ static int parse_row(const char *s, const char *end, double *row, int cols, cons
     return k;
 }
 
-/* "# crs: NAME" (spaces free) copies NAME into crs. */
-static void crs_line(const char *t, const char *end, char *crs, size_t len)
+/* "# crs: NAME" (spaces free, "crs:" in any case) copies NAME into crs;
+ * 1 when the line is one. */
+static int crs_line(const char *t, const char *end, char *crs, size_t len)
 {
     size_t n;
     for (t++; t < end && (*t == ' ' || *t == '\t'); t++)
         ;
-    if (end - t < 4 || strncmp(t, "crs:", 4) != 0)
-        return;
+    if (end - t < 4 || tolower((unsigned char)t[0]) != 'c' || tolower((unsigned char)t[1]) != 'r' ||
+        tolower((unsigned char)t[2]) != 's' || t[3] != ':')
+        return 0;
     for (t += 4; t < end && (*t == ' ' || *t == '\t'); t++)
         ;
     for (n = (size_t)(end - t); n > 0 && (t[n - 1] == ' ' || t[n - 1] == '\r' || t[n - 1] == '\t'); n--)
@@ -69,6 +72,25 @@ static void crs_line(const char *t, const char *end, char *crs, size_t len)
         n = len - 1;
     memcpy(crs, t, n);
     crs[n] = '\0';
+    return 1;
+}
+
+/* A '# crs:' line holds for the whole file, so it comes before the first
+ * point, once (a later one silently moved the points above it; two
+ * different ones were taken without a word). 0, or -1 with the message. */
+static int crs_place(const char *name, size_t lineno, const points *out, const char *crs, char *err, size_t errlen)
+{
+    if (out->n > 0) {
+        snprintf(err, errlen, "%s:%zu: a '# crs:' line after the first point: it names the whole file's "
+                 "coordinates, so it comes before the points", name, lineno);
+        return -1;
+    }
+    if (out->crs[0] && strcmp(out->crs, crs) != 0) {
+        snprintf(err, errlen, "%s:%zu: a second '# crs:' line (%.60s) differs from the first (%.60s)", name, lineno,
+                 crs, out->crs);
+        return -1;
+    }
+    return 0;
 }
 
 int points_parse(const char *name, const char *text, int need, int cols, const double *fill,
@@ -87,8 +109,16 @@ int points_parse(const char *name, const char *text, int need, int cols, const d
         lineno++;
         for (t = s; t < end && sep(*t); t++)
             ;
-        if (t < end && *t == '#')
-            crs_line(t, end, out->crs, sizeof out->crs);
+        if (t < end && *t == '#') {
+            char crs[sizeof out->crs];
+            if (crs_line(t, end, crs, sizeof crs)) {
+                if (crs_place(name, lineno, out, crs, err, errlen) != 0) {
+                    points_free(out);
+                    return -1;
+                }
+                memcpy(out->crs, crs, sizeof crs);
+            }
+        }
         if (t == end || *t == '#') {
             s = *end ? end + 1 : end;
             continue;

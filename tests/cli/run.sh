@@ -947,7 +947,12 @@ assert 'OpenStreetMap' in m['attribution'], m
 "
 # meters that all read 0 lx, points far outside the scene, an empty points file: a word each (helper-57's pass)
 expect meter-dark 0 "^polarlux meter: warning: every point is dark \\(0 lx\\): no lamp's light reaches it" -- sh -c "echo '1000 0' | '$bin' meter fixtures/tiny.geojson --points -"
-expect points-far-outside 0 "^polarlux illum: warning: -: 1 of 2 points lie more than 1 km outside the scene's bounds and every lamp's reach \\(the farthest 95\\.[0-9] km, line 1\\)" -- sh -c "printf '25.5 61\\n24.944 60.1677\\n' | '$bin' illum fixtures/helsinki-centre.geojson --points - --no-indirect"
+expect points-far-outside 0 "^polarlux illum: warning: <stdin>: 1 of 2 points lie more than 1 km outside the scene's bounds and every lamp's reach \\(the farthest 95\\.[0-9] km, line 1\\)" -- sh -c "printf '25.5 61\\n24.944 60.1677\\n' | '$bin' illum fixtures/helsinki-centre.geojson --points - --no-indirect"
+expect points-far-1e300 0 "the farthest 1e\+297 km, line 2\)" -- sh -c "printf '# crs: local\n1e300 0\n' | '$bin' illum fixtures/tiny.geojson --points - --no-indirect"
+# a '# crs:' line holds for the whole file: after a point, or a second different one, is an error (the last one moved the points above it); any case
+expect points-crs-after-point 1 "<stdin>:2: a '# crs:' line after the first point" -- sh -c "printf '24.944557742 60.172006463\n# crs: local\n0 0\n' | '$bin' illum -q --no-indirect fixtures/helsinki-centre.geojson --points -"
+expect points-crs-two 1 "<stdin>:2: a second '# crs:' line \(lonlat\) differs from the first \(local\)" -- sh -c "printf '# crs: local\n# crs: lonlat\n0 0\n' | '$bin' illum -q --no-indirect fixtures/helsinki-centre.geojson --points -"
+expect points-crs-any-case 0 "^24\.944557742 60\.172006463 0 2\.53" -- sh -c "printf '# CRS: LonLat\n24.944557742 60.172006463\n' | '$bin' illum -q --no-indirect fixtures/helsinki-centre.geojson --points -"
 printf '{"type":"FeatureCollection","properties":{"units":"m"},"features":[{"type":"Feature","properties":{"height":10},"geometry":{"type":"Polygon","coordinates":[[[0,0],[10,0],[10,10],[0,10],[0,0]]]}},{"type":"Feature","properties":{"lamp":true},"geometry":{"type":"Point","coordinates":[3000,0]}}]}' >"$tmp/far-lamp.geojson"
 echo '3000 5' | "$bin" illum "$tmp/far-lamp.geojson" --points - --no-indirect >"$tmp/out" 2>&1
 if grep -q "^3000 5 0 [1-9]" "$tmp/out" && ! grep -q "outside the scene's bounds" "$tmp/out"; then echo "ok   points-near-far-lamp"; pass=$((pass + 1)); else echo "FAIL points-near-far-lamp: a lit point by a lamp 3 km out was called out of reach"; sed 's/^/    /' "$tmp/out"; fail=$((fail + 1)); fi
