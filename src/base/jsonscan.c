@@ -394,6 +394,34 @@ int jsonscan_truncated(const char *text, size_t len)
     return in_string || depth > 0;
 }
 
+/* 1 when the text at 'at' starts with word w. */
+static int starts(const char *text, size_t len, size_t at, const char *w)
+{
+    size_t n = strlen(w);
+    return at + n <= len && memcmp(text + at, w, n) == 0;
+}
+
+/* Why the text is malformed at 'at' (before it: white space skipped back),
+ * for the common slips of text written by hand or by other tools: "" when
+ * none of them. */
+static const char *slip_at(const char *text, size_t len, size_t at)
+{
+    size_t b = at;
+    while (b > 0 && (unsigned char)text[b - 1] <= 32)
+        b--;
+    if (starts(text, len, at, "NaN") || starts(text, len, at, "nan") || starts(text, len, at, "Infinity") ||
+        starts(text, len, at, "-Infinity") || starts(text, len, at, "inf") || starts(text, len, at, "-inf"))
+        return ": JSON has no NaN or Infinity (write null, or leave the value out)";
+    if (text[at] == '\'' || (at > 0 && text[at - 1] == '\'')) /* a key fails one byte after its start */
+        return ": JSON strings take double quotes";
+    if ((text[at] == ']' || text[at] == '}') && b > 0 && text[b - 1] == ',')
+        return ": a comma before the closing bracket";
+    if (starts(text, len, at, "//") || starts(text, len, at, "/*") ||
+        (at > 0 && text[at - 1] == '/' && (text[at] == '/' || text[at] == '*')))
+        return ": JSON has no comments";
+    return "";
+}
+
 size_t jsonscan_error_at(const char *text, size_t len, size_t at, const char **tail)
 {
     int truncated = jsonscan_truncated(text, len), empty = 1;
@@ -402,7 +430,7 @@ size_t jsonscan_error_at(const char *text, size_t len, size_t at, const char **t
         empty = text[k] == ' ' || text[k] == '\t' || text[k] == '\r' || text[k] == '\n';
     if (at > len || (truncated && at + 1 >= len) || empty)
         at = len;
-    *tail = at < len ? ""
+    *tail = at < len ? slip_at(text, len, at)
             : empty ? (len == 0      ? ": the file is empty"
                        : len == bom  ? ": the text holds only a UTF-8 byte-order mark"
                        : bom         ? ": the text holds only a UTF-8 byte-order mark and white space"

@@ -94,7 +94,9 @@ int jsonscan_truncated(const char *text, size_t len);
  * which the readers skip), else 'at'; *tail gets the words for the end
  * (": the file is empty", ": the text holds only white space", ": the
  * text holds only a UTF-8 byte-order mark" [" and white space"], ": the
- * text ends early", ": unexpected end") or "". */
+ * text ends early", ": unexpected end"), or the slip found at 'at' (": JSON
+ * has no NaN or Infinity ...", ": JSON strings take double quotes", ": a
+ * comma before the closing bracket", ": JSON has no comments"), or "". */
 size_t jsonscan_error_at(const char *text, size_t len, size_t at, const char **tail /* OUT */);
 
 #endif

@@ -35,6 +35,13 @@ expect info-tiny-blocks 0 "^blocks: 3 with 1 courtyards" -- "$bin" info fixtures
 expect info-tiny-lamp-warning 0 "warning: fixtures/tiny.geojson: feature 6 \(L3, line 18, column 3\): lamp is inside building 0 \(A\); left out" -- "$bin" info fixtures/tiny.geojson
 (cat fixtures/tiny.geojson; printf '\000garbage') >"$tmp/nul-text.geojson"
 expect info-nul-then-text 1 "nul-text\\.geojson: malformed JSON at byte [0-9]+ \\(line 23, column 1\\)" -- "$bin" info "$tmp/nul-text.geojson"
+# the common slips of hand-written JSON are named (helper-64: a NaN said only "malformed JSON at byte 81")
+printf "{'type':'FeatureCollection'}" >"$tmp/single-quotes.geojson"
+expect info-json-single-quotes 1 "malformed JSON at byte 2 \(line 1, column 3\): JSON strings take double quotes$" -- "$bin" info "$tmp/single-quotes.geojson"
+printf '{"type":"FeatureCollection","features":[1,]}' >"$tmp/trailing-comma.geojson"
+expect info-json-trailing-comma 1 "malformed JSON at byte 42 \(line 1, column 43\): a comma before the closing bracket$" -- "$bin" info "$tmp/trailing-comma.geojson"
+printf '{"type":"FeatureCollection", // the city\n"features":[]}' >"$tmp/comment.geojson"
+expect info-json-comment 1 "\(line 1, column 31\): JSON has no comments$" -- "$bin" info "$tmp/comment.geojson"
 (cat fixtures/tiny.geojson; printf '\000\000') >"$tmp/nul-end.geojson"
 expect info-nul-at-end 0 "^buildings: 4 " -- "$bin" info "$tmp/nul-end.geojson"
 # a key read twice in one object: the first is read (cJSON's way), said on stderr; fatal when strict

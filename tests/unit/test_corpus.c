@@ -226,8 +226,10 @@ static const corpus_case corpus[] = {
       1, 3, 8, 0,
       "hlongmantissa|i1e308 id-huge 1e308" },
     { "infinity-bare.geojson", PLX_E_PARSE,
-      "malformed JSON at byte 109 (line 2, column 42)",
-      "malformed JSON at byte 109 (line 2, column 42)",
+      "malformed JSON at byte 109 (line 2, column 42)"
+      ": JSON has no NaN or Infinity (write null, or leave the value out)",
+      "malformed JSON at byte 109 (line 2, column 42)"
+      ": JSON has no NaN or Infinity (write null, or leave the value out)",
       "",
       0, 0, 0, 0,
       NULL },
@@ -271,14 +273,18 @@ static const corpus_case corpus[] = {
       0, 3, 1, 0,
       "|zero zero-str neg-zero" },
     { "minus-infinity-bare.geojson", PLX_E_PARSE,
-      "malformed JSON at byte 116 (line 2, column 49)",
-      "malformed JSON at byte 116 (line 2, column 49)",
+      "malformed JSON at byte 116 (line 2, column 49)"
+      ": JSON has no NaN or Infinity (write null, or leave the value out)",
+      "malformed JSON at byte 116 (line 2, column 49)"
+      ": JSON has no NaN or Infinity (write null, or leave the value out)",
       "",
       0, 0, 0, 0,
       NULL },
     { "nan-bare.geojson", PLX_E_PARSE,
-      "malformed JSON at byte 154 (line 2, column 87)",
-      "malformed JSON at byte 154 (line 2, column 87)",
+      "malformed JSON at byte 154 (line 2, column 87)"
+      ": JSON has no NaN or Infinity (write null, or leave the value out)",
+      "malformed JSON at byte 154 (line 2, column 87)"
+      ": JSON has no NaN or Infinity (write null, or leave the value out)",
       "",
       0, 0, 0, 0,
       NULL },
