@@ -681,7 +681,9 @@ expect walk-contact-narrow 0 "^walk: 4 frames 3x1600 " -- \
 "$bin" bake -q fixtures/helsinki-centre.geojson --mem 16M --no-aerial --no-polar --max-size 320x240 --frames 2 -o "$tmp/hs.plxb" >/dev/null 2>&1
 echo "0 0 1.5" >"$tmp/hs.txt"
 expect illum-bake-reduced 0 "^polarlux illum: indirect light at reduced quality as the bake was made \(to fit its --mem when baked\): photon buffers" -- \
-    "$bin" illum -q "$tmp/hs.plxb" --points "$tmp/hs.txt" --frames 2
+    "$bin" illum "$tmp/hs.plxb" --points "$tmp/hs.txt" --frames 2
+expect illum-bake-reduced-quiet 0 "" -- "$bin" illum -q "$tmp/hs.plxb" --points "$tmp/hs.txt" --frames 2
+if grep -q "reduced quality" "$tmp/out"; then echo "FAIL illum-bake-reduced-quiet: --quiet printed the note"; fail=$((fail + 1)); fi
 # slow frames in a block given with --mem: a larger --mem is named too
 expect walk-slower-mem 0 "fall behind on this machine; --aa 1 \(one sample a pixel\), a smaller --size or a lower --fps keep up; a larger --mem may too" -- \
     "$bin" walk "$tmp/e.plxb" --fps 10000 --mem 1G --path "$tmp/endpath.geojson" --size 160x120 --max-frames 3 -o "$tmp/endw"
