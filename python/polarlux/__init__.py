@@ -447,6 +447,7 @@ class Scene:
             if nrm.shape != pts.shape:
                 raise ValueError("normals must have the shape of points")
         n = pts.shape[0]
+        self._far(pts)
         ed, ei = np.empty(n), np.empty(n)
         st = lib.plx_illuminance(self._e, n, _dptr(pts), _dptr(nrm), _dptr(ed), _dptr(ei), None)
         if st not in (_lib.OK, _lib.E_RANGE):
@@ -464,6 +465,21 @@ class Scene:
                            RuntimeWarning, stacklevel=3)
         return ed, ei
 
+    def _far(self, pts):
+        """A RuntimeWarning when points lie more than 1 km outside the scene's
+        bounds (the command's warning: no lamp reaches them, and they read 0
+        lx without a word)."""
+        b = self.info["bounds"]
+        with np.errstate(invalid="ignore"):
+            d = np.hypot(np.maximum(np.maximum(b[0] - pts[:, 0], pts[:, 0] - b[2]), 0.0),
+                         np.maximum(np.maximum(b[1] - pts[:, 1], pts[:, 1] - b[3]), 0.0))
+        far = d > 1000.0
+        if far.any():
+            k = int(np.argmax(np.where(far, d, -1.0)))
+            _warnings.warn(f"{int(far.sum())} of {len(pts)} points lie more than 1 km outside the scene's bounds "
+                           f"(the farthest, point {k}, {d[k] / 1000.0:.4g} km): are they in the scene's local "
+                           f"metres?", RuntimeWarning, stacklevel=4)
+
     @_engine_call
     def meter(self, points, facing=None):
         """Light meter readings in free air (SPEC §6, EN 13201's pedestrian
@@ -477,6 +493,7 @@ class Scene:
         PolarluxError (PLX_E_INVALID)."""
         pts = _points(points, 3, "points")
         self._local(pts, "points")
+        self._far(pts)
         n = pts.shape[0]
         u = None
         if facing is not None:
@@ -553,6 +570,13 @@ class Scene:
         n = a.shape[0]
         if n < 2:
             raise ValueError("a route needs 2 or more vertices")
+        if not (isinstance(step, numbers.Real) and np.isfinite(step) and step > 0):
+            raise ValueError(f"step must be a number of metres above 0, not {step!r}")
+        if not (isinstance(dark_lux, numbers.Real) and np.isfinite(dark_lux) and dark_lux >= 0):
+            raise ValueError(f"dark_lux must be a number of lux from 0, not {dark_lux!r}")
+        if facial_height is not None and not (isinstance(facial_height, numbers.Real) and
+                                              np.isfinite(facial_height) and facial_height > 0):
+            raise ValueError(f"facial_height must be a height in metres above 0, not {facial_height!r}")
         self._local(a, "xy")
         total = _lib.padded(_lib.RouteStats)
         segs = (_lib.RouteStats * (n - 1))()
@@ -601,6 +625,9 @@ class Scene:
         again); aa=N: N x N samples a pixel, adaptive (1: the pixel centre,
         SPEC §5). What plx_render reported (the exposure applied, ...) is in
         .last_render."""
+        if not hasattr(size, "__len__") or len(size) != 2 or any(not isinstance(k, numbers.Integral) or k < 1
+                                                                 for k in size):
+            raise ValueError(f"size must be (width, height) in whole pixels, not {size!r}")
         w, h = int(size[0]), int(size[1])
         if not (isinstance(aa, numbers.Integral) and 1 <= aa <= 16):
             raise ValueError(f"aa must be a whole number from 1 to 16, not {aa!r}")
@@ -610,9 +637,6 @@ class Scene:
             raise ValueError("held needs exposure='auto' (it holds the automatic exposure)")
         if held is not None and not (isinstance(held, numbers.Real) and np.isfinite(held) and held > 0):
             raise ValueError(f"held must be the last frame's exposure, a positive number, not {held!r}")
-        for name, v in (("size", size),):
-            if len(v) != 2 or any(not isinstance(k, numbers.Integral) or k < 1 for k in v):
-                raise ValueError(f"size must be (width, height) in whole pixels, not {tuple(v)!r}")
         if tone_curve and exposure == "auto":
             raise ValueError("tone_curve needs a number for exposure (automatic exposure has the curve)")
         for name, v in (("eye", eye), ("target", target)):

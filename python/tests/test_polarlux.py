@@ -325,6 +325,21 @@ def test_errors_name_the_place():
         polarlux.Scene.from_file(TINY).illuminance(np.zeros((3, 4)))
 
 
+def test_far_points_are_said():
+    s = polarlux.Scene.from_file(TINY)
+    with pytest.warns(RuntimeWarning, match=r"1 of 2 points lie more than 1 km outside the scene's bounds "
+                                            r"\(the farthest, point 1, 1e\+04 km\)"):
+        ed, _ = s.illuminance([[30, 12], [1e7, 0]])
+    assert ed[1] == 0.0 and ed[0] > 0.0
+    with pytest.warns(RuntimeWarning, match="more than 1 km outside"):
+        s.meter([[1e5, 0, 1.5]])
+    import warnings
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", RuntimeWarning)
+        warnings.filterwarnings("ignore", "E_indirect is 0")
+        s.illuminance([[30, 12], [60, 40]])  # near points: no word
+
+
 def test_lonlat_given_for_metres_is_refused(tmp_path):
     """A lon/lat scene's API takes local metres: lon/lat degrees within the
     scene are refused (a route of them scored 0 m, a render was black), and
@@ -555,6 +570,12 @@ def test_scene_inputs_and_lifetime_errors(tmp_path):
         s.render(eye=(30, 12, 1.7), target=(50, 10, 1), size=(8, 6), exposure="auto", held=-1)
     with pytest.raises(ValueError, match="size must be"):
         s.render(eye=(30, 12, 1.7), target=(50, 10, 1), size=(8.5, 6))
+    with pytest.raises(ValueError, match="size must be"):  # a bare int was a TypeError from inside (helper-64)
+        s.render(eye=(30, 12, 1.7), target=(50, 10, 1), size=32)
+    with pytest.raises(ValueError, match="step must be a number of metres above 0, not 0"):  # each named
+        s.route_score([[30, 12], [50, 12]], step=0)
+    with pytest.raises(ValueError, match="dark_lux must be"):
+        s.route_score([[30, 12], [50, 12]], dark_lux=-1)
     s.close()
     assert repr(s) == "<polarlux.Scene (closed)>"
     for call in (lambda: s.illuminance([[30, 12]]), lambda: s.memory(), lambda: s.meter([[30, 12, 1.5]])):

@@ -518,6 +518,12 @@ const char *cli_black_reason(plx_engine *e, const plx_camera *cam, const plx_ren
                  "level from high up (--target, or a walk path's properties.targets, aims it)");
         return buf;
     }
+    if (info.drawn == 0) { /* looking down on ground no lamp reaches: past the city's edge (a kiosk pass's
+                            * flight was told that no lamp's light reached it) */
+        snprintf(buf, len, "the camera sees no building and no lit ground: it looks down past the city's edge "
+                 "(--target, or a walk path's properties.targets, aims it)");
+        return buf;
+    }
     return cli_dark_reason(e);
 }
 

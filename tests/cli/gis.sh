@@ -20,6 +20,9 @@ expect dark-walk-no-lamps 0 "nolamp\.geojson has no lamps, so every result is da
 expect dark-walk-every-frame 0 "warning: every frame is entirely black: the scene has no lamps" -- "$bin" walk "$tmp/nolamp.geojson" --path "$tmp/away.geojson" --speed 100 --fps 1 --size 16x12 --no-indirect -o "$tmp/dwalk"
 # walking away from tiny's lamps, looking ahead: the first frame lit, the five after it black
 expect dark-walk-some-frames 0 "warning: 5 of 6 frames are entirely black \(the first: frame 2\): the camera sees no building and no lit ground: it looks away from the city" -- "$bin" walk fixtures/tiny.geojson --path "$tmp/away.geojson" --speed 100 --fps 1 --size 32x24 --no-indirect --no-glow -o "$tmp/dwalk2"
+# flying high, looking down past the city's edge: said so (a kiosk pass's flight was told no lamp's light reached it)
+echo '{"type":"Feature","properties":{"units":"m"},"geometry":{"type":"LineString","coordinates":[[30,12,300],[-3000,12,300]]}}' >"$tmp/high.geojson"
+expect dark-walk-past-edge 0 "warning: every frame is entirely black: the camera sees no building and no lit ground: it looks down past the city's edge" -- "$bin" walk fixtures/tiny.geojson --path "$tmp/high.geojson" --pitch 45 --speed 500 --fps 1 --size 32x24 --no-indirect --no-glow -o "$tmp/dwalk5"
 expect dark-walk-lit-silent 0 "" -- "$bin" walk fixtures/tiny.geojson --path "$tmp/away.geojson" --speed 100 --fps 1 --size 32x24 --no-indirect --no-glow --max-frames 1 -o "$tmp/dwalk3"
 if grep -q "black" "$tmp/out"; then echo "FAIL dark-walk-lit-silent: a lit frame was called black"; fail=$((fail + 1)); fi
 expect dark-bake-no-lamps 0 "nolamp\.geojson has no lamps, so every result is dark" -- "$bin" bake "$tmp/nolamp.geojson" --frames 1 -o "$tmp/nolamp.plxb"
