@@ -375,8 +375,12 @@ static int find_routes(const net_opts *o, plx_engine *e, network *net, int read_
     r1 = net_route_find(net, e, &a, &b, 0.0, &shortest, err, sizeof err);
     r2 = r1 == 0 ? net_route_find(net, e, &a, &b, o->weight, &best, err, sizeof err) : r1;
     if (r1 == 1 || r2 == 1) {
+        double la = net_part_length(net, net->edges[a.edge].a), lb = net_part_length(net, net->edges[b.edge].a);
         fprintf(stderr, "polarlux %s: %s: no path from --from %s to --to %s: they lie on unconnected parts of the "
-                        "network (it has %u parts)\n", o->cmd, o->network, o->from_s, o->to_s, net_components(net));
+                        "network (it has %u parts): --from snapped %.1f m to a part of %.0f m of streets, --to "
+                        "%.1f m to one of %.0f m%s\n", o->cmd, o->network, o->from_s, o->to_s, net_components(net),
+                a.dist, la, b.dist, lb, fmin(la, lb) < 0.1 * fmax(la, lb) ? " (the smaller is likely an isolated "
+                "piece of the street data: move that end nearer a street of the larger)" : "");
         rc = EXIT_FAIL;
     } else if (r1 < 0 || r2 < 0) {
         fprintf(stderr, "polarlux %s: %s\n", o->cmd, err);

@@ -816,6 +816,36 @@ void net_route_free(net_route *r)
     r->n = 0;
 }
 
+double net_part_length(const network *net, uint32_t node)
+{
+    uint32_t *stack = malloc(sizeof *stack * ((size_t)net->nnodes + 1)), top = 0, j;
+    unsigned char *seen = calloc((size_t)net->nnodes + 1, 1);
+    double len = 0.0;
+    if (!stack || !seen || node >= net->nnodes) {
+        free(stack);
+        free(seen);
+        return 0.0;
+    }
+    seen[node] = 1;
+    stack[top++] = node;
+    while (top > 0) {
+        uint32_t u = stack[--top];
+        for (j = net->adj_first[u]; j < net->adj_first[u + 1]; j++) {
+            const net_edge *ed = &net->edges[net->adj[j]];
+            uint32_t v = ed->a == u ? ed->b : ed->a;
+            if (ed->a == u && (ed->b != u || j == net->adj_first[u] || net->adj[j - 1] != net->adj[j]))
+                len += ed->length; /* each edge once: from its end a */
+            if (!seen[v]) {
+                seen[v] = 1;
+                stack[top++] = v;
+            }
+        }
+    }
+    free(stack);
+    free(seen);
+    return len;
+}
+
 uint32_t net_components(const network *net)
 {
     uint32_t *stack = malloc(sizeof *stack * ((size_t)net->nnodes + 1)), i, parts = 0;

@@ -129,5 +129,7 @@ int net_route_capped(network *net, plx_engine *e, const net_snap *a, const net_s
 
 /* The number of connected parts of the network (for messages). */
 uint32_t net_components(const network *net);
+/* The length (m) of the streets of the part of the network node lies on. */
+double net_part_length(const network *net, uint32_t node);
 
 #endif

@@ -16,6 +16,9 @@ expect net-capped-any-weight 0 "cost = length \+ 0\.763[0-9]* x dark metres.*wei
 expect net-max-detour-loose 0 "^best-lit +300\.0 " -- "$bin" route -q $net --from 0,0 --to 200,0 --max-detour 0.6
 expect net-far-start 1 "route: --from 0,-80 is 80\.0 m from the nearest street of fixtures/net-detour-streets\.geojson \(more than --snap 50 m\)" -- "$bin" route -q $net --from 0,-80 --to 200,0
 expect net-unreachable 1 "no path from --from 0,0 to --to 410,400: they lie on unconnected parts of the network \(it has 2 parts\)" -- "$bin" route -q $net --from 0,0 --to 410,400
+# each end's part is measured, and a small one named (helper-64: a 42 m fragment 1.7 m away took the Helsinki route)
+expect net-unreachable-parts 1 "\(it has 2 parts\): --from snapped 0\.0 m to a part of [0-9]+ m of streets, --to 0\.0 m to one of [0-9]+ m" -- "$bin" route -q $net --from 0,0 --to 410,400
+expect net-unreachable-helsinki 1 "--from snapped 1\.7 m to a part of 42 m of streets, --to 1\.0 m to one of 98413 m \(the smaller is likely an isolated piece of the street data" -- "$bin" route -q fixtures/helsinki-centre.geojson --network fixtures/helsinki-streets.geojson --from 24.9438573,60.1716161 --to 24.9509247,60.1681328
 printf '{"type":"FeatureCollection","properties":{"units":"m"},"features":[]}' >"$tmp/empty-net.json"
 expect net-empty 1 "route: $tmp/empty-net\.json: no LineString features" -- "$bin" route -q fixtures/net-detour.geojson --network "$tmp/empty-net.json" --from 0,0 --to 1,1
 expect net-missing-to 2 "--network needs --from X,Y and --to X,Y" -- "$bin" route -q $net --from 0,0
