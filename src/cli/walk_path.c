@@ -283,26 +283,44 @@ void walk_path_free(walk_path *wp)
     memset(wp, 0, sizeof *wp);
 }
 
+/* A segment's length under this moves the eye too little to look along
+ * (m). */
+#define WALK_FLAT 1e-6
+
+static double dist3(const double *a, const double *b)
+{
+    return hypot(hypot(b[0] - a[0], b[1] - a[1]), b[2] - a[2]);
+}
+
+/* Segment k's (1 .. n - 1) share of the walk: the eye's metres, or, where
+ * the eye stays put and targets turn the view (a pan on the spot: it gave
+ * one frame, its targets unused), the target's metres. */
+static double seg_len(const walk_path *wp, uint32_t k)
+{
+    double d = dist3(wp->eye + 3 * (k - 1), wp->eye + 3 * k);
+    if (!(d > WALK_FLAT) && wp->target)
+        return dist3(wp->target + 3 * (k - 1), wp->target + 3 * k);
+    return d;
+}
+
 double walk_path_length(const walk_path *wp)
 {
     double L = 0;
     uint32_t k;
     for (k = 1; k < wp->n; k++)
-        L += hypot(hypot(wp->eye[3 * k] - wp->eye[3 * k - 3], wp->eye[3 * k + 1] - wp->eye[3 * k - 2]),
-                   wp->eye[3 * k + 2] - wp->eye[3 * k - 1]);
+        L += seg_len(wp, k);
     return L;
 }
 
-/* The segment k (1 .. n - 1, from position k - 1 to k) of the eye
- * polyline holding arc length s, the last one beyond the end; *acc the
+/* The segment k (1 .. n - 1, from position k - 1 to k) of the path
+ * holding arc length s (seg_len's), the last one beyond the end; *acc the
  * length before it, *seg its own. */
 static uint32_t segment_at(const walk_path *wp, double s, double *acc, double *seg)
 {
     uint32_t k;
     *acc = 0.0;
     for (k = 1;; k++) {
-        const double *a = wp->eye + 3 * (k - 1), *b = wp->eye + 3 * k;
-        *seg = hypot(hypot(b[0] - a[0], b[1] - a[1]), b[2] - a[2]);
+        *seg = seg_len(wp, k);
         if (!(s > *acc + *seg) || k + 1 >= wp->n)
             return k;
         *acc += *seg;
@@ -325,10 +343,6 @@ static void at(const walk_path *wp, const double *pts, double s, double out[3])
     for (c = 0; c < 3; c++)
         out[c] = pts[3 * (k - 1) + c] + t * (pts[3 * k + c] - pts[3 * (k - 1) + c]);
 }
-
-/* A segment's horizontal length under this moves the eye too little to
- * look along (m). */
-#define WALK_FLAT 1e-6
 
 /* Segment k's (1 .. n - 1) horizontal direction, unit; 0 when it hardly
  * moves horizontally. */

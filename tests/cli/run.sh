@@ -788,6 +788,10 @@ expect walk-metres-on-lonlat-hint 1 "is more than 1e7 m from the scene's origin 
 printf '{"type":"LineString","properties":{"units":"m"},"coordinates":[[1,2,1.7,9],[1,9,2]]}' >"$tmp/four.geojson"
 expect walk-four-numbers 1 "position 0 is not \[x, y\] or \[x, y, z\] of finite numbers$" -- \
     "$bin" walk -q "$tmp/e.plxb" --path "$tmp/four.geojson" -o "$tmp/w3"
+# a pan on the spot: the eye stays, the targets turn the view at --speed (it gave one frame, the targets unused)
+printf '{"type":"Feature","properties":{"units":"m","targets":[[60,133,1.5],[70,143,1.5],[50,153,1.5]]},"geometry":{"type":"LineString","coordinates":[[50,133],[50,133],[50,133]]}}' >"$tmp/pan.geojson"
+expect walk-pan-on-the-spot 0 "^walk: 653 frames 32x24 \(36\.5 m of 36\.5 m " -- "$bin" walk fixtures/tiny.geojson --path "$tmp/pan.geojson" --size 32x24 --no-indirect --aa 1 -o "$tmp/pan"
+expect walk-pan-cameras 0 "^299 50 133 1\.7 67\.72[0-9]* 144\.13[0-9]* 1\.5 " -- cat "$tmp/pan/cameras.txt"
 printf 'x' >"$tmp/wfile"
 expect walk-out-is-file 1 "^polarlux walk: $tmp/wfile: not a folder" -- \
     "$bin" walk -q "$tmp/e.plxb" --path "$tmp/path.geojson" --size 32x24 -o "$tmp/wfile"
