@@ -124,7 +124,7 @@ static int set_frame(const cJSON *root, const cJSON *features, plx_engine *e, fr
     const cJSON *props = cJSON_GetObjectItemCaseSensitive(root, "properties");
     const cJSON *units = cJSON_GetObjectItemCaseSensitive(props, "units"), *ft;
     plx_scene_info si;
-    int ll = 1, plain = 0, k = 0;
+    int ll = 1, plain = 0, k = 0, lines = 0, lines_ll = 0;
     memset(f, 0, sizeof f[0]);
     note[0] = '\0';
     plx_scene_info_get(e, &si);
@@ -147,6 +147,10 @@ static int set_frame(const cJSON *root, const cJSON *features, plx_engine *e, fr
         if (feature_units(ft) > 0)
             continue;
         plain += count_positions(co);
+        if (count_positions(co) > 0) {
+            lines++;
+            lines_ll += all_lonlat(co);
+        }
         if (!all_lonlat(co))
             ll = 0;
     }
@@ -162,9 +166,12 @@ static int set_frame(const cJSON *root, const cJSON *features, plx_engine *e, fr
         return 0;
     }
     if (!ll) {
-        snprintf(note, notelen,
-                 "coordinates exceed the lon/lat range: read as metres of the scene's frame, where the scene is in "
-                 "lon/lat (properties.units \"m\" says so and silences this)");
+        int n = snprintf(note, notelen,
+                         "coordinates exceed the lon/lat range: read as metres of the scene's frame, where the scene "
+                         "is in lon/lat (properties.units \"m\" says so and silences this)");
+        if (lines_ll > 0 && n > 0 && (size_t)n < notelen) /* a line in lon/lat among them was read as metres */
+            snprintf(note + n, notelen - (size_t)n, "; %d of the %d lines lie wholly within it: if those are "
+                     "lon/lat, the file mixes coordinate systems", lines_ll, lines);
         return 0;
     }
     f->lonlat = 1;

@@ -18,7 +18,7 @@ typedef struct route_line {
 typedef struct route_set {
     route_line *lines;
     size_t n;
-    char note[200];    /* a warning on how the file was read ("" if none): printed unless --quiet */
+    char note[400];    /* a warning on how the file was read ("" if none): printed unless --quiet */
 } route_set;
 
 /* 0 on success; -1 with "FILE: feature k: why" in err. */

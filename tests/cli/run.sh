@@ -886,6 +886,8 @@ expect photometry-nadir 0 "^0 0 0 2\\.768895999" -- sh -c "echo '0 0' | '$bin' i
 H=fixtures/helsinki-centre.geojson
 printf '{"type":"FeatureCollection","features":[{"type":"Feature","properties":{},"geometry":{"type":"LineString","coordinates":[[100,200],[300,200]]}}]}' >"$tmp/metres-route.json"
 expect route-metres-on-lonlat-warns 0 "warning: .*metres-route.json: coordinates exceed the lon/lat range: read as metres" -- "$bin" route $H --path "$tmp/metres-route.json"
+printf '{"type":"FeatureCollection","features":[{"type":"Feature","properties":{"name":"a"},"geometry":{"type":"LineString","coordinates":[[24.944,60.1677],[24.945,60.1677]]}},{"type":"Feature","properties":{"name":"b"},"geometry":{"type":"LineString","coordinates":[[385920,6672300],[385930,6672300]]}}]}' >"$tmp/mixroute.json"
+expect route-mixed-lines-counted 0 "mixroute\.json: coordinates exceed the lon/lat range: read as metres .*; 1 of the 2 lines lie wholly within it: if those are lon/lat, the file mixes coordinate systems" -- "$bin" route $H --path "$tmp/mixroute.json"
 printf '{"type":"FeatureCollection","properties":{"units":"m"},"features":[{"type":"Feature","properties":{},"geometry":{"type":"LineString","coordinates":[[100,200],[300,200]]}}]}' >"$tmp/metres-route-m.json"
 "$bin" route $H --path "$tmp/metres-route-m.json" >/dev/null 2>"$tmp/err"
 if ! grep -q "exceed the lon/lat range" "$tmp/err" && grep -q "note: the lux are direct light only" "$tmp/err"; then echo "ok   route-units-m-no-warning"; pass=$((pass + 1)); else echo "FAIL route-units-m-no-warning"; fail=$((fail + 1)); fi
