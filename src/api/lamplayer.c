@@ -14,6 +14,7 @@
 #include "base/strbuf.h"
 #include "base/lonlat.h"
 #include "scene/features.h"
+#include "scene/photometry.h"
 
 #define LAYER_MAX_COORD 1.0e7
 #define LAYER_MAX_HEIGHT 1000.0
@@ -72,8 +73,8 @@ static const char *layer_lamp(const scene *s, const plx_lamp *in, scene_lamp *ou
         return "position is out of range (|coordinate| > 1e7 m)";
     if (!isfinite(in->z) || in->z < 0.0 || in->z > LAYER_MAX_HEIGHT)
         return "z is out of range (0 to 1000 m)";
-    if (!isfinite(in->intensity) || in->intensity < 0.0)
-        return "intensity is negative or not finite";
+    if (!(in->intensity >= 0.0 && in->intensity <= PHOTOMETRY_MAX_CD))
+        return "intensity is negative, not finite or above 1e12 cd";
     if (!isfinite(in->radius) || !(in->radius > 0.0) || in->radius > LAYER_MAX_RADIUS)
         return "radius is out of range (> 0 and <= 100000 m)";
     for (k = 0; k < 3; k++)

@@ -17,8 +17,9 @@ typedef struct points {
  * Without fill (vis), numbers past 'cols' are ignored and missing ones up
  * to 'cols' are an error. With fill (illum, meter), missing ones take
  * fill[k], but the numbers after the third are given whole (a normal or a
- * facing) and none past 'cols' (a row of 4 or 5 of 6, 4 or 7 of 5, is an
- * error). Returns 0, or -1 with
+ * facing) and none past 'cols' (with cols 6, a row of 4, 5 or more than 6
+ * numbers is an error; with cols 5, of 4 or more than 5). Returns 0, or
+ * -1 with
  * "NAME:LINE: why" in err. */
 int points_parse(const char *name, const char *text, int need, int cols, const double *fill,
                  points *out, char *err, size_t errlen);

@@ -661,10 +661,11 @@ static plx_status read_lamp(loader *ld, const feat *m, jv props, uint32_t fi, co
         sb_str(&why, "lamp z ");
         sb_num(&why, l->z, 6);
         sb_str(&why, " m is out of range (0 to 1000 m)");
-    } else if (!isfinite(l->intensity) || l->intensity < 0.0) {
+    } else if (!(l->intensity >= 0.0 && l->intensity <= PHOTOMETRY_MAX_CD)) {
+        /* above it, every lux and the photons' sums overflowed (1e308 cd gave E_indirect inf) */
         sb_str(&why, "lamp intensity ");
         sb_num(&why, l->intensity, 6);
-        sb_str(&why, " cd is negative or not finite");
+        sb_str(&why, " cd is negative, not finite or above 1e12 cd");
     } else if (!isfinite(l->radius) || l->radius <= 0.0 || l->radius > MAX_RADIUS) {
         sb_str(&why, "lamp radius ");
         sb_num(&why, l->radius, 6);

@@ -61,8 +61,9 @@ int ld_prop_number(loader *ld, uint32_t fi, const char *id, jv props, const char
 /* Reading values in place (loader.c; base/jsonscan.h for the rules). */
 js_kind ld_kind(const loader *ld, jv v);
 /* The member key of object obj (JV_NONE if none or obj is no object): the
- * first, as cJSON; a later member of the same key (in an object of at most
- * LD_MEMBERS members) is noted in the cache's dup. */
+ * first, as cJSON; a later member of the same key among the object's first
+ * LD_MEMBERS members is noted in the cache's dup (a key found past them,
+ * or a second one past them, is not compared). */
 jv ld_get(const loader *ld, jv obj, const char *key);
 /* Children of an array or object (an object's member values), as cJSON's
  * child list: the first (JV_NONE if none), the one after child. */

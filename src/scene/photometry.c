@@ -340,7 +340,9 @@ static plx_status pm_bounded(pm_text *t, uint32_t line, double cd, const char *b
     sb_init(&m, why, sizeof why);
     sb_str(&m, "an intensity times ");
     sb_str(&m, by);
-    sb_str(&m, " is above 1e12 cd: not a luminaire's");
+    sb_str(&m, " is above ");
+    sb_num(&m, PHOTOMETRY_MAX_CD, 3);
+    sb_str(&m, " cd: not a luminaire's");
     return pm_fail(t, line, why, NULL);
 }
 
@@ -354,7 +356,7 @@ static plx_status pm_candela(pm_text *t, double *cd, size_t n, double mult)
         if (cd[i] < 0.0)
             return pm_fail(t, t->line, "negative candela value", NULL);
         cd[i] *= mult;
-        if ((st = pm_bounded(t, t->line, cd[i], "the candela multiplier x the ballast factors")) != PLX_OK)
+        if ((st = pm_bounded(t, t->line, cd[i], "the candela multiplier and ballast factors")) != PLX_OK)
             return st;
     }
     return PLX_OK;

@@ -193,7 +193,10 @@ static const bad_case bad_cases[] = {
     { "{\"type\":\"Point\",\"coordinates\":[0,0]}", "{\"lamp\":true,\"z\":-1}",
       "t.geojson: feature 0 (line 1, column 68): lamp z -1 m is out of range (0 to 1000 m)" },
     { "{\"type\":\"Point\",\"coordinates\":[0,0]}", "{\"lamp\":true,\"intensity\":-5}",
-      "t.geojson: feature 0 (line 1, column 68): lamp intensity -5 cd is negative or not finite" },
+      "t.geojson: feature 0 (line 1, column 68): lamp intensity -5 cd is negative, not finite or above 1e12 cd" },
+    /* helper-65: 1e308 cd made E_indirect inf */
+    { "{\"type\":\"Point\",\"coordinates\":[0,0]}", "{\"lamp\":true,\"intensity\":1e308}",
+      "t.geojson: feature 0 (line 1, column 68): lamp intensity 1e308 cd is negative, not finite or above 1e12 cd" },
     { "{\"type\":\"MultiPolygon\",\"coordinates\":[[[[0,0],[1,0],[1,1]]],[[[5,5],[6,5]]]]}", "{}",
       "t.geojson: feature 0 (line 1, column 68): polygon 1: outer ring has 2 distinct vertices (a ring needs at least 3)" },
 };

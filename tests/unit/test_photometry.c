@@ -213,7 +213,7 @@ static void test_parse_errors(void **state)
                  "factor is negative");
     /* CI's fuzz_ies: each number finite, their product not (1e300 x 1e10); the bound is 1e12 cd as used */
     expect_error(&b, "TILT=NONE\n1 -1 1e300 2 1 1 2 0 0 0 1 1 0\n0 90\n0\n1e10 0\n", "t.ies: line 5: an intensity "
-                 "times the candela multiplier x the ballast factors is above 1e12 cd: not a luminaire's");
+                 "times the candela multiplier and ballast factors is above 1e12 cd: not a luminaire's");
     expect_error(&b, "TILT=NONE\n1 -1 10 2 1 1 2 0 0 0 1 1 0\n0 90\n0\n0\n2e11\n", "t.ies: line 6: an intensity");
     parse(&b, "TILT=NONE\n1 -1 10 2 1 1 2 0 0 0 1 1 0\n0 90\n0\n0 1e11\n", PLX_OK); /* 1e12 cd exactly: kept */
     expect_error(&b, ldt(buf, sizeof buf, 1, 4, 90, "0\n90\n", 2, "1\n1e300\n", 1e10, 1000), "t.ies: line 50: an "
