@@ -118,16 +118,54 @@ static int feature_units(const cJSON *ft)
     return cJSON_IsString(u) && strcmp(u->valuestring, "m") == 0 ? 1 : -1;
 }
 
+/* The CRS a file names, GeoJSON-2008 style ({"crs": {"type": "name",
+ * "properties": {"name": ...}}}) or as properties.crs (that object or a
+ * string), as the scene loader reads it; NULL when none. */
+static const char *file_crs(const cJSON *root)
+{
+    const cJSON *c = cJSON_GetObjectItemCaseSensitive(root, "crs"), *n;
+    if (!c)
+        c = cJSON_GetObjectItemCaseSensitive(cJSON_GetObjectItemCaseSensitive(root, "properties"), "crs");
+    if (cJSON_IsString(c))
+        return c->valuestring;
+    n = cJSON_GetObjectItemCaseSensitive(cJSON_GetObjectItemCaseSensitive(c, "properties"), "name");
+    return cJSON_IsString(n) ? n->valuestring : NULL;
+}
+
+/* A CRS the file names against the scene's: 0 when it names none, 1 when
+ * it names the scene's (either way of writing it) or WGS 84 for a lon/lat
+ * scene that names none; else -1 with why (a file tagged EPSG:2154 was
+ * scored on an EPSG:3067 scene without a word). */
+static int same_crs(const cJSON *root, plx_engine *e, const plx_scene_info *si, char *why, size_t whylen)
+{
+    const char *fc = file_crs(root), *sc = plx_scene_crs(e);
+    if (!fc)
+        return 0;
+    if (sc && cli_same_crs(fc, sc))
+        return 1;
+    if (!sc && si->lonlat && (strstr(fc, "CRS84") || cli_crs_epsg(fc) == 4326))
+        return 1;
+    snprintf(why, whylen, "the file's crs is %.60s but the scene's is %.60s: give the lines in the scene's "
+             "coordinates (ogr2ogr -t_srs reprojects them)", fc,
+             sc ? sc : si->lonlat ? "WGS84 lon/lat (none named)" : "local metres (none named)");
+    return -1;
+}
+
 static int set_frame(const cJSON *root, const cJSON *features, plx_engine *e, frame *f, char *note, size_t notelen,
                      char *why, size_t whylen)
 {
     const cJSON *props = cJSON_GetObjectItemCaseSensitive(root, "properties");
     const cJSON *units = cJSON_GetObjectItemCaseSensitive(props, "units"), *ft;
     plx_scene_info si;
-    int ll = 1, plain = 0, k = 0, lines = 0, lines_ll = 0;
+    int ll = 1, plain = 0, k = 0, lines = 0, lines_ll = 0, named;
     memset(f, 0, sizeof f[0]);
     note[0] = '\0';
     plx_scene_info_get(e, &si);
+    named = same_crs(root, e, &si, why, whylen);
+    if (named < 0)
+        return -1;
+    if (named && !si.lonlat) /* the scene's projected crs: metres, whatever their range */
+        return 0;
     if (units && !(cJSON_IsString(units) && strcmp(units->valuestring, "m") == 0)) {
         snprintf(why, whylen, "properties.units must be \"m\" when given");
         return -1;

@@ -177,6 +177,11 @@ g.get('properties', {}).pop('units', None)
 json.dump(g, open(sys.argv[1], 'w'))" "$tmp/e3067.geojson"
 expect crs-points-same-code 0 "^50 50 0 [0-9.e+-]+ 0$" -- sh -c "printf '# crs: EPSG:3067\n50 50\n' | '$bin' illum -q --no-indirect '$tmp/e3067.geojson' --points -"
 expect crs-points-other-code 1 "points crs 'EPSG:2154' is not lonlat, local or the scene's CRS" -- sh -c "printf '# crs: EPSG:2154\n50 50\n' | '$bin' illum -q --no-indirect '$tmp/e3067.geojson' --points -"
+# a route file's own crs: another one is refused (it was scored without a word); the scene's own reads as its metres
+printf '{"type":"FeatureCollection","crs":{"type":"name","properties":{"name":"urn:ogc:def:crs:EPSG::2154"}},"features":[{"type":"Feature","properties":{},"geometry":{"type":"LineString","coordinates":[[10,10],[50,10]]}}]}' >"$tmp/r2154.json"
+sed 's/2154/3067/' "$tmp/r2154.json" >"$tmp/r3067.json"
+expect crs-route-other 1 "r2154\.json: the file's crs is urn:ogc:def:crs:EPSG::2154 but the scene's is urn:ogc:def:crs:EPSG::3067" -- "$bin" route -q "$tmp/e3067.geojson" --path "$tmp/r2154.json"
+expect crs-route-same 0 "^#0 +all +40\.0 " -- "$bin" route -q "$tmp/e3067.geojson" --path "$tmp/r3067.json"
 # a scene mixing lon/lat and metres: the warning names the feature out of range (it named feature 0) and counts the rest
 printf '{"type":"FeatureCollection","features":[\n{"type":"Feature","properties":{"height":10},"geometry":{"type":"Polygon","coordinates":[[[24.94,60.17],[24.9401,60.17],[24.9401,60.1701],[24.94,60.1701],[24.94,60.17]]]}},\n{"type":"Feature","properties":{"highway":"street_lamp"},"geometry":{"type":"Point","coordinates":[385920,6672300]}}]}\n' >"$tmp/mixed.geojson"
 expect crs-mixed-names-feature 0 "warning: .*mixed\.geojson: feature 1 \(line 3, column 1\): coordinates exceed the lon/lat range .*; 1 of the 2 features lie wholly within it: if those are lon/lat, the file mixes coordinate systems" -- "$bin" info "$tmp/mixed.geojson"
