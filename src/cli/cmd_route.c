@@ -222,6 +222,55 @@ static int check_samples(const route_opts *o, const route_set *rs)
     return EXIT_OK;
 }
 
+/* The box of the scene's bounds and every lamp's reach: outside it nothing
+ * lights a route and nothing is known of the ground. */
+static void scene_reach(plx_engine *e, double b[4])
+{
+    plx_scene_info si;
+    plx_lamp l;
+    uint32_t i;
+    plx_scene_info_get(e, &si);
+    memcpy(b, si.bounds, 4 * sizeof b[0]);
+    for (i = 0; i < si.lamps; i++)
+        if (plx_lamp_get(e, i, &l) == PLX_OK) {
+            b[0] = fmin(b[0], l.x - l.radius);
+            b[1] = fmin(b[1], l.y - l.radius);
+            b[2] = fmax(b[2], l.x + l.radius);
+            b[3] = fmax(b[3], l.y + l.radius);
+        }
+}
+
+/* The metres of the polyline xy (n vertices) outside box b: each segment
+ * clipped to the box (Liang-Barsky), the rest summed. */
+static double outside_length(const double *xy, uint32_t n, const double b[4])
+{
+    double out = 0.0;
+    uint32_t k;
+    for (k = 0; k + 1 < n; k++) {
+        const double *p = xy + 2 * k, *q = p + 2;
+        double d[2] = { q[0] - p[0], q[1] - p[1] }, t0 = 0.0, t1 = 1.0, len = hypot(d[0], d[1]);
+        int c, ok = 1;
+        for (c = 0; c < 2 && ok; c++) {
+            double lo = b[c] - p[c], hi = b[c + 2] - p[c];
+            if (d[c] == 0.0) {
+                ok = lo <= 0.0 && hi >= 0.0;
+            } else {
+                double a = lo / d[c], z = hi / d[c];
+                if (a > z) {
+                    double t = a;
+                    a = z;
+                    z = t;
+                }
+                t0 = fmax(t0, a);
+                t1 = fmin(t1, z);
+                ok = t0 <= t1;
+            }
+        }
+        out += ok ? len * (1.0 - (t1 - t0)) : len;
+    }
+    return out;
+}
+
 static int score_all(plx_engine *e, const route_opts *o, route_set *rs)
 {
     geo_out g;
@@ -262,6 +311,15 @@ static int score_all(plx_engine *e, const route_opts *o, route_set *rs)
             break;
         }
         snprintf(name, sizeof name, "%s", l->name);
+        {
+            double b[4], far;
+            scene_reach(e, b);
+            far = outside_length(l->xy, l->n, b);
+            if (far > 1.0) /* helper-64: 2 km east of the district counted as measured dark metres */
+                cli_warn("route", &o->c, "%s: line %s runs %.1f m outside the scene (its buildings' box and 50 m, "
+                         "and every lamp's reach): no lamp and no building there, so those metres count as dark",
+                         o->path, l->name, far);
+        }
         if (tot.samples > 0 && !(tot.max > 0))
             cli_warn("route", &o->c, "%s: line %s is entirely dark (0 lx): %s", o->path, l->name,
                      cli_dark_reason(e));
