@@ -323,8 +323,16 @@ static int snap_end(const net_opts *o, plx_engine *e, const network *net, const 
     }
     net_snap_point(net, x, y, s);
     if (s->dist > o->snap) {
-        fprintf(stderr, "polarlux %s: %s %s is %.1f m from the nearest street of %s (more than --snap %g m)\n",
-                o->cmd, opt, val, s->dist, o->network, o->snap);
+        double a, b;
+        net_snap sw;
+        char swapped[64];
+        /* the two numbers the other way round near a street: likely lat,lon given for lon,lat */
+        int hint = sscanf(val, "%lf,%lf", &a, &b) == 2 && (snprintf(swapped, sizeof swapped, "%.10g,%.10g", b, a),
+                                                            parse_point(e, swapped, &x, &y) == 0) &&
+                   net_snap_point(net, x, y, &sw) == 0 && sw.dist <= o->snap;
+        fprintf(stderr, "polarlux %s: %s %s is %.1f m from the nearest street of %s (more than --snap %g m)%s%s%s\n",
+                o->cmd, opt, val, s->dist, o->network, o->snap, hint ? "; " : "", hint ? swapped : "",
+                hint ? " is on a street: lon and lat swapped?" : "");
         return EXIT_FAIL;
     }
     return EXIT_OK;

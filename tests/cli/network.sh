@@ -19,6 +19,7 @@ expect net-unreachable 1 "no path from --from 0,0 to --to 410,400: they lie on u
 # each end's part is measured, and a small one named (helper-64: a 42 m fragment 1.7 m away took the Helsinki route)
 expect net-unreachable-parts 1 "\(it has 2 parts\): --from snapped 0\.0 m to a part of [0-9]+ m of streets, --to 0\.0 m to one of [0-9]+ m" -- "$bin" route -q $net --from 0,0 --to 410,400
 expect net-unreachable-helsinki 1 "--from snapped 1\.7 m to a part of 42 m of streets, --to 1\.0 m to one of 98413 m \(the smaller is likely an isolated piece of the street data" -- "$bin" route -q fixtures/helsinki-centre.geojson --network fixtures/helsinki-streets.geojson --from 24.9438573,60.1716161 --to 24.9509247,60.1681328
+expect net-swapped-lonlat 1 "--from 60\.1677,24\.9443 is [0-9.]+ m from the nearest street .*; 24\.9443,60\.1677 is on a street: lon and lat swapped\?$" -- "$bin" route -q fixtures/helsinki-centre.geojson --network fixtures/helsinki-streets.geojson --from 60.1677,24.9443 --to 24.9509247,60.1681328
 printf '{"type":"FeatureCollection","properties":{"units":"m"},"features":[]}' >"$tmp/empty-net.json"
 expect net-empty 1 "route: $tmp/empty-net\.json: no LineString features" -- "$bin" route -q fixtures/net-detour.geojson --network "$tmp/empty-net.json" --from 0,0 --to 1,1
 expect net-missing-to 2 "--network needs --from X,Y and --to X,Y" -- "$bin" route -q $net --from 0,0
