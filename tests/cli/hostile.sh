@@ -330,7 +330,7 @@ expect render-nomem-street 3 "^polarlux render: out of memory while building the
 expect illum-nomem-photons 3 "^polarlux illum: out of memory while creating the photon buffers: [0-9]+ bytes at their lowest quality" -- illum -q $T --points "$tmp/p.txt" --mem 300K
 expect info-photons-default 0 "^photon buffers: [0-9]+ bytes \(default quality [0-9]+, budget [0-9]+\): 0 quality steps; facade charts 256x32, .*lamp ray tables on$" -- info -q --photons fixtures/helsinki-centre.geojson
 expect info-photons-reduced 0 "^photon buffers: [0-9]+ bytes \(default quality [0-9]+, budget [0-9]+\): [1-9][0-9]* quality steps; .*lamp ray tables off$" -- info -q --photons --mem 12M fixtures/helsinki-centre.geojson
-expect render-photons-reduced 0 "^polarlux render: indirect light at reduced quality to fit --mem: photon buffers" -- render -q fixtures/helsinki-centre.geojson --size 32x24 --frames 1 --photons 1000 --mem 12M -o "$tmp/r.png"
+expect render-photons-reduced 0 "^polarlux render: indirect light at reduced quality to fit --mem: photon buffers" -- render fixtures/helsinki-centre.geojson --size 32x24 --frames 1 --photons 1000 --mem 12M -o "$tmp/r.png"
 
 ls "$tmp"/*.tmp* >/dev/null 2>&1 && bad "temporary files left: $(ls "$tmp"/*.tmp*)"
 echo "hostile: $pass passed, $fail failed"

@@ -25,7 +25,7 @@ if [ $rc -eq 0 ] && grep -q "^polar diagrams: built" "$tmp/out" && grep -Eq "^ph
     ok "info-photons-$MEM: $(grep '^photon buffers' "$tmp/out")"
 else bad "info-photons-$MEM: exit $rc"; fi
 # a street frame with indirect light (the default street view searches with visibility queries)
-"$bin" render -q --mem $MEM --size 640x480 "$tmp/city.geojson" -o "$tmp/street.png" >"$tmp/out" 2>"$tmp/err"; rc=$?
+"$bin" render --mem $MEM --size 640x480 "$tmp/city.geojson" -o "$tmp/street.png" >"$tmp/out" 2>"$tmp/err"; rc=$?
 if [ $rc -eq 0 ] && [ -s "$tmp/street.png" ] && grep -q "indirect light at reduced quality to fit --mem" "$tmp/err"; then
     ok "render-street-640x480-$MEM"
 else bad "render-street-640x480-$MEM: exit $rc"; fi
@@ -35,7 +35,7 @@ if [ $rc -eq 0 ] && [ -s "$tmp/walk/frame-0005.png" ] && grep -q "^walk: 5 frame
     ok "walk-640x480-$MEM: $(grep '^frame time' "$tmp/out")"
 else bad "walk-640x480-$MEM: exit $rc"; fi
 # the issue's 32M
-"$bin" walk -q --mem 32M --aa 1 --max-frames 5 "$tmp/city.geojson" --path "$tmp/path.geojson" -o "$tmp/walk32" >"$tmp/out" 2>"$tmp/err"; rc=$?
+"$bin" walk --mem 32M --aa 1 --max-frames 5 "$tmp/city.geojson" --path "$tmp/path.geojson" -o "$tmp/walk32" >"$tmp/out" 2>"$tmp/err"; rc=$?
 if [ $rc -eq 0 ] && [ -s "$tmp/walk32/frame-0005.png" ] && grep -q "^walk: 5 frames 640x480" "$tmp/out"; then
     ok "walk-640x480-32M: $(grep '^frame time' "$tmp/out")"
 else bad "walk-640x480-32M: exit $rc"; fi
@@ -48,7 +48,7 @@ else bad "walk-32M-smaller-sheet"; fi
 "$bin" bake -q --mem 32M --no-polar --no-aerial --max-size 640x480 "$tmp/city.geojson" -o "$tmp/k.plxb" >"$tmp/out" 2>"$tmp/err"; rc=$?
 if [ $rc -eq 0 ] && [ -s "$tmp/k.plxb" ]; then ok "bake-32M: $(grep '^baked' "$tmp/out" | sed 's/.*: //')"
 else bad "bake-32M: exit $rc"; fi
-"$bin" walk -q --mem 32M --aa 1 --max-frames 5 "$tmp/k.plxb" --path "$tmp/path.geojson" -o "$tmp/walkk" >"$tmp/out" 2>"$tmp/err"; rc=$?
+"$bin" walk --mem 32M --aa 1 --max-frames 5 "$tmp/k.plxb" --path "$tmp/path.geojson" -o "$tmp/walkk" >"$tmp/out" 2>"$tmp/err"; rc=$?
 if [ $rc -eq 0 ] && [ -s "$tmp/walkk/frame-0005.png" ] && grep -q "^walk: 5 frames 640x480" "$tmp/out"; then
     ok "walk-bake-640x480-32M: $(grep '^frame time' "$tmp/out")"
 else bad "walk-bake-640x480-32M: exit $rc"; fi
